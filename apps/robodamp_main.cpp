@@ -1,0 +1,83 @@
+// robodamp: active vibration damping for robotic milling. Subcommands are thin: they parse, call the
+// libraries and print.
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "apps/filters_command.hpp"
+#include "config/config.hpp"
+#include "control/chain_design.hpp"
+
+namespace {
+
+using robodamp::config::ConfigError;
+
+// Parses and designs; prints every problem and returns false if there are any.
+bool load_design(const std::string& path, robodamp::control::ChainDesign& out) {
+  try {
+    out = robodamp::control::design_chain(robodamp::config::load_config_file(path));
+    return true;
+  } catch (const ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return false;
+  }
+}
+
+int run_filters(const std::string& path, double freq_hz, bool json, const std::string& plot) {
+  robodamp::control::ChainDesign d;
+  if (!load_design(path, d)) return 2;
+  if (!(freq_hz > 0.0 && freq_hz < 0.5 * d.params.fs_hz)) {
+    std::cerr << "--freq " << freq_hz << " Hz: allowed 0 < value < " << 0.5 * d.params.fs_hz
+              << " Hz (below Nyquist of loop.rate_hz)\n";
+    return 2;
+  }
+  const auto report = robodamp::apps::filters_report(d, freq_hz);
+  if (json)
+    std::cout << report.dump(2) << '\n';
+  else
+    std::cout << robodamp::apps::filters_table(report);
+  if (!plot.empty()) {
+    if (const std::string err = robodamp::apps::plot_filters(d, plot); !err.empty()) {
+      std::cerr << "plot: " << err << '\n';
+      return 1;
+    }
+    (json ? std::cerr : std::cout) << "wrote " << plot << '\n';
+  }
+  return 0;
+}
+
+int run_check_config(const std::string& path) {
+  robodamp::control::ChainDesign d;
+  if (!load_design(path, d)) return 2;
+  std::cout << path << ": OK (" << d.blocks.size() << " blocks, " << d.params.sections.count
+            << " second-order sections at " << d.params.fs_hz << " Hz)\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"robodamp: real-time active vibration damping for robotic milling"};
+  app.require_subcommand(1);
+
+  std::string config_path = ROBODAMP_DEFAULT_CONFIG;
+  double freq_hz = 9.2;
+  bool json = false;
+  std::string plot;
+  auto* filters = app.add_subcommand("filters", "Magnitude and phase of each block and the chain, analog and digital");
+  filters->add_option("--config", config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  filters->add_option("--freq", freq_hz, "Frequency in Hz")->capture_default_str();
+  filters->add_flag("--json", json, "Print JSON instead of a table");
+  filters->add_option("--plot", plot, "Write a Bode diagram of the blocks and the chain (PNG)");
+
+  std::string check_path;
+  auto* check = app.add_subcommand("check-config", "Validate a configuration and report every problem at once");
+  check->add_option("file", check_path, "Configuration file (YAML)")->required();
+
+  CLI11_PARSE(app, argc, argv);
+  if (filters->parsed()) return run_filters(config_path, freq_hz, json, plot);
+  if (check->parsed()) return run_check_config(check_path);
+  return 1;
+}

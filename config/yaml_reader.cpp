@@ -1,0 +1,173 @@
+#include "config/yaml_reader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace robodamp::config::detail {
+
+SourceMark to_mark(const YAML::Mark& m) {
+  if (m.is_null()) return {};
+  return {m.line + 1, m.column + 1};  // yaml-cpp marks are 0-based
+}
+
+std::string format_number(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+void Diagnostics::add(const YAML::Mark& mark, std::string key, std::string message) {
+  add(to_mark(mark), std::move(key), std::move(message));
+}
+
+void Diagnostics::add(SourceMark mark, std::string key, std::string message) {
+  problems_.push_back({file_, mark, std::move(key), std::move(message)});
+}
+
+namespace {
+
+std::string describe_range(const Range& r) {
+  std::ostringstream os;
+  os << "allowed " << format_number(r.min) << (r.min_open ? " < " : " <= ") << "value"
+     << (r.max_open ? " < " : " <= ") << format_number(r.max) << ' ' << r.unit;
+  if (!r.note.empty()) os << " (" << r.note << ')';
+  return os.str();
+}
+
+bool in_range(double v, const Range& r) {
+  const bool lo = r.min_open ? v > r.min : v >= r.min;
+  const bool hi = r.max_open ? v < r.max : v <= r.max;
+  return lo && hi;
+}
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+}  // namespace
+
+MapReader::MapReader(Diagnostics& d, const YAML::Node& node, std::string path, const YAML::Mark& parent_mark)
+    : d_(d), node_(node), path_(std::move(path)), mark_(node.IsDefined() ? node.Mark() : parent_mark) {
+  if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap()) {
+    d_.add(node_.Mark(), path_, "expected a map of keys, found " +
+                                    std::string(node_.IsSequence() ? "a list" : "a single value"));
+    node_ = YAML::Node();
+  }
+}
+
+YAML::Node MapReader::lookup(const std::string& key) {
+  known_.push_back(key);
+  if (!node_.IsDefined() || !node_.IsMap()) return YAML::Node();
+  for (auto it = node_.begin(); it != node_.end(); ++it)
+    if (it->first.IsScalar() && it->first.Scalar() == key) return it->second;
+  return YAML::Node();
+}
+
+YAML::Node MapReader::child(const std::string& key, bool required, std::string_view what) {
+  YAML::Node n = lookup(key);
+  if (required && (!n.IsDefined() || n.IsNull()))
+    d_.add(mark_, path_of(key), "missing (required: " + std::string(what) + ")");
+  return n;
+}
+
+std::optional<double> MapReader::number(const std::string& key, const Range& range,
+                                        std::optional<double> default_value) {
+  const YAML::Node n = lookup(key);
+  const std::string k = path_of(key);
+  if (!n.IsDefined() || n.IsNull()) {
+    if (default_value) return default_value;
+    d_.add(mark_, k, "missing (required: a number in " + std::string(range.unit) + ", " + describe_range(range) + ")");
+    return std::nullopt;
+  }
+  double v = 0.0;
+  if (!n.IsScalar() || !YAML::convert<double>::decode(n, v)) {
+    d_.add(n.Mark(), k,
+           "= '" + (n.IsScalar() ? n.Scalar() : std::string("<not a scalar>")) + "' is not a number (" +
+               std::string(range.unit) + ", " + describe_range(range) + ")");
+    return std::nullopt;
+  }
+  if (!std::isfinite(v) || !in_range(v, range)) {
+    d_.add(n.Mark(), k,
+           "= " + format_number(v) + ' ' + std::string(range.unit) + " is out of range: " + describe_range(range));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<std::string> MapReader::choice(const std::string& key, const std::vector<std::string>& allowed,
+                                             std::optional<std::string> default_value) {
+  const YAML::Node n = lookup(key);
+  const std::string k = path_of(key);
+  if (!n.IsDefined() || n.IsNull()) {
+    if (default_value) return default_value;
+    d_.add(mark_, k, "missing (required: one of " + joined(allowed) + ")");
+    return std::nullopt;
+  }
+  if (!n.IsScalar() || std::find(allowed.begin(), allowed.end(), n.Scalar()) == allowed.end()) {
+    d_.add(n.Mark(), k, "= '" + (n.IsScalar() ? n.Scalar() : std::string("<not a scalar>")) +
+                            "' is not allowed: one of " + joined(allowed));
+    return std::nullopt;
+  }
+  return n.Scalar();
+}
+
+std::optional<std::string> MapReader::text(const std::string& key, std::optional<std::string> default_value) {
+  const YAML::Node n = lookup(key);
+  if (!n.IsDefined() || n.IsNull()) {
+    if (!default_value) d_.add(mark_, path_of(key), "missing (required: a name)");
+    return default_value;
+  }
+  if (!n.IsScalar() || n.Scalar().empty()) {
+    d_.add(n.Mark(), path_of(key), "must be a non-empty text");
+    return std::nullopt;
+  }
+  return n.Scalar();
+}
+
+std::optional<std::vector<double>> MapReader::number_list(const std::string& key, std::string_view unit) {
+  const YAML::Node n = lookup(key);
+  const std::string k = path_of(key);
+  if (!n.IsDefined() || n.IsNull()) {
+    d_.add(mark_, k, "missing (required: a list of finite numbers, " + std::string(unit) + ")");
+    return std::nullopt;
+  }
+  if (!n.IsSequence() || n.size() == 0) {
+    d_.add(n.Mark(), k, "must be a non-empty list of finite numbers (" + std::string(unit) + ")");
+    return std::nullopt;
+  }
+  std::vector<double> out;
+  bool ok = true;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    double v = 0.0;
+    const YAML::Node e = n[i];
+    if (!e.IsScalar() || !YAML::convert<double>::decode(e, v) || !std::isfinite(v)) {
+      d_.add(e.Mark(), k + "[" + std::to_string(i) + "]",
+             "= '" + (e.IsScalar() ? e.Scalar() : std::string("<not a scalar>")) + "' is not a finite number (" +
+                 std::string(unit) + ")");
+      ok = false;
+    }
+    out.push_back(v);
+  }
+  return ok ? std::optional(out) : std::nullopt;
+}
+
+void MapReader::finish() {
+  if (!node_.IsDefined() || !node_.IsMap()) return;
+  std::map<std::string, int> seen;
+  std::vector<std::string> allowed = known_;
+  std::sort(allowed.begin(), allowed.end());
+  allowed.erase(std::unique(allowed.begin(), allowed.end()), allowed.end());
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const std::string key = it->first.IsScalar() ? it->first.Scalar() : std::string("<complex key>");
+    if (++seen[key] == 2) d_.add(it->first.Mark(), path_of(key), "duplicate key (YAML would silently keep one)");
+    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+      d_.add(it->first.Mark(), path_of(key), "unknown key; allowed here: " + joined(allowed));
+  }
+}
+
+}  // namespace robodamp::config::detail

@@ -1,0 +1,72 @@
+// Checked reading of YAML maps: every key consumed, every value range-checked with its unit, every
+// problem collected with its source position. Internal to the config library.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "config/config.hpp"
+
+namespace robodamp::config::detail {
+
+class Diagnostics {
+ public:
+  explicit Diagnostics(std::string file) : file_(std::move(file)) {}
+  void add(const YAML::Mark& mark, std::string key, std::string message);
+  void add(SourceMark mark, std::string key, std::string message);
+  [[nodiscard]] const std::vector<Problem>& problems() const { return problems_; }
+  [[nodiscard]] const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  std::vector<Problem> problems_;
+};
+
+// Allowed interval of a number; an open end excludes the bound itself.
+struct Range {
+  std::string_view unit;
+  double min;
+  double max;
+  bool min_open{false};
+  bool max_open{false};
+  std::string note{};  // why the bound, e.g. "Nyquist of loop.rate_hz = 5000 Hz"
+};
+
+[[nodiscard]] SourceMark to_mark(const YAML::Mark& m);
+[[nodiscard]] std::string format_number(double v);
+
+class MapReader {
+ public:
+  // node must be a map (an absent node reads as empty so that required keys are reported one by one).
+  MapReader(Diagnostics& d, const YAML::Node& node, std::string path, const YAML::Mark& parent_mark);
+
+  [[nodiscard]] std::optional<double> number(const std::string& key, const Range& range,
+                                             std::optional<double> default_value = std::nullopt);
+  [[nodiscard]] std::optional<std::string> choice(const std::string& key, const std::vector<std::string>& allowed,
+                                                  std::optional<std::string> default_value = std::nullopt);
+  // Any non-empty string.
+  [[nodiscard]] std::optional<std::string> text(const std::string& key, std::optional<std::string> default_value);
+  [[nodiscard]] std::optional<std::vector<double>> number_list(const std::string& key, std::string_view unit);
+  // The raw child (an undefined node if absent), for nested maps and sequences.
+  [[nodiscard]] YAML::Node child(const std::string& key, bool required, std::string_view what);
+  // Reports keys that were never asked for, and duplicates.
+  void finish();
+
+  [[nodiscard]] std::string path_of(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  [[nodiscard]] YAML::Mark mark() const { return mark_; }
+  [[nodiscard]] Diagnostics& diagnostics() { return d_; }
+
+ private:
+  YAML::Node lookup(const std::string& key);
+  Diagnostics& d_;
+  YAML::Node node_;
+  std::string path_;
+  YAML::Mark mark_;
+  std::vector<std::string> known_;
+};
+
+}  // namespace robodamp::config::detail

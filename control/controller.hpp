@@ -1,0 +1,158 @@
+// The DVF controller (Eq. 8): accelerometer samples in, amplifier volts out. No clock, no I/O; every
+// member after construction is RT-safe: no allocation, locking, exceptions or logging.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "control/controller_params.hpp"
+#include "filters/biquad.hpp"
+
+namespace robodamp::control {
+
+struct ControllerCounters {
+  std::uint64_t samples{0};
+  std::uint64_t nonfinite_inputs{0};      // never entered the filter state
+  std::uint64_t filter_state_resets{0};   // non-finite filter output (overflow), state cleared
+  std::uint64_t force_limited{0};         // command force clipped at the actuator force limit
+  std::uint64_t voltage_limited{0};       // clipped at the amplifier voltage range
+  std::uint64_t slew_limited{0};          // clipped at the slew-rate limit
+  std::uint64_t rejected_requests{0};     // gain or parameter requests refused (out of range, other rate)
+};
+
+enum class RequestStatus { kAccepted, kRejectedOutOfRange, kRejectedSampleRate };
+
+// Largest K a request may ask for; the configuration enforces the same bound.
+inline constexpr double kMaxGainNsPerM = 1e5;
+
+class Controller final {
+ public:
+  explicit Controller(const ControllerParams& p) noexcept
+      : p_(p), cascade_(p.sections), dt_s_(1.0 / p.fs_hz) {
+    target_gain_ = p.gain_ns_per_m;
+    scale_ = target_scale_ = output_scale(p_, target_gain_);
+  }
+
+  // RT-safe. One loop sample: acceleration at the actuator location (m/s^2) -> amplifier command (V).
+  [[nodiscard]] double update(double accel_mps2) noexcept {
+    ++counters_.samples;
+    const double shaped = cascade_.process(accel_mps2);
+    advance_ramp();
+    double force_n = scale_ * shaped;  // polarity * K * chain(accel), newtons
+    if (std::abs(force_n) > p_.force_limit_n) {
+      force_n = std::copysign(p_.force_limit_n, force_n);
+      ++counters_.force_limited;
+    }
+    double volts = force_n / p_.actuator_constant_n_per_v;
+    if (std::abs(volts) > p_.voltage_limit_v) {
+      volts = std::copysign(p_.voltage_limit_v, volts);
+      ++counters_.voltage_limited;
+    }
+    const double max_step_v = p_.slew_rate_v_per_s * dt_s_;
+    if (std::abs(volts - command_v_) > max_step_v) {
+      volts = command_v_ + std::copysign(max_step_v, volts - command_v_);
+      ++counters_.slew_limited;
+    }
+    command_v_ = volts;
+    force_n_ = force_n;
+    return volts;
+  }
+
+  // RT-safe. Filter states at steady state for a constant input; the command restarts from there
+  // (zero for a chain with a high-pass), without a slew transient.
+  void reset(double accel_mps2) noexcept {
+    cascade_.reset(accel_mps2);
+    const double f = scale_ * cascade_.last_output();
+    force_n_ = std::copysign(std::min(std::abs(f), p_.force_limit_n), f);
+    command_v_ = std::copysign(std::min(std::abs(force_n_ / p_.actuator_constant_n_per_v), p_.voltage_limit_v), f);
+  }
+
+  // RT-safe. Ramps K to the new value over the configured ramp time; refuses what the configuration
+  // would refuse.
+  [[nodiscard]] RequestStatus set_gain(double gain_ns_per_m) noexcept {
+    if (!std::isfinite(gain_ns_per_m) || gain_ns_per_m < 0.0 || gain_ns_per_m > kMaxGainNsPerM) {
+      ++counters_.rejected_requests;
+      return RequestStatus::kRejectedOutOfRange;
+    }
+    target_gain_ = gain_ns_per_m;
+    if (!pending_) start_ramp(output_scale(p_, target_gain_));
+    return RequestStatus::kAccepted;
+  }
+
+  // RT-safe (copies a fixed-size struct). Hands over to a new parameter set at cycle boundaries: the
+  // output fades to zero, the sections are swapped (signal history kept, so the filters do not
+  // restart), then the output fades in with the new polarity, gain and limits.
+  [[nodiscard]] RequestStatus request_params(const ControllerParams& next) noexcept {
+    if (next.fs_hz != p_.fs_hz) {
+      ++counters_.rejected_requests;
+      return RequestStatus::kRejectedSampleRate;
+    }
+    if (!std::isfinite(next.gain_ns_per_m) || next.gain_ns_per_m < 0.0 || next.gain_ns_per_m > kMaxGainNsPerM ||
+        next.sections.count > filters::kMaxSections) {
+      ++counters_.rejected_requests;
+      return RequestStatus::kRejectedOutOfRange;
+    }
+    next_ = next;
+    pending_ = true;
+    target_gain_ = next.gain_ns_per_m;
+    start_ramp(0.0);
+    return RequestStatus::kAccepted;
+  }
+
+  [[nodiscard]] const ControllerCounters& counters() const noexcept {
+    counters_.nonfinite_inputs = cascade_.nonfinite_input_count();
+    counters_.filter_state_resets = cascade_.state_reset_count();
+    return counters_;
+  }
+  // Current (ramping) K.
+  [[nodiscard]] double gain_ns_per_m() const noexcept { return scale_ / (p_.polarity * p_.sections_gain); }
+  [[nodiscard]] double target_gain_ns_per_m() const noexcept { return target_gain_; }
+  [[nodiscard]] bool handover_pending() const noexcept { return pending_; }
+  [[nodiscard]] double command_v() const noexcept { return command_v_; }
+  [[nodiscard]] double force_command_n() const noexcept { return force_n_; }
+  [[nodiscard]] const ControllerParams& params() const noexcept { return p_; }
+
+ private:
+  static double output_scale(const ControllerParams& p, double gain) noexcept {
+    return p.polarity * gain * p.sections_gain;
+  }
+
+  void start_ramp(double target_scale) noexcept {
+    target_scale_ = target_scale;
+    const double n = std::ceil(p_.gain_ramp_s * p_.fs_hz);
+    ramp_left_ = n >= 1.0 ? static_cast<std::uint64_t>(n) : 0;
+    ramp_step_ = ramp_left_ > 0 ? (target_scale_ - scale_) / static_cast<double>(ramp_left_) : 0.0;
+    if (ramp_left_ == 0) finish_ramp();
+  }
+
+  void advance_ramp() noexcept {
+    if (ramp_left_ == 0) return;
+    scale_ += ramp_step_;
+    if (--ramp_left_ == 0) finish_ramp();
+  }
+
+  void finish_ramp() noexcept {
+    scale_ = target_scale_;
+    if (pending_) {  // faded out: hand over, then fade in
+      pending_ = false;
+      cascade_.swap_coefficients(next_.sections);
+      p_ = next_;
+      dt_s_ = 1.0 / p_.fs_hz;
+      start_ramp(output_scale(p_, target_gain_));
+    }
+  }
+
+  ControllerParams p_;
+  ControllerParams next_{};
+  filters::BiquadCascade cascade_;
+  double dt_s_;
+  double target_gain_{0.0};
+  double scale_{0.0}, target_scale_{0.0}, ramp_step_{0.0};
+  std::uint64_t ramp_left_{0};
+  bool pending_{false};
+  double command_v_{0.0};
+  double force_n_{0.0};
+  mutable ControllerCounters counters_{};
+};
+
+}  // namespace robodamp::control
