@@ -19,7 +19,7 @@ std::string Problem::to_string() const {
   std::ostringstream os;
   os << file;
   if (mark.line > 0) os << ':' << mark.line << ':' << mark.column;
-  os << ": " << key << ": " << message;
+  os << ": " << key << (message.rfind("= ", 0) == 0 ? " " : ": ") << message;
   return os.str();
 }
 
@@ -116,10 +116,7 @@ std::optional<BlockConfig> read_block(Diagnostics& d, const YAML::Node& node, co
   const auto kind = r.choice("kind", {"lowpass2", "highpass2", "notch", "integrator", "compensator"});
   b.name = r.text("name", std::string()).value_or("");
   if (auto p = r.number("prewarp_hz", below_nyquist(rate), -1.0); p && *p >= 0.0) b.prewarp_hz = *p;
-  if (!kind) {
-    r.finish();
-    return std::nullopt;
-  }
+  if (!kind) return std::nullopt;  // its other keys cannot be judged without a kind
   if (*kind == "lowpass2" || *kind == "highpass2") {
     b.kind = *kind == "lowpass2" ? BlockKind::kLowpass2 : BlockKind::kHighpass2;
     if (auto v = r.number("cutoff_hz", below_nyquist(rate))) b.cutoff_hz = *v;
@@ -185,6 +182,11 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
       for (std::size_t i = 0; i < chain.size(); ++i) {
         const std::string key = "controller.chain[" + std::to_string(i) + "]";
         auto b = read_block(d, chain[i], key, rate);
+        // Count kinds from the text, so a block with a bad value is not also reported as missing.
+        for (int k = 0; k < 5; ++k)
+          if (chain[i].IsMap() && chain[i]["kind"].IsScalar() &&
+              chain[i]["kind"].Scalar() == to_string(static_cast<BlockKind>(k)) && !b)
+            ++counts[k];
         if (!b) continue;
         const int n = ++counts[static_cast<int>(b->kind)];
         if (b->name.empty()) b->name = std::string(to_string(b->kind)) + (n > 1 ? "_" + std::to_string(n) : "");

@@ -58,6 +58,7 @@ MapReader::MapReader(Diagnostics& d, const YAML::Node& node, std::string path, c
                                     std::string(node_.IsSequence() ? "a list" : "a single value"));
     node_ = YAML::Node();
   }
+  quiet_ = !node_.IsDefined() || !node_.IsMap();
 }
 
 YAML::Node MapReader::lookup(const std::string& key) {
@@ -70,7 +71,7 @@ YAML::Node MapReader::lookup(const std::string& key) {
 
 YAML::Node MapReader::child(const std::string& key, bool required, std::string_view what) {
   YAML::Node n = lookup(key);
-  if (required && (!n.IsDefined() || n.IsNull()))
+  if (required && !quiet_ && (!n.IsDefined() || n.IsNull()))
     d_.add(mark_, path_of(key), "missing (required: " + std::string(what) + ")");
   return n;
 }
@@ -80,7 +81,7 @@ std::optional<double> MapReader::number(const std::string& key, const Range& ran
   const YAML::Node n = lookup(key);
   const std::string k = path_of(key);
   if (!n.IsDefined() || n.IsNull()) {
-    if (default_value) return default_value;
+    if (default_value || quiet_) return default_value;
     d_.add(mark_, k, "missing (required: a number in " + std::string(range.unit) + ", " + describe_range(range) + ")");
     return std::nullopt;
   }
@@ -104,7 +105,7 @@ std::optional<std::string> MapReader::choice(const std::string& key, const std::
   const YAML::Node n = lookup(key);
   const std::string k = path_of(key);
   if (!n.IsDefined() || n.IsNull()) {
-    if (default_value) return default_value;
+    if (default_value || quiet_) return default_value;
     d_.add(mark_, k, "missing (required: one of " + joined(allowed) + ")");
     return std::nullopt;
   }
@@ -119,7 +120,7 @@ std::optional<std::string> MapReader::choice(const std::string& key, const std::
 std::optional<std::string> MapReader::text(const std::string& key, std::optional<std::string> default_value) {
   const YAML::Node n = lookup(key);
   if (!n.IsDefined() || n.IsNull()) {
-    if (!default_value) d_.add(mark_, path_of(key), "missing (required: a name)");
+    if (!default_value && !quiet_) d_.add(mark_, path_of(key), "missing (required: a name)");
     return default_value;
   }
   if (!n.IsScalar() || n.Scalar().empty()) {
@@ -133,7 +134,7 @@ std::optional<std::vector<double>> MapReader::number_list(const std::string& key
   const YAML::Node n = lookup(key);
   const std::string k = path_of(key);
   if (!n.IsDefined() || n.IsNull()) {
-    d_.add(mark_, k, "missing (required: a list of finite numbers, " + std::string(unit) + ")");
+    if (!quiet_) d_.add(mark_, k, "missing (required: a list of finite numbers, " + std::string(unit) + ")");
     return std::nullopt;
   }
   if (!n.IsSequence() || n.size() == 0) {

@@ -41,7 +41,8 @@ struct Range {
 
 class MapReader {
  public:
-  // node must be a map (an absent node reads as empty so that required keys are reported one by one).
+  // node must be a map. An absent or wrongly shaped node has been reported once (by the parent or
+  // here): reading from it then reports nothing more and gives the defaults.
   MapReader(Diagnostics& d, const YAML::Node& node, std::string path, const YAML::Mark& parent_mark);
 
   [[nodiscard]] std::optional<double> number(const std::string& key, const Range& range,
@@ -67,6 +68,7 @@ class MapReader {
   std::string path_;
   YAML::Mark mark_;
   std::vector<std::string> known_;
+  bool quiet_{false};
 };
 
 }  // namespace robodamp::config::detail

@@ -37,6 +37,7 @@ class Controller final {
   [[nodiscard]] double update(double accel_mps2) noexcept {
     ++counters_.samples;
     const double shaped = cascade_.process(accel_mps2);
+    if (pending_) (void)shadow_.process(accel_mps2);  // the incoming chain warms up on the same signal
     advance_ramp();
     double force_n = scale_ * shaped;  // polarity * K * chain(accel), newtons
     if (std::abs(force_n) > p_.force_limit_n) {
@@ -79,9 +80,10 @@ class Controller final {
     return RequestStatus::kAccepted;
   }
 
-  // RT-safe (copies a fixed-size struct). Hands over to a new parameter set at cycle boundaries: the
-  // output fades to zero, the sections are swapped (signal history kept, so the filters do not
-  // restart), then the output fades in with the new polarity, gain and limits.
+  // RT-safe (copies fixed-size structs). Hands over to a new parameter set at cycle boundaries: the
+  // incoming chain starts from the running chain's signal history (sections shared by both chains
+  // carry over exactly) and runs in the shadow on the same samples while the output fades to zero;
+  // then it takes over and the output fades in with the new polarity, gain and limits.
   [[nodiscard]] RequestStatus request_params(const ControllerParams& next) noexcept {
     if (next.fs_hz != p_.fs_hz) {
       ++counters_.rejected_requests;
@@ -93,6 +95,8 @@ class Controller final {
       return RequestStatus::kRejectedOutOfRange;
     }
     next_ = next;
+    shadow_ = cascade_;
+    shadow_.swap_coefficients(next.sections);
     pending_ = true;
     target_gain_ = next.gain_ns_per_m;
     start_ramp(0.0);
@@ -135,7 +139,7 @@ class Controller final {
     scale_ = target_scale_;
     if (pending_) {  // faded out: hand over, then fade in
       pending_ = false;
-      cascade_.swap_coefficients(next_.sections);
+      cascade_ = shadow_;
       p_ = next_;
       dt_s_ = 1.0 / p_.fs_hz;
       start_ramp(output_scale(p_, target_gain_));
@@ -145,6 +149,7 @@ class Controller final {
   ControllerParams p_;
   ControllerParams next_{};
   filters::BiquadCascade cascade_;
+  filters::BiquadCascade shadow_;
   double dt_s_;
   double target_gain_{0.0};
   double scale_{0.0}, target_scale_{0.0}, ramp_step_{0.0};

@@ -1,0 +1,107 @@
+// The robodamp executable as an engineer runs it: filters (table, JSON, plot) and check-config.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include "test_util.hpp"
+
+namespace {
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(ROBODAMP_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int rc = pclose(p);
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("robodamp-test-" + std::to_string(getpid()) + "-" + name)).string();
+}
+
+TEST(Cli, FiltersJsonHasTheDocumentedShape) {
+  const Result r = run("filters --config " + robodamp::test::preset("horizontal_c1") + " --freq 9.2 --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["fs_hz"], 5000.0);
+  EXPECT_EQ(j["freq_hz"], 9.2);
+  const std::set<std::string> kinds = {"lowpass2", "highpass2", "notch", "integrator", "gain", "compensator"};
+  bool found_c1 = false;
+  for (const auto& b : j["blocks"]) {
+    EXPECT_TRUE(kinds.count(b["kind"].get<std::string>())) << b["kind"];
+    for (const char* side : {"analog", "digital"}) {
+      EXPECT_TRUE(b[side]["mag_db"].is_number());
+      EXPECT_TRUE(b[side]["phase_deg"].is_number());
+    }
+    if (b["kind"] == "compensator") {
+      found_c1 = true;
+      EXPECT_NEAR(b["analog"]["phase_deg"].get<double>(), -75.44, 0.01);
+      EXPECT_NEAR(b["digital"]["phase_deg"].get<double>(), -75.44, 0.05);
+    }
+  }
+  EXPECT_TRUE(found_c1);
+  EXPECT_TRUE(j["chain"]["analog"]["mag_db"].is_number());
+  EXPECT_NEAR(j["chain"]["digital"]["phase_deg"].get<double>(), j["chain"]["analog"]["phase_deg"].get<double>(), 0.1);
+}
+
+TEST(Cli, FiltersTableByDefaultAndFrequencyChecked) {
+  const Result r = run("filters --freq 21");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("horizontal_c2.yaml"), std::string::npos);
+  EXPECT_NE(r.out.find("chain"), std::string::npos);
+  const Result bad = run("filters --freq 3000");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.out.find("below Nyquist"), std::string::npos) << bad.out;
+}
+
+TEST(Cli, FiltersPlotWritesAPng) {
+  const std::string png = temp_path("bode.png");
+  const Result r = run("filters --freq 9.2 --plot " + png);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream in(png, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, 8);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  EXPECT_GT(std::filesystem::file_size(png), 10000U);
+  std::filesystem::remove(png);
+}
+
+TEST(Cli, CheckConfigAcceptsEveryPreset) {
+  for (const char* p : {"horizontal_c2", "horizontal_c1", "horizontal_c3", "vertical_c1"}) {
+    const Result r = run("check-config " + robodamp::test::preset(p));
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find(": OK"), std::string::npos) << r.out;
+  }
+}
+
+TEST(Cli, CheckConfigReportsAllProblemsAtOnce) {
+  std::ifstream in(robodamp::test::preset("horizontal_c2"));
+  std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  s.replace(s.find("rate_hz: 5000"), 13, "rate_hz: 50000");
+  s.replace(s.find("cutoff_hz: 4,"), 13, "cutoff_hz: 0,");
+  s.replace(s.find("force_limit_n: 36"), 17, "force_limt_n: 36");
+  const std::string path = temp_path("bad.yaml");
+  std::ofstream(path) << s;
+  const Result r = run("check-config " + path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("4 configuration problem(s)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("loop.rate_hz = 50000 Hz is out of range: allowed 1000 <= value <= 20000 Hz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("controller.chain[3].cutoff_hz = 0 Hz is out of range"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("actuator.force_limt_n: unknown key"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("actuator.force_limit_n: missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bad.yaml:4:"), std::string::npos) << r.out;  // the rate's line
+}
+
+}  // namespace

@@ -1,0 +1,264 @@
+// Configuration: presets load, and every error path names file, line, key, value, unit and range.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+
+#include "config/config.hpp"
+#include "control/chain_design.hpp"
+#include "test_util.hpp"
+
+namespace robodamp::config {
+namespace {
+
+const char* kValid = R"(loop:
+  rate_hz: 5000
+actuator:
+  mounting: horizontal
+  constant_n_per_v: 4.8
+  natural_freq_hz: 9.0
+  damping_ratio: 0.15
+  delay_s: 0.0006
+  force_limit_n: 36
+amplifier:
+  voltage_limit_v: 10
+  slew_rate_v_per_s: 20000
+controller:
+  gain_ns_per_m: 2000
+  polarity: 1
+  match_freq_hz: 9.2
+  chain:
+    - {kind: lowpass2, cutoff_hz: 50, damping_ratio: 0.707}
+    - {kind: integrator}
+    - {kind: highpass2, cutoff_hz: 4}
+    - {kind: notch, center_hz: 3, bandwidth_hz: 4}
+    - {kind: compensator, model: c2}
+)";
+
+// Replaces the first occurrence of `from` in the valid file.
+std::string edited(const std::string& from, const std::string& to) {
+  std::string s = kValid;
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return s.replace(pos, from.size(), to);
+}
+
+std::vector<Problem> problems_of(const std::string& yaml) {
+  try {
+    (void)control::design_chain(parse_config(yaml, "bad.yaml"));
+  } catch (const ConfigError& e) {
+    return e.problems();
+  }
+  return {};
+}
+
+std::string only_problem(const std::string& yaml) {
+  const auto p = problems_of(yaml);
+  std::string all;
+  for (const auto& q : p) all += q.to_string() + "\n";
+  EXPECT_EQ(p.size(), 1U) << all;
+  return all;
+}
+
+TEST(Config, AllPresetsLoadAndDesign) {
+  for (const char* name : {"horizontal_c2", "horizontal_c1", "horizontal_c3", "vertical_c1"}) {
+    SCOPED_TRACE(name);
+    const Config c = load_config_file(test::preset(name));
+    EXPECT_EQ(c.loop.rate_hz, 5000.0);
+    EXPECT_EQ(c.controller.gain_ns_per_m, 2000.0);
+    EXPECT_EQ(c.actuator.force_limit_n, 36.0);
+    EXPECT_EQ(c.actuator.constant_n_per_v, 4.8);
+    ASSERT_EQ(c.robot.frfs.size(), 3U);
+    EXPECT_EQ(c.robot.frfs[0].modes.size(), 3U);
+    EXPECT_DOUBLE_EQ(c.robot.frfs[0].modes[0].residue_im_m_per_n, -3.63e-5);
+    EXPECT_DOUBLE_EQ(c.robot.frfs[2].modes[0].residue_im_m_per_n, 4.06e-5);  // H22 = H21 (Table 1)
+    EXPECT_NEAR(*dominant_mode_hz(c.robot), 9.2, 1e-12);
+    const auto d = control::design_chain(c);
+    EXPECT_EQ(d.match_freq_hz, 9.2);
+  }
+  EXPECT_EQ(load_config_file(test::preset("vertical_c1")).actuator.natural_freq_hz, 14.0);
+  EXPECT_EQ(load_config_file(test::preset("horizontal_c1")).controller.polarity, -1);
+}
+
+TEST(Config, ValidMinimalFileParses) {
+  EXPECT_TRUE(problems_of(kValid).empty());
+  const Config c = parse_config(kValid, "x.yaml");
+  EXPECT_EQ(c.controller.chain.size(), 5U);
+  EXPECT_EQ(c.controller.chain[2].damping_ratio, 0.707);  // documented default
+  EXPECT_EQ(c.controller.gain_ramp_s, 0.5);
+  EXPECT_EQ(c.controller.chain[4].name, "compensator");
+}
+
+TEST(Config, OutOfRangeNamesFileLineKeyValueUnitAndRange) {
+  const std::string m = only_problem(edited("cutoff_hz: 50", "cutoff_hz: 3000"));
+  EXPECT_NE(m.find("bad.yaml:18:"), std::string::npos) << m;
+  EXPECT_NE(m.find("controller.chain[0].cutoff_hz"), std::string::npos) << m;
+  EXPECT_NE(m.find("= 3000 Hz"), std::string::npos) << m;
+  EXPECT_NE(m.find("allowed 0 < value < 2500 Hz"), std::string::npos) << m;
+  EXPECT_NE(m.find("Nyquist"), std::string::npos) << m;
+}
+
+TEST(Config, CutoffExactlyAtNyquistIsRejected) {
+  EXPECT_NE(only_problem(edited("cutoff_hz: 50", "cutoff_hz: 2500")).find("out of range"), std::string::npos);
+}
+
+TEST(Config, EveryNumericKeyIsRangeChecked) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"rate_hz: 5000", "rate_hz: 500"},
+      {"rate_hz: 5000", "rate_hz: 25000"},
+      {"constant_n_per_v: 4.8", "constant_n_per_v: 0"},
+      {"natural_freq_hz: 9.0", "natural_freq_hz: -9"},
+      {"damping_ratio: 0.15", "damping_ratio: 0"},
+      {"delay_s: 0.0006", "delay_s: -0.001"},
+      {"force_limit_n: 36", "force_limit_n: 0"},
+      {"voltage_limit_v: 10", "voltage_limit_v: 0"},
+      {"slew_rate_v_per_s: 20000", "slew_rate_v_per_s: -1"},
+      {"gain_ns_per_m: 2000", "gain_ns_per_m: -5"},
+      {"match_freq_hz: 9.2", "match_freq_hz: 2600"},
+      {"damping_ratio: 0.707}", "damping_ratio: 0}"},
+      {"center_hz: 3", "center_hz: 0"},
+      {"bandwidth_hz: 4", "bandwidth_hz: 0"},
+      {"{kind: integrator}", "{kind: integrator, leak_hz: 5}"},
+  };
+  for (const auto& [from, to] : cases) {
+    const std::string m = only_problem(edited(from, to));
+    EXPECT_NE(m.find("is out of range: allowed"), std::string::npos) << to << "\n" << m;
+    EXPECT_NE(m.find("bad.yaml:"), std::string::npos) << m;
+  }
+}
+
+TEST(Config, NotANumberNamesTheExpectedUnit) {
+  const std::string m = only_problem(edited("gain_ns_per_m: 2000", "gain_ns_per_m: lots"));
+  EXPECT_NE(m.find("controller.gain_ns_per_m"), std::string::npos) << m;
+  EXPECT_NE(m.find("'lots' is not a number (N s/m"), std::string::npos) << m;
+  EXPECT_NE(only_problem(edited("gain_ns_per_m: 2000", "gain_ns_per_m: .nan")).find("out of range"), std::string::npos);
+  EXPECT_NE(only_problem(edited("gain_ns_per_m: 2000", "gain_ns_per_m: .inf")).find("out of range"), std::string::npos);
+}
+
+TEST(Config, UnknownKeysAreErrorsThatListTheAllowedOnes) {
+  // A misspelt key next to the real one: the typo is reported, not silently ignored.
+  const auto p = problems_of(edited("cutoff_hz: 4}", "cutoff_hz: 4, cutof_hz: 4}"));
+  ASSERT_EQ(p.size(), 1U);
+  EXPECT_EQ(p[0].key, "controller.chain[2].cutof_hz");
+  EXPECT_NE(p[0].message.find("unknown key; allowed here: cutoff_hz, damping_ratio"), std::string::npos) << p[0].message;
+  EXPECT_EQ(p[0].mark.line, 20);
+  const auto top = problems_of(std::string(kValid) + "spindle_rpm: 12000\n");
+  ASSERT_EQ(top.size(), 1U);
+  EXPECT_EQ(top[0].key, "spindle_rpm");
+}
+
+TEST(Config, DuplicateKeysAreErrors) {
+  const auto p = problems_of(edited("  rate_hz: 5000\n", "  rate_hz: 5000\n  rate_hz: 10000\n"));
+  ASSERT_FALSE(p.empty());
+  EXPECT_EQ(p[0].key, "loop.rate_hz");
+  EXPECT_NE(p[0].message.find("duplicate"), std::string::npos);
+}
+
+TEST(Config, MissingRequiredKeysSayWhatIsExpected) {
+  const std::string m = only_problem(edited("  force_limit_n: 36\n", ""));
+  EXPECT_NE(m.find("actuator.force_limit_n: missing (required: a number in N"), std::string::npos) << m;
+  const auto no_controller = problems_of(std::string(kValid).substr(0, std::string(kValid).find("controller:")));
+  ASSERT_EQ(no_controller.size(), 1U);
+  EXPECT_EQ(no_controller[0].key, "controller");
+}
+
+TEST(Config, ChoicesAndPolarity) {
+  EXPECT_NE(only_problem(edited("mounting: horizontal", "mounting: sideways")).find("one of horizontal, vertical"),
+            std::string::npos);
+  EXPECT_NE(only_problem(edited("polarity: 1", "polarity: 2")).find("+1 or -1"), std::string::npos);
+  EXPECT_NE(only_problem(edited("model: c2", "model: c9")).find("one of c1, c2, c3, rational"), std::string::npos);
+  EXPECT_NE(only_problem(edited("kind: notch", "kind: comb")).find("'comb' is not allowed"), std::string::npos);
+  EXPECT_TRUE(problems_of(edited("polarity: 1", "polarity: -1")).empty());
+  EXPECT_TRUE(problems_of(edited("polarity: 1", "polarity: +1")).empty());
+}
+
+TEST(Config, ChainStructureIsChecked) {
+  // No integrator: not DVF.
+  EXPECT_NE(only_problem(edited("    - {kind: integrator}\n", "")).find("exactly one integrator"), std::string::npos);
+  // Ideal integrator without a high-pass would wind up on an offset.
+  const std::string m = only_problem(edited("    - {kind: highpass2, cutoff_hz: 4}\n", ""));
+  EXPECT_NE(m.find("controller.chain[1].leak_hz"), std::string::npos) << m;
+  EXPECT_TRUE(problems_of(edited("    - {kind: highpass2, cutoff_hz: 4}\n", "").replace(
+                              std::string(kValid).find("{kind: integrator}"), 18, "{kind: integrator, leak_hz: 0.1}"))
+                  .empty());
+  EXPECT_NE(only_problem(edited("{kind: notch,", "{kind: notch, name: lowpass2,")).find("used twice"), std::string::npos);
+  const auto renamed = problems_of(edited("  chain:\n", "  chain: {}\n  old_chain:\n"));
+  ASSERT_EQ(renamed.size(), 2U);
+  EXPECT_NE(renamed[0].message.find("non-empty list"), std::string::npos);
+  EXPECT_EQ(renamed[1].key, "controller.old_chain");
+}
+
+TEST(Config, UnstableOrImproperCompensatorIsADesignErrorAtItsLine) {
+  const std::string unstable = edited("{kind: compensator, model: c2}",
+                                      "{kind: compensator, model: rational, numerator: [1, 2], denominator: [1, -3, 2]}");
+  const std::string m = only_problem(unstable);
+  EXPECT_NE(m.find("bad.yaml:22:"), std::string::npos) << m;
+  EXPECT_NE(m.find("controller.chain[4]"), std::string::npos) << m;
+  EXPECT_NE(m.find("unstable or marginally stable: pole at s = 2"), std::string::npos) << m;
+  const std::string improper = edited("{kind: compensator, model: c2}",
+                                      "{kind: compensator, model: rational, numerator: [1, 0, 0], denominator: [1, 3]}");
+  EXPECT_NE(only_problem(improper).find("improper"), std::string::npos);
+  const std::string bad_list = edited("{kind: compensator, model: c2}",
+                                      "{kind: compensator, model: rational, numerator: [1, x], denominator: [0, 3]}");
+  EXPECT_EQ(problems_of(bad_list).size(), 2U);
+}
+
+TEST(Config, CompensatorWithoutMatchFrequencyOrModalData) {
+  const std::string m = only_problem(edited("  match_freq_hz: 9.2\n", ""));
+  EXPECT_NE(m.find("controller.match_freq_hz"), std::string::npos) << m;
+}
+
+TEST(Config, PrewarpAtOrAboveNyquistIsRejected) {
+  EXPECT_NE(only_problem(edited("{kind: notch,", "{kind: notch, prewarp_hz: 2500,")).find("prewarp_hz"), std::string::npos);
+}
+
+TEST(Config, WrongShapesAreReported) {
+  EXPECT_NE(only_problem(edited("loop:\n  rate_hz: 5000\n", "loop: [5000]\n")).find("expected a map"), std::string::npos);
+  const auto syntax = problems_of("loop:\n  rate_hz: [5000\n");
+  ASSERT_EQ(syntax.size(), 1U);
+  EXPECT_NE(syntax[0].message.find("syntax error"), std::string::npos);
+  EXPECT_GT(syntax[0].mark.line, 0);
+  EXPECT_NE(problems_of("- just\n- a list\n")[0].message.find("expected a map"), std::string::npos);
+}
+
+TEST(Config, AllProblemsAreReportedAtOnce) {
+  std::string s = edited("rate_hz: 5000", "rate_hz: 50");
+  s.replace(s.find("gain_ns_per_m: 2000"), 19, "gain_ns_per_m: -1");
+  s.replace(s.find("mounting: horizontal"), 20, "mounting: upside");
+  s += "extra: 1\n";
+  const auto p = problems_of(s);
+  EXPECT_EQ(p.size(), 4U);
+  try {
+    (void)parse_config(s, "bad.yaml");
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("4 configuration problem(s)"), std::string::npos);
+  }
+}
+
+TEST(Config, UnreadableFile) {
+  try {
+    (void)load_config_file("/nonexistent/robodamp.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/robodamp.yaml"), std::string::npos);
+  }
+}
+
+TEST(Config, RobotModalDataIsValidated) {
+  const std::string base = std::string(kValid) + R"(robot:
+  frfs:
+    - name: H11yy
+      response_location: 1
+      excitation_location: 1
+      modes:
+        - {natural_freq_hz: 9.2, damping_ratio: 0.02, residue_re_m_per_n: -2.92e-6, residue_im_m_per_n: -3.63e-5}
+)";
+  EXPECT_TRUE(problems_of(base).empty());
+  auto bad = base;
+  bad.replace(bad.find("damping_ratio: 0.02"), 19, "damping_ratio: 1.5");
+  const std::string m = only_problem(bad);
+  EXPECT_NE(m.find("robot.frfs[0].modes[0].damping_ratio = 1.5"), std::string::npos) << m;
+}
+
+}  // namespace
+}  // namespace robodamp::config
