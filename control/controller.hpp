@@ -76,14 +76,15 @@ class Controller final {
       return RequestStatus::kRejectedOutOfRange;
     }
     target_gain_ = gain_ns_per_m;
-    if (!pending_) start_ramp(output_scale(p_, target_gain_));
+    if (!pending_) start_ramp(output_scale(p_, target_gain_));  // during a hand-over: applied at fade-in
     return RequestStatus::kAccepted;
   }
 
   // RT-safe (copies fixed-size structs). Hands over to a new parameter set at cycle boundaries: the
   // incoming chain starts from the running chain's signal history (sections shared by both chains
   // carry over exactly) and runs in the shadow on the same samples while the output fades to zero;
-  // then it takes over and the output fades in with the new polarity, gain and limits.
+  // it runs for the incoming chain's settling time (its slowest pole) before the fade-out ends, then
+  // it takes over and the output fades in with the new polarity, gain and limits.
   [[nodiscard]] RequestStatus request_params(const ControllerParams& next) noexcept {
     if (next.fs_hz != p_.fs_hz) {
       ++counters_.rejected_requests;
@@ -99,7 +100,9 @@ class Controller final {
     shadow_.swap_coefficients(next.sections);
     pending_ = true;
     target_gain_ = next.gain_ns_per_m;
-    start_ramp(0.0);
+    const double fade = std::ceil(p_.gain_ramp_s * p_.fs_hz), settle = std::ceil(next.settle_s * p_.fs_hz);
+    warmup_left_ = settle > fade ? static_cast<std::uint64_t>(settle - fade) : 0;
+    if (warmup_left_ == 0) start_ramp(0.0);
     return RequestStatus::kAccepted;
   }
 
@@ -130,6 +133,7 @@ class Controller final {
   }
 
   void advance_ramp() noexcept {
+    if (warmup_left_ > 0 && --warmup_left_ == 0) start_ramp(0.0);
     if (ramp_left_ == 0) return;
     scale_ += ramp_step_;
     if (--ramp_left_ == 0) finish_ramp();
@@ -154,6 +158,7 @@ class Controller final {
   double target_gain_{0.0};
   double scale_{0.0}, target_scale_{0.0}, ramp_step_{0.0};
   std::uint64_t ramp_left_{0};
+  std::uint64_t warmup_left_{0};
   bool pending_{false};
   double command_v_{0.0};
   double force_n_{0.0};

@@ -12,6 +12,7 @@ struct ControllerParams {
   double sections_gain{1.0};  // H_filters(z) = sections_gain * prod sections
   double gain_ns_per_m{0.0};  // K
   double gain_ramp_s{0.5};    // time for any gain change (also a parameter-set hand-over fades out and in)
+  double settle_s{0.0};       // time for the slowest pole's transient to fall to 1e-3 (from the design)
   int polarity{1};            // +1 / -1: force command = polarity * K * filters(accel)
   double actuator_constant_n_per_v{4.8};
   double force_limit_n{36.0};
