@@ -96,8 +96,8 @@ class Controller final {
       return RequestStatus::kRejectedOutOfRange;
     }
     next_ = next;
-    shadow_ = cascade_;
-    shadow_.swap_coefficients(next.sections);
+    shadow_ = cascade_;  // an exact copy: identical to the running chain until its swap
+    shadow_.request_swap(next.sections);
     pending_ = true;
     target_gain_ = next.gain_ns_per_m;
     const double fade = std::ceil(p_.gain_ramp_s * p_.fs_hz), settle = std::ceil(next.settle_s * p_.fs_hz);

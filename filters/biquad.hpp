@@ -49,9 +49,9 @@ class BiquadCascade final {
       ++nonfinite_inputs_;
       return last_output_;
     }
-    auto& w = boundary_[newest_ ^ 1U];  // becomes the newest sample's boundary signals
+    if (record_left_ != 0) [[unlikely]]
+      return finish(process_recording(x));
     double v = x;
-    w[0] = v;
     for (std::size_t i = 0; i < c_.count; ++i) {
       const BiquadCoefficients& k = c_.sections[i];
       State& s = state_[i];
@@ -59,16 +59,8 @@ class BiquadCascade final {
       s.s1 = k.b1 * v - k.a1 * y + s.s2;
       s.s2 = k.b2 * v - k.a2 * y;
       v = y;
-      w[i + 1] = v;
     }
-    newest_ ^= 1U;
-    if (!std::isfinite(v)) {
-      ++state_resets_;
-      reset(0.0);
-      v = 0.0;
-    }
-    last_output_ = v;
-    return v;
+    return finish(v);
   }
 
   // RT-safe. Steady state for a constant input x (PX4's reset(sample)): the next output for input x
@@ -90,26 +82,19 @@ class BiquadCascade final {
     last_output_ = v;
   }
 
-  // RT-safe; call between two process() calls. The new coefficients take over the actual signal
-  // history at every section boundary (the direct-form-I view of the state), so the output continues
-  // from where it was and moves to the new response with the new filter's own dynamics. Sections
-  // beyond the old count see the old cascade's output, as if the missing old sections were identity.
-  void swap_coefficients(const SosCoefficients& next) noexcept {
-    const std::size_t old_count = c_.count;
-    c_ = next;
-    const auto& now = boundary_[newest_];
-    const auto& before = boundary_[newest_ ^ 1U];
-    for (std::size_t i = 0; i < c_.count; ++i) {
-      const std::size_t in = i < old_count ? i : old_count;
-      const std::size_t out = i + 1 < old_count ? i + 1 : old_count;
-      const BiquadCoefficients& k = c_.sections[i];
-      state_[i].s2 = k.b2 * now[in] - k.a2 * now[out];
-      state_[i].s1 = k.b1 * now[in] - k.a1 * now[out] + k.b2 * before[in] - k.a2 * before[out];
-    }
-    // Keep the boundary history consistent with the new section count.
-    for (auto* b : {&boundary_[0], &boundary_[1]})
-      for (std::size_t i = old_count + 1; i <= c_.count; ++i) (*b)[i] = (*b)[old_count];
+  // RT-safe. Requests new coefficients; they take over at the sample boundary after the next two
+  // processed samples (whose section-boundary signals are recorded for it). The new coefficients
+  // take over the actual signal history at every section boundary (the direct-form-I view of the
+  // state), so the output continues from where it was and moves to the new response with the new
+  // filter's own dynamics. Sections beyond the old count see the old cascade's output, as if the
+  // missing old sections were identity. Recording only around a swap keeps the per-sample cost of
+  // the normal path at that of a plain cascade plus the NaN guard.
+  void request_swap(const SosCoefficients& next) noexcept {
+    next_ = next;
+    swap_pending_ = true;
+    record_left_ = 2;
   }
+  [[nodiscard]] bool swap_pending() const noexcept { return swap_pending_; }
 
   [[nodiscard]] const SosCoefficients& coefficients() const noexcept { return c_; }
   [[nodiscard]] std::uint64_t nonfinite_input_count() const noexcept { return nonfinite_inputs_; }
@@ -120,11 +105,57 @@ class BiquadCascade final {
   struct State {
     double s1{0.0}, s2{0.0};
   };
+
+  double finish(double v) noexcept {
+    if (!std::isfinite(v)) [[unlikely]] {
+      ++state_resets_;
+      reset(0.0);
+      v = 0.0;
+    }
+    last_output_ = v;
+    return v;
+  }
+
+  double process_recording(double x) noexcept {
+    auto& w = boundary_[newest_ ^ 1U];  // becomes the newest sample's boundary signals
+    double v = x;
+    w[0] = v;
+    for (std::size_t i = 0; i < c_.count; ++i) {
+      const BiquadCoefficients& k = c_.sections[i];
+      State& s = state_[i];
+      const double y = k.b0 * v + s.s1;
+      s.s1 = k.b1 * v - k.a1 * y + s.s2;
+      s.s2 = k.b2 * v - k.a2 * y;
+      v = y;
+      w[i + 1] = v;
+    }
+    newest_ ^= 1U;
+    if (--record_left_ == 0 && swap_pending_) apply_swap();
+    return v;
+  }
+
+  void apply_swap() noexcept {
+    swap_pending_ = false;
+    const std::size_t old_count = c_.count;
+    c_ = next_;
+    const auto& now = boundary_[newest_];
+    const auto& before = boundary_[newest_ ^ 1U];
+    for (std::size_t i = 0; i < c_.count; ++i) {
+      const std::size_t in = i < old_count ? i : old_count;
+      const std::size_t out = i + 1 < old_count ? i + 1 : old_count;
+      const BiquadCoefficients& k = c_.sections[i];
+      state_[i].s2 = k.b2 * now[in] - k.a2 * now[out];
+      state_[i].s1 = k.b1 * now[in] - k.a1 * now[out] + k.b2 * before[in] - k.a2 * before[out];
+    }
+  }
   SosCoefficients c_{};
+  SosCoefficients next_{};
   std::array<State, kMaxSections> state_{};
   // Signals at the section boundaries (0 = input, i + 1 = output of section i) for the last two samples.
   std::array<std::array<double, kMaxSections + 1>, 2> boundary_{};
   unsigned newest_{0};
+  unsigned record_left_{0};
+  bool swap_pending_{false};
   double last_output_{0.0};
   std::uint64_t nonfinite_inputs_{0};
   std::uint64_t state_resets_{0};

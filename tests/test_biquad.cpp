@@ -137,7 +137,7 @@ TEST(BiquadCascade, CoefficientSwapAtASampleBoundaryDoesNotJump) {
   BiquadCascade c(a);
   std::vector<double> y;
   for (std::size_t i = 0; i < n; ++i) {
-    if (i == swap_at) c.swap_coefficients(b);
+    if (i == swap_at - 2) c.request_swap(b);  // in force from sample swap_at
     y.push_back(c.process(input(i)));
   }
   // The same swap done naively (new coefficients over the old TDF-II state) does jump: this is what
@@ -172,7 +172,7 @@ TEST(BiquadCascade, SwapToTheSameCoefficientsChangesNothing) {
   const SosCoefficients same = a.coefficients();
   for (int i = 0; i < 10000; ++i) {
     const double x = std::sin(i * 0.013) + 0.2 * std::sin(i * 0.41);
-    if (i == 5000) b.swap_coefficients(same);
+    if (i == 5000) b.request_swap(same);
     const double ya = a.process(x), yb = b.process(x);
     ASSERT_NEAR(ya, yb, 1e-12) << i;  // rounding of the re-derived state, relative to the unit input
   }
@@ -182,10 +182,15 @@ TEST(BiquadCascade, SwapToADifferentSectionCount) {
   BiquadCascade c = default_chain();
   const SosCoefficients shorter = SosCoefficients::from(bilinear_sos(lowpass2(50.0, 0.707), 5000.0, 50.0).sections);
   for (int i = 0; i < 20000; ++i) (void)c.process(std::sin(i * 0.0116));
-  c.swap_coefficients(shorter);
+  c.request_swap(shorter);
+  EXPECT_TRUE(c.swap_pending());
+  (void)c.process(0.0);
+  EXPECT_EQ(c.coefficients().count, 6U);
+  (void)c.process(0.0);
+  EXPECT_FALSE(c.swap_pending());
   EXPECT_EQ(c.coefficients().count, 1U);
   for (int i = 0; i < 20000; ++i) ASSERT_TRUE(std::isfinite(c.process(std::sin(i * 0.0116))));
-  c.swap_coefficients(default_chain().coefficients());
+  c.request_swap(default_chain().coefficients());
   for (int i = 0; i < 20000; ++i) ASSERT_TRUE(std::isfinite(c.process(std::sin(i * 0.0116))));
 }
 

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Reproduces the chain cost numbers in the README: Google Benchmark ns/sample and callgrind
+# instructions/sample for the plain cascade, the product's chain, and the controller step.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+./build/bench/bench_chain --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_min_time=0.5 --benchmark_counters_tabular=true
+n=1000000
+echo
+echo "callgrind instructions per sample (N = $n, closed loop, Release flags):"
+for k in plain chain controller; do
+  out=$(mktemp)
+  valgrind --tool=callgrind --callgrind-out-file="$out" '--toggle-collect=*run_kernel*' \
+    ./build/bench/callgrind_chain "$k" "$n" >/dev/null 2>&1
+  ir=$(grep -E '^(summary|totals):' "$out" | head -1 | awk '{print $2}')
+  rm -f "$out"
+  awk -v k="$k" -v ir="$ir" -v n="$n" 'BEGIN { printf "  %-11s %8.2f\n", k, ir / n }'
+done

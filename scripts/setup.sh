@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what robodamp needs on Debian 12 (only what is missing; quiet when all is there), then
+# configures and builds in ./build (Release). Used by run.sh and test.sh; idempotent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libgtest-dev libgmock-dev
+          libbenchmark-dev libcli11-dev libspdlog-dev nlohmann-json3-dev gnuplot-nox valgrind)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "robodamp: installing ${missing[*]}"
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if [[ ! -f build/CMakeCache.txt ]]; then
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+fi
+cmake --build build --parallel "$(nproc)" | { grep -vE '^\[[0-9]+/[0-9]+\] ' || true; }
