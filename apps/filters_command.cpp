@@ -83,8 +83,8 @@ std::string filters_table(const nlohmann::json& r) {
 }
 
 std::string plot_filters(const control::ChainDesign& d, const std::string& png_path) {
-  // Columns: f, then (mag, phase) of each block (analog), then the filter chain analog and digital
-  // (without K and 1/T, so the shapes share one axis).
+  // Columns: f, then (mag, phase) of each block (analog), then the whole chain analog and digital in
+  // volts per m/s^2 (with K, polarity and 1/T).
   std::ostringstream data;
   const double f_max = std::min(500.0, 0.45 * d.params.fs_hz);
   for (int i = 0; i <= 400; ++i) {
@@ -94,7 +94,7 @@ std::string plot_filters(const control::ChainDesign& d, const std::string& png_p
       const Complex h = b.analog.at_hz(f);
       data << ' ' << magnitude_db(h) << ' ' << phase_deg(h);
     }
-    for (const Complex h : {d.filters_analog(f), d.filters_digital(f)}) data << ' ' << magnitude_db(h) << ' ' << phase_deg(h);
+    for (const Complex h : {d.chain_analog(f), d.chain_digital(f)}) data << ' ' << magnitude_db(h) << ' ' << phase_deg(h);
     data << '\n';
   }
   std::ostringstream s;
@@ -108,8 +108,8 @@ std::string plot_filters(const control::ChainDesign& d, const std::string& png_p
     s << "plot ";
     for (std::size_t k = 0; k < n; ++k)
       s << "DATA u 1:" << 2 + 2 * k + panel << " w l lw 1.5 t '" << d.blocks[k].name << "', ";
-    s << "DATA u 1:" << 2 + 2 * n + panel << " w l lw 3 lc 'black' t 'chain (analog)', "
-      << "DATA u 1:" << 4 + 2 * n + panel << " w l lw 2 dt 2 lc 'red' t 'chain (digital)'\n";
+    s << "DATA u 1:" << 2 + 2 * n + panel << " w l lw 3 lc 'black' t 'chain V/(m/s^2), analog', "
+      << "DATA u 1:" << 4 + 2 * n + panel << " w l lw 2 dt 2 lc 'red' t 'chain, digital'\n";
   }
   s << "unset multiplot\n";
   return run_gnuplot(s.str(), data.str(), png_path);

@@ -23,7 +23,7 @@ std::string run_gnuplot(const std::string& script, const std::string& data, cons
     fs::remove(data_path, ec);
     return "cannot start gnuplot (apt-get install gnuplot-nox)";
   }
-  std::fprintf(gp, "DATA = '%s'\nset terminal pngcairo size 1200,900 font ',10'\nset output '%s'\n%s\nset output\n",
+  std::fprintf(gp, "DATA = '%s'\nset terminal pngcairo noenhanced size 1200,900 font ',10'\nset output '%s'\n%s\nset output\n",
                data_path.c_str(), png_path.c_str(), script.c_str());
   const int rc = pclose(gp);
   fs::remove(data_path, ec);
