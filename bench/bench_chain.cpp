@@ -8,33 +8,32 @@ namespace {
 
 using namespace robodamp;
 
-void BM_PlainCascade(benchmark::State& state) {
-  const auto d = bench::default_design();
-  bench::PlainCascade c(d.params.sections);
+template <class Kernel>
+void run(benchmark::State& state, Kernel& kernel) {
   const auto u = bench::excitation();
-  auto k = [&](double x) { return c.process(x); };
+  auto k = [&](double x) { return kernel(x); };
   for (auto _ : state) benchmark::DoNotOptimize(bench::run_closed_loop(k, u, 1000));
   state.SetItemsProcessed(state.iterations() * 1000);
+}
+
+void BM_PlainCascade(benchmark::State& state) {
+  bench::PlainCascade c(bench::default_design().params.sections);
+  auto k = [&](double x) { return c.process(x); };
+  run(state, k);
 }
 BENCHMARK(BM_PlainCascade);
 
 void BM_Chain(benchmark::State& state) {
-  const auto d = bench::default_design();
-  filters::BiquadCascade c(d.params.sections);
-  const auto u = bench::excitation();
+  filters::BiquadCascade c(bench::default_design().params.sections);
   auto k = [&](double x) { return c.process(x); };
-  for (auto _ : state) benchmark::DoNotOptimize(bench::run_closed_loop(k, u, 1000));
-  state.SetItemsProcessed(state.iterations() * 1000);
+  run(state, k);
 }
 BENCHMARK(BM_Chain);
 
 void BM_ControllerUpdate(benchmark::State& state) {
-  const auto d = bench::default_design();
-  control::Controller c(d.params);
-  const auto u = bench::excitation();
+  control::Controller c(bench::default_design().params);
   auto k = [&](double x) { return c.update(x); };
-  for (auto _ : state) benchmark::DoNotOptimize(bench::run_closed_loop(k, u, 1000));
-  state.SetItemsProcessed(state.iterations() * 1000);
+  run(state, k);
 }
 BENCHMARK(BM_ControllerUpdate);
 

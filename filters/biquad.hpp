@@ -53,12 +53,7 @@ class BiquadCascade final {
       return finish(process_recording(x));
     double v = x;
     for (std::size_t i = 0; i < c_.count; ++i) {
-      const BiquadCoefficients& k = c_.sections[i];
-      State& s = state_[i];
-      const double y = k.b0 * v + s.s1;
-      s.s1 = k.b1 * v - k.a1 * y + s.s2;
-      s.s2 = k.b2 * v - k.a2 * y;
-      v = y;
+      v = step(c_.sections[i], state_[i], v);
     }
     return finish(v);
   }
@@ -106,6 +101,14 @@ class BiquadCascade final {
     double s1{0.0}, s2{0.0};
   };
 
+  // One TDF-II section: y = b0 x + s1; s1' = b1 x - a1 y + s2; s2' = b2 x - a2 y.
+  static double step(const BiquadCoefficients& k, State& s, double x) noexcept {
+    const double y = k.b0 * x + s.s1;
+    s.s1 = k.b1 * x - k.a1 * y + s.s2;
+    s.s2 = k.b2 * x - k.a2 * y;
+    return y;
+  }
+
   double finish(double v) noexcept {
     if (!std::isfinite(v)) [[unlikely]] {
       ++state_resets_;
@@ -121,12 +124,7 @@ class BiquadCascade final {
     double v = x;
     w[0] = v;
     for (std::size_t i = 0; i < c_.count; ++i) {
-      const BiquadCoefficients& k = c_.sections[i];
-      State& s = state_[i];
-      const double y = k.b0 * v + s.s1;
-      s.s1 = k.b1 * v - k.a1 * y + s.s2;
-      s.s2 = k.b2 * v - k.a2 * y;
-      v = y;
+      v = step(c_.sections[i], state_[i], v);
       w[i + 1] = v;
     }
     newest_ ^= 1U;

@@ -21,4 +21,4 @@ fi
 if [[ ! -f build/CMakeCache.txt ]]; then
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
-cmake --build build --parallel "$(nproc)" | { grep -vE '^\[[0-9]+/[0-9]+\] ' || true; }
+cmake --build build --parallel "$(nproc)" | { grep -vE '^(\[[0-9]+/[0-9]+\] |ninja: no work to do)' || true; }
