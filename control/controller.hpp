@@ -63,6 +63,7 @@ class Controller final {
   // (zero for a chain with a high-pass), without a slew transient.
   void reset(double accel_mps2) noexcept {
     cascade_.reset(accel_mps2);
+    if (pending_) shadow_.reset(accel_mps2);
     const double f = scale_ * cascade_.last_output();
     force_n_ = std::copysign(std::min(std::abs(f), p_.force_limit_n), f);
     command_v_ = std::copysign(std::min(std::abs(force_n_ / p_.actuator_constant_n_per_v), p_.voltage_limit_v), f);
@@ -100,9 +101,9 @@ class Controller final {
     shadow_.request_swap(next.sections);
     pending_ = true;
     target_gain_ = next.gain_ns_per_m;
+    // At least the two samples the shadow's swap needs, however short the ramp.
     const double fade = std::ceil(p_.gain_ramp_s * p_.fs_hz), settle = std::ceil(next.settle_s * p_.fs_hz);
-    warmup_left_ = settle > fade ? static_cast<std::uint64_t>(settle - fade) : 0;
-    if (warmup_left_ == 0) start_ramp(0.0);
+    warmup_left_ = settle > fade + 2.0 ? static_cast<std::uint64_t>(settle - fade) : 2;
     return RequestStatus::kAccepted;
   }
 

@@ -161,6 +161,17 @@ TEST(Controller, ParameterHandOverFadesOutSwapsAndFadesIn) {
   EXPECT_NEAR(got, want, 1e-6 * std::abs(want) + 1e-9);
 }
 
+TEST(Controller, HandOverWithoutRampStillSwapsTheSections) {
+  // Zero ramp, zero settling time: the new sections must still be in force when the new limits are.
+  ControllerParams a = identity(1.0), b = identity(1.0);
+  b.sections.sections[0].b0 = 3.0;
+  Controller c(a);
+  ASSERT_EQ(c.request_params(b), RequestStatus::kAccepted);
+  for (int i = 0; i < 3; ++i) (void)c.update(1.0);
+  EXPECT_FALSE(c.handover_pending());
+  EXPECT_DOUBLE_EQ(c.update(1.0), 3.0 / 4.8);
+}
+
 TEST(Controller, ResetStartsFromSteadyStateWithoutSlewTransient) {
   auto d = test::design_preset("horizontal_c2");
   Controller c(d.params);
