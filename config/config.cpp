@@ -45,6 +45,13 @@ const char* to_string(BlockKind kind) {
   return "?";
 }
 
+std::optional<BlockKind> block_kind_from(const std::string& name) {
+  for (BlockKind k : {BlockKind::kLowpass2, BlockKind::kHighpass2, BlockKind::kNotch, BlockKind::kIntegrator,
+                      BlockKind::kCompensator})
+    if (name == to_string(k)) return k;
+  return std::nullopt;
+}
+
 const char* to_string(CompensatorModel model) {
   switch (model) {
     case CompensatorModel::kC1: return "c1";
@@ -117,20 +124,17 @@ std::optional<BlockConfig> read_block(Diagnostics& d, const YAML::Node& node, co
   b.name = r.text("name", std::string()).value_or("");
   if (auto p = r.number("prewarp_hz", below_nyquist(rate), -1.0); p && *p >= 0.0) b.prewarp_hz = *p;
   if (!kind) return std::nullopt;  // its other keys cannot be judged without a kind
-  if (*kind == "lowpass2" || *kind == "highpass2") {
-    b.kind = *kind == "lowpass2" ? BlockKind::kLowpass2 : BlockKind::kHighpass2;
+  b.kind = *block_kind_from(*kind);
+  if (b.kind == BlockKind::kLowpass2 || b.kind == BlockKind::kHighpass2) {
     if (auto v = r.number("cutoff_hz", below_nyquist(rate))) b.cutoff_hz = *v;
     if (auto v = r.number("damping_ratio", kDamping, 0.707)) b.damping_ratio = *v;
-  } else if (*kind == "notch") {
-    b.kind = BlockKind::kNotch;
+  } else if (b.kind == BlockKind::kNotch) {
     if (auto v = r.number("center_hz", below_nyquist(rate))) b.center_hz = *v;
     if (auto v = r.number("bandwidth_hz", below_nyquist(rate))) b.bandwidth_hz = *v;
-  } else if (*kind == "integrator") {
-    b.kind = BlockKind::kIntegrator;
+  } else if (b.kind == BlockKind::kIntegrator) {
     if (auto v = r.number("leak_hz", {"Hz", 0.0, 1.0, false, false, "0 = ideal, realised with the high-pass"}, 0.0))
       b.leak_hz = *v;
   } else {
-    b.kind = BlockKind::kCompensator;
     const auto model = r.choice("model", {"c1", "c2", "c3", "rational"});
     if (model == "c1") {
       b.model = CompensatorModel::kC1;
@@ -182,12 +186,12 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
       for (std::size_t i = 0; i < chain.size(); ++i) {
         const std::string key = "controller.chain[" + std::to_string(i) + "]";
         auto b = read_block(d, chain[i], key, rate);
-        // Count kinds from the text, so a block with a bad value is not also reported as missing.
-        for (int k = 0; k < 5; ++k)
-          if (chain[i].IsMap() && chain[i]["kind"].IsScalar() &&
-              chain[i]["kind"].Scalar() == to_string(static_cast<BlockKind>(k)) && !b)
-            ++counts[k];
-        if (!b) continue;
+        if (!b) {
+          // Still count its kind, so a block with a bad value is not also reported as missing.
+          if (chain[i].IsMap() && chain[i]["kind"].IsScalar())
+            if (auto k = block_kind_from(chain[i]["kind"].Scalar())) ++counts[static_cast<int>(*k)];
+          continue;
+        }
         const int n = ++counts[static_cast<int>(b->kind)];
         if (b->name.empty()) b->name = std::string(to_string(b->kind)) + (n > 1 ? "_" + std::to_string(n) : "");
         if (!names.insert(b->name).second) d.add(chain[i].Mark(), key + ".name", "= '" + b->name + "' is used twice");

@@ -57,6 +57,7 @@ enum class BlockKind { kLowpass2, kHighpass2, kNotch, kIntegrator, kCompensator 
 enum class CompensatorModel { kC1, kC2, kC3, kRational };
 
 [[nodiscard]] const char* to_string(BlockKind kind);  // the YAML/JSON name: lowpass2, highpass2, ...
+[[nodiscard]] std::optional<BlockKind> block_kind_from(const std::string& name);
 [[nodiscard]] const char* to_string(CompensatorModel model);
 [[nodiscard]] const char* to_string(Mounting mounting);
 

@@ -135,12 +135,7 @@ ChainDesign design_chain(const config::Config& cfg) {
   p.gain_ramp_s = cfg.controller.gain_ramp_s;
   // Slowest pole radius of any section: its transient falls to 1e-3 in ln(1e-3)/ln(r) samples.
   double r_max = 0.0;
-  for (const auto& s : sections) {
-    const double disc = s.a1 * s.a1 - 4.0 * s.a2;
-    const double r = disc < 0.0 ? std::sqrt(s.a2)
-                                : std::max(std::abs(-s.a1 + std::sqrt(disc)), std::abs(-s.a1 - std::sqrt(disc))) / 2.0;
-    r_max = std::max(r_max, r);
-  }
+  for (const auto& s : sections) r_max = std::max(r_max, filters::pole_radius(s));
   p.settle_s = r_max > 0.0 ? std::log(1e-3) / std::log(r_max) / fs : 0.0;
   p.polarity = cfg.controller.polarity;
   p.actuator_constant_n_per_v = cfg.actuator.constant_n_per_v;

@@ -145,8 +145,7 @@ class Controller final {
     if (pending_) {  // faded out: hand over, then fade in
       pending_ = false;
       cascade_ = shadow_;
-      p_ = next_;
-      dt_s_ = 1.0 / p_.fs_hz;
+      p_ = next_;  // same fs_hz (request_params refuses another rate), so dt_s_ stands
       start_ramp(output_scale(p_, target_gain_));
     }
   }

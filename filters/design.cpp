@@ -132,6 +132,13 @@ DigitalDesign bilinear_sos(const TransferFunction& tf, double fs_hz, double prew
   return out;
 }
 
+double pole_radius(const BiquadCoefficients& s) {
+  const double disc = s.a1 * s.a1 - 4.0 * s.a2;
+  if (disc < 0.0) return std::sqrt(s.a2);  // complex pair: |p|^2 = a2
+  const double root = std::sqrt(disc);
+  return std::max(std::abs(-s.a1 + root), std::abs(-s.a1 - root)) / 2.0;
+}
+
 Complex digital_response(const std::vector<BiquadCoefficients>& sections, double gain, double f_hz, double fs_hz) {
   const Complex w = std::polar(1.0, -kTwoPi * f_hz / fs_hz);  // z^-1
   Complex h(gain);

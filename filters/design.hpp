@@ -36,6 +36,9 @@ struct DigitalDesign {
 // at or above Nyquist, or a non-finite result.
 [[nodiscard]] DigitalDesign bilinear_sos(const TransferFunction& tf, double fs_hz, double prewarp_hz);
 
+// Largest pole magnitude of one section (its denominator 1 + a1 z^-1 + a2 z^-2).
+[[nodiscard]] double pole_radius(const BiquadCoefficients& s);
+
 // Response of sections x gain at f_hz for sample rate fs_hz.
 [[nodiscard]] Complex digital_response(const std::vector<BiquadCoefficients>& sections, double gain, double f_hz,
                                        double fs_hz);

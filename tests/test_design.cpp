@@ -90,12 +90,15 @@ TEST(BilinearDesign, SectionsAreNormalisedAndStrictlyStable) {
       double peak = 0.0;
       for (int i = 0; i <= 2000; ++i) peak = std::max(peak, std::abs(digital_response({s}, 1.0, 2500.0 * i / 2000.0, 5000.0)));
       EXPECT_LT(peak, 1.0 + 1e-3) << b.name;
-      // Pole radius: a2 = r^2 for a complex pair, |a2| = product for real poles.
-      const double disc = s.a1 * s.a1 - 4 * s.a2;
-      const double rmax = disc < 0 ? std::sqrt(s.a2) : std::max(std::abs((-s.a1 + std::sqrt(disc)) / 2), std::abs((-s.a1 - std::sqrt(disc)) / 2));
-      EXPECT_LT(rmax, 1.0) << b.name;
+      EXPECT_LT(pole_radius(s), 1.0) << b.name;
     }
   }
+}
+
+TEST(BilinearDesign, PoleRadiusOfRealAndComplexPairs) {
+  // (1 - 0.5 z^-1)(1 + 0.9 z^-1) and a pair at radius 0.8.
+  EXPECT_NEAR(pole_radius({1, 0, 0, 0.4, -0.45}), 0.9, 1e-12);
+  EXPECT_NEAR(pole_radius({1, 0, 0, -2 * 0.8 * std::cos(0.3), 0.64}), 0.8, 1e-12);
 }
 
 TEST(BilinearDesign, HigherOrderCompensatorIsFactoredIntoSections) {
