@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "analysis/loop_model.hpp"
+#include "apps/analyze_command.hpp"
 #include "apps/filters_command.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
@@ -56,6 +58,29 @@ int run_check_config(const std::string& path) {
   return 0;
 }
 
+int run_analyze(const std::string& path, bool json, const std::string& plot_dir) {
+  try {
+    const robodamp::analysis::LoopModel model(robodamp::config::load_config_file(path));
+    const auto result = robodamp::analysis::analyse(model);
+    const auto report = robodamp::apps::analysis_report(model, result);
+    if (json)
+      std::cout << report.dump(2) << '\n';
+    else
+      std::cout << robodamp::apps::analysis_table(report);
+    if (!plot_dir.empty()) {
+      if (const std::string err = robodamp::apps::plot_analysis(model, result, plot_dir); !err.empty()) {
+        std::cerr << "plot: " << err << '\n';
+        return 1;
+      }
+      (json ? std::cerr : std::cout) << "wrote frf_open_closed.png, nyquist.png, gain_sweep.png in " << plot_dir << '\n';
+    }
+    return result.stable ? 0 : 3;
+  } catch (const ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,7 +101,14 @@ int main(int argc, char** argv) {
   auto* check = app.add_subcommand("check-config", "Validate a configuration and report every problem at once");
   check->add_option("file", check_path, "Configuration file (YAML)")->required();
 
+  std::string plot_dir;
+  auto* analyze = app.add_subcommand("analyze", "Closed-loop stability, margins, polarity and predicted improvement");
+  analyze->add_option("--config", config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  analyze->add_flag("--json", json, "Print JSON instead of a table");
+  analyze->add_option("--plot-dir", plot_dir, "Write FRF, Nyquist and gain-sweep plots (PNG) here");
+
   CLI11_PARSE(app, argc, argv);
+  if (analyze->parsed()) return run_analyze(config_path, json, plot_dir);
   if (filters->parsed()) return run_filters(config_path, freq_hz, json, plot);
   if (check->parsed()) return run_check_config(check_path);
   return 1;

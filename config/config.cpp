@@ -66,6 +66,8 @@ const char* to_string(Mounting mounting) { return mounting == Mounting::kHorizon
 
 namespace {
 
+bool present(const YAML::Node& n) { return n.IsDefined() && !n.IsNull(); }
+
 // Limits shared by several keys. The loop rate range is the product's (1-20 kHz).
 constexpr double kMinRateHz = 1000.0;
 constexpr double kMaxRateHz = 20000.0;
@@ -99,6 +101,7 @@ ActuatorConfig read_actuator(MapReader& top, std::optional<double> rate) {
   if (auto v = r.number("damping_ratio", kDamping)) c.damping_ratio = *v;
   if (auto v = r.number("delay_s", {"s", 0.0, 0.1})) c.delay_s = *v;
   if (auto v = r.number("force_limit_n", {"N", 0.0, 10000.0, true})) c.force_limit_n = *v;
+  if (auto v = r.number("location", {"(location id)", 1, 64}, 2.0)) c.location = static_cast<int>(*v);
   r.finish();
   return c;
 }
@@ -212,43 +215,215 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
   return c;
 }
 
+const Range kLocationId{"(location id)", 1, 64};
+
+std::optional<int> read_int(MapReader& r, const std::string& key, const Range& range, std::optional<double> def = {}) {
+  const auto v = r.number(key, range, def);
+  if (!v) return std::nullopt;
+  if (*v != std::floor(*v)) {
+    r.diagnostics().add(r.mark(), r.path_of(key), "= " + format_number(*v) + " must be a whole number");
+    return std::nullopt;
+  }
+  return static_cast<int>(*v);
+}
+
+std::optional<int> read_sign(MapReader& r, const std::string& key, int def) {
+  const YAML::Node n = r.child(key, false, "");
+  if (!n.IsDefined() || n.IsNull()) return def;
+  int p = 0;
+  if (!n.IsScalar() || !YAML::convert<int>::decode(n, p) || (p != 1 && p != -1)) {
+    r.diagnostics().add(n.Mark(), r.path_of(key),
+                        "= '" + (n.IsScalar() ? n.Scalar() : std::string("?")) + "' is not allowed: +1 or -1");
+    return std::nullopt;
+  }
+  return p;
+}
+
+ModeConfig read_mode(MapReader& mr, std::optional<double> rate) {
+  ModeConfig m;
+  if (auto v = mr.number("natural_freq_hz", below_nyquist(rate))) m.natural_freq_hz = *v;
+  if (auto v = mr.number("damping_ratio", {"(dimensionless)", 0.0, 1.0, true, true})) m.damping_ratio = *v;
+  const bool stiffness = present(mr.child("stiffness_n_per_m", false, ""));
+  if (stiffness) {
+    m.form = ModeForm::kStiffness;
+    if (auto v = mr.number("stiffness_n_per_m", {"N/m", 0.0, 1e12, true, false, "modal-stiffness form"}))
+      m.stiffness_n_per_m = *v;
+    for (const char* k : {"residue_re_m_per_n", "residue_im_m_per_n"})
+      if (present(mr.child(k, false, "")))
+        mr.diagnostics().add(mr.mark(), mr.path_of(k),
+                             "given together with stiffness_n_per_m: a mode is in residue form (Eq. 1) or in "
+                             "modal-stiffness form, not both");
+  } else {
+    if (auto v = mr.number("residue_re_m_per_n", {"m/N", -1.0, 1.0})) m.residue_re_m_per_n = *v;
+    if (auto v = mr.number("residue_im_m_per_n", {"m/N", -1.0, 1.0})) m.residue_im_m_per_n = *v;
+  }
+  mr.finish();
+  return m;
+}
+
 RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
   Diagnostics& d = top.diagnostics();
   RobotConfig robot;
   const YAML::Node node = top.child("robot", false, "");
   if (!node.IsDefined() || node.IsNull()) return robot;
   MapReader r(d, node, "robot", top.mark());
+  const YAML::Node locs = r.child("locations", false, "");
+  if (locs.IsDefined() && !locs.IsNull()) {
+    if (!locs.IsSequence() || locs.size() == 0) d.add(locs.Mark(), "robot.locations", "must be a non-empty list");
+    std::set<int> ids;
+    for (std::size_t i = 0; locs.IsSequence() && i < locs.size(); ++i) {
+      const std::string key = "robot.locations[" + std::to_string(i) + "]";
+      MapReader lr(d, locs[i], key, locs.Mark());
+      LocationConfig l;
+      if (auto v = read_int(lr, "id", kLocationId)) {
+        l.id = *v;
+        if (!ids.insert(l.id).second) d.add(locs[i].Mark(), key + ".id", "= " + std::to_string(l.id) + " is used twice");
+      }
+      l.name = lr.text("name", "location " + std::to_string(l.id)).value_or("");
+      if (auto v = read_sign(lr, "axis_sign", 1)) l.axis_sign = *v;
+      lr.finish();
+      robot.locations.push_back(l);
+    }
+  }
   const YAML::Node frfs = r.child("frfs", true, "list of FRFs, each a sum of modes (Eq. 1)");
   if (frfs.IsDefined() && !frfs.IsNull()) {
     if (!frfs.IsSequence()) d.add(frfs.Mark(), "robot.frfs", "must be a list");
     std::set<std::string> names;
+    std::set<std::pair<int, int>> paths;
     for (std::size_t i = 0; frfs.IsSequence() && i < frfs.size(); ++i) {
       const std::string key = "robot.frfs[" + std::to_string(i) + "]";
       MapReader fr(d, frfs[i], key, frfs.Mark());
       FrfConfig f;
       f.name = fr.text("name", std::nullopt).value_or("");
       if (!names.insert(f.name).second) d.add(frfs[i].Mark(), key + ".name", "= '" + f.name + "' is used twice");
-      if (auto v = fr.number("response_location", {"(location index)", 1, 16})) f.response_location = static_cast<int>(*v);
-      if (auto v = fr.number("excitation_location", {"(location index)", 1, 16})) f.excitation_location = static_cast<int>(*v);
+      const auto g = read_int(fr, "response_location", kLocationId);
+      const auto h = read_int(fr, "excitation_location", kLocationId);
+      if (g) f.response_location = *g;
+      if (h) f.excitation_location = *h;
+      if (g && h && !paths.insert({*g, *h}).second)
+        d.add(frfs[i].Mark(), key, "a second FRF for response " + std::to_string(*g) + ", excitation " +
+                                       std::to_string(*h) + ": one FRF per path");
       const YAML::Node modes = fr.child("modes", true, "list of modes");
       if (modes.IsDefined() && (!modes.IsSequence() || modes.size() == 0))
         d.add(modes.Mark(), key + ".modes", "must be a non-empty list of modes");
       for (std::size_t k = 0; modes.IsSequence() && k < modes.size(); ++k) {
         MapReader mr(d, modes[k], key + ".modes[" + std::to_string(k) + "]", modes.Mark());
-        ModeConfig m;
-        if (auto v = mr.number("natural_freq_hz", below_nyquist(rate))) m.natural_freq_hz = *v;
-        if (auto v = mr.number("damping_ratio", {"(dimensionless)", 0.0, 1.0, true, true})) m.damping_ratio = *v;
-        if (auto v = mr.number("residue_re_m_per_n", {"m/N", -1.0, 1.0})) m.residue_re_m_per_n = *v;
-        if (auto v = mr.number("residue_im_m_per_n", {"m/N", -1.0, 1.0})) m.residue_im_m_per_n = *v;
-        mr.finish();
-        f.modes.push_back(m);
+        f.modes.push_back(read_mode(mr, rate));
       }
       fr.finish();
       robot.frfs.push_back(std::move(f));
     }
   }
   r.finish();
+  // Without a locations list every location is in the common frame.
+  if (robot.locations.empty()) {
+    std::set<int> ids;
+    for (const auto& f : robot.frfs) ids.insert({f.response_location, f.excitation_location});
+    for (int id : ids) robot.locations.push_back({id, "location " + std::to_string(id), 1});
+  } else {
+    for (std::size_t i = 0; i < robot.frfs.size(); ++i)
+      for (int id : {robot.frfs[i].response_location, robot.frfs[i].excitation_location})
+        if (!find_location(robot, id))
+          d.add(r.mark(), "robot.frfs[" + std::to_string(i) + "]",
+                "uses location " + std::to_string(id) + ", which robot.locations does not list");
+  }
   return robot;
+}
+
+SensorConfig read_sensor(MapReader& top, std::optional<double> rate) {
+  MapReader r(top.diagnostics(), top.child("sensor", false, ""), "sensor", top.mark());
+  SensorConfig c;
+  if (auto v = read_int(r, "location", kLocationId, c.location)) c.location = *v;
+  if (auto v = r.number("sensitivity_mv_per_g", {"mV/g", 0.0, 1e5, true}, c.sensitivity_mv_per_g))
+    c.sensitivity_mv_per_g = *v;
+  if (auto v = r.number("range_g", {"g", 0.0, 1e5, true}, c.range_g)) c.range_g = *v;
+  if (auto v = r.number("noise_density_ug_per_rthz", {"ug/sqrt(Hz)", 0.0, 1e6}, c.noise_density_ug_per_rthz))
+    c.noise_density_ug_per_rthz = *v;
+  if (auto v = r.number("highpass_hz", {"Hz", 0.0, 0.5 * rate.value_or(kMaxRateHz), false, true, "0 = DC coupled"},
+                        c.highpass_hz))
+    c.highpass_hz = *v;
+  if (auto v = read_int(r, "adc_bits", {"bits", 8, 32}, c.adc_bits)) c.adc_bits = *v;
+  if (auto v = r.number("adc_range_v", {"V", 0.0, 1000.0, true}, c.adc_range_v)) c.adc_range_v = *v;
+  r.finish();
+  return c;
+}
+
+PlantConfig read_plant(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("plant", false, ""), "plant", top.mark());
+  PlantConfig c;
+  if (auto v = read_int(r, "oversampling", {"(internal steps per loop period)", 1, 64}, c.oversampling))
+    c.oversampling = *v;
+  r.finish();
+  return c;
+}
+
+DisturbanceConfig read_disturbances(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("disturbances", false, ""), "disturbances", top.mark());
+  DisturbanceConfig c;
+  if (auto v = r.choice("drives_on", {"true", "false"}, "true")) c.drives_on = *v == "true";
+  if (auto v = r.number("drive_vibration_hz", {"Hz", 0.0, 100.0, true}, c.drive_vibration_hz)) c.drive_vibration_hz = *v;
+  if (auto v = r.number("drive_vibration_mps2", {"m/s^2", 0.0, 100.0}, c.drive_vibration_mps2))
+    c.drive_vibration_mps2 = *v;
+  if (auto v = read_int(r, "drive_vibration_location", kLocationId, c.drive_vibration_location))
+    c.drive_vibration_location = *v;
+  if (auto v = r.number("seed", {"(integer)", 0.0, 9007199254740992.0}, 1.0)) c.seed = static_cast<std::uint64_t>(*v);
+  r.finish();
+  return c;
+}
+
+AnalysisConfig read_analysis(MapReader& top, std::optional<double> rate) {
+  MapReader r(top.diagnostics(), top.child("analysis", false, ""), "analysis", top.mark());
+  AnalysisConfig c;
+  const Range band = below_nyquist(rate);
+  if (auto v = r.number("band_min_hz", band, c.band_min_hz)) c.band_min_hz = *v;
+  if (auto v = r.number("band_max_hz", band, c.band_max_hz)) c.band_max_hz = *v;
+  if (c.band_max_hz <= c.band_min_hz)
+    r.diagnostics().add(r.mark(), "analysis.band_max_hz",
+                        "= " + format_number(c.band_max_hz) + " Hz must be above analysis.band_min_hz = " +
+                            format_number(c.band_min_hz) + " Hz");
+  r.finish();
+  return c;
+}
+
+BenchConfig read_bench(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("bench", false, ""), "bench", top.mark());
+  BenchConfig c;
+  if (auto v = r.number("impact_peak_n", {"N", 0.0, 1e6, true}, c.impact_peak_n)) c.impact_peak_n = *v;
+  if (auto v = r.number("impact_duration_ms", {"ms", 0.05, 50.0}, c.impact_duration_ms)) c.impact_duration_ms = *v;
+  if (auto v = r.number("saturating_impact_peak_n", {"N", 0.0, 1e7, true}, c.saturating_impact_peak_n))
+    c.saturating_impact_peak_n = *v;
+  if (auto v = read_int(r, "averages", {"(impacts per test)", 1, 1000}, c.averages)) c.averages = *v;
+  if (auto v = r.number("record_s", {"s", 0.5, 600.0}, c.record_s)) c.record_s = *v;
+  if (auto v = read_int(r, "zero_pad", {"(x record length)", 1, 64}, c.zero_pad)) c.zero_pad = *v;
+  if (auto v = r.number("measurement_highpass_hz", {"Hz", 0.0, 10.0}, c.measurement_highpass_hz))
+    c.measurement_highpass_hz = *v;
+  if (present(r.child("sweep_gain_factors", false, ""))) {
+    if (auto v = r.number_list("sweep_gain_factors", "x the predicted maximum stable gain")) {
+      c.sweep_gain_factors = *v;
+      for (std::size_t i = 0; i < v->size(); ++i)
+        if (!((*v)[i] > 0.0 && (*v)[i] <= 100.0))
+          r.diagnostics().add(r.mark(), "bench.sweep_gain_factors[" + std::to_string(i) + "]",
+                              "= " + format_number((*v)[i]) + " is out of range: allowed 0 < value <= 100 (x K_max)");
+    }
+  }
+  if (auto v = r.number("sweep_duration_s", {"s", 1.0, 3600.0}, c.sweep_duration_s)) c.sweep_duration_s = *v;
+  r.finish();
+  return c;
+}
+
+// Locations named outside the robot section must exist in it.
+void check_location_refs(Diagnostics& d, const Config& c) {
+  if (c.robot.frfs.empty()) return;
+  const std::pair<const char*, int> refs[] = {{"actuator.location", c.actuator.location},
+                                              {"sensor.location", c.sensor.location},
+                                              {"disturbances.drive_vibration_location",
+                                               c.disturbances.drive_vibration_location}};
+  for (const auto& [key, id] : refs)
+    if (!find_location(c.robot, id)) {
+      std::string known;
+      for (const auto& l : c.robot.locations) known += (known.empty() ? "" : ", ") + std::to_string(l.id);
+      d.add(SourceMark{}, key, "= " + std::to_string(id) + " is not a robot location (known: " + known + ")");
+    }
 }
 
 }  // namespace
@@ -275,7 +450,13 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.amplifier = read_amplifier(top);
   c.controller = read_controller(top, rate);
   c.robot = read_robot(top, rate);
+  c.sensor = read_sensor(top, rate);
+  c.plant = read_plant(top);
+  c.disturbances = read_disturbances(top);
+  c.analysis = read_analysis(top, rate);
+  c.bench = read_bench(top);
   top.finish();
+  check_location_refs(d, c);
   if (!d.problems().empty()) throw ConfigError(d.problems());
   return c;
 }
@@ -288,28 +469,42 @@ Config load_config_file(const std::string& path) {
   return parse_config(ss.str(), path);
 }
 
-std::optional<double> dominant_mode_hz(const RobotConfig& robot) {
+const LocationConfig* find_location(const RobotConfig& robot, int id) {
+  for (const auto& l : robot.locations)
+    if (l.id == id) return &l;
+  return nullptr;
+}
+
+ModeNumerator mode_numerator(const ModeConfig& m) {
+  const double wn = 2.0 * M_PI * m.natural_freq_hz;
+  if (m.form == ModeForm::kStiffness) return {wn * wn / m.stiffness_n_per_m, 0.0};
+  const double wd = wn * std::sqrt(1.0 - m.damping_ratio * m.damping_ratio);
+  return {2.0 * (m.damping_ratio * wn * m.residue_re_m_per_n - wd * m.residue_im_m_per_n), 2.0 * m.residue_re_m_per_n};
+}
+
+std::complex<double> frf_receptance(const FrfConfig& f, double f_hz) {
+  const std::complex<double> s(0.0, 2.0 * M_PI * f_hz);
+  std::complex<double> h(0.0);
+  for (const auto& m : f.modes) {
+    const double wn = 2.0 * M_PI * m.natural_freq_hz;
+    const ModeNumerator n = mode_numerator(m);
+    h += (n.a + n.b * s) / (s * s + 2.0 * m.damping_ratio * wn * s + wn * wn);
+  }
+  return h;
+}
+
+std::optional<double> dominant_mode_hz(const RobotConfig& robot, int actuator_location) {
   const FrfConfig* best_frf = nullptr;
   for (const auto& f : robot.frfs)
-    if (f.response_location == 2 && f.excitation_location == 2) best_frf = &f;
+    if (f.response_location == actuator_location && f.excitation_location == actuator_location) best_frf = &f;
   std::optional<double> best_hz;
   double best_peak = -1.0;
   for (const auto& f : robot.frfs) {
     if (best_frf != nullptr && &f != best_frf) continue;
-    for (const auto& probe : f.modes) {
-      // |H(j wn)| of the whole FRF at each mode's frequency (Eq. 1), so close modes count together.
-      const double w = 2.0 * M_PI * probe.natural_freq_hz;
-      std::complex<double> h(0.0);
-      for (const auto& m : f.modes) {
-        const double wn = 2.0 * M_PI * m.natural_freq_hz;
-        const double wd = wn * std::sqrt(1.0 - m.damping_ratio * m.damping_ratio);
-        const double a = 2.0 * (m.damping_ratio * wn * m.residue_re_m_per_n - wd * m.residue_im_m_per_n);
-        const double b = 2.0 * m.residue_re_m_per_n;
-        const std::complex<double> s(0.0, w);
-        h += (a + b * s) / (s * s + 2.0 * m.damping_ratio * wn * s + wn * wn);
-      }
-      if (std::abs(h) > best_peak) best_peak = std::abs(h), best_hz = probe.natural_freq_hz;
-    }
+    // |H| of the whole FRF at each mode's frequency, so close modes count together.
+    for (const auto& probe : f.modes)
+      if (const double h = std::abs(frf_receptance(f, probe.natural_freq_hz)); h > best_peak)
+        best_peak = h, best_hz = probe.natural_freq_hz;
   }
   return best_hz;
 }

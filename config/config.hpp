@@ -3,6 +3,8 @@
 // a file are collected and reported together.
 #pragma once
 
+#include <complex>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -46,6 +48,7 @@ struct ActuatorConfig {
   double damping_ratio{0.15};
   double delay_s{0.0006};
   double force_limit_n{36.0};
+  int location{2};  // structural location (robot.locations id) the actuator pushes on
 };
 
 struct AmplifierConfig {
@@ -87,12 +90,26 @@ struct ControllerConfig {
   std::vector<BlockConfig> chain;
 };
 
-// Eq. 1, residue form.
+enum class ModeForm { kResidue, kStiffness };
+
+// One mode of an FRF path: Eq. 1 residue form (sigma = re + j im), or modal-stiffness form
+// H = 1 / (k (1 - (w/wn)^2 + 2 j zeta w/wn)).
 struct ModeConfig {
+  ModeForm form{ModeForm::kResidue};
   double natural_freq_hz{0.0};
   double damping_ratio{0.0};
   double residue_re_m_per_n{0.0};
   double residue_im_m_per_n{0.0};
+  double stiffness_n_per_m{0.0};
+};
+
+// A structural degree of freedom (a point and a direction). axis_sign is the sign of the tabulated
+// FRFs' response axis at this location relative to the common frame: the physical FRF is
+// axis_sign(response) * tabulated (REFERENCE.md section 1: Table 1's location-2 axis is reversed, -1).
+struct LocationConfig {
+  int id{1};
+  std::string name;
+  int axis_sign{1};
 };
 
 struct FrfConfig {
@@ -103,7 +120,52 @@ struct FrfConfig {
 };
 
 struct RobotConfig {
+  std::vector<LocationConfig> locations;  // every id used by an FRF, the actuator and the sensor
   std::vector<FrfConfig> frfs;
+};
+
+// The control accelerometer (IEPE, e.g. PCB 356B08) and its ADC channel.
+struct SensorConfig {
+  int location{2};
+  double sensitivity_mv_per_g{10.0};
+  double range_g{500.0};                   // the sensor clips beyond this
+  double noise_density_ug_per_rthz{3.0};   // broadband, white
+  double highpass_hz{1.6};                 // IEPE coupling, first order: within 5 % above 5 Hz
+  int adc_bits{24};
+  double adc_range_v{30.0};                // +- full scale
+};
+
+// The simulated plant's numerical settings.
+struct PlantConfig {
+  int oversampling{4};  // internal steps per loop period
+};
+
+// Disturbances present in bench runs.
+struct DisturbanceConfig {
+  bool drives_on{true};                 // the robot's inherent vibration is present with the drives on
+  double drive_vibration_hz{3.0};
+  double drive_vibration_mps2{0.05};    // amplitude of acceleration at the sensor location, control off
+  int drive_vibration_location{1};      // where the equivalent force acts
+  std::uint64_t seed{1};
+};
+
+// Frequency band where FRF peaks are sought, by the analysis and the bench alike.
+struct AnalysisConfig {
+  double band_min_hz{4.0};
+  double band_max_hz{100.0};
+};
+
+// The bench run: averaged impact tests control off and on, and a gain sweep.
+struct BenchConfig {
+  double impact_peak_n{20.0};            // small enough not to saturate the actuator
+  double impact_duration_ms{1.0};        // half-sine
+  double saturating_impact_peak_n{2000.0};
+  int averages{6};
+  double record_s{10.0};                 // per impact: frequency resolution 1 / record_s
+  int zero_pad{8};                       // evaluation grid = resolution / zero_pad (records decay fully)
+  double measurement_highpass_hz{0.16};  // measurement accelerometers (modal grade)
+  std::vector<double> sweep_gain_factors{0.5, 0.9, 1.1, 1.5};  // x the predicted maximum stable K
+  double sweep_duration_s{20.0};
 };
 
 struct Config {
@@ -113,14 +175,31 @@ struct Config {
   AmplifierConfig amplifier;
   ControllerConfig controller;
   RobotConfig robot;
+  SensorConfig sensor;
+  PlantConfig plant;
+  DisturbanceConfig disturbances;
+  AnalysisConfig analysis;
+  BenchConfig bench;
 };
 
 // Throw ConfigError holding every problem found.
 [[nodiscard]] Config parse_config(const std::string& yaml_text, const std::string& source_name);
 [[nodiscard]] Config load_config_file(const std::string& path);
 
-// Frequency of the robot mode with the largest receptance peak, preferring a driving-point FRF at the
-// actuator location (2) where the loop closes; nullopt without modal data.
-[[nodiscard]] std::optional<double> dominant_mode_hz(const RobotConfig& robot);
+[[nodiscard]] const LocationConfig* find_location(const RobotConfig& robot, int id);
+
+// Eq. 1 numerator of one mode, H(s) = (a + b s) / (s^2 + 2 zeta wn s + wn^2), in the tabulated frame:
+// residue form a = 2 (zeta wn re - wd im), b = 2 re; stiffness form a = wn^2 / k, b = 0.
+struct ModeNumerator {
+  double a{0.0};  // m/N * rad^2/s^2
+  double b{0.0};  // m/N * rad/s
+};
+[[nodiscard]] ModeNumerator mode_numerator(const ModeConfig& m);
+// Receptance of one FRF path at f_hz, tabulated frame (no axis sign), m/N.
+[[nodiscard]] std::complex<double> frf_receptance(const FrfConfig& f, double f_hz);
+
+// Frequency of the robot mode with the largest receptance peak, preferring the driving-point FRF at the
+// actuator location where the loop closes; nullopt without modal data.
+[[nodiscard]] std::optional<double> dominant_mode_hz(const RobotConfig& robot, int actuator_location = 2);
 
 }  // namespace robodamp::config

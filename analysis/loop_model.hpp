@@ -1,0 +1,165 @@
+// The damping loop in the frequency domain (REFERENCE.md section 1, Eq. 8-12 with the corrected H11):
+// the continuous model (actuator delay exact, the configured sensor's analog coupling) and the discrete
+// loop that actually runs (the plant discretised exactly with zero-order hold at the loop rate, the
+// sampled sensor, one sample of computation delay, the digital chain). Stability of the discrete loop from
+// its closed-loop poles, cross-checked by a Nyquist count. Off the real-time path.
+#pragma once
+
+#include <complex>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "config/config.hpp"
+#include "control/chain_design.hpp"
+#include "sim_plant/plant_model.hpp"
+#include "sim_plant/sensor.hpp"
+
+namespace robodamp::analysis {
+
+using Complex = std::complex<double>;
+
+// Discrete state-space x[k+1] = A x + B u, y = C x + D u (SISO here).
+struct DiscreteSs {
+  Eigen::MatrixXd a, b, c, d;
+};
+
+// The plant's discrete transfers at one frequency: sampled acceleration at each location per held
+// coil voltage and per held external force at each location (sample at t_k per input held over [k, k+1)).
+struct PlantResponse {
+  double f_hz{0.0};
+  std::vector<Complex> accel_per_volt;              // [location]
+  std::vector<std::vector<Complex>> accel_per_force;  // [response][excitation]
+};
+
+class LoopModel {
+ public:
+  explicit LoopModel(const config::Config& cfg);
+
+  [[nodiscard]] const sim::PlantModel& plant() const { return plant_; }
+  [[nodiscard]] const control::ChainDesign& chain() const { return chain_; }
+  [[nodiscard]] const config::Config& config() const { return cfg_; }
+  [[nodiscard]] std::size_t sensor_location() const { return sensor_; }
+  [[nodiscard]] std::size_t actuator_location() const { return plant_.actuator.location; }
+  [[nodiscard]] double loop_rate_hz() const { return cfg_.loop.rate_hz; }
+
+  // Force per displacement at the sensor location that the controller feeds back (F_act = Q x_s), for
+  // gain K and polarity; continuous: Q = pol K / T * filters * H_act e^{-s t_a} * S(s) * s^2.
+  [[nodiscard]] Complex feedback_continuous(double f_hz, double gain_ns_per_m, int polarity) const;
+  // Return-difference loop gain L (closed loop = 1 / (1 + L)), continuous and discrete.
+  [[nodiscard]] Complex loop_continuous(double f_hz, double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] Complex loop_discrete(double f_hz, double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] Complex loop_discrete(const PlantResponse& p, Complex chain_filters, double gain_ns_per_m,
+                                      int polarity) const;
+
+  // Receptance from force at h to displacement at g (physical frame), open and closed loop.
+  [[nodiscard]] Complex open_continuous(std::size_t g, std::size_t h, double f_hz) const;
+  [[nodiscard]] Complex closed_continuous(std::size_t g, std::size_t h, double f_hz, double gain_ns_per_m,
+                                          int polarity) const;
+  // Discrete: sampled accelerance / (-w^2), as an impact test at the loop rate measures it.
+  [[nodiscard]] PlantResponse plant_response(double f_hz) const;
+  [[nodiscard]] Complex chain_filters_digital(double f_hz) const { return chain_.filters_digital(f_hz); }
+  [[nodiscard]] Complex open_discrete(const PlantResponse& p, std::size_t g, std::size_t h) const;
+  [[nodiscard]] Complex closed_discrete(const PlantResponse& p, Complex chain_filters, std::size_t g, std::size_t h,
+                                        double gain_ns_per_m, int polarity) const;
+
+  // Closed-loop state matrix of the discrete loop and its eigenvalues.
+  [[nodiscard]] Eigen::MatrixXd closed_loop_matrix(double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] Eigen::VectorXcd closed_loop_poles(double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] double spectral_radius(double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] bool stable(double gain_ns_per_m, int polarity) const { return spectral_radius(gain_ns_per_m, polarity) < 1.0; }
+  // Net clockwise encirclements of -1 by L(e^{jwT}) over the whole unit circle (0 for a stable loop,
+  // all open-loop poles being inside the unit circle).
+  [[nodiscard]] int nyquist_encirclements(double gain_ns_per_m, int polarity) const;
+
+ private:
+  config::Config cfg_;
+  sim::PlantModel plant_;
+  control::ChainDesign chain_;
+  sim::Accelerometer sensor_model_;
+  std::size_t sensor_;
+  // Loop-rate discretisation of the plant with the actuator delay.
+  Eigen::MatrixXd phi_, gamma_late_, gamma_early_, gamma_force_, c_accel_, d_accel_coil_, d_accel_force_;
+  int delay_steps_{0};
+  DiscreteSs open_loop_unit_;  // controller output -> controller output at K = 1, polarity +1 (no gain yet)
+};
+
+// --- Results -------------------------------------------------------------------------------------
+
+struct FrfResult {
+  std::string name;           // as configured (e.g. H22yy)
+  std::size_t response{0}, excitation{0};
+  double open_peak_m_per_n{0.0};
+  double closed_peak_m_per_n{0.0};
+  double open_peak_freq_hz{0.0};
+  double peak_freq_hz{0.0};   // of the closed-loop peak
+  double improvement_pct{0.0};
+};
+
+struct ModePhase {
+  double freq_hz{0.0};
+  double feedback_phase_deg{0.0};  // phase of -F_act / v at the sensor: damping within (-90, 90)
+  bool damps{false};
+};
+
+struct Margins {
+  std::optional<double> gain_margin_db;     // 20 log10(K_max / K); none if stable up to the gain limit
+  std::optional<double> phase_margin_deg;   // smallest angular distance of L from -1 at a gain crossover
+  std::optional<double> phase_crossover_hz;
+  std::optional<double> gain_crossover_hz;
+  std::optional<double> delay_margin_ms;    // smallest extra pure delay that turns L onto -1 at a crossover
+};
+
+struct AnalysisResult {
+  double gain_ns_per_m{0.0};
+  int polarity{1};
+  bool stable{false};
+  double spectral_radius{0.0};
+  int nyquist_encirclements{0};
+  bool stable_continuous{false};
+  std::optional<double> max_stable_gain_ns_per_m;  // none = stable up to kMaxGainNsPerM
+  Margins margins;
+  int recommended_polarity{1};
+  std::string polarity_reason;
+  std::vector<ModePhase> modes;
+  std::vector<FrfResult> frfs_continuous;
+  std::vector<FrfResult> frfs_discrete;
+  std::vector<std::string> notes;
+};
+
+// Peak of |H| over [lo, hi] on a grid refined by golden-section search around each local maximum.
+struct Peak {
+  double freq_hz{0.0};
+  double magnitude{0.0};
+};
+// grid_hz ascending with values[i] = magnitude(grid_hz[i]); refine() evaluates between grid points.
+[[nodiscard]] Peak find_peak(const std::vector<double>& grid_hz, const std::vector<double>& values,
+                             const std::function<double(double)>& refine);
+[[nodiscard]] std::vector<double> linear_grid(double lo_hz, double hi_hz, double step_hz);
+
+// Net counter-clockwise turns of arg(fn(f)) as f goes lo -> hi, by adaptive subdivision.
+[[nodiscard]] double turns(const std::function<Complex(double)>& fn, double lo_hz, double hi_hz);
+
+// Improvement and the dominant closed-loop pole across K (the root-locus view of the gain).
+struct SweepPoint {
+  double gain_ns_per_m{0.0};
+  double spectral_radius{0.0};
+  double least_damping_ratio{0.0};  // of the closed-loop poles below Nyquist/2, from s = fs ln z
+  double least_damped_hz{0.0};
+  std::vector<double> improvement_pct;  // per configured FRF (discrete loop)
+};
+[[nodiscard]] std::vector<SweepPoint> gain_sweep(const LoopModel& m, int polarity, const std::vector<double>& gains);
+
+// Smallest K > 0 at which the discrete loop becomes unstable (log scan, then bisection to 1e-6).
+[[nodiscard]] std::optional<double> max_stable_gain(const LoopModel& m, int polarity);
+[[nodiscard]] Margins margins(const LoopModel& m, double gain_ns_per_m, int polarity,
+                              std::optional<double> max_gain);
+[[nodiscard]] std::vector<FrfResult> improvements(const LoopModel& m, double gain_ns_per_m, int polarity,
+                                                  bool discrete);
+[[nodiscard]] AnalysisResult analyse(const LoopModel& m);
+[[nodiscard]] AnalysisResult analyse(const LoopModel& m, double gain_ns_per_m, int polarity);
+
+}  // namespace robodamp::analysis

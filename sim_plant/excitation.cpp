@@ -1,0 +1,72 @@
+#include "sim_plant/excitation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "filters/design.hpp"
+#include "filters/transfer_function.hpp"
+
+namespace robodamp::sim {
+
+ImpactHammer::ImpactHammer(std::size_t location, double peak_n, double duration_s, std::vector<double> times_s)
+    : Excitation(location), peak_n_(peak_n), duration_s_(duration_s), times_s_(std::move(times_s)) {
+  if (!(duration_s_ > 0.0)) throw std::invalid_argument("impact duration must be > 0 s");
+  std::sort(times_s_.begin(), times_s_.end());
+}
+
+double ImpactHammer::force_n(double t_s, double h_s) noexcept {
+  while (next_ < times_s_.size() && times_s_[next_] + duration_s_ <= t_s) ++next_;
+  double impulse = 0.0;
+  for (std::size_t i = next_; i < times_s_.size() && times_s_[i] < t_s + h_s; ++i) {
+    // Exact integral of the half-sine over the overlap of [t, t + h) and the pulse.
+    const double lo = std::max(t_s, times_s_[i]) - times_s_[i];
+    const double hi = std::min(t_s + h_s, times_s_[i] + duration_s_) - times_s_[i];
+    if (hi > lo)
+      impulse += peak_n_ * duration_s_ / M_PI * (std::cos(M_PI * lo / duration_s_) - std::cos(M_PI * hi / duration_s_));
+  }
+  return impulse / h_s;
+}
+
+Sine::Sine(std::size_t location, double amplitude_n, double freq_hz, double phase_rad)
+    : Excitation(location), amplitude_n_(amplitude_n), w_(2.0 * M_PI * freq_hz), phase_(phase_rad) {}
+
+double Sine::force_n(double t_s, double h_s) noexcept {
+  // Mean of A sin(w t + phi) over the step.
+  return amplitude_n_ * (std::cos(w_ * t_s + phase_) - std::cos(w_ * (t_s + h_s) + phase_)) / (w_ * h_s);
+}
+
+Chirp::Chirp(std::size_t location, double amplitude_n, double f0_hz, double f1_hz, double duration_s)
+    : Excitation(location), amplitude_n_(amplitude_n), f0_(f0_hz), f1_(f1_hz), duration_s_(duration_s) {}
+
+double Chirp::force_n(double t_s, double h_s) noexcept {
+  const double t = t_s + 0.5 * h_s;
+  if (t >= duration_s_) return 0.0;
+  const double k = (f1_ - f0_) / duration_s_;
+  return amplitude_n_ * std::sin(2.0 * M_PI * (f0_ * t + 0.5 * k * t * t));
+}
+
+Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed) : Excitation(location), rms_n_(rms_n), rng_(seed) {}
+
+Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed, double band_lo_hz, double band_hi_hz,
+             double step_rate_hz)
+    : Noise(location, rms_n, seed) {
+  const auto tf = filters::highpass2(band_lo_hz, M_SQRT1_2) * filters::lowpass2(band_hi_hz, M_SQRT1_2);
+  const auto d = filters::bilinear_sos(tf, step_rate_hz, std::sqrt(band_lo_hz * band_hi_hz));
+  band_ = filters::BiquadCascade(filters::SosCoefficients::from(d.sections));
+  // Scale so the output RMS is rms_n: the mean of |H|^2 over (0, Nyquist) for unit-variance white input.
+  double power = 0.0;
+  const int n = 8192;
+  for (int i = 0; i < n; ++i)
+    power += std::norm(filters::digital_response(d.sections, 1.0, (i + 0.5) / n * 0.5 * step_rate_hz, step_rate_hz)) / n;
+  band_gain_ = 1.0 / std::sqrt(std::max(power, 1e-300));
+  band_limited_ = true;
+}
+
+double Noise::force_n(double, double) noexcept {
+  const double w = normal_(rng_);
+  if (!band_limited_) return rms_n_ * w;
+  return rms_n_ * band_gain_ * band_.process(w);
+}
+
+}  // namespace robodamp::sim

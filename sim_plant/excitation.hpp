@@ -1,0 +1,77 @@
+// Forces on the structure: impact hammer, sine, chirp, white and band-limited noise, and the robot's
+// inherent vibration with the drives on. Every source is seeded and reproducible; each returns the mean
+// force over a step [t, t + h), which a zero-order hold then applies exactly (an impact's impulse is
+// preserved at any step). Constructed off the real-time path; force_n() is RT-safe.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "filters/biquad.hpp"
+
+namespace robodamp::sim {
+
+class Excitation {
+ public:
+  explicit Excitation(std::size_t location) : location_(location) {}
+  virtual ~Excitation() = default;
+  // Mean force over [t_s, t_s + h_s), N. Called with consecutive steps.
+  virtual double force_n(double t_s, double h_s) noexcept = 0;
+  [[nodiscard]] std::size_t location() const { return location_; }
+
+ private:
+  std::size_t location_;
+};
+
+// Half-sine impacts of a modal hammer: F(t) = peak sin(pi (t - t0) / duration) for t0 <= t < t0 + duration.
+class ImpactHammer final : public Excitation {
+ public:
+  ImpactHammer(std::size_t location, double peak_n, double duration_s, std::vector<double> times_s);
+  double force_n(double t_s, double h_s) noexcept override;
+  [[nodiscard]] double impulse_n_s() const { return 2.0 * peak_n_ * duration_s_ / M_PI; }
+  [[nodiscard]] const std::vector<double>& times_s() const { return times_s_; }
+
+ private:
+  double peak_n_, duration_s_;
+  std::vector<double> times_s_;
+  std::size_t next_{0};
+};
+
+class Sine final : public Excitation {
+ public:
+  Sine(std::size_t location, double amplitude_n, double freq_hz, double phase_rad);
+  double force_n(double t_s, double h_s) noexcept override;
+
+ private:
+  double amplitude_n_, w_, phase_;
+};
+
+// Linear sine sweep f0 -> f1 over duration_s, then silent (sampled at step mid-points).
+class Chirp final : public Excitation {
+ public:
+  Chirp(std::size_t location, double amplitude_n, double f0_hz, double f1_hz, double duration_s);
+  double force_n(double t_s, double h_s) noexcept override;
+
+ private:
+  double amplitude_n_, f0_, f1_, duration_s_;
+};
+
+// Gaussian white noise of a given RMS per step, optionally band-limited by a Butterworth-type band-pass
+// (second-order high-pass and low-pass, digital at the step rate).
+class Noise final : public Excitation {
+ public:
+  Noise(std::size_t location, double rms_n, std::uint64_t seed);
+  Noise(std::size_t location, double rms_n, std::uint64_t seed, double band_lo_hz, double band_hi_hz, double step_rate_hz);
+  double force_n(double t_s, double h_s) noexcept override;
+
+ private:
+  double rms_n_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  bool band_limited_{false};
+  filters::BiquadCascade band_;
+  double band_gain_{1.0};
+};
+
+}  // namespace robodamp::sim

@@ -1,0 +1,86 @@
+// Scheduled faults for safety work: the sensor drops out, sticks, spikes or reads NaN; the actuator goes
+// dead or saturates at a lower force. Faults are added before a run; queries are RT-safe.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace robodamp::sim {
+
+enum class FaultKind { kSensorDropout, kSensorStuck, kSensorSpike, kSensorNan, kActuatorDead, kActuatorSaturated };
+
+[[nodiscard]] const char* to_string(FaultKind kind);
+
+struct Fault {
+  FaultKind kind{FaultKind::kSensorDropout};
+  double start_s{0.0};
+  double duration_s{std::numeric_limits<double>::infinity()};
+  double magnitude{0.0};  // spike: m/s^2 added; actuator saturated: force limit (N)
+  double period_s{0.0};   // spike: repeat period within the window (0 = once)
+};
+
+// What the sensor delivers for one tick: a value and whether it is a new sample.
+struct SensorReading {
+  double accel_mps2{0.0};
+  bool fresh{true};
+};
+
+class FaultInjector {
+ public:
+  void add(const Fault& f) { faults_.push_back(f); }
+  void clear() { faults_.clear(); }
+  [[nodiscard]] bool empty() const { return faults_.empty(); }
+
+  // RT-safe. The reading at time t for a measured value; stuck holds the value measured when the fault
+  // began, dropout repeats the last delivered value marked not fresh.
+  SensorReading apply_sensor(double t_s, double dt_s, double value) noexcept {
+    SensorReading r{value, true};
+    for (const auto& f : faults_) {
+      if (!active(f, t_s)) continue;
+      switch (f.kind) {
+        case FaultKind::kSensorDropout: r = {last_.accel_mps2, false}; break;
+        case FaultKind::kSensorStuck:
+          if (!stuck_) stuck_value_ = last_.accel_mps2, stuck_ = true;
+          r.accel_mps2 = stuck_value_;
+          break;
+        case FaultKind::kSensorSpike: {
+          const double since = t_s - f.start_s;
+          const double phase = f.period_s > 0.0 ? std::fmod(since, f.period_s) : since;
+          if (phase < dt_s) r.accel_mps2 += f.magnitude;
+          break;
+        }
+        case FaultKind::kSensorNan: r.accel_mps2 = std::numeric_limits<double>::quiet_NaN(); break;
+        default: break;
+      }
+    }
+    if (!any_active(FaultKind::kSensorStuck, t_s)) stuck_ = false;
+    last_ = r;
+    return r;
+  }
+  // RT-safe. Actuator force limit at time t (0 when dead), given the nominal one.
+  [[nodiscard]] double actuator_force_limit_n(double t_s, double nominal_n) const noexcept {
+    double limit = nominal_n;
+    for (const auto& f : faults_) {
+      if (!active(f, t_s)) continue;
+      if (f.kind == FaultKind::kActuatorDead) limit = 0.0;
+      if (f.kind == FaultKind::kActuatorSaturated) limit = std::min(limit, f.magnitude);
+    }
+    return limit;
+  }
+
+ private:
+  static bool active(const Fault& f, double t_s) noexcept { return t_s >= f.start_s && t_s < f.start_s + f.duration_s; }
+  [[nodiscard]] bool any_active(FaultKind k, double t_s) const noexcept {
+    for (const auto& f : faults_)
+      if (f.kind == k && active(f, t_s)) return true;
+    return false;
+  }
+  std::vector<Fault> faults_;
+  SensorReading last_{};
+  bool stuck_{false};
+  double stuck_value_{0.0};
+};
+
+}  // namespace robodamp::sim

@@ -1,0 +1,114 @@
+#include "sim_plant/plant.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace robodamp::sim {
+
+Plant::Plant(PlantModel model, const config::Config& cfg)
+    : model_(std::move(model)),
+      period_s_(1.0 / cfg.loop.rate_hz),
+      oversampling_(cfg.plant.oversampling),
+      h_s_(period_s_ / cfg.plant.oversampling),
+      sensor_(cfg.sensor, cfg.loop.rate_hz, cfg.disturbances.seed * 0x9E3779B97F4A7C15ULL + 1),
+      sensor_loc_(model_.index_of(cfg.sensor.location)) {
+  const Matrix& b = model_.ss.b;
+  const Eigen::Index nu = b.cols();
+  // The coil drive is delayed (Eq. 3's t_a); the external forces are not.
+  zoh_ = discretise_zoh_delayed(model_.ss.a, b.leftCols(1), h_s_, model_.actuator.delay_s);
+  const Zoh forces = discretise_zoh(model_.ss.a, b.rightCols(nu - 1), h_s_);
+  const auto& pattern = model_.pattern;
+  phi_ = SparseRows(zoh_.phi, &pattern);
+  gamma_early_ = SparseRows(zoh_.gamma_early);
+  gamma_late_ = SparseRows(zoh_.gamma_late);
+  gamma_force_ = SparseRows(forces.gamma);
+  c_ = SparseRows(model_.ss.c);
+  d_ = SparseRows(model_.ss.d);
+  const std::size_t n = static_cast<std::size_t>(model_.ss.a.rows());
+  x_.assign(n, 0.0);
+  x_next_.assign(n, 0.0);
+  y_.assign(static_cast<std::size_t>(model_.ss.c.rows()), 0.0);
+  u_.assign(static_cast<std::size_t>(nu), 0.0);
+  u_early_.assign(1, 0.0);
+  coil_history_.assign(static_cast<std::size_t>(zoh_.steps) + 2, 0.0);
+  period_force_.assign(model_.locations.size(), 0.0);
+}
+
+void Plant::reset() {
+  std::fill(x_.begin(), x_.end(), 0.0);
+  std::fill(y_.begin(), y_.end(), 0.0);
+  std::fill(u_.begin(), u_.end(), 0.0);
+  std::fill(coil_history_.begin(), coil_history_.end(), 0.0);
+  std::fill(period_force_.begin(), period_force_.end(), 0.0);
+  history_pos_ = 0;
+  internal_steps_ = 0;
+  counters_ = {};
+  sensor_.reset();
+}
+
+std::size_t Plant::nonzeros_per_step() const {
+  return phi_.nonzeros() + gamma_early_.nonzeros() + gamma_late_.nonzeros() + gamma_force_.nonzeros();
+}
+
+void Plant::step(double drive_v) noexcept {
+  const std::size_t nl = model_.locations.size();
+  const std::size_t hist = coil_history_.size();
+  std::fill(period_force_.begin(), period_force_.end(), 0.0);
+  for (int i = 0; i < oversampling_; ++i) {
+    const double t = static_cast<double>(internal_steps_) * h_s_;
+    // Amplifier voltage range, then the actuator's coil force limit (faults may lower it to zero).
+    double v = std::isfinite(drive_v) ? drive_v : 0.0;
+    if (std::abs(v) > model_.voltage_limit_v) {
+      v = std::copysign(model_.voltage_limit_v, v);
+      ++counters_.voltage_clipped;
+    }
+    const double limit_v =
+        faults_.actuator_force_limit_n(t, model_.actuator.force_limit_n) / model_.actuator.constant_n_per_v;
+    if (std::abs(v) > limit_v) {
+      v = std::copysign(limit_v, v);
+      ++counters_.force_limited;
+    }
+    coil_history_[history_pos_] = v;
+    // u[k - steps] and u[k - steps - 1] from the ring.
+    const std::size_t late = (history_pos_ + hist - static_cast<std::size_t>(zoh_.steps)) % hist;
+    const std::size_t early = (late + hist - 1) % hist;
+    history_pos_ = (history_pos_ + 1) % hist;
+    u_[0] = coil_history_[late];
+    u_early_[0] = coil_history_[early];
+    for (std::size_t l = 0; l < nl; ++l) u_[1 + l] = 0.0;
+    for (auto& e : excitations_) u_[1 + e->location()] += e->force_n(t, h_s_);
+    for (std::size_t l = 0; l < nl; ++l) period_force_[l] += u_[1 + l] / oversampling_;
+
+    std::fill(x_next_.begin(), x_next_.end(), 0.0);
+    phi_.accumulate(x_.data(), x_next_.data());
+    gamma_late_.accumulate(u_.data(), x_next_.data());
+    gamma_early_.accumulate(u_early_.data(), x_next_.data());
+    gamma_force_.accumulate(u_.data() + 1, x_next_.data());
+    x_.swap(x_next_);
+    ++internal_steps_;
+  }
+  // Left limits at the end of the period: the inputs of the last internal step.
+  std::fill(y_.begin(), y_.end(), 0.0);
+  c_.accumulate(x_.data(), y_.data());
+  d_.accumulate(u_.data(), y_.data());
+  ++counters_.steps;
+}
+
+SensorReading Plant::sense() noexcept {
+  const double measured = sensor_.measure(acceleration_mps2(sensor_loc_));
+  return faults_.apply_sensor(time_s(), period_s_, measured);
+}
+
+std::unique_ptr<Excitation> make_drive_vibration(const PlantModel& model, const config::Config& cfg) {
+  const auto& d = cfg.disturbances;
+  const std::size_t at = model.index_of(d.drive_vibration_location), sensor = model.index_of(cfg.sensor.location);
+  const double w = 2.0 * M_PI * d.drive_vibration_hz;
+  const double accel_per_n = w * w * std::abs(model.receptance(sensor, at, d.drive_vibration_hz));
+  const double amplitude = accel_per_n > 0.0 ? d.drive_vibration_mps2 / accel_per_n : 0.0;
+  std::mt19937_64 rng(d.seed);
+  const double phase = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(rng);
+  return std::make_unique<Sine>(at, amplitude, d.drive_vibration_hz, phase);
+}
+
+}  // namespace robodamp::sim

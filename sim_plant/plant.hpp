@@ -1,0 +1,86 @@
+// The simulated plant in time: the state-space of PlantModel discretised exactly (zero-order hold on the
+// amplifier voltage and the external forces) at loop rate x oversampling, with the actuator delay exact
+// at the internal rate, the amplifier's voltage range and the actuator's force limit, the control
+// accelerometer, excitations and faults. Construction allocates; step() and the readers are RT-safe.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "config/config.hpp"
+#include "sim_plant/excitation.hpp"
+#include "sim_plant/faults.hpp"
+#include "sim_plant/plant_model.hpp"
+#include "sim_plant/sensor.hpp"
+#include "sim_plant/state_space.hpp"
+
+namespace robodamp::sim {
+
+struct PlantCounters {
+  std::uint64_t steps{0};             // loop periods
+  std::uint64_t voltage_clipped{0};   // internal steps with the amplifier at its voltage range
+  std::uint64_t force_limited{0};     // internal steps with the actuator coil force at its limit
+};
+
+class Plant {
+ public:
+  Plant(PlantModel model, const config::Config& cfg);
+
+  // Before a run (allocates).
+  void add_excitation(std::unique_ptr<Excitation> e) { excitations_.push_back(std::move(e)); }
+  void clear_excitations() { excitations_.clear(); }
+  FaultInjector& faults() { return faults_; }
+  // Zero state, empty delay line, time 0, counters cleared; excitations and faults stay.
+  void reset();
+
+  // RT-safe. One loop period with the amplifier input held at drive_v.
+  void step(double drive_v) noexcept;
+  // RT-safe. The control accelerometer's reading at the current instant (call once per loop tick).
+  [[nodiscard]] SensorReading sense() noexcept;
+
+  // True outputs at the current instant (left limits), m, m/s, m/s^2, N.
+  [[nodiscard]] double displacement_m(std::size_t loc) const { return y_[model_.output_displacement(loc)]; }
+  [[nodiscard]] double velocity_mps(std::size_t loc) const { return y_[model_.output_velocity(loc)]; }
+  [[nodiscard]] double acceleration_mps2(std::size_t loc) const { return y_[model_.output_acceleration(loc)]; }
+  [[nodiscard]] double actuator_force_n() const { return y_[model_.output_actuator_force()]; }
+  // Mean external force at a location over the last period (what a force sensor sampled at the loop
+  // rate through its anti-aliasing sees, to first order), N.
+  [[nodiscard]] double external_force_n(std::size_t loc) const { return period_force_[loc]; }
+
+  [[nodiscard]] double time_s() const { return static_cast<double>(counters_.steps) * period_s_; }
+  [[nodiscard]] double period_s() const { return period_s_; }
+  [[nodiscard]] int oversampling() const { return oversampling_; }
+  [[nodiscard]] const PlantCounters& counters() const { return counters_; }
+  [[nodiscard]] const PlantModel& model() const { return model_; }
+  [[nodiscard]] const DelayedZoh& discretisation() const { return zoh_; }
+  [[nodiscard]] Accelerometer& sensor() { return sensor_; }
+  [[nodiscard]] std::size_t sensor_location() const { return sensor_loc_; }
+  [[nodiscard]] std::size_t state_count() const { return static_cast<std::size_t>(x_.size()); }
+  [[nodiscard]] std::size_t nonzeros_per_step() const;
+
+ private:
+  PlantModel model_;
+  double period_s_;
+  int oversampling_;
+  double h_s_;
+  DelayedZoh zoh_;
+  SparseRows phi_, gamma_early_, gamma_late_, gamma_force_;  // gamma_force: late columns of the forces
+  SparseRows c_, d_;
+  std::vector<double> x_, x_next_, y_, u_, u_early_;
+  std::vector<double> coil_history_;  // delay line of the coil drive at the internal rate
+  std::size_t history_pos_{0};
+  std::vector<double> period_force_;
+  std::vector<std::unique_ptr<Excitation>> excitations_;
+  FaultInjector faults_;
+  Accelerometer sensor_;
+  std::size_t sensor_loc_;
+  std::uint64_t internal_steps_{0};
+  PlantCounters counters_{};
+};
+
+// The robot's inherent vibration with the drives on (REFERENCE.md section 1: about 3 Hz): a sine force at
+// the configured location sized for the configured open-loop acceleration amplitude at the sensor.
+[[nodiscard]] std::unique_ptr<Excitation> make_drive_vibration(const PlantModel& model, const config::Config& cfg);
+
+}  // namespace robodamp::sim

@@ -1,0 +1,179 @@
+#include "sim_plant/plant_model.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace robodamp::sim {
+
+namespace {
+constexpr double kTwoPi = 2.0 * M_PI;
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+}  // namespace
+
+Complex FrfPath::receptance(double f_hz) const {
+  const Complex s(0.0, kTwoPi * f_hz);
+  Complex h(0.0);
+  for (const auto& m : modes)
+    h += (m.a + m.b * s) / (s * s + 2.0 * m.damping_ratio * m.wn_rad_per_s * s + m.wn_rad_per_s * m.wn_rad_per_s);
+  return h;
+}
+
+double FrfPath::static_compliance_m_per_n() const {
+  double h = 0.0;
+  for (const auto& m : modes) h += m.a / (m.wn_rad_per_s * m.wn_rad_per_s);
+  return h;
+}
+
+Complex ActuatorModel::n_per_v(double f_hz) const {
+  const Complex s(0.0, kTwoPi * f_hz);
+  const double wa = kTwoPi * natural_freq_hz;
+  return constant_n_per_v * s * s * std::exp(-s * delay_s) / (s * s + 2.0 * damping_ratio * wa * s + wa * wa);
+}
+
+std::size_t PlantModel::index_of(int location_id) const {
+  for (std::size_t i = 0; i < locations.size(); ++i)
+    if (locations[i].id == location_id) return i;
+  throw std::out_of_range("no robot location with id " + std::to_string(location_id));
+}
+
+const FrfPath* PlantModel::path(std::size_t response, std::size_t excitation) const {
+  for (const auto& p : paths)
+    if (p.response == response && p.excitation == excitation) return &p;
+  return nullptr;
+}
+
+Complex PlantModel::receptance(std::size_t response, std::size_t excitation, double f_hz) const {
+  const FrfPath* p = path(response, excitation);
+  return p != nullptr ? p->receptance(f_hz) : Complex(0.0);
+}
+
+PlantModel build_plant_model(const config::Config& cfg) {
+  std::vector<config::Problem> problems;
+  auto problem = [&](const std::string& key, const std::string& msg) {
+    problems.push_back({cfg.source, {}, key, msg});
+  };
+  if (cfg.robot.frfs.empty()) {
+    problem("robot.frfs", "missing: the simulated plant and the loop analysis need the robot's modal data");
+    throw config::ConfigError(problems);
+  }
+  PlantModel m;
+  m.locations = cfg.robot.locations;
+  m.voltage_limit_v = cfg.amplifier.voltage_limit_v;
+
+  // FRF paths in the physical frame: H_phys = axis_sign(response) * H_table.
+  for (std::size_t i = 0; i < cfg.robot.frfs.size(); ++i) {
+    const auto& f = cfg.robot.frfs[i];
+    FrfPath p;
+    p.name = f.name;
+    p.origin = "robot.frfs[" + std::to_string(i) + "]";
+    p.response = m.index_of(f.response_location);
+    p.excitation = m.index_of(f.excitation_location);
+    const double sign = m.locations[p.response].axis_sign;
+    for (const auto& mode : f.modes) {
+      const config::ModeNumerator n = config::mode_numerator(mode);
+      p.modes.push_back({kTwoPi * mode.natural_freq_hz, mode.damping_ratio, sign * n.a, sign * n.b});
+    }
+    const double h0 = p.static_compliance_m_per_n();
+    if (p.response == p.excitation && !(h0 > 0.0))
+      problem(p.origin, "(" + p.name + ") is a driving-point FRF with static compliance " + num(h0) +
+                            " m/N after axis_sign " + std::to_string(static_cast<int>(sign)) +
+                            " of location " + std::to_string(f.response_location) +
+                            ": a physical receptance needs > 0; check the location's axis_sign");
+    m.paths.push_back(std::move(p));
+  }
+  // Reciprocity (Maxwell-Betti): H_gh = H_hg in the physical frame. A given pair must agree in sign;
+  // a missing one is taken from its reciprocal.
+  const std::size_t given = m.paths.size();
+  for (std::size_t i = 0; i < given; ++i) {
+    const FrfPath& p = m.paths[i];
+    if (p.response == p.excitation) continue;
+    if (const FrfPath* q = m.path(p.excitation, p.response)) {
+      if (p.static_compliance_m_per_n() * q->static_compliance_m_per_n() < 0.0)
+        problem(p.origin, "(" + p.name + ") and " + q->origin + " (" + q->name +
+                              ") have static compliances of opposite sign (" + num(p.static_compliance_m_per_n()) +
+                              " and " + num(q->static_compliance_m_per_n()) +
+                              " m/N) in the physical frame: reciprocity fails; check the axis_sign of both locations");
+      continue;
+    }
+    FrfPath r = p;
+    std::swap(r.response, r.excitation);
+    std::ostringstream name;  // (a stream: GCC 12 warns falsely on a chain of string +)
+    name << 'H' << m.locations[r.response].id << m.locations[r.excitation].id << " (= " << p.name << ')';
+    r.name = name.str();
+    r.origin = "reciprocal of " + p.name;
+    m.notes.push_back(r.name + ": not given, taken from " + p.name + " by reciprocity (physical frame)");
+    m.paths.push_back(std::move(r));
+  }
+  for (const auto& p : m.paths)
+    if (m.locations[p.response].axis_sign < 0 && p.origin.rfind("robot", 0) == 0)
+      m.notes.push_back(p.name + ": tabulated response axis at location " +
+                        std::to_string(m.locations[p.response].id) + " is reversed; physical FRF = -table");
+
+  const config::ActuatorConfig& ac = cfg.actuator;
+  m.actuator = {ac.constant_n_per_v, ac.natural_freq_hz, ac.damping_ratio, ac.delay_s, ac.force_limit_n,
+                m.index_of(ac.location)};
+  const std::size_t act = m.actuator.location, sensor = m.index_of(cfg.sensor.location);
+  if (m.path(act, act) == nullptr)
+    problem("robot.frfs", "no driving-point FRF at the actuator location " + std::to_string(ac.location) +
+                              ": the actuator's own receptance is needed to simulate and close the loop");
+  if (m.path(sensor, act) == nullptr)
+    problem("robot.frfs", "no FRF from the actuator location " + std::to_string(ac.location) +
+                              " to the sensor location " + std::to_string(cfg.sensor.location) +
+                              " (nor its reciprocal): the loop cannot close");
+  if (!problems.empty()) throw config::ConfigError(problems);
+
+  // One state-space: actuator proof mass [p, p'] first, then [q, q'] per mode of every path.
+  std::size_t modes = 0;
+  for (const auto& p : m.paths) modes += p.modes.size();
+  const Eigen::Index n = static_cast<Eigen::Index>(2 + 2 * modes);
+  const Eigen::Index nl = static_cast<Eigen::Index>(m.locations.size());
+  Matrix a = Matrix::Zero(n, n), b = Matrix::Zero(n, 1 + nl), cx = Matrix::Zero(nl, n);
+  const double wa = kTwoPi * ac.natural_freq_hz, za = ac.damping_ratio, t = ac.constant_n_per_v;
+  a(0, 1) = 1.0;
+  a(1, 0) = -wa * wa;
+  a(1, 1) = -2.0 * za * wa;
+  b(1, 0) = 1.0;
+  // Eq. 3: F = T s^2 / (s^2 + 2 za wa s + wa^2) V = T (V - 2 za wa p' - wa^2 p).
+  const Eigen::RowVector2d f_state(-t * wa * wa, -t * 2.0 * za * wa);
+  Eigen::Index k = 2;
+  for (const auto& p : m.paths) {
+    for (const auto& mode : p.modes) {
+      a(k, k + 1) = 1.0;
+      a(k + 1, k) = -mode.wn_rad_per_s * mode.wn_rad_per_s;
+      a(k + 1, k + 1) = -2.0 * mode.damping_ratio * mode.wn_rad_per_s;
+      b(k + 1, 1 + static_cast<Eigen::Index>(p.excitation)) = 1.0;
+      if (p.excitation == act) {
+        a.block(k + 1, 0, 1, 2) += f_state;
+        b(k + 1, 0) += t;
+      }
+      cx(static_cast<Eigen::Index>(p.response), k) = mode.a;
+      cx(static_cast<Eigen::Index>(p.response), k + 1) = mode.b;
+      k += 2;
+    }
+  }
+  // Receptance is strictly proper; velocity and acceleration follow by differentiating along the
+  // held input (u' = 0 between samples).
+  const Matrix cv = cx * a, dv = cx * b, ca = cv * a, da = cv * b;
+  m.ss.a = a;
+  m.ss.b = b;
+  m.ss.c = Matrix::Zero(3 * nl + 1, n);
+  m.ss.d = Matrix::Zero(3 * nl + 1, 1 + nl);
+  m.ss.c.topRows(nl) = cx;
+  m.ss.c.middleRows(nl, nl) = cv;
+  m.ss.d.middleRows(nl, nl) = dv;
+  m.ss.c.middleRows(2 * nl, nl) = ca;
+  m.ss.d.middleRows(2 * nl, nl) = da;
+  m.ss.c.block(3 * nl, 0, 1, 2) = f_state;
+  m.ss.d(3 * nl, 0) = t;
+  m.pattern = reachability(a);
+  return m;
+}
+
+}  // namespace robodamp::sim
