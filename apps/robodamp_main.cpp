@@ -1,6 +1,7 @@
 // robodamp: active vibration damping for robotic milling. Subcommands are thin: they parse, call the
 // libraries and print.
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <string>
 
@@ -8,6 +9,7 @@
 
 #include "analysis/loop_model.hpp"
 #include "apps/analyze_command.hpp"
+#include "apps/bench_command.hpp"
 #include "apps/filters_command.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
@@ -81,6 +83,37 @@ int run_analyze(const std::string& path, bool json, const std::string& plot_dir)
   }
 }
 
+int run_bench(const std::string& path, const std::string& json_path, const std::string& plot_dir) {
+  try {
+    const robodamp::analysis::Bench bench(robodamp::config::load_config_file(path));
+    const auto report = bench.run([](const std::string& line) { std::cerr << "[bench] " << line << std::endl; });
+    std::cout << robodamp::apps::bench_table(bench, report);
+    if (!json_path.empty()) {
+      std::ofstream out(json_path);
+      out << robodamp::apps::bench_report_json(bench, report).dump(2) << '\n';
+      if (!out) {
+        std::cerr << "--json " << json_path << ": cannot write\n";
+        return 1;
+      }
+      std::cout << "wrote " << json_path << '\n';
+    }
+    if (!plot_dir.empty()) {
+      std::string err = robodamp::apps::plot_analysis(bench.model(), report.analysis, plot_dir);
+      if (err.empty()) err = robodamp::apps::plot_bench(bench, report, plot_dir);
+      if (!err.empty()) {
+        std::cerr << "plot: " << err << '\n';
+        return 1;
+      }
+      std::cout << "wrote plots in " << plot_dir << '\n';
+    }
+    if (!report.ran_closed_loop) return 3;
+    return report.improvement_within_5pct && report.sweep_agrees ? 0 : 1;
+  } catch (const ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,7 +140,14 @@ int main(int argc, char** argv) {
   analyze->add_flag("--json", json, "Print JSON instead of a table");
   analyze->add_option("--plot-dir", plot_dir, "Write FRF, Nyquist and gain-sweep plots (PNG) here");
 
+  std::string json_path;
+  auto* bench = app.add_subcommand("bench", "Simulated-plant bench run: impact tests control off/on, saturation, gain sweep");
+  bench->add_option("--config", config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  bench->add_option("--json", json_path, "Write the report as JSON to this file");
+  bench->add_option("--plot-dir", plot_dir, "Write plots (PNG) here");
+
   CLI11_PARSE(app, argc, argv);
+  if (bench->parsed()) return run_bench(config_path, json_path, plot_dir);
   if (analyze->parsed()) return run_analyze(config_path, json, plot_dir);
   if (filters->parsed()) return run_filters(config_path, freq_hz, json, plot);
   if (check->parsed()) return run_check_config(check_path);

@@ -392,6 +392,8 @@ BenchConfig read_bench(MapReader& top) {
   if (auto v = r.number("impact_duration_ms", {"ms", 0.05, 50.0}, c.impact_duration_ms)) c.impact_duration_ms = *v;
   if (auto v = r.number("saturating_impact_peak_n", {"N", 0.0, 1e7, true}, c.saturating_impact_peak_n))
     c.saturating_impact_peak_n = *v;
+  if (auto v = r.number("saturating_impact_duration_ms", {"ms", 0.05, 50.0}, c.saturating_impact_duration_ms))
+    c.saturating_impact_duration_ms = *v;
   if (auto v = read_int(r, "averages", {"(impacts per test)", 1, 1000}, c.averages)) c.averages = *v;
   if (auto v = r.number("record_s", {"s", 0.5, 600.0}, c.record_s)) c.record_s = *v;
   if (auto v = read_int(r, "zero_pad", {"(x record length)", 1, 64}, c.zero_pad)) c.zero_pad = *v;

@@ -157,9 +157,10 @@ struct AnalysisConfig {
 
 // The bench run: averaged impact tests control off and on, and a gain sweep.
 struct BenchConfig {
-  double impact_peak_n{20.0};            // small enough not to saturate the actuator
+  double impact_peak_n{1000.0};          // small enough not to saturate the actuator
   double impact_duration_ms{1.0};        // half-sine
-  double saturating_impact_peak_n{2000.0};
+  double saturating_impact_peak_n{8000.0};
+  double saturating_impact_duration_ms{5.0};  // soft tip: more impulse at the robot modes
   int averages{6};
   double record_s{10.0};                 // per impact: frequency resolution 1 / record_s
   int zero_pad{8};                       // evaluation grid = resolution / zero_pad (records decay fully)

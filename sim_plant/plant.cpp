@@ -41,6 +41,7 @@ void Plant::reset() {
   std::fill(u_.begin(), u_.end(), 0.0);
   std::fill(coil_history_.begin(), coil_history_.end(), 0.0);
   std::fill(period_force_.begin(), period_force_.end(), 0.0);
+  std::fill(period_excitation_force_.begin(), period_excitation_force_.end(), 0.0);
   history_pos_ = 0;
   internal_steps_ = 0;
   counters_ = {};
@@ -55,6 +56,7 @@ void Plant::step(double drive_v) noexcept {
   const std::size_t nl = model_.locations.size();
   const std::size_t hist = coil_history_.size();
   std::fill(period_force_.begin(), period_force_.end(), 0.0);
+  std::fill(period_excitation_force_.begin(), period_excitation_force_.end(), 0.0);
   for (int i = 0; i < oversampling_; ++i) {
     const double t = static_cast<double>(internal_steps_) * h_s_;
     // Amplifier voltage range, then the actuator's coil force limit (faults may lower it to zero).
@@ -77,7 +79,11 @@ void Plant::step(double drive_v) noexcept {
     u_[0] = coil_history_[late];
     u_early_[0] = coil_history_[early];
     for (std::size_t l = 0; l < nl; ++l) u_[1 + l] = 0.0;
-    for (auto& e : excitations_) u_[1 + e->location()] += e->force_n(t, h_s_);
+    for (std::size_t e = 0; e < excitations_.size(); ++e) {
+      const double f = excitations_[e]->force_n(t, h_s_);
+      u_[1 + excitations_[e]->location()] += f;
+      period_excitation_force_[e] += f / oversampling_;
+    }
     for (std::size_t l = 0; l < nl; ++l) period_force_[l] += u_[1 + l] / oversampling_;
 
     std::fill(x_next_.begin(), x_next_.end(), 0.0);

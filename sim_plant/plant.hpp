@@ -28,8 +28,16 @@ class Plant {
   Plant(PlantModel model, const config::Config& cfg);
 
   // Before a run (allocates).
-  void add_excitation(std::unique_ptr<Excitation> e) { excitations_.push_back(std::move(e)); }
-  void clear_excitations() { excitations_.clear(); }
+  // Returns the excitation's index for excitation_force_n().
+  std::size_t add_excitation(std::unique_ptr<Excitation> e) {
+    excitations_.push_back(std::move(e));
+    period_excitation_force_.push_back(0.0);
+    return excitations_.size() - 1;
+  }
+  void clear_excitations() {
+    excitations_.clear();
+    period_excitation_force_.clear();
+  }
   FaultInjector& faults() { return faults_; }
   // Zero state, empty delay line, time 0, counters cleared; excitations and faults stay.
   void reset();
@@ -47,6 +55,8 @@ class Plant {
   // Mean external force at a location over the last period (what a force sensor sampled at the loop
   // rate through its anti-aliasing sees, to first order), N.
   [[nodiscard]] double external_force_n(std::size_t loc) const { return period_force_[loc]; }
+  // The same for one excitation alone (e.g. what the impact hammer's load cell measures), N.
+  [[nodiscard]] double excitation_force_n(std::size_t i) const { return period_excitation_force_[i]; }
 
   [[nodiscard]] double time_s() const { return static_cast<double>(counters_.steps) * period_s_; }
   [[nodiscard]] double period_s() const { return period_s_; }
@@ -71,6 +81,7 @@ class Plant {
   std::vector<double> coil_history_;  // delay line of the coil drive at the internal rate
   std::size_t history_pos_{0};
   std::vector<double> period_force_;
+  std::vector<double> period_excitation_force_;
   std::vector<std::unique_ptr<Excitation>> excitations_;
   FaultInjector faults_;
   Accelerometer sensor_;

@@ -1,0 +1,112 @@
+// The bench run: the real-time Controller object against the simulated plant on a virtual clock at the
+// loop rate, measured the way the paper measured it (REFERENCE.md section 1): averaged impact tests
+// with control off and on, H1 receptance estimates, dynamic stiffness improvement, next to what the
+// loop analysis predicts; a saturating excitation; and a gain sweep across the predicted stability limit.
+// Off the real-time path (it allocates its records), but the per-tick loop body is the RT code path.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/loop_model.hpp"
+#include "analysis/spectral.hpp"
+
+namespace robodamp::analysis {
+
+struct ImpactTest {
+  std::size_t excitation{0};  // location index
+  double peak_n{1000.0};
+  double duration_ms{1.0};
+  bool control_on{false};
+  double gain_ns_per_m{0.0};
+  int polarity{1};
+};
+
+struct ImpactTestResult {
+  std::vector<FrfEstimate> receptance;  // per response location (measurement accelerometers, H1 / -w^2)
+  double peak_actuator_force_n{0.0};
+  double saturation_time_s{0.0};  // loop ticks at a controller or actuator limit
+  double simulated_s{0.0};
+  double wall_s{0.0};
+  bool finite{true};
+};
+
+struct DivergenceRun {
+  double gain_ns_per_m{0.0};
+  bool predicted_unstable{false};
+  double predicted_growth_per_s{0.0};  // fs ln(spectral radius)
+  bool diverged{false};
+  double growth_ratio{0.0};             // command RMS at the end / just after the impact
+  double measured_growth_per_s{0.0};    // slope of ln RMS over the second half
+  double saturation_time_s{0.0};
+  std::vector<double> envelope_v;       // command RMS per window
+  double window_s{0.25};
+};
+
+struct MeasuredPeak {
+  double freq_hz{0.0};
+  double magnitude_m_per_n{0.0};
+  double coherence_min{0.0};  // within +-10 % of the peak frequency
+};
+
+// Peak of |H| over [lo, hi], refined by a parabola through the three grid points around it.
+[[nodiscard]] MeasuredPeak measured_peak(const FrfEstimate& e, double lo_hz, double hi_hz);
+
+struct BenchRow {
+  std::string name;
+  double gain_ns_per_m{0.0};
+  double impact_peak_n{0.0};
+  std::optional<double> measured_improvement_pct;
+  std::optional<double> predicted_improvement_pct;            // discrete loop that runs
+  std::optional<double> predicted_continuous_improvement_pct;  // REFERENCE.md equations
+  bool saturated{false};
+  double saturation_time_s{0.0};
+  double peak_actuator_force_n{0.0};
+  double coherence_min{0.0};
+  MeasuredPeak open, closed;
+  std::string kind;  // "nominal", "saturating", "sweep"
+};
+
+struct OpenLoopCheck {
+  std::string name;
+  double model_peak_m_per_n{0.0};
+  double measured_peak_m_per_n{0.0};
+  double error_db{0.0};
+  double coherence_min{0.0};
+};
+
+struct BenchReport {
+  std::string config;
+  AnalysisResult analysis;
+  std::vector<OpenLoopCheck> open_loop;
+  std::vector<BenchRow> rows;
+  std::vector<DivergenceRun> sweep;
+  double simulated_s{0.0};
+  double wall_s{0.0};
+  bool ran_closed_loop{false};
+  bool improvement_within_5pct{false};
+  bool sweep_agrees{false};
+  std::string verdict;
+  std::vector<std::string> notes;
+};
+
+using Progress = std::function<void(const std::string&)>;
+
+class Bench {
+ public:
+  explicit Bench(const config::Config& cfg);
+  [[nodiscard]] const LoopModel& model() const { return model_; }
+
+  [[nodiscard]] ImpactTestResult impact_test(const ImpactTest& t) const;
+  [[nodiscard]] DivergenceRun divergence_run(double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] BenchReport run(const Progress& progress = {}) const;
+
+ private:
+  config::Config cfg_;
+  LoopModel model_;
+};
+
+}  // namespace robodamp::analysis
