@@ -155,16 +155,21 @@ DivergenceRun Bench::divergence_run(double gain, int polarity) const {
   const auto win = static_cast<std::size_t>(std::lround(d.window_s * fs));
   double command = 0.0, sum2 = 0.0;
   std::uint64_t saturated = 0;
+  std::vector<bool> window_saturated;
+  bool sat_in_window = false;
   for (std::size_t k = 0; k < n; ++k) {
     const auto c0 = controller.counters().force_limited + controller.counters().voltage_limited;
     const double next = controller.update(plant.sense().accel_mps2);
-    if (controller.counters().force_limited + controller.counters().voltage_limited > c0) ++saturated;
+    if (controller.counters().force_limited + controller.counters().voltage_limited > c0) ++saturated, sat_in_window = true;
     plant.step(command);
     command = next;
+    d.peak_actuator_force_n = std::max(d.peak_actuator_force_n, std::abs(plant.actuator_force_n()));
     sum2 += command * command;
     if ((k + 1) % win == 0) {
       d.envelope_v.push_back(std::sqrt(sum2 / static_cast<double>(win)));
+      window_saturated.push_back(sat_in_window);
       sum2 = 0.0;
+      sat_in_window = false;
     }
   }
   d.saturation_time_s = static_cast<double>(saturated) / fs;
@@ -173,16 +178,24 @@ DivergenceRun Bench::divergence_run(double gain, int polarity) const {
   double early = 0.0;
   for (std::size_t w = w0; w < std::min(w1, d.envelope_v.size()); ++w) early = std::max(early, d.envelope_v[w]);
   d.growth_ratio = early > 0.0 ? d.envelope_v.back() / early : 0.0;
-  // Least-squares slope of ln RMS over the second half.
-  const std::size_t h0 = d.envelope_v.size() / 2;
+  // Least-squares slope of ln RMS from the end of the impact's first second to the end of the run, or
+  // to the first window at a limit (a saturated loop no longer grows exponentially).
+  std::size_t w_end = d.envelope_v.size();
+  for (std::size_t w = w1; w < window_saturated.size(); ++w)
+    if (window_saturated[w]) {
+      w_end = w;
+      break;
+    }
   double sx = 0, sy = 0, sxx = 0, sxy = 0, m = 0;
-  for (std::size_t w = h0; w < d.envelope_v.size(); ++w) {
+  for (std::size_t w = w1; w < w_end; ++w) {
     if (!(d.envelope_v[w] > 0.0)) continue;
     const double x = (static_cast<double>(w) + 0.5) * d.window_s, y = std::log(d.envelope_v[w]);
     sx += x, sy += y, sxx += x * x, sxy += x * y, m += 1;
   }
-  if (m > 2) d.measured_growth_per_s = (m * sxy - sx * sy) / (m * sxx - sx * sx);
-  d.diverged = d.growth_ratio > 1.0 || !std::isfinite(d.growth_ratio);
+  d.measured_growth_per_s = m > 2 ? (m * sxy - sx * sy) / (m * sxx - sx * sx) : std::nan("");
+  // Grew after the impact, or still at a limit at the end (a stable loop has long decayed by then).
+  d.final_window_saturated = !window_saturated.empty() && window_saturated.back();
+  d.diverged = d.growth_ratio > 1.0 || !std::isfinite(d.growth_ratio) || d.final_window_saturated;
   return d;
 }
 
@@ -308,6 +321,7 @@ BenchReport Bench::run(const Progress& progress) const {
         row.impact_peak_n = b.impact_peak_n;
         row.saturated = d.saturation_time_s > 0.0;
         row.saturation_time_s = d.saturation_time_s;
+        row.peak_actuator_force_n = d.peak_actuator_force_n;
         rep.rows.push_back(row);
       }
       rep.sweep.push_back(std::move(d));

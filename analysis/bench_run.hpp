@@ -40,7 +40,10 @@ struct DivergenceRun {
   double predicted_growth_per_s{0.0};  // fs ln(spectral radius)
   bool diverged{false};
   double growth_ratio{0.0};             // command RMS at the end / just after the impact
-  double measured_growth_per_s{0.0};    // slope of ln RMS over the second half
+  double measured_growth_per_s{0.0};    // slope of ln RMS after the impact, before any saturation (NaN if
+                                        // the loop saturated too soon to measure it)
+  bool final_window_saturated{false};
+  double peak_actuator_force_n{0.0};
   double saturation_time_s{0.0};
   std::vector<double> envelope_v;       // command RMS per window
   double window_s{0.25};

@@ -71,7 +71,8 @@ json bench_report_json(const analysis::Bench& bench, const analysis::BenchReport
                           {"predicted_unstable", d.predicted_unstable},
                           {"predicted_growth_per_s", d.predicted_growth_per_s},
                           {"diverged", d.diverged},
-                          {"measured_growth_per_s", d.measured_growth_per_s},
+                          {"measured_growth_per_s", std::isfinite(d.measured_growth_per_s) ? json(d.measured_growth_per_s) : json(nullptr)},
+                          {"final_window_saturated", d.final_window_saturated},
                           {"end_to_start_rms_ratio", d.growth_ratio},
                           {"saturation_time_s", d.saturation_time_s}});
   j["simulated_s"] = r.simulated_s;
@@ -116,11 +117,16 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
   if (!r.sweep.empty()) {
     os << "\nGain sweep (impact at the actuator, " << cfg.bench.sweep_duration_s << " s each):\n";
     for (const auto& d : r.sweep) {
+      char growth[64];
+      if (std::isfinite(d.measured_growth_per_s))
+        std::snprintf(growth, sizeof growth, "growth %+.3f 1/s", d.measured_growth_per_s);
+      else
+        std::snprintf(growth, sizeof growth, "at its limit too soon to fit");
       std::snprintf(line, sizeof line,
-                    "  K = %8.0f N s/m: predicted %-8s (growth %+.3f 1/s), simulated %-8s (growth %+.3f 1/s, end/start "
-                    "RMS %.3g)\n",
+                    "  K = %8.0f N s/m: predicted %-8s (growth %+.3f 1/s), simulated %-8s (%s, end/start RMS %.3g%s)\n",
                     d.gain_ns_per_m, d.predicted_unstable ? "unstable" : "stable", d.predicted_growth_per_s,
-                    d.diverged ? "diverges" : "decays", d.measured_growth_per_s, d.growth_ratio);
+                    d.diverged ? "diverges" : "decays", growth, d.growth_ratio,
+                    d.final_window_saturated ? ", saturated at the end" : "");
       os << line;
     }
   }
@@ -146,7 +152,7 @@ std::string plot_bench(const analysis::Bench& bench, const analysis::BenchReport
     std::size_t n = 0;
     for (const auto& d : r.sweep) n = std::max(n, d.envelope_v.size());
     for (std::size_t w = 0; w < n; ++w) {
-      data << (w + 0.5) * r.sweep.front().window_s;
+      data << (static_cast<double>(w) + 0.5) * r.sweep.front().window_s;
       for (const auto& d : r.sweep) data << ' ' << (w < d.envelope_v.size() && d.envelope_v[w] > 0 ? d.envelope_v[w] : NAN);
       data << '\n';
     }
