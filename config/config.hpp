@@ -137,7 +137,7 @@ struct SensorConfig {
 
 // The simulated plant's numerical settings.
 struct PlantConfig {
-  int oversampling{4};  // internal steps per loop period
+  int oversampling{1};  // internal steps per loop period
 };
 
 // Disturbances present in bench runs.

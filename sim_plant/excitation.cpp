@@ -33,7 +33,10 @@ Sine::Sine(std::size_t location, double amplitude_n, double freq_hz, double phas
 
 double Sine::force_n(double t_s, double h_s) noexcept {
   // Mean of A sin(w t + phi) over the step.
-  return amplitude_n_ * (std::cos(w_ * t_s + phase_) - std::cos(w_ * (t_s + h_s) + phase_)) / (w_ * h_s);
+  const double c0 = std::abs(t_s - end_t_) <= 1e-12 * (1.0 + t_s) ? end_cos_ : std::cos(w_ * t_s + phase_);
+  end_t_ = t_s + h_s;
+  end_cos_ = std::cos(w_ * end_t_ + phase_);
+  return amplitude_n_ * (c0 - end_cos_) / (w_ * h_s);
 }
 
 Chirp::Chirp(std::size_t location, double amplitude_n, double f0_hz, double f1_hz, double duration_s)

@@ -45,6 +45,7 @@ class Sine final : public Excitation {
 
  private:
   double amplitude_n_, w_, phase_;
+  double end_t_{-1.0}, end_cos_{0.0};  // cos at the end of the last step, reused as the next start
 };
 
 // Linear sine sweep f0 -> f1 over duration_s, then silent (sampled at step mid-points).

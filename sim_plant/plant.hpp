@@ -48,10 +48,11 @@ class Plant {
   [[nodiscard]] SensorReading sense() noexcept;
 
   // True outputs at the current instant (left limits), m, m/s, m/s^2, N.
-  [[nodiscard]] double displacement_m(std::size_t loc) const { return y_[model_.output_displacement(loc)]; }
-  [[nodiscard]] double velocity_mps(std::size_t loc) const { return y_[model_.output_velocity(loc)]; }
-  [[nodiscard]] double acceleration_mps2(std::size_t loc) const { return y_[model_.output_acceleration(loc)]; }
-  [[nodiscard]] double actuator_force_n() const { return y_[model_.output_actuator_force()]; }
+  // Each is evaluated when read (C x + D u of its row).
+  [[nodiscard]] double displacement_m(std::size_t loc) const { return output(model_.output_displacement(loc)); }
+  [[nodiscard]] double velocity_mps(std::size_t loc) const { return output(model_.output_velocity(loc)); }
+  [[nodiscard]] double acceleration_mps2(std::size_t loc) const { return output(model_.output_acceleration(loc)); }
+  [[nodiscard]] double actuator_force_n() const { return output(model_.output_actuator_force()); }
   // Mean external force at a location over the last period (what a force sensor sampled at the loop
   // rate through its anti-aliasing sees, to first order), N.
   [[nodiscard]] double external_force_n(std::size_t loc) const { return period_force_[loc]; }
@@ -66,18 +67,24 @@ class Plant {
   [[nodiscard]] const DelayedZoh& discretisation() const { return zoh_; }
   [[nodiscard]] Accelerometer& sensor() { return sensor_; }
   [[nodiscard]] std::size_t sensor_location() const { return sensor_loc_; }
-  [[nodiscard]] std::size_t state_count() const { return static_cast<std::size_t>(x_.size()); }
+  [[nodiscard]] std::size_t state_count() const { return n_; }
   [[nodiscard]] std::size_t nonzeros_per_step() const;
 
  private:
+  [[nodiscard]] double output(std::size_t row) const noexcept {
+    return c_.row_dot(row, z_.data()) + d_.row_dot(row, u_.data());
+  }
   PlantModel model_;
   double period_s_;
   int oversampling_;
   double h_s_;
   DelayedZoh zoh_;
-  SparseRows phi_, gamma_early_, gamma_late_, gamma_force_;  // gamma_force: late columns of the forces
+  // One product per internal step: x[k+1] = [phi, gamma_late, gamma_early, gamma_force] z with
+  // z = [x; coil drive u[k-d]; u[k-d-1]; forces].
+  SparseRows step_;
   SparseRows c_, d_;
-  std::vector<double> x_, x_next_, y_, u_, u_early_;
+  std::size_t n_{0};
+  std::vector<double> z_, x_next_, u_;  // u_: inputs of the last internal step (for the left limits)
   std::vector<double> coil_history_;  // delay line of the coil drive at the internal rate
   std::size_t history_pos_{0};
   std::vector<double> period_force_;

@@ -66,13 +66,13 @@ SparseRows::SparseRows(const Matrix& m, const Eigen::Matrix<bool, Eigen::Dynamic
   row_start_.push_back(0);
   for (Eigen::Index r = 0; r < m.rows(); ++r) {
     for (Eigen::Index c = 0; c < m.cols(); ++c) {
-      const bool keep = pattern != nullptr ? (*pattern)(r, c) : m(r, c) != 0.0;
+      const bool keep = pattern == nullptr || (c < pattern->cols() && (*pattern)(r, c)) || c >= pattern->cols();
       if (keep && m(r, c) != 0.0) {
-        column_.push_back(static_cast<std::size_t>(c));
+        column_.push_back(static_cast<std::uint32_t>(c));
         value_.push_back(m(r, c));
       }
     }
-    row_start_.push_back(value_.size());
+    row_start_.push_back(static_cast<std::uint32_t>(value_.size()));
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -44,18 +45,26 @@ class SparseRows {
   SparseRows(const Matrix& m, const Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic>* pattern = nullptr);
   // out += M x. RT-safe.
   void accumulate(const double* x, double* out) const noexcept {
-    for (std::size_t r = 0; r + 1 < row_start_.size(); ++r) {
-      double acc = 0.0;
-      for (std::size_t i = row_start_[r]; i < row_start_[r + 1]; ++i) acc += value_[i] * x[column_[i]];
-      out[r] += acc;
-    }
+    const std::size_t rows = row_start_.size() - 1;
+    for (std::size_t r = 0; r < rows; ++r) out[r] += row_dot(r, x);
+  }
+  // out = M x. RT-safe.
+  void apply(const double* x, double* out) const noexcept {
+    const std::size_t rows = row_start_.size() - 1;
+    for (std::size_t r = 0; r < rows; ++r) out[r] = row_dot(r, x);
   }
   [[nodiscard]] std::size_t nonzeros() const { return value_.size(); }
+  // One row of M x. RT-safe.
+  [[nodiscard]] double row_dot(std::size_t r, const double* x) const noexcept {
+    double acc = 0.0;
+    for (std::uint32_t i = row_start_[r], end = row_start_[r + 1]; i < end; ++i) acc += value_[i] * x[column_[i]];
+    return acc;
+  }
   [[nodiscard]] std::size_t rows() const { return row_start_.empty() ? 0 : row_start_.size() - 1; }
 
  private:
-  std::vector<std::size_t> row_start_;
-  std::vector<std::size_t> column_;
+  std::vector<std::uint32_t> row_start_;
+  std::vector<std::uint32_t> column_;
   std::vector<double> value_;
 };
 
