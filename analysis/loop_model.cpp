@@ -324,8 +324,15 @@ Margins margins(const LoopModel& m, double gain, int polarity, std::optional<dou
       if (!r.delay_margin_ms || dm < *r.delay_margin_ms) r.delay_margin_ms = dm;
     }
     if (prev.imag() * cur.imag() < 0.0 && cur.real() < 0.0) {
-      const double gap = std::abs(std::log(std::abs(cur)));
-      if (gap < best_phase_cross_gap) best_phase_cross_gap = gap, r.phase_crossover_hz = f1;
+      double a = f0, b = f1;  // refine the crossing of the negative real axis
+      const bool from_above = prev.imag() > 0.0;
+      for (int it = 0; it < 60; ++it) {
+        const double c = 0.5 * (a + b);
+        ((loop(c).imag() > 0.0) == from_above ? a : b) = c;
+      }
+      const double fp = 0.5 * (a + b);
+      const double gap = std::abs(std::log(std::abs(loop(fp))));
+      if (gap < best_phase_cross_gap) best_phase_cross_gap = gap, r.phase_crossover_hz = fp;
     }
     prev = cur;
   }

@@ -29,15 +29,22 @@ struct SensorReading {
 
 class FaultInjector {
  public:
-  void add(const Fault& f) { faults_.push_back(f); }
-  void clear() { faults_.clear(); }
+  void add(const Fault& f) {
+    faults_.push_back(f);
+    next_spike_s_.push_back(f.start_s);
+  }
+  void clear() {
+    faults_.clear();
+    next_spike_s_.clear();
+  }
   [[nodiscard]] bool empty() const { return faults_.empty(); }
 
   // RT-safe. The reading at time t for a measured value; stuck holds the value measured when the fault
   // began, dropout repeats the last delivered value marked not fresh.
   SensorReading apply_sensor(double t_s, double dt_s, double value) noexcept {
     SensorReading r{value, true};
-    for (const auto& f : faults_) {
+    for (std::size_t i = 0; i < faults_.size(); ++i) {
+      const Fault& f = faults_[i];
       if (!active(f, t_s)) continue;
       switch (f.kind) {
         case FaultKind::kSensorDropout: r = {last_.accel_mps2, false}; break;
@@ -45,12 +52,14 @@ class FaultInjector {
           if (!stuck_) stuck_value_ = last_.accel_mps2, stuck_ = true;
           r.accel_mps2 = stuck_value_;
           break;
-        case FaultKind::kSensorSpike: {
-          const double since = t_s - f.start_s;
-          const double phase = f.period_s > 0.0 ? std::fmod(since, f.period_s) : since;
-          if (phase < dt_s) r.accel_mps2 += f.magnitude;
+        case FaultKind::kSensorSpike:
+          // One sample per due time: at the start, then every period.
+          if (t_s >= next_spike_s_[i]) {
+            r.accel_mps2 += f.magnitude;
+            next_spike_s_[i] = f.period_s > 0.0 ? next_spike_s_[i] + f.period_s * std::ceil((t_s - next_spike_s_[i] + 0.5 * dt_s) / f.period_s)
+                                                : std::numeric_limits<double>::infinity();
+          }
           break;
-        }
         case FaultKind::kSensorNan: r.accel_mps2 = std::numeric_limits<double>::quiet_NaN(); break;
         default: break;
       }
@@ -78,6 +87,7 @@ class FaultInjector {
     return false;
   }
   std::vector<Fault> faults_;
+  std::vector<double> next_spike_s_;
   SensorReading last_{};
   bool stuck_{false};
   double stuck_value_{0.0};

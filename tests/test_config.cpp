@@ -252,8 +252,13 @@ TEST(Config, RobotModalDataIsValidated) {
       excitation_location: 1
       modes:
         - {natural_freq_hz: 9.2, damping_ratio: 0.02, residue_re_m_per_n: -2.92e-6, residue_im_m_per_n: -3.63e-5}
+    - name: H22yy
+      response_location: 2
+      excitation_location: 2
+      modes:
+        - {natural_freq_hz: 9.2, damping_ratio: 0.02, stiffness_n_per_m: 2.0e6}
 )";
-  EXPECT_TRUE(problems_of(base).empty());
+  EXPECT_TRUE(problems_of(base).empty()) << (problems_of(base).empty() ? "" : problems_of(base).front().to_string());
   auto bad = base;
   bad.replace(bad.find("damping_ratio: 0.02"), 19, "damping_ratio: 1.5");
   const std::string m = only_problem(bad);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "config/config.hpp"
@@ -15,6 +17,13 @@ inline control::ChainDesign design_preset(const std::string& name, double rate_h
   config::Config c = config::load_config_file(preset(name));
   if (rate_hz > 0.0) c.loop.rate_hz = rate_hz;
   return control::design_chain(c);
+}
+
+inline std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
 }
 
 // Wrapped phase difference in degrees.

@@ -1,0 +1,134 @@
+// The loop analysis: the corrected closed-loop equations, discrete stability by poles and by Nyquist,
+// the gain limit and margins, the polarity, and the H1 estimator.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "analysis/loop_model.hpp"
+#include "analysis/spectral.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+using namespace robodamp;
+using analysis::Complex;
+
+analysis::LoopModel model(const std::string& name) { return analysis::LoopModel(config::load_config_file(test::preset(name))); }
+
+TEST(LoopModel, ClosedLoopFollowsTheCorrectedEquations) {
+  // REFERENCE.md section 1 (Eq. 10-12, H11 corrected), with every FRF in one consistent frame, the
+  // physical one: L = G H22 / T, H22_cl = H22 / (1 + L), H11_cl = [H11 (1 + L) - H12 H21 G / T] / (1 + L).
+  // In the table's frame H22 changes sign but H12 H21 does not: written with the table's H22 in L (as the
+  // reference puts it, "sign per polarity"), the coupling term's sign must flip with it.
+  const auto m = model("horizontal_c2");
+  const auto& cfg = m.config();
+  const double k = cfg.controller.gain_ns_per_m;
+  for (double f : {5.0, 9.2, 14.0, 21.0, 23.5, 40.0}) {
+    const Complex h11 = config::frf_receptance(cfg.robot.frfs[0], f);
+    const Complex h21 = -config::frf_receptance(cfg.robot.frfs[1], f);  // physical: location 2 axis reversed
+    const Complex h22 = -config::frf_receptance(cfg.robot.frfs[2], f);
+    const Complex h12 = h21;                                            // reciprocity
+    // G / T: force per displacement fed back with negative sign (F_act = -G/T x2).
+    const Complex g_over_t = -m.feedback_continuous(f, k, 1);
+    const Complex l = g_over_t * h22;
+    EXPECT_NEAR(std::abs(m.loop_continuous(f, k, 1) - l), 0.0, 1e-12 * std::abs(l)) << f;
+    const Complex h22_cl = h22 / (1.0 + l), h11_cl = (h11 * (1.0 + l) - h12 * h21 * g_over_t) / (1.0 + l);
+    EXPECT_NEAR(std::abs(m.closed_continuous(1, 1, f, k, 1) - h22_cl), 0.0, 1e-9 * std::abs(h22_cl)) << f;
+    EXPECT_NEAR(std::abs(m.closed_continuous(0, 0, f, k, 1) - h11_cl), 0.0, 1e-9 * std::abs(h11_cl)) << f;
+    // Table frame: L_table = G' H22_table / T with G' = -G; the coupling term then enters with +.
+    const Complex h21_t = -h21, h22_t = -h22, g_t = -g_over_t, l_t = g_t * h22_t;
+    EXPECT_NEAR(std::abs((h11 * (1.0 + l_t) + h21_t * h21_t * g_t) / (1.0 + l_t) - h11_cl), 0.0, 1e-9 * std::abs(h11_cl));
+  }
+}
+
+TEST(LoopModel, DiscreteLoopApproachesTheContinuousOneAtLowFrequency) {
+  // The discrete loop adds only ZOH and one sample of computation delay (0.3 ms) to the continuous
+  // model: within 1 % in magnitude and the phase of 1.5 samples at 9.2 Hz.
+  const auto m = model("horizontal_c2");
+  const double f = 9.2, k = 2000.0;
+  const Complex lc = m.loop_continuous(f, k, 1), ld = m.loop_discrete(f, k, 1);
+  EXPECT_NEAR(std::abs(ld) / std::abs(lc), 1.0, 0.01);
+  const double extra_deg = std::arg(ld / lc) * 180.0 / M_PI;
+  EXPECT_NEAR(extra_deg, -360.0 * f * 1.5 / 5000.0, 0.3);
+}
+
+TEST(LoopModel, PolesAndNyquistAgreeAcrossTheGainLimit) {
+  for (const char* name : {"horizontal_c2", "horizontal_c1", "horizontal_c3"}) {
+    const auto m = model(name);
+    const int pol = m.config().controller.polarity;
+    const auto k_max = analysis::max_stable_gain(m, pol);
+    ASSERT_TRUE(k_max) << name;
+    EXPECT_TRUE(m.stable(0.999 * *k_max, pol)) << name;
+    EXPECT_FALSE(m.stable(1.001 * *k_max, pol)) << name;
+    for (double factor : {0.3, 0.9, 0.99, 1.01, 1.2, 3.0}) {
+      const double k = factor * *k_max;
+      EXPECT_EQ(m.nyquist_encirclements(k, pol) == 0, m.stable(k, pol)) << name << " K = " << k;
+    }
+  }
+}
+
+TEST(LoopModel, GainMarginFromBisectionMatchesThePhaseCrossover) {
+  const auto m = model("horizontal_c2");
+  const auto r = analysis::analyse(m);
+  ASSERT_TRUE(r.margins.gain_margin_db && r.margins.phase_crossover_hz);
+  const double l = std::abs(m.loop_discrete(*r.margins.phase_crossover_hz, r.gain_ns_per_m, r.polarity));
+  EXPECT_NEAR(-20.0 * std::log10(l), *r.margins.gain_margin_db, 0.05);
+  ASSERT_TRUE(r.margins.delay_margin_ms && r.margins.phase_margin_deg);
+  EXPECT_GT(*r.margins.phase_margin_deg, 0.0);
+}
+
+TEST(LoopModel, PolarityIsSettledByTheAnalysis) {
+  // With the table's reversed location-2 axis no single polarity damps with both C1 and C2.
+  const auto c2 = analysis::analyse(model("horizontal_c2"));
+  const auto c1 = analysis::analyse(model("horizontal_c1"));
+  EXPECT_EQ(c2.recommended_polarity, 1);
+  EXPECT_EQ(c1.recommended_polarity, -1);
+  EXPECT_EQ(analysis::analyse(model("vertical_c1")).recommended_polarity, -1);
+  EXPECT_TRUE(c2.stable && c1.stable);
+  EXPECT_TRUE(c2.modes.front().damps);
+  // The wrong polarity amplifies the dominant mode: stable only at low gain, and no improvement.
+  const auto m = model("horizontal_c2");
+  const auto wrong = analysis::analyse(m, 2000.0, -1);
+  EXPECT_FALSE(wrong.modes.front().damps);
+  EXPECT_NE(wrong.notes.front().find("does not damp"), std::string::npos);
+  if (wrong.stable) {
+    for (const auto& f : wrong.frfs_discrete) EXPECT_LT(f.improvement_pct, 0.0) << f.name;
+  }
+}
+
+TEST(LoopModel, UnstableConfigurationIsReportedAsSuch) {
+  const auto m = model("horizontal_c2");
+  const auto k_max = analysis::max_stable_gain(m, 1);
+  const auto r = analysis::analyse(m, 1.5 * *k_max, 1);
+  EXPECT_FALSE(r.stable);
+  EXPECT_GT(r.spectral_radius, 1.0);
+  EXPECT_GT(r.nyquist_encirclements, 0);
+}
+
+TEST(Spectral, H1OfAKnownFilterWithAndWithoutOutputNoise) {
+  // y = IIR(x) for white x; H1 recovers the filter, coherence 1 without noise; output noise leaves H1
+  // unbiased and lowers the coherence.
+  const double fs = 1000.0, a = 0.9;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<double> x(200000), y(x.size()), yn(x.size());
+  double prev = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    x[i] = n(rng);
+    prev = x[i] + a * prev;  // 1 / (1 - a z^-1)
+    y[i] = prev;
+    yn[i] = prev + 2.0 * n(rng);
+  }
+  const auto e = analysis::welch_frf(x, y, fs, 1024, 0.5, 400.0);
+  const auto en = analysis::welch_frf(x, yn, fs, 1024, 0.5, 400.0);
+  for (std::size_t k = 5; k < e.f_hz.size(); k += 37) {
+    const Complex h = 1.0 / (1.0 - a * std::exp(Complex(0.0, -2 * M_PI * e.f_hz[k] / fs)));
+    EXPECT_NEAR(std::abs(e.h1[k] / h), 1.0, 0.02) << e.f_hz[k];
+    EXPECT_GT(e.coherence[k], 0.995);
+    EXPECT_NEAR(std::abs(en.h1[k] / h), 1.0, 0.15) << e.f_hz[k];
+  }
+  EXPECT_LT(en.coherence.back(), 0.9);
+}
+
+}  // namespace
