@@ -135,7 +135,9 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
   if (saturating)
     os << "\nSaturating rows: the " << cfg.bench.saturating_impact_peak_n << " N impacts drive the force command into the "
        << cfg.actuator.force_limit_n << " N actuator limit; clipped feedback adds less damping than the linear analysis\n"
-       << "assumes, so the measured improvement falls below the prediction (the paper's experiments saturated at 36 N).\n";
+       << "assumes, so the measured improvement falls below the prediction (the paper's experiments saturated at 36 N).\n"
+       << "'peak F' is the force transmitted to the structure (Eq. 3); the limit acts on the commanded coil force T V,\n"
+       << "which near the actuator's own resonance is transmitted up to 1 / (2 zeta_a) times larger.\n";
   for (const auto& n : r.notes) os << "note: " << n << "\n";
   std::snprintf(line, sizeof line, "\n%.0f s simulated in %.2f s wall (%.0fx real time)\n", r.simulated_s, r.wall_s,
                 r.simulated_s / r.wall_s);

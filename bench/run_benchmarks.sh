@@ -17,3 +17,7 @@ for k in plain chain controller; do
   rm -f "$out"
   awk -v k="$k" -v ir="$ir" -v n="$n" 'BEGIN { printf "  %-11s %8.2f\n", k, ir / n }'
 done
+echo
+echo "simulated plant + controller, default preset (x_real_time = simulated s per wall s, one core):"
+./build/bench/bench_plant --benchmark_repetitions=5 --benchmark_report_aggregates_only=true --benchmark_min_time=0.5 \
+  --benchmark_counters_tabular=true

@@ -5,6 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 if (($#)); then exec ./build/apps/robodamp "$@"; fi
-# Until the simulated plant lands, the main job is the chain's response at the dominant robot mode
-# and its Bode diagram.
-./build/apps/robodamp filters --config config/presets/horizontal_c2.yaml --freq 9.2 --plot build/filters_horizontal_c2.png
+# The main job: the simulated-plant bench run on the default preset (impact tests with control off and
+# on, saturating impacts, gain sweep), its JSON report and plots.
+exec ./build/apps/robodamp bench --config config/presets/horizontal_c2.yaml --json build/bench_horizontal_c2.json \
+  --plot-dir build/bench_plots

@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "test_util.hpp"
 
@@ -102,6 +104,65 @@ TEST(Cli, CheckConfigReportsAllProblemsAtOnce) {
   EXPECT_NE(r.out.find("actuator.force_limt_n: unknown key"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("actuator.force_limit_n: missing"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("bad.yaml:4:"), std::string::npos) << r.out;  // the rate's line
+}
+
+TEST(Cli, AnalyzeJsonHasTheDocumentedShapeAndPlots) {
+  const std::string dir = temp_path("analyze-plots");
+  const Result r = run("analyze --config " + robodamp::test::preset("horizontal_c2") + " --json --plot-dir " + dir);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("}\n") + 1));
+  for (const char* key : {"stable", "max_stable_gain_ns_per_m", "gain_margin_db", "phase_margin_deg", "delay_margin_ms",
+                          "recommended_polarity"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_TRUE(j["stable"].get<bool>());
+  EXPECT_EQ(j["recommended_polarity"], 1);
+  ASSERT_EQ(j["frfs"].size(), 3u);
+  for (const auto& f : j["frfs"])
+    for (const char* key : {"name", "open_peak_m_per_n", "closed_peak_m_per_n", "peak_freq_hz", "improvement_pct"})
+      EXPECT_TRUE(f.contains(key)) << key;
+  for (const char* png : {"frf_open_closed.png", "nyquist.png", "gain_sweep.png"})
+    EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, AnalyzeReportsAnUnstableConfigurationWithItsOwnExitCode) {
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml.replace(yaml.find("gain_ns_per_m: 2000"), 19, "gain_ns_per_m: 9000");
+  const std::string path = temp_path("unstable.yaml");
+  std::ofstream(path) << yaml;
+  const Result r = run("analyze --config " + path);
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("UNSTABLE"), std::string::npos) << r.out;
+  const Result b = run("bench --config " + path);
+  EXPECT_EQ(b.status, 3) << b.out;
+  EXPECT_NE(b.out.find("closed-loop tests were not run"), std::string::npos) << b.out;
+  std::filesystem::remove(path);
+}
+
+TEST(Cli, BenchWritesRowsJsonPlotsAndAVerdict) {
+  // A shorter schedule than the preset's, same physics.
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml.replace(yaml.find("averages: 10"), 12, "averages: 4");
+  yaml.replace(yaml.find("sweep_gain_factors: [0.5, 0.9, 1.1, 1.5]"), 40, "sweep_gain_factors: [0.9, 1.1]");
+  const std::string path = temp_path("bench.yaml"), json = temp_path("bench.json"), dir = temp_path("bench-plots");
+  std::ofstream(path) << yaml;
+  const Result r = run("bench --config " + path + " --json " + json + " --plot-dir " + dir);
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("VERDICT: PASS"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("[bench] impact test 1/6"), std::string::npos) << r.out;  // progress lines
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_GE(j["rows"].size(), 6u);
+  for (const auto& row : j["rows"])
+    for (const char* key : {"name", "control_gain_ns_per_m", "measured_improvement_pct", "predicted_improvement_pct",
+                            "saturated", "peak_actuator_force_n", "coherence_min"})
+      EXPECT_TRUE(row.contains(key)) << key;
+  EXPECT_EQ(j["sweep"].size(), 2u);
+  for (const char* png : {"frf_open_closed.png", "bench_sweep.png", "bench_improvement.png"})
+    EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(path);
+  std::filesystem::remove(json);
 }
 
 }  // namespace
