@@ -13,6 +13,7 @@
 #include "apps/filters_command.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
+#include "sim_plant/plant_model.hpp"
 
 namespace {
 
@@ -55,6 +56,13 @@ int run_filters(const std::string& path, double freq_hz, bool json, const std::s
 int run_check_config(const std::string& path) {
   robodamp::control::ChainDesign d;
   if (!load_design(path, d)) return 2;
+  try {  // with modal data, the plant's physical consistency too
+    const auto cfg = robodamp::config::load_config_file(path);
+    if (!cfg.robot.frfs.empty()) (void)robodamp::sim::build_plant_model(cfg);
+  } catch (const ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
   std::cout << path << ": OK (" << d.blocks.size() << " blocks, " << d.params.sections.count
             << " second-order sections at " << d.params.fs_hz << " Hz)\n";
   return 0;

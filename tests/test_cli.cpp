@@ -165,4 +165,15 @@ TEST(Cli, BenchWritesRowsJsonPlotsAndAVerdict) {
   std::filesystem::remove(json);
 }
 
+TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml.replace(yaml.find("axis_sign: -1"), 13, "axis_sign: +1");
+  const std::string path = temp_path("flipped.yaml");
+  std::ofstream(path) << yaml;
+  const Result r = run("check-config " + path);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("robot.frfs[2]"), std::string::npos) << r.out;
+  std::filesystem::remove(path);
+}
+
 }  // namespace
