@@ -265,5 +265,34 @@ TEST(Config, RobotModalDataIsValidated) {
   EXPECT_NE(m.find("robot.frfs[0].modes[0].damping_ratio = 1.5"), std::string::npos) << m;
 }
 
+TEST(Config, PlantSectionsAreValidated) {
+  const std::string preset = test::read_file(test::preset("horizontal_c2"));
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string y = preset;
+    y.replace(y.find(from), from.size(), to);
+    return y;
+  };
+  auto one = [&](const std::string& yaml) {
+    const auto p = problems_of(yaml);
+    EXPECT_EQ(p.size(), 1u);
+    return p.empty() ? std::string() : p.front().to_string();
+  };
+  std::string m = one(with("  location: 2\n  sensitivity_mv_per_g", "  location: 7\n  sensitivity_mv_per_g"));
+  EXPECT_NE(m.find("sensor.location = 7 is not a robot location (known: 1, 2)"), std::string::npos) << m;
+  m = one(with("axis_sign: -1", "axis_sign: 2"));
+  EXPECT_NE(m.find("robot.locations[1].axis_sign = '2' is not allowed: +1 or -1"), std::string::npos) << m;
+  m = one(with("noise_density_ug_per_rthz: 3 ", "noise_density_ug_per_rthz: -3 "));
+  EXPECT_NE(m.find("sensor.noise_density_ug_per_rthz = -3 ug/sqrt(Hz) is out of range"), std::string::npos) << m;
+  m = one(with("sweep_gain_factors: [0.5, 0.9, 1.1, 1.5]", "sweep_gain_factors: [0.5, -1]"));
+  EXPECT_NE(m.find("bench.sweep_gain_factors[1] = -1 is out of range"), std::string::npos) << m;
+  m = one(with("oversampling: 1 ", "oversampling: 2.5 "));
+  EXPECT_NE(m.find("plant.oversampling = 2.5 must be a whole number"), std::string::npos) << m;
+  m = one(with("band_max_hz: 100", "band_max_hz: 3"));
+  EXPECT_NE(m.find("analysis.band_max_hz = 3 Hz must be above analysis.band_min_hz = 5 Hz"), std::string::npos) << m;
+  m = one(with("{natural_freq_hz: 21.0, damping_ratio: 0.025, residue_re_m_per_n: 2.01e-6, residue_im_m_per_n: -7.85e-6}",
+               "{natural_freq_hz: 21.0, damping_ratio: 0.025, residue_re_m_per_n: 2.01e-6, stiffness_n_per_m: 1e6}"));
+  EXPECT_NE(m.find("robot.frfs[0].modes[1].residue_re_m_per_n: given together with stiffness_n_per_m"), std::string::npos) << m;
+}
+
 }  // namespace
 }  // namespace robodamp::config
