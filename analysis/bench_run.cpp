@@ -57,15 +57,25 @@ MeasuredPeak measured_peak(const FrfEstimate& e, double lo, double hi) {
 
 Bench::Bench(const config::Config& cfg) : cfg_(cfg), model_(cfg) {}
 
+sim::Plant Bench::make_plant() const {
+  sim::Plant plant(model_.plant(), cfg_);
+  if (cfg_.disturbances.drives_on) plant.add_excitation(sim::make_drive_vibration(model_.plant(), cfg_));
+  return plant;
+}
+
+control::ControllerParams Bench::controller_params(double gain, int polarity) const {
+  control::ControllerParams params = model_.chain().params;
+  params.gain_ns_per_m = gain;
+  params.polarity = polarity;
+  return params;
+}
+
 ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
   const auto wall0 = std::chrono::steady_clock::now();
   const auto& b = cfg_.bench;
   const double fs = cfg_.loop.rate_hz;
-  sim::Plant plant(model_.plant(), cfg_);
-  if (cfg_.disturbances.drives_on) plant.add_excitation(sim::make_drive_vibration(model_.plant(), cfg_));
-  control::ControllerParams params = model_.chain().params;
-  params.gain_ns_per_m = t.gain_ns_per_m;
-  params.polarity = t.polarity;
+  sim::Plant plant = make_plant();
+  const control::ControllerParams params = controller_params(t.gain_ns_per_m, t.polarity);
   control::Controller controller(params);
 
   const double settle = settle_time_s(params);
@@ -142,15 +152,11 @@ DivergenceRun Bench::divergence_run(double gain, int polarity) const {
   const double rho = model_.spectral_radius(gain, polarity);
   d.predicted_unstable = rho >= 1.0;
   d.predicted_growth_per_s = fs * std::log(rho);
-  sim::Plant plant(model_.plant(), cfg_);
-  if (cfg_.disturbances.drives_on) plant.add_excitation(sim::make_drive_vibration(model_.plant(), cfg_));
+  sim::Plant plant = make_plant();
   const double t_hit = 1.0;
   plant.add_excitation(std::make_unique<sim::ImpactHammer>(model_.actuator_location(), cfg_.bench.impact_peak_n,
                                                            cfg_.bench.impact_duration_ms * 1e-3, std::vector<double>{t_hit}));
-  control::ControllerParams params = model_.chain().params;
-  params.gain_ns_per_m = gain;
-  params.polarity = polarity;
-  control::Controller controller(params);
+  control::Controller controller(controller_params(gain, polarity));
   const auto n = static_cast<std::size_t>(std::lround(cfg_.bench.sweep_duration_s * fs));
   const auto win = static_cast<std::size_t>(std::lround(d.window_s * fs));
   double command = 0.0, sum2 = 0.0;

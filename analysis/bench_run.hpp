@@ -13,6 +13,8 @@
 
 #include "analysis/loop_model.hpp"
 #include "analysis/spectral.hpp"
+#include "control/controller_params.hpp"
+#include "sim_plant/plant.hpp"
 
 namespace robodamp::analysis {
 
@@ -108,6 +110,10 @@ class Bench {
   [[nodiscard]] BenchReport run(const Progress& progress = {}) const;
 
  private:
+  // The simulated plant with the configured disturbances, and the designed controller at (K, polarity).
+  [[nodiscard]] sim::Plant make_plant() const;
+  [[nodiscard]] control::ControllerParams controller_params(double gain_ns_per_m, int polarity) const;
+
   config::Config cfg_;
   LoopModel model_;
 };

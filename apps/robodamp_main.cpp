@@ -55,10 +55,10 @@ int run_filters(const std::string& path, double freq_hz, bool json, const std::s
 
 int run_check_config(const std::string& path) {
   robodamp::control::ChainDesign d;
-  if (!load_design(path, d)) return 2;
-  try {  // with modal data, the plant's physical consistency too
+  try {
     const auto cfg = robodamp::config::load_config_file(path);
-    if (!cfg.robot.frfs.empty()) (void)robodamp::sim::build_plant_model(cfg);
+    d = robodamp::control::design_chain(cfg);
+    if (!cfg.robot.frfs.empty()) (void)robodamp::sim::build_plant_model(cfg);  // the plant's physical consistency
   } catch (const ConfigError& e) {
     std::cerr << e.what() << '\n';
     return 2;

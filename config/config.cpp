@@ -91,6 +91,18 @@ LoopConfig read_loop(MapReader& top, std::optional<double>& rate) {
   return c;
 }
 
+const Range kLocationId{"(location id)", 1, 64};
+
+std::optional<int> read_int(MapReader& r, const std::string& key, const Range& range, std::optional<double> def = {}) {
+  const auto v = r.number(key, range, def);
+  if (!v) return std::nullopt;
+  if (*v != std::floor(*v)) {
+    r.diagnostics().add(r.mark(), r.path_of(key), "= " + format_number(*v) + " must be a whole number");
+    return std::nullopt;
+  }
+  return static_cast<int>(*v);
+}
+
 ActuatorConfig read_actuator(MapReader& top, std::optional<double> rate) {
   MapReader r(top.diagnostics(), top.child("actuator", true, "map, Eq. 3 parameters"), "actuator", top.mark());
   ActuatorConfig c;
@@ -101,7 +113,7 @@ ActuatorConfig read_actuator(MapReader& top, std::optional<double> rate) {
   if (auto v = r.number("damping_ratio", kDamping)) c.damping_ratio = *v;
   if (auto v = r.number("delay_s", {"s", 0.0, 0.1})) c.delay_s = *v;
   if (auto v = r.number("force_limit_n", {"N", 0.0, 10000.0, true})) c.force_limit_n = *v;
-  if (auto v = r.number("location", {"(location id)", 1, 64}, 2.0)) c.location = static_cast<int>(*v);
+  if (auto v = read_int(r, "location", kLocationId, c.location)) c.location = *v;
   r.finish();
   return c;
 }
@@ -213,18 +225,6 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
   }
   r.finish();
   return c;
-}
-
-const Range kLocationId{"(location id)", 1, 64};
-
-std::optional<int> read_int(MapReader& r, const std::string& key, const Range& range, std::optional<double> def = {}) {
-  const auto v = r.number(key, range, def);
-  if (!v) return std::nullopt;
-  if (*v != std::floor(*v)) {
-    r.diagnostics().add(r.mark(), r.path_of(key), "= " + format_number(*v) + " must be a whole number");
-    return std::nullopt;
-  }
-  return static_cast<int>(*v);
 }
 
 std::optional<int> read_sign(MapReader& r, const std::string& key, int def) {

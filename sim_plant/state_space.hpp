@@ -43,11 +43,6 @@ class SparseRows {
   SparseRows() = default;
   // Keeps the entries where pattern is true (or every non-zero entry without a pattern).
   SparseRows(const Matrix& m, const Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic>* pattern = nullptr);
-  // out += M x. RT-safe.
-  void accumulate(const double* x, double* out) const noexcept {
-    const std::size_t rows = row_start_.size() - 1;
-    for (std::size_t r = 0; r < rows; ++r) out[r] += row_dot(r, x);
-  }
   // out = M x. RT-safe.
   void apply(const double* x, double* out) const noexcept {
     const std::size_t rows = row_start_.size() - 1;
