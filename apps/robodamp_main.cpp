@@ -11,6 +11,7 @@
 #include "apps/analyze_command.hpp"
 #include "apps/bench_command.hpp"
 #include "apps/filters_command.hpp"
+#include "apps/run_command.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
 #include "sim_plant/plant_model.hpp"
@@ -154,7 +155,34 @@ int main(int argc, char** argv) {
   bench->add_option("--json", json_path, "Write the report as JSON to this file");
   bench->add_option("--plot-dir", plot_dir, "Write plots (PNG) here");
 
+  robodamp::apps::RunOptions run_opts;
+  std::string clock;
+  auto* run = app.add_subcommand("run", "The real-time loop (simulated plant backend), paced on the wall clock; Ctrl-C ends it safely");
+  run->add_option("--config", config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  run->add_option("--duration", run_opts.duration_s, "Run time in seconds")->capture_default_str();
+  run->add_option("--record", run_opts.record_path, "Record every tick to this file (binary, docs/recording_format.md)");
+  run->add_option("--json", run_opts.json_path, "Write the run summary as JSON to this file");
+  run->add_option("--clock", clock, "Override loop.clock: wall (real time) or virtual (as fast as possible)")
+      ->check(CLI::IsMember({"wall", "virtual"}));
+  run->add_option("--impact-every", run_opts.impact_every_s,
+                  "Simulated plant: a hammer hit at the TCP every S seconds (bench.impact_peak_n); 0 = none")
+      ->capture_default_str();
+
+  std::string recording, csv_out;
+  auto* replay = app.add_subcommand("replay", "Feed a recording's inputs through the same controller; check the commands bit for bit");
+  replay->add_option("file", recording, "Recording (from run --record)")->required()->check(CLI::ExistingFile);
+  auto* csv = app.add_subcommand("csv", "Export a recording as CSV");
+  csv->add_option("file", recording, "Recording (from run --record)")->required()->check(CLI::ExistingFile);
+  csv->add_option("-o,--out", csv_out, "Output file (default: stdout)");
+
   CLI11_PARSE(app, argc, argv);
+  if (run->parsed()) {
+    run_opts.config_path = config_path;
+    if (!clock.empty()) run_opts.clock = clock == "wall" ? robodamp::config::ClockKind::kWall : robodamp::config::ClockKind::kVirtual;
+    return robodamp::apps::run_loop(run_opts);
+  }
+  if (replay->parsed()) return robodamp::apps::run_replay(recording);
+  if (csv->parsed()) return robodamp::apps::run_csv(recording, csv_out);
   if (bench->parsed()) return run_bench(config_path, json_path, plot_dir);
   if (analyze->parsed()) return run_analyze(config_path, json, plot_dir);
   if (filters->parsed()) return run_filters(config_path, freq_hz, json, plot);

@@ -62,6 +62,8 @@ const char* to_string(CompensatorModel model) {
   return "?";
 }
 
+const char* to_string(ClockKind clock) { return clock == ClockKind::kWall ? "wall" : "virtual"; }
+
 const char* to_string(Mounting mounting) { return mounting == Mounting::kHorizontal ? "horizontal" : "vertical"; }
 
 namespace {
@@ -87,6 +89,7 @@ LoopConfig read_loop(MapReader& top, std::optional<double>& rate) {
   LoopConfig c;
   rate = r.number("rate_hz", {"Hz", kMinRateHz, kMaxRateHz});
   if (rate) c.rate_hz = *rate;
+  if (auto v = r.choice("clock", {"wall", "virtual"}, "wall")) c.clock = *v == "wall" ? ClockKind::kWall : ClockKind::kVirtual;
   r.finish();
   return c;
 }
@@ -413,6 +416,64 @@ BenchConfig read_bench(MapReader& top) {
   return c;
 }
 
+std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def) {
+  if (auto v = r.choice(key, {"true", "false"}, def ? "true" : "false")) return *v == "true";
+  return std::nullopt;
+}
+
+RealtimeConfig read_realtime(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("realtime", false, ""), "realtime", top.mark());
+  RealtimeConfig c;
+  if (auto v = read_int(r, "priority", {"(SCHED_FIFO priority, 0 = SCHED_OTHER)", 0, 99}, c.priority)) c.priority = *v;
+  if (auto v = read_int(r, "cpu", {"(CPU index, -1 = any)", -1, 1023}, c.cpu)) c.cpu = *v;
+  if (auto v = read_bool(r, "lock_memory", c.lock_memory)) c.lock_memory = *v;
+  if (auto v = read_int(r, "stack_prefault_kib", {"KiB", 0, 65536}, c.stack_prefault_kib)) c.stack_prefault_kib = *v;
+  if (auto v = read_bool(r, "hold_cpu_dma_latency", c.hold_cpu_dma_latency)) c.hold_cpu_dma_latency = *v;
+  r.finish();
+  return c;
+}
+
+SupervisionConfig read_supervision(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("supervision", false, ""), "supervision", top.mark());
+  SupervisionConfig c;
+  const Range cycles{"(loop ticks)", 1, 1e6};
+  if (auto v = read_int(r, "stale_sensor_cycles", cycles, c.stale_sensor_cycles)) c.stale_sensor_cycles = *v;
+  if (auto v = read_int(r, "invalid_sample_cycles", cycles, c.invalid_sample_cycles)) c.invalid_sample_cycles = *v;
+  if (auto v = r.number("sample_limit_mps2", {"m/s^2", 0.0, 1e7, false, false, "0 = the sensor's range"},
+                        c.sample_limit_mps2))
+    c.sample_limit_mps2 = *v;
+  if (auto v = read_int(r, "overrun_cycles", cycles, c.overrun_cycles)) c.overrun_cycles = *v;
+  if (auto v = r.number("saturation_window_s", {"s", 0.001, 10.0}, c.saturation_window_s)) c.saturation_window_s = *v;
+  if (auto v = r.number("saturation_duty_max", {"(fraction of the window)", 0.0, 1.0, true}, c.saturation_duty_max))
+    c.saturation_duty_max = *v;
+  if (auto v = r.number("instability_block_s", {"s", 0.005, 10.0}, c.instability_block_s)) c.instability_block_s = *v;
+  if (auto v = read_int(r, "instability_blocks", {"(blocks)", 2, 1000}, c.instability_blocks)) c.instability_blocks = *v;
+  if (auto v = r.number("instability_growth_factor", {"(ratio)", 1.0, 1e6, true}, c.instability_growth_factor))
+    c.instability_growth_factor = *v;
+  if (auto v = r.number("instability_floor_v", {"V", 0.0, 100.0}, c.instability_floor_v)) c.instability_floor_v = *v;
+  if (auto v = r.number("trip_ramp_s", {"s", 0.0, 1.0}, c.trip_ramp_s)) c.trip_ramp_s = *v;
+  if (auto v = read_int(r, "arming_live_cycles", cycles, c.arming_live_cycles)) c.arming_live_cycles = *v;
+  if (auto v = r.number("amplifier_ready_timeout_s", {"s", 0.0, 60.0}, c.amplifier_ready_timeout_s))
+    c.amplifier_ready_timeout_s = *v;
+  if (auto v = r.number("max_gain_fraction", {"(x maximum stable K)", 0.0, 1.0, true}, c.max_gain_fraction))
+    c.max_gain_fraction = *v;
+  r.finish();
+  return c;
+}
+
+TelemetryConfig read_telemetry(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("telemetry", false, ""), "telemetry", top.mark());
+  TelemetryConfig c;
+  if (auto v = read_int(r, "ring_frames", {"(frames, a power of two)", 1024, 1 << 24}, c.ring_frames)) {
+    if ((*v & (*v - 1)) != 0)
+      r.diagnostics().add(r.mark(), "telemetry.ring_frames", "= " + std::to_string(*v) + " must be a power of two");
+    else
+      c.ring_frames = *v;
+  }
+  r.finish();
+  return c;
+}
+
 // Locations named outside the robot section must exist in it.
 void check_location_refs(Diagnostics& d, const Config& c) {
   if (c.robot.frfs.empty()) return;
@@ -441,6 +502,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   }
   Config c;
   c.source = source_name;
+  c.yaml_text = yaml_text;
   if (!root.IsMap()) {
     d.add(root.Mark(), "(top level)", "expected a map with loop, actuator, amplifier, controller, robot");
     throw ConfigError(d.problems());
@@ -457,6 +519,9 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.disturbances = read_disturbances(top);
   c.analysis = read_analysis(top, rate);
   c.bench = read_bench(top);
+  c.realtime = read_realtime(top);
+  c.supervision = read_supervision(top);
+  c.telemetry = read_telemetry(top);
   top.finish();
   check_location_refs(d, c);
   if (!d.problems().empty()) throw ConfigError(d.problems());

@@ -34,8 +34,45 @@ class ConfigError : public std::runtime_error {
   std::vector<Problem> problems_;
 };
 
+enum class ClockKind { kWall, kVirtual };
+[[nodiscard]] const char* to_string(ClockKind clock);
+
 struct LoopConfig {
   double rate_hz{5000.0};
+  // wall: clock_nanosleep on CLOCK_MONOTONIC (hardware, real-time simulation); virtual: ticks back to
+  // back as fast as possible, time = tick / rate (bench runs, bit-identical run to run).
+  ClockKind clock{ClockKind::kWall};
+};
+
+// Start-up of the real-time thread. Each step that is not permitted falls back with a warning.
+struct RealtimeConfig {
+  int priority{80};              // SCHED_FIFO 1-99; 0 = stay SCHED_OTHER
+  int cpu{-1};                   // CPU affinity; -1 = any
+  bool lock_memory{true};        // mlockall(MCL_CURRENT | MCL_FUTURE)
+  int stack_prefault_kib{256};   // stack touched before activation
+  bool hold_cpu_dma_latency{true};  // /dev/cpu_dma_latency held at 0 us while running
+};
+
+// The supervisor's trips and ramps (rt/supervisor.hpp).
+struct SupervisionConfig {
+  int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample
+  int invalid_sample_cycles{1};      // consecutive non-finite or out-of-range samples
+  double sample_limit_mps2{0.0};     // out of range beyond this; 0 = the sensor's range (sensor.range_g)
+  int overrun_cycles{10};            // consecutive overruns (compute past the period or missed ticks)
+  double saturation_window_s{0.5};
+  double saturation_duty_max{0.2};   // fraction of the window's ticks at a controller or actuator limit
+  double instability_block_s{0.1};   // command RMS per block
+  int instability_blocks{8};         // growth in every one of this many consecutive blocks ...
+  double instability_growth_factor{1.5};  // ... and by at least this factor overall
+  double instability_floor_v{0.02};  // RMS below this is never called unstable
+  double trip_ramp_s{0.01};          // a trip ramps the command to zero within this time
+  int arming_live_cycles{50};        // fresh, valid samples needed before arming
+  double amplifier_ready_timeout_s{0.2};
+  double max_gain_fraction{0.9};     // gain requests up to this x the analysed maximum stable K
+};
+
+struct TelemetryConfig {
+  int ring_frames{65536};  // lock-free ring between the loop and the drain thread (power of two)
 };
 
 enum class Mounting { kHorizontal, kVertical };
@@ -171,7 +208,11 @@ struct BenchConfig {
 
 struct Config {
   std::string source;
+  std::string yaml_text;  // the text it was parsed from (recordings carry it)
   LoopConfig loop;
+  RealtimeConfig realtime;
+  SupervisionConfig supervision;
+  TelemetryConfig telemetry;
   ActuatorConfig actuator;
   AmplifierConfig amplifier;
   ControllerConfig controller;

@@ -37,6 +37,7 @@ class Controller final {
   [[nodiscard]] double update(double accel_mps2) noexcept {
     ++counters_.samples;
     const double shaped = cascade_.process(accel_mps2);
+    filtered_ = shaped;
     if (pending_) (void)shadow_.process(accel_mps2);  // the incoming chain warms up on the same signal
     advance_ramp();
     double force_n = scale_ * shaped;  // polarity * K * chain(accel), newtons
@@ -117,6 +118,8 @@ class Controller final {
   [[nodiscard]] double target_gain_ns_per_m() const noexcept { return target_gain_; }
   [[nodiscard]] bool handover_pending() const noexcept { return pending_; }
   [[nodiscard]] double command_v() const noexcept { return command_v_; }
+  // The chain's output for the last sample: the velocity estimate the gain acts on, m/s.
+  [[nodiscard]] double filtered_mps() const noexcept { return p_.sections_gain * filtered_; }
   [[nodiscard]] double force_command_n() const noexcept { return force_n_; }
   [[nodiscard]] const ControllerParams& params() const noexcept { return p_; }
 
@@ -162,6 +165,7 @@ class Controller final {
   bool pending_{false};
   double command_v_{0.0};
   double force_n_{0.0};
+  double filtered_{0.0};
   mutable ControllerCounters counters_{};
 };
 

@@ -10,6 +10,10 @@ const char* to_string(FaultKind kind) {
     case FaultKind::kSensorNan: return "sensor_nan";
     case FaultKind::kActuatorDead: return "actuator_dead";
     case FaultKind::kActuatorSaturated: return "actuator_saturated";
+    case FaultKind::kAmplifierFault: return "amplifier_fault";
+    case FaultKind::kSensorDriverError: return "sensor_driver_error";
+    case FaultKind::kActuatorDriverError: return "actuator_driver_error";
+    case FaultKind::kDriverStall: return "driver_stall";
   }
   return "?";
 }

@@ -1,7 +1,10 @@
 // Scheduled faults for safety work: the sensor drops out, sticks, spikes or reads NaN; the actuator goes
-// dead or saturates at a lower force. Faults are added before a run; queries are RT-safe.
+// dead or saturates at a lower force; and faults of the path to the devices, which the simulated backend
+// (drivers/sim_backend) reports through the driver interfaces: the amplifier signals a fault, the sensor's
+// or the actuator's driver reports an error, a driver call stalls the loop (magnitude = seconds per call). Faults are added before a run; queries are RT-safe.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -9,7 +12,18 @@
 
 namespace robodamp::sim {
 
-enum class FaultKind { kSensorDropout, kSensorStuck, kSensorSpike, kSensorNan, kActuatorDead, kActuatorSaturated };
+enum class FaultKind {
+  kSensorDropout,
+  kSensorStuck,
+  kSensorSpike,
+  kSensorNan,
+  kActuatorDead,
+  kActuatorSaturated,
+  kAmplifierFault,
+  kSensorDriverError,
+  kActuatorDriverError,
+  kDriverStall,
+};
 
 [[nodiscard]] const char* to_string(FaultKind kind);
 
@@ -67,6 +81,14 @@ class FaultInjector {
     if (!any_active(FaultKind::kSensorStuck, t_s)) stuck_ = false;
     last_ = r;
     return r;
+  }
+  // RT-safe. Whether a fault of this kind is active at time t, and the largest magnitude among them.
+  [[nodiscard]] bool active(FaultKind k, double t_s) const noexcept { return any_active(k, t_s); }
+  [[nodiscard]] double magnitude(FaultKind k, double t_s) const noexcept {
+    double m = 0.0;
+    for (const auto& f : faults_)
+      if (f.kind == k && active(f, t_s)) m = std::max(m, f.magnitude);
+    return m;
   }
   // RT-safe. Actuator force limit at time t (0 when dead), given the nominal one.
   [[nodiscard]] double actuator_force_limit_n(double t_s, double nominal_n) const noexcept {

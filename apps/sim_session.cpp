@@ -1,0 +1,195 @@
+#include "apps/sim_session.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <thread>
+
+#include "rt/signals.hpp"
+
+namespace robodamp::apps {
+
+SimSession::SimSession(const config::Config& cfg, const SessionOptions& o) : cfg_(cfg), o_(o) {
+  if (o_.clock) cfg_.loop.clock = *o_.clock;
+  model_ = std::make_unique<analysis::LoopModel>(cfg_);
+  const int polarity = cfg_.controller.polarity;
+  stable_ = model_->stable(cfg_.controller.gain_ns_per_m, polarity);
+  max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
+
+  plant_ = std::make_unique<sim::Plant>(model_->plant(), cfg_);
+  if (cfg_.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(model_->plant(), cfg_));
+  backend_ = std::make_unique<drivers::SimBackend>(*plant_);
+  const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
+  supervisor_ = std::make_unique<rt::Supervisor>(rt::supervisor_settings(cfg_, stable_, k_max), model_->chain().params);
+  ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
+  loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *backend_, *backend_, *backend_,
+                                     ring_.get());
+  if (o_.arm_at_start)
+    loop_->schedule(static_cast<std::uint64_t>(cfg_.supervision.arming_live_cycles) + 1, {rt::CommandKind::kArm, 0.0});
+}
+
+SimSession::~SimSession() = default;
+
+RunSummary SimSession::run(double duration_s) {
+  RunSummary s;
+  s.config = cfg_.source;
+  s.clock = config::to_string(cfg_.loop.clock);
+  s.rate_hz = cfg_.loop.rate_hz;
+  s.duration_s = duration_s;
+  s.analysis_stable = stable_;
+  s.max_stable_gain_ns_per_m = max_stable_gain_.value_or(control::kMaxGainNsPerM);
+  const bool wall = cfg_.loop.clock == config::ClockKind::kWall;
+  const auto ticks = static_cast<std::uint64_t>(std::llround(duration_s * cfg_.loop.rate_hz));
+
+  if (o_.impact_every_s > 0.0) {
+    std::vector<double> hits;
+    for (double t = o_.impact_every_s; t < duration_s; t += o_.impact_every_s) hits.push_back(t);
+    plant_->add_excitation(std::make_unique<sim::ImpactHammer>(0, cfg_.bench.impact_peak_n,
+                                                               cfg_.bench.impact_duration_ms * 1e-3, hits));
+  }
+
+  std::optional<rt::RealtimeProcess> rt_process;
+  if (wall && o_.realtime_setup) rt_process.emplace(cfg_.realtime, s.realtime);
+  std::unique_ptr<rt::Recorder> recorder;
+  if (!o_.record_path.empty())
+    recorder = std::make_unique<rt::Recorder>(o_.record_path, rt::recording_header(cfg_, *supervisor_, cfg_.loop.clock));
+
+  double sum_sq = 0.0, peak = 0.0;
+  std::uint64_t n = 0;
+  frames_.clear();
+  std::vector<rt::TelemetryDrain::Consumer> consumers;
+  if (recorder) consumers.emplace_back([&recorder](const rt::TelemetryFrame& f) { recorder->write(f); });
+  consumers.emplace_back([&](const rt::TelemetryFrame& f) {
+    if (std::isfinite(f.accel_mps2)) sum_sq += f.accel_mps2 * f.accel_mps2, ++n;
+    peak = std::max(peak, std::abs(f.command_v));
+    if (keep_frames_) frames_.push_back(f);
+  });
+  rt::TelemetryDrain drain(*ring_, std::move(consumers));
+  drain.start();
+  std::thread thread([&] {
+    if (wall && o_.realtime_setup) rt::setup_realtime_thread(cfg_.realtime, s.realtime);
+    loop_->run(ticks);
+  });
+  thread.join();
+  drain.stop();
+  if (recorder) {
+    recorder->close();
+    s.recorded_frames = recorder->frames();
+    s.record_errors = recorder->write_errors();
+    s.record_path = recorder->path();
+  }
+  s.loop = loop_->stats();
+  s.supervisor = supervisor_->counters();
+  s.final_state = rt::to_string(supervisor_->state());
+  s.trip = rt::to_string(supervisor_->latched_trip());
+  s.trip_description = rt::describe(supervisor_->latched_trip());
+  s.telemetry_frames = drain.frames();
+  s.sensor_rms_mps2 = n ? std::sqrt(sum_sq / static_cast<double>(n)) : 0.0;
+  s.peak_command_v = peak;
+  return s;
+}
+
+nlohmann::json summary_json(const RunSummary& s) {
+  using nlohmann::json;
+  auto hist = [](const rt::TimingHistogram& h) {
+    return json{{"count", h.count()},           {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
+                {"p999_us", h.percentile_us(0.999)}, {"max_us", h.max_us()},       {"mean_us", h.mean_us()}};
+  };
+  json trips = json::object();
+  for (std::size_t i = 1; i < rt::kTripCount; ++i)
+    trips[rt::to_string(static_cast<rt::Trip>(i))] = s.supervisor.trips[i];
+  const auto ticks = static_cast<double>(std::max<std::uint64_t>(1, s.loop.ticks_run + s.loop.missed_ticks));
+  return {{"config", s.config},
+          {"clock", s.clock},
+          {"rate_hz", s.rate_hz},
+          {"duration_s", s.duration_s},
+          {"elapsed_s", s.loop.elapsed_s},
+          {"final_state", s.final_state},
+          {"trip", s.trip},
+          {"trip_description", s.trip_description},
+          {"analysis_stable", s.analysis_stable},
+          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
+          {"ticks_run", s.loop.ticks_run},
+          {"missed_ticks", s.loop.missed_ticks},
+          {"overruns", s.loop.overruns},
+          {"overrun_pct", 100.0 * static_cast<double>(s.loop.overruns) / ticks},
+          {"wake_latency", hist(s.loop.wake_latency)},
+          {"compute", hist(s.loop.compute)},
+          {"telemetry", {{"frames", s.telemetry_frames}, {"ring_drops", s.loop.ring_drops}, {"ring_waits", s.loop.ring_waits}}},
+          {"recording", {{"path", s.record_path}, {"frames", s.recorded_frames}, {"write_errors", s.record_errors}}},
+          {"supervisor",
+           {{"trips", trips},
+            {"stale_ticks", s.supervisor.stale_ticks},
+            {"invalid_samples", s.supervisor.invalid_samples},
+            {"saturated_ticks", s.supervisor.saturated_ticks},
+            {"arm_refused", s.supervisor.arm_refused},
+            {"gain_refused", s.supervisor.gain_refused}}},
+          {"realtime",
+           {{"memory_locked", s.realtime.memory_locked},
+            {"sched_fifo", s.realtime.fifo},
+            {"priority", s.realtime.priority},
+            {"affinity", s.realtime.affinity},
+            {"timer_slack_1ns", s.realtime.timer_slack},
+            {"cpu_dma_latency_held", s.realtime.dma_latency_held},
+            {"warnings", s.realtime.warnings}}},
+          {"sensor_rms_mps2", s.sensor_rms_mps2},
+          {"peak_command_v", s.peak_command_v}};
+}
+
+std::string summary_text(const RunSummary& s) {
+  std::ostringstream os;
+  char b[256];
+  const auto& st = s.loop;
+  const double all = static_cast<double>(std::max<std::uint64_t>(1, st.ticks_run + st.missed_ticks));
+  std::snprintf(b, sizeof b, "robodamp run: %s, simulated plant, %s clock, %.0f Hz, %.3f s (%.3f s elapsed)\n",
+                s.config.c_str(), s.clock.c_str(), s.rate_hz, s.duration_s, st.elapsed_s);
+  os << b;
+  if (s.clock == "wall") {
+    os << "  real time: " << (s.realtime.fifo ? "SCHED_FIFO " + std::to_string(s.realtime.priority) : "SCHED_OTHER")
+       << (s.realtime.memory_locked ? ", memory locked" : "") << (s.realtime.dma_latency_held ? ", cpu_dma_latency 0" : "")
+       << (s.realtime.timer_slack ? ", timer slack 1 ns" : "") << (s.realtime.affinity ? ", pinned" : "") << '\n';
+  }
+  os << "  state: " << s.final_state;
+  if (s.trip != "none") os << "  (tripped: " << s.trip << " - " << s.trip_description << ")";
+  os << '\n';
+  std::snprintf(b, sizeof b, "  ticks %llu, missed %llu, overruns %llu (%.4f %%)\n",
+                static_cast<unsigned long long>(st.ticks_run), static_cast<unsigned long long>(st.missed_ticks),
+                static_cast<unsigned long long>(st.overruns), 100.0 * static_cast<double>(st.overruns) / all);
+  os << b;
+  if (s.clock == "wall") {
+    const auto& h = st.wake_latency;
+    std::snprintf(b, sizeof b, "  wake-up latency: p50 %.0f us, p99 %.0f us, p99.9 %.0f us, max %.1f us\n",
+                  h.percentile_us(0.5), h.percentile_us(0.99), h.percentile_us(0.999), h.max_us());
+    os << b;
+  }
+  std::snprintf(b, sizeof b, "  compute per tick: mean %.2f us, p99 %.0f us, max %.1f us\n", st.compute.mean_us(),
+                st.compute.percentile_us(0.99), st.compute.max_us());
+  os << b;
+  std::string trips;
+  for (std::size_t i = 1; i < rt::kTripCount; ++i)
+    if (s.supervisor.trips[i] > 0)
+      trips += std::string(trips.empty() ? "" : ", ") + rt::to_string(static_cast<rt::Trip>(i)) + " " +
+               std::to_string(s.supervisor.trips[i]);
+  std::snprintf(b, sizeof b, "  supervisor: stale %llu, invalid %llu, saturated %llu ticks, arm refused %llu, gain refused %llu; trips: %s\n",
+                static_cast<unsigned long long>(s.supervisor.stale_ticks),
+                static_cast<unsigned long long>(s.supervisor.invalid_samples),
+                static_cast<unsigned long long>(s.supervisor.saturated_ticks),
+                static_cast<unsigned long long>(s.supervisor.arm_refused),
+                static_cast<unsigned long long>(s.supervisor.gain_refused), trips.empty() ? "none" : trips.c_str());
+  os << b;
+  std::snprintf(b, sizeof b, "  vibration at the sensor: %.4f m/s^2 RMS; peak command %.3f V; K_max %.0f N s/m\n",
+                s.sensor_rms_mps2, s.peak_command_v, s.max_stable_gain_ns_per_m);
+  os << b;
+  std::snprintf(b, sizeof b, "  telemetry: %llu frames, %llu dropped", static_cast<unsigned long long>(s.telemetry_frames),
+                static_cast<unsigned long long>(st.ring_drops));
+  os << b;
+  if (!s.record_path.empty())
+    os << "; recorded " << s.recorded_frames << " frames to " << s.record_path
+       << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
+  os << '\n';
+  if (!s.realtime.warnings.empty())
+    os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
+  return os.str();
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,91 @@
+// A loop session against the simulated plant: the configuration analysed (stability and the maximum
+// stable gain, for the supervisor's arming and gain checks), the plant with the configured disturbances
+// behind the simulated backend, the supervisor and its controller, the loop, the telemetry ring and its
+// drain thread with the recorder and live timing. `robodamp run` and the loop tests use it; the same
+// pieces with hardware drivers in place of the backend make the deployment.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/loop_model.hpp"
+#include "drivers/sim_backend.hpp"
+#include "rt/loop.hpp"
+#include "rt/realtime.hpp"
+#include "rt/recording.hpp"
+#include "rt/telemetry_drain.hpp"
+#include "sim_plant/plant.hpp"
+
+namespace robodamp::apps {
+
+struct SessionOptions {
+  std::optional<config::ClockKind> clock;  // default: loop.clock from the configuration
+  double impact_every_s{0.0};              // hammer hits at the TCP (location 1), bench.impact_peak_n; 0 = none
+  bool arm_at_start{true};                 // arm once the sensor can be live
+  std::string record_path;                 // empty = no recording
+  bool realtime_setup{true};               // wall clock: mlockall, SCHED_FIFO, ... (config realtime)
+};
+
+struct RunSummary {
+  std::string config;
+  std::string clock;
+  double rate_hz{0.0};
+  double duration_s{0.0};
+  rt::LoopStats loop;
+  rt::SupervisorCounters supervisor;
+  std::string final_state, trip, trip_description;
+  double max_stable_gain_ns_per_m{0.0};
+  bool analysis_stable{false};
+  rt::RealtimeStatus realtime;
+  std::uint64_t telemetry_frames{0};
+  std::uint64_t recorded_frames{0}, record_errors{0};
+  std::string record_path;
+  double sensor_rms_mps2{0.0};  // control accelerometer over the run
+  double peak_command_v{0.0};
+};
+
+class SimSession {
+ public:
+  explicit SimSession(const config::Config& cfg, const SessionOptions& o = {});
+  ~SimSession();
+
+  // Before run(): more operator commands at given ticks (deterministic on the virtual clock).
+  void schedule(std::uint64_t tick, const rt::OperatorCommand& c) { loop_->schedule(tick, c); }
+  // Runs for duration_s of loop time on a thread of its own (set up for real time on the wall clock),
+  // then disarms to the safe state; blocks until done.
+  RunSummary run(double duration_s);
+
+  [[nodiscard]] sim::Plant& plant() { return *plant_; }
+  [[nodiscard]] drivers::SimBackend& backend() { return *backend_; }
+  [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }
+  [[nodiscard]] rt::Loop& loop() { return *loop_; }
+  [[nodiscard]] const analysis::LoopModel& model() const { return *model_; }
+  [[nodiscard]] const config::Config& config() const { return cfg_; }
+  // All frames drained in this session (kept in memory for tests when asked).
+  void keep_frames(bool on) { keep_frames_ = on; }
+  [[nodiscard]] const std::vector<rt::TelemetryFrame>& frames() const { return frames_; }
+
+ private:
+  config::Config cfg_;
+  SessionOptions o_;
+  std::unique_ptr<analysis::LoopModel> model_;
+  std::optional<double> max_stable_gain_;
+  bool stable_{false};
+  std::unique_ptr<sim::Plant> plant_;
+  std::unique_ptr<drivers::SimBackend> backend_;
+  std::unique_ptr<rt::Supervisor> supervisor_;
+  std::unique_ptr<rt::SpscRing<rt::TelemetryFrame>> ring_;
+  std::unique_ptr<rt::Loop> loop_;
+  bool keep_frames_{false};
+  std::vector<rt::TelemetryFrame> frames_;
+};
+
+[[nodiscard]] nlohmann::json summary_json(const RunSummary& s);
+[[nodiscard]] std::string summary_text(const RunSummary& s);
+
+}  // namespace robodamp::apps

@@ -1,0 +1,81 @@
+// The fixed-rate loop. Each tick: wait for the deadline, read the sensor, take one operator command,
+// step the supervisor (and its controller), write the actuator, ask for the amplifier enable, push a
+// telemetry frame, record the timing. Runs on the calling thread (rt::RealtimeThread sets that thread
+// up); after construction it allocates nothing, takes no lock, does no blocking I/O, throws nothing and
+// logs nothing (tests/test_rt_allocation counts).
+//
+// Wall clock: clock_nanosleep(TIMER_ABSTIME) on CLOCK_MONOTONIC, deadline = previous deadline + period;
+// a late wake-up skips the ticks it missed (counted, never run in a burst) and is an overrun, as is a tick
+// whose work ends past the next deadline; the measured dt goes to the supervisor and the frame.
+// Virtual clock: ticks back to back as fast as possible, dt = period exactly, no timing in the frames:
+// the same inputs give bit-identical frames run to run.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "config/config.hpp"
+#include "rt/io.hpp"
+#include "rt/spsc_ring.hpp"
+#include "rt/supervisor.hpp"
+#include "rt/telemetry_frame.hpp"
+#include "rt/timing_histogram.hpp"
+
+namespace robodamp::rt {
+
+struct LoopStats {
+  std::uint64_t ticks_run{0};
+  std::uint64_t last_tick{0};
+  std::uint64_t missed_ticks{0};
+  std::uint64_t overruns{0};
+  std::uint64_t ring_drops{0};
+  std::uint64_t ring_waits{0};  // virtual clock: times the loop waited for the drain (never drops)
+  double elapsed_s{0.0};        // wall time of the run
+  TimingHistogram wake_latency;  // wake-up minus deadline (wall clock)
+  TimingHistogram compute;       // wake-up to end of the tick's work
+};
+
+class Loop {
+ public:
+  Loop(double rate_hz, config::ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
+       SupervisoryIo& io, SpscRing<TelemetryFrame>* telemetry);
+
+  // From one operator thread: queue a command for the next tick boundary. False when the queue is full.
+  bool post(const OperatorCommand& c) noexcept { return commands_.push(c); }
+  // Before run(): a command for a given tick (a script: tests, virtual-clock runs). A scheduled command
+  // takes the tick before posted ones; if its tick was skipped it runs at the next tick.
+  void schedule(std::uint64_t tick, const OperatorCommand& c);
+  // From any thread: end the run as if its duration were over (disarm, ramp, return).
+  void request_stop() noexcept { stop_.store(true, std::memory_order_relaxed); }
+  // The flag read each tick as SIGINT/SIGTERM (default: rt::shutdown_signal()).
+  void set_shutdown_flag(const std::atomic<int>* flag) noexcept { shutdown_ = flag; }
+
+  // Runs until `duration_ticks` nominal periods have passed (or request_stop / a shutdown signal), then
+  // disarms and keeps running until the supervisor is safe (amplifier off, command zero). Allocation-free.
+  void run(std::uint64_t duration_ticks) noexcept;
+
+  [[nodiscard]] const LoopStats& stats() const noexcept { return *stats_; }
+  [[nodiscard]] double period_s() const noexcept { return static_cast<double>(period_ns_) * 1e-9; }
+  [[nodiscard]] config::ClockKind clock() const noexcept { return clock_; }
+
+ private:
+  std::int64_t period_ns_;
+  config::ClockKind clock_;
+  Supervisor& sup_;
+  SensorSource& sensor_;
+  ActuatorSink& actuator_;
+  SupervisoryIo& io_;
+  SpscRing<TelemetryFrame>* telemetry_;
+  SpscRing<OperatorCommand> commands_{64};
+  std::vector<std::pair<std::uint64_t, OperatorCommand>> scheduled_;
+  std::size_t next_scheduled_{0};
+  std::atomic<bool> stop_{false};
+  const std::atomic<int>* shutdown_;
+  std::unique_ptr<LoopStats> stats_;
+  std::uint64_t tick_{0};
+};
+
+}  // namespace robodamp::rt

@@ -1,0 +1,238 @@
+#include "rt/recording.hpp"
+
+#include <cstring>
+#include <ctime>
+
+#include "rt/version.hpp"
+
+namespace robodamp::rt {
+
+using nlohmann::json;
+
+json to_json(const control::ControllerParams& p) {
+  json sections = json::array();
+  for (std::size_t i = 0; i < p.sections.count; ++i) {
+    const auto& s = p.sections.sections[i];
+    sections.push_back({s.b0, s.b1, s.b2, s.a1, s.a2});
+  }
+  return {{"fs_hz", p.fs_hz},
+          {"sections", sections},
+          {"sections_gain", p.sections_gain},
+          {"gain_ns_per_m", p.gain_ns_per_m},
+          {"gain_ramp_s", p.gain_ramp_s},
+          {"settle_s", p.settle_s},
+          {"polarity", p.polarity},
+          {"actuator_constant_n_per_v", p.actuator_constant_n_per_v},
+          {"force_limit_n", p.force_limit_n},
+          {"voltage_limit_v", p.voltage_limit_v},
+          {"slew_rate_v_per_s", p.slew_rate_v_per_s}};
+}
+
+control::ControllerParams controller_params_from(const json& j) {
+  control::ControllerParams p;
+  p.fs_hz = j.at("fs_hz").get<double>();
+  std::vector<filters::BiquadCoefficients> v;
+  for (const auto& s : j.at("sections")) v.push_back({s.at(0), s.at(1), s.at(2), s.at(3), s.at(4)});
+  p.sections = filters::SosCoefficients::from(v);
+  p.sections_gain = j.at("sections_gain").get<double>();
+  p.gain_ns_per_m = j.at("gain_ns_per_m").get<double>();
+  p.gain_ramp_s = j.at("gain_ramp_s").get<double>();
+  p.settle_s = j.at("settle_s").get<double>();
+  p.polarity = j.at("polarity").get<int>();
+  p.actuator_constant_n_per_v = j.at("actuator_constant_n_per_v").get<double>();
+  p.force_limit_n = j.at("force_limit_n").get<double>();
+  p.voltage_limit_v = j.at("voltage_limit_v").get<double>();
+  p.slew_rate_v_per_s = j.at("slew_rate_v_per_s").get<double>();
+  return p;
+}
+
+json to_json(const SupervisorSettings& s) {
+  const auto& l = s.limits;
+  return {{"stale_sensor_cycles", l.stale_sensor_cycles},
+          {"invalid_sample_cycles", l.invalid_sample_cycles},
+          {"sample_limit_mps2", l.sample_limit_mps2},
+          {"overrun_cycles", l.overrun_cycles},
+          {"saturation_window_s", l.saturation_window_s},
+          {"saturation_duty_max", l.saturation_duty_max},
+          {"instability_block_s", l.instability_block_s},
+          {"instability_blocks", l.instability_blocks},
+          {"instability_growth_factor", l.instability_growth_factor},
+          {"instability_floor_v", l.instability_floor_v},
+          {"trip_ramp_s", l.trip_ramp_s},
+          {"arming_live_cycles", l.arming_live_cycles},
+          {"amplifier_ready_timeout_s", l.amplifier_ready_timeout_s},
+          {"max_gain_fraction", l.max_gain_fraction},
+          {"fs_hz", s.fs_hz},
+          {"resolved_sample_limit_mps2", s.sample_limit_mps2},
+          {"fade_s", s.fade_s},
+          {"analysis_stable", s.analysis_stable},
+          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m}};
+}
+
+SupervisorSettings supervisor_settings_from(const json& j) {
+  SupervisorSettings s;
+  auto& l = s.limits;
+  l.stale_sensor_cycles = j.at("stale_sensor_cycles");
+  l.invalid_sample_cycles = j.at("invalid_sample_cycles");
+  l.sample_limit_mps2 = j.at("sample_limit_mps2");
+  l.overrun_cycles = j.at("overrun_cycles");
+  l.saturation_window_s = j.at("saturation_window_s");
+  l.saturation_duty_max = j.at("saturation_duty_max");
+  l.instability_block_s = j.at("instability_block_s");
+  l.instability_blocks = j.at("instability_blocks");
+  l.instability_growth_factor = j.at("instability_growth_factor");
+  l.instability_floor_v = j.at("instability_floor_v");
+  l.trip_ramp_s = j.at("trip_ramp_s");
+  l.arming_live_cycles = j.at("arming_live_cycles");
+  l.amplifier_ready_timeout_s = j.at("amplifier_ready_timeout_s");
+  l.max_gain_fraction = j.at("max_gain_fraction");
+  s.fs_hz = j.at("fs_hz");
+  s.sample_limit_mps2 = j.at("resolved_sample_limit_mps2");
+  s.fade_s = j.at("fade_s");
+  s.analysis_stable = j.at("analysis_stable");
+  s.max_stable_gain_ns_per_m = j.at("max_stable_gain_ns_per_m");
+  return s;
+}
+
+json recording_header(const config::Config& cfg, const Supervisor& supervisor, config::ClockKind clock) {
+  json fields = json::array();
+  for (const auto& f : frame_fields())
+    fields.push_back({{"name", f.name}, {"type", to_string(f.type)}, {"offset", f.offset}, {"unit", f.unit}});
+  json states = json::array(), trips = json::array(), commands = json::array();
+  for (int i = 0; i <= static_cast<int>(State::kFault); ++i) states.push_back(to_string(static_cast<State>(i)));
+  for (std::size_t i = 0; i < kTripCount; ++i) trips.push_back(to_string(static_cast<Trip>(i)));
+  for (int i = 0; i <= static_cast<int>(CommandKind::kSetGain); ++i)
+    commands.push_back(to_string(static_cast<CommandKind>(i)));
+  char created[32];
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  std::strftime(created, sizeof created, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return {{"format", "robodamp-recording"},
+          {"format_version", kRecordingFormatVersion},
+          {"robodamp_version", kVersion},
+          {"git_commit", kGitCommit},
+          {"created_utc", created},
+          {"byte_order", "little"},
+          {"frame_bytes", sizeof(TelemetryFrame)},
+          {"fields", fields},
+          {"flag_bits",
+           {"fresh", "sensor_ok", "actuator_ok", "actuator_saturated", "amplifier_ready", "amplifier_fault", "overrun",
+            "shutdown", "amplifier_enable", "saturated"}},
+          {"states", states},
+          {"trips", trips},
+          {"commands", commands},
+          {"clock", to_string(clock)},
+          {"rate_hz", cfg.loop.rate_hz},
+          {"config_source", cfg.source},
+          {"config_yaml", cfg.yaml_text},
+          {"controller_params", to_json(supervisor.initial_params())},
+          {"supervisor", to_json(supervisor.settings())}};
+}
+
+Recorder::Recorder(const std::string& path, const json& header) : path_(path), buffer_(1 << 20) {
+  f_ = std::fopen(path.c_str(), "wb");
+  if (f_ == nullptr) throw RecordingError("cannot open " + path + " for writing: " + std::strerror(errno));
+  std::setvbuf(f_, buffer_.data(), _IOFBF, buffer_.size());
+  const std::string text = header.dump();
+  const auto version = kRecordingFormatVersion;
+  const auto length = static_cast<std::uint32_t>(text.size());
+  if (std::fwrite(kRecordingMagic, 1, 8, f_) != 8 || std::fwrite(&version, 4, 1, f_) != 1 ||
+      std::fwrite(&length, 4, 1, f_) != 1 || std::fwrite(text.data(), 1, text.size(), f_) != text.size())
+    throw RecordingError("cannot write the header of " + path + ": " + std::strerror(errno));
+}
+
+Recorder::~Recorder() { close(); }
+
+void Recorder::write(const TelemetryFrame& f) {
+  if (f_ == nullptr) return;
+  if (std::fwrite(&f, sizeof f, 1, f_) == 1)
+    ++frames_;
+  else
+    ++write_errors_;
+}
+
+void Recorder::close() {
+  if (f_ == nullptr) return;
+  if (std::fclose(f_) != 0) ++write_errors_;
+  f_ = nullptr;
+}
+
+Recording read_recording(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) throw RecordingError(path + ": cannot open: " + std::strerror(errno));
+  struct Closer {
+    std::FILE* f;
+    ~Closer() { std::fclose(f); }
+  } closer{f};
+  char magic[8];
+  std::uint32_t version = 0, length = 0;
+  if (std::fread(magic, 1, 8, f) != 8 || std::memcmp(magic, kRecordingMagic, 8) != 0)
+    throw RecordingError(path + ": not a robodamp recording (magic RDAMPREC missing)");
+  if (std::fread(&version, 4, 1, f) != 1 || version != kRecordingFormatVersion)
+    throw RecordingError(path + ": recording format version " + std::to_string(version) + ", this build reads " +
+                         std::to_string(kRecordingFormatVersion));
+  if (std::fread(&length, 4, 1, f) != 1 || length > (64U << 20))
+    throw RecordingError(path + ": header length missing or implausible");
+  std::string text(length, '\0');
+  if (std::fread(text.data(), 1, length, f) != length) throw RecordingError(path + ": header truncated");
+  Recording r;
+  try {
+    r.header = json::parse(text);
+  } catch (const json::exception& e) {
+    throw RecordingError(path + ": header is not valid JSON: " + e.what());
+  }
+  if (r.header.value("frame_bytes", 0U) != sizeof(TelemetryFrame))
+    throw RecordingError(path + ": frame size " + std::to_string(r.header.value("frame_bytes", 0U)) +
+                         " bytes, this build's frame is " + std::to_string(sizeof(TelemetryFrame)));
+  TelemetryFrame fr;
+  std::size_t got = 0;
+  while ((got = std::fread(&fr, 1, sizeof fr, f)) == sizeof fr) r.frames.push_back(fr);
+  r.trailing_bytes = got;
+  return r;
+}
+
+void write_csv(const Recording& r, std::FILE* out) {
+  const auto& fields = frame_fields();
+  for (std::size_t i = 0; i < fields.size(); ++i) std::fprintf(out, "%s%.*s", i ? "," : "", static_cast<int>(fields[i].name.size()), fields[i].name.data());
+  std::fprintf(out, ",state_name,trip_name\n");
+  for (const auto& f : r.frames) {
+    const auto* base = reinterpret_cast<const unsigned char*>(&f);
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      const unsigned char* p = base + fields[i].offset;
+      if (i) std::fputc(',', out);
+      switch (fields[i].type) {
+        case FieldType::kU8: std::fprintf(out, "%u", static_cast<unsigned>(*p)); break;
+        case FieldType::kU16: { std::uint16_t v; std::memcpy(&v, p, 2); std::fprintf(out, "%u", static_cast<unsigned>(v)); break; }
+        case FieldType::kU32: { std::uint32_t v; std::memcpy(&v, p, 4); std::fprintf(out, "%u", v); break; }
+        case FieldType::kU64: { std::uint64_t v; std::memcpy(&v, p, 8); std::fprintf(out, "%llu", static_cast<unsigned long long>(v)); break; }
+        case FieldType::kF32: { float v; std::memcpy(&v, p, 4); std::fprintf(out, "%.9g", static_cast<double>(v)); break; }
+        case FieldType::kF64: { double v; std::memcpy(&v, p, 8); std::fprintf(out, "%.17g", v); break; }
+      }
+    }
+    std::fprintf(out, ",%s,%s\n", to_string(static_cast<State>(f.state)), to_string(static_cast<Trip>(f.trip)));
+  }
+}
+
+ReplayResult replay(const Recording& r) {
+  ReplayResult res;
+  Supervisor sup(supervisor_settings_from(r.header.at("supervisor")),
+                 controller_params_from(r.header.at("controller_params")));
+  for (const auto& f : r.frames) {
+    const TickOutput out = sup.step(tick_input(f));
+    ++res.frames;
+    const bool same = std::memcmp(&out.command_v, &f.command_v, sizeof(double)) == 0 &&
+                      std::memcmp(&out.controller_v, &f.controller_v, sizeof(double)) == 0 &&
+                      static_cast<std::uint8_t>(out.state) == f.state && static_cast<std::uint8_t>(out.trip) == f.trip;
+    if (!same && res.mismatches++ == 0) {
+      res.first_mismatch_tick = f.tick;
+      res.first_recorded_v = f.command_v;
+      res.first_replayed_v = out.command_v;
+    }
+  }
+  res.final_state = to_string(sup.state());
+  res.final_trip = to_string(sup.latched_trip());
+  return res;
+}
+
+}  // namespace robodamp::rt

@@ -1,0 +1,299 @@
+#include "rt/supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace robodamp::rt {
+
+namespace {
+constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
+}  // namespace
+
+const char* to_string(State s) {
+  switch (s) {
+    case State::kDisabled: return "disabled";
+    case State::kArming: return "arming";
+    case State::kActive: return "active";
+    case State::kStopping: return "stopping";
+    case State::kFault: return "fault";
+  }
+  return "?";
+}
+
+const char* to_string(Trip t) {
+  switch (t) {
+    case Trip::kNone: return "none";
+    case Trip::kSensorStale: return "sensor_stale";
+    case Trip::kSampleInvalid: return "sample_invalid";
+    case Trip::kOverruns: return "overruns";
+    case Trip::kSaturation: return "saturation";
+    case Trip::kInstability: return "instability";
+    case Trip::kSensorDriver: return "sensor_driver";
+    case Trip::kActuatorDriver: return "actuator_driver";
+    case Trip::kAmplifierFault: return "amplifier_fault";
+    case Trip::kAmplifierNotReady: return "amplifier_not_ready";
+    case Trip::kSignal: return "signal";
+  }
+  return "?";
+}
+
+const char* describe(Trip t) {
+  switch (t) {
+    case Trip::kNone: return "no fault";
+    case Trip::kSensorStale: return "no fresh accelerometer sample for supervision.stale_sensor_cycles ticks: check the sensor node and its bus";
+    case Trip::kSampleInvalid: return "non-finite or out-of-range acceleration samples: check the sensor, its cable and supervision.sample_limit_mps2";
+    case Trip::kOverruns: return "consecutive loop overruns: the loop cannot keep its rate on this machine (see the timing statistics; isolate a CPU, lower loop.rate_hz)";
+    case Trip::kSaturation: return "actuator at its limit for more than supervision.saturation_duty_max of the window: the disturbance is too large for the actuator, or the gain too high";
+    case Trip::kInstability: return "growing oscillation in the loop: the gain is too high for this pose (re-run the analysis, lower controller.gain_ns_per_m)";
+    case Trip::kSensorDriver: return "the sensor driver reports a fault";
+    case Trip::kActuatorDriver: return "the actuator driver could not deliver the command";
+    case Trip::kAmplifierFault: return "the amplifier reports a fault (temperature, current, link)";
+    case Trip::kAmplifierNotReady: return "the amplifier did not become ready within supervision.amplifier_ready_timeout_s after enable";
+    case Trip::kSignal: return "SIGINT/SIGTERM: shut down through the safe state";
+  }
+  return "?";
+}
+
+const char* to_string(ArmRefusal r) {
+  switch (r) {
+    case ArmRefusal::kNone: return "none";
+    case ArmRefusal::kNotDisabled: return "not disabled (reset the fault or disarm first)";
+    case ArmRefusal::kSensorNotLive: return "sensor not live (needs supervision.arming_live_cycles fresh valid samples)";
+    case ArmRefusal::kActuatorPath: return "actuator path not healthy (driver or amplifier fault)";
+    case ArmRefusal::kAnalysisUnstable: return "the analysis does not find the loop stable at this gain with margin";
+  }
+  return "?";
+}
+
+const char* to_string(CommandKind k) {
+  switch (k) {
+    case CommandKind::kNone: return "none";
+    case CommandKind::kArm: return "arm";
+    case CommandKind::kDisarm: return "disarm";
+    case CommandKind::kResetFault: return "reset_fault";
+    case CommandKind::kSetGain: return "set_gain";
+  }
+  return "?";
+}
+
+SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable, double max_stable_gain_ns_per_m) {
+  SupervisorSettings s;
+  s.limits = cfg.supervision;
+  s.fs_hz = cfg.loop.rate_hz;
+  s.sample_limit_mps2 = cfg.supervision.sample_limit_mps2 > 0.0 ? cfg.supervision.sample_limit_mps2
+                                                                : cfg.sensor.range_g * kStandardGravity;
+  s.fade_s = cfg.controller.gain_ramp_s;
+  s.analysis_stable = analysis_stable;
+  s.max_stable_gain_ns_per_m = max_stable_gain_ns_per_m;
+  return s;
+}
+
+Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
+    : s_(s), params_(params), controller_(params) {
+  const auto window = static_cast<std::size_t>(std::max(1.0, std::round(s.limits.saturation_window_s * s.fs_hz)));
+  sat_window_.assign(window, 0);
+  sat_threshold_ = static_cast<std::uint64_t>(std::floor(s.limits.saturation_duty_max * static_cast<double>(window)));
+  block_len_ = static_cast<std::uint64_t>(std::max(1.0, std::round(s.limits.instability_block_s * s.fs_hz)));
+}
+
+void Supervisor::reset_detectors() noexcept {
+  std::fill(sat_window_.begin(), sat_window_.end(), std::uint8_t{0});
+  sat_pos_ = 0;
+  sat_count_ = 0;
+  block_ticks_ = 0;
+  block_sum_sq_ = 0.0;
+  last_block_rms_ = run_start_rms_ = 0.0;
+  growth_run_ = 0;
+}
+
+void Supervisor::trip(Trip t) noexcept {
+  ++counters_.trips[static_cast<std::size_t>(t)];
+  state_ = State::kFault;
+  trip_ = t;
+  trip_from_v_ = command_v_;
+  trip_ramp_left_s_ = s_.limits.trip_ramp_s;
+}
+
+void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
+  ++counters_.commands;
+  switch (c.kind) {
+    case CommandKind::kNone: break;
+    case CommandKind::kArm: {
+      refusal_ = ArmRefusal::kNone;
+      if (state_ != State::kDisabled)
+        refusal_ = ArmRefusal::kNotDisabled;
+      else if (!live)
+        refusal_ = ArmRefusal::kSensorNotLive;
+      else if (!path_ok_)
+        refusal_ = ArmRefusal::kActuatorPath;
+      else if (!s_.analysis_stable || controller_.target_gain_ns_per_m() > s_.max_gain_ns_per_m())
+        refusal_ = ArmRefusal::kAnalysisUnstable;
+      if (refusal_ != ArmRefusal::kNone) {
+        ++counters_.arm_refused;
+        break;
+      }
+      state_ = State::kArming;
+      arming_s_ = 0.0;
+      fade_ = 0.0;
+      break;
+    }
+    case CommandKind::kDisarm:
+      if (state_ == State::kArming) state_ = State::kDisabled;
+      if (state_ == State::kActive) state_ = State::kStopping;
+      break;
+    case CommandKind::kResetFault:
+      if (state_ == State::kFault && trip_ramp_left_s_ <= 0.0) {
+        state_ = State::kDisabled;
+        trip_ = Trip::kNone;
+      }
+      break;
+    case CommandKind::kSetGain:
+      if (!(std::isfinite(c.value) && c.value >= 0.0 && c.value <= s_.max_gain_ns_per_m()) ||
+          controller_.set_gain(c.value) != control::RequestStatus::kAccepted)
+        ++counters_.gain_refused;
+      break;
+  }
+}
+
+Trip Supervisor::check_trips(const TickInput& in) const noexcept {
+  if (in.shutdown) return Trip::kSignal;
+  if (state_ == State::kDisabled || state_ == State::kFault) return Trip::kNone;  // not driving
+  const auto& l = s_.limits;
+  if (stale_run_ >= static_cast<std::uint64_t>(l.stale_sensor_cycles)) return Trip::kSensorStale;
+  if (invalid_run_ >= static_cast<std::uint64_t>(l.invalid_sample_cycles)) return Trip::kSampleInvalid;
+  if (!in.sensor_ok) return Trip::kSensorDriver;
+  if (!in.actuator_ok) return Trip::kActuatorDriver;
+  if (in.amplifier_fault) return Trip::kAmplifierFault;
+  if (overrun_run_ >= static_cast<std::uint64_t>(l.overrun_cycles)) return Trip::kOverruns;
+  if (state_ == State::kArming && !in.amplifier_ready && arming_s_ >= l.amplifier_ready_timeout_s)
+    return Trip::kAmplifierNotReady;
+  return Trip::kNone;
+}
+
+bool Supervisor::record_saturation(bool saturated) noexcept {
+  sat_count_ -= sat_window_[sat_pos_];
+  sat_window_[sat_pos_] = saturated ? 1 : 0;
+  sat_count_ += sat_window_[sat_pos_];
+  if (++sat_pos_ == sat_window_.size()) sat_pos_ = 0;
+  return sat_count_ > sat_threshold_;
+}
+
+bool Supervisor::instability(double controller_v) noexcept {
+  block_sum_sq_ += controller_v * controller_v;
+  if (++block_ticks_ < block_len_) return false;
+  const double rms = std::sqrt(block_sum_sq_ / static_cast<double>(block_len_));
+  block_ticks_ = 0;
+  block_sum_sq_ = 0.0;
+  if (last_block_rms_ > 0.0 && rms > last_block_rms_) {
+    if (growth_run_ == 0) run_start_rms_ = last_block_rms_;
+    ++growth_run_;
+  } else {
+    growth_run_ = 0;
+  }
+  last_block_rms_ = rms;
+  const auto& l = s_.limits;
+  return growth_run_ >= l.instability_blocks && rms >= l.instability_floor_v &&
+         rms >= l.instability_growth_factor * run_start_rms_;
+}
+
+TickOutput Supervisor::step(const TickInput& in) noexcept {
+  ++counters_.ticks;
+  const auto& l = s_.limits;
+  // The sample: a repeat (not fresh) is stale; a fresh one must be finite and in range.
+  const bool valid = std::isfinite(in.accel_mps2) && std::abs(in.accel_mps2) <= s_.sample_limit_mps2;
+  if (!in.fresh) {
+    ++stale_run_;
+    ++counters_.stale_ticks;
+  } else {
+    stale_run_ = 0;
+    if (valid) {
+      invalid_run_ = 0;
+    } else {
+      ++invalid_run_;
+      ++counters_.invalid_samples;
+    }
+  }
+  live_run_ = in.fresh && valid && in.sensor_ok ? live_run_ + 1 : 0;
+  if (in.overrun) {
+    ++overrun_run_;
+    ++counters_.overruns;
+  } else {
+    overrun_run_ = 0;
+  }
+  path_ok_ = in.sensor_ok && in.actuator_ok && !in.amplifier_fault;
+
+  // The controller runs in every state so its filters are settled when it is armed; it only ever sees
+  // valid samples (an invalid or stale one repeats the last valid one).
+  if (in.fresh && valid) last_valid_mps2_ = in.accel_mps2;
+  const double controller_v = controller_.update(last_valid_mps2_);
+  const control::ControllerCounters& cc = controller_.counters();
+  const bool limited = cc.force_limited != last_limits_.force_limited ||
+                       cc.voltage_limited != last_limits_.voltage_limited || cc.slew_limited != last_limits_.slew_limited;
+  last_limits_ = cc;
+
+  // Operator commands at the tick boundary, then the trips (which override them).
+  if (in.command.kind != CommandKind::kNone)
+    handle(in.command, live_run_ >= static_cast<std::uint64_t>(l.arming_live_cycles));
+  if (const Trip t = check_trips(in); t != Trip::kNone) trip(t);
+
+  TickOutput out;
+  out.controller_v = controller_v;
+  out.filtered_mps = controller_.filtered_mps();
+  switch (state_) {
+    case State::kDisabled: command_v_ = 0.0; break;
+    case State::kArming:
+      command_v_ = 0.0;
+      out.amplifier_enable = true;
+      arming_s_ += in.dt_s;
+      if (in.amplifier_ready) {
+        state_ = State::kActive;
+        fade_ = 0.0;
+        reset_detectors();
+      }
+      break;
+    case State::kActive: {
+      fade_ = s_.fade_s > 0.0 ? std::min(1.0, fade_ + in.dt_s / s_.fade_s) : 1.0;
+      command_v_ = fade_ * controller_v;
+      out.amplifier_enable = true;
+      out.saturated = limited || in.actuator_saturated;
+      if (out.saturated) ++counters_.saturated_ticks;
+      if (record_saturation(out.saturated)) {
+        trip(Trip::kSaturation);
+      } else if (instability(controller_v)) {
+        trip(Trip::kInstability);
+      }
+      if (state_ == State::kFault) command_v_ = trip_from_v_;  // the ramp below starts from the last command
+      break;
+    }
+    case State::kStopping:
+      fade_ = s_.fade_s > 0.0 ? fade_ - in.dt_s / s_.fade_s : 0.0;
+      if (fade_ <= 0.0) {
+        fade_ = 0.0;
+        state_ = State::kDisabled;
+        command_v_ = 0.0;
+      } else {
+        command_v_ = fade_ * controller_v;
+        out.amplifier_enable = true;
+      }
+      break;
+    case State::kFault: break;
+  }
+  if (state_ == State::kFault) {
+    // Linear ramp from the command at the trip to zero over trip_ramp_s (measured time), then off.
+    if (trip_ramp_left_s_ > 0.0) trip_ramp_left_s_ -= in.dt_s;
+    if (trip_ramp_left_s_ > 0.0 && l.trip_ramp_s > 0.0) {
+      command_v_ = trip_from_v_ * (trip_ramp_left_s_ / l.trip_ramp_s);
+      out.amplifier_enable = true;
+    } else {
+      trip_ramp_left_s_ = 0.0;
+      command_v_ = 0.0;
+      out.amplifier_enable = false;
+    }
+  }
+  out.command_v = command_v_;
+  out.state = state_;
+  out.trip = trip_;
+  return out;
+}
+
+}  // namespace robodamp::rt

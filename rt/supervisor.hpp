@@ -1,0 +1,165 @@
+// The supervisor and the controller together: one deterministic step per loop tick from that tick's
+// inputs (sensor sample, driver and amplifier status, timing flags, an operator command) to the
+// amplifier command and enable. Everything it does depends on those inputs only, so a recording of them
+// replays bit for bit (rt/recording.hpp). Construction allocates (the saturation window); step() is
+// RT-safe: no allocation, locking, I/O, exceptions or logging.
+//
+// States:  Disabled --arm--> Arming --amplifier ready--> Active --disarm--> Stopping --ramped--> Disabled
+//          any --trip--> Fault (command ramps to zero within trip_ramp_s, then the amplifier is disabled;
+//          latched until reset_fault, which returns to Disabled once the ramp is over).
+// Arming is refused unless the sensor is live (arming_live_cycles fresh valid samples in a row), the
+// actuator path is healthy (drivers ok, amplifier without fault) and the analysis found the configured
+// loop stable. Activation and disarming fade the command in and out over controller.gain_ramp_s; gain
+// requests are validated (0 <= K <= max_gain_fraction x the analysed maximum stable K) and ramped by the
+// controller; everything is applied at the tick boundary.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "config/config.hpp"
+#include "control/controller.hpp"
+
+namespace robodamp::rt {
+
+enum class State : std::uint8_t { kDisabled, kArming, kActive, kStopping, kFault };
+
+enum class Trip : std::uint8_t {
+  kNone,
+  kSensorStale,       // no fresh sample for stale_sensor_cycles ticks
+  kSampleInvalid,     // non-finite or out-of-range samples for invalid_sample_cycles ticks
+  kOverruns,          // overrun_cycles consecutive overruns
+  kSaturation,        // more than saturation_duty_max of the window's ticks at a limit
+  kInstability,       // the loop signal grew in instability_blocks consecutive blocks
+  kSensorDriver,      // the sensor driver reports a fault
+  kActuatorDriver,    // the actuator driver could not deliver the command
+  kAmplifierFault,    // the amplifier reports a fault
+  kAmplifierNotReady, // enabled but not ready within amplifier_ready_timeout_s
+  kSignal,            // SIGINT / SIGTERM: shut down through the safe state
+};
+inline constexpr std::size_t kTripCount = 11;
+
+enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable };
+
+enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain };
+
+struct OperatorCommand {
+  CommandKind kind{CommandKind::kNone};
+  double value{0.0};  // set_gain: K in N s/m
+};
+
+[[nodiscard]] const char* to_string(State s);
+[[nodiscard]] const char* to_string(Trip t);
+[[nodiscard]] const char* describe(Trip t);  // what it means and what the operator should look at
+[[nodiscard]] const char* to_string(ArmRefusal r);
+[[nodiscard]] const char* to_string(CommandKind k);
+
+// Everything one tick's decision depends on (and what a recording stores to replay it).
+struct TickInput {
+  double dt_s{0.0};  // measured time since the previous tick: drives the ramps and timeouts
+  double accel_mps2{0.0};
+  bool fresh{false};
+  bool sensor_ok{true};
+  bool actuator_ok{true};
+  bool actuator_saturated{false};
+  bool amplifier_ready{false};
+  bool amplifier_fault{false};
+  bool overrun{false};   // the previous tick ran past its deadline, or ticks were missed
+  bool shutdown{false};  // SIGINT / SIGTERM seen
+  OperatorCommand command{};
+};
+
+struct TickOutput {
+  double command_v{0.0};
+  double controller_v{0.0};  // the controller's output before the supervisor's fade / trip ramp
+  double filtered_mps{0.0};  // chain output
+  bool amplifier_enable{false};
+  State state{State::kDisabled};
+  Trip trip{Trip::kNone};
+  bool saturated{false};  // this tick counted as saturated
+};
+
+struct SupervisorCounters {
+  std::array<std::uint64_t, kTripCount> trips{};  // per reason
+  std::uint64_t ticks{0};
+  std::uint64_t stale_ticks{0};
+  std::uint64_t invalid_samples{0};
+  std::uint64_t overruns{0};
+  std::uint64_t saturated_ticks{0};
+  std::uint64_t arm_refused{0};
+  std::uint64_t gain_refused{0};
+  std::uint64_t commands{0};
+};
+
+// What the supervisor needs beyond the controller's parameters; a recording stores it.
+struct SupervisorSettings {
+  config::SupervisionConfig limits;
+  double fs_hz{5000.0};
+  double sample_limit_mps2{0.0};     // resolved (never 0)
+  double fade_s{0.5};                // activation / disarm fade (controller.gain_ramp_s)
+  bool analysis_stable{false};       // the analysis found the configured loop stable
+  double max_stable_gain_ns_per_m{0.0};
+  [[nodiscard]] double max_gain_ns_per_m() const { return limits.max_gain_fraction * max_stable_gain_ns_per_m; }
+};
+
+// The settings for a configuration, given what the analysis found.
+[[nodiscard]] SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable,
+                                                     double max_stable_gain_ns_per_m);
+
+class Supervisor {
+ public:
+  Supervisor(const SupervisorSettings& s, const control::ControllerParams& params);
+
+  // RT-safe.
+  [[nodiscard]] TickOutput step(const TickInput& in) noexcept;
+
+  [[nodiscard]] State state() const noexcept { return state_; }
+  [[nodiscard]] Trip latched_trip() const noexcept { return trip_; }
+  [[nodiscard]] ArmRefusal last_arm_refusal() const noexcept { return refusal_; }
+  [[nodiscard]] const SupervisorCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const control::Controller& controller() const noexcept { return controller_; }
+  [[nodiscard]] const SupervisorSettings& settings() const noexcept { return s_; }
+  [[nodiscard]] const control::ControllerParams& initial_params() const noexcept { return params_; }
+  // The trip ramp is over and the amplifier disabled.
+  [[nodiscard]] bool safe() const noexcept {
+    return state_ == State::kDisabled || (state_ == State::kFault && trip_ramp_left_s_ <= 0.0);
+  }
+
+ private:
+  void handle(const OperatorCommand& c, bool live) noexcept;
+  void trip(Trip t) noexcept;
+  [[nodiscard]] Trip check_trips(const TickInput& in) const noexcept;
+  bool record_saturation(bool saturated) noexcept;  // true: duty exceeded
+  bool instability(double controller_v) noexcept;     // true: growing oscillation
+  void reset_detectors() noexcept;
+
+  SupervisorSettings s_;
+  control::ControllerParams params_;
+  control::Controller controller_;
+  State state_{State::kDisabled};
+  Trip trip_{Trip::kNone};
+  ArmRefusal refusal_{ArmRefusal::kNone};
+  SupervisorCounters counters_{};
+
+  double last_valid_mps2_{0.0};
+  std::uint64_t stale_run_{0}, invalid_run_{0}, live_run_{0}, overrun_run_{0};
+  bool path_ok_{true};
+  double fade_{0.0};       // 0..1, activation / disarm
+  double arming_s_{0.0};   // time spent arming
+  double trip_from_v_{0.0}, trip_ramp_left_s_{0.0};
+  double command_v_{0.0};
+  control::ControllerCounters last_limits_{};
+
+  std::vector<std::uint8_t> sat_window_;  // one entry per tick of the window
+  std::size_t sat_pos_{0};
+  std::uint64_t sat_count_{0};
+  std::uint64_t sat_threshold_{0};
+
+  std::uint64_t block_ticks_{0}, block_len_{1};
+  double block_sum_sq_{0.0};
+  double last_block_rms_{0.0}, run_start_rms_{0.0};
+  int growth_run_{0};
+};
+
+}  // namespace robodamp::rt
