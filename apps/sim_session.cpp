@@ -16,9 +16,11 @@ SimSession::SimSession(const config::Config& cfg, const SessionOptions& o) : cfg
   stable_ = model_->stable(cfg_.controller.gain_ns_per_m, polarity);
   max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
 
-  plant_ = std::make_unique<sim::Plant>(model_->plant(), cfg_);
-  if (cfg_.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(model_->plant(), cfg_));
-  backend_ = std::make_unique<drivers::SimBackend>(*plant_);
+  const config::Config& plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
+  const sim::PlantModel plant_model = o_.plant_config ? sim::build_plant_model(plant_cfg) : model_->plant();
+  plant_ = std::make_unique<sim::Plant>(plant_model, plant_cfg);
+  if (plant_cfg.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(plant_model, plant_cfg));
+  backend_ = std::make_unique<drivers::SimBackend>(*plant_, o_.backend);
   const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
   supervisor_ = std::make_unique<rt::Supervisor>(rt::supervisor_settings(cfg_, stable_, k_max), model_->chain().params);
   ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));

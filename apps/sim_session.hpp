@@ -29,6 +29,10 @@ struct SessionOptions {
   bool arm_at_start{true};                 // arm once the sensor can be live
   std::string record_path;                 // empty = no recording
   bool realtime_setup{true};               // wall clock: mlockall, SCHED_FIFO, ... (config realtime)
+  // The robot as it really is, when it differs from the configuration the controller was designed and
+  // analysed for (another pose, a worn actuator): the plant is built from this one.
+  std::optional<config::Config> plant_config;
+  drivers::SimBackendOptions backend{};
 };
 
 struct RunSummary {

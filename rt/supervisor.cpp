@@ -156,8 +156,9 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
 }
 
 Trip Supervisor::check_trips(const TickInput& in) const noexcept {
+  if (state_ == State::kFault) return Trip::kNone;  // latched: the first reason stands
   if (in.shutdown) return Trip::kSignal;
-  if (state_ == State::kDisabled || state_ == State::kFault) return Trip::kNone;  // not driving
+  if (state_ == State::kDisabled) return Trip::kNone;  // not driving
   const auto& l = s_.limits;
   if (stale_run_ >= static_cast<std::uint64_t>(l.stale_sensor_cycles)) return Trip::kSensorStale;
   if (invalid_run_ >= static_cast<std::uint64_t>(l.invalid_sample_cycles)) return Trip::kSampleInvalid;

@@ -1,0 +1,341 @@
+// The real-time loop against the simulated plant: every state transition and every trip, with the
+// faults injected through the plant's fault injector; the time from fault to zero command; nothing lost
+// from the telemetry; deterministic virtual-clock runs; gain changes validated and ramped.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+#include "apps/sim_session.hpp"
+#include "rt/signals.hpp"
+#include "test_util.hpp"
+
+namespace robodamp::rt {
+namespace {
+
+using apps::SessionOptions;
+using apps::SimSession;
+using sim::FaultKind;
+
+config::Config c2() { return config::load_config_file(test::preset("horizontal_c2")); }
+
+SessionOptions virtual_clock() {
+  SessionOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  return o;
+}
+
+struct Outcome {
+  apps::RunSummary s;
+  std::vector<TelemetryFrame> frames;
+};
+
+template <typename Setup>
+Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, SessionOptions o = virtual_clock()) {
+  SimSession session(cfg, o);
+  session.keep_frames(true);
+  setup(session);
+  Outcome out;
+  out.s = session.run(duration_s);
+  out.frames = session.frames();
+  return out;
+}
+Outcome run(const config::Config& cfg, double duration_s, SessionOptions o = virtual_clock()) {
+  return run(cfg, duration_s, [](SimSession&) {}, o);
+}
+
+// Every tick the loop ran reached the consumer, in order, none twice.
+void expect_nothing_lost(const Outcome& r) {
+  ASSERT_EQ(r.frames.size(), r.s.loop.ticks_run);
+  EXPECT_EQ(r.s.loop.ring_drops, 0U);
+  for (std::size_t i = 1; i < r.frames.size(); ++i) ASSERT_GT(r.frames[i].tick, r.frames[i - 1].tick) << i;
+}
+
+std::size_t first_state(const Outcome& r, State s, std::size_t from = 0) {
+  for (std::size_t i = from; i < r.frames.size(); ++i)
+    if (r.frames[i].state == static_cast<std::uint8_t>(s)) return i;
+  return r.frames.size();
+}
+
+// A fault at fault_s must trip `expected`; the command must then be zero, and the amplifier off,
+// within detection + trip_ramp_s. Returns the time from the fault to zero command.
+double expect_trip(const Outcome& r, Trip expected, double fault_s, double detection_s) {
+  const auto& cfg = r.s;
+  EXPECT_EQ(r.s.trip, to_string(expected));
+  EXPECT_EQ(r.s.supervisor.trips[static_cast<std::size_t>(expected)], 1U);
+  EXPECT_EQ(r.s.final_state, "fault");
+  const std::size_t i_trip = first_state(r, State::kFault);
+  EXPECT_LT(i_trip, r.frames.size());
+  if (i_trip >= r.frames.size()) return INFINITY;
+  EXPECT_EQ(r.frames[i_trip].trip, static_cast<std::uint8_t>(expected));
+  EXPECT_NE(r.frames[i_trip - 1].command_v, 0.0) << "was driving before the trip";
+  std::size_t i_zero = i_trip;
+  while (i_zero < r.frames.size() && r.frames[i_zero].command_v != 0.0) ++i_zero;
+  EXPECT_LT(i_zero, r.frames.size());
+  if (i_zero >= r.frames.size()) return INFINITY;
+  const double period = 1.0 / cfg.rate_hz;
+  const double t_zero = r.frames[i_zero].time_s;
+  const double fault_to_zero = t_zero - fault_s;
+  EXPECT_LE(fault_to_zero, detection_s + 0.01 + 2 * period) << to_string(expected);
+  EXPECT_EQ(r.frames[i_zero].flags & kFlagAmplifierEnable, 0) << "amplifier disabled once the command is zero";
+  // The ramp is monotone towards zero and the fault stays latched to the end.
+  for (std::size_t i = i_trip + 1; i <= i_zero; ++i)
+    EXPECT_LE(std::abs(r.frames[i].command_v), std::abs(r.frames[i - 1].command_v) + 1e-12);
+  for (std::size_t i = i_zero; i < r.frames.size(); ++i) {
+    EXPECT_EQ(r.frames[i].command_v, 0.0);
+    EXPECT_EQ(r.frames[i].state, static_cast<std::uint8_t>(State::kFault));
+  }
+  expect_nothing_lost(r);
+  return fault_to_zero;
+}
+
+TEST(Loop, ArmsOnceLiveFadesInDampsAndDisarmsToDisabled) {
+  const auto r = run(c2(), 3.0);
+  expect_nothing_lost(r);
+  const auto& f = r.frames;
+  EXPECT_EQ(f.front().state, static_cast<std::uint8_t>(State::kDisabled));
+  const std::size_t arming = first_state(r, State::kArming), active = first_state(r, State::kActive);
+  const std::size_t stopping = first_state(r, State::kStopping);
+  ASSERT_LT(arming, f.size());
+  ASSERT_LT(active, f.size());
+  ASSERT_LT(stopping, f.size());
+  EXPECT_EQ(arming, 51U) << "armed at the first tick after supervision.arming_live_cycles live samples";
+  EXPECT_TRUE(f[arming].flags & kFlagAmplifierEnable);
+  EXPECT_EQ(f[arming].command_v, 0.0) << "no drive until the amplifier is ready";
+  EXPECT_NEAR(f[active].time_s - f[arming].time_s, 0.005, 0.0003) << "amplifier ready delay";
+  // Fade-in over controller.gain_ramp_s: command / controller output rises linearly to 1.
+  const std::size_t mid = active + 1250;  // 0.25 s into the 0.5 s fade
+  EXPECT_NEAR(f[mid].command_v / f[mid].controller_v, 0.5, 0.01);
+  const std::size_t full = active + 2600;
+  EXPECT_EQ(f[full].command_v, f[full].controller_v);
+  // The end of the run disarms: the command fades out, then Disabled with the amplifier off.
+  EXPECT_EQ(r.s.final_state, "disabled");
+  EXPECT_EQ(r.s.trip, "none");
+  EXPECT_EQ(f.back().command_v, 0.0);
+  EXPECT_FALSE(f.back().flags & kFlagAmplifierEnable);
+  EXPECT_NEAR(f.back().time_s - f[stopping].time_s, 0.5, 0.001);
+  EXPECT_GT(r.s.peak_command_v, 0.02);
+}
+
+TEST(Loop, ArmingRefusedUntilSensorLive) {
+  SessionOptions o = virtual_clock();
+  o.arm_at_start = false;
+  const auto r = run(c2(), 0.1, [](SimSession& s) { s.schedule(3, {CommandKind::kArm, 0.0}); }, o);
+  EXPECT_EQ(r.s.supervisor.arm_refused, 1U);
+  EXPECT_EQ(first_state(r, State::kArming), r.frames.size());
+}
+
+TEST(Loop, ArmingRefusedWithAmplifierFault) {
+  SimSession session(c2(), virtual_clock());
+  session.plant().faults().add({FaultKind::kAmplifierFault, 0.0, 1.0});
+  const auto s = session.run(0.2);
+  EXPECT_EQ(s.supervisor.arm_refused, 1U);
+  EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kActuatorPath);
+  EXPECT_EQ(s.trip, "none") << "not armed, nothing to trip";
+}
+
+TEST(Loop, ArmingRefusedWhenTheAnalysisFindsTheGainUnstable) {
+  auto cfg = c2();
+  cfg.controller.gain_ns_per_m = 6000.0;  // K_max 4805
+  SimSession session(cfg, virtual_clock());
+  const auto s = session.run(0.2);
+  EXPECT_FALSE(s.analysis_stable);
+  EXPECT_EQ(s.supervisor.arm_refused, 1U);
+  EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kAnalysisUnstable);
+}
+
+TEST(Loop, ArmingRefusedAboveTheGainMargin) {
+  auto cfg = c2();
+  cfg.controller.gain_ns_per_m = 4700.0;  // stable, but above max_gain_fraction 0.9 x 4805
+  SimSession session(cfg, virtual_clock());
+  const auto s = session.run(0.2);
+  EXPECT_TRUE(s.analysis_stable);
+  EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kAnalysisUnstable);
+}
+
+struct TripCase {
+  const char* name;
+  sim::Fault fault;
+  Trip trip;
+  double detection_s;  // allowed time from the fault to the trip
+};
+
+class Trips : public ::testing::TestWithParam<TripCase> {};
+
+TEST_P(Trips, RampToZeroWithinTheConfiguredTimeAndLatch) {
+  const TripCase& c = GetParam();
+  const auto r = run(c2(), 2.0, [&](SimSession& s) { s.plant().faults().add(c.fault); });
+  const double t = expect_trip(r, c.trip, c.fault.start_s, c.detection_s);
+  RecordProperty("fault_to_zero_ms", std::to_string(t * 1e3));
+  std::printf("[ trip     ] %-22s fault to zero command %.2f ms\n", c.name, t * 1e3);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    SimulatedFaults, Trips,
+    ::testing::Values(TripCase{"sensor_dropout", {FaultKind::kSensorDropout, 1.0, 0.5}, Trip::kSensorStale, 5 / 5000.0},
+                      TripCase{"sensor_nan", {FaultKind::kSensorNan, 1.0, 0.5}, Trip::kSampleInvalid, 1 / 5000.0},
+                      TripCase{"sensor_spike", {FaultKind::kSensorSpike, 1.0, 0.5, 1e5}, Trip::kSampleInvalid, 1 / 5000.0},
+                      TripCase{"amplifier_fault", {FaultKind::kAmplifierFault, 1.0, 0.5}, Trip::kAmplifierFault, 1 / 5000.0},
+                      TripCase{"sensor_driver", {FaultKind::kSensorDriverError, 1.0, 0.5}, Trip::kSensorDriver, 1 / 5000.0},
+                      TripCase{"actuator_driver", {FaultKind::kActuatorDriverError, 1.0, 0.5}, Trip::kActuatorDriver,
+                               2 / 5000.0},
+                      TripCase{"actuator_saturated", {FaultKind::kActuatorSaturated, 1.0, 0.5, 0.002}, Trip::kSaturation,
+                               0.11}),
+    [](const auto& test_info) { return std::string(test_info.param.name); });
+
+TEST(Loop, AStuckSensorIsNotATripButItsOutputStaysBounded) {
+  // A stuck reading is finite, in range and (for this DAQ) fresh: nothing to trip on at once. The chain's
+  // high-pass takes the constant out, so the command decays instead of holding an offset.
+  const auto r = run(c2(), 3.0, [](SimSession& s) { s.plant().faults().add({FaultKind::kSensorStuck, 1.0, 1.5}); });
+  EXPECT_EQ(r.s.trip, "none");
+  const std::size_t i = static_cast<std::size_t>(2.4 * 5000);
+  EXPECT_LT(std::abs(r.frames[i].command_v), 0.01);
+}
+
+TEST(Loop, AmplifierNotReadyTripsAfterTheTimeout) {
+  SessionOptions o = virtual_clock();
+  o.backend.amplifier_ready_delay_s = 1.0;  // longer than supervision.amplifier_ready_timeout_s = 0.2
+  const auto r = run(c2(), 1.0, o);
+  EXPECT_EQ(r.s.trip, "amplifier_not_ready");
+  const std::size_t arming = first_state(r, State::kArming), fault = first_state(r, State::kFault);
+  ASSERT_LT(fault, r.frames.size());
+  EXPECT_NEAR(r.frames[fault].time_s - r.frames[arming].time_s, 0.2, 0.001);
+  EXPECT_EQ(first_state(r, State::kActive), r.frames.size()) << "never drove";
+}
+
+TEST(Loop, InstabilityTripsBeforeTheCommandDiverges) {
+  // The robot is not what the controller was tuned for: the actuator is 3x stronger than configured, so
+  // the loop gain is 1.25x its maximum stable value and an oscillation grows.
+  auto real = c2();
+  real.actuator.constant_n_per_v *= 3.0;
+  SessionOptions o = virtual_clock();
+  o.plant_config = real;
+  const auto r = run(c2(), 30.0, o);
+  EXPECT_EQ(r.s.trip, "instability");
+  const std::size_t fault = first_state(r, State::kFault);
+  ASSERT_LT(fault, r.frames.size());
+  EXPECT_EQ(r.frames[fault].saturated_ticks, 0U) << "tripped before any limit was reached";
+  double peak = 0.0;
+  for (std::size_t i = 0; i < fault; ++i) peak = std::max(peak, std::abs(r.frames[i].command_v));
+  const double limit_v = c2().actuator.force_limit_n / c2().actuator.constant_n_per_v;
+  EXPECT_LT(peak, 0.5 * limit_v);
+  std::printf("[ trip     ] instability after %.2f s active, peak command %.3f V (limit %.2f V)\n",
+              r.frames[fault].time_s - r.frames[first_state(r, State::kActive)].time_s, peak, limit_v);
+  expect_nothing_lost(r);
+}
+
+TEST(Loop, NoFalseInstabilityTripWithImpactsAtTheConfiguredGain) {
+  SessionOptions o = virtual_clock();
+  o.impact_every_s = 1.3;
+  const auto r = run(c2(), 20.0, o);
+  EXPECT_EQ(r.s.trip, "none");
+  EXPECT_EQ(r.s.final_state, "disabled");
+}
+
+TEST(Loop, ResetFaultThenRearm) {
+  const auto r = run(c2(), 3.0, [](SimSession& s) {
+    s.plant().faults().add({FaultKind::kSensorNan, 1.0, 0.01});
+    s.schedule(static_cast<std::uint64_t>(1.005 * 5000), {CommandKind::kResetFault, 0.0});  // refused: ramp not over
+    s.schedule(static_cast<std::uint64_t>(1.2 * 5000), {CommandKind::kResetFault, 0.0});
+    s.schedule(static_cast<std::uint64_t>(1.3 * 5000), {CommandKind::kArm, 0.0});
+  });
+  const std::size_t fault = first_state(r, State::kFault);
+  ASSERT_LT(fault, r.frames.size());
+  EXPECT_EQ(r.frames[static_cast<std::size_t>(1.1 * 5000)].state, static_cast<std::uint8_t>(State::kFault));
+  const std::size_t disabled = first_state(r, State::kDisabled, fault);
+  EXPECT_NEAR(r.frames[disabled].time_s, 1.2, 1e-9);
+  EXPECT_EQ(r.frames[disabled].trip, static_cast<std::uint8_t>(Trip::kNone)) << "reset clears the latch";
+  EXPECT_LT(first_state(r, State::kActive, disabled), r.frames.size()) << "armed again";
+  EXPECT_EQ(r.s.final_state, "disabled");
+  EXPECT_EQ(r.s.supervisor.trips[static_cast<std::size_t>(Trip::kSampleInvalid)], 1U);
+}
+
+TEST(Loop, GainRequestsAreValidatedAndRamped) {
+  const auto r = run(c2(), 3.0, [](SimSession& s) {
+    s.schedule(5000, {CommandKind::kSetGain, 3000.0});
+    s.schedule(5001, {CommandKind::kSetGain, 4400.0});  // > 0.9 x K_max = 4324: refused
+    s.schedule(5002, {CommandKind::kSetGain, NAN});
+    s.schedule(5003, {CommandKind::kSetGain, -1.0});
+  });
+  EXPECT_EQ(r.s.supervisor.gain_refused, 3U);
+  EXPECT_DOUBLE_EQ(r.frames[4999].gain_ns_per_m, 2000.0);
+  EXPECT_NEAR(r.frames[5000 + 1250].gain_ns_per_m, 2500.0, 5.0) << "halfway through the 0.5 s ramp";
+  EXPECT_NEAR(r.frames[5000 + 2600].gain_ns_per_m, 3000.0, 1e-9);
+  for (std::size_t i = 5001; i < 5000 + 2500; ++i)
+    ASSERT_GE(r.frames[i].gain_ns_per_m, r.frames[i - 1].gain_ns_per_m - 1e-9) << "monotone ramp";
+}
+
+TEST(Loop, VirtualClockRunsAreBitIdentical) {
+  SessionOptions o = virtual_clock();
+  o.impact_every_s = 0.7;
+  auto setup = [](SimSession& s) {
+    s.plant().faults().add({FaultKind::kSensorSpike, 1.5, 0.001, 1e5});
+    s.schedule(2000, {CommandKind::kSetGain, 2500.0});
+  };
+  const auto a = run(c2(), 2.0, setup, o), b = run(c2(), 2.0, setup, o);
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  EXPECT_EQ(std::memcmp(a.frames.data(), b.frames.data(), a.frames.size() * sizeof(TelemetryFrame)), 0);
+  EXPECT_EQ(a.s.trip, "sample_invalid");
+}
+
+TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
+  // One driver call stalls for 1.1 ms (5.5 periods at 5 kHz): the loop skips the ticks it missed.
+  SessionOptions o;
+  o.realtime_setup = true;
+  const auto r = run(c2(), 0.6, [](SimSession& s) { s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3}); }, o);
+  expect_nothing_lost(r);
+  EXPECT_GE(r.s.loop.missed_ticks, 4U);
+  EXPECT_EQ(r.s.loop.ticks_run + r.s.loop.missed_ticks, r.frames.back().tick + 1) << "every nominal tick run or skipped";
+  bool gap = false;
+  for (std::size_t i = 1; i < r.frames.size(); ++i)
+    if (r.frames[i].tick - r.frames[i - 1].tick >= 5) {
+      gap = true;
+      EXPECT_GT(r.frames[i].dt_s, 1.0e-3) << "the measured dt spans the stall";
+      EXPECT_TRUE(r.frames[i].flags & kFlagOverrun);
+    }
+  EXPECT_TRUE(gap);
+  EXPECT_EQ(r.s.trip, "none") << "one overrun is below supervision.overrun_cycles";
+}
+
+TEST(Loop, ConsecutiveOverrunsTrip) {
+  SessionOptions o;
+  auto cfg = c2();
+  const auto r = run(cfg, 1.5, [](SimSession& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  EXPECT_EQ(r.s.trip, "overruns");
+  expect_nothing_lost(r);
+  const std::size_t fault = first_state(r, State::kFault);
+  ASSERT_LT(fault, r.frames.size());
+  EXPECT_LE(r.frames[fault].time_s - 1.0, 0.02) << "10 consecutive overruns of a 0.3 ms stall";
+}
+
+TEST(Loop, SigintShutsDownThroughTheSafeState) {
+  install_shutdown_handlers();
+  shutdown_signal().store(0);
+  SessionOptions o;
+  SimSession session(c2(), o);
+  session.keep_frames(true);
+  std::thread killer([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    std::raise(SIGINT);
+  });
+  const auto s = session.run(30.0);
+  killer.join();
+  shutdown_signal().store(0);
+  EXPECT_EQ(s.trip, "signal");
+  EXPECT_LT(s.loop.elapsed_s, 5.0) << "ended early";
+  const auto& f = session.frames();
+  ASSERT_FALSE(f.empty());
+  EXPECT_EQ(f.back().command_v, 0.0);
+  EXPECT_FALSE(f.back().flags & kFlagAmplifierEnable);
+  std::size_t trip = 0;
+  while (trip < f.size() && !(f[trip].flags & kFlagShutdown)) ++trip;
+  ASSERT_LT(trip, f.size());
+  EXPECT_LE(f.back().time_s - f[trip].time_s, 0.0102) << "ramped to zero within trip_ramp_s";
+}
+
+}  // namespace
+}  // namespace robodamp::rt
