@@ -1,6 +1,7 @@
 // The robodamp executable as an engineer runs it: filters (table, JSON, plot) and check-config.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -174,6 +175,59 @@ TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("robot.frfs[2]"), std::string::npos) << r.out;
   std::filesystem::remove(path);
+}
+
+// The deployment entry point on the wall clock, a recording of it, its replay and CSV export.
+TEST(Cli, RunRecordsReplaysBitExactAndExportsCsv) {
+  const std::string rec = temp_path("run.rec"), json = temp_path("run.json"), csv = temp_path("run.csv");
+  const Result r = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 1.5 --record " + rec +
+                       " --json " + json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("wake-up latency: p50"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("state: disabled"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  EXPECT_EQ(j["clock"], "wall");
+  EXPECT_EQ(j["trip"], "none");
+  EXPECT_EQ(j["telemetry"]["ring_drops"], 0);
+  EXPECT_EQ(j["recording"]["frames"], j["ticks_run"]);
+  for (const char* k : {"p50_us", "p99_us", "p999_us", "max_us"}) EXPECT_TRUE(j["wake_latency"][k].is_number()) << k;
+
+  const Result rp = run("replay " + rec);
+  EXPECT_EQ(rp.status, 0) << rp.out;
+  EXPECT_NE(rp.out.find("bit for bit"), std::string::npos) << rp.out;
+  const Result c = run("csv " + rec + " -o " + csv);
+  EXPECT_EQ(c.status, 0) << c.out;
+  const std::string text = robodamp::test::read_file(csv);
+  EXPECT_EQ(static_cast<long>(std::count(text.begin(), text.end(), '\n')), j["ticks_run"].get<long>() + 1);
+}
+
+TEST(Cli, RunRejectsBadInputWithClearErrors) {
+  const std::string bad = temp_path("bad_super.yaml");
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml += "supervision:\n  trip_ramp_s: 5\n  saturation_duty_max: 0\n";
+  std::ofstream(bad) << yaml;
+  const Result r = run("run --config " + bad + " --duration 1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("supervision.trip_ramp_s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("supervision.saturation_duty_max"), std::string::npos) << r.out;
+  const Result d = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 0");
+  EXPECT_EQ(d.status, 2) << d.out;
+  EXPECT_NE(d.out.find("--duration"), std::string::npos);
+  const Result rp = run("replay " + robodamp::test::preset("horizontal_c2"));
+  EXPECT_EQ(rp.status, 2) << rp.out;
+  EXPECT_NE(rp.out.find("not a robodamp recording"), std::string::npos) << rp.out;
+}
+
+TEST(Cli, RunEndsInAFaultWithExitCode4) {
+  // Virtual clock: hits far harder than the actuator can answer, and a strict saturation duty.
+  const std::string cfg = temp_path("sat.yaml");
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml.replace(yaml.find("impact_peak_n: 1000"), 19, "impact_peak_n: 50000");
+  yaml += "supervision:\n  saturation_duty_max: 0.01\n  saturation_window_s: 0.1\n";
+  std::ofstream(cfg) << yaml;
+  const Result r = run("run --config " + cfg + " --duration 3 --clock virtual --impact-every 1");
+  EXPECT_EQ(r.status, 4) << r.out;
+  EXPECT_NE(r.out.find("tripped: saturation"), std::string::npos) << r.out;
 }
 
 }  // namespace
