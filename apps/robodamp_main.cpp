@@ -162,6 +162,8 @@ int main(int argc, char** argv) {
   run->add_option("--duration", run_opts.duration_s, "Run time in seconds")->capture_default_str();
   run->add_option("--record", run_opts.record_path, "Record every tick to this file (binary, docs/recording_format.md)");
   run->add_option("--json", run_opts.json_path, "Write the run summary as JSON to this file");
+  run->add_option("--histogram", run_opts.histogram_path,
+                  "Write the wake-up latency histogram (cyclictest --histfile layout) to this file");
   run->add_option("--clock", clock, "Override loop.clock: wall (real time) or virtual (as fast as possible)")
       ->check(CLI::IsMember({"wall", "virtual"}));
   run->add_option("--impact-every", run_opts.impact_every_s,

@@ -14,6 +14,7 @@ struct RunOptions {
   double duration_s{10.0};
   std::string record_path;
   std::string json_path;
+  std::string histogram_path;  // wake-up latency histogram in cyclictest's --histfile format
   std::optional<config::ClockKind> clock;
   double impact_every_s{2.0};
 };
