@@ -230,4 +230,21 @@ TEST(Cli, RunEndsInAFaultWithExitCode4) {
   EXPECT_NE(r.out.find("tripped: saturation"), std::string::npos) << r.out;
 }
 
+TEST(Cli, CtrlCEndsARunThroughTheSafeStateWithASummary) {
+  const std::string json = temp_path("sigint.json");
+  const std::string cmd = "timeout --preserve-status -s INT 1.5 " + std::string(ROBODAMP_BINARY) + " run --config " +
+                          robodamp::test::preset("horizontal_c2") + " --duration 60 --json " + json + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int rc = pclose(p);
+  ASSERT_TRUE(WIFEXITED(rc)) << out;
+  EXPECT_EQ(WEXITSTATUS(rc), 0) << out;
+  EXPECT_NE(out.find("tripped: signal"), std::string::npos) << out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  EXPECT_EQ(j["trip"], "signal");
+  EXPECT_LT(j["elapsed_s"].get<double>(), 10.0);
+}
+
 }  // namespace

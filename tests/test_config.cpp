@@ -294,5 +294,42 @@ TEST(Config, PlantSectionsAreValidated) {
   EXPECT_NE(m.find("robot.frfs[0].modes[1].residue_re_m_per_n: given together with stiffness_n_per_m"), std::string::npos) << m;
 }
 
+TEST(Config, LoopSupervisionRealtimeAndTelemetryAreValidated) {
+  const Config defaults = parse_config(kValid, "ok.yaml");
+  EXPECT_EQ(defaults.loop.clock, ClockKind::kWall);
+  EXPECT_EQ(defaults.realtime.priority, 80);
+  EXPECT_EQ(defaults.supervision.stale_sensor_cycles, 5);
+  EXPECT_EQ(defaults.telemetry.ring_frames, 65536);
+  EXPECT_NE(defaults.yaml_text.find("rate_hz: 5000"), std::string::npos);
+
+  const Config v = parse_config(edited("  rate_hz: 5000\n", "  rate_hz: 5000\n  clock: virtual\n") +
+                                    "realtime: {priority: 0, cpu: 1, lock_memory: false}\n"
+                                    "supervision: {trip_ramp_s: 0.02, instability_blocks: 6}\n"
+                                    "telemetry: {ring_frames: 4096}\n",
+                                "ok.yaml");
+  EXPECT_EQ(v.loop.clock, ClockKind::kVirtual);
+  EXPECT_EQ(v.realtime.priority, 0);
+  EXPECT_EQ(v.realtime.cpu, 1);
+  EXPECT_FALSE(v.realtime.lock_memory);
+  EXPECT_DOUBLE_EQ(v.supervision.trip_ramp_s, 0.02);
+  EXPECT_EQ(v.supervision.instability_blocks, 6);
+  EXPECT_EQ(v.telemetry.ring_frames, 4096);
+
+  const auto p = problems_of(edited("  rate_hz: 5000\n", "  rate_hz: 5000\n  clock: sundial\n") +
+                             "realtime: {priority: 120, cpu: -2}\n"
+                             "supervision: {saturation_duty_max: 0, trip_ramp_s: 2, stale_sensor_cycles: 0.5,"
+                             " max_gain_fraction: 1.5}\n"
+                             "telemetry: {ring_frames: 5000}\n");
+  std::string all;
+  for (const auto& q : p) all += q.to_string() + "\n";
+  EXPECT_EQ(p.size(), 8U) << all;
+  for (const char* expected :
+       {"loop.clock = 'sundial' is not allowed: one of wall, virtual", "realtime.priority = 120",
+        "realtime.cpu = -2", "supervision.saturation_duty_max = 0 (fraction of the window) is out of range",
+        "supervision.trip_ramp_s = 2 s is out of range", "supervision.stale_sensor_cycles = 0.5",
+        "supervision.max_gain_fraction = 1.5", "telemetry.ring_frames = 5000 must be a power of two"})
+    EXPECT_NE(all.find(expected), std::string::npos) << expected << "\n" << all;
+}
+
 }  // namespace
 }  // namespace robodamp::config
