@@ -164,6 +164,8 @@ struct TripCase {
   double detection_s;  // allowed time from the fault to the trip
 };
 
+void PrintTo(const TripCase& c, std::ostream* os) { *os << c.name; }
+
 class Trips : public ::testing::TestWithParam<TripCase> {};
 
 TEST_P(Trips, RampToZeroWithinTheConfiguredTimeAndLatch) {
