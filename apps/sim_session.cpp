@@ -32,6 +32,14 @@ SimSession::SimSession(const config::Config& cfg, const SessionOptions& o) : cfg
 
 SimSession::~SimSession() = default;
 
+std::size_t SimSession::add_parameter_set(const config::Config& cfg) {
+  const analysis::LoopModel m(cfg);
+  const int polarity = cfg.controller.polarity;
+  const auto k_max = analysis::max_stable_gain(m, polarity);
+  return supervisor_->add_parameter_set({m.chain().params, m.stable(cfg.controller.gain_ns_per_m, polarity),
+                                         k_max.value_or(control::kMaxGainNsPerM)});
+}
+
 RunSummary SimSession::run(double duration_s) {
   RunSummary s;
   s.config = cfg_.source;
@@ -125,7 +133,9 @@ nlohmann::json summary_json(const RunSummary& s) {
             {"invalid_samples", s.supervisor.invalid_samples},
             {"saturated_ticks", s.supervisor.saturated_ticks},
             {"arm_refused", s.supervisor.arm_refused},
-            {"gain_refused", s.supervisor.gain_refused}}},
+            {"gain_refused", s.supervisor.gain_refused},
+            {"params_selected", s.supervisor.params_selected},
+            {"params_refused", s.supervisor.params_refused}}},
           {"realtime",
            {{"memory_locked", s.realtime.memory_locked},
             {"sched_fifo", s.realtime.fifo},

@@ -60,6 +60,9 @@ class SimSession {
 
   // Before run(): more operator commands at given ticks (deterministic on the virtual clock).
   void schedule(std::uint64_t tick, const rt::OperatorCommand& c) { loop_->schedule(tick, c); }
+  // Before run(): another controller parameter set (designed and analysed from cfg, same loop rate)
+  // that a select_params command may hand over to. Returns its index.
+  std::size_t add_parameter_set(const config::Config& cfg);
   // Runs for duration_s of loop time on a thread of its own (set up for real time on the wall clock),
   // then disarms to the safe state; blocks until done.
   RunSummary run(double duration_s);

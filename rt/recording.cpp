@@ -101,8 +101,15 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
   json states = json::array(), trips = json::array(), commands = json::array();
   for (int i = 0; i <= static_cast<int>(State::kFault); ++i) states.push_back(to_string(static_cast<State>(i)));
   for (std::size_t i = 0; i < kTripCount; ++i) trips.push_back(to_string(static_cast<Trip>(i)));
-  for (int i = 0; i <= static_cast<int>(CommandKind::kSetGain); ++i)
+  for (int i = 0; i <= static_cast<int>(CommandKind::kSelectParams); ++i)
     commands.push_back(to_string(static_cast<CommandKind>(i)));
+  json sets = json::array();  // index 0 is controller_params with the supervisor's verdict
+  for (std::size_t i = 1; i < supervisor.parameter_sets().size(); ++i) {
+    const ParameterSet& p = supervisor.parameter_sets()[i];
+    sets.push_back({{"params", to_json(p.params)},
+                    {"analysis_stable", p.analysis_stable},
+                    {"max_stable_gain_ns_per_m", p.max_stable_gain_ns_per_m}});
+  }
   char created[32];
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
@@ -127,6 +134,7 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
           {"config_source", cfg.source},
           {"config_yaml", cfg.yaml_text},
           {"controller_params", to_json(supervisor.initial_params())},
+          {"parameter_sets", sets},
           {"supervisor", to_json(supervisor.settings())}};
 }
 
@@ -218,6 +226,9 @@ ReplayResult replay(const Recording& r) {
   ReplayResult res;
   Supervisor sup(supervisor_settings_from(r.header.at("supervisor")),
                  controller_params_from(r.header.at("controller_params")));
+  for (const auto& p : r.header.value("parameter_sets", json::array()))
+    sup.add_parameter_set({controller_params_from(p.at("params")), p.at("analysis_stable").get<bool>(),
+                           p.at("max_stable_gain_ns_per_m").get<double>()});
   for (const auto& f : r.frames) {
     const TickOutput out = sup.step(tick_input(f));
     ++res.frames;

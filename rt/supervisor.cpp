@@ -72,6 +72,7 @@ const char* to_string(CommandKind k) {
     case CommandKind::kDisarm: return "disarm";
     case CommandKind::kResetFault: return "reset_fault";
     case CommandKind::kSetGain: return "set_gain";
+    case CommandKind::kSelectParams: return "select_params";
   }
   return "?";
 }
@@ -90,10 +91,35 @@ SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_
 
 Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
     : s_(s), params_(params), controller_(params) {
+  sets_.push_back({params, s.analysis_stable, s.max_stable_gain_ns_per_m});
   const auto window = static_cast<std::size_t>(std::max(1.0, std::round(s.limits.saturation_window_s * s.fs_hz)));
   sat_window_.assign(window, 0);
   sat_threshold_ = static_cast<std::uint64_t>(std::floor(s.limits.saturation_duty_max * static_cast<double>(window)));
   block_len_ = static_cast<std::uint64_t>(std::max(1.0, std::round(s.limits.instability_block_s * s.fs_hz)));
+}
+
+std::size_t Supervisor::add_parameter_set(const ParameterSet& set) {
+  sets_.push_back(set);
+  return sets_.size() - 1;
+}
+
+void Supervisor::select(const OperatorCommand& c) noexcept {
+  const double i = c.value;
+  const bool index_ok = std::isfinite(i) && i >= 0.0 && i == std::floor(i) && i < static_cast<double>(sets_.size());
+  if (!index_ok) {
+    ++counters_.params_refused;
+    return;
+  }
+  const auto idx = static_cast<std::size_t>(i);
+  const ParameterSet& set = sets_[idx];
+  if (idx == active_set_ || !set.analysis_stable || controller_.handover_pending() ||
+      set.params.gain_ns_per_m > s_.limits.max_gain_fraction * set.max_stable_gain_ns_per_m ||
+      controller_.request_params(set.params) != control::RequestStatus::kAccepted) {
+    ++counters_.params_refused;
+    return;
+  }
+  active_set_ = idx;
+  ++counters_.params_selected;
 }
 
 void Supervisor::reset_detectors() noexcept {
@@ -126,7 +152,7 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         refusal_ = ArmRefusal::kSensorNotLive;
       else if (!path_ok_)
         refusal_ = ArmRefusal::kActuatorPath;
-      else if (!s_.analysis_stable || controller_.target_gain_ns_per_m() > s_.max_gain_ns_per_m())
+      else if (!sets_[active_set_].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
         refusal_ = ArmRefusal::kAnalysisUnstable;
       if (refusal_ != ArmRefusal::kNone) {
         ++counters_.arm_refused;
@@ -148,10 +174,11 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
       }
       break;
     case CommandKind::kSetGain:
-      if (!(std::isfinite(c.value) && c.value >= 0.0 && c.value <= s_.max_gain_ns_per_m()) ||
+      if (!(std::isfinite(c.value) && c.value >= 0.0 && c.value <= max_gain_ns_per_m()) ||
           controller_.set_gain(c.value) != control::RequestStatus::kAccepted)
         ++counters_.gain_refused;
       break;
+    case CommandKind::kSelectParams: select(c); break;
   }
 }
 

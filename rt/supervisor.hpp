@@ -11,7 +11,8 @@
 // actuator path is healthy (drivers ok, amplifier without fault) and the analysis found the configured
 // loop stable. Activation and disarming fade the command in and out over controller.gain_ramp_s; gain
 // requests are validated (0 <= K <= max_gain_fraction x the analysed maximum stable K) and ramped by the
-// controller; everything is applied at the tick boundary.
+// controller; a parameter-set selection is validated the same way (the set's own analysis) and handed
+// over by the controller (fade out, swap, fade in); everything is applied at the tick boundary.
 #pragma once
 
 #include <array>
@@ -42,11 +43,11 @@ inline constexpr std::size_t kTripCount = 11;
 
 enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable };
 
-enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain };
+enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams };
 
 struct OperatorCommand {
   CommandKind kind{CommandKind::kNone};
-  double value{0.0};  // set_gain: K in N s/m
+  double value{0.0};  // set_gain: K in N s/m; select_params: index of the parameter set
 };
 
 [[nodiscard]] const char* to_string(State s);
@@ -89,6 +90,8 @@ struct SupervisorCounters {
   std::uint64_t saturated_ticks{0};
   std::uint64_t arm_refused{0};
   std::uint64_t gain_refused{0};
+  std::uint64_t params_refused{0};
+  std::uint64_t params_selected{0};
   std::uint64_t commands{0};
 };
 
@@ -100,7 +103,14 @@ struct SupervisorSettings {
   double fade_s{0.5};                // activation / disarm fade (controller.gain_ramp_s)
   bool analysis_stable{false};       // the analysis found the configured loop stable
   double max_stable_gain_ns_per_m{0.0};
-  [[nodiscard]] double max_gain_ns_per_m() const { return limits.max_gain_fraction * max_stable_gain_ns_per_m; }
+};
+
+// A controller parameter set with the analysis verdict for it (e.g. the horizontal and the vertical
+// mounting's chains). Set 0 is the one the supervisor starts with.
+struct ParameterSet {
+  control::ControllerParams params;
+  bool analysis_stable{false};
+  double max_stable_gain_ns_per_m{0.0};
 };
 
 // The settings for a configuration, given what the analysis found.
@@ -110,6 +120,10 @@ struct SupervisorSettings {
 class Supervisor {
  public:
   Supervisor(const SupervisorSettings& s, const control::ControllerParams& params);
+  // Before activation (allocates): another set select_params may hand over to. Returns its index.
+  std::size_t add_parameter_set(const ParameterSet& set);
+  [[nodiscard]] const std::vector<ParameterSet>& parameter_sets() const noexcept { return sets_; }
+  [[nodiscard]] std::size_t active_parameter_set() const noexcept { return active_set_; }
 
   // RT-safe.
   [[nodiscard]] TickOutput step(const TickInput& in) noexcept;
@@ -134,8 +148,15 @@ class Supervisor {
   bool instability(double controller_v) noexcept;     // true: growing oscillation
   void reset_detectors() noexcept;
 
+  [[nodiscard]] double max_gain_ns_per_m() const noexcept {
+    return s_.limits.max_gain_fraction * sets_[active_set_].max_stable_gain_ns_per_m;
+  }
+  void select(const OperatorCommand& c) noexcept;
+
   SupervisorSettings s_;
   control::ControllerParams params_;
+  std::vector<ParameterSet> sets_;
+  std::size_t active_set_{0};
   control::Controller controller_;
   State state_{State::kDisabled};
   Trip trip_{Trip::kNone};

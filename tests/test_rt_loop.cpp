@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "apps/sim_session.hpp"
+#include "rt/recording.hpp"
 #include "rt/signals.hpp"
 #include "test_util.hpp"
 
@@ -269,6 +270,42 @@ TEST(Loop, GainRequestsAreValidatedAndRamped) {
   EXPECT_NEAR(r.frames[5000 + 2600].gain_ns_per_m, 3000.0, 1e-9);
   for (std::size_t i = 5001; i < 5000 + 2500; ++i)
     ASSERT_GE(r.frames[i].gain_ns_per_m, r.frames[i - 1].gain_ns_per_m - 1e-9) << "monotone ramp";
+}
+
+TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
+  // C2 runs; an operator selects C3 (analysed on its own: K_max 2473, K = 2000 within 0.9 x). A set the
+  // analysis finds unstable, an unknown index and a selection during a hand-over are refused.
+  auto unstable = config::load_config_file(test::preset("horizontal_c3"));
+  unstable.controller.gain_ns_per_m = 3000.0;
+  SessionOptions o = virtual_clock();
+  o.record_path = ::testing::TempDir() + "/select_params.rec";
+  SimSession session(c2(), o);
+  session.keep_frames(true);
+  const std::size_t c3 = session.add_parameter_set(config::load_config_file(test::preset("horizontal_c3")));
+  const std::size_t bad = session.add_parameter_set(unstable);
+  session.schedule(5000, {CommandKind::kSelectParams, static_cast<double>(c3)});
+  session.schedule(5001, {CommandKind::kSelectParams, 0.0});  // refused: hand-over in progress
+  session.schedule(5002, {CommandKind::kSelectParams, 7.0});  // refused: no such set
+  session.schedule(15000, {CommandKind::kSelectParams, static_cast<double>(bad)});  // refused: unstable
+  const auto s = session.run(4.0);
+  EXPECT_EQ(s.trip, "none");
+  EXPECT_EQ(s.supervisor.params_selected, 1U);
+  EXPECT_EQ(s.supervisor.params_refused, 3U);
+  EXPECT_EQ(session.supervisor().active_parameter_set(), c3);
+  EXPECT_EQ(session.supervisor().controller().params().sections.count,
+            session.supervisor().parameter_sets()[c3].params.sections.count);
+  const auto& f = session.frames();
+  // Through the hand-over the loop stays active and the command changes smoothly (no step).
+  double worst_step = 0.0, normal_step = 0.0;
+  for (std::size_t i = 4000; i < 5000; ++i) normal_step = std::max(normal_step, std::abs(f[i].command_v - f[i - 1].command_v));
+  for (std::size_t i = 5000; i < 15000; ++i) {
+    EXPECT_EQ(f[i].state, static_cast<std::uint8_t>(State::kActive));
+    worst_step = std::max(worst_step, std::abs(f[i].command_v - f[i - 1].command_v));
+  }
+  EXPECT_LT(worst_step, 2.0 * normal_step);
+  const ReplayResult r = replay(read_recording(o.record_path));
+  EXPECT_EQ(r.mismatches, 0U);
+  EXPECT_EQ(r.frames, f.size());
 }
 
 TEST(Loop, VirtualClockRunsAreBitIdentical) {
