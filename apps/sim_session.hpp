@@ -71,6 +71,7 @@ class SimSession {
   [[nodiscard]] drivers::SimBackend& backend() { return *backend_; }
   [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }
   [[nodiscard]] rt::Loop& loop() { return *loop_; }
+  [[nodiscard]] rt::SpscRing<rt::TelemetryFrame>& telemetry_ring() { return *ring_; }
   [[nodiscard]] const analysis::LoopModel& model() const { return *model_; }
   [[nodiscard]] const config::Config& config() const { return cfg_; }
   // All frames drained in this session (kept in memory for tests when asked).

@@ -90,7 +90,7 @@ SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_
 }
 
 Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
-    : s_(s), params_(params), controller_(params) {
+    : s_(s), controller_(params) {
   sets_.push_back({params, s.analysis_stable, s.max_stable_gain_ns_per_m});
   const auto window = static_cast<std::size_t>(std::max(1.0, std::round(s.limits.saturation_window_s * s.fs_hz)));
   sat_window_.assign(window, 0);

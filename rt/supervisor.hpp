@@ -134,7 +134,7 @@ class Supervisor {
   [[nodiscard]] const SupervisorCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const control::Controller& controller() const noexcept { return controller_; }
   [[nodiscard]] const SupervisorSettings& settings() const noexcept { return s_; }
-  [[nodiscard]] const control::ControllerParams& initial_params() const noexcept { return params_; }
+  [[nodiscard]] const control::ControllerParams& initial_params() const noexcept { return sets_.front().params; }
   // The trip ramp is over and the amplifier disabled.
   [[nodiscard]] bool safe() const noexcept {
     return state_ == State::kDisabled || (state_ == State::kFault && trip_ramp_left_s_ <= 0.0);
@@ -154,8 +154,7 @@ class Supervisor {
   void select(const OperatorCommand& c) noexcept;
 
   SupervisorSettings s_;
-  control::ControllerParams params_;
-  std::vector<ParameterSet> sets_;
+  std::vector<ParameterSet> sets_;  // [0]: the set it starts with
   std::size_t active_set_{0};
   control::Controller controller_;
   State state_{State::kDisabled};

@@ -19,15 +19,17 @@ struct Result {
   std::string out;
 };
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(ROBODAMP_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
+// A shell command line, stdout and stderr together.
+Result run_shell(const std::string& cmd) {
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
   std::string out;
   char buf[4096];
   while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
   const int rc = pclose(p);
   return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
 }
+
+Result run(const std::string& args) { return run_shell(std::string(ROBODAMP_BINARY) + " " + args); }
 
 std::string temp_path(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("robodamp-test-" + std::to_string(getpid()) + "-" + name)).string();
@@ -232,16 +234,10 @@ TEST(Cli, RunEndsInAFaultWithExitCode4) {
 
 TEST(Cli, CtrlCEndsARunThroughTheSafeStateWithASummary) {
   const std::string json = temp_path("sigint.json");
-  const std::string cmd = "timeout --preserve-status -s INT 1.5 " + std::string(ROBODAMP_BINARY) + " run --config " +
-                          robodamp::test::preset("horizontal_c2") + " --duration 60 --json " + json + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int rc = pclose(p);
-  ASSERT_TRUE(WIFEXITED(rc)) << out;
-  EXPECT_EQ(WEXITSTATUS(rc), 0) << out;
-  EXPECT_NE(out.find("tripped: signal"), std::string::npos) << out;
+  const Result r = run_shell("timeout --preserve-status -s INT 1.5 " + std::string(ROBODAMP_BINARY) +
+                             " run --config " + robodamp::test::preset("horizontal_c2") + " --duration 60 --json " + json);
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("tripped: signal"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
   EXPECT_EQ(j["trip"], "signal");
   EXPECT_LT(j["elapsed_s"].get<double>(), 10.0);

@@ -126,20 +126,18 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   plant.faults().add({sim::FaultKind::kAmplifierFault, 100.0, 0.01});
   plant.faults().add({sim::FaultKind::kActuatorSaturated, 140.0, 1.0, 0.002});
 
-  rt::SpscRing<rt::TelemetryFrame> ring(1 << 16);
-  rt::Loop loop(cfg.loop.rate_hz, config::ClockKind::kVirtual, session.supervisor(), session.backend(),
-                session.backend(), session.backend(), &ring);
+  // The session's own loop (armed at tick 51) and ring, driven here so that this thread is the loop's.
+  rt::Loop& loop = session.loop();
   for (double t : {21.0, 61.0, 101.0, 142.0}) {
     loop.schedule(static_cast<std::uint64_t>(t * 5000), {rt::CommandKind::kResetFault, 0.0});
     loop.schedule(static_cast<std::uint64_t>((t + 0.1) * 5000), {rt::CommandKind::kArm, 0.0});
   }
-  loop.schedule(52, {rt::CommandKind::kArm, 0.0});
   loop.schedule(30 * 5000, {rt::CommandKind::kSetGain, 3000.0});
   loop.schedule(31 * 5000, {rt::CommandKind::kSetGain, 1e9});
   loop.schedule(180 * 5000, {rt::CommandKind::kDisarm, 0.0});
   const std::string path = ::testing::TempDir() + "/alloc_loop.rec";
   rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kVirtual));
-  rt::TelemetryDrain drain(ring, {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
+  rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
   drain.start();
 
   const long probe = g_loop_thread_allocations.load();
@@ -186,14 +184,12 @@ TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   std::vector<double> hits;
   for (double t = 0.5; t < 60.0; t += 2.0) hits.push_back(t);
   session.plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, 1000.0, 1e-3, hits));
-  rt::SpscRing<rt::TelemetryFrame> ring(static_cast<std::size_t>(cfg.telemetry.ring_frames));
-  rt::Loop loop(cfg.loop.rate_hz, config::ClockKind::kWall, session.supervisor(), session.backend(), session.backend(),
-                session.backend(), &ring);
-  loop.schedule(52, {rt::CommandKind::kArm, 0.0});
+  rt::Loop& loop = session.loop();  // wall clock (loop.clock), armed at tick 51
   const std::string path = ::testing::TempDir() + "/soak.rec";
   rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kWall));
   rt::LiveTiming live;
-  rt::TelemetryDrain drain(ring, {[&](const rt::TelemetryFrame& f) { recorder.write(f); }, std::ref(live)});
+  rt::TelemetryDrain drain(session.telemetry_ring(),
+                          {[&](const rt::TelemetryFrame& f) { recorder.write(f); }, std::ref(live)});
   rt::RealtimeStatus status;
   rt::RealtimeProcess process(cfg.realtime, status);
   drain.start();

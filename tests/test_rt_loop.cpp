@@ -65,7 +65,6 @@ std::size_t first_state(const Outcome& r, State s, std::size_t from = 0) {
 // A fault at fault_s must trip `expected`; the command must then be zero, and the amplifier off,
 // within detection + trip_ramp_s. Returns the time from the fault to zero command.
 double expect_trip(const Outcome& r, Trip expected, double fault_s, double detection_s) {
-  const auto& cfg = r.s;
   EXPECT_EQ(r.s.trip, to_string(expected));
   EXPECT_EQ(r.s.supervisor.trips[static_cast<std::size_t>(expected)], 1U);
   EXPECT_EQ(r.s.final_state, "fault");
@@ -78,7 +77,7 @@ double expect_trip(const Outcome& r, Trip expected, double fault_s, double detec
   while (i_zero < r.frames.size() && r.frames[i_zero].command_v != 0.0) ++i_zero;
   EXPECT_LT(i_zero, r.frames.size());
   if (i_zero >= r.frames.size()) return INFINITY;
-  const double period = 1.0 / cfg.rate_hz;
+  const double period = 1.0 / r.s.rate_hz;
   const double t_zero = r.frames[i_zero].time_s;
   const double fault_to_zero = t_zero - fault_s;
   EXPECT_LE(fault_to_zero, detection_s + 0.01 + 2 * period) << to_string(expected);
