@@ -121,11 +121,27 @@ Complex LoopModel::open_continuous(std::size_t g, std::size_t h, double f_hz) co
   return plant_.receptance(g, h, f_hz);
 }
 
-Complex LoopModel::closed_continuous(std::size_t g, std::size_t h, double f_hz, double gain, int polarity) const {
+Complex LoopModel::closed_with_feedback(std::size_t g, std::size_t h, double f_hz, Complex q) const {
   const std::size_t a = actuator_location();
-  const Complex q = feedback_continuous(f_hz, gain, polarity);
   return plant_.receptance(g, h, f_hz) + plant_.receptance(g, a, f_hz) * q * plant_.receptance(sensor_, h, f_hz) /
                                              (1.0 - q * plant_.receptance(sensor_, a, f_hz));
+}
+
+Complex LoopModel::closed_continuous(std::size_t g, std::size_t h, double f_hz, double gain, int polarity) const {
+  return closed_with_feedback(g, h, f_hz, feedback_continuous(f_hz, gain, polarity));
+}
+
+Complex LoopModel::feedback_sampled(double f_hz, double gain, int polarity) const {
+  const Complex s(0.0, kTwoPi * f_hz);
+  const double period_s = 1.0 / cfg_.loop.rate_hz;
+  const Complex delay = std::exp(-s * period_s);  // the command computed at tick k is applied from k + 1
+  const Complex zoh = f_hz > 0.0 ? (1.0 - delay) / (s * period_s) : Complex(1.0);
+  return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_digital(f_hz) * delay * zoh *
+         plant_.actuator.n_per_v(f_hz) * sensor_model_.analog_response(f_hz) * s * s;
+}
+
+Complex LoopModel::closed_sampled(std::size_t g, std::size_t h, double f_hz, double gain, int polarity) const {
+  return closed_with_feedback(g, h, f_hz, feedback_sampled(f_hz, gain, polarity));
 }
 
 PlantResponse LoopModel::plant_response(double f_hz) const {
@@ -200,6 +216,13 @@ double LoopModel::spectral_radius(double gain, int polarity) const {
 }
 
 double turns(const std::function<Complex(double)>& fn, double lo, double hi) {
+  const int n0 = 4096;
+  std::vector<double> grid(n0 + 1);
+  for (int i = 0; i <= n0; ++i) grid[static_cast<std::size_t>(i)] = lo + (hi - lo) * i / n0;
+  return turns(fn, grid);
+}
+
+double turns(const std::function<Complex(double)>& fn, const std::vector<double>& grid) {
   // Subdivide until each piece turns by less than 0.2 rad and moves by less than a fifth of its distance
   // from the origin (so no whole turn can hide between two samples near a sharp resonance).
   struct Piece {
@@ -208,13 +231,11 @@ double turns(const std::function<Complex(double)>& fn, double lo, double hi) {
     int depth;
   };
   double total = 0.0;
-  const int n0 = 4096;
   std::vector<Piece> stack;
-  Complex prev = fn(lo);
-  for (int i = 1; i <= n0; ++i) {
-    const double f1 = lo + (hi - lo) * i / n0;
-    const Complex v1 = fn(f1);
-    stack.push_back({lo + (hi - lo) * (i - 1) / n0, f1, prev, v1, 0});
+  Complex prev = fn(grid.front());
+  for (std::size_t i = 1; i < grid.size(); ++i) {
+    const Complex v1 = fn(grid[i]);
+    stack.push_back({grid[i - 1], grid[i], prev, v1, 0});
     prev = v1;
     while (!stack.empty()) {
       Piece p = stack.back();

@@ -59,6 +59,12 @@ class LoopModel {
   [[nodiscard]] Complex open_continuous(std::size_t g, std::size_t h, double f_hz) const;
   [[nodiscard]] Complex closed_continuous(std::size_t g, std::size_t h, double f_hz, double gain_ns_per_m,
                                           int polarity) const;
+  // The continuous structure under the sampled controller, the view chatter sees at any frequency: the
+  // digital chain at z = e^{sT}, one period of computation delay and the zero-order hold in place of the
+  // analog chain (aliasing neglected; equals closed_discrete well below Nyquist).
+  [[nodiscard]] Complex feedback_sampled(double f_hz, double gain_ns_per_m, int polarity) const;
+  [[nodiscard]] Complex closed_sampled(std::size_t g, std::size_t h, double f_hz, double gain_ns_per_m,
+                                       int polarity) const;
   // Discrete: sampled accelerance / (-w^2), as an impact test at the loop rate measures it.
   [[nodiscard]] PlantResponse plant_response(double f_hz) const;
   [[nodiscard]] Complex chain_filters_digital(double f_hz) const { return chain_.filters_digital(f_hz); }
@@ -81,6 +87,8 @@ class LoopModel {
   control::ChainDesign chain_;
   sim::Accelerometer sensor_model_;
   std::size_t sensor_;
+  // Closed-loop receptance g <- h for a feedback force q per displacement at the sensor.
+  [[nodiscard]] Complex closed_with_feedback(std::size_t g, std::size_t h, double f_hz, Complex q) const;
   // Loop-rate discretisation of the plant with the actuator delay.
   Eigen::MatrixXd phi_, gamma_late_, gamma_early_, gamma_force_, c_accel_, d_accel_coil_, d_accel_force_;
   int delay_steps_{0};
@@ -142,6 +150,8 @@ struct Peak {
 
 // Net counter-clockwise turns of arg(fn(f)) as f goes lo -> hi, by adaptive subdivision.
 [[nodiscard]] double turns(const std::function<Complex(double)>& fn, double lo_hz, double hi_hz);
+// The same over an ascending grid, subdividing between its points (dense where fn varies fast).
+[[nodiscard]] double turns(const std::function<Complex(double)>& fn, const std::vector<double>& grid_hz);
 
 // Improvement and the dominant closed-loop pole across K (the root-locus view of the gain).
 struct SweepPoint {

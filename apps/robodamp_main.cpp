@@ -11,6 +11,7 @@
 #include "apps/analyze_command.hpp"
 #include "apps/bench_command.hpp"
 #include "apps/filters_command.hpp"
+#include "apps/milling_command.hpp"
 #include "apps/run_command.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
@@ -177,7 +178,22 @@ int main(int argc, char** argv) {
   csv->add_option("file", recording, "Recording (from run --record)")->required()->check(CLI::ExistingFile);
   csv->add_option("-o,--out", csv_out, "Output file (default: stdout)");
 
+  robodamp::apps::MillingOptions mill;
+  mill.config_path = ROBODAMP_DEFAULT_MILLING_CONFIG;
+  auto* lobes = app.add_subcommand("lobes", "Stability lobes (zero-order method) with a direct check, open loop and --damped");
+  auto* sle = app.add_subcommand("sle", "Surface location error over speed and at the test conditions, with compensation");
+  for (auto* sc : {lobes, sle}) {
+    sc->add_option("--config", mill.config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
+    sc->add_option("--structure", mill.structure, "Which of the job's structures (default: its `structure`)");
+    sc->add_flag("--json", mill.json, "Print JSON instead of a table");
+    sc->add_option("--plot", mill.plot_path, "Write a plot (PNG)");
+    sc->add_flag("--damped", mill.damped, "Also with the damping controller's loop closed, overlaid");
+  }
+  lobes->add_option("--rpm", mill.rpm, "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
+
   CLI11_PARSE(app, argc, argv);
+  if (lobes->parsed()) return robodamp::apps::run_lobes(mill);
+  if (sle->parsed()) return robodamp::apps::run_sle(mill);
   if (run->parsed()) {
     run_opts.config_path = config_path;
     if (!clock.empty()) run_opts.clock = clock == "wall" ? robodamp::config::ClockKind::kWall : robodamp::config::ClockKind::kVirtual;

@@ -14,6 +14,11 @@ using detail::Diagnostics;
 using detail::format_number;
 using detail::MapReader;
 using detail::Range;
+using detail::present;
+using detail::read_bool;
+using detail::read_int;
+using detail::read_mode;
+using detail::read_sign;
 
 std::string Problem::to_string() const {
   std::ostringstream os;
@@ -68,7 +73,6 @@ const char* to_string(Mounting mounting) { return mounting == Mounting::kHorizon
 
 namespace {
 
-bool present(const YAML::Node& n) { return n.IsDefined() && !n.IsNull(); }
 
 // Limits shared by several keys. The loop rate range is the product's (1-20 kHz).
 constexpr double kMinRateHz = 1000.0;
@@ -96,15 +100,6 @@ LoopConfig read_loop(MapReader& top, std::optional<double>& rate) {
 
 const Range kLocationId{"(location id)", 1, 64};
 
-std::optional<int> read_int(MapReader& r, const std::string& key, const Range& range, std::optional<double> def = {}) {
-  const auto v = r.number(key, range, def);
-  if (!v) return std::nullopt;
-  if (*v != std::floor(*v)) {
-    r.diagnostics().add(r.mark(), r.path_of(key), "= " + format_number(*v) + " must be a whole number");
-    return std::nullopt;
-  }
-  return static_cast<int>(*v);
-}
 
 ActuatorConfig read_actuator(MapReader& top, std::optional<double> rate) {
   MapReader r(top.diagnostics(), top.child("actuator", true, "map, Eq. 3 parameters"), "actuator", top.mark());
@@ -230,39 +225,7 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
   return c;
 }
 
-std::optional<int> read_sign(MapReader& r, const std::string& key, int def) {
-  const YAML::Node n = r.child(key, false, "");
-  if (!n.IsDefined() || n.IsNull()) return def;
-  int p = 0;
-  if (!n.IsScalar() || !YAML::convert<int>::decode(n, p) || (p != 1 && p != -1)) {
-    r.diagnostics().add(n.Mark(), r.path_of(key),
-                        "= '" + (n.IsScalar() ? n.Scalar() : std::string("?")) + "' is not allowed: +1 or -1");
-    return std::nullopt;
-  }
-  return p;
-}
 
-ModeConfig read_mode(MapReader& mr, std::optional<double> rate) {
-  ModeConfig m;
-  if (auto v = mr.number("natural_freq_hz", below_nyquist(rate))) m.natural_freq_hz = *v;
-  if (auto v = mr.number("damping_ratio", {"(dimensionless)", 0.0, 1.0, true, true})) m.damping_ratio = *v;
-  const bool stiffness = present(mr.child("stiffness_n_per_m", false, ""));
-  if (stiffness) {
-    m.form = ModeForm::kStiffness;
-    if (auto v = mr.number("stiffness_n_per_m", {"N/m", 0.0, 1e12, true, false, "modal-stiffness form"}))
-      m.stiffness_n_per_m = *v;
-    for (const char* k : {"residue_re_m_per_n", "residue_im_m_per_n"})
-      if (present(mr.child(k, false, "")))
-        mr.diagnostics().add(mr.mark(), mr.path_of(k),
-                             "given together with stiffness_n_per_m: a mode is in residue form (Eq. 1) or in "
-                             "modal-stiffness form, not both");
-  } else {
-    if (auto v = mr.number("residue_re_m_per_n", {"m/N", -1.0, 1.0})) m.residue_re_m_per_n = *v;
-    if (auto v = mr.number("residue_im_m_per_n", {"m/N", -1.0, 1.0})) m.residue_im_m_per_n = *v;
-  }
-  mr.finish();
-  return m;
-}
 
 RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
   Diagnostics& d = top.diagnostics();
@@ -311,7 +274,7 @@ RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
         d.add(modes.Mark(), key + ".modes", "must be a non-empty list of modes");
       for (std::size_t k = 0; modes.IsSequence() && k < modes.size(); ++k) {
         MapReader mr(d, modes[k], key + ".modes[" + std::to_string(k) + "]", modes.Mark());
-        f.modes.push_back(read_mode(mr, rate));
+        f.modes.push_back(read_mode(mr, below_nyquist(rate)));
       }
       fr.finish();
       robot.frfs.push_back(std::move(f));
@@ -416,10 +379,6 @@ BenchConfig read_bench(MapReader& top) {
   return c;
 }
 
-std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def) {
-  if (auto v = r.choice(key, {"true", "false"}, def ? "true" : "false")) return *v == "true";
-  return std::nullopt;
-}
 
 RealtimeConfig read_realtime(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("realtime", false, ""), "realtime", top.mark());

@@ -171,4 +171,56 @@ void MapReader::finish() {
   }
 }
 
+
+bool present(const YAML::Node& n) { return n.IsDefined() && !n.IsNull(); }
+
+std::optional<int> read_int(MapReader& r, const std::string& key, const Range& range, std::optional<double> def) {
+  const auto v = r.number(key, range, def);
+  if (!v) return std::nullopt;
+  if (*v != std::floor(*v)) {
+    r.diagnostics().add(r.mark(), r.path_of(key), "= " + format_number(*v) + " must be a whole number");
+    return std::nullopt;
+  }
+  return static_cast<int>(*v);
+}
+
+std::optional<int> read_sign(MapReader& r, const std::string& key, int def) {
+  const YAML::Node n = r.child(key, false, "");
+  if (!n.IsDefined() || n.IsNull()) return def;
+  int p = 0;
+  if (!n.IsScalar() || !YAML::convert<int>::decode(n, p) || (p != 1 && p != -1)) {
+    r.diagnostics().add(n.Mark(), r.path_of(key),
+                        "= '" + (n.IsScalar() ? n.Scalar() : std::string("?")) + "' is not allowed: +1 or -1");
+    return std::nullopt;
+  }
+  return p;
+}
+
+std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def) {
+  if (auto v = r.choice(key, {"true", "false"}, def ? "true" : "false")) return *v == "true";
+  return std::nullopt;
+}
+
+ModeConfig read_mode(MapReader& mr, const Range& frequency_range) {
+  ModeConfig m;
+  if (auto v = mr.number("natural_freq_hz", frequency_range)) m.natural_freq_hz = *v;
+  if (auto v = mr.number("damping_ratio", {"(dimensionless)", 0.0, 1.0, true, true})) m.damping_ratio = *v;
+  const bool stiffness = present(mr.child("stiffness_n_per_m", false, ""));
+  if (stiffness) {
+    m.form = ModeForm::kStiffness;
+    if (auto v = mr.number("stiffness_n_per_m", {"N/m", 0.0, 1e12, true, false, "modal-stiffness form"}))
+      m.stiffness_n_per_m = *v;
+    for (const char* k : {"residue_re_m_per_n", "residue_im_m_per_n"})
+      if (present(mr.child(k, false, "")))
+        mr.diagnostics().add(mr.mark(), mr.path_of(k),
+                             "given together with stiffness_n_per_m: a mode is in residue form (Eq. 1) or in "
+                             "modal-stiffness form, not both");
+  } else {
+    if (auto v = mr.number("residue_re_m_per_n", {"m/N", -1.0, 1.0})) m.residue_re_m_per_n = *v;
+    if (auto v = mr.number("residue_im_m_per_n", {"m/N", -1.0, 1.0})) m.residue_im_m_per_n = *v;
+  }
+  mr.finish();
+  return m;
+}
+
 }  // namespace robodamp::config::detail

@@ -71,4 +71,15 @@ class MapReader {
   bool quiet_{false};
 };
 
+// True for a key that is given and not null.
+[[nodiscard]] bool present(const YAML::Node& n);
+// A whole number in range.
+[[nodiscard]] std::optional<int> read_int(MapReader& r, const std::string& key, const Range& range,
+                                          std::optional<double> def = {});
+// +1 or -1.
+[[nodiscard]] std::optional<int> read_sign(MapReader& r, const std::string& key, int def);
+[[nodiscard]] std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def);
+// One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.
+[[nodiscard]] ModeConfig read_mode(MapReader& mr, const Range& frequency_range);
+
 }  // namespace robodamp::config::detail

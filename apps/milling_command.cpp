@@ -1,0 +1,308 @@
+#include "apps/milling_command.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/gnuplot.hpp"
+#include "config/milling_config.hpp"
+#include "milling/lobes.hpp"
+#include "milling/sle.hpp"
+
+namespace robodamp::apps {
+
+using nlohmann::json;
+
+namespace {
+
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+double elapsed_ms(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const config::StructureConfig& selected(const config::MillingConfig& cfg, const MillingOptions& o) {
+  const std::string name = o.structure.empty() ? cfg.structure : o.structure;
+  if (const auto* s = cfg.find_structure(name)) return *s;
+  std::string known;
+  for (const auto& s : cfg.structures) known += (known.empty() ? "" : ", ") + s.name;
+  throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "= '" + name + "' is not one of: " + known}});
+}
+
+// One lobe diagram (open or damped) with the direct test at the requested speeds.
+json lobes_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const milling::LobeModel model(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
+  const milling::LobeDiagram d = model.diagram();
+  json j;
+  j["structure"] = structure.name();
+  j["closed_loop"] = structure.damped();
+  j["frequency_points"] = d.frequency_points;
+  j["curve"] = json::array();
+  for (const auto& p : d.curve)
+    j["curve"].push_back({{"rpm", p.rpm}, {"b_lim_mm", finite_or_null(p.b_lim_m * 1e3)},
+                          {"chatter_hz", std::isfinite(p.b_lim_m) ? json(p.chatter_hz) : json(nullptr)}, {"lobe", p.lobe}});
+  j["min_b_lim_mm"] = finite_or_null(d.minimum.b_lim_m * 1e3);
+  j["min_rpm"] = d.minimum.rpm;
+  j["min_chatter_hz"] = d.minimum.chatter_hz;
+  j["diagram_ms"] = elapsed_ms(t0);
+  j["at_rpm"] = json::array();
+  for (double rpm : rpms) {
+    const auto zoa = model.limit_at(rpm);
+    const double direct = model.critical_depth_m(rpm);
+    j["at_rpm"].push_back({{"rpm", rpm},
+                           {"b_lim_mm", finite_or_null(direct * 1e3)},
+                           {"b_lim_lobes_mm", zoa ? json(zoa->b_lim_m * 1e3) : json(nullptr)},
+                           {"chatter_hz", zoa ? json(zoa->chatter_hz) : json(nullptr)},
+                           {"lobe", zoa ? json(zoa->lobe) : json(nullptr)}});
+  }
+  j["notes"] = structure.notes();
+  return j;
+}
+
+double pct_change(const json& open, const json& damped) {
+  if (open.is_null() || damped.is_null()) return NAN;
+  return (damped.get<double>() / open.get<double>() - 1.0) * 100.0;
+}
+
+std::string fmt(const json& v, const char* format) {
+  if (v.is_null()) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, format, v.get<double>());
+  return b;
+}
+
+std::string lobes_table(const json& r) {
+  std::ostringstream os;
+  auto one = [&](const json& d, const char* label) {
+    os << "  " << label << ": minimum limiting depth " << fmt(d["min_b_lim_mm"], "%.3f") << " mm at "
+       << fmt(d["min_rpm"], "%.0f") << " rpm (chatter " << fmt(d["min_chatter_hz"], "%.1f") << " Hz); "
+       << d["frequency_points"].get<std::size_t>() << " chatter frequencies, " << fmt(d["diagram_ms"], "%.1f")
+       << " ms\n";
+    for (const auto& a : d["at_rpm"])
+      os << "    at " << fmt(a["rpm"], "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
+         << " mm (direct test), lobes " << fmt(a["b_lim_lobes_mm"], "%.3f") << " mm, chatter "
+         << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
+  };
+  os << "Stability lobes of " << r["config"].get<std::string>() << " (structure " << r["structure"].get<std::string>()
+     << ", " << r["tool"].get<std::string>() << ")\n";
+  one(r, "open  ");
+  if (r.contains("damped")) {
+    one(r["damped"], "damped");
+    os << "  change with active damping: minimum limiting depth " << fmt(r["gain"]["min_b_lim_change_pct"], "%+.1f")
+       << " %, at the spindle speed " << fmt(r["gain"]["at_spindle_rpm"], "%.0f") << " rpm "
+       << fmt(r["gain"]["at_spindle_change_pct"], "%+.1f") << " %\n";
+  }
+  for (const auto& n : r["notes"]) os << "  note: " << n.get<std::string>() << '\n';
+  if (r.contains("damped"))
+    for (const auto& n : r["damped"]["notes"]) os << "  note: " << n.get<std::string>() << '\n';
+  return os.str();
+}
+
+std::string plot_lobes(const json& r, const std::string& path) {
+  std::ostringstream data;
+  const bool damped = r.contains("damped");
+  double y_max = 0.0;
+  for (const json* d : {&r, damped ? &r["damped"] : nullptr})
+    if (d && !(*d)["min_b_lim_mm"].is_null()) y_max = std::max(y_max, 6.0 * (*d)["min_b_lim_mm"].get<double>());
+  for (std::size_t i = 0; i < r["curve"].size(); ++i) {
+    auto val = [](const json& p) { return p["b_lim_mm"].is_null() ? std::string("NaN") : std::to_string(p["b_lim_mm"].get<double>()); };
+    data << r["curve"][i]["rpm"].get<double>() << ' ' << val(r["curve"][i]);
+    if (damped) data << ' ' << val(r["damped"]["curve"][i]);
+    data << '\n';
+  }
+  std::ostringstream s;
+  s << "set title 'Stability lobes (zero-order), " << r["structure"].get<std::string>() << ": " << r["tool"].get<std::string>()
+    << "'\nset grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'limiting axial depth b_lim (mm)'\n"
+    << "set yrange [0:" << y_max << "]\nset key top left\n";
+  s << "set arrow from " << r["spindle_rpm"].get<double>() << ", graph 0 to " << r["spindle_rpm"].get<double>()
+    << ", graph 1 nohead dt 3 lc rgb 'gray40'\n";
+  s << "plot DATA u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop (min " << fmt(r["min_b_lim_mm"], "%.3f") << " mm)'";
+  if (damped)
+    s << ", DATA u 1:3 w l lw 2 lc rgb '#2471a3' t 'active damping (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f")
+      << " mm)'";
+  s << '\n';
+  return run_gnuplot(s.str(), data.str(), path);
+}
+
+std::string tool_text(const config::MillingConfig& c) {
+  std::ostringstream os;
+  os << c.tool.diameter_mm << " mm " << c.tool.teeth << "-tooth " << to_string(c.tool.kind) << ", "
+     << c.cut.radial_mm << " mm radial " << to_string(c.cut.mode) << " milling, " << c.material.name;
+  return os.str();
+}
+
+int finish(const json& report, const MillingOptions& o, const std::string& table,
+           std::string (*plot)(const json&, const std::string&)) {
+  if (o.json)
+    std::cout << report.dump(2) << '\n';
+  else
+    std::cout << table;
+  if (!o.plot_path.empty()) {
+    if (const std::string err = plot(report, o.plot_path); !err.empty()) {
+      std::cerr << "plot: " << err << '\n';
+      return 1;
+    }
+    (o.json ? std::cerr : std::cout) << "wrote " << o.plot_path << '\n';
+  }
+  return 0;
+}
+
+// --- SLE -------------------------------------------------------------------------------------------
+
+json sle_json(const milling::Structure& structure, const config::MillingConfig& cfg) {
+  const auto cutter = milling::cutter_from(cfg.tool);
+  const auto& s = cfg.sle;
+  json j;
+  j["structure"] = structure.name();
+  j["closed_loop"] = structure.damped();
+  j["map"] = json::array();
+  const milling::CutConditions cut{cfg.cut.mode, cfg.cut.radial_mm, cfg.cut.axial_mm, cfg.cut.feed_per_tooth_mm};
+  for (int i = 0; i < s.points; ++i) {
+    const double rpm = s.rpm_min + (s.rpm_max - s.rpm_min) * i / (s.points - 1);
+    const auto r = milling::surface_location_error(structure, cutter, cfg.material, cut, cfg.cut.feed_axis, rpm,
+                                                   s.axial_slices, s.harmonics);
+    j["map"].push_back({{"rpm", rpm}, {"sle_um", r.sle_um}, {"sle_min_um", r.min_um}, {"sle_max_um", r.max_um}});
+  }
+  j["conditions"] = json::array();
+  for (const auto& c : cfg.conditions) {
+    for (const config::Axis normal : s.surface_normals) {
+      const config::Axis feed = normal == config::Axis::kY ? config::Axis::kX : config::Axis::kY;
+      const milling::CutConditions cc{cfg.cut.mode, c.radial_mm, c.axial_mm, c.feed_per_tooth_mm};
+      const double offset_um = 1000.0 * (normal == config::Axis::kX ? c.path_offset_x_mm : c.path_offset_y_mm);
+      const auto r = milling::surface_location_error(structure, cutter, cfg.material, cc, feed, c.rpm, s.axial_slices,
+                                                     s.harmonics);
+      const auto comp = milling::compensate(structure, cutter, cfg.material, cc, feed, c.rpm, offset_um, s);
+      // SLE assumes a stable cut: say whether this one is (direct test with this immersion and feed axis).
+      config::CutConfig cut_c = cfg.cut;
+      cut_c.radial_mm = c.radial_mm;
+      cut_c.feed_axis = feed;
+      config::LobesConfig lc = cfg.lobes;
+      const milling::LobeModel lobes(structure, milling::chatter_process(cfg.tool, cfg.material, cut_c), lc);
+      j["conditions"].push_back({{"name", c.name},
+                                 {"rpm", c.rpm},
+                                 {"axial_mm", c.axial_mm},
+                                 {"radial_mm", c.radial_mm},
+                                 {"ft_mm", c.feed_per_tooth_mm},
+                                 {"surface_normal", to_string(normal)},
+                                 {"sle_um", r.sle_um + offset_um},
+                                 {"sle_dynamic_um", r.sle_um},
+                                 {"path_offset_um", offset_um},
+                                 {"sle_min_um", r.min_um + offset_um},
+                                 {"sle_max_um", r.max_um + offset_um},
+                                 {"mean_normal_force_n", r.mean_normal_force_n},
+                                 {"compensated_radial_mm", comp.radial_mm},
+                                 {"compensation_residual_um", comp.residual_um},
+                                 {"compensation_iterations", comp.iterations},
+                                 {"compensation_converged", comp.converged},
+                                 {"stable", lobes.stable(c.axial_mm * 1e-3, c.rpm)}});
+    }
+  }
+  j["notes"] = structure.notes();
+  return j;
+}
+
+std::string sle_table(const json& r) {
+  std::ostringstream os;
+  os << "Surface location error of " << r["config"].get<std::string>() << " (structure "
+     << r["structure"].get<std::string>() << ", " << r["tool"].get<std::string>() << ")\n";
+  auto one = [&](const json& d, const char* label) {
+    double lo = 1e300, hi = -1e300;
+    for (const auto& p : d["map"]) lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
+    os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-" << fmt(d["map"].back()["rpm"], "%.0f")
+       << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to " << fmt(json(hi), "%.1f") << " um\n";
+    if (d["conditions"].empty()) return;
+    os << "    cond  rpm    axial  radial  ft     normal  SLE(um)  dyn(um)  offset  radial_cmd(mm)  iter  stable\n";
+    for (const auto& c : d["conditions"]) {
+      char line[200];
+      std::snprintf(line, sizeof line, "    %-5s %-6.0f %-6.2f %-7.2f %-6.3f %-7s %-8.1f %-8.1f %-7.1f %-15.4f %-5d %s\n",
+                    c["name"].get<std::string>().c_str(), c["rpm"].get<double>(), c["axial_mm"].get<double>(),
+                    c["radial_mm"].get<double>(), c["ft_mm"].get<double>(), c["surface_normal"].get<std::string>().c_str(),
+                    c["sle_um"].get<double>(), c["sle_dynamic_um"].get<double>(), c["path_offset_um"].get<double>(),
+                    c["compensated_radial_mm"].get<double>(), c["compensation_iterations"].get<int>(),
+                    c["stable"].get<bool>() ? "yes" : "NO (chatter: SLE not meaningful)");
+      os << line;
+    }
+  };
+  one(r, "open  ");
+  if (r.contains("damped")) one(r["damped"], "damped");
+  for (const auto& n : r["notes"]) os << "  note: " << n.get<std::string>() << '\n';
+  return os.str();
+}
+
+std::string plot_sle(const json& r, const std::string& path) {
+  std::ostringstream data;
+  const bool damped = r.contains("damped");
+  for (std::size_t i = 0; i < r["map"].size(); ++i) {
+    data << r["map"][i]["rpm"].get<double>() << ' ' << r["map"][i]["sle_um"].get<double>();
+    if (damped) data << ' ' << r["damped"]["map"][i]["sle_um"].get<double>();
+    data << '\n';
+  }
+  std::ostringstream s;
+  s << "set title 'Surface location error (mean over the axial depth), " << r["tool"].get<std::string>()
+    << "'\nset grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'SLE (um), + = undercut'\nset key top left\n"
+    << "plot DATA u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop'";
+  if (damped) s << ", DATA u 1:3 w l lw 2 lc rgb '#2471a3' t 'active damping'";
+  s << '\n';
+  return run_gnuplot(s.str(), data.str(), path);
+}
+
+template <typename Fn>
+int guarded(Fn fn) {
+  try {
+    return fn();
+  } catch (const config::ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
+}
+
+}  // namespace
+
+int run_lobes(const MillingOptions& o) {
+  return guarded([&] {
+    const auto cfg = config::load_milling_config(o.config_path);
+    const auto& sc = selected(cfg, o);
+    std::vector<double> rpms = o.rpm;
+    rpms.push_back(cfg.cut.spindle_rpm);
+    const milling::Structure open(sc, false);
+    if (o.damped && !open.has_controller())
+      throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
+                                                 "--damped needs a part with a controller (a damping configuration)"}});
+    json r = lobes_json(open, cfg, rpms);
+    r["config"] = cfg.source;
+    r["tool"] = tool_text(cfg);
+    r["spindle_rpm"] = cfg.cut.spindle_rpm;
+    if (o.damped) {
+      const milling::Structure closed(sc, true);
+      r["damped"] = lobes_json(closed, cfg, rpms);
+      r["gain"] = {{"min_b_lim_change_pct", finite_or_null(pct_change(r["min_b_lim_mm"], r["damped"]["min_b_lim_mm"]))},
+                   {"at_spindle_rpm", cfg.cut.spindle_rpm},
+                   {"at_spindle_change_pct",
+                    finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"], r["damped"]["at_rpm"].back()["b_lim_mm"]))}};
+    }
+    return finish(r, o, lobes_table(r), plot_lobes);
+  });
+}
+
+int run_sle(const MillingOptions& o) {
+  return guarded([&] {
+    const auto cfg = config::load_milling_config(o.config_path);
+    const auto& sc = selected(cfg, o);
+    const milling::Structure open(sc, false);
+    if (o.damped && !open.has_controller())
+      throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
+                                                 "--damped needs a part with a controller (a damping configuration)"}});
+    json r = sle_json(open, cfg);
+    r["config"] = cfg.source;
+    r["tool"] = tool_text(cfg);
+    if (o.damped) r["damped"] = sle_json(milling::Structure(sc, true), cfg);
+    return finish(r, o, sle_table(r), plot_sle);
+  });
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,284 @@
+#include "config/milling_config.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "config/yaml_reader.hpp"
+
+namespace robodamp::config {
+
+using detail::Diagnostics;
+using detail::format_number;
+using detail::MapReader;
+using detail::present;
+using detail::Range;
+using detail::read_int;
+using detail::read_mode;
+
+const char* to_string(ToolKind kind) { return kind == ToolKind::kEndMill ? "end_mill" : "ball_end"; }
+const char* to_string(MillingMode mode) { return mode == MillingMode::kDown ? "down" : "up"; }
+const char* to_string(Axis axis) { return axis == Axis::kX ? "x" : "y"; }
+
+const StructureConfig* MillingConfig::find_structure(const std::string& name) const {
+  for (const auto& s : structures)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+namespace {
+
+constexpr std::array<const char*, 4> kPairs{"xx", "xy", "yx", "yy"};
+const Range kModeFrequency{"Hz", 0.0, 100000.0, true, false};
+const Range kRpm{"rpm", 0.0, 200000.0, true, false};
+const Range kCoefficient{"N/mm^2", 0.0, 100000.0, false, false};
+const Range kEdge{"N/mm", 0.0, 10000.0, false, false};
+const Range kOffset{"mm", -10.0, 10.0};
+
+Axis axis_from(const std::string& s) { return s == "x" ? Axis::kX : Axis::kY; }
+
+ToolConfig read_tool(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("tool", true, "map with kind, diameter_mm, teeth, helix_deg"), "tool",
+              top.mark());
+  ToolConfig t;
+  if (auto v = r.choice("kind", {"end_mill", "ball_end"}, "end_mill"))
+    t.kind = *v == "end_mill" ? ToolKind::kEndMill : ToolKind::kBallEnd;
+  if (auto v = r.number("diameter_mm", {"mm", 0.0, 200.0, true, false})) t.diameter_mm = *v;
+  if (auto v = read_int(r, "teeth", {"(teeth)", 1, 32})) t.teeth = *v;
+  if (auto v = r.number("helix_deg", {"deg", 0.0, 70.0, false, false}, 30.0)) t.helix_deg = *v;
+  r.finish();
+  return t;
+}
+
+// Exactly one spelling of each coefficient: kt or ktc, kn or krc, kte, kne or kre.
+std::optional<double> one_of(MapReader& r, const std::string& a, const std::string& b, const Range& range,
+                             std::optional<double> def) {
+  const bool has_a = present(r.child(a, false, "")), has_b = present(r.child(b, false, ""));
+  if (has_a && has_b) {
+    r.diagnostics().add(r.mark(), r.path_of(b), "given together with " + a + ": the same coefficient, give one");
+    return std::nullopt;
+  }
+  if (!has_a && !has_b && !def) {
+    r.diagnostics().add(r.mark(), r.path_of(a), "missing (required: " + a + " or " + b + ", " +
+                                                    std::string(range.unit) + ")");
+    return std::nullopt;
+  }
+  return r.number(has_b ? b : a, range, def);
+}
+
+MaterialConfig read_material(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("material", true, "map with the cutting coefficients"), "material",
+              top.mark());
+  MaterialConfig m;
+  m.name = r.text("name", "material").value_or("");
+  if (auto v = one_of(r, "kt_n_per_mm2", "ktc_n_per_mm2", {"N/mm^2", 0.0, 100000.0, true, false}, std::nullopt))
+    m.kt_n_per_mm2 = *v;
+  if (auto v = one_of(r, "kn_n_per_mm2", "krc_n_per_mm2", kCoefficient, std::nullopt)) m.kr_n_per_mm2 = *v;
+  if (auto v = r.number("kte_n_per_mm", kEdge, 0.0)) m.kte_n_per_mm = *v;
+  if (auto v = one_of(r, "kne_n_per_mm", "kre_n_per_mm", kEdge, 0.0)) m.kre_n_per_mm = *v;
+  if (present(r.child("kac_n_per_mm2", false, ""))) m.ka_n_per_mm2 = r.number("kac_n_per_mm2", kCoefficient);
+  r.finish();
+  return m;
+}
+
+Range radial_range(const ToolConfig& t) {
+  return {"mm", 0.0, t.diameter_mm, true, false, "up to tool.diameter_mm = " + format_number(t.diameter_mm) + " (slotting)"};
+}
+
+CutConfig read_cut(MapReader& top, const ToolConfig& tool) {
+  MapReader r(top.diagnostics(), top.child("cut", true, "map with mode, radial_mm, axial_mm, feed_per_tooth_mm"), "cut",
+              top.mark());
+  CutConfig c;
+  if (auto v = r.choice("mode", {"down", "up"})) c.mode = *v == "down" ? MillingMode::kDown : MillingMode::kUp;
+  if (auto v = r.number("radial_mm", radial_range(tool))) c.radial_mm = *v;
+  if (auto v = r.number("axial_mm", {"mm", 0.0, 100.0, true, false})) c.axial_mm = *v;
+  if (auto v = r.number("feed_per_tooth_mm", {"mm", 0.0, 5.0, true, false})) c.feed_per_tooth_mm = *v;
+  if (auto v = r.choice("feed_axis", {"x", "y"}, "x")) c.feed_axis = axis_from(*v);
+  if (auto v = r.number("spindle_rpm", kRpm)) c.spindle_rpm = *v;
+  r.finish();
+  return c;
+}
+
+std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const std::string& base_dir) {
+  Diagnostics& d = pr.diagnostics();
+  const YAML::Node n = pr.child("controller", false, "");
+  if (!present(n)) return std::nullopt;
+  MapReader r(d, n, pr.path_of("controller"), pr.mark());
+  ControllerPartConfig c;
+  if (auto v = r.text("config", std::nullopt)) {
+    const std::filesystem::path p = std::filesystem::path(*v).is_absolute() ? std::filesystem::path(*v)
+                                                                           : std::filesystem::path(base_dir) / *v;
+    c.config_path = p.lexically_normal().string();
+    if (!std::ifstream(c.config_path))
+      d.add(n.Mark(), r.path_of("config"), "= '" + *v + "': cannot open " + c.config_path);
+  }
+  if (auto v = read_int(r, "location", {"(location id)", 1, 64}, 1)) c.location = *v;
+  if (auto v = r.choice("direction", {"x", "y"}, "y")) c.direction = axis_from(*v);
+  r.finish();
+  return c;
+}
+
+StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std::string& key,
+                               const std::string& base_dir) {
+  MapReader r(d, node, key, node.Mark());
+  StructureConfig s;
+  s.name = r.text("name", std::nullopt).value_or("");
+  const YAML::Node parts = r.child("parts", true, "list of FRF contributions (summed)");
+  if (present(parts) && (!parts.IsSequence() || parts.size() == 0))
+    d.add(parts.Mark(), key + ".parts", "must be a non-empty list");
+  for (std::size_t i = 0; parts.IsSequence() && i < parts.size(); ++i) {
+    const std::string pk = key + ".parts[" + std::to_string(i) + "]";
+    MapReader pr(d, parts[i], pk, parts.Mark());
+    StructurePartConfig p;
+    p.name = pr.text("name", "part " + std::to_string(i + 1)).value_or("");
+    p.controller = read_controller_part(pr, base_dir);
+    bool any = p.controller.has_value();
+    for (std::size_t k = 0; k < kPairs.size(); ++k) {
+      const YAML::Node modes = pr.child(kPairs[k], false, "");
+      if (!present(modes)) continue;
+      any = true;
+      if (!modes.IsSequence() || modes.size() == 0) {
+        d.add(modes.Mark(), pr.path_of(kPairs[k]), "must be a non-empty list of modes");
+        continue;
+      }
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        MapReader mr(d, modes[m], pr.path_of(kPairs[k]) + "[" + std::to_string(m) + "]", modes.Mark());
+        p.modes[k].push_back(read_mode(mr, kModeFrequency));
+      }
+    }
+    if (!any) d.add(parts[i].Mark(), pk, "has no FRF: give modes under xx, xy, yx, yy, or a controller location");
+    pr.finish();
+    s.parts.push_back(std::move(p));
+  }
+  r.finish();
+  return s;
+}
+
+LobesConfig read_lobes(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("lobes", false, ""), "lobes", top.mark());
+  LobesConfig c;
+  if (auto v = r.number("rpm_min", kRpm, c.rpm_min)) c.rpm_min = *v;
+  if (auto v = r.number("rpm_max", kRpm, c.rpm_max)) c.rpm_max = *v;
+  if (c.rpm_max <= c.rpm_min)
+    r.diagnostics().add(r.mark(), "lobes.rpm_max", "= " + format_number(c.rpm_max) + " rpm must exceed lobes.rpm_min = " +
+                                                        format_number(c.rpm_min) + " rpm");
+  if (auto v = read_int(r, "points", {"(speeds)", 10, 1000000}, c.points)) c.points = *v;
+  if (auto v = r.choice("spacing", {"linear", "log"}, "linear")) c.log_spacing = *v == "log";
+  if (present(r.child("freq_max_hz", false, ""))) c.freq_max_hz = r.number("freq_max_hz", kModeFrequency);
+  if (auto v = read_int(r, "points_per_mode", {"(frequencies)", 8, 100000}, c.points_per_mode)) c.points_per_mode = *v;
+  r.finish();
+  return c;
+}
+
+SleConfig read_sle(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("sle", false, ""), "sle", top.mark());
+  SleConfig c;
+  if (auto v = r.number("rpm_min", kRpm, c.rpm_min)) c.rpm_min = *v;
+  if (auto v = r.number("rpm_max", kRpm, c.rpm_max)) c.rpm_max = *v;
+  if (c.rpm_max <= c.rpm_min)
+    r.diagnostics().add(r.mark(), "sle.rpm_max", "= " + format_number(c.rpm_max) + " rpm must exceed sle.rpm_min = " +
+                                                      format_number(c.rpm_min) + " rpm");
+  if (auto v = read_int(r, "points", {"(speeds)", 2, 1000000}, c.points)) c.points = *v;
+  if (auto v = read_int(r, "axial_slices", {"(slices)", 1, 10000}, c.axial_slices)) c.axial_slices = *v;
+  if (auto v = read_int(r, "harmonics", {"(of the tooth frequency)", 1, 10000}, c.harmonics)) c.harmonics = *v;
+  if (auto v = r.number("tolerance_um", {"um", 0.0, 1000.0, true, false}, c.tolerance_um)) c.tolerance_um = *v;
+  if (auto v = read_int(r, "max_iterations", {"(iterations)", 1, 1000}, c.max_iterations)) c.max_iterations = *v;
+  const YAML::Node normals = r.child("surface_normals", false, "");
+  if (present(normals)) {
+    c.surface_normals.clear();
+    bool ok = normals.IsSequence() && normals.size() > 0 && normals.size() <= 2;
+    for (std::size_t i = 0; ok && i < normals.size(); ++i) {
+      ok = normals[i].IsScalar() && (normals[i].Scalar() == "x" || normals[i].Scalar() == "y");
+      if (ok) c.surface_normals.push_back(axis_from(normals[i].Scalar()));
+    }
+    if (!ok) r.diagnostics().add(normals.Mark(), "sle.surface_normals", "must be a list of x and/or y");
+  }
+  r.finish();
+  return c;
+}
+
+std::vector<ConditionConfig> read_conditions(MapReader& top, const ToolConfig& tool) {
+  Diagnostics& d = top.diagnostics();
+  std::vector<ConditionConfig> out;
+  const YAML::Node n = top.child("conditions", false, "");
+  if (!present(n)) return out;
+  if (!n.IsSequence()) {
+    d.add(n.Mark(), "conditions", "must be a list");
+    return out;
+  }
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string key = "conditions[" + std::to_string(i) + "]";
+    MapReader r(d, n[i], key, n.Mark());
+    ConditionConfig c;
+    c.name = r.text("name", std::to_string(i + 1)).value_or("");
+    if (!names.insert(c.name).second) d.add(n[i].Mark(), key + ".name", "= '" + c.name + "' is used twice");
+    if (auto v = r.number("rpm", kRpm)) c.rpm = *v;
+    if (auto v = r.number("axial_mm", {"mm", 0.0, 100.0, true, false})) c.axial_mm = *v;
+    if (auto v = r.number("radial_mm", radial_range(tool))) c.radial_mm = *v;
+    if (auto v = r.number("feed_per_tooth_mm", {"mm", 0.0, 5.0, true, false})) c.feed_per_tooth_mm = *v;
+    if (auto v = r.number("path_offset_x_mm", kOffset, 0.0)) c.path_offset_x_mm = *v;
+    if (auto v = r.number("path_offset_y_mm", kOffset, 0.0)) c.path_offset_y_mm = *v;
+    r.finish();
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace
+
+MillingConfig parse_milling_config(const std::string& yaml_text, const std::string& source_name,
+                                   const std::string& base_dir) {
+  Diagnostics d(source_name);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    d.add(e.mark, "(yaml)", "syntax error: " + e.msg);
+    throw ConfigError(d.problems());
+  }
+  if (!root.IsMap()) {
+    d.add(root.Mark(), "(top level)", "expected a map with tool, material, cut, structures");
+    throw ConfigError(d.problems());
+  }
+  MillingConfig c;
+  c.source = source_name;
+  MapReader top(d, root, "", root.Mark());
+  c.tool = read_tool(top);
+  c.material = read_material(top);
+  c.cut = read_cut(top, c.tool);
+  const YAML::Node structures = top.child("structures", true, "list of named structures (FRFs at the tool tip)");
+  if (present(structures) && (!structures.IsSequence() || structures.size() == 0))
+    d.add(structures.Mark(), "structures", "must be a non-empty list");
+  std::set<std::string> names;
+  for (std::size_t i = 0; structures.IsSequence() && i < structures.size(); ++i) {
+    const std::string key = "structures[" + std::to_string(i) + "]";
+    c.structures.push_back(read_structure(d, structures[i], key, base_dir));
+    if (!names.insert(c.structures.back().name).second)
+      d.add(structures[i].Mark(), key + ".name", "= '" + c.structures.back().name + "' is used twice");
+  }
+  const std::string first = c.structures.empty() ? std::string() : c.structures.front().name;
+  c.structure = top.text("structure", first.empty() ? std::optional<std::string>() : first).value_or("");
+  if (!c.structures.empty() && c.find_structure(c.structure) == nullptr) {
+    std::string known;
+    for (const auto& s : c.structures) known += (known.empty() ? "" : ", ") + s.name;
+    d.add(top.mark(), "structure", "= '" + c.structure + "' is not one of the structures: " + known);
+  }
+  c.lobes = read_lobes(top);
+  c.sle = read_sle(top);
+  c.conditions = read_conditions(top, c.tool);
+  top.finish();
+  if (!d.problems().empty()) throw ConfigError(d.problems());
+  return c;
+}
+
+MillingConfig load_milling_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError({Problem{path, {}, "(file)", "cannot be opened for reading"}});
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_milling_config(ss.str(), path, std::filesystem::path(path).parent_path().string());
+}
+
+}  // namespace robodamp::config

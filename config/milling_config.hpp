@@ -1,0 +1,124 @@
+// A milling job for the chatter and surface-location-error analyses (REFERENCE.md sections 2 and 3): tool,
+// material, cut, the structure's FRFs seen at the tool tip, and the settings of the lobe and SLE
+// computations. YAML with units in the key names, validated like the controller configuration (every
+// problem with file, line, key, value, unit and allowed range). Off the real-time path.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/config.hpp"
+
+namespace robodamp::config {
+
+enum class ToolKind { kEndMill, kBallEnd };
+enum class MillingMode { kDown, kUp };
+enum class Axis { kX, kY };
+
+[[nodiscard]] const char* to_string(ToolKind kind);
+[[nodiscard]] const char* to_string(MillingMode mode);
+[[nodiscard]] const char* to_string(Axis axis);
+
+struct ToolConfig {
+  ToolKind kind{ToolKind::kEndMill};
+  double diameter_mm{12.7};
+  int teeth{3};
+  double helix_deg{30.0};
+};
+
+// Mechanistic force model (REFERENCE.md section 2): Ft = kt b h + kte b, Fr = kr b h + kre b. The radial
+// coefficient is called kn (normal) in seed 004 and Krc in seed 000; both spellings are accepted.
+struct MaterialConfig {
+  std::string name;
+  double kt_n_per_mm2{0.0};
+  double kr_n_per_mm2{0.0};
+  double kte_n_per_mm{0.0};
+  double kre_n_per_mm{0.0};
+  std::optional<double> ka_n_per_mm2;  // axial (ball end, seed 000): recorded, unused by the 2D models
+};
+
+struct CutConfig {
+  MillingMode mode{MillingMode::kDown};
+  double radial_mm{2.0};
+  double axial_mm{1.0};
+  double feed_per_tooth_mm{0.1};
+  Axis feed_axis{Axis::kX};  // the machined wall's normal is the other axis
+  double spindle_rpm{10000.0};
+};
+
+// The driving-point receptance of one location of a damping configuration (config/presets/*.yaml),
+// open loop, or closed loop with that configuration's controller (lobes/sle --damped).
+struct ControllerPartConfig {
+  std::string config_path;  // resolved against the milling file's directory
+  int location{1};
+  Axis direction{Axis::kY};
+};
+
+// One contribution to the tool-workpiece relative FRF: modal terms per direction pair (stiffness or
+// residue form), or a location of a damping configuration.
+struct StructurePartConfig {
+  std::string name;
+  std::array<std::vector<ModeConfig>, 4> modes;  // xx, xy, yx, yy
+  std::optional<ControllerPartConfig> controller;
+};
+
+// The relative FRF is the sum of its parts (robot + workpiece).
+struct StructureConfig {
+  std::string name;
+  std::vector<StructurePartConfig> parts;
+};
+
+struct LobesConfig {
+  double rpm_min{1000.0};
+  double rpm_max{20000.0};
+  int points{2000};                    // speeds of the lobe diagram
+  bool log_spacing{false};
+  std::optional<double> freq_max_hz;   // chatter-frequency search limit; default 4 x the highest resonance
+                                       // and at least 4 x the top tooth-passing frequency
+  int points_per_mode{160};            // fine chatter-frequency grid across each mode's resonance
+};
+
+struct SleConfig {
+  double rpm_min{1000.0};
+  double rpm_max{20000.0};
+  int points{400};
+  int axial_slices{40};
+  int harmonics{64};                   // of the tooth-passing frequency
+  double tolerance_um{2.0};            // compensation stops below this part error
+  int max_iterations{30};
+  std::vector<Axis> surface_normals{Axis::kY};  // conditions are evaluated for each
+};
+
+// An SLE test condition (seed 004 Table 7) with the measured path offset the published predictions add.
+struct ConditionConfig {
+  std::string name;
+  double rpm{0.0};
+  double axial_mm{0.0};
+  double radial_mm{0.0};
+  double feed_per_tooth_mm{0.0};
+  double path_offset_x_mm{0.0};
+  double path_offset_y_mm{0.0};
+};
+
+struct MillingConfig {
+  std::string source;
+  ToolConfig tool;
+  MaterialConfig material;
+  CutConfig cut;
+  std::vector<StructureConfig> structures;
+  std::string structure;  // the one used unless the command line selects another
+  LobesConfig lobes;
+  SleConfig sle;
+  std::vector<ConditionConfig> conditions;
+
+  [[nodiscard]] const StructureConfig* find_structure(const std::string& name) const;
+};
+
+// Throw ConfigError holding every problem found. base_dir resolves controller config paths.
+[[nodiscard]] MillingConfig parse_milling_config(const std::string& yaml_text, const std::string& source_name,
+                                                 const std::string& base_dir);
+[[nodiscard]] MillingConfig load_milling_config(const std::string& path);
+
+}  // namespace robodamp::config

@@ -1,0 +1,121 @@
+#include "milling/cutting.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace robodamp::milling {
+
+Engagement engagement(double radius_mm, double radial_mm, config::MillingMode mode) {
+  const double r = std::clamp(radial_mm / (2.0 * radius_mm), 0.0, 1.0);
+  if (mode == config::MillingMode::kDown) return {std::acos(2.0 * r - 1.0), M_PI};
+  return {0.0, std::acos(1.0 - 2.0 * r)};
+}
+
+double surface_angle_rad(config::MillingMode mode) { return mode == config::MillingMode::kDown ? M_PI : 0.0; }
+
+Eigen::Matrix2d directional_matrix(const Engagement& e, double kr) {
+  // REFERENCE.md section 2 (Altintas-Budak), [.] = value at exit minus value at entry.
+  auto at = [kr](double p) {
+    Eigen::Matrix2d a;
+    a(0, 0) = 0.5 * (std::cos(2 * p) - 2 * kr * p + kr * std::sin(2 * p));
+    a(0, 1) = 0.5 * (-std::sin(2 * p) - 2 * p + kr * std::cos(2 * p));
+    a(1, 0) = 0.5 * (-std::sin(2 * p) + 2 * p + kr * std::cos(2 * p));
+    a(1, 1) = 0.5 * (-std::cos(2 * p) - 2 * kr * p - kr * std::sin(2 * p));
+    return a;
+  };
+  return at(e.exit_rad) - at(e.start_rad);
+}
+
+Cutter cutter_from(const config::ToolConfig& tool) {
+  return {tool.kind, 0.5 * tool.diameter_mm, tool.teeth, tool.helix_deg * M_PI / 180.0};
+}
+
+std::vector<Slice> slices(const Cutter& c, double axial_mm, int count) {
+  std::vector<Slice> out;
+  const double db = axial_mm / count;
+  for (int j = 0; j < count; ++j) {
+    Slice s;
+    s.z_mm = (j + 0.5) * db;
+    s.height_mm = db;
+    s.radius_mm = c.radius_mm;
+    s.kappa_rad = 0.5 * M_PI;
+    if (c.kind == config::ToolKind::kBallEnd && s.z_mm < c.radius_mm) {
+      // On the sphere (REFERENCE.md section 4): z = R (1 - cos kappa), local radius R sin kappa.
+      s.kappa_rad = std::acos(1.0 - s.z_mm / c.radius_mm);
+      s.radius_mm = c.radius_mm * std::sin(s.kappa_rad);
+    }
+    // Lag of the edge behind the tip: z tan(helix) / R (REFERENCE.md sections 3 and 4).
+    s.lag_rad = s.z_mm * std::tan(c.helix_rad) / c.radius_mm;
+    out.push_back(s);
+  }
+  return out;
+}
+
+namespace {
+
+// Integral of exp(i q phi) over [a, b].
+Complex exp_integral(double q, double a, double b) {
+  if (std::abs(q) < 1e-12) return {b - a, 0.0};
+  const Complex i(0.0, 1.0);
+  return (std::exp(i * (q * b)) - std::exp(i * (q * a))) / (i * q);
+}
+
+// A force component A sin^2 + B sin cos + C sin + D cos as coefficients of exp(i m phi), m = -2..2.
+std::array<Complex, 5> exponential_form(double A, double B, double C, double D) {
+  const Complex i(0.0, 1.0);
+  std::array<Complex, 5> c{};  // index m + 2
+  c[2] += 0.5 * A;
+  c[4] += -0.25 * A;
+  c[0] += -0.25 * A;
+  c[4] += B / (4.0 * i);
+  c[0] += -B / (4.0 * i);
+  c[3] += C / (2.0 * i);
+  c[1] += -C / (2.0 * i);
+  c[3] += 0.5 * D;
+  c[1] += 0.5 * D;
+  return c;
+}
+
+}  // namespace
+
+ForceSpectrum force_spectrum(const Cutter& c, const config::MaterialConfig& mat, const CutConditions& cut,
+                             int axial_slices, int harmonics) {
+  ForceSpectrum out;
+  out.fx.assign(static_cast<std::size_t>(harmonics) + 1, Complex(0.0));
+  out.fy.assign(static_cast<std::size_t>(harmonics) + 1, Complex(0.0));
+  const int n = c.teeth;
+  const Complex i(0.0, 1.0);
+  for (const Slice& s : slices(c, cut.axial_mm, axial_slices)) {
+    // The wall's edge is at R - radial from the axis on the engaged side; a slice of smaller radius (ball
+    // end) engages what lies beyond it.
+    const double local_radial = cut.radial_mm - (c.radius_mm - s.radius_mm);
+    if (local_radial <= 0.0) continue;
+    const Engagement e = engagement(s.radius_mm, local_radial, cut.mode);
+    const double sk = std::sin(s.kappa_rad);
+    const double db = s.height_mm, ft = cut.feed_per_tooth_mm;
+    // Ft = kt db ft sk sin + kte db, Fr(projected) = sk (kr db ft sk sin + kre db) (section 4 projection).
+    const double tc = mat.kt_n_per_mm2 * db * ft * sk, te = mat.kte_n_per_mm * db;
+    const double rc = sk * mat.kr_n_per_mm2 * db * ft * sk, re = sk * mat.kre_n_per_mm * db;
+    // Fx = -Ft cos - Fr sin = -tc sin cos - te cos - rc sin^2 - re sin
+    // Fy =  Ft sin - Fr cos =  tc sin^2 + te sin - rc sin cos - re cos
+    const auto ex = exponential_form(-rc, -tc, -re, -te);
+    const auto ey = exponential_form(tc, -rc, te, -re);
+    // The slice's edge reaches angle phi at t = (phi + lag) / Omega.
+    for (int k = 0; k <= harmonics; ++k) {
+      const double kn = static_cast<double>(k) * n;
+      const Complex shift = std::exp(-i * (kn * s.lag_rad));
+      Complex sx(0.0), sy(0.0);
+      for (int m = -2; m <= 2; ++m) {
+        const Complex integral = exp_integral(m - kn, e.start_rad, e.exit_rad);
+        sx += ex[static_cast<std::size_t>(m + 2)] * integral;
+        sy += ey[static_cast<std::size_t>(m + 2)] * integral;
+      }
+      const double scale = n / (2.0 * M_PI);
+      out.fx[static_cast<std::size_t>(k)] += scale * sx * shift;
+      out.fy[static_cast<std::size_t>(k)] += scale * sy * shift;
+    }
+  }
+  return out;
+}
+
+}  // namespace robodamp::milling

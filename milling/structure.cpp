@@ -1,0 +1,89 @@
+#include "milling/structure.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace robodamp::milling {
+
+namespace {
+
+void add_resonances(std::vector<Resonance>& out, const config::FrfConfig& frf) {
+  for (const auto& m : frf.modes) out.push_back({m.natural_freq_hz, m.damping_ratio});
+}
+
+}  // namespace
+
+Structure::Structure(std::array<std::vector<config::ModeConfig>, 4> modes, std::string name) : name_(std::move(name)) {
+  for (std::size_t k = 0; k < 4; ++k) {
+    modal_[k].modes = std::move(modes[k]);
+    add_resonances(resonances_, modal_[k]);
+  }
+}
+
+Structure::Structure(const config::StructureConfig& cfg, bool damped) : name_(cfg.name), damped_(damped) {
+  for (const auto& part : cfg.parts) {
+    for (std::size_t k = 0; k < 4; ++k)
+      modal_[k].modes.insert(modal_[k].modes.end(), part.modes[k].begin(), part.modes[k].end());
+    if (!part.controller) continue;
+    const auto& pc = *part.controller;
+    auto model = std::make_shared<const analysis::LoopModel>(config::load_config_file(pc.config_path));
+    ControllerPart c;
+    c.model = model;
+    c.location = model->plant().index_of(pc.location);
+    c.direction = pc.direction == config::Axis::kX ? 0 : 1;
+    c.gain_ns_per_m = model->config().controller.gain_ns_per_m;
+    c.polarity = model->config().controller.polarity;
+    for (const auto& f : model->config().robot.frfs) add_resonances(resonances_, f);
+    resonances_.push_back({model->config().actuator.natural_freq_hz, model->config().actuator.damping_ratio});
+    std::ostringstream os;
+    os << part.name << ": location " << pc.location << " of " << pc.config_path;
+    if (damped) {
+      if (!model->stable(c.gain_ns_per_m, c.polarity))
+        throw config::ConfigError({config::Problem{pc.config_path, {}, "controller",
+                                                   "the damping loop is unstable at K = " +
+                                                       std::to_string(c.gain_ns_per_m) + " N s/m, polarity " +
+                                                       std::to_string(c.polarity) + ": no closed-loop FRF exists"}});
+      // Closed-loop poles below Nyquist: where the damped FRF has its resonances.
+      const double fs = model->loop_rate_hz();
+      for (const auto& z : model->closed_loop_poles(c.gain_ns_per_m, c.polarity)) {
+        if (std::abs(z) < 1e-12) continue;
+        const std::complex<double> s = std::log(z) * fs;
+        const double f = std::abs(s.imag()) / (2.0 * M_PI);
+        if (f > 0.5 && f < 0.5 * fs) resonances_.push_back({f, std::max(1e-4, -s.real() / std::abs(s))});
+      }
+      os << ", closed loop at K = " << c.gain_ns_per_m << " N s/m, polarity " << c.polarity
+         << " (sampled controller at " << fs << " Hz)";
+    } else {
+      os << ", open loop";
+    }
+    notes_.push_back(os.str());
+    controllers_.push_back(std::move(c));
+  }
+  for (const auto& f : modal_) add_resonances(resonances_, f);
+}
+
+bool Structure::has_controller() const { return !controllers_.empty(); }
+
+Eigen::Matrix2cd Structure::frf(double f_hz) const {
+  Eigen::Matrix2cd g;
+  for (std::size_t k = 0; k < 4; ++k)
+    g(static_cast<Eigen::Index>(k / 2), static_cast<Eigen::Index>(k % 2)) =
+        modal_[k].modes.empty() ? Complex(0.0) : config::frf_receptance(modal_[k], f_hz);
+  for (const auto& c : controllers_) {
+    const auto d = static_cast<Eigen::Index>(c.direction);
+    g(d, d) += damped_ ? c.model->closed_sampled(c.location, c.location, f_hz, c.gain_ns_per_m, c.polarity)
+                       : c.model->open_continuous(c.location, c.location, f_hz);
+  }
+  return g;
+}
+
+Eigen::Matrix2cd Structure::frf_cutter(double f_hz, config::Axis feed_axis) const {
+  const Eigen::Matrix2cd g = frf(f_hz);
+  if (feed_axis == config::Axis::kX) return g;
+  // Feed along +y: the cutter's x is the machine's y, its wall normal the machine's -x.
+  Eigen::Matrix2cd c;
+  c << g(1, 1), -g(1, 0), -g(0, 1), g(0, 0);
+  return c;
+}
+
+}  // namespace robodamp::milling

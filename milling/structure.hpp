@@ -1,0 +1,61 @@
+// The tool-workpiece relative FRF the cut sees: a 2x2 receptance matrix in the machine frame (x, y),
+// summed over the structure's parts (robot + workpiece), each a modal table with cross terms or a
+// location of a damping configuration, open loop or closed with its controller. Off the real-time path.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "analysis/loop_model.hpp"
+#include "config/milling_config.hpp"
+
+namespace robodamp::milling {
+
+using Complex = std::complex<double>;
+
+// A resonance the frequency grids refine around.
+struct Resonance {
+  double freq_hz{0.0};
+  double damping_ratio{0.0};
+};
+
+class Structure {
+ public:
+  // damped: close each controller part's loop at its configured gain and polarity. Throws
+  // config::ConfigError if a controller configuration is invalid or its loop is unstable.
+  Structure(const config::StructureConfig& cfg, bool damped);
+  // Sum of modal terms only (tests, benchmarks).
+  explicit Structure(std::array<std::vector<config::ModeConfig>, 4> modes, std::string name = "modal");
+
+  // Receptance matrix, m/N, machine frame [xx xy; yx yy].
+  [[nodiscard]] Eigen::Matrix2cd frf(double f_hz) const;
+  // In the cutter's frame (x = feed, y = wall normal) for a feed along feed_axis.
+  [[nodiscard]] Eigen::Matrix2cd frf_cutter(double f_hz, config::Axis feed_axis) const;
+
+  [[nodiscard]] const std::vector<Resonance>& resonances() const { return resonances_; }
+  [[nodiscard]] const std::string& name() const { return name_; }
+  [[nodiscard]] bool damped() const { return damped_; }
+  [[nodiscard]] bool has_controller() const;
+  // What the controller parts were closed with, for reports.
+  [[nodiscard]] const std::vector<std::string>& notes() const { return notes_; }
+
+ private:
+  struct ControllerPart {
+    std::shared_ptr<const analysis::LoopModel> model;
+    std::size_t location{0};
+    std::size_t direction{1};  // 0 = x, 1 = y
+    double gain_ns_per_m{0.0};
+    int polarity{1};
+  };
+  std::string name_;
+  bool damped_{false};
+  std::array<config::FrfConfig, 4> modal_;  // xx, xy, yx, yy, all parts' modes together
+  std::vector<ControllerPart> controllers_;
+  std::vector<Resonance> resonances_;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace robodamp::milling
