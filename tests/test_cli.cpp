@@ -243,4 +243,78 @@ TEST(Cli, CtrlCEndsARunThroughTheSafeStateWithASummary) {
   EXPECT_LT(j["elapsed_s"].get<double>(), 10.0);
 }
 
+std::string milling_job(const std::string& name) {
+  return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + name + ".yaml";
+}
+
+void expect_lobe_shape(const nlohmann::json& j, std::size_t points) {
+  ASSERT_EQ(j["curve"].size(), points);
+  for (const char* k : {"rpm", "b_lim_mm", "chatter_hz"}) EXPECT_TRUE(j["curve"][0].contains(k)) << k;
+  EXPECT_GT(j["min_b_lim_mm"].get<double>(), 0.0);
+  EXPECT_GT(j["min_rpm"].get<double>(), 0.0);
+  for (const auto& a : j["at_rpm"]) {
+    EXPECT_GT(a["b_lim_mm"].get<double>(), 0.0);
+    EXPECT_NEAR(a["b_lim_mm"].get<double>() / a["b_lim_lobes_mm"].get<double>(), 1.0, 0.01);
+  }
+}
+
+TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
+  const std::string png = temp_path("lobes.png");
+  const Result r = run("lobes --config " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot " + png);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
+  expect_lobe_shape(j, 2000);
+  expect_lobe_shape(j["damped"], 2000);
+  ASSERT_EQ(j["at_rpm"].size(), 2u);  // --rpm 400 and the configured spindle speed
+  EXPECT_EQ(j["at_rpm"][1]["rpm"], 700.0);
+  EXPECT_GT(j["gain"]["min_b_lim_change_pct"].get<double>(), 100.0);
+  EXPECT_TRUE(j["gain"].contains("at_spindle_change_pct"));
+  EXPECT_GT(std::filesystem::file_size(png), 10000u);
+  std::filesystem::remove(png);
+}
+
+TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
+  const Result r = run("lobes --config " + milling_job("industrial_robot_aluminium") + " --json --rpm 3000");
+  ASSERT_EQ(r.status, 0) << r.out;
+  expect_lobe_shape(nlohmann::json::parse(r.out), 2000);
+  for (int p = 1; p <= 5; ++p) {
+    const Result b = run("lobes --config " + milling_job("orthopaedic_bone") + " --structure position_" + std::to_string(p));
+    EXPECT_EQ(b.status, 0) << b.out;
+    EXPECT_NE(b.out.find("minimum limiting depth"), std::string::npos) << b.out;
+  }
+  const Result bad = run("lobes --config " + milling_job("orthopaedic_bone") + " --structure position_9");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.out.find("'position_9' is not one of: position_1"), std::string::npos) << bad.out;
+  const Result undamped = run("lobes --config " + milling_job("orthopaedic_bone") + " --damped");
+  EXPECT_EQ(undamped.status, 2);
+  EXPECT_NE(undamped.out.find("--damped needs a part with a controller"), std::string::npos) << undamped.out;
+}
+
+TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
+  const std::string png = temp_path("sle.png");
+  const Result r = run("sle --config " + milling_job("industrial_robot_aluminium") + " --json --plot " + png);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
+  EXPECT_EQ(j["map"].size(), 300u);
+  EXPECT_TRUE(j["map"][0].contains("rpm"));
+  EXPECT_TRUE(j["map"][0].contains("sle_um"));
+  ASSERT_EQ(j["conditions"].size(), 16u);  // 8 conditions x surface normals y and x
+  for (const auto& c : j["conditions"]) {
+    for (const char* k : {"name", "rpm", "axial_mm", "radial_mm", "ft_mm", "surface_normal", "sle_um", "compensated_radial_mm"})
+      EXPECT_TRUE(c.contains(k)) << k;
+    EXPECT_GT(c["sle_um"].get<double>(), 10.0);
+    EXPECT_GT(c["compensated_radial_mm"].get<double>(), c["radial_mm"].get<double>());
+    EXPECT_TRUE(c["compensation_converged"].get<bool>());
+    EXPECT_TRUE(c["stable"].get<bool>());
+  }
+  EXPECT_EQ(j["conditions"][0]["surface_normal"], "y");
+  EXPECT_EQ(j["conditions"][1]["surface_normal"], "x");
+  EXPECT_GT(std::filesystem::file_size(png), 10000u);
+  std::filesystem::remove(png);
+  const Result d = run("sle --config " + milling_job("active_damping_c2") + " --json --damped");
+  ASSERT_EQ(d.status, 0) << d.out;
+  const auto jd = nlohmann::json::parse(d.out);
+  EXPECT_EQ(jd["damped"]["map"].size(), jd["map"].size());
+}
+
 }  // namespace
