@@ -25,9 +25,15 @@ double elapsed_ms(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-const config::StructureConfig& selected(const config::MillingConfig& cfg, const MillingOptions& o) {
+config::StructureConfig selected(const config::MillingConfig& cfg, const MillingOptions& o) {
   const std::string name = o.structure.empty() ? cfg.structure : o.structure;
-  if (const auto* s = cfg.find_structure(name)) return *s;
+  if (const auto* s = cfg.find_structure(name)) {
+    config::StructureConfig out = *s;
+    if (!o.controller_path.empty())
+      for (auto& part : out.parts)
+        if (part.controller) part.controller->config_path = o.controller_path;
+    return out;
+  }
   std::string known;
   for (const auto& s : cfg.structures) known += (known.empty() ? "" : ", ") + s.name;
   throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "= '" + name + "' is not one of: " + known}});
@@ -162,12 +168,26 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
   j["closed_loop"] = structure.damped();
   j["map"] = json::array();
   const milling::CutConditions cut{cfg.cut.mode, cfg.cut.radial_mm, cfg.cut.axial_mm, cfg.cut.feed_per_tooth_mm};
+  // SLE assumes a stable cut: the lobes at the map's speeds say where the configured depth chatters.
+  config::LobesConfig at_map = cfg.lobes;
+  at_map.rpm_min = s.rpm_min;
+  at_map.rpm_max = s.rpm_max;
+  at_map.points = s.points;
+  at_map.log_spacing = false;
+  const auto lobes =
+      milling::LobeModel(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), at_map).diagram();
+  int chatter = 0;
   for (int i = 0; i < s.points; ++i) {
-    const double rpm = s.rpm_min + (s.rpm_max - s.rpm_min) * i / (s.points - 1);
+    const double rpm = lobes.curve[static_cast<std::size_t>(i)].rpm;
     const auto r = milling::surface_location_error(structure, cutter, cfg.material, cut, cfg.cut.feed_axis, rpm,
                                                    s.axial_slices, s.harmonics);
-    j["map"].push_back({{"rpm", rpm}, {"sle_um", r.sle_um}, {"sle_min_um", r.min_um}, {"sle_max_um", r.max_um}});
+    const double b_lim = lobes.curve[static_cast<std::size_t>(i)].b_lim_m;
+    const bool stable = cfg.cut.axial_mm * 1e-3 < b_lim;
+    chatter += stable ? 0 : 1;
+    j["map"].push_back({{"rpm", rpm}, {"sle_um", r.sle_um}, {"sle_min_um", r.min_um}, {"sle_max_um", r.max_um},
+                        {"b_lim_mm", finite_or_null(b_lim * 1e3)}, {"stable", stable}});
   }
+  j["map_unstable_points"] = chatter;
   j["conditions"] = json::array();
   for (const auto& c : cfg.conditions) {
     for (const config::Axis normal : s.surface_normals) {
@@ -214,7 +234,10 @@ std::string sle_table(const json& r) {
     double lo = 1e300, hi = -1e300;
     for (const auto& p : d["map"]) lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
     os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-" << fmt(d["map"].back()["rpm"], "%.0f")
-       << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to " << fmt(json(hi), "%.1f") << " um\n";
+       << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to " << fmt(json(hi), "%.1f") << " um";
+    if (const int u = d["map_unstable_points"].get<int>(); u > 0)
+      os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds: SLE not meaningful there)";
+    os << '\n';
     if (d["conditions"].empty()) return;
     os << "    cond  rpm    axial  radial  ft     normal  SLE(um)  dyn(um)  offset  radial_cmd(mm)  iter  stable\n";
     for (const auto& c : d["conditions"]) {
@@ -237,6 +260,10 @@ std::string sle_table(const json& r) {
 std::string plot_sle(const json& r, const std::string& path) {
   std::ostringstream data;
   const bool damped = r.contains("damped");
+  double lo = 0.0, hi = 0.0;  // zero stays in view: the level matters, not only the ripple
+  for (const json* d : {&r, damped ? &r["damped"] : nullptr})
+    for (const auto& p : d ? (*d)["map"] : json::array())
+      lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
   for (std::size_t i = 0; i < r["map"].size(); ++i) {
     data << r["map"][i]["rpm"].get<double>() << ' ' << r["map"][i]["sle_um"].get<double>();
     if (damped) data << ' ' << r["damped"]["map"][i]["sle_um"].get<double>();
@@ -245,6 +272,7 @@ std::string plot_sle(const json& r, const std::string& path) {
   std::ostringstream s;
   s << "set title 'Surface location error (mean over the axial depth), " << r["tool"].get<std::string>()
     << "'\nset grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'SLE (um), + = undercut'\nset key top left\n"
+    << "set yrange [" << 1.1 * lo << ":" << 1.1 * hi << "]\n"
     << "plot DATA u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop'";
   if (damped) s << ", DATA u 1:3 w l lw 2 lc rgb '#2471a3' t 'active damping'";
   s << '\n';
@@ -266,7 +294,7 @@ int guarded(Fn fn) {
 int run_lobes(const MillingOptions& o) {
   return guarded([&] {
     const auto cfg = config::load_milling_config(o.config_path);
-    const auto& sc = selected(cfg, o);
+    const auto sc = selected(cfg, o);
     std::vector<double> rpms = o.rpm;
     rpms.push_back(cfg.cut.spindle_rpm);
     const milling::Structure open(sc, false);
@@ -292,7 +320,7 @@ int run_lobes(const MillingOptions& o) {
 int run_sle(const MillingOptions& o) {
   return guarded([&] {
     const auto cfg = config::load_milling_config(o.config_path);
-    const auto& sc = selected(cfg, o);
+    const auto sc = selected(cfg, o);
     const milling::Structure open(sc, false);
     if (o.damped && !open.has_controller())
       throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,

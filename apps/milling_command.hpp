@@ -14,6 +14,7 @@ struct MillingOptions {
   std::string plot_path;          // PNG
   bool damped{false};             // also with the controller's loop closed, overlaid
   std::vector<double> rpm;        // lobes: extra speeds for the direct test
+  std::string controller_path;    // replaces every controller part's damping configuration
 };
 
 // Exit status: 0 done, 1 plot failed, 2 configuration error.

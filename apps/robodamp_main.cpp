@@ -6,6 +6,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "analysis/loop_model.hpp"
 #include "apps/analyze_command.hpp"
@@ -14,6 +15,8 @@
 #include "apps/milling_command.hpp"
 #include "apps/run_command.hpp"
 #include "config/config.hpp"
+#include "config/milling_config.hpp"
+#include "milling/structure.hpp"
 #include "control/chain_design.hpp"
 #include "sim_plant/plant_model.hpp"
 
@@ -55,7 +58,30 @@ int run_filters(const std::string& path, double freq_hz, bool json, const std::s
   return 0;
 }
 
+// A milling job (config/milling/) has a top-level `tool`; its controller parts are loaded and checked too.
+bool is_milling_job(const std::string& path) {
+  try {
+    return YAML::LoadFile(path)["tool"].IsDefined();
+  } catch (const YAML::Exception&) {
+    return false;  // the configuration parser reports the syntax error
+  }
+}
+
+int run_check_milling(const std::string& path) {
+  try {
+    const auto job = robodamp::config::load_milling_config(path);
+    for (const auto& s : job.structures) (void)robodamp::milling::Structure(s, false);
+    std::cout << path << ": OK (milling job, " << job.structures.size() << " structure(s), " << job.conditions.size()
+              << " condition(s))\n";
+    return 0;
+  } catch (const ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
+}
+
 int run_check_config(const std::string& path) {
+  if (is_milling_job(path)) return run_check_milling(path);
   robodamp::control::ChainDesign d;
   try {
     const auto cfg = robodamp::config::load_config_file(path);
@@ -141,7 +167,7 @@ int main(int argc, char** argv) {
   filters->add_option("--plot", plot, "Write a Bode diagram of the blocks and the chain (PNG)");
 
   std::string check_path;
-  auto* check = app.add_subcommand("check-config", "Validate a configuration and report every problem at once");
+  auto* check = app.add_subcommand("check-config", "Validate a configuration (controller or milling job) and report every problem at once");
   check->add_option("file", check_path, "Configuration file (YAML)")->required();
 
   std::string plot_dir;
@@ -188,6 +214,8 @@ int main(int argc, char** argv) {
     sc->add_flag("--json", mill.json, "Print JSON instead of a table");
     sc->add_option("--plot", mill.plot_path, "Write a plot (PNG)");
     sc->add_flag("--damped", mill.damped, "Also with the damping controller's loop closed, overlaid");
+    sc->add_option("--controller", mill.controller_path,
+                   "Damping configuration to use instead of the job's (compare compensators)")->check(CLI::ExistingFile);
   }
   lobes->add_option("--rpm", mill.rpm, "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
 

@@ -21,3 +21,8 @@ echo
 echo "simulated plant + controller, default preset (x_real_time = simulated s per wall s, one core):"
 ./build/bench/bench_plant --benchmark_repetitions=5 --benchmark_report_aggregates_only=true --benchmark_min_time=0.5 \
   --benchmark_counters_tabular=true
+echo
+echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (seed 004), the direct test's"
+echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
+taskset -c 0 ./build/bench/bench_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_counters_tabular=true

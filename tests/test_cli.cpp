@@ -88,6 +88,11 @@ TEST(Cli, CheckConfigAcceptsEveryPreset) {
     EXPECT_EQ(r.status, 0) << r.out;
     EXPECT_NE(r.out.find(": OK"), std::string::npos) << r.out;
   }
+  for (const char* p : {"industrial_robot_aluminium", "orthopaedic_bone", "active_damping_c2"}) {
+    const Result r = run("check-config " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + p + ".yaml");
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find(": OK (milling job"), std::string::npos) << r.out;
+  }
 }
 
 TEST(Cli, CheckConfigReportsAllProblemsAtOnce) {
@@ -271,6 +276,14 @@ TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
   EXPECT_TRUE(j["gain"].contains("at_spindle_change_pct"));
   EXPECT_GT(std::filesystem::file_size(png), 10000u);
   std::filesystem::remove(png);
+  // Another compensator through --controller: C1 also raises the 23.5 Hz lobe where C2 lowers it.
+  const Result c1 = run("lobes --config " + milling_job("active_damping_c2") + " --json --damped --controller " +
+                        robodamp::test::preset("horizontal_c1"));
+  ASSERT_EQ(c1.status, 0) << c1.out;
+  const auto j1 = nlohmann::json::parse(c1.out);
+  EXPECT_LT(j["gain"]["at_spindle_change_pct"].get<double>(), 0.0);
+  EXPECT_GT(j1["gain"]["at_spindle_change_pct"].get<double>(), 0.0);
+  EXPECT_NE(j1["damped"]["notes"][0].get<std::string>().find("horizontal_c1.yaml"), std::string::npos);
 }
 
 TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
@@ -298,6 +311,7 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   EXPECT_EQ(j["map"].size(), 300u);
   EXPECT_TRUE(j["map"][0].contains("rpm"));
   EXPECT_TRUE(j["map"][0].contains("sle_um"));
+  EXPECT_EQ(j["map_unstable_points"], 0) << "1.5 mm is below the 4.7 mm limit above 2000 rpm";
   ASSERT_EQ(j["conditions"].size(), 16u);  // 8 conditions x surface normals y and x
   for (const auto& c : j["conditions"]) {
     for (const char* k : {"name", "rpm", "axial_mm", "radial_mm", "ft_mm", "surface_normal", "sle_um", "compensated_radial_mm"})
@@ -315,6 +329,9 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   ASSERT_EQ(d.status, 0) << d.out;
   const auto jd = nlohmann::json::parse(d.out);
   EXPECT_EQ(jd["damped"]["map"].size(), jd["map"].size());
+  // 0.5 mm chatters near the 9.2 Hz mode's lobes open loop (0.32 mm minimum), nowhere with damping.
+  EXPECT_GT(jd["map_unstable_points"].get<int>(), 0);
+  EXPECT_EQ(jd["damped"]["map_unstable_points"].get<int>(), 0);
 }
 
 }  // namespace
