@@ -202,7 +202,7 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
       cut_c.radial_mm = c.radial_mm;
       cut_c.feed_axis = feed;
       config::LobesConfig lc = cfg.lobes;
-      const milling::LobeModel lobes(structure, milling::chatter_process(cfg.tool, cfg.material, cut_c), lc);
+      const milling::LobeModel stability(structure, milling::chatter_process(cfg.tool, cfg.material, cut_c), lc);
       j["conditions"].push_back({{"name", c.name},
                                  {"rpm", c.rpm},
                                  {"axial_mm", c.axial_mm},
@@ -219,7 +219,7 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
                                  {"compensation_residual_um", comp.residual_um},
                                  {"compensation_iterations", comp.iterations},
                                  {"compensation_converged", comp.converged},
-                                 {"stable", lobes.stable(c.axial_mm * 1e-3, c.rpm)}});
+                                 {"stable", stability.stable(c.axial_mm * 1e-3, c.rpm)}});
     }
   }
   j["notes"] = structure.notes();

@@ -452,20 +452,10 @@ void check_location_refs(Diagnostics& d, const Config& c) {
 
 Config parse_config(const std::string& yaml_text, const std::string& source_name) {
   Diagnostics d(source_name);
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    d.add(e.mark, "(yaml)", "syntax error: " + e.msg);
-    throw ConfigError(d.problems());
-  }
+  const YAML::Node root = detail::load_top_map(d, yaml_text, "loop, actuator, amplifier, controller, robot");
   Config c;
   c.source = source_name;
   c.yaml_text = yaml_text;
-  if (!root.IsMap()) {
-    d.add(root.Mark(), "(top level)", "expected a map with loop, actuator, amplifier, controller, robot");
-    throw ConfigError(d.problems());
-  }
   MapReader top(d, root, "", root.Mark());
   std::optional<double> rate;
   c.loop = read_loop(top, rate);
@@ -487,13 +477,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   return c;
 }
 
-Config load_config_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError({Problem{path, {}, "(file)", "cannot be opened for reading"}});
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_config(ss.str(), path);
-}
+Config load_config_file(const std::string& path) { return parse_config(detail::read_config_text(path), path); }
 
 const LocationConfig* find_location(const RobotConfig& robot, int id) {
   for (const auto& l : robot.locations)

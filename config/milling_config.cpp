@@ -155,14 +155,19 @@ StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std
   return s;
 }
 
+// rpm_min < rpm_max of a section.
+void read_speed_range(MapReader& r, double& rpm_min, double& rpm_max) {
+  if (auto v = r.number("rpm_min", kRpm, rpm_min)) rpm_min = *v;
+  if (auto v = r.number("rpm_max", kRpm, rpm_max)) rpm_max = *v;
+  if (rpm_max <= rpm_min)
+    r.diagnostics().add(r.mark(), r.path_of("rpm_max"), "= " + format_number(rpm_max) + " rpm must exceed " +
+                                                            r.path_of("rpm_min") + " = " + format_number(rpm_min) + " rpm");
+}
+
 LobesConfig read_lobes(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("lobes", false, ""), "lobes", top.mark());
   LobesConfig c;
-  if (auto v = r.number("rpm_min", kRpm, c.rpm_min)) c.rpm_min = *v;
-  if (auto v = r.number("rpm_max", kRpm, c.rpm_max)) c.rpm_max = *v;
-  if (c.rpm_max <= c.rpm_min)
-    r.diagnostics().add(r.mark(), "lobes.rpm_max", "= " + format_number(c.rpm_max) + " rpm must exceed lobes.rpm_min = " +
-                                                        format_number(c.rpm_min) + " rpm");
+  read_speed_range(r, c.rpm_min, c.rpm_max);
   if (auto v = read_int(r, "points", {"(speeds)", 10, 1000000}, c.points)) c.points = *v;
   if (auto v = r.choice("spacing", {"linear", "log"}, "linear")) c.log_spacing = *v == "log";
   if (present(r.child("freq_max_hz", false, ""))) c.freq_max_hz = r.number("freq_max_hz", kModeFrequency);
@@ -174,11 +179,7 @@ LobesConfig read_lobes(MapReader& top) {
 SleConfig read_sle(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("sle", false, ""), "sle", top.mark());
   SleConfig c;
-  if (auto v = r.number("rpm_min", kRpm, c.rpm_min)) c.rpm_min = *v;
-  if (auto v = r.number("rpm_max", kRpm, c.rpm_max)) c.rpm_max = *v;
-  if (c.rpm_max <= c.rpm_min)
-    r.diagnostics().add(r.mark(), "sle.rpm_max", "= " + format_number(c.rpm_max) + " rpm must exceed sle.rpm_min = " +
-                                                      format_number(c.rpm_min) + " rpm");
+  read_speed_range(r, c.rpm_min, c.rpm_max);
   if (auto v = read_int(r, "points", {"(speeds)", 2, 1000000}, c.points)) c.points = *v;
   if (auto v = read_int(r, "axial_slices", {"(slices)", 1, 10000}, c.axial_slices)) c.axial_slices = *v;
   if (auto v = read_int(r, "harmonics", {"(of the tooth frequency)", 1, 10000}, c.harmonics)) c.harmonics = *v;
@@ -231,17 +232,7 @@ std::vector<ConditionConfig> read_conditions(MapReader& top, const ToolConfig& t
 MillingConfig parse_milling_config(const std::string& yaml_text, const std::string& source_name,
                                    const std::string& base_dir) {
   Diagnostics d(source_name);
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    d.add(e.mark, "(yaml)", "syntax error: " + e.msg);
-    throw ConfigError(d.problems());
-  }
-  if (!root.IsMap()) {
-    d.add(root.Mark(), "(top level)", "expected a map with tool, material, cut, structures");
-    throw ConfigError(d.problems());
-  }
+  const YAML::Node root = detail::load_top_map(d, yaml_text, "tool, material, cut, structures");
   MillingConfig c;
   c.source = source_name;
   MapReader top(d, root, "", root.Mark());
@@ -274,11 +265,7 @@ MillingConfig parse_milling_config(const std::string& yaml_text, const std::stri
 }
 
 MillingConfig load_milling_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError({Problem{path, {}, "(file)", "cannot be opened for reading"}});
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parse_milling_config(ss.str(), path, std::filesystem::path(path).parent_path().string());
+  return parse_milling_config(detail::read_config_text(path), path, std::filesystem::path(path).parent_path().string());
 }
 
 }  // namespace robodamp::config

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -171,6 +172,29 @@ void MapReader::finish() {
   }
 }
 
+
+std::string read_config_text(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError({Problem{path, {}, "(file)", "cannot be opened for reading"}});
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+YAML::Node load_top_map(Diagnostics& d, const std::string& yaml_text, const std::string& expected) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    d.add(e.mark, "(yaml)", "syntax error: " + e.msg);
+    throw ConfigError(d.problems());
+  }
+  if (!root.IsMap()) {
+    d.add(root.Mark(), "(top level)", "expected a map with " + expected);
+    throw ConfigError(d.problems());
+  }
+  return root;
+}
 
 bool present(const YAML::Node& n) { return n.IsDefined() && !n.IsNull(); }
 

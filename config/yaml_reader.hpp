@@ -71,6 +71,10 @@ class MapReader {
   bool quiet_{false};
 };
 
+// The whole file; ConfigError naming it if it cannot be read.
+[[nodiscard]] std::string read_config_text(const std::string& path);
+// The top-level map of a document; ConfigError (syntax error, or not a map: expected names the keys).
+[[nodiscard]] YAML::Node load_top_map(Diagnostics& d, const std::string& yaml_text, const std::string& expected);
 // True for a key that is given and not null.
 [[nodiscard]] bool present(const YAML::Node& n);
 // A whole number in range.

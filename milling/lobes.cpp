@@ -157,27 +157,22 @@ LobeDiagram LobeModel::diagram() const {
     const int hi = static_cast<int>(std::floor((w60 / n_min - eps) / kTwoPi)) + 1;
     return std::make_pair(lo, std::max(lo, hi));
   };
-  for (int br = 0; br < 2; ++br) {
-    for (std::size_t i = 0; i + 1 < grid_hz_.size(); ++i) {
-      const auto p1 = depth_and_phase(evals_[i].lambda[br]);
-      const auto p2 = depth_and_phase(evals_[i + 1].lambda[br]);
-      if (!p1 || !p2) continue;
-      const double f1 = grid_hz_[i], f2 = grid_hz_[i + 1];
-      const auto r1 = lobe_range(f1, p1->second), r2 = lobe_range(f2, p2->second);
-      for (int j = std::min(r1.first, r2.first); j <= std::max(r1.second, r2.second); ++j) {
-        const double n1 = speed_rpm(f1, p1->second, j), n2 = speed_rpm(f2, p2->second, j);
-        const double x1 = index_of(std::min(n1, n2)), x2 = index_of(std::max(n1, n2));
-        const auto k_lo = static_cast<long>(std::max(0.0, std::ceil(x1)));
-        const auto k_hi = static_cast<long>(std::min(static_cast<double>(settings_.points - 1), std::floor(x2)));
-        for (long k = k_lo; k <= k_hi; ++k) {
-          LobePoint& c = d.curve[static_cast<std::size_t>(k)];
-          const double t = n2 != n1 ? (c.rpm - n1) / (n2 - n1) : 0.0;
-          const double b = p1->first + t * (p2->first - p1->first);
-          if (b < c.b_lim_m) c = {c.rpm, b, f1 + t * (f2 - f1), j, br};
-        }
+  for_each_segment([&](int br, std::size_t i, std::pair<double, double> p1, std::pair<double, double> p2) {
+    const double f1 = grid_hz_[i], f2 = grid_hz_[i + 1];
+    const auto r1 = lobe_range(f1, p1.second), r2 = lobe_range(f2, p2.second);
+    for (int j = std::min(r1.first, r2.first); j <= std::max(r1.second, r2.second); ++j) {
+      const double n1 = speed_rpm(f1, p1.second, j), n2 = speed_rpm(f2, p2.second, j);
+      const double x1 = index_of(std::min(n1, n2)), x2 = index_of(std::max(n1, n2));
+      const auto k_lo = static_cast<long>(std::max(0.0, std::ceil(x1)));
+      const auto k_hi = static_cast<long>(std::min(static_cast<double>(settings_.points - 1), std::floor(x2)));
+      for (long k = k_lo; k <= k_hi; ++k) {
+        LobePoint& c = d.curve[static_cast<std::size_t>(k)];
+        const double t = n2 != n1 ? (c.rpm - n1) / (n2 - n1) : 0.0;
+        const double b = p1.first + t * (p2.first - p1.first);
+        if (b < c.b_lim_m) c = {c.rpm, b, f1 + t * (f2 - f1), j, br};
       }
     }
-  }
+  });
   d.minimum = {0.0, kInf, 0.0, -1, -1};
   for (const auto& c : d.curve)
     if (c.b_lim_m < d.minimum.b_lim_m) d.minimum = c;
@@ -186,45 +181,40 @@ LobeDiagram LobeModel::diagram() const {
 
 std::optional<LobePoint> LobeModel::limit_at(double rpm) const {
   std::optional<LobePoint> best;
-  for (int br = 0; br < 2; ++br) {
-    for (std::size_t i = 0; i + 1 < grid_hz_.size(); ++i) {
-      const auto p1 = depth_and_phase(evals_[i].lambda[br]);
-      const auto p2 = depth_and_phase(evals_[i + 1].lambda[br]);
-      if (!p1 || !p2) continue;
-      const double f1 = grid_hz_[i], f2 = grid_hz_[i + 1];
-      const int j_max = static_cast<int>(60.0 * kTwoPi * std::max(f1, f2) / (process_.teeth * rpm) / kTwoPi) + 1;
-      for (int j = 0; j <= j_max; ++j) {
-        double fa = f1, fb = f2;
-        double ga = speed_rpm(f1, p1->second, j) - rpm, gb = speed_rpm(f2, p2->second, j) - rpm;
-        if (ga * gb > 0.0) continue;
-        // Bisection on the chatter frequency, the branch followed from the segment's end points.
-        const Complex la = evals_[i].lambda[br], lb = evals_[i + 1].lambda[br];
-        std::pair<double, double> pm = ga == 0.0 ? *p1 : *p2;
-        double fm = ga == 0.0 ? f1 : f2;
-        bool ok = true;
-        for (int it = 0; it < 60 && ga != 0.0 && gb != 0.0; ++it) {
-          fm = 0.5 * (fa + fb);
-          const double t = (fm - f1) / (f2 - f1);
-          const Complex guess_eig = -1.0 / (la + t * (lb - la));
-          const auto e = eigenvalues(oriented(fm));
-          const Complex eig = std::abs(e[0] - guess_eig) <= std::abs(e[1] - guess_eig) ? e[0] : e[1];
-          const auto p = depth_and_phase(-1.0 / eig);
-          if (!p) {
-            ok = false;
-            break;
-          }
-          pm = *p;
-          const double gm = speed_rpm(fm, p->second, j) - rpm;
-          if (gm * ga <= 0.0)
-            fb = fm, gb = gm;
-          else
-            fa = fm, ga = gm;
-          if (fb - fa < 1e-12 * fb) break;
+  for_each_segment([&](int br, std::size_t i, std::pair<double, double> p1, std::pair<double, double> p2) {
+    const double f1 = grid_hz_[i], f2 = grid_hz_[i + 1];
+    const int j_max = static_cast<int>(60.0 * std::max(f1, f2) / (process_.teeth * rpm)) + 1;
+    for (int j = 0; j <= j_max; ++j) {
+      double fa = f1, fb = f2;
+      double ga = speed_rpm(f1, p1.second, j) - rpm, gb = speed_rpm(f2, p2.second, j) - rpm;
+      if (ga * gb > 0.0) continue;
+      // Bisection on the chatter frequency, the branch followed from the segment's end points.
+      const Complex la = evals_[i].lambda[br], lb = evals_[i + 1].lambda[br];
+      std::pair<double, double> pm = ga == 0.0 ? p1 : p2;
+      double fm = ga == 0.0 ? f1 : f2;
+      bool ok = true;
+      for (int it = 0; it < 60 && ga != 0.0 && gb != 0.0; ++it) {
+        fm = 0.5 * (fa + fb);
+        const double t = (fm - f1) / (f2 - f1);
+        const Complex guess_eig = -1.0 / (la + t * (lb - la));
+        const auto e = eigenvalues(oriented(fm));
+        const Complex eig = std::abs(e[0] - guess_eig) <= std::abs(e[1] - guess_eig) ? e[0] : e[1];
+        const auto p = depth_and_phase(-1.0 / eig);
+        if (!p) {
+          ok = false;
+          break;
         }
-        if (ok && (!best || pm.first < best->b_lim_m)) best = LobePoint{rpm, pm.first, fm, j, br};
+        pm = *p;
+        const double gm = speed_rpm(fm, p->second, j) - rpm;
+        if (gm * ga <= 0.0)
+          fb = fm, gb = gm;
+        else
+          fa = fm, ga = gm;
+        if (fb - fa < 1e-12 * fb) break;
       }
+      if (ok && (!best || pm.first < best->b_lim_m)) best = LobePoint{rpm, pm.first, fm, j, br};
     }
-  }
+  });
   return best;
 }
 

@@ -79,6 +79,17 @@ class LobeModel {
   // b_lim, eps for a Lambda; nullopt unless b_lim > 0.
   [[nodiscard]] std::optional<std::pair<double, double>> depth_and_phase(Complex lambda) const;
   [[nodiscard]] double speed_rpm(double f_hz, double eps, int lobe) const;
+  // Calls fn(branch, i, (b, eps) at i, (b, eps) at i + 1) for each grid segment where the branch can chatter
+  // at both ends.
+  template <typename Fn>
+  void for_each_segment(Fn fn) const {
+    for (int br = 0; br < 2; ++br)
+      for (std::size_t i = 0; i + 1 < grid_hz_.size(); ++i) {
+        const auto p1 = depth_and_phase(evals_[i].lambda[br]);
+        const auto p2 = depth_and_phase(evals_[i + 1].lambda[br]);
+        if (p1 && p2) fn(br, i, *p1, *p2);
+      }
+  }
 
   const Structure& structure_;
   ChatterProcess process_;

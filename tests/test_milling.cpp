@@ -75,7 +75,11 @@ INSTANTIATE_TEST_SUITE_P(Milling, ClosedFormMinimum,
                          ::testing::Values(SingleModeCase{"slotting", cfg::MillingMode::kDown, 1.0},
                                            SingleModeCase{"half-immersion down milling", cfg::MillingMode::kDown, 0.5},
                                            SingleModeCase{"25% up milling", cfg::MillingMode::kUp, 0.25}),
-                         [](const auto& info) { return std::string(info.index == 0 ? "Slotting" : info.index == 1 ? "HalfDown" : "QuarterUp"); });
+                         [](const auto& param_info) {
+                           return std::string(param_info.index == 0   ? "Slotting"
+                                              : param_info.index == 1 ? "HalfDown"
+                                                                      : "QuarterUp");
+                         });
 
 TEST(Milling, DirectionalFactorsMatchHandValues) {
   const double kr = 0.3;
@@ -135,7 +139,9 @@ TEST(Milling, DirectTestAgreesWithLobesWithinOnePercent) {
     EXPECT_TRUE(model.stable(0.99 * zoa->b_lim_m, rpm)) << rpm;
     EXPECT_FALSE(model.stable(1.01 * zoa->b_lim_m, rpm)) << rpm;
     // The diagram's interpolated curve is close to the refined value at the same speed.
-    if (rpm == diagram.minimum.rpm) EXPECT_NEAR(diagram.minimum.b_lim_m / zoa->b_lim_m, 1.0, 0.01);
+    if (rpm == diagram.minimum.rpm) {
+      EXPECT_NEAR(diagram.minimum.b_lim_m / zoa->b_lim_m, 1.0, 0.01);
+    }
   }
   const auto bone = cfg::load_milling_config(milling_preset("orthopaedic_bone"));
   const mill::Structure sb(*bone.find_structure("position_4"), false);
