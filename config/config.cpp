@@ -1,6 +1,7 @@
 #include "config/config.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <complex>
 #include <fstream>
 #include <set>
@@ -433,6 +434,114 @@ TelemetryConfig read_telemetry(MapReader& top) {
   return c;
 }
 
+// A CAN identifier: decimal or 0x hex, 11 bits (or 29 with extended_id).
+std::optional<std::uint32_t> read_can_id(MapReader& r, bool extended) {
+  const YAML::Node n = r.child("id", true, "the frame's CAN identifier, e.g. 0x101");
+  if (!present(n)) return std::nullopt;
+  const std::uint32_t max = extended ? 0x1FFFFFFFu : 0x7FFu;
+  try {
+    std::size_t used = 0;
+    const unsigned long v = std::stoul(n.Scalar(), &used, 0);
+    if (used == n.Scalar().size() && v <= max) return static_cast<std::uint32_t>(v);
+  } catch (const std::exception&) {
+  }
+  char lim[16];
+  std::snprintf(lim, sizeof lim, "0x%X", max);
+  r.diagnostics().add(n.Mark(), r.path_of("id"), "= '" + n.Scalar() + "' is not allowed: an identifier 0 <= id <= " +
+                                                     lim + (extended ? " (29-bit, extended_id)" : " (11-bit)"));
+  return std::nullopt;
+}
+
+std::optional<CanSignal> read_can_signal(MapReader& parent, const std::string& key, const std::string& unit,
+                                         int frame_bytes) {
+  MapReader r(parent.diagnostics(), parent.child(key, true, "map with start_byte, size_bytes, scale, offset"),
+              parent.path_of(key), parent.mark());
+  CanSignal s;
+  if (auto v = read_int(r, "start_byte", {"(byte)", 0, 63})) s.start_byte = *v;
+  if (auto v = read_int(r, "size_bytes", {"(bytes)", 1, 4}, 2)) s.size_bytes = *v;
+  if (auto v = read_bool(r, "signed", true)) s.is_signed = *v;
+  if (auto v = r.choice("byte_order", {"little", "big"}, "little")) s.byte_order = *v == "little" ? ByteOrder::kLittle : ByteOrder::kBig;
+  if (auto v = r.number("scale_" + unit + "_per_count", {unit, -1e6, 1e6}, std::nullopt)) s.scale = *v;
+  if (s.scale == 0.0) r.diagnostics().add(r.mark(), r.path_of("scale_" + unit + "_per_count"), "= 0 would lose the signal");
+  if (auto v = r.number("offset_" + unit, {unit, -1e6, 1e6}, 0.0)) s.offset = *v;
+  r.finish();
+  if (s.start_byte + s.size_bytes > frame_bytes)
+    parent.diagnostics().add(r.mark(), parent.path_of(key), "bytes " + std::to_string(s.start_byte) + ".." +
+                                                                std::to_string(s.start_byte + s.size_bytes - 1) +
+                                                                " do not fit in length_bytes = " + std::to_string(frame_bytes));
+  return s;
+}
+
+CanFrameMapping read_can_frame(MapReader& top, const std::string& key, const std::string& unit, bool fd) {
+  MapReader r(top.diagnostics(), top.child(key, true, "map with id, length_bytes, value"), top.path_of(key), top.mark());
+  CanFrameMapping f;
+  if (auto v = read_bool(r, "extended_id", false)) f.extended_id = *v;
+  if (auto v = read_can_id(r, f.extended_id)) f.id = *v;
+  if (auto v = read_int(r, "length_bytes", {"(bytes)", 1.0, fd ? 64.0 : 8.0, false, false, fd ? "CAN FD" : "classic CAN"}, 8)) {
+    const bool fd_len = *v <= 8 || *v == 12 || *v == 16 || *v == 20 || *v == 24 || *v == 32 || *v == 48 || *v == 64;
+    if (!fd_len)
+      r.diagnostics().add(r.mark(), r.path_of("length_bytes"),
+                          "= " + std::to_string(*v) + " is not a CAN FD length: 0-8, 12, 16, 20, 24, 32, 48 or 64");
+    else
+      f.length_bytes = *v;
+  }
+  if (auto s = read_can_signal(r, "value", unit, f.length_bytes)) f.value = *s;
+  const YAML::Node cn = r.child("counter", false, "");
+  if (present(cn)) {
+    MapReader cr(r.diagnostics(), cn, r.path_of("counter"), r.mark());
+    CanCounter c;
+    if (auto v = read_int(cr, "start_byte", {"(byte)", 0, 63})) c.start_byte = *v;
+    if (auto v = read_int(cr, "size_bytes", {"(bytes)", 1, 4}, 1)) c.size_bytes = *v;
+    cr.finish();
+    if (c.start_byte + c.size_bytes > f.length_bytes)
+      r.diagnostics().add(cn.Mark(), r.path_of("counter"), "does not fit in length_bytes = " + std::to_string(f.length_bytes));
+    const bool overlap = c.start_byte < f.value.start_byte + f.value.size_bytes && f.value.start_byte < c.start_byte + c.size_bytes;
+    if (overlap) r.diagnostics().add(cn.Mark(), r.path_of("counter"), "overlaps the value's bytes");
+    f.counter = c;
+  }
+  r.finish();
+  return f;
+}
+
+std::optional<CanConfig> read_can(MapReader& top, std::optional<double> rate) {
+  const YAML::Node node = top.child("can", false, "");
+  if (!present(node)) return std::nullopt;
+  MapReader r(top.diagnostics(), node, "can", top.mark());
+  CanConfig c;
+  c.interface = r.text("interface", c.interface).value_or(c.interface);
+  if (auto v = read_bool(r, "fd", false)) c.fd = *v;
+  if (auto v = r.number("bitrate_bps", {"bit/s", 10e3, 1e6}, c.bitrate_bps)) c.bitrate_bps = *v;
+  if (c.fd) {
+    if (auto v = r.number("data_bitrate_bps", {"bit/s", 0.0, 12e6, false, false, "CAN FD data phase; 0 = no bit-rate switch"}, 0.0))
+      c.data_bitrate_bps = *v;
+  }
+  c.sensor = read_can_frame(r, "sensor", "mps2", c.fd);
+  c.command = read_can_frame(r, "command", "v", c.fd);
+  if (c.sensor.id == c.command.id && c.sensor.extended_id == c.command.extended_id)
+    r.diagnostics().add(r.mark(), "can.command.id", "is the sensor frame's identifier too: they must differ");
+  if (auto v = r.number("bus_load_max", {"(fraction of bus time)", 0.0, 1.0, true, false}, c.bus_load_max)) c.bus_load_max = *v;
+  if (auto v = read_int(r, "lost_frames_fault", {"(frames per second)", 1, 100000}, c.lost_frames_fault)) c.lost_frames_fault = *v;
+  if (auto v = r.number("backoff_initial_s", {"s", 0.0, 10.0, true, false}, c.backoff_initial_s)) c.backoff_initial_s = *v;
+  if (auto v = r.number("backoff_max_s", {"s", 0.0, 600.0, true, false}, c.backoff_max_s)) c.backoff_max_s = *v;
+  r.finish();
+  if (rate) {
+    const double load = can_bus_load(c, *rate);
+    if (load > c.bus_load_max) {
+      char msg[400];
+      std::snprintf(msg, sizeof msg,
+                    "the bus cannot carry this loop: %.0f Hz x (%.1f us sensor + %.1f us command frame, worst-case "
+                    "stuffing) = %.0f %% of the bus at %.0f kbit/s%s, above can.bus_load_max = %.0f %%; the highest loop "
+                    "rate is %.0f Hz",
+                    *rate, 1e6 * can_frame_time_s(c.sensor, c.fd, c.bitrate_bps, c.data_bitrate_bps),
+                    1e6 * can_frame_time_s(c.command, c.fd, c.bitrate_bps, c.data_bitrate_bps), 100.0 * load,
+                    c.bitrate_bps / 1e3, c.fd && c.data_bitrate_bps > 0 ? (" / " + std::to_string(static_cast<int>(c.data_bitrate_bps / 1e3)) + " kbit/s data").c_str() : "",
+                    100.0 * c.bus_load_max, std::floor(*rate * c.bus_load_max / load));
+      r.diagnostics().add(r.mark(), "loop.rate_hz", msg);
+    }
+  }
+  return c;
+}
+
 // Locations named outside the robot section must exist in it.
 void check_location_refs(Diagnostics& d, const Config& c) {
   if (c.robot.frfs.empty()) return;
@@ -471,6 +580,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.realtime = read_realtime(top);
   c.supervision = read_supervision(top);
   c.telemetry = read_telemetry(top);
+  c.can = read_can(top, rate);
   top.finish();
   check_location_refs(d, c);
   if (!d.problems().empty()) throw ConfigError(d.problems());

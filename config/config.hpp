@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "config/can_config.hpp"
+
 namespace robodamp::config {
 
 struct SourceMark {
@@ -222,6 +224,7 @@ struct Config {
   DisturbanceConfig disturbances;
   AnalysisConfig analysis;
   BenchConfig bench;
+  std::optional<CanConfig> can;  // hardware: the CAN link (drivers/can_*); absent for the simulated plant
 };
 
 // Throw ConfigError holding every problem found.

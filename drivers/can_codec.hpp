@@ -1,0 +1,39 @@
+// Frame codec of the CAN link: signals packed into and unpacked from a payload by the configured layout
+// (config/can_config.hpp). Pure functions on fixed-size buffers: no allocation, no exceptions, safe on
+// the real-time path and against any payload (tests/test_can.cpp fuzzes it).
+#pragma once
+
+#include <cstdint>
+#include <linux/can.h>
+
+#include "config/can_config.hpp"
+
+namespace robodamp::drivers {
+
+// The payload length a frame mapping sends (DLC rounded up for CAN FD lengths above 8).
+[[nodiscard]] int can_payload_length(const config::CanFrameMapping& m) noexcept;
+
+// Raw integer of a field (sign-extended when signed); the caller guarantees the field lies within len.
+[[nodiscard]] std::int64_t unpack_field(const std::uint8_t* data, int start, int size, bool is_signed,
+                                        config::ByteOrder order) noexcept;
+void pack_field(std::uint8_t* data, int start, int size, config::ByteOrder order, std::uint64_t raw) noexcept;
+
+enum class DecodeError : std::uint8_t { kNone, kWrongId, kErrorFrame, kRemoteFrame, kShort, kNotFd };
+
+struct Decoded {
+  DecodeError error{DecodeError::kNone};
+  double value{0.0};         // SI unit
+  std::uint32_t counter{0};  // raw counter when the mapping has one
+};
+
+// frame_bytes: what the transport read (CAN_MTU or CANFD_MTU); the frame's own len is checked against it.
+[[nodiscard]] Decoded decode(const config::CanFrameMapping& m, const canfd_frame& f, int frame_bytes) noexcept;
+
+struct Encoded {
+  canfd_frame frame{};
+  int frame_bytes{CAN_MTU};  // to write
+  bool clipped{false};       // the value was outside the field's range and was clamped
+};
+[[nodiscard]] Encoded encode(const config::CanFrameMapping& m, bool fd, double value, std::uint32_t counter) noexcept;
+
+}  // namespace robodamp::drivers

@@ -1,0 +1,140 @@
+#include "drivers/can_driver.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <linux/can/error.h>
+
+namespace robodamp::drivers {
+
+namespace {
+constexpr int kMaxFramesPerTick = 64;   // bounded work per tick however much is queued
+constexpr int kTxFailuresToFault = 3;   // consecutive full queues before the actuator is reported faulty
+}  // namespace
+
+CanDriver::CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz)
+    : cfg_(cfg), channel_(std::move(channel)), rate_hz_(loop_rate_hz) {
+  if (cfg_.sensor.counter) {
+    const int bits = 8 * cfg_.sensor.counter->size_bytes;
+    counter_mask_ = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
+  }
+  window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz)));
+  backoff_initial_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(cfg_.backoff_initial_s * loop_rate_hz)));
+  backoff_max_ticks_ = std::max(backoff_initial_ticks_, static_cast<std::uint64_t>(std::llround(cfg_.backoff_max_s * loop_rate_hz)));
+}
+
+void CanDriver::enter_backoff(std::uint64_t tick) noexcept {
+  backoff_ticks_ = backoff_ticks_ == 0 ? backoff_initial_ticks_ : std::min(2 * backoff_ticks_, backoff_max_ticks_);
+  retry_tick_ = tick + backoff_ticks_;
+}
+
+rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
+  if (tick >= window_start_tick_ + window_ticks_) {
+    lost_in_previous_window_ = tick >= window_start_tick_ + 2 * window_ticks_ ? 0 : lost_in_window_;
+    lost_in_window_ = 0;
+    window_start_tick_ = tick - (tick % window_ticks_);
+  }
+  bool fresh = false;
+  rx_fault_ = false;
+  for (int i = 0; i < kMaxFramesPerTick; ++i) {
+    canfd_frame f{};
+    std::int64_t ts = 0;
+    const int n = channel_.receive(f, ts);
+    if (n == 0) break;
+    if (n == -ENOTCONN) {
+      link_lost_ = true;
+      break;
+    }
+    if (n < 0) {
+      bump(n_.rx_errors);
+      rx_fault_ = true;
+      break;
+    }
+    link_lost_ = false;
+    if (n != CAN_MTU && n != CANFD_MTU) {
+      bump(n_.rx_malformed);
+      continue;
+    }
+    if (f.can_id & CAN_ERR_FLAG) {
+      bump(n_.error_frames);
+      if (f.can_id & CAN_ERR_BUSOFF) {
+        if (!bus_off_) bump(n_.bus_off);
+        bus_off_ = true;
+        enter_backoff(tick);
+      }
+      if (f.can_id & CAN_ERR_RESTARTED) {
+        if (bus_off_) bump(n_.restarts);
+        bus_off_ = false;
+      }
+      continue;
+    }
+    const Decoded d = decode(cfg_.sensor, f, n);
+    if (d.error == DecodeError::kWrongId) {
+      bump(n_.rx_other);
+      continue;
+    }
+    if (d.error != DecodeError::kNone) {
+      bump(n_.rx_malformed);
+      continue;
+    }
+    if (cfg_.sensor.counter && have_counter_) {
+      const std::uint32_t step = (d.counter - last_counter_) & counter_mask_;
+      if (step == 0) {
+        bump(n_.stale_frames);
+        continue;
+      }
+      // A large step backwards is a restarted sender, not half a counter's range of lost frames.
+      if (step > 1 && step <= counter_mask_ / 2) {
+        bump(n_.lost_frames, step - 1);
+        lost_in_window_ += step - 1;
+      }
+    }
+    last_counter_ = d.counter;
+    have_counter_ = true;
+    last_value_ = d.value;
+    last_rx_ns_ = ts;
+    bump(n_.rx_frames);
+    fresh = true;
+  }
+  const bool too_many_lost =
+      lost_in_window_ + lost_in_previous_window_ >= static_cast<std::uint64_t>(cfg_.lost_frames_fault);
+  return {last_value_, fresh, !(bus_off_ || link_lost_ || rx_fault_ || too_many_lost)};
+}
+
+rt::ActuatorStatus CanDriver::write(double command_v, std::uint64_t tick) noexcept {
+  // Bus-off without a restart notice: once the back-off has passed, try again (the controller may have
+  // restarted without telling, e.g. restart-ms on an interface that does not report it).
+  if (bus_off_ && tick >= retry_tick_) bus_off_ = false;
+  if (tick < retry_tick_) {
+    bump(n_.tx_skipped);
+    return {false, false};
+  }
+  const Encoded e = encode(cfg_.command, cfg_.fd, command_v, tx_counter_);
+  if (e.clipped) bump(n_.tx_clipped);
+  const int rc = channel_.send(e.frame, e.frame_bytes);
+  if (rc == 0) {
+    ++tx_counter_;
+    bump(n_.tx_frames);
+    consecutive_tx_failures_ = 0;
+    backoff_ticks_ = 0;
+    return {true, e.clipped};
+  }
+  const bool queue_full = rc == -ENOBUFS || rc == -EAGAIN;
+  bump(queue_full ? n_.tx_queue_full : n_.tx_errors);
+  // A full queue may be a burst: tolerated twice. Anything else (the link has gone, the interface is
+  // down) is a fault at once.
+  if (++consecutive_tx_failures_ >= kTxFailuresToFault || !queue_full) {
+    enter_backoff(tick);
+    return {false, e.clipped};
+  }
+  return {true, e.clipped};  // one dropped command: the amplifier holds the last one
+}
+
+CanCounters CanDriver::counters() const noexcept {
+  auto l = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
+  return {l(n_.rx_frames),  l(n_.rx_other),   l(n_.rx_malformed),  l(n_.lost_frames), l(n_.stale_frames),
+          l(n_.error_frames), l(n_.bus_off),  l(n_.restarts),      l(n_.rx_errors),   l(n_.tx_frames),
+          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped)};
+}
+
+}  // namespace robodamp::drivers

@@ -1,0 +1,89 @@
+// The sensor and actuator over CAN (REFERENCE.md section 1's DAQ and amplifier, on a CAN bus): the loop's
+// SensorSource and ActuatorSink on one CanChannel. Everything here runs on the real-time thread: non-
+// blocking socket calls, no allocation, no exceptions, no logging. Problems are counted (counters() is
+// safe to read from any thread) and reported to the supervisor as driver faults:
+// - sensor: error frames; bus-off (until the controller restarts or the back-off has passed); a peer
+//   that has gone; lost frames (counter gaps) at or above can.lost_frames_fault within one second. A
+//   repeated counter is a stale frame: not fresh, so the supervisor's stale-sensor trip sees a stuck DAQ.
+// - actuator: bus-off, a transmit queue that stays full (ENOBUFS / EAGAIN, three times running) or any
+//   other send failure (the link has gone, the interface is down). Transmission then backs
+//   off (can.backoff_initial_s, doubling up to can.backoff_max_s) and is retried: never a dead driver.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "config/can_config.hpp"
+#include "drivers/can_channel.hpp"
+#include "drivers/can_codec.hpp"
+#include "rt/io.hpp"
+
+namespace robodamp::drivers {
+
+struct CanCounters {
+  std::uint64_t rx_frames{0};       // sensor frames decoded
+  std::uint64_t rx_other{0};        // frames with another identifier (fd transport: no kernel filter)
+  std::uint64_t rx_malformed{0};    // short, oversize, remote or non-FD frames for the sensor mapping
+  std::uint64_t lost_frames{0};     // counter gaps
+  std::uint64_t stale_frames{0};    // repeated counters
+  std::uint64_t error_frames{0};
+  std::uint64_t bus_off{0};         // bus-off events
+  std::uint64_t restarts{0};        // controller restarted after bus-off
+  std::uint64_t rx_errors{0};       // receive calls that failed (other than nothing waiting)
+  std::uint64_t tx_frames{0};
+  std::uint64_t tx_queue_full{0};   // ENOBUFS / EAGAIN
+  std::uint64_t tx_errors{0};       // other send failures
+  std::uint64_t tx_skipped{0};      // commands not sent while backing off
+  std::uint64_t tx_clipped{0};      // commands outside the command field's range
+};
+
+class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
+ public:
+  CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz);
+
+  [[nodiscard]] rt::SensorSample read(std::uint64_t tick) noexcept override;
+  [[nodiscard]] rt::ActuatorStatus write(double command_v, std::uint64_t tick) noexcept override;
+
+  [[nodiscard]] CanCounters counters() const noexcept;
+  [[nodiscard]] bool bus_off() const noexcept { return bus_off_; }
+  [[nodiscard]] bool link_lost() const noexcept { return link_lost_; }
+  [[nodiscard]] double backoff_s() const noexcept { return static_cast<double>(backoff_ticks_) / rate_hz_; }
+  [[nodiscard]] std::int64_t last_rx_timestamp_ns() const noexcept { return last_rx_ns_; }
+  [[nodiscard]] const CanChannel& channel() const noexcept { return channel_; }
+
+ private:
+  // Counters are written by the loop thread only and read by others: relaxed atomics.
+  struct AtomicCounters {
+    std::atomic<std::uint64_t> rx_frames{0}, rx_other{0}, rx_malformed{0}, lost_frames{0}, stale_frames{0},
+        error_frames{0}, bus_off{0}, restarts{0}, rx_errors{0}, tx_frames{0}, tx_queue_full{0}, tx_errors{0},
+        tx_skipped{0}, tx_clipped{0};
+  };
+  static void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) noexcept {
+    c.store(c.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
+  }
+  void enter_backoff(std::uint64_t tick) noexcept;
+
+  config::CanConfig cfg_;
+  CanChannel channel_;
+  double rate_hz_;
+  AtomicCounters n_;
+  // Sensor side.
+  double last_value_{0.0};
+  bool have_counter_{false};
+  std::uint32_t last_counter_{0};
+  std::uint32_t counter_mask_{0};
+  std::uint64_t window_start_tick_{0};
+  std::uint64_t lost_in_window_{0}, lost_in_previous_window_{0};
+  std::uint64_t window_ticks_{1};
+  std::int64_t last_rx_ns_{-1};
+  bool link_lost_{false};
+  bool rx_fault_{false};
+  // Bus state and transmit back-off.
+  bool bus_off_{false};
+  std::uint64_t retry_tick_{0};
+  std::uint64_t backoff_ticks_{0}, backoff_initial_ticks_{1}, backoff_max_ticks_{1};
+  int consecutive_tx_failures_{0};
+  std::uint32_t tx_counter_{0};
+};
+
+}  // namespace robodamp::drivers
