@@ -520,7 +520,7 @@ std::optional<CanConfig> read_can(MapReader& top, std::optional<double> rate) {
   if (c.sensor.id == c.command.id && c.sensor.extended_id == c.command.extended_id)
     r.diagnostics().add(r.mark(), "can.command.id", "is the sensor frame's identifier too: they must differ");
   if (auto v = r.number("bus_load_max", {"(fraction of bus time)", 0.0, 1.0, true, false}, c.bus_load_max)) c.bus_load_max = *v;
-  if (auto v = read_int(r, "lost_frames_fault", {"(frames per second)", 1, 100000}, c.lost_frames_fault)) c.lost_frames_fault = *v;
+  if (auto v = read_int(r, "lost_frames_fault", {"(frames per second)", 1, 1024}, c.lost_frames_fault)) c.lost_frames_fault = *v;
   if (auto v = r.number("backoff_initial_s", {"s", 0.0, 10.0, true, false}, c.backoff_initial_s)) c.backoff_initial_s = *v;
   if (auto v = r.number("backoff_max_s", {"s", 0.0, 600.0, true, false}, c.backoff_max_s)) c.backoff_max_s = *v;
   r.finish();

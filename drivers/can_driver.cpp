@@ -29,11 +29,6 @@ void CanDriver::enter_backoff(std::uint64_t tick) noexcept {
 }
 
 rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
-  if (tick >= window_start_tick_ + window_ticks_) {
-    lost_in_previous_window_ = tick >= window_start_tick_ + 2 * window_ticks_ ? 0 : lost_in_window_;
-    lost_in_window_ = 0;
-    window_start_tick_ = tick - (tick % window_ticks_);
-  }
   bool fresh = false;
   rx_fault_ = false;
   for (int i = 0; i < kMaxFramesPerTick; ++i) {
@@ -86,7 +81,7 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
       // A large step backwards is a restarted sender, not half a counter's range of lost frames.
       if (step > 1 && step <= counter_mask_ / 2) {
         bump(n_.lost_frames, step - 1);
-        lost_in_window_ += step - 1;
+        for (std::uint32_t k = 1; k < step && k <= kLossRing; ++k) loss_ticks_[losses_++ % kLossRing] = tick;
       }
     }
     last_counter_ = d.counter;
@@ -96,8 +91,8 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
     bump(n_.rx_frames);
     fresh = true;
   }
-  const bool too_many_lost =
-      lost_in_window_ + lost_in_previous_window_ >= static_cast<std::uint64_t>(cfg_.lost_frames_fault);
+  const auto limit = static_cast<std::uint64_t>(cfg_.lost_frames_fault);
+  const bool too_many_lost = losses_ >= limit && tick < loss_ticks_[(losses_ - limit) % kLossRing] + window_ticks_;
   return {last_value_, fresh, !(bus_off_ || link_lost_ || rx_fault_ || too_many_lost)};
 }
 

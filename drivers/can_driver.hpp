@@ -10,6 +10,7 @@
 //   off (can.backoff_initial_s, doubling up to can.backoff_max_s) and is retried: never a dead driver.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 
@@ -72,8 +73,11 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   bool have_counter_{false};
   std::uint32_t last_counter_{0};
   std::uint32_t counter_mask_{0};
-  std::uint64_t window_start_tick_{0};
-  std::uint64_t lost_in_window_{0}, lost_in_previous_window_{0};
+  // Ticks of the most recent lost frames (ring): a fault when the lost_frames_fault-th latest is within
+  // the last second.
+  static constexpr std::size_t kLossRing = 1024;
+  std::array<std::uint64_t, kLossRing> loss_ticks_{};
+  std::uint64_t losses_{0};
   std::uint64_t window_ticks_{1};
   std::int64_t last_rx_ns_{-1};
   bool link_lost_{false};

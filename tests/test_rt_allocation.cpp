@@ -2,6 +2,10 @@
 // counting ones, and the controller runs over a million cycles with every RT-side operation exercised.
 #include <gtest/gtest.h>
 
+#include <linux/can/error.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 // The replacements below pair malloc/free themselves; GCC cannot see that through the inlined calls.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 
@@ -18,6 +22,7 @@
 #include "rt/recording.hpp"
 #include "rt/telemetry_drain.hpp"
 #include "control/controller.hpp"
+#include "drivers/can_driver.hpp"
 #include "sim_plant/plant.hpp"
 #include "test_util.hpp"
 
@@ -106,6 +111,47 @@ TEST(RealTimePath, SimulatedPlantBackendAllocatesNothingOverAMillionCycles) {
   EXPECT_EQ(g_allocations.load() - before, 0) << "allocations in the simulated backend's tick";
   EXPECT_TRUE(std::isfinite(sink));
   EXPECT_GT(plant.counters().force_limited, 0U);
+}
+
+// The CAN driver's read and write, with sensor frames, frames of other nodes, malformed datagrams, error
+// frames, bus-off and restarts arriving, and the command frames read back by the peer.
+TEST(RealTimePath, CanDriverAllocatesNothing) {
+  config::CanConfig can;
+  can.fd = true;
+  can.sensor = {0x101, false, 8, {0, 4, true, config::ByteOrder::kLittle, 1e-5, 0.0}, config::CanCounter{4, 1}};
+  can.command = {0x201, false, 8, {0, 2, true, config::ByteOrder::kBig, 1e-3, 0.0}, config::CanCounter{2, 1}};
+  int sv[2];
+  ASSERT_EQ(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
+  drivers::CanDriver driver(can, drivers::CanChannel::adopt(sv[0]), 5000.0);
+  const long before = g_allocations.load();
+  double sink = 0.0;
+  std::uint64_t ok_reads = 0;
+  for (std::uint64_t tick = 0; tick < 200'000; ++tick) {
+    const canfd_frame f = drivers::encode(can.sensor, true, std::sin(0.01 * static_cast<double>(tick)),
+                                          static_cast<std::uint32_t>(tick + tick / 2000)).frame;  // a gap every 0.4 s
+    (void)send(sv[1], &f, CANFD_MTU, 0);
+    canfd_frame extra = f;
+    if (tick % 97 == 0) extra.can_id = 0x555;                                // another node
+    if (tick % 5001 == 0) extra.can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;      // bus-off ...
+    if (tick % 5001 == 40) extra.can_id = CAN_ERR_FLAG | CAN_ERR_RESTARTED;  // ... and restart
+    if (extra.can_id != f.can_id) (void)send(sv[1], &extra, CANFD_MTU, 0);
+    if (tick % 331 == 0) (void)send(sv[1], &f, 9, 0);                        // malformed datagram
+    const auto s = driver.read(tick);
+    ok_reads += s.ok ? 1 : 0;
+    sink += s.accel_mps2;
+    (void)driver.write(0.001 * static_cast<double>(tick % 100), tick);
+    canfd_frame out{};
+    while (recv(sv[1], &out, sizeof out, MSG_DONTWAIT) > 0) sink += out.data[0];
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0) << "allocations in the CAN driver";
+  close(sv[1]);
+  const auto k = driver.counters();
+  EXPECT_GT(k.rx_frames, 190'000u);
+  EXPECT_GT(k.bus_off, 30u);
+  EXPECT_GT(k.rx_malformed, 500u);
+  EXPECT_GT(k.lost_frames, 90u);
+  EXPECT_GT(ok_reads, 150'000u);
+  EXPECT_TRUE(std::isfinite(sink));
 }
 
 // The whole loop (sensor read, supervisor, controller, actuator write, amplifier I/O, telemetry push,
