@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <unistd.h>
 
 namespace robodamp::apps {
@@ -30,6 +31,22 @@ std::string run_gnuplot(const std::string& script, const std::string& data, cons
   if (rc != 0) return "gnuplot exited with status " + std::to_string(rc);
   if (!fs::exists(png_path) || fs::file_size(png_path) == 0) return "gnuplot wrote no image to " + png_path;
   return {};
+}
+
+int print_report(const std::string& json_text, bool json, const std::string& table, const std::string& plot_target,
+                 const std::function<std::string()>& plot, const std::string& wrote) {
+  if (json)
+    std::cout << json_text << '\n';
+  else
+    std::cout << table;
+  if (!plot_target.empty()) {
+    if (const std::string err = plot(); !err.empty()) {
+      std::cerr << "plot: " << err << '\n';
+      return 1;
+    }
+    (json ? std::cerr : std::cout) << "wrote " << wrote << '\n';
+  }
+  return 0;
 }
 
 }  // namespace robodamp::apps

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -144,18 +145,8 @@ std::string tool_text(const config::MillingConfig& c) {
 
 int finish(const json& report, const MillingOptions& o, const std::string& table,
            std::string (*plot)(const json&, const std::string&)) {
-  if (o.json)
-    std::cout << report.dump(2) << '\n';
-  else
-    std::cout << table;
-  if (!o.plot_path.empty()) {
-    if (const std::string err = plot(report, o.plot_path); !err.empty()) {
-      std::cerr << "plot: " << err << '\n';
-      return 1;
-    }
-    (o.json ? std::cerr : std::cout) << "wrote " << o.plot_path << '\n';
-  }
-  return 0;
+  return print_report(report.dump(2), o.json, table, o.plot_path, [&] { return plot(report, o.plot_path); },
+                      o.plot_path);
 }
 
 // --- SLE -------------------------------------------------------------------------------------------
@@ -189,6 +180,8 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
   }
   j["map_unstable_points"] = chatter;
   j["conditions"] = json::array();
+  // One lobe model per immersion and feed axis, shared by the conditions that cut with them.
+  std::map<std::pair<double, config::Axis>, milling::LobeModel> stability_models;
   for (const auto& c : cfg.conditions) {
     for (const config::Axis normal : s.surface_normals) {
       const config::Axis feed = normal == config::Axis::kY ? config::Axis::kX : config::Axis::kY;
@@ -201,8 +194,11 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
       config::CutConfig cut_c = cfg.cut;
       cut_c.radial_mm = c.radial_mm;
       cut_c.feed_axis = feed;
-      config::LobesConfig lc = cfg.lobes;
-      const milling::LobeModel stability(structure, milling::chatter_process(cfg.tool, cfg.material, cut_c), lc);
+      const milling::LobeModel& stability =
+          stability_models
+              .try_emplace({c.radial_mm, feed}, structure, milling::chatter_process(cfg.tool, cfg.material, cut_c),
+                           cfg.lobes)
+              .first->second;
       j["conditions"].push_back({{"name", c.name},
                                  {"rpm", c.rpm},
                                  {"axial_mm", c.axial_mm},

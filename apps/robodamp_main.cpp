@@ -12,6 +12,7 @@
 #include "apps/analyze_command.hpp"
 #include "apps/bench_command.hpp"
 #include "apps/filters_command.hpp"
+#include "apps/gnuplot.hpp"
 #include "apps/milling_command.hpp"
 #include "apps/run_command.hpp"
 #include "config/config.hpp"
@@ -44,18 +45,8 @@ int run_filters(const std::string& path, double freq_hz, bool json, const std::s
     return 2;
   }
   const auto report = robodamp::apps::filters_report(d, freq_hz);
-  if (json)
-    std::cout << report.dump(2) << '\n';
-  else
-    std::cout << robodamp::apps::filters_table(report);
-  if (!plot.empty()) {
-    if (const std::string err = robodamp::apps::plot_filters(d, plot); !err.empty()) {
-      std::cerr << "plot: " << err << '\n';
-      return 1;
-    }
-    (json ? std::cerr : std::cout) << "wrote " << plot << '\n';
-  }
-  return 0;
+  return robodamp::apps::print_report(report.dump(2), json, robodamp::apps::filters_table(report), plot,
+                                      [&] { return robodamp::apps::plot_filters(d, plot); }, plot);
 }
 
 // A milling job (config/milling/) has a top-level `tool`; its controller parts are loaded and checked too.
@@ -101,17 +92,10 @@ int run_analyze(const std::string& path, bool json, const std::string& plot_dir)
     const robodamp::analysis::LoopModel model(robodamp::config::load_config_file(path));
     const auto result = robodamp::analysis::analyse(model);
     const auto report = robodamp::apps::analysis_report(model, result);
-    if (json)
-      std::cout << report.dump(2) << '\n';
-    else
-      std::cout << robodamp::apps::analysis_table(report);
-    if (!plot_dir.empty()) {
-      if (const std::string err = robodamp::apps::plot_analysis(model, result, plot_dir); !err.empty()) {
-        std::cerr << "plot: " << err << '\n';
-        return 1;
-      }
-      (json ? std::cerr : std::cout) << "wrote frf_open_closed.png, nyquist.png, gain_sweep.png in " << plot_dir << '\n';
-    }
+    if (robodamp::apps::print_report(report.dump(2), json, robodamp::apps::analysis_table(report), plot_dir,
+                                     [&] { return robodamp::apps::plot_analysis(model, result, plot_dir); },
+                                     "frf_open_closed.png, nyquist.png, gain_sweep.png in " + plot_dir) != 0)
+      return 1;
     return result.stable ? 0 : 3;
   } catch (const ConfigError& e) {
     std::cerr << e.what() << '\n';

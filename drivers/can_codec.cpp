@@ -4,8 +4,6 @@
 
 namespace robodamp::drivers {
 
-int can_payload_length(const config::CanFrameMapping& m) noexcept { return m.length_bytes; }
-
 std::int64_t unpack_field(const std::uint8_t* data, int start, int size, bool is_signed, config::ByteOrder order) noexcept {
   std::uint64_t raw = 0;
   for (int i = 0; i < size; ++i) {

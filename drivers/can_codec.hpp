@@ -10,9 +10,6 @@
 
 namespace robodamp::drivers {
 
-// The payload length a frame mapping sends (DLC rounded up for CAN FD lengths above 8).
-[[nodiscard]] int can_payload_length(const config::CanFrameMapping& m) noexcept;
-
 // Raw integer of a field (sign-extended when signed); the caller guarantees the field lies within len.
 [[nodiscard]] std::int64_t unpack_field(const std::uint8_t* data, int start, int size, bool is_signed,
                                         config::ByteOrder order) noexcept;

@@ -50,7 +50,6 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   [[nodiscard]] bool link_lost() const noexcept { return link_lost_; }
   [[nodiscard]] double backoff_s() const noexcept { return static_cast<double>(backoff_ticks_) / rate_hz_; }
   [[nodiscard]] std::int64_t last_rx_timestamp_ns() const noexcept { return last_rx_ns_; }
-  [[nodiscard]] const CanChannel& channel() const noexcept { return channel_; }
 
  private:
   // Counters are written by the loop thread only and read by others: relaxed atomics.

@@ -53,7 +53,6 @@ class LobeModel {
 
   // Oriented FRF Phi0 = [alpha] G_cutter(f), m/N.
   [[nodiscard]] Eigen::Matrix2cd oriented(double f_hz) const;
-  [[nodiscard]] const std::vector<double>& frequency_grid_hz() const { return grid_hz_; }
 
   // The lobe diagram at the configured speeds (linear interpolation along each lobe between grid points).
   [[nodiscard]] LobeDiagram diagram() const;
