@@ -581,6 +581,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.supervision = read_supervision(top);
   c.telemetry = read_telemetry(top);
   c.can = read_can(top, rate);
+  detail::read_supervisory(top, c);
   top.finish();
   check_location_refs(d, c);
   if (!d.problems().empty()) throw ConfigError(d.problems());

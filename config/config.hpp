@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "config/can_config.hpp"
+#include "config/supervisory_config.hpp"
 
 namespace robodamp::config {
 
@@ -225,7 +226,16 @@ struct Config {
   AnalysisConfig analysis;
   BenchConfig bench;
   std::optional<CanConfig> can;  // hardware: the CAN link (drivers/can_*); absent for the simulated plant
+  std::optional<ModbusConfig> modbus;          // hardware: amplifier and robot registers
+  std::vector<ParameterSetRef> parameter_sets; // other mountings' configurations, selected by the robot
+  std::optional<DdsConfig> dds;                // telemetry and supervised parameters over Fast DDS
+  HilConfig hil;                               // read by the plant emulator (robodamp plant)
 };
+
+// A parameter request's gain against what the supervisor allows (the analysed maximum stable K x
+// supervision.max_gain_fraction), worded as the configuration words a problem; nothing when allowed.
+[[nodiscard]] std::optional<std::string> gain_request_problem(double gain_ns_per_m, double max_ns_per_m,
+                                                              const std::string& why);
 
 // Throw ConfigError holding every problem found.
 [[nodiscard]] Config parse_config(const std::string& yaml_text, const std::string& source_name);

@@ -247,4 +247,9 @@ ModeConfig read_mode(MapReader& mr, const Range& frequency_range) {
   return m;
 }
 
+std::optional<std::string> range_problem(const std::string& key, double v, const Range& range) {
+  if (std::isfinite(v) && in_range(v, range)) return std::nullopt;
+  return key + " = " + format_number(v) + ' ' + std::string(range.unit) + " is out of range: " + describe_range(range);
+}
+
 }  // namespace robodamp::config::detail

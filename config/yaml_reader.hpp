@@ -83,6 +83,10 @@ class MapReader {
 // +1 or -1.
 [[nodiscard]] std::optional<int> read_sign(MapReader& r, const std::string& key, int def);
 [[nodiscard]] std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def);
+// "key = value unit is out of range: ..." (the configuration's own wording), or nothing when in range.
+[[nodiscard]] std::optional<std::string> range_problem(const std::string& key, double v, const Range& range);
+// The optional modbus, parameter_sets, dds and hil sections (config/supervisory_config.hpp).
+void read_supervisory(MapReader& top, Config& c);
 // One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.
 [[nodiscard]] ModeConfig read_mode(MapReader& mr, const Range& frequency_range);
 

@@ -1,0 +1,180 @@
+#include "config/supervisory_config.hpp"
+
+#include <filesystem>
+
+#include "config/config.hpp"
+#include "config/yaml_reader.hpp"
+
+namespace robodamp::config {
+
+using detail::MapReader;
+using detail::present;
+using detail::Range;
+using detail::read_bool;
+using detail::read_int;
+
+const char* to_string(ModbusTransport t) { return t == ModbusTransport::kTcp ? "tcp" : "rtu"; }
+const char* to_string(DdsTransport t) {
+  switch (t) {
+    case DdsTransport::kUdpLoopback: return "udp_loopback";
+    case DdsTransport::kSharedMemory: return "shared_memory";
+    case DdsTransport::kDefault: break;
+  }
+  return "default";
+}
+const char* to_string(HilPacing p) { return p == HilPacing::kRealtime ? "realtime" : "lockstep"; }
+
+std::string describe(const ModbusEndpoint& e) {
+  if (e.transport == ModbusTransport::kTcp)
+    return "tcp " + e.host + ":" + std::to_string(e.port) + " unit " + std::to_string(e.unit_id);
+  return "rtu " + e.device + " " + std::to_string(e.baud) + " " + std::to_string(e.data_bits) + e.parity +
+         std::to_string(e.stop_bits) + " unit " + std::to_string(e.unit_id);
+}
+
+std::optional<std::string> gain_request_problem(double gain_ns_per_m, double max_ns_per_m, const std::string& why) {
+  return detail::range_problem("controller.gain_ns_per_m", gain_ns_per_m, {"N s/m", 0.0, max_ns_per_m, false, false, why});
+}
+
+namespace detail {
+namespace {
+
+const Range kAddress{"(register address, zero-based)", 0, 65535};
+
+ModbusEndpoint read_endpoint(MapReader& r) {
+  ModbusEndpoint e;
+  const auto t = r.choice("transport", {"tcp", "rtu"}, "tcp");
+  e.transport = t && *t == "rtu" ? ModbusTransport::kRtu : ModbusTransport::kTcp;
+  if (e.transport == ModbusTransport::kTcp) {
+    e.host = r.text("host", e.host).value_or(e.host);
+    if (auto v = read_int(r, "port", {"(TCP port)", 1, 65535})) e.port = *v;
+  } else {
+    e.device = r.text("device", std::nullopt).value_or(e.device);
+    if (auto v = read_int(r, "baud", {"bit/s", 1200, 4'000'000}, e.baud)) e.baud = *v;
+    if (auto v = r.choice("parity", {"none", "even", "odd"}, "none")) e.parity = *v == "none" ? 'N' : *v == "even" ? 'E' : 'O';
+    if (auto v = read_int(r, "data_bits", {"bits", 7, 8}, e.data_bits)) e.data_bits = *v;
+    if (auto v = read_int(r, "stop_bits", {"bits", 1, 2}, e.stop_bits)) e.stop_bits = *v;
+  }
+  if (auto v = read_int(r, "unit_id", {"(Modbus unit id)", e.transport == ModbusTransport::kTcp ? 0.0 : 1.0, 247}, e.unit_id))
+    e.unit_id = *v;
+  return e;
+}
+
+std::optional<ModbusConfig> read_modbus(MapReader& top) {
+  const YAML::Node node = top.child("modbus", false, "");
+  if (!present(node)) return std::nullopt;
+  MapReader r(top.diagnostics(), node, "modbus", top.mark());
+  ModbusConfig c;
+  if (auto v = r.number("poll_period_s", {"s", 0.001, 10.0}, c.poll_period_s)) c.poll_period_s = *v;
+  if (auto v = r.number("response_timeout_s", {"s", 0.001, 10.0}, c.response_timeout_s)) c.response_timeout_s = *v;
+  if (auto v = r.number("backoff_initial_s", {"s", 0.001, 10.0}, c.backoff_initial_s)) c.backoff_initial_s = *v;
+  if (auto v = r.number("backoff_max_s", {"s", 0.001, 600.0}, c.backoff_max_s)) c.backoff_max_s = *v;
+  if (c.backoff_max_s < c.backoff_initial_s)
+    r.diagnostics().add(r.mark(), "modbus.backoff_max_s",
+                        "= " + format_number(c.backoff_max_s) + " s is below modbus.backoff_initial_s = " +
+                            format_number(c.backoff_initial_s) + " s");
+  if (auto v = r.number("link_timeout_s", {"s", 0.001, 60.0}, c.link_timeout_s)) c.link_timeout_s = *v;
+  if (c.link_timeout_s < c.poll_period_s)
+    r.diagnostics().add(r.mark(), "modbus.link_timeout_s",
+                        "= " + format_number(c.link_timeout_s) + " s is shorter than modbus.poll_period_s = " +
+                            format_number(c.poll_period_s) + " s: every poll would count as a lost link");
+
+  MapReader a(r.diagnostics(), r.child("amplifier", true, "the amplifier's endpoint and registers"), "modbus.amplifier", r.mark());
+  c.amplifier_link = read_endpoint(a);
+  auto& ar = c.amplifier;
+  if (auto v = read_int(a, "enable_coil", kAddress, ar.enable_coil)) ar.enable_coil = *v;
+  if (auto v = read_int(a, "ready_input", kAddress, ar.ready_input)) ar.ready_input = *v;
+  if (auto v = read_int(a, "fault_input", kAddress, ar.fault_input)) ar.fault_input = *v;
+  if (ar.ready_input == ar.fault_input)
+    a.diagnostics().add(a.mark(), "modbus.amplifier.fault_input", "= " + std::to_string(ar.fault_input) +
+                                                                      " is the ready input's address too: they must differ");
+  if (auto v = read_int(a, "temperature_register", kAddress, ar.temperature_register)) ar.temperature_register = *v;
+  if (auto v = a.number("temperature_c_per_count", {"degC per count", 0.0, 100.0, true}, ar.temperature_c_per_count))
+    ar.temperature_c_per_count = *v;
+  if (auto v = a.number("temperature_max_c", {"degC", 0.0, 200.0}, ar.temperature_max_c)) ar.temperature_max_c = *v;
+  a.finish();
+
+  const YAML::Node rn = r.child("robot", false, "");
+  if (present(rn)) {
+    MapReader b(r.diagnostics(), rn, "modbus.robot", r.mark());
+    c.robot_link = read_endpoint(b);
+    auto& rr = c.robot;
+    if (auto v = read_int(b, "mounting_register", kAddress, rr.mounting_register)) rr.mounting_register = *v;
+    if (auto v = read_int(b, "horizontal_value", {"(register value)", 0, 65535}, rr.horizontal_value)) rr.horizontal_value = *v;
+    if (auto v = read_int(b, "vertical_value", {"(register value)", 0, 65535}, rr.vertical_value)) rr.vertical_value = *v;
+    if (rr.horizontal_value == rr.vertical_value)
+      b.diagnostics().add(b.mark(), "modbus.robot.vertical_value",
+                          "= " + std::to_string(rr.vertical_value) + " is the horizontal value too: they must differ");
+    if (auto v = read_int(b, "settle_polls", {"(polls)", 1, 1000}, rr.settle_polls)) rr.settle_polls = *v;
+    b.finish();
+  }
+  r.finish();
+  return c;
+}
+
+std::vector<ParameterSetRef> read_parameter_sets(MapReader& top, const std::string& source) {
+  const YAML::Node node = top.child("parameter_sets", false, "");
+  std::vector<ParameterSetRef> sets;
+  if (!present(node)) return sets;
+  MapReader r(top.diagnostics(), node, "parameter_sets", top.mark());
+  const std::filesystem::path dir = std::filesystem::path(source).parent_path();
+  for (const char* m : {"horizontal", "vertical"}) {
+    const auto p = r.text(m, "");
+    if (!p || p->empty()) continue;
+    ParameterSetRef s{m, *p, (std::filesystem::path(*p).is_absolute() ? std::filesystem::path(*p) : dir / *p).string()};
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(s.resolved_path, ec))
+      r.diagnostics().add(r.mark(), "parameter_sets." + s.mounting,
+                          "= '" + s.path + "': no such file (looked for " + s.resolved_path + ")");
+    else
+      sets.push_back(std::move(s));
+  }
+  r.finish();
+  return sets;
+}
+
+std::optional<DdsConfig> read_dds(MapReader& top) {
+  const YAML::Node node = top.child("dds", false, "");
+  if (!present(node)) return std::nullopt;
+  MapReader r(top.diagnostics(), node, "dds", top.mark());
+  DdsConfig c;
+  if (auto v = read_int(r, "domain_id", {"(DDS domain)", 0, 232}, c.domain_id)) c.domain_id = *v;
+  if (auto v = r.choice("transport", {"default", "udp_loopback", "shared_memory"}, "default"))
+    c.transport = *v == "udp_loopback" ? DdsTransport::kUdpLoopback
+                  : *v == "shared_memory" ? DdsTransport::kSharedMemory
+                                          : DdsTransport::kDefault;
+  if (auto v = r.number("telemetry_rate_hz", {"Hz", 0.0, 1000.0, true}, c.telemetry_rate_hz)) c.telemetry_rate_hz = *v;
+  if (auto v = r.number("status_rate_hz", {"Hz", 0.0, 100.0, true}, c.status_rate_hz)) c.status_rate_hz = *v;
+  if (auto v = read_bool(r, "parameter_writes", c.parameter_writes)) c.parameter_writes = *v;
+  r.finish();
+  return c;
+}
+
+HilConfig read_hil(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("hil", false, ""), "hil", top.mark());
+  HilConfig c;
+  if (auto v = r.choice("pacing", {"realtime", "lockstep"}, "realtime"))
+    c.pacing = *v == "lockstep" ? HilPacing::kLockstep : HilPacing::kRealtime;
+  if (auto v = r.number("settle_s", {"s", 0.0, 600.0}, c.settle_s)) c.settle_s = *v;
+  if (auto v = r.number("accept_timeout_s", {"s", 0.0, 3600.0, true}, c.accept_timeout_s)) c.accept_timeout_s = *v;
+  if (auto v = r.number("amplifier_ready_delay_s", {"s", 0.0, 10.0}, c.amplifier_ready_delay_s))
+    c.amplifier_ready_delay_s = *v;
+  if (auto v = r.number("ambient_c", {"degC", -40.0, 100.0}, c.ambient_c)) c.ambient_c = *v;
+  if (auto v = r.number("heating_c_per_v2", {"degC per V^2", 0.0, 100.0}, c.heating_c_per_v2)) c.heating_c_per_v2 = *v;
+  r.finish();
+  return c;
+}
+
+}  // namespace
+
+void read_supervisory(MapReader& top, Config& c) {
+  c.modbus = read_modbus(top);
+  c.parameter_sets = read_parameter_sets(top, c.source);
+  c.dds = read_dds(top);
+  c.hil = read_hil(top);
+  if (!c.parameter_sets.empty() && !(c.modbus && c.modbus->robot_link))
+    top.diagnostics().add(top.mark(), "parameter_sets",
+                          "needs modbus.robot: the robot's mounting register is what selects a set");
+}
+
+}  // namespace detail
+}  // namespace robodamp::config

@@ -1,0 +1,94 @@
+// The non-real-time links of a robot cell: Modbus to the amplifier and the robot controller
+// (drivers/modbus_supervisor), the parameter sets the robot's mounting selects, Fast DDS telemetry and
+// supervised parameters (dds/), and the hardware-in-the-loop emulator's pacing (robodamp plant).
+// All optional: a configuration without them runs against the simulated plant in process.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace robodamp::config {
+
+enum class ModbusTransport { kTcp, kRtu };
+
+// One Modbus device: TCP (host, port) or RTU (serial line), and its unit (slave) id.
+struct ModbusEndpoint {
+  ModbusTransport transport{ModbusTransport::kTcp};
+  std::string host{"127.0.0.1"};
+  int port{502};
+  std::string device{"/dev/ttyUSB0"};  // RTU
+  int baud{115200};
+  char parity{'N'};  // N, E, O
+  int data_bits{8};
+  int stop_bits{1};
+  int unit_id{1};
+};
+
+// The amplifier's register map (zero-based protocol addresses).
+struct AmplifierRegisters {
+  int enable_coil{0};             // coil, written: 1 = enabled
+  int ready_input{0};             // discrete input: enabled and able to drive
+  int fault_input{1};             // discrete input: over-current, over-temperature, internal fault
+  int temperature_register{0};    // input register, signed 16-bit count
+  double temperature_c_per_count{0.1};
+  double temperature_max_c{80.0};  // hotter than this is treated as an amplifier fault
+};
+
+// The robot controller's register that tells how the actuator is mounted at this pose.
+struct RobotRegisters {
+  int mounting_register{0};  // holding register
+  int horizontal_value{0};
+  int vertical_value{1};
+  int settle_polls{3};       // the same value this many polls running before a set is selected
+};
+
+struct ModbusConfig {
+  double poll_period_s{0.01};
+  double response_timeout_s{0.1};
+  double backoff_initial_s{0.05};
+  double backoff_max_s{2.0};
+  // No successful poll for this long while the amplifier is enabled (or asked to be): its status is
+  // unknown, which the supervisor sees as an amplifier fault.
+  double link_timeout_s{0.1};
+  ModbusEndpoint amplifier_link;
+  AmplifierRegisters amplifier;
+  std::optional<ModbusEndpoint> robot_link;  // absent: no pose input
+  RobotRegisters robot;
+};
+
+// Another controller parameter set: a configuration file (same loop rate) for another mounting.
+struct ParameterSetRef {
+  std::string mounting;  // horizontal | vertical
+  std::string path;      // as written; resolved relative to the configuration file
+  std::string resolved_path;
+};
+
+enum class DdsTransport { kUdpLoopback, kSharedMemory, kDefault };
+
+struct DdsConfig {
+  int domain_id{0};
+  DdsTransport transport{DdsTransport::kDefault};
+  double telemetry_rate_hz{50.0};  // decimated loop frames
+  double status_rate_hz{5.0};
+  bool parameter_writes{false};    // parameter requests are refused unless this is on
+};
+
+enum class HilPacing { kRealtime, kLockstep };
+
+struct HilConfig {
+  HilPacing pacing{HilPacing::kRealtime};
+  double settle_s{3.0};             // after the amplifier is enabled, before the first impact
+  double accept_timeout_s{30.0};    // waiting for the controller to connect
+  double amplifier_ready_delay_s{0.005};
+  double ambient_c{35.0};
+  double heating_c_per_v2{0.5};     // amplifier temperature above ambient per mean-square volt
+};
+
+[[nodiscard]] const char* to_string(ModbusTransport t);
+[[nodiscard]] const char* to_string(DdsTransport t);
+[[nodiscard]] const char* to_string(HilPacing p);
+// "tcp 127.0.0.1:1502 unit 1" or "rtu /dev/ttyUSB0 115200 8N1 unit 1".
+[[nodiscard]] std::string describe(const ModbusEndpoint& e);
+
+}  // namespace robodamp::config
