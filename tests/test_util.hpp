@@ -1,6 +1,9 @@
 #pragma once
 
+#include <chrono>
 #include <fstream>
+#include <functional>
+#include <thread>
 #include <sstream>
 #include <string>
 
@@ -32,6 +35,17 @@ inline double phase_diff_deg(double a, double b) {
   while (d > 180.0) d -= 360.0;
   while (d <= -180.0) d += 360.0;
   return d;
+}
+
+// Polls pred every millisecond until it holds or timeout_s passes (for threads and other processes;
+// the timeout only bounds a failing test, nothing is asserted about how long it took).
+inline bool eventually(const std::function<bool()>& pred, double timeout_s = 10.0) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < end) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return pred();
 }
 
 }  // namespace robodamp::test

@@ -1,0 +1,260 @@
+#include "drivers/modbus_supervisor.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+
+#include <modbus/modbus.h>
+#include <spdlog/spdlog.h>
+
+namespace robodamp::drivers {
+
+namespace {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+void set_timeout(modbus_t* ctx, double s) {
+  const auto us = static_cast<std::uint32_t>(std::llround(s * 1e6));
+  modbus_set_response_timeout(ctx, us / 1'000'000, us % 1'000'000);
+  modbus_set_byte_timeout(ctx, us / 1'000'000, us % 1'000'000);
+}
+
+}  // namespace
+
+ModbusLink::ModbusLink(const config::ModbusEndpoint& ep, const config::ModbusConfig& t)
+    : ep_(ep),
+      initial_(t.backoff_initial_s),
+      max_(t.backoff_max_s),
+      backoff_(t.backoff_initial_s),
+      response_timeout_(t.response_timeout_s) {}
+
+ModbusLink::~ModbusLink() {
+  if (ctx_ != nullptr) {
+    modbus_close(ctx_);
+    modbus_free(ctx_);
+  }
+}
+
+modbus_t* ModbusLink::connect(Clock::time_point now) {
+  if (connected_) return ctx_;
+  if (now < retry_at_) return nullptr;
+  if (ctx_ == nullptr) {
+    ctx_ = ep_.transport == config::ModbusTransport::kTcp
+               ? modbus_new_tcp(ep_.host.c_str(), ep_.port)
+               : modbus_new_rtu(ep_.device.c_str(), ep_.baud, ep_.parity, ep_.data_bits, ep_.stop_bits);
+    if (ctx_ == nullptr) {
+      last_error_ = modbus_strerror(errno);
+      ++connect_failures;
+      failed(now);
+      return nullptr;
+    }
+    modbus_set_slave(ctx_, ep_.unit_id);
+    set_timeout(ctx_, response_timeout_.count());
+    modbus_set_error_recovery(ctx_, MODBUS_ERROR_RECOVERY_NONE);
+  }
+  if (modbus_connect(ctx_) == -1) {
+    last_error_ = modbus_strerror(errno);
+    ++connect_failures;
+    failed(now);
+    return nullptr;
+  }
+  connected_ = true;
+  ++connects;
+  return ctx_;
+}
+
+void ModbusLink::failed(Clock::time_point now) {
+  if (connected_) {
+    last_error_ = modbus_strerror(errno);
+    if (errno == ETIMEDOUT) ++timeouts;
+    ++errors;
+    modbus_close(ctx_);
+    connected_ = false;
+  }
+  retry_at_ = now + std::chrono::duration_cast<Clock::duration>(backoff_);
+  backoff_ = std::min(backoff_ * 2.0, max_);
+}
+
+ModbusSupervisor::ModbusSupervisor(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback cb)
+    : cfg_(cfg),
+      on_mounting_(std::move(cb)),
+      amp_link_(cfg.amplifier_link, cfg),
+      mounting_(static_cast<int>(initial)),
+      link_timeout_ns_(static_cast<std::int64_t>(cfg.link_timeout_s * 1e9)) {
+  if (cfg_.robot_link) robot_link_.emplace(*cfg_.robot_link, cfg_);
+}
+
+ModbusSupervisor::~ModbusSupervisor() { stop(); }
+
+void ModbusSupervisor::start() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (running_) return;
+    running_ = true;
+  }
+  amp_thread_ = std::thread([this] { amplifier_thread(); });
+  if (robot_link_) robot_thread_ = std::thread([this] { robot_thread(); });
+}
+
+void ModbusSupervisor::stop() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (!running_) return;
+    running_ = false;
+  }
+  cv_.notify_all();
+  if (amp_thread_.joinable()) amp_thread_.join();
+  if (robot_thread_.joinable()) robot_thread_.join();
+}
+
+bool ModbusSupervisor::sleep_for(std::chrono::duration<double> d) {
+  std::unique_lock<std::mutex> lock(m_);
+  cv_.wait_for(lock, d, [this] { return !running_; });
+  return running_;
+}
+
+bool ModbusSupervisor::wait_for_amplifier(std::chrono::duration<double> timeout) const {
+  std::unique_lock<std::mutex> lock(m_);
+  return cv_.wait_for(lock, timeout, [this] { return last_ok_ns_.load() >= 0 || !running_; }) && last_ok_ns_.load() >= 0;
+}
+
+void ModbusSupervisor::request_amplifier_enable(bool on) noexcept { requested_.store(on, std::memory_order_relaxed); }
+
+rt::AmplifierStatus ModbusSupervisor::amplifier_status() noexcept {
+  rt::AmplifierStatus s;
+  const std::int64_t last = last_ok_ns_.load(std::memory_order_acquire);
+  const bool stale = last < 0 || monotonic_ns() - last > link_timeout_ns_;
+  const bool matters = requested_.load(std::memory_order_relaxed) || enabled_.load(std::memory_order_relaxed);
+  if (stale) {
+    // Unknown: harmless while the amplifier is off and not wanted; a fault otherwise.
+    const bool fault = matters && last >= 0;
+    if (fault && !link_fault_.exchange(true, std::memory_order_relaxed))
+      link_faults_.store(link_faults_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    s.fault = fault;
+    return s;
+  }
+  link_fault_.store(false, std::memory_order_relaxed);
+  s.enabled = enabled_.load(std::memory_order_relaxed);
+  s.ready = ready_.load(std::memory_order_relaxed);
+  s.fault = fault_.load(std::memory_order_relaxed);
+  s.temperature_c = temperature_c_.load(std::memory_order_relaxed);
+  return s;
+}
+
+void ModbusSupervisor::amplifier_thread() {
+  const auto& r = cfg_.amplifier;
+  const int in_lo = std::min(r.ready_input, r.fault_input), in_n = std::abs(r.ready_input - r.fault_input) + 1;
+  std::vector<std::uint8_t> inputs(static_cast<std::size_t>(in_n));
+  const auto period = std::chrono::duration<double>(cfg_.poll_period_s);
+  bool running = true;
+  while (running) {
+    const auto now = ModbusLink::Clock::now();
+    modbus_t* ctx = amp_link_.connect(now);
+    amp_up_.store(ctx != nullptr);
+    if (ctx == nullptr) {
+      running = sleep_for(std::min<std::chrono::duration<double>>(period, amp_link_.retry_at() - now));
+      continue;
+    }
+    const bool want = requested_.load(std::memory_order_relaxed);
+    std::uint8_t coil = 0;
+    std::uint16_t temp_raw = 0;
+    bool ok = modbus_read_bits(ctx, r.enable_coil, 1, &coil) == 1;
+    if (ok && (coil != 0) != want) {
+      ok = modbus_write_bit(ctx, r.enable_coil, want ? 1 : 0) == 1;
+      if (ok) coil = want ? 1 : 0, ++coil_writes_;
+    }
+    ok = ok && modbus_read_input_bits(ctx, in_lo, in_n, inputs.data()) == in_n;
+    ok = ok && modbus_read_input_registers(ctx, r.temperature_register, 1, &temp_raw) == 1;
+    if (!ok) {
+      amp_link_.failed(ModbusLink::Clock::now());
+      amp_up_.store(false);
+      spdlog::warn("modbus amplifier {}: {} (reconnect in {:.3f} s)", config::describe(cfg_.amplifier_link),
+                   amp_link_.last_error(), amp_link_.backoff().count() / 2.0);
+      running = sleep_for(std::chrono::duration<double>(0.0));
+      continue;
+    }
+    amp_link_.succeeded();
+    const double temp = static_cast<std::int16_t>(temp_raw) * r.temperature_c_per_count;
+    enabled_.store(coil != 0, std::memory_order_relaxed);
+    ready_.store(coil != 0 && inputs[static_cast<std::size_t>(r.ready_input - in_lo)] != 0, std::memory_order_relaxed);
+    fault_.store(inputs[static_cast<std::size_t>(r.fault_input - in_lo)] != 0 || temp > r.temperature_max_c,
+                 std::memory_order_relaxed);
+    temperature_c_.store(temp, std::memory_order_relaxed);
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      last_ok_ns_.store(monotonic_ns(), std::memory_order_release);
+    }
+    cv_.notify_all();
+    ++amp_polls_;
+    running = sleep_for(period);
+  }
+  // Leave the amplifier off: the loop has disarmed (or died); one last write if the link is up.
+  if (modbus_t* ctx = amp_link_.connected() ? amp_link_.connect(ModbusLink::Clock::now()) : nullptr)
+    modbus_write_bit(ctx, r.enable_coil, 0);
+}
+
+void ModbusSupervisor::robot_thread() {
+  const auto& r = cfg_.robot;
+  const auto period = std::chrono::duration<double>(cfg_.poll_period_s);
+  int candidate = -1, same = 0;
+  bool running = true;
+  while (running) {
+    const auto now = ModbusLink::Clock::now();
+    modbus_t* ctx = robot_link_->connect(now);
+    robot_up_.store(ctx != nullptr);
+    if (ctx == nullptr) {
+      running = sleep_for(std::min<std::chrono::duration<double>>(period, robot_link_->retry_at() - now));
+      continue;
+    }
+    std::uint16_t v = 0;
+    if (modbus_read_registers(ctx, r.mounting_register, 1, &v) != 1) {
+      robot_link_->failed(ModbusLink::Clock::now());
+      robot_up_.store(false);
+      spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
+      candidate = -1, same = 0;
+      running = sleep_for(std::chrono::duration<double>(0.0));
+      continue;
+    }
+    robot_link_->succeeded();
+    ++robot_polls_;
+    int m = -1;
+    if (v == r.horizontal_value) m = static_cast<int>(config::Mounting::kHorizontal);
+    else if (v == r.vertical_value) m = static_cast<int>(config::Mounting::kVertical);
+    else ++mounting_unknown_;
+    same = m == candidate ? same + 1 : 1;
+    candidate = m;
+    if (m >= 0 && same >= r.settle_polls && m != mounting_.load()) {
+      mounting_.store(m);
+      ++mounting_changes_;
+      spdlog::info("modbus robot: actuator mounting now {}", config::to_string(static_cast<config::Mounting>(m)));
+      if (on_mounting_) on_mounting_(static_cast<config::Mounting>(m));
+    }
+    running = sleep_for(period);
+  }
+}
+
+ModbusCounters ModbusSupervisor::counters() const {
+  ModbusCounters c;
+  c.amplifier_polls = amp_polls_.load();
+  c.robot_polls = robot_polls_.load();
+  for (const ModbusLink* l : {&amp_link_, robot_link_ ? &*robot_link_ : nullptr}) {
+    if (l == nullptr) continue;
+    c.connects += l->connects.load();
+    c.connect_failures += l->connect_failures.load();
+    c.errors += l->errors.load();
+    c.timeouts += l->timeouts.load();
+  }
+  c.link_faults = link_faults_.load();
+  c.coil_writes = coil_writes_.load();
+  c.mounting_changes = mounting_changes_.load();
+  c.mounting_unknown = mounting_unknown_.load();
+  return c;
+}
+
+}  // namespace robodamp::drivers

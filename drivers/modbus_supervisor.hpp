@@ -1,0 +1,124 @@
+// The supervisory Modbus client (libmodbus, TCP or RTU): the amplifier's enable coil and its ready,
+// fault and temperature registers, and the robot controller's mounting register, polled on threads of
+// their own (one per device, so a device that hangs does not stall the other). The loop's real-time
+// thread only touches atomics: request_amplifier_enable() stores the wish, amplifier_status() reads
+// what the last successful poll saw.
+//
+// - A failed call (timeout, reset, refused connection) closes the link; it reconnects after a back-off
+//   that doubles from modbus.backoff_initial_s up to modbus.backoff_max_s and resets on success.
+// - No successful poll for modbus.link_timeout_s while the amplifier is enabled or asked to be: its
+//   state is unknown, and amplifier_status() reports a fault (the supervisor trips). While the loop
+//   does not need the amplifier a lost link is only counted.
+// - The amplifier is reported faulty above modbus.amplifier.temperature_max_c too.
+// - The robot's mounting (horizontal / vertical value) must read the same settle_polls polls running
+//   before the callback is told; the session turns that into a parameter-set selection the supervisor
+//   validates and the controller hands over with a fade (never a switch mid-cycle).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "config/config.hpp"
+#include "rt/io.hpp"
+
+typedef struct _modbus modbus_t;
+
+namespace robodamp::drivers {
+
+// One Modbus device's connection with reconnect back-off; used from one thread.
+class ModbusLink {
+ public:
+  using Clock = std::chrono::steady_clock;
+  ModbusLink(const config::ModbusEndpoint& endpoint, const config::ModbusConfig& timing);
+  ~ModbusLink();
+  ModbusLink(const ModbusLink&) = delete;
+  ModbusLink& operator=(const ModbusLink&) = delete;
+
+  // Connects if not connected and the back-off has passed. Null when not connected.
+  modbus_t* connect(Clock::time_point now);
+  // The last call failed: close, and wait out the back-off before the next attempt.
+  void failed(Clock::time_point now);
+  void succeeded() { backoff_ = initial_; }
+  [[nodiscard]] bool connected() const { return ctx_ != nullptr && connected_; }
+  [[nodiscard]] Clock::time_point retry_at() const { return retry_at_; }
+  [[nodiscard]] std::chrono::duration<double> backoff() const { return backoff_; }
+  [[nodiscard]] const std::string& last_error() const { return last_error_; }
+  std::atomic<std::uint64_t> connects{0}, connect_failures{0}, errors{0}, timeouts{0};
+
+ private:
+  config::ModbusEndpoint ep_;
+  std::chrono::duration<double> initial_, max_, backoff_, response_timeout_;
+  modbus_t* ctx_{nullptr};
+  bool connected_{false};
+  Clock::time_point retry_at_{};
+  std::string last_error_;
+};
+
+struct ModbusCounters {
+  std::uint64_t amplifier_polls{0}, robot_polls{0};
+  std::uint64_t connects{0}, connect_failures{0}, errors{0}, timeouts{0};
+  std::uint64_t link_faults{0};        // times the amplifier's status became unknown while it mattered
+  std::uint64_t coil_writes{0};
+  std::uint64_t mounting_changes{0};   // selections handed to the callback
+  std::uint64_t mounting_unknown{0};   // polls with a value that is neither horizontal nor vertical
+};
+
+class ModbusSupervisor final : public rt::SupervisoryIo {
+ public:
+  using MountingCallback = std::function<void(config::Mounting)>;
+  // initial: the mounting the controller starts with (its configuration's actuator.mounting).
+  ModbusSupervisor(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback on_mounting = {});
+  ~ModbusSupervisor() override;
+  ModbusSupervisor(const ModbusSupervisor&) = delete;
+  ModbusSupervisor& operator=(const ModbusSupervisor&) = delete;
+
+  void start();
+  // Writes the enable coil off when it can, then joins the threads.
+  void stop();
+
+  // Real-time side: atomics only.
+  void request_amplifier_enable(bool on) noexcept override;
+  [[nodiscard]] rt::AmplifierStatus amplifier_status() noexcept override;
+
+  // Any thread.
+  [[nodiscard]] ModbusCounters counters() const;
+  [[nodiscard]] bool amplifier_link_up() const { return amp_up_.load(); }
+  [[nodiscard]] bool robot_link_up() const { return robot_up_.load(); }
+  [[nodiscard]] config::Mounting mounting() const { return static_cast<config::Mounting>(mounting_.load()); }
+  // Blocks until the first successful amplifier poll or the timeout; true when it came.
+  bool wait_for_amplifier(std::chrono::duration<double> timeout) const;
+
+ private:
+  void amplifier_thread();
+  void robot_thread();
+  bool sleep_for(std::chrono::duration<double> d);  // false when stopping
+
+  config::ModbusConfig cfg_;
+  MountingCallback on_mounting_;
+  ModbusLink amp_link_;
+  std::optional<ModbusLink> robot_link_;
+  std::thread amp_thread_, robot_thread_;
+  mutable std::mutex m_;
+  mutable std::condition_variable cv_;
+  bool running_{false};
+
+  std::atomic<bool> requested_{false};
+  std::atomic<bool> enabled_{false}, ready_{false}, fault_{false};
+  std::atomic<double> temperature_c_{0.0};
+  std::atomic<std::int64_t> last_ok_ns_{-1};  // CLOCK_MONOTONIC of the last good amplifier poll
+  std::atomic<bool> amp_up_{false}, robot_up_{false};
+  std::atomic<bool> link_fault_{false};
+  std::atomic<int> mounting_;
+  std::atomic<std::uint64_t> amp_polls_{0}, robot_polls_{0}, link_faults_{0}, coil_writes_{0}, mounting_changes_{0},
+      mounting_unknown_{0};
+  std::int64_t link_timeout_ns_;
+};
+
+}  // namespace robodamp::drivers

@@ -1,0 +1,201 @@
+// The Modbus supervisory client against a real libmodbus server on 127.0.0.1 (started here): the
+// amplifier's enable coil, ready / fault / temperature, timeouts and disconnects with reconnect back-off,
+// a lost link as a fault only when it matters, and the robot's mounting register with its settling.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <vector>
+
+#include "drivers/modbus_server.hpp"
+#include "drivers/modbus_supervisor.hpp"
+#include "test_util.hpp"
+
+namespace robodamp {
+namespace {
+
+using drivers::ModbusServer;
+using drivers::ModbusSupervisor;
+using test::eventually;
+
+config::ModbusConfig client_config(int port) {
+  config::ModbusConfig c;
+  c.poll_period_s = 0.005;
+  c.response_timeout_s = 0.05;
+  c.backoff_initial_s = 0.02;
+  c.backoff_max_s = 0.2;
+  c.link_timeout_s = 0.1;
+  c.amplifier_link.host = "127.0.0.1";
+  c.amplifier_link.port = port;
+  c.amplifier.enable_coil = 3;
+  c.amplifier.ready_input = 4;
+  c.amplifier.fault_input = 7;
+  c.amplifier.temperature_register = 2;
+  c.amplifier.temperature_c_per_count = 0.1;
+  c.amplifier.temperature_max_c = 80.0;
+  config::ModbusEndpoint robot = c.amplifier_link;
+  robot.unit_id = 2;
+  c.robot_link = robot;
+  c.robot.mounting_register = 10;
+  c.robot.horizontal_value = 0;
+  c.robot.vertical_value = 1;
+  c.robot.settle_polls = 3;
+  return c;
+}
+
+TEST(Modbus, AmplifierEnableReadyFaultAndTemperature) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  server.set_input_register(2, 352);  // 35.2 degC
+  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  sup.start();
+  ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
+  rt::AmplifierStatus s = sup.amplifier_status();
+  EXPECT_FALSE(s.enabled);
+  EXPECT_FALSE(s.fault);
+  EXPECT_NEAR(s.temperature_c, 35.2, 1e-9);
+
+  sup.request_amplifier_enable(true);
+  ASSERT_TRUE(eventually([&] { return server.coil(3); }));
+  EXPECT_TRUE(eventually([&] { return sup.amplifier_status().enabled; }));
+  EXPECT_FALSE(sup.amplifier_status().ready);  // enabled, not yet ready
+  server.set_discrete_input(4, true);
+  EXPECT_TRUE(eventually([&] { return sup.amplifier_status().ready; }));
+  server.set_discrete_input(7, true);
+  EXPECT_TRUE(eventually([&] { return sup.amplifier_status().fault; }));
+  server.set_discrete_input(7, false);
+  EXPECT_TRUE(eventually([&] { return !sup.amplifier_status().fault; }));
+  server.set_input_register(2, 812);  // 81.2 degC: over temperature_max_c
+  EXPECT_TRUE(eventually([&] { return sup.amplifier_status().fault; }));
+  EXPECT_NEAR(sup.amplifier_status().temperature_c, 81.2, 1e-9);
+  server.set_input_register(2, static_cast<std::uint16_t>(-50));  // -5.0 degC: signed
+  EXPECT_TRUE(eventually([&] { return std::abs(sup.amplifier_status().temperature_c + 5.0) < 1e-9; }));
+
+  // Someone else switches the amplifier off: the client writes the wanted state back.
+  server.set_coil(3, false);
+  EXPECT_TRUE(eventually([&] { return sup.counters().coil_writes >= 2 && server.coil(3); }));
+  sup.request_amplifier_enable(false);
+  EXPECT_TRUE(eventually([&] { return !server.coil(3); }));
+  sup.stop();
+  EXPECT_EQ(sup.counters().errors, 0U);
+  EXPECT_EQ(sup.counters().link_faults, 0U);
+}
+
+TEST(Modbus, HangingDeviceTimesOutAndIsAFaultWhileEnabled) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  server.set_discrete_input(4, true);
+  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  sup.start();
+  sup.request_amplifier_enable(true);
+  ASSERT_TRUE(eventually([&] { return sup.amplifier_status().ready; }));
+
+  server.set_responding(false);  // the device hangs: requests are read, never answered
+  ASSERT_TRUE(eventually([&] { return sup.amplifier_status().fault; }));
+  const auto status = sup.amplifier_status();
+  EXPECT_FALSE(status.ready);
+  EXPECT_TRUE(eventually([&] { return sup.counters().timeouts >= 1; }));
+  EXPECT_EQ(sup.counters().link_faults, 1U);
+
+  server.set_responding(true);  // back: reconnect, status known again
+  EXPECT_TRUE(eventually([&] { return sup.amplifier_status().ready && !sup.amplifier_status().fault; }));
+  EXPECT_GE(sup.counters().connects, 2U);
+  sup.stop();
+}
+
+TEST(Modbus, LostLinkIsOnlyCountedWhileTheAmplifierIsNotNeeded) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  sup.start();
+  ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
+  server.stop();
+  ASSERT_TRUE(eventually([&] { return !sup.amplifier_link_up(); }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // past link_timeout_s
+  const auto s = sup.amplifier_status();
+  EXPECT_FALSE(s.fault);
+  EXPECT_FALSE(s.ready);
+  EXPECT_EQ(sup.counters().link_faults, 0U);
+  // Asking for the amplifier while its state is unknown is a fault.
+  sup.request_amplifier_enable(true);
+  EXPECT_TRUE(sup.amplifier_status().fault);
+  EXPECT_EQ(sup.counters().link_faults, 1U);
+  sup.stop();
+}
+
+TEST(Modbus, DisconnectReconnectsWithBackoff) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  auto cfg = client_config(port);
+  cfg.robot_link.reset();
+  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  sup.start();
+  ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
+  server.stop();  // the device goes away
+  const auto down = std::chrono::steady_clock::now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  const auto failures = sup.counters().connect_failures;
+  // Back-off 20, 40, 80, 160, 200, 200 ... ms: about 8 attempts in a second, never a busy loop.
+  EXPECT_GE(failures, 3U);
+  EXPECT_LE(failures, 12U);
+  (void)down;
+  ModbusServer again;
+  again.start("127.0.0.1", port);  // the device is back on the same address
+  again.set_input_register(2, 400);
+  EXPECT_TRUE(eventually([&] { return sup.amplifier_link_up() && std::abs(sup.amplifier_status().temperature_c - 40.0) < 1e-9; }));
+  EXPECT_GE(sup.counters().connects, 2U);
+  sup.stop();
+}
+
+TEST(Modbus, DroppedConnectionsReconnect) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  sup.start();
+  ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
+  ASSERT_TRUE(eventually([&] { return sup.robot_link_up(); }));
+  const auto before = sup.counters().connects;
+  server.drop_clients();
+  EXPECT_TRUE(eventually([&] { return sup.counters().connects >= before + 2 && sup.amplifier_link_up(); }));
+  EXPECT_GE(sup.counters().errors, 1U);
+  sup.stop();
+}
+
+TEST(Modbus, RobotMountingSelectsAfterSettling) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  std::atomic<int> calls{0};
+  std::atomic<int> last{-1};
+  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal, [&](config::Mounting m) {
+    last = static_cast<int>(m);
+    ++calls;
+  });
+  sup.start();
+  ASSERT_TRUE(eventually([&] { return sup.counters().robot_polls >= 5; }));
+  EXPECT_EQ(calls.load(), 0);  // horizontal, as configured
+  server.set_holding_register(10, 7);  // neither value: counted, ignored
+  ASSERT_TRUE(eventually([&] { return sup.counters().mounting_unknown >= 3; }));
+  EXPECT_EQ(calls.load(), 0);
+  server.set_holding_register(10, 1);
+  ASSERT_TRUE(eventually([&] { return calls.load() == 1; }));
+  EXPECT_EQ(last.load(), static_cast<int>(config::Mounting::kVertical));
+  EXPECT_EQ(sup.mounting(), config::Mounting::kVertical);
+  server.set_holding_register(10, 0);
+  ASSERT_TRUE(eventually([&] { return calls.load() == 2; }));
+  EXPECT_EQ(last.load(), static_cast<int>(config::Mounting::kHorizontal));
+  sup.stop();
+  EXPECT_EQ(sup.counters().mounting_changes, 2U);
+}
+
+TEST(Modbus, StopLeavesTheAmplifierOff) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  sup.start();
+  sup.request_amplifier_enable(true);
+  ASSERT_TRUE(eventually([&] { return server.coil(3); }));
+  sup.stop();
+  EXPECT_FALSE(server.coil(3));
+}
+
+}  // namespace
+}  // namespace robodamp
