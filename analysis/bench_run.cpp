@@ -70,53 +70,71 @@ control::ControllerParams Bench::controller_params(double gain, int polarity) co
   return params;
 }
 
+ImpactCampaign::ImpactCampaign(const config::Config& cfg, sim::Plant& plant, const ImpactTest& t, double start_s)
+    : plant_(plant),
+      acc_(static_cast<std::size_t>(std::lround(cfg.bench.record_s * cfg.loop.rate_hz)), cfg.loop.rate_hz,
+           cfg.bench.zero_pad, Window::kRectangular, cfg.analysis.band_max_hz * 1.5, plant.model().locations.size()),
+      start_s_(start_s) {
+  const auto& b = cfg.bench;
+  const double fs = cfg.loop.rate_hz;
+  record_n_ = static_cast<std::size_t>(std::lround(b.record_s * fs));
+  // Hits come at irregular intervals, as from an operator (seeded): the drive vibration then enters each
+  // record with a random phase and averages out of the cross spectrum instead of adding coherently.
+  std::mt19937_64 rng(cfg.disturbances.seed * 31 + t.excitation);
+  std::uniform_real_distribution<double> gap(0.0, 1.0);
+  std::vector<double> hits;
+  double start = start_s;
+  for (int i = 0; i < b.averages; ++i) {
+    start += gap(rng);
+    start_n_.push_back(static_cast<std::size_t>(std::lround(start * fs)));
+    hits.push_back(start + kPretriggerS);
+    start += b.record_s;
+  }
+  hammer_ = plant.add_excitation(std::make_unique<sim::ImpactHammer>(t.excitation, t.peak_n, t.duration_ms * 1e-3, hits));
+  const std::size_t nl = plant.model().locations.size();
+  for (std::size_t l = 0; l < nl; ++l)
+    meas_.emplace_back(measurement_sensor(cfg), fs, cfg.disturbances.seed * 7919 + 101 * (l + 1) + 13 * t.excitation);
+  total_ = start_n_.back() + record_n_;
+  force_.assign(record_n_, 0.0);
+  response_.assign(nl, std::vector<double>(record_n_));
+}
+
+void ImpactCampaign::before_step(std::size_t k) {
+  while (seg_ + 1 < start_n_.size() && k >= start_n_[seg_ + 1]) ++seg_;
+  if (k < start_n_[seg_] || k >= start_n_[seg_] + record_n_) return;
+  const std::size_t i = k - start_n_[seg_];
+  for (std::size_t l = 0; l < meas_.size(); ++l) response_[l][i] = meas_[l].measure(plant_.acceleration_mps2(l));
+}
+
+void ImpactCampaign::after_step(std::size_t k) {
+  if (k < start_n_[seg_] || k >= start_n_[seg_] + record_n_) return;
+  const std::size_t i = k - start_n_[seg_];
+  force_[i] = plant_.excitation_force_n(hammer_);
+  if (i + 1 == record_n_) acc_.add(force_, response_);
+}
+
+std::vector<FrfEstimate> ImpactCampaign::receptance() const {
+  std::vector<FrfEstimate> r;
+  for (std::size_t l = 0; l < meas_.size(); ++l) {
+    r.push_back(acc_.result(l));
+    accelerance_to_receptance(r.back());
+  }
+  return r;
+}
+
 ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
   const auto wall0 = std::chrono::steady_clock::now();
-  const auto& b = cfg_.bench;
   const double fs = cfg_.loop.rate_hz;
   sim::Plant plant = make_plant();
   const control::ControllerParams params = controller_params(t.gain_ns_per_m, t.polarity);
   control::Controller controller(params);
-
-  const double settle = settle_time_s(params);
-  const auto record_n = static_cast<std::size_t>(std::lround(b.record_s * fs));
-  // Hits come at irregular intervals, as from an operator (seeded): the drive vibration then enters each
-  // record with a random phase and averages out of the cross spectrum instead of adding coherently.
-  std::mt19937_64 rng(cfg_.disturbances.seed * 31 + t.excitation);
-  std::uniform_real_distribution<double> gap(0.0, 1.0);
-  std::vector<double> hits, starts;
-  double start = settle;
-  for (int i = 0; i < b.averages; ++i) {
-    start += gap(rng);
-    starts.push_back(start);
-    hits.push_back(start + kPretriggerS);
-    start += b.record_s;
-  }
-  const std::size_t hammer =
-      plant.add_excitation(std::make_unique<sim::ImpactHammer>(t.excitation, t.peak_n, t.duration_ms * 1e-3, hits));
-
-  const std::size_t nl = model_.plant().locations.size();
-  std::vector<sim::Accelerometer> meas;
-  for (std::size_t l = 0; l < nl; ++l)
-    meas.emplace_back(measurement_sensor(cfg_), fs, cfg_.disturbances.seed * 7919 + 101 * (l + 1) + 13 * t.excitation);
-  FrfAccumulator acc(record_n, fs, b.zero_pad, Window::kRectangular, cfg_.analysis.band_max_hz * 1.5, nl);
-
-  std::vector<std::size_t> start_n;
-  for (double s0 : starts) start_n.push_back(static_cast<std::size_t>(std::lround(s0 * fs)));
-  const std::size_t total = start_n.back() + record_n;
-  std::vector<double> force(record_n);
-  std::vector<std::vector<double>> response(nl, std::vector<double>(record_n));
+  ImpactCampaign campaign(cfg_, plant, t, settle_time_s(params));
   ImpactTestResult r;
   double command = 0.0;
   std::uint64_t saturated_ticks = 0;
-  std::size_t seg = 0;
-  for (std::size_t k = 0; k < total; ++k) {
+  for (std::size_t k = 0; k < campaign.end_tick(); ++k) {
     // At t_k: sample, compute; the command reaches the amplifier at the next tick.
-    while (seg + 1 < start_n.size() && k >= start_n[seg + 1]) ++seg;
-    const bool recording = k >= start_n[seg] && k < start_n[seg] + record_n;
-    const std::size_t i = recording ? k - start_n[seg] : 0;
-    if (recording)
-      for (std::size_t l = 0; l < nl; ++l) response[l][i] = meas[l].measure(plant.acceleration_mps2(l));
+    campaign.before_step(k);
     const sim::SensorReading s = plant.sense();
     double next = 0.0;
     if (t.control_on) {
@@ -130,17 +148,13 @@ ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
     plant.step(command);
     if (plant.counters().force_limited + plant.counters().voltage_clipped > limited0) ++saturated_ticks;
     command = next;
-    if (recording) force[i] = plant.excitation_force_n(hammer);
+    campaign.after_step(k);
     r.peak_actuator_force_n = std::max(r.peak_actuator_force_n, std::abs(plant.actuator_force_n()));
     if (!std::isfinite(plant.acceleration_mps2(0))) r.finite = false;
-    if (recording && i + 1 == record_n) acc.add(force, response);
   }
-  for (std::size_t l = 0; l < nl; ++l) {
-    r.receptance.push_back(acc.result(l));
-    accelerance_to_receptance(r.receptance.back());
-  }
+  r.receptance = campaign.receptance();
   r.saturation_time_s = static_cast<double>(saturated_ticks) / fs;
-  r.simulated_s = static_cast<double>(total) / fs;
+  r.simulated_s = static_cast<double>(campaign.end_tick()) / fs;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return r;
 }

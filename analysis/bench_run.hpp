@@ -15,6 +15,7 @@
 #include "analysis/spectral.hpp"
 #include "control/controller_params.hpp"
 #include "sim_plant/plant.hpp"
+#include "sim_plant/sensor.hpp"
 
 namespace robodamp::analysis {
 
@@ -34,6 +35,37 @@ struct ImpactTestResult {
   double simulated_s{0.0};
   double wall_s{0.0};
   bool finite{true};
+};
+
+// The measuring side of an impact test on a plant someone else steps, tick by tick (the bench steps it
+// in process; the HIL emulator steps it for a controller in another process): `averages` hammer hits at
+// irregular, seeded intervals from start_s on, the measurement accelerometers at every location, and
+// the H1 receptance over the whole records (rectangular window, zero-padded).
+class ImpactCampaign {
+ public:
+  // Adds the hammer to the plant. Plant time is tick / loop.rate_hz.
+  ImpactCampaign(const config::Config& cfg, sim::Plant& plant, const ImpactTest& t, double start_s);
+  // Tick k, before plant.step(): the responses.
+  void before_step(std::size_t k);
+  // Tick k, after plant.step(): the hammer's force; a record is complete at its last tick.
+  void after_step(std::size_t k);
+  [[nodiscard]] std::size_t end_tick() const { return total_; }  // ticks until the last record is complete
+  [[nodiscard]] bool done(std::size_t k) const { return k >= total_; }
+  [[nodiscard]] int records() const { return acc_.averages(); }
+  [[nodiscard]] double start_s() const { return start_s_; }
+  // Per location.
+  [[nodiscard]] std::vector<FrfEstimate> receptance() const;
+
+ private:
+  sim::Plant& plant_;
+  std::size_t hammer_{0};
+  std::vector<sim::Accelerometer> meas_;
+  FrfAccumulator acc_;
+  std::vector<std::size_t> start_n_;
+  std::size_t record_n_{0}, total_{0}, seg_{0};
+  std::vector<double> force_;
+  std::vector<std::vector<double>> response_;
+  double start_s_{0.0};
 };
 
 struct DivergenceRun {
