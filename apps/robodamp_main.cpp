@@ -14,6 +14,7 @@
 #include "apps/filters_command.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/milling_command.hpp"
+#include "apps/plant_command.hpp"
 #include "apps/run_command.hpp"
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
@@ -168,7 +169,8 @@ int main(int argc, char** argv) {
 
   robodamp::apps::RunOptions run_opts;
   std::string clock;
-  auto* run = app.add_subcommand("run", "The real-time loop (simulated plant backend), paced on the wall clock; Ctrl-C ends it safely");
+  auto* run = app.add_subcommand("run", "The real-time loop against the simulated plant, or the hardware (can + modbus sections: "
+                                        "a CAN interface or the HIL emulator); Ctrl-C ends it safely");
   run->add_option("--config", config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   run->add_option("--duration", run_opts.duration_s, "Run time in seconds")->capture_default_str();
   run->add_option("--record", run_opts.record_path, "Record every tick to this file (binary, docs/recording_format.md)");
@@ -180,6 +182,20 @@ int main(int argc, char** argv) {
   run->add_option("--impact-every", run_opts.impact_every_s,
                   "Simulated plant: a hammer hit at the TCP every S seconds (bench.impact_peak_n); 0 = none")
       ->capture_default_str();
+
+  robodamp::apps::PlantOptions plant_opts;
+  std::string pacing;
+  auto* plant = app.add_subcommand("plant", "HIL plant emulator: the simulated plant behind CAN frames and Modbus registers, "
+                                            "in its own process, for `robodamp run` to control");
+  plant->add_option("--config", config_path, "Configuration file (YAML) with can, modbus and hil sections")->check(CLI::ExistingFile);
+  plant->add_option("--pacing", pacing, "Override hil.pacing: realtime (true HIL) or lockstep (one step per command frame)")
+      ->check(CLI::IsMember({"realtime", "lockstep"}));
+  plant->add_option("--duration", plant_opts.duration_s, "Stop after this much plant time, s (0 = when the controller leaves)");
+  plant->add_option("--json", plant_opts.json_path, "Write the report (frames, timing, measured FRFs) as JSON to this file");
+  plant->add_flag("!--no-impacts", plant_opts.impacts, "Do not run the impact schedule");
+  plant->add_option("--impact-location", plant_opts.impact_location, "Location id the hammer hits (default: the first FRF's excitation)");
+  plant->add_option("--mounting", plant_opts.mounting_schedule,
+                    "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
 
   std::string recording, csv_out;
   auto* replay = app.add_subcommand("replay", "Feed a recording's inputs through the same controller; check the commands bit for bit");
@@ -210,6 +226,11 @@ int main(int argc, char** argv) {
     run_opts.config_path = config_path;
     if (!clock.empty()) run_opts.clock = clock == "wall" ? robodamp::config::ClockKind::kWall : robodamp::config::ClockKind::kVirtual;
     return robodamp::apps::run_loop(run_opts);
+  }
+  if (plant->parsed()) {
+    plant_opts.config_path = config_path;
+    if (!pacing.empty()) plant_opts.pacing = pacing == "lockstep" ? robodamp::config::HilPacing::kLockstep : robodamp::config::HilPacing::kRealtime;
+    return robodamp::apps::run_plant(plant_opts);
   }
   if (replay->parsed()) return robodamp::apps::run_replay(recording);
   if (csv->parsed()) return robodamp::apps::run_csv(recording, csv_out);

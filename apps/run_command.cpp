@@ -6,7 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "apps/sim_session.hpp"
+#include "apps/session.hpp"
 #include "rt/recording.hpp"
 #include "rt/signals.hpp"
 
@@ -29,10 +29,11 @@ int run_loop(const RunOptions& o) {
     so.clock = o.clock;
     so.impact_every_s = o.impact_every_s;
     so.record_path = o.record_path;
-    SimSession session(cfg, so);
+    Session session(cfg, so);
     rt::install_shutdown_handlers();
-    spdlog::info("robodamp run: {} at {} Hz on the {} clock for {} s (Ctrl-C ends it through the safe state)",
-                 o.config_path, cfg.loop.rate_hz, config::to_string(session.config().loop.clock), o.duration_s);
+    spdlog::info("robodamp run: {} at {} Hz on the {} clock for {} s against {} (Ctrl-C ends it through the safe state)",
+                 o.config_path, cfg.loop.rate_hz, config::to_string(session.config().loop.clock), o.duration_s,
+                 session.hardware() ? "the hardware" : "the simulated plant");
     const RunSummary s = session.run(o.duration_s);
     std::cout << summary_text(s);
     if (!o.json_path.empty()) {
@@ -71,6 +72,9 @@ int run_loop(const RunOptions& o) {
     return 2;
   } catch (const rt::RecordingError& e) {
     std::cerr << "--record: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {  // a CAN transport or interface that cannot be opened
+    std::cerr << "robodamp run: " << e.what() << '\n';
     return 1;
   }
 }

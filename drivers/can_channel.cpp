@@ -5,6 +5,10 @@
 #include <ctime>
 #include <linux/can/raw.h>
 #include <net/if.h>
+#include <poll.h>
+#include <sys/un.h>
+#include <thread>
+#include <chrono>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <system_error>
@@ -39,6 +43,66 @@ CanChannel CanChannel::open_interface(const std::string& interface, bool fd_fram
   addr.can_ifindex = ifr.ifr_ifindex;
   if (::bind(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) fail(s, "CAN interface '" + interface + "': bind");
   return CanChannel(s, true);
+}
+
+namespace {
+sockaddr_un unix_address(const std::string& path) {
+  sockaddr_un a{};
+  a.sun_family = AF_UNIX;
+  if (path.size() >= sizeof a.sun_path)
+    throw std::system_error(ENAMETOOLONG, std::generic_category(), "CAN transport unix:" + path);
+  std::memcpy(a.sun_path, path.c_str(), path.size() + 1);
+  return a;
+}
+}  // namespace
+
+CanChannel CanChannel::connect_unix(const std::string& path, double timeout_s) {
+  const sockaddr_un a = unix_address(path);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (true) {
+    const int s = ::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+    if (s < 0) fail(-1, "CAN transport unix:" + path + ": socket");
+    if (::connect(s, reinterpret_cast<const sockaddr*>(&a), sizeof a) == 0) return CanChannel(s, false);
+    const int e = errno;
+    ::close(s);
+    if ((e != ENOENT && e != ECONNREFUSED) || std::chrono::steady_clock::now() >= end) {
+      errno = e;
+      fail(-1, "CAN transport unix:" + path + ": connect (is `robodamp plant` running?)");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+CanChannel CanChannel::open(const std::string& interface, bool fd, std::uint32_t rx_id, bool rx_extended,
+                            double connect_timeout_s) {
+  if (interface.rfind("unix:", 0) == 0) return connect_unix(interface.substr(5), connect_timeout_s);
+  return open_interface(interface, fd, rx_id, rx_extended);
+}
+
+bool CanChannel::wait_readable(std::int64_t timeout_ns) const noexcept {
+  pollfd p{fd_, POLLIN, 0};
+  const timespec ts{static_cast<time_t>(timeout_ns / 1'000'000'000), static_cast<long>(timeout_ns % 1'000'000'000)};
+  return ::ppoll(&p, 1, &ts, nullptr) > 0;
+}
+
+CanListener::CanListener(const std::string& path) : path_(path) {
+  const sockaddr_un a = unix_address(path);
+  fd_ = ::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+  if (fd_ < 0) fail(-1, "CAN transport unix:" + path + ": socket");
+  ::unlink(path.c_str());  // a stale socket file of an emulator that died
+  if (::bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) < 0) fail(fd_, "CAN transport unix:" + path + ": bind");
+  if (::listen(fd_, 1) < 0) fail(fd_, "CAN transport unix:" + path + ": listen");
+}
+
+CanListener::~CanListener() {
+  if (fd_ >= 0) ::close(fd_);
+  ::unlink(path_.c_str());
+}
+
+int CanListener::accept(double timeout_s) {
+  pollfd p{fd_, POLLIN, 0};
+  if (::poll(&p, 1, static_cast<int>(timeout_s * 1000.0)) <= 0) return -1;
+  return ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
 }
 
 CanChannel& CanChannel::operator=(CanChannel&& o) noexcept {

@@ -34,7 +34,8 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
   for (int i = 0; i < kMaxFramesPerTick; ++i) {
     canfd_frame f{};
     std::int64_t ts = 0;
-    const int n = channel_.receive(f, ts);
+    int n = channel_.receive(f, ts);
+    if (n == 0 && i == 0 && lockstep_wait_ns_ > 0 && channel_.wait_readable(lockstep_wait_ns_)) n = channel_.receive(f, ts);
     if (n == 0) break;
     if (n == -ENOTCONN) {
       link_lost_ = true;

@@ -42,6 +42,11 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
  public:
   CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz);
 
+  // Lockstep pacing (virtual clock against the HIL emulator): each read waits up to wait_s for the
+  // tick's sensor frame, which the emulator sends once it has the previous command. 0 (the default, and
+  // always on the wall clock): never wait.
+  void set_lockstep_wait(double wait_s) noexcept { lockstep_wait_ns_ = static_cast<std::int64_t>(wait_s * 1e9); }
+
   [[nodiscard]] rt::SensorSample read(std::uint64_t tick) noexcept override;
   [[nodiscard]] rt::ActuatorStatus write(double command_v, std::uint64_t tick) noexcept override;
 
@@ -87,6 +92,7 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   std::uint64_t backoff_ticks_{0}, backoff_initial_ticks_{1}, backoff_max_ticks_{1};
   int consecutive_tx_failures_{0};
   std::uint32_t tx_counter_{0};
+  std::int64_t lockstep_wait_ns_{0};
 };
 
 }  // namespace robodamp::drivers

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -43,8 +44,13 @@ class Loop {
   Loop(double rate_hz, config::ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
        SupervisoryIo& io, SpscRing<TelemetryFrame>* telemetry);
 
-  // From one operator thread: queue a command for the next tick boundary. False when the queue is full.
-  bool post(const OperatorCommand& c) noexcept { return commands_.push(c); }
+  // From any non-real-time thread (operator, Modbus pose, DDS parameter requests): queue a command for
+  // the next tick boundary. False when the queue is full. The producers take turns under a mutex; the
+  // loop only pops the ring and never waits for it.
+  bool post(const OperatorCommand& c) noexcept {
+    std::lock_guard<std::mutex> lock(post_mutex_);
+    return commands_.push(c);
+  }
   // Before run(): a command for a given tick (a script: tests, virtual-clock runs). A scheduled command
   // takes the tick before posted ones; if its tick was skipped it runs at the next tick.
   void schedule(std::uint64_t tick, const OperatorCommand& c);
@@ -70,6 +76,7 @@ class Loop {
   SupervisoryIo& io_;
   SpscRing<TelemetryFrame>* telemetry_;
   SpscRing<OperatorCommand> commands_{64};
+  std::mutex post_mutex_;
   std::vector<std::pair<std::uint64_t, OperatorCommand>> scheduled_;
   std::size_t next_scheduled_{0};
   std::atomic<bool> stop_{false};

@@ -18,7 +18,7 @@
 #include <unistd.h>
 
 #include "analysis/loop_model.hpp"
-#include "apps/sim_session.hpp"
+#include "apps/session.hpp"
 #include "rt/recording.hpp"
 #include "rt/telemetry_drain.hpp"
 #include "control/controller.hpp"
@@ -161,7 +161,7 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
   apps::SessionOptions o;
   o.clock = config::ClockKind::kVirtual;
-  apps::SimSession session(cfg, o);
+  apps::Session session(cfg, o);
   auto& plant = session.plant();
   std::vector<double> hits;
   for (double t = 1.0; t < 200.0; t += 1.7) hits.push_back(t);
@@ -226,7 +226,7 @@ long resident_kib() {
 // thread allocates nothing, nothing is dropped, and the resident memory stays flat.
 TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-  apps::SimSession session(cfg, {});
+  apps::Session session(cfg, {});
   std::vector<double> hits;
   for (double t = 0.5; t < 60.0; t += 2.0) hits.push_back(t);
   session.plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, 1000.0, 1e-3, hits));

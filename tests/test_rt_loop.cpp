@@ -10,7 +10,7 @@
 #include <cstring>
 #include <thread>
 
-#include "apps/sim_session.hpp"
+#include "apps/session.hpp"
 #include "rt/recording.hpp"
 #include "rt/signals.hpp"
 #include "test_util.hpp"
@@ -19,7 +19,7 @@ namespace robodamp::rt {
 namespace {
 
 using apps::SessionOptions;
-using apps::SimSession;
+using apps::Session;
 using sim::FaultKind;
 
 config::Config c2() { return config::load_config_file(test::preset("horizontal_c2")); }
@@ -37,7 +37,7 @@ struct Outcome {
 
 template <typename Setup>
 Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, SessionOptions o = virtual_clock()) {
-  SimSession session(cfg, o);
+  Session session(cfg, o);
   session.keep_frames(true);
   setup(session);
   Outcome out;
@@ -46,7 +46,7 @@ Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, Session
   return out;
 }
 Outcome run(const config::Config& cfg, double duration_s, SessionOptions o = virtual_clock()) {
-  return run(cfg, duration_s, [](SimSession&) {}, o);
+  return run(cfg, duration_s, [](Session&) {}, o);
 }
 
 // Every tick the loop ran reached the consumer, in order, none twice.
@@ -124,13 +124,13 @@ TEST(Loop, ArmsOnceLiveFadesInDampsAndDisarmsToDisabled) {
 TEST(Loop, ArmingRefusedUntilSensorLive) {
   SessionOptions o = virtual_clock();
   o.arm_at_start = false;
-  const auto r = run(c2(), 0.1, [](SimSession& s) { s.schedule(3, {CommandKind::kArm, 0.0}); }, o);
+  const auto r = run(c2(), 0.1, [](Session& s) { s.schedule(3, {CommandKind::kArm, 0.0}); }, o);
   EXPECT_EQ(r.s.supervisor.arm_refused, 1U);
   EXPECT_EQ(first_state(r, State::kArming), r.frames.size());
 }
 
 TEST(Loop, ArmingRefusedWithAmplifierFault) {
-  SimSession session(c2(), virtual_clock());
+  Session session(c2(), virtual_clock());
   session.plant().faults().add({FaultKind::kAmplifierFault, 0.0, 1.0});
   const auto s = session.run(0.2);
   EXPECT_EQ(s.supervisor.arm_refused, 1U);
@@ -141,7 +141,7 @@ TEST(Loop, ArmingRefusedWithAmplifierFault) {
 TEST(Loop, ArmingRefusedWhenTheAnalysisFindsTheGainUnstable) {
   auto cfg = c2();
   cfg.controller.gain_ns_per_m = 6000.0;  // K_max 4805
-  SimSession session(cfg, virtual_clock());
+  Session session(cfg, virtual_clock());
   const auto s = session.run(0.2);
   EXPECT_FALSE(s.analysis_stable);
   EXPECT_EQ(s.supervisor.arm_refused, 1U);
@@ -151,7 +151,7 @@ TEST(Loop, ArmingRefusedWhenTheAnalysisFindsTheGainUnstable) {
 TEST(Loop, ArmingRefusedAboveTheGainMargin) {
   auto cfg = c2();
   cfg.controller.gain_ns_per_m = 4700.0;  // stable, but above max_gain_fraction 0.9 x 4805
-  SimSession session(cfg, virtual_clock());
+  Session session(cfg, virtual_clock());
   const auto s = session.run(0.2);
   EXPECT_TRUE(s.analysis_stable);
   EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kAnalysisUnstable);
@@ -170,7 +170,7 @@ class Trips : public ::testing::TestWithParam<TripCase> {};
 
 TEST_P(Trips, RampToZeroWithinTheConfiguredTimeAndLatch) {
   const TripCase& c = GetParam();
-  const auto r = run(c2(), 2.0, [&](SimSession& s) { s.plant().faults().add(c.fault); });
+  const auto r = run(c2(), 2.0, [&](Session& s) { s.plant().faults().add(c.fault); });
   const double t = expect_trip(r, c.trip, c.fault.start_s, c.detection_s);
   RecordProperty("fault_to_zero_ms", std::to_string(t * 1e3));
   std::printf("[ trip     ] %-22s fault to zero command %.2f ms\n", c.name, t * 1e3);
@@ -192,7 +192,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Loop, AStuckSensorIsNotATripButItsOutputStaysBounded) {
   // A stuck reading is finite, in range and (for this DAQ) fresh: nothing to trip on at once. The chain's
   // high-pass takes the constant out, so the command decays instead of holding an offset.
-  const auto r = run(c2(), 3.0, [](SimSession& s) { s.plant().faults().add({FaultKind::kSensorStuck, 1.0, 1.5}); });
+  const auto r = run(c2(), 3.0, [](Session& s) { s.plant().faults().add({FaultKind::kSensorStuck, 1.0, 1.5}); });
   EXPECT_EQ(r.s.trip, "none");
   const std::size_t i = static_cast<std::size_t>(2.4 * 5000);
   EXPECT_LT(std::abs(r.frames[i].command_v), 0.01);
@@ -239,7 +239,7 @@ TEST(Loop, NoFalseInstabilityTripWithImpactsAtTheConfiguredGain) {
 }
 
 TEST(Loop, ResetFaultThenRearm) {
-  const auto r = run(c2(), 3.0, [](SimSession& s) {
+  const auto r = run(c2(), 3.0, [](Session& s) {
     s.plant().faults().add({FaultKind::kSensorNan, 1.0, 0.01});
     s.schedule(static_cast<std::uint64_t>(1.005 * 5000), {CommandKind::kResetFault, 0.0});  // refused: ramp not over
     s.schedule(static_cast<std::uint64_t>(1.2 * 5000), {CommandKind::kResetFault, 0.0});
@@ -257,7 +257,7 @@ TEST(Loop, ResetFaultThenRearm) {
 }
 
 TEST(Loop, GainRequestsAreValidatedAndRamped) {
-  const auto r = run(c2(), 3.0, [](SimSession& s) {
+  const auto r = run(c2(), 3.0, [](Session& s) {
     s.schedule(5000, {CommandKind::kSetGain, 3000.0});
     s.schedule(5001, {CommandKind::kSetGain, 4400.0});  // > 0.9 x K_max = 4324: refused
     s.schedule(5002, {CommandKind::kSetGain, NAN});
@@ -278,7 +278,7 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   unstable.controller.gain_ns_per_m = 3000.0;
   SessionOptions o = virtual_clock();
   o.record_path = ::testing::TempDir() + "/select_params.rec";
-  SimSession session(c2(), o);
+  Session session(c2(), o);
   session.keep_frames(true);
   const std::size_t c3 = session.add_parameter_set(config::load_config_file(test::preset("horizontal_c3")));
   const std::size_t bad = session.add_parameter_set(unstable);
@@ -310,7 +310,7 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
 TEST(Loop, VirtualClockRunsAreBitIdentical) {
   SessionOptions o = virtual_clock();
   o.impact_every_s = 0.7;
-  auto setup = [](SimSession& s) {
+  auto setup = [](Session& s) {
     s.plant().faults().add({FaultKind::kSensorSpike, 1.5, 0.001, 1e5});
     s.schedule(2000, {CommandKind::kSetGain, 2500.0});
   };
@@ -324,7 +324,7 @@ TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
   // One driver call stalls for 1.1 ms (5.5 periods at 5 kHz): the loop skips the ticks it missed.
   SessionOptions o;
   o.realtime_setup = true;
-  const auto r = run(c2(), 0.6, [](SimSession& s) { s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3}); }, o);
+  const auto r = run(c2(), 0.6, [](Session& s) { s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3}); }, o);
   expect_nothing_lost(r);
   EXPECT_GE(r.s.loop.missed_ticks, 4U);
   EXPECT_EQ(r.s.loop.ticks_run + r.s.loop.missed_ticks, r.frames.back().tick + 1) << "every nominal tick run or skipped";
@@ -342,7 +342,7 @@ TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
 TEST(Loop, ConsecutiveOverrunsTrip) {
   SessionOptions o;
   auto cfg = c2();
-  const auto r = run(cfg, 1.5, [](SimSession& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  const auto r = run(cfg, 1.5, [](Session& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
   EXPECT_EQ(r.s.trip, "overruns");
   expect_nothing_lost(r);
   const std::size_t fault = first_state(r, State::kFault);
@@ -354,7 +354,7 @@ TEST(Loop, SigintShutsDownThroughTheSafeState) {
   install_shutdown_handlers();
   shutdown_signal().store(0);
   SessionOptions o;
-  SimSession session(c2(), o);
+  Session session(c2(), o);
   session.keep_frames(true);
   std::thread killer([] {
     std::this_thread::sleep_for(std::chrono::milliseconds(800));

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <thread>
 
-#include "apps/sim_session.hpp"
+#include "apps/session.hpp"
 #include "rt/recording.hpp"
 #include "rt/spsc_ring.hpp"
 #include "rt/timing_histogram.hpp"
@@ -69,7 +69,7 @@ class RecordingTest : public ::testing::Test {
     o.clock = config::ClockKind::kVirtual;
     o.record_path = path_;
     o.impact_every_s = 0.4;
-    apps::SimSession session(config::load_config_file(test::preset("horizontal_c2")), o);
+    apps::Session session(config::load_config_file(test::preset("horizontal_c2")), o);
     session.keep_frames(true);
     session.plant().faults().add({sim::FaultKind::kSensorNan, 1.2, 0.001});
     session.schedule(3000, {CommandKind::kSetGain, 2600.0});

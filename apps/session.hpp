@@ -1,8 +1,13 @@
-// A loop session against the simulated plant: the configuration analysed (stability and the maximum
-// stable gain, for the supervisor's arming and gain checks), the plant with the configured disturbances
-// behind the simulated backend, the supervisor and its controller, the loop, the telemetry ring and its
-// drain thread with the recorder and live timing. `robodamp run` and the loop tests use it; the same
-// pieces with hardware drivers in place of the backend make the deployment.
+// A loop session: the configuration analysed (stability and the maximum stable gain, for the
+// supervisor's arming and gain checks), the supervisor and its controller, the loop, the telemetry ring
+// and its drain thread with the recorder and live timing, behind one of two backends:
+// - the simulated plant in process (no can / modbus sections): the plant with the configured
+//   disturbances behind drivers/sim_backend;
+// - hardware (can and modbus sections): the CAN driver for the sensor and the amplifier command (a
+//   PF_CAN interface, or "unix:PATH" to the HIL emulator) and the Modbus supervisory client for the
+//   amplifier's enable and status and the robot's mounting, which selects among parameter_sets.
+// On the virtual clock the CAN driver paces the loop in lockstep with the emulator (it waits for each
+// sensor frame). `robodamp run` and the loop tests use it.
 #pragma once
 
 #include <memory>
@@ -14,6 +19,8 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/loop_model.hpp"
+#include "drivers/can_driver.hpp"
+#include "drivers/modbus_supervisor.hpp"
 #include "drivers/sim_backend.hpp"
 #include "rt/loop.hpp"
 #include "rt/realtime.hpp"
@@ -33,6 +40,14 @@ struct SessionOptions {
   // analysed for (another pose, a worn actuator): the plant is built from this one.
   std::optional<config::Config> plant_config;
   drivers::SimBackendOptions backend{};
+  double connect_timeout_s{10.0};  // hardware: waiting for the CAN transport and the amplifier's first poll
+};
+
+// When the run lost its sensor and went safe (from the telemetry frames; loop time since the start).
+struct TripTiming {
+  double last_fresh_s{-1.0};  // the last fresh sensor sample before the trip
+  double trip_s{-1.0};        // the first tick with a latched trip
+  double safe_s{-1.0};        // the first tick after it with zero command and the amplifier enable off
 };
 
 struct RunSummary {
@@ -48,26 +63,37 @@ struct RunSummary {
   rt::RealtimeStatus realtime;
   std::uint64_t telemetry_frames{0};
   std::uint64_t recorded_frames{0}, record_errors{0};
+  std::string backend;  // "simulated plant" or the CAN transport and Modbus endpoints
+  std::optional<drivers::CanCounters> can;
+  std::optional<drivers::ModbusCounters> modbus;
+  TripTiming trip_timing;
   std::string record_path;
   double sensor_rms_mps2{0.0};  // control accelerometer over the run
   double peak_command_v{0.0};
 };
 
-class SimSession {
+class Session {
  public:
-  explicit SimSession(const config::Config& cfg, const SessionOptions& o = {});
-  ~SimSession();
+  explicit Session(const config::Config& cfg, const SessionOptions& o = {});
+  ~Session();
 
   // Before run(): more operator commands at given ticks (deterministic on the virtual clock).
   void schedule(std::uint64_t tick, const rt::OperatorCommand& c) { loop_->schedule(tick, c); }
   // Before run(): another controller parameter set (designed and analysed from cfg, same loop rate)
   // that a select_params command may hand over to. Returns its index.
   std::size_t add_parameter_set(const config::Config& cfg);
+  // From any non-real-time thread while running: an operator command for the next tick boundary.
+  bool post(const rt::OperatorCommand& c) { return loop_->post(c); }
+  // The parameter set for a mounting (set 0 is the configuration's own), if there is one.
+  [[nodiscard]] std::optional<std::size_t> parameter_set_for(config::Mounting m) const;
+  [[nodiscard]] bool hardware() const { return can_ != nullptr; }
+  [[nodiscard]] drivers::CanDriver* can_driver() { return can_.get(); }
+  [[nodiscard]] drivers::ModbusSupervisor* modbus() { return modbus_.get(); }
   // Runs for duration_s of loop time on a thread of its own (set up for real time on the wall clock),
   // then disarms to the safe state; blocks until done.
   RunSummary run(double duration_s);
 
-  [[nodiscard]] sim::Plant& plant() { return *plant_; }
+  [[nodiscard]] sim::Plant& plant() { return *plant_; }  // simulated backend only
   [[nodiscard]] drivers::SimBackend& backend() { return *backend_; }
   [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }
   [[nodiscard]] rt::Loop& loop() { return *loop_; }
@@ -86,6 +112,13 @@ class SimSession {
   bool stable_{false};
   std::unique_ptr<sim::Plant> plant_;
   std::unique_ptr<drivers::SimBackend> backend_;
+  std::unique_ptr<drivers::CanDriver> can_;
+  std::unique_ptr<drivers::ModbusSupervisor> modbus_;
+  rt::SensorSource* sensor_{nullptr};
+  rt::ActuatorSink* actuator_{nullptr};
+  rt::SupervisoryIo* io_{nullptr};
+  std::vector<std::pair<config::Mounting, std::size_t>> mounting_sets_;
+  std::string backend_name_;
   std::unique_ptr<rt::Supervisor> supervisor_;
   std::unique_ptr<rt::SpscRing<rt::TelemetryFrame>> ring_;
   std::unique_ptr<rt::Loop> loop_;

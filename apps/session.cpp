@@ -1,4 +1,4 @@
-#include "apps/sim_session.hpp"
+#include "apps/session.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -7,32 +7,85 @@
 
 #include "rt/signals.hpp"
 
+#include <spdlog/spdlog.h>
+
 namespace robodamp::apps {
 
-SimSession::SimSession(const config::Config& cfg, const SessionOptions& o) : cfg_(cfg), o_(o) {
+Session::Session(const config::Config& cfg, const SessionOptions& o) : cfg_(cfg), o_(o) {
   if (o_.clock) cfg_.loop.clock = *o_.clock;
   model_ = std::make_unique<analysis::LoopModel>(cfg_);
   const int polarity = cfg_.controller.polarity;
   stable_ = model_->stable(cfg_.controller.gain_ns_per_m, polarity);
   max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
 
-  const config::Config& plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
-  const sim::PlantModel plant_model = o_.plant_config ? sim::build_plant_model(plant_cfg) : model_->plant();
-  plant_ = std::make_unique<sim::Plant>(plant_model, plant_cfg);
-  if (plant_cfg.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(plant_model, plant_cfg));
-  backend_ = std::make_unique<drivers::SimBackend>(*plant_, o_.backend);
+  if (cfg_.can.has_value() != cfg_.modbus.has_value())
+    throw config::ConfigError({{cfg_.source, {}, cfg_.can ? "modbus" : "can",
+                                "missing: a hardware session needs both the can section (sensor and command frames) and "
+                                "the modbus section (the amplifier's enable and status)"}});
+  if (cfg_.can) {
+    const auto& c = *cfg_.can;
+    can_ = std::make_unique<drivers::CanDriver>(
+        c, drivers::CanChannel::open(c.interface, c.fd, c.sensor.id, c.sensor.extended_id, o_.connect_timeout_s),
+        cfg_.loop.rate_hz);
+    // Lockstep with the emulator: a missing frame waits up to this long, then counts towards the stale trip.
+    if (cfg_.loop.clock == config::ClockKind::kVirtual) can_->set_lockstep_wait(1.0);
+    modbus_ = std::make_unique<drivers::ModbusSupervisor>(*cfg_.modbus, cfg_.actuator.mounting, [this](config::Mounting m) {
+      if (const auto set = parameter_set_for(m)) {
+        if (!loop_->post({rt::CommandKind::kSelectParams, static_cast<double>(*set)}))
+          spdlog::warn("the robot reports {} mounting: the command queue is full, selection dropped", config::to_string(m));
+      } else {
+        spdlog::warn("the robot reports {} mounting and no parameter set is configured for it (parameter_sets)",
+                     config::to_string(m));
+      }
+    });
+    sensor_ = can_.get();
+    actuator_ = can_.get();
+    io_ = modbus_.get();
+    backend_name_ = "CAN " + c.interface + (c.fd ? " (FD)" : "") + ", Modbus amplifier " +
+                    config::describe(cfg_.modbus->amplifier_link) +
+                    (cfg_.modbus->robot_link ? ", robot " + config::describe(*cfg_.modbus->robot_link) : "");
+  } else {
+    const config::Config& plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
+    const sim::PlantModel plant_model = o_.plant_config ? sim::build_plant_model(plant_cfg) : model_->plant();
+    plant_ = std::make_unique<sim::Plant>(plant_model, plant_cfg);
+    if (plant_cfg.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(plant_model, plant_cfg));
+    backend_ = std::make_unique<drivers::SimBackend>(*plant_, o_.backend);
+    sensor_ = backend_.get();
+    actuator_ = backend_.get();
+    io_ = backend_.get();
+    backend_name_ = "simulated plant";
+  }
   const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
   supervisor_ = std::make_unique<rt::Supervisor>(rt::supervisor_settings(cfg_, stable_, k_max), model_->chain().params);
   ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
-  loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *backend_, *backend_, *backend_,
+  loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor_, *actuator_, *io_,
                                      ring_.get());
+  mounting_sets_.emplace_back(cfg_.actuator.mounting, 0);
+  for (const auto& ref : cfg_.parameter_sets) {
+    const config::Config other = config::load_config_file(ref.resolved_path);
+    if (other.loop.rate_hz != cfg_.loop.rate_hz)
+      throw config::ConfigError({{cfg_.source, {}, "parameter_sets." + ref.mounting,
+                                  "= '" + ref.path + "' runs at loop.rate_hz = " + std::to_string(other.loop.rate_hz) +
+                                      " Hz; every set must run at this configuration's " +
+                                      std::to_string(cfg_.loop.rate_hz) + " Hz"}});
+    const std::size_t idx = add_parameter_set(other);
+    const auto mounting = ref.mounting == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal;
+    std::erase_if(mounting_sets_, [&](const auto& p) { return p.first == mounting; });
+    mounting_sets_.emplace_back(mounting, idx);
+  }
   if (o_.arm_at_start)
     loop_->schedule(static_cast<std::uint64_t>(cfg_.supervision.arming_live_cycles) + 1, {rt::CommandKind::kArm, 0.0});
 }
 
-SimSession::~SimSession() = default;
+Session::~Session() = default;
 
-std::size_t SimSession::add_parameter_set(const config::Config& cfg) {
+std::optional<std::size_t> Session::parameter_set_for(config::Mounting m) const {
+  for (const auto& [mounting, idx] : mounting_sets_)
+    if (mounting == m) return idx;
+  return std::nullopt;
+}
+
+std::size_t Session::add_parameter_set(const config::Config& cfg) {
   const analysis::LoopModel m(cfg);
   const int polarity = cfg.controller.polarity;
   const auto k_max = analysis::max_stable_gain(m, polarity);
@@ -40,7 +93,7 @@ std::size_t SimSession::add_parameter_set(const config::Config& cfg) {
                                          k_max.value_or(control::kMaxGainNsPerM)});
 }
 
-RunSummary SimSession::run(double duration_s) {
+RunSummary Session::run(double duration_s) {
   RunSummary s;
   s.config = cfg_.source;
   s.clock = config::to_string(cfg_.loop.clock);
@@ -51,7 +104,7 @@ RunSummary SimSession::run(double duration_s) {
   const bool wall = cfg_.loop.clock == config::ClockKind::kWall;
   const auto ticks = static_cast<std::uint64_t>(std::llround(duration_s * cfg_.loop.rate_hz));
 
-  if (o_.impact_every_s > 0.0) {
+  if (o_.impact_every_s > 0.0 && plant_) {
     std::vector<double> hits;
     for (double t = o_.impact_every_s; t < duration_s; t += o_.impact_every_s) hits.push_back(t);
     plant_->add_excitation(std::make_unique<sim::ImpactHammer>(0, cfg_.bench.impact_peak_n,
@@ -64,14 +117,26 @@ RunSummary SimSession::run(double duration_s) {
   if (!o_.record_path.empty())
     recorder = std::make_unique<rt::Recorder>(o_.record_path, rt::recording_header(cfg_, *supervisor_, cfg_.loop.clock));
 
+  s.backend = backend_name_;
+  if (modbus_) {
+    modbus_->start();
+    if (!modbus_->wait_for_amplifier(std::chrono::duration<double>(o_.connect_timeout_s)))
+      spdlog::warn("Modbus: no answer from the amplifier ({}) within {} s; arming will wait for it",
+                   config::describe(cfg_.modbus->amplifier_link), o_.connect_timeout_s);
+  }
   double sum_sq = 0.0, peak = 0.0;
   std::uint64_t n = 0;
+  TripTiming& tt = s.trip_timing;
   frames_.clear();
   std::vector<rt::TelemetryDrain::Consumer> consumers;
   if (recorder) consumers.emplace_back([&recorder](const rt::TelemetryFrame& f) { recorder->write(f); });
   consumers.emplace_back([&](const rt::TelemetryFrame& f) {
     if (std::isfinite(f.accel_mps2)) sum_sq += f.accel_mps2 * f.accel_mps2, ++n;
     peak = std::max(peak, std::abs(f.command_v));
+    if (tt.trip_s < 0.0 && (f.flags & rt::kFlagFresh)) tt.last_fresh_s = f.time_s;
+    if (tt.trip_s < 0.0 && f.trip != 0) tt.trip_s = f.time_s;
+    if (tt.trip_s >= 0.0 && tt.safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable))
+      tt.safe_s = f.time_s;
     if (keep_frames_) frames_.push_back(f);
   });
   rt::TelemetryDrain drain(*ring_, std::move(consumers));
@@ -82,6 +147,11 @@ RunSummary SimSession::run(double duration_s) {
   });
   thread.join();
   drain.stop();
+  if (modbus_) {
+    modbus_->stop();
+    s.modbus = modbus_->counters();
+  }
+  if (can_) s.can = can_->counters();
   if (recorder) {
     recorder->close();
     s.recorded_frames = recorder->frames();
@@ -109,7 +179,7 @@ nlohmann::json summary_json(const RunSummary& s) {
   for (std::size_t i = 1; i < rt::kTripCount; ++i)
     trips[rt::to_string(static_cast<rt::Trip>(i))] = s.supervisor.trips[i];
   const auto ticks = static_cast<double>(std::max<std::uint64_t>(1, s.loop.ticks_run + s.loop.missed_ticks));
-  return {{"config", s.config},
+  json j = {{"config", s.config},
           {"clock", s.clock},
           {"rate_hz", s.rate_hz},
           {"duration_s", s.duration_s},
@@ -146,6 +216,28 @@ nlohmann::json summary_json(const RunSummary& s) {
             {"warnings", s.realtime.warnings}}},
           {"sensor_rms_mps2", s.sensor_rms_mps2},
           {"peak_command_v", s.peak_command_v}};
+  j["backend"] = s.backend;
+  auto t = [](double v) { return v >= 0.0 ? json(v) : json(nullptr); };
+  j["trip_timing"] = {{"last_fresh_s", t(s.trip_timing.last_fresh_s)},
+                      {"trip_s", t(s.trip_timing.trip_s)},
+                      {"safe_s", t(s.trip_timing.safe_s)}};
+  if (s.can) {
+    const auto& c = *s.can;
+    j["can"] = {{"rx_frames", c.rx_frames},       {"rx_other", c.rx_other},     {"rx_malformed", c.rx_malformed},
+                {"lost_frames", c.lost_frames},   {"stale_frames", c.stale_frames}, {"error_frames", c.error_frames},
+                {"bus_off", c.bus_off},           {"restarts", c.restarts},     {"rx_errors", c.rx_errors},
+                {"tx_frames", c.tx_frames},       {"tx_queue_full", c.tx_queue_full}, {"tx_errors", c.tx_errors},
+                {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}};
+  }
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
+                   {"connects", m.connects},               {"connect_failures", m.connect_failures},
+                   {"errors", m.errors},                   {"timeouts", m.timeouts},
+                   {"link_faults", m.link_faults},         {"coil_writes", m.coil_writes},
+                   {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown}};
+  }
+  return j;
 }
 
 std::string summary_text(const RunSummary& s) {
@@ -153,8 +245,8 @@ std::string summary_text(const RunSummary& s) {
   char b[256];
   const auto& st = s.loop;
   const double all = static_cast<double>(std::max<std::uint64_t>(1, st.ticks_run + st.missed_ticks));
-  std::snprintf(b, sizeof b, "robodamp run: %s, simulated plant, %s clock, %.0f Hz, %.3f s (%.3f s elapsed)\n",
-                s.config.c_str(), s.clock.c_str(), s.rate_hz, s.duration_s, st.elapsed_s);
+  std::snprintf(b, sizeof b, "robodamp run: %s, %s, %s clock, %.0f Hz, %.3f s (%.3f s elapsed)\n",
+                s.config.c_str(), s.backend.c_str(), s.clock.c_str(), s.rate_hz, s.duration_s, st.elapsed_s);
   os << b;
   if (s.clock == "wall") {
     os << "  real time: " << (s.realtime.fifo ? "SCHED_FIFO " + std::to_string(s.realtime.priority) : "SCHED_OTHER")
@@ -199,6 +291,35 @@ std::string summary_text(const RunSummary& s) {
     os << "; recorded " << s.recorded_frames << " frames to " << s.record_path
        << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
   os << '\n';
+  if (s.can) {
+    const auto& c = *s.can;
+    std::snprintf(b, sizeof b,
+                  "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
+                  "%llu bus-off; %llu commands sent (%llu queue full, %llu errors, %llu skipped)\n",
+                  static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
+                  static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
+                  static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
+                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.tx_frames),
+                  static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
+                  static_cast<unsigned long long>(c.tx_skipped));
+    os << b;
+  }
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    std::snprintf(b, sizeof b,
+                  "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
+                  "%llu link faults, %llu mounting changes\n",
+                  static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
+                  static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
+                  static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
+                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes));
+    os << b;
+  }
+  if (s.trip_timing.trip_s >= 0.0) {
+    std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s\n", s.trip_timing.trip_s,
+                  s.trip_timing.last_fresh_s, s.trip_timing.safe_s);
+    os << b;
+  }
   if (!s.realtime.warnings.empty())
     os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
   return os.str();

@@ -1,0 +1,407 @@
+#include "hil/plant_emulator.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "analysis/bench_run.hpp"
+#include "drivers/can_channel.hpp"
+#include "drivers/can_codec.hpp"
+#include "drivers/modbus_server.hpp"
+#include "rt/realtime.hpp"
+#include "sim_plant/plant.hpp"
+#include "sim_plant/plant_model.hpp"
+
+namespace robodamp::hil {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kSilentControllerS = 10.0;  // lockstep: no command for this long ends the run
+constexpr double kTemperatureTauS = 10.0;    // amplifier heating time constant
+
+std::int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+sim::Plant make_plant(const config::Config& cfg, const sim::PlantModel& model) {
+  sim::Plant plant(model, cfg);
+  if (cfg.disturbances.drives_on) plant.add_excitation(sim::make_drive_vibration(model, cfg));
+  return plant;
+}
+
+// The amplifier and the robot controller on Modbus: one server per distinct TCP port.
+class Registers {
+ public:
+  explicit Registers(const config::Config& cfg) : m_(*cfg.modbus) {
+    amp_ = std::make_unique<drivers::ModbusServer>();
+    amp_->start(m_.amplifier_link.host, m_.amplifier_link.port);
+    robot_ = amp_.get();
+    if (m_.robot_link && m_.robot_link->port != m_.amplifier_link.port) {
+      robot_server_ = std::make_unique<drivers::ModbusServer>();
+      robot_server_->start(m_.robot_link->host, m_.robot_link->port);
+      robot_ = robot_server_.get();
+    }
+    set_mounting(cfg.actuator.mounting);
+  }
+  [[nodiscard]] bool enable() const { return amp_->coil(m_.amplifier.enable_coil); }
+  void set_ready(bool on) { amp_->set_discrete_input(m_.amplifier.ready_input, on); }
+  void set_temperature(double c) {
+    const double counts = std::clamp(std::round(c / m_.amplifier.temperature_c_per_count), -32768.0, 32767.0);
+    amp_->set_input_register(m_.amplifier.temperature_register, static_cast<std::uint16_t>(static_cast<std::int16_t>(counts)));
+  }
+  void set_mounting(config::Mounting m) {
+    if (m_.robot_link)
+      robot_->set_holding_register(m_.robot.mounting_register, static_cast<std::uint16_t>(
+                                                                   m == config::Mounting::kVertical ? m_.robot.vertical_value
+                                                                                                    : m_.robot.horizontal_value));
+  }
+  [[nodiscard]] std::uint64_t requests() const {
+    return amp_->requests() + (robot_server_ ? robot_server_->requests() : 0);
+  }
+  [[nodiscard]] std::string describe() const {
+    std::string s = "amplifier " + config::describe(m_.amplifier_link);
+    if (m_.robot_link) s += ", robot " + config::describe(*m_.robot_link);
+    return s;
+  }
+
+ private:
+  config::ModbusConfig m_;
+  std::unique_ptr<drivers::ModbusServer> amp_, robot_server_;
+  drivers::ModbusServer* robot_{nullptr};
+};
+
+}  // namespace
+
+EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o) {
+  if (!cfg.can) throw std::runtime_error(cfg.source + ": the emulator needs the can section (frames and transport)");
+  if (!cfg.modbus) throw std::runtime_error(cfg.source + ": the emulator needs the modbus section (amplifier registers)");
+  const config::CanConfig& can = *cfg.can;
+  EmulatorReport rep;
+  rep.config = cfg.source;
+  const config::HilPacing pacing = o.pacing.value_or(cfg.hil.pacing);
+  rep.pacing = config::to_string(pacing);
+  rep.transport = can.interface;
+  const double fs = cfg.loop.rate_hz, dt = 1.0 / fs;
+
+  const sim::PlantModel model = sim::build_plant_model(cfg);
+  sim::Plant plant = make_plant(cfg, model);
+  const int impact_id = o.impact_location > 0 ? o.impact_location
+                                              : (cfg.robot.frfs.empty() ? 1 : cfg.robot.frfs.front().excitation_location);
+  const std::size_t impact_index = model.index_of(impact_id);
+  rep.impact_location = model.locations[impact_index].name + " (location " + std::to_string(impact_id) + ")";
+  const analysis::ImpactTest test{impact_index, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, true,
+                                  cfg.controller.gain_ns_per_m, cfg.controller.polarity};
+  rep.records_planned = o.impacts ? cfg.bench.averages : 0;
+
+  Registers regs(cfg);
+  rep.modbus = regs.describe();
+  regs.set_temperature(cfg.hil.ambient_c);
+
+  // The controller's connection.
+  std::optional<drivers::CanListener> listener;
+  std::optional<drivers::CanChannel> channel;
+  if (can.interface.rfind("unix:", 0) == 0) {
+    listener.emplace(can.interface.substr(5));
+    spdlog::info("robodamp plant: waiting for the controller on {} ({}), Modbus {}", can.interface, rep.pacing, rep.modbus);
+    const int fd = listener->accept(cfg.hil.accept_timeout_s);
+    if (fd < 0) throw std::runtime_error("no controller connected to " + can.interface + " within hil.accept_timeout_s = " +
+                                         std::to_string(cfg.hil.accept_timeout_s) + " s");
+    channel.emplace(drivers::CanChannel::adopt(fd));
+  } else {
+    channel.emplace(drivers::CanChannel::open_interface(can.interface, can.fd, can.command.id, can.command.extended_id));
+  }
+  spdlog::info("robodamp plant: controller connected");
+
+  rt::RealtimeStatus rts;
+  std::optional<rt::RealtimeProcess> rt_process;
+  if (pacing == config::HilPacing::kRealtime && o.realtime_setup) {
+    config::RealtimeConfig rc = cfg.realtime;
+    rc.priority = std::max(0, rc.priority - 1);  // below the loop's thread when both share a machine
+    rc.cpu = -1;
+    rt_process.emplace(rc, rts);
+    rt::setup_realtime_thread(rc, rts);
+    for (const auto& w : rts.warnings) spdlog::warn("robodamp plant: {}", w);
+  }
+
+  std::unique_ptr<analysis::ImpactCampaign> campaign;
+  std::uint32_t sensor_counter = 0, last_cmd_counter = 0;
+  bool have_cmd_counter = false;
+  double command_v = 0.0;     // newest command received
+  double applied_v = 0.0;     // what the amplifier drives this period with
+  bool enabled = false, ready = false;
+  double enabled_at_s = 0.0, ms_v = 0.0, temperature_c = cfg.hil.ambient_c;
+  std::size_t next_mounting = 0;
+  const auto wall0 = Clock::now();
+  std::int64_t deadline = now_ns();
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / fs));
+  const auto max_ticks = o.max_duration_s > 0.0 ? static_cast<std::uint64_t>(std::llround(o.max_duration_s * fs)) : UINT64_MAX;
+
+  auto send_sensor = [&]() {
+    const sim::SensorReading s = plant.sense();
+    const drivers::Encoded e = drivers::encode(can.sensor, can.fd, s.accel_mps2, sensor_counter++);
+    if (channel->send(e.frame, e.frame_bytes) == 0) ++rep.sensor_frames_sent;
+    else ++rep.send_errors;
+  };
+  // Drains the frames waiting; false when the controller has gone.
+  auto receive_commands = [&](bool& got) {
+    got = false;
+    for (;;) {
+      canfd_frame f{};
+      std::int64_t ts = 0;
+      const int n = channel->receive(f, ts);
+      if (n == 0) return true;
+      if (n < 0) return false;
+      const drivers::Decoded d = drivers::decode(can.command, f, n);
+      if (d.error == drivers::DecodeError::kWrongId) {
+        ++rep.frames_other;
+        continue;
+      }
+      if (d.error != drivers::DecodeError::kNone) {
+        ++rep.frames_malformed;
+        continue;
+      }
+      if (can.command.counter) {
+        const int bits = 8 * can.command.counter->size_bytes;
+        const std::uint32_t mask = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
+        const std::uint32_t step = (d.counter - last_cmd_counter) & mask;
+        if (have_cmd_counter && step > 1 && step <= mask / 2) rep.commands_lost += step - 1;
+        last_cmd_counter = d.counter, have_cmd_counter = true;
+      }
+      ++rep.command_frames;
+      command_v = d.value;
+      got = true;
+    }
+  };
+  // One plant period with the amplifier's output, then the amplifier and robot registers.
+  auto step_plant = [&]() {
+    const std::size_t k = rep.ticks;
+    const double t = static_cast<double>(k) * dt;
+    if (campaign) campaign->before_step(k);
+    plant.step(ready ? applied_v : 0.0);
+    if (campaign) {
+      campaign->after_step(k);
+      if (campaign->done(k + 1) && !rep.campaign_complete) {
+        rep.campaign_complete = true;
+        spdlog::info("robodamp plant: impact schedule complete at {:.1f} s ({} records)", t, campaign->records());
+      }
+    }
+    ++rep.ticks;
+    // Amplifier: the enable coil, ready after the delay; heating with the mean-square drive.
+    const bool en = regs.enable();
+    if (en != enabled) {
+      enabled = en, enabled_at_s = t, ++rep.enable_changes;
+      spdlog::info("robodamp plant: amplifier {} at {:.3f} s", en ? "enabled" : "disabled", t);
+    }
+    const bool now_ready = enabled && t - enabled_at_s >= cfg.hil.amplifier_ready_delay_s;
+    if (now_ready != ready) regs.set_ready(now_ready), ready = now_ready;
+    if (enabled) rep.enabled_s += dt;
+    const double v = ready ? applied_v : 0.0;
+    rep.peak_command_v = std::max(rep.peak_command_v, std::abs(v));
+    ms_v += (v * v - ms_v) * dt / kTemperatureTauS;
+    if (k % 100 == 0) {
+      temperature_c = cfg.hil.ambient_c + cfg.hil.heating_c_per_v2 * ms_v;
+      rep.peak_temperature_c = std::max(rep.peak_temperature_c, temperature_c);
+      regs.set_temperature(temperature_c);
+    }
+    // The impact schedule starts settle_s after the amplifier is first ready.
+    if (o.impacts && !campaign && ready) {
+      rep.campaign_started = true;
+      rep.campaign_start_s = t + cfg.hil.settle_s;
+      campaign = std::make_unique<analysis::ImpactCampaign>(cfg, plant, test, rep.campaign_start_s);
+      spdlog::info("robodamp plant: amplifier ready at {:.3f} s; {} impacts at the {} from {:.1f} s", t,
+                   cfg.bench.averages, rep.impact_location, rep.campaign_start_s);
+    }
+    while (next_mounting < o.mounting_schedule.size() && o.mounting_schedule[next_mounting].first <= t) {
+      regs.set_mounting(o.mounting_schedule[next_mounting].second);
+      ++rep.mounting_changes;
+      spdlog::info("robodamp plant: robot reports {} mounting at {:.3f} s",
+                   config::to_string(o.mounting_schedule[next_mounting].second), t);
+      ++next_mounting;
+    }
+  };
+  auto stopping = [&]() { return o.stop_flag != nullptr && o.stop_flag->load() != 0; };
+
+  send_sensor();  // tick 0's sample
+  bool got = false;
+  if (pacing == config::HilPacing::kLockstep) {
+    rep.end_reason = "the controller disconnected";
+    while (rep.ticks < max_ticks) {
+      if (stopping()) {
+        rep.end_reason = "signal";
+        break;
+      }
+      // Command k (the reply to sensor frame k).
+      if (!receive_commands(got)) break;
+      if (!got) {
+        if (!channel->wait_readable(static_cast<std::int64_t>(kSilentControllerS * 1e9))) {
+          rep.end_reason = "the controller went silent (no command frame for 10 s)";
+          break;
+        }
+        continue;
+      }
+      step_plant();  // with command k-1
+      applied_v = command_v;
+      send_sensor();
+    }
+  } else {
+    rep.end_reason = "the controller disconnected";
+    while (rep.ticks < max_ticks) {
+      if (stopping()) {
+        rep.end_reason = "signal";
+        break;
+      }
+      deadline += period_ns;
+      const timespec ts{static_cast<time_t>(deadline / 1'000'000'000), static_cast<long>(deadline % 1'000'000'000)};
+      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+      }
+      const std::int64_t late = now_ns() - deadline;
+      rep.wake_latency.record(late);
+      if (late > period_ns) {  // behind: skip ahead (the plant holds its pace in steps, not in a burst)
+        ++rep.overruns;
+        deadline += (late / period_ns) * period_ns;
+      }
+      if (!receive_commands(got)) break;
+      if (!got) ++rep.held_periods;
+      applied_v = command_v;
+      step_plant();
+      send_sensor();
+    }
+  }
+  if (rep.ticks >= max_ticks) rep.end_reason = "--duration reached";
+  rep.plant_time_s = static_cast<double>(rep.ticks) * dt;
+  rep.elapsed_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  rep.modbus_requests = regs.requests();
+
+  if (campaign) {
+    rep.records = campaign->records();
+    rep.closed_receptance = campaign->receptance();
+    // The same schedule with the amplifier off: the open-loop reference, in process.
+    sim::Plant open = make_plant(cfg, model);
+    analysis::ImpactCampaign ref(cfg, open, test, rep.campaign_start_s);
+    for (std::size_t k = 0; k < ref.end_tick(); ++k) {
+      ref.before_step(k);
+      (void)open.sense();  // the control sensor's noise stream advances as in the closed-loop run
+      open.step(0.0);
+      ref.after_step(k);
+    }
+    rep.open_receptance = ref.receptance();
+    if (rep.records > 0) {
+      const double lo = cfg.analysis.band_min_hz, hi = cfg.analysis.band_max_hz;
+      for (const auto& f : cfg.robot.frfs) {
+        if (f.excitation_location != impact_id) continue;
+        const std::size_t resp = model.index_of(f.response_location);
+        const auto op = analysis::measured_peak(rep.open_receptance[resp], lo, hi);
+        const auto cl = analysis::measured_peak(rep.closed_receptance[resp], lo, hi);
+        rep.frfs.push_back({f.name, op.magnitude_m_per_n, op.freq_hz, cl.magnitude_m_per_n, cl.freq_hz,
+                            (op.magnitude_m_per_n / cl.magnitude_m_per_n - 1.0) * 100.0,
+                            std::min(op.coherence_min, cl.coherence_min)});
+      }
+    }
+  }
+  return rep;
+}
+
+nlohmann::json report_json(const EmulatorReport& r) {
+  using nlohmann::json;
+  json frfs = json::array();
+  for (const auto& f : r.frfs)
+    frfs.push_back({{"name", f.name},
+                    {"open_peak_m_per_n", f.open_peak_m_per_n},
+                    {"open_peak_hz", f.open_peak_hz},
+                    {"closed_peak_m_per_n", f.closed_peak_m_per_n},
+                    {"closed_peak_hz", f.closed_peak_hz},
+                    {"measured_improvement_pct", f.improvement_pct},
+                    {"coherence_min", f.coherence_min}});
+  const auto& h = r.wake_latency;
+  return {{"config", r.config},
+          {"pacing", r.pacing},
+          {"transport", r.transport},
+          {"modbus", r.modbus},
+          {"ticks", r.ticks},
+          {"plant_time_s", r.plant_time_s},
+          {"elapsed_s", r.elapsed_s},
+          {"end_reason", r.end_reason},
+          {"frames",
+           {{"sensor_sent", r.sensor_frames_sent},
+            {"send_errors", r.send_errors},
+            {"commands", r.command_frames},
+            {"commands_lost", r.commands_lost},
+            {"malformed", r.frames_malformed},
+            {"other_ids", r.frames_other},
+            {"held_periods", r.held_periods}}},
+          {"amplifier",
+           {{"enable_changes", r.enable_changes},
+            {"enabled_s", r.enabled_s},
+            {"peak_command_v", r.peak_command_v},
+            {"peak_temperature_c", r.peak_temperature_c}}},
+          {"robot", {{"mounting_changes", r.mounting_changes}}},
+          {"modbus_requests", r.modbus_requests},
+          {"timing",
+           {{"wake_latency", {{"count", h.count()}, {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
+                              {"max_us", h.max_us()}}},
+            {"overruns", r.overruns}}},
+          {"impacts",
+           {{"location", r.impact_location},
+            {"started", r.campaign_started},
+            {"complete", r.campaign_complete},
+            {"start_s", r.campaign_start_s},
+            {"records", r.records},
+            {"records_planned", r.records_planned},
+            {"frfs", frfs}}}};
+}
+
+std::string report_text(const EmulatorReport& r) {
+  std::ostringstream os;
+  char b[400];
+  std::snprintf(b, sizeof b, "robodamp plant: %s, %s pacing over %s; Modbus %s\n", r.config.c_str(), r.pacing.c_str(),
+                r.transport.c_str(), r.modbus.c_str());
+  os << b;
+  std::snprintf(b, sizeof b, "  %llu plant steps (%.3f s plant time) in %.3f s; ended: %s\n",
+                static_cast<unsigned long long>(r.ticks), r.plant_time_s, r.elapsed_s, r.end_reason.c_str());
+  os << b;
+  std::snprintf(b, sizeof b,
+                "  frames: %llu sensor sent (%llu send errors), %llu commands (%llu lost, %llu malformed, %llu other ids)%s\n",
+                static_cast<unsigned long long>(r.sensor_frames_sent), static_cast<unsigned long long>(r.send_errors),
+                static_cast<unsigned long long>(r.command_frames), static_cast<unsigned long long>(r.commands_lost),
+                static_cast<unsigned long long>(r.frames_malformed), static_cast<unsigned long long>(r.frames_other),
+                r.pacing == "realtime" ? (", " + std::to_string(r.held_periods) + " periods held the last command").c_str() : "");
+  os << b;
+  if (r.pacing == "realtime") {
+    const auto& h = r.wake_latency;
+    std::snprintf(b, sizeof b, "  emulator wake-up latency: p50 %.0f us, p99 %.0f us, max %.1f us; %llu overruns\n",
+                  h.percentile_us(0.5), h.percentile_us(0.99), h.max_us(), static_cast<unsigned long long>(r.overruns));
+    os << b;
+  }
+  std::snprintf(b, sizeof b, "  amplifier: enabled %.3f s (%llu changes), peak drive %.3f V, peak %.1f degC; %llu Modbus requests\n",
+                r.enabled_s, static_cast<unsigned long long>(r.enable_changes), r.peak_command_v, r.peak_temperature_c,
+                static_cast<unsigned long long>(r.modbus_requests));
+  os << b;
+  if (r.records_planned > 0) {
+    std::snprintf(b, sizeof b, "  impacts at the %s: %d of %d records%s\n", r.impact_location.c_str(), r.records,
+                  r.records_planned, r.campaign_complete ? "" : " (incomplete: the controller left first)");
+    os << b;
+    for (const auto& f : r.frfs) {
+      std::snprintf(b, sizeof b,
+                    "    %-8s open %.4g m/N at %.2f Hz, closed %.4g m/N at %.2f Hz: improvement %.1f %% (coherence min %.4f)\n",
+                    f.name.c_str(), f.open_peak_m_per_n, f.open_peak_hz, f.closed_peak_m_per_n, f.closed_peak_hz,
+                    f.improvement_pct, f.coherence_min);
+      os << b;
+    }
+  }
+  return os.str();
+}
+
+}  // namespace robodamp::hil

@@ -1,0 +1,96 @@
+// The hardware-in-the-loop plant emulator (robodamp plant): the simulated plant in a process of its own,
+// behind the same wires a robot cell has. It is the DAQ node and the amplifier on the CAN transport
+// (sensor frames out, command frames in, the configuration's can mapping), and the amplifier and robot
+// controller on Modbus TCP (enable coil, ready / fault inputs, temperature register, mounting register).
+//
+// Pacing:
+// - realtime: one plant step per loop period on CLOCK_MONOTONIC (clock_nanosleep, absolute deadlines).
+//   Each period it takes the newest command frame that arrived, steps the plant with the amplifier's
+//   output, and sends the sensor frame: true HIL timing, the controller's phase relative to it is
+//   whatever the two clocks give.
+// - lockstep: one plant step per command frame, as fast as the controller answers (the controller runs
+//   on its virtual clock and waits for each sensor frame). Tick k: sensor frame k out, command k in, the
+//   plant steps with command k-1, which is the one-period computation delay of the in-process bench, so
+//   the same schedule measures the same loop through the real frame path.
+//
+// The amplifier drives the actuator only while its enable coil is set and after amplifier_ready_delay_s
+// (plant time); its temperature rises with the mean-square command. Once it is ready, after hil.settle_s,
+// the emulator runs the bench's impact schedule (bench.averages hits at the impact location) with
+// measurement accelerometers on the plant side, and at the end runs the same schedule with the amplifier
+// off in process for the open-loop reference: the FRFs it reports are measured, not modelled.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/spectral.hpp"
+#include "config/config.hpp"
+#include "rt/timing_histogram.hpp"
+
+namespace robodamp::hil {
+
+struct EmulatorOptions {
+  std::optional<config::HilPacing> pacing;  // default hil.pacing
+  double max_duration_s{0.0};               // plant time; 0 = until the controller disconnects
+  bool impacts{true};
+  int impact_location{0};                   // location id; 0 = the first configured FRF's excitation
+  // Robot mounting register changes: (plant time s, mounting).
+  std::vector<std::pair<double, config::Mounting>> mounting_schedule;
+  bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
+  const std::atomic<int>* stop_flag{nullptr};  // SIGINT / SIGTERM
+};
+
+struct FrfReport {
+  std::string name;
+  double open_peak_m_per_n{0.0}, open_peak_hz{0.0};
+  double closed_peak_m_per_n{0.0}, closed_peak_hz{0.0};
+  double improvement_pct{0.0};
+  double coherence_min{0.0};
+};
+
+struct EmulatorReport {
+  std::string config;
+  std::string pacing;
+  std::string transport;
+  std::string modbus;
+  std::uint64_t ticks{0};
+  double plant_time_s{0.0};
+  double elapsed_s{0.0};
+  std::string end_reason;
+  // Frames.
+  std::uint64_t sensor_frames_sent{0}, send_errors{0};
+  std::uint64_t command_frames{0}, commands_lost{0}, frames_malformed{0}, frames_other{0};
+  std::uint64_t held_periods{0};  // realtime: periods without a new command (the amplifier holds)
+  // Amplifier and robot.
+  std::uint64_t enable_changes{0};
+  double enabled_s{0.0};
+  double peak_temperature_c{0.0};
+  double peak_command_v{0.0};
+  std::uint64_t mounting_changes{0};
+  std::uint64_t modbus_requests{0};
+  // Realtime pacing: the emulator's own wake-up latency.
+  rt::TimingHistogram wake_latency;
+  std::uint64_t overruns{0};
+  // The impact campaign.
+  bool campaign_started{false}, campaign_complete{false};
+  double campaign_start_s{0.0};
+  int records{0}, records_planned{0};
+  std::string impact_location;
+  std::vector<FrfReport> frfs;
+  std::vector<analysis::FrfEstimate> closed_receptance, open_receptance;  // per location
+};
+
+// Serves one controller connection and returns when it disconnects (or max_duration_s, or the stop
+// flag). Throws std::runtime_error / std::system_error when it cannot set up (socket, Modbus port).
+[[nodiscard]] EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o);
+
+[[nodiscard]] nlohmann::json report_json(const EmulatorReport& r);
+[[nodiscard]] std::string report_text(const EmulatorReport& r);
+
+}  // namespace robodamp::hil
