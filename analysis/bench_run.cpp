@@ -70,56 +70,64 @@ control::ControllerParams Bench::controller_params(double gain, int polarity) co
   return params;
 }
 
-ImpactCampaign::ImpactCampaign(const config::Config& cfg, sim::Plant& plant, const ImpactTest& t, double start_s)
-    : plant_(plant),
-      acc_(static_cast<std::size_t>(std::lround(cfg.bench.record_s * cfg.loop.rate_hz)), cfg.loop.rate_hz,
-           cfg.bench.zero_pad, Window::kRectangular, cfg.analysis.band_max_hz * 1.5, plant.model().locations.size()),
-      start_s_(start_s) {
-  const auto& b = cfg.bench;
+ImpactCampaign::ImpactCampaign(const config::Config& cfg, sim::Plant& plant, const ImpactTest& t)
+    : cfg_(cfg), plant_(plant), test_(t) {
   const double fs = cfg.loop.rate_hz;
-  record_n_ = static_cast<std::size_t>(std::lround(b.record_s * fs));
-  // Hits come at irregular intervals, as from an operator (seeded): the drive vibration then enters each
-  // record with a random phase and averages out of the cross spectrum instead of adding coherently.
-  std::mt19937_64 rng(cfg.disturbances.seed * 31 + t.excitation);
-  std::uniform_real_distribution<double> gap(0.0, 1.0);
-  std::vector<double> hits;
-  double start = start_s;
-  for (int i = 0; i < b.averages; ++i) {
-    start += gap(rng);
-    start_n_.push_back(static_cast<std::size_t>(std::lround(start * fs)));
-    hits.push_back(start + kPretriggerS);
-    start += b.record_s;
-  }
-  hammer_ = plant.add_excitation(std::make_unique<sim::ImpactHammer>(t.excitation, t.peak_n, t.duration_ms * 1e-3, hits));
+  record_n_ = static_cast<std::size_t>(std::lround(cfg.bench.record_s * fs));
   const std::size_t nl = plant.model().locations.size();
   for (std::size_t l = 0; l < nl; ++l)
     meas_.emplace_back(measurement_sensor(cfg), fs, cfg.disturbances.seed * 7919 + 101 * (l + 1) + 13 * t.excitation);
-  total_ = start_n_.back() + record_n_;
-  force_.assign(record_n_, 0.0);
-  response_.assign(nl, std::vector<double>(record_n_));
+  const auto records = static_cast<std::size_t>(cfg.bench.averages);
+  force_.assign(records, std::vector<double>(record_n_));
+  response_.assign(records, std::vector<std::vector<double>>(nl, std::vector<double>(record_n_)));
 }
 
-void ImpactCampaign::before_step(std::size_t k) {
+void ImpactCampaign::start(double start_s) {
+  if (started()) return;
+  start_s_ = start_s;
+  const double fs = cfg_.loop.rate_hz;
+  // Hits come at irregular intervals, as from an operator (seeded): the drive vibration then enters each
+  // record with a random phase and averages out of the cross spectrum instead of adding coherently.
+  std::mt19937_64 rng(cfg_.disturbances.seed * 31 + test_.excitation);
+  std::uniform_real_distribution<double> gap(0.0, 1.0);
+  std::vector<double> hits;
+  double t = start_s;
+  for (int i = 0; i < cfg_.bench.averages; ++i) {
+    t += gap(rng);
+    start_n_.push_back(static_cast<std::size_t>(std::lround(t * fs)));
+    hits.push_back(t + kPretriggerS);
+    t += cfg_.bench.record_s;
+  }
+  hammer_ = plant_.add_excitation(
+      std::make_unique<sim::ImpactHammer>(test_.excitation, test_.peak_n, test_.duration_ms * 1e-3, hits));
+  total_ = start_n_.back() + record_n_;
+}
+
+void ImpactCampaign::before_step(std::size_t k) noexcept {
+  if (!started()) return;
   while (seg_ + 1 < start_n_.size() && k >= start_n_[seg_ + 1]) ++seg_;
   if (k < start_n_[seg_] || k >= start_n_[seg_] + record_n_) return;
   const std::size_t i = k - start_n_[seg_];
-  for (std::size_t l = 0; l < meas_.size(); ++l) response_[l][i] = meas_[l].measure(plant_.acceleration_mps2(l));
+  for (std::size_t l = 0; l < meas_.size(); ++l) response_[seg_][l][i] = meas_[l].measure(plant_.acceleration_mps2(l));
 }
 
-void ImpactCampaign::after_step(std::size_t k) {
-  if (k < start_n_[seg_] || k >= start_n_[seg_] + record_n_) return;
+void ImpactCampaign::after_step(std::size_t k) noexcept {
+  if (!started() || k < start_n_[seg_] || k >= start_n_[seg_] + record_n_) return;
   const std::size_t i = k - start_n_[seg_];
-  force_[i] = plant_.excitation_force_n(hammer_);
-  if (i + 1 == record_n_) acc_.add(force_, response_);
+  force_[seg_][i] = plant_.excitation_force_n(hammer_);
+  if (i + 1 == record_n_) ++records_;
 }
 
 std::vector<FrfEstimate> ImpactCampaign::receptance() const {
-  std::vector<FrfEstimate> r;
+  FrfAccumulator acc(record_n_, cfg_.loop.rate_hz, cfg_.bench.zero_pad, Window::kRectangular,
+                     cfg_.analysis.band_max_hz * 1.5, meas_.size());
+  for (int r = 0; r < records_; ++r) acc.add(force_[static_cast<std::size_t>(r)], response_[static_cast<std::size_t>(r)]);
+  std::vector<FrfEstimate> out;
   for (std::size_t l = 0; l < meas_.size(); ++l) {
-    r.push_back(acc_.result(l));
-    accelerance_to_receptance(r.back());
+    out.push_back(acc.result(l));
+    accelerance_to_receptance(out.back());
   }
-  return r;
+  return out;
 }
 
 ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
@@ -128,7 +136,8 @@ ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
   sim::Plant plant = make_plant();
   const control::ControllerParams params = controller_params(t.gain_ns_per_m, t.polarity);
   control::Controller controller(params);
-  ImpactCampaign campaign(cfg_, plant, t, settle_time_s(params));
+  ImpactCampaign campaign(cfg_, plant, t);
+  campaign.start(settle_time_s(params));
   ImpactTestResult r;
   double command = 0.0;
   std::uint64_t saturated_ticks = 0;

@@ -39,32 +39,39 @@ struct ImpactTestResult {
 
 // The measuring side of an impact test on a plant someone else steps, tick by tick (the bench steps it
 // in process; the HIL emulator steps it for a controller in another process): `averages` hammer hits at
-// irregular, seeded intervals from start_s on, the measurement accelerometers at every location, and
-// the H1 receptance over the whole records (rectangular window, zero-padded).
+// irregular, seeded intervals from the start on, the measurement accelerometers at every location, and
+// the H1 receptance over the whole records (rectangular window, zero-padded). The records are stored
+// as they come and transformed at the end: the per-tick calls only write samples (the emulator's
+// real-time pacing cannot stall for an FFT), and nothing is allocated after construction.
 class ImpactCampaign {
  public:
-  // Adds the hammer to the plant. Plant time is tick / loop.rate_hz.
-  ImpactCampaign(const config::Config& cfg, sim::Plant& plant, const ImpactTest& t, double start_s);
+  // Allocates the records.
+  ImpactCampaign(const config::Config& cfg, sim::Plant& plant, const ImpactTest& t);
+  // Adds the hammer with its hits from start_s on (plant time = tick / loop.rate_hz). Once.
+  void start(double start_s);
+  [[nodiscard]] bool started() const { return !start_n_.empty(); }
   // Tick k, before plant.step(): the responses.
-  void before_step(std::size_t k);
+  void before_step(std::size_t k) noexcept;
   // Tick k, after plant.step(): the hammer's force; a record is complete at its last tick.
-  void after_step(std::size_t k);
+  void after_step(std::size_t k) noexcept;
   [[nodiscard]] std::size_t end_tick() const { return total_; }  // ticks until the last record is complete
-  [[nodiscard]] bool done(std::size_t k) const { return k >= total_; }
-  [[nodiscard]] int records() const { return acc_.averages(); }
+  [[nodiscard]] bool done(std::size_t k) const { return started() && k >= total_; }
+  [[nodiscard]] int records() const { return records_; }
   [[nodiscard]] double start_s() const { return start_s_; }
-  // Per location.
+  // Per location, from the complete records.
   [[nodiscard]] std::vector<FrfEstimate> receptance() const;
 
  private:
+  const config::Config& cfg_;
   sim::Plant& plant_;
-  std::size_t hammer_{0};
+  ImpactTest test_;
   std::vector<sim::Accelerometer> meas_;
-  FrfAccumulator acc_;
   std::vector<std::size_t> start_n_;
   std::size_t record_n_{0}, total_{0}, seg_{0};
-  std::vector<double> force_;
-  std::vector<std::vector<double>> response_;
+  std::vector<std::vector<double>> force_;                  // [record][sample]
+  std::vector<std::vector<std::vector<double>>> response_;  // [record][location][sample]
+  std::size_t hammer_{0};
+  int records_{0};
   double start_s_{0.0};
 };
 

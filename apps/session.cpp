@@ -29,6 +29,7 @@ Session::Session(const config::Config& cfg, const SessionOptions& o) : cfg_(cfg)
         cfg_.loop.rate_hz);
     // Lockstep with the emulator: a missing frame waits up to this long, then counts towards the stale trip.
     if (cfg_.loop.clock == config::ClockKind::kVirtual) can_->set_lockstep_wait(1.0);
+    else can_->set_dejitter(true);
     modbus_ = std::make_unique<drivers::ModbusSupervisor>(*cfg_.modbus, cfg_.actuator.mounting, [this](config::Mounting m) {
       if (const auto set = parameter_set_for(m)) {
         if (!loop_->post({rt::CommandKind::kSelectParams, static_cast<double>(*set)}))
@@ -227,7 +228,8 @@ nlohmann::json summary_json(const RunSummary& s) {
                 {"lost_frames", c.lost_frames},   {"stale_frames", c.stale_frames}, {"error_frames", c.error_frames},
                 {"bus_off", c.bus_off},           {"restarts", c.restarts},     {"rx_errors", c.rx_errors},
                 {"tx_frames", c.tx_frames},       {"tx_queue_full", c.tx_queue_full}, {"tx_errors", c.tx_errors},
-                {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}};
+                {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}, {"rx_held", c.rx_held},
+                {"rx_skipped", c.rx_skipped}};
   }
   if (s.modbus) {
     const auto& m = *s.modbus;
@@ -295,11 +297,13 @@ std::string summary_text(const RunSummary& s) {
     const auto& c = *s.can;
     std::snprintf(b, sizeof b,
                   "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
-                  "%llu bus-off; %llu commands sent (%llu queue full, %llu errors, %llu skipped)\n",
+                  "%llu bus-off, %llu held over / %llu skipped (de-jitter); %llu commands sent (%llu queue full, %llu errors, "
+                  "%llu skipped)\n",
                   static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
                   static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
                   static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
-                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.tx_frames),
+                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
+                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.tx_frames),
                   static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
                   static_cast<unsigned long long>(c.tx_skipped));
     os << b;

@@ -30,6 +30,13 @@ void CanDriver::enter_backoff(std::uint64_t tick) noexcept {
 
 rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
   bool fresh = false;
+  int arrived = 0;
+  double sample = last_value_;
+  if (dejitter_ && held_) {  // last tick's second frame is this tick's sample
+    sample = held_value_;
+    held_ = false;
+    fresh = true;
+  }
   rx_fault_ = false;
   for (int i = 0; i < kMaxFramesPerTick; ++i) {
     canfd_frame f{};
@@ -87,14 +94,33 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
     }
     last_counter_ = d.counter;
     have_counter_ = true;
-    last_value_ = d.value;
     last_rx_ns_ = ts;
     bump(n_.rx_frames);
+    ++arrived;
+    if (!dejitter_ || !fresh) {
+      sample = d.value;
+    } else if (!held_) {
+      held_value_ = d.value, held_ = true;
+      bump(n_.rx_held);
+    } else {  // a backlog beyond one frame: move on to the newer ones
+      sample = held_value_, held_value_ = d.value;
+      bump(n_.rx_skipped);
+    }
     fresh = true;
   }
+  if (dejitter_) {
+    // Exactly one frame per tick while one is held: the phase is steady; after resync_ticks of it, drop
+    // the held frame's extra period of latency.
+    steady_ticks_ = held_ && arrived == 1 ? steady_ticks_ + 1 : 0;
+    if (held_ && steady_ticks_ >= resync_ticks_) {
+      sample = held_value_, held_ = false, steady_ticks_ = 0;
+      bump(n_.rx_skipped);
+    }
+  }
+  last_value_ = sample;
   const auto limit = static_cast<std::uint64_t>(cfg_.lost_frames_fault);
   const bool too_many_lost = losses_ >= limit && tick < loss_ticks_[(losses_ - limit) % kLossRing] + window_ticks_;
-  return {last_value_, fresh, !(bus_off_ || link_lost_ || rx_fault_ || too_many_lost)};
+  return {sample, fresh, !(bus_off_ || link_lost_ || rx_fault_ || too_many_lost)};
 }
 
 rt::ActuatorStatus CanDriver::write(double command_v, std::uint64_t tick) noexcept {
@@ -130,7 +156,7 @@ CanCounters CanDriver::counters() const noexcept {
   auto l = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
   return {l(n_.rx_frames),  l(n_.rx_other),   l(n_.rx_malformed),  l(n_.lost_frames), l(n_.stale_frames),
           l(n_.error_frames), l(n_.bus_off),  l(n_.restarts),      l(n_.rx_errors),   l(n_.tx_frames),
-          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped)};
+          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped), l(n_.rx_held), l(n_.rx_skipped)};
 }
 
 }  // namespace robodamp::drivers

@@ -36,6 +36,8 @@ struct CanCounters {
   std::uint64_t tx_errors{0};       // other send failures
   std::uint64_t tx_skipped{0};      // commands not sent while backing off
   std::uint64_t tx_clipped{0};      // commands outside the command field's range
+  std::uint64_t rx_held{0};         // de-jitter: frames held over to the next tick
+  std::uint64_t rx_skipped{0};      // de-jitter: frames skipped (backlog, or resync to the newest)
 };
 
 class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
@@ -46,6 +48,15 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   // tick's sensor frame, which the emulator sends once it has the previous command. 0 (the default, and
   // always on the wall clock): never wait.
   void set_lockstep_wait(double wait_s) noexcept { lockstep_wait_ns_ = static_cast<std::int64_t>(wait_s * 1e9); }
+  // Wall clock against a sensor node on its own clock at the loop rate: when the two clocks' phases are
+  // close, wake-up jitter delivers 0 frames in one tick and 2 in the next. With the de-jitter slot on,
+  // the second of two frames is held for the next tick, so every tick gets a fresh sample (one period
+  // older when the slot is in use). After resync_ticks ticks running with the slot in use and exactly
+  // one new frame each, the held frame is skipped to get the latency back. Off by default.
+  void set_dejitter(bool on, std::uint64_t resync_ticks = 1000) noexcept {
+    dejitter_ = on;
+    resync_ticks_ = resync_ticks;
+  }
 
   [[nodiscard]] rt::SensorSample read(std::uint64_t tick) noexcept override;
   [[nodiscard]] rt::ActuatorStatus write(double command_v, std::uint64_t tick) noexcept override;
@@ -61,7 +72,7 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   struct AtomicCounters {
     std::atomic<std::uint64_t> rx_frames{0}, rx_other{0}, rx_malformed{0}, lost_frames{0}, stale_frames{0},
         error_frames{0}, bus_off{0}, restarts{0}, rx_errors{0}, tx_frames{0}, tx_queue_full{0}, tx_errors{0},
-        tx_skipped{0}, tx_clipped{0};
+        tx_skipped{0}, tx_clipped{0}, rx_held{0}, rx_skipped{0};
   };
   static void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) noexcept {
     c.store(c.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
@@ -93,6 +104,10 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   int consecutive_tx_failures_{0};
   std::uint32_t tx_counter_{0};
   std::int64_t lockstep_wait_ns_{0};
+  bool dejitter_{false};
+  bool held_{false};
+  double held_value_{0.0};
+  std::uint64_t resync_ticks_{1000}, steady_ticks_{0};
 };
 
 }  // namespace robodamp::drivers

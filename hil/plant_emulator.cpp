@@ -136,7 +136,9 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     for (const auto& w : rts.warnings) spdlog::warn("robodamp plant: {}", w);
   }
 
-  std::unique_ptr<analysis::ImpactCampaign> campaign;
+  // Allocated now: starting it later only schedules the hits (the realtime pacing never stalls for it).
+  std::optional<analysis::ImpactCampaign> campaign;
+  if (o.impacts) campaign.emplace(cfg, plant, test);
   std::uint32_t sensor_counter = 0, last_cmd_counter = 0;
   bool have_cmd_counter = false;
   double command_v = 0.0;     // newest command received
@@ -217,10 +219,10 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
       regs.set_temperature(temperature_c);
     }
     // The impact schedule starts settle_s after the amplifier is first ready.
-    if (o.impacts && !campaign && ready) {
+    if (campaign && !campaign->started() && ready) {
       rep.campaign_started = true;
       rep.campaign_start_s = t + cfg.hil.settle_s;
-      campaign = std::make_unique<analysis::ImpactCampaign>(cfg, plant, test, rep.campaign_start_s);
+      campaign->start(rep.campaign_start_s);
       spdlog::info("robodamp plant: amplifier ready at {:.3f} s; {} impacts at the {} from {:.1f} s", t,
                    cfg.bench.averages, rep.impact_location, rep.campaign_start_s);
     }
@@ -285,12 +287,13 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.elapsed_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   rep.modbus_requests = regs.requests();
 
-  if (campaign) {
+  if (campaign && campaign->started()) {
     rep.records = campaign->records();
     rep.closed_receptance = campaign->receptance();
     // The same schedule with the amplifier off: the open-loop reference, in process.
     sim::Plant open = make_plant(cfg, model);
-    analysis::ImpactCampaign ref(cfg, open, test, rep.campaign_start_s);
+    analysis::ImpactCampaign ref(cfg, open, test);
+    ref.start(rep.campaign_start_s);
     for (std::size_t k = 0; k < ref.end_tick(); ++k) {
       ref.before_step(k);
       (void)open.sense();  // the control sensor's noise stream advances as in the closed-loop run
