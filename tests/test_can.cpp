@@ -207,6 +207,44 @@ TEST(CanDriver, DecodesFreshSamplesAndCountsLostAndStaleFrames) {
   EXPECT_TRUE(s.ok);
 }
 
+TEST(CanDriver, DejitterHoldsTheSecondOfTwoFramesAndResyncs) {
+  const auto c = fd_link();
+  Link link(c);
+  link.driver->set_dejitter(true, 4);
+  // Phases close: 2 frames in one tick, none in the next. Every tick gets a fresh sample, in order.
+  std::uint32_t n = 0;
+  link.send_sample(c, 1.0, n++);
+  link.send_sample(c, 2.0, n++);
+  auto s = link.driver->read(0);
+  EXPECT_TRUE(s.fresh);
+  EXPECT_NEAR(s.accel_mps2, 1.0, 1e-5);
+  s = link.driver->read(1);
+  EXPECT_TRUE(s.fresh) << "the held frame";
+  EXPECT_NEAR(s.accel_mps2, 2.0, 1e-5);
+  s = link.driver->read(2);
+  EXPECT_FALSE(s.fresh) << "nothing held, nothing arrived";
+  // Three at once: the oldest is skipped, the newest held.
+  for (double v : {3.0, 4.0, 5.0}) link.send_sample(c, v, n++);
+  s = link.driver->read(3);
+  EXPECT_NEAR(s.accel_mps2, 4.0, 1e-5);
+  // One frame per tick with one held: one period late, until resync_ticks (4) of it; then the newest.
+  std::vector<double> got;
+  for (int t = 0; t < 6; ++t) {
+    link.send_sample(c, 6.0 + t, n++);
+    s = link.driver->read(4 + t);
+    EXPECT_TRUE(s.fresh);
+    got.push_back(s.accel_mps2);
+  }
+  EXPECT_NEAR(got[0], 5.0, 1e-5);
+  EXPECT_NEAR(got[2], 7.0, 1e-5);
+  EXPECT_NEAR(got[3], 9.0, 1e-5) << "resynced to the newest";
+  EXPECT_NEAR(got[5], 11.0, 1e-5) << "no longer late";
+  const auto k = link.driver->counters();
+  EXPECT_EQ(k.rx_frames, n);
+  EXPECT_EQ(k.lost_frames, 0u);
+  EXPECT_EQ(k.rx_skipped, 2u);
+}
+
 TEST(CanDriver, SendsTheCommandFrameEveryCycleWithItsCounter) {
   const auto c = fd_link();
   Link link(c);
