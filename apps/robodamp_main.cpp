@@ -14,6 +14,7 @@
 #include "apps/filters_command.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/milling_command.hpp"
+#include "apps/dds_commands.hpp"
 #include "apps/plant_command.hpp"
 #include "apps/run_command.hpp"
 #include "config/config.hpp"
@@ -197,6 +198,26 @@ int main(int argc, char** argv) {
   plant->add_option("--mounting", plant_opts.mounting_schedule,
                     "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
 
+  robodamp::apps::DdsClientOptions dds_opts;
+  std::string dds_transport = "default";
+  std::string dds_config;
+  auto add_dds_options = [&](CLI::App* c) {
+    c->add_option("--domain", dds_opts.domain_id, "DDS domain (default: dds.domain_id of --config, else 0)")->check(CLI::Range(0, 232));
+    c->add_option("--config", dds_config, "Take the domain and transport from this configuration's dds section")->check(CLI::ExistingFile);
+    c->add_option("--transport", dds_transport, "default, udp_loopback or shared_memory")
+        ->check(CLI::IsMember({"default", "udp_loopback", "shared_memory"}));
+  };
+  auto* monitor = app.add_subcommand("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing)");
+  add_dds_options(monitor);
+  monitor->add_option("--duration", dds_opts.duration_s, "Stop after S seconds (0 = at Ctrl-C)");
+  robodamp::apps::RequestOptions req_opts;
+  auto* request = app.add_subcommand("request", "One supervised parameter request over DDS (needs dds.parameter_writes: true)");
+  add_dds_options(request);
+  request->add_option("--gain", req_opts.gain_ns_per_m, "Set the gain K, N s/m");
+  request->add_option("--select", req_opts.parameter_set, "Select a parameter set (0 = the configuration's own)");
+  request->add_option("--enable", req_opts.enable, "1 = arm, 0 = disarm")->check(CLI::Range(0, 1));
+  request->add_option("--timeout", dds_opts.duration_s, "Wait this long for the loop and the reply, s (default 10)");
+
   std::string recording, csv_out;
   auto* replay = app.add_subcommand("replay", "Feed a recording's inputs through the same controller; check the commands bit for bit");
   replay->add_option("file", recording, "Recording (from run --record)")->required()->check(CLI::ExistingFile);
@@ -226,6 +247,27 @@ int main(int argc, char** argv) {
     run_opts.config_path = config_path;
     if (!clock.empty()) run_opts.clock = clock == "wall" ? robodamp::config::ClockKind::kWall : robodamp::config::ClockKind::kVirtual;
     return robodamp::apps::run_loop(run_opts);
+  }
+  if (monitor->parsed() || request->parsed()) {
+    if (!dds_config.empty()) {
+      try {
+        const auto cfg = robodamp::config::load_config_file(dds_config);
+        if (cfg.dds && (*monitor->get_option("--domain")).count() == 0 && (*request->get_option("--domain")).count() == 0)
+          dds_opts.domain_id = cfg.dds->domain_id;
+        if (cfg.dds && dds_transport == "default") dds_opts.transport = cfg.dds->transport;
+      } catch (const robodamp::config::ConfigError& e) {
+        std::cerr << e.what() << '\n';
+        return 2;
+      }
+    }
+    if (dds_transport == "udp_loopback") dds_opts.transport = robodamp::config::DdsTransport::kUdpLoopback;
+    if (dds_transport == "shared_memory") dds_opts.transport = robodamp::config::DdsTransport::kSharedMemory;
+    try {
+      return monitor->parsed() ? robodamp::apps::run_monitor(dds_opts) : robodamp::apps::run_request(dds_opts, req_opts);
+    } catch (const std::exception& e) {
+      std::cerr << e.what() << '\n';
+      return 1;
+    }
   }
   if (plant->parsed()) {
     plant_opts.config_path = config_path;

@@ -80,6 +80,50 @@ Session::Session(const config::Config& cfg, const SessionOptions& o) : cfg_(cfg)
 
 Session::~Session() = default;
 
+dds::Decision Session::handle_request(dds::RequestKind kind, double value) {
+  char b[256];
+  rt::OperatorCommand c;
+  std::string what;
+  switch (kind) {
+    case dds::RequestKind::kSetGain: {
+      const std::size_t set = supervisor_->active_parameter_set();
+      const double limit = std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM);
+      std::snprintf(b, sizeof b, "supervision.max_gain_fraction = %g x the analysed maximum stable K of parameter set %zu",
+                    cfg_.supervision.max_gain_fraction, set);
+      if (auto problem = config::gain_request_problem(value, limit, b)) return {false, *problem};
+      c = {rt::CommandKind::kSetGain, value};
+      std::snprintf(b, sizeof b, "K ramps to %g N s/m over controller.gain_ramp_s = %g s", value, cfg_.controller.gain_ramp_s);
+      what = b;
+      break;
+    }
+    case dds::RequestKind::kSelectParameterSet: {
+      const auto& sets = supervisor_->parameter_sets();
+      if (!(value >= 0.0 && value == std::floor(value) && value < static_cast<double>(sets.size()))) {
+        std::snprintf(b, sizeof b, "parameter_set = %g is not a configured set: allowed 0 <= value <= %zu (0 = %s, then parameter_sets)",
+                      value, sets.size() - 1, cfg_.source.c_str());
+        return {false, b};
+      }
+      const auto idx = static_cast<std::size_t>(value);
+      if (!sets[idx].analysis_stable) return {false, "parameter set " + std::to_string(idx) + ": the analysis finds its loop unstable"};
+      c = {rt::CommandKind::kSelectParams, value};
+      what = "parameter set " + std::to_string(idx) + " is handed over at the next tick (fade out, swap, fade in)";
+      break;
+    }
+    case dds::RequestKind::kEnable:
+      if (value != 0.0 && value != 1.0) {
+        std::snprintf(b, sizeof b, "enable = %g is out of range: allowed 0 (disarm) or 1 (arm)", value);
+        return {false, b};
+      }
+      c = {value == 1.0 ? rt::CommandKind::kArm : rt::CommandKind::kDisarm, 0.0};
+      what = value == 1.0 ? "arming: the supervisor checks the sensor, the actuator path and the analysis at the next tick "
+                            "(the status topic shows the outcome)"
+                          : "disarming: the command fades out over controller.gain_ramp_s";
+      break;
+  }
+  if (!loop_->post(c)) return {false, "the loop's command queue is full: try again"};
+  return {true, what};
+}
+
 std::optional<std::size_t> Session::parameter_set_for(config::Mounting m) const {
   for (const auto& [mounting, idx] : mounting_sets_)
     if (mounting == m) return idx;
@@ -140,6 +184,19 @@ RunSummary Session::run(double duration_s) {
       tt.safe_s = f.time_s;
     if (keep_frames_) frames_.push_back(f);
   });
+  std::unique_ptr<dds::Bridge> bridge;
+  if (cfg_.dds) {
+    bridge = std::make_unique<dds::Bridge>(
+        *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
+        dds::BridgeSources{backend_name_, [this] { return supervisor_->active_parameter_set(); },
+                           [this] { return std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM); },
+                           [this](dds::RequestKind k, double v) { return handle_request(k, v); }});
+    consumers.emplace_back([&bridge](const rt::TelemetryFrame& f) { bridge->on_frame(f); });
+    bridge->start();
+    spdlog::info("DDS: domain {} ({}), telemetry {} Hz, status {} Hz, parameter writes {}", cfg_.dds->domain_id,
+                 config::to_string(cfg_.dds->transport), cfg_.dds->telemetry_rate_hz, cfg_.dds->status_rate_hz,
+                 cfg_.dds->parameter_writes ? "on" : "off");
+  }
   rt::TelemetryDrain drain(*ring_, std::move(consumers));
   drain.start();
   std::thread thread([&] {
@@ -148,6 +205,10 @@ RunSummary Session::run(double duration_s) {
   });
   thread.join();
   drain.stop();
+  if (bridge) {
+    bridge->stop();
+    s.dds = bridge->counters();
+  }
   if (modbus_) {
     modbus_->stop();
     s.modbus = modbus_->counters();
@@ -231,6 +292,8 @@ nlohmann::json summary_json(const RunSummary& s) {
                 {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}, {"rx_held", c.rx_held},
                 {"rx_skipped", c.rx_skipped}};
   }
+  if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
+                         {"refused", s.dds->refused}};
   if (s.modbus) {
     const auto& m = *s.modbus;
     j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
@@ -317,6 +380,12 @@ std::string summary_text(const RunSummary& s) {
                   static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
                   static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
                   static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes));
+    os << b;
+  }
+  if (s.dds) {
+    std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
+                  static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
+                  static_cast<unsigned long long>(s.dds->requests), static_cast<unsigned long long>(s.dds->refused));
     os << b;
   }
   if (s.trip_timing.trip_s >= 0.0) {

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/loop_model.hpp"
+#include "dds/bridge.hpp"
 #include "drivers/can_driver.hpp"
 #include "drivers/modbus_supervisor.hpp"
 #include "drivers/sim_backend.hpp"
@@ -66,6 +67,7 @@ struct RunSummary {
   std::string backend;  // "simulated plant" or the CAN transport and Modbus endpoints
   std::optional<drivers::CanCounters> can;
   std::optional<drivers::ModbusCounters> modbus;
+  std::optional<dds::BridgeCounters> dds;
   TripTiming trip_timing;
   std::string record_path;
   double sensor_rms_mps2{0.0};  // control accelerometer over the run
@@ -87,6 +89,8 @@ class Session {
   // The parameter set for a mounting (set 0 is the configuration's own), if there is one.
   [[nodiscard]] std::optional<std::size_t> parameter_set_for(config::Mounting m) const;
   [[nodiscard]] bool hardware() const { return can_ != nullptr; }
+  // A parameter request (DDS): validated as the configuration validates its values, then queued.
+  [[nodiscard]] dds::Decision handle_request(dds::RequestKind kind, double value);
   [[nodiscard]] drivers::CanDriver* can_driver() { return can_.get(); }
   [[nodiscard]] drivers::ModbusSupervisor* modbus() { return modbus_.get(); }
   // Runs for duration_s of loop time on a thread of its own (set up for real time on the wall clock),

@@ -112,13 +112,13 @@ void Supervisor::select(const OperatorCommand& c) noexcept {
   }
   const auto idx = static_cast<std::size_t>(i);
   const ParameterSet& set = sets_[idx];
-  if (idx == active_set_ || !set.analysis_stable || controller_.handover_pending() ||
+  if (idx == active_parameter_set() || !set.analysis_stable || controller_.handover_pending() ||
       set.params.gain_ns_per_m > s_.limits.max_gain_fraction * set.max_stable_gain_ns_per_m ||
       controller_.request_params(set.params) != control::RequestStatus::kAccepted) {
     ++counters_.params_refused;
     return;
   }
-  active_set_ = idx;
+  active_set_.store(idx, std::memory_order_relaxed);
   ++counters_.params_selected;
 }
 
@@ -152,7 +152,7 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         refusal_ = ArmRefusal::kSensorNotLive;
       else if (!path_ok_)
         refusal_ = ArmRefusal::kActuatorPath;
-      else if (!sets_[active_set_].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
+      else if (!sets_[active_parameter_set()].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
         refusal_ = ArmRefusal::kAnalysisUnstable;
       if (refusal_ != ArmRefusal::kNone) {
         ++counters_.arm_refused;

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -123,7 +124,10 @@ class Supervisor {
   // Before activation (allocates): another set select_params may hand over to. Returns its index.
   std::size_t add_parameter_set(const ParameterSet& set);
   [[nodiscard]] const std::vector<ParameterSet>& parameter_sets() const noexcept { return sets_; }
-  [[nodiscard]] std::size_t active_parameter_set() const noexcept { return active_set_; }
+  // What a gain request may ask for now: max_gain_fraction x the active set's analysed K_max (any thread).
+  [[nodiscard]] double gain_limit_ns_per_m() const noexcept { return max_gain_ns_per_m(); }
+  // Safe to read from any thread (relaxed atomic; DDS status and parameter requests read it).
+  [[nodiscard]] std::size_t active_parameter_set() const noexcept { return active_set_.load(std::memory_order_relaxed); }
 
   // RT-safe.
   [[nodiscard]] TickOutput step(const TickInput& in) noexcept;
@@ -149,13 +153,13 @@ class Supervisor {
   void reset_detectors() noexcept;
 
   [[nodiscard]] double max_gain_ns_per_m() const noexcept {
-    return s_.limits.max_gain_fraction * sets_[active_set_].max_stable_gain_ns_per_m;
+    return s_.limits.max_gain_fraction * sets_[active_parameter_set()].max_stable_gain_ns_per_m;
   }
   void select(const OperatorCommand& c) noexcept;
 
   SupervisorSettings s_;
   std::vector<ParameterSet> sets_;  // [0]: the set it starts with
-  std::size_t active_set_{0};
+  std::atomic<std::size_t> active_set_{0};
   control::Controller controller_;
   State state_{State::kDisabled};
   Trip trip_{Trip::kNone};

@@ -1,0 +1,176 @@
+#include "apps/dds_commands.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <mutex>
+#include <thread>
+
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include "dds/participant.hpp"
+#include "robodamp.h"
+#include "rt/signals.hpp"
+#include "rt/supervisor.hpp"
+
+namespace robodamp::apps {
+
+using namespace eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+template <typename T>
+class Latest : public DataReaderListener {
+ public:
+  void on_data_available(DataReader* r) override {
+    T v;
+    SampleInfo info;
+    while (r->take_next_sample(&v, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) {
+        std::lock_guard<std::mutex> lock(m_);
+        value_ = v;
+        ++count_;
+      }
+  }
+  std::pair<T, std::uint64_t> get() {
+    std::lock_guard<std::mutex> lock(m_);
+    return {value_, count_};
+  }
+
+ private:
+  std::mutex m_;
+  T value_{};
+  std::uint64_t count_{0};
+};
+
+std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s, std::uint64_t ns) {
+  char b[1200];
+  const char* state = ns ? s.state().c_str() : nt ? rt::to_string(static_cast<rt::State>(t.state())) : "-";
+  const char* trip = ns ? s.trip().c_str() : nt ? rt::to_string(static_cast<rt::Trip>(t.trip())) : "-";
+  std::snprintf(b, sizeof b,
+                "robodamp monitor  t = %.2f s  (%s)\n"
+                "  state      %-10s trip %s\n"
+                "  vibration  %.5f m/s^2 RMS (last %.5f m/s^2), velocity estimate %.3g m/s\n"
+                "  command    %+.4f V (peak %.4f V), K = %.0f N s/m (limit %.0f), parameter set %u\n"
+                "  saturation %.1f %% of the last window, %llu ticks in all\n"
+                "  timing     wake-up p50 %.0f us, p99 %.0f us, max %.1f us; compute mean %.2f us, max %.1f us\n"
+                "             ticks %llu, missed %llu, overruns %llu, stale %llu, ring drops %llu\n"
+                "  samples    %llu telemetry, %llu status; parameter writes %s\n",
+                nt ? t.time_s() : s.time_s(), ns ? s.backend().c_str() : "no status yet", state, trip,
+                t.accel_rms_mps2(), t.accel_mps2(), t.filtered_mps(), t.command_v(), t.command_peak_v(),
+                nt ? t.gain_ns_per_m() : s.gain_ns_per_m(), s.max_gain_ns_per_m(), s.parameter_set(),
+                100.0 * t.saturated_fraction(), static_cast<unsigned long long>(s.saturated_ticks()), s.wake_p50_us(),
+                s.wake_p99_us(), s.wake_max_us(), s.compute_mean_us(), s.compute_max_us(),
+                static_cast<unsigned long long>(s.ticks()), static_cast<unsigned long long>(s.missed_ticks()),
+                static_cast<unsigned long long>(s.overruns()), static_cast<unsigned long long>(s.stale_ticks()),
+                static_cast<unsigned long long>(s.ring_drops()), static_cast<unsigned long long>(nt),
+                static_cast<unsigned long long>(ns), ns ? (s.parameter_writes() ? "on" : "off") : "-");
+  return b;
+}
+
+}  // namespace
+
+int run_monitor(const DdsClientOptions& o) {
+  rt::install_shutdown_handlers();
+  Latest<msg::Telemetry> telemetry;  // before the participant: it outlives the readers that call it
+  Latest<msg::Status> status;
+  dds::Participant p(o.domain_id, o.transport, "robodamp monitor");
+  p.reader(dds::TopicKind::kTelemetry, &telemetry);
+  p.reader(dds::TopicKind::kStatus, &status);
+  const bool tty = isatty(STDOUT_FILENO) != 0;
+  std::cerr << "robodamp monitor: domain " << o.domain_id << " (" << config::to_string(o.transport)
+            << "), waiting for a loop; Ctrl-C ends\n";
+  const auto end = Clock::now() + std::chrono::duration<double>(o.duration_s);
+  std::uint64_t shown = 0;
+  while (rt::shutdown_signal().load() == 0 && (o.duration_s <= 0.0 || Clock::now() < end)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const auto [t, nt] = telemetry.get();
+    const auto [s, ns] = status.get();
+    if (nt + ns == shown) continue;
+    shown = nt + ns;
+    if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
+    std::cout << view(t, nt, s, ns) << (tty ? "" : "\n") << std::flush;
+  }
+  return shown > 0 ? 0 : 1;
+}
+
+namespace {
+class Replies : public DataReaderListener {
+ public:
+  Replies(std::string client, std::uint32_t id) : client_(std::move(client)), id_(id) {}
+  void on_data_available(DataReader* r) override {
+    msg::ParameterReply v;
+    SampleInfo info;
+    while (r->take_next_sample(&v, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data && v.client() == client_ && v.request_id() == id_) {
+        std::lock_guard<std::mutex> lock(m_);
+        reply_ = v;
+        got_ = true;
+      }
+  }
+  bool get(msg::ParameterReply& out) {
+    std::lock_guard<std::mutex> lock(m_);
+    out = reply_;
+    return got_;
+  }
+
+ private:
+  std::string client_;
+  std::uint32_t id_;
+  std::mutex m_;
+  msg::ParameterReply reply_;
+  bool got_{false};
+};
+}  // namespace
+
+int run_request(const DdsClientOptions& o, const RequestOptions& r) {
+  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0);
+  if (given != 1) {
+    std::cerr << "robodamp request: give exactly one of --gain, --select, --enable\n";
+    return 2;
+  }
+  msg::ParameterRequest req;
+  const std::string client = "robodamp-request-" + std::to_string(getpid());
+  req.client(client);
+  req.request_id(1);
+  if (r.gain_ns_per_m) req.kind(msg::SET_GAIN), req.value(*r.gain_ns_per_m);
+  if (r.parameter_set) req.kind(msg::SELECT_PARAMETER_SET), req.value(*r.parameter_set);
+  if (r.enable) req.kind(msg::ENABLE), req.value(*r.enable);
+  const double wait_s = o.duration_s > 0.0 ? o.duration_s : 10.0;
+  int rc = 1;
+  {
+    Replies replies(client, 1);  // before the participant: it outlives the reader that calls it
+    dds::Participant p(o.domain_id, o.transport, "robodamp request");
+    DataReader* reader = p.reader(dds::TopicKind::kReply, &replies);
+    DataWriter* writer = p.writer(dds::TopicKind::kRequest);
+    const auto end = Clock::now() + std::chrono::duration<double>(wait_s);
+    // Reliable and volatile: send once the loop's reader and reply writer have matched.
+    PublicationMatchedStatus pm;
+    SubscriptionMatchedStatus sm;
+    while (Clock::now() < end) {
+      writer->get_publication_matched_status(pm);
+      reader->get_subscription_matched_status(sm);
+      if (pm.current_count > 0 && sm.current_count > 0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (pm.current_count == 0 || sm.current_count == 0) {
+      std::cerr << "robodamp request: no loop on domain " << o.domain_id << " within " << wait_s << " s\n";
+      return 1;
+    }
+    writer->write(&req);
+    msg::ParameterReply reply;
+    while (Clock::now() < end && !replies.get(reply)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (replies.get(reply)) {
+      std::cout << (reply.accepted() ? "accepted: " : "refused: ") << reply.reason() << '\n';
+      rc = reply.accepted() ? 0 : 3;
+    } else {
+      std::cerr << "robodamp request: no reply within " << wait_s << " s\n";
+    }
+  }
+  return rc;
+}
+
+}  // namespace robodamp::apps

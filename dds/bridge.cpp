@@ -1,0 +1,166 @@
+#include "dds/bridge.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include "dds/participant.hpp"
+#include "robodamp.h"
+
+namespace robodamp::dds {
+
+using namespace eprosima::fastdds::dds;
+
+class Bridge::RequestListener : public DataReaderListener {
+ public:
+  explicit RequestListener(Bridge& b) : b_(b) {}
+  void on_data_available(DataReader* reader) override {
+    msg::ParameterRequest req;
+    SampleInfo info;
+    while (reader->take_next_sample(&req, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const auto kind = req.kind() == msg::SET_GAIN ? RequestKind::kSetGain
+                        : req.kind() == msg::SELECT_PARAMETER_SET ? RequestKind::kSelectParameterSet
+                                                                  : RequestKind::kEnable;
+      const Decision d = b_.decide(kind, req.value());
+      msg::ParameterReply reply;
+      reply.client(req.client());
+      reply.request_id(req.request_id());
+      reply.accepted(d.accepted);
+      reply.reason(d.reason.substr(0, 255));
+      static_cast<DataWriter*>(b_.reply_writer_)->write(&reply);
+    }
+  }
+
+ private:
+  Bridge& b_;
+};
+
+Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources)
+    : cfg_(cfg), source_(config_source), src_(std::move(sources)) {
+  window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
+  participant_ = std::make_unique<Participant>(cfg.domain_id, cfg.transport, "robodamp loop");
+  telemetry_writer_ = participant_->writer(TopicKind::kTelemetry);
+  status_writer_ = participant_->writer(TopicKind::kStatus);
+  reply_writer_ = participant_->writer(TopicKind::kReply);
+  listener_ = std::make_unique<RequestListener>(*this);
+  participant_->reader(TopicKind::kRequest, listener_.get());
+}
+
+Bridge::~Bridge() {
+  stop();
+  participant_.reset();  // the listener outlives the reader
+}
+
+Decision Bridge::decide(RequestKind kind, double value) {
+  ++n_requests_;
+  Decision d;
+  if (!cfg_.parameter_writes)
+    d = {false, "parameter writes are off: dds.parameter_writes is false in " + source_};
+  else
+    d = src_.handle(kind, value);
+  if (!d.accepted) ++n_refused_;
+  return d;
+}
+
+void Bridge::on_frame(const rt::TelemetryFrame& f) {
+  sum_sq_ += f.accel_mps2 * f.accel_mps2;
+  peak_v_ = std::max(peak_v_, std::abs(f.command_v));
+  wake_max_us_ = std::max(wake_max_us_, f.wake_latency_us);
+  if (f.flags & rt::kFlagSaturated) ++saturated_in_window_;
+  bool changed = false;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    last_ = f;
+    have_frame_ = true;
+    if (f.wake_latency_us > 0.0F || f.compute_us > 0.0F) {
+      wake_.record(static_cast<std::int64_t>(f.wake_latency_us * 1e3F));
+      compute_.record(static_cast<std::int64_t>(f.compute_us * 1e3F));
+    }
+    changed = f.state != published_state_ || f.trip != published_trip_;
+  }
+  if (++in_window_ >= window_ticks_) {
+    msg::Telemetry t;
+    t.tick(f.tick);
+    t.time_s(f.time_s);
+    t.accel_rms_mps2(std::sqrt(sum_sq_ / static_cast<double>(in_window_)));
+    t.accel_mps2(f.accel_mps2);
+    t.filtered_mps(f.filtered_mps);
+    t.command_v(f.command_v);
+    t.command_peak_v(peak_v_);
+    t.gain_ns_per_m(f.gain_ns_per_m);
+    t.saturated_fraction(static_cast<float>(saturated_in_window_) / static_cast<float>(in_window_));
+    t.wake_latency_max_us(wake_max_us_);
+    t.state(f.state);
+    t.trip(f.trip);
+    if (static_cast<DataWriter*>(telemetry_writer_)->write(&t)) ++n_telemetry_;
+    in_window_ = 0, sum_sq_ = 0.0, peak_v_ = 0.0, saturated_in_window_ = 0, wake_max_us_ = 0.0F;
+  }
+  if (changed) publish_status();
+}
+
+void Bridge::publish_status() {
+  msg::Status s;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    const auto& f = last_;
+    s.tick(f.tick);
+    s.time_s(f.time_s);
+    s.state(rt::to_string(static_cast<rt::State>(f.state)));
+    s.trip(rt::to_string(static_cast<rt::Trip>(f.trip)));
+    s.trip_description(std::string(rt::describe(static_cast<rt::Trip>(f.trip))).substr(0, 159));
+    s.gain_ns_per_m(f.gain_ns_per_m);
+    s.ticks(have_frame_ ? f.tick + 1 - f.missed_ticks : 0);
+    s.missed_ticks(f.missed_ticks);
+    s.overruns(f.overruns);
+    s.stale_ticks(f.stale_ticks);
+    s.invalid_samples(f.invalid_samples);
+    s.saturated_ticks(f.saturated_ticks);
+    s.ring_drops(f.ring_drops);
+    s.wake_p50_us(static_cast<float>(wake_.percentile_us(0.5)));
+    s.wake_p99_us(static_cast<float>(wake_.percentile_us(0.99)));
+    s.wake_max_us(static_cast<float>(wake_.max_us()));
+    s.compute_mean_us(static_cast<float>(compute_.mean_us()));
+    s.compute_max_us(static_cast<float>(compute_.max_us()));
+    published_state_ = f.state;
+    published_trip_ = f.trip;
+  }
+  s.backend(src_.backend.substr(0, 63));
+  s.parameter_set(static_cast<std::uint32_t>(src_.parameter_set ? src_.parameter_set() : 0));
+  s.max_gain_ns_per_m(src_.gain_limit_ns_per_m ? src_.gain_limit_ns_per_m() : 0.0);
+  s.parameter_writes(cfg_.parameter_writes);
+  if (static_cast<DataWriter*>(status_writer_)->write(&s)) ++n_status_;
+}
+
+void Bridge::start() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (running_) return;
+    running_ = true;
+  }
+  status_thread_ = std::thread([this] {
+    const auto period = std::chrono::duration<double>(1.0 / cfg_.status_rate_hz);
+    std::unique_lock<std::mutex> lock(m_);
+    while (running_) {
+      cv_.wait_for(lock, period, [this] { return !running_; });
+      lock.unlock();
+      publish_status();
+      lock.lock();
+    }
+  });
+}
+
+void Bridge::stop() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (!running_) return;
+    running_ = false;
+  }
+  cv_.notify_all();
+  status_thread_.join();
+}
+
+BridgeCounters Bridge::counters() const { return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load()}; }
+
+}  // namespace robodamp::dds

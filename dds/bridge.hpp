@@ -1,0 +1,89 @@
+// The loop on DDS: decimated telemetry and status from the telemetry drain's frames (the real-time
+// thread never touches DDS: it only fills the ring; the drain thread calls on_frame), and parameter
+// requests answered with a reply. A request is refused with a reason unless dds.parameter_writes is on;
+// when on, the handler validates it exactly as the configuration would (key, value, unit, allowed range)
+// and queues it for the loop's next tick boundary.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "config/supervisory_config.hpp"
+#include "rt/telemetry_frame.hpp"
+#include "rt/timing_histogram.hpp"
+
+namespace robodamp::dds {
+
+class Participant;
+
+enum class RequestKind : std::uint8_t { kSetGain, kSelectParameterSet, kEnable };
+
+struct Decision {
+  bool accepted{false};
+  std::string reason;
+};
+
+struct BridgeSources {
+  std::string backend;                             // for the status
+  std::function<std::size_t()> parameter_set;      // the active set (any thread)
+  std::function<double()> gain_limit_ns_per_m;     // what a gain request may ask for now
+  std::function<Decision(RequestKind, double)> handle;  // validate and queue (parameter writes on)
+};
+
+struct BridgeCounters {
+  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0};
+};
+
+class Bridge {
+ public:
+  Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources);
+  ~Bridge();
+  Bridge(const Bridge&) = delete;
+  Bridge& operator=(const Bridge&) = delete;
+
+  // The telemetry drain's consumer (non-real-time thread).
+  void on_frame(const rt::TelemetryFrame& f);
+  // Status at dds.status_rate_hz on a thread of its own; stop() publishes a last one.
+  void start();
+  void stop();
+  [[nodiscard]] BridgeCounters counters() const;
+
+ private:
+  class RequestListener;
+  void publish_status();
+  Decision decide(RequestKind kind, double value);
+
+  config::DdsConfig cfg_;
+  std::string source_;
+  BridgeSources src_;
+  std::unique_ptr<Participant> participant_;
+  void* telemetry_writer_{nullptr};  // DataWriter*, kept opaque here
+  void* status_writer_{nullptr};
+  void* reply_writer_{nullptr};
+  std::unique_ptr<RequestListener> listener_;
+
+  // Decimation window (drain thread).
+  std::uint64_t window_ticks_{1}, in_window_{0};
+  double sum_sq_{0.0}, peak_v_{0.0};
+  std::uint64_t saturated_in_window_{0};
+  float wake_max_us_{0.0F};
+  std::uint32_t last_saturated_total_{0};
+
+  mutable std::mutex m_;  // the status snapshot
+  std::condition_variable cv_;
+  rt::TelemetryFrame last_{};
+  bool have_frame_{false};
+  rt::TimingHistogram wake_, compute_;
+  std::uint8_t published_state_{255}, published_trip_{255};
+  bool running_{false};
+  std::thread status_thread_;
+  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0};
+};
+
+}  // namespace robodamp::dds

@@ -1,0 +1,99 @@
+#include "dds/participant.hpp"
+
+#include <memory>
+#include <stdexcept>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+
+#include "robodampPubSubTypes.h"
+
+namespace robodamp::dds {
+
+using namespace eprosima::fastdds::dds;
+
+namespace {
+constexpr const char* kTopicNames[4] = {"robodamp/telemetry", "robodamp/status", "robodamp/parameter_request",
+                                        "robodamp/parameter_reply"};
+}
+
+Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name)
+    : domain_id_(domain_id), transport_(transport) {
+  DomainParticipantQos pq = PARTICIPANT_QOS_DEFAULT;
+  pq.name(name);
+  if (transport == config::DdsTransport::kUdpLoopback) {
+    pq.transport().use_builtin_transports = false;
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList.emplace_back("127.0.0.1");
+    pq.transport().user_transports.push_back(udp);
+    eprosima::fastrtps::rtps::Locator_t peer;
+    eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, "127.0.0.1");
+    pq.wire_protocol().builtin.initialPeersList.push_back(peer);
+  } else if (transport == config::DdsTransport::kSharedMemory) {
+    pq.transport().use_builtin_transports = false;
+    pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  }
+  participant_ = DomainParticipantFactory::get_instance()->create_participant(domain_id, pq);
+  if (participant_ == nullptr)
+    throw std::runtime_error("DDS: cannot create a participant on domain " + std::to_string(domain_id) + " (" +
+                             config::to_string(transport) + ")");
+  TypeSupport types[4] = {TypeSupport(new robodamp::msg::TelemetryPubSubType()),
+                          TypeSupport(new robodamp::msg::StatusPubSubType()),
+                          TypeSupport(new robodamp::msg::ParameterRequestPubSubType()),
+                          TypeSupport(new robodamp::msg::ParameterReplyPubSubType())};
+  for (int i = 0; i < 4; ++i) {
+    types[i].register_type(participant_);
+    topics_[i] = participant_->create_topic(kTopicNames[i], types[i].get_type_name(), TOPIC_QOS_DEFAULT);
+    if (topics_[i] == nullptr) throw std::runtime_error(std::string("DDS: cannot create topic ") + kTopicNames[i]);
+  }
+  publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (publisher_ == nullptr || subscriber_ == nullptr) throw std::runtime_error("DDS: cannot create publisher / subscriber");
+}
+
+Participant::~Participant() {
+  if (participant_ != nullptr) {
+    participant_->delete_contained_entities();
+    DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+}
+
+Topic* Participant::topic(TopicKind t) { return topics_[static_cast<int>(t)]; }
+
+namespace {
+template <typename Qos>
+void apply(Qos& q, TopicKind t, config::DdsTransport transport) {
+  if (t == TopicKind::kTelemetry) {
+    q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;
+    q.durability().kind = VOLATILE_DURABILITY_QOS;
+    q.history().kind = KEEP_LAST_HISTORY_QOS;
+    q.history().depth = 64;
+  } else {
+    q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+    q.durability().kind = t == TopicKind::kStatus ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+    q.history().kind = KEEP_LAST_HISTORY_QOS;
+    q.history().depth = t == TopicKind::kStatus ? 1 : 32;
+  }
+  if (transport == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+}
+}  // namespace
+
+DataWriter* Participant::writer(TopicKind t, DataWriterListener* listener) {
+  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+  apply(q, t, transport_);
+  DataWriter* w = publisher_->create_datawriter(topic(t), q, listener);
+  if (w == nullptr) throw std::runtime_error(std::string("DDS: cannot create a writer on ") + kTopicNames[static_cast<int>(t)]);
+  return w;
+}
+
+DataReader* Participant::reader(TopicKind t, DataReaderListener* listener) {
+  DataReaderQos q = DATAREADER_QOS_DEFAULT;
+  apply(q, t, transport_);
+  DataReader* r = subscriber_->create_datareader(topic(t), q, listener);
+  if (r == nullptr) throw std::runtime_error(std::string("DDS: cannot create a reader on ") + kTopicNames[static_cast<int>(t)]);
+  return r;
+}
+
+}  // namespace robodamp::dds

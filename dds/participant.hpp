@@ -1,0 +1,53 @@
+// A Fast DDS participant with robodamp's four topics and their QoS (docs/dds.md), shared by the loop's
+// bridge, `robodamp monitor` and the tests. Off the real-time path.
+//
+//   topic                      type              reliability   durability       history
+//   robodamp/telemetry         Telemetry         best effort   volatile         keep last 64
+//   robodamp/status            Status            reliable      transient local  keep last 1
+//   robodamp/parameter_request ParameterRequest  reliable      volatile         keep last 32
+//   robodamp/parameter_reply   ParameterReply    reliable      volatile         keep last 32
+//
+// Transports: default (Fast DDS built-ins: UDPv4 and shared memory), udp_loopback (UDPv4 on 127.0.0.1
+// only, data sharing off) or shared_memory (SHM only).
+#pragma once
+
+#include <string>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+
+#include "config/supervisory_config.hpp"
+
+namespace robodamp::dds {
+
+enum class TopicKind { kTelemetry, kStatus, kRequest, kReply };
+
+class Participant {
+ public:
+  // Throws std::runtime_error when the participant or a topic cannot be created.
+  Participant(int domain_id, config::DdsTransport transport, const std::string& name);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  // Writers and readers with the topic's QoS (listener may be null). Deleted with the participant.
+  eprosima::fastdds::dds::DataWriter* writer(TopicKind t, eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
+  eprosima::fastdds::dds::DataReader* reader(TopicKind t, eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
+
+  [[nodiscard]] int domain_id() const { return domain_id_; }
+
+ private:
+  eprosima::fastdds::dds::Topic* topic(TopicKind t);
+  int domain_id_;
+  config::DdsTransport transport_;
+  eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
+  eprosima::fastdds::dds::Publisher* publisher_{nullptr};
+  eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};
+  eprosima::fastdds::dds::Topic* topics_[4]{};
+};
+
+}  // namespace robodamp::dds
