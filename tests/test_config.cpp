@@ -332,4 +332,53 @@ TEST(Config, LoopSupervisionRealtimeAndTelemetryAreValidated) {
 }
 
 }  // namespace
+TEST(Config, TheHilConfigurationLoadsWithEveryHardwareSection) {
+  const Config c = load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_horizontal_c2.yaml");
+  ASSERT_TRUE(c.can && c.modbus && c.dds);
+  EXPECT_EQ(c.can->interface, "unix:/tmp/robodamp-hil.sock");
+  EXPECT_EQ(c.modbus->amplifier_link.port, 1502);
+  ASSERT_TRUE(c.modbus->robot_link);
+  EXPECT_EQ(c.modbus->robot_link->unit_id, 2);
+  ASSERT_EQ(c.parameter_sets.size(), 1U);
+  EXPECT_EQ(c.parameter_sets[0].mounting, "vertical");
+  EXPECT_NE(c.parameter_sets[0].resolved_path.find("config/presets/vertical_c1.yaml"), std::string::npos);
+  EXPECT_FALSE(c.dds->parameter_writes);
+  EXPECT_EQ(c.hil.pacing, HilPacing::kRealtime);
+}
+
+TEST(Config, ModbusDdsAndHilSectionsAreValidated) {
+  const Config rtu = parse_config(std::string(kValid) +
+                                      "modbus:\n  amplifier: {transport: rtu, device: /dev/ttyS1, baud: 38400, parity: even,"
+                                      " unit_id: 5}\n",
+                                  "ok.yaml");
+  ASSERT_TRUE(rtu.modbus);
+  EXPECT_EQ(rtu.modbus->amplifier_link.transport, ModbusTransport::kRtu);
+  EXPECT_EQ(describe(rtu.modbus->amplifier_link), "rtu /dev/ttyS1 38400 8E1 unit 5");
+
+  const auto p = problems_of(std::string(kValid) +
+                             "modbus:\n  poll_period_s: 0.05\n  link_timeout_s: 0.01\n"
+                             "  amplifier: {host: 127.0.0.1, port: 70000, ready_input: 3, fault_input: 3}\n"
+                             "  robot: {port: 502, horizontal_value: 1, vertical_value: 1}\n"
+                             "parameter_sets: {vertical: no_such_file.yaml}\n"
+                             "dds: {domain_id: 300, transport: carrier_pigeon}\n"
+                             "hil: {pacing: sometimes}\n");
+  std::string all;
+  for (const auto& q : p) all += q.to_string() + "\n";
+  for (const char* expected :
+       {"modbus.link_timeout_s = 0.01 s is shorter than modbus.poll_period_s = 0.05 s",
+        "modbus.amplifier.port = 70000 (TCP port) is out of range", "modbus.amplifier.fault_input = 3 is the ready input's address too",
+        "modbus.robot.vertical_value = 1 is the horizontal value too", "parameter_sets.vertical = 'no_such_file.yaml': no such file",
+        "dds.domain_id = 300", "dds.transport = 'carrier_pigeon' is not allowed", "hil.pacing = 'sometimes' is not allowed"})
+    EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
+  EXPECT_EQ(p.size(), 8U) << all;
+}
+
+TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {
+  EXPECT_FALSE(gain_request_problem(2000.0, 4324.0, "0.9 x K_max"));
+  const auto p = gain_request_problem(5000.0, 4324.0, "0.9 x K_max");
+  ASSERT_TRUE(p);
+  EXPECT_EQ(*p, "controller.gain_ns_per_m = 5000 N s/m is out of range: allowed 0 <= value <= 4324 N s/m (0.9 x K_max)");
+  EXPECT_TRUE(gain_request_problem(std::nan(""), 4324.0, ""));
+}
+
 }  // namespace robodamp::config

@@ -23,6 +23,8 @@
 #include "rt/telemetry_drain.hpp"
 #include "control/controller.hpp"
 #include "drivers/can_driver.hpp"
+#include "drivers/modbus_server.hpp"
+#include "drivers/modbus_supervisor.hpp"
 #include "sim_plant/plant.hpp"
 #include "test_util.hpp"
 
@@ -158,6 +160,37 @@ TEST(RealTimePath, CanDriverAllocatesNothing) {
   EXPECT_GT(k.rx_held, 10000u);
   EXPECT_GT(ok_reads, 150'000u);
   EXPECT_TRUE(std::isfinite(sink));
+}
+
+// The Modbus client's real-time side: the loop asks for the enable and reads the status every tick;
+// both are atomics (the polling threads are elsewhere). With the link down and up.
+TEST(RealTimePath, ModbusStatusAllocatesNothing) {
+  drivers::ModbusServer server;
+  config::ModbusConfig m;
+  m.amplifier_link.port = server.start("127.0.0.1", 0);
+  m.poll_period_s = 0.002;
+  drivers::ModbusSupervisor sup(m, config::Mounting::kHorizontal);
+  sup.start();
+  ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
+  std::uint64_t faults = 0;
+  const long before = g_loop_thread_allocations.load();
+  t_loop_thread = true;  // only this thread's allocations: the polling threads are not real-time
+  const auto t0 = std::chrono::steady_clock::now();
+  bool stopped = false;
+  for (int i = 0; std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(400); ++i) {
+    sup.request_amplifier_enable(i % 1000 < 500);
+    faults += sup.amplifier_status().fault ? 1 : 0;
+    if (!stopped && std::chrono::steady_clock::now() - t0 > std::chrono::milliseconds(100)) {
+      t_loop_thread = false;
+      server.stop();  // the link goes down: the status becomes unknown (a fault while enabled)
+      stopped = true;
+      t_loop_thread = true;
+    }
+  }
+  t_loop_thread = false;
+  EXPECT_EQ(g_loop_thread_allocations.load() - before, 0) << "allocations in the Modbus client's real-time calls";
+  sup.stop();
+  EXPECT_GT(faults, 0U);
 }
 
 // The whole loop (sensor read, supervisor, controller, actuator write, amplifier I/O, telemetry push,
