@@ -172,12 +172,26 @@ RunSummary Session::run(double duration_s) {
   double sum_sq = 0.0, peak = 0.0;
   std::uint64_t n = 0;
   TripTiming& tt = s.trip_timing;
+  // Hardware: arming is retried every 0.5 s while the loop is disabled (the sensor may not be live yet at
+  // the first attempt), until it has been active once; the run's end and a trip are never re-armed.
+  const bool retry_arm = can_ && o_.arm_at_start;
+  bool was_active = false;
+  double next_arm_s = 0.5;
   frames_.clear();
   std::vector<rt::TelemetryDrain::Consumer> consumers;
   if (recorder) consumers.emplace_back([&recorder](const rt::TelemetryFrame& f) { recorder->write(f); });
   consumers.emplace_back([&](const rt::TelemetryFrame& f) {
     if (std::isfinite(f.accel_mps2)) sum_sq += f.accel_mps2 * f.accel_mps2, ++n;
     peak = std::max(peak, std::abs(f.command_v));
+    if (retry_arm && !was_active) {
+      if (f.state == static_cast<std::uint8_t>(rt::State::kActive)) {
+        was_active = true;
+      } else if (f.state == static_cast<std::uint8_t>(rt::State::kDisabled) && f.time_s >= next_arm_s &&
+                 f.time_s < duration_s - 1.0) {
+        (void)loop_->post({rt::CommandKind::kArm, 0.0});
+        next_arm_s = f.time_s + 0.5;
+      }
+    }
     if (tt.trip_s < 0.0 && (f.flags & rt::kFlagFresh)) tt.last_fresh_s = f.time_s;
     if (tt.trip_s < 0.0 && f.trip != 0) tt.trip_s = f.time_s;
     if (tt.trip_s >= 0.0 && tt.safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable))
@@ -199,6 +213,9 @@ RunSummary Session::run(double duration_s) {
   }
   rt::TelemetryDrain drain(*ring_, std::move(consumers));
   drain.start();
+  if (can_ && wall) {
+    if (const auto stale = can_->flush()) spdlog::info("CAN: {} frames queued before the loop started, discarded", stale);
+  }
   std::thread thread([&] {
     if (wall && o_.realtime_setup) rt::setup_realtime_thread(cfg_.realtime, s.realtime);
     loop_->run(ticks);

@@ -152,6 +152,14 @@ rt::ActuatorStatus CanDriver::write(double command_v, std::uint64_t tick) noexce
   return {true, e.clipped};  // one dropped command: the amplifier holds the last one
 }
 
+std::uint64_t CanDriver::flush() noexcept {
+  std::uint64_t n = 0;
+  canfd_frame f{};
+  std::int64_t ts = 0;
+  while (channel_.receive(f, ts) > 0) ++n;
+  return n;
+}
+
 CanCounters CanDriver::counters() const noexcept {
   auto l = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
   return {l(n_.rx_frames),  l(n_.rx_other),   l(n_.rx_malformed),  l(n_.lost_frames), l(n_.stale_frames),

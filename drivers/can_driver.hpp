@@ -61,6 +61,11 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   [[nodiscard]] rt::SensorSample read(std::uint64_t tick) noexcept override;
   [[nodiscard]] rt::ActuatorStatus write(double command_v, std::uint64_t tick) noexcept override;
 
+  // Before the loop starts (wall clock): discards what queued up while the controller was starting (a
+  // DAQ streams from power-up; the socket's queue overflowed meanwhile), so those are not counted as
+  // lost frames. Returns how many were discarded.
+  std::uint64_t flush() noexcept;
+
   [[nodiscard]] CanCounters counters() const noexcept;
   [[nodiscard]] bool bus_off() const noexcept { return bus_off_; }
   [[nodiscard]] bool link_lost() const noexcept { return link_lost_; }
