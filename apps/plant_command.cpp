@@ -5,19 +5,16 @@
 
 #include <spdlog/spdlog.h>
 
+#include "apps/run_command.hpp"
 #include "hil/plant_emulator.hpp"
 #include "rt/signals.hpp"
 
 namespace robodamp::apps {
 
 int run_plant(const PlantOptions& o) {
-  config::Config cfg;
-  try {
-    cfg = config::load_config_file(o.config_path);
-  } catch (const config::ConfigError& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
-  }
+  const auto loaded = load_config_or_report(o.config_path);
+  if (!loaded) return 2;
+  const config::Config& cfg = *loaded;
   hil::EmulatorOptions eo;
   eo.pacing = o.pacing;
   eo.max_duration_s = o.duration_s;

@@ -12,14 +12,19 @@
 
 namespace robodamp::apps {
 
-int run_loop(const RunOptions& o) {
-  config::Config cfg;
+std::optional<config::Config> load_config_or_report(const std::string& path) {
   try {
-    cfg = config::load_config_file(o.config_path);
+    return config::load_config_file(path);
   } catch (const config::ConfigError& e) {
     std::cerr << e.what() << '\n';
-    return 2;
+    return std::nullopt;
   }
+}
+
+int run_loop(const RunOptions& o) {
+  const auto loaded = load_config_or_report(o.config_path);
+  if (!loaded) return 2;
+  const config::Config& cfg = *loaded;
   if (!(o.duration_s > 0.0 && o.duration_s <= 7.0 * 24 * 3600)) {
     std::cerr << "--duration " << o.duration_s << " s: allowed 0 < value <= 604800 s (one week)\n";
     return 2;

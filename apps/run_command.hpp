@@ -19,6 +19,9 @@ struct RunOptions {
   double impact_every_s{2.0};
 };
 
+// The configuration at path, or nothing after printing every problem to stderr (exit status 2).
+[[nodiscard]] std::optional<config::Config> load_config_or_report(const std::string& path);
+
 // Exit codes: 0 ended safe (disarmed, or shut down by a signal), 2 configuration error, 4 ended in a
 // fault trip, 1 other error (recording).
 [[nodiscard]] int run_loop(const RunOptions& o);

@@ -29,7 +29,7 @@ class Bridge::RequestListener : public DataReaderListener {
       reply.request_id(req.request_id());
       reply.accepted(d.accepted);
       reply.reason(d.reason.substr(0, 255));
-      static_cast<DataWriter*>(b_.reply_writer_)->write(&reply);
+      b_.reply_writer_->write(&reply);
     }
   }
 
@@ -94,7 +94,7 @@ void Bridge::on_frame(const rt::TelemetryFrame& f) {
     t.wake_latency_max_us(wake_max_us_);
     t.state(f.state);
     t.trip(f.trip);
-    if (static_cast<DataWriter*>(telemetry_writer_)->write(&t)) ++n_telemetry_;
+    if (telemetry_writer_->write(&t)) ++n_telemetry_;
     in_window_ = 0, sum_sq_ = 0.0, peak_v_ = 0.0, saturated_in_window_ = 0, wake_max_us_ = 0.0F;
   }
   if (changed) publish_status();
@@ -130,7 +130,7 @@ void Bridge::publish_status() {
   s.parameter_set(static_cast<std::uint32_t>(src_.parameter_set ? src_.parameter_set() : 0));
   s.max_gain_ns_per_m(src_.gain_limit_ns_per_m ? src_.gain_limit_ns_per_m() : 0.0);
   s.parameter_writes(cfg_.parameter_writes);
-  if (static_cast<DataWriter*>(status_writer_)->write(&s)) ++n_status_;
+  if (status_writer_->write(&s)) ++n_status_;
 }
 
 void Bridge::start() {

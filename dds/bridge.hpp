@@ -18,6 +18,10 @@
 #include "rt/telemetry_frame.hpp"
 #include "rt/timing_histogram.hpp"
 
+namespace eprosima::fastdds::dds {
+class DataWriter;
+}
+
 namespace robodamp::dds {
 
 class Participant;
@@ -63,9 +67,9 @@ class Bridge {
   std::string source_;
   BridgeSources src_;
   std::unique_ptr<Participant> participant_;
-  void* telemetry_writer_{nullptr};  // DataWriter*, kept opaque here
-  void* status_writer_{nullptr};
-  void* reply_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* telemetry_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* status_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* reply_writer_{nullptr};
   std::unique_ptr<RequestListener> listener_;
 
   // Decimation window (drain thread).

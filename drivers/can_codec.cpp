@@ -75,4 +75,15 @@ Encoded encode(const config::CanFrameMapping& m, bool fd, double value, std::uin
   return e;
 }
 
+std::uint32_t counter_mask(const config::CanCounter& c) noexcept {
+  const int bits = 8 * c.size_bytes;
+  return bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
+}
+
+CounterStep counter_step(std::uint32_t previous, std::uint32_t current, std::uint32_t mask) noexcept {
+  const std::uint32_t step = (current - previous) & mask;
+  if (step == 0) return {true, 0};
+  return {false, step > 1 && step <= mask / 2 ? step - 1 : 0};
+}
+
 }  // namespace robodamp::drivers

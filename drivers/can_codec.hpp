@@ -33,4 +33,14 @@ struct Encoded {
 };
 [[nodiscard]] Encoded encode(const config::CanFrameMapping& m, bool fd, double value, std::uint32_t counter) noexcept;
 
+// A sender's wrapping counter from one frame to the next: the same value again (a stale frame), or the
+// frames missing in between. A large step backwards is a restarted sender, not half a counter's range of
+// lost frames.
+struct CounterStep {
+  bool repeated{false};
+  std::uint32_t lost{0};
+};
+[[nodiscard]] std::uint32_t counter_mask(const config::CanCounter& c) noexcept;
+[[nodiscard]] CounterStep counter_step(std::uint32_t previous, std::uint32_t current, std::uint32_t mask) noexcept;
+
 }  // namespace robodamp::drivers

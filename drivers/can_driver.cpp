@@ -14,10 +14,7 @@ constexpr int kTxFailuresToFault = 3;   // consecutive full queues before the ac
 
 CanDriver::CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz)
     : cfg_(cfg), channel_(std::move(channel)), rate_hz_(loop_rate_hz) {
-  if (cfg_.sensor.counter) {
-    const int bits = 8 * cfg_.sensor.counter->size_bytes;
-    counter_mask_ = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
-  }
+  if (cfg_.sensor.counter) counter_mask_ = counter_mask(*cfg_.sensor.counter);
   window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz)));
   backoff_initial_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(cfg_.backoff_initial_s * loop_rate_hz)));
   backoff_max_ticks_ = std::max(backoff_initial_ticks_, static_cast<std::uint64_t>(std::llround(cfg_.backoff_max_s * loop_rate_hz)));
@@ -81,15 +78,14 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
       continue;
     }
     if (cfg_.sensor.counter && have_counter_) {
-      const std::uint32_t step = (d.counter - last_counter_) & counter_mask_;
-      if (step == 0) {
+      const CounterStep step = counter_step(last_counter_, d.counter, counter_mask_);
+      if (step.repeated) {
         bump(n_.stale_frames);
         continue;
       }
-      // A large step backwards is a restarted sender, not half a counter's range of lost frames.
-      if (step > 1 && step <= counter_mask_ / 2) {
-        bump(n_.lost_frames, step - 1);
-        for (std::uint32_t k = 1; k < step && k <= kLossRing; ++k) loss_ticks_[losses_++ % kLossRing] = tick;
+      if (step.lost > 0) {
+        bump(n_.lost_frames, step.lost);
+        for (std::uint32_t k = 0; k < step.lost && k < kLossRing; ++k) loss_ticks_[losses_++ % kLossRing] = tick;
       }
     }
     last_counter_ = d.counter;

@@ -176,10 +176,8 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
         continue;
       }
       if (can.command.counter) {
-        const int bits = 8 * can.command.counter->size_bytes;
-        const std::uint32_t mask = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
-        const std::uint32_t step = (d.counter - last_cmd_counter) & mask;
-        if (have_cmd_counter && step > 1 && step <= mask / 2) rep.commands_lost += step - 1;
+        if (have_cmd_counter)
+          rep.commands_lost += drivers::counter_step(last_cmd_counter, d.counter, drivers::counter_mask(*can.command.counter)).lost;
         last_cmd_counter = d.counter, have_cmd_counter = true;
       }
       ++rep.command_frames;

@@ -204,7 +204,7 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   text += "\ndds:\n  domain_id: " + std::to_string(domain) + "\n  transport: udp_loopback\n  telemetry_rate_hz: 20\n";
   std::ofstream(dir + "/dds.yaml") << text;
   const std::string bin = ROBODAMP_BINARY;
-  const std::string run = bin + " run --config " + dir + "/dds.yaml --duration 6 > " + dir + "/run.log 2>&1 &";
+  const std::string run = bin + " run --config " + dir + "/dds.yaml --duration 14 > " + dir + "/run.log 2>&1 &";
   ASSERT_EQ(std::system(run.c_str()), 0);
   const std::string monitor = bin + " monitor --config " + dir + "/dds.yaml --duration 4 > " + dir + "/monitor.log 2>&1";
   EXPECT_EQ(std::system(monitor.c_str()), 0) << test::read_file(dir + "/monitor.log");
@@ -217,7 +217,9 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   const int rc = std::system(request.c_str());
   EXPECT_EQ(WEXITSTATUS(rc), 3) << test::read_file(dir + "/request.log");
   EXPECT_NE(test::read_file(dir + "/request.log").find("refused: parameter writes are off"), std::string::npos);
-  std::this_thread::sleep_for(std::chrono::seconds(3));  // the run ends on its own
+  // The run ends on its own (its 14 s leave DDS discovery time for both clients on a loaded machine).
+  EXPECT_TRUE(eventually([&] { return test::read_file(dir + "/run.log").find("state: disabled") != std::string::npos; }, 30.0))
+      << test::read_file(dir + "/run.log");
 }
 
 }  // namespace
