@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include <memory>
 
 namespace robodamp::apps {
 
@@ -171,6 +173,41 @@ std::string plot_analysis(const analysis::LoopModel& m, const analysis::Analysis
     if (auto e = run_gnuplot(s.str(), data.str(), dir + "/gain_sweep.png"); !e.empty()) return e;
   }
   return {};
+}
+
+}  // namespace robodamp::apps
+
+namespace robodamp::apps {
+
+namespace {
+
+struct AnalyzeArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  bool json{false};
+  std::string plot_dir;
+};
+
+// 0 stable, 3 unstable at the configured K, 1 plot failed.
+int run_analyze(const AnalyzeArgs& a) {
+  const analysis::LoopModel model(config::load_config_file(a.config_path));
+  const auto result = analysis::analyse(model);
+  const auto report = analysis_report(model, result);
+  if (print_report(report.dump(2), a.json, analysis_table(report), a.plot_dir,
+                   [&] { return plot_analysis(model, result, a.plot_dir); },
+                   "frf_open_closed.png, nyquist.png, gain_sweep.png in " + a.plot_dir) != 0)
+    return 1;
+  return result.stable ? 0 : 3;
+}
+
+}  // namespace
+
+void register_analyze(Registry& r) {
+  auto a = std::make_shared<AnalyzeArgs>();
+  CLI::App* sub = r.add("analyze", "Closed-loop stability, margins, polarity and predicted improvement",
+                        [a] { return run_analyze(*a); });
+  sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  sub->add_flag("--json", a->json, "Print JSON instead of a table");
+  sub->add_option("--plot-dir", a->plot_dir, "Write FRF, Nyquist and gain-sweep plots (PNG) here");
 }
 
 }  // namespace robodamp::apps

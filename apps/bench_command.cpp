@@ -6,7 +6,11 @@
 #include <sstream>
 
 #include "apps/analyze_command.hpp"
+#include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include <fstream>
+#include <iostream>
+#include <memory>
 
 namespace robodamp::apps {
 
@@ -185,6 +189,56 @@ std::string plot_bench(const analysis::Bench& bench, const analysis::BenchReport
   }
   (void)bench;
   return {};
+}
+
+}  // namespace robodamp::apps
+
+namespace robodamp::apps {
+
+namespace {
+
+struct BenchArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string json_path;
+  std::string plot_dir;
+};
+
+// 0 PASS, 1 mismatch (or an output that could not be written), 3 unstable (no closed-loop tests).
+int run_bench(const BenchArgs& a) {
+  const analysis::Bench bench(config::load_config_file(a.config_path));
+  const auto report = bench.run([](const std::string& line) { std::cerr << "[bench] " << line << std::endl; });
+  std::cout << bench_table(bench, report);
+  if (!a.json_path.empty()) {
+    std::ofstream out(a.json_path);
+    out << bench_report_json(bench, report).dump(2) << '\n';
+    if (!out) {
+      std::cerr << "--json " << a.json_path << ": cannot write\n";
+      return 1;
+    }
+    std::cout << "wrote " << a.json_path << '\n';
+  }
+  if (!a.plot_dir.empty()) {
+    std::string err = plot_analysis(bench.model(), report.analysis, a.plot_dir);
+    if (err.empty()) err = plot_bench(bench, report, a.plot_dir);
+    if (!err.empty()) {
+      std::cerr << "plot: " << err << '\n';
+      return 1;
+    }
+    std::cout << "wrote plots in " << a.plot_dir << '\n';
+  }
+  if (!report.ran_closed_loop) return 3;
+  return report.improvement_within_5pct && report.sweep_agrees ? 0 : 1;
+}
+
+}  // namespace
+
+void register_bench(Registry& r) {
+  auto a = std::make_shared<BenchArgs>();
+  CLI::App* sub = r.add("bench", "Simulated-plant bench run: impact tests control off/on, saturation, gain sweep",
+                        [a] { return run_bench(*a); });
+  sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  sub->add_option("--json", a->json_path, "Write the report as JSON to this file");
+  sub->add_option("--plot-dir", a->plot_dir, "Write plots (PNG) here");
 }
 
 }  // namespace robodamp::apps

@@ -4,7 +4,10 @@
 #include <cstdio>
 #include <sstream>
 
+#include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include <iostream>
+#include <memory>
 
 namespace robodamp::apps {
 
@@ -113,6 +116,44 @@ std::string plot_filters(const control::ChainDesign& d, const std::string& png_p
   }
   s << "unset multiplot\n";
   return run_gnuplot(s.str(), data.str(), png_path);
+}
+
+}  // namespace robodamp::apps
+
+namespace robodamp::apps {
+
+namespace {
+
+struct FiltersArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  double freq_hz{9.2};
+  bool json{false};
+  std::string plot;
+};
+
+int run_filters(const FiltersArgs& a) {
+  const control::ChainDesign d = control::design_chain(config::load_config_file(a.config_path));
+  // The frequency's upper bound depends on the configuration's loop rate, so it is checked here.
+  if (auto p = config::range_problem("--freq", a.freq_hz,
+                                     {"Hz", 0.0, 0.5 * d.params.fs_hz, true, true, "below Nyquist of loop.rate_hz"})) {
+    std::cerr << "robodamp filters: " << *p << '\n';
+    return 2;
+  }
+  const auto report = filters_report(d, a.freq_hz);
+  return print_report(report.dump(2), a.json, filters_table(report), a.plot, [&] { return plot_filters(d, a.plot); },
+                      a.plot);
+}
+
+}  // namespace
+
+void register_filters(Registry& r) {
+  auto a = std::make_shared<FiltersArgs>();
+  CLI::App* sub = r.add("filters", "Magnitude and phase of each block and the chain, analog and digital",
+                        [a] { return run_filters(*a); });
+  sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  r.number(sub, "--freq", a->freq_hz, {"Hz", 0.0, 1e6, true, false, "and below Nyquist of loop.rate_hz"}, "Frequency in Hz");
+  sub->add_flag("--json", a->json, "Print JSON instead of a table");
+  sub->add_option("--plot", a->plot, "Write a Bode diagram of the blocks and the chain (PNG)");
 }
 
 }  // namespace robodamp::apps

@@ -1,57 +1,93 @@
-#include "apps/plant_command.hpp"
-
+// `robodamp plant`: the HIL plant emulator (hil/plant_emulator.hpp) as a process of its own: the
+// simulated plant behind CAN frames and Modbus registers, for `robodamp run` to control.
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
-#include <spdlog/spdlog.h>
-
-#include "apps/run_command.hpp"
+#include "apps/cli.hpp"
 #include "hil/plant_emulator.hpp"
 #include "rt/signals.hpp"
 
 namespace robodamp::apps {
 
-int run_plant(const PlantOptions& o) {
-  const auto loaded = load_config_or_report(o.config_path);
-  if (!loaded) return 2;
-  const config::Config& cfg = *loaded;
+namespace {
+
+struct PlantArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string pacing;
+  double duration_s{0.0};
+  std::string json_path;
+  bool impacts{true};
+  int impact_location{0};
+  std::vector<std::string> mounting_schedule;  // "T:vertical" / "T:horizontal", plant time in s
+};
+
+// "T:horizontal" or "T:vertical" with T a finite plant time >= 0 s.
+std::optional<std::pair<double, config::Mounting>> parse_mounting(const std::string& item) {
+  const auto colon = item.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  double t = 0.0;
+  if (parse_number("--mounting", item.substr(0, colon), {"s", 0.0, 1e7}, false, t)) return std::nullopt;
+  const std::string m = item.substr(colon + 1);
+  if (m != "horizontal" && m != "vertical") return std::nullopt;
+  return std::pair{t, m == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal};
+}
+
+// 0 served a controller to the end; 2 configuration or option error; 1 could not set up or the impact
+// schedule did not complete.
+int run_plant(const PlantArgs& a) {
+  const config::Config cfg = config::load_config_file(a.config_path);
   hil::EmulatorOptions eo;
-  eo.pacing = o.pacing;
-  eo.max_duration_s = o.duration_s;
-  eo.impacts = o.impacts;
-  eo.impact_location = o.impact_location;
-  for (const auto& item : o.mounting_schedule) {
-    const auto colon = item.find(':');
-    double t = -1.0;
-    try {
-      t = colon == std::string::npos ? -1.0 : std::stod(item.substr(0, colon));
-    } catch (const std::exception&) {
-    }
-    const std::string m = colon == std::string::npos ? "" : item.substr(colon + 1);
-    if (!(t >= 0.0) || (m != "horizontal" && m != "vertical")) {
-      std::cerr << "--mounting '" << item << "': expected TIME_S:horizontal or TIME_S:vertical with TIME_S >= 0 s\n";
+  if (!a.pacing.empty()) eo.pacing = a.pacing == "lockstep" ? config::HilPacing::kLockstep : config::HilPacing::kRealtime;
+  eo.max_duration_s = a.duration_s;
+  eo.impacts = a.impacts;
+  eo.impact_location = a.impact_location;
+  for (const auto& item : a.mounting_schedule) {
+    const auto m = parse_mounting(item);
+    if (!m) {
+      std::cerr << "robodamp plant: --mounting = '" << item
+                << "': expected TIME_S:horizontal or TIME_S:vertical, allowed 0 <= TIME_S <= 1e+07 s\n";
       return 2;
     }
-    eo.mounting_schedule.emplace_back(t, m == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal);
+    eo.mounting_schedule.push_back(*m);
   }
   rt::install_shutdown_handlers();
   eo.stop_flag = &rt::shutdown_signal();
-  try {
-    const hil::EmulatorReport r = hil::run_emulator(cfg, eo);
-    std::cout << hil::report_text(r);
-    if (!o.json_path.empty()) {
-      std::ofstream out(o.json_path);
-      out << hil::report_json(r).dump(2) << '\n';
-      if (!out) {
-        std::cerr << "--json " << o.json_path << ": cannot write\n";
-        return 1;
-      }
+  const hil::EmulatorReport r = hil::run_emulator(cfg, eo);
+  std::cout << hil::report_text(r);
+  if (!a.json_path.empty()) {
+    std::ofstream out(a.json_path);
+    out << hil::report_json(r).dump(2) << '\n';
+    if (!out) {
+      std::cerr << "--json " << a.json_path << ": cannot write\n";
+      return 1;
     }
-    return r.records_planned > 0 && !r.campaign_complete ? 1 : 0;
-  } catch (const std::exception& e) {
-    std::cerr << "robodamp plant: " << e.what() << '\n';
-    return 1;
   }
+  return r.records_planned > 0 && !r.campaign_complete ? 1 : 0;
+}
+
+}  // namespace
+
+void register_plant(Registry& r) {
+  auto a = std::make_shared<PlantArgs>();
+  CLI::App* sub = r.add("plant", "HIL plant emulator: the simulated plant behind CAN frames and Modbus registers, "
+                                 "in its own process, for `robodamp run` to control",
+                        [a] { return run_plant(*a); });
+  sub->add_option("--config", a->config_path, "Configuration file (YAML) with can, modbus and hil sections")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--pacing", a->pacing, "Override hil.pacing: realtime (true HIL) or lockstep (one step per command frame)")
+      ->check(CLI::IsMember({"realtime", "lockstep"}));
+  r.number(sub, "--duration", a->duration_s, {"s", 0.0, 604800.0, false, false, "0 = when the controller leaves"},
+           "Stop after this much plant time");
+  sub->add_option("--json", a->json_path, "Write the report (frames, timing, measured FRFs) as JSON to this file");
+  sub->add_flag("!--no-impacts", a->impacts, "Do not run the impact schedule");
+  r.whole_number(sub, "--impact-location", a->impact_location,
+                 {"(location id)", 0, 1000, false, false, "0 = the first FRF's excitation"}, "Location id the hammer hits");
+  sub->add_option("--mounting", a->mounting_schedule,
+                  "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
 }
 
 }  // namespace robodamp::apps

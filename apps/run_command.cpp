@@ -1,137 +1,298 @@
-#include "apps/run_command.hpp"
-
+// `robodamp run`: the deployment entry point. Builds the cell (runtime/cell.hpp) from a configuration,
+// takes it through its lifecycle (configure, activate, run, deactivate, cleanup) and prints the summary.
+// The simulated backend paces the simulated plant in real time; can + modbus sections run the hardware
+// (a CAN interface or the HIL emulator).
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <sstream>
 
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
-#include "apps/session.hpp"
-#include "rt/recording.hpp"
+#include "apps/cli.hpp"
 #include "rt/signals.hpp"
+#include "runtime/cell.hpp"
 
 namespace robodamp::apps {
 
-std::optional<config::Config> load_config_or_report(const std::string& path) {
-  try {
-    return config::load_config_file(path);
-  } catch (const config::ConfigError& e) {
-    std::cerr << e.what() << '\n';
-    return std::nullopt;
+namespace {
+
+struct RunArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  double duration_s{10.0};
+  std::string record_path;
+  std::string json_path;
+  std::string histogram_path;  // wake-up latency histogram in cyclictest's --histfile format
+  std::string clock;
+  double impact_every_s{2.0};
+};
+
+[[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s) {
+  using nlohmann::json;
+  auto hist = [](const rt::TimingHistogram& h) {
+    return json{{"count", h.count()},           {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
+                {"p999_us", h.percentile_us(0.999)}, {"max_us", h.max_us()},       {"mean_us", h.mean_us()}};
+  };
+  json trips = json::object();
+  for (std::size_t i = 1; i < rt::kTripCount; ++i)
+    trips[rt::to_string(static_cast<rt::Trip>(i))] = s.supervisor.trips[i];
+  const auto ticks = static_cast<double>(std::max<std::uint64_t>(1, s.loop.ticks_run + s.loop.missed_ticks));
+  json j = {{"config", s.config},
+          {"clock", s.clock},
+          {"rate_hz", s.rate_hz},
+          {"duration_s", s.duration_s},
+          {"elapsed_s", s.loop.elapsed_s},
+          {"final_state", s.final_state},
+          {"trip", s.trip},
+          {"trip_description", s.trip_description},
+          {"analysis_stable", s.analysis_stable},
+          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
+          {"ticks_run", s.loop.ticks_run},
+          {"missed_ticks", s.loop.missed_ticks},
+          {"overruns", s.loop.overruns},
+          {"overrun_pct", 100.0 * static_cast<double>(s.loop.overruns) / ticks},
+          {"wake_latency", hist(s.loop.wake_latency)},
+          {"compute", hist(s.loop.compute)},
+          {"telemetry", {{"frames", s.telemetry_frames}, {"ring_drops", s.loop.ring_drops}, {"ring_waits", s.loop.ring_waits}}},
+          {"recording", {{"path", s.record_path}, {"frames", s.recorded_frames}, {"write_errors", s.record_errors}}},
+          {"supervisor",
+           {{"trips", trips},
+            {"stale_ticks", s.supervisor.stale_ticks},
+            {"invalid_samples", s.supervisor.invalid_samples},
+            {"saturated_ticks", s.supervisor.saturated_ticks},
+            {"arm_refused", s.supervisor.arm_refused},
+            {"gain_refused", s.supervisor.gain_refused},
+            {"params_selected", s.supervisor.params_selected},
+            {"params_refused", s.supervisor.params_refused}}},
+          {"realtime",
+           {{"memory_locked", s.realtime.memory_locked},
+            {"sched_fifo", s.realtime.fifo},
+            {"priority", s.realtime.priority},
+            {"affinity", s.realtime.affinity},
+            {"timer_slack_1ns", s.realtime.timer_slack},
+            {"cpu_dma_latency_held", s.realtime.dma_latency_held},
+            {"warnings", s.realtime.warnings}}},
+          {"sensor_rms_mps2", s.sensor_rms_mps2},
+          {"peak_command_v", s.peak_command_v}};
+  j["backend"] = s.backend;
+  j["arming"] = {{"enabled", s.arming.enabled},
+                 {"outcome", runtime::to_string(s.arming.outcome)},
+                 {"attempts", s.arming.attempts},
+                 {"last_refusal", rt::to_string(s.arming.last_refusal)},
+                 {"deadline_s", s.arming.deadline_s}};
+  auto t = [](double v) { return v >= 0.0 ? json(v) : json(nullptr); };
+  j["trip_timing"] = {{"last_fresh_s", t(s.trip_timing.last_fresh_s)},
+                      {"trip_s", t(s.trip_timing.trip_s)},
+                      {"safe_s", t(s.trip_timing.safe_s)}};
+  if (s.can) {
+    const auto& c = *s.can;
+    j["can"] = {{"rx_frames", c.rx_frames},       {"rx_other", c.rx_other},     {"rx_malformed", c.rx_malformed},
+                {"lost_frames", c.lost_frames},   {"stale_frames", c.stale_frames}, {"error_frames", c.error_frames},
+                {"bus_off", c.bus_off},           {"restarts", c.restarts},     {"rx_errors", c.rx_errors},
+                {"tx_frames", c.tx_frames},       {"tx_queue_full", c.tx_queue_full}, {"tx_errors", c.tx_errors},
+                {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}, {"rx_held", c.rx_held},
+                {"rx_skipped", c.rx_skipped}};
   }
+  if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
+                         {"refused", s.dds->refused}};
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
+                   {"connects", m.connects},               {"connect_failures", m.connect_failures},
+                   {"errors", m.errors},                   {"timeouts", m.timeouts},
+                   {"link_faults", m.link_faults},         {"coil_writes", m.coil_writes},
+                   {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown}};
+  }
+  return j;
 }
 
-int run_loop(const RunOptions& o) {
-  const auto loaded = load_config_or_report(o.config_path);
-  if (!loaded) return 2;
-  const config::Config& cfg = *loaded;
-  if (!(o.duration_s > 0.0 && o.duration_s <= 7.0 * 24 * 3600)) {
-    std::cerr << "--duration " << o.duration_s << " s: allowed 0 < value <= 604800 s (one week)\n";
-    return 2;
+[[nodiscard]] std::string summary_text(const runtime::RunSummary& s) {
+  std::ostringstream os;
+  char b[256];
+  const auto& st = s.loop;
+  const double all = static_cast<double>(std::max<std::uint64_t>(1, st.ticks_run + st.missed_ticks));
+  std::snprintf(b, sizeof b, "robodamp run: %s, %s, %s clock, %.0f Hz, %.3f s (%.3f s elapsed)\n",
+                s.config.c_str(), s.backend.c_str(), s.clock.c_str(), s.rate_hz, s.duration_s, st.elapsed_s);
+  os << b;
+  if (s.clock == "wall") {
+    os << "  real time: " << (s.realtime.fifo ? "SCHED_FIFO " + std::to_string(s.realtime.priority) : "SCHED_OTHER")
+       << (s.realtime.memory_locked ? ", memory locked" : "") << (s.realtime.dma_latency_held ? ", cpu_dma_latency 0" : "")
+       << (s.realtime.timer_slack ? ", timer slack 1 ns" : "") << (s.realtime.affinity ? ", pinned" : "") << '\n';
   }
-  try {
-    SessionOptions so;
-    so.clock = o.clock;
-    so.impact_every_s = o.impact_every_s;
-    so.record_path = o.record_path;
-    Session session(cfg, so);
-    rt::install_shutdown_handlers();
-    spdlog::info("robodamp run: {} at {} Hz on the {} clock for {} s against {} (Ctrl-C ends it through the safe state)",
-                 o.config_path, cfg.loop.rate_hz, config::to_string(session.config().loop.clock), o.duration_s,
-                 session.hardware() ? "the hardware" : "the simulated plant");
-    const RunSummary s = session.run(o.duration_s);
-    std::cout << summary_text(s);
-    if (!o.json_path.empty()) {
-      std::ofstream out(o.json_path);
-      out << summary_json(s).dump(2) << '\n';
-      if (!out) {
-        std::cerr << "--json " << o.json_path << ": cannot write\n";
-        return 1;
-      }
-    }
-    if (!o.histogram_path.empty()) {
-      // The layout of cyclictest's --histfile (whole-microsecond bins), so one script reads both.
-      std::ofstream out(o.histogram_path);
-      const auto& h = s.loop.wake_latency;
-      out << "# robodamp run wake-up latency histogram (us)\n";
-      std::size_t last = 0;
-      for (std::size_t us = 0; us < rt::TimingHistogram::kBins; ++us)
-        if (h.bin(us) > 0) last = us;
-      char line[64];
-      for (std::size_t us = 0; us <= last; ++us) {
-        std::snprintf(line, sizeof line, "%06zu %06llu\n", us, static_cast<unsigned long long>(h.bin(us)));
-        out << line;
-      }
-      out << "# Total: " << h.count() << "\n# Max Latencies: " << h.max_us() << "\n# Histogram Overflows: "
-          << h.overflow() << "\n# Loop overruns: " << s.loop.overruns << "\n# Missed ticks: " << s.loop.missed_ticks
-          << '\n';
-      if (!out) {
-        std::cerr << "--histogram " << o.histogram_path << ": cannot write\n";
-        return 1;
-      }
-    }
-    if (s.record_errors > 0) return 1;
-    return s.trip == "none" || s.trip == "signal" ? 0 : 4;
-  } catch (const config::ConfigError& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
-  } catch (const rt::RecordingError& e) {
-    std::cerr << "--record: " << e.what() << '\n';
-    return 1;
-  } catch (const std::exception& e) {  // a CAN transport or interface that cannot be opened
-    std::cerr << "robodamp run: " << e.what() << '\n';
-    return 1;
+  os << "  state: " << s.final_state;
+  if (s.trip != "none") os << "  (tripped: " << s.trip << " - " << s.trip_description << ")";
+  os << '\n';
+  if (s.arming.enabled) {
+    os << "  arming: " << runtime::to_string(s.arming.outcome) << " after " << s.arming.attempts << " attempt(s)";
+    if (s.arming.last_refusal != rt::ArmRefusal::kNone) os << "; last refusal: " << rt::to_string(s.arming.last_refusal);
+    os << '\n';
   }
+  std::snprintf(b, sizeof b, "  ticks %llu, missed %llu, overruns %llu (%.4f %%)\n",
+                static_cast<unsigned long long>(st.ticks_run), static_cast<unsigned long long>(st.missed_ticks),
+                static_cast<unsigned long long>(st.overruns), 100.0 * static_cast<double>(st.overruns) / all);
+  os << b;
+  if (s.clock == "wall") {
+    const auto& h = st.wake_latency;
+    std::snprintf(b, sizeof b, "  wake-up latency: p50 %.0f us, p99 %.0f us, p99.9 %.0f us, max %.1f us\n",
+                  h.percentile_us(0.5), h.percentile_us(0.99), h.percentile_us(0.999), h.max_us());
+    os << b;
+  }
+  std::snprintf(b, sizeof b, "  compute per tick: mean %.2f us, p99 %.0f us, max %.1f us\n", st.compute.mean_us(),
+                st.compute.percentile_us(0.99), st.compute.max_us());
+  os << b;
+  std::string trips;
+  for (std::size_t i = 1; i < rt::kTripCount; ++i)
+    if (s.supervisor.trips[i] > 0)
+      trips += std::string(trips.empty() ? "" : ", ") + rt::to_string(static_cast<rt::Trip>(i)) + " " +
+               std::to_string(s.supervisor.trips[i]);
+  std::snprintf(b, sizeof b, "  supervisor: stale %llu, invalid %llu, saturated %llu ticks, arm refused %llu, gain refused %llu; trips: %s\n",
+                static_cast<unsigned long long>(s.supervisor.stale_ticks),
+                static_cast<unsigned long long>(s.supervisor.invalid_samples),
+                static_cast<unsigned long long>(s.supervisor.saturated_ticks),
+                static_cast<unsigned long long>(s.supervisor.arm_refused),
+                static_cast<unsigned long long>(s.supervisor.gain_refused), trips.empty() ? "none" : trips.c_str());
+  os << b;
+  std::snprintf(b, sizeof b, "  vibration at the sensor: %.4f m/s^2 RMS; peak command %.3f V; K_max %.0f N s/m\n",
+                s.sensor_rms_mps2, s.peak_command_v, s.max_stable_gain_ns_per_m);
+  os << b;
+  std::snprintf(b, sizeof b, "  telemetry: %llu frames, %llu dropped", static_cast<unsigned long long>(s.telemetry_frames),
+                static_cast<unsigned long long>(st.ring_drops));
+  os << b;
+  if (!s.record_path.empty())
+    os << "; recorded " << s.recorded_frames << " frames to " << s.record_path
+       << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
+  os << '\n';
+  if (s.can) {
+    const auto& c = *s.can;
+    std::snprintf(b, sizeof b,
+                  "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
+                  "%llu bus-off, %llu held over / %llu skipped (de-jitter); %llu commands sent (%llu queue full, %llu errors, "
+                  "%llu skipped)\n",
+                  static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
+                  static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
+                  static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
+                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
+                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.tx_frames),
+                  static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
+                  static_cast<unsigned long long>(c.tx_skipped));
+    os << b;
+  }
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    std::snprintf(b, sizeof b,
+                  "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
+                  "%llu link faults, %llu mounting changes\n",
+                  static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
+                  static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
+                  static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
+                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes));
+    os << b;
+  }
+  if (s.dds) {
+    std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
+                  static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
+                  static_cast<unsigned long long>(s.dds->requests), static_cast<unsigned long long>(s.dds->refused));
+    os << b;
+  }
+  if (s.trip_timing.trip_s >= 0.0) {
+    std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s\n", s.trip_timing.trip_s,
+                  s.trip_timing.last_fresh_s, s.trip_timing.safe_s);
+    os << b;
+  }
+  if (!s.realtime.warnings.empty())
+    os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
+  return os.str();
 }
 
-int run_replay(const std::string& path) {
-  try {
-    const rt::Recording r = rt::read_recording(path);
-    const rt::ReplayResult res = rt::replay(r);
-    std::cout << path << ": " << res.frames << " frames (" << r.header.value("clock", "?") << " clock, "
-              << r.header.value("rate_hz", 0.0) << " Hz, robodamp " << r.header.value("robodamp_version", "?") << " "
-              << r.header.value("git_commit", "?") << ")\n";
-    if (r.trailing_bytes > 0)
-      std::cout << "  note: " << r.trailing_bytes << " trailing bytes of a partial frame ignored\n";
-    std::cout << "  replayed through the same supervisor and controller: final state " << res.final_state
-              << ", trip " << res.final_trip << '\n';
-    if (res.mismatches == 0) {
-      std::cout << "  commands reproduced bit for bit\n";
-      return 0;
-    }
-    char b[200];
-    std::snprintf(b, sizeof b, "  %llu frames differ; first at tick %llu: recorded %.17g V, replayed %.17g V\n",
-                  static_cast<unsigned long long>(res.mismatches),
-                  static_cast<unsigned long long>(res.first_mismatch_tick), res.first_recorded_v, res.first_replayed_v);
-    std::cout << b;
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
+
+// The layout of cyclictest's --histfile (whole-microsecond bins), so one script reads both.
+bool write_histogram(const std::string& path, const runtime::RunSummary& s) {
+  std::ofstream out(path);
+  const auto& h = s.loop.wake_latency;
+  out << "# robodamp run wake-up latency histogram (us)\n";
+  std::size_t last = 0;
+  for (std::size_t us = 0; us < rt::TimingHistogram::kBins; ++us)
+    if (h.bin(us) > 0) last = us;
+  char line[64];
+  for (std::size_t us = 0; us <= last; ++us) {
+    std::snprintf(line, sizeof line, "%06zu %06llu\n", us, static_cast<unsigned long long>(h.bin(us)));
+    out << line;
   }
+  out << "# Total: " << h.count() << "\n# Max Latencies: " << h.max_us() << "\n# Histogram Overflows: " << h.overflow()
+      << "\n# Loop overruns: " << s.loop.overruns << "\n# Missed ticks: " << s.loop.missed_ticks << '\n';
+  return static_cast<bool>(out);
 }
 
-int run_csv(const std::string& path, const std::string& out_path) {
-  try {
-    const rt::Recording r = rt::read_recording(path);
-    std::FILE* out = out_path.empty() || out_path == "-" ? stdout : std::fopen(out_path.c_str(), "w");
-    if (out == nullptr) {
-      std::cerr << "-o " << out_path << ": cannot open for writing\n";
+int exit_status(const runtime::Status& s) { return s.kind == runtime::StatusKind::kConfigError ? 2 : 1; }
+
+// 0 ended safe (disarmed, or shut down by a signal); 2 configuration error; 4 ended in a fault trip;
+// 5 never armed (the arming policy's deadline passed, or the run ended first); 1 other (devices, recording).
+int run_loop(const RunArgs& a) {
+  config::Config cfg = config::load_config_file(a.config_path);
+  runtime::CellOptions o;
+  if (!a.clock.empty()) o.clock = a.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
+  o.impact_every_s = a.impact_every_s;
+  o.record_path = a.record_path;
+  runtime::Cell cell(cfg, o);
+  if (runtime::Status s = cell.configure(); !s.ok()) {
+    std::cerr << s.message << '\n';
+    return exit_status(s);
+  }
+  rt::install_shutdown_handlers();
+  spdlog::info("robodamp run: {} at {} Hz on the {} clock for {} s against {} (Ctrl-C ends it through the safe state)",
+               a.config_path, cfg.loop.rate_hz, config::to_string(cell.config().loop.clock), a.duration_s,
+               cell.hardware() ? "the hardware" : "the simulated plant");
+  if (runtime::Status s = cell.activate(a.duration_s); !s.ok()) {
+    std::cerr << "robodamp run: " << s.message << '\n';
+    return exit_status(s);
+  }
+  cell.wait();
+  if (runtime::Status s = cell.deactivate(); !s.ok()) std::cerr << "robodamp run: " << s.message << '\n';
+  const runtime::RunSummary& s = cell.summary();
+  std::cout << summary_text(s);
+  if (!a.json_path.empty()) {
+    std::ofstream out(a.json_path);
+    out << summary_json(s).dump(2) << '\n';
+    if (!out) {
+      std::cerr << "--json " << a.json_path << ": cannot write\n";
       return 1;
     }
-    rt::write_csv(r, out);
-    const bool ok = std::ferror(out) == 0;
-    if (out != stdout) std::fclose(out);
-    if (!ok) {
-      std::cerr << "-o " << out_path << ": write failed\n";
-      return 1;
-    }
-    if (out != stdout) std::cout << "wrote " << r.frames.size() << " frames to " << out_path << '\n';
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
   }
+  if (!a.histogram_path.empty() && !write_histogram(a.histogram_path, s)) {
+    std::cerr << "--histogram " << a.histogram_path << ": cannot write\n";
+    return 1;
+  }
+  if (s.record_errors > 0) return 1;
+  if (s.trip == "signal") return 0;
+  if (s.trip != "none") return 4;
+  if (s.never_armed()) {
+    std::cerr << "robodamp run: the loop never armed: " << s.arming.attempts << " attempt(s) within supervision.arm_deadline_s = "
+              << s.arming.deadline_s << " s, last refusal: " << rt::to_string(s.arming.last_refusal) << '\n';
+    return 5;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_run(Registry& r) {
+  auto a = std::make_shared<RunArgs>();
+  CLI::App* sub = r.add("run", "The real-time loop against the simulated plant, or the hardware (can + modbus sections: "
+                               "a CAN interface or the HIL emulator); Ctrl-C ends it safely",
+                        [a] { return run_loop(*a); });
+  sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  r.number(sub, "--duration", a->duration_s, {"s", 0.0, 604800.0, true, false, "one week"}, "Run time in seconds");
+  sub->add_option("--record", a->record_path, "Record every tick to this file (binary, docs/recording_format.md)");
+  sub->add_option("--json", a->json_path, "Write the run summary as JSON to this file");
+  sub->add_option("--histogram", a->histogram_path,
+                  "Write the wake-up latency histogram (cyclictest --histfile layout) to this file");
+  sub->add_option("--clock", a->clock, "Override loop.clock: wall (real time) or virtual (as fast as possible)")
+      ->check(CLI::IsMember({"wall", "virtual"}));
+  r.number(sub, "--impact-every", a->impact_every_s, {"s", 0.0, 86400.0, false, false, "0 = none"},
+           "Simulated plant: a hammer hit at the TCP every S seconds (bench.impact_peak_n)");
 }
 
 }  // namespace robodamp::apps

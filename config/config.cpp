@@ -413,6 +413,8 @@ SupervisionConfig read_supervision(MapReader& top) {
   if (auto v = r.number("instability_floor_v", {"V", 0.0, 100.0}, c.instability_floor_v)) c.instability_floor_v = *v;
   if (auto v = r.number("trip_ramp_s", {"s", 0.0, 1.0}, c.trip_ramp_s)) c.trip_ramp_s = *v;
   if (auto v = read_int(r, "arming_live_cycles", cycles, c.arming_live_cycles)) c.arming_live_cycles = *v;
+  if (auto v = r.number("arm_retry_s", {"s", 0.001, 60.0}, c.arm_retry_s)) c.arm_retry_s = *v;
+  if (auto v = r.number("arm_deadline_s", {"s", 0.01, 86400.0}, c.arm_deadline_s)) c.arm_deadline_s = *v;
   if (auto v = r.number("amplifier_ready_timeout_s", {"s", 0.0, 60.0}, c.amplifier_ready_timeout_s))
     c.amplifier_ready_timeout_s = *v;
   if (auto v = r.number("max_gain_fraction", {"(x maximum stable K)", 0.0, 1.0, true}, c.max_gain_fraction))

@@ -70,6 +70,11 @@ struct SupervisionConfig {
   double instability_floor_v{0.02};  // RMS below this is never called unstable
   double trip_ramp_s{0.01};          // a trip ramps the command to zero within this time
   int arming_live_cycles{50};        // fresh, valid samples needed before arming
+  // The arming policy (runtime/arming_policy.hpp), the same for every backend: arm once the sensor can
+  // be live, retry every arm_retry_s while refused, give up after arm_deadline_s of loop time (the run
+  // then ends with the last refusal and a non-zero exit status).
+  double arm_retry_s{0.5};
+  double arm_deadline_s{10.0};
   double amplifier_ready_timeout_s{0.2};
   double max_gain_fraction{0.9};     // gain requests up to this x the analysed maximum stable K
 };

@@ -13,13 +13,6 @@ SourceMark to_mark(const YAML::Mark& m) {
   return {m.line + 1, m.column + 1};  // yaml-cpp marks are 0-based
 }
 
-std::string format_number(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
 void Diagnostics::add(const YAML::Mark& mark, std::string key, std::string message) {
   add(to_mark(mark), std::move(key), std::move(message));
 }
@@ -29,20 +22,6 @@ void Diagnostics::add(SourceMark mark, std::string key, std::string message) {
 }
 
 namespace {
-
-std::string describe_range(const Range& r) {
-  std::ostringstream os;
-  os << "allowed " << format_number(r.min) << (r.min_open ? " < " : " <= ") << "value"
-     << (r.max_open ? " < " : " <= ") << format_number(r.max) << ' ' << r.unit;
-  if (!r.note.empty()) os << " (" << r.note << ')';
-  return os.str();
-}
-
-bool in_range(double v, const Range& r) {
-  const bool lo = r.min_open ? v > r.min : v >= r.min;
-  const bool hi = r.max_open ? v < r.max : v <= r.max;
-  return lo && hi;
-}
 
 std::string joined(const std::vector<std::string>& v) {
   std::string out;
@@ -245,11 +224,6 @@ ModeConfig read_mode(MapReader& mr, const Range& frequency_range) {
   }
   mr.finish();
   return m;
-}
-
-std::optional<std::string> range_problem(const std::string& key, double v, const Range& range) {
-  if (std::isfinite(v) && in_range(v, range)) return std::nullopt;
-  return key + " = " + format_number(v) + ' ' + std::string(range.unit) + " is out of range: " + describe_range(range);
 }
 
 }  // namespace robodamp::config::detail

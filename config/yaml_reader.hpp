@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config.hpp"
+#include "config/number_range.hpp"
 
 namespace robodamp::config::detail {
 
@@ -26,18 +27,13 @@ class Diagnostics {
   std::vector<Problem> problems_;
 };
 
-// Allowed interval of a number; an open end excludes the bound itself.
-struct Range {
-  std::string_view unit;
-  double min;
-  double max;
-  bool min_open{false};
-  bool max_open{false};
-  std::string note{};  // why the bound, e.g. "Nyquist of loop.rate_hz = 5000 Hz"
-};
+using config::Range;
+using config::format_number;
+using config::describe_range;
+using config::in_range;
+using config::range_problem;
 
 [[nodiscard]] SourceMark to_mark(const YAML::Mark& m);
-[[nodiscard]] std::string format_number(double v);
 
 class MapReader {
  public:
@@ -83,8 +79,6 @@ class MapReader {
 // +1 or -1.
 [[nodiscard]] std::optional<int> read_sign(MapReader& r, const std::string& key, int def);
 [[nodiscard]] std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def);
-// "key = value unit is out of range: ..." (the configuration's own wording), or nothing when in range.
-[[nodiscard]] std::optional<std::string> range_problem(const std::string& key, double v, const Range& range);
 // The optional modbus, parameter_sets, dds and hil sections (config/supervisory_config.hpp).
 void read_supervisory(MapReader& top, Config& c);
 // One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.

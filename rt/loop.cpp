@@ -94,11 +94,16 @@ void Loop::run(std::uint64_t duration_ticks) noexcept {
     in.amplifier_fault = amp.fault;
     in.overrun = overrun || missed > 0;
     in.shutdown = shutdown_ != nullptr && shutdown_->load(std::memory_order_relaxed) != 0;
-    if (!ending && (tick_ >= end_tick || stop_.load(std::memory_order_relaxed))) {
+    const bool scripted = next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].first <= tick_;
+    PolicyDecision policy{};
+    if (policy_ != nullptr && !ending && !scripted) policy = policy_->on_tick(tick_, sup_.state(), sup_.last_arm_refusal());
+    if (!ending && (tick_ >= end_tick || policy.end_run || stop_.load(std::memory_order_relaxed))) {
       ending = true;
       in.command = {CommandKind::kDisarm, 0.0};
-    } else if (next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].first <= tick_) {
+    } else if (scripted) {
       in.command = scheduled_[next_scheduled_++].second;
+    } else if (policy.command.kind != CommandKind::kNone) {
+      in.command = policy.command;
     } else if (!commands_.pop(in.command)) {
       in.command = {};
     }

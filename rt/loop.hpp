@@ -7,6 +7,8 @@
 // Wall clock: clock_nanosleep(TIMER_ABSTIME) on CLOCK_MONOTONIC, deadline = previous deadline + period;
 // a late wake-up skips the ticks it missed (counted, never run in a burst) and is an overrun, as is a tick
 // whose work ends past the next deadline; the measured dt goes to the supervisor and the frame.
+// Commands, in order of precedence at a tick: the end of the run, a scheduled command, the tick policy's
+// (runtime/arming_policy), then one posted by another thread.
 // Virtual clock: ticks back to back as fast as possible, dt = period exactly, no timing in the frames:
 // the same inputs give bit-identical frames run to run.
 #pragma once
@@ -23,6 +25,7 @@
 #include "rt/spsc_ring.hpp"
 #include "rt/supervisor.hpp"
 #include "rt/telemetry_frame.hpp"
+#include "rt/tick_policy.hpp"
 #include "rt/timing_histogram.hpp"
 
 namespace robodamp::rt {
@@ -54,6 +57,8 @@ class Loop {
   // Before run(): a command for a given tick (a script: tests, virtual-clock runs). A scheduled command
   // takes the tick before posted ones; if its tick was skipped it runs at the next tick.
   void schedule(std::uint64_t tick, const OperatorCommand& c);
+  // Before run(): the policy asked each tick when no scripted command is due (arming); nullptr = none.
+  void set_policy(TickPolicy* policy) noexcept { policy_ = policy; }
   // From any thread: end the run as if its duration were over (disarm, ramp, return).
   void request_stop() noexcept { stop_.store(true, std::memory_order_relaxed); }
   // The flag read each tick as SIGINT/SIGTERM (default: rt::shutdown_signal()).
@@ -81,6 +86,7 @@ class Loop {
   std::size_t next_scheduled_{0};
   std::atomic<bool> stop_{false};
   const std::atomic<int>* shutdown_;
+  TickPolicy* policy_{nullptr};
   std::unique_ptr<LoopStats> stats_;
   std::uint64_t tick_{0};
 };

@@ -110,16 +110,18 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
                     {"analysis_stable", p.analysis_stable},
                     {"max_stable_gain_ns_per_m", p.max_stable_gain_ns_per_m}});
   }
-  char created[32];
+  // A virtual-clock run has no wall time in it: its file carries none, so the same run gives the same
+  // bytes (docs/recording_format.md).
+  char created[32] = "";
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
   gmtime_r(&now, &tm);
-  std::strftime(created, sizeof created, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  if (clock == config::ClockKind::kWall) std::strftime(created, sizeof created, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return {{"format", "robodamp-recording"},
           {"format_version", kRecordingFormatVersion},
           {"robodamp_version", kVersion},
           {"git_commit", kGitCommit},
-          {"created_utc", created},
+          {"created_utc", clock == config::ClockKind::kWall ? json(created) : json(nullptr)},
           {"byte_order", "little"},
           {"frame_bytes", sizeof(TelemetryFrame)},
           {"fields", fields},

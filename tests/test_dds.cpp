@@ -13,7 +13,8 @@
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
-#include "apps/session.hpp"
+#include "cell_util.hpp"
+#include "child_process.hpp"
 #include "dds/bridge.hpp"
 #include "dds/participant.hpp"
 #include "robodamp.h"
@@ -148,6 +149,9 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   EXPECT_EQ(bridge.counters().refused, 1U);
 }
 
+// The loop runs in this process (a cell activated for long enough, ended by deactivate() or, on a
+// failed assertion, by the cell's destructor: no thread is left behind). Arming is the arming policy's,
+// so the test waits for the state, not for a fixed tick.
 TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
   config::DdsConfig d;
@@ -156,17 +160,19 @@ TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   d.parameter_writes = true;
   cfg.dds = d;
   cfg.loop.clock = config::ClockKind::kWall;
-  apps::SessionOptions o;
+  runtime::CellOptions o;
   o.realtime_setup = false;
-  apps::Session session(cfg, o);
-  session.add_parameter_set(config::load_config_file(test::preset("horizontal_c1")));
-  apps::RunSummary summary;
-  std::thread loop([&] { summary = session.run(6.0); });
+  runtime::Cell cell(cfg, o);
+  test::configure(cell);
+  cell.add_parameter_set(config::load_config_file(test::preset("horizontal_c1")));
+  ASSERT_TRUE(cell.activate(600.0).ok());
   Client client(d.domain_id);
-  ASSERT_TRUE(eventually([&] { return client.matched(); }));
-  ASSERT_TRUE(eventually([&] { return client.status.size() > 0 && std::string(client.status.last().state()) == "active"; }));
+  ASSERT_TRUE(eventually([&] { return client.matched(); }, 60.0));
+  ASSERT_TRUE(eventually([&] { return client.status.size() > 0 && std::string(client.status.last().state()) == "active"; }, 60.0))
+      << "arming outcome " << runtime::to_string(cell.arming().outcome()) << ", last refusal "
+      << rt::to_string(cell.arming().last_refusal());
   const double limit = client.status.last().max_gain_ns_per_m();
-  EXPECT_NEAR(limit, cfg.supervision.max_gain_fraction * session.supervisor().parameter_sets()[0].max_stable_gain_ns_per_m, 1e-6);
+  EXPECT_NEAR(limit, cfg.supervision.max_gain_fraction * cell.supervisor().parameter_sets()[0].max_stable_gain_ns_per_m, 1e-6);
 
   auto r = client.ask(1, msg::SET_GAIN, 90000.0);
   EXPECT_FALSE(r.accepted());
@@ -180,22 +186,26 @@ TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   EXPECT_FALSE(r.accepted());
   r = client.ask(5, msg::SET_GAIN, 2500.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
-  ASSERT_TRUE(eventually([&] { return client.telemetry.size() > 0 && client.telemetry.last().gain_ns_per_m() > 2499.0; }));
+  ASSERT_TRUE(eventually([&] { return client.telemetry.size() > 0 && client.telemetry.last().gain_ns_per_m() > 2499.0; }, 60.0));
   r = client.ask(6, msg::SELECT_PARAMETER_SET, 1.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
-  ASSERT_TRUE(eventually([&] { return client.status.last().parameter_set() == 1; }));
+  ASSERT_TRUE(eventually([&] { return client.status.last().parameter_set() == 1; }, 60.0));
   r = client.ask(7, msg::ENABLE, 0.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
-  ASSERT_TRUE(eventually([&] { return std::string(client.status.last().state()) == "disabled"; }));
-  loop.join();
+  ASSERT_TRUE(eventually([&] { return std::string(client.status.last().state()) == "disabled"; }, 60.0));
+  ASSERT_TRUE(cell.deactivate().ok());
+  const runtime::RunSummary& summary = cell.summary();
   ASSERT_TRUE(summary.dds.has_value());
   EXPECT_EQ(summary.dds->requests, 7U);
   EXPECT_EQ(summary.dds->refused, 4U);
   EXPECT_EQ(summary.supervisor.params_selected, 1U);
   EXPECT_EQ(summary.trip, "none");
+  EXPECT_EQ(summary.arming.outcome, runtime::ArmingOutcome::kArmed) << "the operator's disarm came after arming";
 }
 
-// The command-line tools against a `robodamp run` process: the live view and a refused request.
+// The command-line tools against a `robodamp run` process: the live view and a refused request. The
+// run lasts until the test ends it with SIGINT (exit 0 through the safe state), so nothing depends on
+// how long arming or discovery take on a loaded machine.
 TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   const int domain = test_domain(3);
   const std::string dir = ::testing::TempDir() + "robodamp_dds_cli_" + std::to_string(getpid());
@@ -203,23 +213,27 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   std::string text = test::read_file(test::preset("horizontal_c2"));
   text += "\ndds:\n  domain_id: " + std::to_string(domain) + "\n  transport: udp_loopback\n  telemetry_rate_hz: 20\n";
   std::ofstream(dir + "/dds.yaml") << text;
-  const std::string bin = ROBODAMP_BINARY;
-  const std::string run = bin + " run --config " + dir + "/dds.yaml --duration 14 > " + dir + "/run.log 2>&1 &";
-  ASSERT_EQ(std::system(run.c_str()), 0);
-  const std::string monitor = bin + " monitor --config " + dir + "/dds.yaml --duration 4 > " + dir + "/monitor.log 2>&1";
-  EXPECT_EQ(std::system(monitor.c_str()), 0) << test::read_file(dir + "/monitor.log");
-  const std::string view = test::read_file(dir + "/monitor.log");
-  EXPECT_NE(view.find("state      active"), std::string::npos) << view;
+  test::Child run({"run", "--config", dir + "/dds.yaml", "--duration", "600"}, dir + "/run.log");
+  std::string view;
+  // The monitor shows what it sees: ask again until it has seen the loop active (or a minute passed).
+  const bool seen = eventually([&] {
+    test::Child monitor({"monitor", "--config", dir + "/dds.yaml", "--duration", "3"}, dir + "/monitor.log");
+    (void)monitor.wait_for(60.0);
+    view = test::read_file(dir + "/monitor.log");
+    return view.find("state      active") != std::string::npos;
+  }, 60.0);
+  EXPECT_TRUE(seen) << view << "\nrun log:\n" << test::read_file(dir + "/run.log");
   EXPECT_NE(view.find("m/s^2 RMS"), std::string::npos) << view;
   EXPECT_NE(view.find("wake-up p50"), std::string::npos) << view;
   EXPECT_NE(view.find("parameter writes off"), std::string::npos) << view;
-  const std::string request = bin + " request --config " + dir + "/dds.yaml --gain 2500 > " + dir + "/request.log 2>&1";
-  const int rc = std::system(request.c_str());
-  EXPECT_EQ(WEXITSTATUS(rc), 3) << test::read_file(dir + "/request.log");
+  test::Child request({"request", "--config", dir + "/dds.yaml", "--gain", "2500", "--timeout", "60"}, dir + "/request.log");
+  EXPECT_EQ(request.wait_for(120.0), std::optional<int>(3)) << test::read_file(dir + "/request.log");
   EXPECT_NE(test::read_file(dir + "/request.log").find("refused: parameter writes are off"), std::string::npos);
-  // The run ends on its own (its 14 s leave DDS discovery time for both clients on a loaded machine).
-  EXPECT_TRUE(eventually([&] { return test::read_file(dir + "/run.log").find("state: disabled") != std::string::npos; }, 30.0))
-      << test::read_file(dir + "/run.log");
+  run.kill(SIGINT);
+  EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
+  const std::string log = test::read_file(dir + "/run.log");
+  EXPECT_NE(log.find("tripped: signal"), std::string::npos) << log;
+  EXPECT_NE(log.find("arming: armed"), std::string::npos) << log;
 }
 
 }  // namespace

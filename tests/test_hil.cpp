@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench_run.hpp"
+#include "child_process.hpp"
 #include "test_util.hpp"
 
 namespace robodamp {
@@ -32,43 +33,7 @@ namespace {
 
 using nlohmann::json;
 
-// A child process running the robodamp binary, its output in a file.
-class Child {
- public:
-  Child(const std::vector<std::string>& args, const std::string& log) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(fd, 1);
-      dup2(fd, 2);
-      std::vector<char*> argv;
-      std::string bin = ROBODAMP_BINARY;
-      argv.push_back(bin.data());
-      std::vector<std::string> copy = args;
-      for (auto& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(bin.c_str(), argv.data());
-      _exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ > 0 && !reaped_) {
-      ::kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  void kill(int sig) const { ::kill(pid_, sig); }
-  int wait() {
-    int status = 0;
-    waitpid(pid_, &status, 0);
-    reaped_ = true;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-
- private:
-  pid_t pid_{-1};
-  bool reaped_{false};
-};
+using test::Child;
 
 int free_tcp_port() {
   const int s = socket(AF_INET, SOCK_STREAM, 0);

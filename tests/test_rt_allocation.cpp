@@ -18,7 +18,7 @@
 #include <unistd.h>
 
 #include "analysis/loop_model.hpp"
-#include "apps/session.hpp"
+#include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/telemetry_drain.hpp"
 #include "control/controller.hpp"
@@ -198,9 +198,10 @@ TEST(RealTimePath, ModbusStatusAllocatesNothing) {
 // records every frame to a file. Only the loop thread's allocations are counted: that is the RT thread.
 TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-  apps::SessionOptions o;
+  runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
-  apps::Session session(cfg, o);
+  runtime::Cell session(cfg, o);
+  test::configure(session);
   auto& plant = session.plant();
   std::vector<double> hits;
   for (double t = 1.0; t < 200.0; t += 1.7) hits.push_back(t);
@@ -265,7 +266,8 @@ long resident_kib() {
 // thread allocates nothing, nothing is dropped, and the resident memory stays flat.
 TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-  apps::Session session(cfg, {});
+  runtime::Cell session(cfg, {});
+  test::configure(session);
   std::vector<double> hits;
   for (double t = 0.5; t < 60.0; t += 2.0) hits.push_back(t);
   session.plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, 1000.0, 1e-3, hits));

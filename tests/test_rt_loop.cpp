@@ -10,7 +10,7 @@
 #include <cstring>
 #include <thread>
 
-#include "apps/session.hpp"
+#include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/signals.hpp"
 #include "test_util.hpp"
@@ -18,35 +18,36 @@
 namespace robodamp::rt {
 namespace {
 
-using apps::SessionOptions;
-using apps::Session;
+using runtime::Cell;
+using runtime::CellOptions;
 using sim::FaultKind;
 
 config::Config c2() { return config::load_config_file(test::preset("horizontal_c2")); }
 
-SessionOptions virtual_clock() {
-  SessionOptions o;
+CellOptions virtual_clock() {
+  CellOptions o;
   o.clock = config::ClockKind::kVirtual;
+  o.keep_frames = true;
   return o;
 }
 
 struct Outcome {
-  apps::RunSummary s;
+  runtime::RunSummary s;
   std::vector<TelemetryFrame> frames;
 };
 
 template <typename Setup>
-Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, SessionOptions o = virtual_clock()) {
-  Session session(cfg, o);
-  session.keep_frames(true);
+Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, CellOptions o = virtual_clock()) {
+  Cell session(cfg, o);
+  test::configure(session);
   setup(session);
   Outcome out;
   out.s = session.run(duration_s);
   out.frames = session.frames();
   return out;
 }
-Outcome run(const config::Config& cfg, double duration_s, SessionOptions o = virtual_clock()) {
-  return run(cfg, duration_s, [](Session&) {}, o);
+Outcome run(const config::Config& cfg, double duration_s, CellOptions o = virtual_clock()) {
+  return run(cfg, duration_s, [](Cell&) {}, o);
 }
 
 // Every tick the loop ran reached the consumer, in order, none twice.
@@ -122,15 +123,16 @@ TEST(Loop, ArmsOnceLiveFadesInDampsAndDisarmsToDisabled) {
 }
 
 TEST(Loop, ArmingRefusedUntilSensorLive) {
-  SessionOptions o = virtual_clock();
+  CellOptions o = virtual_clock();
   o.arm_at_start = false;
-  const auto r = run(c2(), 0.1, [](Session& s) { s.schedule(3, {CommandKind::kArm, 0.0}); }, o);
+  const auto r = run(c2(), 0.1, [](Cell& s) { s.schedule(3, {CommandKind::kArm, 0.0}); }, o);
   EXPECT_EQ(r.s.supervisor.arm_refused, 1U);
   EXPECT_EQ(first_state(r, State::kArming), r.frames.size());
 }
 
 TEST(Loop, ArmingRefusedWithAmplifierFault) {
-  Session session(c2(), virtual_clock());
+  Cell session(c2(), virtual_clock());
+  test::configure(session);
   session.plant().faults().add({FaultKind::kAmplifierFault, 0.0, 1.0});
   const auto s = session.run(0.2);
   EXPECT_EQ(s.supervisor.arm_refused, 1U);
@@ -141,7 +143,8 @@ TEST(Loop, ArmingRefusedWithAmplifierFault) {
 TEST(Loop, ArmingRefusedWhenTheAnalysisFindsTheGainUnstable) {
   auto cfg = c2();
   cfg.controller.gain_ns_per_m = 6000.0;  // K_max 4805
-  Session session(cfg, virtual_clock());
+  Cell session(cfg, virtual_clock());
+  test::configure(session);
   const auto s = session.run(0.2);
   EXPECT_FALSE(s.analysis_stable);
   EXPECT_EQ(s.supervisor.arm_refused, 1U);
@@ -151,7 +154,8 @@ TEST(Loop, ArmingRefusedWhenTheAnalysisFindsTheGainUnstable) {
 TEST(Loop, ArmingRefusedAboveTheGainMargin) {
   auto cfg = c2();
   cfg.controller.gain_ns_per_m = 4700.0;  // stable, but above max_gain_fraction 0.9 x 4805
-  Session session(cfg, virtual_clock());
+  Cell session(cfg, virtual_clock());
+  test::configure(session);
   const auto s = session.run(0.2);
   EXPECT_TRUE(s.analysis_stable);
   EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kAnalysisUnstable);
@@ -170,7 +174,7 @@ class Trips : public ::testing::TestWithParam<TripCase> {};
 
 TEST_P(Trips, RampToZeroWithinTheConfiguredTimeAndLatch) {
   const TripCase& c = GetParam();
-  const auto r = run(c2(), 2.0, [&](Session& s) { s.plant().faults().add(c.fault); });
+  const auto r = run(c2(), 2.0, [&](Cell& s) { s.plant().faults().add(c.fault); });
   const double t = expect_trip(r, c.trip, c.fault.start_s, c.detection_s);
   RecordProperty("fault_to_zero_ms", std::to_string(t * 1e3));
   std::printf("[ trip     ] %-22s fault to zero command %.2f ms\n", c.name, t * 1e3);
@@ -192,14 +196,14 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Loop, AStuckSensorIsNotATripButItsOutputStaysBounded) {
   // A stuck reading is finite, in range and (for this DAQ) fresh: nothing to trip on at once. The chain's
   // high-pass takes the constant out, so the command decays instead of holding an offset.
-  const auto r = run(c2(), 3.0, [](Session& s) { s.plant().faults().add({FaultKind::kSensorStuck, 1.0, 1.5}); });
+  const auto r = run(c2(), 3.0, [](Cell& s) { s.plant().faults().add({FaultKind::kSensorStuck, 1.0, 1.5}); });
   EXPECT_EQ(r.s.trip, "none");
   const std::size_t i = static_cast<std::size_t>(2.4 * 5000);
   EXPECT_LT(std::abs(r.frames[i].command_v), 0.01);
 }
 
 TEST(Loop, AmplifierNotReadyTripsAfterTheTimeout) {
-  SessionOptions o = virtual_clock();
+  CellOptions o = virtual_clock();
   o.backend.amplifier_ready_delay_s = 1.0;  // longer than supervision.amplifier_ready_timeout_s = 0.2
   const auto r = run(c2(), 1.0, o);
   EXPECT_EQ(r.s.trip, "amplifier_not_ready");
@@ -214,7 +218,7 @@ TEST(Loop, InstabilityTripsBeforeTheCommandDiverges) {
   // the loop gain is 1.25x its maximum stable value and an oscillation grows.
   auto real = c2();
   real.actuator.constant_n_per_v *= 3.0;
-  SessionOptions o = virtual_clock();
+  CellOptions o = virtual_clock();
   o.plant_config = real;
   const auto r = run(c2(), 30.0, o);
   EXPECT_EQ(r.s.trip, "instability");
@@ -231,7 +235,7 @@ TEST(Loop, InstabilityTripsBeforeTheCommandDiverges) {
 }
 
 TEST(Loop, NoFalseInstabilityTripWithImpactsAtTheConfiguredGain) {
-  SessionOptions o = virtual_clock();
+  CellOptions o = virtual_clock();
   o.impact_every_s = 1.3;
   const auto r = run(c2(), 20.0, o);
   EXPECT_EQ(r.s.trip, "none");
@@ -239,7 +243,7 @@ TEST(Loop, NoFalseInstabilityTripWithImpactsAtTheConfiguredGain) {
 }
 
 TEST(Loop, ResetFaultThenRearm) {
-  const auto r = run(c2(), 3.0, [](Session& s) {
+  const auto r = run(c2(), 3.0, [](Cell& s) {
     s.plant().faults().add({FaultKind::kSensorNan, 1.0, 0.01});
     s.schedule(static_cast<std::uint64_t>(1.005 * 5000), {CommandKind::kResetFault, 0.0});  // refused: ramp not over
     s.schedule(static_cast<std::uint64_t>(1.2 * 5000), {CommandKind::kResetFault, 0.0});
@@ -257,7 +261,7 @@ TEST(Loop, ResetFaultThenRearm) {
 }
 
 TEST(Loop, GainRequestsAreValidatedAndRamped) {
-  const auto r = run(c2(), 3.0, [](Session& s) {
+  const auto r = run(c2(), 3.0, [](Cell& s) {
     s.schedule(5000, {CommandKind::kSetGain, 3000.0});
     s.schedule(5001, {CommandKind::kSetGain, 4400.0});  // > 0.9 x K_max = 4324: refused
     s.schedule(5002, {CommandKind::kSetGain, NAN});
@@ -276,10 +280,10 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   // analysis finds unstable, an unknown index and a selection during a hand-over are refused.
   auto unstable = config::load_config_file(test::preset("horizontal_c3"));
   unstable.controller.gain_ns_per_m = 3000.0;
-  SessionOptions o = virtual_clock();
+  CellOptions o = virtual_clock();
   o.record_path = ::testing::TempDir() + "/select_params.rec";
-  Session session(c2(), o);
-  session.keep_frames(true);
+  Cell session(c2(), o);
+  test::configure(session);
   const std::size_t c3 = session.add_parameter_set(config::load_config_file(test::preset("horizontal_c3")));
   const std::size_t bad = session.add_parameter_set(unstable);
   session.schedule(5000, {CommandKind::kSelectParams, static_cast<double>(c3)});
@@ -308,9 +312,9 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
 }
 
 TEST(Loop, VirtualClockRunsAreBitIdentical) {
-  SessionOptions o = virtual_clock();
+  CellOptions o = virtual_clock();
   o.impact_every_s = 0.7;
-  auto setup = [](Session& s) {
+  auto setup = [](Cell& s) {
     s.plant().faults().add({FaultKind::kSensorSpike, 1.5, 0.001, 1e5});
     s.schedule(2000, {CommandKind::kSetGain, 2500.0});
   };
@@ -322,9 +326,10 @@ TEST(Loop, VirtualClockRunsAreBitIdentical) {
 
 TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
   // One driver call stalls for 1.1 ms (5.5 periods at 5 kHz): the loop skips the ticks it missed.
-  SessionOptions o;
+  CellOptions o;
+  o.keep_frames = true;
   o.realtime_setup = true;
-  const auto r = run(c2(), 0.6, [](Session& s) { s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3}); }, o);
+  const auto r = run(c2(), 0.6, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3}); }, o);
   expect_nothing_lost(r);
   EXPECT_GE(r.s.loop.missed_ticks, 4U);
   EXPECT_EQ(r.s.loop.ticks_run + r.s.loop.missed_ticks, r.frames.back().tick + 1) << "every nominal tick run or skipped";
@@ -340,9 +345,10 @@ TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
 }
 
 TEST(Loop, ConsecutiveOverrunsTrip) {
-  SessionOptions o;
+  CellOptions o;
+  o.keep_frames = true;
   auto cfg = c2();
-  const auto r = run(cfg, 1.5, [](Session& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  const auto r = run(cfg, 1.5, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
   EXPECT_EQ(r.s.trip, "overruns");
   expect_nothing_lost(r);
   const std::size_t fault = first_state(r, State::kFault);
@@ -353,9 +359,10 @@ TEST(Loop, ConsecutiveOverrunsTrip) {
 TEST(Loop, SigintShutsDownThroughTheSafeState) {
   install_shutdown_handlers();
   shutdown_signal().store(0);
-  SessionOptions o;
-  Session session(c2(), o);
-  session.keep_frames(true);
+  CellOptions o;
+  o.keep_frames = true;
+  Cell session(c2(), o);
+  test::configure(session);
   std::thread killer([] {
     std::this_thread::sleep_for(std::chrono::milliseconds(800));
     std::raise(SIGINT);

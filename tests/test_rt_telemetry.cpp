@@ -7,7 +7,7 @@
 #include <fstream>
 #include <thread>
 
-#include "apps/session.hpp"
+#include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/spsc_ring.hpp"
 #include "rt/timing_histogram.hpp"
@@ -65,13 +65,14 @@ class RecordingTest : public ::testing::Test {
  protected:
   void SetUp() override {
     path_ = ::testing::TempDir() + "/rt_recording_" + std::to_string(::getpid()) + ".rec";
-    apps::SessionOptions o;
+    runtime::CellOptions o;
     o.clock = config::ClockKind::kVirtual;
     o.record_path = path_;
     o.impact_every_s = 0.4;
-    apps::Session session(config::load_config_file(test::preset("horizontal_c2")), o);
-    session.keep_frames(true);
-    session.plant().faults().add({sim::FaultKind::kSensorNan, 1.2, 0.001});
+    o.keep_frames = true;
+    runtime::Cell session(config::load_config_file(test::preset("horizontal_c2")), o);
+    test::configure(session);
+      session.plant().faults().add({sim::FaultKind::kSensorNan, 1.2, 0.001});
     session.schedule(3000, {CommandKind::kSetGain, 2600.0});
     session.schedule(7000, {CommandKind::kResetFault, 0.0});
     session.schedule(7100, {CommandKind::kArm, 0.0});
@@ -79,7 +80,7 @@ class RecordingTest : public ::testing::Test {
     frames_ = session.frames();
   }
   std::string path_;
-  apps::RunSummary summary_;
+  runtime::RunSummary summary_;
   std::vector<TelemetryFrame> frames_;
 };
 

@@ -1,15 +1,17 @@
-#include "apps/dds_commands.hpp"
-
+// `robodamp monitor`: a live text view of a running loop from its DDS topics.
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <mutex>
 #include <thread>
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "apps/cli.hpp"
+#include "apps/dds_client.hpp"
 #include "dds/participant.hpp"
 #include "robodamp.h"
 #include "rt/signals.hpp"
@@ -19,6 +21,7 @@ namespace robodamp::apps {
 
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
+
 
 namespace {
 
@@ -73,6 +76,7 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
 
 }  // namespace
 
+// 0 when it saw the loop (telemetry or status), 1 when nothing came.
 int run_monitor(const DdsClientOptions& o) {
   rt::install_shutdown_handlers();
   Latest<msg::Telemetry> telemetry;  // before the participant: it outlives the readers that call it
@@ -97,80 +101,15 @@ int run_monitor(const DdsClientOptions& o) {
   return shown > 0 ? 0 : 1;
 }
 
-namespace {
-class Replies : public DataReaderListener {
- public:
-  Replies(std::string client, std::uint32_t id) : client_(std::move(client)), id_(id) {}
-  void on_data_available(DataReader* r) override {
-    msg::ParameterReply v;
-    SampleInfo info;
-    while (r->take_next_sample(&v, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data && v.client() == client_ && v.request_id() == id_) {
-        std::lock_guard<std::mutex> lock(m_);
-        reply_ = v;
-        got_ = true;
-      }
-  }
-  bool get(msg::ParameterReply& out) {
-    std::lock_guard<std::mutex> lock(m_);
-    out = reply_;
-    return got_;
-  }
-
- private:
-  std::string client_;
-  std::uint32_t id_;
-  std::mutex m_;
-  msg::ParameterReply reply_;
-  bool got_{false};
-};
-}  // namespace
-
-int run_request(const DdsClientOptions& o, const RequestOptions& r) {
-  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0);
-  if (given != 1) {
-    std::cerr << "robodamp request: give exactly one of --gain, --select, --enable\n";
-    return 2;
-  }
-  msg::ParameterRequest req;
-  const std::string client = "robodamp-request-" + std::to_string(getpid());
-  req.client(client);
-  req.request_id(1);
-  if (r.gain_ns_per_m) req.kind(msg::SET_GAIN), req.value(*r.gain_ns_per_m);
-  if (r.parameter_set) req.kind(msg::SELECT_PARAMETER_SET), req.value(*r.parameter_set);
-  if (r.enable) req.kind(msg::ENABLE), req.value(*r.enable);
-  const double wait_s = o.duration_s > 0.0 ? o.duration_s : 10.0;
-  int rc = 1;
-  {
-    Replies replies(client, 1);  // before the participant: it outlives the reader that calls it
-    dds::Participant p(o.domain_id, o.transport, "robodamp request");
-    DataReader* reader = p.reader(dds::TopicKind::kReply, &replies);
-    DataWriter* writer = p.writer(dds::TopicKind::kRequest);
-    const auto end = Clock::now() + std::chrono::duration<double>(wait_s);
-    // Reliable and volatile: send once the loop's reader and reply writer have matched.
-    PublicationMatchedStatus pm;
-    SubscriptionMatchedStatus sm;
-    while (Clock::now() < end) {
-      writer->get_publication_matched_status(pm);
-      reader->get_subscription_matched_status(sm);
-      if (pm.current_count > 0 && sm.current_count > 0) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    if (pm.current_count == 0 || sm.current_count == 0) {
-      std::cerr << "robodamp request: no loop on domain " << o.domain_id << " within " << wait_s << " s\n";
-      return 1;
-    }
-    writer->write(&req);
-    msg::ParameterReply reply;
-    while (Clock::now() < end && !replies.get(reply)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (replies.get(reply)) {
-      std::cout << (reply.accepted() ? "accepted: " : "refused: ") << reply.reason() << '\n';
-      rc = reply.accepted() ? 0 : 3;
-    } else {
-      std::cerr << "robodamp request: no reply within " << wait_s << " s\n";
-    }
-  }
-  return rc;
+void register_monitor(Registry& r) {
+  auto o = std::make_shared<DdsClientArgs>();
+  CLI::App* sub = r.add("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing)",
+                        [o] {
+                          const auto opts = resolve(*o);
+                          return opts ? run_monitor(*opts) : 2;
+                        });
+  add_dds_options(r, sub, *o);
+  r.number(sub, "--duration", o->options.duration_s, {"s", 0.0, 86400.0, false, false, "0 = until Ctrl-C"}, "Stop after S seconds");
 }
 
 }  // namespace robodamp::apps

@@ -1,4 +1,4 @@
-#include "apps/milling_command.hpp"
+#include "apps/milling_report.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -275,58 +275,56 @@ std::string plot_sle(const json& r, const std::string& path) {
   return run_gnuplot(s.str(), data.str(), path);
 }
 
-template <typename Fn>
-int guarded(Fn fn) {
-  try {
-    return fn();
-  } catch (const config::ConfigError& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
-  }
-}
-
 }  // namespace
 
-int run_lobes(const MillingOptions& o) {
-  return guarded([&] {
-    const auto cfg = config::load_milling_config(o.config_path);
-    const auto sc = selected(cfg, o);
-    std::vector<double> rpms = o.rpm;
-    rpms.push_back(cfg.cut.spindle_rpm);
-    const milling::Structure open(sc, false);
-    if (o.damped && !open.has_controller())
-      throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
-                                                 "--damped needs a part with a controller (a damping configuration)"}});
-    json r = lobes_json(open, cfg, rpms);
-    r["config"] = cfg.source;
-    r["tool"] = tool_text(cfg);
-    r["spindle_rpm"] = cfg.cut.spindle_rpm;
-    if (o.damped) {
-      const milling::Structure closed(sc, true);
-      r["damped"] = lobes_json(closed, cfg, rpms);
-      r["gain"] = {{"min_b_lim_change_pct", finite_or_null(pct_change(r["min_b_lim_mm"], r["damped"]["min_b_lim_mm"]))},
-                   {"at_spindle_rpm", cfg.cut.spindle_rpm},
-                   {"at_spindle_change_pct",
-                    finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"], r["damped"]["at_rpm"].back()["b_lim_mm"]))}};
-    }
-    return finish(r, o, lobes_table(r), plot_lobes);
-  });
+json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
+  const auto sc = selected(cfg, o);
+  std::vector<double> rpms = o.rpm;
+  rpms.push_back(cfg.cut.spindle_rpm);
+  const milling::Structure open(sc, false);
+  if (o.damped && !open.has_controller())
+    throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
+                                               "--damped needs a part with a controller (a damping configuration)"}});
+  json r = lobes_json(open, cfg, rpms);
+  r["config"] = cfg.source;
+  r["tool"] = tool_text(cfg);
+  r["spindle_rpm"] = cfg.cut.spindle_rpm;
+  if (o.damped) {
+    const milling::Structure closed(sc, true);
+    r["damped"] = lobes_json(closed, cfg, rpms);
+    r["gain"] = {{"min_b_lim_change_pct", finite_or_null(pct_change(r["min_b_lim_mm"], r["damped"]["min_b_lim_mm"]))},
+                 {"at_spindle_rpm", cfg.cut.spindle_rpm},
+                 {"at_spindle_change_pct",
+                  finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"], r["damped"]["at_rpm"].back()["b_lim_mm"]))}};
+  }
+  return r;
 }
 
-int run_sle(const MillingOptions& o) {
-  return guarded([&] {
-    const auto cfg = config::load_milling_config(o.config_path);
-    const auto sc = selected(cfg, o);
-    const milling::Structure open(sc, false);
-    if (o.damped && !open.has_controller())
-      throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
-                                                 "--damped needs a part with a controller (a damping configuration)"}});
-    json r = sle_json(open, cfg);
-    r["config"] = cfg.source;
-    r["tool"] = tool_text(cfg);
-    if (o.damped) r["damped"] = sle_json(milling::Structure(sc, true), cfg);
-    return finish(r, o, sle_table(r), plot_sle);
-  });
+int print_lobes(const json& r, const MillingOptions& o) { return finish(r, o, lobes_table(r), plot_lobes); }
+
+json sle_report(const config::MillingConfig& cfg, const MillingOptions& o) {
+  const auto sc = selected(cfg, o);
+  const milling::Structure open(sc, false);
+  if (o.damped && !open.has_controller())
+    throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
+                                               "--damped needs a part with a controller (a damping configuration)"}});
+  json r = sle_json(open, cfg);
+  r["config"] = cfg.source;
+  r["tool"] = tool_text(cfg);
+  if (o.damped) r["damped"] = sle_json(milling::Structure(sc, true), cfg);
+  return r;
+}
+
+int print_sle(const json& r, const MillingOptions& o) { return finish(r, o, sle_table(r), plot_sle); }
+
+void add_milling_options(CLI::App* sub, MillingOptions& o) {
+  sub->add_option("--config", o.config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
+  sub->add_option("--structure", o.structure, "Which of the job's structures (default: its `structure`)");
+  sub->add_flag("--json", o.json, "Print JSON instead of a table");
+  sub->add_option("--plot", o.plot_path, "Write a plot (PNG)");
+  sub->add_flag("--damped", o.damped, "Also with the damping controller's loop closed, overlaid");
+  sub->add_option("--controller", o.controller_path, "Damping configuration to use instead of the job's (compare compensators)")
+      ->check(CLI::ExistingFile);
 }
 
 }  // namespace robodamp::apps

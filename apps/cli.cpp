@@ -1,0 +1,163 @@
+#include "apps/cli.hpp"
+
+#include "config/config.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+namespace robodamp::apps {
+
+CLI::App* Registry::add(const std::string& name, const std::string& description, std::function<int()> handler) {
+  CLI::App* sub = app_.add_subcommand(name, description);
+  handlers_.emplace_back(sub, std::move(handler));
+  return sub;
+}
+
+std::optional<std::string> parse_number(const std::string& flag, const std::string& text, const config::Range& range,
+                                        bool whole, double& out) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(begin, &end);
+  const bool parsed = !text.empty() && end != begin && *end == '\0' && errno != ERANGE;
+  if (!parsed || !std::isfinite(v))
+    return flag + " = '" + text + "' is not a finite number: " + config::describe_range(range);
+  if (auto p = config::range_problem(flag, v, range)) return p;
+  if (whole && v != std::floor(v))
+    return flag + " = " + config::format_number(v) + " is not a whole number: " + config::describe_range(range);
+  out = v;
+  return std::nullopt;
+}
+
+CLI::Option* Registry::text_option(CLI::App* sub, const std::string& flag, const std::string& help, bool many) {
+  texts_.emplace_back();
+  std::vector<std::string>& texts = texts_.back();
+  CLI::Option* opt = sub->add_option(flag, texts, help);
+  if (!many) opt->expected(1);
+  return opt;
+}
+
+namespace {
+std::string first_name(const CLI::Option* opt) { return opt->get_name(false, true).substr(0, opt->get_name(false, true).find(',')); }
+}  // namespace
+
+CLI::Option* Registry::number(CLI::App* sub, const std::string& flag, double& target, const config::Range& range,
+                              const std::string& help) {
+  CLI::Option* opt = text_option(sub, flag, help, false);
+  const std::vector<std::string>& texts = texts_.back();
+  opt->default_str(config::format_number(target));
+  checks_.push_back({sub, [opt, &texts, &target, range] {
+                       return texts.empty() ? std::nullopt : parse_number(first_name(opt), texts.back(), range, false, target);
+                     }});
+  return opt;
+}
+
+CLI::Option* Registry::number(CLI::App* sub, const std::string& flag, std::optional<double>& target,
+                              const config::Range& range, const std::string& help) {
+  CLI::Option* opt = text_option(sub, flag, help, false);
+  const std::vector<std::string>& texts = texts_.back();
+  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
+                       if (texts.empty()) return std::nullopt;
+                       double v = 0.0;
+                       if (auto p = parse_number(first_name(opt), texts.back(), range, false, v)) return p;
+                       target = v;
+                       return std::nullopt;
+                     }});
+  return opt;
+}
+
+CLI::Option* Registry::whole_number(CLI::App* sub, const std::string& flag, int& target, const config::Range& range,
+                                    const std::string& help) {
+  CLI::Option* opt = text_option(sub, flag, help, false);
+  const std::vector<std::string>& texts = texts_.back();
+  opt->default_str(std::to_string(target));
+  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
+                       if (texts.empty()) return std::nullopt;
+                       double v = 0.0;
+                       if (auto p = parse_number(first_name(opt), texts.back(), range, true, v)) return p;
+                       target = static_cast<int>(v);
+                       return std::nullopt;
+                     }});
+  return opt;
+}
+
+CLI::Option* Registry::whole_number(CLI::App* sub, const std::string& flag, std::optional<int>& target,
+                                    const config::Range& range, const std::string& help) {
+  CLI::Option* opt = text_option(sub, flag, help, false);
+  const std::vector<std::string>& texts = texts_.back();
+  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
+                       if (texts.empty()) return std::nullopt;
+                       double v = 0.0;
+                       if (auto p = parse_number(first_name(opt), texts.back(), range, true, v)) return p;
+                       target = static_cast<int>(v);
+                       return std::nullopt;
+                     }});
+  return opt;
+}
+
+CLI::Option* Registry::numbers(CLI::App* sub, const std::string& flag, std::vector<double>& target,
+                               const config::Range& range, const std::string& help) {
+  CLI::Option* opt = text_option(sub, flag, help, true);
+  const std::vector<std::string>& texts = texts_.back();
+  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
+                       for (const auto& t : texts) {
+                         double v = 0.0;
+                         if (auto p = parse_number(first_name(opt), t, range, false, v)) return p;
+                         target.push_back(v);
+                       }
+                       return std::nullopt;
+                     }});
+  return opt;
+}
+
+std::vector<std::string> Registry::number_problems(const CLI::App* sub) const {
+  std::vector<std::string> out;
+  for (const auto& c : checks_)
+    if (c.sub == sub)
+      if (auto p = c.problem()) out.push_back(*p);
+  return out;
+}
+
+int Registry::run_parsed() const {
+  for (const auto& [sub, handler] : handlers_) {
+    if (!sub->parsed()) continue;
+    const auto problems = number_problems(sub);
+    for (const auto& p : problems) std::cerr << "robodamp " << sub->get_name() << ": " << p << '\n';
+    if (!problems.empty()) return 2;
+    try {
+      return handler();
+    } catch (const config::ConfigError& e) {  // a handler's own configuration checks
+      std::cerr << e.what() << '\n';
+      return 2;
+    } catch (const std::exception& e) {  // a device, a file or a transport that failed: never a crash
+      std::cerr << "robodamp " << sub->get_name() << ": " << e.what() << '\n';
+      return 1;
+    }
+  }
+  return 2;
+}
+
+int dispatch(int argc, const char* const* argv) {
+  CLI::App app{"robodamp: real-time active vibration damping for robotic milling"};
+  app.require_subcommand(1);
+  Registry r(app);
+  for (auto reg : {register_bench, register_analyze, register_filters, register_check_config, register_run,
+                   register_replay, register_csv, register_lobes, register_sle, register_plant, register_monitor,
+                   register_request})
+    reg(r);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "robodamp: " << e.what() << " (robodamp --help lists the commands, robodamp COMMAND --help the options)\n";
+    return 2;
+  }
+  return r.run_parsed();
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,80 @@
+// The command line: each subcommand lives in its own apps/<name>_command.cpp, where a register_<name>()
+// adds its options and its handler; main() only calls dispatch(). Every number on the command line is
+// declared with its unit and allowed range and checked after parsing with the configuration's wording
+// ("--rpm = 0 rpm is out of range: allowed 1 <= value <= 200000 rpm"); a bad command line exits with
+// status 2 and a message, before anything runs.
+#pragma once
+
+#include <deque>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "config/number_range.hpp"
+
+namespace robodamp::apps {
+
+class Registry {
+ public:
+  explicit Registry(CLI::App& app) : app_(app) {}
+
+  // A subcommand and what runs when it is given (its exit status).
+  CLI::App* add(const std::string& name, const std::string& description, std::function<int()> handler);
+
+  // Numbers, parsed strictly (no trailing text, finite) and range-checked after parsing; the target keeps
+  // its default when the option is absent.
+  CLI::Option* number(CLI::App* sub, const std::string& flag, double& target, const config::Range& range,
+                      const std::string& help);
+  CLI::Option* number(CLI::App* sub, const std::string& flag, std::optional<double>& target, const config::Range& range,
+                      const std::string& help);
+  CLI::Option* whole_number(CLI::App* sub, const std::string& flag, int& target, const config::Range& range,
+                            const std::string& help);
+  CLI::Option* whole_number(CLI::App* sub, const std::string& flag, std::optional<int>& target,
+                            const config::Range& range, const std::string& help);
+  CLI::Option* numbers(CLI::App* sub, const std::string& flag, std::vector<double>& target, const config::Range& range,
+                       const std::string& help);
+
+  // After parsing: the problems of the numbers given to `sub`, each in the configuration's wording.
+  [[nodiscard]] std::vector<std::string> number_problems(const CLI::App* sub) const;
+  // The handler of the subcommand that was given.
+  [[nodiscard]] int run_parsed() const;
+
+  CLI::App& app() { return app_; }
+
+ private:
+  struct Check {
+    const CLI::App* sub;
+    std::function<std::optional<std::string>()> problem;  // parses the text into its target
+  };
+  CLI::Option* text_option(CLI::App* sub, const std::string& flag, const std::string& help, bool many);
+  CLI::App& app_;
+  std::vector<std::pair<CLI::App*, std::function<int()>>> handlers_;
+  std::vector<Check> checks_;
+  std::deque<std::vector<std::string>> texts_;  // stable addresses for CLI11 to fill
+};
+
+// The text of one number: finite and nothing after it; else the problem in the configuration's wording.
+[[nodiscard]] std::optional<std::string> parse_number(const std::string& flag, const std::string& text,
+                                                      const config::Range& range, bool whole, double& out);
+
+// Parses and runs a command line. 0 for --help; 2 for a bad command line (message on stderr).
+[[nodiscard]] int dispatch(int argc, const char* const* argv);
+
+// Registration of each subcommand (apps/<name>_command.cpp).
+void register_filters(Registry& r);
+void register_check_config(Registry& r);
+void register_analyze(Registry& r);
+void register_bench(Registry& r);
+void register_run(Registry& r);
+void register_plant(Registry& r);
+void register_monitor(Registry& r);
+void register_request(Registry& r);
+void register_replay(Registry& r);
+void register_csv(Registry& r);
+void register_lobes(Registry& r);
+void register_sle(Registry& r);
+
+}  // namespace robodamp::apps

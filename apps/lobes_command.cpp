@@ -1,0 +1,39 @@
+// `robodamp lobes`: stability lobes (zero-order method) with the direct test at chosen speeds, open loop
+// and with the damping loop closed (--damped).
+#include <iostream>
+#include <memory>
+
+#include "apps/cli.hpp"
+#include "apps/milling_report.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+// 0 done, 1 plot failed, 2 configuration or option error.
+int run_lobes(const MillingOptions& o) {
+  const config::MillingConfig cfg = config::load_milling_config(o.config_path);
+  // The direct test is defined where the job computes its lobes.
+  const config::Range speeds{"rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false,
+                             "the job's lobes.rpm_min .. lobes.rpm_max"};
+  for (double rpm : o.rpm) {
+    if (auto p = config::range_problem("--rpm", rpm, speeds)) {
+      std::cerr << "robodamp lobes: " << *p << '\n';
+      return 2;
+    }
+  }
+  return print_lobes(lobes_report(cfg, o), o);
+}
+
+}  // namespace
+
+void register_lobes(Registry& r) {
+  auto o = std::make_shared<MillingOptions>();
+  CLI::App* sub = r.add("lobes", "Stability lobes (zero-order method) with a direct check, open loop and --damped",
+                        [o] { return run_lobes(*o); });
+  add_milling_options(sub, *o);
+  r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 1e6, true, false, "and within the job's lobes speed range"},
+            "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
+}
+
+}  // namespace robodamp::apps

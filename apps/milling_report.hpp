@@ -1,0 +1,34 @@
+// What `robodamp lobes` and `robodamp sle` share: the milling job's options, the reports (what a cut
+// buys with and without active damping, docs/milling.md) as JSON, a table and a plot.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "config/milling_config.hpp"
+
+namespace robodamp::apps {
+
+struct MillingOptions {
+  std::string config_path{ROBODAMP_DEFAULT_MILLING_CONFIG};
+  std::string structure;          // empty: the configuration's choice
+  bool json{false};
+  std::string plot_path;          // PNG
+  bool damped{false};             // also with the controller's loop closed, overlaid
+  std::vector<double> rpm;        // lobes: extra speeds for the direct test
+  std::string controller_path;    // replaces every controller part's damping configuration
+};
+
+void add_milling_options(CLI::App* sub, MillingOptions& o);
+
+// Throw config::ConfigError for a job or an option that does not fit it.
+[[nodiscard]] nlohmann::json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o);
+[[nodiscard]] nlohmann::json sle_report(const config::MillingConfig& cfg, const MillingOptions& o);
+// The table or JSON on stdout, then the plot: 0, or 1 when the plot failed.
+[[nodiscard]] int print_lobes(const nlohmann::json& r, const MillingOptions& o);
+[[nodiscard]] int print_sle(const nlohmann::json& r, const MillingOptions& o);
+
+}  // namespace robodamp::apps

@@ -1,0 +1,293 @@
+#include "runtime/cell.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "runtime/parameter_requests.hpp"
+#include "sim_plant/excitation.hpp"
+
+namespace robodamp::runtime {
+
+Cell::Cell(const config::Config& cfg, CellOptions o) : cfg_(cfg), o_(std::move(o)) {
+  if (o_.clock) cfg_.loop.clock = *o_.clock;
+}
+
+Cell::~Cell() {
+  if (state_ == LifecycleState::kActive) (void)deactivate();
+  if (state_ == LifecycleState::kInactive) (void)cleanup();
+}
+
+std::vector<Component*> Cell::components() {
+  std::vector<Component*> v;
+  for (Component* c : std::initializer_list<Component*>{sim_.get(), can_.get(), modbus_.get(), dds_.get()})
+    if (c != nullptr) v.push_back(c);
+  return v;
+}
+
+Status Cell::configure() {
+  if (state_ != LifecycleState::kUnconfigured)
+    return {StatusKind::kWrongState, std::string("cell: cannot configure while ") + to_string(state_)};
+  if (cfg_.can.has_value() != cfg_.modbus.has_value())
+    return {StatusKind::kConfigError,
+            config::ConfigError({{cfg_.source, {}, cfg_.can ? "modbus" : "can",
+                                  "missing: a hardware cell needs both the can section (sensor and command frames) and "
+                                  "the modbus section (the amplifier's enable and status)"}})
+                .what()};
+  try {
+    model_ = std::make_unique<analysis::LoopModel>(cfg_);
+  } catch (const config::ConfigError& e) {
+    return {StatusKind::kConfigError, e.what()};
+  }
+  const int polarity = cfg_.controller.polarity;
+  stable_ = model_->stable(cfg_.controller.gain_ns_per_m, polarity);
+  max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
+  const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
+  supervisor_ = std::make_unique<rt::Supervisor>(rt::supervisor_settings(cfg_, stable_, k_max), model_->chain().params);
+  ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
+  if (Status s = configure_devices(); !s.ok()) return s;
+  rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
+  rt::ActuatorSink* actuator = can_ ? static_cast<rt::ActuatorSink*>(&can_->driver()) : &sim_->backend();
+  rt::SupervisoryIo* io = modbus_ ? static_cast<rt::SupervisoryIo*>(&modbus_->client()) : &sim_->backend();
+  loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io, ring_.get());
+  arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
+  if (o_.arm_at_start) loop_->set_policy(arming_.get());
+  if (Status s = configure_parameter_sets(); !s.ok()) return s;
+  state_ = LifecycleState::kInactive;
+  return {};
+}
+
+Status Cell::configure_devices() {
+  if (cfg_.can) {
+    can_ = std::make_unique<CanBus>(*cfg_.can, cfg_.loop.rate_hz, cfg_.loop.clock, o_.connect_timeout_s);
+    modbus_ = std::make_unique<ModbusSupervisory>(
+        *cfg_.modbus, cfg_.actuator.mounting,
+        [this](config::Mounting m) {
+          if (const auto set = parameter_set_for(m)) {
+            if (!loop_->post({rt::CommandKind::kSelectParams, static_cast<double>(*set)}))
+              spdlog::warn("the robot reports {} mounting: the command queue is full, selection dropped",
+                           config::to_string(m));
+          } else {
+            spdlog::warn("the robot reports {} mounting and no parameter set is configured for it (parameter_sets)",
+                         config::to_string(m));
+          }
+        },
+        o_.connect_timeout_s);
+    const auto& c = *cfg_.can;
+    backend_name_ = "CAN " + c.interface + (c.fd ? " (FD)" : "") + ", Modbus amplifier " +
+                    config::describe(cfg_.modbus->amplifier_link) +
+                    (cfg_.modbus->robot_link ? ", robot " + config::describe(*cfg_.modbus->robot_link) : "");
+  } else {
+    const config::Config& plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
+    const sim::PlantModel plant_model = o_.plant_config ? sim::build_plant_model(plant_cfg) : model_->plant();
+    sim_ = std::make_unique<SimulatedPlant>(plant_model, plant_cfg, o_.backend);
+    backend_name_ = "simulated plant";
+  }
+  if (cfg_.dds) {
+    dds_ = std::make_unique<DdsEndpoint>(
+        *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
+        dds::BridgeSources{backend_name_, [this] { return supervisor_->active_parameter_set(); },
+                           [this] { return std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM); },
+                           [this](dds::RequestKind k, double v) { return handle_request(k, v); }});
+  }
+  for (Component* c : components()) {
+    if (Status s = c->configure(); !s.ok()) {
+      for (Component* d : components())
+        if (d->state() == LifecycleState::kInactive) (void)d->cleanup();
+      return s;
+    }
+  }
+  return {};
+}
+
+Status Cell::configure_parameter_sets() {
+  mounting_sets_.clear();
+  mounting_sets_.emplace_back(cfg_.actuator.mounting, 0);
+  try {
+    for (const auto& ref : cfg_.parameter_sets) {
+      const config::Config other = config::load_config_file(ref.resolved_path);
+      if (other.loop.rate_hz != cfg_.loop.rate_hz)
+        throw config::ConfigError({{cfg_.source, {}, "parameter_sets." + ref.mounting,
+                                    "= '" + ref.path + "' runs at loop.rate_hz = " + std::to_string(other.loop.rate_hz) +
+                                        " Hz; every set must run at this configuration's " +
+                                        std::to_string(cfg_.loop.rate_hz) + " Hz"}});
+      const std::size_t idx = add_parameter_set(other);
+      const auto mounting = ref.mounting == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal;
+      std::erase_if(mounting_sets_, [&](const auto& p) { return p.first == mounting; });
+      mounting_sets_.emplace_back(mounting, idx);
+    }
+  } catch (const config::ConfigError& e) {
+    for (Component* d : components()) (void)d->cleanup();
+    return {StatusKind::kConfigError, e.what()};
+  }
+  return {};
+}
+
+std::size_t Cell::add_parameter_set(const config::Config& cfg) {
+  const analysis::LoopModel m(cfg);
+  const int polarity = cfg.controller.polarity;
+  const auto k_max = analysis::max_stable_gain(m, polarity);
+  return supervisor_->add_parameter_set({m.chain().params, m.stable(cfg.controller.gain_ns_per_m, polarity),
+                                         k_max.value_or(control::kMaxGainNsPerM)});
+}
+
+std::optional<std::size_t> Cell::parameter_set_for(config::Mounting m) const {
+  for (const auto& [mounting, idx] : mounting_sets_)
+    if (mounting == m) return idx;
+  return std::nullopt;
+}
+
+dds::Decision Cell::handle_request(dds::RequestKind kind, double value) {
+  const CheckedRequest r = check_request(*supervisor_, cfg_, kind, value);
+  if (!r.decision.accepted) return r.decision;
+  if (kind == dds::RequestKind::kEnable) arming_->cancel();  // an operator has taken over arming
+  if (!loop_->post(r.command)) return {false, "the loop's command queue is full: try again"};
+  return r.decision;
+}
+
+void Cell::request_stop() noexcept {
+  if (loop_) loop_->request_stop();
+}
+
+void Cell::on_frame(const rt::TelemetryFrame& f) {
+  if (std::isfinite(f.accel_mps2)) sum_sq_ += f.accel_mps2 * f.accel_mps2, ++n_samples_;
+  summary_.peak_command_v = std::max(summary_.peak_command_v, std::abs(f.command_v));
+  TripTiming& tt = summary_.trip_timing;
+  if (tt.trip_s < 0.0 && (f.flags & rt::kFlagFresh)) tt.last_fresh_s = f.time_s;
+  if (tt.trip_s < 0.0 && f.trip != 0) tt.trip_s = f.time_s;
+  if (tt.trip_s >= 0.0 && tt.safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable))
+    tt.safe_s = f.time_s;
+  if (o_.keep_frames) frames_.push_back(f);
+}
+
+Status Cell::activate(double duration_s) {
+  if (state_ != LifecycleState::kInactive)
+    return {StatusKind::kWrongState, std::string("cell: cannot activate while ") + to_string(state_) +
+                                         " (configure first; a cell runs once per configuration)"};
+  if (loop_->stats().ticks_run > 0) return {StatusKind::kWrongState, "cell: this configuration has run already"};
+  summary_ = {};
+  summary_.config = cfg_.source;
+  summary_.clock = config::to_string(cfg_.loop.clock);
+  summary_.rate_hz = cfg_.loop.rate_hz;
+  summary_.duration_s = duration_s;
+  summary_.backend = backend_name_;
+  summary_.analysis_stable = stable_;
+  summary_.max_stable_gain_ns_per_m = max_stable_gain_.value_or(control::kMaxGainNsPerM);
+  summary_.arming.enabled = o_.arm_at_start;
+  summary_.arming.deadline_s = cfg_.supervision.arm_deadline_s;
+  sum_sq_ = 0.0;
+  n_samples_ = 0;
+  frames_.clear();
+  const bool wall = cfg_.loop.clock == config::ClockKind::kWall;
+  if (o_.impact_every_s > 0.0 && sim_) {
+    std::vector<double> hits;
+    for (double t = o_.impact_every_s; t < duration_s; t += o_.impact_every_s) hits.push_back(t);
+    sim_->plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, cfg_.bench.impact_peak_n,
+                                                                     cfg_.bench.impact_duration_ms * 1e-3, hits));
+  }
+  try {
+    if (!o_.record_path.empty())
+      recorder_ = std::make_unique<rt::Recorder>(o_.record_path,
+                                                 rt::recording_header(cfg_, *supervisor_, cfg_.loop.clock));
+  } catch (const std::exception& e) {
+    return {StatusKind::kDeviceError, std::string("--record: ") + e.what()};
+  }
+  if (wall && o_.realtime_setup) rt_process_.emplace(cfg_.realtime, summary_.realtime);
+  std::vector<rt::TelemetryDrain::Consumer> consumers;
+  if (recorder_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { recorder_->write(f); });
+  consumers.emplace_back([this](const rt::TelemetryFrame& f) { on_frame(f); });
+  if (dds_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { dds_->bridge().on_frame(f); });
+  drain_ = std::make_unique<rt::TelemetryDrain>(*ring_, std::move(consumers));
+  drain_->start();
+  state_ = LifecycleState::kActive;  // from here on deactivate() undoes whatever was started
+  for (Component* c : components()) {
+    if (Status s = c->activate(); !s.ok()) {
+      (void)deactivate();
+      return s;
+    }
+  }
+  const auto ticks = static_cast<std::uint64_t>(std::llround(duration_s * cfg_.loop.rate_hz));
+  loop_thread_ = std::thread([this, wall, ticks] {
+    if (wall && o_.realtime_setup) rt::setup_realtime_thread(cfg_.realtime, summary_.realtime);
+    loop_->run(ticks);
+  });
+  return {};
+}
+
+void Cell::wait() {
+  if (loop_thread_.joinable()) loop_thread_.join();
+}
+
+Status Cell::deactivate() {
+  if (state_ != LifecycleState::kActive)
+    return {StatusKind::kWrongState, std::string("cell: cannot deactivate while ") + to_string(state_)};
+  if (loop_thread_.joinable()) {
+    loop_->request_stop();  // no-op if the run already ended: the loop only returns once safe
+    loop_thread_.join();
+  }
+  drain_->stop();
+  Status result;
+  // The amplifier goes off (Modbus) after the loop has ramped the command to zero and disabled it.
+  for (Component* c : components()) {
+    if (c->state() != LifecycleState::kActive) continue;
+    if (Status s = c->deactivate(); !s.ok() && result.ok()) result = s;
+  }
+  finish_summary();
+  drain_.reset();
+  recorder_.reset();
+  rt_process_.reset();
+  state_ = LifecycleState::kInactive;
+  return result;
+}
+
+void Cell::finish_summary() {
+  RunSummary& s = summary_;
+  if (dds_) s.dds = dds_->bridge().counters();
+  if (modbus_) s.modbus = modbus_->client().counters();
+  if (can_) s.can = can_->driver().counters();
+  if (recorder_) {
+    recorder_->close();
+    s.recorded_frames = recorder_->frames();
+    s.record_errors = recorder_->write_errors();
+    s.record_path = recorder_->path();
+  }
+  s.loop = loop_->stats();
+  s.supervisor = supervisor_->counters();
+  s.final_state = rt::to_string(supervisor_->state());
+  s.trip = rt::to_string(supervisor_->latched_trip());
+  s.trip_description = rt::describe(supervisor_->latched_trip());
+  s.arming.outcome = arming_->outcome();
+  s.arming.attempts = arming_->attempts();
+  s.arming.last_refusal = arming_->last_refusal();
+  s.telemetry_frames = drain_->frames();
+  s.sensor_rms_mps2 = n_samples_ ? std::sqrt(sum_sq_ / static_cast<double>(n_samples_)) : 0.0;
+}
+
+Status Cell::cleanup() {
+  if (state_ != LifecycleState::kInactive)
+    return {StatusKind::kWrongState, std::string("cell: cannot clean up while ") + to_string(state_)};
+  for (Component* c : components())
+    if (c->state() == LifecycleState::kInactive) (void)c->cleanup();
+  loop_.reset();
+  arming_.reset();
+  ring_.reset();
+  supervisor_.reset();
+  sim_.reset();
+  can_.reset();
+  modbus_.reset();
+  dds_.reset();
+  model_.reset();
+  mounting_sets_.clear();
+  state_ = LifecycleState::kUnconfigured;
+  return {};
+}
+
+RunSummary Cell::run(double duration_s) {
+  if (Status s = activate(duration_s); !s.ok()) throw std::runtime_error(s.message);
+  wait();
+  if (Status s = deactivate(); !s.ok()) spdlog::warn("{}", s.message);
+  return summary_;
+}
+
+}  // namespace robodamp::runtime

@@ -1,0 +1,136 @@
+// The composition root: a robot cell built from one configuration, with an explicit lifecycle.
+//
+//   Cell cell(cfg, options);
+//   cell.configure();    analyse the loop (stability, K_max), load and analyse parameter_sets, configure
+//                        the devices (simulated plant, or CAN bus + Modbus client), DDS, the supervisor,
+//                        the loop, the arming policy. May allocate; reports every problem as a Status.
+//   cell.activate(T);    recorder, telemetry drain, devices started (Modbus polling and the amplifier's
+//                        first answer, the CAN queue flushed), DDS, then the loop thread (set up for real
+//                        time on the wall clock) for T seconds of loop time.
+//   cell.wait();         until the loop has ended (its duration, request_stop, a signal, or the arming
+//                        policy giving up) and is safe.
+//   cell.deactivate();   stop the loop through the safe state if it still runs, drain, amplifier off,
+//                        devices and DDS stopped, the run summary filled in.
+//   cell.cleanup();      devices closed.
+// run(T) is activate + wait + deactivate. The destructor deactivates and cleans up on every path, so a
+// test that returns early never leaves a thread running.
+//
+// Backends: no can/modbus sections: the simulated plant in process (runtime/components.hpp), paced by
+// the loop's clock; can + modbus: the CAN driver for the sensor and the amplifier command and the Modbus
+// client for the amplifier's enable and status and the robot's mounting, which selects among
+// parameter_sets. On the virtual clock the CAN driver paces the loop in lockstep with the HIL emulator.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "analysis/loop_model.hpp"
+#include "rt/loop.hpp"
+#include "rt/realtime.hpp"
+#include "rt/recording.hpp"
+#include "rt/telemetry_drain.hpp"
+#include "runtime/arming_policy.hpp"
+#include "runtime/components.hpp"
+#include "runtime/lifecycle.hpp"
+#include "runtime/run_summary.hpp"
+
+namespace robodamp::runtime {
+
+struct CellOptions {
+  std::optional<config::ClockKind> clock;  // default: loop.clock from the configuration
+  double impact_every_s{0.0};              // simulated plant: hammer hits at the TCP (bench.impact_peak_n); 0 = none
+  bool arm_at_start{true};                 // the arming policy arms (and retries) once the sensor can be live
+  std::string record_path;                 // empty = no recording
+  bool realtime_setup{true};               // wall clock: mlockall, SCHED_FIFO, ... (config realtime)
+  // The robot as it really is, when it differs from the configuration the controller was designed and
+  // analysed for (another pose, a worn actuator): the simulated plant is built from this one.
+  std::optional<config::Config> plant_config;
+  drivers::SimBackendOptions backend{};
+  double connect_timeout_s{10.0};  // hardware: waiting for the CAN transport and the amplifier's first poll
+  bool keep_frames{false};         // keep every drained frame in memory (tests)
+};
+
+class Cell {
+ public:
+  explicit Cell(const config::Config& cfg, CellOptions o = {});
+  ~Cell();
+  Cell(const Cell&) = delete;
+  Cell& operator=(const Cell&) = delete;
+
+  Status configure();
+  Status activate(double duration_s);
+  void wait();
+  Status deactivate();
+  Status cleanup();
+  // activate + wait + deactivate, from Inactive; a failed activation throws std::runtime_error.
+  [[nodiscard]] RunSummary run(double duration_s);
+  [[nodiscard]] LifecycleState state() const noexcept { return state_; }
+
+  // Inactive (configured): another controller parameter set (designed and analysed from cfg, same loop
+  // rate) that a select_params command may hand over to. Returns its index.
+  std::size_t add_parameter_set(const config::Config& cfg);
+  // Inactive: an operator command at a given tick (deterministic on the virtual clock).
+  void schedule(std::uint64_t tick, const rt::OperatorCommand& c) { loop_->schedule(tick, c); }
+  // Active, any non-real-time thread: an operator command for the next tick boundary.
+  bool post(const rt::OperatorCommand& c) { return loop_->post(c); }
+  // Active, any thread: end the run early through the safe state.
+  void request_stop() noexcept;
+  // A parameter request (DDS): validated as the configuration validates its values, then queued.
+  [[nodiscard]] dds::Decision handle_request(dds::RequestKind kind, double value);
+  // The parameter set for a mounting (set 0 is the configuration's own), if there is one.
+  [[nodiscard]] std::optional<std::size_t> parameter_set_for(config::Mounting m) const;
+
+  [[nodiscard]] bool hardware() const { return can_ != nullptr; }
+  [[nodiscard]] const std::string& backend_name() const { return backend_name_; }
+  [[nodiscard]] const RunSummary& summary() const { return summary_; }
+  [[nodiscard]] sim::Plant& plant() { return sim_->plant(); }  // simulated backend only
+  [[nodiscard]] drivers::CanDriver* can_driver() { return can_ ? &can_->driver() : nullptr; }
+  [[nodiscard]] drivers::ModbusSupervisor* modbus() { return modbus_ ? &modbus_->client() : nullptr; }
+  [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }
+  [[nodiscard]] rt::Loop& loop() { return *loop_; }
+  [[nodiscard]] ArmingPolicy& arming() { return *arming_; }
+  [[nodiscard]] rt::SpscRing<rt::TelemetryFrame>& telemetry_ring() { return *ring_; }
+  [[nodiscard]] const analysis::LoopModel& model() const { return *model_; }
+  [[nodiscard]] const config::Config& config() const { return cfg_; }
+  [[nodiscard]] const std::vector<rt::TelemetryFrame>& frames() const { return frames_; }
+
+ private:
+  Status configure_devices();
+  Status configure_parameter_sets();
+  std::vector<Component*> components();
+  void on_frame(const rt::TelemetryFrame& f);
+  void finish_summary();
+
+  config::Config cfg_;
+  CellOptions o_;
+  LifecycleState state_{LifecycleState::kUnconfigured};
+  std::unique_ptr<analysis::LoopModel> model_;
+  std::optional<double> max_stable_gain_;
+  bool stable_{false};
+  std::unique_ptr<SimulatedPlant> sim_;
+  std::unique_ptr<CanBus> can_;
+  std::unique_ptr<ModbusSupervisory> modbus_;
+  std::unique_ptr<DdsEndpoint> dds_;
+  std::vector<std::pair<config::Mounting, std::size_t>> mounting_sets_;
+  std::string backend_name_;
+  std::unique_ptr<rt::Supervisor> supervisor_;
+  std::unique_ptr<rt::SpscRing<rt::TelemetryFrame>> ring_;
+  std::unique_ptr<rt::Loop> loop_;
+  std::unique_ptr<ArmingPolicy> arming_;
+
+  // Active run.
+  std::optional<rt::RealtimeProcess> rt_process_;
+  std::unique_ptr<rt::Recorder> recorder_;
+  std::unique_ptr<rt::TelemetryDrain> drain_;
+  std::thread loop_thread_;
+  RunSummary summary_;
+  double sum_sq_{0.0};
+  std::uint64_t n_samples_{0};
+  std::vector<rt::TelemetryFrame> frames_;
+};
+
+}  // namespace robodamp::runtime

@@ -1,0 +1,120 @@
+#include "runtime/components.hpp"
+
+#include <chrono>
+
+#include <spdlog/spdlog.h>
+
+#include "drivers/can_channel.hpp"
+#include "sim_plant/excitation.hpp"
+
+namespace robodamp::runtime {
+
+SimulatedPlant::SimulatedPlant(const sim::PlantModel& model, const config::Config& plant_cfg,
+                               drivers::SimBackendOptions o)
+    : Component("simulated plant"), model_(model), cfg_(plant_cfg), o_(o) {}
+
+Status SimulatedPlant::on_configure() {
+  plant_ = std::make_unique<sim::Plant>(model_, cfg_);
+  if (cfg_.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(model_, cfg_));
+  backend_ = std::make_unique<drivers::SimBackend>(*plant_, o_);
+  return {};
+}
+
+Status SimulatedPlant::on_cleanup() {
+  backend_.reset();
+  plant_.reset();
+  return {};
+}
+
+CanBus::CanBus(const config::CanConfig& cfg, double rate_hz, config::ClockKind clock, double connect_timeout_s)
+    : Component("CAN " + cfg.interface), cfg_(cfg), rate_hz_(rate_hz), clock_(clock), connect_timeout_s_(connect_timeout_s) {}
+
+Status CanBus::on_configure() {
+  driver_ = std::make_unique<drivers::CanDriver>(
+      cfg_, drivers::CanChannel::open(cfg_.interface, cfg_.fd, cfg_.sensor.id, cfg_.sensor.extended_id, connect_timeout_s_),
+      rate_hz_);
+  // Lockstep with the emulator: a missing frame waits up to this long, then counts towards the stale trip.
+  if (clock_ == config::ClockKind::kVirtual) driver_->set_lockstep_wait(1.0);
+  else driver_->set_dejitter(true);
+  return {};
+}
+
+Status CanBus::on_activate() {
+  // A DAQ streams from power-up: what queued while the controller was starting is not a lost frame.
+  if (clock_ == config::ClockKind::kWall) {
+    flushed_ = driver_->flush();
+    if (flushed_ > 0) spdlog::info("CAN: {} frames queued before the loop started, discarded", flushed_);
+  }
+  return {};
+}
+
+Status CanBus::on_cleanup() {
+  driver_.reset();  // closes the channel
+  return {};
+}
+
+ModbusSupervisory::ModbusSupervisory(const config::ModbusConfig& cfg, config::Mounting initial,
+                                     drivers::ModbusSupervisor::MountingCallback on_mounting, double connect_timeout_s)
+    : Component("Modbus " + config::describe(cfg.amplifier_link)),
+      cfg_(cfg),
+      initial_(initial),
+      on_mounting_(std::move(on_mounting)),
+      connect_timeout_s_(connect_timeout_s) {}
+
+Status ModbusSupervisory::on_configure() {
+  client_ = std::make_unique<drivers::ModbusSupervisor>(cfg_, initial_, on_mounting_);
+  return {};
+}
+
+Status ModbusSupervisory::on_activate() {
+  client_->start();
+  answered_ = client_->wait_for_amplifier(std::chrono::duration<double>(connect_timeout_s_));
+  // Not a failure: the link may come up later, and the arming policy reports the refusal if it never does.
+  if (!answered_)
+    spdlog::warn("Modbus: no answer from the amplifier ({}) within {} s; arming will wait for it",
+                 config::describe(cfg_.amplifier_link), connect_timeout_s_);
+  return {};
+}
+
+Status ModbusSupervisory::on_deactivate() {
+  client_->request_amplifier_enable(false);
+  client_->stop();  // writes the enable coil off when it can, then joins the polling threads
+  return {};
+}
+
+Status ModbusSupervisory::on_cleanup() {
+  client_.reset();
+  return {};
+}
+
+DdsEndpoint::DdsEndpoint(const config::DdsConfig& cfg, double rate_hz, std::string source, dds::BridgeSources sources)
+    : Component("DDS domain " + std::to_string(cfg.domain_id)),
+      cfg_(cfg),
+      rate_hz_(rate_hz),
+      source_(std::move(source)),
+      sources_(std::move(sources)) {}
+
+Status DdsEndpoint::on_configure() {
+  bridge_ = std::make_unique<dds::Bridge>(cfg_, rate_hz_, source_, sources_);
+  return {};
+}
+
+Status DdsEndpoint::on_activate() {
+  bridge_->start();
+  spdlog::info("DDS: domain {} ({}), telemetry {} Hz, status {} Hz, parameter writes {}", cfg_.domain_id,
+               config::to_string(cfg_.transport), cfg_.telemetry_rate_hz, cfg_.status_rate_hz,
+               cfg_.parameter_writes ? "on" : "off");
+  return {};
+}
+
+Status DdsEndpoint::on_deactivate() {
+  bridge_->stop();
+  return {};
+}
+
+Status DdsEndpoint::on_cleanup() {
+  bridge_.reset();
+  return {};
+}
+
+}  // namespace robodamp::runtime

@@ -1,0 +1,107 @@
+// The devices of a cell as lifecycle components (runtime/lifecycle.hpp): what each one does on
+// configure, activate, deactivate and cleanup. The loop reaches them only through rt/io.hpp.
+//
+//   component          configure                      activate                         deactivate
+//   SimulatedPlant     build the plant and drives     -                                -
+//   CanBus             open the channel, the driver   flush the queue (wall clock) or  -
+//                                                     lockstep wait (virtual clock)
+//   ModbusSupervisory  the client, register maps      start polling, wait for the      amplifier enable off,
+//                                                     amplifier's first answer         stop polling
+//   DdsEndpoint        participant and topics         status thread                    last status, stop
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "config/config.hpp"
+#include "dds/bridge.hpp"
+#include "drivers/can_driver.hpp"
+#include "drivers/modbus_supervisor.hpp"
+#include "drivers/sim_backend.hpp"
+#include "rt/io.hpp"
+#include "runtime/lifecycle.hpp"
+#include "sim_plant/plant.hpp"
+#include "sim_plant/plant_model.hpp"
+
+namespace robodamp::runtime {
+
+// The simulated plant in process: sensor, actuator and amplifier in one.
+class SimulatedPlant final : public Component {
+ public:
+  // model: the plant the controller was designed for; plant_cfg: the robot as it really is.
+  SimulatedPlant(const sim::PlantModel& model, const config::Config& plant_cfg, drivers::SimBackendOptions o);
+  [[nodiscard]] sim::Plant& plant() { return *plant_; }
+  [[nodiscard]] drivers::SimBackend& backend() { return *backend_; }
+
+ private:
+  Status on_configure() override;
+  Status on_cleanup() override;
+  sim::PlantModel model_;
+  config::Config cfg_;
+  drivers::SimBackendOptions o_;
+  std::unique_ptr<sim::Plant> plant_;
+  std::unique_ptr<drivers::SimBackend> backend_;
+};
+
+// The CAN bus: the sensor frames in and the amplifier command out.
+class CanBus final : public Component {
+ public:
+  CanBus(const config::CanConfig& cfg, double rate_hz, config::ClockKind clock, double connect_timeout_s);
+  [[nodiscard]] drivers::CanDriver& driver() { return *driver_; }
+  [[nodiscard]] bool open() const { return driver_ != nullptr; }
+  [[nodiscard]] std::uint64_t flushed_frames() const { return flushed_; }
+
+ private:
+  Status on_configure() override;
+  Status on_activate() override;
+  Status on_cleanup() override;
+  config::CanConfig cfg_;
+  double rate_hz_;
+  config::ClockKind clock_;
+  double connect_timeout_s_;
+  std::unique_ptr<drivers::CanDriver> driver_;
+  std::uint64_t flushed_{0};
+};
+
+// The Modbus supervisory client: amplifier enable, ready, fault, temperature; the robot's mounting.
+class ModbusSupervisory final : public Component {
+ public:
+  ModbusSupervisory(const config::ModbusConfig& cfg, config::Mounting initial,
+                    drivers::ModbusSupervisor::MountingCallback on_mounting, double connect_timeout_s);
+  [[nodiscard]] drivers::ModbusSupervisor& client() { return *client_; }
+  [[nodiscard]] bool amplifier_answered() const { return answered_; }
+
+ private:
+  Status on_configure() override;
+  Status on_activate() override;
+  Status on_deactivate() override;
+  Status on_cleanup() override;
+  config::ModbusConfig cfg_;
+  config::Mounting initial_;
+  drivers::ModbusSupervisor::MountingCallback on_mounting_;
+  double connect_timeout_s_;
+  std::unique_ptr<drivers::ModbusSupervisor> client_;
+  bool answered_{false};
+};
+
+// The DDS bridge: telemetry, status and supervised parameter requests (fed by the telemetry drain).
+class DdsEndpoint final : public Component {
+ public:
+  DdsEndpoint(const config::DdsConfig& cfg, double rate_hz, std::string source, dds::BridgeSources sources);
+  [[nodiscard]] dds::Bridge& bridge() { return *bridge_; }
+
+ private:
+  Status on_configure() override;
+  Status on_activate() override;
+  Status on_deactivate() override;
+  Status on_cleanup() override;
+  config::DdsConfig cfg_;
+  double rate_hz_;
+  std::string source_;
+  dds::BridgeSources sources_;
+  std::unique_ptr<dds::Bridge> bridge_;
+};
+
+}  // namespace robodamp::runtime

@@ -1,0 +1,64 @@
+#include "runtime/parameter_requests.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "control/controller.hpp"
+
+namespace robodamp::runtime {
+
+namespace {
+
+CheckedRequest check_gain(const rt::Supervisor& sup, const config::Config& cfg, double value) {
+  char b[256];
+  const std::size_t set = sup.active_parameter_set();
+  const double limit = std::min(sup.gain_limit_ns_per_m(), control::kMaxGainNsPerM);
+  std::snprintf(b, sizeof b, "supervision.max_gain_fraction = %g x the analysed maximum stable K of parameter set %zu",
+                cfg.supervision.max_gain_fraction, set);
+  if (auto problem = config::gain_request_problem(value, limit, b)) return {{false, *problem}, {}};
+  std::snprintf(b, sizeof b, "K ramps to %g N s/m over controller.gain_ramp_s = %g s", value, cfg.controller.gain_ramp_s);
+  return {{true, b}, {rt::CommandKind::kSetGain, value}};
+}
+
+CheckedRequest check_select(const rt::Supervisor& sup, const config::Config& cfg, double value) {
+  const auto& sets = sup.parameter_sets();
+  if (!(value >= 0.0 && value == std::floor(value) && value < static_cast<double>(sets.size()))) {
+    char b[256];
+    std::snprintf(b, sizeof b, "parameter_set = %g is not a configured set: allowed 0 <= value <= %zu (0 = %s, then parameter_sets)",
+                  value, sets.size() - 1, cfg.source.c_str());
+    return {{false, b}, {}};
+  }
+  const auto idx = static_cast<std::size_t>(value);
+  if (!sets[idx].analysis_stable)
+    return {{false, "parameter set " + std::to_string(idx) + ": the analysis finds its loop unstable"}, {}};
+  return {{true, "parameter set " + std::to_string(idx) + " is handed over at the next tick (fade out, swap, fade in)"},
+          {rt::CommandKind::kSelectParams, value}};
+}
+
+CheckedRequest check_enable(double value) {
+  if (value != 0.0 && value != 1.0) {
+    char b[128];
+    std::snprintf(b, sizeof b, "enable = %g is out of range: allowed 0 (disarm) or 1 (arm)", value);
+    return {{false, b}, {}};
+  }
+  if (value == 1.0)
+    return {{true, "arming: the supervisor checks the sensor, the actuator path and the analysis at the next tick "
+                   "(the status topic shows the outcome)"},
+            {rt::CommandKind::kArm, 0.0}};
+  return {{true, "disarming: the command fades out over controller.gain_ramp_s"}, {rt::CommandKind::kDisarm, 0.0}};
+}
+
+}  // namespace
+
+CheckedRequest check_request(const rt::Supervisor& sup, const config::Config& cfg, dds::RequestKind kind, double value) {
+  switch (kind) {
+    case dds::RequestKind::kSetGain: return check_gain(sup, cfg, value);
+    case dds::RequestKind::kSelectParameterSet: return check_select(sup, cfg, value);
+    case dds::RequestKind::kEnable: return check_enable(value);
+  }
+  return {{false, "unknown request kind"}, {}};
+}
+
+}  // namespace robodamp::runtime

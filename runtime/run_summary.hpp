@@ -1,0 +1,64 @@
+// What a cell's run did: loop timing, supervisor counters, the arming outcome, the devices' counters,
+// trip timing. `robodamp run` prints it (apps/run_command.cpp) as text and JSON.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "dds/bridge.hpp"
+#include "drivers/can_driver.hpp"
+#include "drivers/modbus_supervisor.hpp"
+#include "rt/loop.hpp"
+#include "rt/realtime.hpp"
+#include "rt/supervisor.hpp"
+#include "runtime/arming_policy.hpp"
+
+namespace robodamp::runtime {
+
+// When the run lost its sensor and went safe (from the telemetry frames; loop time since the start).
+struct TripTiming {
+  double last_fresh_s{-1.0};  // the last fresh sensor sample before the trip
+  double trip_s{-1.0};        // the first tick with a latched trip
+  double safe_s{-1.0};        // the first tick after it with zero command and the amplifier enable off
+};
+
+struct ArmingReport {
+  ArmingOutcome outcome{ArmingOutcome::kWaiting};  // kWaiting at the end: the run ended before it armed
+  std::uint32_t attempts{0};
+  rt::ArmRefusal last_refusal{rt::ArmRefusal::kNone};
+  double deadline_s{0.0};
+  bool enabled{false};  // false: nobody armed automatically (CellOptions::arm_at_start)
+};
+
+struct RunSummary {
+  std::string config;
+  std::string clock;
+  double rate_hz{0.0};
+  double duration_s{0.0};
+  rt::LoopStats loop;
+  rt::SupervisorCounters supervisor;
+  std::string final_state, trip, trip_description;
+  ArmingReport arming;
+  double max_stable_gain_ns_per_m{0.0};
+  bool analysis_stable{false};
+  rt::RealtimeStatus realtime;
+  std::uint64_t telemetry_frames{0};
+  std::uint64_t recorded_frames{0}, record_errors{0};
+  std::string backend;  // "simulated plant" or the CAN transport and Modbus endpoints
+  std::optional<drivers::CanCounters> can;
+  std::optional<drivers::ModbusCounters> modbus;
+  std::optional<dds::BridgeCounters> dds;
+  TripTiming trip_timing;
+  std::string record_path;
+  double sensor_rms_mps2{0.0};  // control accelerometer over the run
+  double peak_command_v{0.0};
+
+  // The arming policy gave up, or the run ended before the loop was ever active while arming was wanted.
+  [[nodiscard]] bool never_armed() const {
+    return arming.enabled && arming.outcome != ArmingOutcome::kArmed && arming.outcome != ArmingOutcome::kCancelled &&
+           arming.outcome != ArmingOutcome::kFaulted;
+  }
+};
+
+}  // namespace robodamp::runtime
