@@ -248,6 +248,66 @@ TEST(Cli, CtrlCEndsARunThroughTheSafeStateWithASummary) {
   EXPECT_LT(j["elapsed_s"].get<double>(), 10.0);
 }
 
+// Before the runtime layer a simulated run armed once: refused, it ran the whole duration with the
+// damper off and exited 0. Now the arming policy retries until supervision.arm_deadline_s and the run
+// exits 5 naming the last refusal.
+TEST(Cli, RunThatNeverArmsExitsNonZeroNamingTheRefusal) {
+  const std::string cfg = temp_path("never_arms.yaml");
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml.replace(yaml.find("gain_ns_per_m: 2000"), 19, "gain_ns_per_m: 4700");  // above 0.9 x K_max 4805
+  yaml += "supervision:\n  arm_deadline_s: 1.5\n";
+  std::ofstream(cfg) << yaml;
+  const Result r = run_shell("timeout 120 " + std::string(ROBODAMP_BINARY) + " run --config " + cfg +
+                             " --duration 60 --clock virtual --json " + temp_path("never_arms.json"));
+  EXPECT_EQ(r.status, 5) << r.out;
+  EXPECT_NE(r.out.find("the loop never armed: 3 attempt(s) within supervision.arm_deadline_s = 1.5 s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("last refusal: the analysis does not find the loop stable"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(temp_path("never_arms.json")));
+  EXPECT_EQ(j["arming"]["outcome"], "gave_up");
+  EXPECT_LT(j["ticks_run"].get<double>(), 5000.0 * 3) << "ended at the deadline, not after 60 s";
+}
+
+// Before: --rpm 0 aborted with std::bad_alloc, --rpm nan never returned, --rpm 1e9 was ignored.
+TEST(Cli, LobesRefusesSpeedsWithTheUnitAndTheAllowedRange) {
+  for (const std::string v : {"0", "nan", "1e9", "-5", "inf", "abc", "''", "1e999", "3000x"}) {
+    const Result r = run_shell("timeout 60 " + std::string(ROBODAMP_BINARY) + " lobes --rpm " + v);
+    EXPECT_EQ(r.status, 2) << v << ": " << r.out;
+    EXPECT_NE(r.out.find("--rpm = "), std::string::npos) << v << ": " << r.out;
+    EXPECT_NE(r.out.find(" rpm"), std::string::npos) << v << ": " << r.out;
+    EXPECT_NE(r.out.find("allowed "), std::string::npos) << v << ": " << r.out;
+  }
+  const Result below = run("lobes --rpm 100");  // positive, but outside the job's lobes speed range
+  EXPECT_EQ(below.status, 2) << below.out;
+  EXPECT_NE(below.out.find("--rpm = 100 rpm is out of range: allowed 500 <= value <= 15000 rpm (the job's lobes.rpm_min .. "
+                           "lobes.rpm_max)"),
+            std::string::npos)
+      << below.out;
+}
+
+TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
+  const std::string c2 = robodamp::test::preset("horizontal_c2");
+  const std::pair<std::string, std::string> cases[] = {
+      {"filters --freq 0", "--freq = 0 Hz is out of range: allowed 0 < value"},
+      {"filters --config " + c2 + " --freq 2500", "--freq = 2500 Hz is out of range: allowed 0 < value < 2500 Hz"},
+      {"run --duration nan", "--duration = 'nan' is not a finite number: allowed 0 < value <= 604800 s"},
+      {"run --duration 1e6", "--duration = 1000000 s is out of range"},
+      {"run --impact-every -1", "--impact-every = -1 s is out of range: allowed 0 <= value <= 86400 s (0 = none)"},
+      {"plant --duration -3", "--duration = -3 s is out of range"},
+      {"plant --impact-location 2.5", "--impact-location = 2.5 is not a whole number"},
+      {"plant --mounting x:vertical", "--mounting = 'x:vertical': expected TIME_S:horizontal or TIME_S:vertical"},
+      {"monitor --domain 233", "--domain = 233 (DDS domain id) is out of range: allowed 0 <= value <= 232"},
+      {"monitor --duration inf", "--duration = 'inf' is not a finite number"},
+      {"request --gain -1", "--gain = -1 N s/m is out of range"},
+      {"request --enable 2", "--enable = 2 (1 = arm, 0 = disarm) is out of range"},
+      {"request --timeout 0", "--timeout = 0 s is out of range"},
+  };
+  for (const auto& [args, wording] : cases) {
+    const Result r = run_shell("timeout 60 " + std::string(ROBODAMP_BINARY) + " " + args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(wording), std::string::npos) << args << ": " << r.out;
+  }
+}
+
 std::string milling_job(const std::string& name) {
   return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + name + ".yaml";
 }

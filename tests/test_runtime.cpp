@@ -1,0 +1,297 @@
+// The runtime layer: the lifecycle's transitions, the arming policy on its own and in a running cell
+// (the simulated backend retries, gives up at the deadline and says why), a cell torn down on every
+// path, device failures reported as statuses, and parameter requests with random values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "cell_util.hpp"
+#include "runtime/arming_policy.hpp"
+#include "runtime/lifecycle.hpp"
+#include "runtime/parameter_requests.hpp"
+#include "test_util.hpp"
+
+namespace robodamp::runtime {
+namespace {
+
+using rt::ArmRefusal;
+using rt::CommandKind;
+using rt::State;
+
+config::Config c2() { return config::load_config_file(test::preset("horizontal_c2")); }
+
+// --- lifecycle ---------------------------------------------------------------------------------------
+
+class FakeDevice final : public Component {
+ public:
+  FakeDevice() : Component("fake device") {}
+  int fail_configure{0};  // the first N configures fail
+  bool throw_on_activate{false};
+  int deactivations{0};
+
+ private:
+  Status on_configure() override {
+    if (fail_configure > 0) return --fail_configure, Status{StatusKind::kDeviceError, "bus not there"};
+    return {};
+  }
+  Status on_activate() override {
+    if (throw_on_activate) throw std::runtime_error("port busy");
+    return {};
+  }
+  Status on_deactivate() override {
+    ++deactivations;
+    return {};
+  }
+};
+
+TEST(Lifecycle, TransitionsFollowTheStatesAndRefuseTheWrongOnes) {
+  FakeDevice d;
+  EXPECT_EQ(d.activate().kind, StatusKind::kWrongState);
+  EXPECT_EQ(d.state(), LifecycleState::kUnconfigured);
+  d.fail_configure = 1;
+  const Status failed = d.configure();
+  EXPECT_EQ(failed.kind, StatusKind::kDeviceError);
+  EXPECT_EQ(d.state(), LifecycleState::kUnconfigured) << "a failed transition stays where it was";
+  ASSERT_TRUE(d.configure().ok());
+  EXPECT_EQ(d.state(), LifecycleState::kInactive);
+  EXPECT_EQ(d.configure().kind, StatusKind::kWrongState);
+  d.throw_on_activate = true;
+  const Status thrown = d.activate();
+  EXPECT_EQ(thrown.kind, StatusKind::kDeviceError);
+  EXPECT_NE(thrown.message.find("fake device: port busy"), std::string::npos) << thrown.message;
+  EXPECT_EQ(d.state(), LifecycleState::kInactive);
+  d.throw_on_activate = false;
+  ASSERT_TRUE(d.activate().ok());
+  EXPECT_EQ(d.cleanup().kind, StatusKind::kWrongState) << "clean up only when inactive";
+  ASSERT_TRUE(d.deactivate().ok());
+  EXPECT_EQ(d.deactivations, 1);
+  ASSERT_TRUE(d.cleanup().ok());
+  EXPECT_EQ(d.state(), LifecycleState::kUnconfigured);
+}
+
+// --- the arming policy alone ----------------------------------------------------------------------------
+
+TEST(ArmingPolicy, ArmsAtTheFirstLiveTickAndRetriesUntilActive) {
+  ArmingPolicy p({51, 100, 1000});
+  for (std::uint64_t t = 0; t < 51; ++t) EXPECT_EQ(p.on_tick(t, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+  EXPECT_EQ(p.on_tick(51, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kArm);
+  // Refused: the supervisor stays disabled; the next attempt comes retry_ticks later.
+  for (std::uint64_t t = 52; t < 151; ++t)
+    EXPECT_EQ(p.on_tick(t, State::kDisabled, ArmRefusal::kSensorNotLive).command.kind, CommandKind::kNone) << t;
+  EXPECT_EQ(p.on_tick(151, State::kDisabled, ArmRefusal::kSensorNotLive).command.kind, CommandKind::kArm);
+  EXPECT_EQ(p.attempts(), 2U);
+  EXPECT_EQ(p.last_refusal(), ArmRefusal::kSensorNotLive);
+  EXPECT_EQ(p.on_tick(152, State::kArming, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+  EXPECT_EQ(p.on_tick(153, State::kActive, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+  EXPECT_EQ(p.outcome(), ArmingOutcome::kArmed);
+  // The end of the run disarms: never re-armed.
+  EXPECT_EQ(p.on_tick(5000, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+}
+
+TEST(ArmingPolicy, GivesUpAtTheDeadlineAndEndsTheRun) {
+  ArmingPolicy p({51, 100, 400});
+  int arms = 0;
+  rt::PolicyDecision d;
+  std::uint64_t t = 0;
+  for (; t < 1000; ++t) {
+    d = p.on_tick(t, State::kDisabled, ArmRefusal::kAnalysisUnstable);
+    if (d.command.kind == CommandKind::kArm) ++arms;
+    if (d.end_run) break;
+  }
+  EXPECT_EQ(t, 400U);
+  EXPECT_EQ(arms, 4) << "ticks 51, 151, 251, 351";
+  EXPECT_EQ(p.outcome(), ArmingOutcome::kGaveUp);
+  EXPECT_EQ(p.last_refusal(), ArmRefusal::kAnalysisUnstable);
+  EXPECT_FALSE(p.on_tick(401, State::kDisabled, ArmRefusal::kAnalysisUnstable).end_run) << "once";
+}
+
+TEST(ArmingPolicy, StopsAtATripAndWhenAnOperatorTakesOver) {
+  ArmingPolicy tripped({1, 10, 100});
+  EXPECT_EQ(tripped.on_tick(1, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kArm);
+  EXPECT_EQ(tripped.on_tick(2, State::kFault, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+  EXPECT_EQ(tripped.outcome(), ArmingOutcome::kFaulted);
+  EXPECT_EQ(tripped.on_tick(50, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kNone)
+      << "a reset is the operator's, and so is the arm after it";
+  ArmingPolicy cancelled({1, 10, 100});
+  cancelled.cancel();
+  EXPECT_EQ(cancelled.on_tick(1, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+  EXPECT_EQ(cancelled.outcome(), ArmingOutcome::kCancelled);
+}
+
+TEST(ArmingPolicy, ScheduleComesFromTheSupervisionSection) {
+  config::SupervisionConfig s;
+  s.arming_live_cycles = 50;
+  s.arm_retry_s = 0.5;
+  s.arm_deadline_s = 10.0;
+  const ArmingSchedule a = ArmingSchedule::from(s, 5000.0);
+  EXPECT_EQ(a.first_tick, 51U);
+  EXPECT_EQ(a.retry_ticks, 2500U);
+  EXPECT_EQ(a.deadline_tick, 50051U);
+}
+
+// --- the arming policy in a running cell ------------------------------------------------------------------
+
+CellOptions virtual_clock() {
+  CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  o.keep_frames = true;
+  return o;
+}
+
+// Before the runtime layer, the simulated backend armed once at a fixed tick: a refused attempt left the
+// damper off for the whole run. Now the first attempt is refused (the sensor is dropped out for 0.3 s)
+// and a retry arms it.
+TEST(CellArming, ARefusedFirstAttemptIsRetriedOnTheSimulatedBackend) {
+  Cell cell(c2(), virtual_clock());
+  test::configure(cell);
+  cell.plant().faults().add({sim::FaultKind::kSensorDropout, 0.0, 0.3});
+  const RunSummary s = cell.run(3.0);
+  EXPECT_EQ(s.arming.outcome, ArmingOutcome::kArmed);
+  EXPECT_EQ(s.arming.attempts, 2U) << "refused at 10.2 ms, armed at 510 ms";
+  EXPECT_EQ(s.arming.last_refusal, ArmRefusal::kSensorNotLive);
+  EXPECT_EQ(s.supervisor.arm_refused, 1U);
+  EXPECT_EQ(s.trip, "none");
+  EXPECT_FALSE(s.never_armed());
+  EXPECT_GT(s.peak_command_v, 0.0) << "the damper ran";
+  bool active = false;
+  for (const auto& f : cell.frames()) active = active || f.state == static_cast<std::uint8_t>(State::kActive);
+  EXPECT_TRUE(active);
+}
+
+TEST(CellArming, GivesUpAtTheDeadlineNamingTheRefusalAndEndsTheRunEarly) {
+  auto cfg = c2();
+  cfg.controller.gain_ns_per_m = 4700.0;  // stable, but above max_gain_fraction 0.9 x K_max 4805
+  cfg.supervision.arm_deadline_s = 1.2;
+  Cell cell(cfg, virtual_clock());
+  test::configure(cell);
+  const RunSummary s = cell.run(30.0);
+  EXPECT_EQ(s.arming.outcome, ArmingOutcome::kGaveUp);
+  EXPECT_EQ(s.arming.attempts, 3U) << "at 10.2 ms, 510 ms and 1010 ms";
+  EXPECT_EQ(s.arming.last_refusal, ArmRefusal::kAnalysisUnstable);
+  EXPECT_TRUE(s.never_armed());
+  EXPECT_LT(s.loop.ticks_run, 5000U * 3) << "ended at the deadline, not after 30 s";
+  EXPECT_EQ(s.final_state, "disabled");
+}
+
+TEST(CellArming, ArmingTheSameWayOnEveryRunOfTheVirtualClock) {
+  auto once = [] {
+    Cell cell(c2(), virtual_clock());
+    test::configure(cell);
+    cell.plant().faults().add({sim::FaultKind::kSensorDropout, 0.0, 0.7});
+    (void)cell.run(2.0);
+    return cell.frames();
+  };
+  const auto a = once(), b = once();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].command_kind, b[i].command_kind) << i;
+    ASSERT_EQ(a[i].command_v, b[i].command_v) << i;
+  }
+}
+
+// --- the cell's lifecycle --------------------------------------------------------------------------------
+
+CellOptions wall_clock_no_rt() {
+  CellOptions o;
+  o.realtime_setup = false;  // the loop's real-time set-up is the run command's; tests share the machine
+  return o;
+}
+
+TEST(CellLifecycle, TransitionsInOrderAndDeactivateEndsARunEarly) {
+  Cell cell(c2(), wall_clock_no_rt());
+  EXPECT_EQ(cell.activate(1.0).kind, StatusKind::kWrongState) << "configure first";
+  test::configure(cell);
+  EXPECT_EQ(cell.state(), LifecycleState::kInactive);
+  ASSERT_TRUE(cell.activate(3600.0).ok());  // wall clock, an hour
+  EXPECT_EQ(cell.state(), LifecycleState::kActive);
+  EXPECT_EQ(cell.cleanup().kind, StatusKind::kWrongState);
+  ASSERT_TRUE(test::eventually([&] { return cell.arming().outcome() == ArmingOutcome::kArmed; }, 60.0));
+  ASSERT_TRUE(cell.deactivate().ok());
+  EXPECT_EQ(cell.state(), LifecycleState::kInactive);
+  EXPECT_EQ(cell.summary().final_state, "disabled") << "through the disarm fade to the safe state";
+  EXPECT_LT(cell.summary().loop.elapsed_s, 3600.0);
+  EXPECT_EQ(cell.activate(1.0).kind, StatusKind::kWrongState) << "a configuration runs once";
+  ASSERT_TRUE(cell.cleanup().ok());
+  EXPECT_EQ(cell.state(), LifecycleState::kUnconfigured);
+}
+
+TEST(CellLifecycle, DestroyingAnActiveCellStopsAndJoinsEverything) {
+  auto cell = std::make_unique<Cell>(c2(), wall_clock_no_rt());
+  test::configure(*cell);
+  ASSERT_TRUE(cell->activate(3600.0).ok());
+  cell.reset();  // a test that returns early does this: no std::terminate, no thread left
+  SUCCEED();
+}
+
+TEST(CellLifecycle, ADeviceThatCannotBeOpenedIsADeviceErrorAndNothingIsLeftOpen) {
+  auto cfg = config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_horizontal_c2.yaml");
+  cfg.can->interface = "unix:/nonexistent/robodamp.sock";
+  CellOptions o;
+  o.connect_timeout_s = 0.2;
+  Cell cell(cfg, o);
+  const Status s = cell.configure();
+  EXPECT_EQ(s.kind, StatusKind::kDeviceError);
+  EXPECT_NE(s.message.find("/nonexistent/robodamp.sock"), std::string::npos) << s.message;
+  EXPECT_EQ(cell.state(), LifecycleState::kUnconfigured);
+}
+
+TEST(CellLifecycle, HalfAHardwareConfigurationIsAConfigError) {
+  auto cfg = config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_horizontal_c2.yaml");
+  cfg.modbus.reset();
+  Cell cell(cfg);
+  const Status s = cell.configure();
+  EXPECT_EQ(s.kind, StatusKind::kConfigError);
+  EXPECT_NE(s.message.find("modbus"), std::string::npos) << s.message;
+}
+
+// --- parameter requests with random values ----------------------------------------------------------------
+
+TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
+  auto cfg = c2();
+  Cell cell(cfg, virtual_clock());
+  test::configure(cell);
+  cell.add_parameter_set(config::load_config_file(test::preset("horizontal_c1")));
+  const rt::Supervisor& sup = cell.supervisor();
+  const double limit = sup.gain_limit_ns_per_m();
+  std::mt19937_64 rng(13);
+  const double specials[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity(), -0.0, 0.0, 1.0, 2.0, -1.0, 1e308, -1e308,
+                             std::numeric_limits<double>::denorm_min(), limit, std::nextafter(limit, 1e9), 0.5, 1.5};
+  std::uniform_real_distribution<double> wide(-1e6, 1e6);
+  std::uniform_int_distribution<int> pick(0, 2), special(0, std::size(specials) - 1), coin(0, 1);
+  int accepted = 0;
+  for (int i = 0; i < 10000; ++i) {
+    const auto kind = static_cast<dds::RequestKind>(pick(rng));
+    const double v = coin(rng) ? specials[special(rng)] : wide(rng);
+    const CheckedRequest r = check_request(sup, cfg, kind, v);
+    EXPECT_FALSE(r.decision.reason.empty());
+    if (!r.decision.accepted) {
+      EXPECT_EQ(r.command.kind, CommandKind::kNone);
+      continue;
+    }
+    ++accepted;
+    ASSERT_TRUE(std::isfinite(v)) << r.decision.reason;
+    switch (kind) {
+      case dds::RequestKind::kSetGain:
+        EXPECT_GE(v, 0.0);
+        EXPECT_LE(v, limit);
+        EXPECT_EQ(r.command.kind, CommandKind::kSetGain);
+        break;
+      case dds::RequestKind::kSelectParameterSet:
+        EXPECT_TRUE(v == 0.0 || v == 1.0) << v;
+        EXPECT_EQ(r.command.kind, CommandKind::kSelectParams);
+        break;
+      case dds::RequestKind::kEnable:
+        EXPECT_TRUE(v == 0.0 || v == 1.0) << v;
+        break;
+    }
+  }
+  EXPECT_GT(accepted, 100);
+  std::printf("[ requests ] 10000 random parameter requests, %d accepted\n", accepted);
+}
+
+}  // namespace
+}  // namespace robodamp::runtime
