@@ -1,6 +1,7 @@
 #include "config/config.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <complex>
 #include <fstream>
@@ -36,6 +37,42 @@ std::string summarise(const std::vector<Problem>& problems) {
   return s;
 }
 }  // namespace
+
+std::vector<Problem> located(std::vector<Problem> problems, const std::string& yaml_text) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception&) {
+  }
+  for (Problem& p : problems) {
+    if (p.mark.line > 0) continue;
+    p.mark = {1, 1};
+    YAML::Node node = root;
+    std::size_t start = 0;
+    // Walk "robot.frfs[2].modes": a name, then any [index], segment by segment.
+    while (start < p.key.size() && node && node.IsMap()) {
+      std::size_t end = p.key.find('.', start);
+      if (end == std::string::npos) end = p.key.size();
+      const std::string seg = p.key.substr(start, end - start);
+      const std::size_t bracket = seg.find('[');
+      YAML::Node next;
+      try {
+        next = node[seg.substr(0, bracket)];
+        if (next && bracket != std::string::npos && next.IsSequence()) {
+          const std::size_t idx = std::strtoul(seg.c_str() + bracket + 1, nullptr, 10);
+          if (idx < next.size()) next = next[idx];
+        }
+      } catch (const YAML::Exception&) {
+        break;
+      }
+      if (!next || next.Mark().is_null()) break;
+      p.mark = detail::to_mark(next.Mark());
+      node = next;
+      start = end + 1;
+    }
+  }
+  return problems;
+}
 
 ConfigError::ConfigError(std::vector<Problem> problems)
     : std::runtime_error(summarise(problems)), problems_(std::move(problems)) {}
@@ -202,8 +239,10 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
         auto b = read_block(d, chain[i], key, rate);
         if (!b) {
           // Still count its kind, so a block with a bad value is not also reported as missing.
-          if (chain[i].IsMap() && chain[i]["kind"].IsScalar())
-            if (auto k = block_kind_from(chain[i]["kind"].Scalar())) ++counts[static_cast<int>(*k)];
+          const YAML::Node item = chain[i];
+          const YAML::Node kind = item.IsMap() ? YAML::Node(item["kind"]) : YAML::Node();
+          if (kind.IsDefined() && kind.IsScalar())
+            if (auto k = block_kind_from(kind.Scalar())) ++counts[static_cast<int>(*k)];
           continue;
         }
         const int n = ++counts[static_cast<int>(b->kind)];
@@ -272,7 +311,7 @@ RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
                                        std::to_string(*h) + ": one FRF per path");
       const YAML::Node modes = fr.child("modes", true, "list of modes");
       if (modes.IsDefined() && (!modes.IsSequence() || modes.size() == 0))
-        d.add(modes.Mark(), key + ".modes", "must be a non-empty list of modes");
+        d.add(modes.Mark().is_null() ? frfs[i].Mark() : modes.Mark(), key + ".modes", "must be a non-empty list of modes");
       for (std::size_t k = 0; modes.IsSequence() && k < modes.size(); ++k) {
         MapReader mr(d, modes[k], key + ".modes[" + std::to_string(k) + "]", modes.Mark());
         f.modes.push_back(read_mode(mr, below_nyquist(rate)));
@@ -544,8 +583,22 @@ std::optional<CanConfig> read_can(MapReader& top, std::optional<double> rate) {
   return c;
 }
 
+// Where a dotted key (section.field) stands in the document: the field, else its section, else the top.
+SourceMark mark_of(const YAML::Node& root, const std::string& dotted) {
+  const std::size_t dot = dotted.find('.');
+  try {
+    const YAML::Node section = root[dotted.substr(0, dot)];
+    if (section && section.IsMap()) {
+      if (const YAML::Node field = section[dotted.substr(dot + 1)]) return detail::to_mark(field.Mark());
+      return detail::to_mark(section.Mark());
+    }
+  } catch (const YAML::Exception&) {
+  }
+  return detail::to_mark(root.Mark());
+}
+
 // Locations named outside the robot section must exist in it.
-void check_location_refs(Diagnostics& d, const Config& c) {
+void check_location_refs(Diagnostics& d, const Config& c, const YAML::Node& root) {
   if (c.robot.frfs.empty()) return;
   const std::pair<const char*, int> refs[] = {{"actuator.location", c.actuator.location},
                                               {"sensor.location", c.sensor.location},
@@ -555,7 +608,7 @@ void check_location_refs(Diagnostics& d, const Config& c) {
     if (!find_location(c.robot, id)) {
       std::string known;
       for (const auto& l : c.robot.locations) known += (known.empty() ? "" : ", ") + std::to_string(l.id);
-      d.add(SourceMark{}, key, "= " + std::to_string(id) + " is not a robot location (known: " + known + ")");
+      d.add(mark_of(root, key), key, "= " + std::to_string(id) + " is not a robot location (known: " + known + ")");
     }
 }
 
@@ -585,8 +638,8 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.can = read_can(top, rate);
   detail::read_supervisory(top, c);
   top.finish();
-  check_location_refs(d, c);
-  if (!d.problems().empty()) throw ConfigError(d.problems());
+  check_location_refs(d, c, root);
+  if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));
   return c;
 }
 

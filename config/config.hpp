@@ -28,6 +28,11 @@ struct Problem {
   [[nodiscard]] std::string to_string() const;  // "file:line:col: key: message"
 };
 
+// Problems found after parsing (chain design, plant consistency) carry only their key: this gives each
+// one without a line the line of that key in the document, or of its nearest enclosing key present there
+// (line 1 when none is), so every problem reads file:line.
+[[nodiscard]] std::vector<Problem> located(std::vector<Problem> problems, const std::string& yaml_text);
+
 class ConfigError : public std::runtime_error {
  public:
   explicit ConfigError(std::vector<Problem> problems);

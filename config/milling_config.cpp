@@ -139,7 +139,7 @@ StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std
       if (!present(modes)) continue;
       any = true;
       if (!modes.IsSequence() || modes.size() == 0) {
-        d.add(modes.Mark(), pr.path_of(kPairs[k]), "must be a non-empty list of modes");
+        d.add(modes.Mark().is_null() ? pr.mark() : modes.Mark(), pr.path_of(kPairs[k]), "must be a non-empty list of modes");
         continue;
       }
       for (std::size_t m = 0; m < modes.size(); ++m) {
@@ -260,7 +260,7 @@ MillingConfig parse_milling_config(const std::string& yaml_text, const std::stri
   c.sle = read_sle(top);
   c.conditions = read_conditions(top, c.tool);
   top.finish();
-  if (!d.problems().empty()) throw ConfigError(d.problems());
+  if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));
   return c;
 }
 

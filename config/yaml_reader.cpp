@@ -169,7 +169,8 @@ YAML::Node load_top_map(Diagnostics& d, const std::string& yaml_text, const std:
     throw ConfigError(d.problems());
   }
   if (!root.IsMap()) {
-    d.add(root.Mark(), "(top level)", "expected a map with " + expected);
+    // An empty document has no mark: its problem is at its first line.
+    d.add(root.Mark().is_null() ? SourceMark{1, 1} : to_mark(root.Mark()), "(top level)", "expected a map with " + expected);
     throw ConfigError(d.problems());
   }
   return root;

@@ -125,7 +125,7 @@ ChainDesign design_chain(const config::Config& cfg) {
     problems.push_back({cfg.source, {}, "controller.chain",
                         "needs " + std::to_string(sections.size()) + " second-order sections, at most " +
                             std::to_string(filters::kMaxSections) + " are supported"});
-  if (!problems.empty()) throw config::ConfigError(problems);
+  if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
 
   ControllerParams& p = d.params;
   p.fs_hz = fs;

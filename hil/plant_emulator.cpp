@@ -86,8 +86,10 @@ class Registers {
 }  // namespace
 
 EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o) {
-  if (!cfg.can) throw std::runtime_error(cfg.source + ": the emulator needs the can section (frames and transport)");
-  if (!cfg.modbus) throw std::runtime_error(cfg.source + ": the emulator needs the modbus section (amplifier registers)");
+  if (!cfg.can || !cfg.modbus)
+    throw config::ConfigError({{cfg.source, {}, cfg.can ? "modbus" : "can",
+                                cfg.can ? "missing: the emulator serves the amplifier's registers from the modbus section"
+                                        : "missing: the emulator sends and receives the frames of the can section"}});
   const config::CanConfig& can = *cfg.can;
   EmulatorReport rep;
   rep.config = cfg.source;

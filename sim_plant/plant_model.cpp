@@ -61,7 +61,7 @@ PlantModel build_plant_model(const config::Config& cfg) {
   };
   if (cfg.robot.frfs.empty()) {
     problem("robot.frfs", "missing: the simulated plant and the loop analysis need the robot's modal data");
-    throw config::ConfigError(problems);
+    throw config::ConfigError(config::located(problems, cfg.yaml_text));
   }
   PlantModel m;
   m.locations = cfg.robot.locations;
@@ -127,7 +127,7 @@ PlantModel build_plant_model(const config::Config& cfg) {
     problem("robot.frfs", "no FRF from the actuator location " + std::to_string(ac.location) +
                               " to the sensor location " + std::to_string(cfg.sensor.location) +
                               " (nor its reciprocal): the loop cannot close");
-  if (!problems.empty()) throw config::ConfigError(problems);
+  if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
 
   // One state-space: actuator proof mass [p, p'] first, then [q, q'] per mode of every path.
   std::size_t modes = 0;
