@@ -1,18 +1,23 @@
-// Proof that the real-time path allocates nothing: the global allocation functions are replaced by
-// counting ones, and the controller runs over a million cycles with every RT-side operation exercised.
+// Proof that the real-time path allocates nothing and takes no lock: malloc, calloc, realloc,
+// posix_memalign, aligned_alloc, memalign, valloc (and through them every form of new) and
+// pthread_mutex_lock / trylock are interposed by counting versions, and the controller, the simulated
+// plant, the CAN and Modbus drivers' real-time calls and the whole loop run with every RT-side operation
+// exercised.
 #include <gtest/gtest.h>
 
 #include <linux/can/error.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
-// The replacements below pair malloc/free themselves; GCC cannot see that through the inlined calls.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#include <dlfcn.h>
+#include <pthread.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
 #include <new>
 #include <thread>
 #include <unistd.h>
@@ -28,32 +33,115 @@
 #include "sim_plant/plant.hpp"
 #include "test_util.hpp"
 
+// Symbol interposition: this executable defines the C allocation functions and pthread_mutex_lock /
+// trylock, so every call, from our code, libstdc++, yaml-cpp or Fast DDS, comes here first and is counted,
+// then handed to glibc. new and new[] (plain, nothrow, aligned) reach malloc or aligned_alloc through
+// libstdc++; the probes below check that each path is counted.
 namespace {
 std::atomic<long> g_allocations{0};
-// Allocations on threads marked as the loop's (the real-time thread), counted separately.
+// Allocations and lock acquisitions on threads marked as the loop's (the real-time thread).
 std::atomic<long> g_loop_thread_allocations{0};
+std::atomic<long> g_loop_thread_locks{0};
 thread_local bool t_loop_thread = false;
-void count_allocation() {
+void count_allocation() noexcept {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (t_loop_thread) g_loop_thread_allocations.fetch_add(1, std::memory_order_relaxed);
 }
+void count_lock() noexcept {
+  if (t_loop_thread) g_loop_thread_locks.fetch_add(1, std::memory_order_relaxed);
+}
 }  // namespace
 
-void* operator new(std::size_t n) {
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void* __libc_valloc(std::size_t);
+void __libc_free(void*);
+
+void* malloc(std::size_t n) {
   count_allocation();
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
+  return __libc_malloc(n);
 }
-void* operator new[](std::size_t n) { return operator new(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+void* calloc(std::size_t n, std::size_t size) {
   count_allocation();
-  return std::malloc(n == 0 ? 1 : n);
+  return __libc_calloc(n, size);
 }
-void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept { return operator new(n, t); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void* realloc(void* p, std::size_t n) {
+  count_allocation();
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+int posix_memalign(void** out, std::size_t alignment, std::size_t n) {
+  count_allocation();
+  if (alignment < sizeof(void*) || (alignment & (alignment - 1)) != 0) return EINVAL;
+  void* p = __libc_memalign(alignment, n);
+  if (p == nullptr) return ENOMEM;
+  *out = p;
+  return 0;
+}
+void* aligned_alloc(std::size_t alignment, std::size_t n) {
+  count_allocation();
+  return __libc_memalign(alignment, n);
+}
+void* memalign(std::size_t alignment, std::size_t n) {
+  count_allocation();
+  return __libc_memalign(alignment, n);
+}
+void* valloc(std::size_t n) {
+  count_allocation();
+  return __libc_valloc(n);
+}
+
+using MutexFn = int (*)(pthread_mutex_t*);
+int pthread_mutex_lock(pthread_mutex_t* m) {
+  static const auto real = reinterpret_cast<MutexFn>(dlsym(RTLD_NEXT, "pthread_mutex_lock"));
+  count_lock();
+  return real(m);
+}
+int pthread_mutex_trylock(pthread_mutex_t* m) {
+  static const auto real = reinterpret_cast<MutexFn>(dlsym(RTLD_NEXT, "pthread_mutex_trylock"));
+  count_lock();
+  return real(m);
+}
+}
+
+namespace {
+
+// Each allocation path and the lock are counted on a marked thread; nothing on an unmarked one.
+TEST(RealTimePath, TheHooksCountEveryAllocationPathAndLock) {
+  const long a0 = g_loop_thread_allocations.load(), l0 = g_loop_thread_locks.load();
+  std::mutex m;
+  t_loop_thread = true;
+  void* p = std::malloc(24);
+  p = std::realloc(p, 4096);
+  void* q = std::calloc(3, 8);
+  void* r = nullptr;
+  const int rc = posix_memalign(&r, 64, 128);
+  void* s = std::aligned_alloc(64, 128);
+  void* t = ::operator new(16);
+  void* u = ::operator new(16, std::align_val_t{64});
+  void* v = ::operator new[](16, std::nothrow);
+  m.lock();
+  m.unlock();
+  (void)m.try_lock();
+  m.unlock();
+  t_loop_thread = false;
+  EXPECT_EQ(rc, 0);
+  EXPECT_EQ(g_loop_thread_allocations.load() - a0, 8) << "malloc, realloc, calloc, posix_memalign, aligned_alloc, "
+                                                         "new, aligned new, nothrow new[]";
+  EXPECT_EQ(g_loop_thread_locks.load() - l0, 2) << "lock and try_lock";
+  std::free(p), std::free(q), std::free(r), std::free(s);
+  ::operator delete(t);
+  ::operator delete(u, std::align_val_t{64});
+  ::operator delete[](v);
+  const long before = g_loop_thread_allocations.load();
+  std::free(std::malloc(8));  // not a marked thread
+  EXPECT_EQ(g_loop_thread_allocations.load(), before);
+}
+
+}  // namespace
 
 namespace robodamp::control {
 namespace {
@@ -126,7 +214,8 @@ TEST(RealTimePath, CanDriverAllocatesNothing) {
   ASSERT_EQ(socketpair(AF_UNIX, SOCK_SEQPACKET, 0, sv), 0);
   drivers::CanDriver driver(can, drivers::CanChannel::adopt(sv[0]), 5000.0);
   driver.set_dejitter(true, 500);  // as on the wall clock
-  const long before = g_allocations.load();
+  const long before = g_allocations.load(), locks_before = g_loop_thread_locks.load();
+  t_loop_thread = true;
   double sink = 0.0;
   std::uint64_t ok_reads = 0;
   for (std::uint64_t tick = 0; tick < 200'000; ++tick) {
@@ -150,7 +239,9 @@ TEST(RealTimePath, CanDriverAllocatesNothing) {
     canfd_frame out{};
     while (recv(sv[1], &out, sizeof out, MSG_DONTWAIT) > 0) sink += out.data[0];
   }
+  t_loop_thread = false;
   EXPECT_EQ(g_allocations.load() - before, 0) << "allocations in the CAN driver";
+  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken in the CAN driver";
   close(sv[1]);
   const auto k = driver.counters();
   EXPECT_GT(k.rx_frames, 190'000u);
@@ -173,7 +264,7 @@ TEST(RealTimePath, ModbusStatusAllocatesNothing) {
   sup.start();
   ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
   std::uint64_t faults = 0;
-  const long before = g_loop_thread_allocations.load();
+  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
   t_loop_thread = true;  // only this thread's allocations: the polling threads are not real-time
   const auto t0 = std::chrono::steady_clock::now();
   bool stopped = false;
@@ -189,6 +280,7 @@ TEST(RealTimePath, ModbusStatusAllocatesNothing) {
   }
   t_loop_thread = false;
   EXPECT_EQ(g_loop_thread_allocations.load() - before, 0) << "allocations in the Modbus client's real-time calls";
+  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken in the Modbus client's real-time calls";
   sup.stop();
   EXPECT_GT(faults, 0U);
 }
@@ -232,11 +324,12 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   t_loop_thread = false;
   ASSERT_EQ(g_loop_thread_allocations.load(), probe + 1);
 
-  const long before = g_loop_thread_allocations.load();
+  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
   t_loop_thread = true;
   loop.run(1'000'000);
   t_loop_thread = false;
   const long during = g_loop_thread_allocations.load() - before;
+  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken on the loop thread";
   drain.stop();
   recorder.close();
 
@@ -280,14 +373,15 @@ TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   rt::RealtimeStatus status;
   rt::RealtimeProcess process(cfg.realtime, status);
   drain.start();
-  long loop_allocations = -1;
+  long loop_allocations = -1, loop_locks = -1;
   std::thread thread([&] {
     rt::setup_realtime_thread(cfg.realtime, status);
-    const long before = g_loop_thread_allocations.load();
+    const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
     t_loop_thread = true;
     loop.run(60 * 5000);
     t_loop_thread = false;
     loop_allocations = g_loop_thread_allocations.load() - before;
+    loop_locks = g_loop_thread_locks.load() - locks_before;
   });
   std::vector<long> rss;
   for (int i = 0; i < 13; ++i) {
@@ -299,6 +393,7 @@ TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   recorder.close();
   const auto stats = loop.stats();
   EXPECT_EQ(loop_allocations, 0);
+  EXPECT_EQ(loop_locks, 0);
   EXPECT_EQ(stats.ring_drops, 0U);
   EXPECT_EQ(recorder.frames(), stats.ticks_run);
   // Timing on a shared machine is not this test's subject; anything else tripping is.

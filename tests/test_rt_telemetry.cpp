@@ -168,5 +168,28 @@ TEST_F(RecordingTest, CsvHasOneRowPerFrameAndExactValues) {
   EXPECT_EQ(std::stod(cell), r.frames[6000].command_v);
 }
 
+// The file, not only the frames: a virtual-clock run's recording has no wall time in it (created_utc is
+// null), so the same configuration, faults and commands give the same bytes.
+TEST(Recording, AVirtualClockRecordingIsByteIdenticalRunToRun) {
+  auto record = [](const std::string& path) {
+    runtime::CellOptions o;
+    o.clock = config::ClockKind::kVirtual;
+    o.record_path = path;
+    o.impact_every_s = 0.3;
+    runtime::Cell cell(config::load_config_file(test::preset("horizontal_c2")), o);
+    test::configure(cell);
+    cell.plant().faults().add({sim::FaultKind::kSensorNan, 0.7, 0.001});
+    cell.schedule(2000, {CommandKind::kSetGain, 2400.0});
+    (void)cell.run(1.0);
+    return test::read_file(path);
+  };
+  const std::string dir = ::testing::TempDir() + "/rt_identical_" + std::to_string(::getpid());
+  const std::string a = record(dir + "_a.rec"), b = record(dir + "_b.rec");
+  ASSERT_GT(a.size(), 5000U * sizeof(TelemetryFrame));
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b) << "first differing byte at " << std::distance(a.begin(), std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first);
+  EXPECT_NE(a.find("\"created_utc\":null"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace robodamp::rt
