@@ -651,38 +651,4 @@ const LocationConfig* find_location(const RobotConfig& robot, int id) {
   return nullptr;
 }
 
-ModeNumerator mode_numerator(const ModeConfig& m) {
-  const double wn = 2.0 * M_PI * m.natural_freq_hz;
-  if (m.form == ModeForm::kStiffness) return {wn * wn / m.stiffness_n_per_m, 0.0};
-  const double wd = wn * std::sqrt(1.0 - m.damping_ratio * m.damping_ratio);
-  return {2.0 * (m.damping_ratio * wn * m.residue_re_m_per_n - wd * m.residue_im_m_per_n), 2.0 * m.residue_re_m_per_n};
-}
-
-std::complex<double> frf_receptance(const FrfConfig& f, double f_hz) {
-  const std::complex<double> s(0.0, 2.0 * M_PI * f_hz);
-  std::complex<double> h(0.0);
-  for (const auto& m : f.modes) {
-    const double wn = 2.0 * M_PI * m.natural_freq_hz;
-    const ModeNumerator n = mode_numerator(m);
-    h += (n.a + n.b * s) / (s * s + 2.0 * m.damping_ratio * wn * s + wn * wn);
-  }
-  return h;
-}
-
-std::optional<double> dominant_mode_hz(const RobotConfig& robot, int actuator_location) {
-  const FrfConfig* best_frf = nullptr;
-  for (const auto& f : robot.frfs)
-    if (f.response_location == actuator_location && f.excitation_location == actuator_location) best_frf = &f;
-  std::optional<double> best_hz;
-  double best_peak = -1.0;
-  for (const auto& f : robot.frfs) {
-    if (best_frf != nullptr && &f != best_frf) continue;
-    // |H| of the whole FRF at each mode's frequency, so close modes count together.
-    for (const auto& probe : f.modes)
-      if (const double h = std::abs(frf_receptance(f, probe.natural_freq_hz)); h > best_peak)
-        best_peak = h, best_hz = probe.natural_freq_hz;
-  }
-  return best_hz;
-}
-
 }  // namespace robodamp::config

@@ -253,18 +253,4 @@ struct Config {
 
 [[nodiscard]] const LocationConfig* find_location(const RobotConfig& robot, int id);
 
-// Eq. 1 numerator of one mode, H(s) = (a + b s) / (s^2 + 2 zeta wn s + wn^2), in the tabulated frame:
-// residue form a = 2 (zeta wn re - wd im), b = 2 re; stiffness form a = wn^2 / k, b = 0.
-struct ModeNumerator {
-  double a{0.0};  // m/N * rad^2/s^2
-  double b{0.0};  // m/N * rad/s
-};
-[[nodiscard]] ModeNumerator mode_numerator(const ModeConfig& m);
-// Receptance of one FRF path at f_hz, tabulated frame (no axis sign), m/N.
-[[nodiscard]] std::complex<double> frf_receptance(const FrfConfig& f, double f_hz);
-
-// Frequency of the robot mode with the largest receptance peak, preferring the driving-point FRF at the
-// actuator location where the loop closes; nullopt without modal data.
-[[nodiscard]] std::optional<double> dominant_mode_hz(const RobotConfig& robot, int actuator_location = 2);
-
 }  // namespace robodamp::config

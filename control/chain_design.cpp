@@ -1,3 +1,4 @@
+#include "modal/receptance.hpp"
 #include "control/chain_design.hpp"
 
 #include <algorithm>
@@ -51,7 +52,7 @@ ChainDesign design_chain(const config::Config& cfg) {
   d.source = cfg.source;
   if (cfg.controller.match_freq_hz) {
     d.match_freq_hz = *cfg.controller.match_freq_hz;
-  } else if (auto dom = config::dominant_mode_hz(cfg.robot, cfg.actuator.location)) {
+  } else if (auto dom = modal::dominant_mode_hz(cfg.robot, cfg.actuator.location)) {
     d.match_freq_hz = *dom;
   } else {
     const bool needs = std::any_of(chain.begin(), chain.end(), [](const auto& b) {

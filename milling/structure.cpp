@@ -1,3 +1,4 @@
+#include "modal/receptance.hpp"
 #include "milling/structure.hpp"
 
 #include <cmath>
@@ -68,7 +69,7 @@ Eigen::Matrix2cd Structure::frf(double f_hz) const {
   Eigen::Matrix2cd g;
   for (std::size_t k = 0; k < 4; ++k)
     g(static_cast<Eigen::Index>(k / 2), static_cast<Eigen::Index>(k % 2)) =
-        modal_[k].modes.empty() ? Complex(0.0) : config::frf_receptance(modal_[k], f_hz);
+        modal_[k].modes.empty() ? Complex(0.0) : modal::frf_receptance(modal_[k], f_hz);
   for (const auto& c : controllers_) {
     const auto d = static_cast<Eigen::Index>(c.direction);
     g(d, d) += damped_ ? c.model->closed_sampled(c.location, c.location, f_hz, c.gain_ns_per_m, c.polarity)

@@ -1,3 +1,4 @@
+#include "modal/receptance.hpp"
 #include "sim_plant/plant_model.hpp"
 
 #include <cmath>
@@ -77,7 +78,7 @@ PlantModel build_plant_model(const config::Config& cfg) {
     p.excitation = m.index_of(f.excitation_location);
     const double sign = m.locations[p.response].axis_sign;
     for (const auto& mode : f.modes) {
-      const config::ModeNumerator n = config::mode_numerator(mode);
+      const modal::ModeNumerator n = modal::mode_numerator(mode);
       p.modes.push_back({kTwoPi * mode.natural_freq_hz, mode.damping_ratio, sign * n.a, sign * n.b});
     }
     const double h0 = p.static_compliance_m_per_n();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "modal/receptance.hpp"
 #include "analysis/loop_model.hpp"
 #include "analysis/spectral.hpp"
 #include "test_util.hpp"
@@ -25,9 +26,9 @@ TEST(LoopModel, ClosedLoopFollowsTheCorrectedEquations) {
   const auto& cfg = m.config();
   const double k = cfg.controller.gain_ns_per_m;
   for (double f : {5.0, 9.2, 14.0, 21.0, 23.5, 40.0}) {
-    const Complex h11 = config::frf_receptance(cfg.robot.frfs[0], f);
-    const Complex h21 = -config::frf_receptance(cfg.robot.frfs[1], f);  // physical: location 2 axis reversed
-    const Complex h22 = -config::frf_receptance(cfg.robot.frfs[2], f);
+    const Complex h11 = modal::frf_receptance(cfg.robot.frfs[0], f);
+    const Complex h21 = -modal::frf_receptance(cfg.robot.frfs[1], f);  // physical: location 2 axis reversed
+    const Complex h22 = -modal::frf_receptance(cfg.robot.frfs[2], f);
     const Complex h12 = h21;                                            // reciprocity
     // G / T: force per displacement fed back with negative sign (F_act = -G/T x2).
     const Complex g_over_t = -m.feedback_continuous(f, k, 1);

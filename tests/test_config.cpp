@@ -4,6 +4,7 @@
 #include <fstream>
 #include <regex>
 
+#include "modal/receptance.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
 #include "test_util.hpp"
@@ -72,7 +73,7 @@ TEST(Config, AllPresetsLoadAndDesign) {
     EXPECT_EQ(c.robot.frfs[0].modes.size(), 3U);
     EXPECT_DOUBLE_EQ(c.robot.frfs[0].modes[0].residue_im_m_per_n, -3.63e-5);
     EXPECT_DOUBLE_EQ(c.robot.frfs[2].modes[0].residue_im_m_per_n, 4.06e-5);  // H22 = H21 (Table 1)
-    EXPECT_NEAR(*dominant_mode_hz(c.robot), 9.2, 1e-12);
+    EXPECT_NEAR(*modal::dominant_mode_hz(c.robot), 9.2, 1e-12);
     const auto d = control::design_chain(c);
     EXPECT_EQ(d.match_freq_hz, 9.2);
   }

@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-./build/bench/bench_chain --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+./build/benchmarks/benchmark_chain --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_min_time=0.5 --benchmark_counters_tabular=true
 n=1000000
 echo
@@ -12,17 +12,17 @@ echo "callgrind instructions per sample (N = $n, closed loop, Release flags):"
 for k in plain chain controller; do
   out=$(mktemp)
   valgrind --tool=callgrind --callgrind-out-file="$out" '--toggle-collect=*run_kernel*' \
-    ./build/bench/callgrind_chain "$k" "$n" >/dev/null 2>&1
+    ./build/benchmarks/callgrind_chain "$k" "$n" >/dev/null 2>&1
   ir=$(grep -E '^(summary|totals):' "$out" | head -1 | awk '{print $2}')
   rm -f "$out"
   awk -v k="$k" -v ir="$ir" -v n="$n" 'BEGIN { printf "  %-11s %8.2f\n", k, ir / n }'
 done
 echo
 echo "simulated plant + controller, default preset (x_real_time = simulated s per wall s, one core):"
-./build/bench/bench_plant --benchmark_repetitions=5 --benchmark_report_aggregates_only=true --benchmark_min_time=0.5 \
+./build/benchmarks/benchmark_plant --benchmark_repetitions=5 --benchmark_report_aggregates_only=true --benchmark_min_time=0.5 \
   --benchmark_counters_tabular=true
 echo
 echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (seed 004), the direct test's"
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
-taskset -c 0 ./build/bench/bench_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+taskset -c 0 ./build/benchmarks/benchmark_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_counters_tabular=true

@@ -5,8 +5,8 @@
 # the simulated plant, the supervisor and controller, telemetry and the drain thread.
 # Both histograms are in whole microseconds and go through the same percentile code below.
 #
-#   bash bench/rt_latency.sh              # 30 s per run at 5 and 10 kHz
-#   DURATION=120 bash bench/rt_latency.sh
+#   bash benchmarks/rt_latency.sh              # 30 s per run at 5 and 10 kHz
+#   DURATION=120 bash benchmarks/rt_latency.sh
 # Writes build/rt_latency.md (a table) and the histograms in build/rt_latency/.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
