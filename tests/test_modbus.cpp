@@ -3,7 +3,15 @@
 // a lost link as a fault only when it matters, and the robot's mounting register with its settling.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <random>
+#include <thread>
 #include <vector>
 
 #include "drivers/modbus_server.hpp"
@@ -195,6 +203,109 @@ TEST(Modbus, StopLeavesTheAmplifierOff) {
   ASSERT_TRUE(eventually([&] { return server.coil(3); }));
   sup.stop();
   EXPECT_FALSE(server.coil(3));
+}
+
+// A device that answers every request with garbage: random bytes, a header with another transaction id,
+// a length that lies, an exception, half a reply, or a closed connection. On loopback, bounded in time,
+// seeded.
+class GarbageServer {
+ public:
+  explicit GarbageServer(std::uint64_t seed) : rng_(seed) {
+    fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const int one = 1;
+    setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    listen(fd_, 4);
+    socklen_t len = sizeof a;
+    getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+    port_ = ntohs(a.sin_port);
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~GarbageServer() {
+    stop_.store(true);
+    thread_.join();
+    for (int c : clients_) close(c);
+    close(fd_);
+  }
+  [[nodiscard]] int port() const { return port_; }
+  [[nodiscard]] int replies() const { return replies_.load(); }
+
+ private:
+  void serve() {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);  // bounded whatever happens
+    while (!stop_.load() && std::chrono::steady_clock::now() < end) {
+      std::vector<pollfd> p{{fd_, POLLIN, 0}};
+      for (int c : clients_) p.push_back({c, POLLIN, 0});
+      if (poll(p.data(), p.size(), 20) <= 0) continue;
+      if (p[0].revents & POLLIN) clients_.push_back(accept(fd_, nullptr, nullptr));
+      for (std::size_t i = 1; i < p.size(); ++i) {
+        if (!(p[i].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+        unsigned char req[300];
+        const ssize_t n = recv(p[i].fd, req, sizeof req, 0);
+        if (n <= 0 || !answer(p[i].fd, req, static_cast<std::size_t>(n))) {
+          close(p[i].fd);
+          std::erase(clients_, p[i].fd);
+        }
+      }
+    }
+  }
+  // false: the connection was closed on purpose.
+  bool answer(int fd, const unsigned char* req, std::size_t n) {
+    std::vector<unsigned char> r;
+    auto random_bytes = [&](std::size_t k) {
+      for (std::size_t i = 0; i < k; ++i) r.push_back(static_cast<unsigned char>(rng_() & 0xFF));
+    };
+    const unsigned char tid0 = n > 1 ? req[0] : 0, tid1 = n > 1 ? req[1] : 0, unit = n > 6 ? req[6] : 1;
+    const unsigned char fn = n > 7 ? req[7] : 1;
+    switch (rng_() % 7) {
+      case 0: random_bytes(1 + rng_() % 40); break;
+      case 1: r = {static_cast<unsigned char>(tid0 + 1), tid1, 0, 0, 0, 4, unit, fn, 1, 0xFF}; break;  // another id
+      case 2: r = {tid0, tid1, 0, 0, 0xFF, 0xFF, unit, fn, 1, 0xFF}; break;                         // length lies
+      case 3: r = {tid0, tid1, 0, 0, 0, 3, unit, static_cast<unsigned char>(fn | 0x80), 4}; break;  // exception
+      case 4: r = {tid0, tid1, 0, 0, 0, 6, unit}; break;                                             // half a reply
+      case 5: return false;                                                                          // hang up
+      default: r = {tid0, tid1, 0, 0, 0, 4, unit, fn, 9}; random_bytes(2); break;  // byte count lies
+    }
+    ++replies_;
+    return send(fd, r.data(), r.size(), MSG_NOSIGNAL) >= 0;
+  }
+
+  std::mt19937_64 rng_;
+  int fd_{-1};
+  int port_{0};
+  std::vector<int> clients_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> replies_{0};
+  std::thread thread_;
+};
+
+TEST(Modbus, ADeviceAnsweringGarbageIsCountedAndNeverReady) {
+  GarbageServer server(11);
+  ModbusSupervisor sup(client_config(server.port()), config::Mounting::kHorizontal);
+  sup.start();
+  sup.request_amplifier_enable(true);
+  bool ever_ready = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) {
+    ever_ready = ever_ready || sup.amplifier_status().ready;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_TRUE(eventually([&] { return server.replies() > 50; }, 20.0)) << server.replies();
+  EXPECT_FALSE(ever_ready) << "garbage never reads as a ready amplifier";
+  // Never one good poll: the status stays unknown (not ready, not enabled), so an arming supervisor
+  // trips on amplifier_not_ready after supervision.amplifier_ready_timeout_s (test_rt_loop).
+  EXPECT_FALSE(sup.amplifier_status().ready);
+  EXPECT_FALSE(sup.amplifier_status().enabled);
+  const auto c = sup.counters();
+  EXPECT_GT(c.errors + c.timeouts + c.connect_failures, 10U);
+  EXPECT_EQ(c.mounting_changes, 0U);
+  sup.stop();
+  std::printf("[ garbage  ] %d garbage replies: %llu errors, %llu timeouts, %llu connects, %llu link faults\n",
+              server.replies(), static_cast<unsigned long long>(c.errors), static_cast<unsigned long long>(c.timeouts),
+              static_cast<unsigned long long>(c.connects), static_cast<unsigned long long>(c.link_faults));
 }
 
 }  // namespace
