@@ -20,6 +20,7 @@ std::optional<DdsClientOptions> resolve(const DdsClientArgs& a) {
       if (cfg.dds) {
         o.domain_id = cfg.dds->domain_id;
         o.transport = cfg.dds->transport;
+        o.security = cfg.dds->security;
       }
     } catch (const config::ConfigError& e) {
       std::cerr << e.what() << '\n';

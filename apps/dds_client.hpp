@@ -14,6 +14,7 @@ struct DdsClientOptions {
   int domain_id{0};
   config::DdsTransport transport{config::DdsTransport::kDefault};
   double duration_s{0.0};  // monitor: 0 = until Ctrl-C; request: how long to wait for the loop and the reply
+  std::optional<config::DdsSecurityConfig> security;  // the client's own identity (the --config's dds.security)
 };
 
 struct DdsClientArgs {

@@ -81,7 +81,7 @@ int run_monitor(const DdsClientOptions& o) {
   rt::install_shutdown_handlers();
   Latest<msg::Telemetry> telemetry;  // before the participant: it outlives the readers that call it
   Latest<msg::Status> status;
-  dds::Participant p(o.domain_id, o.transport, "robodamp monitor");
+  dds::Participant p(o.domain_id, o.transport, "robodamp monitor", o.security);
   p.reader(dds::TopicKind::kTelemetry, &telemetry);
   p.reader(dds::TopicKind::kStatus, &status);
   const bool tty = isatty(STDOUT_FILENO) != 0;

@@ -75,7 +75,7 @@ int run_request(const DdsClientOptions& o, const RequestOptions& r) {
   int rc = 1;
   {
     Replies replies(client, 1);  // before the participant: it outlives the reader that calls it
-    dds::Participant p(o.domain_id, o.transport, "robodamp request");
+    dds::Participant p(o.domain_id, o.transport, "robodamp request", o.security);
     DataReader* reader = p.reader(dds::TopicKind::kReply, &replies);
     DataWriter* writer = p.writer(dds::TopicKind::kRequest);
     const auto end = Clock::now() + std::chrono::duration<double>(wait_s);

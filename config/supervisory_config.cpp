@@ -132,6 +132,29 @@ std::vector<ParameterSetRef> read_parameter_sets(MapReader& top, const std::stri
   return sets;
 }
 
+std::optional<DdsSecurityConfig> read_dds_security(MapReader& dds, const std::string& source) {
+  const YAML::Node node = dds.child("security", false, "");
+  if (!present(node)) return std::nullopt;
+  MapReader r(dds.diagnostics(), node, "dds.security", dds.mark());
+  const std::filesystem::path dir = std::filesystem::path(source).parent_path();
+  DdsSecurityConfig c;
+  const std::pair<const char*, std::string*> files[] = {
+      {"identity_ca", &c.identity_ca},       {"identity_certificate", &c.identity_certificate},
+      {"private_key", &c.private_key},       {"permissions_ca", &c.permissions_ca},
+      {"governance", &c.governance},         {"permissions", &c.permissions}};
+  for (const auto& [key, out] : files) {
+    const auto p = r.text(key, std::nullopt);
+    if (!p) continue;
+    const std::filesystem::path resolved = std::filesystem::path(*p).is_absolute() ? std::filesystem::path(*p) : dir / *p;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(resolved, ec))
+      r.diagnostics().add(r.mark(), r.path_of(key), "= '" + *p + "': no such file (looked for " + resolved.string() + ")");
+    *out = resolved.string();
+  }
+  r.finish();
+  return c;
+}
+
 std::optional<DdsConfig> read_dds(MapReader& top) {
   const YAML::Node node = top.child("dds", false, "");
   if (!present(node)) return std::nullopt;
@@ -145,6 +168,7 @@ std::optional<DdsConfig> read_dds(MapReader& top) {
   if (auto v = r.number("telemetry_rate_hz", {"Hz", 0.0, 1000.0, true}, c.telemetry_rate_hz)) c.telemetry_rate_hz = *v;
   if (auto v = r.number("status_rate_hz", {"Hz", 0.0, 100.0, true}, c.status_rate_hz)) c.status_rate_hz = *v;
   if (auto v = read_bool(r, "parameter_writes", c.parameter_writes)) c.parameter_writes = *v;
+  c.security = read_dds_security(r, top.diagnostics().file());
   r.finish();
   return c;
 }

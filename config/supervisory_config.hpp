@@ -66,12 +66,25 @@ struct ParameterSetRef {
 
 enum class DdsTransport { kUdpLoopback, kSharedMemory, kDefault };
 
+// DDS Security (OMG DDS Security 1.1, Fast DDS's builtin plugins: PKI-DH authentication,
+// Access-Permissions access control, AES-GCM-GMAC encryption). Paths are resolved against the
+// configuration file's folder. docs/hardware.md says how to make them (scripts/dds_security.sh).
+struct DdsSecurityConfig {
+  std::string identity_ca;           // PEM: the CA that signs every participant's identity
+  std::string identity_certificate;  // PEM: this participant's certificate
+  std::string private_key;           // PEM: its key
+  std::string permissions_ca;        // PEM: the CA that signs governance and permissions
+  std::string governance;            // S/MIME-signed XML: which topics are protected, and how
+  std::string permissions;           // S/MIME-signed XML: what this participant may publish and subscribe
+};
+
 struct DdsConfig {
   int domain_id{0};
   DdsTransport transport{DdsTransport::kDefault};
   double telemetry_rate_hz{50.0};  // decimated loop frames
   double status_rate_hz{5.0};
   bool parameter_writes{false};    // parameter requests are refused unless this is on
+  std::optional<DdsSecurityConfig> security;  // absent: no authentication (a closed cell network)
 };
 
 enum class HilPacing { kRealtime, kLockstep };

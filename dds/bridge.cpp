@@ -40,7 +40,7 @@ class Bridge::RequestListener : public DataReaderListener {
 Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources)
     : cfg_(cfg), source_(config_source), src_(std::move(sources)) {
   window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
-  participant_ = std::make_unique<Participant>(cfg.domain_id, cfg.transport, "robodamp loop");
+  participant_ = std::make_unique<Participant>(cfg.domain_id, cfg.transport, "robodamp loop", cfg.security);
   telemetry_writer_ = participant_->writer(TopicKind::kTelemetry);
   status_writer_ = participant_->writer(TopicKind::kStatus);
   reply_writer_ = participant_->writer(TopicKind::kReply);

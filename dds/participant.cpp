@@ -19,10 +19,24 @@ constexpr const char* kTopicNames[4] = {"robodamp/telemetry", "robodamp/status",
                                         "robodamp/parameter_reply"};
 }
 
-Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name)
+Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name,
+                         const std::optional<config::DdsSecurityConfig>& security)
     : domain_id_(domain_id), transport_(transport) {
   DomainParticipantQos pq = PARTICIPANT_QOS_DEFAULT;
   pq.name(name);
+  if (security) {
+    auto& props = pq.properties().properties();
+    auto file = [](const std::string& path) { return "file://" + path; };
+    props.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+    props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", file(security->identity_ca));
+    props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", file(security->identity_certificate));
+    props.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", file(security->private_key));
+    props.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+    props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", file(security->permissions_ca));
+    props.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", file(security->governance));
+    props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", file(security->permissions));
+    props.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+  }
   if (transport == config::DdsTransport::kUdpLoopback) {
     pq.transport().use_builtin_transports = false;
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
@@ -38,7 +52,10 @@ Participant::Participant(int domain_id, config::DdsTransport transport, const st
   participant_ = DomainParticipantFactory::get_instance()->create_participant(domain_id, pq);
   if (participant_ == nullptr)
     throw std::runtime_error("DDS: cannot create a participant on domain " + std::to_string(domain_id) + " (" +
-                             config::to_string(transport) + ")");
+                             config::to_string(transport) + ")" +
+                             (security ? ": check dds.security (certificates, key, signed governance and permissions, "
+                                         "the subject names in the permissions)"
+                                       : ""));
   TypeSupport types[4] = {TypeSupport(new robodamp::msg::TelemetryPubSubType()),
                           TypeSupport(new robodamp::msg::StatusPubSubType()),
                           TypeSupport(new robodamp::msg::ParameterRequestPubSubType()),

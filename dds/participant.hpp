@@ -9,8 +9,14 @@
 //
 // Transports: default (Fast DDS built-ins: UDPv4 and shared memory), udp_loopback (UDPv4 on 127.0.0.1
 // only, data sharing off) or shared_memory (SHM only).
+//
+// With a security section the participant authenticates (PKI-DH), is authorised by its signed
+// permissions against the signed governance (Access-Permissions) and encrypts what the governance says
+// (AES-GCM-GMAC): robodamp's governance (scripts/dds_security.sh) protects and encrypts the parameter
+// request and reply topics and leaves telemetry and status readable (docs/hardware.md).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -29,7 +35,8 @@ enum class TopicKind { kTelemetry, kStatus, kRequest, kReply };
 class Participant {
  public:
   // Throws std::runtime_error when the participant or a topic cannot be created.
-  Participant(int domain_id, config::DdsTransport transport, const std::string& name);
+  Participant(int domain_id, config::DdsTransport transport, const std::string& name,
+              const std::optional<config::DdsSecurityConfig>& security = std::nullopt);
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
