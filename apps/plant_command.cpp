@@ -23,6 +23,7 @@ struct PlantArgs {
   bool impacts{true};
   int impact_location{0};
   std::vector<std::string> mounting_schedule;  // "T:vertical" / "T:horizontal", plant time in s
+  double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
 
 // "T:horizontal" or "T:vertical" with T a finite plant time >= 0 s.
@@ -45,6 +46,9 @@ int run_plant(const PlantArgs& a) {
   eo.max_duration_s = a.duration_s;
   eo.impacts = a.impacts;
   eo.impact_location = a.impact_location;
+  eo.bus_off_at_s = a.bus_off_at_s;
+  eo.bus_off_for_s = a.bus_off_for_s;
+  eo.modbus_hang_at_s = a.modbus_hang_at_s;
   for (const auto& item : a.mounting_schedule) {
     const auto m = parse_mounting(item);
     if (!m) {
@@ -86,6 +90,11 @@ void register_plant(Registry& r) {
   sub->add_flag("!--no-impacts", a->impacts, "Do not run the impact schedule");
   r.whole_number(sub, "--impact-location", a->impact_location,
                  {"(location id)", 0, 1000, false, false, "0 = the first FRF's excitation"}, "Location id the hammer hits");
+  r.number(sub, "--bus-off-at", a->bus_off_at_s, {"s", 0.0, 604800.0},
+           "Fault injection: the CAN bus goes off at this plant time (error frame, no sensor frames, then a restart)");
+  r.number(sub, "--bus-off-for", a->bus_off_for_s, {"s", 0.001, 3600.0}, "How long the bus stays off");
+  r.number(sub, "--modbus-hang-at", a->modbus_hang_at_s, {"s", 0.0, 604800.0},
+           "Fault injection: the Modbus device stops answering at this plant time");
   sub->add_option("--mounting", a->mounting_schedule,
                   "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
 }

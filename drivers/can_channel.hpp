@@ -60,6 +60,12 @@ class CanChannel {
   [[nodiscard]] bool wait_readable(std::int64_t timeout_ns) const noexcept;
 
   [[nodiscard]] int fd() const noexcept { return fd_; }
+  // Gives up the descriptor without closing it (the caller owns it now).
+  [[nodiscard]] int release() noexcept {
+    const int fd = fd_;
+    fd_ = -1;
+    return fd;
+  }
   [[nodiscard]] bool kernel_socket() const noexcept { return kernel_; }
 
  private:

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <linux/can/error.h>
+#include <unistd.h>
 
 namespace robodamp::drivers {
 
@@ -20,12 +21,38 @@ CanDriver::CanDriver(const config::CanConfig& cfg, CanChannel channel, double lo
   backoff_max_ticks_ = std::max(backoff_initial_ticks_, static_cast<std::uint64_t>(std::llround(cfg_.backoff_max_s * loop_rate_hz)));
 }
 
+CanDriver::~CanDriver() {
+  for (const int fd : {pending_fd_.load(), retired_fd_.load()})
+    if (fd >= 0) ::close(fd);
+}
+
 void CanDriver::enter_backoff(std::uint64_t tick) noexcept {
   backoff_ticks_ = backoff_ticks_ == 0 ? backoff_initial_ticks_ : std::min(2 * backoff_ticks_, backoff_max_ticks_);
   retry_tick_ = tick + backoff_ticks_;
 }
 
+bool CanDriver::offer_channel(CanChannel&& c) noexcept {
+  int expected = -1;
+  const int fd = c.fd();
+  if (!pending_fd_.compare_exchange_strong(expected, fd, std::memory_order_acq_rel)) return false;
+  (void)c.release();
+  return true;
+}
+
+// RT-safe: descriptors change hands, nothing is opened or closed here.
+void CanDriver::take_over_pending() noexcept {
+  if (pending_fd_.load(std::memory_order_acquire) < 0 || retired_fd_.load(std::memory_order_acquire) >= 0) return;
+  const int fd = pending_fd_.exchange(-1, std::memory_order_acq_rel);
+  retired_fd_.store(channel_.release(), std::memory_order_release);
+  channel_ = CanChannel::adopt(fd);  // nothing to close: released above
+  link_lost_.store(false, std::memory_order_relaxed);
+  have_counter_ = false;  // a new sender: its counter starts where it starts
+  held_ = false;
+  bump(n_.reconnects);
+}
+
 rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
+  take_over_pending();
   bool fresh = false;
   int arrived = 0;
   double sample = last_value_;
@@ -42,7 +69,7 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
     if (n == 0 && i == 0 && lockstep_wait_ns_ > 0 && channel_.wait_readable(lockstep_wait_ns_)) n = channel_.receive(f, ts);
     if (n == 0) break;
     if (n == -ENOTCONN) {
-      link_lost_ = true;
+      link_lost_.store(true, std::memory_order_relaxed);
       break;
     }
     if (n < 0) {
@@ -50,7 +77,7 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
       rx_fault_ = true;
       break;
     }
-    link_lost_ = false;
+    link_lost_.store(false, std::memory_order_relaxed);
     if (n != CAN_MTU && n != CANFD_MTU) {
       bump(n_.rx_malformed);
       continue;
@@ -116,7 +143,7 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
   last_value_ = sample;
   const auto limit = static_cast<std::uint64_t>(cfg_.lost_frames_fault);
   const bool too_many_lost = losses_ >= limit && tick < loss_ticks_[(losses_ - limit) % kLossRing] + window_ticks_;
-  return {sample, fresh, !(bus_off_ || link_lost_ || rx_fault_ || too_many_lost)};
+  return {sample, fresh, !(bus_off_ || link_lost_.load(std::memory_order_relaxed) || rx_fault_ || too_many_lost)};
 }
 
 rt::ActuatorStatus CanDriver::write(double command_v, std::uint64_t tick) noexcept {
@@ -160,7 +187,7 @@ CanCounters CanDriver::counters() const noexcept {
   auto l = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
   return {l(n_.rx_frames),  l(n_.rx_other),   l(n_.rx_malformed),  l(n_.lost_frames), l(n_.stale_frames),
           l(n_.error_frames), l(n_.bus_off),  l(n_.restarts),      l(n_.rx_errors),   l(n_.tx_frames),
-          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped), l(n_.rx_held), l(n_.rx_skipped)};
+          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped), l(n_.rx_held), l(n_.rx_skipped), l(n_.reconnects)};
 }
 
 }  // namespace robodamp::drivers

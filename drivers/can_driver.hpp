@@ -38,11 +38,15 @@ struct CanCounters {
   std::uint64_t tx_clipped{0};      // commands outside the command field's range
   std::uint64_t rx_held{0};         // de-jitter: frames held over to the next tick
   std::uint64_t rx_skipped{0};      // de-jitter: frames skipped (backlog, or resync to the newest)
+  std::uint64_t reconnects{0};      // transports handed over after the peer went away (offer_channel)
 };
 
 class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
  public:
   CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz);
+  ~CanDriver();
+  CanDriver(const CanDriver&) = delete;
+  CanDriver& operator=(const CanDriver&) = delete;
 
   // Lockstep pacing (virtual clock against the HIL emulator): each read waits up to wait_s for the
   // tick's sensor frame, which the emulator sends once it has the previous command. 0 (the default, and
@@ -68,7 +72,14 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
 
   [[nodiscard]] CanCounters counters() const noexcept;
   [[nodiscard]] bool bus_off() const noexcept { return bus_off_; }
-  [[nodiscard]] bool link_lost() const noexcept { return link_lost_; }
+  // Any thread: the peer of a connected transport (the HIL emulator's socket) has gone away.
+  [[nodiscard]] bool link_lost() const noexcept { return link_lost_.load(std::memory_order_relaxed); }
+  // From a non-real-time thread: a new connection to take over at the loop's next read (the emulator
+  // came back). The loop swaps descriptors without a system call and leaves the old one for
+  // take_retired_fd(). False while an earlier hand-over is still pending.
+  bool offer_channel(CanChannel&& c) noexcept;
+  // The descriptor the loop let go of, to be closed off the real-time thread; -1 when none.
+  [[nodiscard]] int take_retired_fd() noexcept { return retired_fd_.exchange(-1, std::memory_order_acq_rel); }
   [[nodiscard]] double backoff_s() const noexcept { return static_cast<double>(backoff_ticks_) / rate_hz_; }
   [[nodiscard]] std::int64_t last_rx_timestamp_ns() const noexcept { return last_rx_ns_; }
 
@@ -77,12 +88,13 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   struct AtomicCounters {
     std::atomic<std::uint64_t> rx_frames{0}, rx_other{0}, rx_malformed{0}, lost_frames{0}, stale_frames{0},
         error_frames{0}, bus_off{0}, restarts{0}, rx_errors{0}, tx_frames{0}, tx_queue_full{0}, tx_errors{0},
-        tx_skipped{0}, tx_clipped{0}, rx_held{0}, rx_skipped{0};
+        tx_skipped{0}, tx_clipped{0}, rx_held{0}, rx_skipped{0}, reconnects{0};
   };
   static void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) noexcept {
     c.store(c.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
   }
   void enter_backoff(std::uint64_t tick) noexcept;
+  void take_over_pending() noexcept;
 
   config::CanConfig cfg_;
   CanChannel channel_;
@@ -100,7 +112,8 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   std::uint64_t losses_{0};
   std::uint64_t window_ticks_{1};
   std::int64_t last_rx_ns_{-1};
-  bool link_lost_{false};
+  std::atomic<bool> link_lost_{false};
+  std::atomic<int> pending_fd_{-1}, retired_fd_{-1};
   bool rx_fault_{false};
   // Bus state and transmit back-off.
   bool bus_off_{false};

@@ -1,5 +1,7 @@
 #include "hil/plant_emulator.hpp"
 
+#include <linux/can/error.h>
+
 #include <time.h>
 
 #include <algorithm>
@@ -67,6 +69,10 @@ class Registers {
       robot_->set_holding_register(m_.robot.mounting_register, static_cast<std::uint16_t>(
                                                                    m == config::Mounting::kVertical ? m_.robot.vertical_value
                                                                                                     : m_.robot.horizontal_value));
+  }
+  void hang() {
+    amp_->set_responding(false);
+    if (robot_server_) robot_server_->set_responding(false);
   }
   [[nodiscard]] std::uint64_t requests() const {
     return amp_->requests() + (robot_server_ ? robot_server_->requests() : 0);
@@ -153,7 +159,43 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / fs));
   const auto max_ticks = o.max_duration_s > 0.0 ? static_cast<std::uint64_t>(std::llround(o.max_duration_s * fs)) : UINT64_MAX;
 
+  // Fault injection (plant time): the bus off for a while, the Modbus device hanging.
+  double bus_off_until_s = -1.0;
+  bool bus_off_done = false, hang_done = false;
+  auto inject = [&](const char* kind, double t) {
+    rep.injected.push_back({kind, t, now_ns()});
+    spdlog::warn("robodamp plant: injected {} at {:.3f} s", kind, t);
+  };
+  auto send_error_frame = [&](canid_t flags) {
+    canfd_frame e{};
+    e.can_id = CAN_ERR_FLAG | flags;
+    e.len = CAN_ERR_DLC;
+    (void)channel->send(e, static_cast<int>(CAN_MTU));
+  };
+  auto faults_at = [&](double t) {
+    if (!bus_off_done && o.bus_off_at_s >= 0.0 && t >= o.bus_off_at_s) {
+      bus_off_done = true;
+      bus_off_until_s = t + o.bus_off_for_s;
+      send_error_frame(CAN_ERR_BUSOFF);
+      inject("bus_off", t);
+    }
+    if (bus_off_until_s >= 0.0 && t >= bus_off_until_s) {
+      bus_off_until_s = -1.0;
+      send_error_frame(CAN_ERR_RESTARTED);
+      inject("bus_restarted", t);
+    }
+    if (!hang_done && o.modbus_hang_at_s >= 0.0 && t >= o.modbus_hang_at_s) {
+      hang_done = true;
+      regs.hang();
+      inject("modbus_hang", t);
+    }
+  };
   auto send_sensor = [&]() {
+    faults_at(static_cast<double>(rep.ticks) * dt);
+    if (bus_off_until_s >= 0.0) {  // off the bus: the DAQ's frames do not arrive (the plant goes on)
+      (void)plant.sense();
+      return;
+    }
     const sim::SensorReading s = plant.sense();
     const drivers::Encoded e = drivers::encode(can.sensor, can.fd, s.accel_mps2, sensor_counter++);
     if (channel->send(e.frame, e.frame_bytes) == 0) ++rep.sensor_frames_sent;
@@ -351,6 +393,12 @@ nlohmann::json report_json(const EmulatorReport& r) {
             {"peak_command_v", r.peak_command_v},
             {"peak_temperature_c", r.peak_temperature_c}}},
           {"robot", {{"mounting_changes", r.mounting_changes}}},
+          {"injected", [&r] {
+             json a = json::array();
+             for (const auto& f : r.injected)
+               a.push_back({{"kind", f.kind}, {"plant_time_s", f.plant_time_s}, {"monotonic_ns", f.monotonic_ns}});
+             return a;
+           }()},
           {"modbus_requests", r.modbus_requests},
           {"timing",
            {{"wake_latency", {{"count", h.count()}, {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
@@ -403,6 +451,10 @@ std::string report_text(const EmulatorReport& r) {
                     f.improvement_pct, f.coherence_min);
       os << b;
     }
+  }
+  for (const auto& f : r.injected) {
+    std::snprintf(b, sizeof b, "  injected %s at %.3f s plant time\n", f.kind.c_str(), f.plant_time_s);
+    os << b;
   }
   return os.str();
 }

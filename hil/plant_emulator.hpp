@@ -43,6 +43,13 @@ struct EmulatorOptions {
   // Robot mounting register changes: (plant time s, mounting).
   std::vector<std::pair<double, config::Mounting>> mounting_schedule;
   bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
+  // Faults injected at plant times (s; negative = none), to measure how the controller gets to its safe
+  // state: the CAN bus goes off (an error frame with CAN_ERR_BUSOFF, no sensor frames for bus_off_for_s,
+  // then CAN_ERR_RESTARTED, as a SocketCAN interface with restart-ms reports it), and the Modbus device
+  // stops answering (requests read, never answered, for good).
+  double bus_off_at_s{-1.0};
+  double bus_off_for_s{0.5};
+  double modbus_hang_at_s{-1.0};
   const std::atomic<int>* stop_flag{nullptr};  // SIGINT / SIGTERM
 };
 
@@ -52,6 +59,12 @@ struct FrfReport {
   double closed_peak_m_per_n{0.0}, closed_peak_hz{0.0};
   double improvement_pct{0.0};
   double coherence_min{0.0};
+};
+
+struct InjectedFault {
+  std::string kind;           // "bus_off", "bus_restarted", "modbus_hang"
+  double plant_time_s{0.0};
+  std::int64_t monotonic_ns{0};  // CLOCK_MONOTONIC, comparable with the controller's on the same machine
 };
 
 struct EmulatorReport {
@@ -84,6 +97,7 @@ struct EmulatorReport {
   std::string impact_location;
   std::vector<FrfReport> frfs;
   std::vector<analysis::FrfEstimate> closed_receptance, open_receptance;  // per location
+  std::vector<InjectedFault> injected;
 };
 
 // Serves one controller connection and returns when it disconnects (or max_duration_s, or the stop

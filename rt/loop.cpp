@@ -56,6 +56,7 @@ void Loop::run(std::uint64_t duration_ticks) noexcept {
       std::ceil((sup_.settings().fade_s + sup_.settings().limits.trip_ramp_s + 1.0) / period_s));
   const std::int64_t t0 = now_ns();
   std::int64_t deadline = t0;
+  if (tick_ == 0) st.start_monotonic_ns = t0;
   std::int64_t prev_wake = t0 - period_ns_;
   ActuatorStatus act{};
   bool overrun = false;

@@ -38,6 +38,7 @@ struct LoopStats {
   std::uint64_t ring_drops{0};
   std::uint64_t ring_waits{0};  // virtual clock: times the loop waited for the drain (never drops)
   double elapsed_s{0.0};        // wall time of the run
+  std::int64_t start_monotonic_ns{0};  // CLOCK_MONOTONIC of tick 0's deadline: a frame's time_s after it (wall clock)
   TimingHistogram wake_latency;  // wake-up minus deadline (wall clock)
   TimingHistogram compute;       // wake-up to end of the tick's work
 };

@@ -321,6 +321,8 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   out.command_v = command_v_;
   out.state = state_;
   out.trip = trip_;
+  observed_state_.store(state_, std::memory_order_relaxed);
+  observed_trip_.store(trip_, std::memory_order_relaxed);
   return out;
 }
 

@@ -133,6 +133,10 @@ class Supervisor {
   [[nodiscard]] TickOutput step(const TickInput& in) noexcept;
 
   [[nodiscard]] State state() const noexcept { return state_; }
+  // The state and latched trip after the last step, from any thread (relaxed atomics): for watchers such
+  // as the tests, the operator's view and the run's end; the loop thread uses state().
+  [[nodiscard]] State observed_state() const noexcept { return observed_state_.load(std::memory_order_relaxed); }
+  [[nodiscard]] Trip observed_trip() const noexcept { return observed_trip_.load(std::memory_order_relaxed); }
   [[nodiscard]] Trip latched_trip() const noexcept { return trip_; }
   [[nodiscard]] ArmRefusal last_arm_refusal() const noexcept { return refusal_; }
   [[nodiscard]] const SupervisorCounters& counters() const noexcept { return counters_; }
@@ -160,6 +164,8 @@ class Supervisor {
   SupervisorSettings s_;
   std::vector<ParameterSet> sets_;  // [0]: the set it starts with
   std::atomic<std::size_t> active_set_{0};
+  std::atomic<State> observed_state_{State::kDisabled};
+  std::atomic<Trip> observed_trip_{Trip::kNone};
   control::Controller controller_;
   State state_{State::kDisabled};
   Trip trip_{Trip::kNone};

@@ -1,5 +1,7 @@
 #include "runtime/components.hpp"
 
+#include <unistd.h>
+
 #include <chrono>
 
 #include <spdlog/spdlog.h>
@@ -39,12 +41,51 @@ Status CanBus::on_configure() {
   return {};
 }
 
+CanBus::~CanBus() { stop_reconnecting(); }
+
 Status CanBus::on_activate() {
   // A DAQ streams from power-up: what queued while the controller was starting is not a lost frame.
   if (clock_ == config::ClockKind::kWall) {
     flushed_ = driver_->flush();
     if (flushed_ > 0) spdlog::info("CAN: {} frames queued before the loop started, discarded", flushed_);
   }
+  if (cfg_.interface.rfind("unix:", 0) == 0) {
+    stopping_ = false;
+    reconnect_ = std::thread([this] { reconnect_loop(); });
+  }
+  return {};
+}
+
+void CanBus::reconnect_loop() {
+  const std::string path = cfg_.interface.substr(5);
+  std::unique_lock<std::mutex> lock(m_);
+  while (!cv_.wait_for(lock, std::chrono::milliseconds(20), [this] { return stopping_; })) {
+    if (const int fd = driver_->take_retired_fd(); fd >= 0) ::close(fd);
+    if (!driver_->link_lost()) continue;
+    lock.unlock();
+    try {
+      drivers::CanChannel c = drivers::CanChannel::connect_unix(path, 0.05);
+      if (driver_->offer_channel(std::move(c))) spdlog::warn("CAN: {} reconnected (the trip stays latched until reset)", cfg_.interface);
+    } catch (const std::exception&) {
+      // nobody listening yet: try again at the next round
+    }
+    lock.lock();
+  }
+}
+
+void CanBus::stop_reconnecting() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    stopping_ = true;
+  }
+  cv_.notify_all();
+  if (reconnect_.joinable()) reconnect_.join();
+  if (driver_)
+    if (const int fd = driver_->take_retired_fd(); fd >= 0) ::close(fd);
+}
+
+Status CanBus::on_deactivate() {
+  stop_reconnecting();
   return {};
 }
 

@@ -3,14 +3,18 @@
 //
 //   component          configure                      activate                         deactivate
 //   SimulatedPlant     build the plant and drives     -                                -
-//   CanBus             open the channel, the driver   flush the queue (wall clock) or  -
-//                                                     lockstep wait (virtual clock)
+//   CanBus             open the channel, the driver   flush the queue (wall clock) or  stop reconnecting
+//                                                     lockstep wait (virtual clock);
+//                                                     unix: transport: reconnect thread
 //   ModbusSupervisory  the client, register maps      start polling, wait for the      amplifier enable off,
 //                                                     amplifier's first answer         stop polling
 //   DdsEndpoint        participant and topics         status thread                    last status, stop
 #pragma once
 
+#include <condition_variable>
 #include <functional>
+#include <mutex>
+#include <thread>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,10 +49,14 @@ class SimulatedPlant final : public Component {
   std::unique_ptr<drivers::SimBackend> backend_;
 };
 
-// The CAN bus: the sensor frames in and the amplifier command out.
+// The CAN bus: the sensor frames in and the amplifier command out. On a unix: transport (the HIL
+// emulator) a thread reconnects when the peer has gone and is listening again (an emulator restarted):
+// the driver takes the new connection over at its next read; the supervisor's trip stays latched until
+// an operator resets it.
 class CanBus final : public Component {
  public:
   CanBus(const config::CanConfig& cfg, double rate_hz, config::ClockKind clock, double connect_timeout_s);
+  ~CanBus() override;
   [[nodiscard]] drivers::CanDriver& driver() { return *driver_; }
   [[nodiscard]] bool open() const { return driver_ != nullptr; }
   [[nodiscard]] std::uint64_t flushed_frames() const { return flushed_; }
@@ -56,9 +64,16 @@ class CanBus final : public Component {
  private:
   Status on_configure() override;
   Status on_activate() override;
+  Status on_deactivate() override;
   Status on_cleanup() override;
+  void reconnect_loop();
+  void stop_reconnecting();
   config::CanConfig cfg_;
   double rate_hz_;
+  std::thread reconnect_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool stopping_{false};
   config::ClockKind clock_;
   double connect_timeout_s_;
   std::unique_ptr<drivers::CanDriver> driver_;

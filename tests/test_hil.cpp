@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench_run.hpp"
+#include "cell_util.hpp"
 #include "child_process.hpp"
 #include "test_util.hpp"
 
@@ -32,6 +33,7 @@ namespace robodamp {
 namespace {
 
 using nlohmann::json;
+using test::eventually;
 
 using test::Child;
 
@@ -178,6 +180,159 @@ TEST(Hil, ControllerWithoutTheEmulatorReportsTheTransport) {
   const std::string log = test::read_file(f.run_log);
   EXPECT_NE(log.find("can.sock"), std::string::npos) << log;
   EXPECT_NE(log.find("robodamp plant"), std::string::npos) << log;
+}
+
+// --- Faults across processes: the controller in this process (a runtime::Cell, so the test can reset
+// and re-arm as an operator would), the emulator as a child process. Times are on CLOCK_MONOTONIC, which
+// both processes share: the emulator reports when it injected a fault, the loop when its tick 0 was.
+
+// The shipped trips are tight for a machine both processes share with other jobs: stale 10 ms, no
+// overrun trip from scheduling hiccups. The checks are against what is configured here.
+const std::vector<std::pair<std::string, std::string>> kSharedMachine{
+    {"stale_sensor_cycles: 10", "stale_sensor_cycles: 50\n  overrun_cycles: 1000000"}};
+
+struct FaultRun {
+  config::Config cfg;
+  std::unique_ptr<runtime::Cell> cell;
+  explicit FaultRun(const std::string& config_path) : cfg(config::load_config_file(config_path)) {
+    cfg.dds.reset();  // not this test's subject; other tests use the shipped domain
+    runtime::CellOptions o;
+    o.realtime_setup = false;
+    o.keep_frames = true;
+    o.connect_timeout_s = 30.0;
+    cell = std::make_unique<runtime::Cell>(cfg, o);
+  }
+  bool in(rt::State s) const { return cell->supervisor().observed_state() == s; }
+  double tick_monotonic_s(double loop_time_s) const {
+    return static_cast<double>(cell->summary().loop.start_monotonic_ns) * 1e-9 + loop_time_s;  // after deactivate
+  }
+};
+
+// The first frame at or after `from` with the latched trip, and the first after it that is safe.
+struct TripFrames {
+  std::size_t trip{0}, safe{0};
+};
+TripFrames find_trip(const std::vector<rt::TelemetryFrame>& f, std::size_t from = 0) {
+  TripFrames t{f.size(), f.size()};
+  for (std::size_t i = from; i < f.size() && t.trip == f.size(); ++i)
+    if (f[i].trip != 0) t.trip = i;
+  for (std::size_t i = t.trip; i < f.size(); ++i)
+    if (f[i].command_v == 0.0 && !(f[i].flags & rt::kFlagAmplifierEnable)) return t.safe = i, t;
+  return t;
+}
+
+double injected_at_s(const json& plant_report, const std::string& kind) {
+  for (const auto& f : plant_report["injected"])
+    if (f["kind"] == kind) return f["monotonic_ns"].get<double>() * 1e-9;
+  return -1.0;
+}
+
+TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndRecoversOnlyByAnOperatorReset) {
+  const HilFiles f = hil_files("restart", kSharedMachine);
+  auto plant = std::make_unique<Child>(std::vector<std::string>{"plant", "--config", f.config, "--no-impacts"}, f.plant_log);
+  FaultRun r(f.config);
+  test::configure(*r.cell);
+  ASSERT_TRUE(r.cell->activate(3600.0).ok());
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kActive); }, 60.0)) << test::read_file(f.plant_log);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+
+  plant->kill(SIGKILL);  // the cell's other process dies
+  EXPECT_EQ(plant->wait(), 128 + SIGKILL);
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kFault); }, 30.0));
+  plant = std::make_unique<Child>(std::vector<std::string>{"plant", "--config", f.config, "--no-impacts"}, f.plant_log + "2");
+  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().reconnects >= 1; }, 60.0))
+      << test::read_file(f.plant_log + "2");
+  const auto rx = r.cell->can_driver()->counters().rx_frames;
+  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().rx_frames > rx + 1000; }, 30.0)) << "frames flow again";
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_TRUE(r.in(rt::State::kFault)) << "the trip stays latched with the sensor back";
+
+  ASSERT_TRUE(r.cell->post({rt::CommandKind::kResetFault, 0.0}));
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kDisabled); }, 30.0));
+  ASSERT_TRUE(r.cell->post({rt::CommandKind::kArm, 0.0}));
+  EXPECT_TRUE(eventually([&] { return r.in(rt::State::kActive); }, 60.0)) << "re-armed against the new emulator";
+  ASSERT_TRUE(r.cell->deactivate().ok());
+
+  const auto& frames = r.cell->frames();
+  const TripFrames t = find_trip(frames);
+  ASSERT_LT(t.safe, frames.size());
+  std::size_t last_fresh = t.trip;
+  while (last_fresh > 0 && !(frames[last_fresh].flags & rt::kFlagFresh)) --last_fresh;
+  const std::string trip = rt::to_string(static_cast<rt::Trip>(frames[t.trip].trip));
+  EXPECT_TRUE(trip == "sensor_stale" || trip == "sensor_driver") << trip;
+  const double safe_after_s = frames[t.safe].time_s - frames[last_fresh].time_s;
+  const double allowed_s = r.cfg.supervision.stale_sensor_cycles / r.cfg.loop.rate_hz + r.cfg.supervision.trip_ramp_s +
+                           1.0 / r.cfg.loop.rate_hz;
+  EXPECT_LE(safe_after_s, allowed_s + 1e-9);
+  // Never active between the trip and the operator's arm.
+  std::size_t arm = t.trip;
+  while (arm < frames.size() && frames[arm].command_kind != static_cast<std::uint8_t>(rt::CommandKind::kArm)) ++arm;
+  for (std::size_t i = t.trip; i < arm; ++i) ASSERT_NE(frames[i].state, static_cast<std::uint8_t>(rt::State::kActive)) << i;
+  std::printf("[ hil kill ] emulator killed: trip %s, safe %.1f ms after the last fresh sample (allowed %.1f ms); "
+              "reconnected, reset and re-armed\n",
+              trip.c_str(), 1e3 * safe_after_s, 1e3 * allowed_s);
+}
+
+TEST(HilFaults, CanBusOffTripsToTheSafeStateAtOnce) {
+  const HilFiles f = hil_files("busoff", kSharedMachine);
+  Child plant({"plant", "--config", f.config, "--no-impacts", "--bus-off-at", "6", "--bus-off-for", "0.5", "--json",
+               f.plant_json},
+              f.plant_log);
+  FaultRun r(f.config);
+  test::configure(*r.cell);
+  ASSERT_TRUE(r.cell->activate(3600.0).ok());
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kActive); }, 60.0)) << test::read_file(f.plant_log);
+  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().bus_off >= 1; }, 60.0)) << test::read_file(f.plant_log);
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kFault); }, 30.0));
+  const auto rx = r.cell->can_driver()->counters().rx_frames;
+  EXPECT_TRUE(eventually([&] { return r.cell->can_driver()->counters().rx_frames > rx + 1000; }, 30.0))
+      << "frames again after the restart";
+  ASSERT_TRUE(r.cell->deactivate().ok());
+  ASSERT_TRUE(r.cell->cleanup().ok());  // the emulator sees the controller leave and writes its report
+  ASSERT_EQ(plant.wait_for(60.0), std::optional<int>(0)) << test::read_file(f.plant_log);
+  const json p = read_json(f.plant_json);
+  const double injected_s = injected_at_s(p, "bus_off");
+  ASSERT_GT(injected_s, 0.0) << p.dump();
+  const auto& frames = r.cell->frames();
+  const TripFrames t = find_trip(frames);
+  ASSERT_LT(t.safe, frames.size());
+  EXPECT_EQ(rt::to_string(static_cast<rt::Trip>(frames[t.trip].trip)), std::string("sensor_driver"));
+  const double trip_after_s = r.tick_monotonic_s(frames[t.trip].time_s) - injected_s;
+  const double safe_after_s = r.tick_monotonic_s(frames[t.safe].time_s) - injected_s;
+  // The error frame is read at the next tick; the ramp takes trip_ramp_s. Scheduling on a shared
+  // machine adds its latency to both processes' clocks: 20 ms of slack.
+  EXPECT_LE(safe_after_s, r.cfg.supervision.trip_ramp_s + 0.020);
+  std::printf("[ hil bus  ] bus-off: trip %.1f ms, safe %.1f ms after the error frame was sent\n", 1e3 * trip_after_s,
+              1e3 * safe_after_s);
+}
+
+TEST(HilFaults, ModbusHangingDuringARunTripsOnTheAmplifierStatus) {
+  const HilFiles f = hil_files("modbushang", kSharedMachine);
+  Child plant({"plant", "--config", f.config, "--no-impacts", "--modbus-hang-at", "6", "--json", f.plant_json}, f.plant_log);
+  FaultRun r(f.config);
+  test::configure(*r.cell);
+  ASSERT_TRUE(r.cell->activate(3600.0).ok());
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kActive); }, 60.0)) << test::read_file(f.plant_log);
+  ASSERT_TRUE(eventually([&] { return r.in(rt::State::kFault); }, 60.0)) << test::read_file(f.plant_log);
+  ASSERT_TRUE(r.cell->deactivate().ok());
+  ASSERT_TRUE(r.cell->cleanup().ok());
+  ASSERT_EQ(plant.wait_for(60.0), std::optional<int>(0)) << test::read_file(f.plant_log);
+  const json p = read_json(f.plant_json);
+  const double injected_s = injected_at_s(p, "modbus_hang");
+  ASSERT_GT(injected_s, 0.0) << p.dump();
+  const auto& frames = r.cell->frames();
+  const TripFrames t = find_trip(frames);
+  ASSERT_LT(t.safe, frames.size());
+  EXPECT_EQ(rt::to_string(static_cast<rt::Trip>(frames[t.trip].trip)), std::string("amplifier_fault"));
+  const double trip_after_s = r.tick_monotonic_s(frames[t.trip].time_s) - injected_s;
+  const double safe_after_s = r.tick_monotonic_s(frames[t.safe].time_s) - injected_s;
+  // Unknown for link_timeout_s after the last good poll (at most one poll period before the hang), then
+  // the ramp: link_timeout + poll period + trip_ramp, and the same 20 ms of slack.
+  const auto& m = *r.cfg.modbus;
+  EXPECT_LE(safe_after_s, m.link_timeout_s + m.poll_period_s + r.cfg.supervision.trip_ramp_s + 0.020);
+  std::printf("[ hil mb   ] Modbus hang: trip %.1f ms, safe %.1f ms after the device stopped answering "
+              "(link_timeout_s %.0f ms)\n",
+              1e3 * trip_after_s, 1e3 * safe_after_s, 1e3 * m.link_timeout_s);
 }
 
 }  // namespace
