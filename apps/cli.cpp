@@ -35,6 +35,7 @@ CLI::Option* Registry::text_option(CLI::App* sub, const std::string& flag, const
   texts_.emplace_back();
   std::vector<std::string>& texts = texts_.back();
   CLI::Option* opt = sub->add_option(flag, texts, help);
+  opt->type_name("NUMBER");
   if (!many) opt->expected(1);
   return opt;
 }
@@ -43,63 +44,45 @@ namespace {
 std::string first_name(const CLI::Option* opt) { return opt->get_name(false, true).substr(0, opt->get_name(false, true).find(',')); }
 }  // namespace
 
-CLI::Option* Registry::number(CLI::App* sub, const std::string& flag, double& target, const config::Range& range,
-                              const std::string& help) {
-  CLI::Option* opt = text_option(sub, flag, help, false);
+CLI::Option* Registry::scalar(CLI::App* sub, const std::string& flag, const config::Range& range, bool whole,
+                              const std::string& help, std::function<void(double)> assign) {
+  CLI::Option* opt = text_option(sub, flag, help + " [" + config::describe_range(range) + "]", false);
   const std::vector<std::string>& texts = texts_.back();
-  opt->default_str(config::format_number(target));
-  checks_.push_back({sub, [opt, &texts, &target, range] {
-                       return texts.empty() ? std::nullopt : parse_number(first_name(opt), texts.back(), range, false, target);
+  checks_.push_back({sub, [opt, &texts, range, whole, assign = std::move(assign)]() -> std::optional<std::string> {
+                       if (texts.empty()) return std::nullopt;
+                       double v = 0.0;
+                       if (auto p = parse_number(first_name(opt), texts.back(), range, whole, v)) return p;
+                       assign(v);
+                       return std::nullopt;
                      }});
   return opt;
+}
+
+CLI::Option* Registry::number(CLI::App* sub, const std::string& flag, double& target, const config::Range& range,
+                              const std::string& help) {
+  return scalar(sub, flag, range, false, help, [&target](double v) { target = v; })
+      ->default_str(config::format_number(target));
 }
 
 CLI::Option* Registry::number(CLI::App* sub, const std::string& flag, std::optional<double>& target,
                               const config::Range& range, const std::string& help) {
-  CLI::Option* opt = text_option(sub, flag, help, false);
-  const std::vector<std::string>& texts = texts_.back();
-  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
-                       if (texts.empty()) return std::nullopt;
-                       double v = 0.0;
-                       if (auto p = parse_number(first_name(opt), texts.back(), range, false, v)) return p;
-                       target = v;
-                       return std::nullopt;
-                     }});
-  return opt;
+  return scalar(sub, flag, range, false, help, [&target](double v) { target = v; });
 }
 
 CLI::Option* Registry::whole_number(CLI::App* sub, const std::string& flag, int& target, const config::Range& range,
                                     const std::string& help) {
-  CLI::Option* opt = text_option(sub, flag, help, false);
-  const std::vector<std::string>& texts = texts_.back();
-  opt->default_str(std::to_string(target));
-  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
-                       if (texts.empty()) return std::nullopt;
-                       double v = 0.0;
-                       if (auto p = parse_number(first_name(opt), texts.back(), range, true, v)) return p;
-                       target = static_cast<int>(v);
-                       return std::nullopt;
-                     }});
-  return opt;
+  return scalar(sub, flag, range, true, help, [&target](double v) { target = static_cast<int>(v); })
+      ->default_str(std::to_string(target));
 }
 
 CLI::Option* Registry::whole_number(CLI::App* sub, const std::string& flag, std::optional<int>& target,
                                     const config::Range& range, const std::string& help) {
-  CLI::Option* opt = text_option(sub, flag, help, false);
-  const std::vector<std::string>& texts = texts_.back();
-  checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
-                       if (texts.empty()) return std::nullopt;
-                       double v = 0.0;
-                       if (auto p = parse_number(first_name(opt), texts.back(), range, true, v)) return p;
-                       target = static_cast<int>(v);
-                       return std::nullopt;
-                     }});
-  return opt;
+  return scalar(sub, flag, range, true, help, [&target](double v) { target = static_cast<int>(v); });
 }
 
 CLI::Option* Registry::numbers(CLI::App* sub, const std::string& flag, std::vector<double>& target,
                                const config::Range& range, const std::string& help) {
-  CLI::Option* opt = text_option(sub, flag, help, true);
+  CLI::Option* opt = text_option(sub, flag, help + " [" + config::describe_range(range) + "]", true);
   const std::vector<std::string>& texts = texts_.back();
   checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
                        for (const auto& t : texts) {

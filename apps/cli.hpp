@@ -50,6 +50,8 @@ class Registry {
     std::function<std::optional<std::string>()> problem;  // parses the text into its target
   };
   CLI::Option* text_option(CLI::App* sub, const std::string& flag, const std::string& help, bool many);
+  CLI::Option* scalar(CLI::App* sub, const std::string& flag, const config::Range& range, bool whole,
+                      const std::string& help, std::function<void(double)> assign);
   CLI::App& app_;
   std::vector<std::pair<CLI::App*, std::function<int()>>> handlers_;
   std::vector<Check> checks_;
