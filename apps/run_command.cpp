@@ -86,7 +86,8 @@ struct RunArgs {
   auto t = [](double v) { return v >= 0.0 ? json(v) : json(nullptr); };
   j["trip_timing"] = {{"last_fresh_s", t(s.trip_timing.last_fresh_s)},
                       {"trip_s", t(s.trip_timing.trip_s)},
-                      {"safe_s", t(s.trip_timing.safe_s)}};
+                      {"safe_s", t(s.trip_timing.safe_s)},
+                      {"ticks_to_safe", s.trip_timing.ticks_to_safe >= 0 ? json(s.trip_timing.ticks_to_safe) : json(nullptr)}};
   if (s.can) {
     const auto& c = *s.can;
     j["can"] = {{"rx_frames", c.rx_frames},       {"rx_other", c.rx_other},     {"rx_malformed", c.rx_malformed},

@@ -154,10 +154,13 @@ void Cell::on_frame(const rt::TelemetryFrame& f) {
   if (std::isfinite(f.accel_mps2)) sum_sq_ += f.accel_mps2 * f.accel_mps2, ++n_samples_;
   summary_.peak_command_v = std::max(summary_.peak_command_v, std::abs(f.command_v));
   TripTiming& tt = summary_.trip_timing;
-  if (tt.trip_s < 0.0 && (f.flags & rt::kFlagFresh)) tt.last_fresh_s = f.time_s;
+  if (tt.trip_s < 0.0 && (f.flags & rt::kFlagFresh)) tt.last_fresh_s = f.time_s, last_fresh_frame_ = n_frames_;
   if (tt.trip_s < 0.0 && f.trip != 0) tt.trip_s = f.time_s;
-  if (tt.trip_s >= 0.0 && tt.safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable))
+  if (tt.trip_s >= 0.0 && tt.safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable)) {
     tt.safe_s = f.time_s;
+    tt.ticks_to_safe = n_frames_ - last_fresh_frame_;
+  }
+  ++n_frames_;
   if (o_.keep_frames) frames_.push_back(f);
 }
 
@@ -178,6 +181,8 @@ Status Cell::activate(double duration_s) {
   summary_.arming.deadline_s = cfg_.supervision.arm_deadline_s;
   sum_sq_ = 0.0;
   n_samples_ = 0;
+  n_frames_ = 0;
+  last_fresh_frame_ = -1;
   frames_.clear();
   const bool wall = cfg_.loop.clock == config::ClockKind::kWall;
   if (o_.impact_every_s > 0.0 && sim_) {

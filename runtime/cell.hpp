@@ -130,6 +130,7 @@ class Cell {
   RunSummary summary_;
   double sum_sq_{0.0};
   std::uint64_t n_samples_{0};
+  std::int64_t n_frames_{0}, last_fresh_frame_{-1};
   std::vector<rt::TelemetryFrame> frames_;
 };
 

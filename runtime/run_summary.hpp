@@ -21,6 +21,9 @@ struct TripTiming {
   double last_fresh_s{-1.0};  // the last fresh sensor sample before the trip
   double trip_s{-1.0};        // the first tick with a latched trip
   double safe_s{-1.0};        // the first tick after it with zero command and the amplifier enable off
+  // Ticks the loop ran from the last fresh sample to safe: what the supervisor bounds (stale_sensor_cycles
+  // + the trip ramp); in time it is longer by any ticks a loaded machine made the loop skip.
+  std::int64_t ticks_to_safe{-1};
 };
 
 struct ArmingReport {

@@ -92,7 +92,7 @@ struct Client {
       for (const auto& rep : replies.all())
         if (rep.request_id() == id) return true;
       return false;
-    }));
+    }, 60.0));
     for (const auto& rep : replies.all())
       if (rep.request_id() == id) return rep;
     return {};
@@ -114,7 +114,7 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
                       }});
   bridge.start();
   Client client(cfg.domain_id);
-  ASSERT_TRUE(eventually([&] { return client.matched(); }));
+  ASSERT_TRUE(eventually([&] { return client.matched(); }, 60.0));
   // One second of loop frames: a 2 m/s^2 square wave's RMS, 3 ticks in 10 saturated, state active.
   for (std::uint64_t k = 0; k < 5000; ++k) {
     rt::TelemetryFrame f;
@@ -130,12 +130,16 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
     bridge.on_frame(f);
     if (k % 50 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  ASSERT_TRUE(eventually([&] { return client.telemetry.size() >= 90; }));  // best effort: 100 sent
+  // Best effort: 100 windows sent; on a loaded machine the subscriber's socket may drop some, and this
+  // test is about what a sample says, not about UDP under load.
+  EXPECT_EQ(bridge.counters().telemetry, 100U);
+  ASSERT_TRUE(eventually([&] { return client.telemetry.size() >= 1; }, 60.0));
+  EXPECT_LE(client.telemetry.size(), 100U);
   const auto t = client.telemetry.last();
   EXPECT_NEAR(t.accel_rms_mps2(), 2.0, 1e-12);
   EXPECT_NEAR(t.saturated_fraction(), 0.3, 1e-6);
   EXPECT_DOUBLE_EQ(t.gain_ns_per_m(), 2000.0);
-  ASSERT_TRUE(eventually([&] { return client.status.size() > 0 && client.status.last().tick() == 4999; }));
+  ASSERT_TRUE(eventually([&] { return client.status.size() > 0 && client.status.last().tick() == 4999; }, 60.0));
   const auto s = client.status.last();
   EXPECT_EQ(std::string(s.state()), "active");
   EXPECT_EQ(std::string(s.trip()), "none");
