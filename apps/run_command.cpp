@@ -110,6 +110,46 @@ struct RunArgs {
   return j;
 }
 
+// The hardware devices' counters (CAN, Modbus, DDS), a line each.
+[[nodiscard]] std::string devices_text(const runtime::RunSummary& s) {
+  std::ostringstream os;
+  char b[512];
+  if (s.can) {
+    const auto& c = *s.can;
+    std::snprintf(b, sizeof b,
+                  "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
+                  "%llu bus-off, %llu held over / %llu skipped (de-jitter), %llu reconnects; %llu commands sent (%llu queue full, "
+                  "%llu errors, %llu skipped)\n",
+                  static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
+                  static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
+                  static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
+                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
+                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.reconnects),
+                  static_cast<unsigned long long>(c.tx_frames),
+                  static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
+                  static_cast<unsigned long long>(c.tx_skipped));
+    os << b;
+  }
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    std::snprintf(b, sizeof b,
+                  "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
+                  "%llu link faults, %llu mounting changes\n",
+                  static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
+                  static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
+                  static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
+                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes));
+    os << b;
+  }
+  if (s.dds) {
+    std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
+                  static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
+                  static_cast<unsigned long long>(s.dds->requests), static_cast<unsigned long long>(s.dds->refused));
+    os << b;
+  }
+  return os.str();
+}
+
 [[nodiscard]] std::string summary_text(const runtime::RunSummary& s) {
   std::ostringstream os;
   char b[256];
@@ -166,42 +206,11 @@ struct RunArgs {
     os << "; recorded " << s.recorded_frames << " frames to " << s.record_path
        << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
   os << '\n';
-  if (s.can) {
-    const auto& c = *s.can;
-    std::snprintf(b, sizeof b,
-                  "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
-                  "%llu bus-off, %llu held over / %llu skipped (de-jitter), %llu reconnects; %llu commands sent (%llu queue full, "
-                  "%llu errors, %llu skipped)\n",
-                  static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
-                  static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
-                  static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
-                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
-                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.reconnects),
-                  static_cast<unsigned long long>(c.tx_frames),
-                  static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
-                  static_cast<unsigned long long>(c.tx_skipped));
-    os << b;
-  }
-  if (s.modbus) {
-    const auto& m = *s.modbus;
-    std::snprintf(b, sizeof b,
-                  "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
-                  "%llu link faults, %llu mounting changes\n",
-                  static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
-                  static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
-                  static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
-                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes));
-    os << b;
-  }
-  if (s.dds) {
-    std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
-                  static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
-                  static_cast<unsigned long long>(s.dds->requests), static_cast<unsigned long long>(s.dds->refused));
-    os << b;
-  }
+  os << devices_text(s);
   if (s.trip_timing.trip_s >= 0.0) {
-    std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s\n", s.trip_timing.trip_s,
-                  s.trip_timing.last_fresh_s, s.trip_timing.safe_s);
+    std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s (%lld ticks after it)\n",
+                  s.trip_timing.trip_s, s.trip_timing.last_fresh_s, s.trip_timing.safe_s,
+                  static_cast<long long>(s.trip_timing.ticks_to_safe));
     os << b;
   }
   if (!s.realtime.warnings.empty())
