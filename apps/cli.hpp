@@ -42,8 +42,6 @@ class Registry {
   // The handler of the subcommand that was given.
   [[nodiscard]] int run_parsed() const;
 
-  CLI::App& app() { return app_; }
-
  private:
   struct Check {
     const CLI::App* sub;

@@ -58,8 +58,6 @@ class CanBus final : public Component {
   CanBus(const config::CanConfig& cfg, double rate_hz, config::ClockKind clock, double connect_timeout_s);
   ~CanBus() override;
   [[nodiscard]] drivers::CanDriver& driver() { return *driver_; }
-  [[nodiscard]] bool open() const { return driver_ != nullptr; }
-  [[nodiscard]] std::uint64_t flushed_frames() const { return flushed_; }
 
  private:
   Status on_configure() override;
@@ -86,7 +84,6 @@ class ModbusSupervisory final : public Component {
   ModbusSupervisory(const config::ModbusConfig& cfg, config::Mounting initial,
                     drivers::ModbusSupervisor::MountingCallback on_mounting, double connect_timeout_s);
   [[nodiscard]] drivers::ModbusSupervisor& client() { return *client_; }
-  [[nodiscard]] bool amplifier_answered() const { return answered_; }
 
  private:
   Status on_configure() override;
