@@ -4,8 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <unsupported/Eigen/FFT>
-
 namespace robodamp::analysis {
 
 FrfAccumulator::FrfAccumulator(std::size_t segment_samples, double fs_hz, int zero_pad, Window window, double max_hz,
@@ -19,28 +17,30 @@ FrfAccumulator::FrfAccumulator(std::size_t segment_samples, double fs_hz, int ze
   sxy_.assign(outputs, std::vector<std::complex<double>>(bins_, 0.0));
   sxx_.assign(bins_, 0.0);
   syy_.assign(outputs, std::vector<double>(bins_, 0.0));
+  fft_ = std::make_unique<RealFft>(nfft_);
+  fx_.assign(bins_, 0.0);
+  fy_.assign(bins_, 0.0);
 }
 
-std::vector<std::complex<double>> FrfAccumulator::spectrum(const std::vector<double>& v) const {
-  if (v.size() != n_) throw std::invalid_argument("FrfAccumulator::add: segment length mismatch");
-  std::vector<double> b(nfft_, 0.0);
-  for (std::size_t i = 0; i < n_; ++i) b[i] = v[i] * window_[i];
-  Eigen::FFT<double> fft;
-  std::vector<std::complex<double>> out;
-  fft.fwd(out, b);
-  out.resize(bins_);
-  return out;
+void FrfAccumulator::spectrum(const std::vector<double>& v, std::vector<std::complex<double>>& out) {
+  double* in = fft_->input();  // samples n_.. stay zero (the padding)
+  for (std::size_t i = 0; i < n_; ++i) in[i] = v[i] * window_[i];
+  const std::complex<double>* x = fft_->forward();
+  std::copy(x, x + bins_, out.begin());
 }
 
 void FrfAccumulator::add(const std::vector<double>& x, const std::vector<std::vector<double>>& ys) {
   if (ys.size() != sxy_.size()) throw std::invalid_argument("FrfAccumulator::add: wrong number of outputs");
-  const auto fx = spectrum(x);
-  for (std::size_t k = 0; k < bins_; ++k) sxx_[k] += std::norm(fx[k]);
+  if (x.size() != n_) throw std::invalid_argument("FrfAccumulator::add: segment length mismatch");
+  for (const auto& y : ys)
+    if (y.size() != n_) throw std::invalid_argument("FrfAccumulator::add: segment length mismatch");
+  spectrum(x, fx_);
+  for (std::size_t k = 0; k < bins_; ++k) sxx_[k] += std::norm(fx_[k]);
   for (std::size_t o = 0; o < ys.size(); ++o) {
-    const auto fy = spectrum(ys[o]);
+    spectrum(ys[o], fy_);
     for (std::size_t k = 0; k < bins_; ++k) {
-      sxy_[o][k] += std::conj(fx[k]) * fy[k];
-      syy_[o][k] += std::norm(fy[k]);
+      sxy_[o][k] += std::conj(fx_[k]) * fy_[k];
+      syy_[o][k] += std::norm(fy_[k]);
     }
   }
   ++averages_;

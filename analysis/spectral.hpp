@@ -2,12 +2,15 @@
 // spectrum) with ordinary coherence, averaged over segments. Segments are either whole impact records
 // (rectangular window, zero-padded: a record whose response has decayed is transformed exactly, so the
 // padding interpolates the true FRF between the 1/T bins) or Welch's overlapping Hann segments of a
-// long record. Off the real-time path; FFTs by Eigen's FFT module (kissfft).
+// long record. Off the real-time path; real-input FFTs by FFTW (analysis/fft.hpp), one plan per accumulator.
 #pragma once
 
 #include <complex>
 #include <cstddef>
+#include <memory>
 #include <vector>
+
+#include "analysis/fft.hpp"
 
 namespace robodamp::analysis {
 
@@ -36,8 +39,11 @@ class FrfAccumulator {
   [[nodiscard]] int averages() const { return averages_; }
 
  private:
-  std::vector<std::complex<double>> spectrum(const std::vector<double>& v) const;
+  // The first bins_ bins of the windowed, zero-padded segment's transform, into out.
+  void spectrum(const std::vector<double>& v, std::vector<std::complex<double>>& out);
   std::size_t n_, nfft_, bins_;
+  std::unique_ptr<RealFft> fft_;  // planned once
+  std::vector<std::complex<double>> fx_, fy_;
   double fs_hz_;
   std::vector<double> window_;
   std::vector<std::vector<std::complex<double>>> sxy_;
