@@ -1,6 +1,8 @@
 // Simulated seconds per wall second of the bench's closed loop on the default preset: the simulated
-// plant (exact ZOH, 4x oversampling, delayed actuator, control accelerometer with noise, the 3 Hz drive
-// vibration) and the real-time Controller, one loop tick per iteration, one core.
+// plant (exact ZOH in modal block form, delayed actuator, control accelerometer with noise, the 3 Hz drive
+// vibration) and the real-time Controller, one loop tick per iteration, one core; at oversampling 1 (the
+// preset) and 4. Beside it, the plant alone (a fixed command sequence instead of the controller), with and
+// without the sensor's noise generator, to show where a tick's time goes (README: plant speed).
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -20,6 +22,41 @@ config::Config preset(int oversampling) {
   return c;
 }
 
+void set_counters(benchmark::State& state, const config::Config& cfg, const sim::Plant& plant, int ticks) {
+  state.SetItemsProcessed(state.iterations() * ticks);
+  // Simulated seconds per wall second = ticks per second / loop rate.
+  state.counters["x_real_time"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * ticks / cfg.loop.rate_hz, benchmark::Counter::kIsRate);
+  state.counters["states"] = static_cast<double>(plant.state_count());
+}
+
+// The plant alone: sense and step with a command that does not depend on the reading.
+void plant_alone(benchmark::State& state, config::Config cfg) {
+  const analysis::LoopModel model(cfg);
+  sim::Plant plant(model.plant(), cfg);
+  plant.add_excitation(sim::make_drive_vibration(model.plant(), cfg));
+  const int ticks = 5000;
+  double sum = 0.0;
+  for (auto _ : state) {
+    for (int k = 0; k < ticks; ++k) {
+      sum += plant.sense().accel_mps2;
+      plant.step(0.5 * static_cast<double>((k >> 6) & 1));
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  set_counters(state, cfg, plant, ticks);
+}
+
+void BM_PlantAlone(benchmark::State& state) { plant_alone(state, preset(static_cast<int>(state.range(0)))); }
+BENCHMARK(BM_PlantAlone)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_PlantAloneNoiseless(benchmark::State& state) {
+  config::Config cfg = preset(static_cast<int>(state.range(0)));
+  cfg.sensor.noise_density_ug_per_rthz = 0.0;
+  plant_alone(state, cfg);
+}
+BENCHMARK(BM_PlantAloneNoiseless)->Arg(1)->Unit(benchmark::kMillisecond);
+
 void BM_PlantAndController(benchmark::State& state) {
   const config::Config cfg = preset(static_cast<int>(state.range(0)));
   const analysis::LoopModel model(cfg);
@@ -36,11 +73,7 @@ void BM_PlantAndController(benchmark::State& state) {
     }
     benchmark::DoNotOptimize(command);
   }
-  state.SetItemsProcessed(state.iterations() * ticks);
-  // Simulated seconds per wall second = ticks per second / loop rate.
-  state.counters["x_real_time"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * ticks / cfg.loop.rate_hz, benchmark::Counter::kIsRate);
-  state.counters["states"] = static_cast<double>(plant.state_count());
+  set_counters(state, cfg, plant, ticks);
 }
 BENCHMARK(BM_PlantAndController)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 

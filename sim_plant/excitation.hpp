@@ -45,7 +45,9 @@ class Sine final : public Excitation {
 
  private:
   double amplitude_n_, w_, phase_;
-  double end_t_{-1.0}, end_cos_{0.0};  // cos at the end of the last step, reused as the next start
+  double end_t_{-1.0}, end_cos_{0.0}, end_sin_{0.0};  // phase at the end of the last step: the next start
+  double step_h_s_{0.0}, rot_cos_{1.0}, rot_sin_{0.0};  // rotation of the phase by one step
+  int steps_{0};                                        // steps since the phase was evaluated exactly
 };
 
 // Linear sine sweep f0 -> f1 over duration_s, then silent (sampled at step mid-points).

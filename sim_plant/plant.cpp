@@ -14,28 +14,22 @@ Plant::Plant(PlantModel model, const config::Config& cfg)
       sensor_(cfg.sensor, cfg.loop.rate_hz, cfg.disturbances.seed * 0x9E3779B97F4A7C15ULL + 1),
       sensor_loc_(model_.index_of(cfg.sensor.location)) {
   const Matrix& b = model_.ss.b;
-  const Eigen::Index nu = b.cols(), n = model_.ss.a.rows(), nl = nu - 1;
+  const Eigen::Index nu = b.cols(), nl = nu - 1;
   // The coil drive is delayed (Eq. 3's t_a); the external forces are not.
   zoh_ = discretise_zoh_delayed(model_.ss.a, b.leftCols(1), h_s_, model_.actuator.delay_s);
   const Zoh forces = discretise_zoh(model_.ss.a, b.rightCols(nl), h_s_);
-  Matrix step(n, n + 2 + nl);
-  step << zoh_.phi, zoh_.gamma_late, zoh_.gamma_early, forces.gamma;
-  Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> pattern(n, n + 2 + nl);
-  pattern.setConstant(true);
-  pattern.leftCols(n) = model_.pattern;  // exact zeros of e^{Ah} stay zeros
-  step_ = SparseRows(step, &pattern);
-  c_ = SparseRows(model_.ss.c);
-  d_ = SparseRows(model_.ss.d);
-  n_ = static_cast<std::size_t>(n);
-  z_.assign(n_ + 2 + static_cast<std::size_t>(nl), 0.0);
-  x_next_.assign(n_, 0.0);
+  step_ = ModalStep(model_.ss, zoh_, forces.gamma);
+  nominal_limit_v_ = model_.actuator.force_limit_n / model_.actuator.constant_n_per_v;
+  inv_oversampling_ = 1.0 / oversampling_;
+  force_.assign(static_cast<std::size_t>(nl), 0.0);
   u_.assign(static_cast<std::size_t>(nu), 0.0);
   coil_history_.assign(static_cast<std::size_t>(zoh_.steps) + 2, 0.0);
   period_force_.assign(model_.locations.size(), 0.0);
 }
 
 void Plant::reset() {
-  std::fill(z_.begin(), z_.end(), 0.0);
+  step_.reset();
+  std::fill(force_.begin(), force_.end(), 0.0);
   std::fill(u_.begin(), u_.end(), 0.0);
   std::fill(coil_history_.begin(), coil_history_.end(), 0.0);
   std::fill(period_force_.begin(), period_force_.end(), 0.0);
@@ -46,15 +40,13 @@ void Plant::reset() {
   sensor_.reset();
 }
 
-std::size_t Plant::nonzeros_per_step() const { return step_.nonzeros(); }
-
 void Plant::step(double drive_v) noexcept {
   const std::size_t nl = model_.locations.size();
   const std::size_t hist = coil_history_.size();
   const auto delay = static_cast<std::size_t>(zoh_.steps);
-  double* force = z_.data() + n_ + 2;
-  std::fill(period_force_.begin(), period_force_.end(), 0.0);
-  std::fill(period_excitation_force_.begin(), period_excitation_force_.end(), 0.0);
+  double* force = force_.data();
+  for (double& f : period_force_) f = 0.0;
+  for (double& f : period_excitation_force_) f = 0.0;
   // Amplifier voltage range, then the actuator's coil force limit (faults may lower it to zero).
   double v = std::isfinite(drive_v) ? drive_v : 0.0;
   bool clipped = false;
@@ -62,7 +54,9 @@ void Plant::step(double drive_v) noexcept {
   for (int i = 0; i < oversampling_; ++i) {
     const double t = static_cast<double>(internal_steps_) * h_s_;
     double vi = v;
-    const double limit_v = faults_.actuator_force_limit_n(t, model_.actuator.force_limit_n) / model_.actuator.constant_n_per_v;
+    const double limit_v = faults_.empty() ? nominal_limit_v_
+                                           : faults_.actuator_force_limit_n(t, model_.actuator.force_limit_n) /
+                                                 model_.actuator.constant_n_per_v;
     if (std::abs(vi) > limit_v) {
       vi = std::copysign(limit_v, vi);
       ++counters_.force_limited;
@@ -73,8 +67,6 @@ void Plant::step(double drive_v) noexcept {
     const std::size_t late = history_pos_ >= delay ? history_pos_ - delay : history_pos_ + hist - delay;
     const std::size_t early = late == 0 ? hist - 1 : late - 1;
     if (++history_pos_ == hist) history_pos_ = 0;
-    z_[n_] = coil_history_[late];
-    z_[n_ + 1] = coil_history_[early];
     for (std::size_t l = 0; l < nl; ++l) force[l] = 0.0;
     for (std::size_t e = 0; e < excitations_.size(); ++e) {
       const double f = excitations_[e]->force_n(t, h_s_);
@@ -82,15 +74,13 @@ void Plant::step(double drive_v) noexcept {
       period_excitation_force_[e] += f;
     }
     for (std::size_t l = 0; l < nl; ++l) period_force_[l] += force[l];
-    step_.apply(z_.data(), x_next_.data());
-    std::copy(x_next_.begin(), x_next_.end(), z_.begin());
+    step_.advance(coil_history_[late], coil_history_[early], force);
+    u_[0] = coil_history_[late];
     ++internal_steps_;
   }
-  const double inv = 1.0 / oversampling_;
-  for (auto& f : period_force_) f *= inv;
-  for (auto& f : period_excitation_force_) f *= inv;
+  for (auto& f : period_force_) f *= inv_oversampling_;
+  for (auto& f : period_excitation_force_) f *= inv_oversampling_;
   // Left limits at the end of the period: the inputs of the last internal step.
-  u_[0] = z_[n_];
   for (std::size_t l = 0; l < nl; ++l) u_[1 + l] = force[l];
   ++counters_.steps;
 }

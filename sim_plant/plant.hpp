@@ -11,6 +11,7 @@
 #include "config/config.hpp"
 #include "sim_plant/excitation.hpp"
 #include "sim_plant/faults.hpp"
+#include "sim_plant/modal_step.hpp"
 #include "sim_plant/plant_model.hpp"
 #include "sim_plant/sensor.hpp"
 #include "sim_plant/state_space.hpp"
@@ -67,24 +68,25 @@ class Plant {
   [[nodiscard]] const DelayedZoh& discretisation() const { return zoh_; }
   [[nodiscard]] Accelerometer& sensor() { return sensor_; }
   [[nodiscard]] std::size_t sensor_location() const { return sensor_loc_; }
-  [[nodiscard]] std::size_t state_count() const { return n_; }
-  [[nodiscard]] std::size_t nonzeros_per_step() const;
+  [[nodiscard]] std::size_t state_count() const { return step_.states(); }
+  [[nodiscard]] std::size_t mode_blocks() const { return step_.mode_blocks(); }
+  // The state in PlantModel::ss's order (tests; allocates).
+  [[nodiscard]] Vector state() const { return step_.state(); }
 
  private:
-  [[nodiscard]] double output(std::size_t row) const noexcept {
-    return c_.row_dot(row, z_.data()) + d_.row_dot(row, u_.data());
-  }
+  [[nodiscard]] double output(std::size_t row) const noexcept { return step_.output(row, u_.data()); }
   PlantModel model_;
   double period_s_;
   int oversampling_;
   double h_s_;
+  double inv_oversampling_{1.0};
+  double nominal_limit_v_{0.0};  // the actuator's force limit as coil voltage, V
   DelayedZoh zoh_;
-  // One product per internal step: x[k+1] = [phi, gamma_late, gamma_early, gamma_force] z with
-  // z = [x; coil drive u[k-d]; u[k-d-1]; forces].
-  SparseRows step_;
-  SparseRows c_, d_;
-  std::size_t n_{0};
-  std::vector<double> z_, x_next_, u_;  // u_: inputs of the last internal step (for the left limits)
+  // One internal step in modal block form: x[k+1] = phi x + gamma_late u[k-d] + gamma_early u[k-d-1]
+  // + gamma_force f[k].
+  ModalStep step_;
+  std::vector<double> force_;  // external force per location over the current internal step, N
+  std::vector<double> u_;      // inputs of the last internal step (for the left limits)
   std::vector<double> coil_history_;  // delay line of the coil drive at the internal rate
   std::size_t history_pos_{0};
   std::vector<double> period_force_;

@@ -130,10 +130,27 @@ PlantModel build_plant_model(const config::Config& cfg) {
                               " (nor its reciprocal): the loop cannot close");
   if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
 
-  // One state-space: actuator proof mass [p, p'] first, then [q, q'] per mode of every path.
-  std::size_t modes = 0;
-  for (const auto& p : m.paths) modes += p.modes.size();
-  const Eigen::Index n = static_cast<Eigen::Index>(2 + 2 * modes);
+  // One state-space: actuator proof mass [p, p'] first, then [q, q'] per mode block. A mode block is one
+  // (excitation location, natural frequency, damping) triple: paths excited at the same location that
+  // share a mode share its block and differ only in their output weights (a, b), so the realisation has
+  // no repeated block (docs/simulation.md). The transfer functions are the same as with one block per
+  // path and mode.
+  struct Block {
+    std::size_t excitation;
+    double wn, zeta;
+  };
+  std::vector<Block> blocks;
+  std::vector<std::vector<std::size_t>> block_of(m.paths.size());  // [path][mode]
+  for (std::size_t pi = 0; pi < m.paths.size(); ++pi)
+    for (const auto& mode : m.paths[pi].modes) {
+      std::size_t k = 0;
+      while (k < blocks.size() && !(blocks[k].excitation == m.paths[pi].excitation &&
+                                    blocks[k].wn == mode.wn_rad_per_s && blocks[k].zeta == mode.damping_ratio))
+        ++k;
+      if (k == blocks.size()) blocks.push_back({m.paths[pi].excitation, mode.wn_rad_per_s, mode.damping_ratio});
+      block_of[pi].push_back(k);
+    }
+  const Eigen::Index n = static_cast<Eigen::Index>(2 + 2 * blocks.size());
   const Eigen::Index nl = static_cast<Eigen::Index>(m.locations.size());
   Matrix a = Matrix::Zero(n, n), b = Matrix::Zero(n, 1 + nl), cx = Matrix::Zero(nl, n);
   const double wa = kTwoPi * ac.natural_freq_hz, za = ac.damping_ratio, t = ac.constant_n_per_v;
@@ -143,22 +160,24 @@ PlantModel build_plant_model(const config::Config& cfg) {
   b(1, 0) = 1.0;
   // Eq. 3: F = T s^2 / (s^2 + 2 za wa s + wa^2) V = T (V - 2 za wa p' - wa^2 p).
   const Eigen::RowVector2d f_state(-t * wa * wa, -t * 2.0 * za * wa);
-  Eigen::Index k = 2;
-  for (const auto& p : m.paths) {
-    for (const auto& mode : p.modes) {
-      a(k, k + 1) = 1.0;
-      a(k + 1, k) = -mode.wn_rad_per_s * mode.wn_rad_per_s;
-      a(k + 1, k + 1) = -2.0 * mode.damping_ratio * mode.wn_rad_per_s;
-      b(k + 1, 1 + static_cast<Eigen::Index>(p.excitation)) = 1.0;
-      if (p.excitation == act) {
-        a.block(k + 1, 0, 1, 2) += f_state;
-        b(k + 1, 0) += t;
-      }
-      cx(static_cast<Eigen::Index>(p.response), k) = mode.a;
-      cx(static_cast<Eigen::Index>(p.response), k + 1) = mode.b;
-      k += 2;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(2 + 2 * i);
+    a(k, k + 1) = 1.0;
+    a(k + 1, k) = -blocks[i].wn * blocks[i].wn;
+    a(k + 1, k + 1) = -2.0 * blocks[i].zeta * blocks[i].wn;
+    b(k + 1, 1 + static_cast<Eigen::Index>(blocks[i].excitation)) = 1.0;
+    if (blocks[i].excitation == act) {
+      a.block(k + 1, 0, 1, 2) += f_state;
+      b(k + 1, 0) += t;
     }
   }
+  for (std::size_t pi = 0; pi < m.paths.size(); ++pi)
+    for (std::size_t j = 0; j < m.paths[pi].modes.size(); ++j) {
+      const Eigen::Index k = static_cast<Eigen::Index>(2 + 2 * block_of[pi][j]);
+      const auto r = static_cast<Eigen::Index>(m.paths[pi].response);
+      cx(r, k) += m.paths[pi].modes[j].a;
+      cx(r, k + 1) += m.paths[pi].modes[j].b;
+    }
   // Receptance is strictly proper; velocity and acceleration follow by differentiating along the
   // held input (u' = 0 between samples).
   const Matrix cv = cx * a, dv = cx * b, ca = cv * a, da = cv * b;
@@ -173,7 +192,6 @@ PlantModel build_plant_model(const config::Config& cfg) {
   m.ss.d.middleRows(2 * nl, nl) = da;
   m.ss.c.block(3 * nl, 0, 1, 2) = f_state;
   m.ss.d(3 * nl, 0) = t;
-  m.pattern = reachability(a);
   return m;
 }
 

@@ -57,7 +57,6 @@ struct PlantModel {
   // Acceleration and velocity are the left limits at a sample instant (the impulses that a held force
   // step causes through the residue-form b terms are not sampled).
   StateSpace ss;
-  Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> pattern;  // reachability of A
 
   [[nodiscard]] std::size_t input_coil() const { return 0; }
   [[nodiscard]] std::size_t input_force(std::size_t loc) const { return 1 + loc; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace robodamp::sim {
 
@@ -30,13 +31,18 @@ double Accelerometer::measure(double a) noexcept {
     x1_ = a;
     y1_ = y;
   }
-  y += noise_rms_ * normal_(rng_);
+  if (noise_rms_ > 0.0) y += noise_rms_ * normal_(rng_);  // (a noiseless sensor draws nothing: same output)
   const double limit = std::min(range_mps2_, adc_full_scale_mps2_);
   if (std::abs(y) > limit) {
     y = std::copysign(limit, y);
     ++clipped_;
   }
-  return std::round(y / lsb_mps2_) * lsb_mps2_;
+  // std::round (half away from zero) without the libm call: |counts| < 2^31 after the clip above, so the
+  // truncation is exact and so is counts - whole.
+  const double counts = y / lsb_mps2_;
+  const auto whole = static_cast<double>(static_cast<std::int64_t>(counts));
+  const double frac = counts - whole;
+  return (whole + static_cast<double>(frac >= 0.5) - static_cast<double>(frac <= -0.5)) * lsb_mps2_;
 }
 
 std::complex<double> Accelerometer::response(double f_hz) const {

@@ -49,31 +49,4 @@ DelayedZoh discretise_zoh_delayed(const Matrix& a, const Matrix& b, double h_s, 
   return d;
 }
 
-Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> reachability(const Matrix& a) {
-  const Eigen::Index n = a.rows();
-  Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> r(n, n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = 0; j < n; ++j) r(i, j) = i == j || a(i, j) != 0.0;
-  // Warshall's transitive closure.
-  for (Eigen::Index k = 0; k < n; ++k)
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (r(i, k))
-        for (Eigen::Index j = 0; j < n; ++j) r(i, j) = r(i, j) || r(k, j);
-  return r;
-}
-
-SparseRows::SparseRows(const Matrix& m, const Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic>* pattern) {
-  row_start_.push_back(0);
-  for (Eigen::Index r = 0; r < m.rows(); ++r) {
-    for (Eigen::Index c = 0; c < m.cols(); ++c) {
-      const bool keep = pattern == nullptr || (c < pattern->cols() && (*pattern)(r, c)) || c >= pattern->cols();
-      if (keep && m(r, c) != 0.0) {
-        column_.push_back(static_cast<std::uint32_t>(c));
-        value_.push_back(m(r, c));
-      }
-    }
-    row_start_.push_back(static_cast<std::uint32_t>(value_.size()));
-  }
-}
-
 }  // namespace robodamp::sim

@@ -1,10 +1,6 @@
 // Linear state-space models and their exact zero-order-hold discretisation (matrix exponential), with an
-// input delay that need not be a whole number of steps. Off the real-time path except SparseRows::apply.
+// input delay that need not be a whole number of steps. Off the real-time path.
 #pragma once
-
-#include <cstddef>
-#include <cstdint>
-#include <vector>
 
 #include <Eigen/Dense>
 
@@ -33,34 +29,5 @@ struct DelayedZoh {
   double fraction{0.0};
 };
 [[nodiscard]] DelayedZoh discretise_zoh_delayed(const Matrix& a, const Matrix& b, double h_s, double delay_s);
-
-// Which entries of e^{A t} can be non-zero: state j reaches state i through the graph of A.
-[[nodiscard]] Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> reachability(const Matrix& a);
-
-// Compressed rows of a matrix with a known sparsity pattern, for allocation-free products.
-class SparseRows {
- public:
-  SparseRows() = default;
-  // Keeps the entries where pattern is true (or every non-zero entry without a pattern).
-  SparseRows(const Matrix& m, const Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic>* pattern = nullptr);
-  // out = M x. RT-safe.
-  void apply(const double* x, double* out) const noexcept {
-    const std::size_t rows = row_start_.size() - 1;
-    for (std::size_t r = 0; r < rows; ++r) out[r] = row_dot(r, x);
-  }
-  [[nodiscard]] std::size_t nonzeros() const { return value_.size(); }
-  // One row of M x. RT-safe.
-  [[nodiscard]] double row_dot(std::size_t r, const double* x) const noexcept {
-    double acc = 0.0;
-    for (std::uint32_t i = row_start_[r], end = row_start_[r + 1]; i < end; ++i) acc += value_[i] * x[column_[i]];
-    return acc;
-  }
-  [[nodiscard]] std::size_t rows() const { return row_start_.empty() ? 0 : row_start_.size() - 1; }
-
- private:
-  std::vector<std::uint32_t> row_start_;
-  std::vector<std::uint32_t> column_;
-  std::vector<double> value_;
-};
 
 }  // namespace robodamp::sim
