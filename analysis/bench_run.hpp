@@ -146,12 +146,20 @@ class Bench {
 
   [[nodiscard]] ImpactTestResult impact_test(const ImpactTest& t) const;
   [[nodiscard]] DivergenceRun divergence_run(double gain_ns_per_m, int polarity) const;
-  [[nodiscard]] BenchReport run(const Progress& progress = {}) const;
+  // All runs, on `jobs` threads (0: one per core; 1: serial); the report does not depend on jobs.
+  [[nodiscard]] BenchReport run(const Progress& progress = {}, std::size_t jobs = 0) const;
 
  private:
   // The simulated plant with the configured disturbances, and the designed controller at (K, polarity).
   [[nodiscard]] sim::Plant make_plant() const;
   [[nodiscard]] control::ControllerParams controller_params(double gain_ns_per_m, int polarity) const;
+  // The report's parts (bench_report.cpp).
+  [[nodiscard]] std::string test_line(int number, int tests, const ImpactTest& t, const std::string& what,
+                                      const ImpactTestResult& r) const;
+  [[nodiscard]] BenchRow make_row(const AnalysisResult& an, std::size_t i, const ImpactTestResult& open_r,
+                                  const ImpactTestResult& closed_r, double peak_n, const std::string& kind, double k,
+                                  const FrfResult* predicted, const FrfResult* predicted_c) const;
+  [[nodiscard]] std::string verdict(const BenchReport& rep) const;
 
   config::Config cfg_;
   LoopModel model_;

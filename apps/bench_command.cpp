@@ -201,12 +201,14 @@ struct BenchArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   std::string json_path;
   std::string plot_dir;
+  int jobs{0};  // threads for the independent runs; 0 = one per core
 };
 
 // 0 PASS, 1 mismatch (or an output that could not be written), 3 unstable (no closed-loop tests).
 int run_bench(const BenchArgs& a) {
   const analysis::Bench bench(config::load_config_file(a.config_path));
-  const auto report = bench.run([](const std::string& line) { std::cerr << "[bench] " << line << std::endl; });
+  const auto report = bench.run([](const std::string& line) { std::cerr << "[bench] " << line << std::endl; },
+                                static_cast<std::size_t>(a.jobs));
   std::cout << bench_table(bench, report);
   if (!a.json_path.empty()) {
     std::ofstream out(a.json_path);
@@ -239,6 +241,8 @@ void register_bench(Registry& r) {
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   sub->add_option("--json", a->json_path, "Write the report as JSON to this file");
   sub->add_option("--plot-dir", a->plot_dir, "Write plots (PNG) here");
+  r.whole_number(sub, "--jobs", a->jobs, {"(threads)", 0, 256, false, false, "0 = one per core"},
+                 "Threads for the independent runs (0 = one per core, 1 = serial); the report is the same for any");
 }
 
 }  // namespace robodamp::apps

@@ -5,7 +5,12 @@
 
 #include <cmath>
 
+#include <atomic>
+#include <stdexcept>
+#include <thread>
+
 #include "analysis/bench_run.hpp"
+#include "analysis/task_pool.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -109,6 +114,34 @@ TEST(Bench, CoarseResolutionUnderReadsTheOpenLoopPeak) {
   const auto p = analysis::measured_peak(t.receptance[1], cfg.analysis.band_min_hz, cfg.analysis.band_max_hz);
   const double model_peak = analysis::improvements(bench.model(), 0.0, 1, true)[2].open_peak_m_per_n;
   EXPECT_LT(p.magnitude_m_per_n, 0.97 * model_peak);
+}
+
+TEST(TaskPool, RunsEveryTaskOnceOnEveryThreadCountAndRethrowsTheFirstError) {
+  for (std::size_t threads : {1u, 2u, 3u, 64u}) {
+    std::vector<std::atomic<int>> runs(40);
+    std::vector<std::function<void()>> tasks;
+    for (std::size_t i = 0; i < runs.size(); ++i) tasks.emplace_back([&runs, i] { ++runs[i]; });
+    analysis::run_tasks(tasks, threads);
+    for (const auto& r : runs) EXPECT_EQ(r.load(), 1) << threads << " threads";
+    // Tasks 7 and 3 throw: every task still runs, every thread is joined, and task 3's error comes out.
+    std::atomic<int> ran{0};
+    std::vector<std::function<void()>> failing;
+    for (int i = 0; i < 10; ++i)
+      failing.emplace_back([&ran, i] {
+        ++ran;
+        if (i == 3 || i == 7) throw std::runtime_error("task " + std::to_string(i));
+      });
+    try {
+      analysis::run_tasks(failing, threads);
+      ADD_FAILURE() << "no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "task 3");
+    }
+    EXPECT_EQ(ran.load(), 10);
+  }
+  analysis::run_tasks({}, 4);  // nothing to do
+  EXPECT_EQ(analysis::task_threads(3), 3u);
+  EXPECT_GE(analysis::task_threads(0), 1u);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -173,6 +174,36 @@ TEST(Cli, BenchWritesRowsJsonPlotsAndAVerdict) {
   std::filesystem::remove(json);
 }
 
+// Issue 14: the independent runs on several threads give the serial run's report, byte for byte, apart
+// from the wall-clock times (and the progress lines come in the same order).
+TEST(Cli, BenchOnSeveralThreadsGivesTheSerialRunsOutput) {
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  yaml.replace(yaml.find("averages: 10"), 12, "averages: 3");
+  yaml.replace(yaml.find("sweep_gain_factors: [0.5, 0.9, 1.1, 1.5]"), 40, "sweep_gain_factors: [0.9, 1.1]");
+  const std::string path = temp_path("bench-jobs.yaml");
+  std::ofstream(path) << yaml;
+  const std::regex wall(R"( in [0-9.]+ s( wall \([0-9]+x real time\))?)"), json_wall(R"("wall_s": [0-9.e+-]+)");
+  std::string serial_out, serial_json;
+  for (int jobs : {1, 2, 5}) {
+    const std::string json = temp_path("bench-jobs-" + std::to_string(jobs) + ".json");
+    const Result r = run("bench --config " + path + " --jobs " + std::to_string(jobs) + " --json " + json);
+    EXPECT_EQ(r.status, 0) << r.out;
+    const std::string out = std::regex_replace(std::regex_replace(r.out, wall, " in (wall)"), std::regex(json + "|bench-jobs-[0-9].json"), "J");
+    const std::string text = std::regex_replace(robodamp::test::read_file(json), json_wall, "\"wall_s\": W");
+    std::filesystem::remove(json);
+    if (jobs == 1) {
+      serial_out = out, serial_json = text;
+      EXPECT_GT(text.size(), 1000u);
+      EXPECT_NE(out.find("[bench] gain sweep K ="), std::string::npos) << out;
+      EXPECT_NE(out.find("VERDICT: PASS"), std::string::npos) << out;
+      continue;
+    }
+    EXPECT_EQ(out, serial_out) << jobs << " threads";
+    EXPECT_EQ(text, serial_json) << jobs << " threads";
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {
   std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
   yaml.replace(yaml.find("axis_sign: -1"), 13, "axis_sign: +1");
@@ -303,6 +334,7 @@ TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
       {"request --gain -1", "--gain = -1 N s/m is out of range"},
       {"request --enable 2", "--enable = 2 (1 = arm, 0 = disarm) is out of range"},
       {"request --timeout 0", "--timeout = 0 s is out of range"},
+      {"bench --jobs 300", "--jobs = 300 (threads) is out of range: allowed 0 <= value <= 256 (threads) (0 = one per core)"},
   };
   for (const auto& [args, wording] : cases) {
     const Result r = run_shell("timeout 60 " + std::string(ROBODAMP_BINARY) + " " + args);
