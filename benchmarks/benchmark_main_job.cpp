@@ -1,7 +1,7 @@
 // What each part of the main job (`robodamp bench` on the default preset) costs, one core each: loading
 // the configuration and building the loop model, the closed-loop analysis, one impact test's simulation
 // (10 hits, ~110 s simulated, control on) and its H1 estimate (the FFTs), one gain-sweep run (20 s), and
-// the whole bench run. README: "Main job: what each part costs".
+// the whole bench run, serial and on two threads. README: "Main job: what each part costs".
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -86,15 +86,16 @@ void BM_DivergenceRun(benchmark::State& state) {
 }
 BENCHMARK(BM_DivergenceRun)->Unit(benchmark::kMillisecond);
 
-// The whole bench run (what `robodamp bench` computes; without printing, JSON and plots).
+// The whole bench run (what `robodamp bench` computes; without printing, JSON and plots), on 1 thread
+// (serial) and on 2 (this machine's cores). Real time, since the work is on several threads.
 void BM_BenchRun(benchmark::State& state) {
   const analysis::Bench bench(config::load_config_file(kPreset));
   for (auto _ : state) {
-    const analysis::BenchReport r = bench.run();
+    const analysis::BenchReport r = bench.run({}, static_cast<std::size_t>(state.range(0)));
     benchmark::DoNotOptimize(r.simulated_s);
   }
 }
-BENCHMARK(BM_BenchRun)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_BenchRun)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
 }  // namespace
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Reproduces the chain cost numbers in the README: Google Benchmark ns/sample and callgrind
-# instructions/sample for the plain cascade, the product's chain, and the controller step.
+# Reproduces the README's performance numbers: Google Benchmark ns/sample and callgrind
+# instructions/sample for the plain cascade, the product's chain and the controller step; the simulated
+# plant; the FFT back-ends; the parts of the main job; the milling analyses.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -21,6 +22,12 @@ echo
 echo "simulated plant + controller, default preset (x_real_time = simulated s per wall s, one core):"
 ./build/benchmarks/benchmark_plant --benchmark_repetitions=5 --benchmark_report_aggregates_only=true --benchmark_min_time=0.5 \
   --benchmark_counters_tabular=true
+echo
+echo "the estimator's FFT, 400 000 real points (kissfft as before, FFTW as now):"
+./build/benchmarks/benchmark_fft --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+echo
+echo "what each part of the main job costs (robodamp bench on the default preset):"
+./build/benchmarks/benchmark_main_job
 echo
 echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (seed 004), the direct test's"
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
