@@ -1,5 +1,6 @@
 #include "config/milling_config.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -199,6 +200,37 @@ SleConfig read_sle(MapReader& top) {
   return c;
 }
 
+TimeDomainConfig read_time_domain(MapReader& top, const ToolConfig& tool) {
+  MapReader r(top.diagnostics(), top.child("time_domain", false, ""), "time_domain", top.mark());
+  TimeDomainConfig c;
+  if (auto v = read_int(r, "steps_per_tooth", {"(steps, 0 = automatic)", 0, 100000}, c.steps_per_tooth)) c.steps_per_tooth = *v;
+  if (auto v = read_int(r, "min_steps_per_mode_period", {"(steps)", 8, 10000}, c.min_steps_per_mode_period))
+    c.min_steps_per_mode_period = *v;
+  if (auto v = read_int(r, "revolutions", {"(revolutions)", 2, 100000}, c.revolutions)) c.revolutions = *v;
+  if (auto v = read_int(r, "settle_revolutions", {"(revolutions)", 1, 100000}, c.settle_revolutions)) c.settle_revolutions = *v;
+  if (c.settle_revolutions >= c.revolutions)
+    r.diagnostics().add(r.mark(), r.path_of("settle_revolutions"),
+                        "= " + std::to_string(c.settle_revolutions) + " must be less than " + r.path_of("revolutions") +
+                            " = " + std::to_string(c.revolutions) + " (statistics need revolutions after settling)");
+  if (auto v = read_int(r, "axial_slices", {"(slices)", 1, 1000}, c.axial_slices)) c.axial_slices = *v;
+  if (auto v = read_int(r, "sdm_steps_per_period", {"(steps)", 4, 1000}, c.sdm_steps_per_period)) c.sdm_steps_per_period = *v;
+  const YAML::Node runout = r.child("runout_um", false, "");
+  if (present(runout)) {
+    bool ok = runout.IsSequence() && static_cast<int>(runout.size()) == tool.teeth;
+    for (std::size_t i = 0; ok && i < runout.size(); ++i) {
+      double v = 0.0;
+      ok = runout[i].IsScalar() && YAML::convert<double>::decode(runout[i], v) && std::isfinite(v) && std::abs(v) <= 1000.0;
+      if (ok) c.runout_um.push_back(v);
+    }
+    if (!ok)
+      r.diagnostics().add(runout.Mark(), "time_domain.runout_um",
+                          "must be a list of " + std::to_string(tool.teeth) +
+                              " radial offsets, one per tooth, each -1000 <= value <= 1000 um");
+  }
+  r.finish();
+  return c;
+}
+
 std::vector<ConditionConfig> read_conditions(MapReader& top, const ToolConfig& tool) {
   Diagnostics& d = top.diagnostics();
   std::vector<ConditionConfig> out;
@@ -258,6 +290,7 @@ MillingConfig parse_milling_config(const std::string& yaml_text, const std::stri
   }
   c.lobes = read_lobes(top);
   c.sle = read_sle(top);
+  c.time_domain = read_time_domain(top, c.tool);
   c.conditions = read_conditions(top, c.tool);
   top.finish();
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

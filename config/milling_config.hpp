@@ -91,6 +91,17 @@ struct SleConfig {
   std::vector<Axis> surface_normals{Axis::kY};  // conditions are evaluated for each
 };
 
+// Time-domain cut simulation (milling/cut_simulation.hpp) and semi-discretization (milling/sdm.hpp).
+struct TimeDomainConfig {
+  int steps_per_tooth{0};               // 0: the fewest giving min_steps_per_mode_period (and >= 40)
+  int min_steps_per_mode_period{20};    // steps per period of the structure's highest mode
+  int revolutions{60};                  // simulated, start-up included
+  int settle_revolutions{20};           // not used by the statistics (start-up transient)
+  int axial_slices{20};
+  std::vector<double> runout_um;        // per tooth, radial (empty: none)
+  int sdm_steps_per_period{40};         // semi-discretization intervals per tooth period
+};
+
 // An SLE test condition (seed 004 Table 7) with the measured path offset the published predictions add.
 struct ConditionConfig {
   std::string name;
@@ -111,6 +122,7 @@ struct MillingConfig {
   std::string structure;  // the one used unless the command line selects another
   LobesConfig lobes;
   SleConfig sle;
+  TimeDomainConfig time_domain;
   std::vector<ConditionConfig> conditions;
 
   [[nodiscard]] const StructureConfig* find_structure(const std::string& name) const;

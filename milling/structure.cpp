@@ -65,6 +65,13 @@ Structure::Structure(const config::StructureConfig& cfg, bool damped) : name_(cf
 
 bool Structure::has_controller() const { return !controllers_.empty(); }
 
+std::vector<Structure::ControllerPath> Structure::controller_paths() const {
+  std::vector<ControllerPath> out;
+  for (const auto& c : controllers_)
+    if (const sim::FrfPath* p = c.model->plant().path(c.location, c.location)) out.push_back({c.direction, *p});
+  return out;
+}
+
 Eigen::Matrix2cd Structure::frf(double f_hz) const {
   Eigen::Matrix2cd g;
   for (std::size_t k = 0; k < 4; ++k)

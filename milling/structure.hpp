@@ -39,6 +39,15 @@ class Structure {
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] bool damped() const { return damped_; }
   [[nodiscard]] bool has_controller() const;
+  // The modal tables summed per direction pair [xx, xy, yx, yy], machine frame, as given.
+  [[nodiscard]] const std::array<config::FrfConfig, 4>& modal_terms() const { return modal_; }
+  // Each controller part's open-loop robot FRF at its location (physical frame) and its direction
+  // (0 = x, 1 = y): the structure a time-domain model needs besides the modal tables.
+  struct ControllerPath {
+    std::size_t direction{1};
+    sim::FrfPath path;
+  };
+  [[nodiscard]] std::vector<ControllerPath> controller_paths() const;
   // What the controller parts were closed with, for reports.
   [[nodiscard]] const std::vector<std::string>& notes() const { return notes_; }
 

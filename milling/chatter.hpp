@@ -1,0 +1,44 @@
+// Chatter detection from sampled vibration signals (simulated cuts here, measured ones later):
+//   - the once-per-period statistic: the signal sampled once per tooth period (once per revolution with
+//     runout) repeats in a stable cut; its differences d_i = s_{i+1} - s_i decay, and their growth per
+//     period is ln of the dominant Floquet multiplier's magnitude;
+//   - the share of spectral energy away from the tooth-passing (or spindle) harmonics, and the dominant
+//     chatter frequency there;
+//   - a classification: stable, Hopf (quasi-periodic), period doubling (flip: the once-per-period samples
+//     alternate, chatter at an odd multiple of half the tooth frequency), or tool out of cut.
+// docs/milling.md, "Chatter detection", has the thresholds. Off the real-time path.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace robodamp::milling {
+
+enum class CutClass { kStable, kHopf, kFlip, kOutOfCut };
+[[nodiscard]] const char* to_string(CutClass c);
+
+struct ChatterThresholds {
+  double growth_per_period{0.0};      // growth of the once-per-period differences above which it chatters
+  double out_of_cut_share{1e-3};      // engaged tooth-slice samples without a chip: the tool left the cut
+  double settled_ratio{1e-6};         // differences below this share of the signal are settled (stable)
+  double flip_correlation{-0.5};      // lag-1 correlation of the differences below this: period doubling
+};
+
+struct ChatterVerdict {
+  bool stable{true};
+  CutClass classification{CutClass::kStable};
+  double chatter_hz{0.0};                 // dominant non-harmonic frequency (0 when none)
+  double once_per_period_ratio{0.0};      // RMS of the differences over the signal's RMS (last half)
+  double nonharmonic_energy_ratio{0.0};   // 0..1, DC excluded
+  double growth_per_period{0.0};          // ln(multiplier): < 0 decays, > 0 grows
+  double out_of_cut_share{0.0};
+};
+
+// signals: each sampled at sample_rate_hz, analysed from `start` on, whose period is samples_per_period
+// (a whole number of samples). harmonic_base_periods: how many of those periods the harmonics repeat in
+// (1 without runout; the teeth with runout, so the spindle frequency counts as harmonic).
+[[nodiscard]] ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& signals, std::size_t start,
+                                            int samples_per_period, int harmonic_base_periods, double sample_rate_hz,
+                                            double out_of_cut_share, const ChatterThresholds& t = {});
+
+}  // namespace robodamp::milling

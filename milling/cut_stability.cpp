@@ -1,0 +1,72 @@
+#include "milling/cut_stability.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace robodamp::milling {
+
+CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter, const config::MaterialConfig& mat,
+                   const CutSettings& s) {
+  CutOutcome o;
+  o.record = simulate_cut(terms, cutter, mat, s);
+  bool runout = false;
+  for (double r : s.runout_um) runout = runout || r != 0.0;
+  const CutRecord& r = o.record;
+  o.verdict = detect_chatter({&r.x_m, &r.y_m}, r.settle_steps, r.steps_per_tooth, runout ? r.teeth : 1,
+                             1.0 / r.step_s, r.out_of_cut_share());
+  return o;
+}
+
+CriticalDepth critical_depth(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
+                             const config::MaterialConfig& mat, CutSettings s, double guess_mm, double rel_tol,
+                             const std::function<void(const std::string&)>& progress) {
+  if (!(guess_mm > 0.0)) throw std::invalid_argument("critical_depth: the first guess must be > 0 mm");
+  CriticalDepth c;
+  auto trial = [&](double depth_mm) {
+    s.cut.axial_mm = depth_mm;
+    const CutOutcome o = run_cut(terms, cutter, mat, s);
+    ++c.simulations;
+    if (progress) {
+      std::ostringstream os;
+      os << "  depth " << depth_mm << " mm: " << to_string(o.verdict.classification);
+      if (!o.verdict.stable) os << " at " << o.verdict.chatter_hz << " Hz";
+      progress(os.str());
+    }
+    return o.verdict;
+  };
+  double lo = 0.0, hi = 0.0;
+  ChatterVerdict above;
+  const ChatterVerdict first = trial(guess_mm);
+  if (first.stable) {
+    lo = guess_mm;
+    for (hi = 2.0 * guess_mm; c.simulations < 12; hi *= 2.0) {
+      above = trial(hi);
+      if (!above.stable) break;
+      lo = hi;
+    }
+    if (above.stable) throw std::runtime_error("critical_depth: stable up to " + std::to_string(hi) + " mm");
+  } else {
+    hi = guess_mm, above = first;
+    for (lo = 0.5 * guess_mm; c.simulations < 24; lo *= 0.5) {
+      const ChatterVerdict v = trial(lo);
+      if (v.stable) break;
+      hi = lo, above = v;
+    }
+  }
+  while (hi - lo > rel_tol * hi) {
+    const double mid = 0.5 * (lo + hi);
+    const ChatterVerdict v = trial(mid);
+    if (v.stable) {
+      lo = mid;
+    } else {
+      hi = mid, above = v;
+    }
+  }
+  c.depth_mm = lo;
+  c.above = above.classification;
+  c.chatter_hz = above.chatter_hz;
+  return c;
+}
+
+}  // namespace robodamp::milling

@@ -1,0 +1,36 @@
+// Whether a simulated cut chatters, and the time-domain critical depth at a speed by bisection on the
+// axial depth with the chatter detector's verdict (docs/milling.md, "Time domain"). Off the real-time path.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "milling/chatter.hpp"
+#include "milling/cut_simulation.hpp"
+
+namespace robodamp::milling {
+
+struct CutOutcome {
+  CutRecord record;
+  ChatterVerdict verdict;
+};
+
+// Simulates and classifies one cut (the signals: both displacement components after settling).
+[[nodiscard]] CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
+                                 const config::MaterialConfig& material, const CutSettings& settings);
+
+struct CriticalDepth {
+  double depth_mm{0.0};          // largest stable depth found (within rel_tol of the smallest unstable one)
+  CutClass above{CutClass::kStable};  // what the cut does just above it
+  double chatter_hz{0.0};        // there
+  int simulations{0};
+};
+
+// Bisection from a first guess (e.g. the zero-order limit): doubled or halved until the verdict changes,
+// then halved to rel_tol. progress (optional) gets one line per simulation.
+[[nodiscard]] CriticalDepth critical_depth(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
+                                           const config::MaterialConfig& material, CutSettings settings,
+                                           double guess_mm, double rel_tol = 2e-3,
+                                           const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace robodamp::milling

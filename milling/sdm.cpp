@@ -1,0 +1,114 @@
+#include "milling/sdm.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+#include <unsupported/Eigen/MatrixFunctions>
+
+namespace robodamp::milling {
+
+SdmModel::SdmModel(const std::vector<CutterModalTerm>& terms, const Cutter& cutter, const config::MaterialConfig& mat,
+                   config::MillingMode mode, double radial_mm, int axial_slices, int steps_per_period)
+    : cutter_(cutter), material_(mat), mode_(mode), radial_mm_(radial_mm), slices_(axial_slices), m_(steps_per_period) {
+  if (m_ < 2) throw std::invalid_argument("SdmModel: needs at least 2 steps per period");
+  const ToolDynamics dyn(terms, 1.0);  // only its continuous model is used
+  a_ = dyn.a(), b_ = dyn.b(), c_ = dyn.c();
+  for (const auto& t : terms) mode_hz_.push_back(t.wn_rad_per_s / (2.0 * M_PI));
+}
+
+Eigen::Matrix2d SdmModel::mean_directional(double axial_mm, double rpm, int interval) const {
+  // Mean of M(t) over [t_i, t_i+1), by the midpoint rule on sub-intervals (the engagement switches inside).
+  constexpr int kSub = 8;
+  const int n = cutter_.teeth;
+  const double dphi = 2.0 * M_PI / (n * m_);  // spindle angle per interval
+  const double kt = material_.kt_n_per_mm2 * 1e6, kr = material_.kr_n_per_mm2 * 1e6;
+  Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
+  const std::vector<Slice> geometry = slices(cutter_, axial_mm, slices_);
+  for (const Slice& s : geometry) {
+    const double local_radial = radial_mm_ - (cutter_.radius_mm - s.radius_mm);
+    if (local_radial <= 0.0) continue;
+    const Engagement e = engagement(s.radius_mm, local_radial, mode_);
+    const double sk = std::sin(s.kappa_rad), db = s.height_mm * 1e-3;
+    for (int sub = 0; sub < kSub; ++sub) {
+      const double spindle = (interval + (sub + 0.5) / kSub) * dphi;
+      for (int j = 0; j < n; ++j) {
+        double phi = std::fmod(spindle + 2.0 * M_PI * j / n - s.lag_rad, 2.0 * M_PI);
+        if (phi < 0.0) phi += 2.0 * M_PI;
+        if (phi < e.start_rad || phi > e.exit_rad) continue;
+        const double sp = std::sin(phi), cp = std::cos(phi);
+        const Eigen::Vector2d force(-kt * cp - kr * sk * sp, kt * sp - kr * sk * cp);
+        mean += db * sk * force * Eigen::RowVector2d(sp, cp) / kSub;
+      }
+    }
+  }
+  (void)rpm;
+  return mean;
+}
+
+std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const {
+  const Eigen::Index n = a_.rows(), d = n + 2 * m_;
+  const double h = 60.0 / (rpm * cutter_.teeth) / m_;
+  Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d);
+  Eigen::MatrixXd big = Eigen::MatrixXd::Zero(n + 4, n + 4);
+  for (int i = 0; i < m_; ++i) {
+    const Eigen::Matrix2d mi = mean_directional(axial_mm, rpm, i);
+    // x' = (A + B M C) x - B M q(t - tau); the delayed q goes linearly from q_{i-m} to q_{i-m+1}.
+    big.setZero();
+    big.topLeftCorner(n, n) = a_ + b_ * mi * c_;
+    big.block(0, n, n, 2) = -b_ * mi;
+    big.block(n, n + 2, 2, 2).setIdentity();
+    const Eigen::MatrixXd e = (big * h).exp();
+    const Eigen::MatrixXd phi = e.topLeftCorner(n, n), held = e.block(0, n, n, 2), ramp = e.block(0, n + 2, n, 2) / h;
+    const auto old_x = z.topRows(n);
+    const auto q_oldest = z.middleRows(n + 2 * (m_ - 1), 2);          // q_{i-m}
+    const Eigen::MatrixXd q_next = z.middleRows(n + 2 * (m_ - 2), 2);  // q_{i-m+1}
+    next.topRows(n) = phi * old_x + (held - ramp) * q_oldest + ramp * q_next;
+    next.middleRows(n, 2) = c_ * old_x;                                 // q_i
+    next.middleRows(n + 2, 2 * (m_ - 1)) = z.middleRows(n, 2 * (m_ - 1));
+    z.swap(next);
+  }
+  const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(z, false).eigenvalues();
+  std::complex<double> best(0.0);
+  for (Eigen::Index i = 0; i < ev.size(); ++i)
+    if (std::abs(ev(i)) > std::abs(best)) best = ev(i);
+  return best;
+}
+
+SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
+  if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
+  auto stable = [&](double b) { return std::abs(multiplier(b, rpm)) < 1.0; };
+  double lo = 0.0, hi = guess_mm;
+  if (stable(guess_mm)) {
+    lo = guess_mm;
+    for (hi = 2.0 * guess_mm; stable(hi); hi *= 2.0) {
+      lo = hi;
+      if (hi > 1e3) throw std::runtime_error("SdmModel::critical: stable beyond 1 m depth");
+    }
+  } else {
+    for (lo = 0.5 * guess_mm; !stable(lo); lo *= 0.5) {
+      hi = lo;
+      if (lo < 1e-9) throw std::runtime_error("SdmModel::critical: unstable at any depth");
+    }
+  }
+  while (hi - lo > rel_tol * hi) {
+    const double mid = 0.5 * (lo + hi);
+    (stable(mid) ? lo : hi) = mid;
+  }
+  SdmPoint p;
+  p.rpm = rpm;
+  p.critical_depth_mm = lo;
+  const std::complex<double> mu = multiplier(hi, rpm);
+  // Period doubling when the critical multiplier is (nearly) real and negative.
+  p.type = mu.real() < 0.0 && std::abs(mu.imag()) < 1e-3 * std::abs(mu) ? CutClass::kFlip : CutClass::kHopf;
+  // Chatter frequencies are (arg mu + 2 pi k) / (2 pi T): the one nearest a mode of the structure.
+  const double tooth_hz = rpm * cutter_.teeth / 60.0, base = std::abs(std::arg(mu)) / (2.0 * M_PI) * tooth_hz;
+  double best = 1e300;
+  for (double fm : mode_hz_)
+    for (int k = -1; k <= static_cast<int>(fm / tooth_hz) + 1; ++k)
+      for (double f : {base + k * tooth_hz, -base + k * tooth_hz})
+        if (f > 0.0 && std::abs(f - fm) < best) best = std::abs(f - fm), p.chatter_hz = f;
+  return p;
+}
+
+}  // namespace robodamp::milling

@@ -1,0 +1,52 @@
+// Stability of the milling process by first-order semi-discretization (Insperger and Stepan 2004;
+// docs/milling.md, "Semi-discretization"). The open-loop structure's modal state space (cutter frame,
+// milling/tool_dynamics.hpp) with the linearised regenerative force
+//   x' = A x + B M(t) (q(t) - q(t - tau)),  q = C x,
+// M(t) the tooth-periodic directional matrix summed over the engaged teeth and axial slices (helix lag
+// and ball end as in the frequency-domain and time-domain models). Over each of m intervals of the tooth
+// period, M is its interval mean and the delayed q is interpolated linearly between samples; the exact
+// solution of each interval gives the monodromy matrix over one period, whose largest eigenvalue decides:
+// stable below 1 in magnitude; crossing -1 (period doubling, flip) or as a complex pair (Hopf).
+// Off the real-time path.
+#pragma once
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "milling/chatter.hpp"
+#include "milling/cutting.hpp"
+#include "milling/tool_dynamics.hpp"
+
+namespace robodamp::milling {
+
+struct SdmPoint {
+  double rpm{0.0};
+  double critical_depth_mm{0.0};
+  CutClass type{CutClass::kHopf};  // how it loses stability there: kHopf or kFlip
+  double chatter_hz{0.0};          // from the critical multiplier's angle, nearest the structure's modes
+};
+
+class SdmModel {
+ public:
+  SdmModel(const std::vector<CutterModalTerm>& terms, const Cutter& cutter, const config::MaterialConfig& material,
+           config::MillingMode mode, double radial_mm, int axial_slices, int steps_per_period);
+
+  // The largest-magnitude eigenvalue of the monodromy matrix at this depth and speed.
+  [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
+  // Critical depth by bisection, starting from a guess (e.g. the zero-order limit).
+  [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
+  [[nodiscard]] int steps_per_period() const { return m_; }
+
+ private:
+  [[nodiscard]] Eigen::Matrix2d mean_directional(double axial_mm, double rpm, int interval) const;
+  Eigen::MatrixXd a_, b_, c_;
+  std::vector<double> mode_hz_;
+  Cutter cutter_;
+  config::MaterialConfig material_;
+  config::MillingMode mode_;
+  double radial_mm_;
+  int slices_, m_;
+};
+
+}  // namespace robodamp::milling

@@ -1,0 +1,145 @@
+// Time-domain milling (issue 15, in progress): the simulated cut against the frequency-domain models on
+// single-mode structures (SDM's Floquet multipliers, slotting critical depths), SDM's convergence, and the
+// chatter detector on a cut below and above the limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "milling/cut_stability.hpp"
+#include "milling/lobes.hpp"
+#include "milling/sdm.hpp"
+#include "milling/structure.hpp"
+
+namespace {
+
+using namespace robodamp;
+using namespace robodamp::milling;
+
+config::ModeConfig stiff_mode(double fn, double zeta, double k) {
+  config::ModeConfig m;
+  m.form = config::ModeForm::kStiffness;
+  m.natural_freq_hz = fn;
+  m.damping_ratio = zeta;
+  m.stiffness_n_per_m = k;
+  return m;
+}
+
+struct Job {
+  Structure structure;
+  Cutter cutter;
+  config::MaterialConfig material;
+  config::CutConfig cut;
+};
+
+// A 600 Hz mode in y (and in x too unless y_only), 2 straight teeth on a 12 mm cutter, kr/kt = 0.3.
+Job single_mode_job(double radial_mm, bool y_only) {
+  std::array<std::vector<config::ModeConfig>, 4> modes;
+  if (!y_only) modes[0] = {stiff_mode(600.0, 0.02, 5.6e6)};
+  modes[3] = {stiff_mode(600.0, 0.02, 5.6e6)};
+  Job j{Structure(modes), {config::ToolKind::kEndMill, 6.0, 2, 0.0}, {}, {}};
+  j.material.kt_n_per_mm2 = 600.0;
+  j.material.kr_n_per_mm2 = 180.0;
+  j.cut.mode = config::MillingMode::kDown;
+  j.cut.radial_mm = radial_mm;
+  j.cut.feed_per_tooth_mm = 0.05;
+  return j;
+}
+
+CutSettings settings_for(const Job& j, double rpm, double axial_mm) {
+  CutSettings s;
+  s.rpm = rpm;
+  s.cut = {j.cut.mode, j.cut.radial_mm, axial_mm, j.cut.feed_per_tooth_mm};
+  s.axial_slices = 1;
+  s.steps_per_tooth = steps_per_tooth(config::TimeDomainConfig{}, 600.0, rpm, j.cutter.teeth);
+  s.revolutions = 80;
+  s.settle_revolutions = 30;
+  return s;
+}
+
+TEST(Sdm, MultiplierConvergesWithTheStepsPerPeriod) {
+  const Job j = single_mode_job(1.2, false);
+  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
+  std::vector<double> mu;
+  for (int m : {20, 40, 80, 160}) mu.push_back(std::abs(SdmModel(terms, j.cutter, j.material, j.cut.mode, 1.2, 1, m).multiplier(5.0, 12000.0)));
+  // Each doubling at least halves the change (first order or better), and the last change is below 0.2 %.
+  EXPECT_LT(std::abs(mu[3] - mu[2]), 0.6 * std::abs(mu[2] - mu[1]));
+  EXPECT_LT(std::abs(mu[2] - mu[1]), 0.6 * std::abs(mu[1] - mu[0]));
+  EXPECT_LT(std::abs(mu[3] - mu[2]), 2e-3);
+}
+
+// Below the limit the simulated cut's once-per-tooth differences decay at the rate of SDM's dominant
+// Floquet multiplier: the two methods solve the same linearised process.
+TEST(Cut, DecayPerToothIsSdmsMultiplier) {
+  const Job j = single_mode_job(1.2, true);
+  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
+  const SdmModel sdm(terms, j.cutter, j.material, j.cut.mode, 1.2, 1, 80);
+  for (double b : {1.0, 2.0, 3.0, 4.0}) {
+    const CutOutcome o = run_cut(terms, j.cutter, j.material, settings_for(j, 12000.0, b));
+    const double sdm_mu = std::abs(sdm.multiplier(b, 12000.0));
+    EXPECT_TRUE(o.verdict.stable) << b;
+    EXPECT_NEAR(std::exp(o.verdict.growth_per_period), sdm_mu, 0.01) << b << " mm";
+  }
+}
+
+TEST(Cut, SlottingCriticalDepthAgreesWithSdmAndTheZeroOrderLobes) {
+  const Job j = single_mode_job(12.0, false);
+  const config::ToolConfig tool{config::ToolKind::kEndMill, 12.0, 2, 0.0};
+  const LobeModel lobes(j.structure, chatter_process(tool, j.material, j.cut), config::LobesConfig{});
+  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
+  const SdmModel sdm(terms, j.cutter, j.material, j.cut.mode, 12.0, 1, 40);
+  for (double rpm : {9000.0, 12000.0, 24000.0}) {
+    const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
+    const SdmPoint p = sdm.critical(rpm, zoa_mm);
+    const CriticalDepth td = critical_depth(terms, j.cutter, j.material, settings_for(j, rpm, 1.0), p.critical_depth_mm);
+    std::printf("slotting %.0f rpm: zero-order %.4f mm, SDM %.4f mm (%s), time domain %.4f mm (%s at %.0f Hz)\n", rpm,
+                zoa_mm, p.critical_depth_mm, to_string(p.type), td.depth_mm, to_string(td.above), td.chatter_hz);
+    EXPECT_NEAR(td.depth_mm / p.critical_depth_mm, 1.0, 0.03) << rpm;
+    EXPECT_NEAR(p.critical_depth_mm / zoa_mm, 1.0, 0.06) << rpm;
+    EXPECT_NEAR(td.chatter_hz, 600.0, 60.0) << rpm;
+  }
+}
+
+// Seed 000's observation: above the limit the spectrum has a chatter peak near the structure's mode;
+// below it, only the tooth-passing harmonics.
+TEST(Cut, ChatterShowsAtTheModeAboveTheLimitAndNotBelow) {
+  const Job j = single_mode_job(12.0, false);
+  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
+  const double limit_mm = SdmModel(terms, j.cutter, j.material, j.cut.mode, 12.0, 1, 40).critical(9000.0, 3.0).critical_depth_mm;
+  const CutOutcome below = run_cut(terms, j.cutter, j.material, settings_for(j, 9000.0, 0.8 * limit_mm));
+  const CutOutcome above = run_cut(terms, j.cutter, j.material, settings_for(j, 9000.0, 1.2 * limit_mm));
+  EXPECT_TRUE(below.verdict.stable);
+  EXPECT_EQ(below.verdict.classification, CutClass::kStable);
+  EXPECT_LT(below.verdict.nonharmonic_energy_ratio, 1e-3);
+  EXPECT_FALSE(above.verdict.stable);
+  EXPECT_GT(above.verdict.nonharmonic_energy_ratio, 0.3);
+  EXPECT_NEAR(above.verdict.chatter_hz, 600.0, 60.0);
+}
+
+TEST(Cut, TimeDomainSettingsAreValidatedLikeEveryKey) {
+  const std::string path = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/industrial_robot_aluminium.yaml";
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string dir = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling";
+  const config::MillingConfig ok =
+      config::parse_milling_config(text.str() + "\ntime_domain: {revolutions: 50, settle_revolutions: 10}\n", "job.yaml", dir);
+  EXPECT_EQ(ok.time_domain.revolutions, 50);
+  EXPECT_EQ(ok.time_domain.min_steps_per_mode_period, 20);
+  try {
+    (void)config::parse_milling_config(
+        text.str() + "\ntime_domain: {revolutions: 10, settle_revolutions: 10, runout_um: [1, 2], sdm_steps_per_period: 2}\n",
+        "job.yaml", dir);
+    ADD_FAILURE() << "expected a ConfigError";
+  } catch (const config::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("time_domain.settle_revolutions = 10 must be less than time_domain.revolutions = 10"), std::string::npos) << what;
+    EXPECT_NE(what.find("time_domain.runout_um"), std::string::npos) << what;
+    EXPECT_NE(what.find("radial offsets, one per tooth"), std::string::npos) << what;
+    EXPECT_NE(what.find("time_domain.sdm_steps_per_period = 2"), std::string::npos) << what;
+  }
+}
+
+}  // namespace
