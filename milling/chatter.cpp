@@ -26,6 +26,8 @@ namespace {
 
 struct OneSignal {
   double ratio{0.0}, growth{-1e300}, correlation{0.0}, nonharmonic{0.0}, chatter_hz{0.0}, chatter_energy{0.0};
+  double persistence{0.0};  // RMS of the differences in the last quarter over the second
+  std::complex<double> root{0.0};  // the dominant multiplier's estimate
   bool settled{true};
 };
 
@@ -38,10 +40,10 @@ double rms(const std::vector<double>& v, std::size_t a, std::size_t b) {
 // ln |largest root| of an autoregressive model of order 4 fitted by least squares to the second half of
 // the differences: the dominant Floquet multiplier's magnitude, even when several decaying and growing
 // components are mixed (a ratio of RMS values is not).
-double dominant_growth(const std::vector<double>& d) {
+std::complex<double> dominant_root(const std::vector<double>& d) {
   constexpr int p = 4;
   const std::size_t from = d.size() / 2;
-  if (d.size() - from < 4 * p) return -1e300;
+  if (d.size() - from < 4 * p) return 0.0;
   const auto rows = static_cast<Eigen::Index>(d.size() - from - p);
   Eigen::MatrixXd a(rows, p);
   Eigen::VectorXd b(rows);
@@ -51,15 +53,16 @@ double dominant_growth(const std::vector<double>& d) {
     for (int k = 0; k < p; ++k) a(r, k) = d[i - 1 - static_cast<std::size_t>(k)];
   }
   const double scale = a.cwiseAbs().maxCoeff();
-  if (!(scale > 0.0)) return -1e300;
+  if (!(scale > 0.0)) return 0.0;
   const Eigen::VectorXd coef = (a / scale).colPivHouseholderQr().solve(b / scale);
   Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(p, p);
   companion.row(0) = coef.transpose();
   for (int k = 1; k < p; ++k) companion(k, k - 1) = 1.0;
   const Eigen::VectorXcd roots = Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues();
-  double largest = 0.0;
-  for (Eigen::Index k = 0; k < roots.size(); ++k) largest = std::max(largest, std::abs(roots(k)));
-  return largest > 0.0 ? std::log(largest) : -1e300;
+  std::complex<double> largest(0.0);
+  for (Eigen::Index k = 0; k < roots.size(); ++k)
+    if (std::abs(roots(k)) > std::abs(largest)) largest = roots(k);
+  return largest;
 }
 
 OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t period, std::size_t base, double fs,
@@ -83,8 +86,9 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
   for (std::size_t i = half; i < end; ++i) scale = std::max(scale, std::abs(x[i]));
   o.ratio = ac > 0.0 ? rms(d, d.size() / 2, d.size()) / ac : 0.0;
   o.settled = r4 <= t.settled_ratio * std::max(scale, 1e-300);
-  (void)r2;
-  o.growth = dominant_growth(d);
+  o.persistence = r2 > 0.0 ? r4 / r2 : 0.0;
+  o.root = dominant_root(d);
+  o.growth = std::abs(o.root) > 0.0 ? std::log(std::abs(o.root)) : -1e300;
   double c0 = 0.0, c1 = 0.0;
   for (std::size_t i = d.size() / 2; i + 1 < d.size(); ++i) c0 += d[i] * d[i], c1 += d[i] * d[i + 1];
   o.correlation = c0 > 0.0 ? c1 / c0 : 0.0;
@@ -119,31 +123,37 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
   ChatterVerdict v;
   v.out_of_cut_share = out_of_cut_share;
   bool settled = true;
-  double chatter_energy = -1.0, correlation = 0.0;
+  double chatter_energy = -1.0, correlation = 0.0, persistence = 0.0;
+  std::complex<double> root(0.0);
   v.growth_per_period = -1e300;
   for (const auto* s : signals) {
     const OneSignal o = analyse(*s, start, static_cast<std::size_t>(samples_per_period),
                                 static_cast<std::size_t>(std::max(harmonic_base_periods, 1)), fs, t);
     settled = settled && o.settled;
+    persistence = std::max(persistence, o.persistence);
     v.once_per_period_ratio = std::max(v.once_per_period_ratio, o.ratio);
     v.nonharmonic_energy_ratio = std::max(v.nonharmonic_energy_ratio, o.nonharmonic);
-    if (o.growth > v.growth_per_period) v.growth_per_period = o.growth, correlation = o.correlation;
+    if (o.growth > v.growth_per_period) v.growth_per_period = o.growth, correlation = o.correlation, root = o.root;
     if (o.chatter_energy > chatter_energy) chatter_energy = o.chatter_energy, v.chatter_hz = o.chatter_hz;
   }
   // A cut whose once-per-period samples have settled is periodic, hence stable, even if its edges leave the
   // chip somewhere in each period (a forced periodic loss of contact). Otherwise it chatters when the
-  // differences grow, or when the tool keeps leaving the cut (chatter bounded by the loss of contact).
-  const bool grows = v.growth_per_period > t.growth_per_period;
+  // differences grow (the dominant multiplier's magnitude above 1), or when they persist at a sizeable
+  // share of the motion (a limit cycle: chatter bounded by the loss of contact).
+  const bool grows = v.growth_per_period > t.growth_per_period + t.neutral_growth;
+  const bool persists = persistence >= t.persistence && v.once_per_period_ratio >= t.limit_cycle_ratio;
   const bool out = out_of_cut_share > t.out_of_cut_share;
-  v.stable = settled || (!grows && !out);
+  v.stable = settled || !(grows || persists);
   if (v.stable) {
-    v.classification = CutClass::kStable;
+    v.classification = v.mechanism = CutClass::kStable;
     v.chatter_hz = 0.0;
-  } else if (out) {
-    v.classification = CutClass::kOutOfCut;
-  } else {
-    v.classification = correlation < t.flip_correlation ? CutClass::kFlip : CutClass::kHopf;
+    return v;
   }
+  // Period doubling: the dominant multiplier real and negative (within 3 degrees of -1's direction).
+  (void)correlation;
+  const bool flip = root.real() < 0.0 && std::abs(root.imag()) < t.flip_angle * std::abs(root);
+  v.mechanism = flip ? CutClass::kFlip : CutClass::kHopf;
+  v.classification = out ? CutClass::kOutOfCut : v.mechanism;
   return v;
 }
 

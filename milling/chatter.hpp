@@ -5,7 +5,8 @@
 //   - the share of spectral energy away from the tooth-passing (or spindle) harmonics, and the dominant
 //     chatter frequency there;
 //   - a classification: stable, Hopf (quasi-periodic), period doubling (flip: the once-per-period samples
-//     alternate, chatter at an odd multiple of half the tooth frequency), or tool out of cut.
+//     alternate, chatter at an odd multiple of half the tooth frequency), or tool out of cut (chatter that
+//     has grown until the edges leave the chip; its mechanism is reported beside it).
 // docs/milling.md, "Chatter detection", has the thresholds. Off the real-time path.
 #pragma once
 
@@ -19,14 +20,21 @@ enum class CutClass { kStable, kHopf, kFlip, kOutOfCut };
 
 struct ChatterThresholds {
   double growth_per_period{0.0};      // growth of the once-per-period differences above which it chatters
-  double out_of_cut_share{1e-3};      // engaged tooth-slice samples without a chip: the tool left the cut
+  double neutral_growth{1e-3};        // margin on growth_per_period (the multiplier's magnitude is estimated)
+  double persistence{0.9};            // differences keeping this share of their RMS over half the window ...
+  double limit_cycle_ratio{0.1};      // ... at this share of the motion or more: a limit cycle, chatter
+  double out_of_cut_share{1e-3};      // chatter with more engaged steps without a chip is "out of cut"
   double settled_ratio{1e-6};         // differences below this share of the signal are settled (stable)
-  double flip_correlation{-0.5};      // lag-1 correlation of the differences below this: period doubling
+  double flip_angle{0.05};            // dominant multiplier's |imag| / |mu| below this, real part < 0: flip
 };
 
 struct ChatterVerdict {
   bool stable{true};
   CutClass classification{CutClass::kStable};
+  // How an unstable cut chatters, whether or not the tool also leaves the cut: kFlip when the estimated
+  // dominant multiplier is real and negative (the once-per-period samples alternate), kHopf otherwise;
+  // kStable for a stable cut.
+  CutClass mechanism{CutClass::kStable};
   double chatter_hz{0.0};                 // dominant non-harmonic frequency (0 when none)
   double once_per_period_ratio{0.0};      // RMS of the differences over the signal's RMS (last half)
   double nonharmonic_energy_ratio{0.0};   // 0..1, DC excluded

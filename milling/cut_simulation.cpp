@@ -21,11 +21,13 @@ struct SliceState {
   Slice geometry;
   bool engaged_anywhere{false};
   double sk{1.0};                      // sin(kappa)
-  std::vector<double> sin_phi, cos_phi;
-  std::vector<char> in_material;       // inside the slice's engagement (the workpiece is there)
+  std::vector<double> sin_phi, cos_phi;  // at the middle of the bin's step
+  std::vector<double> weight;          // share of the bin's step the edge spends in the engagement
+  std::vector<char> in_material;       // weight > 0
   std::vector<double> surface_m;       // radial reach of the last pass that cut, per bin (workpiece frame)
   std::vector<char> cut_before;
-  std::size_t wall_bin{0};             // bin at the surface-generating angle
+  std::size_t wall_bin{0};             // bin whose step passes the surface-generating angle
+  double wall_fraction{0.0};           // where in that step
   double wall_sum_m{0.0};
   int wall_count{0};
   double wall_rev_max_m{-std::numeric_limits<double>::infinity()};
@@ -41,22 +43,28 @@ std::vector<SliceState> make_slices(const Cutter& cutter, const CutSettings& s, 
     const double local_radial = s.cut.radial_mm - (cutter.radius_mm - g.radius_mm);
     st.engaged_anywhere = local_radial > 0.0;
     const Engagement e = engagement(g.radius_mm, std::max(local_radial, 0.0), s.cut.mode);
-    st.sin_phi.resize(bins), st.cos_phi.resize(bins), st.in_material.resize(bins);
+    st.sin_phi.resize(bins), st.cos_phi.resize(bins), st.weight.resize(bins), st.in_material.resize(bins);
+    // Bin i is the step over which the edge goes from i dphi - lag to (i + 1) dphi - lag.
     for (std::size_t i = 0; i < bins; ++i) {
-      double phi = std::fmod(static_cast<double>(i) * dphi - g.lag_rad, 2.0 * M_PI);
-      if (phi < 0.0) phi += 2.0 * M_PI;
-      st.sin_phi[i] = std::sin(phi), st.cos_phi[i] = std::cos(phi);
-      st.in_material[i] = st.engaged_anywhere && phi >= e.start_rad - 1e-12 && phi <= e.exit_rad + 1e-12;
+      double a = std::fmod(static_cast<double>(i) * dphi - g.lag_rad, 2.0 * M_PI);
+      if (a < 0.0) a += 2.0 * M_PI;
+      const double mid = a + 0.5 * dphi;
+      st.sin_phi[i] = std::sin(mid), st.cos_phi[i] = std::cos(mid);
+      double inside = 0.0;
+      for (double turn : {0.0, 2.0 * M_PI})
+        inside += std::max(0.0, std::min(a + dphi, e.exit_rad + turn) - std::max(a, e.start_rad + turn));
+      st.weight[i] = st.engaged_anywhere ? inside / dphi : 0.0;
+      st.in_material[i] = st.weight[i] > 1e-12;
     }
     st.surface_m.assign(bins, 0.0);
     st.cut_before.assign(bins, 0);
-    // The engaged bin nearest the wall: the last before exit (down milling, pi) or the first after entry
-    // (up milling, 0).
+    // The step in which the edge passes the surface-generating angle (pi down, 0 up milling), and where.
     const double wall_angle = surface_angle_rad(s.cut.mode);
-    const double pos = (wall_angle + g.lag_rad) / dphi;
-    st.wall_bin = static_cast<std::size_t>(s.cut.mode == config::MillingMode::kDown ? std::floor(pos + 1e-9)
-                                                                                       : std::ceil(pos - 1e-9)) %
-                  bins;
+    double pos = std::fmod(wall_angle + g.lag_rad, 2.0 * M_PI) / dphi;
+    if (s.cut.mode == config::MillingMode::kDown) pos -= 1e-9;  // the step that ends at pi, not the next
+    const double whole = std::floor(pos);
+    st.wall_bin = static_cast<std::size_t>(whole + static_cast<double>(bins)) % bins;
+    st.wall_fraction = std::clamp(pos - whole, 0.0, 1.0);
     out.push_back(std::move(st));
   }
   return out;
@@ -84,11 +92,18 @@ CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& 
   const std::size_t steps = bins * static_cast<std::size_t>(s.revolutions);
   r.settle_steps = bins * static_cast<std::size_t>(s.settle_revolutions);
   r.x_m.reserve(steps), r.y_m.reserve(steps), r.fx_n.reserve(steps), r.fy_n.reserve(steps);
-  // The cutting force at step k with the tool displaced by q. commit: this is the step itself (renew the
-  // surface, count, record the wall); otherwise a look-ahead that only reads the surface memory.
-  auto cutting_force = [&](std::size_t k, const Eigen::Vector2d& q, bool commit) {
-    const double feed_m = ft * static_cast<double>(k) / m;  // nominal tool advance along x
-    const bool stats = commit && k >= r.settle_steps;
+  // The mean cutting force over step k, from the tool's displacement at the middle of the step (q_mid) and
+  // the edges' angles there, each edge weighted by the share of the step it spends in the engagement.
+  // commit=false would only read; the surface is renewed and the wall recorded at each step.
+  struct WallPass {
+    SliceState* slice;
+    double runout_m;
+  };
+  std::vector<WallPass> walls;  // this step's
+  walls.reserve(sl.size() * static_cast<std::size_t>(n));
+  auto cutting_force = [&](std::size_t k, const Eigen::Vector2d& q_mid) {
+    const double feed_m = ft * (static_cast<double>(k) + 0.5) / m;  // nominal tool advance along x
+    const bool stats = k >= r.settle_steps;
     Eigen::Vector2d f = Eigen::Vector2d::Zero();
     for (SliceState& st : sl) {
       const double db = st.geometry.height_mm * 1e-3, radius = st.geometry.radius_mm * 1e-3;
@@ -96,45 +111,48 @@ CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& 
         const std::size_t bin = (k + static_cast<std::size_t>(j) * static_cast<std::size_t>(m)) % bins;
         if (!st.in_material[bin]) continue;
         const double sp = st.sin_phi[bin], cp = st.cos_phi[bin];
-        const double deflection = q(0) * sp + q(1) * cp;
+        const double runout = runout_m[static_cast<std::size_t>(j)];
+        const double deflection = q_mid(0) * sp + q_mid(1) * cp;
         // Radial reach of this tooth's edge along its direction, in the workpiece's frame.
-        const double reach = radius + runout_m[static_cast<std::size_t>(j)] + deflection + feed_m * sp;
-        // Before any pass cut here, the workpiece is as a rigid previous tooth left it.
-        const std::size_t prev_tooth = static_cast<std::size_t>((j + n - 1) % n);
+        const double reach = radius + runout + deflection + feed_m * sp;
+        // Before any pass cut here, the workpiece is as the tooth one pitch ahead (which passed this angle
+        // a tooth period ago) would have left it with the tool displaced as it is now: the nominal chip,
+        // with the two teeth's runout. (A rigid previous pass would leave material near the wall that a
+        // tool deflected away from it never reaches, and that steady cut would never remove.)
+        const std::size_t prev_tooth = static_cast<std::size_t>((j + 1) % n);
         const double previous = st.cut_before[bin] ? st.surface_m[bin]
-                                                   : radius + runout_m[prev_tooth] + (feed_m - ft) * sp;
+                                                   : radius + runout_m[prev_tooth] + deflection + (feed_m - ft) * sp;
         const double chip_xy = reach - previous;
-        // The edge passing the surface-generating angle makes the wall there (the deepest pass of a
-        // revolution is what remains), whether or not it still removes a chip at that very angle.
-        if (stats && bin == st.wall_bin)
-          st.wall_rev_max_m = std::max(st.wall_rev_max_m, runout_m[static_cast<std::size_t>(j)] + deflection);
-        // Counted away from entry and exit, where the nominal chip itself tends to zero.
-        const bool counted = stats && sp > 0.1;
+        // The edge passes the surface angle in this step: it makes the wall there (recorded once the step's
+        // end is known), whether or not it still removes a chip at that very angle.
+        if (stats && bin == st.wall_bin) walls.push_back({&st, runout});
+        // Counted over whole steps inside the engagement (a steady cut has a chip everywhere there).
+        const bool counted = stats && st.weight[bin] == 1.0;
         if (counted) ++r.engaged_samples;
         if (chip_xy <= 0.0) {
           if (counted) ++r.out_of_cut_samples;  // no chip: no force, the surface stays as it was
           continue;
         }
-        const double chip = chip_xy * st.sk;
+        const double chip = chip_xy * st.sk, w = st.weight[bin];
         const double f_t = kt * db * chip + kte * db, f_r = st.sk * (kr * db * chip + kre * db);
-        f(0) += -f_t * cp - f_r * sp;
-        f(1) += f_t * sp - f_r * cp;
-        if (!commit) continue;
+        f(0) += w * (-f_t * cp - f_r * sp);
+        f(1) += w * (f_t * sp - f_r * cp);
         st.surface_m[bin] = reach;
         st.cut_before[bin] = 1;
       }
     }
     return f;
   };
-  // Each step: the force at its start, a look-ahead to its end with that force held, and the exact
-  // response to the force going linearly between the two (second order in h; a held force alone would
-  // act half a step late).
-  Eigen::Vector2d q = dyn.displacement();
+  // Each step: the displacement at its middle from the start and a look-ahead to its end with the last
+  // force held, the mean force over the step from there, and the exact response to that force held
+  // (second order in h; the force at the step's start alone would act half a step late).
+  Eigen::Vector2d f_last = Eigen::Vector2d::Zero();
   for (std::size_t k = 0; k < steps; ++k) {
-    const Eigen::Vector2d f0 = cutting_force(k, q, true);
-    const Eigen::Vector2d f1 = cutting_force(k + 1, dyn.predict(f0), false);
+    const Eigen::Vector2d q = dyn.displacement(), q_end = dyn.predict(f_last);
+    walls.clear();
+    const Eigen::Vector2d f = cutting_force(k, 0.5 * (q + q_end));
     if (k >= r.settle_steps) {
-      r.peak_force_n = std::max(r.peak_force_n, f0.norm());
+      r.peak_force_n = std::max(r.peak_force_n, f.norm());
       if ((k + 1) % bins == 0)  // a revolution ends: the deepest pass of it made the wall
         for (SliceState& st : sl)
           if (std::isfinite(st.wall_rev_max_m)) {
@@ -142,9 +160,15 @@ CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& 
             st.wall_rev_max_m = -std::numeric_limits<double>::infinity();
           }
     }
-    r.x_m.push_back(q(0)), r.y_m.push_back(q(1)), r.fx_n.push_back(f0(0)), r.fy_n.push_back(f0(1));
-    dyn.step(f0, f1);
-    q = dyn.displacement();
+    r.x_m.push_back(q(0)), r.y_m.push_back(q(1)), r.fx_n.push_back(f(0)), r.fy_n.push_back(f(1));
+    dyn.step(f, f);
+    f_last = f;
+    const Eigen::Vector2d q_next = dyn.displacement();
+    const double wall = surface_angle_rad(s.cut.mode);
+    for (const WallPass& w : walls) {  // the deflection when the edge is at the wall, linear in time
+      const Eigen::Vector2d at = q + w.slice->wall_fraction * (q_next - q);
+      w.slice->wall_rev_max_m = std::max(w.slice->wall_rev_max_m, w.runout_m + at(0) * std::sin(wall) + at(1) * std::cos(wall));
+    }
   }
   // Positive = undercut: the edge reached less far towards the wall than nominal.
   double sum = 0.0;

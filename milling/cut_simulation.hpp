@@ -42,8 +42,7 @@ struct CutRecord {
   double peak_force_n{0.0};      // after settling
   double sle_um{0.0};            // wall error after settling, mean over the engaged slices (+ = undercut)
   std::vector<double> wall_um;   // per slice (tip first), NaN where the slice does not reach the wall
-  std::uint64_t engaged_samples{0};  // tooth-slice samples inside the engagement after settling, where the
-                                     // nominal chip is at least 0.1 ft (sin phi > 0.1)
+  std::uint64_t engaged_samples{0};  // tooth-slice steps wholly inside the engagement after settling
   std::uint64_t out_of_cut_samples{0};  // of those, with no chip (h <= 0): the tool left the cut
   [[nodiscard]] double out_of_cut_share() const {
     return engaged_samples ? static_cast<double>(out_of_cut_samples) / static_cast<double>(engaged_samples) : 0.0;

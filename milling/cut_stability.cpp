@@ -65,6 +65,7 @@ CriticalDepth critical_depth(const std::vector<CutterModalTerm>& terms, const Cu
   }
   c.depth_mm = lo;
   c.above = above.classification;
+  c.mechanism = above.mechanism;
   c.chatter_hz = above.chatter_hz;
   return c;
 }
