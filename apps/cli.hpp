@@ -76,5 +76,6 @@ void register_replay(Registry& r);
 void register_csv(Registry& r);
 void register_lobes(Registry& r);
 void register_sle(Registry& r);
+void register_cut(Registry& r);
 
 }  // namespace robodamp::apps

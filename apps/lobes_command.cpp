@@ -29,9 +29,11 @@ int run_lobes(const MillingOptions& o) {
 
 void register_lobes(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
-  CLI::App* sub = r.add("lobes", "Stability lobes (zero-order method) with a direct check, open loop and --damped",
+  CLI::App* sub = r.add("lobes", "Stability lobes (zero-order or semi-discretization) with a direct check, open loop and --damped",
                         [o] { return run_lobes(*o); });
   add_milling_options(sub, *o);
+  sub->add_option("--method", o->method, "zoa: zero-order (default); sdm: semi-discretization (open loop, time_domain.sdm_*)")
+      ->check(CLI::IsMember({"zoa", "sdm"}));
   r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 1e6, true, false, "and within the job's lobes speed range"},
             "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
 }

@@ -12,6 +12,7 @@
 #include "apps/gnuplot.hpp"
 #include "config/milling_config.hpp"
 #include "milling/lobes.hpp"
+#include "milling/sdm.hpp"
 #include "milling/sle.hpp"
 
 namespace robodamp::apps {
@@ -71,6 +72,49 @@ json lobes_json(const milling::Structure& structure, const config::MillingConfig
   return j;
 }
 
+// The lobe diagram by semi-discretization (open-loop structure): the critical depth at time_domain.sdm_points
+// speeds over the lobes range, each from the zero-order limit there as the first guess.
+json sdm_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto terms = milling::cutter_modal_terms(structure, cfg.cut.feed_axis);
+  const milling::SdmModel sdm(terms, milling::cutter_from(cfg.tool), cfg.material, cfg.cut.mode, cfg.cut.radial_mm,
+                              cfg.time_domain.axial_slices, cfg.time_domain.sdm_steps_per_period);
+  config::LobesConfig grid = cfg.lobes;
+  grid.points = cfg.time_domain.sdm_points;
+  const milling::LobeModel zoa(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), grid);
+  const milling::LobeDiagram guess = zoa.diagram();
+  auto one = [&](double rpm, double guess_m) {
+    const double g = std::isfinite(guess_m) && guess_m > 0.0 ? guess_m * 1e3 : cfg.cut.axial_mm;
+    return sdm.critical(rpm, g);
+  };
+  json j;
+  j["structure"] = structure.name();
+  j["closed_loop"] = false;
+  j["method"] = "sdm";
+  j["steps_per_period"] = cfg.time_domain.sdm_steps_per_period;
+  j["curve"] = json::array();
+  double best = 1e300, best_rpm = 0.0, best_hz = 0.0;
+  for (const auto& p : guess.curve) {
+    const milling::SdmPoint s = one(p.rpm, p.b_lim_m);
+    j["curve"].push_back({{"rpm", p.rpm}, {"b_lim_mm", s.critical_depth_mm}, {"chatter_hz", s.chatter_hz},
+                          {"type", milling::to_string(s.type)}});
+    if (s.critical_depth_mm < best) best = s.critical_depth_mm, best_rpm = p.rpm, best_hz = s.chatter_hz;
+  }
+  j["min_b_lim_mm"] = best;
+  j["min_rpm"] = best_rpm;
+  j["min_chatter_hz"] = best_hz;
+  j["frequency_points"] = 0;
+  j["at_rpm"] = json::array();
+  for (double rpm : rpms) {
+    const milling::SdmPoint s = one(rpm, zoa.critical_depth_m(rpm));
+    j["at_rpm"].push_back({{"rpm", rpm}, {"b_lim_mm", s.critical_depth_mm}, {"chatter_hz", s.chatter_hz},
+                           {"type", milling::to_string(s.type)}, {"b_lim_lobes_mm", finite_or_null(zoa.critical_depth_m(rpm) * 1e3)}});
+  }
+  j["diagram_ms"] = elapsed_ms(t0);
+  j["notes"] = structure.notes();
+  return j;
+}
+
 double pct_change(const json& open, const json& damped) {
   if (open.is_null() || damped.is_null()) return NAN;
   return (damped.get<double>() / open.get<double>() - 1.0) * 100.0;
@@ -86,17 +130,23 @@ std::string fmt(const json& v, const char* format) {
 std::string lobes_table(const json& r) {
   std::ostringstream os;
   auto one = [&](const json& d, const char* label) {
+    const bool sdm = d.contains("method");
     os << "  " << label << ": minimum limiting depth " << fmt(d["min_b_lim_mm"], "%.3f") << " mm at "
-       << fmt(d["min_rpm"], "%.0f") << " rpm (chatter " << fmt(d["min_chatter_hz"], "%.1f") << " Hz); "
-       << d["frequency_points"].get<std::size_t>() << " chatter frequencies, " << fmt(d["diagram_ms"], "%.1f")
-       << " ms\n";
-    for (const auto& a : d["at_rpm"])
+       << fmt(d["min_rpm"], "%.0f") << " rpm (chatter " << fmt(d["min_chatter_hz"], "%.1f") << " Hz); ";
+    if (sdm)
+      os << d["curve"].size() << " speeds, " << d["steps_per_period"].get<int>() << " steps per tooth period, ";
+    else
+      os << d["frequency_points"].get<std::size_t>() << " chatter frequencies, ";
+    os << fmt(d["diagram_ms"], "%.1f") << " ms\n";
+    for (const auto& a : d["at_rpm"]) {
       os << "    at " << fmt(a["rpm"], "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
-         << " mm (direct test), lobes " << fmt(a["b_lim_lobes_mm"], "%.3f") << " mm, chatter "
-         << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
+         << (sdm ? " mm (semi-discretization, " + a["type"].get<std::string>() + "), zero-order " : " mm (direct test), lobes ")
+         << fmt(a["b_lim_lobes_mm"], "%.3f") << " mm, chatter " << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
+    }
   };
-  os << "Stability lobes of " << r["config"].get<std::string>() << " (structure " << r["structure"].get<std::string>()
-     << ", " << r["tool"].get<std::string>() << ")\n";
+  os << "Stability lobes (" << (r.contains("method") ? "semi-discretization" : "zero-order") << ") of "
+     << r["config"].get<std::string>() << " (structure " << r["structure"].get<std::string>() << ", "
+     << r["tool"].get<std::string>() << ")\n";
   one(r, "open  ");
   if (r.contains("damped")) {
     one(r["damped"], "damped");
@@ -285,7 +335,11 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   if (o.damped && !open.has_controller())
     throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
                                                "--damped needs a part with a controller (a damping configuration)"}});
-  json r = lobes_json(open, cfg, rpms);
+  if (o.method == "sdm" && o.damped)
+    throw config::ConfigError({config::Problem{cfg.source, {}, "--method",
+                                               "--method sdm is for the open-loop structure; with --damped use "
+                                               "--method zoa, or `robodamp cut --critical --damped`"}});
+  json r = o.method == "sdm" ? sdm_json(open, cfg, rpms) : lobes_json(open, cfg, rpms);
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
   r["spindle_rpm"] = cfg.cut.spindle_rpm;

@@ -20,6 +20,7 @@ struct MillingOptions {
   bool damped{false};             // also with the controller's loop closed, overlaid
   std::vector<double> rpm;        // lobes: extra speeds for the direct test
   std::string controller_path;    // replaces every controller part's damping configuration
+  std::string method{"zoa"};      // lobes: zoa (zero-order) or sdm (semi-discretization)
 };
 
 void add_milling_options(CLI::App* sub, MillingOptions& o);

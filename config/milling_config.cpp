@@ -214,6 +214,7 @@ TimeDomainConfig read_time_domain(MapReader& top, const ToolConfig& tool) {
                             " = " + std::to_string(c.revolutions) + " (statistics need revolutions after settling)");
   if (auto v = read_int(r, "axial_slices", {"(slices)", 1, 1000}, c.axial_slices)) c.axial_slices = *v;
   if (auto v = read_int(r, "sdm_steps_per_period", {"(steps)", 4, 1000}, c.sdm_steps_per_period)) c.sdm_steps_per_period = *v;
+  if (auto v = read_int(r, "sdm_points", {"(speeds)", 10, 100000}, c.sdm_points)) c.sdm_points = *v;
   const YAML::Node runout = r.child("runout_um", false, "");
   if (present(runout)) {
     bool ok = runout.IsSequence() && static_cast<int>(runout.size()) == tool.teeth;

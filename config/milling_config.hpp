@@ -100,6 +100,7 @@ struct TimeDomainConfig {
   int axial_slices{20};
   std::vector<double> runout_um;        // per tooth, radial (empty: none)
   int sdm_steps_per_period{40};         // semi-discretization intervals per tooth period
+  int sdm_points{200};                  // speeds of `lobes --method sdm` over the lobes range
 };
 
 // An SLE test condition (seed 004 Table 7) with the measured path offset the published predictions add.

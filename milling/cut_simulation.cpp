@@ -74,12 +74,20 @@ std::vector<SliceState> make_slices(const Cutter& cutter, const CutSettings& s, 
 
 CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                        const config::MaterialConfig& mat, const CutSettings& s) {
+  if (!(s.rpm > 0.0) || s.steps_per_tooth < 1)
+    throw std::invalid_argument("simulate_cut: needs rpm > 0 and steps_per_tooth >= 1");
+  ToolDynamics dyn(terms, 60.0 / (s.rpm * cutter.teeth) / s.steps_per_tooth);
+  return simulate_cut(dyn, cutter, mat, s);
+}
+
+CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::MaterialConfig& mat, const CutSettings& s) {
   if (!(s.rpm > 0.0) || s.steps_per_tooth < 1 || s.revolutions <= s.settle_revolutions)
     throw std::invalid_argument("simulate_cut: needs rpm > 0, steps_per_tooth >= 1, revolutions > settle_revolutions");
   const int n = cutter.teeth, m = s.steps_per_tooth;
   const std::size_t bins = static_cast<std::size_t>(n) * static_cast<std::size_t>(m);
   const double tooth_period_s = 60.0 / (s.rpm * n), h = tooth_period_s / m;
-  ToolDynamics dyn(terms, h);
+  if (std::abs(dyn.step_s() - h) > 1e-9 * h)
+    throw std::invalid_argument("simulate_cut: the dynamics' step is not the tooth period / steps_per_tooth");
   std::vector<SliceState> sl = make_slices(cutter, s, bins);
   std::vector<double> runout_m(static_cast<std::size_t>(n), 0.0);
   for (std::size_t j = 0; j < runout_m.size() && j < s.runout_um.size(); ++j) runout_m[j] = s.runout_um[j] * 1e-6;
@@ -148,20 +156,26 @@ CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& 
   // (second order in h; the force at the step's start alone would act half a step late).
   Eigen::Vector2d f_last = Eigen::Vector2d::Zero();
   for (std::size_t k = 0; k < steps; ++k) {
+    if (k == r.settle_steps) dyn.settled();
     const Eigen::Vector2d q = dyn.displacement(), q_end = dyn.predict(f_last);
     walls.clear();
     const Eigen::Vector2d f = cutting_force(k, 0.5 * (q + q_end));
     if (k >= r.settle_steps) {
       r.peak_force_n = std::max(r.peak_force_n, f.norm());
-      if ((k + 1) % bins == 0)  // a revolution ends: the deepest pass of it made the wall
+      if ((k + 1) % bins == 0) {  // a revolution ends: the deepest pass of it made the wall
+        double sum = 0.0;
+        int count = 0;
         for (SliceState& st : sl)
           if (std::isfinite(st.wall_rev_max_m)) {
             st.wall_sum_m += st.wall_rev_max_m, ++st.wall_count;
+            sum += st.wall_rev_max_m, ++count;
             st.wall_rev_max_m = -std::numeric_limits<double>::infinity();
           }
+        if (count) r.wall_per_rev_um.push_back(-sum / count * 1e6);
+      }
     }
     r.x_m.push_back(q(0)), r.y_m.push_back(q(1)), r.fx_n.push_back(f(0)), r.fy_n.push_back(f(1));
-    dyn.step(f, f);
+    dyn.step(f);
     f_last = f;
     const Eigen::Vector2d q_next = dyn.displacement();
     const double wall = surface_angle_rad(s.cut.mode);

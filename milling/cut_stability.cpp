@@ -6,10 +6,10 @@
 
 namespace robodamp::milling {
 
-CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter, const config::MaterialConfig& mat,
-                   const CutSettings& s) {
+namespace {
+CutOutcome classify(CutRecord record, const CutSettings& s) {
   CutOutcome o;
-  o.record = simulate_cut(terms, cutter, mat, s);
+  o.record = std::move(record);
   bool runout = false;
   for (double r : s.runout_um) runout = runout || r != 0.0;
   const CutRecord& r = o.record;
@@ -17,15 +17,34 @@ CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutt
                              1.0 / r.step_s, r.out_of_cut_share());
   return o;
 }
+}  // namespace
+
+CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter, const config::MaterialConfig& mat,
+                   const CutSettings& s) {
+  return classify(simulate_cut(terms, cutter, mat, s), s);
+}
+
+CutOutcome run_cut(CutDynamics& dynamics, const Cutter& cutter, const config::MaterialConfig& mat, const CutSettings& s) {
+  return classify(simulate_cut(dynamics, cutter, mat, s), s);
+}
 
 CriticalDepth critical_depth(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                              const config::MaterialConfig& mat, CutSettings s, double guess_mm, double rel_tol,
+                             const std::function<void(const std::string&)>& progress) {
+  const double h = 60.0 / (s.rpm * cutter.teeth) / s.steps_per_tooth;
+  return critical_depth([&] { return std::make_unique<ToolDynamics>(terms, h); }, cutter, mat, s, guess_mm, rel_tol,
+                        progress);
+}
+
+CriticalDepth critical_depth(const DynamicsFactory& dynamics, const Cutter& cutter, const config::MaterialConfig& mat,
+                             CutSettings s, double guess_mm, double rel_tol,
                              const std::function<void(const std::string&)>& progress) {
   if (!(guess_mm > 0.0)) throw std::invalid_argument("critical_depth: the first guess must be > 0 mm");
   CriticalDepth c;
   auto trial = [&](double depth_mm) {
     s.cut.axial_mm = depth_mm;
-    const CutOutcome o = run_cut(terms, cutter, mat, s);
+    const std::unique_ptr<CutDynamics> dyn = dynamics();
+    const CutOutcome o = run_cut(*dyn, cutter, mat, s);
     ++c.simulations;
     if (progress) {
       std::ostringstream os;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "milling/chatter.hpp"
@@ -18,6 +19,10 @@ struct CutOutcome {
 // Simulates and classifies one cut (the signals: both displacement components after settling).
 [[nodiscard]] CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                                  const config::MaterialConfig& material, const CutSettings& settings);
+[[nodiscard]] CutOutcome run_cut(CutDynamics& dynamics, const Cutter& cutter, const config::MaterialConfig& material,
+                                 const CutSettings& settings);
+// Fresh dynamics for each simulated cut (a bisection runs many).
+using DynamicsFactory = std::function<std::unique_ptr<CutDynamics>()>;
 
 struct CriticalDepth {
   double depth_mm{0.0};          // largest stable depth found (within rel_tol of the smallest unstable one)
@@ -30,6 +35,10 @@ struct CriticalDepth {
 // Bisection from a first guess (e.g. the zero-order limit): doubled or halved until the verdict changes,
 // then halved to rel_tol. progress (optional) gets one line per simulation.
 [[nodiscard]] CriticalDepth critical_depth(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
+                                           const config::MaterialConfig& material, CutSettings settings,
+                                           double guess_mm, double rel_tol = 2e-3,
+                                           const std::function<void(const std::string&)>& progress = {});
+[[nodiscard]] CriticalDepth critical_depth(const DynamicsFactory& dynamics, const Cutter& cutter,
                                            const config::MaterialConfig& material, CutSettings settings,
                                            double guess_mm, double rel_tol = 2e-3,
                                            const std::function<void(const std::string&)>& progress = {});

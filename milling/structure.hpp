@@ -24,6 +24,15 @@ struct Resonance {
 
 class Structure {
  public:
+  // A location of a damping configuration: its loop model, the location, the direction (0 = x, 1 = y) and
+  // the configured gain and polarity.
+  struct ControllerPart {
+    std::shared_ptr<const analysis::LoopModel> model;
+    std::size_t location{0};
+    std::size_t direction{1};
+    double gain_ns_per_m{0.0};
+    int polarity{1};
+  };
   // damped: close each controller part's loop at its configured gain and polarity. Throws
   // config::ConfigError if a controller configuration is invalid or its loop is unstable.
   Structure(const config::StructureConfig& cfg, bool damped);
@@ -48,17 +57,15 @@ class Structure {
     sim::FrfPath path;
   };
   [[nodiscard]] std::vector<ControllerPath> controller_paths() const;
+  [[nodiscard]] const std::vector<ControllerPart>& controller_parts() const { return controllers_; }
+  // The modal tables alone, per pair [xx, xy, yx, yy] (a Structure without the controller parts).
+  [[nodiscard]] std::array<std::vector<config::ModeConfig>, 4> modal_terms_by_pair() const {
+    return {modal_[0].modes, modal_[1].modes, modal_[2].modes, modal_[3].modes};
+  }
   // What the controller parts were closed with, for reports.
   [[nodiscard]] const std::vector<std::string>& notes() const { return notes_; }
 
  private:
-  struct ControllerPart {
-    std::shared_ptr<const analysis::LoopModel> model;
-    std::size_t location{0};
-    std::size_t direction{1};  // 0 = x, 1 = y
-    double gain_ns_per_m{0.0};
-    int polarity{1};
-  };
   std::string name_;
   bool damped_{false};
   std::array<config::FrfConfig, 4> modal_;  // xx, xy, yx, yy, all parts' modes together

@@ -26,7 +26,21 @@ struct CutterModalTerm {
 // The open-loop structure's modal terms in the cutter frame for a feed along feed_axis.
 [[nodiscard]] std::vector<CutterModalTerm> cutter_modal_terms(const Structure& structure, config::Axis feed_axis);
 
-class ToolDynamics {
+// What the cut simulation steps: the tool's displacement relative to the workpiece (cutter frame) under the
+// cutting force held over each step.
+class CutDynamics {
+ public:
+  virtual ~CutDynamics() = default;
+  [[nodiscard]] virtual double step_s() const = 0;
+  [[nodiscard]] virtual Eigen::Vector2d displacement() const = 0;  // m
+  // The displacement at the end of the next step with the force f held (an estimate where not exact), m.
+  [[nodiscard]] virtual Eigen::Vector2d predict(const Eigen::Vector2d& f_n) const = 0;
+  virtual void step(const Eigen::Vector2d& f_n) = 0;
+  // Called once when the statistics start (after the settling revolutions).
+  virtual void settled() {}
+};
+
+class ToolDynamics final : public CutDynamics {
  public:
   ToolDynamics(const std::vector<CutterModalTerm>& terms, double step_s);
 
@@ -34,11 +48,12 @@ class ToolDynamics {
   // (f1 = f0: held).
   void step(const Eigen::Vector2d& f0_n, const Eigen::Vector2d& f1_n) noexcept;
   void step(double fx_n, double fy_n) noexcept { step({fx_n, fy_n}, {fx_n, fy_n}); }
+  void step(const Eigen::Vector2d& f_n) override { step(f_n, f_n); }
   // The displacement one step ahead with the force f held, state unchanged, m.
-  [[nodiscard]] Eigen::Vector2d predict(const Eigen::Vector2d& f_n) const noexcept;
+  [[nodiscard]] Eigen::Vector2d predict(const Eigen::Vector2d& f_n) const noexcept override;
   // Tool displacement relative to the workpiece (cutter frame), m.
-  [[nodiscard]] Eigen::Vector2d displacement() const noexcept { return {output(0), output(1)}; }
-  [[nodiscard]] double step_s() const { return step_s_; }
+  [[nodiscard]] Eigen::Vector2d displacement() const noexcept override { return {output(0), output(1)}; }
+  [[nodiscard]] double step_s() const override { return step_s_; }
   [[nodiscard]] std::size_t blocks() const { return blocks_.size(); }
   // The continuous model (states [q_0, q_0', q_1, ...], inputs [fx, fy], outputs [x, y]): SDM uses it.
   [[nodiscard]] const Eigen::MatrixXd& a() const { return a_; }

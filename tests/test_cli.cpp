@@ -204,6 +204,84 @@ TEST(Cli, BenchOnSeveralThreadsGivesTheSerialRunsOutput) {
   std::filesystem::remove(path);
 }
 
+// Issue 15: one simulated cut (JSON, plots), open loop and with the damper; the critical depth by
+// simulation next to the semi-discretization lobes; bad input named with its unit and range.
+TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
+  const std::string open_json = temp_path("cut-open.json"), damped_json = temp_path("cut-damped.json"),
+                    dir = temp_path("cut-plots");
+  const Result open = run("cut --config " + job + " --rpm 252 --axial-mm 0.6 --json " + open_json + " --plot-dir " + dir);
+  ASSERT_EQ(open.status, 0) << open.out;
+  const auto o = nlohmann::json::parse(robodamp::test::read_file(open_json));
+  for (const char* key : {"rpm", "axial_mm", "stable", "classification", "chatter_hz", "once_per_tooth_ratio",
+                          "nonharmonic_energy_ratio", "peak_force_n", "peak_actuator_force_n", "actuator_saturated", "sle_um"})
+    EXPECT_TRUE(o.contains(key)) << key;
+  EXPECT_FALSE(o["stable"].get<bool>());
+  EXPECT_NEAR(o["chatter_hz"].get<double>(), 9.4, 0.5);  // the robot's first mode, as seed 002 saw
+  EXPECT_GT(o["nonharmonic_energy_ratio"].get<double>(), 0.5);
+  for (const char* png : {"cut_displacement.png", "cut_force.png", "cut_spectrum.png", "cut_surface.png"})
+    EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
+  const Result damped = run("cut --config " + job + " --rpm 252 --axial-mm 0.6 --damped --json " + damped_json);
+  ASSERT_EQ(damped.status, 0) << damped.out;
+  const auto d = nlohmann::json::parse(robodamp::test::read_file(damped_json));
+  EXPECT_TRUE(d["stable"].get<bool>()) << damped.out;
+  EXPECT_LT(d["nonharmonic_energy_ratio"].get<double>(), 0.01);
+  EXPECT_GT(d["peak_actuator_force_n"].get<double>(), 0.1);  // the damper works during the cut
+  EXPECT_FALSE(d["actuator_saturated"].get<bool>());
+  // Deep enough, the damped cut chatters too and drives the actuator into its limit: it shows.
+  const Result deep = run("cut --config " + job + " --rpm 252 --axial-mm 4 --damped --json " + damped_json);
+  const auto deep_j = nlohmann::json::parse(robodamp::test::read_file(damped_json));
+  EXPECT_FALSE(deep_j["stable"].get<bool>());
+  EXPECT_TRUE(deep_j["actuator_saturated"].get<bool>()) << deep.out;
+  EXPECT_NE(deep.out.find("SATURATED"), std::string::npos) << deep.out;
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(open_json);
+  std::filesystem::remove(damped_json);
+}
+
+TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
+  const std::string cut_json = temp_path("critical.json");
+  const Result c = run("cut --config " + job + " --critical --rpm 282 700 --json " + cut_json);
+  ASSERT_EQ(c.status, 0) << c.out;
+  const auto crit = nlohmann::json::parse(robodamp::test::read_file(cut_json))["critical"];
+  ASSERT_EQ(crit.size(), 2u);
+  const Result l = run("lobes --config " + job + " --method sdm --rpm 282 700 --json");
+  ASSERT_EQ(l.status, 0) << l.out;
+  const auto sdm = nlohmann::json::parse(l.out);
+  for (const char* key : {"curve", "min_b_lim_mm", "at_rpm"}) EXPECT_TRUE(sdm.contains(key)) << key;
+  EXPECT_EQ(sdm["curve"].size(), 200u);
+  EXPECT_TRUE(sdm["curve"][0].contains("type"));
+  for (std::size_t i = 0; i < 2; ++i) {
+    const double td = crit[i]["critical_depth_mm"].get<double>(), s = sdm["at_rpm"][i]["b_lim_mm"].get<double>();
+    EXPECT_NEAR(td / s, 1.0, 0.03) << crit[i]["rpm"];
+    EXPECT_TRUE(crit[i].contains("lobes_b_lim_mm"));
+  }
+  std::filesystem::remove(cut_json);
+  // SDM is an open-loop method: with --damped it says what to use instead.
+  const Result refused = run("lobes --config " + job + " --method sdm --damped");
+  EXPECT_EQ(refused.status, 2) << refused.out;
+  EXPECT_NE(refused.out.find("--method sdm is for the open-loop structure"), std::string::npos) << refused.out;
+}
+
+TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
+  const Result wide = run("cut --config " + job + " --radial-mm 13");
+  EXPECT_EQ(wide.status, 2) << wide.out;
+  EXPECT_NE(wide.out.find("--radial-mm = 13 mm is out of range: allowed 0 < value <= 12.7 mm (the tool's diameter)"),
+            std::string::npos) << wide.out;
+  std::string yaml = robodamp::test::read_file(job);
+  yaml.replace(yaml.find("../presets/"), 11, std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/");
+  yaml += "\ntime_domain: {steps_per_tooth: 2}\n";
+  const std::string path = temp_path("coarse.yaml");
+  std::ofstream(path) << yaml;
+  const Result coarse = run("cut --config " + path);
+  EXPECT_EQ(coarse.status, 2) << coarse.out;
+  EXPECT_NE(coarse.out.find("time_domain.steps_per_tooth = 2 steps is too coarse for the modes: allowed >= "), std::string::npos)
+      << coarse.out;
+  std::filesystem::remove(path);
+}
+
 TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {
   std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
   yaml.replace(yaml.find("axis_sign: -1"), 13, "axis_sign: +1");
@@ -335,6 +413,10 @@ TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
       {"request --enable 2", "--enable = 2 (1 = arm, 0 = disarm) is out of range"},
       {"request --timeout 0", "--timeout = 0 s is out of range"},
       {"bench --jobs 300", "--jobs = 300 (threads) is out of range: allowed 0 <= value <= 256 (threads) (0 = one per core)"},
+      {"cut --rpm 0", "--rpm = 0 rpm is out of range: allowed 0 < value <= 200000 rpm"},
+      {"cut --rpm nan", "--rpm = 'nan' is not a finite number"},
+      {"cut --axial-mm 0", "--axial-mm = 0 mm is out of range: allowed 0 < value <= 100 mm"},
+      {"cut --revs 2.5", "--revs = 2.5 is not a whole number"},
   };
   for (const auto& [args, wording] : cases) {
     const Result r = run_shell("timeout 60 " + std::string(ROBODAMP_BINARY) + " " + args);

@@ -115,6 +115,7 @@ std::vector<Sub> subcommands() {
       {"csv", {}, {}, {}, {}, true},
       {"lobes", {"--rpm"}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"sle", {}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
+      {"cut", {"--rpm", "--axial-mm", "--radial-mm", "--revs"}, {"--critical", "--damped"}, {}, {"--config"}, false},
   };
 }
 

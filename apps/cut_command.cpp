@@ -1,0 +1,219 @@
+// `robodamp cut`: one simulated cut of a milling job in time, with the chatter detector's verdict, the
+// forces, the machined wall and plots; or, with --critical, the time-domain critical depth at speeds next
+// to the zero-order limit (docs/milling.md, "Time domain").
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/fft.hpp"
+#include "apps/cli.hpp"
+#include "apps/gnuplot.hpp"
+#include "milling/cut_job.hpp"
+#include "milling/cut_stability.hpp"
+#include "milling/lobes.hpp"
+
+namespace robodamp::apps {
+
+using nlohmann::json;
+
+namespace {
+
+struct CutArgs {
+  std::string config_path{ROBODAMP_DEFAULT_MILLING_CONFIG};
+  std::string structure;
+  std::optional<double> axial_mm, radial_mm;
+  std::vector<double> rpm;
+  std::optional<int> revs;
+  bool critical{false};
+  bool damped{false};
+  std::string json_path, plot_dir;
+};
+
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+const config::StructureConfig& structure_of(const config::MillingConfig& cfg, const std::string& name) {
+  const std::string n = name.empty() ? cfg.structure : name;
+  if (const auto* s = cfg.find_structure(n)) return *s;
+  throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "--structure = '" + n + "' is not one of the job's structures"}});
+}
+
+json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double wall_s) {
+  const auto& r = o.record;
+  const auto& v = o.verdict;
+  return {{"rpm", r.rpm},
+          {"axial_mm", job.settings.cut.axial_mm},
+          {"radial_mm", job.settings.cut.radial_mm},
+          {"stable", v.stable},
+          {"classification", milling::to_string(v.classification)},
+          {"mechanism", milling::to_string(v.mechanism)},
+          {"chatter_hz", v.stable ? json(nullptr) : json(v.chatter_hz)},
+          {"once_per_tooth_ratio", v.once_per_period_ratio},
+          {"nonharmonic_energy_ratio", v.nonharmonic_energy_ratio},
+          {"growth_per_tooth", finite_or_null(v.growth_per_period)},
+          {"out_of_cut_share", v.out_of_cut_share},
+          {"peak_force_n", r.peak_force_n},
+          {"peak_actuator_force_n", finite_or_null(r.peak_actuator_force_n)},
+          {"actuator_saturated", r.actuator_saturated_s > 0.0},
+          {"actuator_saturated_s", r.actuator_saturated_s},
+          {"damped", job.damped},
+          {"requested_rpm", job.requested_rpm},
+          {"sle_um", finite_or_null(r.sle_um)},
+          {"steps_per_tooth", r.steps_per_tooth},
+          {"step_s", r.step_s},
+          {"simulated_s", r.step_s * static_cast<double>(r.x_m.size())},
+          {"wall_s", wall_s}};
+}
+
+std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  const auto& r = o.record;
+  const std::size_t from = r.settle_steps, n = r.x_m.size();
+  {  // displacement and force after settling
+    std::ostringstream d;
+    for (std::size_t k = from; k < n; ++k)
+      d << static_cast<double>(k) * r.step_s << ' ' << r.x_m[k] * 1e6 << ' ' << r.y_m[k] * 1e6 << ' ' << r.fx_n[k] << ' '
+        << r.fy_n[k] << '\n';
+    const std::string s1 =
+        "set title 'Tool displacement (cutter frame)'\nset grid\nset xlabel 'time (s)'\nset ylabel 'um'\n"
+        "plot DATA u 1:2 w l t 'x (feed)', DATA u 1:3 w l t 'y (wall normal)'\n";
+    if (auto e = run_gnuplot(s1, d.str(), dir + "/cut_displacement.png"); !e.empty()) return e;
+    const std::string s2 = "set title 'Cutting force on the tool'\nset grid\nset xlabel 'time (s)'\nset ylabel 'N'\n"
+                           "plot DATA u 1:4 w l t 'Fx', DATA u 1:5 w l t 'Fy'\n";
+    if (auto e = run_gnuplot(s2, d.str(), dir + "/cut_force.png"); !e.empty()) return e;
+  }
+  {  // spectrum of y after settling, tooth-passing harmonics marked
+    const std::size_t len = ((n - from) / static_cast<std::size_t>(r.steps_per_tooth)) * static_cast<std::size_t>(r.steps_per_tooth);
+    analysis::RealFft fft(len);
+    double mean = 0.0;
+    for (std::size_t i = 0; i < len; ++i) mean += r.y_m[n - len + i] / static_cast<double>(len);
+    for (std::size_t i = 0; i < len; ++i) fft.input()[i] = r.y_m[n - len + i] - mean;
+    const std::complex<double>* x = fft.forward();
+    const double df = 1.0 / (r.step_s * static_cast<double>(len)), tooth_hz = r.rpm * r.teeth / 60.0;
+    const double f_max = std::min(0.5 / r.step_s, 8.0 * tooth_hz + 2.0 * o.verdict.chatter_hz);
+    std::ostringstream d, s;
+    for (std::size_t k = 1; k < fft.bins() && static_cast<double>(k) * df <= f_max; ++k)
+      d << static_cast<double>(k) * df << ' ' << 2.0 * std::abs(x[k]) / static_cast<double>(len) * 1e6 << '\n';
+    s << "set title 'Spectrum of the wall-normal displacement (" << milling::to_string(o.verdict.classification)
+      << ")'\nset grid\nset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel 'amplitude (um)'\n";
+    for (int h = 1; h * tooth_hz <= f_max; ++h)
+      s << "set arrow from " << h * tooth_hz << ", graph 0 to " << h * tooth_hz << ", graph 1 nohead dt 3 lc rgb 'gray50'\n";
+    s << "plot DATA u 1:2 w l lw 2 t 'y (tooth-passing harmonics dotted)'\n";
+    if (auto e = run_gnuplot(s.str(), d.str(), dir + "/cut_spectrum.png"); !e.empty()) return e;
+  }
+  {  // the machined wall per revolution
+    std::ostringstream d;
+    for (std::size_t i = 0; i < r.wall_per_rev_um.size(); ++i) d << i << ' ' << r.wall_per_rev_um[i] << '\n';
+    const std::string s = "set title 'Machined wall: surface location error per revolution (+ = undercut)'\nset grid\n"
+                          "set xlabel 'revolution after settling'\nset ylabel 'um'\nplot DATA u 1:2 w lp t 'SLE'\n";
+    if (auto e = run_gnuplot(s, d.str(), dir + "/cut_surface.png"); !e.empty()) return e;
+  }
+  return {};
+}
+
+int run_cut(const CutArgs& a) {
+  try {
+    const config::MillingConfig cfg = config::load_milling_config(a.config_path);
+    const milling::Structure structure(structure_of(cfg, a.structure), false);
+    milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
+    std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
+    json out;
+    if (!a.critical) {
+      if (speeds.size() > 1)
+        throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", "--rpm: one speed for a cut (several with --critical)"}});
+      if (!a.rpm.empty()) ov.rpm = speeds.front();
+      const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
+      const auto t0 = std::chrono::steady_clock::now();
+      const milling::CutOutcome o = milling::run_job(job);
+      out = cut_json(job, o, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      std::printf("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
+                  out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
+                  out["classification"].get<std::string>().c_str());
+      if (!o.verdict.stable) std::printf(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
+      std::printf("; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f s\n",
+                  o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
+                  out["simulated_s"].get<double>(), out["wall_s"].get<double>());
+      if (job.damped)
+        std::printf("  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole number of loop periods)\n",
+                    o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
+                    o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
+      if (!a.plot_dir.empty()) {
+        if (auto e = plot_cut(o, a.plot_dir); !e.empty()) {
+          std::cerr << "plot: " << e << '\n';
+          return 1;
+        }
+        std::printf("wrote plots in %s\n", a.plot_dir.c_str());
+      }
+    } else {
+      const milling::Structure zoa_structure(structure_of(cfg, a.structure), a.damped);
+      const milling::LobeModel lobes(zoa_structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
+      out["critical"] = json::array();
+      for (double rpm : speeds) {
+        ov.rpm = rpm;
+        const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
+        const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
+        std::cerr << "[cut] critical depth at " << rpm << " rpm (zero-order " << zoa_mm << " mm):\n";
+        const auto t0 = std::chrono::steady_clock::now();
+        const milling::CriticalDepth c = milling::critical_depth(
+            job.dynamics, job.cutter, job.material, job.settings, std::isfinite(zoa_mm) ? zoa_mm : 1.0, 2e-3,
+            [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        out["critical"].push_back({{"rpm", rpm}, {"simulated_rpm", job.settings.rpm}, {"damped", a.damped},
+                                   {"critical_depth_mm", c.depth_mm}, {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
+                                   {"classification", milling::to_string(c.above)}, {"mechanism", milling::to_string(c.mechanism)},
+                                   {"chatter_hz", c.chatter_hz}, {"simulations", c.simulations}, {"wall_s", wall}});
+        std::printf("%8.0f rpm: time-domain critical depth %.4f mm (zero-order %.4f mm), above it %s (%s) at %.1f Hz; %d cuts in %.2f s\n",
+                    rpm, c.depth_mm, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism), c.chatter_hz,
+                    c.simulations, wall);
+      }
+    }
+    out["config"] = cfg.source;
+    out["structure"] = structure.name();
+    if (!a.json_path.empty()) {
+      std::ofstream f(a.json_path);
+      f << out.dump(2) << '\n';
+      if (!f) {
+        std::cerr << "--json " << a.json_path << ": cannot write\n";
+        return 1;
+      }
+      std::printf("wrote %s\n", a.json_path.c_str());
+    }
+    return 0;
+  } catch (const config::ConfigError& e) {
+    // Options and derived checks name themselves; problems in the job file come with file:line.
+    for (const auto& p : e.problems())
+      std::cerr << "robodamp cut: " << (p.mark.line > 0 ? p.to_string() : p.message) << '\n';
+    return 2;
+  }
+}
+
+}  // namespace
+
+void register_cut(Registry& r) {
+  auto a = std::make_shared<CutArgs>();
+  CLI::App* sub = r.add("cut", "Time-domain cut with chatter detection; --critical: critical depth by simulation",
+                        [a] { return run_cut(*a); });
+  sub->add_option("--config", a->config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
+  sub->add_option("--structure", a->structure, "Which of the job's structures (default: its `structure`)");
+  r.numbers(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, true, false}, "Spindle speed (several with --critical)");
+  r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "Axial depth (default: the job's)");
+  r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 1000.0, true, false, "and at most the tool's diameter"},
+           "Radial depth (default: the job's)");
+  r.whole_number(sub, "--revs", a->revs, {"(revolutions)", 2, 100000}, "Revolutions to simulate (default: the job's)");
+  sub->add_flag("--critical", a->critical, "Critical depth at each --rpm by bisection on simulated cuts");
+  sub->add_flag("--damped", a->damped,
+                "With the damping controller running: the real Controller, the simulated plant with its actuator, "
+                "limits and sensor, at the configuration's loop rate");
+  sub->add_option("--json", a->json_path, "Write the result as JSON to this file");
+  sub->add_option("--plot-dir", a->plot_dir, "Write displacement, force, spectrum and surface plots (PNG) here");
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,56 @@
+// The tool's dynamics in a cut with the damper running (docs/milling.md, "Time domain with the damper"):
+// the structure's modal tables as exact modal blocks (milling/tool_dynamics.hpp) plus, for each controller
+// part, the damping configuration's simulated plant (sim::Plant: the robot's modal model, the actuator of
+// Eq. 3 with its delay and its force and voltage limits, the control accelerometer with its noise and
+// ADC) closed by the real-time control::Controller (its chain, gain ramp and limits) with one sample of
+// computation delay, stepping at the configuration's loop rate. The cutting force acts on the plant at the
+// part's location along its direction. The cut steps at the loop period. Off the real-time path (the
+// per-step calls are the real-time code paths of the controller and the plant).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "analysis/loop_model.hpp"
+#include "control/controller.hpp"
+#include "milling/structure.hpp"
+#include "milling/tool_dynamics.hpp"
+#include "sim_plant/plant.hpp"
+
+namespace robodamp::milling {
+
+struct DampingStats {
+  double peak_actuator_force_n{0.0};  // transmitted (Eq. 3), after settling
+  double saturated_s{0.0};            // loop ticks at a controller or actuator limit, after settling
+  double loop_rate_hz{0.0};
+};
+
+class DampedDynamics final : public CutDynamics {
+ public:
+  // The structure's controller parts (loop models) with its modal tables, for a feed along feed_axis.
+  // Throws std::invalid_argument without a controller part or with two of different loop rates.
+  DampedDynamics(const Structure& structure, config::Axis feed_axis);
+
+  [[nodiscard]] double step_s() const override { return period_s_; }
+  [[nodiscard]] Eigen::Vector2d displacement() const override;
+  // Linear extrapolation of the last step (the plant has no look-ahead): second order in the step.
+  [[nodiscard]] Eigen::Vector2d predict(const Eigen::Vector2d& f_n) const override;
+  void step(const Eigen::Vector2d& f_n) override;
+
+  // Statistics from now on.
+  void settled() override { stats_ = true; }
+  [[nodiscard]] const DampingStats& stats() const { return stats_out_; }
+
+ private:
+  struct Loop;
+  [[nodiscard]] Eigen::Vector2d loops_displacement() const;
+  double period_s_{0.0};
+  config::Axis feed_axis_;
+  std::unique_ptr<ToolDynamics> modal_;  // the modal tables (none: null)
+  std::vector<std::shared_ptr<Loop>> loops_;
+  Eigen::Vector2d last_{Eigen::Vector2d::Zero()}, previous_{Eigen::Vector2d::Zero()};
+  bool stats_{false};
+  DampingStats stats_out_;
+};
+
+}  // namespace robodamp::milling
