@@ -79,6 +79,10 @@ MaterialConfig read_material(MapReader& top) {
   if (auto v = r.number("kte_n_per_mm", kEdge, 0.0)) m.kte_n_per_mm = *v;
   if (auto v = one_of(r, "kne_n_per_mm", "kre_n_per_mm", kEdge, 0.0)) m.kre_n_per_mm = *v;
   if (present(r.child("kac_n_per_mm2", false, ""))) m.ka_n_per_mm2 = r.number("kac_n_per_mm2", kCoefficient);
+  if (auto v = r.choice("force_model", {"linear", "exponential"}, "linear"); v && *v == "exponential") {
+    if (auto e = r.number("chip_exponent", {"(exponent)", 0.0, 0.9, false, false})) m.chip_exponent = *e;
+    if (auto h = r.number("reference_chip_mm", {"mm", 0.0, 5.0, true, false}, 0.1)) m.reference_chip_mm = *h;
+  }
   r.finish();
   return m;
 }

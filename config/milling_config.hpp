@@ -37,6 +37,10 @@ struct MaterialConfig {
   double kte_n_per_mm{0.0};
   double kre_n_per_mm{0.0};
   std::optional<double> ka_n_per_mm2;  // axial (ball end, seed 000): recorded, unused by the 2D models
+  // Exponential force model (time domain only): the cutting terms scale as (h / h_ref)^(-chip_exponent),
+  // so kt and kr are the specific coefficients at the reference chip h_ref. 0: linear.
+  double chip_exponent{0.0};
+  double reference_chip_mm{0.1};
 };
 
 struct CutConfig {

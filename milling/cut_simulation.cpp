@@ -94,6 +94,7 @@ CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::Mat
   const double ft = s.cut.feed_per_tooth_mm * 1e-3;
   const double kt = mat.kt_n_per_mm2 * 1e6, kr = mat.kr_n_per_mm2 * 1e6, kte = mat.kte_n_per_mm * 1e3,
                kre = mat.kre_n_per_mm * 1e3;
+  const double exponent = mat.chip_exponent, reference_chip_m = mat.reference_chip_mm * 1e-3;
 
   CutRecord r;
   r.rpm = s.rpm, r.step_s = h, r.teeth = n, r.steps_per_tooth = m;
@@ -142,7 +143,9 @@ CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::Mat
           continue;
         }
         const double chip = chip_xy * st.sk, w = st.weight[bin];
-        const double f_t = kt * db * chip + kte * db, f_r = st.sk * (kr * db * chip + kre * db);
+        // Linear, or exponential: the coefficients at the reference chip scaled by (h / h_ref)^-exponent.
+        const double scale = exponent > 0.0 ? std::pow(chip / reference_chip_m, -exponent) : 1.0;
+        const double f_t = kt * scale * db * chip + kte * db, f_r = st.sk * (kr * scale * db * chip + kre * db);
         f(0) += w * (-f_t * cp - f_r * sp);
         f(1) += w * (f_t * sp - f_r * cp);
         st.surface_m[bin] = reach;

@@ -193,4 +193,61 @@ TEST(Cut, LowImmersionFlipLobesAgreeWithSdm) {
   EXPECT_GE(flips, 1);
 }
 
+// Runout: the cut repeats once per revolution (not per tooth), the longer tooth takes the thicker chip;
+// with runout above the feed the shorter tooth never reaches the material (the tool leaves the cut every
+// other pass) and the cut is still stable and periodic.
+TEST(Cut, RunoutAndTheToolLeavingTheCutComeFromTheSurfaceMemory) {
+  const Job j = single_mode_job(3.0, false);
+  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
+  for (double runout_um : {10.0, 60.0}) {
+    CutSettings s = settings_for(j, 11000.0, 0.5);
+    s.runout_um = {runout_um, 0.0};
+    const CutOutcome o = run_cut(terms, j.cutter, j.material, s);
+    EXPECT_TRUE(o.verdict.stable) << runout_um;
+    EXPECT_LT(o.verdict.nonharmonic_energy_ratio, 1e-3) << runout_um;  // spindle harmonics count as harmonic
+    // Peak force of each tooth over the last revolution.
+    const std::size_t m = static_cast<std::size_t>(o.record.steps_per_tooth), end = o.record.fy_n.size();
+    double peak[2] = {0.0, 0.0};
+    for (std::size_t k = end - 2 * m; k < end; ++k) {
+      const std::size_t tooth = ((k % (2 * m)) < m) ? 0 : 1;  // tooth 0 sweeps the first half-revolution's bins
+      peak[tooth] = std::max(peak[tooth], std::hypot(o.record.fx_n[k], o.record.fy_n[k]));
+    }
+    const double ft_um = 50.0;
+    if (runout_um < ft_um) {
+      EXPECT_NEAR(std::max(peak[0], peak[1]) / std::min(peak[0], peak[1]), (ft_um + runout_um) / (ft_um - runout_um), 0.15);
+      // The short tooth misses the chip only where ft sin(phi) < the runout (near entry and exit).
+      EXPECT_GT(o.record.out_of_cut_samples, 0u);
+      EXPECT_LT(o.record.out_of_cut_share(), 0.25);
+    } else {
+      EXPECT_EQ(std::min(peak[0], peak[1]), 0.0);  // the shorter tooth cuts nothing
+      EXPECT_NEAR(o.record.out_of_cut_share(), 0.5, 0.02);
+    }
+  }
+}
+
+TEST(Cut, ExponentialForceModelScalesTheCuttingTermsWithTheChip) {
+  // A very stiff structure: the chip is the nominal ft sin(phi), so the force follows the model directly.
+  std::array<std::vector<config::ModeConfig>, 4> modes;
+  modes[0] = {stiff_mode(600.0, 0.02, 5.6e12)};
+  modes[3] = {stiff_mode(600.0, 0.02, 5.6e12)};
+  Job j{Structure(modes), {config::ToolKind::kEndMill, 6.0, 2, 0.0}, {}, {}};
+  j.material.kt_n_per_mm2 = 600.0;
+  j.material.kr_n_per_mm2 = 180.0;
+  j.cut = {config::MillingMode::kDown, 12.0, 1.0, 0.05, config::Axis::kX, 10000.0};
+  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
+  const CutSettings s = settings_for(j, 10000.0, 1.0);
+  const CutOutcome linear = run_cut(terms, j.cutter, j.material, s);
+  j.material.chip_exponent = 0.3;
+  j.material.reference_chip_mm = 0.05;
+  const CutOutcome exponential = run_cut(terms, j.cutter, j.material, s);
+  // Where the chip is the reference (phi = 90 deg) the two agree; elsewhere the thinner chip cuts harder.
+  const std::size_t m = static_cast<std::size_t>(s.steps_per_tooth), k90 = exponential.record.fy_n.size() - 2 * m + m / 2;
+  EXPECT_NEAR(exponential.record.fx_n[k90] / linear.record.fx_n[k90], 1.0, 0.01);
+  const std::size_t k20 = exponential.record.fy_n.size() - 2 * m + m / 9;  // phi near 20 deg: h = 0.34 ft
+  const double chip = std::sin((static_cast<double>(m / 9) + 0.5) * M_PI / static_cast<double>(m));
+  EXPECT_NEAR(std::hypot(exponential.record.fx_n[k20], exponential.record.fy_n[k20]) /
+                  std::hypot(linear.record.fx_n[k20], linear.record.fy_n[k20]),
+              std::pow(chip, -0.3), 0.01);
+}
+
 }  // namespace
