@@ -111,6 +111,22 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
     o.nonharmonic = total > 0.0 ? off / total : 0.0;
     o.chatter_hz = static_cast<double>(best_k) * fs / static_cast<double>(whole);
     o.chatter_energy = best;
+    // The dominant multiplier fixes the chatter frequency up to whole multiples of the period's frequency:
+    // f = k f_p +- arg(mu) / (2 pi) f_p. The candidate with the most energy in the spectrum is the chatter
+    // (a large transient of a slow mode elsewhere in the spectrum is not one of them).
+    if (std::abs(o.root) > 0.0) {
+      const double fp = fs / static_cast<double>(period), df = fs / static_cast<double>(whole);
+      const double alias_hz = std::abs(std::arg(o.root)) / (2.0 * M_PI) * fp;
+      double best_candidate = -1.0;
+      for (std::size_t k = 0; (static_cast<double>(k) + 1.0) * fp <= 0.5 * fs; ++k)
+        for (const double f : {static_cast<double>(k) * fp + alias_hz, static_cast<double>(k + 1) * fp - alias_hz}) {
+          const auto bin = static_cast<std::size_t>(std::lround(f / df));
+          double e = 0.0;
+          for (std::size_t b = bin > 0 ? bin - 1 : 1; b <= bin + 1 && b < fft.bins(); ++b)
+            if (b % step != 0) e = std::max(e, std::norm(X[b]));
+          if (e > best_candidate && f > 0.0) best_candidate = e, o.chatter_hz = f;
+        }
+    }
   }
   return o;
 }

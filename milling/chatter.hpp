@@ -2,8 +2,9 @@
 //   - the once-per-period statistic: the signal sampled once per tooth period (once per revolution with
 //     runout) repeats in a stable cut; its differences d_i = s_{i+1} - s_i decay, and their growth per
 //     period is ln of the dominant Floquet multiplier's magnitude;
-//   - the share of spectral energy away from the tooth-passing (or spindle) harmonics, and the dominant
-//     chatter frequency there;
+//   - the share of spectral energy away from the tooth-passing (or spindle) harmonics, and the chatter
+//     frequency: of the frequencies the dominant multiplier allows (k f_p +- arg(mu) f_p / 2 pi), the one
+//     with the most energy in the spectrum;
 //   - a classification: stable, Hopf (quasi-periodic), period doubling (flip: the once-per-period samples
 //     alternate, chatter at an odd multiple of half the tooth frequency), or tool out of cut (chatter that
 //     has grown until the edges leave the chip; its mechanism is reported beside it).
