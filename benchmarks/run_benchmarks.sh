@@ -29,6 +29,9 @@ echo
 echo "what each part of the main job costs (robodamp bench on the default preset):"
 ./build/benchmarks/benchmark_main_job
 echo
+echo "milling in time (cut, damped cut, critical depth, SDM diagram), one core:"
+taskset -c 0 ./build/benchmarks/benchmark_cut --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+echo
 echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (seed 004), the direct test's"
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
 taskset -c 0 ./build/benchmarks/benchmark_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
