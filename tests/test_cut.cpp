@@ -13,20 +13,14 @@
 #include "milling/sdm.hpp"
 #include "milling/sle.hpp"
 #include "milling/structure.hpp"
+#include "test_util.hpp"
 
 namespace {
 
 using namespace robodamp;
 using namespace robodamp::milling;
 
-config::ModeConfig stiff_mode(double fn, double zeta, double k) {
-  config::ModeConfig m;
-  m.form = config::ModeForm::kStiffness;
-  m.natural_freq_hz = fn;
-  m.damping_ratio = zeta;
-  m.stiffness_n_per_m = k;
-  return m;
-}
+using test::stiffness_mode;
 
 struct Job {
   Structure structure;
@@ -38,8 +32,8 @@ struct Job {
 // A 600 Hz mode in y (and in x too unless y_only), 2 straight teeth on a 12 mm cutter, kr/kt = 0.3.
 Job single_mode_job(double radial_mm, bool y_only) {
   std::array<std::vector<config::ModeConfig>, 4> modes;
-  if (!y_only) modes[0] = {stiff_mode(600.0, 0.02, 5.6e6)};
-  modes[3] = {stiff_mode(600.0, 0.02, 5.6e6)};
+  if (!y_only) modes[0] = {stiffness_mode(600.0, 0.02, 5.6e6)};
+  modes[3] = {stiffness_mode(600.0, 0.02, 5.6e6)};
   Job j{Structure(modes), {config::ToolKind::kEndMill, 6.0, 2, 0.0}, {}, {}};
   j.material.kt_n_per_mm2 = 600.0;
   j.material.kr_n_per_mm2 = 180.0;
@@ -228,8 +222,8 @@ TEST(Cut, RunoutAndTheToolLeavingTheCutComeFromTheSurfaceMemory) {
 TEST(Cut, ExponentialForceModelScalesTheCuttingTermsWithTheChip) {
   // A very stiff structure: the chip is the nominal ft sin(phi), so the force follows the model directly.
   std::array<std::vector<config::ModeConfig>, 4> modes;
-  modes[0] = {stiff_mode(600.0, 0.02, 5.6e12)};
-  modes[3] = {stiff_mode(600.0, 0.02, 5.6e12)};
+  modes[0] = {stiffness_mode(600.0, 0.02, 5.6e12)};
+  modes[3] = {stiffness_mode(600.0, 0.02, 5.6e12)};
   Job j{Structure(modes), {config::ToolKind::kEndMill, 6.0, 2, 0.0}, {}, {}};
   j.material.kt_n_per_mm2 = 600.0;
   j.material.kr_n_per_mm2 = 180.0;

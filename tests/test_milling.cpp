@@ -20,14 +20,7 @@ std::string milling_preset(const std::string& name) {
   return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + name + ".yaml";
 }
 
-cfg::ModeConfig stiffness_mode(double fn, double zeta, double k) {
-  cfg::ModeConfig m;
-  m.form = cfg::ModeForm::kStiffness;
-  m.natural_freq_hz = fn;
-  m.damping_ratio = zeta;
-  m.stiffness_n_per_m = k;
-  return m;
-}
+using robodamp::test::stiffness_mode;
 
 // One mode in y only: the oriented FRF's eigenvalues are alpha_yy G and 0.
 mill::Structure single_y_mode(double fn, double zeta, double k) {

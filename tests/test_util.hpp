@@ -22,6 +22,16 @@ inline control::ChainDesign design_preset(const std::string& name, double rate_h
   return control::design_chain(c);
 }
 
+// A mode in modal-stiffness form (Eq. 1 with a stiffness instead of a residue).
+inline config::ModeConfig stiffness_mode(double fn_hz, double zeta, double k_n_per_m) {
+  config::ModeConfig m;
+  m.form = config::ModeForm::kStiffness;
+  m.natural_freq_hz = fn_hz;
+  m.damping_ratio = zeta;
+  m.stiffness_n_per_m = k_n_per_m;
+  return m;
+}
+
 inline std::string read_file(const std::string& path) {
   std::ifstream in(path);
   std::stringstream ss;
