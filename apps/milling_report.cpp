@@ -94,8 +94,12 @@ json sdm_json(const milling::Structure& structure, const config::MillingConfig& 
   j["steps_per_period"] = cfg.time_domain.sdm_steps_per_period;
   j["curve"] = json::array();
   double best = 1e300, best_rpm = 0.0, best_hz = 0.0;
+  std::size_t done = 0;
   for (const auto& p : guess.curve) {
     const milling::SdmPoint s = one(p.rpm, p.b_lim_m);
+    if (++done % 20 == 0 || done == guess.curve.size())  // progress on stderr: a big model takes minutes
+      std::cerr << "[lobes sdm] " << done << "/" << guess.curve.size() << " speeds, " << elapsed_ms(t0) / 1000.0
+                << " s\n";
     j["curve"].push_back({{"rpm", p.rpm}, {"b_lim_mm", s.critical_depth_mm}, {"chatter_hz", s.chatter_hz},
                           {"type", milling::to_string(s.type)}});
     if (s.critical_depth_mm < best) best = s.critical_depth_mm, best_rpm = p.rpm, best_hz = s.chatter_hz;

@@ -248,7 +248,8 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
   ASSERT_EQ(crit.size(), 2u);
   const Result l = run("lobes --config " + job + " --method sdm --rpm 282 700 --json");
   ASSERT_EQ(l.status, 0) << l.out;
-  const auto sdm = nlohmann::json::parse(l.out);
+  EXPECT_NE(l.out.find("[lobes sdm] 200/200 speeds"), std::string::npos) << l.out;  // progress, on stderr
+  const auto sdm = nlohmann::json::parse(l.out.substr(l.out.find('{')));
   for (const char* key : {"curve", "min_b_lim_mm", "at_rpm"}) EXPECT_TRUE(sdm.contains(key)) << key;
   EXPECT_EQ(sdm["curve"].size(), 200u);
   EXPECT_TRUE(sdm["curve"][0].contains("type"));
