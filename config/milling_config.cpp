@@ -232,6 +232,20 @@ TimeDomainConfig read_time_domain(MapReader& top, const ToolConfig& tool) {
                           "must be a list of " + std::to_string(tool.teeth) +
                               " radial offsets, one per tooth, each -1000 <= value <= 1000 um");
   }
+  const YAML::Node pitch = r.child("pitch_deg", false, "");
+  if (present(pitch)) {
+    bool ok = pitch.IsSequence() && static_cast<int>(pitch.size()) == tool.teeth;
+    double sum = 0.0;
+    for (std::size_t i = 0; ok && i < pitch.size(); ++i) {
+      double v = 0.0;
+      ok = pitch[i].IsScalar() && YAML::convert<double>::decode(pitch[i], v) && std::isfinite(v) && v > 0.0 && v < 360.0;
+      if (ok) c.pitch_deg.push_back(v), sum += v;
+    }
+    if (!ok || std::abs(sum - 360.0) > 1e-6)
+      r.diagnostics().add(pitch.Mark(), "time_domain.pitch_deg",
+                          "must be a list of " + std::to_string(tool.teeth) +
+                              " angles from each tooth to the next, each 0 < value < 360 deg, summing to 360 deg");
+  }
   r.finish();
   return c;
 }

@@ -103,6 +103,7 @@ struct TimeDomainConfig {
   int settle_revolutions{20};           // not used by the statistics (start-up transient)
   int axial_slices{20};
   std::vector<double> runout_um;        // per tooth, radial (empty: none)
+  std::vector<double> pitch_deg;        // from each tooth to the next, summing to 360 (empty: even pitch)
   int sdm_steps_per_period{40};         // semi-discretization intervals per tooth period
   int sdm_points{200};                  // speeds of `lobes --method sdm` over the lobes range
 };

@@ -30,6 +30,7 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   s.settle_revolutions = td.settle_revolutions;
   s.axial_slices = td.axial_slices;
   s.runout_um = td.runout_um;
+  s.pitch_deg = td.pitch_deg;
   check(o.rpm ? "--rpm" : "cut.spindle_rpm", s.rpm, {"rpm", 0.0, 200000.0, true, false});
   check(o.axial_mm ? "--axial-mm" : "cut.axial_mm", s.cut.axial_mm, {"mm", 0.0, 100.0, true, false});
   check(o.radial_mm ? "--radial-mm" : "cut.radial_mm", s.cut.radial_mm,

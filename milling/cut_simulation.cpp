@@ -92,6 +92,23 @@ CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::Mat
   std::vector<double> runout_m(static_cast<std::size_t>(n), 0.0);
   for (std::size_t j = 0; j < runout_m.size() && j < s.runout_um.size(); ++j) runout_m[j] = s.runout_um[j] * 1e-6;
   const double ft = s.cut.feed_per_tooth_mm * 1e-3;
+  // Each tooth's angular position on the step grid and the feed since the tooth one pitch ahead passed the
+  // same angle (uneven pitch: the pitch's share of a revolution times the feed per revolution).
+  std::vector<std::size_t> tooth_bin(static_cast<std::size_t>(n));
+  std::vector<double> pitch_feed_m(static_cast<std::size_t>(n), ft);
+  {
+    const bool uneven = static_cast<int>(s.pitch_deg.size()) == n;
+    double angle_deg = 0.0;
+    for (int j = 0; j < n; ++j) {
+      tooth_bin[static_cast<std::size_t>(j)] =
+          uneven ? static_cast<std::size_t>(std::lround(angle_deg / 360.0 * static_cast<double>(bins))) % bins
+                 : static_cast<std::size_t>(j) * static_cast<std::size_t>(m);
+      if (uneven) {
+        pitch_feed_m[static_cast<std::size_t>(j)] = ft * n * s.pitch_deg[static_cast<std::size_t>(j)] / 360.0;
+        angle_deg += s.pitch_deg[static_cast<std::size_t>(j)];
+      }
+    }
+  }
   const double kt = mat.kt_n_per_mm2 * 1e6, kr = mat.kr_n_per_mm2 * 1e6, kte = mat.kte_n_per_mm * 1e3,
                kre = mat.kre_n_per_mm * 1e3;
   const double exponent = mat.chip_exponent, reference_chip_m = mat.reference_chip_mm * 1e-3;
@@ -117,7 +134,7 @@ CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::Mat
     for (SliceState& st : sl) {
       const double db = st.geometry.height_mm * 1e-3, radius = st.geometry.radius_mm * 1e-3;
       for (int j = 0; j < n; ++j) {
-        const std::size_t bin = (k + static_cast<std::size_t>(j) * static_cast<std::size_t>(m)) % bins;
+        const std::size_t bin = (k + tooth_bin[static_cast<std::size_t>(j)]) % bins;
         if (!st.in_material[bin]) continue;
         const double sp = st.sin_phi[bin], cp = st.cos_phi[bin];
         const double runout = runout_m[static_cast<std::size_t>(j)];
@@ -130,7 +147,8 @@ CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::Mat
         // tool deflected away from it never reaches, and that steady cut would never remove.)
         const std::size_t prev_tooth = static_cast<std::size_t>((j + 1) % n);
         const double previous = st.cut_before[bin] ? st.surface_m[bin]
-                                                   : radius + runout_m[prev_tooth] + deflection + (feed_m - ft) * sp;
+                                                   : radius + runout_m[prev_tooth] + deflection +
+                                                         (feed_m - pitch_feed_m[static_cast<std::size_t>(j)]) * sp;
         const double chip_xy = reach - previous;
         // The edge passes the surface angle in this step: it makes the wall there (recorded once the step's
         // end is known), whether or not it still removes a chip at that very angle.

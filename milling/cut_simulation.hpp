@@ -25,6 +25,7 @@ struct CutSettings {
   int revolutions{60};
   int settle_revolutions{20};
   std::vector<double> runout_um;  // per tooth (empty: none)
+  std::vector<double> pitch_deg;  // angle from each tooth to the next (empty: even pitch); on the step grid
 };
 
 // The steps per tooth period for a job: the configured value, or the fewest (at least 40) that give

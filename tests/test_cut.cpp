@@ -129,7 +129,8 @@ TEST(Cut, TimeDomainSettingsAreValidatedLikeEveryKey) {
   EXPECT_EQ(ok.time_domain.min_steps_per_mode_period, 20);
   try {
     (void)config::parse_milling_config(
-        text.str() + "\ntime_domain: {revolutions: 10, settle_revolutions: 10, runout_um: [1, 2], sdm_steps_per_period: 2}\n",
+        text.str() + "\ntime_domain: {revolutions: 10, settle_revolutions: 10, runout_um: [1, 2], sdm_steps_per_period: 2, "
+                     "pitch_deg: [100, 100, 100]}\n",
         "job.yaml", dir);
     ADD_FAILURE() << "expected a ConfigError";
   } catch (const config::ConfigError& e) {
@@ -138,6 +139,8 @@ TEST(Cut, TimeDomainSettingsAreValidatedLikeEveryKey) {
     EXPECT_NE(what.find("time_domain.runout_um"), std::string::npos) << what;
     EXPECT_NE(what.find("radial offsets, one per tooth"), std::string::npos) << what;
     EXPECT_NE(what.find("time_domain.sdm_steps_per_period = 2"), std::string::npos) << what;
+    EXPECT_NE(what.find("time_domain.pitch_deg: must be a list of 3 angles from each tooth to the next"), std::string::npos)
+        << what;
   }
 }
 
@@ -242,6 +245,30 @@ TEST(Cut, ExponentialForceModelScalesTheCuttingTermsWithTheChip) {
   EXPECT_NEAR(std::hypot(exponential.record.fx_n[k20], exponential.record.fy_n[k20]) /
                   std::hypot(linear.record.fx_n[k20], linear.record.fy_n[k20]),
               std::pow(chip, -0.3), 0.01);
+}
+
+// Uneven pitch: each tooth's chip is the feed since the tooth one pitch ahead passed (pitch / mean pitch x
+// the feed per tooth); the cut repeats once per revolution.
+TEST(Cut, UnevenPitchGivesEachToothTheFeedOfItsPitch) {
+  std::array<std::vector<config::ModeConfig>, 4> modes;
+  modes[0] = {stiffness_mode(600.0, 0.02, 5.6e12)};  // stiff: the chip is the nominal one
+  modes[3] = {stiffness_mode(600.0, 0.02, 5.6e12)};
+  Job j{Structure(modes), {config::ToolKind::kEndMill, 6.0, 2, 0.0}, {}, {}};
+  j.material.kt_n_per_mm2 = 600.0;
+  j.material.kr_n_per_mm2 = 180.0;
+  j.cut = {config::MillingMode::kDown, 12.0, 1.0, 0.05, config::Axis::kX, 10000.0};
+  CutSettings s = settings_for(j, 10000.0, 1.0);
+  s.steps_per_tooth = 180;  // the pitch angles fall on the 1 degree step grid
+  s.pitch_deg = {170.0, 190.0};
+  const CutOutcome o = run_cut(cutter_modal_terms(j.structure, config::Axis::kX), j.cutter, j.material, s);
+  EXPECT_TRUE(o.verdict.stable);
+  const std::size_t end = o.record.fy_n.size(), rev = 360;
+  double peak[2] = {0.0, 0.0};
+  for (std::size_t k = end - rev; k < end; ++k) {
+    const std::size_t tooth = (k % rev) < 180 ? 1 : 0;  // tooth 0 sits at bin 0, tooth 1 at bin 170
+    peak[tooth] = std::max(peak[tooth], std::hypot(o.record.fx_n[k], o.record.fy_n[k]));
+  }
+  EXPECT_NEAR(std::max(peak[0], peak[1]) / std::min(peak[0], peak[1]), 190.0 / 170.0, 0.02);
 }
 
 }  // namespace
