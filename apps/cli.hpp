@@ -77,5 +77,6 @@ void register_csv(Registry& r);
 void register_lobes(Registry& r);
 void register_sle(Registry& r);
 void register_cut(Registry& r);
+void register_identify(Registry& r);
 
 }  // namespace robodamp::apps

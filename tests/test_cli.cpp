@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "identify/cutting_coefficients.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -283,6 +284,46 @@ TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   std::filesystem::remove(path);
 }
 
+// Issue 16: cutting coefficients from a CSV of mean forces, the material block a milling job accepts, and
+// the refusals (nearly equal feeds with the condition number, a bad row with its line).
+TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData) {
+  const robodamp::identify::CuttingTest t{3, 12.7, 2.0, 3.175, robodamp::config::MillingMode::kDown};
+  auto write_csv = [&](const std::string& path, const std::vector<double>& feeds) {
+    std::ofstream out(path);
+    out << "feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n\n";
+    for (double c : feeds) {
+      const auto m = robodamp::identify::mean_forces(t, c, 700.0, 210.0, 100.0, 15.0, 20.0, 3.0);
+      out << c << ',' << m.fx_n << ',' << m.fy_n << ',' << m.fz_n << '\n';
+    }
+  };
+  const std::string csv = temp_path("forces.csv"), json = temp_path("coefficients.json"), yaml = temp_path("material.yaml");
+  write_csv(csv, {0.05, 0.1, 0.15, 0.2, 0.25});
+  const std::string opts = " --teeth 3 --diameter-mm 12.7 --axial-mm 2 --radial-mm 3.175 --mode down";
+  const Result r = run("identify cutting --csv " + csv + opts + " --json " + json + " --yaml " + yaml);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  EXPECT_NEAR(j["ktc_n_per_mm2"]["value"].get<double>(), 700.0, 0.01);
+  EXPECT_NEAR(j["kre_n_per_mm"]["value"].get<double>(), 20.0, 1e-3);
+  for (const char* key : {"r2_xy", "residual_rms_n", "condition_number"}) EXPECT_TRUE(j.contains(key)) << key;
+  // The material block goes into a milling job as it is.
+  std::string job = robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/single_mode_low_immersion.yaml");
+  const auto from = job.find("material:"), to = job.find("cut:");
+  job.replace(from, to - from, robodamp::test::read_file(yaml) + "\n");
+  const std::string job_path = temp_path("identified-job.yaml");
+  std::ofstream(job_path) << job;
+  const Result check = run("check-config " + job_path);
+  EXPECT_EQ(check.status, 0) << check.out;
+  write_csv(csv, {0.1, 0.100001, 0.100002});
+  const Result close = run("identify cutting --csv " + csv + opts);
+  EXPECT_EQ(close.status, 2) << close.out;
+  EXPECT_NE(close.out.find("collinear regressors: the condition number of the regression is"), std::string::npos) << close.out;
+  std::ofstream(csv) << "feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n\n0.1,1,2,3\n0.2,x,2,3\n";
+  const Result bad = run("identify cutting --csv " + csv + opts);
+  EXPECT_EQ(bad.status, 2) << bad.out;
+  EXPECT_NE(bad.out.find(":3: 'x' is not a number"), std::string::npos) << bad.out;
+  for (const auto& p : {csv, json, yaml, job_path}) std::filesystem::remove(p);
+}
+
 TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {
   std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
   yaml.replace(yaml.find("axis_sign: -1"), 13, "axis_sign: +1");
@@ -399,6 +440,7 @@ TEST(Cli, LobesRefusesSpeedsWithTheUnitAndTheAllowedRange) {
 
 TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
   const std::string c2 = robodamp::test::preset("horizontal_c2");
+  const std::string readme = std::string(ROBODAMP_SOURCE_DIR) + "/README.md";  // an existing file
   const std::pair<std::string, std::string> cases[] = {
       {"filters --freq 0", "--freq = 0 Hz is out of range: allowed 0 < value"},
       {"filters --config " + c2 + " --freq 2500", "--freq = 2500 Hz is out of range: allowed 0 < value < 2500 Hz"},
@@ -418,6 +460,10 @@ TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
       {"cut --rpm nan", "--rpm = 'nan' is not a finite number"},
       {"cut --axial-mm 0", "--axial-mm = 0 mm is out of range: allowed 0 < value <= 100 mm"},
       {"cut --revs 2.5", "--revs = 2.5 is not a whole number"},
+      {"identify cutting --csv " + readme + " --teeth 0 --diameter-mm 12 --axial-mm 1 --radial-mm 1",
+       "--teeth = 0 (teeth) is out of range: allowed 1 <= value <= 32 (teeth)"},
+      {"identify cutting --csv " + readme + " --teeth 2 --diameter-mm 12 --axial-mm -2 --radial-mm 1",
+       "--axial-mm = -2 mm is out of range: allowed 0 < value <= 100 mm"},
   };
   for (const auto& [args, wording] : cases) {
     const Result r = run_shell("timeout 60 " + std::string(ROBODAMP_BINARY) + " " + args);

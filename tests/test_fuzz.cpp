@@ -116,6 +116,7 @@ std::vector<Sub> subcommands() {
       {"lobes", {"--rpm"}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"sle", {}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"cut", {"--rpm", "--axial-mm", "--radial-mm", "--revs"}, {"--critical", "--damped"}, {}, {"--config"}, false},
+      {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm"}, {}, {{"--mode", {"down", "up"}}}, {"--csv"}, false},
   };
 }
 

@@ -1,0 +1,95 @@
+// Identification (issue 16, in progress): cutting coefficients from mean forces (Altintas' mechanistic
+// model) recovered from forces generated with known coefficients, slotting and 25 % immersion down
+// milling; confidence intervals that cover the truth under noise; refusals for ill-posed data.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "identify/cutting_coefficients.hpp"
+#include "milling/cutting.hpp"
+
+namespace {
+
+using namespace robodamp;
+using identify::CuttingTest;
+using identify::MeanForces;
+
+// seed 004's aluminium with edge and axial terms (N/mm^2 and N/mm).
+constexpr double kTc = 597.3, kRc = 59.8, kAc = 120.0, kTe = 20.0, kRe = 25.0, kAe = 4.0;
+
+std::vector<MeanForces> generated(const CuttingTest& t, const std::vector<double>& feeds) {
+  std::vector<MeanForces> out;
+  for (double c : feeds) out.push_back(identify::mean_forces(t, c, kTc, kRc, kAc, kTe, kRe, kAe));
+  return out;
+}
+
+TEST(IdentifyCutting, MeanForcesAreTheMillingModelsMeanForce) {
+  // The forward model is the frequency-domain model's zero harmonic (milling/cutting.hpp), x and y.
+  const CuttingTest t{3, 12.7, 2.0, 3.175, config::MillingMode::kDown};
+  config::MaterialConfig mat;
+  mat.kt_n_per_mm2 = kTc, mat.kr_n_per_mm2 = kRc, mat.kte_n_per_mm = kTe, mat.kre_n_per_mm = kRe;
+  const auto spectrum = milling::force_spectrum({config::ToolKind::kEndMill, 6.35, 3, 0.5}, mat,
+                                                {config::MillingMode::kDown, 3.175, 2.0, 0.1}, 10, 2);
+  const MeanForces m = identify::mean_forces(t, 0.1, kTc, kRc, kAc, kTe, kRe, kAe);
+  EXPECT_NEAR(m.fx_n, spectrum.fx[0].real(), 1e-9 * std::abs(m.fx_n) + 1e-12);
+  EXPECT_NEAR(m.fy_n, spectrum.fy[0].real(), 1e-9 * std::abs(m.fy_n));
+}
+
+TEST(IdentifyCutting, RecoversKnownCoefficientsInSlottingAndAtQuarterImmersion) {
+  for (const CuttingTest& t : {CuttingTest{3, 12.7, 2.0, 12.7, config::MillingMode::kDown},
+                               CuttingTest{3, 12.7, 2.0, 3.175, config::MillingMode::kDown}}) {
+    const identify::CuttingFit f = identify::identify_cutting(generated(t, {0.05, 0.075, 0.1, 0.125, 0.15}), t);
+    for (const auto& [got, want] : {std::pair{f.ktc.value, kTc}, {f.krc.value, kRc}, {f.kac.value, kAc},
+                                    {f.kte.value, kTe}, {f.kre.value, kRe}, {f.kae.value, kAe}})
+      EXPECT_NEAR(got, want, 1e-6 * want) << t.radial_mm << " mm radial";
+    EXPECT_NEAR(f.r2_xy, 1.0, 1e-12);
+    EXPECT_LT(f.residual_rms_n, 1e-9);
+    EXPECT_LT(f.condition_number, 100.0);
+  }
+}
+
+TEST(IdentifyCutting, ConfidenceIntervalsCoverTheTruthUnderNoise) {
+  const CuttingTest t{3, 12.7, 2.0, 3.175, config::MillingMode::kDown};
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);  // 1 N on forces of 20-200 N
+  int covered = 0, total = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    auto data = generated(t, {0.05, 0.075, 0.1, 0.125, 0.15, 0.175, 0.2});
+    for (auto& d : data) d.fx_n += noise(rng), d.fy_n += noise(rng), d.fz_n += noise(rng);
+    const identify::CuttingFit f = identify::identify_cutting(data, t);
+    for (const auto& [e, want] : {std::pair{f.ktc, kTc}, {f.krc, kRc}, {f.kte, kTe}, {f.kre, kRe}}) {
+      ++total;
+      covered += std::abs(e.value - want) <= e.ci95 ? 1 : 0;
+    }
+    EXPECT_LT(f.r2_xy, 1.0);
+    EXPECT_GT(f.residual_rms_n, 0.3);
+  }
+  EXPECT_GE(covered, static_cast<int>(0.85 * total)) << covered << " of " << total;  // 95 % nominal
+}
+
+TEST(IdentifyCutting, RefusesNearlyEqualFeedsTooFewPointsAndNaN) {
+  const CuttingTest t{3, 12.7, 2.0, 12.7, config::MillingMode::kDown};
+  // The condition number rises as the feeds close in, and the fit is refused with it.
+  const double spread_cond = identify::identify_cutting(generated(t, {0.05, 0.1, 0.15}), t).condition_number;
+  const double close_cond = identify::identify_cutting(generated(t, {0.1, 0.101, 0.102}), t).condition_number;
+  EXPECT_GT(close_cond, 10.0 * spread_cond);
+  try {
+    (void)identify::identify_cutting(generated(t, {0.1, 0.100001, 0.100002}), t);
+    ADD_FAILURE() << "nearly equal feeds were accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("collinear regressors: the condition number of the regression is"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW((void)identify::identify_cutting(generated(t, {0.1, 0.2}), t), std::invalid_argument);
+  auto with_nan = generated(t, {0.05, 0.1, 0.15, 0.2});
+  with_nan[2].fy_n = std::nan("");
+  try {
+    (void)identify::identify_cutting(with_nan, t);
+    ADD_FAILURE() << "NaN accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("row 3"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
