@@ -81,16 +81,26 @@ TEST(Cut, DecayPerToothIsSdmsMultiplier) {
   }
 }
 
-TEST(Cut, SlottingCriticalDepthAgreesWithSdmAndTheZeroOrderLobes) {
-  const Job j = single_mode_job(12.0, false);
+// The three methods' critical depths at one speed: zero-order direct test, SDM (40 steps), time domain.
+struct ThreeMethods {
+  double zoa_mm;
+  SdmPoint sdm;
+  CriticalDepth td;
+};
+ThreeMethods three_methods(const Job& j, double rpm) {
   const config::ToolConfig tool{config::ToolKind::kEndMill, 12.0, 2, 0.0};
   const LobeModel lobes(j.structure, chatter_process(tool, j.material, j.cut), config::LobesConfig{});
   const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
-  const SdmModel sdm(terms, j.cutter, j.material, j.cut.mode, 12.0, 1, 40);
+  const SdmModel sdm(terms, j.cutter, j.material, j.cut.mode, j.cut.radial_mm, 1, 40);
+  const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
+  const SdmPoint p = sdm.critical(rpm, zoa_mm);
+  return {zoa_mm, p, critical_depth(terms, j.cutter, j.material, settings_for(j, rpm, 1.0), p.critical_depth_mm)};
+}
+
+TEST(Cut, SlottingCriticalDepthAgreesWithSdmAndTheZeroOrderLobes) {
+  const Job j = single_mode_job(12.0, false);
   for (double rpm : {9000.0, 12000.0, 24000.0}) {
-    const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
-    const SdmPoint p = sdm.critical(rpm, zoa_mm);
-    const CriticalDepth td = critical_depth(terms, j.cutter, j.material, settings_for(j, rpm, 1.0), p.critical_depth_mm);
+    const auto [zoa_mm, p, td] = three_methods(j, rpm);
     std::printf("slotting %.0f rpm: zero-order %.4f mm, SDM %.4f mm (%s), time domain %.4f mm (%s, %s at %.0f Hz)\n", rpm,
                 zoa_mm, p.critical_depth_mm, to_string(p.type), td.depth_mm, to_string(td.mechanism), to_string(td.above),
                 td.chatter_hz);
@@ -168,15 +178,9 @@ TEST(Cut, StableCutReproducesTheFrequencyDomainSle) {
 // cut find them, and agree on the critical depth.
 TEST(Cut, LowImmersionFlipLobesAgreeWithSdm) {
   const Job j = single_mode_job(0.6, false);
-  const config::ToolConfig tool{config::ToolKind::kEndMill, 12.0, 2, 0.0};
-  const LobeModel lobes(j.structure, chatter_process(tool, j.material, j.cut), config::LobesConfig{});
-  const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
-  const SdmModel sdm(terms, j.cutter, j.material, j.cut.mode, 0.6, 1, 40);
   int flips = 0;
   for (double rpm : {13000.0, 20000.0, 24000.0, 38000.0}) {
-    const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
-    const SdmPoint p = sdm.critical(rpm, zoa_mm);
-    const CriticalDepth td = critical_depth(terms, j.cutter, j.material, settings_for(j, rpm, 1.0), p.critical_depth_mm);
+    const auto [zoa_mm, p, td] = three_methods(j, rpm);
     std::printf("5 %% immersion %.0f rpm: zero-order %.3f mm, SDM %.3f mm (%s, %.0f Hz), time domain %.3f mm (%s, %s at %.0f Hz)\n",
                 rpm, zoa_mm, p.critical_depth_mm, to_string(p.type), p.chatter_hz, td.depth_mm, to_string(td.mechanism),
                 to_string(td.above), td.chatter_hz);
