@@ -1,7 +1,12 @@
-// `robodamp identify cutting`: cutting coefficients of a flat end mill from mean forces at several feeds
-// (docs/identification.md), with their 95 % confidence intervals and the fit's quality figures, as JSON
-// and as a `material:` block for milling jobs.
+// `robodamp identify cutting`: cutting coefficients of a flat end mill from mean forces at several feeds,
+// with their 95 % confidence intervals and the fit's quality figures, as JSON and as a `material:` block
+// for milling jobs. `robodamp identify modes`: the modes of a measured FRF (LSCF poles with a stabilisation
+// diagram, LSFD residues, a nonlinear refinement) as JSON, a `modes:` list for presets and milling jobs,
+// and plots. docs/identification.md.
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <sstream>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -9,7 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
+#include "apps/gnuplot.hpp"
 #include "identify/cutting_coefficients.hpp"
+#include "identify/modal_fit.hpp"
 
 namespace robodamp::apps {
 
@@ -21,11 +28,95 @@ struct IdentifyArgs {
   int teeth{0};
   double diameter_mm{0.0}, axial_mm{0.0}, radial_mm{0.0};
   std::string mode{"down"};
+  // modes
+  std::string frf_path, kind{"receptance"}, plot_dir;
+  std::vector<double> band_hz;
+  int max_order{40};
 };
 
 nlohmann::json estimate(const identify::Estimate& e) { return {{"value", e.value}, {"ci95", e.ci95}}; }
 
+std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::ostringstream data;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < d.f_hz.size(); ++i) {
+    while (j < fit.fitted_f_hz.size() && fit.fitted_f_hz[j] < d.f_hz[i]) ++j;
+    const bool in = j < fit.fitted_f_hz.size() && fit.fitted_f_hz[j] == d.f_hz[i];
+    data << d.f_hz[i] << ' ' << std::abs(d.h[i]) << ' ' << std::arg(d.h[i]) * 180.0 / M_PI << ' '
+         << (in ? std::to_string(std::abs(fit.fitted[j])) : "NaN") << ' '
+         << (in ? std::to_string(std::arg(fit.fitted[j]) * 180.0 / M_PI) : "NaN") << '\n';
+  }
+  std::ostringstream s;
+  s << "set multiplot layout 2,1 title 'Measured and fitted receptance (fit error " << fit.fit_error_pct << " %)'\n"
+    << "set grid\nset logscale y\nset ylabel '|H| (m/N)'\nplot DATA u 1:2 w l t 'measured', DATA u 1:4 w l lw 2 t 'fit'\n"
+    << "unset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\n"
+    << "plot DATA u 1:3 w l t 'measured', DATA u 1:5 w l lw 2 t 'fit'\nunset multiplot\n";
+  if (auto e = run_gnuplot(s.str(), data.str(), dir + "/modes_fit.png"); !e.empty()) return e;
+  std::ostringstream diag;
+  for (const auto& p : fit.diagram) diag << p.freq_hz << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
+  const std::string s2 = "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
+                         "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
+  return run_gnuplot(s2, diag.str(), dir + "/modes_stabilisation.png");
+}
+
+int run_modes(const IdentifyArgs& a) {
+  identify::ModalFitSettings s;
+  if (a.band_hz.size() == 2) s.band_lo_hz = a.band_hz[0], s.band_hi_hz = a.band_hz[1];
+  s.max_order = a.max_order;
+  identify::FrfData d;
+  identify::ModalFit fit;
+  try {
+    if (!a.band_hz.empty() && (a.band_hz.size() != 2 || !(a.band_hz[1] > a.band_hz[0])))
+      throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
+    if (a.frf_path.empty()) throw std::invalid_argument("--frf is required for `identify modes`");
+    const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
+                      : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+    d = identify::read_frf_csv(a.frf_path, kind);
+    fit = identify::fit_modes(d, s);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "robodamp identify modes: " << e.what() << '\n';
+    return 2;
+  }
+  std::printf("%zu modes in %.3g-%.3g Hz, fit error %.3f %% (RMS |H - fit| / RMS |H|):\n", fit.modes.size(),
+              fit.band_lo_hz, fit.band_hi_hz, fit.fit_error_pct);
+  nlohmann::json j{{"fit_error_pct", fit.fit_error_pct}, {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}}, {"modes", nlohmann::json::array()}};
+  std::ostringstream yaml;
+  yaml << "# robodamp identify modes " << a.frf_path << ": fit error " << fit.fit_error_pct
+       << " %; Eq. 1 residue form in the table's frame. Paste under a robot.frfs entry or a milling part's pair.\nmodes:\n";
+  for (const auto& m : fit.modes) {
+    std::printf("  %9.4f Hz  zeta %.5f  sigma %+.4e %+.4ei m/N  (k %.4g N/m)\n", m.natural_freq_hz, m.damping_ratio,
+                m.residue_re, m.residue_im, m.stiffness_n_per_m);
+    j["modes"].push_back({{"natural_freq_hz", m.natural_freq_hz}, {"damping_ratio", m.damping_ratio},
+                          {"residue_re", m.residue_re}, {"residue_im", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
+    yaml << "  - {natural_freq_hz: " << m.natural_freq_hz << ", damping_ratio: " << m.damping_ratio
+         << ", residue_re_m_per_n: " << m.residue_re << ", residue_im_m_per_n: " << m.residue_im << "}\n";
+  }
+  if (!a.json_path.empty()) {
+    std::ofstream(a.json_path) << j.dump(2) << '\n';
+    std::printf("wrote %s\n", a.json_path.c_str());
+  }
+  if (!a.yaml_path.empty()) {
+    std::ofstream(a.yaml_path) << yaml.str();
+    std::printf("wrote %s\n", a.yaml_path.c_str());
+  }
+  if (!a.plot_dir.empty()) {
+    if (auto e = plot_modes(d, fit, a.plot_dir); !e.empty()) {
+      std::cerr << "plot: " << e << '\n';
+      return 1;
+    }
+    std::printf("wrote plots in %s\n", a.plot_dir.c_str());
+  }
+  return 0;
+}
+
 int run_identify(const IdentifyArgs& a) {
+  if (a.what == "modes") return run_modes(a);
+  if (a.csv_path.empty() || a.teeth == 0 || a.diameter_mm == 0.0 || a.axial_mm == 0.0 || a.radial_mm == 0.0) {
+    std::cerr << "robodamp identify cutting: --csv, --teeth, --diameter-mm, --axial-mm and --radial-mm are required\n";
+    return 2;
+  }
   identify::CuttingTest t{a.teeth, a.diameter_mm, a.axial_mm, a.radial_mm,
                           a.mode == "up" ? config::MillingMode::kUp : config::MillingMode::kDown};
   identify::CuttingFit f;
@@ -73,19 +164,26 @@ int run_identify(const IdentifyArgs& a) {
 
 void register_identify(Registry& r) {
   auto a = std::make_shared<IdentifyArgs>();
-  CLI::App* sub = r.add("identify", "Identify from measurements: `identify cutting` (cutting coefficients from mean forces)",
+  CLI::App* sub = r.add("identify",
+                        "Identify from measurements: `identify modes` (modes of an FRF), `identify cutting` (cutting "
+                        "coefficients from mean forces)",
                         [a] { return run_identify(*a); });
-  sub->add_option("what", a->what, "What to identify: cutting")->required()->check(CLI::IsMember({"cutting"}));
-  sub->add_option("--csv", a->csv_path, "Mean forces: feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n")
-      ->required()->check(CLI::ExistingFile);
-  r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "Teeth of the tool")->required();
-  r.number(sub, "--diameter-mm", a->diameter_mm, {"mm", 0.0, 200.0, true, false}, "Tool diameter")->required();
-  r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "Axial depth of the tests")->required();
+  sub->add_option("what", a->what, "What to identify: modes or cutting")->required()->check(CLI::IsMember({"modes", "cutting"}));
+  sub->add_option("--frf", a->frf_path, "modes: FRF CSV freq_hz,re_m_per_n,im_m_per_n[,coherence]")->check(CLI::ExistingFile);
+  sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
+  r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes: fit band LO HI (default: the whole FRF)");
+  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes: highest order of the stabilisation diagram (even)");
+  sub->add_option("--plot-dir", a->plot_dir, "modes: write the fit and the stabilisation diagram (PNG) here");
+  sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n")
+      ->check(CLI::ExistingFile);
+  r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");
+  r.number(sub, "--diameter-mm", a->diameter_mm, {"mm", 0.0, 200.0, true, false}, "cutting: tool diameter");
+  r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "cutting: axial depth of the tests");
   r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 200.0, true, false, "and at most --diameter-mm"},
-           "Radial depth of the tests (the diameter: slotting)")->required();
-  sub->add_option("--mode", a->mode, "down or up milling")->check(CLI::IsMember({"down", "up"}));
-  sub->add_option("--json", a->json_path, "Write the coefficients and quality figures as JSON");
-  sub->add_option("--yaml", a->yaml_path, "Write a material: block for milling jobs");
+           "cutting: radial depth of the tests (the diameter: slotting)");
+  sub->add_option("--mode", a->mode, "cutting: down or up milling")->check(CLI::IsMember({"down", "up"}));
+  sub->add_option("--json", a->json_path, "Write the result and its quality figures as JSON");
+  sub->add_option("--yaml", a->yaml_path, "Write a modes: list (modes) or a material: block (cutting)");
 }
 
 }  // namespace robodamp::apps

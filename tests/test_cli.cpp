@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include "identify/cutting_coefficients.hpp"
+#include "modal/receptance.hpp"
+#include <complex>
 #include "test_util.hpp"
 
 namespace {
@@ -322,6 +324,46 @@ TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData)
   EXPECT_EQ(bad.status, 2) << bad.out;
   EXPECT_NE(bad.out.find(":3: 'x' is not a number"), std::string::npos) << bad.out;
   for (const auto& p : {csv, json, yaml, job_path}) std::filesystem::remove(p);
+}
+
+// Issue 16: the preset's published H21yy modes (seed 001 Table 1, close modes at 21 and 23.5 Hz) back
+// from an accelerance CSV, with JSON, the modes: list and the plots.
+TEST(Cli, IdentifyModesRecoversThePresetsModesFromAnAccelerance) {
+  const auto cfg = robodamp::config::load_config_file(robodamp::test::preset("horizontal_c2"));
+  const auto& frf = cfg.robot.frfs[1];  // H21yy
+  const std::string csv = temp_path("frf.csv"), json = temp_path("modes.json"), yaml = temp_path("modes.yaml"),
+                    dir = temp_path("modes-plots");
+  {
+    std::ofstream out(csv);
+    out << "freq_hz,re_m_per_n,im_m_per_n,coherence\n";
+    for (double f = 2.0; f <= 60.0; f += 0.0125) {
+      const std::complex<double> a = -std::pow(2.0 * M_PI * f, 2) * robodamp::modal::frf_receptance(frf, f);
+      out << f << ',' << a.real() << ',' << a.imag() << ',' << (f < 4.0 ? 0.5 : 0.999) << '\n';
+    }
+  }
+  const Result r = run("identify modes --frf " + csv + " --kind accelerance --band-hz 5 40 --json " + json + " --yaml " +
+                       yaml + " --plot-dir " + dir);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
+  for (std::size_t i = 0; i < frf.modes.size(); ++i) {
+    const auto& m = j["modes"][i];
+    EXPECT_NEAR(m["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz, 0.005 * frf.modes[i].natural_freq_hz);
+    EXPECT_NEAR(m["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.05 * frf.modes[i].damping_ratio);
+    const double mag = std::hypot(frf.modes[i].residue_re_m_per_n, frf.modes[i].residue_im_m_per_n);
+    EXPECT_NEAR(std::hypot(m["residue_re"].get<double>() - frf.modes[i].residue_re_m_per_n,
+                           m["residue_im"].get<double>() - frf.modes[i].residue_im_m_per_n), 0.0, 0.05 * mag);
+  }
+  EXPECT_LT(j["fit_error_pct"].get<double>(), 1.0);
+  EXPECT_NE(robodamp::test::read_file(yaml).find("residue_re_m_per_n:"), std::string::npos);
+  for (const char* png : {"modes_fit.png", "modes_stabilisation.png"})
+    EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
+  // Too few coherent points: a clear refusal.
+  const Result narrow = run("identify modes --frf " + csv + " --band-hz 2 2.1");
+  EXPECT_EQ(narrow.status, 2) << narrow.out;
+  EXPECT_NE(narrow.out.find("too few coherent points in the band"), std::string::npos) << narrow.out;
+  std::filesystem::remove_all(dir);
+  for (const auto& p : {csv, json, yaml}) std::filesystem::remove(p);
 }
 
 TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {

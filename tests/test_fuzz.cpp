@@ -116,7 +116,8 @@ std::vector<Sub> subcommands() {
       {"lobes", {"--rpm"}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"sle", {}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"cut", {"--rpm", "--axial-mm", "--radial-mm", "--revs"}, {"--critical", "--damped"}, {}, {"--config"}, false},
-      {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm"}, {}, {{"--mode", {"down", "up"}}}, {"--csv"}, false},
+      {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm", "--band-hz", "--max-order"}, {},
+       {{"--mode", {"down", "up"}}, {"--kind", {"receptance", "mobility", "accelerance"}}}, {"--csv", "--frf"}, false},
   };
 }
 

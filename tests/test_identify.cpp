@@ -7,6 +7,8 @@
 #include <random>
 
 #include "identify/cutting_coefficients.hpp"
+#include "identify/modal_fit.hpp"
+#include "modal/receptance.hpp"
 #include "milling/cutting.hpp"
 
 namespace {
@@ -90,6 +92,47 @@ TEST(IdentifyCutting, RefusesNearlyEqualFeedsTooFewPointsAndNaN) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("row 3"), std::string::npos) << e.what();
   }
+}
+
+config::ModeConfig residue_mode(double fn, double zeta, double re, double im) {
+  config::ModeConfig m;
+  m.form = config::ModeForm::kResidue;
+  m.natural_freq_hz = fn, m.damping_ratio = zeta, m.residue_re_m_per_n = re, m.residue_im_m_per_n = im;
+  return m;
+}
+
+// Three modes, two of them 2 % apart, with 1 % complex noise: frequencies within 0.5 %, damping within
+// 5 %, residues within 5 % (issue 16's acceptance).
+TEST(IdentifyModes, SeparatesCloseModesUnderOnePercentNoise) {
+  config::FrfConfig truth;
+  truth.modes = {residue_mode(20.0, 0.02, -1.0e-7, -4.0e-6), residue_mode(20.4, 0.025, 2.0e-7, -3.0e-6),
+                 residue_mode(35.0, 0.03, 0.0, -2.0e-6)};
+  identify::FrfData d;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, 0.01 / std::sqrt(2.0));
+  for (double f = 10.0; f <= 50.0; f += 0.02) {
+    const std::complex<double> h = modal::frf_receptance(truth, f);
+    d.f_hz.push_back(f);
+    d.h.push_back(h * std::complex<double>(1.0 + n(rng), n(rng)));
+  }
+  identify::ModalFitSettings s;
+  s.max_order = 30;
+  const identify::ModalFit fit = identify::fit_modes(d, s);
+  ASSERT_EQ(fit.modes.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& want = truth.modes[i];
+    const auto& got = fit.modes[i];
+    std::printf("mode %zu: %.4f Hz (%.4f), zeta %.5f (%.5f), sigma %.4g%+.4gi (%.4g%+.4gi)\n", i, got.natural_freq_hz,
+                want.natural_freq_hz, got.damping_ratio, want.damping_ratio, got.residue_re, got.residue_im,
+                want.residue_re_m_per_n, want.residue_im_m_per_n);
+    EXPECT_NEAR(got.natural_freq_hz, want.natural_freq_hz, 0.005 * want.natural_freq_hz);
+    EXPECT_NEAR(got.damping_ratio, want.damping_ratio, 0.05 * want.damping_ratio);
+    const double mag = std::hypot(want.residue_re_m_per_n, want.residue_im_m_per_n);
+    EXPECT_NEAR(std::hypot(got.residue_re - want.residue_re_m_per_n, got.residue_im - want.residue_im_m_per_n), 0.0, 0.05 * mag);
+  }
+  std::printf("fit error %.3f %%\n", fit.fit_error_pct);
+  EXPECT_LT(fit.fit_error_pct, 2.0);  // the noise is 1 %
+  EXPECT_GT(fit.fit_error_pct, 0.3);
 }
 
 }  // namespace

@@ -1,0 +1,302 @@
+#include "identify/modal_fit.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+#include <unsupported/Eigen/NonLinearOptimization>
+#include <unsupported/Eigen/NumericalDiff>
+
+namespace robodamp::identify {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+struct Pole {
+  Complex s;  // rad/s
+  [[nodiscard]] double freq_hz() const { return std::abs(s) / kTwoPi; }
+  [[nodiscard]] double damping() const { return -s.real() / std::abs(s); }
+};
+
+// LSCF at one order: the common denominator A(W) = sum a_j W^j (a_p = 1) with W = e^{-i w dt}, fitted with
+// the numerator by linear least squares on B(W_k) - H_k A(W_k) = 0; the poles are A's roots.
+std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Complex>& h, int p, double dt,
+                             double f_lo, double f_hi) {
+  const auto k = static_cast<Eigen::Index>(f.size());
+  Eigen::MatrixXd a(2 * k, 2 * p + 1);
+  Eigen::VectorXd rhs(2 * k);
+  for (Eigen::Index r = 0; r < k; ++r) {
+    const Complex w = std::polar(1.0, -kTwoPi * f[static_cast<std::size_t>(r)] * dt);
+    const Complex hk = h[static_cast<std::size_t>(r)];
+    Complex wj(1.0);
+    for (int j = 0; j <= p; ++j) {
+      a(2 * r, j) = wj.real(), a(2 * r + 1, j) = wj.imag();  // numerator b_j
+      if (j < p) {
+        const Complex c = -hk * wj;  // denominator a_j
+        a(2 * r, p + 1 + j) = c.real(), a(2 * r + 1, p + 1 + j) = c.imag();
+      } else {
+        const Complex c = hk * wj;  // a_p = 1 on the right-hand side
+        rhs(2 * r) = c.real(), rhs(2 * r + 1) = c.imag();
+      }
+      wj *= w;
+    }
+  }
+  const Eigen::VectorXd norms = a.colwise().norm().cwiseMax(1e-300);
+  const Eigen::VectorXd x = (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(rhs).cwiseQuotient(norms);
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(p, p);  // monic: W^p + a_{p-1} W^{p-1} + ... + a_0
+  for (int j = 0; j < p; ++j) companion(0, j) = -x(p + 1 + (p - 1 - j));
+  for (int j = 1; j < p; ++j) companion(j, j - 1) = 1.0;
+  const Eigen::VectorXcd roots = Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues();
+  std::vector<Pole> out;
+  for (Eigen::Index i = 0; i < roots.size(); ++i) {
+    if (std::abs(roots(i)) < 1e-12) continue;
+    const Complex s = -std::log(roots(i)) / dt;
+    const Pole q{s};
+    if (s.imag() > 0.0 && s.real() < 0.0 && q.freq_hz() >= f_lo && q.freq_hz() <= f_hi && q.damping() < 0.5)
+      out.push_back(q);
+  }
+  std::sort(out.begin(), out.end(), [](const Pole& x1, const Pole& x2) { return x1.freq_hz() < x2.freq_hz(); });
+  return out;
+}
+
+// LSFD: residues of the given poles with lower (1 / (i w)^2) and upper (constant) residual terms.
+void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std::vector<Pole>& poles, ModalFit& fit) {
+  const auto k = static_cast<Eigen::Index>(f.size()), m = static_cast<Eigen::Index>(poles.size());
+  const Eigen::Index unknowns = 2 * m + 4;
+  Eigen::MatrixXd a(2 * k, unknowns);
+  Eigen::VectorXd y(2 * k);
+  auto basis = [&](double f_hz, Eigen::Index col) -> Complex {
+    const Complex s(0.0, kTwoPi * f_hz);
+    if (col < 2 * m) {
+      const Complex lam = poles[static_cast<std::size_t>(col / 2)].s;
+      const Complex p1 = 1.0 / (s - lam), p2 = 1.0 / (s - std::conj(lam));
+      return col % 2 == 0 ? p1 + p2 : Complex(0.0, 1.0) * (p1 - p2);  // sigma_re, sigma_im
+    }
+    const Complex lower = 1.0 / (s * s);
+    switch (col - 2 * m) {
+      case 0: return lower;
+      case 1: return Complex(0.0, 1.0) * lower;
+      case 2: return 1.0;
+      default: return Complex(0.0, 1.0);
+    }
+  };
+  for (Eigen::Index r = 0; r < k; ++r) {
+    for (Eigen::Index c = 0; c < unknowns; ++c) {
+      const Complex b = basis(f[static_cast<std::size_t>(r)], c);
+      a(2 * r, c) = b.real(), a(2 * r + 1, c) = b.imag();
+    }
+    y(2 * r) = h[static_cast<std::size_t>(r)].real(), y(2 * r + 1) = h[static_cast<std::size_t>(r)].imag();
+  }
+  const Eigen::VectorXd norms = a.colwise().norm().cwiseMax(1e-300);
+  const Eigen::VectorXd x = (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(y).cwiseQuotient(norms);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const Pole& q = poles[static_cast<std::size_t>(i)];
+    IdentifiedMode md;
+    md.natural_freq_hz = q.freq_hz();
+    md.damping_ratio = q.damping();
+    md.residue_re = x(2 * i), md.residue_im = x(2 * i + 1);
+    const double wn = std::abs(q.s), wd = q.s.imag(), mag = std::hypot(md.residue_re, md.residue_im);
+    md.stiffness_n_per_m = mag > 0.0 ? wn * wn / (2.0 * mag * wd) : INFINITY;
+    fit.modes.push_back(md);
+  }
+  fit.lower_residual = {x(2 * m), x(2 * m + 1)};
+  fit.upper_residual = {x(2 * m + 2), x(2 * m + 3)};
+  double err = 0.0, ref = 0.0;
+  for (Eigen::Index r = 0; r < k; ++r) {
+    Complex model(0.0);
+    for (Eigen::Index c = 0; c < unknowns; ++c) model += x(c) * basis(f[static_cast<std::size_t>(r)], c);
+    fit.fitted.push_back(model);
+    fit.fitted_f_hz.push_back(f[static_cast<std::size_t>(r)]);
+    err += std::norm(model - h[static_cast<std::size_t>(r)]);
+    ref += std::norm(h[static_cast<std::size_t>(r)]);
+  }
+  fit.fit_error_pct = ref > 0.0 ? 100.0 * std::sqrt(err / ref) : 0.0;
+}
+
+// The model's value at f: sum over modes of sigma/(s - lam) + conj, plus lower/(s^2) and upper residuals.
+Complex model_at(double f_hz, const std::vector<IdentifiedMode>& modes, Complex lower, Complex upper) {
+  const Complex s(0.0, kTwoPi * f_hz);
+  Complex h = lower / (s * s) + upper;
+  for (const auto& m : modes) {
+    const double wn = kTwoPi * m.natural_freq_hz, z = m.damping_ratio;
+    const Complex lam(-z * wn, wn * std::sqrt(std::max(1.0 - z * z, 1e-12))), sig(m.residue_re, m.residue_im);
+    h += sig / (s - lam) + std::conj(sig) / (s - std::conj(lam));
+  }
+  return h;
+}
+
+// Nonlinear least squares (Levenberg-Marquardt, Eigen) of every mode's frequency, damping and residue and
+// the residual terms, from the LSCF/LSFD estimate, on the relative error (noise proportional to |H|, as an
+// H1 estimate's is): it removes the bias the linearised LSCF has under noise.
+struct Refinement {
+  using Scalar = double;
+  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
+  using InputType = Eigen::VectorXd;
+  using ValueType = Eigen::VectorXd;
+  using JacobianType = Eigen::MatrixXd;
+  const std::vector<double>* f;
+  const std::vector<Complex>* h;
+  std::size_t modes;
+  double sigma_scale, lower_scale, upper_scale;
+  [[nodiscard]] int inputs() const { return static_cast<int>(4 * modes + 4); }
+  [[nodiscard]] int values() const { return static_cast<int>(2 * f->size()); }
+  [[nodiscard]] std::vector<IdentifiedMode> unpack(const Eigen::VectorXd& x, Complex& lower, Complex& upper) const {
+    std::vector<IdentifiedMode> out(modes);
+    for (std::size_t i = 0; i < modes; ++i) {
+      const auto k = static_cast<Eigen::Index>(4 * i);
+      out[i].natural_freq_hz = x(k);
+      out[i].damping_ratio = x(k + 1) * 1e-2;
+      out[i].residue_re = x(k + 2) * sigma_scale, out[i].residue_im = x(k + 3) * sigma_scale;
+    }
+    const auto k = static_cast<Eigen::Index>(4 * modes);
+    lower = {x(k) * lower_scale, x(k + 1) * lower_scale};
+    upper = {x(k + 2) * upper_scale, x(k + 3) * upper_scale};
+    return out;
+  }
+  int operator()(const Eigen::VectorXd& x, Eigen::VectorXd& r) const {
+    Complex lower, upper;
+    const auto m = unpack(x, lower, upper);
+    for (std::size_t i = 0; i < f->size(); ++i) {
+      const Complex e = (model_at((*f)[i], m, lower, upper) - (*h)[i]) / std::max(std::abs((*h)[i]), 1e-300);
+      r(static_cast<Eigen::Index>(2 * i)) = e.real(), r(static_cast<Eigen::Index>(2 * i + 1)) = e.imag();
+    }
+    return 0;
+  }
+};
+
+void refine(const std::vector<double>& f, const std::vector<Complex>& h, ModalFit& fit) {
+  double sigma_scale = 0.0;
+  for (const auto& m : fit.modes) sigma_scale = std::max(sigma_scale, std::hypot(m.residue_re, m.residue_im));
+  if (!(sigma_scale > 0.0)) return;
+  const double w_lo = kTwoPi * f.front(), w_hi = kTwoPi * f.back();
+  Refinement fn{&f, &h, fit.modes.size(), sigma_scale, sigma_scale * w_lo, sigma_scale / w_hi};
+  Eigen::VectorXd x(fn.inputs());
+  for (std::size_t i = 0; i < fit.modes.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(4 * i);
+    x(k) = fit.modes[i].natural_freq_hz, x(k + 1) = fit.modes[i].damping_ratio * 1e2;
+    x(k + 2) = fit.modes[i].residue_re / sigma_scale, x(k + 3) = fit.modes[i].residue_im / sigma_scale;
+  }
+  const auto k = static_cast<Eigen::Index>(4 * fit.modes.size());
+  x(k) = fit.lower_residual.real() / fn.lower_scale, x(k + 1) = fit.lower_residual.imag() / fn.lower_scale;
+  x(k + 2) = fit.upper_residual.real() / fn.upper_scale, x(k + 3) = fit.upper_residual.imag() / fn.upper_scale;
+  Eigen::NumericalDiff<Refinement> diff(fn);
+  Eigen::LevenbergMarquardt<Eigen::NumericalDiff<Refinement>> lm(diff);
+  lm.parameters.maxfev = 200 * (fn.inputs() + 1);
+  lm.minimize(x);
+  Complex lower, upper;
+  std::vector<IdentifiedMode> modes = fn.unpack(x, lower, upper);
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    // Keep the refinement only while it stays physical (a mode in the band, damped).
+    if (!(modes[i].damping_ratio > 0.0 && modes[i].damping_ratio < 0.5 && modes[i].natural_freq_hz >= f.front() &&
+          modes[i].natural_freq_hz <= f.back()))
+      return;
+    const double wn = kTwoPi * modes[i].natural_freq_hz, wd = wn * std::sqrt(1.0 - std::pow(modes[i].damping_ratio, 2));
+    const double mag = std::hypot(modes[i].residue_re, modes[i].residue_im);
+    modes[i].stiffness_n_per_m = mag > 0.0 ? wn * wn / (2.0 * mag * wd) : INFINITY;
+  }
+  fit.modes = modes;
+  fit.lower_residual = lower, fit.upper_residual = upper;
+  double err = 0.0, ref = 0.0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    fit.fitted[i] = model_at(f[i], fit.modes, lower, upper);
+    err += std::norm(fit.fitted[i] - h[i]), ref += std::norm(h[i]);
+  }
+  fit.fit_error_pct = 100.0 * std::sqrt(err / ref);
+}
+
+}  // namespace
+
+ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
+  if (d.f_hz.size() != d.h.size() || (!d.coherence.empty() && d.coherence.size() != d.h.size()))
+    throw std::invalid_argument("the FRF's columns have different lengths");
+  if (s.max_order < 4 || s.max_order > 200 || s.max_order % 2 != 0)
+    throw std::invalid_argument("max order = " + std::to_string(s.max_order) + ": allowed an even 4 <= value <= 200");
+  std::vector<double> f;
+  std::vector<Complex> h;
+  for (std::size_t i = 0; i < d.h.size(); ++i) {
+    if (!std::isfinite(d.f_hz[i]) || !std::isfinite(d.h[i].real()) || !std::isfinite(d.h[i].imag()))
+      throw std::invalid_argument("row " + std::to_string(i + 1) + ": a value is not a finite number");
+    const bool in_band = (s.band_hi_hz <= 0.0) || (d.f_hz[i] >= s.band_lo_hz && d.f_hz[i] <= s.band_hi_hz);
+    const bool coherent = d.coherence.empty() || d.coherence[i] >= s.min_coherence;
+    if (in_band && coherent && d.f_hz[i] > 0.0) f.push_back(d.f_hz[i]), h.push_back(d.h[i]);
+  }
+  if (f.size() < 20)
+    throw std::invalid_argument("too few coherent points in the band: " + std::to_string(f.size()) +
+                                " (at least 20 with coherence >= " + std::to_string(s.min_coherence) + ")");
+  ModalFit fit;
+  fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
+  const double dt = 1.0 / (2.0 * f.back());
+  // The stabilisation diagram: a pole is stable when the order below has one close to it in frequency and
+  // damping; the chain of such orders counts how long it has stayed.
+  std::vector<Pole> previous;
+  std::vector<int> previous_chain;
+  std::vector<Pole> last;
+  std::vector<int> last_chain;
+  for (int p = 2; p <= s.max_order; p += 2) {
+    const std::vector<Pole> poles = lscf_poles(f, h, p, dt, fit.band_lo_hz, fit.band_hi_hz);
+    std::vector<int> chain(poles.size(), 0);
+    for (std::size_t i = 0; i < poles.size(); ++i) {
+      for (std::size_t j = 0; j < previous.size(); ++j) {
+        const double df = std::abs(poles[i].freq_hz() - previous[j].freq_hz()) / poles[i].freq_hz();
+        const double dz = std::abs(poles[i].damping() - previous[j].damping()) / std::max(poles[i].damping(), 1e-6);
+        if (df < s.stable_freq && dz < s.stable_damping) chain[i] = std::max(chain[i], previous_chain[j] + 1);
+      }
+      fit.diagram.push_back({p, poles[i].freq_hz(), poles[i].damping(), chain[i] > 0});
+    }
+    previous = poles, previous_chain = chain;
+    last = poles, last_chain = chain;
+  }
+  std::vector<Pole> chosen;
+  for (std::size_t i = 0; i < last.size(); ++i)
+    if (last_chain[i] >= s.stable_orders) {
+      const bool duplicate = !chosen.empty() && std::abs(chosen.back().freq_hz() - last[i].freq_hz()) < 2e-3 * last[i].freq_hz();
+      if (!duplicate) chosen.push_back(last[i]);
+    }
+  if (chosen.empty())
+    throw std::invalid_argument("no pole stays put over " + std::to_string(s.stable_orders) +
+                                " orders in the band: raise the maximum order, widen the band or check the data");
+  lsfd(f, h, chosen, fit);
+  refine(f, h, fit);
+  return fit;
+}
+
+FrfData read_frf_csv(const std::string& path, FrfKind kind) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  std::string line;
+  const std::string header = "freq_hz,re_m_per_n,im_m_per_n";
+  if (!std::getline(in, line) || line.substr(0, header.size()) != header)
+    throw std::invalid_argument(path + ":1: the header must be " + header + "[,coherence]");
+  const bool with_coherence = line.find(",coherence") != std::string::npos;
+  const std::size_t columns = with_coherence ? 4 : 3;
+  FrfData d;
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    std::istringstream row(line);
+    std::string cell;
+    double v[4] = {0, 0, 0, 1};
+    std::size_t n = 0;
+    for (; n < columns && std::getline(row, cell, ','); ++n) {
+      char* end = nullptr;
+      v[n] = std::strtod(cell.c_str(), &end);
+      if (cell.empty() || end == cell.c_str() || *end != '\0')
+        throw std::invalid_argument(path + ":" + std::to_string(number) + ": '" + cell + "' is not a number");
+    }
+    if (n != columns) throw std::invalid_argument(path + ":" + std::to_string(number) + ": " + std::to_string(columns) + " values expected");
+    const Complex s(0.0, kTwoPi * v[0]);
+    Complex h(v[1], v[2]);
+    if (kind == FrfKind::kMobility) h = v[0] > 0.0 ? h / s : Complex(0.0);
+    if (kind == FrfKind::kAccelerance) h = v[0] > 0.0 ? h / (s * s) : Complex(0.0);
+    d.f_hz.push_back(v[0]), d.h.push_back(h);
+    if (with_coherence) d.coherence.push_back(v[3]);
+  }
+  return d;
+}
+
+}  // namespace robodamp::identify
