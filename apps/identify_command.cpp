@@ -30,6 +30,8 @@ struct IdentifyArgs {
   std::string mode{"down"};
   // modes
   std::string frf_path, kind{"receptance"}, plot_dir;
+  std::string series_path, response{"acceleration"};
+  double segment_s{10.0}, overlap{0.5};
   std::vector<double> band_hz;
   int max_order{40};
 };
@@ -70,10 +72,18 @@ int run_modes(const IdentifyArgs& a) {
   try {
     if (!a.band_hz.empty() && (a.band_hz.size() != 2 || !(a.band_hz[1] > a.band_hz[0])))
       throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
-    if (a.frf_path.empty()) throw std::invalid_argument("--frf is required for `identify modes`");
-    const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
-                      : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
-    d = identify::read_frf_csv(a.frf_path, kind);
+    if (a.frf_path.empty() == a.series_path.empty())
+      throw std::invalid_argument("give either --frf (an FRF) or --series (force and response in time)");
+    if (!a.frf_path.empty()) {
+      const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
+                        : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+      d = identify::read_frf_csv(a.frf_path, kind);
+    } else {
+      const auto kind = a.response == "velocity" ? identify::FrfKind::kMobility
+                        : a.response == "acceleration" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+      d = identify::frf_from_time_series_csv(a.series_path, kind, a.segment_s, a.overlap,
+                                             a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
+    }
     fit = identify::fit_modes(d, s);
   } catch (const std::invalid_argument& e) {
     std::cerr << "robodamp identify modes: " << e.what() << '\n';
@@ -170,6 +180,12 @@ void register_identify(Registry& r) {
                         [a] { return run_identify(*a); });
   sub->add_option("what", a->what, "What to identify: modes or cutting")->required()->check(CLI::IsMember({"modes", "cutting"}));
   sub->add_option("--frf", a->frf_path, "modes: FRF CSV freq_hz,re_m_per_n,im_m_per_n[,coherence]")->check(CLI::ExistingFile);
+  sub->add_option("--series", a->series_path, "modes: time series CSV time_s,force_n,response (H1 by Welch)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--response", a->response, "modes: the --series response (acceleration, velocity, displacement)")
+      ->check(CLI::IsMember({"acceleration", "velocity", "displacement"}));
+  r.number(sub, "--segment-s", a->segment_s, {"s", 0.0, 1e5, true, false}, "modes: Welch segment length for --series");
+  r.number(sub, "--overlap", a->overlap, {"(fraction)", 0.0, 0.9, false, false}, "modes: Welch segment overlap for --series");
   sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes: fit band LO HI (default: the whole FRF)");
   r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes: highest order of the stabilisation diagram (even)");

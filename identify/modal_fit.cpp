@@ -12,6 +12,8 @@
 #include <unsupported/Eigen/NonLinearOptimization>
 #include <unsupported/Eigen/NumericalDiff>
 
+#include "analysis/spectral.hpp"
+
 namespace robodamp::identify {
 
 namespace {
@@ -295,6 +297,52 @@ FrfData read_frf_csv(const std::string& path, FrfKind kind) {
     if (kind == FrfKind::kAccelerance) h = v[0] > 0.0 ? h / (s * s) : Complex(0.0);
     d.f_hz.push_back(v[0]), d.h.push_back(h);
     if (with_coherence) d.coherence.push_back(v[3]);
+  }
+  return d;
+}
+
+FrfData frf_from_time_series_csv(const std::string& path, FrfKind kind, double segment_s, double overlap,
+                                 double max_hz) {
+  std::ifstream in(path);
+  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  std::string line;
+  const std::string header = "time_s,force_n,response";
+  if (!std::getline(in, line) || line.substr(0, header.size()) != header)
+    throw std::invalid_argument(path + ":1: the header must be " + header);
+  std::vector<double> t, x, y;
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    std::istringstream row(line);
+    std::string cell;
+    double v[3];
+    int n = 0;
+    for (; n < 3 && std::getline(row, cell, ','); ++n) {
+      char* end = nullptr;
+      v[n] = std::strtod(cell.c_str(), &end);
+      if (cell.empty() || end == cell.c_str() || *end != '\0' || !std::isfinite(v[n]))
+        throw std::invalid_argument(path + ":" + std::to_string(number) + ": '" + cell + "' is not a finite number");
+    }
+    if (n != 3) throw std::invalid_argument(path + ":" + std::to_string(number) + ": 3 values expected");
+    t.push_back(v[0]), x.push_back(v[1]), y.push_back(v[2]);
+  }
+  if (t.size() < 64) throw std::invalid_argument(path + ": too few samples (" + std::to_string(t.size()) + ", at least 64)");
+  const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (!(std::abs(t[i] - t[i - 1] - dt) <= 1e-6 * dt))
+      throw std::invalid_argument(path + ":" + std::to_string(i + 2) + ": the time step changes (a constant sample rate is needed)");
+  const double fs = 1.0 / dt;
+  const auto segment = static_cast<std::size_t>(std::lround(segment_s * fs));
+  if (segment < 16 || segment > t.size())
+    throw std::invalid_argument("segment of " + std::to_string(segment_s) + " s = " + std::to_string(segment) +
+                                " samples: allowed 16 .. the record's " + std::to_string(t.size()));
+  const analysis::FrfEstimate e = analysis::welch_frf(x, y, fs, segment, overlap, max_hz);
+  FrfData d;
+  for (std::size_t k = 1; k < e.f_hz.size(); ++k) {
+    const Complex s(0.0, kTwoPi * e.f_hz[k]);
+    Complex h = e.h1[k];
+    if (kind == FrfKind::kMobility) h /= s;
+    if (kind == FrfKind::kAccelerance) h /= s * s;
+    d.f_hz.push_back(e.f_hz[k]), d.h.push_back(h), d.coherence.push_back(e.coherence[k]);
   }
   return d;
 }

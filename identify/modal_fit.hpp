@@ -62,4 +62,11 @@ enum class FrfKind { kReceptance, kMobility, kAccelerance };
 // the file and line of the first problem.
 [[nodiscard]] FrfData read_frf_csv(const std::string& path, FrfKind kind);
 
+// The H1 FRF and coherence (analysis/spectral.hpp, Welch: Hann segments of segment_s with the overlap)
+// from time series `time_s,force_n,response` at a constant sample rate, the response of the given kind
+// (displacement m, velocity m/s or acceleration m/s^2), returned as receptance up to max_hz. Throws
+// std::invalid_argument with the file and line of the first problem, or for an uneven time step.
+[[nodiscard]] FrfData frf_from_time_series_csv(const std::string& path, FrfKind response_kind, double segment_s,
+                                               double overlap, double max_hz);
+
 }  // namespace robodamp::identify

@@ -13,6 +13,7 @@
 
 #include "identify/cutting_coefficients.hpp"
 #include "modal/receptance.hpp"
+#include "sim_plant/plant.hpp"
 #include <complex>
 #include "test_util.hpp"
 
@@ -364,6 +365,43 @@ TEST(Cli, IdentifyModesRecoversThePresetsModesFromAnAccelerance) {
   EXPECT_NE(narrow.out.find("too few coherent points in the band"), std::string::npos) << narrow.out;
   std::filesystem::remove_all(dir);
   for (const auto& p : {csv, json, yaml}) std::filesystem::remove(p);
+}
+
+// The same from time series: band-limited noise on the simulated plant's TCP (location 1) and the true
+// acceleration there, 200 s sampled at 500 Hz; H1 by Welch (20 s Hann segments) and the fit give the
+// preset's H11yy modes.
+TEST(Cli, IdentifyModesFromTimeSeriesOfTheSimulatedPlant) {
+  const auto cfg = robodamp::config::load_config_file(robodamp::test::preset("horizontal_c2"));
+  const robodamp::sim::PlantModel model = robodamp::sim::build_plant_model(cfg);
+  robodamp::sim::Plant plant(model, cfg);
+  const std::size_t hammer =
+      plant.add_excitation(std::make_unique<robodamp::sim::Noise>(0, 20.0, 5, 2.0, 60.0, cfg.loop.rate_hz));
+  const std::string csv = temp_path("series.csv"), json = temp_path("series-modes.json");
+  {
+    std::ofstream out(csv);
+    out << "time_s,force_n,response\n";
+    out.precision(12);
+    for (int k = 0; k < 1000000; ++k) {
+      const double a = plant.acceleration_mps2(0);
+      plant.step(0.0);
+      if (k % 10 == 0) out << k / cfg.loop.rate_hz << ',' << plant.excitation_force_n(hammer) << ',' << a << '\n';
+    }
+  }
+  const Result r = run("identify modes --series " + csv + " --response acceleration --segment-s 20 --band-hz 5 40 --json " + json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::printf("%s", r.out.c_str());
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  const auto& frf = cfg.robot.frfs[0];  // H11yy
+  ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
+  for (std::size_t i = 0; i < frf.modes.size(); ++i) {
+    EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz, 0.01 * frf.modes[i].natural_freq_hz) << r.out;
+    EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.1 * frf.modes[i].damping_ratio) << r.out;
+    const double mag = std::hypot(frf.modes[i].residue_re_m_per_n, frf.modes[i].residue_im_m_per_n);
+    EXPECT_NEAR(std::hypot(j["modes"][i]["residue_re"].get<double>() - frf.modes[i].residue_re_m_per_n,
+                           j["modes"][i]["residue_im"].get<double>() - frf.modes[i].residue_im_m_per_n), 0.0, 0.1 * mag);
+  }
+  std::filesystem::remove(csv);
+  std::filesystem::remove(json);
 }
 
 TEST(Cli, CheckConfigRejectsANonPhysicalPlant) {

@@ -116,8 +116,9 @@ std::vector<Sub> subcommands() {
       {"lobes", {"--rpm"}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"sle", {}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},
       {"cut", {"--rpm", "--axial-mm", "--radial-mm", "--revs"}, {"--critical", "--damped"}, {}, {"--config"}, false},
-      {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm", "--band-hz", "--max-order"}, {},
-       {{"--mode", {"down", "up"}}, {"--kind", {"receptance", "mobility", "accelerance"}}}, {"--csv", "--frf"}, false},
+      {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm", "--band-hz", "--max-order", "--segment-s", "--overlap"}, {},
+       {{"--mode", {"down", "up"}}, {"--kind", {"receptance", "mobility", "accelerance"}}, {"--response", {"acceleration", "velocity"}}},
+       {"--csv", "--frf", "--series"}, false},
   };
 }
 
