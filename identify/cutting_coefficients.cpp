@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 
+#include "identify/numeric_csv.hpp"
 #include "milling/cutting.hpp"
 
 namespace robodamp::identify {
@@ -123,28 +124,9 @@ CuttingFit identify_cutting(const std::vector<MeanForces>& samples, const Cuttin
 }
 
 std::vector<MeanForces> read_mean_forces_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot be read");
-  std::string line;
   const std::string header = "feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n";
-  if (!std::getline(in, line) || line.substr(0, header.size()) != header)
-    throw std::invalid_argument(path + ":1: the header must be " + header);
   std::vector<MeanForces> out;
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    std::istringstream row(line);
-    std::string cell;
-    double v[4];
-    int n = 0;
-    for (; n < 4 && std::getline(row, cell, ','); ++n) {
-      char* end = nullptr;
-      v[n] = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || end == cell.c_str() || *end != '\0')
-        throw std::invalid_argument(path + ":" + std::to_string(number) + ": '" + cell + "' is not a number");
-    }
-    if (n != 4) throw std::invalid_argument(path + ":" + std::to_string(number) + ": 4 values expected");
-    out.push_back({v[0], v[1], v[2], v[3]});
-  }
+  for (const auto& r : read_numeric_csv(path, header, header, 4).rows) out.push_back({r[0], r[1], r[2], r[3]});
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include <unsupported/Eigen/NumericalDiff>
 
 #include "analysis/spectral.hpp"
+#include "identify/numeric_csv.hpp"
 
 namespace robodamp::identify {
 
@@ -269,28 +270,14 @@ ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
 }
 
 FrfData read_frf_csv(const std::string& path, FrfKind kind) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot be read");
-  std::string line;
-  const std::string header = "freq_hz,re_m_per_n,im_m_per_n";
-  if (!std::getline(in, line) || line.substr(0, header.size()) != header)
-    throw std::invalid_argument(path + ":1: the header must be " + header + "[,coherence]");
-  const bool with_coherence = line.find(",coherence") != std::string::npos;
-  const std::size_t columns = with_coherence ? 4 : 3;
+  const std::string prefix = "freq_hz,re_m_per_n,im_m_per_n";
+  std::ifstream probe(path);
+  std::string first;
+  std::getline(probe, first);
+  const bool with_coherence = first.rfind(prefix + ",coherence", 0) == 0;
+  const NumericCsv csv = read_numeric_csv(path, prefix, prefix + "[,coherence]", with_coherence ? 4 : 3);
   FrfData d;
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    std::istringstream row(line);
-    std::string cell;
-    double v[4] = {0, 0, 0, 1};
-    std::size_t n = 0;
-    for (; n < columns && std::getline(row, cell, ','); ++n) {
-      char* end = nullptr;
-      v[n] = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || end == cell.c_str() || *end != '\0')
-        throw std::invalid_argument(path + ":" + std::to_string(number) + ": '" + cell + "' is not a number");
-    }
-    if (n != columns) throw std::invalid_argument(path + ":" + std::to_string(number) + ": " + std::to_string(columns) + " values expected");
+  for (const auto& v : csv.rows) {
     const Complex s(0.0, kTwoPi * v[0]);
     Complex h(v[1], v[2]);
     if (kind == FrfKind::kMobility) h = v[0] > 0.0 ? h / s : Complex(0.0);
@@ -303,33 +290,20 @@ FrfData read_frf_csv(const std::string& path, FrfKind kind) {
 
 FrfData frf_from_time_series_csv(const std::string& path, FrfKind kind, double segment_s, double overlap,
                                  double max_hz) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot be read");
-  std::string line;
   const std::string header = "time_s,force_n,response";
-  if (!std::getline(in, line) || line.substr(0, header.size()) != header)
-    throw std::invalid_argument(path + ":1: the header must be " + header);
+  const NumericCsv csv = read_numeric_csv(path, header, header, 3);
   std::vector<double> t, x, y;
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    std::istringstream row(line);
-    std::string cell;
-    double v[3];
-    int n = 0;
-    for (; n < 3 && std::getline(row, cell, ','); ++n) {
-      char* end = nullptr;
-      v[n] = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || end == cell.c_str() || *end != '\0' || !std::isfinite(v[n]))
-        throw std::invalid_argument(path + ":" + std::to_string(number) + ": '" + cell + "' is not a finite number");
-    }
-    if (n != 3) throw std::invalid_argument(path + ":" + std::to_string(number) + ": 3 values expected");
+  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
+    const auto& v = csv.rows[i];
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+      throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) + ": a value is not a finite number");
     t.push_back(v[0]), x.push_back(v[1]), y.push_back(v[2]);
   }
   if (t.size() < 64) throw std::invalid_argument(path + ": too few samples (" + std::to_string(t.size()) + ", at least 64)");
   const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   for (std::size_t i = 1; i < t.size(); ++i)
     if (!(std::abs(t[i] - t[i - 1] - dt) <= 1e-6 * dt))
-      throw std::invalid_argument(path + ":" + std::to_string(i + 2) + ": the time step changes (a constant sample rate is needed)");
+      throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) + ": the time step changes (a constant sample rate is needed)");
   const double fs = 1.0 / dt;
   const auto segment = static_cast<std::size_t>(std::lround(segment_s * fs));
   if (segment < 16 || segment > t.size())

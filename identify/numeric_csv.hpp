@@ -1,0 +1,21 @@
+// Reading the identification tools' CSV inputs: a required header, then rows of numbers. Off the
+// real-time path.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace robodamp::identify {
+
+struct NumericCsv {
+  std::string header;                    // the file's first line
+  std::vector<std::vector<double>> rows;  // each exactly `columns` numbers (NaN and inf are passed on)
+  std::vector<int> lines;                // each row's line number in the file
+};
+
+// The header must start with header_prefix; every non-empty row must hold `columns` numbers. Throws
+// std::invalid_argument naming the file and line of the first problem.
+[[nodiscard]] NumericCsv read_numeric_csv(const std::string& path, const std::string& header_prefix,
+                                          const std::string& header_shown, std::size_t columns);
+
+}  // namespace robodamp::identify
