@@ -1,7 +1,6 @@
 #include "identify/cutting_coefficients.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 

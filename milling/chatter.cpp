@@ -25,7 +25,7 @@ const char* to_string(CutClass c) {
 namespace {
 
 struct OneSignal {
-  double ratio{0.0}, growth{-1e300}, correlation{0.0}, nonharmonic{0.0}, chatter_hz{0.0}, chatter_energy{0.0};
+  double ratio{0.0}, growth{-1e300}, nonharmonic{0.0}, chatter_hz{0.0}, chatter_energy{0.0};
   double persistence{0.0};  // RMS of the differences in the last quarter over the second
   std::complex<double> root{0.0};  // the dominant multiplier's estimate
   bool settled{true};
@@ -89,9 +89,6 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
   o.persistence = r2 > 0.0 ? r4 / r2 : 0.0;
   o.root = dominant_root(d);
   o.growth = std::abs(o.root) > 0.0 ? std::log(std::abs(o.root)) : -1e300;
-  double c0 = 0.0, c1 = 0.0;
-  for (std::size_t i = d.size() / 2; i + 1 < d.size(); ++i) c0 += d[i] * d[i], c1 += d[i] * d[i + 1];
-  o.correlation = c0 > 0.0 ? c1 / c0 : 0.0;
   // Spectrum of the last half (a whole number of harmonic base periods, so the harmonics sit on bins).
   const std::size_t whole = ((end - half) / (period * base)) * period * base;
   if (whole >= 2 * period * base) {
@@ -139,7 +136,7 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
   ChatterVerdict v;
   v.out_of_cut_share = out_of_cut_share;
   bool settled = true;
-  double chatter_energy = -1.0, correlation = 0.0, persistence = 0.0;
+  double chatter_energy = -1.0, persistence = 0.0;
   std::complex<double> root(0.0);
   v.growth_per_period = -1e300;
   for (const auto* s : signals) {
@@ -149,7 +146,7 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
     persistence = std::max(persistence, o.persistence);
     v.once_per_period_ratio = std::max(v.once_per_period_ratio, o.ratio);
     v.nonharmonic_energy_ratio = std::max(v.nonharmonic_energy_ratio, o.nonharmonic);
-    if (o.growth > v.growth_per_period) v.growth_per_period = o.growth, correlation = o.correlation, root = o.root;
+    if (o.growth > v.growth_per_period) v.growth_per_period = o.growth, root = o.root;
     if (o.chatter_energy > chatter_energy) chatter_energy = o.chatter_energy, v.chatter_hz = o.chatter_hz;
   }
   // A cut whose once-per-period samples have settled is periodic, hence stable, even if its edges leave the
@@ -166,7 +163,6 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
     return v;
   }
   // Period doubling: the dominant multiplier real and negative (within 3 degrees of -1's direction).
-  (void)correlation;
   const bool flip = root.real() < 0.0 && std::abs(root.imag()) < t.flip_angle * std::abs(root);
   v.mechanism = flip ? CutClass::kFlip : CutClass::kHopf;
   v.classification = out ? CutClass::kOutOfCut : v.mechanism;

@@ -47,10 +47,10 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   if (problems.empty() && o.damped) {
     // The controller steps at its loop rate, so the cut does: the tooth period is made a whole number of
     // loop periods (the speed moves by at most half a loop period per tooth period).
-    const DampedDynamics probe(structure, cfg.cut.feed_axis);
+    const double loop_s = 1.0 / structure.controller_parts().front().model->loop_rate_hz();
     const double tooth_s = 60.0 / (s.rpm * cfg.tool.teeth);
-    s.steps_per_tooth = std::max(1, static_cast<int>(std::lround(tooth_s / probe.step_s())));
-    s.rpm = 60.0 / (cfg.tool.teeth * s.steps_per_tooth * probe.step_s());
+    s.steps_per_tooth = std::max(1, static_cast<int>(std::lround(tooth_s / loop_s)));
+    s.rpm = 60.0 / (cfg.tool.teeth * s.steps_per_tooth * loop_s);
     const Structure* st = &structure;
     const config::Axis feed = cfg.cut.feed_axis;
     j.dynamics = [st, feed] { return std::make_unique<DampedDynamics>(*st, feed); };

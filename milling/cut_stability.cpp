@@ -10,12 +10,10 @@ namespace {
 CutOutcome classify(CutRecord record, const CutSettings& s) {
   CutOutcome o;
   o.record = std::move(record);
-  bool runout = false;
-  for (double r : s.runout_um) runout = runout || r != 0.0;
+  bool per_revolution = !s.pitch_deg.empty();  // with runout or uneven pitch the cut repeats once per revolution
+  for (double r : s.runout_um) per_revolution = per_revolution || r != 0.0;
   const CutRecord& r = o.record;
-  runout = runout || !s.pitch_deg.empty();
-  // With runout or uneven pitch the cut repeats once per revolution, not once per tooth period.
-  o.verdict = detect_chatter({&r.x_m, &r.y_m}, r.settle_steps, r.steps_per_tooth * (runout ? r.teeth : 1), 1,
+  o.verdict = detect_chatter({&r.x_m, &r.y_m}, r.settle_steps, r.steps_per_tooth * (per_revolution ? r.teeth : 1), 1,
                              1.0 / r.step_s, r.out_of_cut_share());
   return o;
 }
