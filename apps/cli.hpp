@@ -78,5 +78,6 @@ void register_lobes(Registry& r);
 void register_sle(Registry& r);
 void register_cut(Registry& r);
 void register_identify(Registry& r);
+void register_measure(Registry& r);
 
 }  // namespace robodamp::apps

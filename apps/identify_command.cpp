@@ -15,26 +15,13 @@
 
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/identify_command.hpp"
 #include "identify/cutting_coefficients.hpp"
 #include "identify/modal_fit.hpp"
 
 namespace robodamp::apps {
 
 namespace {
-
-struct IdentifyArgs {
-  std::string what;
-  std::string csv_path, json_path, yaml_path;
-  int teeth{0};
-  double diameter_mm{0.0}, axial_mm{0.0}, radial_mm{0.0};
-  std::string mode{"down"};
-  // modes
-  std::string frf_path, kind{"receptance"}, plot_dir;
-  std::string series_path, response{"acceleration"};
-  double segment_s{10.0}, overlap{0.5};
-  std::vector<double> band_hz;
-  int max_order{40};
-};
 
 nlohmann::json estimate(const identify::Estimate& e) { return {{"value", e.value}, {"ci95", e.ci95}}; }
 
@@ -123,6 +110,8 @@ int run_modes(const IdentifyArgs& a) {
 
 int run_identify(const IdentifyArgs& a) {
   if (a.what == "modes") return run_modes(a);
+  if (a.what == "actuator") return run_identify_actuator(a);
+  if (a.what == "all") return run_identify_all(a);
   if (a.csv_path.empty() || a.teeth == 0 || a.diameter_mm == 0.0 || a.axial_mm == 0.0 || a.radial_mm == 0.0) {
     std::cerr << "robodamp identify cutting: --csv, --teeth, --diameter-mm, --axial-mm and --radial-mm are required\n";
     return 2;
@@ -175,22 +164,25 @@ int run_identify(const IdentifyArgs& a) {
 void register_identify(Registry& r) {
   auto a = std::make_shared<IdentifyArgs>();
   CLI::App* sub = r.add("identify",
-                        "Identify from measurements: `identify modes` (modes of an FRF), `identify cutting` (cutting "
-                        "coefficients from mean forces)",
+                        "Identify from measurements: `identify modes` (modes of an FRF), `identify actuator` (Eq. 3 from a "
+                        "chirp), `identify all` (a configuration from a `measure` directory), `identify cutting` "
+                        "(cutting coefficients from mean forces)",
                         [a] { return run_identify(*a); });
-  sub->add_option("what", a->what, "What to identify: modes or cutting")->required()->check(CLI::IsMember({"modes", "cutting"}));
+  sub->add_option("what", a->what, "What to identify: modes, actuator, all or cutting")
+      ->required()
+      ->check(CLI::IsMember({"modes", "actuator", "all", "cutting"}));
   sub->add_option("--frf", a->frf_path, "modes: FRF CSV freq_hz,re_m_per_n,im_m_per_n[,coherence]")->check(CLI::ExistingFile);
   sub->add_option("--series", a->series_path, "modes: time series CSV time_s,force_n,response (H1 by Welch)")
       ->check(CLI::ExistingFile);
   sub->add_option("--response", a->response, "modes: the --series response (acceleration, velocity, displacement)")
       ->check(CLI::IsMember({"acceleration", "velocity", "displacement"}));
-  r.number(sub, "--segment-s", a->segment_s, {"s", 0.0, 1e5, true, false}, "modes: Welch segment length for --series");
+  r.number(sub, "--segment-s", a->segment_s, {"s", 0.0, 1e5, true, false}, "modes, actuator: Welch segment length for --series / --csv");
   r.number(sub, "--overlap", a->overlap, {"(fraction)", 0.0, 0.9, false, false}, "modes: Welch segment overlap for --series");
   sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
-  r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes: fit band LO HI (default: the whole FRF)");
-  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes: highest order of the stabilisation diagram (even)");
+  r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes, actuator: fit band LO HI (default: the whole FRF; actuator: the chirp within analysis.band)");
+  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes, all: highest order of the stabilisation diagram (even)");
   sub->add_option("--plot-dir", a->plot_dir, "modes: write the fit and the stabilisation diagram (PNG) here");
-  sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n")
+  sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
       ->check(CLI::ExistingFile);
   r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");
   r.number(sub, "--diameter-mm", a->diameter_mm, {"mm", 0.0, 200.0, true, false}, "cutting: tool diameter");
@@ -198,6 +190,13 @@ void register_identify(Registry& r) {
   r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 200.0, true, false, "and at most --diameter-mm"},
            "cutting: radial depth of the tests (the diameter: slotting)");
   sub->add_option("--mode", a->mode, "cutting: down or up milling")->check(CLI::IsMember({"down", "up"}));
+  sub->add_option("--recording", a->recording_path, "actuator: a robodamp measure recording (the chirp and the sensor)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--structure", a->structure_path,
+                  "actuator: FRF CSV of the structure at the sensor for a force at the actuator (--kind applies)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--in", a->in_dir, "all: the directory robodamp measure wrote")->check(CLI::ExistingDirectory);
+  sub->add_option("--out", a->out_path, "all: write the identified configuration (YAML) here");
   sub->add_option("--json", a->json_path, "Write the result and its quality figures as JSON");
   sub->add_option("--yaml", a->yaml_path, "Write a modes: list (modes) or a material: block (cutting)");
 }

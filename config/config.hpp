@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "config/can_config.hpp"
+#include "config/commissioning_config.hpp"
 #include "config/supervisory_config.hpp"
 
 namespace robodamp::config {
@@ -240,6 +241,7 @@ struct Config {
   std::vector<ParameterSetRef> parameter_sets; // other mountings' configurations, selected by the robot
   std::optional<DdsConfig> dds;                // telemetry and supervised parameters over Fast DDS
   HilConfig hil;                               // read by the plant emulator (robodamp plant)
+  CommissioningConfig commissioning;           // robodamp measure and the plant side of it
 };
 
 // A parameter request's gain against what the supervisor allows (the analysed maximum stable K x

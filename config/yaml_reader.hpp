@@ -81,6 +81,8 @@ class MapReader {
 [[nodiscard]] std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def);
 // The optional modbus, parameter_sets, dds and hil sections (config/supervisory_config.hpp).
 void read_supervisory(MapReader& top, Config& c);
+// The optional commissioning section (config/commissioning_config.hpp).
+[[nodiscard]] CommissioningConfig read_commissioning(MapReader& top);
 // One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.
 [[nodiscard]] ModeConfig read_mode(MapReader& mr, const Range& frequency_range);
 

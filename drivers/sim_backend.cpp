@@ -20,7 +20,9 @@ void SimBackend::advance_to(std::uint64_t tick) noexcept {
     double v = 0.0;
     if (any_written_) v = written_tick_ + 1 <= m ? written_v_ : previous_v_;
     applied_v_ = enabled_ ? v : 0.0;
+    if (hook_ != nullptr) hook_->before_step(m);
     plant_.step(applied_v_);
+    if (hook_ != nullptr) hook_->after_step(m);
   }
   const sim::PlantCounters& after = plant_.counters();
   saturated_ = after.force_limited != before.force_limited || after.voltage_clipped != before.voltage_clipped;

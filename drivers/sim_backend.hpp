@@ -14,6 +14,15 @@
 
 namespace robodamp::drivers {
 
+// Called around every plant period (the plant-side instruments of robodamp measure: the hammer's load
+// cell and the measurement accelerometers). k = the period's index. RT-safe implementations only.
+class PlantStepHook {
+ public:
+  virtual ~PlantStepHook() = default;
+  virtual void before_step(std::uint64_t k) noexcept = 0;
+  virtual void after_step(std::uint64_t k) noexcept = 0;
+};
+
 struct SimBackendOptions {
   double amplifier_ready_delay_s{0.005};
   double amplifier_temperature_c{35.0};
@@ -30,6 +39,8 @@ class SimBackend final : public rt::SensorSource, public rt::ActuatorSink, publi
 
   [[nodiscard]] sim::Plant& plant() noexcept { return plant_; }
   [[nodiscard]] double applied_v() const noexcept { return applied_v_; }  // drive of the last plant period
+  // Before activation: instruments stepped with the plant (nullptr = none).
+  void set_step_hook(PlantStepHook* hook) noexcept { hook_ = hook; }
 
  private:
   void advance_to(std::uint64_t tick) noexcept;
@@ -43,6 +54,7 @@ class SimBackend final : public rt::SensorSource, public rt::ActuatorSink, publi
   bool saturated_{false};
   bool enabled_{false};
   double enabled_at_s_{0.0};
+  PlantStepHook* hook_{nullptr};
 };
 
 }  // namespace robodamp::drivers

@@ -20,6 +20,10 @@ namespace robodamp::identify {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
+// The refinement's relative error counts |H| as at least this fraction of the band's peak: at a deep
+// antiresonance an H1 estimate's relative error is large (low coherence, leakage of the drive
+// vibration), and a pure relative weight would let those few points pull every residue.
+constexpr double kAntiresonanceFloor = 0.05;
 
 struct Pole {
   Complex s;  // rad/s
@@ -147,6 +151,7 @@ struct Refinement {
   const std::vector<Complex>* h;
   std::size_t modes;
   double sigma_scale, lower_scale, upper_scale;
+  double floor;  // the relative error's denominator never drops below this (deep antiresonances)
   [[nodiscard]] int inputs() const { return static_cast<int>(4 * modes + 4); }
   [[nodiscard]] int values() const { return static_cast<int>(2 * f->size()); }
   [[nodiscard]] std::vector<IdentifiedMode> unpack(const Eigen::VectorXd& x, Complex& lower, Complex& upper) const {
@@ -166,7 +171,7 @@ struct Refinement {
     Complex lower, upper;
     const auto m = unpack(x, lower, upper);
     for (std::size_t i = 0; i < f->size(); ++i) {
-      const Complex e = (model_at((*f)[i], m, lower, upper) - (*h)[i]) / std::max(std::abs((*h)[i]), 1e-300);
+      const Complex e = (model_at((*f)[i], m, lower, upper) - (*h)[i]) / std::max(std::abs((*h)[i]), floor);
       r(static_cast<Eigen::Index>(2 * i)) = e.real(), r(static_cast<Eigen::Index>(2 * i + 1)) = e.imag();
     }
     return 0;
@@ -178,7 +183,10 @@ void refine(const std::vector<double>& f, const std::vector<Complex>& h, ModalFi
   for (const auto& m : fit.modes) sigma_scale = std::max(sigma_scale, std::hypot(m.residue_re, m.residue_im));
   if (!(sigma_scale > 0.0)) return;
   const double w_lo = kTwoPi * f.front(), w_hi = kTwoPi * f.back();
-  Refinement fn{&f, &h, fit.modes.size(), sigma_scale, sigma_scale * w_lo, sigma_scale / w_hi};
+  double peak = 0.0;
+  for (const Complex& v : h) peak = std::max(peak, std::abs(v));
+  Refinement fn{&f, &h, fit.modes.size(), sigma_scale, sigma_scale * w_lo, sigma_scale / w_hi,
+                std::max(kAntiresonanceFloor * peak, 1e-300)};
   Eigen::VectorXd x(fn.inputs());
   for (std::size_t i = 0; i < fit.modes.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(4 * i);
@@ -214,6 +222,10 @@ void refine(const std::vector<double>& f, const std::vector<Complex>& h, ModalFi
 }
 
 }  // namespace
+
+Complex fitted_receptance(const ModalFit& fit, double f_hz) {
+  return model_at(f_hz, fit.modes, fit.lower_residual, fit.upper_residual);
+}
 
 ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
   if (d.f_hz.size() != d.h.size() || (!d.coherence.empty() && d.coherence.size() != d.h.size()))
@@ -290,25 +302,14 @@ FrfData read_frf_csv(const std::string& path, FrfKind kind) {
 
 FrfData frf_from_time_series_csv(const std::string& path, FrfKind kind, double segment_s, double overlap,
                                  double max_hz) {
-  const std::string header = "time_s,force_n,response";
-  const NumericCsv csv = read_numeric_csv(path, header, header, 3);
-  std::vector<double> t, x, y;
-  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
-    const auto& v = csv.rows[i];
-    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-      throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) + ": a value is not a finite number");
-    t.push_back(v[0]), x.push_back(v[1]), y.push_back(v[2]);
-  }
-  if (t.size() < 64) throw std::invalid_argument(path + ": too few samples (" + std::to_string(t.size()) + ", at least 64)");
-  const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
-  for (std::size_t i = 1; i < t.size(); ++i)
-    if (!(std::abs(t[i] - t[i - 1] - dt) <= 1e-6 * dt))
-      throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) + ": the time step changes (a constant sample rate is needed)");
-  const double fs = 1.0 / dt;
+  const TimeSeries ts = read_time_series_csv(path, "time_s,force_n,response");
+  const double fs = ts.fs_hz;
+  const std::vector<double>& x = ts.input;
+  const std::vector<double>& y = ts.output;
   const auto segment = static_cast<std::size_t>(std::lround(segment_s * fs));
-  if (segment < 16 || segment > t.size())
+  if (segment < 16 || segment > x.size())
     throw std::invalid_argument("segment of " + std::to_string(segment_s) + " s = " + std::to_string(segment) +
-                                " samples: allowed 16 .. the record's " + std::to_string(t.size()));
+                                " samples: allowed 16 .. the record's " + std::to_string(x.size()));
   const analysis::FrfEstimate e = analysis::welch_frf(x, y, fs, segment, overlap, max_hz);
   FrfData d;
   for (std::size_t k = 1; k < e.f_hz.size(); ++k) {

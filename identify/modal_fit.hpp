@@ -56,6 +56,9 @@ struct ModalFit {
 // Throws std::invalid_argument: too few points, non-finite values, no coherent band, no stable pole.
 [[nodiscard]] ModalFit fit_modes(const FrfData& data, const ModalFitSettings& settings);
 
+// The fitted model (modes and residual terms) at any frequency, m/N.
+[[nodiscard]] Complex fitted_receptance(const ModalFit& fit, double f_hz);
+
 enum class FrfKind { kReceptance, kMobility, kAccelerance };
 // Reads `freq_hz,re_m_per_n,im_m_per_n[,coherence]` (header required) holding an FRF of the given kind,
 // and returns it as receptance (mobility / (i w), accelerance / -w^2). Throws std::invalid_argument with

@@ -18,4 +18,12 @@ struct NumericCsv {
 [[nodiscard]] NumericCsv read_numeric_csv(const std::string& path, const std::string& header_prefix,
                                           const std::string& header_shown, std::size_t columns);
 
+// Two channels against time at a constant rate: `time_s,<input>,<output>` (the header given), at least
+// 64 finite rows. Throws std::invalid_argument naming the file and line of the first problem.
+struct TimeSeries {
+  double fs_hz{0.0};
+  std::vector<double> input, output;
+};
+[[nodiscard]] TimeSeries read_time_series_csv(const std::string& path, const std::string& header);
+
 }  // namespace robodamp::identify

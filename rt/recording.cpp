@@ -66,7 +66,16 @@ json to_json(const SupervisorSettings& s) {
           {"resolved_sample_limit_mps2", s.sample_limit_mps2},
           {"fade_s", s.fade_s},
           {"analysis_stable", s.analysis_stable},
-          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m}};
+          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
+          {"test_signal",
+           {{"enabled", s.test_signal.enabled},
+            {"start_s", s.test_signal.start_s},
+            {"period_s", s.test_signal.period_s},
+            {"periods", s.test_signal.periods},
+            {"f0_hz", s.test_signal.f0_hz},
+            {"f1_hz", s.test_signal.f1_hz},
+            {"amplitude_v", s.test_signal.amplitude_v},
+            {"voltage_limit_v", s.test_signal.voltage_limit_v}}}};
 }
 
 SupervisorSettings supervisor_settings_from(const json& j) {
@@ -91,6 +100,17 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   s.fade_s = j.at("fade_s");
   s.analysis_stable = j.at("analysis_stable");
   s.max_stable_gain_ns_per_m = j.at("max_stable_gain_ns_per_m");
+  if (j.contains("test_signal")) {  // absent in recordings made before robodamp measure existed
+    const json& t = j.at("test_signal");
+    s.test_signal.enabled = t.at("enabled");
+    s.test_signal.start_s = t.at("start_s");
+    s.test_signal.period_s = t.at("period_s");
+    s.test_signal.periods = t.at("periods");
+    s.test_signal.f0_hz = t.at("f0_hz");
+    s.test_signal.f1_hz = t.at("f1_hz");
+    s.test_signal.amplitude_v = t.at("amplitude_v");
+    s.test_signal.voltage_limit_v = t.at("voltage_limit_v");
+  }
   return s;
 }
 

@@ -224,8 +224,17 @@ bool Supervisor::instability(double controller_v) noexcept {
          rms >= l.instability_growth_factor * run_start_rms_;
 }
 
+double TestSignal::value_v(double t_s) const noexcept {
+  if (!enabled || t_s < start_s || t_s >= end_s()) return 0.0;
+  const double tau = std::fmod(t_s - start_s, period_s);
+  const double phase = 2.0 * M_PI * (f0_hz * tau + 0.5 * (f1_hz - f0_hz) * tau * tau / period_s);
+  return amplitude_v * std::sin(phase);
+}
+
 TickOutput Supervisor::step(const TickInput& in) noexcept {
   ++counters_.ticks;
+  const double test_v = s_.test_signal.value_v(time_s_);
+  time_s_ += in.dt_s;
   const auto& l = s_.limits;
   // The sample: a repeat (not fresh) is stale; a fresh one must be finite and in range.
   const bool valid = std::isfinite(in.accel_mps2) && std::abs(in.accel_mps2) <= s_.sample_limit_mps2;
@@ -282,6 +291,10 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
     case State::kActive: {
       fade_ = s_.fade_s > 0.0 ? std::min(1.0, fade_ + in.dt_s / s_.fade_s) : 1.0;
       command_v_ = fade_ * controller_v;
+      if (test_v != 0.0) {
+        const double lim = s_.test_signal.voltage_limit_v;
+        command_v_ = std::clamp(fade_ * (controller_v + test_v), -lim, lim);
+      }
       out.amplifier_enable = true;
       out.saturated = limited || in.actuator_saturated;
       if (out.saturated) ++counters_.saturated_ticks;

@@ -96,6 +96,23 @@ struct SupervisorCounters {
   std::uint64_t commands{0};
 };
 
+// A periodic linear chirp added to the command while active (robodamp measure, with the gain at 0:
+// control off, amplifier enabled). Time is the supervisor's (the sum of the measured dt), so a replay
+// regenerates it bit for bit. Each period sweeps f0 -> f1 from phase 0; the sum is clamped to the
+// amplifier's voltage limit.
+struct TestSignal {
+  bool enabled{false};
+  double start_s{0.0};
+  double period_s{8.0};
+  int periods{0};
+  double f0_hz{0.0}, f1_hz{0.0};
+  double amplitude_v{0.0};
+  double voltage_limit_v{10.0};
+  // The signal at supervisor time t_s (0 outside [start, start + periods x period)). RT-safe.
+  [[nodiscard]] double value_v(double t_s) const noexcept;
+  [[nodiscard]] double end_s() const noexcept { return start_s + period_s * periods; }
+};
+
 // What the supervisor needs beyond the controller's parameters; a recording stores it.
 struct SupervisorSettings {
   config::SupervisionConfig limits;
@@ -104,6 +121,7 @@ struct SupervisorSettings {
   double fade_s{0.5};                // activation / disarm fade (controller.gain_ramp_s)
   bool analysis_stable{false};       // the analysis found the configured loop stable
   double max_stable_gain_ns_per_m{0.0};
+  TestSignal test_signal;            // robodamp measure only
 };
 
 // A controller parameter set with the analysis verdict for it (e.g. the horizontal and the vertical
@@ -179,6 +197,7 @@ class Supervisor {
   double arming_s_{0.0};   // time spent arming
   double trip_from_v_{0.0}, trip_ramp_left_s_{0.0};
   double command_v_{0.0};
+  double time_s_{0.0};  // sum of dt before this tick: the test signal's clock
   control::ControllerCounters last_limits_{};
 
   std::vector<std::uint8_t> sat_window_;  // one entry per tick of the window

@@ -44,7 +44,9 @@ Status Cell::configure() {
   stable_ = model_->stable(cfg_.controller.gain_ns_per_m, polarity);
   max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
   const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
-  supervisor_ = std::make_unique<rt::Supervisor>(rt::supervisor_settings(cfg_, stable_, k_max), model_->chain().params);
+  rt::SupervisorSettings settings = rt::supervisor_settings(cfg_, stable_, k_max);
+  settings.test_signal = o_.test_signal;
+  supervisor_ = std::make_unique<rt::Supervisor>(settings, model_->chain().params);
   ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
   if (Status s = configure_devices(); !s.ok()) return s;
   rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
@@ -151,6 +153,7 @@ void Cell::request_stop() noexcept {
 }
 
 void Cell::on_frame(const rt::TelemetryFrame& f) {
+  if (o_.on_frame) o_.on_frame(f);
   if (std::isfinite(f.accel_mps2)) sum_sq_ += f.accel_mps2 * f.accel_mps2, ++n_samples_;
   summary_.peak_command_v = std::max(summary_.peak_command_v, std::abs(f.command_v));
   TripTiming& tt = summary_.trip_timing;

@@ -21,6 +21,7 @@
 // parameter_sets. On the virtual clock the CAN driver paces the loop in lockstep with the HIL emulator.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,6 +53,9 @@ struct CellOptions {
   drivers::SimBackendOptions backend{};
   double connect_timeout_s{10.0};  // hardware: waiting for the CAN transport and the amplifier's first poll
   bool keep_frames{false};         // keep every drained frame in memory (tests)
+  rt::TestSignal test_signal{};    // robodamp measure: the chirp added to the command while active
+  // Every drained frame, on the drain thread (progress lines); must not block for long.
+  std::function<void(const rt::TelemetryFrame&)> on_frame;
 };
 
 class Cell {
@@ -88,6 +92,7 @@ class Cell {
   [[nodiscard]] const std::string& backend_name() const { return backend_name_; }
   [[nodiscard]] const RunSummary& summary() const { return summary_; }
   [[nodiscard]] sim::Plant& plant() { return sim_->plant(); }  // simulated backend only
+  [[nodiscard]] drivers::SimBackend& sim_backend() { return sim_->backend(); }  // simulated backend only
   [[nodiscard]] drivers::CanDriver* can_driver() { return can_ ? &can_->driver() : nullptr; }
   [[nodiscard]] drivers::ModbusSupervisor* modbus() { return modbus_ ? &modbus_->client() : nullptr; }
   [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }

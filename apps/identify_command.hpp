@@ -1,0 +1,29 @@
+// `robodamp identify`: its options (apps/identify_command.cpp registers them) and the handlers that
+// live in their own files (apps/identify_commissioning.cpp: `identify actuator` and `identify all`).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace robodamp::apps {
+
+struct IdentifyArgs {
+  std::string what;
+  std::string csv_path, json_path, yaml_path;
+  int teeth{0};
+  double diameter_mm{0.0}, axial_mm{0.0}, radial_mm{0.0};
+  std::string mode{"down"};
+  // modes
+  std::string frf_path, kind{"receptance"}, plot_dir;
+  std::string series_path, response{"acceleration"};
+  double segment_s{10.0}, overlap{0.5};
+  std::vector<double> band_hz;
+  int max_order{40};
+  // actuator and all
+  std::string recording_path, structure_path, in_dir, out_path;
+};
+
+[[nodiscard]] int run_identify_actuator(const IdentifyArgs& a);
+[[nodiscard]] int run_identify_all(const IdentifyArgs& a);
+
+}  // namespace robodamp::apps

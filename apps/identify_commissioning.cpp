@@ -1,0 +1,148 @@
+// `robodamp identify actuator`: Eq. 3 (T, natural frequency, damping, delay) from a chirp recorded by
+// robodamp measure (with the structure's FRF at the sensor) or from a CSV of command and transmitted
+// force. `robodamp identify all`: a complete configuration from a robodamp measure directory.
+// docs/identification.md.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/identify_command.hpp"
+#include "identify/actuator_fit.hpp"
+#include "identify/commissioning.hpp"
+#include "identify/numeric_csv.hpp"
+#include "rt/recording.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+constexpr double kActuatorMinCoherence = 0.9;
+
+identify::FrfKind kind_of(const std::string& k) {
+  return k == "mobility" ? identify::FrfKind::kMobility
+         : k == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+}
+
+// From a CSV of the amplifier command and the transmitted force (Welch).
+identify::ActuatorFit actuator_from_force_csv(const IdentifyArgs& a) {
+  const identify::TimeSeries ts = identify::read_time_series_csv(a.csv_path, "time_s,command_v,force_n");
+  const auto segment = static_cast<std::size_t>(std::lround(a.segment_s * ts.fs_hz));
+  if (segment < 16 || segment > ts.input.size())
+    throw std::invalid_argument("--segment-s = " + std::to_string(a.segment_s) + " s = " + std::to_string(segment) +
+                                " samples: allowed 16 .. the record's " + std::to_string(ts.input.size()));
+  const analysis::FrfEstimate e = analysis::welch_frf(ts.input, ts.output, ts.fs_hz, segment, a.overlap, 0.45 * ts.fs_hz);
+  identify::ActuatorFrf g;
+  for (std::size_t k = 1; k < e.f_hz.size(); ++k)
+    g.f_hz.push_back(e.f_hz[k]), g.n_per_v.push_back(e.h1[k]), g.coherence.push_back(e.coherence[k]);
+  identify::ActuatorFitSettings s;
+  if (a.band_hz.size() == 2) s.band_lo_hz = a.band_hz[0], s.band_hi_hz = a.band_hz[1];
+  s.min_coherence = kActuatorMinCoherence;
+  return identify::fit_actuator(g, s);
+}
+
+}  // namespace
+
+int run_identify_actuator(const IdentifyArgs& a) {
+  identify::ActuatorFit fit;
+  std::string mounting = "unknown";
+  try {
+    if (!a.band_hz.empty() && (a.band_hz.size() != 2 || !(a.band_hz[1] > a.band_hz[0])))
+      throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
+    if (a.recording_path.empty() == a.csv_path.empty())
+      throw std::invalid_argument("give either --recording (a robodamp measure recording, with --structure) or --csv "
+                                  "(time_s,command_v,force_n)");
+    if (!a.recording_path.empty()) {
+      if (a.structure_path.empty())
+        throw std::invalid_argument("--recording needs --structure: the FRF at the sensor for a force at the actuator "
+                                    "(frf_<sensor>_<actuator>.csv of the same measurement)");
+      const identify::ChirpMeasurement m = identify::read_chirp_measurement(a.recording_path);
+      mounting = config::to_string(m.config.actuator.mounting);
+      identify::ModalFitSettings ms;
+      ms.band_lo_hz = m.config.analysis.band_min_hz, ms.band_hi_hz = m.config.analysis.band_max_hz;
+      ms.max_order = a.max_order;
+      const identify::ModalFit structure = identify::fit_modes(identify::read_frf_csv(a.structure_path, kind_of(a.kind)), ms);
+      const double lo = a.band_hz.size() == 2 ? a.band_hz[0] : 0.0, hi = a.band_hz.size() == 2 ? a.band_hz[1] : 0.0;
+      fit = identify::identify_actuator(m, identify::with_collocated_structure(m.config, structure), lo, hi,
+                                        kActuatorMinCoherence);
+    } else {
+      fit = actuator_from_force_csv(a);
+    }
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "robodamp identify actuator: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {  // a recording that cannot be read, a configuration in it that does not validate
+    std::cerr << "robodamp identify actuator: " << e.what() << '\n';
+    return 2;
+  }
+  std::printf("Actuator (%s mounting): T %.4f N/V, natural frequency %.4f Hz, damping ratio %.4f, delay %.4f ms\n"
+              "  fit error %.3f %% (RMS |G - fit| / RMS |G|) over %.3g-%.3g Hz, %d points with coherence >= %.2f\n",
+              mounting.c_str(), fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, fit.delay_ms,
+              fit.fit_error_pct, fit.band_lo_hz, fit.band_hi_hz, fit.points, kActuatorMinCoherence);
+  if (!a.json_path.empty()) {
+    const nlohmann::json j = {{"mounting", mounting},
+                              {"force_constant_n_per_v", fit.force_constant_n_per_v},
+                              {"natural_freq_hz", fit.natural_freq_hz},
+                              {"damping_ratio", fit.damping_ratio},
+                              {"delay_ms", fit.delay_ms},
+                              {"fit_error_pct", fit.fit_error_pct},
+                              {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}},
+                              {"points", fit.points}};
+    std::ofstream out(a.json_path);
+    out << j.dump(2) << '\n';
+    if (!out) {
+      std::cerr << "--json " << a.json_path << ": cannot write\n";
+      return 1;
+    }
+    std::printf("wrote %s\n", a.json_path.c_str());
+  }
+  return 0;
+}
+
+int run_identify_all(const IdentifyArgs& a) {
+  if (a.in_dir.empty() || a.out_path.empty()) {
+    std::cerr << "robodamp identify all: --in (a robodamp measure directory) and --out (the configuration to write) are "
+                 "required\n";
+    return 2;
+  }
+  identify::CommissioningSettings s;
+  s.max_order = a.max_order;
+  identify::CommissioningResult r;
+  try {
+    r = identify::identify_all(a.in_dir, s);
+  } catch (const std::exception& e) {
+    std::cerr << "robodamp identify all: " << e.what() << '\n';
+    return 2;
+  }
+  std::printf("robodamp identify all: %s (%s, measured with %s)\n", a.in_dir.c_str(), r.manifest.backend.c_str(),
+              r.manifest.config_source.c_str());
+  std::cout << identify::summary_text(r);
+  {
+    std::ofstream out(a.out_path);
+    out << r.yaml;
+    if (!out) {
+      std::cerr << "--out " << a.out_path << ": cannot write\n";
+      return 1;
+    }
+  }
+  std::printf("wrote %s\n", a.out_path.c_str());
+  if (!a.json_path.empty()) {
+    std::ofstream out(a.json_path);
+    out << identify::to_json(r).dump(2) << '\n';
+    if (!out) {
+      std::cerr << "--json " << a.json_path << ": cannot write\n";
+      return 1;
+    }
+    std::printf("wrote %s\n", a.json_path.c_str());
+  }
+  if (!r.stable) {
+    std::cerr << "robodamp identify all: the identified loop is unstable at the configured gain: lower "
+                 "controller.gain_ns_per_m before running it\n";
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace robodamp::apps
