@@ -22,6 +22,7 @@ struct PlantArgs {
   std::string json_path;
   bool impacts{true};
   int impact_location{0};
+  std::string measure_out;
   std::vector<std::string> mounting_schedule;  // "T:vertical" / "T:horizontal", plant time in s
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
@@ -45,6 +46,7 @@ int run_plant(const PlantArgs& a) {
   if (!a.pacing.empty()) eo.pacing = a.pacing == "lockstep" ? config::HilPacing::kLockstep : config::HilPacing::kRealtime;
   eo.max_duration_s = a.duration_s;
   eo.impacts = a.impacts;
+  eo.measure_out = a.measure_out;
   eo.impact_location = a.impact_location;
   eo.bus_off_at_s = a.bus_off_at_s;
   eo.bus_off_for_s = a.bus_off_for_s;
@@ -88,6 +90,8 @@ void register_plant(Registry& r) {
            "Stop after this much plant time");
   sub->add_option("--json", a->json_path, "Write the report (frames, timing, measured FRFs) as JSON to this file");
   sub->add_flag("!--no-impacts", a->impacts, "Do not run the impact schedule");
+  sub->add_option("--measure-out", a->measure_out,
+                  "The plant side of robodamp measure: the commissioning impacts at every location, FRFs written here");
   r.whole_number(sub, "--impact-location", a->impact_location,
                  {"(location id)", 0, 1000, false, false, "0 = the first FRF's excitation"}, "Location id the hammer hits");
   r.number(sub, "--bus-off-at", a->bus_off_at_s, {"s", 0.0, 604800.0},

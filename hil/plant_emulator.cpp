@@ -112,7 +112,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.impact_location = model.locations[impact_index].name + " (location " + std::to_string(impact_id) + ")";
   const analysis::ImpactTest test{impact_index, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, true,
                                   cfg.controller.gain_ns_per_m, cfg.controller.polarity};
-  rep.records_planned = o.impacts ? cfg.bench.averages : 0;
+  rep.records_planned = o.impacts && o.measure_out.empty() ? cfg.bench.averages : 0;
 
   Registers regs(cfg);
   rep.modbus = regs.describe();
@@ -146,7 +146,16 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
 
   // Allocated now: starting it later only schedules the hits (the realtime pacing never stalls for it).
   std::optional<analysis::ImpactCampaign> campaign;
-  if (o.impacts) campaign.emplace(cfg, plant, test);
+  std::unique_ptr<analysis::ModalTest> modal_test;
+  if (!o.measure_out.empty()) {
+    modal_test = std::make_unique<analysis::ModalTest>(cfg, plant, analysis::commissioning_plan(cfg, model));
+    rep.measure_records_planned = modal_test->records_planned();
+    spdlog::info("robodamp plant: commissioning measurement: {} impacts at each location from {:.1f} s, FRFs to {}",
+                 cfg.commissioning.impacts_per_location, analysis::commissioning_plan(cfg, model).impacts_start_s.front(),
+                 o.measure_out);
+  } else if (o.impacts) {
+    campaign.emplace(cfg, plant, test);
+  }
   std::uint32_t sensor_counter = 0, last_cmd_counter = 0;
   bool have_cmd_counter = false;
   double command_v = 0.0;     // newest command received
@@ -234,7 +243,9 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     const std::size_t k = rep.ticks;
     const double t = static_cast<double>(k) * dt;
     if (campaign) campaign->before_step(k);
+    if (modal_test) modal_test->before_step(k);
     plant.step(ready ? applied_v : 0.0);
+    if (modal_test) modal_test->after_step(k);
     if (campaign) {
       campaign->after_step(k);
       if (campaign->done(k + 1) && !rep.campaign_complete) {
@@ -329,6 +340,12 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.elapsed_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   rep.modbus_requests = regs.requests();
 
+  if (modal_test) {
+    rep.measure_records = modal_test->records();
+    rep.measure_files = modal_test->write_frf_csvs(o.measure_out);
+    spdlog::info("robodamp plant: {} of {} impact records; wrote {} FRFs to {}", rep.measure_records,
+                 rep.measure_records_planned, rep.measure_files.size(), o.measure_out);
+  }
   if (campaign && campaign->started()) {
     rep.records = campaign->records();
     rep.closed_receptance = campaign->receptance();
@@ -440,6 +457,11 @@ std::string report_text(const EmulatorReport& r) {
                 r.enabled_s, static_cast<unsigned long long>(r.enable_changes), r.peak_command_v, r.peak_temperature_c,
                 static_cast<unsigned long long>(r.modbus_requests));
   os << b;
+  if (r.measure_records_planned > 0) {
+    std::snprintf(b, sizeof b, "  commissioning impacts: %d of %d records; %zu FRFs written\n", r.measure_records,
+                  r.measure_records_planned, r.measure_files.size());
+    os << b;
+  }
   if (r.records_planned > 0) {
     std::snprintf(b, sizeof b, "  impacts at the %s: %d of %d records%s\n", r.impact_location.c_str(), r.records,
                   r.records_planned, r.campaign_complete ? "" : " (incomplete: the controller left first)");

@@ -29,6 +29,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/modal_test.hpp"
 #include "analysis/spectral.hpp"
 #include "config/config.hpp"
 #include "rt/timing_histogram.hpp"
@@ -39,7 +40,11 @@ struct EmulatorOptions {
   std::optional<config::HilPacing> pacing;  // default hil.pacing
   double max_duration_s{0.0};               // plant time; 0 = until the controller disconnects
   bool impacts{true};
-  int impact_location{0};                   // location id; 0 = the first configured FRF's excitation
+  int impact_location{0};
+  // robodamp measure's plant side (analysis/modal_test.hpp): instead of the bench's impact schedule, the
+  // commissioning plan's impacts at every location (plant time from the first step), and the FRFs
+  // written to this directory when the run ends. Empty = off.
+  std::string measure_out;                   // location id; 0 = the first configured FRF's excitation
   // Robot mounting register changes: (plant time s, mounting).
   std::vector<std::pair<double, config::Mounting>> mounting_schedule;
   bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
@@ -98,6 +103,9 @@ struct EmulatorReport {
   std::vector<FrfReport> frfs;
   std::vector<analysis::FrfEstimate> closed_receptance, open_receptance;  // per location
   std::vector<InjectedFault> injected;
+  // robodamp measure's plant side.
+  int measure_records{0}, measure_records_planned{0};
+  std::vector<std::string> measure_files;
 };
 
 // Serves one controller connection and returns when it disconnects (or max_duration_s, or the stop

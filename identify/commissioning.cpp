@@ -1,6 +1,7 @@
 #include "identify/commissioning.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -71,14 +72,21 @@ double mode_peak(const IdentifiedMode& m) {
   return std::hypot(m.residue_re, m.residue_im) / (m.damping_ratio * kTwoPi * m.natural_freq_hz);
 }
 
+// A number as the configuration writes it (7 significant digits, enough for every identified value).
+YAML::Node num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.7g", v);
+  return YAML::Node(std::string(b));
+}
+
 YAML::Node modes_node(const ModalFit& fit) {
   YAML::Node list(YAML::NodeType::Sequence);
   for (const auto& m : fit.modes) {
     YAML::Node n;
-    n["natural_freq_hz"] = m.natural_freq_hz;
-    n["damping_ratio"] = m.damping_ratio;
-    n["residue_re_m_per_n"] = m.residue_re;
-    n["residue_im_m_per_n"] = m.residue_im;
+    n["natural_freq_hz"] = num(m.natural_freq_hz);
+    n["damping_ratio"] = num(m.damping_ratio);
+    n["residue_re_m_per_n"] = num(m.residue_re);
+    n["residue_im_m_per_n"] = num(m.residue_im);
     n.SetStyle(YAML::EmitterStyle::Flow);
     list.push_back(n);
   }
@@ -89,10 +97,10 @@ YAML::Node modes_node(const ModalFit& fit) {
 std::string compose_yaml(const CommissioningResult& r, int polarity) {
   YAML::Node root = YAML::Load(r.manifest.config_text);
   YAML::Node act = root["actuator"];
-  act["constant_n_per_v"] = r.actuator.force_constant_n_per_v;
-  act["natural_freq_hz"] = r.actuator.natural_freq_hz;
-  act["damping_ratio"] = r.actuator.damping_ratio;
-  act["delay_s"] = r.actuator.delay_ms * 1e-3;
+  act["constant_n_per_v"] = num(r.actuator.force_constant_n_per_v);
+  act["natural_freq_hz"] = num(r.actuator.natural_freq_hz);
+  act["damping_ratio"] = num(r.actuator.damping_ratio);
+  act["delay_s"] = num(r.actuator.delay_ms * 1e-3);
   YAML::Node robot(YAML::NodeType::Map);
   YAML::Node locs(YAML::NodeType::Sequence);
   for (const auto& [id, name] : r.manifest.locations) {
@@ -114,7 +122,7 @@ std::string compose_yaml(const CommissioningResult& r, int polarity) {
   robot["frfs"] = frfs;
   root["robot"] = robot;
   root["controller"]["polarity"] = polarity;
-  root["controller"]["match_freq_hz"] = r.dominant_mode_hz;
+  root["controller"]["match_freq_hz"] = num(r.dominant_mode_hz);
   // Files the measured configuration names relative to itself stay reachable from anywhere.
   if (root["parameter_sets"] && root["parameter_sets"].IsMap()) {
     const fs::path base = fs::path(r.manifest.config_source).parent_path();
@@ -125,7 +133,6 @@ std::string compose_yaml(const CommissioningResult& r, int polarity) {
   }
   YAML::Emitter out;
   out.SetIndent(2);
-  out.SetDoublePrecision(6);
   out << root;
   std::ostringstream os;
   os << "# robodamp identify all: the configuration " << r.manifest.config_source
@@ -150,7 +157,7 @@ void analyse_into(CommissioningResult& r) {
 
 }  // namespace
 
-ChirpMeasurement read_chirp_measurement(const std::string& path) {
+ChirpMeasurement read_chirp_measurement(const std::string& path, const std::string& config_source) {
   if (!fs::exists(path)) throw std::invalid_argument(path + " is missing: robodamp measure records the loop there");
   const rt::Recording rec = rt::read_recording(path);
   ChirpMeasurement m;
@@ -159,7 +166,8 @@ ChirpMeasurement read_chirp_measurement(const std::string& path) {
   if (!sig.enabled)
     throw std::invalid_argument(path + " holds no test signal (a robodamp run recording, not a robodamp measure one)");
   if (rec.frames.empty()) throw std::invalid_argument(path + " holds no frames");
-  m.config = config::parse_config(rec.header.at("config_yaml").get<std::string>(), path + " (its configuration)");
+  m.config = config::parse_config(rec.header.at("config_yaml").get<std::string>(),
+                                  config_source.empty() ? rec.header.value("config_source", path) : config_source);
   // Samples by tick; a skipped tick holds the command and repeats the sample, as the devices do.
   const std::uint64_t n = rec.frames.back().tick + 1;
   std::vector<double> u(n, 0.0), y(n, 0.0);
@@ -283,7 +291,7 @@ CommissioningResult identify_all(const std::string& dir, const CommissioningSett
     if (mode_peak(m) > best) best = mode_peak(m), r.dominant_mode_hz = m.natural_freq_hz;
 
   // The actuator against the identified structure (the measured configuration's actuator meanwhile).
-  const ChirpMeasurement chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string());
+  const ChirpMeasurement chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string(), r.manifest.config_source);
   r.actuator_periods = chirp.periods_averaged;
   r.actuator.force_constant_n_per_v = measured.actuator.constant_n_per_v;
   r.actuator.natural_freq_hz = measured.actuator.natural_freq_hz;

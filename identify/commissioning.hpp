@@ -46,7 +46,10 @@ struct ChirpMeasurement {
   double f0_hz{0.0}, f1_hz{0.0};
 };
 // Throws std::invalid_argument (no such file, no test signal, too short) or rt::RecordingError.
-[[nodiscard]] ChirpMeasurement read_chirp_measurement(const std::string& recording_path);
+// config_source: where the recorded configuration's relative paths resolve from (empty: the recording's
+// own record of it).
+[[nodiscard]] ChirpMeasurement read_chirp_measurement(const std::string& recording_path,
+                                                      const std::string& config_source = {});
 
 // Eq. 3 from the chirp: force per volt through the structure's receptance (sensor per actuator force),
 // the configured sensor's coupling and the loop's hold (identify/actuator_fit.hpp), fitted over the

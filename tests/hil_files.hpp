@@ -1,0 +1,61 @@
+// config/hil_horizontal_c2.yaml for one cross-process test: its own CAN socket (in the test's
+// directory) and a free Modbus TCP port, the vertical parameter set by absolute path, plus edits.
+#pragma once
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "test_util.hpp"
+
+namespace robodamp::test {
+
+inline int free_tcp_port() {
+  const int s = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t len = sizeof a;
+  getsockname(s, reinterpret_cast<sockaddr*>(&a), &len);
+  close(s);
+  return ntohs(a.sin_port);
+}
+
+inline void replace_all(std::string& s, const std::string& from, const std::string& to) {
+  for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
+}
+
+struct HilFiles {
+  std::string dir, config, plant_json, run_json, plant_log, run_log;
+};
+
+// config/hil_horizontal_c2.yaml with this test's own socket and Modbus port.
+inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<std::string, std::string>>& edits = {}) {
+  HilFiles f;
+  f.dir = ::testing::TempDir() + "robodamp_hil_" + name + "_" + std::to_string(getpid());
+  mkdir(f.dir.c_str(), 0755);
+  std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_horizontal_c2.yaml");
+  replace_all(text, "unix:/tmp/robodamp-hil.sock", "unix:" + f.dir + "/can.sock");
+  replace_all(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
+  replace_all(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
+  for (const auto& [from, to] : edits) replace_all(text, from, to);
+  f.config = f.dir + "/hil.yaml";
+  std::ofstream(f.config) << text;
+  f.plant_json = f.dir + "/plant.json";
+  f.run_json = f.dir + "/run.json";
+  f.plant_log = f.dir + "/plant.log";
+  f.run_log = f.dir + "/run.log";
+  return f;
+}
+
+}  // namespace robodamp::test
