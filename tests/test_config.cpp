@@ -374,6 +374,24 @@ TEST(Config, ModbusDdsAndHilSectionsAreValidated) {
   EXPECT_EQ(p.size(), 8U) << all;
 }
 
+TEST(Config, CommissioningSectionIsValidated) {
+  const Config ok = parse_config(std::string(kValid) + "commissioning: {chirp_periods: 3, record_s: 6}\n", "ok.yaml");
+  EXPECT_EQ(ok.commissioning.chirp_periods, 3);
+  EXPECT_EQ(ok.commissioning.record_s, 6.0);
+  EXPECT_EQ(ok.commissioning.chirp_f1_hz, 100.0);  // defaults for the rest
+  const auto p = problems_of(std::string(kValid) +
+                             "commissioning: {chirp_f0_hz: 50, chirp_f1_hz: 20, chirp_periods: 1, chirp_force_fraction: 1.5,"
+                             " impacts_per_location: 0, settle_s: .nan}\n");
+  std::string all;
+  for (const auto& q : p) all += q.to_string() + "\n";
+  for (const char* expected :
+       {"commissioning.chirp_f1_hz = 20 Hz must be above chirp_f0_hz = 50 Hz", "commissioning.chirp_periods = 1",
+        "commissioning.chirp_force_fraction = 1.5 (x actuator.force_limit_n) is out of range",
+        "commissioning.impacts_per_location = 0", "commissioning.settle_s"})
+    EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
+  EXPECT_EQ(p.size(), 5U) << all;
+}
+
 TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {
   EXPECT_FALSE(gain_request_problem(2000.0, 4324.0, "0.9 x K_max"));
   const auto p = gain_request_problem(5000.0, 4324.0, "0.9 x K_max");

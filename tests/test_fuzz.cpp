@@ -118,7 +118,8 @@ std::vector<Sub> subcommands() {
       {"cut", {"--rpm", "--axial-mm", "--radial-mm", "--revs"}, {"--critical", "--damped"}, {}, {"--config"}, false},
       {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm", "--band-hz", "--max-order", "--segment-s", "--overlap"}, {},
        {{"--mode", {"down", "up"}}, {"--kind", {"receptance", "mobility", "accelerance"}}, {"--response", {"acceleration", "velocity"}}},
-       {"--csv", "--frf", "--series"}, false},
+       {"--csv", "--frf", "--series", "--recording", "--structure"}, false},
+      {"measure", {}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
   };
 }
 
