@@ -73,7 +73,10 @@ std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Com
 }
 
 // LSFD: residues of the given poles with lower (1 / (i w)^2) and upper (constant) residual terms.
-void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std::vector<Pole>& poles, ModalFit& fit) {
+// weight_floor > 0: each row divided by max(|H|, weight_floor) (relative error, for wide bands whose
+// magnitude spans decades); 0: absolute error.
+void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std::vector<Pole>& poles, ModalFit& fit,
+          double weight_floor = 0.0) {
   const auto k = static_cast<Eigen::Index>(f.size()), m = static_cast<Eigen::Index>(poles.size());
   const Eigen::Index unknowns = 2 * m + 4;
   Eigen::MatrixXd a(2 * k, unknowns);
@@ -94,11 +97,13 @@ void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std
     }
   };
   for (Eigen::Index r = 0; r < k; ++r) {
+    const Complex hr = h[static_cast<std::size_t>(r)];
+    const double wgt = weight_floor > 0.0 ? 1.0 / std::max(std::abs(hr), weight_floor) : 1.0;
     for (Eigen::Index c = 0; c < unknowns; ++c) {
-      const Complex b = basis(f[static_cast<std::size_t>(r)], c);
+      const Complex b = basis(f[static_cast<std::size_t>(r)], c) * wgt;
       a(2 * r, c) = b.real(), a(2 * r + 1, c) = b.imag();
     }
-    y(2 * r) = h[static_cast<std::size_t>(r)].real(), y(2 * r + 1) = h[static_cast<std::size_t>(r)].imag();
+    y(2 * r) = hr.real() * wgt, y(2 * r + 1) = hr.imag() * wgt;
   }
   const Eigen::VectorXd norms = a.colwise().norm().cwiseMax(1e-300);
   const Eigen::VectorXd x = (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(y).cwiseQuotient(norms);
@@ -221,29 +226,8 @@ void refine(const std::vector<double>& f, const std::vector<Complex>& h, ModalFi
   fit.fit_error_pct = 100.0 * std::sqrt(err / ref);
 }
 
-}  // namespace
-
-Complex fitted_receptance(const ModalFit& fit, double f_hz) {
-  return model_at(f_hz, fit.modes, fit.lower_residual, fit.upper_residual);
-}
-
-ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
-  if (d.f_hz.size() != d.h.size() || (!d.coherence.empty() && d.coherence.size() != d.h.size()))
-    throw std::invalid_argument("the FRF's columns have different lengths");
-  if (s.max_order < 4 || s.max_order > 200 || s.max_order % 2 != 0)
-    throw std::invalid_argument("max order = " + std::to_string(s.max_order) + ": allowed an even 4 <= value <= 200");
-  std::vector<double> f;
-  std::vector<Complex> h;
-  for (std::size_t i = 0; i < d.h.size(); ++i) {
-    if (!std::isfinite(d.f_hz[i]) || !std::isfinite(d.h[i].real()) || !std::isfinite(d.h[i].imag()))
-      throw std::invalid_argument("row " + std::to_string(i + 1) + ": a value is not a finite number");
-    const bool in_band = (s.band_hi_hz <= 0.0) || (d.f_hz[i] >= s.band_lo_hz && d.f_hz[i] <= s.band_hi_hz);
-    const bool coherent = d.coherence.empty() || d.coherence[i] >= s.min_coherence;
-    if (in_band && coherent && d.f_hz[i] > 0.0) f.push_back(d.f_hz[i]), h.push_back(d.h[i]);
-  }
-  if (f.size() < 20)
-    throw std::invalid_argument("too few coherent points in the band: " + std::to_string(f.size()) +
-                                " (at least 20 with coherence >= " + std::to_string(s.min_coherence) + ")");
+// One band: LSCF poles over the stabilisation diagram, LSFD residues, the refinement.
+ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, const ModalFitSettings& s) {
   ModalFit fit;
   fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
   const double dt = 1.0 / (2.0 * f.back());
@@ -279,6 +263,104 @@ ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
   lsfd(f, h, chosen, fit);
   refine(f, h, fit);
   return fit;
+}
+
+
+// A band spanning decades (seed 004's robot: 46 modes from 8 Hz to 6.6 kHz). One LSCF over it needs a
+// high order, is slow and ill-conditioned at the low end, so it is cut into sub-bands (a frequency ratio
+// of at least kSubBandRatio and at least kSubBandPoints points, overlapping by kSubBandOverlap on each
+// side), each fitted as a band of its own with its residual terms standing for the rest; a sub-band keeps
+// the modes in its core (its own share, without the overlap). The residues of all of them then come from
+// one LSFD over the whole band, weighted to relative error.
+constexpr double kSubBandRatio = 2.0;
+constexpr std::size_t kSubBandPoints = 80;
+constexpr double kSubBandOverlap = 1.4;
+constexpr std::size_t kSubBandMaxPoints = 600;
+constexpr std::size_t kWideLsfdMaxPoints = 6000;
+constexpr double kSubBandStableDamping = 0.2;
+
+std::vector<std::size_t> thinned(std::size_t begin, std::size_t end, std::size_t max_points) {
+  std::vector<std::size_t> idx;
+  const std::size_t stride = std::max<std::size_t>(1, (end - begin + max_points - 1) / max_points);
+  for (std::size_t i = begin; i < end; i += stride) idx.push_back(i);
+  return idx;
+}
+
+ModalFit fit_wide_band(const std::vector<double>& f, const std::vector<Complex>& h, const ModalFitSettings& s) {
+  // Core edges.
+  std::vector<std::size_t> edges{0};
+  while (edges.back() < f.size() - 1) {
+    std::size_t j = edges.back();
+    while (j < f.size() - 1 && (f[j] < kSubBandRatio * f[edges.back()] || j - edges.back() < kSubBandPoints)) ++j;
+    if (f.size() - 1 - j < kSubBandPoints) j = f.size() - 1;  // no short tail: it joins this band
+    edges.push_back(j);
+  }
+  ModalFitSettings sub = s;
+  sub.max_order = s.max_order;
+  sub.stable_damping = std::max(s.stable_damping, kSubBandStableDamping);
+  std::vector<Pole> poles;
+  ModalFit fit;
+  fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
+  for (std::size_t b = 0; b + 1 < edges.size(); ++b) {
+    const double core_lo = f[edges[b]], core_hi = f[edges[b + 1]];
+    const auto lo = static_cast<std::size_t>(std::lower_bound(f.begin(), f.end(), core_lo / kSubBandOverlap) - f.begin());
+    const auto hi = static_cast<std::size_t>(std::upper_bound(f.begin(), f.end(), core_hi * kSubBandOverlap) - f.begin());
+    std::vector<double> fb;
+    std::vector<Complex> hb;
+    for (std::size_t i : thinned(lo, hi, kSubBandMaxPoints)) fb.push_back(f[i]), hb.push_back(h[i]);
+    ModalFit part;
+    try {
+      part = fit_band(fb, hb, sub);
+    } catch (const std::invalid_argument&) {
+      continue;  // no mode stays put here
+    }
+    for (const auto& p : part.diagram) fit.diagram.push_back(p);
+    const bool last = b + 2 == edges.size();
+    for (const auto& m : part.modes)
+      if (m.natural_freq_hz >= core_lo && (m.natural_freq_hz < core_hi || last)) {
+        const double wn = kTwoPi * m.natural_freq_hz;
+        poles.push_back({Complex(-m.damping_ratio * wn, wn * std::sqrt(1.0 - m.damping_ratio * m.damping_ratio))});
+      }
+  }
+  if (poles.empty())
+    throw std::invalid_argument("no pole stays put in any sub-band: raise the maximum order or check the data");
+  std::vector<double> fa;
+  std::vector<Complex> ha;
+  double peak = 0.0;
+  for (std::size_t i : thinned(0, f.size(), kWideLsfdMaxPoints)) fa.push_back(f[i]), ha.push_back(h[i]);
+  for (const Complex& v : ha) peak = std::max(peak, std::abs(v));
+  lsfd(fa, ha, poles, fit, std::max(1e-6 * peak, 1e-300));
+  double err = 0.0, ref = 0.0;
+  for (std::size_t i = 0; i < fa.size(); ++i) err += std::norm(fit.fitted[i] - ha[i]), ref += std::norm(ha[i]);
+  fit.fit_error_pct = 100.0 * std::sqrt(err / ref);
+  return fit;
+}
+
+}  // namespace
+
+Complex fitted_receptance(const ModalFit& fit, double f_hz) {
+  return model_at(f_hz, fit.modes, fit.lower_residual, fit.upper_residual);
+}
+
+ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
+  if (d.f_hz.size() != d.h.size() || (!d.coherence.empty() && d.coherence.size() != d.h.size()))
+    throw std::invalid_argument("the FRF's columns have different lengths");
+  if (s.max_order < 4 || s.max_order > 200 || s.max_order % 2 != 0)
+    throw std::invalid_argument("max order = " + std::to_string(s.max_order) + ": allowed an even 4 <= value <= 200");
+  std::vector<double> f;
+  std::vector<Complex> h;
+  for (std::size_t i = 0; i < d.h.size(); ++i) {
+    if (!std::isfinite(d.f_hz[i]) || !std::isfinite(d.h[i].real()) || !std::isfinite(d.h[i].imag()))
+      throw std::invalid_argument("row " + std::to_string(i + 1) + ": a value is not a finite number");
+    const bool in_band = (s.band_hi_hz <= 0.0) || (d.f_hz[i] >= s.band_lo_hz && d.f_hz[i] <= s.band_hi_hz);
+    const bool coherent = d.coherence.empty() || d.coherence[i] >= s.min_coherence;
+    if (in_band && coherent && d.f_hz[i] > 0.0) f.push_back(d.f_hz[i]), h.push_back(d.h[i]);
+  }
+  if (f.size() < 20)
+    throw std::invalid_argument("too few coherent points in the band: " + std::to_string(f.size()) +
+                                " (at least 20 with coherence >= " + std::to_string(s.min_coherence) + ")");
+  if (f.back() / f.front() > s.wide_band_ratio) return fit_wide_band(f, h, s);
+  return fit_band(f, h, s);
 }
 
 FrfData read_frf_csv(const std::string& path, FrfKind kind) {

@@ -28,6 +28,7 @@ struct ModalFitSettings {
   double stable_damping{0.05};              // ... and its damping less than this from the order below
   int stable_orders{3};                     // ... over this many consecutive orders
   double min_coherence{0.8};                // bins below it are left out of the fit
+  double wide_band_ratio{40.0};             // a band with hi / lo above this is fitted in sub-bands
 };
 
 struct IdentifiedMode {
