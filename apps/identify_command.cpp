@@ -112,6 +112,7 @@ int run_identify(const IdentifyArgs& a) {
   if (a.what == "modes") return run_modes(a);
   if (a.what == "actuator") return run_identify_actuator(a);
   if (a.what == "all") return run_identify_all(a);
+  if (a.ball_end) return run_identify_ball_end(a);
   if (a.csv_path.empty() || a.teeth == 0 || a.diameter_mm == 0.0 || a.axial_mm == 0.0 || a.radial_mm == 0.0) {
     std::cerr << "robodamp identify cutting: --csv, --teeth, --diameter-mm, --axial-mm and --radial-mm are required\n";
     return 2;
@@ -189,6 +190,11 @@ void register_identify(Registry& r) {
   r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "cutting: axial depth of the tests");
   r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 200.0, true, false, "and at most --diameter-mm"},
            "cutting: radial depth of the tests (the diameter: slotting)");
+  sub->add_flag("--ball-end", a->ball_end,
+                "cutting: a ball-end mill from slot-milling mean forces axial_mm,feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n");
+  r.number(sub, "--helix-deg", a->helix_deg, {"deg", 0.0, 89.0}, "cutting --ball-end: helix angle at the ball's equator");
+  r.whole_number(sub, "--order", a->order, {"(polynomial order)", 0, 3},
+                 "cutting --ball-end: order of the shear coefficients' polynomial in the axial angle (seed 003: 3)");
   sub->add_option("--mode", a->mode, "cutting: down or up milling")->check(CLI::IsMember({"down", "up"}));
   sub->add_option("--recording", a->recording_path, "actuator: a robodamp measure recording (the chirp and the sensor)")
       ->check(CLI::ExistingFile);

@@ -1,5 +1,6 @@
 // `robodamp identify`: its options (apps/identify_command.cpp registers them) and the handlers that
-// live in their own files (apps/identify_commissioning.cpp: `identify actuator` and `identify all`).
+// live in their own files (apps/identify_commissioning.cpp: `identify actuator` and `identify all`;
+// apps/identify_ball_end.cpp: `identify cutting --ball-end`).
 #pragma once
 
 #include <string>
@@ -19,11 +20,16 @@ struct IdentifyArgs {
   double segment_s{10.0}, overlap{0.5};
   std::vector<double> band_hz;
   int max_order{40};
+  // cutting, ball end (slot milling)
+  bool ball_end{false};
+  double helix_deg{30.0};
+  int order{3};
   // actuator and all
   std::string recording_path, structure_path, in_dir, out_path;
 };
 
 [[nodiscard]] int run_identify_actuator(const IdentifyArgs& a);
+[[nodiscard]] int run_identify_ball_end(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_all(const IdentifyArgs& a);
 
 }  // namespace robodamp::apps

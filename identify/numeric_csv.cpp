@@ -13,11 +13,13 @@ NumericCsv read_numeric_csv(const std::string& path, const std::string& header_p
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": cannot be read");
   NumericCsv csv;
-  if (!std::getline(in, csv.header) || csv.header.substr(0, header_prefix.size()) != header_prefix)
-    throw std::invalid_argument(path + ":1: the header must be " + header_shown);
+  int number = 1;
+  while (std::getline(in, csv.header) && !csv.header.empty() && csv.header[0] == '#') ++number;  // comments first
+  if (csv.header.substr(0, header_prefix.size()) != header_prefix)
+    throw std::invalid_argument(path + ":" + std::to_string(number) + ": the header must be " + header_shown);
   std::string line;
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
+  for (++number; std::getline(in, line); ++number) {
+    if (line.empty() || line[0] == '#') continue;
     std::istringstream row(line);
     std::string cell;
     std::vector<double> values;

@@ -13,7 +13,7 @@ struct NumericCsv {
   std::vector<int> lines;                // each row's line number in the file
 };
 
-// The header must start with header_prefix; every non-empty row must hold `columns` numbers. Throws
+// Lines starting with # are comments. The header must start with header_prefix; every non-empty row must hold `columns` numbers. Throws
 // std::invalid_argument naming the file and line of the first problem.
 [[nodiscard]] NumericCsv read_numeric_csv(const std::string& path, const std::string& header_prefix,
                                           const std::string& header_shown, std::size_t columns);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "identify/ball_end.hpp"
 #include "identify/cutting_coefficients.hpp"
 #include "identify/modal_fit.hpp"
 #include "modal/receptance.hpp"
@@ -133,6 +134,74 @@ TEST(IdentifyModes, SeparatesCloseModesUnderOnePercentNoise) {
   std::printf("fit error %.3f %%\n", fit.fit_error_pct);
   EXPECT_LT(fit.fit_error_pct, 2.0);  // the noise is 1 %
   EXPECT_GT(fit.fit_error_pct, 0.3);
+}
+
+// --- Ball end (seed 003's method) ---
+
+identify::BallEndCoefficients known_ball_end() {
+  return {{800.0, -300.0, 100.0, -20.0}, {400.0, 150.0, -60.0, 10.0}, {200.0, -50.0, 30.0, 5.0}, 5.0, 3.0, 1.5};
+}
+
+TEST(IdentifyBallEnd, RecoversCubicShearAndEdgeCoefficientsFromSlotMeanForces) {
+  const identify::BallEndTest t{8, 4.0, 30.0, 3};
+  const auto c = known_ball_end();
+  std::vector<identify::BallEndRun> runs;
+  for (double a : {0.2, 0.5, 0.8, 1.2, 1.6, 2.0})
+    for (double fz : {0.01, 0.02, 0.04}) runs.push_back(identify::ball_end_mean_forces(t, a, fz, c));
+  const identify::BallEndFit f = identify::identify_ball_end(runs, t);
+  for (int j = 0; j < 4; ++j) {
+    EXPECT_NEAR(f.ktc[j].value, c.ktc[j], 1e-6 * std::abs(c.ktc[0])) << j;
+    EXPECT_NEAR(f.krc[j].value, c.krc[j], 1e-6 * std::abs(c.krc[0])) << j;
+    EXPECT_NEAR(f.kac[j].value, c.kac[j], 1e-6 * std::abs(c.kac[0])) << j;
+  }
+  EXPECT_NEAR(f.kte.value, 5.0, 1e-8);
+  EXPECT_NEAR(f.kre.value, 3.0, 1e-8);
+  EXPECT_NEAR(f.kae.value, 1.5, 1e-8);
+  EXPECT_NEAR(f.r2_y, 1.0, 1e-9);
+  EXPECT_LT(f.condition_number, identify::kMaxConditionNumber);
+  std::printf("condition number %.3g\n", f.condition_number);
+  // The mean does not depend on the helix in the shear terms; the edge terms' dS does.
+  const identify::BallEndTest steep{8, 4.0, 45.0, 3};
+  EXPECT_NEAR(identify::ball_end_mean_forces(steep, 1.0, 0.02, {{800, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, 0, 0, 0}).fy_n,
+              identify::ball_end_mean_forces(t, 1.0, 0.02, {{800, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, 0, 0, 0}).fy_n, 1e-12);
+}
+
+TEST(IdentifyBallEnd, RefusesWhatCannotBeSeparated) {
+  const identify::BallEndTest t{8, 4.0, 30.0, 3};
+  std::vector<identify::BallEndRun> one_depth;
+  for (double fz : {0.01, 0.015, 0.02, 0.03, 0.04, 0.05})
+    one_depth.push_back(identify::ball_end_mean_forces(t, 0.5, fz, known_ball_end()));
+  try {
+    (void)identify::identify_ball_end(one_depth, t);
+    FAIL() << "one axial depth separated a cubic in kappa";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("condition number"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lower --order"), std::string::npos) << e.what();
+  }
+  auto runs = one_depth;
+  runs.resize(3);
+  EXPECT_THROW((void)identify::identify_ball_end(runs, t), std::invalid_argument);  // too few for order 3
+  runs = one_depth;
+  runs[2].fx_n = NAN;
+  EXPECT_THROW((void)identify::identify_ball_end(runs, {8, 4.0, 30.0, 0}), std::invalid_argument);
+  runs = one_depth;
+  runs[0].axial_mm = 2.5;  // beyond the 2 mm ball
+  EXPECT_THROW((void)identify::identify_ball_end(runs, {8, 4.0, 30.0, 0}), std::invalid_argument);
+}
+
+// Seed 003's own slot runs (config/milling/data/seed003_slot_milling.csv): the fit runs and reports that
+// the shear coefficients are not determined (the forces hardly change with the feed: edge forces dominate).
+TEST(IdentifyBallEnd, Seed003SlotRunsDoNotDetermineTheShearCoefficients) {
+  const auto runs = identify::read_ball_end_csv(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/data/seed003_slot_milling.csv");
+  ASSERT_EQ(runs.size(), 10u);
+  const identify::BallEndFit f = identify::identify_ball_end(runs, {8, 4.0, 30.0, 3});
+  std::printf("seed 003, cubic: Ktc0 %.4g +- %.3g, Kte %.3g +- %.3g N/mm, R^2 %.3f / %.3f, cond %.3g\n", f.ktc[0].value,
+              f.ktc[0].ci95, f.kte.value, f.kte.ci95, f.r2_y, f.r2_xz, f.condition_number);
+  EXPECT_GT(f.ktc[0].ci95, std::abs(f.ktc[0].value));
+  EXPECT_GT(f.kte.value, 1.0);
+  EXPECT_LT(f.kte.value, 2.5);
+  const identify::BallEndFit f0 = identify::identify_ball_end(runs, {8, 4.0, 30.0, 0});
+  EXPECT_GT(f0.ktc[0].ci95, 375.61);  // seed 000's Ktc lies inside an interval this wide, and so does 0
 }
 
 }  // namespace
