@@ -25,7 +25,10 @@ namespace {
 
 nlohmann::json estimate(const identify::Estimate& e) { return {{"value", e.value}, {"ci95", e.ci95}}; }
 
-std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir) {
+}  // namespace
+
+std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir,
+                       const std::string& prefix) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   std::ostringstream data;
@@ -42,13 +45,15 @@ std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit
     << "set grid\nset logscale y\nset ylabel '|H| (m/N)'\nplot DATA u 1:2 w l t 'measured', DATA u 1:4 w l lw 2 t 'fit'\n"
     << "unset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\n"
     << "plot DATA u 1:3 w l t 'measured', DATA u 1:5 w l lw 2 t 'fit'\nunset multiplot\n";
-  if (auto e = run_gnuplot(s.str(), data.str(), dir + "/modes_fit.png"); !e.empty()) return e;
+  if (auto e = run_gnuplot(s.str(), data.str(), dir + "/" + prefix + "_fit.png"); !e.empty()) return e;
   std::ostringstream diag;
   for (const auto& p : fit.diagram) diag << p.freq_hz << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
   const std::string s2 = "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
                          "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
-  return run_gnuplot(s2, diag.str(), dir + "/modes_stabilisation.png");
+  return run_gnuplot(s2, diag.str(), dir + "/" + prefix + "_stabilisation.png");
 }
+
+namespace {
 
 int run_modes(const IdentifyArgs& a) {
   identify::ModalFitSettings s;
@@ -99,7 +104,7 @@ int run_modes(const IdentifyArgs& a) {
     std::printf("wrote %s\n", a.yaml_path.c_str());
   }
   if (!a.plot_dir.empty()) {
-    if (auto e = plot_modes(d, fit, a.plot_dir); !e.empty()) {
+    if (auto e = plot_modes(d, fit, a.plot_dir, "modes"); !e.empty()) {
       std::cerr << "plot: " << e << '\n';
       return 1;
     }
@@ -182,7 +187,7 @@ void register_identify(Registry& r) {
   sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes, actuator: fit band LO HI (default: the whole FRF; actuator: the chirp within analysis.band)");
   r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes, all: highest order of the stabilisation diagram (even)");
-  sub->add_option("--plot-dir", a->plot_dir, "modes: write the fit and the stabilisation diagram (PNG) here");
+  sub->add_option("--plot-dir", a->plot_dir, "modes, all: write the fits and the stabilisation diagrams (PNG) here");
   sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
       ->check(CLI::ExistingFile);
   r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "identify/modal_fit.hpp"
+
 namespace robodamp::apps {
 
 struct IdentifyArgs {
@@ -27,6 +29,11 @@ struct IdentifyArgs {
   // actuator and all
   std::string recording_path, structure_path, in_dir, out_path;
 };
+
+// Measured against fitted magnitude and phase (<prefix>_fit.png) and the stabilisation diagram
+// (<prefix>_stabilisation.png) in dir; an empty string, or what went wrong.
+[[nodiscard]] std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir,
+                                     const std::string& prefix);
 
 [[nodiscard]] int run_identify_actuator(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_ball_end(const IdentifyArgs& a);

@@ -4,11 +4,14 @@
 // docs/identification.md.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
+#include "apps/gnuplot.hpp"
 #include "apps/identify_command.hpp"
 #include "identify/actuator_fit.hpp"
 #include "identify/commissioning.hpp"
@@ -41,6 +44,23 @@ identify::ActuatorFit actuator_from_force_csv(const IdentifyArgs& a) {
   if (a.band_hz.size() == 2) s.band_lo_hz = a.band_hz[0], s.band_hi_hz = a.band_hz[1];
   s.min_coherence = kActuatorMinCoherence;
   return identify::fit_actuator(g, s);
+}
+
+// Measured against fitted force per volt (magnitude and phase) in dir/<name>.
+std::string plot_actuator(const identify::ActuatorFit& fit, const std::string& dir, const std::string& name) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::ostringstream data;
+  for (std::size_t i = 0; i < fit.f_hz.size(); ++i)
+    data << fit.f_hz[i] << ' ' << std::abs(fit.measured[i]) << ' ' << std::arg(fit.measured[i]) * 180.0 / M_PI << ' '
+         << std::abs(fit.fitted[i]) << ' ' << std::arg(fit.fitted[i]) * 180.0 / M_PI << '\n';
+  std::ostringstream s;
+  s << "set multiplot layout 2,1 title 'Actuator force per volt: measured and Eq. 3 fitted (fit error " << fit.fit_error_pct
+    << " %)'\nset grid\nset logscale x\nset ylabel '|F/V| (N/V)'\n"
+    << "plot DATA u 1:2 w l t 'measured (hold as 1.5 periods)', DATA u 1:4 w l lw 2 t 'fit (exactly sampled)'\n"
+    << "set xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nplot DATA u 1:3 w l t 'measured (hold as 1.5 periods)', DATA u 1:5 w l lw 2 t 'fit (exactly sampled)'\n"
+    << "unset multiplot\n";
+  return run_gnuplot(s.str(), data.str(), dir + "/" + name);
 }
 
 }  // namespace
@@ -128,6 +148,17 @@ int run_identify_all(const IdentifyArgs& a) {
     }
   }
   std::printf("wrote %s\n", a.out_path.c_str());
+  if (!a.plot_dir.empty()) {
+    std::string e;
+    for (const auto& f : r.frfs)
+      if (e.empty()) e = plot_modes(f.data, f.fit, a.plot_dir, f.name);
+    if (e.empty()) e = plot_actuator(r.actuator, a.plot_dir, "actuator_fit.png");
+    if (!e.empty()) {
+      std::cerr << "plot: " << e << '\n';
+      return 1;
+    }
+    std::printf("wrote plots in %s\n", a.plot_dir.c_str());
+  }
   if (!a.json_path.empty()) {
     std::ofstream out(a.json_path);
     out << identify::to_json(r).dump(2) << '\n';

@@ -164,8 +164,10 @@ void expect_analysis_matches(const config::Config& identified, const config::Con
 
 void expect_round_trip(const std::string& dir, const std::string& measured_config) {
   const std::string log = dir + "/identify.log", out = dir + "/identified.yaml", json_path = dir + "/identified.json";
-  Child identify({"identify", "all", "--in", dir, "--out", out, "--json", json_path}, log);
+  Child identify({"identify", "all", "--in", dir, "--out", out, "--json", json_path, "--plot-dir", dir + "/plots"}, log);
   ASSERT_EQ(identify.wait(), 0) << test::read_file(log);
+  for (const char* png : {"H11yy_fit.png", "H21yy_stabilisation.png", "H22yy_fit.png", "actuator_fit.png"})
+    EXPECT_GT(std::filesystem::file_size(dir + "/plots/" + png), 1000U) << png;
   Child check({"check-config", out}, dir + "/check.log");
   ASSERT_EQ(check.wait(), 0) << test::read_file(dir + "/check.log");
   const config::Config identified = config::load_config_file(out);

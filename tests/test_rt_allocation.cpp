@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "analysis/loop_model.hpp"
+#include "analysis/modal_test.hpp"
 #include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/telemetry_drain.hpp"
@@ -346,6 +347,49 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   const rt::ReplayResult r = rt::replay(rt::read_recording(path));
   EXPECT_EQ(r.frames, loop.stats().ticks_run);
   EXPECT_EQ(r.mismatches, 0U);
+}
+
+// robodamp measure's loop: the supervisor's chirp test signal with K = 0 and the plant-side impact test
+// (analysis::ModalTest on the simulated backend's step hook) through the whole commissioning plan: the
+// loop thread allocates nothing and takes no lock.
+TEST(RealTimePath, CommissioningMeasurementAllocatesNothing) {
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  cfg.commissioning.chirp_periods = 2, cfg.commissioning.chirp_period_s = 4.0;
+  cfg.commissioning.impacts_per_location = 2, cfg.commissioning.record_s = 3.0;
+  const sim::PlantModel model = sim::build_plant_model(cfg);
+  const analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg, model);
+  config::Config off = cfg;
+  off.controller.gain_ns_per_m = 0.0;
+  runtime::CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  o.test_signal = {true, plan.chirp_start_s, cfg.commissioning.chirp_period_s, cfg.commissioning.chirp_periods,
+                   cfg.commissioning.chirp_f0_hz, cfg.commissioning.chirp_f1_hz, plan.chirp_amplitude_v,
+                   cfg.amplifier.voltage_limit_v};
+  runtime::Cell session(off, o);
+  test::configure(session);
+  analysis::ModalTest modal(cfg, session.plant(), plan);
+  struct Hook final : drivers::PlantStepHook {
+    analysis::ModalTest* t;
+    void before_step(std::uint64_t k) noexcept override { t->before_step(k); }
+    void after_step(std::uint64_t k) noexcept override { t->after_step(k); }
+  } hook;
+  hook.t = &modal;
+  session.sim_backend().set_step_hook(&hook);
+  rt::Loop& loop = session.loop();
+  loop.schedule(1, {rt::CommandKind::kArm, 0.0});
+  rt::TelemetryDrain drain(session.telemetry_ring(), {[](const rt::TelemetryFrame&) {}});
+  drain.start();
+  const auto ticks = static_cast<std::uint64_t>(plan.duration_s * cfg.loop.rate_hz);
+  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
+  t_loop_thread = true;
+  loop.run(ticks);
+  t_loop_thread = false;
+  const long during = g_loop_thread_allocations.load() - before;
+  drain.stop();
+  EXPECT_EQ(during, 0) << "allocations on the loop thread";
+  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken on the loop thread";
+  EXPECT_EQ(modal.records(), modal.records_planned());
+  EXPECT_EQ(session.supervisor().latched_trip(), rt::Trip::kNone);
 }
 
 long resident_kib() {
