@@ -96,7 +96,7 @@ class BiquadCascade final {
   [[nodiscard]] std::uint64_t state_reset_count() const noexcept { return state_resets_; }
   [[nodiscard]] double last_output() const noexcept { return last_output_; }
 
- private:
+  // One section's state and step (also used by filters/harmonic_notch.hpp).
   struct State {
     double s1{0.0}, s2{0.0};
   };
@@ -108,6 +108,8 @@ class BiquadCascade final {
     s.s2 = k.b2 * x - k.a2 * y;
     return y;
   }
+
+ private:
 
   double finish(double v) noexcept {
     if (!std::isfinite(v)) [[unlikely]] {

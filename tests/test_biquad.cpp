@@ -5,6 +5,7 @@
 
 #include "filters/biquad.hpp"
 #include "filters/design.hpp"
+#include "filters/harmonic_notch.hpp"
 #include "test_util.hpp"
 
 namespace robodamp::filters {
@@ -196,6 +197,102 @@ TEST(BiquadCascade, SwapToADifferentSectionCount) {
 
 TEST(SosCoefficients, RejectsMoreThanTheFixedCapacity) {
   EXPECT_THROW((void)SosCoefficients::from(std::vector<BiquadCoefficients>(kMaxSections + 1)), std::length_error);
+}
+
+// --- Spindle-locked harmonic notches ---
+
+HarmonicNotchSettings notch_settings() {
+  HarmonicNotchSettings s;
+  s.enabled = true;
+  s.harmonics = 4;
+  s.bandwidth_hz = 20.0;
+  s.depth_db = 30.0;
+  s.slew_fraction = 0.02;
+  s.min_hz = 20.0;
+  s.fade_s = 0.2;
+  s.update_hz = 100.0;
+  return s;
+}
+
+// Steady-state amplitude gain of the bank for a sine at f (RMS over the last second of three).
+double bank_gain_db(HarmonicNotchBank bank, double f_hz, double fs) {
+  double in = 0.0, out = 0.0;
+  const int n = static_cast<int>(3 * fs);
+  for (int i = 0; i < n; ++i) {
+    const double x = std::sin(2.0 * M_PI * f_hz * i / fs), y = bank.process(x);
+    if (i >= n - static_cast<int>(fs)) in += x * x, out += y * y;
+  }
+  return 10.0 * std::log10(out / in);
+}
+
+TEST(HarmonicNotch, AttenuatesEachEnabledHarmonicByTheConfiguredDepth) {
+  const double fs = 5000.0, tooth_hz = 12000.0 * 3 / 60.0;  // 600 Hz
+  HarmonicNotchBank bank(notch_settings(), fs);
+  bank.set_tooth_frequency(tooth_hz);
+  for (int i = 0; i < 5000; ++i) (void)bank.process(0.0);  // settle the fade
+  ASSERT_DOUBLE_EQ(bank.fade(), 1.0);
+  for (int k = 1; k <= 3; ++k) {
+    const double g = bank_gain_db(bank, k * tooth_hz, fs);
+    std::printf("harmonic %d (%.0f Hz): %.3f dB\n", k, k * tooth_hz, g);
+    EXPECT_NEAR(g, -30.0, 0.5) << k;
+    EXPECT_NEAR(20.0 * std::log10(std::abs(bank.response(k * tooth_hz))), -30.0, 0.5) << k;
+  }
+  // The 4th harmonic (2400 Hz) is at or above 0.45 fs = 2250 Hz: off.
+  EXPECT_FALSE(bank.harmonic_on(3));
+  EXPECT_NEAR(bank_gain_db(bank, 4 * tooth_hz, fs), 0.0, 0.1);
+  // Far from every notch (the 9.2 Hz robot mode) the bank passes the signal.
+  EXPECT_NEAR(std::abs(bank.response(9.2)), 1.0, 1e-3);
+  std::printf("phase at 9.2 Hz: %.4f deg\n", std::arg(bank.response(9.2)) * 180.0 / M_PI);
+}
+
+// A sine at the robot mode plus one near the notches; the centre ramps 200 -> 320 Hz at the slew limit.
+// The largest sample-to-sample output change stays within that of the same signal with the bank standing
+// at either end (a coefficient change with the state kept adds no step of its own).
+TEST(HarmonicNotch, MovingAtTheSlewLimitMakesNoLargerOutputStepThanStandingStill) {
+  const double fs = 5000.0;
+  auto run = [&](double from_hz, double to_hz, HarmonicNotchCounters* counters) {
+    HarmonicNotchBank bank(notch_settings(), fs);
+    bank.set_tooth_frequency(from_hz);
+    double max_step = 0.0, last = 0.0;
+    for (int i = 0; i < static_cast<int>(6 * fs); ++i) {
+      if (i == static_cast<int>(1 * fs)) bank.set_tooth_frequency(to_hz);
+      const double t = i / fs;
+      const double x = std::sin(2.0 * M_PI * 9.2 * t) + 0.3 * std::sin(2.0 * M_PI * 150.0 * t);
+      const double y = bank.process(x);
+      if (i > static_cast<int>(0.5 * fs)) max_step = std::max(max_step, std::abs(y - last));
+      last = y;
+    }
+    if (counters != nullptr) *counters = bank.counters();
+    EXPECT_DOUBLE_EQ(bank.centre_hz(), to_hz);
+    return max_step;
+  };
+  HarmonicNotchCounters moved{};
+  const double at_200 = run(200.0, 200.0, nullptr), at_320 = run(320.0, 320.0, nullptr);
+  const double moving = run(200.0, 320.0, &moved);
+  std::printf("largest output step: %.6f at 200 Hz, %.6f at 320 Hz, %.6f moving (%llu slew-limited updates)\n", at_200,
+              at_320, moving, static_cast<unsigned long long>(moved.slew_limited));
+  EXPECT_GT(moved.slew_limited, 10U);
+  EXPECT_LE(moving, std::max(at_200, at_320) * 1.001);
+}
+
+TEST(HarmonicNotch, ParksOnAStoppedOrUnknownSpindleAndPassesTheSignalExactly) {
+  const double fs = 5000.0;
+  HarmonicNotchBank bank(notch_settings(), fs);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(bank.process(0.25 * i), 0.25 * i);  // never started: faded out
+  bank.set_tooth_frequency(400.0);
+  for (int i = 0; i < 2000; ++i) (void)bank.process(0.0);
+  EXPECT_DOUBLE_EQ(bank.fade(), 1.0);
+  for (double bad : {std::nan(""), -100.0, HUGE_VAL}) bank.set_tooth_frequency(bad);
+  EXPECT_EQ(bank.counters().invalid_inputs, 3U);
+  EXPECT_EQ(bank.target_hz(), 0.0);
+  // Faded out within fade_s (plus one update), then the input passes bit for bit.
+  for (int i = 0; i < static_cast<int>(0.21 * fs) + 50; ++i) (void)bank.process(std::sin(0.01 * i));
+  EXPECT_EQ(bank.fade(), 0.0);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(bank.process(0.5 * i), 0.5 * i);
+  EXPECT_GT(bank.counters().parked, 0U);
+  bank.set_tooth_frequency(5.0);  // below min_hz: still parked
+  for (int i = 0; i < 500; ++i) (void)bank.process(0.0);
+  EXPECT_EQ(bank.fade(), 0.0);
 }
 
 }  // namespace
