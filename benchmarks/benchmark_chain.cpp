@@ -37,6 +37,23 @@ void BM_ControllerUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_ControllerUpdate);
 
+// Issue 17's comparison: the controller with 8 harmonic notches following the spindle (coefficients
+// recomputed at 100 Hz) against a plain hand-written cascade of the same 14 sections; target <= 1.3x.
+void BM_PlainCascadeWithNotches(benchmark::State& state) {
+  bench::PlainCascade c(bench::notched_sections());
+  auto k = [&](double x) { return c.process(x); };
+  run(state, k);
+}
+BENCHMARK(BM_PlainCascadeWithNotches);
+
+void BM_ControllerUpdateWithNotches(benchmark::State& state) {
+  control::Controller c(bench::notched_params());
+  (void)c.set_spindle_rpm(bench::kNotchedRpm);
+  auto k = [&](double x) { return c.update(x); };
+  run(state, k);
+}
+BENCHMARK(BM_ControllerUpdateWithNotches);
+
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -1,4 +1,4 @@
-// callgrind_chain KERNEL N: runs KERNEL (plain | chain | controller) for N closed-loop samples inside
+// callgrind_chain KERNEL N: runs KERNEL (plain | chain | controller | plain_notched | controller_notched) for N closed-loop samples inside
 // run_kernel(), so `valgrind --tool=callgrind --toggle-collect=run_kernel` counts only that work.
 #include <cstdio>
 #include <cstdlib>
@@ -15,7 +15,7 @@ __attribute__((noinline)) double run_kernel(Kernel& k, const std::array<double, 
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: callgrind_chain plain|chain|controller N\n");
+    std::fprintf(stderr, "usage: callgrind_chain plain|chain|controller|plain_notched|controller_notched N\n");
     return 2;
   }
   const long n = std::atol(argv[2]);
@@ -32,6 +32,15 @@ int main(int argc, char** argv) {
     y = run_kernel(k, u, n);
   } else if (std::strcmp(argv[1], "controller") == 0) {
     control::Controller c(d.params);
+    auto k = [&](double x) { return c.update(x); };
+    y = run_kernel(k, u, n);
+  } else if (std::strcmp(argv[1], "plain_notched") == 0) {
+    bench::PlainCascade c(bench::notched_sections());
+    auto k = [&](double x) { return c.process(x); };
+    y = run_kernel(k, u, n);
+  } else if (std::strcmp(argv[1], "controller_notched") == 0) {
+    control::Controller c(bench::notched_params());
+    (void)c.set_spindle_rpm(bench::kNotchedRpm);
     auto k = [&](double x) { return c.update(x); };
     y = run_kernel(k, u, n);
   } else {

@@ -15,6 +15,29 @@ inline control::ChainDesign default_design() {
   return control::design_chain(config::load_config_file(ROBODAMP_SOURCE_DIR "/config/presets/horizontal_c2.yaml"));
 }
 
+// The default design with 8 spindle-locked notches (3000 rpm x 3 teeth: 150 to 1200 Hz), running.
+inline control::ControllerParams notched_params() {
+  control::ControllerParams p = default_design().params;
+  p.harmonic_notch.enabled = true;
+  p.harmonic_notch.harmonics = 8;
+  p.harmonic_notch.bandwidth_hz = 10.0;
+  p.harmonic_notch.depth_db = 30.0;
+  p.harmonic_notch.fade_s = 0.0;
+  p.spindle_teeth = 3;
+  return p;
+}
+inline constexpr double kNotchedRpm = 3000.0;
+
+// The same sections as notched_params() running: the chain's, then the 8 notches at their centres.
+inline filters::SosCoefficients notched_sections() {
+  const control::ControllerParams p = notched_params();
+  filters::SosCoefficients c = p.sections;
+  const double tooth_hz = kNotchedRpm * p.spindle_teeth / 60.0;
+  for (int k = 1; k <= 8; ++k)
+    c.sections[c.count++] = filters::HarmonicNotchBank::design(k * tooth_hz, 10.0, 30.0, p.fs_hz);
+  return c;
+}
+
 class PlainCascade {
  public:
   explicit PlainCascade(const filters::SosCoefficients& c) : n_(c.count) {

@@ -10,13 +10,13 @@ bash scripts/setup.sh
 n=1000000
 echo
 echo "callgrind instructions per sample (N = $n, closed loop, Release flags):"
-for k in plain chain controller; do
+for k in plain chain controller plain_notched controller_notched; do
   out=$(mktemp)
   valgrind --tool=callgrind --callgrind-out-file="$out" '--toggle-collect=*run_kernel*' \
     ./build/benchmarks/callgrind_chain "$k" "$n" >/dev/null 2>&1
   ir=$(grep -E '^(summary|totals):' "$out" | head -1 | awk '{print $2}')
   rm -f "$out"
-  awk -v k="$k" -v ir="$ir" -v n="$n" 'BEGIN { printf "  %-11s %8.2f\n", k, ir / n }'
+  awk -v k="$k" -v ir="$ir" -v n="$n" 'BEGIN { printf "  %-19s %8.2f\n", k, ir / n }'
 done
 echo
 echo "simulated plant + controller, default preset (x_real_time = simulated s per wall s, one core):"

@@ -227,6 +227,7 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
       c.polarity = p;
   }
   if (auto v = r.number("match_freq_hz", below_nyquist(rate), -1.0); v && *v >= 0.0) c.match_freq_hz = *v;
+  c.harmonic_notch = detail::read_harmonic_notch(r, rate);
   const YAML::Node chain = r.child("chain", true, "list of blocks (Eq. 8)");
   if (chain.IsDefined() && !chain.IsNull()) {
     if (!chain.IsSequence() || chain.size() == 0) {
@@ -638,6 +639,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.can = read_can(top, rate);
   detail::read_supervisory(top, c);
   c.commissioning = detail::read_commissioning(top);
+  c.spindle = detail::read_spindle(top);
   top.finish();
   check_location_refs(d, c, root);
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

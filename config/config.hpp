@@ -12,6 +12,7 @@
 
 #include "config/can_config.hpp"
 #include "config/commissioning_config.hpp"
+#include "config/spindle_config.hpp"
 #include "config/supervisory_config.hpp"
 
 namespace robodamp::config {
@@ -139,6 +140,7 @@ struct ControllerConfig {
   int polarity{1};
   std::optional<double> match_freq_hz;  // compensators' pre-warp; default the dominant robot mode
   std::vector<BlockConfig> chain;
+  std::optional<HarmonicNotchConfig> harmonic_notch;  // spindle-locked notches after the chain
 };
 
 enum class ModeForm { kResidue, kStiffness };
@@ -242,6 +244,7 @@ struct Config {
   std::optional<DdsConfig> dds;                // telemetry and supervised parameters over Fast DDS
   HilConfig hil;                               // read by the plant emulator (robodamp plant)
   CommissioningConfig commissioning;           // robodamp measure and the plant side of it
+  SpindleConfig spindle;                       // tooth count and speed range (the harmonic notches)
 };
 
 // A parameter request's gain against what the supervisor allows (the analysed maximum stable K x

@@ -81,6 +81,9 @@ class MapReader {
 [[nodiscard]] std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def);
 // The optional modbus, parameter_sets, dds and hil sections (config/supervisory_config.hpp).
 void read_supervisory(MapReader& top, Config& c);
+// The controller's optional harmonic_notch map and the optional spindle section (config/spindle_config.hpp).
+[[nodiscard]] std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller, std::optional<double> rate_hz);
+[[nodiscard]] SpindleConfig read_spindle(MapReader& top);
 // The optional commissioning section (config/commissioning_config.hpp).
 [[nodiscard]] CommissioningConfig read_commissioning(MapReader& top);
 // One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.

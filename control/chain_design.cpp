@@ -143,6 +143,18 @@ ChainDesign design_chain(const config::Config& cfg) {
   p.force_limit_n = cfg.actuator.force_limit_n;
   p.voltage_limit_v = cfg.amplifier.voltage_limit_v;
   p.slew_rate_v_per_s = cfg.amplifier.slew_rate_v_per_s;
+  if (const auto& n = cfg.controller.harmonic_notch) {
+    p.harmonic_notch.enabled = true;
+    p.harmonic_notch.harmonics = n->harmonics;
+    p.harmonic_notch.bandwidth_hz = n->bandwidth_hz;
+    p.harmonic_notch.depth_db = n->depth_db;
+    p.harmonic_notch.slew_fraction = n->slew_fraction;
+    p.harmonic_notch.min_hz = n->min_hz;
+    p.harmonic_notch.fade_s = n->fade_s;
+    p.harmonic_notch.update_hz = n->update_hz;
+  }
+  p.spindle_teeth = cfg.spindle.teeth;
+  p.spindle_rpm_max = cfg.spindle.rpm_max;
   return d;
 }
 

@@ -18,6 +18,7 @@ struct ControllerCounters {
   std::uint64_t voltage_limited{0};       // clipped at the amplifier voltage range
   std::uint64_t slew_limited{0};          // clipped at the slew-rate limit
   std::uint64_t rejected_requests{0};     // gain or parameter requests refused (out of range, other rate)
+  std::uint64_t spindle_refused{0};       // spindle speeds refused (NaN, negative, above rpm_max): notches parked
 };
 
 enum class RequestStatus { kAccepted, kRejectedOutOfRange, kRejectedSampleRate };
@@ -28,7 +29,7 @@ inline constexpr double kMaxGainNsPerM = 1e5;
 class Controller final {
  public:
   explicit Controller(const ControllerParams& p) noexcept
-      : p_(p), cascade_(p.sections), dt_s_(1.0 / p.fs_hz) {
+      : p_(p), cascade_(p.sections), notches_(p.harmonic_notch, p.fs_hz), dt_s_(1.0 / p.fs_hz) {
     target_gain_ = p.gain_ns_per_m;
     scale_ = target_scale_ = output_scale(p_, target_gain_);
   }
@@ -36,7 +37,7 @@ class Controller final {
   // RT-safe. One loop sample: acceleration at the actuator location (m/s^2) -> amplifier command (V).
   [[nodiscard]] double update(double accel_mps2) noexcept {
     ++counters_.samples;
-    const double shaped = cascade_.process(accel_mps2);
+    const double shaped = notches_.process(cascade_.process(accel_mps2));
     filtered_ = shaped;
     if (pending_) (void)shadow_.process(accel_mps2);  // the incoming chain warms up on the same signal
     advance_ramp();
@@ -64,10 +65,24 @@ class Controller final {
   // (zero for a chain with a high-pass), without a slew transient.
   void reset(double accel_mps2) noexcept {
     cascade_.reset(accel_mps2);
+    notches_.reset(cascade_.last_output());
     if (pending_) shadow_.reset(accel_mps2);
     const double f = scale_ * cascade_.last_output();
     force_n_ = std::copysign(std::min(std::abs(f), p_.force_limit_n), f);
     command_v_ = std::copysign(std::min(std::abs(force_n_ / p_.actuator_constant_n_per_v), p_.voltage_limit_v), f);
+  }
+
+  // RT-safe. The spindle speed the harmonic notches follow (tooth frequency = rpm x teeth / 60); 0 =
+  // stopped. A NaN, negative or above-range speed is refused, counted, and parks the notches.
+  RequestStatus set_spindle_rpm(double rpm) noexcept {
+    if (!std::isfinite(rpm) || rpm < 0.0 || rpm > p_.spindle_rpm_max) {
+      ++counters_.spindle_refused;
+      notches_.set_tooth_frequency(0.0);
+      return RequestStatus::kRejectedOutOfRange;
+    }
+    spindle_rpm_ = rpm;
+    notches_.set_tooth_frequency(rpm * p_.spindle_teeth / 60.0);
+    return RequestStatus::kAccepted;
   }
 
   // RT-safe. Ramps K to the new value over the configured ramp time; refuses what the configuration
@@ -122,6 +137,8 @@ class Controller final {
   [[nodiscard]] double filtered_mps() const noexcept { return p_.sections_gain * filtered_; }
   [[nodiscard]] double force_command_n() const noexcept { return force_n_; }
   [[nodiscard]] const ControllerParams& params() const noexcept { return p_; }
+  [[nodiscard]] const filters::HarmonicNotchBank& notches() const noexcept { return notches_; }
+  [[nodiscard]] double spindle_rpm() const noexcept { return spindle_rpm_; }
 
  private:
   static double output_scale(const ControllerParams& p, double gain) noexcept {
@@ -149,6 +166,8 @@ class Controller final {
       pending_ = false;
       cascade_ = shadow_;
       p_ = next_;  // same fs_hz (request_params refuses another rate), so dt_s_ stands
+      notches_.configure(p_.harmonic_notch, p_.fs_hz);  // the notches' state and centre carry over
+      notches_.set_tooth_frequency(spindle_rpm_ * p_.spindle_teeth / 60.0);
       start_ramp(output_scale(p_, target_gain_));
     }
   }
@@ -157,7 +176,9 @@ class Controller final {
   ControllerParams next_{};
   filters::BiquadCascade cascade_;
   filters::BiquadCascade shadow_;
+  filters::HarmonicNotchBank notches_;
   double dt_s_;
+  double spindle_rpm_{0.0};
   double target_gain_{0.0};
   double scale_{0.0}, target_scale_{0.0}, ramp_step_{0.0};
   std::uint64_t ramp_left_{0};

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "filters/biquad.hpp"
+#include "filters/harmonic_notch.hpp"
 
 namespace robodamp::control {
 
@@ -18,6 +19,9 @@ struct ControllerParams {
   double force_limit_n{36.0};
   double voltage_limit_v{10.0};
   double slew_rate_v_per_s{10000.0};
+  filters::HarmonicNotchSettings harmonic_notch{};  // spindle-locked notches after the chain (off by default)
+  int spindle_teeth{3};
+  double spindle_rpm_max{30000.0};
 };
 
 }  // namespace robodamp::control

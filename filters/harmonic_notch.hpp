@@ -8,10 +8,12 @@
 // The centres are recomputed at update_hz (not every sample): the target follows the tooth frequency, the
 // centre moves towards it by at most slew_fraction of itself per update. While the bank is faded out
 // (spindle stopped, speed unknown or below min_hz) the centre jumps; then the bank fades in over fade_s.
-// Harmonics at or above max_fraction_of_fs x fs fade out on their own (their filter keeps running at
-// that limit). A notch's state stays across a coefficient change (transposed direct form II), and each
-// notch is mixed in as x + g (N x - x) with its fade g, so starting, stopping and moving never switch the
-// signal path abruptly. Everything after construction is RT-safe: no allocation, locking, exceptions.
+// Harmonics at or above max_fraction_of_fs x fs fade out on their own. Each notch is mixed in with its
+// fade g as x + g (N x - x) = ((1 - g) A + g B) / A for N = B / A: one biquad whose numerator blends
+// towards the denominator, so the mix costs nothing per sample. A notch's state stays across every
+// coefficient change (transposed direct form II): starting, stopping and moving never switch the signal
+// path abruptly. A notch whose fade reaches 0 leaves the path (its state cleared), so a parked bank passes
+// the signal bit for bit. Everything after construction is RT-safe: no allocation, locking, exceptions.
 #pragma once
 
 #include <algorithm>
@@ -72,6 +74,17 @@ class HarmonicNotchBank final {
     target_hz_ = f_hz;
   }
 
+  // RT-safe. Steady state for a constant input (every notch passes DC unchanged).
+  void reset(double x) noexcept {
+    if (!std::isfinite(x)) x = 0.0;
+    for (int k = 0; k < kMaxHarmonics; ++k) {
+      const auto& c = mixed_[static_cast<std::size_t>(k)];
+      auto& st = state_[static_cast<std::size_t>(k)];
+      st.s2 = (c.b2 - c.a2) * x;
+      st.s1 = (c.b1 - c.a1) * x + st.s2;
+    }
+  }
+
   // RT-safe. One sample through the bank.
   [[nodiscard]] double process(double x) noexcept {
     if (!s_.enabled) return x;
@@ -80,9 +93,9 @@ class HarmonicNotchBank final {
       update();
     }
     double v = x;
-    for (int k = 0; k < s_.harmonics; ++k) {
-      const double n = BiquadCascade::step(coef_[k], state_[k], v);
-      v += gain_[k] * (n - v);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(s_.harmonics); ++k) {
+      if (gain_[k] == 0.0) continue;
+      v = BiquadCascade::step(mixed_[k], state_[k], v);
     }
     if (!std::isfinite(v)) [[unlikely]] {  // overflow: clear the notches' state, pass the input
       for (auto& st : state_) st = {};
@@ -96,10 +109,10 @@ class HarmonicNotchBank final {
     if (!s_.enabled) return 1.0;
     const std::complex<double> z1 = std::polar(1.0, -2.0 * M_PI * f_hz / fs_hz_);
     std::complex<double> h = 1.0;
-    for (int k = 0; k < s_.harmonics; ++k) {
-      const auto& c = coef_[k];
-      const std::complex<double> n = (c.b0 + c.b1 * z1 + c.b2 * z1 * z1) / (1.0 + c.a1 * z1 + c.a2 * z1 * z1);
-      h *= 1.0 + gain_[k] * (n - 1.0);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(s_.harmonics); ++k) {
+      if (gain_[k] == 0.0) continue;
+      const auto& c = mixed_[k];
+      h *= (c.b0 + c.b1 * z1 + c.b2 * z1 * z1) / (1.0 + c.a1 * z1 + c.a2 * z1 * z1);
     }
     return h;
   }
@@ -151,6 +164,7 @@ class HarmonicNotchBank final {
       const double own = own_[static_cast<std::size_t>(k)];
       own_[static_cast<std::size_t>(k)] = target > own ? std::min(target, own + fade_step_) : std::max(target, own - fade_step_);
       gain_[static_cast<std::size_t>(k)] = fade_ * own_[static_cast<std::size_t>(k)];
+      if (gain_[static_cast<std::size_t>(k)] == 0.0) state_[static_cast<std::size_t>(k)] = {};  // out of the path
     }
     design_all();
   }
@@ -159,7 +173,13 @@ class HarmonicNotchBank final {
     const double top = s_.max_fraction_of_fs * fs_hz_;
     for (int k = 0; k < s_.harmonics; ++k) {
       const double f = std::min((k + 1) * centre_hz_, top);  // an off harmonic keeps running at the limit
-      coef_[static_cast<std::size_t>(k)] = design(f, std::min(s_.bandwidth_hz, f), s_.depth_db, fs_hz_);
+      const BiquadCoefficients n = design(f, std::min(s_.bandwidth_hz, f), s_.depth_db, fs_hz_);
+      const double g = gain_[static_cast<std::size_t>(k)];
+      BiquadCoefficients& m = mixed_[static_cast<std::size_t>(k)];
+      m = n;  // (1 - g) A + g B over A (A's leading coefficient is 1)
+      m.b0 = (1.0 - g) + g * n.b0;
+      m.b1 = (1.0 - g) * n.a1 + g * n.b1;
+      m.b2 = (1.0 - g) * n.a2 + g * n.b2;
     }
   }
 
@@ -168,7 +188,7 @@ class HarmonicNotchBank final {
   std::uint32_t update_every_{50}, since_update_{0};
   double fade_step_{0.05};
   double target_hz_{0.0}, centre_hz_{0.0}, fade_{0.0};
-  std::array<BiquadCoefficients, kMaxHarmonics> coef_{};
+  std::array<BiquadCoefficients, kMaxHarmonics> mixed_{};  // each notch blended with its fade
   std::array<BiquadCascade::State, kMaxHarmonics> state_{};
   std::array<double, kMaxHarmonics> own_{}, gain_{};
   HarmonicNotchCounters counters_{};

@@ -121,7 +121,7 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
   json states = json::array(), trips = json::array(), commands = json::array();
   for (int i = 0; i <= static_cast<int>(State::kFault); ++i) states.push_back(to_string(static_cast<State>(i)));
   for (std::size_t i = 0; i < kTripCount; ++i) trips.push_back(to_string(static_cast<Trip>(i)));
-  for (int i = 0; i <= static_cast<int>(CommandKind::kSelectParams); ++i)
+  for (int i = 0; i <= static_cast<int>(CommandKind::kSetSpindle); ++i)
     commands.push_back(to_string(static_cast<CommandKind>(i)));
   json sets = json::array();  // index 0 is controller_params with the supervisor's verdict
   for (std::size_t i = 1; i < supervisor.parameter_sets().size(); ++i) {

@@ -73,6 +73,7 @@ const char* to_string(CommandKind k) {
     case CommandKind::kResetFault: return "reset_fault";
     case CommandKind::kSetGain: return "set_gain";
     case CommandKind::kSelectParams: return "select_params";
+    case CommandKind::kSetSpindle: return "set_spindle";
   }
   return "?";
 }
@@ -179,6 +180,9 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         ++counters_.gain_refused;
       break;
     case CommandKind::kSelectParams: select(c); break;
+    case CommandKind::kSetSpindle:  // validated by the controller: refused speeds park the notches
+      if (controller_.set_spindle_rpm(c.value) != control::RequestStatus::kAccepted) ++counters_.spindle_refused;
+      break;
   }
 }
 

@@ -44,11 +44,11 @@ inline constexpr std::size_t kTripCount = 11;
 
 enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable };
 
-enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams };
+enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams, kSetSpindle };
 
 struct OperatorCommand {
   CommandKind kind{CommandKind::kNone};
-  double value{0.0};  // set_gain: K in N s/m; select_params: index of the parameter set
+  double value{0.0};  // set_gain: K in N s/m; select_params: index of the parameter set; set_spindle: rpm
 };
 
 [[nodiscard]] const char* to_string(State s);
@@ -93,6 +93,7 @@ struct SupervisorCounters {
   std::uint64_t gain_refused{0};
   std::uint64_t params_refused{0};
   std::uint64_t params_selected{0};
+  std::uint64_t spindle_refused{0};  // set_spindle commands refused (the notches parked)
   std::uint64_t commands{0};
 };
 

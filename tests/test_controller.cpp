@@ -180,5 +180,33 @@ TEST(Controller, ResetStartsFromSteadyStateWithoutSlewTransient) {
   EXPECT_EQ(c.counters().slew_limited, 0U);
 }
 
+// The spindle-locked notches in the controller: the tooth frequency from the speed and the configured
+// teeth, the command at it cut by the depth, bad speeds refused, counted and parking the notches.
+TEST(Controller, SpindleSpeedSteersTheHarmonicNotchesAndBadSpeedsParkThem) {
+  ControllerParams p = identity(4.8);  // 1 V per m/s^2
+  p.harmonic_notch.enabled = true;
+  p.harmonic_notch.harmonics = 3;
+  p.harmonic_notch.bandwidth_hz = 20.0;
+  p.harmonic_notch.depth_db = 40.0;
+  p.harmonic_notch.min_hz = 20.0;
+  p.spindle_teeth = 3;
+  p.spindle_rpm_max = 20000.0;
+  Controller c(p);
+  ASSERT_EQ(c.set_spindle_rpm(12000.0), RequestStatus::kAccepted);  // 600 Hz
+  double in = 0.0, out = 0.0;
+  for (int i = 0; i < 15000; ++i) {
+    const double x = 0.1 * std::sin(2.0 * M_PI * 600.0 * i / 5000.0), y = c.update(x);
+    if (i >= 10000) in += x * x, out += y * y;
+  }
+  EXPECT_NEAR(10.0 * std::log10(out / in), -40.0, 0.5);
+  EXPECT_DOUBLE_EQ(c.notches().centre_hz(), 600.0);
+  for (double bad : {std::nan(""), -1.0, 25000.0}) EXPECT_EQ(c.set_spindle_rpm(bad), RequestStatus::kRejectedOutOfRange);
+  EXPECT_EQ(c.counters().spindle_refused, 3U);
+  for (int i = 0; i < 2000; ++i) (void)c.update(0.0);
+  EXPECT_EQ(c.notches().fade(), 0.0);  // parked
+  EXPECT_DOUBLE_EQ(c.update(0.5), 0.5);  // and out of the signal path
+}
+
 }  // namespace
 }  // namespace robodamp::control
+

@@ -1,0 +1,25 @@
+// The spindle the damper works beside (docs/harmonic_notch.md): its tooth count and speed range, and the
+// controller's spindle-locked harmonic notches (controller.harmonic_notch), which follow the tooth-passing
+// frequency spindle speed x teeth / 60.
+#pragma once
+
+#include <optional>
+
+namespace robodamp::config {
+
+struct HarmonicNotchConfig {
+  int harmonics{3};             // notches at 1..harmonics x the tooth frequency
+  double bandwidth_hz{10.0};    // -3 dB width of each notch
+  double depth_db{30.0};        // attenuation at each centre
+  double slew_fraction{0.05};   // largest centre move per update, relative to the centre
+  double min_hz{10.0};          // below it the bank parks and fades out
+  double fade_s{0.2};
+  double update_hz{100.0};
+};
+
+struct SpindleConfig {
+  int teeth{3};
+  double rpm_max{30000.0};      // a requested speed above it is refused (and parks the notches)
+};
+
+}  // namespace robodamp::config
