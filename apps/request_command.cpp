@@ -26,6 +26,7 @@ struct RequestOptions {
   std::optional<double> gain_ns_per_m;
   std::optional<int> parameter_set;
   std::optional<int> enable;
+  std::optional<double> spindle_rpm;
 };
 
 namespace {
@@ -59,9 +60,9 @@ class Replies : public DataReaderListener {
 
 // 0 accepted, 3 refused (the reason is printed), 1 no loop or no reply, 2 bad options.
 int run_request(const DdsClientOptions& o, const RequestOptions& r) {
-  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0);
+  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0) + (r.spindle_rpm ? 1 : 0);
   if (given != 1) {
-    std::cerr << "robodamp request: give exactly one of --gain, --select, --enable\n";
+    std::cerr << "robodamp request: give exactly one of --gain, --select, --enable, --spindle-rpm\n";
     return 2;
   }
   msg::ParameterRequest req;
@@ -71,6 +72,7 @@ int run_request(const DdsClientOptions& o, const RequestOptions& r) {
   if (r.gain_ns_per_m) req.kind(msg::SET_GAIN), req.value(*r.gain_ns_per_m);
   if (r.parameter_set) req.kind(msg::SELECT_PARAMETER_SET), req.value(*r.parameter_set);
   if (r.enable) req.kind(msg::ENABLE), req.value(*r.enable);
+  if (r.spindle_rpm) req.kind(msg::SET_SPINDLE_RPM), req.value(*r.spindle_rpm);
   const double wait_s = o.duration_s > 0.0 ? o.duration_s : 10.0;
   int rc = 1;
   {
@@ -117,6 +119,8 @@ void register_request(Registry& r) {
   r.whole_number(sub, "--select", req->parameter_set, {"(parameter set)", 0, 255, false, false, "0 = the configuration's own"},
                  "Select a parameter set");
   r.whole_number(sub, "--enable", req->enable, {"(1 = arm, 0 = disarm)", 0, 1}, "1 = arm, 0 = disarm");
+  r.number(sub, "--spindle-rpm", req->spindle_rpm, {"rpm", 0.0, 200000.0},
+           "The spindle speed the harmonic notches follow (0 = stopped; the loop checks spindle.rpm_max)");
   r.number(sub, "--timeout", o->options.duration_s, {"s", 0.1, 3600.0}, "Wait this long for the loop and the reply (default 10 s)");
 }
 

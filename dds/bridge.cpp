@@ -20,8 +20,9 @@ class Bridge::RequestListener : public DataReaderListener {
     SampleInfo info;
     while (reader->take_next_sample(&req, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      const auto kind = req.kind() == msg::SET_GAIN ? RequestKind::kSetGain
+      const auto kind = req.kind() == msg::SET_GAIN               ? RequestKind::kSetGain
                         : req.kind() == msg::SELECT_PARAMETER_SET ? RequestKind::kSelectParameterSet
+                        : req.kind() == msg::SET_SPINDLE_RPM      ? RequestKind::kSetSpindleRpm
                                                                   : RequestKind::kEnable;
       const Decision d = b_.decide(kind, req.value());
       msg::ParameterReply reply;

@@ -26,7 +26,7 @@ namespace robodamp::dds {
 
 class Participant;
 
-enum class RequestKind : std::uint8_t { kSetGain, kSelectParameterSet, kEnable };
+enum class RequestKind : std::uint8_t { kSetGain, kSelectParameterSet, kEnable, kSetSpindleRpm };
 
 struct Decision {
   bool accepted{false};

@@ -50,6 +50,21 @@ CheckedRequest check_enable(double value) {
   return {{true, "disarming: the command fades out over controller.gain_ramp_s"}, {rt::CommandKind::kDisarm, 0.0}};
 }
 
+CheckedRequest check_spindle(const config::Config& cfg, double rpm) {
+  char b[256];
+  if (!(std::isfinite(rpm) && rpm >= 0.0 && rpm <= cfg.spindle.rpm_max)) {
+    std::snprintf(b, sizeof b, "spindle_rpm = %g rpm is out of range: allowed 0 <= value <= spindle.rpm_max = %g rpm", rpm,
+                  cfg.spindle.rpm_max);
+    return {{false, b}, {}};
+  }
+  if (cfg.controller.harmonic_notch)
+    std::snprintf(b, sizeof b, "the harmonic notches follow %g rpm x %d teeth = %g Hz (below controller.harmonic_notch.min_hz "
+                  "= %g Hz they park)", rpm, cfg.spindle.teeth, rpm * cfg.spindle.teeth / 60.0, cfg.controller.harmonic_notch->min_hz);
+  else
+    std::snprintf(b, sizeof b, "spindle at %g rpm noted (no controller.harmonic_notch is configured)", rpm);
+  return {{true, b}, {rt::CommandKind::kSetSpindle, rpm}};
+}
+
 }  // namespace
 
 CheckedRequest check_request(const rt::Supervisor& sup, const config::Config& cfg, dds::RequestKind kind, double value) {
@@ -57,6 +72,7 @@ CheckedRequest check_request(const rt::Supervisor& sup, const config::Config& cf
     case dds::RequestKind::kSetGain: return check_gain(sup, cfg, value);
     case dds::RequestKind::kSelectParameterSet: return check_select(sup, cfg, value);
     case dds::RequestKind::kEnable: return check_enable(value);
+    case dds::RequestKind::kSetSpindleRpm: return check_spindle(cfg, value);
   }
   return {{false, "unknown request kind"}, {}};
 }

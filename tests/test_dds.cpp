@@ -167,6 +167,7 @@ TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   d.parameter_writes = true;
   cfg.dds = d;
   cfg.loop.clock = config::ClockKind::kWall;
+  cfg.controller.harmonic_notch = config::HarmonicNotchConfig{};
   runtime::CellOptions o;
   o.realtime_setup = false;
   runtime::Cell cell(cfg, o);
@@ -197,14 +198,22 @@ TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   r = client.ask(6, msg::SELECT_PARAMETER_SET, 1.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
   ASSERT_TRUE(eventually([&] { return client.status.last().parameter_set() == 1; }, 60.0));
-  r = client.ask(7, msg::ENABLE, 0.0);
+  r = client.ask(7, msg::SET_SPINDLE_RPM, 40000.0);
+  EXPECT_FALSE(r.accepted());
+  EXPECT_NE(std::string(r.reason()).find("spindle_rpm = 40000 rpm is out of range: allowed 0 <= value <= spindle.rpm_max = 30000 rpm"),
+            std::string::npos) << r.reason();
+  r = client.ask(8, msg::SET_SPINDLE_RPM, 12000.0);
+  EXPECT_TRUE(r.accepted()) << r.reason();
+  EXPECT_NE(std::string(r.reason()).find("12000 rpm x 3 teeth = 600 Hz"), std::string::npos) << r.reason();
+  r = client.ask(9, msg::ENABLE, 0.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
   ASSERT_TRUE(eventually([&] { return std::string(client.status.last().state()) == "disabled"; }, 60.0));
   ASSERT_TRUE(cell.deactivate().ok());
+  EXPECT_EQ(cell.supervisor().controller().spindle_rpm(), 12000.0);  // the loop thread has ended: no race
   const runtime::RunSummary& summary = cell.summary();
   ASSERT_TRUE(summary.dds.has_value());
-  EXPECT_EQ(summary.dds->requests, 7U);
-  EXPECT_EQ(summary.dds->refused, 4U);
+  EXPECT_EQ(summary.dds->requests, 9U);
+  EXPECT_EQ(summary.dds->refused, 5U);
   EXPECT_EQ(summary.supervisor.params_selected, 1U);
   EXPECT_EQ(summary.trip, "none");
   EXPECT_EQ(summary.arming.outcome, runtime::ArmingOutcome::kArmed) << "the operator's disarm came after arming";

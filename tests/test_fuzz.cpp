@@ -110,7 +110,7 @@ std::vector<Sub> subcommands() {
       {"run", {"--duration", "--impact-every"}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
       {"plant", {"--duration", "--impact-location"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
       {"monitor", {"--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback", "shared_memory"}}}, {"--config"}, false},
-      {"request", {"--domain", "--gain", "--select", "--enable", "--timeout"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
+      {"request", {"--domain", "--gain", "--select", "--enable", "--timeout", "--spindle-rpm"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
       {"replay", {}, {}, {}, {}, true},
       {"csv", {}, {}, {}, {}, true},
       {"lobes", {"--rpm"}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},

@@ -261,7 +261,7 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
                              -std::numeric_limits<double>::infinity(), -0.0, 0.0, 1.0, 2.0, -1.0, 1e308, -1e308,
                              std::numeric_limits<double>::denorm_min(), limit, std::nextafter(limit, 1e9), 0.5, 1.5};
   std::uniform_real_distribution<double> wide(-1e6, 1e6);
-  std::uniform_int_distribution<int> pick(0, 2), special(0, std::size(specials) - 1), coin(0, 1);
+  std::uniform_int_distribution<int> pick(0, 3), special(0, std::size(specials) - 1), coin(0, 1);
   int accepted = 0;
   for (int i = 0; i < 10000; ++i) {
     const auto kind = static_cast<dds::RequestKind>(pick(rng));
@@ -286,6 +286,11 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
         break;
       case dds::RequestKind::kEnable:
         EXPECT_TRUE(v == 0.0 || v == 1.0) << v;
+        break;
+      case dds::RequestKind::kSetSpindleRpm:
+        EXPECT_GE(v, 0.0);
+        EXPECT_LE(v, cfg.spindle.rpm_max);
+        EXPECT_EQ(r.command.kind, CommandKind::kSetSpindle);
         break;
     }
   }
