@@ -4,10 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 
 #include "control/controller.hpp"
+#include "filters/design.hpp"
+#include "filters/harmonic_notch.hpp"
 #include "sim_plant/state_space.hpp"
 
 namespace robodamp::analysis {
@@ -57,13 +60,29 @@ DiscreteSs section_ss(const filters::BiquadCoefficients& q, double scale) {
 
 }  // namespace
 
-LoopModel::LoopModel(const config::Config& cfg)
+LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rpm)
     : cfg_(cfg),
       plant_(sim::build_plant_model(cfg)),
       chain_(control::design_chain(cfg)),
       sensor_model_(cfg.sensor, cfg.loop.rate_hz, 0),
       sensor_(plant_.index_of(cfg.sensor.location)) {
   const double t = 1.0 / cfg.loop.rate_hz;
+  // The harmonic notches at this speed, fully faded in, as the chain runs them (filters/harmonic_notch.hpp).
+  if (spindle_rpm && cfg.controller.harmonic_notch) {
+    const auto& n = *cfg.controller.harmonic_notch;
+    spindle_rpm_ = *spindle_rpm;
+    const double tooth_hz = *spindle_rpm * cfg.spindle.teeth / 60.0;
+    for (int k = 1; k <= n.harmonics && tooth_hz >= n.min_hz; ++k) {
+      const double f = k * tooth_hz;
+      if (f >= filters::HarmonicNotchSettings{}.max_fraction_of_fs * cfg.loop.rate_hz) break;
+      if (chain_.params.sections.count >= filters::kMaxSections)
+        throw std::invalid_argument("the chain and the harmonic notches need more than " +
+                                    std::to_string(filters::kMaxSections) + " second-order sections");
+      const auto c = filters::HarmonicNotchBank::design(f, std::min(n.bandwidth_hz, f), n.depth_db, cfg.loop.rate_hz);
+      chain_.params.sections.sections[chain_.params.sections.count++] = c;
+      notches_.sections[notches_.count++] = c;
+    }
+  }
   const auto& ss = plant_.ss;
   const Eigen::Index nu = ss.b.cols(), nl = static_cast<Eigen::Index>(plant_.locations.size());
   const sim::DelayedZoh coil = sim::discretise_zoh_delayed(ss.a, ss.b.leftCols(1), t, plant_.actuator.delay_s);
@@ -107,9 +126,16 @@ LoopModel::LoopModel(const config::Config& cfg)
   open_loop_unit_ = o;
 }
 
+Complex LoopModel::notch_response(double f_hz) const {
+  if (notches_.count == 0) return 1.0;
+  const std::vector<filters::BiquadCoefficients> v(notches_.sections.begin(),
+                                                   notches_.sections.begin() + static_cast<std::ptrdiff_t>(notches_.count));
+  return filters::digital_response(v, 1.0, f_hz, cfg_.loop.rate_hz);
+}
+
 Complex LoopModel::feedback_continuous(double f_hz, double gain, int polarity) const {
   const Complex s(0.0, kTwoPi * f_hz);
-  return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_analog(f_hz) *
+  return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_analog(f_hz) * notch_response(f_hz) *
          plant_.actuator.n_per_v(f_hz) * sensor_model_.analog_response(f_hz) * s * s;
 }
 

@@ -37,7 +37,9 @@ struct PlantResponse {
 
 class LoopModel {
  public:
-  explicit LoopModel(const config::Config& cfg);
+  // spindle_rpm: with controller.harmonic_notch, the notches at that speed (fully faded in) join the
+  // chain: the discrete loop runs them, the continuous model takes their digital response.
+  explicit LoopModel(const config::Config& cfg, std::optional<double> spindle_rpm = std::nullopt);
 
   [[nodiscard]] const sim::PlantModel& plant() const { return plant_; }
   [[nodiscard]] const control::ChainDesign& chain() const { return chain_; }
@@ -45,6 +47,10 @@ class LoopModel {
   [[nodiscard]] std::size_t sensor_location() const { return sensor_; }
   [[nodiscard]] std::size_t actuator_location() const { return plant_.actuator.location; }
   [[nodiscard]] double loop_rate_hz() const { return cfg_.loop.rate_hz; }
+  // The harmonic notches in the model (none without a spindle speed) and their response.
+  [[nodiscard]] std::size_t notch_count() const { return notches_.count; }
+  [[nodiscard]] Complex notch_response(double f_hz) const;
+  [[nodiscard]] std::optional<double> spindle_rpm() const { return spindle_rpm_; }
 
   // Force per displacement at the sensor location that the controller feeds back (F_act = Q x_s), for
   // gain K and polarity; continuous: Q = pol K / T * filters * H_act e^{-s t_a} * S(s) * s^2.
@@ -83,6 +89,8 @@ class LoopModel {
 
  private:
   config::Config cfg_;
+  filters::SosCoefficients notches_{};
+  std::optional<double> spindle_rpm_;
   sim::PlantModel plant_;
   control::ChainDesign chain_;
   sim::Accelerometer sensor_model_;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "apps/cli.hpp"
@@ -55,7 +56,13 @@ json analysis_report(const analysis::LoopModel& m, const analysis::AnalysisResul
   j["polarity_reason"] = r.polarity_reason;
   j["modes"] = json::array();
   for (const auto& mp : r.modes)
-    j["modes"].push_back({{"freq_hz", mp.freq_hz}, {"feedback_phase_deg", mp.feedback_phase_deg}, {"damps", mp.damps}});
+    j["modes"].push_back({{"freq_hz", mp.freq_hz}, {"feedback_phase_deg", mp.feedback_phase_deg}, {"damps", mp.damps},
+                          {"notch_phase_deg", std::arg(m.notch_response(mp.freq_hz)) * 180.0 / M_PI}});
+  if (m.spindle_rpm()) {
+    const double teeth = m.config().spindle.teeth;
+    j["spindle"] = {{"rpm", *m.spindle_rpm()}, {"teeth", teeth}, {"tooth_hz", *m.spindle_rpm() * teeth / 60.0},
+                    {"notches", m.notch_count()}};
+  }
   j["frfs"] = json::array();  // the discrete loop that runs
   for (const auto& f : r.frfs_discrete) j["frfs"].push_back(frf_json(f, r.stable));
   j["frfs_continuous"] = json::array();  // REFERENCE.md section 1 equations, delay exact
@@ -77,6 +84,17 @@ std::string analysis_table(const json& r) {
      << fmt(r["gain_margin_db"], "%.2f") << " dB, phase margin " << fmt(r["phase_margin_deg"], "%.1f")
      << " deg at " << fmt(r["gain_crossover_hz"], "%.2f") << " Hz, delay margin " << fmt(r["delay_margin_ms"], "%.2f")
      << " ms\n";
+  if (r.contains("spindle")) {
+    const auto& sp = r["spindle"];
+    std::snprintf(line, sizeof line, "  spindle %.0f rpm x %.0f teeth = %.2f Hz: %zu harmonic notches in the loop\n",
+                  sp["rpm"].get<double>(), sp["teeth"].get<double>(), sp["tooth_hz"].get<double>(), sp["notches"].get<std::size_t>());
+    os << line;
+    for (const auto& mp : r["modes"]) {
+      std::snprintf(line, sizeof line, "    the notches' phase at %.2f Hz: %+.3f deg\n", mp["freq_hz"].get<double>(),
+                    mp["notch_phase_deg"].get<double>());
+      os << line;
+    }
+  }
   os << "  recommended polarity " << std::showpos << r["recommended_polarity"].get<int>() << std::noshowpos << ": "
      << r["polarity_reason"].get<std::string>() << "\n";
   for (const auto& mp : r["modes"]) {
@@ -185,11 +203,12 @@ struct AnalyzeArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   bool json{false};
   std::string plot_dir;
+  std::optional<double> spindle_rpm;
 };
 
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
-  const analysis::LoopModel model(config::load_config_file(a.config_path));
+  const analysis::LoopModel model(config::load_config_file(a.config_path), a.spindle_rpm);
   const auto result = analysis::analyse(model);
   const auto report = analysis_report(model, result);
   if (print_report(report.dump(2), a.json, analysis_table(report), a.plot_dir,
@@ -208,6 +227,8 @@ void register_analyze(Registry& r) {
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   sub->add_flag("--json", a->json, "Print JSON instead of a table");
   sub->add_option("--plot-dir", a->plot_dir, "Write FRF, Nyquist and gain-sweep plots (PNG) here");
+  r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0},
+           "Analyse with controller.harmonic_notch at this spindle speed (spindle.teeth)");
 }
 
 }  // namespace robodamp::apps
