@@ -105,6 +105,13 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
       b.diagnostics().add(b.mark(), "modbus.robot.vertical_value",
                           "= " + std::to_string(rr.vertical_value) + " is the horizontal value too: they must differ");
     if (auto v = read_int(b, "settle_polls", {"(polls)", 1, 1000}, rr.settle_polls)) rr.settle_polls = *v;
+    if (auto v = read_int(b, "spindle_rpm_register", {"(register address, zero-based; -1 = none)", -1, 65535},
+                          rr.spindle_rpm_register))
+      rr.spindle_rpm_register = *v;
+    if (rr.spindle_rpm_register >= 0 && rr.spindle_rpm_register == rr.mounting_register)
+      b.diagnostics().add(b.mark(), "modbus.robot.spindle_rpm_register",
+                          "= " + std::to_string(rr.spindle_rpm_register) + " is the mounting register too: they must differ");
+    if (auto v = b.number("rpm_per_count", {"rpm per count", 0.0, 1000.0, true}, rr.rpm_per_count)) rr.rpm_per_count = *v;
     b.finish();
   }
   r.finish();

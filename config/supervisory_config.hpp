@@ -41,6 +41,10 @@ struct RobotRegisters {
   int horizontal_value{0};
   int vertical_value{1};
   int settle_polls{3};       // the same value this many polls running before a set is selected
+  // The spindle speed (docs/harmonic_notch.md): a holding register (-1 = none), scaled, with the same
+  // settling; the robot link lost for modbus.link_timeout_s parks the harmonic notches.
+  int spindle_rpm_register{-1};
+  double rpm_per_count{1.0};
 };
 
 struct ModbusConfig {

@@ -203,12 +203,20 @@ void ModbusSupervisor::robot_thread() {
   const auto& r = cfg_.robot;
   const auto period = std::chrono::duration<double>(cfg_.poll_period_s);
   int candidate = -1, same = 0;
+  SpindleWatch spindle;
   bool running = true;
   while (running) {
     const auto now = ModbusLink::Clock::now();
     modbus_t* ctx = robot_link_->connect(now);
     robot_up_.store(ctx != nullptr);
-    if (ctx == nullptr) {
+    if (ctx == nullptr || !poll_spindle(ctx, spindle)) {
+      if (ctx != nullptr) {  // the spindle register's read failed
+        robot_link_->failed(ModbusLink::Clock::now());
+        robot_up_.store(false);
+        spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
+        candidate = -1, same = 0;
+      }
+      park_spindle_if_lost(spindle);
       running = sleep_for(std::min<std::chrono::duration<double>>(period, robot_link_->retry_at() - now));
       continue;
     }
@@ -218,6 +226,7 @@ void ModbusSupervisor::robot_thread() {
       robot_up_.store(false);
       spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
       candidate = -1, same = 0;
+      park_spindle_if_lost(spindle);
       running = sleep_for(std::chrono::duration<double>(0.0));
       continue;
     }
@@ -239,6 +248,36 @@ void ModbusSupervisor::robot_thread() {
   }
 }
 
+bool ModbusSupervisor::poll_spindle(modbus_t* ctx, SpindleWatch& w) {
+  const auto& r = cfg_.robot;
+  if (r.spindle_rpm_register < 0) return true;
+  std::uint16_t v = 0;
+  if (modbus_read_registers(ctx, r.spindle_rpm_register, 1, &v) != 1) return false;
+  w.last_ok = ModbusLink::Clock::now();
+  w.parked = false;
+  w.same = static_cast<int>(v) == w.candidate ? w.same + 1 : 1;
+  w.candidate = v;
+  const double rpm = v * r.rpm_per_count;
+  if (w.same >= r.settle_polls && rpm != w.rpm) {
+    w.rpm = rpm;
+    ++spindle_changes_;
+    spdlog::info("modbus robot: spindle at {} rpm", rpm);
+    if (on_spindle_) on_spindle_(rpm);
+  }
+  return true;
+}
+
+void ModbusSupervisor::park_spindle_if_lost(SpindleWatch& w) {
+  if (cfg_.robot.spindle_rpm_register < 0 || w.parked) return;
+  w.candidate = -1, w.same = 0;
+  if (ModbusLink::Clock::now() - w.last_ok < std::chrono::duration<double>(cfg_.link_timeout_s)) return;
+  w.parked = true;
+  w.rpm = 0.0;
+  ++spindle_link_parks_;
+  spdlog::warn("modbus robot: no spindle speed for {} s: the harmonic notches park", cfg_.link_timeout_s);
+  if (on_spindle_) on_spindle_(0.0);
+}
+
 ModbusCounters ModbusSupervisor::counters() const {
   ModbusCounters c;
   c.amplifier_polls = amp_polls_.load();
@@ -254,6 +293,8 @@ ModbusCounters ModbusSupervisor::counters() const {
   c.coil_writes = coil_writes_.load();
   c.mounting_changes = mounting_changes_.load();
   c.mounting_unknown = mounting_unknown_.load();
+  c.spindle_changes = spindle_changes_.load();
+  c.spindle_link_parks = spindle_link_parks_.load();
   return c;
 }
 

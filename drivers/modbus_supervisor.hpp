@@ -68,16 +68,23 @@ struct ModbusCounters {
   std::uint64_t coil_writes{0};
   std::uint64_t mounting_changes{0};   // selections handed to the callback
   std::uint64_t mounting_unknown{0};   // polls with a value that is neither horizontal nor vertical
+  std::uint64_t spindle_changes{0};    // settled spindle speeds handed to the callback
+  std::uint64_t spindle_link_parks{0}; // robot link lost for link_timeout_s: speed 0 handed over (notches parked)
 };
 
 class ModbusSupervisor final : public rt::SupervisoryIo {
  public:
   using MountingCallback = std::function<void(config::Mounting)>;
+  using SpindleCallback = std::function<void(double rpm)>;
   // initial: the mounting the controller starts with (its configuration's actuator.mounting).
   ModbusSupervisor(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback on_mounting = {});
   ~ModbusSupervisor() override;
   ModbusSupervisor(const ModbusSupervisor&) = delete;
   ModbusSupervisor& operator=(const ModbusSupervisor&) = delete;
+
+  // Before start(): called from the robot thread with each settled spindle speed (rpm; 0 when the robot
+  // link has been lost for link_timeout_s). Needs modbus.robot.spindle_rpm_register.
+  void set_spindle_callback(SpindleCallback cb) { on_spindle_ = std::move(cb); }
 
   void start();
   // Writes the enable coil off when it can, then joins the threads.
@@ -98,10 +105,20 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
  private:
   void amplifier_thread();
   void robot_thread();
+  // The spindle register's settling (robot thread only).
+  struct SpindleWatch {
+    int candidate{-1}, same{0};
+    double rpm{0.0};
+    bool parked{false};
+    std::chrono::steady_clock::time_point last_ok{std::chrono::steady_clock::now()};
+  };
+  bool poll_spindle(modbus_t* ctx, SpindleWatch& w);  // false: the read failed
+  void park_spindle_if_lost(SpindleWatch& w);
   bool sleep_for(std::chrono::duration<double> d);  // false when stopping
 
   config::ModbusConfig cfg_;
   MountingCallback on_mounting_;
+  SpindleCallback on_spindle_;
   ModbusLink amp_link_;
   std::optional<ModbusLink> robot_link_;
   std::thread amp_thread_, robot_thread_;
@@ -117,7 +134,7 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   std::atomic<bool> link_fault_{false};
   std::atomic<int> mounting_;
   std::atomic<std::uint64_t> amp_polls_{0}, robot_polls_{0}, link_faults_{0}, coil_writes_{0}, mounting_changes_{0},
-      mounting_unknown_{0};
+      mounting_unknown_{0}, spindle_changes_{0}, spindle_link_parks_{0};
   std::int64_t link_timeout_ns_;
 };
 

@@ -100,6 +100,14 @@ Status Cell::configure_devices() {
       return s;
     }
   }
+  if (modbus_ && cfg_.modbus->robot.spindle_rpm_register >= 0) {
+    // The robot's spindle register: each settled speed (0 when the link is lost) becomes a set_spindle
+    // command; the controller validates it against spindle.rpm_max.
+    modbus_->client().set_spindle_callback([this](double rpm) {
+      if (!loop_->post({rt::CommandKind::kSetSpindle, rpm}))
+        spdlog::warn("the robot reports the spindle at {} rpm: the command queue is full, dropped", rpm);
+    });
+  }
   return {};
 }
 

@@ -392,6 +392,30 @@ TEST(Config, CommissioningSectionIsValidated) {
   EXPECT_EQ(p.size(), 5U) << all;
 }
 
+TEST(Config, HarmonicNotchAndSpindleAreValidated) {
+  std::string text = std::string(kValid);
+  const auto at = text.find("controller:\n");
+  ASSERT_NE(at, std::string::npos);
+  std::string ok = text;
+  ok.insert(at + 12, "  harmonic_notch: {harmonics: 4, bandwidth_hz: 20, depth_db: 40}\n");
+  const Config c = parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000}\n", "ok.yaml");
+  ASSERT_TRUE(c.controller.harmonic_notch);
+  EXPECT_EQ(c.controller.harmonic_notch->harmonics, 4);
+  EXPECT_EQ(c.controller.harmonic_notch->slew_fraction, 0.05);  // default
+  EXPECT_EQ(c.spindle.teeth, 2);
+  std::string bad = text;
+  bad.insert(at + 12, "  harmonic_notch: {harmonics: 9, depth_db: 0, slew_fraction: 2, update_hz: .nan}\n");
+  const auto p = problems_of(bad + "spindle: {teeth: 0, rpm_max: -5}\n");
+  std::string all;
+  for (const auto& q : p) all += q.to_string() + "\n";
+  for (const char* expected :
+       {"controller.harmonic_notch.harmonics = 9", "controller.harmonic_notch.depth_db = 0 dB is out of range",
+        "controller.harmonic_notch.slew_fraction = 2", "controller.harmonic_notch.update_hz", "spindle.teeth = 0",
+        "spindle.rpm_max = -5 rpm is out of range"})
+    EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
+  EXPECT_EQ(p.size(), 6U) << all;
+}
+
 TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {
   EXPECT_FALSE(gain_request_problem(2000.0, 4324.0, "0.9 x K_max"));
   const auto p = gain_request_problem(5000.0, 4324.0, "0.9 x K_max");

@@ -3,6 +3,9 @@
 // a lost link as a fault only when it matters, and the robot's mounting register with its settling.
 #include <gtest/gtest.h>
 
+#include <mutex>
+#include <vector>
+
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -192,6 +195,39 @@ TEST(Modbus, RobotMountingSelectsAfterSettling) {
   EXPECT_EQ(last.load(), static_cast<int>(config::Mounting::kHorizontal));
   sup.stop();
   EXPECT_EQ(sup.counters().mounting_changes, 2U);
+}
+
+// The spindle speed register (docs/harmonic_notch.md): scaled, handed over once settled, and a lost
+// robot link parks the notches (speed 0) after modbus.link_timeout_s.
+TEST(Modbus, SpindleRegisterSettlesScalesAndALostLinkParksTheNotches) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  config::ModbusConfig cfg = client_config(port);
+  cfg.robot.spindle_rpm_register = 11;
+  cfg.robot.rpm_per_count = 10.0;
+  std::mutex m;
+  std::vector<double> speeds;
+  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  sup.set_spindle_callback([&](double rpm) {
+    std::lock_guard<std::mutex> lock(m);
+    speeds.push_back(rpm);
+  });
+  auto seen = [&] {
+    std::lock_guard<std::mutex> lock(m);
+    return speeds;
+  };
+  server.set_holding_register(11, 1200);  // 12 000 rpm
+  sup.start();
+  ASSERT_TRUE(eventually([&] { return !seen().empty(); }));
+  EXPECT_EQ(seen().front(), 12000.0);
+  server.set_holding_register(11, 600);
+  ASSERT_TRUE(eventually([&] { return seen().size() == 2; }));
+  EXPECT_EQ(seen().back(), 6000.0);
+  EXPECT_EQ(sup.counters().spindle_changes, 2U);
+  server.stop();  // the robot controller goes away
+  ASSERT_TRUE(eventually([&] { return sup.counters().spindle_link_parks == 1; }));
+  EXPECT_EQ(seen().back(), 0.0);
+  sup.stop();
 }
 
 TEST(Modbus, StopLeavesTheAmplifierOff) {
