@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "analysis/notch_speed_map.hpp"
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include <memory>
@@ -204,10 +205,42 @@ struct AnalyzeArgs {
   bool json{false};
   std::string plot_dir;
   std::optional<double> spindle_rpm;
+  bool spindle_sweep{false};
 };
+
+// The harmonic notches across spindle.rpm range: the refused speeds and the worst phase at each mode.
+void print_speed_map(const config::Config& cfg) {
+  const analysis::NotchSpeedMap map = analysis::notch_speed_map(cfg);
+  if (map.points.empty()) {
+    std::printf("no controller.harmonic_notch configured: nothing to sweep\n");
+    return;
+  }
+  std::printf("harmonic notches across %.0f-%.0f rpm (%zu speeds, %d teeth):\n", map.points.front().rpm,
+              map.points.back().rpm, map.points.size(), cfg.spindle.teeth);
+  for (std::size_t k = 0; k < map.points.front().mode_hz.size(); ++k) {
+    double worst = 0.0, at = 0.0;
+    for (const auto& p : map.points)
+      if (std::abs(p.notch_phase_deg[k]) > std::abs(worst)) worst = p.notch_phase_deg[k], at = p.rpm;
+    std::printf("  %.2f Hz mode: the notches cost at most %+.1f deg (at %.0f rpm)\n", map.points.front().mode_hz[k], worst, at);
+  }
+  if (map.refused_rpm.empty()) std::printf("  no speed refused\n");
+  for (const auto& [lo, hi] : map.refused_rpm) {
+    std::string why;
+    for (const auto& p : map.points)
+      if (p.refused && p.rpm >= lo && p.rpm <= hi) {
+        why = p.reason;
+        break;
+      }
+    std::printf("  refused %.0f-%.0f rpm: %s; the notches park there\n", lo, hi, why.c_str());
+  }
+}
 
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
+  if (a.spindle_sweep) {
+    print_speed_map(config::load_config_file(a.config_path));
+    return 0;
+  }
   const analysis::LoopModel model(config::load_config_file(a.config_path), a.spindle_rpm);
   const auto result = analysis::analyse(model);
   const auto report = analysis_report(model, result);
@@ -229,6 +262,8 @@ void register_analyze(Registry& r) {
   sub->add_option("--plot-dir", a->plot_dir, "Write FRF, Nyquist and gain-sweep plots (PNG) here");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0},
            "Analyse with controller.harmonic_notch at this spindle speed (spindle.teeth)");
+  sub->add_flag("--spindle-sweep", a->spindle_sweep,
+                "The harmonic notches across the spindle's speed range: refused speeds and their cost at each mode");
 }
 
 }  // namespace robodamp::apps

@@ -73,10 +73,15 @@ class Controller final {
   }
 
   // RT-safe. The spindle speed the harmonic notches follow (tooth frequency = rpm x teeth / 60); 0 =
-  // stopped. A NaN, negative or above-range speed is refused, counted, and parks the notches.
+  // stopped. A NaN, negative or above-range speed, or one where the analysis refused the notches
+  // (ControllerParams::refused_rpm), is refused, counted, and parks the notches.
   RequestStatus set_spindle_rpm(double rpm) noexcept {
-    if (!std::isfinite(rpm) || rpm < 0.0 || rpm > p_.spindle_rpm_max) {
+    bool refused = !std::isfinite(rpm) || rpm < 0.0 || rpm > p_.spindle_rpm_max;
+    for (std::size_t i = 0; i < p_.refused_rpm_count; ++i)
+      refused = refused || (rpm >= p_.refused_rpm[i].first && rpm <= p_.refused_rpm[i].second);
+    if (refused) {
       ++counters_.spindle_refused;
+      spindle_rpm_ = 0.0;  // parked (a later hand-over keeps them parked)
       notches_.set_tooth_frequency(0.0);
       return RequestStatus::kRejectedOutOfRange;
     }

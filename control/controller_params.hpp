@@ -2,6 +2,9 @@
 // real-time thread and handed over by copy (no allocation).
 #pragma once
 
+#include <array>
+#include <utility>
+
 #include "filters/biquad.hpp"
 #include "filters/harmonic_notch.hpp"
 
@@ -22,6 +25,11 @@ struct ControllerParams {
   filters::HarmonicNotchSettings harmonic_notch{};  // spindle-locked notches after the chain (off by default)
   int spindle_teeth{3};
   double spindle_rpm_max{30000.0};
+  // Speeds where the analysis refused the notches (analysis/notch_speed_map.hpp): a speed inside one
+  // parks them. At most kMaxRefusedSpeeds intervals (the configuration time merges more).
+  static constexpr std::size_t kMaxRefusedSpeeds = 8;
+  std::array<std::pair<double, double>, kMaxRefusedSpeeds> refused_rpm{};
+  std::size_t refused_rpm_count{0};
 };
 
 }  // namespace robodamp::control

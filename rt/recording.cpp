@@ -9,6 +9,42 @@ namespace robodamp::rt {
 
 using nlohmann::json;
 
+namespace {
+
+json notch_json(const control::ControllerParams& p) {
+  const auto& n = p.harmonic_notch;
+  json refused = json::array();
+  for (std::size_t i = 0; i < p.refused_rpm_count; ++i) refused.push_back({p.refused_rpm[i].first, p.refused_rpm[i].second});
+  return {{"enabled", n.enabled},         {"harmonics", n.harmonics},   {"bandwidth_hz", n.bandwidth_hz},
+          {"depth_db", n.depth_db},       {"slew_fraction", n.slew_fraction}, {"min_hz", n.min_hz},
+          {"fade_s", n.fade_s},           {"update_hz", n.update_hz},   {"max_fraction_of_fs", n.max_fraction_of_fs},
+          {"spindle_teeth", p.spindle_teeth}, {"spindle_rpm_max", p.spindle_rpm_max}, {"refused_rpm", refused}};
+}
+
+// Recordings made before the harmonic notches have none of this: the defaults (off) replay them.
+void notch_from(const json& j, control::ControllerParams& p) {
+  if (!j.contains("harmonic_notch")) return;
+  const json& h = j.at("harmonic_notch");
+  auto& n = p.harmonic_notch;
+  n.enabled = h.at("enabled");
+  n.harmonics = h.at("harmonics");
+  n.bandwidth_hz = h.at("bandwidth_hz");
+  n.depth_db = h.at("depth_db");
+  n.slew_fraction = h.at("slew_fraction");
+  n.min_hz = h.at("min_hz");
+  n.fade_s = h.at("fade_s");
+  n.update_hz = h.at("update_hz");
+  n.max_fraction_of_fs = h.at("max_fraction_of_fs");
+  p.spindle_teeth = h.at("spindle_teeth");
+  p.spindle_rpm_max = h.at("spindle_rpm_max");
+  for (const auto& r : h.at("refused_rpm")) {
+    if (p.refused_rpm_count == control::ControllerParams::kMaxRefusedSpeeds) break;
+    p.refused_rpm[p.refused_rpm_count++] = {r.at(0).get<double>(), r.at(1).get<double>()};
+  }
+}
+
+}  // namespace
+
 json to_json(const control::ControllerParams& p) {
   json sections = json::array();
   for (std::size_t i = 0; i < p.sections.count; ++i) {
@@ -25,7 +61,8 @@ json to_json(const control::ControllerParams& p) {
           {"actuator_constant_n_per_v", p.actuator_constant_n_per_v},
           {"force_limit_n", p.force_limit_n},
           {"voltage_limit_v", p.voltage_limit_v},
-          {"slew_rate_v_per_s", p.slew_rate_v_per_s}};
+          {"slew_rate_v_per_s", p.slew_rate_v_per_s},
+          {"harmonic_notch", notch_json(p)}};
 }
 
 control::ControllerParams controller_params_from(const json& j) {
@@ -43,6 +80,7 @@ control::ControllerParams controller_params_from(const json& j) {
   p.force_limit_n = j.at("force_limit_n").get<double>();
   p.voltage_limit_v = j.at("voltage_limit_v").get<double>();
   p.slew_rate_v_per_s = j.at("slew_rate_v_per_s").get<double>();
+  notch_from(j, p);
   return p;
 }
 

@@ -5,6 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "analysis/notch_speed_map.hpp"
+
 #include "runtime/parameter_requests.hpp"
 #include "sim_plant/excitation.hpp"
 
@@ -18,6 +20,27 @@ Cell::~Cell() {
   if (state_ == LifecycleState::kActive) (void)deactivate();
   if (state_ == LifecycleState::kInactive) (void)cleanup();
 }
+
+namespace {
+
+// The harmonic notches' speed map (analysis/notch_speed_map.hpp): the speeds refused go into the
+// controller's parameters, and each refused interval is reported once here.
+control::ControllerParams with_notch_speed_map(const config::Config& cfg, control::ControllerParams p) {
+  const analysis::NotchSpeedMap map = analysis::notch_speed_map(cfg);
+  for (const auto& [lo, hi] : map.refused_rpm) {
+    std::string why;
+    for (const auto& pt : map.points)
+      if (pt.refused && pt.rpm >= lo && pt.rpm <= hi) {
+        why = pt.reason;
+        break;
+      }
+    spdlog::warn("{}: the harmonic notches are refused at {:.0f}-{:.0f} rpm ({}); they park there", cfg.source, lo, hi, why);
+  }
+  analysis::apply_refused_speeds(map, p);
+  return p;
+}
+
+}  // namespace
 
 std::vector<Component*> Cell::components() {
   std::vector<Component*> v;
@@ -46,7 +69,7 @@ Status Cell::configure() {
   const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
   rt::SupervisorSettings settings = rt::supervisor_settings(cfg_, stable_, k_max);
   settings.test_signal = o_.test_signal;
-  supervisor_ = std::make_unique<rt::Supervisor>(settings, model_->chain().params);
+  supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(cfg_, model_->chain().params));
   ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
   if (Status s = configure_devices(); !s.ok()) return s;
   rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
@@ -138,7 +161,7 @@ std::size_t Cell::add_parameter_set(const config::Config& cfg) {
   const analysis::LoopModel m(cfg);
   const int polarity = cfg.controller.polarity;
   const auto k_max = analysis::max_stable_gain(m, polarity);
-  return supervisor_->add_parameter_set({m.chain().params, m.stable(cfg.controller.gain_ns_per_m, polarity),
+  return supervisor_->add_parameter_set({with_notch_speed_map(cfg, m.chain().params), m.stable(cfg.controller.gain_ns_per_m, polarity),
                                          k_max.value_or(control::kMaxGainNsPerM)});
 }
 

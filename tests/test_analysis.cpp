@@ -7,6 +7,8 @@
 
 #include "modal/receptance.hpp"
 #include "analysis/loop_model.hpp"
+#include "analysis/notch_speed_map.hpp"
+#include "control/controller.hpp"
 #include "analysis/spectral.hpp"
 #include "test_util.hpp"
 
@@ -157,6 +159,42 @@ TEST(Analysis, HarmonicNotchesJoinTheLoopAtASpindleSpeed) {
   EXPECT_NEAR(*k_fast, *k_plain, 0.005 * *k_plain);
   // The notches' depth is in the discrete loop: its filter response at 600 Hz is 30 dB down.
   EXPECT_NEAR(20.0 * std::log10(std::abs(fast.chain_filters_digital(600.0) / plain.chain_filters_digital(600.0))), -30.0, 0.5);
+}
+
+// Across the speed range: a notch just above the 9.2 Hz mode (tooth frequency 10-14.6 Hz, 20 Hz wide)
+// turns the feedback there by up to -118 deg, out of its damping window: those speeds are refused and
+// go into the controller's parameters, which then refuse a spindle speed there and park the notches.
+TEST(Analysis, NotchSpeedMapRefusesSpeedsThatPushADampedModeOutOfItsWindow) {
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  config::HarmonicNotchConfig n;
+  n.harmonics = 4, n.bandwidth_hz = 20.0, n.depth_db = 30.0;
+  cfg.controller.harmonic_notch = n;
+  cfg.spindle.teeth = 3;
+  cfg.spindle.rpm_max = 20000.0;
+  const analysis::NotchSpeedMap map = analysis::notch_speed_map(cfg);
+  ASSERT_EQ(map.points.size(), 400U);
+  EXPECT_NEAR(map.points.front().rpm, 200.0, 1e-9);  // min_hz 10 Hz x 60 / 3 teeth
+  ASSERT_EQ(map.refused_rpm.size(), 1U);
+  EXPECT_LT(map.refused_rpm[0].first, 200.0);
+  EXPECT_GT(map.refused_rpm[0].second, 250.0);
+  EXPECT_LT(map.refused_rpm[0].second, 400.0);
+  for (const auto& p : map.points) {
+    EXPECT_TRUE(p.stable) << p.rpm;
+    if (p.refused) EXPECT_NE(p.reason.find("out of its damping window"), std::string::npos) << p.reason;
+  }
+  control::ControllerParams params = control::design_chain(cfg).params;
+  analysis::apply_refused_speeds(map, params);
+  control::Controller c(params);
+  EXPECT_EQ(c.set_spindle_rpm(250.0), control::RequestStatus::kRejectedOutOfRange);
+  EXPECT_EQ(c.set_spindle_rpm(12000.0), control::RequestStatus::kAccepted);
+  EXPECT_EQ(c.counters().spindle_refused, 1U);
+  // More intervals than the controller holds are merged across the smallest gaps, never dropped.
+  analysis::NotchSpeedMap many;
+  for (int i = 0; i < 12; ++i) many.refused_rpm.emplace_back(1000.0 * i, 1000.0 * i + 100.0 + i);
+  analysis::apply_refused_speeds(many, params);
+  EXPECT_EQ(params.refused_rpm_count, control::ControllerParams::kMaxRefusedSpeeds);
+  EXPECT_EQ(params.refused_rpm[0].first, 0.0);
+  EXPECT_EQ(params.refused_rpm[params.refused_rpm_count - 1].second, 11111.0);
 }
 
 }  // namespace

@@ -311,6 +311,37 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   EXPECT_EQ(r.frames, f.size());
 }
 
+// Spindle commands through the loop with the harmonic notches: a speed ramp while active keeps the loop
+// active (no trip), a refused speed (in the analysis' refused band, and one above spindle.rpm_max) is
+// counted and parks the notches, and the recording with its notch parameters replays bit for bit.
+TEST(Loop, SpindleSpeedRampWithHarmonicNotchesStaysActiveAndReplays) {
+  auto cfg = c2();
+  config::HarmonicNotchConfig n;
+  n.harmonics = 4, n.bandwidth_hz = 20.0, n.depth_db = 30.0;
+  cfg.controller.harmonic_notch = n;
+  cfg.spindle.rpm_max = 20000.0;
+  CellOptions o = virtual_clock();
+  o.impact_every_s = 0.9;
+  o.record_path = ::testing::TempDir() + "/spindle.rec";
+  Cell session(cfg, o);
+  test::configure(session);
+  ASSERT_GE(session.supervisor().controller().params().refused_rpm_count, 1U);  // the band near 200-290 rpm
+  for (int i = 0; i <= 40; ++i)  // 6000 -> 12000 rpm over 2 s, every 50 ms
+    session.schedule(5000 + 250 * static_cast<std::uint64_t>(i), {CommandKind::kSetSpindle, 6000.0 + 150.0 * i});
+  session.schedule(16000, {CommandKind::kSetSpindle, 250.0});    // refused by the analysis: parks
+  session.schedule(17000, {CommandKind::kSetSpindle, 25000.0});  // above spindle.rpm_max: parks
+  session.schedule(18000, {CommandKind::kSetSpindle, 12000.0});
+  const auto s = session.run(5.0);
+  EXPECT_EQ(s.trip, "none");
+  EXPECT_EQ(s.supervisor.spindle_refused, 2U);
+  const auto& f = session.frames();
+  for (std::size_t i = 5000; i < 25000; ++i) ASSERT_EQ(f[i].state, static_cast<std::uint8_t>(State::kActive)) << i;
+  EXPECT_DOUBLE_EQ(session.supervisor().controller().notches().centre_hz(), 600.0);
+  const ReplayResult r = replay(read_recording(o.record_path));
+  EXPECT_EQ(r.mismatches, 0U);
+  EXPECT_EQ(r.frames, f.size());
+}
+
 TEST(Loop, VirtualClockRunsAreBitIdentical) {
   CellOptions o = virtual_clock();
   o.impact_every_s = 0.7;
