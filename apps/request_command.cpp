@@ -13,7 +13,7 @@
 #include "apps/cli.hpp"
 #include "apps/dds_client.hpp"
 #include "dds/participant.hpp"
-#include "robodamp.h"
+#include "dds/messages.hpp"
 #include "rt/signals.hpp"
 #include "rt/supervisor.hpp"
 

@@ -6,7 +6,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "dds/participant.hpp"
-#include "robodamp.h"
+#include "dds/messages.hpp"
 
 namespace robodamp::dds {
 

@@ -8,15 +8,16 @@
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 
-#include "robodampPubSubTypes.h"
+#include "dds/messages.hpp"
 
 namespace robodamp::dds {
 
 using namespace eprosima::fastdds::dds;
 
 namespace {
-constexpr const char* kTopicNames[4] = {"robodamp/telemetry", "robodamp/status", "robodamp/parameter_request",
-                                        "robodamp/parameter_reply"};
+// ROS 2's names for the topics /robodamp/telemetry ... (ROS 2 prefixes its topics with rt/ in DDS).
+constexpr const char* kTopicNames[4] = {"rt/robodamp/telemetry", "rt/robodamp/status", "rt/robodamp/parameter_request",
+                                        "rt/robodamp/parameter_reply"};
 }
 
 Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name,

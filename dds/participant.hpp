@@ -1,11 +1,12 @@
 // A Fast DDS participant with robodamp's four topics and their QoS (docs/dds.md), shared by the loop's
 // bridge, `robodamp monitor` and the tests. Off the real-time path.
 //
-//   topic                      type              reliability   durability       history
-//   robodamp/telemetry         Telemetry         best effort   volatile         keep last 64
-//   robodamp/status            Status            reliable      transient local  keep last 1
-//   robodamp/parameter_request ParameterRequest  reliable      volatile         keep last 32
-//   robodamp/parameter_reply   ParameterReply    reliable      volatile         keep last 32
+//   DDS topic (ROS 2 topic)              type (ROS 2 form)                     reliability  durability       history
+//   rt/robodamp/telemetry                robodamp::msg::dds_::Telemetry_        best effort  volatile         keep last 64
+//   rt/robodamp/status                   robodamp::msg::dds_::Status_           reliable     transient local  keep last 1
+//   rt/robodamp/parameter_request        robodamp::msg::dds_::ParameterRequest_ reliable     volatile         keep last 32
+//   rt/robodamp/parameter_reply          robodamp::msg::dds_::ParameterReply_   reliable     volatile         keep last 32
+// (ROS 2: /robodamp/telemetry with robodamp/msg/Telemetry, and so on; ros2/robodamp holds the .msg files.)
 //
 // Transports: default (Fast DDS built-ins: UDPv4 and shared memory), udp_loopback (UDPv4 on 127.0.0.1
 // only, data sharing off) or shared_memory (SHM only).
@@ -46,9 +47,10 @@ class Participant {
   eprosima::fastdds::dds::DataReader* reader(TopicKind t, eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
   [[nodiscard]] int domain_id() const { return domain_id_; }
+  // The topic (its DDS name and type name: ROS 2's, see above).
+  [[nodiscard]] eprosima::fastdds::dds::Topic* topic(TopicKind t);
 
  private:
-  eprosima::fastdds::dds::Topic* topic(TopicKind t);
   int domain_id_;
   config::DdsTransport transport_;
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};

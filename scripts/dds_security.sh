@@ -50,7 +50,7 @@ cat > governance.xml <<'XML'
       <rtps_protection_kind>NONE</rtps_protection_kind>
       <topic_access_rules>
         <topic_rule>
-          <topic_expression>robodamp/parameter_*</topic_expression>
+          <topic_expression>rt/robodamp/parameter_*</topic_expression>
           <enable_discovery_protection>true</enable_discovery_protection>
           <enable_liveliness_protection>false</enable_liveliness_protection>
           <enable_read_access_control>true</enable_read_access_control>
@@ -95,9 +95,9 @@ permissions() {  # name, publish topics, subscribe topics
     echo '</dds>'
   } > "$1_permissions.xml"
 }
-permissions loop "robodamp/telemetry robodamp/status robodamp/parameter_reply" "robodamp/parameter_request"
-permissions operator "robodamp/parameter_request" "robodamp/telemetry robodamp/status robodamp/parameter_reply"
-permissions observer "" "robodamp/telemetry robodamp/status"
+permissions loop "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/parameter_reply" "rt/robodamp/parameter_request"
+permissions operator "rt/robodamp/parameter_request" "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/parameter_reply"
+permissions observer "" "rt/robodamp/telemetry rt/robodamp/status"
 
 for doc in governance loop_permissions operator_permissions observer_permissions; do
   ossl smime -sign -in "$doc.xml" -text -out "$doc.smime" -signer ca.pem -inkey ca.key

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <fstream>
 #include <mutex>
 #include <sys/wait.h>
@@ -20,7 +21,7 @@
 #include "child_process.hpp"
 #include "dds/bridge.hpp"
 #include "dds/participant.hpp"
-#include "robodamp.h"
+#include "dds/messages.hpp"
 #include "test_util.hpp"
 
 namespace robodamp {
@@ -250,6 +251,78 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   const std::string log = test::read_file(dir + "/run.log");
   EXPECT_NE(log.find("tripped: signal"), std::string::npos) << log;
   EXPECT_NE(log.find("arming: armed"), std::string::npos) << log;
+}
+
+// --- ROS 2 conventions ---
+
+// The topics and types under ROS 2's names, so a ROS 2 node (rclcpp on Fast DDS) with ros2/robodamp
+// matches them: `ros2 topic echo /robodamp/telemetry robodamp/msg/Telemetry`.
+TEST(Dds, TopicsAndTypesUseRos2Names) {
+  dds::Participant p(test_domain(5), config::DdsTransport::kUdpLoopback, "ros2 names", std::nullopt);
+  const std::pair<dds::TopicKind, std::pair<const char*, const char*>> expected[] = {
+      {dds::TopicKind::kTelemetry, {"rt/robodamp/telemetry", "robodamp::msg::dds_::Telemetry_"}},
+      {dds::TopicKind::kStatus, {"rt/robodamp/status", "robodamp::msg::dds_::Status_"}},
+      {dds::TopicKind::kRequest, {"rt/robodamp/parameter_request", "robodamp::msg::dds_::ParameterRequest_"}},
+      {dds::TopicKind::kReply, {"rt/robodamp/parameter_reply", "robodamp::msg::dds_::ParameterReply_"}}};
+  for (const auto& [kind, names] : expected) {
+    EXPECT_EQ(p.topic(kind)->get_name(), names.first);
+    EXPECT_EQ(p.topic(kind)->get_type_name(), names.second);
+  }
+}
+
+// (type, name) pairs of a struct in dds/robodamp.idl, in ROS 2's spelling.
+std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& idl, const std::string& name) {
+  const std::size_t at = idl.find("struct " + name + "_ {");
+  EXPECT_NE(at, std::string::npos) << name;
+  const std::size_t end = idl.find("};", at);
+  std::istringstream body(idl.substr(idl.find('{', at) + 1, end - idl.find('{', at) - 1));
+  const std::vector<std::pair<std::string, std::string>> types = {
+      {"unsigned long long", "uint64"}, {"unsigned long", "uint32"}, {"double", "float64"},
+      {"float", "float32"},             {"octet", "uint8"},          {"boolean", "bool"}};
+  std::vector<std::pair<std::string, std::string>> out;
+  for (std::string line; std::getline(body, line);) {
+    line = line.substr(0, line.find("//"));
+    const std::size_t semi = line.find(';');
+    if (semi == std::string::npos) continue;
+    line = line.substr(line.find_first_not_of(' '), semi - line.find_first_not_of(' '));
+    const std::size_t space = line.rfind(' ');
+    std::string type = line.substr(0, space), field = line.substr(space + 1);
+    if (type.rfind("string<", 0) == 0) type = "string<=" + type.substr(7, type.size() - 8);
+    for (const auto& [idl_type, ros_type] : types)
+      if (type == idl_type) type = ros_type;
+    out.emplace_back(type, field);
+  }
+  return out;
+}
+
+// (type, name) pairs of a ROS 2 .msg file (constants and comments left out).
+std::vector<std::pair<std::string, std::string>> msg_fields(const std::string& path) {
+  std::istringstream in(test::read_file(path));
+  std::vector<std::pair<std::string, std::string>> out;
+  for (std::string line; std::getline(in, line);) {
+    line = line.substr(0, line.find('#'));
+    std::istringstream words(line);
+    std::string type, field;
+    if (!(words >> type >> field) || field.find('=') != std::string::npos) continue;
+    out.emplace_back(type, field);
+  }
+  return out;
+}
+
+TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
+  const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
+  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply"}) {
+    const auto from_idl = idl_fields(idl, name);
+    const auto from_msg = msg_fields(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/" + name + ".msg");
+    EXPECT_GT(from_idl.size(), 3U) << name;
+    EXPECT_EQ(from_msg, from_idl) << name;
+  }
+  // The request kinds: the same numbers in both.
+  const std::string request = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/ParameterRequest.msg");
+  EXPECT_NE(request.find("uint8 SET_GAIN=" + std::to_string(msg::SET_GAIN)), std::string::npos);
+  EXPECT_NE(request.find("uint8 SELECT_PARAMETER_SET=" + std::to_string(msg::SELECT_PARAMETER_SET)), std::string::npos);
+  EXPECT_NE(request.find("uint8 ENABLE=" + std::to_string(msg::ENABLE)), std::string::npos);
+  EXPECT_NE(request.find("uint8 SET_SPINDLE_RPM=" + std::to_string(msg::SET_SPINDLE_RPM)), std::string::npos);
 }
 
 // --- DDS Security ------------------------------------------------------------------------------------------

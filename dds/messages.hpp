@@ -1,0 +1,26 @@
+// robodamp's DDS message types by their plain names. The IDL (dds/robodamp.idl) declares them in ROS 2's
+// form (robodamp::msg::dds_::Telemetry_ ...), which is what goes on the wire; the code uses these aliases.
+#pragma once
+
+#include <cstdint>
+
+#include "robodamp.h"
+#include "robodampPubSubTypes.h"
+
+namespace robodamp::msg {
+
+using Telemetry = dds_::Telemetry_;
+using Status = dds_::Status_;
+using ParameterRequest = dds_::ParameterRequest_;
+using ParameterReply = dds_::ParameterReply_;
+using TelemetryPubSubType = dds_::Telemetry_PubSubType;
+using StatusPubSubType = dds_::Status_PubSubType;
+using ParameterRequestPubSubType = dds_::ParameterRequest_PubSubType;
+using ParameterReplyPubSubType = dds_::ParameterReply_PubSubType;
+using RequestKind = std::uint8_t;  // ParameterRequest_.kind
+using dds_::ENABLE;
+using dds_::SELECT_PARAMETER_SET;
+using dds_::SET_GAIN;
+using dds_::SET_SPINDLE_RPM;
+
+}  // namespace robodamp::msg
