@@ -24,6 +24,7 @@ struct PlantArgs {
   int impact_location{0};
   std::string measure_out;
   std::vector<std::string> mounting_schedule;  // "T:vertical" / "T:horizontal", plant time in s
+  std::vector<std::string> spindle_schedule;   // "T:RPM", plant time in s
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
 
@@ -59,6 +60,17 @@ int run_plant(const PlantArgs& a) {
       return 2;
     }
     eo.mounting_schedule.push_back(*m);
+  }
+  for (const auto& item : a.spindle_schedule) {
+    const auto colon = item.find(':');
+    double t = 0.0, rpm = 0.0;
+    if (colon == std::string::npos || parse_number("--spindle", item.substr(0, colon), {"s", 0.0, 1e7}, false, t) ||
+        parse_number("--spindle", item.substr(colon + 1), {"rpm", 0.0, 200000.0}, false, rpm)) {
+      std::cerr << "robodamp plant: --spindle = '" << item
+                << "': expected TIME_S:RPM, allowed 0 <= TIME_S <= 1e+07 s and 0 <= RPM <= 200000 rpm\n";
+      return 2;
+    }
+    eo.spindle_schedule.emplace_back(t, rpm);
   }
   rt::install_shutdown_handlers();
   eo.stop_flag = &rt::shutdown_signal();
@@ -101,6 +113,8 @@ void register_plant(Registry& r) {
            "Fault injection: the Modbus device stops answering at this plant time");
   sub->add_option("--mounting", a->mounting_schedule,
                   "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
+  sub->add_option("--spindle", a->spindle_schedule,
+                  "Robot spindle speed register changes, TIME_S:RPM (plant time; modbus.robot.spindle_rpm_register), repeatable");
 }
 
 }  // namespace robodamp::apps

@@ -77,7 +77,8 @@ struct RunArgs {
             {"cpu_dma_latency_held", s.realtime.dma_latency_held},
             {"warnings", s.realtime.warnings}}},
           {"sensor_rms_mps2", s.sensor_rms_mps2},
-          {"peak_command_v", s.peak_command_v}};
+          {"peak_command_v", s.peak_command_v},
+          {"spindle", {{"rpm", s.spindle_rpm}, {"notch_centre_hz", s.notch_centre_hz}}}};
   j["backend"] = s.backend;
   j["arming"] = {{"enabled", s.arming.enabled},
                  {"outcome", runtime::to_string(s.arming.outcome)},
@@ -106,7 +107,8 @@ struct RunArgs {
                    {"connects", m.connects},               {"connect_failures", m.connect_failures},
                    {"errors", m.errors},                   {"timeouts", m.timeouts},
                    {"link_faults", m.link_faults},         {"coil_writes", m.coil_writes},
-                   {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown}};
+                   {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown},
+                   {"spindle_changes", m.spindle_changes}, {"spindle_link_parks", m.spindle_link_parks}};
   }
   return j;
 }

@@ -59,6 +59,11 @@ class Registers {
     set_mounting(cfg.actuator.mounting);
   }
   [[nodiscard]] bool enable() const { return amp_->coil(m_.amplifier.enable_coil); }
+  void set_spindle_rpm(double rpm) {
+    if (m_.robot_link && m_.robot.spindle_rpm_register >= 0)
+      robot_->set_holding_register(m_.robot.spindle_rpm_register,
+                                   static_cast<std::uint16_t>(std::clamp(std::lround(rpm / m_.robot.rpm_per_count), 0L, 65535L)));
+  }
   void set_ready(bool on) { amp_->set_discrete_input(m_.amplifier.ready_input, on); }
   void set_temperature(double c) {
     const double counts = std::clamp(std::round(c / m_.amplifier.temperature_c_per_count), -32768.0, 32767.0);
@@ -162,7 +167,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   double applied_v = 0.0;     // what the amplifier drives this period with
   bool enabled = false, ready = false;
   double enabled_at_s = 0.0, ms_v = 0.0, temperature_c = cfg.hil.ambient_c;
-  std::size_t next_mounting = 0;
+  std::size_t next_mounting = 0, next_spindle = 0;
   const auto wall0 = Clock::now();
   std::int64_t deadline = now_ns();
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / fs));
@@ -278,6 +283,12 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
       campaign->start(rep.campaign_start_s);
       spdlog::info("robodamp plant: amplifier ready at {:.3f} s; {} impacts at the {} from {:.1f} s", t,
                    cfg.bench.averages, rep.impact_location, rep.campaign_start_s);
+    }
+    while (next_spindle < o.spindle_schedule.size() && o.spindle_schedule[next_spindle].first <= t) {
+      regs.set_spindle_rpm(o.spindle_schedule[next_spindle].second);
+      ++rep.spindle_changes;
+      spdlog::info("robodamp plant: robot reports the spindle at {} rpm at {:.3f} s", o.spindle_schedule[next_spindle].second, t);
+      ++next_spindle;
     }
     while (next_mounting < o.mounting_schedule.size() && o.mounting_schedule[next_mounting].first <= t) {
       regs.set_mounting(o.mounting_schedule[next_mounting].second);
@@ -409,7 +420,7 @@ nlohmann::json report_json(const EmulatorReport& r) {
             {"enabled_s", r.enabled_s},
             {"peak_command_v", r.peak_command_v},
             {"peak_temperature_c", r.peak_temperature_c}}},
-          {"robot", {{"mounting_changes", r.mounting_changes}}},
+          {"robot", {{"mounting_changes", r.mounting_changes}, {"spindle_changes", r.spindle_changes}}},
           {"injected", [&r] {
              json a = json::array();
              for (const auto& f : r.injected)

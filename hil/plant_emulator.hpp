@@ -47,6 +47,9 @@ struct EmulatorOptions {
   std::string measure_out;                   // location id; 0 = the first configured FRF's excitation
   // Robot mounting register changes: (plant time s, mounting).
   std::vector<std::pair<double, config::Mounting>> mounting_schedule;
+  // Spindle speed register changes: (plant time s, rpm), written to modbus.robot.spindle_rpm_register
+  // (rpm / rpm_per_count).
+  std::vector<std::pair<double, double>> spindle_schedule;
   bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
   // Faults injected at plant times (s; negative = none), to measure how the controller gets to its safe
   // state: the CAN bus goes off (an error frame with CAN_ERR_BUSOFF, no sensor frames for bus_off_for_s,
@@ -91,6 +94,7 @@ struct EmulatorReport {
   double peak_temperature_c{0.0};
   double peak_command_v{0.0};
   std::uint64_t mounting_changes{0};
+  std::uint64_t spindle_changes{0};
   std::uint64_t modbus_requests{0};
   // Realtime pacing: the emulator's own wake-up latency.
   rt::TimingHistogram wake_latency;

@@ -293,6 +293,8 @@ void Cell::finish_summary() {
   }
   s.loop = loop_->stats();
   s.supervisor = supervisor_->counters();
+  s.spindle_rpm = supervisor_->controller().spindle_rpm();
+  s.notch_centre_hz = supervisor_->controller().notches().settings().enabled ? supervisor_->controller().notches().centre_hz() : 0.0;
   s.final_state = rt::to_string(supervisor_->state());
   s.trip = rt::to_string(supervisor_->latched_trip());
   s.trip_description = rt::describe(supervisor_->latched_trip());

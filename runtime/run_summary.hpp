@@ -56,6 +56,8 @@ struct RunSummary {
   std::string record_path;
   double sensor_rms_mps2{0.0};  // control accelerometer over the run
   double peak_command_v{0.0};
+  double spindle_rpm{0.0};         // the speed the controller's notches follow at the end (0: stopped or parked)
+  double notch_centre_hz{0.0};     // the harmonic notches' fundamental at the end
 
   // The arming policy gave up, or the run ended before the loop was ever active while arming was wanted.
   [[nodiscard]] bool never_armed() const {

@@ -140,6 +140,28 @@ TEST(Hil, RobotMountingSelectsTheVerticalParameterSet) {
   EXPECT_EQ(r["trip"], "none");
 }
 
+// The emulator's robot publishes the spindle speed on its Modbus register; the controller in the other
+// process reads it (settled), and its harmonic notches follow: 12 000 then 6000 rpm x 3 teeth.
+TEST(Hil, RobotSpindleRegisterSteersTheHarmonicNotches) {
+  const HilFiles f = hil_files("spindle", {{"    settle_polls: 3", "    settle_polls: 3\n    spindle_rpm_register: 1\n    rpm_per_count: 10"},
+                                           {"  chain:                 # Eq. 8",
+                                            "  harmonic_notch: {harmonics: 3, bandwidth_hz: 20, depth_db: 30}\n  chain:                 # Eq. 8"}});
+  std::ofstream(f.config, std::ios::app) << "\nspindle: {teeth: 3, rpm_max: 20000}\n";
+  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--spindle", "1:12000", "--spindle",
+               "2.5:6000", "--json", f.plant_json},
+              f.plant_log);
+  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", "4", "--json", f.run_json}, f.run_log);
+  ASSERT_EQ(run.wait(), 0) << test::read_file(f.run_log);
+  ASSERT_EQ(plant.wait(), 0) << test::read_file(f.plant_log);
+  const json r = read_json(f.run_json), p = read_json(f.plant_json);
+  EXPECT_EQ(p["robot"]["spindle_changes"], 2);
+  EXPECT_EQ(r["modbus"]["spindle_changes"], 2);
+  EXPECT_EQ(r["supervisor"]["spindle_refused"], 0);
+  EXPECT_EQ(r["spindle"]["rpm"], 6000.0);
+  EXPECT_DOUBLE_EQ(r["spindle"]["notch_centre_hz"].get<double>(), 300.0);
+  EXPECT_EQ(r["trip"], "none");
+}
+
 TEST(Hil, ControllerWithoutTheEmulatorReportsTheTransport) {
   const HilFiles f = hil_files("absent");
   // Nobody listens on the socket: the controller names the transport and fails (after its connect timeout).
