@@ -105,7 +105,7 @@ std::vector<Sub> subcommands() {
   return {
       {"filters", {"--freq"}, {"--json"}, {}, {"--config"}, false},
       {"check-config", {}, {}, {}, {}, true},
-      {"analyze", {}, {"--json"}, {}, {"--config"}, false},
+      {"analyze", {"--spindle-rpm"}, {"--json", "--spindle-sweep"}, {}, {"--config"}, false},
       {"bench", {}, {}, {}, {"--config"}, false},
       {"run", {"--duration", "--impact-every"}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
       {"plant", {"--duration", "--impact-location"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
