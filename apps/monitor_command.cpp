@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -74,6 +75,39 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
   return b;
 }
 
+std::string mm(double v) {
+  char b[32];
+  if (std::isinf(v)) return "no lobe";
+  std::snprintf(b, sizeof b, "%.3f mm", v);
+  return b;
+}
+
+// The machining lines (spindle.job): speed, depth, limits, chatter indicator.
+std::string machining_view(const msg::Machining& m) {
+  char b[900];
+  std::string limits = "computing";
+  if (m.spindle_rpm() <= 0.0) limits = "spindle stopped";
+  else if (m.limits_ready())
+    limits = "open " + mm(m.open_limit_mm()) + ", damped " + mm(m.damped_limit_mm()) + "; now " + mm(m.limit_mm()) +
+             (m.loop_active() ? " (damper active)" : " (damper off)") +
+             (m.depth_warning() ? "  WARNING: depth above the limit" : "  depth within");
+  std::string indicator = "-";
+  if (m.indicator_valid()) {
+    char c[200];
+    std::snprintf(c, sizeof c, "once-per-rev %.2f, non-harmonic %.0f %% (strongest %.1f Hz): %s", m.once_per_rev_ratio(),
+                  100.0 * m.nonharmonic_share(), m.chatter_hz(), m.chatter() ? "CHATTER" : "no chatter");
+    indicator = c;
+  } else if (m.spindle_rpm() > 0.0) {
+    indicator = "collecting revolutions";
+  }
+  std::snprintf(b, sizeof b,
+                "  spindle    %.0f rpm (tooth passing %.1f Hz), job depth %.3f mm\n"
+                "  stability  %s\n"
+                "  chatter    %s\n",
+                m.spindle_rpm(), m.tooth_passing_hz(), m.depth_mm(), limits.c_str(), indicator.c_str());
+  return b;
+}
+
 }  // namespace
 
 // 0 when it saw the loop (telemetry or status), 1 when nothing came.
@@ -81,9 +115,11 @@ int run_monitor(const DdsClientOptions& o) {
   rt::install_shutdown_handlers();
   Latest<msg::Telemetry> telemetry;  // before the participant: it outlives the readers that call it
   Latest<msg::Status> status;
+  Latest<msg::Machining> machining;
   dds::Participant p(o.domain_id, o.transport, "robodamp monitor", o.security);
   p.reader(dds::TopicKind::kTelemetry, &telemetry);
   p.reader(dds::TopicKind::kStatus, &status);
+  p.reader(dds::TopicKind::kMachining, &machining);
   const bool tty = isatty(STDOUT_FILENO) != 0;
   std::cerr << "robodamp monitor: domain " << o.domain_id << " (" << config::to_string(o.transport)
             << "), waiting for a loop; Ctrl-C ends\n";
@@ -93,17 +129,18 @@ int run_monitor(const DdsClientOptions& o) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     const auto [t, nt] = telemetry.get();
     const auto [s, ns] = status.get();
-    if (nt + ns == shown) continue;
-    shown = nt + ns;
+    const auto [m, nm] = machining.get();
+    if (nt + ns + nm == shown) continue;
+    shown = nt + ns + nm;
     if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
-    std::cout << view(t, nt, s, ns) << (tty ? "" : "\n") << std::flush;
+    std::cout << view(t, nt, s, ns) << (nm ? machining_view(m) : "") << (tty ? "" : "\n") << std::flush;
   }
   return shown > 0 ? 0 : 1;
 }
 
 void register_monitor(Registry& r) {
   auto o = std::make_shared<DdsClientArgs>();
-  CLI::App* sub = r.add("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing)",
+  CLI::App* sub = r.add("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing; with spindle.job the speed, depth, open and damped limits and the chatter indicator)",
                         [o] {
                           const auto opts = resolve(*o);
                           return opts ? run_monitor(*opts) : 2;

@@ -28,6 +28,8 @@ struct RunArgs {
   std::string histogram_path;  // wake-up latency histogram in cyclictest's --histfile format
   std::string clock;
   double impact_every_s{2.0};
+  std::string job_path;
+  double spindle_rpm{0.0};
 };
 
 [[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s) {
@@ -100,7 +102,18 @@ struct RunArgs {
                 {"rx_skipped", c.rx_skipped},     {"reconnects", c.reconnects}};
   }
   if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
-                         {"refused", s.dds->refused}};
+                         {"refused", s.dds->refused}, {"machining", s.dds->machining}};
+  if (s.machining) {
+    const auto& m = *s.machining;
+    auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    j["machining"] = {{"spindle_rpm", m.spindle_rpm},         {"depth_mm", m.depth_mm},
+                      {"limits_ready", m.limits_ready},       {"open_limit_mm", finite(m.open_limit_mm)},
+                      {"damped_limit_mm", finite(m.damped_limit_mm)}, {"loop_active", m.loop_active},
+                      {"limit_mm", finite(m.limit_mm)},       {"depth_warning", m.depth_warning},
+                      {"indicator_valid", m.indicator_valid}, {"once_per_rev_ratio", m.once_per_rev_ratio},
+                      {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
+                      {"chatter", m.chatter}};
+  }
   if (s.modbus) {
     const auto& m = *s.modbus;
     j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
@@ -216,6 +229,21 @@ struct RunArgs {
                   static_cast<long long>(s.trip_timing.ticks_to_safe));
     os << b;
   }
+  if (s.machining) {
+    const auto& m = *s.machining;
+    if (m.spindle_rpm <= 0.0) {
+      os << "  machining: spindle stopped at the end; job depth " << m.depth_mm << " mm\n";
+    } else {
+      std::snprintf(b, sizeof b,
+                    "  machining at the end: %.0f rpm, job depth %.3f mm; limit open %.3f mm, damped %.3f mm%s; chatter "
+                    "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)\n",
+                    m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm,
+                    !m.limits_ready ? " (not computed)" : m.depth_warning ? ": WARNING, depth above the limit" : "",
+                    !m.indicator_valid ? "not ready" : m.chatter ? "CHATTER" : "quiet", m.once_per_rev_ratio,
+                    100.0 * m.nonharmonic_share);
+      os << b;
+    }
+  }
   if (!s.realtime.warnings.empty())
     os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
   return os.str();
@@ -246,6 +274,7 @@ int exit_status(const runtime::Status& s) { return s.kind == runtime::StatusKind
 // 5 never armed (the arming policy's deadline passed, or the run ended first); 1 other (devices, recording).
 int run_loop(const RunArgs& a) {
   config::Config cfg = config::load_config_file(a.config_path);
+  if (!a.job_path.empty()) cfg.spindle.job = cfg.spindle.job_resolved = a.job_path;
   runtime::CellOptions o;
   if (!a.clock.empty()) o.clock = a.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
   o.impact_every_s = a.impact_every_s;
@@ -255,6 +284,7 @@ int run_loop(const RunArgs& a) {
     std::cerr << s.message << '\n';
     return exit_status(s);
   }
+  if (a.spindle_rpm > 0.0) cell.schedule(1, {rt::CommandKind::kSetSpindle, a.spindle_rpm});
   rt::install_shutdown_handlers();
   spdlog::info("robodamp run: {} at {} Hz on the {} clock for {} s against {} (Ctrl-C ends it through the safe state)",
                a.config_path, cfg.loop.rate_hz, config::to_string(cell.config().loop.clock), a.duration_s,
@@ -307,6 +337,11 @@ void register_run(Registry& r) {
       ->check(CLI::IsMember({"wall", "virtual"}));
   r.number(sub, "--impact-every", a->impact_every_s, {"s", 0.0, 86400.0, false, false, "0 = none"},
            "Simulated plant: a hammer hit at the TCP every S seconds (bench.impact_peak_n)");
+  sub->add_option("--job", a->job_path,
+                  "Milling job (config/milling/*.yaml) for live stability and the chatter indicator; overrides spindle.job")
+      ->check(CLI::ExistingFile);
+  r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0, false, false, "0 = stopped"},
+           "The spindle speed from the start (as the robot's register or a DDS request would set it)");
 }
 
 }  // namespace robodamp::apps

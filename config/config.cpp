@@ -639,7 +639,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   c.can = read_can(top, rate);
   detail::read_supervisory(top, c);
   c.commissioning = detail::read_commissioning(top);
-  c.spindle = detail::read_spindle(top);
+  c.spindle = detail::read_spindle(top, c.source);
   top.finish();
   check_location_refs(d, c, root);
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

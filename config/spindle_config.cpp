@@ -1,5 +1,7 @@
 #include "config/spindle_config.hpp"
 
+#include <filesystem>
+
 #include "config/config.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -23,11 +25,20 @@ std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller, st
   return c;
 }
 
-SpindleConfig read_spindle(MapReader& top) {
+SpindleConfig read_spindle(MapReader& top, const std::string& source) {
   MapReader r(top.diagnostics(), top.child("spindle", false, ""), "spindle", top.mark());
   SpindleConfig c;
   if (auto v = read_int(r, "teeth", {"(teeth)", 1, 32}, c.teeth)) c.teeth = *v;
   if (auto v = r.number("rpm_max", {"rpm", 0.0, 200000.0, true}, c.rpm_max)) c.rpm_max = *v;
+  if (auto v = r.text("job", ""); v && !v->empty()) {
+    const std::filesystem::path p(*v);
+    c.job = *v;
+    c.job_resolved = (p.is_absolute() ? p : std::filesystem::path(source).parent_path() / p).string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(c.job_resolved, ec))
+      r.diagnostics().add(r.mark(), "spindle.job", "= '" + c.job + "': no such file (looked for " + c.job_resolved + ")");
+  }
+  if (auto v = r.text("structure", "")) c.structure = *v;
   r.finish();
   return c;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 namespace robodamp::config {
 
@@ -20,6 +21,11 @@ struct HarmonicNotchConfig {
 struct SpindleConfig {
   int teeth{3};
   double rpm_max{30000.0};      // a requested speed above it is refused (and parks the notches)
+  // The milling job the cell cuts (config/milling/*.yaml), for live stability: its depth and the
+  // open and damped limits at the spindle speed now. Resolved relative to the configuration file.
+  std::string job;              // as written; empty = no live stability
+  std::string job_resolved;
+  std::string structure;        // the job's structure to use (empty: the job's own)
 };
 
 }  // namespace robodamp::config

@@ -45,6 +45,7 @@ Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::str
   telemetry_writer_ = participant_->writer(TopicKind::kTelemetry);
   status_writer_ = participant_->writer(TopicKind::kStatus);
   reply_writer_ = participant_->writer(TopicKind::kReply);
+  if (src_.machining) machining_writer_ = participant_->writer(TopicKind::kMachining);
   listener_ = std::make_unique<RequestListener>(*this);
   participant_->reader(TopicKind::kRequest, listener_.get());
 }
@@ -134,6 +135,29 @@ void Bridge::publish_status() {
   if (status_writer_->write(&s)) ++n_status_;
 }
 
+void Bridge::publish_machining() {
+  if (machining_writer_ == nullptr) return;
+  const MachiningSample m = src_.machining();
+  msg::Machining out;
+  out.tick(m.tick);
+  out.time_s(m.time_s);
+  out.spindle_rpm(m.spindle_rpm);
+  out.tooth_passing_hz(m.tooth_passing_hz);
+  out.depth_mm(m.depth_mm);
+  out.limits_ready(m.limits_ready);
+  out.open_limit_mm(m.open_limit_mm);
+  out.damped_limit_mm(m.damped_limit_mm);
+  out.loop_active(m.loop_active);
+  out.limit_mm(m.limit_mm);
+  out.depth_warning(m.depth_warning);
+  out.indicator_valid(m.indicator_valid);
+  out.once_per_rev_ratio(static_cast<float>(m.once_per_rev_ratio));
+  out.nonharmonic_share(static_cast<float>(m.nonharmonic_share));
+  out.chatter_hz(static_cast<float>(m.chatter_hz));
+  out.chatter(m.chatter);
+  if (machining_writer_->write(&out)) ++n_machining_;
+}
+
 void Bridge::start() {
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -147,6 +171,7 @@ void Bridge::start() {
       cv_.wait_for(lock, period, [this] { return !running_; });
       lock.unlock();
       publish_status();
+      publish_machining();
       lock.lock();
     }
   });
@@ -162,6 +187,6 @@ void Bridge::stop() {
   status_thread_.join();
 }
 
-BridgeCounters Bridge::counters() const { return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load()}; }
+BridgeCounters Bridge::counters() const { return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load(), n_machining_.load()}; }
 
 }  // namespace robodamp::dds

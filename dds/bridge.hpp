@@ -33,15 +33,31 @@ struct Decision {
   std::string reason;
 };
 
+// What the Machining_ topic carries (dds/robodamp.idl), filled by the cell's machining monitor.
+struct MachiningSample {
+  std::uint64_t tick{0};
+  double time_s{0.0};
+  double spindle_rpm{0.0}, tooth_passing_hz{0.0}, depth_mm{0.0};
+  bool limits_ready{false};
+  double open_limit_mm{0.0}, damped_limit_mm{0.0};
+  bool loop_active{false};
+  double limit_mm{0.0};
+  bool depth_warning{false};
+  bool indicator_valid{false};
+  double once_per_rev_ratio{0.0}, nonharmonic_share{0.0}, chatter_hz{0.0};
+  bool chatter{false};
+};
+
 struct BridgeSources {
   std::string backend;                             // for the status
   std::function<std::size_t()> parameter_set;      // the active set (any thread)
   std::function<double()> gain_limit_ns_per_m;     // what a gain request may ask for now
   std::function<Decision(RequestKind, double)> handle;  // validate and queue (parameter writes on)
+  std::function<MachiningSample()> machining;      // empty: no machining topic (no spindle.job)
 };
 
 struct BridgeCounters {
-  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0};
+  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0}, machining{0};
 };
 
 class Bridge {
@@ -53,7 +69,7 @@ class Bridge {
 
   // The telemetry drain's consumer (non-real-time thread).
   void on_frame(const rt::TelemetryFrame& f);
-  // Status at dds.status_rate_hz on a thread of its own; stop() publishes a last one.
+  // Status (and machining) at dds.status_rate_hz on a thread of its own; stop() publishes a last one.
   void start();
   void stop();
   [[nodiscard]] BridgeCounters counters() const;
@@ -61,6 +77,7 @@ class Bridge {
  private:
   class RequestListener;
   void publish_status();
+  void publish_machining();
   Decision decide(RequestKind kind, double value);
 
   config::DdsConfig cfg_;
@@ -70,6 +87,7 @@ class Bridge {
   eprosima::fastdds::dds::DataWriter* telemetry_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* status_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* reply_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* machining_writer_{nullptr};
   std::unique_ptr<RequestListener> listener_;
 
   // Decimation window (drain thread).
@@ -87,7 +105,7 @@ class Bridge {
   std::uint8_t published_state_{255}, published_trip_{255};
   bool running_{false};
   std::thread status_thread_;
-  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0};
+  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0};
 };
 
 }  // namespace robodamp::dds

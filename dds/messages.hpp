@@ -13,10 +13,12 @@ using Telemetry = dds_::Telemetry_;
 using Status = dds_::Status_;
 using ParameterRequest = dds_::ParameterRequest_;
 using ParameterReply = dds_::ParameterReply_;
+using Machining = dds_::Machining_;
 using TelemetryPubSubType = dds_::Telemetry_PubSubType;
 using StatusPubSubType = dds_::Status_PubSubType;
 using ParameterRequestPubSubType = dds_::ParameterRequest_PubSubType;
 using ParameterReplyPubSubType = dds_::ParameterReply_PubSubType;
+using MachiningPubSubType = dds_::Machining_PubSubType;
 using RequestKind = std::uint8_t;  // ParameterRequest_.kind
 using dds_::ENABLE;
 using dds_::SELECT_PARAMETER_SET;

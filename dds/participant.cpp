@@ -16,8 +16,9 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 // ROS 2's names for the topics /robodamp/telemetry ... (ROS 2 prefixes its topics with rt/ in DDS).
-constexpr const char* kTopicNames[4] = {"rt/robodamp/telemetry", "rt/robodamp/status", "rt/robodamp/parameter_request",
-                                        "rt/robodamp/parameter_reply"};
+constexpr const char* kTopicNames[kTopicCount] = {"rt/robodamp/telemetry", "rt/robodamp/status",
+                                                  "rt/robodamp/parameter_request", "rt/robodamp/parameter_reply",
+                                                  "rt/robodamp/machining"};
 }
 
 Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name,
@@ -57,11 +58,12 @@ Participant::Participant(int domain_id, config::DdsTransport transport, const st
                              (security ? ": check dds.security (certificates, key, signed governance and permissions, "
                                          "the subject names in the permissions)"
                                        : ""));
-  TypeSupport types[4] = {TypeSupport(new robodamp::msg::TelemetryPubSubType()),
-                          TypeSupport(new robodamp::msg::StatusPubSubType()),
-                          TypeSupport(new robodamp::msg::ParameterRequestPubSubType()),
-                          TypeSupport(new robodamp::msg::ParameterReplyPubSubType())};
-  for (int i = 0; i < 4; ++i) {
+  TypeSupport types[kTopicCount] = {TypeSupport(new robodamp::msg::TelemetryPubSubType()),
+                                    TypeSupport(new robodamp::msg::StatusPubSubType()),
+                                    TypeSupport(new robodamp::msg::ParameterRequestPubSubType()),
+                                    TypeSupport(new robodamp::msg::ParameterReplyPubSubType()),
+                                    TypeSupport(new robodamp::msg::MachiningPubSubType())};
+  for (int i = 0; i < kTopicCount; ++i) {
     types[i].register_type(participant_);
     topics_[i] = participant_->create_topic(kTopicNames[i], types[i].get_type_name(), TOPIC_QOS_DEFAULT);
     if (topics_[i] == nullptr) throw std::runtime_error(std::string("DDS: cannot create topic ") + kTopicNames[i]);
@@ -90,9 +92,10 @@ void apply(Qos& q, TopicKind t, config::DdsTransport transport) {
     q.history().depth = 64;
   } else {
     q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-    q.durability().kind = t == TopicKind::kStatus ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+    const bool latest = t == TopicKind::kStatus || t == TopicKind::kMachining;  // a late joiner gets the last
+    q.durability().kind = latest ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
     q.history().kind = KEEP_LAST_HISTORY_QOS;
-    q.history().depth = t == TopicKind::kStatus ? 1 : 32;
+    q.history().depth = latest ? 1 : 32;
   }
   if (transport == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
 }

@@ -28,39 +28,59 @@ Structure::Structure(const config::StructureConfig& cfg, bool damped) : name_(cf
     if (!part.controller) continue;
     const auto& pc = *part.controller;
     auto model = std::make_shared<const analysis::LoopModel>(config::load_config_file(pc.config_path));
-    ControllerPart c;
-    c.model = model;
-    c.location = model->plant().index_of(pc.location);
-    c.direction = pc.direction == config::Axis::kX ? 0 : 1;
-    c.gain_ns_per_m = model->config().controller.gain_ns_per_m;
-    c.polarity = model->config().controller.polarity;
-    for (const auto& f : model->config().robot.frfs) add_resonances(resonances_, f);
-    resonances_.push_back({model->config().actuator.natural_freq_hz, model->config().actuator.damping_ratio});
-    std::ostringstream os;
-    os << part.name << ": location " << pc.location << " of " << pc.config_path;
-    if (damped) {
-      if (!model->stable(c.gain_ns_per_m, c.polarity))
-        throw config::ConfigError({config::Problem{pc.config_path, {}, "controller",
-                                                   "the damping loop is unstable at K = " +
-                                                       std::to_string(c.gain_ns_per_m) + " N s/m, polarity " +
-                                                       std::to_string(c.polarity) + ": no closed-loop FRF exists"}});
-      // Closed-loop poles below Nyquist: where the damped FRF has its resonances.
-      const double fs = model->loop_rate_hz();
-      for (const auto& z : model->closed_loop_poles(c.gain_ns_per_m, c.polarity)) {
-        if (std::abs(z) < 1e-12) continue;
-        const std::complex<double> s = std::log(z) * fs;
-        const double f = std::abs(s.imag()) / (2.0 * M_PI);
-        if (f > 0.5 && f < 0.5 * fs) resonances_.push_back({f, std::max(1e-4, -s.real() / std::abs(s))});
-      }
-      os << ", closed loop at K = " << c.gain_ns_per_m << " N s/m, polarity " << c.polarity
-         << " (sampled controller at " << fs << " Hz)";
-    } else {
-      os << ", open loop";
-    }
-    notes_.push_back(os.str());
-    controllers_.push_back(std::move(c));
+    const double gain = model->config().controller.gain_ns_per_m;
+    const int polarity = model->config().controller.polarity;
+    add_controller(part.name, pc.config_path, pc, std::move(model), gain, polarity);
   }
   for (const auto& f : modal_) add_resonances(resonances_, f);
+}
+
+Structure::Structure(const config::StructureConfig& cfg, bool damped, const LiveLoop& live)
+    : name_(cfg.name), damped_(damped) {
+  for (const auto& part : cfg.parts) {
+    for (std::size_t k = 0; k < 4; ++k)
+      modal_[k].modes.insert(modal_[k].modes.end(), part.modes[k].begin(), part.modes[k].end());
+    if (part.controller)
+      add_controller(part.name, live.model->config().source, *part.controller, live.model, live.gain_ns_per_m,
+                     live.polarity);
+  }
+  for (const auto& f : modal_) add_resonances(resonances_, f);
+}
+
+void Structure::add_controller(const std::string& part, const std::string& source,
+                               const config::ControllerPartConfig& pc, std::shared_ptr<const analysis::LoopModel> model,
+                               double gain_ns_per_m, int polarity) {
+  ControllerPart c;
+  c.location = model->plant().index_of(pc.location);
+  c.direction = pc.direction == config::Axis::kX ? 0 : 1;
+  c.gain_ns_per_m = gain_ns_per_m;
+  c.polarity = polarity;
+  for (const auto& f : model->config().robot.frfs) add_resonances(resonances_, f);
+  resonances_.push_back({model->config().actuator.natural_freq_hz, model->config().actuator.damping_ratio});
+  std::ostringstream os;
+  os << part << ": location " << pc.location << " of " << source;
+  if (damped_) {
+    if (!model->stable(c.gain_ns_per_m, c.polarity))
+      throw config::ConfigError({config::Problem{source, {}, "controller",
+                                                 "the damping loop is unstable at K = " +
+                                                     std::to_string(c.gain_ns_per_m) + " N s/m, polarity " +
+                                                     std::to_string(c.polarity) + ": no closed-loop FRF exists"}});
+    // Closed-loop poles below Nyquist: where the damped FRF has its resonances.
+    const double fs = model->loop_rate_hz();
+    for (const auto& z : model->closed_loop_poles(c.gain_ns_per_m, c.polarity)) {
+      if (std::abs(z) < 1e-12) continue;
+      const std::complex<double> s = std::log(z) * fs;
+      const double f = std::abs(s.imag()) / (2.0 * M_PI);
+      if (f > 0.5 && f < 0.5 * fs) resonances_.push_back({f, std::max(1e-4, -s.real() / std::abs(s))});
+    }
+    os << ", closed loop at K = " << c.gain_ns_per_m << " N s/m, polarity " << c.polarity
+       << " (sampled controller at " << fs << " Hz)";
+  } else {
+    os << ", open loop";
+  }
+  notes_.push_back(os.str());
+  c.model = std::move(model);
+  controllers_.push_back(std::move(c));
 }
 
 bool Structure::has_controller() const { return !controllers_.empty(); }

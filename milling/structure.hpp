@@ -36,6 +36,15 @@ class Structure {
   // damped: close each controller part's loop at its configured gain and polarity. Throws
   // config::ConfigError if a controller configuration is invalid or its loop is unstable.
   Structure(const config::StructureConfig& cfg, bool damped);
+  // The running loop in place of every controller part's configuration file (live stability: the cell's
+  // active parameter set at its gain now, with the harmonic notches at the spindle speed): the part's
+  // robot and controller come from `live`, the location and direction from the part.
+  struct LiveLoop {
+    std::shared_ptr<const analysis::LoopModel> model;
+    double gain_ns_per_m{0.0};
+    int polarity{1};
+  };
+  Structure(const config::StructureConfig& cfg, bool damped, const LiveLoop& live);
   // Sum of modal terms only (tests, benchmarks).
   explicit Structure(std::array<std::vector<config::ModeConfig>, 4> modes, std::string name = "modal");
 
@@ -72,6 +81,9 @@ class Structure {
   std::vector<ControllerPart> controllers_;
   std::vector<Resonance> resonances_;
   std::vector<std::string> notes_;
+
+  void add_controller(const std::string& part, const std::string& source, const config::ControllerPartConfig& pc,
+                      std::shared_ptr<const analysis::LoopModel> model, double gain_ns_per_m, int polarity);
 };
 
 }  // namespace robodamp::milling

@@ -79,6 +79,15 @@ Status Cell::configure() {
   arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
   if (o_.arm_at_start) loop_->set_policy(arming_.get());
   if (Status s = configure_parameter_sets(); !s.ok()) return s;
+  if (!cfg_.spindle.job.empty()) {
+    try {
+      machining_ = std::make_unique<MachiningMonitor>(cfg_, set_configs_,
+                                                      [this] { return supervisor_->active_parameter_set(); });
+    } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
+      for (Component* d : components()) (void)d->cleanup();
+      return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};
+    }
+  }
   state_ = LifecycleState::kInactive;
   return {};
 }
@@ -114,7 +123,9 @@ Status Cell::configure_devices() {
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
         dds::BridgeSources{backend_name_, [this] { return supervisor_->active_parameter_set(); },
                            [this] { return std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM); },
-                           [this](dds::RequestKind k, double v) { return handle_request(k, v); }});
+                           [this](dds::RequestKind k, double v) { return handle_request(k, v); },
+                           cfg_.spindle.job.empty() ? std::function<dds::MachiningSample()>{}
+                                                    : [this] { return machining_->sample(); }});
   }
   for (Component* c : components()) {
     if (Status s = c->configure(); !s.ok()) {
@@ -135,6 +146,7 @@ Status Cell::configure_devices() {
 }
 
 Status Cell::configure_parameter_sets() {
+  set_configs_.assign(1, cfg_);
   mounting_sets_.clear();
   mounting_sets_.emplace_back(cfg_.actuator.mounting, 0);
   try {
@@ -159,6 +171,7 @@ Status Cell::configure_parameter_sets() {
 
 std::size_t Cell::add_parameter_set(const config::Config& cfg) {
   const analysis::LoopModel m(cfg);
+  set_configs_.push_back(cfg);
   const int polarity = cfg.controller.polarity;
   const auto k_max = analysis::max_stable_gain(m, polarity);
   return supervisor_->add_parameter_set({with_notch_speed_map(cfg, m.chain().params), m.stable(cfg.controller.gain_ns_per_m, polarity),
@@ -237,6 +250,7 @@ Status Cell::activate(double duration_s) {
   if (recorder_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { recorder_->write(f); });
   consumers.emplace_back([this](const rt::TelemetryFrame& f) { on_frame(f); });
   if (dds_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { dds_->bridge().on_frame(f); });
+  if (machining_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { machining_->on_frame(f); });
   drain_ = std::make_unique<rt::TelemetryDrain>(*ring_, std::move(consumers));
   drain_->start();
   state_ = LifecycleState::kActive;  // from here on deactivate() undoes whatever was started
@@ -303,6 +317,7 @@ void Cell::finish_summary() {
   s.arming.last_refusal = arming_->last_refusal();
   s.telemetry_frames = drain_->frames();
   s.sensor_rms_mps2 = n_samples_ ? std::sqrt(sum_sq_ / static_cast<double>(n_samples_)) : 0.0;
+  if (machining_) s.machining = machining_->settled_sample(kMachiningSummaryWaitS);
 }
 
 Status Cell::cleanup() {
@@ -320,6 +335,8 @@ Status Cell::cleanup() {
   dds_.reset();
   model_.reset();
   mounting_sets_.clear();
+  machining_.reset();
+  set_configs_.clear();
   state_ = LifecycleState::kUnconfigured;
   return {};
 }

@@ -37,6 +37,7 @@
 #include "runtime/arming_policy.hpp"
 #include "runtime/components.hpp"
 #include "runtime/lifecycle.hpp"
+#include "runtime/machining_monitor.hpp"
 #include "runtime/run_summary.hpp"
 
 namespace robodamp::runtime {
@@ -102,6 +103,8 @@ class Cell {
   [[nodiscard]] const analysis::LoopModel& model() const { return *model_; }
   [[nodiscard]] const config::Config& config() const { return cfg_; }
   [[nodiscard]] const std::vector<rt::TelemetryFrame>& frames() const { return frames_; }
+  // With spindle.job: the live machining view (nullptr without).
+  [[nodiscard]] MachiningMonitor* machining() { return machining_.get(); }
 
  private:
   Status configure_devices();
@@ -126,6 +129,9 @@ class Cell {
   std::unique_ptr<rt::SpscRing<rt::TelemetryFrame>> ring_;
   std::unique_ptr<rt::Loop> loop_;
   std::unique_ptr<ArmingPolicy> arming_;
+  std::vector<config::Config> set_configs_;       // every parameter set's configuration, index = set
+  std::unique_ptr<MachiningMonitor> machining_;   // spindle.job: live stability and the chatter indicator
+  static constexpr double kMachiningSummaryWaitS = 30.0;  // for the limits at the last state (worker thread)
 
   // Active run.
   std::optional<rt::RealtimeProcess> rt_process_;

@@ -58,6 +58,7 @@ struct RunSummary {
   double peak_command_v{0.0};
   double spindle_rpm{0.0};         // the speed the controller's notches follow at the end (0: stopped or parked)
   double notch_centre_hz{0.0};     // the harmonic notches' fundamental at the end
+  std::optional<dds::MachiningSample> machining;  // spindle.job: speed, depth, limits, indicator at the end
 
   // The arming policy gave up, or the run ended before the loop was ever active while arming was wanted.
   [[nodiscard]] bool never_armed() const {

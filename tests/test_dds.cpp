@@ -112,7 +112,8 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
                       [&](dds::RequestKind, double) {
                         ++handled;
                         return dds::Decision{true, ""};
-                      }});
+                      },
+                      {}});
   bridge.start();
   Client client(cfg.domain_id);
   ASSERT_TRUE(eventually([&] { return client.matched(); }, 60.0));
@@ -363,7 +364,8 @@ struct SecureLoop {
                                                               [this](dds::RequestKind, double v) {
                                                                 ++handled;
                                                                 return dds::Decision{true, "K = " + std::to_string(v)};
-                                                              }});
+                                                              },
+                                                              {}});
     bridge->start();
   }
   ~SecureLoop() { bridge->stop(); }

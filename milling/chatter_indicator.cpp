@@ -1,0 +1,87 @@
+#include "milling/chatter_indicator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "analysis/fft.hpp"
+
+namespace robodamp::milling {
+
+ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s)
+    : fs_(sample_rate_hz), s_(s) {
+  ring_.assign(static_cast<std::size_t>(std::ceil(s_.max_window_s * fs_)), 0.0);
+  window_.reserve(ring_.size());
+}
+
+ChatterMonitor::~ChatterMonitor() = default;
+
+void ChatterMonitor::push(double accel_mps2) {
+  if (!std::isfinite(accel_mps2)) return;  // invalid samples are counted by the supervisor
+  ring_[head_] = accel_mps2;
+  head_ = (head_ + 1) % ring_.size();
+  count_ = std::min(count_ + 1, ring_.size());
+}
+
+ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
+  ChatterIndicator out;
+  if (!(spindle_rpm > 0.0)) return out;
+  const double f_sp = spindle_rpm / 60.0;
+  const double want_s = std::min(s_.max_window_s, std::max(s_.window_s, s_.min_revolutions / f_sp));
+  const auto n = std::min(count_, static_cast<std::size_t>(want_s * fs_));
+  if (static_cast<double>(n) / fs_ * f_sp < s_.min_revolutions || n < 64) return out;
+
+  // The span, oldest first, mean removed.
+  window_.resize(n);
+  const std::size_t start = (head_ + ring_.size() - n) % ring_.size();
+  double mean = 0.0;
+  for (std::size_t i = 0; i < n; ++i) mean += (window_[i] = ring_[(start + i) % ring_.size()]);
+  mean /= static_cast<double>(n);
+  double ss = 0.0;
+  for (double& v : window_) {
+    v -= mean;
+    ss += v * v;
+  }
+  out.rms_mps2 = std::sqrt(ss / static_cast<double>(n));
+  if (out.rms_mps2 <= 0.0) return out;
+
+  // Once per revolution.
+  const double rev_samples = fs_ / f_sp;
+  double prev = window_[0], sd = 0.0;
+  int revs = 0;
+  for (double t = rev_samples; t <= static_cast<double>(n - 1); t += rev_samples, ++revs) {
+    const auto i = static_cast<std::size_t>(t);
+    const double frac = t - static_cast<double>(i);
+    const double s = i + 1 < n ? window_[i] * (1.0 - frac) + window_[i + 1] * frac : window_[i];
+    sd += (s - prev) * (s - prev);
+    prev = s;
+  }
+  out.once_per_rev_ratio = revs > 0 ? std::sqrt(sd / revs) / out.rms_mps2 : 0.0;
+
+  // Spectrum (Hann), energy away from the spindle harmonics.
+  if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
+  double* in = fft_->input();
+  for (std::size_t i = 0; i < n; ++i)
+    in[i] = window_[i] * (0.5 - 0.5 * std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(n)));
+  const std::complex<double>* X = fft_->forward();
+  const double df = fs_ / static_cast<double>(n);
+  double total = 0.0, off = 0.0, best = 0.0;
+  for (std::size_t k = 1; k < fft_->bins(); ++k) {
+    const double f = static_cast<double>(k) * df;
+    if (f < s_.band_min_hz || f > 0.45 * fs_) continue;
+    const double e = std::norm(X[k]);
+    total += e;
+    const double h = std::round(f / f_sp);
+    if (std::abs(f - h * f_sp) <= 2.0 * df + 1e-12) continue;
+    off += e;
+    if (e > best) best = e, out.chatter_hz = f;
+  }
+  out.valid = true;
+  out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
+  out.nonharmonic_rms_mps2 = out.rms_mps2 * std::sqrt(out.nonharmonic_share);
+  out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
+                out.nonharmonic_rms_mps2 > s_.floor_mps2;
+  if (off <= 0.0) out.chatter_hz = 0.0;
+  return out;
+}
+
+}  // namespace robodamp::milling

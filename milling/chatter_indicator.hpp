@@ -1,0 +1,68 @@
+// The online chatter indicator (docs/harmonic_notch.md, "Chatter indicator"): from the control
+// accelerometer's samples as the telemetry drain receives them, over the last few seconds,
+//   - the once-per-revolution statistic: the signal resampled once per spindle revolution (linear
+//     interpolation between loop samples) repeats in a forced, stable cut; the RMS of the differences of
+//     consecutive revolution samples over the RMS of the signal is near 0 then and near sqrt(2) for a
+//     vibration unrelated to the spindle;
+//   - the non-harmonic energy share: of the spectral energy in [band_min_hz, 0.45 x the loop rate], the
+//     share more than two bins away from every spindle harmonic (Hann window; runout makes every
+//     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency.
+// Chatter is indicated when both exceed their thresholds and the non-harmonic vibration exceeds a floor
+// (sensor noise alone is not chatter). Off the real-time path: push() per sample on the drain thread,
+// evaluate() at the status rate; buffers allocated at construction.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace robodamp::analysis {
+class RealFft;
+}
+
+namespace robodamp::milling {
+
+struct ChatterIndicatorSettings {
+  double window_s{2.0};              // analysed span (at least min_revolutions revolutions when longer)
+  double max_window_s{8.0};          // the buffer
+  int min_revolutions{12};
+  double band_min_hz{5.0};
+  double once_per_rev_threshold{0.5};
+  double nonharmonic_threshold{0.5};
+  double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
+};
+
+struct ChatterIndicator {
+  bool valid{false};                 // enough samples at a turning spindle
+  double once_per_rev_ratio{0.0};
+  double nonharmonic_share{0.0};     // 0..1
+  double nonharmonic_rms_mps2{0.0};
+  double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
+  double rms_mps2{0.0};
+  bool chatter{false};
+};
+
+class ChatterMonitor {
+ public:
+  ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s = {});
+  ~ChatterMonitor();
+  ChatterMonitor(const ChatterMonitor&) = delete;
+  ChatterMonitor& operator=(const ChatterMonitor&) = delete;
+
+  void push(double accel_mps2);
+  // Forget the samples (the spindle speed changed: the window restarts).
+  void reset() { count_ = 0; }
+  [[nodiscard]] ChatterIndicator evaluate(double spindle_rpm);
+  [[nodiscard]] const ChatterIndicatorSettings& settings() const { return s_; }
+
+ private:
+  double fs_;
+  ChatterIndicatorSettings s_;
+  std::vector<double> ring_;
+  std::size_t head_{0}, count_{0};
+  std::vector<double> window_;  // the analysed span, oldest first
+  std::unique_ptr<analysis::RealFft> fft_;
+  std::size_t fft_n_{0};
+};
+
+}  // namespace robodamp::milling

@@ -1,0 +1,140 @@
+#include "milling/live_stability.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "analysis/loop_model.hpp"
+#include "milling/lobes.hpp"
+#include "milling/structure.hpp"
+
+namespace robodamp::milling {
+
+namespace {
+
+config::StructureConfig pick_structure(const config::MillingConfig& job, const std::string& name) {
+  const std::string wanted = name.empty() ? job.structure : name;
+  const config::StructureConfig* s = job.find_structure(wanted);
+  if (s == nullptr && name.empty() && !job.structures.empty()) s = &job.structures.front();
+  if (s == nullptr)
+    throw config::ConfigError({config::Problem{job.source, {}, "structure",
+                                               "the job has no structure named '" + wanted + "'"}});
+  bool has_controller = false;
+  for (const auto& p : s->parts) has_controller = has_controller || p.controller.has_value();
+  if (!has_controller)
+    throw config::ConfigError(
+        {config::Problem{job.source, {}, "structures." + s->name,
+                         "live stability needs a part with a controller (the damper's location and direction)"}});
+  return *s;
+}
+
+}  // namespace
+
+LiveStability::LiveStability(config::MillingConfig job, const std::string& structure, std::vector<config::Config> sets,
+                             LiveStabilitySettings s)
+    : job_(std::move(job)), structure_(pick_structure(job_, structure)), sets_(std::move(sets)), s_(s) {
+  if (sets_.empty())
+    throw config::ConfigError({config::Problem{job_.source, {}, "", "live stability needs a loop configuration"}});
+  thread_ = std::thread([this] { worker(); });
+}
+
+LiveStability::~LiveStability() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+}
+
+LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain) const {
+  return {std::lround(rpm / s_.rpm_step), set < sets_.size() ? set : 0, std::lround(gain / s_.gain_step_ns_per_m)};
+}
+
+std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, double gain_ns_per_m) {
+  const Key k = key(rpm, set, gain_ns_per_m);
+  std::lock_guard<std::mutex> lock(m_);
+  if (const auto it = cache_.find(k); it != cache_.end()) return it->second;
+  wanted_ = k;
+  cv_.notify_all();
+  return std::nullopt;
+}
+
+LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_per_m) {
+  const Key k = key(rpm, set, gain_ns_per_m);
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (const auto it = cache_.find(k); it != cache_.end()) return it->second;
+  }
+  LiveLimits l = evaluate(k);
+  std::lock_guard<std::mutex> lock(m_);
+  ++computations_;
+  if (cache_.size() < s_.cache_entries) cache_.emplace(k, l);
+  return l;
+}
+
+std::uint64_t LiveStability::computations() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return computations_;
+}
+
+void LiveStability::worker() {
+  std::unique_lock<std::mutex> lock(m_);
+  for (;;) {
+    cv_.wait(lock, [this] { return stop_ || wanted_.has_value(); });
+    if (stop_) return;
+    const Key k = *wanted_;
+    wanted_.reset();
+    if (cache_.count(k) != 0) continue;
+    lock.unlock();
+    LiveLimits l;
+    try {
+      l = evaluate(k);
+    } catch (const std::exception& e) {  // a model that cannot be built: reported, never thrown at the cell
+      l.rpm = static_cast<double>(std::get<0>(k)) * s_.rpm_step;
+      l.open_mm = l.damped_mm = 0.0;
+      l.damped_valid = false;
+      l.problem = e.what();
+    }
+    lock.lock();
+    ++computations_;
+    if (cache_.size() >= s_.cache_entries) cache_.clear();  // bounded; a run visits few states
+    cache_.emplace(k, std::move(l));
+  }
+}
+
+LiveLimits LiveStability::evaluate(const Key& k) const {
+  LiveLimits out;
+  out.rpm = static_cast<double>(std::get<0>(k)) * s_.rpm_step;
+  const config::Config& cfg = sets_[std::get<1>(k)];
+  const double gain = static_cast<double>(std::get<2>(k)) * s_.gain_step_ns_per_m;
+  const double inf = std::numeric_limits<double>::infinity();
+  out.open_mm = out.damped_mm = inf;
+  if (out.rpm <= 0.0) return out;
+
+  config::LobesConfig lobes = job_.lobes;
+  lobes.rpm_min = std::min(lobes.rpm_min, out.rpm);
+  lobes.rpm_max = std::max(lobes.rpm_max, out.rpm);
+  const ChatterProcess process = chatter_process(job_.tool, job_.material, job_.cut);
+  const int polarity = cfg.controller.polarity;
+
+  const Structure open(structure_, false, {std::make_shared<const analysis::LoopModel>(cfg), gain, polarity});
+  if (const auto p = LobeModel(open, process, lobes).limit_at(out.rpm)) {
+    out.open_mm = p->b_lim_m * 1e3;
+    out.open_chatter_hz = p->chatter_hz;
+  }
+  try {
+    const Structure damped(structure_, true,
+                           {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});
+    if (const auto p = LobeModel(damped, process, lobes).limit_at(out.rpm)) {
+      out.damped_mm = p->b_lim_m * 1e3;
+      out.damped_chatter_hz = p->chatter_hz;
+    }
+  } catch (const config::ConfigError& e) {
+    out.damped_valid = false;
+    out.damped_mm = 0.0;
+    out.problem = e.what();
+  }
+  return out;
+}
+
+}  // namespace robodamp::milling

@@ -1,0 +1,81 @@
+// Live stability at the current cut (docs/harmonic_notch.md, "Live stability"): the open-loop and damped
+// zero-order limiting depths of a milling job at the spindle speed the cell runs now, with the active
+// parameter set at its gain now and the harmonic notches at that speed in the loop. Computed on a worker
+// thread of its own and cached per (speed, parameter set, gain); lookup() never waits for a computation,
+// so the telemetry drain and the DDS status thread can ask at their own rate. Off the real-time path.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "config/config.hpp"
+#include "config/milling_config.hpp"
+
+namespace robodamp::milling {
+
+struct LiveLimits {
+  double rpm{0.0};
+  double open_mm{0.0};         // zero-order limit of the open-loop structure at rpm (+inf: no lobe reaches it)
+  double damped_mm{0.0};       // with the loop closed at the set and gain, notches at rpm
+  double open_chatter_hz{0.0}, damped_chatter_hz{0.0};
+  bool damped_valid{true};     // false: the loop is unstable there (no damped FRF); damped_mm is 0
+  std::string problem;         // why damped_valid is false
+};
+
+struct LiveStabilitySettings {
+  double rpm_step{1.0};        // speeds are rounded to this for the cache
+  double gain_step_ns_per_m{10.0};
+  std::size_t cache_entries{4096};
+};
+
+class LiveStability {
+ public:
+  // job: tool, material, cut (its axial depth is the job's depth) and the structure named `structure`
+  // (empty: the job's own), whose controller parts take the cell's loop; sets: the cell's parameter sets,
+  // index 0 the configuration's own. Throws config::ConfigError when the job does not fit the cell (no
+  // controller part, structure not found).
+  LiveStability(config::MillingConfig job, const std::string& structure, std::vector<config::Config> sets,
+                LiveStabilitySettings s = {});
+  ~LiveStability();
+  LiveStability(const LiveStability&) = delete;
+  LiveStability& operator=(const LiveStability&) = delete;
+
+  // Any non-real-time thread, never blocks on a computation: the cached limits for this state, or nothing
+  // yet (the request is queued; the newest request replaces an older one not yet started).
+  [[nodiscard]] std::optional<LiveLimits> lookup(double rpm, std::size_t set, double gain_ns_per_m);
+  // Blocking, for tests and the command line: computes (or finds) the limits.
+  [[nodiscard]] LiveLimits compute(double rpm, std::size_t set, double gain_ns_per_m);
+
+  [[nodiscard]] double depth_mm() const { return job_.cut.axial_mm; }
+  [[nodiscard]] const config::MillingConfig& job() const { return job_; }
+  [[nodiscard]] std::uint64_t computations() const;
+
+ private:
+  using Key = std::tuple<long, std::size_t, long>;
+  [[nodiscard]] Key key(double rpm, std::size_t set, double gain) const;
+  [[nodiscard]] LiveLimits evaluate(const Key& k) const;
+  void worker();
+
+  config::MillingConfig job_;
+  config::StructureConfig structure_;
+  std::vector<config::Config> sets_;
+  LiveStabilitySettings s_;
+
+  mutable std::mutex m_;
+  std::condition_variable cv_;
+  std::map<Key, LiveLimits> cache_;
+  std::optional<Key> wanted_;
+  bool stop_{false};
+  std::uint64_t computations_{0};
+  std::thread thread_;
+};
+
+}  // namespace robodamp::milling

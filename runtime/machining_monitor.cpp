@@ -1,0 +1,89 @@
+#include "runtime/machining_monitor.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "config/milling_config.hpp"
+#include "rt/supervisor.hpp"
+
+namespace robodamp::runtime {
+
+namespace {
+
+milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) {
+  milling::ChatterIndicatorSettings s;
+  s.band_min_hz = cfg.analysis.band_min_hz;
+  return s;
+}
+
+}  // namespace
+
+MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets,
+                                   std::function<std::size_t()> active_set)
+    : teeth_(cfg.spindle.teeth), active_set_(std::move(active_set)),
+      chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
+  for (const auto& s : sets) set_gains_.push_back(s.controller.gain_ns_per_m);
+  config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
+  if (job.tool.teeth != cfg.spindle.teeth)
+    throw config::ConfigError({config::Problem{cfg.source, {}, "spindle.teeth",
+                                               "= " + std::to_string(cfg.spindle.teeth) + " but the job " +
+                                                   cfg.spindle.job + " cuts with tool.teeth = " +
+                                                   std::to_string(job.tool.teeth)}});
+  stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets));
+}
+
+void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
+  std::lock_guard<std::mutex> lock(m_);
+  if (static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kSetSpindle && f.command_value != rpm_) {
+    rpm_ = std::isfinite(f.command_value) && f.command_value > 0.0 ? f.command_value : 0.0;
+    chatter_.reset();  // another speed: the window restarts
+  }
+  chatter_.push(f.accel_mps2);
+  last_ = f;
+}
+
+dds::MachiningSample MachiningMonitor::sample() {
+  dds::MachiningSample s;
+  std::size_t set = active_set_ ? active_set_() : 0;
+  if (set >= set_gains_.size()) set = 0;
+  double gain = 0.0;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    s.tick = last_.tick;
+    s.time_s = last_.time_s;
+    s.spindle_rpm = rpm_;
+    s.loop_active = static_cast<rt::State>(last_.state) == rt::State::kActive;
+    // The damper's limit at the gain it has (ramping included), or, while it is off, at the set's gain.
+    gain = s.loop_active && last_.gain_ns_per_m > 0.0 ? last_.gain_ns_per_m : set_gains_[set];
+    const milling::ChatterIndicator c = chatter_.evaluate(rpm_);
+    s.indicator_valid = c.valid;
+    s.once_per_rev_ratio = c.once_per_rev_ratio;
+    s.nonharmonic_share = c.nonharmonic_share;
+    s.chatter_hz = c.chatter_hz;
+    s.chatter = c.chatter;
+  }
+  s.tooth_passing_hz = s.spindle_rpm * teeth_ / 60.0;
+  s.depth_mm = stability_->depth_mm();
+  if (s.spindle_rpm > 0.0)
+    if (const auto l = stability_->lookup(s.spindle_rpm, set, gain)) {
+      s.limits_ready = true;
+      s.open_limit_mm = l->open_mm;
+      s.damped_limit_mm = l->damped_mm;
+      s.limit_mm = s.loop_active ? l->damped_mm : l->open_mm;
+      s.depth_warning = s.depth_mm > s.limit_mm;
+    }
+  return s;
+}
+
+dds::MachiningSample MachiningMonitor::settled_sample(double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  dds::MachiningSample s = sample();
+  while (s.spindle_rpm > 0.0 && !s.limits_ready && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    s = sample();
+  }
+  return s;
+}
+
+}  // namespace robodamp::runtime

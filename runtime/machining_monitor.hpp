@@ -1,0 +1,48 @@
+// The cell's live machining view (docs/harmonic_notch.md, "Live stability"): the spindle speed the loop
+// has (from the set_spindle commands in the telemetry frames, whatever sent them: the robot's Modbus
+// register or a DDS request), the job's depth, its open-loop and damped limits at that speed from
+// milling::LiveStability (worker thread, cached), and the chatter indicator over the control
+// accelerometer's recent samples. Fed by the telemetry drain (on_frame), read by the DDS status thread
+// and the run summary (sample). Off the real-time path.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "config/config.hpp"
+#include "dds/bridge.hpp"
+#include "milling/chatter_indicator.hpp"
+#include "milling/live_stability.hpp"
+#include "rt/telemetry_frame.hpp"
+
+namespace robodamp::runtime {
+
+class MachiningMonitor {
+ public:
+  // cfg: the cell's configuration (spindle.job names the job); sets: every parameter set's configuration
+  // (index 0 = cfg); active_set: the supervisor's active set (any thread). Throws config::ConfigError
+  // when the job cannot be read or does not fit.
+  MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, std::function<std::size_t()> active_set);
+
+  // The drain thread, every frame.
+  void on_frame(const rt::TelemetryFrame& f);
+  // Any thread: the state now (the limits as far as computed; the indicator evaluated now).
+  [[nodiscard]] dds::MachiningSample sample();
+  // Blocking: waits (up to timeout_s) for the limits at the current state, then samples (tests, summary).
+  [[nodiscard]] dds::MachiningSample settled_sample(double timeout_s);
+  [[nodiscard]] milling::LiveStability& stability() { return *stability_; }
+
+ private:
+  int teeth_;
+  std::vector<double> set_gains_;
+  std::function<std::size_t()> active_set_;
+  std::unique_ptr<milling::LiveStability> stability_;
+  std::mutex m_;
+  milling::ChatterMonitor chatter_;
+  rt::TelemetryFrame last_{};
+  double rpm_{0.0};
+};
+
+}  // namespace robodamp::runtime
