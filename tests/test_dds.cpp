@@ -257,6 +257,47 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   EXPECT_NE(log.find("arming: armed"), std::string::npos) << log;
 }
 
+// Live stability on DDS: `robodamp run` with a milling job (spindle.job), the spindle speed from a DDS
+// request, and `robodamp monitor` showing the speed, the job's depth, the open and damped limits at that
+// speed and the chatter indicator. Ends with SIGINT; every wait has a deadline and none is about speed.
+TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
+  const int domain = test_domain(7);
+  const std::string dir = ::testing::TempDir() + "robodamp_dds_machining_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  std::string text = test::read_file(test::preset("horizontal_c2"));
+  text += "\ndds:\n  domain_id: " + std::to_string(domain) +
+          "\n  transport: udp_loopback\n  telemetry_rate_hz: 20\n  parameter_writes: true\n";
+  text += "supervision:\n  overrun_cycles: 5000\n";
+  text += "spindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
+  std::ofstream(dir + "/dds.yaml") << text;
+  test::Child run({"run", "--config", dir + "/dds.yaml", "--duration", "600"}, dir + "/run.log");
+  // The speed, asked until the loop is there to take it.
+  const bool accepted = eventually([&] {
+    test::Child request({"request", "--config", dir + "/dds.yaml", "--spindle-rpm", "700", "--timeout", "20"},
+                        dir + "/request.log");
+    return request.wait_for(60.0) == std::optional<int>(0);
+  }, 120.0);
+  EXPECT_TRUE(accepted) << test::read_file(dir + "/request.log") << "\nrun log:\n" << test::read_file(dir + "/run.log");
+  std::string view;
+  const bool seen = eventually([&] {
+    test::Child monitor({"monitor", "--config", dir + "/dds.yaml", "--duration", "3"}, dir + "/monitor.log");
+    (void)monitor.wait_for(60.0);
+    view = test::read_file(dir + "/monitor.log");
+    return view.find("state      active") != std::string::npos && view.find("once-per-rev") != std::string::npos &&
+           view.find("damper active") != std::string::npos;
+  }, 120.0);
+  EXPECT_TRUE(seen) << view << "\nrun log:\n" << test::read_file(dir + "/run.log");
+  EXPECT_NE(view.find("spindle    700 rpm (tooth passing 35.0 Hz), job depth 0.500 mm"), std::string::npos) << view;
+  EXPECT_NE(view.find("open 1.661 mm, damped 1.071 mm; now 1.071 mm (damper active)  depth within"), std::string::npos)
+      << view;
+  EXPECT_NE(view.find("no chatter"), std::string::npos) << view;
+  run.kill(SIGINT);
+  EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
+  const std::string log = test::read_file(dir + "/run.log");
+  EXPECT_NE(log.find("machining at the end: 700 rpm, job depth 0.500 mm; limit open 1.661 mm, damped 1.071 mm"),
+            std::string::npos) << log;
+}
+
 // --- ROS 2 conventions ---
 
 // The topics and types under ROS 2's names, so a ROS 2 node (rclcpp on Fast DDS) with ros2/robodamp
@@ -267,7 +308,8 @@ TEST(Dds, TopicsAndTypesUseRos2Names) {
       {dds::TopicKind::kTelemetry, {"rt/robodamp/telemetry", "robodamp::msg::dds_::Telemetry_"}},
       {dds::TopicKind::kStatus, {"rt/robodamp/status", "robodamp::msg::dds_::Status_"}},
       {dds::TopicKind::kRequest, {"rt/robodamp/parameter_request", "robodamp::msg::dds_::ParameterRequest_"}},
-      {dds::TopicKind::kReply, {"rt/robodamp/parameter_reply", "robodamp::msg::dds_::ParameterReply_"}}};
+      {dds::TopicKind::kReply, {"rt/robodamp/parameter_reply", "robodamp::msg::dds_::ParameterReply_"}},
+      {dds::TopicKind::kMachining, {"rt/robodamp/machining", "robodamp::msg::dds_::Machining_"}}};
   for (const auto& [kind, names] : expected) {
     EXPECT_EQ(p.topic(kind)->get_name(), names.first);
     EXPECT_EQ(p.topic(kind)->get_type_name(), names.second);
@@ -315,7 +357,7 @@ std::vector<std::pair<std::string, std::string>> msg_fields(const std::string& p
 
 TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
-  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply"}) {
+  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining"}) {
     const auto from_idl = idl_fields(idl, name);
     const auto from_msg = msg_fields(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/" + name + ".msg");
     EXPECT_GT(from_idl.size(), 3U) << name;

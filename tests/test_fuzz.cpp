@@ -107,7 +107,7 @@ std::vector<Sub> subcommands() {
       {"check-config", {}, {}, {}, {}, true},
       {"analyze", {"--spindle-rpm"}, {"--json", "--spindle-sweep"}, {}, {"--config"}, false},
       {"bench", {}, {}, {}, {"--config"}, false},
-      {"run", {"--duration", "--impact-every"}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
+      {"run", {"--duration", "--impact-every", "--spindle-rpm"}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config", "--job"}, false},
       {"plant", {"--duration", "--impact-location"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
       {"monitor", {"--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback", "shared_memory"}}}, {"--config"}, false},
       {"request", {"--domain", "--gain", "--select", "--enable", "--timeout", "--spindle-rpm"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},

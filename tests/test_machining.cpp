@@ -1,0 +1,197 @@
+// Live machining context: the job's limits at the spindle speed now (milling/live_stability), the online
+// chatter indicator (milling/chatter_indicator) and the cell's machining view (runtime/machining_monitor).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "config/milling_config.hpp"
+#include "milling/chatter_indicator.hpp"
+#include "milling/cut_job.hpp"
+#include "milling/lobes.hpp"
+#include "milling/live_stability.hpp"
+#include "milling/structure.hpp"
+#include "runtime/cell.hpp"
+#include "test_util.hpp"
+
+namespace robodamp {
+namespace {
+
+std::string job_path() { return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml"; }
+
+// The preset with the harmonic notches on (controller.harmonic_notch).
+config::Config preset_with_notches(const std::string& notch) {
+  std::string text = test::read_file(test::preset("horizontal_c2"));
+  const std::size_t at = text.find("  chain:");
+  text.insert(at, "  harmonic_notch: " + notch + "\n");
+  return config::parse_config(text, test::preset("horizontal_c2"));
+}
+
+// The limits at a speed are the job's own lobes there: the same numbers `robodamp lobes --damped` gives
+// (the job's structure loads the same preset), from the worker thread through the cache.
+TEST(LiveStability, LimitsAtASpeedAreTheJobsLobesThere) {
+  const config::MillingConfig job = config::load_milling_config(job_path());
+  const milling::Structure open(*job.find_structure(job.structure), false);
+  const milling::Structure damped(*job.find_structure(job.structure), true);
+  const auto process = milling::chatter_process(job.tool, job.material, job.cut);
+  const config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  milling::LiveStability live(job, "", {cfg});
+  for (const double rpm : {350.0, 700.0, 1200.0}) {
+    const auto o = milling::LobeModel(open, process, job.lobes).limit_at(rpm);
+    const auto d = milling::LobeModel(damped, process, job.lobes).limit_at(rpm);
+    ASSERT_TRUE(o && d) << rpm;
+    std::optional<milling::LiveLimits> l;
+    EXPECT_FALSE(live.lookup(rpm, 0, cfg.controller.gain_ns_per_m).has_value()) << "computed off the caller's thread";
+    ASSERT_TRUE(test::eventually([&] { return (l = live.lookup(rpm, 0, cfg.controller.gain_ns_per_m)).has_value(); }, 120.0));
+    EXPECT_NEAR(l->open_mm, o->b_lim_m * 1e3, 1e-9) << rpm;
+    EXPECT_NEAR(l->damped_mm, d->b_lim_m * 1e3, 1e-9) << rpm;
+    EXPECT_TRUE(l->damped_valid);
+  }
+  // The figures at 700 rpm (docs/milling.md): 1.661 mm open, 1.071 mm damped.
+  const auto l700 = live.compute(700.0, 0, 2000.0);
+  EXPECT_NEAR(l700.open_mm, 1.661, 0.001);
+  EXPECT_NEAR(l700.damped_mm, 1.071, 0.001);
+  // The gain is part of the state: at 700 rpm the 23.5 Hz mode's lobe limits, and C2's feedback there is
+  // outside the damping window (docs/milling.md), so less gain leaves more depth (1.516 mm at 500 N s/m).
+  EXPECT_GT(live.compute(700.0, 0, 500.0).damped_mm, l700.damped_mm + 0.3);
+}
+
+// The notches at the speed are in the damped loop: at 700 rpm (tooth passing 35 Hz, harmonics at 70 and
+// 105 Hz) their phase at 21-23.5 Hz changes the damped limit; at 12 000 rpm (600 Hz) it does not matter.
+TEST(LiveStability, HarmonicNotchesAtTheSpeedEnterTheDampedLimit) {
+  const config::MillingConfig job = config::load_milling_config(job_path());
+  const config::Config plain = config::load_config_file(test::preset("horizontal_c2"));
+  const config::Config notched = preset_with_notches("{harmonics: 3, bandwidth_hz: 10, depth_db: 30}");
+  milling::LiveStability a(job, "", {plain}), b(job, "", {notched});
+  const auto a700 = a.compute(700.0, 0, 2000.0), b700 = b.compute(700.0, 0, 2000.0);
+  EXPECT_EQ(a700.open_mm, b700.open_mm);
+  EXPECT_GT(std::abs(b700.damped_mm / a700.damped_mm - 1.0), 1e-3) << a700.damped_mm << " " << b700.damped_mm;
+  const auto a12k = a.compute(12000.0, 0, 2000.0), b12k = b.compute(12000.0, 0, 2000.0);
+  EXPECT_NEAR(b12k.damped_mm / a12k.damped_mm, 1.0, 1e-3);
+}
+
+TEST(LiveStability, AJobWithoutADampingLocationIsRefused) {
+  config::MillingConfig job = config::load_milling_config(job_path());
+  for (auto& s : job.structures)
+    for (auto& p : s.parts) p.controller.reset();
+  EXPECT_THROW(milling::LiveStability(job, "", {config::load_config_file(test::preset("horizontal_c2"))}),
+               config::ConfigError);
+  EXPECT_THROW(milling::LiveStability(config::load_milling_config(job_path()), "no_such_structure",
+                                      {config::load_config_file(test::preset("horizontal_c2"))}),
+               config::ConfigError);
+}
+
+// Synthetic: a forced cut (the spindle's harmonics) with sensor noise is quiet; add a growing vibration at
+// a robot mode off the harmonics and it indicates chatter at that frequency.
+TEST(ChatterIndicator, ForcedVibrationIsQuietAndAnOffHarmonicModeIsChatter) {
+  const double fs = 5000.0, rpm = 700.0, f_sp = rpm / 60.0;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  milling::ChatterMonitor quiet(fs), chatter(fs);
+  for (int i = 0; i < 4 * 5000; ++i) {
+    const double t = i / fs;
+    double forced = 0.0;
+    for (int k = 1; k <= 12; ++k) forced += (1.0 / k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.3 * k);
+    quiet.push(forced + noise(rng));
+    chatter.push(forced + noise(rng) + 0.05 * std::exp(0.8 * t) * std::sin(2.0 * M_PI * 17.3 * t));
+  }
+  const auto q = quiet.evaluate(rpm), c = chatter.evaluate(rpm);
+  ASSERT_TRUE(q.valid && c.valid);
+  EXPECT_FALSE(q.chatter);
+  EXPECT_LT(q.nonharmonic_share, 0.01);
+  EXPECT_LT(q.once_per_rev_ratio, 0.05);
+  EXPECT_TRUE(c.chatter) << c.once_per_rev_ratio << " " << c.nonharmonic_share;
+  EXPECT_NEAR(c.chatter_hz, 17.3, 0.5);
+  // Too few revolutions, a stopped spindle, NaN samples: no verdict, nothing breaks.
+  milling::ChatterMonitor fresh(fs);
+  for (int i = 0; i < 100; ++i) fresh.push(i % 7 == 0 ? NAN : 0.1);
+  EXPECT_FALSE(fresh.evaluate(rpm).valid);
+  EXPECT_FALSE(quiet.evaluate(0.0).valid);
+  EXPECT_FALSE(quiet.evaluate(NAN).valid);
+}
+
+// Simulated cuts of the job at 700 rpm (time domain, docs/milling.md): the indicator on the wall-normal
+// acceleration is quiet below the open-loop limit (1.66 mm) and indicates chatter above it.
+TEST(ChatterIndicator, SimulatedCutsBelowAndAboveTheLimit) {
+  const config::MillingConfig job = config::load_milling_config(job_path());
+  const milling::Structure open(*job.find_structure(job.structure), false);
+  for (const double depth : {1.0, 2.5}) {
+    milling::CutOverrides o;
+    o.rpm = 700.0;
+    o.axial_mm = depth;
+    o.revolutions = 60;
+    const milling::CutJob cut = milling::make_cut_job(job, open, o);
+    const milling::CutOutcome r = milling::run_job(cut);
+    const double fs = 1.0 / r.record.step_s;
+    milling::ChatterMonitor m(fs, {.window_s = 3.0, .max_window_s = 4.0});
+    const auto& y = r.record.y_m;
+    for (std::size_t i = 2; i < y.size(); ++i) m.push((y[i] - 2.0 * y[i - 1] + y[i - 2]) * fs * fs);
+    const auto v = m.evaluate(r.record.rpm);
+    ASSERT_TRUE(v.valid) << depth;
+    EXPECT_EQ(v.chatter, !r.verdict.stable) << depth << " mm: once-per-rev " << v.once_per_rev_ratio << ", non-harmonic "
+                                           << v.nonharmonic_share << ", " << v.nonharmonic_rms_mps2 << " m/s^2";
+    EXPECT_EQ(r.verdict.stable, depth < 1.66) << depth;
+    if (!r.verdict.stable) EXPECT_NEAR(v.chatter_hz, r.verdict.chatter_hz, 1.0 / 3.0);  // within the window's bins
+  }
+}
+
+// A cell with spindle.job: the speed from a set_spindle command reaches the machining view, which gives the
+// job's depth, the limits at that speed and the damper's state; a deeper job is warned about.
+TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
+  const std::string dir = ::testing::TempDir() + "robodamp_machining_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  std::string job = test::read_file(job_path());
+  job.replace(job.find("../presets/horizontal_c2.yaml"), 29, test::preset("horizontal_c2"));
+  for (const double depth : {0.5, 1.5}) {
+    std::string text = job;
+    text.replace(text.find("axial_mm: 0.5"), 13, "axial_mm: " + std::to_string(depth));
+    std::ofstream(dir + "/job.yaml") << text;
+    config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+    cfg.spindle.job = cfg.spindle.job_resolved = dir + "/job.yaml";
+    cfg.loop.clock = config::ClockKind::kVirtual;
+    runtime::Cell cell(cfg);
+    ASSERT_TRUE(cell.configure().ok());
+    ASSERT_NE(cell.machining(), nullptr);
+    cell.schedule(1, {rt::CommandKind::kSetSpindle, 700.0});
+    const runtime::RunSummary s = cell.run(6.0);
+    ASSERT_TRUE(s.machining.has_value());
+    const auto& m = *s.machining;
+    EXPECT_EQ(m.spindle_rpm, 700.0);
+    EXPECT_NEAR(m.tooth_passing_hz, 35.0, 1e-9);
+    EXPECT_EQ(m.depth_mm, depth);
+    ASSERT_TRUE(m.limits_ready);
+    EXPECT_NEAR(m.open_limit_mm, 1.661, 0.001);
+    EXPECT_NEAR(m.damped_limit_mm, 1.071, 0.001);
+    EXPECT_FALSE(m.loop_active) << "the run has ended: the damper is off";
+    EXPECT_EQ(m.limit_mm, m.open_limit_mm);
+    EXPECT_EQ(m.depth_warning, depth > 1.661);
+    EXPECT_TRUE(m.indicator_valid);
+    EXPECT_FALSE(m.chatter) << "no cut in the simulated plant";
+    // While the damper is active the damped limit applies: 1.5 mm is above it.
+    milling::LiveStability& live = cell.machining()->stability();
+    EXPECT_EQ(live.compute(700.0, 0, cfg.controller.gain_ns_per_m).damped_mm, m.damped_limit_mm);
+  }
+}
+
+TEST(MachiningMonitor, AJobThatDoesNotFitTheCellIsAConfigurationError) {
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  cfg.spindle.job = cfg.spindle.job_resolved = job_path();
+  cfg.spindle.teeth = 4;  // the job's tool has 3
+  runtime::Cell cell(cfg);
+  const runtime::Status st = cell.configure();
+  EXPECT_EQ(st.kind, runtime::StatusKind::kConfigError);
+  EXPECT_NE(st.message.find("spindle.teeth"), std::string::npos) << st.message;
+  // A missing job file is refused by name when the configuration is read.
+  std::string text = test::read_file(test::preset("horizontal_c2"));
+  text += "\nspindle:\n  job: no/such/job.yaml\n";
+  try {
+    (void)config::parse_config(text, test::preset("horizontal_c2"));
+    ADD_FAILURE() << "accepted a missing job";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("spindle.job"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace robodamp
