@@ -25,6 +25,8 @@ struct PlantArgs {
   std::string measure_out;
   std::vector<std::string> mounting_schedule;  // "T:vertical" / "T:horizontal", plant time in s
   std::vector<std::string> spindle_schedule;   // "T:RPM", plant time in s
+  std::vector<std::string> spindle_ramps;      // "T0:T1:RPM"
+  std::string cut_job;
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
 
@@ -72,6 +74,20 @@ int run_plant(const PlantArgs& a) {
     }
     eo.spindle_schedule.emplace_back(t, rpm);
   }
+  for (const auto& item : a.spindle_ramps) {
+    const auto c1 = item.find(':'), c2 = item.find(':', c1 == std::string::npos ? 0 : c1 + 1);
+    double t0 = 0.0, t1 = 0.0, rpm = 0.0;
+    if (c1 == std::string::npos || c2 == std::string::npos ||
+        parse_number("--spindle-ramp", item.substr(0, c1), {"s", 0.0, 1e7}, false, t0) ||
+        parse_number("--spindle-ramp", item.substr(c1 + 1, c2 - c1 - 1), {"s", 0.0, 1e7}, false, t1) ||
+        parse_number("--spindle-ramp", item.substr(c2 + 1), {"rpm", 0.0, 200000.0}, false, rpm) || t1 < t0) {
+      std::cerr << "robodamp plant: --spindle-ramp = '" << item
+                << "': expected T0_S:T1_S:RPM, allowed 0 <= T0_S <= T1_S <= 1e+07 s and 0 <= RPM <= 200000 rpm\n";
+      return 2;
+    }
+    eo.spindle_ramps.push_back({t0, t1, rpm});
+  }
+  eo.cut_job = a.cut_job;
   rt::install_shutdown_handlers();
   eo.stop_flag = &rt::shutdown_signal();
   const hil::EmulatorReport r = hil::run_emulator(cfg, eo);
@@ -113,6 +129,11 @@ void register_plant(Registry& r) {
            "Fault injection: the Modbus device stops answering at this plant time");
   sub->add_option("--mounting", a->mounting_schedule,
                   "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
+  sub->add_option("--spindle-ramp", a->spindle_ramps,
+                  "A linear spindle ramp T0_S:T1_S:RPM (plant time; from the speed at T0 to RPM at T1), repeatable");
+  sub->add_option("--cut", a->cut_job,
+                  "Milling job (config/milling/*.yaml) whose cutting force acts on the robot at the spindle speed")
+      ->check(CLI::ExistingFile);
   sub->add_option("--spindle", a->spindle_schedule,
                   "Robot spindle speed register changes, TIME_S:RPM (plant time; modbus.robot.spindle_rpm_register), repeatable");
 }

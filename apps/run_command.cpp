@@ -30,6 +30,7 @@ struct RunArgs {
   double impact_every_s{2.0};
   std::string job_path;
   double spindle_rpm{0.0};
+  bool no_harmonic_notch{false};
 };
 
 [[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s) {
@@ -274,6 +275,7 @@ int exit_status(const runtime::Status& s) { return s.kind == runtime::StatusKind
 // 5 never armed (the arming policy's deadline passed, or the run ended first); 1 other (devices, recording).
 int run_loop(const RunArgs& a) {
   config::Config cfg = config::load_config_file(a.config_path);
+  if (a.no_harmonic_notch) cfg.controller.harmonic_notch.reset();
   if (!a.job_path.empty()) cfg.spindle.job = cfg.spindle.job_resolved = a.job_path;
   runtime::CellOptions o;
   if (!a.clock.empty()) o.clock = a.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
@@ -340,6 +342,8 @@ void register_run(Registry& r) {
   sub->add_option("--job", a->job_path,
                   "Milling job (config/milling/*.yaml) for live stability and the chatter indicator; overrides spindle.job")
       ->check(CLI::ExistingFile);
+  sub->add_flag("--no-harmonic-notch", a->no_harmonic_notch,
+               "Run without the configuration's controller.harmonic_notch (to compare the bank on and off)");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0, false, false, "0 = stopped"},
            "The spindle speed from the start (as the robot's register or a DDS request would set it)");
 }

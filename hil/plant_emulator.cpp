@@ -31,6 +31,7 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kSilentControllerS = 10.0;  // lockstep: no command for this long ends the run
 constexpr double kTemperatureTauS = 10.0;    // amplifier heating time constant
+constexpr double kSpindleRegisterPeriodS = 0.05;  // the robot controller's spindle register update
 
 std::int64_t now_ns() {
   timespec ts{};
@@ -161,6 +162,18 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   } else if (o.impacts) {
     campaign.emplace(cfg, plant, test);
   }
+  // The spindle (steps and ramps) and the cut at its speed.
+  std::vector<SpindleChange> changes = o.spindle_ramps;
+  for (const auto& [t, rpm] : o.spindle_schedule) changes.push_back({t, t, rpm});
+  std::optional<CutLoad> cut;
+  if (!o.cut_job.empty()) {
+    cut = cut_load_from_job(o.cut_job, model, o.cut_harmonics);
+    spdlog::info("robodamp plant: cutting {} ({} teeth) at the {}: tooth harmonics {:.1f}, {:.1f}, {:.1f} N", o.cut_job,
+                 cut->teeth, model.locations[cut->location].name, std::abs(cut->harmonics_n[1]),
+                 std::abs(cut->harmonics_n[2]), std::abs(cut->harmonics_n[3]));
+  }
+  CuttingLoad cutting(plant, std::move(cut), SpindleProfile(std::move(changes)));
+  double published_rpm = -1.0, published_at_s = -1.0;
   std::uint32_t sensor_counter = 0, last_cmd_counter = 0;
   bool have_cmd_counter = false;
   double command_v = 0.0;     // newest command received
@@ -249,7 +262,15 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     const double t = static_cast<double>(k) * dt;
     if (campaign) campaign->before_step(k);
     if (modal_test) modal_test->before_step(k);
+    // The robot controller updates its spindle register every kSpindleRegisterPeriodS (a ramp arrives
+    // as a staircase the controller's settle rule can follow); the cut sees the speed itself.
+    const double rpm = cutting.before_step(t);
+    if (rpm != published_rpm && t >= published_at_s + kSpindleRegisterPeriodS) {
+      regs.set_spindle_rpm(rpm);
+      published_rpm = rpm, published_at_s = t;
+    }
     plant.step(ready ? applied_v : 0.0);
+    cutting.after_step(ready ? applied_v : 0.0, dt);
     if (modal_test) modal_test->after_step(k);
     if (campaign) {
       campaign->after_step(k);
@@ -285,7 +306,6 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
                    cfg.bench.averages, rep.impact_location, rep.campaign_start_s);
     }
     while (next_spindle < o.spindle_schedule.size() && o.spindle_schedule[next_spindle].first <= t) {
-      regs.set_spindle_rpm(o.spindle_schedule[next_spindle].second);
       ++rep.spindle_changes;
       spdlog::info("robodamp plant: robot reports the spindle at {} rpm at {:.3f} s", o.spindle_schedule[next_spindle].second, t);
       ++next_spindle;
@@ -350,6 +370,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.plant_time_s = static_cast<double>(rep.ticks) * dt;
   rep.elapsed_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   rep.modbus_requests = regs.requests();
+  rep.cutting = cutting.report();
 
   if (modal_test) {
     rep.measure_records = modal_test->records();
@@ -407,6 +428,7 @@ nlohmann::json report_json(const EmulatorReport& r) {
           {"plant_time_s", r.plant_time_s},
           {"elapsed_s", r.elapsed_s},
           {"end_reason", r.end_reason},
+          {"cutting", cutting_json(r.cutting)},
           {"frames",
            {{"sensor_sent", r.sensor_frames_sent},
             {"send_errors", r.send_errors},
@@ -484,6 +506,17 @@ std::string report_text(const EmulatorReport& r) {
                     f.improvement_pct, f.coherence_min);
       os << b;
     }
+  }
+  if (r.cutting.cut) {
+    const auto& c = r.cutting;
+    const auto at = [](const std::vector<double>& v, std::size_t i) { return i < v.size() ? v[i] : 0.0; };
+    std::snprintf(b, sizeof b,
+                  "  cutting %s: %.3f s in the cut (last %.0f rpm), %.3f s of it at the actuator's limits; command at "
+                  "1/2/3 x tooth passing %.3g / %.3g / %.3g V over %.1f s at a steady speed (force %.1f / %.1f / %.1f N)\n",
+                  c.job.c_str(), c.in_cut_s, c.last_rpm, c.saturated_in_cut_s, at(c.command_harmonics_v, 0),
+                  at(c.command_harmonics_v, 1), at(c.command_harmonics_v, 2), c.measured_s, at(c.force_harmonics_n, 0),
+                  at(c.force_harmonics_n, 1), at(c.force_harmonics_n, 2));
+    os << b;
   }
   for (const auto& f : r.injected) {
     std::snprintf(b, sizeof b, "  injected %s at %.3f s plant time\n", f.kind.c_str(), f.plant_time_s);

@@ -31,6 +31,7 @@
 
 #include "analysis/modal_test.hpp"
 #include "analysis/spectral.hpp"
+#include "hil/cutting_load.hpp"
 #include "config/config.hpp"
 #include "rt/timing_histogram.hpp"
 
@@ -50,6 +51,12 @@ struct EmulatorOptions {
   // Spindle speed register changes: (plant time s, rpm), written to modbus.robot.spindle_rpm_register
   // (rpm / rpm_per_count).
   std::vector<std::pair<double, double>> spindle_schedule;
+  // Linear spindle ramps (t0 s, t1 s, rpm reached at t1), with the steps above one speed profile.
+  std::vector<SpindleChange> spindle_ramps;
+  // A milling job (config/milling/*.yaml) whose cutting force acts on the plant at the spindle speed
+  // (hil/cutting_load.hpp). Empty = no cut.
+  std::string cut_job;
+  int cut_harmonics{12};
   bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
   // Faults injected at plant times (s; negative = none), to measure how the controller gets to its safe
   // state: the CAN bus goes off (an error frame with CAN_ERR_BUSOFF, no sensor frames for bus_off_for_s,
@@ -110,6 +117,7 @@ struct EmulatorReport {
   // robodamp measure's plant side.
   int measure_records{0}, measure_records_planned{0};
   std::vector<std::string> measure_files;
+  CuttingReport cutting;
 };
 
 // Serves one controller connection and returns when it disconnects (or max_duration_s, or the stop

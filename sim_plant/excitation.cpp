@@ -86,4 +86,23 @@ double Noise::force_n(double, double) noexcept {
   return rms_n_ * band_gain_ * band_.process(w);
 }
 
+ToothPassingForce::ToothPassingForce(std::size_t location, std::vector<std::complex<double>> harmonics_n)
+    : Excitation(location), c_(std::move(harmonics_n)) {}
+
+double ToothPassingForce::force_n(double /*t_s*/, double h_s) noexcept {
+  const double f = tooth_hz();
+  if (!(f > 0.0) || c_.empty()) return 0.0;
+  const double dphi = 2.0 * M_PI * f * h_s;  // over the step
+  double sum = c_[0].real();
+  for (std::size_t k = 1; k < c_.size(); ++k) {
+    // Mean of e^{i k phi} over [phi0, phi0 + dphi]: e^{i k phi0} (e^{i k dphi} - 1) / (i k dphi).
+    const double kd = static_cast<double>(k) * dphi;
+    const std::complex<double> start = std::polar(1.0, static_cast<double>(k) * phase_);
+    const std::complex<double> mean = kd > 1e-9 ? (std::polar(1.0, kd) - 1.0) / std::complex<double>(0.0, kd) : 1.0;
+    sum += (c_[k] * start * mean).real();
+  }
+  phase_ = std::fmod(phase_ + dphi, 2.0 * M_PI);
+  return sum;
+}
+
 }  // namespace robodamp::sim

@@ -4,6 +4,8 @@
 // preserved at any step). Constructed off the real-time path; force_n() is RT-safe.
 #pragma once
 
+#include <atomic>
+#include <complex>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -75,6 +77,26 @@ class Noise final : public Excitation {
   bool band_limited_{false};
   filters::BiquadCascade band_;
   double band_gain_{1.0};
+};
+
+// A milling cut's periodic force at the tooth-passing frequency and its harmonics (the HIL emulator's
+// cutting forces: the harmonics come from the job, milling::force_spectrum), at a spindle speed that may
+// change during the run: F(t) = Re sum_k c_k e^{i k phi(t)}, phi the tooth phase integrated from the speed
+// (continuous across changes), k = 0..K (c_0 the mean force). Each step returns the exact mean over the
+// step at the speed then. set_tooth_hz() may be called from another thread (atomic); 0 = out of the cut.
+class ToothPassingForce final : public Excitation {
+ public:
+  ToothPassingForce(std::size_t location, std::vector<std::complex<double>> harmonics_n);
+  double force_n(double t_s, double h_s) noexcept override;
+  void set_tooth_hz(double f_hz) noexcept { tooth_hz_.store(f_hz, std::memory_order_relaxed); }
+  [[nodiscard]] double tooth_hz() const noexcept { return tooth_hz_.load(std::memory_order_relaxed); }
+  // The tooth phase at the end of the last step, rad (for a lock-in on a response).
+  [[nodiscard]] double phase_rad() const noexcept { return phase_; }
+
+ private:
+  std::vector<std::complex<double>> c_;
+  std::atomic<double> tooth_hz_{0.0};
+  double phase_{0.0};
 };
 
 }  // namespace robodamp::sim

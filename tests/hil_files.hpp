@@ -39,13 +39,16 @@ struct HilFiles {
   std::string dir, config, plant_json, run_json, plant_log, run_log;
 };
 
-// config/hil_horizontal_c2.yaml with this test's own socket and Modbus port.
-inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<std::string, std::string>>& edits = {}) {
+// config/<base>.yaml with this test's own socket and Modbus port.
+inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<std::string, std::string>>& edits = {},
+                          const std::string& base = "hil_horizontal_c2") {
   HilFiles f;
   f.dir = ::testing::TempDir() + "robodamp_hil_" + name + "_" + std::to_string(getpid());
   mkdir(f.dir.c_str(), 0755);
-  std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_horizontal_c2.yaml");
+  std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/" + base + ".yaml");
   replace_all(text, "unix:/tmp/robodamp-hil.sock", "unix:" + f.dir + "/can.sock");
+  replace_all(text, "unix:/tmp/robodamp-hil-cut.sock", "unix:" + f.dir + "/can.sock");
+  replace_all(text, "job: milling/", std::string("job: ") + ROBODAMP_SOURCE_DIR + "/config/milling/");
   replace_all(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
   replace_all(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
   for (const auto& [from, to] : edits) replace_all(text, from, to);

@@ -132,7 +132,9 @@ TEST(ChatterIndicator, SimulatedCutsBelowAndAboveTheLimit) {
     EXPECT_EQ(v.chatter, !r.verdict.stable) << depth << " mm: once-per-rev " << v.once_per_rev_ratio << ", non-harmonic "
                                            << v.nonharmonic_share << ", " << v.nonharmonic_rms_mps2 << " m/s^2";
     EXPECT_EQ(r.verdict.stable, depth < 1.66) << depth;
-    if (!r.verdict.stable) EXPECT_NEAR(v.chatter_hz, r.verdict.chatter_hz, 1.0 / 3.0);  // within the window's bins
+    if (!r.verdict.stable) {
+      EXPECT_NEAR(v.chatter_hz, r.verdict.chatter_hz, 1.0 / 3.0);  // within the window's bins
+    }
   }
 }
 
