@@ -47,15 +47,36 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   // Once per revolution.
   const double rev_samples = fs_ / f_sp;
   double prev = window_[0], sd = 0.0;
-  int revs = 0;
-  for (double t = rev_samples; t <= static_cast<double>(n - 1); t += rev_samples, ++revs) {
+  std::size_t revs = 0;
+  for (double t = rev_samples; t <= static_cast<double>(n - 1); t += rev_samples) {
     const auto i = static_cast<std::size_t>(t);
     const double frac = t - static_cast<double>(i);
     const double s = i + 1 < n ? window_[i] * (1.0 - frac) + window_[i + 1] * frac : window_[i];
+    ++revs;
     sd += (s - prev) * (s - prev);
     prev = s;
   }
-  out.once_per_rev_ratio = revs > 0 ? std::sqrt(sd / revs) / out.rms_mps2 : 0.0;
+  out.once_per_rev_ratio = revs > 0 ? std::sqrt(sd / static_cast<double>(revs)) / out.rms_mps2 : 0.0;
+  // Persistence: x(t) - x(t - one revolution) at every sample (the forced, periodic part cancels), RMS in
+  // the window's halves, the smaller over the larger. A decaying transient (a hammer impact, a step of
+  // the cut) is loud in one half; chatter fills the window.
+  double half_ss[2] = {0.0, 0.0};
+  std::size_t half_n[2] = {0, 0};
+  const auto first = static_cast<std::size_t>(std::ceil(rev_samples));
+  for (std::size_t i = first; i < n; ++i) {
+    const double back = static_cast<double>(i) - rev_samples;
+    const auto b = static_cast<std::size_t>(back);
+    const double frac = back - static_cast<double>(b);
+    const double e = window_[i] - (window_[b] * (1.0 - frac) + window_[b + 1] * frac);
+    const std::size_t h = i < (first + n) / 2 ? 0 : 1;
+    half_ss[h] += e * e, ++half_n[h];
+  }
+  double q_min = INFINITY, q_max = 0.0;
+  for (int h = 0; h < 2; ++h) {
+    const double r = half_n[h] ? std::sqrt(half_ss[h] / static_cast<double>(half_n[h])) : 0.0;
+    q_min = std::min(q_min, r), q_max = std::max(q_max, r);
+  }
+  out.persistence = q_max > 0.0 ? q_min / q_max : 0.0;
 
   // Spectrum (Hann), energy away from the spindle harmonics.
   if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
@@ -79,7 +100,7 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
   out.nonharmonic_rms_mps2 = out.rms_mps2 * std::sqrt(out.nonharmonic_share);
   out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
-                out.nonharmonic_rms_mps2 > s_.floor_mps2;
+                out.nonharmonic_rms_mps2 > s_.floor_mps2 && out.persistence > s_.persistence_threshold;
   if (off <= 0.0) out.chatter_hz = 0.0;
   return out;
 }

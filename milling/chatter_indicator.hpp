@@ -7,8 +7,9 @@
 //   - the non-harmonic energy share: of the spectral energy in [band_min_hz, 0.45 x the loop rate], the
 //     share more than two bins away from every spindle harmonic (Hann window; runout makes every
 //     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency.
-// Chatter is indicated when both exceed their thresholds and the non-harmonic vibration exceeds a floor
-// (sensor noise alone is not chatter). Off the real-time path: push() per sample on the drain thread,
+// Chatter is indicated when both exceed their thresholds, the non-harmonic vibration exceeds a floor
+// (sensor noise alone is not chatter) and it persists across the window (its quieter half at least
+// 0.4 of its louder half: a hammer impact's decaying ring is not chatter). Off the real-time path: push() per sample on the drain thread,
 // evaluate() at the status rate; buffers allocated at construction.
 #pragma once
 
@@ -32,6 +33,9 @@ struct ChatterIndicatorSettings {
   double once_per_rev_threshold{0.2};
   double nonharmonic_threshold{0.1};
   double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
+  // Smaller / larger half of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
+  // 0.87 s) gives at most exp(-1 s / 0.87 s) = 0.32.
+  double persistence_threshold{0.4};
 };
 
 struct ChatterIndicator {
@@ -41,6 +45,7 @@ struct ChatterIndicator {
   double nonharmonic_rms_mps2{0.0};
   double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
   double rms_mps2{0.0};
+  double persistence{0.0};           // x(t) - x(t - 1 rev): RMS over the quieter half / the louder
   bool chatter{false};
 };
 
