@@ -58,22 +58,22 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   }
   out.once_per_rev_ratio = revs > 0 ? std::sqrt(sd / static_cast<double>(revs)) / out.rms_mps2 : 0.0;
   // Persistence: x(t) - x(t - one revolution) at every sample (the forced, periodic part cancels), RMS in
-  // the window's halves, the smaller over the larger. A decaying transient (a hammer impact, a step of
-  // the cut) is loud in one half; chatter fills the window.
-  double half_ss[2] = {0.0, 0.0};
-  std::size_t half_n[2] = {0, 0};
+  // the window's quarters, the smallest over the largest. A decaying transient (a hammer impact, a step of
+  // the cut) leaves a quiet quarter before it or after it; chatter fills the window.
+  double part_ss[4] = {0.0, 0.0, 0.0, 0.0};
+  std::size_t part_n[4] = {0, 0, 0, 0};
   const auto first = static_cast<std::size_t>(std::ceil(rev_samples));
   for (std::size_t i = first; i < n; ++i) {
     const double back = static_cast<double>(i) - rev_samples;
     const auto b = static_cast<std::size_t>(back);
     const double frac = back - static_cast<double>(b);
     const double e = window_[i] - (window_[b] * (1.0 - frac) + window_[b + 1] * frac);
-    const std::size_t h = i < (first + n) / 2 ? 0 : 1;
-    half_ss[h] += e * e, ++half_n[h];
+    const std::size_t q = std::min<std::size_t>(3, 4 * (i - first) / (n - first));
+    part_ss[q] += e * e, ++part_n[q];
   }
   double q_min = INFINITY, q_max = 0.0;
-  for (int h = 0; h < 2; ++h) {
-    const double r = half_n[h] ? std::sqrt(half_ss[h] / static_cast<double>(half_n[h])) : 0.0;
+  for (int q = 0; q < 4; ++q) {
+    const double r = part_n[q] ? std::sqrt(part_ss[q] / static_cast<double>(part_n[q])) : 0.0;
     q_min = std::min(q_min, r), q_max = std::max(q_max, r);
   }
   out.persistence = q_max > 0.0 ? q_min / q_max : 0.0;

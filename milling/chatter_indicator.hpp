@@ -8,8 +8,8 @@
 //     share more than two bins away from every spindle harmonic (Hann window; runout makes every
 //     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency.
 // Chatter is indicated when both exceed their thresholds, the non-harmonic vibration exceeds a floor
-// (sensor noise alone is not chatter) and it persists across the window (its quieter half at least
-// 0.4 of its louder half: a hammer impact's decaying ring is not chatter). Off the real-time path: push() per sample on the drain thread,
+// (sensor noise alone is not chatter) and it persists across the window (its quietest quarter at
+// least 0.4 of its loudest: a hammer impact's decaying ring is not chatter). Off the real-time path: push() per sample on the drain thread,
 // evaluate() at the status rate; buffers allocated at construction.
 #pragma once
 
@@ -33,8 +33,8 @@ struct ChatterIndicatorSettings {
   double once_per_rev_threshold{0.2};
   double nonharmonic_threshold{0.1};
   double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
-  // Smaller / larger half of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
-  // 0.87 s) gives at most exp(-1 s / 0.87 s) = 0.32.
+  // Quietest / loudest quarter of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
+  // 0.87 s) in a 2 s window gives at most about exp(-1 s / 0.87 s) = 0.32.
   double persistence_threshold{0.4};
 };
 
@@ -45,7 +45,7 @@ struct ChatterIndicator {
   double nonharmonic_rms_mps2{0.0};
   double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
   double rms_mps2{0.0};
-  double persistence{0.0};           // x(t) - x(t - 1 rev): RMS over the quieter half / the louder
+  double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest quarter / the loudest
   bool chatter{false};
 };
 
