@@ -9,8 +9,8 @@
 //     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency.
 // Chatter is indicated when both exceed their thresholds, the non-harmonic vibration exceeds a floor
 // (sensor noise alone is not chatter) and it persists across the window (its quietest quarter at
-// least 0.4 of its loudest: a hammer impact's decaying ring is not chatter). Off the real-time path: push() per sample on the drain thread,
-// evaluate() at the status rate; buffers allocated at construction.
+// least 0.4 of its loudest: a hammer impact's decaying ring is not chatter). Off the real-time path:
+// push() per sample on the drain thread, evaluate() at the status rate; buffers allocated at construction.
 #pragma once
 
 #include <cstdint>
