@@ -180,7 +180,9 @@ TEST(Analysis, NotchSpeedMapRefusesSpeedsThatPushADampedModeOutOfItsWindow) {
   EXPECT_LT(map.refused_rpm[0].second, 400.0);
   for (const auto& p : map.points) {
     EXPECT_TRUE(p.stable) << p.rpm;
-    if (p.refused) EXPECT_NE(p.reason.find("out of its damping window"), std::string::npos) << p.reason;
+    if (p.refused) {
+      EXPECT_NE(p.reason.find("out of its damping window"), std::string::npos) << p.reason;
+    }
   }
   control::ControllerParams params = control::design_chain(cfg).params;
   analysis::apply_refused_speeds(map, params);
