@@ -79,5 +79,6 @@ void register_sle(Registry& r);
 void register_cut(Registry& r);
 void register_identify(Registry& r);
 void register_measure(Registry& r);
+void register_pose(Registry& r);
 
 }  // namespace robodamp::apps

@@ -1,0 +1,216 @@
+// `robodamp pose`: seed 002's pose-dependent robot dynamics (robot/, docs/pose_dynamics.md).
+//   pose frf  --model F (--joints Q1 Q2 Q3 | --pose NAME) [--json] [--plot PNG]: the TCP's modes and FRF at a pose
+//   pose table --model F: the model's first mode at each named pose beside the published values
+//   pose map  --model F --vary J1 J2 [--steps N] [--json F] [--plot PNG]: first-mode frequency and modal
+//             stiffness over a grid of two joints (the others at the first named pose)
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/cli.hpp"
+#include "apps/gnuplot.hpp"
+#include "robot/robot_model.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+using nlohmann::json;
+
+struct PoseArgs {
+  std::string what;
+  std::string model_path{std::string(ROBODAMP_SOURCE_DIR_FOR_CLI) + "/config/robots/seed002.yaml"};
+  std::vector<double> joints_deg;
+  std::string pose_name;
+  bool json_out{false};
+  std::string json_path, plot_path;
+  int modes{4};
+  std::vector<double> band_hz{2.0, 60.0};
+  std::vector<int> vary{2, 3};
+  int steps{21};
+};
+
+std::vector<double> pose_of(const config::RobotModelConfig& m, const PoseArgs& a) {
+  if (!a.pose_name.empty()) {
+    for (const auto& p : m.poses)
+      if (p.name == a.pose_name) return p.joints_deg;
+    std::string known;
+    for (const auto& p : m.poses) known += (known.empty() ? "" : ", ") + p.name;
+    throw config::ConfigError({config::Problem{m.source, {}, "poses", "--pose = '" + a.pose_name + "' is not one of: " + known}});
+  }
+  if (!a.joints_deg.empty()) return a.joints_deg;
+  if (m.poses.empty())
+    throw config::ConfigError({config::Problem{m.source, {}, "poses", "give --joints (the file names no pose)"}});
+  return m.poses.front().joints_deg;
+}
+
+json modes_json(const std::vector<robot::Mode>& modes) {
+  json out = json::array();
+  for (const auto& md : modes)
+    out.push_back({{"freq_hz", md.freq_hz},
+                   {"tcp_modal_stiffness_n_per_m", md.tcp_modal_stiffness_n_per_m},
+                   {"tcp_direction_deg", md.tcp_direction_rad * 180.0 / M_PI}});
+  return out;
+}
+
+int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
+  const std::vector<double> q = pose_of(m, a);
+  const robot::PlanarChain c = robot::at_pose(m, q);
+  const auto modes = c.modes(static_cast<std::size_t>(a.modes));
+  json r = {{"model", m.source}, {"joints_deg", q}, {"tcp_m", {c.tcp_position_m().x(), c.tcp_position_m().y()}},
+            {"modes", modes_json(modes)}};
+  // The FRF on a log grid across the band, direct; RCSA's largest difference from it reported.
+  json frf = json::array();
+  double worst = 0.0;
+  std::ostringstream data;
+  for (double f = a.band_hz[0]; f <= a.band_hz[1] * 1.0001; f *= std::pow(a.band_hz[1] / a.band_hz[0], 1.0 / 399.0)) {
+    const Eigen::Matrix2cd g = c.tcp_frf_direct(f), h = c.tcp_frf_rcsa(f);
+    worst = std::max(worst, (g - h).norm() / g.norm());
+    frf.push_back({{"freq_hz", f},
+                   {"xx", {g(0, 0).real(), g(0, 0).imag()}},
+                   {"xy", {g(0, 1).real(), g(0, 1).imag()}},
+                   {"yy", {g(1, 1).real(), g(1, 1).imag()}}});
+    data << f << ' ' << std::abs(g(0, 0)) << ' ' << std::abs(g(1, 1)) << ' ' << std::abs(g(0, 1)) << '\n';
+  }
+  r["frf_m_per_n"] = frf;
+  r["rcsa_max_relative_difference"] = worst;
+  std::ostringstream t;
+  char b[200];
+  std::snprintf(b, sizeof b, "robot %s at joints", m.name.c_str());
+  t << b;
+  for (double v : q) t << ' ' << v;
+  std::snprintf(b, sizeof b, " deg: TCP at (%.3f, %.3f) m\n", c.tcp_position_m().x(), c.tcp_position_m().y());
+  t << b << "  mode   freq Hz   TCP modal stiffness N/m   TCP direction deg\n";
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    std::snprintf(b, sizeof b, "  %4zu  %8.3f   %22.4g   %17.1f\n", i + 1, modes[i].freq_hz,
+                  modes[i].tcp_modal_stiffness_n_per_m, modes[i].tcp_direction_rad * 180.0 / M_PI);
+    t << b;
+  }
+  std::snprintf(b, sizeof b, "  TCP FRF %g-%g Hz: receptance coupling (RCSA) within %.2g of the assembled model\n",
+                a.band_hz[0], a.band_hz[1], worst);
+  t << b;
+  if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
+  return print_report(r.dump(2), a.json_out, t.str(), a.plot_path, [&] {
+    const std::string s = "set terminal pngcairo size 900,600; set output '" + a.plot_path +
+                          "'; set logscale xy; set grid; set xlabel 'frequency (Hz)'; set ylabel '|receptance| (m/N)';"
+                          " set title 'TCP receptance at the pose'; plot DATA u 1:2 w l lw 2 t 'xx', '' u 1:3 w l lw 2 t 'yy',"
+                          " '' u 1:4 w l t 'xy'";
+    return run_gnuplot(s, data.str(), a.plot_path);
+  }, a.plot_path);
+}
+
+int run_table(const config::RobotModelConfig& m, const PoseArgs& a) {
+  json rows = json::array();
+  std::ostringstream t;
+  t << "robot " << m.name << ": the first mode at each named pose\n  pose        joints deg                    model Hz  "
+       "published predicted Hz  measured Hz\n";
+  for (const auto& p : m.poses) {
+    const robot::PlanarChain c = robot::at_pose(m, p.joints_deg);
+    const auto modes = c.modes(3);
+    char b[240];
+    std::string q;
+    for (double v : p.joints_deg) {
+      if (!q.empty()) q += ' ';
+      q += config::format_number(v);
+    }
+    std::snprintf(b, sizeof b, "  %-10s  %-28s  %8.2f  %22s  %11s\n", p.name.c_str(), q.c_str(), modes[0].freq_hz,
+                  p.predicted_f1_hz ? config::format_number(*p.predicted_f1_hz).c_str() : "-",
+                  p.measured_f1_hz ? config::format_number(*p.measured_f1_hz).c_str() : "-");
+    t << b;
+    rows.push_back({{"name", p.name}, {"joints_deg", p.joints_deg}, {"modes", modes_json(modes)},
+                    {"predicted_f1_hz", p.predicted_f1_hz ? json(*p.predicted_f1_hz) : json(nullptr)},
+                    {"measured_f1_hz", p.measured_f1_hz ? json(*p.measured_f1_hz) : json(nullptr)}});
+  }
+  const json r = {{"model", m.source}, {"poses", rows}};
+  if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
+  return print_report(r.dump(2), a.json_out, t.str(), "", {}, "");
+}
+
+int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
+  const std::size_t n = m.joints.size();
+  if (a.vary.size() != 2 || a.vary[0] == a.vary[1] || a.vary[0] < 1 || a.vary[1] < 1 ||
+      static_cast<std::size_t>(a.vary[0]) > n || static_cast<std::size_t>(a.vary[1]) > n) {
+    std::cerr << "robodamp pose map: --vary takes two different joints, 1.." << n << '\n';
+    return 2;
+  }
+  std::vector<double> base = pose_of(m, a);
+  const auto j1 = static_cast<std::size_t>(a.vary[0] - 1), j2 = static_cast<std::size_t>(a.vary[1] - 1);
+  json grid = json::array();
+  std::ostringstream data;
+  double f_min = INFINITY, f_max = 0.0;
+  for (int i = 0; i < a.steps; ++i) {
+    for (int k = 0; k < a.steps; ++k) {
+      std::vector<double> q = base;
+      const auto& ja = m.joints[j1];
+      const auto& jb = m.joints[j2];
+      q[j1] = ja.min_deg + (ja.max_deg - ja.min_deg) * i / (a.steps - 1);
+      q[j2] = jb.min_deg + (jb.max_deg - jb.min_deg) * k / (a.steps - 1);
+      const robot::PlanarChain c = robot::at_pose(m, q);
+      const auto md = c.modes(1);
+      f_min = std::min(f_min, md[0].freq_hz), f_max = std::max(f_max, md[0].freq_hz);
+      grid.push_back({{"joints_deg", q}, {"f1_hz", md[0].freq_hz}, {"k1_n_per_m", md[0].tcp_modal_stiffness_n_per_m}});
+      data << q[j1] << ' ' << q[j2] << ' ' << md[0].freq_hz << ' ' << md[0].tcp_modal_stiffness_n_per_m << '\n';
+    }
+    data << '\n';
+  }
+  const json r = {{"model", m.source}, {"vary", a.vary}, {"steps", a.steps}, {"grid", grid},
+                  {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
+  std::ostringstream t;
+  char b[200];
+  std::snprintf(b, sizeof b, "robot %s: first mode over joints %d and %d (%d x %d poses): %.2f to %.2f Hz\n",
+                m.name.c_str(), a.vary[0], a.vary[1], a.steps, a.steps, f_min, f_max);
+  t << b;
+  if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
+  return print_report(r.dump(2), a.json_out, t.str(), a.plot_path, [&] {
+    const std::string s = "set terminal pngcairo size 1400,600; set output '" + a.plot_path +
+                          "'; set multiplot layout 1,2; set view map; set xlabel 'joint " + std::to_string(a.vary[0]) +
+                          " (deg)'; set ylabel 'joint " + std::to_string(a.vary[1]) +
+                          " (deg)'; set title 'first mode (Hz)'; splot DATA u 1:2:3 w pm3d notitle;"
+                          " set title 'TCP modal stiffness of the first mode (N/m)'; set logscale cb; set format cb '%.0e';"
+                          " splot DATA u 1:2:4 w pm3d notitle; unset multiplot";
+    return run_gnuplot(s, data.str(), a.plot_path);
+  }, a.plot_path);
+}
+
+int run_pose(const PoseArgs& a) {
+  try {
+    const config::RobotModelConfig m = config::load_robot_model(a.model_path);
+    if (a.what == "frf") return run_frf(m, a);
+    if (a.what == "table") return run_table(m, a);
+    return run_map(m, a);
+  } catch (const config::ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "robodamp pose: " << e.what() << '\n';
+    return 2;
+  }
+}
+
+}  // namespace
+
+void register_pose(Registry& r) {
+  auto a = std::make_shared<PoseArgs>();
+  CLI::App* sub = r.add("pose",
+                        "Pose-dependent robot dynamics (seed 002): `pose frf` (modes and TCP FRF at a pose), `pose table` "
+                        "(the first mode at the model's named poses), `pose map` (first mode over two joints)",
+                        [a] { return run_pose(*a); });
+  sub->add_option("what", a->what, "frf, table or map")->required()->check(CLI::IsMember({"frf", "table", "map"}));
+  sub->add_option("--model", a->model_path, "Robot model file (config/robots/*.yaml)")->check(CLI::ExistingFile);
+  r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map: the pose, one relative angle per joint");
+  sub->add_option("--pose", a->pose_name, "frf, map: a pose the model file names");
+  r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes");
+  r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e4, true, false}, "frf: FRF band LO HI");
+  sub->add_flag("--json", a->json_out, "Print JSON instead of the table");
+  sub->add_option("--json-out", a->json_path, "Also write the JSON to this file");
+  sub->add_option("--plot", a->plot_path, "frf, map: write a PNG");
+  sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
+  r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,106 @@
+#include "config/robot_model_config.hpp"
+
+#include "config/yaml_reader.hpp"
+
+namespace robodamp::config {
+
+using detail::Diagnostics;
+using detail::MapReader;
+using detail::present;
+
+namespace {
+
+RobotLinkConfig read_link(MapReader& r) {
+  RobotLinkConfig c;
+  if (auto v = r.number("length_m", {"m", 0.0, 20.0, true})) c.length_m = *v;
+  if (auto v = r.number("mass_kg", {"kg", 0.0, 1e4, true})) c.mass_kg = *v;
+  if (auto v = r.number("bending_stiffness_nm2", {"N m^2", 0.0, 1e12, true})) c.bending_stiffness_nm2 = *v;
+  if (auto v = r.number("axial_stiffness_n", {"N", 0.0, 1e13, true}, 1e10)) c.axial_stiffness_n = *v;
+  if (auto v = detail::read_int(r, "elements", {"(elements)", 1, 64}, 4)) c.elements = *v;
+  return c;
+}
+
+RobotJointConfig read_joint(MapReader& r) {
+  RobotJointConfig c;
+  if (auto v = r.number("stiffness_nm_per_rad", {"N m/rad", 0.0, 1e10, true})) c.stiffness_nm_per_rad = *v;
+  if (auto v = r.number("damping_ratio", {"", 0.0, 1.0, false, true}, 0.02)) c.damping_ratio = *v;
+  if (auto v = r.number("min_deg", {"deg", -360.0, 360.0}, -180.0)) c.min_deg = *v;
+  if (auto v = r.number("max_deg", {"deg", -360.0, 360.0}, 180.0)) c.max_deg = *v;
+  if (c.min_deg >= c.max_deg)
+    r.diagnostics().add(r.mark(), r.path_of("max_deg"),
+                        "= " + format_number(c.max_deg) + " deg must be above min_deg = " + format_number(c.min_deg) + " deg");
+  return c;
+}
+
+template <typename Item, typename Read>
+std::vector<Item> read_list(Diagnostics& d, MapReader& top, const std::string& key, const char* what, Read read) {
+  const YAML::Node n = top.child(key, true, what);
+  std::vector<Item> out;
+  if (present(n) && (!n.IsSequence() || n.size() == 0)) d.add(n.Mark(), key, "must be a non-empty list");
+  for (std::size_t i = 0; n.IsSequence() && i < n.size(); ++i) {
+    MapReader r(d, n[i], key + "[" + std::to_string(i) + "]", n.Mark());
+    out.push_back(read(r));
+    r.finish();
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<std::string> pose_problem(const RobotModelConfig& m, const std::vector<double>& q) {
+  if (q.size() != m.joints.size())
+    return "a pose needs " + std::to_string(m.joints.size()) + " joint angles (deg), got " + std::to_string(q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const auto& j = m.joints[i];
+    if (auto p = range_problem("joint " + std::to_string(i + 1), q[i], {"deg", j.min_deg, j.max_deg, false, false,
+                                                                       "the joint's travel in " + m.source}))
+      return p;
+  }
+  return std::nullopt;
+}
+
+RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::string& source_name) {
+  Diagnostics d(source_name);
+  const YAML::Node root = detail::load_top_map(d, yaml_text, "name, links, joints, head, poses");
+  RobotModelConfig c;
+  c.source = source_name;
+  MapReader top(d, root, "", root.Mark());
+  c.name = top.text("name", "robot").value_or("robot");
+  c.links = read_list<RobotLinkConfig>(d, top, "links", "the links from the base, each a map", read_link);
+  c.joints = read_list<RobotJointConfig>(d, top, "joints", "one joint per link, from the base", read_joint);
+  if (!c.links.empty() && c.joints.size() != c.links.size())
+    d.add(top.mark(), "joints", "has " + std::to_string(c.joints.size()) + " entries for " +
+                                    std::to_string(c.links.size()) + " links: one joint drives each link");
+  const YAML::Node head = top.child("head", false, "");
+  if (present(head)) {
+    MapReader h(d, head, "head", top.mark());
+    if (auto v = h.number("mass_kg", {"kg", 0.0, 1e4}, 0.0)) c.head_mass_kg = *v;
+    if (auto v = h.number("inertia_kgm2", {"kg m^2", 0.0, 1e4}, 0.0)) c.head_inertia_kgm2 = *v;
+    h.finish();
+  }
+  const YAML::Node poses = top.child("poses", false, "");
+  for (std::size_t i = 0; poses.IsSequence() && i < poses.size(); ++i) {
+    const std::string key = "poses[" + std::to_string(i) + "]";
+    MapReader r(d, poses[i], key, poses.Mark());
+    RobotPoseConfig p;
+    p.name = r.text("name", "pose " + std::to_string(i + 1)).value_or("");
+    p.joints_deg = r.number_list("joints_deg", "deg").value_or(std::vector<double>{});
+    p.measured_f1_hz = r.number("measured_f1_hz", {"Hz", 0.0, 1e4, true}, 0.0);
+    p.predicted_f1_hz = r.number("predicted_f1_hz", {"Hz", 0.0, 1e4, true}, 0.0);
+    if (p.measured_f1_hz == 0.0) p.measured_f1_hz.reset();
+    if (p.predicted_f1_hz == 0.0) p.predicted_f1_hz.reset();
+    r.finish();
+    if (!c.joints.empty())
+      if (auto problem = pose_problem(c, p.joints_deg)) d.add(poses[i].Mark(), key + ".joints_deg", *problem);
+    c.poses.push_back(std::move(p));
+  }
+  top.finish();
+  if (!d.problems().empty()) throw ConfigError(d.problems());
+  return c;
+}
+
+RobotModelConfig load_robot_model(const std::string& path) {
+  return parse_robot_model(detail::read_config_text(path), path);
+}
+
+}  // namespace robodamp::config
