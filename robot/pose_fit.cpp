@@ -1,0 +1,153 @@
+#include "robot/pose_fit.hpp"
+
+#include <cmath>
+
+#include <nlopt.h>
+
+#include <functional>
+
+#include "config/number_range.hpp"
+#include "robot/robot_model.hpp"
+
+namespace robodamp::robot {
+
+namespace {
+
+std::complex<double> pick(const Eigen::Matrix2cd& g, FrfDirection d) {
+  return d == FrfDirection::kXX ? g(0, 0) : d == FrfDirection::kYY ? g(1, 1) : g(0, 1);
+}
+
+struct Band {
+  std::vector<double> f;
+  std::vector<std::complex<double>> h;
+  std::vector<double> w;
+};
+
+config::RobotModelConfig with_joints(config::RobotModelConfig m, const std::vector<double>& x, const PoseFitSettings& s) {
+  const std::size_t n = m.joints.size();
+  for (std::size_t j = 0; j < n; ++j) {
+    m.joints[j].stiffness_nm_per_rad = std::pow(10.0, x[j]);
+    if (s.fit_damping) m.joints[j].damping_ratio = x[n + j];
+  }
+  return m;
+}
+
+// Each pose's weighted relative error, squared.
+std::vector<double> pose_errors(const config::RobotModelConfig& m, const std::vector<MeasuredFrf>& data,
+                                const std::vector<Band>& bands, FrfDirection dir) {
+  std::vector<double> out;
+  for (std::size_t p = 0; p < data.size(); ++p) {
+    const PlanarChain c = at_pose(m, data[p].joints_deg);
+    double num = 0.0, den = 0.0;
+    const Band& b = bands[p];
+    for (std::size_t i = 0; i < b.f.size(); ++i) {
+      num += b.w[i] * std::norm(pick(c.tcp_frf_direct(b.f[i]), dir) - b.h[i]);
+      den += b.w[i] * std::norm(b.h[i]);
+    }
+    out.push_back(num / den);
+  }
+  return out;
+}
+
+struct Objective {
+  const std::function<double(const std::vector<double>&)>* cost;
+  int evaluations{0};
+};
+
+double nlopt_cost(unsigned n, const double* x, double* /*grad*/, void* data) {
+  auto* o = static_cast<Objective*>(data);
+  ++o->evaluations;
+  const double f = (*o->cost)(std::vector<double>(x, x + n));
+  return std::isfinite(f) ? f : 1e300;
+}
+
+// BOBYQA from x within [lo, hi]; x keeps the best point found (the swarm's if BOBYQA fails).
+double polish(const std::function<double(const std::vector<double>&)>& cost, std::vector<double>& x,
+              const std::vector<double>& lo, const std::vector<double>& hi, int max_evaluations, int& evaluations) {
+  const auto n = static_cast<unsigned>(x.size());
+  nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, n);
+  Objective o{&cost};
+  nlopt_set_lower_bounds(opt, lo.data());
+  nlopt_set_upper_bounds(opt, hi.data());
+  nlopt_set_min_objective(opt, nlopt_cost, &o);
+  nlopt_set_xtol_rel(opt, 1e-6);
+  nlopt_set_maxeval(opt, max_evaluations);
+  std::vector<double> y = x;
+  double f = 0.0;
+  const nlopt_result rc = nlopt_optimize(opt, y.data(), &f);
+  nlopt_destroy(opt);
+  evaluations += o.evaluations;
+  const double before = cost(x);
+  if (rc > 0 && f < before) {
+    x = y;
+    return f;
+  }
+  return before;
+}
+
+}  // namespace
+
+PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
+                         const PoseFitSettings& s) {
+  if (data.empty()) throw config::ConfigError({config::Problem{model.source, {}, "", "no measured FRF to fit"}});
+  std::vector<Band> bands;
+  for (const auto& d : data) {
+    if (auto p = config::pose_problem(model, d.joints_deg))
+      throw config::ConfigError({config::Problem{d.name, {}, "pose", *p}});
+    Band b;
+    double peak = 0.0;
+    for (std::size_t i = 0; i < d.freq_hz.size(); ++i)
+      if (d.freq_hz[i] >= s.band_min_hz && d.freq_hz[i] <= s.band_max_hz && std::isfinite(std::abs(d.receptance_m_per_n[i])))
+        b.f.push_back(d.freq_hz[i]), b.h.push_back(d.receptance_m_per_n[i]), peak = std::max(peak, std::abs(d.receptance_m_per_n[i]));
+    if (b.f.size() < 8 || !(peak > 0.0))
+      throw config::ConfigError({config::Problem{d.name, {}, "", "fewer than 8 usable points in the fit band " +
+                                                                     config::format_number(s.band_min_hz) + "-" +
+                                                                     config::format_number(s.band_max_hz) + " Hz"}});
+    for (const auto& h : b.h) b.w.push_back(std::abs(h) / peak);
+    bands.push_back(std::move(b));
+  }
+  const std::size_t n = model.joints.size();
+  std::vector<double> lo(n, std::log10(s.stiffness_min_nm_per_rad)), hi(n, std::log10(s.stiffness_max_nm_per_rad));
+  if (s.fit_damping) lo.insert(lo.end(), n, s.damping_min), hi.insert(hi.end(), n, s.damping_max);
+  const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) {
+    double sum = 0.0;
+    for (double e : pose_errors(with_joints(model, x, s), data, bands, s.direction)) sum += e;
+    return sum / static_cast<double>(data.size());
+  };
+  PoseFitResult r;
+  std::vector<std::vector<double>> ks;
+  PsoResult best;
+  best.best_cost = INFINITY;
+  for (int k = 0; k < std::max(1, s.restarts); ++k) {
+    PsoSettings ps = s.pso;
+    ps.seed = s.pso.seed + static_cast<std::uint64_t>(k);
+    PsoResult one = particle_swarm(cost, lo, hi, ps);
+    r.evaluations += one.evaluations;
+    if (s.polish) one.best_cost = polish(cost, one.best, lo, hi, s.polish_evaluations, r.evaluations);
+    r.restart_costs.push_back(one.best_cost);
+    std::vector<double> kk;
+    for (std::size_t j = 0; j < n; ++j) kk.push_back(std::pow(10.0, one.best[j]));
+    ks.push_back(kk);
+    if (one.best_cost < best.best_cost) best = std::move(one);
+  }
+  r.fitted = with_joints(model, best.best, s);
+  // The spread over the restarts that found the best basin (cost within 10 % of the best); the others are
+  // counted, not averaged in.
+  std::vector<const std::vector<double>*> converged;
+  for (std::size_t k = 0; k < ks.size(); ++k)
+    if (r.restart_costs[k] <= 1.1 * best.best_cost) converged.push_back(&ks[k]);
+  r.converged_restarts = static_cast<int>(converged.size());
+  for (std::size_t j = 0; j < n; ++j) {
+    r.stiffness_nm_per_rad.push_back(r.fitted.joints[j].stiffness_nm_per_rad);
+    r.damping_ratio.push_back(r.fitted.joints[j].damping_ratio);
+    double mean = 0.0, var = 0.0;
+    for (const auto* kk : converged) mean += (*kk)[j];
+    mean /= static_cast<double>(converged.size());
+    for (const auto* kk : converged) var += ((*kk)[j] - mean) * ((*kk)[j] - mean);
+    r.stiffness_spread_pct.push_back(100.0 * std::sqrt(var / static_cast<double>(converged.size())) / mean);
+  }
+  for (double e : pose_errors(r.fitted, data, bands, s.direction)) r.pose_error.push_back(std::sqrt(e));
+  return r;
+}
+
+}  // namespace robodamp::robot

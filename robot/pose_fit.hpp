@@ -1,0 +1,54 @@
+// Fitting a robot model's joints to measured TCP FRFs at one or more poses by particle swarm (seed 002,
+// docs/pose_dynamics.md): the joint stiffnesses (log-scaled within their bounds) and, optionally, the
+// joints' damping ratios; the objective is each pose's complex FRF error over the fit band weighted by the
+// measured magnitude (so the resonances dominate, as seed 002 weights near the peaks), averaged over the
+// poses. Each restart's swarm optimum is polished by a local derivative-free search (NLopt's BOBYQA, within
+// the same bounds): the swarm finds the basin, BOBYQA its bottom. Restarts with other seeds give the
+// parameters' spread. Off the real-time path.
+#pragma once
+
+#include <complex>
+#include <string>
+#include <vector>
+
+#include "config/robot_model_config.hpp"
+#include "robot/pso.hpp"
+
+namespace robodamp::robot {
+
+enum class FrfDirection { kXX, kYY, kXY };
+
+struct MeasuredFrf {
+  std::string name;
+  std::vector<double> joints_deg;
+  std::vector<double> freq_hz;
+  std::vector<std::complex<double>> receptance_m_per_n;
+};
+
+struct PoseFitSettings {
+  FrfDirection direction{FrfDirection::kYY};
+  double band_min_hz{10.0}, band_max_hz{30.0};   // seed 002 fits 10-30 Hz
+  double stiffness_min_nm_per_rad{1e3}, stiffness_max_nm_per_rad{1e7};  // seed 002's bounds (Eq. 21)
+  bool fit_damping{true};
+  double damping_min{0.002}, damping_max{0.1};
+  int restarts{3};
+  PsoSettings pso{};
+  bool polish{true};          // each restart's swarm result refined by NLopt's BOBYQA within the bounds
+  int polish_evaluations{3000};
+};
+
+struct PoseFitResult {
+  config::RobotModelConfig fitted;            // the model with the best restart's joints
+  std::vector<double> stiffness_nm_per_rad, damping_ratio;
+  std::vector<double> stiffness_spread_pct;   // standard deviation / mean over the converged restarts
+  int converged_restarts{0};                  // restarts ending within 10 % of the best cost
+  std::vector<double> pose_error;             // the best fit's weighted relative RMS error per pose
+  std::vector<double> restart_costs;
+  int evaluations{0};
+};
+
+// Throws config::ConfigError for a pose outside the joints' travel or a measurement without points in the band.
+[[nodiscard]] PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
+                                       const PoseFitSettings& s);
+
+}  // namespace robodamp::robot
