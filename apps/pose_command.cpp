@@ -1,6 +1,8 @@
 // `robodamp pose`: seed 002's pose-dependent robot dynamics (robot/, docs/pose_dynamics.md).
 //   pose frf  --model F (--joints Q1 Q2 Q3 | --pose NAME) [--json] [--plot PNG]: the TCP's modes and FRF at a pose
 //   pose table --model F: the model's first mode at each named pose beside the published values
+//   pose fit  --model F --measured Q1,Q2,Q3:FRF.csv ... [--direction yy] [--out fitted.yaml]: the joints'
+//             stiffness and damping from measured TCP FRFs at poses (particle swarm, then BOBYQA)
 //   pose map  --model F --vary J1 J2 [--steps N] [--json F] [--plot PNG]: first-mode frequency and modal
 //             stiffness over a grid of two joints (the others at the first named pose)
 #include <cmath>
@@ -14,6 +16,8 @@
 
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "identify/modal_fit.hpp"
+#include "robot/pose_fit.hpp"
 #include "robot/robot_model.hpp"
 
 namespace robodamp::apps {
@@ -33,7 +37,82 @@ struct PoseArgs {
   std::vector<double> band_hz{2.0, 60.0};
   std::vector<int> vary{2, 3};
   int steps{21};
+  std::vector<std::string> measured;  // "Q1,Q2,Q3:path"
+  std::string direction{"yy"};
+  std::vector<double> fit_band_hz{10.0, 30.0};
+  int restarts{3}, particles{40}, iterations{150}, seed{1};
+  std::string out_path;
+  std::string csv_path;
+  double csv_step_hz{0.1};
 };
+
+// "Q1,Q2,Q3:path" -> the pose and the FRF (a freq_hz,re_m_per_n,im_m_per_n[,coherence] receptance CSV).
+robot::MeasuredFrf measured_frf(const std::string& item) {
+  const auto colon = item.find(':');
+  if (colon == std::string::npos)
+    throw std::invalid_argument("--measured = '" + item + "': expected Q1,Q2,...:FRF.csv (joint angles in deg)");
+  robot::MeasuredFrf m;
+  std::stringstream qs(item.substr(0, colon));
+  for (std::string tok; std::getline(qs, tok, ',');) {
+    double v = 0.0;
+    if (auto p = parse_number("--measured", tok, {"deg", -360.0, 360.0}, false, v))
+      throw std::invalid_argument(*p + " (in '" + item + "')");
+    m.joints_deg.push_back(v);
+  }
+  m.name = item.substr(colon + 1);
+  const identify::FrfData d = identify::read_frf_csv(m.name, identify::FrfKind::kReceptance);
+  m.freq_hz = d.f_hz;
+  m.receptance_m_per_n = d.h;
+  return m;
+}
+
+int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
+  if (a.measured.empty()) {
+    std::cerr << "robodamp pose fit: give at least one --measured Q1,Q2,...:FRF.csv\n";
+    return 2;
+  }
+  std::vector<robot::MeasuredFrf> data;
+  for (const auto& item : a.measured) data.push_back(measured_frf(item));
+  robot::PoseFitSettings s;
+  s.direction = a.direction == "xx" ? robot::FrfDirection::kXX : a.direction == "xy" ? robot::FrfDirection::kXY : robot::FrfDirection::kYY;
+  s.band_min_hz = a.fit_band_hz[0], s.band_max_hz = a.fit_band_hz[1];
+  s.restarts = a.restarts;
+  s.pso.particles = a.particles, s.pso.iterations = a.iterations, s.pso.seed = static_cast<std::uint64_t>(a.seed);
+  const robot::PoseFitResult r = robot::fit_joints(m, data, s);
+  std::ostringstream t;
+  char b[240];
+  std::snprintf(b, sizeof b, "robot %s fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
+                m.name.c_str(), data.size(), a.direction.c_str(), s.band_min_hz, s.band_max_hz, r.evaluations,
+                r.converged_restarts, s.restarts);
+  t << b << "  joint   stiffness N m/rad   spread %   damping ratio\n";
+  json joints = json::array();
+  for (std::size_t j = 0; j < r.stiffness_nm_per_rad.size(); ++j) {
+    std::snprintf(b, sizeof b, "  %5zu   %17.5g   %8.3f   %13.4f\n", j + 1, r.stiffness_nm_per_rad[j], r.stiffness_spread_pct[j],
+                  r.damping_ratio[j]);
+    t << b;
+    joints.push_back({{"stiffness_nm_per_rad", r.stiffness_nm_per_rad[j]}, {"spread_pct", r.stiffness_spread_pct[j]},
+                      {"damping_ratio", r.damping_ratio[j]}});
+  }
+  json poses = json::array();
+  for (std::size_t p = 0; p < data.size(); ++p) {
+    std::snprintf(b, sizeof b, "  %s: weighted relative error %.2f %%\n", data[p].name.c_str(), 100.0 * r.pose_error[p]);
+    t << b;
+    poses.push_back({{"frf", data[p].name}, {"joints_deg", data[p].joints_deg}, {"error_pct", 100.0 * r.pose_error[p]}});
+  }
+  const json out = {{"model", m.source}, {"joints", joints}, {"poses", poses}, {"restart_costs", r.restart_costs},
+                    {"evaluations", r.evaluations}, {"converged_restarts", r.converged_restarts}};
+  if (!a.out_path.empty()) {
+    std::ofstream f(a.out_path);
+    f << config::robot_model_yaml(r.fitted);
+    if (!f) {
+      std::cerr << "--out " << a.out_path << ": cannot write\n";
+      return 1;
+    }
+    t << "  wrote the fitted model to " << a.out_path << '\n';
+  }
+  if (!a.json_path.empty()) std::ofstream(a.json_path) << out.dump(2) << '\n';
+  return print_report(out.dump(2), a.json_out, t.str(), "", {}, "");
+}
 
 std::vector<double> pose_of(const config::RobotModelConfig& m, const PoseArgs& a) {
   if (!a.pose_name.empty()) {
@@ -78,6 +157,20 @@ int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
     data << f << ' ' << std::abs(g(0, 0)) << ' ' << std::abs(g(1, 1)) << ' ' << std::abs(g(0, 1)) << '\n';
   }
   r["frf_m_per_n"] = frf;
+  if (!a.csv_path.empty()) {  // the identification tools' format, one direction
+    std::ofstream csv(a.csv_path);
+    csv << "freq_hz,re_m_per_n,im_m_per_n\n";
+    csv.precision(12);
+    const int row = a.direction == "xx" ? 0 : 1, col = a.direction == "yy" ? 1 : 0;
+    for (double f = a.band_hz[0]; f <= a.band_hz[1] * 1.0001; f += a.csv_step_hz) {
+      const std::complex<double> h = c.tcp_frf_direct(f)(row, col);
+      csv << f << ',' << h.real() << ',' << h.imag() << '\n';
+    }
+    if (!csv) {
+      std::cerr << "--csv " << a.csv_path << ": cannot write\n";
+      return 1;
+    }
+  }
   r["rcsa_max_relative_difference"] = worst;
   std::ostringstream t;
   char b[200];
@@ -182,6 +275,7 @@ int run_pose(const PoseArgs& a) {
     const config::RobotModelConfig m = config::load_robot_model(a.model_path);
     if (a.what == "frf") return run_frf(m, a);
     if (a.what == "table") return run_table(m, a);
+    if (a.what == "fit") return run_fit(m, a);
     return run_map(m, a);
   } catch (const config::ConfigError& e) {
     std::cerr << e.what() << '\n';
@@ -197,10 +291,10 @@ int run_pose(const PoseArgs& a) {
 void register_pose(Registry& r) {
   auto a = std::make_shared<PoseArgs>();
   CLI::App* sub = r.add("pose",
-                        "Pose-dependent robot dynamics (seed 002): `pose frf` (modes and TCP FRF at a pose), `pose table` "
+                        "Pose-dependent robot dynamics (seed 002): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose table` "
                         "(the first mode at the model's named poses), `pose map` (first mode over two joints)",
                         [a] { return run_pose(*a); });
-  sub->add_option("what", a->what, "frf, table or map")->required()->check(CLI::IsMember({"frf", "table", "map"}));
+  sub->add_option("what", a->what, "frf, table, fit or map")->required()->check(CLI::IsMember({"frf", "table", "fit", "map"}));
   sub->add_option("--model", a->model_path, "Robot model file (config/robots/*.yaml)")->check(CLI::ExistingFile);
   r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map: the pose, one relative angle per joint");
   sub->add_option("--pose", a->pose_name, "frf, map: a pose the model file names");
@@ -211,6 +305,16 @@ void register_pose(Registry& r) {
   sub->add_option("--plot", a->plot_path, "frf, map: write a PNG");
   sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
+  sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
+  sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
+  r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (seed 002: 10 30)");
+  r.whole_number(sub, "--restarts", a->restarts, {"(restarts)", 1, 100}, "fit: swarms with seeds seed, seed+1, ...");
+  r.whole_number(sub, "--particles", a->particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
+  r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
+  r.whole_number(sub, "--seed", a->seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
+  sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here");
+  sub->add_option("--csv", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz");
+  r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv frequency step");
 }
 
 }  // namespace robodamp::apps

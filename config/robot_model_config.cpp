@@ -104,3 +104,31 @@ RobotModelConfig load_robot_model(const std::string& path) {
 }
 
 }  // namespace robodamp::config
+
+namespace robodamp::config {
+
+std::string robot_model_yaml(const RobotModelConfig& m) {
+  std::string s = "# robodamp robot model (docs/pose_dynamics.md)\nname: " + m.name + "\nlinks:\n";
+  auto n = [](double v) { return format_number(v); };
+  for (const auto& l : m.links)
+    s += "  - {length_m: " + n(l.length_m) + ", mass_kg: " + n(l.mass_kg) + ", bending_stiffness_nm2: " +
+         n(l.bending_stiffness_nm2) + ", axial_stiffness_n: " + n(l.axial_stiffness_n) +
+         ", elements: " + std::to_string(l.elements) + "}\n";
+  s += "joints:\n";
+  for (const auto& j : m.joints)
+    s += "  - {stiffness_nm_per_rad: " + n(j.stiffness_nm_per_rad) + ", damping_ratio: " + n(j.damping_ratio) +
+         ", min_deg: " + n(j.min_deg) + ", max_deg: " + n(j.max_deg) + "}\n";
+  s += "head: {mass_kg: " + n(m.head_mass_kg) + ", inertia_kgm2: " + n(m.head_inertia_kgm2) + "}\n";
+  if (!m.poses.empty()) s += "poses:\n";
+  for (const auto& p : m.poses) {
+    s += "  - {name: " + p.name + ", joints_deg: [";
+    for (std::size_t i = 0; i < p.joints_deg.size(); ++i) s += (i ? ", " : "") + n(p.joints_deg[i]);
+    s += "]";
+    if (p.measured_f1_hz) s += ", measured_f1_hz: " + n(*p.measured_f1_hz);
+    if (p.predicted_f1_hz) s += ", predicted_f1_hz: " + n(*p.predicted_f1_hz);
+    s += "}\n";
+  }
+  return s;
+}
+
+}  // namespace robodamp::config

@@ -48,3 +48,8 @@ struct RobotModelConfig {
 [[nodiscard]] std::optional<std::string> pose_problem(const RobotModelConfig& m, const std::vector<double>& joints_deg);
 
 }  // namespace robodamp::config
+
+namespace robodamp::config {
+// The model as a robot model file (what parse_robot_model reads back).
+[[nodiscard]] std::string robot_model_yaml(const RobotModelConfig& m);
+}  // namespace robodamp::config

@@ -99,6 +99,15 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
     for (std::size_t i = 0; i < d.freq_hz.size(); ++i)
       if (d.freq_hz[i] >= s.band_min_hz && d.freq_hz[i] <= s.band_max_hz && std::isfinite(std::abs(d.receptance_m_per_n[i])))
         b.f.push_back(d.freq_hz[i]), b.h.push_back(d.receptance_m_per_n[i]), peak = std::max(peak, std::abs(d.receptance_m_per_n[i]));
+    if (static_cast<int>(b.f.size()) > s.max_points_per_pose) {  // thinned evenly: each point costs a solve
+      Band t;
+      const double step = static_cast<double>(b.f.size() - 1) / (s.max_points_per_pose - 1);
+      for (int i = 0; i < s.max_points_per_pose; ++i) {
+        const auto k = static_cast<std::size_t>(std::lround(i * step));
+        t.f.push_back(b.f[k]), t.h.push_back(b.h[k]);
+      }
+      b = std::move(t);
+    }
     if (b.f.size() < 8 || !(peak > 0.0))
       throw config::ConfigError({config::Problem{d.name, {}, "", "fewer than 8 usable points in the fit band " +
                                                                      config::format_number(s.band_min_hz) + "-" +
@@ -109,9 +118,12 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
   const std::size_t n = model.joints.size();
   std::vector<double> lo(n, std::log10(s.stiffness_min_nm_per_rad)), hi(n, std::log10(s.stiffness_max_nm_per_rad));
   if (s.fit_damping) lo.insert(lo.end(), n, s.damping_min), hi.insert(hi.end(), n, s.damping_max);
+  config::RobotModelConfig coarse = model;
+  if (s.search_elements > 0)
+    for (auto& l : coarse.links) l.elements = std::min(l.elements, s.search_elements);
   const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) {
     double sum = 0.0;
-    for (double e : pose_errors(with_joints(model, x, s), data, bands, s.direction)) sum += e;
+    for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s.direction)) sum += e;
     return sum / static_cast<double>(data.size());
   };
   PoseFitResult r;
@@ -131,11 +143,11 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
     if (one.best_cost < best.best_cost) best = std::move(one);
   }
   r.fitted = with_joints(model, best.best, s);
-  // The spread over the restarts that found the best basin (cost within 10 % of the best); the others are
-  // counted, not averaged in.
+  // The spread over the restarts that found the best basin (weighted relative error within 0.5 percentage
+  // points of the best); the others are counted, not averaged in.
   std::vector<const std::vector<double>*> converged;
   for (std::size_t k = 0; k < ks.size(); ++k)
-    if (r.restart_costs[k] <= 1.1 * best.best_cost) converged.push_back(&ks[k]);
+    if (std::sqrt(r.restart_costs[k]) <= std::sqrt(best.best_cost) + 0.005) converged.push_back(&ks[k]);
   r.converged_restarts = static_cast<int>(converged.size());
   for (std::size_t j = 0; j < n; ++j) {
     r.stiffness_nm_per_rad.push_back(r.fitted.joints[j].stiffness_nm_per_rad);
