@@ -1,6 +1,8 @@
 // The robodamp executable as an engineer runs it: filters (table, JSON, plot) and check-config.
 #include <gtest/gtest.h>
 
+#include "config/robot_model_config.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -289,6 +291,35 @@ TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
 
 // Issue 16: cutting coefficients from a CSV of mean forces, the material block a milling job accepts, and
 // the refusals (nearly equal feeds with the condition number, a bad row with its line).
+// robodamp pose on seed 002's preset: the table beside the published frequencies, a pose outside a joint's
+// travel refused by name, FRFs written at the three poses and fitted back into a model file that reads.
+TEST(Cli, PoseTableFrfAndFitOnSeed002) {
+  const Result table = run("pose table");
+  ASSERT_EQ(table.status, 0) << table.out;
+  EXPECT_NE(table.out.find("pose 1      -120.13 133.37 -14.13            11.80                      16         15.5"),
+            std::string::npos) << table.out;
+  const Result far = run("pose frf --joints -100 200 -20");
+  EXPECT_EQ(far.status, 2);
+  EXPECT_NE(far.out.find("joint 2 = 200 deg is out of range: allowed 0 <= value <= 170 deg"), std::string::npos) << far.out;
+  const std::string dir = ::testing::TempDir() + "robodamp_pose_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  std::string measured;
+  const char* poses[3][2] = {{"pose 1", "-120.13,133.37,-14.13"}, {"pose 2", "-100.59,119.81,-19.55"}, {"pose 3", "-84.75,104.63,-20.08"}};
+  for (int i = 0; i < 3; ++i) {
+    const std::string csv = dir + "/p" + std::to_string(i + 1) + ".csv";
+    const Result frf = run("pose frf --pose '" + std::string(poses[i][0]) + "' --band-hz 5 40 --csv " + csv);
+    ASSERT_EQ(frf.status, 0) << frf.out;
+    EXPECT_NE(frf.out.find("receptance coupling (RCSA) within"), std::string::npos) << frf.out;
+    measured += std::string(" --measured=") + poses[i][1] + ":" + csv;
+  }
+  const Result fit = run("pose fit" + measured + " --restarts 1 --particles 20 --iterations 30 --out " + dir + "/fitted.yaml");
+  ASSERT_EQ(fit.status, 0) << fit.out;
+  EXPECT_NE(fit.out.find("weighted relative error"), std::string::npos) << fit.out;
+  const auto fitted = robodamp::config::load_robot_model(dir + "/fitted.yaml");
+  EXPECT_EQ(fitted.joints.size(), 3U);
+  EXPECT_EQ(fitted.poses.size(), 3U);
+}
+
 TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData) {
   const robodamp::identify::CuttingTest t{3, 12.7, 2.0, 3.175, robodamp::config::MillingMode::kDown};
   auto write_csv = [&](const std::string& path, const std::vector<double>& feeds) {
