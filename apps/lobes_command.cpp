@@ -12,7 +12,8 @@ namespace {
 
 // 0 done, 1 plot failed, 2 configuration or option error.
 int run_lobes(const MillingOptions& o) {
-  const config::MillingConfig cfg = config::load_milling_config(o.config_path);
+  config::MillingConfig cfg = config::load_milling_config(o.config_path);
+  apply_pose(cfg, o);
   // The direct test is defined where the job computes its lobes.
   const config::Range speeds{"rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false,
                              "the job's lobes.rpm_min .. lobes.rpm_max"};
@@ -36,6 +37,7 @@ void register_lobes(Registry& r) {
       ->check(CLI::IsMember({"zoa", "sdm"}));
   r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 1e6, true, false, "and within the job's lobes speed range"},
             "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
+  r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
 }
 
 }  // namespace robodamp::apps

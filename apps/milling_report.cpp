@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/gnuplot.hpp"
+#include "config/robot_model_config.hpp"
 #include "config/milling_config.hpp"
 #include "milling/lobes.hpp"
 #include "milling/sdm.hpp"
@@ -383,6 +384,23 @@ void add_milling_options(CLI::App* sub, MillingOptions& o) {
   sub->add_flag("--damped", o.damped, "Also with the damping controller's loop closed, overlaid");
   sub->add_option("--controller", o.controller_path, "Damping configuration to use instead of the job's (compare compensators)")
       ->check(CLI::ExistingFile);
+}
+
+void apply_pose(config::MillingConfig& cfg, const MillingOptions& o) {
+  if (o.pose_deg.empty()) return;
+  bool any = false;
+  for (auto& st : cfg.structures)
+    for (auto& part : st.parts) {
+      if (!part.pose) continue;
+      any = true;
+      const config::RobotModelConfig m = config::load_robot_model(part.pose->model_path);
+      if (auto p = config::pose_problem(m, o.pose_deg))
+        throw config::ConfigError({config::Problem{cfg.source, {}, "--pose", *p}});
+      part.pose->joints_deg = o.pose_deg;
+    }
+  if (!any)
+    throw config::ConfigError({config::Problem{cfg.source, {}, "--pose",
+                                               "the job has no robot pose part (a part with pose: {model, joints_deg})"}});
 }
 
 }  // namespace robodamp::apps

@@ -21,7 +21,12 @@ struct MillingOptions {
   std::vector<double> rpm;        // lobes: extra speeds for the direct test
   std::string controller_path;    // replaces every controller part's damping configuration
   std::string method{"zoa"};      // lobes: zoa (zero-order) or sdm (semi-discretization)
+  std::vector<double> pose_deg;   // replaces the joints of every robot pose part (docs/pose_dynamics.md)
 };
+
+// --pose into the job: every pose part takes the joints, checked against its model's travel. Throws
+// config::ConfigError when the job has no pose part or the pose does not fit.
+void apply_pose(config::MillingConfig& cfg, const MillingOptions& o);
 
 void add_milling_options(CLI::App* sub, MillingOptions& o);
 

@@ -10,10 +10,12 @@ namespace robodamp::apps {
 void register_sle(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
   CLI::App* sub = r.add("sle", "Surface location error over speed and at the test conditions, with compensation", [o] {
-    const config::MillingConfig cfg = config::load_milling_config(o->config_path);
+    config::MillingConfig cfg = config::load_milling_config(o->config_path);
+    apply_pose(cfg, *o);
     return print_sle(sle_report(cfg, *o), *o);
   });
   add_milling_options(sub, *o);
+  r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
 }
 
 }  // namespace robodamp::apps

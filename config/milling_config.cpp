@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "config/robot_model_config.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace robodamp::config {
@@ -124,6 +125,31 @@ std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const st
   return c;
 }
 
+// pose: {model: FILE, joints_deg: [...]}: the model read and the pose checked against its joints' travel.
+std::optional<PosePartConfig> read_pose_part(MapReader& pr, const std::string& base_dir) {
+  Diagnostics& d = pr.diagnostics();
+  const YAML::Node n = pr.child("pose", false, "");
+  if (!present(n)) return std::nullopt;
+  MapReader r(d, n, pr.path_of("pose"), pr.mark());
+  PosePartConfig c;
+  if (auto v = r.text("model", std::nullopt)) {
+    const std::filesystem::path p = std::filesystem::path(*v).is_absolute() ? std::filesystem::path(*v)
+                                                                           : std::filesystem::path(base_dir) / *v;
+    c.model_path = p.lexically_normal().string();
+  }
+  c.joints_deg = r.number_list("joints_deg", "deg").value_or(std::vector<double>{});
+  r.finish();
+  if (!c.model_path.empty()) {
+    try {
+      const RobotModelConfig m = load_robot_model(c.model_path);
+      if (auto problem = pose_problem(m, c.joints_deg)) d.add(n.Mark(), r.path_of("joints_deg"), *problem);
+    } catch (const ConfigError& e) {
+      d.add(n.Mark(), r.path_of("model"), std::string("= '") + c.model_path + "': " + e.what());
+    }
+  }
+  return c;
+}
+
 StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std::string& key,
                                const std::string& base_dir) {
   MapReader r(d, node, key, node.Mark());
@@ -138,7 +164,8 @@ StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std
     StructurePartConfig p;
     p.name = pr.text("name", "part " + std::to_string(i + 1)).value_or("");
     p.controller = read_controller_part(pr, base_dir);
-    bool any = p.controller.has_value();
+    p.pose = read_pose_part(pr, base_dir);
+    bool any = p.controller.has_value() || p.pose.has_value();
     for (std::size_t k = 0; k < kPairs.size(); ++k) {
       const YAML::Node modes = pr.child(kPairs[k], false, "");
       if (!present(modes)) continue;
@@ -152,7 +179,7 @@ StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std
         p.modes[k].push_back(read_mode(mr, kModeFrequency));
       }
     }
-    if (!any) d.add(parts[i].Mark(), pk, "has no FRF: give modes under xx, xy, yx, yy, or a controller location");
+    if (!any) d.add(parts[i].Mark(), pk, "has no FRF: give modes under xx, xy, yx, yy, a controller location or a robot pose");
     pr.finish();
     s.parts.push_back(std::move(p));
   }

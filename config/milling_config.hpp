@@ -60,12 +60,19 @@ struct ControllerPartConfig {
   Axis direction{Axis::kY};
 };
 
+// The robot's TCP receptance from a robot model at a pose (docs/pose_dynamics.md), in the machine frame.
+struct PosePartConfig {
+  std::string model_path;        // resolved against the milling file's directory
+  std::vector<double> joints_deg;
+};
+
 // One contribution to the tool-workpiece relative FRF: modal terms per direction pair (stiffness or
-// residue form), or a location of a damping configuration.
+// residue form), a location of a damping configuration, or a robot model at a pose.
 struct StructurePartConfig {
   std::string name;
   std::array<std::vector<ModeConfig>, 4> modes;  // xx, xy, yx, yy
   std::optional<ControllerPartConfig> controller;
+  std::optional<PosePartConfig> pose;
 };
 
 // The relative FRF is the sum of its parts (robot + workpiece).

@@ -1,6 +1,8 @@
 #include "modal/receptance.hpp"
 #include "milling/structure.hpp"
 
+#include "robot/robot_model.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -25,6 +27,7 @@ Structure::Structure(const config::StructureConfig& cfg, bool damped) : name_(cf
   for (const auto& part : cfg.parts) {
     for (std::size_t k = 0; k < 4; ++k)
       modal_[k].modes.insert(modal_[k].modes.end(), part.modes[k].begin(), part.modes[k].end());
+    if (part.pose) add_pose(part.name, *part.pose);
     if (!part.controller) continue;
     const auto& pc = *part.controller;
     auto model = std::make_shared<const analysis::LoopModel>(config::load_config_file(pc.config_path));
@@ -40,11 +43,26 @@ Structure::Structure(const config::StructureConfig& cfg, bool damped, const Live
   for (const auto& part : cfg.parts) {
     for (std::size_t k = 0; k < 4; ++k)
       modal_[k].modes.insert(modal_[k].modes.end(), part.modes[k].begin(), part.modes[k].end());
+    if (part.pose) add_pose(part.name, *part.pose);
     if (part.controller)
       add_controller(part.name, live.model->config().source, *part.controller, live.model, live.gain_ns_per_m,
                      live.polarity);
   }
   for (const auto& f : modal_) add_resonances(resonances_, f);
+}
+
+void Structure::add_pose(const std::string& part, const config::PosePartConfig& pc) {
+  const config::RobotModelConfig m = config::load_robot_model(pc.model_path);
+  auto chain = std::make_shared<const robot::PlanarChain>(robot::at_pose(m, pc.joints_deg));
+  double zeta = 1.0;
+  for (const auto& j : m.joints) zeta = std::min(zeta, std::max(j.damping_ratio, 1e-3));
+  for (const auto& md : chain->modes(6)) resonances_.push_back({md.freq_hz, zeta});  // where the grids refine
+  std::ostringstream os;
+  os << part << ": " << m.name << " (" << pc.model_path << ") at joints";
+  for (double q : pc.joints_deg) os << ' ' << q;
+  os << " deg";
+  notes_.push_back(os.str());
+  poses_.push_back(std::move(chain));
 }
 
 void Structure::add_controller(const std::string& part, const std::string& source,
@@ -97,6 +115,7 @@ Eigen::Matrix2cd Structure::frf(double f_hz) const {
   for (std::size_t k = 0; k < 4; ++k)
     g(static_cast<Eigen::Index>(k / 2), static_cast<Eigen::Index>(k % 2)) =
         modal_[k].modes.empty() ? Complex(0.0) : modal::frf_receptance(modal_[k], f_hz);
+  for (const auto& p : poses_) g += p->tcp_frf_direct(f_hz);
   for (const auto& c : controllers_) {
     const auto d = static_cast<Eigen::Index>(c.direction);
     g(d, d) += damped_ ? c.model->closed_sampled(c.location, c.location, f_hz, c.gain_ns_per_m, c.polarity)

@@ -11,6 +11,7 @@
 
 #include "analysis/loop_model.hpp"
 #include "config/milling_config.hpp"
+#include "robot/planar_chain.hpp"
 
 namespace robodamp::milling {
 
@@ -57,6 +58,8 @@ class Structure {
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] bool damped() const { return damped_; }
   [[nodiscard]] bool has_controller() const;
+  // Parts given as a robot model at a pose (frequency domain only: the time-domain cut needs modal terms).
+  [[nodiscard]] bool has_pose_part() const { return !poses_.empty(); }
   // The modal tables summed per direction pair [xx, xy, yx, yy], machine frame, as given.
   [[nodiscard]] const std::array<config::FrfConfig, 4>& modal_terms() const { return modal_; }
   // Each controller part's open-loop robot FRF at its location (physical frame) and its direction
@@ -79,9 +82,11 @@ class Structure {
   bool damped_{false};
   std::array<config::FrfConfig, 4> modal_;  // xx, xy, yx, yy, all parts' modes together
   std::vector<ControllerPart> controllers_;
+  std::vector<std::shared_ptr<const robot::PlanarChain>> poses_;  // TCP receptance, machine frame
   std::vector<Resonance> resonances_;
   std::vector<std::string> notes_;
 
+  void add_pose(const std::string& part, const config::PosePartConfig& pc);
   void add_controller(const std::string& part, const std::string& source, const config::ControllerPartConfig& pc,
                       std::shared_ptr<const analysis::LoopModel> model, double gain_ns_per_m, int polarity);
 };

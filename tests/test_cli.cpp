@@ -315,6 +315,18 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   const Result fit = run("pose fit" + measured + " --restarts 1 --particles 20 --iterations 30 --out " + dir + "/fitted.yaml");
   ASSERT_EQ(fit.status, 0) << fit.out;
   EXPECT_NE(fit.out.find("weighted relative error"), std::string::npos) << fit.out;
+  // Lobes at a pose: the job's pose part takes --pose; a pose out of the travel, or --pose on a job without
+  // a pose part, is refused by name.
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml";
+  const Result at3 = run("lobes --config " + job + " --pose -84.75 104.63 -20.08");
+  ASSERT_EQ(at3.status, 0) << at3.out;
+  EXPECT_NE(at3.out.find("at joints -84.75 104.63 -20.08 deg"), std::string::npos) << at3.out;
+  const Result out_of_travel = run("lobes --config " + job + " --pose -84.75 204.63 -20.08");
+  EXPECT_EQ(out_of_travel.status, 2);
+  EXPECT_NE(out_of_travel.out.find("--pose: joint 2 = 204.63 deg is out of range"), std::string::npos) << out_of_travel.out;
+  const Result no_pose = run("lobes --pose -84.75 104.63 -20.08");
+  EXPECT_EQ(no_pose.status, 2);
+  EXPECT_NE(no_pose.out.find("the job has no robot pose part"), std::string::npos) << no_pose.out;
   const auto fitted = robodamp::config::load_robot_model(dir + "/fitted.yaml");
   EXPECT_EQ(fitted.joints.size(), 3U);
   EXPECT_EQ(fitted.poses.size(), 3U);

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 
 #include <random>
@@ -14,6 +16,13 @@
 
 namespace robodamp {
 namespace {
+
+std::string test_read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -157,6 +166,60 @@ TEST(PoseFit, ModelFilesAndPosesAreValidatedByName) {
     EXPECT_NE(w.find("links[0].length_m = -1 m is out of range"), std::string::npos) << w;
     EXPECT_NE(w.find("joints[0].stiffness_nm_per_rad = 0 N m/rad is out of range"), std::string::npos) << w;
     EXPECT_NE(w.find("2 entries for 1 links"), std::string::npos) << w;
+  }
+}
+
+}  // namespace
+}  // namespace robodamp
+
+#include "milling/cut_job.hpp"
+#include "milling/lobes.hpp"
+#include "milling/structure.hpp"
+
+namespace robodamp {
+namespace {
+
+// A milling job whose structure is the robot model at a pose (config/milling/seed002_pose2.yaml): the
+// structure's FRF is the model's TCP receptance, the lobes and the direct test agree, another pose moves the
+// low modes' lobes, and the time-domain cut refuses it by name.
+TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
+  config::MillingConfig job = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml");
+  job.lobes.points = 400;  // enough for the check, a fifth of the job's cost
+  job.lobes.points_per_mode = 80;
+  const auto& part = *job.structures.front().parts.front().pose;
+  const config::RobotModelConfig model = config::load_robot_model(part.model_path);
+  const robot::PlanarChain chain = robot::at_pose(model, part.joints_deg);
+  const milling::Structure s(job.structures.front(), false);
+  for (const double f : {5.0, 11.6, 23.0, 120.0}) EXPECT_LT((s.frf(f) - chain.tcp_frf_direct(f)).norm(), 1e-15) << f;
+  const auto process = milling::chatter_process(job.tool, job.material, job.cut);
+  const milling::LobeModel lobes(s, process, job.lobes);
+  const auto d = lobes.diagram();
+  const double direct = lobes.critical_depth_m(d.minimum.rpm);
+  std::cout << "pose 2: minimum " << d.minimum.b_lim_m * 1e3 << " mm at " << d.minimum.rpm << " rpm, chatter "
+            << d.minimum.chatter_hz << " Hz; direct test " << direct * 1e3 << " mm\n";
+  EXPECT_NEAR(direct / d.minimum.b_lim_m, 1.0, 0.01);
+  EXPECT_GT(d.minimum.chatter_hz, 5.0);
+  EXPECT_LT(d.minimum.chatter_hz, 40.0) << "the minimum is set by the joints' modes";
+  // Pose 1 (stiffer): a higher minimum.
+  config::StructureConfig at1 = job.structures.front();
+  at1.parts.front().pose->joints_deg = model.poses.front().joints_deg;
+  const milling::Structure s1(at1, false);
+  EXPECT_GT(milling::LobeModel(s1, process, job.lobes).diagram().minimum.b_lim_m, d.minimum.b_lim_m);
+  // The cut in time needs modal terms.
+  try {
+    (void)milling::make_cut_job(job, s, {});
+    ADD_FAILURE() << "a pose part accepted by the time-domain cut";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("robot pose part"), std::string::npos) << e.what();
+  }
+  // A pose outside the travel in the job file is refused when the job is read.
+  std::string text = test_read(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml");
+  text.replace(text.find("119.81"), 6, "200.00");
+  try {
+    (void)config::parse_milling_config(text, "pose.yaml", std::string(ROBODAMP_SOURCE_DIR) + "/config/milling");
+    ADD_FAILURE() << "accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("joint 2 = 200 deg is out of range"), std::string::npos) << e.what();
   }
 }
 
