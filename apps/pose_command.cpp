@@ -3,13 +3,14 @@
 //   pose table --model F: the model's first mode at each named pose beside the published values
 //   pose fit  --model F --measured Q1,Q2,Q3:FRF.csv ... [--direction yy] [--out fitted.yaml]: the joints'
 //             stiffness and damping from measured TCP FRFs at poses (particle swarm, then BOBYQA)
-//   pose map  --model F --vary J1 J2 [--steps N] [--json F] [--plot PNG]: first-mode frequency and modal
-//             stiffness over a grid of two joints (the others at the first named pose)
+//   pose map  --model F --vary J1 J2 [--steps N] [--job JOB] [--json F] [--plot PNG]: first-mode frequency,
+//             modal stiffness and (with a job) the minimum limiting depth over a grid of two joints
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -17,6 +18,8 @@
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "identify/modal_fit.hpp"
+#include "milling/lobes.hpp"
+#include "milling/structure.hpp"
 #include "robot/pose_fit.hpp"
 #include "robot/robot_model.hpp"
 
@@ -44,6 +47,7 @@ struct PoseArgs {
   std::string out_path;
   std::string csv_path;
   double csv_step_hz{0.1};
+  std::string job_path;  // map: a milling job with a pose part: its minimum limiting depth at each pose
 };
 
 // "Q1,Q2,Q3:path" -> the pose and the FRF (a freq_hz,re_m_per_n,im_m_per_n[,coherence] receptance CSV).
@@ -235,7 +239,16 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
   const auto j1 = static_cast<std::size_t>(a.vary[0] - 1), j2 = static_cast<std::size_t>(a.vary[1] - 1);
   json grid = json::array();
   std::ostringstream data;
-  double f_min = INFINITY, f_max = 0.0;
+  double f_min = INFINITY, f_max = 0.0, b_min = INFINITY, b_max = 0.0;
+  std::optional<config::MillingConfig> job;
+  if (!a.job_path.empty()) {
+    job = config::load_milling_config(a.job_path);
+    bool has_pose = false;
+    for (const auto& part : job->find_structure(job->structure)->parts) has_pose = has_pose || part.pose.has_value();
+    if (!has_pose)
+      throw config::ConfigError({config::Problem{a.job_path, {}, "structures",
+                                                 "--job: the job's structure has no robot pose part (pose: {model, joints_deg})"}});
+  }
   for (int i = 0; i < a.steps; ++i) {
     for (int k = 0; k < a.steps; ++k) {
       std::vector<double> q = base;
@@ -246,26 +259,52 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
       const robot::PlanarChain c = robot::at_pose(m, q);
       const auto md = c.modes(1);
       f_min = std::min(f_min, md[0].freq_hz), f_max = std::max(f_max, md[0].freq_hz);
-      grid.push_back({{"joints_deg", q}, {"f1_hz", md[0].freq_hz}, {"k1_n_per_m", md[0].tcp_modal_stiffness_n_per_m}});
-      data << q[j1] << ' ' << q[j2] << ' ' << md[0].freq_hz << ' ' << md[0].tcp_modal_stiffness_n_per_m << '\n';
+      json point = {{"joints_deg", q}, {"f1_hz", md[0].freq_hz}, {"k1_n_per_m", md[0].tcp_modal_stiffness_n_per_m}};
+      double depth_mm = NAN;
+      if (job) {  // the job's minimum limiting depth over its speed range, the robot at this pose
+        config::StructureConfig st = *job->find_structure(job->structure);
+        for (auto& part : st.parts)
+          if (part.pose) part.pose->joints_deg = q;
+        const milling::Structure structure(st, false);
+        const auto lobes = milling::LobeModel(structure, milling::chatter_process(job->tool, job->material, job->cut),
+                                              job->lobes).diagram();
+        depth_mm = lobes.minimum.b_lim_m * 1e3;
+        b_min = std::min(b_min, depth_mm), b_max = std::max(b_max, depth_mm);
+        point["min_depth_mm"] = depth_mm;
+        point["min_depth_rpm"] = lobes.minimum.rpm;
+      }
+      grid.push_back(point);
+      data << q[j1] << ' ' << q[j2] << ' ' << md[0].freq_hz << ' ' << md[0].tcp_modal_stiffness_n_per_m << ' '
+           << depth_mm << '\n';
     }
     data << '\n';
+    if (job) std::cerr << "robodamp pose map: row " << i + 1 << " of " << a.steps << " done\n";
   }
-  const json r = {{"model", m.source}, {"vary", a.vary}, {"steps", a.steps}, {"grid", grid},
+  json r = {{"model", m.source}, {"vary", a.vary}, {"steps", a.steps}, {"grid", grid},
                   {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
   std::ostringstream t;
   char b[200];
   std::snprintf(b, sizeof b, "robot %s: first mode over joints %d and %d (%d x %d poses): %.2f to %.2f Hz\n",
                 m.name.c_str(), a.vary[0], a.vary[1], a.steps, a.steps, f_min, f_max);
   t << b;
+  if (job) {
+    std::snprintf(b, sizeof b, "  %s: minimum limiting depth (open loop, %g-%g rpm) %.3f to %.3f mm\n",
+                  a.job_path.c_str(), job->lobes.rpm_min, job->lobes.rpm_max, b_min, b_max);
+    t << b;
+    r["min_depth_min_mm"] = b_min;
+    r["min_depth_max_mm"] = b_max;
+  }
   if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
   return print_report(r.dump(2), a.json_out, t.str(), a.plot_path, [&] {
-    const std::string s = "set terminal pngcairo size 1400,600; set output '" + a.plot_path +
-                          "'; set multiplot layout 1,2; set view map; set xlabel 'joint " + std::to_string(a.vary[0]) +
+    const std::string s = "set terminal pngcairo size " + std::string(job ? "2000" : "1400") + ",600; set output '" + a.plot_path +
+                          "'; set multiplot layout 1," + std::string(job ? "3" : "2") + "; set view map; set xlabel 'joint " + std::to_string(a.vary[0]) +
                           " (deg)'; set ylabel 'joint " + std::to_string(a.vary[1]) +
                           " (deg)'; set title 'first mode (Hz)'; splot DATA u 1:2:3 w pm3d notitle;"
-                          " set title 'TCP modal stiffness of the first mode (N/m)'; set logscale cb; set format cb '%.0e';"
-                          " splot DATA u 1:2:4 w pm3d notitle; unset multiplot";
+                          " set title 'TCP modal stiffness of the first mode (N/m)'; set format cb '%.1e';"
+                          " splot DATA u 1:2:4 w pm3d notitle;" +
+                          std::string(job ? " set format cb '%g'; set title 'minimum limiting depth (mm)';"
+                                            " splot DATA u 1:2:5 w pm3d notitle;" : "") +
+                          " unset multiplot";
     return run_gnuplot(s, data.str(), a.plot_path);
   }, a.plot_path);
 }
@@ -304,6 +343,8 @@ void register_pose(Registry& r) {
   sub->add_option("--json-out", a->json_path, "Also write the JSON to this file");
   sub->add_option("--plot", a->plot_path, "frf, map: write a PNG");
   sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
+  sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose)")
+      ->check(CLI::ExistingFile);
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
   sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
   sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));

@@ -327,6 +327,16 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   const Result no_pose = run("lobes --pose -84.75 104.63 -20.08");
   EXPECT_EQ(no_pose.status, 2);
   EXPECT_NE(no_pose.out.find("the job has no robot pose part"), std::string::npos) << no_pose.out;
+  // A depth map: each grid pose carries the job's minimum limiting depth; a job without a pose part is refused.
+  const Result map = run("pose map --vary 2 3 --steps 2 --job " + job + " --json-out " + dir + "/map.json");
+  ASSERT_EQ(map.status, 0) << map.out;
+  EXPECT_NE(map.out.find("minimum limiting depth (open loop, 500-8000 rpm)"), std::string::npos) << map.out;
+  const auto grid = nlohmann::json::parse(robodamp::test::read_file(dir + "/map.json"))["grid"];
+  ASSERT_EQ(grid.size(), 4U);
+  for (const auto& g : grid) EXPECT_GT(g["min_depth_mm"].get<double>(), 0.0) << g.dump();
+  const Result no_pose_job = run("pose map --steps 2 --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  EXPECT_EQ(no_pose_job.status, 2);
+  EXPECT_NE(no_pose_job.out.find("no robot pose part"), std::string::npos) << no_pose_job.out;
   const auto fitted = robodamp::config::load_robot_model(dir + "/fitted.yaml");
   EXPECT_EQ(fitted.joints.size(), 3U);
   EXPECT_EQ(fitted.poses.size(), 3U);

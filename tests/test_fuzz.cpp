@@ -122,7 +122,7 @@ std::vector<Sub> subcommands() {
        {"--csv", "--frf", "--series", "--recording", "--structure"}, false},
       {"measure", {}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
       {"pose", {"--joints", "--modes", "--band-hz", "--steps", "--fit-band-hz", "--restarts", "--particles", "--iterations",
-                "--seed", "--csv-step-hz"}, {"--json"}, {{"--direction", {"xx", "yy", "xy"}}}, {"--model"}, false},
+                "--seed", "--csv-step-hz"}, {"--json"}, {{"--direction", {"xx", "yy", "xy"}}}, {"--model", "--job"}, false},
   };
 }
 
