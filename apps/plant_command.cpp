@@ -27,6 +27,7 @@ struct PlantArgs {
   std::vector<std::string> spindle_schedule;   // "T:RPM", plant time in s
   std::vector<std::string> spindle_ramps;      // "T0:T1:RPM"
   std::string cut_job;
+  double spindle_register_period_s{0.05};
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
 
@@ -88,6 +89,7 @@ int run_plant(const PlantArgs& a) {
     eo.spindle_ramps.push_back({t0, t1, rpm});
   }
   eo.cut_job = a.cut_job;
+  eo.spindle_register_period_s = a.spindle_register_period_s;
   rt::install_shutdown_handlers();
   eo.stop_flag = &rt::shutdown_signal();
   const hil::EmulatorReport r = hil::run_emulator(cfg, eo);
@@ -131,6 +133,8 @@ void register_plant(Registry& r) {
                   "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
   sub->add_option("--spindle-ramp", a->spindle_ramps,
                   "A linear spindle ramp T0_S:T1_S:RPM (plant time; from the speed at T0 to RPM at T1), repeatable");
+  r.number(sub, "--spindle-register-period", a->spindle_register_period_s, {"s", 0.0, 10.0},
+           "How often the robot updates its spindle register during a ramp (plant time)");
   sub->add_option("--cut", a->cut_job,
                   "Milling job (config/milling/*.yaml) whose cutting force acts on the robot at the spindle speed")
       ->check(CLI::ExistingFile);

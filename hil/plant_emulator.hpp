@@ -53,6 +53,10 @@ struct EmulatorOptions {
   std::vector<std::pair<double, double>> spindle_schedule;
   // Linear spindle ramps (t0 s, t1 s, rpm reached at t1), with the steps above one speed profile.
   std::vector<SpindleChange> spindle_ramps;
+  // How often the robot controller updates its spindle register (plant time; a ramp arrives as a
+  // staircase). In lockstep, plant time outruns the controller's wall-clock Modbus poll, so a lockstep
+  // ramp needs steps long enough for the poll's settle rule.
+  double spindle_register_period_s{0.05};
   // A milling job (config/milling/*.yaml) whose cutting force acts on the plant at the spindle speed
   // (hil/cutting_load.hpp). Empty = no cut.
   std::string cut_job;

@@ -108,7 +108,7 @@ std::vector<Sub> subcommands() {
       {"analyze", {"--spindle-rpm"}, {"--json", "--spindle-sweep"}, {}, {"--config"}, false},
       {"bench", {}, {}, {}, {"--config"}, false},
       {"run", {"--duration", "--impact-every", "--spindle-rpm"}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config", "--job"}, false},
-      {"plant", {"--duration", "--impact-location"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
+      {"plant", {"--duration", "--impact-location", "--spindle-register-period"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
       {"monitor", {"--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback", "shared_memory"}}}, {"--config"}, false},
       {"request", {"--domain", "--gain", "--select", "--enable", "--timeout", "--spindle-rpm"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
       {"replay", {}, {}, {}, {}, true},
