@@ -106,6 +106,13 @@ CutConfig read_cut(MapReader& top, const ToolConfig& tool) {
   return c;
 }
 
+// A path as written in the job, relative to the job file's directory unless absolute.
+std::string resolve_against(const std::string& base_dir, const std::string& written) {
+  const std::filesystem::path p = std::filesystem::path(written).is_absolute() ? std::filesystem::path(written)
+                                                                               : std::filesystem::path(base_dir) / written;
+  return p.lexically_normal().string();
+}
+
 std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const std::string& base_dir) {
   Diagnostics& d = pr.diagnostics();
   const YAML::Node n = pr.child("controller", false, "");
@@ -113,9 +120,7 @@ std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const st
   MapReader r(d, n, pr.path_of("controller"), pr.mark());
   ControllerPartConfig c;
   if (auto v = r.text("config", std::nullopt)) {
-    const std::filesystem::path p = std::filesystem::path(*v).is_absolute() ? std::filesystem::path(*v)
-                                                                           : std::filesystem::path(base_dir) / *v;
-    c.config_path = p.lexically_normal().string();
+    c.config_path = resolve_against(base_dir, *v);
     if (!std::ifstream(c.config_path))
       d.add(n.Mark(), r.path_of("config"), "= '" + *v + "': cannot open " + c.config_path);
   }
@@ -133,9 +138,7 @@ std::optional<PosePartConfig> read_pose_part(MapReader& pr, const std::string& b
   MapReader r(d, n, pr.path_of("pose"), pr.mark());
   PosePartConfig c;
   if (auto v = r.text("model", std::nullopt)) {
-    const std::filesystem::path p = std::filesystem::path(*v).is_absolute() ? std::filesystem::path(*v)
-                                                                           : std::filesystem::path(base_dir) / *v;
-    c.model_path = p.lexically_normal().string();
+    c.model_path = resolve_against(base_dir, *v);
   }
   c.joints_deg = r.number_list("joints_deg", "deg").value_or(std::vector<double>{});
   r.finish();

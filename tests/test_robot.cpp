@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <iostream>
 
 #include <random>
@@ -13,16 +11,10 @@
 #include "robot/planar_chain.hpp"
 #include "robot/pose_fit.hpp"
 #include "robot/robot_model.hpp"
+#include "test_util.hpp"
 
 namespace robodamp {
 namespace {
-
-std::string test_read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -213,7 +205,7 @@ TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
     EXPECT_NE(std::string(e.what()).find("robot pose part"), std::string::npos) << e.what();
   }
   // A pose outside the travel in the job file is refused when the job is read.
-  std::string text = test_read(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml");
+  std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml");
   text.replace(text.find("119.81"), 6, "200.00");
   try {
     (void)config::parse_milling_config(text, "pose.yaml", std::string(ROBODAMP_SOURCE_DIR) + "/config/milling");
