@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "analysis/notch_speed_map.hpp"
+#include "analysis/pose_schedule.hpp"
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include <memory>
@@ -206,6 +207,7 @@ struct AnalyzeArgs {
   std::string plot_dir;
   std::optional<double> spindle_rpm;
   bool spindle_sweep{false};
+  bool base{false};
 };
 
 // The harmonic notches across spindle.rpm range: the refused speeds and the worst phase at each mode.
@@ -235,12 +237,60 @@ void print_speed_map(const config::Config& cfg) {
   }
 }
 
+// pose_schedule: each region's set, analysed over its grid (analysis/pose_schedule.hpp); a region with no
+// stable set throws ConfigError (exit 2).
+int print_pose_schedule(const config::Config& cfg, bool as_json) {
+  const analysis::PoseScheduleAnalysis ps = analysis::analyse_pose_schedule(cfg);
+  json regions = json::array();
+  for (const auto& r : ps.regions) {
+    const analysis::LoopModel centre(r.config);
+    const analysis::AnalysisResult a = analysis::analyse(centre, r.gain_ns_per_m, r.polarity);
+    regions.push_back({{"name", r.name},
+                       {"centre_deg", r.centre_deg},
+                       {"dominant_hz", r.dominant_hz},
+                       {"dominant_min_hz", r.dominant_min_hz},
+                       {"dominant_max_hz", r.dominant_max_hz},
+                       {"grid_poses", r.grid_poses},
+                       {"gain_ns_per_m", r.gain_ns_per_m},
+                       {"polarity", r.polarity},
+                       {"k_max_ns_per_m", r.k_max_ns_per_m},
+                       {"k_max_pose_deg", r.k_max_pose_deg},
+                       {"centre_gain_margin_db", optional_number(a.margins.gain_margin_db)},
+                       {"centre_phase_margin_deg", optional_number(a.margins.phase_margin_deg)},
+                       {"improvement_centre_pct", r.improvement_centre_pct}});
+  }
+  const json report = {{"config", cfg.source}, {"model", ps.model.source}, {"axis", cfg.pose_schedule->axis ? "y" : "x"},
+                       {"regions", regions}};
+  if (as_json) {
+    std::printf("%s\n", report.dump(2).c_str());
+    return 0;
+  }
+  std::printf("pose schedule of %s: robot model %s, actuator along %s\n", cfg.source.c_str(), ps.model.source.c_str(),
+              cfg.pose_schedule->axis ? "y" : "x");
+  std::printf("%-12s %-26s %-18s %9s %4s %9s %11s %9s %9s %8s\n", "region", "centre (deg)", "dominant (Hz)", "match Hz",
+              "pol", "K N s/m", "K_max N s/m", "GM dB", "PM deg", "impr %");
+  for (const auto& r : regions) {
+    const std::string centre = config::describe_pose(r["centre_deg"].get<std::vector<double>>());
+    char dom[40];
+    std::snprintf(dom, sizeof dom, "%.2f-%.2f", r["dominant_min_hz"].get<double>(), r["dominant_max_hz"].get<double>());
+    std::printf("%-12s %-26s %-18s %9.2f %+4d %9.0f %11.0f %9s %9s %8.1f\n", r["name"].get<std::string>().c_str(),
+                centre.c_str(), dom, r["dominant_hz"].get<double>(), r["polarity"].get<int>(), r["gain_ns_per_m"].get<double>(),
+                r["k_max_ns_per_m"].get<double>(), fmt(r["centre_gain_margin_db"], "%.1f").c_str(),
+                fmt(r["centre_phase_margin_deg"], "%.1f").c_str(), r["improvement_centre_pct"].get<double>());
+  }
+  std::printf("K_max is the smallest over each region's %d^%zu grid; margins and improvement at its centre\n",
+              cfg.pose_schedule->grid_points, cfg.pose_schedule->joints());
+  return 0;
+}
+
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
   if (a.spindle_sweep) {
     print_speed_map(config::load_config_file(a.config_path));
     return 0;
   }
+  if (const config::Config cfg = config::load_config_file(a.config_path); cfg.pose_schedule && !a.base)
+    return print_pose_schedule(cfg, a.json);
   const analysis::LoopModel model(config::load_config_file(a.config_path), a.spindle_rpm);
   const auto result = analysis::analyse(model);
   const auto report = analysis_report(model, result);
@@ -264,6 +314,8 @@ void register_analyze(Registry& r) {
            "Analyse with controller.harmonic_notch at this spindle speed (spindle.teeth)");
   sub->add_flag("--spindle-sweep", a->spindle_sweep,
                 "The harmonic notches across the spindle's speed range: refused speeds and their cost at each mode");
+  sub->add_flag("--no-pose-schedule", a->base,
+                "With pose_schedule: analyse the configuration's own robot section instead of each region's set");
 }
 
 }  // namespace robodamp::apps

@@ -615,6 +615,31 @@ void check_location_refs(Diagnostics& d, const Config& c, const YAML::Node& root
 
 }  // namespace
 
+namespace {
+
+// modbus.robot.joints_register against pose_schedule: one register per joint, clear of the others.
+void check_joint_registers(detail::Diagnostics& d, const Config& c, const YAML::Node& root) {
+  if (!c.modbus) return;
+  const RobotRegisters& r = c.modbus->robot;
+  if (r.joints_register < 0) return;
+  if (!c.pose_schedule) {
+    d.add(root.Mark(), "modbus.robot.joints_register",
+          "= " + std::to_string(r.joints_register) + " is set without pose_schedule: the joint angles would select nothing");
+    return;
+  }
+  const int first = r.joints_register, last = first + static_cast<int>(c.pose_schedule->joints()) - 1;
+  for (const auto& [key, reg] : {std::pair{"mounting_register", r.mounting_register},
+                                 std::pair{"spindle_rpm_register", r.spindle_rpm_register}})
+    if (reg >= first && reg <= last)
+      d.add(root.Mark(), "modbus.robot.joints_register",
+            "= " + std::to_string(first) + " covers registers " + std::to_string(first) + "-" + std::to_string(last) +
+                " (one per joint), which holds modbus.robot." + key + " = " + std::to_string(reg) + ": they must differ");
+  if (last > 65535)
+    d.add(root.Mark(), "modbus.robot.joints_register", "= " + std::to_string(first) + ": the joints' registers run past 65535");
+}
+
+}  // namespace
+
 Config parse_config(const std::string& yaml_text, const std::string& source_name) {
   Diagnostics d(source_name);
   const YAML::Node root = detail::load_top_map(d, yaml_text, "loop, actuator, amplifier, controller, robot");
@@ -640,6 +665,11 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   detail::read_supervisory(top, c);
   c.commissioning = detail::read_commissioning(top);
   c.spindle = detail::read_spindle(top, c.source);
+  c.pose_schedule = detail::read_pose_schedule(top, c.source);
+  if (c.pose_schedule && !c.parameter_sets.empty())
+    d.add(root.Mark(), "pose_schedule",
+          "and parameter_sets select parameter sets both: a configuration schedules by pose or by mounting, not both");
+  check_joint_registers(d, c, root);
   top.finish();
   check_location_refs(d, c, root);
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

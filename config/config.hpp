@@ -12,6 +12,7 @@
 
 #include "config/can_config.hpp"
 #include "config/commissioning_config.hpp"
+#include "config/pose_schedule_config.hpp"
 #include "config/spindle_config.hpp"
 #include "config/supervisory_config.hpp"
 
@@ -245,6 +246,7 @@ struct Config {
   HilConfig hil;                               // read by the plant emulator (robodamp plant)
   CommissioningConfig commissioning;           // robodamp measure and the plant side of it
   SpindleConfig spindle;                       // tooth count and speed range (the harmonic notches)
+  std::optional<PoseScheduleConfig> pose_schedule;  // parameter sets by pose region (analysis/pose_schedule)
 };
 
 // A parameter request's gain against what the supervisor allows (the analysed maximum stable K x

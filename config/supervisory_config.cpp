@@ -112,6 +112,10 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
       b.diagnostics().add(b.mark(), "modbus.robot.spindle_rpm_register",
                           "= " + std::to_string(rr.spindle_rpm_register) + " is the mounting register too: they must differ");
     if (auto v = b.number("rpm_per_count", {"rpm per count", 0.0, 1000.0, true}, rr.rpm_per_count)) rr.rpm_per_count = *v;
+    if (auto v = read_int(b, "joints_register", {"(register address, zero-based; -1 = none)", -1, 65535},
+                          rr.joints_register))
+      rr.joints_register = *v;
+    if (auto v = b.number("deg_per_count", {"deg per count", 0.0, 1.0, true}, rr.deg_per_count)) rr.deg_per_count = *v;
     b.finish();
   }
   r.finish();

@@ -45,6 +45,11 @@ struct RobotRegisters {
   // settling; the robot link lost for modbus.link_timeout_s parks the harmonic notches.
   int spindle_rpm_register{-1};
   double rpm_per_count{1.0};
+  // The joint angles (pose_schedule): consecutive holding registers from joints_register (-1 = none),
+  // one per joint, signed 16-bit counts x deg_per_count; -32768 means "not available" (the robot's NaN).
+  // The pose's region must read the same settle_polls polls running before a hand-over.
+  int joints_register{-1};
+  double deg_per_count{0.01};
 };
 
 struct ModbusConfig {

@@ -84,6 +84,8 @@ void read_supervisory(MapReader& top, Config& c);
 // The controller's optional harmonic_notch map and the optional spindle section (config/spindle_config.hpp).
 [[nodiscard]] std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller, std::optional<double> rate_hz);
 [[nodiscard]] SpindleConfig read_spindle(MapReader& top, const std::string& source);
+// The optional pose_schedule section (config/pose_schedule_config.hpp); the robot model it names is loaded.
+[[nodiscard]] std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::string& source);
 // The optional commissioning section (config/commissioning_config.hpp).
 [[nodiscard]] CommissioningConfig read_commissioning(MapReader& top);
 // One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.

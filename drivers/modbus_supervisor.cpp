@@ -204,19 +204,21 @@ void ModbusSupervisor::robot_thread() {
   const auto period = std::chrono::duration<double>(cfg_.poll_period_s);
   int candidate = -1, same = 0;
   SpindleWatch spindle;
+  PoseWatch pose;
   bool running = true;
   while (running) {
     const auto now = ModbusLink::Clock::now();
     modbus_t* ctx = robot_link_->connect(now);
     robot_up_.store(ctx != nullptr);
-    if (ctx == nullptr || !poll_spindle(ctx, spindle)) {
-      if (ctx != nullptr) {  // the spindle register's read failed
+    if (ctx == nullptr || !poll_spindle(ctx, spindle) || !poll_pose(ctx, pose)) {
+      if (ctx != nullptr) {  // the spindle or joint registers' read failed
         robot_link_->failed(ModbusLink::Clock::now());
         robot_up_.store(false);
         spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
         candidate = -1, same = 0;
       }
       park_spindle_if_lost(spindle);
+      pose_unknown_if_lost(pose);
       running = sleep_for(std::min<std::chrono::duration<double>>(period, robot_link_->retry_at() - now));
       continue;
     }
@@ -227,6 +229,7 @@ void ModbusSupervisor::robot_thread() {
       spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
       candidate = -1, same = 0;
       park_spindle_if_lost(spindle);
+      pose_unknown_if_lost(pose);
       running = sleep_for(std::chrono::duration<double>(0.0));
       continue;
     }
@@ -278,6 +281,63 @@ void ModbusSupervisor::park_spindle_if_lost(SpindleWatch& w) {
   if (on_spindle_) on_spindle_(0.0);
 }
 
+bool ModbusSupervisor::poll_pose(modbus_t* ctx, PoseWatch& w) {
+  const auto& r = cfg_.robot;
+  if (r.joints_register < 0 || !schedule_) return true;
+  constexpr std::size_t kMaxJoints = 16;
+  const std::size_t n = std::min(schedule_->joints(), kMaxJoints);
+  std::uint16_t regs[kMaxJoints] = {};
+  if (modbus_read_registers(ctx, r.joints_register, static_cast<int>(n), regs) != static_cast<int>(n)) return false;
+  w.last_ok = ModbusLink::Clock::now();
+  w.lost = false;
+  std::vector<double> q(n);
+  bool available = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto count = static_cast<std::int16_t>(regs[i]);
+    if (count == INT16_MIN) available = false;
+    q[i] = count == INT16_MIN ? std::nan("") : count * r.deg_per_count;
+  }
+  {
+    std::lock_guard lk(m_);
+    joints_deg_ = q;
+  }
+  if (!available) ++pose_unavailable_polls_;
+  std::optional<std::size_t> current;
+  if (w.reported >= 0) current = static_cast<std::size_t>(w.reported);
+  const auto region = config::region_of(*schedule_, q.data(), n, current);
+  if (!region) ++pose_out_of_map_polls_;
+  const long id = region ? static_cast<long>(*region) : -1;
+  w.same = id == w.candidate ? w.same + 1 : 1;
+  w.candidate = id;
+  if (w.same >= r.settle_polls && id != w.reported) report_pose(w, id);
+  return true;
+}
+
+void ModbusSupervisor::report_pose(PoseWatch& w, long region) {
+  w.reported = region;
+  ++pose_changes_;
+  if (region >= 0)
+    spdlog::info("modbus robot: pose in region '{}'", schedule_->regions[static_cast<std::size_t>(region)].name);
+  else
+    spdlog::warn("modbus robot: the pose is out of the map (outside every region of pose_schedule, or not available)");
+  if (on_pose_) on_pose_(region >= 0 ? std::optional(static_cast<std::size_t>(region)) : std::nullopt);
+}
+
+void ModbusSupervisor::pose_unknown_if_lost(PoseWatch& w) {
+  if (cfg_.robot.joints_register < 0 || !schedule_ || w.lost) return;
+  w.candidate = -2, w.same = 0;
+  if (ModbusLink::Clock::now() - w.last_ok < std::chrono::duration<double>(cfg_.link_timeout_s)) return;
+  w.lost = true;
+  ++pose_link_losses_;
+  spdlog::warn("modbus robot: no joint angles for {} s: the pose is unknown", cfg_.link_timeout_s);
+  report_pose(w, -1);
+}
+
+std::vector<double> ModbusSupervisor::joints_deg() const {
+  std::lock_guard lk(m_);
+  return joints_deg_;
+}
+
 ModbusCounters ModbusSupervisor::counters() const {
   ModbusCounters c;
   c.amplifier_polls = amp_polls_.load();
@@ -295,6 +355,10 @@ ModbusCounters ModbusSupervisor::counters() const {
   c.mounting_unknown = mounting_unknown_.load();
   c.spindle_changes = spindle_changes_.load();
   c.spindle_link_parks = spindle_link_parks_.load();
+  c.pose_changes = pose_changes_.load();
+  c.pose_out_of_map_polls = pose_out_of_map_polls_.load();
+  c.pose_unavailable_polls = pose_unavailable_polls_.load();
+  c.pose_link_losses = pose_link_losses_.load();
   return c;
 }
 

@@ -13,6 +13,10 @@
 // - The robot's mounting (horizontal / vertical value) must read the same settle_polls polls running
 //   before the callback is told; the session turns that into a parameter-set selection the supervisor
 //   validates and the controller hands over with a fade (never a switch mid-cycle).
+// - The robot's joint angles (pose_schedule, modbus.robot.joints_register): the region the pose is in
+//   (or "out of the map") must read the same settle_polls polls running before the callback is told; a
+//   register holding -32768 (not available) reads as out of the map, and no successful poll for
+//   link_timeout_s makes the pose unknown (out of the map) as well.
 #pragma once
 
 #include <atomic>
@@ -24,6 +28,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "config/config.hpp"
 #include "rt/io.hpp"
@@ -70,12 +75,18 @@ struct ModbusCounters {
   std::uint64_t mounting_unknown{0};   // polls with a value that is neither horizontal nor vertical
   std::uint64_t spindle_changes{0};    // settled spindle speeds handed to the callback
   std::uint64_t spindle_link_parks{0}; // robot link lost for link_timeout_s: speed 0 handed over (notches parked)
+  std::uint64_t pose_changes{0};       // settled regions (or out of the map) handed to the callback
+  std::uint64_t pose_out_of_map_polls{0};  // polls with the pose outside every region
+  std::uint64_t pose_unavailable_polls{0}; // polls with a joint register at -32768 (not available)
+  std::uint64_t pose_link_losses{0};   // robot link lost for link_timeout_s: the pose became unknown
 };
 
 class ModbusSupervisor final : public rt::SupervisoryIo {
  public:
   using MountingCallback = std::function<void(config::Mounting)>;
   using SpindleCallback = std::function<void(double rpm)>;
+  // The settled region's index in pose_schedule.regions, or nothing: out of the map or unknown.
+  using PoseCallback = std::function<void(std::optional<std::size_t> region)>;
   // initial: the mounting the controller starts with (its configuration's actuator.mounting).
   ModbusSupervisor(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback on_mounting = {});
   ~ModbusSupervisor() override;
@@ -85,6 +96,14 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   // Before start(): called from the robot thread with each settled spindle speed (rpm; 0 when the robot
   // link has been lost for link_timeout_s). Needs modbus.robot.spindle_rpm_register.
   void set_spindle_callback(SpindleCallback cb) { on_spindle_ = std::move(cb); }
+  // Before start(): the pose schedule the joint registers are classified by, and the callback (robot
+  // thread). Needs modbus.robot.joints_register.
+  void set_pose_callback(const config::PoseScheduleConfig& schedule, PoseCallback cb) {
+    schedule_ = schedule;
+    on_pose_ = std::move(cb);
+  }
+  // The joint angles of the last successful poll, deg (empty before one; NaN where not available).
+  [[nodiscard]] std::vector<double> joints_deg() const;
 
   void start();
   // Writes the enable coil off when it can, then joins the threads.
@@ -114,11 +133,24 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   };
   bool poll_spindle(modbus_t* ctx, SpindleWatch& w);  // false: the read failed
   void park_spindle_if_lost(SpindleWatch& w);
+  // The joint registers' settling (robot thread only). Region -1: out of the map; -2: nothing yet.
+  struct PoseWatch {
+    long candidate{-2}, reported{-2};
+    int same{0};
+    bool lost{false};
+    std::chrono::steady_clock::time_point last_ok{std::chrono::steady_clock::now()};
+  };
+  bool poll_pose(modbus_t* ctx, PoseWatch& w);  // false: the read failed
+  void pose_unknown_if_lost(PoseWatch& w);
+  void report_pose(PoseWatch& w, long region);
   bool sleep_for(std::chrono::duration<double> d);  // false when stopping
 
   config::ModbusConfig cfg_;
   MountingCallback on_mounting_;
   SpindleCallback on_spindle_;
+  std::optional<config::PoseScheduleConfig> schedule_;
+  PoseCallback on_pose_;
+  std::vector<double> joints_deg_;  // guarded by m_
   ModbusLink amp_link_;
   std::optional<ModbusLink> robot_link_;
   std::thread amp_thread_, robot_thread_;
@@ -134,7 +166,8 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   std::atomic<bool> link_fault_{false};
   std::atomic<int> mounting_;
   std::atomic<std::uint64_t> amp_polls_{0}, robot_polls_{0}, link_faults_{0}, coil_writes_{0}, mounting_changes_{0},
-      mounting_unknown_{0}, spindle_changes_{0}, spindle_link_parks_{0};
+      mounting_unknown_{0}, spindle_changes_{0}, spindle_link_parks_{0}, pose_changes_{0}, pose_out_of_map_polls_{0},
+      pose_unavailable_polls_{0}, pose_link_losses_{0};
   std::int64_t link_timeout_ns_;
 };
 

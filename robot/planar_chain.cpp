@@ -156,6 +156,9 @@ std::vector<Mode> PlanarChain::modes(std::size_t count) const {
     const Eigen::Vector2d tcp(md.shape(tcp_x_), md.shape(tcp_x_ + 1));
     md.tcp_direction_rad = std::atan2(tcp.y(), tcp.x());
     md.tcp_modal_stiffness_n_per_m = tcp.squaredNorm() > 0.0 ? w2 / tcp.squaredNorm() : INFINITY;
+    md.tcp_shape = tcp;
+    const double stored = md.shape.dot(kr * md.shape);
+    md.loss_factor = stored > 0.0 ? md.shape.dot(k_.imag() * md.shape) / stored : 0.0;
     out.push_back(std::move(md));
   }
   return out;

@@ -44,6 +44,8 @@ struct Mode {
   Eigen::VectorXd shape;             // over the assembled DOFs
   double tcp_modal_stiffness_n_per_m{0.0};  // in the direction it moves the TCP most (k = w^2 / (phi_tcp^2 / phi' M phi))
   double tcp_direction_rad{0.0};
+  Eigen::Vector2d tcp_shape{0.0, 0.0};      // the mass-normalised shape's TCP x and y, 1/sqrt(kg)
+  double loss_factor{0.0};                  // phi' Im(K) phi / phi' Re(K) phi: the joints' hysteretic share
 };
 
 // Element matrices in the element's own axes (u1 v1 th1 u2 v2 th2).

@@ -105,6 +105,7 @@ json to_json(const SupervisorSettings& s) {
           {"fade_s", s.fade_s},
           {"analysis_stable", s.analysis_stable},
           {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
+          {"pose_scheduled", s.pose_scheduled},
           {"test_signal",
            {{"enabled", s.test_signal.enabled},
             {"start_s", s.test_signal.start_s},
@@ -138,6 +139,7 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   s.fade_s = j.at("fade_s");
   s.analysis_stable = j.at("analysis_stable");
   s.max_stable_gain_ns_per_m = j.at("max_stable_gain_ns_per_m");
+  s.pose_scheduled = j.value("pose_scheduled", false);  // absent before pose_schedule existed
   if (j.contains("test_signal")) {  // absent in recordings made before robodamp measure existed
     const json& t = j.at("test_signal");
     s.test_signal.enabled = t.at("enabled");
@@ -159,7 +161,7 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
   json states = json::array(), trips = json::array(), commands = json::array();
   for (int i = 0; i <= static_cast<int>(State::kFault); ++i) states.push_back(to_string(static_cast<State>(i)));
   for (std::size_t i = 0; i < kTripCount; ++i) trips.push_back(to_string(static_cast<Trip>(i)));
-  for (int i = 0; i <= static_cast<int>(CommandKind::kSetSpindle); ++i)
+  for (int i = 0; i <= static_cast<int>(kLastCommandKind); ++i)
     commands.push_back(to_string(static_cast<CommandKind>(i)));
   json sets = json::array();  // index 0 is controller_params with the supervisor's verdict
   for (std::size_t i = 1; i < supervisor.parameter_sets().size(); ++i) {

@@ -33,6 +33,7 @@ const char* to_string(Trip t) {
     case Trip::kAmplifierFault: return "amplifier_fault";
     case Trip::kAmplifierNotReady: return "amplifier_not_ready";
     case Trip::kSignal: return "signal";
+    case Trip::kPoseOutOfMap: return "pose_out_of_map";
   }
   return "?";
 }
@@ -50,6 +51,7 @@ const char* describe(Trip t) {
     case Trip::kAmplifierFault: return "the amplifier reports a fault (temperature, current, link)";
     case Trip::kAmplifierNotReady: return "the amplifier did not become ready within supervision.amplifier_ready_timeout_s after enable";
     case Trip::kSignal: return "SIGINT/SIGTERM: shut down through the safe state";
+    case Trip::kPoseOutOfMap: return "the robot's pose is outside every region of pose_schedule, or unknown (joint registers lost, not available or not finite): no analysed parameter set applies there";
   }
   return "?";
 }
@@ -61,6 +63,7 @@ const char* to_string(ArmRefusal r) {
     case ArmRefusal::kSensorNotLive: return "sensor not live (needs supervision.arming_live_cycles fresh valid samples)";
     case ArmRefusal::kActuatorPath: return "actuator path not healthy (driver or amplifier fault)";
     case ArmRefusal::kAnalysisUnstable: return "the analysis does not find the loop stable at this gain with margin";
+    case ArmRefusal::kPoseUnknown: return "the robot's pose is not known to be in a region of pose_schedule";
   }
   return "?";
 }
@@ -74,6 +77,7 @@ const char* to_string(CommandKind k) {
     case CommandKind::kSetGain: return "set_gain";
     case CommandKind::kSelectParams: return "select_params";
     case CommandKind::kSetSpindle: return "set_spindle";
+    case CommandKind::kSetPoseRegion: return "set_pose_region";
   }
   return "?";
 }
@@ -91,7 +95,7 @@ SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_
 }
 
 Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
-    : s_(s), controller_(params) {
+    : s_(s), controller_(params), pose_known_(!s.pose_scheduled) {
   sets_.push_back({params, s.analysis_stable, s.max_stable_gain_ns_per_m});
   const auto window = static_cast<std::size_t>(std::max(1.0, std::round(s.limits.saturation_window_s * s.fs_hz)));
   sat_window_.assign(window, 0);
@@ -104,12 +108,11 @@ std::size_t Supervisor::add_parameter_set(const ParameterSet& set) {
   return sets_.size() - 1;
 }
 
-void Supervisor::select(const OperatorCommand& c) noexcept {
-  const double i = c.value;
+bool Supervisor::select(double i) noexcept {
   const bool index_ok = std::isfinite(i) && i >= 0.0 && i == std::floor(i) && i < static_cast<double>(sets_.size());
   if (!index_ok) {
     ++counters_.params_refused;
-    return;
+    return false;
   }
   const auto idx = static_cast<std::size_t>(i);
   const ParameterSet& set = sets_[idx];
@@ -117,10 +120,34 @@ void Supervisor::select(const OperatorCommand& c) noexcept {
       set.params.gain_ns_per_m > s_.limits.max_gain_fraction * set.max_stable_gain_ns_per_m ||
       controller_.request_params(set.params) != control::RequestStatus::kAccepted) {
     ++counters_.params_refused;
-    return;
+    return false;
   }
   active_set_.store(idx, std::memory_order_relaxed);
   ++counters_.params_selected;
+  return true;
+}
+
+void Supervisor::set_pose_region(double value) noexcept {
+  const bool driving = state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping;
+  const bool index_ok = std::isfinite(value) && value >= 0.0 && value == std::floor(value) &&
+                        value < static_cast<double>(sets_.size());
+  if (!s_.pose_scheduled || !index_ok) {  // out of the map, unknown, or not a set: no analysed set applies
+    ++counters_.pose_out_of_map;
+    pose_known_ = false;
+    if (driving) trip(Trip::kPoseOutOfMap);
+    return;
+  }
+  ++counters_.pose_regions;
+  pose_known_ = true;
+  pose_set_ = static_cast<std::size_t>(value);
+}
+
+void Supervisor::follow_pose() noexcept {
+  if (!s_.pose_scheduled || !pose_known_ || pose_set_ == active_parameter_set() || controller_.handover_pending()) return;
+  if (!select(static_cast<double>(pose_set_))) {  // the region's set refused (cannot pass the configuration's analysis)
+    pose_known_ = false;
+    if (state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping) trip(Trip::kPoseOutOfMap);
+  }
 }
 
 void Supervisor::reset_detectors() noexcept {
@@ -153,6 +180,8 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         refusal_ = ArmRefusal::kSensorNotLive;
       else if (!path_ok_)
         refusal_ = ArmRefusal::kActuatorPath;
+      else if (!pose_known_ || (s_.pose_scheduled && pose_set_ != active_parameter_set()))
+        refusal_ = ArmRefusal::kPoseUnknown;
       else if (!sets_[active_parameter_set()].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
         refusal_ = ArmRefusal::kAnalysisUnstable;
       if (refusal_ != ArmRefusal::kNone) {
@@ -179,7 +208,8 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
           controller_.set_gain(c.value) != control::RequestStatus::kAccepted)
         ++counters_.gain_refused;
       break;
-    case CommandKind::kSelectParams: select(c); break;
+    case CommandKind::kSelectParams: (void)select(c.value); break;
+    case CommandKind::kSetPoseRegion: set_pose_region(c.value); break;
     case CommandKind::kSetSpindle:  // validated by the controller: refused speeds park the notches
       if (controller_.set_spindle_rpm(c.value) != control::RequestStatus::kAccepted) ++counters_.spindle_refused;
       break;
@@ -275,6 +305,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   // Operator commands at the tick boundary, then the trips (which override them).
   if (in.command.kind != CommandKind::kNone)
     handle(in.command, live_run_ >= static_cast<std::uint64_t>(l.arming_live_cycles));
+  follow_pose();
   if (const Trip t = check_trips(in); t != Trip::kNone) trip(t);
 
   TickOutput out;

@@ -39,16 +39,20 @@ enum class Trip : std::uint8_t {
   kAmplifierFault,    // the amplifier reports a fault
   kAmplifierNotReady, // enabled but not ready within amplifier_ready_timeout_s
   kSignal,            // SIGINT / SIGTERM: shut down through the safe state
+  kPoseOutOfMap,      // pose_schedule: the pose is outside every region, or unknown, or its set was refused
 };
-inline constexpr std::size_t kTripCount = 11;
+inline constexpr std::size_t kTripCount = 12;
 
-enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable };
+enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable, kPoseUnknown };
 
-enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams, kSetSpindle };
+enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams, kSetSpindle, kSetPoseRegion };
+inline constexpr CommandKind kLastCommandKind = CommandKind::kSetPoseRegion;
 
 struct OperatorCommand {
   CommandKind kind{CommandKind::kNone};
-  double value{0.0};  // set_gain: K in N s/m; select_params: index of the parameter set; set_spindle: rpm
+  // set_gain: K in N s/m; select_params: index of the parameter set; set_spindle: rpm;
+  // set_pose_region: the parameter set of the region the pose is in, or -1 when it is out of the map.
+  double value{0.0};
 };
 
 [[nodiscard]] const char* to_string(State s);
@@ -94,6 +98,8 @@ struct SupervisorCounters {
   std::uint64_t params_refused{0};
   std::uint64_t params_selected{0};
   std::uint64_t spindle_refused{0};  // set_spindle commands refused (the notches parked)
+  std::uint64_t pose_out_of_map{0};  // set_pose_region -1: the pose outside every region, or unknown
+  std::uint64_t pose_regions{0};     // set_pose_region with a region's set
   std::uint64_t commands{0};
 };
 
@@ -123,6 +129,9 @@ struct SupervisorSettings {
   bool analysis_stable{false};       // the analysis found the configured loop stable
   double max_stable_gain_ns_per_m{0.0};
   TestSignal test_signal;            // robodamp measure only
+  // pose_schedule: arming waits for a pose in a region (set_pose_region), the supervisor hands over to
+  // each region's set as the pose moves, and a pose out of the map trips (kPoseOutOfMap).
+  bool pose_scheduled{false};
 };
 
 // A controller parameter set with the analysis verdict for it (e.g. the horizontal and the vertical
@@ -178,7 +187,10 @@ class Supervisor {
   [[nodiscard]] double max_gain_ns_per_m() const noexcept {
     return s_.limits.max_gain_fraction * sets_[active_parameter_set()].max_stable_gain_ns_per_m;
   }
-  void select(const OperatorCommand& c) noexcept;
+  // The parameter set at index value: validated (its analysis, its gain) and handed over. False when refused.
+  bool select(double value) noexcept;
+  void set_pose_region(double value) noexcept;
+  void follow_pose() noexcept;  // each tick: hand over to the pose's region's set once the controller can
 
   SupervisorSettings s_;
   std::vector<ParameterSet> sets_;  // [0]: the set it starts with
@@ -200,6 +212,8 @@ class Supervisor {
   double command_v_{0.0};
   double time_s_{0.0};  // sum of dt before this tick: the test signal's clock
   control::ControllerCounters last_limits_{};
+  bool pose_known_{false};
+  std::size_t pose_set_{0};  // the set the pose's region wants (pose_scheduled)
 
   std::vector<std::uint8_t> sat_window_;  // one entry per tick of the window
   std::size_t sat_pos_{0};

@@ -58,18 +58,23 @@ Status Cell::configure() {
                                   "missing: a hardware cell needs both the can section (sensor and command frames) and "
                                   "the modbus section (the amplifier's enable and status)"}})
                 .what()};
+  if (Status s = configure_pose_schedule(); !s.ok()) return s;
+  const config::Config& set0 = pose_schedule_.regions.empty() ? cfg_ : pose_schedule_.regions.front().config;
   try {
-    model_ = std::make_unique<analysis::LoopModel>(cfg_);
+    model_ = std::make_unique<analysis::LoopModel>(set0);
   } catch (const config::ConfigError& e) {
     return {StatusKind::kConfigError, e.what()};
   }
-  const int polarity = cfg_.controller.polarity;
-  stable_ = model_->stable(cfg_.controller.gain_ns_per_m, polarity);
+  const int polarity = set0.controller.polarity;
+  stable_ = model_->stable(set0.controller.gain_ns_per_m, polarity);
   max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
-  const double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
+  double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
+  if (!pose_schedule_.regions.empty()) k_max = std::min(k_max, pose_schedule_.regions.front().k_max_ns_per_m);
   rt::SupervisorSettings settings = rt::supervisor_settings(cfg_, stable_, k_max);
   settings.test_signal = o_.test_signal;
-  supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(cfg_, model_->chain().params));
+  settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
+  supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(set0, model_->chain().params));
+  if (settings.pose_scheduled) configure_pose_sets();
   ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
   if (Status s = configure_devices(); !s.ok()) return s;
   rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
@@ -78,6 +83,10 @@ Status Cell::configure() {
   loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io, ring_.get());
   arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
   if (o_.arm_at_start) loop_->set_policy(arming_.get());
+  if (settings.pose_scheduled && !o_.pose_deg.empty() && !cfg_.can) {  // the simulated robot stands at --pose
+    const auto region = config::region_of(*cfg_.pose_schedule, o_.pose_deg.data(), o_.pose_deg.size());
+    loop_->schedule(0, {rt::CommandKind::kSetPoseRegion, region ? static_cast<double>(*region) : -1.0});
+  }
   if (Status s = configure_parameter_sets(); !s.ok()) return s;
   if (!cfg_.spindle.job.empty()) {
     try {
@@ -113,8 +122,12 @@ Status Cell::configure_devices() {
                     config::describe(cfg_.modbus->amplifier_link) +
                     (cfg_.modbus->robot_link ? ", robot " + config::describe(*cfg_.modbus->robot_link) : "");
   } else {
-    const config::Config& plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
-    const sim::PlantModel plant_model = o_.plant_config ? sim::build_plant_model(plant_cfg) : model_->plant();
+    config::Config plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
+    if (cfg_.pose_schedule && !o_.pose_deg.empty())  // the robot model at the pose
+      plant_cfg = analysis::config_at_pose(
+          plant_cfg, analysis::pose_modes(pose_schedule_.model, o_.pose_deg, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes));
+    const bool own = o_.plant_config || (cfg_.pose_schedule && !o_.pose_deg.empty());
+    const sim::PlantModel plant_model = own ? sim::build_plant_model(plant_cfg) : model_->plant();
     sim_ = std::make_unique<SimulatedPlant>(plant_model, plant_cfg, o_.backend);
     backend_name_ = "simulated plant";
   }
@@ -134,6 +147,9 @@ Status Cell::configure_devices() {
       return s;
     }
   }
+  if (modbus_ && cfg_.modbus->robot.joints_register >= 0 && cfg_.pose_schedule && !o_.pose_schedule_off)
+    modbus_->client().set_pose_callback(*cfg_.pose_schedule,
+                                        [this](std::optional<std::size_t> region) { post_pose_region(region); });
   if (modbus_ && cfg_.modbus->robot.spindle_rpm_register >= 0) {
     // The robot's spindle register: each settled speed (0 when the link is lost) becomes a set_spindle
     // command; the controller validates it against spindle.rpm_max.
@@ -145,8 +161,43 @@ Status Cell::configure_devices() {
   return {};
 }
 
+Status Cell::configure_pose_schedule() {
+  pose_schedule_ = {};
+  if (!cfg_.pose_schedule) return {};
+  try {
+    pose_schedule_ = analysis::analyse_pose_schedule(cfg_);
+    for (const auto& r : pose_schedule_.regions)
+      spdlog::info("pose region '{}': matched at {:.2f} Hz (dominant mode {:.2f}-{:.2f} Hz over {} poses), K = {} N s/m, "
+                   "polarity {}, K_max {:.0f} N s/m",
+                   r.name, r.dominant_hz, r.dominant_min_hz, r.dominant_max_hz, r.grid_poses, r.gain_ns_per_m, r.polarity,
+                   r.k_max_ns_per_m);
+    if (!o_.pose_deg.empty())
+      if (auto p = config::pose_problem(pose_schedule_.model, o_.pose_deg))
+        throw config::ConfigError({config::Problem{cfg_.source, {}, "--pose", *p}});
+  } catch (const config::ConfigError& e) {
+    return {StatusKind::kConfigError, e.what()};
+  }
+  return {};
+}
+
+void Cell::configure_pose_sets() {
+  for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i) {
+    const auto& r = pose_schedule_.regions[i];
+    supervisor_->add_parameter_set({with_notch_speed_map(r.config, analysis::LoopModel(r.config).chain().params), true,
+                                    r.k_max_ns_per_m});
+  }
+}
+
+void Cell::post_pose_region(std::optional<std::size_t> region) {
+  const double set = region ? static_cast<double>(*region) : -1.0;
+  if (!loop_->post({rt::CommandKind::kSetPoseRegion, set}))
+    spdlog::warn("the robot's pose moved: the command queue is full, dropped");
+}
+
 Status Cell::configure_parameter_sets() {
-  set_configs_.assign(1, cfg_);
+  set_configs_.assign(1, pose_schedule_.regions.empty() ? cfg_ : pose_schedule_.regions.front().config);
+  if (supervisor_->settings().pose_scheduled)
+    for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i) set_configs_.push_back(pose_schedule_.regions[i].config);
   mounting_sets_.clear();
   mounting_sets_.emplace_back(cfg_.actuator.mounting, 0);
   try {
@@ -335,6 +386,7 @@ Status Cell::cleanup() {
   dds_.reset();
   model_.reset();
   mounting_sets_.clear();
+  pose_schedule_ = {};
   machining_.reset();
   set_configs_.clear();
   state_ = LifecycleState::kUnconfigured;

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "analysis/loop_model.hpp"
+#include "analysis/pose_schedule.hpp"
 #include "rt/loop.hpp"
 #include "rt/realtime.hpp"
 #include "rt/recording.hpp"
@@ -55,6 +56,13 @@ struct CellOptions {
   double connect_timeout_s{10.0};  // hardware: waiting for the CAN transport and the amplifier's first poll
   bool keep_frames{false};         // keep every drained frame in memory (tests)
   rt::TestSignal test_signal{};    // robodamp measure: the chirp added to the command while active
+  // pose_schedule (analysis/pose_schedule.hpp):
+  //  - pose_deg: the robot stands at this pose (simulated backend: the plant is the robot model there and
+  //    the pose is reported to the supervisor at tick 0);
+  //  - pose_schedule_off: region 0's set runs at every pose and the joint angles are not read (what a
+  //    damper tuned at one pose does elsewhere).
+  std::vector<double> pose_deg;
+  bool pose_schedule_off{false};
   // Every drained frame, on the drain thread (progress lines); must not block for long.
   std::function<void(const rt::TelemetryFrame&)> on_frame;
 };
@@ -86,6 +94,8 @@ class Cell {
   void request_stop() noexcept;
   // A parameter request (DDS): validated as the configuration validates its values, then queued.
   [[nodiscard]] dds::Decision handle_request(dds::RequestKind kind, double value);
+  // pose_schedule: each region's set and analysis (empty without a schedule).
+  [[nodiscard]] const analysis::PoseScheduleAnalysis& pose_schedule() const { return pose_schedule_; }
   // The parameter set for a mounting (set 0 is the configuration's own), if there is one.
   [[nodiscard]] std::optional<std::size_t> parameter_set_for(config::Mounting m) const;
 
@@ -109,6 +119,9 @@ class Cell {
  private:
   Status configure_devices();
   Status configure_parameter_sets();
+  Status configure_pose_schedule();  // before the supervisor: region 0's set becomes set 0
+  void configure_pose_sets();        // after it: regions 1.. as sets 1..
+  void post_pose_region(std::optional<std::size_t> region);
   std::vector<Component*> components();
   void on_frame(const rt::TelemetryFrame& f);
   void finish_summary();
@@ -131,6 +144,7 @@ class Cell {
   std::unique_ptr<ArmingPolicy> arming_;
   std::vector<config::Config> set_configs_;       // every parameter set's configuration, index = set
   std::unique_ptr<MachiningMonitor> machining_;   // spindle.job: live stability and the chatter indicator
+  analysis::PoseScheduleAnalysis pose_schedule_;  // region i's set is supervisor set i
   static constexpr double kMachiningSummaryWaitS = 30.0;  // for the limits at the last state (worker thread)
 
   // Active run.

@@ -1,0 +1,155 @@
+#include "analysis/pose_schedule.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "analysis/loop_model.hpp"
+#include "config/number_range.hpp"
+#include "control/controller.hpp"
+#include "robot/robot_model.hpp"
+
+namespace robodamp::analysis {
+
+namespace {
+
+constexpr double kMinModeDampingRatio = 1e-3;  // a mode without joint damping still gets a little
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+config::ConfigError region_error(const config::Config& cfg, std::size_t i, const std::string& message) {
+  return config::ConfigError(config::located(
+      {config::Problem{cfg.source, {}, "pose_schedule.regions[" + std::to_string(i) + "]", message}}, cfg.yaml_text));
+}
+
+// Every pose of a grid_points^n grid over the box (the ends included).
+std::vector<std::vector<double>> grid_over(const config::PoseRegionConfig& r, int points) {
+  const std::size_t n = r.min_deg.size();
+  std::vector<std::vector<double>> out;
+  std::vector<int> idx(n, 0);
+  for (;;) {
+    std::vector<double> q(n);
+    for (std::size_t j = 0; j < n; ++j)
+      q[j] = r.min_deg[j] + (r.max_deg[j] - r.min_deg[j]) * idx[j] / static_cast<double>(points - 1);
+    out.push_back(std::move(q));
+    std::size_t j = 0;
+    while (j < n && ++idx[j] == points) idx[j++] = 0;
+    if (j == n) return out;
+  }
+}
+
+double driving_point_improvement(const LoopModel& m, double gain, int polarity) {
+  for (const FrfResult& f : improvements(m, gain, polarity, true))
+    if (f.response == m.actuator_location() && f.excitation == m.actuator_location()) return f.improvement_pct;
+  return 0.0;
+}
+
+}  // namespace
+
+PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
+  const robot::PlanarChain chain = robot::at_pose(model, q);
+  PoseModes out;
+  double best = std::numeric_limits<double>::infinity();
+  for (const robot::Mode& md : chain.modes(static_cast<std::size_t>(count))) {
+    const double phi = md.tcp_shape(axis);
+    const double w = 2.0 * M_PI * md.freq_hz;
+    if (!(std::abs(phi) > 0.0) || !(w > 0.0)) continue;  // a mode that does not move the TCP along the axis
+    config::ModeConfig c;
+    c.form = config::ModeForm::kStiffness;
+    c.natural_freq_hz = md.freq_hz;
+    c.damping_ratio = std::max(kMinModeDampingRatio, 0.5 * md.loss_factor);
+    c.stiffness_n_per_m = w * w / (phi * phi);
+    if (c.stiffness_n_per_m * c.damping_ratio < best) best = c.stiffness_n_per_m * c.damping_ratio, out.dominant = out.modes.size();
+    out.modes.push_back(c);
+  }
+  if (out.modes.empty())
+    throw config::ConfigError({config::Problem{model.source, {}, "pose", "no mode of " + model.name + " at " +
+                                                                             config::describe_pose(q) + " moves the TCP along the axis"}});
+  return out;
+}
+
+config::Config config_at_pose(const config::Config& base, const PoseModes& modes) {
+  config::Config c = base;
+  for (auto& l : c.robot.locations) l.axis_sign = 1;
+  for (auto& f : c.robot.frfs) f.modes = modes.modes;
+  return c;
+}
+
+namespace {
+
+RegionSet design_region(const config::Config& cfg, const config::RobotModelConfig& model, std::size_t i) {
+  const config::PoseScheduleConfig& s = *cfg.pose_schedule;
+  const config::PoseRegionConfig& r = s.regions[i];
+  RegionSet set;
+  set.name = r.name;
+  for (std::size_t j = 0; j < r.min_deg.size(); ++j) set.centre_deg.push_back(0.5 * (r.min_deg[j] + r.max_deg[j]));
+  const PoseModes centre = pose_modes(model, set.centre_deg, s.axis, s.modes);
+  set.dominant_hz = centre.dominant_hz();
+  set.gain_ns_per_m = r.gain_ns_per_m.value_or(cfg.controller.gain_ns_per_m);
+  set.config = config_at_pose(cfg, centre);
+  set.config.pose_schedule.reset();
+  set.config.controller.match_freq_hz = set.dominant_hz;
+  set.config.controller.gain_ns_per_m = set.gain_ns_per_m;
+  const AnalysisResult a = analyse(LoopModel(set.config), set.gain_ns_per_m, cfg.controller.polarity);
+  set.polarity = a.recommended_polarity;
+  set.config.controller.polarity = set.polarity;
+  set.config.source = cfg.source + " [pose region " + r.name + "]";
+  return set;
+}
+
+// The set against the plant at every pose of the region's grid; throws at the first pose it fails.
+void check_region(const config::Config& cfg, const config::RobotModelConfig& model, std::size_t i, RegionSet& set) {
+  const config::PoseScheduleConfig& s = *cfg.pose_schedule;
+  const double fraction = cfg.supervision.max_gain_fraction;
+  set.k_max_ns_per_m = std::numeric_limits<double>::infinity();
+  set.dominant_min_hz = std::numeric_limits<double>::infinity();
+  set.dominant_max_hz = 0.0;
+  for (const auto& q : grid_over(s.regions[i], s.grid_points)) {
+    const PoseModes pm = pose_modes(model, q, s.axis, s.modes);
+    set.dominant_min_hz = std::min(set.dominant_min_hz, pm.dominant_hz());
+    set.dominant_max_hz = std::max(set.dominant_max_hz, pm.dominant_hz());
+    config::Config at = config_at_pose(set.config, pm);
+    const LoopModel m(at);
+    const double k_max = max_stable_gain(m, set.polarity).value_or(control::kMaxGainNsPerM);
+    if (k_max < set.k_max_ns_per_m) set.k_max_ns_per_m = k_max, set.k_max_pose_deg = q;
+    ++set.grid_poses;
+    const std::string where = "region '" + set.name + "' at " + config::describe_pose(q) + " (dominant mode " +
+                              fmt(pm.dominant_hz()) + " Hz; the set is matched at " + fmt(set.dominant_hz) + " Hz, polarity " +
+                              std::to_string(set.polarity) + ")";
+    if (!m.stable(set.gain_ns_per_m, set.polarity))
+      throw region_error(cfg, i, "has no stable set: " + where + " the loop is unstable at K = " + fmt(set.gain_ns_per_m) +
+                                     " N s/m (K_max there " + fmt(k_max) + " N s/m): split the region or lower its gain_ns_per_m");
+    if (set.gain_ns_per_m > fraction * k_max)
+      throw region_error(cfg, i, "has no set with margin: " + where + " K = " + fmt(set.gain_ns_per_m) +
+                                     " N s/m is above supervision.max_gain_fraction x K_max = " + fmt(fraction) + " x " +
+                                     fmt(k_max) + " N s/m: split the region or lower its gain_ns_per_m");
+  }
+  set.improvement_centre_pct = driving_point_improvement(LoopModel(set.config), set.gain_ns_per_m, set.polarity);
+}
+
+}  // namespace
+
+PoseScheduleAnalysis analyse_pose_schedule(const config::Config& cfg) {
+  PoseScheduleAnalysis out;
+  if (!cfg.pose_schedule) return out;
+  out.model = config::load_robot_model(cfg.pose_schedule->model_resolved);
+  for (std::size_t i = 0; i < cfg.pose_schedule->regions.size(); ++i) {
+    RegionSet set = design_region(cfg, out.model, i);
+    check_region(cfg, out.model, i, set);
+    out.regions.push_back(std::move(set));
+  }
+  return out;
+}
+
+double predicted_improvement_pct(const config::Config& set, const config::RobotModelConfig& model,
+                                 const config::PoseScheduleConfig& schedule, const std::vector<double>& q) {
+  const LoopModel m(config_at_pose(set, pose_modes(model, q, schedule.axis, schedule.modes)));
+  return driving_point_improvement(m, set.controller.gain_ns_per_m, set.controller.polarity);
+}
+
+}  // namespace robodamp::analysis

@@ -1,0 +1,66 @@
+// The controller scheduled by pose (docs/pose_dynamics.md, "Scheduling by pose"): for each region of
+// pose_schedule, the parameter set and its analysis, done once at configuration time.
+//   - The plant at a pose is the robot model's lowest modes at the TCP along the actuator's axis
+//     (modal-stiffness form; every configured FRF path becomes that TCP receptance: the actuator and
+//     the accelerometer sit on the spindle head, at the TCP).
+//   - A region's set is the configuration with the plant at the region's centre, the compensators
+//     matched at that pose's dominant mode, the polarity the analysis recommends there and the region's
+//     gain; it is then analysed against the plant at every pose of a grid over the region (grid_points
+//     per joint). The set's K_max is the smallest found; a pose where the set is unstable, or where its
+//     gain is above supervision.max_gain_fraction x K_max, refuses the whole configuration, naming the
+//     region, the pose and the reason.
+// Off the real-time path.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "config/config.hpp"
+#include "config/robot_model_config.hpp"
+
+namespace robodamp::analysis {
+
+// The robot model's modes at a pose along one axis, lowest first.
+struct PoseModes {
+  std::vector<config::ModeConfig> modes;  // modal-stiffness form, damping from each mode's loss factor / 2
+  std::size_t dominant{0};                // the largest peak receptance along the axis (smallest k zeta)
+  [[nodiscard]] double dominant_hz() const { return modes.empty() ? 0.0 : modes[dominant].natural_freq_hz; }
+};
+// Throws config::ConfigError (a pose outside the travel) or std::invalid_argument (a non-physical model).
+[[nodiscard]] PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
+                                   int axis, int count);
+
+// base with the robot's modal table replaced by the model's at the pose (every location at the TCP,
+// axis_sign +1).
+[[nodiscard]] config::Config config_at_pose(const config::Config& base, const PoseModes& modes);
+
+struct RegionSet {
+  std::string name;
+  std::vector<double> centre_deg;
+  double dominant_hz{0.0};            // at the centre: the compensators' match frequency
+  double gain_ns_per_m{0.0};
+  int polarity{1};                    // recommended by the analysis at the centre
+  config::Config config;              // the set (plant at the centre)
+  double k_max_ns_per_m{0.0};         // smallest over the grid
+  std::vector<double> k_max_pose_deg; // where
+  double dominant_min_hz{0.0}, dominant_max_hz{0.0};  // over the grid
+  double improvement_centre_pct{0.0}; // predicted driving-point improvement at the centre (discrete loop)
+  int grid_poses{0};
+};
+
+struct PoseScheduleAnalysis {
+  config::RobotModelConfig model;
+  std::vector<RegionSet> regions;
+};
+
+// Throws config::ConfigError naming the region, the pose and the reason when a region has no stable set.
+[[nodiscard]] PoseScheduleAnalysis analyse_pose_schedule(const config::Config& cfg);
+
+// The driving-point improvement the analysis predicts for a set at a pose (discrete loop, %): how much
+// the peak of the actuator location's receptance drops with the loop closed.
+[[nodiscard]] double predicted_improvement_pct(const config::Config& set, const config::RobotModelConfig& model,
+                                               const config::PoseScheduleConfig& schedule,
+                                               const std::vector<double>& joints_deg);
+
+}  // namespace robodamp::analysis

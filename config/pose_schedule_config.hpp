@@ -1,0 +1,43 @@
+// The controller scheduled by the robot's pose (docs/pose_dynamics.md, "Scheduling by pose"): boxes of
+// joint angles (regions), each with its own parameter set, designed and analysed at configuration time
+// from the robot model (config/robots/*.yaml) at the region's poses. Read by analysis/pose_schedule
+// (the sets), runtime/ (the hand-over) and drivers/modbus_supervisor (the joint registers).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace robodamp::config {
+
+struct PoseRegionConfig {
+  std::string name;
+  std::vector<double> min_deg, max_deg;  // a box in joint space, one entry per joint
+  std::optional<double> gain_ns_per_m;   // default controller.gain_ns_per_m
+};
+
+struct PoseScheduleConfig {
+  std::string model;           // the robot model file, as written
+  std::string model_resolved;  // resolved against the configuration file
+  int axis{1};                 // the actuator's direction in the model's plane: 0 = x, 1 = y
+  int modes{3};                // the robot's lowest modes put in the loop's plant
+  int grid_points{3};          // per joint over each region (2: its corners; 3: and the middle ...)
+  std::vector<double> workspace_min_deg, workspace_max_deg;  // the regions must cover it (no holes)
+  std::vector<PoseRegionConfig> regions;
+  [[nodiscard]] std::size_t joints() const { return workspace_min_deg.size(); }
+};
+
+// The region for a pose: the current one while the pose stays inside it (regions that overlap give the
+// hand-over its hysteresis), else the first that holds it; nothing when the pose is outside the
+// workspace or every region, or any angle is not finite. No allocation.
+[[nodiscard]] std::optional<std::size_t> region_of(const PoseScheduleConfig& s, const double* joints_deg,
+                                                   std::size_t count, std::optional<std::size_t> current = {});
+[[nodiscard]] bool region_holds(const PoseRegionConfig& r, const double* joints_deg, std::size_t count);
+// A pose of the workspace no region holds (a hole in the map), if there is one. Exact: it tests one
+// point inside each cell of the grid the boxes' faces cut the workspace into.
+[[nodiscard]] std::optional<std::vector<double>> uncovered_pose(const PoseScheduleConfig& s);
+// "[a, b, c] deg"
+[[nodiscard]] std::string describe_pose(const std::vector<double>& joints_deg);
+
+}  // namespace robodamp::config
