@@ -28,6 +28,8 @@ struct PlantArgs {
   std::vector<std::string> spindle_ramps;      // "T0:T1:RPM"
   std::string cut_job;
   double spindle_register_period_s{0.05};
+  std::vector<std::string> pose_at;            // "T:Q1,Q2,..." waypoints
+  double pose_register_period_s{0.05}, pose_update_s{0.02};
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
 
@@ -90,6 +92,17 @@ int run_plant(const PlantArgs& a) {
   }
   eo.cut_job = a.cut_job;
   eo.spindle_register_period_s = a.spindle_register_period_s;
+  for (const auto& item : a.pose_at) {
+    hil::PoseWaypoint w;
+    std::string error;
+    if (!hil::parse_waypoint(item, w, error)) {
+      std::cerr << "robodamp plant: --pose-at = " << error << '\n';
+      return 2;
+    }
+    eo.pose_trajectory.push_back(std::move(w));
+  }
+  eo.pose_register_period_s = a.pose_register_period_s;
+  eo.pose_update_s = a.pose_update_s;
   rt::install_shutdown_handlers();
   eo.stop_flag = &rt::shutdown_signal();
   const hil::EmulatorReport r = hil::run_emulator(cfg, eo);
@@ -138,6 +151,13 @@ void register_plant(Registry& r) {
   sub->add_option("--cut", a->cut_job,
                   "Milling job (config/milling/*.yaml) whose cutting force acts on the robot at the spindle speed")
       ->check(CLI::ExistingFile);
+  sub->add_option("--pose-at", a->pose_at,
+                  "The robot's pose trajectory, a waypoint TIME_S:Q1,Q2,... (plant time, joint angles in deg; linear between "
+                  "waypoints; two with the same pose make a dwell, measured by impacts), repeatable; needs pose_schedule");
+  r.number(sub, "--pose-register-period", a->pose_register_period_s, {"s", 0.0, 10.0},
+           "How often the robot updates its joint registers (plant time)");
+  r.number(sub, "--pose-update", a->pose_update_s, {"s", 0.0002, 10.0},
+           "How often the plant's modes follow the pose (plant time)");
   sub->add_option("--spindle", a->spindle_schedule,
                   "Robot spindle speed register changes, TIME_S:RPM (plant time; modbus.robot.spindle_rpm_register), repeatable");
 }

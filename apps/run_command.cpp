@@ -31,6 +31,8 @@ struct RunArgs {
   std::string job_path;
   double spindle_rpm{0.0};
   bool no_harmonic_notch{false};
+  std::vector<double> pose_deg;  // pose_schedule, simulated plant: the robot stands here
+  bool no_pose_schedule{false};
 };
 
 [[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s) {
@@ -70,7 +72,10 @@ struct RunArgs {
             {"gain_refused", s.supervisor.gain_refused},
             {"params_selected", s.supervisor.params_selected},
             {"params_refused", s.supervisor.params_refused},
-            {"spindle_refused", s.supervisor.spindle_refused}}},
+            {"spindle_refused", s.supervisor.spindle_refused},
+            {"pose_regions", s.supervisor.pose_regions},
+            {"pose_out_of_map", s.supervisor.pose_out_of_map},
+            {"active_parameter_set", s.active_parameter_set}}},
           {"realtime",
            {{"memory_locked", s.realtime.memory_locked},
             {"sched_fifo", s.realtime.fifo},
@@ -122,7 +127,9 @@ struct RunArgs {
                    {"errors", m.errors},                   {"timeouts", m.timeouts},
                    {"link_faults", m.link_faults},         {"coil_writes", m.coil_writes},
                    {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown},
-                   {"spindle_changes", m.spindle_changes}, {"spindle_link_parks", m.spindle_link_parks}};
+                   {"spindle_changes", m.spindle_changes}, {"spindle_link_parks", m.spindle_link_parks},
+                   {"pose_changes", m.pose_changes},       {"pose_out_of_map_polls", m.pose_out_of_map_polls},
+                   {"pose_unavailable_polls", m.pose_unavailable_polls}, {"pose_link_losses", m.pose_link_losses}};
   }
   return j;
 }
@@ -151,11 +158,14 @@ struct RunArgs {
     const auto& m = *s.modbus;
     std::snprintf(b, sizeof b,
                   "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
-                  "%llu link faults, %llu mounting changes\n",
+                  "%llu link faults, %llu mounting changes, %llu pose changes (%llu polls out of the map, %llu not available, "
+                  "%llu link losses)\n",
                   static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
                   static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
                   static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
-                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes));
+                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes),
+                  static_cast<unsigned long long>(m.pose_changes), static_cast<unsigned long long>(m.pose_out_of_map_polls),
+                  static_cast<unsigned long long>(m.pose_unavailable_polls), static_cast<unsigned long long>(m.pose_link_losses));
     os << b;
   }
   if (s.dds) {
@@ -281,6 +291,12 @@ int run_loop(const RunArgs& a) {
   if (!a.clock.empty()) o.clock = a.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
   o.impact_every_s = a.impact_every_s;
   o.record_path = a.record_path;
+  o.pose_deg = a.pose_deg;
+  o.pose_schedule_off = a.no_pose_schedule;
+  if ((!a.pose_deg.empty() || a.no_pose_schedule) && !cfg.pose_schedule) {
+    std::cerr << "robodamp run: --pose and --no-pose-schedule need a configuration with pose_schedule\n";
+    return 2;
+  }
   runtime::Cell cell(cfg, o);
   if (runtime::Status s = cell.configure(); !s.ok()) {
     std::cerr << s.message << '\n';
@@ -346,6 +362,10 @@ void register_run(Registry& r) {
                "Run without the configuration's controller.harmonic_notch (to compare the bank on and off)");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0, false, false, "0 = stopped"},
            "The spindle speed from the start (as the robot's register or a DDS request would set it)");
+  r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0},
+            "pose_schedule, simulated plant: the robot stands at these joint angles (one per joint)");
+  sub->add_flag("--no-pose-schedule", a->no_pose_schedule,
+                "pose_schedule: run the first region's set at every pose and ignore the joint angles (scheduling off)");
 }
 
 }  // namespace robodamp::apps

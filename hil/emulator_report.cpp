@@ -1,5 +1,7 @@
 // The emulator's report as JSON and as the text `robodamp plant` prints (hil/plant_emulator.hpp).
+#include <cmath>
 #include <cstdio>
+#include <string>
 #include <sstream>
 
 #include "hil/plant_emulator.hpp"
@@ -16,8 +18,23 @@ nlohmann::json report_json(const EmulatorReport& r) {
                     {"closed_peak_hz", f.closed_peak_hz},
                     {"measured_improvement_pct", f.improvement_pct},
                     {"coherence_min", f.coherence_min}});
+  json dwells = json::array();
+  for (const auto& d : r.pose_dwells)
+    dwells.push_back({{"joints_deg", d.joints_deg},
+                      {"t0_s", d.t0_s},
+                      {"t1_s", d.t1_s},
+                      {"region", d.region},
+                      {"dominant_hz", d.dominant_hz},
+                      {"records", d.records},
+                      {"open_peak_m_per_n", d.open_peak_m_per_n},
+                      {"closed_peak_m_per_n", d.closed_peak_m_per_n},
+                      {"closed_peak_hz", d.closed_peak_hz},
+                      {"measured_improvement_pct", d.improvement_pct},
+                      {"predicted_improvement_pct", d.predicted_pct},
+                      {"coherence_min", d.coherence_min}});
   const auto& h = r.wake_latency;
   return {{"config", r.config},
+          {"pose", {{"retunes", r.pose_retunes}, {"dwells", dwells}}},
           {"pacing", r.pacing},
           {"transport", r.transport},
           {"modbus", r.modbus},
@@ -103,6 +120,24 @@ std::string report_text(const EmulatorReport& r) {
                     f.improvement_pct, f.coherence_min);
       os << b;
     }
+  }
+  if (!r.pose_dwells.empty()) {
+    std::snprintf(b, sizeof b, "  pose trajectory: the plant's modes retuned %llu times\n",
+                  static_cast<unsigned long long>(r.pose_retunes));
+    os << b;
+  }
+  for (const auto& d : r.pose_dwells) {
+    std::string q;
+    for (double v : d.joints_deg) {
+      if (!q.empty()) q += ' ';
+      q += std::to_string(std::lround(v));
+    }
+    std::snprintf(b, sizeof b,
+                  "    dwell %.1f-%.1f s at [%s] deg (region '%s', dominant mode %.2f Hz): %d records, open %.4g m/N, closed "
+                  "%.4g m/N at %.2f Hz: improvement %.1f %% measured, %.1f %% predicted (coherence min %.3f)\n",
+                  d.t0_s, d.t1_s, q.c_str(), d.region.c_str(), d.dominant_hz, d.records, d.open_peak_m_per_n,
+                  d.closed_peak_m_per_n, d.closed_peak_hz, d.improvement_pct, d.predicted_pct, d.coherence_min);
+    os << b;
   }
   if (r.cutting.cut) {
     const auto& c = r.cutting;

@@ -75,6 +75,15 @@ class Registers {
                                                                    m == config::Mounting::kVertical ? m_.robot.vertical_value
                                                                                                     : m_.robot.horizontal_value));
   }
+  // The joint angles in the robot's registers: signed counts of deg_per_count; -32768 = not available.
+  void set_joints(const std::vector<double>& q) {
+    if (!m_.robot_link || m_.robot.joints_register < 0) return;
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      const double counts = std::isfinite(q[i]) ? std::clamp(std::round(q[i] / m_.robot.deg_per_count), -32767.0, 32767.0) : -32768.0;
+      robot_->set_holding_register(m_.robot.joints_register + static_cast<int>(i),
+                                   static_cast<std::uint16_t>(static_cast<std::int16_t>(counts)));
+    }
+  }
   void hang() {
     amp_->set_responding(false);
     if (robot_server_) robot_server_->set_responding(false);
@@ -109,7 +118,9 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.transport = can.interface;
   const double fs = cfg.loop.rate_hz, dt = 1.0 / fs;
 
-  const sim::PlantModel model = sim::build_plant_model(cfg);
+  std::optional<PoseTrajectory> trajectory;
+  if (!o.pose_trajectory.empty()) trajectory.emplace(cfg, o.pose_trajectory);
+  const sim::PlantModel model = trajectory ? trajectory->plant_at(trajectory->at(0.0)) : sim::build_plant_model(cfg);
   sim::Plant plant = make_plant(cfg, model);
   const int impact_id = o.impact_location > 0 ? o.impact_location
                                               : (cfg.robot.frfs.empty() ? 1 : cfg.robot.frfs.front().excitation_location);
@@ -122,6 +133,9 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   Registers regs(cfg);
   rep.modbus = regs.describe();
   regs.set_temperature(cfg.hil.ambient_c);
+  std::vector<double> pose_now = trajectory ? trajectory->at(0.0) : std::vector<double>{};
+  double pose_published_s = 0.0, pose_retuned_s = 0.0;
+  if (trajectory) regs.set_joints(pose_now);
 
   // The controller's connection.
   std::optional<drivers::CanListener> listener;
@@ -158,8 +172,15 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     spdlog::info("robodamp plant: commissioning measurement: {} impacts at each location from {:.1f} s, FRFs to {}",
                  cfg.commissioning.impacts_per_location, analysis::commissioning_plan(cfg, model).impacts_start_s.front(),
                  o.measure_out);
-  } else if (o.impacts) {
+  } else if (o.impacts && !trajectory) {
     campaign.emplace(cfg, plant, test);
+  }
+  std::optional<DwellCampaigns> dwell_campaigns;
+  if (trajectory && o.impacts) {
+    dwell_campaigns.emplace(cfg, plant, *trajectory, test);
+    rep.records_planned = 0;
+    spdlog::info("robodamp plant: the robot moves along {} waypoints; impacts at {} dwells", o.pose_trajectory.size(),
+                 dwell_campaigns->count());
   }
   // The spindle (steps and ramps) and the cut at its speed.
   std::vector<SpindleChange> changes = o.spindle_ramps;
@@ -260,7 +281,19 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     const std::size_t k = rep.ticks;
     const double t = static_cast<double>(k) * dt;
     if (campaign) campaign->before_step(k);
+    if (dwell_campaigns) dwell_campaigns->before_step(k);
     if (modal_test) modal_test->before_step(k);
+    if (trajectory) {  // the robot moves: its registers, then the plant's modes at the pose now
+      if (t >= pose_published_s + o.pose_register_period_s) regs.set_joints(trajectory->at(t)), pose_published_s = t;
+      if (t >= pose_retuned_s + o.pose_update_s) {
+        pose_retuned_s = t;
+        if (std::vector<double> q = trajectory->at(t); q != pose_now) {
+          plant.retune(trajectory->plant_at(q));
+          pose_now = std::move(q);
+          ++rep.pose_retunes;
+        }
+      }
+    }
     // The robot controller updates its spindle register every spindle_register_period_s (a ramp arrives
     // as a staircase the controller's settle rule can follow); the cut sees the speed itself.
     const double rpm = cutting.before_step(t);
@@ -270,6 +303,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     }
     plant.step(ready ? applied_v : 0.0);
     cutting.after_step(ready ? applied_v : 0.0, dt);
+    if (dwell_campaigns) dwell_campaigns->after_step(k);
     if (modal_test) modal_test->after_step(k);
     if (campaign) {
       campaign->after_step(k);
@@ -371,6 +405,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.modbus_requests = regs.requests();
   rep.cutting = cutting.report();
 
+  if (dwell_campaigns) rep.pose_dwells = dwell_campaigns->finish();
   if (modal_test) {
     rep.measure_records = modal_test->records();
     rep.measure_files = modal_test->write_frf_csvs(o.measure_out);

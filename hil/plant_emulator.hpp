@@ -32,6 +32,7 @@
 #include "analysis/modal_test.hpp"
 #include "analysis/spectral.hpp"
 #include "hil/cutting_load.hpp"
+#include "hil/pose_trajectory.hpp"
 #include "config/config.hpp"
 #include "rt/timing_histogram.hpp"
 
@@ -61,6 +62,12 @@ struct EmulatorOptions {
   // (hil/cutting_load.hpp). Empty = no cut.
   std::string cut_job;
   int cut_harmonics{12};
+  // The robot moving (hil/pose_trajectory.hpp): waypoints (plant time, joint angles), the joint
+  // registers written every pose_register_period_s and the plant's modes retuned every pose_update_s.
+  // With a trajectory the impacts run at each dwell (two waypoints with the same pose) instead of once.
+  std::vector<PoseWaypoint> pose_trajectory;
+  double pose_register_period_s{0.05};
+  double pose_update_s{0.02};
   bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
   // Faults injected at plant times (s; negative = none), to measure how the controller gets to its safe
   // state: the CAN bus goes off (an error frame with CAN_ERR_BUSOFF, no sensor frames for bus_off_for_s,
@@ -122,6 +129,9 @@ struct EmulatorReport {
   int measure_records{0}, measure_records_planned{0};
   std::vector<std::string> measure_files;
   CuttingReport cutting;
+  // The pose trajectory: plant retunes and what each dwell measured.
+  std::uint64_t pose_retunes{0};
+  std::vector<PoseDwellReport> pose_dwells;
 };
 
 // Serves one controller connection and returns when it disconnects (or max_duration_s, or the stop

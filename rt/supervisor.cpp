@@ -63,7 +63,7 @@ const char* to_string(ArmRefusal r) {
     case ArmRefusal::kSensorNotLive: return "sensor not live (needs supervision.arming_live_cycles fresh valid samples)";
     case ArmRefusal::kActuatorPath: return "actuator path not healthy (driver or amplifier fault)";
     case ArmRefusal::kAnalysisUnstable: return "the analysis does not find the loop stable at this gain with margin";
-    case ArmRefusal::kPoseUnknown: return "the robot's pose is not known to be in a region of pose_schedule";
+    case ArmRefusal::kPoseUnknown: return "the robot's pose is not known to be in a region of pose_schedule, or that region's set is still being handed over";
   }
   return "?";
 }
@@ -180,7 +180,7 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         refusal_ = ArmRefusal::kSensorNotLive;
       else if (!path_ok_)
         refusal_ = ArmRefusal::kActuatorPath;
-      else if (!pose_known_ || (s_.pose_scheduled && pose_set_ != active_parameter_set()))
+      else if (!pose_known_ || (s_.pose_scheduled && (pose_set_ != active_parameter_set() || controller_.handover_pending())))
         refusal_ = ArmRefusal::kPoseUnknown;
       else if (!sets_[active_parameter_set()].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
         refusal_ = ArmRefusal::kAnalysisUnstable;

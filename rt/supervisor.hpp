@@ -8,8 +8,8 @@
 //          any --trip--> Fault (command ramps to zero within trip_ramp_s, then the amplifier is disabled;
 //          latched until reset_fault, which returns to Disabled once the ramp is over).
 // Arming is refused unless the sensor is live (arming_live_cycles fresh valid samples in a row), the
-// actuator path is healthy (drivers ok, amplifier without fault) and the analysis found the configured
-// loop stable. Activation and disarming fade the command in and out over controller.gain_ramp_s; gain
+// actuator path is healthy (drivers ok, amplifier without fault), the analysis found the configured
+// loop stable and, with a pose schedule, the pose is in a region whose set is in place (handed over). Activation and disarming fade the command in and out over controller.gain_ramp_s; gain
 // requests are validated (0 <= K <= max_gain_fraction x the analysed maximum stable K) and ramped by the
 // controller; a parameter-set selection is validated the same way (the set's own analysis) and handed
 // over by the controller (fade out, swap, fade in); everything is applied at the tick boundary.

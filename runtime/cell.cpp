@@ -69,7 +69,10 @@ Status Cell::configure() {
   stable_ = model_->stable(set0.controller.gain_ns_per_m, polarity);
   max_stable_gain_ = analysis::max_stable_gain(*model_, polarity);
   double k_max = max_stable_gain_.value_or(control::kMaxGainNsPerM);
-  if (!pose_schedule_.regions.empty()) k_max = std::min(k_max, pose_schedule_.regions.front().k_max_ns_per_m);
+  if (!pose_schedule_.regions.empty()) {
+    k_max = std::min(k_max, pose_schedule_.regions.front().k_max_ns_per_m);
+    max_stable_gain_ = k_max;
+  }
   rt::SupervisorSettings settings = rt::supervisor_settings(cfg_, stable_, k_max);
   settings.test_signal = o_.test_signal;
   settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
@@ -361,6 +364,7 @@ void Cell::finish_summary() {
   s.spindle_rpm = supervisor_->controller().spindle_rpm();
   s.notch_centre_hz = supervisor_->controller().notches().settings().enabled ? supervisor_->controller().notches().centre_hz() : 0.0;
   s.final_state = rt::to_string(supervisor_->state());
+  s.active_parameter_set = supervisor_->active_parameter_set();
   s.trip = rt::to_string(supervisor_->latched_trip());
   s.trip_description = rt::describe(supervisor_->latched_trip());
   s.arming.outcome = arming_->outcome();

@@ -42,6 +42,7 @@ struct RunSummary {
   rt::LoopStats loop;
   rt::SupervisorCounters supervisor;
   std::string final_state, trip, trip_description;
+  std::size_t active_parameter_set{0};  // at the end (pose_schedule: the region's index)
   ArmingReport arming;
   double max_stable_gain_ns_per_m{0.0};
   bool analysis_stable{false};

@@ -148,4 +148,12 @@ Vector ModalStep::state() const {
   return x;
 }
 
+void ModalStep::set_state(const Vector& x) {
+  if (x.size() != static_cast<Eigen::Index>(states()))
+    throw std::invalid_argument("ModalStep::set_state: " + std::to_string(x.size()) + " states for a plant of " +
+                                std::to_string(states()));
+  act_ = x.head(2);
+  for (std::size_t i = 0; i < x_.size(); ++i) x_[i] = x.segment(2 + 2 * static_cast<Eigen::Index>(ss_block_[i]), 2);
+}
+
 }  // namespace robodamp::sim

@@ -39,6 +39,8 @@ class ModalStep {
   [[nodiscard]] double output(std::size_t row, const double* u) const noexcept;
   // The whole state in ss's order (tests and cross-checks; allocates).
   [[nodiscard]] Vector state() const;
+  // Sets it (same order and size as state()); throws std::invalid_argument on another size.
+  void set_state(const Vector& x);
 
  private:
   // Consecutive blocks [begin, end) driven by the force at one location (and the actuator or not).

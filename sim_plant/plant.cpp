@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 namespace robodamp::sim {
 
@@ -25,6 +27,25 @@ Plant::Plant(PlantModel model, const config::Config& cfg)
   u_.assign(static_cast<std::size_t>(nu), 0.0);
   coil_history_.assign(static_cast<std::size_t>(zoh_.steps) + 2, 0.0);
   period_force_.assign(model_.locations.size(), 0.0);
+}
+
+void Plant::retune(PlantModel model) {
+  if (model.locations.size() != model_.locations.size())
+    throw std::invalid_argument("Plant::retune: the new structure has " + std::to_string(model.locations.size()) +
+                                " locations, the plant " + std::to_string(model_.locations.size()));
+  const Vector x = step_.state();
+  model_ = std::move(model);
+  const Matrix& b = model_.ss.b;
+  zoh_ = discretise_zoh_delayed(model_.ss.a, b.leftCols(1), h_s_, model_.actuator.delay_s);
+  const Zoh forces = discretise_zoh(model_.ss.a, b.rightCols(b.cols() - 1), h_s_);
+  step_ = ModalStep(model_.ss, zoh_, forces.gamma);
+  if (static_cast<std::size_t>(x.size()) == step_.states()) {
+    step_.set_state(x);
+  } else {
+    Vector y = Vector::Zero(static_cast<Eigen::Index>(step_.states()));
+    y.head(2) = x.head(2);
+    step_.set_state(y);
+  }
 }
 
 void Plant::reset() {

@@ -42,6 +42,11 @@ class Plant {
   FaultInjector& faults() { return faults_; }
   // Zero state, empty delay line, time 0, counters cleared; excitations and faults stay.
   void reset();
+  // The same plant with another structure (the robot at another pose; same locations and actuator):
+  // the discretisation is rebuilt and the state carried over mode block by mode block (frozen
+  // coefficients: right while the modes move slowly against their periods); with another number of
+  // modes only the actuator's state is kept. Allocates: between steps, off the controller's path.
+  void retune(PlantModel model);
 
   // RT-safe. One loop period with the amplifier input held at drive_v.
   void step(double drive_v) noexcept;

@@ -49,6 +49,7 @@ inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<s
   replace_all(text, "unix:/tmp/robodamp-hil.sock", "unix:" + f.dir + "/can.sock");
   replace_all(text, "unix:/tmp/robodamp-hil-cut.sock", "unix:" + f.dir + "/can.sock");
   replace_all(text, "job: milling/", std::string("job: ") + ROBODAMP_SOURCE_DIR + "/config/milling/");
+  replace_all(text, "model: robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
   replace_all(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
   replace_all(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
   for (const auto& [from, to] : edits) replace_all(text, from, to);
