@@ -618,12 +618,13 @@ void check_location_refs(Diagnostics& d, const Config& c, const YAML::Node& root
 namespace {
 
 // modbus.robot.joints_register against pose_schedule: one register per joint, clear of the others.
-void check_joint_registers(detail::Diagnostics& d, const Config& c, const YAML::Node& root) {
+void check_joint_registers(detail::Diagnostics& d, const Config& c) {
+  const SourceMark here{};  // located() gives it the key's line
   if (!c.modbus) return;
   const RobotRegisters& r = c.modbus->robot;
   if (r.joints_register < 0) return;
   if (!c.pose_schedule) {
-    d.add(root.Mark(), "modbus.robot.joints_register",
+    d.add(here, "modbus.robot.joints_register",
           "= " + std::to_string(r.joints_register) + " is set without pose_schedule: the joint angles would select nothing");
     return;
   }
@@ -631,11 +632,11 @@ void check_joint_registers(detail::Diagnostics& d, const Config& c, const YAML::
   for (const auto& [key, reg] : {std::pair{"mounting_register", r.mounting_register},
                                  std::pair{"spindle_rpm_register", r.spindle_rpm_register}})
     if (reg >= first && reg <= last)
-      d.add(root.Mark(), "modbus.robot.joints_register",
+      d.add(here, "modbus.robot.joints_register",
             "= " + std::to_string(first) + " covers registers " + std::to_string(first) + "-" + std::to_string(last) +
                 " (one per joint), which holds modbus.robot." + key + " = " + std::to_string(reg) + ": they must differ");
   if (last > 65535)
-    d.add(root.Mark(), "modbus.robot.joints_register", "= " + std::to_string(first) + ": the joints' registers run past 65535");
+    d.add(here, "modbus.robot.joints_register", "= " + std::to_string(first) + ": the joints' registers run past 65535");
 }
 
 }  // namespace
@@ -669,7 +670,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   if (c.pose_schedule && !c.parameter_sets.empty())
     d.add(root.Mark(), "pose_schedule",
           "and parameter_sets select parameter sets both: a configuration schedules by pose or by mounting, not both");
-  check_joint_registers(d, c, root);
+  check_joint_registers(d, c);
   top.finish();
   check_location_refs(d, c, root);
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

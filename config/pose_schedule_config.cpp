@@ -119,7 +119,8 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
     try {
       model = load_robot_model(c.model_resolved);
     } catch (const ConfigError& e) {
-      d.add(r.mark(), "pose_schedule.model", "= '" + c.model + "': " + e.what());
+      const std::string why = e.problems().empty() ? e.what() : e.problems().front().to_string();
+      d.add(r.mark(), "pose_schedule.model", "= '" + c.model + "': " + why);
     }
   }
   if (auto v = r.choice("axis", {"x", "y"}, "y")) c.axis = *v == "x" ? 0 : 1;

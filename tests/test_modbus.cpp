@@ -13,6 +13,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
+#include <optional>
 #include <random>
 #include <thread>
 #include <vector>
@@ -227,6 +229,70 @@ TEST(Modbus, SpindleRegisterSettlesScalesAndALostLinkParksTheNotches) {
   server.stop();  // the robot controller goes away
   ASSERT_TRUE(eventually([&] { return sup.counters().spindle_link_parks == 1; }));
   EXPECT_EQ(seen().back(), 0.0);
+  sup.stop();
+}
+
+// The joint registers (pose_schedule): the region settles before it is handed over, the overlap keeps
+// the region the pose is in, a register at -32768 (the robot's "not available") and a pose outside every
+// region hand over "out of the map", and a lost link makes the pose unknown after link_timeout_s.
+TEST(Modbus, JointRegistersSettleToARegionAndUnknownPosesAreOutOfTheMap) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  config::ModbusConfig cfg = client_config(port);
+  cfg.robot.joints_register = 20;
+  cfg.robot.deg_per_count = 0.01;
+  config::PoseScheduleConfig schedule;
+  schedule.workspace_min_deg = {-10.0, 0.0};
+  schedule.workspace_max_deg = {10.0, 100.0};
+  schedule.regions = {{"low", {-10.0, 0.0}, {10.0, 55.0}, {}}, {"high", {-10.0, 45.0}, {10.0, 100.0}, {}}};
+  std::mutex m;
+  std::vector<long> regions;  // -1: out of the map
+  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  sup.set_pose_callback(schedule, [&](std::optional<std::size_t> r) {
+    std::lock_guard<std::mutex> lock(m);
+    regions.push_back(r ? static_cast<long>(*r) : -1L);
+  });
+  auto seen = [&] {
+    std::lock_guard<std::mutex> lock(m);
+    return regions;
+  };
+  auto set_pose = [&](double q1, double q2) {
+    server.set_holding_register(20, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(q1 / 0.01))));
+    server.set_holding_register(21, static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(q2 / 0.01))));
+  };
+  set_pose(-5.0, 30.0);
+  sup.start();
+  ASSERT_TRUE(eventually([&] { return seen().size() == 1; }));
+  EXPECT_EQ(seen().back(), 0);
+  EXPECT_TRUE(eventually([&] { return sup.joints_deg() == std::vector<double>{-5.0, 30.0}; }));
+  set_pose(-5.0, 50.0);  // in the overlap: stays low
+  set_pose(-5.0, 70.0);  // high
+  ASSERT_TRUE(eventually([&] { return seen().size() == 2; }));
+  EXPECT_EQ(seen().back(), 1);
+  set_pose(-5.0, 50.0);  // in the overlap: stays high
+  ASSERT_TRUE(eventually([&] { return sup.counters().robot_polls > 20 && sup.joints_deg().at(1) == 50.0; }));
+  const auto polls = sup.counters().robot_polls;
+  ASSERT_TRUE(eventually([&] { return sup.counters().robot_polls > polls + 5; }));
+  EXPECT_EQ(seen().size(), 2u);
+  server.set_holding_register(21, 0x8000);  // not available
+  ASSERT_TRUE(eventually([&] { return seen().size() == 3; }));
+  EXPECT_EQ(seen().back(), -1);
+  EXPECT_GT(sup.counters().pose_unavailable_polls, 0u);
+  EXPECT_TRUE(std::isnan(sup.joints_deg().at(1)));
+  set_pose(-5.0, 20.0);
+  ASSERT_TRUE(eventually([&] { return seen().size() == 4; }));
+  EXPECT_EQ(seen().back(), 0);
+  set_pose(50.0, 20.0);  // joint 1 outside the workspace
+  ASSERT_TRUE(eventually([&] { return seen().size() == 5; }));
+  EXPECT_EQ(seen().back(), -1);
+  EXPECT_GT(sup.counters().pose_out_of_map_polls, 0u);
+  set_pose(-5.0, 20.0);
+  ASSERT_TRUE(eventually([&] { return seen().size() == 6; }));
+  server.stop();  // the robot controller goes away
+  ASSERT_TRUE(eventually([&] { return seen().size() == 7; }));
+  EXPECT_EQ(seen().back(), -1);
+  EXPECT_EQ(sup.counters().pose_link_losses, 1u);
+  EXPECT_EQ(sup.counters().pose_changes, 7u);
   sup.stop();
 }
 

@@ -349,6 +349,50 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   EXPECT_EQ(r.mismatches, 0U);
 }
 
+// A loop scheduled by pose (config/presets/pose_scheduled_c2.yaml, the robot standing folded): the pose
+// arrives, the loop arms, the pose moves to the stretched region and back (two hand-overs), then out of
+// the map (a trip), a reset and the pose back: the loop thread allocates nothing and takes no lock, and
+// the recording replays bit for bit.
+TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
+  runtime::CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  o.arm_at_start = false;
+  o.impact_every_s = 0.0;
+  const config::Config cfg = config::load_config_file(test::preset("pose_scheduled_c2"));
+  runtime::Cell session(cfg, o);
+  test::configure(session);
+  rt::Loop& loop = session.loop();
+  const auto at = [](double t) { return static_cast<std::uint64_t>(t * 5000); };
+  loop.schedule(1, {rt::CommandKind::kSetPoseRegion, 0.0});
+  loop.schedule(at(0.5), {rt::CommandKind::kArm, 0.0});
+  loop.schedule(at(3.0), {rt::CommandKind::kSetPoseRegion, 1.0});
+  loop.schedule(at(12.0), {rt::CommandKind::kSetPoseRegion, 0.0});
+  loop.schedule(at(21.0), {rt::CommandKind::kSetPoseRegion, -1.0});
+  loop.schedule(at(22.0), {rt::CommandKind::kResetFault, 0.0});
+  loop.schedule(at(22.1), {rt::CommandKind::kSetPoseRegion, 0.0});
+  const std::string path = ::testing::TempDir() + "/alloc_pose.rec";
+  rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kVirtual));
+  rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
+  drain.start();
+  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
+  t_loop_thread = true;
+  loop.run(at(25.0));
+  t_loop_thread = false;
+  const long during = g_loop_thread_allocations.load() - before;
+  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken on the loop thread";
+  drain.stop();
+  recorder.close();
+  EXPECT_EQ(during, 0) << "allocations on the loop thread";
+  const auto& c = session.supervisor().counters();
+  EXPECT_EQ(c.params_selected, 2U);
+  EXPECT_EQ(c.pose_regions, 4U);
+  EXPECT_EQ(c.pose_out_of_map, 1U);
+  EXPECT_EQ(c.trips[static_cast<std::size_t>(rt::Trip::kPoseOutOfMap)], 1U);
+  EXPECT_EQ(session.supervisor().state(), rt::State::kDisabled);
+  const rt::ReplayResult r = rt::replay(rt::read_recording(path));
+  EXPECT_EQ(r.mismatches, 0U);
+}
+
 // robodamp measure's loop: the supervisor's chirp test signal with K = 0 and the plant-side impact test
 // (analysis::ModalTest on the simulated backend's step hook) through the whole commissioning plan: the
 // loop thread allocates nothing and takes no lock.
