@@ -16,6 +16,7 @@
 #include "analysis/fft.hpp"
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/milling_report.hpp"
 #include "milling/cut_job.hpp"
 #include "milling/cut_stability.hpp"
 #include "milling/lobes.hpp"
@@ -35,6 +36,7 @@ struct CutArgs {
   bool critical{false};
   bool damped{false};
   std::string json_path, plot_dir;
+  std::vector<double> pose_deg;  // the joints of the job's robot pose parts
 };
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
@@ -121,7 +123,10 @@ std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
 
 int run_cut(const CutArgs& a) {
   try {
-    const config::MillingConfig cfg = config::load_milling_config(a.config_path);
+    config::MillingConfig cfg = config::load_milling_config(a.config_path);
+    MillingOptions pose;
+    pose.pose_deg = a.pose_deg;
+    apply_pose(cfg, pose);
     const milling::Structure structure(structure_of(cfg, a.structure), false);
     milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
     std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
@@ -203,6 +208,7 @@ void register_cut(Registry& r) {
                         [a] { return run_cut(*a); });
   sub->add_option("--config", a->config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
   sub->add_option("--structure", a->structure, "Which of the job's structures (default: its `structure`)");
+  r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
   r.numbers(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, true, false}, "Spindle speed (several with --critical)");
   r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "Axial depth (default: the job's)");
   r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 1000.0, true, false, "and at most the tool's diameter"},

@@ -16,10 +16,6 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   CutJob j;
   j.cutter = cutter_from(cfg.tool);
   j.material = cfg.material;
-  if (structure.has_pose_part())
-    problems.push_back({cfg.source, {}, "structures." + structure.name(),
-                        "has a robot pose part: the time-domain cut needs modal tables (xx, xy, yx, yy) or a controller "
-                        "location; use lobes or sle at a pose (docs/pose_dynamics.md)"});
   j.terms = cutter_modal_terms(structure, cfg.cut.feed_axis);
   if (j.terms.empty())
     problems.push_back({cfg.source, {}, "structures." + structure.name(),

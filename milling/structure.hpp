@@ -58,8 +58,12 @@ class Structure {
   [[nodiscard]] const std::string& name() const { return name_; }
   [[nodiscard]] bool damped() const { return damped_; }
   [[nodiscard]] bool has_controller() const;
-  // Parts given as a robot model at a pose (frequency domain only: the time-domain cut needs modal terms).
+  // Parts given as a robot model at a pose: the frequency domain uses the model's exact TCP receptance,
+  // the time-domain cut its lowest modes (pose_modes_for_cut of them, mass-normalised, hysteretic
+  // damping as viscous zeta = loss factor / 2).
   [[nodiscard]] bool has_pose_part() const { return !poses_.empty(); }
+  [[nodiscard]] const std::vector<std::shared_ptr<const robot::PlanarChain>>& pose_chains() const { return poses_; }
+  static constexpr std::size_t kPoseModesForCut = 8;
   // The modal tables summed per direction pair [xx, xy, yx, yy], machine frame, as given.
   [[nodiscard]] const std::array<config::FrfConfig, 4>& modal_terms() const { return modal_; }
   // Each controller part's open-loop robot FRF at its location (physical frame) and its direction

@@ -26,6 +26,16 @@ std::vector<CutterModalTerm> cutter_modal_terms(const Structure& structure, conf
       const modal::ModeNumerator n = modal::mode_numerator(mode);
       add(out, k / 2, k % 2, 2.0 * M_PI * mode.natural_freq_hz, mode.damping_ratio, n.a, n.b);
     }
+  // A robot model at a pose: mode r contributes phi_r phi_e / (s^2 + 2 zeta w s + w^2) to H_re, with the
+  // mass-normalised TCP shape phi (docs/pose_dynamics.md).
+  constexpr double kMinZeta = 1e-9;  // the links have no damping of their own
+  for (const auto& chain : structure.pose_chains())
+    for (const auto& md : chain->modes(Structure::kPoseModesForCut)) {
+      const double wn = 2.0 * M_PI * md.freq_hz, zeta = std::max(kMinZeta, 0.5 * md.loss_factor);
+      for (int r = 0; r < 2; ++r)
+        for (int e = 0; e < 2; ++e)
+          if (const double a = md.tcp_shape(r) * md.tcp_shape(e); a != 0.0 && wn > 0.0) add(out, r, e, wn, zeta, a, 0.0);
+    }
   for (const auto& c : structure.controller_paths())
     for (const auto& m : c.path.modes) {
       const int d = static_cast<int>(c.direction);

@@ -342,6 +342,35 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   EXPECT_EQ(fitted.poses.size(), 3U);
 }
 
+// The pose schedule from the command line: analyze prints each region's set; run stands the simulated
+// robot at a pose; bad poses and waypoints are refused by name, with exit status 2.
+TEST(Cli, PoseScheduleAnalyzeRunAndBadPoses) {
+  const std::string cfg = robodamp::test::preset("pose_scheduled_c2");
+  const Result a = run("analyze --config " + cfg);
+  ASSERT_EQ(a.status, 0) << a.out;
+  EXPECT_NE(a.out.find("folded       [-100, 12.5, 90] deg"), std::string::npos) << a.out;
+  EXPECT_NE(a.out.find("stretched    [-100, 80, 90] deg"), std::string::npos) << a.out;
+  const Result r = run("run --config " + cfg + " --clock virtual --duration 6 --pose -100 10 90");
+  EXPECT_EQ(r.status, 0) << r.out;
+  const Result outside = run("run --config " + cfg + " --clock virtual --duration 1 --pose -100 10");
+  EXPECT_EQ(outside.status, 2);
+  EXPECT_NE(outside.out.find("a pose needs 3 joint angles (deg), got 2"), std::string::npos) << outside.out;
+  const Result no_schedule = run("run --clock virtual --duration 1 --pose -100 10 90");
+  EXPECT_EQ(no_schedule.status, 2);
+  EXPECT_NE(no_schedule.out.find("--pose and --no-pose-schedule need a configuration with pose_schedule"), std::string::npos)
+      << no_schedule.out;
+  const std::string hil = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_pose_schedule.yaml";
+  const Result bad_waypoint = run("plant --config " + hil + " --pose-at 3:-100,abc,90");
+  EXPECT_EQ(bad_waypoint.status, 2);
+  EXPECT_NE(bad_waypoint.out.find("joint angle 'abc' is not a number in -360..360 deg"), std::string::npos) << bad_waypoint.out;
+  const Result backwards = run("plant --config " + hil + " --pose-at 3:-100,10,90 --pose-at 1:-100,20,90");
+  EXPECT_EQ(backwards.status, 2);
+  EXPECT_NE(backwards.out.find("waypoint 2 at 1 s comes before the one before it"), std::string::npos) << backwards.out;
+  const Result travel = run("plant --config " + hil + " --pose-at 0:-100,190,90");
+  EXPECT_EQ(travel.status, 2);
+  EXPECT_NE(travel.out.find("waypoint 1 at 0 s: joint 2 = 190 deg is out of range"), std::string::npos) << travel.out;
+}
+
 TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData) {
   const robodamp::identify::CuttingTest t{3, 12.7, 2.0, 3.175, robodamp::config::MillingMode::kDown};
   auto write_csv = [&](const std::string& path, const std::vector<double>& feeds) {
