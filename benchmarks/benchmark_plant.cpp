@@ -6,8 +6,10 @@
 #include <benchmark/benchmark.h>
 
 #include <string>
+#include <vector>
 
 #include "analysis/loop_model.hpp"
+#include "analysis/pose_schedule.hpp"
 #include "control/controller.hpp"
 #include "sim_plant/plant.hpp"
 
@@ -76,6 +78,54 @@ void BM_PlantAndController(benchmark::State& state) {
   set_counters(state, cfg, plant, ticks);
 }
 BENCHMARK(BM_PlantAndController)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
+
+// The HIL emulator along a pose trajectory (docs/pose_dynamics.md): each pose update builds the robot
+// model's modes at the pose and retunes the plant (a new exact discretisation, the state carried over).
+// At its default period (0.02 s) this costs one update per 100 loop ticks.
+void BM_PoseRetune(benchmark::State& state) {
+  const config::Config cfg =
+      config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/pose_scheduled_c2.yaml");
+  const config::RobotModelConfig model = config::load_robot_model(cfg.pose_schedule->model_resolved);
+  const auto at = [&](double q2) {
+    return sim::build_plant_model(analysis::config_at_pose(cfg, analysis::pose_modes(model, {-100.0, q2, 90.0}, 0, 3)));
+  };
+  sim::Plant plant(at(10.0), cfg);
+  double q2 = 10.0;
+  for (auto _ : state) {
+    q2 = q2 < 130.0 ? q2 + 0.1 : 10.0;
+    plant.retune(at(q2));
+    plant.step(0.0);
+  }
+}
+BENCHMARK(BM_PoseRetune)->Unit(benchmark::kMicrosecond);
+
+// The same with the structures built beforehand (what the emulator does: the trajectory is known before
+// the run): the retune alone.
+void BM_PoseRetunePrebuilt(benchmark::State& state) {
+  const config::Config cfg =
+      config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/pose_scheduled_c2.yaml");
+  const config::RobotModelConfig model = config::load_robot_model(cfg.pose_schedule->model_resolved);
+  std::vector<sim::PlantModel> models;
+  for (double q2 = 10.0; q2 < 130.0; q2 += 1.0)
+    models.push_back(sim::build_plant_model(analysis::config_at_pose(cfg, analysis::pose_modes(model, {-100.0, q2, 90.0}, 0, 3))));
+  sim::Plant plant(models.front(), cfg);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    plant.retune(models[i]);
+    i = (i + 1) % models.size();
+    plant.step(0.0);
+  }
+}
+BENCHMARK(BM_PoseRetunePrebuilt)->Unit(benchmark::kMicrosecond);
+
+// The configuration-time analysis of the preset's schedule: two regions, 27 poses each (robodamp analyze,
+// and every cell's configure()).
+void BM_PoseScheduleAnalysis(benchmark::State& state) {
+  const config::Config cfg =
+      config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/pose_scheduled_c2.yaml");
+  for (auto _ : state) benchmark::DoNotOptimize(analysis::analyse_pose_schedule(cfg));
+}
+BENCHMARK(BM_PoseScheduleAnalysis)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 

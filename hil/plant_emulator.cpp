@@ -133,9 +133,13 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   Registers regs(cfg);
   rep.modbus = regs.describe();
   regs.set_temperature(cfg.hil.ambient_c);
-  std::vector<double> pose_now = trajectory ? trajectory->at(0.0) : std::vector<double>{};
-  double pose_published_s = 0.0, pose_retuned_s = 0.0;
-  if (trajectory) regs.set_joints(pose_now);
+  double pose_published_s = 0.0;
+  std::vector<std::pair<double, sim::PlantModel>> retunes;  // the structure along the trajectory, built now
+  std::size_t next_retune = 0;
+  if (trajectory) {
+    regs.set_joints(trajectory->at(0.0));
+    retunes = trajectory->retunes(o.pose_update_s);
+  }
 
   // The controller's connection.
   std::optional<drivers::CanListener> listener;
@@ -285,13 +289,9 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     if (modal_test) modal_test->before_step(k);
     if (trajectory) {  // the robot moves: its registers, then the plant's modes at the pose now
       if (t >= pose_published_s + o.pose_register_period_s) regs.set_joints(trajectory->at(t)), pose_published_s = t;
-      if (t >= pose_retuned_s + o.pose_update_s) {
-        pose_retuned_s = t;
-        if (std::vector<double> q = trajectory->at(t); q != pose_now) {
-          plant.retune(trajectory->plant_at(q));
-          pose_now = std::move(q);
-          ++rep.pose_retunes;
-        }
+      for (; next_retune < retunes.size() && retunes[next_retune].first <= t; ++next_retune) {
+        plant.retune(std::move(retunes[next_retune].second));
+        ++rep.pose_retunes;
       }
     }
     // The robot controller updates its spindle register every spindle_register_period_s (a ramp arrives

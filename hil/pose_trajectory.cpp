@@ -58,6 +58,19 @@ sim::PlantModel PoseTrajectory::plant_at(const std::vector<double>& q) const {
   return sim::build_plant_model(analysis::config_at_pose(cfg_, analysis::pose_modes(schedule_.model, q, s.axis, s.modes)));
 }
 
+std::vector<std::pair<double, sim::PlantModel>> PoseTrajectory::retunes(double update_s) const {
+  std::vector<std::pair<double, sim::PlantModel>> out;
+  std::vector<double> last = at(0.0);
+  for (long k = 1; static_cast<double>(k - 1) * update_s <= end_s(); ++k) {
+    const double t = static_cast<double>(k) * update_s;
+    if (std::vector<double> q = at(t); q != last) {
+      out.emplace_back(t, plant_at(q));
+      last = std::move(q);
+    }
+  }
+  return out;
+}
+
 void PoseTrajectory::predict(PoseDwellReport& r) const {
   const auto& s = *cfg_.pose_schedule;
   r.dominant_hz = analysis::pose_modes(schedule_.model, r.joints_deg, s.axis, s.modes).dominant_hz();

@@ -10,6 +10,7 @@
 #include <deque>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/bench_run.hpp"
@@ -51,6 +52,9 @@ class PoseTrajectory {
   [[nodiscard]] std::vector<PoseDwell> dwells() const;
   // The plant's structure at a pose (the configuration's actuator, sensor and locations).
   [[nodiscard]] sim::PlantModel plant_at(const std::vector<double>& joints_deg) const;
+  // Built before the run (about 0.25 ms each, longer than a loop period): the structure at every multiple
+  // of update_s where the pose has moved since the last one, in time order.
+  [[nodiscard]] std::vector<std::pair<double, sim::PlantModel>> retunes(double update_s) const;
   // The region's name, the dominant mode and the predicted improvement at a pose.
   void predict(PoseDwellReport& r) const;
   [[nodiscard]] double end_s() const { return points_.back().t_s; }
