@@ -288,6 +288,18 @@ TEST(RealTimePath, ModbusStatusAllocatesNothing) {
 
 // The whole loop (sensor read, supervisor, controller, actuator write, amplifier I/O, telemetry push,
 // timing) for a million ticks with the simulated backend, on the virtual clock, while the drain thread
+
+// Runs the loop on this thread, marked as the loop's: what it allocated and locked.
+struct LoopThreadCounts {
+  long allocations{0}, locks{0};
+};
+LoopThreadCounts run_counted(rt::Loop& loop, std::uint64_t ticks) {
+  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
+  t_loop_thread = true;
+  loop.run(ticks);
+  t_loop_thread = false;
+  return {g_loop_thread_allocations.load() - before, g_loop_thread_locks.load() - locks_before};
+}
 // records every frame to a file. Only the loop thread's allocations are counted: that is the RT thread.
 TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
@@ -325,16 +337,12 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   t_loop_thread = false;
   ASSERT_EQ(g_loop_thread_allocations.load(), probe + 1);
 
-  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
-  t_loop_thread = true;
-  loop.run(1'000'000);
-  t_loop_thread = false;
-  const long during = g_loop_thread_allocations.load() - before;
-  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken on the loop thread";
+  const LoopThreadCounts counts = run_counted(loop, 1'000'000);
   drain.stop();
   recorder.close();
 
-  EXPECT_EQ(during, 0) << "allocations on the loop thread";
+  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
+  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
   EXPECT_GE(loop.stats().ticks_run, 1'000'000U);
   EXPECT_EQ(recorder.frames(), loop.stats().ticks_run) << "every tick recorded";
   const auto& c = session.supervisor().counters();
@@ -374,15 +382,11 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
   rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kVirtual));
   rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
   drain.start();
-  const long before = g_loop_thread_allocations.load(), locks_before = g_loop_thread_locks.load();
-  t_loop_thread = true;
-  loop.run(at(25.0));
-  t_loop_thread = false;
-  const long during = g_loop_thread_allocations.load() - before;
-  EXPECT_EQ(g_loop_thread_locks.load() - locks_before, 0) << "mutexes taken on the loop thread";
+  const LoopThreadCounts counts = run_counted(loop, at(25.0));
   drain.stop();
   recorder.close();
-  EXPECT_EQ(during, 0) << "allocations on the loop thread";
+  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
+  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
   const auto& c = session.supervisor().counters();
   EXPECT_EQ(c.params_selected, 2U);
   EXPECT_EQ(c.pose_regions, 4U);
