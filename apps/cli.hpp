@@ -80,5 +80,6 @@ void register_cut(Registry& r);
 void register_identify(Registry& r);
 void register_measure(Registry& r);
 void register_pose(Registry& r);
+void register_tune(Registry& r);
 
 }  // namespace robodamp::apps

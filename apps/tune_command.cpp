@@ -1,0 +1,151 @@
+// `robodamp tune`: compensator synthesis (tune/compensator_search.hpp, docs/tuning.md). It searches the
+// configuration's compensator (as a rational block) and gain, prints progress, compares the result with
+// C1, C2 and C3 on the same chain and job, and writes the tuned configuration only when every constraint
+// holds and the written file passes the configuration checks and the analysis.
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <regex>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/loop_model.hpp"
+#include "apps/cli.hpp"
+#include "tune/compensator_search.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+using nlohmann::json;
+
+struct TuneArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string job_path;
+  std::string out_path;
+  std::string json_path;
+  tune::TuneSettings settings;
+};
+
+json candidate_json(const tune::Candidate& c) {
+  return {{"gain_ns_per_m", c.gain_ns_per_m}, {"polarity", c.polarity}, {"fz_hz", c.fz_hz}, {"zeta_z", c.zeta_z},
+          {"fp_hz", c.fp_hz},                 {"zeta_p", c.zeta_p},     {"fa_hz", c.fa_hz}, {"fb_hz", c.fb_hz}};
+}
+
+json evaluation_json(const tune::Evaluation& e) {
+  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"candidate", candidate_json(e.candidate)},   {"stable", e.stable},
+          {"gain_margin_db", finite(e.gain_margin_db)}, {"phase_margin_deg", finite(e.phase_margin_deg)},
+          {"delay_margin_ms", finite(e.delay_margin_ms)}, {"k_max_ns_per_m", finite(e.k_max_ns_per_m)},
+          {"min_depth_mm", e.min_depth_mm},             {"floor_ratio", finite(e.floor_ratio)},
+          {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
+          {"feasible", e.feasible()},                   {"binding", e.binding}};
+}
+
+// The configuration's text with the compensator block, the gain and the polarity of the tuned candidate.
+std::string tuned_yaml(const config::Config& base, const tune::Candidate& c) {
+  const config::Config tuned = tune::with_candidate(base, c);
+  const config::BlockConfig* block = nullptr;
+  for (const auto& b : tuned.controller.chain)
+    if (b.kind == config::BlockKind::kCompensator) block = &b;
+  std::ostringstream num, den;
+  num.precision(17), den.precision(17);
+  for (std::size_t i = 0; i < block->numerator.size(); ++i) num << (i ? ", " : "") << block->numerator[i];
+  for (std::size_t i = 0; i < block->denominator.size(); ++i) den << (i ? ", " : "") << block->denominator[i];
+  std::istringstream in(base.yaml_text);
+  std::ostringstream out;
+  std::string line;
+  int n = 0;
+  const std::regex gain(R"(^(\s*gain_ns_per_m:\s*)[^#]*)"), polarity(R"(^(\s*polarity:\s*)[^#]*)");
+  while (std::getline(in, line)) {
+    ++n;
+    if (n == block->mark.line) {
+      const std::string indent = line.substr(0, line.find('-'));
+      line = indent + "- {kind: compensator, model: rational, numerator: [" + num.str() + "], denominator: [" + den.str() +
+             "]}   # robodamp tune";
+    } else if (std::regex_search(line, gain) && line.find("gain_ns_per_m:") == line.find_first_not_of(' ') &&
+               line.find_first_not_of(' ') == 2) {
+      line = std::regex_replace(line, gain, "$1" + std::to_string(c.gain_ns_per_m) + "   ");
+    } else if (std::regex_search(line, polarity) && line.find_first_not_of(' ') == 2) {
+      line = std::regex_replace(line, polarity, std::string("$1") + (c.polarity > 0 ? "+1" : "-1") + "   ");
+    }
+    out << line << '\n';
+  }
+  return out.str();
+}
+
+void print_row(const char* name, const tune::Evaluation& e) {
+  std::printf("  %-6s K %8.0f N s/m pol %+d | K_max %8.0f  GM %6.1f dB  PM %6.1f deg  DM %6.2f ms | ", name,
+              e.candidate.gain_ns_per_m, e.candidate.polarity, e.k_max_ns_per_m, e.gain_margin_db, e.phase_margin_deg,
+              e.delay_margin_ms);
+  if (e.peak_m_per_n > 0.0)
+    std::printf("closed-loop peak %.4g m/N", e.peak_m_per_n);
+  else
+    std::printf("min depth %.3f mm, floors x%.2f", e.min_depth_mm, e.floor_ratio);
+  std::printf("%s\n", e.feasible() ? "" : (" (violates " + e.binding + ")").c_str());
+}
+
+// 0 tuned and written (or no --out), 3 no candidate met every constraint (nothing written), 2 bad input.
+int run_tune(const TuneArgs& a) {
+  const config::Config base = config::load_config_file(a.config_path);
+  std::optional<config::MillingConfig> job;
+  if (!a.job_path.empty()) job = config::load_milling_config(a.job_path);
+  const tune::Evaluator evaluate(base, job, a.settings);
+  const tune::TuneResult r = tune::tune(base, job, a.settings, [](const std::string& l) { std::cerr << l << '\n'; });
+  std::printf("robodamp tune: %s%s, %zu evaluations\n", a.config_path.c_str(), job ? (" on " + a.job_path).c_str() : "",
+              r.history.size());
+  if (job) std::printf("  open loop: min depth %.3f mm\n", evaluate.open_min_depth_mm());
+  json report{{"config", a.config_path}, {"job", a.job_path}, {"best", evaluation_json(r.best)}};
+  for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2, config::CompensatorModel::kC3}) {
+    config::Config c = base;
+    for (auto& b : c.controller.chain)
+      if (b.kind == config::BlockKind::kCompensator) b.model = model;
+    c.controller.polarity = analysis::analyse(analysis::LoopModel(c)).recommended_polarity;
+    const tune::Evaluation e = evaluate.assess(c);
+    print_row(config::to_string(model), e);
+    report[config::to_string(model)] = evaluation_json(e);
+  }
+  print_row("tuned", r.best);
+  json history = json::array();
+  for (const auto& e : r.history) history.push_back(evaluation_json(e));
+  report["history"] = history;
+  if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
+  if (!r.best.feasible()) {
+    std::cerr << "robodamp tune: no candidate met every constraint; the closest violates " << r.best.binding
+              << ": nothing written\n";
+    return 3;
+  }
+  if (!a.out_path.empty()) {
+    const std::string text = tuned_yaml(base, r.best.candidate);
+    const config::Config check = config::parse_config(text, a.out_path);  // throws (exit 2) before writing
+    if (!analysis::LoopModel(check).stable(check.controller.gain_ns_per_m, check.controller.polarity))
+      throw std::runtime_error("the written configuration's loop is not stable: nothing written");
+    std::ofstream(a.out_path) << text;
+    std::printf("wrote %s\n", a.out_path.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_tune(Registry& r) {
+  auto a = std::make_shared<TuneArgs>();
+  CLI::App* sub = r.add("tune", "Compensator synthesis: a rational compensator and K searched (NLopt) for the deepest damped "
+                                "cut (--job) or the lowest closed-loop peak, with gain, phase and delay margins",
+                        [a] { return run_tune(*a); });
+  sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  sub->add_option("--job", a->job_path, "Milling job (config/milling/*.yaml) with a damping location")->check(CLI::ExistingFile);
+  sub->add_option("--out", a->out_path, "Write the tuned configuration here (only when every constraint holds)");
+  sub->add_option("--json", a->json_path, "Write the report and the search's history as JSON here");
+  r.number(sub, "--gain-margin-db", a->settings.gain_margin_min_db, {"dB", 0.0, 40.0}, "Smallest gain margin allowed");
+  r.number(sub, "--phase-margin-deg", a->settings.phase_margin_min_deg, {"deg", 0.0, 90.0}, "Smallest phase margin allowed");
+  r.number(sub, "--delay-margin-ms", a->settings.delay_margin_min_ms, {"ms", 0.0, 1000.0, true}, "Smallest delay margin allowed");
+  r.whole_number(sub, "--evaluations", a->settings.global_evaluations, {"(evaluations per polarity)", 10, 100000},
+                 "Global search budget per polarity");
+  r.whole_number(sub, "--polish", a->settings.local_evaluations, {"(evaluations per polarity)", 0, 100000},
+                 "Local polish budget per polarity");
+  r.whole_number(sub, "--seed", a->settings.seed, {"(seed)", 0, 2147483647}, "The global search's seed");
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,268 @@
+#include "tune/compensator_search.hpp"
+
+#include <nlopt.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+#include "analysis/loop_model.hpp"
+#include "milling/lobes.hpp"
+#include "milling/structure.hpp"
+#include "modal/receptance.hpp"
+
+namespace robodamp::tune {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// a x b for polynomials with the highest power first.
+std::vector<double> multiply(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> r(a.size() + b.size() - 1, 0.0);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j) r[i + j] += a[i] * b[j];
+  return r;
+}
+
+std::vector<double> second_order(double f_hz, double zeta) {
+  const double w = kTwoPi * f_hz;
+  return {1.0 / (w * w), 2.0 * zeta / w, 1.0};
+}
+
+std::vector<double> first_order(double f_hz) { return {1.0 / (kTwoPi * f_hz), 1.0}; }
+
+const config::StructureConfig& job_structure(const config::MillingConfig& job) {
+  const config::StructureConfig* st = job.find_structure(job.structure);
+  if (st == nullptr) st = &job.structures.front();
+  return *st;
+}
+
+// The largest closed-loop peak over the configured FRFs (discrete loop).
+double closed_peak(const analysis::LoopModel& m, double gain, int polarity) {
+  double peak = 0.0;
+  for (const auto& f : analysis::improvements(m, gain, polarity, true)) peak = std::max(peak, f.closed_peak_m_per_n);
+  return peak;
+}
+
+void add_violation(Evaluation& e, double amount, const char* what) {
+  if (amount <= 0.0) return;
+  if (amount > e.violation) e.binding = what;
+  e.violation += amount;
+}
+
+}  // namespace
+
+config::BlockConfig compensator_block(const Candidate& c, const config::BlockConfig& replaced, double unity_hz) {
+  config::BlockConfig b = replaced;
+  b.kind = config::BlockKind::kCompensator;
+  b.model = config::CompensatorModel::kRational;
+  b.numerator = multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz));
+  b.denominator = multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz));
+  const std::complex<double> s(0.0, kTwoPi * unity_hz);
+  auto eval = [&](const std::vector<double>& p) {
+    std::complex<double> v = 0.0;
+    for (double a : p) v = v * s + a;
+    return v;
+  };
+  const double gain = std::abs(eval(b.numerator) / eval(b.denominator));
+  for (double& a : b.numerator) a /= gain;
+  return b;
+}
+
+double unity_gain_hz(const config::Config& cfg) {
+  if (cfg.controller.match_freq_hz) return *cfg.controller.match_freq_hz;
+  return modal::dominant_mode_hz(cfg.robot, cfg.actuator.location).value_or(10.0);
+}
+
+config::Config with_candidate(const config::Config& base, const Candidate& c) {
+  config::Config cfg = base;
+  auto it = std::find_if(cfg.controller.chain.begin(), cfg.controller.chain.end(),
+                         [](const config::BlockConfig& b) { return b.kind == config::BlockKind::kCompensator; });
+  if (it == cfg.controller.chain.end())
+    throw config::ConfigError({config::Problem{base.source, {}, "controller.chain",
+                                               "has no compensator block for robodamp tune to replace"}});
+  *it = compensator_block(c, *it, unity_gain_hz(base));
+  cfg.controller.gain_ns_per_m = c.gain_ns_per_m;
+  cfg.controller.polarity = c.polarity;
+  return cfg;
+}
+
+Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingConfig> job, const TuneSettings& s)
+    : base_(base), job_(std::move(job)), s_(s) {
+  (void)with_candidate(base_, {});  // a chain without a compensator is refused here
+  if (!job_) return;
+  const config::StructureConfig& st = job_structure(*job_);
+  const bool damps = std::any_of(st.parts.begin(), st.parts.end(), [](const auto& p) { return p.controller.has_value(); });
+  if (!damps)
+    throw config::ConfigError({config::Problem{job_->source, {}, "structures." + st.name,
+                                               "has no damping location (a part with controller: {config, location, "
+                                               "direction}): there is nothing for robodamp tune to tune against"}});
+  const milling::Structure open(st, false);
+  const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
+  const milling::LobeDiagram d = milling::LobeModel(open, process, job_->lobes).diagram();
+  open_min_mm_ = d.minimum.b_lim_m * 1e3;
+  // The open loop's lobe peaks (local maxima of the envelope), and the floor between each two.
+  std::vector<std::size_t> peaks;
+  const auto& c = d.curve;
+  for (std::size_t i = 1; i + 1 < c.size(); ++i)
+    if (std::isfinite(c[i].b_lim_m) && c[i].b_lim_m > c[i - 1].b_lim_m && c[i].b_lim_m >= c[i + 1].b_lim_m) peaks.push_back(i);
+  std::vector<std::size_t> edges{0};
+  edges.insert(edges.end(), peaks.begin(), peaks.end());
+  edges.push_back(c.size() - 1);
+  for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
+    double floor = kInf;
+    for (std::size_t i = edges[k]; i <= edges[k + 1]; ++i) floor = std::min(floor, c[i].b_lim_m);
+    if (!std::isfinite(floor)) continue;
+    intervals_.emplace_back(c[edges[k]].rpm, c[edges[k + 1]].rpm);
+    floors_mm_.push_back(floor * 1e3);
+  }
+}
+
+Evaluation Evaluator::operator()(const Candidate& cand) const {
+  Evaluation e;
+  try {
+    e = assess(with_candidate(base_, cand));
+  } catch (const config::ConfigError&) {
+    add_violation(e, 100.0, "the chain cannot realise the compensator at the loop rate");
+    e.objective = -kInf;
+  }
+  e.candidate = cand;
+  return e;
+}
+
+Evaluation Evaluator::assess(const config::Config& cfg) const {
+  Evaluation e;
+  e.candidate.gain_ns_per_m = cfg.controller.gain_ns_per_m;
+  e.candidate.polarity = cfg.controller.polarity;
+  const Candidate& cand = e.candidate;
+  const auto m = std::make_shared<const analysis::LoopModel>(cfg);
+  const double k = cand.gain_ns_per_m;
+  e.stable = m->stable(k, cand.polarity);
+  const auto k_max = analysis::max_stable_gain(*m, cand.polarity);
+  e.k_max_ns_per_m = k_max.value_or(kInf);
+  const analysis::Margins mg = analysis::margins(*m, k, cand.polarity, k_max);
+  e.gain_margin_db = mg.gain_margin_db.value_or(kInf);
+  e.phase_margin_deg = mg.phase_margin_deg.value_or(180.0);
+  e.delay_margin_ms = mg.delay_margin_ms.value_or(kInf);
+  if (!e.stable) {
+    add_violation(e, 10.0 + std::log10(k / std::max(1.0, e.k_max_ns_per_m)), "stability");
+    e.objective = -kInf;
+    return e;
+  }
+  add_violation(e, (s_.gain_margin_min_db - e.gain_margin_db) / s_.gain_margin_min_db, "gain margin");
+  add_violation(e, (s_.phase_margin_min_deg - e.phase_margin_deg) / s_.phase_margin_min_deg, "phase margin");
+  add_violation(e, (s_.delay_margin_min_ms - e.delay_margin_ms) / s_.delay_margin_min_ms, "delay margin");
+  if (!job_) {
+    e.peak_m_per_n = closed_peak(*m, k, cand.polarity);
+    e.objective = -std::log10(e.peak_m_per_n);
+    return e;
+  }
+  const milling::Structure damped(job_structure(*job_), true, {m, k, cand.polarity});
+  const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
+  const milling::LobeDiagram d = milling::LobeModel(damped, process, job_->lobes).diagram();
+  e.min_depth_mm = d.minimum.b_lim_m * 1e3;
+  e.objective = e.min_depth_mm;
+  e.floor_ratio = kInf;
+  for (std::size_t k2 = 0; k2 < intervals_.size(); ++k2) {
+    double floor = kInf;
+    for (const auto& p : d.curve)
+      if (p.rpm >= intervals_[k2].first && p.rpm <= intervals_[k2].second) floor = std::min(floor, p.b_lim_m * 1e3);
+    e.floor_ratio = std::min(e.floor_ratio, floor / floors_mm_[k2]);
+  }
+  add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
+  return e;
+}
+
+namespace {
+
+// x = [log10 K, log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb]
+constexpr unsigned kDims = 7;
+const double kLower[kDims] = {2.0, std::log10(0.3), 0.05, std::log10(0.3), 0.05, std::log10(0.3), std::log10(0.3)};
+const double kUpper[kDims] = {std::log10(20000.0), std::log10(80.0), 1.5, std::log10(80.0), 1.5, std::log10(200.0), std::log10(200.0)};
+
+Candidate candidate_of(const double* x, int polarity) {
+  return {std::pow(10.0, x[0]), std::pow(10.0, x[1]), x[2], std::pow(10.0, x[3]), x[4], std::pow(10.0, x[5]),
+          std::pow(10.0, x[6]), polarity};
+}
+
+struct Search {
+  const Evaluator* evaluate;
+  int polarity;
+  TuneResult* result;
+  const std::function<void(const std::string&)>* progress;
+  const char* phase;
+  int budget;
+  int count{0};
+};
+
+bool better(const Evaluation& a, const Evaluation& b) {
+  if (a.feasible() != b.feasible()) return a.feasible();
+  if (!a.feasible()) return a.violation < b.violation;
+  return a.objective > b.objective;
+}
+
+double penalised(unsigned /*n*/, const double* x, double* /*grad*/, void* data) {
+  auto& s = *static_cast<Search*>(data);
+  const Evaluation e = (*s.evaluate)(candidate_of(x, s.polarity));
+  s.result->history.push_back(e);
+  if (s.result->history.size() == 1 || better(e, s.result->best)) s.result->best = e;
+  ++s.count;
+  if (*s.progress && (s.count % 20 == 0 || s.count == s.budget)) {
+    const Evaluation& b = s.result->best;
+    char line[200];
+    std::snprintf(line, sizeof line, "tune: polarity %+d, %s %d/%d; best so far %s %.4g, %s", s.polarity, s.phase, s.count,
+                  s.budget, b.peak_m_per_n > 0.0 ? "-log10 peak" : "min depth mm", b.objective,
+                  b.feasible() ? "feasible" : ("violates " + b.binding).c_str());
+    (*s.progress)(line);
+  }
+  // Larger is better; a violated constraint costs more than any objective can gain.
+  const double objective = std::isfinite(e.objective) ? e.objective : -1e3;
+  return objective - 1e3 * e.violation;
+}
+
+void run(nlopt_algorithm algorithm, Search& s, std::vector<double>& x) {
+  nlopt_opt opt = nlopt_create(algorithm, kDims);
+  nlopt_set_lower_bounds(opt, kLower);
+  nlopt_set_upper_bounds(opt, kUpper);
+  nlopt_set_max_objective(opt, penalised, &s);
+  nlopt_set_maxeval(opt, s.budget);
+  double f = 0.0;
+  (void)nlopt_optimize(opt, x.data(), &f);  // the best point is kept in s.result whatever the return code
+  nlopt_destroy(opt);
+}
+
+std::vector<double> x_of(const Candidate& c) {
+  return {std::log10(c.gain_ns_per_m), std::log10(c.fz_hz), c.zeta_z, std::log10(c.fp_hz), c.zeta_p, std::log10(c.fa_hz),
+          std::log10(c.fb_hz)};
+}
+
+}  // namespace
+
+TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job, const TuneSettings& s,
+                const std::function<void(const std::string&)>& progress) {
+  const Evaluator evaluate(base, job, s);
+  TuneResult result;
+  nlopt_srand(static_cast<unsigned long>(s.seed));  // CRS2's population: seeded, so a tune repeats exactly
+  for (const int polarity : {1, -1}) {
+    TuneResult per;
+    Search global{&evaluate, polarity, &per, &progress, "global search", s.global_evaluations};
+    // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
+    const Candidate c1{std::clamp(base.controller.gain_ns_per_m, 100.0, 20000.0), base.actuator.natural_freq_hz,
+                       base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
+    std::vector<double> x = x_of(c1);
+    run(NLOPT_GN_CRS2_LM, global, x);
+    Search local{&evaluate, polarity, &per, &progress, "local polish", s.local_evaluations};
+    x = x_of(per.best.candidate);
+    run(NLOPT_LN_BOBYQA, local, x);
+    result.history.insert(result.history.end(), per.history.begin(), per.history.end());
+    if (result.history.size() == per.history.size() || better(per.best, result.best)) result.best = per.best;
+  }
+  return result;
+}
+
+}  // namespace robodamp::tune

@@ -1,0 +1,98 @@
+// Compensator synthesis (robodamp tune; docs/tuning.md): the compensator block of a configuration's chain
+// replaced by a rational transfer function of bounded order, and its shape and the gain K searched with
+// NLopt (a seeded global search, then a local polish) against the analysis of the discrete loop that runs.
+//
+// The shape, minimum phase and stable by construction (every coefficient positive):
+//   C(s) = g (s^2/wz^2 + 2 zeta_z s/wz + 1) / (s^2/wp^2 + 2 zeta_p s/wp + 1) * (s/wa + 1) / (s/wb + 1)
+// with g making |C| = 1 at the match frequency (the dominant mode).
+// Objective: with a milling job, the smallest damped limiting depth over the job's speed range; without
+// one, the smallest peak of the closed-loop receptances over the analysis band. Constraints: stable, gain
+// margin, phase margin and delay margin at least the settings', and with a job no lobe floor lower than the
+// open loop's (between two neighbouring peaks of the open-loop lobes, the smallest damped limit at least the
+// smallest open-loop limit there). Off the real-time path.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/config.hpp"
+#include "config/milling_config.hpp"
+
+namespace robodamp::tune {
+
+struct Candidate {
+  double gain_ns_per_m{2000.0};
+  double fz_hz{10.0}, zeta_z{0.5};   // the second-order zero pair
+  double fp_hz{10.0}, zeta_p{0.5};   // the second-order pole pair
+  double fa_hz{10.0}, fb_hz{10.0};   // the first-order zero and pole
+  int polarity{1};
+};
+
+// The candidate as the chain's compensator block (kind compensator, model rational, pre-warped at the
+// configuration's match frequency), scaled to unity gain at unity_hz: K is then the velocity feedback
+// gain at that frequency whatever the shape.
+[[nodiscard]] config::BlockConfig compensator_block(const Candidate& c, const config::BlockConfig& replaced,
+                                                    double unity_hz);
+// The match frequency (controller.match_freq_hz, else the dominant robot mode).
+[[nodiscard]] double unity_gain_hz(const config::Config& cfg);
+// The configuration with the candidate's compensator, gain and polarity. Throws config::ConfigError when
+// the chain has no compensator block to replace.
+[[nodiscard]] config::Config with_candidate(const config::Config& base, const Candidate& c);
+
+struct TuneSettings {
+  double gain_margin_min_db{6.0};
+  double phase_margin_min_deg{45.0};
+  double delay_margin_min_ms{0.5};
+  int global_evaluations{240};  // per polarity
+  int local_evaluations{120};
+  int seed{1};
+};
+
+struct Evaluation {
+  Candidate candidate;
+  bool stable{false};
+  double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
+  double k_max_ns_per_m{0.0};
+  double min_depth_mm{0.0};      // with a job: the damped lobes' minimum
+  double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
+  double peak_m_per_n{0.0};      // without a job: the largest closed-loop peak
+  double objective{0.0};         // larger is better (depth in mm, or -log10 of the peak)
+  double violation{0.0};         // 0 when every constraint holds
+  std::string binding;           // the constraint violated most (empty when feasible)
+  [[nodiscard]] bool feasible() const { return violation <= 0.0; }
+};
+
+struct TuneResult {
+  Evaluation best;
+  std::vector<Evaluation> history;  // every evaluation, in order
+};
+
+// One candidate, evaluated. Never throws for a bad candidate (it is infeasible with the reason).
+class Evaluator {
+ public:
+  Evaluator(const config::Config& base, std::optional<config::MillingConfig> job, const TuneSettings& s);
+  [[nodiscard]] Evaluation operator()(const Candidate& c) const;
+  // Any configuration at its own gain and polarity (C1, C2, C3 for the report).
+  [[nodiscard]] Evaluation assess(const config::Config& cfg) const;
+  // The open loop's lobes, for reports: the minimum and the floors between neighbouring peaks.
+  [[nodiscard]] double open_min_depth_mm() const { return open_min_mm_; }
+  [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
+  [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
+
+ private:
+  config::Config base_;
+  std::optional<config::MillingConfig> job_;
+  TuneSettings s_;
+  double open_min_mm_{0.0};
+  std::vector<std::pair<double, double>> intervals_;  // between neighbouring open-loop lobe peaks
+  std::vector<double> floors_mm_;                     // the open loop's smallest limit in each
+};
+
+// Throws config::ConfigError when the configuration cannot be tuned (no compensator block, a job without
+// a damping location). The result may be infeasible: the caller reports the binding constraint.
+[[nodiscard]] TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job,
+                              const TuneSettings& s, const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace robodamp::tune
