@@ -5,7 +5,6 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <regex>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -39,6 +38,7 @@ json evaluation_json(const tune::Evaluation& e) {
           {"gain_margin_db", finite(e.gain_margin_db)}, {"phase_margin_deg", finite(e.phase_margin_deg)},
           {"delay_margin_ms", finite(e.delay_margin_ms)}, {"k_max_ns_per_m", finite(e.k_max_ns_per_m)},
           {"min_depth_mm", e.min_depth_mm},             {"floor_ratio", finite(e.floor_ratio)},
+          {"depth_at_speed_mm", e.depth_at_speed_mm},
           {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
           {"feasible", e.feasible()},                   {"binding", e.binding}};
 }
@@ -57,18 +57,23 @@ std::string tuned_yaml(const config::Config& base, const tune::Candidate& c) {
   std::ostringstream out;
   std::string line;
   int n = 0;
-  const std::regex gain(R"(^(\s*gain_ns_per_m:\s*)[^#]*)"), polarity(R"(^(\s*polarity:\s*)[^#]*)");
+  // The controller's own keys (two spaces in): the value replaced, the comment kept.
+  auto replace_value = [](std::string& l, const std::string& key, const std::string& value) {
+    const std::string prefix = "  " + key + ":";
+    if (l.rfind(prefix, 0) != 0) return false;
+    l = prefix + " " + value + "   # robodamp tune";
+    return true;
+  };
+  char gain[32];
+  std::snprintf(gain, sizeof gain, "%.10g", c.gain_ns_per_m);
   while (std::getline(in, line)) {
     ++n;
     if (n == block->mark.line) {
       const std::string indent = line.substr(0, line.find('-'));
       line = indent + "- {kind: compensator, model: rational, numerator: [" + num.str() + "], denominator: [" + den.str() +
              "]}   # robodamp tune";
-    } else if (std::regex_search(line, gain) && line.find("gain_ns_per_m:") == line.find_first_not_of(' ') &&
-               line.find_first_not_of(' ') == 2) {
-      line = std::regex_replace(line, gain, "$1" + std::to_string(c.gain_ns_per_m) + "   ");
-    } else if (std::regex_search(line, polarity) && line.find_first_not_of(' ') == 2) {
-      line = std::regex_replace(line, polarity, std::string("$1") + (c.polarity > 0 ? "+1" : "-1") + "   ");
+    } else if (!replace_value(line, "gain_ns_per_m", gain)) {
+      (void)replace_value(line, "polarity", c.polarity > 0 ? "+1" : "-1");
     }
     out << line << '\n';
   }
@@ -82,7 +87,8 @@ void print_row(const char* name, const tune::Evaluation& e) {
   if (e.peak_m_per_n > 0.0)
     std::printf("closed-loop peak %.4g m/N", e.peak_m_per_n);
   else
-    std::printf("min depth %.3f mm, floors x%.2f", e.min_depth_mm, e.floor_ratio);
+    std::printf("min depth %.3f mm, at the job's speed %.3f mm, floors x%.2f", e.min_depth_mm, e.depth_at_speed_mm,
+                e.floor_ratio);
   std::printf("%s\n", e.feasible() ? "" : (" (violates " + e.binding + ")").c_str());
 }
 
@@ -141,6 +147,8 @@ void register_tune(Registry& r) {
   r.number(sub, "--gain-margin-db", a->settings.gain_margin_min_db, {"dB", 0.0, 40.0}, "Smallest gain margin allowed");
   r.number(sub, "--phase-margin-deg", a->settings.phase_margin_min_deg, {"deg", 0.0, 90.0}, "Smallest phase margin allowed");
   r.number(sub, "--delay-margin-ms", a->settings.delay_margin_min_ms, {"ms", 0.0, 1000.0, true}, "Smallest delay margin allowed");
+  r.number(sub, "--depth-at-speed-mm", a->settings.depth_at_speed_min_mm, {"mm", 0.0, 1000.0},
+           "With --job: the damped limit at the job's spindle speed at least this (0 = free)");
   r.whole_number(sub, "--evaluations", a->settings.global_evaluations, {"(evaluations per polarity)", 10, 100000},
                  "Global search budget per polarity");
   r.whole_number(sub, "--polish", a->settings.local_evaluations, {"(evaluations per polarity)", 0, 100000},

@@ -164,9 +164,14 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   }
   const milling::Structure damped(job_structure(*job_), true, {m, k, cand.polarity});
   const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
-  const milling::LobeDiagram d = milling::LobeModel(damped, process, job_->lobes).diagram();
+  const milling::LobeModel lobes(damped, process, job_->lobes);
+  const milling::LobeDiagram d = lobes.diagram();
   e.min_depth_mm = d.minimum.b_lim_m * 1e3;
   e.objective = e.min_depth_mm;
+  e.depth_at_speed_mm = lobes.critical_depth_m(job_->cut.spindle_rpm, 1e-3) * 1e3;
+  if (s_.depth_at_speed_min_mm > 0.0)
+    add_violation(e, (s_.depth_at_speed_min_mm - e.depth_at_speed_mm) / s_.depth_at_speed_min_mm,
+                  "the depth at the job's spindle speed");
   e.floor_ratio = kInf;
   for (std::size_t k2 = 0; k2 < intervals_.size(); ++k2) {
     double floor = kInf;

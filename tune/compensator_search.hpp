@@ -45,6 +45,9 @@ struct TuneSettings {
   double gain_margin_min_db{6.0};
   double phase_margin_min_deg{45.0};
   double delay_margin_min_ms{0.5};
+  // With a job: the limiting depth at the job's spindle speed (cut.spindle_rpm) at least this, mm (0 = no
+  // such constraint). For the trade-off between the minimum and one speed's lobe.
+  double depth_at_speed_min_mm{0.0};
   int global_evaluations{240};  // per polarity
   int local_evaluations{120};
   int seed{1};
@@ -56,6 +59,7 @@ struct Evaluation {
   double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
   double k_max_ns_per_m{0.0};
   double min_depth_mm{0.0};      // with a job: the damped lobes' minimum
+  double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (direct test)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
   double peak_m_per_n{0.0};      // without a job: the largest closed-loop peak
   double objective{0.0};         // larger is better (depth in mm, or -log10 of the peak)
