@@ -371,6 +371,31 @@ TEST(Cli, PoseScheduleAnalyzeRunAndBadPoses) {
   EXPECT_NE(travel.out.find("waypoint 1 at 0 s: joint 2 = 190 deg is out of range"), std::string::npos) << travel.out;
 }
 
+// robodamp tune's refusals: an unreachable objective (exit 3, nothing written), a job without a damping
+// location and a chain without a compensator (exit 2, by name).
+TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
+  const std::string dir = ::testing::TempDir() + "robodamp_tune_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  const std::string out = dir + "/tuned.yaml";
+  const Result unreachable = run("tune --evaluations 10 --polish 0 --gain-margin-db 40 --phase-margin-deg 90 --out " + out);
+  EXPECT_EQ(unreachable.status, 3) << unreachable.out;
+  EXPECT_NE(unreachable.out.find("no candidate met every constraint; the closest violates"), std::string::npos) << unreachable.out;
+  EXPECT_NE(unreachable.out.find("nothing written"), std::string::npos) << unreachable.out;
+  EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
+  const Result no_damper = run("tune --evaluations 10 --job " + std::string(ROBODAMP_SOURCE_DIR) +
+                               "/config/milling/industrial_robot_aluminium.yaml --out " + out);
+  EXPECT_EQ(no_damper.status, 2);
+  EXPECT_NE(no_damper.out.find("has no damping location"), std::string::npos) << no_damper.out;
+  std::string text = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  const std::string compensator = "    - {kind: compensator, model: c2}";
+  text.replace(text.find(compensator), compensator.size(), "");
+  std::ofstream(dir + "/no_comp.yaml") << text;
+  const Result no_comp = run("tune --evaluations 10 --config " + dir + "/no_comp.yaml --out " + out);
+  EXPECT_EQ(no_comp.status, 2) << no_comp.out;
+  EXPECT_NE(no_comp.out.find("has no compensator block for robodamp tune to replace"), std::string::npos) << no_comp.out;
+  EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
+}
+
 TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData) {
   const robodamp::identify::CuttingTest t{3, 12.7, 2.0, 3.175, robodamp::config::MillingMode::kDown};
   auto write_csv = [&](const std::string& path, const std::vector<double>& feeds) {

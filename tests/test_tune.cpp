@@ -87,8 +87,9 @@ TEST(Tune, AShortSeededSearchRepeatsAndBeatsTheOpenLoopWithinItsConstraints) {
 }
 
 // config/presets/tuned_horizontal.yaml is what `robodamp tune --config config/presets/horizontal_c2.yaml --job
-// config/milling/active_damping_c2.yaml --evaluations 300 --polish 150 --out ...` wrote: its margins by the
-// analysis of the file itself, and its damped lobes on the job.
+// config/milling/active_damping_c2.yaml --evaluations 300 --polish 150 --depth-at-speed-mm 2.75 --out ...`
+// wrote: its margins by the analysis of the file itself, and its damped lobes on the job: the issue's
+// targets (minimum >= 0.9 mm, >= 2.75 mm at 700 rpm, no floor below the open loop's, GM >= 6 dB, PM >= 45 deg).
 TEST(Tune, TheTunedPresetHasItsMarginsAndDepths) {
   const config::Config cfg = config::load_config_file(test::preset("tuned_horizontal"));
   const analysis::LoopModel m(cfg);
@@ -98,9 +99,11 @@ TEST(Tune, TheTunedPresetHasItsMarginsAndDepths) {
   EXPECT_GE(*a.margins.phase_margin_deg, 45.0);
   const tune::Evaluator evaluate(cfg, config::load_milling_config(kJob), {});
   const tune::Evaluation e = evaluate.assess(cfg);
-  std::printf("tuned preset: min depth %.3f mm (open 0.324, C2 0.841), floors x%.2f, GM %.1f dB, PM %.1f deg\n",
-              e.min_depth_mm, e.floor_ratio, e.gain_margin_db, e.phase_margin_deg);
+  std::printf("tuned preset: min depth %.3f mm (open 0.324, C2 0.841), %.3f mm at 700 rpm, floors x%.2f, GM %.1f dB, "
+              "PM %.1f deg\n", e.min_depth_mm, e.depth_at_speed_mm, e.floor_ratio, e.gain_margin_db, e.phase_margin_deg);
   EXPECT_GE(e.min_depth_mm, 0.9);
+  EXPECT_GE(e.depth_at_speed_mm, 2.75);
+  for (const auto& mode : a.modes) EXPECT_TRUE(mode.damps) << mode.freq_hz << " Hz";
   EXPECT_GE(e.floor_ratio, 1.0);
   EXPECT_TRUE(e.feasible()) << e.binding;
 }

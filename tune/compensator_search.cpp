@@ -261,9 +261,11 @@ TuneResult tune(const config::Config& base, const std::optional<config::MillingC
                        base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
     std::vector<double> x = x_of(c1);
     run(NLOPT_GN_CRS2_LM, global, x);
-    Search local{&evaluate, polarity, &per, &progress, "local polish", s.local_evaluations};
-    x = x_of(per.best.candidate);
-    run(NLOPT_LN_BOBYQA, local, x);
+    if (s.local_evaluations > 0) {  // NLopt reads a budget of 0 as no limit
+      Search local{&evaluate, polarity, &per, &progress, "local polish", s.local_evaluations};
+      x = x_of(per.best.candidate);
+      run(NLOPT_LN_BOBYQA, local, x);
+    }
     result.history.insert(result.history.end(), per.history.begin(), per.history.end());
     if (result.history.size() == per.history.size() || better(per.best, result.best)) result.best = per.best;
   }
