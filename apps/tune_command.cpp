@@ -153,7 +153,7 @@ void register_tune(Registry& r) {
                  "Global search budget per polarity");
   r.whole_number(sub, "--polish", a->settings.local_evaluations, {"(evaluations per polarity)", 0, 100000},
                  "Local polish budget per polarity");
-  r.whole_number(sub, "--seed", a->settings.seed, {"(seed)", 0, 2147483647}, "The global search's seed");
+  r.whole_number(sub, "--seed", a->settings.seed, {"(seed)", 0, 999999}, "The global search's seed");
 }
 
 }  // namespace robodamp::apps
