@@ -98,7 +98,7 @@ int run_tune(const TuneArgs& a) {
   std::optional<config::MillingConfig> job;
   if (!a.job_path.empty()) job = config::load_milling_config(a.job_path);
   const tune::Evaluator evaluate(base, job, a.settings);
-  const tune::TuneResult r = tune::tune(base, job, a.settings, [](const std::string& l) { std::cerr << l << '\n'; });
+  const tune::TuneResult r = tune::tune(evaluate, base, a.settings, [](const std::string& l) { std::cerr << l << '\n'; });
   std::printf("robodamp tune: %s%s, %zu evaluations\n", a.config_path.c_str(), job ? (" on " + a.job_path).c_str() : "",
               r.history.size());
   if (job) std::printf("  open loop: min depth %.3f mm\n", evaluate.open_min_depth_mm());

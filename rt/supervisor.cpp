@@ -109,8 +109,7 @@ std::size_t Supervisor::add_parameter_set(const ParameterSet& set) {
 }
 
 bool Supervisor::select(double i) noexcept {
-  const bool index_ok = std::isfinite(i) && i >= 0.0 && i == std::floor(i) && i < static_cast<double>(sets_.size());
-  if (!index_ok) {
+  if (!set_index_ok(i)) {
     ++counters_.params_refused;
     return false;
   }
@@ -128,13 +127,10 @@ bool Supervisor::select(double i) noexcept {
 }
 
 void Supervisor::set_pose_region(double value) noexcept {
-  const bool driving = state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping;
-  const bool index_ok = std::isfinite(value) && value >= 0.0 && value == std::floor(value) &&
-                        value < static_cast<double>(sets_.size());
-  if (!s_.pose_scheduled || !index_ok) {  // out of the map, unknown, or not a set: no analysed set applies
+  if (!s_.pose_scheduled || !set_index_ok(value)) {  // out of the map, unknown, or not a set: no analysed set applies
     ++counters_.pose_out_of_map;
     pose_known_ = false;
-    if (driving) trip(Trip::kPoseOutOfMap);
+    if (driving()) trip(Trip::kPoseOutOfMap);
     return;
   }
   ++counters_.pose_regions;
@@ -146,7 +142,7 @@ void Supervisor::follow_pose() noexcept {
   if (!s_.pose_scheduled || !pose_known_ || pose_set_ == active_parameter_set() || controller_.handover_pending()) return;
   if (!select(static_cast<double>(pose_set_))) {  // the region's set refused (cannot pass the configuration's analysis)
     pose_known_ = false;
-    if (state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping) trip(Trip::kPoseOutOfMap);
+    if (driving()) trip(Trip::kPoseOutOfMap);
   }
 }
 

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -190,6 +191,12 @@ class Supervisor {
   // The parameter set at index value: validated (its analysis, its gain) and handed over. False when refused.
   bool select(double value) noexcept;
   void set_pose_region(double value) noexcept;
+  [[nodiscard]] bool set_index_ok(double i) const noexcept {
+    return std::isfinite(i) && i >= 0.0 && i == std::floor(i) && i < static_cast<double>(sets_.size());
+  }
+  [[nodiscard]] bool driving() const noexcept {
+    return state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping;
+  }
   void follow_pose() noexcept;  // each tick: hand over to the pose's region's set once the controller can
 
   SupervisorSettings s_;

@@ -250,7 +250,11 @@ std::vector<double> x_of(const Candidate& c) {
 
 TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job, const TuneSettings& s,
                 const std::function<void(const std::string&)>& progress) {
-  const Evaluator evaluate(base, job, s);
+  return tune(Evaluator(base, job, s), base, s, progress);
+}
+
+TuneResult tune(const Evaluator& evaluate, const config::Config& base, const TuneSettings& s,
+                const std::function<void(const std::string&)>& progress) {
   TuneResult result;
   nlopt_srand(static_cast<unsigned long>(s.seed));  // CRS2's population: seeded, so a tune repeats exactly
   for (const int polarity : {1, -1}) {

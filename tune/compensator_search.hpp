@@ -98,5 +98,8 @@ class Evaluator {
 // a damping location). The result may be infeasible: the caller reports the binding constraint.
 [[nodiscard]] TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job,
                               const TuneSettings& s, const std::function<void(const std::string&)>& progress = {});
+// The same with an evaluator the caller keeps (its open-loop lobes computed once, for the report too).
+[[nodiscard]] TuneResult tune(const Evaluator& evaluate, const config::Config& base, const TuneSettings& s,
+                              const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace robodamp::tune
