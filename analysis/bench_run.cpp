@@ -149,6 +149,7 @@ ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
     plant.step(command);
     if (plant.counters().force_limited + plant.counters().voltage_clipped > limited0) ++saturated_ticks;
     command = next;
+    r.peak_command_v = std::max(r.peak_command_v, std::abs(command));
     campaign.after_step(k);
     r.peak_actuator_force_n = std::max(r.peak_actuator_force_n, std::abs(plant.actuator_force_n()));
     if (!std::isfinite(plant.acceleration_mps2(0))) r.finite = false;

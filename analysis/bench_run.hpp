@@ -31,6 +31,7 @@ struct ImpactTest {
 struct ImpactTestResult {
   std::vector<FrfEstimate> receptance;  // per response location (measurement accelerometers, H1 / -w^2)
   double peak_actuator_force_n{0.0};
+  double peak_command_v{0.0};      // largest |command| the controller sent (after its limits)
   double saturation_time_s{0.0};  // loop ticks at a controller or actuator limit
   double simulated_s{0.0};
   double wall_s{0.0};

@@ -31,4 +31,26 @@ class RealFft {
   void* plan_{nullptr};
 };
 
+// The inverse: x[n] = sum_k X[k] e^{2 pi i k n / N} over all N bins (the bins above N / 2 the conjugates of
+// those below), unnormalised as FFTW's c2r (divide by N for the inverse of forward()). Same rules as RealFft.
+class RealInverseFft {
+ public:
+  explicit RealInverseFft(std::size_t n);
+  ~RealInverseFft();
+  RealInverseFft(const RealInverseFft&) = delete;
+  RealInverseFft& operator=(const RealInverseFft&) = delete;
+
+  [[nodiscard]] std::size_t size() const { return n_; }
+  [[nodiscard]] std::size_t bins() const { return n_ / 2 + 1; }
+  // The spectrum (bins() values) to fill before inverse(); inverse() overwrites it.
+  [[nodiscard]] std::complex<double>* input() { return in_; }
+  [[nodiscard]] const double* inverse();
+
+ private:
+  std::size_t n_;
+  std::complex<double>* in_{nullptr};
+  double* out_{nullptr};
+  void* plan_{nullptr};
+};
+
 }  // namespace robodamp::analysis

@@ -228,6 +228,13 @@ Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std:
   return a / (-w * w);
 }
 
+Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, std::size_t h, double gain,
+                                     int polarity) const {
+  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
+                                      sensor_model_.response(p.f_hz));
+  return q * p.accel_per_force[sensor_][h] / (1.0 - q * p.accel_per_volt[sensor_]);
+}
+
 Eigen::MatrixXd LoopModel::closed_loop_matrix(double gain, int polarity) const {
   const DiscreteSs& o = open_loop_unit_;
   return o.a + (polarity * gain) * o.b * o.c;  // o.d = 0: the delays make the loop strictly causal

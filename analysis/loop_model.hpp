@@ -78,6 +78,11 @@ class LoopModel {
   [[nodiscard]] Complex closed_discrete(const PlantResponse& p, Complex chain_filters, std::size_t g, std::size_t h,
                                         double gain_ns_per_m, int polarity) const;
 
+  // Volts the controller commands per newton of held force at location h, the loop closed (discrete loop
+  // that runs, before any limit): V = q A_sh / (1 - q A_sv), q the chain's volts per sampled m/s^2.
+  [[nodiscard]] Complex command_per_force(const PlantResponse& p, Complex chain_filters, std::size_t h,
+                                          double gain_ns_per_m, int polarity) const;
+
   // Closed-loop state matrix of the discrete loop and its eigenvalues.
   [[nodiscard]] Eigen::MatrixXd closed_loop_matrix(double gain_ns_per_m, int polarity) const;
   [[nodiscard]] Eigen::VectorXcd closed_loop_poles(double gain_ns_per_m, int polarity) const;

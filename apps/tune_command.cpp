@@ -5,6 +5,8 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <vector>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -24,6 +26,8 @@ struct TuneArgs {
   std::string job_path;
   std::string out_path;
   std::string json_path;
+  std::vector<std::string> also_paths;  // more plants: the worst case is tuned
+  std::optional<double> shift_pct;      // each plant also with its modes shifted by -/+ this
   tune::TuneSettings settings;
 };
 
@@ -40,7 +44,19 @@ json evaluation_json(const tune::Evaluation& e) {
           {"min_depth_mm", e.min_depth_mm},             {"floor_ratio", finite(e.floor_ratio)},
           {"depth_at_speed_mm", e.depth_at_speed_mm},
           {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
-          {"feasible", e.feasible()},                   {"binding", e.binding}};
+          {"peak_coil_force_n", e.peak_coil_force_n},   {"peak_command_v", e.peak_command_v},
+          {"peak_slew_v_per_s", e.peak_slew_v_per_s},   {"actuator_use", e.actuator_use},
+          {"feasible", e.feasible()},                   {"binding", e.binding},
+          {"plant", e.plant}};
+}
+
+json evaluation_json_with_plants(const tune::Evaluation& e) {
+  json j = evaluation_json(e);
+  if (!e.per_plant.empty()) {
+    j["per_plant"] = json::array();
+    for (const auto& p : e.per_plant) j["per_plant"].push_back(evaluation_json(p));
+  }
+  return j;
 }
 
 // The configuration's text with the compensator block, the gain and the polarity of the tuned candidate.
@@ -84,6 +100,9 @@ void print_row(const char* name, const tune::Evaluation& e) {
   std::printf("  %-6s K %8.0f N s/m pol %+d | K_max %8.0f  GM %6.1f dB  PM %6.1f deg  DM %6.2f ms | ", name,
               e.candidate.gain_ns_per_m, e.candidate.polarity, e.k_max_ns_per_m, e.gain_margin_db, e.phase_margin_deg,
               e.delay_margin_ms);
+  if (e.actuator_use > 0.0)
+    std::printf("impact: %.1f N coil, %.2f V, %.0f V/s (%.0f %% of a limit) | ", e.peak_coil_force_n, e.peak_command_v,
+                e.peak_slew_v_per_s, 100.0 * e.actuator_use);
   if (e.peak_m_per_n > 0.0)
     std::printf("closed-loop peak %.4g m/N", e.peak_m_per_n);
   else
@@ -92,27 +111,63 @@ void print_row(const char* name, const tune::Evaluation& e) {
   std::printf("%s\n", e.feasible() ? "" : (" (violates " + e.binding + ")").c_str());
 }
 
+// The plants the candidate is tuned for: --config, each --also, and with --shift-pct each of them with its
+// modes shifted down and up.
+std::vector<tune::Evaluator> make_plants(const TuneArgs& a, const std::optional<config::MillingConfig>& job) {
+  std::vector<std::string> paths{a.config_path};
+  paths.insert(paths.end(), a.also_paths.begin(), a.also_paths.end());
+  std::vector<tune::Evaluator> plants;
+  for (const auto& path : paths) {
+    const config::Config cfg = config::load_config_file(path);
+    plants.emplace_back(cfg, job, a.settings, path);
+    if (!a.shift_pct) continue;
+    for (const double sign : {-1.0, 1.0}) {
+      char name[64];
+      std::snprintf(name, sizeof name, " (modes %+.3g %%)", sign * *a.shift_pct);
+      plants.emplace_back(tune::with_shifted_modes(cfg, 1.0 + sign * *a.shift_pct / 100.0), job, a.settings, path + name);
+    }
+  }
+  return plants;
+}
+
+// One plant's rows: C1, C2 and C3 (at the configured gain, the recommended polarity) and the tuned candidate.
+void report_plant(const tune::Evaluator& p, const tune::Evaluation& tuned, bool hand_designs, json& out) {
+  std::printf("plant %s%s\n", p.name().c_str(),
+              p.open_floors_mm().empty() ? "" : ("; open loop: min depth " + std::to_string(p.open_min_depth_mm()) + " mm").c_str());
+  json j;
+  if (hand_designs)
+    for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2, config::CompensatorModel::kC3}) {
+      config::Config c = p.base();
+      for (auto& b : c.controller.chain)
+        if (b.kind == config::BlockKind::kCompensator) b.model = model;
+      c.controller.polarity = analysis::analyse(analysis::LoopModel(c)).recommended_polarity;
+      const tune::Evaluation e = p.assess(c);
+      print_row(config::to_string(model), e);
+      j[config::to_string(model)] = evaluation_json(e);
+    }
+  print_row("tuned", tuned);
+  j["tuned"] = evaluation_json(tuned);
+  out[p.name()] = j;
+}
+
 // 0 tuned and written (or no --out), 3 no candidate met every constraint (nothing written), 2 bad input.
 int run_tune(const TuneArgs& a) {
-  const config::Config base = config::load_config_file(a.config_path);
   std::optional<config::MillingConfig> job;
   if (!a.job_path.empty()) job = config::load_milling_config(a.job_path);
-  const tune::Evaluator evaluate(base, job, a.settings);
-  const tune::TuneResult r = tune::tune(evaluate, base, a.settings, [](const std::string& l) { std::cerr << l << '\n'; });
-  std::printf("robodamp tune: %s%s, %zu evaluations\n", a.config_path.c_str(), job ? (" on " + a.job_path).c_str() : "",
-              r.history.size());
-  if (job) std::printf("  open loop: min depth %.3f mm\n", evaluate.open_min_depth_mm());
-  json report{{"config", a.config_path}, {"job", a.job_path}, {"best", evaluation_json(r.best)}};
-  for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2, config::CompensatorModel::kC3}) {
-    config::Config c = base;
-    for (auto& b : c.controller.chain)
-      if (b.kind == config::BlockKind::kCompensator) b.model = model;
-    c.controller.polarity = analysis::analyse(analysis::LoopModel(c)).recommended_polarity;
-    const tune::Evaluation e = evaluate.assess(c);
-    print_row(config::to_string(model), e);
-    report[config::to_string(model)] = evaluation_json(e);
+  const std::vector<tune::Evaluator> plants = make_plants(a, job);
+  std::vector<const tune::Evaluator*> refs;
+  for (const auto& p : plants) refs.push_back(&p);
+  const tune::TuneResult r = tune::tune(refs, a.settings, [](const std::string& l) { std::cerr << l << '\n'; });
+  std::printf("robodamp tune: %s%s, %zu plant%s, %zu evaluations\n", a.config_path.c_str(),
+              job ? (" on " + a.job_path).c_str() : "", plants.size(), plants.size() == 1 ? "" : "s", r.history.size());
+  json report{{"config", a.config_path}, {"also", a.also_paths}, {"job", a.job_path}, {"best", evaluation_json_with_plants(r.best)}};
+  json per_plant;
+  for (std::size_t i = 0; i < plants.size(); ++i) {
+    const bool nominal = !a.shift_pct || i % 3 == 0;
+    report_plant(plants[i], plants.size() == 1 ? r.best : r.best.per_plant[i], nominal, per_plant);
   }
-  print_row("tuned", r.best);
+  report["plants"] = per_plant;
+  if (plants.size() > 1) print_row("worst", r.best);
   json history = json::array();
   for (const auto& e : r.history) history.push_back(evaluation_json(e));
   report["history"] = history;
@@ -123,7 +178,7 @@ int run_tune(const TuneArgs& a) {
     return 3;
   }
   if (!a.out_path.empty()) {
-    const std::string text = tuned_yaml(base, r.best.candidate);
+    const std::string text = tuned_yaml(plants.front().base(), r.best.candidate);
     const config::Config check = config::parse_config(text, a.out_path);  // throws (exit 2) before writing
     if (!analysis::LoopModel(check).stable(check.controller.gain_ns_per_m, check.controller.polarity))
       throw std::runtime_error("the written configuration's loop is not stable: nothing written");
@@ -147,6 +202,17 @@ void register_tune(Registry& r) {
   r.number(sub, "--gain-margin-db", a->settings.gain_margin_min_db, {"dB", 0.0, 40.0}, "Smallest gain margin allowed");
   r.number(sub, "--phase-margin-deg", a->settings.phase_margin_min_deg, {"deg", 0.0, 90.0}, "Smallest phase margin allowed");
   r.number(sub, "--delay-margin-ms", a->settings.delay_margin_min_ms, {"ms", 0.0, 1000.0, true}, "Smallest delay margin allowed");
+  sub->add_option("--also", a->also_paths,
+                  "More configurations (another mounting, another pose's modes) with the same chain: the worst case over "
+                  "all is tuned; --out writes --config's file")
+      ->check(CLI::ExistingFile);
+  r.number(sub, "--shift-pct", a->shift_pct, {"%", 0.0, 50.0, true},
+           "Also tune for every plant with all its modal frequencies shifted down and up by this");
+  r.number(sub, "--impact-n", a->settings.impact_peak_n, {"N", 0.0, 100000.0},
+           "The impact (half-sine at every location) the actuator's limits must hold for; default the configuration's "
+           "bench.impact_peak_n, 0 = no such constraint");
+  r.number(sub, "--impact-ms", a->settings.impact_duration_ms, {"ms", 0.0, 1000.0, true},
+           "Its duration; default bench.impact_duration_ms");
   r.number(sub, "--depth-at-speed-mm", a->settings.depth_at_speed_min_mm, {"mm", 0.0, 1000.0},
            "With --job: the damped limit at the job's spindle speed at least this (0 = free)");
   r.whole_number(sub, "--evaluations", a->settings.global_evaluations, {"(evaluations per polarity)", 10, 100000},

@@ -8,6 +8,8 @@
 #include <complex>
 #include <string>
 
+#include "analysis/bench_run.hpp"
+#include "analysis/impact_command.hpp"
 #include "analysis/loop_model.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
@@ -106,6 +108,51 @@ TEST(Tune, TheTunedPresetHasItsMarginsAndDepths) {
   for (const auto& mode : a.modes) EXPECT_TRUE(mode.damps) << mode.freq_hz << " Hz";
   EXPECT_GE(e.floor_ratio, 1.0);
   EXPECT_TRUE(e.feasible()) << e.binding;
+}
+
+// The command the actuator-limit constraint predicts for the bench's impact (frequency domain, inverse FFT)
+// against the bench's time-domain run of the real-time Controller on the simulated plant (with its sensor
+// noise and the robot's drives on): the largest command within 10 %, for two compensators and both hammer
+// locations, and for a hit hard enough to reach the limit the prediction says so and the bench saturates.
+TEST(Tune, ThePredictedImpactCommandMatchesTheBench) {
+  for (const char* preset : {"tuned_horizontal", "horizontal_c1"}) {
+    const config::Config cfg = config::load_config_file(test::preset(preset));
+    const analysis::LoopModel m(cfg);
+    const analysis::Bench bench(cfg);
+    analysis::ImpactCommand predict(m, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms * 1e-3);
+    const double k = cfg.controller.gain_ns_per_m;
+    const int pol = cfg.controller.polarity;
+    double worst_measured = 0.0;
+    for (std::size_t h = 0; h < m.plant().locations.size(); ++h) {
+      analysis::ImpactTest t;
+      t.excitation = h;
+      t.peak_n = cfg.bench.impact_peak_n;
+      t.duration_ms = cfg.bench.impact_duration_ms;
+      t.control_on = true;
+      t.gain_ns_per_m = k;
+      t.polarity = pol;
+      const analysis::ImpactTestResult r = bench.impact_test(t);
+      EXPECT_EQ(r.saturation_time_s, 0.0) << preset;
+      worst_measured = std::max(worst_measured, r.peak_command_v);
+    }
+    const analysis::CommandPeak p = predict.peak(m, k, pol);
+    std::printf("%s: impact %.0f N: predicted largest command %.3f V (%.1f N coil, %.0f V/s, tail %.3f), bench %.3f V\n",
+                preset, cfg.bench.impact_peak_n, p.voltage_v, p.coil_force_n, p.slew_v_per_s, p.tail_fraction, worst_measured);
+    EXPECT_NEAR(p.voltage_v, worst_measured, 0.1 * worst_measured) << preset;
+    EXPECT_LT(p.tail_fraction, 0.01) << preset;
+    // Hard enough that the linear command passes the force limit: the bench clips it.
+    const double hard_n = cfg.bench.impact_peak_n * 1.5 * cfg.actuator.force_limit_n / p.coil_force_n;
+    analysis::ImpactCommand hard(m, hard_n, cfg.bench.impact_duration_ms * 1e-3);
+    EXPECT_GT(hard.peak(m, k, pol).coil_force_n, cfg.actuator.force_limit_n);
+    analysis::ImpactTest t;
+    t.excitation = p.location;
+    t.peak_n = hard_n;
+    t.duration_ms = cfg.bench.impact_duration_ms;
+    t.control_on = true;
+    t.gain_ns_per_m = k;
+    t.polarity = pol;
+    EXPECT_GT(bench.impact_test(t).saturation_time_s, 0.0) << preset;
+  }
 }
 
 TEST(Tune, AJobWithoutADampingLocationIsRefused) {

@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 
+#include "analysis/impact_command.hpp"
 #include "analysis/loop_model.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
@@ -92,9 +94,22 @@ config::Config with_candidate(const config::Config& base, const Candidate& c) {
   return cfg;
 }
 
-Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingConfig> job, const TuneSettings& s)
-    : base_(base), job_(std::move(job)), s_(s) {
+struct Evaluator::Impact {
+  Impact(const analysis::LoopModel& plant, double peak_n, double duration_s) : command(plant, peak_n, duration_s) {}
+  analysis::ImpactCommand command;
+};
+
+Evaluator::~Evaluator() = default;
+Evaluator::Evaluator(Evaluator&&) noexcept = default;
+
+Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingConfig> job, const TuneSettings& s,
+                     std::string name)
+    : base_(base), name_(name.empty() ? base.source : std::move(name)), job_(std::move(job)), s_(s) {
   (void)with_candidate(base_, {});  // a chain without a compensator is refused here
+  const auto open_loop = std::make_shared<const analysis::LoopModel>(base_);
+  const double impact_n = s_.impact_peak_n.value_or(base_.bench.impact_peak_n);
+  if (impact_n > 0.0)
+    impact_ = std::make_unique<Impact>(*open_loop, impact_n, s_.impact_duration_ms.value_or(base_.bench.impact_duration_ms) * 1e-3);
   if (!job_) return;
   const config::StructureConfig& st = job_structure(*job_);
   const bool damps = std::any_of(st.parts.begin(), st.parts.end(), [](const auto& p) { return p.controller.has_value(); });
@@ -102,7 +117,8 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
     throw config::ConfigError({config::Problem{job_->source, {}, "structures." + st.name,
                                                "has no damping location (a part with controller: {config, location, "
                                                "direction}): there is nothing for robodamp tune to tune against"}});
-  const milling::Structure open(st, false);
+  // The open loop of this plant (not of the job's own controller file): each plant's floors are its own.
+  const milling::Structure open(st, false, {open_loop, base_.controller.gain_ns_per_m, base_.controller.polarity});
   const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
   const milling::LobeDiagram d = milling::LobeModel(open, process, job_->lobes).diagram();
   open_min_mm_ = d.minimum.b_lim_m * 1e3;
@@ -157,6 +173,15 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   add_violation(e, (s_.gain_margin_min_db - e.gain_margin_db) / s_.gain_margin_min_db, "gain margin");
   add_violation(e, (s_.phase_margin_min_deg - e.phase_margin_deg) / s_.phase_margin_min_deg, "phase margin");
   add_violation(e, (s_.delay_margin_min_ms - e.delay_margin_ms) / s_.delay_margin_min_ms, "delay margin");
+  if (impact_) {
+    const analysis::CommandPeak p = impact_->command.peak(*m, k, cand.polarity);
+    e.peak_command_v = p.voltage_v;
+    e.peak_coil_force_n = p.coil_force_n;
+    e.peak_slew_v_per_s = p.slew_v_per_s;
+    e.actuator_use = std::max({p.coil_force_n / cfg.actuator.force_limit_n, p.voltage_v / cfg.amplifier.voltage_limit_v,
+                               p.slew_v_per_s / cfg.amplifier.slew_rate_v_per_s});
+    add_violation(e, e.actuator_use - 1.0, "the actuator's limits at the impact");
+  }
   if (!job_) {
     e.peak_m_per_n = closed_peak(*m, k, cand.polarity);
     e.objective = -std::log10(e.peak_m_per_n);
@@ -183,6 +208,57 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   return e;
 }
 
+Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c) {
+  if (plants.size() == 1) {
+    Evaluation e = (*plants.front())(c);
+    e.plant = plants.front()->name();
+    return e;
+  }
+  std::vector<Evaluation> per;
+  for (const Evaluator* p : plants) {
+    per.push_back((*p)(c));
+    per.back().plant = p->name();
+  }
+  // The worst: the most violating plant, else the one with the smallest objective.
+  const auto worst = std::min_element(per.begin(), per.end(), [](const Evaluation& a, const Evaluation& b) {
+    if (a.violation != b.violation) return a.violation > b.violation;
+    return a.objective < b.objective;
+  });
+  Evaluation w = *worst;
+  if (!w.binding.empty()) w.binding = w.plant + ": " + w.binding;
+  for (const Evaluation& e : per) {
+    w.stable = w.stable && e.stable;
+    w.gain_margin_db = std::min(w.gain_margin_db, e.gain_margin_db);
+    w.phase_margin_deg = std::min(w.phase_margin_deg, e.phase_margin_deg);
+    w.delay_margin_ms = std::min(w.delay_margin_ms, e.delay_margin_ms);
+    w.k_max_ns_per_m = std::min(w.k_max_ns_per_m, e.k_max_ns_per_m);
+    w.min_depth_mm = std::min(w.min_depth_mm, e.min_depth_mm);
+    w.depth_at_speed_mm = std::min(w.depth_at_speed_mm, e.depth_at_speed_mm);
+    w.floor_ratio = std::min(w.floor_ratio, e.floor_ratio);
+    w.peak_m_per_n = std::max(w.peak_m_per_n, e.peak_m_per_n);
+    w.peak_coil_force_n = std::max(w.peak_coil_force_n, e.peak_coil_force_n);
+    w.peak_command_v = std::max(w.peak_command_v, e.peak_command_v);
+    w.peak_slew_v_per_s = std::max(w.peak_slew_v_per_s, e.peak_slew_v_per_s);
+    w.actuator_use = std::max(w.actuator_use, e.actuator_use);
+  }
+  w.per_plant = std::move(per);
+  return w;
+}
+
+config::Config with_shifted_modes(const config::Config& base, double factor) {
+  config::Config cfg = base;
+  // The controller stays the nominal's: its compensator pre-warped and scaled at the nominal match frequency.
+  cfg.controller.match_freq_hz = unity_gain_hz(base);
+  for (auto& frf : cfg.robot.frfs)
+    for (auto& mode : frf.modes) {
+      mode.natural_freq_hz *= factor;
+      mode.residue_re_m_per_n /= factor;
+      mode.residue_im_m_per_n /= factor;
+      mode.stiffness_n_per_m *= factor * factor;
+    }
+  return cfg;
+}
+
 namespace {
 
 // x = [log10 K, log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb]
@@ -196,7 +272,7 @@ Candidate candidate_of(const double* x, int polarity) {
 }
 
 struct Search {
-  const Evaluator* evaluate;
+  const std::vector<const Evaluator*>* plants;
   int polarity;
   TuneResult* result;
   const std::function<void(const std::string&)>* progress;
@@ -213,7 +289,7 @@ bool better(const Evaluation& a, const Evaluation& b) {
 
 double penalised(unsigned /*n*/, const double* x, double* /*grad*/, void* data) {
   auto& s = *static_cast<Search*>(data);
-  const Evaluation e = (*s.evaluate)(candidate_of(x, s.polarity));
+  const Evaluation e = evaluate_worst(*s.plants, candidate_of(x, s.polarity));
   s.result->history.push_back(e);
   if (s.result->history.size() == 1 || better(e, s.result->best)) s.result->best = e;
   ++s.count;
@@ -253,20 +329,27 @@ TuneResult tune(const config::Config& base, const std::optional<config::MillingC
   return tune(Evaluator(base, job, s), base, s, progress);
 }
 
-TuneResult tune(const Evaluator& evaluate, const config::Config& base, const TuneSettings& s,
+TuneResult tune(const Evaluator& evaluate, const config::Config& /*base*/, const TuneSettings& s,
                 const std::function<void(const std::string&)>& progress) {
+  return tune(std::vector<const Evaluator*>{&evaluate}, s, progress);
+}
+
+TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
+                const std::function<void(const std::string&)>& progress) {
+  if (plants.empty()) throw std::invalid_argument("robodamp tune: no plant to tune for");
+  const config::Config& base = plants.front()->base();
   TuneResult result;
   nlopt_srand(static_cast<unsigned long>(s.seed));  // CRS2's population: seeded, so a tune repeats exactly
   for (const int polarity : {1, -1}) {
     TuneResult per;
-    Search global{&evaluate, polarity, &per, &progress, "global search", s.global_evaluations};
+    Search global{&plants, polarity, &per, &progress, "global search", s.global_evaluations};
     // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
     const Candidate c1{std::clamp(base.controller.gain_ns_per_m, 100.0, 20000.0), base.actuator.natural_freq_hz,
                        base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
     std::vector<double> x = x_of(c1);
     run(NLOPT_GN_CRS2_LM, global, x);
     if (s.local_evaluations > 0) {  // NLopt reads a budget of 0 as no limit
-      Search local{&evaluate, polarity, &per, &progress, "local polish", s.local_evaluations};
+      Search local{&plants, polarity, &per, &progress, "local polish", s.local_evaluations};
       x = x_of(per.best.candidate);
       run(NLOPT_LN_BOBYQA, local, x);
     }

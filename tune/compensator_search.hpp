@@ -13,6 +13,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,11 @@ struct TuneSettings {
   // With a job: the limiting depth at the job's spindle speed (cut.spindle_rpm) at least this, mm (0 = no
   // such constraint). For the trade-off between the minimum and one speed's lobe.
   double depth_at_speed_min_mm{0.0};
+  // The actuator's limits (force, coil voltage, slew) not reached, by the command the discrete loop predicts
+  // for an impact at every location (analysis/impact_command.hpp). Unset: the configuration's bench
+  // nominal impact (bench.impact_peak_n, bench.impact_duration_ms); a peak of 0 drops the constraint.
+  std::optional<double> impact_peak_n;
+  std::optional<double> impact_duration_ms;
   int global_evaluations{240};  // per polarity
   int local_evaluations{120};
   int seed{1};
@@ -62,9 +68,15 @@ struct Evaluation {
   double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (direct test)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
   double peak_m_per_n{0.0};      // without a job: the largest closed-loop peak
+  double peak_coil_force_n{0.0}; // at the impact: T |V|, the largest coil voltage, the largest slew
+  double peak_command_v{0.0};
+  double peak_slew_v_per_s{0.0};
+  double actuator_use{0.0};      // the largest of those over its limit (1 = at a limit; 0 without the check)
   double objective{0.0};         // larger is better (depth in mm, or -log10 of the peak)
   double violation{0.0};         // 0 when every constraint holds
   std::string binding;           // the constraint violated most (empty when feasible)
+  std::string plant;             // the plant this describes (with several, the worst case's)
+  std::vector<Evaluation> per_plant;  // with several plants: each plant's own evaluation
   [[nodiscard]] bool feasible() const { return violation <= 0.0; }
 };
 
@@ -73,10 +85,18 @@ struct TuneResult {
   std::vector<Evaluation> history;  // every evaluation, in order
 };
 
-// One candidate, evaluated. Never throws for a bad candidate (it is infeasible with the reason).
+// One candidate, evaluated on one plant (a configuration: mounting, robot modes, chain). Never throws for
+// a bad candidate (it is infeasible with the reason).
 class Evaluator {
  public:
-  Evaluator(const config::Config& base, std::optional<config::MillingConfig> job, const TuneSettings& s);
+  // name: how reports call this plant (default: the configuration's file).
+  Evaluator(const config::Config& base, std::optional<config::MillingConfig> job, const TuneSettings& s,
+            std::string name = {});
+  ~Evaluator();
+  Evaluator(Evaluator&&) noexcept;
+  Evaluator(const Evaluator&) = delete;
+  Evaluator& operator=(const Evaluator&) = delete;
+  Evaluator& operator=(Evaluator&&) = delete;
   [[nodiscard]] Evaluation operator()(const Candidate& c) const;
   // Any configuration at its own gain and polarity (C1, C2, C3 for the report).
   [[nodiscard]] Evaluation assess(const config::Config& cfg) const;
@@ -84,9 +104,14 @@ class Evaluator {
   [[nodiscard]] double open_min_depth_mm() const { return open_min_mm_; }
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
   [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
+  [[nodiscard]] const config::Config& base() const { return base_; }
+  [[nodiscard]] const std::string& name() const { return name_; }
 
  private:
+  struct Impact;
   config::Config base_;
+  std::string name_;
+  std::unique_ptr<Impact> impact_;  // the actuator-limit check's precomputed plant (one thread at a time)
   std::optional<config::MillingConfig> job_;
   TuneSettings s_;
   double open_min_mm_{0.0};
@@ -94,12 +119,23 @@ class Evaluator {
   std::vector<double> floors_mm_;                     // the open loop's smallest limit in each
 };
 
+// Several plants at once (both mountings, shifted modes): the candidate evaluated on each and the worst case
+// kept: the smallest objective and margins, the largest violation, named with its plant.
+[[nodiscard]] Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c);
+
+// The configuration with every robot mode's natural frequency times `factor` at the same modal mass
+// (residues / factor, modal stiffnesses x factor^2): for robustness to modal frequency shifts.
+[[nodiscard]] config::Config with_shifted_modes(const config::Config& base, double factor);
+
 // Throws config::ConfigError when the configuration cannot be tuned (no compensator block, a job without
 // a damping location). The result may be infeasible: the caller reports the binding constraint.
 [[nodiscard]] TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job,
                               const TuneSettings& s, const std::function<void(const std::string&)>& progress = {});
 // The same with an evaluator the caller keeps (its open-loop lobes computed once, for the report too).
 [[nodiscard]] TuneResult tune(const Evaluator& evaluate, const config::Config& base, const TuneSettings& s,
+                              const std::function<void(const std::string&)>& progress = {});
+// The robust tune: the worst case over the plants optimised; the search starts from the first's C1 shape.
+[[nodiscard]] TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
                               const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace robodamp::tune
