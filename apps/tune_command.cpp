@@ -2,6 +2,7 @@
 // configuration's compensator (as a rational block) and gain, prints progress, compares the result with
 // C1, C2 and C3 on the same chain and job, and writes the tuned configuration only when every constraint
 // holds and the written file passes the configuration checks and the analysis.
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include "analysis/loop_model.hpp"
 #include "apps/cli.hpp"
+#include "apps/gnuplot.hpp"
 #include "tune/compensator_search.hpp"
 
 namespace robodamp::apps {
@@ -26,6 +28,7 @@ struct TuneArgs {
   std::string job_path;
   std::string out_path;
   std::string json_path;
+  std::string plot_path;
   std::vector<std::string> also_paths;  // more plants: the worst case is tuned
   std::optional<double> shift_pct;      // each plant also with its modes shifted by -/+ this
   tune::TuneSettings settings;
@@ -130,24 +133,83 @@ std::vector<tune::Evaluator> make_plants(const TuneArgs& a, const std::optional<
   return plants;
 }
 
-// One plant's rows: C1, C2 and C3 (at the configured gain, the recommended polarity) and the tuned candidate.
-void report_plant(const tune::Evaluator& p, const tune::Evaluation& tuned, bool hand_designs, json& out) {
-  std::printf("plant %s%s\n", p.name().c_str(),
-              p.open_floors_mm().empty() ? "" : ("; open loop: min depth " + std::to_string(p.open_min_depth_mm()) + " mm").c_str());
-  json j;
+struct Compared {
+  std::string name;
+  config::Config cfg;
+  tune::Evaluation e;
+};
+
+// The plant's hand designs (C1, C2, C3 at the configured gain and the recommended polarity), and the tuned one.
+std::vector<Compared> compare(const tune::Evaluator& p, const tune::Evaluation& tuned, bool hand_designs) {
+  std::vector<Compared> out;
   if (hand_designs)
     for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2, config::CompensatorModel::kC3}) {
       config::Config c = p.base();
       for (auto& b : c.controller.chain)
         if (b.kind == config::BlockKind::kCompensator) b.model = model;
       c.controller.polarity = analysis::analyse(analysis::LoopModel(c)).recommended_polarity;
-      const tune::Evaluation e = p.assess(c);
-      print_row(config::to_string(model), e);
-      j[config::to_string(model)] = evaluation_json(e);
+      out.push_back({config::to_string(model), c, p.assess(c)});
     }
-  print_row("tuned", tuned);
-  j["tuned"] = evaluation_json(tuned);
+  out.push_back({"tuned", tune::with_candidate(p.base(), tuned.candidate), tuned});
+  return out;
+}
+
+// One plant: the rows, the damped floor in each interval between the open loop's lobe peaks, the
+// improvement at each mode.
+void report_plant(const tune::Evaluator& p, const std::vector<Compared>& rows, json& out) {
+  std::printf("plant %s\n", p.name().c_str());
+  json j;
+  for (const auto& r : rows) {
+    print_row(r.name.c_str(), r.e);
+    j[r.name] = evaluation_json(r.e);
+  }
+  if (!p.open_floors_mm().empty()) {
+    std::printf("  lobe floor between the open loop's peaks, mm:\n    %-15s %8s", "rpm", "open");
+    for (const auto& r : rows) std::printf(" %8s", r.name.c_str());
+    for (std::size_t i = 0; i < p.open_floors_mm().size(); ++i) {
+      const auto& iv = p.open_intervals_rpm()[i];
+      std::printf("\n    %6.0f - %6.0f %8.3f", iv.first, iv.second, p.open_floors_mm()[i]);
+      for (const auto& r : rows) std::printf(" %8.3f", i < r.e.floors_mm.size() ? r.e.floors_mm[i] : 0.0);
+    }
+    std::printf("\n");
+  }
+  std::printf("  improvement at each mode (%s peak within +-10 %%):", p.base().robot.frfs.front().name.c_str());
+  std::vector<std::vector<tune::ModeImprovement>> mi;
+  for (const auto& r : rows) mi.push_back(p.mode_improvements(r.cfg));
+  for (std::size_t k = 0; k < p.base().robot.frfs.front().modes.size(); ++k) {
+    std::printf("\n    %6.2f Hz", p.base().robot.frfs.front().modes[k].natural_freq_hz);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (k < mi[i].size()) std::printf("  %s %+7.1f %%", rows[i].name.c_str(), mi[i][k].improvement_pct);
+      if (k < mi[i].size()) j[rows[i].name]["mode_improvement_pct"].push_back(mi[i][k].improvement_pct);
+    }
+  }
+  std::printf("\n");
   out[p.name()] = j;
+}
+
+// The open loop's lobes with each compared controller's, on the first plant.
+std::string plot_lobes(const tune::Evaluator& p, const std::vector<Compared>& rows, const std::string& path) {
+  std::vector<std::vector<std::pair<double, double>>> curves{p.open_curve_mm()};
+  for (const auto& r : rows) curves.push_back(p.damped_curve_mm(r.cfg));
+  std::ostringstream data;
+  for (std::size_t i = 0; i < curves.front().size(); ++i) {
+    data << curves.front()[i].first;
+    for (const auto& c : curves) data << ' ' << (i < c.size() && std::isfinite(c[i].second) ? c[i].second : NAN);
+    data << '\n';
+  }
+  double y_max = 0.0;
+  for (const auto& r : rows)
+    if (r.e.min_depth_mm > 0.0) y_max = std::max(y_max, 3.0 * r.e.min_depth_mm);
+  std::ostringstream s;
+  s << "set title 'Stability lobes: open loop, hand designs and robodamp tune (" << p.name() << ")' noenhanced\n"
+    << "set grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'limiting axial depth b_lim (mm)'\nset key top left\n"
+    << "set yrange [0:" << std::max(y_max, 3.0 * p.open_min_depth_mm()) << "]\n";
+  const char* colours[] = {"#7f8c8d", "#27ae60", "#e67e22", "#8e44ad", "#2471a3"};
+  s << "plot DATA u 1:2 w l lw 2 lc rgb '" << colours[0] << "' t 'open loop'";
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    s << ", DATA u 1:" << i + 3 << " w l lw 2 lc rgb '" << colours[(i + 1) % 5] << "' t '" << rows[i].name << "'";
+  s << '\n';
+  return run_gnuplot(s.str(), data.str(), path);
 }
 
 // 0 tuned and written (or no --out), 3 no candidate met every constraint (nothing written), 2 bad input.
@@ -164,7 +226,13 @@ int run_tune(const TuneArgs& a) {
   json per_plant;
   for (std::size_t i = 0; i < plants.size(); ++i) {
     const bool nominal = !a.shift_pct || i % 3 == 0;
-    report_plant(plants[i], plants.size() == 1 ? r.best : r.best.per_plant[i], nominal, per_plant);
+    const auto rows = compare(plants[i], plants.size() == 1 ? r.best : r.best.per_plant[i], nominal);
+    report_plant(plants[i], rows, per_plant);
+    if (i == 0 && !a.plot_path.empty() && job) {
+      const std::string failed = plot_lobes(plants[i], rows, a.plot_path);
+      if (!failed.empty()) throw std::runtime_error("the lobes plot: " + failed);
+      std::printf("wrote %s\n", a.plot_path.c_str());
+    }
   }
   report["plants"] = per_plant;
   if (plants.size() > 1) print_row("worst", r.best);
@@ -202,6 +270,7 @@ void register_tune(Registry& r) {
   r.number(sub, "--gain-margin-db", a->settings.gain_margin_min_db, {"dB", 0.0, 40.0}, "Smallest gain margin allowed");
   r.number(sub, "--phase-margin-deg", a->settings.phase_margin_min_deg, {"deg", 0.0, 90.0}, "Smallest phase margin allowed");
   r.number(sub, "--delay-margin-ms", a->settings.delay_margin_min_ms, {"ms", 0.0, 1000.0, true}, "Smallest delay margin allowed");
+  sub->add_option("--plot", a->plot_path, "With --job: the open, C1, C2, C3 and tuned lobes of --config's plant (PNG)");
   sub->add_option("--also", a->also_paths,
                   "More configurations (another mounting, another pose's modes) with the same chain: the worst case over "
                   "all is tuned; --out writes --config's file")
@@ -220,6 +289,8 @@ void register_tune(Registry& r) {
   r.whole_number(sub, "--polish", a->settings.local_evaluations, {"(evaluations per polarity)", 0, 100000},
                  "Local polish budget per polarity");
   r.whole_number(sub, "--seed", a->settings.seed, {"(seed)", 0, 999999}, "The global search's seed");
+  r.whole_number(sub, "--restarts", a->settings.restarts, {"(searches)", 1, 100},
+                 "Whole searches with seeds --seed, --seed + 1, ...; the best is kept");
 }
 
 }  // namespace robodamp::apps

@@ -394,6 +394,18 @@ TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
   EXPECT_EQ(no_comp.status, 2) << no_comp.out;
   EXPECT_NE(no_comp.out.find("has no compensator block for robodamp tune to replace"), std::string::npos) << no_comp.out;
   EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
+  // An impact no candidate's command stays within the actuator's limits for (100 kN at the bench's 1 ms).
+  const Result hammered = run("tune --evaluations 10 --polish 0 --impact-n 100000 --out " + out);
+  EXPECT_EQ(hammered.status, 3) << hammered.out;
+  EXPECT_NE(hammered.out.find("the closest violates the actuator's limits at the impact"), std::string::npos) << hammered.out;
+  EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
+  const Result shift = run("tune --evaluations 10 --shift-pct 0 --out " + out);
+  EXPECT_EQ(shift.status, 2) << shift.out;
+  EXPECT_NE(shift.out.find("--shift-pct"), std::string::npos) << shift.out;
+  EXPECT_NE(shift.out.find("0 < value <= 50 %"), std::string::npos) << shift.out;
+  const Result missing = run("tune --evaluations 10 --also " + dir + "/no_such.yaml --out " + out);
+  EXPECT_EQ(missing.status, 2) << missing.out;
+  EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
 }
 
 TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData) {

@@ -122,7 +122,8 @@ std::vector<Sub> subcommands() {
        {"--csv", "--frf", "--series", "--recording", "--structure"}, false},
       {"measure", {}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
       {"tune", {"--gain-margin-db", "--phase-margin-deg", "--delay-margin-ms", "--depth-at-speed-mm", "--evaluations",
-                 "--polish", "--seed"}, {}, {}, {"--config", "--job"}, false},
+                 "--polish", "--seed", "--restarts", "--shift-pct", "--impact-n", "--impact-ms"}, {}, {},
+       {"--config", "--job", "--also"}, false},
       {"pose", {"--joints", "--modes", "--band-hz", "--steps", "--fit-band-hz", "--restarts", "--particles", "--iterations",
                 "--seed", "--csv-step-hz"}, {"--json"}, {{"--direction", {"xx", "yy", "xy"}}}, {"--model", "--job"}, false},
   };

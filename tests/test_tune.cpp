@@ -155,6 +155,72 @@ TEST(Tune, ThePredictedImpactCommandMatchesTheBench) {
   }
 }
 
+// The actuator-limit constraint in the evaluation: the preset's command at the bench's impact is a small
+// share of the 36 N limit; at 100 kN it passes the limit and the candidate is infeasible for that reason.
+TEST(Tune, TheActuatorLimitAtTheImpactIsAConstraint) {
+  const config::Config cfg = config::load_config_file(test::preset("tuned_horizontal"));
+  const tune::Evaluation nominal = tune::Evaluator(cfg, std::nullopt, {}).assess(cfg);
+  EXPECT_GT(nominal.actuator_use, 0.05);
+  EXPECT_LT(nominal.actuator_use, 0.5);
+  EXPECT_NEAR(nominal.peak_coil_force_n, nominal.peak_command_v * cfg.actuator.constant_n_per_v, 1e-9);
+  tune::TuneSettings s;
+  s.impact_peak_n = 100000.0;
+  const tune::Evaluation hard = tune::Evaluator(cfg, std::nullopt, s).assess(cfg);
+  EXPECT_NEAR(hard.actuator_use, 100.0 * nominal.actuator_use, 1e-6 * hard.actuator_use);  // linear in the impact
+  EXPECT_FALSE(hard.feasible());
+  EXPECT_EQ(hard.binding, "the actuator's limits at the impact");
+  s.impact_peak_n = 0.0;  // no such constraint
+  EXPECT_EQ(tune::Evaluator(cfg, std::nullopt, s).assess(cfg).actuator_use, 0.0);
+}
+
+// Several plants: the worst case is each quantity's worst over the plants, and a violation is named with
+// its plant. Shifted modes keep the nominal's controller (the compensator identical) and move the lobes.
+TEST(Tune, TheRobustEvaluationKeepsTheWorstCaseOverThePlants) {
+  const config::Config h = config::load_config_file(test::preset("horizontal_c2"));
+  const config::Config v = config::load_config_file(test::preset("vertical_c1"));
+  const auto job = config::load_milling_config(kJob);
+  const tune::Evaluator eh(h, job, {}, "horizontal"), ev(v, job, {}, "vertical");
+  const tune::Candidate c{2000.0, h.actuator.natural_freq_hz, h.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, -1};
+  const tune::Evaluation w = tune::evaluate_worst({&eh, &ev}, c);
+  ASSERT_EQ(w.per_plant.size(), 2u);
+  EXPECT_EQ(w.per_plant[0].plant, "horizontal");
+  EXPECT_EQ(w.per_plant[1].plant, "vertical");
+  EXPECT_EQ(w.min_depth_mm, std::min(w.per_plant[0].min_depth_mm, w.per_plant[1].min_depth_mm));
+  EXPECT_EQ(w.gain_margin_db, std::min(w.per_plant[0].gain_margin_db, w.per_plant[1].gain_margin_db));
+  EXPECT_EQ(w.actuator_use, std::max(w.per_plant[0].actuator_use, w.per_plant[1].actuator_use));
+  EXPECT_EQ(w.feasible(), w.per_plant[0].feasible() && w.per_plant[1].feasible());
+  if (!w.feasible()) EXPECT_EQ(w.binding.rfind(w.plant + ": ", 0), 0u) << w.binding;
+  const config::Config up = tune::with_shifted_modes(h, 1.1);
+  EXPECT_NEAR(tune::unity_gain_hz(up), tune::unity_gain_hz(h), 1e-12);
+  EXPECT_EQ(tune::with_candidate(up, c).controller.chain.back().numerator,
+            tune::with_candidate(h, c).controller.chain.back().numerator);
+  const analysis::LoopModel m_up(up), m(h);
+  const double f_open = 9.2;
+  EXPECT_LT(std::abs(m_up.open_continuous(0, 0, 1.1 * f_open)), 1.2 * std::abs(m.open_continuous(0, 0, f_open)));
+  EXPECT_GT(std::abs(m_up.open_continuous(0, 0, 1.1 * f_open)), 0.8 * std::abs(m.open_continuous(0, 0, f_open)));
+  const tune::Evaluator e_up(up, job, {}, "up");
+  EXPECT_GT(std::abs(e_up.open_min_depth_mm() - eh.open_min_depth_mm()), 0.01);
+}
+
+// The bench run with each tuned preset: measured improvement within 5 % of the analysis on every FRF and no
+// saturation at the bench's nominal impacts (the acceptance; robodamp bench prints the same).
+TEST(Tune, TheTunedPresetsPassTheBench) {
+  for (const char* preset : {"tuned_horizontal", "tuned_vertical"}) {
+    const analysis::BenchReport rep = analysis::Bench(config::load_config_file(test::preset(preset))).run();
+    EXPECT_TRUE(rep.improvement_within_5pct) << preset << ": " << rep.verdict;
+    int nominal = 0;
+    for (const auto& row : rep.rows)
+      if (row.kind == "nominal") {
+        ++nominal;
+        EXPECT_FALSE(row.saturated) << preset << " " << row.name;
+        ASSERT_TRUE(row.measured_improvement_pct && row.predicted_improvement_pct);
+        std::printf("%s %s: measured %.1f %%, predicted %.1f %%\n", preset, row.name.c_str(), *row.measured_improvement_pct,
+                    *row.predicted_improvement_pct);
+      }
+    EXPECT_EQ(nominal, 3) << preset;
+  }
+}
+
 TEST(Tune, AJobWithoutADampingLocationIsRefused) {
   const config::Config base = config::load_config_file(test::preset("horizontal_c2"));
   auto job = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/industrial_robot_aluminium.yaml");

@@ -122,6 +122,7 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
   const milling::LobeDiagram d = milling::LobeModel(open, process, job_->lobes).diagram();
   open_min_mm_ = d.minimum.b_lim_m * 1e3;
+  for (const auto& p : d.curve) open_curve_.emplace_back(p.rpm, p.b_lim_m * 1e3);
   // The open loop's lobe peaks (local maxima of the envelope), and the floor between each two.
   std::vector<std::size_t> peaks;
   const auto& c = d.curve;
@@ -202,6 +203,7 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
     double floor = kInf;
     for (const auto& p : d.curve)
       if (p.rpm >= intervals_[k2].first && p.rpm <= intervals_[k2].second) floor = std::min(floor, p.b_lim_m * 1e3);
+    e.floors_mm.push_back(floor);
     e.floor_ratio = std::min(e.floor_ratio, floor / floors_mm_[k2]);
   }
   add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
@@ -257,6 +259,40 @@ config::Config with_shifted_modes(const config::Config& base, double factor) {
       mode.stiffness_n_per_m *= factor * factor;
     }
   return cfg;
+}
+
+std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::Config& cfg) const {
+  std::vector<std::pair<double, double>> out;
+  if (!job_) return out;
+  const auto m = std::make_shared<const analysis::LoopModel>(cfg);
+  if (!m->stable(cfg.controller.gain_ns_per_m, cfg.controller.polarity)) return out;
+  const milling::Structure damped(job_structure(*job_), true, {m, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
+  const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
+  for (const auto& p : milling::LobeModel(damped, process, job_->lobes).diagram().curve) out.emplace_back(p.rpm, p.b_lim_m * 1e3);
+  return out;
+}
+
+std::vector<ModeImprovement> Evaluator::mode_improvements(const config::Config& cfg) const {
+  std::vector<ModeImprovement> out;
+  const analysis::LoopModel m(cfg);
+  const double k = cfg.controller.gain_ns_per_m;
+  const int pol = cfg.controller.polarity;
+  if (cfg.robot.frfs.empty() || !m.stable(k, pol)) return out;
+  const auto& frf = cfg.robot.frfs.front();
+  const std::size_t g = m.plant().index_of(frf.response_location), h = m.plant().index_of(frf.excitation_location);
+  for (const auto& mode : frf.modes) {
+    ModeImprovement mi;
+    mi.freq_hz = mode.natural_freq_hz;
+    for (double f = 0.9 * mi.freq_hz; f <= 1.1 * mi.freq_hz; f += 0.005 * mi.freq_hz) {
+      const analysis::PlantResponse p = m.plant_response(f);
+      mi.open_peak_m_per_n = std::max(mi.open_peak_m_per_n, std::abs(m.open_discrete(p, g, h)));
+      mi.closed_peak_m_per_n =
+          std::max(mi.closed_peak_m_per_n, std::abs(m.closed_discrete(p, m.chain_filters_digital(f), g, h, k, pol)));
+    }
+    mi.improvement_pct = 100.0 * (mi.open_peak_m_per_n / mi.closed_peak_m_per_n - 1.0);
+    out.push_back(mi);
+  }
+  return out;
 }
 
 namespace {
@@ -334,27 +370,41 @@ TuneResult tune(const Evaluator& evaluate, const config::Config& /*base*/, const
   return tune(std::vector<const Evaluator*>{&evaluate}, s, progress);
 }
 
+namespace {
+
+// One polarity's search (seeded global, then the polish), its evaluations and best added to `result`.
+void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSettings& s, int polarity,
+                     const std::function<void(const std::string&)>& progress, const std::string& tag, TuneResult& result) {
+  const config::Config& base = plants.front()->base();
+  TuneResult per;
+  const std::string global_phase = "global search" + tag, local_phase = "local polish" + tag;
+  Search global{&plants, polarity, &per, &progress, global_phase.c_str(), s.global_evaluations};
+  // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
+  const Candidate c1{std::clamp(base.controller.gain_ns_per_m, 100.0, 20000.0), base.actuator.natural_freq_hz,
+                     base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
+  std::vector<double> x = x_of(c1);
+  run(NLOPT_GN_CRS2_LM, global, x);
+  if (s.local_evaluations > 0) {  // NLopt reads a budget of 0 as no limit
+    Search local{&plants, polarity, &per, &progress, local_phase.c_str(), s.local_evaluations};
+    x = x_of(per.best.candidate);
+    run(NLOPT_LN_BOBYQA, local, x);
+  }
+  const bool first = result.history.empty();
+  result.history.insert(result.history.end(), per.history.begin(), per.history.end());
+  if (first || better(per.best, result.best)) result.best = per.best;
+}
+
+}  // namespace
+
 TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
                 const std::function<void(const std::string&)>& progress) {
   if (plants.empty()) throw std::invalid_argument("robodamp tune: no plant to tune for");
-  const config::Config& base = plants.front()->base();
   TuneResult result;
-  nlopt_srand(static_cast<unsigned long>(s.seed));  // CRS2's population: seeded, so a tune repeats exactly
-  for (const int polarity : {1, -1}) {
-    TuneResult per;
-    Search global{&plants, polarity, &per, &progress, "global search", s.global_evaluations};
-    // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
-    const Candidate c1{std::clamp(base.controller.gain_ns_per_m, 100.0, 20000.0), base.actuator.natural_freq_hz,
-                       base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
-    std::vector<double> x = x_of(c1);
-    run(NLOPT_GN_CRS2_LM, global, x);
-    if (s.local_evaluations > 0) {  // NLopt reads a budget of 0 as no limit
-      Search local{&plants, polarity, &per, &progress, "local polish", s.local_evaluations};
-      x = x_of(per.best.candidate);
-      run(NLOPT_LN_BOBYQA, local, x);
-    }
-    result.history.insert(result.history.end(), per.history.begin(), per.history.end());
-    if (result.history.size() == per.history.size() || better(per.best, result.best)) result.best = per.best;
+  for (int restart = 0; restart < std::max(1, s.restarts); ++restart) {
+    const int seed = s.seed + restart;
+    nlopt_srand(static_cast<unsigned long>(seed));  // CRS2's population: seeded, so a tune repeats exactly
+    const std::string tag = s.restarts > 1 ? " (seed " + std::to_string(seed) + ")" : "";
+    for (const int polarity : {1, -1}) search_polarity(plants, s, polarity, progress, tag, result);
   }
   return result;
 }

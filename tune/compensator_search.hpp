@@ -57,6 +57,7 @@ struct TuneSettings {
   int global_evaluations{240};  // per polarity
   int local_evaluations{120};
   int seed{1};
+  int restarts{1};  // whole searches with seeds seed, seed + 1, ...; the best kept (the search is not global)
 };
 
 struct Evaluation {
@@ -67,6 +68,7 @@ struct Evaluation {
   double min_depth_mm{0.0};      // with a job: the damped lobes' minimum
   double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (direct test)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
+  std::vector<double> floors_mm; // with a job: the damped floor in each of the open lobes' intervals
   double peak_m_per_n{0.0};      // without a job: the largest closed-loop peak
   double peak_coil_force_n{0.0}; // at the impact: T |V|, the largest coil voltage, the largest slew
   double peak_command_v{0.0};
@@ -83,6 +85,13 @@ struct Evaluation {
 struct TuneResult {
   Evaluation best;
   std::vector<Evaluation> history;  // every evaluation, in order
+};
+
+// The receptance peak near one robot mode (+-10 %), open and closed loop.
+struct ModeImprovement {
+  double freq_hz{0.0};
+  double open_peak_m_per_n{0.0}, closed_peak_m_per_n{0.0};
+  double improvement_pct{0.0};  // open / closed - 1
 };
 
 // One candidate, evaluated on one plant (a configuration: mounting, robot modes, chain). Never throws for
@@ -105,6 +114,11 @@ class Evaluator {
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
   [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
   [[nodiscard]] const config::Config& base() const { return base_; }
+  // For reports: the open loop's lobes, a configuration's damped lobes (the job's structure closed through
+  // its loop), and its improvement at each mode of the first configured FRF (the TCP's, discrete loop).
+  [[nodiscard]] const std::vector<std::pair<double, double>>& open_curve_mm() const { return open_curve_; }
+  [[nodiscard]] std::vector<std::pair<double, double>> damped_curve_mm(const config::Config& cfg) const;
+  [[nodiscard]] std::vector<ModeImprovement> mode_improvements(const config::Config& cfg) const;
   [[nodiscard]] const std::string& name() const { return name_; }
 
  private:
@@ -117,6 +131,7 @@ class Evaluator {
   double open_min_mm_{0.0};
   std::vector<std::pair<double, double>> intervals_;  // between neighbouring open-loop lobe peaks
   std::vector<double> floors_mm_;                     // the open loop's smallest limit in each
+  std::vector<std::pair<double, double>> open_curve_; // rpm, mm (inf where no lobe reaches)
 };
 
 // Several plants at once (both mountings, shifted modes): the candidate evaluated on each and the worst case
