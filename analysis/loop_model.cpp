@@ -476,6 +476,17 @@ AnalysisResult analyse(const LoopModel& m) {
   return analyse(m, m.config().controller.gain_ns_per_m, m.config().controller.polarity);
 }
 
+std::vector<ModePhase> mode_phases(const LoopModel& m, double gain, int polarity) {
+  std::vector<ModePhase> out;
+  const sim::FrfPath* loop_path = m.plant().path(m.sensor_location(), m.actuator_location());
+  for (const auto& mode : loop_path->modes) {
+    const double f = mode.wn_rad_per_s / kTwoPi;
+    const Complex c = -m.feedback_continuous(f, gain, polarity) / Complex(0.0, kTwoPi * f);  // -F / v
+    out.push_back({f, std::arg(c) * 180.0 / M_PI, c.real() > 0.0});
+  }
+  return out;
+}
+
 AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
   AnalysisResult r;
   r.gain_ns_per_m = gain;
@@ -496,17 +507,12 @@ AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
   r.max_stable_gain_ns_per_m = max_stable_gain(m, polarity);
   r.margins = margins(m, gain, polarity, r.max_stable_gain_ns_per_m);
 
-  // Phase of the feedback force against the velocity at each mode of the loop's own FRF.
-  const auto& plant = m.plant();
-  const sim::FrfPath* loop_path = plant.path(m.sensor_location(), m.actuator_location());
+  r.modes = mode_phases(m, gain, polarity);
+  const sim::FrfPath* loop_path = m.plant().path(m.sensor_location(), m.actuator_location());
   double dominant = 0.0, dominant_mag = -1.0;
-  for (const auto& mode : loop_path->modes) {
-    const double f = mode.wn_rad_per_s / kTwoPi;
-    const Complex c = -m.feedback_continuous(f, gain, polarity) / Complex(0.0, kTwoPi * f);  // -F / v
-    ModePhase mp{f, std::arg(c) * 180.0 / M_PI, c.real() > 0.0};
-    r.modes.push_back(mp);
-    const double mag = std::abs(loop_path->receptance(f));
-    if (mag > dominant_mag) dominant_mag = mag, dominant = f;
+  for (const auto& mode : r.modes) {
+    const double mag = std::abs(loop_path->receptance(mode.freq_hz));
+    if (mag > dominant_mag) dominant_mag = mag, dominant = mode.freq_hz;
   }
   const Complex c_plus = -m.feedback_continuous(dominant, gain, 1) / Complex(0.0, kTwoPi * dominant);
   r.recommended_polarity = c_plus.real() > 0.0 ? 1 : -1;
@@ -523,7 +529,7 @@ AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
                       "the analysis recommends " + std::to_string(r.recommended_polarity));
   r.frfs_continuous = improvements(m, gain, polarity, false);
   r.frfs_discrete = improvements(m, gain, polarity, true);
-  for (const auto& n : plant.notes) r.notes.push_back(n);
+  for (const auto& n : m.plant().notes) r.notes.push_back(n);
   return r;
 }
 

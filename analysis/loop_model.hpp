@@ -182,6 +182,8 @@ struct SweepPoint {
                               std::optional<double> max_gain);
 [[nodiscard]] std::vector<FrfResult> improvements(const LoopModel& m, double gain_ns_per_m, int polarity,
                                                   bool discrete);
+// Phase of the feedback force against the velocity at each mode of the loop's own FRF (continuous loop).
+[[nodiscard]] std::vector<ModePhase> mode_phases(const LoopModel& m, double gain_ns_per_m, int polarity);
 [[nodiscard]] AnalysisResult analyse(const LoopModel& m);
 [[nodiscard]] AnalysisResult analyse(const LoopModel& m, double gain_ns_per_m, int polarity);
 

@@ -44,6 +44,7 @@ json evaluation_json(const tune::Evaluation& e) {
   return {{"candidate", candidate_json(e.candidate)},   {"stable", e.stable},
           {"gain_margin_db", finite(e.gain_margin_db)}, {"phase_margin_deg", finite(e.phase_margin_deg)},
           {"delay_margin_ms", finite(e.delay_margin_ms)}, {"k_max_ns_per_m", finite(e.k_max_ns_per_m)},
+          {"worst_mode_phase_deg", e.worst_mode_phase_deg},
           {"min_depth_mm", e.min_depth_mm},             {"floor_ratio", finite(e.floor_ratio)},
           {"depth_at_speed_mm", e.depth_at_speed_mm},
           {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
@@ -100,9 +101,9 @@ std::string tuned_yaml(const config::Config& base, const tune::Candidate& c) {
 }
 
 void print_row(const char* name, const tune::Evaluation& e) {
-  std::printf("  %-6s K %8.0f N s/m pol %+d | K_max %8.0f  GM %6.1f dB  PM %6.1f deg  DM %6.2f ms | ", name,
-              e.candidate.gain_ns_per_m, e.candidate.polarity, e.k_max_ns_per_m, e.gain_margin_db, e.phase_margin_deg,
-              e.delay_margin_ms);
+  std::printf("  %-6s K %8.0f N s/m pol %+d | K_max %8.0f  GM %6.1f dB  PM %6.1f deg  DM %6.2f ms  modes within %.0f deg | ",
+              name, e.candidate.gain_ns_per_m, e.candidate.polarity, e.k_max_ns_per_m, e.gain_margin_db, e.phase_margin_deg,
+              e.delay_margin_ms, e.worst_mode_phase_deg);
   if (e.actuator_use > 0.0)
     std::printf("impact: %.1f N coil, %.2f V, %.0f V/s (%.0f %% of a limit) | ", e.peak_coil_force_n, e.peak_command_v,
                 e.peak_slew_v_per_s, 100.0 * e.actuator_use);

@@ -53,7 +53,8 @@ TEST(Tune, TheRationalBlockIsMinimumPhaseStableAndUnityAtTheMatchFrequency) {
 }
 
 // The evaluation reproduces the analysis the issue quotes: C2 0.841 mm, C1 0.667 mm (K = 2000 N s/m), the
-// open loop 0.324 mm; C2 sinks the 23.5 Hz mode's floor below the open loop's, C1 does not.
+// open loop 0.324 mm; C2 sinks the 23.5 Hz mode's floor below the open loop's and leaves the damping window
+// at 21 and 23.5 Hz, C1 does neither.
 TEST(Tune, EvaluationMatchesTheAnalysisForC1AndC2) {
   const config::Config base = config::load_config_file(test::preset("horizontal_c2"));
   const tune::Evaluator evaluate(base, config::load_milling_config(kJob), {});
@@ -62,7 +63,10 @@ TEST(Tune, EvaluationMatchesTheAnalysisForC1AndC2) {
   const tune::Evaluation c2 = evaluate.assess(base);
   EXPECT_NEAR(c2.min_depth_mm, 0.841, 0.001);
   EXPECT_LT(c2.floor_ratio, 1.0);
-  EXPECT_EQ(c2.binding, "a lobe floor below the open loop's");
+  EXPECT_GT(c2.worst_mode_phase_deg, 90.0);  // C2 feeds 21 and 23.5 Hz back outside the damping window
+  EXPECT_FALSE(c2.feasible());
+  EXPECT_TRUE(c2.binding == "a lobe floor below the open loop's" || c2.binding == "a mode outside the damping window")
+      << c2.binding;
   config::Config c1 = config::load_config_file(test::preset("horizontal_c1"));
   const tune::Evaluation e1 = evaluate.assess(c1);
   EXPECT_NEAR(e1.min_depth_mm, 0.667, 0.001);
@@ -90,26 +94,50 @@ TEST(Tune, AShortSeededSearchRepeatsAndBeatsTheOpenLoopWithinItsConstraints) {
   EXPECT_GE(a.best.floor_ratio, 1.0);
 }
 
-// config/presets/tuned_horizontal.yaml is what `robodamp tune --config config/presets/horizontal_c2.yaml --job
-// config/milling/active_damping_c2.yaml --evaluations 300 --polish 150 --depth-at-speed-mm 2.75 --out ...`
-// wrote: its margins by the analysis of the file itself, and its damped lobes on the job: the issue's
-// targets (minimum >= 0.9 mm, >= 2.75 mm at 700 rpm, no floor below the open loop's, GM >= 6 dB, PM >= 45 deg).
-TEST(Tune, TheTunedPresetHasItsMarginsAndDepths) {
-  const config::Config cfg = config::load_config_file(test::preset("tuned_horizontal"));
-  const analysis::LoopModel m(cfg);
-  const analysis::AnalysisResult a = analysis::analyse(m);
-  ASSERT_TRUE(a.stable);
-  EXPECT_GE(*a.margins.gain_margin_db, 6.0);
-  EXPECT_GE(*a.margins.phase_margin_deg, 45.0);
-  const tune::Evaluator evaluate(cfg, config::load_milling_config(kJob), {});
-  const tune::Evaluation e = evaluate.assess(cfg);
-  std::printf("tuned preset: min depth %.3f mm (open 0.324, C2 0.841), %.3f mm at 700 rpm, floors x%.2f, GM %.1f dB, "
-              "PM %.1f deg\n", e.min_depth_mm, e.depth_at_speed_mm, e.floor_ratio, e.gain_margin_db, e.phase_margin_deg);
-  EXPECT_GE(e.min_depth_mm, 0.9);
-  EXPECT_GE(e.depth_at_speed_mm, 2.75);
-  for (const auto& mode : a.modes) EXPECT_TRUE(mode.damps) << mode.freq_hz << " Hz";
-  EXPECT_GE(e.floor_ratio, 1.0);
-  EXPECT_TRUE(e.feasible()) << e.binding;
+// Without a job the objective is the largest closed-loop peak: a short search lowers it below the open
+// loop's (3.153e-5 m/N at the TCP) within the margins and the actuator's limits.
+TEST(Tune, WithoutAJobTheSearchLowersTheClosedLoopPeak) {
+  const config::Config base = config::load_config_file(test::preset("horizontal_c2"));
+  tune::TuneSettings s;
+  s.global_evaluations = 30;
+  s.local_evaluations = 10;
+  const tune::TuneResult r = tune::tune(base, std::nullopt, s);
+  ASSERT_TRUE(r.best.feasible()) << r.best.binding;
+  EXPECT_GT(r.best.peak_m_per_n, 0.0);
+  EXPECT_LT(r.best.peak_m_per_n, 0.8 * 3.153e-5);
+  EXPECT_NEAR(r.best.objective, -std::log10(r.best.peak_m_per_n), 1e-12);
+  EXPECT_GT(r.best.actuator_use, 0.0);
+  EXPECT_LT(r.best.actuator_use, 1.0);
+  std::printf("no job: closed-loop peak %.4g m/N (open 3.153e-5), K %.0f N s/m, GM %.1f dB, PM %.1f deg\n",
+              r.best.peak_m_per_n, r.best.candidate.gain_ns_per_m, r.best.gain_margin_db, r.best.phase_margin_deg);
+}
+
+// config/presets/tuned_horizontal.yaml and tuned_vertical.yaml are what `robodamp tune --config
+// config/presets/{horizontal_c2,vertical_c1}.yaml --job config/milling/active_damping_c2.yaml
+// --depth-at-speed-mm 2.75 ...` wrote (docs/tuning.md has the commands): their margins by the analysis of the
+// file itself, and their damped lobes on the job: the issue's targets (minimum >= 0.9 mm, >= 2.75 mm at
+// 700 rpm, no floor below the open loop's, GM >= 6 dB, PM >= 45 deg), every mode in the damping window, and
+// the command at the bench's impact within the actuator's limits.
+TEST(Tune, TheTunedPresetsHaveTheirMarginsAndDepths) {
+  for (const char* preset : {"tuned_horizontal", "tuned_vertical"}) {
+    const config::Config cfg = config::load_config_file(test::preset(preset));
+    const analysis::LoopModel m(cfg);
+    const analysis::AnalysisResult a = analysis::analyse(m);
+    ASSERT_TRUE(a.stable) << preset;
+    EXPECT_GE(*a.margins.gain_margin_db, 6.0) << preset;
+    EXPECT_GE(*a.margins.phase_margin_deg, 45.0) << preset;
+    const tune::Evaluator evaluate(cfg, config::load_milling_config(kJob), {});
+    const tune::Evaluation e = evaluate.assess(cfg);
+    std::printf("%s: min depth %.3f mm (open 0.324, C2 0.841), %.3f mm at 700 rpm, floors x%.2f, GM %.1f dB, PM %.1f deg, "
+                "impact %.1f N coil\n", preset, e.min_depth_mm, e.depth_at_speed_mm, e.floor_ratio, e.gain_margin_db,
+                e.phase_margin_deg, e.peak_coil_force_n);
+    EXPECT_GE(e.min_depth_mm, 0.9) << preset;
+    EXPECT_GE(e.depth_at_speed_mm, 2.75) << preset;
+    for (const auto& mode : a.modes) EXPECT_TRUE(mode.damps) << preset << " " << mode.freq_hz << " Hz";
+    EXPECT_GE(e.floor_ratio, 1.0) << preset;
+    EXPECT_LT(e.actuator_use, 1.0) << preset;
+    EXPECT_TRUE(e.feasible()) << preset << ": " << e.binding;
+  }
 }
 
 // The command the actuator-limit constraint predicts for the bench's impact (frequency domain, inverse FFT)
@@ -191,7 +219,9 @@ TEST(Tune, TheRobustEvaluationKeepsTheWorstCaseOverThePlants) {
   EXPECT_EQ(w.gain_margin_db, std::min(w.per_plant[0].gain_margin_db, w.per_plant[1].gain_margin_db));
   EXPECT_EQ(w.actuator_use, std::max(w.per_plant[0].actuator_use, w.per_plant[1].actuator_use));
   EXPECT_EQ(w.feasible(), w.per_plant[0].feasible() && w.per_plant[1].feasible());
-  if (!w.feasible()) EXPECT_EQ(w.binding.rfind(w.plant + ": ", 0), 0u) << w.binding;
+  if (!w.feasible()) {
+    EXPECT_EQ(w.binding.rfind(w.plant + ": ", 0), 0u) << w.binding;
+  }
   const config::Config up = tune::with_shifted_modes(h, 1.1);
   EXPECT_NEAR(tune::unity_gain_hz(up), tune::unity_gain_hz(h), 1e-12);
   EXPECT_EQ(tune::with_candidate(up, c).controller.chain.back().numerator,

@@ -174,6 +174,9 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   add_violation(e, (s_.gain_margin_min_db - e.gain_margin_db) / s_.gain_margin_min_db, "gain margin");
   add_violation(e, (s_.phase_margin_min_deg - e.phase_margin_deg) / s_.phase_margin_min_deg, "phase margin");
   add_violation(e, (s_.delay_margin_min_ms - e.delay_margin_ms) / s_.delay_margin_min_ms, "delay margin");
+  for (const auto& mode : analysis::mode_phases(*m, k, cand.polarity))
+    e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
+  add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
   if (impact_) {
     const analysis::CommandPeak p = impact_->command.peak(*m, k, cand.polarity);
     e.peak_command_v = p.voltage_v;
@@ -234,6 +237,7 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
     w.phase_margin_deg = std::min(w.phase_margin_deg, e.phase_margin_deg);
     w.delay_margin_ms = std::min(w.delay_margin_ms, e.delay_margin_ms);
     w.k_max_ns_per_m = std::min(w.k_max_ns_per_m, e.k_max_ns_per_m);
+    w.worst_mode_phase_deg = std::max(w.worst_mode_phase_deg, e.worst_mode_phase_deg);
     w.min_depth_mm = std::min(w.min_depth_mm, e.min_depth_mm);
     w.depth_at_speed_mm = std::min(w.depth_at_speed_mm, e.depth_at_speed_mm);
     w.floor_ratio = std::min(w.floor_ratio, e.floor_ratio);

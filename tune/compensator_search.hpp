@@ -7,9 +7,11 @@
 // with g making |C| = 1 at the match frequency (the dominant mode).
 // Objective: with a milling job, the smallest damped limiting depth over the job's speed range; without
 // one, the smallest peak of the closed-loop receptances over the analysis band. Constraints: stable, gain
-// margin, phase margin and delay margin at least the settings', and with a job no lobe floor lower than the
-// open loop's (between two neighbouring peaks of the open-loop lobes, the smallest damped limit at least the
-// smallest open-loop limit there). Off the real-time path.
+// margin, phase margin and delay margin at least the settings'; every mode of the loop inside the damping
+// window (the feedback force within 90 deg of -velocity); the command for an impact within the
+// actuator's force, voltage and slew limits; with a job no lobe floor lower than the open loop's (between
+// two neighbouring peaks of the open-loop lobes, the smallest damped limit at least the smallest open-loop
+// limit there). Over several plants (mountings, shifted modes) the worst case. Off the real-time path.
 #pragma once
 
 #include <functional>
@@ -65,6 +67,7 @@ struct Evaluation {
   bool stable{false};
   double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
   double k_max_ns_per_m{0.0};
+  double worst_mode_phase_deg{0.0};  // the largest |phase of -F / v| over the loop's modes (< 90: all damped)
   double min_depth_mm{0.0};      // with a job: the damped lobes' minimum
   double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (direct test)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
