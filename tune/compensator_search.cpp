@@ -231,21 +231,18 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
   });
   Evaluation w = *worst;
   if (!w.binding.empty()) w.binding = w.plant + ": " + w.binding;
+  // Margins and depths: the smallest over the plants; peaks and shares of a limit: the largest.
+  constexpr double Evaluation::*kSmallest[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
+                                              &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
+                                              &Evaluation::min_depth_mm,    &Evaluation::depth_at_speed_mm,
+                                              &Evaluation::floor_ratio};
+  constexpr double Evaluation::*kLargest[] = {&Evaluation::worst_mode_phase_deg, &Evaluation::peak_m_per_n,
+                                             &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
+                                             &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use};
   for (const Evaluation& e : per) {
     w.stable = w.stable && e.stable;
-    w.gain_margin_db = std::min(w.gain_margin_db, e.gain_margin_db);
-    w.phase_margin_deg = std::min(w.phase_margin_deg, e.phase_margin_deg);
-    w.delay_margin_ms = std::min(w.delay_margin_ms, e.delay_margin_ms);
-    w.k_max_ns_per_m = std::min(w.k_max_ns_per_m, e.k_max_ns_per_m);
-    w.worst_mode_phase_deg = std::max(w.worst_mode_phase_deg, e.worst_mode_phase_deg);
-    w.min_depth_mm = std::min(w.min_depth_mm, e.min_depth_mm);
-    w.depth_at_speed_mm = std::min(w.depth_at_speed_mm, e.depth_at_speed_mm);
-    w.floor_ratio = std::min(w.floor_ratio, e.floor_ratio);
-    w.peak_m_per_n = std::max(w.peak_m_per_n, e.peak_m_per_n);
-    w.peak_coil_force_n = std::max(w.peak_coil_force_n, e.peak_coil_force_n);
-    w.peak_command_v = std::max(w.peak_command_v, e.peak_command_v);
-    w.peak_slew_v_per_s = std::max(w.peak_slew_v_per_s, e.peak_slew_v_per_s);
-    w.actuator_use = std::max(w.actuator_use, e.actuator_use);
+    for (const auto field : kSmallest) w.*field = std::min(w.*field, e.*field);
+    for (const auto field : kLargest) w.*field = std::max(w.*field, e.*field);
   }
   w.per_plant = std::move(per);
   return w;
