@@ -38,3 +38,7 @@ echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
 taskset -c 0 ./build/benchmarks/benchmark_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_counters_tabular=true
+echo
+echo "robodamp tune, one core: one candidate's evaluation (with the job's damped lobes, and without a job), the"
+echo "impact's command prediction and its set-up per plant:"
+taskset -c 0 ./build/benchmarks/benchmark_tune --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
