@@ -399,6 +399,23 @@ TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
   EXPECT_EQ(hammered.status, 3) << hammered.out;
   EXPECT_NE(hammered.out.find("the closest violates the actuator's limits at the impact"), std::string::npos) << hammered.out;
   EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
+  // A robot 10^4 times softer (every residue x 1e4): the analysis finds every candidate unstable, even at
+  // the search's smallest gain (100 N s/m).
+  const std::string stiff = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  const std::regex residue(R"((residue_(?:re|im)_m_per_n: -?[0-9.]+)e-0?(\d+))");
+  std::string soft;
+  auto from = stiff.cbegin();
+  for (std::sregex_iterator it(stiff.begin(), stiff.end(), residue), end; it != end; ++it) {
+    soft.append(from, stiff.cbegin() + it->position()) += (*it)[1].str() + "e-" + std::to_string(std::stoi((*it)[2]) - 4);
+    from = stiff.cbegin() + it->position() + it->length();
+  }
+  soft.append(from, stiff.cend());
+  ASSERT_NE(soft, stiff);
+  std::ofstream(dir + "/soft.yaml") << soft;
+  const Result unstable = run("tune --evaluations 10 --polish 0 --config " + dir + "/soft.yaml --out " + out);
+  EXPECT_EQ(unstable.status, 3) << unstable.out;
+  EXPECT_NE(unstable.out.find("the closest violates stability: nothing written"), std::string::npos) << unstable.out;
+  EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
   const Result shift = run("tune --evaluations 10 --shift-pct 0 --out " + out);
   EXPECT_EQ(shift.status, 2) << shift.out;
   EXPECT_NE(shift.out.find("--shift-pct"), std::string::npos) << shift.out;
