@@ -46,7 +46,8 @@ json evaluation_json(const tune::Evaluation& e) {
           {"delay_margin_ms", finite(e.delay_margin_ms)}, {"k_max_ns_per_m", finite(e.k_max_ns_per_m)},
           {"worst_mode_phase_deg", e.worst_mode_phase_deg},
           {"min_depth_mm", e.min_depth_mm},             {"floor_ratio", finite(e.floor_ratio)},
-          {"depth_at_speed_mm", e.depth_at_speed_mm},
+          {"depth_at_speed_mm", e.depth_at_speed_mm},   {"floors_mm", e.floors_mm},
+          {"at_open_minima_mm", e.at_open_minima_mm},
           {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
           {"peak_coil_force_n", e.peak_coil_force_n},   {"peak_command_v", e.peak_command_v},
           {"peak_slew_v_per_s", e.peak_slew_v_per_s},   {"actuator_use", e.actuator_use},
@@ -165,12 +166,16 @@ void report_plant(const tune::Evaluator& p, const std::vector<Compared>& rows, j
     j[r.name] = evaluation_json(r.e);
   }
   if (!p.open_floors_mm().empty()) {
-    std::printf("  lobe floor between the open loop's peaks, mm:\n    %-15s %8s", "rpm", "open");
-    for (const auto& r : rows) std::printf(" %8s", r.name.c_str());
+    std::printf("  lobe floor between the open loop's peaks, and the limit at the open loop's floor speed, mm:\n"
+                "    %-15s %8s", "rpm", "open");
+    for (const auto& r : rows) std::printf(" %8s %8s", r.name.c_str(), "at min");
     for (std::size_t i = 0; i < p.open_floors_mm().size(); ++i) {
       const auto& iv = p.open_intervals_rpm()[i];
       std::printf("\n    %6.0f - %6.0f %8.3f", iv.first, iv.second, p.open_floors_mm()[i]);
-      for (const auto& r : rows) std::printf(" %8.3f", i < r.e.floors_mm.size() ? r.e.floors_mm[i] : 0.0);
+      for (const auto& r : rows)
+        std::printf(" %8.3f %8.3f", i < r.e.floors_mm.size() ? r.e.floors_mm[i] : 0.0,
+                    i < r.e.at_open_minima_mm.size() ? r.e.at_open_minima_mm[i] : 0.0);
+      std::printf("   (open floor at %.0f rpm)", p.open_floor_rpm()[i]);
     }
     std::printf("\n");
   }

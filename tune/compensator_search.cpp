@@ -132,11 +132,13 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   edges.insert(edges.end(), peaks.begin(), peaks.end());
   edges.push_back(c.size() - 1);
   for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
-    double floor = kInf;
-    for (std::size_t i = edges[k]; i <= edges[k + 1]; ++i) floor = std::min(floor, c[i].b_lim_m);
+    double floor = kInf, at = 0.0;
+    for (std::size_t i = edges[k]; i <= edges[k + 1]; ++i)
+      if (c[i].b_lim_m < floor) floor = c[i].b_lim_m, at = c[i].rpm;
     if (!std::isfinite(floor)) continue;
     intervals_.emplace_back(c[edges[k]].rpm, c[edges[k + 1]].rpm);
     floors_mm_.push_back(floor * 1e3);
+    floor_rpm_.push_back(at);
   }
 }
 
@@ -208,6 +210,9 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
       if (p.rpm >= intervals_[k2].first && p.rpm <= intervals_[k2].second) floor = std::min(floor, p.b_lim_m * 1e3);
     e.floors_mm.push_back(floor);
     e.floor_ratio = std::min(e.floor_ratio, floor / floors_mm_[k2]);
+    // The damped curve is on the same speeds as the open one: the point at the open floor's speed.
+    const auto at = std::find_if(d.curve.begin(), d.curve.end(), [&](const auto& p) { return p.rpm >= floor_rpm_[k2]; });
+    e.at_open_minima_mm.push_back(at == d.curve.end() ? kInf : at->b_lim_m * 1e3);
   }
   add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
   return e;

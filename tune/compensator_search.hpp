@@ -72,6 +72,7 @@ struct Evaluation {
   double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (direct test)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
   std::vector<double> floors_mm; // with a job: the damped floor in each of the open lobes' intervals
+  std::vector<double> at_open_minima_mm;  // with a job: the damped limit at each open-loop floor's speed
   double peak_m_per_n{0.0};      // without a job: the largest closed-loop peak
   double peak_coil_force_n{0.0}; // at the impact: T |V|, the largest coil voltage, the largest slew
   double peak_command_v{0.0};
@@ -116,6 +117,7 @@ class Evaluator {
   [[nodiscard]] double open_min_depth_mm() const { return open_min_mm_; }
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
   [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
+  [[nodiscard]] const std::vector<double>& open_floor_rpm() const { return floor_rpm_; }
   [[nodiscard]] const config::Config& base() const { return base_; }
   // For reports: the open loop's lobes, a configuration's damped lobes (the job's structure closed through
   // its loop), and its improvement at each mode of the first configured FRF (the TCP's, discrete loop).
@@ -134,6 +136,7 @@ class Evaluator {
   double open_min_mm_{0.0};
   std::vector<std::pair<double, double>> intervals_;  // between neighbouring open-loop lobe peaks
   std::vector<double> floors_mm_;                     // the open loop's smallest limit in each
+  std::vector<double> floor_rpm_;                     // and the speed where it is
   std::vector<std::pair<double, double>> open_curve_; // rpm, mm (inf where no lobe reaches)
 };
 
