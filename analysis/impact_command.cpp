@@ -9,9 +9,7 @@
 namespace robodamp::analysis {
 
 ImpactCommand::ImpactCommand(const LoopModel& plant, double peak_n, double duration_s, std::size_t samples)
-    : peak_n_(peak_n),
-      duration_s_(duration_s),
-      fs_(plant.loop_rate_hz()),
+    : fs_(plant.loop_rate_hz()),
       locations_(plant.plant().locations.size()),
       inverse_(samples) {
   if (samples < 1024 || (samples & (samples - 1)) != 0)

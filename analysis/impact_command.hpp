@@ -34,11 +34,8 @@ class ImpactCommand {
   // For the loop m (the same plant, its own chain) at the gain and polarity. One object per thread.
   [[nodiscard]] CommandPeak peak(const LoopModel& m, double gain_ns_per_m, int polarity);
 
-  [[nodiscard]] double peak_n() const { return peak_n_; }
-  [[nodiscard]] double duration_s() const { return duration_s_; }
-
  private:
-  double peak_n_, duration_s_, fs_;
+  double fs_;
   std::size_t locations_;
   std::vector<PlantResponse> responses_;      // per bin from 1 (DC carries no command)
   std::vector<std::complex<double>> force_;   // per bin: the DFT of the held force samples

@@ -119,8 +119,8 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
                                                "direction}): there is nothing for robodamp tune to tune against"}});
   // The open loop of this plant (not of the job's own controller file): each plant's floors are its own.
   const milling::Structure open(st, false, {open_loop, base_.controller.gain_ns_per_m, base_.controller.polarity});
-  const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
-  const milling::LobeDiagram d = milling::LobeModel(open, process, job_->lobes).diagram();
+  process_ = milling::chatter_process(job_->tool, job_->material, job_->cut);
+  const milling::LobeDiagram d = milling::LobeModel(open, *process_, job_->lobes).diagram();
   open_min_mm_ = d.minimum.b_lim_m * 1e3;
   for (const auto& p : d.curve) open_curve_.emplace_back(p.rpm, p.b_lim_m * 1e3);
   // The open loop's lobe peaks (local maxima of the envelope), and the floor between each two.
@@ -194,8 +194,7 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
     return e;
   }
   const milling::Structure damped(job_structure(*job_), true, {m, k, cand.polarity});
-  const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
-  const milling::LobeModel lobes(damped, process, job_->lobes);
+  const milling::LobeModel lobes(damped, *process_, job_->lobes);
   const milling::LobeDiagram d = lobes.diagram();
   e.min_depth_mm = d.minimum.b_lim_m * 1e3;
   e.objective = e.min_depth_mm;
@@ -273,8 +272,7 @@ std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::
   const auto m = std::make_shared<const analysis::LoopModel>(cfg);
   if (!m->stable(cfg.controller.gain_ns_per_m, cfg.controller.polarity)) return out;
   const milling::Structure damped(job_structure(*job_), true, {m, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
-  const auto process = milling::chatter_process(job_->tool, job_->material, job_->cut);
-  for (const auto& p : milling::LobeModel(damped, process, job_->lobes).diagram().curve) out.emplace_back(p.rpm, p.b_lim_m * 1e3);
+  for (const auto& p : milling::LobeModel(damped, *process_, job_->lobes).diagram().curve) out.emplace_back(p.rpm, p.b_lim_m * 1e3);
   return out;
 }
 
@@ -368,11 +366,7 @@ std::vector<double> x_of(const Candidate& c) {
 
 TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job, const TuneSettings& s,
                 const std::function<void(const std::string&)>& progress) {
-  return tune(Evaluator(base, job, s), base, s, progress);
-}
-
-TuneResult tune(const Evaluator& evaluate, const config::Config& /*base*/, const TuneSettings& s,
-                const std::function<void(const std::string&)>& progress) {
+  const Evaluator evaluate(base, job, s);
   return tune(std::vector<const Evaluator*>{&evaluate}, s, progress);
 }
 

@@ -22,6 +22,7 @@
 
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
+#include "milling/lobes.hpp"
 
 namespace robodamp::tune {
 
@@ -132,6 +133,7 @@ class Evaluator {
   std::string name_;
   std::unique_ptr<Impact> impact_;  // the actuator-limit check's precomputed plant (one thread at a time)
   std::optional<config::MillingConfig> job_;
+  std::optional<milling::ChatterProcess> process_;  // with a job: what its cut contributes
   TuneSettings s_;
   double open_min_mm_{0.0};
   std::vector<std::pair<double, double>> intervals_;  // between neighbouring open-loop lobe peaks
@@ -152,10 +154,8 @@ class Evaluator {
 // a damping location). The result may be infeasible: the caller reports the binding constraint.
 [[nodiscard]] TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job,
                               const TuneSettings& s, const std::function<void(const std::string&)>& progress = {});
-// The same with an evaluator the caller keeps (its open-loop lobes computed once, for the report too).
-[[nodiscard]] TuneResult tune(const Evaluator& evaluate, const config::Config& base, const TuneSettings& s,
-                              const std::function<void(const std::string&)>& progress = {});
-// The robust tune: the worst case over the plants optimised; the search starts from the first's C1 shape.
+// With evaluators the caller keeps (their open-loop lobes computed once, for the report too). Several
+// plants make the robust tune: the worst case over the plants optimised; the search starts from the first's C1 shape.
 [[nodiscard]] TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
                               const std::function<void(const std::string&)>& progress = {});
 
