@@ -96,19 +96,26 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
   d_accel_coil_ = ss.d.block(2 * nl, 0, nl, 1);
   d_accel_force_ = ss.d.block(2 * nl, 1, nl, nl);
 
-  // Controller output -> (computation delay + actuator delay) -> plant -> sensor -> chain (unit K).
-  DiscreteSs plant;  // input w[k] = coil drive, state [x; w[k-1]], output sampled acceleration at the sensor
-  const Eigen::Index n = phi_.rows();
-  plant.a = MatrixXd::Zero(n + 1, n + 1);
+  open_loop_unit_ = open_loop(std::nullopt);
+}
+
+DiscreteSs LoopModel::open_loop(std::optional<std::size_t> force_at) const {
+  // Controller output -> (computation delay + actuator delay) -> plant -> sensor -> chain (unit K). With a
+  // force location, the plant keeps the last held force as a state too: the sampled acceleration feels it
+  // directly (the same left limit as the coil drive's, plant_response).
+  DiscreteSs plant;  // input w[k] = coil drive, state [x; w[k-1] (; f[k-1])], output sampled acceleration
+  const Eigen::Index n = phi_.rows(), extra = force_at ? 2 : 1;
+  plant.a = MatrixXd::Zero(n + extra, n + extra);
   plant.a.topLeftCorner(n, n) = phi_;
-  plant.a.topRightCorner(n, 1) = gamma_early_;
-  plant.b = MatrixXd::Zero(n + 1, 1);
+  plant.a.block(0, n, n, 1) = gamma_early_;
+  plant.b = MatrixXd::Zero(n + extra, 1);
   plant.b.topRows(n) = gamma_late_;
   plant.b(n, 0) = 1.0;
-  plant.c = MatrixXd::Zero(1, n + 1);
+  plant.c = MatrixXd::Zero(1, n + extra);
   plant.c.leftCols(n) = c_accel_.row(static_cast<Eigen::Index>(sensor_));
   plant.c(0, n) = d_accel_coil_(static_cast<Eigen::Index>(sensor_), 0);
   plant.d = MatrixXd::Zero(1, 1);
+  if (force_at) plant.c(0, n + 1) = d_accel_force_(static_cast<Eigen::Index>(sensor_), static_cast<Eigen::Index>(*force_at));
   DiscreteSs sensor;
   if (sensor_model_.has_highpass()) {
     const double g = sensor_model_.highpass_gain(), p = sensor_model_.highpass_pole();
@@ -123,7 +130,22 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
     const double scale = i == 0 ? chain_.params.sections_gain / chain_.params.actuator_constant_n_per_v : 1.0;
     o = series(o, section_ss(sos.sections[i], scale));
   }
-  open_loop_unit_ = o;
+  return o;
+}
+
+SampledPath LoopModel::sampled_path(std::size_t location, double gain, int polarity) const {
+  if (location >= plant_.locations.size()) throw std::invalid_argument("LoopModel::sampled_path: no such location");
+  const DiscreteSs o = open_loop(location);
+  const Eigen::Index n = phi_.rows(), plant_at = 1 + delay_steps_;  // the delay line's states come first
+  const auto h = static_cast<Eigen::Index>(location);
+  SampledPath p;
+  p.a = o.a + (polarity * gain) * o.b * o.c;
+  p.b = Eigen::VectorXd::Zero(o.a.rows());
+  p.b.segment(plant_at, n) = gamma_force_.col(h);
+  p.b(plant_at + n + 1) = 1.0;
+  p.c = Eigen::RowVectorXd::Zero(o.a.rows());
+  p.c.segment(plant_at, n) = plant_.ss.c.row(static_cast<Eigen::Index>(plant_.output_displacement(location)));
+  return p;
 }
 
 Complex LoopModel::notch_response(double f_hz) const {

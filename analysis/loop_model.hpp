@@ -27,6 +27,14 @@ struct DiscreteSs {
   Eigen::MatrixXd a, b, c, d;
 };
 
+// The discrete loop as a cut sees it at one location: x[k+1] = a x + b f[k], d[k] = c x, with f the
+// force held over tick k at the location (N, physical frame) and d the displacement there at tick k (m).
+struct SampledPath {
+  Eigen::MatrixXd a;
+  Eigen::VectorXd b;
+  Eigen::RowVectorXd c;
+};
+
 // The plant's discrete transfers at one frequency: sampled acceleration at each location per held
 // coil voltage and per held external force at each location (sample at t_k per input held over [k, k+1)).
 struct PlantResponse {
@@ -83,6 +91,10 @@ class LoopModel {
   [[nodiscard]] Complex command_per_force(const PlantResponse& p, Complex chain_filters, std::size_t h,
                                           double gain_ns_per_m, int polarity) const;
 
+  // The loop that runs, closed at gain K and polarity, from a force held over each tick at `location` to
+  // the displacement there (milling/sampled_sdm.hpp: the damped cut's semi-discretization).
+  [[nodiscard]] SampledPath sampled_path(std::size_t location, double gain_ns_per_m, int polarity) const;
+
   // Closed-loop state matrix of the discrete loop and its eigenvalues.
   [[nodiscard]] Eigen::MatrixXd closed_loop_matrix(double gain_ns_per_m, int polarity) const;
   [[nodiscard]] Eigen::VectorXcd closed_loop_poles(double gain_ns_per_m, int polarity) const;
@@ -106,6 +118,8 @@ class LoopModel {
   Eigen::MatrixXd phi_, gamma_late_, gamma_early_, gamma_force_, c_accel_, d_accel_coil_, d_accel_force_;
   int delay_steps_{0};
   DiscreteSs open_loop_unit_;  // controller output -> controller output at K = 1, polarity +1 (no gain yet)
+  // The same, with the last held force at force_at as one more plant state (sampled_path).
+  [[nodiscard]] DiscreteSs open_loop(std::optional<std::size_t> force_at) const;
 };
 
 // --- Results -------------------------------------------------------------------------------------

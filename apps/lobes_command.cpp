@@ -1,4 +1,4 @@
-// `robodamp lobes`: stability lobes (zero-order method) with the direct test at chosen speeds, open loop
+// `robodamp lobes`: stability lobes (semi-discretization by default, the zero-order method as a preview) with the direct test at chosen speeds, open loop
 // and with the damping loop closed (--damped).
 #include <iostream>
 #include <memory>
@@ -30,10 +30,10 @@ int run_lobes(const MillingOptions& o) {
 
 void register_lobes(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
-  CLI::App* sub = r.add("lobes", "Stability lobes (zero-order or semi-discretization) with a direct check, open loop and --damped",
+  CLI::App* sub = r.add("lobes", "Stability lobes (semi-discretization of what runs, or a zero-order preview), open loop and --damped",
                         [o] { return run_lobes(*o); });
   add_milling_options(sub, *o);
-  sub->add_option("--method", o->method, "zoa: zero-order (default); sdm: semi-discretization (open loop, time_domain.sdm_*)")
+  sub->add_option("--method", o->method, "sdm (default): semi-discretization of what runs, open loop and the sampled damped loop (time_domain.sdm_*); zoa: the zero-order method, a fast preview")
       ->check(CLI::IsMember({"zoa", "sdm"}));
   r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 1e6, true, false, "and within the job's lobes speed range"},
             "Limiting depth at these speeds by the direct test (the spindle speed is always included)");

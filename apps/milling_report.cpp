@@ -13,7 +13,7 @@
 #include "config/robot_model_config.hpp"
 #include "config/milling_config.hpp"
 #include "milling/lobes.hpp"
-#include "milling/sdm.hpp"
+#include "milling/accurate_stability.hpp"
 #include "milling/sle.hpp"
 
 namespace robodamp::apps {
@@ -21,6 +21,9 @@ namespace robodamp::apps {
 using nlohmann::json;
 
 namespace {
+
+// What the zero-order method's depths are: a fast preview, never a promise (docs/milling.md).
+constexpr const char* kPreview = "zero-order preview";
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
@@ -59,6 +62,7 @@ json lobes_json(const milling::Structure& structure, const config::MillingConfig
   j["min_rpm"] = d.minimum.rpm;
   j["min_chatter_hz"] = d.minimum.chatter_hz;
   j["diagram_ms"] = elapsed_ms(t0);
+  j["method"] = kPreview;
   j["at_rpm"] = json::array();
   for (double rpm : rpms) {
     const auto zoa = model.limit_at(rpm);
@@ -73,50 +77,57 @@ json lobes_json(const milling::Structure& structure, const config::MillingConfig
   return j;
 }
 
-// The lobe diagram by semi-discretization (open-loop structure): the critical depth at time_domain.sdm_points
-// speeds over the lobes range, each from the zero-order limit there as the first guess.
+// The lobe diagram by the accurate method (milling/accurate_stability.hpp): semi-discretization of the
+// open-loop structure, or of the sampled damped loop; the critical depth at time_domain.sdm_points speeds
+// over the lobes range (those the method can step), each from the zero-order limit there as the first guess.
 json sdm_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto terms = milling::cutter_modal_terms(structure, cfg.cut.feed_axis);
-  const milling::SdmModel sdm(terms, milling::cutter_from(cfg.tool), cfg.material, cfg.cut.mode, cfg.cut.radial_mm,
-                              cfg.time_domain.axial_slices, cfg.time_domain.sdm_steps_per_period);
+  const milling::AccurateStability truth(structure, cfg);
   config::LobesConfig grid = cfg.lobes;
   grid.points = cfg.time_domain.sdm_points;
   const milling::LobeModel zoa(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), grid);
   const milling::LobeDiagram guess = zoa.diagram();
-  auto one = [&](double rpm, double guess_m) {
-    const double g = std::isfinite(guess_m) && guess_m > 0.0 ? guess_m * 1e3 : cfg.cut.axial_mm;
-    return sdm.critical(rpm, g);
-  };
+  std::vector<double> speeds, guesses;
+  for (const auto& p : guess.curve)
+    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm), guesses.push_back(p.b_lim_m * 1e3);
+  for (double rpm : rpms) {
+    if (rpm > truth.max_rpm())
+      throw config::ConfigError({config::Problem{cfg.source, {}, "spindle speed",
+                                                 "= " + std::to_string(rpm) + " rpm: the " + truth.method() +
+                                                     " needs at most " + std::to_string(truth.max_rpm()) +
+                                                     " rpm (10 loop periods per tooth period); use --method zoa for a preview"}});
+  }
+  const std::vector<milling::SdmPoint> curve = truth.critical(speeds, guesses);
+  std::vector<double> at_guess;
+  for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_m(rpm) * 1e3);
+  const std::vector<milling::SdmPoint> at = truth.critical(rpms, at_guess);
   json j;
   j["structure"] = structure.name();
-  j["closed_loop"] = false;
-  j["method"] = "sdm";
-  j["steps_per_period"] = cfg.time_domain.sdm_steps_per_period;
+  j["closed_loop"] = structure.damped();
+  j["method"] = truth.method();
+  j["steps_per_period"] = truth.grid_per_period();
   j["curve"] = json::array();
   double best = 1e300, best_rpm = 0.0, best_hz = 0.0;
-  std::size_t done = 0;
-  for (const auto& p : guess.curve) {
-    const milling::SdmPoint s = one(p.rpm, p.b_lim_m);
-    if (++done % 20 == 0 || done == guess.curve.size())  // progress on stderr: a big model takes minutes
-      std::cerr << "[lobes sdm] " << done << "/" << guess.curve.size() << " speeds, " << elapsed_ms(t0) / 1000.0
-                << " s\n";
-    j["curve"].push_back({{"rpm", p.rpm}, {"b_lim_mm", s.critical_depth_mm}, {"chatter_hz", s.chatter_hz},
+  for (const auto& s : curve) {
+    j["curve"].push_back({{"rpm", s.rpm}, {"b_lim_mm", finite_or_null(s.critical_depth_mm)}, {"chatter_hz", s.chatter_hz},
                           {"type", milling::to_string(s.type)}});
-    if (s.critical_depth_mm < best) best = s.critical_depth_mm, best_rpm = p.rpm, best_hz = s.chatter_hz;
+    if (s.critical_depth_mm < best) best = s.critical_depth_mm, best_rpm = s.rpm, best_hz = s.chatter_hz;
   }
-  j["min_b_lim_mm"] = best;
+  j["min_b_lim_mm"] = finite_or_null(best);
   j["min_rpm"] = best_rpm;
   j["min_chatter_hz"] = best_hz;
   j["frequency_points"] = 0;
   j["at_rpm"] = json::array();
-  for (double rpm : rpms) {
-    const milling::SdmPoint s = one(rpm, zoa.critical_depth_m(rpm));
-    j["at_rpm"].push_back({{"rpm", rpm}, {"b_lim_mm", s.critical_depth_mm}, {"chatter_hz", s.chatter_hz},
-                           {"type", milling::to_string(s.type)}, {"b_lim_lobes_mm", finite_or_null(zoa.critical_depth_m(rpm) * 1e3)}});
-  }
+  for (std::size_t i = 0; i < rpms.size(); ++i)
+    j["at_rpm"].push_back({{"rpm", at[i].rpm}, {"requested_rpm", rpms[i]}, {"b_lim_mm", finite_or_null(at[i].critical_depth_mm)},
+                           {"chatter_hz", at[i].chatter_hz}, {"type", milling::to_string(at[i].type)},
+                           {"b_lim_lobes_mm", finite_or_null(at_guess[i])}});
   j["diagram_ms"] = elapsed_ms(t0);
   j["notes"] = structure.notes();
+  if (speeds.size() < guess.curve.size())
+    j["notes"].push_back("the " + truth.method() + " stops at " + std::to_string(static_cast<int>(truth.max_rpm())) +
+                         " rpm (10 loop periods per tooth period): " + std::to_string(guess.curve.size() - speeds.size()) +
+                         " speeds above it left out; --method zoa previews them");
   return j;
 }
 
@@ -135,8 +146,9 @@ std::string fmt(const json& v, const char* format) {
 std::string lobes_table(const json& r) {
   std::ostringstream os;
   auto one = [&](const json& d, const char* label) {
-    const bool sdm = d.contains("method");
-    os << "  " << label << ": minimum limiting depth " << fmt(d["min_b_lim_mm"], "%.3f") << " mm at "
+    const std::string method = d["method"].get<std::string>();
+    const bool sdm = method != kPreview;
+    os << "  " << label << ": minimum limiting depth " << fmt(d["min_b_lim_mm"], "%.3f") << " mm (" << method << ") at "
        << fmt(d["min_rpm"], "%.0f") << " rpm (chatter " << fmt(d["min_chatter_hz"], "%.1f") << " Hz); ";
     if (sdm)
       os << d["curve"].size() << " speeds, " << d["steps_per_period"].get<int>() << " steps per tooth period, ";
@@ -144,12 +156,14 @@ std::string lobes_table(const json& r) {
       os << d["frequency_points"].get<std::size_t>() << " chatter frequencies, ";
     os << fmt(d["diagram_ms"], "%.1f") << " ms\n";
     for (const auto& a : d["at_rpm"]) {
-      os << "    at " << fmt(a["rpm"], "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
-         << (sdm ? " mm (semi-discretization, " + a["type"].get<std::string>() + "), zero-order " : " mm (direct test), lobes ")
+      os << "    at " << fmt(a["rpm"], sdm ? "%9.2f" : "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
+         << (sdm ? " mm (" + method + ", " + a["type"].get<std::string>() + "), zero-order preview "
+                 : " mm (zero-order direct test), zero-order lobes ")
          << fmt(a["b_lim_lobes_mm"], "%.3f") << " mm, chatter " << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
     }
   };
-  os << "Stability lobes (" << (r.contains("method") ? "semi-discretization" : "zero-order") << ") of "
+  os << "Stability lobes (" << r["method"].get<std::string>()
+     << (r.contains("damped") ? ", damped: " + r["damped"]["method"].get<std::string>() : std::string()) << ") of "
      << r["config"].get<std::string>() << " (structure " << r["structure"].get<std::string>() << ", "
      << r["tool"].get<std::string>() << ")\n";
   one(r, "open  ");
@@ -171,22 +185,29 @@ std::string plot_lobes(const json& r, const std::string& path) {
   double y_max = 0.0;
   for (const json* d : {&r, damped ? &r["damped"] : nullptr})
     if (d && !(*d)["min_b_lim_mm"].is_null()) y_max = std::max(y_max, 6.0 * (*d)["min_b_lim_mm"].get<double>());
-  for (std::size_t i = 0; i < r["curve"].size(); ++i) {
-    auto val = [](const json& p) { return p["b_lim_mm"].is_null() ? std::string("NaN") : std::to_string(p["b_lim_mm"].get<double>()); };
-    data << r["curve"][i]["rpm"].get<double>() << ' ' << val(r["curve"][i]);
-    if (damped) data << ' ' << val(r["damped"]["curve"][i]);
-    data << '\n';
+  // One data block per diagram (index 0 open, 1 damped): their speeds differ where the damped method
+  // steps the speed to the loop rate. Full precision: the plotted data is the report's.
+  for (const json* d : {&r, damped ? &r["damped"] : nullptr}) {
+    if (!d) continue;
+    for (const auto& p : (*d)["curve"]) {
+      char line[96];
+      std::snprintf(line, sizeof line, "%.10g %.10g\n", p["rpm"].get<double>(),
+                    p["b_lim_mm"].is_null() ? NAN : p["b_lim_mm"].get<double>());
+      data << line;
+    }
+    data << "\n\n";
   }
   std::ostringstream s;
-  s << "set title 'Stability lobes (zero-order), " << r["structure"].get<std::string>() << ": " << r["tool"].get<std::string>()
+  s << "set title 'Stability lobes, " << r["structure"].get<std::string>() << ": " << r["tool"].get<std::string>()
     << "'\nset grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'limiting axial depth b_lim (mm)'\n"
     << "set yrange [0:" << y_max << "]\nset key top left\n";
   s << "set arrow from " << r["spindle_rpm"].get<double>() << ", graph 0 to " << r["spindle_rpm"].get<double>()
     << ", graph 1 nohead dt 3 lc rgb 'gray40'\n";
-  s << "plot DATA u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop (min " << fmt(r["min_b_lim_mm"], "%.3f") << " mm)'";
+  s << "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop, " << r["method"].get<std::string>() << " (min "
+    << fmt(r["min_b_lim_mm"], "%.3f") << " mm)'";
   if (damped)
-    s << ", DATA u 1:3 w l lw 2 lc rgb '#2471a3' t 'active damping (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f")
-      << " mm)'";
+    s << ", DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'active damping, " << r["damped"]["method"].get<std::string>()
+      << " (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f") << " mm)'";
   s << '\n';
   return run_gnuplot(s.str(), data.str(), path);
 }
@@ -340,17 +361,13 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   if (o.damped && !open.has_controller())
     throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
                                                "--damped needs a part with a controller (a damping configuration)"}});
-  if (o.method == "sdm" && o.damped)
-    throw config::ConfigError({config::Problem{cfg.source, {}, "--method",
-                                               "--method sdm is for the open-loop structure; with --damped use "
-                                               "--method zoa, or `robodamp cut --critical --damped`"}});
   json r = o.method == "sdm" ? sdm_json(open, cfg, rpms) : lobes_json(open, cfg, rpms);
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
   r["spindle_rpm"] = cfg.cut.spindle_rpm;
   if (o.damped) {
     const milling::Structure closed(sc, true);
-    r["damped"] = lobes_json(closed, cfg, rpms);
+    r["damped"] = o.method == "sdm" ? sdm_json(closed, cfg, rpms) : lobes_json(closed, cfg, rpms);
     r["gain"] = {{"min_b_lim_change_pct", finite_or_null(pct_change(r["min_b_lim_mm"], r["damped"]["min_b_lim_mm"]))},
                  {"at_spindle_rpm", cfg.cut.spindle_rpm},
                  {"at_spindle_change_pct",

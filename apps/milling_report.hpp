@@ -20,7 +20,7 @@ struct MillingOptions {
   bool damped{false};             // also with the controller's loop closed, overlaid
   std::vector<double> rpm;        // lobes: extra speeds for the direct test
   std::string controller_path;    // replaces every controller part's damping configuration
-  std::string method{"zoa"};      // lobes: zoa (zero-order) or sdm (semi-discretization)
+  std::string method{"sdm"};      // lobes: sdm (semi-discretization of what runs: the promise) or zoa (preview)
   std::vector<double> pose_deg;   // replaces the joints of every robot pose part (docs/pose_dynamics.md)
 };
 

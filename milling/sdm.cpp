@@ -17,32 +17,33 @@ SdmModel::SdmModel(const std::vector<CutterModalTerm>& terms, const Cutter& cutt
   for (const auto& t : terms) mode_hz_.push_back(t.wn_rad_per_s / (2.0 * M_PI));
 }
 
-Eigen::Matrix2d SdmModel::mean_directional(double axial_mm, double rpm, int interval) const {
-  // Mean of M(t) over [t_i, t_i+1), by the midpoint rule on sub-intervals (the engagement switches inside).
-  constexpr int kSub = 8;
-  const int n = cutter_.teeth;
-  const double dphi = 2.0 * M_PI / (n * m_);  // spindle angle per interval
-  const double kt = material_.kt_n_per_mm2 * 1e6, kr = material_.kr_n_per_mm2 * 1e6;
+DirectionalMatrix::DirectionalMatrix(const Cutter& cutter, const config::MaterialConfig& material,
+                                     config::MillingMode mode, double radial_mm, int axial_slices, double axial_mm)
+    : teeth_(cutter.teeth), kt_(material.kt_n_per_mm2 * 1e6), kr_(material.kr_n_per_mm2 * 1e6) {
+  for (const Slice& s : slices(cutter, axial_mm, axial_slices)) {
+    const double local_radial = radial_mm - (cutter.radius_mm - s.radius_mm);
+    if (local_radial > 0.0) slices_.push_back({s, engagement(s.radius_mm, local_radial, mode)});
+  }
+}
+
+Eigen::Matrix2d DirectionalMatrix::mean(double phi0, double dphi, int sub) const {
   Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
-  const std::vector<Slice> geometry = slices(cutter_, axial_mm, slices_);
-  for (const Slice& s : geometry) {
-    const double local_radial = radial_mm_ - (cutter_.radius_mm - s.radius_mm);
-    if (local_radial <= 0.0) continue;
-    const Engagement e = engagement(s.radius_mm, local_radial, mode_);
+  for (const EngagedSlice& es : slices_) {
+    const Slice& s = es.slice;
+    const Engagement& e = es.engagement;
     const double sk = std::sin(s.kappa_rad), db = s.height_mm * 1e-3;
-    for (int sub = 0; sub < kSub; ++sub) {
-      const double spindle = (interval + (sub + 0.5) / kSub) * dphi;
-      for (int j = 0; j < n; ++j) {
-        double phi = std::fmod(spindle + 2.0 * M_PI * j / n - s.lag_rad, 2.0 * M_PI);
+    for (int i = 0; i < sub; ++i) {
+      const double spindle = phi0 + (i + 0.5) / sub * dphi;
+      for (int j = 0; j < teeth_; ++j) {
+        double phi = std::fmod(spindle + 2.0 * M_PI * j / teeth_ - s.lag_rad, 2.0 * M_PI);
         if (phi < 0.0) phi += 2.0 * M_PI;
         if (phi < e.start_rad || phi > e.exit_rad) continue;
         const double sp = std::sin(phi), cp = std::cos(phi);
-        const Eigen::Vector2d force(-kt * cp - kr * sk * sp, kt * sp - kr * sk * cp);
-        mean += db * sk * force * Eigen::RowVector2d(sp, cp) / kSub;
+        const Eigen::Vector2d force(-kt_ * cp - kr_ * sk * sp, kt_ * sp - kr_ * sk * cp);
+        mean += db * sk * force * Eigen::RowVector2d(sp, cp) / sub;
       }
     }
   }
-  (void)rpm;
   return mean;
 }
 
@@ -51,8 +52,11 @@ std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const {
   const double h = 60.0 / (rpm * cutter_.teeth) / m_;
   Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d);
   Eigen::MatrixXd big = Eigen::MatrixXd::Zero(n + 4, n + 4);
+  const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, slices_, axial_mm);
+  const double dphi = 2.0 * M_PI / (cutter_.teeth * m_);  // spindle angle per interval
+  constexpr int kSub = 8;
   for (int i = 0; i < m_; ++i) {
-    const Eigen::Matrix2d mi = mean_directional(axial_mm, rpm, i);
+    const Eigen::Matrix2d mi = directional.mean(i * dphi, dphi, kSub);
     // x' = (A + B M C) x - B M q(t - tau); the delayed q goes linearly from q_{i-m} to q_{i-m+1}.
     big.setZero();
     big.topLeftCorner(n, n) = a_ + b_ * mi * c_;

@@ -20,6 +20,27 @@
 
 namespace robodamp::milling {
 
+// The directional matrix of the linearised regenerative force, F = M (q(t - tau) - q(t)) with M in N/m,
+// summed over the engaged teeth and the axial slices of a cut at one depth (helix lag and ball end as in
+// the frequency-domain and time-domain models).
+class DirectionalMatrix {
+ public:
+  DirectionalMatrix(const Cutter& cutter, const config::MaterialConfig& material, config::MillingMode mode,
+                    double radial_mm, int axial_slices, double axial_mm);
+  // Mean over the spindle angles [phi0, phi0 + dphi) by the midpoint rule on `sub` sub-intervals (the
+  // engagement switches inside), N/m.
+  [[nodiscard]] Eigen::Matrix2d mean(double phi0_rad, double dphi_rad, int sub) const;
+
+ private:
+  struct EngagedSlice {
+    Slice slice;
+    Engagement engagement;
+  };
+  std::vector<EngagedSlice> slices_;
+  int teeth_;
+  double kt_, kr_;
+};
+
 struct SdmPoint {
   double rpm{0.0};
   double critical_depth_mm{0.0};
@@ -39,7 +60,6 @@ class SdmModel {
   [[nodiscard]] int steps_per_period() const { return m_; }
 
  private:
-  [[nodiscard]] Eigen::Matrix2d mean_directional(double axial_mm, double rpm, int interval) const;
   Eigen::MatrixXd a_, b_, c_;
   std::vector<double> mode_hz_;
   Cutter cutter_;

@@ -1,0 +1,52 @@
+// The one stability verdict robodamp promises depths from (docs/milling.md, "Which method makes a depth"):
+// semi-discretization of what runs. The open-loop structure by first-order SDM (milling/sdm.hpp); with a
+// controller part closed (a damped structure), by the sampled loop's semi-discretization
+// (milling/sampled_sdm.hpp). The zero-order method (milling/lobes.hpp) is only a preview or a first guess.
+// Off the real-time path.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "config/milling_config.hpp"
+#include "milling/sampled_sdm.hpp"
+#include "milling/sdm.hpp"
+#include "milling/structure.hpp"
+
+namespace robodamp::milling {
+
+class AccurateStability {
+ public:
+  // Throws std::invalid_argument for a structure this cannot model (controller parts of different loop
+  // rates) and config::ConfigError-free: the job is already checked.
+  AccurateStability(const Structure& structure, const config::MillingConfig& job);
+  AccurateStability(const Structure& structure, const config::MillingConfig& job, const config::CutConfig& cut);
+
+  // "sampled-loop SDM" (damped) or "SDM" (open loop).
+  [[nodiscard]] const std::string& method() const { return method_; }
+  [[nodiscard]] bool sampled() const { return sampled_ != nullptr; }
+  // The speed the verdict is for (the damped loop: a whole number of loop periods per tooth period).
+  [[nodiscard]] double stepped_rpm(double rpm) const { return sampled_ ? sampled_->stepped_rpm(rpm) : rpm; }
+  // The highest speed it can analyse (infinite open loop).
+  [[nodiscard]] double max_rpm() const;
+  // Grid points per tooth period (open loop: the SDM's steps).
+  [[nodiscard]] int grid_per_period() const { return grid_; }
+
+  // Critical depth at one speed from a first guess (e.g. the zero-order limit). Throws
+  // std::invalid_argument for a speed out of range.
+  [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
+  // The same at many speeds on `threads` threads (0: one per core); same result for any thread count.
+  [[nodiscard]] std::vector<SdmPoint> critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
+                                               std::size_t threads = 0, double rel_tol = 1e-3) const;
+  // Stable at this depth and speed (the dominant multiplier inside the unit circle).
+  [[nodiscard]] bool stable(double axial_mm, double rpm) const;
+
+ private:
+  std::string method_;
+  int grid_{0};
+  std::unique_ptr<SdmModel> open_;
+  std::unique_ptr<SampledSdm> sampled_;
+};
+
+}  // namespace robodamp::milling

@@ -1,0 +1,303 @@
+#include "milling/sampled_sdm.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include "milling/tool_dynamics.hpp"
+
+namespace robodamp::milling {
+
+namespace {
+
+using Eigen::MatrixXd;
+
+// Cutter frame -> machine frame (Structure::frf_cutter): a feed along +y makes the cutter's x the
+// machine's y and its y the machine's -x. f_machine = R f_cutter, q_cutter = R^T q_machine.
+Eigen::Matrix2d to_machine(config::Axis feed) {
+  return feed == config::Axis::kX ? Eigen::Matrix2d::Identity() : (Eigen::Matrix2d() << 0.0, -1.0, 1.0, 0.0).finished();
+}
+
+void append_block(MatrixXd& a, MatrixXd& b, MatrixXd& c, const MatrixXd& ai, const MatrixXd& bi, const MatrixXd& ci) {
+  const Eigen::Index n = a.rows(), m = ai.rows();
+  MatrixXd a2 = MatrixXd::Zero(n + m, n + m), b2(n + m, 2), c2(2, n + m);
+  a2.topLeftCorner(n, n) = a;
+  a2.bottomRightCorner(m, m) = ai;
+  b2 << b, bi;
+  c2 << c, ci;
+  a.swap(a2), b.swap(b2), c.swap(c2);
+}
+
+// Lagrange weights of the quadratic through (t0, t1, t2) at t.
+Eigen::Vector3d lagrange(double t0, double t1, double t2, double t) {
+  return {(t - t1) * (t - t2) / ((t0 - t1) * (t0 - t2)), (t - t0) * (t - t2) / ((t1 - t0) * (t1 - t2)),
+          (t - t0) * (t - t1) / ((t2 - t0) * (t2 - t1))};
+}
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+}  // namespace
+
+SampledSdm::SampledSdm(const Structure& damped, const Cutter& cutter, const config::MaterialConfig& material,
+                       config::MillingMode mode, double radial_mm, config::Axis feed_axis, SampledSdmSettings settings)
+    : parts_(damped.controller_parts()),
+      cutter_(cutter),
+      material_(material),
+      mode_(mode),
+      radial_mm_(radial_mm),
+      feed_axis_(feed_axis),
+      settings_(settings) {
+  if (parts_.empty()) throw std::invalid_argument("SampledSdm: the structure has no controller part");
+  if (settings_.min_grid_per_period < 3) throw std::invalid_argument("SampledSdm: needs at least 3 grid points per period");
+  for (const auto& p : parts_) {
+    const double t = 1.0 / p.model->loop_rate_hz();
+    if (tick_s_ > 0.0 && std::abs(t - tick_s_) > 1e-12 * t)
+      throw std::invalid_argument("SampledSdm: controller parts with different loop rates");
+    tick_s_ = t;
+    per_speed_ = per_speed_ || p.model->config().controller.harmonic_notch.has_value();
+  }
+  // The modal tables only: the controller parts' robot is in their loops (as the damped time-domain cut).
+  const Structure tables(damped.modal_terms_by_pair(), damped.name());
+  tables_ = cutter_modal_terms(tables, feed_axis);
+  base_ = system_at(0.0);
+}
+
+int SampledSdm::ticks_per_tooth(double rpm) const {
+  const double tooth_s = 60.0 / (rpm * cutter_.teeth);
+  const double ticks = std::round(tooth_s / tick_s_);
+  if (!(rpm > 0.0) || !std::isfinite(rpm) || ticks < SampledSdmSettings::kMinTicksPerTooth)
+    throw std::invalid_argument("spindle speed = " + fmt(rpm) + " rpm: the sampled loop's semi-discretization needs a tooth period of at least " +
+                                std::to_string(SampledSdmSettings::kMinTicksPerTooth) + " loop periods (" +
+                                fmt(SampledSdmSettings::kMinTicksPerTooth * tick_s_ * 1e3) + " ms at " +
+                                fmt(loop_rate_hz()) + " Hz), allowed range (0, " + fmt(max_rpm()) + "] rpm");
+  return static_cast<int>(ticks);
+}
+
+double SampledSdm::stepped_rpm(double rpm) const { return 60.0 / (cutter_.teeth * ticks_per_tooth(rpm) * tick_s_); }
+
+double SampledSdm::max_rpm() const {
+  return 60.0 / (cutter_.teeth * (SampledSdmSettings::kMinTicksPerTooth - 0.5) * tick_s_) * (1.0 - 1e-9);
+}
+
+SampledSdm::System SampledSdm::system_at(double rpm) const {
+  System s;
+  s.a.resize(0, 0), s.b.resize(0, 2), s.c.resize(2, 0);
+  const Eigen::Matrix2d r = to_machine(feed_axis_);
+  for (const auto& part : parts_) {
+    std::shared_ptr<const analysis::LoopModel> model = part.model;
+    if (per_speed_ && rpm > 0.0) model = std::make_shared<const analysis::LoopModel>(part.model->config(), rpm);
+    const analysis::SampledPath p = model->sampled_path(part.location, part.gain_ns_per_m, part.polarity);
+    const auto d = static_cast<Eigen::Index>(part.direction);
+    append_block(s.a, s.b, s.c, p.a, p.b * r.row(d), r.transpose().col(d) * p.c);
+  }
+  if (!tables_.empty()) {
+    const ToolDynamics dyn(tables_, tick_s_);
+    const Eigen::Index n = dyn.a().rows();
+    MatrixXd big = MatrixXd::Zero(n + 2, n + 2);
+    big.topLeftCorner(n, n) = dyn.a();
+    big.topRightCorner(n, 2) = dyn.b();
+    const MatrixXd e = (big * tick_s_).exp();
+    append_block(s.a, s.b, s.c, e.topLeftCorner(n, n), e.topRightCorner(n, 2), dyn.c());
+  }
+  // The loop's modes: poles with a frequency below Nyquist and damping below 30 %.
+  const Eigen::VectorXcd poles = Eigen::EigenSolver<MatrixXd>(s.a, false).eigenvalues();
+  if (poles.cwiseAbs().maxCoeff() >= 1.0)
+    throw std::invalid_argument("SampledSdm: the damped loop is unstable without cutting (spectral radius " +
+                                fmt(poles.cwiseAbs().maxCoeff()) + ")");
+  for (Eigen::Index i = 0; i < poles.size(); ++i) {
+    if (poles(i).imag() <= 0.0 || std::abs(poles(i)) < 1e-3) continue;
+    const std::complex<double> sp = std::log(poles(i)) / tick_s_;
+    const double f = std::abs(sp) / (2.0 * M_PI), zeta = -sp.real() / std::abs(sp);
+    if (zeta >= 0.3) continue;
+    s.mode_hz.push_back(sp.imag() / (2.0 * M_PI));
+    s.highest_mode_hz = std::max(s.highest_mode_hz, f);
+  }
+  return s;
+}
+
+SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int ticks, bool want_vector) const {
+  const Eigen::Index n = sys.a.rows();
+  const double period_s = ticks * tick_s_;
+  const int k = std::min(ticks, std::max(settings_.min_grid_per_period,
+                                         static_cast<int>(std::ceil(2.0 * M_PI * sys.highest_mode_hz * period_s /
+                                                                    settings_.max_grid_phase_rad))));
+  const Eigen::Index dim = n + 2 * (k + 1);
+  Result res;
+  res.grid.resize(static_cast<std::size_t>(k) + 1);
+  for (int j = 0; j <= k; ++j) res.grid[static_cast<std::size_t>(j)] = static_cast<int>(std::lround(static_cast<double>(j) * ticks / k));
+  auto grid_tick = [&](int q) {  // any grid index, periodic in k
+    const int p = q >= 0 ? q / k : -((-q + k - 1) / k);
+    return static_cast<double>(res.grid[static_cast<std::size_t>(q - p * k)] + p * ticks);
+  };
+  // The directional matrix per tick at this depth.
+  const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, settings_.axial_slices, axial_mm);
+  const double dphi = 2.0 * M_PI / (cutter_.teeth * ticks);
+  const int sub = std::max(2, static_cast<int>(std::ceil(400.0 / ticks)));
+  std::map<int, MatrixXd> powers;
+  auto power = [&](int m) -> const MatrixXd& {
+    auto it = powers.find(m);
+    if (it == powers.end()) {
+      MatrixXd p = MatrixXd::Identity(n, n);
+      for (int i = 0; i < m; ++i) p = sys.a * p;
+      it = powers.emplace(m, std::move(p)).first;
+    }
+    return it->second;
+  };
+  // Columns: [s_0, g_-1, ..., g_-(k+1)]; rows of each grid value as a function of them.
+  MatrixXd x = MatrixXd::Zero(n, dim);
+  x.leftCols(n).setIdentity();
+  std::vector<MatrixXd> g(static_cast<std::size_t>(k) + 1);
+  g[0] = sys.c * x;
+  auto ref = [&](int q) -> MatrixXd {
+    if (q >= 0) return g[static_cast<std::size_t>(q)];
+    MatrixXd e = MatrixXd::Zero(2, dim);
+    e.block(0, n + 2 * (-q - 1), 2, 2).setIdentity();
+    return e;
+  };
+  MatrixXd w(n, 12), y(n, dim);
+  for (int j = 0; j < k; ++j) {
+    const int first = res.grid[static_cast<std::size_t>(j)], last = res.grid[static_cast<std::size_t>(j) + 1];
+    // References: current j-1, j, j+1 (+), delayed j-k-1, j-k, j-k+1 (-): F = K (q - q(t - tau)).
+    const int refs[6] = {j - 1, j, j + 1, j - k - 1, j - k, j - k + 1};
+    w.setZero();
+    bool any = false;
+    for (int l = first; l < last; ++l) {
+      if (any) w = sys.a * w;
+      const Eigen::Matrix2d kl = directional.mean(l * dphi, dphi, sub);
+      if (kl.isZero(0.0)) continue;
+      const double t = l + 0.5;
+      const Eigen::Vector3d cur = lagrange(grid_tick(j - 1), grid_tick(j), grid_tick(j + 1), t);
+      const Eigen::Vector3d del = lagrange(grid_tick(j - k - 1), grid_tick(j - k), grid_tick(j - k + 1), t - ticks);
+      const MatrixXd bk = sys.b * kl;
+      for (int i = 0; i < 3; ++i) {
+        w.middleCols(2 * i, 2) += cur(i) * bk;
+        w.middleCols(6 + 2 * i, 2) -= del(i) * bk;
+      }
+      any = true;
+    }
+    y.noalias() = power(last - first) * x;
+    if (any) {
+      for (int i : {0, 1, 3, 4, 5}) y.noalias() += w.middleCols(2 * i, 2) * ref(refs[i]);
+      const MatrixXd wu = w.middleCols(4, 2);
+      const Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - sys.c * wu;
+      const MatrixXd next = m.partialPivLu().solve(sys.c * y);
+      x = y + wu * next;
+      if (j + 1 < k) g[static_cast<std::size_t>(j) + 1] = next;
+    } else {
+      x = y;
+      if (j + 1 < k) g[static_cast<std::size_t>(j) + 1] = sys.c * x;
+    }
+  }
+  MatrixXd phi = MatrixXd::Zero(dim, dim);
+  phi.topRows(n) = x;
+  for (int m = 1; m <= k; ++m) phi.middleRows(n + 2 * (m - 1), 2) = g[static_cast<std::size_t>(k - m)];
+  phi.block(n + 2 * k, n, 2, 2).setIdentity();  // g'_-(k+1) = g_-1
+  const Eigen::EigenSolver<MatrixXd> es(phi, want_vector);
+  const Eigen::VectorXcd ev = es.eigenvalues();
+  Eigen::Index best = 0;
+  for (Eigen::Index i = 1; i < ev.size(); ++i)
+    if (std::abs(ev(i)) > std::abs(ev(best))) best = i;
+  res.mu = ev(best);
+  if (want_vector) res.history = es.eigenvectors().col(best).segment(n, 2 * k);
+  return res;
+}
+
+double SampledSdm::chatter_hz(const Result& r, int ticks) const {
+  // The Floquet mode q(t) = mu^(t/T) p(t), p periodic: p's strongest harmonic m gives the frequency
+  // (arg mu / 2 pi + m) / T of the displacement.
+  const auto k = static_cast<int>(r.history.size() / 2);
+  const std::complex<double> log_mu = std::log(r.mu);
+  const std::complex<double> i(0.0, 1.0);
+  double best_energy = -1.0, best_hz = 0.0;
+  const double tooth_hz = 1.0 / (ticks * tick_s_);
+  for (int m = -k / 2; m <= k / 2; ++m) {
+    std::complex<double> cx = 0.0, cy = 0.0;
+    for (int q = 1; q <= k; ++q) {
+      const double t = static_cast<double>(r.grid[static_cast<std::size_t>(k - q)] - ticks) / ticks;  // in periods
+      const std::complex<double> w = std::exp(-t * log_mu - 2.0 * M_PI * i * static_cast<double>(m) * t);
+      cx += w * r.history(2 * (q - 1)), cy += w * r.history(2 * (q - 1) + 1);
+    }
+    const double energy = std::norm(cx) + std::norm(cy);
+    if (energy > best_energy) best_energy = energy, best_hz = std::abs((log_mu.imag() / (2.0 * M_PI) + m) * tooth_hz);
+  }
+  return best_hz;
+}
+
+std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const {
+  if (!(axial_mm > 0.0) || !std::isfinite(axial_mm))
+    throw std::invalid_argument("axial depth = " + fmt(axial_mm) + " mm: must be > 0 and finite");
+  const int ticks = ticks_per_tooth(rpm);
+  return monodromy(per_speed_ ? system_at(stepped_rpm(rpm)) : base_, axial_mm, ticks, false).mu;
+}
+
+SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const {
+  const int ticks = ticks_per_tooth(rpm);
+  const double at_rpm = stepped_rpm(rpm);
+  const System sys = per_speed_ ? system_at(at_rpm) : base_;
+  auto growth = [&](double b) { return std::log(std::abs(monodromy(sys, b, ticks, false).mu)); };
+  SdmPoint p;
+  p.rpm = at_rpm;
+  double lo = 0.0, hi = 0.0, g_lo = 0.0, g_hi = 0.0;
+  double b = std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0;
+  constexpr double kStep = 1.6, kMaxMm = 1e3, kMinMm = 1e-6;
+  if (const double g0 = growth(b); g0 < 0.0) {
+    lo = b, g_lo = g0;
+    for (;;) {
+      b *= kStep;
+      if (b > kMaxMm) {
+        p.critical_depth_mm = std::numeric_limits<double>::infinity();
+        return p;
+      }
+      const double gb = growth(b);
+      if (gb >= 0.0) {
+        hi = b, g_hi = gb;
+        break;
+      }
+      lo = b, g_lo = gb;
+    }
+  } else {
+    hi = b, g_hi = g0;
+    for (;;) {
+      b /= kStep;
+      if (b < kMinMm) throw std::runtime_error("SampledSdm::critical: the cut is unstable at any depth");
+      const double gb = growth(b);
+      if (gb < 0.0) {
+        lo = b, g_lo = gb;
+        break;
+      }
+      hi = b, g_hi = gb;
+    }
+  }
+  // Illinois (regula falsi that halves the stale end's weight), bisection when it stalls.
+  int side = 0;
+  while (hi - lo > rel_tol * hi) {
+    double mid = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+    if (!(mid > lo && mid < hi) || hi - lo > 0.5 * hi) mid = 0.5 * (lo + hi);
+    const double gm = growth(mid);
+    if (gm < 0.0) {
+      lo = mid, g_lo = gm;
+      if (side == -1) g_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = mid, g_hi = gm;
+      if (side == 1) g_lo *= 0.5;
+      side = 1;
+    }
+  }
+  p.critical_depth_mm = lo;
+  const Result r = monodromy(sys, hi, ticks, true);
+  p.type = r.mu.real() < 0.0 && std::abs(r.mu.imag()) < 1e-3 * std::abs(r.mu) ? CutClass::kFlip : CutClass::kHopf;
+  p.chatter_hz = chatter_hz(r, ticks);
+  return p;
+}
+
+}  // namespace robodamp::milling
