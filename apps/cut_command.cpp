@@ -15,6 +15,7 @@
 
 #include "analysis/fft.hpp"
 #include "apps/cli.hpp"
+#include "milling/accurate_stability.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/milling_report.hpp"
 #include "milling/cut_job.hpp"
@@ -36,16 +37,11 @@ struct CutArgs {
   bool critical{false};
   bool damped{false};
   std::string json_path, plot_dir;
+  std::string controller_path;   // replaces every controller part's damping configuration
   std::vector<double> pose_deg;  // the joints of the job's robot pose parts
 };
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-const config::StructureConfig& structure_of(const config::MillingConfig& cfg, const std::string& name) {
-  const std::string n = name.empty() ? cfg.structure : name;
-  if (const auto* s = cfg.find_structure(n)) return *s;
-  throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "--structure = '" + n + "' is not one of the job's structures"}});
-}
 
 json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double wall_s) {
   const auto& r = o.record;
@@ -127,7 +123,8 @@ int run_cut(const CutArgs& a) {
     MillingOptions pose;
     pose.pose_deg = a.pose_deg;
     apply_pose(cfg, pose);
-    const milling::Structure structure(structure_of(cfg, a.structure), false);
+    const config::StructureConfig chosen = selected_structure(cfg, a.structure, a.controller_path);
+    const milling::Structure structure(chosen, false);
     milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
     std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
     json out;
@@ -158,26 +155,43 @@ int run_cut(const CutArgs& a) {
         std::printf("wrote plots in %s\n", a.plot_dir.c_str());
       }
     } else {
-      const milling::Structure zoa_structure(structure_of(cfg, a.structure), a.damped);
-      const milling::LobeModel lobes(zoa_structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
+      // The accurate verdict (what lobes and tune promise) beside the simulation, and its first guess.
+      const milling::Structure model_structure(chosen, a.damped);
+      const milling::LobeModel lobes(model_structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
+      config::MillingConfig at_cut = cfg;
+      if (a.radial_mm) at_cut.cut.radial_mm = *a.radial_mm;
+      const milling::AccurateStability truth(model_structure, at_cut);
       out["critical"] = json::array();
       for (double rpm : speeds) {
         ov.rpm = rpm;
         const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
         const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
-        std::cerr << "[cut] critical depth at " << rpm << " rpm (zero-order " << zoa_mm << " mm):\n";
+        milling::SdmPoint sdm;
+        try {
+          sdm = truth.critical(rpm, zoa_mm);
+        } catch (const std::invalid_argument& e) {
+          throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", e.what()}});
+        }
+        std::cerr << "[cut] critical depth at " << rpm << " rpm (" << truth.method() << " " << sdm.critical_depth_mm
+                  << " mm, zero-order preview " << zoa_mm << " mm):\n";
         const auto t0 = std::chrono::steady_clock::now();
+        const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm : std::isfinite(zoa_mm) ? zoa_mm : 1.0;
         const milling::CriticalDepth c = milling::critical_depth(
-            job.dynamics, job.cutter, job.material, job.settings, std::isfinite(zoa_mm) ? zoa_mm : 1.0, 2e-3,
+            job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
             [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         out["critical"].push_back({{"rpm", rpm}, {"simulated_rpm", job.settings.rpm}, {"damped", a.damped},
                                    {"critical_depth_mm", c.depth_mm}, {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
+                                   {"accurate_method", truth.method()}, {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
+                                   {"accurate_rpm", sdm.rpm}, {"accurate_chatter_hz", sdm.chatter_hz},
+                                   {"accurate_type", milling::to_string(sdm.type)},
                                    {"classification", milling::to_string(c.above)}, {"mechanism", milling::to_string(c.mechanism)},
                                    {"chatter_hz", c.chatter_hz}, {"simulations", c.simulations}, {"wall_s", wall}});
-        std::printf("%8.0f rpm: time-domain critical depth %.4f mm (zero-order %.4f mm), above it %s (%s) at %.1f Hz; %d cuts in %.2f s\n",
-                    rpm, c.depth_mm, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism), c.chatter_hz,
-                    c.simulations, wall);
+        std::printf("%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
+                    "above it %s (%s) at %.1f Hz; %d cuts in %.2f s\n",
+                    rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm, (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0,
+                    milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism),
+                    c.chatter_hz, c.simulations, wall);
       }
     }
     out["config"] = cfg.source;
@@ -218,6 +232,8 @@ void register_cut(Registry& r) {
   sub->add_flag("--damped", a->damped,
                 "With the damping controller running: the real Controller, the simulated plant with its actuator, "
                 "limits and sensor, at the configuration's loop rate");
+  sub->add_option("--controller", a->controller_path, "Damping configuration to use instead of the job's (compare compensators)")
+      ->check(CLI::ExistingFile);
   sub->add_option("--json", a->json_path, "Write the result as JSON to this file");
   sub->add_option("--plot-dir", a->plot_dir, "Write displacement, force, spectrum and surface plots (PNG) here");
 }

@@ -32,17 +32,7 @@ double elapsed_ms(std::chrono::steady_clock::time_point t0) {
 }
 
 config::StructureConfig selected(const config::MillingConfig& cfg, const MillingOptions& o) {
-  const std::string name = o.structure.empty() ? cfg.structure : o.structure;
-  if (const auto* s = cfg.find_structure(name)) {
-    config::StructureConfig out = *s;
-    if (!o.controller_path.empty())
-      for (auto& part : out.parts)
-        if (part.controller) part.controller->config_path = o.controller_path;
-    return out;
-  }
-  std::string known;
-  for (const auto& s : cfg.structures) known += (known.empty() ? "" : ", ") + s.name;
-  throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "= '" + name + "' is not one of: " + known}});
+  return selected_structure(cfg, o.structure, o.controller_path);
 }
 
 // One lobe diagram (open or damped) with the direct test at the requested speeds.
@@ -352,6 +342,21 @@ std::string plot_sle(const json& r, const std::string& path) {
 }
 
 }  // namespace
+
+config::StructureConfig selected_structure(const config::MillingConfig& cfg, const std::string& structure,
+                                           const std::string& controller_path) {
+  const std::string name = structure.empty() ? cfg.structure : structure;
+  if (const auto* s = cfg.find_structure(name)) {
+    config::StructureConfig out = *s;
+    if (!controller_path.empty())
+      for (auto& part : out.parts)
+        if (part.controller) part.controller->config_path = controller_path;
+    return out;
+  }
+  std::string known;
+  for (const auto& s : cfg.structures) known += (known.empty() ? "" : ", ") + s.name;
+  throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "= '" + name + "' is not one of: " + known}});
+}
 
 json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   const auto sc = selected(cfg, o);

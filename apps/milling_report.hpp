@@ -30,6 +30,11 @@ void apply_pose(config::MillingConfig& cfg, const MillingOptions& o);
 
 void add_milling_options(CLI::App* sub, MillingOptions& o);
 
+// The job's structure by name (empty: the job's choice), every controller part's damping configuration
+// replaced by controller_path when given. Throws config::ConfigError for an unknown name.
+[[nodiscard]] config::StructureConfig selected_structure(const config::MillingConfig& cfg, const std::string& structure,
+                                                         const std::string& controller_path);
+
 // Throw config::ConfigError for a job or an option that does not fit it.
 [[nodiscard]] nlohmann::json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o);
 [[nodiscard]] nlohmann::json sle_report(const config::MillingConfig& cfg, const MillingOptions& o);
