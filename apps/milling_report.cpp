@@ -370,6 +370,10 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
   r["spindle_rpm"] = cfg.cut.spindle_rpm;
+  if (cfg.cut.mode == config::MillingMode::kUp)
+    r["notes"].push_back("up milling starts each chip at zero thickness: a start-up transient can take the tool out of "
+                         "the cut and chatter below these linear limits (docs/milling.md); `robodamp cut --critical` "
+                         "simulates it");
   if (o.damped) {
     const milling::Structure closed(sc, true);
     r["damped"] = o.method == "sdm" ? sdm_json(closed, cfg, rpms) : lobes_json(closed, cfg, rpms);

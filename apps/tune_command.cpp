@@ -16,6 +16,7 @@
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "tune/compensator_search.hpp"
+#include "tune/verification.hpp"
 
 namespace robodamp::apps {
 
@@ -245,11 +246,37 @@ int run_tune(const TuneArgs& a) {
   json history = json::array();
   for (const auto& e : r.history) history.push_back(evaluation_json(e));
   report["history"] = history;
-  if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
   if (!r.best.feasible()) {
     std::cerr << "robodamp tune: no candidate met every constraint; the closest violates " << r.best.binding
               << ": nothing written\n";
+    if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
     return 3;
+  }
+  // Every promise verified by the accurate method, and the time-domain cut with the real Controller.
+  if (job) {
+    const config::Config tuned = tune::with_candidate(plants.front().base(), r.best.candidate);
+    const tune::Verification v = tune::verify(tuned, *job);
+    std::printf("verified (%s, %zu speeds): damped minimum %.3f mm at %.1f rpm (open loop %.3f mm, SDM), at the job's "
+                "%.1f rpm %.3f mm\n  the time-domain cut with the real Controller: %.3f mm at the job's speed (%+.1f %%), "
+                "%.3f mm at the minimum's speed (%+.1f %%)\n",
+                v.method.c_str(), v.damped_curve_mm.size(), v.min_depth_mm, v.min_rpm, v.open_min_depth_mm, v.speed_rpm,
+                v.depth_at_speed_mm, v.time_domain_at_speed_mm, (v.time_domain_at_speed_mm / v.depth_at_speed_mm - 1.0) * 100.0,
+                v.time_domain_at_min_mm, (v.time_domain_at_min_mm / v.min_depth_mm - 1.0) * 100.0);
+    report["verified"] = {{"method", v.method}, {"min_depth_mm", v.min_depth_mm}, {"min_rpm", v.min_rpm},
+                          {"open_min_depth_mm", v.open_min_depth_mm}, {"speed_rpm", v.speed_rpm},
+                          {"depth_at_speed_mm", v.depth_at_speed_mm}, {"time_domain_at_speed_mm", v.time_domain_at_speed_mm},
+                          {"time_domain_at_min_mm", v.time_domain_at_min_mm}, {"time_domain_agrees", v.time_domain_agrees()}};
+    if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
+    if (a.settings.depth_at_speed_min_mm > 0.0 && v.depth_at_speed_mm < a.settings.depth_at_speed_min_mm) {
+      std::cerr << "robodamp tune: the verified depth at the job's speed is below --depth-at-speed-mm: nothing written\n";
+      return 3;
+    }
+    if (!v.time_domain_agrees()) {
+      std::cerr << "robodamp tune: the time-domain cut disagrees with the " << v.method << " by more than 5 %: nothing written\n";
+      return 3;
+    }
+  } else if (!a.json_path.empty()) {
+    std::ofstream(a.json_path) << report.dump(2) << '\n';
   }
   if (!a.out_path.empty()) {
     const std::string text = tuned_yaml(plants.front().base(), r.best.candidate);

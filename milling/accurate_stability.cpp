@@ -48,8 +48,8 @@ std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm
   return out;
 }
 
-bool AccurateStability::stable(double axial_mm, double rpm) const {
-  return std::abs(sampled_ ? sampled_->multiplier(axial_mm, rpm) : open_->multiplier(axial_mm, rpm)) < 1.0;
+std::complex<double> AccurateStability::multiplier(double axial_mm, double rpm) const {
+  return sampled_ ? sampled_->multiplier(axial_mm, rpm) : open_->multiplier(axial_mm, rpm);
 }
 
 }  // namespace robodamp::milling

@@ -5,6 +5,7 @@
 // Off the real-time path.
 #pragma once
 
+#include <complex>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,8 +40,9 @@ class AccurateStability {
   // The same at many speeds on `threads` threads (0: one per core); same result for any thread count.
   [[nodiscard]] std::vector<SdmPoint> critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
                                                std::size_t threads = 0, double rel_tol = 1e-3) const;
-  // Stable at this depth and speed (the dominant multiplier inside the unit circle).
-  [[nodiscard]] bool stable(double axial_mm, double rpm) const;
+  // The dominant multiplier at this depth and speed, and whether it is inside the unit circle.
+  [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
+  [[nodiscard]] bool stable(double axial_mm, double rpm) const { return std::abs(multiplier(axial_mm, rpm)) < 1.0; }
 
  private:
   std::string method_;

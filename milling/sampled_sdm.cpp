@@ -71,15 +71,20 @@ SampledSdm::SampledSdm(const Structure& damped, const Cutter& cutter, const conf
   base_ = system_at(0.0);
 }
 
+std::optional<std::string> sampled_speed_problem(double rpm, int teeth, double loop_rate_hz) {
+  const double tick_s = 1.0 / loop_rate_hz;
+  const double ticks = std::round(60.0 / (rpm * teeth) / tick_s);
+  if (rpm > 0.0 && std::isfinite(rpm) && ticks >= SampledSdmSettings::kMinTicksPerTooth) return std::nullopt;
+  const double max_rpm = 60.0 / (teeth * (SampledSdmSettings::kMinTicksPerTooth - 0.5) * tick_s) * (1.0 - 1e-9);
+  return "spindle speed = " + fmt(rpm) + " rpm: the sampled loop's semi-discretization needs a tooth period of at least " +
+         std::to_string(SampledSdmSettings::kMinTicksPerTooth) + " loop periods (" +
+         fmt(SampledSdmSettings::kMinTicksPerTooth * tick_s * 1e3) + " ms at " + fmt(loop_rate_hz) +
+         " Hz), allowed range (0, " + fmt(max_rpm) + "] rpm";
+}
+
 int SampledSdm::ticks_per_tooth(double rpm) const {
-  const double tooth_s = 60.0 / (rpm * cutter_.teeth);
-  const double ticks = std::round(tooth_s / tick_s_);
-  if (!(rpm > 0.0) || !std::isfinite(rpm) || ticks < SampledSdmSettings::kMinTicksPerTooth)
-    throw std::invalid_argument("spindle speed = " + fmt(rpm) + " rpm: the sampled loop's semi-discretization needs a tooth period of at least " +
-                                std::to_string(SampledSdmSettings::kMinTicksPerTooth) + " loop periods (" +
-                                fmt(SampledSdmSettings::kMinTicksPerTooth * tick_s_ * 1e3) + " ms at " +
-                                fmt(loop_rate_hz()) + " Hz), allowed range (0, " + fmt(max_rpm()) + "] rpm");
-  return static_cast<int>(ticks);
+  if (auto p = sampled_speed_problem(rpm, cutter_.teeth, loop_rate_hz())) throw std::invalid_argument(*p);
+  return static_cast<int>(std::round(60.0 / (rpm * cutter_.teeth) / tick_s_));
 }
 
 double SampledSdm::stepped_rpm(double rpm) const { return 60.0 / (cutter_.teeth * ticks_per_tooth(rpm) * tick_s_); }

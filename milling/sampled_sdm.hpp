@@ -19,7 +19,8 @@
 #include <complex>
 #include <map>
 #include <memory>
-#include <mutex>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -35,6 +36,10 @@ struct SampledSdmSettings {
   double max_grid_phase_rad{0.25};  // and a grid interval at most this phase of the highest loop mode
   static constexpr int kMinTicksPerTooth = 10;  // below, the speed grid of the loop period is too coarse
 };
+
+// Why the sampled loop's semi-discretization cannot analyse this speed (a tooth period shorter than
+// kMinTicksPerTooth loop periods, or not a positive finite speed), naming the value, unit and range.
+[[nodiscard]] std::optional<std::string> sampled_speed_problem(double rpm, int teeth, double loop_rate_hz);
 
 class SampledSdm {
  public:

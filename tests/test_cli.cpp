@@ -252,10 +252,12 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
   ASSERT_EQ(c.status, 0) << c.out;
   const auto crit = nlohmann::json::parse(robodamp::test::read_file(cut_json))["critical"];
   ASSERT_EQ(crit.size(), 2u);
-  const Result l = run("lobes --config " + job + " --method sdm --rpm 282 700 --json");
+  // The default method is the accurate one, open loop and damped, and says so.
+  const Result l = run("lobes --config " + job + " --rpm 282 700 --json --damped");
   ASSERT_EQ(l.status, 0) << l.out;
-  EXPECT_NE(l.out.find("[lobes sdm] 200/200 speeds"), std::string::npos) << l.out;  // progress, on stderr
   const auto sdm = nlohmann::json::parse(l.out.substr(l.out.find('{')));
+  EXPECT_EQ(sdm["method"], "SDM");
+  EXPECT_EQ(sdm["damped"]["method"], "sampled-loop SDM");
   for (const char* key : {"curve", "min_b_lim_mm", "at_rpm"}) EXPECT_TRUE(sdm.contains(key)) << key;
   EXPECT_EQ(sdm["curve"].size(), 200u);
   EXPECT_TRUE(sdm["curve"][0].contains("type"));
@@ -264,11 +266,18 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
     EXPECT_NEAR(td / s, 1.0, 0.03) << crit[i]["rpm"];
     EXPECT_TRUE(crit[i].contains("lobes_b_lim_mm"));
   }
+  // Damped: the sampled loop's SDM is the time-domain cut's with the real Controller (at the stepped speed),
+  // where the zero-order preview is 37 % too deep.
+  const Result d = run("cut --config " + job + " --critical --damped --revs 300 --rpm 700 --json " + cut_json);
+  ASSERT_EQ(d.status, 0) << d.out;
+  const auto dc = nlohmann::json::parse(robodamp::test::read_file(cut_json))["critical"][0];
+  const auto& da = sdm["damped"]["at_rpm"][1];
+  EXPECT_NEAR(da["rpm"].get<double>(), dc["simulated_rpm"].get<double>(), 1e-9);
+  EXPECT_NEAR(da["b_lim_mm"].get<double>() / dc["critical_depth_mm"].get<double>(), 1.0, 0.05) << d.out;
+  EXPECT_NEAR(dc["accurate_b_lim_mm"].get<double>(), da["b_lim_mm"].get<double>(), 1e-9);
+  EXPECT_GT(da["b_lim_lobes_mm"].get<double>() / dc["critical_depth_mm"].get<double>(), 1.2) << "the preview is the one that is off";
+  EXPECT_NE(l.out.find("b_lim"), std::string::npos);
   std::filesystem::remove(cut_json);
-  // SDM is an open-loop method: with --damped it says what to use instead.
-  const Result refused = run("lobes --config " + job + " --method sdm --damped");
-  EXPECT_EQ(refused.status, 2) << refused.out;
-  EXPECT_NE(refused.out.find("--method sdm is for the open-loop structure"), std::string::npos) << refused.out;
 }
 
 TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
@@ -318,7 +327,7 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   // Lobes at a pose: the job's pose part takes --pose; a pose out of the travel, or --pose on a job without
   // a pose part, is refused by name.
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml";
-  const Result at3 = run("lobes --config " + job + " --pose -84.75 104.63 -20.08");
+  const Result at3 = run("lobes --method zoa --config " + job + " --pose -84.75 104.63 -20.08");
   ASSERT_EQ(at3.status, 0) << at3.out;
   EXPECT_NE(at3.out.find("at joints -84.75 104.63 -20.08 deg"), std::string::npos) << at3.out;
   const Result out_of_travel = run("lobes --config " + job + " --pose -84.75 204.63 -20.08");
@@ -705,9 +714,10 @@ void expect_lobe_shape(const nlohmann::json& j, std::size_t points) {
 
 TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
   const std::string png = temp_path("lobes.png");
-  const Result r = run("lobes --config " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot " + png);
+  const Result r = run("lobes --method zoa --config " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot " + png);
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
+  EXPECT_EQ(j["method"], "zero-order preview");  // labelled: not a promise
   expect_lobe_shape(j, 2000);
   expect_lobe_shape(j["damped"], 2000);
   ASSERT_EQ(j["at_rpm"].size(), 2u);  // --rpm 400 and the configured spindle speed
@@ -716,22 +726,24 @@ TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
   EXPECT_TRUE(j["gain"].contains("at_spindle_change_pct"));
   EXPECT_GT(std::filesystem::file_size(png), 10000u);
   std::filesystem::remove(png);
-  // Another compensator through --controller: C1 also raises the 23.5 Hz lobe where C2 lowers it.
+  // Another compensator through --controller, by the accurate default: C1 also raises the 23.5 Hz lobe
+  // where C2 lowers it.
   const Result c1 = run("lobes --config " + milling_job("active_damping_c2") + " --json --damped --controller " +
                         robodamp::test::preset("horizontal_c1"));
   ASSERT_EQ(c1.status, 0) << c1.out;
   const auto j1 = nlohmann::json::parse(c1.out);
+  EXPECT_EQ(j1["damped"]["method"], "sampled-loop SDM");
   EXPECT_LT(j["gain"]["at_spindle_change_pct"].get<double>(), 0.0);
   EXPECT_GT(j1["gain"]["at_spindle_change_pct"].get<double>(), 0.0);
   EXPECT_NE(j1["damped"]["notes"][0].get<std::string>().find("horizontal_c1.yaml"), std::string::npos);
 }
 
 TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
-  const Result r = run("lobes --config " + milling_job("industrial_robot_aluminium") + " --json --rpm 3000");
+  const Result r = run("lobes --method zoa --config " + milling_job("industrial_robot_aluminium") + " --json --rpm 3000");
   ASSERT_EQ(r.status, 0) << r.out;
   expect_lobe_shape(nlohmann::json::parse(r.out), 2000);
   for (int p = 1; p <= 5; ++p) {
-    const Result b = run("lobes --config " + milling_job("orthopaedic_bone") + " --structure position_" + std::to_string(p));
+    const Result b = run("lobes --method zoa --config " + milling_job("orthopaedic_bone") + " --structure position_" + std::to_string(p));
     EXPECT_EQ(b.status, 0) << b.out;
     EXPECT_NE(b.out.find("minimum limiting depth"), std::string::npos) << b.out;
   }

@@ -12,6 +12,7 @@
 
 #include "analysis/impact_command.hpp"
 #include "analysis/loop_model.hpp"
+#include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 #include "modal/receptance.hpp"
@@ -120,6 +121,9 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   // The open loop of this plant (not of the job's own controller file): each plant's floors are its own.
   const milling::Structure open(st, false, {open_loop, base_.controller.gain_ns_per_m, base_.controller.polarity});
   process_ = milling::chatter_process(job_->tool, job_->material, job_->cut);
+  // The depth at the job's speed is promised by the sampled loop's semi-discretization: a speed it can step.
+  if (auto p = milling::sampled_speed_problem(job_->cut.spindle_rpm, job_->tool.teeth, base_.loop.rate_hz))
+    throw config::ConfigError({config::Problem{job_->source, {}, "cut.spindle_rpm", *p}});
   const milling::LobeDiagram d = milling::LobeModel(open, *process_, job_->lobes).diagram();
   open_min_mm_ = d.minimum.b_lim_m * 1e3;
   for (const auto& p : d.curve) open_curve_.emplace_back(p.rpm, p.b_lim_m * 1e3);
@@ -198,7 +202,9 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   const milling::LobeDiagram d = lobes.diagram();
   e.min_depth_mm = d.minimum.b_lim_m * 1e3;
   e.objective = e.min_depth_mm;
-  e.depth_at_speed_mm = lobes.critical_depth_m(job_->cut.spindle_rpm, 1e-3) * 1e3;
+  // The promise at the job's speed by the accurate method (the zero-order limit is only its first guess).
+  const double zoa_at_speed_mm = lobes.critical_depth_m(job_->cut.spindle_rpm, 1e-3) * 1e3;
+  e.depth_at_speed_mm = milling::AccurateStability(damped, *job_).critical(job_->cut.spindle_rpm, zoa_at_speed_mm, 2e-3).critical_depth_mm;
   if (s_.depth_at_speed_min_mm > 0.0)
     add_violation(e, (s_.depth_at_speed_min_mm - e.depth_at_speed_mm) / s_.depth_at_speed_min_mm,
                   "the depth at the job's spindle speed");

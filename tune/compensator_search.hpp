@@ -69,8 +69,9 @@ struct Evaluation {
   double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
   double k_max_ns_per_m{0.0};
   double worst_mode_phase_deg{0.0};  // the largest |phase of -F / v| over the loop's modes (< 90: all damped)
-  double min_depth_mm{0.0};      // with a job: the damped lobes' minimum
-  double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (direct test)
+  double min_depth_mm{0.0};      // with a job: the damped lobes' minimum (zero-order: it steers the search;
+                                 // tune/verification.hpp gives the verified one)
+  double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (sampled-loop SDM)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
   std::vector<double> floors_mm; // with a job: the damped floor in each of the open lobes' intervals
   std::vector<double> at_open_minima_mm;  // with a job: the damped limit at each open-loop floor's speed
