@@ -88,7 +88,7 @@ std::string machining_view(const msg::Machining& m) {
   std::string limits = "computing";
   if (m.spindle_rpm() <= 0.0) limits = "spindle stopped";
   else if (m.limits_ready())
-    limits = "open " + mm(m.open_limit_mm()) + ", damped " + mm(m.damped_limit_mm()) + "; now " + mm(m.limit_mm()) +
+    limits = "open " + mm(m.open_limit_mm()) + " (SDM), damped " + mm(m.damped_limit_mm()) + " (" + m.limit_method() + "); now " + mm(m.limit_mm()) +
              (m.loop_active() ? " (damper active)" : " (damper off)") +
              (m.depth_warning() ? "  WARNING: depth above the limit" : "  depth within");
   std::string indicator = "-";

@@ -114,7 +114,7 @@ struct RunArgs {
     auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
     j["machining"] = {{"spindle_rpm", m.spindle_rpm},         {"depth_mm", m.depth_mm},
                       {"limits_ready", m.limits_ready},       {"open_limit_mm", finite(m.open_limit_mm)},
-                      {"damped_limit_mm", finite(m.damped_limit_mm)}, {"loop_active", m.loop_active},
+                      {"damped_limit_mm", finite(m.damped_limit_mm)}, {"limit_method", m.limit_method}, {"loop_active", m.loop_active},
                       {"limit_mm", finite(m.limit_mm)},       {"depth_warning", m.depth_warning},
                       {"indicator_valid", m.indicator_valid}, {"once_per_rev_ratio", m.once_per_rev_ratio},
                       {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
@@ -246,9 +246,9 @@ struct RunArgs {
       os << "  machining: spindle stopped at the end; job depth " << m.depth_mm << " mm\n";
     } else {
       std::snprintf(b, sizeof b,
-                    "  machining at the end: %.0f rpm, job depth %.3f mm; limit open %.3f mm, damped %.3f mm%s; chatter "
+                    "  machining at the end: %.0f rpm, job depth %.3f mm; limit open %.3f mm (SDM), damped %.3f mm (%s)%s; chatter "
                     "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)\n",
-                    m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm,
+                    m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm, m.limit_method.c_str(),
                     !m.limits_ready ? " (not computed)" : m.depth_warning ? ": WARNING, depth above the limit" : "",
                     !m.indicator_valid ? "not ready" : m.chatter ? "CHATTER" : "quiet", m.once_per_rev_ratio,
                     100.0 * m.nonharmonic_share);

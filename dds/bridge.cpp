@@ -147,6 +147,7 @@ void Bridge::publish_machining() {
   out.limits_ready(m.limits_ready);
   out.open_limit_mm(m.open_limit_mm);
   out.damped_limit_mm(m.damped_limit_mm);
+  out.limit_method(m.limit_method);
   out.loop_active(m.loop_active);
   out.limit_mm(m.limit_mm);
   out.depth_warning(m.depth_warning);

@@ -40,6 +40,7 @@ struct MachiningSample {
   double spindle_rpm{0.0}, tooth_passing_hz{0.0}, depth_mm{0.0};
   bool limits_ready{false};
   double open_limit_mm{0.0}, damped_limit_mm{0.0};
+  std::string limit_method;  // which method made damped_limit_mm (milling::LiveLimits::method)
   bool loop_active{false};
   double limit_mm{0.0};
   bool depth_warning{false};

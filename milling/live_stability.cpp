@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "analysis/loop_model.hpp"
+#include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 
@@ -117,17 +118,29 @@ LiveLimits LiveStability::evaluate(const Key& k) const {
   const ChatterProcess process = chatter_process(job_.tool, job_.material, job_.cut);
   const int polarity = cfg.controller.polarity;
 
+  // The zero-order limits are the accurate method's first guesses (and, labelled, the answer where the
+  // sampled loop cannot step the speed).
   const Structure open(structure_, false, {std::make_shared<const analysis::LoopModel>(cfg), gain, polarity});
-  if (const auto p = LobeModel(open, process, lobes).limit_at(out.rpm)) {
-    out.open_mm = p->b_lim_m * 1e3;
-    out.open_chatter_hz = p->chatter_hz;
-  }
+  const auto open_zoa = LobeModel(open, process, lobes).limit_at(out.rpm);
+  const SdmPoint o = AccurateStability(open, job_).critical(out.rpm, open_zoa ? open_zoa->b_lim_m * 1e3 : 1.0);
+  out.open_mm = o.critical_depth_mm;
+  out.open_chatter_hz = o.chatter_hz;
+  out.open_method = "SDM";
+  out.analysed_rpm = out.rpm;
   try {
     const Structure damped(structure_, true,
                            {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});
-    if (const auto p = LobeModel(damped, process, lobes).limit_at(out.rpm)) {
-      out.damped_mm = p->b_lim_m * 1e3;
-      out.damped_chatter_hz = p->chatter_hz;
+    const auto zoa = LobeModel(damped, process, lobes).limit_at(out.rpm);
+    const AccurateStability truth(damped, job_);
+    if (out.rpm <= truth.max_rpm()) {
+      const SdmPoint d = truth.critical(out.rpm, zoa ? zoa->b_lim_m * 1e3 : 1.0);
+      out.damped_mm = d.critical_depth_mm;
+      out.damped_chatter_hz = d.chatter_hz;
+      out.analysed_rpm = d.rpm;
+      out.method = truth.method();
+    } else {
+      out.method = "zero-order preview";
+      if (zoa) out.damped_mm = zoa->b_lim_m * 1e3, out.damped_chatter_hz = zoa->chatter_hz;
     }
   } catch (const config::ConfigError& e) {
     out.damped_valid = false;

@@ -1,5 +1,7 @@
 // Live stability at the current cut (docs/harmonic_notch.md, "Live stability"): the open-loop and damped
-// zero-order limiting depths of a milling job at the spindle speed the cell runs now, with the active
+// limiting depths of a milling job by the accurate method (milling/accurate_stability.hpp: SDM open loop,
+// the sampled loop's SDM damped; the zero-order method, labelled, only where the sampled loop cannot step
+// the speed) at the spindle speed the cell runs now, with the active
 // parameter set at its gain now and the harmonic notches at that speed in the loop. Computed on a worker
 // thread of its own and cached per (speed, parameter set, gain); lookup() never waits for a computation,
 // so the telemetry drain and the DDS status thread can ask at their own rate. Off the real-time path.
@@ -23,11 +25,14 @@ namespace robodamp::milling {
 
 struct LiveLimits {
   double rpm{0.0};
-  double open_mm{0.0};         // zero-order limit of the open-loop structure at rpm (+inf: no lobe reaches it)
+  double analysed_rpm{0.0};    // the damped limit's speed: a whole number of loop periods per tooth period
+  double open_mm{0.0};         // limit of the open-loop structure at rpm (+inf: none below 1 m)
   double damped_mm{0.0};       // with the loop closed at the set and gain, notches at rpm
   double open_chatter_hz{0.0}, damped_chatter_hz{0.0};
   bool damped_valid{true};     // false: the loop is unstable there (no damped FRF); damped_mm is 0
   std::string problem;         // why damped_valid is false
+  std::string method;          // of the damped limit: "sampled-loop SDM", or "zero-order preview" above its speeds
+  std::string open_method;     // of the open limit: "SDM"
 };
 
 struct LiveStabilitySettings {

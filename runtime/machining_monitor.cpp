@@ -70,6 +70,7 @@ dds::MachiningSample MachiningMonitor::sample() {
       s.limits_ready = true;
       s.open_limit_mm = l->open_mm;
       s.damped_limit_mm = l->damped_mm;
+      s.limit_method = l->method;
       s.limit_mm = s.loop_active ? l->damped_mm : l->open_mm;
       s.depth_warning = s.depth_mm > s.limit_mm;
     }

@@ -10,6 +10,7 @@
 #include "milling/chatter_indicator.hpp"
 #include "milling/cut_job.hpp"
 #include "milling/lobes.hpp"
+#include "milling/accurate_stability.hpp"
 #include "milling/live_stability.hpp"
 #include "milling/structure.hpp"
 #include "runtime/cell.hpp"
@@ -28,33 +29,37 @@ config::Config preset_with_notches(const std::string& notch) {
   return config::parse_config(text, test::preset("horizontal_c2"));
 }
 
-// The limits at a speed are the job's own lobes there: the same numbers `robodamp lobes --damped` gives
-// (the job's structure loads the same preset), from the worker thread through the cache.
-TEST(LiveStability, LimitsAtASpeedAreTheJobsLobesThere) {
+// The limits at a speed are the accurate method's there: the same numbers `robodamp lobes --damped` gives
+// (the job's structure loads the same preset; SDM open loop, the sampled loop's SDM damped), from the worker
+// thread through the cache, each with its method.
+TEST(LiveStability, LimitsAtASpeedAreTheJobsAccurateLimitsThere) {
   const config::MillingConfig job = config::load_milling_config(job_path());
   const milling::Structure open(*job.find_structure(job.structure), false);
   const milling::Structure damped(*job.find_structure(job.structure), true);
-  const auto process = milling::chatter_process(job.tool, job.material, job.cut);
+  const milling::AccurateStability open_truth(open, job), damped_truth(damped, job);
   const config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
   milling::LiveStability live(job, "", {cfg});
   for (const double rpm : {350.0, 700.0, 1200.0}) {
-    const auto o = milling::LobeModel(open, process, job.lobes).limit_at(rpm);
-    const auto d = milling::LobeModel(damped, process, job.lobes).limit_at(rpm);
-    ASSERT_TRUE(o && d) << rpm;
     std::optional<milling::LiveLimits> l;
     EXPECT_FALSE(live.lookup(rpm, 0, cfg.controller.gain_ns_per_m).has_value()) << "computed off the caller's thread";
     ASSERT_TRUE(test::eventually([&] { return (l = live.lookup(rpm, 0, cfg.controller.gain_ns_per_m)).has_value(); }, 120.0));
-    EXPECT_NEAR(l->open_mm, o->b_lim_m * 1e3, 1e-9) << rpm;
-    EXPECT_NEAR(l->damped_mm, d->b_lim_m * 1e3, 1e-9) << rpm;
+    EXPECT_NEAR(l->open_mm / open_truth.critical(rpm, l->open_mm).critical_depth_mm, 1.0, 2e-3) << rpm;
+    const milling::SdmPoint d = damped_truth.critical(rpm, l->damped_mm);
+    EXPECT_NEAR(l->damped_mm / d.critical_depth_mm, 1.0, 2e-3) << rpm;
+    EXPECT_EQ(l->analysed_rpm, d.rpm);
+    EXPECT_EQ(l->method, "sampled-loop SDM");
+    EXPECT_EQ(l->open_method, "SDM");
     EXPECT_TRUE(l->damped_valid);
   }
-  // The figures at 700 rpm (docs/milling.md): 1.661 mm open, 1.071 mm damped.
+  // docs/milling.md at 700 rpm: 1.111 mm open, 0.782 mm damped (the time domain: 1.113 and 0.781 mm).
   const auto l700 = live.compute(700.0, 0, 2000.0);
-  EXPECT_NEAR(l700.open_mm, 1.661, 0.001);
-  EXPECT_NEAR(l700.damped_mm, 1.071, 0.001);
+  EXPECT_NEAR(l700.open_mm, 1.111, 0.002);
+  EXPECT_NEAR(l700.damped_mm, 0.782, 0.002);
   // The gain is part of the state: at 700 rpm the 23.5 Hz mode's lobe limits, and C2's feedback there is
-  // outside the damping window (docs/milling.md), so less gain leaves more depth (1.516 mm at 500 N s/m).
-  EXPECT_GT(live.compute(700.0, 0, 500.0).damped_mm, l700.damped_mm + 0.3);
+  // outside the damping window (docs/milling.md), so less gain leaves more depth.
+  EXPECT_GT(live.compute(700.0, 0, 500.0).damped_mm, l700.damped_mm + 0.2);
+  // Above the speeds the sampled loop can step (10 526 rpm here), the preview, labelled.
+  EXPECT_EQ(live.compute(12000.0, 0, 2000.0).method, "zero-order preview");
 }
 
 // The notches at the speed are in the damped loop: at 700 rpm (tooth passing 35 Hz, harmonics at 70 and
@@ -177,11 +182,12 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_NEAR(m.tooth_passing_hz, 35.0, 1e-9);
     EXPECT_EQ(m.depth_mm, depth);
     ASSERT_TRUE(m.limits_ready);
-    EXPECT_NEAR(m.open_limit_mm, 1.661, 0.001);
-    EXPECT_NEAR(m.damped_limit_mm, 1.071, 0.001);
+    EXPECT_NEAR(m.open_limit_mm, 1.111, 0.002);   // SDM
+    EXPECT_NEAR(m.damped_limit_mm, 0.782, 0.002);  // the sampled loop's SDM
+    EXPECT_EQ(m.limit_method, "sampled-loop SDM");
     EXPECT_FALSE(m.loop_active) << "the run has ended: the damper is off";
     EXPECT_EQ(m.limit_mm, m.open_limit_mm);
-    EXPECT_EQ(m.depth_warning, depth > 1.661);
+    EXPECT_EQ(m.depth_warning, depth > m.open_limit_mm);
     EXPECT_TRUE(m.indicator_valid);
     EXPECT_FALSE(m.chatter) << "no cut in the simulated plant";
     // While the damper is active the damped limit applies: 1.5 mm is above it.
