@@ -190,7 +190,7 @@ std::string plot_lobes(const json& r, const std::string& path) {
   std::ostringstream s;
   s << "set title 'Stability lobes, " << r["structure"].get<std::string>() << ": " << r["tool"].get<std::string>()
     << "'\nset grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'limiting axial depth b_lim (mm)'\n"
-    << "set yrange [0:" << y_max << "]\nset key top left\n";
+    << "set yrange [0:" << y_max << "]\nset key bottom right opaque box\n";
   s << "set arrow from " << r["spindle_rpm"].get<double>() << ", graph 0 to " << r["spindle_rpm"].get<double>()
     << ", graph 1 nohead dt 3 lc rgb 'gray40'\n";
   s << "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop, " << r["method"].get<std::string>() << " (min "

@@ -65,6 +65,51 @@ json evaluation_json_with_plants(const tune::Evaluation& e) {
   return j;
 }
 
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+// The command that writes this file again (the options that differ from their defaults).
+std::string command_line(const TuneArgs& a) {
+  const tune::TuneSettings d;
+  std::string c = "robodamp tune --config " + a.config_path + (a.job_path.empty() ? "" : " --job " + a.job_path);
+  for (const auto& p : a.also_paths) c += " --also " + p;
+  if (a.shift_pct) c += " --shift-pct " + num(*a.shift_pct);
+  const tune::TuneSettings& s = a.settings;
+  if (s.gain_margin_min_db != d.gain_margin_min_db) c += " --gain-margin-db " + num(s.gain_margin_min_db);
+  if (s.phase_margin_min_deg != d.phase_margin_min_deg) c += " --phase-margin-deg " + num(s.phase_margin_min_deg);
+  if (s.delay_margin_min_ms != d.delay_margin_min_ms) c += " --delay-margin-ms " + num(s.delay_margin_min_ms);
+  if (s.impact_peak_n) c += " --impact-n " + num(*s.impact_peak_n);
+  if (s.impact_duration_ms) c += " --impact-ms " + num(*s.impact_duration_ms);
+  if (s.depth_at_speed_min_mm > 0.0) c += " --depth-at-speed-mm " + num(s.depth_at_speed_min_mm);
+  if (s.global_evaluations != d.global_evaluations) c += " --evaluations " + std::to_string(s.global_evaluations);
+  if (s.local_evaluations != d.local_evaluations) c += " --polish " + std::to_string(s.local_evaluations);
+  if (s.seed != d.seed) c += " --seed " + std::to_string(s.seed);
+  if (s.restarts != d.restarts) c += " --restarts " + std::to_string(s.restarts);
+  return c + " --out " + a.out_path;
+}
+
+// The written file's header: where it comes from, the command that writes it again, and what was verified.
+std::string tuned_header(const TuneArgs& a, const std::optional<tune::Verification>& v) {
+  std::ostringstream h;
+  h << "# robodamp tune wrote this (docs/tuning.md) from " << a.config_path;
+  if (!a.job_path.empty()) h << " for " << a.job_path;
+  h << ":\n#   " << command_line(a) << "\n";
+  if (v) {
+    char b[400];
+    std::snprintf(b, sizeof b,
+                  "# Verified (%s, %zu speeds): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's %.1f rpm;\n"
+                  "# the time-domain cut with the real Controller: %.3f mm and %.3f mm there.\n",
+                  v->method.c_str(), v->damped_curve_mm.size(), v->min_depth_mm, v->min_rpm, v->depth_at_speed_mm,
+                  v->speed_rpm, v->time_domain_at_min_mm, v->time_domain_at_speed_mm);
+    h << b;
+  }
+  h << "# Everything else is " << a.config_path << "'s, whose header follows.\n#\n";
+  return h.str();
+}
+
 // The configuration's text with the compensator block, the gain and the polarity of the tuned candidate.
 std::string tuned_yaml(const config::Config& base, const tune::Candidate& c) {
   const config::Config tuned = tune::with_candidate(base, c);
@@ -112,8 +157,8 @@ void print_row(const char* name, const tune::Evaluation& e) {
   if (e.peak_m_per_n > 0.0)
     std::printf("closed-loop peak %.4g m/N", e.peak_m_per_n);
   else
-    std::printf("min depth %.3f mm, at the job's speed %.3f mm, floors x%.2f", e.min_depth_mm, e.depth_at_speed_mm,
-                e.floor_ratio);
+    std::printf("min depth %.3f mm (zero-order preview), at the job's speed %.3f mm (sampled-loop SDM), floors x%.2f (zero-order)",
+                e.min_depth_mm, e.depth_at_speed_mm, e.floor_ratio);
   std::printf("%s\n", e.feasible() ? "" : (" (violates " + e.binding + ")").c_str());
 }
 
@@ -167,7 +212,7 @@ void report_plant(const tune::Evaluator& p, const std::vector<Compared>& rows, j
     j[r.name] = evaluation_json(r.e);
   }
   if (!p.open_floors_mm().empty()) {
-    std::printf("  lobe floor between the open loop's peaks, and the limit at the open loop's floor speed, mm:\n"
+    std::printf("  lobe floor between the open loop's peaks, and the limit at the open loop's floor speed, mm (zero-order preview: it steers the search):\n"
                 "    %-15s %8s", "rpm", "open");
     for (const auto& r : rows) std::printf(" %8s %8s", r.name.c_str(), "at min");
     for (std::size_t i = 0; i < p.open_floors_mm().size(); ++i) {
@@ -253,9 +298,11 @@ int run_tune(const TuneArgs& a) {
     return 3;
   }
   // Every promise verified by the accurate method, and the time-domain cut with the real Controller.
+  std::optional<tune::Verification> verified;
   if (job) {
     const config::Config tuned = tune::with_candidate(plants.front().base(), r.best.candidate);
     const tune::Verification v = tune::verify(tuned, *job);
+    verified = v;
     std::printf("verified (%s, %zu speeds): damped minimum %.3f mm at %.1f rpm (open loop %.3f mm, SDM), at the job's "
                 "%.1f rpm %.3f mm\n  the time-domain cut with the real Controller: %.3f mm at the job's speed (%+.1f %%), "
                 "%.3f mm at the minimum's speed (%+.1f %%)\n",
@@ -267,7 +314,8 @@ int run_tune(const TuneArgs& a) {
                           {"depth_at_speed_mm", v.depth_at_speed_mm}, {"time_domain_at_speed_mm", v.time_domain_at_speed_mm},
                           {"time_domain_at_min_mm", v.time_domain_at_min_mm}, {"time_domain_agrees", v.time_domain_agrees()}};
     if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
-    if (a.settings.depth_at_speed_min_mm > 0.0 && v.depth_at_speed_mm < a.settings.depth_at_speed_min_mm) {
+    // The search's limit and this one are each bracketed to 0.1 %: the same within that.
+    if (a.settings.depth_at_speed_min_mm > 0.0 && v.depth_at_speed_mm < a.settings.depth_at_speed_min_mm * (1.0 - 2e-3)) {
       std::cerr << "robodamp tune: the verified depth at the job's speed is below --depth-at-speed-mm: nothing written\n";
       return 3;
     }
@@ -279,7 +327,7 @@ int run_tune(const TuneArgs& a) {
     std::ofstream(a.json_path) << report.dump(2) << '\n';
   }
   if (!a.out_path.empty()) {
-    const std::string text = tuned_yaml(plants.front().base(), r.best.candidate);
+    const std::string text = tuned_header(a, verified) + tuned_yaml(plants.front().base(), r.best.candidate);
     const config::Config check = config::parse_config(text, a.out_path);  // throws (exit 2) before writing
     if (!analysis::LoopModel(check).stable(check.controller.gain_ns_per_m, check.controller.polarity))
       throw std::runtime_error("the written configuration's loop is not stable: nothing written");

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "config/milling_config.hpp"
+#include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/sle.hpp"
 
@@ -49,6 +50,33 @@ void BM_DirectTestCriticalDepth(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(m.critical_depth_m(10700.0));
 }
 BENCHMARK(BM_DirectTestCriticalDepth)->Unit(benchmark::kMillisecond);
+
+// The accurate damped lobes (issue 27): the sampled loop's semi-discretization of active_damping_c2.yaml with
+// C2 closed, over the job's 200 SDM speeds, each from the zero-order limit; threads: the speeds' task pool.
+void BM_DampedSdmLobes(benchmark::State& state) {
+  const config::MillingConfig j =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  const milling::Structure damped(j.structures.front(), true);
+  config::LobesConfig grid = j.lobes;
+  grid.points = j.time_domain.sdm_points;
+  const milling::LobeDiagram guess = milling::LobeModel(damped, milling::chatter_process(j.tool, j.material, j.cut), grid).diagram();
+  std::vector<double> rpm, mm;
+  for (const auto& p : guess.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_m * 1e3);
+  const milling::AccurateStability truth(damped, j);
+  for (auto _ : state) benchmark::DoNotOptimize(truth.critical(rpm, mm, static_cast<std::size_t>(state.range(0))));
+  state.counters["speeds"] = static_cast<double>(rpm.size());
+}
+BENCHMARK(BM_DampedSdmLobes)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+
+// One speed's damped critical depth (700 rpm, 143 loop periods per tooth period).
+void BM_DampedSdmCriticalDepth(benchmark::State& state) {
+  const config::MillingConfig j =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  const milling::Structure damped(j.structures.front(), true);
+  const milling::AccurateStability truth(damped, j);
+  for (auto _ : state) benchmark::DoNotOptimize(truth.critical(700.0, 1.071));
+}
+BENCHMARK(BM_DampedSdmCriticalDepth)->Unit(benchmark::kMillisecond);
 
 void BM_SleOneSpeed(benchmark::State& state) {
   const milling::Structure s(*job().find_structure("robot_workpiece"), false);

@@ -37,7 +37,10 @@ echo
 echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (seed 004), the direct test's"
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
 taskset -c 0 ./build/benchmarks/benchmark_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
-  --benchmark_counters_tabular=true
+  --benchmark_counters_tabular=true --benchmark_filter='-BM_DampedSdmLobes'
+echo "the accurate damped lobes (the sampled loop's SDM) of active_damping_c2.yaml, 200 speeds, on 1 and 2 threads"
+echo "(both cores: the command's default):"
+./build/benchmarks/benchmark_lobes --benchmark_filter=BM_DampedSdmLobes --benchmark_counters_tabular=true
 echo
 echo "robodamp tune, one core: one candidate's evaluation (with the job's damped lobes, and without a job), the"
 echo "impact's command prediction and its set-up per plant:"

@@ -248,57 +248,16 @@ SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const
   const int ticks = ticks_per_tooth(rpm);
   const double at_rpm = stepped_rpm(rpm);
   const System sys = per_speed_ ? system_at(at_rpm) : base_;
-  auto growth = [&](double b) { return std::log(std::abs(monodromy(sys, b, ticks, false).mu)); };
+  const DepthBracket br = find_critical_depth(
+      [&](double b) { return std::log(std::abs(monodromy(sys, b, ticks, false).mu)); }, guess_mm, rel_tol);
   SdmPoint p;
   p.rpm = at_rpm;
-  double lo = 0.0, hi = 0.0, g_lo = 0.0, g_hi = 0.0;
-  double b = std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0;
-  constexpr double kStep = 1.6, kMaxMm = 1e3, kMinMm = 1e-6;
-  if (const double g0 = growth(b); g0 < 0.0) {
-    lo = b, g_lo = g0;
-    for (;;) {
-      b *= kStep;
-      if (b > kMaxMm) {
-        p.critical_depth_mm = std::numeric_limits<double>::infinity();
-        return p;
-      }
-      const double gb = growth(b);
-      if (gb >= 0.0) {
-        hi = b, g_hi = gb;
-        break;
-      }
-      lo = b, g_lo = gb;
-    }
-  } else {
-    hi = b, g_hi = g0;
-    for (;;) {
-      b /= kStep;
-      if (b < kMinMm) throw std::runtime_error("SampledSdm::critical: the cut is unstable at any depth");
-      const double gb = growth(b);
-      if (gb < 0.0) {
-        lo = b, g_lo = gb;
-        break;
-      }
-      hi = b, g_hi = gb;
-    }
+  p.critical_depth_mm = br.lo_mm;
+  if (!std::isfinite(br.hi_mm)) {
+    p.critical_depth_mm = br.hi_mm;
+    return p;
   }
-  // Illinois (regula falsi that halves the stale end's weight), bisection when it stalls.
-  int side = 0;
-  while (hi - lo > rel_tol * hi) {
-    double mid = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-    if (!(mid > lo && mid < hi) || hi - lo > 0.5 * hi) mid = 0.5 * (lo + hi);
-    const double gm = growth(mid);
-    if (gm < 0.0) {
-      lo = mid, g_lo = gm;
-      if (side == -1) g_hi *= 0.5;
-      side = -1;
-    } else {
-      hi = mid, g_hi = gm;
-      if (side == 1) g_lo *= 0.5;
-      side = 1;
-    }
-  }
-  p.critical_depth_mm = lo;
+  const double hi = br.hi_mm;
   const Result r = monodromy(sys, hi, ticks, true);
   p.type = r.mu.real() < 0.0 && std::abs(r.mu.imag()) < 1e-3 * std::abs(r.mu) ? CutClass::kFlip : CutClass::kHopf;
   p.chatter_hz = chatter_hz(r, ticks);

@@ -1,6 +1,7 @@
 #include "milling/sdm.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
@@ -79,29 +80,64 @@ std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const {
   return best;
 }
 
-SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
-  if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
-  auto stable = [&](double b) { return std::abs(multiplier(b, rpm)) < 1.0; };
-  double lo = 0.0, hi = guess_mm;
-  if (stable(guess_mm)) {
-    lo = guess_mm;
-    for (hi = 2.0 * guess_mm; stable(hi); hi *= 2.0) {
-      lo = hi;
-      if (hi > 1e3) throw std::runtime_error("SdmModel::critical: stable beyond 1 m depth");
+DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol) {
+  constexpr double kStep = 1.6, kMaxMm = 1e3, kMinMm = 1e-6;
+  double lo = 0.0, hi = 0.0, g_lo = 0.0, g_hi = 0.0;
+  double b = std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0;
+  if (const double g0 = ln_mu(b); g0 < 0.0) {
+    lo = b, g_lo = g0;
+    for (;;) {
+      b *= kStep;
+      if (b > kMaxMm) return {lo, std::numeric_limits<double>::infinity()};
+      const double gb = ln_mu(b);
+      if (gb >= 0.0) {
+        hi = b, g_hi = gb;
+        break;
+      }
+      lo = b, g_lo = gb;
     }
   } else {
-    for (lo = 0.5 * guess_mm; !stable(lo); lo *= 0.5) {
-      hi = lo;
-      if (lo < 1e-9) throw std::runtime_error("SdmModel::critical: unstable at any depth");
+    hi = b, g_hi = g0;
+    for (;;) {
+      b /= kStep;
+      if (b < kMinMm) throw std::runtime_error("semi-discretization: the cut is unstable at any depth");
+      const double gb = ln_mu(b);
+      if (gb < 0.0) {
+        lo = b, g_lo = gb;
+        break;
+      }
+      hi = b, g_hi = gb;
     }
   }
+  int side = 0;
   while (hi - lo > rel_tol * hi) {
-    const double mid = 0.5 * (lo + hi);
-    (stable(mid) ? lo : hi) = mid;
+    double mid = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+    if (!(mid > lo && mid < hi) || hi - lo > 0.5 * hi) mid = 0.5 * (lo + hi);
+    const double gm = ln_mu(mid);
+    if (gm < 0.0) {
+      lo = mid, g_lo = gm;
+      if (side == -1) g_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = mid, g_hi = gm;
+      if (side == 1) g_lo *= 0.5;
+      side = 1;
+    }
   }
+  return {lo, hi};
+}
+
+SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
+  if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
+  const DepthBracket br = find_critical_depth([&](double b) { return std::log(std::abs(multiplier(b, rpm))); }, guess_mm, rel_tol);
   SdmPoint p;
   p.rpm = rpm;
-  p.critical_depth_mm = lo;
+  p.critical_depth_mm = br.lo_mm;
+  if (!std::isfinite(br.hi_mm)) {
+    p.critical_depth_mm = br.hi_mm;
+    return p;
+  }
+  const double hi = br.hi_mm;
   const std::complex<double> mu = multiplier(hi, rpm);
   // Period doubling when the critical multiplier is (nearly) real and negative.
   p.type = mu.real() < 0.0 && std::abs(mu.imag()) < 1e-3 * std::abs(mu) ? CutClass::kFlip : CutClass::kHopf;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <complex>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,15 @@ class DirectionalMatrix {
   int teeth_;
   double kt_, kr_;
 };
+
+// The smallest unstable depth near a first guess from ln|mu(depth)| (< 0 stable): bracketed by factors of 1.6
+// from the guess, then the Illinois method (regula falsi halving the stale end's weight; bisection while the
+// bracket is wide) to hi - lo <= rel_tol hi. lo is stable, hi unstable; hi = inf when stable up to 1 m.
+// Throws std::runtime_error when unstable down to 1 nm.
+struct DepthBracket {
+  double lo_mm{0.0}, hi_mm{0.0};
+};
+[[nodiscard]] DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol);
 
 struct SdmPoint {
   double rpm{0.0};
