@@ -47,6 +47,8 @@ json evaluation_json(const tune::Evaluation& e) {
           {"delay_margin_ms", finite(e.delay_margin_ms)}, {"k_max_ns_per_m", finite(e.k_max_ns_per_m)},
           {"worst_mode_phase_deg", e.worst_mode_phase_deg},
           {"min_depth_mm", e.min_depth_mm},             {"floor_ratio", finite(e.floor_ratio)},
+          {"accurate_min_mm", finite(e.accurate_min_mm)}, {"accurate_min_rpm", e.accurate_min_rpm},
+          {"open_minima_ratio", finite(e.open_minima_ratio)},
           {"depth_at_speed_mm", e.depth_at_speed_mm},   {"floors_mm", e.floors_mm},
           {"at_open_minima_mm", e.at_open_minima_mm},
           {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
@@ -157,8 +159,9 @@ void print_row(const char* name, const tune::Evaluation& e) {
   if (e.peak_m_per_n > 0.0)
     std::printf("closed-loop peak %.4g m/N", e.peak_m_per_n);
   else
-    std::printf("min depth %.3f mm (zero-order preview), at the job's speed %.3f mm (sampled-loop SDM), floors x%.2f (zero-order)",
-                e.min_depth_mm, e.depth_at_speed_mm, e.floor_ratio);
+    std::printf("min depth %.3f mm at %.0f rpm and %.3f mm at the job's speed (sampled-loop SDM), open minima x%.2f; "
+                "zero-order preview: min %.3f mm, floors x%.2f",
+                e.accurate_min_mm, e.accurate_min_rpm, e.depth_at_speed_mm, e.open_minima_ratio, e.min_depth_mm, e.floor_ratio);
   std::printf("%s\n", e.feasible() ? "" : (" (violates " + e.binding + ")").c_str());
 }
 
@@ -241,25 +244,30 @@ void report_plant(const tune::Evaluator& p, const std::vector<Compared>& rows, j
 
 // The open loop's lobes with each compared controller's, on the first plant.
 std::string plot_lobes(const tune::Evaluator& p, const std::vector<Compared>& rows, const std::string& path) {
+  // One data block per curve: the damped speeds are stepped to the loop rate, each its own.
   std::vector<std::vector<std::pair<double, double>>> curves{p.open_curve_mm()};
   for (const auto& r : rows) curves.push_back(p.damped_curve_mm(r.cfg));
   std::ostringstream data;
-  for (std::size_t i = 0; i < curves.front().size(); ++i) {
-    data << curves.front()[i].first;
-    for (const auto& c : curves) data << ' ' << (i < c.size() && std::isfinite(c[i].second) ? c[i].second : NAN);
-    data << '\n';
+  for (const auto& c : curves) {
+    for (const auto& [rpm, mm] : c) {
+      char line[96];
+      std::snprintf(line, sizeof line, "%.10g %.10g\n", rpm, std::isfinite(mm) ? mm : NAN);
+      data << line;
+    }
+    data << "\n\n";
   }
-  double y_max = 0.0;
+  double y_max = 3.0 * p.open_min_depth_mm();
   for (const auto& r : rows)
-    if (r.e.min_depth_mm > 0.0) y_max = std::max(y_max, 3.0 * r.e.min_depth_mm);
+    if (r.e.accurate_min_mm > 0.0 && std::isfinite(r.e.accurate_min_mm)) y_max = std::max(y_max, 4.0 * r.e.accurate_min_mm);
   std::ostringstream s;
-  s << "set title 'Stability lobes: open loop, hand designs and robodamp tune (" << p.name() << ")' noenhanced\n"
-    << "set grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'limiting axial depth b_lim (mm)'\nset key top left\n"
-    << "set yrange [0:" << std::max(y_max, 3.0 * p.open_min_depth_mm()) << "]\n";
+  s << "set title 'Stability lobes by semi-discretization (open loop: SDM; damped: sampled-loop SDM), "
+    << "hand designs and robodamp tune (" << p.name() << ")' noenhanced\n"
+    << "set grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'limiting axial depth b_lim (mm)'\n"
+    << "set key bottom right opaque box\nset yrange [0:" << y_max << "]\n";
   const char* colours[] = {"#7f8c8d", "#27ae60", "#e67e22", "#8e44ad", "#2471a3"};
-  s << "plot DATA u 1:2 w l lw 2 lc rgb '" << colours[0] << "' t 'open loop'";
+  s << "plot DATA index 0 u 1:2 w l lw 2 lc rgb '" << colours[0] << "' t 'open loop'";
   for (std::size_t i = 0; i < rows.size(); ++i)
-    s << ", DATA u 1:" << i + 3 << " w l lw 2 lc rgb '" << colours[(i + 1) % 5] << "' t '" << rows[i].name << "'";
+    s << ", DATA index " << i + 1 << " u 1:2 w l lw 2 lc rgb '" << colours[(i + 1) % 5] << "' t '" << rows[i].name << "'";
   s << '\n';
   return run_gnuplot(s.str(), data.str(), path);
 }

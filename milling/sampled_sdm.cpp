@@ -123,7 +123,6 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
     const std::complex<double> sp = std::log(poles(i)) / tick_s_;
     const double f = std::abs(sp) / (2.0 * M_PI), zeta = -sp.real() / std::abs(sp);
     if (zeta >= 0.3) continue;
-    s.mode_hz.push_back(sp.imag() / (2.0 * M_PI));
     s.highest_mode_hz = std::max(s.highest_mode_hz, f);
   }
   return s;
@@ -217,24 +216,12 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int
 }
 
 double SampledSdm::chatter_hz(const Result& r, int ticks) const {
-  // The Floquet mode q(t) = mu^(t/T) p(t), p periodic: p's strongest harmonic m gives the frequency
-  // (arg mu / 2 pi + m) / T of the displacement.
+  // History entry q (q = 1 .. k) is the grid point k - q of the last period.
   const auto k = static_cast<int>(r.history.size() / 2);
-  const std::complex<double> log_mu = std::log(r.mu);
-  const std::complex<double> i(0.0, 1.0);
-  double best_energy = -1.0, best_hz = 0.0;
-  const double tooth_hz = 1.0 / (ticks * tick_s_);
-  for (int m = -k / 2; m <= k / 2; ++m) {
-    std::complex<double> cx = 0.0, cy = 0.0;
-    for (int q = 1; q <= k; ++q) {
-      const double t = static_cast<double>(r.grid[static_cast<std::size_t>(k - q)] - ticks) / ticks;  // in periods
-      const std::complex<double> w = std::exp(-t * log_mu - 2.0 * M_PI * i * static_cast<double>(m) * t);
-      cx += w * r.history(2 * (q - 1)), cy += w * r.history(2 * (q - 1) + 1);
-    }
-    const double energy = std::norm(cx) + std::norm(cy);
-    if (energy > best_energy) best_energy = energy, best_hz = std::abs((log_mu.imag() / (2.0 * M_PI) + m) * tooth_hz);
-  }
-  return best_hz;
+  std::vector<double> t(static_cast<std::size_t>(k));
+  for (int q = 1; q <= k; ++q)
+    t[static_cast<std::size_t>(q - 1)] = static_cast<double>(r.grid[static_cast<std::size_t>(k - q)] - ticks) / ticks;
+  return floquet_chatter_hz(r.mu, t, r.history, 1.0 / (ticks * tick_s_));
 }
 
 std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const {

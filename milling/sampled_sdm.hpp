@@ -66,7 +66,6 @@ class SampledSdm {
  private:
   struct System {
     Eigen::MatrixXd a, b, c;           // cutter frame: b n x 2, c 2 x n
-    std::vector<double> mode_hz;       // the loop's lightly damped modes below Nyquist
     double highest_mode_hz{0.0};
   };
   struct Result {

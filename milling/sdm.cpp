@@ -15,7 +15,6 @@ SdmModel::SdmModel(const std::vector<CutterModalTerm>& terms, const Cutter& cutt
   if (m_ < 2) throw std::invalid_argument("SdmModel: needs at least 2 steps per period");
   const ToolDynamics dyn(terms, 1.0);  // only its continuous model is used
   a_ = dyn.a(), b_ = dyn.b(), c_ = dyn.c();
-  for (const auto& t : terms) mode_hz_.push_back(t.wn_rad_per_s / (2.0 * M_PI));
 }
 
 DirectionalMatrix::DirectionalMatrix(const Cutter& cutter, const config::MaterialConfig& material,
@@ -48,7 +47,26 @@ Eigen::Matrix2d DirectionalMatrix::mean(double phi0, double dphi, int sub) const
   return mean;
 }
 
-std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const {
+std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const { return multiplier(axial_mm, rpm, nullptr); }
+
+double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t, const Eigen::VectorXcd& history,
+                          double tooth_hz) {
+  const auto k = static_cast<int>(t.size());
+  const std::complex<double> log_mu = std::log(mu), i(0.0, 1.0);
+  double best_energy = -1.0, best_hz = 0.0;
+  for (int m = -k / 2; m <= k / 2; ++m) {
+    std::complex<double> cx = 0.0, cy = 0.0;
+    for (int q = 0; q < k; ++q) {
+      const std::complex<double> w = std::exp(-t[static_cast<std::size_t>(q)] * log_mu - 2.0 * M_PI * i * static_cast<double>(m) * t[static_cast<std::size_t>(q)]);
+      cx += w * history(2 * q), cy += w * history(2 * q + 1);
+    }
+    const double energy = std::norm(cx) + std::norm(cy);
+    if (energy > best_energy) best_energy = energy, best_hz = std::abs((log_mu.imag() / (2.0 * M_PI) + m) * tooth_hz);
+  }
+  return best_hz;
+}
+
+std::complex<double> SdmModel::multiplier(double axial_mm, double rpm, double* chatter_hz) const {
   const Eigen::Index n = a_.rows(), d = n + 2 * m_;
   const double h = 60.0 / (rpm * cutter_.teeth) / m_;
   Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d);
@@ -73,11 +91,18 @@ std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const {
     next.middleRows(n + 2, 2 * (m_ - 1)) = z.middleRows(n, 2 * (m_ - 1));
     z.swap(next);
   }
-  const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(z, false).eigenvalues();
-  std::complex<double> best(0.0);
-  for (Eigen::Index i = 0; i < ev.size(); ++i)
-    if (std::abs(ev(i)) > std::abs(best)) best = ev(i);
-  return best;
+  const Eigen::EigenSolver<Eigen::MatrixXd> es(z, chatter_hz != nullptr);
+  const Eigen::VectorXcd ev = es.eigenvalues();
+  Eigen::Index best = 0;
+  for (Eigen::Index i = 1; i < ev.size(); ++i)
+    if (std::abs(ev(i)) > std::abs(ev(best))) best = i;
+  if (chatter_hz) {
+    // History slot j holds q at -(j + 1) / m tooth periods.
+    std::vector<double> t(static_cast<std::size_t>(m_));
+    for (int j = 0; j < m_; ++j) t[static_cast<std::size_t>(j)] = -(j + 1.0) / m_;
+    *chatter_hz = floquet_chatter_hz(ev(best), t, es.eigenvectors().col(best).segment(n, 2 * m_), rpm * cutter_.teeth / 60.0);
+  }
+  return ev(best);
 }
 
 DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol) {
@@ -138,16 +163,9 @@ SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
     return p;
   }
   const double hi = br.hi_mm;
-  const std::complex<double> mu = multiplier(hi, rpm);
+  const std::complex<double> mu = multiplier(hi, rpm, &p.chatter_hz);
   // Period doubling when the critical multiplier is (nearly) real and negative.
   p.type = mu.real() < 0.0 && std::abs(mu.imag()) < 1e-3 * std::abs(mu) ? CutClass::kFlip : CutClass::kHopf;
-  // Chatter frequencies are (arg mu + 2 pi k) / (2 pi T): the one nearest a mode of the structure.
-  const double tooth_hz = rpm * cutter_.teeth / 60.0, base = std::abs(std::arg(mu)) / (2.0 * M_PI) * tooth_hz;
-  double best = 1e300;
-  for (double fm : mode_hz_)
-    for (int k = -1; k <= static_cast<int>(fm / tooth_hz) + 1; ++k)
-      for (double f : {base + k * tooth_hz, -base + k * tooth_hz})
-        if (f > 0.0 && std::abs(f - fm) < best) best = std::abs(f - fm), p.chatter_hz = f;
   return p;
 }
 

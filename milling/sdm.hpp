@@ -51,6 +51,12 @@ struct DepthBracket {
 };
 [[nodiscard]] DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol);
 
+// The chatter frequency of a Floquet mode q(t) = mu^(t/T) p(t), p periodic, from its displacement at times
+// t_periods (in tooth periods, over one period) as [x, y] pairs: p's strongest harmonic m gives the
+// frequency |arg mu / 2 pi + m| / T, the physically right one of the aliases the multiplier allows.
+[[nodiscard]] double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t_periods,
+                                        const Eigen::VectorXcd& history, double tooth_hz);
+
 struct SdmPoint {
   double rpm{0.0};
   double critical_depth_mm{0.0};
@@ -65,13 +71,14 @@ class SdmModel {
 
   // The largest-magnitude eigenvalue of the monodromy matrix at this depth and speed.
   [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
+  // The same with the critical eigenvector's chatter frequency (floquet_chatter_hz).
+  [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm, double* chatter_hz) const;
   // Critical depth by bisection, starting from a guess (e.g. the zero-order limit).
   [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
   [[nodiscard]] int steps_per_period() const { return m_; }
 
  private:
   Eigen::MatrixXd a_, b_, c_;
-  std::vector<double> mode_hz_;
   Cutter cutter_;
   config::MaterialConfig material_;
   config::MillingMode mode_;

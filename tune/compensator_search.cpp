@@ -100,6 +100,26 @@ struct Evaluator::Impact {
   analysis::ImpactCommand command;
 };
 
+namespace {
+
+constexpr std::size_t kCheckedMinima = 4;
+
+// The lowest `count` local minima of a lobe curve: (rpm, mm), lowest first.
+std::vector<std::pair<double, double>> lowest_minima(const milling::LobeDiagram& d, std::size_t count) {
+  std::vector<std::pair<double, double>> out;
+  const auto& c = d.curve;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const double v = c[i].b_lim_m;
+    if (!std::isfinite(v)) continue;
+    if ((i == 0 || v <= c[i - 1].b_lim_m) && (i + 1 == c.size() || v <= c[i + 1].b_lim_m)) out.emplace_back(c[i].rpm, v * 1e3);
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  if (out.size() > count) out.resize(count);
+  return out;
+}
+
+}  // namespace
+
 Evaluator::~Evaluator() = default;
 Evaluator::Evaluator(Evaluator&&) noexcept = default;
 
@@ -126,7 +146,22 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
     throw config::ConfigError({config::Problem{job_->source, {}, "cut.spindle_rpm", *p}});
   const milling::LobeDiagram d = milling::LobeModel(open, *process_, job_->lobes).diagram();
   open_min_mm_ = d.minimum.b_lim_m * 1e3;
-  for (const auto& p : d.curve) open_curve_.emplace_back(p.rpm, p.b_lim_m * 1e3);
+  // The open loop's lobes by SDM on the job's SDM speeds: their lowest minima are where the damped limit is
+  // checked against the open loop's, by the accurate method.
+  {
+    config::LobesConfig grid = job_->lobes;
+    grid.points = job_->time_domain.sdm_points;
+    const milling::LobeDiagram g = milling::LobeModel(open, *process_, grid).diagram();
+    std::vector<double> rpm, mm;
+    for (const auto& p : g.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_m * 1e3);
+    const std::vector<milling::SdmPoint> sdm = milling::AccurateStability(open, *job_).critical(rpm, mm);
+    milling::LobeDiagram as_lobes;
+    for (const auto& p : sdm) {
+      as_lobes.curve.push_back({p.rpm, p.critical_depth_mm * 1e-3, p.chatter_hz, 0});
+      open_curve_.emplace_back(p.rpm, p.critical_depth_mm);
+    }
+    for (const auto& [r, m] : lowest_minima(as_lobes, kCheckedMinima)) open_sdm_min_rpm_.push_back(r), open_sdm_min_mm_.push_back(m);
+  }
   // The open loop's lobe peaks (local maxima of the envelope), and the floor between each two.
   std::vector<std::size_t> peaks;
   const auto& c = d.curve;
@@ -201,10 +236,28 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   const milling::LobeModel lobes(damped, *process_, job_->lobes);
   const milling::LobeDiagram d = lobes.diagram();
   e.min_depth_mm = d.minimum.b_lim_m * 1e3;
-  e.objective = e.min_depth_mm;
-  // The promise at the job's speed by the accurate method (the zero-order limit is only its first guess).
-  const double zoa_at_speed_mm = lobes.critical_depth_m(job_->cut.spindle_rpm, 1e-3) * 1e3;
-  e.depth_at_speed_mm = milling::AccurateStability(damped, *job_).critical(job_->cut.spindle_rpm, zoa_at_speed_mm, 2e-3).critical_depth_mm;
+  // The objective and the depth at the job's speed by the accurate method: the sampled loop's SDM at the
+  // job's speed, at the damped zero-order lobes' lowest minima (where the damped lobes dip) and at the open
+  // loop's SDM minima (where the open loop's floors are); the zero-order limits are only the first guesses.
+  std::vector<double> speeds{job_->cut.spindle_rpm}, guesses{lobes.critical_depth_m(job_->cut.spindle_rpm, 1e-3) * 1e3};
+  for (const auto& [rpm, mm] : lowest_minima(d, kCheckedMinima)) speeds.push_back(rpm), guesses.push_back(mm);
+  for (std::size_t i = 0; i < open_sdm_min_rpm_.size(); ++i) {
+    speeds.push_back(open_sdm_min_rpm_[i]);
+    const auto z = lobes.limit_at(open_sdm_min_rpm_[i]);
+    guesses.push_back(z ? z->b_lim_m * 1e3 : 1.0);
+  }
+  const milling::AccurateStability truth(damped, *job_);
+  const std::vector<milling::SdmPoint> acc = truth.critical(speeds, guesses, 0, 5e-3);
+  e.depth_at_speed_mm = acc.front().critical_depth_mm;
+  e.accurate_min_mm = kInf;
+  for (const auto& p : acc)
+    if (p.critical_depth_mm < e.accurate_min_mm) e.accurate_min_mm = p.critical_depth_mm, e.accurate_min_rpm = p.rpm;
+  e.objective = e.accurate_min_mm;
+  e.open_minima_ratio = kInf;
+  const std::size_t first_open = speeds.size() - open_sdm_min_rpm_.size();
+  for (std::size_t i = 0; i < open_sdm_min_rpm_.size(); ++i)
+    e.open_minima_ratio = std::min(e.open_minima_ratio, acc[first_open + i].critical_depth_mm / open_sdm_min_mm_[i]);
+  add_violation(e, 1.0 - e.open_minima_ratio, "a lobe minimum below the open loop's (sampled-loop SDM)");
   if (s_.depth_at_speed_min_mm > 0.0)
     add_violation(e, (s_.depth_at_speed_min_mm - e.depth_at_speed_mm) / s_.depth_at_speed_min_mm,
                   "the depth at the job's spindle speed");
@@ -245,7 +298,8 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
   constexpr double Evaluation::*kSmallest[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
                                               &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
                                               &Evaluation::min_depth_mm,    &Evaluation::depth_at_speed_mm,
-                                              &Evaluation::floor_ratio};
+                                              &Evaluation::floor_ratio,     &Evaluation::accurate_min_mm,
+                                              &Evaluation::open_minima_ratio};
   constexpr double Evaluation::*kLargest[] = {&Evaluation::worst_mode_phase_deg, &Evaluation::peak_m_per_n,
                                              &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
                                              &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use};
@@ -278,7 +332,13 @@ std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::
   const auto m = std::make_shared<const analysis::LoopModel>(cfg);
   if (!m->stable(cfg.controller.gain_ns_per_m, cfg.controller.polarity)) return out;
   const milling::Structure damped(job_structure(*job_), true, {m, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
-  for (const auto& p : milling::LobeModel(damped, *process_, job_->lobes).diagram().curve) out.emplace_back(p.rpm, p.b_lim_m * 1e3);
+  config::LobesConfig grid = job_->lobes;
+  grid.points = job_->time_domain.sdm_points;
+  const milling::AccurateStability truth(damped, *job_);
+  std::vector<double> rpm, mm;
+  for (const auto& p : milling::LobeModel(damped, *process_, grid).diagram().curve)
+    if (p.rpm <= truth.max_rpm()) rpm.push_back(p.rpm), mm.push_back(p.b_lim_m * 1e3);
+  for (const auto& p : truth.critical(rpm, mm)) out.emplace_back(p.rpm, p.critical_depth_mm);
   return out;
 }
 

@@ -5,8 +5,10 @@
 // The shape, minimum phase and stable by construction (every coefficient positive):
 //   C(s) = g (s^2/wz^2 + 2 zeta_z s/wz + 1) / (s^2/wp^2 + 2 zeta_p s/wp + 1) * (s/wa + 1) / (s/wb + 1)
 // with g making |C| = 1 at the match frequency (the dominant mode).
-// Objective: with a milling job, the smallest damped limiting depth over the job's speed range; without
-// one, the smallest peak of the closed-loop receptances over the analysis band. Constraints: stable, gain
+// Objective: with a milling job, the smallest damped limiting depth by the sampled loop's semi-discretization
+// (milling/sampled_sdm.hpp) at the speeds where it can be lowest (the job's speed, the damped zero-order
+// lobes' lowest minima, the open loop's SDM minima); without one, the smallest peak of the closed-loop
+// receptances over the analysis band. Constraints: stable, gain
 // margin, phase margin and delay margin at least the settings'; every mode of the loop inside the damping
 // window (the feedback force within 90 deg of -velocity); the command for an impact within the
 // actuator's force, voltage and slew limits; with a job no lobe floor lower than the open loop's (between
@@ -72,6 +74,9 @@ struct Evaluation {
   double min_depth_mm{0.0};      // with a job: the damped lobes' minimum (zero-order: it steers the search;
                                  // tune/verification.hpp gives the verified one)
   double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (sampled-loop SDM)
+  double accurate_min_mm{0.0};   // with a job: the objective, the smallest sampled-loop SDM limit over the job's
+  double accurate_min_rpm{0.0};  // speed, the damped zero-order lobes' lowest minima and the open SDM minima
+  double open_minima_ratio{0.0}; // with a job: min over the open loop's SDM minima of damped / open (accurate)
   double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
   std::vector<double> floors_mm; // with a job: the damped floor in each of the open lobes' intervals
   std::vector<double> at_open_minima_mm;  // with a job: the damped limit at each open-loop floor's speed
@@ -121,8 +126,9 @@ class Evaluator {
   [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
   [[nodiscard]] const std::vector<double>& open_floor_rpm() const { return floor_rpm_; }
   [[nodiscard]] const config::Config& base() const { return base_; }
-  // For reports: the open loop's lobes, a configuration's damped lobes (the job's structure closed through
-  // its loop), and its improvement at each mode of the first configured FRF (the TCP's, discrete loop).
+  // For reports: the open loop's lobes (SDM), a configuration's damped lobes (the job's structure closed
+  // through its loop, the sampled loop's SDM; both on the job's time_domain.sdm_points speeds), and its
+  // improvement at each mode of the first configured FRF (the TCP's, discrete loop).
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_curve_mm() const { return open_curve_; }
   [[nodiscard]] std::vector<std::pair<double, double>> damped_curve_mm(const config::Config& cfg) const;
   [[nodiscard]] std::vector<ModeImprovement> mode_improvements(const config::Config& cfg) const;
@@ -141,6 +147,7 @@ class Evaluator {
   std::vector<double> floors_mm_;                     // the open loop's smallest limit in each
   std::vector<double> floor_rpm_;                     // and the speed where it is
   std::vector<std::pair<double, double>> open_curve_; // rpm, mm (inf where no lobe reaches)
+  std::vector<double> open_sdm_min_rpm_, open_sdm_min_mm_;  // the open loop's lowest SDM minima
 };
 
 // Several plants at once (both mountings, shifted modes): the candidate evaluated on each and the worst case
