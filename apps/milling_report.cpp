@@ -80,13 +80,9 @@ json sdm_json(const milling::Structure& structure, const config::MillingConfig& 
   std::vector<double> speeds, guesses;
   for (const auto& p : guess.curve)
     if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm), guesses.push_back(p.b_lim_m * 1e3);
-  for (double rpm : rpms) {
-    if (rpm > truth.max_rpm())
-      throw config::ConfigError({config::Problem{cfg.source, {}, "spindle speed",
-                                                 "= " + std::to_string(rpm) + " rpm: the " + truth.method() +
-                                                     " needs at most " + std::to_string(truth.max_rpm()) +
-                                                     " rpm (10 loop periods per tooth period); use --method zoa for a preview"}});
-  }
+  for (double rpm : rpms)
+    if (auto p = truth.speed_problem(rpm))
+      throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p + "; --method zoa previews it"}});
   const std::vector<milling::SdmPoint> curve = truth.critical(speeds, guesses);
   std::vector<double> at_guess;
   for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_m(rpm) * 1e3);

@@ -13,7 +13,7 @@ AccurateStability::AccurateStability(const Structure& structure, const config::M
 
 AccurateStability::AccurateStability(const Structure& structure, const config::MillingConfig& job,
                                      const config::CutConfig& cut)
-    : grid_(job.time_domain.sdm_steps_per_period) {
+    : grid_(job.time_domain.sdm_steps_per_period), teeth_(job.tool.teeth) {
   const Cutter cutter = cutter_from(job.tool);
   if (structure.damped() && structure.has_controller()) {
     method_ = "sampled-loop SDM";
@@ -30,6 +30,12 @@ AccurateStability::AccurateStability(const Structure& structure, const config::M
 
 double AccurateStability::max_rpm() const {
   return sampled_ ? sampled_->max_rpm() : std::numeric_limits<double>::infinity();
+}
+
+std::optional<std::string> AccurateStability::speed_problem(double rpm) const {
+  if (sampled_) return sampled_speed_problem(rpm, teeth_, sampled_->loop_rate_hz());
+  if (!(rpm > 0.0) || !std::isfinite(rpm)) return "spindle speed = " + std::to_string(rpm) + " rpm: must be > 0 and finite";
+  return std::nullopt;
 }
 
 SdmPoint AccurateStability::critical(double rpm, double guess_mm, double rel_tol) const {

@@ -7,6 +7,7 @@
 
 #include <complex>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,8 @@ class AccurateStability {
   [[nodiscard]] double stepped_rpm(double rpm) const { return sampled_ ? sampled_->stepped_rpm(rpm) : rpm; }
   // The highest speed it can analyse (infinite open loop).
   [[nodiscard]] double max_rpm() const;
+  // Why it cannot analyse this speed (value, unit and range), or nothing.
+  [[nodiscard]] std::optional<std::string> speed_problem(double rpm) const;
   // Grid points per tooth period (open loop: the SDM's steps).
   [[nodiscard]] int grid_per_period() const { return grid_; }
 
@@ -47,6 +50,7 @@ class AccurateStability {
  private:
   std::string method_;
   int grid_{0};
+  int teeth_{1};
   std::unique_ptr<SdmModel> open_;
   std::unique_ptr<SampledSdm> sampled_;
 };

@@ -280,6 +280,33 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
   std::filesystem::remove(cut_json);
 }
 
+// The sampled loop's SDM needs 10 loop periods per tooth period: a damped speed above that (10 526 rpm with
+// 3 teeth at 5 kHz) is refused with the value, the unit and the range, by lobes and by cut --critical; so is
+// an unstable controller.
+TEST(Cli, DampedStabilityRefusesASpeedTheLoopCannotStepAndAnUnstableController) {
+  std::string yaml = robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  yaml.replace(yaml.find("../presets/"), 11, std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/");
+  yaml.replace(yaml.find("rpm_max: 1500"), 13, "rpm_max: 15000");
+  const std::string job = temp_path("fast.yaml");
+  std::ofstream(job) << yaml;
+  const Result lobes = run("lobes --config " + job + " --damped --rpm 12000");
+  EXPECT_EQ(lobes.status, 2) << lobes.out;
+  EXPECT_NE(lobes.out.find("12000 rpm"), std::string::npos) << lobes.out;
+  EXPECT_NE(lobes.out.find("(0, 10526.3] rpm"), std::string::npos) << lobes.out;
+  const Result cut = run("cut --config " + job + " --critical --damped --rpm 12000");
+  EXPECT_EQ(cut.status, 2) << cut.out;
+  EXPECT_NE(cut.out.find("allowed range (0, 10526.3] rpm"), std::string::npos) << cut.out;
+  std::string unstable = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  unstable.replace(unstable.find("gain_ns_per_m: 2000"), 19, "gain_ns_per_m: 9000");
+  const std::string controller = temp_path("unstable.yaml");
+  std::ofstream(controller) << unstable;
+  const Result bad = run("lobes --config " + job + " --damped --controller " + controller);
+  EXPECT_EQ(bad.status, 2) << bad.out;
+  EXPECT_NE(bad.out.find("the damping loop is unstable at K = 9000"), std::string::npos) << bad.out;
+  std::filesystem::remove(job);
+  std::filesystem::remove(controller);
+}
+
 TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
   const Result wide = run("cut --config " + job + " --radial-mm 13");
