@@ -83,7 +83,12 @@ json sdm_json(const milling::Structure& structure, const config::MillingConfig& 
   for (double rpm : rpms)
     if (auto p = truth.speed_problem(rpm))
       throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p + "; --method zoa previews it"}});
-  const std::vector<milling::SdmPoint> curve = truth.critical(speeds, guesses);
+  // Progress on stderr: the open loop of a many-mode structure takes minutes.
+  const std::vector<milling::SdmPoint> curve = truth.critical(speeds, guesses, 0, 1e-3, [&](std::size_t done) {
+    if (done % 20 == 0 || done == speeds.size())
+      std::cerr << "[lobes " << truth.method() << "] " << done << "/" << speeds.size() << " speeds, "
+                << elapsed_ms(t0) / 1000.0 << " s\n";
+  });
   std::vector<double> at_guess;
   for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_m(rpm) * 1e3);
   const std::vector<milling::SdmPoint> at = truth.critical(rpms, at_guess);
@@ -241,6 +246,7 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
                         {"b_lim_mm", finite_or_null(b_lim * 1e3)}, {"stable", stable}});
   }
   j["map_unstable_points"] = chatter;
+  j["stability_method"] = kPreview;  // the map's and the conditions' stable flags (docs/milling.md)
   j["conditions"] = json::array();
   // One lobe model per immersion and feed axis, shared by the conditions that cut with them.
   std::map<std::pair<double, config::Axis>, milling::LobeModel> stability_models;
@@ -294,7 +300,8 @@ std::string sle_table(const json& r) {
     os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-" << fmt(d["map"].back()["rpm"], "%.0f")
        << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to " << fmt(json(hi), "%.1f") << " um";
     if (const int u = d["map_unstable_points"].get<int>(); u > 0)
-      os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds: SLE not meaningful there)";
+      os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds by the " << kPreview
+         << ": SLE not meaningful there)";
     os << '\n';
     if (d["conditions"].empty()) return;
     os << "    cond  rpm    axial  radial  ft     normal  SLE(um)  dyn(um)  offset  radial_cmd(mm)  iter  stable\n";

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <mutex>
 
 #include "analysis/task_pool.hpp"
 
@@ -44,12 +45,21 @@ SdmPoint AccurateStability::critical(double rpm, double guess_mm, double rel_tol
 }
 
 std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
-                                                  std::size_t threads, double rel_tol) const {
+                                                  std::size_t threads, double rel_tol,
+                                                  const std::function<void(std::size_t)>& progress) const {
   std::vector<SdmPoint> out(rpm.size());
   std::vector<std::function<void()>> tasks;
   tasks.reserve(rpm.size());
+  std::mutex m;
+  std::size_t done = 0;
   for (std::size_t i = 0; i < rpm.size(); ++i)
-    tasks.emplace_back([&, i] { out[i] = critical(rpm[i], i < guess_mm.size() ? guess_mm[i] : 1.0, rel_tol); });
+    tasks.emplace_back([&, i] {
+      out[i] = critical(rpm[i], i < guess_mm.size() ? guess_mm[i] : 1.0, rel_tol);
+      if (progress) {
+        const std::lock_guard<std::mutex> lock(m);
+        progress(++done);
+      }
+    });
   analysis::run_tasks(tasks, analysis::task_threads(threads));
   return out;
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <complex>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -41,8 +42,10 @@ class AccurateStability {
   // std::invalid_argument for a speed out of range.
   [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
   // The same at many speeds on `threads` threads (0: one per core); same result for any thread count.
+  // progress (optional) is called after each speed with the number done, from one thread at a time.
   [[nodiscard]] std::vector<SdmPoint> critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
-                                               std::size_t threads = 0, double rel_tol = 1e-3) const;
+                                               std::size_t threads = 0, double rel_tol = 1e-3,
+                                               const std::function<void(std::size_t)>& progress = {}) const;
   // The dominant multiplier at this depth and speed, and whether it is inside the unit circle.
   [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
   [[nodiscard]] bool stable(double axial_mm, double rpm) const { return std::abs(multiplier(axial_mm, rpm)) < 1.0; }

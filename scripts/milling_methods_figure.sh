@@ -12,7 +12,7 @@ fi
 job=config/milling/single_mode_low_immersion.yaml
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-./build/apps/robodamp lobes --config "$job" --json > "$tmp/zoa.json"
+./build/apps/robodamp lobes --config "$job" --method zoa --json > "$tmp/zoa.json"
 ./build/apps/robodamp lobes --config "$job" --method sdm --json > "$tmp/sdm.json"
 speeds=$(seq 11000 1500 39500 | tr '\n' ' ')
 # shellcheck disable=SC2086
