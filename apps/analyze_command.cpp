@@ -9,6 +9,8 @@
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/pose_schedule.hpp"
 #include "apps/cli.hpp"
+#include "config/milling_config.hpp"
+#include "milling/live_stability.hpp"
 #include "apps/gnuplot.hpp"
 #include <memory>
 
@@ -96,6 +98,14 @@ std::string analysis_table(const json& r) {
                     mp["notch_phase_deg"].get<double>());
       os << line;
     }
+  }
+  if (r.contains("job_limits")) {
+    const auto& l = r["job_limits"];
+    auto mm = [](const json& v) { return v.is_null() ? std::string("none below 1 m") : fmt(v, "%.3f") + " mm"; };
+    os << "  the job (spindle.job) at " << fmt(l["rpm"], "%.0f") << " rpm, depth " << fmt(l["depth_mm"], "%.3f")
+       << " mm: limit open " << mm(l["open_mm"]) << " (" << l["open_method"].get<std::string>() << "), damped "
+       << mm(l["damped_mm"]) << " (" << l["damped_method"].get<std::string>() << " at " << fmt(l["analysed_rpm"], "%.2f")
+       << " rpm)\n";
   }
   os << "  recommended polarity " << std::showpos << r["recommended_polarity"].get<int>() << std::noshowpos << ": "
      << r["polarity_reason"].get<std::string>() << "\n";
@@ -283,6 +293,20 @@ int print_pose_schedule(const config::Config& cfg, bool as_json) {
   return 0;
 }
 
+// With spindle.job and --spindle-rpm: the job's limits at that speed by the accurate method (the cell's live
+// stability, milling/live_stability.hpp), each with its method.
+void add_job_limits(const analysis::LoopModel& m, std::optional<double> rpm, json& report) {
+  const config::Config& cfg = m.config();
+  if (!rpm || cfg.spindle.job_resolved.empty()) return;
+  milling::LiveStability live(config::load_milling_config(cfg.spindle.job_resolved), cfg.spindle.structure, {cfg});
+  const milling::LiveLimits l = live.compute(*rpm, 0, cfg.controller.gain_ns_per_m);
+  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  report["job_limits"] = {{"rpm", *rpm}, {"depth_mm", live.depth_mm()},          {"open_mm", finite(l.open_mm)},
+                                     {"open_method", l.open_method},         {"damped_mm", finite(l.damped_mm)},
+                                     {"damped_method", l.method},            {"analysed_rpm", l.analysed_rpm},
+                                     {"damped_valid", l.damped_valid}};
+}
+
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
   if (a.spindle_sweep) {
@@ -293,7 +317,8 @@ int run_analyze(const AnalyzeArgs& a) {
     return print_pose_schedule(cfg, a.json);
   const analysis::LoopModel model(config::load_config_file(a.config_path), a.spindle_rpm);
   const auto result = analysis::analyse(model);
-  const auto report = analysis_report(model, result);
+  auto report = analysis_report(model, result);
+  add_job_limits(model, a.spindle_rpm, report);
   if (print_report(report.dump(2), a.json, analysis_table(report), a.plot_dir,
                    [&] { return plot_analysis(model, result, a.plot_dir); },
                    "frf_open_closed.png, nyquist.png, gain_sweep.png in " + a.plot_dir) != 0)

@@ -307,6 +307,21 @@ TEST(Cli, DampedStabilityRefusesASpeedTheLoopCannotStepAndAnUnstableController) 
   std::filesystem::remove(controller);
 }
 
+// analyze --spindle-rpm with a spindle.job: the job's limits at that speed, each with the method that made it.
+TEST(Cli, AnalyzeAtASpindleSpeedGivesTheJobsLimitsWithTheirMethod) {
+  std::string text = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  text += "\nspindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
+  const std::string cfg = temp_path("spindle_job.yaml");
+  std::ofstream(cfg) << text;
+  const Result r = run("analyze --config " + cfg + " --spindle-rpm 700");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("the job (spindle.job) at 700 rpm, depth 0.500 mm: limit open 1.111 mm (SDM), damped 0.782 mm "
+                       "(sampled-loop SDM at 699.30 rpm)"),
+            std::string::npos)
+      << r.out;
+  std::filesystem::remove(cfg);
+}
+
 TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
   const Result wide = run("cut --config " + job + " --radial-mm 13");
