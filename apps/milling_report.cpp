@@ -73,22 +73,18 @@ json lobes_json(const milling::Structure& structure, const config::MillingConfig
 json sdm_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
   const auto t0 = std::chrono::steady_clock::now();
   const milling::AccurateStability truth(structure, cfg);
-  config::LobesConfig grid = cfg.lobes;
-  grid.points = cfg.time_domain.sdm_points;
-  const milling::LobeModel zoa(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), grid);
-  const milling::LobeDiagram guess = zoa.diagram();
-  std::vector<double> speeds, guesses;
-  for (const auto& p : guess.curve)
-    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm), guesses.push_back(p.b_lim_m * 1e3);
   for (double rpm : rpms)
     if (auto p = truth.speed_problem(rpm))
       throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p + "; --method zoa previews it"}});
+  config::LobesConfig grid = cfg.lobes;
+  grid.points = cfg.time_domain.sdm_points;
+  const milling::LobeModel zoa(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), grid);
   // Progress on stderr: the open loop of a many-mode structure takes minutes.
-  const std::vector<milling::SdmPoint> curve = truth.critical(speeds, guesses, 0, 1e-3, [&](std::size_t done) {
-    if (done % 20 == 0 || done == speeds.size())
-      std::cerr << "[lobes " << truth.method() << "] " << done << "/" << speeds.size() << " speeds, "
-                << elapsed_ms(t0) / 1000.0 << " s\n";
+  const milling::AccurateDiagram diagram = milling::accurate_diagram(structure, cfg, 0, [&](std::size_t done, std::size_t of) {
+    if (done % 20 == 0 || done == of)
+      std::cerr << "[lobes " << truth.method() << "] " << done << "/" << of << " speeds, " << elapsed_ms(t0) / 1000.0 << " s\n";
   });
+  const std::vector<milling::SdmPoint>& curve = diagram.curve;
   std::vector<double> at_guess;
   for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_m(rpm) * 1e3);
   const std::vector<milling::SdmPoint> at = truth.critical(rpms, at_guess);
@@ -115,9 +111,9 @@ json sdm_json(const milling::Structure& structure, const config::MillingConfig& 
                            {"b_lim_lobes_mm", finite_or_null(at_guess[i])}});
   j["diagram_ms"] = elapsed_ms(t0);
   j["notes"] = structure.notes();
-  if (speeds.size() < guess.curve.size())
+  if (diagram.speeds_left_out > 0)
     j["notes"].push_back("the " + truth.method() + " stops at " + std::to_string(static_cast<int>(truth.max_rpm())) +
-                         " rpm (10 loop periods per tooth period): " + std::to_string(guess.curve.size() - speeds.size()) +
+                         " rpm (10 loop periods per tooth period): " + std::to_string(diagram.speeds_left_out) +
                          " speeds above it left out; --method zoa previews them");
   return j;
 }

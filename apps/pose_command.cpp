@@ -18,6 +18,7 @@
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "identify/modal_fit.hpp"
+#include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 #include "robot/pose_fit.hpp"
@@ -48,6 +49,7 @@ struct PoseArgs {
   std::string csv_path;
   double csv_step_hz{0.1};
   std::string job_path;  // map: a milling job with a pose part: its minimum limiting depth at each pose
+  std::string method{"sdm"};  // map: the accurate method, or "zoa" (the zero-order preview)
 };
 
 // "Q1,Q2,Q3:path" -> the pose and the FRF (a freq_hz,re_m_per_n,im_m_per_n[,coherence] receptance CSV).
@@ -241,6 +243,7 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
   std::ostringstream data;
   double f_min = INFINITY, f_max = 0.0, b_min = INFINITY, b_max = 0.0;
   std::optional<config::MillingConfig> job;
+  const std::string method = a.method == "zoa" ? "zero-order preview" : "SDM";
   if (!a.job_path.empty()) {
     job = config::load_milling_config(a.job_path);
     bool has_pose = false;
@@ -266,19 +269,25 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
         for (auto& part : st.parts)
           if (part.pose) part.pose->joints_deg = q;
         const milling::Structure structure(st, false);
-        const auto lobes = milling::LobeModel(structure, milling::chatter_process(job->tool, job->material, job->cut),
-                                              job->lobes).diagram();
-        depth_mm = lobes.minimum.b_lim_m * 1e3;
+        double min_rpm = 0.0;
+        if (a.method == "zoa") {
+          const auto lobes = milling::LobeModel(structure, milling::chatter_process(job->tool, job->material, job->cut),
+                                                job->lobes).diagram();
+          depth_mm = lobes.minimum.b_lim_m * 1e3, min_rpm = lobes.minimum.rpm;
+        } else {
+          const milling::AccurateDiagram d = milling::accurate_diagram(structure, *job);
+          depth_mm = d.minimum.critical_depth_mm, min_rpm = d.minimum.rpm;
+        }
         b_min = std::min(b_min, depth_mm), b_max = std::max(b_max, depth_mm);
         point["min_depth_mm"] = depth_mm;
-        point["min_depth_rpm"] = lobes.minimum.rpm;
+        point["min_depth_rpm"] = min_rpm;
       }
       grid.push_back(point);
       data << q[j1] << ' ' << q[j2] << ' ' << md[0].freq_hz << ' ' << md[0].tcp_modal_stiffness_n_per_m << ' '
            << depth_mm << '\n';
     }
     data << '\n';
-    if (job) std::cerr << "robodamp pose map: row " << i + 1 << " of " << a.steps << " done\n";
+    if (job) std::cerr << "robodamp pose map: row " << i + 1 << " of " << a.steps << " done (" << method << ")\n";
   }
   json r = {{"model", m.source}, {"vary", a.vary}, {"steps", a.steps}, {"grid", grid},
                   {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
@@ -288,9 +297,10 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
                 m.name.c_str(), a.vary[0], a.vary[1], a.steps, a.steps, f_min, f_max);
   t << b;
   if (job) {
-    std::snprintf(b, sizeof b, "  %s: minimum limiting depth (open loop, %g-%g rpm) %.3f to %.3f mm\n",
-                  a.job_path.c_str(), job->lobes.rpm_min, job->lobes.rpm_max, b_min, b_max);
+    std::snprintf(b, sizeof b, "  %s: minimum limiting depth (open loop, %s, %g-%g rpm) %.3f to %.3f mm\n",
+                  a.job_path.c_str(), method.c_str(), job->lobes.rpm_min, job->lobes.rpm_max, b_min, b_max);
     t << b;
+    r["method"] = method;
     r["min_depth_min_mm"] = b_min;
     r["min_depth_max_mm"] = b_max;
   }
@@ -302,7 +312,7 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
                           " (deg)'; set title 'first mode (Hz)'; splot DATA u 1:2:3 w pm3d notitle;"
                           " set title 'TCP modal stiffness of the first mode (N/m)'; set format cb '%.1e';"
                           " splot DATA u 1:2:4 w pm3d notitle;" +
-                          std::string(job ? " set format cb '%g'; set title 'minimum limiting depth (mm)';"
+                          std::string(job ? " set format cb '%g'; set title 'minimum limiting depth (mm, " + method + ")';"
                                             " splot DATA u 1:2:5 w pm3d notitle;" : "") +
                           " unset multiplot";
     return run_gnuplot(s, data.str(), a.plot_path);
@@ -345,6 +355,8 @@ void register_pose(Registry& r) {
   sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
   sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose)")
       ->check(CLI::ExistingFile);
+  sub->add_option("--method", a->method, "map: sdm (default): the job's minimum by semi-discretization over its SDM speeds; zoa: the zero-order method, a fast preview")
+      ->check(CLI::IsMember({"sdm", "zoa"}));
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
   sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
   sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));

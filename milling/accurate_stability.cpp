@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "analysis/task_pool.hpp"
+#include "milling/lobes.hpp"
 
 namespace robodamp::milling {
 
@@ -66,6 +67,29 @@ std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm
 
 std::complex<double> AccurateStability::multiplier(double axial_mm, double rpm) const {
   return sampled_ ? sampled_->multiplier(axial_mm, rpm) : open_->multiplier(axial_mm, rpm);
+}
+
+AccurateDiagram accurate_diagram(const Structure& structure, const config::MillingConfig& job, std::size_t threads,
+                                 const std::function<void(std::size_t done, std::size_t of)>& progress) {
+  const AccurateStability truth(structure, job);
+  config::LobesConfig grid = job.lobes;
+  grid.points = job.time_domain.sdm_points;
+  const LobeDiagram guess = LobeModel(structure, chatter_process(job.tool, job.material, job.cut), grid).diagram();
+  std::vector<double> speeds, guesses;
+  for (const auto& p : guess.curve)
+    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm), guesses.push_back(p.b_lim_m * 1e3);
+  AccurateDiagram d;
+  d.method = truth.method();
+  d.grid_per_period = truth.grid_per_period();
+  d.speeds_left_out = guess.curve.size() - speeds.size();
+  d.max_rpm = truth.max_rpm();
+  d.curve = truth.critical(speeds, guesses, threads, 1e-3, [&](std::size_t done) {
+    if (progress) progress(done, speeds.size());
+  });
+  d.minimum.critical_depth_mm = std::numeric_limits<double>::infinity();
+  for (const SdmPoint& p : d.curve)
+    if (p.critical_depth_mm < d.minimum.critical_depth_mm) d.minimum = p;
+  return d;
 }
 
 }  // namespace robodamp::milling

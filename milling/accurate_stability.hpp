@@ -58,4 +58,19 @@ class AccurateStability {
   std::unique_ptr<SampledSdm> sampled_;
 };
 
+// The whole diagram by the accurate method: the critical depth at time_domain.sdm_points speeds over the
+// job's lobes range (those the method can step; the sampled loop stops at max_rpm()), each from the
+// zero-order limit there as the first guess, on `threads` threads (0: one per core).
+struct AccurateDiagram {
+  std::string method;                // AccurateStability::method()
+  int grid_per_period{0};
+  std::vector<SdmPoint> curve;       // by speed
+  SdmPoint minimum;                  // the curve's shallowest point (critical_depth_mm infinite if none)
+  std::size_t speeds_left_out{0};    // above the method's highest speed
+  double max_rpm{0.0};
+};
+[[nodiscard]] AccurateDiagram accurate_diagram(const Structure& structure, const config::MillingConfig& job,
+                                               std::size_t threads = 0,
+                                               const std::function<void(std::size_t done, std::size_t of)>& progress = {});
+
 }  // namespace robodamp::milling

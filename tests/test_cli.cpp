@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -378,13 +379,35 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   const Result no_pose = run("lobes --pose -84.75 104.63 -20.08");
   EXPECT_EQ(no_pose.status, 2);
   EXPECT_NE(no_pose.out.find("the job has no robot pose part"), std::string::npos) << no_pose.out;
-  // A depth map: each grid pose carries the job's minimum limiting depth; a job without a pose part is refused.
-  const Result map = run("pose map --vary 2 3 --steps 2 --job " + job + " --json-out " + dir + "/map.json");
+  // A depth map: each grid pose carries the job's minimum limiting depth by SDM (the default) over the job's
+  // SDM speeds (12 here, to keep the test short), or by the zero-order preview when asked, each labelled;
+  // SDM's minimum at each pose is the lowest of SDM's critical depths at those 12 speeds, which the test
+  // computes again with `lobes`. A job without a pose part is refused.
+  std::string small_job = robodamp::test::read_file(job);
+  small_job.replace(small_job.find("../robots/seed002.yaml"), std::strlen("../robots/seed002.yaml"),
+                    std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/seed002.yaml");
+  small_job += "time_domain:\n  sdm_points: 12\n";
+  std::ofstream(dir + "/small_job.yaml") << small_job;
+  const Result map = run("pose map --vary 2 3 --steps 2 --job " + dir + "/small_job.yaml --json-out " + dir + "/map.json");
   ASSERT_EQ(map.status, 0) << map.out;
-  EXPECT_NE(map.out.find("minimum limiting depth (open loop, 500-8000 rpm)"), std::string::npos) << map.out;
-  const auto grid = nlohmann::json::parse(robodamp::test::read_file(dir + "/map.json"))["grid"];
+  EXPECT_NE(map.out.find("minimum limiting depth (open loop, SDM, 500-8000 rpm)"), std::string::npos) << map.out;
+  const auto map_json = nlohmann::json::parse(robodamp::test::read_file(dir + "/map.json"));
+  EXPECT_EQ(map_json["method"], "SDM");
+  const auto grid = map_json["grid"];
   ASSERT_EQ(grid.size(), 4U);
   for (const auto& g : grid) EXPECT_GT(g["min_depth_mm"].get<double>(), 0.0) << g.dump();
+  {  // the first grid pose again, as `lobes --pose` computes its SDM diagram
+    std::string q;
+    for (const auto& v : grid[0]["joints_deg"]) q += " " + std::to_string(v.get<double>());
+    const Result lobes = run("lobes --json --config " + dir + "/small_job.yaml --pose" + q);
+    ASSERT_EQ(lobes.status, 0) << lobes.out;
+    const auto l = nlohmann::json::parse(lobes.out.substr(lobes.out.find('{')));
+    EXPECT_EQ(l["method"], "SDM");
+    EXPECT_NEAR(l["min_b_lim_mm"].get<double>(), grid[0]["min_depth_mm"].get<double>(), 1e-9) << lobes.out;
+  }
+  const Result preview = run("pose map --vary 2 3 --steps 2 --method zoa --job " + dir + "/small_job.yaml");
+  ASSERT_EQ(preview.status, 0) << preview.out;
+  EXPECT_NE(preview.out.find("minimum limiting depth (open loop, zero-order preview, 500-8000 rpm)"), std::string::npos) << preview.out;
   const Result no_pose_job = run("pose map --steps 2 --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
   EXPECT_EQ(no_pose_job.status, 2);
   EXPECT_NE(no_pose_job.out.find("no robot pose part"), std::string::npos) << no_pose_job.out;
