@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -230,22 +231,34 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
   at_map.log_spacing = false;
   const auto lobes =
       milling::LobeModel(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), at_map).diagram();
-  int chatter = 0;
+  // Whether the configured depth chatters at each speed: the accurate method where it can step the speed,
+  // the zero-order preview above that (the damped loop's highest speed), each point labelled.
+  const milling::AccurateStability truth(structure, cfg);
+  std::vector<double> speeds;
+  for (const auto& p : lobes.curve)
+    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm);
+  const std::vector<bool> accurate = truth.stable(cfg.cut.axial_mm, speeds);
+  int chatter = 0, previewed = 0;
   for (int i = 0; i < s.points; ++i) {
-    const double rpm = lobes.curve[static_cast<std::size_t>(i)].rpm;
+    const auto idx = static_cast<std::size_t>(i);
+    const double rpm = lobes.curve[idx].rpm;
     const auto r = milling::surface_location_error(structure, cutter, cfg.material, cut, cfg.cut.feed_axis, rpm,
                                                    s.axial_slices, s.harmonics);
-    const double b_lim = lobes.curve[static_cast<std::size_t>(i)].b_lim_m;
-    const bool stable = cfg.cut.axial_mm * 1e-3 < b_lim;
+    const double b_lim = lobes.curve[idx].b_lim_m;
+    const bool by_truth = idx < accurate.size();
+    const bool stable = by_truth ? accurate[idx] : cfg.cut.axial_mm * 1e-3 < b_lim;
     chatter += stable ? 0 : 1;
+    previewed += by_truth ? 0 : 1;
     j["map"].push_back({{"rpm", rpm}, {"sle_um", r.sle_um}, {"sle_min_um", r.min_um}, {"sle_max_um", r.max_um},
-                        {"b_lim_mm", finite_or_null(b_lim * 1e3)}, {"stable", stable}});
+                        {"b_lim_preview_mm", finite_or_null(b_lim * 1e3)}, {"stable", stable},
+                        {"stability_method", by_truth ? truth.method() : std::string(kPreview)}});
   }
   j["map_unstable_points"] = chatter;
-  j["stability_method"] = kPreview;  // the map's and the conditions' stable flags (docs/milling.md)
+  j["stability_method"] = truth.method();  // the map's and the conditions' stable flags (docs/milling.md)
+  j["map_preview_points"] = previewed;     // above the accurate method's highest speed
   j["conditions"] = json::array();
-  // One lobe model per immersion and feed axis, shared by the conditions that cut with them.
-  std::map<std::pair<double, config::Axis>, milling::LobeModel> stability_models;
+  // One stability model per immersion and feed axis, shared by the conditions that cut with them.
+  std::map<std::pair<double, config::Axis>, std::unique_ptr<milling::AccurateStability>> stability_models;
   for (const auto& c : cfg.conditions) {
     for (const config::Axis normal : s.surface_normals) {
       const config::Axis feed = normal == config::Axis::kY ? config::Axis::kX : config::Axis::kY;
@@ -254,15 +267,17 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
       const auto r = milling::surface_location_error(structure, cutter, cfg.material, cc, feed, c.rpm, s.axial_slices,
                                                      s.harmonics);
       const auto comp = milling::compensate(structure, cutter, cfg.material, cc, feed, c.rpm, offset_um, s);
-      // SLE assumes a stable cut: say whether this one is (direct test with this immersion and feed axis).
+      // SLE assumes a stable cut: say whether this one is, with this immersion and feed axis.
       config::CutConfig cut_c = cfg.cut;
       cut_c.radial_mm = c.radial_mm;
       cut_c.feed_axis = feed;
-      const milling::LobeModel& stability =
-          stability_models
-              .try_emplace({c.radial_mm, feed}, structure, milling::chatter_process(cfg.tool, cfg.material, cut_c),
-                           cfg.lobes)
-              .first->second;
+      auto& model = stability_models[{c.radial_mm, feed}];
+      if (!model) model = std::make_unique<milling::AccurateStability>(structure, cfg, cut_c);
+      const bool by_truth = !model->speed_problem(c.rpm);
+      const bool stable =
+          by_truth ? model->stable(c.axial_mm, c.rpm)
+                   : milling::LobeModel(structure, milling::chatter_process(cfg.tool, cfg.material, cut_c), cfg.lobes)
+                         .stable(c.axial_mm * 1e-3, c.rpm);
       j["conditions"].push_back({{"name", c.name},
                                  {"rpm", c.rpm},
                                  {"axial_mm", c.axial_mm},
@@ -279,7 +294,8 @@ json sle_json(const milling::Structure& structure, const config::MillingConfig& 
                                  {"compensation_residual_um", comp.residual_um},
                                  {"compensation_iterations", comp.iterations},
                                  {"compensation_converged", comp.converged},
-                                 {"stable", stability.stable(c.axial_mm * 1e-3, c.rpm)}});
+                                 {"stable", stable},
+                                 {"stability_method", by_truth ? model->method() : std::string(kPreview)}});
     }
   }
   j["notes"] = structure.notes();
@@ -296,8 +312,11 @@ std::string sle_table(const json& r) {
     os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-" << fmt(d["map"].back()["rpm"], "%.0f")
        << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to " << fmt(json(hi), "%.1f") << " um";
     if (const int u = d["map_unstable_points"].get<int>(); u > 0)
-      os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds by the " << kPreview
-         << ": SLE not meaningful there)";
+      os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds by the "
+         << d["stability_method"].get<std::string>() << ": SLE not meaningful there)";
+    if (const int p = d["map_preview_points"].get<int>(); p > 0)
+      os << " (" << p << " speeds above the " << d["stability_method"].get<std::string>()
+         << "'s highest: their stability by the " << kPreview << ")";
     os << '\n';
     if (d["conditions"].empty()) return;
     os << "    cond  rpm    axial  radial  ft     normal  SLE(um)  dyn(um)  offset  radial_cmd(mm)  iter  stable\n";
@@ -308,7 +327,8 @@ std::string sle_table(const json& r) {
                     c["radial_mm"].get<double>(), c["ft_mm"].get<double>(), c["surface_normal"].get<std::string>().c_str(),
                     c["sle_um"].get<double>(), c["sle_dynamic_um"].get<double>(), c["path_offset_um"].get<double>(),
                     c["compensated_radial_mm"].get<double>(), c["compensation_iterations"].get<int>(),
-                    c["stable"].get<bool>() ? "yes" : "NO (chatter: SLE not meaningful)");
+                    (c["stable"].get<bool>() ? "yes (" + c["stability_method"].get<std::string>() + ")"
+                                             : "NO (chatter by the " + c["stability_method"].get<std::string>() + ": SLE not meaningful)").c_str());
       os << line;
     }
   };
@@ -325,17 +345,22 @@ std::string plot_sle(const json& r, const std::string& path) {
   for (const json* d : {&r, damped ? &r["damped"] : nullptr})
     for (const auto& p : d ? (*d)["map"] : json::array())
       lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
+  // Columns: rpm, open SLE, open SLE where the cut chatters (NaN elsewhere), and the same damped.
+  auto chattering = [](const json& p) { return p["stable"].get<bool>() ? NAN : p["sle_um"].get<double>(); };
   for (std::size_t i = 0; i < r["map"].size(); ++i) {
-    data << r["map"][i]["rpm"].get<double>() << ' ' << r["map"][i]["sle_um"].get<double>();
-    if (damped) data << ' ' << r["damped"]["map"][i]["sle_um"].get<double>();
+    data << r["map"][i]["rpm"].get<double>() << ' ' << r["map"][i]["sle_um"].get<double>() << ' ' << chattering(r["map"][i]);
+    if (damped) data << ' ' << r["damped"]["map"][i]["sle_um"].get<double>() << ' ' << chattering(r["damped"]["map"][i]);
     data << '\n';
   }
   std::ostringstream s;
   s << "set title 'Surface location error (mean over the axial depth), " << r["tool"].get<std::string>()
     << "'\nset grid\nset xlabel 'spindle speed (rpm)'\nset ylabel 'SLE (um), + = undercut'\nset key top left\n"
     << "set yrange [" << 1.1 * lo << ":" << 1.1 * hi << "]\n"
-    << "plot DATA u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop'";
-  if (damped) s << ", DATA u 1:3 w l lw 2 lc rgb '#2471a3' t 'active damping'";
+    << "plot DATA u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop', DATA u 1:3 w p pt 2 ps 1.2 lc rgb '#c0392b' t "
+    << "'open loop: chatters (" << r["stability_method"].get<std::string>() << "), SLE not meaningful'";
+  if (damped)
+    s << ", DATA u 1:4 w l lw 2 lc rgb '#2471a3' t 'active damping', DATA u 1:5 w p pt 6 ps 1.2 lc rgb '#2471a3' t "
+      << "'active damping: chatters (" << r["damped"]["stability_method"].get<std::string>() << ")'";
   s << '\n';
   return run_gnuplot(s.str(), data.str(), path);
 }

@@ -69,6 +69,15 @@ std::complex<double> AccurateStability::multiplier(double axial_mm, double rpm) 
   return sampled_ ? sampled_->multiplier(axial_mm, rpm) : open_->multiplier(axial_mm, rpm);
 }
 
+std::vector<bool> AccurateStability::stable(double axial_mm, const std::vector<double>& rpm, std::size_t threads) const {
+  std::vector<char> out(rpm.size(), 0);  // not vector<bool>: the tasks write their own elements
+  std::vector<std::function<void()>> tasks;
+  tasks.reserve(rpm.size());
+  for (std::size_t i = 0; i < rpm.size(); ++i) tasks.emplace_back([&, i] { out[i] = stable(axial_mm, rpm[i]) ? 1 : 0; });
+  analysis::run_tasks(tasks, analysis::task_threads(threads));
+  return {out.begin(), out.end()};
+}
+
 AccurateDiagram accurate_diagram(const Structure& structure, const config::MillingConfig& job, std::size_t threads,
                                  const std::function<void(std::size_t done, std::size_t of)>& progress) {
   const AccurateStability truth(structure, job);

@@ -49,6 +49,8 @@ class AccurateStability {
   // The dominant multiplier at this depth and speed, and whether it is inside the unit circle.
   [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
   [[nodiscard]] bool stable(double axial_mm, double rpm) const { return std::abs(multiplier(axial_mm, rpm)) < 1.0; }
+  // The same at many speeds on `threads` threads (0: one per core); every speed must be analysable.
+  [[nodiscard]] std::vector<bool> stable(double axial_mm, const std::vector<double>& rpm, std::size_t threads = 0) const;
 
  private:
   std::string method_;

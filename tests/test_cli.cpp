@@ -821,14 +821,23 @@ TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
 }
 
 TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
-  const std::string png = temp_path("sle.png");
-  const Result r = run("sle --config " + milling_job("industrial_robot_aluminium") + " --json --plot " + png);
+  // The industrial robot's job with 30 map speeds instead of 300: each speed's stability is an SDM
+  // multiplier of the 46-mode structure (about 0.2 s).
+  std::string job = robodamp::test::read_file(milling_job("industrial_robot_aluminium"));
+  const std::size_t at = job.find("  points: 300\n  axial_slices: 40");
+  ASSERT_NE(at, std::string::npos);
+  job.replace(at, std::strlen("  points: 300"), "  points: 30");
+  const std::string job_path = temp_path("sle_job.yaml"), png = temp_path("sle.png");
+  std::ofstream(job_path) << job;
+  const Result r = run("sle --config " + job_path + " --json --plot " + png);
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
-  EXPECT_EQ(j["map"].size(), 300u);
+  EXPECT_EQ(j["map"].size(), 30u);
   EXPECT_TRUE(j["map"][0].contains("rpm"));
   EXPECT_TRUE(j["map"][0].contains("sle_um"));
-  EXPECT_EQ(j["map_unstable_points"], 0) << "1.5 mm is below the 4.7 mm limit above 2000 rpm";
+  EXPECT_EQ(j["stability_method"], "SDM");
+  EXPECT_EQ(j["map_preview_points"], 0);
+  EXPECT_EQ(j["map_unstable_points"], 0) << "1.5 mm is below the 3.5 mm SDM limit above 2000 rpm";
   ASSERT_EQ(j["conditions"].size(), 16u);  // 8 conditions x surface normals y and x
   for (const auto& c : j["conditions"]) {
     for (const char* k : {"name", "rpm", "axial_mm", "radial_mm", "ft_mm", "surface_normal", "sle_um", "compensated_radial_mm"})
@@ -837,6 +846,7 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
     EXPECT_GT(c["compensated_radial_mm"].get<double>(), c["radial_mm"].get<double>());
     EXPECT_TRUE(c["compensation_converged"].get<bool>());
     EXPECT_TRUE(c["stable"].get<bool>());
+    EXPECT_EQ(c["stability_method"], "SDM");
   }
   EXPECT_EQ(j["conditions"][0]["surface_normal"], "y");
   EXPECT_EQ(j["conditions"][1]["surface_normal"], "x");
@@ -846,9 +856,14 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   ASSERT_EQ(d.status, 0) << d.out;
   const auto jd = nlohmann::json::parse(d.out);
   EXPECT_EQ(jd["damped"]["map"].size(), jd["map"].size());
-  // 0.5 mm chatters near the 9.2 Hz mode's lobes open loop (0.32 mm minimum), nowhere with damping.
-  EXPECT_GT(jd["map_unstable_points"].get<int>(), 0);
-  EXPECT_EQ(jd["damped"]["map_unstable_points"].get<int>(), 0);
+  // 0.5 mm chatters near the 9.2 Hz mode's lobes open loop (SDM: 0.224 mm minimum); with C2 only around
+  // 403 rpm, where the sampled loop's SDM puts the damped minimum at 0.478 mm (the zero-order preview said
+  // nowhere: its damped minimum is 0.841 mm).
+  EXPECT_EQ(jd["damped"]["stability_method"], "sampled-loop SDM");
+  EXPECT_GT(jd["map_unstable_points"].get<int>(), 10);
+  EXPECT_GT(jd["damped"]["map_unstable_points"].get<int>(), 0);
+  for (const auto& p : jd["damped"]["map"])
+    if (!p["stable"].get<bool>()) EXPECT_NEAR(p["rpm"].get<double>(), 403.0, 10.0) << p.dump();
 }
 
 }  // namespace
