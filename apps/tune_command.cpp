@@ -16,6 +16,7 @@
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "tune/compensator_search.hpp"
+#include "tune/tuned_file.hpp"
 #include "tune/verification.hpp"
 
 namespace robodamp::apps {
@@ -113,42 +114,6 @@ std::string tuned_header(const TuneArgs& a, const std::optional<tune::Verificati
 }
 
 // The configuration's text with the compensator block, the gain and the polarity of the tuned candidate.
-std::string tuned_yaml(const config::Config& base, const tune::Candidate& c) {
-  const config::Config tuned = tune::with_candidate(base, c);
-  const config::BlockConfig* block = nullptr;
-  for (const auto& b : tuned.controller.chain)
-    if (b.kind == config::BlockKind::kCompensator) block = &b;
-  std::ostringstream num, den;
-  num.precision(17), den.precision(17);
-  for (std::size_t i = 0; i < block->numerator.size(); ++i) num << (i ? ", " : "") << block->numerator[i];
-  for (std::size_t i = 0; i < block->denominator.size(); ++i) den << (i ? ", " : "") << block->denominator[i];
-  std::istringstream in(base.yaml_text);
-  std::ostringstream out;
-  std::string line;
-  int n = 0;
-  // The controller's own keys (two spaces in): the value replaced, the comment kept.
-  auto replace_value = [](std::string& l, const std::string& key, const std::string& value) {
-    const std::string prefix = "  " + key + ":";
-    if (l.rfind(prefix, 0) != 0) return false;
-    l = prefix + " " + value + "   # robodamp tune";
-    return true;
-  };
-  char gain[32];
-  std::snprintf(gain, sizeof gain, "%.10g", c.gain_ns_per_m);
-  while (std::getline(in, line)) {
-    ++n;
-    if (n == block->mark.line) {
-      const std::string indent = line.substr(0, line.find('-'));
-      line = indent + "- {kind: compensator, model: rational, numerator: [" + num.str() + "], denominator: [" + den.str() +
-             "]}   # robodamp tune";
-    } else if (!replace_value(line, "gain_ns_per_m", gain)) {
-      (void)replace_value(line, "polarity", c.polarity > 0 ? "+1" : "-1");
-    }
-    out << line << '\n';
-  }
-  return out.str();
-}
-
 void print_row(const char* name, const tune::Evaluation& e) {
   std::printf("  %-6s K %8.0f N s/m pol %+d | K_max %8.0f  GM %6.1f dB  PM %6.1f deg  DM %6.2f ms  modes within %.0f deg | ",
               name, e.candidate.gain_ns_per_m, e.candidate.polarity, e.k_max_ns_per_m, e.gain_margin_db, e.phase_margin_deg,
@@ -335,7 +300,11 @@ int run_tune(const TuneArgs& a) {
     std::ofstream(a.json_path) << report.dump(2) << '\n';
   }
   if (!a.out_path.empty()) {
-    const std::string text = tuned_header(a, verified) + tuned_yaml(plants.front().base(), r.best.candidate);
+    const config::EditedYaml edited = tune::tuned_config_text(plants.front().base(), r.best.candidate);
+    if (!edited.comments_kept)
+      std::fprintf(stderr, "tune: %s could not be edited in place; written again from its data, without its comments\n",
+                   a.config_path.c_str());
+    const std::string text = tuned_header(a, verified) + edited.text;
     const config::Config check = config::parse_config(text, a.out_path);  // throws (exit 2) before writing
     if (!analysis::LoopModel(check).stable(check.controller.gain_ns_per_m, check.controller.polarity))
       throw std::runtime_error("the written configuration's loop is not stable: nothing written");

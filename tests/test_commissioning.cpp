@@ -26,6 +26,7 @@
 #include "identify/commissioning.hpp"
 #include "rt/supervisor.hpp"
 #include "test_util.hpp"
+#include "tune/tuned_file.hpp"
 
 namespace robodamp {
 namespace {
@@ -172,6 +173,17 @@ void expect_round_trip(const std::string& dir, const std::string& measured_confi
   ASSERT_EQ(check.wait(), 0) << test::read_file(dir + "/check.log");
   const config::Config identified = config::load_config_file(out);
   const config::Config preset = config::load_config_file(measured_config);
+  {  // the next command in the chain: what tune writes from it (identify all writes the chain in block style)
+    tune::Candidate c;
+    c.gain_ns_per_m = 777.0;
+    c.polarity = -1;
+    const config::EditedYaml tuned = tune::tuned_config_text(identified, c);
+    EXPECT_TRUE(tuned.comments_kept);
+    const config::Config t = config::parse_config(tuned.text, out);
+    EXPECT_EQ(t.controller.gain_ns_per_m, 777.0);
+    EXPECT_EQ(t.controller.polarity, -1);
+    EXPECT_EQ(t.controller.chain.size(), identified.controller.chain.size());
+  }
   expect_modes_match(identified, preset);
   expect_actuator_matches(identified, preset);
   expect_analysis_matches(identified, preset);

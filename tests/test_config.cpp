@@ -6,6 +6,7 @@
 
 #include "modal/receptance.hpp"
 #include "config/config.hpp"
+#include "config/yaml_edit.hpp"
 #include "control/chain_design.hpp"
 #include "test_util.hpp"
 
@@ -425,3 +426,76 @@ TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {
 }
 
 }  // namespace robodamp::config
+
+// config::edit_yaml: values set as data in any YAML style, the rest of the text kept.
+namespace {
+std::string edited(const std::string& text, const std::vector<robodamp::config::YamlEdit>& edits, bool* kept) {
+  const auto r = robodamp::config::edit_yaml(text, edits);
+  *kept = r.comments_kept;
+  return r.text;
+}
+}  // namespace
+
+TEST(YamlEdit, SetsValuesInBlockAndFlowStyleAndKeepsComments) {
+  using robodamp::config::YamlEdit;
+  const std::string text =
+      "# header\n"
+      "controller:\n"
+      "  gain_ns_per_m: 2000   # the gain\n"
+      "  polarity: \"+1\"       # quoted\n"
+      "  chain:\n"
+      "    - kind: lowpass2    # block entry\n"
+      "      cutoff_hz: 50\n"
+      "    - {kind: compensator, model: c1}   # flow entry\n"
+      "    -\n"
+      "      kind: compensator\n"
+      "      model: c2\n"
+      "other: {a: [1, 2], b: {}}\n";
+  YAML::Node entry;
+  entry["kind"] = "compensator";
+  entry["model"] = "rational";
+  entry["numerator"] = std::vector<double>{1.0, 2.0};
+  bool kept = false;
+  const std::string out = edited(text,
+                                 {{{"controller", "gain_ns_per_m"}, YAML::Node("288.5")},
+                                  {{"controller", "polarity"}, YAML::Node("-1")},
+                                  {{"controller", "chain", std::size_t{0}}, entry},
+                                  {{"controller", "chain", std::size_t{1}}, entry},
+                                  {{"controller", "chain", std::size_t{2}}, entry},
+                                  {{"controller", "match_freq_hz"}, YAML::Node("9.2")},
+                                  {{"other", "b", "c"}, YAML::Node("3")},
+                                  {{"other", "a", std::size_t{1}}, YAML::Node("5")}},
+                                 &kept);
+  EXPECT_TRUE(kept) << out;
+  // Comments outside the replaced values are kept ("# block entry" was inside one).
+  for (const char* comment : {"# header", "# the gain", "# quoted", "# flow entry"})
+    EXPECT_NE(out.find(comment), std::string::npos) << comment << "\n" << out;
+  const YAML::Node r = YAML::Load(out);
+  EXPECT_EQ(r["controller"]["gain_ns_per_m"].as<double>(), 288.5);
+  EXPECT_EQ(r["controller"]["polarity"].as<int>(), -1);
+  EXPECT_EQ(r["controller"]["match_freq_hz"].as<double>(), 9.2);
+  ASSERT_EQ(r["controller"]["chain"].size(), 3U);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(r["controller"]["chain"][i]["model"].as<std::string>(), "rational") << out;
+    EXPECT_FALSE(r["controller"]["chain"][i]["cutoff_hz"]) << out;
+    EXPECT_EQ(r["controller"]["chain"][i]["numerator"][1].as<double>(), 2.0) << out;
+  }
+  EXPECT_EQ(r["other"]["a"][1].as<int>(), 5);
+  EXPECT_EQ(r["other"]["b"]["c"].as<int>(), 3);
+}
+
+TEST(YamlEdit, WhatCannotBeSplicedIsWrittenAgainFromTheDataAndBadPathsAreRefused) {
+  using robodamp::config::YamlEdit;
+  // A block scalar cannot be replaced in place: the document is emitted again (comments lost), correctly.
+  const std::string text = "# comment\nnote: |\n  two\n  lines\nk: 1\n";
+  bool kept = true;
+  const std::string out = edited(text, {{{"note"}, YAML::Node("one")}, {{"k"}, YAML::Node("2")}}, &kept);
+  EXPECT_FALSE(kept);
+  const YAML::Node r = YAML::Load(out);
+  EXPECT_EQ(r["note"].as<std::string>(), "one");
+  EXPECT_EQ(r["k"].as<int>(), 2);
+  EXPECT_THROW((void)robodamp::config::edit_yaml("a: [1, 2]\n", {{{"a", std::size_t{2}}, YAML::Node("3")}}),
+               std::invalid_argument);
+  EXPECT_THROW((void)robodamp::config::edit_yaml("a: 1\n", {{{"a", "b"}, YAML::Node("3")}}), std::invalid_argument);
+  EXPECT_THROW((void)robodamp::config::edit_yaml("a: [1, 2\n", {{{"a"}, YAML::Node("3")}}), YAML::Exception);
+}

@@ -18,6 +18,7 @@
 #include "milling/structure.hpp"
 #include "test_util.hpp"
 #include "tune/compensator_search.hpp"
+#include "tune/tuned_file.hpp"
 #include "tune/verification.hpp"
 
 namespace robodamp {
@@ -341,4 +342,73 @@ TEST(Tune, AJobWithoutADampingLocationIsRefused) {
 }
 
 }  // namespace
+}  // namespace robodamp
+
+namespace robodamp {
+namespace {
+// Every collection of the document in one style (identify all writes block style; a person may write flow).
+void restyle(YAML::Node n, YAML::EmitterStyle::value style) {
+  if (n.IsMap() || n.IsSequence()) n.SetStyle(style);
+  if (n.IsMap())
+    for (auto it = n.begin(); it != n.end(); ++it) restyle(it->second, style);
+  if (n.IsSequence())
+    for (auto it = n.begin(); it != n.end(); ++it) restyle(*it, style);
+}
+std::string in_style(const std::string& text, YAML::EmitterStyle::value style) {
+  YAML::Node root = YAML::Load(text);
+  restyle(root, style);
+  YAML::Emitter out;
+  out << root;
+  return std::string(out.c_str()) + "\n";
+}
+}  // namespace
+
+// The file tune writes, from every preset with a compensator, as written, in block style (as identify all
+// writes) and in flow style: it parses, has the candidate's compensator, gain and polarity, and everything
+// else of the configuration unchanged; the presets' comments outside the edited values are kept (issue 29).
+TEST(Tune, TheTunedFileReadsBackFromEveryPresetInEveryStyle) {
+  tune::Candidate c;
+  c.gain_ns_per_m = 1234.5;
+  c.fz_hz = 9.0, c.zeta_z = 0.3, c.fp_hz = 2.0, c.zeta_p = 0.7, c.fa_hz = 12.0, c.fb_hz = 30.0;
+  c.polarity = -1;
+  int files = 0;
+  for (const char* name : {"horizontal_c1", "horizontal_c2", "horizontal_c3", "vertical_c1", "tuned_horizontal",
+                           "tuned_vertical", "pose_scheduled_c2"}) {
+    const std::string original = test::read_file(test::preset(name));
+    for (const auto& [style, text] : {std::pair{"as written", original},
+                                      std::pair{"block", in_style(original, YAML::EmitterStyle::Block)},
+                                      std::pair{"flow", in_style(original, YAML::EmitterStyle::Flow)}}) {
+      const config::Config base = config::parse_config(text, test::preset(name));  // relative paths from there
+      const config::Config want = tune::with_candidate(base, c);
+      const config::EditedYaml out = tune::tuned_config_text(base, c);
+      EXPECT_TRUE(out.comments_kept) << name << " " << style;
+      const config::Config got = config::parse_config(out.text, test::preset(name));
+      EXPECT_EQ(got.controller.gain_ns_per_m, want.controller.gain_ns_per_m) << name << " " << style;
+      EXPECT_EQ(got.controller.polarity, -1) << name << " " << style;
+      ASSERT_EQ(got.controller.chain.size(), want.controller.chain.size()) << name << " " << style;
+      for (std::size_t i = 0; i < got.controller.chain.size(); ++i) {
+        const auto& g = got.controller.chain[i];
+        const auto& w = want.controller.chain[i];
+        EXPECT_EQ(g.kind, w.kind) << name << " " << style << " " << i;
+        EXPECT_EQ(g.model, w.model) << name << " " << style << " " << i;
+        ASSERT_EQ(g.numerator.size(), w.numerator.size()) << name << " " << style << " " << i;
+        for (std::size_t k = 0; k < g.numerator.size(); ++k) EXPECT_DOUBLE_EQ(g.numerator[k], w.numerator[k]);
+        for (std::size_t k = 0; k < g.denominator.size(); ++k) EXPECT_DOUBLE_EQ(g.denominator[k], w.denominator[k]);
+        EXPECT_EQ(g.cutoff_hz, w.cutoff_hz) << name << " " << style << " " << i;
+        EXPECT_EQ(g.center_hz, w.center_hz) << name << " " << style << " " << i;
+      }
+      // The rest of the configuration is the base's.
+      EXPECT_EQ(got.loop.rate_hz, base.loop.rate_hz);
+      EXPECT_EQ(got.actuator.delay_s, base.actuator.delay_s);
+      EXPECT_EQ(got.controller.match_freq_hz, base.controller.match_freq_hz);
+      EXPECT_EQ(got.controller.gain_ramp_s, base.controller.gain_ramp_s);
+      if (std::string(style) == "as written")
+        for (const char* comment : {"# Published parameters", "# Eq. 15"})
+          if (original.find(comment) != std::string::npos)
+            EXPECT_NE(out.text.find(comment), std::string::npos) << name << ": " << comment;
+      ++files;
+    }
+  }
+  EXPECT_EQ(files, 21);
+}
 }  // namespace robodamp

@@ -1,0 +1,39 @@
+#include "tune/tuned_file.hpp"
+
+#include <cstdio>
+
+namespace robodamp::tune {
+
+// The configuration's own text with the compensator, the gain and the polarity set, as data
+// (config/yaml_edit.hpp): any YAML style; comments kept where the splice is exact.
+config::EditedYaml tuned_config_text(const config::Config& base, const Candidate& c) {
+  const config::Config tuned = with_candidate(base, c);
+  std::size_t index = 0;
+  for (std::size_t i = 0; i < tuned.controller.chain.size(); ++i)
+    if (tuned.controller.chain[i].kind == config::BlockKind::kCompensator) index = i;
+  const config::BlockConfig& block = tuned.controller.chain[index];
+  const YAML::Node original = config::yaml_at(YAML::Load(base.yaml_text), {"controller", "chain", index});
+  YAML::Node entry(YAML::NodeType::Map);
+  entry["kind"] = "compensator";
+  for (const char* key : {"name", "prewarp_hz"})  // what a rational compensator keeps of the original entry
+    if (original.IsMap() && original[key]) entry[key] = original[key];
+  entry["model"] = "rational";
+  auto numbers = [](const std::vector<double>& v) {
+    YAML::Node n(YAML::NodeType::Sequence);
+    for (const double x : v) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%.17g", x);
+      n.push_back(std::string(b));
+    }
+    return n;
+  };
+  entry["numerator"] = numbers(block.numerator);
+  entry["denominator"] = numbers(block.denominator);
+  char gain[32];
+  std::snprintf(gain, sizeof gain, "%.10g", c.gain_ns_per_m);
+  return config::edit_yaml(base.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node(std::string(gain))},
+                                            {{"controller", "polarity"}, YAML::Node(c.polarity > 0 ? "+1" : "-1")},
+                                            {{"controller", "chain", index}, entry}});
+}
+
+}  // namespace robodamp::tune
