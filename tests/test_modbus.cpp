@@ -223,11 +223,11 @@ TEST(Modbus, SpindleRegisterSettlesScalesAndALostLinkParksTheNotches) {
   ASSERT_TRUE(eventually([&] { return !seen().empty(); }));
   EXPECT_EQ(seen().front(), 12000.0);
   server.set_holding_register(11, 600);
-  ASSERT_TRUE(eventually([&] { return seen().size() == 2; }));
+  // The counters and the hand-over are updated one after the other on the poll thread: wait for both.
+  ASSERT_TRUE(eventually([&] { return seen().size() == 2 && sup.counters().spindle_changes == 2U; }));
   EXPECT_EQ(seen().back(), 6000.0);
-  EXPECT_EQ(sup.counters().spindle_changes, 2U);
   server.stop();  // the robot controller goes away
-  ASSERT_TRUE(eventually([&] { return sup.counters().spindle_link_parks == 1; }));
+  ASSERT_TRUE(eventually([&] { return sup.counters().spindle_link_parks == 1 && seen().size() == 3; }));
   EXPECT_EQ(seen().back(), 0.0);
   sup.stop();
 }
