@@ -75,7 +75,10 @@ struct RunArgs {
             {"spindle_refused", s.supervisor.spindle_refused},
             {"pose_regions", s.supervisor.pose_regions},
             {"pose_out_of_map", s.supervisor.pose_out_of_map},
-            {"active_parameter_set", s.active_parameter_set}}},
+            {"active_parameter_set", s.active_parameter_set},
+            {"recoveries", s.supervisor.recoveries},
+            {"budget_latches", s.supervisor.budget_latches},
+            {"probation_latches", s.supervisor.probation_latches}}},
           {"realtime",
            {{"memory_locked", s.realtime.memory_locked},
             {"sched_fifo", s.realtime.fifo},
@@ -88,6 +91,10 @@ struct RunArgs {
           {"peak_command_v", s.peak_command_v},
           {"spindle", {{"rpm", s.spindle_rpm}, {"notch_centre_hz", s.notch_centre_hz}}}};
   j["backend"] = s.backend;
+  j["events"] = json::array();
+  for (const auto& e : s.events)
+    j["events"].push_back({{"time_s", e.time_s}, {"event", rt::to_string(e.kind)}, {"trip", rt::to_string(e.trip)}});
+  j["events_total"] = s.events_total;
   j["arming"] = {{"enabled", s.arming.enabled},
                  {"outcome", runtime::to_string(s.arming.outcome)},
                  {"attempts", s.arming.attempts},
@@ -223,6 +230,19 @@ struct RunArgs {
                 static_cast<unsigned long long>(s.supervisor.arm_refused),
                 static_cast<unsigned long long>(s.supervisor.gain_refused), trips.empty() ? "none" : trips.c_str());
   os << b;
+  if (s.events_total > 0) {
+    std::snprintf(b, sizeof b, "  recovery: %llu recovered, %llu latched by the budget, %llu by the probation; events:",
+                  static_cast<unsigned long long>(s.supervisor.recoveries),
+                  static_cast<unsigned long long>(s.supervisor.budget_latches),
+                  static_cast<unsigned long long>(s.supervisor.probation_latches));
+    os << b;
+    for (const auto& e : s.events) {
+      std::snprintf(b, sizeof b, " %.3f s %s %s;", e.time_s, rt::to_string(e.kind), rt::to_string(e.trip));
+      os << b;
+    }
+    if (s.events_total > s.events.size()) os << " (" << s.events_total - s.events.size() << " more)";
+    os << '\n';
+  }
   std::snprintf(b, sizeof b, "  vibration at the sensor: %.4f m/s^2 RMS; peak command %.3f V; K_max %.0f N s/m\n",
                 s.sensor_rms_mps2, s.peak_command_v, s.max_stable_gain_ns_per_m);
   os << b;

@@ -1,5 +1,6 @@
 #include "config/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -433,6 +434,43 @@ RealtimeConfig read_realtime(MapReader& top) {
   return c;
 }
 
+RecoveryConfig read_recovery(MapReader& top) {
+  const YAML::Node node = top.child("recovery", false, "");
+  MapReader r(top.diagnostics(), node, "supervision.recovery", top.mark());
+  RecoveryConfig c;
+  if (present(node) && node.IsMap() && present(node["recoverable"])) {
+    const YAML::Node list = node["recoverable"];
+    c.recoverable.clear();
+    if (!list.IsSequence()) {
+      top.diagnostics().add(list.Mark(), "supervision.recovery.recoverable",
+                            "must be a list of trip classes (any of: overruns, sensor_stale, sample_invalid, sensor_driver, "
+                            "actuator_driver, amplifier_not_ready; [] = every trip latches)");
+    } else {
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string key = "supervision.recovery.recoverable[" + std::to_string(i) + "]";
+        const std::string name = list[i].IsScalar() ? list[i].Scalar() : std::string();
+        if (std::find(kRecoverableTripNames.begin(), kRecoverableTripNames.end(), name) == kRecoverableTripNames.end())
+          top.diagnostics().add(list[i].Mark(), key,
+                                "= '" + name + "' cannot recover by itself: allowed are overruns, sensor_stale, sample_invalid, "
+                                "sensor_driver, actuator_driver, amplifier_not_ready (instability, saturation, amplifier_fault, "
+                                "pose_out_of_map and signal always latch)");
+        else if (std::find(c.recoverable.begin(), c.recoverable.end(), name) != c.recoverable.end())
+          top.diagnostics().add(list[i].Mark(), key, "= '" + name + "' is listed twice");
+        else
+          c.recoverable.push_back(name);
+      }
+    }
+  }
+  (void)r.child("recoverable", false, "");  // read above; known to finish()
+  if (auto v = r.number("cool_down_s", {"s", 0.0, 3600.0}, c.cool_down_s)) c.cool_down_s = *v;
+  if (auto v = r.number("healthy_for_s", {"s", 0.0, 3600.0}, c.healthy_for_s)) c.healthy_for_s = *v;
+  if (auto v = read_int(r, "max_recoveries", {"(recoveries)", 0, 1000}, c.max_recoveries)) c.max_recoveries = *v;
+  if (auto v = r.number("window_s", {"s", 1.0, 604800.0}, c.window_s)) c.window_s = *v;
+  if (auto v = r.number("probation_s", {"s", 0.0, 86400.0}, c.probation_s)) c.probation_s = *v;
+  r.finish();
+  return c;
+}
+
 SupervisionConfig read_supervision(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("supervision", false, ""), "supervision", top.mark());
   SupervisionConfig c;
@@ -459,6 +497,7 @@ SupervisionConfig read_supervision(MapReader& top) {
     c.amplifier_ready_timeout_s = *v;
   if (auto v = r.number("max_gain_fraction", {"(x maximum stable K)", 0.0, 1.0, true}, c.max_gain_fraction))
     c.max_gain_fraction = *v;
+  c.recovery = read_recovery(r);
   r.finish();
   return c;
 }

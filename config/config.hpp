@@ -65,6 +65,26 @@ struct RealtimeConfig {
 };
 
 // The supervisor's trips and ramps (rt/supervisor.hpp).
+// Automatic recovery from a transient fault (docs/runtime.md, "Recovery"): after a trip of a recoverable
+// class the safe state as always, then once the cool-down is over and the cell has been healthy for
+// healthy_for_s (sensor live, ticks on time, actuator path and amplifier without fault, the active set's
+// analysis stable, the pose in a region where scheduled) the supervisor re-arms through the gain ramp.
+// At most max_recoveries within window_s; a trip within probation_s of a recovery, or of a class not
+// listed, latches until an operator resets it.
+struct RecoveryConfig {
+  // Trip classes that may recover (rt::to_string names); empty: every trip latches.
+  std::vector<std::string> recoverable{"overruns", "sensor_stale", "sample_invalid", "sensor_driver", "actuator_driver"};
+  double cool_down_s{1.0};
+  double healthy_for_s{2.0};
+  int max_recoveries{3};
+  double window_s{600.0};
+  double probation_s{10.0};
+};
+// The trip classes that may be recoverable; the others (instability, saturation, amplifier_fault,
+// pose_out_of_map, signal) the damper may have caused, or an operator must see.
+inline const std::vector<std::string> kRecoverableTripNames{"overruns", "sensor_stale", "sample_invalid", "sensor_driver",
+                                                             "actuator_driver", "amplifier_not_ready"};
+
 struct SupervisionConfig {
   int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample
   int invalid_sample_cycles{1};      // consecutive non-finite or out-of-range samples
@@ -85,6 +105,7 @@ struct SupervisionConfig {
   double arm_deadline_s{10.0};
   double amplifier_ready_timeout_s{0.2};
   double max_gain_fraction{0.9};     // gain requests up to this x the analysed maximum stable K
+  RecoveryConfig recovery;
 };
 
 struct TelemetryConfig {

@@ -136,7 +136,7 @@ rt::AmplifierStatus ModbusSupervisor::amplifier_status() noexcept {
     const bool fault = matters && last >= 0;
     if (fault && !link_fault_.exchange(true, std::memory_order_relaxed))
       link_faults_.store(link_faults_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-    s.fault = fault;
+    s.link_lost = fault;
     return s;
   }
   link_fault_.store(false, std::memory_order_relaxed);

@@ -7,7 +7,7 @@
 // - A failed call (timeout, reset, refused connection) closes the link; it reconnects after a back-off
 //   that doubles from modbus.backoff_initial_s up to modbus.backoff_max_s and resets on success.
 // - No successful poll for modbus.link_timeout_s while the amplifier is enabled or asked to be: its
-//   state is unknown, and amplifier_status() reports a fault (the supervisor trips). While the loop
+//   state is unknown, and amplifier_status() reports the link lost (the supervisor trips on the actuator path). While the loop
 //   does not need the amplifier a lost link is only counted.
 // - The amplifier is reported faulty above modbus.amplifier.temperature_max_c too.
 // - The robot's mounting (horizontal / vertical value) must read the same settle_polls polls running

@@ -37,7 +37,10 @@ class ActuatorSink {
 struct AmplifierStatus {
   bool enabled{false};  // the enable the amplifier last acknowledged
   bool ready{false};    // enabled and able to drive
-  bool fault{false};    // the amplifier reports a fault (over-temperature, over-current, link lost)
+  bool fault{false};    // the amplifier reports a fault (over-temperature, over-current)
+  // Its status is unknown while it is needed (the supervisory link lost): the loop cannot deliver the
+  // command with certainty, an actuator-path fault the supervisor may recover from once the link is back.
+  bool link_lost{false};
   double temperature_c{0.0};
 };
 

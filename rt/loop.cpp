@@ -89,7 +89,7 @@ void Loop::run(std::uint64_t duration_ticks) noexcept {
     in.accel_mps2 = sample.accel_mps2;
     in.fresh = sample.fresh;
     in.sensor_ok = sample.ok;
-    in.actuator_ok = act.ok;
+    in.actuator_ok = act.ok && !amp.link_lost;  // a lost supervisory link: the command's path is not known
     in.actuator_saturated = act.saturated;
     in.amplifier_ready = amp.ready;
     in.amplifier_fault = amp.fault;

@@ -100,6 +100,13 @@ json to_json(const SupervisorSettings& s) {
           {"arming_live_cycles", l.arming_live_cycles},
           {"amplifier_ready_timeout_s", l.amplifier_ready_timeout_s},
           {"max_gain_fraction", l.max_gain_fraction},
+          {"recovery",
+           {{"recoverable", l.recovery.recoverable},
+            {"cool_down_s", l.recovery.cool_down_s},
+            {"healthy_for_s", l.recovery.healthy_for_s},
+            {"max_recoveries", l.recovery.max_recoveries},
+            {"window_s", l.recovery.window_s},
+            {"probation_s", l.recovery.probation_s}}},
           {"fs_hz", s.fs_hz},
           {"resolved_sample_limit_mps2", s.sample_limit_mps2},
           {"fade_s", s.fade_s},
@@ -134,6 +141,17 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   l.arming_live_cycles = j.at("arming_live_cycles");
   l.amplifier_ready_timeout_s = j.at("amplifier_ready_timeout_s");
   l.max_gain_fraction = j.at("max_gain_fraction");
+  if (j.contains("recovery")) {
+    const json& r = j.at("recovery");
+    l.recovery.recoverable = r.at("recoverable").get<std::vector<std::string>>();
+    l.recovery.cool_down_s = r.at("cool_down_s");
+    l.recovery.healthy_for_s = r.at("healthy_for_s");
+    l.recovery.max_recoveries = r.at("max_recoveries");
+    l.recovery.window_s = r.at("window_s");
+    l.recovery.probation_s = r.at("probation_s");
+  } else {
+    l.recovery.recoverable.clear();  // recorded before recovery existed: every trip latched
+  }
   s.fs_hz = j.at("fs_hz");
   s.sample_limit_mps2 = j.at("resolved_sample_limit_mps2");
   s.fade_s = j.at("fade_s");

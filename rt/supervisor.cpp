@@ -47,7 +47,7 @@ const char* describe(Trip t) {
     case Trip::kSaturation: return "actuator at its limit for more than supervision.saturation_duty_max of the window: the disturbance is too large for the actuator, or the gain too high";
     case Trip::kInstability: return "growing oscillation in the loop: the gain is too high for this pose (re-run the analysis, lower controller.gain_ns_per_m)";
     case Trip::kSensorDriver: return "the sensor driver reports a fault";
-    case Trip::kActuatorDriver: return "the actuator driver could not deliver the command";
+    case Trip::kActuatorDriver: return "the actuator driver could not deliver the command, or the amplifier's supervisory (Modbus) link was lost while it was needed";
     case Trip::kAmplifierFault: return "the amplifier reports a fault (temperature, current, link)";
     case Trip::kAmplifierNotReady: return "the amplifier did not become ready within supervision.amplifier_ready_timeout_s after enable";
     case Trip::kSignal: return "SIGINT/SIGTERM: shut down through the safe state";
@@ -64,6 +64,15 @@ const char* to_string(ArmRefusal r) {
     case ArmRefusal::kActuatorPath: return "actuator path not healthy (driver or amplifier fault)";
     case ArmRefusal::kAnalysisUnstable: return "the analysis does not find the loop stable at this gain with margin";
     case ArmRefusal::kPoseUnknown: return "the robot's pose is not known to be in a region of pose_schedule, or that region's set is still being handed over";
+  }
+  return "?";
+}
+
+const char* to_string(EventKind k) {
+  switch (k) {
+    case EventKind::kTrip: return "trip";
+    case EventKind::kRecovered: return "recovered";
+    case EventKind::kLatched: return "latched";
   }
   return "?";
 }
@@ -101,6 +110,15 @@ Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerPar
   sat_window_.assign(window, 0);
   sat_threshold_ = static_cast<std::uint64_t>(std::floor(s.limits.saturation_duty_max * static_cast<double>(window)));
   block_len_ = static_cast<std::uint64_t>(std::max(1.0, std::round(s.limits.instability_block_s * s.fs_hz)));
+  for (const std::string& name : s.limits.recovery.recoverable)
+    for (std::size_t t = 0; t < kTripCount; ++t)
+      if (name == to_string(static_cast<Trip>(t))) recoverable_mask_ |= 1U << t;
+  recovery_times_.assign(static_cast<std::size_t>(std::max(0, s.limits.recovery.max_recoveries)), -1e300);
+}
+
+void Supervisor::log_event(EventKind k, Trip t) noexcept {
+  if (events_total_ < kEventLogSize) events_[events_total_] = {time_s_, k, t};
+  ++events_total_;
 }
 
 std::size_t Supervisor::add_parameter_set(const ParameterSet& set) {
@@ -158,10 +176,57 @@ void Supervisor::reset_detectors() noexcept {
 
 void Supervisor::trip(Trip t) noexcept {
   ++counters_.trips[static_cast<std::size_t>(t)];
+  log_event(EventKind::kTrip, t);
+  const bool recoverable = (recoverable_mask_ >> static_cast<unsigned>(t)) & 1U;
+  const bool on_probation = time_s_ < probation_until_s_;
+  latched_ = !recoverable || on_probation;
+  if (recoverable && on_probation) {  // the recovery did not hold
+    ++counters_.probation_latches;
+    log_event(EventKind::kLatched, t);
+  }
+  fault_safe_s_ = healthy_s_ = 0.0;
   state_ = State::kFault;
   trip_ = t;
   trip_from_v_ = command_v_;
   trip_ramp_left_s_ = s_.limits.trip_ramp_s;
+}
+
+ArmRefusal Supervisor::arm_refusal(bool live) const noexcept {
+  if (!live) return ArmRefusal::kSensorNotLive;
+  if (!path_ok_) return ArmRefusal::kActuatorPath;
+  if (!pose_known_ || (s_.pose_scheduled && (pose_set_ != active_parameter_set() || controller_.handover_pending())))
+    return ArmRefusal::kPoseUnknown;
+  if (!sets_[active_parameter_set()].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
+    return ArmRefusal::kAnalysisUnstable;
+  return ArmRefusal::kNone;
+}
+
+void Supervisor::recover(const TickInput& in) noexcept {
+  const config::RecoveryConfig& r = s_.limits.recovery;
+  fault_safe_s_ += in.dt_s;
+  const bool live = live_run_ >= static_cast<std::uint64_t>(s_.limits.arming_live_cycles);
+  // Ticks on time: no run of consecutive overruns as long as half the trip's (a lone late tick on an
+  // ordinary PC is not a burst).
+  const bool on_time = 2 * overrun_run_ < static_cast<std::uint64_t>(s_.limits.overrun_cycles);
+  const bool healthy = on_time && !in.shutdown && arm_refusal(live) == ArmRefusal::kNone;
+  healthy_s_ = healthy ? healthy_s_ + in.dt_s : 0.0;
+  if (fault_safe_s_ < r.cool_down_s || healthy_s_ < r.healthy_for_s || !healthy) return;
+  // The budget: at most max_recoveries within window_s (the ring holds the last max_recoveries times).
+  if (recovery_times_.empty() || recovery_times_[recovery_pos_] > time_s_ - r.window_s) {
+    latched_ = true;
+    ++counters_.budget_latches;
+    log_event(EventKind::kLatched, trip_);
+    return;
+  }
+  recovery_times_[recovery_pos_] = time_s_;
+  recovery_pos_ = (recovery_pos_ + 1) % recovery_times_.size();
+  ++counters_.recoveries;
+  log_event(EventKind::kRecovered, trip_);
+  trip_ = Trip::kNone;
+  state_ = State::kArming;  // through the arming path: amplifier ready, then the gain fades in
+  arming_s_ = 0.0;
+  fade_ = 0.0;
+  probation_until_s_ = time_s_ + r.probation_s;
 }
 
 void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
@@ -169,17 +234,7 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
   switch (c.kind) {
     case CommandKind::kNone: break;
     case CommandKind::kArm: {
-      refusal_ = ArmRefusal::kNone;
-      if (state_ != State::kDisabled)
-        refusal_ = ArmRefusal::kNotDisabled;
-      else if (!live)
-        refusal_ = ArmRefusal::kSensorNotLive;
-      else if (!path_ok_)
-        refusal_ = ArmRefusal::kActuatorPath;
-      else if (!pose_known_ || (s_.pose_scheduled && (pose_set_ != active_parameter_set() || controller_.handover_pending())))
-        refusal_ = ArmRefusal::kPoseUnknown;
-      else if (!sets_[active_parameter_set()].analysis_stable || controller_.target_gain_ns_per_m() > max_gain_ns_per_m())
-        refusal_ = ArmRefusal::kAnalysisUnstable;
+      refusal_ = state_ != State::kDisabled ? ArmRefusal::kNotDisabled : arm_refusal(live);
       if (refusal_ != ArmRefusal::kNone) {
         ++counters_.arm_refused;
         break;
@@ -190,6 +245,7 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
       break;
     }
     case CommandKind::kDisarm:
+      if (state_ == State::kFault) latched_ = true;  // the operator wants it off: no automatic recovery
       if (state_ == State::kArming) state_ = State::kDisabled;
       if (state_ == State::kActive) state_ = State::kStopping;
       break;
@@ -360,6 +416,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
       trip_ramp_left_s_ = 0.0;
       command_v_ = 0.0;
       out.amplifier_enable = false;
+      if (!latched_) recover(in);  // re-arms from the next tick on (state kArming)
     }
   }
   out.command_v = command_v_;

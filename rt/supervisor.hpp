@@ -15,6 +15,7 @@
 // over by the controller (fade out, swap, fade in); everything is applied at the tick boundary.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -102,7 +103,23 @@ struct SupervisorCounters {
   std::uint64_t pose_out_of_map{0};  // set_pose_region -1: the pose outside every region, or unknown
   std::uint64_t pose_regions{0};     // set_pose_region with a region's set
   std::uint64_t commands{0};
+  // Recovery (supervision.recovery): re-armed after a recoverable trip; latched because the budget of
+  // max_recoveries within window_s was spent, or because a recovery tripped again within probation_s.
+  std::uint64_t recoveries{0};
+  std::uint64_t budget_latches{0};
+  std::uint64_t probation_latches{0};
 };
+
+// What the supervisor did about faults, with its time (the supervisor's clock: the sum of the measured
+// dt since the start), in a fixed log of the first kEventLogSize events.
+enum class EventKind : std::uint8_t { kTrip, kRecovered, kLatched };
+struct SupervisorEvent {
+  double time_s{0.0};
+  EventKind kind{EventKind::kTrip};
+  Trip trip{Trip::kNone};  // the trip, or the trip recovered from or latched
+};
+inline constexpr std::size_t kEventLogSize = 64;
+[[nodiscard]] const char* to_string(EventKind k);
 
 // A periodic linear chirp added to the command while active (robodamp measure, with the gain at 0:
 // control off, amplifier enabled). Time is the supervisor's (the sum of the measured dt), so a replay
@@ -169,6 +186,12 @@ class Supervisor {
   [[nodiscard]] Trip latched_trip() const noexcept { return trip_; }
   [[nodiscard]] ArmRefusal last_arm_refusal() const noexcept { return refusal_; }
   [[nodiscard]] const SupervisorCounters& counters() const noexcept { return counters_; }
+  // The fault events so far (the first kEventLogSize; events_total() counts them all).
+  [[nodiscard]] const SupervisorEvent* events() const noexcept { return events_.data(); }
+  [[nodiscard]] std::size_t events_logged() const noexcept { return std::min(events_total_, kEventLogSize); }
+  [[nodiscard]] std::uint64_t events_total() const noexcept { return events_total_; }
+  // The latched trip will not recover by itself (an operator must reset it).
+  [[nodiscard]] bool latched() const noexcept { return state_ == State::kFault && latched_; }
   [[nodiscard]] const control::Controller& controller() const noexcept { return controller_; }
   [[nodiscard]] const SupervisorSettings& settings() const noexcept { return s_; }
   [[nodiscard]] const control::ControllerParams& initial_params() const noexcept { return sets_.front().params; }
@@ -198,6 +221,9 @@ class Supervisor {
     return state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping;
   }
   void follow_pose() noexcept;  // each tick: hand over to the pose's region's set once the controller can
+  [[nodiscard]] ArmRefusal arm_refusal(bool live) const noexcept;  // why arming would be refused now
+  void recover(const TickInput& in) noexcept;                       // in Fault after the ramp: recover when allowed
+  void log_event(EventKind k, Trip t) noexcept;
 
   SupervisorSettings s_;
   std::vector<ParameterSet> sets_;  // [0]: the set it starts with
@@ -221,6 +247,17 @@ class Supervisor {
   control::ControllerCounters last_limits_{};
   bool pose_known_{false};
   std::size_t pose_set_{0};  // the set the pose's region wants (pose_scheduled)
+
+  // Recovery: which trips may recover (bit per Trip), whether this fault may, its timers, the probation
+  // after the last recovery and the recoveries' times (a ring of max_recoveries, allocated at construction).
+  std::uint32_t recoverable_mask_{0};
+  bool latched_{true};
+  double fault_safe_s_{0.0}, healthy_s_{0.0};
+  double probation_until_s_{-1.0};
+  std::vector<double> recovery_times_;
+  std::size_t recovery_pos_{0};
+  std::array<SupervisorEvent, kEventLogSize> events_{};
+  std::size_t events_total_{0};
 
   std::vector<std::uint8_t> sat_window_;  // one entry per tick of the window
   std::size_t sat_pos_{0};

@@ -361,6 +361,8 @@ void Cell::finish_summary() {
   }
   s.loop = loop_->stats();
   s.supervisor = supervisor_->counters();
+  s.events.assign(supervisor_->events(), supervisor_->events() + supervisor_->events_logged());
+  s.events_total = supervisor_->events_total();
   s.spindle_rpm = supervisor_->controller().spindle_rpm();
   s.notch_centre_hz = supervisor_->controller().notches().settings().enabled ? supervisor_->controller().notches().centre_hz() : 0.0;
   s.final_state = rt::to_string(supervisor_->state());

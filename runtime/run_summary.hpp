@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "dds/bridge.hpp"
 #include "drivers/can_driver.hpp"
@@ -41,6 +42,8 @@ struct RunSummary {
   double duration_s{0.0};
   rt::LoopStats loop;
   rt::SupervisorCounters supervisor;
+  std::vector<rt::SupervisorEvent> events;  // trips, recoveries and latches with their times (the first 64)
+  std::uint64_t events_total{0};
   std::string final_state, trip, trip_description;
   std::size_t active_parameter_set{0};  // at the end (pose_schedule: the region's index)
   ArmingReport arming;

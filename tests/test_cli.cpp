@@ -863,7 +863,9 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   EXPECT_GT(jd["map_unstable_points"].get<int>(), 10);
   EXPECT_GT(jd["damped"]["map_unstable_points"].get<int>(), 0);
   for (const auto& p : jd["damped"]["map"])
-    if (!p["stable"].get<bool>()) EXPECT_NEAR(p["rpm"].get<double>(), 403.0, 10.0) << p.dump();
+    if (!p["stable"].get<bool>()) {
+      EXPECT_NEAR(p["rpm"].get<double>(), 403.0, 10.0) << p.dump();
+    }
 }
 
 }  // namespace

@@ -333,6 +333,32 @@ TEST(Config, LoopSupervisionRealtimeAndTelemetryAreValidated) {
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\n" << all;
 }
 
+TEST(Config, RecoveryIsValidatedByKeyWithItsUnitAndRange) {
+  const Config defaults = parse_config(kValid, "ok.yaml");
+  const auto& d = defaults.supervision.recovery;
+  EXPECT_EQ(d.recoverable, (std::vector<std::string>{"overruns", "sensor_stale", "sample_invalid", "sensor_driver", "actuator_driver"}));
+  EXPECT_EQ(d.max_recoveries, 3);
+  const Config v = parse_config(kValid + std::string("supervision:\n  recovery:\n    recoverable: [overruns]\n"
+                                                     "    cool_down_s: 0.5\n    max_recoveries: 5\n"),
+                                "ok.yaml");
+  EXPECT_EQ(v.supervision.recovery.recoverable, std::vector<std::string>{"overruns"});
+  EXPECT_DOUBLE_EQ(v.supervision.recovery.cool_down_s, 0.5);
+  EXPECT_EQ(v.supervision.recovery.max_recoveries, 5);
+  EXPECT_TRUE(parse_config(kValid + std::string("supervision: {recovery: {recoverable: []}}\n"), "ok.yaml")
+                  .supervision.recovery.recoverable.empty());
+  const auto p = problems_of(kValid + std::string("supervision: {recovery: {recoverable: [instability, overruns, overruns, "
+                                                  "sundial], cool_down_s: -1, max_recoveries: 2.5, window_s: 0, probaton_s: 3}}\n"));
+  std::string all;
+  for (const auto& q : p) all += q.to_string() + "\n";
+  EXPECT_EQ(p.size(), 7U) << all;
+  for (const char* expected :
+       {"supervision.recovery.recoverable[0] = 'instability' cannot recover by itself", "recoverable[2] = 'overruns' is listed twice",
+        "recoverable[3] = 'sundial' cannot recover", "supervision.recovery.cool_down_s = -1 s is out of range",
+        "supervision.recovery.max_recoveries = 2.5", "supervision.recovery.window_s = 0 s is out of range",
+        "supervision.recovery.probaton_s: unknown key"})
+    EXPECT_NE(all.find(expected), std::string::npos) << expected << "\n" << all;
+}
+
 }  // namespace
 TEST(Config, TheHilConfigurationLoadsWithEveryHardwareSection) {
   const Config c = load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_horizontal_c2.yaml");

@@ -319,7 +319,7 @@ TEST(Tune, TheTunedControllerHoldsItsDepthsInTheSimulatedCut) {
   const std::string tuned = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_tuned.yaml";
   // At 252 rpm the critical motion is the 9.4 Hz mode, which grows slowly near the limit: 300 revolutions
   // (71 s) call 0.86 mm stable, 1500 revolutions find its Hopf chatter.
-  for (const auto [rpm, revolutions] : {std::pair{252.0, 1500.0}, std::pair{672.0, 300.0}}) {
+  for (const auto& [rpm, revolutions] : {std::pair{252.0, 1500.0}, std::pair{672.0, 300.0}}) {
     double sdm = 0.0;
     const double t = limits(tuned, rpm, revolutions, &sdm);
     std::printf("%.0f rpm: tuned %.3f mm simulated, %.3f mm sampled-loop SDM\n", rpm, t, sdm);
