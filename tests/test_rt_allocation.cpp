@@ -271,10 +271,10 @@ TEST(RealTimePath, ModbusStatusAllocatesNothing) {
   bool stopped = false;
   for (int i = 0; std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(400); ++i) {
     sup.request_amplifier_enable(i % 1000 < 500);
-    faults += sup.amplifier_status().fault ? 1 : 0;
+    faults += sup.amplifier_status().link_lost ? 1 : 0;
     if (!stopped && std::chrono::steady_clock::now() - t0 > std::chrono::milliseconds(100)) {
       t_loop_thread = false;
-      server.stop();  // the link goes down: the status becomes unknown (a fault while enabled)
+      server.stop();  // the link goes down: the status becomes unknown (the link lost while enabled)
       stopped = true;
       t_loop_thread = true;
     }
