@@ -204,13 +204,18 @@ ArmRefusal Supervisor::arm_refusal(bool live) const noexcept {
 void Supervisor::recover(const TickInput& in) noexcept {
   const config::RecoveryConfig& r = s_.limits.recovery;
   fault_safe_s_ += in.dt_s;
-  const bool live = live_run_ >= static_cast<std::uint64_t>(s_.limits.arming_live_cycles);
-  // Ticks on time: no run of consecutive overruns as long as half the trip's (a lone late tick on an
-  // ordinary PC is not a burst).
-  const bool on_time = 2 * overrun_run_ < static_cast<std::uint64_t>(s_.limits.overrun_cycles);
-  const bool healthy = on_time && !in.shutdown && arm_refusal(live) == ArmRefusal::kNone;
+  const auto& l = s_.limits;
+  // Healthy: none of the sensor's trip conditions building up (a lone repeated sample, which a CAN
+  // de-jitter makes now and then, is not one), ticks on time (no run of consecutive overruns as long as
+  // half the trip's: a lone late tick on an ordinary PC is not a burst), and everything else arming asks.
+  const bool sensor_ok = in.sensor_ok && 2 * stale_run_ < static_cast<std::uint64_t>(l.stale_sensor_cycles) + 1 &&
+                         invalid_run_ == 0;
+  const bool on_time = 2 * overrun_run_ < static_cast<std::uint64_t>(l.overrun_cycles);
+  const bool healthy = sensor_ok && on_time && !in.shutdown && arm_refusal(true) == ArmRefusal::kNone;
   healthy_s_ = healthy ? healthy_s_ + in.dt_s : 0.0;
-  if (fault_safe_s_ < r.cool_down_s || healthy_s_ < r.healthy_for_s || !healthy) return;
+  if (fault_safe_s_ < r.cool_down_s || healthy_s_ < r.healthy_for_s) return;
+  // Arming itself needs a live sensor (arming_live_cycles fresh valid samples in a row).
+  if (live_run_ < static_cast<std::uint64_t>(l.arming_live_cycles)) return;
   // The budget: at most max_recoveries within window_s (the ring holds the last max_recoveries times).
   if (recovery_times_.empty() || recovery_times_[recovery_pos_] > time_s_ - r.window_s) {
     latched_ = true;
