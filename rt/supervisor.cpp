@@ -213,7 +213,7 @@ void Supervisor::recover(const TickInput& in) noexcept {
   const bool on_time = 2 * overrun_run_ < static_cast<std::uint64_t>(l.overrun_cycles);
   const bool healthy = sensor_ok && on_time && !in.shutdown && arm_refusal(true) == ArmRefusal::kNone;
   healthy_s_ = healthy ? healthy_s_ + in.dt_s : 0.0;
-  if (fault_safe_s_ < r.cool_down_s || healthy_s_ < r.healthy_for_s) return;
+  if (!healthy || fault_safe_s_ < r.cool_down_s || healthy_s_ < r.healthy_for_s) return;  // healthy_for_s may be 0
   // Arming itself needs a live sensor (arming_live_cycles fresh valid samples in a row).
   if (live_run_ < static_cast<std::uint64_t>(l.arming_live_cycles)) return;
   // The budget: at most max_recoveries within window_s (the ring holds the last max_recoveries times).
