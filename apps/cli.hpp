@@ -79,6 +79,7 @@ void register_sle(Registry& r);
 void register_cut(Registry& r);
 void register_identify(Registry& r);
 void register_measure(Registry& r);
+void register_commission(Registry& r);
 void register_pose(Registry& r);
 void register_tune(Registry& r);
 

@@ -4,11 +4,11 @@
 #include <functional>
 #include <string>
 
+#include "plot/gnuplot.hpp"
+
 namespace robodamp::apps {
 
-// Writes `data` to a temporary file, runs `script` (which refers to it as DATA) and checks that
-// gnuplot produced `png_path`. Returns an empty string on success, else the reason.
-[[nodiscard]] std::string run_gnuplot(const std::string& script, const std::string& data, const std::string& png_path);
+using plot::run_gnuplot;
 
 // A report on stdout (JSON or the table), then the plot if a target is given: plot() returns the reason it
 // failed or an empty string, and "wrote <what>" goes to stdout (stderr with JSON, to keep stdout parseable).

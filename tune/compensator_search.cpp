@@ -181,10 +181,10 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   }
 }
 
-Evaluation Evaluator::operator()(const Candidate& cand) const {
+Evaluation Evaluator::operator()(const Candidate& cand, bool constraints_only) const {
   Evaluation e;
   try {
-    e = assess(with_candidate(base_, cand));
+    e = assess(with_candidate(base_, cand), constraints_only || constraints_only_);
   } catch (const config::ConfigError&) {
     add_violation(e, 100.0, "the chain cannot realise the compensator at the loop rate");
     e.objective = -kInf;
@@ -193,7 +193,7 @@ Evaluation Evaluator::operator()(const Candidate& cand) const {
   return e;
 }
 
-Evaluation Evaluator::assess(const config::Config& cfg) const {
+Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) const {
   Evaluation e;
   e.candidate.gain_ns_per_m = cfg.controller.gain_ns_per_m;
   e.candidate.polarity = cfg.controller.polarity;
@@ -227,6 +227,7 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
                                p.slew_v_per_s / cfg.amplifier.slew_rate_v_per_s});
     add_violation(e, e.actuator_use - 1.0, "the actuator's limits at the impact");
   }
+  if (constraints_only) return e;
   if (!job_) {
     e.peak_m_per_n = closed_peak(*m, k, cand.polarity);
     e.objective = -std::log10(e.peak_m_per_n);
@@ -276,36 +277,51 @@ Evaluation Evaluator::assess(const config::Config& cfg) const {
   return e;
 }
 
-Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c) {
-  if (plants.size() == 1) {
-    Evaluation e = (*plants.front())(c);
-    e.plant = plants.front()->name();
-    return e;
-  }
+Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c,
+                          bool skip_infeasible_objective) {
   std::vector<Evaluation> per;
-  for (const Evaluator* p : plants) {
-    per.push_back((*p)(c));
-    per.back().plant = p->name();
+  if (skip_infeasible_objective) {
+    for (const Evaluator* p : plants) {
+      per.push_back((*p)(c, true));
+      per.back().plant = p->name();
+    }
+    if (std::none_of(per.begin(), per.end(), [](const Evaluation& e) { return e.violation > 0.0; })) per.clear();
   }
-  // The worst: the most violating plant, else the one with the smallest objective.
-  const auto worst = std::min_element(per.begin(), per.end(), [](const Evaluation& a, const Evaluation& b) {
-    if (a.violation != b.violation) return a.violation > b.violation;
-    return a.objective < b.objective;
-  });
-  Evaluation w = *worst;
+  if (per.empty())
+    for (const Evaluator* p : plants) {
+      per.push_back((*p)(c));
+      per.back().plant = p->name();
+    }
+  if (per.size() == 1) return per.front();
+  // The worst: the most violating plant, else the one with the smallest objective (among the plants that
+  // compute one; a constraints-only plant contributes its constraints and margins).
+  const auto full = [&](std::size_t i) { return !plants[i]->constraints_only(); };
+  std::size_t lowest = per.size();
+  for (std::size_t i = 0; i < per.size(); ++i)
+    if (full(i) && (lowest == per.size() || per[i].objective < per[lowest].objective)) lowest = i;
+  std::size_t wi = lowest == per.size() ? 0 : lowest;
+  for (std::size_t i = 0; i < per.size(); ++i)
+    if (per[i].violation > per[wi].violation) wi = i;
+  Evaluation w = per[wi];
+  if (!full(wi) && lowest != per.size()) w.objective = per[lowest].objective;
   if (!w.binding.empty()) w.binding = w.plant + ": " + w.binding;
   // Margins and depths: the smallest over the plants; peaks and shares of a limit: the largest.
-  constexpr double Evaluation::*kSmallest[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
-                                              &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
-                                              &Evaluation::min_depth_mm,    &Evaluation::depth_at_speed_mm,
-                                              &Evaluation::floor_ratio,     &Evaluation::accurate_min_mm,
-                                              &Evaluation::open_minima_ratio};
+  constexpr double Evaluation::*kMargins[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
+                                             &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m};
+  constexpr double Evaluation::*kDepths[] = {&Evaluation::min_depth_mm, &Evaluation::depth_at_speed_mm,
+                                            &Evaluation::floor_ratio, &Evaluation::accurate_min_mm,
+                                            &Evaluation::open_minima_ratio};
   constexpr double Evaluation::*kLargest[] = {&Evaluation::worst_mode_phase_deg, &Evaluation::peak_m_per_n,
                                              &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
                                              &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use};
-  for (const Evaluation& e : per) {
+  if (!full(wi) && lowest != per.size())
+    for (const auto field : kDepths) w.*field = per[lowest].*field;
+  for (std::size_t i = 0; i < per.size(); ++i) {
+    const Evaluation& e = per[i];
     w.stable = w.stable && e.stable;
-    for (const auto field : kSmallest) w.*field = std::min(w.*field, e.*field);
+    for (const auto field : kMargins) w.*field = std::min(w.*field, e.*field);
+    if (full(i))
+      for (const auto field : kDepths) w.*field = std::min(w.*field, e.*field);
     for (const auto field : kLargest) w.*field = std::max(w.*field, e.*field);
   }
   w.per_plant = std::move(per);
@@ -395,7 +411,7 @@ bool better(const Evaluation& a, const Evaluation& b) {
 
 double penalised(unsigned /*n*/, const double* x, double* /*grad*/, void* data) {
   auto& s = *static_cast<Search*>(data);
-  const Evaluation e = evaluate_worst(*s.plants, candidate_of(x, s.polarity));
+  const Evaluation e = evaluate_worst(*s.plants, candidate_of(x, s.polarity), true);
   s.result->history.push_back(e);
   if (s.result->history.size() == 1 || better(e, s.result->best)) s.result->best = e;
   ++s.count;

@@ -117,9 +117,11 @@ class Evaluator {
   Evaluator(const Evaluator&) = delete;
   Evaluator& operator=(const Evaluator&) = delete;
   Evaluator& operator=(Evaluator&&) = delete;
-  [[nodiscard]] Evaluation operator()(const Candidate& c) const;
+  // constraints_only: stop after the cheap constraints (stability, margins, the damping window, the
+  // actuator's limits), objective 0; the search uses it to skip the lobes of a candidate already infeasible.
+  [[nodiscard]] Evaluation operator()(const Candidate& c, bool constraints_only = false) const;
   // Any configuration at its own gain and polarity (C1, C2, C3 for the report).
-  [[nodiscard]] Evaluation assess(const config::Config& cfg) const;
+  [[nodiscard]] Evaluation assess(const config::Config& cfg, bool constraints_only = false) const;
   // The open loop's lobes, for reports: the minimum and the floors between neighbouring peaks.
   [[nodiscard]] double open_min_depth_mm() const { return open_min_mm_; }
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
@@ -133,6 +135,10 @@ class Evaluator {
   [[nodiscard]] std::vector<std::pair<double, double>> damped_curve_mm(const config::Config& cfg) const;
   [[nodiscard]] std::vector<ModeImprovement> mode_improvements(const config::Config& cfg) const;
   [[nodiscard]] const std::string& name() const { return name_; }
+  // A plant that only constrains the search (stability, margins, the damping window, the actuator's limits):
+  // robustness to it at a fraction of the cost; its lobes are never computed.
+  void set_constraints_only(bool on) { constraints_only_ = on; }
+  [[nodiscard]] bool constraints_only() const { return constraints_only_; }
 
  private:
   struct Impact;
@@ -148,11 +154,15 @@ class Evaluator {
   std::vector<double> floor_rpm_;                     // and the speed where it is
   std::vector<std::pair<double, double>> open_curve_; // rpm, mm (inf where no lobe reaches)
   std::vector<double> open_sdm_min_rpm_, open_sdm_min_mm_;  // the open loop's lowest SDM minima
+  bool constraints_only_{false};
 };
 
 // Several plants at once (both mountings, shifted modes): the candidate evaluated on each and the worst case
-// kept: the smallest objective and margins, the largest violation, named with its plant.
-[[nodiscard]] Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c);
+// kept: the smallest objective and margins, the largest violation, named with its plant. With
+// skip_infeasible_objective, a candidate that already violates a cheap constraint on some plant is not
+// given its lobes (objective 0): the search's order of infeasible candidates is by violation alone anyway.
+[[nodiscard]] Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c,
+                                        bool skip_infeasible_objective = false);
 
 // The configuration with every robot mode's natural frequency times `factor` at the same modal mass
 // (residues / factor, modal stiffnesses x factor^2): for robustness to modal frequency shifts.

@@ -33,6 +33,12 @@ double time_domain_mm(const config::MillingConfig& job, const milling::Structure
 
 }  // namespace
 
+double time_domain_critical_mm(const config::Config& cfg, const config::MillingConfig& job, double rpm, double guess_mm) {
+  const auto model = std::make_shared<const analysis::LoopModel>(cfg);
+  const milling::Structure open(job_structure(job), false, {model, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
+  return time_domain_mm(job, open, rpm, guess_mm);
+}
+
 bool Verification::time_domain_agrees(double tolerance) const {
   return std::abs(time_domain_at_speed_mm / depth_at_speed_mm - 1.0) <= tolerance &&
          std::abs(time_domain_at_min_mm / min_depth_mm - 1.0) <= tolerance;

@@ -28,6 +28,11 @@ struct Verification {
   [[nodiscard]] bool time_domain_agrees(double tolerance = 0.05) const;
 };
 
+// The damped cut's critical depth in time at `rpm` (the time-domain cut with the real Controller running
+// cfg's controller on cfg's plant, at least 300 revolutions), mm; guess_mm starts the bracket.
+[[nodiscard]] double time_domain_critical_mm(const config::Config& cfg, const config::MillingConfig& job, double rpm,
+                                             double guess_mm);
+
 // Throws config::ConfigError for a job or configuration that cannot be analysed.
 [[nodiscard]] Verification verify(const config::Config& cfg, const config::MillingConfig& job);
 

@@ -1,0 +1,85 @@
+// `robodamp commission`: measure, identify, tune, verify on the cell, write (commission/commission.hpp,
+// docs/identification.md "Commissioning in one command").
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+
+#include "apps/cli.hpp"
+#include "commission/commission.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+struct CommissionArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string job_path;
+  std::string out_dir;
+  std::string from{"measure"};
+  std::optional<double> shift_pct;
+  commission::CommissionSettings settings;
+};
+
+std::string command_line(const CommissionArgs& a) {
+  std::string c = "robodamp commission --config " + a.config_path + " --job " + a.job_path + " --out " + a.out_dir;
+  const tune::TuneSettings d = commission::CommissionSettings{}.tune;
+  const tune::TuneSettings& s = a.settings.tune;
+  char b[64];
+  if (a.shift_pct) std::snprintf(b, sizeof b, " --shift-pct %g", *a.shift_pct), c += b;
+  if (s.global_evaluations != d.global_evaluations) c += " --evaluations " + std::to_string(s.global_evaluations);
+  if (s.local_evaluations != d.local_evaluations) c += " --polish " + std::to_string(s.local_evaluations);
+  if (s.seed != d.seed) c += " --seed " + std::to_string(s.seed);
+  return c;
+}
+
+int run_commission(CommissionArgs& a) {
+  commission::CommissionSettings s = a.settings;
+  s.config_path = a.config_path;
+  s.job_path = a.job_path;
+  s.out_dir = a.out_dir;
+  s.shift_pct = a.shift_pct;
+  try {
+    s.from = commission::stage_from_string(a.from);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "robodamp commission: " << e.what() << '\n';
+    return 2;
+  }
+  s.command_line = command_line(a);
+  const commission::CommissionResult r = commission::commission(s, [](const std::string& l) { spdlog::info("{}", l); });
+  if (r.outcome == commission::Outcome::kVerified) {
+    std::printf("robodamp commission: VERIFIED in %.1f s: wrote %s\n", r.wall_s, r.configuration_path.c_str());
+  } else {
+    std::fprintf(stderr, "robodamp commission: stopped at the %s stage after %.1f s: %s; no configuration written\n",
+                 commission::to_string(r.stage), r.wall_s, r.reason.c_str());
+  }
+  if (!r.report_path.empty()) std::printf("robodamp commission: the report is %s\n", r.report_path.c_str());
+  return commission::exit_code(r.outcome);
+}
+
+}  // namespace
+
+void register_commission(Registry& r) {
+  auto a = std::make_shared<CommissionArgs>();
+  CLI::App* sub = r.add("commission",
+                        "Commission a cell in one command: measure, identify, tune for the job (robust over the fit's "
+                        "uncertainty), verify on the cell, write DIR/configuration.yaml and DIR/report.html",
+                        [a] { return run_commission(*a); });
+  sub->add_option("--config", a->config_path, "The cell's configuration (YAML)")->check(CLI::ExistingFile);
+  sub->add_option("--job", a->job_path, "Milling job (config/milling/*.yaml) whose structure is the cell's damping location")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sub->add_option("--out", a->out_dir, "Directory for every stage's output, configuration.yaml and report.html")->required();
+  sub->add_option("--from", a->from, "Start at this stage, reusing the earlier stages' output in --out: measure, "
+                                     "identify, tune or verify");
+  r.number(sub, "--shift-pct", a->shift_pct, {"%", 0.0, 50.0, true},
+           "Tune robust over the identified modes shifted by -/+ this (default: 3 x their spread over the FRFs, 1-10 %)");
+  r.whole_number(sub, "--evaluations", a->settings.tune.global_evaluations, {"(evaluations per polarity)", 10, 100000},
+                 "Global search budget per polarity");
+  r.whole_number(sub, "--polish", a->settings.tune.local_evaluations, {"(evaluations per polarity)", 0, 100000},
+                 "Local polish budget per polarity");
+  r.whole_number(sub, "--seed", a->settings.tune.seed, {"(seed)", 0, 999999}, "The global search's seed");
+}
+
+}  // namespace robodamp::apps

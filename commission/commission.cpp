@@ -1,0 +1,308 @@
+#include "commission/commission.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "analysis/loop_model.hpp"
+#include "commission/measurement.hpp"
+#include "commission/report.hpp"
+#include "config/milling_config.hpp"
+#include "tune/tuned_file.hpp"
+
+namespace robodamp::commission {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+template <class... A>
+std::string fmt(const char* f, A... a) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, f, a...);
+  return buf;
+}
+
+// A stop: the stage, the outcome, the reason.
+struct Stop {
+  Stage stage;
+  Outcome outcome;
+  std::string reason;
+};
+
+class Run {
+ public:
+  Run(const CommissionSettings& s, const std::function<void(const std::string&)>& progress, CommissionResult& r)
+      : s_(s), say_(progress), r_(r), dir_(s.out_dir) {}
+
+  void all() {
+    fs::create_directories(dir_);
+    std::error_code ec;
+    fs::remove(dir_ / "configuration.yaml", ec);  // only this run's verified result may stand there
+    cell_ = config::load_config_file(s_.config_path);
+    if (cell_.can) throw Stop{Stage::kMeasure, Outcome::kBadInput,
+                              "the cell is configured for hardware (can:); commission runs the simulated plant only "
+                              "for now: measure with `robodamp measure` and `robodamp plant --measure-out`, then "
+                              "`robodamp identify all` and `robodamp tune`"};
+    job_ = config::load_milling_config(s_.job_path);
+    stage(Stage::kMeasure, [this] { measure(); });
+    stage(Stage::kIdentify, [this] { identify(); });
+    stage(Stage::kTune, [this] { tune(); });
+    stage(Stage::kVerify, [this] { verify(); });
+    stage(Stage::kWrite, [this] { write(); });
+  }
+
+ private:
+  template <class F>
+  void stage(Stage st, F&& f) {
+    r_.stage = st;
+    const auto t0 = Clock::now();
+    const bool reuse = st < s_.from && st != Stage::kIdentify;  // identifying again is quick and deterministic
+    say_(std::string("commission: stage ") + std::to_string(static_cast<int>(st)) + "/5 " + to_string(st) +
+         (reuse ? " (reusing " + dir_.string() + ")" : ""));
+    reuse_ = reuse;
+    f();
+    r_.times.push_back({st, seconds_since(t0), reuse});
+    say_(fmt("commission: %s done in %.1f s", to_string(st), seconds_since(t0)));
+  }
+
+  void measure() {
+    const fs::path m = dir_ / "measurement";
+    if (!reuse_) {
+      const MeasureOutcome o = commission::measure(s_.config_path, m.string());
+      if (o.status == MeasureStatus::kTripped) throw Stop{Stage::kMeasure, Outcome::kTripped, o.message};
+      if (o.status == MeasureStatus::kConfigError) throw Stop{Stage::kMeasure, Outcome::kBadInput, o.message};
+      if (o.status != MeasureStatus::kOk) throw Stop{Stage::kMeasure, Outcome::kFailed, o.message};
+      say_(fmt("commission: measured %d of %d impact records, chirp active over %.1f %% of its ticks, peak command "
+               "%.3f V", o.impact_records, o.impact_records_planned, 100.0 * o.chirp_active_share, o.peak_command_v));
+    } else if (!fs::exists(m / identify::kManifestName)) {
+      throw Stop{Stage::kMeasure, Outcome::kBadInput,
+                 "--from " + std::string(to_string(s_.from)) + ": " + (m / identify::kManifestName).string() +
+                     " does not exist: run from measure"};
+    }
+  }
+
+  void identify() {
+    const identify::MeasurementManifest man = identify::read_manifest((dir_ / "measurement").string());
+    const auto sat = man.run.value("saturated_ticks", 0ULL);
+    if (sat > 0)
+      throw Stop{Stage::kIdentify, Outcome::kBadInput,
+                 "the chirp saturated the actuator over " + std::to_string(sat) +
+                     " ticks: the measurement is not linear; lower commissioning.chirp_force_fraction"};
+    identify::CommissioningSettings cs;
+    r_.identified = identify::identify_all((dir_ / "measurement").string(), cs);
+    const auto& id = *r_.identified;
+    std::ofstream(dir_ / "identified.yaml") << id.yaml;
+    std::ofstream(dir_ / "identified.json") << identify::to_json(id).dump(2) << '\n';
+    say_("commission: identified " + std::to_string(id.frfs.size()) + " FRFs; " +
+         fmt("actuator T %.3f N/V, %.3f Hz, zeta %.4f, delay %.3f ms", id.actuator.force_constant_n_per_v,
+             id.actuator.natural_freq_hz, id.actuator.damping_ratio, id.actuator.delay_ms));
+    for (const auto& f : id.frfs)
+      say_("commission:   " + f.name + ": " + std::to_string(f.fit.modes.size()) + " modes, " +
+           fmt("fit error %.2f %%", f.fit.fit_error_pct));
+    if (s_.shift_pct) {
+      r_.shift_pct = *s_.shift_pct;
+      r_.shift_reason = "given (--shift-pct)";
+    } else {
+      std::tie(r_.shift_pct, r_.shift_reason) = modal_uncertainty_pct(id, s_.min_shift_pct, s_.max_shift_pct);
+    }
+    say_(fmt("commission: the tune is robust over the modes shifted by +-%.2f %%: ", r_.shift_pct) + r_.shift_reason);
+  }
+
+  // The identified plant (the objective: the job's damped limits) and, as constraints only (stable, the
+  // margins, every mode damped, the actuator's limits), the same with its modes shifted down and up.
+  std::vector<tune::Evaluator> plants() const {
+    const config::Config& base = r_.identified->config;
+    std::vector<tune::Evaluator> p;
+    p.emplace_back(base, job_, s_.tune, "identified");
+    for (const double sign : {-1.0, 1.0}) {
+      p.emplace_back(tune::with_shifted_modes(base, 1.0 + sign * r_.shift_pct / 100.0), std::nullopt, s_.tune,
+                     fmt("identified, modes %+.2f %%", sign * r_.shift_pct));
+      p.back().set_constraints_only(true);
+    }
+    return p;
+  }
+
+  void tune() {
+    const std::vector<tune::Evaluator> p = plants();
+    std::vector<const tune::Evaluator*> refs;
+    for (const auto& e : p) refs.push_back(&e);
+    r_.open_curve_mm = p.front().open_curve_mm();
+    const fs::path tuned_path = dir_ / "tuned.yaml";
+    if (reuse_) {
+      if (!fs::exists(tuned_path))
+        throw Stop{Stage::kTune, Outcome::kBadInput, "--from verify: " + tuned_path.string() + " does not exist: run from tune"};
+      r_.tuned_config = config::load_config_file(tuned_path.string());
+      r_.tuned_nominal = p.front().assess(*r_.tuned_config);
+      r_.tuned = r_.tuned_nominal;
+      return;
+    }
+    const tune::TuneResult t = tune::tune(refs, s_.tune, [this](const std::string& l) { say_("commission: " + l); });
+    r_.tuned = t.best;
+    if (!t.best.feasible())
+      throw Stop{Stage::kTune, Outcome::kNotVerified, "no candidate met every constraint; the closest violates " + t.best.binding};
+    r_.tuned_nominal = t.best.per_plant.empty() ? t.best : t.best.per_plant.front();
+    const config::EditedYaml edited = tune::tuned_config_text(r_.identified->config, t.best.candidate);
+    const std::string text = "# robodamp commission tuned this (docs/identification.md) from the identified cell:\n#   " +
+                             s_.command_line + "\n#\n" + edited.text;
+    r_.tuned_config = config::parse_config(text, tuned_path.string());
+    std::ofstream(tuned_path) << text;
+    say_(fmt("commission: tuned K %.0f N s/m, polarity %+d; worst over the plants GM %.1f dB, PM %.1f deg",
+             t.best.candidate.gain_ns_per_m, t.best.candidate.polarity, t.best.gain_margin_db, t.best.phase_margin_deg));
+  }
+
+  void verify() {
+    const auto t0 = Clock::now();
+    r_.promise = tune::verify(*r_.tuned_config, job_);
+    const tune::Verification& v = *r_.promise;
+    say_(fmt("commission: promise (%s, identified model): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's "
+             "%.1f rpm; the time-domain cut there %.3f / %.3f mm (%.1f s)",
+             v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm, v.time_domain_at_min_mm,
+             v.time_domain_at_speed_mm, seconds_since(t0)));
+    if (!v.time_domain_agrees())
+      throw Stop{Stage::kVerify, Outcome::kNotVerified,
+                 "on the identified model the time-domain cut disagrees with the " + v.method + " by more than 5 %"};
+    r_.cell = check_on_cell(cell_, *r_.tuned_config, job_, v);
+    const CellCheck& c = *r_.cell;
+    for (const auto& f : c.frfs)
+      say_("commission: on the cell " + f.name +
+           fmt(": improvement %.1f %% measured, %.1f %% predicted (coherence >= %.3f)", f.measured_improvement_pct,
+               f.predicted_improvement_pct, f.coherence_min));
+    say_(fmt("commission: the damped cut on the cell (time domain, real Controller): %.3f mm at %.1f rpm (promised "
+             "%.3f mm), ", c.time_domain_at_min_mm, v.min_rpm, v.min_depth_mm) +
+         fmt("%.3f mm at %.1f rpm (promised %.3f mm)", c.time_domain_at_speed_mm, v.speed_rpm, v.depth_at_speed_mm));
+    if (const std::string f = c.failure(v); !f.empty()) throw Stop{Stage::kVerify, Outcome::kNotVerified, f};
+  }
+
+  void write() {
+    const tune::Verification& v = *r_.promise;
+    const CellCheck& c = *r_.cell;
+    std::ostringstream h;
+    h << "# robodamp commission wrote this (docs/identification.md) for the cell " << s_.config_path << " and the job "
+      << s_.job_path << ":\n#   " << s_.command_line << "\n";
+    h << fmt("# Promised (%s, identified model): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's %.1f rpm.\n",
+             v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm)
+      << fmt("# Verified on the cell: the damped cut in time %.3f mm and %.3f mm there;", c.time_domain_at_min_mm,
+             c.time_domain_at_speed_mm);
+    for (const auto& f : c.frfs)
+      h << " " << f.name << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
+                                f.predicted_improvement_pct);
+    h << "\n#\n";
+    std::ifstream in(dir_ / "tuned.yaml");
+    const std::string tuned((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string text = h.str() + tuned;
+    (void)config::parse_config(text, (dir_ / "configuration.yaml").string());
+    const fs::path tmp = dir_ / "configuration.yaml.partial";
+    {
+      std::ofstream out(tmp);
+      out << text;
+      if (!out) throw Stop{Stage::kWrite, Outcome::kFailed, "cannot write " + tmp.string()};
+    }
+    fs::rename(tmp, dir_ / "configuration.yaml");
+    r_.configuration_path = (dir_ / "configuration.yaml").string();
+  }
+
+  const CommissionSettings& s_;
+  const std::function<void(const std::string&)>& say_;
+  CommissionResult& r_;
+  fs::path dir_;
+  bool reuse_{false};
+  config::Config cell_;
+  config::MillingConfig job_;
+};
+
+}  // namespace
+
+const char* to_string(Stage s) {
+  switch (s) {
+    case Stage::kMeasure: return "measure";
+    case Stage::kIdentify: return "identify";
+    case Stage::kTune: return "tune";
+    case Stage::kVerify: return "verify";
+    case Stage::kWrite: return "write";
+  }
+  return "?";
+}
+
+Stage stage_from_string(const std::string& s) {
+  for (const Stage st : {Stage::kMeasure, Stage::kIdentify, Stage::kTune, Stage::kVerify})
+    if (s == to_string(st)) return st;
+  throw std::invalid_argument("--from = '" + s + "': allowed measure, identify, tune, verify");
+}
+
+int exit_code(Outcome o) {
+  switch (o) {
+    case Outcome::kVerified: return 0;
+    case Outcome::kBadInput: return 2;
+    case Outcome::kNotVerified: return 3;
+    case Outcome::kTripped: return 4;
+    case Outcome::kFailed: return 1;
+  }
+  return 1;
+}
+
+std::pair<double, std::string> modal_uncertainty_pct(const identify::CommissioningResult& r, double min_pct,
+                                                     double max_pct) {
+  double worst = 0.0;
+  std::string which = "every mode agrees across the FRFs";
+  if (!r.frfs.empty())
+    for (const auto& m : r.frfs.front().fit.modes) {
+      double lo = m.natural_freq_hz, hi = m.natural_freq_hz;
+      int seen = 1;
+      for (std::size_t i = 1; i < r.frfs.size(); ++i)
+        for (const auto& o : r.frfs[i].fit.modes)
+          if (std::abs(o.natural_freq_hz / m.natural_freq_hz - 1.0) < 0.05)
+            lo = std::min(lo, o.natural_freq_hz), hi = std::max(hi, o.natural_freq_hz), ++seen;
+      const double spread = (hi - lo) / m.natural_freq_hz * 100.0;
+      if (seen > 1 && spread > worst) {
+        worst = spread;
+        which = fmt("the %.3f Hz mode spreads %.3f %% over the FRFs", m.natural_freq_hz, spread);
+      }
+    }
+  const double pct = std::clamp(3.0 * worst, min_pct, max_pct);
+  return {pct, which + fmt(" (3 x the spread, within %.1f-%.1f %%)", min_pct, max_pct)};
+}
+
+CommissionResult commission(const CommissionSettings& s, const std::function<void(const std::string&)>& progress) {
+  CommissionResult r;
+  const auto t0 = Clock::now();
+  try {
+    Run(s, progress, r).all();
+    r.outcome = Outcome::kVerified;
+  } catch (const Stop& stop) {
+    r.stage = stop.stage;
+    r.outcome = stop.outcome;
+    r.reason = stop.reason;
+  } catch (const config::ConfigError& e) {
+    r.outcome = Outcome::kBadInput;
+    r.reason = e.what();
+  } catch (const std::invalid_argument& e) {
+    r.outcome = Outcome::kBadInput;
+    r.reason = e.what();
+  } catch (const std::exception& e) {
+    r.outcome = Outcome::kFailed;
+    r.reason = e.what();
+  }
+  r.wall_s = seconds_since(t0);
+  r.report_path = (fs::path(s.out_dir) / "report.html").string();
+  std::error_code ec;
+  if (fs::is_directory(s.out_dir, ec)) {
+    if (const std::string e = write_report(s, r, r.report_path); !e.empty()) {
+      progress("commission: the report: " + e);
+      r.report_path.clear();
+    }
+  } else {
+    r.report_path.clear();
+  }
+  return r;
+}
+
+}  // namespace robodamp::commission

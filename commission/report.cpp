@@ -1,0 +1,235 @@
+#include "commission/report.hpp"
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "plot/gnuplot.hpp"
+
+namespace robodamp::commission {
+
+namespace {
+
+namespace fs = std::filesystem;
+using plot::num;
+
+template <class... A>
+std::string fmt(const char* f, A... a) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, f, a...);
+  return buf;
+}
+
+std::string esc(const std::string& s) {
+  std::string o;
+  for (const char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else if (c == '"') o += "&quot;";
+    else o += c;
+  }
+  return o;
+}
+
+double deg(std::complex<double> z) { return std::arg(z) * 180.0 / M_PI; }
+
+// One plot: its PNG and its data file in dir, returned as an <img> (or the reason in the page).
+class Plots {
+ public:
+  explicit Plots(fs::path dir) : dir_(std::move(dir)) { fs::create_directories(dir_); }
+  std::string img(const std::string& name, const std::string& script, const std::string& data, const std::string& alt) {
+    const fs::path png = dir_ / (name + ".png");
+    std::ofstream(dir_ / (name + ".dat")) << data;
+    if (const std::string e = plot::run_gnuplot(script, data, png.string()); !e.empty())
+      return "<p class=bad>plot " + esc(name) + ": " + esc(e) + "</p>";
+    return "<figure><img src=\"" + plot::png_data_uri(png.string()) + "\" alt=\"" + esc(alt) +
+           "\"><figcaption>" + esc(alt) + "</figcaption></figure>\n";
+  }
+
+ private:
+  fs::path dir_;
+};
+
+std::string identified_section(const identify::CommissioningResult& id, Plots& p) {
+  std::ostringstream h;
+  h << "<h2>2. Identified structure and actuator</h2>\n<table><tr><th>FRF</th><th>mode</th><th>natural frequency (Hz)</th>"
+       "<th>damping ratio</th><th>residue (m/N)</th><th>fit error (%)</th></tr>\n";
+  for (const auto& f : id.frfs)
+    for (std::size_t k = 0; k < f.fit.modes.size(); ++k) {
+      const auto& m = f.fit.modes[k];
+      h << "<tr><td>" << esc(f.name) << "</td><td>" << k + 1 << "</td><td>" << fmt("%.4f", m.natural_freq_hz) << "</td><td>"
+        << fmt("%.4f", m.damping_ratio) << "</td><td>" << fmt("%+.4g %+.4gi", m.residue_re, m.residue_im) << "</td><td>"
+        << (k == 0 ? fmt("%.2f", f.fit.fit_error_pct) : "") << "</td></tr>\n";
+    }
+  h << "</table>\n";
+  const auto& a = id.actuator;
+  h << "<p>Actuator (Eq. 3): T " << fmt("%.4f", a.force_constant_n_per_v) << " N/V, natural frequency "
+    << fmt("%.4f", a.natural_freq_hz) << " Hz, damping ratio " << fmt("%.4f", a.damping_ratio) << ", delay "
+    << fmt("%.4f", a.delay_ms) << " ms; fit error " << fmt("%.2f", a.fit_error_pct) << " % over "
+    << fmt("%.3g-%.3g", a.band_lo_hz, a.band_hi_hz) << " Hz (" << a.points << " points, " << id.actuator_periods
+    << " chirp periods averaged).</p>\n";
+  for (const auto& f : id.frfs) {
+    std::ostringstream d;
+    for (std::size_t i = 0; i < f.data.f_hz.size(); ++i) {
+      const double fh = f.data.f_hz[i];
+      const bool in = fh >= f.fit.band_lo_hz && fh <= f.fit.band_hi_hz;
+      const std::complex<double> fit = in ? identify::fitted_receptance(f.fit, fh) : std::complex<double>(NAN, NAN);
+      d << num(fh) << ' ' << num(std::abs(f.data.h[i])) << ' ' << num(deg(f.data.h[i])) << ' ' << num(std::abs(fit)) << ' '
+        << num(deg(fit)) << '\n';
+    }
+    const std::string s =
+        "set multiplot layout 2,1 title '" + f.name + ": measured receptance and the fitted modes (fit error " +
+        fmt("%.2f", f.fit.fit_error_pct) + " %)'\nset grid\nset logscale y\nset format y '%.0e'\nset ylabel '|H| (m/N)'\n"
+        "plot DATA u 1:2 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:4 w l lw 2 lc rgb '#c0392b' t 'fitted'\n"
+        "unset logscale y\nset format y '%g'\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nset yrange [-180:180]\n"
+        "plot DATA u 1:3 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:5 w l lw 2 lc rgb '#c0392b' t 'fitted'\nunset multiplot\n";
+    h << p.img(f.name + "_fit", s, d.str(), f.name + ": measured and fitted receptance, magnitude and phase");
+    std::ostringstream g;
+    for (const auto& q : f.fit.diagram) g << num(q.freq_hz) << ' ' << q.order << ' ' << (q.stable ? 1 : 0) << '\n';
+    const std::string s2 = "set title '" + f.name + ": stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\n"
+                           "set ylabel 'model order'\nplot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 lc rgb '#7f8c8d' t 'new pole', "
+                           "DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 lc rgb '#2471a3' t 'stable pole'\n";
+    h << p.img(f.name + "_stabilisation", s2, g.str(), f.name + ": stabilisation diagram");
+  }
+  std::ostringstream d;
+  for (std::size_t i = 0; i < a.f_hz.size(); ++i)
+    d << num(a.f_hz[i]) << ' ' << num(std::abs(a.measured[i])) << ' ' << num(deg(a.measured[i])) << ' '
+      << num(std::abs(a.fitted[i])) << ' ' << num(deg(a.fitted[i])) << '\n';
+  const std::string s = "set multiplot layout 2,1 title 'Actuator force per volt: measured through the structure, and Eq. 3 fitted'\n"
+                        "set grid\nset logscale x\nset ylabel '|F/V| (N/V)'\nplot DATA u 1:2 w l lc rgb '#7f8c8d' t 'measured', "
+                        "DATA u 1:4 w l lw 2 lc rgb '#c0392b' t 'Eq. 3 fit'\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\n"
+                        "plot DATA u 1:3 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:5 w l lw 2 lc rgb '#c0392b' t 'Eq. 3 fit'\n"
+                        "unset multiplot\n";
+  h << p.img("actuator_fit", s, d.str(), "Actuator: measured and fitted force per volt");
+  return h.str();
+}
+
+std::string tuned_section(const CommissionResult& r) {
+  std::ostringstream h;
+  h << "<h2>3. Tuned controller</h2>\n<p>Robust over the identified plant and its modes shifted by &plusmn;"
+    << fmt("%.2f", r.shift_pct) << " % (" << esc(r.shift_reason) << ").</p>\n";
+  if (!r.tuned) return h.str() + "<p>Not reached.</p>\n";
+  const auto& e = *r.tuned;
+  const auto& c = e.candidate;
+  h << "<table><tr><th></th><th>identified plant</th><th>worst over the shifted plants</th></tr>\n";
+  const auto row = [&](const char* name, double a, double b, const char* f) {
+    h << "<tr><td>" << name << "</td><td>" << fmt(f, a) << "</td><td>" << fmt(f, b) << "</td></tr>\n";
+  };
+  const tune::Evaluation& n = r.tuned_nominal ? *r.tuned_nominal : e;
+  row("gain K (N s/m)", n.candidate.gain_ns_per_m, c.gain_ns_per_m, "%.0f");
+  row("gain margin (dB)", n.gain_margin_db, e.gain_margin_db, "%.2f");
+  row("phase margin (deg)", n.phase_margin_deg, e.phase_margin_deg, "%.1f");
+  row("delay margin (ms)", n.delay_margin_ms, e.delay_margin_ms, "%.2f");
+  row("largest feedback phase at a mode (deg, &lt; 90 damps)", n.worst_mode_phase_deg, e.worst_mode_phase_deg, "%.1f");
+  row("peak command at the bench impact (V)", n.peak_command_v, e.peak_command_v, "%.3f");
+  h << "</table>\n<p>Compensator (rational, unity gain at the match frequency): zero pair " << fmt("%.3f", c.fz_hz)
+    << " Hz, &zeta; " << fmt("%.3f", c.zeta_z) << "; pole pair " << fmt("%.3f", c.fp_hz) << " Hz, &zeta; "
+    << fmt("%.3f", c.zeta_p) << "; lead/lag zero " << fmt("%.3f", c.fa_hz) << " Hz, pole " << fmt("%.3f", c.fb_hz)
+    << " Hz; polarity " << fmt("%+d", c.polarity) << ". Feasible: " << (e.feasible() ? "yes" : "no, " + esc(e.binding))
+    << ".</p>\n";
+  return h.str();
+}
+
+std::string verify_section(const CommissionResult& r, Plots& p) {
+  std::ostringstream h;
+  h << "<h2>4. Verification</h2>\n";
+  if (!r.promise) return h.str() + "<p>Not reached.</p>\n";
+  const auto& v = *r.promise;
+  h << "<table><tr><th></th><th>speed (rpm)</th><th>promised (" << esc(v.method)
+    << ", identified model) (mm)</th><th>time-domain cut, identified model (mm)</th><th>time-domain cut on the cell (mm)</th></tr>\n";
+  const auto cell_min = r.cell ? fmt("%.3f", r.cell->time_domain_at_min_mm) : std::string("-");
+  const auto cell_at = r.cell ? fmt("%.3f", r.cell->time_domain_at_speed_mm) : std::string("-");
+  h << "<tr><td>damped lobes' minimum</td><td>" << fmt("%.1f", v.min_rpm) << "</td><td>" << fmt("%.3f", v.min_depth_mm)
+    << "</td><td>" << fmt("%.3f", v.time_domain_at_min_mm) << "</td><td>" << cell_min << "</td></tr>\n";
+  h << "<tr><td>the job's speed</td><td>" << fmt("%.1f", v.speed_rpm) << "</td><td>" << fmt("%.3f", v.depth_at_speed_mm)
+    << "</td><td>" << fmt("%.3f", v.time_domain_at_speed_mm) << "</td><td>" << cell_at << "</td></tr>\n";
+  h << "<tr><td>open loop's minimum (SDM)</td><td></td><td>" << fmt("%.3f", v.open_min_depth_mm) << "</td><td></td><td></td></tr></table>\n";
+  {
+    std::ostringstream d;
+    for (const auto& [rpm, mm] : r.open_curve_mm) d << num(rpm) << ' ' << num(mm) << '\n';
+    d << "\n\n";
+    for (const auto& [rpm, mm] : v.damped_curve_mm) d << num(rpm) << ' ' << num(mm) << '\n';
+    d << "\n\n" << num(v.min_rpm) << ' ' << num(v.time_domain_at_min_mm) << '\n'
+      << num(v.speed_rpm) << ' ' << num(v.time_domain_at_speed_mm) << "\n\n\n";
+    if (r.cell)
+      d << num(v.min_rpm) << ' ' << num(r.cell->time_domain_at_min_mm) << '\n'
+        << num(v.speed_rpm) << ' ' << num(r.cell->time_domain_at_speed_mm) << '\n';
+    else
+      d << "NaN NaN\n";
+    const double ymax = 3.0 * std::max(v.min_depth_mm, v.depth_at_speed_mm);
+    const std::string s = "set title 'Stability lobes of the job: open loop (SDM) and damped (" + v.method +
+                          "), identified model; the damped cut in time'\nset grid\nset xlabel 'spindle speed (rpm)'\n"
+                          "set ylabel 'limiting axial depth (mm)'\nset key top left opaque box\nset yrange [0:" + num(ymax) + "]\n"
+                          "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#7f8c8d' t 'open loop (SDM)', "
+                          "DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'damped, promised (" + v.method + ")', "
+                          "DATA index 2 u 1:2 w p pt 6 ps 2 lc rgb '#27ae60' t 'time-domain cut, identified model', "
+                          "DATA index 3 u 1:2 w p pt 7 ps 1.5 lc rgb '#c0392b' t 'time-domain cut on the cell'\n";
+    h << p.img("lobes", s, d.str(), "Stability lobes, open and damped, with the time-domain checks");
+  }
+  if (!r.cell) return h.str();
+  const auto& c = *r.cell;
+  h << "<h3>Impact tests on the cell, control off and on</h3>\n<table><tr><th>FRF</th><th>open peak (m/N at Hz)</th>"
+       "<th>closed peak (m/N at Hz)</th><th>measured improvement (%)</th><th>predicted (%)</th><th>difference (points)</th>"
+       "<th>coherence min</th></tr>\n";
+  for (const auto& f : c.frfs) {
+    const double diff = f.measured_improvement_pct - f.predicted_improvement_pct;
+    h << "<tr><td>" << esc(f.name) << "</td><td>" << fmt("%.4g at %.2f", f.open_peak_m_per_n, f.open_peak_hz) << "</td><td>"
+      << fmt("%.4g at %.2f", f.closed_peak_m_per_n, f.closed_peak_hz) << "</td><td>" << fmt("%.1f", f.measured_improvement_pct)
+      << "</td><td>" << fmt("%.1f", f.predicted_improvement_pct) << "</td><td class="
+      << (std::abs(diff) <= c.improvement_tolerance_points ? "ok" : "bad") << ">" << fmt("%+.1f", diff) << "</td><td>"
+      << fmt("%.3f", f.coherence_min) << "</td></tr>\n";
+  }
+  h << "</table>\n<p>The loop was active over " << fmt("%.1f", 100.0 * c.closed_active_share)
+    << " % of the impact tests with the tuned controller; trips: " << esc(c.open_trip) << " (off), " << esc(c.closed_trip)
+    << " (on); " << c.closed_saturated_ticks << " saturated ticks; " << fmt("%.1f", c.wall_s) << " s.</p>\n";
+  for (const auto& f : c.frfs) {
+    std::ostringstream d;
+    for (std::size_t i = 0; i < f.f_hz.size(); ++i)
+      d << num(f.f_hz[i]) << ' ' << num(f.measured_open[i]) << ' ' << num(f.measured_closed[i]) << ' '
+        << num(f.predicted_open[i]) << ' ' << num(f.predicted_closed[i]) << '\n';
+    const std::string s = "set title '" + f.name + ": receptance on the cell, control off and on, measured (impacts) and "
+                          "predicted (identified model, discrete loop)'\nset grid\nset logscale y\nset format y '%.0e'\n"
+                          "set xlabel 'frequency (Hz)'\nset ylabel '|H| (m/N)'\nset key top right\n"
+                          "plot DATA u 1:2 w l lc rgb '#95a5a6' t 'open, measured', DATA u 1:4 w l dt 2 lw 2 lc rgb '#34495e' "
+                          "t 'open, predicted', DATA u 1:3 w l lc rgb '#e59866' t 'closed, measured', DATA u 1:5 w l dt 2 lw 2 "
+                          "lc rgb '#c0392b' t 'closed, predicted'\n";
+    h << p.img(f.name + "_cell", s, d.str(), f.name + ": open and closed loop on the cell, measured and predicted");
+  }
+  return h.str();
+}
+
+}  // namespace
+
+std::string write_report(const CommissionSettings& s, const CommissionResult& r, const std::string& path) {
+  Plots p(fs::path(path).parent_path() / "plots");
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>robodamp commission: " << esc(s.config_path)
+    << "</title>\n<style>body{font-family:sans-serif;max-width:1250px;margin:auto;padding:1em}table{border-collapse:collapse;"
+       "margin:0.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}td:first-child{text-align:left}"
+       ".ok{color:#1e8449}.bad{color:#c0392b;font-weight:bold}.banner{padding:0.6em;font-size:1.2em;border-radius:4px}"
+       ".pass{background:#d5f5e3}.fail{background:#fadbd8}img{max-width:100%}code{background:#f4f4f4}</style></head><body>\n";
+  h << "<h1>robodamp commission</h1>\n<p>Cell <code>" << esc(s.config_path) << "</code>, job <code>" << esc(s.job_path)
+    << "</code>.<br>Command: <code>" << esc(s.command_line) << "</code></p>\n";
+  if (r.outcome == Outcome::kVerified)
+    h << "<p class=\"banner pass\">VERIFIED: " << esc(r.configuration_path) << " written.</p>\n";
+  else
+    h << "<p class=\"banner fail\">NOT VERIFIED: stopped at the " << to_string(r.stage) << " stage: " << esc(r.reason)
+      << ". Nothing written as configuration.yaml.</p>\n";
+  h << "<h2>1. Stages</h2>\n<table><tr><th>stage</th><th>wall time (s)</th><th></th></tr>\n";
+  for (const auto& t : r.times)
+    h << "<tr><td>" << to_string(t.stage) << "</td><td>" << fmt("%.1f", t.wall_s) << "</td><td>"
+      << (t.reused ? "reused from the directory" : "") << "</td></tr>\n";
+  h << "<tr><td>total</td><td>" << fmt("%.1f", r.wall_s) << "</td><td></td></tr></table>\n";
+  if (r.identified) h << identified_section(*r.identified, p);
+  h << tuned_section(r) << verify_section(r, p) << "</body></html>\n";
+  std::ofstream out(path);
+  out << h.str();
+  if (!out) return "cannot write " + path;
+  return {};
+}
+
+}  // namespace robodamp::commission
