@@ -31,14 +31,13 @@ std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit
                        const std::string& prefix) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
+  // The fit over the whole band it was made for (not only the sub-bands' cores), at full precision.
   std::ostringstream data;
-  std::size_t j = 0;
   for (std::size_t i = 0; i < d.f_hz.size(); ++i) {
-    while (j < fit.fitted_f_hz.size() && fit.fitted_f_hz[j] < d.f_hz[i]) ++j;
-    const bool in = j < fit.fitted_f_hz.size() && fit.fitted_f_hz[j] == d.f_hz[i];
-    data << d.f_hz[i] << ' ' << std::abs(d.h[i]) << ' ' << std::arg(d.h[i]) * 180.0 / M_PI << ' '
-         << (in ? std::to_string(std::abs(fit.fitted[j])) : "NaN") << ' '
-         << (in ? std::to_string(std::arg(fit.fitted[j]) * 180.0 / M_PI) : "NaN") << '\n';
+    const bool in = d.f_hz[i] >= fit.band_lo_hz && d.f_hz[i] <= fit.band_hi_hz;
+    const std::complex<double> h = in ? identify::fitted_receptance(fit, d.f_hz[i]) : std::complex<double>(NAN, NAN);
+    data << plot::num(d.f_hz[i]) << ' ' << plot::num(std::abs(d.h[i])) << ' ' << plot::num(std::arg(d.h[i]) * 180.0 / M_PI)
+         << ' ' << plot::num(std::abs(h)) << ' ' << plot::num(std::arg(h) * 180.0 / M_PI) << '\n';
   }
   std::ostringstream s;
   s << "set multiplot layout 2,1 title 'Measured and fitted receptance (fit error " << fit.fit_error_pct << " %)'\n"
@@ -47,7 +46,7 @@ std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit
     << "plot DATA u 1:3 w l t 'measured', DATA u 1:5 w l lw 2 t 'fit'\nunset multiplot\n";
   if (auto e = run_gnuplot(s.str(), data.str(), dir + "/" + prefix + "_fit.png"); !e.empty()) return e;
   std::ostringstream diag;
-  for (const auto& p : fit.diagram) diag << p.freq_hz << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
+  for (const auto& p : fit.diagram) diag << plot::num(p.freq_hz) << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
   const std::string s2 = "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
                          "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
   return run_gnuplot(s2, diag.str(), dir + "/" + prefix + "_stabilisation.png");

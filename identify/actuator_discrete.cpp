@@ -17,6 +17,7 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 constexpr std::size_t kMaxPoints = 160;  // the points matched (evenly thinned from the continuous fit's)
+constexpr int kIntervalsBelow = 8;       // sample intervals tried below the continuous fit's delay
 
 // x = (T, fn, 10 zeta, u); the delay lies in one sample interval [n, n + 1) periods, u placing it there.
 // The sampled response jumps where the delay crosses a sample instant (the feedthrough part is sampled
@@ -88,14 +89,16 @@ ActuatorFit refine_actuator_discrete(const ActuatorFit& start, const analysis::F
     if (j == accel_per_volt.f_hz.size()) break;
     f.push_back(accel_per_volt.f_hz[j]), measured.push_back(accel_per_volt.h1[j]);
   }
-  // The interval the continuous fit's delay falls in, the one before (it reads up to half a period
-  // short) and the one after.
+  // Every interval from no delay up to the one after the continuous fit's: that fit trades its delay
+  // against the resonance's frequency and damping and reads it up to several periods long (a true 0.45 ms
+  // came out as 0.88 ms), and within one interval the fit runs to the interval's edge when the true delay
+  // lies in another.
   const double period_s = 1.0 / structure.loop.rate_hz;
   const int n0 = static_cast<int>(std::floor(start.delay_ms * 1e-3 / period_s));
   Eigen::VectorXd best;
   int best_n = 0;
   double best_norm = INFINITY;
-  for (int n = std::max(0, n0 - 1); n <= n0 + 1; ++n) {
+  for (int n = std::max(0, n0 - kIntervalsBelow); n <= n0 + 1; ++n) {
     Residual fn{&structure, n, &f, &measured};
     Eigen::VectorXd x(4);
     x << start.force_constant_n_per_v, start.natural_freq_hz, start.damping_ratio * 1e1, 0.5 * M_PI;

@@ -402,10 +402,12 @@ TEST(Tune, TheTunedFileReadsBackFromEveryPresetInEveryStyle) {
       EXPECT_EQ(got.actuator.delay_s, base.actuator.delay_s);
       EXPECT_EQ(got.controller.match_freq_hz, base.controller.match_freq_hz);
       EXPECT_EQ(got.controller.gain_ramp_s, base.controller.gain_ramp_s);
-      if (std::string(style) == "as written")
+      if (std::string(style) == "as written") {
         for (const char* comment : {"# Published parameters", "# Eq. 15"})
-          if (original.find(comment) != std::string::npos)
+          if (original.find(comment) != std::string::npos) {
             EXPECT_NE(out.text.find(comment), std::string::npos) << name << ": " << comment;
+          }
+      }
       ++files;
     }
   }

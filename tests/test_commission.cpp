@@ -1,0 +1,244 @@
+// robodamp commission (commission/commission.hpp): a synthetic robot no preset describes commissioned end to
+// end on the simulated plant and verified on the running cell; bad input stopped at its stage with the
+// reason and nothing written as configuration.yaml; the report's plotted data checked.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "commission/commission.hpp"
+#include "commission/measurement.hpp"
+#include "identify/modal_fit.hpp"
+#include "test_util.hpp"
+#include "tune/compensator_search.hpp"
+
+namespace robodamp {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string cell(const std::string& name) {
+  return std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_" + name + ".yaml";
+}
+std::string job(const std::string& name) {
+  return std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_" + name + ".yaml";
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("robodamp_commission_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+commission::CommissionSettings settings(const std::string& robot, const fs::path& dir) {
+  commission::CommissionSettings s;
+  s.config_path = cell(robot);
+  s.job_path = job(robot);
+  s.out_dir = dir.string();
+  s.command_line = "test";
+  return s;
+}
+
+std::vector<std::string> lines;
+const auto collect = [](const std::string& l) { lines.push_back(l); };
+
+// The rows of a plot's data file: numbers per column ("NaN" kept as NaN).
+std::vector<std::vector<double>> rows_of(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::vector<double>> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    std::vector<double> r;
+    std::string w;
+    while (ss >> w) r.push_back(w == "NaN" ? NAN : std::stod(w));
+    if (!r.empty()) out.push_back(r);
+  }
+  return out;
+}
+
+TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCell) {
+  const fs::path dir = fresh_dir("a");
+  commission::CommissionSettings s = settings("a_two_modes", dir);
+  s.tune.global_evaluations = 40;  // a short search: the test is the chain, not the optimum
+  s.tune.local_evaluations = 20;
+  const commission::CommissionResult r = commission::commission(s, collect);
+  ASSERT_EQ(r.outcome, commission::Outcome::kVerified) << commission::to_string(r.stage) << ": " << r.reason;
+  // Identified within 1 % of the robot's true modes (5.5 and 16 Hz) and its actuator's delay (0.45 ms).
+  ASSERT_TRUE(r.identified);
+  ASSERT_EQ(r.identified->frfs.front().fit.modes.size(), 2u);
+  EXPECT_NEAR(r.identified->frfs.front().fit.modes[0].natural_freq_hz, 5.5, 0.055);
+  EXPECT_NEAR(r.identified->frfs.front().fit.modes[1].natural_freq_hz, 16.0, 0.16);
+  // Verified on the cell: every FRF's improvement within 5 points of its prediction, and the damped cut in
+  // time on the cell at least the promise less 5 % at the lobes' minimum and the job's speed.
+  ASSERT_TRUE(r.cell && r.promise);
+  for (const auto& f : r.cell->frfs) {
+    EXPECT_NEAR(f.measured_improvement_pct, f.predicted_improvement_pct, 5.0) << f.name;
+    EXPECT_GT(f.predicted_improvement_pct, 10.0) << f.name;
+  }
+  EXPECT_GE(r.cell->time_domain_at_min_mm, 0.95 * r.promise->min_depth_mm);
+  EXPECT_GE(r.cell->time_domain_at_speed_mm, 0.95 * r.promise->depth_at_speed_mm);
+  EXPECT_GT(r.promise->min_depth_mm, r.promise->open_min_depth_mm);
+  // The written configuration reads back with the tuned controller and says what verified it.
+  const config::Config written = config::load_config_file((dir / "configuration.yaml").string());
+  EXPECT_EQ(written.controller.gain_ns_per_m, r.tuned_config->controller.gain_ns_per_m);
+  const std::string text = test::read_file((dir / "configuration.yaml").string());
+  EXPECT_NE(text.find("Verified on the cell"), std::string::npos);
+  // The report: self-contained (every plot inlined), verified, and its plotted data are the computed series.
+  const std::string html = test::read_file(r.report_path);
+  EXPECT_NE(html.find("VERIFIED"), std::string::npos);
+  std::size_t images = 0;
+  for (std::size_t p = html.find("data:image/png;base64,"); p != std::string::npos;
+       p = html.find("data:image/png;base64,", p + 1))
+    ++images;
+  EXPECT_EQ(images, 3u * 3u + 2u);  // per FRF: fit, stabilisation, cell; the actuator; the lobes
+  const auto& f0 = r.identified->frfs.front();
+  const auto fit_rows = rows_of(dir / "plots" / (f0.name + "_fit.dat"));
+  ASSERT_EQ(fit_rows.size(), f0.data.f_hz.size());
+  std::size_t in_band = 0;
+  for (const auto& row : fit_rows) {
+    if (row[0] < f0.fit.band_lo_hz || row[0] > f0.fit.band_hi_hz) continue;
+    ++in_band;
+    const double expected = std::abs(identify::fitted_receptance(f0.fit, row[0]));
+    ASSERT_TRUE(std::isfinite(row[3])) << row[0] << " Hz: the fit is drawn over the whole band";
+    ASSERT_NEAR(row[3], expected, 1e-4 * expected) << row[0] << " Hz";
+  }
+  EXPECT_GT(in_band, 1000u);
+  const auto lobe_rows = rows_of(dir / "plots" / "lobes.dat");
+  EXPECT_GT(lobe_rows.size(), r.promise->damped_curve_mm.size());
+  fs::remove_all(dir);
+}
+
+TEST(Commission, BadMeasurementsStopAtTheirStageWithTheReasonAndWriteNoConfiguration) {
+  const fs::path dir = fresh_dir("bad");
+  const commission::MeasureOutcome m = commission::measure(cell("a_two_modes"), (dir / "measurement").string());
+  ASSERT_EQ(m.status, commission::MeasureStatus::kOk) << m.message;
+  std::ofstream(dir / "configuration.yaml") << "# left from an earlier run\n";
+  commission::CommissionSettings s = settings("a_two_modes", dir);
+  s.from = commission::Stage::kIdentify;
+  const fs::path frf = dir / "measurement" / "frf_1_1.csv";
+  const std::string good = test::read_file(frf.string());
+
+  // NaN in an FRF.
+  {
+    std::string bad = good;
+    const auto line = bad.find('\n', bad.find('\n', bad.find('\n') + 1) + 1);
+    const auto comma = bad.find(',', line + 1);
+    bad.replace(line + 1, comma - line - 1, "nan");
+    std::ofstream(frf) << bad;
+    const auto r = commission::commission(s, collect);
+    EXPECT_EQ(r.outcome, commission::Outcome::kBadInput);
+    EXPECT_EQ(r.stage, commission::Stage::kIdentify);
+    EXPECT_NE(r.reason.find("frf_1_1.csv"), std::string::npos) << r.reason;
+    EXPECT_FALSE(fs::exists(dir / "configuration.yaml"));
+    EXPECT_NE(test::read_file(r.report_path).find("NOT VERIFIED"), std::string::npos);
+  }
+  // No coherence: every bin below the fit's threshold.
+  {
+    std::istringstream in(good);
+    std::ostringstream out;
+    std::string line;
+    bool header = true;
+    while (std::getline(in, line)) {
+      if (header || line.empty() || line[0] == '#') {
+        out << line << '\n';
+        header = header && (line.empty() || line[0] == '#' || line.find("freq") != std::string::npos);
+        continue;
+      }
+      out << line.substr(0, line.rfind(',')) << ",0.05\n";
+    }
+    std::ofstream(frf) << out.str();
+    const auto r = commission::commission(s, collect);
+    EXPECT_EQ(r.outcome, commission::Outcome::kBadInput) << r.reason;
+    EXPECT_EQ(r.stage, commission::Stage::kIdentify);
+    EXPECT_NE(r.reason.find("coheren"), std::string::npos) << r.reason;
+    EXPECT_FALSE(fs::exists(dir / "configuration.yaml"));
+  }
+  std::ofstream(frf) << good;
+  // A chirp that saturated the actuator (as the measurement's own record says).
+  {
+    const fs::path man = dir / "measurement" / "measurement.json";
+    const std::string j = test::read_file(man.string());
+    std::string bad = j;
+    const auto p = bad.find("\"saturated_ticks\": 0");
+    ASSERT_NE(p, std::string::npos);
+    bad.replace(p, 20, "\"saturated_ticks\": 250");
+    std::ofstream(man) << bad;
+    const auto r = commission::commission(s, collect);
+    EXPECT_EQ(r.outcome, commission::Outcome::kBadInput);
+    EXPECT_EQ(r.stage, commission::Stage::kIdentify);
+    EXPECT_NE(r.reason.find("saturated"), std::string::npos) << r.reason;
+    std::ofstream(man) << j;
+  }
+  // Resuming from a stage whose input is missing.
+  {
+    s.from = commission::Stage::kVerify;
+    const auto r = commission::commission(s, collect);
+    EXPECT_EQ(r.outcome, commission::Outcome::kBadInput);
+    EXPECT_EQ(r.stage, commission::Stage::kTune);
+    EXPECT_NE(r.reason.find("tuned.yaml"), std::string::npos) << r.reason;
+  }
+  // A missing job file.
+  {
+    s.from = commission::Stage::kMeasure;
+    s.job_path = (dir / "no_such_job.yaml").string();
+    const auto r = commission::commission(s, collect);
+    EXPECT_EQ(r.outcome, commission::Outcome::kBadInput);
+    EXPECT_NE(r.reason.find("no_such_job.yaml"), std::string::npos) << r.reason;
+    EXPECT_FALSE(fs::exists(dir / "configuration.yaml"));
+  }
+  EXPECT_THROW((void)commission::stage_from_string("write"), std::invalid_argument);
+  fs::remove_all(dir);
+}
+
+TEST(Commission, TheRobustShiftFollowsTheFitsSpreadWithinItsBounds) {
+  identify::CommissioningResult r;
+  identify::IdentifiedFrf a, b;
+  a.fit.modes = {{10.0, 0.02, 0, 0, 0}, {20.0, 0.02, 0, 0, 0}};
+  b.fit.modes = {{10.05, 0.02, 0, 0, 0}, {20.0, 0.02, 0, 0, 0}};
+  r.frfs = {a, b};
+  const auto [pct, why] = commission::modal_uncertainty_pct(r, 1.0, 10.0);
+  EXPECT_NEAR(pct, 1.5, 1e-9);  // 3 x the 0.5 % spread of the 10 Hz mode
+  EXPECT_NE(why.find("10.000 Hz"), std::string::npos) << why;
+  r.frfs[1].fit.modes[0].natural_freq_hz = 10.0;
+  EXPECT_NEAR(commission::modal_uncertainty_pct(r, 1.0, 10.0).first, 1.0, 1e-9);  // the floor
+}
+
+TEST(Tune, AConstraintsOnlyPlantBindsItsConstraintsAndLeavesTheObjectiveToTheFullPlant) {
+  const config::Config base = config::load_config_file(cell("a_two_modes"));
+  const config::MillingConfig j = config::load_milling_config(job("a_two_modes"));
+  tune::TuneSettings s;
+  const tune::Evaluator full(base, j, s, "nominal");
+  tune::Evaluator shifted(tune::with_shifted_modes(base, 1.3), std::nullopt, s, "shifted");
+  shifted.set_constraints_only(true);
+  tune::Candidate c;
+  c.gain_ns_per_m = 300.0;
+  c.fz_hz = base.actuator.natural_freq_hz, c.zeta_z = base.actuator.damping_ratio;
+  c.fp_hz = 0.5, c.zeta_p = 1.0, c.fa_hz = 10.0, c.fb_hz = 10.0;
+  for (const int pol : {1, -1}) {
+    c.polarity = pol;
+    const tune::Evaluation alone = full(c);
+    const tune::Evaluation both = tune::evaluate_worst({&full, &shifted}, c);
+    const tune::Evaluation sh = shifted(c);
+    EXPECT_EQ(sh.min_depth_mm, 0.0);  // no lobes computed
+    if (sh.violation > alone.violation) {
+      EXPECT_EQ(both.plant, "shifted");
+      EXPECT_EQ(both.violation, sh.violation);
+    }
+    if (alone.feasible() && sh.feasible()) {
+      EXPECT_EQ(both.objective, alone.objective);
+      EXPECT_EQ(both.accurate_min_mm, alone.accurate_min_mm);
+    }
+    EXPECT_LE(both.gain_margin_db, std::min(alone.gain_margin_db, sh.gain_margin_db));
+  }
+}
+
+}  // namespace
+}  // namespace robodamp
