@@ -57,7 +57,7 @@ namespace {
 int run_modes(const IdentifyArgs& a) {
   identify::ModalFitSettings s;
   if (a.band_hz.size() == 2) s.band_lo_hz = a.band_hz[0], s.band_hi_hz = a.band_hz[1];
-  s.max_order = a.max_order;
+  s.max_order = a.max_order.value_or(40);
   identify::FrfData d;
   identify::ModalFit fit;
   try {
@@ -185,7 +185,7 @@ void register_identify(Registry& r) {
   r.number(sub, "--overlap", a->overlap, {"(fraction)", 0.0, 0.9, false, false}, "modes: Welch segment overlap for --series");
   sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes, actuator: fit band LO HI (default: the whole FRF; actuator: the chirp within analysis.band)");
-  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes, all: highest order of the stabilisation diagram (even)");
+  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes, all: highest order of the stabilisation diagram (even; default 40 for modes, 60 for all: a close pair common to several FRFs separates slowly with the order)");
   sub->add_option("--plot-dir", a->plot_dir, "modes, all: write the fits and the stabilisation diagrams (PNG) here");
   sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
       ->check(CLI::ExistingFile);

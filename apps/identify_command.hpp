@@ -3,6 +3,7 @@
 // apps/identify_ball_end.cpp: `identify cutting --ball-end`).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ struct IdentifyArgs {
   std::string series_path, response{"acceleration"};
   double segment_s{10.0}, overlap{0.5};
   std::vector<double> band_hz;
-  int max_order{40};
+  std::optional<int> max_order;  // default: 40 for one FRF, CommissioningSettings{}.max_order for all
   // cutting, ball end (slot milling)
   bool ball_end{false};
   double helix_deg{30.0};

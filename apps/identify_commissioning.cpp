@@ -82,7 +82,7 @@ int run_identify_actuator(const IdentifyArgs& a) {
       mounting = config::to_string(m.config.actuator.mounting);
       identify::ModalFitSettings ms;
       ms.band_lo_hz = m.config.analysis.band_min_hz, ms.band_hi_hz = m.config.analysis.band_max_hz;
-      ms.max_order = a.max_order;
+      ms.max_order = a.max_order.value_or(40);
       const identify::ModalFit structure = identify::fit_modes(identify::read_frf_csv(a.structure_path, kind_of(a.kind)), ms);
       const double lo = a.band_hz.size() == 2 ? a.band_hz[0] : 0.0, hi = a.band_hz.size() == 2 ? a.band_hz[1] : 0.0;
       fit = identify::identify_actuator(m, identify::with_collocated_structure(m.config, structure), lo, hi,
@@ -128,7 +128,7 @@ int run_identify_all(const IdentifyArgs& a) {
     return 2;
   }
   identify::CommissioningSettings s;
-  s.max_order = a.max_order;
+  if (a.max_order) s.max_order = *a.max_order;
   identify::CommissioningResult r;
   try {
     r = identify::identify_all(a.in_dir, s);

@@ -1,5 +1,7 @@
 #include "identify/commissioning.hpp"
 
+#include "identify/common_pole_fit.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -34,7 +36,7 @@ std::string frf_name(const config::Config& cfg, int g, int h) {
 
 // The robot's FRFs: one per pair of locations (the lower triangle; the upper follows by reciprocity).
 std::vector<IdentifiedFrf> fit_frfs(const std::string& dir, const MeasurementManifest& m, const config::Config& cfg,
-                                    const CommissioningSettings& s) {
+                                    const CommissioningSettings& s, std::string& pole_fit) {
   std::vector<IdentifiedFrf> out;
   ModalFitSettings ms;
   ms.band_lo_hz = cfg.analysis.band_min_hz, ms.band_hi_hz = cfg.analysis.band_max_hz;
@@ -50,12 +52,26 @@ std::vector<IdentifiedFrf> fit_frfs(const std::string& dir, const MeasurementMan
         throw std::invalid_argument(path + " is missing: the plant side of robodamp measure writes it (the simulated "
                                     "plant in process, or robodamp plant --measure-out " + dir + " with hardware)");
       f.data = read_frf_csv(path, FrfKind::kReceptance);
-      try {
-        f.fit = fit_modes(f.data, ms);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(f.file + " (" + f.name + "): " + e.what());
-      }
       out.push_back(std::move(f));
+    }
+  }
+  // The poles common to all of them (a close pair one FRF shows as one peak is apart in another), each
+  // FRF's residues its own; one by one when the band is too wide for one common fit.
+  std::vector<FrfData> data;
+  for (const auto& f : out) data.push_back(f.data);
+  try {
+    const std::vector<ModalFit> fits = fit_modes_common(data, ms);
+    for (std::size_t i = 0; i < out.size(); ++i) out[i].fit = fits[i];
+    pole_fit = "common poles over " + std::to_string(out.size()) + " FRFs";
+    return out;
+  } catch (const std::invalid_argument&) {
+    pole_fit = "poles per FRF";
+  }
+  for (auto& f : out) {
+    try {
+      f.fit = fit_modes(f.data, ms);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(f.file + " (" + f.name + "): " + e.what());
     }
   }
   return out;
@@ -281,7 +297,7 @@ CommissioningResult identify_all(const std::string& dir, const CommissioningSett
   CommissioningResult r;
   r.manifest = read_manifest(dir);
   const config::Config measured = config::parse_config(r.manifest.config_text, r.manifest.config_source);
-  r.frfs = fit_frfs(dir, r.manifest, measured, s);
+  r.frfs = fit_frfs(dir, r.manifest, measured, s, r.pole_fit);
 
   // The structure between the actuator and the sensor: the dominant mode, and the path the chirp
   // went through.
@@ -328,7 +344,7 @@ json to_json(const CommissioningResult& r) {
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   json imp = json::object();
   for (const auto& [name, pct] : r.improvements_pct) imp[name] = pct;
-  return {{"frfs", frfs},
+  return {{"frfs", frfs}, {"pole_fit", r.pole_fit},
           {"actuator",
            {{"mounting", config::to_string(r.config.actuator.mounting)},
             {"force_constant_n_per_v", r.actuator.force_constant_n_per_v},
@@ -353,6 +369,7 @@ json to_json(const CommissioningResult& r) {
 std::string summary_text(const CommissioningResult& r) {
   std::ostringstream os;
   char b[256];
+  os << "  modes: " << r.pole_fit << "\n";
   for (const auto& f : r.frfs) {
     std::snprintf(b, sizeof b, "  %s (%s): %zu modes, fit error %.2f %% over %.1f-%.1f Hz\n", f.name.c_str(), f.file.c_str(),
                   f.fit.modes.size(), f.fit.fit_error_pct, f.fit.band_lo_hz, f.fit.band_hi_hz);

@@ -73,7 +73,7 @@ struct IdentifiedFrf {
 };
 
 struct CommissioningSettings {
-  int max_order{40};
+  int max_order{60};  // the common-pole fit: a close pair 2 % apart settles from about order 50
   double min_coherence{0.8};        // modal fits
   double actuator_min_coherence{0.9};
 };
@@ -81,6 +81,7 @@ struct CommissioningSettings {
 struct CommissioningResult {
   MeasurementManifest manifest;
   std::vector<IdentifiedFrf> frfs;
+  std::string pole_fit;                // "common poles over N FRFs" or "poles per FRF"
   ActuatorFit actuator;
   int actuator_periods{0};             // chirp periods averaged
   double dominant_mode_hz{0.0};

@@ -13,23 +13,17 @@
 #include <unsupported/Eigen/NumericalDiff>
 
 #include "analysis/spectral.hpp"
+#include "identify/modal_fit_detail.hpp"
 #include "identify/numeric_csv.hpp"
 
 namespace robodamp::identify {
 
-namespace {
+namespace detail {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 // The refinement's relative error counts |H| as at least this fraction of the band's peak: at a deep
 // antiresonance an H1 estimate's relative error is large (low coherence, leakage of the drive
 // vibration), and a pure relative weight would let those few points pull every residue.
 constexpr double kAntiresonanceFloor = 0.05;
-
-struct Pole {
-  Complex s;  // rad/s
-  [[nodiscard]] double freq_hz() const { return std::abs(s) / kTwoPi; }
-  [[nodiscard]] double damping() const { return -s.real() / std::abs(s); }
-};
 
 // LSCF at one order: the common denominator A(W) = sum a_j W^j (a_p = 1) with W = e^{-i w dt}, fitted with
 // the numerator by linear least squares on B(W_k) - H_k A(W_k) = 0; the poles are A's roots.
@@ -76,7 +70,7 @@ std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Com
 // weight_floor > 0: each row divided by max(|H|, weight_floor) (relative error, for wide bands whose
 // magnitude spans decades); 0: absolute error.
 void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std::vector<Pole>& poles, ModalFit& fit,
-          double weight_floor = 0.0) {
+          double weight_floor) {
   const auto k = static_cast<Eigen::Index>(f.size()), m = static_cast<Eigen::Index>(poles.size());
   const Eigen::Index unknowns = 2 * m + 4;
   Eigen::MatrixXd a(2 * k, unknowns);
@@ -226,19 +220,29 @@ void refine(const std::vector<double>& f, const std::vector<Complex>& h, ModalFi
   fit.fit_error_pct = 100.0 * std::sqrt(err / ref);
 }
 
-// One band: LSCF poles over the stabilisation diagram, LSFD residues, the refinement.
-ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, const ModalFitSettings& s) {
-  ModalFit fit;
-  fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
-  const double dt = 1.0 / (2.0 * f.back());
+void usable_points(const FrfData& d, const ModalFitSettings& s, std::vector<double>& f, std::vector<Complex>& h) {
+  if (d.f_hz.size() != d.h.size() || (!d.coherence.empty() && d.coherence.size() != d.h.size()))
+    throw std::invalid_argument("the FRF's columns have different lengths");
+  for (std::size_t i = 0; i < d.h.size(); ++i) {
+    if (!std::isfinite(d.f_hz[i]) || !std::isfinite(d.h[i].real()) || !std::isfinite(d.h[i].imag()))
+      throw std::invalid_argument("row " + std::to_string(i + 1) + ": a value is not a finite number");
+    const bool in_band = (s.band_hi_hz <= 0.0) || (d.f_hz[i] >= s.band_lo_hz && d.f_hz[i] <= s.band_hi_hz);
+    const bool coherent = d.coherence.empty() || d.coherence[i] >= s.min_coherence;
+    if (in_band && coherent && d.f_hz[i] > 0.0) f.push_back(d.f_hz[i]), h.push_back(d.h[i]);
+  }
+  if (f.size() < 20)
+    throw std::invalid_argument("too few coherent points in the band: " + std::to_string(f.size()) +
+                                " (at least 20 with coherence >= " + std::to_string(s.min_coherence) + ")");
+}
+
+std::vector<Pole> stable_poles(const std::function<std::vector<Pole>(int)>& poles_at_order, const ModalFitSettings& s,
+                               std::vector<StabilisationPoint>& diagram) {
   // The stabilisation diagram: a pole is stable when the order below has one close to it in frequency and
   // damping; the chain of such orders counts how long it has stayed.
-  std::vector<Pole> previous;
-  std::vector<int> previous_chain;
-  std::vector<Pole> last;
-  std::vector<int> last_chain;
+  std::vector<Pole> previous, last;
+  std::vector<int> previous_chain, last_chain;
   for (int p = 2; p <= s.max_order; p += 2) {
-    const std::vector<Pole> poles = lscf_poles(f, h, p, dt, fit.band_lo_hz, fit.band_hi_hz);
+    const std::vector<Pole> poles = poles_at_order(p);
     std::vector<int> chain(poles.size(), 0);
     for (std::size_t i = 0; i < poles.size(); ++i) {
       for (std::size_t j = 0; j < previous.size(); ++j) {
@@ -246,7 +250,7 @@ ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, c
         const double dz = std::abs(poles[i].damping() - previous[j].damping()) / std::max(poles[i].damping(), 1e-6);
         if (df < s.stable_freq && dz < s.stable_damping) chain[i] = std::max(chain[i], previous_chain[j] + 1);
       }
-      fit.diagram.push_back({p, poles[i].freq_hz(), poles[i].damping(), chain[i] > 0});
+      diagram.push_back({p, poles[i].freq_hz(), poles[i].damping(), chain[i] > 0});
     }
     previous = poles, previous_chain = chain;
     last = poles, last_chain = chain;
@@ -260,6 +264,16 @@ ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, c
   if (chosen.empty())
     throw std::invalid_argument("no pole stays put over " + std::to_string(s.stable_orders) +
                                 " orders in the band: raise the maximum order, widen the band or check the data");
+  return chosen;
+}
+
+// One band: LSCF poles over the stabilisation diagram, LSFD residues, the refinement.
+ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, const ModalFitSettings& s) {
+  ModalFit fit;
+  fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
+  const double dt = 1.0 / (2.0 * f.back());
+  const std::vector<Pole> chosen =
+      stable_poles([&](int p) { return lscf_poles(f, h, p, dt, fit.band_lo_hz, fit.band_hi_hz); }, s, fit.diagram);
   lsfd(f, h, chosen, fit);
   refine(f, h, fit);
   return fit;
@@ -336,7 +350,9 @@ ModalFit fit_wide_band(const std::vector<double>& f, const std::vector<Complex>&
   return fit;
 }
 
-}  // namespace
+}  // namespace detail
+
+using namespace detail;
 
 Complex fitted_receptance(const ModalFit& fit, double f_hz) {
   return model_at(f_hz, fit.modes, fit.lower_residual, fit.upper_residual);
@@ -349,16 +365,7 @@ ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
     throw std::invalid_argument("max order = " + std::to_string(s.max_order) + ": allowed an even 4 <= value <= 200");
   std::vector<double> f;
   std::vector<Complex> h;
-  for (std::size_t i = 0; i < d.h.size(); ++i) {
-    if (!std::isfinite(d.f_hz[i]) || !std::isfinite(d.h[i].real()) || !std::isfinite(d.h[i].imag()))
-      throw std::invalid_argument("row " + std::to_string(i + 1) + ": a value is not a finite number");
-    const bool in_band = (s.band_hi_hz <= 0.0) || (d.f_hz[i] >= s.band_lo_hz && d.f_hz[i] <= s.band_hi_hz);
-    const bool coherent = d.coherence.empty() || d.coherence[i] >= s.min_coherence;
-    if (in_band && coherent && d.f_hz[i] > 0.0) f.push_back(d.f_hz[i]), h.push_back(d.h[i]);
-  }
-  if (f.size() < 20)
-    throw std::invalid_argument("too few coherent points in the band: " + std::to_string(f.size()) +
-                                " (at least 20 with coherence >= " + std::to_string(s.min_coherence) + ")");
+  usable_points(d, s, f, h);
   if (f.back() / f.front() > s.wide_band_ratio) return fit_wide_band(f, h, s);
   return fit_band(f, h, s);
 }
