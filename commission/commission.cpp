@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -78,6 +79,11 @@ class Run {
     const fs::path m = dir_ / "measurement";
     if (!reuse_) {
       const MeasureOutcome o = commission::measure(s_.config_path, m.string());
+      // The measurement turns SIGINT / SIGTERM into a trip of its loop; the stages after it have no loop
+      // to stop, so the signals end the process again (nothing half-written: the result is renamed into
+      // place at the end).
+      std::signal(SIGINT, SIG_DFL);
+      std::signal(SIGTERM, SIG_DFL);
       if (o.status == MeasureStatus::kTripped) throw Stop{Stage::kMeasure, Outcome::kTripped, o.message};
       if (o.status == MeasureStatus::kConfigError) throw Stop{Stage::kMeasure, Outcome::kBadInput, o.message};
       if (o.status != MeasureStatus::kOk) throw Stop{Stage::kMeasure, Outcome::kFailed, o.message};
@@ -257,10 +263,14 @@ std::pair<double, std::string> modal_uncertainty_pct(const identify::Commissioni
     for (const auto& m : r.frfs.front().fit.modes) {
       double lo = m.natural_freq_hz, hi = m.natural_freq_hz;
       int seen = 1;
-      for (std::size_t i = 1; i < r.frfs.size(); ++i)
+      for (std::size_t i = 1; i < r.frfs.size(); ++i) {  // the same mode: the nearest one, within 5 %
+        const identify::IdentifiedMode* near = nullptr;
         for (const auto& o : r.frfs[i].fit.modes)
-          if (std::abs(o.natural_freq_hz / m.natural_freq_hz - 1.0) < 0.05)
-            lo = std::min(lo, o.natural_freq_hz), hi = std::max(hi, o.natural_freq_hz), ++seen;
+          if (!near || std::abs(o.natural_freq_hz - m.natural_freq_hz) < std::abs(near->natural_freq_hz - m.natural_freq_hz))
+            near = &o;
+        if (near && std::abs(near->natural_freq_hz / m.natural_freq_hz - 1.0) < 0.05)
+          lo = std::min(lo, near->natural_freq_hz), hi = std::max(hi, near->natural_freq_hz), ++seen;
+      }
       const double spread = (hi - lo) / m.natural_freq_hz * 100.0;
       if (seen > 1 && spread > worst) {
         worst = spread;

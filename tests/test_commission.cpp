@@ -16,6 +16,8 @@
 #include "commission/measurement.hpp"
 #include "identify/modal_fit.hpp"
 #include "test_util.hpp"
+#include "tune/tuned_file.hpp"
+#include "yaml_style.hpp"
 #include "tune/compensator_search.hpp"
 
 namespace robodamp {
@@ -91,6 +93,19 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   EXPECT_EQ(written.controller.gain_ns_per_m, r.tuned_config->controller.gain_ns_per_m);
   const std::string text = test::read_file((dir / "configuration.yaml").string());
   EXPECT_NE(text.find("Verified on the cell"), std::string::npos);
+  // Every file commission writes is valid input again, as written and in block and flow style: a tune of it
+  // (the next commissioning) writes a file that reads back.
+  for (const char* file : {"identified.yaml", "tuned.yaml", "configuration.yaml"}) {
+    const std::string original = test::read_file((dir / file).string());
+    for (const std::string& t : {original, test::in_style(original, YAML::EmitterStyle::Block),
+                                 test::in_style(original, YAML::EmitterStyle::Flow)}) {
+      const config::Config c = config::parse_config(t, (dir / file).string());
+      const config::EditedYaml again = tune::tuned_config_text(c, r.tuned->candidate);
+      EXPECT_EQ(config::parse_config(again.text, (dir / file).string()).controller.gain_ns_per_m,
+                r.tuned->candidate.gain_ns_per_m)
+          << file;
+    }
+  }
   // The report: self-contained (every plot inlined), verified, and its plotted data are the computed series.
   const std::string html = test::read_file(r.report_path);
   EXPECT_NE(html.find("VERIFIED"), std::string::npos);
@@ -209,6 +224,10 @@ TEST(Commission, TheRobustShiftFollowsTheFitsSpreadWithinItsBounds) {
   EXPECT_NE(why.find("10.000 Hz"), std::string::npos) << why;
   r.frfs[1].fit.modes[0].natural_freq_hz = 10.0;
   EXPECT_NEAR(commission::modal_uncertainty_pct(r, 1.0, 10.0).first, 1.0, 1e-9);  // the floor
+  // A close pair (10.0 and 10.2 Hz, in both FRFs): each mode is compared with its own, not with the other.
+  r.frfs[0].fit.modes = {{10.0, 0.02, 0, 0, 0}, {10.2, 0.02, 0, 0, 0}};
+  r.frfs[1].fit.modes = {{10.01, 0.02, 0, 0, 0}, {10.2, 0.02, 0, 0, 0}};
+  EXPECT_NEAR(commission::modal_uncertainty_pct(r, 0.1, 10.0).first, 0.3, 1e-9);
 }
 
 TEST(Tune, AConstraintsOnlyPlantBindsItsConstraintsAndLeavesTheObjectiveToTheFullPlant) {

@@ -17,6 +17,7 @@
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 #include "test_util.hpp"
+#include "yaml_style.hpp"
 #include "tune/compensator_search.hpp"
 #include "tune/tuned_file.hpp"
 #include "tune/verification.hpp"
@@ -345,23 +346,7 @@ TEST(Tune, AJobWithoutADampingLocationIsRefused) {
 }  // namespace robodamp
 
 namespace robodamp {
-namespace {
-// Every collection of the document in one style (identify all writes block style; a person may write flow).
-void restyle(YAML::Node n, YAML::EmitterStyle::value style) {
-  if (n.IsMap() || n.IsSequence()) n.SetStyle(style);
-  if (n.IsMap())
-    for (auto it = n.begin(); it != n.end(); ++it) restyle(it->second, style);
-  if (n.IsSequence())
-    for (auto it = n.begin(); it != n.end(); ++it) restyle(*it, style);
-}
-std::string in_style(const std::string& text, YAML::EmitterStyle::value style) {
-  YAML::Node root = YAML::Load(text);
-  restyle(root, style);
-  YAML::Emitter out;
-  out << root;
-  return std::string(out.c_str()) + "\n";
-}
-}  // namespace
+using test::in_style;
 
 // The file tune writes, from every preset with a compensator, as written, in block style (as identify all
 // writes) and in flow style: it parses, has the candidate's compensator, gain and polarity, and everything
