@@ -443,7 +443,9 @@ TEST(Recovery, ATransientSensorDropoutRecoversAfterTheCoolDownAndTheHealthCheck)
   EXPECT_NEAR(r.frames[back].time_s, 1.1 + 2.0, 0.002);
   for (std::size_t i = fault; i < back; ++i) {
     ASSERT_EQ(r.frames[i].state, static_cast<std::uint8_t>(State::kFault)) << i;
-    if (r.frames[i].time_s > r.frames[fault].time_s + 0.011) EXPECT_EQ(r.frames[i].command_v, 0.0);
+    if (r.frames[i].time_s > r.frames[fault].time_s + 0.011) {
+      EXPECT_EQ(r.frames[i].command_v, 0.0);
+    }
   }
   const std::size_t active = first_state_after(r, State::kActive, r.frames[back].time_s);
   ASSERT_LT(active, r.frames.size());

@@ -1,8 +1,19 @@
 #include "tune/tuned_file.hpp"
 
-#include <cstdio>
+#include <charconv>
+#include <string>
 
 namespace robodamp::tune {
+namespace {
+
+// The shortest decimal text that reads back as exactly x: the written file holds the verified numbers.
+std::string exact(double x) {
+  char b[32];
+  const auto r = std::to_chars(b, b + sizeof b, x);
+  return std::string(b, r.ptr);
+}
+
+}  // namespace
 
 // The configuration's own text with the compensator, the gain and the polarity set, as data
 // (config/yaml_edit.hpp): any YAML style; comments kept where the splice is exact.
@@ -20,18 +31,12 @@ config::EditedYaml tuned_config_text(const config::Config& base, const Candidate
   entry["model"] = "rational";
   auto numbers = [](const std::vector<double>& v) {
     YAML::Node n(YAML::NodeType::Sequence);
-    for (const double x : v) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%.17g", x);
-      n.push_back(std::string(b));
-    }
+    for (const double x : v) n.push_back(exact(x));
     return n;
   };
   entry["numerator"] = numbers(block.numerator);
   entry["denominator"] = numbers(block.denominator);
-  char gain[32];
-  std::snprintf(gain, sizeof gain, "%.10g", c.gain_ns_per_m);
-  return config::edit_yaml(base.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node(std::string(gain))},
+  return config::edit_yaml(base.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node(exact(c.gain_ns_per_m))},
                                             {{"controller", "polarity"}, YAML::Node(c.polarity > 0 ? "+1" : "-1")},
                                             {{"controller", "chain", index}, entry}});
 }
