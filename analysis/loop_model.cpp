@@ -95,6 +95,9 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
   c_accel_ = ss.c.middleRows(2 * nl, nl);
   d_accel_coil_ = ss.d.block(2 * nl, 0, nl, 1);
   d_accel_force_ = ss.d.block(2 * nl, 1, nl, nl);
+  Eigen::MatrixXd inputs(phi_.rows(), 2 + nl);
+  inputs << gamma_late_, gamma_early_, gamma_force_;
+  resolvent_ = Resolvent(phi_, inputs, c_accel_);
 
   open_loop_unit_ = open_loop(std::nullopt);
 }
@@ -193,16 +196,12 @@ Complex LoopModel::closed_sampled(std::size_t g, std::size_t h, double f_hz, dou
 }
 
 PlantResponse LoopModel::plant_response(double f_hz) const {
-  const Eigen::Index n = phi_.rows(), nl = static_cast<Eigen::Index>(plant_.locations.size());
+  const Eigen::Index nl = static_cast<Eigen::Index>(plant_.locations.size());
   const Complex zi = std::exp(Complex(0.0, -kTwoPi * f_hz / cfg_.loop.rate_hz));  // z^-1
-  const Complex z = 1.0 / zi;
-  Eigen::MatrixXcd rhs(n, 1 + nl);
-  rhs.col(0) = (gamma_late_ + gamma_early_ * zi).cast<Complex>();
-  rhs.rightCols(nl) = gamma_force_.cast<Complex>();
-  Eigen::MatrixXcd m = -phi_.cast<Complex>();
-  m.diagonal().array() += z;
-  const Eigen::MatrixXcd x = m.partialPivLu().solve(rhs);
-  const Eigen::MatrixXcd y = c_accel_.cast<Complex>() * x;
+  const Eigen::MatrixXcd r = resolvent_(1.0 / zi);  // the late and early coil inputs, then the forces
+  Eigen::MatrixXcd y(nl, 1 + nl);
+  y.col(0) = r.col(0) + r.col(1) * zi;
+  y.rightCols(nl) = r.rightCols(nl);
   const Complex delay = std::pow(zi, delay_steps_);
   PlantResponse p;
   p.f_hz = f_hz;

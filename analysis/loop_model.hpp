@@ -13,6 +13,7 @@
 
 #include <Eigen/Dense>
 
+#include "analysis/resolvent.hpp"
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
 #include "sim_plant/plant_model.hpp"
@@ -117,6 +118,7 @@ class LoopModel {
   // Loop-rate discretisation of the plant with the actuator delay.
   Eigen::MatrixXd phi_, gamma_late_, gamma_early_, gamma_force_, c_accel_, d_accel_coil_, d_accel_force_;
   int delay_steps_{0};
+  Resolvent resolvent_;  // c_accel_ (z I - phi_)^-1 [gamma_late_, gamma_early_, gamma_force_]
   DiscreteSs open_loop_unit_;  // controller output -> controller output at K = 1, polarity +1 (no gain yet)
   // The same, with the last held force at force_at as one more plant state (sampled_path).
   [[nodiscard]] DiscreteSs open_loop(std::optional<std::size_t> force_at) const;

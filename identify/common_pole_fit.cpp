@@ -1,6 +1,7 @@
 #include "identify/common_pole_fit.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -88,17 +89,27 @@ std::vector<ModalFit> fit_modes_common(const std::vector<FrfData>& frfs, const M
     throw std::invalid_argument("the band is too wide for one common LSCF: fit the FRFs one by one");
   const double dt = 1.0 / (2.0 * hi);
   std::vector<StabilisationPoint> diagram;
-  const std::vector<Pole> poles =
+  const detail::PoleSelection selection =
       detail::stable_poles([&](int p) { return common_lscf_poles(thin, p, dt, lo, hi); }, s, diagram);
-  std::vector<ModalFit> out;
-  for (std::size_t i = 0; i < frfs.size(); ++i) {
-    ModalFit fit;
-    fit.band_lo_hz = all[i].f.front(), fit.band_hi_hz = all[i].f.back();
-    fit.diagram = diagram;
-    detail::lsfd(all[i].f, all[i].h, poles, fit);
-    detail::refine(all[i].f, all[i].h, fit);
-    out.push_back(std::move(fit));
-  }
+  auto fitted = [&](const std::vector<Pole>& poles) {
+    std::vector<ModalFit> fits;
+    for (std::size_t i = 0; i < frfs.size(); ++i) {
+      ModalFit fit;
+      fit.band_lo_hz = all[i].f.front(), fit.band_hi_hz = all[i].f.back();
+      detail::lsfd(all[i].f, all[i].h, poles, fit);
+      detail::refine(all[i].f, all[i].h, fit);
+      fits.push_back(std::move(fit));
+    }
+    return fits;
+  };
+  auto error = [&](const std::vector<Pole>& poles) {  // every FRF's relative error alike
+    double sum = 0.0;
+    for (const ModalFit& f : fitted(poles)) sum += f.fit_error_pct * f.fit_error_pct;
+    return std::sqrt(sum / static_cast<double>(frfs.size()));
+  };
+  std::vector<ModalFit> out =
+      fitted(selection.candidates.empty() ? selection.stable : detail::with_supported_candidates(selection, error));
+  for (ModalFit& f : out) f.diagram = diagram;
   return out;
 }
 

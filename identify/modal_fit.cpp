@@ -235,36 +235,58 @@ void usable_points(const FrfData& d, const ModalFitSettings& s, std::vector<doub
                                 " (at least 20 with coherence >= " + std::to_string(s.min_coherence) + ")");
 }
 
-std::vector<Pole> stable_poles(const std::function<std::vector<Pole>(int)>& poles_at_order, const ModalFitSettings& s,
-                               std::vector<StabilisationPoint>& diagram) {
+PoleSelection stable_poles(const std::function<std::vector<Pole>(int)>& poles_at_order, const ModalFitSettings& s,
+                           std::vector<StabilisationPoint>& diagram) {
   // The stabilisation diagram: a pole is stable when the order below has one close to it in frequency and
-  // damping; the chain of such orders counts how long it has stayed.
+  // damping; the chain of such orders counts how long it has stayed. A second chain with the damping's
+  // tolerance relaxed keeps the columns whose damping scatters under noise (one of a close pair, whose
+  // linearised estimate wanders while its frequency holds): candidates the fit must justify.
   std::vector<Pole> previous, last;
-  std::vector<int> previous_chain, last_chain;
+  std::vector<int> previous_chain, previous_loose, last_chain, last_loose;
   for (int p = 2; p <= s.max_order; p += 2) {
     const std::vector<Pole> poles = poles_at_order(p);
-    std::vector<int> chain(poles.size(), 0);
+    std::vector<int> chain(poles.size(), 0), loose(poles.size(), 0);
     for (std::size_t i = 0; i < poles.size(); ++i) {
       for (std::size_t j = 0; j < previous.size(); ++j) {
         const double df = std::abs(poles[i].freq_hz() - previous[j].freq_hz()) / poles[i].freq_hz();
         const double dz = std::abs(poles[i].damping() - previous[j].damping()) / std::max(poles[i].damping(), 1e-6);
-        if (df < s.stable_freq && dz < s.stable_damping) chain[i] = std::max(chain[i], previous_chain[j] + 1);
+        if (df >= s.stable_freq) continue;
+        if (dz < s.stable_damping) chain[i] = std::max(chain[i], previous_chain[j] + 1);
+        if (dz < kLooseStableDamping) loose[i] = std::max(loose[i], previous_loose[j] + 1);
       }
       diagram.push_back({p, poles[i].freq_hz(), poles[i].damping(), chain[i] > 0});
     }
-    previous = poles, previous_chain = chain;
-    last = poles, last_chain = chain;
+    previous = poles, previous_chain = chain, previous_loose = loose;
+    last = poles, last_chain = chain, last_loose = loose;
   }
-  std::vector<Pole> chosen;
+  PoleSelection out;
+  auto near = [](const std::vector<Pole>& set, const Pole& q, double rel) {
+    return std::any_of(set.begin(), set.end(), [&](const Pole& c) { return std::abs(c.freq_hz() - q.freq_hz()) < rel * q.freq_hz(); });
+  };
   for (std::size_t i = 0; i < last.size(); ++i)
-    if (last_chain[i] >= s.stable_orders) {
-      const bool duplicate = !chosen.empty() && std::abs(chosen.back().freq_hz() - last[i].freq_hz()) < 2e-3 * last[i].freq_hz();
-      if (!duplicate) chosen.push_back(last[i]);
-    }
-  if (chosen.empty())
+    if (last_chain[i] >= s.stable_orders && !near(out.stable, last[i], 2e-3)) out.stable.push_back(last[i]);
+  for (std::size_t i = 0; i < last.size(); ++i)
+    if (last_chain[i] < s.stable_orders && last_loose[i] >= s.stable_orders && !near(out.stable, last[i], s.stable_freq) &&
+        !near(out.candidates, last[i], s.stable_freq))
+      out.candidates.push_back(last[i]);
+  if (out.stable.empty())
     throw std::invalid_argument("no pole stays put over " + std::to_string(s.stable_orders) +
                                 " orders in the band: raise the maximum order, widen the band or check the data");
-  return chosen;
+  return out;
+}
+
+std::vector<Pole> with_supported_candidates(const PoleSelection& selection,
+                                            const std::function<double(const std::vector<Pole>&)>& fit_error) {
+  std::vector<Pole> poles = selection.stable;
+  double error = fit_error(poles);
+  for (const Pole& c : selection.candidates) {
+    std::vector<Pole> more = poles;
+    more.push_back(c);
+    std::sort(more.begin(), more.end(), [](const Pole& a, const Pole& b) { return a.freq_hz() < b.freq_hz(); });
+    const double e = fit_error(more);
+    if (e < kCandidateErrorRatio * error) poles = std::move(more), error = e;
+  }
+  return poles;
 }
 
 // One band: LSCF poles over the stabilisation diagram, LSFD residues, the refinement.
@@ -272,11 +294,23 @@ ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, c
   ModalFit fit;
   fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
   const double dt = 1.0 / (2.0 * f.back());
-  const std::vector<Pole> chosen =
+  const PoleSelection selection =
       stable_poles([&](int p) { return lscf_poles(f, h, p, dt, fit.band_lo_hz, fit.band_hi_hz); }, s, fit.diagram);
-  lsfd(f, h, chosen, fit);
-  refine(f, h, fit);
-  return fit;
+  auto fitted = [&](const std::vector<Pole>& poles) {
+    ModalFit trial;
+    trial.band_lo_hz = fit.band_lo_hz, trial.band_hi_hz = fit.band_hi_hz;
+    lsfd(f, h, poles, trial);
+    refine(f, h, trial);
+    return trial;
+  };
+  const std::vector<Pole> chosen =
+      selection.candidates.empty() ? selection.stable
+                                   : with_supported_candidates(selection, [&](const std::vector<Pole>& poles) {
+                                       return fitted(poles).fit_error_pct;
+                                     });
+  ModalFit out = fitted(chosen);
+  out.diagram = std::move(fit.diagram);
+  return out;
 }
 
 

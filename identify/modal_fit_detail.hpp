@@ -24,10 +24,25 @@ void usable_points(const FrfData& d, const ModalFitSettings& s, std::vector<doub
 // LSCF poles at order p within [f_lo, f_hi].
 [[nodiscard]] std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Complex>& h, int p, double dt,
                                            double f_lo, double f_hi);
+// A column of the diagram whose damping scatters more than ModalFitSettings::stable_damping allows but less
+// than this (relative, order to order) while its frequency holds is a candidate mode ...
+inline constexpr double kLooseStableDamping = 0.25;
+// ... kept only when it brings the fit's error below this share of the error without it (noise does not).
+inline constexpr double kCandidateErrorRatio = 0.8;
+
+struct PoleSelection {
+  std::vector<Pole> stable;      // stable at the highest order (frequency and damping)
+  std::vector<Pole> candidates;  // stable in frequency, damping within kLooseStableDamping, not one of `stable`
+};
+
 // The stabilisation diagram over orders 2..max_order (into `diagram`) and the poles stable at the highest.
 // Throws std::invalid_argument when none is.
-[[nodiscard]] std::vector<Pole> stable_poles(const std::function<std::vector<Pole>(int)>& poles_at_order,
-                                             const ModalFitSettings& s, std::vector<StabilisationPoint>& diagram);
+[[nodiscard]] PoleSelection stable_poles(const std::function<std::vector<Pole>(int)>& poles_at_order,
+                                         const ModalFitSettings& s, std::vector<StabilisationPoint>& diagram);
+// The stable poles and each candidate whose addition lowers fit_error (of the poles, sorted by frequency)
+// below kCandidateErrorRatio times the error without it.
+[[nodiscard]] std::vector<Pole> with_supported_candidates(const PoleSelection& selection,
+                                                          const std::function<double(const std::vector<Pole>&)>& fit_error);
 // LSFD residues of the poles with residual terms; weight_floor > 0 weighs rows to relative error.
 void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std::vector<Pole>& poles, ModalFit& fit,
           double weight_floor = 0.0);

@@ -8,6 +8,7 @@
 #include "modal/receptance.hpp"
 #include "analysis/loop_model.hpp"
 #include "analysis/notch_speed_map.hpp"
+#include "analysis/resolvent.hpp"
 #include "control/controller.hpp"
 #include "analysis/spectral.hpp"
 #include "test_util.hpp"
@@ -107,6 +108,35 @@ TEST(LoopModel, UnstableConfigurationIsReportedAsSuch) {
   EXPECT_FALSE(r.stable);
   EXPECT_GT(r.spectral_radius, 1.0);
   EXPECT_GT(r.nyquist_encirclements, 0);
+}
+
+// The loop model's frequency responses through the diagonalised Phi against the LU of z I - Phi at every
+// z, on each mounting's plant discretised at the loop rate; a defective Phi (a Jordan block) keeps the LU.
+TEST(Resolvent, TheDiagonalFormIsTheLuSolveAndADefectivePhiKeepsTheLu) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const char* name : {"horizontal_c2", "vertical_c1"}) {
+    const config::Config cfg = config::load_config_file(test::preset(name));
+    const sim::PlantModel p = sim::build_plant_model(cfg);
+    const sim::Zoh d = sim::discretise_zoh(p.ss.a, p.ss.b, 1.0 / cfg.loop.rate_hz);
+    const analysis::Resolvent r(d.phi, d.gamma, p.ss.c);
+    ASSERT_TRUE(r.diagonal()) << name;
+    for (double f_hz = 0.5; f_hz < 0.5 * cfg.loop.rate_hz; f_hz *= 1.07) {
+      const Complex z = std::exp(Complex(0.0, 2.0 * M_PI * f_hz / cfg.loop.rate_hz));
+      Eigen::MatrixXcd m = -d.phi.cast<Complex>();
+      m.diagonal().array() += z;
+      const Eigen::MatrixXcd lu = p.ss.c.cast<Complex>() * m.partialPivLu().solve(d.gamma.cast<Complex>());
+      EXPECT_LT((r(z) - lu).norm(), 1e-9 * lu.norm()) << name << " at " << f_hz << " Hz";
+    }
+  }
+  Eigen::MatrixXd jordan{{0.9, 1.0, 0.0}, {0.0, 0.9, 1.0}, {0.0, 0.0, 0.9}}, b(3, 1), c(1, 3);
+  b << u(rng), u(rng), u(rng);
+  c << u(rng), u(rng), u(rng);
+  const analysis::Resolvent r(jordan, b, c);
+  EXPECT_FALSE(r.diagonal());
+  const Complex z = std::exp(Complex(0.0, 0.3));
+  const Eigen::Matrix3cd m = Complex(z) * Eigen::Matrix3cd::Identity() - jordan.cast<Complex>();
+  EXPECT_LT(std::abs(r(z)(0, 0) - (c.cast<Complex>() * m.inverse() * b.cast<Complex>())(0, 0)), 1e-12);
 }
 
 TEST(Spectral, H1OfAKnownFilterWithAndWithoutOutputNoise) {
