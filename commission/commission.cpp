@@ -149,6 +149,14 @@ class Run {
       r_.tuned_config = config::load_config_file(tuned_path.string());
       r_.tuned_nominal = p.front().assess(*r_.tuned_config);
       r_.tuned = r_.tuned_nominal;
+      if (const tune::Evaluation& e = *r_.tuned_nominal; !e.stable)
+        throw Stop{Stage::kTune, Outcome::kBadInput,
+                   tuned_path.string() + fmt(": its loop is unstable on the identified model (K = %.0f N s/m, polarity %+d; ",
+                                             e.candidate.gain_ns_per_m, e.candidate.polarity) +
+                       (std::isfinite(e.k_max_ns_per_m)
+                            ? fmt("the largest stable K is %.0f N s/m)", e.k_max_ns_per_m)
+                            : std::string("no gain is stable with this polarity)")) +
+                       ": run from tune"};
       return;
     }
     const tune::TuneResult t = tune::tune(refs, s_.tune, [this](const std::string& l) { say_("commission: " + l); });

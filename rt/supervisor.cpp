@@ -303,14 +303,19 @@ bool Supervisor::instability(double controller_v) noexcept {
   const double rms = std::sqrt(block_sum_sq_ / static_cast<double>(block_len_));
   block_ticks_ = 0;
   block_sum_sq_ = 0.0;
-  if (last_block_rms_ > 0.0 && rms > last_block_rms_) {
+  const auto& l = s_.limits;
+  // A run counts from a block within one growth factor of the floor: the growth that matters is the one
+  // that carries the command over the floor. Below it, a quiet loop's command beats up and down (a rising
+  // envelope for a few blocks is common), and a hammer blow landing at the end of such a rise made a run
+  // of ambient blocks plus one struck block look like a growing oscillation.
+  const double counted = l.instability_floor_v / l.instability_growth_factor;
+  if (last_block_rms_ > 0.0 && rms > last_block_rms_ && last_block_rms_ >= counted) {
     if (growth_run_ == 0) run_start_rms_ = last_block_rms_;
     ++growth_run_;
   } else {
     growth_run_ = 0;
   }
   last_block_rms_ = rms;
-  const auto& l = s_.limits;
   return growth_run_ >= l.instability_blocks && rms >= l.instability_floor_v &&
          rms >= l.instability_growth_factor * run_start_rms_;
 }
