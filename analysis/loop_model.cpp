@@ -1,4 +1,5 @@
 #include "analysis/loop_model.hpp"
+#include "analysis/quiet_command.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -254,6 +255,18 @@ Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, st
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
                                       sensor_model_.response(p.f_hz));
   return q * p.accel_per_force[sensor_][h] / (1.0 - q * p.accel_per_volt[sensor_]);
+}
+
+Complex LoopModel::command_per_sensor_noise(const PlantResponse& p, Complex filters, double gain, int polarity) const {
+  const double t = chain_.params.actuator_constant_n_per_v, fs = cfg_.loop.rate_hz;
+  const Complex q = discrete_feedback(p, filters, gain, polarity, fs, t, sensor_model_.response(p.f_hz));
+  return discrete_feedback(p, filters, gain, polarity, fs, t, 1.0) / (1.0 - q * p.accel_per_volt[sensor_]);
+}
+
+Complex LoopModel::command_per_open_accel(const PlantResponse& p, Complex filters, double gain, int polarity) const {
+  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
+                                     sensor_model_.response(p.f_hz));
+  return q / (1.0 - q * p.accel_per_volt[sensor_]);
 }
 
 Eigen::MatrixXd LoopModel::closed_loop_matrix(double gain, int polarity) const {
@@ -550,6 +563,20 @@ AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
                       "the analysis recommends " + std::to_string(r.recommended_polarity));
   r.frfs_continuous = improvements(m, gain, polarity, false);
   r.frfs_discrete = improvements(m, gain, polarity, true);
+  if (r.stable) {
+    const QuietCommand q = quiet_command(m, gain, polarity);
+    r.quiet_command_rms_v = q.rms_v, r.quiet_command_peak_hz = q.peak_density_hz;
+    const double floor_v = m.config().supervision.instability_floor_v;
+    if (floor_v > 0.0 && 3.0 * q.rms_v > floor_v) {
+      std::ostringstream os;
+      os.precision(3);
+      os << "the command on a quiet cell is " << q.rms_v << " V RMS (most of it near " << q.peak_density_hz
+         << " Hz), above a third of supervision.instability_floor_v = " << floor_v
+         << " V: its swells can trip the instability detector on a stable loop; retune, or raise the floor to at least "
+         << 3.0 * q.rms_v << " V";
+      r.notes.push_back(os.str());
+    }
+  }
   for (const auto& n : m.plant().notes) r.notes.push_back(n);
   return r;
 }

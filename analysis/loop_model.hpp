@@ -92,6 +92,15 @@ class LoopModel {
   [[nodiscard]] Complex command_per_force(const PlantResponse& p, Complex chain_filters, std::size_t h,
                                           double gain_ns_per_m, int polarity) const;
 
+  // Volts the controller commands per m/s^2 of noise added to the sensor's reading (after its analog
+  // response), the loop closed: V = q' / (1 - q A_sv), q' = q without the sensor's response.
+  [[nodiscard]] Complex command_per_sensor_noise(const PlantResponse& p, Complex chain_filters, double gain_ns_per_m,
+                                                 int polarity) const;
+  // Volts per m/s^2 of acceleration at the sensor that an outside force causes with control off.
+  [[nodiscard]] Complex command_per_open_accel(const PlantResponse& p, Complex chain_filters, double gain_ns_per_m,
+                                               int polarity) const;
+  [[nodiscard]] const sim::Accelerometer& sensor_model() const { return sensor_model_; }
+
   // The loop that runs, closed at gain K and polarity, from a force held over each tick at `location` to
   // the displacement there (milling/sampled_sdm.hpp: the damped cut's semi-discretization).
   [[nodiscard]] SampledPath sampled_path(std::size_t location, double gain_ns_per_m, int polarity) const;
@@ -164,6 +173,9 @@ struct AnalysisResult {
   std::vector<ModePhase> modes;
   std::vector<FrfResult> frfs_continuous;
   std::vector<FrfResult> frfs_discrete;
+  // The command on a quiet cell (analysis/quiet_command.hpp), stable loops only.
+  double quiet_command_rms_v{0.0};
+  double quiet_command_peak_hz{0.0};
   std::vector<std::string> notes;
 };
 

@@ -71,6 +71,8 @@ json analysis_report(const analysis::LoopModel& m, const analysis::AnalysisResul
   for (const auto& f : r.frfs_discrete) j["frfs"].push_back(frf_json(f, r.stable));
   j["frfs_continuous"] = json::array();  // REFERENCE.md section 1 equations, delay exact
   for (const auto& f : r.frfs_continuous) j["frfs_continuous"].push_back(frf_json(f, r.stable_continuous));
+  j["quiet_command_rms_v"] = r.quiet_command_rms_v;
+  j["quiet_command_peak_hz"] = r.quiet_command_peak_hz;
   j["notes"] = r.notes;
   return j;
 }
@@ -107,6 +109,9 @@ std::string analysis_table(const json& r) {
        << mm(l["damped_mm"]) << " (" << l["damped_method"].get<std::string>() << " at " << fmt(l["analysed_rpm"], "%.2f")
        << " rpm)\n";
   }
+  if (r["stable"].get<bool>())
+    os << "  quiet cell: command " << fmt(r["quiet_command_rms_v"], "%.4f") << " V RMS (density peak at "
+       << fmt(r["quiet_command_peak_hz"], "%.2f") << " Hz; sensor noise, ADC, drive vibration)\n";
   os << "  recommended polarity " << std::showpos << r["recommended_polarity"].get<int>() << std::noshowpos << ": "
      << r["polarity_reason"].get<std::string>() << "\n";
   for (const auto& mp : r["modes"]) {

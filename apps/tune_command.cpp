@@ -55,6 +55,7 @@ json evaluation_json(const tune::Evaluation& e) {
           {"peak_m_per_n", e.peak_m_per_n},             {"objective", finite(e.objective)},
           {"peak_coil_force_n", e.peak_coil_force_n},   {"peak_command_v", e.peak_command_v},
           {"peak_slew_v_per_s", e.peak_slew_v_per_s},   {"actuator_use", e.actuator_use},
+          {"quiet_command_rms_v", e.quiet_command_rms_v},
           {"feasible", e.feasible()},                   {"binding", e.binding},
           {"plant", e.plant}};
 }
@@ -118,6 +119,7 @@ void print_row(const char* name, const tune::Evaluation& e) {
   std::printf("  %-6s K %8.0f N s/m pol %+d | K_max %8.0f  GM %6.1f dB  PM %6.1f deg  DM %6.2f ms  modes within %.0f deg | ",
               name, e.candidate.gain_ns_per_m, e.candidate.polarity, e.k_max_ns_per_m, e.gain_margin_db, e.phase_margin_deg,
               e.delay_margin_ms, e.worst_mode_phase_deg);
+  if (e.quiet_command_rms_v > 0.0) std::printf("quiet command %.4f V RMS | ", e.quiet_command_rms_v);
   if (e.actuator_use > 0.0)
     std::printf("impact: %.1f N coil, %.2f V, %.0f V/s (%.0f %% of a limit) | ", e.peak_coil_force_n, e.peak_command_v,
                 e.peak_slew_v_per_s, 100.0 * e.actuator_use);

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <thread>
 
+#include "analysis/quiet_command.hpp"
 #include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/signals.hpp"
@@ -240,6 +241,44 @@ TEST(Loop, NoFalseInstabilityTripWithImpactsAtTheConfiguredGain) {
   const auto r = run(c2(), 20.0, o);
   EXPECT_EQ(r.s.trip, "none");
   EXPECT_EQ(r.s.final_state, "disabled");
+}
+
+// The command on a quiet cell (the sensor's noise and ADC rounding, the drive vibration) predicted from
+// the loop model (analysis/quiet_command.hpp) against the running loop's, over 200 s with the instability
+// detector out of the way: C2's broadband command and the slow-pole controller's 0.3 Hz swell.
+TEST(Loop, TheQuietCommandIsWhatTheLoopModelPredicts) {
+  for (config::Config cfg : {c2(), test::slow_pole_vertical()}) {
+    cfg.supervision.instability_floor_v = 100.0;
+    const analysis::QuietCommand predicted =
+        analysis::quiet_command(analysis::LoopModel(cfg), cfg.controller.gain_ns_per_m, cfg.controller.polarity);
+    const auto r = run(cfg, 200.0);
+    ASSERT_EQ(r.s.trip, "none");
+    const std::size_t active = first_state(r, State::kActive);
+    ASSERT_LT(active, r.frames.size());
+    double sum_sq = 0.0;
+    std::size_t n = 0;
+    for (std::size_t i = active; i < r.frames.size(); ++i)
+      if (r.frames[i].time_s > r.frames[active].time_s + cfg.controller.gain_ramp_s + 10.0)
+        sum_sq += r.frames[i].command_v * r.frames[i].command_v, ++n;
+    const double measured = std::sqrt(sum_sq / static_cast<double>(n));
+    std::printf("[ quiet    ] %s: command %.5f V RMS measured, %.5f V predicted (density peak at %.2f Hz)\n",
+                cfg.source.c_str(), measured, predicted.rms_v, predicted.peak_density_hz);
+    // 190 s of a swell 0.05 Hz wide is about 10 independent looks: its RMS is known to about 30 %.
+    EXPECT_NEAR(measured, predicted.rms_v, 0.25 * predicted.rms_v) << cfg.source;
+  }
+}
+
+// With the detector's floor as configured, the slow-pole controller's quiet command (five times the
+// floor) trips "instability" on a quiet cell although the loop is stable; the tuner now refuses it
+// (Tune.TheQuietCommandIsAConstraint).
+TEST(Loop, AQuietCommandAboveTheFloorTripsAStableLoop) {
+  const config::Config cfg = test::slow_pole_vertical();
+  const analysis::LoopModel m(cfg);
+  ASSERT_TRUE(m.stable(cfg.controller.gain_ns_per_m, cfg.controller.polarity));
+  EXPECT_GT(analysis::quiet_command(m, cfg.controller.gain_ns_per_m, cfg.controller.polarity).rms_v,
+            cfg.supervision.instability_floor_v);
+  const auto r = run(cfg, 120.0);
+  EXPECT_EQ(r.s.trip, "instability");
 }
 
 TEST(Loop, ResetFaultThenRearm) {

@@ -11,6 +11,7 @@
 #include "analysis/bench_run.hpp"
 #include "analysis/impact_command.hpp"
 #include "analysis/loop_model.hpp"
+#include "analysis/quiet_command.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/cut_job.hpp"
 #include "milling/cut_stability.hpp"
@@ -210,6 +211,28 @@ TEST(Tune, ThePredictedImpactCommandMatchesTheBench) {
 
 // The actuator-limit constraint in the evaluation: the preset's command at the bench's impact is a small
 // share of the 36 N limit (within it); at 100 kN it passes the limit and the candidate is infeasible for that reason.
+// A candidate whose command on a quiet cell reaches the supervisor's instability floor is refused: the
+// first tuned_vertical.yaml (a slow, lightly damped compensator pole pair; its quiet command 0.10 V RMS
+// against a 0.02 V floor) tripped "instability" after 22 s on a quiet cell (Loop.AQuietCommandAbove...).
+TEST(Tune, TheQuietCommandIsAConstraint) {
+  const config::Config slow = test::slow_pole_vertical();
+  const config::MillingConfig job =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  const tune::Evaluator evaluate(config::load_config_file(test::preset("vertical_c1")), job, {});
+  const tune::Evaluation e = evaluate.assess(slow);
+  EXPECT_TRUE(e.stable);
+  EXPECT_NEAR(e.quiet_command_rms_v, 0.104, 0.005);
+  EXPECT_FALSE(e.feasible());
+  EXPECT_NE(e.binding.find("quiet cell's command"), std::string::npos) << e.binding;
+  // The presets' controllers are far below a third of the floor.
+  for (const char* name : {"horizontal_c2", "tuned_horizontal", "tuned_vertical", "vertical_c1"}) {
+    const config::Config c = config::load_config_file(test::preset(name));
+    EXPECT_LT(analysis::quiet_command(analysis::LoopModel(c), c.controller.gain_ns_per_m, c.controller.polarity).rms_v,
+              c.supervision.instability_floor_v / 3.0)
+        << name;
+  }
+}
+
 TEST(Tune, TheActuatorLimitAtTheImpactIsAConstraint) {
   const config::Config cfg = config::load_config_file(test::preset("tuned_horizontal"));
   const tune::Evaluation nominal = tune::Evaluator(cfg, std::nullopt, {}).assess(cfg);

@@ -9,6 +9,7 @@
 
 #include "config/config.hpp"
 #include "control/chain_design.hpp"
+#include "config/yaml_edit.hpp"
 
 namespace robodamp::test {
 
@@ -20,6 +21,22 @@ inline control::ChainDesign design_preset(const std::string& name, double rate_h
   config::Config c = config::load_config_file(preset(name));
   if (rate_hz > 0.0) c.loop.rate_hz = rate_hz;
   return control::design_chain(c);
+}
+
+// tuned_vertical.yaml as `robodamp tune` first wrote it (before the quiet-command constraint): a stable
+// loop (gain margin 12 dB) whose compensator has a slow, lightly damped pole pair; the instability
+// detector's floor at its default (vertical_c1.yaml now raises it for C1).
+inline config::Config slow_pole_vertical() {
+  const config::Config base = config::load_config_file(preset("vertical_c1"));
+  const std::string entry =
+      "{kind: compensator, model: rational, numerator: [0.027404602793258317, 0.42320583618593827, 341.23272947339467, "
+      "1463.5814931482228], denominator: [0.074624991310120958, 0.43650875239379344, 0.96951995294320148, 1]}";
+  return config::parse_config(config::edit_yaml(base.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node("6040.303629")},
+                                                                 {{"controller", "polarity"}, YAML::Node("-1")},
+                                                                 {{"controller", "chain", std::size_t{5}}, YAML::Load(entry)},
+                                                                 {{"supervision", "instability_floor_v"}, YAML::Node("0.02")}})
+                                  .text,
+                              "slow_pole_vertical");
 }
 
 // A mode in modal-stiffness form (Eq. 1 with a stiffness instead of a residue).

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "analysis/impact_command.hpp"
+#include "analysis/quiet_command.hpp"
 #include "analysis/loop_model.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
@@ -51,6 +52,11 @@ double closed_peak(const analysis::LoopModel& m, double gain, int polarity) {
   for (const auto& f : analysis::improvements(m, gain, polarity, true)) peak = std::max(peak, f.closed_peak_m_per_n);
   return peak;
 }
+
+// The quiet cell's command RMS (analysis/quiet_command.hpp) may be at most this share of the supervisor's
+// instability floor: at a third, a slow swell reaching twice the floor (what tripped a tuned loop on a
+// quiet cell) is a 5-sigma event.
+constexpr double kQuietShareOfFloor = 1.0 / 3.0;
 
 void add_violation(Evaluation& e, double amount, const char* what) {
   if (amount <= 0.0) return;
@@ -218,6 +224,11 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   for (const auto& mode : analysis::mode_phases(*m, k, cand.polarity))
     e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
   add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
+  if (const double floor_v = cfg.supervision.instability_floor_v; floor_v > 0.0) {
+    e.quiet_command_rms_v = analysis::quiet_command(*m, k, cand.polarity).rms_v;
+    add_violation(e, e.quiet_command_rms_v / (kQuietShareOfFloor * floor_v) - 1.0,
+                  "the quiet cell's command against the instability detector's floor");
+  }
   if (impact_) {
     const analysis::CommandPeak p = impact_->command.peak(*m, k, cand.polarity);
     e.peak_command_v = p.voltage_v;
@@ -313,7 +324,8 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
                                             &Evaluation::open_minima_ratio};
   constexpr double Evaluation::*kLargest[] = {&Evaluation::worst_mode_phase_deg, &Evaluation::peak_m_per_n,
                                              &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
-                                             &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use};
+                                             &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use,
+                                             &Evaluation::quiet_command_rms_v};
   if (!full(wi) && lowest != per.size())
     for (const auto field : kDepths) w.*field = per[lowest].*field;
   for (std::size_t i = 0; i < per.size(); ++i) {

@@ -85,6 +85,7 @@ struct Evaluation {
   double peak_command_v{0.0};
   double peak_slew_v_per_s{0.0};
   double actuator_use{0.0};      // the largest of those over its limit (1 = at a limit; 0 without the check)
+  double quiet_command_rms_v{0.0};  // the command on a quiet cell (sensor noise, drive vibration): analysis/quiet_command.hpp
   double objective{0.0};         // larger is better (depth in mm, or -log10 of the peak)
   double violation{0.0};         // 0 when every constraint holds
   std::string binding;           // the constraint violated most (empty when feasible)
