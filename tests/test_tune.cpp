@@ -225,7 +225,7 @@ TEST(Tune, TheQuietCommandIsAConstraint) {
   EXPECT_FALSE(e.feasible());
   EXPECT_NE(e.binding.find("quiet cell's command"), std::string::npos) << e.binding;
   // The presets' controllers are far below a third of the floor.
-  for (const char* name : {"horizontal_c2", "tuned_horizontal", "tuned_vertical", "vertical_c1"}) {
+  for (const char* name : {"horizontal_c1", "horizontal_c2", "horizontal_c3", "tuned_horizontal", "tuned_vertical", "vertical_c1"}) {
     const config::Config c = config::load_config_file(test::preset(name));
     EXPECT_LT(analysis::quiet_command(analysis::LoopModel(c), c.controller.gain_ns_per_m, c.controller.polarity).rms_v,
               c.supervision.instability_floor_v / 3.0)
