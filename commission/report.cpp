@@ -101,8 +101,8 @@ std::string identified_section(const identify::CommissioningResult& id, Plots& p
       << num(std::abs(a.fitted[i])) << ' ' << num(deg(a.fitted[i])) << '\n';
   const std::string s = "set multiplot layout 2,1 title 'Actuator force per volt: measured through the structure, and Eq. 3 fitted'\n"
                         "set grid\nset logscale x\nset ylabel '|F/V| (N/V)'\nplot DATA u 1:2 w l lc rgb '#7f8c8d' t 'measured', "
-                        "DATA u 1:4 w l lw 2 lc rgb '#c0392b' t 'Eq. 3 fit'\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\n"
-                        "plot DATA u 1:3 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:5 w l lw 2 lc rgb '#c0392b' t 'Eq. 3 fit'\n"
+                        "DATA u 1:4 w l lw 2 lc rgb '#c0392b' t 'Eq. 3 fitted, through the sampled loop'\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\n"
+                        "plot DATA u 1:3 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:5 w l lw 2 lc rgb '#c0392b' t 'Eq. 3 fitted, through the sampled loop'\n"
                         "unset multiplot\n";
   h << p.img("actuator_fit", s, d.str(), "Actuator: measured and fitted force per volt");
   return h.str();

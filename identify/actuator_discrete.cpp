@@ -127,9 +127,18 @@ ActuatorFit refine_actuator_discrete(const ActuatorFit& start, const analysis::F
     ref += std::norm(measured[i]);
   }
   out.fit_error_pct = 100.0 * std::sqrt(err / ref);
-  for (std::size_t i = 0; i < out.f_hz.size(); ++i)  // the force-per-volt view, for plots
-    out.fitted[i] = actuator_n_per_v(out.f_hz[i], out.force_constant_n_per_v, out.natural_freq_hz, out.damping_ratio,
-                                     out.delay_ms * 1e-3);
+  // The force-per-volt view, for plots: the model's recorded response mapped to force per volt exactly as
+  // the measurement was (the continuous fit's factor at each point). Eq. 3 alone would leave out what the
+  // sampled loop adds (the hold, the tick of computation, the sensor's coupling): 19 deg at 100 Hz.
+  const std::vector<double>& fa = accel_per_volt.f_hz;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < out.f_hz.size(); ++i) {
+    while (k + 1 < fa.size() && std::abs(fa[k + 1] - out.f_hz[i]) <= std::abs(fa[k] - out.f_hz[i])) ++k;  // nearest bin
+    const bool found = !fa.empty() && std::abs(accel_per_volt.h1[k]) > 0.0;
+    out.fitted[i] = found ? out.measured[i] / accel_per_volt.h1[k] * recorded(m, sensor, fa[k])
+                          : actuator_n_per_v(out.f_hz[i], out.force_constant_n_per_v, out.natural_freq_hz,
+                                             out.damping_ratio, out.delay_ms * 1e-3);
+  }
   return out;
 }
 
