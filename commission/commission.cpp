@@ -169,8 +169,10 @@ class Run {
                              s_.command_line + "\n#\n" + edited.text;
     r_.tuned_config = config::parse_config(text, tuned_path.string());
     std::ofstream(tuned_path) << text;
-    say_(fmt("commission: tuned K %.0f N s/m, polarity %+d; worst over the plants GM %.1f dB, PM %.1f deg",
-             t.best.candidate.gain_ns_per_m, t.best.candidate.polarity, t.best.gain_margin_db, t.best.phase_margin_deg));
+    say_(fmt("commission: tuned K %.0f N s/m, polarity %+d; worst over the plants GM %.1f dB, PM %.1f deg, the command "
+             "on a quiet cell %.4f V RMS (the instability detector's floor %.3f V)",
+             t.best.candidate.gain_ns_per_m, t.best.candidate.polarity, t.best.gain_margin_db, t.best.phase_margin_deg,
+             t.best.quiet_command_rms_v, r_.identified->config.supervision.instability_floor_v));
   }
 
   void verify() {
@@ -209,6 +211,10 @@ class Run {
     for (const auto& f : c.frfs)
       h << " " << f.name << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
                                 f.predicted_improvement_pct);
+    if (r_.tuned_nominal)
+      h << fmt("\n# On a quiet cell the command is %.4f V RMS (the discrete loop's prediction; the instability "
+               "detector's floor %.3f V).",
+               r_.tuned_nominal->quiet_command_rms_v, r_.tuned_config->supervision.instability_floor_v);
     h << "\n#\n";
     std::ifstream in(dir_ / "tuned.yaml");
     const std::string tuned((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

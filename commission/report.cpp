@@ -126,6 +126,8 @@ std::string tuned_section(const CommissionResult& r) {
   row("delay margin (ms)", n.delay_margin_ms, e.delay_margin_ms, "%.2f");
   row("largest feedback phase at a mode (deg, &lt; 90 damps)", n.worst_mode_phase_deg, e.worst_mode_phase_deg, "%.1f");
   row("peak command at the bench impact (V)", n.peak_command_v, e.peak_command_v, "%.3f");
+  row("command on a quiet cell (V RMS; sensor noise, ADC, drive vibration)", n.quiet_command_rms_v, e.quiet_command_rms_v,
+      "%.4f");
   h << "</table>\n<p>Compensator (rational, unity gain at the match frequency): zero pair " << fmt("%.3f", c.fz_hz)
     << " Hz, &zeta; " << fmt("%.3f", c.zeta_z) << "; pole pair " << fmt("%.3f", c.fp_hz) << " Hz, &zeta; "
     << fmt("%.3f", c.zeta_p) << "; lead/lag zero " << fmt("%.3f", c.fa_hz) << " Hz, pole " << fmt("%.3f", c.fb_hz)
