@@ -258,9 +258,10 @@ Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, st
 }
 
 Complex LoopModel::command_per_sensor_noise(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const double t = chain_.params.actuator_constant_n_per_v, fs = cfg_.loop.rate_hz;
-  const Complex q = discrete_feedback(p, filters, gain, polarity, fs, t, sensor_model_.response(p.f_hz));
-  return discrete_feedback(p, filters, gain, polarity, fs, t, 1.0) / (1.0 - q * p.accel_per_volt[sensor_]);
+  const Complex q_noise = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
+                                           chain_.params.actuator_constant_n_per_v, 1.0);
+  const Complex q = q_noise * sensor_model_.response(p.f_hz);
+  return q_noise / (1.0 - q * p.accel_per_volt[sensor_]);
 }
 
 Complex LoopModel::command_per_open_accel(const PlantResponse& p, Complex filters, double gain, int polarity) const {

@@ -7,6 +7,7 @@
 #include "analysis/bench_run.hpp"
 #include "analysis/loop_model.hpp"
 #include "analysis/modal_test.hpp"
+#include "commission/modal_test_hook.hpp"
 #include "runtime/cell.hpp"
 #include "tune/compensator_search.hpp"
 
@@ -21,16 +22,6 @@ struct ImpactRun {
   std::string trip{"none"};
   double active_share{0.0};
   unsigned long long saturated_ticks{0};
-};
-
-class Hook final : public drivers::PlantStepHook {
- public:
-  explicit Hook(analysis::ModalTest& t) : t_(t) {}
-  void before_step(std::uint64_t k) noexcept override { t_.before_step(static_cast<std::size_t>(k)); }
-  void after_step(std::uint64_t k) noexcept override { t_.after_step(static_cast<std::size_t>(k)); }
-
- private:
-  analysis::ModalTest& t_;
 };
 
 // Hammer impacts at every location, one location after the other, once the loop is active at full gain:
@@ -53,7 +44,7 @@ ImpactRun impacts_on_cell(const config::Config& run, const config::Config& cell)
   if (runtime::Status s = rc.configure(); !s.ok()) throw std::runtime_error("the cell: " + s.message);
   if (rc.hardware()) throw std::runtime_error("the check on the cell needs the simulated plant");
   analysis::ModalTest test(cell, rc.plant(), plan);
-  Hook hook(test);
+  ModalTestHook hook(test);
   rc.sim_backend().set_step_hook(&hook);
   if (runtime::Status s = rc.activate(plan.duration_s); !s.ok()) throw std::runtime_error("the cell: " + s.message);
   rc.wait();

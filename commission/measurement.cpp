@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "analysis/modal_test.hpp"
+#include "commission/modal_test_hook.hpp"
 #include "rt/signals.hpp"
 #include "runtime/cell.hpp"
 
@@ -16,17 +17,6 @@ namespace robodamp::commission {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The plant-side instruments stepped with the simulated plant.
-class ModalTestHook final : public drivers::PlantStepHook {
- public:
-  explicit ModalTestHook(analysis::ModalTest& t) : t_(t) {}
-  void before_step(std::uint64_t k) noexcept override { t_.before_step(static_cast<std::size_t>(k)); }
-  void after_step(std::uint64_t k) noexcept override { t_.after_step(static_cast<std::size_t>(k)); }
-
- private:
-  analysis::ModalTest& t_;
-};
 
 // One progress line per phase of the plan, from the drained frames' loop time.
 class Progress {
