@@ -27,6 +27,9 @@ struct PlantArgs {
   std::vector<std::string> spindle_schedule;   // "T:RPM", plant time in s
   std::vector<std::string> spindle_ramps;      // "T0:T1:RPM"
   std::string cut_job;
+  std::string cut_model{"regenerative"};
+  std::optional<double> cut_rpm, cut_axial_mm, cut_at_s;
+  std::optional<int> cut_revolutions;
   double spindle_register_period_s{0.05};
   std::vector<std::string> pose_at;            // "T:Q1,Q2,..." waypoints
   double pose_register_period_s{0.05}, pose_update_s{0.02};
@@ -91,6 +94,11 @@ int run_plant(const PlantArgs& a) {
     eo.spindle_ramps.push_back({t0, t1, rpm});
   }
   eo.cut_job = a.cut_job;
+  eo.cut_model = a.cut_model == "forced" ? hil::EmulatorOptions::CutModel::kForced : hil::EmulatorOptions::CutModel::kRegenerative;
+  eo.regenerative.rpm = a.cut_rpm;
+  eo.regenerative.axial_mm = a.cut_axial_mm;
+  eo.regenerative.revolutions = a.cut_revolutions;
+  eo.regenerative.start_s = a.cut_at_s.value_or(-1.0);
   eo.spindle_register_period_s = a.spindle_register_period_s;
   for (const auto& item : a.pose_at) {
     hil::PoseWaypoint w;
@@ -149,8 +157,18 @@ void register_plant(Registry& r) {
   r.number(sub, "--spindle-register-period", a->spindle_register_period_s, {"s", 0.0, 10.0},
            "How often the robot updates its spindle register during a ramp (plant time)");
   sub->add_option("--cut", a->cut_job,
-                  "Milling job (config/milling/*.yaml) whose cutting force acts on the robot at the spindle speed")
+                  "Milling job (config/milling/*.yaml) cut against the robot at its controller part's location")
       ->check(CLI::ExistingFile);
+  sub->add_option("--cut-model", a->cut_model,
+                  "regenerative (default): the time-domain cut with surface memory at one speed, which can chatter; "
+                  "forced: the rigid tool's force harmonics at the --spindle / --spindle-ramp speed")
+      ->check(CLI::IsMember({"regenerative", "forced"}));
+  r.number(sub, "--cut-rpm", a->cut_rpm, {"rpm", 0.0, 200000.0, true}, "The regenerative cut's spindle speed (default: the job's)");
+  r.number(sub, "--cut-axial-mm", a->cut_axial_mm, {"mm", 0.0, 100.0, true}, "The regenerative cut's axial depth (default: the job's)");
+  r.whole_number(sub, "--cut-revs", a->cut_revolutions, {"(revolutions)", 2, 100000},
+                 "Revolutions of the regenerative cut (default: the job's, at least 300)");
+  r.number(sub, "--cut-at", a->cut_at_s, {"s", 0.0, 604800.0},
+           "Plant time the regenerative cut starts (default: hil.settle_s + controller.gain_ramp_s after the amplifier is ready)");
   sub->add_option("--pose-at", a->pose_at,
                   "The robot's pose trajectory, a waypoint TIME_S:Q1,Q2,... (plant time, joint angles in deg; linear between "
                   "waypoints; two with the same pose make a dwell, measured by impacts), repeatable; needs pose_schedule");

@@ -43,6 +43,7 @@ nlohmann::json report_json(const EmulatorReport& r) {
           {"elapsed_s", r.elapsed_s},
           {"end_reason", r.end_reason},
           {"cutting", cutting_json(r.cutting)},
+          {"regenerative_cut", regenerative_cut_json(r.regenerative_cut)},
           {"frames",
            {{"sensor_sent", r.sensor_frames_sent},
             {"send_errors", r.send_errors},
@@ -148,6 +149,21 @@ std::string report_text(const EmulatorReport& r) {
                   c.job.c_str(), c.in_cut_s, c.last_rpm, c.saturated_in_cut_s, at(c.command_harmonics_v, 0),
                   at(c.command_harmonics_v, 1), at(c.command_harmonics_v, 2), c.measured_s, at(c.force_harmonics_n, 0),
                   at(c.force_harmonics_n, 1), at(c.force_harmonics_n, 2));
+    os << b;
+  }
+  if (r.regenerative_cut.cut) {
+    const auto& c = r.regenerative_cut;
+    const auto& v = c.verdict;
+    if (!c.complete)
+      std::snprintf(b, sizeof b, "  regenerative cut %s: %.3f mm at %.1f rpm from %.3f s: incomplete (the run ended at %.3f s)\n",
+                    c.job.c_str(), c.axial_mm, c.rpm, c.start_s, c.end_s);
+    else
+      std::snprintf(b, sizeof b,
+                    "  regenerative cut %s: %.3f mm at %.1f rpm, %d revolutions from %.3f s: %s (%s), chatter %.2f Hz, "
+                    "growth %.4f per tooth, non-harmonic energy %.3f, peak force %.1f N\n",
+                    c.job.c_str(), c.axial_mm, c.rpm, c.revolutions, c.start_s, milling::to_string(v.classification),
+                    milling::to_string(v.mechanism), v.chatter_hz, v.growth_per_period, v.nonharmonic_energy_ratio,
+                    c.peak_force_n);
     os << b;
   }
   for (const auto& f : r.injected) {

@@ -129,6 +129,31 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   const analysis::ImpactTest test{impact_index, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, true,
                                   cfg.controller.gain_ns_per_m, cfg.controller.polarity};
   rep.records_planned = o.impacts && o.measure_out.empty() ? cfg.bench.averages : 0;
+  // The spindle (steps and ramps) and the cut at its speed: checked before any controller is served.
+  std::vector<SpindleChange> changes = o.spindle_ramps;
+  for (const auto& [t, rpm] : o.spindle_schedule) changes.push_back({t, t, rpm});
+  std::optional<CutLoad> cut;
+  std::optional<RegenerativeCut> regenerative;
+  const bool regenerative_model = o.cut_model == EmulatorOptions::CutModel::kRegenerative;
+  if (!o.cut_job.empty() && regenerative_model) {
+    if (!changes.empty())
+      throw config::ConfigError({{o.cut_job, {}, "--spindle",
+                                  "the regenerative cut runs at one speed (--cut-rpm); a spindle profile needs --cut-model forced"}});
+    RegenerativeCutOptions ro = o.regenerative;
+    ro.job_path = o.cut_job;
+    regenerative.emplace(cfg, plant, ro);
+    changes.push_back({0.0, 0.0, regenerative->rpm()});  // the robot's spindle register shows the cut's speed
+    const RegenerativeCutReport head = regenerative->report();
+    spdlog::info("robodamp plant: regenerative cut {}: {:.3f} mm at {:.1f} rpm ({} steps per tooth), {} revolutions{}",
+                 o.cut_job, head.axial_mm, head.rpm, head.steps_per_tooth, head.revolutions,
+                 head.start_s >= 0.0 ? fmt::format(" from {:.3f} s", head.start_s) : std::string(" once the loop is at full gain"));
+  } else if (!o.cut_job.empty()) {
+    cut = cut_load_from_job(o.cut_job, model, o.cut_harmonics);
+    spdlog::info("robodamp plant: cutting {} ({} teeth) at the {}: tooth harmonics {:.1f}, {:.1f}, {:.1f} N", o.cut_job,
+                 cut->teeth, model.locations[cut->location].name, std::abs(cut->harmonics_n[1]),
+                 std::abs(cut->harmonics_n[2]), std::abs(cut->harmonics_n[3]));
+  }
+  CuttingLoad cutting(plant, std::move(cut), SpindleProfile(std::move(changes)));
 
   Registers regs(cfg);
   rep.modbus = regs.describe();
@@ -186,17 +211,6 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     spdlog::info("robodamp plant: the robot moves along {} waypoints; impacts at {} dwells", o.pose_trajectory.size(),
                  dwell_campaigns->count());
   }
-  // The spindle (steps and ramps) and the cut at its speed.
-  std::vector<SpindleChange> changes = o.spindle_ramps;
-  for (const auto& [t, rpm] : o.spindle_schedule) changes.push_back({t, t, rpm});
-  std::optional<CutLoad> cut;
-  if (!o.cut_job.empty()) {
-    cut = cut_load_from_job(o.cut_job, model, o.cut_harmonics);
-    spdlog::info("robodamp plant: cutting {} ({} teeth) at the {}: tooth harmonics {:.1f}, {:.1f}, {:.1f} N", o.cut_job,
-                 cut->teeth, model.locations[cut->location].name, std::abs(cut->harmonics_n[1]),
-                 std::abs(cut->harmonics_n[2]), std::abs(cut->harmonics_n[3]));
-  }
-  CuttingLoad cutting(plant, std::move(cut), SpindleProfile(std::move(changes)));
   double published_rpm = -1.0, published_at_s = -1.0;
   std::uint32_t sensor_counter = 0, last_cmd_counter = 0;
   bool have_cmd_counter = false;
@@ -301,7 +315,9 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
       regs.set_spindle_rpm(rpm);
       published_rpm = rpm, published_at_s = t;
     }
+    if (regenerative) regenerative->before_step(t);
     plant.step(ready ? applied_v : 0.0);
+    if (regenerative) regenerative->after_step();
     cutting.after_step(ready ? applied_v : 0.0, dt);
     if (dwell_campaigns) dwell_campaigns->after_step(k);
     if (modal_test) modal_test->after_step(k);
@@ -321,6 +337,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     }
     const bool now_ready = enabled && t - enabled_at_s >= cfg.hil.amplifier_ready_delay_s;
     if (now_ready != ready) regs.set_ready(now_ready), ready = now_ready;
+    if (ready && regenerative) regenerative->amplifier_ready(t);
     if (enabled) rep.enabled_s += dt;
     const double v = ready ? applied_v : 0.0;
     rep.peak_command_v = std::max(rep.peak_command_v, std::abs(v));
@@ -404,6 +421,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   rep.elapsed_s = std::chrono::duration<double>(Clock::now() - wall0).count();
   rep.modbus_requests = regs.requests();
   rep.cutting = cutting.report();
+  if (regenerative) rep.regenerative_cut = regenerative->report();
 
   if (dwell_campaigns) rep.pose_dwells = dwell_campaigns->finish();
   if (modal_test) {

@@ -33,6 +33,7 @@
 #include "analysis/spectral.hpp"
 #include "hil/cutting_load.hpp"
 #include "hil/pose_trajectory.hpp"
+#include "hil/regenerative_cut.hpp"
 #include "config/config.hpp"
 #include "rt/timing_histogram.hpp"
 
@@ -61,6 +62,12 @@ struct EmulatorOptions {
   // A milling job (config/milling/*.yaml) whose cutting force acts on the plant at the spindle speed
   // (hil/cutting_load.hpp). Empty = no cut.
   std::string cut_job;
+  // regenerative: the time-domain cut against the plant at one speed (hil/regenerative_cut.hpp: cut_rpm,
+  // cut_axial_mm, cut_revolutions, cut_start_s; the spindle register shows its speed); forced: the rigid
+  // tool's force harmonics at the spindle profile's speed (hil/cutting_load.hpp), which never regenerates.
+  enum class CutModel { kRegenerative, kForced };
+  CutModel cut_model{CutModel::kRegenerative};
+  RegenerativeCutOptions regenerative;  // job_path = cut_job
   int cut_harmonics{12};
   // The robot moving (hil/pose_trajectory.hpp): waypoints (plant time, joint angles), the joint
   // registers written every pose_register_period_s and the plant's modes retuned every pose_update_s.
@@ -129,6 +136,7 @@ struct EmulatorReport {
   int measure_records{0}, measure_records_planned{0};
   std::vector<std::string> measure_files;
   CuttingReport cutting;
+  RegenerativeCutReport regenerative_cut;
   // The pose trajectory: plant retunes and what each dwell measured.
   std::uint64_t pose_retunes{0};
   std::vector<PoseDwellReport> pose_dwells;

@@ -6,7 +6,6 @@
 
 namespace robodamp::milling {
 
-namespace {
 CutOutcome classify(CutRecord record, const CutSettings& s) {
   CutOutcome o;
   o.record = std::move(record);
@@ -17,7 +16,6 @@ CutOutcome classify(CutRecord record, const CutSettings& s) {
                              1.0 / r.step_s, r.out_of_cut_share());
   return o;
 }
-}  // namespace
 
 CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter, const config::MaterialConfig& mat,
                    const CutSettings& s) {

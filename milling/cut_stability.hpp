@@ -16,6 +16,9 @@ struct CutOutcome {
   ChatterVerdict verdict;
 };
 
+// The chatter detector's verdict on a cut's record (both displacement components after settling; with
+// runout or uneven pitch the cut repeats once per revolution, else once per tooth period).
+[[nodiscard]] CutOutcome classify(CutRecord record, const CutSettings& settings);
 // Simulates and classifies one cut (the signals: both displacement components after settling).
 [[nodiscard]] CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                                  const config::MaterialConfig& material, const CutSettings& settings);

@@ -5,33 +5,12 @@
 
 namespace robodamp::milling {
 
-namespace {
-
-// The cutting force on the robot at the controller part's location, set before each loop tick.
-class HeldForce final : public sim::Excitation {
- public:
-  explicit HeldForce(std::size_t location) : Excitation(location) {}
-  double force_n(double, double) noexcept override { return value_n; }
-  double value_n{0.0};
-};
-
-// Cutter frame <-> machine frame (Structure::frf_cutter): a feed along +y makes the cutter's x the
-// machine's y and its y the machine's -x.
-Eigen::Vector2d to_machine(const Eigen::Vector2d& c, config::Axis feed) {
-  return feed == config::Axis::kX ? c : Eigen::Vector2d(-c(1), c(0));
-}
-Eigen::Vector2d to_cutter(const Eigen::Vector2d& m, config::Axis feed) {
-  return feed == config::Axis::kX ? m : Eigen::Vector2d(m(1), -m(0));
-}
-
-}  // namespace
-
 struct DampedDynamics::Loop {
   std::shared_ptr<const analysis::LoopModel> model;
   std::size_t location{0}, direction{1};
   std::unique_ptr<sim::Plant> plant;
   std::unique_ptr<control::Controller> controller;
-  HeldForce* cutting{nullptr};
+  sim::HeldForce* cutting{nullptr};  // the cutting force on the robot at the part's location, set each tick
   double command_v{0.0};
 };
 
@@ -42,7 +21,7 @@ DampedDynamics::DampedDynamics(const Structure& structure, config::Axis feed_axi
     loop->location = part.location;
     loop->direction = part.direction;
     loop->plant = std::make_unique<sim::Plant>(part.model->plant(), part.model->config());
-    auto force = std::make_unique<HeldForce>(part.location);
+    auto force = std::make_unique<sim::HeldForce>(part.location);
     loop->cutting = force.get();
     loop->plant->add_excitation(std::move(force));
     control::ControllerParams params = part.model->chain().params;

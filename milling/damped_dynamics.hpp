@@ -19,6 +19,15 @@
 
 namespace robodamp::milling {
 
+// Cutter frame <-> machine frame (Structure::frf_cutter): a feed along +y makes the cutter's x the
+// machine's y and its y the machine's -x.
+[[nodiscard]] inline Eigen::Vector2d to_machine(const Eigen::Vector2d& c, config::Axis feed) {
+  return feed == config::Axis::kX ? c : Eigen::Vector2d(-c(1), c(0));
+}
+[[nodiscard]] inline Eigen::Vector2d to_cutter(const Eigen::Vector2d& m, config::Axis feed) {
+  return feed == config::Axis::kX ? m : Eigen::Vector2d(m(1), -m(0));
+}
+
 struct DampingStats {
   double peak_actuator_force_n{0.0};  // transmitted (Eq. 3), after settling
   double saturated_s{0.0};            // loop ticks at a controller or actuator limit, after settling

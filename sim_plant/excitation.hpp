@@ -79,6 +79,15 @@ class Noise final : public Excitation {
   double band_gain_{1.0};
 };
 
+// A force set from outside before each step and held over it (a cut computed step by step against the
+// structure's response: milling/damped_dynamics.hpp, hil/regenerative_cut.hpp).
+class HeldForce final : public Excitation {
+ public:
+  explicit HeldForce(std::size_t location) : Excitation(location) {}
+  double force_n(double, double) noexcept override { return value_n; }
+  double value_n{0.0};
+};
+
 // A milling cut's periodic force at the tooth-passing frequency and its harmonics (the HIL emulator's
 // cutting forces: the harmonics come from the job, milling::force_spectrum), at a spindle speed that may
 // change during the run: F(t) = Re sum_k c_k e^{i k phi(t)}, phi the tooth phase integrated from the speed

@@ -176,7 +176,7 @@ TEST(Hil, CuttingForcesAtToothPassingAreNotchedOutAcrossProcesses) {
   std::map<std::string, json> plant, run;
   for (const std::string bank : {"off", "on"}) {
     const HilFiles f = hil_files("cut_" + bank, {}, "hil_cutting_c2");
-    Child p({"plant", "--config", f.config, "--pacing", "lockstep", "--cut",
+    Child p({"plant", "--config", f.config, "--pacing", "lockstep", "--cut-model", "forced", "--cut",
              std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml", "--spindle", "0.5:12000",
              "--json", f.plant_json},
             f.plant_log);
@@ -217,7 +217,7 @@ TEST(Hil, CuttingForcesAtToothPassingAreNotchedOutAcrossProcesses) {
 // notches follow at their slew limit, no speed is refused, the loop stays armed with no trip.
 TEST(Hil, SpindleRampWhileCuttingKeepsTheLoopActive) {
   const HilFiles f = hil_files("cut_ramp", {}, "hil_cutting_c2");
-  Child p({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut",
+  Child p({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut-model", "forced", "--cut",
            std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml", "--spindle", "0.5:12000",
            "--spindle-ramp", "4:14:6000", "--spindle-register-period", "0.5", "--json", f.plant_json},
           f.plant_log);
