@@ -79,6 +79,8 @@ void register_commission(Registry& r) {
                  "Global search budget per polarity");
   r.whole_number(sub, "--polish", a->settings.tune.local_evaluations, {"(evaluations per polarity)", 0, 100000},
                  "Local polish budget per polarity");
+  r.whole_number(sub, "--cut-revs", a->settings.cut_revolutions, {"(revolutions)", 60, 100000},
+                 "Revolutions of each regenerative cut in the HIL emulator's check (a cell behind can.interface unix:...)");
   r.whole_number(sub, "--seed", a->settings.tune.seed, {"(seed)", 0, 999999}, "The global search's seed");
 }
 

@@ -30,6 +30,7 @@ struct PlantArgs {
   std::string cut_model{"regenerative"};
   std::optional<double> cut_rpm, cut_axial_mm, cut_at_s;
   std::optional<int> cut_revolutions;
+  bool drives_off{false};
   double spindle_register_period_s{0.05};
   std::vector<std::string> pose_at;            // "T:Q1,Q2,..." waypoints
   double pose_register_period_s{0.05}, pose_update_s{0.02};
@@ -50,7 +51,8 @@ std::optional<std::pair<double, config::Mounting>> parse_mounting(const std::str
 // 0 served a controller to the end; 2 configuration or option error; 1 could not set up or the impact
 // schedule did not complete.
 int run_plant(const PlantArgs& a) {
-  const config::Config cfg = config::load_config_file(a.config_path);
+  config::Config cfg = config::load_config_file(a.config_path);
+  if (a.drives_off) cfg.disturbances.drives_on = false;
   hil::EmulatorOptions eo;
   if (!a.pacing.empty()) eo.pacing = a.pacing == "lockstep" ? config::HilPacing::kLockstep : config::HilPacing::kRealtime;
   eo.max_duration_s = a.duration_s;
@@ -167,6 +169,8 @@ void register_plant(Registry& r) {
   r.number(sub, "--cut-axial-mm", a->cut_axial_mm, {"mm", 0.0, 100.0, true}, "The regenerative cut's axial depth (default: the job's)");
   r.whole_number(sub, "--cut-revs", a->cut_revolutions, {"(revolutions)", 2, 100000},
                  "Revolutions of the regenerative cut (default: the job's, at least 300)");
+  sub->add_flag("--drives-off", a->drives_off,
+                "The robot's drive vibration off for this run (disturbances.drives_on), as the in-process cut has it");
   r.number(sub, "--cut-at", a->cut_at_s, {"s", 0.0, 604800.0},
            "Plant time the regenerative cut starts (default: hil.settle_s + controller.gain_ramp_s after the amplifier is ready)");
   sub->add_option("--pose-at", a->pose_at,

@@ -86,6 +86,11 @@ bool CellCheck::improvement_ok() const {
 }
 
 bool CellCheck::depth_ok(const tune::Verification& p) const {
+  if (!cut_trials.empty()) {
+    for (const auto& t : cut_trials)
+      if (!t.held()) return false;
+    return true;
+  }
   return time_domain_at_min_mm >= (1.0 - depth_tolerance) * p.min_depth_mm &&
          time_domain_at_speed_mm >= (1.0 - depth_tolerance) * p.depth_at_speed_mm;
 }
@@ -104,6 +109,7 @@ std::string CellCheck::failure(const tune::Verification& p) const {
                     f.name.c_str(), f.measured_improvement_pct, f.predicted_improvement_pct, improvement_tolerance_points);
       return b;
     }
+  if (!depth_ok(p) && !cut_trials.empty()) return "the damped cut on the cell: " + cut_summary(p);
   if (!depth_ok(p)) {
     std::snprintf(b, sizeof b,
                   "the damped cut on the cell: %.3f mm at %.1f rpm (promised %.3f mm) and %.3f mm at %.1f rpm (promised "
@@ -115,21 +121,35 @@ std::string CellCheck::failure(const tune::Verification& p) const {
   return {};
 }
 
-CellCheck check_on_cell(const config::Config& cell, const config::Config& tuned, const config::MillingConfig& job,
-                        const tune::Verification& promise) {
-  const auto t0 = std::chrono::steady_clock::now();
-  CellCheck out;
-  config::Config off = tuned;
-  off.controller.gain_ns_per_m = 0.0;
-  const ImpactRun open = impacts_on_cell(off, cell), closed = impacts_on_cell(tuned, cell);
-  out.open_trip = open.trip;
-  out.closed_trip = closed.trip;
-  out.closed_active_share = closed.active_share;
-  out.closed_saturated_ticks = closed.saturated_ticks;
+std::string CellCheck::cut_summary(const tune::Verification& p) const {
+  char b[300];
+  if (cut_trials.empty()) {
+    std::snprintf(b, sizeof b,
+                  "the damped cut in time in process (the real Controller on the cell's plant): critical %.3f mm at %.1f "
+                  "rpm (promised %.3f mm), %.3f mm at %.1f rpm (promised %.3f mm)",
+                  time_domain_at_min_mm, p.min_rpm, p.min_depth_mm, time_domain_at_speed_mm, p.speed_rpm, p.depth_at_speed_mm);
+    return b;
+  }
+  std::string s = "the regenerative cut in the HIL emulator (its drive vibration off, as the in-process cut) with the tuned "
+                  "controller across processes, at the promise less " +
+                  std::to_string(static_cast<int>(std::lround(100.0 * depth_tolerance))) + " %:";
+  for (std::size_t i = 0; i < cut_trials.size(); ++i) {
+    const CutTrial& t = cut_trials[i];
+    std::snprintf(b, sizeof b, "%s %.3f mm at %.1f rpm %s", i ? ";" : "", t.depth_mm, t.rpm,
+                  t.held() ? "stable" : t.classification.c_str());
+    s += b;
+    if (!t.held() && t.chatter_hz > 0.0) std::snprintf(b, sizeof b, " at %.2f Hz", t.chatter_hz), s += b;
+    if (t.trip != "none") s += " (the controller tripped: " + t.trip + ")";
+    else if (t.complete && t.active_share < 1.0)
+      std::snprintf(b, sizeof b, " (the loop active over %.1f %% of it)", 100.0 * t.active_share), s += b;
+  }
+  return s;
+}
 
+std::vector<FrfCheck> frf_checks(const config::Config& tuned, const ReceptanceOf& open, const ReceptanceOf& closed) {
+  std::vector<FrfCheck> out;
   const analysis::LoopModel model(tuned);
   const analysis::AnalysisResult an = analysis::analyse(model);
-  const sim::PlantModel cell_plant = sim::build_plant_model(cell);
   const double lo = tuned.analysis.band_min_hz, hi = tuned.analysis.band_max_hz;
   const double k = tuned.controller.gain_ns_per_m;
   const int pol = tuned.controller.polarity;
@@ -140,9 +160,8 @@ CellCheck check_on_cell(const config::Config& cell, const config::Config& tuned,
     f.name = fc.name;
     f.response_id = fc.response_location;
     f.excitation_id = fc.excitation_location;
-    const std::size_t e = index_of(cell_plant, f.excitation_id), r = index_of(cell_plant, f.response_id);
-    const analysis::FrfEstimate& mo = open.receptance.at(e).at(r);
-    const analysis::FrfEstimate& mc = closed.receptance.at(e).at(r);
+    const analysis::FrfEstimate& mo = open(f.excitation_id, f.response_id);
+    const analysis::FrfEstimate& mc = closed(f.excitation_id, f.response_id);
     const analysis::MeasuredPeak po = analysis::measured_peak(mo, lo, hi), pc = analysis::measured_peak(mc, lo, hi);
     f.open_peak_m_per_n = po.magnitude_m_per_n;
     f.closed_peak_m_per_n = pc.magnitude_m_per_n;
@@ -162,8 +181,28 @@ CellCheck check_on_cell(const config::Config& cell, const config::Config& tuned,
       f.predicted_closed.push_back(
           std::abs(model.closed_discrete(p, model.chain_filters_digital(fh), pf.response, pf.excitation, k, pol)));
     }
-    out.frfs.push_back(std::move(f));
+    out.push_back(std::move(f));
   }
+  return out;
+}
+
+CellCheck check_on_cell(const config::Config& cell, const config::Config& tuned, const config::MillingConfig& job,
+                        const tune::Verification& promise) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CellCheck out;
+  config::Config off = tuned;
+  off.controller.gain_ns_per_m = 0.0;
+  const ImpactRun open = impacts_on_cell(off, cell), closed = impacts_on_cell(tuned, cell);
+  out.open_trip = open.trip;
+  out.closed_trip = closed.trip;
+  out.closed_active_share = closed.active_share;
+  out.closed_saturated_ticks = closed.saturated_ticks;
+
+  const sim::PlantModel cell_plant = sim::build_plant_model(cell);
+  out.frfs = frf_checks(
+      tuned,
+      [&](int e, int r) -> const analysis::FrfEstimate& { return open.receptance.at(index_of(cell_plant, e)).at(index_of(cell_plant, r)); },
+      [&](int e, int r) -> const analysis::FrfEstimate& { return closed.receptance.at(index_of(cell_plant, e)).at(index_of(cell_plant, r)); });
   const config::Config on_cell = with_controller_of(cell, tuned);
   out.time_domain_at_min_mm = tune::time_domain_critical_mm(on_cell, job, promise.min_rpm, promise.min_depth_mm);
   out.time_domain_at_speed_mm = tune::time_domain_critical_mm(on_cell, job, promise.speed_rpm, promise.depth_at_speed_mm);

@@ -1,5 +1,7 @@
 #include "commission/commission.hpp"
 
+#include "commission/emulated_cell.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -49,10 +51,13 @@ class Run {
     std::error_code ec;
     fs::remove(dir_ / "configuration.yaml", ec);  // only this run's verified result may stand there
     cell_ = config::load_config_file(s_.config_path);
-    if (cell_.can) throw Stop{Stage::kMeasure, Outcome::kBadInput,
-                              "the cell is configured for hardware (can:); commission runs the simulated plant only "
-                              "for now: measure with `robodamp measure` and `robodamp plant --measure-out`, then "
-                              "`robodamp identify all` and `robodamp tune`"};
+    if (const std::string why = hardware_refusal(cell_); !why.empty()) throw Stop{Stage::kMeasure, Outcome::kBadInput, why};
+    emulated_ = cell_.can.has_value();
+    if (emulated_) {
+      binary_ = s_.robodamp_binary.empty() ? this_executable() : s_.robodamp_binary;
+      say_("commission: the cell is the HIL emulator on " + cell_.can->interface + ": " + binary_ +
+           " plant runs as a second process for each run on the cell (lockstep)");
+    }
     job_ = config::load_milling_config(s_.job_path);
     stage(Stage::kMeasure, [this] { measure(); });
     stage(Stage::kIdentify, [this] { identify(); });
@@ -78,7 +83,8 @@ class Run {
   void measure() {
     const fs::path m = dir_ / "measurement";
     if (!reuse_) {
-      const MeasureOutcome o = commission::measure(s_.config_path, m.string());
+      const MeasureOutcome o = emulated_ ? measure_through_emulator(s_.config_path, m.string(), binary_)
+                                         : commission::measure(s_.config_path, m.string());
       // The measurement turns SIGINT / SIGTERM into a trip of its loop; the stages after it have no loop
       // to stop, so the signals end the process again (nothing half-written: the result is renamed into
       // place at the end).
@@ -186,15 +192,16 @@ class Run {
     if (!v.time_domain_agrees())
       throw Stop{Stage::kVerify, Outcome::kNotVerified,
                  "on the identified model the time-domain cut disagrees with the " + v.method + " by more than 5 %"};
-    r_.cell = check_on_cell(cell_, *r_.tuned_config, job_, v);
+    r_.cell = emulated_ ? check_through_emulator(cell_, *r_.tuned_config, v,
+                                                 {binary_, s_.config_path, s_.job_path, (dir_ / "measurement").string(),
+                                                  (dir_ / "verify").string(), s_.cut_revolutions})
+                        : check_on_cell(cell_, *r_.tuned_config, job_, v);
     const CellCheck& c = *r_.cell;
     for (const auto& f : c.frfs)
       say_("commission: on the cell " + f.name +
            fmt(": improvement %.1f %% measured, %.1f %% predicted (coherence >= %.3f)", f.measured_improvement_pct,
                f.predicted_improvement_pct, f.coherence_min));
-    say_(fmt("commission: the damped cut on the cell (time domain, real Controller): %.3f mm at %.1f rpm (promised "
-             "%.3f mm), ", c.time_domain_at_min_mm, v.min_rpm, v.min_depth_mm) +
-         fmt("%.3f mm at %.1f rpm (promised %.3f mm)", c.time_domain_at_speed_mm, v.speed_rpm, v.depth_at_speed_mm));
+    say_("commission: on " + c.cell + ": " + c.cut_summary(v));
     if (const std::string f = c.failure(v); !f.empty()) throw Stop{Stage::kVerify, Outcome::kNotVerified, f};
   }
 
@@ -206,8 +213,7 @@ class Run {
       << s_.job_path << ":\n#   " << s_.command_line << "\n";
     h << fmt("# Promised (%s, identified model): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's %.1f rpm.\n",
              v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm)
-      << fmt("# Verified on the cell: the damped cut in time %.3f mm and %.3f mm there;", c.time_domain_at_min_mm,
-             c.time_domain_at_speed_mm);
+      << "# Verified on " << c.cell << ": " << c.cut_summary(v) << ";";
     for (const auto& f : c.frfs)
       h << " " << f.name << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
                                 f.predicted_improvement_pct);
@@ -237,6 +243,8 @@ class Run {
   bool reuse_{false};
   config::Config cell_;
   config::MillingConfig job_;
+  bool emulated_{false};  // the cell is the HIL emulator (a can: section with a unix: interface)
+  std::string binary_;    // robodamp, for the emulator's process
 };
 
 }  // namespace

@@ -47,6 +47,8 @@ struct CommissionSettings {
   double max_shift_pct{10.0};
   tune::TuneSettings tune{commission_tune_defaults()};
   std::string command_line;  // how it was called, for the files' headers and the report
+  std::string robodamp_binary;  // the emulator's executable for a HIL cell (default: this process's)
+  int cut_revolutions{300};     // each regenerative cut in the HIL emulator's check
 };
 
 enum class Outcome { kVerified, kBadInput, kNotVerified, kTripped, kFailed };

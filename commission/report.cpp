@@ -141,10 +141,20 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
   h << "<h2>4. Verification</h2>\n";
   if (!r.promise) return h.str() + "<p>Not reached.</p>\n";
   const auto& v = *r.promise;
+  const bool hil = r.cell && !r.cell->cut_trials.empty();
   h << "<table><tr><th></th><th>speed (rpm)</th><th>promised (" << esc(v.method)
-    << ", identified model) (mm)</th><th>time-domain cut, identified model (mm)</th><th>time-domain cut on the cell (mm)</th></tr>\n";
-  const auto cell_min = r.cell ? fmt("%.3f", r.cell->time_domain_at_min_mm) : std::string("-");
-  const auto cell_at = r.cell ? fmt("%.3f", r.cell->time_domain_at_speed_mm) : std::string("-");
+    << ", identified model) (mm)</th><th>time-domain cut, identified model (mm)</th><th>"
+    << (hil ? "the regenerative cut in the HIL emulator at the promise less 5 % (mm)"
+            : "time-domain cut on the cell, critical (mm)")
+    << "</th></tr>\n";
+  auto on_cell = [&](std::size_t i, double mm) {
+    if (!r.cell) return std::string("-");
+    if (!hil) return fmt("%.3f", mm);
+    const CutTrial& t = r.cell->cut_trials.at(i);
+    return fmt("%.3f at %.1f rpm: ", t.depth_mm, t.rpm) + (t.held() ? std::string("stable") : esc(t.classification));
+  };
+  const auto cell_min = on_cell(0, r.cell ? r.cell->time_domain_at_min_mm : 0.0);
+  const auto cell_at = on_cell(1, r.cell ? r.cell->time_domain_at_speed_mm : 0.0);
   h << "<tr><td>damped lobes' minimum</td><td>" << fmt("%.1f", v.min_rpm) << "</td><td>" << fmt("%.3f", v.min_depth_mm)
     << "</td><td>" << fmt("%.3f", v.time_domain_at_min_mm) << "</td><td>" << cell_min << "</td></tr>\n";
   h << "<tr><td>the job's speed</td><td>" << fmt("%.1f", v.speed_rpm) << "</td><td>" << fmt("%.3f", v.depth_at_speed_mm)
@@ -157,7 +167,9 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
     for (const auto& [rpm, mm] : v.damped_curve_mm) d << num(rpm) << ' ' << num(mm) << '\n';
     d << "\n\n" << num(v.min_rpm) << ' ' << num(v.time_domain_at_min_mm) << '\n'
       << num(v.speed_rpm) << ' ' << num(v.time_domain_at_speed_mm) << "\n\n\n";
-    if (r.cell)
+    if (hil)
+      for (const CutTrial& t : r.cell->cut_trials) d << num(t.rpm) << ' ' << num(t.depth_mm) << '\n';
+    else if (r.cell)
       d << num(v.min_rpm) << ' ' << num(r.cell->time_domain_at_min_mm) << '\n'
         << num(v.speed_rpm) << ' ' << num(r.cell->time_domain_at_speed_mm) << '\n';
     else
@@ -169,11 +181,15 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
                           "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#7f8c8d' t 'open loop (SDM)', "
                           "DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'damped, promised (" + v.method + ")', "
                           "DATA index 2 u 1:2 w p pt 6 ps 2 lc rgb '#27ae60' t 'time-domain cut, identified model', "
-                          "DATA index 3 u 1:2 w p pt 7 ps 1.5 lc rgb '#c0392b' t 'time-domain cut on the cell'\n";
+                          "DATA index 3 u 1:2 w p pt 7 ps 1.5 lc rgb '#c0392b' t '" +
+                          (hil ? std::string(r.cell->depth_ok(v) ? "regenerative cut in the HIL emulator: stable at the promise - 5 %"
+                                                                 : "regenerative cut in the HIL emulator at the promise - 5 % (chatter at one)")
+                               : std::string("time-domain cut on the cell, critical")) + "'\n";
     h << p.img("lobes", s, d.str(), "Stability lobes, open and damped, with the time-domain checks");
   }
   if (!r.cell) return h.str();
   const auto& c = *r.cell;
+  h << "<p>The cell: " << esc(c.cell) << ". " << esc(c.cut_summary(v)) << ".</p>\n";
   h << "<h3>Impact tests on the cell, control off and on</h3>\n<table><tr><th>FRF</th><th>open peak (m/N at Hz)</th>"
        "<th>closed peak (m/N at Hz)</th><th>measured improvement (%)</th><th>predicted (%)</th><th>difference (points)</th>"
        "<th>coherence min</th></tr>\n";

@@ -44,6 +44,8 @@ nlohmann::json report_json(const EmulatorReport& r) {
           {"end_reason", r.end_reason},
           {"cutting", cutting_json(r.cutting)},
           {"regenerative_cut", regenerative_cut_json(r.regenerative_cut)},
+          {"measurement",
+           {{"records", r.measure_records}, {"records_planned", r.measure_records_planned}, {"files", r.measure_files}}},
           {"frames",
            {{"sensor_sent", r.sensor_frames_sent},
             {"send_errors", r.send_errors},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 
 #include "analysis/loop_model.hpp"
 #include "milling/cut_job.hpp"
@@ -14,7 +15,11 @@ namespace robodamp::hil {
 namespace {
 
 constexpr int kMinRevolutions = 300;  // as the commissioning's time-domain check: a slow decay is not chatter
-constexpr int kForcedSidebands = 3;   // the drive vibration's sidebands taken out: +- 1..3 x the tooth frequency
+// The drive vibration's forced response taken out: its frequency and harmonics (the amplifier's and the
+// converters' steps make them) up to kForcedHarmonics, each +- up to kForcedSidebands x the tooth frequency
+// (the cut's periodic force modulates them).
+constexpr int kForcedHarmonics = 3;
+constexpr int kForcedSidebands = 3;
 
 const config::StructureConfig& job_structure(const config::MillingConfig& job) {
   const auto* s = job.find_structure(job.structure);
@@ -22,23 +27,33 @@ const config::StructureConfig& job_structure(const config::MillingConfig& job) {
   return *s;
 }
 
-// Least-squares sinusoids at the given frequencies fitted to x[start..] and subtracted there.
+// Least-squares sinusoids at the given frequencies fitted to x[start..] and subtracted there (the normal
+// equations accumulated sample by sample: a record of 10^5-10^6 samples needs no tall matrix).
 void remove_tones(std::vector<double>& x, std::size_t start, double fs, const std::vector<double>& freqs_hz) {
-  if (freqs_hz.empty() || x.size() <= start + 4 * freqs_hz.size()) return;
-  const auto n = static_cast<Eigen::Index>(x.size() - start), m = static_cast<Eigen::Index>(2 * freqs_hz.size());
-  Eigen::MatrixXd a(n, m);
-  Eigen::VectorXd b(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) / fs;
+  const auto m = static_cast<Eigen::Index>(2 * freqs_hz.size());
+  if (freqs_hz.empty() || x.size() <= start + static_cast<std::size_t>(4 * m)) return;
+  std::vector<std::complex<double>> rot, ph(freqs_hz.size(), 1.0);
+  for (const double f : freqs_hz) rot.push_back(std::polar(1.0, 2.0 * M_PI * f / fs));
+  Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(m, m);
+  Eigen::VectorXd atb = Eigen::VectorXd::Zero(m), row(m);
+  auto next_row = [&](std::size_t i) {
     for (std::size_t k = 0; k < freqs_hz.size(); ++k) {
-      const double ph = 2.0 * M_PI * freqs_hz[k] * t;
-      a(i, static_cast<Eigen::Index>(2 * k)) = std::cos(ph), a(i, static_cast<Eigen::Index>(2 * k + 1)) = std::sin(ph);
+      row(static_cast<Eigen::Index>(2 * k)) = ph[k].real(), row(static_cast<Eigen::Index>(2 * k + 1)) = ph[k].imag();
+      ph[k] *= rot[k];
+      if (i % 1024 == 0) ph[k] /= std::abs(ph[k]);  // the rotation's rounding kept off the unit circle's drift
     }
-    b(i) = x[start + static_cast<std::size_t>(i)];
+  };
+  for (std::size_t i = start; i < x.size(); ++i) {
+    next_row(i);
+    ata.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    atb += row * x[i];
   }
-  const Eigen::VectorXd c = a.colPivHouseholderQr().solve(b);
-  const Eigen::VectorXd fit = a * c;
-  for (Eigen::Index i = 0; i < n; ++i) x[start + static_cast<std::size_t>(i)] -= fit(i);
+  const Eigen::VectorXd c = ata.selfadjointView<Eigen::Lower>().ldlt().solve(atb);
+  std::fill(ph.begin(), ph.end(), std::complex<double>(1.0));
+  for (std::size_t i = start; i < x.size(); ++i) {
+    next_row(i);
+    x[i] -= row.dot(c);
+  }
 }
 
 }  // namespace
@@ -77,10 +92,13 @@ RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, c
   // cut's tooth-periodic force, at that frequency +- the tooth harmonics: not the cut's regeneration.
   if (cfg.disturbances.drives_on && cfg.disturbances.drive_vibration_hz > 0.0) {
     const double fd = cfg.disturbances.drive_vibration_hz, ft = settings_.rpm * cutter_.teeth / 60.0;
-    forced_hz_.push_back(fd);
-    for (int k = 1; k <= kForcedSidebands; ++k)
-      for (const double f : {k * ft - fd, k * ft + fd})
-        if (f > 0.0 && f < 0.5 / plant.period_s()) forced_hz_.push_back(f);
+    for (int h = 1; h <= kForcedHarmonics; ++h)
+      for (int k = -kForcedSidebands; k <= kForcedSidebands; ++k) {
+        const double f = std::abs(h * fd + k * ft);
+        const double to_harmonic = std::abs(f / ft - std::round(f / ft)) * ft;  // the cut's own harmonics stay
+        const bool seen = std::any_of(forced_hz_.begin(), forced_hz_.end(), [f](double g) { return std::abs(g - f) < 1e-9; });
+        if (f > 0.0 && f < 0.5 / plant.period_s() && to_harmonic > 1e-6 && !seen) forced_hz_.push_back(f);
+      }
   }
   rep_.cut = true;
   rep_.job = o.job_path;

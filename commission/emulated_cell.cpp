@@ -1,0 +1,274 @@
+#include "commission/emulated_cell.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include "analysis/modal_test.hpp"
+#include "identify/commissioning.hpp"
+#include "identify/modal_fit.hpp"
+#include "runtime/cell.hpp"
+#include "sim_plant/plant_model.hpp"
+
+extern char** environ;
+
+namespace robodamp::commission {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr double kEmulatorEndS = 60.0;     // after the controller leaves: the emulator writes its files and ends
+constexpr double kRampMarginS = 2.0;       // after settle and the gain ramp: the loop at full gain
+
+std::string text_of(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// The controller side of one run: the runtime cell on `cfg` (its CAN and Modbus drivers), on the virtual
+// clock (the emulator paces in lockstep), counting the ticks with the loop active over a window.
+struct ControllerRun {
+  std::string trip{"none"};
+  double active_share{0.0};
+  unsigned long long saturated_ticks{0};
+};
+
+ControllerRun run_controller(const config::Config& cfg, double duration_s, double from_s, double to_s,
+                             const EmulatorProcess& emulator) {
+  runtime::CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  std::uint64_t in = 0, active = 0;  // written on the drain thread, read after wait()
+  o.on_frame = [&](const rt::TelemetryFrame& f) {
+    if (f.time_s < from_s || f.time_s >= to_s) return;
+    ++in;
+    if (f.state == static_cast<std::uint8_t>(rt::State::kActive)) ++active;
+  };
+  runtime::Cell cell(cfg, o);
+  if (runtime::Status s = cell.configure(); !s.ok())
+    throw std::runtime_error("the controller could not reach the emulator: " + s.message + "; the emulator's log " +
+                             emulator.log_path() + ": " + emulator.log_tail());
+  if (runtime::Status s = cell.activate(duration_s); !s.ok()) throw std::runtime_error("the controller: " + s.message);
+  cell.wait();
+  (void)cell.deactivate();
+  ControllerRun r;
+  r.trip = cell.summary().trip;
+  r.saturated_ticks = cell.summary().supervisor.saturated_ticks;
+  r.active_share = in == 0 ? 0.0 : static_cast<double>(active) / static_cast<double>(in);
+  return r;
+}
+
+void expect_exit_zero(EmulatorProcess& p, const std::string& what) {
+  const int rc = p.wait(kEmulatorEndS);
+  if (rc != 0)
+    throw std::runtime_error("the emulator (" + what + ") " +
+                             (rc < 0 ? "did not end within " + number(kEmulatorEndS) + " s of the controller"
+                                     : "exited with " + std::to_string(rc)) +
+                             "; its log " + p.log_path() + ": " + p.log_tail());
+}
+
+analysis::FrfEstimate read_estimate(const fs::path& p) {
+  if (!fs::exists(p)) throw std::runtime_error(p.string() + " is missing: the emulator did not measure it");
+  const identify::FrfData d = identify::read_frf_csv(p.string(), identify::FrfKind::kReceptance);
+  analysis::FrfEstimate e;
+  e.f_hz = d.f_hz, e.h1 = d.h, e.coherence = d.coherence;
+  if (e.coherence.empty()) e.coherence.assign(e.f_hz.size(), 1.0);
+  return e;
+}
+
+}  // namespace
+
+std::string this_executable() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot find this executable (/proc/self/exe): " + ec.message());
+  return p.string();
+}
+
+EmulatorProcess::EmulatorProcess(const std::string& binary, const std::vector<std::string>& args,
+                                 const std::string& log_path)
+    : log_(log_path) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  std::vector<std::string> copy{binary};
+  copy.insert(copy.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const int rc = posix_spawn(&pid_, binary.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) throw std::runtime_error("cannot start the emulator " + binary + ": " + std::strerror(rc));
+}
+
+EmulatorProcess::~EmulatorProcess() {
+  if (pid_ > 0 && !reaped_) {
+    ::kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+}
+
+int EmulatorProcess::wait(double timeout_s) {
+  if (reaped_) return -1;
+  const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    int status = 0;
+    const pid_t r = waitpid(pid_, &status, WNOHANG);
+    if (r == pid_) {
+      reaped_ = true;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    }
+    if (Clock::now() >= end) {
+      ::kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+      reaped_ = true;
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+std::string EmulatorProcess::log_tail(std::size_t lines) const {
+  std::ifstream in(log_);
+  std::deque<std::string> last;
+  for (std::string l; std::getline(in, l);) {
+    last.push_back(l);
+    if (last.size() > lines) last.pop_front();
+  }
+  std::string s;
+  for (const auto& l : last) s += (s.empty() ? "" : " | ") + l;
+  return s.empty() ? "(empty)" : s;
+}
+
+std::string hardware_refusal(const config::Config& cell) {
+  if (!cell.can || cell.can->interface.rfind("unix:", 0) == 0) return {};
+  return "the cell is a CAN bus (can.interface = " + cell.can->interface +
+         "): commissioning needs hammer impacts and a cut that robodamp can run, which it can on the simulated plant "
+         "(no can: section) or through the HIL emulator (can.interface: unix:PATH), not on a real cell yet; measure "
+         "there with `robodamp measure` and your modal hammer, then `robodamp identify all` and `robodamp tune`";
+}
+
+MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
+                                        const std::string& binary) {
+  fs::create_directories(out_dir);
+  const fs::path dir(out_dir);
+  EmulatorProcess plant(binary,
+                        {"plant", "--config", cell_path, "--pacing", "lockstep", "--measure-out", out_dir, "--json",
+                         (dir / "plant.json").string()},
+                        (dir / "plant.log").string());
+  MeasureOutcome o = measure(cell_path, out_dir, {"virtual"});
+  const int rc = plant.wait(kEmulatorEndS);
+  if (rc != 0) {
+    if (o.status == MeasureStatus::kOk) o.status = MeasureStatus::kFailed;
+    o.message += (o.message.empty() ? "" : "; ") + std::string("the emulator (robodamp plant --measure-out) ") +
+                 (rc < 0 ? "did not end" : "exited with " + std::to_string(rc)) + "; its log " + plant.log_path() +
+                 ": " + plant.log_tail();
+    return o;
+  }
+  const auto j = nlohmann::json::parse(text_of(dir / "plant.json"));
+  o.impact_records = j["measurement"]["records"].get<int>();
+  o.impact_records_planned = j["measurement"]["records_planned"].get<int>();
+  o.frf_files = j["measurement"]["files"].size();
+  if (o.status == MeasureStatus::kOk && o.impact_records < o.impact_records_planned) {
+    o.status = MeasureStatus::kIncomplete;
+    o.message = "the emulator measured " + std::to_string(o.impact_records) + " of " +
+                std::to_string(o.impact_records_planned) + " impact records";
+  }
+  return o;
+}
+
+CellCheck check_through_emulator(const config::Config& cell, const config::Config& tuned,
+                                 const tune::Verification& promise, const EmulatedCheckFiles& f) {
+  const auto t0 = Clock::now();
+  CellCheck out;
+  out.cell = "the HIL emulator (robodamp plant in a second process, lockstep) through the CAN and Modbus drivers";
+  const fs::path work(f.work_dir);
+  fs::create_directories(work / "impacts");
+
+  // The impacts with the tuned controller; the measurement was the same schedule with control off.
+  const analysis::CommissioningPlan plan = analysis::commissioning_plan(cell, sim::build_plant_model(cell));
+  {
+    EmulatorProcess plant(f.binary,
+                          {"plant", "--config", f.cell_path, "--pacing", "lockstep", "--measure-out",
+                           (work / "impacts").string(), "--json", (work / "impacts" / "plant.json").string()},
+                          (work / "impacts" / "plant.log").string());
+    const ControllerRun c = run_controller(tuned, plan.duration_s, plan.impacts_start_s.front(), plan.duration_s - 1.0, plant);
+    expect_exit_zero(plant, "impacts");
+    out.closed_trip = c.trip;
+    out.closed_active_share = c.active_share;
+    out.closed_saturated_ticks = c.saturated_ticks;
+  }
+  out.open_trip = identify::read_manifest(f.measurement_dir).run.value("trip", std::string("none"));
+  std::map<fs::path, analysis::FrfEstimate> cache;
+  auto from = [&cache](const fs::path& dir) {
+    return [&cache, dir](int e, int r) -> const analysis::FrfEstimate& {
+      const fs::path p = dir / analysis::frf_file_name(r, e);
+      auto it = cache.find(p);
+      if (it == cache.end()) it = cache.emplace(p, read_estimate(p)).first;
+      return it->second;
+    };
+  };
+  out.frfs = frf_checks(tuned, from(f.measurement_dir), from(work / "impacts"));
+
+  // The regenerative cut at each promised speed, at the promise less the tolerance.
+  const double start_s = cell.commissioning.settle_s + tuned.controller.gain_ramp_s + kRampMarginS;
+  const std::pair<double, double> points[] = {{promise.min_rpm, promise.min_depth_mm},
+                                              {promise.speed_rpm, promise.depth_at_speed_mm}};
+  for (std::size_t i = 0; i < 2; ++i) {
+    CutTrial t;
+    t.requested_rpm = points[i].first;
+    t.depth_mm = (1.0 - out.depth_tolerance) * points[i].second;
+    const fs::path d = work / ("cut_" + std::to_string(i + 1));
+    fs::create_directories(d);
+    const double cut_s = f.cut_revolutions * 60.0 / t.requested_rpm;
+    EmulatorProcess plant(f.binary,
+                          {"plant", "--config", f.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off", "--cut", f.job_path,
+                           "--cut-rpm", number(t.requested_rpm), "--cut-axial-mm", number(t.depth_mm), "--cut-revs",
+                           std::to_string(f.cut_revolutions), "--cut-at", number(start_s), "--json",
+                           (d / "plant.json").string()},
+                          (d / "plant.log").string());
+    // The emulator's speed is within half a loop period per tooth of the request: 2 % more time covers it.
+    const ControllerRun c = run_controller(tuned, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant);
+    expect_exit_zero(plant, "cut " + std::to_string(i + 1));
+    const auto j = nlohmann::json::parse(text_of(d / "plant.json"))["regenerative_cut"];
+    t.rpm = j["rpm"].get<double>();
+    t.complete = j["complete"].get<bool>();
+    t.stable = j["stable"].get<bool>();
+    t.classification = j["classification"].get<std::string>();
+    t.chatter_hz = j["chatter_hz"].is_number() ? j["chatter_hz"].get<double>() : 0.0;
+    t.trip = c.trip;
+    t.active_share = c.active_share;
+    spdlog::info("commission: the regenerative cut in the emulator, {:.3f} mm at {:.1f} rpm: {}", t.depth_mm, t.rpm,
+                 t.classification);
+    out.cut_trials.push_back(t);
+  }
+  out.time_domain_at_min_mm = out.cut_trials[0].held() ? out.cut_trials[0].depth_mm : 0.0;
+  out.time_domain_at_speed_mm = out.cut_trials[1].held() ? out.cut_trials[1].depth_mm : 0.0;
+  out.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace robodamp::commission

@@ -1,0 +1,69 @@
+// Commissioning through the HIL emulator (docs/identification.md, "Through the HIL emulator"): for a cell
+// whose frames go over the emulator's transport (can.interface unix:...), `robodamp commission` starts
+// `robodamp plant` as a second process for each run on the cell and runs the controller side itself,
+// through the CAN and Modbus drivers, in lockstep (the emulator steps once per command frame, the loop runs
+// on its virtual clock):
+//   measure  the emulator's commissioning impacts (--measure-out) while the loop plays the chirp;
+//   verify   the same impacts with the tuned controller running (the measurement is the control-off run),
+//            and the regenerative cut in the emulator (hil/regenerative_cut.hpp) at each promised speed at
+//            the promise less the tolerance, with the tuned controller: it must not chatter.
+// Off the real-time path.
+#pragma once
+
+#include <string>
+#include <sys/types.h>
+#include <vector>
+
+#include "commission/cell_check.hpp"
+#include "commission/measurement.hpp"
+#include "config/config.hpp"
+#include "config/milling_config.hpp"
+#include "tune/verification.hpp"
+
+namespace robodamp::commission {
+
+// The robodamp executable that runs this process (/proc/self/exe).
+[[nodiscard]] std::string this_executable();
+
+// A child process `BINARY ARGS...`, its output to a log file; killed and reaped if it is still running when
+// destroyed (no emulator outlives a failed stage).
+class EmulatorProcess {
+ public:
+  EmulatorProcess(const std::string& binary, const std::vector<std::string>& args, const std::string& log_path);
+  ~EmulatorProcess();
+  EmulatorProcess(const EmulatorProcess&) = delete;
+  EmulatorProcess& operator=(const EmulatorProcess&) = delete;
+  // Its exit code, or -1 if it had not ended within timeout_s (it is killed then).
+  int wait(double timeout_s);
+  [[nodiscard]] const std::string& log_path() const { return log_; }
+  [[nodiscard]] std::string log_tail(std::size_t lines = 6) const;
+
+ private:
+  pid_t pid_{-1};
+  bool reaped_{false};
+  std::string log_;
+};
+
+// Whether a cell is commissioned through the emulator: its can.interface is the emulator's unix: socket.
+// A cell with another interface (a real CAN bus) has no hammer and no cut that robodamp drives: refused
+// with this reason (empty: through the emulator, or the simulated plant without can:).
+[[nodiscard]] std::string hardware_refusal(const config::Config& cell);
+
+// robodamp measure's run with the emulator as the plant side (it writes the FRFs into out_dir).
+[[nodiscard]] MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
+                                                       const std::string& binary);
+
+struct EmulatedCheckFiles {
+  std::string binary;
+  std::string cell_path, job_path;
+  std::string measurement_dir;  // the control-off impacts (the measure stage's FRFs)
+  std::string work_dir;         // the runs' FRFs, logs and reports
+  int cut_revolutions{300};     // each regenerative cut's; 300: a slow decay is not read as chatter
+};
+
+// check_on_cell's checks through the emulator: improvement from the measure stage's FRFs (off) and the
+// verify run's (on); the damped cut as a verdict at the promise less depth_tolerance at each speed.
+[[nodiscard]] CellCheck check_through_emulator(const config::Config& cell, const config::Config& tuned,
+                                               const tune::Verification& promise, const EmulatedCheckFiles& files);
+
+}  // namespace robodamp::commission

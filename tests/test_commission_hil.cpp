@@ -1,0 +1,105 @@
+// robodamp commission through the HIL emulator (commission/emulated_cell.hpp): robot A
+// (config/commissioning/robot_a_two_modes_hil.yaml, a robot no preset describes) behind the emulator's CAN
+// frames and Modbus registers. Commission starts `robodamp plant` as a second process for the measurement,
+// the impacts with the tuned controller and each regenerative cut, and runs the controller side through the
+// drivers in lockstep; it must end with a verified configuration, the measured improvements within 5
+// points of the predicted, and the cuts at the promise less 5 % stable.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "commission/commission.hpp"
+#include "config/config.hpp"
+#include "hil_files.hpp"
+#include "test_util.hpp"
+
+namespace robodamp {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(CommissionHil, ARobotNoPresetDescribesIsCommissionedAndVerifiedThroughTheEmulator) {
+  const std::string robot = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes_hil.yaml";
+  // Its own socket and port; a shorter plan (3 chirp periods, 4 impacts of 6 s per location).
+  const test::HilFiles f = test::hil_files(
+      "commission", {{"unix:/tmp/robodamp-hil-commission.sock", "unix:/PLACEHOLDER"}}, "commissioning/robot_a_two_modes_hil");
+  std::string text = test::read_file(f.config);
+  test::replace_all(text, "unix:/PLACEHOLDER", "unix:" + f.dir + "/can.sock");
+  test::replace_all(text, "port: 1512", "port: " + std::to_string(test::free_tcp_port()));
+  text += "\ncommissioning: {chirp_periods: 3, chirp_period_s: 8, impacts_per_location: 4, record_s: 6}\n";
+  std::ofstream(f.config) << text;
+
+  commission::CommissionSettings s;
+  s.config_path = f.config;
+  s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
+  s.out_dir = f.dir + "/out";
+  s.command_line = "test";
+  s.robodamp_binary = ROBODAMP_BINARY;
+  s.tune.global_evaluations = 40;  // the test is the chain through the emulator, not the optimum
+  s.tune.local_evaluations = 10;
+  s.cut_revolutions = 120;
+  std::vector<std::string> lines;
+  const commission::CommissionResult r = commission::commission(s, [&](const std::string& l) { lines.push_back(l); });
+  ASSERT_EQ(r.outcome, commission::Outcome::kVerified)
+      << commission::to_string(r.stage) << ": " << r.reason << "\nemulator logs in " << f.dir;
+
+  // The measurement came from the emulator's process (its report says it measured every record).
+  const auto m = nlohmann::json::parse(test::read_file(s.out_dir + "/measurement/plant.json"));
+  EXPECT_EQ(m["measurement"]["records"], m["measurement"]["records_planned"]);
+  EXPECT_EQ(m["measurement"]["records"], 8);
+  EXPECT_EQ(m["transport"], "unix:" + f.dir + "/can.sock");
+  ASSERT_TRUE(r.identified);
+  ASSERT_EQ(r.identified->frfs.front().fit.modes.size(), 2u);
+  EXPECT_NEAR(r.identified->frfs.front().fit.modes[0].natural_freq_hz, 5.5, 0.055);
+  EXPECT_NEAR(r.identified->frfs.front().fit.modes[1].natural_freq_hz, 16.0, 0.16);
+
+  ASSERT_TRUE(r.cell && r.promise);
+  EXPECT_NE(r.cell->cell.find("HIL emulator"), std::string::npos) << r.cell->cell;
+  EXPECT_EQ(r.cell->closed_trip, "none");
+  EXPECT_DOUBLE_EQ(r.cell->closed_active_share, 1.0);
+  ASSERT_EQ(r.cell->frfs.size(), 3u);
+  for (const auto& fc : r.cell->frfs) {
+    EXPECT_NEAR(fc.measured_improvement_pct, fc.predicted_improvement_pct, 5.0) << fc.name;
+    EXPECT_GT(fc.predicted_improvement_pct, 3.0) << fc.name;
+  }
+  // The regenerative cuts ran in the emulator's process at the promised speeds, at the promise less 5 %.
+  ASSERT_EQ(r.cell->cut_trials.size(), 2u);
+  const double promised[] = {r.promise->min_depth_mm, r.promise->depth_at_speed_mm};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto& t = r.cell->cut_trials[i];
+    EXPECT_TRUE(t.held()) << t.classification << " at " << t.rpm << " rpm";
+    EXPECT_NEAR(t.depth_mm, 0.95 * promised[i], 1e-9);
+    const auto j = nlohmann::json::parse(test::read_file(s.out_dir + "/verify/cut_" + std::to_string(i + 1) + "/plant.json"));
+    EXPECT_EQ(j["regenerative_cut"]["classification"], "stable");
+    EXPECT_EQ(j["regenerative_cut"]["revolutions"], 120);
+    EXPECT_NEAR(j["regenerative_cut"]["axial_mm"].get<double>(), t.depth_mm, 1e-5);
+  }
+  // Written only because it verified, and it is a configuration for the same wires.
+  const config::Config written = config::load_config_file(s.out_dir + "/configuration.yaml");
+  EXPECT_EQ(written.controller.gain_ns_per_m, r.tuned_config->controller.gain_ns_per_m);
+  ASSERT_TRUE(written.can);
+  EXPECT_EQ(written.can->interface, "unix:" + f.dir + "/can.sock");
+  EXPECT_NE(test::read_file(s.out_dir + "/configuration.yaml").find("HIL emulator"), std::string::npos);
+  EXPECT_NE(test::read_file(s.out_dir + "/report.html").find("the regenerative cut in the HIL emulator"), std::string::npos);
+}
+
+TEST(CommissionHil, ARealCanBusIsRefusedWithTheReason) {
+  const test::HilFiles f = test::hil_files("commission_can", {{"unix:/tmp/robodamp-hil-commission.sock", "can0"}},
+                                           "commissioning/robot_a_two_modes_hil");
+  commission::CommissionSettings s;
+  s.config_path = f.config;
+  s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
+  s.out_dir = f.dir + "/out";
+  const commission::CommissionResult r = commission::commission(s, [](const std::string&) {});
+  EXPECT_EQ(r.outcome, commission::Outcome::kBadInput);
+  EXPECT_EQ(r.stage, commission::Stage::kMeasure);
+  EXPECT_NE(r.reason.find("can.interface = can0"), std::string::npos) << r.reason;
+  EXPECT_FALSE(fs::exists(s.out_dir + "/configuration.yaml"));
+}
+
+}  // namespace
+}  // namespace robodamp
