@@ -105,6 +105,19 @@ struct RunArgs {
                       {"trip_s", t(s.trip_timing.trip_s)},
                       {"safe_s", t(s.trip_timing.safe_s)},
                       {"ticks_to_safe", s.trip_timing.ticks_to_safe >= 0 ? json(s.trip_timing.ticks_to_safe) : json(nullptr)}};
+  {
+    const auto& a = s.availability;
+    json trips = json::array();
+    for (const auto& tr : a.trips)
+      trips.push_back({{"trip", tr.trip}, {"trip_s", tr.trip_s}, {"safe_s", t(tr.safe_s)},
+                       {"rearmed_s", t(tr.rearmed_s)}, {"full_gain_again_s", t(tr.full_gain_again_s)},
+                       {"safe_after_s", tr.safe_s >= 0.0 ? json(tr.safe_s - tr.trip_s) : json(nullptr)},
+                       {"rearmed_after_s", tr.rearmed_s >= 0.0 ? json(tr.rearmed_s - tr.trip_s) : json(nullptr)},
+                       {"full_gain_after_s", tr.full_gain_again_s >= 0.0 ? json(tr.full_gain_again_s - tr.trip_s) : json(nullptr)}});
+    j["availability"] = {{"asked_s", a.asked_s},         {"active_full_gain_s", a.active_s},
+                         {"share", a.share()},           {"first_full_gain_s", t(a.first_full_gain_s)},
+                         {"trips_total", a.trips_total}, {"trips", trips}};
+  }
   if (s.can) {
     const auto& c = *s.can;
     j["can"] = {{"rx_frames", c.rx_frames},       {"rx_other", c.rx_other},     {"rx_malformed", c.rx_malformed},
@@ -254,6 +267,19 @@ struct RunArgs {
        << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
   os << '\n';
   os << devices_text(s);
+  if (s.availability.first_full_gain_s >= 0.0) {
+    const auto& a = s.availability;
+    std::size_t rearmed = 0;
+    double worst = 0.0;
+    for (const auto& tr : a.trips)
+      if (tr.full_gain_again_s >= 0.0) ++rearmed, worst = std::max(worst, tr.full_gain_again_s - tr.trip_s);
+    std::snprintf(b, sizeof b,
+                  "  availability: at full gain %.4f %% of the %.1f s asked (from %.3f s); %llu trips, %zu back at full "
+                  "gain (the slowest after %.2f s)\n",
+                  100.0 * a.share(), a.asked_s, a.first_full_gain_s, static_cast<unsigned long long>(a.trips_total), rearmed,
+                  worst);
+    os << b;
+  }
   if (s.trip_timing.trip_s >= 0.0) {
     std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s (%lld ticks after it)\n",
                   s.trip_timing.trip_s, s.trip_timing.last_fresh_s, s.trip_timing.safe_s,

@@ -55,8 +55,8 @@ class Run {
     emulated_ = cell_.can.has_value();
     if (emulated_) {
       binary_ = s_.robodamp_binary.empty() ? this_executable() : s_.robodamp_binary;
-      say_("commission: the cell is the HIL emulator on " + cell_.can->interface + ": " + binary_ +
-           " plant runs as a second process for each run on the cell (lockstep)");
+      say_("commission: the cell is the HIL emulator on " + cell_.can->interface +
+           ": `robodamp plant` runs as a second process for each run on the cell (lockstep)");
     }
     job_ = config::load_milling_config(s_.job_path);
     stage(Stage::kMeasure, [this] { measure(); });

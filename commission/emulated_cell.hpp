@@ -22,7 +22,7 @@
 
 namespace robodamp::commission {
 
-// The robodamp executable that runs this process (/proc/self/exe).
+// The robodamp executable that runs this process, to start again as the emulator (/proc/self/exe).
 [[nodiscard]] std::string this_executable();
 
 // A child process `BINARY ARGS...`, its output to a log file; killed and reaped if it is still running when
@@ -36,6 +36,7 @@ class EmulatorProcess {
   // Its exit code, or -1 if it had not ended within timeout_s (it is killed then).
   int wait(double timeout_s);
   [[nodiscard]] const std::string& log_path() const { return log_; }
+  [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] std::string log_tail(std::size_t lines = 6) const;
 
  private:

@@ -261,6 +261,7 @@ void Cell::on_frame(const rt::TelemetryFrame& f) {
     tt.safe_s = f.time_s;
     tt.ticks_to_safe = n_frames_ - last_fresh_frame_;
   }
+  if (availability_) availability_->on_frame(f);
   ++n_frames_;
   if (o_.keep_frames) frames_.push_back(f);
 }
@@ -283,6 +284,7 @@ Status Cell::activate(double duration_s) {
   sum_sq_ = 0.0;
   n_samples_ = 0;
   n_frames_ = 0;
+  availability_.emplace(cfg_.loop.rate_hz, cfg_.controller.gain_ramp_s);
   last_fresh_frame_ = -1;
   frames_.clear();
   const bool wall = cfg_.loop.clock == config::ClockKind::kWall;
@@ -373,6 +375,7 @@ void Cell::finish_summary() {
   s.arming.attempts = arming_->attempts();
   s.arming.last_refusal = arming_->last_refusal();
   s.telemetry_frames = drain_->frames();
+  if (availability_) s.availability = availability_->result();
   s.sensor_rms_mps2 = n_samples_ ? std::sqrt(sum_sq_ / static_cast<double>(n_samples_)) : 0.0;
   if (machining_) s.machining = machining_->settled_sample(kMachiningSummaryWaitS);
 }

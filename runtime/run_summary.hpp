@@ -14,6 +14,7 @@
 #include "rt/realtime.hpp"
 #include "rt/supervisor.hpp"
 #include "runtime/arming_policy.hpp"
+#include "runtime/availability.hpp"
 
 namespace robodamp::runtime {
 
@@ -57,6 +58,7 @@ struct RunSummary {
   std::optional<drivers::ModbusCounters> modbus;
   std::optional<dds::BridgeCounters> dds;
   TripTiming trip_timing;
+  Availability availability;  // the share of the asked time at full gain; every trip's safe and re-arm times
   std::string record_path;
   double sensor_rms_mps2{0.0};  // control accelerometer over the run
   double peak_command_v{0.0};

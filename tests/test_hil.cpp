@@ -428,6 +428,13 @@ TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   std::size_t arm = t.trip;
   while (arm < frames.size() && frames[arm].command_kind != static_cast<std::uint8_t>(rt::CommandKind::kArm)) ++arm;
   for (std::size_t i = t.trip; i < arm; ++i) ASSERT_NE(frames[i].state, static_cast<std::uint8_t>(rt::State::kActive)) << i;
+  // The run summary's availability saw the same trip and safe state, and the outage.
+  const runtime::Availability& av = r.cell->summary().availability;
+  ASSERT_GE(av.trips_total, 1u);
+  EXPECT_EQ(av.trips.front().trip, trip);
+  EXPECT_DOUBLE_EQ(av.trips.front().trip_s, frames[t.trip].time_s);
+  EXPECT_DOUBLE_EQ(av.trips.front().safe_s, frames[t.safe].time_s);
+  EXPECT_GT(av.asked_s, av.active_s);
   std::printf("[ hil kill ] emulator killed: trip %s, safe %.1f ms after the last fresh sample (allowed %.1f ms); "
               "reconnected, reset and re-armed\n",
               trip.c_str(), 1e3 * safe_after_s, 1e3 * allowed_s);

@@ -10,6 +10,7 @@
 
 #include "cell_util.hpp"
 #include "runtime/arming_policy.hpp"
+#include "runtime/availability.hpp"
 #include "runtime/lifecycle.hpp"
 #include "runtime/parameter_requests.hpp"
 #include "test_util.hpp"
@@ -296,6 +297,45 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
   }
   EXPECT_GT(accepted, 100);
   std::printf("[ requests ] 10000 random parameter requests, %d accepted\n", accepted);
+}
+
+// The availability meter on a scripted run at 1 kHz with a 0.1 s gain ramp: start-up (not asked), full gain
+// from 0.2 s, a trip at 2 s (safe 10 ms later, re-armed at 5 s, full gain at 5.1 s), 20 missed ticks at
+// 7 s, the run's own stop at 9 s (not asked).
+TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
+  AvailabilityMeter m(1000.0, 0.1);
+  auto frame = [&](std::uint64_t tick, rt::State st, rt::Trip trip, double command_v, bool enable) {
+    rt::TelemetryFrame f;
+    f.tick = tick;
+    f.time_s = static_cast<double>(tick) * 1e-3;
+    f.state = static_cast<std::uint8_t>(st);
+    f.trip = static_cast<std::uint8_t>(trip);
+    f.command_v = command_v;
+    f.flags = enable ? rt::kFlagAmplifierEnable : 0;
+    m.on_frame(f);
+  };
+  for (std::uint64_t k = 0; k <= 10000; ++k) {
+    if (k >= 7000 && k < 7020) continue;  // missed: no frames
+    if (k < 100) frame(k, rt::State::kArming, rt::Trip::kNone, 0.0, true);
+    else if (k < 2000) frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
+    else if (k < 2010) frame(k, rt::State::kStopping, rt::Trip::kSensorStale, 0.05, true);
+    else if (k < 4900) frame(k, rt::State::kFault, rt::Trip::kSensorStale, 0.0, false);
+    else if (k < 5000) frame(k, rt::State::kArming, rt::Trip::kNone, 0.0, true);
+    else if (k < 9000) frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
+    else frame(k, rt::State::kStopping, rt::Trip::kNone, 0.0, true);
+  }
+  const Availability& a = m.result();
+  EXPECT_NEAR(a.first_full_gain_s, 0.2, 1e-9);
+  EXPECT_NEAR(a.asked_s, 9.0 - 0.2, 1.5e-3);                            // 0.2 .. 9.0 s
+  EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1) - 0.020, 1.5e-3);  // less the trip and the missed ticks
+  EXPECT_NEAR(a.share(), a.active_s / a.asked_s, 1e-12);
+  ASSERT_EQ(a.trips_total, 1u);
+  ASSERT_EQ(a.trips.size(), 1u);
+  EXPECT_EQ(a.trips[0].trip, "sensor_stale");
+  EXPECT_NEAR(a.trips[0].trip_s, 2.0, 1e-9);
+  EXPECT_NEAR(a.trips[0].safe_s, 2.010, 1e-9);
+  EXPECT_NEAR(a.trips[0].rearmed_s, 5.0, 1e-9);
+  EXPECT_NEAR(a.trips[0].full_gain_again_s, 5.1, 1e-9);
 }
 
 }  // namespace

@@ -1,0 +1,45 @@
+#include "runtime/availability.hpp"
+
+#include "rt/supervisor.hpp"
+
+namespace robodamp::runtime {
+
+void AvailabilityMeter::on_frame(const rt::TelemetryFrame& f) {
+  const bool active = f.state == static_cast<std::uint8_t>(rt::State::kActive);
+  if (!active) active_since_s_ = -1.0;
+  else if (active_since_s_ < 0.0) active_since_s_ = f.time_s;
+  // Full gain: active for a whole gain ramp (the arming's and every re-arm's fade-in is over).
+  const bool full = active && f.time_s - active_since_s_ >= ramp_s_ - 0.5 * period_s_;
+  if (full && a_.first_full_gain_s < 0.0) a_.first_full_gain_s = f.time_s;
+  // Stopping or disabled with no trip: the run's end or an operator asked for off; not asked to damp.
+  const bool off_asked = f.trip == 0 && (f.state == static_cast<std::uint8_t>(rt::State::kStopping) ||
+                                         f.state == static_cast<std::uint8_t>(rt::State::kDisabled));
+  if (a_.first_full_gain_s >= 0.0 && have_prev_ && !off_asked) {
+    const std::uint64_t ticks = f.tick > prev_tick_ ? f.tick - prev_tick_ : 1;  // the missed ones were not damping
+    a_.asked_s += static_cast<double>(ticks) * period_s_;
+    if (full) a_.active_s += period_s_;
+  }
+  have_prev_ = true;
+  prev_tick_ = f.tick;
+  // Trips: a new one when the latched trip appears; safe when the command is zero with the amplifier off;
+  // over when the loop is at full gain again.
+  if (f.trip != 0 && !in_trip_) {
+    in_trip_ = true;
+    ++a_.trips_total;
+    open_ = nullptr;
+    if (a_.trips.size() < Availability::kMaxTrips) {
+      a_.trips.push_back({rt::to_string(static_cast<rt::Trip>(f.trip)), f.time_s});
+      open_ = &a_.trips.back();
+    }
+  }
+  if (in_trip_ && open_ && open_->safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable))
+    open_->safe_s = f.time_s;
+  if (in_trip_ && open_ && open_->rearmed_s < 0.0 && active && f.trip == 0) open_->rearmed_s = f.time_s;
+  if (in_trip_ && f.trip == 0 && full) {
+    if (open_) open_->full_gain_again_s = f.time_s;
+    in_trip_ = false;
+    open_ = nullptr;
+  }
+}
+
+}  // namespace robodamp::runtime
