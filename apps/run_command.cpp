@@ -77,6 +77,7 @@ struct RunArgs {
             {"pose_out_of_map", s.supervisor.pose_out_of_map},
             {"active_parameter_set", s.active_parameter_set},
             {"recoveries", s.supervisor.recoveries},
+            {"overrun_runs_ridden", s.supervisor.overrun_runs_ridden},
             {"budget_latches", s.supervisor.budget_latches},
             {"probation_latches", s.supervisor.probation_latches}}},
           {"realtime",
@@ -267,6 +268,11 @@ struct RunArgs {
        << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
   os << '\n';
   os << devices_text(s);
+  if (s.supervisor.overrun_runs_ridden > 0) {
+    std::snprintf(b, sizeof b, "  overruns: %llu runs of supervision.overrun_cycles or more ridden through within the delay margin\n",
+                  static_cast<unsigned long long>(s.supervisor.overrun_runs_ridden));
+    os << b;
+  }
   if (s.availability.first_full_gain_s >= 0.0) {
     const auto& a = s.availability;
     std::size_t rearmed = 0;

@@ -481,6 +481,10 @@ SupervisionConfig read_supervision(MapReader& top) {
                         c.sample_limit_mps2))
     c.sample_limit_mps2 = *v;
   if (auto v = read_int(r, "overrun_cycles", cycles, c.overrun_cycles)) c.overrun_cycles = *v;
+  if (auto v = r.number("overrun_delay_margin_share", {"(share of the delay margin)", 0.0, 1.0, false, false,
+                                                       "0 = overrun_cycles alone"},
+                        c.overrun_delay_margin_share))
+    c.overrun_delay_margin_share = *v;
   if (auto v = r.number("saturation_window_s", {"s", 0.001, 10.0}, c.saturation_window_s)) c.saturation_window_s = *v;
   if (auto v = r.number("saturation_duty_max", {"(fraction of the window)", 0.0, 1.0, true}, c.saturation_duty_max))
     c.saturation_duty_max = *v;

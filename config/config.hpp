@@ -89,7 +89,11 @@ struct SupervisionConfig {
   int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample
   int invalid_sample_cycles{1};      // consecutive non-finite or out-of-range samples
   double sample_limit_mps2{0.0};     // out of range beyond this; 0 = the sensor's range (sensor.range_g)
-  int overrun_cycles{10};            // consecutive overruns (compute past the period or missed ticks)
+  int overrun_cycles{10};            // consecutive overruns (compute past the period or missed ticks) ...
+  // ... lasting, in measured time, at least this share of the active set's delay margin (the extra delay
+  // the loop tolerates for good, analysis/loop_model.hpp): a stall shorter than that cannot destabilise
+  // the loop, so it is ridden through (counted). 0 = overrun_cycles alone.
+  double overrun_delay_margin_share{1.0};
   double saturation_window_s{0.5};
   double saturation_duty_max{0.2};   // fraction of the window's ticks at a controller or actuator limit
   double instability_block_s{0.1};   // command RMS per block

@@ -39,7 +39,7 @@ class Bridge::RequestListener : public DataReaderListener {
 };
 
 Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources)
-    : cfg_(cfg), source_(config_source), src_(std::move(sources)) {
+    : cfg_(cfg), source_(config_source), src_(std::move(sources)), availability_(loop_rate_hz, src_.gain_ramp_s) {
   window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
   participant_ = std::make_unique<Participant>(cfg.domain_id, cfg.transport, "robodamp loop", cfg.security);
   telemetry_writer_ = participant_->writer(TopicKind::kTelemetry);
@@ -76,6 +76,7 @@ void Bridge::on_frame(const rt::TelemetryFrame& f) {
     std::lock_guard<std::mutex> lock(m_);
     last_ = f;
     have_frame_ = true;
+    availability_.on_frame(f);
     if (f.wake_latency_us > 0.0F || f.compute_us > 0.0F) {
       wake_.record(static_cast<std::int64_t>(f.wake_latency_us * 1e3F));
       compute_.record(static_cast<std::int64_t>(f.compute_us * 1e3F));
@@ -125,6 +126,13 @@ void Bridge::publish_status() {
     s.wake_max_us(static_cast<float>(wake_.max_us()));
     s.compute_mean_us(static_cast<float>(compute_.mean_us()));
     s.compute_max_us(static_cast<float>(compute_.max_us()));
+    const rt::Availability& a = availability_.result();
+    s.availability_pct(static_cast<float>(100.0 * a.share()));
+    s.trips(static_cast<std::uint32_t>(a.trips_total));
+    std::uint32_t back = 0;
+    for (const auto& t : a.trips) back += t.full_gain_again_s >= 0.0 ? 1U : 0U;
+    s.back_at_full_gain(back);
+    s.last_trip_s(a.trips.empty() ? -1.0 : a.trips.back().trip_s);
     published_state_ = f.state;
     published_trip_ = f.trip;
   }

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "config/supervisory_config.hpp"
+#include "rt/availability.hpp"
 #include "rt/telemetry_frame.hpp"
 #include "rt/timing_histogram.hpp"
 
@@ -55,6 +56,7 @@ struct BridgeSources {
   std::function<double()> gain_limit_ns_per_m;     // what a gain request may ask for now
   std::function<Decision(RequestKind, double)> handle;  // validate and queue (parameter writes on)
   std::function<MachiningSample()> machining;      // empty: no machining topic (no spindle.job)
+  double gain_ramp_s{0.0};                         // controller.gain_ramp_s: when the loop is at full gain
 };
 
 struct BridgeCounters {
@@ -90,6 +92,7 @@ class Bridge {
   eprosima::fastdds::dds::DataWriter* reply_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* machining_writer_{nullptr};
   std::unique_ptr<RequestListener> listener_;
+  rt::AvailabilityMeter availability_;  // under m_
 
   // Decimation window (drain thread).
   std::uint64_t window_ticks_{1}, in_window_{0};

@@ -90,6 +90,7 @@ json to_json(const SupervisorSettings& s) {
           {"invalid_sample_cycles", l.invalid_sample_cycles},
           {"sample_limit_mps2", l.sample_limit_mps2},
           {"overrun_cycles", l.overrun_cycles},
+          {"overrun_delay_margin_share", l.overrun_delay_margin_share},
           {"saturation_window_s", l.saturation_window_s},
           {"saturation_duty_max", l.saturation_duty_max},
           {"instability_block_s", l.instability_block_s},
@@ -112,6 +113,7 @@ json to_json(const SupervisorSettings& s) {
           {"fade_s", s.fade_s},
           {"analysis_stable", s.analysis_stable},
           {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
+          {"delay_margin_s", s.delay_margin_s},
           {"pose_scheduled", s.pose_scheduled},
           {"test_signal",
            {{"enabled", s.test_signal.enabled},
@@ -131,6 +133,7 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   l.invalid_sample_cycles = j.at("invalid_sample_cycles");
   l.sample_limit_mps2 = j.at("sample_limit_mps2");
   l.overrun_cycles = j.at("overrun_cycles");
+  l.overrun_delay_margin_share = j.value("overrun_delay_margin_share", 0.0);  // absent before issue 28's ride-through
   l.saturation_window_s = j.at("saturation_window_s");
   l.saturation_duty_max = j.at("saturation_duty_max");
   l.instability_block_s = j.at("instability_block_s");
@@ -157,6 +160,7 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   s.fade_s = j.at("fade_s");
   s.analysis_stable = j.at("analysis_stable");
   s.max_stable_gain_ns_per_m = j.at("max_stable_gain_ns_per_m");
+  s.delay_margin_s = j.value("delay_margin_s", 0.0);
   s.pose_scheduled = j.value("pose_scheduled", false);  // absent before pose_schedule existed
   if (j.contains("test_signal")) {  // absent in recordings made before robodamp measure existed
     const json& t = j.at("test_signal");
@@ -186,7 +190,8 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
     const ParameterSet& p = supervisor.parameter_sets()[i];
     sets.push_back({{"params", to_json(p.params)},
                     {"analysis_stable", p.analysis_stable},
-                    {"max_stable_gain_ns_per_m", p.max_stable_gain_ns_per_m}});
+                    {"max_stable_gain_ns_per_m", p.max_stable_gain_ns_per_m},
+                    {"delay_margin_s", p.delay_margin_s}});
   }
   // A virtual-clock run has no wall time in it: its file carries none, so the same run gives the same
   // bytes (docs/recording_format.md).
@@ -308,7 +313,7 @@ ReplayResult replay(const Recording& r) {
                  controller_params_from(r.header.at("controller_params")));
   for (const auto& p : r.header.value("parameter_sets", json::array()))
     sup.add_parameter_set({controller_params_from(p.at("params")), p.at("analysis_stable").get<bool>(),
-                           p.at("max_stable_gain_ns_per_m").get<double>()});
+                           p.at("max_stable_gain_ns_per_m").get<double>(), p.value("delay_margin_s", 0.0)});
   for (const auto& f : r.frames) {
     const TickOutput out = sup.step(tick_input(f));
     ++res.frames;

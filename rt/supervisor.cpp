@@ -91,7 +91,8 @@ const char* to_string(CommandKind k) {
   return "?";
 }
 
-SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable, double max_stable_gain_ns_per_m) {
+SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable, double max_stable_gain_ns_per_m,
+                                       double delay_margin_s) {
   SupervisorSettings s;
   s.limits = cfg.supervision;
   s.fs_hz = cfg.loop.rate_hz;
@@ -100,12 +101,13 @@ SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_
   s.fade_s = cfg.controller.gain_ramp_s;
   s.analysis_stable = analysis_stable;
   s.max_stable_gain_ns_per_m = max_stable_gain_ns_per_m;
+  s.delay_margin_s = delay_margin_s;
   return s;
 }
 
 Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
     : s_(s), controller_(params), pose_known_(!s.pose_scheduled) {
-  sets_.push_back({params, s.analysis_stable, s.max_stable_gain_ns_per_m});
+  sets_.push_back({params, s.analysis_stable, s.max_stable_gain_ns_per_m, s.delay_margin_s});
   const auto window = static_cast<std::size_t>(std::max(1.0, std::round(s.limits.saturation_window_s * s.fs_hz)));
   sat_window_.assign(window, 0);
   sat_threshold_ = static_cast<std::uint64_t>(std::floor(s.limits.saturation_duty_max * static_cast<double>(window)));
@@ -283,7 +285,8 @@ Trip Supervisor::check_trips(const TickInput& in) const noexcept {
   if (!in.sensor_ok) return Trip::kSensorDriver;
   if (!in.actuator_ok) return Trip::kActuatorDriver;
   if (in.amplifier_fault) return Trip::kAmplifierFault;
-  if (overrun_run_ >= static_cast<std::uint64_t>(l.overrun_cycles)) return Trip::kOverruns;
+  if (overrun_run_ >= static_cast<std::uint64_t>(l.overrun_cycles) && overrun_run_s_ >= overrun_tolerance_s())
+    return Trip::kOverruns;
   if (state_ == State::kArming && !in.amplifier_ready && arming_s_ >= l.amplifier_ready_timeout_s)
     return Trip::kAmplifierNotReady;
   return Trip::kNone;
@@ -349,9 +352,13 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   live_run_ = in.fresh && valid && in.sensor_ok ? live_run_ + 1 : 0;
   if (in.overrun) {
     ++overrun_run_;
+    overrun_run_s_ += in.dt_s;
     ++counters_.overruns;
   } else {
+    if (overrun_run_ >= static_cast<std::uint64_t>(s_.limits.overrun_cycles) && trip_ != Trip::kOverruns)
+      ++counters_.overrun_runs_ridden;
     overrun_run_ = 0;
+    overrun_run_s_ = 0.0;
   }
   path_ok_ = in.sensor_ok && in.actuator_ok && !in.amplifier_fault;
 

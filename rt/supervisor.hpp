@@ -94,6 +94,9 @@ struct SupervisorCounters {
   std::uint64_t stale_ticks{0};
   std::uint64_t invalid_samples{0};
   std::uint64_t overruns{0};
+  // Runs of overrun_cycles or more consecutive overruns that ended within the active set's delay margin
+  // (supervision.overrun_delay_margin_share): ridden through, not tripped.
+  std::uint64_t overrun_runs_ridden{0};
   std::uint64_t saturated_ticks{0};
   std::uint64_t arm_refused{0};
   std::uint64_t gain_refused{0};
@@ -146,6 +149,7 @@ struct SupervisorSettings {
   double fade_s{0.5};                // activation / disarm fade (controller.gain_ramp_s)
   bool analysis_stable{false};       // the analysis found the configured loop stable
   double max_stable_gain_ns_per_m{0.0};
+  double delay_margin_s{0.0};        // the analysis' delay margin at the configured gain (0: none known)
   TestSignal test_signal;            // robodamp measure only
   // pose_schedule: arming waits for a pose in a region (set_pose_region), the supervisor hands over to
   // each region's set as the pose moves, and a pose out of the map trips (kPoseOutOfMap).
@@ -158,11 +162,12 @@ struct ParameterSet {
   control::ControllerParams params;
   bool analysis_stable{false};
   double max_stable_gain_ns_per_m{0.0};
+  double delay_margin_s{0.0};  // at its gain; 0: none known (the overrun trip is overrun_cycles alone)
 };
 
 // The settings for a configuration, given what the analysis found.
 [[nodiscard]] SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable,
-                                                     double max_stable_gain_ns_per_m);
+                                                     double max_stable_gain_ns_per_m, double delay_margin_s = 0.0);
 
 class Supervisor {
  public:
@@ -237,7 +242,13 @@ class Supervisor {
   SupervisorCounters counters_{};
 
   double last_valid_mps2_{0.0};
+  // How long a run of overruns may last (measured time) before it trips: the share of the active set's
+  // delay margin. Arithmetic only (RT-safe).
+  [[nodiscard]] double overrun_tolerance_s() const noexcept {
+    return s_.limits.overrun_delay_margin_share * sets_[active_parameter_set()].delay_margin_s;
+  }
   std::uint64_t stale_run_{0}, invalid_run_{0}, live_run_{0}, overrun_run_{0};
+  double overrun_run_s_{0.0};  // the measured time the current run of overruns has lasted
   bool path_ok_{true};
   double fade_{0.0};       // 0..1, activation / disarm
   double arming_s_{0.0};   // time spent arming

@@ -23,6 +23,13 @@ Cell::~Cell() {
 
 namespace {
 
+// The extra delay the loop at its configured gain tolerates for good (s; 0 when none is known): how long a
+// run of overruns may last before it trips (supervision.overrun_delay_margin_share).
+double delay_margin_s(const analysis::LoopModel& m, const config::Config& c, std::optional<double> k_max) {
+  const analysis::Margins mg = analysis::margins(m, c.controller.gain_ns_per_m, c.controller.polarity, k_max);
+  return mg.delay_margin_ms ? *mg.delay_margin_ms * 1e-3 : 0.0;
+}
+
 // The harmonic notches' speed map (analysis/notch_speed_map.hpp): the speeds refused go into the
 // controller's parameters, and each refused interval is reported once here.
 control::ControllerParams with_notch_speed_map(const config::Config& cfg, control::ControllerParams p) {
@@ -73,7 +80,8 @@ Status Cell::configure() {
     k_max = std::min(k_max, pose_schedule_.regions.front().k_max_ns_per_m);
     max_stable_gain_ = k_max;
   }
-  rt::SupervisorSettings settings = rt::supervisor_settings(cfg_, stable_, k_max);
+  rt::SupervisorSettings settings =
+      rt::supervisor_settings(cfg_, stable_, k_max, delay_margin_s(*model_, set0, max_stable_gain_));
   settings.test_signal = o_.test_signal;
   settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
   supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(set0, model_->chain().params));
@@ -141,7 +149,8 @@ Status Cell::configure_devices() {
                            [this] { return std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM); },
                            [this](dds::RequestKind k, double v) { return handle_request(k, v); },
                            cfg_.spindle.job.empty() ? std::function<dds::MachiningSample()>{}
-                                                    : [this] { return machining_->sample(); }});
+                                                    : [this] { return machining_->sample(); },
+                           cfg_.controller.gain_ramp_s});
   }
   for (Component* c : components()) {
     if (Status s = c->configure(); !s.ok()) {
@@ -186,8 +195,9 @@ Status Cell::configure_pose_schedule() {
 void Cell::configure_pose_sets() {
   for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i) {
     const auto& r = pose_schedule_.regions[i];
-    supervisor_->add_parameter_set({with_notch_speed_map(r.config, analysis::LoopModel(r.config).chain().params), true,
-                                    r.k_max_ns_per_m});
+    const analysis::LoopModel m(r.config);
+    supervisor_->add_parameter_set({with_notch_speed_map(r.config, m.chain().params), true, r.k_max_ns_per_m,
+                                    delay_margin_s(m, r.config, r.k_max_ns_per_m)});
   }
 }
 
@@ -229,7 +239,7 @@ std::size_t Cell::add_parameter_set(const config::Config& cfg) {
   const int polarity = cfg.controller.polarity;
   const auto k_max = analysis::max_stable_gain(m, polarity);
   return supervisor_->add_parameter_set({with_notch_speed_map(cfg, m.chain().params), m.stable(cfg.controller.gain_ns_per_m, polarity),
-                                         k_max.value_or(control::kMaxGainNsPerM)});
+                                         k_max.value_or(control::kMaxGainNsPerM), delay_margin_s(m, cfg, k_max)});
 }
 
 std::optional<std::size_t> Cell::parameter_set_for(config::Mounting m) const {

@@ -156,7 +156,7 @@ class Cell {
   double sum_sq_{0.0};
   std::uint64_t n_samples_{0};
   std::int64_t n_frames_{0}, last_fresh_frame_{-1};
-  std::optional<AvailabilityMeter> availability_;  // fed on the drain thread
+  std::optional<rt::AvailabilityMeter> availability_;  // fed on the drain thread
   std::vector<rt::TelemetryFrame> frames_;
 };
 

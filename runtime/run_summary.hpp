@@ -14,7 +14,7 @@
 #include "rt/realtime.hpp"
 #include "rt/supervisor.hpp"
 #include "runtime/arming_policy.hpp"
-#include "runtime/availability.hpp"
+#include "rt/availability.hpp"
 
 namespace robodamp::runtime {
 
@@ -58,7 +58,7 @@ struct RunSummary {
   std::optional<drivers::ModbusCounters> modbus;
   std::optional<dds::BridgeCounters> dds;
   TripTiming trip_timing;
-  Availability availability;  // the share of the asked time at full gain; every trip's safe and re-arm times
+  rt::Availability availability;  // the share of the asked time at full gain; every trip's safe and re-arm times
   std::string record_path;
   double sensor_rms_mps2{0.0};  // control accelerometer over the run
   double peak_command_v{0.0};

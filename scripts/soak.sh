@@ -2,7 +2,7 @@
 # Soak: `robodamp run` on the wall clock for a long time (default 1 h; not in CI), set up for real time
 # as deployed, with a 1000 N hit at the TCP every 2 s and the drives' vibration. Samples the process's
 # resident memory every 10 s and reports the availability (the share of the asked time at full gain,
-# runtime/availability.hpp), every trip with its class, its time to the safe state and to full gain again,
+# rt/availability.hpp), every trip with its class, its time to the safe state and to full gain again,
 # memory growth, telemetry drops, missed ticks, overruns and the wake-up latency. Exit status: 0 when the
 # availability is at least MIN_PCT (default 99.9), no trip stayed latched, every trip was safe within
 # 0.1 s, no frame was dropped and the memory grew less than 1 MiB after the first minute; 1 otherwise.

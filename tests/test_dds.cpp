@@ -117,7 +117,8 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   bridge.start();
   Client client(cfg.domain_id);
   ASSERT_TRUE(eventually([&] { return client.matched(); }, 60.0));
-  // One second of loop frames: a 2 m/s^2 square wave's RMS, 3 ticks in 10 saturated, state active.
+  // One second of loop frames: a 2 m/s^2 square wave's RMS, 3 ticks in 10 saturated, state active but for
+  // a stale-sensor trip from 0.4 to 0.6 s.
   for (std::uint64_t k = 0; k < 5000; ++k) {
     rt::TelemetryFrame f;
     f.tick = k;
@@ -125,7 +126,9 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
     f.accel_mps2 = (k % 2) ? 2.0 : -2.0;
     f.command_v = 0.5;
     f.gain_ns_per_m = 2000.0;
-    f.state = static_cast<std::uint8_t>(rt::State::kActive);
+    const bool tripped = k >= 2000 && k < 3000;
+    f.state = static_cast<std::uint8_t>(tripped ? rt::State::kFault : rt::State::kActive);
+    f.trip = static_cast<std::uint8_t>(tripped ? rt::Trip::kSensorStale : rt::Trip::kNone);
     f.flags = (k % 10 < 3) ? rt::kFlagSaturated : 0;
     f.wake_latency_us = 12.0F;
     f.compute_us = 3.0F;
@@ -149,6 +152,11 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   EXPECT_FALSE(s.parameter_writes());
   EXPECT_DOUBLE_EQ(s.max_gain_ns_per_m(), 4324.0);
   EXPECT_NEAR(s.wake_p99_us(), 12.0, 1.0);
+  // The availability the status carries: 0.2 s of the 1 s out, one trip at 0.4 s, back at full gain.
+  EXPECT_NEAR(s.availability_pct(), 80.0, 0.1);
+  EXPECT_EQ(s.trips(), 1U);
+  EXPECT_EQ(s.back_at_full_gain(), 1U);
+  EXPECT_NEAR(s.last_trip_s(), 0.4, 1e-9);
 
   const auto reply = client.ask(1, msg::SET_GAIN, 2500.0);
   EXPECT_FALSE(reply.accepted());

@@ -429,7 +429,7 @@ TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   while (arm < frames.size() && frames[arm].command_kind != static_cast<std::uint8_t>(rt::CommandKind::kArm)) ++arm;
   for (std::size_t i = t.trip; i < arm; ++i) ASSERT_NE(frames[i].state, static_cast<std::uint8_t>(rt::State::kActive)) << i;
   // The run summary's availability saw the same trip and safe state, and the outage.
-  const runtime::Availability& av = r.cell->summary().availability;
+  const rt::Availability& av = r.cell->summary().availability;
   ASSERT_GE(av.trips_total, 1u);
   EXPECT_EQ(av.trips.front().trip, trip);
   EXPECT_DOUBLE_EQ(av.trips.front().trip_s, frames[t.trip].time_s);

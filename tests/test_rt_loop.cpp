@@ -10,6 +10,7 @@
 #include <cstring>
 #include <thread>
 
+#include "analysis/loop_model.hpp"
 #include "analysis/quiet_command.hpp"
 #include "cell_util.hpp"
 #include "rt/recording.hpp"
@@ -418,15 +419,52 @@ TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
 }
 
 TEST(Loop, ConsecutiveOverrunsTrip) {
+  // overrun_cycles alone (the delay-margin ride-through off): 10 consecutive overruns trip.
   CellOptions o;
   o.keep_frames = true;
   auto cfg = c2();
+  cfg.supervision.overrun_delay_margin_share = 0.0;
   const auto r = run(cfg, 1.5, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
   EXPECT_EQ(r.s.trip, "overruns");
   expect_nothing_lost(r);
   const std::size_t fault = first_state(r, State::kFault);
   ASSERT_LT(fault, r.frames.size());
   EXPECT_LE(r.frames[fault].time_s - 1.0, 0.02) << "10 consecutive overruns of a 0.3 ms stall";
+}
+
+// The preset's loop tolerates 24.2 ms of extra delay for good (its delay margin at K = 2000 N s/m): a run of
+// overruns shorter than that is ridden through and counted; one that lasts longer trips once it has.
+double preset_delay_margin_s(const config::Config& cfg) {
+  const analysis::LoopModel m(cfg);
+  const auto k_max = analysis::max_stable_gain(m, cfg.controller.polarity);
+  return *analysis::margins(m, cfg.controller.gain_ns_per_m, cfg.controller.polarity, k_max).delay_margin_ms * 1e-3;
+}
+
+TEST(Loop, OverrunsWithinTheDelayMarginAreRiddenThrough) {
+  CellOptions o;
+  o.keep_frames = true;
+  o.realtime_setup = true;
+  const auto cfg = c2();
+  const double dm = preset_delay_margin_s(cfg);
+  ASSERT_GT(dm, 0.02);
+  // 8 ms of 0.3 ms stalls: about 27 consecutive overruns, more than overrun_cycles, a third of the margin.
+  const auto r = run(cfg, 2.0, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.008, 3e-4}); }, o);
+  expect_nothing_lost(r);
+  EXPECT_EQ(r.s.trip, "none");
+  EXPECT_GE(r.s.supervisor.overruns, 20U);
+  EXPECT_GE(r.s.supervisor.overrun_runs_ridden, 1U);
+  EXPECT_EQ(first_state(r, State::kFault), r.frames.size()) << "never in fault";
+
+  // 0.2 s of them: the run outlasts the margin and trips, not before the margin has passed.
+  const auto t = run(cfg, 1.5, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  EXPECT_EQ(t.s.trip, "overruns");
+  const std::size_t fault = first_state(t, State::kFault);
+  ASSERT_LT(fault, t.frames.size());
+  EXPECT_GE(t.frames[fault].time_s - 1.0, dm - 1e-3);
+  EXPECT_LE(t.frames[fault].time_s - 1.0, dm + 0.02);
+  std::printf("[ overruns ] delay margin %.2f ms: 8 ms of overruns ridden through (%llu runs), 0.2 s tripped after %.2f ms\n",
+              1e3 * dm, static_cast<unsigned long long>(r.s.supervisor.overrun_runs_ridden),
+              1e3 * (t.frames[fault].time_s - 1.0));
 }
 
 TEST(Loop, SigintShutsDownThroughTheSafeState) {

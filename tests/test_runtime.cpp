@@ -10,7 +10,7 @@
 
 #include "cell_util.hpp"
 #include "runtime/arming_policy.hpp"
-#include "runtime/availability.hpp"
+#include "rt/availability.hpp"
 #include "runtime/lifecycle.hpp"
 #include "runtime/parameter_requests.hpp"
 #include "test_util.hpp"
@@ -303,7 +303,7 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
 // from 0.2 s, a trip at 2 s (safe 10 ms later, re-armed at 5 s, full gain at 5.1 s), 20 missed ticks at
 // 7 s, the run's own stop at 9 s (not asked).
 TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
-  AvailabilityMeter m(1000.0, 0.1);
+  rt::AvailabilityMeter m(1000.0, 0.1);
   auto frame = [&](std::uint64_t tick, rt::State st, rt::Trip trip, double command_v, bool enable) {
     rt::TelemetryFrame f;
     f.tick = tick;
@@ -324,7 +324,7 @@ TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
     else if (k < 9000) frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
     else frame(k, rt::State::kStopping, rt::Trip::kNone, 0.0, true);
   }
-  const Availability& a = m.result();
+  const rt::Availability& a = m.result();
   EXPECT_NEAR(a.first_full_gain_s, 0.2, 1e-9);
   EXPECT_NEAR(a.asked_s, 9.0 - 0.2, 1.5e-3);                            // 0.2 .. 9.0 s
   EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1) - 0.020, 1.5e-3);  // less the trip and the missed ticks

@@ -14,7 +14,7 @@
 
 #include "rt/telemetry_frame.hpp"
 
-namespace robodamp::runtime {
+namespace robodamp::rt {
 
 struct TripRecord {
   std::string trip;               // rt::Trip's name
@@ -38,7 +38,7 @@ class AvailabilityMeter {
   AvailabilityMeter(double rate_hz, double gain_ramp_s) : period_s_(1.0 / rate_hz), ramp_s_(gain_ramp_s) {
     a_.trips.reserve(Availability::kMaxTrips);  // open_ points into it
   }
-  void on_frame(const rt::TelemetryFrame& f);
+  void on_frame(const TelemetryFrame& f);
   [[nodiscard]] const Availability& result() const { return a_; }
 
  private:
