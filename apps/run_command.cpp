@@ -116,6 +116,7 @@ struct RunArgs {
                        {"rearmed_after_s", tr.rearmed_s >= 0.0 ? json(tr.rearmed_s - tr.trip_s) : json(nullptr)},
                        {"full_gain_after_s", tr.full_gain_again_s >= 0.0 ? json(tr.full_gain_again_s - tr.trip_s) : json(nullptr)}});
     j["availability"] = {{"asked_s", a.asked_s},         {"active_full_gain_s", a.active_s},
+                         {"missed_ticks_while_active_s", a.missed_while_active_s},
                          {"share", a.share()},           {"first_full_gain_s", t(a.first_full_gain_s)},
                          {"trips_total", a.trips_total}, {"trips", trips}};
   }
@@ -280,10 +281,11 @@ struct RunArgs {
     for (const auto& tr : a.trips)
       if (tr.full_gain_again_s >= 0.0) ++rearmed, worst = std::max(worst, tr.full_gain_again_s - tr.trip_s);
     std::snprintf(b, sizeof b,
-                  "  availability: at full gain %.4f %% of the %.1f s asked (from %.3f s); %llu trips, %zu back at full "
-                  "gain (the slowest after %.2f s)\n",
-                  100.0 * a.share(), a.asked_s, a.first_full_gain_s, static_cast<unsigned long long>(a.trips_total), rearmed,
-                  worst);
+                  "  availability: at full gain %.4f %% of the %.1f s asked (from %.3f s; %.4f %% of it missed ticks, the "
+                  "command held); %llu trips, %zu back at full gain (the slowest after %.2f s)\n",
+                  100.0 * a.share(), a.asked_s, a.first_full_gain_s,
+                  a.asked_s > 0.0 ? 100.0 * a.missed_while_active_s / a.asked_s : 0.0,
+                  static_cast<unsigned long long>(a.trips_total), rearmed, worst);
     os << b;
   }
   if (s.trip_timing.trip_s >= 0.0) {

@@ -15,9 +15,12 @@ void AvailabilityMeter::on_frame(const TelemetryFrame& f) {
   const bool off_asked = f.trip == 0 && (f.state == static_cast<std::uint8_t>(State::kStopping) ||
                                          f.state == static_cast<std::uint8_t>(State::kDisabled));
   if (a_.first_full_gain_s >= 0.0 && have_prev_ && !off_asked) {
-    const std::uint64_t ticks = f.tick > prev_tick_ ? f.tick - prev_tick_ : 1;  // the missed ones were not damping
+    const std::uint64_t ticks = f.tick > prev_tick_ ? f.tick - prev_tick_ : 1;  // and the ones missed before it
     a_.asked_s += static_cast<double>(ticks) * period_s_;
-    if (full) a_.active_s += period_s_;
+    if (full) {
+      a_.active_s += static_cast<double>(ticks) * period_s_;
+      a_.missed_while_active_s += static_cast<double>(ticks - 1) * period_s_;
+    }
   }
   have_prev_ = true;
   prev_tick_ = f.tick;

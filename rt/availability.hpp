@@ -1,9 +1,10 @@
 // Availability: how much of the time a cell was asked to damp it damped at full gain (docs/runtime.md,
 // "Soak"). Fed every telemetry frame on the drain thread; off the real-time path.
 //  - asked: from the first tick the loop reached full gain (armed, and gain_ramp_s after it became active)
-//    to the end of the run; the start-up's arming and fade are not an outage. Missed ticks count as asked
-//    and not damping; ticks stopping or disabled with no trip (the run's end, an operator's disarm) do not.
-//  - active: the ticks of it in the active state at full gain.
+//    to the end of the run; the start-up's arming and fade are not an outage. Ticks stopping or disabled
+//    with no trip (the run's end, an operator's disarm) are not asked.
+//  - active: the time of it in the active state at full gain (the "armed and at full gain"), with
+//    the ticks the loop missed meanwhile (a stall: the amplifier held the last command) also counted apart.
 //  - each trip: its class, when it tripped, when the command was zero with the amplifier off (safe), and
 //    when the loop was at full gain again (re-armed by the recovery policy or an operator), if it was.
 #pragma once
@@ -26,6 +27,7 @@ struct TripRecord {
 
 struct Availability {
   double asked_s{0.0}, active_s{0.0};
+  double missed_while_active_s{0.0};  // of active_s: ticks the loop missed (the command held, not updated)
   double first_full_gain_s{-1.0};  // -1: never at full gain
   std::uint64_t trips_total{0};
   std::vector<TripRecord> trips;   // the first kMaxTrips

@@ -53,7 +53,8 @@ lines = [
     f"# Soak: {duration:.0f} s of `robodamp run` on {config}",
     "",
     f"- availability: at full gain {share:.4f} % of the {a['asked_s']:.1f} s asked (from {a['first_full_gain_s']} s; "
-    f"required {min_pct} %)",
+    f"required {min_pct} %); of it {100.0 * a['missed_ticks_while_active_s'] / max(a['asked_s'], 1e-9):.4f} % missed ticks "
+    f"(the amplifier held the last command)",
     f"- exit status {status}, final state {s['final_state']}, trips by class: {trips or 'none'}, "
     f"recoveries {s['supervisor'].get('recoveries', 0)}, arming: {s['arming']['outcome']}",
 ]

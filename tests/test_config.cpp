@@ -357,6 +357,14 @@ TEST(Config, RecoveryIsValidatedByKeyWithItsUnitAndRange) {
         "supervision.recovery.max_recoveries = 2.5", "supervision.recovery.window_s = 0 s is out of range",
         "supervision.recovery.probaton_s: unknown key"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\n" << all;
+  // The overrun trip's ride-through: a share of the delay margin, 0..1.
+  EXPECT_DOUBLE_EQ(defaults.supervision.overrun_delay_margin_share, 1.0);
+  const auto share = problems_of(kValid + std::string("supervision: {overrun_delay_margin_share: 1.5}\n"));
+  ASSERT_EQ(share.size(), 1U);
+  EXPECT_NE(share.front().to_string().find("supervision.overrun_delay_margin_share = 1.5 (share of the delay margin) is out "
+                                           "of range: allowed 0 <= value <= 1"),
+            std::string::npos)
+      << share.front().to_string();
 }
 
 }  // namespace

@@ -327,7 +327,8 @@ TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
   const rt::Availability& a = m.result();
   EXPECT_NEAR(a.first_full_gain_s, 0.2, 1e-9);
   EXPECT_NEAR(a.asked_s, 9.0 - 0.2, 1.5e-3);                            // 0.2 .. 9.0 s
-  EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1) - 0.020, 1.5e-3);  // less the trip and the missed ticks
+  EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1), 1.5e-3);  // less the trip
+  EXPECT_NEAR(a.missed_while_active_s, 0.020, 1e-9);               // of it, the 20 missed ticks
   EXPECT_NEAR(a.share(), a.active_s / a.asked_s, 1e-12);
   ASSERT_EQ(a.trips_total, 1u);
   ASSERT_EQ(a.trips.size(), 1u);
