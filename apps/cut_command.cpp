@@ -11,6 +11,8 @@
 #include <memory>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include "analysis/fft.hpp"
@@ -18,6 +20,7 @@
 #include "milling/accurate_stability.hpp"
 #include "apps/gnuplot.hpp"
 #include "apps/milling_report.hpp"
+#include "commission/emulated_cell.hpp"
 #include "milling/cut_job.hpp"
 #include "milling/cut_stability.hpp"
 #include "milling/lobes.hpp"
@@ -27,6 +30,10 @@ namespace robodamp::apps {
 using nlohmann::json;
 
 namespace {
+
+constexpr double kHilRelTol = 1e-2;  // each step of the emulator's bisection is a pair of processes
+
+json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 struct CutArgs {
   std::string config_path{ROBODAMP_DEFAULT_MILLING_CONFIG};
@@ -39,9 +46,31 @@ struct CutArgs {
   std::string json_path, plot_dir;
   std::string controller_path;   // replaces every controller part's damping configuration
   std::vector<double> pose_deg;  // the joints of the job's robot pose parts
+  std::string hil_path;          // --critical through the HIL emulator too: the cell's configuration
 };
 
-json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+// The critical depth through the HIL emulator beside the in-process one (commission/emulated_cell.hpp):
+// the cell's own controller with --damped, control off (K = 0, the actuator passive) without.
+json hil_critical(const CutArgs& a, const milling::CutJob& job, double rpm, double in_process_mm) {
+  const config::Config cell = config::load_config_file(a.hil_path);
+  config::Config controller = cell;
+  if (!a.damped) controller.controller.gain_ns_per_m = 0.0;
+  const std::string dir = (std::filesystem::temp_directory_path() /
+                           ("robodamp_cut_hil_" + std::to_string(::getpid()) + "_" + std::to_string(std::lround(rpm))))
+                              .string();
+  const auto t0 = std::chrono::steady_clock::now();
+  const commission::EmulatedCritical c = commission::critical_through_emulator(
+      cell, controller, {commission::this_executable(), a.hil_path, a.config_path, job.settings.revolutions}, rpm,
+      in_process_mm, kHilRelTol, dir, [](const std::string& line) { std::cerr << "[cut hil] " << line << '\n'; });
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("          through the HIL emulator (%s): critical %.4f mm at %.1f rpm (%+.1f %% against in process), above it "
+              "%s at %.1f Hz; %d cuts across processes in %.1f s\n",
+              a.hil_path.c_str(), c.depth_mm, c.rpm, (c.depth_mm / in_process_mm - 1.0) * 100.0, c.above.c_str(),
+              c.chatter_hz, c.cuts, wall);
+  return {{"cell", a.hil_path}, {"rpm", c.rpm}, {"critical_depth_mm", c.depth_mm}, {"above", c.above},
+          {"chatter_hz", c.chatter_hz}, {"cuts", c.cuts}, {"rel_tol", kHilRelTol}, {"wall_s", wall}};
+}
+
 
 json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double wall_s) {
   const auto& r = o.record;
@@ -123,6 +152,10 @@ int run_cut(const CutArgs& a) {
     MillingOptions pose;
     pose.pose_deg = a.pose_deg;
     apply_pose(cfg, pose);
+    if (!a.hil_path.empty() && (!a.critical || !a.structure.empty() || !a.controller_path.empty() || !a.pose_deg.empty()))
+      throw config::ConfigError({config::Problem{cfg.source, {}, "--hil",
+                                                 "--hil goes with --critical and the job's own structure (no --structure, "
+                                                 "--controller or --pose): the emulator cuts the job as its file says"}});
     const config::StructureConfig chosen = selected_structure(cfg, a.structure, a.controller_path);
     const milling::Structure structure(chosen, false);
     milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
@@ -192,6 +225,7 @@ int run_cut(const CutArgs& a) {
                     rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm, (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0,
                     milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism),
                     c.chatter_hz, c.simulations, wall);
+        if (!a.hil_path.empty()) out["critical"].back()["hil"] = hil_critical(a, job, rpm, c.depth_mm);
       }
     }
     out["config"] = cfg.source;
@@ -233,6 +267,10 @@ void register_cut(Registry& r) {
                 "With the damping controller running: the real Controller, the simulated plant with its actuator, "
                 "limits and sensor, at the configuration's loop rate");
   sub->add_option("--controller", a->controller_path, "Damping configuration to use instead of the job's (compare compensators)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--hil", a->hil_path,
+                  "With --critical: also the critical depth through the HIL emulator, a cell configuration for the job's "
+                  "robot with can.interface unix:... (robodamp plant and the controller as two processes, lockstep)")
       ->check(CLI::ExistingFile);
   sub->add_option("--json", a->json_path, "Write the result as JSON to this file");
   sub->add_option("--plot-dir", a->plot_dir, "Write displacement, force, spectrum and surface plots (PNG) here");

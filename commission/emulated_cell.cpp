@@ -242,6 +242,85 @@ MeasureOutcome measure_through_emulator(const std::string& cell_path, const std:
   return o;
 }
 
+CutTrial cut_through_emulator(const config::Config& cell, const config::Config& controller, const EmulatedCut& e,
+                              double rpm, double depth_mm, const std::string& dir) {
+  CutTrial t;
+  t.requested_rpm = rpm;
+  t.depth_mm = depth_mm;
+  const fs::path d(dir);
+  fs::create_directories(d);
+  const double start_s = cell.commissioning.settle_s + controller.controller.gain_ramp_s + kRampMarginS;
+  const double cut_s = e.revolutions * 60.0 / rpm;
+  EmulatorProcess plant(e.binary,
+                        {"plant", "--config", e.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off", "--cut",
+                         e.job_path, "--cut-rpm", number(rpm), "--cut-axial-mm", number(depth_mm), "--cut-revs",
+                         std::to_string(e.revolutions), "--cut-at", number(start_s), "--json", (d / "plant.json").string()},
+                        (d / "plant.log").string());
+  // The emulator's speed is within half a loop period per tooth of the request: 2 % more time covers it.
+  const ControllerRun c = run_controller(controller, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant);
+  expect_exit_zero(plant, "cut");
+  const auto j = nlohmann::json::parse(text_of(d / "plant.json"))["regenerative_cut"];
+  t.rpm = j["rpm"].get<double>();
+  t.complete = j["complete"].get<bool>();
+  t.stable = j["stable"].get<bool>();
+  t.classification = j["classification"].get<std::string>();
+  t.chatter_hz = j["chatter_hz"].is_number() ? j["chatter_hz"].get<double>() : 0.0;
+  t.trip = c.trip;
+  t.active_share = c.active_share;
+  return t;
+}
+
+EmulatedCritical critical_through_emulator(const config::Config& cell, const config::Config& controller,
+                                           const EmulatedCut& e, double rpm, double guess_mm, double rel_tol,
+                                           const std::string& dir,
+                                           const std::function<void(const std::string&)>& progress) {
+  EmulatedCritical r;
+  int n = 0;
+  auto trial = [&](double depth) {
+    CutTrial t = cut_through_emulator(cell, controller, e, rpm, depth, dir + "/cut_" + std::to_string(++n));
+    // A cut that chatters hard enough trips the damper (instability, saturation): not stable either.
+    if (t.trip != "none") t.stable = false, t.classification = "tripped the damper (" + t.trip + ")";
+    else if (!t.complete) throw std::runtime_error("the emulator's cut at " + number(depth) + " mm did not complete");
+    r.rpm = t.rpm;
+    if (progress) progress("depth " + number(depth) + " mm: " + (t.stable ? std::string("stable") : t.classification +
+                                                                  " at " + number(t.chatter_hz) + " Hz"));
+    return t;
+  };
+  // Doubled or halved from the guess until the verdict changes, then halved to rel_tol, as in process.
+  double lo = 0.0, hi = 0.0;
+  CutTrial t = trial(guess_mm);
+  if (t.stable) {
+    lo = guess_mm;
+    for (double d = 2.0 * guess_mm;; d *= 2.0) {
+      t = trial(d);
+      if (!t.stable) { hi = d; break; }
+      lo = d;
+      if (n > 12) throw std::runtime_error("no chatter up to " + number(d) + " mm");
+    }
+  } else {
+    hi = guess_mm;
+    for (double d = 0.5 * guess_mm;; d *= 0.5) {
+      t = trial(d);
+      if (t.stable) { lo = d; break; }
+      hi = d;
+      if (n > 12) throw std::runtime_error("chatter down to " + number(d) + " mm");
+    }
+  }
+  CutTrial above = t.stable ? CutTrial{} : t;
+  while (hi - lo > rel_tol * hi) {
+    const double mid = 0.5 * (lo + hi);
+    t = trial(mid);
+    if (t.stable) lo = mid;
+    else hi = mid, above = t;
+  }
+  if (above.classification == "not run") above = trial(hi);
+  r.depth_mm = lo;
+  r.above = above.classification;
+  r.chatter_hz = above.chatter_hz;
+  r.cuts = n;
+  return r;
+}
+
 CellCheck check_through_emulator(const config::Config& cell, const config::Config& tuned,
                                  const tune::Verification& promise, const EmulatedCheckFiles& f) {
   const auto t0 = Clock::now();
@@ -276,33 +355,12 @@ CellCheck check_through_emulator(const config::Config& cell, const config::Confi
   out.frfs = frf_checks(tuned, from(f.measurement_dir), from(work / "impacts"));
 
   // The regenerative cut at each promised speed, at the promise less the tolerance.
-  const double start_s = cell.commissioning.settle_s + tuned.controller.gain_ramp_s + kRampMarginS;
+  const EmulatedCut ec{f.binary, f.cell_path, f.job_path, f.cut_revolutions};
   const std::pair<double, double> points[] = {{promise.min_rpm, promise.min_depth_mm},
                                               {promise.speed_rpm, promise.depth_at_speed_mm}};
   for (std::size_t i = 0; i < 2; ++i) {
-    CutTrial t;
-    t.requested_rpm = points[i].first;
-    t.depth_mm = (1.0 - out.depth_tolerance) * points[i].second;
-    const fs::path d = work / ("cut_" + std::to_string(i + 1));
-    fs::create_directories(d);
-    const double cut_s = f.cut_revolutions * 60.0 / t.requested_rpm;
-    EmulatorProcess plant(f.binary,
-                          {"plant", "--config", f.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off", "--cut", f.job_path,
-                           "--cut-rpm", number(t.requested_rpm), "--cut-axial-mm", number(t.depth_mm), "--cut-revs",
-                           std::to_string(f.cut_revolutions), "--cut-at", number(start_s), "--json",
-                           (d / "plant.json").string()},
-                          (d / "plant.log").string());
-    // The emulator's speed is within half a loop period per tooth of the request: 2 % more time covers it.
-    const ControllerRun c = run_controller(tuned, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant);
-    expect_exit_zero(plant, "cut " + std::to_string(i + 1));
-    const auto j = nlohmann::json::parse(text_of(d / "plant.json"))["regenerative_cut"];
-    t.rpm = j["rpm"].get<double>();
-    t.complete = j["complete"].get<bool>();
-    t.stable = j["stable"].get<bool>();
-    t.classification = j["classification"].get<std::string>();
-    t.chatter_hz = j["chatter_hz"].is_number() ? j["chatter_hz"].get<double>() : 0.0;
-    t.trip = c.trip;
-    t.active_share = c.active_share;
+    const CutTrial t = cut_through_emulator(cell, tuned, ec, points[i].first, (1.0 - out.depth_tolerance) * points[i].second,
+                                            (work / ("cut_" + std::to_string(i + 1))).string());
     spdlog::info("commission: the regenerative cut in the emulator, {:.3f} mm at {:.1f} rpm: {}", t.depth_mm, t.rpm,
                  t.classification);
     out.cut_trials.push_back(t);

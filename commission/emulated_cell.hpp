@@ -10,6 +10,7 @@
 // Off the real-time path.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <sys/types.h>
 #include <vector>
@@ -61,6 +62,30 @@ struct EmulatedCheckFiles {
   std::string work_dir;         // the runs' FRFs, logs and reports
   int cut_revolutions{300};     // each regenerative cut's; 300: a slow decay is not read as chatter
 };
+
+// One regenerative cut in the emulator (drive vibration off) at a speed and depth, with `controller` (a
+// configuration for the same wires) on the controller side from the loop at full gain; files in dir.
+struct EmulatedCut {
+  std::string binary, cell_path, job_path;
+  int revolutions{300};
+};
+[[nodiscard]] CutTrial cut_through_emulator(const config::Config& cell, const config::Config& controller,
+                                            const EmulatedCut& cut, double rpm, double depth_mm, const std::string& dir);
+
+// The critical depth at a speed through the emulator by bisection on such cuts (from a guess, doubled or
+// halved until the verdict changes, then halved to rel_tol), as milling::critical_depth does in process.
+// Throws std::runtime_error when the controller trips or a cut does not complete.
+struct EmulatedCritical {
+  double rpm{0.0};        // the emulator's (a whole number of loop periods per tooth)
+  double depth_mm{0.0};   // the largest stable depth found
+  std::string above;      // the verdict just above it
+  double chatter_hz{0.0};
+  int cuts{0};
+};
+[[nodiscard]] EmulatedCritical critical_through_emulator(const config::Config& cell, const config::Config& controller,
+                                                         const EmulatedCut& cut, double rpm, double guess_mm,
+                                                         double rel_tol, const std::string& dir,
+                                                         const std::function<void(const std::string&)>& progress = {});
 
 // check_on_cell's checks through the emulator: improvement from the measure stage's FRFs (off) and the
 // verify run's (on); the damped cut as a verdict at the promise less depth_tolerance at each speed.
