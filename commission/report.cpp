@@ -136,6 +136,23 @@ std::string tuned_section(const CommissionResult& r) {
   return h.str();
 }
 
+// The smallest and largest depth the lobes plot shows (open and damped curves, the checks), with a margin.
+std::pair<double, double> depth_range(const CommissionResult& r, const tune::Verification& v) {
+  double lo = INFINITY, hi = 0.0;
+  auto see = [&](double mm) {
+    if (std::isfinite(mm) && mm > 0.0) lo = std::min(lo, mm), hi = std::max(hi, mm);
+  };
+  for (const auto& c : r.open_curve_mm) see(c.second);
+  for (const auto& c : v.damped_curve_mm) see(c.second);
+  for (const double mm : {v.min_depth_mm, v.depth_at_speed_mm, v.time_domain_at_min_mm, v.time_domain_at_speed_mm}) see(mm);
+  if (r.cell) {
+    see(r.cell->time_domain_at_min_mm), see(r.cell->time_domain_at_speed_mm);
+    for (const auto& t : r.cell->cut_trials) see(t.depth_mm);
+  }
+  if (!(hi > 0.0)) return {0.01, 10.0};
+  return {0.8 * lo, 1.25 * hi};
+}
+
 std::string verify_section(const CommissionResult& r, Plots& p) {
   std::ostringstream h;
   h << "<h2>4. Verification</h2>\n";
@@ -174,10 +191,12 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
         << num(v.speed_rpm) << ' ' << num(r.cell->time_domain_at_speed_mm) << '\n';
     else
       d << "NaN NaN\n";
-    const double ymax = 3.0 * std::max(v.min_depth_mm, v.depth_at_speed_mm);
+    // Every plotted depth in range: the lobes' peaks are tens of times their floor, so on a log scale.
+    const auto [ymin, ymax] = depth_range(r, v);
     const std::string s = "set title 'Stability lobes of the job: open loop (SDM) and damped (" + v.method +
                           "), identified model; the damped cut in time'\nset grid\nset xlabel 'spindle speed (rpm)'\n"
-                          "set ylabel 'limiting axial depth (mm)'\nset key top left opaque box\nset yrange [0:" + num(ymax) + "]\n"
+                          "set ylabel 'limiting axial depth (mm), log scale'\nset key top left opaque box\nset logscale y\n"
+                          "set yrange [" + num(ymin) + ":" + num(ymax) + "]\n"
                           "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#7f8c8d' t 'open loop (SDM)', "
                           "DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'damped, promised (" + v.method + ")', "
                           "DATA index 2 u 1:2 w p pt 6 ps 2 lc rgb '#27ae60' t 'time-domain cut, identified model', "
