@@ -21,6 +21,7 @@
 #include <spdlog/spdlog.h>
 
 #include "analysis/modal_test.hpp"
+#include "config/number_range.hpp"
 #include "identify/commissioning.hpp"
 #include "identify/modal_fit.hpp"
 #include "runtime/cell.hpp"
@@ -41,12 +42,6 @@ constexpr double kRampMarginS = 2.0;       // after settle and the gain ramp: th
 std::string text_of(const fs::path& p) {
   std::ifstream in(p);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::string number(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
 }
 
 // Lockstep is a ping-pong: one frame each way per tick. On one CPU each hand-over is a context switch; on
@@ -121,7 +116,7 @@ void expect_exit_zero(EmulatorProcess& p, const std::string& what) {
   const int rc = p.wait(kEmulatorEndS);
   if (rc != 0)
     throw std::runtime_error("the emulator (" + what + ") " +
-                             (rc < 0 ? "did not end within " + number(kEmulatorEndS) + " s of the controller"
+                             (rc < 0 ? "did not end within " + config::format_number(kEmulatorEndS) + " s of the controller"
                                      : "exited with " + std::to_string(rc)) +
                              "; its log " + p.log_path() + ": " + p.log_tail());
 }
@@ -253,8 +248,8 @@ CutTrial cut_through_emulator(const config::Config& cell, const config::Config& 
   const double cut_s = e.revolutions * 60.0 / rpm;
   EmulatorProcess plant(e.binary,
                         {"plant", "--config", e.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off", "--cut",
-                         e.job_path, "--cut-rpm", number(rpm), "--cut-axial-mm", number(depth_mm), "--cut-revs",
-                         std::to_string(e.revolutions), "--cut-at", number(start_s), "--json", (d / "plant.json").string()},
+                         e.job_path, "--cut-rpm", config::format_number(rpm), "--cut-axial-mm", config::format_number(depth_mm), "--cut-revs",
+                         std::to_string(e.revolutions), "--cut-at", config::format_number(start_s), "--json", (d / "plant.json").string()},
                         (d / "plant.log").string());
   // The emulator's speed is within half a loop period per tooth of the request: 2 % more time covers it.
   const ControllerRun c = run_controller(controller, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant);
@@ -280,10 +275,10 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
     CutTrial t = cut_through_emulator(cell, controller, e, rpm, depth, dir + "/cut_" + std::to_string(++n));
     // A cut that chatters hard enough trips the damper (instability, saturation): not stable either.
     if (t.trip != "none") t.stable = false, t.classification = "tripped the damper (" + t.trip + ")";
-    else if (!t.complete) throw std::runtime_error("the emulator's cut at " + number(depth) + " mm did not complete");
+    else if (!t.complete) throw std::runtime_error("the emulator's cut at " + config::format_number(depth) + " mm did not complete");
     r.rpm = t.rpm;
-    if (progress) progress("depth " + number(depth) + " mm: " + (t.stable ? std::string("stable") : t.classification +
-                                                                  " at " + number(t.chatter_hz) + " Hz"));
+    if (progress) progress("depth " + config::format_number(depth) + " mm: " + (t.stable ? std::string("stable") : t.classification +
+                                                                  " at " + config::format_number(t.chatter_hz) + " Hz"));
     return t;
   };
   // Doubled or halved from the guess until the verdict changes, then halved to rel_tol, as in process.
@@ -295,7 +290,7 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
       t = trial(d);
       if (!t.stable) { hi = d; break; }
       lo = d;
-      if (n > 12) throw std::runtime_error("no chatter up to " + number(d) + " mm");
+      if (n > 12) throw std::runtime_error("no chatter up to " + config::format_number(d) + " mm");
     }
   } else {
     hi = guess_mm;
@@ -303,7 +298,7 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
       t = trial(d);
       if (t.stable) { lo = d; break; }
       hi = d;
-      if (n > 12) throw std::runtime_error("chatter down to " + number(d) + " mm");
+      if (n > 12) throw std::runtime_error("chatter down to " + config::format_number(d) + " mm");
     }
   }
   CutTrial above = t.stable ? CutTrial{} : t;

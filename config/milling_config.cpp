@@ -29,6 +29,12 @@ const StructureConfig* MillingConfig::find_structure(const std::string& name) co
   return nullptr;
 }
 
+const StructureConfig& MillingConfig::selected_structure() const {
+  const StructureConfig* s = find_structure(structure);
+  if (s == nullptr) throw ConfigError({Problem{source, {}, "structure", "no such structure: " + structure}});
+  return *s;
+}
+
 namespace {
 
 constexpr std::array<const char*, 4> kPairs{"xx", "xy", "yx", "yy"};

@@ -139,6 +139,8 @@ struct MillingConfig {
   std::vector<ConditionConfig> conditions;
 
   [[nodiscard]] const StructureConfig* find_structure(const std::string& name) const;
+  // The job's own structure (`structure`); throws ConfigError when it names none.
+  [[nodiscard]] const StructureConfig& selected_structure() const;
 };
 
 // Throw ConfigError holding every problem found. base_dir resolves controller config paths.

@@ -21,12 +21,6 @@ constexpr int kMinRevolutions = 300;  // as the commissioning's time-domain chec
 constexpr int kForcedHarmonics = 3;
 constexpr int kForcedSidebands = 3;
 
-const config::StructureConfig& job_structure(const config::MillingConfig& job) {
-  const auto* s = job.find_structure(job.structure);
-  if (s == nullptr) throw config::ConfigError({{job.source, {}, "structure", "no such structure: " + job.structure}});
-  return *s;
-}
-
 // Least-squares sinusoids at the given frequencies fitted to x[start..] and subtracted there (the normal
 // equations accumulated sample by sample: a record of 10^5-10^6 samples needs no tall matrix).
 void remove_tones(std::vector<double>& x, std::size_t start, double fs, const std::vector<double>& freqs_hz) {
@@ -63,7 +57,7 @@ RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, c
   const config::MillingConfig job = config::load_milling_config(o.job_path);
   // The job's structure with its controller part on this cell: the part's location and direction are where
   // the cut acts on the plant; its loop rate is the cut's step.
-  const milling::Structure structure(job_structure(job), false,
+  const milling::Structure structure(job.selected_structure(), false,
                                      {std::make_shared<const analysis::LoopModel>(cfg), cfg.controller.gain_ns_per_m,
                                       cfg.controller.polarity});
   if (structure.controller_parts().empty())

@@ -14,12 +14,6 @@ namespace robodamp::tune {
 
 namespace {
 
-const config::StructureConfig& job_structure(const config::MillingConfig& job) {
-  const auto* s = job.find_structure(job.structure);
-  if (s == nullptr) throw config::ConfigError({config::Problem{job.source, {}, "structure", "no such structure"}});
-  return *s;
-}
-
 // The damped cut's critical depth in time, with the real Controller; revolutions enough that a slow decay
 // near the limit is not read as chatter.
 double time_domain_mm(const config::MillingConfig& job, const milling::Structure& open, double rpm, double guess_mm) {
@@ -35,7 +29,7 @@ double time_domain_mm(const config::MillingConfig& job, const milling::Structure
 
 double time_domain_critical_mm(const config::Config& cfg, const config::MillingConfig& job, double rpm, double guess_mm) {
   const auto model = std::make_shared<const analysis::LoopModel>(cfg);
-  const milling::Structure open(job_structure(job), false, {model, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
+  const milling::Structure open(job.selected_structure(), false, {model, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
   return time_domain_mm(job, open, rpm, guess_mm);
 }
 
@@ -50,7 +44,7 @@ Verification verify(const config::Config& cfg, const config::MillingConfig& job_
   const auto model = std::make_shared<const analysis::LoopModel>(cfg);
   const double k = cfg.controller.gain_ns_per_m;
   const int pol = cfg.controller.polarity;
-  const config::StructureConfig& st = job_structure(job);
+  const config::StructureConfig& st = job.selected_structure();
   const milling::Structure open(st, false, {model, k, pol}), damped(st, true, {model, k, pol});
   const milling::AccurateStability truth(damped, job), open_truth(open, job);
   const auto process = milling::chatter_process(job.tool, job.material, job.cut);
