@@ -78,6 +78,9 @@ struct RunArgs {
             {"active_parameter_set", s.active_parameter_set},
             {"recoveries", s.supervisor.recoveries},
             {"overrun_runs_ridden", s.supervisor.overrun_runs_ridden},
+            {"sensor_holds", s.supervisor.sensor_holds},
+            {"sensor_hold_ticks", s.supervisor.sensor_hold_ticks},
+            {"longest_sensor_hold_ticks", s.supervisor.longest_sensor_hold_ticks},
             {"budget_latches", s.supervisor.budget_latches},
             {"probation_latches", s.supervisor.probation_latches}}},
           {"realtime",
@@ -108,17 +111,18 @@ struct RunArgs {
                       {"ticks_to_safe", s.trip_timing.ticks_to_safe >= 0 ? json(s.trip_timing.ticks_to_safe) : json(nullptr)}};
   {
     const auto& a = s.availability;
-    json trips = json::array();
+    json trip_list = json::array();
     for (const auto& tr : a.trips)
-      trips.push_back({{"trip", tr.trip}, {"trip_s", tr.trip_s}, {"safe_s", t(tr.safe_s)},
+      trip_list.push_back({{"trip", tr.trip}, {"trip_s", tr.trip_s}, {"safe_s", t(tr.safe_s)},
                        {"rearmed_s", t(tr.rearmed_s)}, {"full_gain_again_s", t(tr.full_gain_again_s)},
                        {"safe_after_s", tr.safe_s >= 0.0 ? json(tr.safe_s - tr.trip_s) : json(nullptr)},
                        {"rearmed_after_s", tr.rearmed_s >= 0.0 ? json(tr.rearmed_s - tr.trip_s) : json(nullptr)},
                        {"full_gain_after_s", tr.full_gain_again_s >= 0.0 ? json(tr.full_gain_again_s - tr.trip_s) : json(nullptr)}});
     j["availability"] = {{"asked_s", a.asked_s},         {"active_full_gain_s", a.active_s},
                          {"missed_ticks_while_active_s", a.missed_while_active_s},
+                         {"sensor_held_s", a.sensor_held_s},
                          {"share", a.share()},           {"first_full_gain_s", t(a.first_full_gain_s)},
-                         {"trips_total", a.trips_total}, {"trips", trips}};
+                         {"trips_total", a.trips_total}, {"trips", trip_list}};
   }
   if (s.can) {
     const auto& c = *s.can;
@@ -201,7 +205,7 @@ struct RunArgs {
 
 [[nodiscard]] std::string summary_text(const runtime::RunSummary& s) {
   std::ostringstream os;
-  char b[256];
+  char b[512];
   const auto& st = s.loop;
   const double all = static_cast<double>(std::max<std::uint64_t>(1, st.ticks_run + st.missed_ticks));
   std::snprintf(b, sizeof b, "robodamp run: %s, %s, %s clock, %.0f Hz, %.3f s (%.3f s elapsed)\n",
@@ -274,6 +278,15 @@ struct RunArgs {
                   static_cast<unsigned long long>(s.supervisor.overrun_runs_ridden));
     os << b;
   }
+  if (s.supervisor.sensor_holds > 0) {
+    std::snprintf(b, sizeof b,
+                  "  stale or invalid samples while driving: %llu runs, %llu ticks (the longest %llu), ridden through with "
+                  "the controller's command zero\n",
+                  static_cast<unsigned long long>(s.supervisor.sensor_holds),
+                  static_cast<unsigned long long>(s.supervisor.sensor_hold_ticks),
+                  static_cast<unsigned long long>(s.supervisor.longest_sensor_hold_ticks));
+    os << b;
+  }
   if (s.availability.first_full_gain_s >= 0.0) {
     const auto& a = s.availability;
     std::size_t rearmed = 0;
@@ -282,9 +295,11 @@ struct RunArgs {
       if (tr.full_gain_again_s >= 0.0) ++rearmed, worst = std::max(worst, tr.full_gain_again_s - tr.trip_s);
     std::snprintf(b, sizeof b,
                   "  availability: at full gain %.4f %% of the %.1f s asked (from %.3f s; %.4f %% of it missed ticks, the "
-                  "command held); %llu trips, %zu back at full gain (the slowest after %.2f s)\n",
+                  "command held; %.4f %% more on stale samples, not counted); %llu trips, %zu back at full gain (the "
+                  "slowest after %.2f s)\n",
                   100.0 * a.share(), a.asked_s, a.first_full_gain_s,
                   a.asked_s > 0.0 ? 100.0 * a.missed_while_active_s / a.asked_s : 0.0,
+                  a.asked_s > 0.0 ? 100.0 * a.sensor_held_s / a.asked_s : 0.0,
                   static_cast<unsigned long long>(a.trips_total), rearmed, worst);
     os << b;
   }

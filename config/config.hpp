@@ -86,7 +86,11 @@ inline const std::vector<std::string> kRecoverableTripNames{"overruns", "sensor_
                                                              "actuator_driver", "amplifier_not_ready"};
 
 struct SupervisionConfig {
-  int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample
+  int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample: trip
+  // While the sample is stale or invalid the controller's part of the command is zero and the controller
+  // is fed no acceleration (docs/realtime_loop.md, "Riding through a stale sensor"). Not a configuration
+  // key: a recording made before it replays with false (the last valid sample held, as it ran).
+  bool zero_command_while_stale{true};
   int invalid_sample_cycles{1};      // consecutive non-finite or out-of-range samples
   double sample_limit_mps2{0.0};     // out of range beyond this; 0 = the sensor's range (sensor.range_g)
   int overrun_cycles{10};            // consecutive overruns (compute past the period or missed ticks) ...

@@ -17,13 +17,18 @@ void AvailabilityMeter::on_frame(const TelemetryFrame& f) {
   if (a_.first_full_gain_s >= 0.0 && have_prev_ && !off_asked) {
     const std::uint64_t ticks = f.tick > prev_tick_ ? f.tick - prev_tick_ : 1;  // and the ones missed before it
     a_.asked_s += static_cast<double>(ticks) * period_s_;
+    // This tick on a stale or invalid sample: the command was not the controller's (the missed ticks
+    // before it held the last command, which was).
+    const bool held = !(f.flags & kFlagFresh) || f.invalid_samples > prev_invalid_;
     if (full) {
-      a_.active_s += static_cast<double>(ticks) * period_s_;
+      a_.active_s += static_cast<double>(held ? ticks - 1 : ticks) * period_s_;
       a_.missed_while_active_s += static_cast<double>(ticks - 1) * period_s_;
+      if (held) a_.sensor_held_s += period_s_;
     }
   }
   have_prev_ = true;
   prev_tick_ = f.tick;
+  prev_invalid_ = f.invalid_samples;
   // Trips: a new one when the latched trip appears; safe when the command is zero with the amplifier off;
   // over when the loop is at full gain again.
   if (f.trip != 0 && !in_trip_) {

@@ -4,7 +4,8 @@
 //    to the end of the run; the start-up's arming and fade are not an outage. Ticks stopping or disabled
 //    with no trip (the run's end, an operator's disarm) are not asked.
 //  - active: the time of it in the active state at full gain (the "armed and at full gain"), with
-//    the ticks the loop missed meanwhile (a stall: the amplifier held the last command) also counted apart.
+//    the ticks the loop missed meanwhile (a stall: the amplifier held the last command) also counted apart;
+//    ticks on a stale or invalid sample (the command zero, ridden through) are not active, counted apart.
 //  - each trip: its class, when it tripped, when the command was zero with the amplifier off (safe), and
 //    when the loop was at full gain again (re-armed by the recovery policy or an operator), if it was.
 #pragma once
@@ -28,6 +29,9 @@ struct TripRecord {
 struct Availability {
   double asked_s{0.0}, active_s{0.0};
   double missed_while_active_s{0.0};  // of active_s: ticks the loop missed (the command held, not updated)
+  // At full gain on a stale or invalid sample, the controller's part of the command zero: not damping,
+  // so not in active_s (a stale sensor ridden through without a trip).
+  double sensor_held_s{0.0};
   double first_full_gain_s{-1.0};  // -1: never at full gain
   std::uint64_t trips_total{0};
   std::vector<TripRecord> trips;   // the first kMaxTrips
@@ -48,6 +52,7 @@ class AvailabilityMeter {
   Availability a_;
   bool have_prev_{false}, in_trip_{false};
   std::uint64_t prev_tick_{0};
+  std::uint32_t prev_invalid_{0};
   double active_since_s_{-1.0};
   TripRecord* open_{nullptr};  // the trip waiting for its safe time or its full gain again
 };

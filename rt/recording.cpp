@@ -87,6 +87,7 @@ control::ControllerParams controller_params_from(const json& j) {
 json to_json(const SupervisorSettings& s) {
   const auto& l = s.limits;
   return {{"stale_sensor_cycles", l.stale_sensor_cycles},
+          {"zero_command_while_stale", l.zero_command_while_stale},
           {"invalid_sample_cycles", l.invalid_sample_cycles},
           {"sample_limit_mps2", l.sample_limit_mps2},
           {"overrun_cycles", l.overrun_cycles},
@@ -130,6 +131,7 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   SupervisorSettings s;
   auto& l = s.limits;
   l.stale_sensor_cycles = j.at("stale_sensor_cycles");
+  l.zero_command_while_stale = j.value("zero_command_while_stale", false);  // absent before the stale ride-through
   l.invalid_sample_cycles = j.at("invalid_sample_cycles");
   l.sample_limit_mps2 = j.at("sample_limit_mps2");
   l.overrun_cycles = j.at("overrun_cycles");

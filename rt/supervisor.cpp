@@ -166,6 +166,16 @@ void Supervisor::follow_pose() noexcept {
   }
 }
 
+void Supervisor::count_hold(bool held) noexcept {
+  if (!held) {
+    hold_run_ = 0;
+    return;
+  }
+  if (hold_run_++ == 0) ++counters_.sensor_holds;
+  ++counters_.sensor_hold_ticks;
+  counters_.longest_sensor_hold_ticks = std::max(counters_.longest_sensor_hold_ticks, hold_run_);
+}
+
 void Supervisor::reset_detectors() noexcept {
   std::fill(sat_window_.begin(), sat_window_.end(), std::uint8_t{0});
   sat_pos_ = 0;
@@ -190,7 +200,8 @@ void Supervisor::trip(Trip t) noexcept {
   state_ = State::kFault;
   trip_ = t;
   trip_from_v_ = command_v_;
-  trip_ramp_left_s_ = s_.limits.trip_ramp_s;
+  // Already at zero (a stale sensor ridden through until it tripped): the amplifier goes off at once.
+  trip_ramp_left_s_ = command_v_ != 0.0 ? s_.limits.trip_ramp_s : 0.0;
 }
 
 ArmRefusal Supervisor::arm_refusal(bool live) const noexcept {
@@ -362,10 +373,14 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   }
   path_ok_ = in.sensor_ok && in.actuator_ok && !in.amplifier_fault;
 
-  // The controller runs in every state so its filters are settled when it is armed; it only ever sees
-  // valid samples (an invalid or stale one repeats the last valid one).
-  if (in.fresh && valid) last_valid_mps2_ = in.accel_mps2;
-  const double controller_v = controller_.update(last_valid_mps2_);
+  // The controller runs in every state so its filters are settled when it is armed. It only ever sees
+  // valid samples. On a stale or invalid one it is fed no acceleration (its velocity estimate holds
+  // rather than integrating a repeated sample), and its output does not reach the actuator this tick.
+  const bool sample_ok = in.fresh && valid;
+  const bool hold = !sample_ok && l.zero_command_while_stale;
+  if (sample_ok) last_valid_mps2_ = in.accel_mps2;
+  const double controller_v = controller_.update(hold ? 0.0 : last_valid_mps2_);
+  const double driving_v = hold ? 0.0 : controller_v;
   const control::ControllerCounters& cc = controller_.counters();
   const bool limited = cc.force_limited != last_limits_.force_limited ||
                        cc.voltage_limited != last_limits_.voltage_limited || cc.slew_limited != last_limits_.slew_limited;
@@ -394,10 +409,10 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
       break;
     case State::kActive: {
       fade_ = s_.fade_s > 0.0 ? std::min(1.0, fade_ + in.dt_s / s_.fade_s) : 1.0;
-      command_v_ = fade_ * controller_v;
+      command_v_ = fade_ * driving_v;
       if (test_v != 0.0) {
         const double lim = s_.test_signal.voltage_limit_v;
-        command_v_ = std::clamp(fade_ * (controller_v + test_v), -lim, lim);
+        command_v_ = std::clamp(fade_ * (driving_v + test_v), -lim, lim);
       }
       out.amplifier_enable = true;
       out.saturated = limited || in.actuator_saturated;
@@ -417,7 +432,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
         state_ = State::kDisabled;
         command_v_ = 0.0;
       } else {
-        command_v_ = fade_ * controller_v;
+        command_v_ = fade_ * driving_v;
         out.amplifier_enable = true;
       }
       break;
@@ -436,6 +451,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
       if (!latched_) recover(in);  // re-arms from the next tick on (state kArming)
     }
   }
+  count_hold(hold && (state_ == State::kActive || state_ == State::kStopping));
   out.command_v = command_v_;
   out.state = state_;
   out.trip = trip_;

@@ -97,6 +97,11 @@ struct SupervisorCounters {
   // Runs of overrun_cycles or more consecutive overruns that ended within the active set's delay margin
   // (supervision.overrun_delay_margin_share): ridden through, not tripped.
   std::uint64_t overrun_runs_ridden{0};
+  // Ticks active or stopping on a stale or invalid sample: the controller's part of the
+  // command was zero (supervision.zero_command_while_stale). Runs of them, and the longest run in ticks.
+  std::uint64_t sensor_hold_ticks{0};
+  std::uint64_t sensor_holds{0};
+  std::uint64_t longest_sensor_hold_ticks{0};
   std::uint64_t saturated_ticks{0};
   std::uint64_t arm_refused{0};
   std::uint64_t gain_refused{0};
@@ -212,6 +217,7 @@ class Supervisor {
   bool record_saturation(bool saturated) noexcept;  // true: duty exceeded
   bool instability(double controller_v) noexcept;     // true: growing oscillation
   void reset_detectors() noexcept;
+  void count_hold(bool held) noexcept;  // a tick driving on a held (zero) controller part, or not
 
   [[nodiscard]] double max_gain_ns_per_m() const noexcept {
     return s_.limits.max_gain_fraction * sets_[active_parameter_set()].max_stable_gain_ns_per_m;
@@ -248,6 +254,7 @@ class Supervisor {
     return s_.limits.overrun_delay_margin_share * sets_[active_parameter_set()].delay_margin_s;
   }
   std::uint64_t stale_run_{0}, invalid_run_{0}, live_run_{0}, overrun_run_{0};
+  std::uint64_t hold_run_{0};  // consecutive ticks driving with the controller's part held at zero
   double overrun_run_s_{0.0};  // the measured time the current run of overruns has lasted
   bool path_ok_{true};
   double fade_{0.0};       // 0..1, activation / disarm

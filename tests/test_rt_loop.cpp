@@ -15,6 +15,7 @@
 #include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/signals.hpp"
+#include "rt_loop_outcome.hpp"
 #include "test_util.hpp"
 
 namespace robodamp::rt {
@@ -24,46 +25,7 @@ using runtime::Cell;
 using runtime::CellOptions;
 using sim::FaultKind;
 
-config::Config c2() { return config::load_config_file(test::preset("horizontal_c2")); }
-
-CellOptions virtual_clock() {
-  CellOptions o;
-  o.clock = config::ClockKind::kVirtual;
-  o.keep_frames = true;
-  return o;
-}
-
-struct Outcome {
-  runtime::RunSummary s;
-  std::vector<TelemetryFrame> frames;
-};
-
-template <typename Setup>
-Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, CellOptions o = virtual_clock()) {
-  Cell session(cfg, o);
-  test::configure(session);
-  setup(session);
-  Outcome out;
-  out.s = session.run(duration_s);
-  out.frames = session.frames();
-  return out;
-}
-Outcome run(const config::Config& cfg, double duration_s, CellOptions o = virtual_clock()) {
-  return run(cfg, duration_s, [](Cell&) {}, o);
-}
-
-// Every tick the loop ran reached the consumer, in order, none twice.
-void expect_nothing_lost(const Outcome& r) {
-  ASSERT_EQ(r.frames.size(), r.s.loop.ticks_run);
-  EXPECT_EQ(r.s.loop.ring_drops, 0U);
-  for (std::size_t i = 1; i < r.frames.size(); ++i) ASSERT_GT(r.frames[i].tick, r.frames[i - 1].tick) << i;
-}
-
-std::size_t first_state(const Outcome& r, State s, std::size_t from = 0) {
-  for (std::size_t i = from; i < r.frames.size(); ++i)
-    if (r.frames[i].state == static_cast<std::uint8_t>(s)) return i;
-  return r.frames.size();
-}
+// c2(), virtual_clock(), run(), expect_nothing_lost(), first_state(): rt_loop_outcome.hpp.
 
 // A fault at fault_s must trip `expected`; the command must then be zero, and the amplifier off,
 // within detection + trip_ramp_s. Returns the time from the fault to zero command.
@@ -75,7 +37,17 @@ double expect_trip(const Outcome& r, Trip expected, double fault_s, double detec
   EXPECT_LT(i_trip, r.frames.size());
   if (i_trip >= r.frames.size()) return INFINITY;
   EXPECT_EQ(r.frames[i_trip].trip, static_cast<std::uint8_t>(expected));
-  EXPECT_NE(r.frames[i_trip - 1].command_v, 0.0) << "was driving before the trip";
+  // Driving before the trip: on the last tick with a fresh sample. The stale ticks after it, ridden
+  // through until the trip, drove nothing (the controller's part of the command zero).
+  std::size_t i_fresh = i_trip - 1;
+  while (i_fresh > 0 && !(r.frames[i_fresh].flags & kFlagFresh)) --i_fresh;
+  EXPECT_NE(r.frames[i_fresh].command_v, 0.0) << "was driving before the trip";
+  for (std::size_t i = i_fresh + 1; i < i_trip; ++i) EXPECT_EQ(r.frames[i].command_v, 0.0) << "stale tick " << i;
+  if (expected == Trip::kSensorStale) {
+    EXPECT_EQ(i_trip - i_fresh, static_cast<std::size_t>(c2().supervision.stale_sensor_cycles));
+    EXPECT_EQ(r.s.supervisor.sensor_holds, 1U);
+    EXPECT_EQ(r.s.supervisor.sensor_hold_ticks, i_trip - i_fresh - 1);
+  }
   std::size_t i_zero = i_trip;
   while (i_zero < r.frames.size() && r.frames[i_zero].command_v != 0.0) ++i_zero;
   EXPECT_LT(i_zero, r.frames.size());
@@ -493,117 +465,6 @@ TEST(Loop, SigintShutsDownThroughTheSafeState) {
   EXPECT_LE(f.back().time_s - f[trip].time_s, 0.0102) << "ramped to zero within trip_ramp_s";
 }
 
-
-// Recovery (supervision.recovery, issue 28): a transient fault of a recoverable class goes to the safe
-// state as always, then re-arms once the cool-down is over and the cell has been healthy for
-// healthy_for_s; the budget and the probation latch; latched classes never recover; a recording of it
-// replays bit for bit.
-std::size_t first_state_after(const Outcome& r, State s, double t_s) {
-  for (std::size_t i = 0; i < r.frames.size(); ++i)
-    if (r.frames[i].time_s >= t_s && r.frames[i].state == static_cast<std::uint8_t>(s)) return i;
-  return r.frames.size();
-}
-
-TEST(Recovery, ATransientSensorDropoutRecoversAfterTheCoolDownAndTheHealthCheck) {
-  CellOptions o = virtual_clock();
-  o.record_path = ::testing::TempDir() + "/recovery_" + std::to_string(::getpid()) + ".rec";
-  const auto r = run(c2(), 6.0, [](Cell& s) { s.plant().faults().add({FaultKind::kSensorDropout, 1.0, 0.1}); }, o);
-  // The trip as before: safe within the stale detection and the ramp.
-  const std::size_t fault = first_state(r, State::kFault);
-  ASSERT_LT(fault, r.frames.size());
-  EXPECT_EQ(r.frames[fault].trip, static_cast<std::uint8_t>(Trip::kSensorStale));
-  EXPECT_NEAR(r.frames[fault].time_s, 1.0 + 5 / 5000.0, 2 / 5000.0);
-  // Back once the sensor has been healthy for healthy_for_s = 2 s (the cool-down, 1 s, ended earlier): the
-  // sensor returns at 1.1 s.
-  const std::size_t back = first_state_after(r, State::kArming, r.frames[fault].time_s);
-  ASSERT_LT(back, r.frames.size());
-  EXPECT_NEAR(r.frames[back].time_s, 1.1 + 2.0, 0.002);
-  for (std::size_t i = fault; i < back; ++i) {
-    ASSERT_EQ(r.frames[i].state, static_cast<std::uint8_t>(State::kFault)) << i;
-    if (r.frames[i].time_s > r.frames[fault].time_s + 0.011) {
-      EXPECT_EQ(r.frames[i].command_v, 0.0);
-    }
-  }
-  const std::size_t active = first_state_after(r, State::kActive, r.frames[back].time_s);
-  ASSERT_LT(active, r.frames.size());
-  EXPECT_EQ(r.frames[active].trip, static_cast<std::uint8_t>(Trip::kNone));
-  // Through the gain ramp: the command fades in (0.5 s) from zero.
-  EXPECT_LT(std::abs(r.frames[active].command_v), 1e-3);
-  EXPECT_EQ(r.s.supervisor.recoveries, 1U);
-  EXPECT_EQ(r.s.trip, "none") << "ended damping, not latched";
-  ASSERT_EQ(r.s.events.size(), 2U);
-  EXPECT_EQ(r.s.events[0].kind, EventKind::kTrip);
-  EXPECT_EQ(r.s.events[1].kind, EventKind::kRecovered);
-  EXPECT_EQ(r.s.events[1].trip, Trip::kSensorStale);
-  EXPECT_NEAR(r.s.events[1].time_s, r.frames[back].time_s, 2 / 5000.0);
-  expect_nothing_lost(r);
-  const ReplayResult res = replay(read_recording(o.record_path));
-  EXPECT_EQ(res.mismatches, 0U) << "the recovery replays bit for bit";
-  EXPECT_EQ(res.final_state, r.s.final_state);
-}
-
-config::Config with_recovery(int max_recoveries, double probation_s) {
-  config::Config c = c2();
-  c.supervision.recovery.max_recoveries = max_recoveries;
-  c.supervision.recovery.probation_s = probation_s;
-  return c;
-}
-
-TEST(Recovery, TheBudgetLatchesTheThirdFaultAndTheProbationARelapse) {
-  // Three dropouts 4 s apart with a budget of 2: two recoveries, then latched.
-  const auto budget = run(with_recovery(2, 0.5), 14.0, [](Cell& s) {
-    for (const double t : {1.0, 5.0, 9.0}) s.plant().faults().add({FaultKind::kSensorDropout, t, 0.1});
-  });
-  EXPECT_EQ(budget.s.supervisor.trips[static_cast<std::size_t>(Trip::kSensorStale)], 3U);
-  EXPECT_EQ(budget.s.supervisor.recoveries, 2U);
-  EXPECT_EQ(budget.s.supervisor.budget_latches, 1U);
-  EXPECT_EQ(budget.s.trip, "sensor_stale");
-  EXPECT_EQ(budget.s.final_state, "fault");
-  // A relapse 1 s after a recovery, within its 10 s probation: latched at once.
-  const auto probation = run(with_recovery(3, 10.0), 8.0, [](Cell& s) {
-    s.plant().faults().add({FaultKind::kSensorDropout, 1.0, 0.1});
-    s.plant().faults().add({FaultKind::kSensorDropout, 4.5, 0.1});
-  });
-  EXPECT_EQ(probation.s.supervisor.recoveries, 1U);
-  EXPECT_EQ(probation.s.supervisor.probation_latches, 1U);
-  EXPECT_EQ(probation.s.trip, "sensor_stale");
-  EXPECT_EQ(first_state_after(probation, State::kArming, 4.6), probation.frames.size()) << "no second recovery";
-}
-
-TEST(Recovery, LatchedClassesAnEmptyListAndAnOperatorsDisarmNeverRecover) {
-  // An amplifier fault may be the damper's doing: latched although it clears after 0.1 s.
-  const auto amp = run(c2(), 6.0, [](Cell& s) { s.plant().faults().add({FaultKind::kAmplifierFault, 1.0, 0.1}); });
-  EXPECT_EQ(amp.s.trip, "amplifier_fault");
-  EXPECT_EQ(amp.s.supervisor.recoveries, 0U);
-  EXPECT_EQ(first_state_after(amp, State::kArming, 1.01), amp.frames.size());
-  // recoverable: [] latches every trip, as before recovery existed.
-  config::Config none = c2();
-  none.supervision.recovery.recoverable.clear();
-  const auto off = run(none, 6.0, [](Cell& s) { s.plant().faults().add({FaultKind::kSensorDropout, 1.0, 0.1}); });
-  EXPECT_EQ(off.s.trip, "sensor_stale");
-  EXPECT_EQ(off.s.supervisor.recoveries, 0U);
-  // An operator's disarm during the fault: it stays off.
-  const auto disarmed = run(c2(), 6.0, [](Cell& s) {
-    s.plant().faults().add({FaultKind::kSensorDropout, 1.0, 0.1});
-    s.schedule(static_cast<std::uint64_t>(1.5 * 5000), {CommandKind::kDisarm, 0.0});
-  });
-  EXPECT_EQ(disarmed.s.trip, "sensor_stale");
-  EXPECT_EQ(disarmed.s.supervisor.recoveries, 0U);
-}
-
-TEST(Recovery, AnOverrunBurstOnTheWallClockRecovers) {
-  // A 0.2 s stretch of 0.3 ms stalls (the loop cannot keep 5 kHz) on the real clock: overruns trip, the
-  // loop runs on time again, and the damper is back within cool-down + health check + arming.
-  CellOptions o;
-  o.keep_frames = true;
-  config::Config cfg = c2();
-  cfg.supervision.recovery.cool_down_s = 0.3;
-  cfg.supervision.recovery.healthy_for_s = 0.5;
-  const auto r = run(cfg, 4.0, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
-  EXPECT_GE(r.s.supervisor.trips[static_cast<std::size_t>(Trip::kOverruns)], 1U);
-  EXPECT_GE(r.s.supervisor.recoveries, 1U) << "a loaded machine may stall again, but it recovers at least once";
-  EXPECT_LT(first_state_after(r, State::kActive, 1.2), r.frames.size());
-}
 
 }  // namespace
 }  // namespace robodamp::rt

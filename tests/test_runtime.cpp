@@ -301,7 +301,7 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
 
 // The availability meter on a scripted run at 1 kHz with a 0.1 s gain ramp: start-up (not asked), full gain
 // from 0.2 s, a trip at 2 s (safe 10 ms later, re-armed at 5 s, full gain at 5.1 s), 20 missed ticks at
-// 7 s, the run's own stop at 9 s (not asked).
+// 7 s, 4 stale samples ridden through at 8 s (not damping), the run's own stop at 9 s (not asked).
 TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
   rt::AvailabilityMeter m(1000.0, 0.1);
   auto frame = [&](std::uint64_t tick, rt::State st, rt::Trip trip, double command_v, bool enable) {
@@ -311,7 +311,8 @@ TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
     f.state = static_cast<std::uint8_t>(st);
     f.trip = static_cast<std::uint8_t>(trip);
     f.command_v = command_v;
-    f.flags = enable ? rt::kFlagAmplifierEnable : 0;
+    const bool stale = tick >= 8000 && tick < 8004;
+    f.flags = static_cast<std::uint16_t>((enable ? rt::kFlagAmplifierEnable : 0) | (stale ? 0 : rt::kFlagFresh));
     m.on_frame(f);
   };
   for (std::uint64_t k = 0; k <= 10000; ++k) {
@@ -327,8 +328,9 @@ TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
   const rt::Availability& a = m.result();
   EXPECT_NEAR(a.first_full_gain_s, 0.2, 1e-9);
   EXPECT_NEAR(a.asked_s, 9.0 - 0.2, 1.5e-3);                            // 0.2 .. 9.0 s
-  EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1), 1.5e-3);  // less the trip
-  EXPECT_NEAR(a.missed_while_active_s, 0.020, 1e-9);               // of it, the 20 missed ticks
+  EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1) - 0.004, 1.5e-3);  // less the trip and the stale ticks
+  EXPECT_NEAR(a.missed_while_active_s, 0.020, 1e-9);                       // of it, the 20 missed ticks
+  EXPECT_NEAR(a.sensor_held_s, 0.004, 1e-9);
   EXPECT_NEAR(a.share(), a.active_s / a.asked_s, 1e-12);
   ASSERT_EQ(a.trips_total, 1u);
   ASSERT_EQ(a.trips.size(), 1u);
