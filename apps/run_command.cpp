@@ -131,7 +131,7 @@ struct RunArgs {
                 {"bus_off", c.bus_off},           {"restarts", c.restarts},     {"rx_errors", c.rx_errors},
                 {"tx_frames", c.tx_frames},       {"tx_queue_full", c.tx_queue_full}, {"tx_errors", c.tx_errors},
                 {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}, {"rx_held", c.rx_held},
-                {"rx_skipped", c.rx_skipped},     {"reconnects", c.reconnects}};
+                {"rx_skipped", c.rx_skipped},     {"reconnects", c.reconnects}, {"resync_backoffs", c.resync_backoffs}};
   }
   if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
                          {"refused", s.dds->refused}, {"machining", s.dds->machining}};
@@ -168,13 +168,14 @@ struct RunArgs {
     const auto& c = *s.can;
     std::snprintf(b, sizeof b,
                   "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
-                  "%llu bus-off, %llu held over / %llu skipped (de-jitter), %llu reconnects; %llu commands sent (%llu queue full, "
+                  "%llu bus-off, %llu held over / %llu skipped (de-jitter; %llu resyncs backed off), %llu reconnects; %llu commands sent (%llu queue full, "
                   "%llu errors, %llu skipped)\n",
                   static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
                   static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
                   static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
                   static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
-                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.reconnects),
+                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.resync_backoffs),
+                  static_cast<unsigned long long>(c.reconnects),
                   static_cast<unsigned long long>(c.tx_frames),
                   static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
                   static_cast<unsigned long long>(c.tx_skipped));

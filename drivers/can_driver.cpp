@@ -132,11 +132,21 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
     fresh = true;
   }
   if (dejitter_) {
+    // A tick without a frame soon after a resync: the phases are still close, try again later.
+    if (since_resync_ < kResyncProbeTicks) {
+      ++since_resync_;
+      if (!fresh) {
+        resync_ticks_ = std::min(2 * resync_ticks_, kResyncMaxTicks);
+        since_resync_ = kResyncProbeTicks;
+        bump(n_.resync_backoffs);
+      }
+    }
     // Exactly one frame per tick while one is held: the phase is steady; after resync_ticks of it, drop
     // the held frame's extra period of latency.
     steady_ticks_ = held_ && arrived == 1 ? steady_ticks_ + 1 : 0;
     if (held_ && steady_ticks_ >= resync_ticks_) {
       sample = held_value_, held_ = false, steady_ticks_ = 0;
+      since_resync_ = 0;
       bump(n_.rx_skipped);
     }
   }
@@ -187,7 +197,8 @@ CanCounters CanDriver::counters() const noexcept {
   auto l = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
   return {l(n_.rx_frames),  l(n_.rx_other),   l(n_.rx_malformed),  l(n_.lost_frames), l(n_.stale_frames),
           l(n_.error_frames), l(n_.bus_off),  l(n_.restarts),      l(n_.rx_errors),   l(n_.tx_frames),
-          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped), l(n_.rx_held), l(n_.rx_skipped), l(n_.reconnects)};
+          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped), l(n_.rx_held), l(n_.rx_skipped), l(n_.reconnects),
+          l(n_.resync_backoffs)};
 }
 
 }  // namespace robodamp::drivers

@@ -39,6 +39,7 @@ struct CanCounters {
   std::uint64_t rx_held{0};         // de-jitter: frames held over to the next tick
   std::uint64_t rx_skipped{0};      // de-jitter: frames skipped (backlog, or resync to the newest)
   std::uint64_t reconnects{0};      // transports handed over after the peer went away (offer_channel)
+  std::uint64_t resync_backoffs{0}; // de-jitter: a resync left a tick without a frame; its interval doubled
 };
 
 class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
@@ -56,11 +57,15 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   // close, wake-up jitter delivers 0 frames in one tick and 2 in the next. With the de-jitter slot on,
   // the second of two frames is held for the next tick, so every tick gets a fresh sample (one period
   // older when the slot is in use). After resync_ticks ticks running with the slot in use and exactly
-  // one new frame each, the held frame is skipped to get the latency back. Off by default.
+  // one new frame each, the held frame is skipped to get the latency back. A resync followed within
+  // kResyncProbeTicks by a tick without a frame found the phases still close: it cost a stale sample, so
+  // the interval doubles (up to kResyncMaxTicks) before the next try. Off by default.
   void set_dejitter(bool on, std::uint64_t resync_ticks = 1000) noexcept {
     dejitter_ = on;
     resync_ticks_ = resync_ticks;
   }
+  static constexpr std::uint64_t kResyncProbeTicks = 50;
+  static constexpr std::uint64_t kResyncMaxTicks = std::uint64_t{1} << 20;  // 210 s at 5 kHz
 
   [[nodiscard]] rt::SensorSample read(std::uint64_t tick) noexcept override;
   [[nodiscard]] rt::ActuatorStatus write(double command_v, std::uint64_t tick) noexcept override;
@@ -88,7 +93,7 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   struct AtomicCounters {
     std::atomic<std::uint64_t> rx_frames{0}, rx_other{0}, rx_malformed{0}, lost_frames{0}, stale_frames{0},
         error_frames{0}, bus_off{0}, restarts{0}, rx_errors{0}, tx_frames{0}, tx_queue_full{0}, tx_errors{0},
-        tx_skipped{0}, tx_clipped{0}, rx_held{0}, rx_skipped{0}, reconnects{0};
+        tx_skipped{0}, tx_clipped{0}, rx_held{0}, rx_skipped{0}, reconnects{0}, resync_backoffs{0};
   };
   static void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) noexcept {
     c.store(c.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
@@ -126,6 +131,7 @@ class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
   bool held_{false};
   double held_value_{0.0};
   std::uint64_t resync_ticks_{1000}, steady_ticks_{0};
+  std::uint64_t since_resync_{kResyncProbeTicks};  // ticks since the last resync (probing up to kResyncProbeTicks)
 };
 
 }  // namespace robodamp::drivers

@@ -245,6 +245,31 @@ TEST(CanDriver, DejitterHoldsTheSecondOfTwoFramesAndResyncs) {
   EXPECT_EQ(k.rx_skipped, 2u);
 }
 
+// A resync while the phases are still close costs a stale tick (the frame it skipped to was the one that
+// would have covered the next tick without a frame); the driver then waits twice as long before the next.
+TEST(CanDriver, DejitterBacksOffAResyncThatLeftATickWithoutAFrame) {
+  const auto c = fd_link();
+  Link link(c);
+  link.driver->set_dejitter(true, 4);
+  std::uint32_t n = 0;
+  std::uint64_t tick = 0;
+  std::uint64_t stale = 0;
+  // The phases close for good: one frame per tick, every 7th tick none and the next two (jitter).
+  auto step = [&](int frames) {
+    for (int i = 0; i < frames; ++i) link.send_sample(c, static_cast<double>(n), n), ++n;
+    if (!link.driver->read(tick++).fresh) ++stale;
+  };
+  step(2);  // one held from the start
+  for (int cycle = 0; cycle < 60; ++cycle)
+    for (int k = 0; k < 7; ++k) step(k == 5 ? 0 : k == 6 ? 2 : 1);
+  const auto k = link.driver->counters();
+  // The first resync (after 4 steady ticks) costs one stale tick; the interval doubles to 8, longer than
+  // the 5 steady ticks the jitter allows, so no more. Without the back-off each of the 60 cycles lost one.
+  EXPECT_EQ(stale, 1u);
+  EXPECT_EQ(k.resync_backoffs, 1u);
+  EXPECT_EQ(k.lost_frames, 0u);
+}
+
 TEST(CanDriver, SendsTheCommandFrameEveryCycleWithItsCounter) {
   const auto c = fd_link();
   Link link(c);
