@@ -11,6 +11,7 @@
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "apps/advice_view.hpp"
 #include "apps/cli.hpp"
 #include "apps/dds_client.hpp"
 #include "dds/participant.hpp"
@@ -111,6 +112,26 @@ std::string machining_view(const msg::Machining& m) {
   return b;
 }
 
+// The advice line: the topic's fields as the run summary shows them.
+std::string advice_view(const msg::Advice& m) {
+  dds::AdviceSample a;
+  a.seq = m.seq();
+  a.time_s = m.time_s();
+  a.trigger = m.trigger();
+  a.spindle_rpm = m.spindle_rpm();
+  a.depth_mm = m.depth_mm();
+  a.damped = m.damped();
+  a.chatter_hz = m.chatter_hz();
+  a.limit_now_mm = m.limit_now_mm();
+  a.method = m.method();
+  a.found = m.found();
+  a.option_rpm = m.option_rpm();
+  a.option_limit_mm = m.option_limit_mm();
+  a.option_limit_mm.resize(a.option_rpm.size(), 0.0);
+  a.reason = m.reason();
+  return advice_text(a);
+}
+
 }  // namespace
 
 // 0 when it saw the loop (telemetry or status), 1 when nothing came.
@@ -119,10 +140,12 @@ int run_monitor(const DdsClientOptions& o) {
   Latest<msg::Telemetry> telemetry;  // before the participant: it outlives the readers that call it
   Latest<msg::Status> status;
   Latest<msg::Machining> machining;
+  Latest<msg::Advice> advice;
   dds::Participant p(o.domain_id, o.transport, "robodamp monitor", o.security);
   p.reader(dds::TopicKind::kTelemetry, &telemetry);
   p.reader(dds::TopicKind::kStatus, &status);
   p.reader(dds::TopicKind::kMachining, &machining);
+  p.reader(dds::TopicKind::kAdvice, &advice);
   const bool tty = isatty(STDOUT_FILENO) != 0;
   std::cerr << "robodamp monitor: domain " << o.domain_id << " (" << config::to_string(o.transport)
             << "), waiting for a loop; Ctrl-C ends\n";
@@ -133,17 +156,19 @@ int run_monitor(const DdsClientOptions& o) {
     const auto [t, nt] = telemetry.get();
     const auto [s, ns] = status.get();
     const auto [m, nm] = machining.get();
-    if (nt + ns + nm == shown) continue;
-    shown = nt + ns + nm;
+    const auto [a, na] = advice.get();
+    if (nt + ns + nm + na == shown) continue;
+    shown = nt + ns + nm + na;
     if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
-    std::cout << view(t, nt, s, ns) << (nm ? machining_view(m) : "") << (tty ? "" : "\n") << std::flush;
+    std::cout << view(t, nt, s, ns) << (nm ? machining_view(m) : "") << (na ? advice_view(a) : "") << (tty ? "" : "\n")
+              << std::flush;
   }
   return shown > 0 ? 0 : 1;
 }
 
 void register_monitor(Registry& r) {
   auto o = std::make_shared<DdsClientArgs>();
-  CLI::App* sub = r.add("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing; with spindle.job the speed, depth, open and damped limits and the chatter indicator)",
+  CLI::App* sub = r.add("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing; with spindle.job the speed, depth, open and damped limits, the chatter indicator and the latest spindle-speed advice)",
                         [o] {
                           const auto opts = resolve(*o);
                           return opts ? run_monitor(*opts) : 2;

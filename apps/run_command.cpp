@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include "apps/advice_view.hpp"
 #include "apps/cli.hpp"
 #include "rt/signals.hpp"
 #include "runtime/cell.hpp"
@@ -134,7 +135,7 @@ struct RunArgs {
                 {"rx_skipped", c.rx_skipped},     {"reconnects", c.reconnects}, {"resync_backoffs", c.resync_backoffs}};
   }
   if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
-                         {"refused", s.dds->refused}, {"machining", s.dds->machining}};
+                         {"refused", s.dds->refused}, {"machining", s.dds->machining}, {"advice", s.dds->advice}};
   if (s.machining) {
     const auto& m = *s.machining;
     auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
@@ -146,6 +147,7 @@ struct RunArgs {
                       {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
                       {"chatter", m.chatter}};
   }
+  if (s.advice) j["advice"] = advice_json(runtime::to_sample(*s.advice));
   if (s.modbus) {
     const auto& m = *s.modbus;
     j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
@@ -155,7 +157,8 @@ struct RunArgs {
                    {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown},
                    {"spindle_changes", m.spindle_changes}, {"spindle_link_parks", m.spindle_link_parks},
                    {"pose_changes", m.pose_changes},       {"pose_out_of_map_polls", m.pose_out_of_map_polls},
-                   {"pose_unavailable_polls", m.pose_unavailable_polls}, {"pose_link_losses", m.pose_link_losses}};
+                   {"pose_unavailable_polls", m.pose_unavailable_polls}, {"pose_link_losses", m.pose_link_losses},
+                   {"advice_writes", m.advice_writes}};
   }
   return j;
 }
@@ -186,13 +189,14 @@ struct RunArgs {
     std::snprintf(b, sizeof b,
                   "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
                   "%llu link faults, %llu mounting changes, %llu pose changes (%llu polls out of the map, %llu not available, "
-                  "%llu link losses)\n",
+                  "%llu link losses), %llu speed advices written\n",
                   static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
                   static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
                   static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
                   static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes),
                   static_cast<unsigned long long>(m.pose_changes), static_cast<unsigned long long>(m.pose_out_of_map_polls),
-                  static_cast<unsigned long long>(m.pose_unavailable_polls), static_cast<unsigned long long>(m.pose_link_losses));
+                  static_cast<unsigned long long>(m.pose_unavailable_polls), static_cast<unsigned long long>(m.pose_link_losses),
+                  static_cast<unsigned long long>(m.advice_writes));
     os << b;
   }
   if (s.dds) {
@@ -325,6 +329,7 @@ struct RunArgs {
       os << b;
     }
   }
+  if (s.advice) os << advice_text(runtime::to_sample(*s.advice));
   if (!s.realtime.warnings.empty())
     os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
   return os.str();

@@ -116,6 +116,16 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
                           rr.joints_register))
       rr.joints_register = *v;
     if (auto v = b.number("deg_per_count", {"deg per count", 0.0, 1.0, true}, rr.deg_per_count)) rr.deg_per_count = *v;
+    if (auto v = read_int(b, "advice_register", {"(register address, zero-based, 4 registers; -1 = none)", -1, 65532},
+                          rr.advice_register))
+      rr.advice_register = *v;
+    for (const auto& [key, reg] : {std::pair{"mounting_register", rr.mounting_register},
+                                   std::pair{"spindle_rpm_register", rr.spindle_rpm_register}})
+      if (rr.advice_register >= 0 && reg >= rr.advice_register && reg < rr.advice_register + 4)
+        b.diagnostics().add(b.mark(), "modbus.robot.advice_register",
+                            "= " + std::to_string(rr.advice_register) + " covers registers " +
+                                std::to_string(rr.advice_register) + "-" + std::to_string(rr.advice_register + 3) +
+                                ", which holds modbus.robot." + key + " = " + std::to_string(reg) + ": they must differ");
     b.finish();
   }
   r.finish();

@@ -50,6 +50,11 @@ struct RobotRegisters {
   // The pose's region must read the same settle_polls polls running before a hand-over.
   int joints_register{-1};
   double deg_per_count{0.01};
+  // Spindle-speed advice (runtime/speed_advisor.hpp) written for the robot program to read: four holding
+  // registers from advice_register (-1 = none): the advice's sequence number (wraps at 65536), the advised
+  // speed in rpm_per_count counts (0: none), the margin (advised limit / depth) x 100, and the status
+  // (1: a speed advised, 2: no stable speed in the range, reduce the depth).
+  int advice_register{-1};
 };
 
 struct ModbusConfig {

@@ -46,6 +46,7 @@ Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::str
   status_writer_ = participant_->writer(TopicKind::kStatus);
   reply_writer_ = participant_->writer(TopicKind::kReply);
   if (src_.machining) machining_writer_ = participant_->writer(TopicKind::kMachining);
+  if (src_.advice) advice_writer_ = participant_->writer(TopicKind::kAdvice);
   listener_ = std::make_unique<RequestListener>(*this);
   participant_->reader(TopicKind::kRequest, listener_.get());
 }
@@ -167,6 +168,39 @@ void Bridge::publish_machining() {
   if (machining_writer_->write(&out)) ++n_machining_;
 }
 
+void Bridge::publish_advice() {
+  if (advice_writer_ == nullptr) return;
+  const std::optional<AdviceSample> a = src_.advice();
+  if (!a || a->seq == published_advice_) return;
+  msg::Advice out;
+  out.seq(a->seq);
+  out.time_s(a->time_s);
+  out.trigger(a->trigger);
+  out.spindle_rpm(a->spindle_rpm);
+  out.depth_mm(a->depth_mm);
+  out.damped(a->damped);
+  out.chatter_hz(a->chatter_hz);
+  out.limit_now_mm(a->limit_now_mm);
+  out.method(a->method);
+  out.found(a->found);
+  out.advised_rpm(a->advised_rpm);
+  out.advised_limit_mm(a->advised_limit_mm);
+  out.margin(a->margin);
+  const std::size_t n = std::min<std::size_t>(8, std::min(a->option_rpm.size(), a->option_limit_mm.size()));
+  out.option_rpm(std::vector<double>(a->option_rpm.begin(), a->option_rpm.begin() + static_cast<std::ptrdiff_t>(n)));
+  out.option_limit_mm(
+      std::vector<double>(a->option_limit_mm.begin(), a->option_limit_mm.begin() + static_cast<std::ptrdiff_t>(n)));
+  out.best_rpm(a->best_rpm);
+  out.best_limit_mm(a->best_limit_mm);
+  out.reason(a->reason);
+  out.rpm_min(a->rpm_min);
+  out.rpm_max(a->rpm_max);
+  if (advice_writer_->write(&out)) {
+    ++n_advice_;
+    published_advice_ = a->seq;
+  }
+}
+
 void Bridge::start() {
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -181,6 +215,7 @@ void Bridge::start() {
       lock.unlock();
       publish_status();
       publish_machining();
+      publish_advice();
       lock.lock();
     }
   });
@@ -196,6 +231,7 @@ void Bridge::stop() {
   status_thread_.join();
 }
 
-BridgeCounters Bridge::counters() const { return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load(), n_machining_.load()}; }
+BridgeCounters Bridge::counters() const { return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load(), n_machining_.load(),
+                                               n_advice_.load()}; }
 
 }  // namespace robodamp::dds

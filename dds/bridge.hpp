@@ -11,7 +11,9 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <vector>
 #include <thread>
 
 #include "config/supervisory_config.hpp"
@@ -50,17 +52,35 @@ struct MachiningSample {
   bool chatter{false};
 };
 
+// What the Advice_ topic carries (dds/robodamp.idl), filled from the cell's speed advisor.
+struct AdviceSample {
+  std::uint64_t seq{0};
+  double time_s{0.0};
+  std::string trigger;
+  double spindle_rpm{0.0}, depth_mm{0.0};
+  bool damped{false};
+  double chatter_hz{0.0}, limit_now_mm{0.0};
+  std::string method;
+  bool found{false};
+  double advised_rpm{0.0}, advised_limit_mm{0.0}, margin{0.0};
+  std::vector<double> option_rpm, option_limit_mm;  // nearest first (at most 8 go on the wire)
+  double best_rpm{0.0}, best_limit_mm{0.0};
+  std::string reason;
+  double rpm_min{0.0}, rpm_max{0.0};
+};
+
 struct BridgeSources {
   std::string backend;                             // for the status
   std::function<std::size_t()> parameter_set;      // the active set (any thread)
   std::function<double()> gain_limit_ns_per_m;     // what a gain request may ask for now
   std::function<Decision(RequestKind, double)> handle;  // validate and queue (parameter writes on)
   std::function<MachiningSample()> machining;      // empty: no machining topic (no spindle.job)
+  std::function<std::optional<AdviceSample>()> advice{};  // the latest speed advice; empty: no advice topic
   double gain_ramp_s{0.0};                         // controller.gain_ramp_s: when the loop is at full gain
 };
 
 struct BridgeCounters {
-  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0}, machining{0};
+  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0}, machining{0}, advice{0};
 };
 
 class Bridge {
@@ -81,6 +101,7 @@ class Bridge {
   class RequestListener;
   void publish_status();
   void publish_machining();
+  void publish_advice();  // a new advice (its seq) once
   Decision decide(RequestKind kind, double value);
 
   config::DdsConfig cfg_;
@@ -91,6 +112,8 @@ class Bridge {
   eprosima::fastdds::dds::DataWriter* status_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* reply_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* machining_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* advice_writer_{nullptr};
+  std::uint64_t published_advice_{0};  // status thread
   std::unique_ptr<RequestListener> listener_;
   rt::AvailabilityMeter availability_;  // under m_
 
@@ -109,7 +132,7 @@ class Bridge {
   std::uint8_t published_state_{255}, published_trip_{255};
   bool running_{false};
   std::thread status_thread_;
-  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0};
+  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0}, n_advice_{0};
 };
 
 }  // namespace robodamp::dds

@@ -14,11 +14,13 @@ using Status = dds_::Status_;
 using ParameterRequest = dds_::ParameterRequest_;
 using ParameterReply = dds_::ParameterReply_;
 using Machining = dds_::Machining_;
+using Advice = dds_::Advice_;
 using TelemetryPubSubType = dds_::Telemetry_PubSubType;
 using StatusPubSubType = dds_::Status_PubSubType;
 using ParameterRequestPubSubType = dds_::ParameterRequest_PubSubType;
 using ParameterReplyPubSubType = dds_::ParameterReply_PubSubType;
 using MachiningPubSubType = dds_::Machining_PubSubType;
+using AdvicePubSubType = dds_::Advice_PubSubType;
 using RequestKind = std::uint8_t;  // ParameterRequest_.kind
 using dds_::ENABLE;
 using dds_::SELECT_PARAMETER_SET;

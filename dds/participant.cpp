@@ -18,7 +18,7 @@ namespace {
 // ROS 2's names for the topics /robodamp/telemetry ... (ROS 2 prefixes its topics with rt/ in DDS).
 constexpr const char* kTopicNames[kTopicCount] = {"rt/robodamp/telemetry", "rt/robodamp/status",
                                                   "rt/robodamp/parameter_request", "rt/robodamp/parameter_reply",
-                                                  "rt/robodamp/machining"};
+                                                  "rt/robodamp/machining", "rt/robodamp/advice"};
 }
 
 Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name,
@@ -62,7 +62,8 @@ Participant::Participant(int domain_id, config::DdsTransport transport, const st
                                     TypeSupport(new robodamp::msg::StatusPubSubType()),
                                     TypeSupport(new robodamp::msg::ParameterRequestPubSubType()),
                                     TypeSupport(new robodamp::msg::ParameterReplyPubSubType()),
-                                    TypeSupport(new robodamp::msg::MachiningPubSubType())};
+                                    TypeSupport(new robodamp::msg::MachiningPubSubType()),
+                                    TypeSupport(new robodamp::msg::AdvicePubSubType())};
   for (int i = 0; i < kTopicCount; ++i) {
     types[i].register_type(participant_);
     topics_[i] = participant_->create_topic(kTopicNames[i], types[i].get_type_name(), TOPIC_QOS_DEFAULT);
@@ -92,7 +93,7 @@ void apply(Qos& q, TopicKind t, config::DdsTransport transport) {
     q.history().depth = 64;
   } else {
     q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-    const bool latest = t == TopicKind::kStatus || t == TopicKind::kMachining;  // a late joiner gets the last
+    const bool latest = t == TopicKind::kStatus || t == TopicKind::kMachining || t == TopicKind::kAdvice;  // a late joiner gets the last
     q.durability().kind = latest ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
     q.history().kind = KEEP_LAST_HISTORY_QOS;
     q.history().depth = latest ? 1 : 32;

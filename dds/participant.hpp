@@ -1,4 +1,4 @@
-// A Fast DDS participant with robodamp's five topics and their QoS (docs/dds.md), shared by the loop's
+// A Fast DDS participant with robodamp's six topics and their QoS (docs/dds.md), shared by the loop's
 // bridge, `robodamp monitor` and the tests. Off the real-time path.
 //
 //   DDS topic (ROS 2 topic)              type (ROS 2 form)                     reliability  durability       history
@@ -7,6 +7,7 @@
 //   rt/robodamp/parameter_request        robodamp::msg::dds_::ParameterRequest_ reliable     volatile         keep last 32
 //   rt/robodamp/parameter_reply          robodamp::msg::dds_::ParameterReply_   reliable     volatile         keep last 32
 //   rt/robodamp/machining                robodamp::msg::dds_::Machining_        reliable     transient local  keep last 1
+//   rt/robodamp/advice                   robodamp::msg::dds_::Advice_           reliable     transient local  keep last 1
 // (ROS 2: /robodamp/telemetry with robodamp/msg/Telemetry, and so on; ros2/robodamp holds the .msg files.)
 //
 // Transports: default (Fast DDS built-ins: UDPv4 and shared memory), udp_loopback (UDPv4 on 127.0.0.1
@@ -32,8 +33,8 @@
 
 namespace robodamp::dds {
 
-enum class TopicKind { kTelemetry, kStatus, kRequest, kReply, kMachining };
-inline constexpr int kTopicCount = 5;
+enum class TopicKind { kTelemetry, kStatus, kRequest, kReply, kMachining, kAdvice };
+inline constexpr int kTopicCount = 6;
 
 class Participant {
  public:

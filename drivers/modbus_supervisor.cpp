@@ -233,6 +233,13 @@ void ModbusSupervisor::robot_thread() {
       running = sleep_for(std::chrono::duration<double>(0.0));
       continue;
     }
+    if (!write_advice(ctx)) {
+      robot_link_->failed(ModbusLink::Clock::now());
+      robot_up_.store(false);
+      spdlog::warn("modbus robot {}: advice: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
+      running = sleep_for(std::chrono::duration<double>(0.0));
+      continue;
+    }
     robot_link_->succeeded();
     ++robot_polls_;
     int m = -1;
@@ -249,6 +256,30 @@ void ModbusSupervisor::robot_thread() {
     }
     running = sleep_for(period);
   }
+}
+
+void ModbusSupervisor::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
+  if (cfg_.robot.advice_register < 0 || !robot_link_) return;
+  auto count = [](double v) { return static_cast<std::uint16_t>(std::clamp(std::lround(v), 0L, 65535L)); };
+  std::lock_guard<std::mutex> lock(m_);
+  advice_regs_ = {static_cast<std::uint16_t>(seq & 0xFFFFU), found ? count(rpm / cfg_.robot.rpm_per_count) : std::uint16_t{0},
+                  found && std::isfinite(margin) ? count(100.0 * margin) : static_cast<std::uint16_t>(found ? 65535 : 0),
+                  static_cast<std::uint16_t>(found ? 1 : 2)};
+  advice_pending_ = true;
+}
+
+bool ModbusSupervisor::write_advice(modbus_t* ctx) {
+  std::array<std::uint16_t, 4> regs{};
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    if (!advice_pending_) return true;
+    regs = advice_regs_;
+  }
+  if (modbus_write_registers(ctx, cfg_.robot.advice_register, 4, regs.data()) != 4) return false;
+  std::lock_guard<std::mutex> lock(m_);
+  if (advice_regs_ == regs) advice_pending_ = false;  // a newer one waits for the next poll
+  ++advice_writes_;
+  return true;
 }
 
 bool ModbusSupervisor::poll_spindle(modbus_t* ctx, SpindleWatch& w) {
@@ -342,6 +373,7 @@ ModbusCounters ModbusSupervisor::counters() const {
   ModbusCounters c;
   c.amplifier_polls = amp_polls_.load();
   c.robot_polls = robot_polls_.load();
+  c.advice_writes = advice_writes_.load();
   for (const ModbusLink* l : {&amp_link_, robot_link_ ? &*robot_link_ : nullptr}) {
     if (l == nullptr) continue;
     c.connects += l->connects.load();

@@ -19,6 +19,7 @@
 //   link_timeout_s makes the pose unknown (out of the map) as well.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -79,6 +80,7 @@ struct ModbusCounters {
   std::uint64_t pose_out_of_map_polls{0};  // polls with the pose outside every region
   std::uint64_t pose_unavailable_polls{0}; // polls with a joint register at -32768 (not available)
   std::uint64_t pose_link_losses{0};   // robot link lost for link_timeout_s: the pose became unknown
+  std::uint64_t advice_writes{0};      // spindle-speed advices written to modbus.robot.advice_register
 };
 
 class ModbusSupervisor final : public rt::SupervisoryIo {
@@ -102,6 +104,9 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
     schedule_ = schedule;
     on_pose_ = std::move(cb);
   }
+  // Any thread: a new spindle-speed advice for modbus.robot.advice_register (the robot thread writes it
+  // at its next poll; a failed write is tried again). found false: no stable speed in the range.
+  void publish_advice(std::uint64_t seq, bool found, double rpm, double margin);
   // The joint angles of the last successful poll, deg (empty before one; NaN where not available).
   [[nodiscard]] std::vector<double> joints_deg() const;
 
@@ -144,6 +149,7 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   void pose_unknown_if_lost(PoseWatch& w);
   void report_pose(PoseWatch& w, long region);
   bool sleep_for(std::chrono::duration<double> d);  // false when stopping
+  bool write_advice(modbus_t* ctx);  // the pending advice, if any; false: the write failed
 
   config::ModbusConfig cfg_;
   MountingCallback on_mounting_;
@@ -151,6 +157,9 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   std::optional<config::PoseScheduleConfig> schedule_;
   PoseCallback on_pose_;
   std::vector<double> joints_deg_;  // guarded by m_
+  std::array<std::uint16_t, 4> advice_regs_{};  // guarded by m_
+  bool advice_pending_{false};                  // guarded by m_
+  std::atomic<std::uint64_t> advice_writes_{0};
   ModbusLink amp_link_;
   std::optional<ModbusLink> robot_link_;
   std::thread amp_thread_, robot_thread_;

@@ -61,6 +61,8 @@ class LiveStability {
 
   [[nodiscard]] double depth_mm() const { return job_.cut.axial_mm; }
   [[nodiscard]] const config::MillingConfig& job() const { return job_; }
+  [[nodiscard]] const config::StructureConfig& structure() const { return structure_; }
+  [[nodiscard]] const std::vector<config::Config>& sets() const { return sets_; }
   [[nodiscard]] std::uint64_t computations() const;
 
  private:

@@ -101,8 +101,13 @@ Status Cell::configure() {
   if (Status s = configure_parameter_sets(); !s.ok()) return s;
   if (!cfg_.spindle.job.empty()) {
     try {
-      machining_ = std::make_unique<MachiningMonitor>(cfg_, set_configs_,
-                                                      [this] { return supervisor_->active_parameter_set(); });
+      machining_ = std::make_unique<MachiningMonitor>(
+          cfg_, set_configs_, [this] { return supervisor_->active_parameter_set(); },
+          [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
+            if (modbus_)
+              modbus_->client().publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
+                                               r.advice.found ? r.advice.options.front().margin : 0.0);
+          });
     } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
       for (Component* d : components()) (void)d->cleanup();
       return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};
@@ -150,6 +155,12 @@ Status Cell::configure_devices() {
                            [this](dds::RequestKind k, double v) { return handle_request(k, v); },
                            cfg_.spindle.job.empty() ? std::function<dds::MachiningSample()>{}
                                                     : [this] { return machining_->sample(); },
+                           cfg_.spindle.job.empty()
+                               ? std::function<std::optional<dds::AdviceSample>()>{}
+                               : [this]() -> std::optional<dds::AdviceSample> {
+                                   const auto a = machining_->advice();
+                                   return a ? std::optional(to_sample(*a)) : std::nullopt;
+                                 },
                            cfg_.controller.gain_ramp_s});
   }
   for (Component* c : components()) {
@@ -387,7 +398,10 @@ void Cell::finish_summary() {
   s.telemetry_frames = drain_->frames();
   if (availability_) s.availability = availability_->result();
   s.sensor_rms_mps2 = n_samples_ ? std::sqrt(sum_sq_ / static_cast<double>(n_samples_)) : 0.0;
-  if (machining_) s.machining = machining_->settled_sample(kMachiningSummaryWaitS);
+  if (machining_) {
+    s.machining = machining_->settled_sample(kMachiningSummaryWaitS);
+    s.advice = machining_->advice();
+  }
 }
 
 Status Cell::cleanup() {
@@ -395,6 +409,7 @@ Status Cell::cleanup() {
     return {StatusKind::kWrongState, std::string("cell: cannot clean up while ") + to_string(state_)};
   for (Component* c : components())
     if (c->state() == LifecycleState::kInactive) (void)c->cleanup();
+  machining_.reset();  // first: its advisor's thread writes to the Modbus client
   loop_.reset();
   arming_.reset();
   ring_.reset();
@@ -406,7 +421,6 @@ Status Cell::cleanup() {
   model_.reset();
   mounting_sets_.clear();
   pose_schedule_ = {};
-  machining_.reset();
   set_configs_.clear();
   state_ = LifecycleState::kUnconfigured;
   return {};

@@ -1,6 +1,7 @@
 #include "runtime/machining_monitor.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <thread>
 
@@ -20,7 +21,8 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 }  // namespace
 
 MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets,
-                                   std::function<std::size_t()> active_set)
+                                   std::function<std::size_t()> active_set,
+                                   std::function<void(const AdviceRecord&)> on_advice)
     : teeth_(cfg.spindle.teeth), active_set_(std::move(active_set)),
       chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
   for (const auto& s : sets) set_gains_.push_back(s.controller.gain_ns_per_m);
@@ -30,7 +32,9 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
                                                "= " + std::to_string(cfg.spindle.teeth) + " but the job " +
                                                    cfg.spindle.job + " cuts with tool.teeth = " +
                                                    std::to_string(job.tool.teeth)}});
+  const double rpm_min = job.lobes.rpm_min, rpm_max = std::min(job.lobes.rpm_max, cfg.spindle.rpm_max);
   stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets));
+  advisor_ = std::make_unique<SpeedAdvisor>(*stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(on_advice));
 }
 
 void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
@@ -43,8 +47,11 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
   last_ = f;
 }
 
-dds::MachiningSample MachiningMonitor::sample() {
-  dds::MachiningSample s;
+dds::MachiningSample MachiningMonitor::sample() { return view().sample; }
+
+AdviceView MachiningMonitor::view() {
+  AdviceView v;
+  dds::MachiningSample& s = v.sample;
   std::size_t set = active_set_ ? active_set_() : 0;
   if (set >= set_gains_.size()) set = 0;
   double gain = 0.0;
@@ -74,7 +81,9 @@ dds::MachiningSample MachiningMonitor::sample() {
       s.limit_mm = s.loop_active ? l->damped_mm : l->open_mm;
       s.depth_warning = s.depth_mm > s.limit_mm;
     }
-  return s;
+  v.parameter_set = set;
+  v.gain_ns_per_m = gain;
+  return v;
 }
 
 dds::MachiningSample MachiningMonitor::settled_sample(double timeout_s) {

@@ -3,7 +3,8 @@
 // register or a DDS request), the job's depth, its open-loop and damped limits at that speed from
 // milling::LiveStability (worker thread, cached), and the chatter indicator over the control
 // accelerometer's recent samples. Fed by the telemetry drain (on_frame), read by the DDS status thread
-// and the run summary (sample). Off the real-time path.
+// and the run summary (sample). Its speed advisor watches the same view (runtime/speed_advisor.hpp).
+// Off the real-time path.
 #pragma once
 
 #include <functional>
@@ -16,6 +17,7 @@
 #include "milling/chatter_indicator.hpp"
 #include "milling/live_stability.hpp"
 #include "rt/telemetry_frame.hpp"
+#include "runtime/speed_advisor.hpp"
 
 namespace robodamp::runtime {
 
@@ -24,7 +26,9 @@ class MachiningMonitor {
   // cfg: the cell's configuration (spindle.job names the job); sets: every parameter set's configuration
   // (index 0 = cfg); active_set: the supervisor's active set (any thread). Throws config::ConfigError
   // when the job cannot be read or does not fit.
-  MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, std::function<std::size_t()> active_set);
+  // on_advice: each new spindle-speed advice, on the advisor's thread (optional).
+  MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, std::function<std::size_t()> active_set,
+                   std::function<void(const AdviceRecord&)> on_advice = {});
 
   // The drain thread, every frame.
   void on_frame(const rt::TelemetryFrame& f);
@@ -33,8 +37,11 @@ class MachiningMonitor {
   // Blocking: waits (up to timeout_s) for the limits at the current state, then samples (tests, summary).
   [[nodiscard]] dds::MachiningSample settled_sample(double timeout_s);
   [[nodiscard]] milling::LiveStability& stability() { return *stability_; }
+  // Any thread: the latest spindle-speed advice (runtime/speed_advisor.hpp), if any was asked for.
+  [[nodiscard]] std::optional<AdviceRecord> advice() const { return advisor_->latest(); }
 
  private:
+  [[nodiscard]] AdviceView view();
   int teeth_;
   std::vector<double> set_gains_;
   std::function<std::size_t()> active_set_;
@@ -43,6 +50,7 @@ class MachiningMonitor {
   milling::ChatterMonitor chatter_;
   rt::TelemetryFrame last_{};
   double rpm_{0.0};
+  std::unique_ptr<SpeedAdvisor> advisor_;  // last: its thread reads the members above
 };
 
 }  // namespace robodamp::runtime

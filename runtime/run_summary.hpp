@@ -14,6 +14,7 @@
 #include "rt/realtime.hpp"
 #include "rt/supervisor.hpp"
 #include "runtime/arming_policy.hpp"
+#include "runtime/speed_advisor.hpp"
 #include "rt/availability.hpp"
 
 namespace robodamp::runtime {
@@ -65,6 +66,7 @@ struct RunSummary {
   double spindle_rpm{0.0};         // the speed the controller's notches follow at the end (0: stopped or parked)
   double notch_centre_hz{0.0};     // the harmonic notches' fundamental at the end
   std::optional<dds::MachiningSample> machining;  // spindle.job: speed, depth, limits, indicator at the end
+  std::optional<AdviceRecord> advice;             // spindle.job: the latest spindle-speed advice, if one was asked for
 
   // The arming policy gave up, or the run ended before the loop was ever active while arming was wanted.
   [[nodiscard]] bool never_armed() const {

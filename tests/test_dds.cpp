@@ -318,7 +318,8 @@ TEST(Dds, TopicsAndTypesUseRos2Names) {
       {dds::TopicKind::kStatus, {"rt/robodamp/status", "robodamp::msg::dds_::Status_"}},
       {dds::TopicKind::kRequest, {"rt/robodamp/parameter_request", "robodamp::msg::dds_::ParameterRequest_"}},
       {dds::TopicKind::kReply, {"rt/robodamp/parameter_reply", "robodamp::msg::dds_::ParameterReply_"}},
-      {dds::TopicKind::kMachining, {"rt/robodamp/machining", "robodamp::msg::dds_::Machining_"}}};
+      {dds::TopicKind::kMachining, {"rt/robodamp/machining", "robodamp::msg::dds_::Machining_"}},
+      {dds::TopicKind::kAdvice, {"rt/robodamp/advice", "robodamp::msg::dds_::Advice_"}}};
   for (const auto& [kind, names] : expected) {
     EXPECT_EQ(p.topic(kind)->get_name(), names.first);
     EXPECT_EQ(p.topic(kind)->get_type_name(), names.second);
@@ -343,8 +344,15 @@ std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& i
     const std::size_t space = line.rfind(' ');
     std::string type = line.substr(0, space), field = line.substr(space + 1);
     if (type.rfind("string<", 0) == 0) type = "string<=" + type.substr(7, type.size() - 8);
+    std::string bound;  // sequence<T, N>: ROS 2's T[<=N]
+    if (type.rfind("sequence<", 0) == 0) {
+      const std::size_t comma = type.find(',');
+      bound = "[<=" + type.substr(comma + 2, type.size() - comma - 3) + "]";
+      type = type.substr(9, comma - 9);
+    }
     for (const auto& [idl_type, ros_type] : types)
       if (type == idl_type) type = ros_type;
+    type += bound;
     out.emplace_back(type, field);
   }
   return out;
@@ -366,7 +374,7 @@ std::vector<std::pair<std::string, std::string>> msg_fields(const std::string& p
 
 TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
-  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining"}) {
+  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining", "Advice"}) {
     const auto from_idl = idl_fields(idl, name);
     const auto from_msg = msg_fields(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/" + name + ".msg");
     EXPECT_GT(from_idl.size(), 3U) << name;

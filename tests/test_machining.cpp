@@ -12,8 +12,10 @@
 #include "milling/lobes.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/live_stability.hpp"
+#include "milling/speed_advice.hpp"
 #include "milling/structure.hpp"
 #include "runtime/cell.hpp"
+#include "runtime/speed_advisor.hpp"
 #include "test_util.hpp"
 
 namespace robodamp {
@@ -74,6 +76,82 @@ TEST(LiveStability, HarmonicNotchesAtTheSpeedEnterTheDampedLimit) {
   EXPECT_GT(std::abs(b700.damped_mm / a700.damped_mm - 1.0), 1e-3) << a700.damped_mm << " " << b700.damped_mm;
   const auto a12k = a.compute(12000.0, 0, 2000.0), b12k = b.compute(12000.0, 0, 2000.0);
   EXPECT_NEAR(b12k.damped_mm / a12k.damped_mm, 1.0, 1e-3);
+}
+
+// The candidates: the pockets of the chatter frequency and of each mode (tooth frequency f / k) inside the
+// range, then the grid; sorted, near-duplicates merged keeping the most specific source.
+TEST(SpeedAdvice, CandidatesAreThePocketsOfTheChatterAndTheModesAndAGrid) {
+  const auto c = milling::advice_candidates(100.0, 1500.0, 3, 24.0, {9.2}, 3);
+  std::vector<double> chatter, mode;
+  for (const auto& x : c) {
+    EXPECT_GE(x.rpm, 100.0);
+    EXPECT_LE(x.rpm, 1500.0);
+    if (x.source == "chatter frequency") chatter.push_back(x.rpm);
+    if (x.source == "mode") mode.push_back(x.rpm);
+  }
+  for (std::size_t i = 1; i < c.size(); ++i) EXPECT_GE(c[i].rpm - c[i - 1].rpm, 0.5);
+  // 60 x 24 / (3 k) = 480 / k rpm: k = 1..4 are in range (120 rpm), k = 5 (96 rpm) is not.
+  ASSERT_EQ(chatter.size(), 4U);
+  EXPECT_NEAR(chatter.back(), 480.0, 1e-9);
+  EXPECT_NEAR(chatter.front(), 120.0, 1e-9);
+  ASSERT_EQ(mode.size(), 1U);  // 184 rpm; 92 rpm is below the range
+  EXPECT_NEAR(mode.front(), 184.0, 1e-9);
+  EXPECT_EQ(c.front().rpm, 100.0);
+  EXPECT_EQ(c.back().rpm, 1500.0);
+  milling::LiveStability live(config::load_milling_config(job_path()), "",
+                              {config::load_config_file(test::preset("horizontal_c2"))});
+  milling::SpeedAdviceRequest bad;
+  bad.rpm = std::nan("");
+  bad.depth_mm = 1.0;
+  EXPECT_THROW((void)milling::advise_speed(live, bad, 100.0, 1500.0), std::invalid_argument);
+}
+
+// At 700 rpm the damped limit is 0.782 mm: a 1.0 mm cut there is advised elsewhere. Every advised speed is
+// stable at 1.0 mm with the margin by a fresh accurate analysis there, and the nearest one also in the
+// time domain with the real Controller (`cut --damped`); the options are ordered by distance. In a narrow
+// speed range no speed takes the depth: the advice says so, with the best it found.
+TEST(SpeedAdvice, AdvisedSpeedsAreStableAtTheDepthByTheAccurateMethodAndInTheTimeDomain) {
+  const config::MillingConfig job = config::load_milling_config(job_path());
+  const config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  milling::LiveStability live(job, "", {cfg});
+  milling::SpeedAdviceRequest rq;
+  rq.rpm = 700.0;
+  rq.depth_mm = 1.0;
+  rq.gain_ns_per_m = cfg.controller.gain_ns_per_m;
+  rq.trigger = "depth above the limit";
+  const milling::SpeedAdvice a = milling::advise_speed(live, rq, job.lobes.rpm_min, job.lobes.rpm_max);
+  std::printf("[ advice   ] 1.0 mm at 700 rpm (limit %.3f mm, %s): %zu speeds analysed in %.1f s\n", a.limit_now_mm,
+              a.method.c_str(), a.evaluated, a.compute_s);
+  EXPECT_NEAR(a.limit_now_mm, 0.782, 0.002);
+  EXPECT_EQ(a.method, "sampled-loop SDM");
+  ASSERT_TRUE(a.found) << a.reason;
+  milling::LiveStability fresh(job, "", {cfg});
+  double last_distance = 0.0;
+  for (const auto& o : a.options) {
+    std::printf("[ advice   ]   %.1f rpm: limit %.3f mm (margin %.2f, %s)\n", o.rpm, o.limit_mm, o.margin, o.source.c_str());
+    EXPECT_GE(o.margin, 1.15);
+    EXPECT_GE(std::abs(o.rpm - 700.0), last_distance);
+    last_distance = std::abs(o.rpm - 700.0);
+    EXPECT_GE(fresh.compute(o.rpm, 0, rq.gain_ns_per_m).damped_mm, 1.15 * rq.depth_mm) << o.rpm;
+  }
+  const milling::Structure damped(*job.find_structure(job.structure), true);
+  milling::CutOverrides ov;
+  ov.rpm = a.options.front().rpm;
+  ov.axial_mm = rq.depth_mm;
+  ov.damped = true;
+  const milling::CutOutcome cut = milling::run_job(milling::make_cut_job(job, damped, ov));
+  EXPECT_TRUE(cut.verdict.stable) << "the time-domain cut at " << *ov.rpm << " rpm";
+  // The same cut where it was: chatter (so the advice was needed).
+  ov.rpm = 700.0;
+  EXPECT_FALSE(milling::run_job(milling::make_cut_job(job, damped, ov)).verdict.stable);
+
+  // A spindle allowed only 690-710 rpm: nothing there takes 1.0 mm.
+  const milling::SpeedAdvice none = milling::advise_speed(live, rq, 690.0, 710.0);
+  EXPECT_FALSE(none.found);
+  EXPECT_TRUE(none.options.empty());
+  EXPECT_NE(none.reason.find("no speed in 690..710 rpm is stable at 1.000 mm"), std::string::npos) << none.reason;
+  EXPECT_GT(none.best.limit_mm, 0.0);
+  EXPECT_LT(none.best.limit_mm, 1.15);
 }
 
 TEST(LiveStability, AJobWithoutADampingLocationIsRefused) {
@@ -193,6 +271,75 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     // While the damper is active the damped limit applies: 1.5 mm is above it.
     milling::LiveStability& live = cell.machining()->stability();
     EXPECT_EQ(live.compute(700.0, 0, cfg.controller.gain_ns_per_m).damped_mm, m.damped_limit_mm);
+  }
+}
+
+// What asks for advice: chatter (with its frequency), or a depth above the limit that applies; never a
+// stopped spindle or a gain still ramping.
+TEST(SpeedAdvisor, ChatterOrADepthAboveTheLimitAsksForAdvice) {
+  runtime::AdviceView v;
+  v.sample.spindle_rpm = 700.0;
+  v.sample.depth_mm = 1.0;
+  v.sample.loop_active = true;
+  v.parameter_set = 1;
+  v.gain_ns_per_m = 2000.0;
+  EXPECT_FALSE(runtime::SpeedAdvisor::wanted(v, true).has_value()) << "quiet, within the limit";
+  v.sample.limits_ready = v.sample.depth_warning = true;
+  auto r = runtime::SpeedAdvisor::wanted(v, true);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->trigger, "depth above the limit");
+  EXPECT_TRUE(r->damped);
+  EXPECT_EQ(r->set, 1U);
+  EXPECT_EQ(r->chatter_hz, 0.0);
+  v.sample.indicator_valid = v.sample.chatter = true;
+  v.sample.chatter_hz = 23.7;
+  r = runtime::SpeedAdvisor::wanted(v, true);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->trigger, "chatter");
+  EXPECT_EQ(r->chatter_hz, 23.7);
+  EXPECT_FALSE(runtime::SpeedAdvisor::wanted(v, false).has_value()) << "the gain ramping";
+  v.sample.spindle_rpm = 0.0;
+  EXPECT_FALSE(runtime::SpeedAdvisor::wanted(v, true).has_value()) << "spindle stopped";
+}
+
+// A cell whose job is deeper than the limit: the advisor gives speeds where that depth is stable, each
+// checked again here by a fresh accurate analysis at its speed; a job within the limit gets none.
+TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
+  const std::string dir = ::testing::TempDir() + "robodamp_advice_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  std::string job = test::read_file(job_path());
+  job.replace(job.find("../presets/horizontal_c2.yaml"), 29, test::preset("horizontal_c2"));
+  for (const double depth : {0.5, 1.5}) {
+    std::string text = job;
+    text.replace(text.find("axial_mm: 0.5"), 13, "axial_mm: " + std::to_string(depth));
+    std::ofstream(dir + "/job.yaml") << text;
+    config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+    cfg.spindle.job = cfg.spindle.job_resolved = dir + "/job.yaml";
+    cfg.loop.clock = config::ClockKind::kVirtual;
+    runtime::Cell cell(cfg);
+    ASSERT_TRUE(cell.configure().ok());
+    cell.schedule(1, {rt::CommandKind::kSetSpindle, 700.0});
+    const runtime::RunSummary s = cell.run(3.0);
+    if (depth < 0.782) {
+      EXPECT_FALSE(s.advice.has_value()) << "within both limits";
+      continue;
+    }
+    // 1.5 mm is above the damped (0.782 mm) and the open (1.111 mm) limit: asked for while the damper was
+    // active or after the run (the damper off), whichever the advisor saw first.
+    std::optional<runtime::AdviceRecord> a;
+    ASSERT_TRUE(test::eventually([&] { return (a = cell.machining()->advice()).has_value(); }, 300.0));
+    EXPECT_EQ(a->seq, 1U);
+    EXPECT_EQ(a->advice.request.trigger, "depth above the limit");
+    EXPECT_EQ(a->advice.request.rpm, 700.0);
+    ASSERT_TRUE(a->advice.found) << a->advice.reason;
+    milling::LiveStability fresh(config::load_milling_config(dir + "/job.yaml"), "", {cfg});
+    for (const auto& o : a->advice.options) {
+      const auto l = fresh.compute(o.rpm, 0, cfg.controller.gain_ns_per_m);
+      EXPECT_GE(a->advice.request.damped ? l.damped_mm : l.open_mm, 1.15 * depth) << o.rpm;
+    }
+    const dds::AdviceSample sample = runtime::to_sample(*a);
+    EXPECT_EQ(sample.advised_rpm, a->advice.options.front().rpm);
+    EXPECT_EQ(sample.option_rpm.size(), a->advice.options.size());
   }
 }
 

@@ -1,0 +1,127 @@
+#include "milling/speed_advice.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <stdexcept>
+
+namespace robodamp::milling {
+
+namespace {
+
+std::string number(double v, const char* format) {
+  char b[64];
+  std::snprintf(b, sizeof b, format, v);
+  return b;
+}
+
+// The modes of the structure the advice checks, once each: every part's and direction's, and, for the
+// part the damper is on, the robot's in the loop's configuration (the active set's).
+std::vector<double> mode_frequencies(const config::StructureConfig& s, const config::Config& loop) {
+  std::set<long> seen;
+  std::vector<double> out;
+  auto add = [&](double f_hz) {
+    if (f_hz > 0.0 && seen.insert(std::lround(f_hz * 100.0)).second) out.push_back(f_hz);
+  };
+  for (const auto& part : s.parts) {
+    for (const auto& direction : part.modes)
+      for (const auto& m : direction) add(m.natural_freq_hz);
+    if (part.controller)
+      for (const auto& frf : loop.robot.frfs)
+        for (const auto& m : frf.modes) add(m.natural_freq_hz);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<SpeedCandidate> advice_candidates(double rpm_min, double rpm_max, int teeth, double chatter_hz,
+                                              const std::vector<double>& mode_hz, std::size_t grid_points) {
+  std::vector<SpeedCandidate> all;
+  auto pockets = [&](double f_hz, const char* source) {
+    // The tooth frequency at f / k: k = 1 is the highest pocket speed, then down to the range's bottom.
+    for (int k = 1; k <= 1000; ++k) {
+      const double rpm = 60.0 * f_hz / (static_cast<double>(teeth) * k);
+      if (rpm < rpm_min) break;
+      if (rpm <= rpm_max) all.push_back({rpm, source});
+    }
+  };
+  if (chatter_hz > 0.0) pockets(chatter_hz, "chatter frequency");
+  for (const double f : mode_hz) pockets(f, "mode");
+  for (std::size_t i = 0; i < grid_points; ++i) {
+    const double u = grid_points == 1 ? 0.5 : static_cast<double>(i) / static_cast<double>(grid_points - 1);
+    all.push_back({rpm_min + u * (rpm_max - rpm_min), "grid"});
+  }
+  // Sorted by speed; of candidates within 0.5 rpm the first named keeps its source (chatter, mode, grid).
+  std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.rpm < b.rpm; });
+  std::vector<SpeedCandidate> out;
+  for (const auto& c : all) {
+    if (!out.empty() && c.rpm - out.back().rpm < 0.5) {
+      auto rank = [](const std::string& s) { return s == "chatter frequency" ? 0 : s == "mode" ? 1 : 2; };
+      if (rank(c.source) < rank(out.back().source)) out.back().source = c.source;
+      continue;
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& request, double rpm_min, double rpm_max,
+                         const SpeedAdviceSettings& s) {
+  if (!(std::isfinite(request.rpm) && request.rpm > 0.0))
+    throw std::invalid_argument("speed advice: spindle speed " + number(request.rpm, "%g") +
+                                " rpm; it must be finite and above 0 rpm");
+  if (!(std::isfinite(request.depth_mm) && request.depth_mm > 0.0))
+    throw std::invalid_argument("speed advice: depth " + number(request.depth_mm, "%g") +
+                                " mm; it must be finite and above 0 mm");
+  if (!(rpm_min > 0.0 && rpm_max >= rpm_min))
+    throw std::invalid_argument("speed advice: speed range " + number(rpm_min, "%g") + ".." + number(rpm_max, "%g") +
+                                " rpm; it must be positive and not empty");
+  const auto start = std::chrono::steady_clock::now();
+  SpeedAdvice a;
+  a.request = request;
+  a.rpm_min = rpm_min;
+  a.rpm_max = rpm_max;
+  auto limit_of = [&](const LiveLimits& l) { return request.damped ? l.damped_mm : l.open_mm; };
+  const LiveLimits now = stability.compute(request.rpm, request.set, request.gain_ns_per_m);
+  a.limit_now_mm = limit_of(now);
+  a.method = request.damped ? now.method : now.open_method;
+  const int teeth = stability.job().tool.teeth;
+  std::vector<SpeedOption> qualified;
+  a.best.margin = -1.0;
+  for (const SpeedCandidate& c : advice_candidates(rpm_min, rpm_max, teeth, request.chatter_hz,
+                                                   mode_frequencies(stability.structure(),
+                                                                    stability.sets().at(request.set < stability.sets().size() ? request.set : 0)),
+                                                   s.grid_points)) {
+    if (s.cancelled && s.cancelled()) {
+      a.reason = "cancelled after " + std::to_string(a.evaluated) + " speeds";
+      return a;
+    }
+    const LiveLimits l = stability.compute(c.rpm, request.set, request.gain_ns_per_m);
+    ++a.evaluated;
+    if (request.damped && !l.damped_valid) continue;  // the loop itself unstable there
+    const double limit = limit_of(l);
+    // The damped verdict is for the speed the sampled loop steps (whole loop periods per tooth period).
+    const SpeedOption o{request.damped ? l.analysed_rpm : l.rpm, limit, limit / request.depth_mm, c.source};
+    if (o.margin > a.best.margin) a.best = o;
+    if (o.margin >= s.depth_margin && std::abs(o.rpm - request.rpm) > 0.5) qualified.push_back(o);
+  }
+  std::stable_sort(qualified.begin(), qualified.end(), [&](const SpeedOption& x, const SpeedOption& y) {
+    return std::abs(x.rpm - request.rpm) < std::abs(y.rpm - request.rpm);
+  });
+  if (qualified.size() > s.max_options) qualified.resize(s.max_options);
+  a.options = std::move(qualified);
+  a.found = !a.options.empty();
+  if (!a.found)
+    a.reason = "no speed in " + number(rpm_min, "%.0f") + ".." + number(rpm_max, "%.0f") + " rpm is stable at " +
+               number(request.depth_mm, "%.3f") + " mm with " + number(100.0 * (s.depth_margin - 1.0), "%.0f") +
+               " % margin (" + std::to_string(a.evaluated) + " speeds analysed; the best, " +
+               number(a.best.rpm, "%.0f") + " rpm, allows " + number(a.best.limit_mm, "%.3f") +
+               " mm): reduce the depth";
+  a.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return a;
+}
+
+}  // namespace robodamp::milling
