@@ -129,7 +129,7 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
     const bool tripped = k >= 2000 && k < 3000;
     f.state = static_cast<std::uint8_t>(tripped ? rt::State::kFault : rt::State::kActive);
     f.trip = static_cast<std::uint8_t>(tripped ? rt::Trip::kSensorStale : rt::Trip::kNone);
-    f.flags = (k % 10 < 3) ? rt::kFlagSaturated : 0;
+    f.flags = static_cast<std::uint16_t>(rt::kFlagFresh | ((k % 10 < 3) ? rt::kFlagSaturated : 0));
     f.wake_latency_us = 12.0F;
     f.compute_us = 3.0F;
     bridge.on_frame(f);
