@@ -199,9 +199,10 @@ void Supervisor::trip(Trip t) noexcept {
   fault_safe_s_ = healthy_s_ = 0.0;
   state_ = State::kFault;
   trip_ = t;
-  trip_from_v_ = command_v_;
-  // Already at zero (a stale sensor ridden through until it tripped): the amplifier goes off at once.
-  trip_ramp_left_s_ = command_v_ != 0.0 ? s_.limits.trip_ramp_s : 0.0;
+  // On a tick whose sample is stale or invalid nothing is driven, the trip's ramp included: it starts
+  // from zero, and the amplifier goes off at once (so too after a stale run that was ridden through).
+  trip_from_v_ = hold_now_ ? 0.0 : command_v_;
+  trip_ramp_left_s_ = trip_from_v_ != 0.0 ? s_.limits.trip_ramp_s : 0.0;
 }
 
 ArmRefusal Supervisor::arm_refusal(bool live) const noexcept {
@@ -378,6 +379,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   // rather than integrating a repeated sample), and its output does not reach the actuator this tick.
   const bool sample_ok = in.fresh && valid;
   const bool hold = !sample_ok && l.zero_command_while_stale;
+  hold_now_ = hold;
   if (sample_ok) last_valid_mps2_ = in.accel_mps2;
   const double controller_v = controller_.update(hold ? 0.0 : last_valid_mps2_);
   const double driving_v = hold ? 0.0 : controller_v;

@@ -255,6 +255,7 @@ class Supervisor {
   }
   std::uint64_t stale_run_{0}, invalid_run_{0}, live_run_{0}, overrun_run_{0};
   std::uint64_t hold_run_{0};  // consecutive ticks driving with the controller's part held at zero
+  bool hold_now_{false};       // this tick's sample is stale or invalid (zero_command_while_stale)
   double overrun_run_s_{0.0};  // the measured time the current run of overruns has lasted
   bool path_ok_{true};
   double fade_{0.0};       // 0..1, activation / disarm

@@ -256,7 +256,8 @@ TEST(Loop, AQuietCommandAboveTheFloorTripsAStableLoop) {
 
 TEST(Loop, ResetFaultThenRearm) {
   const auto r = run(c2(), 3.0, [](Cell& s) {
-    s.plant().faults().add({FaultKind::kSensorNan, 1.0, 0.01});
+    // An amplifier fault ramps from the command it tripped at (a NaN sample's trip starts from zero).
+    s.plant().faults().add({FaultKind::kAmplifierFault, 1.0, 0.01});
     s.schedule(static_cast<std::uint64_t>(1.005 * 5000), {CommandKind::kResetFault, 0.0});  // refused: ramp not over
     s.schedule(static_cast<std::uint64_t>(1.2 * 5000), {CommandKind::kResetFault, 0.0});
     s.schedule(static_cast<std::uint64_t>(1.3 * 5000), {CommandKind::kArm, 0.0});
@@ -269,7 +270,7 @@ TEST(Loop, ResetFaultThenRearm) {
   EXPECT_EQ(r.frames[disabled].trip, static_cast<std::uint8_t>(Trip::kNone)) << "reset clears the latch";
   EXPECT_LT(first_state(r, State::kActive, disabled), r.frames.size()) << "armed again";
   EXPECT_EQ(r.s.final_state, "disabled");
-  EXPECT_EQ(r.s.supervisor.trips[static_cast<std::size_t>(Trip::kSampleInvalid)], 1U);
+  EXPECT_EQ(r.s.supervisor.trips[static_cast<std::size_t>(Trip::kAmplifierFault)], 1U);
 }
 
 TEST(Loop, GainRequestsAreValidatedAndRamped) {
