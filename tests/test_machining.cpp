@@ -23,6 +23,21 @@ namespace {
 
 std::string job_path() { return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml"; }
 
+// The default preset on the virtual clock cutting the damped job at another depth (written to a directory
+// of the test's own, named by prefix).
+config::Config cell_with_job(const std::string& prefix, double depth_mm) {
+  const std::string dir = ::testing::TempDir() + prefix + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  std::string job = test::read_file(job_path());
+  job.replace(job.find("../presets/horizontal_c2.yaml"), 29, test::preset("horizontal_c2"));
+  job.replace(job.find("axial_mm: 0.5"), 13, "axial_mm: " + std::to_string(depth_mm));
+  std::ofstream(dir + "/job.yaml") << job;
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  cfg.spindle.job = cfg.spindle.job_resolved = dir + "/job.yaml";
+  cfg.loop.clock = config::ClockKind::kVirtual;
+  return cfg;
+}
+
 // The preset with the harmonic notches on (controller.harmonic_notch).
 config::Config preset_with_notches(const std::string& notch) {
   std::string text = test::read_file(test::preset("horizontal_c2"));
@@ -238,17 +253,8 @@ TEST(ChatterIndicator, SimulatedCutsBelowAndAboveTheLimit) {
 // A cell with spindle.job: the speed from a set_spindle command reaches the machining view, which gives the
 // job's depth, the limits at that speed and the damper's state; a deeper job is warned about.
 TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
-  const std::string dir = ::testing::TempDir() + "robodamp_machining_" + std::to_string(getpid());
-  std::system(("mkdir -p " + dir).c_str());
-  std::string job = test::read_file(job_path());
-  job.replace(job.find("../presets/horizontal_c2.yaml"), 29, test::preset("horizontal_c2"));
   for (const double depth : {0.5, 1.5}) {
-    std::string text = job;
-    text.replace(text.find("axial_mm: 0.5"), 13, "axial_mm: " + std::to_string(depth));
-    std::ofstream(dir + "/job.yaml") << text;
-    config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-    cfg.spindle.job = cfg.spindle.job_resolved = dir + "/job.yaml";
-    cfg.loop.clock = config::ClockKind::kVirtual;
+    const config::Config cfg = cell_with_job("robodamp_machining_", depth);
     runtime::Cell cell(cfg);
     ASSERT_TRUE(cell.configure().ok());
     ASSERT_NE(cell.machining(), nullptr);
@@ -305,17 +311,8 @@ TEST(SpeedAdvisor, ChatterOrADepthAboveTheLimitAsksForAdvice) {
 // A cell whose job is deeper than the limit: the advisor gives speeds where that depth is stable, each
 // checked again here by a fresh accurate analysis at its speed; a job within the limit gets none.
 TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
-  const std::string dir = ::testing::TempDir() + "robodamp_advice_" + std::to_string(getpid());
-  std::system(("mkdir -p " + dir).c_str());
-  std::string job = test::read_file(job_path());
-  job.replace(job.find("../presets/horizontal_c2.yaml"), 29, test::preset("horizontal_c2"));
   for (const double depth : {0.5, 1.5}) {
-    std::string text = job;
-    text.replace(text.find("axial_mm: 0.5"), 13, "axial_mm: " + std::to_string(depth));
-    std::ofstream(dir + "/job.yaml") << text;
-    config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-    cfg.spindle.job = cfg.spindle.job_resolved = dir + "/job.yaml";
-    cfg.loop.clock = config::ClockKind::kVirtual;
+    const config::Config cfg = cell_with_job("robodamp_advice_", depth);
     runtime::Cell cell(cfg);
     ASSERT_TRUE(cell.configure().ok());
     cell.schedule(1, {rt::CommandKind::kSetSpindle, 700.0});
@@ -332,7 +329,7 @@ TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
     EXPECT_EQ(a->advice.request.trigger, "depth above the limit");
     EXPECT_EQ(a->advice.request.rpm, 700.0);
     ASSERT_TRUE(a->advice.found) << a->advice.reason;
-    milling::LiveStability fresh(config::load_milling_config(dir + "/job.yaml"), "", {cfg});
+    milling::LiveStability fresh(config::load_milling_config(cfg.spindle.job_resolved), "", {cfg});
     for (const auto& o : a->advice.options) {
       const auto l = fresh.compute(o.rpm, 0, cfg.controller.gain_ns_per_m);
       EXPECT_GE(a->advice.request.damped ? l.damped_mm : l.open_mm, 1.15 * depth) << o.rpm;
