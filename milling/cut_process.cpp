@@ -19,7 +19,8 @@ CutProcess::CutProcess(const Cutter& cutter, const config::MaterialConfig& mat, 
   const double dphi = 2.0 * M_PI / static_cast<double>(bins_);
   for (const Slice& g : slices(cutter, s.cut.axial_mm, s.axial_slices)) {
     SliceState st;
-    st.height_m = g.height_mm * 1e-3, st.radius_m = g.radius_mm * 1e-3;
+    st.z_m = g.z_mm * 1e-3, st.height_m = g.height_mm * 1e-3, st.radius_m = g.radius_mm * 1e-3;
+    st.lag_rad = g.lag_rad;
     st.sk = std::sin(g.kappa_rad);
     const double local_radial = s.cut.radial_mm - (cutter.radius_mm - g.radius_mm);
     const bool engaged_anywhere = local_radial > 0.0;
@@ -38,6 +39,7 @@ CutProcess::CutProcess(const Cutter& cutter, const config::MaterialConfig& mat, 
       st.in_material[i] = st.weight[i] > 1e-12;
     }
     st.surface_m.assign(bins_, 0.0);
+    st.surface_feed_m.assign(bins_, 0.0);
     st.cut_before.assign(bins_, 0);
     // The step in which the edge passes the surface-generating angle (pi down, 0 up milling), and where.
     double pos = std::fmod(wall_angle_rad_ + g.lag_rad, 2.0 * M_PI) / dphi;
@@ -74,7 +76,7 @@ CutProcess::CutProcess(const Cutter& cutter, const config::MaterialConfig& mat, 
 Eigen::Vector2d CutProcess::force(std::size_t k, const Eigen::Vector2d& q_mid, bool stats) noexcept {
   walls_.clear();
   const int n = teeth_;
-  const double feed_m = feed_per_tooth_m_ * (static_cast<double>(k) + 0.5) / steps_per_tooth_;  // nominal advance along x
+  const double feed_m = feed_at_m(static_cast<double>(k) + 0.5);  // nominal advance along x
   Eigen::Vector2d f = Eigen::Vector2d::Zero();
   for (SliceState& st : slices_) {
     const double db = st.height_m, radius = st.radius_m;
@@ -113,6 +115,7 @@ Eigen::Vector2d CutProcess::force(std::size_t k, const Eigen::Vector2d& q_mid, b
       f(0) += w * (-f_t * cp - f_r * sp);
       f(1) += w * (f_t * sp - f_r * cp);
       st.surface_m[bin] = reach;
+      st.surface_feed_m[bin] = feed_m;
       st.cut_before[bin] = 1;
     }
   }
@@ -128,6 +131,37 @@ Eigen::Vector2d CutProcess::force(std::size_t k, const Eigen::Vector2d& q_mid, b
     if (count && wall_per_rev_um_.size() < wall_per_rev_um_.capacity()) wall_per_rev_um_.push_back(-sum / count * 1e6);
   }
   return f;
+}
+
+std::size_t CutProcess::continue_from(const CutProcess& before, std::size_t steps) noexcept {
+  // Tooth 0 at the spindle angle `before` reached, on this grid.
+  const double turn = static_cast<double>(steps % before.bins_) / static_cast<double>(before.bins_);
+  const std::size_t k = static_cast<std::size_t>(std::lround(turn * static_cast<double>(bins_))) % bins_;
+  feed_origin_m_ = before.feed_at_m(static_cast<double>(steps));
+  first_step_ = k;
+  const double depth_before_m = before.slices_.empty() ? 0.0 : before.slices_.back().z_m + 0.5 * before.slices_.back().height_m;
+  const double dphi = 2.0 * M_PI / static_cast<double>(bins_), dphi_before = 2.0 * M_PI / static_cast<double>(before.bins_);
+  for (SliceState& st : slices_) {
+    std::fill(st.cut_before.begin(), st.cut_before.end(), 0);
+    if (st.z_m >= depth_before_m) continue;  // fresh material: no pass cut here yet
+    // The slice of `before` at this height (its slices are of equal height).
+    const auto j = std::min(before.slices_.size() - 1,
+                            static_cast<std::size_t>(st.z_m / depth_before_m * static_cast<double>(before.slices_.size())));
+    const SliceState& old = before.slices_[j];
+    for (std::size_t i = 0; i < bins_; ++i) {
+      // Bin i holds the workpiece angle i dphi - lag; the same angle on the old slice's grid.
+      const double at = (static_cast<double>(i) * dphi - st.lag_rad + old.lag_rad) / dphi_before;
+      const long n = static_cast<long>(before.bins_);
+      const auto b = static_cast<std::size_t>(((std::lround(at) % n) + n) % n);
+      // The reach is along the edge's direction; the nearest old bin's direction differs by up to half a
+      // bin, which matters for the feed travelled (metres after an hour), not for the tool's deflection
+      // (micrometres): the feed's part is projected onto this bin's direction.
+      st.surface_feed_m[i] = old.surface_feed_m[b];
+      st.surface_m[i] = old.surface_m[b] + old.surface_feed_m[b] * (st.sin_phi[i] - old.sin_phi[b]);
+      st.cut_before[i] = old.cut_before[b];
+    }
+  }
+  return k;
 }
 
 void CutProcess::end_step(const Eigen::Vector2d& q, const Eigen::Vector2d& q_next) noexcept {

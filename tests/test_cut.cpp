@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "milling/cut_process.hpp"
 #include "milling/cut_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/sdm.hpp"
@@ -276,3 +277,105 @@ TEST(Cut, UnevenPitchGivesEachToothTheFeedOfItsPitch) {
 }
 
 }  // namespace
+
+namespace robodamp::milling {
+namespace {
+
+// A 3-tooth helical cutter with runout in half immersion at `rpm`, `axial_mm` deep, 10 slices.
+CutSettings changing_cut(double rpm, double axial_mm, int steps_per_tooth) {
+  CutSettings s;
+  s.rpm = rpm;
+  s.cut = {config::MillingMode::kDown, 6.0, axial_mm, 0.1};
+  s.axial_slices = 10;
+  s.steps_per_tooth = steps_per_tooth;
+  s.runout_um = {8.0, 0.0, -3.0};
+  return s;
+}
+
+const Cutter kHelical{config::ToolKind::kEndMill, 6.0, 3, 30.0 * M_PI / 180.0};
+
+config::MaterialConfig aluminium() {
+  config::MaterialConfig m;
+  m.kt_n_per_mm2 = 600.0, m.kr_n_per_mm2 = 180.0, m.kte_n_per_mm = 20.0, m.kre_n_per_mm = 10.0;
+  return m;
+}
+
+// A vibration the cut does not feed back to (prescribed): micrometres at 23 and 61 steps per cycle.
+Eigen::Vector2d shake(std::size_t i) {
+  const double k = static_cast<double>(i);
+  return {2e-6 * std::sin(2.0 * M_PI * k / 23.0), 5e-6 * std::sin(2.0 * M_PI * k / 61.0 + 0.3)};
+}
+
+// Steps p from step k for n steps with the displacement shake(i0 + i); the forces.
+std::vector<Eigen::Vector2d> step_cut(CutProcess& p, std::size_t k, std::size_t n, std::size_t i0, bool zero = false) {
+  std::vector<Eigen::Vector2d> f;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d q = zero ? Eigen::Vector2d::Zero() : shake(i0 + i);
+    f.push_back(p.force(k + i, q, true));
+    p.end_step(q, q);
+  }
+  return f;
+}
+
+double peak_n(const std::vector<Eigen::Vector2d>& f) {
+  double m = 0.0;
+  for (const auto& v : f) m = std::max(m, v.norm());
+  return m;
+}
+
+TEST(CutProcess, ContinuingAtTheSameSpeedAndDepthIsTheSameCut) {
+  const CutSettings s = changing_cut(700.0, 1.0, 40);
+  CutProcess a(kHelical, aluminium(), s), b(kHelical, aluminium(), s);
+  const std::size_t n = 2 * a.steps_per_revolution() + 17;
+  (void)step_cut(a, 0, n, 0);
+  const std::size_t k = b.continue_from(a, n);
+  EXPECT_EQ(k, n % a.steps_per_revolution());
+  const auto fa = step_cut(a, n, 3 * a.steps_per_revolution(), n), fb = step_cut(b, k, 3 * a.steps_per_revolution(), n);
+  const double scale = peak_n(fa);
+  ASSERT_GT(scale, 10.0);
+  for (std::size_t i = 0; i < fa.size(); ++i) ASSERT_NEAR((fa[i] - fb[i]).norm() / scale, 0.0, 1e-9) << i;
+}
+
+// After a speed change (another step grid), the cut goes on where the surface and the feed left it: with
+// the tool still, the force is the steady cut's at the new speed from the first step (within the half
+// bin of the surface's angle) and exactly it once the new speed's teeth have cut a revolution.
+TEST(CutProcess, ASpeedChangeKeepsTheSurfaceTheAngleAndTheFeed) {
+  CutProcess a(kHelical, aluminium(), changing_cut(700.0, 1.0, 40));
+  CutProcess b(kHelical, aluminium(), changing_cut(757.0, 1.0, 37)), fresh(kHelical, aluminium(), changing_cut(757.0, 1.0, 37));
+  const std::size_t n = 3 * a.steps_per_revolution() + 29, per_rev = b.steps_per_revolution();
+  (void)step_cut(a, 0, n, 0, true);
+  const std::size_t k = b.continue_from(a, n);
+  EXPECT_EQ(k, static_cast<std::size_t>(std::lround(29.0 / 120.0 * 111.0)));  // the same spindle angle
+  (void)step_cut(fresh, 0, 3 * per_rev + k, 0, true);  // a cut at the new speed only, at the same angle
+  const auto fb = step_cut(b, k, 2 * per_rev, 0, true), ff = step_cut(fresh, 3 * per_rev + k, 2 * per_rev, 0, true);
+  const double scale = peak_n(ff);
+  ASSERT_GT(scale, 10.0);
+  for (std::size_t i = 0; i < fb.size(); ++i) {
+    const double tolerance = i < per_rev ? 0.02 : 1e-9;  // the old surface's bins, then the new cut's own
+    ASSERT_NEAR((fb[i] - ff[i]).norm() / scale, 0.0, tolerance) << i;
+  }
+}
+
+// A deeper pass meets fresh material above the old depth (the nominal chip there) and the old surface
+// below it; a shallower one keeps only the slices it still reaches. Over the first revolution within 8 %
+// of the peak (a fresh slice's chip is the nominal one; near the exit, where the chip is the runout's size,
+// the steady cut's short tooth skips and the next cuts two feeds: without runout within 2 %), then the same cut.
+TEST(CutProcess, ADepthChangeMapsTheSurfaceByHeight) {
+  for (const double depth_mm : {2.0, 0.5}) {
+    CutProcess a(kHelical, aluminium(), changing_cut(700.0, 1.0, 40));
+    CutProcess b(kHelical, aluminium(), changing_cut(700.0, depth_mm, 40)),
+        fresh(kHelical, aluminium(), changing_cut(700.0, depth_mm, 40));
+    const std::size_t n = 2 * a.steps_per_revolution() + 5, per_rev = b.steps_per_revolution();
+    (void)step_cut(a, 0, n, 0, true);
+    const std::size_t k = b.continue_from(a, n);
+    (void)step_cut(fresh, 0, n, 0, true);
+    const auto fb = step_cut(b, k, 2 * per_rev, 0, true), ff = step_cut(fresh, n, 2 * per_rev, 0, true);
+    const double scale = peak_n(ff);
+    ASSERT_GT(scale, 10.0);
+    for (std::size_t i = 0; i < fb.size(); ++i)
+      ASSERT_NEAR((fb[i] - ff[i]).norm() / scale, 0.0, i < per_rev ? 0.08 : 1e-9) << depth_mm << " mm, step " << i;
+  }
+}
+
+}  // namespace
+}  // namespace robodamp::milling
