@@ -105,7 +105,7 @@ std::string machining_view(const msg::Machining& m) {
     indicator = "collecting revolutions";
   }
   std::snprintf(b, sizeof b,
-                "  spindle    %.0f rpm (tooth passing %.1f Hz), job depth %.3f mm\n"
+                "  spindle    %.0f rpm (tooth passing %.1f Hz), depth %.3f mm\n"
                 "  stability  %s\n"
                 "  chatter    %s\n",
                 m.spindle_rpm(), m.tooth_passing_hz(), m.depth_mm(), limits.c_str(), indicator.c_str());

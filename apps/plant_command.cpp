@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "apps/cli.hpp"
@@ -26,6 +27,8 @@ struct PlantArgs {
   std::vector<std::string> mounting_schedule;  // "T:vertical" / "T:horizontal", plant time in s
   std::vector<std::string> spindle_schedule;   // "T:RPM", plant time in s
   std::vector<std::string> spindle_ramps;      // "T0:T1:RPM"
+  std::vector<std::string> depth_schedule;     // "T:MM"
+  std::vector<std::string> depth_ramps;        // "T0:T1:MM"
   std::string cut_job;
   std::string cut_model{"regenerative"};
   std::optional<double> cut_rpm, cut_axial_mm, cut_at_s;
@@ -46,6 +49,31 @@ std::optional<std::pair<double, config::Mounting>> parse_mounting(const std::str
   const std::string m = item.substr(colon + 1);
   if (m != "horizontal" && m != "vertical") return std::nullopt;
   return std::pair{t, m == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal};
+}
+
+// "T:VALUE" (a step) or, for a ramp, "T0:T1:VALUE" (from the value at T0 to VALUE at T1), plant time in s.
+// Says what is wrong on stderr and returns nothing when it does not parse or is out of range.
+std::optional<hil::SpindleChange> parse_change(const char* option, const std::string& item, const config::Range& value,
+                                               bool ramp) {
+  std::vector<std::string> parts;
+  for (std::size_t from = 0;;) {
+    const auto colon = item.find(':', from);
+    parts.push_back(item.substr(from, colon == std::string::npos ? std::string::npos : colon - from));
+    if (colon == std::string::npos) break;
+    from = colon + 1;
+  }
+  const config::Range time{"s", 0.0, 1e7};
+  hil::SpindleChange c;
+  const bool ok = parts.size() == (ramp ? 3U : 2U) && !parse_number(option, parts[0], time, false, c.t0_s) &&
+                  (!ramp || !parse_number(option, parts[1], time, false, c.t1_s)) &&
+                  !parse_number(option, parts.back(), value, false, c.rpm) && (!ramp || c.t1_s >= c.t0_s);
+  if (!ramp) c.t1_s = c.t0_s;
+  if (ok) return c;
+  const std::string v = std::string(value.unit == "rpm" ? "RPM" : "MM");
+  std::cerr << "robodamp plant: " << option << " = '" << item << "': expected " << (ramp ? "T0_S:T1_S:" : "TIME_S:") << v
+            << ", allowed 0 <= " << (ramp ? "T0_S <= T1_S" : "TIME_S") << " <= 1e+07 s and " << config::format_number(value.min)
+            << " <= " << v << " <= " << config::format_number(value.max) << ' ' << value.unit << '\n';
+  return std::nullopt;
 }
 
 // 0 served a controller to the end; 2 configuration or option error; 1 could not set up or the impact
@@ -71,30 +99,25 @@ int run_plant(const PlantArgs& a) {
     }
     eo.mounting_schedule.push_back(*m);
   }
+  const config::Range rpm_range{"rpm", 0.0, 200000.0}, mm_range{"mm", 0.0, 100.0};
   for (const auto& item : a.spindle_schedule) {
-    const auto colon = item.find(':');
-    double t = 0.0, rpm = 0.0;
-    if (colon == std::string::npos || parse_number("--spindle", item.substr(0, colon), {"s", 0.0, 1e7}, false, t) ||
-        parse_number("--spindle", item.substr(colon + 1), {"rpm", 0.0, 200000.0}, false, rpm)) {
-      std::cerr << "robodamp plant: --spindle = '" << item
-                << "': expected TIME_S:RPM, allowed 0 <= TIME_S <= 1e+07 s and 0 <= RPM <= 200000 rpm\n";
-      return 2;
-    }
-    eo.spindle_schedule.emplace_back(t, rpm);
+    const auto c = parse_change("--spindle", item, rpm_range, false);
+    if (!c) return 2;
+    eo.spindle_schedule.emplace_back(c->t0_s, c->rpm);
   }
-  for (const auto& item : a.spindle_ramps) {
-    const auto c1 = item.find(':'), c2 = item.find(':', c1 == std::string::npos ? 0 : c1 + 1);
-    double t0 = 0.0, t1 = 0.0, rpm = 0.0;
-    if (c1 == std::string::npos || c2 == std::string::npos ||
-        parse_number("--spindle-ramp", item.substr(0, c1), {"s", 0.0, 1e7}, false, t0) ||
-        parse_number("--spindle-ramp", item.substr(c1 + 1, c2 - c1 - 1), {"s", 0.0, 1e7}, false, t1) ||
-        parse_number("--spindle-ramp", item.substr(c2 + 1), {"rpm", 0.0, 200000.0}, false, rpm) || t1 < t0) {
-      std::cerr << "robodamp plant: --spindle-ramp = '" << item
-                << "': expected T0_S:T1_S:RPM, allowed 0 <= T0_S <= T1_S <= 1e+07 s and 0 <= RPM <= 200000 rpm\n";
-      return 2;
-    }
-    eo.spindle_ramps.push_back({t0, t1, rpm});
+  for (const auto& item : a.depth_schedule) {
+    const auto c = parse_change("--depth", item, mm_range, false);
+    if (!c) return 2;
+    eo.depth_changes.push_back(*c);
   }
+  for (const auto& [items, option, range, out] :
+       {std::tuple{&a.spindle_ramps, "--spindle-ramp", &rpm_range, &eo.spindle_ramps},
+        std::tuple{&a.depth_ramps, "--depth-ramp", &mm_range, &eo.depth_changes}})
+    for (const auto& item : *items) {
+      const auto c = parse_change(option, item, *range, true);
+      if (!c) return 2;
+      out->push_back(*c);
+    }
   eo.cut_job = a.cut_job;
   eo.cut_model = a.cut_model == "forced" ? hil::EmulatorOptions::CutModel::kForced : hil::EmulatorOptions::CutModel::kRegenerative;
   eo.regenerative.rpm = a.cut_rpm;
@@ -156,13 +179,19 @@ void register_plant(Registry& r) {
                   "Robot mounting register changes, TIME_S:horizontal|vertical (plant time), repeatable");
   sub->add_option("--spindle-ramp", a->spindle_ramps,
                   "A linear spindle ramp T0_S:T1_S:RPM (plant time; from the speed at T0 to RPM at T1), repeatable");
+  sub->add_option("--depth", a->depth_schedule,
+                  "The robot program's axial depth steps for the regenerative cut, TIME_S:MM (plant time), repeatable; "
+                  "published on modbus.robot.depth_register");
+  sub->add_option("--depth-ramp", a->depth_ramps,
+                  "A linear depth ramp of the regenerative cut T0_S:T1_S:MM (plant time), repeatable");
   r.number(sub, "--spindle-register-period", a->spindle_register_period_s, {"s", 0.0, 10.0},
            "How often the robot updates its spindle register during a ramp (plant time)");
   sub->add_option("--cut", a->cut_job,
                   "Milling job (config/milling/*.yaml) cut against the robot at its controller part's location")
       ->check(CLI::ExistingFile);
   sub->add_option("--cut-model", a->cut_model,
-                  "regenerative (default): the time-domain cut with surface memory at one speed, which can chatter; "
+                  "regenerative (default): the time-domain cut with surface memory, which can chatter, at --cut-rpm and "
+                  "--cut-axial-mm then the --spindle / --depth program (and the advice with spindle.apply_advice); "
                   "forced: the rigid tool's force harmonics at the --spindle / --spindle-ramp speed")
       ->check(CLI::IsMember({"regenerative", "forced"}));
   r.number(sub, "--cut-rpm", a->cut_rpm, {"rpm", 0.0, 200000.0, true}, "The regenerative cut's spindle speed (default: the job's)");
@@ -181,7 +210,8 @@ void register_plant(Registry& r) {
   r.number(sub, "--pose-update", a->pose_update_s, {"s", 0.0002, 10.0},
            "How often the plant's modes follow the pose (plant time)");
   sub->add_option("--spindle", a->spindle_schedule,
-                  "Robot spindle speed register changes, TIME_S:RPM (plant time; modbus.robot.spindle_rpm_register), repeatable");
+                  "Robot spindle speed changes, TIME_S:RPM (plant time; modbus.robot.spindle_rpm_register; with the "
+                  "regenerative cut the cut's speed too, within spindle.rpm_max), repeatable");
 }
 
 }  // namespace robodamp::apps

@@ -317,10 +317,10 @@ struct RunArgs {
   if (s.machining) {
     const auto& m = *s.machining;
     if (m.spindle_rpm <= 0.0) {
-      os << "  machining: spindle stopped at the end; job depth " << m.depth_mm << " mm\n";
+      os << "  machining: spindle stopped at the end; depth " << m.depth_mm << " mm\n";
     } else {
       std::snprintf(b, sizeof b,
-                    "  machining at the end: %.0f rpm, job depth %.3f mm; limit open %.3f mm (SDM), damped %.3f mm (%s)%s; chatter "
+                    "  machining at the end: %.0f rpm, depth %.3f mm; limit open %.3f mm (SDM), damped %.3f mm (%s)%s; chatter "
                     "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)\n",
                     m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm, m.limit_method.c_str(),
                     !m.limits_ready ? " (not computed)" : m.depth_warning ? ": WARNING, depth above the limit" : "",

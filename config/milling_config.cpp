@@ -55,6 +55,7 @@ ToolConfig read_tool(MapReader& top) {
   if (auto v = r.number("diameter_mm", {"mm", 0.0, 200.0, true, false})) t.diameter_mm = *v;
   if (auto v = read_int(r, "teeth", {"(teeth)", 1, 32})) t.teeth = *v;
   if (auto v = r.number("helix_deg", {"deg", 0.0, 70.0, false, false}, 30.0)) t.helix_deg = *v;
+  if (auto v = r.number("flute_length_mm", {"mm", 0.0, 500.0, true, false}, 100.0)) t.flute_length_mm = *v;
   r.finish();
   return t;
 }

@@ -26,6 +26,7 @@ struct ToolConfig {
   double diameter_mm{12.7};
   int teeth{3};
   double helix_deg{30.0};
+  double flute_length_mm{100.0};  // the cutting length: the deepest axial cut the tool can take
 };
 
 // Mechanistic force model (REFERENCE.md section 2): Ft = kt b h + kte b, Fr = kr b h + kre b. The radial

@@ -26,6 +26,9 @@ struct SpindleConfig {
   std::string job;              // as written; empty = no live stability
   std::string job_resolved;
   std::string structure;        // the job's structure to use (empty: the job's own)
+  // The HIL emulator's robot follows robodamp's spindle-speed advice (modbus.robot.advice_register) in
+  // its regenerative cut: an advised speed inside 0 < rpm <= rpm_max replaces the program's speed.
+  bool apply_advice{false};
 };
 
 }  // namespace robodamp::config

@@ -119,8 +119,13 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
     if (auto v = read_int(b, "advice_register", {"(register address, zero-based, 4 registers; -1 = none)", -1, 65532},
                           rr.advice_register))
       rr.advice_register = *v;
+    if (auto v = read_int(b, "depth_register", {"(register address, zero-based; -1 = none)", -1, 65535}, rr.depth_register))
+      rr.depth_register = *v;
+    if (auto v = b.number("depth_mm_per_count", {"mm per count", 0.0, 1.0, true}, rr.depth_mm_per_count))
+      rr.depth_mm_per_count = *v;
     for (const auto& [key, reg] : {std::pair{"mounting_register", rr.mounting_register},
-                                   std::pair{"spindle_rpm_register", rr.spindle_rpm_register}})
+                                   std::pair{"spindle_rpm_register", rr.spindle_rpm_register},
+                                   std::pair{"depth_register", rr.depth_register}})
       if (rr.advice_register >= 0 && reg >= rr.advice_register && reg < rr.advice_register + 4)
         b.diagnostics().add(b.mark(), "modbus.robot.advice_register",
                             "= " + std::to_string(rr.advice_register) + " covers registers " +

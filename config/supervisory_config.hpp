@@ -55,6 +55,11 @@ struct RobotRegisters {
   // speed in rpm_per_count counts (0: none), the margin (advised limit / depth) x 100, and the status
   // (1: a speed advised, 2: no stable speed in the range, reduce the depth).
   int advice_register{-1};
+  // The axial depth the robot program cuts (runtime/machining_monitor.hpp): a holding register (-1 =
+  // none: the job's cut.axial_mm), unsigned counts x depth_mm_per_count; 65535 means "not available"
+  // (the robot's NaN: the job's depth is used and the poll counted).
+  int depth_register{-1};
+  double depth_mm_per_count{0.001};
 };
 
 struct ModbusConfig {

@@ -210,7 +210,7 @@ void ModbusSupervisor::robot_thread() {
     const auto now = ModbusLink::Clock::now();
     modbus_t* ctx = robot_link_->connect(now);
     robot_up_.store(ctx != nullptr);
-    if (ctx == nullptr || !poll_spindle(ctx, spindle) || !poll_pose(ctx, pose)) {
+    if (ctx == nullptr || !poll_spindle(ctx, spindle) || !poll_pose(ctx, pose) || !poll_depth(ctx)) {
       if (ctx != nullptr) {  // the spindle or joint registers' read failed
         robot_link_->failed(ModbusLink::Clock::now());
         robot_up_.store(false);
@@ -219,6 +219,7 @@ void ModbusSupervisor::robot_thread() {
       }
       park_spindle_if_lost(spindle);
       pose_unknown_if_lost(pose);
+      depth_mm_.store(std::numeric_limits<double>::quiet_NaN());  // unknown while the link is down
       running = sleep_for(std::min<std::chrono::duration<double>>(period, robot_link_->retry_at() - now));
       continue;
     }
@@ -279,6 +280,22 @@ bool ModbusSupervisor::write_advice(modbus_t* ctx) {
   std::lock_guard<std::mutex> lock(m_);
   if (advice_regs_ == regs) advice_pending_ = false;  // a newer one waits for the next poll
   ++advice_writes_;
+  return true;
+}
+
+bool ModbusSupervisor::poll_depth(modbus_t* ctx) {
+  const auto& r = cfg_.robot;
+  if (r.depth_register < 0) return true;
+  std::uint16_t v = 0;
+  if (modbus_read_registers(ctx, r.depth_register, 1, &v) != 1) return false;
+  const double mm = v == 65535 ? std::numeric_limits<double>::quiet_NaN() : v * r.depth_mm_per_count;
+  if (v == 65535) ++depth_unavailable_polls_;
+  const double was = depth_mm_.exchange(mm);
+  if (!(mm == was) && !(std::isnan(mm) && std::isnan(was))) {
+    ++depth_changes_;
+    if (std::isnan(mm)) spdlog::warn("modbus robot: depth not available (65535): the job's depth applies");
+    else spdlog::info("modbus robot: cutting {:.3f} mm deep", mm);
+  }
   return true;
 }
 
@@ -374,6 +391,8 @@ ModbusCounters ModbusSupervisor::counters() const {
   c.amplifier_polls = amp_polls_.load();
   c.robot_polls = robot_polls_.load();
   c.advice_writes = advice_writes_.load();
+  c.depth_changes = depth_changes_.load();
+  c.depth_unavailable_polls = depth_unavailable_polls_.load();
   for (const ModbusLink* l : {&amp_link_, robot_link_ ? &*robot_link_ : nullptr}) {
     if (l == nullptr) continue;
     c.connects += l->connects.load();

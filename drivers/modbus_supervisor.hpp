@@ -21,6 +21,7 @@
 
 #include <array>
 #include <atomic>
+#include <limits>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -81,6 +82,8 @@ struct ModbusCounters {
   std::uint64_t pose_unavailable_polls{0}; // polls with a joint register at -32768 (not available)
   std::uint64_t pose_link_losses{0};   // robot link lost for link_timeout_s: the pose became unknown
   std::uint64_t advice_writes{0};      // spindle-speed advices written to modbus.robot.advice_register
+  std::uint64_t depth_changes{0};      // new depths read from modbus.robot.depth_register
+  std::uint64_t depth_unavailable_polls{0};  // polls with the depth register at 65535 (not available)
 };
 
 class ModbusSupervisor final : public rt::SupervisoryIo {
@@ -107,6 +110,9 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   // Any thread: a new spindle-speed advice for modbus.robot.advice_register (the robot thread writes it
   // at its next poll; a failed write is tried again). found false: no stable speed in the range.
   void publish_advice(std::uint64_t seq, bool found, double rpm, double margin);
+  // Any thread: the axial depth the robot cuts (modbus.robot.depth_register), mm; NaN: no register, no
+  // poll yet, not available (65535) or the link lost for link_timeout_s.
+  [[nodiscard]] double depth_mm() const { return depth_mm_.load(); }
   // The joint angles of the last successful poll, deg (empty before one; NaN where not available).
   [[nodiscard]] std::vector<double> joints_deg() const;
 
@@ -150,6 +156,7 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   void report_pose(PoseWatch& w, long region);
   bool sleep_for(std::chrono::duration<double> d);  // false when stopping
   bool write_advice(modbus_t* ctx);  // the pending advice, if any; false: the write failed
+  bool poll_depth(modbus_t* ctx);    // false: the read failed
 
   config::ModbusConfig cfg_;
   MountingCallback on_mounting_;
@@ -159,7 +166,8 @@ class ModbusSupervisor final : public rt::SupervisoryIo {
   std::vector<double> joints_deg_;  // guarded by m_
   std::array<std::uint16_t, 4> advice_regs_{};  // guarded by m_
   bool advice_pending_{false};                  // guarded by m_
-  std::atomic<std::uint64_t> advice_writes_{0};
+  std::atomic<std::uint64_t> advice_writes_{0}, depth_changes_{0}, depth_unavailable_polls_{0};
+  std::atomic<double> depth_mm_{std::numeric_limits<double>::quiet_NaN()};
   ModbusLink amp_link_;
   std::optional<ModbusLink> robot_link_;
   std::thread amp_thread_, robot_thread_;

@@ -6,7 +6,26 @@
 
 #include "hil/plant_emulator.hpp"
 
+#include <spdlog/fmt/fmt.h>
+
 namespace robodamp::hil {
+
+namespace {
+
+nlohmann::json advice_json(const std::vector<AdviceSeen>& advice) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& a : advice)
+    out.push_back({{"plant_time_s", a.plant_time_s},
+                   {"seq", a.seq},
+                   {"status", a.status},
+                   {"rpm", a.rpm},
+                   {"margin", a.margin},
+                   {"action", a.action}});
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json report_json(const EmulatorReport& r) {
   using nlohmann::json;
   json frfs = json::array();
@@ -44,6 +63,7 @@ nlohmann::json report_json(const EmulatorReport& r) {
           {"end_reason", r.end_reason},
           {"cutting", cutting_json(r.cutting)},
           {"regenerative_cut", regenerative_cut_json(r.regenerative_cut)},
+          {"advice", advice_json(r.advice)},
           {"measurement",
            {{"records", r.measure_records}, {"records_planned", r.measure_records_planned}, {"files", r.measure_files}}},
           {"frames",
@@ -166,6 +186,19 @@ std::string report_text(const EmulatorReport& r) {
                     c.job.c_str(), c.axial_mm, c.rpm, c.revolutions, c.start_s, milling::to_string(v.classification),
                     milling::to_string(v.mechanism), v.chatter_hz, v.growth_per_period, v.nonharmonic_energy_ratio,
                     c.peak_force_n);
+    os << b;
+    if (c.segments.size() > 1)
+      for (const auto& g : c.segments) {
+        std::snprintf(b, sizeof b, "    %.3f-%.3f s (%s): %.3f mm at %.1f rpm, %.1f revolutions: %s%s\n", g.start_s, g.end_s,
+                      g.cause.c_str(), g.axial_mm, g.rpm, g.revolutions,
+                      g.judged ? milling::to_string(g.verdict.classification) : "too short to judge",
+                      g.judged && g.verdict.chatter_hz > 0.0 ? fmt::format(" at {:.2f} Hz", g.verdict.chatter_hz).c_str() : "");
+        os << b;
+      }
+  }
+  for (const auto& a : r.advice) {
+    std::snprintf(b, sizeof b, "  advice #%u read at %.3f s: status %d, %.1f rpm, margin %.2f: %s\n", a.seq, a.plant_time_s,
+                  a.status, a.rpm, a.margin, a.action.c_str());
     os << b;
   }
   for (const auto& f : r.injected) {

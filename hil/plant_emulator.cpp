@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -31,6 +32,7 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kSilentControllerS = 10.0;  // lockstep: no command for this long ends the run
 constexpr double kTemperatureTauS = 10.0;    // amplifier heating time constant
+constexpr double kAdvicePollS = 0.01;        // how often the robot program reads the advice block (plant time)
 
 std::int64_t now_ns() {
   timespec ts{};
@@ -64,6 +66,21 @@ class Registers {
       robot_->set_holding_register(m_.robot.spindle_rpm_register,
                                    static_cast<std::uint16_t>(std::clamp(std::lround(rpm / m_.robot.rpm_per_count), 0L, 65535L)));
   }
+  // The depth the robot program cuts: unsigned counts of depth_mm_per_count; 65535 = not available.
+  void set_depth_mm(double mm) {
+    if (!m_.robot_link || m_.robot.depth_register < 0) return;
+    const double counts = std::isfinite(mm) ? std::clamp(std::round(mm / m_.robot.depth_mm_per_count), 0.0, 65534.0) : 65535.0;
+    robot_->set_holding_register(m_.robot.depth_register, static_cast<std::uint16_t>(counts));
+  }
+  // The advice block robodamp run writes (modbus.robot.advice_register): seq, rpm counts, margin x 100,
+  // status; nothing without the block.
+  [[nodiscard]] std::optional<std::array<std::uint16_t, 4>> advice() const {
+    if (!m_.robot_link || m_.robot.advice_register < 0) return std::nullopt;
+    std::array<std::uint16_t, 4> a{};
+    for (int i = 0; i < 4; ++i) a[static_cast<std::size_t>(i)] = robot_->holding_register(m_.robot.advice_register + i);
+    return a;
+  }
+  [[nodiscard]] double rpm_per_count() const { return m_.robot.rpm_per_count; }
   void set_ready(bool on) { amp_->set_discrete_input(m_.amplifier.ready_input, on); }
   void set_temperature(double c) {
     const double counts = std::clamp(std::round(c / m_.amplifier.temperature_c_per_count), -32768.0, 32767.0);
@@ -136,17 +153,17 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   std::optional<RegenerativeCut> regenerative;
   const bool regenerative_model = o.cut_model == EmulatorOptions::CutModel::kRegenerative;
   if (!o.cut_job.empty() && regenerative_model) {
-    if (!changes.empty())
-      throw config::ConfigError({{o.cut_job, {}, "--spindle",
-                                  "the regenerative cut runs at one speed (--cut-rpm); a spindle profile needs --cut-model forced"}});
     RegenerativeCutOptions ro = o.regenerative;
     ro.job_path = o.cut_job;
+    ro.spindle = changes, ro.depth = o.depth_changes;
+    ro.program_period_s = o.spindle_register_period_s;
+    changes.clear();  // the cut's own program: the register shows the speed it turns at
     regenerative.emplace(cfg, plant, ro);
-    changes.push_back({0.0, 0.0, regenerative->rpm()});  // the robot's spindle register shows the cut's speed
     const RegenerativeCutReport head = regenerative->report();
-    spdlog::info("robodamp plant: regenerative cut {}: {:.3f} mm at {:.1f} rpm ({} steps per tooth), {} revolutions{}",
+    spdlog::info("robodamp plant: regenerative cut {}: {:.3f} mm at {:.1f} rpm ({} steps per tooth), {} revolutions{}{}",
                  o.cut_job, head.axial_mm, head.rpm, head.steps_per_tooth, head.revolutions,
-                 head.start_s >= 0.0 ? fmt::format(" from {:.3f} s", head.start_s) : std::string(" once the loop is at full gain"));
+                 head.start_s >= 0.0 ? fmt::format(" from {:.3f} s", head.start_s) : std::string(" once the loop is at full gain"),
+                 ro.spindle.empty() && ro.depth.empty() ? "" : " after the program's last change");
   } else if (!o.cut_job.empty()) {
     cut = cut_load_from_job(o.cut_job, model, o.cut_harmonics);
     spdlog::info("robodamp plant: cutting {} ({} teeth) at the {}: tooth harmonics {:.1f}, {:.1f}, {:.1f} N", o.cut_job,
@@ -262,6 +279,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
       return;
     }
     const sim::SensorReading s = plant.sense();
+    if (regenerative) regenerative->sensed(s.accel_mps2, static_cast<double>(rep.ticks) * dt);
     const drivers::Encoded e = drivers::encode(can.sensor, can.fd, s.accel_mps2, sensor_counter++);
     if (channel->send(e.frame, e.frame_bytes) == 0) ++rep.sensor_frames_sent;
     else ++rep.send_errors;
@@ -294,6 +312,27 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
       got = true;
     }
   };
+  // The robot reads robodamp's advice block and, with spindle.apply_advice, turns the spindle to the
+  // advised speed (a speed outside 0 < rpm <= spindle.rpm_max is refused, as a robot controller would).
+  double published_depth_mm = -1.0, advice_polled_s = -1.0;
+  unsigned advice_seq = 0;
+  auto read_advice = [&](double t) {
+    const auto a = regs.advice();
+    if (!a || (*a)[0] == advice_seq || ((*a)[0] == 0 && (*a)[3] == 0)) return;  // none, or no new one
+    advice_seq = (*a)[0];
+    AdviceSeen seen{t, advice_seq, (*a)[3], (*a)[1] * regs.rpm_per_count(), (*a)[2] / 100.0, {}};
+    if (seen.status == 2) seen.action = "kept the speed: no stable speed";
+    else if (seen.status != 1) seen.action = "refused: status " + std::to_string(seen.status) + " (allowed 1 or 2)";
+    else if (!(seen.rpm > 0.0) || seen.rpm > cfg.spindle.rpm_max)
+      seen.action = fmt::format("refused: {} rpm outside the spindle's 0 < rpm <= {} rpm (spindle.rpm_max)", seen.rpm,
+                                cfg.spindle.rpm_max);
+    else if (!cfg.spindle.apply_advice) seen.action = "not followed (spindle.apply_advice false)";
+    else if (regenerative->ended()) seen.action = "not followed: the cut has ended";
+    else seen.action = "followed", regenerative->follow_advice(seen.rpm, t);
+    spdlog::info("robodamp plant: advice #{} at {:.3f} s: status {}, {:.1f} rpm, margin {:.2f}: {}", seen.seq, t, seen.status,
+                 seen.rpm, seen.margin, seen.action);
+    rep.advice.push_back(std::move(seen));
+  };
   // One plant period with the amplifier's output, then the amplifier and robot registers.
   auto step_plant = [&]() {
     const std::size_t k = rep.ticks;
@@ -310,12 +349,18 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     }
     // The robot controller updates its spindle register every spindle_register_period_s (a ramp arrives
     // as a staircase the controller's settle rule can follow); the cut sees the speed itself.
-    const double rpm = cutting.before_step(t);
+    double rpm = cutting.before_step(t);
+    if (regenerative) {
+      if (t >= advice_polled_s + kAdvicePollS) advice_polled_s = t, read_advice(t);
+      regenerative->before_step(t);
+      rpm = regenerative->rpm();
+      const double depth_mm = regenerative->active() ? regenerative->axial_mm() : 0.0;  // 0: not in the cut
+      if (depth_mm != published_depth_mm) regs.set_depth_mm(published_depth_mm = depth_mm);
+    }
     if (rpm != published_rpm && t >= published_at_s + o.spindle_register_period_s) {
       regs.set_spindle_rpm(rpm);
       published_rpm = rpm, published_at_s = t;
     }
-    if (regenerative) regenerative->before_step(t);
     plant.step(ready ? applied_v : 0.0);
     if (regenerative) regenerative->after_step();
     cutting.after_step(ready ? applied_v : 0.0, dt);

@@ -67,7 +67,9 @@ struct EmulatorOptions {
   // tool's force harmonics at the spindle profile's speed (hil/cutting_load.hpp), which never regenerates.
   enum class CutModel { kRegenerative, kForced };
   CutModel cut_model{CutModel::kRegenerative};
-  RegenerativeCutOptions regenerative;  // job_path = cut_job
+  RegenerativeCutOptions regenerative;  // job_path = cut_job; its spindle program is the steps and ramps above
+  // The regenerative cut's depth program (plant time; rpm = the depth in mm): steps and ramps.
+  std::vector<SpindleChange> depth_changes;
   int cut_harmonics{12};
   // The robot moving (hil/pose_trajectory.hpp): waypoints (plant time, joint angles), the joint
   // registers written every pose_register_period_s and the plant's modes retuned every pose_update_s.
@@ -98,6 +100,17 @@ struct InjectedFault {
   std::string kind;           // "bus_off", "bus_restarted", "modbus_hang"
   double plant_time_s{0.0};
   std::int64_t monotonic_ns{0};  // CLOCK_MONOTONIC, comparable with the controller's on the same machine
+};
+
+// An advice robodamp run wrote to the robot's registers (modbus.robot.advice_register), as the emulated
+// robot read it, and what it did.
+struct AdviceSeen {
+  double plant_time_s{0.0};
+  unsigned seq{0};
+  int status{0};           // 1: a speed, 2: no stable speed in the range
+  double rpm{0.0}, margin{0.0};
+  std::string action;      // "followed", "kept the speed: no stable speed", "not followed (spindle.apply_advice
+                           // false)", "refused: ..." (a value out of range)
 };
 
 struct EmulatorReport {
@@ -137,6 +150,7 @@ struct EmulatorReport {
   std::vector<std::string> measure_files;
   CuttingReport cutting;
   RegenerativeCutReport regenerative_cut;
+  std::vector<AdviceSeen> advice;
   // The pose trajectory: plant retunes and what each dwell measured.
   std::uint64_t pose_retunes{0};
   std::vector<PoseDwellReport> pose_dwells;

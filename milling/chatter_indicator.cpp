@@ -28,7 +28,9 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   const double f_sp = spindle_rpm / 60.0;
   const double want_s = std::min(s_.max_window_s, std::max(s_.window_s, s_.min_revolutions / f_sp));
   const auto n = std::min(count_, static_cast<std::size_t>(want_s * fs_));
-  if (static_cast<double>(n) / fs_ * f_sp < s_.min_revolutions || n < 64) return out;
+  // A full window only: after a reset (another speed) the cut's transient, which decays, fills a
+  // shorter span and would look persistent.
+  if (static_cast<double>(n) < std::floor(want_s * fs_) || n < 64) return out;
 
   // The span, oldest first, mean removed.
   window_.resize(n);
@@ -71,12 +73,16 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     const std::size_t q = std::min<std::size_t>(3, 4 * (i - first) / (n - first));
     part_ss[q] += e * e, ++part_n[q];
   }
-  double q_min = INFINITY, q_max = 0.0;
+  double q_min = INFINITY, q_max = 0.0, q_rms[4] = {0.0, 0.0, 0.0, 0.0};
   for (int q = 0; q < 4; ++q) {
     const double r = part_n[q] ? std::sqrt(part_ss[q] / static_cast<double>(part_n[q])) : 0.0;
+    q_rms[q] = r;
     q_min = std::min(q_min, r), q_max = std::max(q_max, r);
   }
   out.persistence = q_max > 0.0 ? q_min / q_max : 0.0;
+  // Trend: the last quarter over the first. Chatter holds (a limit cycle) or grows; the marks an unstable
+  // cut left fade after a change to a stable speed (the wavy surface regenerates, less each pass).
+  out.trend = q_rms[0] > 0.0 ? q_rms[3] / q_rms[0] : 0.0;
 
   // Spectrum (Hann), energy away from the spindle harmonics.
   if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
@@ -100,7 +106,8 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
   out.nonharmonic_rms_mps2 = out.rms_mps2 * std::sqrt(out.nonharmonic_share);
   out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
-                out.nonharmonic_rms_mps2 > s_.floor_mps2 && out.persistence > s_.persistence_threshold;
+                out.nonharmonic_rms_mps2 > s_.floor_mps2 && out.persistence > s_.persistence_threshold &&
+                out.trend > s_.fading_threshold;
   if (off <= 0.0) out.chatter_hz = 0.0;
   return out;
 }

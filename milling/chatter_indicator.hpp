@@ -24,7 +24,8 @@ class RealFft;
 namespace robodamp::milling {
 
 struct ChatterIndicatorSettings {
-  double window_s{2.0};              // analysed span (at least min_revolutions revolutions when longer)
+  double window_s{2.0};              // analysed span (at least min_revolutions revolutions when longer);
+                                     // no verdict until the span is full (after a reset too)
   double max_window_s{8.0};          // the buffer
   int min_revolutions{12};
   double band_min_hz{5.0};
@@ -36,6 +37,11 @@ struct ChatterIndicatorSettings {
   // Quietest / loudest quarter of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
   // 0.87 s) in a 2 s window gives at most about exp(-1 s / 0.87 s) = 0.32.
   double persistence_threshold{0.4};
+  // Last quarter / first quarter of the window at or below this: fading, not chatter. A speed change
+  // that ends chatter leaves the old marks on the surface, which regenerate less each pass: at 667 rpm
+  // after 700 rpm (config/milling/active_damping_c2.yaml, 1.3 mm, open loop, across processes) they kept
+  // the persistence above 0.4 two seconds after the change.
+  double fading_threshold{0.7};
 };
 
 struct ChatterIndicator {
@@ -46,6 +52,7 @@ struct ChatterIndicator {
   double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
   double rms_mps2{0.0};
   double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest quarter / the loudest
+  double trend{0.0};                 // the same, the last quarter / the first
   bool chatter{false};
 };
 

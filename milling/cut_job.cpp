@@ -32,7 +32,8 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   s.runout_um = td.runout_um;
   s.pitch_deg = td.pitch_deg;
   check(o.rpm ? "--rpm" : "cut.spindle_rpm", s.rpm, {"rpm", 0.0, 200000.0, true, false});
-  check(o.axial_mm ? "--axial-mm" : "cut.axial_mm", s.cut.axial_mm, {"mm", 0.0, 100.0, true, false});
+  check(o.axial_mm ? "--axial-mm" : "cut.axial_mm", s.cut.axial_mm,
+        {"mm", 0.0, cfg.tool.flute_length_mm, true, false, "the tool's tool.flute_length_mm"});
   check(o.radial_mm ? "--radial-mm" : "cut.radial_mm", s.cut.radial_mm,
         {"mm", 0.0, cfg.tool.diameter_mm, true, false, "the tool's diameter"});
   check(o.revolutions ? "--revs" : "time_domain.revolutions", s.revolutions,

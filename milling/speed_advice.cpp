@@ -88,6 +88,8 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   const LiveLimits now = stability.compute(request.rpm, request.set, request.gain_ns_per_m);
   a.limit_now_mm = limit_of(now);
   a.method = request.damped ? now.method : now.open_method;
+  a.depth_mm = request.depth_mm;
+  if (request.chatter_hz > 0.0 && a.limit_now_mm > request.depth_mm) a.depth_mm = a.limit_now_mm, a.depth_from_chatter = true;
   const int teeth = stability.job().tool.teeth;
   std::vector<SpeedOption> qualified;
   a.best.margin = -1.0;
@@ -104,7 +106,7 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
     if (request.damped && !l.damped_valid) continue;  // the loop itself unstable there
     const double limit = limit_of(l);
     // The damped verdict is for the speed the sampled loop steps (whole loop periods per tooth period).
-    const SpeedOption o{request.damped ? l.analysed_rpm : l.rpm, limit, limit / request.depth_mm, c.source};
+    const SpeedOption o{request.damped ? l.analysed_rpm : l.rpm, limit, limit / a.depth_mm, c.source};
     if (o.margin > a.best.margin) a.best = o;
     if (o.margin >= s.depth_margin && std::abs(o.rpm - request.rpm) > 0.5) qualified.push_back(o);
   }
@@ -116,7 +118,7 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.found = !a.options.empty();
   if (!a.found)
     a.reason = "no speed in " + number(rpm_min, "%.0f") + ".." + number(rpm_max, "%.0f") + " rpm is stable at " +
-               number(request.depth_mm, "%.3f") + " mm with " + number(100.0 * (s.depth_margin - 1.0), "%.0f") +
+               number(a.depth_mm, "%.3f") + " mm" + (a.depth_from_chatter ? " (the limit where it chatters)" : "") + " with " + number(100.0 * (s.depth_margin - 1.0), "%.0f") +
                " % margin (" + std::to_string(a.evaluated) + " speeds analysed; the best, " +
                number(a.best.rpm, "%.0f") + " rpm, allows " + number(a.best.limit_mm, "%.3f") +
                " mm): reduce the depth";

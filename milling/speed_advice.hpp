@@ -50,6 +50,11 @@ struct SpeedAdvice {
   SpeedAdviceRequest request;
   double rpm_min{0.0}, rpm_max{0.0};  // the allowed range searched
   double limit_now_mm{0.0};     // at the current speed
+  // The depth the margins are against: the request's, or, when chatter is measured at a speed whose limit
+  // is above it, that limit (the cut chatters, so it is at least that deep by the model: the depth
+  // told is wrong, or the model is optimistic there).
+  double depth_mm{0.0};
+  bool depth_from_chatter{false};
   std::string method;           // which method made the limits ("sampled-loop SDM", "SDM", ...)
   bool found{false};
   std::vector<SpeedOption> options;   // found: up to max_options, nearest the current speed first

@@ -107,7 +107,8 @@ Status Cell::configure() {
             if (modbus_)
               modbus_->client().publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
                                                r.advice.found ? r.advice.options.front().margin : 0.0);
-          });
+          },
+          [this] { return modbus_ ? modbus_->client().depth_mm() : std::nan(""); });
     } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
       for (Component* d : components()) (void)d->cleanup();
       return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};

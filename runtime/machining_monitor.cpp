@@ -22,8 +22,9 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 
 MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets,
                                    std::function<std::size_t()> active_set,
-                                   std::function<void(const AdviceRecord&)> on_advice)
-    : teeth_(cfg.spindle.teeth), active_set_(std::move(active_set)),
+                                   std::function<void(const AdviceRecord&)> on_advice,
+                                   std::function<double()> robot_depth_mm)
+    : teeth_(cfg.spindle.teeth), active_set_(std::move(active_set)), robot_depth_mm_(std::move(robot_depth_mm)),
       chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
   for (const auto& s : sets) set_gains_.push_back(s.controller.gain_ns_per_m);
   config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
@@ -71,7 +72,8 @@ AdviceView MachiningMonitor::view() {
     s.chatter = c.chatter;
   }
   s.tooth_passing_hz = s.spindle_rpm * teeth_ / 60.0;
-  s.depth_mm = stability_->depth_mm();
+  const double robot_depth = robot_depth_mm_ ? robot_depth_mm_() : std::nan("");
+  s.depth_mm = std::isfinite(robot_depth) ? robot_depth : stability_->depth_mm();  // 0: the tool is out of the cut
   if (s.spindle_rpm > 0.0)
     if (const auto l = stability_->lookup(s.spindle_rpm, set, gain)) {
       s.limits_ready = true;

@@ -26,9 +26,10 @@ class MachiningMonitor {
   // cfg: the cell's configuration (spindle.job names the job); sets: every parameter set's configuration
   // (index 0 = cfg); active_set: the supervisor's active set (any thread). Throws config::ConfigError
   // when the job cannot be read or does not fit.
-  // on_advice: each new spindle-speed advice, on the advisor's thread (optional).
+  // on_advice: each new spindle-speed advice, on the advisor's thread (optional). robot_depth_mm: the
+  // depth the robot reports cutting (any thread; 0: out of the cut; NaN or absent: the job's cut.axial_mm).
   MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, std::function<std::size_t()> active_set,
-                   std::function<void(const AdviceRecord&)> on_advice = {});
+                   std::function<void(const AdviceRecord&)> on_advice = {}, std::function<double()> robot_depth_mm = {});
 
   // The drain thread, every frame.
   void on_frame(const rt::TelemetryFrame& f);
@@ -45,6 +46,7 @@ class MachiningMonitor {
   int teeth_;
   std::vector<double> set_gains_;
   std::function<std::size_t()> active_set_;
+  std::function<double()> robot_depth_mm_;
   std::unique_ptr<milling::LiveStability> stability_;
   std::mutex m_;
   milling::ChatterMonitor chatter_;

@@ -26,7 +26,7 @@ dds::AdviceSample to_sample(const AdviceRecord& r) {
   s.time_s = r.time_s;
   s.trigger = a.request.trigger;
   s.spindle_rpm = a.request.rpm;
-  s.depth_mm = a.request.depth_mm;
+  s.depth_mm = a.depth_mm;  // what the margins are against (the limit where it chatters when above the told depth)
   s.damped = a.request.damped;
   s.chatter_hz = a.request.chatter_hz;
   s.limit_now_mm = a.limit_now_mm;
@@ -110,9 +110,9 @@ void SpeedAdvisor::run() {
         const auto& a = rec.advice;
         if (s_.cancelled()) return;
         if (a.found)
-          spdlog::info("speed advice #{} ({} at {:.0f} rpm, {:.3f} mm above {:.3f} mm): {:.0f} rpm allows {:.3f} mm ({})",
-                       rec.seq, r->trigger, r->rpm, r->depth_mm, a.limit_now_mm, a.options.front().rpm,
-                       a.options.front().limit_mm, a.method);
+          spdlog::info("speed advice #{} ({} at {:.0f} rpm, {:.3f} mm{} against a limit of {:.3f} mm): {:.0f} rpm allows {:.3f} mm ({})",
+                       rec.seq, r->trigger, r->rpm, a.depth_mm, a.depth_from_chatter ? " (the limit where it chatters)" : "",
+                       a.limit_now_mm, a.options.front().rpm, a.options.front().limit_mm, a.method);
         else
           spdlog::warn("speed advice #{} ({} at {:.0f} rpm): {}", rec.seq, r->trigger, r->rpm, a.reason);
         if (on_advice_) on_advice_(rec);

@@ -295,7 +295,7 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
            view.find("damper active") != std::string::npos;
   }, 120.0);
   EXPECT_TRUE(seen) << view << "\nrun log:\n" << test::read_file(dir + "/run.log");
-  EXPECT_NE(view.find("spindle    700 rpm (tooth passing 35.0 Hz), job depth 0.500 mm"), std::string::npos) << view;
+  EXPECT_NE(view.find("spindle    700 rpm (tooth passing 35.0 Hz), depth 0.500 mm"), std::string::npos) << view;
   EXPECT_NE(view.find("open 1.111 mm (SDM), damped 0.782 mm (sampled-loop SDM); now 0.782 mm (damper active)  depth within"),
             std::string::npos)
       << view;
@@ -303,7 +303,7 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
   run.kill(SIGINT);
   EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
   const std::string log = test::read_file(dir + "/run.log");
-  EXPECT_NE(log.find("machining at the end: 700 rpm, job depth 0.500 mm; limit open 1.111 mm (SDM), damped 0.782 mm (sampled-loop SDM)"),
+  EXPECT_NE(log.find("machining at the end: 700 rpm, depth 0.500 mm; limit open 1.111 mm (SDM), damped 0.782 mm (sampled-loop SDM)"),
             std::string::npos) << log;
 }
 

@@ -167,6 +167,17 @@ TEST(SpeedAdvice, AdvisedSpeedsAreStableAtTheDepthByTheAccurateMethodAndInTheTim
   EXPECT_NE(none.reason.find("no speed in 690..710 rpm is stable at 1.000 mm"), std::string::npos) << none.reason;
   EXPECT_GT(none.best.limit_mm, 0.0);
   EXPECT_LT(none.best.limit_mm, 1.15);
+
+  // Chatter measured where the told depth (0.5 mm) is below the limit (0.782 mm): the cut is at least as
+  // deep as the limit there, and the advice is for that depth, not for the 0.5 mm the model calls stable.
+  rq.depth_mm = 0.5;
+  rq.chatter_hz = 23.7;
+  rq.trigger = "chatter";
+  const milling::SpeedAdvice measured = milling::advise_speed(live, rq, job.lobes.rpm_min, job.lobes.rpm_max);
+  EXPECT_TRUE(measured.depth_from_chatter);
+  EXPECT_DOUBLE_EQ(measured.depth_mm, measured.limit_now_mm);
+  ASSERT_TRUE(measured.found) << measured.reason;
+  for (const auto& o : measured.options) EXPECT_GE(o.limit_mm, 1.15 * measured.limit_now_mm) << o.rpm;
 }
 
 TEST(LiveStability, AJobWithoutADampingLocationIsRefused) {
@@ -215,6 +226,22 @@ TEST(ChatterIndicator, ForcedVibrationIsQuietAndAnOffHarmonicModeIsChatter) {
   EXPECT_GT(h.nonharmonic_share, 0.1);
   EXPECT_GT(h.once_per_rev_ratio, 0.2);
   EXPECT_FALSE(h.chatter) << h.persistence;
+  // The marks a chattering cut left, fading after a change to a stable speed (time constant 2.5 s, the
+  // window's quiet quarter 0.55 of its loud one): persistent, but fading, so not chatter. And the same
+  // vibration holding (a limit cycle) is.
+  milling::ChatterMonitor fading(fs), holding(fs);
+  for (int i = 0; i < 2 * 5000; ++i) {
+    const double t = i / fs;
+    double forced = 0.0;
+    for (int k = 1; k <= 12; ++k) forced += (1.0 / k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.3 * k);
+    fading.push(forced + noise(rng) + 0.6 * std::exp(-t / 2.5) * std::sin(2.0 * M_PI * 17.3 * t));
+    holding.push(forced + noise(rng) + 0.6 * std::sin(2.0 * M_PI * 17.3 * t));
+  }
+  const auto fd = fading.evaluate(rpm), hd = holding.evaluate(rpm);
+  EXPECT_GT(fd.persistence, 0.4);
+  EXPECT_LT(fd.trend, 0.7);
+  EXPECT_FALSE(fd.chatter) << fd.trend;
+  EXPECT_TRUE(hd.chatter) << hd.trend << " " << hd.persistence;
   // Too few revolutions, a stopped spindle, NaN samples: no verdict, nothing breaks.
   milling::ChatterMonitor fresh(fs);
   for (int i = 0; i < 100; ++i) fresh.push(i % 7 == 0 ? NAN : 0.1);
