@@ -32,6 +32,7 @@ struct PlantArgs {
   std::string cut_job;
   std::string cut_model{"regenerative"};
   std::optional<double> cut_rpm, cut_axial_mm, cut_at_s;
+  double cut_until_s{0.0};
   std::optional<int> cut_revolutions;
   bool drives_off{false};
   double spindle_register_period_s{0.05};
@@ -124,6 +125,7 @@ int run_plant(const PlantArgs& a) {
   eo.regenerative.axial_mm = a.cut_axial_mm;
   eo.regenerative.revolutions = a.cut_revolutions;
   eo.regenerative.start_s = a.cut_at_s.value_or(-1.0);
+  eo.regenerative.until_s = a.cut_until_s;
   eo.spindle_register_period_s = a.spindle_register_period_s;
   for (const auto& item : a.pose_at) {
     hil::PoseWaypoint w;
@@ -200,6 +202,9 @@ void register_plant(Registry& r) {
                  "Revolutions of the regenerative cut (default: the job's, at least 300)");
   sub->add_flag("--drives-off", a->drives_off,
                 "The robot's drive vibration off for this run (disturbances.drives_on), as the in-process cut has it");
+  r.number(sub, "--cut-until", a->cut_until_s, {"s", 0.0, 604800.0, false, false, "0 = no bound"},
+           "The regenerative cut goes on at least until this plant time (the robot's path), then until its last speed and "
+           "depth have had --cut-revs revolutions");
   r.number(sub, "--cut-at", a->cut_at_s, {"s", 0.0, 604800.0},
            "Plant time the regenerative cut starts (default: hil.settle_s + controller.gain_ramp_s after the amplifier is ready)");
   sub->add_option("--pose-at", a->pose_at,

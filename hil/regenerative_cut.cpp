@@ -66,9 +66,10 @@ std::vector<double> forced_tones(double fd_hz, double ft_hz, double nyquist_hz) 
   return out;
 }
 
-milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) {
+milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg, const std::string& job_path) {
   milling::ChatterIndicatorSettings s;  // as robodamp run's (runtime/machining_monitor.cpp)
   s.band_min_hz = cfg.analysis.band_min_hz;
+  s.lines_per_revolution = milling::forced_lines_per_revolution(config::load_milling_config(job_path));
   return s;
 }
 
@@ -77,7 +78,7 @@ constexpr double kIndicatorPeriodS = 0.1;  // plant time between the live indica
 }  // namespace
 
 RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, const RegenerativeCutOptions& o)
-    : plant_(plant), speed_({}), depth_({}), indicator_(1.0 / plant.period_s(), indicator_settings(cfg)) {
+    : plant_(plant), speed_({}), depth_({}), indicator_(1.0 / plant.period_s(), indicator_settings(cfg, o.job_path)) {
   const config::MillingConfig job = config::load_milling_config(o.job_path);
   // The job's structure with its controller part on this cell: the part's location and direction are where
   // the cut acts on the plant; its loop rate is the cut's step.
@@ -114,6 +115,7 @@ RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, c
   depth.insert(depth.end(), o.depth.begin(), o.depth.end());
   for (const auto& c : o.spindle) program_end_s_ = std::max(program_end_s_, c.t1_s);
   for (const auto& c : o.depth) program_end_s_ = std::max(program_end_s_, c.t1_s);
+  program_end_s_ = std::max(program_end_s_, o.until_s);
   speed_ = SpindleProfile(std::move(speed)), depth_ = SpindleProfile(std::move(depth));
   program_period_s_ = std::max(o.program_period_s, plant.period_s());
   process_.emplace(cutter_, material_, settings_);

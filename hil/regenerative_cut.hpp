@@ -11,7 +11,8 @@
 // advice (follow_advice). Each change continues the cut on a new CutProcess (milling::CutProcess::
 // continue_from: the surface, the angle and the feed carry over) and starts a segment; each segment is
 // classified by the in-process cut's chatter detector at report(), so the two processes' verdicts
-// compare. The cut ends `revolutions` revolutions into a segment after the program's last change. Beside
+// compare. The cut ends `revolutions` revolutions into a segment after the program's last change and
+// after until_s (the robot's path). Beside
 // it the live chatter indicator (milling::ChatterMonitor, as robodamp run's) watches the control
 // accelerometer, which times detection and quiet. Built before the run (allocates); the per-step calls
 // do not, except a change of speed or depth, which builds the next process (rare, between steps).
@@ -47,6 +48,8 @@ struct RegenerativeCutOptions {
   // The robot program (plant time): speed (rpm) and depth (mm) steps and ramps from the values above.
   std::vector<SpindleChange> spindle, depth;
   double program_period_s{0.05};  // how often the program's ramps step (the robot's register period)
+  // The tool stays in the cut at least until this plant time (the robot's path), s; 0: no such bound.
+  double until_s{0.0};
 };
 
 // One span of the cut at one speed and depth.

@@ -3,9 +3,17 @@
 #include <algorithm>
 #include <cmath>
 
+#include "config/milling_config.hpp"
+
 #include "analysis/fft.hpp"
 
 namespace robodamp::milling {
+
+int forced_lines_per_revolution(const config::MillingConfig& job) {
+  const bool runout = std::any_of(job.time_domain.runout_um.begin(), job.time_domain.runout_um.end(),
+                                  [](double r) { return r != 0.0; });
+  return runout ? 1 : job.tool.teeth;
+}
 
 ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s)
     : fs_(sample_rate_hz), s_(s) {
@@ -47,7 +55,9 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   if (out.rms_mps2 <= 0.0) return out;
 
   // Once per revolution.
-  const double rev_samples = fs_ / f_sp;
+  // Sampled once per forced period: a revolution, or a tooth period when only the tooth harmonics are
+  // forced (chatter near a spindle harmonic aliases to almost nothing once per revolution).
+  const double rev_samples = fs_ / (f_sp * s_.lines_per_revolution);
   double prev = window_[0], sd = 0.0;
   std::size_t revs = 0;
   for (double t = rev_samples; t <= static_cast<double>(n - 1); t += rev_samples) {
@@ -83,6 +93,10 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   // Trend: the last quarter over the first. Chatter holds (a limit cycle) or grows; the marks an unstable
   // cut left fade after a change to a stable speed (the wavy surface regenerates, less each pass).
   out.trend = q_rms[0] > 0.0 ? q_rms[3] / q_rms[0] : 0.0;
+  // Growing: every quarter louder than the one before by growing_step (chatter building up; an impact
+  // late in the window raises only the last quarter).
+  out.growing = true;
+  for (int q = 1; q < 4; ++q) out.growing = out.growing && q_rms[q] > s_.growing_step * q_rms[q - 1];
 
   // Spectrum (Hann), energy away from the spindle harmonics.
   if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
@@ -91,23 +105,25 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     in[i] = window_[i] * (0.5 - 0.5 * std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(n)));
   const std::complex<double>* X = fft_->forward();
   const double df = fs_ / static_cast<double>(n);
-  double total = 0.0, off = 0.0, best = 0.0;
+  // The share by displacement (each line's energy / f^2): the accelerometer weights the tooth-passing
+  // harmonics by f^2 over a robot mode's chatter below them; the floor is on the acceleration.
+  double total = 0.0, off = 0.0, total_a = 0.0, off_a = 0.0, best = 0.0;
   for (std::size_t k = 1; k < fft_->bins(); ++k) {
     const double f = static_cast<double>(k) * df;
     if (f < s_.band_min_hz || f > 0.45 * fs_) continue;
-    const double e = std::norm(X[k]);
-    total += e;
-    const double h = std::round(f / f_sp);
-    if (std::abs(f - h * f_sp) <= 2.0 * df + 1e-12) continue;
-    off += e;
+    const double e_a = std::norm(X[k]), e = e_a / (f * f);
+    total += e, total_a += e_a;
+    const double f_line = f_sp * s_.lines_per_revolution, h = std::round(f / f_line);
+    if (std::abs(f - h * f_line) <= 2.0 * df + 1e-12) continue;
+    off += e, off_a += e_a;
     if (e > best) best = e, out.chatter_hz = f;
   }
   out.valid = true;
   out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
-  out.nonharmonic_rms_mps2 = out.rms_mps2 * std::sqrt(out.nonharmonic_share);
+  out.nonharmonic_rms_mps2 = total_a > 0.0 ? out.rms_mps2 * std::sqrt(off_a / total_a) : 0.0;
   out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
-                out.nonharmonic_rms_mps2 > s_.floor_mps2 && out.persistence > s_.persistence_threshold &&
-                out.trend > s_.fading_threshold;
+                out.nonharmonic_rms_mps2 > s_.floor_mps2 &&
+                (out.persistence > s_.persistence_threshold || out.growing) && out.trend > s_.fading_threshold;
   if (off <= 0.0) out.chatter_hz = 0.0;
   return out;
 }

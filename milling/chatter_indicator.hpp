@@ -1,15 +1,20 @@
 // The online chatter indicator (docs/harmonic_notch.md, "Chatter indicator"): from the control
 // accelerometer's samples as the telemetry drain receives them, over the last few seconds,
-//   - the once-per-revolution statistic: the signal resampled once per spindle revolution (linear
+//   - the once-per-revolution statistic: the signal resampled once per spindle revolution (or per tooth
+//     period when only the tooth harmonics are forced, lines_per_revolution; linear
 //     interpolation between loop samples) repeats in a forced, stable cut; the RMS of the differences of
 //     consecutive revolution samples over the RMS of the signal is near 0 then and near sqrt(2) for a
 //     vibration unrelated to the spindle;
 //   - the non-harmonic energy share: of the spectral energy in [band_min_hz, 0.45 x the loop rate], the
 //     share more than two bins away from every spindle harmonic (Hann window; runout makes every
-//     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency.
+//     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency; by
+//     displacement (the acceleration's lines / f^2), as the tooth-passing harmonics above a robot mode's
+//     chatter would otherwise outweigh it by (f / f_chatter)^2;
 // Chatter is indicated when both exceed their thresholds, the non-harmonic vibration exceeds a floor
 // (sensor noise alone is not chatter) and it persists across the window (its quietest quarter at
-// least 0.4 of its loudest: a hammer impact's decaying ring is not chatter). Off the real-time path:
+// least 0.4 of its loudest: a hammer impact's decaying ring is not chatter) or grows through it (each
+// quarter louder than the one before), and it is not fading (the last quarter above 0.7 of the first:
+// the marks of a cut that chattered, after a change to a stable speed). Off the real-time path:
 // push() per sample on the drain thread, evaluate() at the status rate; buffers allocated at construction.
 #pragma once
 
@@ -29,6 +34,11 @@ struct ChatterIndicatorSettings {
   double max_window_s{8.0};          // the buffer
   int min_revolutions{12};
   double band_min_hz{5.0};
+  // The forced lines: every spindle harmonic (1: a spindle with runout, each tooth cutting its own chip)
+  // or every tooth-passing harmonic (the teeth: no runout). Chatter near a spindle harmonic (at 700 rpm
+  // on config/milling/active_damping_c2.yaml, 23.7 Hz against the second, 23.3 Hz) hides behind the
+  // first within the window's resolution.
+  int lines_per_revolution{1};
   // Simulated cuts of config/milling/active_damping_c2.yaml at 700 rpm (tests/test_machining.cpp): 1.0 mm,
   // stable: 0.02 and 0.0001; 2.5 mm, chatter at 24.1 Hz: 0.33 and 0.26.
   double once_per_rev_threshold{0.2};
@@ -42,19 +52,34 @@ struct ChatterIndicatorSettings {
   // after 700 rpm (config/milling/active_damping_c2.yaml, 1.3 mm, open loop, across processes) they kept
   // the persistence above 0.4 two seconds after the change.
   double fading_threshold{0.7};
+  // Chatter that is still building up fills the window unevenly (its first quarter quiet): it counts when
+  // each quarter is at least this x the one before.
+  double growing_step{1.1};
 };
 
 struct ChatterIndicator {
   bool valid{false};                 // enough samples at a turning spindle
   double once_per_rev_ratio{0.0};
-  double nonharmonic_share{0.0};     // 0..1
+  double nonharmonic_share{0.0};     // 0..1, of the displacement's energy
   double nonharmonic_rms_mps2{0.0};
   double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
   double rms_mps2{0.0};
   double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest quarter / the loudest
   double trend{0.0};                 // the same, the last quarter / the first
+  bool growing{false};               // each quarter louder than the one before (growing_step)
   bool chatter{false};
 };
+
+}  // namespace robodamp::milling
+
+namespace robodamp::config {
+struct MillingConfig;
+}
+
+namespace robodamp::milling {
+
+// The job's forced lines per revolution: its teeth without runout (time_domain.runout_um all zero), else 1.
+[[nodiscard]] int forced_lines_per_revolution(const config::MillingConfig& job);
 
 class ChatterMonitor {
  public:

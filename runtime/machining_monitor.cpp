@@ -12,9 +12,12 @@ namespace robodamp::runtime {
 
 namespace {
 
+// The job's spindle: without runout (time_domain.runout_um all zero) only the tooth harmonics are forced.
 milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) {
   milling::ChatterIndicatorSettings s;
   s.band_min_hz = cfg.analysis.band_min_hz;
+  const config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
+  s.lines_per_revolution = milling::forced_lines_per_revolution(job);
   return s;
 }
 

@@ -236,6 +236,29 @@ TEST(Modbus, SpindleRegisterSettlesScalesAndALostLinkParksTheNotches) {
   sup.stop();
 }
 
+// The depth the robot cuts (modbus.robot.depth_register): scaled; 65535 (the robot's "not available") and
+// a lost link make it unknown (NaN: the job's depth applies), counted; nothing before the first poll.
+TEST(Modbus, DepthRegisterScalesAndNotAvailableOrALostLinkIsUnknown) {
+  ModbusServer server;
+  const int port = server.start("127.0.0.1", 0);
+  config::ModbusConfig cfg = client_config(port);
+  cfg.robot.depth_register = 12;
+  cfg.robot.depth_mm_per_count = 0.001;
+  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  EXPECT_TRUE(std::isnan(sup.depth_mm()));
+  server.set_holding_register(12, 850);
+  sup.start();
+  ASSERT_TRUE(eventually([&] { return sup.depth_mm() == 0.85; }));
+  server.set_holding_register(12, 65535);
+  ASSERT_TRUE(eventually([&] { return std::isnan(sup.depth_mm()) && sup.counters().depth_unavailable_polls > 0; }));
+  server.set_holding_register(12, 0);  // out of the cut
+  ASSERT_TRUE(eventually([&] { return sup.depth_mm() == 0.0; }));
+  EXPECT_EQ(sup.counters().depth_changes, 3U);
+  server.stop();
+  ASSERT_TRUE(eventually([&] { return std::isnan(sup.depth_mm()); }));
+  sup.stop();
+}
+
 // The joint registers (pose_schedule): the region settles before it is handed over, the overlap keeps
 // the region the pose is in, a register at -32768 (the robot's "not available") and a pose outside every
 // region hand over "out of the map", and a lost link makes the pose unknown after link_timeout_s.
