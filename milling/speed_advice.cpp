@@ -90,6 +90,7 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.method = request.damped ? now.method : now.open_method;
   a.depth_mm = request.depth_mm;
   if (request.chatter_hz > 0.0 && a.limit_now_mm > request.depth_mm) a.depth_mm = a.limit_now_mm, a.depth_from_chatter = true;
+  const double margin = a.depth_from_chatter ? s.chatter_depth_margin : s.depth_margin;
   const int teeth = stability.job().tool.teeth;
   std::vector<SpeedOption> qualified;
   a.best.margin = -1.0;
@@ -108,7 +109,7 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
     // The damped verdict is for the speed the sampled loop steps (whole loop periods per tooth period).
     const SpeedOption o{request.damped ? l.analysed_rpm : l.rpm, limit, limit / a.depth_mm, c.source};
     if (o.margin > a.best.margin) a.best = o;
-    if (o.margin >= s.depth_margin && std::abs(o.rpm - request.rpm) > 0.5) qualified.push_back(o);
+    if (o.margin >= margin && std::abs(o.rpm - request.rpm) > 0.5) qualified.push_back(o);
   }
   std::stable_sort(qualified.begin(), qualified.end(), [&](const SpeedOption& x, const SpeedOption& y) {
     return std::abs(x.rpm - request.rpm) < std::abs(y.rpm - request.rpm);
@@ -118,7 +119,7 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.found = !a.options.empty();
   if (!a.found)
     a.reason = "no speed in " + number(rpm_min, "%.0f") + ".." + number(rpm_max, "%.0f") + " rpm is stable at " +
-               number(a.depth_mm, "%.3f") + " mm" + (a.depth_from_chatter ? " (the limit where it chatters)" : "") + " with " + number(100.0 * (s.depth_margin - 1.0), "%.0f") +
+               number(a.depth_mm, "%.3f") + " mm" + (a.depth_from_chatter ? " (the limit where it chatters)" : "") + " with " + number(100.0 * (margin - 1.0), "%.0f") +
                " % margin (" + std::to_string(a.evaluated) + " speeds analysed; the best, " +
                number(a.best.rpm, "%.0f") + " rpm, allows " + number(a.best.limit_mm, "%.3f") +
                " mm): reduce the depth";

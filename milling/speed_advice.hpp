@@ -19,6 +19,10 @@ namespace robodamp::milling {
 
 struct SpeedAdviceSettings {
   double depth_margin{1.15};    // advised only where the limit is at least this x the depth
+  // ... or this x, when the depth is only known to be at least the limit where the cut chatters: a speed
+  // just above that limit left the HIL cut ringing at 91 % of its limit (0.95 mm at 758 rpm, damped,
+  // scripts/advice_demo.sh), which the live indicator takes for chatter.
+  double chatter_depth_margin{1.3};
   std::size_t grid_points{48};  // uniform candidates over the range, beside the pockets
   std::size_t max_options{3};
   std::function<bool()> cancelled;  // checked between candidates (the cell is shutting down): stop there

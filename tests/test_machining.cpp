@@ -177,7 +177,7 @@ TEST(SpeedAdvice, AdvisedSpeedsAreStableAtTheDepthByTheAccurateMethodAndInTheTim
   EXPECT_TRUE(measured.depth_from_chatter);
   EXPECT_DOUBLE_EQ(measured.depth_mm, measured.limit_now_mm);
   ASSERT_TRUE(measured.found) << measured.reason;
-  for (const auto& o : measured.options) EXPECT_GE(o.limit_mm, 1.15 * measured.limit_now_mm) << o.rpm;
+  for (const auto& o : measured.options) EXPECT_GE(o.limit_mm, 1.3 * measured.limit_now_mm) << o.rpm;  // a lower bound: more margin
 }
 
 TEST(LiveStability, AJobWithoutADampingLocationIsRefused) {
