@@ -124,6 +124,11 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
     if (auto v = b.number("depth_mm_per_count", {"mm per count", 0.0, 1.0, true}, rr.depth_mm_per_count))
       rr.depth_mm_per_count = *v;
     for (const auto& [key, reg] : {std::pair{"mounting_register", rr.mounting_register},
+                                   std::pair{"spindle_rpm_register", rr.spindle_rpm_register}})
+      if (rr.depth_register >= 0 && reg == rr.depth_register)
+        b.diagnostics().add(b.mark(), "modbus.robot.depth_register",
+                            "= " + std::to_string(rr.depth_register) + " is modbus.robot." + key + " too: they must differ");
+    for (const auto& [key, reg] : {std::pair{"mounting_register", rr.mounting_register},
                                    std::pair{"spindle_rpm_register", rr.spindle_rpm_register},
                                    std::pair{"depth_register", rr.depth_register}})
       if (rr.advice_register >= 0 && reg >= rr.advice_register && reg < rr.advice_register + 4)

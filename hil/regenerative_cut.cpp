@@ -305,6 +305,8 @@ nlohmann::json segments_json(const std::vector<CutSegment>& segments) {
                    {"classification", s.judged ? milling::to_string(v.classification) : "too short"},
                    {"stable", s.judged ? nlohmann::json(v.stable) : nlohmann::json(nullptr)},
                    {"chatter_hz", s.judged && v.chatter_hz > 0.0 ? nlohmann::json(v.chatter_hz) : nlohmann::json(nullptr)},
+                   {"growth_per_tooth", s.judged ? nlohmann::json(v.growth_per_period) : nlohmann::json(nullptr)},
+                   {"nonharmonic_energy_ratio", s.judged ? nlohmann::json(v.nonharmonic_energy_ratio) : nlohmann::json(nullptr)},
                    {"indicator_chatter_s", time_or_null(s.indicator_chatter_s)},
                    {"indicator_quiet_s", time_or_null(s.indicator_quiet_s)}});
   }

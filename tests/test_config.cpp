@@ -394,7 +394,8 @@ TEST(Config, ModbusDdsAndHilSectionsAreValidated) {
   const auto p = problems_of(std::string(kValid) +
                              "modbus:\n  poll_period_s: 0.05\n  link_timeout_s: 0.01\n"
                              "  amplifier: {host: 127.0.0.1, port: 70000, ready_input: 3, fault_input: 3}\n"
-                             "  robot: {port: 502, horizontal_value: 1, vertical_value: 1}\n"
+                             "  robot: {port: 502, horizontal_value: 1, vertical_value: 1, depth_register: 0,"
+                             " depth_mm_per_count: -1}\n"
                              "parameter_sets: {vertical: no_such_file.yaml}\n"
                              "dds: {domain_id: 300, transport: carrier_pigeon}\n"
                              "hil: {pacing: sometimes}\n");
@@ -404,9 +405,11 @@ TEST(Config, ModbusDdsAndHilSectionsAreValidated) {
        {"modbus.link_timeout_s = 0.01 s is shorter than modbus.poll_period_s = 0.05 s",
         "modbus.amplifier.port = 70000 (TCP port) is out of range", "modbus.amplifier.fault_input = 3 is the ready input's address too",
         "modbus.robot.vertical_value = 1 is the horizontal value too", "parameter_sets.vertical = 'no_such_file.yaml': no such file",
-        "dds.domain_id = 300", "dds.transport = 'carrier_pigeon' is not allowed", "hil.pacing = 'sometimes' is not allowed"})
+        "dds.domain_id = 300", "dds.transport = 'carrier_pigeon' is not allowed", "hil.pacing = 'sometimes' is not allowed",
+        "modbus.robot.depth_mm_per_count = -1 mm per count is out of range",
+        "modbus.robot.depth_register = 0 is modbus.robot.mounting_register too"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
-  EXPECT_EQ(p.size(), 8U) << all;
+  EXPECT_EQ(p.size(), 10U) << all;
 }
 
 TEST(Config, CommissioningSectionIsValidated) {
@@ -433,22 +436,23 @@ TEST(Config, HarmonicNotchAndSpindleAreValidated) {
   ASSERT_NE(at, std::string::npos);
   std::string ok = text;
   ok.insert(at + 12, "  harmonic_notch: {harmonics: 4, bandwidth_hz: 20, depth_db: 40}\n");
-  const Config c = parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000}\n", "ok.yaml");
+  const Config c = parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000, apply_advice: true}\n", "ok.yaml");
+  EXPECT_TRUE(c.spindle.apply_advice);
   ASSERT_TRUE(c.controller.harmonic_notch);
   EXPECT_EQ(c.controller.harmonic_notch->harmonics, 4);
   EXPECT_EQ(c.controller.harmonic_notch->slew_fraction, 0.05);  // default
   EXPECT_EQ(c.spindle.teeth, 2);
   std::string bad = text;
   bad.insert(at + 12, "  harmonic_notch: {harmonics: 9, depth_db: 0, slew_fraction: 2, update_hz: .nan}\n");
-  const auto p = problems_of(bad + "spindle: {teeth: 0, rpm_max: -5}\n");
+  const auto p = problems_of(bad + "spindle: {teeth: 0, rpm_max: -5, apply_advice: sometimes}\n");
   std::string all;
   for (const auto& q : p) all += q.to_string() + "\n";
   for (const char* expected :
        {"controller.harmonic_notch.harmonics = 9", "controller.harmonic_notch.depth_db = 0 dB is out of range",
         "controller.harmonic_notch.slew_fraction = 2", "controller.harmonic_notch.update_hz", "spindle.teeth = 0",
-        "spindle.rpm_max = -5 rpm is out of range"})
+        "spindle.rpm_max = -5 rpm is out of range", "spindle.apply_advice"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
-  EXPECT_EQ(p.size(), 6U) << all;
+  EXPECT_EQ(p.size(), 7U) << all;
 }
 
 TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {
