@@ -18,14 +18,18 @@ int forced_lines_per_revolution(const config::MillingConfig& job) {
 ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s)
     : fs_(sample_rate_hz), s_(s) {
   ring_.assign(static_cast<std::size_t>(std::ceil(s_.max_window_s * fs_)), 0.0);
+  gap_.assign(ring_.size(), 0);
   window_.reserve(ring_.size());
 }
 
 ChatterMonitor::~ChatterMonitor() = default;
 
-void ChatterMonitor::push(double accel_mps2) {
-  if (!std::isfinite(accel_mps2)) return;  // invalid samples are counted by the supervisor
-  ring_[head_] = accel_mps2;
+void ChatterMonitor::push(double accel_mps2, bool fresh) {
+  // A stale, missed or invalid sample keeps the time base: the last value held, marked as a gap.
+  const bool gap = !fresh || !std::isfinite(accel_mps2);
+  const double last = ring_[(head_ + ring_.size() - 1) % ring_.size()];
+  ring_[head_] = gap ? last : accel_mps2;
+  gap_[head_] = gap ? 1 : 0;
   head_ = (head_ + 1) % ring_.size();
   count_ = std::min(count_ + 1, ring_.size());
 }
@@ -39,6 +43,11 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   // A full window only: after a reset (another speed) the cut's transient, which decays, fills a
   // shorter span and would look persistent.
   if (static_cast<double>(n) < std::floor(want_s * fs_) || n < 64) return out;
+  // Held samples put steps into the signal, which spread over the spectrum: too many, no verdict.
+  std::size_t gaps = 0;
+  for (std::size_t i = 0, at = (head_ + ring_.size() - n) % ring_.size(); i < n; ++i) gaps += gap_[(at + i) % ring_.size()];
+  out.gap_share = static_cast<double>(gaps) / static_cast<double>(n);
+  if (out.gap_share > s_.max_gap_share) return out;
 
   // The span, oldest first, mean removed.
   window_.resize(n);

@@ -7,10 +7,13 @@
 
 #include "config/milling_config.hpp"
 #include "rt/supervisor.hpp"
+#include "rt/telemetry_frame.hpp"
 
 namespace robodamp::runtime {
 
 namespace {
+
+constexpr std::uint64_t kMaxHeldTicks = 100000;  // longer than the indicator's buffer (8 s at 5 kHz)
 
 // The job's spindle: without runout (time_domain.runout_um all zero) only the tooth harmonics are forced.
 milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) {
@@ -47,7 +50,10 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
     rpm_ = std::isfinite(f.command_value) && f.command_value > 0.0 ? f.command_value : 0.0;
     chatter_.reset();  // another speed: the window restarts
   }
-  chatter_.push(f.accel_mps2);
+  // Missed ticks keep their place in the indicator's time base (as gaps), bounded by its buffer.
+  if (last_.tick > 0 && f.tick > last_.tick + 1)
+    for (std::uint64_t k = std::min<std::uint64_t>(f.tick - last_.tick - 1, kMaxHeldTicks); k > 0; --k) chatter_.push(0.0, false);
+  chatter_.push(f.accel_mps2, (f.flags & rt::kFlagFresh) != 0);
   last_ = f;
 }
 

@@ -87,6 +87,37 @@ TEST(HilCut, TheCriticalDepthAcrossProcessesMatchesTheInProcessOne) {
   EXPECT_GE(c["hil"]["cuts"].get<int>(), 5);
 }
 
+// The robot program changes the speed and the depth during one cut (lockstep, virtual clock): 0.85 mm at
+// 700 rpm from 1 s (on the lobe: Hopf), 666.7 rpm from 5 s (above the lobe), then a depth ramp to 0.6 mm
+// over 8-9 s in the register's 50 ms stairs, and 60 revolutions there. Each span is its own segment,
+// judged by the detector; the surface carries over, so the cut goes on where the last left it.
+TEST(HilCut, TheRobotProgramChangesSpeedAndDepthDuringTheCut) {
+  const test::HilFiles f = test::hil_files("regen_program");
+  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", "700",
+               "--cut-axial-mm", "0.85", "--cut-revs", "60", "--cut-at", "1", "--spindle", "5:666.7", "--depth-ramp",
+               "8:9:0.6", "--json", f.plant_json},
+              f.plant_log);
+  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", "16", "--json", f.run_json}, f.run_log);
+  ASSERT_EQ(run.wait(), 0) << test::read_file(f.run_log);
+  ASSERT_EQ(plant.wait(), 0) << test::read_file(f.plant_log);
+  const json cut = json::parse(test::read_file(f.plant_json))["regenerative_cut"];
+  const json& segments = cut["segments"];
+  ASSERT_GE(segments.size(), 4U) << cut.dump(1);  // 700, 666.7, the ramp's stairs, 0.6 mm
+  EXPECT_EQ(segments[0]["classification"], "hopf") << segments[0].dump();
+  EXPECT_NEAR(segments[1]["start_s"].get<double>(), 5.0, 0.06);
+  EXPECT_NEAR(segments[1]["rpm"].get<double>(), 666.7, 0.1);
+  EXPECT_EQ(segments[1]["cause"], "program");
+  const json& last = segments.back();
+  EXPECT_DOUBLE_EQ(last["axial_mm"].get<double>(), 0.6);
+  EXPECT_GE(last["start_s"].get<double>(), 8.9);
+  EXPECT_EQ(last["classification"], "stable") << cut.dump(1);
+  EXPECT_TRUE(cut["complete"].get<bool>());
+  for (std::size_t i = 2; i + 1 < segments.size(); ++i) {  // the stairs, between the two depths
+    EXPECT_LT(segments[i]["axial_mm"].get<double>(), 0.85);
+    EXPECT_GT(segments[i]["axial_mm"].get<double>(), 0.6);
+  }
+}
+
 // The cell that cuts and follows the advice: the robot publishes the spindle speed, the depth it cuts and
 // reads the advice block; spindle.job gives robodamp run the live limits; the emulated robot follows.
 // gain: the damper's (0: open loop); rpm_max: the spindle's.

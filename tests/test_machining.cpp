@@ -242,6 +242,21 @@ TEST(ChatterIndicator, ForcedVibrationIsQuietAndAnOffHarmonicModeIsChatter) {
   EXPECT_LT(fd.trend, 0.7);
   EXPECT_FALSE(fd.chatter) << fd.trend;
   EXPECT_TRUE(hd.chatter) << hd.trend << " " << hd.persistence;
+  // Held samples (stale ticks, missed ticks): a forced cut with 5 % of them held gets no verdict (the steps
+  // they make would read as off-harmonic vibration); with 0.5 % it is judged, quiet.
+  for (const int every : {20, 200}) {
+    milling::ChatterMonitor held(fs);
+    for (int i = 0; i < 4 * 5000; ++i) {
+      const double t = i / fs;
+      double forced = 0.0;
+      for (int k = 1; k <= 12; ++k) forced += (1.0 / k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.3 * k);
+      held.push(forced + noise(rng), i % every != 0);
+    }
+    const auto v = held.evaluate(rpm);
+    EXPECT_NEAR(v.gap_share, 1.0 / every, 1e-3);
+    EXPECT_EQ(v.valid, every == 200) << every;
+    EXPECT_FALSE(v.chatter) << every;
+  }
   // Too few revolutions, a stopped spindle, NaN samples: no verdict, nothing breaks.
   milling::ChatterMonitor fresh(fs);
   for (int i = 0; i < 100; ++i) fresh.push(i % 7 == 0 ? NAN : 0.1);
