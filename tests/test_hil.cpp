@@ -116,7 +116,9 @@ TEST(Hil, RealtimeRunKeepsTimingAndPullingThePlugTripsSafe) {
   // Tripped on the lost sensor (frames stop: stale; the socket closes: driver fault) and safe within the
   // configured time: stale_sensor_cycles periods to notice, trip_ramp_s to ramp, one tick of rounding.
   const std::string trip = r["trip"];
-  EXPECT_TRUE(trip == "sensor_stale" || trip == "sensor_driver") << trip;
+  // The sensor stops (stale, or the transport's error), or the command's send fails first: the peer that
+  // died is the amplifier too (seen once under a CPU hog on both cores). Each is safe.
+  EXPECT_TRUE(trip == "sensor_stale" || trip == "sensor_driver" || trip == "actuator_driver") << trip;
   EXPECT_EQ(r["final_state"], "fault");
   // The supervisor's bound is in ticks the loop ran; skipped ticks on a loaded machine add time, not ticks.
   const auto allowed_ticks = static_cast<std::int64_t>(cfg.supervision.stale_sensor_cycles +
@@ -418,7 +420,9 @@ TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   std::size_t last_fresh = t.trip;
   while (last_fresh > 0 && !(frames[last_fresh].flags & rt::kFlagFresh)) --last_fresh;
   const std::string trip = rt::to_string(static_cast<rt::Trip>(frames[t.trip].trip));
-  EXPECT_TRUE(trip == "sensor_stale" || trip == "sensor_driver") << trip;
+  // The sensor stops (stale, or the transport's error), or the command's send fails first: the peer that
+  // died is the amplifier too (seen once under a CPU hog on both cores). Each is safe.
+  EXPECT_TRUE(trip == "sensor_stale" || trip == "sensor_driver" || trip == "actuator_driver") << trip;
   // From the first tick without a fresh sample nothing drove the actuator: the command zero until the trip.
   for (std::size_t i = last_fresh + 1; i <= t.trip; ++i) EXPECT_EQ(frames[i].command_v, 0.0) << "stale tick " << i;
   const double safe_after_s = frames[t.safe].time_s - frames[last_fresh].time_s;
