@@ -241,6 +241,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
   // The robot reads robodamp's advice block and, with spindle.apply_advice, turns the spindle to the
   // advised speed (a speed outside 0 < rpm <= spindle.rpm_max is refused, as a robot controller would).
   double published_depth_mm = -1.0, advice_polled_s = -1.0;
+  bool cut_end_logged = false;
   unsigned advice_seq = 0;
   auto read_advice = [&](double t) {
     const auto a = regs.advice();
@@ -288,7 +289,11 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
       published_rpm = rpm, published_at_s = t;
     }
     plant.step(ready ? applied_v : 0.0);
-    if (regenerative) regenerative->after_step();
+    if (regenerative) {
+      regenerative->after_step();
+      if (regenerative->ended() && !cut_end_logged)
+        cut_end_logged = true, spdlog::info("robodamp plant: the regenerative cut ended at {:.3f} s", t + dt);
+    }
     cutting.after_step(ready ? applied_v : 0.0, dt);
     if (dwell_campaigns) dwell_campaigns->after_step(k);
     if (modal_test) modal_test->after_step(k);

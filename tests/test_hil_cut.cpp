@@ -4,6 +4,7 @@
 // and the plant in one loop) at the same speed, depth and revolutions, both ways.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -138,24 +139,32 @@ struct AdviceRun {
 // Lockstep with the controller on the wall clock: the plant steps with each command frame, the controller
 // ticks in real time, so the advisor's seconds of analysis pass as plant seconds do on a robot. The cut
 // starts at 2 s (the loop at full gain, the limits at the speed known) and lasts until 12 s at least (the
-// robot's path), its last speed 60 revolutions.
+// robot's path), its last speed 60 revolutions. The controller runs until the test has what it waits for
+// (then Ctrl-C: its summary, the emulator's report): an advice's analysis took 2.4 s idle and 9.5 s with
+// the suite and a CPU hog on both cores.
 struct AdviceCase {
   test::HilFiles files;
   std::unique_ptr<Child> plant, run;
 };
-AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_mm, double duration_s, bool drives_off) {
+AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_mm, bool drives_off,
+                             const std::string& plant_config = "", const std::string& rpm = "700") {
   AdviceCase c{f, nullptr, nullptr};
-  std::vector<std::string> plant_args{"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob,
-                                      "--cut-rpm", "700", "--cut-axial-mm", depth_mm, "--cut-revs", "60", "--cut-at", "2",
-                                      "--cut-until", "12", "--json", f.plant_json};
+  std::vector<std::string> plant_args{"plant", "--config", plant_config.empty() ? f.config : plant_config, "--pacing",
+                                      "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", rpm, "--cut-axial-mm",
+                                      depth_mm, "--cut-revs", "60", "--cut-at", "2", "--cut-until", "12", "--json",
+                                      f.plant_json};
   if (drives_off) plant_args.push_back("--drives-off");
   c.plant = std::make_unique<Child>(plant_args, f.plant_log);
-  c.run = std::make_unique<Child>(std::vector<std::string>{"run", "--config", f.config, "--clock", "wall", "--duration",
-                                                           std::to_string(duration_s), "--json", f.run_json},
-                                  f.run_log);
+  c.run = std::make_unique<Child>(
+      std::vector<std::string>{"run", "--config", f.config, "--clock", "wall", "--duration", "120", "--json", f.run_json},
+      f.run_log);
   return c;
 }
-AdviceRun finish(AdviceCase& c) {
+// Waits (up to 90 s) for `line` in the emulator's log, ends the controller with Ctrl-C, and reads both reports.
+AdviceRun finish_after(AdviceCase& c, const std::string& line) {
+  EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 90.0))
+      << line << " not in\n" << test::read_file(c.files.plant_log);
+  c.run->kill(SIGINT);
   AdviceRun r;
   r.run_exit = c.run->wait();
   r.plant_exit = c.plant->wait();
@@ -164,22 +173,28 @@ AdviceRun finish(AdviceCase& c) {
   return r;
 }
 
+// The run's trips before the Ctrl-C: none; on a machine loaded on both cores the wall-clock loop may stall
+// past its delay margin and trip on timing (safe, and beside the point here), never on the cut.
+void expect_no_cut_trip(const json& run) {
+  for (const auto& t : run["availability"]["trips"]) {
+    const std::string trip = t["trip"];
+    EXPECT_TRUE(trip == "signal" || trip == "overruns" || trip == "sensor_stale") << trip << "\n" << run.dump(1);
+  }
+}
+
 // Closing the loop across processes: a cut on a lobe at 700 rpm (damped 0.85 mm: the limit there is 0.782
 // mm, and the in-process cut chatters, above; open loop 1.3 mm against 1.104 mm, drives off as in process),
 // the advice over Modbus, the emulated robot turning to it, and the cut at the advised speed stable at the
 // same depth by the emulator's detector. The two cells run at once (lockstep, separate sockets and ports).
 TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
-  AdviceCase damped = start_advice_case(advice_cell("advice_damped"), "0.85", 19.0, false);
-  AdviceCase open = start_advice_case(advice_cell("advice_open", "0"), "1.3", 19.0, true);
+  AdviceCase damped = start_advice_case(advice_cell("advice_damped"), "0.85", false);
+  AdviceCase open = start_advice_case(advice_cell("advice_open", "0"), "1.3", true);
   for (auto [c, depth] : {std::pair{&damped, 0.85}, std::pair{&open, 1.3}}) {
-    const AdviceRun r = finish(*c);
+    const AdviceRun r = finish_after(*c, "the regenerative cut ended");
     const std::string logs = test::read_file(c->files.plant_log) + test::read_file(c->files.run_log);
     ASSERT_EQ(r.plant_exit, 0) << logs;
-    // No trip; on a machine loaded on both cores the wall-clock loop may stall past its delay margin and
-    // trip on timing (safe, and beside the point here), never on the cut (instability, saturation).
-    const std::string trip = r.run["trip"];
-    EXPECT_TRUE(trip == "none" || trip == "overruns" || trip == "sensor_stale") << trip << "\n" << logs;
-    if (trip == "none") EXPECT_EQ(r.run_exit, 0) << logs;
+    EXPECT_EQ(r.run_exit, 0) << logs;
+    expect_no_cut_trip(r.run);
     // robodamp run advised (the depth above the limit at 700 rpm) and the robot followed the first advice.
     const json& advice = r.plant["advice"];
     ASSERT_GE(advice.size(), 1U) << r.plant.dump(1);
@@ -221,24 +236,16 @@ TEST(HilCut, NoStableSpeedOrOneTheSpindleCannotReachKeepsTheSpeed) {
   std::string cell = test::read_file(none_files.config);
   test::replace_all(cell, "  job: " + kJob, "  job: " + narrow_job);
   std::ofstream(none_files.config) << cell;
-  AdviceCase none = start_advice_case(none_files, "0.85", 9.0, false);
+  AdviceCase none = start_advice_case(none_files, "0.85", false);
 
   test::HilFiles slow_files = advice_cell("advice_slow");
   std::string text = test::read_file(slow_files.config);  // the emulator's copy: the same socket and port
   test::replace_all(text, "  rpm_max: 1500\n", "  rpm_max: 430\n");
   const std::string slow_plant_config = slow_files.dir + "/hil_plant.yaml";
   std::ofstream(slow_plant_config) << text;
-  AdviceCase slow{slow_files, nullptr, nullptr};
-  slow.plant = std::make_unique<Child>(
-      std::vector<std::string>{"plant", "--config", slow_plant_config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob,
-                               "--cut-rpm", "424", "--cut-axial-mm", "0.85", "--cut-revs", "60", "--cut-at", "2", "--json",
-                               slow_files.plant_json},
-      slow_files.plant_log);
-  slow.run = std::make_unique<Child>(std::vector<std::string>{"run", "--config", slow_files.config, "--clock", "wall",
-                                                              "--duration", "9", "--json", slow_files.run_json},
-                                     slow_files.run_log);
+  AdviceCase slow = start_advice_case(slow_files, "0.85", false, slow_plant_config, "424");
   for (auto [c, action] : {std::pair{&none, "kept the speed: no stable speed"}, std::pair{&slow, "refused: "}}) {
-    const AdviceRun r = finish(*c);
+    const AdviceRun r = finish_after(*c, "robodamp plant: advice #1");
     const std::string logs = test::read_file(c->files.plant_log) + test::read_file(c->files.run_log);
     ASSERT_EQ(r.plant_exit, 0) << logs;
     const json& advice = r.plant["advice"];
