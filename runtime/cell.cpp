@@ -105,10 +105,10 @@ Status Cell::configure() {
           cfg_, set_configs_, [this] { return supervisor_->active_parameter_set(); },
           [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
             if (modbus_)
-              modbus_->client().publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
-                                               r.advice.found ? r.advice.options.front().margin : 0.0);
+              modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
+                                      r.advice.found ? r.advice.options.front().margin : 0.0);
           },
-          [this] { return modbus_ ? modbus_->client().depth_mm() : std::nan(""); });
+          [this] { return modbus_ ? modbus_->robot_depth_mm() : std::nan(""); });
     } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
       for (Component* d : components()) (void)d->cleanup();
       return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};
@@ -408,9 +408,11 @@ void Cell::finish_summary() {
 Status Cell::cleanup() {
   if (state_ != LifecycleState::kInactive)
     return {StatusKind::kWrongState, std::string("cell: cannot clean up while ") + to_string(state_)};
+  // First the machining monitor: its advisor's thread writes to the Modbus client and reads the robot's
+  // depth from it (a run that ended under load crashed there when the client went first).
+  machining_.reset();
   for (Component* c : components())
     if (c->state() == LifecycleState::kInactive) (void)c->cleanup();
-  machining_.reset();  // first: its advisor's thread writes to the Modbus client
   loop_.reset();
   arming_.reset();
   ring_.reset();

@@ -1,5 +1,7 @@
 #include "runtime/components.hpp"
 
+#include <limits>
+
 #include <unistd.h>
 
 #include <chrono>
@@ -103,8 +105,20 @@ ModbusSupervisory::ModbusSupervisory(const config::ModbusConfig& cfg, config::Mo
       connect_timeout_s_(connect_timeout_s) {}
 
 Status ModbusSupervisory::on_configure() {
-  client_ = std::make_unique<drivers::ModbusSupervisor>(cfg_, initial_, on_mounting_);
+  auto client = std::make_unique<drivers::ModbusSupervisor>(cfg_, initial_, on_mounting_);
+  std::lock_guard<std::mutex> lock(client_m_);
+  client_ = std::move(client);
   return {};
+}
+
+void ModbusSupervisory::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
+  std::lock_guard<std::mutex> lock(client_m_);
+  if (client_) client_->publish_advice(seq, found, rpm, margin);
+}
+
+double ModbusSupervisory::robot_depth_mm() const {
+  std::lock_guard<std::mutex> lock(client_m_);
+  return client_ ? client_->depth_mm() : std::numeric_limits<double>::quiet_NaN();
 }
 
 Status ModbusSupervisory::on_activate() {
@@ -124,8 +138,12 @@ Status ModbusSupervisory::on_deactivate() {
 }
 
 Status ModbusSupervisory::on_cleanup() {
-  client_.reset();
-  return {};
+  std::unique_ptr<drivers::ModbusSupervisor> client;
+  {
+    std::lock_guard<std::mutex> lock(client_m_);
+    client = std::move(client_);
+  }
+  return {};  // destroyed here, outside the lock (it joins its threads)
 }
 
 DdsEndpoint::DdsEndpoint(const config::DdsConfig& cfg, double rate_hz, std::string source, dds::BridgeSources sources)

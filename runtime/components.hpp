@@ -83,13 +83,19 @@ class ModbusSupervisory final : public Component {
  public:
   ModbusSupervisory(const config::ModbusConfig& cfg, config::Mounting initial,
                     drivers::ModbusSupervisor::MountingCallback on_mounting, double connect_timeout_s);
+  // Between on_configure and on_cleanup only (the loop's thread and the lifecycle's).
   [[nodiscard]] drivers::ModbusSupervisor& client() { return *client_; }
+  // Any thread, in any state (the machining monitor's advisor runs from the cell's configure on, before
+  // this component's on_configure and until the cell's cleanup): nothing while there is no client.
+  void publish_advice(std::uint64_t seq, bool found, double rpm, double margin);
+  [[nodiscard]] double robot_depth_mm() const;  // NaN without a client
 
  private:
   Status on_configure() override;
   Status on_activate() override;
   Status on_deactivate() override;
   Status on_cleanup() override;
+  mutable std::mutex client_m_;  // guards client_'s creation and reset against the two calls above
   config::ModbusConfig cfg_;
   config::Mounting initial_;
   drivers::ModbusSupervisor::MountingCallback on_mounting_;

@@ -10,6 +10,7 @@
 
 #include "cell_util.hpp"
 #include "runtime/arming_policy.hpp"
+#include "runtime/components.hpp"
 #include "rt/availability.hpp"
 #include "runtime/lifecycle.hpp"
 #include "runtime/parameter_requests.hpp"
@@ -249,6 +250,25 @@ TEST(CellLifecycle, HalfAHardwareConfigurationIsAConfigError) {
 }
 
 // --- parameter requests with random values ----------------------------------------------------------------
+
+// The machining monitor's advisor publishes advice and reads the robot's depth through the Modbus
+// component from the cell's configure to its cleanup, which is longer than the component's client lives
+// (a run that ended under load crashed where the client had gone first): before its configure and after
+// its cleanup the depth is unknown and an advice goes nowhere, without a crash.
+TEST(CellComponents, TheModbusClientsAdviceAndDepthAreSafeOutsideItsLife) {
+  config::ModbusConfig cfg;
+  cfg.amplifier_link.host = "127.0.0.1";
+  cfg.amplifier_link.port = 1;  // nothing listens: never started here
+  runtime::ModbusSupervisory m(cfg, config::Mounting::kHorizontal, {}, 0.1);
+  EXPECT_TRUE(std::isnan(m.robot_depth_mm()));
+  m.publish_advice(1, true, 666.7, 2.0);
+  ASSERT_TRUE(m.configure().ok());
+  EXPECT_TRUE(std::isnan(m.robot_depth_mm()));  // no poll yet
+  m.publish_advice(2, false, 0.0, 0.0);
+  ASSERT_TRUE(m.cleanup().ok());
+  EXPECT_TRUE(std::isnan(m.robot_depth_mm()));
+  m.publish_advice(3, true, 700.0, 1.5);
+}
 
 TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
   auto cfg = c2();
