@@ -33,6 +33,7 @@ struct PlantArgs {
   std::string cut_model{"regenerative"};
   std::optional<double> cut_rpm, cut_axial_mm, cut_at_s;
   double cut_until_s{0.0};
+  bool cut_until_advice{false};
   std::optional<int> cut_revolutions;
   bool drives_off{false};
   double spindle_register_period_s{0.05};
@@ -126,6 +127,7 @@ int run_plant(const PlantArgs& a) {
   eo.regenerative.revolutions = a.cut_revolutions;
   eo.regenerative.start_s = a.cut_at_s.value_or(-1.0);
   eo.regenerative.until_s = a.cut_until_s;
+  eo.regenerative.until_advice = a.cut_until_advice;
   eo.spindle_register_period_s = a.spindle_register_period_s;
   for (const auto& item : a.pose_at) {
     hil::PoseWaypoint w;
@@ -205,6 +207,9 @@ void register_plant(Registry& r) {
   r.number(sub, "--cut-until", a->cut_until_s, {"s", 0.0, 604800.0, false, false, "0 = no bound"},
            "The regenerative cut goes on at least until this plant time (the robot's path), then until its last speed and "
            "depth have had --cut-revs revolutions");
+  sub->add_flag("--cut-until-advice", a->cut_until_advice,
+                "The robot program waits for robodamp's word: the regenerative cut goes on until the robot has read a "
+                "spindle-speed advice (modbus.robot.advice_register), then --cut-revs at the speed it ends at");
   r.number(sub, "--cut-at", a->cut_at_s, {"s", 0.0, 604800.0},
            "Plant time the regenerative cut starts (default: hil.settle_s + controller.gain_ramp_s after the amplifier is ready)");
   sub->add_option("--pose-at", a->pose_at,

@@ -256,6 +256,7 @@ EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o)
     else if (!cfg.spindle.apply_advice) seen.action = "not followed (spindle.apply_advice false)";
     else if (regenerative->ended()) seen.action = "not followed: the cut has ended";
     else seen.action = "followed", regenerative->follow_advice(seen.rpm, t);
+    regenerative->advice_read(t);
     spdlog::info("robodamp plant: advice #{} at {:.3f} s: status {}, {:.1f} rpm, margin {:.2f}: {}", seen.seq, t, seen.status,
                  seen.rpm, seen.margin, seen.action);
     rep.advice.push_back(std::move(seen));

@@ -116,6 +116,7 @@ RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, c
   for (const auto& c : o.spindle) program_end_s_ = std::max(program_end_s_, c.t1_s);
   for (const auto& c : o.depth) program_end_s_ = std::max(program_end_s_, c.t1_s);
   program_end_s_ = std::max(program_end_s_, o.until_s);
+  awaiting_advice_ = o.until_advice;
   speed_ = SpindleProfile(std::move(speed)), depth_ = SpindleProfile(std::move(depth));
   program_period_s_ = std::max(o.program_period_s, plant.period_s());
   process_.emplace(cutter_, material_, settings_);
@@ -149,6 +150,12 @@ milling::CutSettings RegenerativeCut::settings_for(double rpm, double axial_mm) 
 
 void RegenerativeCut::amplifier_ready(double t_s) {
   if (rep_.start_s < 0.0) rep_.start_s = t_s + auto_delay_s_;
+}
+
+void RegenerativeCut::advice_read(double t_s) {
+  if (!awaiting_advice_) return;
+  awaiting_advice_ = false;
+  program_end_s_ = std::max(program_end_s_, t_s);
 }
 
 void RegenerativeCut::follow_advice(double rpm, double t_s) {
@@ -231,7 +238,7 @@ void RegenerativeCut::after_step() noexcept {
   Segment& seg = segments_.back();
   const std::size_t whole = process_->steps_per_revolution() * static_cast<std::size_t>(settings_.revolutions);
   // The last segment's revolutions done after the program's last change: the tool leaves the cut.
-  if (++seg.steps >= whole && t_s_ >= program_end_s_) {
+  if (++seg.steps >= whole && t_s_ >= program_end_s_ && !awaiting_advice_) {
     ended_ = true, rep_.complete = true;
     rep_.end_s = seg.head.end_s = t_s_ + plant_.period_s();
   }

@@ -50,6 +50,9 @@ struct RegenerativeCutOptions {
   double program_period_s{0.05};  // how often the program's ramps step (the robot's register period)
   // The tool stays in the cut at least until this plant time (the robot's path), s; 0: no such bound.
   double until_s{0.0};
+  // A robot program that waits for robodamp's word: the tool stays in the cut until the robot has read
+  // an advice (followed, kept or refused), then the last speed's revolutions.
+  bool until_advice{false};
 };
 
 // One span of the cut at one speed and depth.
@@ -94,6 +97,8 @@ class RegenerativeCut {
   void amplifier_ready(double t_s);
   // The robot follows an advised speed from plant time t (it overrides the program's speed from then).
   void follow_advice(double rpm, double t_s);
+  // The robot read an advice at plant time t (whatever it did with it).
+  void advice_read(double t_s);
   // Around the plant's step at plant time t.
   void before_step(double t_s);
   void after_step() noexcept;
@@ -123,6 +128,7 @@ class RegenerativeCut {
   SpindleProfile speed_, depth_;
   double program_end_s_{0.0}, program_period_s_{0.05}, next_program_s_{0.0};
   double advised_rpm_{0.0};  // > 0: the robot follows it
+  bool awaiting_advice_{false};
   double requested_rpm_{0.0};
   std::vector<Segment> segments_;
   milling::ChatterMonitor indicator_;

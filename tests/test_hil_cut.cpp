@@ -138,10 +138,10 @@ struct AdviceRun {
 
 // Lockstep with the controller on the wall clock: the plant steps with each command frame, the controller
 // ticks in real time, so the advisor's seconds of analysis pass as plant seconds do on a robot. The cut
-// starts at 2 s (the loop at full gain, the limits at the speed known) and lasts until 12 s at least (the
-// robot's path), its last speed 60 revolutions. The controller runs until the test has what it waits for
-// (then Ctrl-C: its summary, the emulator's report): an advice's analysis took 2.4 s idle and 9.5 s with
-// the suite and a CPU hog on both cores.
+// starts at 2 s (the loop at full gain, the limits at the speed known) and goes on until the robot has read
+// an advice (a program that waits for robodamp's word), its last speed 60 revolutions. The controller runs
+// until the test has what it waits for (then Ctrl-C: its summary, the emulator's report): an advice's
+// analysis took 2.4 s idle, 9.5 s and more than 10 s with the suite and a CPU hog on both cores.
 struct AdviceCase {
   test::HilFiles files;
   std::unique_ptr<Child> plant, run;
@@ -151,7 +151,7 @@ AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_m
   AdviceCase c{f, nullptr, nullptr};
   std::vector<std::string> plant_args{"plant", "--config", plant_config.empty() ? f.config : plant_config, "--pacing",
                                       "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", rpm, "--cut-axial-mm",
-                                      depth_mm, "--cut-revs", "60", "--cut-at", "2", "--cut-until", "12", "--json",
+                                      depth_mm, "--cut-revs", "60", "--cut-at", "2", "--cut-until-advice", "--json",
                                       f.plant_json};
   if (drives_off) plant_args.push_back("--drives-off");
   c.plant = std::make_unique<Child>(plant_args, f.plant_log);
@@ -160,9 +160,9 @@ AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_m
       f.run_log);
   return c;
 }
-// Waits (up to 90 s) for `line` in the emulator's log, ends the controller with Ctrl-C, and reads both reports.
+// Waits (up to 110 s) for `line` in the emulator's log, ends the controller with Ctrl-C, and reads both reports.
 AdviceRun finish_after(AdviceCase& c, const std::string& line) {
-  EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 90.0))
+  EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 110.0))
       << line << " not in\n" << test::read_file(c.files.plant_log);
   c.run->kill(SIGINT);
   AdviceRun r;
