@@ -182,10 +182,14 @@ void RegenerativeCut::change_to(double requested_rpm, double axial_mm, const cha
   requested_rpm_ = requested_rpm;
   if (!started_) return;
   segments_.back().head.end_s = t_s;
+  start_segment(cause, t_s);
+}
+
+void RegenerativeCut::start_segment(const char* cause, double t_s) {
   Segment s;
   s.head.cause = cause, s.head.start_s = t_s;
-  s.head.requested_rpm = requested_rpm, s.head.rpm = next.rpm, s.head.axial_mm = axial_mm;
-  s.head.steps_per_tooth = next.steps_per_tooth;
+  s.head.requested_rpm = requested_rpm_, s.head.rpm = settings_.rpm, s.head.axial_mm = settings_.cut.axial_mm;
+  s.head.steps_per_tooth = settings_.steps_per_tooth;
   const std::size_t steps = process_->steps_per_revolution() * static_cast<std::size_t>(settings_.revolutions);
   s.x_m.reserve(steps), s.y_m.reserve(steps);
   segments_.push_back(std::move(s));
@@ -205,14 +209,7 @@ void RegenerativeCut::before_step(double t_s) {
     if (rep_.start_s < 0.0 || t_s < rep_.start_s) return;
     started_ = true;
     previous_ = last_ = displacement();
-    Segment s;
-    s.head.cause = "start", s.head.start_s = t_s;
-    s.head.requested_rpm = requested_rpm_, s.head.rpm = settings_.rpm, s.head.axial_mm = settings_.cut.axial_mm;
-    s.head.steps_per_tooth = settings_.steps_per_tooth;
-    const std::size_t steps = process_->steps_per_revolution() * static_cast<std::size_t>(settings_.revolutions);
-    s.x_m.reserve(steps), s.y_m.reserve(steps);
-    segments_.push_back(std::move(s));
-    indicator_.reset();
+    start_segment("start", t_s);
   }
   Segment& seg = segments_.back();
   // As the in-process cut: the displacement at the step's middle from its start and a linear look-ahead.

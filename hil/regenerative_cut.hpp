@@ -118,6 +118,8 @@ class RegenerativeCut {
   [[nodiscard]] Eigen::Vector2d displacement() const;
   [[nodiscard]] milling::CutSettings settings_for(double rpm, double axial_mm) const;
   void change_to(double requested_rpm, double axial_mm, const char* cause, double t_s);
+  // A segment at the settings now, from plant time t (its record reserved for `revolutions` revolutions).
+  void start_segment(const char* cause, double t_s);
   [[nodiscard]] CutSegment judged(const Segment& s) const;
   sim::Plant& plant_;
   milling::Cutter cutter_;

@@ -255,28 +255,27 @@ TEST(HilCut, NoStableSpeedOrOneTheSpindleCannotReachKeepsTheSpeed) {
   }
 }
 
+// `robodamp plant` with these options refused with exit 2 before serving, its message holding each of `says`.
+void expect_refused(const test::HilFiles& f, const std::string& name, const std::vector<std::string>& options,
+                    const std::vector<std::string>& says) {
+  std::vector<std::string> args{"plant", "--config", f.config, "--cut", kJob};
+  args.insert(args.end(), options.begin(), options.end());
+  const std::string log = f.dir + "/" + name + ".log";
+  Child plant(args, log);
+  EXPECT_EQ(plant.wait(), 2) << name;
+  for (const auto& text : says) EXPECT_NE(test::read_file(log).find(text), std::string::npos) << text << " in\n" << test::read_file(log);
+}
+
 TEST(HilCut, BadCutOptionsAreRefusedByName) {
   const test::HilFiles f = test::hil_files("regen_bad");
-  Child depth({"plant", "--config", f.config, "--cut", kJob, "--cut-axial-mm", "-1"}, f.dir + "/depth.log");
-  EXPECT_EQ(depth.wait(), 2);
-  EXPECT_NE(test::read_file(f.dir + "/depth.log").find("--cut-axial-mm"), std::string::npos) << test::read_file(f.dir + "/depth.log");
-  Child nan({"plant", "--config", f.config, "--cut", kJob, "--cut-rpm", "nan"}, f.dir + "/nan.log");
-  EXPECT_EQ(nan.wait(), 2);
-  EXPECT_NE(test::read_file(f.dir + "/nan.log").find("--cut-rpm"), std::string::npos) << test::read_file(f.dir + "/nan.log");
+  expect_refused(f, "depth", {"--cut-axial-mm", "-1"}, {"--cut-axial-mm"});
+  expect_refused(f, "nan", {"--cut-rpm", "nan"}, {"--cut-rpm"});
   // The program: a speed beyond the spindle (hil_horizontal_c2 has the default spindle.rpm_max, 30000
   // rpm), a depth beyond the tool's cutting length (the job's default 100 mm), a ramp backwards in time.
-  Child fast({"plant", "--config", f.config, "--cut", kJob, "--spindle", "1:40000"}, f.dir + "/fast.log");
-  EXPECT_EQ(fast.wait(), 2);
-  EXPECT_NE(test::read_file(f.dir + "/fast.log").find("--spindle = 40000 rpm"), std::string::npos) << test::read_file(f.dir + "/fast.log");
-  EXPECT_NE(test::read_file(f.dir + "/fast.log").find("spindle.rpm_max"), std::string::npos);
-  Child deep({"plant", "--config", f.config, "--cut", kJob, "--depth", "3:120"}, f.dir + "/deep.log");
-  EXPECT_EQ(deep.wait(), 2);
-  EXPECT_NE(test::read_file(f.dir + "/deep.log").find("--depth"), std::string::npos) << test::read_file(f.dir + "/deep.log");
-  Child back({"plant", "--config", f.config, "--cut", kJob, "--depth-ramp", "5:3:1.0"}, f.dir + "/back.log");
-  EXPECT_EQ(back.wait(), 2);
-  EXPECT_NE(test::read_file(f.dir + "/back.log").find("T0_S <= T1_S"), std::string::npos) << test::read_file(f.dir + "/back.log");
-  Child nan_depth({"plant", "--config", f.config, "--cut", kJob, "--depth", "3:nan"}, f.dir + "/nan_depth.log");
-  EXPECT_EQ(nan_depth.wait(), 2);
+  expect_refused(f, "fast", {"--spindle", "1:40000"}, {"--spindle = 40000 rpm", "spindle.rpm_max"});
+  expect_refused(f, "deep", {"--depth", "3:120"}, {"--depth"});
+  expect_refused(f, "back", {"--depth-ramp", "5:3:1.0"}, {"T0_S <= T1_S"});
+  expect_refused(f, "nan_depth", {"--depth", "3:nan"}, {});
 }
 
 }  // namespace
