@@ -15,6 +15,7 @@ struct DdsClientOptions {
   config::DdsTransport transport{config::DdsTransport::kDefault};
   double duration_s{0.0};  // monitor: 0 = until Ctrl-C; request: how long to wait for the loop and the reply
   std::optional<config::DdsSecurityConfig> security;  // the client's own identity (the --config's dds.security)
+  std::string cell;  // --cell, else the --config's cell.name (its host's name when unset), else empty
 };
 
 struct DdsClientArgs {
@@ -22,6 +23,7 @@ struct DdsClientArgs {
   std::optional<int> domain;
   std::string transport{"default"};
   std::string config_path;
+  std::string cell;
 };
 
 void add_dds_options(Registry& r, CLI::App* sub, DdsClientArgs& a);

@@ -27,14 +27,19 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
+// The latest sample of one cell: the one named, else the first seen.
 template <typename T>
 class Latest : public DataReaderListener {
  public:
+  explicit Latest(std::shared_ptr<std::string> cell) : cell_(std::move(cell)) {}
   void on_data_available(DataReader* r) override {
     T v;
     SampleInfo info;
     while (r->take_next_sample(&v, &info) == ReturnCode_t::RETCODE_OK)
       if (info.valid_data) {
+        std::lock_guard<std::mutex> cell_lock(cell_mutex());
+        if (cell_->empty()) *cell_ = v.cell();
+        if (v.cell() != *cell_) continue;
         std::lock_guard<std::mutex> lock(m_);
         value_ = v;
         ++count_;
@@ -44,8 +49,13 @@ class Latest : public DataReaderListener {
     std::lock_guard<std::mutex> lock(m_);
     return {value_, count_};
   }
+  static std::mutex& cell_mutex() {
+    static std::mutex m;
+    return m;
+  }
 
  private:
+  std::shared_ptr<std::string> cell_;
   std::mutex m_;
   T value_{};
   std::uint64_t count_{0};
@@ -56,7 +66,7 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
   const char* state = ns ? s.state().c_str() : nt ? rt::to_string(static_cast<rt::State>(t.state())) : "-";
   const char* trip = ns ? s.trip().c_str() : nt ? rt::to_string(static_cast<rt::Trip>(t.trip())) : "-";
   std::snprintf(b, sizeof b,
-                "robodamp monitor  t = %.2f s  (%s)\n"
+                "robodamp monitor  cell %s  t = %.2f s  (%s)\n"
                 "  state      %-10s trip %s\n"
                 "  vibration  %.5f m/s^2 RMS (last %.5f m/s^2), velocity estimate %.3g m/s\n"
                 "  command    %+.4f V (peak %.4f V), K = %.0f N s/m (limit %.0f), parameter set %u\n"
@@ -65,7 +75,7 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
                 "             ticks %llu, missed %llu, overruns %llu, stale %llu, ring drops %llu\n"
                 "  damping    at full gain %.3f %% of the time asked; %u trips, %u back at full gain; last trip %s\n"
                 "  samples    %llu telemetry, %llu status; parameter writes %s\n",
-                nt ? t.time_s() : s.time_s(), ns ? s.backend().c_str() : "no status yet", state, trip,
+                ns ? s.cell().c_str() : t.cell().c_str(), nt ? t.time_s() : s.time_s(), ns ? s.backend().c_str() : "no status yet", state, trip,
                 t.accel_rms_mps2(), t.accel_mps2(), t.filtered_mps(), t.command_v(), t.command_peak_v(),
                 nt ? t.gain_ns_per_m() : s.gain_ns_per_m(), s.max_gain_ns_per_m(), s.parameter_set(),
                 100.0 * t.saturated_fraction(), static_cast<unsigned long long>(s.saturated_ticks()), s.wake_p50_us(),
@@ -137,10 +147,11 @@ std::string advice_view(const msg::Advice& m) {
 // 0 when it saw the loop (telemetry or status), 1 when nothing came.
 int run_monitor(const DdsClientOptions& o) {
   rt::install_shutdown_handlers();
-  Latest<msg::Telemetry> telemetry;  // before the participant: it outlives the readers that call it
-  Latest<msg::Status> status;
-  Latest<msg::Machining> machining;
-  Latest<msg::Advice> advice;
+  auto cell = std::make_shared<std::string>(o.cell);  // empty: the first cell heard
+  Latest<msg::Telemetry> telemetry(cell);  // before the participant: it outlives the readers that call it
+  Latest<msg::Status> status(cell);
+  Latest<msg::Machining> machining(cell);
+  Latest<msg::Advice> advice(cell);
   dds::Participant p(o.domain_id, o.transport, "robodamp monitor", o.security);
   p.reader(dds::TopicKind::kTelemetry, &telemetry);
   p.reader(dds::TopicKind::kStatus, &status);

@@ -27,6 +27,7 @@ struct RequestOptions {
   std::optional<int> parameter_set;
   std::optional<int> enable;
   std::optional<double> spindle_rpm;
+  bool reset{false};
 };
 
 namespace {
@@ -60,14 +61,17 @@ class Replies : public DataReaderListener {
 
 // 0 accepted, 3 refused (the reason is printed), 1 no loop or no reply, 2 bad options.
 int run_request(const DdsClientOptions& o, const RequestOptions& r) {
-  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0) + (r.spindle_rpm ? 1 : 0);
+  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0) + (r.spindle_rpm ? 1 : 0) +
+                    (r.reset ? 1 : 0);
   if (given != 1) {
-    std::cerr << "robodamp request: give exactly one of --gain, --select, --enable, --spindle-rpm\n";
+    std::cerr << "robodamp request: give exactly one of --gain, --select, --enable, --spindle-rpm, --reset\n";
     return 2;
   }
   msg::ParameterRequest req;
   const std::string client = "robodamp-request-" + std::to_string(getpid());
   req.client(client);
+  req.cell(o.cell.empty() ? config::cell_name({}) : o.cell);
+  if (r.reset) req.kind(msg::RESET_FAULT), req.value(0.0);
   req.request_id(1);
   if (r.gain_ns_per_m) req.kind(msg::SET_GAIN), req.value(*r.gain_ns_per_m);
   if (r.parameter_set) req.kind(msg::SELECT_PARAMETER_SET), req.value(*r.parameter_set);
@@ -101,7 +105,7 @@ int run_request(const DdsClientOptions& o, const RequestOptions& r) {
       std::cout << (reply.accepted() ? "accepted: " : "refused: ") << reply.reason() << '\n';
       rc = reply.accepted() ? 0 : 3;
     } else {
-      std::cerr << "robodamp request: no reply within " << wait_s << " s\n";
+      std::cerr << "robodamp request: no reply from cell " << req.cell() << " within " << wait_s << " s\n";
     }
   }
   return rc;
@@ -121,6 +125,7 @@ void register_request(Registry& r) {
   r.whole_number(sub, "--enable", req->enable, {"(1 = arm, 0 = disarm)", 0, 1}, "1 = arm, 0 = disarm");
   r.number(sub, "--spindle-rpm", req->spindle_rpm, {"rpm", 0.0, 200000.0},
            "The spindle speed the harmonic notches follow (0 = stopped; the loop checks spindle.rpm_max)");
+  sub->add_flag("--reset", req->reset, "Reset a latched trip (the loop is then disabled: arm it with --enable 1)");
   r.number(sub, "--timeout", o->options.duration_s, {"s", 0.1, 3600.0}, "Wait this long for the loop and the reply (default 10 s)");
 }
 

@@ -272,6 +272,7 @@ struct Config {
   std::optional<ModbusConfig> modbus;          // hardware: amplifier and robot registers
   std::vector<ParameterSetRef> parameter_sets; // other mountings' configurations, selected by the robot
   std::optional<DdsConfig> dds;                // telemetry and supervised parameters over Fast DDS
+  CellConfig cell;                             // the cell's name on the network (cell.name)
   HilConfig hil;                               // read by the plant emulator (robodamp plant)
   CommissioningConfig commissioning;           // robodamp measure and the plant side of it
   SpindleConfig spindle;                       // tooth count and speed range (the harmonic notches)

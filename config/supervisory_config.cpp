@@ -1,5 +1,8 @@
 #include "config/supervisory_config.hpp"
 
+#include <unistd.h>
+
+#include <cctype>
 #include <filesystem>
 
 #include "config/config.hpp"
@@ -204,6 +207,19 @@ std::optional<DdsConfig> read_dds(MapReader& top) {
   return c;
 }
 
+CellConfig read_cell(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("cell", false, ""), "cell", top.mark());
+  CellConfig c;
+  if (auto v = r.text("name", std::string{})) {
+    if (const std::string problem = cell_name_problem(*v); !v->empty() && !problem.empty())
+      r.diagnostics().add(r.mark(), "cell.name", "= \"" + v->substr(0, 64) + "\" " + problem);
+    else
+      c.name = *v;
+  }
+  r.finish();
+  return c;
+}
+
 HilConfig read_hil(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("hil", false, ""), "hil", top.mark());
   HilConfig c;
@@ -225,6 +241,7 @@ void read_supervisory(MapReader& top, Config& c) {
   c.modbus = read_modbus(top);
   c.parameter_sets = read_parameter_sets(top, c.source);
   c.dds = read_dds(top);
+  c.cell = read_cell(top);
   c.hil = read_hil(top);
   if (!c.parameter_sets.empty() && !(c.modbus && c.modbus->robot_link))
     top.diagnostics().add(top.mark(), "parameter_sets",
@@ -232,4 +249,23 @@ void read_supervisory(MapReader& top, Config& c) {
 }
 
 }  // namespace detail
+
+std::string cell_name_problem(const std::string& name) {
+  if (name.empty() || name.size() > 31) return "is not a cell name: allowed 1 to 31 characters";
+  for (const char ch : name)
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'))
+      return "is not a cell name: allowed letters, digits, '-', '_' and '.'";
+  return {};
+}
+
+std::string cell_name(const CellConfig& cfg) {
+  if (!cfg.name.empty()) return cfg.name;
+  char host[256] = {};
+  std::string name;
+  if (gethostname(host, sizeof host - 1) == 0)
+    for (const char* p = host; *p != '\0' && name.size() < 31; ++p)
+      if (std::isalnum(static_cast<unsigned char>(*p)) || *p == '-' || *p == '_' || *p == '.') name += *p;
+  return name.empty() ? "cell" : name;
+}
+
 }  // namespace robodamp::config

@@ -106,6 +106,17 @@ struct DdsConfig {
   std::optional<DdsSecurityConfig> security;  // absent: no authentication (a closed cell network)
 };
 
+// The cell's identity on the network (docs/dashboard.md): every DDS topic carries it, a dashboard tells
+// the cells apart by it and a parameter request names the cell it is for. 1-31 characters of letters,
+// digits, '-', '_' and '.'; empty in the configuration: the host's name.
+struct CellConfig {
+  std::string name;
+};
+// The name a cell uses: cfg's, else the host's name (cut to the allowed characters), else "cell".
+[[nodiscard]] std::string cell_name(const CellConfig& cfg);
+// Why a name is not a valid cell name (empty: it is).
+[[nodiscard]] std::string cell_name_problem(const std::string& name);
+
 enum class HilPacing { kRealtime, kLockstep };
 
 struct HilConfig {

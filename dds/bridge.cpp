@@ -12,6 +12,20 @@ namespace robodamp::dds {
 
 using namespace eprosima::fastdds::dds;
 
+namespace {
+// The 10000 one-microsecond bins summed into kHistogramEdgesUs's bins (overflow in the last).
+std::vector<std::uint64_t> coarse_histogram(const rt::TimingHistogram& h) {
+  std::vector<std::uint64_t> out(kHistogramBins, 0);
+  std::size_t bin = 0;
+  for (std::size_t us = 0; us < rt::TimingHistogram::kBins; ++us) {
+    while (bin + 1 < kHistogramBins && static_cast<double>(us) >= kHistogramEdgesUs[bin + 1]) ++bin;
+    out[bin] += h.bin(us);
+  }
+  out.back() += h.overflow();
+  return out;
+}
+}  // namespace
+
 class Bridge::RequestListener : public DataReaderListener {
  public:
   explicit RequestListener(Bridge& b) : b_(b) {}
@@ -20,12 +34,21 @@ class Bridge::RequestListener : public DataReaderListener {
     SampleInfo info;
     while (reader->take_next_sample(&req, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      const auto kind = req.kind() == msg::SET_GAIN               ? RequestKind::kSetGain
-                        : req.kind() == msg::SELECT_PARAMETER_SET ? RequestKind::kSelectParameterSet
-                        : req.kind() == msg::SET_SPINDLE_RPM      ? RequestKind::kSetSpindleRpm
-                                                                  : RequestKind::kEnable;
-      const Decision d = b_.decide(kind, req.value());
+      if (req.cell() != b_.src_.cell) {  // for another cell on the domain: that one answers
+        ++b_.n_other_cells_;
+        continue;
+      }
+      const std::optional<RequestKind> kind = req.kind() == msg::SET_GAIN               ? RequestKind::kSetGain
+                                              : req.kind() == msg::SELECT_PARAMETER_SET ? RequestKind::kSelectParameterSet
+                                              : req.kind() == msg::SET_SPINDLE_RPM      ? RequestKind::kSetSpindleRpm
+                                              : req.kind() == msg::ENABLE               ? RequestKind::kEnable
+                                              : req.kind() == msg::RESET_FAULT          ? RequestKind::kResetFault
+                                                                                        : std::optional<RequestKind>{};
+      const Decision d = kind ? b_.decide(*kind, req.value())
+                              : b_.refuse("kind = " + std::to_string(req.kind()) + " is not a request kind: allowed 0 to 4 "
+                                          "(dds/robodamp.idl)");
       msg::ParameterReply reply;
+      reply.cell(b_.src_.cell);
       reply.client(req.client());
       reply.request_id(req.request_id());
       reply.accepted(d.accepted);
@@ -47,6 +70,8 @@ Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::str
   reply_writer_ = participant_->writer(TopicKind::kReply);
   if (src_.machining) machining_writer_ = participant_->writer(TopicKind::kMachining);
   if (src_.advice) advice_writer_ = participant_->writer(TopicKind::kAdvice);
+  if (src_.spectrum) spectrum_writer_ = participant_->writer(TopicKind::kSpectrum);
+  if (src_.lobes) lobes_writer_ = participant_->writer(TopicKind::kLobes);
   listener_ = std::make_unique<RequestListener>(*this);
   participant_->reader(TopicKind::kRequest, listener_.get());
 }
@@ -54,6 +79,12 @@ Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::str
 Bridge::~Bridge() {
   stop();
   participant_.reset();  // the listener outlives the reader
+}
+
+Decision Bridge::refuse(std::string reason) {
+  ++n_requests_;
+  ++n_refused_;
+  return {false, std::move(reason)};
 }
 
 Decision Bridge::decide(RequestKind kind, double value) {
@@ -86,6 +117,7 @@ void Bridge::on_frame(const rt::TelemetryFrame& f) {
   }
   if (++in_window_ >= window_ticks_) {
     msg::Telemetry t;
+    t.cell(src_.cell);
     t.tick(f.tick);
     t.time_s(f.time_s);
     t.accel_rms_mps2(std::sqrt(sum_sq_ / static_cast<double>(in_window_)));
@@ -106,6 +138,7 @@ void Bridge::on_frame(const rt::TelemetryFrame& f) {
 
 void Bridge::publish_status() {
   msg::Status s;
+  s.cell(src_.cell);
   {
     std::lock_guard<std::mutex> lock(m_);
     const auto& f = last_;
@@ -134,6 +167,8 @@ void Bridge::publish_status() {
     for (const auto& t : a.trips) back += t.full_gain_again_s >= 0.0 ? 1U : 0U;
     s.back_at_full_gain(back);
     s.last_trip_s(a.trips.empty() ? -1.0 : a.trips.back().trip_s);
+    s.wake_histogram(coarse_histogram(wake_));
+    s.compute_histogram(coarse_histogram(compute_));
     published_state_ = f.state;
     published_trip_ = f.trip;
   }
@@ -148,6 +183,7 @@ void Bridge::publish_machining() {
   if (machining_writer_ == nullptr) return;
   const MachiningSample m = src_.machining();
   msg::Machining out;
+  out.cell(src_.cell);
   out.tick(m.tick);
   out.time_s(m.time_s);
   out.spindle_rpm(m.spindle_rpm);
@@ -173,6 +209,7 @@ void Bridge::publish_advice() {
   const std::optional<AdviceSample> a = src_.advice();
   if (!a || a->seq == published_advice_) return;
   msg::Advice out;
+  out.cell(src_.cell);
   out.seq(a->seq);
   out.time_s(a->time_s);
   out.trigger(a->trigger);
@@ -201,6 +238,43 @@ void Bridge::publish_advice() {
   }
 }
 
+void Bridge::publish_spectrum() {
+  if (spectrum_writer_ == nullptr) return;
+  const std::optional<SpectrumSample> sp = src_.spectrum();
+  if (!sp) return;
+  msg::Spectrum out;
+  out.cell(src_.cell);
+  out.tick(sp->tick);
+  out.time_s(sp->time_s);
+  out.bin_hz(sp->bin_hz);
+  out.record_s(sp->record_s);
+  out.accel_asd(std::vector<float>(sp->accel_asd.begin(), sp->accel_asd.begin() + static_cast<std::ptrdiff_t>(
+                                                                                   std::min<std::size_t>(1024, sp->accel_asd.size()))));
+  out.mode_hz(std::vector<float>(sp->mode_hz.begin(),
+                                 sp->mode_hz.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(16, sp->mode_hz.size()))));
+  out.tooth_passing_hz(sp->tooth_passing_hz);
+  if (spectrum_writer_->write(&out)) ++n_spectrum_;
+}
+
+void Bridge::publish_lobes() {
+  if (lobes_writer_ == nullptr) return;
+  const std::optional<LobesSample> l = src_.lobes();
+  if (!l) return;
+  const std::size_t n = std::min<std::size_t>({256, l->rpm.size(), l->open_limit_mm.size(), l->damped_limit_mm.size()});
+  auto first = [n](const std::vector<double>& v) { return std::vector<double>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)); };
+  msg::Lobes out;
+  out.cell(src_.cell);
+  out.time_s(l->time_s);
+  out.parameter_set(static_cast<std::uint32_t>(l->parameter_set));
+  out.gain_ns_per_m(l->gain_ns_per_m);
+  out.method(l->method.substr(0, 47));
+  out.depth_mm(l->depth_mm);
+  out.rpm(first(l->rpm));
+  out.open_limit_mm(first(l->open_limit_mm));
+  out.damped_limit_mm(first(l->damped_limit_mm));
+  if (lobes_writer_->write(&out)) ++n_lobes_;
+}
+
 void Bridge::start() {
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -216,6 +290,8 @@ void Bridge::start() {
       publish_status();
       publish_machining();
       publish_advice();
+      publish_spectrum();
+      publish_lobes();
       lock.lock();
     }
   });
@@ -231,7 +307,9 @@ void Bridge::stop() {
   status_thread_.join();
 }
 
-BridgeCounters Bridge::counters() const { return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load(), n_machining_.load(),
-                                               n_advice_.load()}; }
+BridgeCounters Bridge::counters() const {
+  return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load(), n_machining_.load(),
+          n_advice_.load(), n_spectrum_.load(), n_lobes_.load(), n_other_cells_.load()};
+}
 
 }  // namespace robodamp::dds

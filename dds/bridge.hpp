@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -29,7 +30,12 @@ namespace robodamp::dds {
 
 class Participant;
 
-enum class RequestKind : std::uint8_t { kSetGain, kSelectParameterSet, kEnable, kSetSpindleRpm };
+enum class RequestKind : std::uint8_t { kSetGain, kSelectParameterSet, kEnable, kSetSpindleRpm, kResetFault };
+
+// The bins of the status topic's timing histograms: [0, 1), [1, 2), [2, 5) ... [5000, 10000) us and the last
+// one from 10000 us up (14 bins).
+inline constexpr double kHistogramEdgesUs[] = {0, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000};
+inline constexpr std::size_t kHistogramBins = std::size(kHistogramEdgesUs);
 
 struct Decision {
   bool accepted{false};
@@ -69,18 +75,42 @@ struct AdviceSample {
   double rpm_min{0.0}, rpm_max{0.0};
 };
 
+// What the Spectrum_ topic carries (dds/robodamp.idl), from the cell's spectrum monitor.
+struct SpectrumSample {
+  std::uint64_t tick{0};
+  double time_s{0.0};
+  double bin_hz{0.0}, record_s{0.0};
+  std::vector<float> accel_asd;  // (m/s^2)/sqrt(Hz), at most 1024 go on the wire
+  std::vector<float> mode_hz;    // at most 16
+  double tooth_passing_hz{0.0};
+};
+
+// What the Lobes_ topic carries (dds/robodamp.idl): the accurate limits the cell knows at its set and gain.
+struct LobesSample {
+  double time_s{0.0};
+  std::size_t parameter_set{0};
+  double gain_ns_per_m{0.0};
+  std::string method;
+  double depth_mm{0.0};
+  std::vector<double> rpm, open_limit_mm, damped_limit_mm;  // by speed, at most 256
+};
+
 struct BridgeSources {
+  std::string cell;                                // cell.name: on every topic; requests for other cells are ignored
   std::string backend;                             // for the status
   std::function<std::size_t()> parameter_set;      // the active set (any thread)
   std::function<double()> gain_limit_ns_per_m;     // what a gain request may ask for now
   std::function<Decision(RequestKind, double)> handle;  // validate and queue (parameter writes on)
   std::function<MachiningSample()> machining;      // empty: no machining topic (no spindle.job)
   std::function<std::optional<AdviceSample>()> advice{};  // the latest speed advice; empty: no advice topic
+  std::function<std::optional<SpectrumSample>()> spectrum{};  // a new spectrum, if one is due; empty: no topic
+  std::function<std::optional<LobesSample>()> lobes{};        // the lobes, if they changed; empty: no topic
   double gain_ramp_s{0.0};                         // controller.gain_ramp_s: when the loop is at full gain
 };
 
 struct BridgeCounters {
-  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0}, machining{0}, advice{0};
+  std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0}, machining{0}, advice{0}, spectrum{0}, lobes{0};
+  std::uint64_t other_cells{0};  // requests for another cell, ignored
 };
 
 class Bridge {
@@ -102,7 +132,10 @@ class Bridge {
   void publish_status();
   void publish_machining();
   void publish_advice();  // a new advice (its seq) once
+  void publish_spectrum();
+  void publish_lobes();
   Decision decide(RequestKind kind, double value);
+  Decision refuse(std::string reason);
 
   config::DdsConfig cfg_;
   std::string source_;
@@ -113,6 +146,8 @@ class Bridge {
   eprosima::fastdds::dds::DataWriter* reply_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* machining_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* advice_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* spectrum_writer_{nullptr};
+  eprosima::fastdds::dds::DataWriter* lobes_writer_{nullptr};
   std::uint64_t published_advice_{0};  // status thread
   std::unique_ptr<RequestListener> listener_;
   rt::AvailabilityMeter availability_;  // under m_
@@ -132,7 +167,8 @@ class Bridge {
   std::uint8_t published_state_{255}, published_trip_{255};
   bool running_{false};
   std::thread status_thread_;
-  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0}, n_advice_{0};
+  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0}, n_advice_{0},
+      n_spectrum_{0}, n_lobes_{0}, n_other_cells_{0};
 };
 
 }  // namespace robodamp::dds

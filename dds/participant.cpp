@@ -18,7 +18,8 @@ namespace {
 // ROS 2's names for the topics /robodamp/telemetry ... (ROS 2 prefixes its topics with rt/ in DDS).
 constexpr const char* kTopicNames[kTopicCount] = {"rt/robodamp/telemetry", "rt/robodamp/status",
                                                   "rt/robodamp/parameter_request", "rt/robodamp/parameter_reply",
-                                                  "rt/robodamp/machining", "rt/robodamp/advice"};
+                                                  "rt/robodamp/machining", "rt/robodamp/advice",
+                                                  "rt/robodamp/spectrum", "rt/robodamp/lobes"};
 }
 
 Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name,
@@ -63,7 +64,9 @@ Participant::Participant(int domain_id, config::DdsTransport transport, const st
                                     TypeSupport(new robodamp::msg::ParameterRequestPubSubType()),
                                     TypeSupport(new robodamp::msg::ParameterReplyPubSubType()),
                                     TypeSupport(new robodamp::msg::MachiningPubSubType()),
-                                    TypeSupport(new robodamp::msg::AdvicePubSubType())};
+                                    TypeSupport(new robodamp::msg::AdvicePubSubType()),
+                                    TypeSupport(new robodamp::msg::SpectrumPubSubType()),
+                                    TypeSupport(new robodamp::msg::LobesPubSubType())};
   for (int i = 0; i < kTopicCount; ++i) {
     types[i].register_type(participant_);
     topics_[i] = participant_->create_topic(kTopicNames[i], types[i].get_type_name(), TOPIC_QOS_DEFAULT);
@@ -84,19 +87,22 @@ Participant::~Participant() {
 Topic* Participant::topic(TopicKind t) { return topics_[static_cast<int>(t)]; }
 
 namespace {
+// A reader keeps more than a writer: the types have no key, so the samples of every cell on the domain
+// share one instance, and a reader's keep-last-1 would let one cell's sample replace another's.
 template <typename Qos>
-void apply(Qos& q, TopicKind t, config::DdsTransport transport) {
+void apply(Qos& q, TopicKind t, config::DdsTransport transport, bool reader) {
   if (t == TopicKind::kTelemetry) {
     q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;
     q.durability().kind = VOLATILE_DURABILITY_QOS;
     q.history().kind = KEEP_LAST_HISTORY_QOS;
-    q.history().depth = 64;
+    q.history().depth = reader ? 1024 : 64;
   } else {
     q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-    const bool latest = t == TopicKind::kStatus || t == TopicKind::kMachining || t == TopicKind::kAdvice;  // a late joiner gets the last
+    const bool latest = t == TopicKind::kStatus || t == TopicKind::kMachining || t == TopicKind::kAdvice ||
+                        t == TopicKind::kSpectrum || t == TopicKind::kLobes;  // a late joiner gets the last
     q.durability().kind = latest ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
     q.history().kind = KEEP_LAST_HISTORY_QOS;
-    q.history().depth = latest ? 1 : 32;
+    q.history().depth = reader ? 256 : latest ? 1 : 32;
   }
   if (transport == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
 }
@@ -104,7 +110,7 @@ void apply(Qos& q, TopicKind t, config::DdsTransport transport) {
 
 DataWriter* Participant::writer(TopicKind t, DataWriterListener* listener) {
   DataWriterQos q = DATAWRITER_QOS_DEFAULT;
-  apply(q, t, transport_);
+  apply(q, t, transport_, false);
   DataWriter* w = publisher_->create_datawriter(topic(t), q, listener);
   if (w == nullptr) throw std::runtime_error(std::string("DDS: cannot create a writer on ") + kTopicNames[static_cast<int>(t)]);
   return w;
@@ -112,7 +118,7 @@ DataWriter* Participant::writer(TopicKind t, DataWriterListener* listener) {
 
 DataReader* Participant::reader(TopicKind t, DataReaderListener* listener) {
   DataReaderQos q = DATAREADER_QOS_DEFAULT;
-  apply(q, t, transport_);
+  apply(q, t, transport_, true);
   DataReader* r = subscriber_->create_datareader(topic(t), q, listener);
   if (r == nullptr) throw std::runtime_error(std::string("DDS: cannot create a reader on ") + kTopicNames[static_cast<int>(t)]);
   return r;

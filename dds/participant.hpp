@@ -1,4 +1,4 @@
-// A Fast DDS participant with robodamp's six topics and their QoS (docs/dds.md), shared by the loop's
+// A Fast DDS participant with robodamp's eight topics and their QoS (docs/dds.md), shared by the loop's
 // bridge, `robodamp monitor` and the tests. Off the real-time path.
 //
 //   DDS topic (ROS 2 topic)              type (ROS 2 form)                     reliability  durability       history
@@ -8,6 +8,9 @@
 //   rt/robodamp/parameter_reply          robodamp::msg::dds_::ParameterReply_   reliable     volatile         keep last 32
 //   rt/robodamp/machining                robodamp::msg::dds_::Machining_        reliable     transient local  keep last 1
 //   rt/robodamp/advice                   robodamp::msg::dds_::Advice_           reliable     transient local  keep last 1
+//   rt/robodamp/spectrum                 robodamp::msg::dds_::Spectrum_         reliable     transient local  keep last 1
+//   rt/robodamp/lobes                    robodamp::msg::dds_::Lobes_            reliable     transient local  keep last 1
+// (a reader keeps the last 256, 1024 of telemetry: every cell on the domain writes the same unkeyed topic)
 // (ROS 2: /robodamp/telemetry with robodamp/msg/Telemetry, and so on; ros2/robodamp holds the .msg files.)
 //
 // Transports: default (Fast DDS built-ins: UDPv4 and shared memory), udp_loopback (UDPv4 on 127.0.0.1
@@ -33,8 +36,8 @@
 
 namespace robodamp::dds {
 
-enum class TopicKind { kTelemetry, kStatus, kRequest, kReply, kMachining, kAdvice };
-inline constexpr int kTopicCount = 6;
+enum class TopicKind { kTelemetry, kStatus, kRequest, kReply, kMachining, kAdvice, kSpectrum, kLobes };
+inline constexpr int kTopicCount = 8;
 
 class Participant {
  public:

@@ -73,6 +73,23 @@ LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_pe
   return l;
 }
 
+void LiveStability::sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm) {
+  std::lock_guard<std::mutex> lock(m_);
+  sweep_.clear();
+  for (const double r : rpm)
+    if (r > 0.0) sweep_.push_back(key(r, set, gain_ns_per_m));
+  cv_.notify_all();
+}
+
+std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per_m) const {
+  const Key k = key(0.0, set, gain_ns_per_m);
+  std::vector<LiveLimits> out;
+  std::lock_guard<std::mutex> lock(m_);
+  for (const auto& [key, l] : cache_)  // the key orders by speed first
+    if (std::get<1>(key) == std::get<1>(k) && std::get<2>(key) == std::get<2>(k) && std::get<0>(key) > 0) out.push_back(l);
+  return out;
+}
+
 std::uint64_t LiveStability::computations() const {
   std::lock_guard<std::mutex> lock(m_);
   return computations_;
@@ -81,10 +98,16 @@ std::uint64_t LiveStability::computations() const {
 void LiveStability::worker() {
   std::unique_lock<std::mutex> lock(m_);
   for (;;) {
-    cv_.wait(lock, [this] { return stop_ || wanted_.has_value(); });
+    cv_.wait(lock, [this] { return stop_ || wanted_.has_value() || !sweep_.empty(); });
     if (stop_) return;
-    const Key k = *wanted_;
-    wanted_.reset();
+    Key k;
+    if (wanted_) {
+      k = *wanted_;
+      wanted_.reset();
+    } else {
+      k = sweep_.front();
+      sweep_.pop_front();
+    }
     if (cache_.count(k) != 0) continue;
     lock.unlock();
     LiveLimits l;

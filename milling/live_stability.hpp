@@ -9,6 +9,7 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -59,6 +60,12 @@ class LiveStability {
   // Blocking, for tests and the command line: computes (or finds) the limits.
   [[nodiscard]] LiveLimits compute(double rpm, std::size_t set, double gain_ns_per_m);
 
+  // Low priority (the live lobes): the worker computes these speeds for (set, gain) whenever nothing is
+  // wanted; a new sweep replaces the one before. Any thread.
+  void sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm);
+  // Any thread: every limit computed so far for (set, gain), by speed.
+  [[nodiscard]] std::vector<LiveLimits> known(std::size_t set, double gain_ns_per_m) const;
+
   [[nodiscard]] double depth_mm() const { return job_.cut.axial_mm; }
   [[nodiscard]] const config::MillingConfig& job() const { return job_; }
   [[nodiscard]] const config::StructureConfig& structure() const { return structure_; }
@@ -80,6 +87,7 @@ class LiveStability {
   std::condition_variable cv_;
   std::map<Key, LiveLimits> cache_;
   std::optional<Key> wanted_;
+  std::deque<Key> sweep_;
   bool stop_{false};
   std::uint64_t computations_{0};
   std::thread thread_;

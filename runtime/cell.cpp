@@ -151,7 +151,7 @@ Status Cell::configure_devices() {
   if (cfg_.dds) {
     dds_ = std::make_unique<DdsEndpoint>(
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
-        dds::BridgeSources{backend_name_, [this] { return supervisor_->active_parameter_set(); },
+        dds::BridgeSources{config::cell_name(cfg_.cell), backend_name_, [this] { return supervisor_->active_parameter_set(); },
                            [this] { return std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM); },
                            [this](dds::RequestKind k, double v) { return handle_request(k, v); },
                            cfg_.spindle.job.empty() ? std::function<dds::MachiningSample()>{}
@@ -162,7 +162,11 @@ Status Cell::configure_devices() {
                                    const auto a = machining_->advice();
                                    return a ? std::optional(to_sample(*a)) : std::nullopt;
                                  },
+                           [this] { return spectrum_->next(); },
+                           cfg_.spindle.job.empty() ? std::function<std::optional<dds::LobesSample>()>{}
+                                                    : [this] { return machining_->lobes(); },
                            cfg_.controller.gain_ramp_s});
+    spectrum_ = std::make_unique<SpectrumMonitor>(cfg_);
   }
   for (Component* c : components()) {
     if (Status s = c->configure(); !s.ok()) {
@@ -329,6 +333,7 @@ Status Cell::activate(double duration_s) {
   consumers.emplace_back([this](const rt::TelemetryFrame& f) { on_frame(f); });
   if (dds_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { dds_->bridge().on_frame(f); });
   if (machining_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { machining_->on_frame(f); });
+  if (spectrum_) consumers.emplace_back([this](const rt::TelemetryFrame& f) { spectrum_->on_frame(f); });
   drain_ = std::make_unique<rt::TelemetryDrain>(*ring_, std::move(consumers));
   drain_->start();
   state_ = LifecycleState::kActive;  // from here on deactivate() undoes whatever was started
@@ -421,6 +426,7 @@ Status Cell::cleanup() {
   can_.reset();
   modbus_.reset();
   dds_.reset();
+  spectrum_.reset();
   model_.reset();
   mounting_sets_.clear();
   pose_schedule_ = {};

@@ -39,6 +39,7 @@
 #include "runtime/components.hpp"
 #include "runtime/lifecycle.hpp"
 #include "runtime/machining_monitor.hpp"
+#include "runtime/spectrum_monitor.hpp"
 #include "runtime/run_summary.hpp"
 
 namespace robodamp::runtime {
@@ -143,6 +144,7 @@ class Cell {
   std::unique_ptr<rt::Loop> loop_;
   std::unique_ptr<ArmingPolicy> arming_;
   std::vector<config::Config> set_configs_;       // every parameter set's configuration, index = set
+  std::unique_ptr<SpectrumMonitor> spectrum_;     // dds: the accelerometer's spectrum for the operator's screen
   std::unique_ptr<MachiningMonitor> machining_;   // spindle.job: live stability and the chatter indicator
   analysis::PoseScheduleAnalysis pose_schedule_;  // region i's set is supervisor set i
   static constexpr double kMachiningSummaryWaitS = 30.0;  // for the limits at the last state (worker thread)

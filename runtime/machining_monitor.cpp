@@ -13,6 +13,7 @@ namespace robodamp::runtime {
 
 namespace {
 
+constexpr int kLobeSpeeds = 80;  // the live lobes' sweep: 81 speeds over the job's range
 constexpr std::uint64_t kMaxHeldTicks = 100000;  // longer than the indicator's buffer (8 s at 5 kHz)
 
 // The job's spindle: without runout (time_domain.runout_um all zero) only the tooth harmonics are forced.
@@ -40,6 +41,7 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
                                                    cfg.spindle.job + " cuts with tool.teeth = " +
                                                    std::to_string(job.tool.teeth)}});
   const double rpm_min = job.lobes.rpm_min, rpm_max = std::min(job.lobes.rpm_max, cfg.spindle.rpm_max);
+  for (int i = 0; i <= kLobeSpeeds; ++i) lobe_rpm_.push_back(rpm_min + (rpm_max - rpm_min) * i / kLobeSpeeds);
   stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets));
   advisor_ = std::make_unique<SpeedAdvisor>(*stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(on_advice));
 }
@@ -95,6 +97,32 @@ AdviceView MachiningMonitor::view() {
   v.parameter_set = set;
   v.gain_ns_per_m = gain;
   return v;
+}
+
+std::optional<dds::LobesSample> MachiningMonitor::lobes() {
+  const AdviceView v = view();
+  if (v.parameter_set != lobes_set_ || v.gain_ns_per_m != lobes_gain_) {  // a new state, or a ramp: wait for it to hold
+    lobes_set_ = v.parameter_set, lobes_gain_ = v.gain_ns_per_m;
+    lobes_swept_ = false, lobes_published_ = 0;
+    return std::nullopt;
+  }
+  if (!lobes_swept_) stability_->sweep(v.parameter_set, v.gain_ns_per_m, lobe_rpm_), lobes_swept_ = true;
+  const std::vector<milling::LiveLimits> known = stability_->known(v.parameter_set, v.gain_ns_per_m);
+  if (known.size() == lobes_published_) return std::nullopt;
+  lobes_published_ = known.size();
+  dds::LobesSample out;
+  out.time_s = v.sample.time_s;
+  out.parameter_set = v.parameter_set;
+  out.gain_ns_per_m = v.gain_ns_per_m;
+  out.depth_mm = stability_->depth_mm();
+  for (const auto& l : known) {
+    out.rpm.push_back(l.rpm);
+    out.open_limit_mm.push_back(l.open_mm);
+    out.damped_limit_mm.push_back(l.damped_mm);
+    if (!l.method.empty() && out.method.find(l.method) == std::string::npos)
+      out.method += (out.method.empty() ? "" : " + ") + l.method;  // e.g. "sampled-loop SDM + zero-order preview"
+  }
+  return out;
 }
 
 dds::MachiningSample MachiningMonitor::settled_sample(double timeout_s) {

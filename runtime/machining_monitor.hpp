@@ -38,6 +38,10 @@ class MachiningMonitor {
   // Blocking: waits (up to timeout_s) for the limits at the current state, then samples (tests, summary).
   [[nodiscard]] dds::MachiningSample settled_sample(double timeout_s);
   [[nodiscard]] milling::LiveStability& stability() { return *stability_; }
+  // The status thread: the live lobes at the active set and the gain the loop has held since the last call
+  // (a sweep over the job's speed range is asked for on the first call with a settled gain), when more
+  // speeds are known than were last returned.
+  [[nodiscard]] std::optional<dds::LobesSample> lobes();
   // Any thread: the latest spindle-speed advice (runtime/speed_advisor.hpp), if any was asked for.
   [[nodiscard]] std::optional<AdviceRecord> advice() const { return advisor_->latest(); }
 
@@ -52,6 +56,11 @@ class MachiningMonitor {
   milling::ChatterMonitor chatter_;
   rt::TelemetryFrame last_{};
   double rpm_{0.0};
+  std::vector<double> lobe_rpm_;  // the sweep's speeds
+  std::size_t lobes_set_{0};       // the status thread's
+  double lobes_gain_{-1.0};
+  bool lobes_swept_{false};
+  std::size_t lobes_published_{0};
   std::unique_ptr<SpeedAdvisor> advisor_;  // last: its thread reads the members above
 };
 

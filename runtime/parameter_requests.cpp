@@ -50,6 +50,16 @@ CheckedRequest check_enable(double value) {
   return {{true, "disarming: the command fades out over controller.gain_ramp_s"}, {rt::CommandKind::kDisarm, 0.0}};
 }
 
+CheckedRequest check_reset(const rt::Supervisor& sup) {
+  if (sup.observed_state() != rt::State::kFault)
+    return {{false, std::string("reset: nothing to reset, the loop is ") + rt::to_string(sup.observed_state()) +
+                        " (a reset clears a latched trip)"},
+            {}};
+  return {{true, std::string("reset: the trip (") + rt::to_string(sup.observed_trip()) +
+                     ") clears once the safe-state ramp is over; the loop is then disabled: arm it to damp again"},
+          {rt::CommandKind::kResetFault, 0.0}};
+}
+
 CheckedRequest check_spindle(const config::Config& cfg, double rpm) {
   char b[256];
   if (!(std::isfinite(rpm) && rpm >= 0.0 && rpm <= cfg.spindle.rpm_max)) {
@@ -72,6 +82,7 @@ CheckedRequest check_request(const rt::Supervisor& sup, const config::Config& cf
     case dds::RequestKind::kSetGain: return check_gain(sup, cfg, value);
     case dds::RequestKind::kSelectParameterSet: return check_select(sup, cfg, value);
     case dds::RequestKind::kEnable: return check_enable(value);
+    case dds::RequestKind::kResetFault: return check_reset(sup);
     case dds::RequestKind::kSetSpindleRpm: return check_spindle(cfg, value);
   }
   return {{false, "unknown request kind"}, {}};

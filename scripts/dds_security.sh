@@ -95,9 +95,9 @@ permissions() {  # name, publish topics, subscribe topics
     echo '</dds>'
   } > "$1_permissions.xml"
 }
-permissions loop "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/machining rt/robodamp/advice rt/robodamp/parameter_reply" "rt/robodamp/parameter_request"
-permissions operator "rt/robodamp/parameter_request" "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/machining rt/robodamp/advice rt/robodamp/parameter_reply"
-permissions observer "" "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/machining rt/robodamp/advice"
+permissions loop "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/machining rt/robodamp/advice rt/robodamp/spectrum rt/robodamp/lobes rt/robodamp/parameter_reply" "rt/robodamp/parameter_request"
+permissions operator "rt/robodamp/parameter_request" "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/machining rt/robodamp/advice rt/robodamp/spectrum rt/robodamp/lobes rt/robodamp/parameter_reply"
+permissions observer "" "rt/robodamp/telemetry rt/robodamp/status rt/robodamp/machining rt/robodamp/advice rt/robodamp/spectrum rt/robodamp/lobes"
 
 for doc in governance loop_permissions operator_permissions observer_permissions; do
   ossl smime -sign -in "$doc.xml" -text -out "$doc.smime" -signer ca.pem -inkey ca.key

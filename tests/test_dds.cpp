@@ -85,6 +85,7 @@ struct Client {
   msg::ParameterReply ask(std::uint32_t id, msg::RequestKind kind, double value) {
     msg::ParameterRequest r;
     r.client("test");
+    r.cell("cell-a");
     r.request_id(id);
     r.kind(kind);
     r.value(value);
@@ -108,7 +109,7 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   cfg.status_rate_hz = 20.0;
   int handled = 0;
   dds::Bridge bridge(cfg, 5000.0, "test.yaml",
-                     {"simulated plant", [] { return std::size_t{0}; }, [] { return 4324.0; },
+                     {"cell-a", "simulated plant", [] { return std::size_t{0}; }, [] { return 4324.0; },
                       [&](dds::RequestKind, double) {
                         ++handled;
                         return dds::Decision{true, ""};
@@ -374,7 +375,7 @@ std::vector<std::pair<std::string, std::string>> msg_fields(const std::string& p
 
 TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
-  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining", "Advice"}) {
+  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining", "Advice", "Spectrum", "Lobes"}) {
     const auto from_idl = idl_fields(idl, name);
     const auto from_msg = msg_fields(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/" + name + ".msg");
     EXPECT_GT(from_idl.size(), 3U) << name;
@@ -386,6 +387,7 @@ TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   EXPECT_NE(request.find("uint8 SELECT_PARAMETER_SET=" + std::to_string(msg::SELECT_PARAMETER_SET)), std::string::npos);
   EXPECT_NE(request.find("uint8 ENABLE=" + std::to_string(msg::ENABLE)), std::string::npos);
   EXPECT_NE(request.find("uint8 SET_SPINDLE_RPM=" + std::to_string(msg::SET_SPINDLE_RPM)), std::string::npos);
+  EXPECT_NE(request.find("uint8 RESET_FAULT=" + std::to_string(msg::RESET_FAULT)), std::string::npos);
 }
 
 // --- DDS Security ------------------------------------------------------------------------------------------
@@ -418,7 +420,7 @@ struct SecureLoop {
     cfg.parameter_writes = true;
     cfg.security = identity("loop");
     bridge = std::make_unique<dds::Bridge>(cfg, 5000.0, "secure.yaml",
-                                           dds::BridgeSources{"simulated plant", [] { return std::size_t{0}; },
+                                           dds::BridgeSources{"cell-a", "simulated plant", [] { return std::size_t{0}; },
                                                               [] { return 4324.0; },
                                                               [this](dds::RequestKind, double v) {
                                                                 ++handled;
@@ -475,6 +477,7 @@ TEST(DdsSecurity, AnUnauthenticatedParticipantsRequestsNeverReachTheLoop) {
   Client intruder(loop.cfg.domain_id);  // no security at all
   msg::ParameterRequest req;
   req.client("intruder");
+  req.cell("cell-a");
   req.kind(msg::SET_GAIN);
   req.value(4000.0);
   for (std::uint32_t id = 1; id <= 30; ++id) {
