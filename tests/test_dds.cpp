@@ -85,7 +85,7 @@ struct Client {
   msg::ParameterReply ask(std::uint32_t id, msg::RequestKind kind, double value) {
     msg::ParameterRequest r;
     r.client("test");
-    r.cell("cell-a");
+    r.cell(config::cell_name({}));
     r.request_id(id);
     r.kind(kind);
     r.value(value);
@@ -109,7 +109,7 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   cfg.status_rate_hz = 20.0;
   int handled = 0;
   dds::Bridge bridge(cfg, 5000.0, "test.yaml",
-                     {"cell-a", "simulated plant", [] { return std::size_t{0}; }, [] { return 4324.0; },
+                     {config::cell_name({}), "simulated plant", [] { return std::size_t{0}; }, [] { return 4324.0; },
                       [&](dds::RequestKind, double) {
                         ++handled;
                         return dds::Decision{true, ""};
@@ -420,7 +420,7 @@ struct SecureLoop {
     cfg.parameter_writes = true;
     cfg.security = identity("loop");
     bridge = std::make_unique<dds::Bridge>(cfg, 5000.0, "secure.yaml",
-                                           dds::BridgeSources{"cell-a", "simulated plant", [] { return std::size_t{0}; },
+                                           dds::BridgeSources{config::cell_name({}), "simulated plant", [] { return std::size_t{0}; },
                                                               [] { return 4324.0; },
                                                               [this](dds::RequestKind, double v) {
                                                                 ++handled;
@@ -477,7 +477,7 @@ TEST(DdsSecurity, AnUnauthenticatedParticipantsRequestsNeverReachTheLoop) {
   Client intruder(loop.cfg.domain_id);  // no security at all
   msg::ParameterRequest req;
   req.client("intruder");
-  req.cell("cell-a");
+  req.cell(config::cell_name({}));
   req.kind(msg::SET_GAIN);
   req.value(4000.0);
   for (std::uint32_t id = 1; id <= 30; ++id) {
