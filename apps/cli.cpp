@@ -128,7 +128,7 @@ int dispatch(int argc, const char* const* argv) {
   Registry r(app);
   for (auto reg : {register_bench, register_analyze, register_filters, register_check_config, register_run,
                    register_replay, register_csv, register_lobes, register_sle, register_cut, register_identify, register_measure, register_commission, register_pose, register_tune, register_plant, register_monitor,
-                   register_request})
+                   register_request, register_dashboard})
     reg(r);
   try {
     app.parse(argc, argv);

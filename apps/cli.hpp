@@ -72,6 +72,7 @@ void register_run(Registry& r);
 void register_plant(Registry& r);
 void register_monitor(Registry& r);
 void register_request(Registry& r);
+void register_dashboard(Registry& r);
 void register_replay(Registry& r);
 void register_csv(Registry& r);
 void register_lobes(Registry& r);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <limits>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 #include "apps/cli.hpp"
 #include "rt/signals.hpp"
 #include "runtime/cell.hpp"
+#include "sim_plant/faults.hpp"
 
 namespace robodamp::apps {
 
@@ -34,7 +36,38 @@ struct RunArgs {
   bool no_harmonic_notch{false};
   std::vector<double> pose_deg;  // pose_schedule, simulated plant: the robot stands here
   bool no_pose_schedule{false};
+  std::vector<std::string> faults;  // simulated plant: KIND:START_S[:DURATION_S]
 };
+
+// "--fault amplifier_fault:8" or "sensor_nan:5:0.2": the plant's fault injector from loop time START_S for
+// DURATION_S (default: to the end). Nothing, after saying why, when the text is not one.
+std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
+  const auto fail = [&](const std::string& why) -> std::optional<sim::Fault> {
+    std::cerr << "robodamp run: --fault = '" << text << "' " << why << '\n';
+    return std::nullopt;
+  };
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  for (std::string p; std::getline(ss, p, ':');) parts.push_back(p);
+  if (parts.size() < 2 || parts.size() > 3) return fail("is not KIND:START_S[:DURATION_S]");
+  sim::Fault f;
+  bool known = false;
+  std::string kinds;
+  for (int k = 0; k <= static_cast<int>(sim::FaultKind::kDriverStall); ++k) {
+    const auto kind = static_cast<sim::FaultKind>(k);
+    kinds += std::string(kinds.empty() ? "" : ", ") + sim::to_string(kind);
+    if (parts[0] == sim::to_string(kind)) f.kind = kind, known = true;
+  }
+  if (!known) return fail("names no fault: allowed " + kinds);
+  double start = 0.0, duration = std::numeric_limits<double>::infinity();
+  if (auto p = parse_number("--fault start", parts[1], {"s", 0.0, run_s, false, false, "within --duration"}, false, start)) return fail(*p);
+  if (parts.size() == 3)
+    if (auto p = parse_number("--fault duration", parts[2], {"s", 0.0, 604800.0, true}, false, duration)) return fail(*p);
+  f.start_s = start;
+  f.duration_s = duration;
+  if (f.kind == sim::FaultKind::kActuatorSaturated) f.magnitude = 0.0;
+  return f;
+}
 
 [[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s) {
   using nlohmann::json;
@@ -372,11 +405,22 @@ int run_loop(const RunArgs& a) {
     std::cerr << "robodamp run: --pose and --no-pose-schedule need a configuration with pose_schedule\n";
     return 2;
   }
+  std::vector<sim::Fault> faults;
+  for (const auto& text : a.faults) {
+    const auto f = parse_fault(text, a.duration_s);
+    if (!f) return 2;
+    faults.push_back(*f);
+  }
   runtime::Cell cell(cfg, o);
   if (runtime::Status s = cell.configure(); !s.ok()) {
     std::cerr << s.message << '\n';
     return exit_status(s);
   }
+  if (!faults.empty() && cell.hardware()) {
+    std::cerr << "robodamp run: --fault needs the simulated plant (this configuration runs the hardware)\n";
+    return 2;
+  }
+  for (const auto& f : faults) cell.plant().faults().add(f);
   if (a.spindle_rpm > 0.0) cell.schedule(1, {rt::CommandKind::kSetSpindle, a.spindle_rpm});
   rt::install_shutdown_handlers();
   spdlog::info("robodamp run: {} at {} Hz on the {} clock for {} s against {} (Ctrl-C ends it through the safe state)",
@@ -439,6 +483,9 @@ void register_run(Registry& r) {
            "The spindle speed from the start (as the robot's register or a DDS request would set it)");
   r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0},
             "pose_schedule, simulated plant: the robot stands at these joint angles (one per joint)");
+  sub->add_option("--fault", a->faults,
+                  "Simulated plant, a fault drill: KIND:START_S[:DURATION_S] (sensor_nan, amplifier_fault, ... from loop "
+                  "time START_S; repeatable)");
   sub->add_flag("--no-pose-schedule", a->no_pose_schedule,
                 "pose_schedule: run the first region's set at every pose and ignore the joint angles (scheduling off)");
 }

@@ -237,6 +237,8 @@ HilConfig read_hil(MapReader& top) {
 
 }  // namespace
 
+std::optional<DdsConfig> read_dds_section(MapReader& top) { return read_dds(top); }
+
 void read_supervisory(MapReader& top, Config& c) {
   c.modbus = read_modbus(top);
   c.parameter_sets = read_parameter_sets(top, c.source);

@@ -81,6 +81,8 @@ class MapReader {
 [[nodiscard]] std::optional<bool> read_bool(MapReader& r, const std::string& key, bool def);
 // The optional modbus, parameter_sets, dds and hil sections (config/supervisory_config.hpp).
 void read_supervisory(MapReader& top, Config& c);
+// The dds section alone (the dashboard's file has one too).
+[[nodiscard]] std::optional<DdsConfig> read_dds_section(MapReader& top);
 // The controller's optional harmonic_notch map and the optional spindle section (config/spindle_config.hpp).
 [[nodiscard]] std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller, std::optional<double> rate_hz);
 [[nodiscard]] SpindleConfig read_spindle(MapReader& top, const std::string& source);

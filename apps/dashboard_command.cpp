@@ -1,0 +1,127 @@
+// `robodamp dashboard`: the operator's web page for every cell on the DDS domain (docs/dashboard.md), and
+// `robodamp dashboard-user`: adds a user to the credentials file it names.
+#include <iostream>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "apps/cli.hpp"
+#include "config/dashboard_config.hpp"
+#include "dashboard/auth.hpp"
+#include "dashboard/fleet.hpp"
+#include "dashboard/server.hpp"
+#include "rt/signals.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+struct DashboardArgs {
+  std::string config_path;
+  std::string listen;
+  std::optional<int> port, domain;
+  std::string transport;
+  double duration_s{0.0};
+};
+
+int run_dashboard(const DashboardArgs& a) {
+  config::DashboardConfig cfg;
+  try {
+    if (!a.config_path.empty()) cfg = config::load_dashboard_config(a.config_path);
+  } catch (const config::ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
+  if (!a.listen.empty()) cfg.listen_address = a.listen;
+  if (a.port) cfg.port = *a.port;
+  if (a.domain) cfg.dds.domain_id = *a.domain;
+  if (a.transport == "udp_loopback") cfg.dds.transport = config::DdsTransport::kUdpLoopback;
+  if (a.transport == "shared_memory") cfg.dds.transport = config::DdsTransport::kSharedMemory;
+  if (a.transport == "default") cfg.dds.transport = config::DdsTransport::kDefault;
+  std::vector<dashboard::User> users;
+  try {
+    if (!cfg.credentials.empty()) users = dashboard::load_users(cfg.credentials);
+  } catch (const config::ConfigError& e) {
+    std::cerr << e.what() << '\n';
+    return 2;
+  }
+  rt::install_shutdown_handlers();
+  try {
+    dashboard::Authenticator auth(users, cfg.session_idle_s);
+    dashboard::ActionLog log(cfg.action_log);
+    dashboard::Fleet fleet(cfg.dds, cfg.stale_after_s);
+    dashboard::WebServer server(cfg, fleet, auth, log);
+    const int port = server.bind();
+    std::thread serving([&] { server.serve(); });
+    std::cout << "robodamp dashboard: http://" << cfg.listen_address << ":" << port << "/  (DDS domain " << cfg.dds.domain_id
+              << ", " << config::to_string(cfg.dds.transport) << (cfg.dds.security ? ", secured" : "") << "; "
+              << (auth.anyone_may_act() ? std::to_string(users.size()) + " users from " + cfg.credentials
+                                        : std::string("no operator configured: view only")) << "; Ctrl-C ends)" << std::endl;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.duration_s);
+    while (rt::shutdown_signal().load() == 0 && (a.duration_s <= 0.0 || std::chrono::steady_clock::now() < end))
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    server.stop();
+    serving.join();
+    std::cout << "robodamp dashboard: " << server.health().dump() << std::endl;
+  } catch (const std::exception& e) {
+    std::cerr << "robodamp dashboard: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
+
+int run_dashboard_user(const std::string& file, const std::string& user, const std::string& role) {
+  if (const std::string p = dashboard::user_name_problem(user); !p.empty()) {
+    std::cerr << "robodamp dashboard-user: --user = '" << user << "' " << p << '\n';
+    return 2;
+  }
+  std::string password;
+  if (!std::getline(std::cin, password) || password.size() < 8) {
+    std::cerr << "robodamp dashboard-user: give the password on the first line of standard input (at least 8 characters)\n";
+    return 2;
+  }
+  try {
+    dashboard::save_user(file, {user, role == "operator" ? dashboard::Role::kOperator : dashboard::Role::kObserver,
+                                dashboard::hash_password(password)});
+  } catch (const std::exception& e) {
+    std::cerr << "robodamp dashboard-user: " << e.what() << '\n';
+    return 1;
+  }
+  std::cout << "robodamp dashboard-user: " << user << " (" << role << ") written to " << file << '\n';
+  return 0;
+}
+
+}  // namespace
+
+void register_dashboard(Registry& r) {
+  auto a = std::make_shared<DashboardArgs>();
+  CLI::App* sub = r.add("dashboard",
+                        "Web page for every robodamp cell on the DDS domain: fleet tiles, a cell's live plots and counters, "
+                        "operator actions after a login (docs/dashboard.md)",
+                        [a] { return run_dashboard(*a); });
+  sub->add_option("--config", a->config_path, "Dashboard configuration (dashboard and dds sections; docs/dashboard.md)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--listen", a->listen, "Address to serve on (default dashboard.listen_address, else 127.0.0.1)");
+  r.whole_number(sub, "--port", a->port, {"(TCP port)", 0, 65535, false, false, "0 = any free port"},
+                 "TCP port (default dashboard.port, else 8080; 0 = any free one, printed)");
+  r.whole_number(sub, "--domain", a->domain, {"(DDS domain id)", 0, 232}, "DDS domain (default dds.domain_id, else 0)");
+  sub->add_option("--transport", a->transport, "default, udp_loopback or shared_memory")
+      ->check(CLI::IsMember({"default", "udp_loopback", "shared_memory"}));
+  r.number(sub, "--duration", a->duration_s, {"s", 0.0, 1e7, false, false, "0 = until Ctrl-C"}, "Stop after S seconds");
+
+  auto file = std::make_shared<std::string>();
+  auto user = std::make_shared<std::string>();
+  auto role = std::make_shared<std::string>("observer");
+  CLI::App* u = r.add("dashboard-user",
+                      "Add or replace a dashboard user in a credentials file (password on the first line of stdin; "
+                      "PBKDF2-HMAC-SHA256, file mode 0600)",
+                      [file, user, role] { return run_dashboard_user(*file, *user, *role); });
+  u->add_option("--file", *file, "The credentials file (created when missing)")->required();
+  u->add_option("--user", *user, "User name (letters, digits, '-', '_', '.')")->required();
+  u->add_option("--role", *role, "operator (may act) or observer (sees only); default observer")
+      ->check(CLI::IsMember({"operator", "observer"}));
+}
+
+}  // namespace robodamp::apps

@@ -1,0 +1,265 @@
+// robodamp dashboard page: the fleet's tiles and one cell's live view from the server's event stream
+// (docs/dashboard.md). Plots are Debian's dygraphs; nothing here draws a chart by hand.
+'use strict';
+
+const $ = (id) => document.getElementById(id);
+const fmt = (v, digits) => (v === null || v === undefined || Number.isNaN(v)) ? '–' : Number(v).toFixed(digits);
+const esc = (s) => String(s === undefined || s === null ? '' : s).replace(/[&<>"']/g,
+  (c) => ({'&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;'}[c]));
+
+// What the browser tests read: state changes seen (with their delay from the cell), and what each plot holds.
+window.robodamp = { latencies: [], plotted: {}, updates: { time: 0, spectrum: 0, lobes: 0, timing: 0 }, events: 0 };
+
+let token = sessionStorage.getItem('robodamp-token') || '';
+let role = 'observer';
+let source = null;
+let currentCell = null;
+const shown = {};  // cell -> "state/trip" last rendered
+const plots = {};
+let timeRows = [];
+
+function message(text, ok) {
+  const m = $('message');
+  m.textContent = text;
+  m.className = ok === undefined ? '' : (ok ? 'ok' : 'bad');
+}
+
+async function api(path, body) {
+  const headers = { 'Content-Type': 'application/json' };
+  if (token) headers.Authorization = 'Bearer ' + token;
+  const res = await fetch(path, body === undefined ? { headers } : { method: 'POST', headers, body: JSON.stringify(body) });
+  let data = {};
+  try { data = await res.json(); } catch (e) { data = { error: res.statusText }; }
+  return { status: res.status, data };
+}
+
+function showWho(user) {
+  $('login').hidden = !!user;
+  $('who').hidden = !user;
+  $('who-name').textContent = user ? user + ' (' + role + ')' : '';
+  document.body.dataset.role = role;
+  $('actions-note').textContent = role === 'operator' ? '' : 'log in as an operator to act';
+}
+
+async function whoami() {
+  const r = await api('/api/whoami');
+  role = r.data.role || 'observer';
+  if (!r.data.user) { token = ''; sessionStorage.removeItem('robodamp-token'); }
+  showWho(r.data.user);
+}
+
+$('login').addEventListener('submit', async (ev) => {
+  ev.preventDefault();
+  const r = await api('/api/login', { user: $('user').value, password: $('password').value });
+  $('password').value = '';
+  if (r.status === 200) {
+    token = r.data.token; role = r.data.role;
+    sessionStorage.setItem('robodamp-token', token);
+    showWho(r.data.user);
+    message('logged in as ' + r.data.user + ' (' + r.data.role + ')', true);
+  } else {
+    message('login refused: ' + (r.data.error || r.status), false);
+  }
+});
+
+$('logout').addEventListener('click', async () => {
+  await api('/api/logout', {});
+  token = ''; role = 'observer'; sessionStorage.removeItem('robodamp-token');
+  showWho(null);
+  message('logged out', true);
+});
+
+document.querySelectorAll('#actions button[data-action]').forEach((b) => b.addEventListener('click', async () => {
+  const action = b.dataset.action;
+  const input = { gain: 'gain-value', set: 'set-value', spindle: 'spindle-value' }[action];
+  const body = { action };
+  if (input) body.value = Number($(input).value);
+  message(action + ' sent to ' + currentCell + '…');
+  const r = await api('/api/cells/' + encodeURIComponent(currentCell) + '/action', body);
+  const d = r.data;
+  if (r.status === 200) message((d.accepted ? 'accepted: ' : 'refused by the cell: ') + d.reason, d.accepted);
+  else message(action + ' refused (' + r.status + '): ' + (d.error || d.reason), false);
+  loadActions();
+}));
+
+function tile(c) {
+  const m = c.machining || {};
+  const state = c.state || 'unknown';
+  const fault = state === 'fault';
+  const limit = m.limit_mm;
+  const pct = (limit && m.depth_mm !== undefined) ? Math.min(100, 100 * m.depth_mm / limit) : 0;
+  const chatter = m.indicator_valid ? (m.chatter ? '<span class="chatter">CHATTER ' + fmt(m.chatter_hz, 1) + ' Hz</span>' : 'quiet')
+                                     : (m.spindle_rpm > 0 ? 'listening…' : '–');
+  return '<div class="tile ' + esc(state) + (c.live ? '' : ' quiet') + '" data-cell="' + esc(c.cell) + '" data-state="' + esc(state) +
+    '" data-trip="' + esc(c.trip) + '" data-live="' + c.live + '">' +
+    '<h2><span>' + esc(c.cell) + '</span><span class="badge ' + esc(state) + '">' + esc(state) + '</span></h2>' +
+    (c.live ? '' : '<p class="trip">no contact for ' + fmt(c.quiet_s, 0) + ' s</p>') +
+    (c.publishers > 1 ? '<p class="trip">' + c.publishers + ' publishers call themselves ' + esc(c.cell) + '</p>' : '') +
+    (fault || (c.trip && c.trip !== 'none') ? '<p class="trip" data-field="trip">trip: ' + esc(c.trip) + ' – ' + esc(c.trip_description) + '</p>' : '') +
+    '<dl>' +
+    '<dt>damping</dt><dd>' + fmt(c.active_s, 1) + ' s active, ' + fmt(c.availability_pct, 1) + ' % of the time asked; ' + (c.trips || 0) + ' trips</dd>' +
+    '<dt>vibration</dt><dd>' + fmt(c.accel_rms_mps2, 4) + ' m/s² RMS</dd>' +
+    '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
+    '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' + (m.limits_ready ? fmt(limit, 2) + ' mm' : '…') +
+      '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
+    '<dt>chatter</dt><dd>' + chatter + '</dd>' +
+    '</dl></div>';
+}
+
+function renderFleet(cells) {
+  const changed = [];
+  for (const c of cells) {
+    const key = c.state + '/' + c.trip;
+    if (shown[c.cell] !== undefined && shown[c.cell] !== key && c.state_source_ms > 0) changed.push(c);
+    shown[c.cell] = key;
+  }
+  // The delay from the cell's sample to the screen: measured at the next frame, after the tiles are painted.
+  if (changed.length > 0) requestAnimationFrame(() => setTimeout(() => {
+    const now = Date.now();
+    changed.forEach((c) => window.robodamp.latencies.push({ cell: c.cell, state: c.state, trip: c.trip, ms: now - c.state_source_ms }));
+  }, 0));
+  $('fleet').innerHTML = cells.map(tile).join('');
+  $('empty').hidden = cells.length > 0;
+  document.querySelectorAll('.tile').forEach((t) => t.addEventListener('click', () => { location.hash = '#/cell/' + encodeURIComponent(t.dataset.cell); }));
+  if (currentCell) {
+    const c = cells.find((x) => x.cell === currentCell);
+    if (c) {
+      $('cell-state').textContent = c.state + (c.live ? '' : ' (no contact)');
+      $('cell-state').className = 'badge ' + c.state;
+      $('cell-state').dataset.state = c.state;
+      $('cell-trip').innerHTML = c.trip && c.trip !== 'none' ? '<span class="trip">' + esc(c.trip) + ': ' + esc(c.trip_description) + '</span>' : '';
+    }
+  }
+}
+
+// A dygraphs chart made with its first data (an empty placeholder upsets a log scale), then updated.
+function draw(id, labels, rows, options) {
+  if (!plots[id]) plots[id] = new Dygraph($(id), rows, Object.assign({ labels, legend: 'always', labelsSeparateLines: false }, options));
+  else plots[id].updateOptions(Object.assign({ file: rows }, options.underlayCallback ? { underlayCallback: options.underlayCallback } : {}));
+}
+
+function plotTime(t) {
+  for (let i = 0; i < t.time_s.length; i++) timeRows.push([t.time_s[i], t.accel_mps2[i], t.accel_rms_mps2[i], t.command_v[i]]);
+  if (timeRows.length === 0) return;
+  const last = timeRows[timeRows.length - 1][0];
+  timeRows = timeRows.filter((r) => r[0] >= last - 20 && r[0] <= last);
+  draw('plot-time', ['t', 'acceleration', 'acceleration RMS', 'command'], timeRows, {
+    xlabel: 'loop time (s)', ylabel: 'm/s²', y2label: 'V', series: { command: { axis: 'y2' } },
+    axes: { y2: { independentTicks: true } }, colors: ['#3367d6', '#9bb5ec', '#d0342c'],
+  });
+  window.robodamp.plotted.time = { points: timeRows.length, last_s: last };
+  window.robodamp.updates.time++;
+}
+
+function plotSpectrum(s) {
+  if (!s || !s.accel_asd) return;
+  const rows = [];
+  const fmax = Math.min(s.bin_hz * (s.accel_asd.length - 1), 250);
+  for (let k = 1; k < s.accel_asd.length && k * s.bin_hz <= fmax; k++) rows.push([k * s.bin_hz, s.accel_asd[k] > 0 ? s.accel_asd[k] : null]);
+  const harmonics = [];
+  for (let k = 1; s.tooth_passing_hz > 0 && k * s.tooth_passing_hz <= fmax; k++) harmonics.push(k * s.tooth_passing_hz);
+  const marks = (ctx, area, g) => {  // dygraphs' underlay hook: vertical markers at known frequencies
+    const line = (hz, color) => { const x = g.toDomXCoord(hz); ctx.fillStyle = color; ctx.fillRect(x - 1, area.y, 2, area.h); };
+    (s.mode_hz || []).forEach((hz) => line(hz, 'rgba(51,103,214,0.55)'));
+    harmonics.forEach((hz) => line(hz, 'rgba(230,124,0,0.55)'));
+  };
+  if (rows.length === 0) return;
+  draw('plot-spectrum', ['Hz', 'ASD'], rows, { logscale: true, xlabel: 'frequency (Hz)', ylabel: '(m/s²)/√Hz', colors: ['#1d2430'],
+    axes: { y: { axisLabelWidth: 70 } }, underlayCallback: marks });
+  $('spectrum-note').textContent = 'Welch, ' + fmt(s.record_s, 1) + ' s, ' + fmt(s.bin_hz, 2) + ' Hz bins; modes ' +
+    (s.mode_hz || []).map((h) => fmt(h, 1)).join(', ') + ' Hz' + (s.tooth_passing_hz > 0 ? '; tooth passing ' + fmt(s.tooth_passing_hz, 1) + ' Hz' : '');
+  window.robodamp.plotted.spectrum = { bins: rows.length, modes: (s.mode_hz || []).length, harmonics: harmonics.length, peak_hz: rows.reduce((a, r) => (r[1] > a[1] ? r : a), [0, 0])[0] };
+  window.robodamp.updates.spectrum++;
+}
+
+function plotLobes(l, m, a) {
+  if (!l || !l.rpm || l.rpm.length === 0) return;
+  const rows = l.rpm.map((r, i) => [r, l.open_limit_mm[i], l.damped_limit_mm[i], l.depth_mm, null, null]);
+  if (m && m.spindle_rpm > 0) rows.push([m.spindle_rpm, null, null, null, m.depth_mm, null]);
+  const options = a && a.found ? a.options : [];
+  options.forEach((o) => rows.push([o.rpm, null, null, null, null, a.depth_mm]));
+  rows.sort((x, y) => x[0] - y[0]);
+  draw('plot-lobes', ['rpm', 'open loop', 'damped', 'job depth', 'cutting now', 'advised'], rows, {
+    xlabel: 'spindle speed (rpm)', ylabel: 'limiting depth (mm)', connectSeparatedPoints: true, colors: ['#7a8494', '#2e9e4f', '#1d2430', '#d0342c', '#e67c00'],
+    series: { 'job depth': { strokePattern: [6, 4] }, 'cutting now': { strokeWidth: 0, drawPoints: true, pointSize: 6 },
+              advised: { strokeWidth: 0, drawPoints: true, pointSize: 5 } },
+  });
+  $('lobes-note').textContent = l.method + ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m, ' + l.rpm.length + ' speeds';
+  $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
+    (a.found ? 'go to ' + fmt(a.advised_rpm, 1) + ' rpm, limit ' + fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')' : esc(a.reason)) +
+    ' – ' + esc(a.method)) : 'no advice asked for';
+  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, advised: options.length };
+  window.robodamp.updates.lobes++;
+}
+
+function plotTiming(s) {
+  if (!s || !s.wake_histogram || s.wake_histogram.length === 0) return;
+  const edges = s.histogram_edges_us;
+  const rows = s.wake_histogram.map((n, i) => [i, n > 0 ? n : null, s.compute_histogram[i] > 0 ? s.compute_histogram[i] : null]);
+  const label = (i) => (i >= edges.length ? '' : (i === edges.length - 1 ? '≥' : '') + edges[i] + ' µs');
+  if (!rows.some((r) => r[1] !== null || r[2] !== null)) return;  // nothing timed yet (a virtual clock times nothing)
+  draw('plot-timing', ['bin', 'wake-up latency', 'compute'], rows, {
+    stepPlot: true, fillGraph: true, logscale: true, xlabel: 'microseconds (bin from)', ylabel: 'ticks', colors: ['#3367d6', '#e67c00'],
+    axes: { x: { axisLabelFormatter: (i) => label(Math.round(i)), valueFormatter: (i) => label(Math.round(i)) } },
+  });
+  window.robodamp.plotted.timing = { ticks: s.wake_histogram.reduce((a, b) => a + b, 0) };
+  window.robodamp.updates.timing++;
+}
+
+function renderCounters(d) {
+  const s = d.status || {};
+  const rows = [['backend', s.backend], ['ticks', s.ticks], ['missed ticks', s.missed_ticks], ['overruns', s.overruns],
+    ['stale sensor ticks', s.stale_ticks], ['invalid samples', s.invalid_samples], ['saturated ticks', s.saturated_ticks],
+    ['telemetry ring drops', s.ring_drops], ['trips', s.trips], ['back at full gain', s.back_at_full_gain],
+    ['wake-up p50 / p99 / max', fmt(s.wake_p50_us, 0) + ' / ' + fmt(s.wake_p99_us, 0) + ' / ' + fmt(s.wake_max_us, 1) + ' µs'],
+    ['compute mean / max', fmt(s.compute_mean_us, 2) + ' / ' + fmt(s.compute_max_us, 1) + ' µs'],
+    ['availability', fmt(s.availability_pct, 2) + ' %'], ['parameter set', s.parameter_set],
+    ['gain K / limit', fmt(s.gain_ns_per_m, 0) + ' / ' + fmt(s.max_gain_ns_per_m, 0) + ' N s/m'],
+    ['parameter writes', s.parameter_writes ? 'on' : 'off (the cell refuses actions)']];
+  $('counters').innerHTML = rows.map((r) => '<tr><td>' + esc(r[0]) + '</td><td data-counter="' + esc(r[0]) + '">' + esc(r[1] === undefined ? '–' : r[1]) + '</td></tr>').join('');
+}
+
+async function loadActions() {
+  const r = await api('/api/actions');
+  if (r.status !== 200) return;
+  $('action-log').innerHTML = r.data.filter((a) => !currentCell || a.cell === currentCell).reverse().map((a) =>
+    '<li class="' + (a.accepted ? '' : 'refused') + '">' + esc(a.time) + ' ' + esc(a.user) + ': ' + esc(a.action) +
+    (['gain', 'set', 'spindle'].includes(a.action) ? ' ' + a.value : '') + ' – ' + (a.accepted ? 'accepted' : 'refused') + ': ' + esc(a.reason) + '</li>').join('');
+}
+
+function connect() {
+  if (source) source.close();
+  source = new EventSource('/api/events' + (currentCell ? '?cell=' + encodeURIComponent(currentCell) : ''));
+  source.onopen = () => { $('link').textContent = 'live'; };
+  source.onerror = () => { $('link').textContent = 'reconnecting…'; };
+  source.addEventListener('fleet', (ev) => { window.robodamp.events++; renderFleet(JSON.parse(ev.data).cells); });
+  source.addEventListener('cell', (ev) => {
+    window.robodamp.events++;
+    const d = JSON.parse(ev.data);
+    if (d.cell !== currentCell) return;
+    plotTime(d.telemetry);
+    if (d.spectrum !== undefined) { plotSpectrum(d.spectrum); plotLobes(d.lobes, d.machining, d.advice); }
+    plotTiming(d.status);
+    renderCounters(d);
+  });
+}
+
+function route() {
+  const m = location.hash.match(/^#\/cell\/(.+)$/);
+  currentCell = m ? decodeURIComponent(m[1]) : null;
+  $('fleet-view').hidden = !!currentCell;
+  $('cell-view').hidden = !currentCell;
+  $('where').textContent = currentCell ? 'cell ' + currentCell : 'fleet';
+  if (currentCell) {
+    $('cell-name').textContent = currentCell;
+    timeRows = [];
+    for (const id of Object.keys(plots)) { plots[id].destroy(); delete plots[id]; }
+    window.robodamp.plotted = {};
+    loadActions();
+  }
+  connect();
+}
+
+window.addEventListener('hashchange', route);
+whoami();
+route();

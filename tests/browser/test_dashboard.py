@@ -1,0 +1,288 @@
+#!/usr/bin/python3
+"""robodamp dashboard in a real browser (docs/dashboard.md): headless Chromium driven through Selenium's
+WebDriver against `robodamp dashboard` and two `robodamp run` cells on a DDS domain of their own, all started
+here and stopped on every path. Waits are for conditions with deadlines (the suite runs on a loaded 2-core
+machine). Usage: test_dashboard.py ROBODAMP_BINARY SOURCE_DIR OUTPUT_DIR"""
+
+import json
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+import urllib.error
+import urllib.request
+
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+
+BINARY, SOURCE, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
+DOMAIN = 220 + os.getpid() % 12  # the C++ tests use 20..219
+TRIP_AT_S = 25.0                 # cell B's amplifier fault, loop time (the page has loaded by then)
+
+
+def until(fn, timeout_s, what, period_s=0.1):
+    end = time.monotonic() + timeout_s
+    last = None
+    while time.monotonic() < end:
+        try:
+            last = fn()
+            if last:
+                return last
+        except Exception as e:  # a page between renders: try again
+            last = e
+        time.sleep(period_s)
+    raise AssertionError(f"{what}: not within {timeout_s} s (last: {last!r})")
+
+
+def http(port, path, body=None, token=None, raw=None):
+    """(status, JSON or text) of one request to the dashboard."""
+    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", data=raw if raw is not None else
+                                 (json.dumps(body).encode() if body is not None else None))
+    if token:
+        req.add_header("Authorization", "Bearer " + token)
+    try:
+        with urllib.request.urlopen(req, timeout=30) as r:
+            text = r.read().decode()
+            return r.status, json.loads(text) if text.startswith(("{", "[")) else text
+    except urllib.error.HTTPError as e:
+        text = e.read().decode()
+        return e.code, json.loads(text) if text.startswith(("{", "[")) else text
+
+
+def raw_request(port, data):
+    """Sends bytes as they are and returns the first line of the answer (a malformed request's status)."""
+    with socket.create_connection(("127.0.0.1", port), timeout=30) as s:
+        s.sendall(data)
+        answer = b""
+        while not answer.endswith(b"\n") and len(answer) < 4096:
+            chunk = s.recv(4096)
+            if not chunk:
+                break
+            answer += chunk
+    return answer.split(b"\r\n", 1)[0].decode(errors="replace")
+
+
+class Fleet:
+    """Two simulated cells, the users and one dashboard (a second one on demand)."""
+
+    def __init__(self):
+        self.dir = tempfile.mkdtemp(prefix="robodamp_dashboard_")
+        self.procs = []
+        suffix = str(os.getpid())
+        self.cells = {"a": "brw-a-" + suffix, "b": "brw-b-" + suffix}
+        preset = open(os.path.join(SOURCE, "config/presets/horizontal_c2.yaml")).read()
+        job = os.path.join(SOURCE, "config/milling/active_damping_c2.yaml")
+        for key, name in self.cells.items():
+            # A cell of this test's own: a preset with a name, a job and DDS on a domain nobody else uses.
+            with open(os.path.join(self.dir, f"cell_{key}.yaml"), "w") as f:
+                f.write(preset + f"\ndds:\n  domain_id: {DOMAIN}\n  transport: udp_loopback\n  parameter_writes: true\n"
+                                 f"cell:\n  name: {name}\nspindle:\n  teeth: 3\n  job: {job}\n"
+                                 "supervision:\n  overrun_cycles: 5000\n")
+        for user, role, password in (("alice", "operator", "alice-operator-1"), ("bob", "observer", "bob-observer-1")):
+            subprocess.run([BINARY, "dashboard-user", "--file", os.path.join(self.dir, "users.yaml"), "--user", user,
+                            "--role", role], input=password + "\n", text=True, check=True, capture_output=True)
+        with open(os.path.join(self.dir, "dashboard.yaml"), "w") as f:
+            f.write(f"dashboard:\n  port: 0\n  credentials: users.yaml\n  stale_after_s: 2\n"
+                    f"dds:\n  domain_id: {DOMAIN}\n  transport: udp_loopback\n")
+        self.cell_a = self.start([BINARY, "run", "--config", os.path.join(self.dir, "cell_a.yaml"), "--duration", "900",
+                                  "--spindle-rpm", "700"], "cell_a.log")
+        self.start([BINARY, "run", "--config", os.path.join(self.dir, "cell_b.yaml"), "--duration", "900",
+                    "--spindle-rpm", "600", "--fault", f"amplifier_fault:{TRIP_AT_S}:1"], "cell_b.log")
+        self.port = self.dashboard("dashboard.log")
+
+    def start(self, argv, log):
+        with open(os.path.join(self.dir, log), "w") as out:
+            p = subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, cwd=self.dir)
+        self.procs.append(p)
+        return p
+
+    def dashboard(self, log):
+        self.start([BINARY, "dashboard", "--config", os.path.join(self.dir, "dashboard.yaml")], log)
+        path = os.path.join(self.dir, log)
+        def address():
+            with open(path) as f:
+                return re.search(r"http://127\.0\.0\.1:(\d+)/", f.read())
+        line = until(address, 60, "the dashboard's address")
+        return int(line.group(1))
+
+    def stop(self):
+        for p in self.procs:
+            if p.poll() is None:
+                p.send_signal(signal.SIGINT)
+        for p in self.procs:
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+
+
+class DashboardInABrowser(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        os.makedirs(OUT, exist_ok=True)
+        cls.fleet = Fleet()
+        options = webdriver.ChromeOptions()
+        for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1000",
+                  f"--user-data-dir={cls.fleet.dir}/chromium"):
+            options.add_argument(a)
+        try:
+            cls.browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+        except Exception:
+            cls.fleet.stop()
+            raise
+        cls.browser.set_page_load_timeout(60)
+        cls.url = f"http://127.0.0.1:{cls.fleet.port}/"
+
+    @classmethod
+    def tearDownClass(cls):
+        try:
+            cls.browser.quit()
+        finally:
+            cls.fleet.stop()
+
+    def js(self, script):
+        return self.browser.execute_script(script)
+
+    def tile(self, key):
+        return self.browser.find_element(By.CSS_SELECTOR, f'.tile[data-cell="{self.fleet.cells[key]}"]')
+
+    def open_cell(self, key):
+        self.browser.get(self.url + "#/cell/" + self.fleet.cells[key])
+        until(lambda: self.js("return window.robodamp && window.robodamp.events > 0"), 60, "the cell page's first event")
+
+    def act(self, action):
+        self.browser.find_element(By.CSS_SELECTOR, f'#actions button[data-action="{action}"]').click()
+        return until(lambda: (lambda t: t if t and not t.endswith("…") else None)(self.browser.find_element(By.ID, "message").text),
+                     30, f"the answer to {action}")
+
+    def login(self, user, password):
+        self.browser.find_element(By.ID, "user").clear()
+        self.browser.find_element(By.ID, "user").send_keys(user)
+        self.browser.find_element(By.ID, "password").send_keys(password)
+        self.browser.find_element(By.ID, "login-button").click()
+        until(lambda: not self.browser.find_element(By.ID, "who").get_attribute("hidden"), 30, f"{user} logged in")
+
+    def logout(self):
+        self.browser.find_element(By.ID, "logout").click()
+        until(lambda: not self.browser.find_element(By.ID, "login").get_attribute("hidden"), 30, "logged out")
+
+    def test_1_tiles_appear_for_two_running_cells_and_the_plots_update(self):
+        self.browser.get(self.url)
+        until(lambda: len(self.browser.find_elements(By.CSS_SELECTOR, ".tile")) >= 2, 90, "two tiles")
+        for key in ("a", "b"):
+            until(lambda: self.tile(key).get_attribute("data-state") == "active", 90, f"cell {key} active")
+        self.assertIn("700 rpm", self.tile("a").text)
+        self.assertIn("600 rpm", self.tile("b").text)
+        self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
+
+        self.open_cell("a")
+        # The time plot follows the telemetry: more points, a later time, across two seconds.
+        first = until(lambda: self.js("return window.robodamp.plotted.time"), 30, "the time plot")
+        until(lambda: self.js("return window.robodamp.plotted.time.last_s") > first["last_s"] + 1.0, 30, "the time plot moving")
+        self.assertGreater(self.js("return window.robodamp.plotted.time.points"), 40)
+        # The spectrum: the preset's three modes and the tooth harmonics of 700 rpm x 3 teeth = 35 Hz.
+        spectrum = until(lambda: self.js("return window.robodamp.plotted.spectrum"), 60, "the spectrum")
+        self.assertGreater(spectrum["bins"], 100)
+        self.assertEqual(spectrum["modes"], 3)
+        self.assertEqual(spectrum["harmonics"], 7)  # 35, 70, ... 245 Hz up to the plot's 250 Hz
+        # The live lobes fill in as the cell's accurate method sweeps the job's speeds; the operating point on it.
+        lobes = until(lambda: (lambda l: l if l and l["speeds"] >= 20 else None)(self.js("return window.robodamp.plotted.lobes")),
+                      120, "20 speeds of live lobes")
+        self.assertEqual(lobes["operating_rpm"], 700)
+        timing = until(lambda: self.js("return window.robodamp.plotted.timing"), 30, "the timing histogram")
+        self.assertGreater(timing["ticks"], 1000)
+        counters = self.browser.find_element(By.ID, "counters").text
+        self.assertIn("simulated plant", counters)
+        self.browser.save_screenshot(os.path.join(OUT, "dashboard_cell.png"))
+
+    def test_2_a_trip_shows_within_a_second(self):
+        self.browser.get(self.url)
+        until(lambda: self.tile("b").get_attribute("data-state") == "active", 60, "cell b active before its trip")
+        until(lambda: self.tile("b").get_attribute("data-state") == "fault", TRIP_AT_S + 90, "cell b's trip on its tile")
+        self.assertIn("amplifier_fault", self.tile("b").text)
+        latencies = self.js("return window.robodamp.latencies")
+        seen = [l for l in latencies if l["cell"] == self.fleet.cells["b"] and l["state"] == "fault"]
+        self.assertTrue(seen, f"no state change recorded: {latencies}")
+        print(f"trip to screen: {seen[0]['ms']} ms", file=sys.stderr)
+        self.assertLess(seen[0]["ms"], 1000, "from the cell's status change to the screen")
+        self.browser.save_screenshot(os.path.join(OUT, "dashboard_trip.png"))
+
+    def test_3_a_reset_needs_an_operators_login_and_an_observers_is_refused(self):
+        until(lambda: http(self.fleet.port, "/api/fleet")[1]["cells"] and
+              any(c["cell"] == self.fleet.cells["b"] and c["state"] == "fault" for c in http(self.fleet.port, "/api/fleet")[1]["cells"]),
+              TRIP_AT_S + 90, "cell b tripped")
+        self.open_cell("b")
+        self.assertIn("refused (401)", self.act("reset"))
+        self.login("bob", "bob-observer-1")
+        answer = self.act("reset")
+        self.assertIn("refused (403)", answer)
+        self.assertIn("observer", answer)
+        self.logout()
+        self.login("alice", "alice-operator-1")
+        answer = self.act("reset")
+        self.assertIn("accepted", answer)
+        until(lambda: http(self.fleet.port, f"/api/cells/{self.fleet.cells['b']}")[1]["status"]["state"] == "disabled", 30,
+              "cell b reset to disabled")
+        self.assertIn("accepted", self.act("arm"))
+        until(lambda: http(self.fleet.port, f"/api/cells/{self.fleet.cells['b']}")[1]["status"]["state"] == "active", 60,
+              "cell b armed again")
+        with open(os.path.join(self.fleet.dir, "users.yaml.actions.log")) as f:
+            log = [json.loads(l) for l in f]
+        self.assertEqual([(l["user"], l["action"], l["accepted"]) for l in log if l["cell"] == self.fleet.cells["b"]],
+                         [("bob", "reset", False), ("alice", "reset", True), ("alice", "arm", True)])
+        self.logout()
+
+    def test_4_hostile_input_is_answered_counted_and_survived(self):
+        port = self.fleet.port
+        self.assertIn(" 400 ", raw_request(port, b"GARBAGE\r\n\r\n") + " ")
+        self.assertIn(" 400 ", raw_request(port, b"\x00\xff\x10junk" * 200 + b"\r\n\r\n") + " ")
+        self.assertIn(" 400 ", raw_request(port, b"GET /api/fleet HTTP/1.1\r\nHost: x\r\nX: " + b"a" * 20000 + b"\r\n\r\n") + " ")
+        status, _ = http(port, "/api/login", raw=b"x" * 100000)
+        self.assertEqual(status, 413)
+        status, body = http(port, "/api/login", raw=b"{not json")
+        self.assertEqual(status, 400)
+        for _ in range(3):
+            self.assertEqual(http(port, "/api/login", {"user": "alice", "password": "wrong"})[0], 401)
+        status, body = http(port, "/api/login", {"user": "alice", "password": "wrong"})
+        self.assertEqual(status, 401)
+        status, body = http(port, "/api/login", {"user": "alice", "password": "alice-operator-1"})
+        self.assertEqual(status, 429, "locked out after four wrong passwords, even with the right one")
+        status, _ = http(port, "/api/cells/" + "%ff%fe" + "/action", {"action": "arm"}, token="not-a-token")
+        self.assertEqual(status, 401)
+        status, _ = http(port, "/api/cells/no-such-cell")
+        self.assertEqual(status, 404)
+        health = http(port, "/api/health")[1]
+        self.assertGreaterEqual(health["http"]["client_errors"], 9)
+        self.assertGreaterEqual(health["http"]["too_large"], 1)
+        self.assertGreaterEqual(health["auth"]["throttled"], 1)
+        self.assertGreaterEqual(health["auth"]["wrong_passwords"], 4)
+        self.assertEqual(http(port, "/api/fleet")[0], 200, "still serving")
+
+    def test_5_a_second_dashboard_and_a_vanishing_cell(self):
+        port2 = self.fleet.dashboard("dashboard2.log")
+        until(lambda: len(http(port2, "/api/fleet")[1]["cells"]) >= 2, 60, "the second dashboard sees both cells")
+        status, login = http(port2, "/api/login", {"user": "alice", "password": "alice-operator-1"})
+        self.assertEqual(status, 200)
+        status, answer = http(port2, f"/api/cells/{self.fleet.cells['a']}/action", {"action": "spindle", "value": 650},
+                              token=login["token"])
+        self.assertEqual((status, answer["accepted"]), (200, True), answer)
+        until(lambda: http(self.fleet.port, "/api/health")[1]["dds"]["foreign_replies"] >= 1, 30,
+              "the first dashboard ignores the reply to the second")
+        # Cell A stops: its tile says so after dashboard.stale_after_s.
+        self.fleet.cell_a.send_signal(signal.SIGKILL)
+        self.fleet.cell_a.wait()
+        self.browser.get(self.url)
+        until(lambda: self.tile("a").get_attribute("data-live") == "false", 30, "cell a shown without contact")
+        self.assertIn("no contact", self.tile("a").text)
+        self.assertGreaterEqual(http(self.fleet.port, "/api/health")[1]["dds"]["cells_lost"], 1)
+
+
+if __name__ == "__main__":
+    unittest.main(argv=[sys.argv[0], "-v"])
