@@ -21,6 +21,8 @@ using json = nlohmann::json;
 
 namespace {
 
+constexpr std::size_t kMaxCells = 256;
+
 std::int64_t wall_ms() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -169,6 +171,10 @@ Fleet::Cell* Fleet::cell_for(const std::string& name, bool& bad) {
   bad = !config::cell_name_problem(name).empty();
   if (bad) {
     ++n_.bad_cell_names;
+    return nullptr;
+  }
+  if (cells_.size() >= kMaxCells && cells_.count(name) == 0) {  // bounded: a flood of names cannot grow memory
+    ++n_.cells_refused;
     return nullptr;
   }
   auto& c = cells_[name];

@@ -1,0 +1,240 @@
+// The dashboard's parts without a browser (docs/dashboard.md): passwords, sessions and throttling, the
+// credentials file, its configuration's refusals, the fleet seen from two named cells on one DDS domain
+// (requests reach only the cell they name), and the spectrum a cell publishes. The page itself is tested in
+// headless Chromium by tests/browser/test_dashboard.py.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "config/config.hpp"
+#include "config/dashboard_config.hpp"
+#include "dashboard/auth.hpp"
+#include "dashboard/fleet.hpp"
+#include "dds/bridge.hpp"
+#include "rt/supervisor.hpp"
+#include "runtime/spectrum_monitor.hpp"
+
+namespace robodamp {
+namespace {
+
+using Clock = dashboard::Authenticator::Clock;
+
+std::string temp(const std::string& name) { return ::testing::TempDir() + "dashboard_" + std::to_string(getpid()) + "_" + name; }
+
+template <typename F>
+bool eventually(F f, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < end) {
+    if (f()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return f();
+}
+
+TEST(DashboardAuth, PasswordsAreSaltedHashesThatVerifyOnlyTheRightPassword) {
+  const std::string h1 = dashboard::hash_password("correct horse", 2000), h2 = dashboard::hash_password("correct horse", 2000);
+  EXPECT_NE(h1, h2) << "a fresh salt each time";
+  EXPECT_EQ(h1.rfind("pbkdf2-sha256$2000$", 0), 0U);
+  EXPECT_TRUE(dashboard::verify_password("correct horse", h1));
+  EXPECT_FALSE(dashboard::verify_password("correct horsE", h1));
+  EXPECT_FALSE(dashboard::verify_password("", h1));
+  for (const char* bad : {"", "pbkdf2-sha256$", "md5$1$aa$bb", "pbkdf2-sha256$x$aa$bb", "pbkdf2-sha256$2000$zz$bb",
+                          "pbkdf2-sha256$1$00$00"})
+    EXPECT_FALSE(dashboard::verify_password("anything", bad)) << bad;
+}
+
+TEST(DashboardAuth, WrongPasswordsAreThrottledPerUserAndAddressAndSessionsExpire) {
+  dashboard::Authenticator auth({{"alice", dashboard::Role::kOperator, dashboard::hash_password("alice-pass", 2000)},
+                                 {"bob", dashboard::Role::kObserver, dashboard::hash_password("bob-pass", 2000)}},
+                                60.0);
+  const auto t0 = Clock::now();
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(auth.login("alice", "nope", "10.0.0.1", t0).outcome, dashboard::LoginOutcome::kWrong);
+  EXPECT_EQ(auth.login("alice", "nope", "10.0.0.1", t0).outcome, dashboard::LoginOutcome::kWrong);  // the 4th: locked 1 s
+  const auto locked = auth.login("alice", "alice-pass", "10.0.0.2", t0 + std::chrono::milliseconds(500));
+  EXPECT_EQ(locked.outcome, dashboard::LoginOutcome::kThrottled) << "by user, from another address too";
+  EXPECT_GT(locked.retry_after_s, 0.0);
+  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.1", t0 + std::chrono::milliseconds(500)).outcome,
+            dashboard::LoginOutcome::kThrottled) << "by address, for another user too";
+  const auto ok = auth.login("alice", "alice-pass", "10.0.0.1", t0 + std::chrono::seconds(2));
+  ASSERT_EQ(ok.outcome, dashboard::LoginOutcome::kOk);
+  EXPECT_EQ(ok.role, dashboard::Role::kOperator);
+  EXPECT_EQ(ok.token.size(), 64U);
+  EXPECT_EQ(auth.login("mallory", "alice-pass", "10.0.0.3", t0).outcome, dashboard::LoginOutcome::kWrong);
+  // The lock-out doubles per further failure: 1, 2, 4 s ...
+  const auto t1 = t0 + std::chrono::seconds(10);
+  for (int i = 0; i < 5; ++i) (void)auth.login("bob", "x", "10.0.0.9", t1 + std::chrono::seconds(100 * i));
+  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.8", t1 + std::chrono::seconds(401)).outcome, dashboard::LoginOutcome::kThrottled);
+  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.8", t1 + std::chrono::seconds(420)).outcome, dashboard::LoginOutcome::kOk);
+
+  const auto s = auth.session(ok.token, t0 + std::chrono::seconds(30));
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->user, "alice");
+  EXPECT_TRUE(auth.session(ok.token, t0 + std::chrono::seconds(80)).has_value()) << "used at 30 s: idle 50 s";
+  EXPECT_FALSE(auth.session(ok.token, t0 + std::chrono::seconds(200)).has_value()) << "idle past session_idle_s";
+  EXPECT_FALSE(auth.session("deadbeef").has_value());
+  EXPECT_GE(auth.counters().throttled, 3U);
+  EXPECT_GE(auth.counters().bad_tokens, 1U);
+}
+
+TEST(DashboardAuth, TheCredentialsFileIsWrittenPrivatelyAndReadBackOrRefusedByKey) {
+  const std::string path = temp("users.yaml");
+  std::remove(path.c_str());
+  dashboard::save_user(path, {"alice", dashboard::Role::kOperator, dashboard::hash_password("alice-pass", 2000)});
+  dashboard::save_user(path, {"bob", dashboard::Role::kObserver, dashboard::hash_password("bob-pass", 2000)});
+  dashboard::save_user(path, {"alice", dashboard::Role::kObserver, dashboard::hash_password("new-pass", 2000)});  // replaced
+  struct stat st {};
+  ASSERT_EQ(stat(path.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600U);
+  const auto users = dashboard::load_users(path);
+  ASSERT_EQ(users.size(), 2U);
+  EXPECT_EQ(users[0].name, "alice");
+  EXPECT_EQ(users[0].role, dashboard::Role::kObserver);
+  EXPECT_TRUE(dashboard::verify_password("new-pass", users[0].hash));
+  EXPECT_THROW(dashboard::save_user(path, {"bad name!", dashboard::Role::kObserver, "x"}), std::runtime_error);
+
+  std::ofstream(path) << "users:\n  - {name: carol, role: admin, hash: 'pbkdf2-sha256$2000$00$00'}\n";
+  try {
+    (void)dashboard::load_users(path);
+    FAIL() << "a role that is not one";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("users[0].role"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("allowed operator or observer"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DashboardConfig, EveryKeyIsCheckedWithItsUnitAndRange) {
+  const auto c = config::parse_dashboard_config("dashboard:\n  port: 0\n  stale_after_s: 1.5\ndds:\n  domain_id: 9\n", "d.yaml");
+  EXPECT_EQ(c.port, 0);
+  EXPECT_EQ(c.listen_address, "127.0.0.1") << "loopback unless told";
+  EXPECT_EQ(c.stale_after_s, 1.5);
+  EXPECT_EQ(c.dds.domain_id, 9);
+  try {
+    (void)config::parse_dashboard_config("dashboard:\n  port: 70000\n  stale_after_s: -1\n  colour: red\n"
+                                         "  credentials: /nonexistent/users.yaml\n", "d.yaml");
+    FAIL() << "refused";
+  } catch (const config::ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("dashboard.port"), std::string::npos) << w;
+    EXPECT_NE(w.find("65535"), std::string::npos) << w;
+    EXPECT_NE(w.find("dashboard.stale_after_s"), std::string::npos) << w;
+    EXPECT_NE(w.find("colour"), std::string::npos) << w;
+    EXPECT_NE(w.find("/nonexistent/users.yaml"), std::string::npos) << w;
+  }
+  try {
+    (void)config::parse_config(std::string("cell:\n  name: 'no spaces allowed'\n"), "c.yaml");
+    FAIL() << "refused";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("cell.name"), std::string::npos) << e.what();
+  }
+}
+
+// A loop's bridge as a cell publishes it, fed with frames here.
+struct NamedCell {
+  std::atomic<int> handled{0};
+  std::atomic<int> resets{0};
+  dds::Bridge bridge;
+  NamedCell(const std::string& name, const config::DdsConfig& cfg)
+      : bridge(cfg, 5000.0, name + ".yaml",
+               {name, "simulated plant", [] { return std::size_t{0}; }, [] { return 4000.0; },
+                [this](dds::RequestKind k, double) {
+                  ++handled;
+                  if (k == dds::RequestKind::kResetFault) ++resets;
+                  return dds::Decision{true, "ok"};
+                },
+                {}}) {
+    bridge.start();
+  }
+  void frames(std::uint64_t from, int n, rt::State state) {
+    for (std::uint64_t k = from; k < from + static_cast<std::uint64_t>(n); ++k) {
+      rt::TelemetryFrame f;
+      f.tick = k;
+      f.time_s = static_cast<double>(k) / 5000.0;
+      f.accel_mps2 = std::sin(static_cast<double>(k) * 0.03);
+      f.state = static_cast<std::uint8_t>(state);
+      bridge.on_frame(f);
+    }
+  }
+};
+
+TEST(DashboardFleet, TwoNamedCellsOnOneDomainAreToldApartAndARequestReachesOnlyItsCell) {
+  config::DdsConfig cfg;
+  cfg.domain_id = static_cast<int>((getpid() * 7 + 13) % 200) + 20;
+  cfg.transport = config::DdsTransport::kUdpLoopback;
+  cfg.parameter_writes = true;
+  cfg.status_rate_hz = 20.0;
+  NamedCell a("cell-a", cfg);
+  auto b_owner = std::make_unique<NamedCell>("cell-b", cfg);
+  NamedCell& b = *b_owner;
+  dashboard::Fleet fleet(cfg, 1.0);
+  ASSERT_TRUE(eventually([&] {
+    a.frames(0, 500, rt::State::kActive), b.frames(0, 500, rt::State::kActive);
+    return fleet.overview().size() == 2;
+  }, 60.0));
+  const auto tiles = fleet.overview();
+  EXPECT_EQ(tiles[0]["cell"], "cell-a");
+  EXPECT_EQ(tiles[1]["cell"], "cell-b");
+  EXPECT_EQ(tiles[0]["state"], "active");
+  // A request named for cell-b: cell-b answers, cell-a ignores it (and counts it).
+  dashboard::RequestOutcome r;
+  ASSERT_TRUE(eventually([&] { return (r = fleet.request("cell-b", dds::RequestKind::kResetFault, 0.0, "alice", 2.0)).answered; }, 60.0));
+  EXPECT_TRUE(r.accepted);
+  EXPECT_GE(b.resets.load(), 1);
+  EXPECT_EQ(a.handled.load(), 0);
+  EXPECT_GE(a.bridge.counters().other_cells, 1U);
+  // A trip wakes a waiting page at once; a cell that vanishes goes quiet after stale_after_s.
+  const std::uint64_t seen = fleet.wait(0, std::chrono::milliseconds(0), false);
+  b.frames(100000, 1, rt::State::kFault);
+  EXPECT_GT(fleet.wait(seen, std::chrono::seconds(30), false), seen);
+  b_owner.reset();
+  ASSERT_TRUE(eventually([&] {
+    a.frames(200000, 50, rt::State::kActive);
+    for (const auto& t : fleet.overview())
+      if (t["cell"] == "cell-b") return !t["live"].get<bool>();
+    return false;
+  }, 30.0));
+  EXPECT_GE(fleet.counters().cells_lost, 1U);
+  const auto d = fleet.detail("cell-a", 0);
+  ASSERT_TRUE(d.has_value());
+  EXPECT_GT((*d)["telemetry"]["time_s"].size(), 10U);
+  EXPECT_FALSE(fleet.detail("cell-c", 0).has_value());
+}
+
+TEST(DashboardSpectrum, TheAccelerometersSpectrumPeaksAtItsSineWithTheModesAndToothPassing) {
+  config::Config cfg = config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/horizontal_c2.yaml");
+  cfg.spindle.teeth = 3;
+  runtime::SpectrumMonitor m(cfg);
+  EXPECT_EQ(m.display_rate_hz(), 1000.0);
+  ASSERT_EQ(m.modes_hz().size(), 3U);
+  EXPECT_FALSE(m.next().has_value()) << "nothing before the record is full";
+  const double rate = cfg.loop.rate_hz;
+  for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(9.0 * rate); ++k) {
+    rt::TelemetryFrame f;
+    f.tick = k;
+    f.time_s = static_cast<double>(k) / rate;
+    f.accel_mps2 = 0.2 * std::sin(2.0 * std::numbers::pi * 23.4 * f.time_s);
+    if (k == 10) f.command_kind = static_cast<std::uint8_t>(rt::CommandKind::kSetSpindle), f.command_value = 700.0;
+    m.on_frame(f);
+  }
+  const auto s = m.next();
+  ASSERT_TRUE(s.has_value());
+  EXPECT_NEAR(s->tooth_passing_hz, 35.0, 1e-9);
+  std::size_t peak = 0;
+  for (std::size_t k = 1; k < s->accel_asd.size(); ++k)
+    if (s->accel_asd[k] > s->accel_asd[peak]) peak = k;
+  EXPECT_NEAR(static_cast<double>(peak) * s->bin_hz, 23.4, s->bin_hz);
+  // Parseval: the density integrates to the sine's mean square (0.02 (m/s^2)^2), within the Hann leakage.
+  double ms = 0.0;
+  for (const float v : s->accel_asd) ms += static_cast<double>(v) * v * s->bin_hz;
+  EXPECT_NEAR(ms, 0.02, 0.002);
+  EXPECT_FALSE(m.next().has_value()) << "at most once per period_s of loop time";
+}
+
+}  // namespace
+}  // namespace robodamp
