@@ -144,15 +144,13 @@ Fleet::Fleet(const config::DdsConfig& dds, double stale_after_s, std::size_t tel
   participant_->reader(dds::TopicKind::kAdvice, advice);
   participant_->reader(dds::TopicKind::kSpectrum, spectrum);
   participant_->reader(dds::TopicKind::kLobes, lobes);
-  participant_->reader(dds::TopicKind::kReply, reply);
-  if (dds.security && !dds.security->permissions.empty()) {
-    try {  // an observer identity may not write requests: the dashboard then only shows
-      request_writer_ = participant_->writer(dds::TopicKind::kRequest);
-    } catch (const std::runtime_error&) {
-      request_writer_ = nullptr;
-    }
-  } else {
+  try {  // an observer identity may neither read replies nor write requests: the dashboard then only shows
+    participant_->reader(dds::TopicKind::kReply, reply);
     request_writer_ = participant_->writer(dds::TopicKind::kRequest);
+  } catch (const std::runtime_error& e) {
+    if (!dds.security) throw;
+    request_writer_ = nullptr;
+    view_only_ = std::string("this dashboard's DDS identity may not write parameter requests (") + e.what() + ")";
   }
   contact_thread_ = std::thread([this] { watch_contact(); });
 }
@@ -369,7 +367,7 @@ std::uint64_t Fleet::wait(std::uint64_t seen, std::chrono::milliseconds timeout,
 
 RequestOutcome Fleet::request(const std::string& cell, dds::RequestKind kind, double value, const std::string& who,
                               double timeout_s) {
-  if (request_writer_ == nullptr) return {true, false, "this dashboard's DDS identity may not write parameter requests"};
+  if (request_writer_ == nullptr) return {true, false, view_only_};
   std::uint32_t id = 0;
   {
     std::lock_guard<std::mutex> lock(m_);

@@ -80,6 +80,8 @@ class Fleet {
                                        double timeout_s);
   [[nodiscard]] FleetCounters counters();
   [[nodiscard]] const std::string& client_name() const { return client_; }
+  // Why this dashboard cannot act (its DDS identity's permissions), or empty.
+  [[nodiscard]] const std::string& view_only() const { return view_only_; }
 
  private:
   struct Cell;
@@ -112,6 +114,7 @@ class Fleet {
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> listeners_;  // outlive the participant
   std::unique_ptr<dds::Participant> participant_;
   eprosima::fastdds::dds::DataWriter* request_writer_{nullptr};
+  std::string view_only_;  // why there is no request writer
 };
 
 }  // namespace robodamp::dashboard

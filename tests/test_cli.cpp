@@ -681,6 +681,35 @@ TEST(Cli, RunEndsInAFaultWithExitCode4) {
   EXPECT_NE(r.out.find("tripped: saturation"), std::string::npos) << r.out;
 }
 
+// A fault drill on the simulated plant (`run --fault`): the injected amplifier fault trips the loop at the
+// loop time asked; bad drills are refused by name before anything runs.
+TEST(Cli, RunFaultDrillTripsAtItsTimeAndBadDrillsAreRefused) {
+  const std::string json = temp_path("drill.json");
+  const Result r = run("run --config " + robodamp::test::preset("horizontal_c2") +
+                       " --duration 3 --clock virtual --impact-every 0 --fault amplifier_fault:2 --json " + json);
+  EXPECT_EQ(r.status, 4) << r.out;
+  EXPECT_NE(r.out.find("amplifier_fault"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  EXPECT_EQ(j["trip"], "amplifier_fault");
+  EXPECT_NEAR(j["trip_timing"]["trip_s"].get<double>(), 2.0, 0.01);
+  for (const auto& [arg, words] : std::vector<std::pair<std::string, std::string>>{
+           {"--fault bogus:1", "names no fault: allowed sensor_dropout"},
+           {"--fault sensor_nan", "is not KIND:START_S[:DURATION_S]"},
+           {"--fault sensor_nan:9", "allowed 0 <= value <= 3 s"},
+           {"--fault sensor_nan:1:0", "--fault duration"}}) {
+    const Result bad = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 3 " + arg);
+    EXPECT_EQ(bad.status, 2) << arg << ": " << bad.out;
+    EXPECT_NE(bad.out.find(words), std::string::npos) << arg << ": " << bad.out;
+  }
+  const Result port = run("dashboard --port 70000");
+  EXPECT_EQ(port.status, 2) << port.out;
+  EXPECT_NE(port.out.find("--port = 70000"), std::string::npos) << port.out;
+  const Result user = run_shell("echo short | " + std::string(ROBODAMP_BINARY) + " dashboard-user --file " +
+                                temp_path("u.yaml") + " --user 'a b'");
+  EXPECT_EQ(user.status, 2) << user.out;
+  EXPECT_NE(user.out.find("is not a user name"), std::string::npos) << user.out;
+}
+
 TEST(Cli, CtrlCEndsARunThroughTheSafeStateWithASummary) {
   const std::string json = temp_path("sigint.json");
   const Result r = run_shell("timeout --preserve-status -s INT 1.5 " + std::string(ROBODAMP_BINARY) +

@@ -19,6 +19,7 @@
 
 #include "cell_util.hpp"
 #include "child_process.hpp"
+#include "dashboard/fleet.hpp"
 #include "dds/bridge.hpp"
 #include "dds/participant.hpp"
 #include "dds/messages.hpp"
@@ -466,6 +467,37 @@ TEST(DdsSecurity, AnAuthenticatedObserverReadsTelemetryButCannotWriteRequests) {
   EXPECT_TRUE(eventually([&] { return loop.publish_frames(250), telemetry.size() > 0; }, 60.0));
   EXPECT_THROW((void)observer.writer(dds::TopicKind::kRequest), std::runtime_error) << "its permissions deny it";
   EXPECT_EQ(loop.handled.load(), 0);
+}
+
+// The dashboard joins a secured domain with the identity its configuration names: an operator's acts, an
+// observer's only shows (its permissions grant neither the request writer nor the reply reader).
+// ctest runs each test in a process of its own (gtest_discover_tests); run after the other security tests
+// in one process, the fourth and fifth secured participants of the process do not discover each other
+// over udp_loopback (Fast DDS 2.9 numbers participants per process and the initial peers cover the first few).
+TEST(DdsSecurity, TheDashboardActsWithAnOperatorIdentityAndOnlyViewsWithAnObservers) {
+  ASSERT_FALSE(security_dir().empty()) << "scripts/dds_security.sh failed (openssl)";
+  SecureLoop loop(test_domain(7));
+  config::DdsConfig op = loop.cfg;
+  op.security = identity("operator");
+  dashboard::Fleet fleet(op, 5.0);
+  ASSERT_TRUE(eventually([&] { return loop.publish_frames(250), fleet.overview().size() == 1; }, 60.0));
+  EXPECT_TRUE(fleet.view_only().empty());
+  dashboard::RequestOutcome r;
+  ASSERT_TRUE(eventually([&] { return (r = fleet.request(config::cell_name({}), dds::RequestKind::kSetGain, 2500.0, "alice", 2.0)).answered; },
+                         60.0));
+  EXPECT_TRUE(r.accepted) << r.reason;
+  EXPECT_EQ(loop.handled.load(), 1);
+
+  config::DdsConfig ob = loop.cfg;
+  ob.security = identity("observer");
+  dashboard::Fleet viewer(ob, 5.0);
+  ASSERT_TRUE(eventually([&] { return loop.publish_frames(250), viewer.overview().size() == 1; }, 60.0))
+      << viewer.counters().samples << " samples; " << viewer.view_only();
+  EXPECT_FALSE(viewer.view_only().empty());
+  r = viewer.request(config::cell_name({}), dds::RequestKind::kSetGain, 3000.0, "alice", 2.0);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.reason.find("may not write parameter requests"), std::string::npos) << r.reason;
+  EXPECT_EQ(loop.handled.load(), 1);
 }
 
 // Debian 12's Fast DDS 2.9.1 does not honour the governance's allow_unauthenticated_participants (Fast DDS
