@@ -111,6 +111,7 @@ std::vector<Sub> subcommands() {
       {"plant", {"--duration", "--impact-location", "--spindle-register-period", "--pose-register-period", "--pose-update"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
       {"monitor", {"--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback", "shared_memory"}}}, {"--config"}, false},
       {"request", {"--domain", "--gain", "--select", "--enable", "--timeout", "--spindle-rpm"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
+      {"dashboard", {"--port", "--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
       {"replay", {}, {}, {}, {}, true},
       {"csv", {}, {}, {}, {}, true},
       {"lobes", {"--rpm", "--pose"}, {"--json", "--damped"}, {}, {"--config", "--controller"}, false},

@@ -82,6 +82,7 @@ document.querySelectorAll('#actions button[data-action]').forEach((b) => b.addEv
   loadActions();
 }));
 
+// A tile's class, data attributes (what the browser tests read) and inner HTML.
 function tile(c) {
   const m = c.machining || {};
   const state = c.state || 'unknown';
@@ -90,20 +91,41 @@ function tile(c) {
   const pct = (limit && m.depth_mm !== undefined) ? Math.min(100, 100 * m.depth_mm / limit) : 0;
   const chatter = m.indicator_valid ? (m.chatter ? '<span class="chatter">CHATTER ' + fmt(m.chatter_hz, 1) + ' Hz</span>' : 'quiet')
                                      : (m.spindle_rpm > 0 ? 'listening…' : '–');
-  return '<div class="tile ' + esc(state) + (c.live ? '' : ' quiet') + '" data-cell="' + esc(c.cell) + '" data-state="' + esc(state) +
-    '" data-trip="' + esc(c.trip) + '" data-live="' + c.live + '">' +
-    '<h2><span>' + esc(c.cell) + '</span><span class="badge ' + esc(state) + '">' + esc(state) + '</span></h2>' +
-    (c.live ? '' : '<p class="trip">no contact for ' + fmt(c.quiet_s, 0) + ' s</p>') +
-    (c.publishers > 1 ? '<p class="trip">' + c.publishers + ' publishers call themselves ' + esc(c.cell) + '</p>' : '') +
-    (fault || (c.trip && c.trip !== 'none') ? '<p class="trip" data-field="trip">trip: ' + esc(c.trip) + ' – ' + esc(c.trip_description) + '</p>' : '') +
-    '<dl>' +
-    '<dt>damping</dt><dd>' + fmt(c.active_s, 1) + ' s active, ' + fmt(c.availability_pct, 1) + ' % of the time asked; ' + (c.trips || 0) + ' trips</dd>' +
-    '<dt>vibration</dt><dd>' + fmt(c.accel_rms_mps2, 4) + ' m/s² RMS</dd>' +
-    '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
-    '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' + (m.limits_ready ? fmt(limit, 2) + ' mm' : '…') +
-      '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
-    '<dt>chatter</dt><dd>' + chatter + '</dd>' +
-    '</dl></div>';
+  return {
+    className: 'tile ' + state + (c.live ? '' : ' quiet'),
+    data: { cell: c.cell, state, trip: c.trip, live: String(c.live) },
+    html: '<h2><span>' + esc(c.cell) + '</span><span class="badge ' + esc(state) + '">' + esc(state) + '</span></h2>' +
+      (c.live ? '' : '<p class="trip">no contact for ' + fmt(c.quiet_s, 0) + ' s</p>') +
+      (c.publishers > 1 ? '<p class="trip">' + c.publishers + ' publishers call themselves ' + esc(c.cell) + '</p>' : '') +
+      (fault || (c.trip && c.trip !== 'none') ? '<p class="trip" data-field="trip">trip: ' + esc(c.trip) + ' – ' + esc(c.trip_description) + '</p>' : '') +
+      '<dl>' +
+      '<dt>damping</dt><dd>' + fmt(c.active_s, 1) + ' s active, ' + fmt(c.availability_pct, 1) + ' % of the time asked; ' + (c.trips || 0) + ' trips</dd>' +
+      '<dt>vibration</dt><dd>' + fmt(c.accel_rms_mps2, 4) + ' m/s² RMS</dd>' +
+      '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
+      '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' + (m.limits_ready ? fmt(limit, 2) + ' mm' : '…') +
+        '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
+      '<dt>chatter</dt><dd>' + chatter + '</dd>' +
+      '</dl>',
+  };
+}
+
+// One element per cell, kept across updates (a click never lands on a node being replaced); only what
+// changed is written.
+const tiles = {};
+function placeTiles(cells) {
+  const grid = $('fleet');
+  cells.forEach((c, i) => {
+    let el = tiles[c.cell];
+    if (!el) {
+      el = tiles[c.cell] = document.createElement('div');
+      el.addEventListener('click', () => { location.hash = '#/cell/' + encodeURIComponent(el.dataset.cell); });
+    }
+    const t = tile(c);
+    if (el.className !== t.className) el.className = t.className;
+    for (const [k, v] of Object.entries(t.data)) if (el.dataset[k] !== v) el.dataset[k] = v;
+    if (el.innerHTML !== t.html) el.innerHTML = t.html;
+    if (grid.children[i] !== el) grid.insertBefore(el, grid.children[i] || null);
+  });
 }
 
 function renderFleet(cells) {
@@ -118,9 +140,8 @@ function renderFleet(cells) {
     const now = Date.now();
     changed.forEach((c) => window.robodamp.latencies.push({ cell: c.cell, state: c.state, trip: c.trip, ms: now - c.state_source_ms }));
   }, 0));
-  $('fleet').innerHTML = cells.map(tile).join('');
+  placeTiles(cells);
   $('empty').hidden = cells.length > 0;
-  document.querySelectorAll('.tile').forEach((t) => t.addEventListener('click', () => { location.hash = '#/cell/' + encodeURIComponent(t.dataset.cell); }));
   if (currentCell) {
     const c = cells.find((x) => x.cell === currentCell);
     if (c) {
