@@ -202,7 +202,8 @@ function plotLobes(l, m, a) {
   rows.sort((x, y) => x[0] - y[0]);
   draw('plot-lobes', ['rpm', 'open loop', 'damped', 'job depth', 'cutting now', 'advised'], rows, {
     xlabel: 'spindle speed (rpm)', ylabel: 'limiting depth (mm)', connectSeparatedPoints: true,
-    valueRange: [0, Math.max(3, 6 * l.depth_mm)],  // the lobes near the job's depth (zoom with the mouse) colors: ['#7a8494', '#2e9e4f', '#1d2430', '#d0342c', '#e67c00'],
+    valueRange: [0, Math.max(3, 6 * l.depth_mm)],  // the lobes near the job's depth (zoom with the mouse)
+    colors: ['#7a8494', '#2e9e4f', '#1d2430', '#d0342c', '#e67c00'],
     series: { 'job depth': { strokePattern: [6, 4] }, 'cutting now': { strokeWidth: 0, drawPoints: true, pointSize: 6 },
               advised: { strokeWidth: 0, drawPoints: true, pointSize: 5 } },
   });
