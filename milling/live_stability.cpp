@@ -1,5 +1,8 @@
 #include "milling/live_stability.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <limits>
 
@@ -36,6 +39,7 @@ LiveStability::LiveStability(config::MillingConfig job, const std::string& struc
   if (sets_.empty())
     throw config::ConfigError({config::Problem{job_.source, {}, "", "live stability needs a loop configuration"}});
   thread_ = std::thread([this] { worker(); });
+  sweep_thread_ = std::thread([this] { sweeper(); });
 }
 
 LiveStability::~LiveStability() {
@@ -45,6 +49,7 @@ LiveStability::~LiveStability() {
   }
   cv_.notify_all();
   thread_.join();
+  sweep_thread_.join();
 }
 
 LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain) const {
@@ -98,31 +103,52 @@ std::uint64_t LiveStability::computations() const {
 void LiveStability::worker() {
   std::unique_lock<std::mutex> lock(m_);
   for (;;) {
-    cv_.wait(lock, [this] { return stop_ || wanted_.has_value() || !sweep_.empty(); });
+    cv_.wait(lock, [this] { return stop_ || wanted_.has_value(); });
     if (stop_) return;
-    Key k;
-    if (wanted_) {
-      k = *wanted_;
-      wanted_.reset();
-    } else {
-      k = sweep_.front();
-      sweep_.pop_front();
-    }
+    const Key k = *wanted_;
+    wanted_.reset();
     if (cache_.count(k) != 0) continue;
     lock.unlock();
-    LiveLimits l;
-    try {
-      l = evaluate(k);
-    } catch (const std::exception& e) {  // a model that cannot be built: reported, never thrown at the cell
-      l.rpm = static_cast<double>(std::get<0>(k)) * s_.rpm_step;
-      l.open_mm = l.damped_mm = 0.0;
-      l.damped_valid = false;
-      l.problem = e.what();
-    }
+    LiveLimits l = evaluate_reported(k);
     lock.lock();
-    ++computations_;
-    if (cache_.size() >= s_.cache_entries) cache_.clear();  // bounded; a run visits few states
-    cache_.emplace(k, std::move(l));
+    store(k, std::move(l));
+  }
+}
+
+LiveLimits LiveStability::evaluate_reported(const Key& k) const {
+  try {
+    return evaluate(k);
+  } catch (const std::exception& e) {  // a model that cannot be built: reported, never thrown at the cell
+    LiveLimits l;
+    l.rpm = static_cast<double>(std::get<0>(k)) * s_.rpm_step;
+    l.open_mm = l.damped_mm = 0.0;
+    l.damped_valid = false;
+    l.problem = e.what();
+    return l;
+  }
+}
+
+void LiveStability::store(const Key& k, LiveLimits l) {
+  ++computations_;
+  if (cache_.size() >= s_.cache_entries) cache_.clear();  // bounded; a run visits few states
+  cache_.emplace(k, std::move(l));
+}
+
+void LiveStability::sweeper() {
+  // The lowest priority of a normal thread (nice 19: about 1.5 % of a core against a busy nice-0 thread), so
+  // the sweep yields to the cell's loop, its drivers and the advice but still moves on a loaded machine.
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+  std::unique_lock<std::mutex> lock(m_);
+  for (;;) {
+    cv_.wait(lock, [this] { return stop_ || !sweep_.empty(); });
+    if (stop_) return;
+    const Key k = sweep_.front();
+    sweep_.pop_front();
+    if (cache_.count(k) != 0) continue;
+    lock.unlock();
+    LiveLimits l = evaluate_reported(k);
+    lock.lock();
+    store(k, std::move(l));
   }
 }
 

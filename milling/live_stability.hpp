@@ -60,8 +60,8 @@ class LiveStability {
   // Blocking, for tests and the command line: computes (or finds) the limits.
   [[nodiscard]] LiveLimits compute(double rpm, std::size_t set, double gain_ns_per_m);
 
-  // Low priority (the live lobes): the worker computes these speeds for (set, gain) whenever nothing is
-  // wanted; a new sweep replaces the one before. Any thread.
+  // Low priority (the live lobes): a thread of its own at the lowest priority (nice 19) computes these speeds
+  // for (set, gain) into the cache; a new sweep replaces the one before. Any thread.
   void sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm);
   // Any thread: every limit computed so far for (set, gain), by speed.
   [[nodiscard]] std::vector<LiveLimits> known(std::size_t set, double gain_ns_per_m) const;
@@ -76,7 +76,10 @@ class LiveStability {
   using Key = std::tuple<long, std::size_t, long>;
   [[nodiscard]] Key key(double rpm, std::size_t set, double gain) const;
   [[nodiscard]] LiveLimits evaluate(const Key& k) const;
+  [[nodiscard]] LiveLimits evaluate_reported(const Key& k) const;  // a failure as a result with its problem
+  void store(const Key& k, LiveLimits l);                          // under m_
   void worker();
+  void sweeper();
 
   config::MillingConfig job_;
   config::StructureConfig structure_;
@@ -91,6 +94,7 @@ class LiveStability {
   bool stop_{false};
   std::uint64_t computations_{0};
   std::thread thread_;
+  std::thread sweep_thread_;  // last: started after everything it reads
 };
 
 }  // namespace robodamp::milling

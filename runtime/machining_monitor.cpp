@@ -61,20 +61,25 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
 
 dds::MachiningSample MachiningMonitor::sample() { return view().sample; }
 
+std::pair<std::size_t, double> MachiningMonitor::set_and_gain() {
+  std::size_t set = active_set_ ? active_set_() : 0;
+  if (set >= set_gains_.size()) set = 0;
+  std::lock_guard<std::mutex> lock(m_);
+  // The damper's limit at the gain it has (ramping included), or, while it is off, at the set's gain.
+  const bool active = static_cast<rt::State>(last_.state) == rt::State::kActive;
+  return {set, active && last_.gain_ns_per_m > 0.0 ? last_.gain_ns_per_m : set_gains_[set]};
+}
+
 AdviceView MachiningMonitor::view() {
   AdviceView v;
   dds::MachiningSample& s = v.sample;
-  std::size_t set = active_set_ ? active_set_() : 0;
-  if (set >= set_gains_.size()) set = 0;
-  double gain = 0.0;
+  const auto [set, gain] = set_and_gain();
   {
     std::lock_guard<std::mutex> lock(m_);
     s.tick = last_.tick;
     s.time_s = last_.time_s;
     s.spindle_rpm = rpm_;
     s.loop_active = static_cast<rt::State>(last_.state) == rt::State::kActive;
-    // The damper's limit at the gain it has (ramping included), or, while it is off, at the set's gain.
-    gain = s.loop_active && last_.gain_ns_per_m > 0.0 ? last_.gain_ns_per_m : set_gains_[set];
     const milling::ChatterIndicator c = chatter_.evaluate(rpm_);
     s.indicator_valid = c.valid;
     s.once_per_rev_ratio = c.once_per_rev_ratio;
@@ -100,20 +105,23 @@ AdviceView MachiningMonitor::view() {
 }
 
 std::optional<dds::LobesSample> MachiningMonitor::lobes() {
-  const AdviceView v = view();
-  if (v.parameter_set != lobes_set_ || v.gain_ns_per_m != lobes_gain_) {  // a new state, or a ramp: wait for it to hold
-    lobes_set_ = v.parameter_set, lobes_gain_ = v.gain_ns_per_m;
+  const auto [set, gain] = set_and_gain();
+  if (set != lobes_set_ || gain != lobes_gain_) {  // a new state, or a ramp: wait for it to hold
+    lobes_set_ = set, lobes_gain_ = gain;
     lobes_swept_ = false, lobes_published_ = 0;
     return std::nullopt;
   }
-  if (!lobes_swept_) stability_->sweep(v.parameter_set, v.gain_ns_per_m, lobe_rpm_), lobes_swept_ = true;
-  const std::vector<milling::LiveLimits> known = stability_->known(v.parameter_set, v.gain_ns_per_m);
+  if (!lobes_swept_) stability_->sweep(set, gain, lobe_rpm_), lobes_swept_ = true;
+  const std::vector<milling::LiveLimits> known = stability_->known(set, gain);
   if (known.size() == lobes_published_) return std::nullopt;
   lobes_published_ = known.size();
   dds::LobesSample out;
-  out.time_s = v.sample.time_s;
-  out.parameter_set = v.parameter_set;
-  out.gain_ns_per_m = v.gain_ns_per_m;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    out.time_s = last_.time_s;
+  }
+  out.parameter_set = set;
+  out.gain_ns_per_m = gain;
   out.depth_mm = stability_->depth_mm();
   for (const auto& l : known) {
     out.rpm.push_back(l.rpm);

@@ -47,6 +47,7 @@ class MachiningMonitor {
 
  private:
   [[nodiscard]] AdviceView view();
+  [[nodiscard]] std::pair<std::size_t, double> set_and_gain();  // the active set and the gain its limits are for
   int teeth_;
   std::vector<double> set_gains_;
   std::function<std::size_t()> active_set_;

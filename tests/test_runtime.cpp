@@ -282,7 +282,7 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
                              -std::numeric_limits<double>::infinity(), -0.0, 0.0, 1.0, 2.0, -1.0, 1e308, -1e308,
                              std::numeric_limits<double>::denorm_min(), limit, std::nextafter(limit, 1e9), 0.5, 1.5};
   std::uniform_real_distribution<double> wide(-1e6, 1e6);
-  std::uniform_int_distribution<int> pick(0, 3), special(0, std::size(specials) - 1), coin(0, 1);
+  std::uniform_int_distribution<int> pick(0, 4), special(0, std::size(specials) - 1), coin(0, 1);
   int accepted = 0;
   for (int i = 0; i < 10000; ++i) {
     const auto kind = static_cast<dds::RequestKind>(pick(rng));
@@ -312,6 +312,10 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
         EXPECT_GE(v, 0.0);
         EXPECT_LE(v, cfg.spindle.rpm_max);
         EXPECT_EQ(r.command.kind, CommandKind::kSetSpindle);
+        break;
+      case dds::RequestKind::kResetFault:  // accepted only while the loop is in fault
+        EXPECT_EQ(sup.observed_state(), rt::State::kFault);
+        EXPECT_EQ(r.command.kind, CommandKind::kResetFault);
         break;
     }
   }

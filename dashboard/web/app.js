@@ -103,6 +103,7 @@ function tile(c) {
       '<dt>vibration</dt><dd>' + fmt(c.accel_rms_mps2, 4) + ' m/s² RMS</dd>' +
       '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
       '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' + (m.limits_ready ? fmt(limit, 2) + ' mm' : '…') +
+        (m.depth_warning ? ' <span class="chatter">above the limit</span>' : '') +
         '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
       '</dl>',

@@ -76,9 +76,16 @@ class Fleet:
         self.procs = []
         suffix = str(os.getpid())
         self.cells = {"a": "brw-a-" + suffix, "b": "brw-b-" + suffix}
-        preset = open(os.path.join(SOURCE, "config/presets/horizontal_c2.yaml")).read()
-        job = os.path.join(SOURCE, "config/milling/active_damping_c2.yaml")
+        with open(os.path.join(SOURCE, "config/presets/horizontal_c2.yaml")) as f:
+            preset = f.read()
+        # Cell A cuts 1.0 mm at 700 rpm, above its damped limit there (0.78 mm): a depth warning and an advice.
+        with open(os.path.join(SOURCE, "config/milling/active_damping_c2.yaml")) as f:
+            job_text = f.read().replace("../presets/", os.path.join(SOURCE, "config/presets") + "/")
+        jobs = {"a": job_text.replace("axial_mm: 0.5 ", "axial_mm: 1.0 "), "b": job_text}
         for key, name in self.cells.items():
+            job = os.path.join(self.dir, f"job_{key}.yaml")
+            with open(job, "w") as f:
+                f.write(jobs[key])
             # A cell of this test's own: a preset with a name, a job and DDS on a domain nobody else uses.
             with open(os.path.join(self.dir, f"cell_{key}.yaml"), "w") as f:
                 f.write(preset + f"\ndds:\n  domain_id: {DOMAIN}\n  transport: udp_loopback\n  parameter_writes: true\n"
@@ -181,6 +188,7 @@ class DashboardInABrowser(unittest.TestCase):
         for key, rpm in (("a", "700 rpm"), ("b", "600 rpm")):
             until(lambda: (self.tile(key) or {}).get("state") == "active", 90, f"cell {key} active")
             until(lambda: rpm in self.tile(key)["text"], 60, f"cell {key} at {rpm}")
+        until(lambda: "1.00 mm of 0.78 mm" in self.tile("a")["text"], 60, "cell a's depth against its damped limit")
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
 
         self.open_cell("a")
@@ -197,6 +205,9 @@ class DashboardInABrowser(unittest.TestCase):
         lobes = until(lambda: (lambda l: l if l and l["speeds"] >= 20 else None)(self.js("return window.robodamp.plotted.lobes")),
                       120, "20 speeds of live lobes")
         self.assertEqual(lobes["operating_rpm"], 700)
+        # The depth above the limit asked for an advice: the advised speeds on the lobes, the advice in words.
+        until(lambda: self.js("return window.robodamp.plotted.lobes.advised") >= 1, 120, "the advised speeds on the lobes")
+        self.assertIn("go to", self.browser.find_element(By.ID, "advice").text)
         timing = until(lambda: self.js("return window.robodamp.plotted.timing"), 30, "the timing histogram")
         self.assertGreater(timing["ticks"], 1000)
         counters = self.browser.find_element(By.ID, "counters").text
