@@ -252,13 +252,16 @@ void read_supervisory(MapReader& top, Config& c) {
 
 }  // namespace detail
 
-std::string cell_name_problem(const std::string& name) {
-  if (name.empty() || name.size() > 31) return "is not a cell name: allowed 1 to 31 characters";
+std::string name_problem(const std::string& name, const std::string& what, std::size_t max_chars) {
+  if (name.empty() || name.size() > max_chars)
+    return "is not a " + what + ": allowed 1 to " + std::to_string(max_chars) + " characters";
   for (const char ch : name)
     if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_' || ch == '.'))
-      return "is not a cell name: allowed letters, digits, '-', '_' and '.'";
+      return "is not a " + what + ": allowed letters, digits, '-', '_' and '.'";
   return {};
 }
+
+std::string cell_name_problem(const std::string& name) { return name_problem(name, "cell name", 31); }
 
 std::string cell_name(const CellConfig& cfg) {
   if (!cfg.name.empty()) return cfg.name;

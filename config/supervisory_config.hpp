@@ -114,6 +114,9 @@ struct CellConfig {
 };
 // The name a cell uses: cfg's, else the host's name (cut to the allowed characters), else "cell".
 [[nodiscard]] std::string cell_name(const CellConfig& cfg);
+// Why a name is not a name of 1 to max_chars letters, digits, '-', '_' and '.' (empty: it is); what: "cell
+// name", "user name".
+[[nodiscard]] std::string name_problem(const std::string& name, const std::string& what, std::size_t max_chars);
 // Why a name is not a valid cell name (empty: it is).
 [[nodiscard]] std::string cell_name_problem(const std::string& name);
 

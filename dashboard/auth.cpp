@@ -17,6 +17,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "config/config.hpp"
+#include "config/supervisory_config.hpp"
 
 namespace robodamp::dashboard {
 
@@ -66,13 +67,7 @@ std::vector<unsigned char> pbkdf2(const std::string& password, const std::vector
 
 const char* to_string(Role r) { return r == Role::kOperator ? "operator" : "observer"; }
 
-std::string user_name_problem(const std::string& name) {
-  if (name.empty() || name.size() > 32) return "is not a user name: allowed 1 to 32 characters";
-  for (const char c : name)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.'))
-      return "is not a user name: allowed letters, digits, '-', '_' and '.'";
-  return {};
-}
+std::string user_name_problem(const std::string& name) { return config::name_problem(name, "user name", 32); }
 
 std::string hash_password(const std::string& password, int iterations) {
   const auto salt = random_bytes(16);

@@ -2,7 +2,8 @@
 # The dashboard under load (docs/dashboard.md, "Measured"): N simulated cells (default 8; the preset at a
 # 1 kHz loop, 50 Hz telemetry each, half of them cutting at 700 rpm so their lobes sweep), one dashboard and
 # two open pages (the fleet and one cell, as server-sent event streams), for D seconds (default 600). Prints
-# the dashboard's CPU share, its resident memory every minute, and the time /api/fleet takes.
+# the dashboard's CPU share, its resident memory every minute, the time /api/fleet takes, and then how a
+# real browser keeps up with the fleet page and a cell page (scripts/dashboard_browser_load.py, 30 s each).
 # Usage: bash scripts/dashboard_load.sh [CELLS] [SECONDS]   (after scripts/setup.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -52,4 +53,5 @@ awk -v a="$t0" -v b="$t1" -v s0="$s0" -v s1="$s1" -v hz="$hz" \
   'BEGIN { printf "dashboard CPU: %.1f %% of one core over %.0f s\n", 100 * (b - a) / hz / (s1 - s0), s1 - s0 }'
 for _ in $(seq 1 20); do curl -s -o /dev/null -w '%{time_total}\n' "http://127.0.0.1:$port/api/fleet"; done |
   sort -n | awk '{ v[NR] = $1 } END { printf "GET /api/fleet: median %.1f ms, max %.1f ms (20 requests)\n", 1e3 * v[int((NR + 1) / 2)], 1e3 * v[NR] }'
+/usr/bin/python3 scripts/dashboard_browser_load.py "$port" load-2 30
 curl -s "http://127.0.0.1:$port/api/health"; echo

@@ -8,7 +8,19 @@ const esc = (s) => String(s === undefined || s === null ? '' : s).replace(/[&<>"
   (c) => ({'&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;'}[c]));
 
 // What the browser tests read: state changes seen (with their delay from the cell), and what each plot holds.
-window.robodamp = { latencies: [], plotted: {}, updates: { time: 0, spectrum: 0, lobes: 0, timing: 0 }, events: 0 };
+window.robodamp = { latencies: [], plotted: {}, updates: { time: 0, spectrum: 0, lobes: 0, timing: 0 }, events: 0, handlerMs: [] };
+
+// How long the page works on each event (the last 2000): the load script reads it to show the page keeps up.
+function timed(fn) {
+  return (ev) => {
+    const t0 = performance.now();
+    window.robodamp.events++;
+    fn(ev);
+    const h = window.robodamp.handlerMs;
+    h.push(performance.now() - t0);
+    if (h.length > 2000) h.shift();
+  };
+}
 
 let token = sessionStorage.getItem('robodamp-token') || '';
 let role = 'observer';
@@ -106,6 +118,8 @@ function tile(c) {
         (m.depth_warning ? ' <span class="chatter">above the limit</span>' : '') +
         '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
+      (c.advice ? '<dt>advice</dt><dd>' + (c.advice.found ? 'go to ' + fmt(c.advice.advised_rpm, 1) + ' rpm' : 'no stable speed in range') +
+        ' (#' + c.advice.seq + ')</dd>' : '') +
       '</dl>',
   };
 }
@@ -256,16 +270,15 @@ function connect() {
   source = new EventSource('/api/events' + (currentCell ? '?cell=' + encodeURIComponent(currentCell) : ''));
   source.onopen = () => { $('link').textContent = 'live'; };
   source.onerror = () => { $('link').textContent = 'reconnecting…'; };
-  source.addEventListener('fleet', (ev) => { window.robodamp.events++; renderFleet(JSON.parse(ev.data).cells); });
-  source.addEventListener('cell', (ev) => {
-    window.robodamp.events++;
+  source.addEventListener('fleet', timed((ev) => renderFleet(JSON.parse(ev.data).cells)));
+  source.addEventListener('cell', timed((ev) => {
     const d = JSON.parse(ev.data);
     if (d.cell !== currentCell) return;
     plotTime(d.telemetry);
     if (d.spectrum !== undefined) { plotSpectrum(d.spectrum); plotLobes(d.lobes, d.machining, d.advice); }
     plotTiming(d.status);
     renderCounters(d);
-  });
+  }));
 }
 
 function route() {
