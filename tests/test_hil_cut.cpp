@@ -128,7 +128,10 @@ test::HilFiles advice_cell(const std::string& name, const std::string& gain = "2
                                  "    depth_register: 2\n    advice_register: 4\n"},
                                 {"  gain_ns_per_m: 2000 ", "  gain_ns_per_m: " + gain + " "},
                                 {"\nhil: ", "\nspindle:\n  teeth: 3\n  rpm_max: " + rpm_max + "\n  job: " + kJob +
-                                               "\n  apply_advice: true\n\nhil: "}});
+                                               "\n  apply_advice: true\n\nhil: "},
+                                // Under the suite with both cores busy the emulator (lockstep, the cut at 143
+                                // steps per tooth) fell behind for the 10 s the loop may take to arm.
+                                {"\nsupervision:\n", "\nsupervision:\n  arm_deadline_s: 60\n"}});
 }
 
 struct AdviceRun {
