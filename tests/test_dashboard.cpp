@@ -12,12 +12,16 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <httplib.h>
 
 #include "config/config.hpp"
 #include "config/dashboard_config.hpp"
 #include "dashboard/auth.hpp"
 #include "dashboard/fleet.hpp"
+#include "dashboard/server.hpp"
 #include "dds/bridge.hpp"
+#include "dds/messages.hpp"
+#include "dds/participant.hpp"
 #include "rt/supervisor.hpp"
 #include "runtime/spectrum_monitor.hpp"
 
@@ -204,6 +208,45 @@ TEST(DashboardFleet, TwoNamedCellsOnOneDomainAreToldApartAndARequestReachesOnlyI
   ASSERT_TRUE(d.has_value());
   EXPECT_GT((*d)["telemetry"]["time_s"].size(), 10U);
   EXPECT_FALSE(fleet.detail("cell-c", 0).has_value());
+}
+
+// More open pages than dashboard.max_event_streams are refused (503) and counted; a sample whose cell name is
+// not a name is dropped and counted; the server stops with a page still open.
+TEST(DashboardServer, ExtraPagesAndBadCellNamesAreRefusedAndCounted) {
+  config::DashboardConfig cfg;
+  cfg.port = 0;
+  cfg.max_event_streams = 1;
+  cfg.dds.domain_id = static_cast<int>((getpid() * 7 + 17) % 200) + 20;
+  cfg.dds.transport = config::DdsTransport::kUdpLoopback;
+  dashboard::Fleet fleet(cfg.dds, 2.0);
+  dashboard::Authenticator auth({}, 60.0);
+  dashboard::ActionLog log("");
+  dashboard::WebServer server(cfg, fleet, auth, log);
+  const int port = server.bind();
+  std::thread serving([&] { server.serve(); });
+  std::atomic<bool> first_event{false};
+  std::thread page([&] {
+    httplib::Client c("127.0.0.1", port);
+    c.set_read_timeout(60, 0);
+    (void)c.Get("/api/events", [&](const char*, std::size_t) { return first_event = true, true; });
+  });
+  EXPECT_TRUE(eventually([&] { return first_event.load(); }, 30.0));
+  httplib::Client c("127.0.0.1", port);
+  const auto second = c.Get("/api/events");
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->status, 503);
+  EXPECT_NE(second->body.find("max_event_streams"), std::string::npos) << second->body;
+  EXPECT_EQ(server.counters().streams_refused, 1U);
+
+  dds::Participant writer(cfg.dds.domain_id, cfg.dds.transport, "bad names");
+  auto* w = writer.writer(dds::TopicKind::kTelemetry);
+  msg::Telemetry t;
+  t.cell("bad name!");
+  EXPECT_TRUE(eventually([&] { return w->write(&t), fleet.counters().bad_cell_names > 0; }, 60.0));
+  EXPECT_TRUE(fleet.overview().empty());
+  server.stop();
+  serving.join();
+  page.join();
 }
 
 TEST(DashboardSpectrum, TheAccelerometersSpectrumPeaksAtItsSineWithTheModesAndToothPassing) {
