@@ -295,16 +295,8 @@ json Fleet::overview() {
   for (const auto& [name, c] : cells_) {
     json t = {{"cell", name}, {"live", c->live}, {"quiet_s", std::chrono::duration<double>(now - c->heard).count()},
               {"publishers", c->status_writers.size()}, {"active_s", c->active_s}, {"state_source_ms", c->state_source_ms}};
-    if (!c->telemetry.empty()) {
-      const auto& p = c->telemetry.back();
-      t["state"] = rt::to_string(static_cast<rt::State>(p.state));
-      t["trip"] = rt::to_string(static_cast<rt::Trip>(p.trip));
-      t["accel_rms_mps2"] = p.accel_rms_mps2;
-      t["command_peak_v"] = p.command_peak_v;
-      t["time_s"] = p.time_s;
-    }
     if (!c->status.is_null()) {
-      t["state"] = c->status["state"];  // the status's word (it also comes on every state change)
+      t["state"] = c->status["state"];  // without telemetry, the status's word
       t["trip"] = c->status["trip"];
       t["trip_description"] = c->status["trip_description"];
       t["availability_pct"] = c->status["availability_pct"];
@@ -317,6 +309,9 @@ json Fleet::overview() {
       const auto& p = c->telemetry.back();
       t["state"] = rt::to_string(static_cast<rt::State>(p.state));
       t["trip"] = rt::to_string(static_cast<rt::Trip>(p.trip));
+      t["accel_rms_mps2"] = p.accel_rms_mps2;
+      t["command_peak_v"] = p.command_peak_v;
+      t["time_s"] = p.time_s;
     }
     if (!c->machining.is_null()) t["machining"] = c->machining;
     if (!c->advice.is_null()) t["advice"] = {{"seq", c->advice["seq"]}, {"found", c->advice["found"]},
