@@ -68,14 +68,15 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
       sensor_model_(cfg.sensor, cfg.loop.rate_hz, 0),
       sensor_(plant_.index_of(cfg.sensor.location)) {
   const double t = 1.0 / cfg.loop.rate_hz;
-  // The harmonic notches at this speed, fully faded in, as the chain runs them (filters/harmonic_notch.hpp).
-  if (spindle_rpm && cfg.controller.harmonic_notch) {
-    const auto& n = *cfg.controller.harmonic_notch;
+  // The harmonic notches at this speed, fully faded in, as the chain runs them: the designed controller's
+  // own settings and the bank's rule of which are on (filters/harmonic_notch.hpp).
+  if (spindle_rpm && chain_.params.harmonic_notch.enabled) {
+    const auto& n = chain_.params.harmonic_notch;
     spindle_rpm_ = *spindle_rpm;
     const double tooth_hz = *spindle_rpm * cfg.spindle.teeth / 60.0;
-    for (int k = 1; k <= n.harmonics && tooth_hz >= n.min_hz; ++k) {
+    const int on = filters::HarmonicNotchBank::steady_count(n, tooth_hz, cfg.loop.rate_hz);
+    for (int k = 1; k <= on; ++k) {
       const double f = k * tooth_hz;
-      if (f >= filters::HarmonicNotchSettings{}.max_fraction_of_fs * cfg.loop.rate_hz) break;
       if (chain_.params.sections.count >= filters::kMaxSections)
         throw std::invalid_argument("the chain and the harmonic notches need more than " +
                                     std::to_string(filters::kMaxSections) + " second-order sections");

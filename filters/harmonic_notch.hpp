@@ -143,7 +143,22 @@ class HarmonicNotchBank final {
   [[nodiscard]] double target_hz() const noexcept { return target_hz_; }
   [[nodiscard]] double fade() const noexcept { return fade_; }
   [[nodiscard]] double harmonic_gain(int k) const noexcept { return gain_[static_cast<std::size_t>(k)]; }
-  [[nodiscard]] bool harmonic_on(int k) const noexcept { return (k + 1) * centre_hz_ < s_.max_fraction_of_fs * fs_hz_; }
+  [[nodiscard]] bool harmonic_on(int k) const noexcept { return harmonic_on(s_, centre_hz_, k, fs_hz_); }
+
+  // The one rule of which notches are in the path (the bank's and the loop analysis', analysis/loop_model):
+  // harmonic k (0 = the tooth frequency) is on when the bank is valid (tooth frequency at least min_hz) and
+  // (k + 1) x the tooth frequency is below max_fraction_of_fs x fs.
+  [[nodiscard]] static bool harmonic_on(const HarmonicNotchSettings& s, double tooth_hz, int k, double fs_hz) noexcept {
+    return (k + 1) * tooth_hz < s.max_fraction_of_fs * fs_hz;
+  }
+  // How many notches a bank with these settings runs at a steady tooth frequency, fully faded in.
+  [[nodiscard]] static int steady_count(const HarmonicNotchSettings& s, double tooth_hz, double fs_hz) noexcept {
+    if (!s.enabled || !(tooth_hz >= s.min_hz)) return 0;
+    const int harmonics = std::clamp(s.harmonics, 1, kMaxHarmonics);
+    int n = 0;
+    while (n < harmonics && harmonic_on(s, tooth_hz, n, fs_hz)) ++n;
+    return n;
+  }
   [[nodiscard]] const HarmonicNotchSettings& settings() const noexcept { return s_; }
   [[nodiscard]] const HarmonicNotchCounters& counters() const noexcept { return counters_; }
 

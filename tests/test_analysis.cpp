@@ -9,7 +9,9 @@
 #include "analysis/loop_model.hpp"
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/resolvent.hpp"
+#include "control/chain_design.hpp"
 #include "control/controller.hpp"
+#include "filters/harmonic_notch.hpp"
 #include "analysis/spectral.hpp"
 #include "test_util.hpp"
 
@@ -189,6 +191,41 @@ TEST(Analysis, HarmonicNotchesJoinTheLoopAtASpindleSpeed) {
   EXPECT_NEAR(*k_fast, *k_plain, 0.005 * *k_plain);
   // The notches' depth is in the discrete loop: its filter response at 600 Hz is 30 dB down.
   EXPECT_NEAR(20.0 * std::log10(std::abs(fast.chain_filters_digital(600.0) / plain.chain_filters_digital(600.0))), -30.0, 0.5);
+}
+
+// One rule of which notches are on: the loop analysis takes the designed controller's settings and the
+// bank's rule, so at every steady speed (parked below min_hz, every harmonic, the top ones cut at
+// 0.45 fs) the analysed notches are the ones the running bank has in its path, with its response.
+TEST(Analysis, AnalysedNotchesAreTheRunningBanksAtEverySpeed) {
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  config::HarmonicNotchConfig n;
+  n.harmonics = 6, n.bandwidth_hz = 15.0, n.depth_db = 25.0, n.min_hz = 12.0;
+  cfg.controller.harmonic_notch = n;
+  cfg.spindle.teeth = 2;
+  const auto designed = control::design_chain(cfg).params.harmonic_notch;
+  ASSERT_TRUE(designed.enabled);
+  int saw_parked = 0, saw_cut = 0, saw_all = 0;
+  for (const double rpm : {300.0, 359.0, 361.0, 3000.0, 20000.0, 33000.0, 44000.0, 67400.0, 90000.0}) {
+    const double tooth_hz = rpm * cfg.spindle.teeth / 60.0;
+    filters::HarmonicNotchBank bank(designed, cfg.loop.rate_hz);
+    bank.set_tooth_frequency(tooth_hz);
+    for (int i = 0; i < static_cast<int>(2.0 * cfg.loop.rate_hz); ++i) (void)bank.process(0.0);
+    std::size_t running = 0;
+    for (int k = 0; k < filters::kMaxHarmonics; ++k) running += bank.harmonic_gain(k) == 1.0;
+    const analysis::LoopModel model(cfg, rpm);
+    EXPECT_EQ(model.notch_count(), running) << rpm << " rpm";
+    EXPECT_EQ(static_cast<int>(running), filters::HarmonicNotchBank::steady_count(designed, tooth_hz, cfg.loop.rate_hz));
+    for (const double f : {9.2, tooth_hz, 1.5 * tooth_hz}) {
+      const auto a = model.notch_response(f), b = bank.response(f);
+      EXPECT_NEAR(std::abs(a - b), 0.0, 1e-9) << rpm << " rpm at " << f << " Hz";
+    }
+    saw_parked += running == 0;
+    saw_all += running == 6;
+    saw_cut += running > 0 && running < 6;
+  }
+  EXPECT_GT(saw_parked, 0);
+  EXPECT_GT(saw_all, 0);
+  EXPECT_GT(saw_cut, 0);
 }
 
 // Across the speed range: a notch just above the 9.2 Hz mode (tooth frequency 10-14.6 Hz, 20 Hz wide)
