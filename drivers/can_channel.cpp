@@ -14,6 +14,8 @@
 #include <system_error>
 #include <unistd.h>
 
+#include "rt/clock.hpp"
+
 namespace robodamp::drivers {
 
 namespace {
@@ -138,11 +140,7 @@ int CanChannel::receive(canfd_frame& frame, std::int64_t& timestamp_ns) noexcept
       std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
       timestamp_ns = ts.tv_sec * 1'000'000'000LL + ts.tv_nsec;
     }
-  if (timestamp_ns < 0) {
-    timespec ts{};
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    timestamp_ns = ts.tv_sec * 1'000'000'000LL + ts.tv_nsec;
-  }
+  if (timestamp_ns < 0) timestamp_ns = rt::monotonic_ns();
   return static_cast<int>(n);
 }
 

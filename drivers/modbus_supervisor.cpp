@@ -1,6 +1,6 @@
 #include "drivers/modbus_supervisor.hpp"
 
-#include <time.h>
+#include "rt/clock.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -12,12 +12,6 @@
 namespace robodamp::drivers {
 
 namespace {
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 void set_timeout(modbus_t* ctx, double s) {
   const auto us = static_cast<std::uint32_t>(std::llround(s * 1e6));
@@ -129,7 +123,7 @@ void ModbusSupervisor::request_amplifier_enable(bool on) noexcept { requested_.s
 rt::AmplifierStatus ModbusSupervisor::amplifier_status() noexcept {
   rt::AmplifierStatus s;
   const std::int64_t last = last_ok_ns_.load(std::memory_order_acquire);
-  const bool stale = last < 0 || monotonic_ns() - last > link_timeout_ns_;
+  const bool stale = last < 0 || rt::monotonic_ns() - last > link_timeout_ns_;
   const bool matters = requested_.load(std::memory_order_relaxed) || enabled_.load(std::memory_order_relaxed);
   if (stale) {
     // Unknown: harmless while the amplifier is off and not wanted; a fault otherwise.
@@ -188,7 +182,7 @@ void ModbusSupervisor::amplifier_thread() {
     temperature_c_.store(temp, std::memory_order_relaxed);
     {
       std::lock_guard<std::mutex> lock(m_);
-      last_ok_ns_.store(monotonic_ns(), std::memory_order_release);
+      last_ok_ns_.store(rt::monotonic_ns(), std::memory_order_release);
     }
     cv_.notify_all();
     ++amp_polls_;

@@ -1,16 +1,8 @@
 #include "drivers/sim_backend.hpp"
 
-#include <time.h>
+#include "rt/clock.hpp"
 
 namespace robodamp::drivers {
-
-namespace {
-double monotonic_s() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-}  // namespace
 
 void SimBackend::advance_to(std::uint64_t tick) noexcept {
   const sim::PlantCounters before = plant_.counters();
@@ -33,8 +25,8 @@ rt::SensorSample SimBackend::read(std::uint64_t tick) noexcept {
   const double t = plant_.time_s();
   auto& faults = plant_.faults();
   if (faults.active(sim::FaultKind::kDriverStall, t)) {  // a driver call that blocks: real time passes
-    const double until = monotonic_s() + faults.magnitude(sim::FaultKind::kDriverStall, t);
-    while (monotonic_s() < until) {
+    const double until = rt::monotonic_s() + faults.magnitude(sim::FaultKind::kDriverStall, t);
+    while (rt::monotonic_s() < until) {
     }
   }
   const sim::SensorReading r = plant_.sense();

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "config/config.hpp"
+#include "rt/clock.hpp"
 #include "rt/io.hpp"
 #include "rt/spsc_ring.hpp"
 #include "rt/supervisor.hpp"
@@ -74,6 +75,29 @@ class Loop {
   [[nodiscard]] config::ClockKind clock() const noexcept { return clock_; }
 
  private:
+  // One run's state between ticks (on the stack of run(); nothing allocated).
+  struct Run {
+    DeadlinePacer pacer;
+    std::uint64_t end_tick;
+    std::uint64_t tail_ticks;  // ticks after the end for the slowest ramp to finish
+    std::int64_t prev_wake_ns;
+    ActuatorStatus actuator{};
+    bool overrun{false};       // the previous tick's work ended past the next deadline
+    bool ending{false};
+    std::uint64_t ending_ticks{0};
+  };
+  struct Pace {
+    std::int64_t wake_ns{0}, latency_ns{0};
+    std::uint64_t missed{0};
+    double dt_s{0.0};
+  };
+  // The tick's stages, in order (all noexcept, allocation-free).
+  Pace pace(Run& r) noexcept;
+  [[nodiscard]] TickInput inputs(const Run& r, const Pace& p) noexcept;
+  [[nodiscard]] OperatorCommand next_command(Run& r) noexcept;
+  void account(Run& r, const Pace& p, const TickInput& in) noexcept;
+  void publish(const Pace& p, const TickInput& in, const TickOutput& out) noexcept;
+
   std::int64_t period_ns_;
   config::ClockKind clock_;
   Supervisor& sup_;
@@ -90,6 +114,7 @@ class Loop {
   TickPolicy* policy_{nullptr};
   std::unique_ptr<LoopStats> stats_;
   std::uint64_t tick_{0};
+  std::int64_t last_compute_ns_{0};  // the tick's compute time, for its frame
 };
 
 }  // namespace robodamp::rt
