@@ -13,12 +13,12 @@
 #include "filters/design.hpp"
 #include "filters/harmonic_notch.hpp"
 #include "sim_plant/state_space.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::analysis {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 using Eigen::MatrixXd;
 
 // Output of `first` feeds `second`.

@@ -4,12 +4,12 @@
 #include <cstdio>
 
 #include "analysis/loop_model.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::analysis {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 
 // Damping at each mode of the loop's own path: the feedback force against -velocity in (-90, 90) deg.
 std::vector<bool> damps(const LoopModel& m, const std::vector<double>& modes_hz, double gain, int polarity) {

@@ -9,6 +9,7 @@
 #include "config/number_range.hpp"
 #include "control/controller.hpp"
 #include "robot/robot_model.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::analysis {
 
@@ -57,7 +58,7 @@ PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<do
   double best = std::numeric_limits<double>::infinity();
   for (const robot::Mode& md : chain.modes(static_cast<std::size_t>(count))) {
     const double phi = md.tcp_shape(axis);
-    const double w = 2.0 * M_PI * md.freq_hz;
+    const double w = kTwoPi * md.freq_hz;
     if (!(std::abs(phi) > 0.0) || !(w > 0.0)) continue;  // a mode that does not move the TCP along the axis
     config::ModeConfig c;
     c.form = config::ModeForm::kStiffness;

@@ -1,4 +1,5 @@
 #include "analysis/spectral.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,7 @@ FrfAccumulator::FrfAccumulator(std::size_t segment_samples, double fs_hz, int ze
   bins_ = std::min(nfft_ / 2 + 1, static_cast<std::size_t>(std::floor(max_hz / (fs_hz / static_cast<double>(nfft_)))) + 1);
   window_.assign(n_, 1.0);
   if (window == Window::kHann)
-    for (std::size_t i = 0; i < n_; ++i) window_[i] = 0.5 - 0.5 * std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(n_));
+    for (std::size_t i = 0; i < n_; ++i) window_[i] = 0.5 - 0.5 * std::cos(kTwoPi * static_cast<double>(i) / static_cast<double>(n_));
   sxy_.assign(outputs, std::vector<std::complex<double>>(bins_, 0.0));
   sxx_.assign(bins_, 0.0);
   syy_.assign(outputs, std::vector<double>(bins_, 0.0));
@@ -76,7 +77,7 @@ FrfEstimate welch_frf(const std::vector<double>& x, const std::vector<double>& y
 
 void accelerance_to_receptance(FrfEstimate& e) {
   for (std::size_t k = 0; k < e.f_hz.size(); ++k) {
-    const double w = 2.0 * M_PI * e.f_hz[k];
+    const double w = kTwoPi * e.f_hz[k];
     e.h1[k] = w > 0.0 ? e.h1[k] / (-w * w) : 0.0;
   }
 }

@@ -1,5 +1,6 @@
 #include "drivers/modbus_supervisor.hpp"
 
+#include "drivers/modbus_codec.hpp"
 #include "rt/clock.hpp"
 
 #include <algorithm>
@@ -174,7 +175,7 @@ void ModbusSupervisor::amplifier_thread() {
       continue;
     }
     amp_link_.succeeded();
-    const double temp = static_cast<std::int16_t>(temp_raw) * r.temperature_c_per_count;
+    const double temp = modbus_codec::decode_temperature_c(temp_raw, r.temperature_c_per_count);
     enabled_.store(coil != 0, std::memory_order_relaxed);
     ready_.store(coil != 0 && inputs[static_cast<std::size_t>(r.ready_input - in_lo)] != 0, std::memory_order_relaxed);
     fault_.store(inputs[static_cast<std::size_t>(r.fault_input - in_lo)] != 0 || temp > r.temperature_max_c,
@@ -255,11 +256,9 @@ void ModbusSupervisor::robot_thread() {
 
 void ModbusSupervisor::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
   if (cfg_.robot.advice_register < 0 || !robot_link_) return;
-  auto count = [](double v) { return static_cast<std::uint16_t>(std::clamp(std::lround(v), 0L, 65535L)); };
+  const auto regs = modbus_codec::encode_advice(seq, found, rpm, margin, cfg_.robot.rpm_per_count);
   std::lock_guard<std::mutex> lock(m_);
-  advice_regs_ = {static_cast<std::uint16_t>(seq & 0xFFFFU), found ? count(rpm / cfg_.robot.rpm_per_count) : std::uint16_t{0},
-                  found && std::isfinite(margin) ? count(100.0 * margin) : static_cast<std::uint16_t>(found ? 65535 : 0),
-                  static_cast<std::uint16_t>(found ? 1 : 2)};
+  advice_regs_ = regs;
   advice_pending_ = true;
 }
 
@@ -282,8 +281,8 @@ bool ModbusSupervisor::poll_depth(modbus_t* ctx) {
   if (r.depth_register < 0) return true;
   std::uint16_t v = 0;
   if (modbus_read_registers(ctx, r.depth_register, 1, &v) != 1) return false;
-  const double mm = v == 65535 ? std::numeric_limits<double>::quiet_NaN() : v * r.depth_mm_per_count;
-  if (v == 65535) ++depth_unavailable_polls_;
+  const double mm = modbus_codec::decode_depth_mm(v, r.depth_mm_per_count);
+  if (v == modbus_codec::kDepthUnavailable) ++depth_unavailable_polls_;
   const double was = depth_mm_.exchange(mm);
   if (!(mm == was) && !(std::isnan(mm) && std::isnan(was))) {
     ++depth_changes_;
@@ -302,7 +301,7 @@ bool ModbusSupervisor::poll_spindle(modbus_t* ctx, SpindleWatch& w) {
   w.parked = false;
   w.same = static_cast<int>(v) == w.candidate ? w.same + 1 : 1;
   w.candidate = v;
-  const double rpm = v * r.rpm_per_count;
+  const double rpm = modbus_codec::decode_rpm(v, r.rpm_per_count);
   if (w.same >= r.settle_polls && rpm != w.rpm) {
     w.rpm = rpm;
     ++spindle_changes_;
@@ -335,9 +334,8 @@ bool ModbusSupervisor::poll_pose(modbus_t* ctx, PoseWatch& w) {
   std::vector<double> q(n);
   bool available = true;
   for (std::size_t i = 0; i < n; ++i) {
-    const auto count = static_cast<std::int16_t>(regs[i]);
-    if (count == INT16_MIN) available = false;
-    q[i] = count == INT16_MIN ? std::nan("") : count * r.deg_per_count;
+    q[i] = modbus_codec::decode_joint_deg(regs[i], r.deg_per_count);
+    if (std::isnan(q[i])) available = false;
   }
   {
     std::lock_guard lk(m_);

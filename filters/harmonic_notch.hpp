@@ -23,6 +23,7 @@
 #include <cstdint>
 
 #include "filters/biquad.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::filters {
 
@@ -111,7 +112,7 @@ class HarmonicNotchBank final {
   // Off the real-time path (or for reports): the bank's response at f with its current centre and fades.
   [[nodiscard]] std::complex<double> response(double f_hz) const {
     if (!s_.enabled) return 1.0;
-    const std::complex<double> z1 = std::polar(1.0, -2.0 * M_PI * f_hz / fs_hz_);
+    const std::complex<double> z1 = std::polar(1.0, -kTwoPi * f_hz / fs_hz_);
     std::complex<double> h = 1.0;
     for (std::size_t k = 0; k < static_cast<std::size_t>(s_.harmonics); ++k) {
       if (gain_[k] == 0.0) continue;

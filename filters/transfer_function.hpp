@@ -5,10 +5,10 @@
 #include <string>
 
 #include "filters/polynomial.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::filters {
 
-inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 inline double hz_to_rad_per_s(double f_hz) { return kTwoPi * f_hz; }
 
 // H(s) = num(s) / den(s), real coefficients.
@@ -49,6 +49,14 @@ TransferFunction notch(double center_hz, double bandwidth_hz);
 TransferFunction integrator(double leak_hz = 0.0);
 // Eq. 3 without its delay: T s^2 / (s^2 + 2 z_a w_a s + w_a^2), newtons per volt.
 TransferFunction actuator(double constant_n_per_v, double natural_freq_hz, double damping_ratio);
+// Eq. 3 at one frequency with its delay, T s^2 e^(-s delay) / (s^2 + 2 z_a w_a s + w_a^2), newtons per
+// volt: the one evaluation the simulated plant, the loop analysis and the actuator's identification use.
+[[nodiscard]] inline std::complex<double> actuator_n_per_v(double f_hz, double constant_n_per_v, double natural_freq_hz,
+                                                           double damping_ratio, double delay_s) {
+  const std::complex<double> s(0.0, kTwoPi * f_hz);
+  const double wa = kTwoPi * natural_freq_hz;
+  return constant_n_per_v * s * s * std::exp(-s * delay_s) / (s * s + 2.0 * damping_ratio * wa * s + wa * wa);
+}
 // Eq. 4 with the correction of REFERENCE.md: numerator = the actuator denominator; denominator
 // s^2 + 2 z_c w_c s + w_c^2 with w_c = 2 pi corner_hz. The paper's -75.44 deg at 9.2 Hz needs z_c = 1.
 TransferFunction compensator_c1(double actuator_freq_hz, double actuator_damping_ratio,

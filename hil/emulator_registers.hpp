@@ -14,9 +14,12 @@
 #include <vector>
 
 #include "config/config.hpp"
+#include "drivers/modbus_codec.hpp"
 #include "drivers/modbus_server.hpp"
 
 namespace robodamp::hil {
+
+namespace modbus_codec = drivers::modbus_codec;
 
 // The amplifier and the robot controller on Modbus: one server per distinct TCP port.
 class EmulatorRegisters {
@@ -35,14 +38,12 @@ class EmulatorRegisters {
   [[nodiscard]] bool enable() const { return amp_->coil(m_.amplifier.enable_coil); }
   void set_spindle_rpm(double rpm) {
     if (m_.robot_link && m_.robot.spindle_rpm_register >= 0)
-      robot_->set_holding_register(m_.robot.spindle_rpm_register,
-                                   static_cast<std::uint16_t>(std::clamp(std::lround(rpm / m_.robot.rpm_per_count), 0L, 65535L)));
+      robot_->set_holding_register(m_.robot.spindle_rpm_register, modbus_codec::encode_rpm(rpm, m_.robot.rpm_per_count));
   }
   // The depth the robot program cuts: unsigned counts of depth_mm_per_count; 65535 = not available.
   void set_depth_mm(double mm) {
     if (!m_.robot_link || m_.robot.depth_register < 0) return;
-    const double counts = std::isfinite(mm) ? std::clamp(std::round(mm / m_.robot.depth_mm_per_count), 0.0, 65534.0) : 65535.0;
-    robot_->set_holding_register(m_.robot.depth_register, static_cast<std::uint16_t>(counts));
+    robot_->set_holding_register(m_.robot.depth_register, modbus_codec::encode_depth_mm(mm, m_.robot.depth_mm_per_count));
   }
   // The advice block robodamp run writes (modbus.robot.advice_register): seq, rpm counts, margin x 100,
   // status; nothing without the block.
@@ -55,8 +56,8 @@ class EmulatorRegisters {
   [[nodiscard]] double rpm_per_count() const { return m_.robot.rpm_per_count; }
   void set_ready(bool on) { amp_->set_discrete_input(m_.amplifier.ready_input, on); }
   void set_temperature(double c) {
-    const double counts = std::clamp(std::round(c / m_.amplifier.temperature_c_per_count), -32768.0, 32767.0);
-    amp_->set_input_register(m_.amplifier.temperature_register, static_cast<std::uint16_t>(static_cast<std::int16_t>(counts)));
+    amp_->set_input_register(m_.amplifier.temperature_register,
+                             modbus_codec::encode_temperature_c(c, m_.amplifier.temperature_c_per_count));
   }
   void set_mounting(config::Mounting m) {
     if (m_.robot_link)
@@ -67,11 +68,9 @@ class EmulatorRegisters {
   // The joint angles in the robot's registers: signed counts of deg_per_count; -32768 = not available.
   void set_joints(const std::vector<double>& q) {
     if (!m_.robot_link || m_.robot.joints_register < 0) return;
-    for (std::size_t i = 0; i < q.size(); ++i) {
-      const double counts = std::isfinite(q[i]) ? std::clamp(std::round(q[i] / m_.robot.deg_per_count), -32767.0, 32767.0) : -32768.0;
+    for (std::size_t i = 0; i < q.size(); ++i)
       robot_->set_holding_register(m_.robot.joints_register + static_cast<int>(i),
-                                   static_cast<std::uint16_t>(static_cast<std::int16_t>(counts)));
-    }
+                                   modbus_codec::encode_joint_deg(q[i], m_.robot.deg_per_count));
   }
   void hang() {
     amp_->set_responding(false);

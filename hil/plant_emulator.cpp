@@ -284,7 +284,8 @@ void PlantEmulator::read_advice(double t) {
   const auto a = regs_.advice();
   if (!a || (*a)[0] == advice_seq_ || ((*a)[0] == 0 && (*a)[3] == 0)) return;  // none, or no new one
   advice_seq_ = (*a)[0];
-  AdviceSeen seen{t, advice_seq_, (*a)[3], (*a)[1] * regs_.rpm_per_count(), (*a)[2] / 100.0, {}};
+  const drivers::modbus_codec::Advice d = drivers::modbus_codec::decode_advice(*a, regs_.rpm_per_count());
+  AdviceSeen seen{t, advice_seq_, static_cast<int>(d.status), d.rpm, d.margin, {}};
   if (seen.status == 2) seen.action = "kept the speed: no stable speed";
   else if (seen.status != 1) seen.action = "refused: status " + std::to_string(seen.status) + " (allowed 1 or 2)";
   else if (!(seen.rpm > 0.0) || seen.rpm > cfg_.spindle.rpm_max)

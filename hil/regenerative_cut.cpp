@@ -10,6 +10,7 @@
 #include "milling/damped_dynamics.hpp"
 #include "milling/structure.hpp"
 #include "config/number_range.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::hil {
 
@@ -28,7 +29,7 @@ void remove_tones(std::vector<double>& x, std::size_t start, double fs, const st
   const auto m = static_cast<Eigen::Index>(2 * freqs_hz.size());
   if (freqs_hz.empty() || x.size() <= start + static_cast<std::size_t>(4 * m)) return;
   std::vector<std::complex<double>> rot, ph(freqs_hz.size(), 1.0);
-  for (const double f : freqs_hz) rot.push_back(std::polar(1.0, 2.0 * M_PI * f / fs));
+  for (const double f : freqs_hz) rot.push_back(std::polar(1.0, kTwoPi * f / fs));
   Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(m, m);
   Eigen::VectorXd atb = Eigen::VectorXd::Zero(m), row(m);
   auto next_row = [&](std::size_t i) {

@@ -10,12 +10,12 @@
 
 #include "analysis/loop_model.hpp"
 #include "sim_plant/sensor.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::identify {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 constexpr std::size_t kMaxPoints = 160;  // the points matched (evenly thinned from the continuous fit's)
 constexpr int kIntervalsBelow = 8;       // sample intervals tried below the continuous fit's delay
 
@@ -136,7 +136,7 @@ ActuatorFit refine_actuator_discrete(const ActuatorFit& start, const analysis::F
     while (k + 1 < fa.size() && std::abs(fa[k + 1] - out.f_hz[i]) <= std::abs(fa[k] - out.f_hz[i])) ++k;  // nearest bin
     const bool found = !fa.empty() && std::abs(accel_per_volt.h1[k]) > 0.0;
     out.fitted[i] = found ? out.measured[i] / accel_per_volt.h1[k] * recorded(m, sensor, fa[k])
-                          : actuator_n_per_v(out.f_hz[i], out.force_constant_n_per_v, out.natural_freq_hz,
+                          : filters::actuator_n_per_v(out.f_hz[i], out.force_constant_n_per_v, out.natural_freq_hz,
                                              out.damping_ratio, out.delay_ms * 1e-3);
   }
   return out;

@@ -1,4 +1,5 @@
 #include "identify/actuator_fit.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +12,6 @@ namespace robodamp::identify {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 constexpr int kMinPoints = 8;
 constexpr double kDelayGridS = 1e-5;
 
@@ -54,12 +54,6 @@ Trial solve_at(const std::vector<Point>& pts, double tau) {
 }
 
 }  // namespace
-
-Complex actuator_n_per_v(double f_hz, double t_n_per_v, double fn_hz, double zeta, double delay_s) {
-  const Complex s(0.0, kTwoPi * f_hz);
-  const double wa = kTwoPi * fn_hz;
-  return t_n_per_v * s * s * std::exp(-s * delay_s) / (s * s + 2.0 * zeta * wa * s + wa * wa);
-}
 
 ActuatorFit fit_actuator(const ActuatorFrf& frf, const ActuatorFitSettings& s) {
   std::vector<Point> pts;
@@ -108,7 +102,7 @@ ActuatorFit fit_actuator(const ActuatorFrf& frf, const ActuatorFitSettings& s) {
   double err = 0.0, ref = 0.0;
   for (const Point& p : pts) {
     const double f = p.w / kTwoPi;
-    const Complex m = actuator_n_per_v(f, fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, best.tau);
+    const Complex m = filters::actuator_n_per_v(f, fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, best.tau);
     fit.f_hz.push_back(f), fit.measured.push_back(p.g), fit.fitted.push_back(m);
     err += std::norm(m - p.g), ref += std::norm(p.g);
   }

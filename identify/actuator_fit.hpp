@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "analysis/spectral.hpp"
+#include "filters/transfer_function.hpp"
 
 namespace robodamp::identify {
 
@@ -46,9 +47,6 @@ struct ActuatorFit {
 // Throws std::invalid_argument: too few coherent points in the band, non-finite data, or no physical
 // (positive stiffness and damping) fit.
 [[nodiscard]] ActuatorFit fit_actuator(const ActuatorFrf& frf, const ActuatorFitSettings& s);
-
-// Eq. 3 at f.
-[[nodiscard]] Complex actuator_n_per_v(double f_hz, double t_n_per_v, double fn_hz, double zeta, double delay_s);
 
 // Periodic excitation: the H1 FRF (output per input) and coherence over whole periods of period_n
 // samples starting at `first` (rectangular window: a periodic steady state has no leakage).

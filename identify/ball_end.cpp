@@ -8,6 +8,7 @@
 
 #include "identify/numeric_csv.hpp"
 #include "identify/regression.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::identify {
 
@@ -23,7 +24,7 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> regressors(const BallEndTest& t, double
   const double kmax = std::acos(1.0 - a_mm / r0);
   const int p = t.order + 1;
   Eigen::Matrix<double, 3, Eigen::Dynamic> m = Eigen::MatrixXd::Zero(3, 3 * p + 3);
-  const double dk = kmax / kKappaPoints, scale = t.teeth / (2.0 * M_PI);
+  const double dk = kmax / kKappaPoints, scale = t.teeth / (kTwoPi);
   for (int i = 0; i < kKappaPoints; ++i) {
     const double k = (i + 0.5) * dk, sk = std::sin(k), ck = std::cos(k);
     const double shear = c_mm * sk * r0 * dk * scale;                                       // h db / sin(psi)

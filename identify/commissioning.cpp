@@ -15,6 +15,7 @@
 #include "identify/actuator_discrete.hpp"
 #include "rt/recording.hpp"
 #include "sim_plant/sensor.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::identify {
 
@@ -23,7 +24,6 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 
 std::string frf_name(const config::Config& cfg, int g, int h) {
   for (const auto& f : cfg.robot.frfs)

@@ -14,7 +14,6 @@ namespace robodamp::identify {
 
 namespace {
 
-using detail::kTwoPi;
 using detail::Pole;
 
 constexpr std::size_t kMaxPointsPerFrf = 500;  // the poles' least squares, thinned evenly

@@ -9,6 +9,7 @@
 
 #include "identify/numeric_csv.hpp"
 #include "milling/cutting.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::identify {
 
@@ -41,7 +42,7 @@ void check_test(const CuttingTest& t) {
 MeanForces mean_forces(const CuttingTest& t, double c, double ktc, double krc, double kac, double kte, double kre,
                        double kae) {
   const Integrals i = integrals(t);
-  const double k = t.teeth * t.axial_mm / (2.0 * M_PI);
+  const double k = t.teeth * t.axial_mm / (kTwoPi);
   return {c, k * (-ktc * c * i.sc - krc * c * i.ss - kte * i.c - kre * i.s),
           k * (ktc * c * i.ss - krc * c * i.sc + kte * i.s - kre * i.c), k * (kac * c * i.s + kae * i.width)};
 }
@@ -59,7 +60,7 @@ CuttingFit identify_cutting(const std::vector<MeanForces>& samples, const Cuttin
     if (!(s.feed_per_tooth_mm > 0.0)) throw std::invalid_argument("row " + std::to_string(r + 1) + ": feed per tooth must be > 0 mm");
   }
   const Integrals i = integrals(t);
-  const double k = t.teeth * t.axial_mm / (2.0 * M_PI);
+  const double k = t.teeth * t.axial_mm / (kTwoPi);
   // x and y rows: unknowns [Ktc, Krc, Kte, Kre]; z rows: [Kac, Kae].
   Eigen::MatrixXd xy(2 * n, 4), z(n, 2);
   Eigen::VectorXd fxy(2 * n), fz(n);

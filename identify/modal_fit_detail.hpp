@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "identify/modal_fit.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::identify::detail {
 
-inline constexpr double kTwoPi = 2.0 * M_PI;
 
 struct Pole {
   Complex s;  // rad/s

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "analysis/fft.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::milling {
 
@@ -113,7 +114,7 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
     // (a large transient of a slow mode elsewhere in the spectrum is not one of them).
     if (std::abs(o.root) > 0.0) {
       const double fp = fs / static_cast<double>(period), df = fs / static_cast<double>(whole);
-      const double alias_hz = std::abs(std::arg(o.root)) / (2.0 * M_PI) * fp;
+      const double alias_hz = std::abs(std::arg(o.root)) / (kTwoPi) * fp;
       double best_candidate = -1.0;
       for (std::size_t k = 0; (static_cast<double>(k) + 1.0) * fp <= 0.5 * fs; ++k)
         for (const double f : {static_cast<double>(k) * fp + alias_hz, static_cast<double>(k + 1) * fp - alias_hz}) {

@@ -6,6 +6,7 @@
 #include "config/milling_config.hpp"
 
 #include "analysis/fft.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::milling {
 
@@ -111,7 +112,7 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
   double* in = fft_->input();
   for (std::size_t i = 0; i < n; ++i)
-    in[i] = window_[i] * (0.5 - 0.5 * std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(n)));
+    in[i] = window_[i] * (0.5 - 0.5 * std::cos(kTwoPi * static_cast<double>(i) / static_cast<double>(n)));
   const std::complex<double>* X = fft_->forward();
   const double df = fs_ / static_cast<double>(n);
   // The share by displacement (each line's energy / f^2): the accelerometer weights the tooth-passing

@@ -5,6 +5,7 @@
 
 #include "config/number_range.hpp"
 #include "milling/damped_dynamics.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::milling {
 
@@ -20,7 +21,7 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   if (j.terms.empty())
     problems.push_back({cfg.source, {}, "structures." + structure.name(),
                         "structures." + structure.name() + " has no modes to simulate"});
-  for (const auto& t : j.terms) j.highest_mode_hz = std::max(j.highest_mode_hz, t.wn_rad_per_s / (2.0 * M_PI));
+  for (const auto& t : j.terms) j.highest_mode_hz = std::max(j.highest_mode_hz, t.wn_rad_per_s / (kTwoPi));
   const config::TimeDomainConfig& td = cfg.time_domain;
   CutSettings& s = j.settings;
   s.rpm = o.rpm.value_or(cfg.cut.spindle_rpm);

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "milling/cut_simulation.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::milling {
 
@@ -16,24 +17,24 @@ CutProcess::CutProcess(const Cutter& cutter, const config::MaterialConfig& mat, 
   bins_ = static_cast<std::size_t>(n) * static_cast<std::size_t>(m);
   step_s_ = 60.0 / (s.rpm * n) / m;
   wall_angle_rad_ = surface_angle_rad(s.cut.mode);
-  const double dphi = 2.0 * M_PI / static_cast<double>(bins_);
+  const double dphi = kTwoPi / static_cast<double>(bins_);
   for (const Slice& g : slices(cutter, s.cut.axial_mm, s.axial_slices)) {
     SliceState st;
     st.z_m = g.z_mm * 1e-3, st.height_m = g.height_mm * 1e-3, st.radius_m = g.radius_mm * 1e-3;
     st.lag_rad = g.lag_rad;
     st.sk = std::sin(g.kappa_rad);
-    const double local_radial = s.cut.radial_mm - (cutter.radius_mm - g.radius_mm);
+    const double local_radial = slice_radial_mm(cutter, g, s.cut.radial_mm);
     const bool engaged_anywhere = local_radial > 0.0;
     const Engagement e = engagement(g.radius_mm, std::max(local_radial, 0.0), s.cut.mode);
     st.sin_phi.resize(bins_), st.cos_phi.resize(bins_), st.weight.resize(bins_), st.in_material.resize(bins_);
     // Bin i is the step over which the edge goes from i dphi - lag to (i + 1) dphi - lag.
     for (std::size_t i = 0; i < bins_; ++i) {
-      double a = std::fmod(static_cast<double>(i) * dphi - g.lag_rad, 2.0 * M_PI);
-      if (a < 0.0) a += 2.0 * M_PI;
+      double a = std::fmod(static_cast<double>(i) * dphi - g.lag_rad, kTwoPi);
+      if (a < 0.0) a += kTwoPi;
       const double mid = a + 0.5 * dphi;
       st.sin_phi[i] = std::sin(mid), st.cos_phi[i] = std::cos(mid);
       double inside = 0.0;
-      for (double turn : {0.0, 2.0 * M_PI})
+      for (double turn : {0.0, kTwoPi})
         inside += std::max(0.0, std::min(a + dphi, e.exit_rad + turn) - std::max(a, e.start_rad + turn));
       st.weight[i] = engaged_anywhere ? inside / dphi : 0.0;
       st.in_material[i] = st.weight[i] > 1e-12;
@@ -42,7 +43,7 @@ CutProcess::CutProcess(const Cutter& cutter, const config::MaterialConfig& mat, 
     st.surface_feed_m.assign(bins_, 0.0);
     st.cut_before.assign(bins_, 0);
     // The step in which the edge passes the surface-generating angle (pi down, 0 up milling), and where.
-    double pos = std::fmod(wall_angle_rad_ + g.lag_rad, 2.0 * M_PI) / dphi;
+    double pos = std::fmod(wall_angle_rad_ + g.lag_rad, kTwoPi) / dphi;
     if (s.cut.mode == config::MillingMode::kDown) pos -= 1e-9;  // the step that ends at pi, not the next
     const double whole = std::floor(pos);
     st.wall_bin = static_cast<std::size_t>(whole + static_cast<double>(bins_)) % bins_;
@@ -140,7 +141,7 @@ std::size_t CutProcess::continue_from(const CutProcess& before, std::size_t step
   feed_origin_m_ = before.feed_at_m(static_cast<double>(steps));
   first_step_ = k;
   const double depth_before_m = before.slices_.empty() ? 0.0 : before.slices_.back().z_m + 0.5 * before.slices_.back().height_m;
-  const double dphi = 2.0 * M_PI / static_cast<double>(bins_), dphi_before = 2.0 * M_PI / static_cast<double>(before.bins_);
+  const double dphi = kTwoPi / static_cast<double>(bins_), dphi_before = kTwoPi / static_cast<double>(before.bins_);
   for (SliceState& st : slices_) {
     std::fill(st.cut_before.begin(), st.cut_before.end(), 0);
     if (st.z_m >= depth_before_m) continue;  // fresh material: no pass cut here yet

@@ -1,4 +1,5 @@
 #include "milling/cutting.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -86,9 +87,7 @@ ForceSpectrum force_spectrum(const Cutter& c, const config::MaterialConfig& mat,
   const int n = c.teeth;
   const Complex i(0.0, 1.0);
   for (const Slice& s : slices(c, cut.axial_mm, axial_slices)) {
-    // The wall's edge is at R - radial from the axis on the engaged side; a slice of smaller radius (ball
-    // end) engages what lies beyond it.
-    const double local_radial = cut.radial_mm - (c.radius_mm - s.radius_mm);
+    const double local_radial = slice_radial_mm(c, s, cut.radial_mm);
     if (local_radial <= 0.0) continue;
     const Engagement e = engagement(s.radius_mm, local_radial, cut.mode);
     const double sk = std::sin(s.kappa_rad);
@@ -110,7 +109,7 @@ ForceSpectrum force_spectrum(const Cutter& c, const config::MaterialConfig& mat,
         sx += ex[static_cast<std::size_t>(m + 2)] * integral;
         sy += ey[static_cast<std::size_t>(m + 2)] * integral;
       }
-      const double scale = n / (2.0 * M_PI);
+      const double scale = n / (kTwoPi);
       out.fx[static_cast<std::size_t>(k)] += scale * sx * shift;
       out.fy[static_cast<std::size_t>(k)] += scale * sy * shift;
     }

@@ -70,5 +70,11 @@ struct Slice {
   double lag_rad{0.0};
 };
 [[nodiscard]] std::vector<Slice> slices(const Cutter& cutter, double axial_mm, int count);
+// A slice's own radial depth of cut: the wall's edge is at R - radial from the axis on the engaged side,
+// so a slice of smaller radius (a ball end's) engages only what lies beyond it; <= 0: the slice is not in
+// the cut. The one rule the force spectrum, the SDM, the time-domain cut and the SLE use.
+[[nodiscard]] inline double slice_radial_mm(const Cutter& cutter, const Slice& s, double radial_mm) {
+  return radial_mm - (cutter.radius_mm - s.radius_mm);
+}
 
 }  // namespace robodamp::milling

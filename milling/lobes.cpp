@@ -1,4 +1,5 @@
 #include "milling/lobes.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@ namespace robodamp::milling {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Eigenvalues of a 2x2 complex matrix, closed form.

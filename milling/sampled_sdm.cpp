@@ -10,6 +10,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "milling/tool_dynamics.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::milling {
 
@@ -121,7 +122,7 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
   for (Eigen::Index i = 0; i < poles.size(); ++i) {
     if (poles(i).imag() <= 0.0 || std::abs(poles(i)) < 1e-3) continue;
     const std::complex<double> sp = std::log(poles(i)) / tick_s_;
-    const double f = std::abs(sp) / (2.0 * M_PI), zeta = -sp.real() / std::abs(sp);
+    const double f = std::abs(sp) / (kTwoPi), zeta = -sp.real() / std::abs(sp);
     if (zeta >= 0.3) continue;
     s.highest_mode_hz = std::max(s.highest_mode_hz, f);
   }
@@ -132,7 +133,7 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int
   const Eigen::Index n = sys.a.rows();
   const double period_s = ticks * tick_s_;
   const int k = std::min(ticks, std::max(settings_.min_grid_per_period,
-                                         static_cast<int>(std::ceil(2.0 * M_PI * sys.highest_mode_hz * period_s /
+                                         static_cast<int>(std::ceil(kTwoPi * sys.highest_mode_hz * period_s /
                                                                     settings_.max_grid_phase_rad))));
   const Eigen::Index dim = n + 2 * (k + 1);
   Result res;
@@ -144,7 +145,7 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int
   };
   // The directional matrix per tick at this depth.
   const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, settings_.axial_slices, axial_mm);
-  const double dphi = 2.0 * M_PI / (cutter_.teeth * ticks);
+  const double dphi = kTwoPi / (cutter_.teeth * ticks);
   const int sub = std::max(2, static_cast<int>(std::ceil(400.0 / ticks)));
   std::map<int, MatrixXd> powers;
   auto power = [&](int m) -> const MatrixXd& {

@@ -1,4 +1,5 @@
 #include "milling/sdm.hpp"
+#include "units/units.hpp"
 
 #include <cmath>
 #include <limits>
@@ -21,7 +22,7 @@ DirectionalMatrix::DirectionalMatrix(const Cutter& cutter, const config::Materia
                                      config::MillingMode mode, double radial_mm, int axial_slices, double axial_mm)
     : teeth_(cutter.teeth), kt_(material.kt_n_per_mm2 * 1e6), kr_(material.kr_n_per_mm2 * 1e6) {
   for (const Slice& s : slices(cutter, axial_mm, axial_slices)) {
-    const double local_radial = radial_mm - (cutter.radius_mm - s.radius_mm);
+    const double local_radial = slice_radial_mm(cutter, s, radial_mm);
     if (local_radial > 0.0) slices_.push_back({s, engagement(s.radius_mm, local_radial, mode)});
   }
 }
@@ -35,8 +36,8 @@ Eigen::Matrix2d DirectionalMatrix::mean(double phi0, double dphi, int sub) const
     for (int i = 0; i < sub; ++i) {
       const double spindle = phi0 + (i + 0.5) / sub * dphi;
       for (int j = 0; j < teeth_; ++j) {
-        double phi = std::fmod(spindle + 2.0 * M_PI * j / teeth_ - s.lag_rad, 2.0 * M_PI);
-        if (phi < 0.0) phi += 2.0 * M_PI;
+        double phi = std::fmod(spindle + kTwoPi * j / teeth_ - s.lag_rad, kTwoPi);
+        if (phi < 0.0) phi += kTwoPi;
         if (phi < e.start_rad || phi > e.exit_rad) continue;
         const double sp = std::sin(phi), cp = std::cos(phi);
         const Eigen::Vector2d force(-kt_ * cp - kr_ * sk * sp, kt_ * sp - kr_ * sk * cp);
@@ -57,11 +58,11 @@ double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t,
   for (int m = -k / 2; m <= k / 2; ++m) {
     std::complex<double> cx = 0.0, cy = 0.0;
     for (int q = 0; q < k; ++q) {
-      const std::complex<double> w = std::exp(-t[static_cast<std::size_t>(q)] * log_mu - 2.0 * M_PI * i * static_cast<double>(m) * t[static_cast<std::size_t>(q)]);
+      const std::complex<double> w = std::exp(-t[static_cast<std::size_t>(q)] * log_mu - kTwoPi * i * static_cast<double>(m) * t[static_cast<std::size_t>(q)]);
       cx += w * history(2 * q), cy += w * history(2 * q + 1);
     }
     const double energy = std::norm(cx) + std::norm(cy);
-    if (energy > best_energy) best_energy = energy, best_hz = std::abs((log_mu.imag() / (2.0 * M_PI) + m) * tooth_hz);
+    if (energy > best_energy) best_energy = energy, best_hz = std::abs((log_mu.imag() / (kTwoPi) + m) * tooth_hz);
   }
   return best_hz;
 }
@@ -72,7 +73,7 @@ std::complex<double> SdmModel::multiplier(double axial_mm, double rpm, double* c
   Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d);
   Eigen::MatrixXd big = Eigen::MatrixXd::Zero(n + 4, n + 4);
   const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, slices_, axial_mm);
-  const double dphi = 2.0 * M_PI / (cutter_.teeth * m_);  // spindle angle per interval
+  const double dphi = kTwoPi / (cutter_.teeth * m_);  // spindle angle per interval
   constexpr int kSub = 8;
   for (int i = 0; i < m_; ++i) {
     const Eigen::Matrix2d mi = directional.mean(i * dphi, dphi, kSub);

@@ -26,7 +26,7 @@ SleResult surface_location_error(const Structure& structure, const Cutter& cutte
   r.max_um = -1e300;
   double sum = 0.0;
   for (const Slice& s : slices(cutter, cut.axial_mm, axial_slices)) {
-    if (cut.radial_mm - (cutter.radius_mm - s.radius_mm) <= 0.0) continue;  // a ball end's tip below the cut
+    if (slice_radial_mm(cutter, s, cut.radial_mm) <= 0.0) continue;  // a ball end's tip below the cut
     // The slice's edge is at the surface angle at t = (phi_surface + lag) / Omega: tooth phase N (phi + lag).
     const double phase = cutter.teeth * (phi_surface + s.lag_rad);
     double y_m = (g_nx[0] * f.fx[0] + g_ny[0] * f.fy[0]).real();

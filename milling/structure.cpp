@@ -2,6 +2,7 @@
 #include "milling/structure.hpp"
 
 #include "robot/robot_model.hpp"
+#include "units/units.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -88,7 +89,7 @@ void Structure::add_controller(const std::string& part, const std::string& sourc
     for (const auto& z : model->closed_loop_poles(c.gain_ns_per_m, c.polarity)) {
       if (std::abs(z) < 1e-12) continue;
       const std::complex<double> s = std::log(z) * fs;
-      const double f = std::abs(s.imag()) / (2.0 * M_PI);
+      const double f = std::abs(s.imag()) / (kTwoPi);
       if (f > 0.5 && f < 0.5 * fs) resonances_.push_back({f, std::max(1e-4, -s.real() / std::abs(s))});
     }
     os << ", closed loop at K = " << c.gain_ns_per_m << " N s/m, polarity " << c.polarity

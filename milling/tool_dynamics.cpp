@@ -6,6 +6,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "modal/receptance.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::milling {
 
@@ -24,14 +25,14 @@ std::vector<CutterModalTerm> cutter_modal_terms(const Structure& structure, conf
   for (int k = 0; k < 4; ++k)
     for (const auto& mode : modal[static_cast<std::size_t>(k)].modes) {
       const modal::ModeNumerator n = modal::mode_numerator(mode);
-      add(out, k / 2, k % 2, 2.0 * M_PI * mode.natural_freq_hz, mode.damping_ratio, n.a, n.b);
+      add(out, k / 2, k % 2, kTwoPi * mode.natural_freq_hz, mode.damping_ratio, n.a, n.b);
     }
   // A robot model at a pose: mode r contributes phi_r phi_e / (s^2 + 2 zeta w s + w^2) to H_re, with the
   // mass-normalised TCP shape phi (docs/pose_dynamics.md).
   constexpr double kMinZeta = 1e-9;  // the links have no damping of their own
   for (const auto& chain : structure.pose_chains())
     for (const auto& md : chain->modes(Structure::kPoseModesForCut)) {
-      const double wn = 2.0 * M_PI * md.freq_hz, zeta = std::max(kMinZeta, 0.5 * md.loss_factor);
+      const double wn = kTwoPi * md.freq_hz, zeta = std::max(kMinZeta, 0.5 * md.loss_factor);
       for (int r = 0; r < 2; ++r)
         for (int e = 0; e < 2; ++e)
           if (const double a = md.tcp_shape(r) * md.tcp_shape(e); a != 0.0 && wn > 0.0) add(out, r, e, wn, zeta, a, 0.0);
@@ -79,7 +80,7 @@ ToolDynamics::ToolDynamics(const std::vector<CutterModalTerm>& terms, double ste
     const Eigen::Matrix4d e = (big * step_s).exp();
     const Eigen::Vector2d held = e.block(0, 2, 2, 1), ramp = e.block(0, 3, 2, 1) / step_s;
     blocks_.push_back({e.topLeftCorner(2, 2), held, ramp, keys[k].excitation});
-    highest_hz_ = std::max(highest_hz_, keys[k].wn / (2.0 * M_PI));
+    highest_hz_ = std::max(highest_hz_, keys[k].wn / (kTwoPi));
   }
   for (std::size_t t = 0; t < terms.size(); ++t) {
     const std::size_t k = block_of[t];

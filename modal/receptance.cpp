@@ -1,23 +1,24 @@
 #include "modal/receptance.hpp"
+#include "units/units.hpp"
 
 #include <cmath>
 
 namespace robodamp::modal {
 
 ModeNumerator mode_numerator(const config::ModeConfig& m) {
-  const double wn = 2.0 * M_PI * m.natural_freq_hz;
+  const double wn = kTwoPi * m.natural_freq_hz;
   if (m.form == config::ModeForm::kStiffness) return {wn * wn / m.stiffness_n_per_m, 0.0};
   const double wd = wn * std::sqrt(1.0 - m.damping_ratio * m.damping_ratio);
   return {2.0 * (m.damping_ratio * wn * m.residue_re_m_per_n - wd * m.residue_im_m_per_n), 2.0 * m.residue_re_m_per_n};
 }
 
 std::complex<double> frf_receptance(const config::FrfConfig& f, double f_hz) {
-  const std::complex<double> s(0.0, 2.0 * M_PI * f_hz);
+  const std::complex<double> s(0.0, kTwoPi * f_hz);
   std::complex<double> h(0.0);
   for (const auto& m : f.modes) {
-    const double wn = 2.0 * M_PI * m.natural_freq_hz;
+    const double wn = kTwoPi * m.natural_freq_hz;
     const ModeNumerator n = mode_numerator(m);
-    h += (n.a + n.b * s) / (s * s + 2.0 * m.damping_ratio * wn * s + wn * wn);
+    h += mode_receptance(n.a, n.b, m.damping_ratio, wn, s);
   }
   return h;
 }

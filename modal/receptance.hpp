@@ -18,6 +18,12 @@ struct ModeNumerator {
   double b{0.0};  // m/N * rad/s
 };
 [[nodiscard]] ModeNumerator mode_numerator(const config::ModeConfig& m);
+// Eq. 1, one mode's receptance at s from its numerator: (a + b s) / (s^2 + 2 zeta wn s + wn^2), m/N. The
+// one evaluation of a mode: the FRF paths here and the simulated plant's use it.
+[[nodiscard]] inline std::complex<double> mode_receptance(double a, double b, double zeta, double wn_rad_per_s,
+                                                          std::complex<double> s) {
+  return (a + b * s) / (s * s + 2.0 * zeta * wn_rad_per_s * s + wn_rad_per_s * wn_rad_per_s);
+}
 // Receptance of one FRF path at f_hz, tabulated frame (no axis sign), m/N.
 [[nodiscard]] std::complex<double> frf_receptance(const config::FrfConfig& f, double f_hz);
 

@@ -1,4 +1,5 @@
 #include "robot/planar_chain.hpp"
+#include "units/units.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -151,7 +152,7 @@ std::vector<Mode> PlanarChain::modes(std::size_t count) const {
   for (Eigen::Index i = 0; i < es.eigenvalues().size() && out.size() < count; ++i) {
     Mode md;
     const double w2 = std::max(0.0, es.eigenvalues()(i));
-    md.freq_hz = std::sqrt(w2) / (2.0 * M_PI);
+    md.freq_hz = std::sqrt(w2) / (kTwoPi);
     md.shape = es.eigenvectors().col(i);
     const Eigen::Vector2d tcp(md.shape(tcp_x_), md.shape(tcp_x_ + 1));
     md.tcp_direction_rad = std::atan2(tcp.y(), tcp.x());
@@ -165,7 +166,7 @@ std::vector<Mode> PlanarChain::modes(std::size_t count) const {
 }
 
 Eigen::Matrix2cd PlanarChain::tcp_frf_direct(double f_hz) const {
-  const double w = 2.0 * M_PI * f_hz;
+  const double w = kTwoPi * f_hz;
   const Eigen::MatrixXcd d = k_ - (w * w) * m_mass_.cast<Complex>();
   Eigen::MatrixXcd rhs = Eigen::MatrixXcd::Zero(d.rows(), 2);
   rhs(tcp_x_, 0) = 1.0, rhs(tcp_x_ + 1, 1) = 1.0;
@@ -194,7 +195,7 @@ Eigen::MatrixXcd PlanarChain::link_dynamic_stiffness(std::size_t i, double w) co
 }
 
 Eigen::Matrix2cd PlanarChain::tcp_frf_rcsa(double f_hz) const {
-  const double w = 2.0 * M_PI * f_hz;
+  const double w = kTwoPi * f_hz;
   Eigen::Matrix3cd g_end = Eigen::Matrix3cd::Zero();  // the assembly so far, at its free end (x, y, th)
   for (std::size_t i = 0; i < m_.links.size(); ++i) {
     // The link's free-free receptances at its two ends (s = start, e = end).

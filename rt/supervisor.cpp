@@ -1,4 +1,5 @@
 #include "rt/supervisor.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -338,7 +339,7 @@ bool Supervisor::instability(double controller_v) noexcept {
 double TestSignal::value_v(double t_s) const noexcept {
   if (!enabled || t_s < start_s || t_s >= end_s()) return 0.0;
   const double tau = std::fmod(t_s - start_s, period_s);
-  const double phase = 2.0 * M_PI * (f0_hz * tau + 0.5 * (f1_hz - f0_hz) * tau * tau / period_s);
+  const double phase = kTwoPi * (f0_hz * tau + 0.5 * (f1_hz - f0_hz) * tau * tau / period_s);
   return amplitude_v * std::sin(phase);
 }
 

@@ -6,6 +6,7 @@
 
 #include "filters/design.hpp"
 #include "filters/transfer_function.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::sim {
 
@@ -29,7 +30,7 @@ double ImpactHammer::force_n(double t_s, double h_s) noexcept {
 }
 
 Sine::Sine(std::size_t location, double amplitude_n, double freq_hz, double phase_rad)
-    : Excitation(location), amplitude_n_(amplitude_n), w_(2.0 * M_PI * freq_hz), phase_(phase_rad) {}
+    : Excitation(location), amplitude_n_(amplitude_n), w_(kTwoPi * freq_hz), phase_(phase_rad) {}
 
 double Sine::force_n(double t_s, double h_s) noexcept {
   // Mean of A sin(w t + phi) over the step: A (cos(w t0 + phi) - cos(w t1 + phi)) / (w h). Consecutive steps of
@@ -60,7 +61,7 @@ double Chirp::force_n(double t_s, double h_s) noexcept {
   const double t = t_s + 0.5 * h_s;
   if (t >= duration_s_) return 0.0;
   const double k = (f1_ - f0_) / duration_s_;
-  return amplitude_n_ * std::sin(2.0 * M_PI * (f0_ * t + 0.5 * k * t * t));
+  return amplitude_n_ * std::sin(kTwoPi * (f0_ * t + 0.5 * k * t * t));
 }
 
 Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed) : Excitation(location), rms_n_(rms_n), rng_(seed) {}
@@ -92,7 +93,7 @@ ToothPassingForce::ToothPassingForce(std::size_t location, std::vector<std::comp
 double ToothPassingForce::force_n(double /*t_s*/, double h_s) noexcept {
   const double f = tooth_hz();
   if (!(f > 0.0) || c_.empty()) return 0.0;
-  const double dphi = 2.0 * M_PI * f * h_s;  // over the step
+  const double dphi = kTwoPi * f * h_s;  // over the step
   double sum = c_[0].real();
   for (std::size_t k = 1; k < c_.size(); ++k) {
     // Mean of e^{i k phi} over [phi0, phi0 + dphi]: e^{i k phi0} (e^{i k dphi} - 1) / (i k dphi).
@@ -101,7 +102,7 @@ double ToothPassingForce::force_n(double /*t_s*/, double h_s) noexcept {
     const std::complex<double> mean = kd > 1e-9 ? (std::polar(1.0, kd) - 1.0) / std::complex<double>(0.0, kd) : 1.0;
     sum += (c_[k] * start * mean).real();
   }
-  phase_ = std::fmod(phase_ + dphi, 2.0 * M_PI);
+  phase_ = std::fmod(phase_ + dphi, kTwoPi);
   return sum;
 }
 

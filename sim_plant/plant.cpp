@@ -1,4 +1,5 @@
 #include "sim_plant/plant.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -114,11 +115,11 @@ SensorReading Plant::sense() noexcept {
 std::unique_ptr<Excitation> make_drive_vibration(const PlantModel& model, const config::Config& cfg) {
   const auto& d = cfg.disturbances;
   const std::size_t at = model.index_of(d.drive_vibration_location), sensor = model.index_of(cfg.sensor.location);
-  const double w = 2.0 * M_PI * d.drive_vibration_hz;
+  const double w = kTwoPi * d.drive_vibration_hz;
   const double accel_per_n = w * w * std::abs(model.receptance(sensor, at, d.drive_vibration_hz));
   const double amplitude = accel_per_n > 0.0 ? d.drive_vibration_mps2 / accel_per_n : 0.0;
   std::mt19937_64 rng(d.seed);
-  const double phase = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(rng);
+  const double phase = std::uniform_real_distribution<double>(0.0, kTwoPi)(rng);
   return std::make_unique<Sine>(at, amplitude, d.drive_vibration_hz, phase);
 }
 

@@ -1,5 +1,7 @@
+#include "filters/transfer_function.hpp"
 #include "modal/receptance.hpp"
 #include "sim_plant/plant_model.hpp"
+#include "units/units.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -8,7 +10,6 @@
 namespace robodamp::sim {
 
 namespace {
-constexpr double kTwoPi = 2.0 * M_PI;
 
 std::string num(double v) {
   std::ostringstream os;
@@ -22,7 +23,7 @@ Complex FrfPath::receptance(double f_hz) const {
   const Complex s(0.0, kTwoPi * f_hz);
   Complex h(0.0);
   for (const auto& m : modes)
-    h += (m.a + m.b * s) / (s * s + 2.0 * m.damping_ratio * m.wn_rad_per_s * s + m.wn_rad_per_s * m.wn_rad_per_s);
+    h += modal::mode_receptance(m.a, m.b, m.damping_ratio, m.wn_rad_per_s, s);
   return h;
 }
 
@@ -33,9 +34,7 @@ double FrfPath::static_compliance_m_per_n() const {
 }
 
 Complex ActuatorModel::n_per_v(double f_hz) const {
-  const Complex s(0.0, kTwoPi * f_hz);
-  const double wa = kTwoPi * natural_freq_hz;
-  return constant_n_per_v * s * s * std::exp(-s * delay_s) / (s * s + 2.0 * damping_ratio * wa * s + wa * wa);
+  return filters::actuator_n_per_v(f_hz, constant_n_per_v, natural_freq_hz, damping_ratio, delay_s);
 }
 
 std::size_t PlantModel::index_of(int location_id) const {
@@ -158,7 +157,7 @@ PlantModel build_plant_model(const config::Config& cfg) {
   a(1, 0) = -wa * wa;
   a(1, 1) = -2.0 * za * wa;
   b(1, 0) = 1.0;
-  // Eq. 3: F = T s^2 / (s^2 + 2 za wa s + wa^2) V = T (V - 2 za wa p' - wa^2 p).
+  // Eq. 3 (filters::actuator_n_per_v) as states: F = T s^2 / (s^2 + 2 za wa s + wa^2) V = T (V - 2 za wa p' - wa^2 p).
   const Eigen::RowVector2d f_state(-t * wa * wa, -t * 2.0 * za * wa);
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     const Eigen::Index k = static_cast<Eigen::Index>(2 + 2 * i);

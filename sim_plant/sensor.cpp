@@ -1,4 +1,5 @@
 #include "sim_plant/sensor.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,7 @@ Accelerometer::Accelerometer(const config::SensorConfig& c, double sample_rate_h
     : c_(c), fs_hz_(sample_rate_hz), rng_(seed) {
   if (c.highpass_hz > 0.0) {
     // Bilinear image of s / (s + wc).
-    const double k = 2.0 * fs_hz_, wc = 2.0 * M_PI * c.highpass_hz;
+    const double k = 2.0 * fs_hz_, wc = kTwoPi * c.highpass_hz;
     hp_gain_ = k / (k + wc);
     hp_pole_ = (k - wc) / (k + wc);
     highpass_ = true;
@@ -47,14 +48,14 @@ double Accelerometer::measure(double a) noexcept {
 
 std::complex<double> Accelerometer::response(double f_hz) const {
   if (!highpass_) return 1.0;
-  const std::complex<double> zi = std::exp(std::complex<double>(0.0, -2.0 * M_PI * f_hz / fs_hz_));
+  const std::complex<double> zi = std::exp(std::complex<double>(0.0, -kTwoPi * f_hz / fs_hz_));
   return hp_gain_ * (1.0 - zi) / (1.0 - hp_pole_ * zi);
 }
 
 std::complex<double> Accelerometer::analog_response(double f_hz) const {
   if (!highpass_) return 1.0;
-  const std::complex<double> s(0.0, 2.0 * M_PI * f_hz);
-  return s / (s + 2.0 * M_PI * c_.highpass_hz);
+  const std::complex<double> s(0.0, kTwoPi * f_hz);
+  return s / (s + kTwoPi * c_.highpass_hz);
 }
 
 }  // namespace robodamp::sim

@@ -48,7 +48,7 @@ TEST(ActuatorFit, RecoversEq3FromAForcePerVoltUnderOnePercentNoise) {
   std::normal_distribution<double> n(0.0, 0.01 / std::sqrt(2.0));
   identify::ActuatorFrf g;
   for (double f = 2.0; f <= 120.0; f += 0.125) {
-    const Complex v = identify::actuator_n_per_v(f, 4.8, 9.0, 0.15, 0.6e-3);
+    const Complex v = filters::actuator_n_per_v(f, 4.8, 9.0, 0.15, 0.6e-3);
     g.f_hz.push_back(f), g.n_per_v.push_back(v * Complex(1.0 + n(rng), n(rng)));
   }
   const identify::ActuatorFit fit = identify::fit_actuator(g, {5.0, 100.0, 0.9, 5.0});
@@ -63,7 +63,7 @@ TEST(ActuatorFit, RecoversEq3FromAForcePerVoltUnderOnePercentNoise) {
 TEST(ActuatorFit, RefusesTooFewCoherentPointsAndNonFiniteData) {
   identify::ActuatorFrf g;
   for (double f = 5.0; f <= 100.0; f += 1.0) {
-    g.f_hz.push_back(f), g.n_per_v.push_back(identify::actuator_n_per_v(f, 4.8, 9.0, 0.15, 0.6e-3));
+    g.f_hz.push_back(f), g.n_per_v.push_back(filters::actuator_n_per_v(f, 4.8, 9.0, 0.15, 0.6e-3));
     g.coherence.push_back(f < 10.0 ? 0.99 : 0.3);
   }
   try {

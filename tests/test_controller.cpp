@@ -122,7 +122,7 @@ TEST(Controller, ParameterHandOverFadesOutSwapsAndFadesIn) {
   const auto c1 = test::design_preset("horizontal_c1");
   Controller c(c2.params);
   const double fs = c2.params.fs_hz;
-  auto accel = [&](int i) { return 0.05 * std::sin(filters::kTwoPi * 9.2 * i / fs); };
+  auto accel = [&](int i) { return 0.05 * std::sin(robodamp::kTwoPi * 9.2 * i / fs); };
   std::vector<double> v;
   int i = 0;
   for (; i < 20000; ++i) v.push_back(c.update(accel(i)));

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/modbus_codec.hpp"
 #include "drivers/modbus_server.hpp"
 #include "drivers/modbus_supervisor.hpp"
 #include "test_util.hpp"
@@ -53,6 +54,31 @@ config::ModbusConfig client_config(int port) {
   c.robot.vertical_value = 1;
   c.robot.settle_polls = 3;
   return c;
+}
+
+// One register codec for the emulator's side and the client's: each value survives the round trip to
+// its resolution, out-of-range values clamp, the "not available" codes decode as NaN.
+TEST(Modbus, RegisterCodecRoundTripsClampsAndMarksUnavailable) {
+  namespace mc = drivers::modbus_codec;
+  EXPECT_DOUBLE_EQ(mc::decode_rpm(mc::encode_rpm(7234.0, 2.0), 2.0), 7234.0);
+  EXPECT_EQ(mc::encode_rpm(-50.0, 1.0), 0U);
+  EXPECT_EQ(mc::encode_rpm(1e9, 1.0), 65535U);
+  EXPECT_NEAR(mc::decode_depth_mm(mc::encode_depth_mm(1.234, 0.001), 0.001), 1.234, 1e-12);
+  EXPECT_EQ(mc::encode_depth_mm(1e9, 0.001), 65534U);  // the largest depth, never "not available"
+  EXPECT_TRUE(std::isnan(mc::decode_depth_mm(mc::encode_depth_mm(std::nan(""), 0.001), 0.001)));
+  EXPECT_NEAR(mc::decode_joint_deg(mc::encode_joint_deg(-123.45, 0.01), 0.01), -123.45, 1e-9);
+  EXPECT_NEAR(mc::decode_joint_deg(mc::encode_joint_deg(-1e9, 0.01), 0.01), -327.67, 1e-9);  // never the NaN code
+  EXPECT_TRUE(std::isnan(mc::decode_joint_deg(mc::encode_joint_deg(INFINITY, 0.01), 0.01)));
+  EXPECT_NEAR(mc::decode_temperature_c(mc::encode_temperature_c(-12.5, 0.1), 0.1), -12.5, 1e-12);
+  const auto a = mc::decode_advice(mc::encode_advice(70001, true, 6150.0, 1.37, 1.0), 1.0);
+  EXPECT_EQ(a.seq, 70001U & 0xFFFFU);
+  EXPECT_EQ(a.status, 1U);
+  EXPECT_DOUBLE_EQ(a.rpm, 6150.0);
+  EXPECT_DOUBLE_EQ(a.margin, 1.37);
+  const auto none = mc::decode_advice(mc::encode_advice(3, false, 6150.0, 1.0, 1.0), 1.0);
+  EXPECT_EQ(none.status, 2U);
+  EXPECT_EQ(none.rpm, 0.0);
+  EXPECT_EQ(mc::encode_advice(4, true, 100.0, INFINITY, 1.0)[2], 65535U);
 }
 
 TEST(Modbus, AmplifierEnableReadyFaultAndTemperature) {

@@ -17,20 +17,18 @@
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 #include "modal/receptance.hpp"
+#include "filters/polynomial.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::tune {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// a x b for polynomials with the highest power first.
+// a x b for polynomials with the highest power first (filters::Polynomial's product).
 std::vector<double> multiply(const std::vector<double>& a, const std::vector<double>& b) {
-  std::vector<double> r(a.size() + b.size() - 1, 0.0);
-  for (std::size_t i = 0; i < a.size(); ++i)
-    for (std::size_t j = 0; j < b.size(); ++j) r[i + j] += a[i] * b[j];
-  return r;
+  return (filters::Polynomial::from_descending(a) * filters::Polynomial::from_descending(b)).descending();
 }
 
 std::vector<double> second_order(double f_hz, double zeta) {

@@ -1,0 +1,12 @@
+// The constants and unit conversions every library shares (one home each). Header-only: the INTERFACE
+// library robodamp_units, below filters and config.
+#pragma once
+
+#include <numbers>
+
+namespace robodamp {
+
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;  // rad per revolution; Hz to rad/s
+inline constexpr double kMmPerM = 1000.0;                 // millimetres per metre
+
+}  // namespace robodamp
