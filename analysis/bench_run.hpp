@@ -1,5 +1,5 @@
 // The bench run: the real-time Controller object against the simulated plant on a virtual clock at the
-// loop rate, measured the way the paper measured it (REFERENCE.md section 1): averaged impact tests
+// loop rate, measured the way the paper measured it (docs/physics.md §1): averaged impact tests
 // with control off and on, H1 receptance estimates, dynamic stiffness improvement, next to what the
 // loop analysis predicts; a saturating excitation; and a gain sweep across the predicted stability limit.
 // Off the real-time path (it allocates its records), but the per-tick loop body is the RT code path.
@@ -106,7 +106,7 @@ struct BenchRow {
   double impact_peak_n{0.0};
   std::optional<double> measured_improvement_pct;
   std::optional<double> predicted_improvement_pct;            // discrete loop that runs
-  std::optional<double> predicted_continuous_improvement_pct;  // REFERENCE.md equations
+  std::optional<double> predicted_continuous_improvement_pct;  // docs/physics.md equations
   bool saturated{false};
   double saturation_time_s{0.0};
   double peak_actuator_force_n{0.0};

@@ -1,4 +1,4 @@
-// The damping loop in the frequency domain (REFERENCE.md section 1, Eq. 8-12 with the corrected H11):
+// The damping loop in the frequency domain (docs/physics.md §1, Eq. 8-12 with the corrected H11):
 // the continuous model (actuator delay exact, the configured sensor's analog coupling) and the discrete
 // loop that actually runs (the plant discretised exactly with zero-order hold at the loop rate, the
 // sampled sensor, one sample of computation delay, the digital chain). Stability of the discrete loop from

@@ -69,7 +69,7 @@ json analysis_report(const analysis::LoopModel& m, const analysis::AnalysisResul
   }
   j["frfs"] = json::array();  // the discrete loop that runs
   for (const auto& f : r.frfs_discrete) j["frfs"].push_back(frf_json(f, r.stable));
-  j["frfs_continuous"] = json::array();  // REFERENCE.md section 1 equations, delay exact
+  j["frfs_continuous"] = json::array();  // docs/physics.md §1 equations, delay exact
   for (const auto& f : r.frfs_continuous) j["frfs_continuous"].push_back(frf_json(f, r.stable_continuous));
   j["quiet_command_rms_v"] = r.quiet_command_rms_v;
   j["quiet_command_peak_hz"] = r.quiet_command_peak_hz;

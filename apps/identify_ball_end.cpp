@@ -1,7 +1,7 @@
 // `robodamp identify cutting --ball-end`: the shear coefficients of a ball-end mill as polynomials in the
-// axial angle and the edge coefficients, from slot-milling mean forces (seed 003's method; identify/
+// axial angle and the edge coefficients, from slot-milling mean forces (the ball-end bone study's method; identify/
 // ball_end.hpp, docs/identification.md), with 95 % intervals, R^2, the residual RMS and the condition
-// number; JSON and a material: block (the coefficients at kappa = 1 rad, as seed 000 tabulates them).
+// number; JSON and a material: block (the coefficients at kappa = 1 rad, as Tian et al. (2024) tabulates them).
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -16,7 +16,7 @@ namespace robodamp::apps {
 
 namespace {
 
-constexpr double kTableKappaRad = 1.0;  // seed 000's single values are seed 003's at kappa = 1 rad
+constexpr double kTableKappaRad = 1.0;  // Tian et al. (2024)'s single values are the ball-end bone study's at kappa = 1 rad
 
 double at(const std::vector<identify::Estimate>& poly, double kappa) {
   double v = 0.0, kp = 1.0;

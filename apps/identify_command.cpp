@@ -198,7 +198,7 @@ void register_identify(Registry& r) {
                 "cutting: a ball-end mill from slot-milling mean forces axial_mm,feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n");
   r.number(sub, "--helix-deg", a->helix_deg, {"deg", 0.0, 89.0}, "cutting --ball-end: helix angle at the ball's equator");
   r.whole_number(sub, "--order", a->order, {"(polynomial order)", 0, 3},
-                 "cutting --ball-end: order of the shear coefficients' polynomial in the axial angle (seed 003: 3)");
+                 "cutting --ball-end: order of the shear coefficients' polynomial in the axial angle (the ball-end bone study: 3)");
   sub->add_option("--mode", a->mode, "cutting: down or up milling")->check(CLI::IsMember({"down", "up"}));
   sub->add_option("--recording", a->recording_path, "actuator: a robodamp measure recording (the chirp and the sensor)")
       ->check(CLI::ExistingFile);

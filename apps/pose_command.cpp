@@ -1,4 +1,4 @@
-// `robodamp pose`: seed 002's pose-dependent robot dynamics (robot/, docs/pose_dynamics.md).
+// `robodamp pose`: the planar-robot study's pose-dependent robot dynamics (robot/, docs/pose_dynamics.md).
 //   pose frf  --model F (--joints Q1 Q2 Q3 | --pose NAME) [--json] [--plot PNG]: the TCP's modes and FRF at a pose
 //   pose table --model F: the model's first mode at each named pose beside the published values
 //   pose fit  --model F --measured Q1,Q2,Q3:FRF.csv ... [--direction yy] [--out fitted.yaml]: the joints'
@@ -32,7 +32,7 @@ using nlohmann::json;
 
 struct PoseArgs {
   std::string what;
-  std::string model_path{std::string(ROBODAMP_SOURCE_DIR_FOR_CLI) + "/config/robots/seed002.yaml"};
+  std::string model_path{std::string(ROBODAMP_SOURCE_DIR_FOR_CLI) + "/config/robots/planar_three_link.yaml"};
   std::vector<double> joints_deg;
   std::string pose_name;
   bool json_out{false};
@@ -340,7 +340,7 @@ int run_pose(const PoseArgs& a) {
 void register_pose(Registry& r) {
   auto a = std::make_shared<PoseArgs>();
   CLI::App* sub = r.add("pose",
-                        "Pose-dependent robot dynamics (seed 002): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose table` "
+                        "Pose-dependent robot dynamics (the planar-robot study): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose table` "
                         "(the first mode at the model's named poses), `pose map` (first mode over two joints)",
                         [a] { return run_pose(*a); });
   sub->add_option("what", a->what, "frf, table, fit or map")->required()->check(CLI::IsMember({"frf", "table", "fit", "map"}));
@@ -360,7 +360,7 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
   sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
   sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
-  r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (seed 002: 10 30)");
+  r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (the planar-robot study: 10 30)");
   r.whole_number(sub, "--restarts", a->restarts, {"(restarts)", 1, 100}, "fit: swarms with seeds seed, seed+1, ...");
   r.whole_number(sub, "--particles", a->particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
   r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");

@@ -1,4 +1,4 @@
-// Modal identification of seed 004's robot and workpiece (README: identification): the tool-workpiece
+// Modal identification of the robot SLE study's robot and workpiece (README: identification): the tool-workpiece
 // FRF of config/milling/industrial_robot_aluminium.yaml in x (25 modes) and y (21 modes), 2-8000 Hz at
 // 0.5 Hz with 0.5 % seeded complex noise, fitted in sub-bands (identify/modal_fit.hpp). One core.
 // Counters: modes identified, and how many of the table's modes have one within 1 % in frequency.
@@ -48,7 +48,7 @@ int found(const identify::ModalFit& fit, const std::vector<double>& truth) {
   return n;
 }
 
-void BM_IdentifySeed004(benchmark::State& state) {
+void BM_IdentifyRobotSle(benchmark::State& state) {
   const Case x = make_case(0), y = make_case(1);
   identify::ModalFit fx, fy;
   for (auto _ : state) {
@@ -62,7 +62,7 @@ void BM_IdentifySeed004(benchmark::State& state) {
   state.counters["fit_error_x_pct"] = fx.fit_error_pct;
   state.counters["fit_error_y_pct"] = fy.fit_error_pct;
 }
-BENCHMARK(BM_IdentifySeed004)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_IdentifyRobotSle)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 

@@ -31,10 +31,10 @@ echo "what each part of the main job costs (robodamp bench on the default preset
 echo
 echo "milling in time (cut, damped cut, critical depth, SDM diagram), one core:"
 taskset -c 0 ./build/benchmarks/benchmark_cut --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
-echo "== modal identification of seed 004's 46-mode FRF (x and y), one core"
+echo "== modal identification of the robot SLE study's 46-mode FRF (x and y), one core"
 taskset -c 0 ./build/benchmarks/benchmark_identify
 echo
-echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (seed 004), the direct test's"
+echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (the robot SLE study), the direct test's"
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
 taskset -c 0 ./build/benchmarks/benchmark_lobes --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_counters_tabular=true --benchmark_filter='-BM_DampedSdmLobes'

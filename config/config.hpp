@@ -122,7 +122,7 @@ struct TelemetryConfig {
 
 enum class Mounting { kHorizontal, kVertical };
 
-// data/seed001_actuator.csv, Eq. 3.
+// Sahu et al. (2024) Table 2, Eq. 3.
 struct ActuatorConfig {
   Mounting mounting{Mounting::kHorizontal};
   double constant_n_per_v{4.8};
@@ -188,7 +188,7 @@ struct ModeConfig {
 
 // A structural degree of freedom (a point and a direction). axis_sign is the sign of the tabulated
 // FRFs' response axis at this location relative to the common frame: the physical FRF is
-// axis_sign(response) * tabulated (REFERENCE.md section 1: Table 1's location-2 axis is reversed, -1).
+// axis_sign(response) * tabulated (docs/physics.md §1: Table 1's location-2 axis is reversed, -1).
 struct LocationConfig {
   int id{1};
   std::string name;

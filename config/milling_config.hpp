@@ -1,4 +1,4 @@
-// A milling job for the chatter and surface-location-error analyses (REFERENCE.md sections 2 and 3): tool,
+// A milling job for the chatter and surface-location-error analyses (docs/physics.md §2-3): tool,
 // material, cut, the structure's FRFs seen at the tool tip, and the settings of the lobe and SLE
 // computations. YAML with units in the key names, validated like the controller configuration (every
 // problem with file, line, key, value, unit and allowed range). Off the real-time path.
@@ -29,15 +29,15 @@ struct ToolConfig {
   double flute_length_mm{100.0};  // the cutting length: the deepest axial cut the tool can take
 };
 
-// Mechanistic force model (REFERENCE.md section 2): Ft = kt b h + kte b, Fr = kr b h + kre b. The radial
-// coefficient is called kn (normal) in seed 004 and Krc in seed 000; both spellings are accepted.
+// Mechanistic force model (docs/physics.md §2): Ft = kt b h + kte b, Fr = kr b h + kre b. The radial
+// coefficient is called kn (normal) in the robot SLE study and Krc in Tian et al. (2024); both spellings are accepted.
 struct MaterialConfig {
   std::string name;
   double kt_n_per_mm2{0.0};
   double kr_n_per_mm2{0.0};
   double kte_n_per_mm{0.0};
   double kre_n_per_mm{0.0};
-  std::optional<double> ka_n_per_mm2;  // axial (ball end, seed 000): recorded, unused by the 2D models
+  std::optional<double> ka_n_per_mm2;  // axial (ball end, Tian et al. (2024)): recorded, unused by the 2D models
   // Exponential force model (time domain only): the cutting terms scale as (h / h_ref)^(-chip_exponent),
   // so kt and kr are the specific coefficients at the reference chip h_ref. 0: linear.
   double chip_exponent{0.0};
@@ -116,7 +116,7 @@ struct TimeDomainConfig {
   int sdm_points{200};                  // speeds of `lobes --method sdm` over the lobes range
 };
 
-// An SLE test condition (seed 004 Table 7) with the measured path offset the published predictions add.
+// An SLE test condition (the robot SLE study Table 7) with the measured path offset the published predictions add.
 struct ConditionConfig {
   std::string name;
   double rpm{0.0};

@@ -1,4 +1,4 @@
-// The sensor and actuator over CAN (REFERENCE.md section 1's DAQ and amplifier, on a CAN bus): the loop's
+// The sensor and actuator over CAN (docs/physics.md §1's DAQ and amplifier, on a CAN bus): the loop's
 // SensorSource and ActuatorSink on one CanChannel. Everything here runs on the real-time thread: non-
 // blocking socket calls, no allocation, no exceptions, no logging. Problems are counted (counters() is
 // safe to read from any thread) and reported to the supervisor as driver faults:

@@ -1,4 +1,4 @@
-// Continuous-time rational transfer functions and the blocks of the DVF chain (REFERENCE.md section 1).
+// Continuous-time rational transfer functions and the blocks of the DVF chain (docs/physics.md §1).
 #pragma once
 
 #include <numbers>
@@ -57,7 +57,7 @@ TransferFunction actuator(double constant_n_per_v, double natural_freq_hz, doubl
   const double wa = kTwoPi * natural_freq_hz;
   return constant_n_per_v * s * s * std::exp(-s * delay_s) / (s * s + 2.0 * damping_ratio * wa * s + wa * wa);
 }
-// Eq. 4 with the correction of REFERENCE.md: numerator = the actuator denominator; denominator
+// Eq. 4 with the correction of docs/physics.md: numerator = the actuator denominator; denominator
 // s^2 + 2 z_c w_c s + w_c^2 with w_c = 2 pi corner_hz. The paper's -75.44 deg at 9.2 Hz needs z_c = 1.
 TransferFunction compensator_c1(double actuator_freq_hz, double actuator_damping_ratio,
                                 double corner_hz = 0.5, double corner_damping_ratio = 1.0);

@@ -1,9 +1,9 @@
-// Cutting coefficients of a ball-end mill from slot-milling mean forces (seed 003's method, REFERENCE.md
+// Cutting coefficients of a ball-end mill from slot-milling mean forces (the ball-end bone study's method, docs/physics.md
 // section 4 in docs/identification.md's words). An edge point at axial angle kappa (0 at the tip) of a
 // ball of radius R0 cuts a chip h = c sin(kappa) sin(psi) over a width db = R0 dkappa along an edge
 // element dS = R0 sqrt(1 + sin^4(kappa) tan^2(beta0)) dkappa, with
 //   dFt = Kte dS + Ktc(kappa) h db,  dFr = Kre dS + Krc(kappa) h db,  dFa = Kae dS + Kac(kappa) h db,
-// the shear coefficients polynomials in kappa of the chosen order (seed 003: cubic), the edge ones constant;
+// the shear coefficients polynomials in kappa of the chosen order (the ball-end bone study: cubic), the edge ones constant;
 // projected on the tool frame
 //   dFx = -cos(psi) dFt - sin(k) sin(psi) dFr + cos(k) sin(psi) dFa,
 //   dFy =  sin(psi) dFt - sin(k) cos(psi) dFr + cos(k) cos(psi) dFa,

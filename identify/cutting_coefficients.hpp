@@ -1,4 +1,4 @@
-// Cutting coefficients of a flat end mill from mean forces (Altintas' mechanistic model, REFERENCE.md
+// Cutting coefficients of a flat end mill from mean forces (Altintas' mechanistic model, docs/physics.md
 // section 2; docs/identification.md): with the chip h = c sin(phi) of a tooth at phi,
 //   Ft = Ktc a h + Kte a,  Fr = Krc a h + Kre a,  Fa = Kac a h + Kae a,
 // the force on the tool in the cutter frame (x along the feed, y normal to it, z along the tool axis,

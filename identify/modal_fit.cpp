@@ -314,7 +314,7 @@ ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, c
 }
 
 
-// A band spanning decades (seed 004's robot: 46 modes from 8 Hz to 6.6 kHz). One LSCF over it needs a
+// A band spanning decades (the robot SLE study's robot: 46 modes from 8 Hz to 6.6 kHz). One LSCF over it needs a
 // high order, is slow and ill-conditioned at the low end, so it is cut into sub-bands (a frequency ratio
 // of at least kSubBandRatio and at least kSubBandPoints points, overlapping by kSubBandOverlap on each
 // side), each fitted as a band of its own with its residual terms standing for the rest; a sub-band keeps

@@ -2,7 +2,7 @@
 // The structure (milling/tool_dynamics.hpp) is stepped exactly at h = tooth period / steps_per_tooth.
 // The cutter has axial slices with helix lag (a ball end's slices on the sphere, as in the
 // frequency-domain model), per-tooth radial runout, and the linear force model with edge coefficients
-// (REFERENCE.md sections 2-4) or its exponential form (material.force_model: exponential). The chip comes from the surface each slice's previous passes actually
+// (docs/physics.md §2-4) or its exponential form (material.force_model: exponential). The chip comes from the surface each slice's previous passes actually
 // left at that angle: a surface memory per slice and angular position, so runout and the tool leaving
 // the cut (h <= 0: no force, the surface is not renewed) come out right. Off the real-time path.
 #pragma once

@@ -15,7 +15,7 @@ Engagement engagement(double radius_mm, double radial_mm, config::MillingMode mo
 double surface_angle_rad(config::MillingMode mode) { return mode == config::MillingMode::kDown ? M_PI : 0.0; }
 
 Eigen::Matrix2d directional_matrix(const Engagement& e, double kr) {
-  // REFERENCE.md section 2 (Altintas-Budak), [.] = value at exit minus value at entry.
+  // docs/physics.md §2 (Altintas-Budak), [.] = value at exit minus value at entry.
   auto at = [kr](double p) {
     Eigen::Matrix2d a;
     a(0, 0) = 0.5 * (std::cos(2 * p) - 2 * kr * p + kr * std::sin(2 * p));
@@ -41,11 +41,11 @@ std::vector<Slice> slices(const Cutter& c, double axial_mm, int count) {
     s.radius_mm = c.radius_mm;
     s.kappa_rad = 0.5 * M_PI;
     if (c.kind == config::ToolKind::kBallEnd && s.z_mm < c.radius_mm) {
-      // On the sphere (REFERENCE.md section 4): z = R (1 - cos kappa), local radius R sin kappa.
+      // On the sphere (docs/physics.md §4): z = R (1 - cos kappa), local radius R sin kappa.
       s.kappa_rad = std::acos(1.0 - s.z_mm / c.radius_mm);
       s.radius_mm = c.radius_mm * std::sin(s.kappa_rad);
     }
-    // Lag of the edge behind the tip: z tan(helix) / R (REFERENCE.md sections 3 and 4).
+    // Lag of the edge behind the tip: z tan(helix) / R (docs/physics.md §3 and 4).
     s.lag_rad = s.z_mm * std::tan(c.helix_rad) / c.radius_mm;
     out.push_back(s);
   }

@@ -1,4 +1,4 @@
-// The milling process model (REFERENCE.md sections 2 and 3), in the cutter's frame: x along the feed, y
+// The milling process model (docs/physics.md §2-3), in the cutter's frame: x along the feed, y
 // along the machined wall's normal, tooth angle phi measured clockwise from +y (Altintas). A tooth at
 // phi is at (R sin phi, R cos phi) from the tool axis; it cuts the chip h = ft sin(phi) and feels
 //   Ft = kt b h + kte b,  Fr = kr b h + kre b,
@@ -29,7 +29,7 @@ struct Engagement {
 // Angle at which the finished wall is generated: exit for down milling, entry for up milling.
 [[nodiscard]] double surface_angle_rad(config::MillingMode mode);
 
-// Zero-order directional matrix [alpha] (REFERENCE.md section 2), each term evaluated between entry and
+// Zero-order directional matrix [alpha] (docs/physics.md §2), each term evaluated between entry and
 // exit, Kr = kr / kt. The mean periodic force is (N kt b / 4 pi) [alpha] {delta}.
 [[nodiscard]] Eigen::Matrix2d directional_matrix(const Engagement& e, double kr_over_kt);
 

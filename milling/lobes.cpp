@@ -27,7 +27,7 @@ ChatterProcess chatter_process(const config::ToolConfig& tool, const config::Mat
   p.teeth = tool.teeth;
   p.kt_n_per_m2 = material.kt_n_per_mm2 * 1e6;
   // The 2D zero-order model uses the nominal radius for the immersion, also for a ball end (its
-  // engagement shrinks towards the tip; with slotting, as in seed 000, the immersion is the same).
+  // engagement shrinks towards the tip; with slotting, as in Tian et al. (2024), the immersion is the same).
   p.alpha = directional_matrix(engagement(0.5 * tool.diameter_mm, cut.radial_mm, cut.mode),
                                material.kr_n_per_mm2 / material.kt_n_per_mm2);
   p.feed_axis = cut.feed_axis;

@@ -1,4 +1,4 @@
-// Stability lobes by the zero-order method (Altintas-Budak, REFERENCE.md section 2) and an independent
+// Stability lobes by the zero-order method (Altintas-Budak, docs/physics.md §2) and an independent
 // direct test of the same characteristic equation. Off the real-time path.
 //
 // For each chatter frequency wc of a grid (fine across every resonance, logarithmic elsewhere) the

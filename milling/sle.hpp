@@ -1,4 +1,4 @@
-// Surface location error by the frequency-domain method of Schmitz and Mann (REFERENCE.md section 3).
+// Surface location error by the frequency-domain method of Schmitz and Mann (docs/physics.md §3).
 // The cutting force over one tooth period as a Fourier series (exact per axial slice, helix lag
 // included), times the cutter-frame FRF at each harmonic of the tooth-passing frequency, gives the
 // steady tool deflection; sampled when each slice's edge is at the surface-generating angle (exit for
@@ -26,7 +26,7 @@ struct SleResult {
                                                const config::MaterialConfig& material, const CutConditions& cut,
                                                config::Axis feed_axis, double rpm, int axial_slices, int harmonics);
 
-// Iterative compensation of the commanded radial depth (REFERENCE.md section 3): the wall's error with a
+// Iterative compensation of the commanded radial depth (docs/physics.md §3): the wall's error with a
 // command a_c is e = SLE(a_c) + offset - (a_c - a_target); a_c += e until |e| < tolerance.
 struct Compensation {
   double radial_mm{0.0};

@@ -1,11 +1,11 @@
-// A planar serial robot for pose-dependent dynamics (docs/pose_dynamics.md; seed 002): links as
+// A planar serial robot for pose-dependent dynamics (docs/pose_dynamics.md; the planar-robot study): links as
 // Euler-Bernoulli frame elements (axial and bending, consistent mass), joined by torsional joint springs
 // with hysteretic damping (k (1 + 2 i zeta)), the first joint to a rigid base, and the spindle head as a
 // lumped mass and rotary inertia at the tool centre point (TCP). A pose is the joint angles (each link's
 // angle relative to the previous link; joint 1's relative to the base's x axis).
 //
 // The TCP receptance (2x2, machine frame x-y) comes two ways that must agree: by assembling the whole
-// model's dynamic stiffness and solving it, and by receptance coupling of substructures (RCSA, seed 002
+// model's dynamic stiffness and solving it, and by receptance coupling of substructures (RCSA, the planar-robot study
 // Figure 2): each link free-free, coupled link by link through its joint (translations rigid, rotation
 // through the spring's compliance), the first to the ground. Off the real-time path.
 #pragma once

@@ -1,7 +1,7 @@
-// Fitting a robot model's joints to measured TCP FRFs at one or more poses by particle swarm (seed 002,
+// Fitting a robot model's joints to measured TCP FRFs at one or more poses by particle swarm (the planar-robot study,
 // docs/pose_dynamics.md): the joint stiffnesses (log-scaled within their bounds) and, optionally, the
 // joints' damping ratios; the objective is each pose's complex FRF error over the fit band weighted by the
-// measured magnitude (so the resonances dominate, as seed 002 weights near the peaks), averaged over the
+// measured magnitude (so the resonances dominate, as the planar-robot study weights near the peaks), averaged over the
 // poses. Each restart's swarm optimum is polished by a local derivative-free search (NLopt's BOBYQA, within
 // the same bounds): the swarm finds the basin, BOBYQA its bottom. Restarts with other seeds give the
 // parameters' spread. Off the real-time path.
@@ -27,13 +27,13 @@ struct MeasuredFrf {
 
 struct PoseFitSettings {
   FrfDirection direction{FrfDirection::kYY};
-  double band_min_hz{10.0}, band_max_hz{30.0};   // seed 002 fits 10-30 Hz
+  double band_min_hz{10.0}, band_max_hz{30.0};   // the planar-robot study fits 10-30 Hz
   int max_points_per_pose{60};                  // the band's points thinned evenly to at most this many
   // Elements per link while searching (0: the model's). The links' own bending modes lie far above the fit
-  // band: on seed 002's preset 2 elements change its 10-30 Hz TCP FRF by 0.06 % against 6, and the search
+  // band: on the planar-robot study's preset 2 elements change its 10-30 Hz TCP FRF by 0.06 % against 6, and the search
   // runs about 20 times faster. The errors reported are the model's own.
   int search_elements{2};
-  double stiffness_min_nm_per_rad{1e3}, stiffness_max_nm_per_rad{1e7};  // seed 002's bounds (Eq. 21)
+  double stiffness_min_nm_per_rad{1e3}, stiffness_max_nm_per_rad{1e7};  // the planar-robot study's bounds (Eq. 21)
   bool fit_damping{true};
   double damping_min{0.002}, damping_max{0.1};
   int restarts{3};

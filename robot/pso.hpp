@@ -1,5 +1,5 @@
 // Particle swarm optimisation (Kennedy and Eberhart, with Clerc's constriction coefficients), bounded,
-// seeded and deterministic: what seed 002 fits its robot's equivalent parameters with. No Debian
+// seeded and deterministic: what the planar-robot study fits its robot's equivalent parameters with. No Debian
 // package offers PSO (NLopt's global methods are DIRECT, CRS, ISRES, ESCH, MLSL), hence this small one.
 // Off the real-time path.
 #pragma once

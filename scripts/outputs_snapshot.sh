@@ -42,8 +42,8 @@ run sle_damped_c2 sle --config config/milling/active_damping_c2.yaml --damped --
 run cut_c2 cut --config config/milling/active_damping_c2.yaml --json "$out/cut_c2.json"
 run cut_damped_c2 cut --config config/milling/active_damping_c2.yaml --damped --rpm 700 --axial-mm 1 --revs 40 \
   --json "$out/cut_damped_c2.json"
-run pose_table pose table --model config/robots/seed002.yaml --json
-run pose_frf pose frf --model config/robots/seed002.yaml --joints -100.59 119.81 -19.55 --json
-run pose_map pose map --model config/robots/seed002.yaml --joints -100.59 119.81 -19.55 --vary 2 3 --steps 5 --json
+run pose_table pose table --model config/robots/planar_three_link.yaml --json
+run pose_frf pose frf --model config/robots/planar_three_link.yaml --joints -100.59 119.81 -19.55 --json
+run pose_map pose map --model config/robots/planar_three_link.yaml --joints -100.59 119.81 -19.55 --vary 2 3 --steps 5 --json
 run tune_small tune --config config/presets/horizontal_c2.yaml --evaluations 20 --polish 10 --json "$out/tune_small.json"
 for f in "$out"/*.json; do scrub <"$f" >"$f.tmp" && mv "$f.tmp" "$f"; done

@@ -104,7 +104,7 @@ class Plant {
   PlantCounters counters_{};
 };
 
-// The robot's inherent vibration with the drives on (REFERENCE.md section 1: about 3 Hz): a sine force at
+// The robot's inherent vibration with the drives on (docs/physics.md §1: about 3 Hz): a sine force at
 // the configured location sized for the configured open-loop acceleration amplitude at the sensor.
 [[nodiscard]] std::unique_ptr<Excitation> make_drive_vibration(const PlantModel& model, const config::Config& cfg);
 

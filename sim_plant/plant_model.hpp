@@ -1,4 +1,4 @@
-// The structural and actuator model of the simulated plant, built from configuration (REFERENCE.md
+// The structural and actuator model of the simulated plant, built from configuration (docs/physics.md
 // section 1): FRF paths as sums of modes (Eq. 1) in the physical frame, the inertial actuator (Eq. 3)
 // and one continuous state-space holding both, from which the time simulation and the discrete loop
 // analysis are derived. Built off the real-time path; throws config::ConfigError on an inconsistent plant.

@@ -23,7 +23,7 @@ using analysis::Complex;
 analysis::LoopModel model(const std::string& name) { return analysis::LoopModel(config::load_config_file(test::preset(name))); }
 
 TEST(LoopModel, ClosedLoopFollowsTheCorrectedEquations) {
-  // REFERENCE.md section 1 (Eq. 10-12, H11 corrected), with every FRF in one consistent frame, the
+  // docs/physics.md §1 (Eq. 10-12, H11 corrected), with every FRF in one consistent frame, the
   // physical one: L = G H22 / T, H22_cl = H22 / (1 + L), H11_cl = [H11 (1 + L) - H12 H21 G / T] / (1 + L).
   // In the table's frame H22 changes sign but H12 H21 does not: written with the table's H22 in L (as the
   // reference puts it, "sign per polarity"), the coupling term's sign must flip with it.

@@ -224,7 +224,7 @@ TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
                           "nonharmonic_energy_ratio", "peak_force_n", "peak_actuator_force_n", "actuator_saturated", "sle_um"})
     EXPECT_TRUE(o.contains(key)) << key;
   EXPECT_FALSE(o["stable"].get<bool>());
-  EXPECT_NEAR(o["chatter_hz"].get<double>(), 9.4, 0.5);  // the robot's first mode, as seed 002 saw
+  EXPECT_NEAR(o["chatter_hz"].get<double>(), 9.4, 0.5);  // the robot's first mode, as the planar-robot study saw
   EXPECT_GT(o["nonharmonic_energy_ratio"].get<double>(), 0.5);
   for (const char* png : {"cut_displacement.png", "cut_force.png", "cut_spectrum.png", "cut_surface.png"})
     EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
@@ -343,9 +343,9 @@ TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
 
 // Issue 16: cutting coefficients from a CSV of mean forces, the material block a milling job accepts, and
 // the refusals (nearly equal feeds with the condition number, a bad row with its line).
-// robodamp pose on seed 002's preset: the table beside the published frequencies, a pose outside a joint's
+// robodamp pose on the planar-robot study's preset: the table beside the published frequencies, a pose outside a joint's
 // travel refused by name, FRFs written at the three poses and fitted back into a model file that reads.
-TEST(Cli, PoseTableFrfAndFitOnSeed002) {
+TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   const Result table = run("pose table");
   ASSERT_EQ(table.status, 0) << table.out;
   EXPECT_NE(table.out.find("pose 1      -120.13 133.37 -14.13            11.80                      16         15.5"),
@@ -369,7 +369,7 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   EXPECT_NE(fit.out.find("weighted relative error"), std::string::npos) << fit.out;
   // Lobes at a pose: the job's pose part takes --pose; a pose out of the travel, or --pose on a job without
   // a pose part, is refused by name.
-  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml";
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml";
   const Result at3 = run("lobes --method zoa --config " + job + " --pose -84.75 104.63 -20.08");
   ASSERT_EQ(at3.status, 0) << at3.out;
   EXPECT_NE(at3.out.find("at joints -84.75 104.63 -20.08 deg"), std::string::npos) << at3.out;
@@ -384,8 +384,8 @@ TEST(Cli, PoseTableFrfAndFitOnSeed002) {
   // SDM's minimum at each pose is the lowest of SDM's critical depths at those 12 speeds, which the test
   // computes again with `lobes`. A job without a pose part is refused.
   std::string small_job = robodamp::test::read_file(job);
-  small_job.replace(small_job.find("../robots/seed002.yaml"), std::strlen("../robots/seed002.yaml"),
-                    std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/seed002.yaml");
+  small_job.replace(small_job.find("../robots/planar_three_link.yaml"), std::strlen("../robots/planar_three_link.yaml"),
+                    std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   small_job += "time_domain:\n  sdm_points: 12\n";
   std::ofstream(dir + "/small_job.yaml") << small_job;
   const Result map = run("pose map --vary 2 3 --steps 2 --job " + dir + "/small_job.yaml --json-out " + dir + "/map.json");
@@ -537,7 +537,7 @@ TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData)
   for (const auto& p : {csv, json, yaml, job_path}) std::filesystem::remove(p);
 }
 
-// Issue 16: the preset's published H21yy modes (seed 001 Table 1, close modes at 21 and 23.5 Hz) back
+// Issue 16: the preset's published H21yy modes (Sahu et al. (2024) Table 1, close modes at 21 and 23.5 Hz) back
 // from an accelerance CSV, with JSON, the modes: list and the plots.
 TEST(Cli, IdentifyModesRecoversThePresetsModesFromAnAccelerance) {
   const auto cfg = robodamp::config::load_config_file(robodamp::test::preset("horizontal_c2"));

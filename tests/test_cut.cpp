@@ -112,7 +112,7 @@ TEST(Cut, SlottingCriticalDepthAgreesWithSdmAndTheZeroOrderLobes) {
   }
 }
 
-// Seed 000's observation: above the limit the spectrum has a chatter peak near the structure's mode;
+// Tian et al. (2024)'s observation: above the limit the spectrum has a chatter peak near the structure's mode;
 // below it, only the tooth-passing harmonics.
 TEST(Cut, ChatterShowsAtTheModeAboveTheLimitAndNotBelow) {
   const Job j = single_mode_job(12.0, false);

@@ -243,7 +243,7 @@ TEST(Hil, SpindleRampWhileCuttingKeepsTheLoopActive) {
   EXPECT_EQ(plant["cutting"]["last_rpm"], 6000.0);
 }
 
-// The robot (seed 002's model, config/hil_pose_schedule.yaml) dwells folded (joint 2 at 10 deg), moves
+// The robot (the planar-robot study's model, config/hil_pose_schedule.yaml) dwells folded (joint 2 at 10 deg), moves
 // over 6 s to stretched (100 deg) and dwells there; its dominant mode along the actuator moves from 9.2
 // to 19.8 Hz. The controller in the other process reads the joint registers and hands over from the
 // folded region's set to the stretched one's. Each dwell's improvement, measured by the emulator's

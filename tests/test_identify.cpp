@@ -19,7 +19,7 @@ using namespace robodamp;
 using identify::CuttingTest;
 using identify::MeanForces;
 
-// seed 004's aluminium with edge and axial terms (N/mm^2 and N/mm).
+// the robot SLE study's aluminium with edge and axial terms (N/mm^2 and N/mm).
 constexpr double kTc = 597.3, kRc = 59.8, kAc = 120.0, kTe = 20.0, kRe = 25.0, kAe = 4.0;
 
 std::vector<MeanForces> generated(const CuttingTest& t, const std::vector<double>& feeds) {
@@ -177,7 +177,7 @@ TEST(IdentifyModes, OneFrfAndTheCommonPoleFitBothSeparateACloseModePair) {
   }
 }
 
-// --- Ball end (seed 003's method) ---
+// --- Ball end (the ball-end bone study's method) ---
 
 identify::BallEndCoefficients known_ball_end() {
   return {{800.0, -300.0, 100.0, -20.0}, {400.0, 150.0, -60.0, 10.0}, {200.0, -50.0, 30.0, 5.0}, 5.0, 3.0, 1.5};
@@ -230,19 +230,19 @@ TEST(IdentifyBallEnd, RefusesWhatCannotBeSeparated) {
   EXPECT_THROW((void)identify::identify_ball_end(runs, {8, 4.0, 30.0, 0}), std::invalid_argument);
 }
 
-// Seed 003's own slot runs (config/milling/data/seed003_slot_milling.csv): the fit runs and reports that
+// The ball-end bone study's own slot runs (config/milling/data/ball_end_bone_slot_milling.csv): the fit runs and reports that
 // the shear coefficients are not determined (the forces hardly change with the feed: edge forces dominate).
-TEST(IdentifyBallEnd, Seed003SlotRunsDoNotDetermineTheShearCoefficients) {
-  const auto runs = identify::read_ball_end_csv(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/data/seed003_slot_milling.csv");
+TEST(IdentifyBallEnd, BallEndBoneSlotRunsDoNotDetermineTheShearCoefficients) {
+  const auto runs = identify::read_ball_end_csv(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/data/ball_end_bone_slot_milling.csv");
   ASSERT_EQ(runs.size(), 10u);
   const identify::BallEndFit f = identify::identify_ball_end(runs, {8, 4.0, 30.0, 3});
-  std::printf("seed 003, cubic: Ktc0 %.4g +- %.3g, Kte %.3g +- %.3g N/mm, R^2 %.3f / %.3f, cond %.3g\n", f.ktc[0].value,
+  std::printf("the ball-end bone study, cubic: Ktc0 %.4g +- %.3g, Kte %.3g +- %.3g N/mm, R^2 %.3f / %.3f, cond %.3g\n", f.ktc[0].value,
               f.ktc[0].ci95, f.kte.value, f.kte.ci95, f.r2_y, f.r2_xz, f.condition_number);
   EXPECT_GT(f.ktc[0].ci95, std::abs(f.ktc[0].value));
   EXPECT_GT(f.kte.value, 1.0);
   EXPECT_LT(f.kte.value, 2.5);
   const identify::BallEndFit f0 = identify::identify_ball_end(runs, {8, 4.0, 30.0, 0});
-  EXPECT_GT(f0.ktc[0].ci95, 375.61);  // seed 000's Ktc lies inside an interval this wide, and so does 0
+  EXPECT_GT(f0.ktc[0].ci95, 375.61);  // Tian et al. (2024)'s Ktc lies inside an interval this wide, and so does 0
 }
 
 }  // namespace

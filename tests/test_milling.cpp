@@ -1,5 +1,5 @@
 // Stability lobes, the direct test and surface location error against closed forms, hand calculations
-// and each other (REFERENCE.md sections 2 and 3).
+// and each other (docs/physics.md §2-3).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,7 +47,7 @@ TEST_P(ClosedFormMinimum, LobeMinimumMatchesTheSingleModeFormula) {
   p.kt_n_per_m2 = kt * 1e6;
   p.alpha = mill::directional_matrix(mill::engagement(5.0, c.radial_fraction * 10.0, c.mode), kr / kt);
   const double alpha = p.alpha(1, 1);
-  // REFERENCE.md section 2: alpha < 0 (slotting, down/up with large immersion) and alpha > 0.
+  // docs/physics.md §2: alpha < 0 (slotting, down/up with large immersion) and alpha > 0.
   const double expected = alpha < 0.0 ? 8.0 * M_PI * k * zeta * (1.0 + zeta) / (teeth * p.kt_n_per_m2 * -alpha)
                                       : 8.0 * M_PI * k * zeta * (1.0 - zeta) / (teeth * p.kt_n_per_m2 * alpha);
   cfg::LobesConfig lc;
@@ -91,7 +91,7 @@ TEST(Milling, DirectionalFactorsMatchHandValues) {
 }
 
 // Lobe points solve det(I + Lambda Phi0) = 0 with Lambda rebuilt from b_lim and the speed, on a
-// structure with cross FRFs (mode coupling: seed 000, position 3).
+// structure with cross FRFs (mode coupling: Tian et al. (2024), position 3).
 TEST(Milling, LobePointsSolveTheCharacteristicEquation) {
   const auto job = cfg::load_milling_config(milling_preset("orthopaedic_bone"));
   const mill::Structure s(*job.find_structure("position_3"), false);
@@ -280,7 +280,7 @@ TEST(Milling, RobotSleIsTensOfMicronsAndNearlySpeedIndependentMachineToolAFew) {
     EXPECT_LT(std::abs(mill::surface_location_error(machine, cutter, job.material, cut, cfg::Axis::kX, rpm, 40, 64).sle_um), 5.0);
   }
   EXPECT_GT(lo, 10.0);
-  EXPECT_LT(hi - lo, 0.5 * lo) << "REFERENCE.md section 3: nearly independent of speed below 12000 rpm";
+  EXPECT_LT(hi - lo, 0.5 * lo) << "docs/physics.md §3: nearly independent of speed below 12000 rpm";
 }
 
 // Configuration errors name the key, the value, the unit and the allowed range.

@@ -88,7 +88,7 @@ TEST(PoseScheduleConfig, NonPhysicalOrInconsistentSectionsAreRefusedByName) {
   e = problems_of({{"{name: stretched,", "{name: folded,"}});
   EXPECT_NE(e.find("names regions[0] too"), std::string::npos) << e;
   // A model that is not there, an unknown axis, a negative gain.
-  e = problems_of({{"model: ../robots/seed002.yaml", "model: ../robots/none.yaml"}});
+  e = problems_of({{"model: ../robots/planar_three_link.yaml", "model: ../robots/none.yaml"}});
   EXPECT_NE(e.find("pose_schedule.model = '../robots/none.yaml'"), std::string::npos) << e;
   e = problems_of({{"axis: x ", "axis: z "}});
   EXPECT_NE(e.find("pose_schedule.axis"), std::string::npos) << e;
@@ -122,7 +122,7 @@ TEST(PoseScheduleConfig, JointRegistersMustNotOverlapTheOtherRobotRegisters) {
 // The robot model's modes as the loop's modal table: the modal-stiffness form with damping from each
 // mode's loss factor reproduces the assembled model's TCP receptance along the axis at the dominant peak.
 TEST(PoseSchedule, PoseModesReproduceTheRobotModelsReceptanceAtTheDominantPeak) {
-  const config::RobotModelConfig model = config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/seed002.yaml");
+  const config::RobotModelConfig model = config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   for (const std::vector<double>& q : {std::vector<double>{-100, 10, 90}, std::vector<double>{-100, 100, 90}}) {
     const analysis::PoseModes pm = analysis::pose_modes(model, q, 0, 3);
     ASSERT_EQ(pm.modes.size(), 3u);

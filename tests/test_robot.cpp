@@ -1,5 +1,5 @@
 // Pose-dependent robot dynamics (robot/): the beam element against Euler-Bernoulli's cantilever, the
-// receptance coupling against the assembled model, seed 002's preset at its three poses.
+// receptance coupling against the assembled model, the planar-robot study's preset at its three poses.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -91,16 +91,16 @@ TEST(RobotModel, NonPhysicalModelsAndPosesAreRefusedByName) {
 namespace robodamp {
 namespace {
 
-config::RobotModelConfig coarse_seed002() {
-  config::RobotModelConfig m = config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/seed002.yaml");
+config::RobotModelConfig coarse_planar_robot() {
+  config::RobotModelConfig m = config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   for (auto& l : m.links) l.elements = std::min(l.elements, 2);  // the links are stiff: 2 elements suffice here
   return m;
 }
 
-// Particle swarm recovers the joints from synthetic TCP FRFs (yy, 10-30 Hz) with 1 % noise at seed 002's
+// Particle swarm recovers the joints from synthetic TCP FRFs (yy, 10-30 Hz) with 1 % noise at the planar-robot study's
 // three poses: each stiffness within 2 %, seeded and repeatable.
 TEST(PoseFit, ParticleSwarmRecoversJointStiffnessesFromNoisyFrfsAtThreePoses) {
-  const config::RobotModelConfig truth = coarse_seed002();
+  const config::RobotModelConfig truth = coarse_planar_robot();
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, 0.01 / std::sqrt(2.0));  // 1 % of |H|, complex
   std::vector<robot::MeasuredFrf> data;
@@ -139,7 +139,7 @@ TEST(PoseFit, ParticleSwarmRecoversJointStiffnessesFromNoisyFrfsAtThreePoses) {
 }
 
 TEST(PoseFit, ModelFilesAndPosesAreValidatedByName) {
-  const config::RobotModelConfig m = coarse_seed002();
+  const config::RobotModelConfig m = coarse_planar_robot();
   EXPECT_EQ(config::pose_problem(m, {-100.0, 120.0, -20.0}), std::nullopt);
   const auto far = config::pose_problem(m, {-100.0, 200.0, -20.0});
   ASSERT_TRUE(far.has_value());
@@ -174,11 +174,11 @@ TEST(PoseFit, ModelFilesAndPosesAreValidatedByName) {
 namespace robodamp {
 namespace {
 
-// A milling job whose structure is the robot model at a pose (config/milling/seed002_pose2.yaml): the
+// A milling job whose structure is the robot model at a pose (config/milling/planar_three_link_pose2.yaml): the
 // structure's FRF is the model's TCP receptance, the lobes and the direct test agree, another pose moves the
 // low modes' lobes, and the time-domain cut refuses it by name.
 TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
-  config::MillingConfig job = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml");
+  config::MillingConfig job = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml");
   job.lobes.points = 400;  // enough for the check, a fifth of the job's cost
   job.lobes.points_per_mode = 80;
   const auto& part = *job.structures.front().parts.front().pose;
@@ -234,7 +234,7 @@ TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
   EXPECT_NEAR(td.depth_mm / zoa_mm, 1.0, 0.12);
   EXPECT_NEAR(td.chatter_hz, 27.3, 2.0);
   // A pose outside the travel in the job file is refused when the job is read.
-  std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/seed002_pose2.yaml");
+  std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml");
   text.replace(text.find("119.81"), 6, "200.00");
   try {
     (void)config::parse_milling_config(text, "pose.yaml", std::string(ROBODAMP_SOURCE_DIR) + "/config/milling");

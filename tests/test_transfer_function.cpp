@@ -1,4 +1,4 @@
-// Continuous blocks against closed-form values and the published phases at 9.2 Hz (REFERENCE.md s. 1).
+// Continuous blocks against closed-form values and the published phases at 9.2 Hz (docs/physics.md s. 1).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates the modal tables of config/milling/*.yaml from the CSV tables beside this script
-(copied from ../shared/reference/data, REFERENCE.md sections 2-3). Prints YAML to paste; run:
-    python3 config/milling/data/generate_presets.py seed004 | seed000
+(copied from the published tables, docs/physics.md §6). Prints YAML to paste; run:
+    python3 config/milling/data/generate_presets.py robot_sle | tian2024
 """
 import csv, sys, os
 
@@ -14,8 +14,8 @@ def rows(name):
 def mode(fn, z, k):
     return "{natural_freq_hz: %s, damping_ratio: %s, stiffness_n_per_m: %s}" % (fn, z, k)
 
-if sys.argv[1] == 'seed004':
-    data = rows('seed004_modal.csv')
+if sys.argv[1] == 'robot_sle':
+    data = rows('robot_sle_modal.csv')
     def part(system, name, indent):
         out = [indent + "- name: " + name]
         for d in ('x', 'y'):
@@ -30,7 +30,7 @@ if sys.argv[1] == 'seed004':
     print("  - name: machine_tool\n    parts:")
     print(part('machine_tool', 'machine_tool', '      '))
 else:
-    data = rows('seed000_modal_positions.csv')
+    data = rows('tian2024_modal_positions.csv')
     for p in range(1, 6):
         print("  - name: position_%d\n    parts:\n      - name: tool_tip" % p)
         for d in ('xx', 'xy', 'yx', 'yy'):
