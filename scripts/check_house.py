@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
-"""House checks that read the tree (ctest House.*):
+"""House checks that read the tree and the build (ctest House.*), and the architecture picture:
 
-  python3 scripts/check_house.py sources    # nothing cites a file outside the repository
+  python3 scripts/check_house.py sources              # nothing cites a file outside the repository
+  python3 scripts/check_house.py layers BUILD_DIR     # every library links and includes only downwards
+  python3 scripts/check_house.py picture CMAKE.dot OUT.dot  # the layered picture from CMake's graphviz
 """
+import glob
+import json
 import os
 import re
 import sys
@@ -45,9 +49,126 @@ def sources():
     return 1 if bad else 0
 
 
+# The architecture: each library's layer, bottom first. A library may link and include only libraries of
+# lower layers (docs/architecture.md). A new library must be placed here.
+LAYERS = [
+    ("foundation", ["units"]),
+    ("data and numbers", ["filters", "config", "plot"]),
+    ("physics", ["modal", "robot"]),
+    ("controller and plant", ["control", "sim_plant"]),
+    ("analysis and the loop", ["analysis", "rt"]),
+    ("machining, devices, network", ["milling", "drivers", "dds"]),
+    ("studies and composition", ["identify", "tune", "hil", "runtime", "dashboard"]),
+    ("commissioning", ["commission"]),
+    ("command line", ["apps"]),
+]
+# Folder -> CMake target (the folder's name with the robodamp_ prefix, but for these).
+TARGET = {"sim_plant": "robodamp_sim", "apps": "robodamp_cli"}
+
+
+def layer_of():
+    out = {}
+    for i, (_, folders) in enumerate(LAYERS):
+        for f in folders:
+            out[f] = i
+    return out
+
+
+def build_graph(build_dir):
+    """Each robodamp library's dependencies (transitive) from CMake's file-API code model."""
+    reply = os.path.join(build_dir, ".cmake", "api", "v1", "reply")
+    index = sorted(glob.glob(os.path.join(reply, "index-*.json")))
+    if not index:
+        return None
+    objects = json.load(open(index[-1]))["objects"]
+    model = json.load(open(os.path.join(reply, [o for o in objects if o["kind"] == "codemodel"][0]["jsonFile"])))
+    targets = {}
+    for t in model["configurations"][0]["targets"]:
+        targets[t["id"]] = json.load(open(os.path.join(reply, t["jsonFile"])))
+    folder = {v: k for k, v in TARGET.items()}
+    graph = {}
+    for t in targets.values():
+        name = t["name"]
+        if not name.startswith("robodamp_") or t["type"] != "STATIC_LIBRARY":
+            continue
+        f = folder.get(name, name[len("robodamp_"):])
+        graph[f] = sorted({folder.get(targets[d["id"]]["name"], targets[d["id"]]["name"][len("robodamp_"):])
+                           for d in t.get("dependencies", []) if targets[d["id"]]["name"].startswith("robodamp_")})
+    return graph
+
+
+def includes(folder):
+    """The library folders a folder's sources include from."""
+    used = set()
+    pattern = re.compile(r'^\s*#\s*include\s+"([a-z_0-9]+)/')
+    for d, _, names in os.walk(os.path.join(ROOT, folder)):
+        for n in names:
+            if n.endswith((".cpp", ".hpp", ".in")):
+                for line in open(os.path.join(d, n), encoding="utf-8", errors="replace"):
+                    m = pattern.match(line)
+                    if m and os.path.isdir(os.path.join(ROOT, m.group(1))):
+                        used.add((m.group(1), os.path.relpath(os.path.join(d, n), ROOT)))
+    return used
+
+
+def layers(build_dir):
+    graph = build_graph(build_dir)
+    if graph is None:
+        print(f"no CMake code model in {build_dir}: configure it again (cmake -S . -B {build_dir})")
+        return 1
+    level = layer_of()
+    bad = []
+    for lib, deps in sorted(graph.items()):
+        if lib not in level:
+            bad.append(f"{lib}: not placed in a layer (scripts/check_house.py LAYERS)")
+            continue
+        for d in deps:
+            if d in level and level[d] >= level[lib]:
+                bad.append(f"{lib} (layer {level[lib]}, {LAYERS[level[lib]][0]}) links {d} "
+                           f"(layer {level[d]}, {LAYERS[level[d]][0]}): a library links only downwards")
+        for used, where in sorted(includes(lib)):
+            if used != lib and used in level and used not in deps and used != "units":
+                bad.append(f"{where} includes {used}/, which {lib} does not link")
+            elif used != lib and used in level and level[used] >= level[lib]:
+                bad.append(f"{where} includes {used}/ (layer {level[used]}) from layer {level[lib]}")
+    for b in bad:
+        print(b)
+    print(f"{len(bad)} link(s) or include(s) against the layers" if bad else
+          f"{len(graph)} libraries link and include only downwards ({len(LAYERS)} layers)")
+    return 1 if bad else 0
+
+
+def picture(cmake_dot, out_dot):
+    """CMake's --graphviz output (direct links) redrawn in the layers, robodamp's libraries only."""
+    text = open(cmake_dot).read()
+    label = dict(re.findall(r'"(node\d+)"\s*\[\s*label\s*=\s*"([^"]+)"', text))
+    edges = re.findall(r'"(node\d+)"\s*->\s*"(node\d+)"', text)
+    folder = {v: k for k, v in TARGET.items()}
+    def name(node):
+        t = label.get(node, "")
+        if t == "robodamp":
+            return "apps"
+        if not t.startswith("robodamp_"):
+            return None
+        return folder.get(t, t[len("robodamp_"):])
+    level = layer_of()
+    keep = {(name(a), name(b)) for a, b in edges if name(a) in level and name(b) in level and name(a) != name(b)}
+    lines = ["digraph robodamp {", '  rankdir=BT; node [shape=box, style="rounded,filled", fillcolor="#eef3fb", '
+             'fontname="Helvetica"]; edge [color="#55607a", arrowsize=0.7];', '  ranksep=0.6; nodesep=0.35;']
+    for i, (title, folders) in enumerate(LAYERS):
+        lines.append(f'  subgraph cluster_{i} {{ label="{i}: {title}"; fontname="Helvetica"; fontsize=11; '
+                     f'color="#c8cfdd"; style=dashed; rank=same; ' + " ".join(f'"{f}";' for f in folders) + " }")
+    for a, b in sorted(keep):
+        lines.append(f'  "{a}" -> "{b}";')
+    lines.append("}")
+    open(out_dot, "w").write("\n".join(lines) + "\n")
+    print(f"{len(keep)} direct links among {len(level)} libraries -> {out_dot}")
+    return 0
+
+
 if __name__ == "__main__":
-    checks = {"sources": sources}
-    if len(sys.argv) != 2 or sys.argv[1] not in checks:
+    checks = {"sources": (sources, 0), "layers": (layers, 1), "picture": (picture, 2)}
+    if len(sys.argv) < 2 or sys.argv[1] not in checks or len(sys.argv) != 2 + checks[sys.argv[1]][1]:
         print(__doc__)
         sys.exit(2)
-    sys.exit(checks[sys.argv[1]]())
+    sys.exit(checks[sys.argv[1]][0](*sys.argv[2:]))
