@@ -218,19 +218,34 @@ namespace {
 
 struct AnalyzeArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
-  bool json{false};
+  JsonOut json;
   std::string plot_dir;
   std::optional<double> spindle_rpm;
   bool spindle_sweep{false};
   bool base{false};
 };
 
+// The speed map as JSON: every speed with the notches' phase at each mode, and the refused ranges.
+json speed_map_json(const config::Config& cfg, const analysis::NotchSpeedMap& map) {
+  json points = json::array();
+  for (const auto& p : map.points)
+    points.push_back({{"rpm", p.rpm}, {"stable", p.stable}, {"refused", p.refused}, {"reason", p.reason},
+                      {"notch_phase_deg", p.notch_phase_deg}});
+  json refused = json::array();
+  for (const auto& [lo, hi] : map.refused_rpm) refused.push_back({{"from_rpm", lo}, {"to_rpm", hi}});
+  return {{"config", cfg.source}, {"teeth", cfg.spindle.teeth},
+          {"mode_hz", map.points.empty() ? json::array() : json(map.points.front().mode_hz)},
+          {"points", points}, {"refused", refused}};
+}
+
 // The harmonic notches across spindle.rpm range: the refused speeds and the worst phase at each mode.
-void print_speed_map(const config::Config& cfg) {
+int print_speed_map(const config::Config& cfg, const JsonOut& out) {
   const analysis::NotchSpeedMap map = analysis::notch_speed_map(cfg);
+  if (!emit_json(out, speed_map_json(cfg, map).dump(2), "analyze")) return 1;
+  if (out.to_stdout()) return 0;
   if (map.points.empty()) {
     std::printf("no controller.harmonic_notch configured: nothing to sweep\n");
-    return;
+    return 0;
   }
   std::printf("harmonic notches across %.0f-%.0f rpm (%zu speeds, %d teeth):\n", map.points.front().rpm,
               map.points.back().rpm, map.points.size(), cfg.spindle.teeth);
@@ -250,11 +265,12 @@ void print_speed_map(const config::Config& cfg) {
       }
     std::printf("  refused %.0f-%.0f rpm: %s; the notches park there\n", lo, hi, why.c_str());
   }
+  return 0;
 }
 
 // pose_schedule: each region's set, analysed over its grid (analysis/pose_schedule.hpp); a region with no
 // stable set throws ConfigError (exit 2).
-int print_pose_schedule(const config::Config& cfg, bool as_json) {
+int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
   const analysis::PoseScheduleAnalysis ps = analysis::analyse_pose_schedule(cfg);
   json regions = json::array();
   for (const auto& r : ps.regions) {
@@ -276,10 +292,8 @@ int print_pose_schedule(const config::Config& cfg, bool as_json) {
   }
   const json report = {{"config", cfg.source}, {"model", ps.model.source}, {"axis", cfg.pose_schedule->axis ? "y" : "x"},
                        {"regions", regions}};
-  if (as_json) {
-    std::printf("%s\n", report.dump(2).c_str());
-    return 0;
-  }
+  if (!emit_json(out, report.dump(2), "analyze")) return 1;
+  if (out.to_stdout()) return 0;
   std::printf("pose schedule of %s: robot model %s, actuator along %s\n", cfg.source.c_str(), ps.model.source.c_str(),
               cfg.pose_schedule->axis ? "y" : "x");
   std::printf("%-12s %-26s %-18s %9s %4s %9s %11s %9s %9s %8s\n", "region", "centre (deg)", "dominant (Hz)", "match Hz",
@@ -314,17 +328,14 @@ void add_job_limits(const analysis::LoopModel& m, std::optional<double> rpm, jso
 
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
-  if (a.spindle_sweep) {
-    print_speed_map(config::load_config_file(a.config_path));
-    return 0;
-  }
+  if (a.spindle_sweep) return print_speed_map(config::load_config_file(a.config_path), a.json);
   if (const config::Config cfg = config::load_config_file(a.config_path); cfg.pose_schedule && !a.base)
     return print_pose_schedule(cfg, a.json);
   const analysis::LoopModel model(config::load_config_file(a.config_path), a.spindle_rpm);
   const auto result = analysis::analyse(model);
   auto report = analysis_report(model, result);
   add_job_limits(model, a.spindle_rpm, report);
-  if (print_report(report.dump(2), a.json, analysis_table(report), a.plot_dir,
+  if (print_report(report.dump(2), a.json, "analyze", analysis_table(report), a.plot_dir,
                    [&] { return plot_analysis(model, result, a.plot_dir); },
                    "frf_open_closed.png, nyquist.png, gain_sweep.png in " + a.plot_dir) != 0)
     return 1;
@@ -338,8 +349,8 @@ void register_analyze(Registry& r) {
   CLI::App* sub = r.add("analyze", "Closed-loop stability, margins, polarity and predicted improvement",
                         [a] { return run_analyze(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
-  sub->add_flag("--json", a->json, "Print JSON instead of a table");
-  sub->add_option("--plot-dir", a->plot_dir, "Write FRF, Nyquist and gain-sweep plots (PNG) here");
+  r.json(sub, a->json, "The analysis (or the pose schedule's regions, or the --spindle-sweep map)");
+  r.plot_dir(sub, a->plot_dir, "frf_open_closed.png, nyquist.png and gain_sweep.png");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0},
            "Analyse with controller.harmonic_notch at this spindle speed (spindle.teeth)");
   sub->add_flag("--spindle-sweep", a->spindle_sweep,

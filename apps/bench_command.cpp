@@ -199,7 +199,7 @@ namespace {
 
 struct BenchArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
-  std::string json_path;
+  JsonOut json;
   std::string plot_dir;
   int jobs{0};  // threads for the independent runs; 0 = one per core
 };
@@ -210,15 +210,8 @@ int run_bench(const BenchArgs& a) {
   const auto report = bench.run([](const std::string& line) { std::cerr << "[bench] " << line << std::endl; },
                                 static_cast<std::size_t>(a.jobs));
   std::cout << bench_table(bench, report);
-  if (!a.json_path.empty()) {
-    std::ofstream out(a.json_path);
-    out << bench_report_json(bench, report).dump(2) << '\n';
-    if (!out) {
-      std::cerr << "--json " << a.json_path << ": cannot write\n";
-      return 1;
-    }
-    std::cout << "wrote " << a.json_path << '\n';
-  }
+  if (!emit_json(a.json, bench_report_json(bench, report).dump(2), "bench")) return 1;
+  if (a.json.to_file()) std::cout << "wrote " << a.json.path << '\n';
   if (!a.plot_dir.empty()) {
     std::string err = plot_analysis(bench.model(), report.analysis, a.plot_dir);
     if (err.empty()) err = plot_bench(bench, report, a.plot_dir);
@@ -239,8 +232,8 @@ void register_bench(Registry& r) {
   CLI::App* sub = r.add("bench", "Simulated-plant bench run: impact tests control off/on, saturation, gain sweep",
                         [a] { return run_bench(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
-  sub->add_option("--json", a->json_path, "Write the report as JSON to this file");
-  sub->add_option("--plot-dir", a->plot_dir, "Write plots (PNG) here");
+  r.json(sub, a->json, "The report");
+  r.plot_dir(sub, a->plot_dir, "the FRFs, Nyquist, gain sweep and bench plots");
   r.whole_number(sub, "--jobs", a->jobs, {"(threads)", 0, 256, false, false, "0 = one per core"},
                  "Threads for the independent runs (0 = one per core, 1 = serial); the report is the same for any");
 }

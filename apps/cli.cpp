@@ -5,7 +5,14 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
 #include <iostream>
+
+#include <unistd.h>
+
+#include "rt/version.hpp"
 
 namespace robodamp::apps {
 
@@ -103,12 +110,99 @@ std::vector<std::string> Registry::number_problems(const CLI::App* sub) const {
   return out;
 }
 
+namespace {
+
+int g_json_fd = -1;  // the real stdout while --json prints there (the command's text goes to stderr)
+
+// While --json prints on stdout: file descriptor 1 is stderr for the command (iostreams and stdio alike),
+// and the JSON goes to the saved stdout.
+class StdoutForJson {
+ public:
+  explicit StdoutForJson(bool on) {
+    if (!on) return;
+    std::cout.flush();
+    std::fflush(stdout);
+    g_json_fd = ::dup(1);
+    if (g_json_fd >= 0) (void)::dup2(2, 1);
+  }
+  ~StdoutForJson() {
+    if (g_json_fd < 0) return;
+    std::cout.flush();
+    std::fflush(stdout);
+    (void)::dup2(g_json_fd, 1);
+    ::close(g_json_fd);
+    g_json_fd = -1;
+  }
+  StdoutForJson(const StdoutForJson&) = delete;
+  StdoutForJson& operator=(const StdoutForJson&) = delete;
+};
+
+}  // namespace
+
+bool emit_json(const JsonOut& out, const std::string& text, const std::string& command) {
+  if (!out.given) return true;
+  if (out.to_stdout()) {
+    const std::string line = text + '\n';
+    const int fd = g_json_fd >= 0 ? g_json_fd : 1;
+    std::cout.flush();
+    std::fflush(stdout);
+    for (std::size_t done = 0; done < line.size();) {
+      const ssize_t n = ::write(fd, line.data() + done, line.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        std::cerr << "robodamp " << command << ": --json: cannot write to stdout\n";
+        return false;
+      }
+      done += static_cast<std::size_t>(n);
+    }
+    return true;
+  }
+  std::ofstream f(out.path);
+  f << text << '\n';
+  f.close();
+  if (!f) {
+    std::cerr << "robodamp " << command << ": --json " << out.path << ": cannot write\n";
+    return false;
+  }
+  return true;
+}
+
+CLI::Option* Registry::json(CLI::App* sub, JsonOut& target, const std::string& what) {
+  CLI::Option* o = sub->add_option("--json", target.path,
+                                   what + ": --json FILE writes it to FILE; --json alone or --json - prints it on "
+                                          "stdout instead of the text (docs/cli.md)")
+                       ->expected(0, 1)
+                       ->type_name("[FILE]");
+  json_.emplace_back(o, &target);
+  return o;
+}
+
+CLI::Option* Registry::plot_dir(CLI::App* sub, std::string& target, const std::string& what) {
+  return sub->add_option("--plot-dir", target, "Write " + what + " (PNG) into this directory")->type_name("DIR");
+}
+
+CLI::Option* Registry::deprecated(CLI::Option* option, const std::string& replacement) {
+  option->description(option->get_description() + " (deprecated, kept for one release: use " + replacement + ")");
+  deprecated_.emplace_back(option, replacement);
+  return option;
+}
+
 int Registry::run_parsed() const {
   for (const auto& [sub, handler] : handlers_) {
     if (!sub->parsed()) continue;
     const auto problems = number_problems(sub);
     for (const auto& p : problems) std::cerr << "robodamp " << sub->get_name() << ": " << p << '\n';
     if (!problems.empty()) return 2;
+    bool json_to_stdout = false;
+    for (const auto& [opt, out] : json_) {
+      out->given = opt->count() > 0;
+      json_to_stdout = json_to_stdout || out->to_stdout();
+    }
+    for (const auto& [opt, replacement] : deprecated_)
+      if (opt->count() > 0)
+        std::cerr << "robodamp " << sub->get_name() << ": " << opt->get_name() << " is deprecated (kept for one release): use "
+                  << replacement << '\n';
+    const StdoutForJson redirect(json_to_stdout);
     try {
       return handler();
     } catch (const config::ConfigError& e) {  // a handler's own configuration checks
@@ -122,6 +216,17 @@ int Registry::run_parsed() const {
   return 2;
 }
 
+std::string version_text() {
+  std::string text = std::string("robodamp ") + rt::version() + " (commit " + rt::git_commit() + ")\nbuilt against:";
+  const std::string deps = ROBODAMP_DEPENDENCY_VERSIONS;
+  for (std::size_t start = 0; start <= deps.size();) {
+    const std::size_t end = std::min(deps.find('|', start), deps.size());
+    text += "\n  " + deps.substr(start, end - start);
+    start = end + 1;
+  }
+  return text;
+}
+
 int dispatch(int argc, const char* const* argv) {
   CLI::App app{"robodamp: real-time active vibration damping for robotic milling"};
   app.require_subcommand(1);
@@ -130,8 +235,11 @@ int dispatch(int argc, const char* const* argv) {
                    register_replay, register_csv, register_lobes, register_sle, register_cut, register_identify, register_measure, register_commission, register_pose, register_tune, register_plant, register_monitor,
                    register_request, register_dashboard})
     reg(r);
+  app.set_version_flag("--version", [] { return version_text(); }, "robodamp's version and the dependencies it was built against");
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

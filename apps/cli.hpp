@@ -17,6 +17,19 @@
 
 namespace robodamp::apps {
 
+// The one --json of every command (docs/cli.md): `--json FILE` writes the JSON to FILE and the command
+// prints its text as usual; `--json` alone or `--json -` prints the JSON on stdout, and then stdout
+// carries nothing else (the command's text goes to stderr).
+struct JsonOut {
+  std::string path;
+  bool given{false};  // set after parsing
+  [[nodiscard]] bool to_stdout() const { return given && (path.empty() || path == "-"); }
+  [[nodiscard]] bool to_file() const { return given && !to_stdout(); }
+};
+// Writes the JSON where --json asked (nothing when it was not given); false, with the reason on stderr,
+// when the file cannot be written.
+[[nodiscard]] bool emit_json(const JsonOut& out, const std::string& text, const std::string& command);
+
 class Registry {
  public:
   explicit Registry(CLI::App& app) : app_(app) {}
@@ -36,6 +49,12 @@ class Registry {
                             const config::Range& range, const std::string& help);
   CLI::Option* numbers(CLI::App* sub, const std::string& flag, std::vector<double>& target, const config::Range& range,
                        const std::string& help);
+  // The --json [FILE] option (JsonOut); `what` says what the JSON holds.
+  CLI::Option* json(CLI::App* sub, JsonOut& target, const std::string& what);
+  // The --plot-dir DIR option: where the command writes its plots (PNG), `what` says which.
+  CLI::Option* plot_dir(CLI::App* sub, std::string& target, const std::string& what);
+  // An old spelling kept for one release: still works, says on stderr what replaces it.
+  CLI::Option* deprecated(CLI::Option* option, const std::string& replacement);
 
   // After parsing: the problems of the numbers given to `sub`, each in the configuration's wording.
   [[nodiscard]] std::vector<std::string> number_problems(const CLI::App* sub) const;
@@ -52,6 +71,8 @@ class Registry {
                       const std::string& help, std::function<void(double)> assign);
   CLI::App& app_;
   std::vector<std::pair<CLI::App*, std::function<int()>>> handlers_;
+  std::vector<std::pair<CLI::Option*, JsonOut*>> json_;
+  std::vector<std::pair<CLI::Option*, std::string>> deprecated_;
   std::vector<Check> checks_;
   std::deque<std::vector<std::string>> texts_;  // stable addresses for CLI11 to fill
 };
@@ -60,7 +81,11 @@ class Registry {
 [[nodiscard]] std::optional<std::string> parse_number(const std::string& flag, const std::string& text,
                                                       const config::Range& range, bool whole, double& out);
 
-// Parses and runs a command line. 0 for --help; 2 for a bad command line (message on stderr).
+// `robodamp --version`: robodamp's version and commit, and the dependencies it was built against.
+[[nodiscard]] std::string version_text();
+
+// Parses and runs a command line. 0 for --help and --version; 2 for a bad command line (message on
+// stderr); the exit statuses are in docs/cli.md.
 [[nodiscard]] int dispatch(int argc, const char* const* argv);
 
 // Registration of each subcommand (apps/<name>_command.cpp).

@@ -43,7 +43,8 @@ struct CutArgs {
   std::optional<int> revs;
   bool critical{false};
   bool damped{false};
-  std::string json_path, plot_dir;
+  JsonOut json;
+  std::string plot_dir;
   std::string controller_path;   // replaces every controller part's damping configuration
   std::vector<double> pose_deg;  // the joints of the job's robot pose parts
   std::string hil_path;          // --critical through the HIL emulator too: the cell's configuration
@@ -230,15 +231,8 @@ int run_cut(const CutArgs& a) {
     }
     out["config"] = cfg.source;
     out["structure"] = structure.name();
-    if (!a.json_path.empty()) {
-      std::ofstream f(a.json_path);
-      f << out.dump(2) << '\n';
-      if (!f) {
-        std::cerr << "--json " << a.json_path << ": cannot write\n";
-        return 1;
-      }
-      std::printf("wrote %s\n", a.json_path.c_str());
-    }
+    if (!emit_json(a.json, out.dump(2), "cut")) return 1;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
     return 0;
   } catch (const config::ConfigError& e) {
     // Options and derived checks name themselves; problems in the job file come with file:line.
@@ -272,8 +266,8 @@ void register_cut(Registry& r) {
                   "With --critical: also the critical depth through the HIL emulator, a cell configuration for the job's "
                   "robot with can.interface unix:... (robodamp plant and the controller as two processes, lockstep)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--json", a->json_path, "Write the result as JSON to this file");
-  sub->add_option("--plot-dir", a->plot_dir, "Write displacement, force, spectrum and surface plots (PNG) here");
+  r.json(sub, a->json, "The result");
+  r.plot_dir(sub, a->plot_dir, "displacement, force, spectrum and surface plots");
 }
 
 }  // namespace robodamp::apps

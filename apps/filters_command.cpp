@@ -127,8 +127,8 @@ namespace {
 struct FiltersArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   double freq_hz{9.2};
-  bool json{false};
-  std::string plot;
+  JsonOut json;
+  std::string plot_dir, plot;
 };
 
 int run_filters(const FiltersArgs& a) {
@@ -140,8 +140,9 @@ int run_filters(const FiltersArgs& a) {
     return 2;
   }
   const auto report = filters_report(d, a.freq_hz);
-  return print_report(report.dump(2), a.json, filters_table(report), a.plot, [&] { return plot_filters(d, a.plot); },
-                      a.plot);
+  const std::string target = plot_file(a.plot_dir, a.plot, "filters.png");
+  return print_report(report.dump(2), a.json, "filters", filters_table(report), target,
+                      [&] { return plot_filters(d, target); }, target);
 }
 
 }  // namespace
@@ -152,8 +153,9 @@ void register_filters(Registry& r) {
                         [a] { return run_filters(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   r.number(sub, "--freq", a->freq_hz, {"Hz", 0.0, 1e6, true, false, "and below Nyquist of loop.rate_hz"}, "Frequency in Hz");
-  sub->add_flag("--json", a->json, "Print JSON instead of a table");
-  sub->add_option("--plot", a->plot, "Write a Bode diagram of the blocks and the chain (PNG)");
+  r.json(sub, a->json, "The blocks' and the chain's magnitude and phase");
+  r.plot_dir(sub, a->plot_dir, "filters.png, the Bode diagram of the blocks and the chain,");
+  r.deprecated(sub->add_option("--plot", a->plot, "Write the Bode diagram to this file (PNG)"), "--plot-dir DIR");
 }
 
 }  // namespace robodamp::apps

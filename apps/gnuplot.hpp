@@ -4,17 +4,22 @@
 #include <functional>
 #include <string>
 
+#include "apps/cli.hpp"
 #include "plot/gnuplot.hpp"
 
 namespace robodamp::apps {
 
 using plot::run_gnuplot;
 
-// A report on stdout (JSON or the table), then the plot if a target is given: plot() returns the reason it
-// failed or an empty string, and "wrote <what>" goes to stdout (stderr with JSON, to keep stdout parseable).
-// Returns 0, or 1 when the plot failed.
-[[nodiscard]] int print_report(const std::string& json_text, bool json, const std::string& table,
-                               const std::string& plot_target, const std::function<std::string()>& plot,
-                               const std::string& wrote);
+// A report: the JSON where --json asked (apps/cli.hpp), the table unless the JSON is on stdout, then the
+// plot if a target is given: plot() returns the reason it failed or an empty string, and "wrote <what>"
+// follows. Returns 0, or 1 when the JSON or the plot could not be written.
+[[nodiscard]] int print_report(const std::string& json_text, const JsonOut& json, const std::string& command,
+                               const std::string& table, const std::string& plot_target,
+                               const std::function<std::string()>& plot, const std::string& wrote);
+
+// Where a command's one plot goes: DIR/name with --plot-dir DIR (the directory made), else the deprecated
+// --plot FILE (empty: no plot).
+[[nodiscard]] std::string plot_file(const std::string& plot_dir, const std::string& legacy_file, const std::string& name);
 
 }  // namespace robodamp::apps

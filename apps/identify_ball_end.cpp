@@ -63,15 +63,15 @@ int run_identify_ball_end(const IdentifyArgs& a) {
   for (const auto* p : {&f.ktc, &f.krc, &f.kac})
     for (const auto& e : *p) wide = wide || e.ci95 > std::abs(e.value);
   if (wide) std::printf("  note: some 95 %% intervals are wider than their values: the runs do not determine them\n");
-  if (!a.json_path.empty()) {
+  if (a.json.given) {
     const nlohmann::json j = {{"ktc_n_per_mm2", terms(f.ktc)}, {"krc_n_per_mm2", terms(f.krc)}, {"kac_n_per_mm2", terms(f.kac)},
                               {"kte_n_per_mm", {{"value", f.kte.value}, {"ci95", f.kte.ci95}}},
                               {"kre_n_per_mm", {{"value", f.kre.value}, {"ci95", f.kre.ci95}}},
                               {"kae_n_per_mm", {{"value", f.kae.value}, {"ci95", f.kae.ci95}}},
                               {"r2_y", f.r2_y}, {"r2_xz", f.r2_xz}, {"residual_rms_n", f.residual_rms_n},
                               {"condition_number", f.condition_number}, {"runs", f.runs}, {"order", a.order}};
-    std::ofstream(a.json_path) << j.dump(2) << '\n';
-    std::printf("wrote %s\n", a.json_path.c_str());
+    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   if (!a.yaml_path.empty()) {
     std::ofstream y(a.yaml_path);

@@ -94,9 +94,9 @@ int run_modes(const IdentifyArgs& a) {
     yaml << "  - {natural_freq_hz: " << m.natural_freq_hz << ", damping_ratio: " << m.damping_ratio
          << ", residue_re_m_per_n: " << m.residue_re << ", residue_im_m_per_n: " << m.residue_im << "}\n";
   }
-  if (!a.json_path.empty()) {
-    std::ofstream(a.json_path) << j.dump(2) << '\n';
-    std::printf("wrote %s\n", a.json_path.c_str());
+  if (a.json.given) {
+    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   if (!a.yaml_path.empty()) {
     std::ofstream(a.yaml_path) << yaml.str();
@@ -143,14 +143,14 @@ int run_identify(const IdentifyArgs& a) {
   line("Kte", f.kte, "N/mm"), line("Kre", f.kre, "N/mm"), line("Kae", f.kae, "N/mm");
   std::printf("  R^2 %.6f (x, y) %.6f (z), residual RMS %.4g N, condition number %.3g (refused above %.0e)\n", f.r2_xy,
               f.r2_z, f.residual_rms_n, f.condition_number, identify::kMaxConditionNumber);
-  if (!a.json_path.empty()) {
+  if (a.json.given) {
     const nlohmann::json j = {{"ktc_n_per_mm2", estimate(f.ktc)}, {"krc_n_per_mm2", estimate(f.krc)},
                               {"kac_n_per_mm2", estimate(f.kac)}, {"kte_n_per_mm", estimate(f.kte)},
                               {"kre_n_per_mm", estimate(f.kre)},  {"kae_n_per_mm", estimate(f.kae)},
                               {"r2_xy", f.r2_xy}, {"r2_z", f.r2_z}, {"residual_rms_n", f.residual_rms_n},
                               {"condition_number", f.condition_number}, {"samples", f.samples}};
-    std::ofstream(a.json_path) << j.dump(2) << '\n';
-    std::printf("wrote %s\n", a.json_path.c_str());
+    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   if (!a.yaml_path.empty()) {
     std::ofstream y(a.yaml_path);
@@ -186,7 +186,7 @@ void register_identify(Registry& r) {
   sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes, actuator: fit band LO HI (default: the whole FRF; actuator: the chirp within analysis.band)");
   r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes, all: highest order of the stabilisation diagram (even; default 40 for modes, 60 for all: a close pair common to several FRFs separates slowly with the order)");
-  sub->add_option("--plot-dir", a->plot_dir, "modes, all: write the fits and the stabilisation diagrams (PNG) here");
+  r.plot_dir(sub, a->plot_dir, "modes, all: the fits and the stabilisation diagrams");
   sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
       ->check(CLI::ExistingFile);
   r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");
@@ -207,7 +207,7 @@ void register_identify(Registry& r) {
       ->check(CLI::ExistingFile);
   sub->add_option("--in", a->in_dir, "all: the directory robodamp measure wrote")->check(CLI::ExistingDirectory);
   sub->add_option("--out", a->out_path, "all: write the identified configuration (YAML) here");
-  sub->add_option("--json", a->json_path, "Write the result and its quality figures as JSON");
+  r.json(sub, a->json, "The result and its quality figures");
   sub->add_option("--yaml", a->yaml_path, "Write a modes: list (modes) or a material: block (cutting)");
 }
 

@@ -5,6 +5,8 @@
 
 #include <optional>
 #include <string>
+
+#include "apps/cli.hpp"
 #include <vector>
 
 #include "identify/modal_fit.hpp"
@@ -13,7 +15,8 @@ namespace robodamp::apps {
 
 struct IdentifyArgs {
   std::string what;
-  std::string csv_path, json_path, yaml_path;
+  std::string csv_path, yaml_path;
+  JsonOut json;
   int teeth{0};
   double diameter_mm{0.0}, axial_mm{0.0}, radial_mm{0.0};
   std::string mode{"down"};

@@ -101,7 +101,7 @@ int run_identify_actuator(const IdentifyArgs& a) {
               "  fit error %.3f %% (RMS |G - fit| / RMS |G|) over %.3g-%.3g Hz, %d points with coherence >= %.2f\n",
               mounting.c_str(), fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, fit.delay_ms,
               fit.fit_error_pct, fit.band_lo_hz, fit.band_hi_hz, fit.points, kActuatorMinCoherence);
-  if (!a.json_path.empty()) {
+  if (a.json.given) {
     const nlohmann::json j = {{"mounting", mounting},
                               {"force_constant_n_per_v", fit.force_constant_n_per_v},
                               {"natural_freq_hz", fit.natural_freq_hz},
@@ -110,13 +110,8 @@ int run_identify_actuator(const IdentifyArgs& a) {
                               {"fit_error_pct", fit.fit_error_pct},
                               {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}},
                               {"points", fit.points}};
-    std::ofstream out(a.json_path);
-    out << j.dump(2) << '\n';
-    if (!out) {
-      std::cerr << "--json " << a.json_path << ": cannot write\n";
-      return 1;
-    }
-    std::printf("wrote %s\n", a.json_path.c_str());
+    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   return 0;
 }
@@ -159,14 +154,9 @@ int run_identify_all(const IdentifyArgs& a) {
     }
     std::printf("wrote plots in %s\n", a.plot_dir.c_str());
   }
-  if (!a.json_path.empty()) {
-    std::ofstream out(a.json_path);
-    out << identify::to_json(r).dump(2) << '\n';
-    if (!out) {
-      std::cerr << "--json " << a.json_path << ": cannot write\n";
-      return 1;
-    }
-    std::printf("wrote %s\n", a.json_path.c_str());
+  if (a.json.given) {
+    if (!emit_json(a.json, identify::to_json(r).dump(2), "identify")) return 1;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   if (!r.stable) {
     std::cerr << "robodamp identify all: the identified loop is unstable at the configured gain: lower "

@@ -32,7 +32,7 @@ void register_lobes(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
   CLI::App* sub = r.add("lobes", "Stability lobes (semi-discretization of what runs, or a zero-order preview), open loop and --damped",
                         [o] { return run_lobes(*o); });
-  add_milling_options(sub, *o);
+  add_milling_options(r, sub, *o, "lobes");
   sub->add_option("--method", o->method, "sdm (default): semi-discretization of what runs, open loop and the sampled damped loop (time_domain.sdm_*); zoa: the zero-order method, a fast preview")
       ->check(CLI::IsMember({"zoa", "sdm"}));
   r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 1e6, true, false, "and within the job's lobes speed range"},

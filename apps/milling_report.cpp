@@ -207,10 +207,10 @@ std::string tool_text(const config::MillingConfig& c) {
   return os.str();
 }
 
-int finish(const json& report, const MillingOptions& o, const std::string& table,
+int finish(const json& report, const MillingOptions& o, const std::string& command, const std::string& table,
            std::string (*plot)(const json&, const std::string&)) {
-  return print_report(report.dump(2), o.json, table, o.plot_path, [&] { return plot(report, o.plot_path); },
-                      o.plot_path);
+  const std::string target = plot_file(o.plot_dir, o.plot_path, command + ".png");
+  return print_report(report.dump(2), o.json, command, table, target, [&] { return plot(report, target); }, target);
 }
 
 // --- SLE -------------------------------------------------------------------------------------------
@@ -409,7 +409,7 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   return r;
 }
 
-int print_lobes(const json& r, const MillingOptions& o) { return finish(r, o, lobes_table(r), plot_lobes); }
+int print_lobes(const json& r, const MillingOptions& o) { return finish(r, o, "lobes", lobes_table(r), plot_lobes); }
 
 json sle_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   const auto sc = selected(cfg, o);
@@ -424,13 +424,14 @@ json sle_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   return r;
 }
 
-int print_sle(const json& r, const MillingOptions& o) { return finish(r, o, sle_table(r), plot_sle); }
+int print_sle(const json& r, const MillingOptions& o) { return finish(r, o, "sle", sle_table(r), plot_sle); }
 
-void add_milling_options(CLI::App* sub, MillingOptions& o) {
+void add_milling_options(Registry& r, CLI::App* sub, MillingOptions& o, const std::string& command) {
   sub->add_option("--config", o.config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
   sub->add_option("--structure", o.structure, "Which of the job's structures (default: its `structure`)");
-  sub->add_flag("--json", o.json, "Print JSON instead of a table");
-  sub->add_option("--plot", o.plot_path, "Write a plot (PNG)");
+  r.json(sub, o.json, "The report (every speed, the limits and their methods)");
+  r.plot_dir(sub, o.plot_dir, command + ".png");
+  r.deprecated(sub->add_option("--plot", o.plot_path, "Write the plot to this file (PNG)"), "--plot-dir DIR");
   sub->add_flag("--damped", o.damped, "Also with the damping controller's loop closed, overlaid");
   sub->add_option("--controller", o.controller_path, "Damping configuration to use instead of the job's (compare compensators)")
       ->check(CLI::ExistingFile);

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli.hpp"
 #include "config/milling_config.hpp"
 
 namespace robodamp::apps {
@@ -15,8 +16,9 @@ namespace robodamp::apps {
 struct MillingOptions {
   std::string config_path{ROBODAMP_DEFAULT_MILLING_CONFIG};
   std::string structure;          // empty: the configuration's choice
-  bool json{false};
-  std::string plot_path;          // PNG
+  JsonOut json;
+  std::string plot_dir;           // --plot-dir: DIR/lobes.png or DIR/sle.png
+  std::string plot_path;          // the deprecated --plot FILE (PNG)
   bool damped{false};             // also with the controller's loop closed, overlaid
   std::vector<double> rpm;        // lobes: extra speeds for the direct test
   std::string controller_path;    // replaces every controller part's damping configuration
@@ -28,7 +30,8 @@ struct MillingOptions {
 // config::ConfigError when the job has no pose part or the pose does not fit.
 void apply_pose(config::MillingConfig& cfg, const MillingOptions& o);
 
-void add_milling_options(CLI::App* sub, MillingOptions& o);
+// `command` is "lobes" or "sle" (the plot's file name in --plot-dir).
+void add_milling_options(Registry& r, CLI::App* sub, MillingOptions& o, const std::string& command);
 
 // The job's structure by name (empty: the job's choice), every controller part's damping configuration
 // replaced by controller_path when given. Throws config::ConfigError for an unknown name.

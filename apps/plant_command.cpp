@@ -20,7 +20,7 @@ struct PlantArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   std::string pacing;
   double duration_s{0.0};
-  std::string json_path;
+  JsonOut json;
   bool impacts{true};
   int impact_location{0};
   std::string measure_out;
@@ -144,14 +144,7 @@ int run_plant(const PlantArgs& a) {
   eo.stop_flag = &rt::shutdown_signal();
   const hil::EmulatorReport r = hil::run_emulator(cfg, eo);
   std::cout << hil::report_text(r);
-  if (!a.json_path.empty()) {
-    std::ofstream out(a.json_path);
-    out << hil::report_json(r).dump(2) << '\n';
-    if (!out) {
-      std::cerr << "--json " << a.json_path << ": cannot write\n";
-      return 1;
-    }
-  }
+  if (!emit_json(a.json, hil::report_json(r).dump(2), "plant")) return 1;
   return r.records_planned > 0 && !r.campaign_complete ? 1 : 0;
 }
 
@@ -168,7 +161,7 @@ void register_plant(Registry& r) {
       ->check(CLI::IsMember({"realtime", "lockstep"}));
   r.number(sub, "--duration", a->duration_s, {"s", 0.0, 604800.0, false, false, "0 = when the controller leaves"},
            "Stop after this much plant time");
-  sub->add_option("--json", a->json_path, "Write the report (frames, timing, measured FRFs) as JSON to this file");
+  r.json(sub, a->json, "The report (frames, timing, measured FRFs)");
   sub->add_flag("!--no-impacts", a->impacts, "Do not run the impact schedule");
   sub->add_option("--measure-out", a->measure_out,
                   "The plant side of robodamp measure: the commissioning impacts at every location, FRFs written here");

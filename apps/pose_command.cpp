@@ -35,8 +35,9 @@ struct PoseArgs {
   std::string model_path{std::string(ROBODAMP_SOURCE_DIR_FOR_CLI) + "/config/robots/planar_three_link.yaml"};
   std::vector<double> joints_deg;
   std::string pose_name;
-  bool json_out{false};
-  std::string json_path, plot_path;
+  JsonOut json;
+  std::string json_out_path;  // the deprecated --json-out FILE: the JSON also there
+  std::string plot_dir, plot_path;
   int modes{4};
   std::vector<double> band_hz{2.0, 60.0};
   std::vector<int> vary{2, 3};
@@ -51,6 +52,8 @@ struct PoseArgs {
   std::string job_path;  // map: a milling job with a pose part: its minimum limiting depth at each pose
   std::string method{"sdm"};  // map: the accurate method, or "zoa" (the zero-order preview)
 };
+
+bool also_json_out(const PoseArgs& a, const json& j);
 
 // "Q1,Q2,Q3:path" -> the pose and the FRF (a freq_hz,re_m_per_n,im_m_per_n[,coherence] receptance CSV).
 robot::MeasuredFrf measured_frf(const std::string& item) {
@@ -116,8 +119,8 @@ int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
     }
     t << "  wrote the fitted model to " << a.out_path << '\n';
   }
-  if (!a.json_path.empty()) std::ofstream(a.json_path) << out.dump(2) << '\n';
-  return print_report(out.dump(2), a.json_out, t.str(), "", {}, "");
+  if (!also_json_out(a, out)) return 1;
+  return print_report(out.dump(2), a.json, "pose", t.str(), "", {}, "");
 }
 
 std::vector<double> pose_of(const config::RobotModelConfig& m, const PoseArgs& a) {
@@ -193,8 +196,8 @@ int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
   std::snprintf(b, sizeof b, "  TCP FRF %g-%g Hz: receptance coupling (RCSA) within %.2g of the assembled model\n",
                 a.band_hz[0], a.band_hz[1], worst);
   t << b;
-  if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
-  return print_report(r.dump(2), a.json_out, t.str(), a.plot_path, [&] {
+  if (!also_json_out(a, r)) return 1;
+  return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
     const std::string s = "set terminal pngcairo size 900,600; set output '" + a.plot_path +
                           "'; set logscale xy; set grid; set xlabel 'frequency (Hz)'; set ylabel '|receptance| (m/N)';"
                           " set title 'TCP receptance at the pose'; plot DATA u 1:2 w l lw 2 t 'xx', '' u 1:3 w l lw 2 t 'yy',"
@@ -226,8 +229,8 @@ int run_table(const config::RobotModelConfig& m, const PoseArgs& a) {
                     {"measured_f1_hz", p.measured_f1_hz ? json(*p.measured_f1_hz) : json(nullptr)}});
   }
   const json r = {{"model", m.source}, {"poses", rows}};
-  if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
-  return print_report(r.dump(2), a.json_out, t.str(), "", {}, "");
+  if (!also_json_out(a, r)) return 1;
+  return print_report(r.dump(2), a.json, "pose", t.str(), "", {}, "");
 }
 
 int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
@@ -304,8 +307,8 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
     r["min_depth_min_mm"] = b_min;
     r["min_depth_max_mm"] = b_max;
   }
-  if (!a.json_path.empty()) std::ofstream(a.json_path) << r.dump(2) << '\n';
-  return print_report(r.dump(2), a.json_out, t.str(), a.plot_path, [&] {
+  if (!also_json_out(a, r)) return 1;
+  return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
     const std::string s = "set terminal pngcairo size " + std::string(job ? "2000" : "1400") + ",600; set output '" + a.plot_path +
                           "'; set multiplot layout 1," + std::string(job ? "3" : "2") + "; set view map; set xlabel 'joint " + std::to_string(a.vary[0]) +
                           " (deg)'; set ylabel 'joint " + std::to_string(a.vary[1]) +
@@ -319,7 +322,15 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
   }, a.plot_path);
 }
 
-int run_pose(const PoseArgs& a) {
+// The deprecated --json-out FILE: the JSON written there as well.
+bool also_json_out(const PoseArgs& a, const json& j) {
+  if (a.json_out_path.empty()) return true;
+  return emit_json(JsonOut{a.json_out_path, true}, j.dump(2), "pose");
+}
+
+int run_pose(const PoseArgs& given) {
+  PoseArgs a = given;
+  a.plot_path = plot_file(a.plot_dir, a.plot_path, "pose_" + a.what + ".png");
   try {
     const config::RobotModelConfig m = config::load_robot_model(a.model_path);
     if (a.what == "frf") return run_frf(m, a);
@@ -349,9 +360,10 @@ void register_pose(Registry& r) {
   sub->add_option("--pose", a->pose_name, "frf, map: a pose the model file names");
   r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes");
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e4, true, false}, "frf: FRF band LO HI");
-  sub->add_flag("--json", a->json_out, "Print JSON instead of the table");
-  sub->add_option("--json-out", a->json_path, "Also write the JSON to this file");
-  sub->add_option("--plot", a->plot_path, "frf, map: write a PNG");
+  r.json(sub, a->json, "The result (modes, the table, the fit or the map)");
+  r.deprecated(sub->add_option("--json-out", a->json_out_path, "Also write the JSON to this file"), "--json FILE");
+  r.plot_dir(sub, a->plot_dir, "frf, map: pose_frf.png or pose_map.png");
+  r.deprecated(sub->add_option("--plot", a->plot_path, "frf, map: write the plot to this file (PNG)"), "--plot-dir DIR");
   sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
   sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose)")
       ->check(CLI::ExistingFile);

@@ -27,7 +27,7 @@ struct RunArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   double duration_s{10.0};
   std::string record_path;
-  std::string json_path;
+  JsonOut json;
   std::string histogram_path;  // wake-up latency histogram in cyclictest's --histfile format
   std::string clock;
   double impact_every_s{2.0};
@@ -434,14 +434,7 @@ int run_loop(const RunArgs& a) {
   if (runtime::Status s = cell.deactivate(); !s.ok()) std::cerr << "robodamp run: " << s.message << '\n';
   const runtime::RunSummary& s = cell.summary();
   std::cout << summary_text(s);
-  if (!a.json_path.empty()) {
-    std::ofstream out(a.json_path);
-    out << summary_json(s).dump(2) << '\n';
-    if (!out) {
-      std::cerr << "--json " << a.json_path << ": cannot write\n";
-      return 1;
-    }
-  }
+  if (!emit_json(a.json, summary_json(s).dump(2), "run")) return 1;
   if (!a.histogram_path.empty() && !write_histogram(a.histogram_path, s)) {
     std::cerr << "--histogram " << a.histogram_path << ": cannot write\n";
     return 1;
@@ -467,7 +460,7 @@ void register_run(Registry& r) {
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   r.number(sub, "--duration", a->duration_s, {"s", 0.0, 604800.0, true, false, "one week"}, "Run time in seconds");
   sub->add_option("--record", a->record_path, "Record every tick to this file (binary, docs/recording_format.md)");
-  sub->add_option("--json", a->json_path, "Write the run summary as JSON to this file");
+  r.json(sub, a->json, "The run summary");
   sub->add_option("--histogram", a->histogram_path,
                   "Write the wake-up latency histogram (cyclictest --histfile layout) to this file");
   sub->add_option("--clock", a->clock, "Override loop.clock: wall (real time) or virtual (as fast as possible)")

@@ -14,7 +14,7 @@ void register_sle(Registry& r) {
     apply_pose(cfg, *o);
     return print_sle(sle_report(cfg, *o), *o);
   });
-  add_milling_options(sub, *o);
+  add_milling_options(r, sub, *o, "sle");
   r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
 }
 

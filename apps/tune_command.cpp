@@ -29,8 +29,8 @@ struct TuneArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   std::string job_path;
   std::string out_path;
-  std::string json_path;
-  std::string plot_path;
+  JsonOut json;
+  std::string plot_dir, plot_path;
   std::vector<std::string> also_paths;  // more plants: the worst case is tuned
   std::optional<double> shift_pct;      // each plant also with its modes shifted by -/+ this
   tune::TuneSettings settings;
@@ -255,10 +255,10 @@ int run_tune(const TuneArgs& a) {
     const bool nominal = !a.shift_pct || i % 3 == 0;
     const auto rows = compare(plants[i], plants.size() == 1 ? r.best : r.best.per_plant[i], nominal);
     report_plant(plants[i], rows, per_plant);
-    if (i == 0 && !a.plot_path.empty() && job) {
-      const std::string failed = plot_lobes(plants[i], rows, a.plot_path);
+    if (const std::string plot = plot_file(a.plot_dir, a.plot_path, "tune_lobes.png"); i == 0 && !plot.empty() && job) {
+      const std::string failed = plot_lobes(plants[i], rows, plot);
       if (!failed.empty()) throw std::runtime_error("the lobes plot: " + failed);
-      std::printf("wrote %s\n", a.plot_path.c_str());
+      std::printf("wrote %s\n", plot.c_str());
     }
   }
   report["plants"] = per_plant;
@@ -269,7 +269,7 @@ int run_tune(const TuneArgs& a) {
   if (!r.best.feasible()) {
     std::cerr << "robodamp tune: no candidate met every constraint; the closest violates " << r.best.binding
               << ": nothing written\n";
-    if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
+    if (!emit_json(a.json, report.dump(2), "tune")) return 1;
     return 3;
   }
   // Every promise verified by the accurate method, and the time-domain cut with the real Controller.
@@ -288,7 +288,7 @@ int run_tune(const TuneArgs& a) {
                           {"open_min_depth_mm", v.open_min_depth_mm}, {"speed_rpm", v.speed_rpm},
                           {"depth_at_speed_mm", v.depth_at_speed_mm}, {"time_domain_at_speed_mm", v.time_domain_at_speed_mm},
                           {"time_domain_at_min_mm", v.time_domain_at_min_mm}, {"time_domain_agrees", v.time_domain_agrees()}};
-    if (!a.json_path.empty()) std::ofstream(a.json_path) << report.dump(2) << '\n';
+    if (!emit_json(a.json, report.dump(2), "tune")) return 1;
     // The search's limit and this one are each bracketed to 0.1 %: the same within that.
     if (a.settings.depth_at_speed_min_mm > 0.0 && v.depth_at_speed_mm < a.settings.depth_at_speed_min_mm * (1.0 - 2e-3)) {
       std::cerr << "robodamp tune: the verified depth at the job's speed is below --depth-at-speed-mm: nothing written\n";
@@ -298,8 +298,8 @@ int run_tune(const TuneArgs& a) {
       std::cerr << "robodamp tune: the time-domain cut disagrees with the " << v.method << " by more than 5 %: nothing written\n";
       return 3;
     }
-  } else if (!a.json_path.empty()) {
-    std::ofstream(a.json_path) << report.dump(2) << '\n';
+  } else if (!emit_json(a.json, report.dump(2), "tune")) {
+    return 1;
   }
   if (!a.out_path.empty()) {
     const config::EditedYaml edited = tune::tuned_config_text(plants.front().base(), r.best.candidate);
@@ -326,11 +326,12 @@ void register_tune(Registry& r) {
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   sub->add_option("--job", a->job_path, "Milling job (config/milling/*.yaml) with a damping location")->check(CLI::ExistingFile);
   sub->add_option("--out", a->out_path, "Write the tuned configuration here (only when every constraint holds)");
-  sub->add_option("--json", a->json_path, "Write the report and the search's history as JSON here");
+  r.json(sub, a->json, "The report and the search's history");
   r.number(sub, "--gain-margin-db", a->settings.gain_margin_min_db, {"dB", 0.0, 40.0}, "Smallest gain margin allowed");
   r.number(sub, "--phase-margin-deg", a->settings.phase_margin_min_deg, {"deg", 0.0, 90.0}, "Smallest phase margin allowed");
   r.number(sub, "--delay-margin-ms", a->settings.delay_margin_min_ms, {"ms", 0.0, 1000.0, true}, "Smallest delay margin allowed");
-  sub->add_option("--plot", a->plot_path, "With --job: the open, C1, C2, C3 and tuned lobes of --config's plant (PNG)");
+  r.plot_dir(sub, a->plot_dir, "with --job: tune_lobes.png, the open, C1, C2, C3 and tuned lobes of --config's plant,");
+  r.deprecated(sub->add_option("--plot", a->plot_path, "With --job: write the lobes to this file (PNG)"), "--plot-dir DIR");
   sub->add_option("--also", a->also_paths,
                   "More configurations (another mounting, another pose's modes) with the same chain: the worst case over "
                   "all is tuned; --out writes --config's file")

@@ -204,8 +204,8 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
   if (clock == config::ClockKind::kWall) std::strftime(created, sizeof created, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return {{"format", "robodamp-recording"},
           {"format_version", kRecordingFormatVersion},
-          {"robodamp_version", kVersion},
-          {"git_commit", kGitCommit},
+          {"robodamp_version", version()},
+          {"git_commit", git_commit()},
           {"created_utc", clock == config::ClockKind::kWall ? json(created) : json(nullptr)},
           {"byte_order", "little"},
           {"frame_bytes", sizeof(TelemetryFrame)},

@@ -1,7 +1,7 @@
-// Build identification (set by CMake at configure time).
+// Build identification (set by CMake at configure time, rt/version.cpp).
 #pragma once
 
 namespace robodamp::rt {
-inline constexpr const char* kVersion = ROBODAMP_VERSION;
-inline constexpr const char* kGitCommit = ROBODAMP_GIT_COMMIT;
+[[nodiscard]] const char* version() noexcept;     // the project's version
+[[nodiscard]] const char* git_commit() noexcept;  // git describe --always --dirty at configure time
 }  // namespace robodamp::rt

@@ -27,7 +27,8 @@ for p in config/presets/*.yaml; do
   run "check_$n" check-config "$p"
   run "bench_$n" bench --config "$p" --json "$out/bench_$n.json" --jobs 1
 done
-run analyze_sweep_hil analyze --config config/hil_cutting_c2.yaml --spindle-sweep --json
+run analyze_sweep_hil analyze --config config/hil_cutting_c2.yaml --spindle-sweep
+run analyze_sweep_hil_json analyze --config config/hil_cutting_c2.yaml --spindle-sweep --json
 run analyze_notch_hil analyze --config config/hil_cutting_c2.yaml --spindle-rpm 6000 --json
 for j in config/milling/*.yaml config/commissioning/job_*.yaml; do
   n=$(basename "$j" .yaml)

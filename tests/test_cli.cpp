@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -78,10 +79,12 @@ TEST(Cli, FiltersTableByDefaultAndFrequencyChecked) {
   EXPECT_NE(bad.out.find("below Nyquist"), std::string::npos) << bad.out;
 }
 
+// The deprecated --plot FILE still writes its plot, and says what replaces it (docs/cli.md).
 TEST(Cli, FiltersPlotWritesAPng) {
   const std::string png = temp_path("bode.png");
   const Result r = run("filters --freq 9.2 --plot " + png);
   ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("--plot is deprecated (kept for one release): use --plot-dir DIR"), std::string::npos) << r.out;
   std::ifstream in(png, std::ios::binary);
   char magic[8] = {};
   in.read(magic, 8);
@@ -388,7 +391,7 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
                     std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   small_job += "time_domain:\n  sdm_points: 12\n";
   std::ofstream(dir + "/small_job.yaml") << small_job;
-  const Result map = run("pose map --vary 2 3 --steps 2 --job " + dir + "/small_job.yaml --json-out " + dir + "/map.json");
+  const Result map = run("pose map --vary 2 3 --steps 2 --job " + dir + "/small_job.yaml --json " + dir + "/map.json");
   ASSERT_EQ(map.status, 0) << map.out;
   EXPECT_NE(map.out.find("minimum limiting depth (open loop, SDM, 500-8000 rpm)"), std::string::npos) << map.out;
   const auto map_json = nlohmann::json::parse(robodamp::test::read_file(dir + "/map.json"));
@@ -807,8 +810,9 @@ void expect_lobe_shape(const nlohmann::json& j, std::size_t points) {
 }
 
 TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
-  const std::string png = temp_path("lobes.png");
-  const Result r = run("lobes --method zoa --config " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot " + png);
+  const std::string png = temp_path("lobes_plots") + "/lobes.png";
+  const Result r = run("lobes --method zoa --config " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot-dir " +
+                       temp_path("lobes_plots"));
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
   EXPECT_EQ(j["method"], "zero-order preview");  // labelled: not a promise
@@ -856,9 +860,9 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   const std::size_t at = job.find("  points: 300\n  axial_slices: 40");
   ASSERT_NE(at, std::string::npos);
   job.replace(at, std::strlen("  points: 300"), "  points: 30");
-  const std::string job_path = temp_path("sle_job.yaml"), png = temp_path("sle.png");
+  const std::string job_path = temp_path("sle_job.yaml"), png = temp_path("sle_plots") + "/sle.png";
   std::ofstream(job_path) << job;
-  const Result r = run("sle --config " + job_path + " --json --plot " + png);
+  const Result r = run("sle --config " + job_path + " --json --plot-dir " + temp_path("sle_plots"));
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
   EXPECT_EQ(j["map"].size(), 30u);
@@ -898,3 +902,103 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
 }
 
 }  // namespace
+
+namespace {
+
+// The subcommands `robodamp --help` lists (the lines under "Subcommands:").
+std::vector<std::string> subcommands() {
+  const Result r = run("--help");
+  std::vector<std::string> out;
+  std::istringstream in(r.out);
+  bool listing = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("Subcommands:", 0) == 0) {
+      listing = true;
+    } else if (listing && line.size() > 2 && line[0] == ' ' && line[1] == ' ' && line[2] != ' ') {
+      out.push_back(line.substr(2, line.find(' ', 2) - 2));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+// One command-line convention (docs/cli.md), checked on every subcommand's help: each one's --json takes
+// an optional FILE (bare or -: stdout), plots go to --plot-dir DIR, an old spelling is marked deprecated
+// and names what replaces it, and every command that writes JSON still offers it.
+TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
+  const std::vector<std::string> subs = subcommands();
+  ASSERT_GE(subs.size(), 20U);
+  const std::set<std::string> writes_json{"analyze", "bench", "cut", "filters", "identify", "lobes",
+                                          "plant",   "pose",  "run", "sle",     "tune"};
+  std::set<std::string> has_json;
+  for (const std::string& sub : subs) {
+    const Result h = run(sub + " --help");
+    EXPECT_EQ(h.status, 0) << sub;
+    std::istringstream in(h.out);
+    bool plot_dir = false, plot_file = false;
+    for (std::string line; std::getline(in, line);) {
+      const std::size_t at = line.find("--");
+      if (at == std::string::npos || line.find_first_not_of(' ') != at) continue;  // option lines only
+      const std::string name = line.substr(at, line.find_first_of(" ,=", at) - at);
+      if (name == "--json") {
+        has_json.insert(sub);
+        EXPECT_NE(line.find("[FILE]"), std::string::npos) << sub << ": " << line;
+        EXPECT_NE(line.find("docs/cli.md"), std::string::npos) << sub << ": " << line;
+      } else if (name == "--plot-dir") {
+        plot_dir = true;
+        EXPECT_NE(line.find("DIR"), std::string::npos) << sub << ": " << line;
+      } else if (name == "--plot" || name == "--json-out") {
+        plot_file = plot_file || name == "--plot";
+        EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": " << line;
+      }
+    }
+    if (plot_file) {
+      EXPECT_TRUE(plot_dir) << sub << ": a deprecated --plot without --plot-dir";
+    }
+  }
+  EXPECT_EQ(has_json, writes_json);
+}
+
+// stdout alone (stderr dropped).
+Result run_stdout(const std::string& args) {
+  FILE* p = popen((std::string(ROBODAMP_BINARY) + " " + args + " 2>/dev/null").c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int rc = pclose(p);
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
+}
+
+// --json alone or "-" puts exactly the JSON on stdout (the text goes to stderr); --json FILE writes the
+// file and keeps the text on stdout; a file that cannot be written is exit 1 with the reason.
+TEST(Cli, JsonGoesToStdoutAloneOrToAFile) {
+  const std::string file = temp_path("analyze.json");
+  for (const char* how : {"--json", "--json -"}) {
+    const Result r = run_stdout(std::string("analyze ") + how);
+    ASSERT_EQ(r.status, 0) << r.out;
+    EXPECT_TRUE(nlohmann::json::parse(r.out).contains("max_stable_gain_ns_per_m")) << how;  // nothing but the JSON
+  }
+  const Result text = run_stdout("analyze --json " + file);
+  ASSERT_EQ(text.status, 0);
+  EXPECT_NE(text.out.find("Closed-loop analysis of"), std::string::npos) << text.out;
+  EXPECT_TRUE(nlohmann::json::parse(robodamp::test::read_file(file)).contains("max_stable_gain_ns_per_m"));
+  std::filesystem::remove(file);
+  // A command whose text is long (bench): with the JSON on stdout, its table is on stderr.
+  const Result bench = run_stdout("bench --jobs 1 --json");
+  ASSERT_EQ(bench.status, 0);
+  EXPECT_TRUE(nlohmann::json::parse(bench.out).contains("analysis"));
+  const Result bad = run("analyze --json /nonexistent/dir/a.json");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.out.find("--json /nonexistent/dir/a.json: cannot write"), std::string::npos) << bad.out;
+}
+
+// robodamp --version: the version, the commit and the dependencies it was built against.
+TEST(Cli, VersionNamesTheBuildAndItsDependencies) {
+  const Result r = run("--version");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.rfind("robodamp 0.1.0 (commit ", 0), 0U) << r.out;
+  for (const char* dep : {"Eigen 3", "yaml-cpp 0", "CLI11 2", "FFTW 3", "NLopt 2", "libmodbus 3", "Fast DDS 2", "cpp-httplib 0",
+                          "OpenSSL 3", "GNU 1"})
+    EXPECT_NE(r.out.find(std::string("\n  ") + dep), std::string::npos) << dep << " in\n" << r.out;
+}

@@ -144,7 +144,12 @@ std::vector<std::string> hostile_args(Rng& rng, const std::vector<Sub>& subs, st
   for (std::size_t i = below(rng, 4); i > 0; --i) {  // benign options first
     switch (below(rng, 3)) {
       case 0:
-        if (!s.flags.empty()) parts.push_back({one_of(rng, s.flags)});
+        if (!s.flags.empty()) {
+          // --json takes an optional FILE (docs/cli.md): given as "--json -" so that a hostile token
+          // shuffled after it stays a token the parser must refuse, not the JSON's file name.
+          const std::string f = one_of(rng, s.flags);
+          parts.push_back(f == "--json" ? std::vector<std::string>{f, "-"} : std::vector<std::string>{f});
+        }
         break;
       case 1:
         if (!s.choices.empty()) {
