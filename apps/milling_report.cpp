@@ -16,6 +16,7 @@
 #include "milling/lobes.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/sle.hpp"
+#include "milling/studies.hpp"
 
 namespace robodamp::apps {
 
@@ -24,99 +25,60 @@ using nlohmann::json;
 namespace {
 
 // What the zero-order method's depths are: a fast preview, never a promise (docs/milling.md).
-constexpr const char* kPreview = "zero-order preview";
+constexpr const char* kPreview = milling::kZeroOrderPreview;
 
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-double elapsed_ms(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 config::StructureConfig selected(const config::MillingConfig& cfg, const MillingOptions& o) {
   return selected_structure(cfg, o.structure, o.controller_path);
 }
 
-// One lobe diagram (open or damped) with the direct test at the requested speeds.
-json lobes_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const milling::LobeModel model(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
-  const milling::LobeDiagram d = model.diagram();
+template <typename T>
+json optional_json(const std::optional<T>& v) {
+  return v ? json(*v) : json(nullptr);
+}
+
+// One lobe study (open or damped, milling/studies.hpp) as the report's JSON.
+json lobes_json(const milling::LobeStudy& s) {
   json j;
-  j["structure"] = structure.name();
-  j["closed_loop"] = structure.damped();
-  j["frequency_points"] = d.frequency_points;
+  j["structure"] = s.structure;
+  j["closed_loop"] = s.closed_loop;
+  j["method"] = s.method;
+  if (s.accurate) j["steps_per_period"] = s.steps_per_period;
+  j["frequency_points"] = s.frequency_points;
   j["curve"] = json::array();
-  for (const auto& p : d.curve)
-    j["curve"].push_back({{"rpm", p.rpm}, {"b_lim_mm", finite_or_null(p.b_lim_m * 1e3)},
-                          {"chatter_hz", std::isfinite(p.b_lim_m) ? json(p.chatter_hz) : json(nullptr)}, {"lobe", p.lobe}});
-  j["min_b_lim_mm"] = finite_or_null(d.minimum.b_lim_m * 1e3);
-  j["min_rpm"] = d.minimum.rpm;
-  j["min_chatter_hz"] = d.minimum.chatter_hz;
-  j["diagram_ms"] = elapsed_ms(t0);
-  j["method"] = kPreview;
-  j["at_rpm"] = json::array();
-  for (double rpm : rpms) {
-    const auto zoa = model.limit_at(rpm);
-    const double direct = model.critical_depth_m(rpm);
-    j["at_rpm"].push_back({{"rpm", rpm},
-                           {"b_lim_mm", finite_or_null(direct * 1e3)},
-                           {"b_lim_lobes_mm", zoa ? json(zoa->b_lim_m * 1e3) : json(nullptr)},
-                           {"chatter_hz", zoa ? json(zoa->chatter_hz) : json(nullptr)},
-                           {"lobe", zoa ? json(zoa->lobe) : json(nullptr)}});
+  for (const auto& p : s.curve) {
+    json c = {{"rpm", p.rpm}, {"b_lim_mm", finite_or_null(p.b_lim_mm)}, {"chatter_hz", optional_json(p.chatter_hz)}};
+    if (s.accurate) c["type"] = *p.type;
+    else c["lobe"] = *p.lobe;
+    j["curve"].push_back(c);
   }
-  j["notes"] = structure.notes();
+  j["min_b_lim_mm"] = finite_or_null(s.min_b_lim_mm);
+  j["min_rpm"] = s.min_rpm;
+  j["min_chatter_hz"] = s.min_chatter_hz;
+  j["at_rpm"] = json::array();
+  for (const auto& a : s.at_rpm) {
+    json r = {{"rpm", a.rpm}, {"b_lim_mm", finite_or_null(a.b_lim_mm)}, {"b_lim_lobes_mm", optional_json(a.b_lim_lobes_mm)},
+              {"chatter_hz", optional_json(a.chatter_hz)}};
+    if (s.accurate) r["requested_rpm"] = *a.requested_rpm, r["type"] = *a.type;
+    else r["lobe"] = optional_json(a.lobe);
+    j["at_rpm"].push_back(r);
+  }
+  j["diagram_ms"] = s.diagram_ms;
+  j["notes"] = s.notes;
   return j;
 }
 
-// The lobe diagram by the accurate method (milling/accurate_stability.hpp): semi-discretization of the
-// open-loop structure, or of the sampled damped loop; the critical depth at time_domain.sdm_points speeds
-// over the lobes range (those the method can step), each from the zero-order limit there as the first guess.
-json sdm_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const milling::AccurateStability truth(structure, cfg);
-  for (double rpm : rpms)
-    if (auto p = truth.speed_problem(rpm))
-      throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p + "; --method zoa previews it"}});
-  config::LobesConfig grid = cfg.lobes;
-  grid.points = cfg.time_domain.sdm_points;
-  const milling::LobeModel zoa(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), grid);
-  // Progress on stderr: the open loop of a many-mode structure takes minutes.
-  const milling::AccurateDiagram diagram = milling::accurate_diagram(structure, cfg, 0, [&](std::size_t done, std::size_t of) {
-    if (done % 20 == 0 || done == of)
-      std::cerr << "[lobes " << truth.method() << "] " << done << "/" << of << " speeds, " << elapsed_ms(t0) / 1000.0 << " s\n";
-  });
-  const std::vector<milling::SdmPoint>& curve = diagram.curve;
-  std::vector<double> at_guess;
-  for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_m(rpm) * 1e3);
-  const std::vector<milling::SdmPoint> at = truth.critical(rpms, at_guess);
-  json j;
-  j["structure"] = structure.name();
-  j["closed_loop"] = structure.damped();
-  j["method"] = truth.method();
-  j["steps_per_period"] = truth.grid_per_period();
-  j["curve"] = json::array();
-  double best = 1e300, best_rpm = 0.0, best_hz = 0.0;
-  for (const auto& s : curve) {
-    j["curve"].push_back({{"rpm", s.rpm}, {"b_lim_mm", finite_or_null(s.critical_depth_mm)}, {"chatter_hz", s.chatter_hz},
-                          {"type", milling::to_string(s.type)}});
-    if (s.critical_depth_mm < best) best = s.critical_depth_mm, best_rpm = s.rpm, best_hz = s.chatter_hz;
-  }
-  j["min_b_lim_mm"] = finite_or_null(best);
-  j["min_rpm"] = best_rpm;
-  j["min_chatter_hz"] = best_hz;
-  j["frequency_points"] = 0;
-  j["at_rpm"] = json::array();
-  for (std::size_t i = 0; i < rpms.size(); ++i)
-    j["at_rpm"].push_back({{"rpm", at[i].rpm}, {"requested_rpm", rpms[i]}, {"b_lim_mm", finite_or_null(at[i].critical_depth_mm)},
-                           {"chatter_hz", at[i].chatter_hz}, {"type", milling::to_string(at[i].type)},
-                           {"b_lim_lobes_mm", finite_or_null(at_guess[i])}});
-  j["diagram_ms"] = elapsed_ms(t0);
-  j["notes"] = structure.notes();
-  if (diagram.speeds_left_out > 0)
-    j["notes"].push_back("the " + truth.method() + " stops at " + std::to_string(static_cast<int>(truth.max_rpm())) +
-                         " rpm (10 loop periods per tooth period): " + std::to_string(diagram.speeds_left_out) +
-                         " speeds above it left out; --method zoa previews them");
-  return j;
+// The study by the requested method; the accurate one's progress on stderr (a many-mode open loop takes
+// minutes).
+json lobes_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms,
+                const std::string& method) {
+  if (method != "sdm") return lobes_json(milling::zero_order_lobe_study(structure, cfg, rpms));
+  return lobes_json(milling::accurate_lobe_study(
+      structure, cfg, rpms, [](const std::string& name, std::size_t done, std::size_t of, double s) {
+        if (done % 20 == 0 || done == of)
+          std::cerr << "[lobes " << name << "] " << done << "/" << of << " speeds, " << s << " s\n";
+      }));
 }
 
 double pct_change(const json& open, const json& damped) {
@@ -215,90 +177,40 @@ int finish(const json& report, const MillingOptions& o, const std::string& comma
 
 // --- SLE -------------------------------------------------------------------------------------------
 
-json sle_json(const milling::Structure& structure, const config::MillingConfig& cfg) {
-  const auto cutter = milling::cutter_from(cfg.tool);
-  const auto& s = cfg.sle;
+// One SLE study (open or damped, milling/studies.hpp) as the report's JSON.
+json sle_json(const milling::SleStudy& s) {
   json j;
-  j["structure"] = structure.name();
-  j["closed_loop"] = structure.damped();
+  j["structure"] = s.structure;
+  j["closed_loop"] = s.closed_loop;
   j["map"] = json::array();
-  const milling::CutConditions cut{cfg.cut.mode, cfg.cut.radial_mm, cfg.cut.axial_mm, cfg.cut.feed_per_tooth_mm};
-  // SLE assumes a stable cut: the lobes at the map's speeds say where the configured depth chatters.
-  config::LobesConfig at_map = cfg.lobes;
-  at_map.rpm_min = s.rpm_min;
-  at_map.rpm_max = s.rpm_max;
-  at_map.points = s.points;
-  at_map.log_spacing = false;
-  const auto lobes =
-      milling::LobeModel(structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), at_map).diagram();
-  // Whether the configured depth chatters at each speed: the accurate method where it can step the speed,
-  // the zero-order preview above that (the damped loop's highest speed), each point labelled.
-  const milling::AccurateStability truth(structure, cfg);
-  std::vector<double> speeds;
-  for (const auto& p : lobes.curve)
-    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm);
-  const std::vector<bool> accurate = truth.stable(cfg.cut.axial_mm, speeds);
-  int chatter = 0, previewed = 0;
-  for (int i = 0; i < s.points; ++i) {
-    const auto idx = static_cast<std::size_t>(i);
-    const double rpm = lobes.curve[idx].rpm;
-    const auto r = milling::surface_location_error(structure, cutter, cfg.material, cut, cfg.cut.feed_axis, rpm,
-                                                   s.axial_slices, s.harmonics);
-    const double b_lim = lobes.curve[idx].b_lim_m;
-    const bool by_truth = idx < accurate.size();
-    const bool stable = by_truth ? accurate[idx] : cfg.cut.axial_mm * 1e-3 < b_lim;
-    chatter += stable ? 0 : 1;
-    previewed += by_truth ? 0 : 1;
-    j["map"].push_back({{"rpm", rpm}, {"sle_um", r.sle_um}, {"sle_min_um", r.min_um}, {"sle_max_um", r.max_um},
-                        {"b_lim_preview_mm", finite_or_null(b_lim * 1e3)}, {"stable", stable},
-                        {"stability_method", by_truth ? truth.method() : std::string(kPreview)}});
-  }
-  j["map_unstable_points"] = chatter;
-  j["stability_method"] = truth.method();  // the map's and the conditions' stable flags (docs/milling.md)
-  j["map_preview_points"] = previewed;     // above the accurate method's highest speed
+  for (const auto& p : s.map)
+    j["map"].push_back({{"rpm", p.rpm}, {"sle_um", p.sle_um}, {"sle_min_um", p.sle_min_um}, {"sle_max_um", p.sle_max_um},
+                        {"b_lim_preview_mm", finite_or_null(p.b_lim_preview_mm)}, {"stable", p.stable},
+                        {"stability_method", p.stability_method}});
+  j["map_unstable_points"] = s.map_unstable_points;
+  j["stability_method"] = s.stability_method;  // the map's and the conditions' stable flags (docs/milling.md)
+  j["map_preview_points"] = s.map_preview_points;
   j["conditions"] = json::array();
-  // One stability model per immersion and feed axis, shared by the conditions that cut with them.
-  std::map<std::pair<double, config::Axis>, std::unique_ptr<milling::AccurateStability>> stability_models;
-  for (const auto& c : cfg.conditions) {
-    for (const config::Axis normal : s.surface_normals) {
-      const config::Axis feed = normal == config::Axis::kY ? config::Axis::kX : config::Axis::kY;
-      const milling::CutConditions cc{cfg.cut.mode, c.radial_mm, c.axial_mm, c.feed_per_tooth_mm};
-      const double offset_um = 1000.0 * (normal == config::Axis::kX ? c.path_offset_x_mm : c.path_offset_y_mm);
-      const auto r = milling::surface_location_error(structure, cutter, cfg.material, cc, feed, c.rpm, s.axial_slices,
-                                                     s.harmonics);
-      const auto comp = milling::compensate(structure, cutter, cfg.material, cc, feed, c.rpm, offset_um, s);
-      // SLE assumes a stable cut: say whether this one is, with this immersion and feed axis.
-      config::CutConfig cut_c = cfg.cut;
-      cut_c.radial_mm = c.radial_mm;
-      cut_c.feed_axis = feed;
-      auto& model = stability_models[{c.radial_mm, feed}];
-      if (!model) model = std::make_unique<milling::AccurateStability>(structure, cfg, cut_c);
-      const bool by_truth = !model->speed_problem(c.rpm);
-      const bool stable =
-          by_truth ? model->stable(c.axial_mm, c.rpm)
-                   : milling::LobeModel(structure, milling::chatter_process(cfg.tool, cfg.material, cut_c), cfg.lobes)
-                         .stable(c.axial_mm * 1e-3, c.rpm);
-      j["conditions"].push_back({{"name", c.name},
-                                 {"rpm", c.rpm},
-                                 {"axial_mm", c.axial_mm},
-                                 {"radial_mm", c.radial_mm},
-                                 {"ft_mm", c.feed_per_tooth_mm},
-                                 {"surface_normal", to_string(normal)},
-                                 {"sle_um", r.sle_um + offset_um},
-                                 {"sle_dynamic_um", r.sle_um},
-                                 {"path_offset_um", offset_um},
-                                 {"sle_min_um", r.min_um + offset_um},
-                                 {"sle_max_um", r.max_um + offset_um},
-                                 {"mean_normal_force_n", r.mean_normal_force_n},
-                                 {"compensated_radial_mm", comp.radial_mm},
-                                 {"compensation_residual_um", comp.residual_um},
-                                 {"compensation_iterations", comp.iterations},
-                                 {"compensation_converged", comp.converged},
-                                 {"stable", stable},
-                                 {"stability_method", by_truth ? model->method() : std::string(kPreview)}});
-    }
-  }
-  j["notes"] = structure.notes();
+  for (const auto& c : s.conditions)
+    j["conditions"].push_back({{"name", c.name},
+                               {"rpm", c.rpm},
+                               {"axial_mm", c.axial_mm},
+                               {"radial_mm", c.radial_mm},
+                               {"ft_mm", c.ft_mm},
+                               {"surface_normal", to_string(c.surface_normal)},
+                               {"sle_um", c.sle_um},
+                               {"sle_dynamic_um", c.sle_dynamic_um},
+                               {"path_offset_um", c.path_offset_um},
+                               {"sle_min_um", c.sle_min_um},
+                               {"sle_max_um", c.sle_max_um},
+                               {"mean_normal_force_n", c.mean_normal_force_n},
+                               {"compensated_radial_mm", c.compensated_radial_mm},
+                               {"compensation_residual_um", c.compensation_residual_um},
+                               {"compensation_iterations", c.compensation_iterations},
+                               {"compensation_converged", c.compensation_converged},
+                               {"stable", c.stable},
+                               {"stability_method", c.stability_method}});
+  j["notes"] = s.notes;
   return j;
 }
 
@@ -390,7 +302,7 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   if (o.damped && !open.has_controller())
     throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
                                                "--damped needs a part with a controller (a damping configuration)"}});
-  json r = o.method == "sdm" ? sdm_json(open, cfg, rpms) : lobes_json(open, cfg, rpms);
+  json r = lobes_json(open, cfg, rpms, o.method);
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
   r["spindle_rpm"] = cfg.cut.spindle_rpm;
@@ -400,7 +312,7 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
                          "simulates it");
   if (o.damped) {
     const milling::Structure closed(sc, true);
-    r["damped"] = o.method == "sdm" ? sdm_json(closed, cfg, rpms) : lobes_json(closed, cfg, rpms);
+    r["damped"] = lobes_json(closed, cfg, rpms, o.method);
     r["gain"] = {{"min_b_lim_change_pct", finite_or_null(pct_change(r["min_b_lim_mm"], r["damped"]["min_b_lim_mm"]))},
                  {"at_spindle_rpm", cfg.cut.spindle_rpm},
                  {"at_spindle_change_pct",
@@ -417,10 +329,10 @@ json sle_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   if (o.damped && !open.has_controller())
     throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
                                                "--damped needs a part with a controller (a damping configuration)"}});
-  json r = sle_json(open, cfg);
+  json r = sle_json(milling::sle_study(open, cfg));
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
-  if (o.damped) r["damped"] = sle_json(milling::Structure(sc, true), cfg);
+  if (o.damped) r["damped"] = sle_json(milling::sle_study(milling::Structure(sc, true), cfg));
   return r;
 }
 
