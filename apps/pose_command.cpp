@@ -22,6 +22,7 @@
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 #include "robot/pose_fit.hpp"
+#include "milling/pose_map.hpp"
 #include "robot/robot_model.hpp"
 
 namespace robodamp::apps {
@@ -240,57 +241,30 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
     std::cerr << "robodamp pose map: --vary takes two different joints, 1.." << n << '\n';
     return 2;
   }
-  std::vector<double> base = pose_of(m, a);
-  const auto j1 = static_cast<std::size_t>(a.vary[0] - 1), j2 = static_cast<std::size_t>(a.vary[1] - 1);
+  std::optional<config::MillingConfig> job;
+  if (!a.job_path.empty()) job = config::load_milling_config(a.job_path);
+  milling::PoseMapRequest req;
+  req.base_deg = pose_of(m, a);
+  req.joint_a = static_cast<std::size_t>(a.vary[0] - 1), req.joint_b = static_cast<std::size_t>(a.vary[1] - 1);
+  req.steps = a.steps;
+  req.job = job ? &*job : nullptr;
+  req.zero_order = a.method == "zoa";
+  const milling::PoseMap map = milling::pose_map(m, req, [&](int row, int rows) {
+    std::cerr << "robodamp pose map: row " << row << " of " << rows << " done ("
+              << (req.zero_order ? "zero-order preview" : "SDM") << ")\n";
+  });
+  const std::string& method = map.method;
+  const double f_min = map.f1_min_hz, f_max = map.f1_max_hz, b_min = map.min_depth_min_mm, b_max = map.min_depth_max_mm;
   json grid = json::array();
   std::ostringstream data;
-  double f_min = INFINITY, f_max = 0.0, b_min = INFINITY, b_max = 0.0;
-  std::optional<config::MillingConfig> job;
-  const std::string method = a.method == "zoa" ? "zero-order preview" : "SDM";
-  if (!a.job_path.empty()) {
-    job = config::load_milling_config(a.job_path);
-    bool has_pose = false;
-    for (const auto& part : job->find_structure(job->structure)->parts) has_pose = has_pose || part.pose.has_value();
-    if (!has_pose)
-      throw config::ConfigError({config::Problem{a.job_path, {}, "structures",
-                                                 "--job: the job's structure has no robot pose part (pose: {model, joints_deg})"}});
-  }
-  for (int i = 0; i < a.steps; ++i) {
-    for (int k = 0; k < a.steps; ++k) {
-      std::vector<double> q = base;
-      const auto& ja = m.joints[j1];
-      const auto& jb = m.joints[j2];
-      q[j1] = ja.min_deg + (ja.max_deg - ja.min_deg) * i / (a.steps - 1);
-      q[j2] = jb.min_deg + (jb.max_deg - jb.min_deg) * k / (a.steps - 1);
-      const robot::PlanarChain c = robot::at_pose(m, q);
-      const auto md = c.modes(1);
-      f_min = std::min(f_min, md[0].freq_hz), f_max = std::max(f_max, md[0].freq_hz);
-      json point = {{"joints_deg", q}, {"f1_hz", md[0].freq_hz}, {"k1_n_per_m", md[0].tcp_modal_stiffness_n_per_m}};
-      double depth_mm = NAN;
-      if (job) {  // the job's minimum limiting depth over its speed range, the robot at this pose
-        config::StructureConfig st = *job->find_structure(job->structure);
-        for (auto& part : st.parts)
-          if (part.pose) part.pose->joints_deg = q;
-        const milling::Structure structure(st, false);
-        double min_rpm = 0.0;
-        if (a.method == "zoa") {
-          const auto lobes = milling::LobeModel(structure, milling::chatter_process(job->tool, job->material, job->cut),
-                                                job->lobes).diagram();
-          depth_mm = lobes.minimum.b_lim_m * 1e3, min_rpm = lobes.minimum.rpm;
-        } else {
-          const milling::AccurateDiagram d = milling::accurate_diagram(structure, *job);
-          depth_mm = d.minimum.critical_depth_mm, min_rpm = d.minimum.rpm;
-        }
-        b_min = std::min(b_min, depth_mm), b_max = std::max(b_max, depth_mm);
-        point["min_depth_mm"] = depth_mm;
-        point["min_depth_rpm"] = min_rpm;
-      }
-      grid.push_back(point);
-      data << q[j1] << ' ' << q[j2] << ' ' << md[0].freq_hz << ' ' << md[0].tcp_modal_stiffness_n_per_m << ' '
-           << depth_mm << '\n';
-    }
-    data << '\n';
-    if (job) std::cerr << "robodamp pose map: row " << i + 1 << " of " << a.steps << " done (" << method << ")\n";
+  for (std::size_t i = 0; i < map.grid.size(); ++i) {
+    const milling::PoseMapPoint& p = map.grid[i];
+    json point = {{"joints_deg", p.joints_deg}, {"f1_hz", p.f1_hz}, {"k1_n_per_m", p.k1_n_per_m}};
+    if (p.min_depth_mm) point["min_depth_mm"] = *p.min_depth_mm, point["min_depth_rpm"] = *p.min_depth_rpm;
+    grid.push_back(point);
+    data << p.joints_deg[req.joint_a] << ' ' << p.joints_deg[req.joint_b] << ' ' << p.f1_hz << ' ' << p.k1_n_per_m << ' '
+         << p.min_depth_mm.value_or(NAN) << '\n';
+    if ((i + 1) % static_cast<std::size_t>(a.steps) == 0) data << '\n';
   }
   json r = {{"model", m.source}, {"vary", a.vary}, {"steps", a.steps}, {"grid", grid},
                   {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
