@@ -347,8 +347,30 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   ++counters_.ticks;
   const double test_v = s_.test_signal.value_v(time_s_);
   time_s_ += in.dt_s;
-  const auto& l = s_.limits;
-  // The sample: a repeat (not fresh) is stale; a fresh one must be finite and in range.
+  const bool valid = assess_sample(in);
+  const ControlStep c = run_controller(in, valid);
+  // Operator commands at the tick boundary, then the trips (which override them).
+  if (in.command.kind != CommandKind::kNone)
+    handle(in.command, live_run_ >= static_cast<std::uint64_t>(s_.limits.arming_live_cycles));
+  follow_pose();
+  if (const Trip t = check_trips(in); t != Trip::kNone) trip(t);
+  TickOutput out;
+  out.controller_v = c.controller_v;
+  out.filtered_mps = controller_.filtered_mps();
+  drive(in, c, test_v, out);
+  if (state_ == State::kFault) ramp_down_fault(in, out);
+  count_hold(c.hold && (state_ == State::kActive || state_ == State::kStopping));
+  out.command_v = command_v_;
+  out.state = state_;
+  out.trip = trip_;
+  observed_state_.store(state_, std::memory_order_relaxed);
+  observed_trip_.store(trip_, std::memory_order_relaxed);
+  return out;
+}
+
+// The sample's health: a repeat (not fresh) is stale; a fresh one must be finite and in range. Also the
+// runs the trips and the arming read (stale, invalid, live, overrun) and the path's health.
+bool Supervisor::assess_sample(const TickInput& in) noexcept {
   const bool valid = std::isfinite(in.accel_mps2) && std::abs(in.accel_mps2) <= s_.sample_limit_mps2;
   if (!in.fresh) {
     ++stale_run_;
@@ -374,30 +396,31 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
     overrun_run_s_ = 0.0;
   }
   path_ok_ = in.sensor_ok && in.actuator_ok && !in.amplifier_fault;
+  return valid;
+}
 
-  // The controller runs in every state so its filters are settled when it is armed. It only ever sees
-  // valid samples. On a stale or invalid one it is fed no acceleration (its velocity estimate holds
-  // rather than integrating a repeated sample), and its output does not reach the actuator this tick.
+// The controller runs in every state so its filters are settled when it is armed. It only ever sees
+// valid samples. On a stale or invalid one it is fed no acceleration (its velocity estimate holds rather
+// than integrating a repeated sample), and its output does not reach the actuator this tick.
+Supervisor::ControlStep Supervisor::run_controller(const TickInput& in, bool valid) noexcept {
   const bool sample_ok = in.fresh && valid;
-  const bool hold = !sample_ok && l.zero_command_while_stale;
-  hold_now_ = hold;
+  ControlStep c;
+  c.hold = !sample_ok && s_.limits.zero_command_while_stale;
+  hold_now_ = c.hold;
   if (sample_ok) last_valid_mps2_ = in.accel_mps2;
-  const double controller_v = controller_.update(hold ? 0.0 : last_valid_mps2_);
-  const double driving_v = hold ? 0.0 : controller_v;
+  c.controller_v = controller_.update(c.hold ? 0.0 : last_valid_mps2_);
+  c.driving_v = c.hold ? 0.0 : c.controller_v;
   const control::ControllerCounters& cc = controller_.counters();
-  const bool limited = cc.force_limited != last_limits_.force_limited ||
-                       cc.voltage_limited != last_limits_.voltage_limited || cc.slew_limited != last_limits_.slew_limited;
+  c.limited = cc.force_limited != last_limits_.force_limited || cc.voltage_limited != last_limits_.voltage_limited ||
+              cc.slew_limited != last_limits_.slew_limited;
   last_limits_ = cc;
+  return c;
+}
 
-  // Operator commands at the tick boundary, then the trips (which override them).
-  if (in.command.kind != CommandKind::kNone)
-    handle(in.command, live_run_ >= static_cast<std::uint64_t>(l.arming_live_cycles));
-  follow_pose();
-  if (const Trip t = check_trips(in); t != Trip::kNone) trip(t);
-
-  TickOutput out;
-  out.controller_v = controller_v;
-  out.filtered_mps = controller_.filtered_mps();
+// The command in each state: nothing while disabled or arming (arming asks for the amplifier and
+// activates when it is ready), the faded controller (with the commissioning chirp added) while active,
+// where the saturation duty and the instability detector can trip, and the fade-out while stopping.
+void Supervisor::drive(const TickInput& in, const ControlStep& c, double test_v, TickOutput& out) noexcept {
   switch (state_) {
     case State::kDisabled: command_v_ = 0.0; break;
     case State::kArming:
@@ -412,20 +435,20 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
       break;
     case State::kActive: {
       fade_ = s_.fade_s > 0.0 ? std::min(1.0, fade_ + in.dt_s / s_.fade_s) : 1.0;
-      command_v_ = fade_ * driving_v;
+      command_v_ = fade_ * c.driving_v;
       if (test_v != 0.0) {
         const double lim = s_.test_signal.voltage_limit_v;
-        command_v_ = std::clamp(fade_ * (driving_v + test_v), -lim, lim);
+        command_v_ = std::clamp(fade_ * (c.driving_v + test_v), -lim, lim);
       }
       out.amplifier_enable = true;
-      out.saturated = limited || in.actuator_saturated;
+      out.saturated = c.limited || in.actuator_saturated;
       if (out.saturated) ++counters_.saturated_ticks;
       if (record_saturation(out.saturated)) {
         trip(Trip::kSaturation);
-      } else if (instability(controller_v)) {
+      } else if (instability(c.controller_v)) {
         trip(Trip::kInstability);
       }
-      if (state_ == State::kFault) command_v_ = trip_from_v_;  // the ramp below starts from the last command
+      if (state_ == State::kFault) command_v_ = trip_from_v_;  // the ramp starts from the last command
       break;
     }
     case State::kStopping:
@@ -435,32 +458,28 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
         state_ = State::kDisabled;
         command_v_ = 0.0;
       } else {
-        command_v_ = fade_ * driving_v;
+        command_v_ = fade_ * c.driving_v;
         out.amplifier_enable = true;
       }
       break;
     case State::kFault: break;
   }
-  if (state_ == State::kFault) {
-    // Linear ramp from the command at the trip to zero over trip_ramp_s (measured time), then off.
-    if (trip_ramp_left_s_ > 0.0) trip_ramp_left_s_ -= in.dt_s;
-    if (trip_ramp_left_s_ > 0.0 && l.trip_ramp_s > 0.0) {
-      command_v_ = trip_from_v_ * (trip_ramp_left_s_ / l.trip_ramp_s);
-      out.amplifier_enable = true;
-    } else {
-      trip_ramp_left_s_ = 0.0;
-      command_v_ = 0.0;
-      out.amplifier_enable = false;
-      if (!latched_) recover(in);  // re-arms from the next tick on (state kArming)
-    }
+}
+
+// A trip: a linear ramp from the command at the trip to zero over trip_ramp_s (measured time), then the
+// amplifier off and, unless latched, recovery (re-arming from the next tick on, state kArming).
+void Supervisor::ramp_down_fault(const TickInput& in, TickOutput& out) noexcept {
+  const auto& l = s_.limits;
+  if (trip_ramp_left_s_ > 0.0) trip_ramp_left_s_ -= in.dt_s;
+  if (trip_ramp_left_s_ > 0.0 && l.trip_ramp_s > 0.0) {
+    command_v_ = trip_from_v_ * (trip_ramp_left_s_ / l.trip_ramp_s);
+    out.amplifier_enable = true;
+  } else {
+    trip_ramp_left_s_ = 0.0;
+    command_v_ = 0.0;
+    out.amplifier_enable = false;
+    if (!latched_) recover(in);
   }
-  count_hold(hold && (state_ == State::kActive || state_ == State::kStopping));
-  out.command_v = command_v_;
-  out.state = state_;
-  out.trip = trip_;
-  observed_state_.store(state_, std::memory_order_relaxed);
-  observed_trip_.store(trip_, std::memory_order_relaxed);
-  return out;
 }
 
 }  // namespace robodamp::rt

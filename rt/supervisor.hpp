@@ -218,6 +218,17 @@ class Supervisor {
   bool instability(double controller_v) noexcept;     // true: growing oscillation
   void reset_detectors() noexcept;
   void count_hold(bool held) noexcept;  // a tick driving on a held (zero) controller part, or not
+  // step()'s stages, in order (RT-safe, noexcept, allocation-free).
+  struct ControlStep {
+    double controller_v{0.0};  // the controller's output this tick
+    double driving_v{0.0};     // what may drive the actuator (0 while a bad sample is held)
+    bool limited{false};       // the controller's force, voltage or slew limit acted this tick
+    bool hold{false};          // a stale or invalid sample: the controller's part is held at zero
+  };
+  [[nodiscard]] bool assess_sample(const TickInput& in) noexcept;  // true: a finite sample in range
+  [[nodiscard]] ControlStep run_controller(const TickInput& in, bool valid) noexcept;
+  void drive(const TickInput& in, const ControlStep& c, double test_v, TickOutput& out) noexcept;
+  void ramp_down_fault(const TickInput& in, TickOutput& out) noexcept;
 
   [[nodiscard]] double max_gain_ns_per_m() const noexcept {
     return s_.limits.max_gain_fraction * sets_[active_parameter_set()].max_stable_gain_ns_per_m;
