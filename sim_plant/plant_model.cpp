@@ -54,20 +54,13 @@ Complex PlantModel::receptance(std::size_t response, std::size_t excitation, dou
   return p != nullptr ? p->receptance(f_hz) : Complex(0.0);
 }
 
-PlantModel build_plant_model(const config::Config& cfg) {
-  std::vector<config::Problem> problems;
-  auto problem = [&](const std::string& key, const std::string& msg) {
-    problems.push_back({cfg.source, {}, key, msg});
-  };
-  if (cfg.robot.frfs.empty()) {
-    problem("robot.frfs", "missing: the simulated plant and the loop analysis need the robot's modal data");
-    throw config::ConfigError(config::located(problems, cfg.yaml_text));
-  }
-  PlantModel m;
-  m.locations = cfg.robot.locations;
-  m.voltage_limit_v = cfg.amplifier.voltage_limit_v;
+namespace {
 
-  // FRF paths in the physical frame: H_phys = axis_sign(response) * H_table.
+using Problems = std::vector<config::Problem>;
+
+// FRF paths in the physical frame: H_phys = axis_sign(response) * H_table; a driving point must have a
+// positive static compliance.
+void add_paths(const config::Config& cfg, PlantModel& m, Problems& problems) {
   for (std::size_t i = 0; i < cfg.robot.frfs.size(); ++i) {
     const auto& f = cfg.robot.frfs[i];
     FrfPath p;
@@ -82,24 +75,29 @@ PlantModel build_plant_model(const config::Config& cfg) {
     }
     const double h0 = p.static_compliance_m_per_n();
     if (p.response == p.excitation && !(h0 > 0.0))
-      problem(p.origin, "(" + p.name + ") is a driving-point FRF with static compliance " + num(h0) +
-                            " m/N after axis_sign " + std::to_string(static_cast<int>(sign)) +
-                            " of location " + std::to_string(f.response_location) +
-                            ": a physical receptance needs > 0; check the location's axis_sign");
+      problems.push_back({cfg.source, {}, p.origin,
+                          "(" + p.name + ") is a driving-point FRF with static compliance " + num(h0) +
+                              " m/N after axis_sign " + std::to_string(static_cast<int>(sign)) + " of location " +
+                              std::to_string(f.response_location) +
+                              ": a physical receptance needs > 0; check the location's axis_sign"});
     m.paths.push_back(std::move(p));
   }
-  // Reciprocity (Maxwell-Betti): H_gh = H_hg in the physical frame. A given pair must agree in sign;
-  // a missing one is taken from its reciprocal.
+}
+
+// Reciprocity (Maxwell-Betti): H_gh = H_hg in the physical frame. A given pair must agree in sign; a
+// missing one is taken from its reciprocal.
+void add_reciprocals(const config::Config& cfg, PlantModel& m, Problems& problems) {
   const std::size_t given = m.paths.size();
   for (std::size_t i = 0; i < given; ++i) {
     const FrfPath& p = m.paths[i];
     if (p.response == p.excitation) continue;
     if (const FrfPath* q = m.path(p.excitation, p.response)) {
       if (p.static_compliance_m_per_n() * q->static_compliance_m_per_n() < 0.0)
-        problem(p.origin, "(" + p.name + ") and " + q->origin + " (" + q->name +
-                              ") have static compliances of opposite sign (" + num(p.static_compliance_m_per_n()) +
-                              " and " + num(q->static_compliance_m_per_n()) +
-                              " m/N) in the physical frame: reciprocity fails; check the axis_sign of both locations");
+        problems.push_back({cfg.source, {}, p.origin,
+                            "(" + p.name + ") and " + q->origin + " (" + q->name +
+                                ") have static compliances of opposite sign (" + num(p.static_compliance_m_per_n()) +
+                                " and " + num(q->static_compliance_m_per_n()) +
+                                " m/N) in the physical frame: reciprocity fails; check the axis_sign of both locations"});
       continue;
     }
     FrfPath r = p;
@@ -113,31 +111,21 @@ PlantModel build_plant_model(const config::Config& cfg) {
   }
   for (const auto& p : m.paths)
     if (m.locations[p.response].axis_sign < 0 && p.origin.rfind("robot", 0) == 0)
-      m.notes.push_back(p.name + ": tabulated response axis at location " +
-                        std::to_string(m.locations[p.response].id) + " is reversed; physical FRF = -table");
+      m.notes.push_back(p.name + ": tabulated response axis at location " + std::to_string(m.locations[p.response].id) +
+                        " is reversed; physical FRF = -table");
+}
 
-  const config::ActuatorConfig& ac = cfg.actuator;
-  m.actuator = {ac.constant_n_per_v, ac.natural_freq_hz, ac.damping_ratio, ac.delay_s, ac.force_limit_n,
-                m.index_of(ac.location)};
-  const std::size_t act = m.actuator.location, sensor = m.index_of(cfg.sensor.location);
-  if (m.path(act, act) == nullptr)
-    problem("robot.frfs", "no driving-point FRF at the actuator location " + std::to_string(ac.location) +
-                              ": the actuator's own receptance is needed to simulate and close the loop");
-  if (m.path(sensor, act) == nullptr)
-    problem("robot.frfs", "no FRF from the actuator location " + std::to_string(ac.location) +
-                              " to the sensor location " + std::to_string(cfg.sensor.location) +
-                              " (nor its reciprocal): the loop cannot close");
-  if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
-
-  // One state-space: actuator proof mass [p, p'] first, then [q, q'] per mode block. A mode block is one
-  // (excitation location, natural frequency, damping) triple: paths excited at the same location that
-  // share a mode share its block and differ only in their output weights (a, b), so the realisation has
-  // no repeated block (docs/simulation.md). The transfer functions are the same as with one block per
-  // path and mode.
+// One state-space: actuator proof mass [p, p'] first, then [q, q'] per mode block. A mode block is one
+// (excitation location, natural frequency, damping) triple: paths excited at the same location that
+// share a mode share its block and differ only in their output weights (a, b), so the realisation has no
+// repeated block (docs/simulation.md). The transfer functions are the same as with one block per path and
+// mode.
+void build_state_space(const config::ActuatorConfig& ac, PlantModel& m) {
   struct Block {
     std::size_t excitation;
     double wn, zeta;
   };
+  const std::size_t act = m.actuator.location;
   std::vector<Block> blocks;
   std::vector<std::vector<std::size_t>> block_of(m.paths.size());  // [path][mode]
   for (std::size_t pi = 0; pi < m.paths.size(); ++pi)
@@ -177,8 +165,8 @@ PlantModel build_plant_model(const config::Config& cfg) {
       cx(r, k) += m.paths[pi].modes[j].a;
       cx(r, k + 1) += m.paths[pi].modes[j].b;
     }
-  // Receptance is strictly proper; velocity and acceleration follow by differentiating along the
-  // held input (u' = 0 between samples).
+  // Receptance is strictly proper; velocity and acceleration follow by differentiating along the held
+  // input (u' = 0 between samples).
   const Matrix cv = cx * a, dv = cx * b, ca = cv * a, da = cv * b;
   m.ss.a = a;
   m.ss.b = b;
@@ -191,6 +179,35 @@ PlantModel build_plant_model(const config::Config& cfg) {
   m.ss.d.middleRows(2 * nl, nl) = da;
   m.ss.c.block(3 * nl, 0, 1, 2) = f_state;
   m.ss.d(3 * nl, 0) = t;
+}
+
+}  // namespace
+
+PlantModel build_plant_model(const config::Config& cfg) {
+  Problems problems;
+  if (cfg.robot.frfs.empty()) {
+    problems.push_back({cfg.source, {}, "robot.frfs", "missing: the simulated plant and the loop analysis need the robot's modal data"});
+    throw config::ConfigError(config::located(problems, cfg.yaml_text));
+  }
+  PlantModel m;
+  m.locations = cfg.robot.locations;
+  m.voltage_limit_v = cfg.amplifier.voltage_limit_v;
+  add_paths(cfg, m, problems);
+  add_reciprocals(cfg, m, problems);
+  const config::ActuatorConfig& ac = cfg.actuator;
+  m.actuator = {ac.constant_n_per_v, ac.natural_freq_hz, ac.damping_ratio, ac.delay_s, ac.force_limit_n,
+                m.index_of(ac.location)};
+  const std::size_t act = m.actuator.location, sensor = m.index_of(cfg.sensor.location);
+  if (m.path(act, act) == nullptr)
+    problems.push_back({cfg.source, {}, "robot.frfs",
+                        "no driving-point FRF at the actuator location " + std::to_string(ac.location) +
+                            ": the actuator's own receptance is needed to simulate and close the loop"});
+  if (m.path(sensor, act) == nullptr)
+    problems.push_back({cfg.source, {}, "robot.frfs",
+                        "no FRF from the actuator location " + std::to_string(ac.location) + " to the sensor location " +
+                            std::to_string(cfg.sensor.location) + " (nor its reciprocal): the loop cannot close"});
+  if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
+  build_state_space(ac, m);
   return m;
 }
 
