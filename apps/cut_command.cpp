@@ -147,6 +147,7 @@ std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
   return {};
 }
 
+// long: the cut command's three modes (one cut, --critical, --hil) and their reports; left for a later pass
 int run_cut(const CutArgs& a) {
   try {
     config::MillingConfig cfg = config::load_milling_config(a.config_path);

@@ -69,6 +69,7 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   return f;
 }
 
+// long: one entry per field of the run summary (the documented JSON shape)
 [[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s) {
   using nlohmann::json;
   auto hist = [](const rt::TimingHistogram& h) {
@@ -241,6 +242,7 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   return os.str();
 }
 
+// long: one line per field of the run summary, in the order an operator reads them
 [[nodiscard]] std::string summary_text(const runtime::RunSummary& s) {
   std::ostringstream os;
   char b[512];

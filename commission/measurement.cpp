@@ -80,6 +80,7 @@ int exit_code(MeasureStatus s) {
   return 1;
 }
 
+// long: the measurement's sequence on a cell (configure, hook, run, write), one rollback path; left for a later pass
 MeasureOutcome measure(const std::string& config_path, const std::string& out_dir, const MeasureOptions& opt) {
   const config::Config cfg = config::load_config_file(config_path);
   const sim::PlantModel model = sim::build_plant_model(cfg);

@@ -153,6 +153,7 @@ std::pair<double, double> depth_range(const CommissionResult& r, const tune::Ver
   return {0.8 * lo, 1.25 * hi};
 }
 
+// long: one HTML section, the verification table row by row
 std::string verify_section(const CommissionResult& r, Plots& p) {
   std::ostringstream h;
   h << "<h2>4. Verification</h2>\n";

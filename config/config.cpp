@@ -1,3 +1,4 @@
+// long: every key of a cell's configuration with its unit and range, section by section; the sections with their own files are split out (can, modbus, spindle, pose schedule)
 #include "config/config.hpp"
 
 #include <algorithm>

@@ -62,6 +62,7 @@ ModbusEndpoint read_endpoint(MapReader& r) {
   return e;
 }
 
+// long: every key of the modbus section with its unit and range, in the file's order
 std::optional<ModbusConfig> read_modbus(MapReader& top) {
   const YAML::Node node = top.child("modbus", false, "");
   if (!present(node)) return std::nullopt;

@@ -51,6 +51,7 @@ void CanDriver::take_over_pending() noexcept {
   bump(n_.reconnects);
 }
 
+// long: the real-time read path: drain, decode, counter and de-jitter in one pass without calls that could allocate; left whole
 rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
   take_over_pending();
   bool fresh = false;

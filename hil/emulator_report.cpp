@@ -101,6 +101,7 @@ nlohmann::json report_json(const EmulatorReport& r) {
             {"frfs", frfs}}}};
 }
 
+// long: one line per field of the emulator's report, in reading order
 std::string report_text(const EmulatorReport& r) {
   std::ostringstream os;
   char b[400];

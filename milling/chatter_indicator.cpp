@@ -35,6 +35,7 @@ void ChatterMonitor::push(double accel_mps2, bool fresh) {
   count_ = std::min(count_ + 1, ring_.size());
 }
 
+// long: one spectrum's evaluation (window, FFT, tooth harmonics, peaks, verdict) on preallocated buffers; left for a later pass
 ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   ChatterIndicator out;
   if (!(spindle_rpm > 0.0)) return out;

@@ -129,6 +129,7 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
   return s;
 }
 
+// long: one monodromy matrix over a tooth period on preallocated blocks (the hot loop of the accurate method)
 SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int ticks, bool want_vector) const {
   const Eigen::Index n = sys.a.rows();
   const double period_s = ticks * tick_s_;

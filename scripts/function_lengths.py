@@ -10,7 +10,7 @@ A function's length counts its lines from the signature to the closing brace. A 
 be longer when a comment `// long: <why>` stands within the three lines above its signature (a file: in
 its first 20 lines). Tests and generated code are left out.
 """
-import json, os, subprocess, sys
+import json, os, shutil, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FUNCTION_LIMIT, FILE_LIMIT = 80, 500
@@ -26,7 +26,8 @@ def sources():
 
 
 def functions(paths):
-    out = subprocess.run(["ctags", "--output-format=json", "--fields=+ne", "--c++-kinds=+fl", "--extras=-q",
+    ctags = shutil.which("ctags-universal") or "ctags"  # Debian's universal-ctags
+    out = subprocess.run([ctags, "--output-format=json", "--fields=+ne", "--c++-kinds=+fl", "--extras=-q",
                           "-o", "-"] + paths, cwd=ROOT, capture_output=True, text=True, check=True).stdout
     for line in out.splitlines():
         t = json.loads(line)

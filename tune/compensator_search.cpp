@@ -1,3 +1,4 @@
+// long: the candidate, its evaluation and the NLopt search share the evaluator's state; left for a later pass
 #include "tune/compensator_search.hpp"
 
 #include <nlopt.h>
@@ -197,6 +198,7 @@ Evaluation Evaluator::operator()(const Candidate& cand, bool constraints_only) c
   return e;
 }
 
+// long: every constraint of one candidate in the order the report names them; left for a later pass
 Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) const {
   Evaluation e;
   e.candidate.gain_ns_per_m = cfg.controller.gain_ns_per_m;
