@@ -1,7 +1,7 @@
 // The controller scheduled by the robot's pose (docs/pose_dynamics.md, "Scheduling by pose"): boxes of
 // joint angles (regions), each with its own parameter set, designed and analysed at configuration time
 // from the robot model (config/robots/*.yaml) at the region's poses. Read by analysis/pose_schedule
-// (the sets), runtime/ (the hand-over) and drivers/modbus_supervisor (the joint registers).
+// (the sets), runtime/ (the hand-over) and drivers/modbus_client (the joint registers).
 #pragma once
 
 #include <cstddef>

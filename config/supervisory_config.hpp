@@ -1,5 +1,5 @@
 // The non-real-time links of a robot cell: Modbus to the amplifier and the robot controller
-// (drivers/modbus_supervisor), the parameter sets the robot's mounting selects, Fast DDS telemetry and
+// (drivers/modbus_client), the parameter sets the robot's mounting selects, Fast DDS telemetry and
 // supervised parameters (dds/), and the hardware-in-the-loop emulator's pacing (robodamp plant).
 // All optional: a configuration without them runs against the simulated plant in process.
 #pragma once

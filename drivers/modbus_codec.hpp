@@ -1,5 +1,5 @@
 // The Modbus registers' scaling, encoded by the HIL emulator (hil/emulator_registers.hpp) and decoded by
-// the supervisory client (drivers/modbus_supervisor): one codec, as the CAN frames have one
+// the supervisory client (drivers/modbus_client): one codec, as the CAN frames have one
 // (drivers/can_codec). The counts per unit come from the modbus section (config/supervisory_config.hpp).
 #pragma once
 

@@ -28,7 +28,7 @@ struct SimBackendOptions {
   double amplifier_temperature_c{35.0};
 };
 
-class SimBackend final : public rt::SensorSource, public rt::ActuatorSink, public rt::SupervisoryIo {
+class SimBackend final : public rt::SensorSource, public rt::ActuatorSink, public rt::AmplifierIo {
  public:
   explicit SimBackend(sim::Plant& plant, SimBackendOptions o = {}) : plant_(plant), o_(o) {}
 

@@ -44,9 +44,9 @@ struct AmplifierStatus {
   double temperature_c{0.0};
 };
 
-class SupervisoryIo {
+class AmplifierIo {
  public:
-  virtual ~SupervisoryIo() = default;
+  virtual ~AmplifierIo() = default;
   // Asks for the amplifier enable state; takes effect when the device acknowledges it.
   virtual void request_amplifier_enable(bool on) noexcept = 0;
   [[nodiscard]] virtual AmplifierStatus amplifier_status() noexcept = 0;

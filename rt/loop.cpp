@@ -13,7 +13,7 @@ std::uint32_t sat32(std::uint64_t v) noexcept { return v > 0xFFFFFFFFULL ? 0xFFF
 }  // namespace
 
 Loop::Loop(double rate_hz, config::ClockKind clock, Supervisor& supervisor, SensorSource& sensor,
-           ActuatorSink& actuator, SupervisoryIo& io, SpscRing<TelemetryFrame>* telemetry)
+           ActuatorSink& actuator, AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry)
     : period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
       clock_(clock),
       sup_(supervisor),

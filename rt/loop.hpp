@@ -47,7 +47,7 @@ struct LoopStats {
 class Loop {
  public:
   Loop(double rate_hz, config::ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
-       SupervisoryIo& io, SpscRing<TelemetryFrame>* telemetry);
+       AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry);
 
   // From any non-real-time thread (operator, Modbus pose, DDS parameter requests): queue a command for
   // the next tick boundary. False when the queue is full. The producers take turns under a mutex; the
@@ -103,7 +103,7 @@ class Loop {
   Supervisor& sup_;
   SensorSource& sensor_;
   ActuatorSink& actuator_;
-  SupervisoryIo& io_;
+  AmplifierIo& io_;
   SpscRing<TelemetryFrame>* telemetry_;
   SpscRing<OperatorCommand> commands_{64};
   std::mutex post_mutex_;

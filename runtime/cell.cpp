@@ -90,7 +90,7 @@ Status Cell::configure() {
   if (Status s = configure_devices(); !s.ok()) return s;
   rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
   rt::ActuatorSink* actuator = can_ ? static_cast<rt::ActuatorSink*>(&can_->driver()) : &sim_->backend();
-  rt::SupervisoryIo* io = modbus_ ? static_cast<rt::SupervisoryIo*>(&modbus_->client()) : &sim_->backend();
+  rt::AmplifierIo* io = modbus_ ? static_cast<rt::AmplifierIo*>(&modbus_->client()) : &sim_->backend();
   loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io, ring_.get());
   arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
   if (o_.arm_at_start) loop_->set_policy(arming_.get());
@@ -121,7 +121,7 @@ Status Cell::configure() {
 Status Cell::configure_devices() {
   if (cfg_.can) {
     can_ = std::make_unique<CanBus>(*cfg_.can, cfg_.loop.rate_hz, cfg_.loop.clock, o_.connect_timeout_s);
-    modbus_ = std::make_unique<ModbusSupervisory>(
+    modbus_ = std::make_unique<ModbusComponent>(
         *cfg_.modbus, cfg_.actuator.mounting,
         [this](config::Mounting m) {
           if (const auto set = parameter_set_for(m)) {
@@ -145,7 +145,7 @@ Status Cell::configure_devices() {
           plant_cfg, analysis::pose_modes(pose_schedule_.model, o_.pose_deg, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes));
     const bool own = o_.plant_config || (cfg_.pose_schedule && !o_.pose_deg.empty());
     const sim::PlantModel plant_model = own ? sim::build_plant_model(plant_cfg) : model_->plant();
-    sim_ = std::make_unique<SimulatedPlant>(plant_model, plant_cfg, o_.backend);
+    sim_ = std::make_unique<SimBackendComponent>(plant_model, plant_cfg, o_.backend);
     backend_name_ = "simulated plant";
   }
   if (cfg_.dds) {

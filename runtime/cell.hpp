@@ -106,7 +106,7 @@ class Cell {
   [[nodiscard]] sim::Plant& plant() { return sim_->plant(); }  // simulated backend only
   [[nodiscard]] drivers::SimBackend& sim_backend() { return sim_->backend(); }  // simulated backend only
   [[nodiscard]] drivers::CanDriver* can_driver() { return can_ ? &can_->driver() : nullptr; }
-  [[nodiscard]] drivers::ModbusSupervisor* modbus() { return modbus_ ? &modbus_->client() : nullptr; }
+  [[nodiscard]] drivers::ModbusClient* modbus() { return modbus_ ? &modbus_->client() : nullptr; }
   [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }
   [[nodiscard]] rt::Loop& loop() { return *loop_; }
   [[nodiscard]] ArmingPolicy& arming() { return *arming_; }
@@ -133,9 +133,9 @@ class Cell {
   std::unique_ptr<analysis::LoopModel> model_;
   std::optional<double> max_stable_gain_;
   bool stable_{false};
-  std::unique_ptr<SimulatedPlant> sim_;
+  std::unique_ptr<SimBackendComponent> sim_;
   std::unique_ptr<CanBus> can_;
-  std::unique_ptr<ModbusSupervisory> modbus_;
+  std::unique_ptr<ModbusComponent> modbus_;
   std::unique_ptr<DdsEndpoint> dds_;
   std::vector<std::pair<config::Mounting, std::size_t>> mounting_sets_;
   std::string backend_name_;

@@ -13,18 +13,18 @@
 
 namespace robodamp::runtime {
 
-SimulatedPlant::SimulatedPlant(const sim::PlantModel& model, const config::Config& plant_cfg,
+SimBackendComponent::SimBackendComponent(const sim::PlantModel& model, const config::Config& plant_cfg,
                                drivers::SimBackendOptions o)
     : Component("simulated plant"), model_(model), cfg_(plant_cfg), o_(o) {}
 
-Status SimulatedPlant::on_configure() {
+Status SimBackendComponent::on_configure() {
   plant_ = std::make_unique<sim::Plant>(model_, cfg_);
   if (cfg_.disturbances.drives_on) plant_->add_excitation(sim::make_drive_vibration(model_, cfg_));
   backend_ = std::make_unique<drivers::SimBackend>(*plant_, o_);
   return {};
 }
 
-Status SimulatedPlant::on_cleanup() {
+Status SimBackendComponent::on_cleanup() {
   backend_.reset();
   plant_.reset();
   return {};
@@ -96,32 +96,32 @@ Status CanBus::on_cleanup() {
   return {};
 }
 
-ModbusSupervisory::ModbusSupervisory(const config::ModbusConfig& cfg, config::Mounting initial,
-                                     drivers::ModbusSupervisor::MountingCallback on_mounting, double connect_timeout_s)
+ModbusComponent::ModbusComponent(const config::ModbusConfig& cfg, config::Mounting initial,
+                                     drivers::ModbusClient::MountingCallback on_mounting, double connect_timeout_s)
     : Component("Modbus " + config::describe(cfg.amplifier_link)),
       cfg_(cfg),
       initial_(initial),
       on_mounting_(std::move(on_mounting)),
       connect_timeout_s_(connect_timeout_s) {}
 
-Status ModbusSupervisory::on_configure() {
-  auto client = std::make_unique<drivers::ModbusSupervisor>(cfg_, initial_, on_mounting_);
+Status ModbusComponent::on_configure() {
+  auto client = std::make_unique<drivers::ModbusClient>(cfg_, initial_, on_mounting_);
   std::lock_guard<std::mutex> lock(client_m_);
   client_ = std::move(client);
   return {};
 }
 
-void ModbusSupervisory::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
+void ModbusComponent::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
   std::lock_guard<std::mutex> lock(client_m_);
   if (client_) client_->publish_advice(seq, found, rpm, margin);
 }
 
-double ModbusSupervisory::robot_depth_mm() const {
+double ModbusComponent::robot_depth_mm() const {
   std::lock_guard<std::mutex> lock(client_m_);
   return client_ ? client_->depth_mm() : std::numeric_limits<double>::quiet_NaN();
 }
 
-Status ModbusSupervisory::on_activate() {
+Status ModbusComponent::on_activate() {
   client_->start();
   answered_ = client_->wait_for_amplifier(std::chrono::duration<double>(connect_timeout_s_));
   // Not a failure: the link may come up later, and the arming policy reports the refusal if it never does.
@@ -131,14 +131,14 @@ Status ModbusSupervisory::on_activate() {
   return {};
 }
 
-Status ModbusSupervisory::on_deactivate() {
+Status ModbusComponent::on_deactivate() {
   client_->request_amplifier_enable(false);
   client_->stop();  // writes the enable coil off when it can, then joins the polling threads
   return {};
 }
 
-Status ModbusSupervisory::on_cleanup() {
-  std::unique_ptr<drivers::ModbusSupervisor> client;
+Status ModbusComponent::on_cleanup() {
+  std::unique_ptr<drivers::ModbusClient> client;
   {
     std::lock_guard<std::mutex> lock(client_m_);
     client = std::move(client_);

@@ -1,14 +1,14 @@
 // The devices of a cell as lifecycle components (runtime/lifecycle.hpp): what each one does on
 // configure, activate, deactivate and cleanup. The loop reaches them only through rt/io.hpp.
 //
-//   component          configure                      activate                         deactivate
-//   SimulatedPlant     build the plant and drives     -                                -
-//   CanBus             open the channel, the driver   flush the queue (wall clock) or  stop reconnecting
-//                                                     lockstep wait (virtual clock);
-//                                                     unix: transport: reconnect thread
-//   ModbusSupervisory  the client, register maps      start polling, wait for the      amplifier enable off,
-//                                                     amplifier's first answer         stop polling
-//   DdsEndpoint        participant and topics         status thread                    last status, stop
+//   component            configure                      activate                         deactivate
+//   SimBackendComponent  build the plant and drives     -                                -
+//   CanBus               open the channel, the driver   flush the queue (wall clock) or  stop reconnecting
+//                                                       lockstep wait (virtual clock);
+//                                                       unix: transport: reconnect thread
+//   ModbusComponent      the client, register maps      start polling, wait for the      amplifier enable off,
+//                                                       amplifier's first answer         stop polling
+//   DdsEndpoint          participant and topics         status thread                    last status, stop
 #pragma once
 
 #include <condition_variable>
@@ -22,7 +22,7 @@
 #include "config/config.hpp"
 #include "dds/bridge.hpp"
 #include "drivers/can_driver.hpp"
-#include "drivers/modbus_supervisor.hpp"
+#include "drivers/modbus_client.hpp"
 #include "drivers/sim_backend.hpp"
 #include "rt/io.hpp"
 #include "runtime/lifecycle.hpp"
@@ -31,11 +31,11 @@
 
 namespace robodamp::runtime {
 
-// The simulated plant in process: sensor, actuator and amplifier in one.
-class SimulatedPlant final : public Component {
+// The simulated backend in process (drivers::SimBackend over sim::Plant): sensor, actuator and amplifier in one.
+class SimBackendComponent final : public Component {
  public:
   // model: the plant the controller was designed for; plant_cfg: the robot as it really is.
-  SimulatedPlant(const sim::PlantModel& model, const config::Config& plant_cfg, drivers::SimBackendOptions o);
+  SimBackendComponent(const sim::PlantModel& model, const config::Config& plant_cfg, drivers::SimBackendOptions o);
   [[nodiscard]] sim::Plant& plant() { return *plant_; }
   [[nodiscard]] drivers::SimBackend& backend() { return *backend_; }
 
@@ -78,13 +78,13 @@ class CanBus final : public Component {
   std::uint64_t flushed_{0};
 };
 
-// The Modbus supervisory client: amplifier enable, ready, fault, temperature; the robot's mounting.
-class ModbusSupervisory final : public Component {
+// The Modbus client (drivers::ModbusClient): amplifier enable, ready, fault, temperature; the robot's mounting.
+class ModbusComponent final : public Component {
  public:
-  ModbusSupervisory(const config::ModbusConfig& cfg, config::Mounting initial,
-                    drivers::ModbusSupervisor::MountingCallback on_mounting, double connect_timeout_s);
+  ModbusComponent(const config::ModbusConfig& cfg, config::Mounting initial,
+                    drivers::ModbusClient::MountingCallback on_mounting, double connect_timeout_s);
   // Between on_configure and on_cleanup only (the loop's thread and the lifecycle's).
-  [[nodiscard]] drivers::ModbusSupervisor& client() { return *client_; }
+  [[nodiscard]] drivers::ModbusClient& client() { return *client_; }
   // Any thread, in any state (the machining monitor's advisor runs from the cell's configure on, before
   // this component's on_configure and until the cell's cleanup): nothing while there is no client.
   void publish_advice(std::uint64_t seq, bool found, double rpm, double margin);
@@ -98,9 +98,9 @@ class ModbusSupervisory final : public Component {
   mutable std::mutex client_m_;  // guards client_'s creation and reset against the two calls above
   config::ModbusConfig cfg_;
   config::Mounting initial_;
-  drivers::ModbusSupervisor::MountingCallback on_mounting_;
+  drivers::ModbusClient::MountingCallback on_mounting_;
   double connect_timeout_s_;
-  std::unique_ptr<drivers::ModbusSupervisor> client_;
+  std::unique_ptr<drivers::ModbusClient> client_;
   bool answered_{false};
 };
 

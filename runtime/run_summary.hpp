@@ -9,7 +9,7 @@
 
 #include "dds/bridge.hpp"
 #include "drivers/can_driver.hpp"
-#include "drivers/modbus_supervisor.hpp"
+#include "drivers/modbus_client.hpp"
 #include "rt/loop.hpp"
 #include "rt/realtime.hpp"
 #include "rt/supervisor.hpp"

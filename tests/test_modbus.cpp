@@ -21,14 +21,14 @@
 
 #include "drivers/modbus_codec.hpp"
 #include "drivers/modbus_server.hpp"
-#include "drivers/modbus_supervisor.hpp"
+#include "drivers/modbus_client.hpp"
 #include "test_util.hpp"
 
 namespace robodamp {
 namespace {
 
 using drivers::ModbusServer;
-using drivers::ModbusSupervisor;
+using drivers::ModbusClient;
 using test::eventually;
 
 config::ModbusConfig client_config(int port) {
@@ -85,7 +85,7 @@ TEST(Modbus, AmplifierEnableReadyFaultAndTemperature) {
   ModbusServer server;
   const int port = server.start("127.0.0.1", 0);
   server.set_input_register(2, 352);  // 35.2 degC
-  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  ModbusClient sup(client_config(port), config::Mounting::kHorizontal);
   sup.start();
   ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
   rt::AmplifierStatus s = sup.amplifier_status();
@@ -125,7 +125,7 @@ TEST(Modbus, HangingDeviceTimesOutAndIsALostLinkWhileEnabled) {
   ModbusServer server;
   const int port = server.start("127.0.0.1", 0);
   server.set_discrete_input(4, true);
-  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  ModbusClient sup(client_config(port), config::Mounting::kHorizontal);
   sup.start();
   sup.request_amplifier_enable(true);
   ASSERT_TRUE(eventually([&] { return sup.amplifier_status().ready; }));
@@ -147,7 +147,7 @@ TEST(Modbus, HangingDeviceTimesOutAndIsALostLinkWhileEnabled) {
 TEST(Modbus, LostLinkIsOnlyCountedWhileTheAmplifierIsNotNeeded) {
   ModbusServer server;
   const int port = server.start("127.0.0.1", 0);
-  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  ModbusClient sup(client_config(port), config::Mounting::kHorizontal);
   sup.start();
   ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
   server.stop();
@@ -170,7 +170,7 @@ TEST(Modbus, DisconnectReconnectsWithBackoff) {
   const int port = server.start("127.0.0.1", 0);
   auto cfg = client_config(port);
   cfg.robot_link.reset();
-  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  ModbusClient sup(cfg, config::Mounting::kHorizontal);
   sup.start();
   ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
   server.stop();  // the device goes away
@@ -192,7 +192,7 @@ TEST(Modbus, DisconnectReconnectsWithBackoff) {
 TEST(Modbus, DroppedConnectionsReconnect) {
   ModbusServer server;
   const int port = server.start("127.0.0.1", 0);
-  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  ModbusClient sup(client_config(port), config::Mounting::kHorizontal);
   sup.start();
   ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
   ASSERT_TRUE(eventually([&] { return sup.robot_link_up(); }));
@@ -208,7 +208,7 @@ TEST(Modbus, RobotMountingSelectsAfterSettling) {
   const int port = server.start("127.0.0.1", 0);
   std::atomic<int> calls{0};
   std::atomic<int> last{-1};
-  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal, [&](config::Mounting m) {
+  ModbusClient sup(client_config(port), config::Mounting::kHorizontal, [&](config::Mounting m) {
     last = static_cast<int>(m);
     ++calls;
   });
@@ -239,7 +239,7 @@ TEST(Modbus, SpindleRegisterSettlesScalesAndALostLinkParksTheNotches) {
   cfg.robot.rpm_per_count = 10.0;
   std::mutex m;
   std::vector<double> speeds;
-  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  ModbusClient sup(cfg, config::Mounting::kHorizontal);
   sup.set_spindle_callback([&](double rpm) {
     std::lock_guard<std::mutex> lock(m);
     speeds.push_back(rpm);
@@ -270,7 +270,7 @@ TEST(Modbus, DepthRegisterScalesAndNotAvailableOrALostLinkIsUnknown) {
   config::ModbusConfig cfg = client_config(port);
   cfg.robot.depth_register = 12;
   cfg.robot.depth_mm_per_count = 0.001;
-  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  ModbusClient sup(cfg, config::Mounting::kHorizontal);
   EXPECT_TRUE(std::isnan(sup.depth_mm()));
   server.set_holding_register(12, 850);
   sup.start();
@@ -300,7 +300,7 @@ TEST(Modbus, JointRegistersSettleToARegionAndUnknownPosesAreOutOfTheMap) {
   schedule.regions = {{"low", {-10.0, 0.0}, {10.0, 55.0}, {}}, {"high", {-10.0, 45.0}, {10.0, 100.0}, {}}};
   std::mutex m;
   std::vector<long> regions;  // -1: out of the map
-  ModbusSupervisor sup(cfg, config::Mounting::kHorizontal);
+  ModbusClient sup(cfg, config::Mounting::kHorizontal);
   sup.set_pose_callback(schedule, [&](std::optional<std::size_t> r) {
     std::lock_guard<std::mutex> lock(m);
     regions.push_back(r ? static_cast<long>(*r) : -1L);
@@ -352,7 +352,7 @@ TEST(Modbus, JointRegistersSettleToARegionAndUnknownPosesAreOutOfTheMap) {
 TEST(Modbus, StopLeavesTheAmplifierOff) {
   ModbusServer server;
   const int port = server.start("127.0.0.1", 0);
-  ModbusSupervisor sup(client_config(port), config::Mounting::kHorizontal);
+  ModbusClient sup(client_config(port), config::Mounting::kHorizontal);
   sup.start();
   sup.request_amplifier_enable(true);
   ASSERT_TRUE(eventually([&] { return server.coil(3); }));
@@ -439,7 +439,7 @@ class GarbageServer {
 
 TEST(Modbus, ADeviceAnsweringGarbageIsCountedAndNeverReady) {
   GarbageServer server(11);
-  ModbusSupervisor sup(client_config(server.port()), config::Mounting::kHorizontal);
+  ModbusClient sup(client_config(server.port()), config::Mounting::kHorizontal);
   sup.start();
   sup.request_amplifier_enable(true);
   bool ever_ready = false;

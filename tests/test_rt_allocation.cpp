@@ -30,7 +30,7 @@
 #include "control/controller.hpp"
 #include "drivers/can_driver.hpp"
 #include "drivers/modbus_server.hpp"
-#include "drivers/modbus_supervisor.hpp"
+#include "drivers/modbus_client.hpp"
 #include "sim_plant/plant.hpp"
 #include "test_util.hpp"
 
@@ -261,7 +261,7 @@ TEST(RealTimePath, ModbusStatusAllocatesNothing) {
   config::ModbusConfig m;
   m.amplifier_link.port = server.start("127.0.0.1", 0);
   m.poll_period_s = 0.002;
-  drivers::ModbusSupervisor sup(m, config::Mounting::kHorizontal);
+  drivers::ModbusClient sup(m, config::Mounting::kHorizontal);
   sup.start();
   ASSERT_TRUE(sup.wait_for_amplifier(std::chrono::seconds(5)));
   std::uint64_t faults = 0;

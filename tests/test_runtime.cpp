@@ -259,7 +259,7 @@ TEST(CellComponents, TheModbusClientsAdviceAndDepthAreSafeOutsideItsLife) {
   config::ModbusConfig cfg;
   cfg.amplifier_link.host = "127.0.0.1";
   cfg.amplifier_link.port = 1;  // nothing listens: never started here
-  runtime::ModbusSupervisory m(cfg, config::Mounting::kHorizontal, {}, 0.1);
+  runtime::ModbusComponent m(cfg, config::Mounting::kHorizontal, {}, 0.1);
   EXPECT_TRUE(std::isnan(m.robot_depth_mm()));
   m.publish_advice(1, true, 666.7, 2.0);
   ASSERT_TRUE(m.configure().ok());

@@ -1,4 +1,4 @@
-#include "drivers/modbus_supervisor.hpp"
+#include "drivers/modbus_client.hpp"
 
 #include "drivers/modbus_codec.hpp"
 #include "rt/clock.hpp"
@@ -76,7 +76,7 @@ void ModbusLink::failed(Clock::time_point now) {
   backoff_ = std::min(backoff_ * 2.0, max_);
 }
 
-ModbusSupervisor::ModbusSupervisor(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback cb)
+ModbusClient::ModbusClient(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback cb)
     : cfg_(cfg),
       on_mounting_(std::move(cb)),
       amp_link_(cfg.amplifier_link, cfg),
@@ -85,9 +85,9 @@ ModbusSupervisor::ModbusSupervisor(const config::ModbusConfig& cfg, config::Moun
   if (cfg_.robot_link) robot_link_.emplace(*cfg_.robot_link, cfg_);
 }
 
-ModbusSupervisor::~ModbusSupervisor() { stop(); }
+ModbusClient::~ModbusClient() { stop(); }
 
-void ModbusSupervisor::start() {
+void ModbusClient::start() {
   {
     std::lock_guard<std::mutex> lock(m_);
     if (running_) return;
@@ -97,7 +97,7 @@ void ModbusSupervisor::start() {
   if (robot_link_) robot_thread_ = std::thread([this] { robot_thread(); });
 }
 
-void ModbusSupervisor::stop() {
+void ModbusClient::stop() {
   {
     std::lock_guard<std::mutex> lock(m_);
     if (!running_) return;
@@ -108,20 +108,20 @@ void ModbusSupervisor::stop() {
   if (robot_thread_.joinable()) robot_thread_.join();
 }
 
-bool ModbusSupervisor::sleep_for(std::chrono::duration<double> d) {
+bool ModbusClient::sleep_for(std::chrono::duration<double> d) {
   std::unique_lock<std::mutex> lock(m_);
   cv_.wait_for(lock, d, [this] { return !running_; });
   return running_;
 }
 
-bool ModbusSupervisor::wait_for_amplifier(std::chrono::duration<double> timeout) const {
+bool ModbusClient::wait_for_amplifier(std::chrono::duration<double> timeout) const {
   std::unique_lock<std::mutex> lock(m_);
   return cv_.wait_for(lock, timeout, [this] { return last_ok_ns_.load() >= 0 || !running_; }) && last_ok_ns_.load() >= 0;
 }
 
-void ModbusSupervisor::request_amplifier_enable(bool on) noexcept { requested_.store(on, std::memory_order_relaxed); }
+void ModbusClient::request_amplifier_enable(bool on) noexcept { requested_.store(on, std::memory_order_relaxed); }
 
-rt::AmplifierStatus ModbusSupervisor::amplifier_status() noexcept {
+rt::AmplifierStatus ModbusClient::amplifier_status() noexcept {
   rt::AmplifierStatus s;
   const std::int64_t last = last_ok_ns_.load(std::memory_order_acquire);
   const bool stale = last < 0 || rt::monotonic_ns() - last > link_timeout_ns_;
@@ -142,7 +142,7 @@ rt::AmplifierStatus ModbusSupervisor::amplifier_status() noexcept {
   return s;
 }
 
-void ModbusSupervisor::amplifier_thread() {
+void ModbusClient::amplifier_thread() {
   const auto& r = cfg_.amplifier;
   const int in_lo = std::min(r.ready_input, r.fault_input), in_n = std::abs(r.ready_input - r.fault_input) + 1;
   std::vector<std::uint8_t> inputs(static_cast<std::size_t>(in_n));
@@ -194,7 +194,7 @@ void ModbusSupervisor::amplifier_thread() {
     modbus_write_bit(ctx, r.enable_coil, 0);
 }
 
-void ModbusSupervisor::robot_thread() {
+void ModbusClient::robot_thread() {
   const auto& r = cfg_.robot;
   const auto period = std::chrono::duration<double>(cfg_.poll_period_s);
   int candidate = -1, same = 0;
@@ -254,7 +254,7 @@ void ModbusSupervisor::robot_thread() {
   }
 }
 
-void ModbusSupervisor::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
+void ModbusClient::publish_advice(std::uint64_t seq, bool found, double rpm, double margin) {
   if (cfg_.robot.advice_register < 0 || !robot_link_) return;
   const auto regs = modbus_codec::encode_advice(seq, found, rpm, margin, cfg_.robot.rpm_per_count);
   std::lock_guard<std::mutex> lock(m_);
@@ -262,7 +262,7 @@ void ModbusSupervisor::publish_advice(std::uint64_t seq, bool found, double rpm,
   advice_pending_ = true;
 }
 
-bool ModbusSupervisor::write_advice(modbus_t* ctx) {
+bool ModbusClient::write_advice(modbus_t* ctx) {
   std::array<std::uint16_t, 4> regs{};
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -276,7 +276,7 @@ bool ModbusSupervisor::write_advice(modbus_t* ctx) {
   return true;
 }
 
-bool ModbusSupervisor::poll_depth(modbus_t* ctx) {
+bool ModbusClient::poll_depth(modbus_t* ctx) {
   const auto& r = cfg_.robot;
   if (r.depth_register < 0) return true;
   std::uint16_t v = 0;
@@ -292,7 +292,7 @@ bool ModbusSupervisor::poll_depth(modbus_t* ctx) {
   return true;
 }
 
-bool ModbusSupervisor::poll_spindle(modbus_t* ctx, SpindleWatch& w) {
+bool ModbusClient::poll_spindle(modbus_t* ctx, SpindleWatch& w) {
   const auto& r = cfg_.robot;
   if (r.spindle_rpm_register < 0) return true;
   std::uint16_t v = 0;
@@ -311,7 +311,7 @@ bool ModbusSupervisor::poll_spindle(modbus_t* ctx, SpindleWatch& w) {
   return true;
 }
 
-void ModbusSupervisor::park_spindle_if_lost(SpindleWatch& w) {
+void ModbusClient::park_spindle_if_lost(SpindleWatch& w) {
   if (cfg_.robot.spindle_rpm_register < 0 || w.parked) return;
   w.candidate = -1, w.same = 0;
   if (ModbusLink::Clock::now() - w.last_ok < std::chrono::duration<double>(cfg_.link_timeout_s)) return;
@@ -322,7 +322,7 @@ void ModbusSupervisor::park_spindle_if_lost(SpindleWatch& w) {
   if (on_spindle_) on_spindle_(0.0);
 }
 
-bool ModbusSupervisor::poll_pose(modbus_t* ctx, PoseWatch& w) {
+bool ModbusClient::poll_pose(modbus_t* ctx, PoseWatch& w) {
   const auto& r = cfg_.robot;
   if (r.joints_register < 0 || !schedule_) return true;
   constexpr std::size_t kMaxJoints = 16;
@@ -353,7 +353,7 @@ bool ModbusSupervisor::poll_pose(modbus_t* ctx, PoseWatch& w) {
   return true;
 }
 
-void ModbusSupervisor::report_pose(PoseWatch& w, long region) {
+void ModbusClient::report_pose(PoseWatch& w, long region) {
   w.reported = region;
   ++pose_changes_;
   if (region >= 0)
@@ -363,7 +363,7 @@ void ModbusSupervisor::report_pose(PoseWatch& w, long region) {
   if (on_pose_) on_pose_(region >= 0 ? std::optional(static_cast<std::size_t>(region)) : std::nullopt);
 }
 
-void ModbusSupervisor::pose_unknown_if_lost(PoseWatch& w) {
+void ModbusClient::pose_unknown_if_lost(PoseWatch& w) {
   if (cfg_.robot.joints_register < 0 || !schedule_ || w.lost) return;
   w.candidate = -2, w.same = 0;
   if (ModbusLink::Clock::now() - w.last_ok < std::chrono::duration<double>(cfg_.link_timeout_s)) return;
@@ -373,12 +373,12 @@ void ModbusSupervisor::pose_unknown_if_lost(PoseWatch& w) {
   report_pose(w, -1);
 }
 
-std::vector<double> ModbusSupervisor::joints_deg() const {
+std::vector<double> ModbusClient::joints_deg() const {
   std::lock_guard lk(m_);
   return joints_deg_;
 }
 
-ModbusCounters ModbusSupervisor::counters() const {
+ModbusCounters ModbusClient::counters() const {
   ModbusCounters c;
   c.amplifier_polls = amp_polls_.load();
   c.robot_polls = robot_polls_.load();

@@ -86,17 +86,17 @@ struct ModbusCounters {
   std::uint64_t depth_unavailable_polls{0};  // polls with the depth register at 65535 (not available)
 };
 
-class ModbusSupervisor final : public rt::SupervisoryIo {
+class ModbusClient final : public rt::AmplifierIo {
  public:
   using MountingCallback = std::function<void(config::Mounting)>;
   using SpindleCallback = std::function<void(double rpm)>;
   // The settled region's index in pose_schedule.regions, or nothing: out of the map or unknown.
   using PoseCallback = std::function<void(std::optional<std::size_t> region)>;
   // initial: the mounting the controller starts with (its configuration's actuator.mounting).
-  ModbusSupervisor(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback on_mounting = {});
-  ~ModbusSupervisor() override;
-  ModbusSupervisor(const ModbusSupervisor&) = delete;
-  ModbusSupervisor& operator=(const ModbusSupervisor&) = delete;
+  ModbusClient(const config::ModbusConfig& cfg, config::Mounting initial, MountingCallback on_mounting = {});
+  ~ModbusClient() override;
+  ModbusClient(const ModbusClient&) = delete;
+  ModbusClient& operator=(const ModbusClient&) = delete;
 
   // Before start(): called from the robot thread with each settled spindle speed (rpm; 0 when the robot
   // link has been lost for link_timeout_s). Needs modbus.robot.spindle_rpm_register.
