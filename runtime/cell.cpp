@@ -435,11 +435,21 @@ Status Cell::cleanup() {
   return {};
 }
 
-RunSummary Cell::run(double duration_s) {
-  if (Status s = activate(duration_s); !s.ok()) throw std::runtime_error(s.message);
+Status Cell::run(double duration_s) {
+  if (Status s = activate(duration_s); !s.ok()) return s;
   wait();
   if (Status s = deactivate(); !s.ok()) spdlog::warn("{}", s.message);
-  return summary_;
+  return {};
+}
+
+sim::Plant& Cell::plant() {
+  if (!sim_) throw std::logic_error("the cell runs the " + backend_name_ + " backend: it has no simulated plant");
+  return sim_->plant();
+}
+
+drivers::SimBackend& Cell::sim_backend() {
+  if (!sim_) throw std::logic_error("the cell runs the " + backend_name_ + " backend: it has no simulated backend");
+  return sim_->backend();
 }
 
 }  // namespace robodamp::runtime

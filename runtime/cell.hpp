@@ -80,8 +80,8 @@ class Cell {
   void wait();
   Status deactivate();
   Status cleanup();
-  // activate + wait + deactivate, from Inactive; a failed activation throws std::runtime_error.
-  [[nodiscard]] RunSummary run(double duration_s);
+  // activate + wait + deactivate, from Inactive: the activation's Status (the run's result in summary()).
+  [[nodiscard]] Status run(double duration_s);
   [[nodiscard]] LifecycleState state() const noexcept { return state_; }
 
   // Inactive (configured): another controller parameter set (designed and analysed from cfg, same loop
@@ -103,8 +103,10 @@ class Cell {
   [[nodiscard]] bool hardware() const { return can_ != nullptr; }
   [[nodiscard]] const std::string& backend_name() const { return backend_name_; }
   [[nodiscard]] const RunSummary& summary() const { return summary_; }
-  [[nodiscard]] sim::Plant& plant() { return sim_->plant(); }  // simulated backend only
-  [[nodiscard]] drivers::SimBackend& sim_backend() { return sim_->backend(); }  // simulated backend only
+  // The simulated backend's plant and devices; on the hardware backend (hardware()) they do not exist and
+  // these throw std::logic_error saying so.
+  [[nodiscard]] sim::Plant& plant();
+  [[nodiscard]] drivers::SimBackend& sim_backend();
   [[nodiscard]] drivers::CanDriver* can_driver() { return can_ ? &can_->driver() : nullptr; }
   [[nodiscard]] drivers::ModbusClient* modbus() { return modbus_ ? &modbus_->client() : nullptr; }
   [[nodiscard]] rt::Supervisor& supervisor() { return *supervisor_; }

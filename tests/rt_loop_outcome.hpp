@@ -2,6 +2,8 @@
 // frame kept, and what to look for in the frames.
 #pragma once
 
+#include <stdexcept>
+
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -36,7 +38,8 @@ inline Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, 
   test::configure(session);
   setup(session);
   Outcome out;
-  out.s = session.run(duration_s);
+  if (const runtime::Status st = session.run(duration_s); !st.ok()) throw std::runtime_error(st.message);
+  out.s = session.summary();
   out.frames = session.frames();
   return out;
 }

@@ -301,7 +301,8 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     ASSERT_TRUE(cell.configure().ok());
     ASSERT_NE(cell.machining(), nullptr);
     cell.schedule(1, {rt::CommandKind::kSetSpindle, 700.0});
-    const runtime::RunSummary s = cell.run(6.0);
+    ASSERT_TRUE(cell.run(6.0).ok());
+    const runtime::RunSummary& s = cell.summary();
     ASSERT_TRUE(s.machining.has_value());
     const auto& m = *s.machining;
     EXPECT_EQ(m.spindle_rpm, 700.0);
@@ -358,7 +359,8 @@ TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
     runtime::Cell cell(cfg);
     ASSERT_TRUE(cell.configure().ok());
     cell.schedule(1, {rt::CommandKind::kSetSpindle, 700.0});
-    const runtime::RunSummary s = cell.run(3.0);
+    ASSERT_TRUE(cell.run(3.0).ok());
+    const runtime::RunSummary& s = cell.summary();
     if (depth < 0.782) {
       EXPECT_FALSE(s.advice.has_value()) << "within both limits";
       continue;

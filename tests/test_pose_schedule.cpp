@@ -255,7 +255,8 @@ TEST(PoseSchedule, CellAtAStretchedPoseRunsItsRegionsSetAndTheFoldedSetTrips) {
     o.pose_schedule_off = off;
     runtime::Cell cell(config::load_config_file(test::preset(kPreset)), o);
     test::configure(cell);
-    const runtime::RunSummary s = cell.run(off ? 8.0 : 12.0);
+    ASSERT_TRUE(cell.run(off ? 8.0 : 12.0).ok());
+    const runtime::RunSummary& s = cell.summary();
     if (!off) {
       EXPECT_EQ(s.trip, "none");
       EXPECT_EQ(s.arming.outcome, runtime::ArmingOutcome::kArmed);

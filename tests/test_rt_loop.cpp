@@ -108,7 +108,8 @@ TEST(Loop, ArmingRefusedWithAmplifierFault) {
   Cell session(c2(), virtual_clock());
   test::configure(session);
   session.plant().faults().add({FaultKind::kAmplifierFault, 0.0, 1.0});
-  const auto s = session.run(0.2);
+  ASSERT_TRUE(session.run(0.2).ok());
+  const auto& s = session.summary();
   EXPECT_EQ(s.supervisor.arm_refused, 1U);
   EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kActuatorPath);
   EXPECT_EQ(s.trip, "none") << "not armed, nothing to trip";
@@ -119,7 +120,8 @@ TEST(Loop, ArmingRefusedWhenTheAnalysisFindsTheGainUnstable) {
   cfg.controller.gain_ns_per_m = 6000.0;  // K_max 4805
   Cell session(cfg, virtual_clock());
   test::configure(session);
-  const auto s = session.run(0.2);
+  ASSERT_TRUE(session.run(0.2).ok());
+  const auto& s = session.summary();
   EXPECT_FALSE(s.analysis_stable);
   EXPECT_EQ(s.supervisor.arm_refused, 1U);
   EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kAnalysisUnstable);
@@ -130,7 +132,8 @@ TEST(Loop, ArmingRefusedAboveTheGainMargin) {
   cfg.controller.gain_ns_per_m = 4700.0;  // stable, but above max_gain_fraction 0.9 x 4805
   Cell session(cfg, virtual_clock());
   test::configure(session);
-  const auto s = session.run(0.2);
+  ASSERT_TRUE(session.run(0.2).ok());
+  const auto& s = session.summary();
   EXPECT_TRUE(s.analysis_stable);
   EXPECT_EQ(session.supervisor().last_arm_refusal(), ArmRefusal::kAnalysisUnstable);
 }
@@ -303,7 +306,8 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   session.schedule(5001, {CommandKind::kSelectParams, 0.0});  // refused: hand-over in progress
   session.schedule(5002, {CommandKind::kSelectParams, 7.0});  // refused: no such set
   session.schedule(15000, {CommandKind::kSelectParams, static_cast<double>(bad)});  // refused: unstable
-  const auto s = session.run(4.0);
+  ASSERT_TRUE(session.run(4.0).ok());
+  const auto& s = session.summary();
   EXPECT_EQ(s.trip, "none");
   EXPECT_EQ(s.supervisor.params_selected, 1U);
   EXPECT_EQ(s.supervisor.params_refused, 3U);
@@ -344,7 +348,8 @@ TEST(Loop, SpindleSpeedRampWithHarmonicNotchesStaysActiveAndReplays) {
   session.schedule(16000, {CommandKind::kSetSpindle, 250.0});    // refused by the analysis: parks
   session.schedule(17000, {CommandKind::kSetSpindle, 25000.0});  // above spindle.rpm_max: parks
   session.schedule(18000, {CommandKind::kSetSpindle, 12000.0});
-  const auto s = session.run(5.0);
+  ASSERT_TRUE(session.run(5.0).ok());
+  const auto& s = session.summary();
   EXPECT_EQ(s.trip, "none");
   EXPECT_EQ(s.supervisor.spindle_refused, 2U);
   const auto& f = session.frames();
@@ -451,7 +456,8 @@ TEST(Loop, SigintShutsDownThroughTheSafeState) {
     std::this_thread::sleep_for(std::chrono::milliseconds(800));
     std::raise(SIGINT);
   });
-  const auto s = session.run(30.0);
+  ASSERT_TRUE(session.run(30.0).ok());
+  const auto& s = session.summary();
   killer.join();
   shutdown_signal().store(0);
   EXPECT_EQ(s.trip, "signal");

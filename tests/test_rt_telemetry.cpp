@@ -76,7 +76,8 @@ class RecordingTest : public ::testing::Test {
     session.schedule(3000, {CommandKind::kSetGain, 2600.0});
     session.schedule(7000, {CommandKind::kResetFault, 0.0});
     session.schedule(7100, {CommandKind::kArm, 0.0});
-    summary_ = session.run(2.0);
+    if (const runtime::Status st = session.run(2.0); !st.ok()) throw std::runtime_error(st.message);
+    summary_ = session.summary();
     frames_ = session.frames();
   }
   std::string path_;

@@ -150,7 +150,8 @@ TEST(CellArming, ARefusedFirstAttemptIsRetriedOnTheSimulatedBackend) {
   Cell cell(c2(), virtual_clock());
   test::configure(cell);
   cell.plant().faults().add({sim::FaultKind::kSensorDropout, 0.0, 0.3});
-  const RunSummary s = cell.run(3.0);
+  ASSERT_TRUE(cell.run(3.0).ok());
+  const RunSummary& s = cell.summary();
   EXPECT_EQ(s.arming.outcome, ArmingOutcome::kArmed);
   EXPECT_EQ(s.arming.attempts, 2U) << "refused at 10.2 ms, armed at 510 ms";
   EXPECT_EQ(s.arming.last_refusal, ArmRefusal::kSensorNotLive);
@@ -169,7 +170,8 @@ TEST(CellArming, GivesUpAtTheDeadlineNamingTheRefusalAndEndsTheRunEarly) {
   cfg.supervision.arm_deadline_s = 1.2;
   Cell cell(cfg, virtual_clock());
   test::configure(cell);
-  const RunSummary s = cell.run(30.0);
+  ASSERT_TRUE(cell.run(30.0).ok());
+  const RunSummary& s = cell.summary();
   EXPECT_EQ(s.arming.outcome, ArmingOutcome::kGaveUp);
   EXPECT_EQ(s.arming.attempts, 3U) << "at 10.2 ms, 510 ms and 1010 ms";
   EXPECT_EQ(s.arming.last_refusal, ArmRefusal::kAnalysisUnstable);
