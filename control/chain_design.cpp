@@ -38,19 +38,11 @@ TransferFunction analog_of(const config::BlockConfig& b, const config::ActuatorC
   return {};
 }
 
-}  // namespace
+using Problems = std::vector<config::Problem>;
 
-// long: Eq. 8's blocks in chain order, each pre-warped where it matters; left whole for a later pass (issue 32 note)
-ChainDesign design_chain(const config::Config& cfg) {
-  const double fs = cfg.loop.rate_hz;
+// The frequency compensators are pre-warped at: match_freq_hz, else the dominant robot mode.
+void choose_match_frequency(const config::Config& cfg, ChainDesign& d, Problems& problems) {
   const auto& chain = cfg.controller.chain;
-  std::vector<config::Problem> problems;
-  auto fail = [&](const config::BlockConfig& b, const std::string& msg) {
-    problems.push_back({cfg.source, b.mark, b.key, msg});
-  };
-
-  ChainDesign d;
-  d.source = cfg.source;
   if (cfg.controller.match_freq_hz) {
     d.match_freq_hz = *cfg.controller.match_freq_hz;
   } else if (auto dom = modal::dominant_mode_hz(cfg.robot, cfg.actuator.location)) {
@@ -64,17 +56,13 @@ ChainDesign design_chain(const config::Config& cfg) {
                           "missing: compensators are pre-warped at the dominant robot mode, and there is no robot "
                           "modal data; set match_freq_hz (Hz, below Nyquist)"});
   }
+}
 
-  // The high-pass the integrator is realised with (see RealisedGroup).
-  std::ptrdiff_t integrator = -1, partner = -1;
-  for (std::size_t i = 0; i < chain.size(); ++i) {
-    if (chain[i].kind == BlockKind::kIntegrator && chain[i].leak_hz == 0.0) integrator = static_cast<std::ptrdiff_t>(i);
-    if (chain[i].kind == BlockKind::kHighpass2 && partner < 0) partner = static_cast<std::ptrdiff_t>(i);
-  }
-  if (integrator < 0) partner = -1;
-
-  for (std::size_t i = 0; i < chain.size(); ++i) {
-    const auto& b = chain[i];
+// Each block of Eq. 8 in chain order, analog, with its pre-warp frequency; the integrator takes its
+// high-pass partner's (partner < 0: none).
+void analog_blocks(const config::Config& cfg, std::ptrdiff_t partner, ChainDesign& d) {
+  const auto& chain = cfg.controller.chain;
+  for (const auto& b : chain) {
     ChainBlock cb{b.name, b.kind, analog_of(b, cfg.actuator), 0.0, 0};
     switch (b.kind) {
       case BlockKind::kLowpass2:
@@ -90,8 +78,14 @@ ChainDesign design_chain(const config::Config& cfg) {
     if (b.prewarp_hz) cb.prewarp_hz = *b.prewarp_hz;
     d.blocks.push_back(std::move(cb));
   }
+}
 
-  // Groups in configured order; the integrator/high-pass pair sits where the integrator is.
+// The digital groups in configured order (pre-warped bilinear, second-order sections); the
+// integrator/high-pass pair is one group where the integrator is (1/s cancels against s^2 exactly).
+void realise_groups(const config::Config& cfg, std::ptrdiff_t integrator, std::ptrdiff_t partner, ChainDesign& d,
+                    Problems& problems) {
+  const auto& chain = cfg.controller.chain;
+  const double fs = cfg.loop.rate_hz;
   for (std::size_t i = 0; i < chain.size(); ++i) {
     if (static_cast<std::ptrdiff_t>(i) == partner) continue;
     RealisedGroup g;
@@ -103,33 +97,26 @@ ChainDesign design_chain(const config::Config& cfg) {
       const auto p = static_cast<std::size_t>(partner);
       g.label += "*" + d.blocks[p].name;
       g.blocks.push_back(p);
-      g.analog = d.blocks[i].analog * d.blocks[p].analog;  // 1/s cancels against s^2 exactly
+      g.analog = d.blocks[i].analog * d.blocks[p].analog;
       prewarp = d.blocks[p].prewarp_hz;
     }
     try {
       g.digital = filters::bilinear_sos(g.analog, fs, prewarp);
     } catch (const filters::DesignError& e) {
-      fail(chain[i], std::string(config::to_string(chain[i].kind)) + " '" + chain[i].name +
-                         "' cannot be realised at loop.rate_hz = " + format_hz(fs) + " Hz: " + e.what());
+      problems.push_back({cfg.source, chain[i].mark, chain[i].key,
+                          std::string(config::to_string(chain[i].kind)) + " '" + chain[i].name +
+                              "' cannot be realised at loop.rate_hz = " + format_hz(fs) + " Hz: " + e.what()});
       continue;
     }
     for (std::size_t k : g.blocks) d.blocks[k].group = d.groups.size();
     d.groups.push_back(std::move(g));
   }
+}
 
-  std::vector<filters::BiquadCoefficients> sections;
-  double gain = 1.0;
-  for (const auto& g : d.groups) {
-    sections.insert(sections.end(), g.digital.sections.begin(), g.digital.sections.end());
-    gain *= g.digital.gain;
-  }
-  if (problems.empty() && sections.size() > filters::kMaxSections)
-    problems.push_back({cfg.source, {}, "controller.chain",
-                        "needs " + std::to_string(sections.size()) + " second-order sections, at most " +
-                            std::to_string(filters::kMaxSections) + " are supported"});
-  if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
-
-  ControllerParams& p = d.params;
+// The controller's parameters from the sections and the configuration's limits and notches.
+void fill_params(const config::Config& cfg, const std::vector<filters::BiquadCoefficients>& sections, double gain,
+                 ControllerParams& p) {
+  const double fs = cfg.loop.rate_hz;
   p.fs_hz = fs;
   p.sections = filters::SosCoefficients::from(sections);
   p.sections_gain = gain;
@@ -156,6 +143,37 @@ ChainDesign design_chain(const config::Config& cfg) {
   }
   p.spindle_teeth = cfg.spindle.teeth;
   p.spindle_rpm_max = cfg.spindle.rpm_max;
+}
+
+}  // namespace
+
+ChainDesign design_chain(const config::Config& cfg) {
+  const auto& chain = cfg.controller.chain;
+  Problems problems;
+  ChainDesign d;
+  d.source = cfg.source;
+  choose_match_frequency(cfg, d, problems);
+  // The high-pass the integrator is realised with (see RealisedGroup).
+  std::ptrdiff_t integrator = -1, partner = -1;
+  for (std::size_t i = 0; i < chain.size(); ++i) {
+    if (chain[i].kind == BlockKind::kIntegrator && chain[i].leak_hz == 0.0) integrator = static_cast<std::ptrdiff_t>(i);
+    if (chain[i].kind == BlockKind::kHighpass2 && partner < 0) partner = static_cast<std::ptrdiff_t>(i);
+  }
+  if (integrator < 0) partner = -1;
+  analog_blocks(cfg, partner, d);
+  realise_groups(cfg, integrator, partner, d, problems);
+  std::vector<filters::BiquadCoefficients> sections;
+  double gain = 1.0;
+  for (const auto& g : d.groups) {
+    sections.insert(sections.end(), g.digital.sections.begin(), g.digital.sections.end());
+    gain *= g.digital.gain;
+  }
+  if (problems.empty() && sections.size() > filters::kMaxSections)
+    problems.push_back({cfg.source, {}, "controller.chain",
+                        "needs " + std::to_string(sections.size()) + " second-order sections, at most " +
+                            std::to_string(filters::kMaxSections) + " are supported"});
+  if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
+  fill_params(cfg, sections, gain, d.params);
   return d;
 }
 
