@@ -200,18 +200,20 @@ void ModbusClient::robot_thread() {
   int candidate = -1, same = 0;
   SpindleWatch spindle;
   PoseWatch pose;
+  // A read on the robot's link failed: the link backs off, and the watched values are not known.
+  auto read_failed = [&] {
+    robot_link_->failed(ModbusLink::Clock::now());
+    robot_up_.store(false);
+    spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
+    candidate = -1, same = 0;
+  };
   bool running = true;
   while (running) {
     const auto now = ModbusLink::Clock::now();
     modbus_t* ctx = robot_link_->connect(now);
     robot_up_.store(ctx != nullptr);
     if (ctx == nullptr || !poll_spindle(ctx, spindle) || !poll_pose(ctx, pose) || !poll_depth(ctx)) {
-      if (ctx != nullptr) {  // the spindle or joint registers' read failed
-        robot_link_->failed(ModbusLink::Clock::now());
-        robot_up_.store(false);
-        spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
-        candidate = -1, same = 0;
-      }
+      if (ctx != nullptr) read_failed();  // the spindle, joint or depth registers' read failed
       park_spindle_if_lost(spindle);
       pose_unknown_if_lost(pose);
       depth_mm_.store(std::numeric_limits<double>::quiet_NaN());  // unknown while the link is down
@@ -220,10 +222,7 @@ void ModbusClient::robot_thread() {
     }
     std::uint16_t v = 0;
     if (modbus_read_registers(ctx, r.mounting_register, 1, &v) != 1) {
-      robot_link_->failed(ModbusLink::Clock::now());
-      robot_up_.store(false);
-      spdlog::warn("modbus robot {}: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
-      candidate = -1, same = 0;
+      read_failed();
       park_spindle_if_lost(spindle);
       pose_unknown_if_lost(pose);
       running = sleep_for(std::chrono::duration<double>(0.0));
