@@ -65,6 +65,19 @@ Status Cell::configure() {
                                   "missing: a hardware cell needs both the can section (sensor and command frames) and "
                                   "the modbus section (the amplifier's enable and status)"}})
                 .what()};
+  Status s = plan_analysis();
+  if (s.ok()) s = compose_devices();
+  if (!s.ok()) {
+    release();  // the one rollback path: whatever the failed step had built
+    return s;
+  }
+  state_ = LifecycleState::kInactive;
+  return {};
+}
+
+// The analysis the cell runs on: the pose schedule's sets, the loop model, its stability and K_max, and
+// the supervisor built on that verdict.
+Status Cell::plan_analysis() {
   if (Status s = configure_pose_schedule(); !s.ok()) return s;
   const config::Config& set0 = pose_schedule_.regions.empty() ? cfg_ : pose_schedule_.regions.front().config;
   try {
@@ -86,6 +99,12 @@ Status Cell::configure() {
   settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
   supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(set0, model_->chain().params));
   if (settings.pose_scheduled) configure_pose_sets();
+  return {};
+}
+
+// The devices and the loop around the supervisor: the telemetry ring, the backend's components, the loop
+// and its arming, the parameter sets and, with spindle.job, the machining monitor.
+Status Cell::compose_devices() {
   ring_ = std::make_unique<rt::SpscRing<rt::TelemetryFrame>>(static_cast<std::size_t>(cfg_.telemetry.ring_frames));
   if (Status s = configure_devices(); !s.ok()) return s;
   rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
@@ -94,27 +113,24 @@ Status Cell::configure() {
   loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io, ring_.get());
   arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
   if (o_.arm_at_start) loop_->set_policy(arming_.get());
-  if (settings.pose_scheduled && !o_.pose_deg.empty() && !cfg_.can) {  // the simulated robot stands at --pose
+  if (supervisor_->settings().pose_scheduled && !o_.pose_deg.empty() && !cfg_.can) {  // the simulated robot stands at --pose
     const auto region = config::region_of(*cfg_.pose_schedule, o_.pose_deg.data(), o_.pose_deg.size());
     loop_->schedule(0, {rt::CommandKind::kSetPoseRegion, region ? static_cast<double>(*region) : -1.0});
   }
   if (Status s = configure_parameter_sets(); !s.ok()) return s;
-  if (!cfg_.spindle.job.empty()) {
-    try {
-      machining_ = std::make_unique<MachiningMonitor>(
-          cfg_, set_configs_, [this] { return supervisor_->active_parameter_set(); },
-          [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
-            if (modbus_)
-              modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
-                                      r.advice.found ? r.advice.options.front().margin : 0.0);
-          },
-          [this] { return modbus_ ? modbus_->robot_depth_mm() : std::nan(""); });
-    } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
-      for (Component* d : components()) (void)d->cleanup();
-      return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};
-    }
+  if (cfg_.spindle.job.empty()) return {};
+  try {
+    machining_ = std::make_unique<MachiningMonitor>(
+        cfg_, set_configs_, [this] { return supervisor_->active_parameter_set(); },
+        [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
+          if (modbus_)
+            modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
+                                    r.advice.found ? r.advice.options.front().margin : 0.0);
+        },
+        [this] { return modbus_ ? modbus_->robot_depth_mm() : std::nan(""); });
+  } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
+    return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};
   }
-  state_ = LifecycleState::kInactive;
   return {};
 }
 
@@ -413,6 +429,13 @@ void Cell::finish_summary() {
 Status Cell::cleanup() {
   if (state_ != LifecycleState::kInactive)
     return {StatusKind::kWrongState, std::string("cell: cannot clean up while ") + to_string(state_)};
+  release();
+  state_ = LifecycleState::kUnconfigured;
+  return {};
+}
+
+// What configure built, released in the reverse order: cleanup()'s work and configure()'s rollback.
+void Cell::release() {
   // First the machining monitor: its advisor's thread writes to the Modbus client and reads the robot's
   // depth from it (a run that ended under load crashed there when the client went first).
   machining_.reset();
@@ -431,8 +454,6 @@ Status Cell::cleanup() {
   mounting_sets_.clear();
   pose_schedule_ = {};
   set_configs_.clear();
-  state_ = LifecycleState::kUnconfigured;
-  return {};
 }
 
 Status Cell::run(double duration_s) {

@@ -120,6 +120,9 @@ class Cell {
   [[nodiscard]] MachiningMonitor* machining() { return machining_.get(); }
 
  private:
+  Status plan_analysis();    // configure(): the analysis and the supervisor
+  Status compose_devices();  // configure(): the devices, the loop and what runs beside it
+  void release();            // configure's rollback and cleanup(): everything configure built
   Status configure_devices();
   Status configure_parameter_sets();
   Status configure_pose_schedule();  // before the supervisor: region 0's set becomes set 0

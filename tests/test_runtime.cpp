@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -249,6 +251,24 @@ TEST(CellLifecycle, HalfAHardwareConfigurationIsAConfigError) {
   const Status s = cell.configure();
   EXPECT_EQ(s.kind, StatusKind::kConfigError);
   EXPECT_NE(s.message.find("modbus"), std::string::npos) << s.message;
+}
+
+// One rollback path: a configure that fails at its last step (a spindle.job that does not parse, after the
+// devices, the loop and the parameter sets are built) leaves the cell unconfigured with nothing left
+// built, so a second configure fails the same way instead of finding the first one's devices.
+TEST(CellLifecycle, AFailedConfigureLeavesTheCellUnconfiguredAndFailsAgainTheSameWay) {
+  auto cfg = config::load_config_file(robodamp::test::preset("horizontal_c2"));
+  const std::string bad = ::testing::TempDir() + "robodamp_bad_job.yaml";
+  { std::ofstream(bad) << "tool: [not a job\n"; }
+  cfg.spindle.job = cfg.spindle.job_resolved = bad;
+  Cell cell(cfg, virtual_clock());
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    const Status s = cell.configure();
+    EXPECT_EQ(s.kind, StatusKind::kConfigError) << attempt;
+    EXPECT_NE(s.message.find("spindle.job"), std::string::npos) << s.message;
+    EXPECT_EQ(cell.state(), LifecycleState::kUnconfigured);
+  }
+  std::remove(bad.c_str());
 }
 
 // --- parameter requests with random values ----------------------------------------------------------------
