@@ -5,7 +5,9 @@
 
 #include <array>
 #include <cstddef>
+#include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "rt/supervisor.hpp"
@@ -67,5 +69,13 @@ struct FieldInfo {
 
 // The supervisor inputs a frame holds.
 [[nodiscard]] TickInput tick_input(const TelemetryFrame& f);
+
+// The spindle speed a frame sets (a set_spindle command at its tick): the commanded rpm, 0 for a stop or a
+// value that is not a finite positive speed; nullopt when the frame sets none. The one reading of it (the
+// runtime's machining and spectrum monitors).
+[[nodiscard]] inline std::optional<double> spindle_rpm_set(const TelemetryFrame& f) noexcept {
+  if (static_cast<CommandKind>(f.command_kind) != CommandKind::kSetSpindle) return std::nullopt;
+  return std::isfinite(f.command_value) && f.command_value > 0.0 ? f.command_value : 0.0;
+}
 
 }  // namespace robodamp::rt

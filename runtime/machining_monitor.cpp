@@ -48,8 +48,8 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
 
 void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
   std::lock_guard<std::mutex> lock(m_);
-  if (static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kSetSpindle && f.command_value != rpm_) {
-    rpm_ = std::isfinite(f.command_value) && f.command_value > 0.0 ? f.command_value : 0.0;
+  if (const auto rpm = rt::spindle_rpm_set(f); rpm && f.command_value != rpm_) {
+    rpm_ = *rpm;
     chatter_.reset();  // another speed: the window restarts
   }
   // Missed ticks keep their place in the indicator's time base (as gaps), bounded by its buffer.

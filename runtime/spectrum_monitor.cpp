@@ -26,8 +26,7 @@ SpectrumMonitor::SpectrumMonitor(const config::Config& cfg, SpectrumSettings s)
 
 void SpectrumMonitor::on_frame(const rt::TelemetryFrame& f) {
   std::lock_guard<std::mutex> lock(m_);
-  if (static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kSetSpindle)
-    rpm_ = std::isfinite(f.command_value) && f.command_value > 0.0 ? f.command_value : 0.0;
+  if (const auto rpm = rt::spindle_rpm_set(f)) rpm_ = *rpm;
   last_ = f;
   if (!std::isfinite(f.accel_mps2)) return;  // an invalid sample (counted by the supervisor): not on the plot
   block_sum_ += f.accel_mps2;
