@@ -177,27 +177,40 @@ AdviceRun finish_after(AdviceCase& c, const std::string& line) {
 }
 
 // The run's trips before the Ctrl-C: none; on a machine loaded on both cores the wall-clock loop may stall
-// past its delay margin and trip on timing (safe, and beside the point here), never on the cut.
-void expect_no_cut_trip(const json& run) {
+// past its delay margin and trip on timing (safe, and beside the point here), never on the cut. Its exit
+// status is then 4 (the cell tripped), the only other one allowed beside 0. Measured on CI's 2 cores: a
+// 7.4 ms wake-up stall, 24 overruns, the trip at 10.2 s, the cut itself stable at the advised speed.
+void expect_no_cut_trip(const json& run, int run_exit, const std::string& logs) {
+  bool timing_trip = false;
   for (const auto& t : run["availability"]["trips"]) {
     const std::string trip = t["trip"];
+    timing_trip = timing_trip || trip == "overruns" || trip == "sensor_stale";
     EXPECT_TRUE(trip == "signal" || trip == "overruns" || trip == "sensor_stale") << trip << "\n" << run.dump(1);
   }
+  EXPECT_TRUE(run_exit == 0 || (run_exit == 4 && timing_trip)) << "exit " << run_exit << "\n" << logs;
 }
 
 // Closing the loop across processes: a cut on a lobe at 700 rpm (damped 0.85 mm: the limit there is 0.782
 // mm, and the in-process cut chatters, above; open loop 1.3 mm against 1.104 mm, drives off as in process),
 // the advice over Modbus, the emulated robot turning to it, and the cut at the advised speed stable at the
-// same depth by the emulator's detector. The two cells run at once (lockstep, separate sockets and ports).
+// same depth by the emulator's detector.
 TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
-  AdviceCase damped = start_advice_case(advice_cell("advice_damped"), "0.85", false);
-  AdviceCase open = start_advice_case(advice_cell("advice_open", "0"), "1.3", true);
-  for (auto [c, depth] : {std::pair{&damped, 0.85}, std::pair{&open, 1.3}}) {
+  struct Case {
+    const char *name, *gain, *depth_text;
+    double depth_mm;
+    bool drives_off;
+  };
+  // One cell after the other: at once (two wall-clock loops and two emulators on CI's 2 cores) the loops
+  // stalled for milliseconds and tripped on overruns.
+  for (const Case& k : {Case{"advice_damped", "2000", "0.85", 0.85, false}, Case{"advice_open", "0", "1.3", 1.3, true}}) {
+    SCOPED_TRACE(k.name);
+    AdviceCase one = start_advice_case(advice_cell(k.name, k.gain), k.depth_text, k.drives_off);
+    AdviceCase* c = &one;
+    const double depth = k.depth_mm;
     const AdviceRun r = finish_after(*c, "the regenerative cut ended");
     const std::string logs = test::read_file(c->files.plant_log) + test::read_file(c->files.run_log);
     ASSERT_EQ(r.plant_exit, 0) << logs;
-    EXPECT_EQ(r.run_exit, 0) << logs;
-    expect_no_cut_trip(r.run);
+    expect_no_cut_trip(r.run, r.run_exit, logs);
     // robodamp run advised (the depth above the limit at 700 rpm) and the robot followed the first advice.
     const json& advice = r.plant["advice"];
     ASSERT_GE(advice.size(), 1U) << r.plant.dump(1);
