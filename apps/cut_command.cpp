@@ -200,7 +200,7 @@ int run_cut(const CutArgs& a) {
       for (double rpm : speeds) {
         ov.rpm = rpm;
         const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
-        const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
+        const double zoa_mm = lobes.critical_depth_mm(rpm);
         milling::SdmPoint sdm;
         try {
           sdm = truth.critical(rpm, zoa_mm);

@@ -60,7 +60,7 @@ void BM_CriticalDepthIndustrialRobot(benchmark::State& state) {
   Loaded l = load("industrial_robot_aluminium.yaml");
   const milling::CutJob job = milling::make_cut_job(l.cfg, l.structure, {});
   const milling::LobeModel lobes(l.structure, milling::chatter_process(l.cfg.tool, l.cfg.material, l.cfg.cut), l.cfg.lobes);
-  const double guess = lobes.critical_depth_m(job.settings.rpm) * 1e3;
+  const double guess = lobes.critical_depth_mm(job.settings.rpm);
   for (auto _ : state) {
     const milling::CriticalDepth c = milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, guess);
     benchmark::DoNotOptimize(c.depth_mm);
@@ -100,7 +100,7 @@ void BM_SdmDiagramSingleMode200Speeds(benchmark::State& state) {
   const milling::LobeDiagram guesses = zoa.diagram();
   for (auto _ : state)
     for (const auto& p : guesses.curve) {
-      const milling::SdmPoint q = sdm.critical(p.rpm, std::isfinite(p.b_lim_m) ? p.b_lim_m * 1e3 : 1.0);
+      const milling::SdmPoint q = sdm.critical(p.rpm, std::isfinite(p.b_lim_mm) ? p.b_lim_mm : 1.0);
       benchmark::DoNotOptimize(q.critical_depth_mm);
     }
 }

@@ -36,7 +36,7 @@ void BM_LobeDiagram37Modes(benchmark::State& state) {
     const milling::LobeModel m(s, process, lobes);  // frequency grid, eigenvalues, branch tracking
     const auto d = m.diagram();                      // 2000 speeds
     grid = d.frequency_points;
-    benchmark::DoNotOptimize(d.minimum.b_lim_m);
+    benchmark::DoNotOptimize(d.minimum.b_lim_mm);
   }
   state.counters["modes"] = static_cast<double>(s.resonances().size());
   state.counters["chatter_freqs"] = static_cast<double>(grid);
@@ -47,7 +47,7 @@ BENCHMARK(BM_LobeDiagram37Modes)->Unit(benchmark::kMillisecond);
 void BM_DirectTestCriticalDepth(benchmark::State& state) {
   const milling::Structure s(robot_37_modes(), false);
   const milling::LobeModel m(s, milling::chatter_process(job().tool, job().material, job().cut), job().lobes);
-  for (auto _ : state) benchmark::DoNotOptimize(m.critical_depth_m(10700.0));
+  for (auto _ : state) benchmark::DoNotOptimize(m.critical_depth_mm(10700.0));
 }
 BENCHMARK(BM_DirectTestCriticalDepth)->Unit(benchmark::kMillisecond);
 
@@ -61,7 +61,7 @@ void BM_DampedSdmLobes(benchmark::State& state) {
   grid.points = j.time_domain.sdm_points;
   const milling::LobeDiagram guess = milling::LobeModel(damped, milling::chatter_process(j.tool, j.material, j.cut), grid).diagram();
   std::vector<double> rpm, mm;
-  for (const auto& p : guess.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_m * 1e3);
+  for (const auto& p : guess.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_mm);
   const milling::AccurateStability truth(damped, j);
   for (auto _ : state) benchmark::DoNotOptimize(truth.critical(rpm, mm, static_cast<std::size_t>(state.range(0))));
   state.counters["speeds"] = static_cast<double>(rpm.size());

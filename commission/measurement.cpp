@@ -96,8 +96,8 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
   else if (!cfg.can) o.clock = config::ClockKind::kVirtual;  // the simulated plant: nothing to pace
   o.record_path = (fs::path(out_dir) / identify::kRecordingName).string();
   o.keep_frames = true;
-  o.test_signal = {true, plan.chirp_start_s, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz,
-                   plan.chirp_amplitude_v, cfg.amplifier.voltage_limit_v};
+  o.chirp = {true, plan.chirp_start_s, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz,
+             plan.chirp_amplitude_v};
   identify::MeasurementManifest& m = out.manifest;
   m.config_source = fs::absolute(config_path).lexically_normal().string();
   m.config_text = cfg.yaml_text;

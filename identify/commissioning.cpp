@@ -178,7 +178,7 @@ ChirpMeasurement read_chirp_measurement(const std::string& path, const std::stri
   const rt::Recording rec = rt::read_recording(path);
   ChirpMeasurement m;
   m.fs_hz = rec.header.at("rate_hz");
-  const rt::TestSignal sig = rt::supervisor_settings_from(rec.header.at("supervisor")).test_signal;
+  const rt::PeriodicChirp sig = rt::excitation_from(rec.header);
   if (!sig.enabled)
     throw std::invalid_argument(path + " holds no test signal (a robodamp run recording, not a robodamp measure one)");
   if (rec.frames.empty()) throw std::invalid_argument(path + " holds no frames");

@@ -86,7 +86,7 @@ AccurateDiagram accurate_diagram(const Structure& structure, const config::Milli
   const LobeDiagram guess = LobeModel(structure, chatter_process(job.tool, job.material, job.cut), grid).diagram();
   std::vector<double> speeds, guesses;
   for (const auto& p : guess.curve)
-    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm), guesses.push_back(p.b_lim_m * 1e3);
+    if (p.rpm <= truth.max_rpm()) speeds.push_back(p.rpm), guesses.push_back(p.b_lim_mm);
   AccurateDiagram d;
   d.method = truth.method();
   d.grid_per_period = truth.grid_per_period();

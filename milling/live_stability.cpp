@@ -171,7 +171,7 @@ LiveLimits LiveStability::evaluate(const Key& k) const {
   // sampled loop cannot step the speed).
   const Structure open(structure_, false, {std::make_shared<const analysis::LoopModel>(cfg), gain, polarity});
   const auto open_zoa = LobeModel(open, process, lobes).limit_at(out.rpm);
-  const SdmPoint o = AccurateStability(open, job_).critical(out.rpm, open_zoa ? open_zoa->b_lim_m * 1e3 : 1.0);
+  const SdmPoint o = AccurateStability(open, job_).critical(out.rpm, open_zoa ? open_zoa->b_lim_mm : 1.0);
   out.open_mm = o.critical_depth_mm;
   out.open_chatter_hz = o.chatter_hz;
   out.open_method = "SDM";
@@ -182,14 +182,14 @@ LiveLimits LiveStability::evaluate(const Key& k) const {
     const auto zoa = LobeModel(damped, process, lobes).limit_at(out.rpm);
     const AccurateStability truth(damped, job_);
     if (out.rpm <= truth.max_rpm()) {
-      const SdmPoint d = truth.critical(out.rpm, zoa ? zoa->b_lim_m * 1e3 : 1.0);
+      const SdmPoint d = truth.critical(out.rpm, zoa ? zoa->b_lim_mm : 1.0);
       out.damped_mm = d.critical_depth_mm;
       out.damped_chatter_hz = d.chatter_hz;
       out.analysed_rpm = d.rpm;
       out.method = truth.method();
     } else {
       out.method = "zero-order preview";
-      if (zoa) out.damped_mm = zoa->b_lim_m * 1e3, out.damped_chatter_hz = zoa->chatter_hz;
+      if (zoa) out.damped_mm = zoa->b_lim_mm, out.damped_chatter_hz = zoa->chatter_hz;
     }
   } catch (const config::ConfigError& e) {
     out.damped_valid = false;

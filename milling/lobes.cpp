@@ -169,13 +169,15 @@ LobeDiagram LobeModel::diagram() const {
         LobePoint& c = d.curve[static_cast<std::size_t>(k)];
         const double t = n2 != n1 ? (c.rpm - n1) / (n2 - n1) : 0.0;
         const double b = p1.first + t * (p2.first - p1.first);
-        if (b < c.b_lim_m) c = {c.rpm, b, f1 + t * (f2 - f1), j, br};
+        if (b < c.b_lim_mm) c = {c.rpm, b, f1 + t * (f2 - f1), j, br};
       }
     }
   });
   d.minimum = {0.0, kInf, 0.0, -1, -1};
   for (const auto& c : d.curve)
-    if (c.b_lim_m < d.minimum.b_lim_m) d.minimum = c;
+    if (c.b_lim_mm < d.minimum.b_lim_mm) d.minimum = c;
+  for (auto& c : d.curve) c = in_mm(c);  // found in metres
+  d.minimum = in_mm(d.minimum);
   return d;
 }
 
@@ -212,9 +214,10 @@ std::optional<LobePoint> LobeModel::limit_at(double rpm) const {
           fa = fm, ga = gm;
         if (fb - fa < 1e-12 * fb) break;
       }
-      if (ok && (!best || pm.first < best->b_lim_m)) best = LobePoint{rpm, pm.first, fm, j, br};
+      if (ok && (!best || pm.first < best->b_lim_mm)) best = LobePoint{rpm, pm.first, fm, j, br};
     }
   });
+  if (best) best = in_mm(*best);  // found in metres
   return best;
 }
 
@@ -223,11 +226,26 @@ std::vector<LobePoint> LobeModel::lobe_points(int lobe) const {
   for (int br = 0; br < 2; ++br)
     for (std::size_t i = 0; i < grid_hz_.size(); ++i)
       if (const auto p = depth_and_phase(evals_[i].lambda[br]))
-        out.push_back({speed_rpm(grid_hz_[i], p->second, lobe), p->first, grid_hz_[i], lobe, br});
+        out.push_back(in_mm({speed_rpm(grid_hz_[i], p->second, lobe), p->first, grid_hz_[i], lobe, br}));
   return out;
 }
 
-Complex LobeModel::characteristic(double b_m, double rpm, double f_hz) const {
+LobePoint LobeModel::in_mm(LobePoint metres) {
+  metres.b_lim_mm *= kMmPerM;
+  return metres;
+}
+
+Complex LobeModel::characteristic(double b_mm, double rpm, double f_hz) const {
+  return characteristic_m(b_mm * 1e-3, rpm, f_hz);
+}
+
+bool LobeModel::stable(double b_mm, double rpm) const { return stable_m(b_mm * 1e-3, rpm); }
+
+double LobeModel::critical_depth_mm(double rpm, double rel_tol) const {
+  return critical_depth_m(rpm, rel_tol) * kMmPerM;
+}
+
+Complex LobeModel::characteristic_m(double b_m, double rpm, double f_hz) const {
   const double tau = 60.0 / (process_.teeth * rpm);
   const Complex regen = 1.0 - std::exp(Complex(0.0, -kTwoPi * f_hz * tau));
   const Complex lambda = -(process_.teeth / (4.0 * M_PI)) * process_.kt_n_per_m2 * b_m * regen;
@@ -235,7 +253,7 @@ Complex LobeModel::characteristic(double b_m, double rpm, double f_hz) const {
   return m.determinant();
 }
 
-bool LobeModel::stable(double b_m, double rpm) const {
+bool LobeModel::stable_m(double b_m, double rpm) const {
   // Nyquist on D(i w): the lobe grid (dense at resonances) merged with a uniform grid fine enough for the
   // delay term (8 points per period 1/tau of e^{-i w tau}), to 4x the lobe grid's top.
   const double tau = 60.0 / (process_.teeth * rpm);
@@ -246,20 +264,20 @@ bool LobeModel::stable(double b_m, double rpm) const {
   for (double f = grid_hz_.back(); f < top; f *= 1.01) grid.push_back(f);
   grid.push_back(top);
   std::sort(grid.begin(), grid.end());
-  const double t = analysis::turns([&](double f) { return characteristic(b_m, rpm, f); }, grid);
+  const double t = analysis::turns([&](double f) { return characteristic_m(b_m, rpm, f); }, grid);
   return std::lround(2.0 * t) == 0;
 }
 
 double LobeModel::critical_depth_m(double rpm, double rel_tol) const {
   double lo = 0.0, hi = 1e-5;
-  while (stable(hi, rpm)) {
+  while (stable_m(hi, rpm)) {
     lo = hi;
     hi *= 2.0;
     if (hi > 100.0) return kInf;
   }
   while (hi - lo > rel_tol * hi) {
     const double mid = 0.5 * (lo + hi);
-    (stable(mid, rpm) ? lo : hi) = mid;
+    (stable_m(mid, rpm) ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }

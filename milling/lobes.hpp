@@ -33,16 +33,18 @@ struct ChatterProcess {
 [[nodiscard]] ChatterProcess chatter_process(const config::ToolConfig& tool, const config::MaterialConfig& material,
                                              const config::CutConfig& cut);
 
+// Depths in millimetres, as in every milling model and the job files (the chatter equation itself is
+// solved in metres inside the model).
 struct LobePoint {
   double rpm{0.0};
-  double b_lim_m{0.0};
+  double b_lim_mm{0.0};
   double chatter_hz{0.0};
   int lobe{0};
   int branch{0};
 };
 
 struct LobeDiagram {
-  std::vector<LobePoint> curve;  // one per speed; b_lim_m = +inf where no lobe reaches the speed
+  std::vector<LobePoint> curve;  // one per speed; b_lim_mm = +inf where no lobe reaches the speed
   LobePoint minimum;
   std::size_t frequency_points{0};
 };
@@ -62,11 +64,11 @@ class LobeModel {
   [[nodiscard]] std::vector<LobePoint> lobe_points(int lobe) const;
 
   // det(I + Lambda Phi0) at depth b, speed and frequency: zero on the stability boundary.
-  [[nodiscard]] Complex characteristic(double b_m, double rpm, double f_hz) const;
+  [[nodiscard]] Complex characteristic(double b_mm, double rpm, double f_hz) const;
   // Direct test: no root of the characteristic equation in the right half plane.
-  [[nodiscard]] bool stable(double b_m, double rpm) const;
-  // Critical depth at a speed by bisection on the direct test (relative tolerance), m.
-  [[nodiscard]] double critical_depth_m(double rpm, double rel_tol = 1e-4) const;
+  [[nodiscard]] bool stable(double b_mm, double rpm) const;
+  // Critical depth at a speed by bisection on the direct test (relative tolerance), mm.
+  [[nodiscard]] double critical_depth_mm(double rpm, double rel_tol = 1e-4) const;
 
   [[nodiscard]] std::vector<double> speeds_rpm() const;
 
@@ -75,6 +77,12 @@ class LobeModel {
     Complex lambda[2];  // -1/eig per branch; NaN where the eigenvalue vanishes
   };
   [[nodiscard]] Eval evaluate(double f_hz, const Eval* previous) const;
+  // The same in metres, the unit the chatter equation is solved in.
+  [[nodiscard]] Complex characteristic_m(double b_m, double rpm, double f_hz) const;
+  [[nodiscard]] bool stable_m(double b_m, double rpm) const;
+  [[nodiscard]] double critical_depth_m(double rpm, double rel_tol) const;
+  // A point found in metres, as the public one in millimetres.
+  [[nodiscard]] static LobePoint in_mm(LobePoint metres);
   // b_lim, eps for a Lambda; nullopt unless b_lim > 0.
   [[nodiscard]] std::optional<std::pair<double, double>> depth_and_phase(Complex lambda) const;
   [[nodiscard]] double speed_rpm(double f_hz, double eps, int lobe) const;

@@ -21,7 +21,7 @@ std::pair<double, double> job_minimum(const config::MillingConfig& job, const st
   const Structure structure(st, false);
   if (zero_order) {
     const auto lobes = LobeModel(structure, chatter_process(job.tool, job.material, job.cut), job.lobes).diagram();
-    return {lobes.minimum.b_lim_m * kMmPerM, lobes.minimum.rpm};
+    return {lobes.minimum.b_lim_mm, lobes.minimum.rpm};
   }
   const AccurateDiagram d = accurate_diagram(structure, job);
   return {d.minimum.critical_depth_mm, d.minimum.rpm};

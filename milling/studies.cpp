@@ -30,9 +30,9 @@ LobeStudy zero_order_lobe_study(const Structure& structure, const config::Millin
   s.method = kZeroOrderPreview;
   s.frequency_points = d.frequency_points;
   for (const auto& p : d.curve)
-    s.curve.push_back({p.rpm, p.b_lim_m * kMmPerM,
-                       std::isfinite(p.b_lim_m) ? std::optional<double>(p.chatter_hz) : std::nullopt, p.lobe, std::nullopt});
-  s.min_b_lim_mm = d.minimum.b_lim_m * kMmPerM;
+    s.curve.push_back({p.rpm, p.b_lim_mm,
+                       std::isfinite(p.b_lim_mm) ? std::optional<double>(p.chatter_hz) : std::nullopt, p.lobe, std::nullopt});
+  s.min_b_lim_mm = d.minimum.b_lim_mm;
   s.min_rpm = d.minimum.rpm;
   s.min_chatter_hz = d.minimum.chatter_hz;
   s.diagram_ms = elapsed_ms(t0);
@@ -40,8 +40,8 @@ LobeStudy zero_order_lobe_study(const Structure& structure, const config::Millin
     const auto zoa = model.limit_at(rpm);
     LobeAtSpeed a;
     a.rpm = rpm;
-    a.b_lim_mm = model.critical_depth_m(rpm) * kMmPerM;
-    if (zoa) a.b_lim_lobes_mm = zoa->b_lim_m * kMmPerM, a.chatter_hz = zoa->chatter_hz, a.lobe = zoa->lobe;
+    a.b_lim_mm = model.critical_depth_mm(rpm);
+    if (zoa) a.b_lim_lobes_mm = zoa->b_lim_mm, a.chatter_hz = zoa->chatter_hz, a.lobe = zoa->lobe;
     s.at_rpm.push_back(a);
   }
   s.notes = structure.notes();
@@ -62,7 +62,7 @@ LobeStudy accurate_lobe_study(const Structure& structure, const config::MillingC
     if (progress) progress(truth.method(), done, of, elapsed_ms(t0) / 1000.0);
   });
   std::vector<double> at_guess;
-  for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_m(rpm) * kMmPerM);
+  for (double rpm : rpms) at_guess.push_back(zoa.critical_depth_mm(rpm));
   const std::vector<SdmPoint> at = truth.critical(rpms, at_guess);
   LobeStudy s;
   s.structure = structure.name();
@@ -121,12 +121,12 @@ void sle_map(const Structure& structure, const config::MillingConfig& cfg, SleSt
     const double rpm = lobes.curve[idx].rpm;
     const auto r = surface_location_error(structure, cutter, cfg.material, cut, cfg.cut.feed_axis, rpm, s.axial_slices,
                                           s.harmonics);
-    const double b_lim = lobes.curve[idx].b_lim_m;
+    const double b_lim_mm = lobes.curve[idx].b_lim_mm;
     const bool by_truth = idx < accurate.size();
-    const bool stable = by_truth ? accurate[idx] : cfg.cut.axial_mm * 1e-3 < b_lim;
+    const bool stable = by_truth ? accurate[idx] : cfg.cut.axial_mm < b_lim_mm;
     out.map_unstable_points += stable ? 0 : 1;
     out.map_preview_points += by_truth ? 0 : 1;
-    out.map.push_back({rpm, r.sle_um, r.min_um, r.max_um, b_lim * kMmPerM, stable,
+    out.map.push_back({rpm, r.sle_um, r.min_um, r.max_um, b_lim_mm, stable,
                        by_truth ? truth.method() : std::string(kZeroOrderPreview)});
   }
   out.stability_method = truth.method();
@@ -153,7 +153,7 @@ void sle_conditions(const Structure& structure, const config::MillingConfig& cfg
       const bool by_truth = !model->speed_problem(c.rpm);
       const bool stable = by_truth ? model->stable(c.axial_mm, c.rpm)
                                    : LobeModel(structure, chatter_process(cfg.tool, cfg.material, cut_c), cfg.lobes)
-                                         .stable(c.axial_mm * 1e-3, c.rpm);
+                                         .stable(c.axial_mm, c.rpm);
       SleCondition o;
       o.name = c.name, o.rpm = c.rpm, o.axial_mm = c.axial_mm, o.radial_mm = c.radial_mm, o.ft_mm = c.feed_per_tooth_mm;
       o.surface_normal = normal;

@@ -89,6 +89,7 @@ TickInput Loop::inputs(const Run& r, const Pace& p) noexcept {
   in.amplifier_fault = amp.fault;
   in.overrun = r.overrun || p.missed > 0;
   in.shutdown = shutdown_ != nullptr && shutdown_->load(std::memory_order_relaxed) != 0;
+  in.excitation_v = excitation_.next_v(p.dt_s);
   return in;
 }
 

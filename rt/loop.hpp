@@ -22,6 +22,7 @@
 
 #include "config/config.hpp"
 #include "rt/clock.hpp"
+#include "rt/excitation.hpp"
 #include "rt/io.hpp"
 #include "rt/spsc_ring.hpp"
 #include "rt/supervisor.hpp"
@@ -59,6 +60,10 @@ class Loop {
   // Before run(): a command for a given tick (a script: tests, virtual-clock runs). A scheduled command
   // takes the tick before posted ones; if its tick was skipped it runs at the next tick.
   void schedule(std::uint64_t tick, const OperatorCommand& c);
+  // Before run(): a command source added to the controller's (the commissioning chirp), on the clock of
+  // the measured dt from this run's first tick.
+  void set_excitation(const PeriodicChirp& chirp) noexcept { chirp_ = chirp, excitation_ = ExcitationClock(chirp); }
+  [[nodiscard]] const PeriodicChirp& excitation() const noexcept { return chirp_; }
   // Before run(): the policy asked each tick when no scripted command is due (arming); nullptr = none.
   void set_policy(TickPolicy* policy) noexcept { policy_ = policy; }
   // From any thread: end the run as if its duration were over (disarm, ramp, return).
@@ -112,6 +117,8 @@ class Loop {
   std::atomic<bool> stop_{false};
   const std::atomic<int>* shutdown_;
   TickPolicy* policy_{nullptr};
+  PeriodicChirp chirp_{};
+  ExcitationClock excitation_{PeriodicChirp{}};
   std::unique_ptr<LoopStats> stats_;
   std::uint64_t tick_{0};
   std::int64_t last_compute_ns_{0};  // the tick's compute time, for its frame

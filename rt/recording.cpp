@@ -116,15 +116,35 @@ json to_json(const SupervisorSettings& s) {
           {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
           {"delay_margin_s", s.delay_margin_s},
           {"pose_scheduled", s.pose_scheduled},
-          {"test_signal",
-           {{"enabled", s.test_signal.enabled},
-            {"start_s", s.test_signal.start_s},
-            {"period_s", s.test_signal.period_s},
-            {"periods", s.test_signal.periods},
-            {"f0_hz", s.test_signal.f0_hz},
-            {"f1_hz", s.test_signal.f1_hz},
-            {"amplitude_v", s.test_signal.amplitude_v},
-            {"voltage_limit_v", s.test_signal.voltage_limit_v}}}};
+          {"command_limit_v", s.command_limit_v}};
+}
+
+json to_json(const PeriodicChirp& c) {
+  return {{"enabled", c.enabled}, {"start_s", c.start_s}, {"period_s", c.period_s}, {"periods", c.periods},
+          {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},     {"amplitude_v", c.amplitude_v}};
+}
+
+namespace {
+
+PeriodicChirp chirp_from(const json& t) {
+  PeriodicChirp c;
+  c.enabled = t.at("enabled");
+  c.start_s = t.at("start_s");
+  c.period_s = t.at("period_s");
+  c.periods = t.at("periods");
+  c.f0_hz = t.at("f0_hz");
+  c.f1_hz = t.at("f1_hz");
+  c.amplitude_v = t.at("amplitude_v");
+  return c;
+}
+
+}  // namespace
+
+PeriodicChirp excitation_from(const json& header) {
+  if (header.contains("excitation")) return chirp_from(header.at("excitation").at("chirp"));
+  // Recorded while the supervisor owned the chirp; none before robodamp measure existed.
+  const json& s = header.at("supervisor");
+  return s.contains("test_signal") ? chirp_from(s.at("test_signal")) : PeriodicChirp{};
 }
 
 SupervisorSettings supervisor_settings_from(const json& j) {
@@ -164,21 +184,14 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   s.max_stable_gain_ns_per_m = j.at("max_stable_gain_ns_per_m");
   s.delay_margin_s = j.value("delay_margin_s", 0.0);
   s.pose_scheduled = j.value("pose_scheduled", false);  // absent before pose_schedule existed
-  if (j.contains("test_signal")) {  // absent in recordings made before robodamp measure existed
-    const json& t = j.at("test_signal");
-    s.test_signal.enabled = t.at("enabled");
-    s.test_signal.start_s = t.at("start_s");
-    s.test_signal.period_s = t.at("period_s");
-    s.test_signal.periods = t.at("periods");
-    s.test_signal.f0_hz = t.at("f0_hz");
-    s.test_signal.f1_hz = t.at("f1_hz");
-    s.test_signal.amplitude_v = t.at("amplitude_v");
-    s.test_signal.voltage_limit_v = t.at("voltage_limit_v");
-  }
+  // Recorded while the supervisor owned the chirp: its voltage limit was the chirp's; before that, none.
+  if (j.contains("command_limit_v")) s.command_limit_v = j.at("command_limit_v");
+  else if (j.contains("test_signal")) s.command_limit_v = j.at("test_signal").at("voltage_limit_v");
   return s;
 }
 
-json recording_header(const config::Config& cfg, const Supervisor& supervisor, config::ClockKind clock) {
+json recording_header(const config::Config& cfg, const Supervisor& supervisor, config::ClockKind clock,
+                      const PeriodicChirp& excitation) {
   json fields = json::array();
   for (const auto& f : frame_fields())
     fields.push_back({{"name", f.name}, {"type", to_string(f.type)}, {"offset", f.offset}, {"unit", f.unit}});
@@ -222,7 +235,8 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
           {"config_yaml", cfg.yaml_text},
           {"controller_params", to_json(supervisor.initial_params())},
           {"parameter_sets", sets},
-          {"supervisor", to_json(supervisor.settings())}};
+          {"supervisor", to_json(supervisor.settings())},
+          {"excitation", {{"chirp", to_json(excitation)}}}};
 }
 
 Recorder::Recorder(const std::string& path, const json& header) : path_(path), buffer_(1 << 20) {
@@ -313,11 +327,14 @@ ReplayResult replay(const Recording& r) {
   ReplayResult res;
   Supervisor sup(supervisor_settings_from(r.header.at("supervisor")),
                  controller_params_from(r.header.at("controller_params")));
+  ExcitationClock excitation(excitation_from(r.header));
   for (const auto& p : r.header.value("parameter_sets", json::array()))
     sup.add_parameter_set({controller_params_from(p.at("params")), p.at("analysis_stable").get<bool>(),
                            p.at("max_stable_gain_ns_per_m").get<double>(), p.value("delay_margin_s", 0.0)});
   for (const auto& f : r.frames) {
-    const TickOutput out = sup.step(tick_input(f));
+    TickInput in = tick_input(f);
+    in.excitation_v = excitation.next_v(in.dt_s);
+    const TickOutput out = sup.step(in);
     ++res.frames;
     const bool same = std::memcmp(&out.command_v, &f.command_v, sizeof(double)) == 0 &&
                       std::memcmp(&out.controller_v, &f.controller_v, sizeof(double)) == 0 &&

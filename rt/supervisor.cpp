@@ -103,6 +103,7 @@ SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_
   s.analysis_stable = analysis_stable;
   s.max_stable_gain_ns_per_m = max_stable_gain_ns_per_m;
   s.delay_margin_s = delay_margin_s;
+  s.command_limit_v = cfg.amplifier.voltage_limit_v;
   return s;
 }
 
@@ -336,16 +337,8 @@ bool Supervisor::instability(double controller_v) noexcept {
          rms >= l.instability_growth_factor * run_start_rms_;
 }
 
-double TestSignal::value_v(double t_s) const noexcept {
-  if (!enabled || t_s < start_s || t_s >= end_s()) return 0.0;
-  const double tau = std::fmod(t_s - start_s, period_s);
-  const double phase = kTwoPi * (f0_hz * tau + 0.5 * (f1_hz - f0_hz) * tau * tau / period_s);
-  return amplitude_v * std::sin(phase);
-}
-
 TickOutput Supervisor::step(const TickInput& in) noexcept {
   ++counters_.ticks;
-  const double test_v = s_.test_signal.value_v(time_s_);
   time_s_ += in.dt_s;
   const bool valid = assess_sample(in);
   const ControlStep c = run_controller(in, valid);
@@ -357,7 +350,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   TickOutput out;
   out.controller_v = c.controller_v;
   out.filtered_mps = controller_.filtered_mps();
-  drive(in, c, test_v, out);
+  drive(in, c, out);
   if (state_ == State::kFault) ramp_down_fault(in, out);
   count_hold(c.hold && (state_ == State::kActive || state_ == State::kStopping));
   out.command_v = command_v_;
@@ -418,9 +411,9 @@ Supervisor::ControlStep Supervisor::run_controller(const TickInput& in, bool val
 }
 
 // The command in each state: nothing while disabled or arming (arming asks for the amplifier and
-// activates when it is ready), the faded controller (with the commissioning chirp added) while active,
+// activates when it is ready), the faded controller (with the loop's excitation added) while active,
 // where the saturation duty and the instability detector can trip, and the fade-out while stopping.
-void Supervisor::drive(const TickInput& in, const ControlStep& c, double test_v, TickOutput& out) noexcept {
+void Supervisor::drive(const TickInput& in, const ControlStep& c, TickOutput& out) noexcept {
   switch (state_) {
     case State::kDisabled: command_v_ = 0.0; break;
     case State::kArming:
@@ -436,9 +429,9 @@ void Supervisor::drive(const TickInput& in, const ControlStep& c, double test_v,
     case State::kActive: {
       fade_ = s_.fade_s > 0.0 ? std::min(1.0, fade_ + in.dt_s / s_.fade_s) : 1.0;
       command_v_ = fade_ * c.driving_v;
-      if (test_v != 0.0) {
-        const double lim = s_.test_signal.voltage_limit_v;
-        command_v_ = std::clamp(fade_ * (c.driving_v + test_v), -lim, lim);
+      if (in.excitation_v != 0.0) {
+        const double lim = s_.command_limit_v;
+        command_v_ = std::clamp(fade_ * (c.driving_v + in.excitation_v), -lim, lim);
       }
       out.amplifier_enable = true;
       out.saturated = c.limited || in.actuator_saturated;

@@ -74,6 +74,7 @@ struct TickInput {
   bool amplifier_ready{false};
   bool amplifier_fault{false};
   bool overrun{false};   // the previous tick ran past its deadline, or ticks were missed
+  double excitation_v{0.0};  // the loop's command source beside the controller (rt/excitation.hpp), V
   bool shutdown{false};  // SIGINT / SIGTERM seen
   OperatorCommand command{};
 };
@@ -129,23 +130,6 @@ struct SupervisorEvent {
 inline constexpr std::size_t kEventLogSize = 64;
 [[nodiscard]] const char* to_string(EventKind k);
 
-// A periodic linear chirp added to the command while active (robodamp measure, with the gain at 0:
-// control off, amplifier enabled). Time is the supervisor's (the sum of the measured dt), so a replay
-// regenerates it bit for bit. Each period sweeps f0 -> f1 from phase 0; the sum is clamped to the
-// amplifier's voltage limit.
-struct TestSignal {
-  bool enabled{false};
-  double start_s{0.0};
-  double period_s{8.0};
-  int periods{0};
-  double f0_hz{0.0}, f1_hz{0.0};
-  double amplitude_v{0.0};
-  double voltage_limit_v{10.0};
-  // The signal at supervisor time t_s (0 outside [start, start + periods x period)). RT-safe.
-  [[nodiscard]] double value_v(double t_s) const noexcept;
-  [[nodiscard]] double end_s() const noexcept { return start_s + period_s * periods; }
-};
-
 // What the supervisor needs beyond the controller's parameters; a recording stores it.
 struct SupervisorSettings {
   config::SupervisionConfig limits;
@@ -155,7 +139,7 @@ struct SupervisorSettings {
   bool analysis_stable{false};       // the analysis found the configured loop stable
   double max_stable_gain_ns_per_m{0.0};
   double delay_margin_s{0.0};        // the analysis' delay margin at the configured gain (0: none known)
-  TestSignal test_signal;            // robodamp measure only
+  double command_limit_v{10.0};      // the amplifier's voltage limit: a command with excitation is clamped to it
   // pose_schedule: arming waits for a pose in a region (set_pose_region), the supervisor hands over to
   // each region's set as the pose moves, and a pose out of the map trips (kPoseOutOfMap).
   bool pose_scheduled{false};
@@ -227,7 +211,7 @@ class Supervisor {
   };
   [[nodiscard]] bool assess_sample(const TickInput& in) noexcept;  // true: a finite sample in range
   [[nodiscard]] ControlStep run_controller(const TickInput& in, bool valid) noexcept;
-  void drive(const TickInput& in, const ControlStep& c, double test_v, TickOutput& out) noexcept;
+  void drive(const TickInput& in, const ControlStep& c, TickOutput& out) noexcept;
   void ramp_down_fault(const TickInput& in, TickOutput& out) noexcept;
 
   [[nodiscard]] double max_gain_ns_per_m() const noexcept {
@@ -273,7 +257,7 @@ class Supervisor {
   double arming_s_{0.0};   // time spent arming
   double trip_from_v_{0.0}, trip_ramp_left_s_{0.0};
   double command_v_{0.0};
-  double time_s_{0.0};  // sum of dt before this tick: the test signal's clock
+  double time_s_{0.0};  // sum of dt so far: the events' and the probation's clock
   control::ControllerCounters last_limits_{};
   bool pose_known_{false};
   std::size_t pose_set_{0};  // the set the pose's region wants (pose_scheduled)

@@ -95,7 +95,6 @@ Status Cell::plan_analysis() {
   }
   rt::SupervisorSettings settings =
       rt::supervisor_settings(cfg_, stable_, k_max, delay_margin_s(*model_, set0, max_stable_gain_));
-  settings.test_signal = o_.test_signal;
   settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
   supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(set0, model_->chain().params));
   if (settings.pose_scheduled) configure_pose_sets();
@@ -111,6 +110,7 @@ Status Cell::compose_devices() {
   rt::ActuatorSink* actuator = can_ ? static_cast<rt::ActuatorSink*>(&can_->driver()) : &sim_->backend();
   rt::AmplifierIo* io = modbus_ ? static_cast<rt::AmplifierIo*>(&modbus_->client()) : &sim_->backend();
   loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io, ring_.get());
+  if (o_.chirp.enabled) loop_->set_excitation(o_.chirp);
   arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
   if (o_.arm_at_start) loop_->set_policy(arming_.get());
   if (supervisor_->settings().pose_scheduled && !o_.pose_deg.empty() && !cfg_.can) {  // the simulated robot stands at --pose
@@ -339,7 +339,7 @@ Status Cell::activate(double duration_s) {
   try {
     if (!o_.record_path.empty())
       recorder_ = std::make_unique<rt::Recorder>(o_.record_path,
-                                                 rt::recording_header(cfg_, *supervisor_, cfg_.loop.clock));
+                                                 rt::recording_header(cfg_, *supervisor_, cfg_.loop.clock, loop_->excitation()));
   } catch (const std::exception& e) {
     return {StatusKind::kDeviceError, std::string("--record: ") + e.what()};
   }

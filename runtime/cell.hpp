@@ -56,7 +56,7 @@ struct CellOptions {
   drivers::SimBackendOptions backend{};
   double connect_timeout_s{10.0};  // hardware: waiting for the CAN transport and the amplifier's first poll
   bool keep_frames{false};         // keep every drained frame in memory (tests)
-  rt::TestSignal test_signal{};    // robodamp measure: the chirp added to the command while active
+  rt::PeriodicChirp chirp{};       // robodamp measure: the loop's chirp added to the command while active
   // pose_schedule (analysis/pose_schedule.hpp):
   //  - pose_deg: the robot stands at this pose (simulated backend: the plant is the robot model there and
   //    the pose is reported to the supervisor at tick 0);

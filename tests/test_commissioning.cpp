@@ -24,6 +24,7 @@
 #include "hil_files.hpp"
 #include "identify/actuator_fit.hpp"
 #include "identify/commissioning.hpp"
+#include "rt/excitation.hpp"
 #include "rt/supervisor.hpp"
 #include "test_util.hpp"
 #include "tune/tuned_file.hpp"
@@ -96,15 +97,15 @@ TEST(ActuatorFit, PeriodicFrfOfAPureDelayIsExact) {
   EXPECT_THROW((void)identify::periodic_frf(u, y, period, period, 5, fs, 100.0), std::invalid_argument);
 }
 
-TEST(TestSignal, IsAPeriodicChirpOnlyInsideItsWindow) {
-  const rt::TestSignal s{true, 1.0, 2.0, 3, 2.0, 50.0, 1.5, 10.0};
+TEST(PeriodicChirp, IsAPeriodicChirpOnlyInsideItsWindow) {
+  const rt::PeriodicChirp s{true, 1.0, 2.0, 3, 2.0, 50.0, 1.5};
   EXPECT_EQ(s.value_v(0.999), 0.0);
   EXPECT_EQ(s.value_v(7.0), 0.0);  // after 3 periods
   EXPECT_NEAR(s.value_v(1.0 + 0.3), s.value_v(3.0 + 0.3), 1e-12);
   double peak = 0.0;
   for (double t = 1.0; t < 7.0; t += 1e-4) peak = std::max(peak, std::abs(s.value_v(t)));
   EXPECT_NEAR(peak, 1.5, 1e-3);
-  EXPECT_EQ(rt::TestSignal{}.value_v(1.0), 0.0);  // disabled
+  EXPECT_EQ(rt::PeriodicChirp{}.value_v(1.0), 0.0);  // disabled
 }
 
 // --- Round trips -------------------------------------------------------------------------------

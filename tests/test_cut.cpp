@@ -93,7 +93,7 @@ ThreeMethods three_methods(const Job& j, double rpm) {
   const LobeModel lobes(j.structure, chatter_process(tool, j.material, j.cut), config::LobesConfig{});
   const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
   const SdmModel sdm(terms, j.cutter, j.material, j.cut.mode, j.cut.radial_mm, 1, 40);
-  const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
+  const double zoa_mm = lobes.critical_depth_mm(rpm);
   const SdmPoint p = sdm.critical(rpm, zoa_mm);
   return {zoa_mm, p, critical_depth(terms, j.cutter, j.material, settings_for(j, rpm, 1.0), p.critical_depth_mm)};
 }

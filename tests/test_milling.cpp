@@ -56,12 +56,12 @@ TEST_P(ClosedFormMinimum, LobeMinimumMatchesTheSingleModeFormula) {
   lc.points = 2000;
   const mill::LobeModel model(structure, p, lc);
   const auto d = model.diagram();
-  EXPECT_NEAR(d.minimum.b_lim_m / expected, 1.0, 5e-3) << c.name << ": alpha_yy = " << alpha;
+  EXPECT_NEAR(d.minimum.b_lim_mm * 1e-3 / expected, 1.0, 5e-3) << c.name << ": alpha_yy = " << alpha;
   // Refined at the speed of the minimum: the grid's interpolation error goes away.
   const auto refined = model.limit_at(d.minimum.rpm);
   ASSERT_TRUE(refined);
-  EXPECT_NEAR(refined->b_lim_m / expected, 1.0, 2e-3) << c.name;
-  EXPECT_GE(refined->b_lim_m, expected * (1.0 - 1e-9)) << "no depth below the analytic minimum";
+  EXPECT_NEAR(refined->b_lim_mm * 1e-3 / expected, 1.0, 2e-3) << c.name;
+  EXPECT_GE(refined->b_lim_mm * 1e-3, expected * (1.0 - 1e-9)) << "no depth below the analytic minimum";
 }
 
 INSTANTIATE_TEST_SUITE_P(Milling, ClosedFormMinimum,
@@ -101,14 +101,14 @@ TEST(Milling, LobePointsSolveTheCharacteristicEquation) {
     for (const auto& p : model.lobe_points(j)) {
       // Depths a tool can cut; towards a band edge b_lim runs to infinity and rebuilding Lambda from
       // (b, eps) loses digits to 1 - e^{-i eps} with eps -> 0.
-      if (p.b_lim_m > 0.1) continue;
-      const Complex d = model.characteristic(p.b_lim_m, p.rpm, p.chatter_hz);
+      if (p.b_lim_mm > 100.0) continue;
+      const Complex d = model.characteristic(p.b_lim_mm, p.rpm, p.chatter_hz);
       // Relative to the size of the terms of the 2x2 determinant (b runs to infinity at band edges).
       const double tau = 60.0 / (job.tool.teeth * p.rpm);
-      const double lambda = job.tool.teeth / (4 * M_PI) * job.material.kt_n_per_mm2 * 1e6 * p.b_lim_m *
+      const double lambda = job.tool.teeth / (4 * M_PI) * job.material.kt_n_per_mm2 * 1e3 * p.b_lim_mm *
                             std::abs(1.0 - std::exp(Complex(0.0, -2 * M_PI * p.chatter_hz * tau)));
       const double scale = 1.0 + lambda * model.oriented(p.chatter_hz).cwiseAbs().maxCoeff();
-      EXPECT_LT(std::abs(d) / (scale * scale), 1e-10) << "lobe " << j << " at " << p.chatter_hz << " Hz, b " << p.b_lim_m;
+      EXPECT_LT(std::abs(d) / (scale * scale), 1e-10) << "lobe " << j << " at " << p.chatter_hz << " Hz, b " << p.b_lim_mm;
       ++checked;
     }
   }
@@ -126,14 +126,14 @@ TEST(Milling, DirectTestAgreesWithLobesWithinOnePercent) {
   for (double rpm : {700.0, 1500.0, 4000.0, 10700.0, diagram.minimum.rpm}) {
     const auto zoa = model.limit_at(rpm);
     ASSERT_TRUE(zoa) << rpm;
-    const double direct = model.critical_depth_m(rpm);
-    EXPECT_NEAR(direct / zoa->b_lim_m, 1.0, 0.01) << rpm << " rpm: direct " << direct << " m, lobes " << zoa->b_lim_m;
+    const double direct = model.critical_depth_mm(rpm);
+    EXPECT_NEAR(direct / zoa->b_lim_mm, 1.0, 0.01) << rpm << " rpm: direct " << direct << " mm, lobes " << zoa->b_lim_mm;
     // Just below the lobe the cut is stable, just above it is not.
-    EXPECT_TRUE(model.stable(0.99 * zoa->b_lim_m, rpm)) << rpm;
-    EXPECT_FALSE(model.stable(1.01 * zoa->b_lim_m, rpm)) << rpm;
+    EXPECT_TRUE(model.stable(0.99 * zoa->b_lim_mm, rpm)) << rpm;
+    EXPECT_FALSE(model.stable(1.01 * zoa->b_lim_mm, rpm)) << rpm;
     // The diagram's interpolated curve is close to the refined value at the same speed.
     if (rpm == diagram.minimum.rpm) {
-      EXPECT_NEAR(diagram.minimum.b_lim_m / zoa->b_lim_m, 1.0, 0.01);
+      EXPECT_NEAR(diagram.minimum.b_lim_mm / zoa->b_lim_mm, 1.0, 0.01);
     }
   }
   const auto bone = cfg::load_milling_config(milling_preset("orthopaedic_bone"));
@@ -142,7 +142,7 @@ TEST(Milling, DirectTestAgreesWithLobesWithinOnePercent) {
   for (double rpm : {4000.0, 5500.0, 7000.0}) {
     const auto zoa = mb.limit_at(rpm);
     ASSERT_TRUE(zoa) << rpm;
-    EXPECT_NEAR(mb.critical_depth_m(rpm) / zoa->b_lim_m, 1.0, 0.01) << rpm;
+    EXPECT_NEAR(mb.critical_depth_mm(rpm) / zoa->b_lim_mm, 1.0, 0.01) << rpm;
   }
 }
 
@@ -340,7 +340,7 @@ TEST(Milling, ActiveDampingRaisesTheMinimumStableDepthOfThePreset) {
   const auto d_closed = mill::LobeModel(closed, process, job.lobes).diagram();
   // The robot's 9.2 Hz mode sets the open-loop minimum; the controller damps it.
   EXPECT_NEAR(d_open.minimum.chatter_hz, 9.4, 0.5);
-  EXPECT_GT(d_closed.minimum.b_lim_m, 2.0 * d_open.minimum.b_lim_m);
+  EXPECT_GT(d_closed.minimum.b_lim_mm, 2.0 * d_open.minimum.b_lim_mm);
 }
 
 }  // namespace

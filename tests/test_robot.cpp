@@ -189,17 +189,17 @@ TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
   const auto process = milling::chatter_process(job.tool, job.material, job.cut);
   const milling::LobeModel lobes(s, process, job.lobes);
   const auto d = lobes.diagram();
-  const double direct = lobes.critical_depth_m(d.minimum.rpm);
-  std::cout << "pose 2: minimum " << d.minimum.b_lim_m * 1e3 << " mm at " << d.minimum.rpm << " rpm, chatter "
+  const double direct = lobes.critical_depth_mm(d.minimum.rpm);
+  std::cout << "pose 2: minimum " << d.minimum.b_lim_mm << " mm at " << d.minimum.rpm << " rpm, chatter "
             << d.minimum.chatter_hz << " Hz; direct test " << direct * 1e3 << " mm\n";
-  EXPECT_NEAR(direct / d.minimum.b_lim_m, 1.0, 0.01);
+  EXPECT_NEAR(direct / d.minimum.b_lim_mm, 1.0, 0.01);
   EXPECT_GT(d.minimum.chatter_hz, 5.0);
   EXPECT_LT(d.minimum.chatter_hz, 40.0) << "the minimum is set by the joints' modes";
   // Pose 1 (stiffer): a higher minimum.
   config::StructureConfig at1 = job.structures.front();
   at1.parts.front().pose->joints_deg = model.poses.front().joints_deg;
   const milling::Structure s1(at1, false);
-  EXPECT_GT(milling::LobeModel(s1, process, job.lobes).diagram().minimum.b_lim_m, d.minimum.b_lim_m);
+  EXPECT_GT(milling::LobeModel(s1, process, job.lobes).diagram().minimum.b_lim_mm, d.minimum.b_lim_mm);
   // The cut in time takes the model's lowest modes (mass-normalised shapes): they reproduce its TCP
   // receptance at the joints' modes, and the simulated cut's critical depth where a joint mode limits
   // agrees with SDM on the same terms and with the zero-order lobes of the exact receptance.
@@ -220,7 +220,7 @@ TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
   milling::CutOverrides ov;
   ov.rpm = rpm;
   const milling::CutJob at = milling::make_cut_job(job, s, ov);
-  const double zoa_mm = lobes.critical_depth_m(rpm) * 1e3;
+  const double zoa_mm = lobes.critical_depth_mm(rpm);
   const milling::SdmPoint sdm = milling::SdmModel(at.terms, at.cutter, at.material, job.cut.mode, job.cut.radial_mm, 1, 40)
                                     .critical(rpm, zoa_mm);
   const milling::CriticalDepth td = milling::critical_depth(at.dynamics, at.cutter, at.material, at.settings, sdm.critical_depth_mm);

@@ -397,7 +397,7 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
   EXPECT_EQ(r.mismatches, 0U);
 }
 
-// robodamp measure's loop: the supervisor's chirp test signal with K = 0 and the plant-side impact test
+// robodamp measure's loop: the loop's chirp with K = 0 and the plant-side impact test
 // (analysis::ModalTest on the simulated backend's step hook) through the whole commissioning plan: the
 // loop thread allocates nothing and takes no lock.
 TEST(RealTimePath, CommissioningMeasurementAllocatesNothing) {
@@ -410,9 +410,8 @@ TEST(RealTimePath, CommissioningMeasurementAllocatesNothing) {
   off.controller.gain_ns_per_m = 0.0;
   runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
-  o.test_signal = {true, plan.chirp_start_s, cfg.commissioning.chirp_period_s, cfg.commissioning.chirp_periods,
-                   cfg.commissioning.chirp_f0_hz, cfg.commissioning.chirp_f1_hz, plan.chirp_amplitude_v,
-                   cfg.amplifier.voltage_limit_v};
+  o.chirp = {true, plan.chirp_start_s, cfg.commissioning.chirp_period_s, cfg.commissioning.chirp_periods,
+             cfg.commissioning.chirp_f0_hz, cfg.commissioning.chirp_f1_hz, plan.chirp_amplitude_v};
   runtime::Cell session(off, o);
   test::configure(session);
   analysis::ModalTest modal(cfg, session.plant(), plan);

@@ -96,6 +96,48 @@ TEST(Loop, ArmsOnceLiveFadesInDampsAndDisarmsToDisabled) {
   EXPECT_GT(r.s.peak_command_v, 0.02);
 }
 
+// The commissioning chirp is the loop's command source beside the controller: with K = 0 the command is
+// the faded chirp evaluated on the sum of the frames' dt, clamped to amplifier.voltage_limit_v (a 3 V
+// chirp against 2 V, inside the actuator's force limit), zero outside its window, and a recording of it replays bit for bit.
+TEST(Loop, TheChirpIsACommandSourceOfTheLoopClampedAndReplayed) {
+  config::Config cfg = c2();
+  cfg.controller.gain_ns_per_m = 0.0;
+  cfg.amplifier.voltage_limit_v = 2.0;
+  CellOptions o = virtual_clock();
+  o.chirp = {true, 1.0, 0.5, 2, 5.0, 40.0, 3.0};
+  o.record_path = ::testing::TempDir() + "/chirp_loop.rec";
+  const auto r = run(cfg, 2.5, o);
+  expect_nothing_lost(r);
+  ASSERT_EQ(r.s.trip, "none") << r.s.final_state;
+  const std::size_t active = first_state(r, State::kActive);
+  ASSERT_LT(active, r.frames.size());
+  double t_s = 0.0, peak_v = 0.0;
+  std::size_t inside = 0, clamped = 0;
+  for (std::size_t i = 0; i < r.frames.size(); ++i) {
+    const TelemetryFrame& f = r.frames[i];
+    const double chirp_v = o.chirp.value_v(t_s);
+    t_s += f.dt_s;
+    if (f.state != static_cast<std::uint8_t>(State::kActive)) continue;
+    EXPECT_EQ(f.controller_v, 0.0) << i;
+    if (chirp_v == 0.0) {
+      EXPECT_EQ(f.command_v, 0.0) << "outside the chirp's window, tick " << i;
+      continue;
+    }
+    ++inside;
+    const double fade = std::min(1.0, static_cast<double>(i - active + 1) / (cfg.controller.gain_ramp_s * cfg.loop.rate_hz));
+    const double want = std::clamp(fade * chirp_v, -2.0, 2.0);
+    clamped += std::abs(fade * chirp_v) > 2.0 ? 1 : 0;
+    EXPECT_NEAR(f.command_v, want, 1e-9) << "tick " << i;
+    peak_v = std::max(peak_v, std::abs(f.command_v));
+  }
+  EXPECT_GE(inside, static_cast<std::size_t>(0.99 * o.chirp.period_s * o.chirp.periods * cfg.loop.rate_hz));  // its window, active
+  EXPECT_GT(clamped, 100U);
+  EXPECT_EQ(peak_v, 2.0);
+  const ReplayResult rp = replay(read_recording(o.record_path));
+  EXPECT_EQ(rp.frames, r.frames.size());
+  EXPECT_EQ(rp.mismatches, 0U);
+}
+
 TEST(Loop, ArmingRefusedUntilSensorLive) {
   CellOptions o = virtual_clock();
   o.arm_at_start = false;
@@ -228,7 +270,7 @@ TEST(Loop, TheQuietCommandIsWhatTheLoopModelPredicts) {
     const analysis::QuietCommand predicted =
         analysis::quiet_command(analysis::LoopModel(cfg), cfg.controller.gain_ns_per_m, cfg.controller.polarity);
     const auto r = run(cfg, 200.0);
-    ASSERT_EQ(r.s.trip, "none");
+    ASSERT_EQ(r.s.trip, "none") << r.s.final_state;
     const std::size_t active = first_state(r, State::kActive);
     ASSERT_LT(active, r.frames.size());
     double sum_sq = 0.0;

@@ -36,7 +36,7 @@ double time_domain_mm(const config::MillingConfig& cfg, const Structure& open, d
 }
 
 double zero_order_mm(const config::MillingConfig& cfg, const Structure& damped, double rpm) {
-  return LobeModel(damped, chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes).critical_depth_m(rpm) * 1e3;
+  return LobeModel(damped, chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes).critical_depth_mm(rpm);
 }
 
 TEST(SampledSdm, DampedLimitIsTheTimeDomainsWhereTheZeroOrderMethodIsWrong) {

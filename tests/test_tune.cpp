@@ -331,7 +331,7 @@ TEST(Tune, TheTunedControllerHoldsItsDepthsInTheSimulatedCut) {
     const config::StructureConfig& st = *cfg.find_structure(cfg.structure);
     const milling::Structure open(st, false), damped(st, true);
     const auto process = milling::chatter_process(cfg.tool, cfg.material, cfg.cut);
-    const double zoa = milling::LobeModel(damped, process, cfg.lobes).critical_depth_m(rpm) * 1e3;
+    const double zoa = milling::LobeModel(damped, process, cfg.lobes).critical_depth_mm(rpm);
     *sdm_mm = milling::AccurateStability(damped, cfg).critical(rpm, zoa).critical_depth_mm;
     milling::CutOverrides ov;
     ov.rpm = rpm;

@@ -114,9 +114,9 @@ std::vector<std::pair<double, double>> lowest_minima(const milling::LobeDiagram&
   std::vector<std::pair<double, double>> out;
   const auto& c = d.curve;
   for (std::size_t i = 0; i < c.size(); ++i) {
-    const double v = c[i].b_lim_m;
+    const double v = c[i].b_lim_mm;
     if (!std::isfinite(v)) continue;
-    if ((i == 0 || v <= c[i - 1].b_lim_m) && (i + 1 == c.size() || v <= c[i + 1].b_lim_m)) out.emplace_back(c[i].rpm, v * 1e3);
+    if ((i == 0 || v <= c[i - 1].b_lim_mm) && (i + 1 == c.size() || v <= c[i + 1].b_lim_mm)) out.emplace_back(c[i].rpm, v);
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   if (out.size() > count) out.resize(count);
@@ -150,7 +150,7 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   if (auto p = milling::sampled_speed_problem(job_->cut.spindle_rpm, job_->tool.teeth, base_.loop.rate_hz))
     throw config::ConfigError({config::Problem{job_->source, {}, "cut.spindle_rpm", *p}});
   const milling::LobeDiagram d = milling::LobeModel(open, *process_, job_->lobes).diagram();
-  open_min_mm_ = d.minimum.b_lim_m * 1e3;
+  open_min_mm_ = d.minimum.b_lim_mm;
   // The open loop's lobes by SDM on the job's SDM speeds: their lowest minima are where the damped limit is
   // checked against the open loop's, by the accurate method.
   {
@@ -158,11 +158,11 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
     grid.points = job_->time_domain.sdm_points;
     const milling::LobeDiagram g = milling::LobeModel(open, *process_, grid).diagram();
     std::vector<double> rpm, mm;
-    for (const auto& p : g.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_m * 1e3);
+    for (const auto& p : g.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_mm);
     const std::vector<milling::SdmPoint> sdm = milling::AccurateStability(open, *job_).critical(rpm, mm);
     milling::LobeDiagram as_lobes;
     for (const auto& p : sdm) {
-      as_lobes.curve.push_back({p.rpm, p.critical_depth_mm * 1e-3, p.chatter_hz, 0});
+      as_lobes.curve.push_back({p.rpm, p.critical_depth_mm, p.chatter_hz, 0});
       open_curve_.emplace_back(p.rpm, p.critical_depth_mm);
     }
     for (const auto& [r, m] : lowest_minima(as_lobes, kCheckedMinima)) open_sdm_min_rpm_.push_back(r), open_sdm_min_mm_.push_back(m);
@@ -171,17 +171,17 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   std::vector<std::size_t> peaks;
   const auto& c = d.curve;
   for (std::size_t i = 1; i + 1 < c.size(); ++i)
-    if (std::isfinite(c[i].b_lim_m) && c[i].b_lim_m > c[i - 1].b_lim_m && c[i].b_lim_m >= c[i + 1].b_lim_m) peaks.push_back(i);
+    if (std::isfinite(c[i].b_lim_mm) && c[i].b_lim_mm > c[i - 1].b_lim_mm && c[i].b_lim_mm >= c[i + 1].b_lim_mm) peaks.push_back(i);
   std::vector<std::size_t> edges{0};
   edges.insert(edges.end(), peaks.begin(), peaks.end());
   edges.push_back(c.size() - 1);
   for (std::size_t k = 0; k + 1 < edges.size(); ++k) {
     double floor = kInf, at = 0.0;
     for (std::size_t i = edges[k]; i <= edges[k + 1]; ++i)
-      if (c[i].b_lim_m < floor) floor = c[i].b_lim_m, at = c[i].rpm;
+      if (c[i].b_lim_mm < floor) floor = c[i].b_lim_mm, at = c[i].rpm;
     if (!std::isfinite(floor)) continue;
     intervals_.emplace_back(c[edges[k]].rpm, c[edges[k + 1]].rpm);
-    floors_mm_.push_back(floor * 1e3);
+    floors_mm_.push_back(floor);
     floor_rpm_.push_back(at);
   }
 }
@@ -247,16 +247,16 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   const milling::Structure damped(job_structure(*job_), true, {m, k, cand.polarity});
   const milling::LobeModel lobes(damped, *process_, job_->lobes);
   const milling::LobeDiagram d = lobes.diagram();
-  e.min_depth_mm = d.minimum.b_lim_m * 1e3;
+  e.min_depth_mm = d.minimum.b_lim_mm;
   // The objective and the depth at the job's speed by the accurate method: the sampled loop's SDM at the
   // job's speed, at the damped zero-order lobes' lowest minima (where the damped lobes dip) and at the open
   // loop's SDM minima (where the open loop's floors are); the zero-order limits are only the first guesses.
-  std::vector<double> speeds{job_->cut.spindle_rpm}, guesses{lobes.critical_depth_m(job_->cut.spindle_rpm, 1e-3) * 1e3};
+  std::vector<double> speeds{job_->cut.spindle_rpm}, guesses{lobes.critical_depth_mm(job_->cut.spindle_rpm, 1e-3)};
   for (const auto& [rpm, mm] : lowest_minima(d, kCheckedMinima)) speeds.push_back(rpm), guesses.push_back(mm);
   for (std::size_t i = 0; i < open_sdm_min_rpm_.size(); ++i) {
     speeds.push_back(open_sdm_min_rpm_[i]);
     const auto z = lobes.limit_at(open_sdm_min_rpm_[i]);
-    guesses.push_back(z ? z->b_lim_m * 1e3 : 1.0);
+    guesses.push_back(z ? z->b_lim_mm : 1.0);
   }
   const milling::AccurateStability truth(damped, *job_);
   const std::vector<milling::SdmPoint> acc = truth.critical(speeds, guesses, 0, 5e-3);
@@ -277,12 +277,12 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   for (std::size_t k2 = 0; k2 < intervals_.size(); ++k2) {
     double floor = kInf;
     for (const auto& p : d.curve)
-      if (p.rpm >= intervals_[k2].first && p.rpm <= intervals_[k2].second) floor = std::min(floor, p.b_lim_m * 1e3);
+      if (p.rpm >= intervals_[k2].first && p.rpm <= intervals_[k2].second) floor = std::min(floor, p.b_lim_mm);
     e.floors_mm.push_back(floor);
     e.floor_ratio = std::min(e.floor_ratio, floor / floors_mm_[k2]);
     // The damped curve is on the same speeds as the open one: the point at the open floor's speed.
     const auto at = std::find_if(d.curve.begin(), d.curve.end(), [&](const auto& p) { return p.rpm >= floor_rpm_[k2]; });
-    e.at_open_minima_mm.push_back(at == d.curve.end() ? kInf : at->b_lim_m * 1e3);
+    e.at_open_minima_mm.push_back(at == d.curve.end() ? kInf : at->b_lim_mm);
   }
   add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
   return e;
@@ -365,7 +365,7 @@ std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::
   const milling::AccurateStability truth(damped, *job_);
   std::vector<double> rpm, mm;
   for (const auto& p : milling::LobeModel(damped, *process_, grid).diagram().curve)
-    if (p.rpm <= truth.max_rpm()) rpm.push_back(p.rpm), mm.push_back(p.b_lim_m * 1e3);
+    if (p.rpm <= truth.max_rpm()) rpm.push_back(p.rpm), mm.push_back(p.b_lim_mm);
   for (const auto& p : truth.critical(rpm, mm)) out.emplace_back(p.rpm, p.critical_depth_mm);
   return out;
 }

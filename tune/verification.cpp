@@ -55,8 +55,8 @@ Verification verify(const config::Config& cfg, const config::MillingConfig& job_
   std::vector<double> speeds, guesses, open_guesses;
   for (std::size_t i = 0; i < guess.curve.size(); ++i)
     if (guess.curve[i].rpm <= truth.max_rpm())
-      speeds.push_back(guess.curve[i].rpm), guesses.push_back(guess.curve[i].b_lim_m * 1e3),
-          open_guesses.push_back(open_guess.curve[i].b_lim_m * 1e3);
+      speeds.push_back(guess.curve[i].rpm), guesses.push_back(guess.curve[i].b_lim_mm),
+          open_guesses.push_back(open_guess.curve[i].b_lim_mm);
   Verification v;
   v.method = truth.method();
   v.min_depth_mm = INFINITY;
@@ -68,7 +68,7 @@ Verification verify(const config::Config& cfg, const config::MillingConfig& job_
   for (const milling::SdmPoint& p : open_truth.critical(speeds, open_guesses))
     v.open_min_depth_mm = std::min(v.open_min_depth_mm, p.critical_depth_mm);
   const milling::LobeModel zoa(damped, process, job.lobes);
-  const milling::SdmPoint at = truth.critical(job.cut.spindle_rpm, zoa.critical_depth_m(job.cut.spindle_rpm) * 1e3);
+  const milling::SdmPoint at = truth.critical(job.cut.spindle_rpm, zoa.critical_depth_mm(job.cut.spindle_rpm));
   v.depth_at_speed_mm = at.critical_depth_mm;
   v.speed_rpm = at.rpm;
   // The time domain closes the same parts with the real Controller running this configuration.
