@@ -6,6 +6,7 @@
 
 #include "apps/cli.hpp"
 #include "commission/measurement.hpp"
+#include "commission/pose_measurements.hpp"
 
 namespace robodamp::apps {
 
@@ -15,10 +16,11 @@ struct MeasureArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
   std::string out_dir;
   std::string clock;
+  std::vector<double> pose_deg;
+  std::string poses_file;
 };
 
-int measure(const MeasureArgs& a) {
-  const commission::MeasureOutcome r = commission::measure(a.config_path, a.out_dir, {a.clock});
+int report(const commission::MeasureOutcome& r, const std::string& out_dir) {
   if (r.status == commission::MeasureStatus::kConfigError || r.status == commission::MeasureStatus::kFailed ||
       (r.status == commission::MeasureStatus::kWriteError && r.final_state.empty())) {
     std::cerr << "robodamp measure: " << r.message << '\n';
@@ -26,9 +28,9 @@ int measure(const MeasureArgs& a) {
   }
   if (r.manifest.backend == "simulated plant")
     std::cout << "robodamp measure: " << r.impact_records << " of " << r.impact_records_planned
-              << " impact records; wrote " << r.frf_files << " FRFs to " << a.out_dir << '\n';
+              << " impact records; wrote " << r.frf_files << " FRFs to " << out_dir << '\n';
   else
-    std::cout << "robodamp measure: the plant side (robodamp plant --measure-out " << a.out_dir
+    std::cout << "robodamp measure: the plant side (robodamp plant --measure-out " << out_dir
               << ") writes the impact FRFs when the run ends\n";
   std::printf("robodamp measure: state %s, trip %s, chirp played with the loop active over %.1f %% of its ticks, "
               "%llu saturated ticks, peak command %.3f V, %llu frames recorded\n",
@@ -36,6 +38,20 @@ int measure(const MeasureArgs& a) {
               r.recorded_frames);
   if (r.status != commission::MeasureStatus::kOk) std::cerr << "robodamp measure: " << r.message << '\n';
   return commission::exit_code(r.status);
+}
+
+int measure(const MeasureArgs& a) {
+  commission::MeasureOptions o{a.clock, a.pose_deg, {}};
+  if (a.poses_file.empty()) return report(commission::measure(a.config_path, a.out_dir, o), a.out_dir);
+  const auto poses = commission::read_measurement_poses(a.config_path, a.poses_file);  // all checked first
+  int status = 0;
+  const auto done = commission::measure_poses(a.config_path, poses, a.out_dir, o, [&](const commission::PoseMeasurement& m) {
+    std::cout << "robodamp measure: pose '" << m.name << "' " << config::describe_pose(m.joints_deg) << " -> " << m.dir << '\n';
+    status = report(m.outcome, m.dir);
+  });
+  std::cout << "robodamp measure: " << done.size() << " of " << poses.size() << " poses measured; index "
+            << a.out_dir << "/poses.json\n";
+  return status;
 }
 
 }  // namespace
@@ -50,6 +66,14 @@ void register_measure(Registry& r) {
   sub->add_option("--out", a->out_dir, "Directory for the recording, the FRFs and measurement.json")->required();
   sub->add_option("--clock", a->clock, "Override loop.clock: wall (real time) or virtual (as fast as possible)")
       ->check(CLI::IsMember({"wall", "virtual"}));
+  auto* pose = r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0},
+                         "The robot's joint angles, one per joint of the configuration's pose_schedule.model: the "
+                         "simulated plant stands there (on hardware: where the robot stands); written to measurement.json");
+  sub->add_option("--poses", a->poses_file,
+                  "Measure at every pose of this file (its poses: list of {name, joints_deg}, e.g. a robot model "
+                  "file), each into --out/<name>/, indexed in --out/poses.json")
+      ->check(CLI::ExistingFile)
+      ->excludes(pose);
 }
 
 }  // namespace robodamp::apps

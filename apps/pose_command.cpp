@@ -5,6 +5,7 @@
 //             stiffness and damping from measured TCP FRFs at poses (particle swarm, then BOBYQA)
 //   pose map  --model F --vary J1 J2 [--steps N] [--job JOB] [--json F] [--plot PNG]: first-mode frequency,
 //             modal stiffness and (with a job) the minimum limiting depth over a grid of two joints
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "identify/modal_fit.hpp"
+#include "identify/pose_measurements.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
@@ -44,6 +46,7 @@ struct PoseArgs {
   std::vector<int> vary{2, 3};
   int steps{21};
   std::vector<std::string> measured;  // "Q1,Q2,Q3:path"
+  std::vector<std::string> measurements, hold_out;  // fit: measure directories; pose names kept out of the fit
   std::string direction{"yy"};
   std::vector<double> fit_band_hz{10.0, 30.0};
   int restarts{3}, particles{40}, iterations{150}, seed{1};
@@ -76,24 +79,74 @@ robot::MeasuredFrf measured_frf(const std::string& item) {
   return m;
 }
 
-int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
-  if (a.measured.empty()) {
-    std::cerr << "robodamp pose fit: give at least one --measured Q1,Q2,...:FRF.csv\n";
-    return 2;
+struct FitData {
+  std::vector<robot::MeasuredFrf> fit, held;
+  std::optional<robot::FrfDirection> direction;  // from the measurements' configuration
+};
+
+// --measured items and --measurements directories, the --hold-out poses set apart.
+FitData fit_data(const PoseArgs& a) {
+  FitData d;
+  for (const auto& item : a.measured) d.fit.push_back(measured_frf(item));
+  if (!a.measurements.empty()) {
+    identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
+    d.direction = pm.direction;
+    for (auto& f : pm.frfs) d.fit.push_back(std::move(f));
   }
-  std::vector<robot::MeasuredFrf> data;
-  for (const auto& item : a.measured) data.push_back(measured_frf(item));
+  for (const auto& name : a.hold_out) {
+    const auto it = std::find_if(d.fit.begin(), d.fit.end(), [&](const auto& f) { return f.name == name; });
+    if (it == d.fit.end()) throw std::invalid_argument("--hold-out '" + name + "': no measured pose of that name");
+    d.held.push_back(std::move(*it));
+    d.fit.erase(it);
+  }
+  if (d.fit.empty())
+    throw std::invalid_argument("robodamp pose fit: give --measured Q1,Q2,...:FRF.csv or --measurements DIR, and keep at "
+                                "least one pose in the fit");
+  return d;
+}
+
+robot::PoseFitSettings fit_settings(const PoseArgs& a, const FitData& d) {
   robot::PoseFitSettings s;
   s.direction = a.direction == "xx" ? robot::FrfDirection::kXX : a.direction == "xy" ? robot::FrfDirection::kXY : robot::FrfDirection::kYY;
+  if (d.direction) s.direction = *d.direction;
   s.band_min_hz = a.fit_band_hz[0], s.band_max_hz = a.fit_band_hz[1];
   s.restarts = a.restarts;
   s.pso.particles = a.particles, s.pso.iterations = a.iterations, s.pso.seed = static_cast<std::uint64_t>(a.seed);
-  const robot::PoseFitResult r = robot::fit_joints(m, data, s);
+  return s;
+}
+
+// Each pose: its role, the model's error before and after the fit, the receptance's peak frequency.
+json pose_rows(const config::RobotModelConfig& nominal, const config::RobotModelConfig& fitted,
+               const std::vector<robot::MeasuredFrf>& data, const robot::PoseFitSettings& s, const char* role,
+               std::ostringstream& t) {
+  json rows = json::array();
+  if (data.empty()) return rows;
+  const std::vector<double> before = robot::model_errors(nominal, data, s), after = robot::model_errors(fitted, data, s);
+  const std::vector<double> f_data = robot::peak_hz(nullptr, data, s), f_before = robot::peak_hz(&nominal, data, s),
+                            f_after = robot::peak_hz(&fitted, data, s);
+  char b[240];
+  for (std::size_t p = 0; p < data.size(); ++p) {
+    std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %9.2f %9.2f   %8.2f %8.2f %8.2f\n", data[p].name.c_str(),
+                  config::describe_pose(data[p].joints_deg).c_str(), role, 100.0 * before[p], 100.0 * after[p], f_data[p],
+                  f_before[p], f_after[p]);
+    t << b;
+    rows.push_back({{"frf", data[p].name}, {"joints_deg", data[p].joints_deg}, {"role", role},
+                    {"nominal_error_pct", 100.0 * before[p]}, {"error_pct", 100.0 * after[p]},
+                    {"peak_hz", f_data[p]}, {"nominal_peak_hz", f_before[p]}, {"fitted_peak_hz", f_after[p]}});
+  }
+  return rows;
+}
+
+int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
+  const FitData d = fit_data(a);
+  const robot::PoseFitSettings s = fit_settings(a, d);
+  const robot::PoseFitResult r = robot::fit_joints(m, d.fit, s);
+  const char* dir = s.direction == robot::FrfDirection::kXX ? "xx" : s.direction == robot::FrfDirection::kXY ? "xy" : "yy";
   std::ostringstream t;
   char b[240];
   std::snprintf(b, sizeof b, "robot %s fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
-                m.name.c_str(), data.size(), a.direction.c_str(), s.band_min_hz, s.band_max_hz, r.evaluations,
-                r.converged_restarts, s.restarts);
+                m.name.c_str(), d.fit.size(), dir, s.band_min_hz, s.band_max_hz, r.evaluations, r.converged_restarts,
+                s.restarts);
   t << b << "  joint   stiffness N m/rad   spread %   damping ratio\n";
   json joints = json::array();
   for (std::size_t j = 0; j < r.stiffness_nm_per_rad.size(); ++j) {
@@ -103,14 +156,16 @@ int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
     joints.push_back({{"stiffness_nm_per_rad", r.stiffness_nm_per_rad[j]}, {"spread_pct", r.stiffness_spread_pct[j]},
                       {"damping_ratio", r.damping_ratio[j]}});
   }
-  json poses = json::array();
-  for (std::size_t p = 0; p < data.size(); ++p) {
-    std::snprintf(b, sizeof b, "  %s: weighted relative error %.2f %%\n", data[p].name.c_str(), 100.0 * r.pose_error[p]);
-    t << b;
-    poses.push_back({{"frf", data[p].name}, {"joints_deg", data[p].joints_deg}, {"error_pct", 100.0 * r.pose_error[p]}});
-  }
-  const json out = {{"model", m.source}, {"joints", joints}, {"poses", poses}, {"restart_costs", r.restart_costs},
-                    {"evaluations", r.evaluations}, {"converged_restarts", r.converged_restarts}};
+  t << "  the TCP receptance against the model file as given (nominal) and fitted: the weighted relative error and\n"
+       "  the frequency of the largest receptance in the band\n";
+  std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %19s   %26s\n  %-10s %-30s %-9s %9s %9s   %8s %8s %8s\n", "", "", "",
+                "error %", "peak Hz", "pose", "joints", "role", "nominal", "fitted", "measured", "nominal", "fitted");
+  t << b;
+  json poses = pose_rows(m, r.fitted, d.fit, s, "fit", t);
+  for (auto& row : pose_rows(m, r.fitted, d.held, s, "held out", t)) poses.push_back(std::move(row));
+  const json out = {{"model", m.source}, {"direction", dir}, {"joints", joints}, {"poses", poses},
+                    {"restart_costs", r.restart_costs}, {"evaluations", r.evaluations},
+                    {"converged_restarts", r.converged_restarts}};
   if (!a.out_path.empty()) {
     std::ofstream f(a.out_path);
     f << config::robot_model_yaml(r.fitted);
@@ -345,6 +400,12 @@ void register_pose(Registry& r) {
       ->check(CLI::IsMember({"sdm", "zoa"}));
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
   sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
+  sub->add_option("--measurements", a->measurements,
+                  "fit: robodamp measure --pose directories (or a --poses directory: all its poses), their joint angles "
+                  "and driving-point FRFs; the direction is their configuration's pose_schedule.axis")
+      ->check(CLI::ExistingDirectory);
+  sub->add_option("--hold-out", a->hold_out,
+                  "fit: pose names (of --measurements) kept out of the fit: the fitted model's error is reported there");
   sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
   r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (the planar-robot study: 10 30)");
   r.whole_number(sub, "--restarts", a->restarts, {"(restarts)", 1, 100}, "fit: swarms with seeds seed, seed+1, ...");

@@ -14,6 +14,7 @@
 
 #include "analysis/loop_model.hpp"
 #include "apps/cli.hpp"
+#include "config/file_paths.hpp"
 #include "apps/gnuplot.hpp"
 #include "tune/compensator_search.hpp"
 #include "tune/tuned_file.hpp"
@@ -306,7 +307,9 @@ int run_tune(const TuneArgs& a) {
     if (!edited.comments_kept)
       std::fprintf(stderr, "tune: %s could not be edited in place; written again from its data, without its comments\n",
                    a.config_path.c_str());
-    const std::string text = tuned_header(a, verified) + edited.text;
+    // Written beside another file than the one read: its relative file paths rebased (config/file_paths.hpp).
+    const std::string text =
+        tuned_header(a, verified) + config::rebase_file_paths(edited.text, plants.front().base().source, a.out_path).text;
     const config::Config check = config::parse_config(text, a.out_path);  // throws (exit 2) before writing
     if (!analysis::LoopModel(check).stable(check.controller.gain_ns_per_m, check.controller.polarity))
       throw std::runtime_error("the written configuration's loop is not stable: nothing written");

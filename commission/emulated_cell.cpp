@@ -215,7 +215,7 @@ MeasureOutcome measure_through_emulator(const std::string& cell_path, const std:
   {
     const PinnedToOneCpu pinned;
     pinned.pin(plant.pid());
-    o = measure(cell_path, out_dir, {"virtual"});
+    o = measure(cell_path, out_dir, {"virtual", {}, {}});
   }
   const int rc = plant.wait(kEmulatorEndS);
   if (rc != 0) {

@@ -13,6 +13,11 @@ namespace robodamp::commission {
 
 struct MeasureOptions {
   std::string clock;  // "", "wall" or "virtual" (default: the configuration's, virtual on the simulated plant)
+  // The robot's joint angles, deg, one per joint of the configuration's pose_schedule.model (empty: not
+  // stated). The simulated plant is the robot model at this pose; on hardware the robot stands there (the
+  // user moved it). Written to measurement.json for `pose fit --measurements` and the pose-indexed model.
+  std::vector<double> pose_deg;
+  std::string pose_name;
 };
 
 enum class MeasureStatus { kOk, kConfigError, kFailed, kTripped, kIncomplete, kWriteError };

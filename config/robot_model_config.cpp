@@ -1,5 +1,7 @@
 #include "config/robot_model_config.hpp"
 
+#include <algorithm>
+
 #include "config/yaml_reader.hpp"
 
 namespace robodamp::config {
@@ -59,6 +61,33 @@ std::optional<std::string> pose_problem(const RobotModelConfig& m, const std::ve
   return std::nullopt;
 }
 
+namespace {
+
+// The poses: list, each checked against the model's joints (when it has them).
+std::vector<RobotPoseConfig> read_poses(Diagnostics& d, MapReader& top, const RobotModelConfig& model, bool required) {
+  std::vector<RobotPoseConfig> out;
+  const YAML::Node poses = top.child("poses", required, "the poses, each {name, joints_deg: [one angle per joint]}");
+  for (std::size_t i = 0; poses.IsSequence() && i < poses.size(); ++i) {
+    const std::string key = "poses[" + std::to_string(i) + "]";
+    MapReader r(d, poses[i], key, poses.Mark());
+    RobotPoseConfig p;
+    p.name = r.text("name", "pose " + std::to_string(i + 1)).value_or("");
+    p.joints_deg = r.number_list("joints_deg", "deg").value_or(std::vector<double>{});
+    p.measured_f1_hz = r.number("measured_f1_hz", {"Hz", 0.0, 1e4, true}, 0.0);
+    p.predicted_f1_hz = r.number("predicted_f1_hz", {"Hz", 0.0, 1e4, true}, 0.0);
+    if (p.measured_f1_hz == 0.0) p.measured_f1_hz.reset();
+    if (p.predicted_f1_hz == 0.0) p.predicted_f1_hz.reset();
+    r.finish();
+    if (!model.joints.empty())
+      if (auto problem = pose_problem(model, p.joints_deg)) d.add(poses[i].Mark(), key + ".joints_deg", *problem);
+    out.push_back(std::move(p));
+  }
+  if (required && present(poses) && out.empty()) d.add(top.mark(), "poses", "is empty: list at least one pose");
+  return out;
+}
+
+}  // namespace
+
 RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::string& source_name) {
   Diagnostics d(source_name);
   const YAML::Node root = detail::load_top_map(d, yaml_text, "name, links, joints, head, poses");
@@ -78,25 +107,29 @@ RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::stri
     if (auto v = h.number("inertia_kgm2", {"kg m^2", 0.0, 1e4}, 0.0)) c.head_inertia_kgm2 = *v;
     h.finish();
   }
-  const YAML::Node poses = top.child("poses", false, "");
-  for (std::size_t i = 0; poses.IsSequence() && i < poses.size(); ++i) {
-    const std::string key = "poses[" + std::to_string(i) + "]";
-    MapReader r(d, poses[i], key, poses.Mark());
-    RobotPoseConfig p;
-    p.name = r.text("name", "pose " + std::to_string(i + 1)).value_or("");
-    p.joints_deg = r.number_list("joints_deg", "deg").value_or(std::vector<double>{});
-    p.measured_f1_hz = r.number("measured_f1_hz", {"Hz", 0.0, 1e4, true}, 0.0);
-    p.predicted_f1_hz = r.number("predicted_f1_hz", {"Hz", 0.0, 1e4, true}, 0.0);
-    if (p.measured_f1_hz == 0.0) p.measured_f1_hz.reset();
-    if (p.predicted_f1_hz == 0.0) p.predicted_f1_hz.reset();
-    r.finish();
-    if (!c.joints.empty())
-      if (auto problem = pose_problem(c, p.joints_deg)) d.add(poses[i].Mark(), key + ".joints_deg", *problem);
-    c.poses.push_back(std::move(p));
-  }
+  c.poses = read_poses(d, top, c, false);
   top.finish();
   if (!d.problems().empty()) throw ConfigError(d.problems());
   return c;
+}
+
+std::vector<RobotPoseConfig> parse_pose_list(const std::string& yaml_text, const std::string& source_name,
+                                             const RobotModelConfig& model) {
+  Diagnostics d(source_name);
+  const YAML::Node root = detail::load_top_map(d, yaml_text, "name, links, joints, head, poses");
+  MapReader top(d, root, "", root.Mark());
+  std::vector<RobotPoseConfig> poses = read_poses(d, top, model, true);
+  for (const char* other : {"name", "links", "joints", "head"}) (void)top.child(other, false, "");  // a model file's
+  top.finish();
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    if (std::find(names.begin(), names.end(), poses[i].name) != names.end())
+      d.add(root.Mark(), "poses[" + std::to_string(i) + "].name",
+            "'" + poses[i].name + "' names two poses: each pose's measurement goes to a directory of its name");
+    names.push_back(poses[i].name);
+  }
+  if (!d.problems().empty()) throw ConfigError(d.problems());
+  return poses;
 }
 
 RobotModelConfig load_robot_model(const std::string& path) {

@@ -44,6 +44,10 @@ struct RobotModelConfig {
 // Throws ConfigError holding every problem (key, value, unit, allowed range).
 [[nodiscard]] RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::string& source_name);
 [[nodiscard]] RobotModelConfig load_robot_model(const std::string& path);
+// The poses: list of a file (a robot model file, or one with only poses:), each checked against the
+// model's joints; names must differ. Throws ConfigError naming each pose and its problem.
+[[nodiscard]] std::vector<RobotPoseConfig> parse_pose_list(const std::string& yaml_text, const std::string& source_name,
+                                                           const RobotModelConfig& model);
 // A pose against the model's joints: the count and each joint's travel; nothing when it fits.
 [[nodiscard]] std::optional<std::string> pose_problem(const RobotModelConfig& m, const std::vector<double>& joints_deg);
 

@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "analysis/loop_model.hpp"
+#include "config/file_paths.hpp"
 #include "identify/actuator_discrete.hpp"
 #include "rt/recording.hpp"
 #include "sim_plant/sensor.hpp"
@@ -139,13 +140,13 @@ std::string compose_yaml(const CommissioningResult& r, int polarity) {
   root["robot"] = robot;
   root["controller"]["polarity"] = polarity;
   root["controller"]["match_freq_hz"] = num(r.dominant_mode_hz);
-  // Files the measured configuration names relative to itself stay reachable from anywhere.
-  if (root["parameter_sets"] && root["parameter_sets"].IsMap()) {
-    const fs::path base = fs::path(r.manifest.config_source).parent_path();
-    for (auto it = root["parameter_sets"].begin(); it != root["parameter_sets"].end(); ++it) {
-      const fs::path p = it->second.as<std::string>();
-      if (p.is_relative()) it->second = (base / p).lexically_normal().string();
-    }
+  // Files the measured configuration names relative to itself (the robot model, the job, the parameter
+  // sets, ...) stay reachable from wherever the identified configuration is written.
+  const fs::path base = fs::path(r.manifest.config_source).parent_path();
+  for (const auto& key : config::file_path_keys()) {
+    YAML::Node v = config::yaml_at(root, key);
+    if (!v.IsDefined() || !v.IsScalar() || v.Scalar().empty()) continue;
+    if (const fs::path p = v.Scalar(); p.is_relative()) v = (base / p).lexically_normal().string();
   }
   YAML::Emitter out;
   out.SetIndent(2);
@@ -260,6 +261,8 @@ json to_json(const MeasurementManifest& m) {
           {"locations", locs},
           {"sensor_location_id", m.sensor_location_id},
           {"actuator_location_id", m.actuator_location_id},
+          {"pose", m.pose_deg.empty() ? json(nullptr)
+                                      : json{{"name", m.pose_name}, {"joints_deg", m.pose_deg}, {"robot_model", m.robot_model}}},
           {"run", m.run}};
 }
 
@@ -287,6 +290,12 @@ MeasurementManifest read_manifest(const std::string& dir) {
     m.sensor_location_id = j.at("sensor_location_id");
     m.actuator_location_id = j.at("actuator_location_id");
     m.run = j.value("run", json::object());
+    if (j.contains("pose") && !j.at("pose").is_null()) {  // absent before robodamp measure --pose
+      const json& q = j.at("pose");
+      m.pose_deg = q.at("joints_deg").get<std::vector<double>>();
+      m.pose_name = q.value("name", "");
+      m.robot_model = q.value("robot_model", "");
+    }
     return m;
   } catch (const std::exception& e) {
     throw std::invalid_argument(path + ": " + e.what());

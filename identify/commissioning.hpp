@@ -30,6 +30,10 @@ struct MeasurementManifest {
   std::vector<std::pair<int, std::string>> locations;  // id, name
   int sensor_location_id{0}, actuator_location_id{0};
   nlohmann::json run;  // the run's summary (state, trips, saturation)
+  // The robot's joint angles during the measurement (robodamp measure --pose; empty: not stated) and the
+  // robot model file they refer to (the configuration's pose_schedule.model).
+  std::vector<double> pose_deg;
+  std::string pose_name, robot_model;
 };
 
 [[nodiscard]] nlohmann::json to_json(const MeasurementManifest& m);

@@ -5,6 +5,7 @@
 #include <nlopt.h>
 
 #include <functional>
+#include <optional>
 
 #include "config/number_range.hpp"
 #include "robot/robot_model.hpp"
@@ -85,11 +86,9 @@ double polish(const std::function<double(const std::vector<double>&)>& cost, std
   return before;
 }
 
-}  // namespace
-
-PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
-                         const PoseFitSettings& s) {
-  if (data.empty()) throw config::ConfigError({config::Problem{model.source, {}, "", "no measured FRF to fit"}});
+// Each pose's points in the fit band (thinned), weighted by their magnitude.
+std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
+                            const PoseFitSettings& s) {
   std::vector<Band> bands;
   for (const auto& d : data) {
     if (auto p = config::pose_problem(model, d.joints_deg))
@@ -115,6 +114,39 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
     for (const auto& h : b.h) b.w.push_back(std::abs(h) / peak);
     bands.push_back(std::move(b));
   }
+  return bands;
+}
+
+}  // namespace
+
+std::vector<double> model_errors(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
+                                 const PoseFitSettings& s) {
+  std::vector<double> out;
+  for (double e : pose_errors(model, data, fit_bands(model, data, s), s.direction)) out.push_back(std::sqrt(e));
+  return out;
+}
+
+std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::vector<MeasuredFrf>& data,
+                            const PoseFitSettings& s) {
+  std::vector<double> out;
+  for (const MeasuredFrf& d : data) {
+    double best = -1.0, at = 0.0;
+    const std::optional<PlanarChain> c = model ? std::optional<PlanarChain>(at_pose(*model, d.joints_deg)) : std::nullopt;
+    for (std::size_t i = 0; i < d.freq_hz.size(); ++i) {
+      const double f = d.freq_hz[i];
+      if (f < s.band_min_hz || f > s.band_max_hz) continue;
+      const double m = c ? std::abs(pick(c->tcp_frf_direct(f), s.direction)) : std::abs(d.receptance_m_per_n[i]);
+      if (m > best) best = m, at = f;
+    }
+    out.push_back(at);
+  }
+  return out;
+}
+
+PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
+                         const PoseFitSettings& s) {
+  if (data.empty()) throw config::ConfigError({config::Problem{model.source, {}, "", "no measured FRF to fit"}});
+  const std::vector<Band> bands = fit_bands(model, data, s);
   const std::size_t n = model.joints.size();
   std::vector<double> lo(n, std::log10(s.stiffness_min_nm_per_rad)), hi(n, std::log10(s.stiffness_max_nm_per_rad));
   if (s.fit_damping) lo.insert(lo.end(), n, s.damping_min), hi.insert(hi.end(), n, s.damping_max);

@@ -52,6 +52,17 @@ struct PoseFitResult {
   int evaluations{0};
 };
 
+// Each pose's weighted relative RMS error of `model` against the data (the fit's measure, for poses held
+// out of it). Throws as fit_joints.
+[[nodiscard]] std::vector<double> model_errors(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
+                                               const PoseFitSettings& s);
+
+// The frequency of each pose's largest receptance in the fit band, on the measurement's own frequencies:
+// of the measurement (model = nullptr) or of the model's TCP FRF there (the first mode a matched
+// compensator aims at, compared like for like).
+[[nodiscard]] std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::vector<MeasuredFrf>& data,
+                                          const PoseFitSettings& s);
+
 // Throws config::ConfigError for a pose outside the joints' travel or a measurement without points in the band.
 [[nodiscard]] PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
                                        const PoseFitSettings& s);
