@@ -49,11 +49,13 @@ int driving_point(const MeasurementManifest& m, int location_id, const std::stri
   return m.locations.front().first;
 }
 
-double peak_hz(const robot::MeasuredFrf& f) {
-  std::size_t k = 0;
-  for (std::size_t i = 1; i < f.freq_hz.size(); ++i)
-    if (std::abs(f.receptance_m_per_n[i]) > std::abs(f.receptance_m_per_n[k])) k = i;
-  return f.freq_hz.empty() ? 0.0 : f.freq_hz[k];
+// The largest receptance's frequency inside [lo, hi] (below the band an impact FRF is noise and drift).
+double peak_hz(const robot::MeasuredFrf& f, double lo_hz, double hi_hz) {
+  double best = -1.0, at = 0.0;
+  for (std::size_t i = 0; i < f.freq_hz.size(); ++i)
+    if (f.freq_hz[i] >= lo_hz && f.freq_hz[i] <= hi_hz && std::abs(f.receptance_m_per_n[i]) > best)
+      best = std::abs(f.receptance_m_per_n[i]), at = f.freq_hz[i];
+  return at;
 }
 
 bool same_pose(const std::vector<double>& a, const std::vector<double>& b) {
@@ -70,8 +72,8 @@ void check_consistent(const PoseMeasurements& r) {
       if (a.name == b.name)
         throw std::invalid_argument(r.dirs[i] + " and " + r.dirs[k] + " both name the pose '" + a.name + "'");
       if (!same_pose(a.joints_deg, b.joints_deg)) continue;
-      const double f = std::max(peak_hz(a), peak_hz(b));
-      const double d = frf_difference(a, b, 0.5 * f, 2.0 * f);
+      const double f = std::max(peak_hz(a, r.band_min_hz, r.band_max_hz), peak_hz(b, r.band_min_hz, r.band_max_hz));
+      const double d = frf_difference(a, b, std::max(r.band_min_hz, 0.5 * f), std::min(r.band_max_hz, 2.0 * f));
       if (d > 0.2)
         throw std::invalid_argument(r.dirs[i] + " and " + r.dirs[k] + " were measured at the same pose " +
                                     config::describe_pose(a.joints_deg) + " and their FRFs differ by " +
@@ -127,6 +129,7 @@ PoseMeasurements read_pose_measurements(const std::vector<std::string>& dirs, in
     if (r.dirs.size() == 1) {
       r.robot_model = m.robot_model;
       const config::Config measured = config::parse_config(m.config_text, m.config_source);
+      r.band_min_hz = measured.analysis.band_min_hz, r.band_max_hz = measured.analysis.band_max_hz;
       if (measured.pose_schedule) r.direction = measured.pose_schedule->axis == 0 ? robot::FrfDirection::kXX : robot::FrfDirection::kYY;
     }
     else if (m.robot_model != r.robot_model)

@@ -15,6 +15,7 @@ struct PoseMeasurements {
   std::vector<std::string> dirs;         // the measurement directory of each
   std::string robot_model;               // the model file the joint angles refer to (the first's)
   robot::FrfDirection direction{robot::FrfDirection::kYY};  // the measured configuration's pose_schedule.axis
+  double band_min_hz{5.0}, band_max_hz{100.0};               // its analysis band: where the FRFs are trusted
 };
 
 // dirs: `measure --pose` directories (measurement.json) or `measure --poses` directories (poses.json: all
@@ -22,7 +23,7 @@ struct PoseMeasurements {
 // the first. Throws std::invalid_argument naming the directory and the reason: no measurement.json, no
 // joint angles in it, a missing FRF, two measurements naming one pose, or two at the same pose (every joint
 // within 0.5 deg) whose FRFs disagree by more than 20 % (weighted relative RMS over 0.5-2x the larger
-// peak's frequency): contradicting data the model cannot fit both ways.
+// peak's frequency, inside the analysis band): contradicting data the model cannot fit both ways.
 [[nodiscard]] PoseMeasurements read_pose_measurements(const std::vector<std::string>& dirs, int location_id = 0);
 
 // The weighted relative RMS difference of two receptances on a's frequencies (b interpolated), over

@@ -1,0 +1,173 @@
+// Commissioning across the workspace (docs/pose_dynamics.md, "Measuring across the workspace"): `measure
+// --poses` on a robot no preset describes, `identify all` on one pose's directory written elsewhere, `pose
+// fit --measurements --hold-out` recovering the joints from the measurements, and the refusals.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "config/config.hpp"
+#include "config/file_paths.hpp"
+#include "hil_files.hpp"
+#include "test_util.hpp"
+
+namespace robodamp {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using test::Child;
+
+const std::string kSource = ROBODAMP_SOURCE_DIR;
+const std::string kNominal = kSource + "/config/robots/planar_three_link.yaml";
+
+struct Outcome {
+  int status;
+  std::string log;
+};
+Outcome robodamp(const std::vector<std::string>& args, const std::string& log) {
+  Child c(args, log);
+  const int status = c.wait();
+  return {status, test::read_file(log)};
+}
+
+// A robot no preset describes: the planar model with joint 2 40 % stiffer and joint 3 27 % softer, in a
+// directory of its own with a cell whose pose_schedule.model names it relative to the cell's file.
+struct Workspace {
+  std::string dir, cell, poses;
+};
+Workspace true_robot_cell(const std::string& name, double k2 = 5.6e5, double k3 = 2.9e3) {
+  Workspace w;
+  w.dir = ::testing::TempDir() + "/" + name;
+  fs::remove_all(w.dir);
+  fs::create_directories(w.dir);
+  std::string robot = test::read_file(kNominal);
+  test::replace_all(robot, "stiffness_nm_per_rad: 4.05e5", "stiffness_nm_per_rad: " + std::to_string(k2));
+  test::replace_all(robot, "stiffness_nm_per_rad: 3.99e3", "stiffness_nm_per_rad: " + std::to_string(k3));
+  std::ofstream(w.dir + "/true_robot.yaml") << robot;
+  std::string cell = test::read_file(kSource + "/config/presets/pose_scheduled_c2.yaml");
+  test::replace_all(cell, "model: ../robots/planar_three_link.yaml", "model: true_robot.yaml");
+  w.cell = w.dir + "/cell.yaml";
+  std::ofstream(w.cell) << cell;
+  // Written as a person would: a comment, block and flow styles mixed.
+  w.poses = w.dir + "/poses.yaml";
+  std::ofstream(w.poses) << "# where the robot was moved for the measurements\nposes:\n- name: p1\n  joints_deg: [-120, 130, -15]\n"
+                            "- {name: p2, joints_deg: [-100, 110, -20]}\n- {name: p3, joints_deg: [-85, 95, 10]}\n"
+                            "- {name: p4, joints_deg: [-110, 60, 30]}\n- {name: p5, joints_deg: [-95, 140, -40]}\n"
+                            "- {name: p6, joints_deg: [-70, 80, 0]}\n";
+  return w;
+}
+
+TEST(PoseMeasurements, SixPosesMeasuredTheFittedModelFindsTheJointsAndPredictsTheHeldOutPeaks) {
+  const Workspace w = true_robot_cell("pose_measurements");
+  const std::string m = w.dir + "/measured";
+  const Outcome measure = robodamp({"measure", "--config", w.cell, "--poses", w.poses, "--out", m}, w.dir + "/measure.log");
+  ASSERT_EQ(measure.status, 0) << measure.log;
+  const json index = json::parse(test::read_file(m + "/poses.json"));
+  ASSERT_EQ(index["poses"].size(), 6U);
+  for (const auto& p : index["poses"]) {
+    EXPECT_EQ(p["status"], 0) << p.dump();
+    const json manifest = json::parse(test::read_file(m + "/" + p["dir"].get<std::string>() + "/measurement.json"));
+    EXPECT_EQ(manifest["pose"]["joints_deg"], p["joints_deg"]);
+    EXPECT_EQ(manifest["pose"]["name"], p["name"]);
+    EXPECT_EQ(fs::path(manifest["pose"]["robot_model"].get<std::string>()).filename(), "true_robot.yaml");
+  }
+  // identify all's configuration, written in another directory, still finds the robot model.
+  const std::string identified = ::testing::TempDir() + "/pose_measurements_p1.yaml";
+  const Outcome id = robodamp({"identify", "all", "--in", m + "/p1", "--out", identified}, w.dir + "/identify.log");
+  ASSERT_EQ(id.status, 0) << id.log;
+  const config::Config c = config::load_config_file(identified);
+  ASSERT_TRUE(c.pose_schedule.has_value());
+  EXPECT_TRUE(fs::equivalent(c.pose_schedule->model_resolved, w.dir + "/true_robot.yaml"));
+
+  const std::string fit = w.dir + "/fit.json";
+  const Outcome f = robodamp({"pose", "fit", "--model", kNominal, "--measurements", m, "--hold-out", "p4", "p5", "p6",
+                          "--json", fit},
+                         w.dir + "/fit.log");
+  ASSERT_EQ(f.status, 0) << f.log;
+  const json r = json::parse(test::read_file(fit));
+  EXPECT_EQ(r["direction"], "xx");  // the cell's pose_schedule.axis
+  // The joints the measurements see (the first joint barely moves the TCP along x: not asserted).
+  EXPECT_NEAR(r["joints"][1]["stiffness_nm_per_rad"].get<double>() / 5.6e5, 1.0, 0.05) << f.log;
+  EXPECT_NEAR(r["joints"][2]["stiffness_nm_per_rad"].get<double>() / 2.9e3, 1.0, 0.05) << f.log;
+  int held = 0;
+  for (const auto& p : r["poses"]) {
+    const double measured = p["peak_hz"], nominal = p["nominal_peak_hz"], fitted = p["fitted_peak_hz"];
+    EXPECT_LT(p["error_pct"].get<double>(), p["nominal_error_pct"].get<double>()) << p.dump();
+    if (p["role"] != "held out") continue;
+    ++held;
+    EXPECT_NEAR(fitted, measured, 0.3) << p.dump();
+    EXPECT_LT(std::abs(fitted - measured), std::abs(nominal - measured) + 0.05) << p.dump();
+  }
+  EXPECT_EQ(held, 3);
+}
+
+TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason) {
+  const Workspace w = true_robot_cell("pose_refusals");
+  // A pose outside joint 2's travel (0-170 deg).
+  Outcome r = robodamp({"measure", "--config", w.cell, "--pose", "-100", "175", "0", "--out", w.dir + "/out"}, w.dir + "/a.log");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.log.find("[-100, 175, 0] deg: joint 2 = 175 deg is out of range"), std::string::npos) << r.log;
+  EXPECT_FALSE(fs::exists(w.dir + "/out/measurement.json"));
+  // A poses file with a wrong count and a repeated name: nothing measured.
+  std::ofstream(w.dir + "/bad_poses.yaml") << "poses:\n  - {name: a, joints_deg: [-100, 100, 0]}\n"
+                                              "  - {name: b, joints_deg: [-100, 100, 0, 5]}\n  - {name: a, joints_deg: [-90, 90, 0]}\n";
+  r = robodamp({"measure", "--config", w.cell, "--poses", w.dir + "/bad_poses.yaml", "--out", w.dir + "/many"}, w.dir + "/b.log");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.log.find("poses[1].joints_deg: a pose needs 3 joint angles"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("poses[2].name: 'a' names two poses"), std::string::npos) << r.log;
+  EXPECT_FALSE(fs::exists(w.dir + "/many/a"));
+  // A measurement without joint angles.
+  r = robodamp({"measure", "--config", kSource + "/config/presets/horizontal_c2.yaml", "--out", w.dir + "/plain"}, w.dir + "/c.log");
+  ASSERT_EQ(r.status, 0) << r.log;
+  r = robodamp({"pose", "fit", "--measurements", w.dir + "/plain"}, w.dir + "/d.log");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.log.find(w.dir + "/plain: its measurement.json holds no joint angles"), std::string::npos) << r.log;
+  // Two measurements at one pose that contradict each other: the same pose on this robot and on one
+  // whose joint 2 is half as stiff.
+  const Workspace soft = true_robot_cell("pose_refusals_soft", 2.8e5);
+  const std::vector<std::string> at{"--pose", "-100", "110", "-20"};
+  std::vector<std::string> a1{"measure", "--config", w.cell, "--out", w.dir + "/here"}, a2{"measure", "--config", soft.cell, "--out", soft.dir + "/there"};
+  a1.insert(a1.end(), at.begin(), at.end());
+  a2.insert(a2.end(), at.begin(), at.end());
+  ASSERT_EQ(robodamp(a1, w.dir + "/e.log").status, 0);
+  ASSERT_EQ(robodamp(a2, w.dir + "/f.log").status, 0);
+  // Measured against two robot model files: refused as such first.
+  r = robodamp({"pose", "fit", "--measurements", w.dir + "/here", soft.dir + "/there"}, w.dir + "/g.log");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.log.find("one model's joints, one set of measurements"), std::string::npos) << r.log;
+  // As if both had named one model file (the soft robot's measurement relabelled): the contradiction is
+  // the data's.
+  fs::rename(soft.dir + "/there", soft.dir + "/there_soft");
+  std::string manifest = test::read_file(soft.dir + "/there_soft/measurement.json");
+  auto model_of = [](const std::string& dir) { return (fs::path(dir) / "true_robot.yaml").lexically_normal().string(); };
+  test::replace_all(manifest, model_of(soft.dir), model_of(w.dir));
+  std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
+  r = robodamp({"pose", "fit", "--measurements", w.dir + "/here", soft.dir + "/there_soft"}, w.dir + "/h.log");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.log.find("were measured at the same pose [-100, 110, -20] deg and their FRFs differ by"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("contradicting data"), std::string::npos) << r.log;
+}
+
+// A configuration moved to another directory names the same files: relative paths rebased, absolute ones
+// and the rest of the text (comments, flow style) kept.
+TEST(ConfigFilePaths, AMovedConfigurationStillNamesTheSameFiles) {
+  const std::string text =
+      "# the cell\npose_schedule: {model: ../robots/r.yaml, axis: x}  # flow\nspindle:\n  job: /abs/job.yaml\n"
+      "parameter_sets:\n  horizontal: sets/h.yaml\n";
+  const config::EditedYaml e = config::rebase_file_paths(text, "/a/b/cells/cell.yaml", "/a/out/deep/cell.yaml");
+  EXPECT_TRUE(e.comments_kept);
+  EXPECT_NE(e.text.find("# the cell"), std::string::npos) << e.text;
+  EXPECT_NE(e.text.find("model: ../../b/robots/r.yaml"), std::string::npos) << e.text;
+  EXPECT_NE(e.text.find("job: /abs/job.yaml"), std::string::npos) << e.text;
+  EXPECT_NE(e.text.find("horizontal: ../../b/cells/sets/h.yaml"), std::string::npos) << e.text;
+  EXPECT_EQ(config::rebase_file_paths(text, "/a/b/cells/cell.yaml", "/a/b/cells/other.yaml").text, text);
+}
+
+}  // namespace
+}  // namespace robodamp
