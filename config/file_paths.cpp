@@ -25,8 +25,9 @@ const std::vector<std::vector<YamlPathItem>>& file_path_keys() {
 }
 
 EditedYaml rebase_file_paths(const std::string& text, const std::string& from_source, const std::string& to_path) {
-  const fs::path from_dir = fs::absolute(fs::path(from_source).parent_path()).lexically_normal();
-  const fs::path to_dir = fs::absolute(fs::path(to_path).parent_path()).lexically_normal();
+  // absolute() first: a bare file name's parent is empty, which absolute() refuses.
+  const fs::path from_dir = fs::absolute(from_source).lexically_normal().parent_path();
+  const fs::path to_dir = fs::absolute(to_path).lexically_normal().parent_path();
   const YAML::Node root = YAML::Load(text);
   std::vector<YamlEdit> edits;
   for (const auto& key : file_path_keys()) {

@@ -167,6 +167,11 @@ TEST(ConfigFilePaths, AMovedConfigurationStillNamesTheSameFiles) {
   EXPECT_NE(e.text.find("job: /abs/job.yaml"), std::string::npos) << e.text;
   EXPECT_NE(e.text.find("horizontal: ../../b/cells/sets/h.yaml"), std::string::npos) << e.text;
   EXPECT_EQ(config::rebase_file_paths(text, "/a/b/cells/cell.yaml", "/a/b/cells/other.yaml").text, text);
+  // Bare file names (tune --out tuned.yaml in the working directory) are in the working directory.
+  const std::string cwd = fs::current_path().lexically_normal().string();
+  EXPECT_NE(config::rebase_file_paths(text, "cell.yaml", cwd + "/sub/tuned.yaml").text.find("model: ../../robots/r.yaml"),
+            std::string::npos);
+  EXPECT_EQ(config::rebase_file_paths(text, "cell.yaml", "tuned.yaml").text, text);
 }
 
 }  // namespace
