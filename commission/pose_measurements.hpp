@@ -2,8 +2,8 @@
 // workspace"): the poses of a file (a robot model file's poses:, or a file holding only poses:), each
 // checked against the configuration's robot model before anything runs, then one `robodamp measure` per
 // pose into DIR/<pose name>/ with its joint angles in measurement.json, and DIR/poses.json indexing them.
-// The simulated plant stands at each pose in turn; on hardware the user (or the HIL emulator's pose
-// trajectory) moves the robot between the measurements.
+// The simulated plant stands at each pose in turn. On hardware (a `can` section) --poses is refused: the
+// user moves the robot and runs `measure --pose` at each pose (the measurement cannot wait for a move).
 #pragma once
 
 #include <functional>
