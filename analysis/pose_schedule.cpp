@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "analysis/loop_model.hpp"
+#include "analysis/mode_improvement.hpp"
 #include "config/number_range.hpp"
 #include "control/controller.hpp"
 #include "robot/robot_model.hpp"
@@ -110,6 +111,7 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
   set.k_max_ns_per_m = std::numeric_limits<double>::infinity();
   set.dominant_min_hz = std::numeric_limits<double>::infinity();
   set.dominant_max_hz = 0.0;
+  set.worst_mode_improvement_pct = std::numeric_limits<double>::infinity();
   for (const auto& q : grid_over(s.regions[i], s.grid_points)) {
     const PoseModes pm = pose_modes(model, q, s.axis, s.modes);
     set.dominant_min_hz = std::min(set.dominant_min_hz, pm.dominant_hz());
@@ -129,6 +131,9 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
       throw region_error(cfg, i, "has no set with margin: " + where + " K = " + fmt(set.gain_ns_per_m) +
                                      " N s/m is above supervision.max_gain_fraction x K_max = " + fmt(fraction) + " x " +
                                      fmt(k_max) + " N s/m: split the region or lower its gain_ns_per_m");
+    for (const ModeImprovement& mi : mode_improvements(m, set.gain_ns_per_m, set.polarity))
+      if (mi.improvement_pct < set.worst_mode_improvement_pct)
+        set.worst_mode_improvement_pct = mi.improvement_pct, set.worst_mode_hz = mi.freq_hz, set.worst_mode_pose_deg = q;
   }
   set.improvement_centre_pct = driving_point_improvement(LoopModel(set.config), set.gain_ns_per_m, set.polarity);
 }

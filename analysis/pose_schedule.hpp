@@ -46,6 +46,11 @@ struct RegionSet {
   std::vector<double> k_max_pose_deg; // where
   double dominant_min_hz{0.0}, dominant_max_hz{0.0};  // over the grid
   double improvement_centre_pct{0.0}; // predicted driving-point improvement at the centre (discrete loop)
+  // The smallest improvement of any robot mode's peak over the grid (analysis/mode_improvement.hpp):
+  // negative where the set makes a mode worse than open loop; where and which mode.
+  double worst_mode_improvement_pct{0.0};
+  double worst_mode_hz{0.0};
+  std::vector<double> worst_mode_pose_deg;
   int grid_poses{0};
 };
 

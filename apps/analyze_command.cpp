@@ -288,7 +288,10 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
                        {"k_max_pose_deg", r.k_max_pose_deg},
                        {"centre_gain_margin_db", optional_number(a.margins.gain_margin_db)},
                        {"centre_phase_margin_deg", optional_number(a.margins.phase_margin_deg)},
-                       {"improvement_centre_pct", r.improvement_centre_pct}});
+                       {"improvement_centre_pct", r.improvement_centre_pct},
+                       {"worst_mode_improvement_pct", r.worst_mode_improvement_pct},
+                       {"worst_mode_hz", r.worst_mode_hz},
+                       {"worst_mode_pose_deg", r.worst_mode_pose_deg}});
   }
   const json report = {{"config", cfg.source}, {"model", ps.model.source}, {"axis", cfg.pose_schedule->axis ? "y" : "x"},
                        {"regions", regions}};
@@ -309,6 +312,14 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
   }
   std::printf("K_max is the smallest over each region's %d^%zu grid; margins and improvement at its centre\n",
               cfg.pose_schedule->grid_points, cfg.pose_schedule->joints());
+  std::printf("the worst mode over each region's grid (the smallest improvement of a robot mode's peak, %s within +-10 %%):\n",
+              cfg.robot.frfs.empty() ? "-" : cfg.robot.frfs.front().name.c_str());
+  for (const auto& r : regions) {
+    const double w = r["worst_mode_improvement_pct"];
+    std::printf("  %-12s %+7.1f %% at %.2f Hz at %s%s\n", r["name"].get<std::string>().c_str(), w, r["worst_mode_hz"].get<double>(),
+                config::describe_pose(r["worst_mode_pose_deg"].get<std::vector<double>>()).c_str(),
+                w < 0.0 ? ": worse than open loop there" : "");
+  }
   return 0;
 }
 

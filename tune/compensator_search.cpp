@@ -371,26 +371,7 @@ std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::
 }
 
 std::vector<ModeImprovement> Evaluator::mode_improvements(const config::Config& cfg) const {
-  std::vector<ModeImprovement> out;
-  const analysis::LoopModel m(cfg);
-  const double k = cfg.controller.gain_ns_per_m;
-  const int pol = cfg.controller.polarity;
-  if (cfg.robot.frfs.empty() || !m.stable(k, pol)) return out;
-  const auto& frf = cfg.robot.frfs.front();
-  const std::size_t g = m.plant().index_of(frf.response_location), h = m.plant().index_of(frf.excitation_location);
-  for (const auto& mode : frf.modes) {
-    ModeImprovement mi;
-    mi.freq_hz = mode.natural_freq_hz;
-    for (double f = 0.9 * mi.freq_hz; f <= 1.1 * mi.freq_hz; f += 0.005 * mi.freq_hz) {
-      const analysis::PlantResponse p = m.plant_response(f);
-      mi.open_peak_m_per_n = std::max(mi.open_peak_m_per_n, std::abs(m.open_discrete(p, g, h)));
-      mi.closed_peak_m_per_n =
-          std::max(mi.closed_peak_m_per_n, std::abs(m.closed_discrete(p, m.chain_filters_digital(f), g, h, k, pol)));
-    }
-    mi.improvement_pct = 100.0 * (mi.open_peak_m_per_n / mi.closed_peak_m_per_n - 1.0);
-    out.push_back(mi);
-  }
-  return out;
+  return analysis::mode_improvements(analysis::LoopModel(cfg), cfg.controller.gain_ns_per_m, cfg.controller.polarity);
 }
 
 namespace {

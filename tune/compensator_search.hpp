@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/mode_improvement.hpp"
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
 #include "milling/lobes.hpp"
@@ -99,12 +100,7 @@ struct TuneResult {
   std::vector<Evaluation> history;  // every evaluation, in order
 };
 
-// The receptance peak near one robot mode (+-10 %), open and closed loop.
-struct ModeImprovement {
-  double freq_hz{0.0};
-  double open_peak_m_per_n{0.0}, closed_peak_m_per_n{0.0};
-  double improvement_pct{0.0};  // open / closed - 1
-};
+using analysis::ModeImprovement;  // the receptance peak near one robot mode, open and closed loop
 
 // One candidate, evaluated on one plant (a configuration: mounting, robot modes, chain). Never throws for
 // a bad candidate (it is infeasible with the reason).

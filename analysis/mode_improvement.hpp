@@ -1,0 +1,22 @@
+// How much the closed loop lowers the receptance's peak near each robot mode: the first configured FRF
+// (the TCP's on the presets), the discrete loop, the largest |H| within +-10 % of each mode's frequency,
+// open against closed. Negative: the loop makes that mode worse. Used by `tune`'s report and by the pose
+// schedule proposal (a set that makes a mode worse than open loop does not serve that pose).
+#pragma once
+
+#include <vector>
+
+#include "analysis/loop_model.hpp"
+
+namespace robodamp::analysis {
+
+struct ModeImprovement {
+  double freq_hz{0.0};
+  double open_peak_m_per_n{0.0}, closed_peak_m_per_n{0.0};
+  double improvement_pct{0.0};  // open / closed - 1
+};
+
+// Empty when the configuration has no FRF or the loop is unstable at this gain and polarity.
+[[nodiscard]] std::vector<ModeImprovement> mode_improvements(const LoopModel& m, double gain_ns_per_m, int polarity);
+
+}  // namespace robodamp::analysis
