@@ -44,7 +44,7 @@ json candidate_json(const tune::Candidate& c) {
 
 json evaluation_json(const tune::Evaluation& e) {
   auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  return {{"candidate", candidate_json(e.candidate)},   {"stable", e.stable},
+  json j = {{"candidate", candidate_json(e.candidate)},   {"stable", e.stable},
           {"gain_margin_db", finite(e.gain_margin_db)}, {"phase_margin_deg", finite(e.phase_margin_deg)},
           {"delay_margin_ms", finite(e.delay_margin_ms)}, {"k_max_ns_per_m", finite(e.k_max_ns_per_m)},
           {"worst_mode_phase_deg", e.worst_mode_phase_deg},
@@ -59,6 +59,9 @@ json evaluation_json(const tune::Evaluation& e) {
           {"quiet_command_rms_v", e.quiet_command_rms_v},
           {"feasible", e.feasible()},                   {"binding", e.binding},
           {"plant", e.plant}};
+  if (!std::isnan(e.worst_mode_improvement_pct))  // --no-worse-mode only
+    j["worst_mode_improvement_pct"] = finite(e.worst_mode_improvement_pct);
+  return j;
 }
 
 json evaluation_json_with_plants(const tune::Evaluation& e) {
@@ -93,6 +96,7 @@ std::string command_line(const TuneArgs& a) {
   if (s.local_evaluations != d.local_evaluations) c += " --polish " + std::to_string(s.local_evaluations);
   if (s.seed != d.seed) c += " --seed " + std::to_string(s.seed);
   if (s.restarts != d.restarts) c += " --restarts " + std::to_string(s.restarts);
+  if (s.no_worse_mode) c += " --no-worse-mode";
   return c + " --out " + a.out_path;
 }
 
@@ -355,6 +359,8 @@ void register_tune(Registry& r) {
   r.whole_number(sub, "--seed", a->settings.seed, {"(seed)", 0, 999999}, "The global search's seed");
   r.whole_number(sub, "--restarts", a->settings.restarts, {"(searches)", 1, 100},
                  "Whole searches with seeds --seed, --seed + 1, ...; the best is kept");
+  sub->add_flag("--no-worse-mode", a->settings.no_worse_mode,
+                "A constraint: no robot mode's receptance peak (first FRF, within +-10 %) worse than open loop on any plant");
 }
 
 }  // namespace robodamp::apps

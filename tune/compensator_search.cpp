@@ -224,6 +224,12 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   for (const auto& mode : analysis::mode_phases(*m, k, cand.polarity))
     e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
   add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
+  if (s_.no_worse_mode) {
+    e.worst_mode_improvement_pct = kInf;
+    for (const auto& mi : analysis::mode_improvements(*m, k, cand.polarity))
+      e.worst_mode_improvement_pct = std::min(e.worst_mode_improvement_pct, mi.improvement_pct);
+    add_violation(e, -e.worst_mode_improvement_pct / 100.0, "a mode's peak worse than open loop");
+  }
   if (const double floor_v = cfg.supervision.instability_floor_v; floor_v > 0.0) {
     e.quiet_command_rms_v = analysis::quiet_command(*m, k, cand.polarity).rms_v;
     add_violation(e, e.quiet_command_rms_v / (kQuietShareOfFloor * floor_v) - 1.0,
@@ -318,7 +324,8 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
   if (!w.binding.empty()) w.binding = w.plant + ": " + w.binding;
   // Margins and depths: the smallest over the plants; peaks and shares of a limit: the largest.
   constexpr double Evaluation::*kMargins[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
-                                             &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m};
+                                             &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
+                                             &Evaluation::worst_mode_improvement_pct};
   constexpr double Evaluation::*kDepths[] = {&Evaluation::min_depth_mm, &Evaluation::depth_at_speed_mm,
                                             &Evaluation::floor_ratio, &Evaluation::accurate_min_mm,
                                             &Evaluation::open_minima_ratio};

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -64,6 +65,9 @@ struct TuneSettings {
   int local_evaluations{120};
   int seed{1};
   int restarts{1};  // whole searches with seeds seed, seed + 1, ...; the best kept (the search is not global)
+  // No robot mode's receptance peak worse than open loop (analysis/mode_improvement.hpp) on any plant: a
+  // constraint when set (tune --no-worse-mode; off by default, the presets' tunings predate it).
+  bool no_worse_mode{false};
 };
 
 struct Evaluation {
@@ -72,6 +76,8 @@ struct Evaluation {
   double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
   double k_max_ns_per_m{0.0};
   double worst_mode_phase_deg{0.0};  // the largest |phase of -F / v| over the loop's modes (< 90: all damped)
+  // With no_worse_mode: the smallest improvement of a mode's peak; NaN when not asked for.
+  double worst_mode_improvement_pct{std::numeric_limits<double>::quiet_NaN()};
   double min_depth_mm{0.0};      // with a job: the damped lobes' minimum (zero-order: it steers the search;
                                  // tune/verification.hpp gives the verified one)
   double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (sampled-loop SDM)
