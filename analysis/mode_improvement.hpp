@@ -1,7 +1,7 @@
 // How much the closed loop lowers the receptance's peak near each robot mode: the first configured FRF
 // (the TCP's on the presets), the discrete loop, the largest |H| within +-10 % of each mode's frequency,
-// open against closed. Negative: the loop makes that mode worse. Used by `tune`'s report and by the pose
-// schedule proposal (a set that makes a mode worse than open loop does not serve that pose).
+// open against closed. Negative: the loop makes that mode worse. Used by `tune`'s report and its
+// --no-worse-mode constraint, and by the pose schedule's check of each region's worst mode.
 #pragma once
 
 #include <vector>

@@ -4,13 +4,14 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
 #include "analysis/modal_test.hpp"
 #include "commission/modal_test_hook.hpp"
-#include "rt/signals.hpp"
 #include "config/robot_model_config.hpp"
+#include "rt/signals.hpp"
 #include "runtime/cell.hpp"
 
 namespace robodamp::commission {
@@ -67,14 +68,12 @@ double chirp_active_share(const std::vector<rt::TelemetryFrame>& frames, const a
   return in == 0 ? 0.0 : static_cast<double>(active) / static_cast<double>(in);
 }
 
-using Status = std::string;  // empty: fine
-
 // --pose: the joints against the configuration's robot model (count, travel); the cell stands there with
 // the pose schedule off (the gain is 0: no set to choose, and a pose outside the scheduled workspace is
-// worth measuring).
-Status apply_pose(const config::Config& cfg, const MeasureOptions& opt, runtime::CellOptions& o,
-                  identify::MeasurementManifest& m) {
-  if (opt.pose_deg.empty()) return {};
+// worth measuring). The problem, if the pose is refused.
+std::optional<std::string> apply_pose(const config::Config& cfg, const MeasureOptions& opt, runtime::CellOptions& o,
+                                      identify::MeasurementManifest& m) {
+  if (opt.pose_deg.empty()) return std::nullopt;
   const std::string pose = config::describe_pose(opt.pose_deg);
   if (!cfg.pose_schedule)
     return "--pose " + pose + ": " + cfg.source + " has no pose_schedule.model, the robot model whose joints the pose names";
@@ -85,7 +84,7 @@ Status apply_pose(const config::Config& cfg, const MeasureOptions& opt, runtime:
   m.pose_deg = opt.pose_deg;
   m.pose_name = opt.pose_name;
   m.robot_model = fs::absolute(cfg.pose_schedule->model_resolved).lexically_normal().string();
-  return {};
+  return std::nullopt;
 }
 
 }  // namespace
@@ -118,9 +117,9 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
   else if (!cfg.can) o.clock = config::ClockKind::kVirtual;  // the simulated plant: nothing to pace
   o.record_path = (fs::path(out_dir) / identify::kRecordingName).string();
   o.keep_frames = true;
-  if (Status bad = apply_pose(cfg, opt, o, out.manifest); !bad.empty()) {
+  if (const auto refused = apply_pose(cfg, opt, o, out.manifest)) {
     out.status = MeasureStatus::kConfigError;
-    out.message = bad;
+    out.message = *refused;
     return out;
   }
   o.chirp = {true, plan.chirp_start_s, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz,

@@ -190,7 +190,7 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
     for (const auto* kk : converged) var += ((*kk)[j] - mean) * ((*kk)[j] - mean);
     r.stiffness_spread_pct.push_back(100.0 * std::sqrt(var / static_cast<double>(converged.size())) / mean);
   }
-  for (double e : pose_errors(r.fitted, data, bands, s.direction)) r.pose_error.push_back(std::sqrt(e));
+  r.pose_error = model_errors(r.fitted, data, s);
   return r;
 }
 

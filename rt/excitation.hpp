@@ -39,6 +39,7 @@ class ExcitationClock {
     t_s_ += dt_s;
     return v;
   }
+  [[nodiscard]] const PeriodicChirp& chirp() const noexcept { return chirp_; }
 
  private:
   PeriodicChirp chirp_;

@@ -62,8 +62,8 @@ class Loop {
   void schedule(std::uint64_t tick, const OperatorCommand& c);
   // Before run(): a command source added to the controller's (the commissioning chirp), on the clock of
   // the measured dt from this run's first tick.
-  void set_excitation(const PeriodicChirp& chirp) noexcept { chirp_ = chirp, excitation_ = ExcitationClock(chirp); }
-  [[nodiscard]] const PeriodicChirp& excitation() const noexcept { return chirp_; }
+  void set_excitation(const PeriodicChirp& chirp) noexcept { excitation_ = ExcitationClock(chirp); }
+  [[nodiscard]] const PeriodicChirp& excitation() const noexcept { return excitation_.chirp(); }
   // Before run(): the policy asked each tick when no scripted command is due (arming); nullptr = none.
   void set_policy(TickPolicy* policy) noexcept { policy_ = policy; }
   // From any thread: end the run as if its duration were over (disarm, ramp, return).
@@ -117,7 +117,6 @@ class Loop {
   std::atomic<bool> stop_{false};
   const std::atomic<int>* shutdown_;
   TickPolicy* policy_{nullptr};
-  PeriodicChirp chirp_{};
   ExcitationClock excitation_{PeriodicChirp{}};
   std::unique_ptr<LoopStats> stats_;
   std::uint64_t tick_{0};
