@@ -111,6 +111,8 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
 
   config::Config off = cfg;  // control off: the loop runs, the controller's gain is 0
   off.controller.gain_ns_per_m = 0.0;
+  if (off.pose_schedule)  // each region's set carries its own gain: off as well, or the loop damps what it measures
+    for (auto& r : off.pose_schedule->regions) r.gain_ns_per_m = 0.0;
   const auto& c = cfg.commissioning;
   runtime::CellOptions o;
   if (!opt.clock.empty()) o.clock = opt.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
