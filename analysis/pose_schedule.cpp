@@ -29,8 +29,15 @@ config::ConfigError region_error(const config::Config& cfg, std::size_t i, const
       {config::Problem{cfg.source, {}, "pose_schedule.regions[" + std::to_string(i) + "]", message}}, cfg.yaml_text));
 }
 
-// Every pose of a grid_points^n grid over the box (the ends included).
-std::vector<std::vector<double>> grid_over(const config::PoseRegionConfig& r, int points) {
+double driving_point_improvement(const LoopModel& m, double gain, int polarity) {
+  for (const FrfResult& f : improvements(m, gain, polarity, true))
+    if (f.response == m.actuator_location() && f.excitation == m.actuator_location()) return f.improvement_pct;
+  return 0.0;
+}
+
+}  // namespace
+
+std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, int points) {
   const std::size_t n = r.min_deg.size();
   std::vector<std::vector<double>> out;
   std::vector<int> idx(n, 0);
@@ -44,14 +51,6 @@ std::vector<std::vector<double>> grid_over(const config::PoseRegionConfig& r, in
     if (j == n) return out;
   }
 }
-
-double driving_point_improvement(const LoopModel& m, double gain, int polarity) {
-  for (const FrfResult& f : improvements(m, gain, polarity, true))
-    if (f.response == m.actuator_location() && f.excitation == m.actuator_location()) return f.improvement_pct;
-  return 0.0;
-}
-
-}  // namespace
 
 PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
   const robot::PlanarChain chain = robot::at_pose(model, q);
@@ -82,7 +81,17 @@ config::Config config_at_pose(const config::Config& base, const PoseModes& modes
   return c;
 }
 
-namespace {
+void with_region_compensator(config::Config& set, const config::RegionCompensatorConfig& c) {
+  for (config::BlockConfig& b : set.controller.chain) {
+    if (b.kind != config::BlockKind::kCompensator) continue;
+    b.model = config::CompensatorModel::kRational;
+    b.numerator = c.numerator;
+    b.denominator = c.denominator;
+    return;
+  }
+  throw config::ConfigError({config::Problem{set.source, {}, "controller.chain",
+                                             "has no compensator block for a pose region's compensator to replace"}});
+}
 
 RegionSet design_region(const config::Config& cfg, const config::RobotModelConfig& model, std::size_t i) {
   const config::PoseScheduleConfig& s = *cfg.pose_schedule;
@@ -95,14 +104,21 @@ RegionSet design_region(const config::Config& cfg, const config::RobotModelConfi
   set.gain_ns_per_m = r.gain_ns_per_m.value_or(cfg.controller.gain_ns_per_m);
   set.config = config_at_pose(cfg, centre);
   set.config.pose_schedule.reset();
-  set.config.controller.match_freq_hz = set.dominant_hz;
+  set.config.controller.match_freq_hz = r.match_freq_hz.value_or(set.dominant_hz);
   set.config.controller.gain_ns_per_m = set.gain_ns_per_m;
-  const AnalysisResult a = analyse(LoopModel(set.config), set.gain_ns_per_m, cfg.controller.polarity);
-  set.polarity = a.recommended_polarity;
+  if (r.compensator) with_region_compensator(set.config, *r.compensator);
+  if (r.polarity) {
+    set.polarity = *r.polarity;
+  } else {
+    const AnalysisResult a = analyse(LoopModel(set.config), set.gain_ns_per_m, cfg.controller.polarity);
+    set.polarity = a.recommended_polarity;
+  }
   set.config.controller.polarity = set.polarity;
   set.config.source = cfg.source + " [pose region " + r.name + "]";
   return set;
 }
+
+namespace {
 
 // The set against the plant at every pose of the region's grid; throws at the first pose it fails.
 void check_region(const config::Config& cfg, const config::RobotModelConfig& model, std::size_t i, RegionSet& set) {
@@ -112,7 +128,7 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
   set.dominant_min_hz = std::numeric_limits<double>::infinity();
   set.dominant_max_hz = 0.0;
   set.worst_mode_improvement_pct = std::numeric_limits<double>::infinity();
-  for (const auto& q : grid_over(s.regions[i], s.grid_points)) {
+  for (const auto& q : region_grid(s.regions[i], s.grid_points)) {
     const PoseModes pm = pose_modes(model, q, s.axis, s.modes);
     set.dominant_min_hz = std::min(set.dominant_min_hz, pm.dominant_hz());
     set.dominant_max_hz = std::max(set.dominant_max_hz, pm.dominant_hz());

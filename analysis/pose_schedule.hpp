@@ -5,7 +5,8 @@
 //     the accelerometer sit on the spindle head, at the TCP).
 //   - A region's set is the configuration with the plant at the region's centre, the compensators
 //     matched at that pose's dominant mode, the polarity the analysis recommends there and the region's
-//     gain; it is then analysed against the plant at every pose of a grid over the region (grid_points
+//     gain; a tuned region (robodamp pose tune) gives its own compensator, pre-warp frequency and
+//     polarity. The set is then analysed against the plant at every pose of a grid over the region (grid_points
 //     per joint). The set's K_max is the smallest found; a pose where the set is unstable, or where its
 //     gain is above supervision.max_gain_fraction x K_max, refuses the whole configuration, naming the
 //     region, the pose and the reason.
@@ -31,9 +32,16 @@ struct PoseModes {
 [[nodiscard]] PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
                                    int axis, int count);
 
+// Every pose of a points^n grid over the region's box (its ends included; points >= 2).
+[[nodiscard]] std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, int points);
+
 // base with the robot's modal table replaced by the model's at the pose (every location at the TCP,
 // axis_sign +1).
 [[nodiscard]] config::Config config_at_pose(const config::Config& base, const PoseModes& modes);
+
+// The set's chain with the region's own compensator in place of the compensator block. Throws
+// config::ConfigError when the chain has none.
+void with_region_compensator(config::Config& set, const config::RegionCompensatorConfig& c);
 
 struct RegionSet {
   std::string name;
@@ -58,6 +66,9 @@ struct PoseScheduleAnalysis {
   config::RobotModelConfig model;
   std::vector<RegionSet> regions;
 };
+
+// Region i's set alone (not yet checked over its grid): its configuration, match frequency and polarity.
+[[nodiscard]] RegionSet design_region(const config::Config& cfg, const config::RobotModelConfig& model, std::size_t i);
 
 // Throws config::ConfigError naming the region, the pose and the reason when a region has no stable set.
 [[nodiscard]] PoseScheduleAnalysis analyse_pose_schedule(const config::Config& cfg);

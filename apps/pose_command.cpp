@@ -18,6 +18,7 @@
 
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/pose_tune_command.hpp"
 #include "identify/modal_fit.hpp"
 #include "identify/pose_measurements.hpp"
 #include "milling/accurate_stability.hpp"
@@ -55,6 +56,8 @@ struct PoseArgs {
   double csv_step_hz{0.1};
   std::string job_path;  // map: a milling job with a pose part: its minimum limiting depth at each pose
   std::string method{"sdm"};  // map: the accurate method, or "zoa" (the zero-order preview)
+  PoseTuneArgs tune;          // tune (apps/pose_tune_command.hpp)
+  bool model_given{false};
 };
 
 bool also_json_out(const PoseArgs& a, const json& j);
@@ -359,6 +362,12 @@ bool also_json_out(const PoseArgs& a, const json& j) {
 
 int run_pose(const PoseArgs& given) {
   PoseArgs a = given;
+  if (a.what == "tune") {
+    a.tune.measurements = a.measurements, a.tune.hold_out = a.hold_out, a.tune.job_path = a.job_path;
+    a.tune.out_path = a.out_path, a.tune.json = a.json, a.tune.seed = a.seed;
+    if (a.model_given) a.tune.model_path = a.model_path;
+    return run_pose_tune(a.tune);
+  }
   a.plot_path = plot_file(a.plot_dir, a.plot_path, "pose_" + a.what + ".png");
   try {
     const config::RobotModelConfig m = config::load_robot_model(a.model_path);
@@ -381,10 +390,19 @@ void register_pose(Registry& r) {
   auto a = std::make_shared<PoseArgs>();
   CLI::App* sub = r.add("pose",
                         "Pose-dependent robot dynamics (the planar-robot study): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose table` "
-                        "(the first mode at the model's named poses), `pose map` (first mode over two joints)",
+                        "(the first mode at the model's named poses), `pose map` (first mode over two joints), `pose tune` (a robust set and a "
+                        "schedule drawn from the data over a configuration's workspace, the better written)",
                         [a] { return run_pose(*a); });
-  sub->add_option("what", a->what, "frf, table, fit or map")->required()->check(CLI::IsMember({"frf", "table", "fit", "map"}));
-  sub->add_option("--model", a->model_path, "Robot model file (config/robots/*.yaml)")->check(CLI::ExistingFile);
+  sub->add_option("what", a->what, "frf, table, fit, map or tune")->required()->check(CLI::IsMember({"frf", "table", "fit", "map", "tune"}));
+  sub->add_option("--model", a->model_path, "Robot model file (config/robots/*.yaml); tune: the pose-indexed model (default the configuration's pose_schedule.model)")
+      ->check(CLI::ExistingFile)
+      ->each([a](const std::string&) { a->model_given = true; });
+  sub->add_option("--config", a->tune.config_path, "tune: the configuration with a pose_schedule (model, axis, workspace)")->check(CLI::ExistingFile);
+  r.whole_number(sub, "--evaluations", a->tune.evaluations, {"(evaluations per polarity)", 10, 5000}, "tune: each set's global search");
+  r.whole_number(sub, "--polish", a->tune.polish, {"(evaluations)", 0, 5000}, "tune: each set's local polish");
+  r.whole_number(sub, "--max-regions", a->tune.max_regions, {"(regions)", 1, 16}, "tune: the scheduled controller's regions at most");
+  r.whole_number(sub, "--map-points", a->tune.map_points, {"(points per joint)", 2, 41}, "tune: the workspace map's grid along the joints that move the dominant mode (default 9)");
+  r.number(sub, "--overlap-deg", a->tune.overlap_deg, {"deg", 0.0, 30.0}, "tune: neighbouring regions overlap by this (the hand-over's hysteresis)");
   r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map: the pose, one relative angle per joint");
   sub->add_option("--pose", a->pose_name, "frf, map: a pose the model file names");
   r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes");
@@ -394,7 +412,7 @@ void register_pose(Registry& r) {
   r.plot_dir(sub, a->plot_dir, "frf, map: pose_frf.png or pose_map.png");
   r.deprecated(sub->add_option("--plot", a->plot_path, "frf, map: write the plot to this file (PNG)"), "--plot-dir DIR");
   sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
-  sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose)")
+  sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose); tune: the job scored over the workspace map")
       ->check(CLI::ExistingFile);
   sub->add_option("--method", a->method, "map: sdm (default): the job's minimum by semi-discretization over its SDM speeds; zoa: the zero-order method, a fast preview")
       ->check(CLI::IsMember({"sdm", "zoa"}));
@@ -412,7 +430,7 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--particles", a->particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
   r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
   r.whole_number(sub, "--seed", a->seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
-  sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here");
+  sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here; tune: the configuration with the chosen controller");
   sub->add_option("--csv", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz");
   r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv frequency step");
 }

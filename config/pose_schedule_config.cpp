@@ -90,6 +90,35 @@ void check_box(MapReader& r, const std::string& what, const std::vector<double>&
   }
 }
 
+// compensator: {numerator: [...], denominator: [...]}: proper, finite, a leading denominator coefficient
+// and every denominator coefficient positive (necessary for a stable compensator).
+std::optional<RegionCompensatorConfig> read_region_compensator(MapReader& region) {
+  const YAML::Node n = region.child("compensator", false, "");
+  if (!present(n)) return std::nullopt;
+  MapReader r(region.diagnostics(), n, region.path_of("compensator"), region.mark());
+  RegionCompensatorConfig c;
+  const auto num = r.number_list("numerator", "coefficients of s, highest power first");
+  const auto den = r.number_list("denominator", "coefficients of s, highest power first");
+  r.finish();
+  if (!num || !den) return std::nullopt;
+  c.numerator = *num, c.denominator = *den;
+  const std::size_t before = region.diagnostics().problems().size();
+  auto refuse = [&](const std::string& key, const std::string& why) { region.diagnostics().add(r.mark(), r.path_of(key), why); };
+  if (c.numerator.empty() || c.denominator.empty()) refuse("denominator", "and numerator must not be empty");
+  else if (c.numerator.size() > c.denominator.size())
+    refuse("numerator", "has " + std::to_string(c.numerator.size()) + " coefficients, more than the denominator's " +
+                            std::to_string(c.denominator.size()) + ": the compensator must be proper");
+  for (std::size_t i = 0; i < c.numerator.size(); ++i)
+    if (!std::isfinite(c.numerator[i])) refuse("numerator[" + std::to_string(i) + "]", "is not a finite number");
+  for (std::size_t i = 0; i < c.denominator.size(); ++i)
+    if (!(c.denominator[i] > 0.0) || !std::isfinite(c.denominator[i]))
+      refuse("denominator[" + std::to_string(i) + "]", "= " + format_number(c.denominator[i]) +
+                                                           " is not allowed: every coefficient must be positive and finite "
+                                                           "(a stable, minimum-phase compensator, as robodamp pose tune writes)");
+  if (region.diagnostics().problems().size() != before) return std::nullopt;
+  return c;
+}
+
 PoseRegionConfig read_region(Diagnostics& d, const YAML::Node& n, const std::string& key, const RobotModelConfig* model) {
   MapReader r(d, n, key, n.Mark());
   PoseRegionConfig c;
@@ -98,6 +127,11 @@ PoseRegionConfig read_region(Diagnostics& d, const YAML::Node& n, const std::str
   if (auto v = r.number_list("max_deg", "deg")) c.max_deg = *v;
   if (present(r.child("gain_ns_per_m", false, "")))  // optional: default controller.gain_ns_per_m
     if (auto v = r.number("gain_ns_per_m", {"N s/m", 0.0, 1e6})) c.gain_ns_per_m = *v;
+  if (present(r.child("polarity", false, "")))
+    if (auto v = read_sign(r, "polarity", 1)) c.polarity = *v;
+  if (present(r.child("match_freq_hz", false, "")))
+    if (auto v = r.number("match_freq_hz", {"Hz", 0.0, 1e4, true})) c.match_freq_hz = *v;
+  c.compensator = read_region_compensator(r);
   check_box(r, "", c.min_deg, c.max_deg, model);
   r.finish();
   return c;

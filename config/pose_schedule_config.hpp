@@ -11,10 +11,21 @@
 
 namespace robodamp::config {
 
+// A region's own compensator (what `robodamp pose tune` writes): a rational transfer function in s, highest
+// power first, in place of the chain's compensator block in the region's set.
+struct RegionCompensatorConfig {
+  std::vector<double> numerator, denominator;
+};
+
 struct PoseRegionConfig {
   std::string name;
   std::vector<double> min_deg, max_deg;  // a box in joint space, one entry per joint
   std::optional<double> gain_ns_per_m;   // default controller.gain_ns_per_m
+  // A tuned set: the compensator, its pre-warp frequency and the polarity. Without them the set is matched
+  // at the region's dominant mode and the polarity is the one the analysis recommends there.
+  std::optional<RegionCompensatorConfig> compensator;
+  std::optional<double> match_freq_hz;  // default the dominant mode at the region's centre
+  std::optional<int> polarity;
 };
 
 struct PoseScheduleConfig {

@@ -297,7 +297,7 @@ TEST(Modbus, JointRegistersSettleToARegionAndUnknownPosesAreOutOfTheMap) {
   config::PoseScheduleConfig schedule;
   schedule.workspace_min_deg = {-10.0, 0.0};
   schedule.workspace_max_deg = {10.0, 100.0};
-  schedule.regions = {{"low", {-10.0, 0.0}, {10.0, 55.0}, {}}, {"high", {-10.0, 45.0}, {10.0, 100.0}, {}}};
+  schedule.regions = {{"low", {-10.0, 0.0}, {10.0, 55.0}, {}, {}, {}, {}}, {"high", {-10.0, 45.0}, {10.0, 100.0}, {}, {}, {}, {}}};
   std::mutex m;
   std::vector<long> regions;  // -1: out of the map
   ModbusClient sup(cfg, config::Mounting::kHorizontal);

@@ -223,12 +223,13 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   add_violation(e, (s_.delay_margin_min_ms - e.delay_margin_ms) / s_.delay_margin_min_ms, "delay margin");
   for (const auto& mode : analysis::mode_phases(*m, k, cand.polarity))
     e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
-  add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
-  if (s_.no_worse_mode) {
+  if (s_.damping_window) add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
+  if (s_.no_worse_mode || s_.worst_mode_objective) {
     e.worst_mode_improvement_pct = kInf;
     for (const auto& mi : analysis::mode_improvements(*m, k, cand.polarity))
       e.worst_mode_improvement_pct = std::min(e.worst_mode_improvement_pct, mi.improvement_pct);
-    add_violation(e, -e.worst_mode_improvement_pct / 100.0, "a mode's peak worse than open loop");
+    if (s_.no_worse_mode)
+      add_violation(e, -(e.worst_mode_improvement_pct + s_.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
   }
   if (const double floor_v = cfg.supervision.instability_floor_v; floor_v > 0.0) {
     e.quiet_command_rms_v = analysis::quiet_command(*m, k, cand.polarity).rms_v;
@@ -247,7 +248,7 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   if (constraints_only) return e;
   if (!job_) {
     e.peak_m_per_n = closed_peak(*m, k, cand.polarity);
-    e.objective = -std::log10(e.peak_m_per_n);
+    e.objective = s_.worst_mode_objective ? e.worst_mode_improvement_pct / 100.0 : -std::log10(e.peak_m_per_n);
     return e;
   }
   const milling::Structure damped(job_structure(*job_), true, {m, k, cand.polarity});
@@ -456,7 +457,8 @@ namespace {
 
 // One polarity's search (seeded global, then the polish), its evaluations and best added to `result`.
 void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSettings& s, int polarity,
-                     const std::function<void(const std::string&)>& progress, const std::string& tag, TuneResult& result) {
+                     const std::function<void(const std::string&)>& progress, const std::string& tag, TuneResult& result,
+                     const std::optional<Candidate>& start = std::nullopt) {
   const config::Config& base = plants.front()->base();
   TuneResult per;
   const std::string global_phase = "global search" + tag, local_phase = "local polish" + tag;
@@ -464,7 +466,8 @@ void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSett
   // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
   const Candidate c1{std::clamp(base.controller.gain_ns_per_m, 100.0, 20000.0), base.actuator.natural_freq_hz,
                      base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
-  std::vector<double> x = x_of(c1);
+  std::vector<double> x = x_of(start ? *start : c1);
+  for (unsigned i = 0; i < kDims; ++i) x[i] = std::clamp(x[i], kLower[i], kUpper[i]);
   run(NLOPT_GN_CRS2_LM, global, x);
   if (s.local_evaluations > 0) {  // NLopt reads a budget of 0 as no limit
     Search local{&plants, polarity, &per, &progress, local_phase.c_str(), s.local_evaluations};
@@ -477,6 +480,17 @@ void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSett
 }
 
 }  // namespace
+
+TuneResult tune_from(const std::vector<const Evaluator*>& plants, const Candidate& start, const TuneSettings& s,
+                     const std::function<void(const std::string&)>& progress) {
+  if (plants.empty()) throw std::invalid_argument("robodamp tune: no plant to tune for");
+  TuneResult result;
+  result.best = evaluate_worst(plants, start);
+  result.history.push_back(result.best);
+  nlopt_srand(static_cast<unsigned long>(s.seed));
+  search_polarity(plants, s, start.polarity, progress, "", result, start);
+  return result;
+}
 
 TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
                 const std::function<void(const std::string&)>& progress) {

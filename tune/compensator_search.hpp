@@ -16,6 +16,7 @@
 // limit there). Over several plants (mountings, shifted modes) the worst case. Off the real-time path.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -68,6 +69,16 @@ struct TuneSettings {
   // No robot mode's receptance peak worse than open loop (analysis/mode_improvement.hpp) on any plant: a
   // constraint when set (tune --no-worse-mode; off by default, the presets' tunings predate it).
   bool no_worse_mode{false};
+  // How much worse than open loop a mode's peak may get before no_worse_mode counts it (%): 0 for tune;
+  // the pose tune allows 1 % (a mode the loop cannot reach moves by a fraction of that either way).
+  double worse_mode_tolerance_pct{0.0};
+  // Every mode of the loop inside the damping window (a constraint by default). The pose tune drops it for
+  // no_worse_mode, which judges its consequence where it matters: a mode the actuator barely moves along its
+  // axis may sit outside the window and lose a fraction of a percent.
+  bool damping_window{true};
+  // Without a job, the objective: the smallest improvement of any robot mode's peak (max-min over the
+  // modes and the plants; the pose tune's) instead of the largest closed-loop peak.
+  bool worst_mode_objective{false};
 };
 
 struct Evaluation {
@@ -127,6 +138,10 @@ class Evaluator {
   [[nodiscard]] Evaluation assess(const config::Config& cfg, bool constraints_only = false) const;
   // The open loop's lobes, for reports: the minimum and the floors between neighbouring peaks.
   [[nodiscard]] double open_min_depth_mm() const { return open_min_mm_; }
+  // With a job: the open loop's smallest limit by the accurate method at its lowest SDM minima.
+  [[nodiscard]] double open_accurate_min_mm() const {
+    return open_sdm_min_mm_.empty() ? open_min_mm_ : *std::min_element(open_sdm_min_mm_.begin(), open_sdm_min_mm_.end());
+  }
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
   [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
   [[nodiscard]] const std::vector<double>& open_floor_rpm() const { return floor_rpm_; }
@@ -179,5 +194,10 @@ class Evaluator {
 // plants make the robust tune: the worst case over the plants optimised; the search starts from the first's C1 shape.
 [[nodiscard]] TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
                               const std::function<void(const std::string&)>& progress = {});
+
+// The search (seeded global, then the polish) at the start's polarity over the plants, from `start`; the
+// start's own evaluation first (the result is never worse than the start).
+[[nodiscard]] TuneResult tune_from(const std::vector<const Evaluator*>& plants, const Candidate& start, const TuneSettings& s,
+                                   const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace robodamp::tune

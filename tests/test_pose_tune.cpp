@@ -1,0 +1,190 @@
+// Tuning across the workspace (docs/pose_dynamics.md, "Tuning across the workspace"): one robust set against
+// a schedule whose regions are drawn where a set stops serving, both scored on the workspace map; a region's
+// own compensator in the configuration; and the chain measure --poses -> pose fit -> pose tune -> analyze ->
+// run on a robot model no preset was drawn for.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/pose_schedule.hpp"
+#include "child_process.hpp"
+#include "config/config.hpp"
+#include "config/robot_model_config.hpp"
+#include "test_util.hpp"
+#include "tune/pose_score.hpp"
+#include "tune/pose_tune.hpp"
+
+namespace robodamp {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kSource = ROBODAMP_SOURCE_DIR;
+
+// Every occurrence; an edit that finds nothing is a broken test, not a silent no-op.
+void replace(std::string& s, const std::string& from, const std::string& to) {
+  if (s.find(from) == std::string::npos) throw std::runtime_error("the test's edit finds no '" + from + "'");
+  for (auto p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
+}
+
+// The scheduled preset along joint 2 alone (joints 1 and 3 held): its two modes trade places near 25-50 deg.
+config::Config joint2_cell() {
+  std::string text = test::read_file(test::preset("pose_scheduled_c2"));
+  replace(text, "workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}",
+                    "workspace: {min_deg: [-100, 0, 90], max_deg: [-100, 140, 90]}");
+  replace(text, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}\n", "");
+  replace(text, "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
+                    "{name: all, min_deg: [-100, 0, 90], max_deg: [-100, 140, 90], gain_ns_per_m: 150}");
+  return config::parse_config(text, test::preset("pose_scheduled_c2"));
+}
+
+// Where the robot's two modes trade places one compensator cannot improve both; the regions cut where the
+// robust set stops serving cover the workspace with overlaps, and over the map the schedule makes no mode
+// worse than the robust set does. The schedule's file form runs through the configuration's own check.
+TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter) {
+  tune::PoseTuneInput in{joint2_cell(), {}, {}};
+  in.model = config::load_robot_model(in.cell.pose_schedule->model_resolved);
+  tune::PoseTuneSettings s;
+  s.tune.global_evaluations = 40, s.tune.local_evaluations = 20;
+  s.max_regions = 4;
+  const tune::TunedRegion robust = tune::tune_robust(in, s);
+  EXPECT_EQ(robust.poses.size(), 3U);  // joint 2's grid; joints 1 and 3 do not move
+  EXPECT_FALSE(robust.serves()) << robust.worst.worst_mode_improvement_pct;
+  EXPECT_NE(robust.worst.binding.find("worse than open loop"), std::string::npos) << robust.worst.binding;
+  const std::vector<tune::TunedRegion> sched = tune::tune_schedule(in, robust, s);
+  for (const auto& r : sched)
+    std::cout << r.region.name << " joint 2 " << r.region.min_deg[1] << "-" << r.region.max_deg[1] << " deg: K "
+              << *r.region.gain_ns_per_m << ", worst mode " << r.worst.worst_mode_improvement_pct << " %"
+              << (r.serves() ? "" : ", " + r.worst.binding) << '\n';
+  ASSERT_GE(sched.size(), 2U);
+  ASSERT_LE(sched.size(), 4U);
+  EXPECT_TRUE(sched.front().serves()) << sched.front().worst.binding;  // folded: the 9 Hz mode alone
+  for (std::size_t i = 0; i < sched.size(); ++i) {
+    const auto& r = sched[i].region;
+    ASSERT_TRUE(r.compensator && r.match_freq_hz && r.polarity && r.gain_ns_per_m);
+    EXPECT_EQ(r.name, "r" + std::to_string(i + 1));
+    if (i > 0) {
+      EXPECT_NEAR(sched[i - 1].region.max_deg[1] - r.min_deg[1], s.overlap_deg, 1e-9);  // the hysteresis
+    }
+  }
+  EXPECT_EQ(sched.front().region.min_deg[1], 0.0);
+  EXPECT_EQ(sched.back().region.max_deg[1], 140.0);
+  config::Config written = in.cell;
+  written.pose_schedule = tune::schedule_of(*in.cell.pose_schedule, sched);
+  EXPECT_FALSE(config::uncovered_pose(*written.pose_schedule));
+  const analysis::PoseScheduleAnalysis a = analysis::analyse_pose_schedule(written);  // throws if a set fails
+  ASSERT_EQ(a.regions.size(), sched.size());
+  for (std::size_t i = 0; i < sched.size(); ++i) {
+    EXPECT_EQ(a.regions[i].polarity, *sched[i].region.polarity);
+    const auto& chain = a.regions[i].config.controller.chain;
+    const auto c = std::find_if(chain.begin(), chain.end(), [](const auto& b) { return b.kind == config::BlockKind::kCompensator; });
+    ASSERT_NE(c, chain.end());
+    EXPECT_EQ(c->model, config::CompensatorModel::kRational);
+    EXPECT_EQ(c->denominator, sched[i].region.compensator->denominator);
+  }
+  const tune::MapScores m = tune::score_on_map(
+      in, tune::workspace_map(in, 9, {}),
+      {{"robust", tune::schedule_of(*in.cell.pose_schedule, {robust})}, {"scheduled", *written.pose_schedule}}, std::nullopt);
+  ASSERT_EQ(m.map.size(), 9U);
+  const tune::ControllerScore &rs = m.controllers[0], &ss = m.controllers[1];
+  EXPECT_TRUE(ss.stable_everywhere);
+  std::cout << "robust: worst mode " << rs.worst_mode_improvement_pct << " %; scheduled (" << sched.size()
+            << " regions): worst mode " << ss.worst_mode_improvement_pct << " %\n";
+  EXPECT_GT(ss.worst_mode_improvement_pct, rs.worst_mode_improvement_pct);
+  EXPECT_EQ(tune::better_controller(m), 1U);
+  // The map scores the sets that run: at joint 2 = 0 the first region's alone, with its own improvement.
+  EXPECT_EQ(ss.poses.front().regions, std::vector<std::string>{"r1"});
+  EXPECT_GT(ss.poses.front().improvement_pct, 50.0);
+}
+
+TEST(PoseTune, ARegionsCompensatorIsCheckedWithItsKeyAndTheReason) {
+  std::string text = test::read_file(test::preset("pose_scheduled_c2"));
+  replace(text, "max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
+                    "max_deg: [-98, 25, 92], gain_ns_per_m: 250, polarity: 2, match_freq_hz: -3,\n"
+                    "       compensator: {numerator: [1, 2, 3], denominator: [-1, 1]}}");
+  try {
+    (void)config::parse_config(text, test::preset("pose_scheduled_c2"));
+    FAIL() << "accepted";
+  } catch (const config::ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("pose_schedule.regions[0].polarity"), std::string::npos) << w;
+    EXPECT_NE(w.find("pose_schedule.regions[0].match_freq_hz"), std::string::npos) << w;
+    EXPECT_NE(w.find("pose_schedule.regions[0].compensator.numerator: has 3 coefficients, more than the denominator's 2"),
+              std::string::npos) << w;
+    EXPECT_NE(w.find("pose_schedule.regions[0].compensator.denominator[0] = -1 is not allowed"), std::string::npos) << w;
+  }
+}
+
+struct Outcome {
+  int status;
+  std::string log;
+};
+Outcome robodamp(const std::vector<std::string>& args, const std::string& log) {
+  test::Child c(args, log);
+  const int status = c.wait();
+  return {status, test::read_file(log)};
+}
+
+// The whole chain on a robot no preset describes (config/robots/compact_three_link.yaml, joint 2 20 %
+// stiffer than its file says): measured at five poses, fitted with two held out, tuned over the measured
+// workspace with the fitted model; the file it writes is analysed and runs at a held-out pose.
+TEST(PoseTune, MeasuredFittedTunedAndRunOnARobotOfOurOwn) {
+  const std::string dir = ::testing::TempDir() + "/pose_tune_chain";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string robot = test::read_file(kSource + "/config/robots/compact_three_link.yaml");
+  replace(robot, "stiffness_nm_per_rad: 2.2e5", "stiffness_nm_per_rad: 2.64e5");
+  std::ofstream(dir + "/true_robot.yaml") << robot;
+  std::string cell = test::read_file(kSource + "/config/presets/pose_scheduled_c2.yaml");
+  replace(cell, "model: ../robots/planar_three_link.yaml", "model: true_robot.yaml");
+  replace(cell, "workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}",
+                    "workspace: {min_deg: [-90, 30, 20], max_deg: [-90, 130, 40]}");
+  replace(cell, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}\n", "");
+  replace(cell, "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
+                    "{name: all, min_deg: [-90, 30, 20], max_deg: [-90, 130, 40], gain_ns_per_m: 100}");
+  std::ofstream(dir + "/cell.yaml") << cell;
+  std::ofstream(dir + "/poses.yaml") << "poses:\n  - {name: a, joints_deg: [-90, 30, 30]}\n  - {name: b, joints_deg: [-90, 60, 20]}\n"
+                                        "  - {name: c, joints_deg: [-90, 95, 40]}\n  - {name: d, joints_deg: [-90, 130, 25]}\n"
+                                        "  - {name: e, joints_deg: [-90, 75, 35]}\n";
+  Outcome r = robodamp({"measure", "--config", dir + "/cell.yaml", "--poses", dir + "/poses.yaml", "--out", dir + "/m"}, dir + "/measure.log");
+  ASSERT_EQ(r.status, 0) << r.log;
+  r = robodamp({"pose", "fit", "--model", kSource + "/config/robots/compact_three_link.yaml", "--measurements", dir + "/m",
+                "--hold-out", "c", "e", "--restarts", "1", "--out", dir + "/fitted.yaml"}, dir + "/fit.log");
+  ASSERT_EQ(r.status, 0) << r.log;
+  r = robodamp({"pose", "tune", "--config", dir + "/cell.yaml", "--model", dir + "/fitted.yaml", "--measurements", dir + "/m",
+                "--hold-out", "c", "e", "--evaluations", "30", "--polish", "20", "--max-regions", "3", "--map-points", "5",
+                "--out", dir + "/tuned/cell.yaml", "--json", dir + "/tune.json"}, dir + "/tune.log");
+  ASSERT_EQ(r.status, 0) << r.log;
+  const json t = json::parse(test::read_file(dir + "/tune.json"));
+  ASSERT_EQ(t["controllers"].size(), 3U);  // robust, scheduled, the configuration as given
+  const std::string chosen = t["chosen"];
+  EXPECT_TRUE(chosen == "robust" || chosen == "scheduled") << chosen;
+  std::size_t held = 0;
+  for (const auto& p : t["map"]) {
+    if (p["role"] != "held out") continue;
+    ++held;
+    EXPECT_TRUE(p[chosen]["stable"].get<bool>()) << p.dump();
+  }
+  EXPECT_EQ(held, 2U);
+  // The written file: its paths still name their files from another directory, its schedule analysed, and it
+  // stands the robot at a held-out pose and damps.
+  r = robodamp({"analyze", "--config", dir + "/tuned/cell.yaml"}, dir + "/analyze.log");
+  EXPECT_EQ(r.status, 0) << r.log;
+  r = robodamp({"run", "--config", dir + "/tuned/cell.yaml", "--clock", "virtual", "--duration", "3", "--pose", "-90", "95", "40",
+                "--json", dir + "/run.json"}, dir + "/run.log");
+  ASSERT_EQ(r.status, 0) << r.log;
+  const json run = json::parse(test::read_file(dir + "/run.json"));
+  EXPECT_EQ(run["trip"], "none");
+  EXPECT_EQ(run["arming"]["outcome"], "armed");
+}
+
+}  // namespace
+}  // namespace robodamp

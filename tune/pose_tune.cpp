@@ -1,0 +1,245 @@
+#include "tune/pose_tune.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+#include "analysis/pose_schedule.hpp"
+
+namespace robodamp::tune {
+
+namespace {
+
+std::string fmt(double v, const char* f = "%.4g") {
+  char b[48];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+bool inside(const std::vector<double>& q, const std::vector<double>& lo, const std::vector<double>& hi) {
+  if (q.size() != lo.size()) return false;
+  for (std::size_t j = 0; j < q.size(); ++j)
+    if (q[j] < lo[j] || q[j] > hi[j]) return false;
+  return true;
+}
+
+// Whether moving joint j over the box's width moves the dominant mode (frequency by 1 %, modal stiffness by 5 %).
+bool joint_moves_modes(const PoseTuneInput& in, const config::PoseRegionConfig& r, std::size_t j) {
+  const config::PoseScheduleConfig& s = *in.cell.pose_schedule;
+  std::vector<double> centre(r.min_deg.size());
+  for (std::size_t i = 0; i < centre.size(); ++i) centre[i] = 0.5 * (r.min_deg[i] + r.max_deg[i]);
+  const analysis::PoseModes mid = analysis::pose_modes(in.model, centre, s.axis, s.modes);
+  const config::ModeConfig& d = mid.modes[mid.dominant];
+  for (const double end : {r.min_deg[j], r.max_deg[j]}) {
+    std::vector<double> q = centre;
+    q[j] = end;
+    const analysis::PoseModes at = analysis::pose_modes(in.model, q, s.axis, s.modes);
+    const config::ModeConfig& e = at.modes[at.dominant];
+    if (std::abs(e.natural_freq_hz / d.natural_freq_hz - 1.0) > 0.01 || std::abs(e.stiffness_n_per_m / d.stiffness_n_per_m - 1.0) > 0.05)
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegionConfig& r, int points) {
+  config::PoseRegionConfig grid = r;
+  for (std::size_t j = 0; j < r.min_deg.size(); ++j)
+    if (!joint_moves_modes(in, r, j)) grid.min_deg[j] = grid.max_deg[j] = 0.5 * (r.min_deg[j] + r.max_deg[j]);
+  std::vector<NamedPose> out;
+  for (auto& q : analysis::region_grid(grid, points)) {
+    if (std::any_of(out.begin(), out.end(), [&](const NamedPose& p) { return p.joints_deg == q; })) continue;
+    out.push_back({config::describe_pose(q), q});
+  }
+  return out;
+}
+
+namespace {
+
+// The region's poses: its grid (see the header) and every measured pose inside it.
+std::vector<NamedPose> region_poses(const PoseTuneInput& in, const config::PoseRegionConfig& r) {
+  std::vector<NamedPose> out = mode_grid(in, r, in.cell.pose_schedule->grid_points);
+  for (const NamedPose& m : in.measured)
+    if (inside(m.joints_deg, r.min_deg, r.max_deg)) out.push_back(m);
+  return out;
+}
+
+// The configuration a set is tuned from: the plant at the region's centre, the compensator pre-warped at
+// the centre's dominant mode (the frequency the candidate's unit gain refers to).
+config::Config region_base(const PoseTuneInput& in, const std::vector<double>& centre, double& match_hz) {
+  const config::PoseScheduleConfig& s = *in.cell.pose_schedule;
+  const analysis::PoseModes pm = analysis::pose_modes(in.model, centre, s.axis, s.modes);
+  match_hz = pm.dominant_hz();
+  config::Config base = analysis::config_at_pose(in.cell, pm);
+  base.pose_schedule.reset();
+  base.controller.match_freq_hz = match_hz;
+  return base;
+}
+
+// The gain margin the tune asks for: the settings' and enough for supervision.max_gain_fraction (the
+// schedule's own check refuses a set above that share of K_max at any pose of its region).
+TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s) {
+  TuneSettings t = s.tune;
+  t.no_worse_mode = true;
+  t.worse_mode_tolerance_pct = s.worse_mode_tolerance_pct;
+  t.damping_window = false;
+  t.worst_mode_objective = true;
+  const double fraction = in.cell.supervision.max_gain_fraction;
+  if (fraction > 0.0 && fraction < 1.0) t.gain_margin_min_db = std::max(t.gain_margin_min_db, -20.0 * std::log10(fraction) + 0.1);
+  return t;
+}
+
+}  // namespace
+
+TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const std::vector<double>& min_deg,
+                        const std::vector<double>& max_deg, const PoseTuneSettings& s, const PoseTuneProgress& progress) {
+  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
+  TunedRegion out;
+  out.region.name = name;
+  out.region.min_deg = min_deg;
+  out.region.max_deg = max_deg;
+  out.poses = region_poses(in, out.region);
+  std::vector<double> centre(min_deg.size());
+  for (std::size_t j = 0; j < centre.size(); ++j) centre[j] = 0.5 * (min_deg[j] + max_deg[j]);
+  double match_hz = 0.0;
+  const config::Config base = region_base(in, centre, match_hz);
+  const TuneSettings t = region_settings(in, s);
+  std::vector<Evaluator> plants;
+  out.dominant_min_hz = std::numeric_limits<double>::infinity();
+  for (const NamedPose& p : out.poses) {
+    const analysis::PoseModes pm = analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes);
+    out.dominant_min_hz = std::min(out.dominant_min_hz, pm.dominant_hz());
+    out.dominant_max_hz = std::max(out.dominant_max_hz, pm.dominant_hz());
+    config::Config at = analysis::config_at_pose(base, pm);
+    at.source = in.cell.source + " at " + p.name;
+    plants.emplace_back(at, std::nullopt, t, p.name);
+  }
+  std::vector<const Evaluator*> ptrs;
+  for (const Evaluator& e : plants) ptrs.push_back(&e);
+  if (progress)
+    progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) + ": " +
+             std::to_string(out.poses.size()) + " poses, dominant mode " + fmt(out.dominant_min_hz) + "-" +
+             fmt(out.dominant_max_hz) + " Hz");
+  // The set tuned at the region's centre (one plant: cheap), then the search over every pose of the region
+  // from there, at its polarity (from C1's shape over many plants at once it finds far less).
+  std::size_t centre_plant = 0;
+  for (std::size_t i = 0; i < out.poses.size(); ++i)
+    if (out.poses[i].joints_deg == centre) centre_plant = i;
+  const Evaluator centre_eval(plants.size() > centre_plant && out.poses[centre_plant].joints_deg == centre
+                                  ? plants[centre_plant].base()
+                                  : analysis::config_at_pose(base, analysis::pose_modes(in.model, centre, sched.axis, sched.modes)),
+                              std::nullopt, t, "centre");
+  TuneSettings at_centre_settings = t;  // one plant: a search three times as long costs less than the region's
+  at_centre_settings.global_evaluations *= 3, at_centre_settings.local_evaluations *= 3;
+  const TuneResult at_centre = tune(std::vector<const Evaluator*>{&centre_eval}, at_centre_settings);
+  const TuneResult r = tune_from(ptrs, at_centre.best.candidate, t);
+  out.worst = r.best;
+  const Candidate& c = r.best.candidate;
+  const config::Config tuned = with_candidate(base, c);
+  for (const config::BlockConfig& b : tuned.controller.chain)
+    if (b.kind == config::BlockKind::kCompensator) out.region.compensator = config::RegionCompensatorConfig{b.numerator, b.denominator};
+  out.region.match_freq_hz = match_hz;
+  out.region.gain_ns_per_m = c.gain_ns_per_m;
+  out.region.polarity = c.polarity;
+  if (progress)
+    progress("  K " + fmt(c.gain_ns_per_m, "%.0f") + " N s/m, polarity " + std::to_string(c.polarity) +
+             (out.serves() ? ", serves (worst mode " + fmt(out.worst.worst_mode_improvement_pct, "%+.1f") + " %)"
+                           : ", does not serve: " + out.worst.binding));
+  return out;
+}
+
+TunedRegion tune_robust(const PoseTuneInput& in, const PoseTuneSettings& s, const PoseTuneProgress& progress) {
+  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
+  return tune_region(in, "workspace", sched.workspace_min_deg, sched.workspace_max_deg, s, progress);
+}
+
+namespace {
+
+struct Cut {
+  std::size_t joint{0};
+  double at_deg{0.0};
+};
+
+// Where to cut a region (see the header): the joint whose travel over the box moves the dominant mode most
+// (the other joints at the centre), among the joints wide enough to cut, at the angle where the dominant
+// mode crosses the geometric mean of its range along it (kept min_width_deg from the ends); nothing when no
+// joint is wide enough.
+std::optional<Cut> cut_of(const PoseTuneInput& in, const TunedRegion& r, const PoseTuneSettings& s) {
+  constexpr int kSteps = 32;
+  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
+  const std::size_t n = r.region.min_deg.size();
+  std::vector<double> centre(n);
+  for (std::size_t j = 0; j < n; ++j) centre[j] = 0.5 * (r.region.min_deg[j] + r.region.max_deg[j]);
+  std::optional<Cut> best;
+  double best_shift = -1.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double lo_deg = r.region.min_deg[j], width = r.region.max_deg[j] - lo_deg;
+    if (width < 2.0 * s.min_width_deg) continue;
+    std::vector<double> f(kSteps + 1);
+    for (int k = 0; k <= kSteps; ++k) {
+      std::vector<double> q = centre;
+      q[j] = lo_deg + width * k / kSteps;
+      f[k] = analysis::pose_modes(in.model, q, sched.axis, sched.modes).dominant_hz();
+    }
+    const auto [lo, hi] = std::minmax_element(f.begin(), f.end());
+    const double shift = std::log(*hi / *lo) + 1e-6 * width;  // wider first when no joint moves the mode
+    if (shift <= best_shift) continue;
+    best_shift = shift;
+    const double middle = std::sqrt(*lo * *hi);
+    double at = lo_deg + 0.5 * width;
+    for (int k = 0; k < kSteps; ++k)
+      if ((f[k] - middle) * (f[k + 1] - middle) <= 0.0 && f[k] != f[k + 1]) {
+        at = lo_deg + width * (k + (middle - f[k]) / (f[k + 1] - f[k])) / kSteps;
+        break;
+      }
+    // Where the set stops serving, when that is known: halfway from the centre towards that pose.
+    const auto binding = std::find_if(r.poses.begin(), r.poses.end(), [&](const NamedPose& p) { return p.name == r.worst.plant; });
+    if (binding != r.poses.end() && std::abs(binding->joints_deg[j] - centre[j]) >= s.min_width_deg)
+      at = 0.5 * (centre[j] + binding->joints_deg[j]);
+    best = Cut{j, std::clamp(std::round(at * 2.0) / 2.0, lo_deg + s.min_width_deg, lo_deg + width - s.min_width_deg)};  // 0.5 deg
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<TunedRegion> tune_schedule(const PoseTuneInput& in, const TunedRegion& robust, const PoseTuneSettings& s,
+                                       const PoseTuneProgress& progress) {
+  std::vector<TunedRegion> done, pending{robust};
+  int count = 1;
+  while (!pending.empty()) {
+    TunedRegion r = std::move(pending.front());
+    pending.erase(pending.begin());
+    const std::optional<Cut> cut = r.serves() || count >= s.max_regions ? std::nullopt : cut_of(in, r, s);
+    if (!cut) {
+      done.push_back(std::move(r));
+      continue;
+    }
+    const std::size_t j = cut->joint;
+    const double mid = cut->at_deg;
+    std::vector<double> lo_max = r.region.max_deg, hi_min = r.region.min_deg;
+    lo_max[j] = std::min(r.region.max_deg[j], mid + 0.5 * s.overlap_deg);
+    hi_min[j] = std::max(r.region.min_deg[j], mid - 0.5 * s.overlap_deg);
+    if (progress)
+      progress("cutting '" + r.region.name + "' across joint " + std::to_string(j + 1) + " at " + fmt(mid) + " deg");
+    ++count;
+    pending.push_back(tune_region(in, r.region.name + "a", r.region.min_deg, lo_max, s, progress));
+    pending.push_back(tune_region(in, r.region.name + "b", hi_min, r.region.max_deg, s, progress));
+  }
+  // Named in joint order along the workspace: r1, r2, ...
+  std::sort(done.begin(), done.end(), [](const TunedRegion& a, const TunedRegion& b) { return a.region.min_deg < b.region.min_deg; });
+  for (std::size_t i = 0; i < done.size(); ++i) done[i].region.name = done.size() == 1 ? "workspace" : "r" + std::to_string(i + 1);
+  return done;
+}
+
+config::PoseScheduleConfig schedule_of(const config::PoseScheduleConfig& base, const std::vector<TunedRegion>& regions) {
+  config::PoseScheduleConfig out = base;
+  out.regions.clear();
+  for (const TunedRegion& r : regions) out.regions.push_back(r.region);
+  return out;
+}
+
+}  // namespace robodamp::tune
