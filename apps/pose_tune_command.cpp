@@ -84,6 +84,7 @@ std::string written_text(const PoseTuneArgs& a, const config::Config& cell, cons
     edits.push_back({{"pose_schedule", "model"}, YAML::Node(std::filesystem::absolute(a.model_path).string())});
   const config::EditedYaml e = config::edit_yaml(cell.yaml_text, edits);
   const std::string text = header + config::rebase_file_paths(e.text, cell.source, a.out_path).text;
+  if (const auto parent = std::filesystem::path(a.out_path).parent_path(); !parent.empty()) std::filesystem::create_directories(parent);
   const std::string check = a.out_path + ".check.yaml";
   { std::ofstream(check) << text; }
   try {

@@ -57,6 +57,25 @@ double closed_peak(const analysis::LoopModel& m, double gain, int polarity) {
 // quiet cell) is a 5-sigma event.
 constexpr double kQuietShareOfFloor = 1.0 / 3.0;
 
+// The largest |C(j w)| of the chain's compensator block from 0.1 Hz to Nyquist, over |C| at the match
+// frequency (continuous; the block is pre-warped there).
+double compensator_gain_ratio(const config::Config& cfg) {
+  const auto b = std::find_if(cfg.controller.chain.begin(), cfg.controller.chain.end(),
+                              [](const config::BlockConfig& x) { return x.kind == config::BlockKind::kCompensator; });
+  if (b == cfg.controller.chain.end() || b->model != config::CompensatorModel::kRational) return 0.0;
+  auto gain = [&](double f_hz) {
+    const std::complex<double> s(0.0, kTwoPi * f_hz);
+    std::complex<double> n = 0.0, d = 0.0;
+    for (double a : b->numerator) n = n * s + a;
+    for (double a : b->denominator) d = d * s + a;
+    return std::abs(n / d);
+  };
+  const double match_hz = cfg.controller.match_freq_hz.value_or(10.0), nyquist_hz = 0.5 * cfg.loop.rate_hz;
+  double largest = 0.0;
+  for (double f = 0.1; f <= nyquist_hz; f *= 1.05) largest = std::max(largest, gain(f));
+  return largest / gain(match_hz);
+}
+
 void add_violation(Evaluation& e, double amount, const char* what) {
   if (amount <= 0.0) return;
   if (amount > e.violation) e.binding = what;
@@ -230,6 +249,10 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
       e.worst_mode_improvement_pct = std::min(e.worst_mode_improvement_pct, mi.improvement_pct);
     if (s_.no_worse_mode)
       add_violation(e, -(e.worst_mode_improvement_pct + s_.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
+  }
+  if (s_.compensator_gain_max > 0.0) {
+    e.compensator_gain_ratio = compensator_gain_ratio(cfg);
+    add_violation(e, e.compensator_gain_ratio / s_.compensator_gain_max - 1.0, "the compensator's gain away from the match frequency");
   }
   if (const double floor_v = cfg.supervision.instability_floor_v; floor_v > 0.0) {
     e.quiet_command_rms_v = analysis::quiet_command(*m, k, cand.polarity).rms_v;

@@ -79,6 +79,10 @@ struct TuneSettings {
   // Without a job, the objective: the smallest improvement of any robot mode's peak (max-min over the
   // modes and the plants; the pose tune's) instead of the largest closed-loop peak.
   bool worst_mode_objective{false};
+  // The compensator's gain over all frequencies (0.1 Hz to Nyquist) at most this many times its gain at the
+  // match frequency (0: no such constraint; the pose tune's 10): a set that shapes the phase without lifting
+  // the drift, the drive vibration or the noise far from the modes it damps.
+  double compensator_gain_max{0.0};
 };
 
 struct Evaluation {
@@ -87,6 +91,7 @@ struct Evaluation {
   double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
   double k_max_ns_per_m{0.0};
   double worst_mode_phase_deg{0.0};  // the largest |phase of -F / v| over the loop's modes (< 90: all damped)
+  double compensator_gain_ratio{0.0};  // with compensator_gain_max: the largest |C| over |C(match)|
   // With no_worse_mode: the smallest improvement of a mode's peak; NaN when not asked for.
   double worst_mode_improvement_pct{std::numeric_limits<double>::quiet_NaN()};
   double min_depth_mm{0.0};      // with a job: the damped lobes' minimum (zero-order: it steers the search;

@@ -25,20 +25,26 @@ bool inside(const std::vector<double>& q, const std::vector<double>& lo, const s
   return true;
 }
 
-// Whether moving joint j over the box's width moves the dominant mode (frequency by 1 %, modal stiffness by 5 %).
+// A mode's peak receptance along the axis (modal-stiffness form): 1 / (2 k zeta).
+double peak_m_per_n(const config::ModeConfig& m) { return 1.0 / (2.0 * m.stiffness_n_per_m * m.damping_ratio); }
+
+// Whether moving joint j over the box's width changes the plant: a mode's frequency by 1 %, or a mode's
+// peak receptance by 5 % of the largest peak (a mode the axis barely sees may turn a lot and matter little).
 bool joint_moves_modes(const PoseTuneInput& in, const config::PoseRegionConfig& r, std::size_t j) {
   const config::PoseScheduleConfig& s = *in.cell.pose_schedule;
   std::vector<double> centre(r.min_deg.size());
   for (std::size_t i = 0; i < centre.size(); ++i) centre[i] = 0.5 * (r.min_deg[i] + r.max_deg[i]);
   const analysis::PoseModes mid = analysis::pose_modes(in.model, centre, s.axis, s.modes);
-  const config::ModeConfig& d = mid.modes[mid.dominant];
+  const double largest = peak_m_per_n(mid.modes[mid.dominant]);
   for (const double end : {r.min_deg[j], r.max_deg[j]}) {
     std::vector<double> q = centre;
     q[j] = end;
     const analysis::PoseModes at = analysis::pose_modes(in.model, q, s.axis, s.modes);
-    const config::ModeConfig& e = at.modes[at.dominant];
-    if (std::abs(e.natural_freq_hz / d.natural_freq_hz - 1.0) > 0.01 || std::abs(e.stiffness_n_per_m / d.stiffness_n_per_m - 1.0) > 0.05)
-      return true;
+    if (at.modes.size() != mid.modes.size()) return true;
+    for (std::size_t m = 0; m < at.modes.size(); ++m)
+      if (std::abs(at.modes[m].natural_freq_hz / mid.modes[m].natural_freq_hz - 1.0) > 0.01 ||
+          std::abs(peak_m_per_n(at.modes[m]) - peak_m_per_n(mid.modes[m])) > 0.05 * largest)
+        return true;
   }
   return false;
 }
@@ -87,9 +93,47 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
   t.worse_mode_tolerance_pct = s.worse_mode_tolerance_pct;
   t.damping_window = false;
   t.worst_mode_objective = true;
+  t.compensator_gain_max = s.compensator_gain_max;
   const double fraction = in.cell.supervision.max_gain_fraction;
   if (fraction > 0.0 && fraction < 1.0) t.gain_margin_min_db = std::max(t.gain_margin_min_db, -20.0 * std::log10(fraction) + 0.1);
   return t;
+}
+
+bool better_than(const Evaluation& a, const Evaluation& b) {
+  if (a.feasible() != b.feasible()) return a.feasible();
+  return a.feasible() ? a.objective > b.objective : a.violation < b.violation;
+}
+
+// Where the region's search starts: sets tuned at single poses (one plant each: cheap, with three times the
+// evaluations) at the centre and at the poses with the region's lowest and highest dominant mode, each
+// judged over every pose of the region; the best of them.
+Candidate best_start(const PoseTuneInput& in, const config::Config& base, const std::vector<double>& centre,
+                     const TunedRegion& region, const std::vector<Evaluator>& plants, const TuneSettings& t) {
+  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
+  std::vector<std::vector<double>> starts{centre};
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  std::vector<double> at_lo, at_hi;
+  for (const NamedPose& p : region.poses) {
+    const double f = analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes).dominant_hz();
+    if (f < lo) lo = f, at_lo = p.joints_deg;
+    if (f > hi) hi = f, at_hi = p.joints_deg;
+  }
+  for (const auto& q : {at_lo, at_hi})
+    if (!q.empty() && std::find(starts.begin(), starts.end(), q) == starts.end()) starts.push_back(q);
+  std::vector<const Evaluator*> all;
+  for (const Evaluator& e : plants) all.push_back(&e);
+  TuneSettings single = t;
+  single.global_evaluations *= 3, single.local_evaluations *= 3;
+  std::optional<Evaluation> best;
+  for (const auto& q : starts) {
+    const Evaluator one(analysis::config_at_pose(base, analysis::pose_modes(in.model, q, sched.axis, sched.modes)), std::nullopt,
+                        single, config::describe_pose(q));
+    const Candidate c = tune(std::vector<const Evaluator*>{&one}, single).best.candidate;
+    Evaluation e = evaluate_worst(all, c);
+    e.candidate = c;
+    if (!best || better_than(e, *best)) best = e;
+  }
+  return best->candidate;
 }
 
 }  // namespace
@@ -123,19 +167,7 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
     progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) + ": " +
              std::to_string(out.poses.size()) + " poses, dominant mode " + fmt(out.dominant_min_hz) + "-" +
              fmt(out.dominant_max_hz) + " Hz");
-  // The set tuned at the region's centre (one plant: cheap), then the search over every pose of the region
-  // from there, at its polarity (from C1's shape over many plants at once it finds far less).
-  std::size_t centre_plant = 0;
-  for (std::size_t i = 0; i < out.poses.size(); ++i)
-    if (out.poses[i].joints_deg == centre) centre_plant = i;
-  const Evaluator centre_eval(plants.size() > centre_plant && out.poses[centre_plant].joints_deg == centre
-                                  ? plants[centre_plant].base()
-                                  : analysis::config_at_pose(base, analysis::pose_modes(in.model, centre, sched.axis, sched.modes)),
-                              std::nullopt, t, "centre");
-  TuneSettings at_centre_settings = t;  // one plant: a search three times as long costs less than the region's
-  at_centre_settings.global_evaluations *= 3, at_centre_settings.local_evaluations *= 3;
-  const TuneResult at_centre = tune(std::vector<const Evaluator*>{&centre_eval}, at_centre_settings);
-  const TuneResult r = tune_from(ptrs, at_centre.best.candidate, t);
+  const TuneResult r = tune_from(ptrs, best_start(in, base, centre, out, plants, t), t);
   out.worst = r.best;
   const Candidate& c = r.best.candidate;
   const config::Config tuned = with_candidate(base, c);

@@ -1,20 +1,23 @@
 // Tuning across the workspace (robodamp pose tune; docs/pose_dynamics.md, "Tuning across the workspace"):
 // from a pose-indexed robot model (fitted to measurements, robodamp pose fit) and the poses measured, two
 // controllers for a configuration's pose_schedule workspace:
-//   - robust: one compensator tuned over the whole workspace (the worst case over a grid of its poses and
-//     every measured pose inside it);
-//   - scheduled: regions drawn from the data: a region whose best tuned set does not serve it (infeasible:
-//     unstable, margins, the damping window, the actuator's limits, or a robot mode's peak worse than open
-//     loop at one of its poses) is cut in two across the joint that moves its dominant mode most, the halves
-//     overlapping by overlap_deg, and each half tuned again, until every region is served or max_regions.
-//     The cut lies where the dominant mode crosses the middle (geometric mean) of its range along that
-//     joint: on a robot whose two modes trade places, between them.
-// A region's poses are a grid over it: grid_points per joint along the joints that move the robot's
-// modes there (frequency by 1 % or modal stiffness by 5 % over the joint's width), the centre along the
-// others; and every measured pose inside it.
-// Each set is tuned by tune::tune (its objective: the largest closed-loop receptance peak over the region's
-// poses; no_worse_mode always on). Both are then scored on the workspace map (tune/pose_score.hpp) and the
-// better written. Off the real-time path.
+//   - robust: one compensator tuned over the whole workspace;
+//   - scheduled: regions drawn from the data: a region whose tuned set does not serve it (infeasible:
+//     unstable, margins, the actuator's limits, or a robot mode's peak more than worse_mode_tolerance_pct
+//     worse than open loop at one of its poses) is cut in two across the joint that moves its dominant mode
+//     most, the halves overlapping by overlap_deg, and each half tuned again, until every region is served
+//     or there are max_regions. The cut lies halfway from the region's centre to the pose where its set
+//     stops serving (the worst case's pose), else where the dominant mode crosses the middle (geometric
+//     mean) of its range along that joint; never closer than min_width_deg to the region's ends.
+// A region's poses: a grid over it, grid_points per joint along the joints that change the plant there
+// (over the joint's width, a mode's frequency by 1 % or a mode's peak receptance by 5 % of the largest
+// peak), the centre along the others; and every measured pose inside it.
+// A set's objective is the smallest improvement of any robot mode's peak over the region's poses (max-min),
+// under the tune's margins and actuator limits (tune/compensator_search.hpp; the damping window is left to
+// the modes' peaks), its compensator's gain nowhere more than compensator_gain_max times its gain at the
+// match frequency (a set that lifted the drift or the noise tripped on saturation in the HIL). It is searched at the region's centre first (one plant, three times the evaluations),
+// then over all the region's poses from there at that polarity (tune::tune_from). Both controllers are then
+// scored on the workspace map (tune/pose_score.hpp) and the better written. Off the real-time path.
 #pragma once
 
 #include <functional>
@@ -40,6 +43,7 @@ struct PoseTuneSettings {
   double overlap_deg{4.0};   // neighbouring regions overlap by this across the cut (the hand-over's hysteresis)
   double min_width_deg{8.0}; // a region is not cut along a joint narrower than twice this
   double worse_mode_tolerance_pct{1.0};  // a mode's peak up to this much worse than open loop still serves
+  double compensator_gain_max{10.0};     // TuneSettings::compensator_gain_max for every set
 };
 
 struct TunedRegion {
