@@ -167,7 +167,9 @@ class Controller final {
 
   void finish_ramp() noexcept {
     scale_ = target_scale_;
-    if (pending_) {  // faded out: hand over, then fade in
+    // Faded out: hand over, then fade in. Only the fade-out the warm-up started ends in a swap: a hand-over
+    // asked for while the last one still faded in waits for its own warm-up and fade-out.
+    if (pending_ && warmup_left_ == 0) {
       pending_ = false;
       cascade_ = shadow_;
       p_ = next_;  // same fs_hz (request_params refuses another rate), so dt_s_ stands

@@ -161,6 +161,39 @@ TEST(Controller, ParameterHandOverFadesOutSwapsAndFadesIn) {
   EXPECT_NEAR(got, want, 1e-6 * std::abs(want) + 1e-9);
 }
 
+// A robot moving through narrow pose regions asks for the next set while the last hand-over is still fading
+// in. The next swap must still wait for its own fade-out: swapping when the fade-in ended put the old
+// output scale on the new chain (a set with a sections gain 230 times smaller drove the HIL to saturation).
+TEST(Controller, AHandOverAskedDuringAFadeInStillFadesOutBeforeItsSwap) {
+  ControllerParams a = identity(1.0), b = identity(1.0), c = identity(1.0);
+  for (ControllerParams* p : {&a, &b, &c}) p->gain_ramp_s = 0.02, p->settle_s = 1.0;  // fade 100 samples, warm-up 4900
+  b.sections_gain = 2.0;
+  c.sections_gain = 1.0 / 230.0;  // the same K through a chain of another scale
+  Controller ctl(a);
+  ASSERT_EQ(ctl.request_params(b), RequestStatus::kAccepted);
+  int i = 0;
+  for (; ctl.handover_pending(); ++i) {
+    ASSERT_LT(i, 10000) << "b never swapped in";
+    (void)ctl.update(0.1);
+  }
+  for (int k = 0; k < 30; ++k, ++i) (void)ctl.update(0.1);  // 30 samples into b's fade-in
+  ASSERT_FALSE(ctl.handover_pending());
+  ASSERT_EQ(ctl.request_params(c), RequestStatus::kAccepted);
+  double largest_gain = 0.0, at_swap = -1.0, before = 0.0;
+  for (int k = 0; k < 6000; ++k) {
+    const bool pending = ctl.handover_pending();
+    const double y = ctl.update(0.1);
+    largest_gain = std::max(largest_gain, std::abs(ctl.gain_ns_per_m()));
+    if (pending && !ctl.handover_pending()) at_swap = std::abs(before);
+    before = y;
+  }
+  EXPECT_FALSE(ctl.handover_pending());
+  EXPECT_LE(largest_gain, 1.0 + 1e-9);  // K never above the sets' 1 N s/m
+  EXPECT_GE(at_swap, 0.0);
+  EXPECT_LE(at_swap, 0.0101 * 0.1 * 2.0 / 4.8);  // faded out before the swap: one ramp step (of 100) of b's output
+  EXPECT_NEAR(ctl.gain_ns_per_m(), 1.0, 1e-9);
+}
+
 TEST(Controller, HandOverWithoutRampStillSwapsTheSections) {
   // Zero ramp, zero settling time: the new sections must still be in force when the new limits are.
   ControllerParams a = identity(1.0), b = identity(1.0);
