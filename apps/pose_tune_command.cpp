@@ -97,6 +97,25 @@ std::string written_text(const PoseTuneArgs& a, const config::Config& cell, cons
   return text;
 }
 
+// The command that reproduces the file (its header).
+std::string command_line(const PoseTuneArgs& a) {
+  std::string c = "robodamp pose tune --config " + a.config_path;
+  if (!a.model_path.empty()) c += " --model " + a.model_path;
+  if (!a.measurements.empty()) {
+    c += " --measurements";
+    for (const auto& m : a.measurements) c += " " + m;
+  }
+  if (!a.hold_out.empty()) {
+    c += " --hold-out";
+    for (const auto& h : a.hold_out) c += " " + h;
+  }
+  if (!a.job_path.empty()) c += " --job " + a.job_path;
+  c += " --evaluations " + std::to_string(a.evaluations) + " --polish " + std::to_string(a.polish) + " --max-regions " +
+       std::to_string(a.max_regions) + " --map-points " + std::to_string(a.map_points) + " --overlap-deg " +
+       config::format_number(a.overlap_deg) + " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
+  return c;
+}
+
 json region_json(const tune::TunedRegion& r) {
   return {{"name", r.region.name}, {"min_deg", r.region.min_deg}, {"max_deg", r.region.max_deg},
           {"poses", r.poses.size()}, {"dominant_min_hz", r.dominant_min_hz}, {"dominant_max_hz", r.dominant_max_hz},
@@ -211,7 +230,8 @@ int run_pose_tune(const PoseTuneArgs& a) {
     }
     if (!a.out_path.empty()) {
       const std::string header = "# robodamp pose tune: the " + scores.controllers[best].name + " controller over the workspace of " +
-                                 a.config_path + " (robot " + in.model.source + "); the comparison: robodamp pose tune --json\n";
+                                 a.config_path + ", written by\n#   " + command_line(a) +
+                                 "\n# (the comparison of the robust, the scheduled and the given controllers: the same with --json)\n";
       (void)written_text(a, in.cell, chosen, header);
       t << "wrote " << a.out_path << " (read back, every region's set analysed over its grid)\n";
       out["out"] = a.out_path;
