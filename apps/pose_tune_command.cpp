@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <regex>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -82,7 +83,9 @@ std::string written_text(const PoseTuneArgs& a, const config::Config& cell, cons
   std::vector<config::YamlEdit> edits{{{"pose_schedule", "regions"}, regions}};
   if (!a.model_path.empty())
     edits.push_back({{"pose_schedule", "model"}, YAML::Node(std::filesystem::absolute(a.model_path).string())});
-  const config::EditedYaml e = config::edit_yaml(cell.yaml_text, edits);
+  config::EditedYaml e = config::edit_yaml(cell.yaml_text, edits);
+  // The regions' old comment describes the regions that were there.
+  e.text = std::regex_replace(e.text, std::regex(R"(\n(  regions:)[ \t]*#[^\n]*)"), "\n$1");
   const std::string text = header + config::rebase_file_paths(e.text, cell.source, a.out_path).text;
   if (const auto parent = std::filesystem::path(a.out_path).parent_path(); !parent.empty()) std::filesystem::create_directories(parent);
   const std::string check = a.out_path + ".check.yaml";
