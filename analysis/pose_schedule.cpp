@@ -29,13 +29,19 @@ config::ConfigError region_error(const config::Config& cfg, std::size_t i, const
       {config::Problem{cfg.source, {}, "pose_schedule.regions[" + std::to_string(i) + "]", message}}, cfg.yaml_text));
 }
 
-double driving_point_improvement(const LoopModel& m, double gain, int polarity) {
+}  // namespace
+
+double driving_point_improvement_pct(const LoopModel& m, double gain, int polarity) {
   for (const FrfResult& f : improvements(m, gain, polarity, true))
     if (f.response == m.actuator_location() && f.excitation == m.actuator_location()) return f.improvement_pct;
   return 0.0;
 }
 
-}  // namespace
+std::vector<double> region_centre(const config::PoseRegionConfig& r) {
+  std::vector<double> c(r.min_deg.size());
+  for (std::size_t j = 0; j < c.size(); ++j) c[j] = 0.5 * (r.min_deg[j] + r.max_deg[j]);
+  return c;
+}
 
 std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, int points) {
   const std::size_t n = r.min_deg.size();
@@ -98,7 +104,7 @@ RegionSet design_region(const config::Config& cfg, const config::RobotModelConfi
   const config::PoseRegionConfig& r = s.regions[i];
   RegionSet set;
   set.name = r.name;
-  for (std::size_t j = 0; j < r.min_deg.size(); ++j) set.centre_deg.push_back(0.5 * (r.min_deg[j] + r.max_deg[j]));
+  set.centre_deg = region_centre(r);
   const PoseModes centre = pose_modes(model, set.centre_deg, s.axis, s.modes);
   set.dominant_hz = centre.dominant_hz();
   set.gain_ns_per_m = r.gain_ns_per_m.value_or(cfg.controller.gain_ns_per_m);
@@ -151,7 +157,7 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
       if (mi.improvement_pct < set.worst_mode_improvement_pct)
         set.worst_mode_improvement_pct = mi.improvement_pct, set.worst_mode_hz = mi.freq_hz, set.worst_mode_pose_deg = q;
   }
-  set.improvement_centre_pct = driving_point_improvement(LoopModel(set.config), set.gain_ns_per_m, set.polarity);
+  set.improvement_centre_pct = driving_point_improvement_pct(LoopModel(set.config), set.gain_ns_per_m, set.polarity);
 }
 
 }  // namespace
@@ -171,7 +177,7 @@ PoseScheduleAnalysis analyse_pose_schedule(const config::Config& cfg) {
 double predicted_improvement_pct(const config::Config& set, const config::RobotModelConfig& model,
                                  const config::PoseScheduleConfig& schedule, const std::vector<double>& q) {
   const LoopModel m(config_at_pose(set, pose_modes(model, q, schedule.axis, schedule.modes)));
-  return driving_point_improvement(m, set.controller.gain_ns_per_m, set.controller.polarity);
+  return driving_point_improvement_pct(m, set.controller.gain_ns_per_m, set.controller.polarity);
 }
 
 }  // namespace robodamp::analysis

@@ -32,6 +32,9 @@ struct PoseModes {
 [[nodiscard]] PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
                                    int axis, int count);
 
+// The middle of the region's box.
+[[nodiscard]] std::vector<double> region_centre(const config::PoseRegionConfig& r);
+
 // Every pose of a points^n grid over the region's box (its ends included; points >= 2).
 [[nodiscard]] std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, int points);
 
@@ -72,6 +75,11 @@ struct PoseScheduleAnalysis {
 
 // Throws config::ConfigError naming the region, the pose and the reason when a region has no stable set.
 [[nodiscard]] PoseScheduleAnalysis analyse_pose_schedule(const config::Config& cfg);
+
+class LoopModel;
+// The driving-point improvement of a loop (discrete, %): how much the peak of the actuator location's
+// receptance drops with the loop closed at this gain and polarity.
+[[nodiscard]] double driving_point_improvement_pct(const LoopModel& m, double gain_ns_per_m, int polarity);
 
 // The driving-point improvement the analysis predicts for a set at a pose (discrete loop, %): how much
 // the peak of the actuator location's receptance drops with the loop closed.

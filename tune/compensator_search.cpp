@@ -318,6 +318,12 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   return e;
 }
 
+bool better(const Evaluation& a, const Evaluation& b) {
+  if (a.feasible() != b.feasible()) return a.feasible();
+  if (!a.feasible()) return a.violation < b.violation;
+  return a.objective > b.objective;
+}
+
 Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c,
                           bool skip_infeasible_objective) {
   std::vector<Evaluation> per;
@@ -426,12 +432,6 @@ struct Search {
   int budget;
   int count{0};
 };
-
-bool better(const Evaluation& a, const Evaluation& b) {
-  if (a.feasible() != b.feasible()) return a.feasible();
-  if (!a.feasible()) return a.violation < b.violation;
-  return a.objective > b.objective;
-}
 
 double penalised(unsigned /*n*/, const double* x, double* /*grad*/, void* data) {
   auto& s = *static_cast<Search*>(data);

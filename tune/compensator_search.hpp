@@ -180,6 +180,9 @@ class Evaluator {
   bool constraints_only_{false};
 };
 
+// The search's order: feasible before infeasible; then the larger objective, or the smaller violation.
+[[nodiscard]] bool better(const Evaluation& a, const Evaluation& b);
+
 // Several plants at once (both mountings, shifted modes): the candidate evaluated on each and the worst case
 // kept: the smallest objective and margins, the largest violation, named with its plant. With
 // skip_infeasible_objective, a candidate that already violates a cheap constraint on some plant is not

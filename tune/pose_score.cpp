@@ -81,7 +81,7 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
       if (std::getenv("RD_DEBUG")) fprintf(stderr, "DBG %s %s mode %.2f Hz open %.3g closed %.3g %.1f%%\n", mp.pose.name.c_str(), sets[i].name.c_str(), mi.freq_hz, mi.open_peak_m_per_n, mi.closed_peak_m_per_n, mi.improvement_pct);
       if (mi.improvement_pct < p.worst_mode_improvement_pct) p.worst_mode_improvement_pct = mi.improvement_pct, p.worst_mode_hz = mi.freq_hz;
     }
-    p.improvement_pct = std::min(p.improvement_pct, analysis::predicted_improvement_pct(sets[i].config, in.model, s, mp.pose.joints_deg));
+    p.improvement_pct = std::min(p.improvement_pct, analysis::driving_point_improvement_pct(m, k, pol));
     if (with_job) {
       const Evaluation e = with_job->assess(at);
       if (!p.damped_min_mm || e.accurate_min_mm < *p.damped_min_mm) p.damped_min_mm = e.accurate_min_mm, p.damped_min_rpm = e.accurate_min_rpm;

@@ -18,13 +18,6 @@ std::string fmt(double v, const char* f = "%.4g") {
   return b;
 }
 
-bool inside(const std::vector<double>& q, const std::vector<double>& lo, const std::vector<double>& hi) {
-  if (q.size() != lo.size()) return false;
-  for (std::size_t j = 0; j < q.size(); ++j)
-    if (q[j] < lo[j] || q[j] > hi[j]) return false;
-  return true;
-}
-
 // A mode's peak receptance along the axis (modal-stiffness form): 1 / (2 k zeta).
 double peak_m_per_n(const config::ModeConfig& m) { return 1.0 / (2.0 * m.stiffness_n_per_m * m.damping_ratio); }
 
@@ -32,8 +25,7 @@ double peak_m_per_n(const config::ModeConfig& m) { return 1.0 / (2.0 * m.stiffne
 // peak receptance by 5 % of the largest peak (a mode the axis barely sees may turn a lot and matter little).
 bool joint_moves_modes(const PoseTuneInput& in, const config::PoseRegionConfig& r, std::size_t j) {
   const config::PoseScheduleConfig& s = *in.cell.pose_schedule;
-  std::vector<double> centre(r.min_deg.size());
-  for (std::size_t i = 0; i < centre.size(); ++i) centre[i] = 0.5 * (r.min_deg[i] + r.max_deg[i]);
+  const std::vector<double> centre = analysis::region_centre(r);
   const analysis::PoseModes mid = analysis::pose_modes(in.model, centre, s.axis, s.modes);
   const double largest = peak_m_per_n(mid.modes[mid.dominant]);
   for (const double end : {r.min_deg[j], r.max_deg[j]}) {
@@ -69,7 +61,7 @@ namespace {
 std::vector<NamedPose> region_poses(const PoseTuneInput& in, const config::PoseRegionConfig& r) {
   std::vector<NamedPose> out = mode_grid(in, r, in.cell.pose_schedule->grid_points);
   for (const NamedPose& m : in.measured)
-    if (inside(m.joints_deg, r.min_deg, r.max_deg)) out.push_back(m);
+    if (config::region_holds(r, m.joints_deg.data(), m.joints_deg.size())) out.push_back(m);
   return out;
 }
 
@@ -99,11 +91,6 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
   return t;
 }
 
-bool better_than(const Evaluation& a, const Evaluation& b) {
-  if (a.feasible() != b.feasible()) return a.feasible();
-  return a.feasible() ? a.objective > b.objective : a.violation < b.violation;
-}
-
 // Where the region's search starts: sets tuned at single poses (one plant each: cheap, with three times the
 // evaluations) at the centre and at the poses with the region's lowest and highest dominant mode, each
 // judged over every pose of the region; the best of them.
@@ -131,7 +118,7 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
     const Candidate c = tune(std::vector<const Evaluator*>{&one}, single).best.candidate;
     Evaluation e = evaluate_worst(all, c);
     e.candidate = c;
-    if (!best || better_than(e, *best)) best = e;
+    if (!best || better(e, *best)) best = e;
   }
   return best->candidate;
 }
@@ -146,8 +133,7 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
   out.region.min_deg = min_deg;
   out.region.max_deg = max_deg;
   out.poses = region_poses(in, out.region);
-  std::vector<double> centre(min_deg.size());
-  for (std::size_t j = 0; j < centre.size(); ++j) centre[j] = 0.5 * (min_deg[j] + max_deg[j]);
+  const std::vector<double> centre = analysis::region_centre(out.region);
   double match_hz = 0.0;
   const config::Config base = region_base(in, centre, match_hz);
   const TuneSettings t = region_settings(in, s);
@@ -203,8 +189,7 @@ std::optional<Cut> cut_of(const PoseTuneInput& in, const TunedRegion& r, const P
   constexpr int kSteps = 32;
   const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
   const std::size_t n = r.region.min_deg.size();
-  std::vector<double> centre(n);
-  for (std::size_t j = 0; j < n; ++j) centre[j] = 0.5 * (r.region.min_deg[j] + r.region.max_deg[j]);
+  const std::vector<double> centre = analysis::region_centre(r.region);
   std::optional<Cut> best;
   double best_shift = -1.0;
   for (std::size_t j = 0; j < n; ++j) {
