@@ -26,4 +26,12 @@ std::vector<ModeImprovement> mode_improvements(const LoopModel& m, double gain_n
   return out;
 }
 
+std::optional<ModeImprovement> worst_mode(const std::vector<ModeImprovement>& modes, double min_hz, double max_hz,
+                                          bool inside) {
+  std::optional<ModeImprovement> out;
+  for (const ModeImprovement& mi : modes)
+    if ((mi.freq_hz >= min_hz && mi.freq_hz <= max_hz) == inside && (!out || mi.improvement_pct < out->improvement_pct)) out = mi;
+  return out;
+}
+
 }  // namespace robodamp::analysis

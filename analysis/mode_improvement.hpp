@@ -4,6 +4,7 @@
 // --no-worse-mode constraint, and by the pose schedule's check of each region's worst mode.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "analysis/loop_model.hpp"
@@ -18,5 +19,10 @@ struct ModeImprovement {
 
 // Empty when the configuration has no FRF or the loop is unstable at this gain and polarity.
 [[nodiscard]] std::vector<ModeImprovement> mode_improvements(const LoopModel& m, double gain_ns_per_m, int polarity);
+
+// The mode with the smallest improvement among those with min_hz <= frequency <= max_hz (inside: true) or
+// outside that band (inside: false); nothing when no mode is there.
+[[nodiscard]] std::optional<ModeImprovement> worst_mode(const std::vector<ModeImprovement>& modes, double min_hz,
+                                                        double max_hz, bool inside = true);
 
 }  // namespace robodamp::analysis

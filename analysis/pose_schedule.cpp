@@ -153,9 +153,12 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
       throw region_error(cfg, i, "has no set with margin: " + where + " K = " + fmt(set.gain_ns_per_m) +
                                      " N s/m is above supervision.max_gain_fraction x K_max = " + fmt(fraction) + " x " +
                                      fmt(k_max) + " N s/m: split the region or lower its gain_ns_per_m");
-    for (const ModeImprovement& mi : mode_improvements(m, set.gain_ns_per_m, set.polarity))
-      if (mi.improvement_pct < set.worst_mode_improvement_pct)
-        set.worst_mode_improvement_pct = mi.improvement_pct, set.worst_mode_hz = mi.freq_hz, set.worst_mode_pose_deg = q;
+    const std::vector<ModeImprovement> modes = mode_improvements(m, set.gain_ns_per_m, set.polarity);
+    if (const auto w = worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz); w && w->improvement_pct < set.worst_mode_improvement_pct)
+      set.worst_mode_improvement_pct = w->improvement_pct, set.worst_mode_hz = w->freq_hz, set.worst_mode_pose_deg = q;
+    if (const auto w = worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz, false);
+        w && (!set.outside_band_pct || w->improvement_pct < *set.outside_band_pct))
+      set.outside_band_pct = w->improvement_pct, set.outside_band_hz = w->freq_hz;
   }
   set.improvement_centre_pct = driving_point_improvement_pct(LoopModel(set.config), set.gain_ns_per_m, set.polarity);
 }

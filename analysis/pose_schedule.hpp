@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,11 +58,13 @@ struct RegionSet {
   std::vector<double> k_max_pose_deg; // where
   double dominant_min_hz{0.0}, dominant_max_hz{0.0};  // over the grid
   double improvement_centre_pct{0.0}; // predicted driving-point improvement at the centre (discrete loop)
-  // The smallest improvement of any robot mode's peak over the grid (analysis/mode_improvement.hpp):
-  // negative where the set makes a mode worse than open loop; where and which mode.
+  // The smallest improvement of any robot mode's peak in pose_schedule's damping band over the grid
+  // (analysis/mode_improvement.hpp): negative where the set makes a mode worse than open loop; where and
+  // which mode. Outside the band: the smallest, if a mode lies there.
   double worst_mode_improvement_pct{0.0};
   double worst_mode_hz{0.0};
   std::vector<double> worst_mode_pose_deg;
+  std::optional<double> outside_band_pct, outside_band_hz;
   int grid_poses{0};
 };
 

@@ -291,10 +291,13 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
                        {"improvement_centre_pct", r.improvement_centre_pct},
                        {"worst_mode_improvement_pct", r.worst_mode_improvement_pct},
                        {"worst_mode_hz", r.worst_mode_hz},
-                       {"worst_mode_pose_deg", r.worst_mode_pose_deg}});
+                       {"worst_mode_pose_deg", r.worst_mode_pose_deg},
+                       {"outside_band_pct", r.outside_band_pct ? json(*r.outside_band_pct) : json(nullptr)},
+                       {"outside_band_hz", r.outside_band_hz ? json(*r.outside_band_hz) : json(nullptr)}});
   }
-  const json report = {{"config", cfg.source}, {"model", ps.model.source}, {"axis", cfg.pose_schedule->axis ? "y" : "x"},
-                       {"regions", regions}};
+  const config::PoseScheduleConfig& sched = *cfg.pose_schedule;
+  const json report = {{"config", cfg.source}, {"model", ps.model.source}, {"axis", sched.axis ? "y" : "x"},
+                       {"damping_band_hz", {sched.damping_band_min_hz, sched.damping_band_max_hz}}, {"regions", regions}};
   if (!emit_json(out, report.dump(2), "analyze")) return 1;
   if (out.to_stdout()) return 0;
   std::printf("pose schedule of %s: robot model %s, actuator along %s\n", cfg.source.c_str(), ps.model.source.c_str(),
@@ -312,13 +315,17 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
   }
   std::printf("K_max is the smallest over each region's %d^%zu grid; margins and improvement at its centre\n",
               cfg.pose_schedule->grid_points, cfg.pose_schedule->joints());
-  std::printf("the worst mode over each region's grid (the smallest improvement of a robot mode's peak, %s within +-10 %%):\n",
-              cfg.robot.frfs.empty() ? "-" : cfg.robot.frfs.front().name.c_str());
+  std::printf("the worst mode in the damping band %g-%g Hz over each region's grid (the smallest improvement of a robot mode's "
+              "peak, %s within +-10 %%):\n",
+              sched.damping_band_min_hz, sched.damping_band_max_hz, cfg.robot.frfs.empty() ? "-" : cfg.robot.frfs.front().name.c_str());
   for (const auto& r : regions) {
     const double w = r["worst_mode_improvement_pct"];
-    std::printf("  %-12s %+7.1f %% at %.2f Hz at %s%s\n", r["name"].get<std::string>().c_str(), w, r["worst_mode_hz"].get<double>(),
+    std::printf("  %-12s %+7.1f %% at %.2f Hz at %s%s", r["name"].get<std::string>().c_str(), w, r["worst_mode_hz"].get<double>(),
                 config::describe_pose(r["worst_mode_pose_deg"].get<std::vector<double>>()).c_str(),
                 w < 0.0 ? ": worse than open loop there" : "");
+    if (!r["outside_band_pct"].is_null())
+      std::printf("; outside the band %+.1f %% at %.2f Hz", r["outside_band_pct"].get<double>(), r["outside_band_hz"].get<double>());
+    std::printf("\n");
   }
   return 0;
 }

@@ -87,12 +87,14 @@ struct FitData {
   std::optional<robot::FrfDirection> direction;  // from the measurements' configuration
 };
 
-// --measured items and --measurements directories, the --hold-out poses set apart.
-FitData fit_data(const PoseArgs& a) {
+// --measured items and --measurements directories (checked against the model: identify::check_against_model),
+// the --hold-out poses set apart.
+FitData fit_data(const PoseArgs& a, const config::RobotModelConfig& model) {
   FitData d;
   for (const auto& item : a.measured) d.fit.push_back(measured_frf(item));
   if (!a.measurements.empty()) {
     identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
+    identify::check_against_model(pm, model);
     d.direction = pm.direction;
     for (auto& f : pm.frfs) d.fit.push_back(std::move(f));
   }
@@ -141,7 +143,7 @@ json pose_rows(const config::RobotModelConfig& nominal, const config::RobotModel
 }
 
 int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
-  const FitData d = fit_data(a);
+  const FitData d = fit_data(a, m);
   const robot::PoseFitSettings s = fit_settings(a, d);
   const robot::PoseFitResult r = robot::fit_joints(m, d.fit, s);
   const char* dir = s.direction == robot::FrfDirection::kXX ? "xx" : s.direction == robot::FrfDirection::kXY ? "xy" : "yy";

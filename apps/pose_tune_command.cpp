@@ -39,10 +39,13 @@ std::string pct(double v) {
   return b;
 }
 
-// The measured poses (fit) and the held-out ones, by name.
-void read_poses(const PoseTuneArgs& a, std::vector<tune::NamedPose>& measured, std::vector<tune::NamedPose>& held) {
+// The measured poses (fit) and the held-out ones, by name; refused where they contradict each other under
+// the model (identify::check_against_model).
+void read_poses(const PoseTuneArgs& a, const config::RobotModelConfig& model, std::vector<tune::NamedPose>& measured,
+                std::vector<tune::NamedPose>& held) {
   if (a.measurements.empty()) return;
   const identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
+  identify::check_against_model(pm, model);
   for (const auto& f : pm.frfs) measured.push_back({f.name, f.joints_deg});
   for (const std::string& name : a.hold_out) {
     const auto it = std::find_if(measured.begin(), measured.end(), [&](const auto& p) { return p.name == name; });
@@ -186,7 +189,7 @@ int run_pose_tune(const PoseTuneArgs& a) {
       throw std::invalid_argument("--config " + a.config_path + " has no pose_schedule (its model, axis and workspace)");
     in.model = config::load_robot_model(a.model_path.empty() ? in.cell.pose_schedule->model_resolved : a.model_path);
     std::vector<tune::NamedPose> held;
-    read_poses(a, in.measured, held);
+    read_poses(a, in.model, in.measured, held);
     std::optional<config::MillingConfig> job;
     if (!a.job_path.empty()) job = config::load_milling_config(a.job_path);
     tune::PoseTuneSettings s;
@@ -205,18 +208,23 @@ int run_pose_tune(const PoseTuneArgs& a) {
     const std::vector<tune::TunedRegion>& chosen = best == 0 ? std::vector<tune::TunedRegion>{robust} : scheduled;
     std::ostringstream t;
     t << "robodamp pose tune: " << a.config_path << ", the robot " << in.model.name << " (" << in.model.source << "), "
-      << in.measured.size() << " measured pose(s) tuned at, " << held.size() << " held out\n";
+      << in.measured.size() << " measured pose(s) tuned at, " << held.size() << " held out; the damping band "
+      << config::format_number(in.cell.pose_schedule->damping_band_min_hz) << "-"
+      << config::format_number(in.cell.pose_schedule->damping_band_max_hz) << " Hz (no mode in it worse than open loop)\n";
     print_regions(t, "robust: one set over the workspace", {robust});
     print_regions(t, ("scheduled: " + std::to_string(scheduled.size()) + " region(s) drawn where one set stops serving").c_str(), scheduled);
     json map = print_map(t, scores);
     json summary = json::array();
     for (const auto& c : scores.controllers) {
       t << "  " << c.name << ": " << (c.stable_everywhere ? "stable at every pose" : "UNSTABLE at a pose")
-        << ", worst mode " << pct(c.worst_mode_improvement_pct) << " %, worst driving point " << pct(c.worst_improvement_pct) << " %";
+        << ", worst mode in the damping band " << pct(c.worst_mode_improvement_pct) << " %";
+      if (c.outside_band_pct) t << " (outside it " << pct(*c.outside_band_pct) << " % at " << config::format_number(std::round(*c.outside_band_hz * 100) / 100) << " Hz)";
+      t << ", worst driving point " << pct(c.worst_improvement_pct) << " %";
       if (c.damped_min_mm) t << ", the job's smallest damped depth " << *c.damped_min_mm << " mm (" << scores.method << ")";
       t << '\n';
       json cj = {{"name", c.name}, {"stable_everywhere", c.stable_everywhere},
-                 {"worst_mode_improvement_pct", c.stable_everywhere ? json(c.worst_mode_improvement_pct) : json(nullptr)}};
+                 {"worst_mode_improvement_pct", c.stable_everywhere ? json(c.worst_mode_improvement_pct) : json(nullptr)},
+                 {"outside_band_pct", c.stable_everywhere && c.outside_band_pct ? json(*c.outside_band_pct) : json(nullptr)}};
       if (c.damped_min_mm) cj["damped_min_mm"] = *c.damped_min_mm;
       summary.push_back(cj);
     }

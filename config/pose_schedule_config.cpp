@@ -160,6 +160,13 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   if (auto v = r.choice("axis", {"x", "y"}, "y")) c.axis = *v == "x" ? 0 : 1;
   if (auto v = read_int(r, "modes", {"(modes)", 1, 12}, c.modes)) c.modes = *v;
   if (auto v = read_int(r, "grid_points", {"(points per joint)", 2, 9}, c.grid_points)) c.grid_points = *v;
+  const Range band{"Hz", 0.0, 1e4, false, false, "the robot's modes lie far below"};
+  if (auto v = r.number("damping_band_min_hz", band, c.damping_band_min_hz)) c.damping_band_min_hz = *v;
+  if (auto v = r.number("damping_band_max_hz", band, c.damping_band_max_hz)) c.damping_band_max_hz = *v;
+  if (c.damping_band_max_hz <= c.damping_band_min_hz)
+    d.add(r.mark(), "pose_schedule.damping_band_max_hz",
+          "= " + format_number(c.damping_band_max_hz) + " Hz must be above pose_schedule.damping_band_min_hz = " +
+              format_number(c.damping_band_min_hz) + " Hz");
   const YAML::Node ws = r.child("workspace", true, "the joint-angle box the robot works in: min_deg, max_deg");
   if (present(ws)) {
     MapReader w(d, ws, "pose_schedule.workspace", r.mark());

@@ -34,6 +34,12 @@ struct PoseScheduleConfig {
   int axis{1};                 // the actuator's direction in the model's plane: 0 = x, 1 = y
   int modes{3};                // the robot's lowest modes put in the loop's plant
   int grid_points{3};          // per joint over each region (2: its corners; 3: and the middle ...)
+  // The damping band: the robot modes the schedule damps and promises never to make worse than open loop
+  // (the serving check, the tuned sets' objective, the schedule's report). A loop that damps one band lifts
+  // the response somewhere else (Bode's sensitivity integral, docs/pose_dynamics.md); outside this band the
+  // reports show by how much. Default: every mode in the plant.
+  double damping_band_min_hz{0.0}, damping_band_max_hz{1e9};
+  [[nodiscard]] bool in_damping_band(double f_hz) const { return f_hz >= damping_band_min_hz && f_hz <= damping_band_max_hz; }
   std::vector<double> workspace_min_deg, workspace_max_deg;  // the regions must cover it (no holes)
   std::vector<PoseRegionConfig> regions;
   [[nodiscard]] std::size_t joints() const { return workspace_min_deg.size(); }

@@ -85,6 +85,26 @@ void check_consistent(const PoseMeasurements& r) {
 
 }  // namespace
 
+void check_against_model(const PoseMeasurements& r, const config::RobotModelConfig& model) {
+  constexpr double kMeasuredApart = 0.2, kTimesTheModel = 3.0;
+  for (std::size_t i = 0; i < r.frfs.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k) {
+      const auto &a = r.frfs[i], &b = r.frfs[k];
+      const double f = std::max(peak_hz(a, r.band_min_hz, r.band_max_hz), peak_hz(b, r.band_min_hz, r.band_max_hz));
+      const double lo = std::max(r.band_min_hz, 0.5 * f), hi = std::min(r.band_max_hz, 2.0 * f);
+      const double d_model = frf_difference(robot::model_frf(model, a, r.direction, lo, hi), robot::model_frf(model, b, r.direction, lo, hi), lo, hi);
+      const double d = frf_difference(a, b, lo, hi);
+      if (d <= std::max(kMeasuredApart, kTimesTheModel * d_model)) continue;
+      const auto pct = [](double v) { return std::to_string(static_cast<int>(std::lround(100.0 * v))) + " %"; };
+      throw std::invalid_argument(
+          r.dirs[i] + " (pose '" + a.name + "' " + config::describe_pose(a.joints_deg) + ") and " + r.dirs[k] + " (pose '" +
+          b.name + "' " + config::describe_pose(b.joints_deg) + "): their measured FRFs differ by " + pct(d) + " around the " +
+          std::to_string(static_cast<int>(std::lround(f))) +
+          " Hz peak, more than 3 times the " + pct(d_model) + " the robot model " + model.name +
+          " puts between the two poses: contradicting data (a pose read wrong, a robot moved, a loose mount?); measure one of them again");
+    }
+}
+
 double frf_difference(const robot::MeasuredFrf& a, const robot::MeasuredFrf& b, double f_lo_hz, double f_hi_hz) {
   double peak = 0.0;
   for (std::size_t i = 0; i < a.freq_hz.size(); ++i)

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "config/robot_model_config.hpp"
 #include "robot/pose_fit.hpp"
 
 namespace robodamp::identify {
@@ -25,6 +26,14 @@ struct PoseMeasurements {
 // within 0.5 deg) whose FRFs disagree by more than 20 % (weighted relative RMS over 0.5-2x the larger
 // peak's frequency, inside the analysis band): contradicting data the model cannot fit both ways.
 [[nodiscard]] PoseMeasurements read_pose_measurements(const std::vector<std::string>& dirs, int location_id = 0);
+
+// Two measured poses whose FRFs differ by more than 20 % (the measure of read_pose_measurements' same-pose
+// check) and by more than 3 times what the robot model puts between those poses: data the model cannot
+// explain both ways (near poses the model's difference is small whatever its stiffnesses; far apart both
+// differences saturate and nothing is refused). Refused.
+// Throws std::invalid_argument naming both directories, both poses and the two differences; a pose
+// outside the model's travel throws config::ConfigError with the pose.
+void check_against_model(const PoseMeasurements& r, const config::RobotModelConfig& model);
 
 // The weighted relative RMS difference of two receptances on a's frequencies (b interpolated), over
 // [f_lo, f_hi] Hz, weights |a| / max|a|.

@@ -126,6 +126,16 @@ std::vector<double> model_errors(const config::RobotModelConfig& model, const st
   return out;
 }
 
+MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at, FrfDirection direction, double f_lo_hz,
+                      double f_hi_hz) {
+  if (auto p = config::pose_problem(model, at.joints_deg)) throw config::ConfigError({config::Problem{at.name, {}, "pose", *p}});
+  const PlanarChain c = at_pose(model, at.joints_deg);
+  MeasuredFrf out{at.name, at.joints_deg, {}, {}};
+  for (const double f : at.freq_hz)
+    if (f >= f_lo_hz && f <= f_hi_hz) out.freq_hz.push_back(f), out.receptance_m_per_n.push_back(pick(c.tcp_frf_direct(f), direction));
+  return out;
+}
+
 std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::vector<MeasuredFrf>& data,
                             const PoseFitSettings& s) {
   std::vector<double> out;

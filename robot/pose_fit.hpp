@@ -63,6 +63,11 @@ struct PoseFitResult {
 [[nodiscard]] std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::vector<MeasuredFrf>& data,
                                           const PoseFitSettings& s);
 
+// The model's receptance at a measurement's pose, on the measurement's frequencies in [f_lo_hz, f_hi_hz].
+// Throws config::ConfigError for a pose outside the joints' travel.
+[[nodiscard]] MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at, FrfDirection direction,
+                                    double f_lo_hz, double f_hi_hz);
+
 // Throws config::ConfigError for a pose outside the joints' travel or a measurement without points in the band.
 [[nodiscard]] PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
                                        const PoseFitSettings& s);

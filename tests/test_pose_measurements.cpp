@@ -182,6 +182,23 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.log.find("were measured at the same pose [-100, 110, -20] deg and their FRFs differ by"), std::string::npos) << r.log;
   EXPECT_NE(r.log.find("contradicting data"), std::string::npos) << r.log;
+  // Two poses, not one: the soft robot's measurement labelled 1.5 deg away along joint 3 (a pose read
+  // wrong). The models put 15 % (nominal) and 33 % (the cell.s) between the two poses. FRFs, the data 106 %:
+  // refused by fit and by pose
+  // tune, naming both poses.
+  test::replace_all(manifest, "-20.0", "-18.5");
+  std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
+  for (const std::vector<std::string>& cmd :
+       {std::vector<std::string>{"pose", "fit", "--model", kNominal, "--measurements", w.dir + "/here", soft.dir + "/there_soft"},
+        std::vector<std::string>{"pose", "tune", "--config", w.cell, "--measurements", w.dir + "/here", soft.dir + "/there_soft",
+                                 "--out", w.dir + "/never.yaml"}}) {
+    r = robodamp(cmd, w.dir + "/i.log");
+    EXPECT_EQ(r.status, 2) << r.log;
+    EXPECT_NE(r.log.find("[-100, 110, -18.5] deg) and " + w.dir + "/here (pose "), std::string::npos) << r.log;
+    EXPECT_NE(r.log.find(" % the robot model "), std::string::npos) << r.log;
+    EXPECT_NE(r.log.find("contradicting data"), std::string::npos) << r.log;
+    EXPECT_FALSE(fs::exists(w.dir + "/never.yaml"));
+  }
 }
 
 // A configuration moved to another directory names the same files: relative paths rebased, absolute ones

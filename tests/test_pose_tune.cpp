@@ -122,6 +122,55 @@ TEST(PoseTune, ARegionsCompensatorIsCheckedWithItsKeyAndTheReason) {
   }
 }
 
+// The damping band (the modes the schedule promises never to make worse) is read with its unit and range,
+// refused upside down, and limits what the schedule's worst mode counts: the rest is reported apart.
+TEST(PoseTune, TheDampingBandIsCheckedAndSplitsTheWorstModeInsideFromOutside) {
+  const std::string path = test::preset("pose_scheduled_c2");
+  std::string text = test::read_file(path);
+  std::string bad = text;
+  replace(bad, "grid_points: 3", "grid_points: 3\n  damping_band_min_hz: 30\n  damping_band_max_hz: 5");
+  try {
+    (void)config::parse_config(bad, path);
+    FAIL() << "accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("pose_schedule.damping_band_max_hz = 5 Hz must be above pose_schedule.damping_band_min_hz = 30 Hz"),
+              std::string::npos) << e.what();
+  }
+  replace(bad, "damping_band_max_hz: 5", "damping_band_max_hz: 2e5");
+  try {
+    (void)config::parse_config(bad, path);
+    FAIL() << "accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("pose_schedule.damping_band_max_hz = 200000 Hz is out of range: allowed 0 <= value <= 10000 Hz"), std::string::npos) << e.what();
+  }
+  // All modes by default; with a band, the modes outside it are reported apart and the worst inside is
+  // the smallest of the modes inside.
+  const config::Config all = config::parse_config(text, path);
+  const analysis::PoseScheduleAnalysis every = analysis::analyse_pose_schedule(all);
+  replace(text, "grid_points: 3", "grid_points: 3\n  damping_band_min_hz: 5\n  damping_band_max_hz: 30");
+  const config::Config banded = config::parse_config(text, path);
+  const analysis::PoseScheduleAnalysis in_band = analysis::analyse_pose_schedule(banded);
+  ASSERT_EQ(every.regions.size(), in_band.regions.size());
+  bool some_outside = false;
+  for (std::size_t i = 0; i < every.regions.size(); ++i) {
+    const analysis::RegionSet &e = every.regions[i], &b = in_band.regions[i];
+    EXPECT_FALSE(e.outside_band_pct.has_value());
+    EXPECT_GE(b.worst_mode_hz, 5.0);
+    EXPECT_LE(b.worst_mode_hz, 30.0);
+    EXPECT_GE(b.worst_mode_improvement_pct, e.worst_mode_improvement_pct);
+    if (b.outside_band_pct) {
+      some_outside = true;
+      EXPECT_TRUE(*b.outside_band_hz < 5.0 || *b.outside_band_hz > 30.0) << *b.outside_band_hz;
+      EXPECT_GE(*b.outside_band_pct, e.worst_mode_improvement_pct);
+      // The two together are the unbanded worst.
+      EXPECT_DOUBLE_EQ(std::min(*b.outside_band_pct, b.worst_mode_improvement_pct), e.worst_mode_improvement_pct);
+    } else {
+      EXPECT_DOUBLE_EQ(b.worst_mode_improvement_pct, e.worst_mode_improvement_pct);
+    }
+  }
+  EXPECT_TRUE(some_outside) << "the preset's third mode lies above 30 Hz somewhere";
+}
+
 struct Outcome {
   int status;
   std::string log;

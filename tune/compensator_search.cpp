@@ -244,9 +244,8 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
     e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
   if (s_.damping_window) add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
   if (s_.no_worse_mode || s_.worst_mode_objective) {
-    e.worst_mode_improvement_pct = kInf;
-    for (const auto& mi : analysis::mode_improvements(*m, k, cand.polarity))
-      e.worst_mode_improvement_pct = std::min(e.worst_mode_improvement_pct, mi.improvement_pct);
+    const auto worst = analysis::worst_mode(analysis::mode_improvements(*m, k, cand.polarity), s_.mode_band_min_hz, s_.mode_band_max_hz);
+    e.worst_mode_improvement_pct = worst ? worst->improvement_pct : kInf;
     if (s_.no_worse_mode)
       add_violation(e, -(e.worst_mode_improvement_pct + s_.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
   }

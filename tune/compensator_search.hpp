@@ -72,6 +72,9 @@ struct TuneSettings {
   // How much worse than open loop a mode's peak may get before no_worse_mode counts it (%): 0 for tune;
   // the pose tune allows 1 % (a mode the loop cannot reach moves by a fraction of that either way).
   double worse_mode_tolerance_pct{0.0};
+  // The modes no_worse_mode and worst_mode_objective count: those with a frequency in this band (Hz; the
+  // pose tune's pose_schedule damping band). Default: every mode.
+  double mode_band_min_hz{0.0}, mode_band_max_hz{1e9};
   // Every mode of the loop inside the damping window (a constraint by default). The pose tune drops it for
   // no_worse_mode, which judges its consequence where it matters: a mode the actuator barely moves along its
   // axis may sit outside the window and lose a fraction of a percent.

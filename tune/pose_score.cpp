@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -53,6 +52,8 @@ void fold(ControllerScore& c, const PoseScore& p) {
   c.stable_everywhere = c.stable_everywhere && p.stable;
   c.worst_mode_improvement_pct = std::min(c.worst_mode_improvement_pct, p.worst_mode_improvement_pct);
   c.worst_improvement_pct = std::min(c.worst_improvement_pct, p.improvement_pct);
+  if (p.outside_band_pct && (!c.outside_band_pct || *p.outside_band_pct < *c.outside_band_pct))
+    c.outside_band_pct = p.outside_band_pct, c.outside_band_hz = p.outside_band_hz;
   if (p.damped_min_mm) c.damped_min_mm = std::min(c.damped_min_mm.value_or(kInf), *p.damped_min_mm);
 }
 
@@ -77,10 +78,13 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
       if (with_job) p.damped_min_mm = 0.0;
       continue;
     }
-    for (const analysis::ModeImprovement& mi : analysis::mode_improvements(m, k, pol)) {
-      if (std::getenv("RD_DEBUG")) fprintf(stderr, "DBG %s %s mode %.2f Hz open %.3g closed %.3g %.1f%%\n", mp.pose.name.c_str(), sets[i].name.c_str(), mi.freq_hz, mi.open_peak_m_per_n, mi.closed_peak_m_per_n, mi.improvement_pct);
-      if (mi.improvement_pct < p.worst_mode_improvement_pct) p.worst_mode_improvement_pct = mi.improvement_pct, p.worst_mode_hz = mi.freq_hz;
-    }
+    const std::vector<analysis::ModeImprovement> modes = analysis::mode_improvements(m, k, pol);
+    if (const auto w = analysis::worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz);
+        w && w->improvement_pct < p.worst_mode_improvement_pct)
+      p.worst_mode_improvement_pct = w->improvement_pct, p.worst_mode_hz = w->freq_hz;
+    if (const auto w = analysis::worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz, false);
+        w && (!p.outside_band_pct || w->improvement_pct < *p.outside_band_pct))
+      p.outside_band_pct = w->improvement_pct, p.outside_band_hz = w->freq_hz;
     p.improvement_pct = std::min(p.improvement_pct, analysis::driving_point_improvement_pct(m, k, pol));
     if (with_job) {
       const Evaluation e = with_job->assess(at);

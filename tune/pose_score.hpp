@@ -2,8 +2,8 @@
 // "Tuning across the workspace"): at every pose of a grid over the workspace and every measured and held-out
 // pose, the sets that can run there (in an overlap either region's, the hand-over's hysteresis decides;
 // the worst of them counts) against the pose-indexed model's plant:
-//   - stable, the smallest improvement of any robot mode's peak (analysis/mode_improvement.hpp) and the
-//     driving point's improvement (discrete loop);
+//   - stable, the smallest improvement of any robot mode's peak (analysis/mode_improvement.hpp) in the
+//     pose_schedule's damping band and outside it, and the driving point's improvement (discrete loop);
 //   - with a milling job, its damped limiting depth by the accurate method (the sampled loop's
 //     semi-discretization, the same checked speeds as tune's objective: the job's speed, the damped
 //     zero-order lobes' lowest minima and the open loop's SDM minima), next to the open loop's.
@@ -23,8 +23,10 @@ namespace robodamp::tune {
 struct PoseScore {
   std::vector<std::string> regions;     // the sets that can run at the pose (none: outside every region, not scored)
   bool stable{false};
-  double worst_mode_improvement_pct{0.0};
+  double worst_mode_improvement_pct{0.0};  // of the modes in pose_schedule's damping band
   double worst_mode_hz{0.0};
+  std::optional<double> outside_band_pct;  // the worst mode outside the damping band, if one is
+  std::optional<double> outside_band_hz;
   double improvement_pct{0.0};          // the driving point's peak
   std::optional<double> damped_min_mm;  // with a job: sampled-loop SDM
   std::optional<double> damped_min_rpm;
@@ -34,7 +36,9 @@ struct ControllerScore {
   std::string name;                     // "robust", "scheduled"
   std::vector<PoseScore> poses;         // in the map's order
   bool stable_everywhere{true};
-  double worst_mode_improvement_pct{0.0};  // over the map
+  double worst_mode_improvement_pct{0.0};  // over the map, in the damping band
+  std::optional<double> outside_band_pct;  // over the map, outside it
+  std::optional<double> outside_band_hz;
   double worst_improvement_pct{0.0};
   std::optional<double> damped_min_mm;  // with a job: the smallest over the map
 };

@@ -57,9 +57,24 @@ std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegi
 
 namespace {
 
-// The region's poses: its grid (see the header) and every measured pose inside it.
+// The region's poses: its grid (see the header), a line every kLineStepDeg at most along each joint that
+// moves the plant (the others at the centre: a wide region's set must hold between its grid's poses too),
+// and every measured pose inside it.
 std::vector<NamedPose> region_poses(const PoseTuneInput& in, const config::PoseRegionConfig& r) {
+  constexpr double kLineStepDeg = 10.0;
   std::vector<NamedPose> out = mode_grid(in, r, in.cell.pose_schedule->grid_points);
+  const std::vector<double> centre = analysis::region_centre(r);
+  for (std::size_t j = 0; j < r.min_deg.size(); ++j) {
+    const double width = r.max_deg[j] - r.min_deg[j];
+    const int steps = static_cast<int>(std::ceil(width / kLineStepDeg));
+    if (steps < in.cell.pose_schedule->grid_points || !joint_moves_modes(in, r, j)) continue;
+    for (int k = 0; k <= steps; ++k) {
+      std::vector<double> q = centre;
+      q[j] = r.min_deg[j] + width * k / steps;
+      if (std::none_of(out.begin(), out.end(), [&](const NamedPose& p) { return p.joints_deg == q; }))
+        out.push_back({config::describe_pose(q), q});
+    }
+  }
   for (const NamedPose& m : in.measured)
     if (config::region_holds(r, m.joints_deg.data(), m.joints_deg.size())) out.push_back(m);
   return out;
@@ -85,6 +100,8 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
   t.worse_mode_tolerance_pct = s.worse_mode_tolerance_pct;
   t.damping_window = false;
   t.worst_mode_objective = true;
+  t.mode_band_min_hz = in.cell.pose_schedule->damping_band_min_hz;
+  t.mode_band_max_hz = in.cell.pose_schedule->damping_band_max_hz;
   t.compensator_gain_max = s.compensator_gain_max;
   const double fraction = in.cell.supervision.max_gain_fraction;
   if (fraction > 0.0 && fraction < 1.0) t.gain_margin_min_db = std::max(t.gain_margin_min_db, -20.0 * std::log10(fraction) + 0.1);
