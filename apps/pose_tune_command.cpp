@@ -79,16 +79,20 @@ YAML::Node region_node(const config::PoseRegionConfig& r) {
 
 // The cell's text with the chosen regions (and the model the sets were tuned on), its relative paths
 // rebased to --out; read back and its schedule analysed before it is written.
+// chosen: the tuned regions; empty: the configuration's own schedule won and its regions stay as written.
 std::string written_text(const PoseTuneArgs& a, const config::Config& cell, const std::vector<tune::TunedRegion>& chosen,
                          const std::string& header) {
-  YAML::Node regions(YAML::NodeType::Sequence);
-  for (const auto& r : chosen) regions.push_back(region_node(r.region));
-  std::vector<config::YamlEdit> edits{{{"pose_schedule", "regions"}, regions}};
+  std::vector<config::YamlEdit> edits;
+  if (!chosen.empty()) {
+    YAML::Node regions(YAML::NodeType::Sequence);
+    for (const auto& r : chosen) regions.push_back(region_node(r.region));
+    edits.push_back({{"pose_schedule", "regions"}, regions});
+  }
   if (!a.model_path.empty())
     edits.push_back({{"pose_schedule", "model"}, YAML::Node(std::filesystem::absolute(a.model_path).string())});
   config::EditedYaml e = config::edit_yaml(cell.yaml_text, edits);
   // The regions' old comment describes the regions that were there.
-  e.text = std::regex_replace(e.text, std::regex(R"(\n(  regions:)[ \t]*#[^\n]*)"), "\n$1");
+  if (!chosen.empty()) e.text = std::regex_replace(e.text, std::regex(R"(\n(  regions:)[ \t]*#[^\n]*)"), "\n$1");
   const std::string text = header + config::rebase_file_paths(e.text, cell.source, a.out_path).text;
   if (const auto parent = std::filesystem::path(a.out_path).parent_path(); !parent.empty()) std::filesystem::create_directories(parent);
   const std::string check = a.out_path + ".check.yaml";
@@ -205,7 +209,9 @@ int run_pose_tune(const PoseTuneArgs& a) {
          {"scheduled", tune::schedule_of(*in.cell.pose_schedule, scheduled)},
          {"as given", *in.cell.pose_schedule}}, job, progress);
     const std::size_t best = tune::better_controller(scores);
-    const std::vector<tune::TunedRegion>& chosen = best == 0 ? std::vector<tune::TunedRegion>{robust} : scheduled;
+    // The configuration's own schedule (the third) is written back as it is when it scores best.
+    const std::vector<tune::TunedRegion> chosen =
+        best == 0 ? std::vector<tune::TunedRegion>{robust} : best == 1 ? scheduled : std::vector<tune::TunedRegion>{};
     std::ostringstream t;
     t << "robodamp pose tune: " << a.config_path << ", the robot " << in.model.name << " (" << in.model.source << "), "
       << in.measured.size() << " measured pose(s) tuned at, " << held.size() << " held out; the damping band "

@@ -57,16 +57,15 @@ std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegi
 
 namespace {
 
-// The region's poses: its grid (see the header), a line every kLineStepDeg at most along each joint that
+// The region's poses: its grid (see the header), a line every line_step_deg at most along each joint that
 // moves the plant (the others at the centre: a wide region's set must hold between its grid's poses too),
 // and every measured pose inside it.
-std::vector<NamedPose> region_poses(const PoseTuneInput& in, const config::PoseRegionConfig& r) {
-  constexpr double kLineStepDeg = 10.0;
+std::vector<NamedPose> region_poses(const PoseTuneInput& in, const config::PoseRegionConfig& r, double line_step_deg) {
   std::vector<NamedPose> out = mode_grid(in, r, in.cell.pose_schedule->grid_points);
   const std::vector<double> centre = analysis::region_centre(r);
   for (std::size_t j = 0; j < r.min_deg.size(); ++j) {
     const double width = r.max_deg[j] - r.min_deg[j];
-    const int steps = static_cast<int>(std::ceil(width / kLineStepDeg));
+    const int steps = static_cast<int>(std::ceil(width / line_step_deg));
     if (steps < in.cell.pose_schedule->grid_points || !joint_moves_modes(in, r, j)) continue;
     for (int k = 0; k <= steps; ++k) {
       std::vector<double> q = centre;
@@ -149,7 +148,7 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
   out.region.name = name;
   out.region.min_deg = min_deg;
   out.region.max_deg = max_deg;
-  out.poses = region_poses(in, out.region);
+  out.poses = region_poses(in, out.region, s.line_step_deg);
   const std::vector<double> centre = analysis::region_centre(out.region);
   double match_hz = 0.0;
   const config::Config base = region_base(in, centre, match_hz);

@@ -11,7 +11,8 @@
 //     mean) of its range along that joint; never closer than min_width_deg to the region's ends.
 // A region's poses: a grid over it, grid_points per joint along the joints that change the plant there
 // (over the joint's width, a mode's frequency by 1 % or a mode's peak receptance by 5 % of the largest
-// peak), the centre along the others; and every measured pose inside it.
+// peak), the centre along the others; a line of poses at most line_step_deg apart along each such joint;
+// and every measured pose inside it.
 // A set's objective is the smallest improvement of any robot mode's peak over the region's poses (max-min),
 // under the tune's margins and actuator limits (tune/compensator_search.hpp; the damping window is left to
 // the modes' peaks), its compensator's gain nowhere more than compensator_gain_max times its gain at the
@@ -42,6 +43,7 @@ struct PoseTuneSettings {
   int max_regions{4};        // the scheduled controller's regions at most
   double overlap_deg{4.0};   // neighbouring regions overlap by this across the cut (the hand-over's hysteresis)
   double min_width_deg{8.0}; // a region is not cut along a joint narrower than twice this
+  double line_step_deg{10.0};  // a region's poses along each joint that changes the plant at most this far apart
   double worse_mode_tolerance_pct{1.0};  // a mode's peak up to this much worse than open loop still serves
   double compensator_gain_max{10.0};     // TuneSettings::compensator_gain_max for every set
 };
