@@ -1,7 +1,6 @@
 #include "apps/pose_tune_command.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,18 +18,14 @@
 #include "identify/pose_measurements.hpp"
 #include "tune/pose_score.hpp"
 #include "tune/pose_tune.hpp"
+#include "tune/tuned_file.hpp"
 
 namespace robodamp::apps {
 
 namespace {
 
 using nlohmann::json;
-
-std::string exact(double x) {
-  char b[32];
-  const auto r = std::to_chars(b, b + sizeof b, x);
-  return std::string(b, r.ptr);
-}
+using tune::exact;
 
 std::string pct(double v) {
   if (std::isinf(v)) return v < 0 ? "unstable" : "-";

@@ -4,16 +4,12 @@
 #include <string>
 
 namespace robodamp::tune {
-namespace {
 
-// The shortest decimal text that reads back as exactly x: the written file holds the verified numbers.
 std::string exact(double x) {
   char b[32];
   const auto r = std::to_chars(b, b + sizeof b, x);
   return std::string(b, r.ptr);
 }
-
-}  // namespace
 
 // The configuration's own text with the compensator, the gain and the polarity set, as data
 // (config/yaml_edit.hpp): any YAML style; comments kept where the splice is exact.

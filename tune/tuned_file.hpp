@@ -3,11 +3,16 @@
 // in whatever YAML style the configuration is written, its comments kept where the edit is exact.
 #pragma once
 
+#include <string>
+
 #include "config/config.hpp"
 #include "config/yaml_edit.hpp"
 #include "tune/compensator_search.hpp"
 
 namespace robodamp::tune {
+
+// The shortest decimal text that reads back as exactly x: a written file holds the verified numbers.
+[[nodiscard]] std::string exact(double x);
 
 // base: a configuration with a compensator in its chain (Evaluator refuses one without); base.yaml_text is
 // edited. Throws std::invalid_argument when the text cannot be edited to read back.
