@@ -166,8 +166,12 @@ json print_map(std::ostringstream& t, const tune::MapScores& s) {
                     p.damped_min_mm ? exact(std::round(*p.damped_min_mm * 1e4) / 1e4).c_str() : "-");
       t << b;
       json pj = {{"regions", p.regions}, {"stable", p.stable}};
-      if (!p.regions.empty() && p.stable)
+      if (!p.regions.empty() && p.stable) {
         pj["worst_mode_improvement_pct"] = p.worst_mode_improvement_pct, pj["improvement_pct"] = p.improvement_pct;
+        json by = json::object();  // the set that runs depends on the path (the hand-over's hysteresis)
+        for (std::size_t r = 0; r < p.regions.size(); ++r) by[p.regions[r]] = p.region_improvement_pct[r];
+        pj["improvement_by_region_pct"] = by;
+      }
       if (p.damped_min_mm) pj["damped_min_mm"] = *p.damped_min_mm, pj["damped_min_rpm"] = *p.damped_min_rpm;
       row[c.name] = pj;
     }

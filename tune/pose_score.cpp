@@ -73,6 +73,7 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
     const double k = sets[i].gain_ns_per_m;
     const int pol = sets[i].polarity;
     if (!m.stable(k, pol)) {
+      p.region_improvement_pct.push_back(-kInf);
       p.stable = false;
       p.worst_mode_improvement_pct = p.improvement_pct = -kInf;
       if (with_job) p.damped_min_mm = 0.0;
@@ -85,7 +86,9 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
     if (const auto w = analysis::worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz, false);
         w && (!p.outside_band_pct || w->improvement_pct < *p.outside_band_pct))
       p.outside_band_pct = w->improvement_pct, p.outside_band_hz = w->freq_hz;
-    p.improvement_pct = std::min(p.improvement_pct, analysis::driving_point_improvement_pct(m, k, pol));
+    const double point = analysis::driving_point_improvement_pct(m, k, pol);
+    p.region_improvement_pct.push_back(point);
+    p.improvement_pct = std::min(p.improvement_pct, point);
     if (with_job) {
       const Evaluation e = with_job->assess(at);
       if (!p.damped_min_mm || e.accurate_min_mm < *p.damped_min_mm) p.damped_min_mm = e.accurate_min_mm, p.damped_min_rpm = e.accurate_min_rpm;

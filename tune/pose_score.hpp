@@ -27,7 +27,8 @@ struct PoseScore {
   double worst_mode_hz{0.0};
   std::optional<double> outside_band_pct;  // the worst mode outside the damping band, if one is
   std::optional<double> outside_band_hz;
-  double improvement_pct{0.0};          // the driving point's peak
+  double improvement_pct{0.0};          // the driving point's peak (in an overlap the worse set's)
+  std::vector<double> region_improvement_pct;  // each region's set in `regions`: the driving point's peak
   std::optional<double> damped_min_mm;  // with a job: sampled-loop SDM
   std::optional<double> damped_min_rpm;
 };
