@@ -183,9 +183,8 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   EXPECT_NE(r.log.find("were measured at the same pose [-100, 110, -20] deg and their FRFs differ by"), std::string::npos) << r.log;
   EXPECT_NE(r.log.find("contradicting data"), std::string::npos) << r.log;
   // Two poses, not one: the soft robot's measurement labelled 1.5 deg away along joint 3 (a pose read
-  // wrong). The models put 15 % (nominal) and 33 % (the cell.s) between the two poses. FRFs, the data 106 %:
-  // refused by fit and by pose
-  // tune, naming both poses.
+  // wrong). The models put 15 % (nominal) and 33 % (the cell's) between the two poses' FRFs, the data 106 %:
+  // refused by fit and by pose tune, naming both poses, and nothing written.
   test::replace_all(manifest, "-20.0", "-18.5");
   std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
   for (const std::vector<std::string>& cmd :
