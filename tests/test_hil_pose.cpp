@@ -30,6 +30,28 @@ using test::hil_files;
 
 json read_json(const std::string& path) { return json::parse(test::read_file(path)); }
 
+struct Exits {
+  int plant{-1}, run{-1};
+};
+
+// The emulator (plant_config) along the trajectory in lockstep and, in the other process, the controller
+// (run_config, with run_extra) on the virtual clock for duration_s; both waited for on every path. Their
+// JSON goes to f.plant_json and f.run_json, their logs to f.plant_log and f.run_log.
+Exits run_along_path(const HilFiles& f, const std::string& plant_config, const std::string& run_config,
+                     const std::vector<std::string>& trajectory, const std::string& duration_s,
+                     const std::vector<std::string>& run_extra = {}) {
+  std::vector<std::string> pargs{"plant", "--config", plant_config, "--pacing", "lockstep", "--json", f.plant_json};
+  pargs.insert(pargs.end(), trajectory.begin(), trajectory.end());
+  Child p(pargs, f.plant_log);
+  std::vector<std::string> rargs{"run", "--config", run_config, "--clock", "virtual", "--duration", duration_s, "--json", f.run_json};
+  rargs.insert(rargs.end(), run_extra.begin(), run_extra.end());
+  Child r(rargs, f.run_log);
+  Exits e;
+  e.run = r.wait();
+  e.plant = p.wait();
+  return e;
+}
+
 // The robot (the planar-robot study's model, config/hil_pose_schedule.yaml) dwells folded (joint 2 at 10 deg), moves
 // over 6 s to stretched (100 deg) and dwells there; its dominant mode along the actuator moves from 9.2
 // to 19.8 Hz. The controller in the other process reads the joint registers and hands over from the
@@ -44,16 +66,11 @@ TEST(Hil, PoseTrajectoryHandsOverBetweenRegionsAndSchedulingOffTrips) {
   std::string record;
   for (const std::string mode : {"on", "off"}) {
     const HilFiles f = hil_files("pose_" + mode, {}, "hil_pose_schedule");
-    std::vector<std::string> pargs{"plant", "--config", f.config, "--pacing", "lockstep", "--json", f.plant_json};
-    pargs.insert(pargs.end(), trajectory.begin(), trajectory.end());
-    Child p(pargs, f.plant_log);
-    std::vector<std::string> rargs{"run", "--config", f.config, "--clock", "virtual", "--duration", "50", "--json", f.run_json};
-    if (mode == "on") record = f.dir + "/run.rec", rargs.insert(rargs.end(), {"--record", record});
-    if (mode == "off") rargs.push_back("--no-pose-schedule");
-    Child r(rargs, f.run_log);
-    const int run_status = r.wait();
-    ASSERT_EQ(p.wait(), 0) << test::read_file(f.plant_log);
-    ASSERT_EQ(run_status, mode == "on" ? 0 : 4) << test::read_file(f.run_log);
+    std::vector<std::string> extra{"--no-pose-schedule"};
+    if (mode == "on") record = f.dir + "/run.rec", extra = {"--record", record};
+    const Exits e = run_along_path(f, f.config, f.config, trajectory, "50", extra);
+    ASSERT_EQ(e.plant, 0) << test::read_file(f.plant_log);
+    ASSERT_EQ(e.run, mode == "on" ? 0 : 4) << test::read_file(f.run_log);
     plant[mode] = read_json(f.plant_json);
     run[mode] = read_json(f.run_json);
   }
@@ -123,14 +140,10 @@ TEST(Hil, TunedScheduleAtPosesNobodyMeasuredDampsAsPredicted) {
                                             "--pose-at", "54:-100,85,90", "--pose-at", "58:-100,125,90", "--pose-at", "82:-100,125,90"};
   // The file's own settle time (3 s into each dwell): two wide regions, one hand-over on the way.
   const HilFiles f = hil_files("pose_tuned", {}, "hil_pose_tuned");
-  std::vector<std::string> pargs{"plant", "--config", f.config, "--pacing", "lockstep", "--json", f.plant_json};
-  pargs.insert(pargs.end(), trajectory.begin(), trajectory.end());
-  Child p(pargs, f.plant_log);
   const std::string record = f.dir + "/run.rec";
-  Child r({"run", "--config", f.config, "--clock", "virtual", "--duration", "82", "--json", f.run_json, "--record", record}, f.run_log);
-  const int run_status = r.wait();
-  ASSERT_EQ(p.wait(), 0) << test::read_file(f.plant_log);
-  ASSERT_EQ(run_status, 0) << test::read_file(f.run_log);
+  const Exits e = run_along_path(f, f.config, f.config, trajectory, "82", {"--record", record});
+  ASSERT_EQ(e.plant, 0) << test::read_file(f.plant_log);
+  ASSERT_EQ(e.run, 0) << test::read_file(f.run_log);
   const json run = read_json(f.run_json), plant = read_json(f.plant_json);
   EXPECT_EQ(run["trip"], "none");
   EXPECT_EQ(run["arming"]["outcome"], "armed");
@@ -235,13 +248,9 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
   std::ofstream(f.dir + "/plant.yaml") << plant_cell;
   const std::vector<std::string> trajectory{"--pose-at", "0:-90,50,29.5",  "--pose-at", "24:-90,50,29.5", "--pose-at", "30:-90,90,30",
                                             "--pose-at", "54:-90,90,30", "--pose-at", "58:-90.25,110,29.5", "--pose-at", "82:-90.25,110,29.5"};
-  std::vector<std::string> pargs{"plant", "--config", f.dir + "/plant.yaml", "--pacing", "lockstep", "--json", f.plant_json};
-  pargs.insert(pargs.end(), trajectory.begin(), trajectory.end());
-  Child p(pargs, f.plant_log);
-  Child r({"run", "--config", tuned, "--clock", "virtual", "--duration", "82", "--json", f.run_json}, f.run_log);
-  const int run_status = r.wait();
-  ASSERT_EQ(p.wait(), 0) << test::read_file(f.plant_log);
-  ASSERT_EQ(run_status, 0) << test::read_file(f.run_log);
+  const Exits e = run_along_path(f, f.dir + "/plant.yaml", tuned, trajectory, "82");
+  ASSERT_EQ(e.plant, 0) << test::read_file(f.plant_log);
+  ASSERT_EQ(e.run, 0) << test::read_file(f.run_log);
   const json run = read_json(f.run_json), plant = read_json(f.plant_json);
   EXPECT_EQ(run["trip"], "none");
   EXPECT_EQ(run["arming"]["outcome"], "armed");
