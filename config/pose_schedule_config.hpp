@@ -39,7 +39,6 @@ struct PoseScheduleConfig {
   // the response somewhere else (Bode's sensitivity integral, docs/pose_dynamics.md); outside this band the
   // reports show by how much. Default: every mode in the plant.
   double damping_band_min_hz{0.0}, damping_band_max_hz{1e9};
-  [[nodiscard]] bool in_damping_band(double f_hz) const { return f_hz >= damping_band_min_hz && f_hz <= damping_band_max_hz; }
   std::vector<double> workspace_min_deg, workspace_max_deg;  // the regions must cover it (no holes)
   std::vector<PoseRegionConfig> regions;
   [[nodiscard]] std::size_t joints() const { return workspace_min_deg.size(); }

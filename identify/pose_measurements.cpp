@@ -87,12 +87,14 @@ void check_consistent(const PoseMeasurements& r) {
 
 void check_against_model(const PoseMeasurements& r, const config::RobotModelConfig& model) {
   constexpr double kMeasuredApart = 0.2, kTimesTheModel = 3.0;
+  std::vector<robot::MeasuredFrf> modelled;  // the model at each pose, once, on its measurement's frequencies
+  for (const auto& f : r.frfs) modelled.push_back(robot::model_frf(model, f, r.direction, r.band_min_hz, r.band_max_hz));
   for (std::size_t i = 0; i < r.frfs.size(); ++i)
     for (std::size_t k = 0; k < i; ++k) {
       const auto &a = r.frfs[i], &b = r.frfs[k];
       const double f = std::max(peak_hz(a, r.band_min_hz, r.band_max_hz), peak_hz(b, r.band_min_hz, r.band_max_hz));
       const double lo = std::max(r.band_min_hz, 0.5 * f), hi = std::min(r.band_max_hz, 2.0 * f);
-      const double d_model = frf_difference(robot::model_frf(model, a, r.direction, lo, hi), robot::model_frf(model, b, r.direction, lo, hi), lo, hi);
+      const double d_model = frf_difference(modelled[i], modelled[k], lo, hi);
       const double d = frf_difference(a, b, lo, hi);
       if (d <= std::max(kMeasuredApart, kTimesTheModel * d_model)) continue;
       const auto pct = [](double v) { return std::to_string(static_cast<int>(std::lround(100.0 * v))) + " %"; };

@@ -16,8 +16,10 @@
 // A set's objective is the smallest improvement of any robot mode's peak over the region's poses (max-min),
 // under the tune's margins and actuator limits (tune/compensator_search.hpp; the damping window is left to
 // the modes' peaks), its compensator's gain nowhere more than compensator_gain_max times its gain at the
-// match frequency (a set that lifted the drift or the noise tripped on saturation in the HIL). It is searched at the region's centre first (one plant, three times the evaluations),
-// then over all the region's poses from there at that polarity (tune::tune_from). Both controllers are then
+// match frequency (a set that lifted the drift or the noise tripped on saturation in the HIL). It starts from
+// the best of single-pose tunes (one plant each, three times the evaluations) at the region's centre and at
+// its lowest and highest dominant mode, then is searched over all the region's poses from there at that
+// polarity (tune::tune_from). Both controllers are then
 // scored on the workspace map (tune/pose_score.hpp) and the better written. Off the real-time path.
 #pragma once
 
