@@ -16,8 +16,6 @@ namespace robodamp::analysis {
 
 namespace {
 
-constexpr double kMinModeDampingRatio = 1e-3;  // a mode without joint damping still gets a little
-
 std::string fmt(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.4g", v);
@@ -69,7 +67,7 @@ PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<do
     config::ModeConfig c;
     c.form = config::ModeForm::kStiffness;
     c.natural_freq_hz = md.freq_hz;
-    c.damping_ratio = std::max(kMinModeDampingRatio, 0.5 * md.loss_factor);
+    c.damping_ratio = robot::modal_damping_ratio(md);
     c.stiffness_n_per_m = w * w / (phi * phi);
     if (c.stiffness_n_per_m * c.damping_ratio < best) best = c.stiffness_n_per_m * c.damping_ratio, out.dominant = out.modes.size();
     out.modes.push_back(c);

@@ -51,6 +51,7 @@ struct PoseArgs {
   std::string direction{"yy"};
   std::vector<double> fit_band_hz{10.0, 30.0};
   int restarts{3}, particles{40}, iterations{150}, seed{1};
+  std::optional<int> fit_modes;  // fit: the model's form (robot::PoseFitSettings::modes)
   std::string out_path;
   std::string csv_path;
   double csv_step_hz{0.1};
@@ -85,6 +86,7 @@ robot::MeasuredFrf measured_frf(const std::string& item) {
 struct FitData {
   std::vector<robot::MeasuredFrf> fit, held;
   std::optional<robot::FrfDirection> direction;  // from the measurements' configuration
+  int modes{0};                                   // its pose_schedule.modes
 };
 
 // --measured items and --measurements directories (checked against the model: identify::check_against_model),
@@ -96,6 +98,7 @@ FitData fit_data(const PoseArgs& a, const config::RobotModelConfig& model) {
     identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
     identify::check_against_model(pm, model);
     d.direction = pm.direction;
+    d.modes = pm.modes;
     for (auto& f : pm.frfs) d.fit.push_back(std::move(f));
   }
   for (const auto& name : a.hold_out) {
@@ -115,6 +118,7 @@ robot::PoseFitSettings fit_settings(const PoseArgs& a, const FitData& d) {
   s.direction = a.direction == "xx" ? robot::FrfDirection::kXX : a.direction == "xy" ? robot::FrfDirection::kXY : robot::FrfDirection::kYY;
   if (d.direction) s.direction = *d.direction;
   s.band_min_hz = a.fit_band_hz[0], s.band_max_hz = a.fit_band_hz[1];
+  s.modes = a.fit_modes.value_or(d.modes);
   s.restarts = a.restarts;
   s.pso.particles = a.particles, s.pso.iterations = a.iterations, s.pso.seed = static_cast<std::uint64_t>(a.seed);
   return s;
@@ -149,9 +153,10 @@ int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
   const char* dir = s.direction == robot::FrfDirection::kXX ? "xx" : s.direction == robot::FrfDirection::kXY ? "xy" : "yy";
   std::ostringstream t;
   char b[240];
-  std::snprintf(b, sizeof b, "robot %s fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
-                m.name.c_str(), d.fit.size(), dir, s.band_min_hz, s.band_max_hz, r.evaluations, r.converged_restarts,
-                s.restarts);
+  const std::string form = s.modes > 0 ? "its " + std::to_string(s.modes) + " lowest modes" : "its own receptance";
+  std::snprintf(b, sizeof b, "robot %s (as %s) fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
+                m.name.c_str(), form.c_str(), d.fit.size(), dir, s.band_min_hz, s.band_max_hz, r.evaluations,
+                r.converged_restarts, s.restarts);
   t << b << "  joint   stiffness N m/rad   spread %   damping ratio\n";
   json joints = json::array();
   for (std::size_t j = 0; j < r.stiffness_nm_per_rad.size(); ++j) {
@@ -168,7 +173,7 @@ int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
   t << b;
   json poses = pose_rows(m, r.fitted, d.fit, s, "fit", t);
   for (auto& row : pose_rows(m, r.fitted, d.held, s, "held out", t)) poses.push_back(std::move(row));
-  const json out = {{"model", m.source}, {"direction", dir}, {"joints", joints}, {"poses", poses},
+  const json out = {{"model", m.source}, {"direction", dir}, {"modes", s.modes}, {"joints", joints}, {"poses", poses},
                     {"restart_costs", r.restart_costs}, {"evaluations", r.evaluations},
                     {"converged_restarts", r.converged_restarts}};
   if (!a.out_path.empty()) {
@@ -428,6 +433,9 @@ void register_pose(Registry& r) {
                   "fit: pose names (of --measurements) kept out of the fit: the fitted model's error is reported there");
   sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
   r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (the planar-robot study: 10 30)");
+  r.whole_number(sub, "--fit-modes", a->fit_modes, {"(modes)", 0, 20},
+                 "fit: compare the model as its N lowest modes with viscous damping, the plant a schedule predicts with "
+                 "(default: the measurements' pose_schedule.modes; 0, and for --measured: the model's own receptance)");
   r.whole_number(sub, "--restarts", a->restarts, {"(restarts)", 1, 100}, "fit: swarms with seeds seed, seed+1, ...");
   r.whole_number(sub, "--particles", a->particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
   r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");

@@ -88,7 +88,7 @@ void check_consistent(const PoseMeasurements& r) {
 void check_against_model(const PoseMeasurements& r, const config::RobotModelConfig& model) {
   constexpr double kMeasuredApart = 0.2, kTimesTheModel = 3.0;
   std::vector<robot::MeasuredFrf> modelled;  // the model at each pose, once, on its measurement's frequencies
-  for (const auto& f : r.frfs) modelled.push_back(robot::model_frf(model, f, r.direction, r.band_min_hz, r.band_max_hz));
+  for (const auto& f : r.frfs) modelled.push_back(robot::model_frf(model, f, r.direction, r.band_min_hz, r.band_max_hz, r.modes));
   for (std::size_t i = 0; i < r.frfs.size(); ++i)
     for (std::size_t k = 0; k < i; ++k) {
       const auto &a = r.frfs[i], &b = r.frfs[k];
@@ -152,7 +152,10 @@ PoseMeasurements read_pose_measurements(const std::vector<std::string>& dirs, in
       r.robot_model = m.robot_model;
       const config::Config measured = config::parse_config(m.config_text, m.config_source);
       r.band_min_hz = measured.analysis.band_min_hz, r.band_max_hz = measured.analysis.band_max_hz;
-      if (measured.pose_schedule) r.direction = measured.pose_schedule->axis == 0 ? robot::FrfDirection::kXX : robot::FrfDirection::kYY;
+      if (measured.pose_schedule) {
+        r.direction = measured.pose_schedule->axis == 0 ? robot::FrfDirection::kXX : robot::FrfDirection::kYY;
+        r.modes = measured.pose_schedule->modes;
+      }
     }
     else if (m.robot_model != r.robot_model)
       throw std::invalid_argument(dir + ": measured against the robot model " + m.robot_model + ", " + r.dirs.front() +

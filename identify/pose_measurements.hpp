@@ -17,6 +17,7 @@ struct PoseMeasurements {
   std::string robot_model;               // the model file the joint angles refer to (the first's)
   robot::FrfDirection direction{robot::FrfDirection::kYY};  // the measured configuration's pose_schedule.axis
   double band_min_hz{5.0}, band_max_hz{100.0};               // its analysis band: where the FRFs are trusted
+  int modes{0};  // its pose_schedule.modes: the plant's form the fit compares (robot::PoseFitSettings::modes)
 };
 
 // dirs: `measure --pose` directories (measurement.json) or `measure --poses` directories (poses.json: all

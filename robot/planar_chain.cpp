@@ -145,6 +145,19 @@ void PlanarChain::assemble() {
   m_mass_(tcp_rot_, tcp_rot_) += m_.head_inertia_kgm2;
 }
 
+double modal_damping_ratio(const Mode& m) { return std::max(kMinModalDampingRatio, 0.5 * m.loss_factor); }
+
+Eigen::Matrix2cd modal_tcp_frf(const std::vector<Mode>& modes, double f_hz) {
+  const double w = kTwoPi * f_hz;
+  Eigen::Matrix2cd g = Eigen::Matrix2cd::Zero();
+  for (const Mode& md : modes) {
+    const double wr = kTwoPi * md.freq_hz;
+    const Complex den(wr * wr - w * w, 2.0 * modal_damping_ratio(md) * wr * w);
+    g += (md.tcp_shape * md.tcp_shape.transpose()).cast<Complex>() / den;
+  }
+  return g;
+}
+
 std::vector<Mode> PlanarChain::modes(std::size_t count) const {
   const Eigen::MatrixXd kr = k_.real();
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(kr, m_mass_);  // mass-normalised shapes

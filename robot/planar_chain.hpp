@@ -48,6 +48,15 @@ struct Mode {
   double loss_factor{0.0};                  // phi' Im(K) phi / phi' Re(K) phi: the joints' hysteretic share
 };
 
+// A mode's viscous damping ratio as the plant and the schedule's analysis model it (docs/pose_dynamics.md):
+// half its loss factor, at least 1e-3 (a mode without joint damping still gets a little).
+inline constexpr double kMinModalDampingRatio = 1e-3;
+[[nodiscard]] double modal_damping_ratio(const Mode& m);
+
+// The TCP receptance matrix, m/N, of these modes alone with their viscous damping ratios: the plant the
+// emulator runs and the schedule's analysis predicts with at a pose (analysis::pose_modes).
+[[nodiscard]] Eigen::Matrix2cd modal_tcp_frf(const std::vector<Mode>& modes, double f_hz);
+
 // Element matrices in the element's own axes (u1 v1 th1 u2 v2 th2).
 struct ElementMatrices {
   Eigen::Matrix<double, 6, 6> k, m;

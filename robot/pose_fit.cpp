@@ -18,6 +18,22 @@ std::complex<double> pick(const Eigen::Matrix2cd& g, FrfDirection d) {
   return d == FrfDirection::kXX ? g(0, 0) : d == FrfDirection::kYY ? g(1, 1) : g(0, 1);
 }
 
+// The model at one pose in the form the fit compares (PoseFitSettings::modes).
+class ModelAtPose {
+ public:
+  ModelAtPose(const config::RobotModelConfig& m, const std::vector<double>& q, int modes)
+      : chain_(at_pose(m, q)), modes_(modes > 0 ? chain_.modes(static_cast<std::size_t>(modes)) : std::vector<Mode>{}),
+        modal_(modes > 0) {}
+  [[nodiscard]] std::complex<double> at(double f_hz, FrfDirection d) const {
+    return pick(modal_ ? modal_tcp_frf(modes_, f_hz) : chain_.tcp_frf_direct(f_hz), d);
+  }
+
+ private:
+  PlanarChain chain_;
+  std::vector<Mode> modes_;
+  bool modal_;
+};
+
 struct Band {
   std::vector<double> f;
   std::vector<std::complex<double>> h;
@@ -35,14 +51,14 @@ config::RobotModelConfig with_joints(config::RobotModelConfig m, const std::vect
 
 // Each pose's weighted relative error, squared.
 std::vector<double> pose_errors(const config::RobotModelConfig& m, const std::vector<MeasuredFrf>& data,
-                                const std::vector<Band>& bands, FrfDirection dir) {
+                                const std::vector<Band>& bands, const PoseFitSettings& s) {
   std::vector<double> out;
   for (std::size_t p = 0; p < data.size(); ++p) {
-    const PlanarChain c = at_pose(m, data[p].joints_deg);
+    const ModelAtPose c(m, data[p].joints_deg, s.modes);
     double num = 0.0, den = 0.0;
     const Band& b = bands[p];
     for (std::size_t i = 0; i < b.f.size(); ++i) {
-      num += b.w[i] * std::norm(pick(c.tcp_frf_direct(b.f[i]), dir) - b.h[i]);
+      num += b.w[i] * std::norm(c.at(b.f[i], s.direction) - b.h[i]);
       den += b.w[i] * std::norm(b.h[i]);
     }
     out.push_back(num / den);
@@ -88,7 +104,7 @@ double polish(const std::function<double(const std::vector<double>&)>& cost, std
 
 // Each pose's points in the fit band (thinned), weighted by their magnitude.
 std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
-                            const PoseFitSettings& s) {
+                            const PoseFitSettings& s, int max_points) {
   std::vector<Band> bands;
   for (const auto& d : data) {
     if (auto p = config::pose_problem(model, d.joints_deg))
@@ -98,10 +114,10 @@ std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::ve
     for (std::size_t i = 0; i < d.freq_hz.size(); ++i)
       if (d.freq_hz[i] >= s.band_min_hz && d.freq_hz[i] <= s.band_max_hz && std::isfinite(std::abs(d.receptance_m_per_n[i])))
         b.f.push_back(d.freq_hz[i]), b.h.push_back(d.receptance_m_per_n[i]), peak = std::max(peak, std::abs(d.receptance_m_per_n[i]));
-    if (static_cast<int>(b.f.size()) > s.max_points_per_pose) {  // thinned evenly: each point costs a solve
+    if (static_cast<int>(b.f.size()) > max_points) {  // thinned evenly: each point costs a solve
       Band t;
-      const double step = static_cast<double>(b.f.size() - 1) / (s.max_points_per_pose - 1);
-      for (int i = 0; i < s.max_points_per_pose; ++i) {
+      const double step = static_cast<double>(b.f.size() - 1) / (max_points - 1);
+      for (int i = 0; i < max_points; ++i) {
         const auto k = static_cast<std::size_t>(std::lround(i * step));
         t.f.push_back(b.f[k]), t.h.push_back(b.h[k]);
       }
@@ -122,17 +138,17 @@ std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::ve
 std::vector<double> model_errors(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
                                  const PoseFitSettings& s) {
   std::vector<double> out;
-  for (double e : pose_errors(model, data, fit_bands(model, data, s), s.direction)) out.push_back(std::sqrt(e));
+  for (double e : pose_errors(model, data, fit_bands(model, data, s, s.final_points_per_pose), s)) out.push_back(std::sqrt(e));
   return out;
 }
 
 MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at, FrfDirection direction, double f_lo_hz,
-                      double f_hi_hz) {
+                      double f_hi_hz, int modes) {
   if (auto p = config::pose_problem(model, at.joints_deg)) throw config::ConfigError({config::Problem{at.name, {}, "pose", *p}});
-  const PlanarChain c = at_pose(model, at.joints_deg);
+  const ModelAtPose c(model, at.joints_deg, modes);
   MeasuredFrf out{at.name, at.joints_deg, {}, {}};
   for (const double f : at.freq_hz)
-    if (f >= f_lo_hz && f <= f_hi_hz) out.freq_hz.push_back(f), out.receptance_m_per_n.push_back(pick(c.tcp_frf_direct(f), direction));
+    if (f >= f_lo_hz && f <= f_hi_hz) out.freq_hz.push_back(f), out.receptance_m_per_n.push_back(c.at(f, direction));
   return out;
 }
 
@@ -141,11 +157,11 @@ std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::ve
   std::vector<double> out;
   for (const MeasuredFrf& d : data) {
     double best = -1.0, at = 0.0;
-    const std::optional<PlanarChain> c = model ? std::optional<PlanarChain>(at_pose(*model, d.joints_deg)) : std::nullopt;
+    const std::optional<ModelAtPose> c = model ? std::optional<ModelAtPose>(ModelAtPose(*model, d.joints_deg, s.modes)) : std::nullopt;
     for (std::size_t i = 0; i < d.freq_hz.size(); ++i) {
       const double f = d.freq_hz[i];
       if (f < s.band_min_hz || f > s.band_max_hz) continue;
-      const double m = c ? std::abs(pick(c->tcp_frf_direct(f), s.direction)) : std::abs(d.receptance_m_per_n[i]);
+      const double m = c ? std::abs(c->at(f, s.direction)) : std::abs(d.receptance_m_per_n[i]);
       if (m > best) best = m, at = f;
     }
     out.push_back(at);
@@ -156,16 +172,19 @@ std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::ve
 PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
                          const PoseFitSettings& s) {
   if (data.empty()) throw config::ConfigError({config::Problem{model.source, {}, "", "no measured FRF to fit"}});
-  const std::vector<Band> bands = fit_bands(model, data, s);
+  // The modal form costs one eigen-solve per pose whatever the points: it searches on the model as written
+  // over the final points. The direct form costs a solve per point: it searches coarse and thinned.
+  const bool modal = s.modes > 0;
+  const std::vector<Band> bands = fit_bands(model, data, s, modal ? s.final_points_per_pose : s.max_points_per_pose);
   const std::size_t n = model.joints.size();
   std::vector<double> lo(n, std::log10(s.stiffness_min_nm_per_rad)), hi(n, std::log10(s.stiffness_max_nm_per_rad));
   if (s.fit_damping) lo.insert(lo.end(), n, s.damping_min), hi.insert(hi.end(), n, s.damping_max);
   config::RobotModelConfig coarse = model;
-  if (s.search_elements > 0)
+  if (!modal && s.search_elements > 0)
     for (auto& l : coarse.links) l.elements = std::min(l.elements, s.search_elements);
   const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) {
     double sum = 0.0;
-    for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s.direction)) sum += e;
+    for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s)) sum += e;
     return sum / static_cast<double>(data.size());
   };
   PoseFitResult r;
