@@ -101,6 +101,21 @@ config::BlockConfig compensator_block(const Candidate& c, const config::BlockCon
   return b;
 }
 
+Candidate restated(const Candidate& c, double from_hz, double to_hz) {
+  const std::vector<double> num = multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz)),
+                            den = multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz));
+  auto gain = [&](double f_hz) {
+    const std::complex<double> s(0.0, kTwoPi * f_hz);
+    std::complex<double> n = 0.0, d = 0.0;
+    for (double a : num) n = n * s + a;
+    for (double a : den) d = d * s + a;
+    return std::abs(n / d);
+  };
+  Candidate out = c;
+  out.gain_ns_per_m = std::clamp(c.gain_ns_per_m * gain(to_hz) / gain(from_hz), kGainMinNsPerM, kGainMaxNsPerM);
+  return out;
+}
+
 double unity_gain_hz(const config::Config& cfg) {
   if (cfg.controller.match_freq_hz) return *cfg.controller.match_freq_hz;
   return modal::dominant_mode_hz(cfg.robot, cfg.actuator.location).value_or(10.0);
@@ -414,8 +429,8 @@ namespace {
 
 // x = [log10 K, log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb]
 constexpr unsigned kDims = 7;
-const double kLower[kDims] = {2.0, std::log10(0.3), 0.05, std::log10(0.3), 0.05, std::log10(0.3), std::log10(0.3)};
-const double kUpper[kDims] = {std::log10(20000.0), std::log10(80.0), 1.5, std::log10(80.0), 1.5, std::log10(200.0), std::log10(200.0)};
+const double kLower[kDims] = {std::log10(kGainMinNsPerM), std::log10(0.3), 0.05, std::log10(0.3), 0.05, std::log10(0.3), std::log10(0.3)};
+const double kUpper[kDims] = {std::log10(kGainMaxNsPerM), std::log10(80.0), 1.5, std::log10(80.0), 1.5, std::log10(200.0), std::log10(200.0)};
 
 Candidate candidate_of(const double* x, int polarity) {
   return {std::pow(10.0, x[0]), std::pow(10.0, x[1]), x[2], std::pow(10.0, x[3]), x[4], std::pow(10.0, x[5]),
@@ -486,7 +501,7 @@ void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSett
   const std::string global_phase = "global search" + tag, local_phase = "local polish" + tag;
   Search global{&plants, polarity, &per, &progress, global_phase.c_str(), s.global_evaluations};
   // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
-  const Candidate c1{std::clamp(base.controller.gain_ns_per_m, 100.0, 20000.0), base.actuator.natural_freq_hz,
+  const Candidate c1{std::clamp(base.controller.gain_ns_per_m, kGainMinNsPerM, kGainMaxNsPerM), base.actuator.natural_freq_hz,
                      base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
   std::vector<double> x = x_of(start ? *start : c1);
   for (unsigned i = 0; i < kDims; ++i) x[i] = std::clamp(x[i], kLower[i], kUpper[i]);

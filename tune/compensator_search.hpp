@@ -44,6 +44,12 @@ struct Candidate {
 // gain at that frequency whatever the shape.
 [[nodiscard]] config::BlockConfig compensator_block(const Candidate& c, const config::BlockConfig& replaced,
                                                     double unity_hz);
+// The search's range of K, N s/m.
+inline constexpr double kGainMinNsPerM = 100.0, kGainMaxNsPerM = 20000.0;
+
+// The same controller (compensator and gain) with K stated at to_hz instead of from_hz: a set tuned with one
+// match frequency, as a start for a configuration with another; K kept inside the search's range.
+[[nodiscard]] Candidate restated(const Candidate& c, double from_hz, double to_hz);
 // The match frequency (controller.match_freq_hz, else the dominant robot mode).
 [[nodiscard]] double unity_gain_hz(const config::Config& cfg);
 // The configuration with the candidate's compensator, gain and polarity. Throws config::ConfigError when

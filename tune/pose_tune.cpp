@@ -108,10 +108,11 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
 }
 
 // Where the region's search starts: sets tuned at single poses (one plant each: cheap, with three times the
-// evaluations) at the centre and at the poses with the region's lowest and highest dominant mode, each
-// judged over every pose of the region; the best of them.
+// evaluations) at the centre and at the poses with the region's lowest and highest dominant mode, and the
+// inherited set (if any), each judged over every pose of the region; the best of them.
 Candidate best_start(const PoseTuneInput& in, const config::Config& base, const std::vector<double>& centre,
-                     const TunedRegion& region, const std::vector<Evaluator>& plants, const TuneSettings& t) {
+                     const TunedRegion& region, const std::vector<Evaluator>& plants, const TuneSettings& t,
+                     const std::optional<Candidate>& inherited) {
   const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
   std::vector<std::vector<double>> starts{centre};
   double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
@@ -128,6 +129,10 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
   TuneSettings single = t;
   single.global_evaluations *= 3, single.local_evaluations *= 3;
   std::optional<Evaluation> best;
+  if (inherited) {
+    best = evaluate_worst(all, *inherited);
+    best->candidate = *inherited;
+  }
   for (const auto& q : starts) {
     const Evaluator one(analysis::config_at_pose(base, analysis::pose_modes(in.model, q, sched.axis, sched.modes)), std::nullopt,
                         single, config::describe_pose(q));
@@ -142,7 +147,8 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
 }  // namespace
 
 TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const std::vector<double>& min_deg,
-                        const std::vector<double>& max_deg, const PoseTuneSettings& s, const PoseTuneProgress& progress) {
+                        const std::vector<double>& max_deg, const PoseTuneSettings& s, const PoseTuneProgress& progress,
+                        const TunedRegion* parent) {
   const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
   TunedRegion out;
   out.region.name = name;
@@ -169,7 +175,9 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
     progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) + ": " +
              std::to_string(out.poses.size()) + " poses, dominant mode " + fmt(out.dominant_min_hz) + "-" +
              fmt(out.dominant_max_hz) + " Hz");
-  const TuneResult r = tune_from(ptrs, best_start(in, base, centre, out, plants, t), t);
+  std::optional<Candidate> inherited;
+  if (parent) inherited = restated(parent->worst.candidate, *parent->region.match_freq_hz, match_hz);
+  const TuneResult r = tune_from(ptrs, best_start(in, base, centre, out, plants, t, inherited), t);
   out.worst = r.best;
   const Candidate& c = r.best.candidate;
   const config::Config tuned = with_candidate(base, c);
@@ -259,12 +267,16 @@ std::vector<TunedRegion> tune_schedule(const PoseTuneInput& in, const TunedRegio
     if (progress)
       progress("cutting '" + r.region.name + "' across joint " + std::to_string(j + 1) + " at " + fmt(mid) + " deg");
     ++count;
-    pending.push_back(tune_region(in, r.region.name + "a", r.region.min_deg, lo_max, s, progress));
-    pending.push_back(tune_region(in, r.region.name + "b", hi_min, r.region.max_deg, s, progress));
+    pending.push_back(tune_region(in, r.region.name + "a", r.region.min_deg, lo_max, s, progress, &r));
+    pending.push_back(tune_region(in, r.region.name + "b", hi_min, r.region.max_deg, s, progress, &r));
   }
   // Named in joint order along the workspace: r1, r2, ...
   std::sort(done.begin(), done.end(), [](const TunedRegion& a, const TunedRegion& b) { return a.region.min_deg < b.region.min_deg; });
-  for (std::size_t i = 0; i < done.size(); ++i) done[i].region.name = done.size() == 1 ? "workspace" : "r" + std::to_string(i + 1);
+  for (std::size_t i = 0; i < done.size(); ++i) {
+    std::string& name = done[i].region.name;
+    name = done.size() == 1 ? "workspace" : "r";
+    if (done.size() > 1) name += std::to_string(i + 1);  // (not "r" + to_string: GCC 12 warns falsely of -Wrestrict)
+  }
   return done;
 }
 

@@ -18,8 +18,8 @@
 // the modes' peaks), its compensator's gain nowhere more than compensator_gain_max times its gain at the
 // match frequency (a set that lifted the drift or the noise tripped on saturation in the HIL). It starts from
 // the best of single-pose tunes (one plant each, three times the evaluations) at the region's centre and at
-// its lowest and highest dominant mode, then is searched over all the region's poses from there at that
-// polarity (tune::tune_from). Both controllers are then
+// its lowest and highest dominant mode, and (a half of a cut region) the set of the region it was cut from,
+// then is searched over all the region's poses from there at that polarity (tune::tune_from). Both controllers are then
 // scored on the workspace map (tune/pose_score.hpp) and the better written. Off the real-time path.
 #pragma once
 
@@ -70,10 +70,12 @@ using PoseTuneProgress = std::function<void(const std::string&)>;
 // centre along the others; each pose once.
 [[nodiscard]] std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegionConfig& r, int points);
 
-// One set tuned over the box's poses. Throws config::ConfigError for a pose outside the model's travel.
+// One set tuned over the box's poses; with a parent (the region it was cut from), the parent's set is one
+// of the starts, so a half is never tuned worse over its poses than the set it replaces. Throws
+// config::ConfigError for a pose outside the model's travel.
 [[nodiscard]] TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const std::vector<double>& min_deg,
                                       const std::vector<double>& max_deg, const PoseTuneSettings& s,
-                                      const PoseTuneProgress& progress = {});
+                                      const PoseTuneProgress& progress = {}, const TunedRegion* parent = nullptr);
 
 // The robust controller: one region, the workspace.
 [[nodiscard]] TunedRegion tune_robust(const PoseTuneInput& in, const PoseTuneSettings& s,
