@@ -207,7 +207,7 @@ int run_pose_tune(const PoseTuneArgs& a) {
         {{"robust", tune::schedule_of(*in.cell.pose_schedule, {robust})},
          {"scheduled", tune::schedule_of(*in.cell.pose_schedule, scheduled)},
          {"as given", *in.cell.pose_schedule}}, job, progress);
-    const std::size_t best = tune::better_controller(scores);
+    const std::size_t best = tune::better_controller(scores, s.worse_mode_tolerance_pct);
     // The configuration's own schedule (the third) is written back as it is when it scores best.
     const std::vector<tune::TunedRegion> chosen =
         best == 0 ? std::vector<tune::TunedRegion>{robust} : best == 1 ? scheduled : std::vector<tune::TunedRegion>{};

@@ -91,6 +91,19 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
             << " regions): worst mode " << ss.worst_mode_improvement_pct << " %\n";
   EXPECT_GT(ss.worst_mode_improvement_pct, rs.worst_mode_improvement_pct);
   EXPECT_EQ(tune::better_controller(m), 1U);
+  // The damping band's promise comes before the depth: a deeper controller that makes a mode 8 % worse
+  // loses to one that keeps every mode; between two that keep it (or two that break it) the depth decides.
+  tune::MapScores choice;
+  choice.controllers.resize(2);
+  for (auto& c : choice.controllers) c.stable_everywhere = true;
+  choice.controllers[0].worst_mode_improvement_pct = -8.3, choice.controllers[0].damped_min_mm = 0.147;
+  choice.controllers[1].worst_mode_improvement_pct = 2.4, choice.controllers[1].damped_min_mm = 0.091;
+  EXPECT_EQ(tune::better_controller(choice), 1U);
+  choice.controllers[0].worst_mode_improvement_pct = -0.5;  // within the 1 % a serving set may lose
+  EXPECT_EQ(tune::better_controller(choice), 0U);
+  choice.controllers[1].worst_mode_improvement_pct = -3.0;
+  choice.controllers[0].worst_mode_improvement_pct = -8.3;
+  EXPECT_EQ(tune::better_controller(choice), 0U);
   // The map scores the sets that run: at joint 2 = 0 the first region's alone, with its own improvement.
   EXPECT_EQ(ss.poses.front().regions, std::vector<std::string>{"r1"});
   EXPECT_GT(ss.poses.front().improvement_pct, 50.0);

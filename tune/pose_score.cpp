@@ -144,12 +144,17 @@ MapScores score_on_map(const PoseTuneInput& in, std::vector<MapPose> map,
   return out;
 }
 
-std::size_t better_controller(const MapScores& s) {
+std::size_t better_controller(const MapScores& s, double worse_mode_tolerance_pct) {
+  const auto keeps = [&](const ControllerScore& c) { return c.worst_mode_improvement_pct >= -worse_mode_tolerance_pct; };
   std::size_t best = 0;
   for (std::size_t i = 1; i < s.controllers.size(); ++i) {
     const ControllerScore &a = s.controllers[best], &b = s.controllers[i];
     if (a.stable_everywhere != b.stable_everywhere) {
       if (b.stable_everywhere) best = i;
+      continue;
+    }
+    if (keeps(a) != keeps(b)) {
+      if (keeps(b)) best = i;
       continue;
     }
     if (a.damped_min_mm && b.damped_min_mm && std::abs(*b.damped_min_mm - *a.damped_min_mm) > 0.01 * *a.damped_min_mm) {

@@ -69,8 +69,10 @@ struct MapScores {
                                      const std::vector<std::pair<std::string, config::PoseScheduleConfig>>& schedules,
                                      const std::optional<config::MillingConfig>& job, const PoseTuneProgress& progress = {});
 
-// The better controller: the larger smallest damped depth with a job (by more than 1 %), else the larger
-// worst mode improvement; ties go to the first (the robust one: no hand-overs).
-[[nodiscard]] std::size_t better_controller(const MapScores& s);
+// The better controller: stable at every map pose; then keeping the damping band's promise (no mode in
+// the band more than worse_mode_tolerance_pct worse than open loop at any map pose); then the larger
+// smallest damped depth with a job (by more than 1 %); else the larger worst mode improvement (by more than
+// 1 point). Ties go to the first (the robust one: no hand-overs).
+[[nodiscard]] std::size_t better_controller(const MapScores& s, double worse_mode_tolerance_pct = 1.0);
 
 }  // namespace robodamp::tune
