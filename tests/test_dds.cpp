@@ -483,10 +483,15 @@ TEST(DdsSecurity, TheDashboardActsWithAnOperatorIdentityAndOnlyViewsWithAnObserv
   ASSERT_TRUE(eventually([&] { return loop.publish_frames(250), fleet.overview().size() == 1; }, 60.0));
   EXPECT_TRUE(fleet.view_only().empty());
   dashboard::RequestOutcome r;
-  ASSERT_TRUE(eventually([&] { return (r = fleet.request(config::cell_name({}), dds::RequestKind::kSetGain, 2500.0, "alice", 2.0)).answered; },
+  // Asked again while unanswered (the reply path may match after the first 2 s on a loaded machine): each
+  // ask reaches the loop at most once, and the answered one did.
+  int asked = 0;
+  ASSERT_TRUE(eventually([&] { return ++asked, (r = fleet.request(config::cell_name({}), dds::RequestKind::kSetGain, 2500.0, "alice", 2.0)).answered; },
                          60.0));
   EXPECT_TRUE(r.accepted) << r.reason;
-  EXPECT_EQ(loop.handled.load(), 1);
+  const int handled = loop.handled.load();
+  EXPECT_GE(handled, 1);
+  EXPECT_LE(handled, asked);
 
   config::DdsConfig ob = loop.cfg;
   ob.security = identity("observer");
@@ -497,7 +502,7 @@ TEST(DdsSecurity, TheDashboardActsWithAnOperatorIdentityAndOnlyViewsWithAnObserv
   r = viewer.request(config::cell_name({}), dds::RequestKind::kSetGain, 3000.0, "alice", 2.0);
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.reason.find("may not write parameter requests"), std::string::npos) << r.reason;
-  EXPECT_EQ(loop.handled.load(), 1);
+  EXPECT_EQ(loop.handled.load(), handled);  // the observer's reached nothing
 }
 
 // Debian 12's Fast DDS 2.9.1 does not honour the governance's allow_unauthenticated_participants (Fast DDS
