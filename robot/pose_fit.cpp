@@ -187,20 +187,17 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
   config::RobotModelConfig coarse = model;
   if (!modal && s.search_elements > 0)
     for (auto& l : coarse.links) l.elements = std::min(l.elements, s.search_elements);
-  const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) {
+  const auto mean_error = [&](const std::vector<double>& x, double log_weight) {
     double sum = 0.0;
-    for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s)) sum += e;
+    for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s, log_weight)) sum += e;
     return sum / static_cast<double>(data.size());
   };
+  const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) { return mean_error(x, 0.0); };
   // The swarm also weighs the log-magnitude error, smooth where the complex error is rugged (a mode a little
   // off in frequency turns its phase over): on the two measured planar robots of docs/pose_dynamics.md 8 and
   // 4 of 8 restarts reach the best basin, against 2 and 1 of 8 on the complex error alone. BOBYQA then
   // polishes the complex error alone.
-  const std::function<double(const std::vector<double>&)> swarm_cost = [&](const std::vector<double>& x) {
-    double sum = 0.0;
-    for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s, 1.0)) sum += e;
-    return sum / static_cast<double>(data.size());
-  };
+  const std::function<double(const std::vector<double>&)> swarm_cost = [&](const std::vector<double>& x) { return mean_error(x, 1.0); };
   PoseFitResult r;
   std::vector<std::vector<double>> ks;
   PsoResult best;
