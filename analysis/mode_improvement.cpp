@@ -34,4 +34,13 @@ std::optional<ModeImprovement> worst_mode(const std::vector<ModeImprovement>& mo
   return out;
 }
 
+bool BandWorst::add(const std::vector<ModeImprovement>& modes, double min_hz, double max_hz) {
+  const auto out = worst_mode(modes, min_hz, max_hz, false);
+  if (out && (!outside || out->improvement_pct < outside->improvement_pct)) outside = out;
+  const auto in = worst_mode(modes, min_hz, max_hz, true);
+  if (!in || (inside && in->improvement_pct >= inside->improvement_pct)) return false;
+  inside = in;
+  return true;
+}
+
 }  // namespace robodamp::analysis

@@ -25,4 +25,12 @@ struct ModeImprovement {
 [[nodiscard]] std::optional<ModeImprovement> worst_mode(const std::vector<ModeImprovement>& modes, double min_hz,
                                                         double max_hz, bool inside = true);
 
+// The worst mode inside a band and the worst outside it, folded over several loops (the poses of a region,
+// the sets that can run at a pose).
+struct BandWorst {
+  std::optional<ModeImprovement> inside, outside;
+  // Folds one loop's modes in; true when the worst inside the band is now one of them.
+  bool add(const std::vector<ModeImprovement>& modes, double min_hz, double max_hz);
+};
+
 }  // namespace robodamp::analysis

@@ -131,7 +131,7 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
   set.k_max_ns_per_m = std::numeric_limits<double>::infinity();
   set.dominant_min_hz = std::numeric_limits<double>::infinity();
   set.dominant_max_hz = 0.0;
-  set.worst_mode_improvement_pct = std::numeric_limits<double>::infinity();
+  BandWorst band;
   for (const auto& q : region_grid(s.regions[i], s.grid_points)) {
     const PoseModes pm = pose_modes(model, q, s.axis, s.modes);
     set.dominant_min_hz = std::min(set.dominant_min_hz, pm.dominant_hz());
@@ -151,13 +151,12 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
       throw region_error(cfg, i, "has no set with margin: " + where + " K = " + fmt(set.gain_ns_per_m) +
                                      " N s/m is above supervision.max_gain_fraction x K_max = " + fmt(fraction) + " x " +
                                      fmt(k_max) + " N s/m: split the region or lower its gain_ns_per_m");
-    const std::vector<ModeImprovement> modes = mode_improvements(m, set.gain_ns_per_m, set.polarity);
-    if (const auto w = worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz); w && w->improvement_pct < set.worst_mode_improvement_pct)
-      set.worst_mode_improvement_pct = w->improvement_pct, set.worst_mode_hz = w->freq_hz, set.worst_mode_pose_deg = q;
-    if (const auto w = worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz, false);
-        w && (!set.outside_band_pct || w->improvement_pct < *set.outside_band_pct))
-      set.outside_band_pct = w->improvement_pct, set.outside_band_hz = w->freq_hz;
+    if (band.add(mode_improvements(m, set.gain_ns_per_m, set.polarity), s.damping_band_min_hz, s.damping_band_max_hz))
+      set.worst_mode_pose_deg = q;
   }
+  set.worst_mode_improvement_pct = band.inside ? band.inside->improvement_pct : std::numeric_limits<double>::infinity();
+  if (band.inside) set.worst_mode_hz = band.inside->freq_hz;
+  if (band.outside) set.outside_band_pct = band.outside->improvement_pct, set.outside_band_hz = band.outside->freq_hz;
   set.improvement_centre_pct = driving_point_improvement_pct(LoopModel(set.config), set.gain_ns_per_m, set.polarity);
 }
 

@@ -117,7 +117,7 @@ std::string command_line(const PoseTuneArgs& a) {
   if (!a.job_path.empty()) c += " --job " + a.job_path;
   c += " --evaluations " + std::to_string(a.evaluations) + " --polish " + std::to_string(a.polish) + " --max-regions " +
        std::to_string(a.max_regions) + " --map-points " + std::to_string(a.map_points) + " --overlap-deg " +
-       config::format_number(a.overlap_deg) + " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
+       config::format_number(a.overlap_deg) + " --worse-mode-pct " + config::format_number(a.worse_mode_pct) + " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
   return c;
 }
 
@@ -197,7 +197,7 @@ int run_pose_tune(const PoseTuneArgs& a) {
     if (!a.job_path.empty()) job = config::load_milling_config(a.job_path);
     tune::PoseTuneSettings s;
     s.tune.global_evaluations = a.evaluations, s.tune.local_evaluations = a.polish, s.tune.seed = a.seed;
-    s.max_regions = a.max_regions, s.overlap_deg = a.overlap_deg;
+    s.max_regions = a.max_regions, s.overlap_deg = a.overlap_deg, s.worse_mode_tolerance_pct = a.worse_mode_pct;
     const auto progress = [](const std::string& m) { std::cerr << "robodamp pose tune: " << m << '\n'; };
     const tune::TunedRegion robust = tune::tune_robust(in, s, progress);
     const std::vector<tune::TunedRegion> scheduled = tune::tune_schedule(in, robust, s, progress);
@@ -215,7 +215,8 @@ int run_pose_tune(const PoseTuneArgs& a) {
     t << "robodamp pose tune: " << a.config_path << ", the robot " << in.model.name << " (" << in.model.source << "), "
       << in.measured.size() << " measured pose(s) tuned at, " << held.size() << " held out; the damping band "
       << config::format_number(in.cell.pose_schedule->damping_band_min_hz) << "-"
-      << config::format_number(in.cell.pose_schedule->damping_band_max_hz) << " Hz (no mode in it worse than open loop)\n";
+      << config::format_number(in.cell.pose_schedule->damping_band_max_hz) << " Hz (a set serves while no mode in it is more than "
+      << config::format_number(s.worse_mode_tolerance_pct) << " % worse than open loop: --worse-mode-pct)\n";
     print_regions(t, "robust: one set over the workspace", {robust});
     print_regions(t, ("scheduled: " + std::to_string(scheduled.size()) + " region(s) drawn where one set stops serving").c_str(), scheduled);
     json map = print_map(t, scores);
@@ -234,11 +235,16 @@ int run_pose_tune(const PoseTuneArgs& a) {
       summary.push_back(cj);
     }
     t << "chosen: " << scores.controllers[best].name << '\n';
+    if (const double w = scores.controllers[best].worst_mode_improvement_pct; w < 0.0)
+      t << "  note: a mode in the damping band ends " << pct(w) << " % against open loop at a map pose, worse ("
+        << (w >= -s.worse_mode_tolerance_pct ? "within" : "BEYOND") << " --worse-mode-pct "
+        << config::format_number(s.worse_mode_tolerance_pct) << ")\n";
     json regions_robust = json::array({region_json(robust)}), regions_sched = json::array();
     for (const auto& r : scheduled) regions_sched.push_back(region_json(r));
     json out = {{"config", a.config_path}, {"model", in.model.source}, {"robust", regions_robust},
                 {"scheduled", regions_sched}, {"map", map}, {"controllers", summary},
-                {"chosen", scores.controllers[best].name}, {"model_of_promises", "the pose-indexed robot model, discrete loop"}};
+                {"chosen", scores.controllers[best].name}, {"model_of_promises", "the pose-indexed robot model, discrete loop"},
+                {"worse_mode_pct", s.worse_mode_tolerance_pct}};
     if (job) out["method"] = scores.method, out["job"] = a.job_path;
     if (!scores.controllers[best].stable_everywhere) {
       std::cerr << t.str() << "robodamp pose tune: no controller is stable at every pose of the map; nothing written\n";

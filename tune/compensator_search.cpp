@@ -10,6 +10,8 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "analysis/impact_command.hpp"
 #include "analysis/quiet_command.hpp"
@@ -39,6 +41,20 @@ std::vector<double> second_order(double f_hz, double zeta) {
 
 std::vector<double> first_order(double f_hz) { return {1.0 / (kTwoPi * f_hz), 1.0}; }
 
+// |N(j 2 pi f) / D(j 2 pi f)| of a rational compensator (coefficients highest power first, continuous).
+double rational_gain(const std::vector<double>& num, const std::vector<double>& den, double f_hz) {
+  const std::complex<double> s(0.0, kTwoPi * f_hz);
+  std::complex<double> n = 0.0, d = 0.0;
+  for (double a : num) n = n * s + a;
+  for (double a : den) d = d * s + a;
+  return std::abs(n / d);
+}
+
+// The candidate's compensator before its pre-warp: numerator and denominator.
+std::pair<std::vector<double>, std::vector<double>> candidate_rational(const Candidate& c) {
+  return {multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz)), multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz))};
+}
+
 const config::StructureConfig& job_structure(const config::MillingConfig& job) {
   const config::StructureConfig* st = job.find_structure(job.structure);
   if (st == nullptr) st = &job.structures.front();
@@ -63,13 +79,7 @@ double compensator_gain_ratio(const config::Config& cfg) {
   const auto b = std::find_if(cfg.controller.chain.begin(), cfg.controller.chain.end(),
                               [](const config::BlockConfig& x) { return x.kind == config::BlockKind::kCompensator; });
   if (b == cfg.controller.chain.end() || b->model != config::CompensatorModel::kRational) return 0.0;
-  auto gain = [&](double f_hz) {
-    const std::complex<double> s(0.0, kTwoPi * f_hz);
-    std::complex<double> n = 0.0, d = 0.0;
-    for (double a : b->numerator) n = n * s + a;
-    for (double a : b->denominator) d = d * s + a;
-    return std::abs(n / d);
-  };
+  const auto gain = [&](double f_hz) { return rational_gain(b->numerator, b->denominator, f_hz); };
   const double match_hz = cfg.controller.match_freq_hz.value_or(10.0), nyquist_hz = 0.5 * cfg.loop.rate_hz;
   double largest = 0.0;
   for (double f = 0.1; f <= nyquist_hz; f *= 1.05) largest = std::max(largest, gain(f));
@@ -88,31 +98,17 @@ config::BlockConfig compensator_block(const Candidate& c, const config::BlockCon
   config::BlockConfig b = replaced;
   b.kind = config::BlockKind::kCompensator;
   b.model = config::CompensatorModel::kRational;
-  b.numerator = multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz));
-  b.denominator = multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz));
-  const std::complex<double> s(0.0, kTwoPi * unity_hz);
-  auto eval = [&](const std::vector<double>& p) {
-    std::complex<double> v = 0.0;
-    for (double a : p) v = v * s + a;
-    return v;
-  };
-  const double gain = std::abs(eval(b.numerator) / eval(b.denominator));
+  std::tie(b.numerator, b.denominator) = candidate_rational(c);
+  const double gain = rational_gain(b.numerator, b.denominator, unity_hz);
   for (double& a : b.numerator) a /= gain;
   return b;
 }
 
 Candidate restated(const Candidate& c, double from_hz, double to_hz) {
-  const std::vector<double> num = multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz)),
-                            den = multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz));
-  auto gain = [&](double f_hz) {
-    const std::complex<double> s(0.0, kTwoPi * f_hz);
-    std::complex<double> n = 0.0, d = 0.0;
-    for (double a : num) n = n * s + a;
-    for (double a : den) d = d * s + a;
-    return std::abs(n / d);
-  };
+  const auto [num, den] = candidate_rational(c);
   Candidate out = c;
-  out.gain_ns_per_m = std::clamp(c.gain_ns_per_m * gain(to_hz) / gain(from_hz), kGainMinNsPerM, kGainMaxNsPerM);
+  out.gain_ns_per_m = std::clamp(c.gain_ns_per_m * rational_gain(num, den, to_hz) / rational_gain(num, den, from_hz),
+                                 kGainMinNsPerM, kGainMaxNsPerM);
   return out;
 }
 

@@ -65,6 +65,7 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
   PoseScore p;
   p.stable = true;
   p.worst_mode_improvement_pct = p.improvement_pct = kInf;
+  analysis::BandWorst band;  // over the stable sets that can run here
   for (std::size_t i = 0; i < sets.size(); ++i) {
     if (!config::region_holds(schedule.regions[i], mp.pose.joints_deg.data(), mp.pose.joints_deg.size())) continue;
     p.regions.push_back(sets[i].name);
@@ -79,13 +80,7 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
       if (with_job) p.damped_min_mm = 0.0;
       continue;
     }
-    const std::vector<analysis::ModeImprovement> modes = analysis::mode_improvements(m, k, pol);
-    if (const auto w = analysis::worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz);
-        w && w->improvement_pct < p.worst_mode_improvement_pct)
-      p.worst_mode_improvement_pct = w->improvement_pct, p.worst_mode_hz = w->freq_hz;
-    if (const auto w = analysis::worst_mode(modes, s.damping_band_min_hz, s.damping_band_max_hz, false);
-        w && (!p.outside_band_pct || w->improvement_pct < *p.outside_band_pct))
-      p.outside_band_pct = w->improvement_pct, p.outside_band_hz = w->freq_hz;
+    band.add(analysis::mode_improvements(m, k, pol), s.damping_band_min_hz, s.damping_band_max_hz);
     const double point = analysis::driving_point_improvement_pct(m, k, pol);
     p.region_improvement_pct.push_back(point);
     p.improvement_pct = std::min(p.improvement_pct, point);
@@ -94,6 +89,9 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
       if (!p.damped_min_mm || e.accurate_min_mm < *p.damped_min_mm) p.damped_min_mm = e.accurate_min_mm, p.damped_min_rpm = e.accurate_min_rpm;
     }
   }
+  if (band.inside && band.inside->improvement_pct < p.worst_mode_improvement_pct)
+    p.worst_mode_improvement_pct = band.inside->improvement_pct, p.worst_mode_hz = band.inside->freq_hz;
+  if (band.outside) p.outside_band_pct = band.outside->improvement_pct, p.outside_band_hz = band.outside->freq_hz;
   return p;
 }
 

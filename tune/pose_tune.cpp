@@ -41,12 +41,18 @@ bool joint_moves_modes(const PoseTuneInput& in, const config::PoseRegionConfig& 
   return false;
 }
 
-}  // namespace
+// Which joints change the plant over the box (joint_moves_modes for each).
+std::vector<bool> moving_joints(const PoseTuneInput& in, const config::PoseRegionConfig& r) {
+  std::vector<bool> out(r.min_deg.size());
+  for (std::size_t j = 0; j < out.size(); ++j) out[j] = joint_moves_modes(in, r, j);
+  return out;
+}
 
-std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegionConfig& r, int points) {
+// The points^n grid over the box along the moving joints, the centre along the others; each pose once.
+std::vector<NamedPose> grid_along(const config::PoseRegionConfig& r, const std::vector<bool>& moves, int points) {
   config::PoseRegionConfig grid = r;
   for (std::size_t j = 0; j < r.min_deg.size(); ++j)
-    if (!joint_moves_modes(in, r, j)) grid.min_deg[j] = grid.max_deg[j] = 0.5 * (r.min_deg[j] + r.max_deg[j]);
+    if (!moves[j]) grid.min_deg[j] = grid.max_deg[j] = 0.5 * (r.min_deg[j] + r.max_deg[j]);
   std::vector<NamedPose> out;
   for (auto& q : analysis::region_grid(grid, points)) {
     if (std::any_of(out.begin(), out.end(), [&](const NamedPose& p) { return p.joints_deg == q; })) continue;
@@ -55,18 +61,25 @@ std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegi
   return out;
 }
 
+}  // namespace
+
+std::vector<NamedPose> mode_grid(const PoseTuneInput& in, const config::PoseRegionConfig& r, int points) {
+  return grid_along(r, moving_joints(in, r), points);
+}
+
 namespace {
 
 // The region's poses: its grid (see the header), a line every line_step_deg at most along each joint that
 // moves the plant (the others at the centre: a wide region's set must hold between its grid's poses too),
 // and every measured pose inside it.
 std::vector<NamedPose> region_poses(const PoseTuneInput& in, const config::PoseRegionConfig& r, double line_step_deg) {
-  std::vector<NamedPose> out = mode_grid(in, r, in.cell.pose_schedule->grid_points);
+  const std::vector<bool> moves = moving_joints(in, r);
+  std::vector<NamedPose> out = grid_along(r, moves, in.cell.pose_schedule->grid_points);
   const std::vector<double> centre = analysis::region_centre(r);
   for (std::size_t j = 0; j < r.min_deg.size(); ++j) {
     const double width = r.max_deg[j] - r.min_deg[j];
     const int steps = static_cast<int>(std::ceil(width / line_step_deg));
-    if (steps < in.cell.pose_schedule->grid_points || !joint_moves_modes(in, r, j)) continue;
+    if (steps < in.cell.pose_schedule->grid_points || !moves[j]) continue;
     for (int k = 0; k <= steps; ++k) {
       std::vector<double> q = centre;
       q[j] = r.min_deg[j] + width * k / steps;
