@@ -61,7 +61,7 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
   for (std::size_t i = 0; i < sched.size(); ++i) {
     const auto& r = sched[i].region;
     ASSERT_TRUE(r.compensator && r.match_freq_hz && r.polarity && r.gain_ns_per_m);
-    EXPECT_EQ(r.name, "r" + std::to_string(i + 1));
+    EXPECT_EQ(r.name, std::string("r").append(std::to_string(i + 1)));  // ("r" + to_string: a false GCC 12 -Wrestrict)
     if (i > 0) {
       EXPECT_NEAR(sched[i - 1].region.max_deg[1] - r.min_deg[1], s.overlap_deg, 1e-9);  // the hysteresis
     }
