@@ -235,6 +235,12 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
   std::cout << "the job's smallest damped depth over the map: robust " << depth["robust"] << " mm, scheduled " << depth["scheduled"]
             << " mm, hand-drawn " << depth["as given"] << " mm; chosen " << chosen << "\n";
   EXPECT_GE(depth[chosen], depth["as given"]);
+  // The band's tolerance is said, and a chosen controller that leaves a mode worse than open loop is noted.
+  EXPECT_DOUBLE_EQ(t["worse_mode_pct"].get<double>(), 1.0);
+  for (const auto& c : t["controllers"])
+    if (c["name"] == chosen && c["worst_mode_improvement_pct"].get<double>() < 0.0) {
+      EXPECT_NE(test::read_file(f.dir + "/tune.log").find("note: a mode in the damping band ends"), std::string::npos);
+    }
   std::map<std::string, json> predicted;  // each held-out pose: the prediction of each set that can run there
   for (const auto& p : t["map"])
     if (p["role"] == "held out") predicted[p["pose"]] = p[chosen]["improvement_by_region_pct"];
