@@ -19,6 +19,7 @@ import urllib.request
 
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.remote.remote_connection import RemoteConnection
 from selenium.webdriver.common.by import By
 
 BINARY, SOURCE, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -145,6 +146,9 @@ class DashboardInABrowser(unittest.TestCase):
     def setUpClass(cls):
         os.makedirs(OUT, exist_ok=True)
         cls.fleet = Fleet()
+        # Each WebDriver command answers within 120 s or fails the test by name (Selenium's default is to wait
+        # for ever: a loaded run once hung in one until ctest's 600 s, the cells never stopped).
+        RemoteConnection.set_timeout(120)
         options = webdriver.ChromeOptions()
         for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1000",
                   f"--user-data-dir={cls.fleet.dir}/chromium"):
