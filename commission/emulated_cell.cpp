@@ -7,13 +7,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <cmath>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -86,6 +89,52 @@ struct ControllerRun {
   unsigned long long saturated_ticks{0};
 };
 
+// How long (wall time) the lockstep may go without a fresh sensor sample before the run is ended as stalled:
+// a run under a CPU hog on both cores steps at about plant speed, and each missing frame costs the loop its
+// 1 s lockstep wait, so a silent emulator would otherwise hold the caller for hours.
+constexpr double kStallWallS = 30.0;
+
+// Ends the cell's run when no fresh sensor sample has arrived for kStallWallS; joined on every path.
+class StallWatch {
+ public:
+  explicit StallWatch(runtime::Cell& cell) : thread_([this, &cell] { watch(cell); }) {}
+  ~StallWatch() {
+    {
+      const std::lock_guard<std::mutex> lock(m_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  StallWatch(const StallWatch&) = delete;
+  StallWatch& operator=(const StallWatch&) = delete;
+  void fresh() noexcept { fresh_.fetch_add(1, std::memory_order_relaxed); }
+  [[nodiscard]] bool stalled() const noexcept { return stalled_.load(); }
+
+ private:
+  void watch(runtime::Cell& cell) {
+    using Clock = std::chrono::steady_clock;
+    std::uint64_t seen = fresh_.load();
+    auto since = Clock::now();
+    std::unique_lock<std::mutex> lock(m_);
+    while (!cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return done_; })) {
+      if (const std::uint64_t now = fresh_.load(); now != seen) {
+        seen = now, since = Clock::now();
+      } else if (std::chrono::duration<double>(Clock::now() - since).count() > kStallWallS) {
+        stalled_ = true;
+        cell.request_stop();
+        return;
+      }
+    }
+  }
+  std::atomic<std::uint64_t> fresh_{0};
+  std::atomic<bool> stalled_{false};
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_{false};
+  std::thread thread_;
+};
+
 ControllerRun run_controller(const config::Config& cfg, double duration_s, double from_s, double to_s,
                              const EmulatorProcess& emulator) {
   const PinnedToOneCpu pinned;
@@ -93,7 +142,9 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
   std::uint64_t in = 0, active = 0;  // written on the drain thread, read after wait()
+  std::atomic<StallWatch*> watch{nullptr};  // set before the loop starts, cleared after the drain has stopped
   o.on_frame = [&](const rt::TelemetryFrame& f) {
+    if (StallWatch* w = watch.load(); w != nullptr && (f.flags & rt::kFlagFresh)) w->fresh();
     if (f.time_s < from_s || f.time_s >= to_s) return;
     ++in;
     if (f.state == static_cast<std::uint8_t>(rt::State::kActive)) ++active;
@@ -102,9 +153,20 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   if (runtime::Status s = cell.configure(); !s.ok())
     throw std::runtime_error("the controller could not reach the emulator: " + s.message + "; the emulator's log " +
                              emulator.log_path() + ": " + emulator.log_tail());
-  if (runtime::Status s = cell.activate(duration_s); !s.ok()) throw std::runtime_error("the controller: " + s.message);
-  cell.wait();
-  (void)cell.deactivate();
+  bool stalled = false;
+  {
+    StallWatch w(cell);
+    watch.store(&w);
+    const runtime::Status activated = cell.activate(duration_s);
+    if (activated.ok()) cell.wait();
+    stalled = w.stalled();
+    (void)cell.deactivate();  // the drain thread (on_frame) has ended: w may go
+    watch.store(nullptr);
+    if (!activated.ok()) throw std::runtime_error("the controller: " + activated.message);
+  }
+  if (stalled)
+    throw std::runtime_error("the lockstep stalled: no fresh sensor sample for " + config::format_number(kStallWallS) +
+                             " s of wall time; the emulator's log " + emulator.log_path() + ": " + emulator.log_tail());
   ControllerRun r;
   r.trip = cell.summary().trip;
   r.saturated_ticks = cell.summary().supervisor.saturated_ticks;

@@ -6,6 +6,7 @@
 // points of the predicted, and the cuts at the promise less 5 % stable.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commission/commission.hpp"
+#include "commission/emulated_cell.hpp"
 #include "config/config.hpp"
 #include "hil_files.hpp"
 #include "test_util.hpp"
@@ -99,6 +101,34 @@ TEST(CommissionHil, ARealCanBusIsRefusedWithTheReason) {
   EXPECT_EQ(r.stage, commission::Stage::kMeasure);
   EXPECT_NE(r.reason.find("can.interface = can0"), std::string::npos) << r.reason;
   EXPECT_FALSE(fs::exists(s.out_dir + "/configuration.yaml"));
+}
+
+// An emulator that goes silent mid-run (SIGSTOP once the controller is connected, by a wrapper around the
+// real `robodamp plant`) ends the cut across processes with a clear error within the stall watch's 30 s of
+// wall time, naming the emulator's log, instead of holding the caller for a 1 s lockstep wait per tick.
+TEST(CommissionHil, AnEmulatorThatGoesSilentEndsTheCutWithTheReason) {
+  const test::HilFiles f = test::hil_files("silent_emulator");
+  const std::string pidfile = f.dir + "/plant.pid", wrapper = f.dir + "/frozen_plant.sh";
+  std::ofstream(wrapper) << "#!/bin/bash\n"
+                            "\"" ROBODAMP_BINARY "\" \"$@\" > >(while IFS= read -r l; do echo \"$l\"; "
+                            "[[ $l == *'controller connected'* ]] && kill -STOP \"$(cat " + pidfile + ")\"; done) 2>&1 &\n"
+                            "echo $! > " + pidfile + "\nwait $!\n";
+  fs::permissions(wrapper, fs::perms::owner_all);
+  const config::Config cell = config::load_config_file(f.config);
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
+  std::string what;
+  try {
+    (void)commission::cut_through_emulator(cell, cell, {wrapper, f.config, job, 60}, 700.0, 0.5, f.dir + "/cut");
+  } catch (const std::runtime_error& e) {
+    what = e.what();
+  }
+  // The frozen plant, whoever its parent was, goes now.
+  std::ifstream pid_in(pidfile);
+  pid_t pid = 0;
+  if (pid_in >> pid && pid > 0) ::kill(pid, SIGKILL);
+  EXPECT_NE(what.find("the lockstep stalled: no fresh sensor sample for 30 s"), std::string::npos) << what;
+  EXPECT_NE(what.find(f.dir + "/cut/plant.log"), std::string::npos) << what;
+  EXPECT_NE(what.find("controller connected"), std::string::npos) << what;  // the log's tail
 }
 
 }  // namespace
