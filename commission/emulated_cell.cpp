@@ -142,7 +142,7 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
   std::uint64_t in = 0, active = 0;  // written on the drain thread, read after wait()
-  std::atomic<StallWatch*> watch{nullptr};  // set before the loop starts, cleared after the drain has stopped
+  std::atomic<StallWatch*> watch{nullptr};  // set once the loop runs, cleared after the drain has stopped
   o.on_frame = [&](const rt::TelemetryFrame& f) {
     if (StallWatch* w = watch.load(); w != nullptr && (f.flags & rt::kFlagFresh)) w->fresh();
     if (f.time_s < from_s || f.time_s >= to_s) return;
@@ -153,16 +153,15 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   if (runtime::Status s = cell.configure(); !s.ok())
     throw std::runtime_error("the controller could not reach the emulator: " + s.message + "; the emulator's log " +
                              emulator.log_path() + ": " + emulator.log_tail());
+  if (runtime::Status s = cell.activate(duration_s); !s.ok()) throw std::runtime_error("the controller: " + s.message);
   bool stalled = false;
   {
-    StallWatch w(cell);
+    StallWatch w(cell);  // from the loop's start: an activation's own waits are bounded by their timeouts
     watch.store(&w);
-    const runtime::Status activated = cell.activate(duration_s);
-    if (activated.ok()) cell.wait();
+    cell.wait();
     stalled = w.stalled();
     (void)cell.deactivate();  // the drain thread (on_frame) has ended: w may go
     watch.store(nullptr);
-    if (!activated.ok()) throw std::runtime_error("the controller: " + activated.message);
   }
   if (stalled)
     throw std::runtime_error("the lockstep stalled: no fresh sensor sample for " + config::format_number(kStallWallS) +
