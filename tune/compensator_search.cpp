@@ -21,6 +21,7 @@
 #include "milling/structure.hpp"
 #include "modal/receptance.hpp"
 #include "filters/polynomial.hpp"
+#include "filters/transfer_function.hpp"
 #include "units/units.hpp"
 
 namespace robodamp::tune {
@@ -41,13 +42,9 @@ std::vector<double> second_order(double f_hz, double zeta) {
 
 std::vector<double> first_order(double f_hz) { return {1.0 / (kTwoPi * f_hz), 1.0}; }
 
-// |N(j 2 pi f) / D(j 2 pi f)| of a rational compensator (coefficients highest power first, continuous).
-double rational_gain(const std::vector<double>& num, const std::vector<double>& den, double f_hz) {
-  const std::complex<double> s(0.0, kTwoPi * f_hz);
-  std::complex<double> n = 0.0, d = 0.0;
-  for (double a : num) n = n * s + a;
-  for (double a : den) d = d * s + a;
-  return std::abs(n / d);
+// A rational compensator's N(s) / D(s), coefficients highest power first (continuous).
+filters::TransferFunction rational(const std::vector<double>& num, const std::vector<double>& den) {
+  return {filters::Polynomial::from_descending(num), filters::Polynomial::from_descending(den)};
 }
 
 // The candidate's compensator before its pre-warp: numerator and denominator.
@@ -79,7 +76,8 @@ double compensator_gain_ratio(const config::Config& cfg) {
   const auto b = std::find_if(cfg.controller.chain.begin(), cfg.controller.chain.end(),
                               [](const config::BlockConfig& x) { return x.kind == config::BlockKind::kCompensator; });
   if (b == cfg.controller.chain.end() || b->model != config::CompensatorModel::kRational) return 0.0;
-  const auto gain = [&](double f_hz) { return rational_gain(b->numerator, b->denominator, f_hz); };
+  const filters::TransferFunction c = rational(b->numerator, b->denominator);
+  const auto gain = [&](double f_hz) { return std::abs(c.at_hz(f_hz)); };
   const double match_hz = cfg.controller.match_freq_hz.value_or(10.0), nyquist_hz = 0.5 * cfg.loop.rate_hz;
   double largest = 0.0;
   for (double f = 0.1; f <= nyquist_hz; f *= 1.05) largest = std::max(largest, gain(f));
@@ -99,7 +97,7 @@ config::BlockConfig compensator_block(const Candidate& c, const config::BlockCon
   b.kind = config::BlockKind::kCompensator;
   b.model = config::CompensatorModel::kRational;
   std::tie(b.numerator, b.denominator) = candidate_rational(c);
-  const double gain = rational_gain(b.numerator, b.denominator, unity_hz);
+  const double gain = std::abs(rational(b.numerator, b.denominator).at_hz(unity_hz));
   for (double& a : b.numerator) a /= gain;
   return b;
 }
@@ -107,7 +105,8 @@ config::BlockConfig compensator_block(const Candidate& c, const config::BlockCon
 Candidate restated(const Candidate& c, double from_hz, double to_hz) {
   const auto [num, den] = candidate_rational(c);
   Candidate out = c;
-  out.gain_ns_per_m = std::clamp(c.gain_ns_per_m * rational_gain(num, den, to_hz) / rational_gain(num, den, from_hz),
+  const filters::TransferFunction tf = rational(num, den);
+  out.gain_ns_per_m = std::clamp(c.gain_ns_per_m * std::abs(tf.at_hz(to_hz)) / std::abs(tf.at_hz(from_hz)),
                                  kGainMinNsPerM, kGainMaxNsPerM);
   return out;
 }
