@@ -111,6 +111,11 @@ Candidate restated(const Candidate& c, double from_hz, double to_hz) {
   return out;
 }
 
+std::complex<double> compensator_response(const Candidate& c, double f_hz) {
+  const auto [num, den] = candidate_rational(c);
+  return rational(num, den).at_hz(f_hz);
+}
+
 double unity_gain_hz(const config::Config& cfg) {
   if (cfg.controller.match_freq_hz) return *cfg.controller.match_freq_hz;
   return modal::dominant_mode_hz(cfg.robot, cfg.actuator.location).value_or(10.0);
@@ -424,8 +429,10 @@ namespace {
 
 // x = [log10 K, log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb]
 constexpr unsigned kDims = 7;
-const double kLower[kDims] = {std::log10(kGainMinNsPerM), std::log10(0.3), 0.05, std::log10(0.3), 0.05, std::log10(0.3), std::log10(0.3)};
-const double kUpper[kDims] = {std::log10(kGainMaxNsPerM), std::log10(80.0), 1.5, std::log10(80.0), 1.5, std::log10(200.0), std::log10(200.0)};
+const double kLower[kDims] = {std::log10(kGainMinNsPerM), std::log10(kPairMinHz), kZetaMin, std::log10(kPairMinHz), kZetaMin,
+                              std::log10(kFirstOrderMinHz), std::log10(kFirstOrderMinHz)};
+const double kUpper[kDims] = {std::log10(kGainMaxNsPerM), std::log10(kPairMaxHz), kZetaMax, std::log10(kPairMaxHz), kZetaMax,
+                              std::log10(kFirstOrderMaxHz), std::log10(kFirstOrderMaxHz)};
 
 Candidate candidate_of(const double* x, int polarity) {
   return {std::pow(10.0, x[0]), std::pow(10.0, x[1]), x[2], std::pow(10.0, x[3]), x[4], std::pow(10.0, x[5]),

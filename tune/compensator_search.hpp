@@ -17,6 +17,7 @@
 #pragma once
 
 #include <algorithm>
+#include <complex>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -44,8 +45,13 @@ struct Candidate {
 // gain at that frequency whatever the shape.
 [[nodiscard]] config::BlockConfig compensator_block(const Candidate& c, const config::BlockConfig& replaced,
                                                     double unity_hz);
-// The search's range of K, N s/m.
+// The search's range of K, N s/m, and of the shape: the pairs' and the first-order terms' frequencies, Hz,
+// and the pairs' damping ratios.
 inline constexpr double kGainMinNsPerM = 100.0, kGainMaxNsPerM = 20000.0;
+inline constexpr double kPairMinHz = 0.3, kPairMaxHz = 80.0, kFirstOrderMinHz = 0.3, kFirstOrderMaxHz = 200.0;
+inline constexpr double kZetaMin = 0.05, kZetaMax = 1.5;
+// The candidate's compensator at f_hz, continuous and before its scaling to unity at the match frequency.
+[[nodiscard]] std::complex<double> compensator_response(const Candidate& c, double f_hz);
 
 // The same controller (compensator and gain) with K stated at to_hz instead of from_hz: a set tuned with one
 // match frequency, as a start for a configuration with another; K kept inside the search's range.

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "analysis/pose_schedule.hpp"
+#include "tune/phase_start.hpp"
 
 namespace robodamp::tune {
 
@@ -120,9 +121,14 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
   return t;
 }
 
+// The gains the phase-matched shape is tried at (tune/phase_start.hpp), N s/m.
+constexpr double kPhaseMatchedGainsNsPerM[] = {100.0, 200.0, 500.0, 1000.0, 2000.0};
+
 // Where the region's search starts: sets tuned at single poses (one plant each: cheap, with three times the
-// evaluations) at the centre and at the poses with the region's lowest and highest dominant mode, and the
-// inherited set (if any), each judged over every pose of the region; the best of them.
+// evaluations) at the centre and at the poses with the region's lowest and highest dominant mode, the
+// inherited set (if any), and the shape whose feedback opposes the velocity at every mode in the band at
+// every pose of the region (tune/phase_start.hpp) at a few gains; each judged over every pose of the
+// region; the best of them.
 Candidate best_start(const PoseTuneInput& in, const config::Config& base, const std::vector<double>& centre,
                      const TunedRegion& region, const std::vector<Evaluator>& plants, const TuneSettings& t,
                      const std::optional<Candidate>& inherited) {
@@ -146,14 +152,24 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
     best = evaluate_worst(all, *inherited);
     best->candidate = *inherited;
   }
-  for (const auto& q : starts) {
-    const Evaluator one(analysis::config_at_pose(base, analysis::pose_modes(in.model, q, sched.axis, sched.modes)), std::nullopt,
-                        single, config::describe_pose(q));
-    const Candidate c = tune(std::vector<const Evaluator*>{&one}, single).best.candidate;
+  const auto contend = [&](const Candidate& c) {
     Evaluation e = evaluate_worst(all, c);
     e.candidate = c;
     if (!best || better(e, *best)) best = e;
+  };
+  for (const auto& q : starts) {
+    const Evaluator one(analysis::config_at_pose(base, analysis::pose_modes(in.model, q, sched.axis, sched.modes)), std::nullopt,
+                        single, config::describe_pose(q));
+    contend(tune(std::vector<const Evaluator*>{&one}, single).best.candidate);
   }
+  std::vector<config::Config> at_poses;
+  for (const Evaluator& e : plants) at_poses.push_back(e.base());
+  if (const auto matched = phase_matched(at_poses, t.mode_band_min_hz, t.mode_band_max_hz, t.compensator_gain_max))
+    for (const double k_ns_per_m : kPhaseMatchedGainsNsPerM) {
+      Candidate c = matched->shape;
+      c.gain_ns_per_m = k_ns_per_m;
+      contend(c);
+    }
   return best->candidate;
 }
 
