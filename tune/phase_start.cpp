@@ -24,8 +24,10 @@ struct ModeAt {
 
 constexpr unsigned kShapeDims = 6;  // log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb
 constexpr int kEvaluationsPerStart = 400;
-// A compensator 10 % over its gain limit costs as much as a 17 deg phase error at one mode.
-constexpr double kGainExcessWeight = 10.0;
+// A compensator 1 % over its gain limit costs as much as an 18 deg phase error at one mode: the limit is
+// the search's constraint, the phase only a start.
+constexpr double kGainExcessWeight = 1e3;
+constexpr double kGainLimitShare = 0.98;  // the penalty starts just inside the limit: a start the search can use
 
 Candidate shape_of(const double* x, int polarity) {
   Candidate c;
@@ -48,12 +50,12 @@ struct Fit {
 };
 
 // How far the compensator's largest gain from 0.1 Hz to Nyquist, over its gain at the match frequency, is
-// above gain_max (squared natural log; 0 within it or without a limit): the search's own constraint.
+// above 98 % of gain_max (squared natural log; 0 within it or without a limit): the search's own constraint.
 double gain_excess(const Candidate& c, const Fit& fit) {
   if (fit.gain_max <= 0.0) return 0.0;
   double largest = 0.0;
   for (double f = 0.1; f <= fit.nyquist_hz; f *= 1.05) largest = std::max(largest, std::abs(compensator_response(c, f)));
-  const double over = std::log(largest / std::abs(compensator_response(c, fit.match_hz)) / fit.gain_max);
+  const double over = std::log(largest / std::abs(compensator_response(c, fit.match_hz)) / (kGainLimitShare * fit.gain_max));
   return over > 0.0 ? over * over : 0.0;
 }
 
