@@ -173,6 +173,61 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
   return best->candidate;
 }
 
+// The plant at one of a region's poses: the region's base configuration with the model's modes there.
+Evaluator region_plant(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t, const NamedPose& p) {
+  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
+  config::Config at = analysis::config_at_pose(base, analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes));
+  at.source = in.cell.source + " at " + p.name;
+  return Evaluator(at, std::nullopt, t, p.name);
+}
+
+std::vector<const Evaluator*> pointers(const std::vector<Evaluator>& plants) {
+  std::vector<const Evaluator*> out;
+  for (const Evaluator& e : plants) out.push_back(&e);
+  return out;
+}
+
+// How many times a region's search runs again with a pose its check found (checked_between).
+constexpr int kCheckRounds = 2;
+
+// The tuned set checked between the poses it was tuned at: the region's poses with half the line step, less
+// those it was tuned at. Where it does not serve, the worst such pose joins the region's poses and the search
+// runs again from the set (tune_from: never worse over them), at most kCheckRounds times. The result's worst
+// case counts every checked pose, so the region serves only where the check holds too.
+TuneResult checked_between(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t, const PoseTuneSettings& s,
+                           const PoseTuneProgress& progress, TunedRegion& out, std::vector<Evaluator>& plants, TuneResult r) {
+  std::vector<Evaluator> check;
+  std::vector<NamedPose> check_poses;
+  for (const NamedPose& p : region_poses(in, out.region, 0.5 * s.line_step_deg)) {
+    if (std::any_of(out.poses.begin(), out.poses.end(), [&](const NamedPose& q) { return q.joints_deg == p.joints_deg; })) continue;
+    check.push_back(region_plant(in, base, t, p));
+    check_poses.push_back(p);
+  }
+  std::vector<bool> joined(check.size(), false);  // moved into plants
+  for (int round = 0; round < kCheckRounds; ++round) {
+    std::optional<std::size_t> worst;
+    double worst_violation = 0.0;
+    for (std::size_t i = 0; i < check.size(); ++i) {
+      if (joined[i]) continue;
+      const Evaluation e = check[i](r.best.candidate);
+      if (!e.feasible() && e.violation > worst_violation) worst = i, worst_violation = e.violation;
+    }
+    if (!worst) return r;
+    if (progress) progress("  does not serve at " + check_poses[*worst].name + " between its poses: searched again with it");
+    plants.push_back(std::move(check[*worst]));
+    joined[*worst] = true;
+    out.poses.push_back(check_poses[*worst]);
+    r = tune_from(pointers(plants), r.best.candidate, t);
+  }
+  std::vector<const Evaluator*> all = pointers(plants);
+  for (std::size_t i = 0; i < check.size(); ++i)
+    if (!joined[i]) all.push_back(&check[i]);
+  const Candidate c = r.best.candidate;
+  r.best = evaluate_worst(all, c);
+  r.best.candidate = c;
+  return r;
+}
+
 }  // namespace
 
 TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const std::vector<double>& min_deg,
@@ -194,19 +249,16 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
     const analysis::PoseModes pm = analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes);
     out.dominant_min_hz = std::min(out.dominant_min_hz, pm.dominant_hz());
     out.dominant_max_hz = std::max(out.dominant_max_hz, pm.dominant_hz());
-    config::Config at = analysis::config_at_pose(base, pm);
-    at.source = in.cell.source + " at " + p.name;
-    plants.emplace_back(at, std::nullopt, t, p.name);
+    plants.push_back(region_plant(in, base, t, p));
   }
-  std::vector<const Evaluator*> ptrs;
-  for (const Evaluator& e : plants) ptrs.push_back(&e);
   if (progress)
     progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) + ": " +
              std::to_string(out.poses.size()) + " poses, dominant mode " + fmt(out.dominant_min_hz) + "-" +
              fmt(out.dominant_max_hz) + " Hz");
   std::optional<Candidate> inherited;
   if (parent) inherited = restated(parent->worst.candidate, *parent->region.match_freq_hz, match_hz);
-  const TuneResult r = tune_from(ptrs, best_start(in, base, centre, out, plants, t, inherited), t);
+  const TuneResult r = checked_between(in, base, t, s, progress, out, plants,
+                                       tune_from(pointers(plants), best_start(in, base, centre, out, plants, t, inherited), t));
   out.worst = r.best;
   const Candidate& c = r.best.candidate;
   const config::Config tuned = with_candidate(base, c);

@@ -18,9 +18,13 @@
 // the modes' peaks), its compensator's gain nowhere more than compensator_gain_max times its gain at the
 // match frequency (a set that lifted the drift or the noise tripped on saturation in the HIL). It starts from
 // the best of single-pose tunes (one plant each, three times the evaluations) at the region's centre and at
-// its lowest and highest dominant mode, and (a half of a cut region) the set of the region it was cut from,
-// then is searched over all the region's poses from there at that polarity (tune::tune_from). Both controllers are then
-// scored on the workspace map (tune/pose_score.hpp) and the better written. Off the real-time path.
+// its lowest and highest dominant mode, the shape whose feedback opposes the velocity at every mode in the
+// band (tune/phase_start.hpp) at a few gains, and (a half of a cut region) the set of the region it was cut
+// from, then is searched over all the region's poses from there at that polarity (tune::tune_from). The set
+// is then checked between those poses (the line at half the step): a pose where it does not serve joins
+// the region's poses and the search runs again from the set (twice at most); a region serves only where
+// that check holds too. Both controllers are then scored on the workspace map (tune/pose_score.hpp) and the
+// better written. Off the real-time path.
 #pragma once
 
 #include <functional>
