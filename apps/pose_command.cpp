@@ -411,7 +411,7 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--map-points", a->tune.map_points, {"(points per joint)", 2, 41}, "tune: the workspace map's grid along the joints that move the dominant mode (default 9)");
   r.number(sub, "--overlap-deg", a->tune.overlap_deg, {"deg", 0.0, 30.0}, "tune: neighbouring regions overlap by this (the hand-over's hysteresis)");
   r.number(sub, "--worse-mode-pct", a->tune.worse_mode_pct, {"%", 0.0, 20.0},
-           "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default 1)");
+           "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default 0: never worse)");
   r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map: the pose, one relative angle per joint");
   sub->add_option("--pose", a->pose_name, "frf, map: a pose the model file names");
   r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes");

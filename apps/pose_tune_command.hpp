@@ -17,7 +17,7 @@ struct PoseTuneArgs {
   std::string job_path;
   int evaluations{60}, polish{30}, max_regions{4}, map_points{9}, seed{1};
   double overlap_deg{4.0};
-  double worse_mode_pct{1.0};                 // a mode in the damping band this much worse than open loop still serves
+  double worse_mode_pct{0.0};                 // a mode in the damping band this much worse than open loop still serves
   std::string out_path;
   JsonOut json;
 };

@@ -48,7 +48,9 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
   s.max_regions = 4;
   s.line_step_deg = 70.0;  // joint 2's grid alone (its 3 poses): this test's budget cannot serve more
   const tune::TunedRegion robust = tune::tune_robust(in, s);
-  EXPECT_EQ(robust.poses.size(), 3U);  // joint 2's grid; joints 1 and 3 do not move
+  // Joint 2's grid (joints 1 and 3 do not move), and at most two poses the check between them added.
+  EXPECT_GE(robust.poses.size(), 3U);
+  EXPECT_LE(robust.poses.size(), 5U);
   EXPECT_FALSE(robust.serves()) << robust.worst.worst_mode_improvement_pct;
   const std::vector<tune::TunedRegion> sched = tune::tune_schedule(in, robust, s);
   for (const auto& r : sched)
@@ -99,8 +101,10 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
   choice.controllers[0].worst_mode_improvement_pct = -8.3, choice.controllers[0].damped_min_mm = 0.147;
   choice.controllers[1].worst_mode_improvement_pct = 2.4, choice.controllers[1].damped_min_mm = 0.091;
   EXPECT_EQ(tune::better_controller(choice), 1U);
-  choice.controllers[0].worst_mode_improvement_pct = -0.5;  // within the 1 % a serving set may lose
-  EXPECT_EQ(tune::better_controller(choice), 0U);
+  // -0.5 % breaks the promise by default (never worse) and keeps it with a 1 % tolerance (--worse-mode-pct 1).
+  choice.controllers[0].worst_mode_improvement_pct = -0.5;
+  EXPECT_EQ(tune::better_controller(choice), 1U);
+  EXPECT_EQ(tune::better_controller(choice, 1.0), 0U);
   choice.controllers[1].worst_mode_improvement_pct = -3.0;
   choice.controllers[0].worst_mode_improvement_pct = -8.3;
   EXPECT_EQ(tune::better_controller(choice), 0U);

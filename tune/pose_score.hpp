@@ -73,6 +73,6 @@ struct MapScores {
 // the band more than worse_mode_tolerance_pct worse than open loop at any map pose); then the larger
 // smallest damped depth with a job (by more than 1 %); else the larger worst mode improvement (by more than
 // 1 point). Ties go to the first (the robust one: no hand-overs).
-[[nodiscard]] std::size_t better_controller(const MapScores& s, double worse_mode_tolerance_pct = 1.0);
+[[nodiscard]] std::size_t better_controller(const MapScores& s, double worse_mode_tolerance_pct = 0.0);
 
 }  // namespace robodamp::tune

@@ -50,7 +50,7 @@ struct PoseTuneSettings {
   double overlap_deg{4.0};   // neighbouring regions overlap by this across the cut (the hand-over's hysteresis)
   double min_width_deg{8.0}; // a region is not cut along a joint narrower than twice this
   double line_step_deg{10.0};  // a region's poses along each joint that changes the plant at most this far apart
-  double worse_mode_tolerance_pct{1.0};  // a mode's peak up to this much worse than open loop still serves
+  double worse_mode_tolerance_pct{0.0};  // a mode's peak up to this much worse than open loop still serves
   double compensator_gain_max{10.0};     // TuneSettings::compensator_gain_max for every set
 };
 
