@@ -121,6 +121,12 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
   return t;
 }
 
+std::vector<const Evaluator*> pointers(const std::vector<Evaluator>& plants) {
+  std::vector<const Evaluator*> out;
+  for (const Evaluator& e : plants) out.push_back(&e);
+  return out;
+}
+
 // The gains the phase-matched shape is tried at (tune/phase_start.hpp), N s/m.
 constexpr double kPhaseMatchedGainsNsPerM[] = {100.0, 200.0, 500.0, 1000.0, 2000.0};
 
@@ -143,8 +149,7 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
   }
   for (const auto& q : {at_lo, at_hi})
     if (!q.empty() && std::find(starts.begin(), starts.end(), q) == starts.end()) starts.push_back(q);
-  std::vector<const Evaluator*> all;
-  for (const Evaluator& e : plants) all.push_back(&e);
+  const std::vector<const Evaluator*> all = pointers(plants);
   TuneSettings single = t;
   single.global_evaluations *= 3, single.local_evaluations *= 3;
   std::optional<Evaluation> best;
@@ -179,12 +184,6 @@ Evaluator region_plant(const PoseTuneInput& in, const config::Config& base, cons
   config::Config at = analysis::config_at_pose(base, analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes));
   at.source = in.cell.source + " at " + p.name;
   return Evaluator(at, std::nullopt, t, p.name);
-}
-
-std::vector<const Evaluator*> pointers(const std::vector<Evaluator>& plants) {
-  std::vector<const Evaluator*> out;
-  for (const Evaluator& e : plants) out.push_back(&e);
-  return out;
 }
 
 // How many times a region's search runs again with a pose its check found (checked_between).
