@@ -3,7 +3,6 @@
 // the TCP than the first and plain velocity feedback lifts the first mode's mass line over it.
 #include <gtest/gtest.h>
 
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,11 +33,7 @@ config::Config folded_plant(const std::vector<double>& joints_deg) {
        "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}"},
       {"{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
        "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}"}};
-  for (const auto& [from, to] : edits) {
-    const auto at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("the test's edit finds no '" + from + "'");
-    text.replace(at, from.size(), to);
-  }
+  for (const auto& [from, to] : edits) test::replace_or_throw(text, from, to);
   const config::Config cell = config::parse_config(text, src + "/config/hil_pose_schedule.yaml");
   const config::RobotModelConfig model = config::load_robot_model(cell.pose_schedule->model_resolved);
   const analysis::PoseModes pm = analysis::pose_modes(model, joints_deg, cell.pose_schedule->axis, 3);

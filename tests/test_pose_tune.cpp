@@ -20,19 +20,15 @@ namespace robodamp {
 namespace {
 
 
-// Every occurrence; an edit that finds nothing is a broken test, not a silent no-op.
-void replace(std::string& s, const std::string& from, const std::string& to) {
-  if (s.find(from) == std::string::npos) throw std::runtime_error("the test's edit finds no '" + from + "'");
-  for (auto p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
-}
+using test::replace_or_throw;
 
 // The scheduled preset along joint 2 alone (joints 1 and 3 held): its two modes trade places near 25-50 deg.
 config::Config joint2_cell() {
   std::string text = test::read_file(test::preset("pose_scheduled_c2"));
-  replace(text, "workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}",
+  replace_or_throw(text, "workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}",
                     "workspace: {min_deg: [-100, 0, 90], max_deg: [-100, 140, 90]}");
-  replace(text, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}\n", "");
-  replace(text, "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
+  replace_or_throw(text, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}\n", "");
+  replace_or_throw(text, "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
                     "{name: all, min_deg: [-100, 0, 90], max_deg: [-100, 140, 90], gain_ns_per_m: 150}");
   return config::parse_config(text, test::preset("pose_scheduled_c2"));
 }
@@ -115,7 +111,7 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
 
 TEST(PoseTune, ARegionsCompensatorIsCheckedWithItsKeyAndTheReason) {
   std::string text = test::read_file(test::preset("pose_scheduled_c2"));
-  replace(text, "max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
+  replace_or_throw(text, "max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
                     "max_deg: [-98, 25, 92], gain_ns_per_m: 250, polarity: 2, match_freq_hz: -3,\n"
                     "       compensator: {numerator: [1, 2, 3], denominator: [-1, 1]}}");
   try {
@@ -137,7 +133,7 @@ TEST(PoseTune, TheDampingBandIsCheckedAndSplitsTheWorstModeInsideFromOutside) {
   const std::string path = test::preset("pose_scheduled_c2");
   std::string text = test::read_file(path);
   std::string bad = text;
-  replace(bad, "grid_points: 3", "grid_points: 3\n  damping_band_min_hz: 30\n  damping_band_max_hz: 5");
+  replace_or_throw(bad, "grid_points: 3", "grid_points: 3\n  damping_band_min_hz: 30\n  damping_band_max_hz: 5");
   try {
     (void)config::parse_config(bad, path);
     FAIL() << "accepted";
@@ -145,7 +141,7 @@ TEST(PoseTune, TheDampingBandIsCheckedAndSplitsTheWorstModeInsideFromOutside) {
     EXPECT_NE(std::string(e.what()).find("pose_schedule.damping_band_max_hz = 5 Hz must be above pose_schedule.damping_band_min_hz = 30 Hz"),
               std::string::npos) << e.what();
   }
-  replace(bad, "damping_band_max_hz: 5", "damping_band_max_hz: 2e5");
+  replace_or_throw(bad, "damping_band_max_hz: 5", "damping_band_max_hz: 2e5");
   try {
     (void)config::parse_config(bad, path);
     FAIL() << "accepted";
@@ -156,7 +152,7 @@ TEST(PoseTune, TheDampingBandIsCheckedAndSplitsTheWorstModeInsideFromOutside) {
   // the smallest of the modes inside.
   const config::Config all = config::parse_config(text, path);
   const analysis::PoseScheduleAnalysis every = analysis::analyse_pose_schedule(all);
-  replace(text, "grid_points: 3", "grid_points: 3\n  damping_band_min_hz: 5\n  damping_band_max_hz: 30");
+  replace_or_throw(text, "grid_points: 3", "grid_points: 3\n  damping_band_min_hz: 5\n  damping_band_max_hz: 30");
   const config::Config banded = config::parse_config(text, path);
   const analysis::PoseScheduleAnalysis in_band = analysis::analyse_pose_schedule(banded);
   ASSERT_EQ(every.regions.size(), in_band.regions.size());

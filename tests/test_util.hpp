@@ -5,6 +5,7 @@
 #include <functional>
 #include <thread>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "config/config.hpp"
@@ -47,6 +48,12 @@ inline config::ModeConfig stiffness_mode(double fn_hz, double zeta, double k_n_p
   m.damping_ratio = zeta;
   m.stiffness_n_per_m = k_n_per_m;
   return m;
+}
+
+// Every occurrence of from in s replaced; an edit that finds nothing is a broken test, not a silent no-op.
+inline void replace_or_throw(std::string& s, const std::string& from, const std::string& to) {
+  if (s.find(from) == std::string::npos) throw std::runtime_error("the test's edit finds no '" + from + "'");
+  for (auto p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
 }
 
 inline std::string read_file(const std::string& path) {

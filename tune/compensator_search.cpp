@@ -70,18 +70,21 @@ double closed_peak(const analysis::LoopModel& m, double gain, int polarity) {
 // quiet cell) is a 5-sigma event.
 constexpr double kQuietShareOfFloor = 1.0 / 3.0;
 
-// The largest |C(j w)| of the chain's compensator block from 0.1 Hz to Nyquist, over |C| at the match
-// frequency (continuous; the block is pre-warped there).
+// The largest |C(j w)| from 0.1 Hz to nyquist_hz over |C(match_hz)|.
+double largest_gain_ratio(const filters::TransferFunction& c, double match_hz, double nyquist_hz) {
+  const auto gain = [&](double f_hz) { return std::abs(c.at_hz(f_hz)); };
+  double largest = 0.0;
+  for (double f = 0.1; f <= nyquist_hz; f *= 1.05) largest = std::max(largest, gain(f));
+  return largest / gain(match_hz);
+}
+
+// The same for the chain's compensator block (continuous; the block is pre-warped at the match frequency).
 double compensator_gain_ratio(const config::Config& cfg) {
   const auto b = std::find_if(cfg.controller.chain.begin(), cfg.controller.chain.end(),
                               [](const config::BlockConfig& x) { return x.kind == config::BlockKind::kCompensator; });
   if (b == cfg.controller.chain.end() || b->model != config::CompensatorModel::kRational) return 0.0;
-  const filters::TransferFunction c = rational(b->numerator, b->denominator);
-  const auto gain = [&](double f_hz) { return std::abs(c.at_hz(f_hz)); };
-  const double match_hz = cfg.controller.match_freq_hz.value_or(10.0), nyquist_hz = 0.5 * cfg.loop.rate_hz;
-  double largest = 0.0;
-  for (double f = 0.1; f <= nyquist_hz; f *= 1.05) largest = std::max(largest, gain(f));
-  return largest / gain(match_hz);
+  return largest_gain_ratio(rational(b->numerator, b->denominator), cfg.controller.match_freq_hz.value_or(10.0),
+                            0.5 * cfg.loop.rate_hz);
 }
 
 void add_violation(Evaluation& e, double amount, const char* what) {
@@ -114,6 +117,11 @@ Candidate restated(const Candidate& c, double from_hz, double to_hz) {
 std::complex<double> compensator_response(const Candidate& c, double f_hz) {
   const auto [num, den] = candidate_rational(c);
   return rational(num, den).at_hz(f_hz);
+}
+
+double compensator_gain_ratio(const Candidate& c, double match_hz, double nyquist_hz) {
+  const auto [num, den] = candidate_rational(c);
+  return largest_gain_ratio(rational(num, den), match_hz, nyquist_hz);
 }
 
 double unity_gain_hz(const config::Config& cfg) {

@@ -52,6 +52,9 @@ inline constexpr double kPairMinHz = 0.3, kPairMaxHz = 80.0, kFirstOrderMinHz = 
 inline constexpr double kZetaMin = 0.05, kZetaMax = 1.5;
 // The candidate's compensator at f_hz, continuous and before its scaling to unity at the match frequency.
 [[nodiscard]] std::complex<double> compensator_response(const Candidate& c, double f_hz);
+// Its largest gain from 0.1 Hz to nyquist_hz over its gain at match_hz: what TuneSettings::compensator_gain_max
+// bounds (Evaluation::compensator_gain_ratio).
+[[nodiscard]] double compensator_gain_ratio(const Candidate& c, double match_hz, double nyquist_hz);
 
 // The same controller (compensator and gain) with K stated at to_hz instead of from_hz: a set tuned with one
 // match frequency, as a start for a configuration with another; K kept inside the search's range.

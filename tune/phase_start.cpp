@@ -53,9 +53,7 @@ struct Fit {
 // above 98 % of gain_max (squared natural log; 0 within it or without a limit): the search's own constraint.
 double gain_excess(const Candidate& c, const Fit& fit) {
   if (fit.gain_max <= 0.0) return 0.0;
-  double largest = 0.0;
-  for (double f = 0.1; f <= fit.nyquist_hz; f *= 1.05) largest = std::max(largest, std::abs(compensator_response(c, f)));
-  const double over = std::log(largest / std::abs(compensator_response(c, fit.match_hz)) / (kGainLimitShare * fit.gain_max));
+  const double over = std::log(compensator_gain_ratio(c, fit.match_hz, fit.nyquist_hz) / (kGainLimitShare * fit.gain_max));
   return over > 0.0 ? over * over : 0.0;
 }
 

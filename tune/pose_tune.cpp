@@ -179,11 +179,15 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
 }
 
 // The plant at one of a region's poses: the region's base configuration with the model's modes there.
-Evaluator region_plant(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t, const NamedPose& p) {
-  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
-  config::Config at = analysis::config_at_pose(base, analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes));
+Evaluator region_plant(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t, const NamedPose& p,
+                       const analysis::PoseModes& modes) {
+  config::Config at = analysis::config_at_pose(base, modes);
   at.source = in.cell.source + " at " + p.name;
   return Evaluator(at, std::nullopt, t, p.name);
+}
+Evaluator region_plant(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t, const NamedPose& p) {
+  const config::PoseScheduleConfig& sched = *in.cell.pose_schedule;
+  return region_plant(in, base, t, p, analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes));
 }
 
 // How many times a region's search runs again with a pose its check found (checked_between).
@@ -248,7 +252,7 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
     const analysis::PoseModes pm = analysis::pose_modes(in.model, p.joints_deg, sched.axis, sched.modes);
     out.dominant_min_hz = std::min(out.dominant_min_hz, pm.dominant_hz());
     out.dominant_max_hz = std::max(out.dominant_max_hz, pm.dominant_hz());
-    plants.push_back(region_plant(in, base, t, p));
+    plants.push_back(region_plant(in, base, t, p, pm));
   }
   if (progress)
     progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) + ": " +
