@@ -32,7 +32,8 @@ json finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }  //
 json to_json(const msg::Status& s) {
   return {{"time_s", s.time_s()}, {"state", s.state().to_string()}, {"trip", s.trip().to_string()}, {"trip_description", s.trip_description().to_string()},
           {"backend", s.backend().to_string()}, {"parameter_set", s.parameter_set()}, {"gain_ns_per_m", s.gain_ns_per_m()},
-          {"max_gain_ns_per_m", s.max_gain_ns_per_m()}, {"parameter_writes", s.parameter_writes()}, {"ticks", s.ticks()},
+          {"max_gain_ns_per_m", s.max_gain_ns_per_m()}, {"parameter_writes", s.parameter_writes()},
+          {"parameter_sets", s.parameter_sets()}, {"spindle_rpm_max", s.spindle_rpm_max()}, {"ticks", s.ticks()},
           {"missed_ticks", s.missed_ticks()}, {"overruns", s.overruns()}, {"stale_ticks", s.stale_ticks()},
           {"invalid_samples", s.invalid_samples()}, {"saturated_ticks", s.saturated_ticks()}, {"ring_drops", s.ring_drops()},
           {"wake_p50_us", s.wake_p50_us()}, {"wake_p99_us", s.wake_p99_us()}, {"wake_max_us", s.wake_max_us()},

@@ -176,6 +176,8 @@ void Bridge::publish_status() {
   s.parameter_set(static_cast<std::uint32_t>(src_.parameter_set ? src_.parameter_set() : 0));
   s.max_gain_ns_per_m(src_.gain_limit_ns_per_m ? src_.gain_limit_ns_per_m() : 0.0);
   s.parameter_writes(cfg_.parameter_writes);
+  s.parameter_sets(static_cast<std::uint32_t>(src_.parameter_sets ? src_.parameter_sets() : 1));
+  s.spindle_rpm_max(src_.spindle_rpm_max);
   if (status_writer_->write(&s)) ++n_status_;
 }
 

@@ -106,6 +106,8 @@ struct BridgeSources {
   std::function<std::optional<SpectrumSample>()> spectrum{};  // a new spectrum, if one is due; empty: no topic
   std::function<std::optional<LobesSample>()> lobes{};        // the lobes, if they changed; empty: no topic
   double gain_ramp_s{0.0};                         // controller.gain_ramp_s: when the loop is at full gain
+  std::function<std::size_t()> parameter_sets{};   // how many sets a select request may choose from (any thread)
+  double spindle_rpm_max{0.0};                     // spindle.rpm_max: what a spindle request may ask for
 };
 
 struct BridgeCounters {

@@ -181,7 +181,8 @@ Status Cell::configure_devices() {
                            [this] { return spectrum_->next(); },
                            cfg_.spindle.job.empty() ? std::function<std::optional<dds::LobesSample>()>{}
                                                     : [this] { return machining_->lobes(); },
-                           cfg_.controller.gain_ramp_s});
+                           cfg_.controller.gain_ramp_s,
+                           [this] { return supervisor_->parameter_sets().size(); }, cfg_.spindle.rpm_max});
     spectrum_ = std::make_unique<SpectrumMonitor>(cfg_);
   }
   for (Component* c : components()) {

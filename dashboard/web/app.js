@@ -81,18 +81,101 @@ $('logout').addEventListener('click', async () => {
   message('logged out', true);
 });
 
-document.querySelectorAll('#actions button[data-action]').forEach((b) => b.addEventListener('click', async () => {
-  const action = b.dataset.action;
-  const input = { gain: 'gain-value', set: 'set-value', spindle: 'spindle-value' }[action];
-  const body = { action };
-  if (input) body.value = Number($(input).value);
-  message(action + ' sent to ' + currentCell + '…');
+// The operator's typed values. The boxes are text, not <input type="number">: that one hands the page '' for
+// anything it cannot parse, and Number('') is 0, so an empty gain box once sent K = 0 and the cell took it.
+// Here the text is parsed strictly and checked against what the cell publishes (its gain limit, its sets,
+// its spindle's range) before anything leaves the page; the cell checks again when it executes.
+const kTyped = {
+  gain: { box: 'gain-value', what: 'the gain K', unit: 'N s/m', integer: false },
+  set: { box: 'set-value', what: 'the parameter set', unit: '', integer: true },
+  spindle: { box: 'spindle-value', what: 'the spindle speed', unit: 'rpm', integer: false },
+};
+const kNumberText = /^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$/;
+let cellStatus = null;     // the current cell's last status (its limits) and machining sample
+let cellMachining = null;
+
+function typedValue(action, text, status) {
+  const spec = kTyped[action];
+  const t = String(text).trim();
+  const unit = spec.unit ? ' ' + spec.unit : '';
+  const said = '"' + t.slice(0, 24) + (t.length > 24 ? '…' : '') + '"';
+  if (t === '') return { error: spec.what + ' is empty: type a value' + (spec.unit ? ' in ' + spec.unit : '') + ' (nothing was sent)' };
+  if (t.includes(',')) return { error: spec.what + ' ' + said + ': write the decimal mark as a point (1.5, not 1,5) and no thousands separator (nothing was sent)' };
+  if (!kNumberText.test(t)) return { error: spec.what + ' ' + said + ' is not a number (nothing was sent)' };
+  const v = Number(t);
+  if (!Number.isFinite(v)) return { error: spec.what + ' ' + said + ' is too large to be a number (nothing was sent)' };
+  if (v < 0) return { error: spec.what + ' = ' + t + unit + ' is negative: allowed from 0 (nothing was sent)' };
+  if (spec.integer && v !== Math.floor(v)) return { error: spec.what + ' = ' + t + ' is not a whole number (nothing was sent)' };
+  if (!status) return { error: 'the cell\'s limits are not known yet (no status heard): nothing was sent' };
+  const max = { gain: status.max_gain_ns_per_m, set: status.parameter_sets - 1, spindle: status.spindle_rpm_max }[action];
+  const name = { gain: 'the cell\'s gain limit', set: 'the last configured set', spindle: 'the spindle\'s spindle.rpm_max' }[action];
+  if (!(max >= 0)) return { error: 'the cell does not publish ' + name + ': nothing was sent' };
+  if (v > max) return { error: spec.what + ' = ' + t + unit + ' is above ' + name + ' (' + fmt(max, spec.integer ? 0 : 1) + unit + '): nothing was sent' };
+  return { value: v };
+}
+
+// What an action does, in words, and whether it reduces or removes damping or changes the spindle (those
+// wait for the operator's confirmation).
+function effect(action, value, status, machining) {
+  const k = status ? status.gain_ns_per_m : undefined;
+  switch (action) {
+    case 'gain':
+      if (value === 0) return { text: 'K ' + fmt(k, 0) + ' → 0 N s/m: removes the damping', confirm: true };
+      if (k !== undefined && value < k) return { text: 'K ' + fmt(k, 0) + ' → ' + fmt(value, 0) + ' N s/m: less damping', confirm: true };
+      return { text: 'K ' + fmt(k, 0) + ' → ' + fmt(value, 0) + ' N s/m', confirm: false };
+    case 'disarm': return { text: 'disarm: the command fades out and the damper stops damping', confirm: true };
+    case 'set': return { text: 'parameter set ' + (status ? status.parameter_set : '?') + ' → ' + value +
+      ': another controller (fade out, swap, fade in)', confirm: true };
+    case 'spindle': return { text: 'spindle ' + fmt(machining ? machining.spindle_rpm : undefined, 0) + ' → ' + fmt(value, 0) +
+      ' rpm: the notches and the limits follow the new speed', confirm: true };
+    default: return { text: action, confirm: false };
+  }
+}
+
+let pending = null;  // the action waiting for its confirmation
+function ask(body, text) {
+  pending = { body, cell: currentCell, until: Date.now() + 20000 };
+  $('confirm-text').textContent = text + ' on ' + currentCell + '?';
+  $('confirm').hidden = false;
+}
+function cancelPending(why) {
+  if (!pending) return;
+  pending = null;
+  $('confirm').hidden = true;
+  if (why) message(why + ': nothing was sent', false);
+}
+
+async function send(body) {
+  message(body.action + ' sent to ' + currentCell + '…');
   const r = await api('/api/cells/' + encodeURIComponent(currentCell) + '/action', body);
   const d = r.data;
   if (r.status === 200) message((d.accepted ? 'accepted: ' : 'refused by the cell: ') + d.reason, d.accepted);
-  else message(action + ' refused (' + r.status + '): ' + (d.error || d.reason), false);
+  else message(body.action + ' refused (' + r.status + '): ' + (d.error || d.reason), false);
   loadActions();
+}
+
+document.querySelectorAll('#actions button[data-action]').forEach((b) => b.addEventListener('click', async () => {
+  const action = b.dataset.action;
+  cancelPending();
+  const body = { action };
+  if (kTyped[action]) {
+    const t = typedValue(action, $(kTyped[action].box).value, cellStatus);
+    if (t.error) return message(t.error, false);
+    body.value = t.value;
+  }
+  const e = effect(action, body.value, cellStatus, cellMachining);
+  if (e.confirm && role === 'operator') return ask(body, e.text);
+  send(body);
 }));
+$('confirm-yes').addEventListener('click', () => {
+  const p = pending;
+  pending = null;
+  $('confirm').hidden = true;
+  if (!p || p.cell !== currentCell) return message('nothing to confirm', false);
+  if (Date.now() > p.until) return message('the confirmation came after 20 s: nothing was sent; ask again', false);
+  send(p.body);
+});
+$('confirm-no').addEventListener('click', () => cancelPending('cancelled'));
 
 // A tile's class, data attributes (what the browser tests read) and inner HTML.
 function tile(c) {
@@ -274,6 +357,8 @@ function connect() {
   source.addEventListener('cell', timed((ev) => {
     const d = JSON.parse(ev.data);
     if (d.cell !== currentCell) return;
+    if (d.status && d.status.state !== undefined) cellStatus = d.status;
+    if (d.machining && d.machining.spindle_rpm !== undefined) cellMachining = d.machining;
     plotTime(d.telemetry);
     if (d.spectrum !== undefined) { plotSpectrum(d.spectrum); plotLobes(d.lobes, d.machining, d.advice); }
     plotTiming(d.status);
@@ -284,6 +369,9 @@ function connect() {
 function route() {
   const m = location.hash.match(/^#\/cell\/(.+)$/);
   currentCell = m ? decodeURIComponent(m[1]) : null;
+  cancelPending();
+  cellStatus = null;
+  cellMachining = null;
   $('fleet-view').hidden = !!currentCell;
   $('cell-view').hidden = !currentCell;
   $('where').textContent = currentCell ? 'cell ' + currentCell : 'fleet';

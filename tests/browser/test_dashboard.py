@@ -269,7 +269,88 @@ class DashboardInABrowser(unittest.TestCase):
                          [("bob", "reset", False), ("alice", "reset", True), ("alice", "arm", True)])
         self.logout()
 
-    def test_4_hostile_input_is_answered_counted_and_survived(self):
+    def sent(self):
+        """What left the dashboard for the cells: its HTTP actions, its DDS requests, the action log's lines."""
+        health = http(self.fleet.port, "/api/health")[1]
+        with open(os.path.join(self.fleet.dir, "users.yaml.actions.log")) as f:
+            lines = sum(1 for _ in f)
+        return health["http"]["actions"], health["dds"]["requests"], lines
+
+    def type_and_press(self, action, text):
+        """Types text into the action's box as it is (no browser sanitising: the boxes are text) and presses
+        the button; returns the message and whether the confirmation is showing."""
+        box = {"gain": "gain-value", "set": "set-value", "spindle": "spindle-value"}[action]
+        self.js("document.getElementById('message').textContent = ''")
+        self.browser.find_element(By.ID, box).clear()
+        if text:
+            self.browser.find_element(By.ID, box).send_keys(text)
+        self.browser.find_element(By.CSS_SELECTOR, f'#actions button[data-action="{action}"]').click()
+        return until(lambda: self.js("const m = document.getElementById('message'), c = document.getElementById('confirm');"
+                                     "return (m.textContent || !c.hidden) ? [m.textContent, m.className, !c.hidden] : null;"),
+                     30, f"the page's answer to {action} {text!r}")
+
+    def test_4_every_typed_value_is_checked_before_it_leaves_the_page(self):
+        cell = self.fleet.cells["b"]
+        status = until(lambda: (lambda s: s if s.get("state") == "active" else None)(
+            http(self.fleet.port, f"/api/cells/{cell}")[1]["status"]), 60, "cell b active")
+        self.assertEqual(status["parameter_sets"], 1)
+        self.assertEqual(status["spindle_rpm_max"], 30000)  # spindle.rpm_max's default
+        self.open_cell("b")
+        self.login("alice", "alice-operator-1")
+        until(lambda: "gain K / limit" in self.browser.find_element(By.ID, "counters").text, 30, "the cell's status on the page")
+        before = self.sent()
+        hostile = {
+            "gain": [("", "is empty"), ("   ", "is empty"), ("1,5", "decimal mark"), ("1.500,5", "decimal mark"),
+                     ("abc", "not a number"), ("0x10", "not a number"), ("1e400", "too large"), ("-5", "negative"),
+                     ("99999999", "above the cell's gain limit")],
+            "set": [("", "is empty"), ("0.5", "not a whole number"), ("-1", "negative"), ("1", "above the last configured set"),
+                    ("1,0", "decimal mark")],
+            "spindle": [("", "is empty"), ("  ", "is empty"), ("650,5", "decimal mark"), ("200000", "above the spindle's"),
+                        ("-700", "negative"), ("1e999", "too large"), ("seven hundred", "not a number")],
+        }
+        for action, cases in hostile.items():
+            for text, why in cases:
+                said, kind, confirming = self.type_and_press(action, text)
+                self.assertIn(why, said, f"{action} {text!r}")
+                self.assertIn("nothing was sent", said, f"{action} {text!r}")
+                self.assertEqual((kind, confirming), ("bad", False), f"{action} {text!r}")
+        self.assertEqual(self.sent(), before, "a hostile value reached the dashboard's server or the cell")
+        # A gain below the one running reduces the damping: said, and sent only on confirmation.
+        k_now = status["gain_ns_per_m"]
+        lower = round(k_now / 4)
+        said, _, confirming = self.type_and_press("gain", f"{lower}")
+        self.assertTrue(confirming)
+        confirm = self.browser.find_element(By.ID, "confirm-text").text
+        self.assertIn(f"K {k_now:.0f} → {lower} N s/m: less damping", confirm)
+        self.browser.save_screenshot(os.path.join(OUT, "dashboard_confirm.png"))
+        self.browser.find_element(By.ID, "confirm-no").click()
+        until(lambda: "cancelled: nothing was sent" in self.browser.find_element(By.ID, "message").text, 30, "the cancel")
+        self.assertEqual(self.sent(), before)
+        said, _, confirming = self.type_and_press("gain", f" {lower} ")
+        self.assertTrue(confirming)
+        self.browser.find_element(By.ID, "confirm-yes").click()
+        until(lambda: "accepted" in self.browser.find_element(By.ID, "message").text, 30, "the confirmed gain")
+        until(lambda: abs(http(self.fleet.port, f"/api/cells/{cell}")[1]["status"]["gain_ns_per_m"] - lower) < 1e-6, 30,
+              f"cell b at K = {lower}")
+        # Disarming asks too; raising the gain back is sent at once.
+        said, _, confirming = self.type_and_press("gain", f"{k_now:.0f}")
+        self.assertFalse(confirming)
+        until(lambda: "accepted" in self.browser.find_element(By.ID, "message").text, 30, "the gain back up")
+        self.js("document.getElementById('message').textContent = ''")
+        self.browser.find_element(By.CSS_SELECTOR, '#actions button[data-action="disarm"]').click()
+        until(lambda: self.browser.find_element(By.ID, "confirm").is_displayed(), 30, "disarm's confirmation")
+        self.assertIn("stops damping", self.browser.find_element(By.ID, "confirm-text").text)
+        self.browser.find_element(By.ID, "confirm-no").click()
+        after = self.sent()
+        self.assertEqual((after[0] - before[0], after[1] - before[1], after[2] - before[2]), (2, 2, 2),
+                         "exactly the confirmed gain and the raise reached the cell")
+        with open(os.path.join(self.fleet.dir, "users.yaml.actions.log")) as f:
+            log = [json.loads(l) for l in f][-2:]
+        self.assertEqual([(l["action"], l["value"], l["accepted"]) for l in log], [("gain", lower, True), ("gain", round(k_now), True)])
+        self.assertEqual(http(self.fleet.port, f"/api/cells/{cell}")[1]["status"]["state"], "active")
+        self.logout()
+
+    def test_5_hostile_requests_are_answered_counted_and_survived(self):
         port = self.fleet.port
         self.assertIn(" 400 ", raw_request(port, b"GARBAGE\r\n\r\n") + " ")
         self.assertIn(" 400 ", raw_request(port, b"\x00\xff\x10junk" * 200 + b"\r\n\r\n") + " ")
@@ -295,7 +376,7 @@ class DashboardInABrowser(unittest.TestCase):
         self.assertGreaterEqual(health["auth"]["wrong_passwords"], 4)
         self.assertEqual(http(port, "/api/fleet")[0], 200, "still serving")
 
-    def test_5_a_second_dashboard_and_a_vanishing_cell(self):
+    def test_6_a_second_dashboard_and_a_vanishing_cell(self):
         port2 = self.fleet.dashboard("dashboard2.log")
         until(lambda: len(http(port2, "/api/fleet")[1]["cells"]) >= 2, 60, "the second dashboard sees both cells")
         status, login = http(port2, "/api/login", {"user": "alice", "password": "alice-operator-1"})
