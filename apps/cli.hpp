@@ -108,5 +108,6 @@ void register_measure(Registry& r);
 void register_commission(Registry& r);
 void register_pose(Registry& r);
 void register_tune(Registry& r);
+void register_schedule(Registry& r);
 
 }  // namespace robodamp::apps

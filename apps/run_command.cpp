@@ -107,6 +107,8 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
             {"gain_refused", s.supervisor.gain_refused},
             {"params_selected", s.supervisor.params_selected},
             {"params_refused", s.supervisor.params_refused},
+            {"speed_handovers", s.supervisor.speed_handovers},
+            {"speed_handovers_refused", s.supervisor.speed_handovers_refused},
             {"spindle_refused", s.supervisor.spindle_refused},
             {"pose_regions", s.supervisor.pose_regions},
             {"pose_out_of_map", s.supervisor.pose_out_of_map},
@@ -128,7 +130,12 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
             {"warnings", s.realtime.warnings}}},
           {"sensor_rms_mps2", s.sensor_rms_mps2},
           {"peak_command_v", s.peak_command_v},
-          {"spindle", {{"rpm", s.spindle_rpm}, {"notch_centre_hz", s.notch_centre_hz}}}};
+          {"spindle", {{"rpm", s.spindle_rpm}, {"notch_centre_hz", s.notch_centre_hz}}},
+          {"gain_ns_per_m", s.gain_ns_per_m}};
+  if (s.speed_bands > 0)
+    j["speed_schedule"] = {{"bands", s.speed_bands}, {"band", s.speed_band ? json(*s.speed_band) : json(nullptr)},
+                           {"handovers", s.supervisor.speed_handovers},
+                           {"handovers_refused", s.supervisor.speed_handovers_refused}};
   j["backend"] = s.backend;
   j["events"] = json::array();
   for (const auto& e : s.events)
@@ -347,6 +354,14 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
     std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s (%lld ticks after it)\n",
                   s.trip_timing.trip_s, s.trip_timing.last_fresh_s, s.trip_timing.safe_s,
                   static_cast<long long>(s.trip_timing.ticks_to_safe));
+    os << b;
+  }
+  if (s.speed_bands > 0) {
+    std::snprintf(b, sizeof b, "  speed schedule: %zu bands; at the end %s, set %zu at K %.0f N s/m; %llu hand-overs as the "
+                  "spindle moved%s\n", s.speed_bands,
+                  s.speed_band ? ("band " + std::to_string(*s.speed_band)).c_str() : "outside every band",
+                  s.active_parameter_set, s.gain_ns_per_m, static_cast<unsigned long long>(s.supervisor.speed_handovers),
+                  s.supervisor.speed_handovers_refused ? " (some REFUSED: K held at 0 there)" : "");
     os << b;
   }
   if (s.machining) {

@@ -230,6 +230,7 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
   }
   if (auto v = r.number("match_freq_hz", below_nyquist(rate), -1.0); v && *v >= 0.0) c.match_freq_hz = *v;
   c.harmonic_notch = detail::read_harmonic_notch(r, rate);
+  c.speed_schedule = detail::read_speed_schedule(r, rate);
   const YAML::Node chain = r.child("chain", true, "list of blocks (Eq. 8)");
   if (chain.IsDefined() && !chain.IsNull()) {
     if (!chain.IsSequence() || chain.size() == 0) {
@@ -685,6 +686,15 @@ void check_joint_registers(detail::Diagnostics& d, const Config& c) {
 
 }  // namespace
 
+namespace detail {
+
+std::optional<BlockConfig> read_chain_block(Diagnostics& d, const YAML::Node& node, const std::string& key,
+                                            std::optional<double> rate_hz) {
+  return read_block(d, node, key, rate_hz);
+}
+
+}  // namespace detail
+
 Config parse_config(const std::string& yaml_text, const std::string& source_name) {
   Diagnostics d(source_name);
   const YAML::Node root = detail::load_top_map(d, yaml_text, "loop, actuator, amplifier, controller, robot");
@@ -714,6 +724,24 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   if (c.pose_schedule && !c.parameter_sets.empty())
     d.add(root.Mark(), "pose_schedule",
           "and parameter_sets select parameter sets both: a configuration schedules by pose or by mounting, not both");
+  if (const auto& s = c.controller.speed_schedule) {
+    if (c.pose_schedule)
+      d.add(root.Mark(), "controller.speed_schedule",
+            "and pose_schedule both choose the controller: a configuration schedules by spindle speed or by pose, not both");
+    if (!s->controllers.empty() && !c.parameter_sets.empty())
+      d.add(root.Mark(), "controller.speed_schedule.controllers",
+            "and parameter_sets both choose the controller: a configuration schedules by spindle speed or by mounting, "
+            "not both (a schedule of K alone may stand beside parameter_sets)");
+    if (!s->controllers.empty() &&
+        std::none_of(c.controller.chain.begin(), c.controller.chain.end(),
+                     [](const BlockConfig& b) { return b.kind == BlockKind::kCompensator; }))
+      d.add(root.Mark(), "controller.speed_schedule.controllers",
+            "each replace the chain's compensator block, and controller.chain has none");
+    if (!s->bands.empty() && s->bands.back().rpm_max > c.spindle.rpm_max)
+      d.add(root.Mark(), "controller.speed_schedule.bands",
+            "reach " + format_number(s->bands.back().rpm_max) + " rpm, above spindle.rpm_max = " +
+                format_number(c.spindle.rpm_max) + " rpm");
+  }
   check_joint_registers(d, c);
   top.finish();
   check_location_refs(d, c, root);

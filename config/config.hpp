@@ -13,6 +13,7 @@
 #include "config/can_config.hpp"
 #include "config/commissioning_config.hpp"
 #include "config/pose_schedule_config.hpp"
+#include "config/speed_schedule_config.hpp"
 #include "config/spindle_config.hpp"
 #include "config/supervisory_config.hpp"
 
@@ -171,6 +172,7 @@ struct ControllerConfig {
   std::optional<double> match_freq_hz;  // compensators' pre-warp; default the dominant robot mode
   std::vector<BlockConfig> chain;
   std::optional<HarmonicNotchConfig> harmonic_notch;  // spindle-locked notches after the chain
+  std::optional<SpeedScheduleConfig> speed_schedule;  // controller and K by spindle speed
 };
 
 enum class ModeForm { kResidue, kStiffness };

@@ -86,6 +86,10 @@ void read_supervisory(MapReader& top, Config& c);
 // The controller's optional harmonic_notch map and the optional spindle section (config/spindle_config.hpp).
 [[nodiscard]] std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller, std::optional<double> rate_hz);
 [[nodiscard]] SpindleConfig read_spindle(MapReader& top, const std::string& source);
+[[nodiscard]] std::optional<SpeedScheduleConfig> read_speed_schedule(MapReader& controller, std::optional<double> rate_hz);
+// One block of controller.chain (or a block that replaces one), checked like the chain's.
+[[nodiscard]] std::optional<BlockConfig> read_chain_block(Diagnostics& d, const YAML::Node& node, const std::string& key,
+                                                          std::optional<double> rate_hz);
 // The optional pose_schedule section (config/pose_schedule_config.hpp); the robot model it names is loaded.
 [[nodiscard]] std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::string& source);
 // The optional commissioning section (config/commissioning_config.hpp).

@@ -143,6 +143,15 @@ void fill_params(const config::Config& cfg, const std::vector<filters::BiquadCoe
   }
   p.spindle_teeth = cfg.spindle.teeth;
   p.spindle_rpm_max = cfg.spindle.rpm_max;
+  static_assert(ControllerParams::kMaxSpeedBands == config::kMaxSpeedBands);
+  p.speed_band_count = 0;
+  if (const auto& s = cfg.controller.speed_schedule)
+    for (const auto& b : s->bands) {
+      if (p.speed_band_count == ControllerParams::kMaxSpeedBands) break;  // the configuration refuses more
+      // The band's controller is its parameter set: 0 this configuration's, i the schedule's controllers[i - 1]
+      // (the cell adds them in that order, right after set 0).
+      p.speed_bands[p.speed_band_count++] = {b.rpm_min, b.rpm_max, b.gain_ns_per_m, static_cast<std::size_t>(b.controller)};
+    }
 }
 
 }  // namespace

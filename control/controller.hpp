@@ -30,7 +30,7 @@ class Controller final {
  public:
   explicit Controller(const ControllerParams& p) noexcept
       : p_(p), cascade_(p.sections), notches_(p.harmonic_notch, p.fs_hz), dt_s_(1.0 / p.fs_hz) {
-    target_gain_ = p.gain_ns_per_m;
+    target_gain_ = p.gain_ns_per_m;  // the spindle is stopped: outside every band of a speed schedule
     scale_ = target_scale_ = output_scale(p_, target_gain_);
   }
 
@@ -74,7 +74,8 @@ class Controller final {
 
   // RT-safe. The spindle speed the harmonic notches follow (tooth frequency = rpm x teeth / 60); 0 =
   // stopped. A NaN, negative or above-range speed, or one where the analysis refused the notches
-  // (ControllerParams::refused_rpm), is refused, counted, and parks the notches.
+  // (ControllerParams::refused_rpm), is refused, counted, and parks the notches. With a speed schedule
+  // (ControllerParams::speed_bands) the speed also sets K.
   RequestStatus set_spindle_rpm(double rpm) noexcept {
     bool refused = !std::isfinite(rpm) || rpm < 0.0 || rpm > p_.spindle_rpm_max;
     for (std::size_t i = 0; i < p_.refused_rpm_count; ++i)
@@ -83,24 +84,38 @@ class Controller final {
       ++counters_.spindle_refused;
       spindle_rpm_ = 0.0;  // parked (a later hand-over keeps them parked)
       notches_.set_tooth_frequency(0.0);
+      // A speed the notches refuse still turns the spindle: the schedule follows it (an impossible speed:
+      // outside every band).
+      schedule_rpm_ = std::isfinite(rpm) && rpm >= 0.0 && rpm <= p_.spindle_rpm_max ? rpm : 0.0;
+      follow_speed_schedule();
       return RequestStatus::kRejectedOutOfRange;
     }
-    spindle_rpm_ = rpm;
+    spindle_rpm_ = schedule_rpm_ = rpm;
     notches_.set_tooth_frequency(rpm * p_.spindle_teeth / 60.0);
+    follow_speed_schedule();
     return RequestStatus::kAccepted;
   }
 
   // RT-safe. Ramps K to the new value over the configured ramp time; refuses what the configuration
-  // would refuse.
+  // would refuse. With a speed schedule, K inside a band is the band's (refused here); outside every band
+  // (the spindle stopped) the request sets the K used there.
   [[nodiscard]] RequestStatus set_gain(double gain_ns_per_m) noexcept {
-    if (!std::isfinite(gain_ns_per_m) || gain_ns_per_m < 0.0 || gain_ns_per_m > kMaxGainNsPerM) {
+    if (!std::isfinite(gain_ns_per_m) || gain_ns_per_m < 0.0 || gain_ns_per_m > kMaxGainNsPerM || in_speed_band()) {
       ++counters_.rejected_requests;
       return RequestStatus::kRejectedOutOfRange;
     }
-    target_gain_ = gain_ns_per_m;
-    if (!pending_) start_ramp(output_scale(p_, target_gain_));  // during a hand-over: applied at fade-in
+    if (p_.speed_scheduled()) p_.gain_ns_per_m = gain_ns_per_m;
+    ramp_gain_to(gain_ns_per_m);
     return RequestStatus::kAccepted;
   }
+  // RT-safe. K to this value over the ramp, whatever the schedule says (the supervisor's safe K of 0 where a
+  // band's set was refused); the next speed change follows the schedule again.
+  void ramp_gain_to(double gain_ns_per_m) noexcept {
+    target_gain_ = gain_ns_per_m;
+    if (!pending_) start_ramp(output_scale(p_, target_gain_));  // during a hand-over: applied at fade-in
+  }
+  // A speed schedule's band holds the spindle's speed (K is the band's).
+  [[nodiscard]] bool in_speed_band() const noexcept { return p_.speed_band_of(schedule_rpm_) < p_.speed_band_count; }
 
   // RT-safe (copies fixed-size structs). Hands over to a new parameter set at cycle boundaries: the
   // incoming chain starts from the running chain's signal history (sections shared by both chains
@@ -121,7 +136,7 @@ class Controller final {
     shadow_ = cascade_;  // an exact copy: identical to the running chain until its swap
     shadow_.request_swap(next.sections);
     pending_ = true;
-    target_gain_ = next.gain_ns_per_m;
+    target_gain_ = next.scheduled_gain_ns_per_m(schedule_rpm_);
     // At least the two samples the shadow's swap needs, however short the ramp.
     const double fade = std::ceil(p_.gain_ramp_s * p_.fs_hz), settle = std::ceil(next.settle_s * p_.fs_hz);
     warmup_left_ = settle > fade + 2.0 ? static_cast<std::uint64_t>(settle - fade) : 2;
@@ -144,10 +159,24 @@ class Controller final {
   [[nodiscard]] const ControllerParams& params() const noexcept { return p_; }
   [[nodiscard]] const filters::HarmonicNotchBank& notches() const noexcept { return notches_; }
   [[nodiscard]] double spindle_rpm() const noexcept { return spindle_rpm_; }
+  // The speed a speed schedule follows (the spindle's, also where the notches park).
+  [[nodiscard]] double schedule_rpm() const noexcept { return schedule_rpm_; }
 
  private:
   static double output_scale(const ControllerParams& p, double gain) noexcept {
     return p.polarity * gain * p.sections_gain;
+  }
+
+  // A speed schedule's K at the spindle speed now, ramped like any gain change (applied at fade-in during a
+  // hand-over).
+  // A band of another set keeps K as it is: the supervisor hands over to that set, and the hand-over fades out.
+  // During a hand-over the incoming set's K is what follows (applied at its fade-in).
+  void follow_speed_schedule() noexcept {
+    const ControllerParams& p = pending_ ? next_ : p_;
+    if (!p.speed_scheduled()) return;
+    if (!pending_ && p.scheduled_set(schedule_rpm_) != p.set_index) return;
+    const double k = p.scheduled_gain_ns_per_m(schedule_rpm_);
+    if (k != target_gain_) ramp_gain_to(k);
   }
 
   void start_ramp(double target_scale) noexcept {
@@ -185,7 +214,8 @@ class Controller final {
   filters::BiquadCascade shadow_;
   filters::HarmonicNotchBank notches_;
   double dt_s_;
-  double spindle_rpm_{0.0};
+  double spindle_rpm_{0.0};    // what the notches follow (0: parked)
+  double schedule_rpm_{0.0};   // what the speed schedule follows: the spindle's speed, parked or not
   double target_gain_{0.0};
   double scale_{0.0}, target_scale_{0.0}, ramp_step_{0.0};
   std::uint64_t ramp_left_{0};

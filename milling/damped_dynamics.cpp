@@ -42,6 +42,8 @@ DampedDynamics::DampedDynamics(const Structure& structure, config::Axis feed_axi
     modal_ = std::make_unique<ToolDynamics>(terms, period_s_);
 }
 
+double DampedDynamics::actuator_force_limit_n() const { return loops_.front()->model->config().actuator.force_limit_n; }
+
 Eigen::Vector2d DampedDynamics::loops_displacement() const {
   Eigen::Vector2d machine = Eigen::Vector2d::Zero();
   for (const auto& l : loops_) machine(static_cast<Eigen::Index>(l->direction)) += l->plant->displacement_m(l->location);
@@ -59,10 +61,16 @@ void DampedDynamics::step(const Eigen::Vector2d& f_cutter) {
   for (const auto& l : loops_) {
     // One loop tick: sample, compute; the command reaches the amplifier at the next tick.
     const sim::SensorReading s = l->plant->sense();
-    const auto c0 = l->controller->counters();
-    const double next = l->controller->update(s.accel_mps2);
-    const auto& c1 = l->controller->counters();
-    const bool limited = c1.force_limited + c1.voltage_limited + c1.slew_limited > c0.force_limited + c0.voltage_limited + c0.slew_limited;
+    bool limited = false;
+    double next = 0.0;
+    if (driver_ != nullptr && l == loops_.front()) {
+      next = driver_->tick(s.accel_mps2, limited);
+    } else {
+      const auto c0 = l->controller->counters();
+      next = l->controller->update(s.accel_mps2);
+      const auto& c1 = l->controller->counters();
+      limited = c1.force_limited + c1.voltage_limited + c1.slew_limited > c0.force_limited + c0.voltage_limited + c0.slew_limited;
+    }
     const auto p0 = l->plant->counters().force_limited + l->plant->counters().voltage_clipped;
     l->cutting->value_n = f_machine(static_cast<Eigen::Index>(l->direction));
     l->plant->step(l->command_v);

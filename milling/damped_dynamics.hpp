@@ -34,6 +34,15 @@ struct DampingStats {
   double loop_rate_hz{0.0};
 };
 
+// What drives a controller part's actuator in place of the part's own control::Controller (e.g. the
+// supervisor with a speed schedule's sets, switching as the spindle moves): one loop tick, the sampled
+// acceleration in, the amplifier command out, and whether a controller limit acted this tick.
+class LoopDriver {
+ public:
+  virtual ~LoopDriver() = default;
+  virtual double tick(double accel_mps2, bool& limited) = 0;
+};
+
 class DampedDynamics final : public CutDynamics {
  public:
   // The structure's controller parts (loop models) with its modal tables, for a feed along feed_axis.
@@ -45,6 +54,11 @@ class DampedDynamics final : public CutDynamics {
   // Linear extrapolation of the last step (the plant has no look-ahead): second order in the step.
   [[nodiscard]] Eigen::Vector2d predict(const Eigen::Vector2d& f_n) const override;
   void step(const Eigen::Vector2d& f_n) override;
+
+  // The first controller part's actuator driven by `driver` (outliving this) instead of its Controller.
+  void drive_with(LoopDriver* driver) { driver_ = driver; }
+  // The plant's actuator force limit (the first part's), N.
+  [[nodiscard]] double actuator_force_limit_n() const;
 
   // Statistics from now on.
   void settled() override { stats_ = true; }
@@ -59,6 +73,7 @@ class DampedDynamics final : public CutDynamics {
   std::vector<std::shared_ptr<Loop>> loops_;
   Eigen::Vector2d last_{Eigen::Vector2d::Zero()}, previous_{Eigen::Vector2d::Zero()};
   bool stats_{false};
+  LoopDriver* driver_{nullptr};
   DampingStats stats_out_;
 };
 

@@ -43,6 +43,25 @@ void notch_from(const json& j, control::ControllerParams& p) {
   }
 }
 
+// controller.speed_schedule: [rpm_min, rpm_max, gain_ns_per_m, set] per band.
+json speed_bands_json(const control::ControllerParams& p) {
+  json bands = json::array();
+  for (std::size_t i = 0; i < p.speed_band_count; ++i) {
+    const auto& b = p.speed_bands[i];
+    bands.push_back({b.rpm_min, b.rpm_max, b.gain_ns_per_m, b.set});
+  }
+  return bands;
+}
+
+// Recordings made before the speed schedule have none: unscheduled.
+void speed_bands_from(const json& j, control::ControllerParams& p) {
+  for (const auto& b : j.value("speed_bands", json::array())) {
+    if (p.speed_band_count == control::ControllerParams::kMaxSpeedBands) break;
+    p.speed_bands[p.speed_band_count++] = {b.at(0).get<double>(), b.at(1).get<double>(), b.at(2).get<double>(),
+                                           b.at(3).get<std::size_t>()};
+  }
+}
+
 }  // namespace
 
 json to_json(const control::ControllerParams& p) {
@@ -62,7 +81,8 @@ json to_json(const control::ControllerParams& p) {
           {"force_limit_n", p.force_limit_n},
           {"voltage_limit_v", p.voltage_limit_v},
           {"slew_rate_v_per_s", p.slew_rate_v_per_s},
-          {"harmonic_notch", notch_json(p)}};
+          {"harmonic_notch", notch_json(p)},
+          {"speed_bands", speed_bands_json(p)}};
 }
 
 control::ControllerParams controller_params_from(const json& j) {
@@ -81,6 +101,7 @@ control::ControllerParams controller_params_from(const json& j) {
   p.voltage_limit_v = j.at("voltage_limit_v").get<double>();
   p.slew_rate_v_per_s = j.at("slew_rate_v_per_s").get<double>();
   notch_from(j, p);
+  speed_bands_from(j, p);
   return p;
 }
 

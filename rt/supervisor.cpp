@@ -110,6 +110,8 @@ SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_
 Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
     : s_(s), controller_(params), pose_known_(!s.pose_scheduled) {
   sets_.push_back({params, s.analysis_stable, s.max_stable_gain_ns_per_m, s.delay_margin_s});
+  sets_.back().params.set_index = 0;
+  speed_refused_set_ = 1;
   const auto window = static_cast<std::size_t>(std::max(1.0, std::round(s.limits.saturation_window_s * s.fs_hz)));
   sat_window_.assign(window, 0);
   sat_threshold_ = static_cast<std::uint64_t>(std::floor(s.limits.saturation_duty_max * static_cast<double>(window)));
@@ -127,6 +129,8 @@ void Supervisor::log_event(EventKind k, Trip t) noexcept {
 
 std::size_t Supervisor::add_parameter_set(const ParameterSet& set) {
   sets_.push_back(set);
+  sets_.back().params.set_index = sets_.size() - 1;
+  speed_refused_set_ = sets_.size();
   return sets_.size() - 1;
 }
 
@@ -165,6 +169,25 @@ void Supervisor::follow_pose() noexcept {
   if (!select(static_cast<double>(pose_set_))) {  // the region's set refused (cannot pass the configuration's analysis)
     pose_known_ = false;
     if (driving()) trip(Trip::kPoseOutOfMap);
+  }
+}
+
+// A speed schedule's band on another set: hand over to it once the controller can (its K comes with it). A
+// set refused (cannot pass the configuration's analysis, which the cell checked at configuration) leaves
+// K at 0 there, the open loop, rather than run the wrong chain at the band's gain; it is not asked again
+// until the band's set changes.
+void Supervisor::follow_speed() noexcept {
+  const control::ControllerParams& p = controller_.params();
+  if (!p.speed_scheduled() || controller_.handover_pending()) return;
+  const std::size_t want = p.scheduled_set(controller_.schedule_rpm());
+  if (want == active_parameter_set() || want == speed_refused_set_) return;
+  if (select(static_cast<double>(want))) {
+    ++counters_.speed_handovers;
+    speed_refused_set_ = sets_.size();
+  } else {
+    ++counters_.speed_handovers_refused;
+    speed_refused_set_ = want;
+    controller_.ramp_gain_to(0.0);
   }
 }
 
@@ -276,12 +299,17 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         trip_ = Trip::kNone;
       }
       break;
-    case CommandKind::kSetGain:
+    case CommandKind::kSetGain:  // inside a speed schedule's band K is the band's (the controller refuses)
       if (!(std::isfinite(c.value) && c.value >= 0.0 && c.value <= max_gain_ns_per_m()) ||
           controller_.set_gain(c.value) != control::RequestStatus::kAccepted)
         ++counters_.gain_refused;
       break;
-    case CommandKind::kSelectParams: (void)select(c.value); break;
+    case CommandKind::kSelectParams:  // a speed schedule's sets follow the spindle, not requests
+      if (controller_.params().speed_chooses_set())
+        ++counters_.params_refused;
+      else
+        (void)select(c.value);
+      break;
     case CommandKind::kSetPoseRegion: set_pose_region(c.value); break;
     case CommandKind::kSetSpindle:  // validated by the controller: refused speeds park the notches
       if (controller_.set_spindle_rpm(c.value) != control::RequestStatus::kAccepted) ++counters_.spindle_refused;
@@ -346,6 +374,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   if (in.command.kind != CommandKind::kNone)
     handle(in.command, live_run_ >= static_cast<std::uint64_t>(s_.limits.arming_live_cycles));
   follow_pose();
+  follow_speed();
   if (const Trip t = check_trips(in); t != Trip::kNone) trip(t);
   TickOutput out;
   out.controller_v = c.controller_v;

@@ -111,6 +111,10 @@ struct SupervisorCounters {
   std::uint64_t spindle_refused{0};  // set_spindle commands refused (the notches parked)
   std::uint64_t pose_out_of_map{0};  // set_pose_region -1: the pose outside every region, or unknown
   std::uint64_t pose_regions{0};     // set_pose_region with a region's set
+  // controller.speed_schedule: hand-overs to another band's set as the spindle moved, and those refused (K
+  // then held at 0 there).
+  std::uint64_t speed_handovers{0};
+  std::uint64_t speed_handovers_refused{0};
   std::uint64_t commands{0};
   // Recovery (supervision.recovery): re-armed after a recoverable trip; latched because the budget of
   // max_recoveries within window_s was spent, or because a recovery tripped again within probation_s.
@@ -227,6 +231,7 @@ class Supervisor {
     return state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping;
   }
   void follow_pose() noexcept;  // each tick: hand over to the pose's region's set once the controller can
+  void follow_speed() noexcept;  // each tick: hand over to the spindle speed's band's set once the controller can
   [[nodiscard]] ArmRefusal arm_refusal(bool live) const noexcept;  // why arming would be refused now
   void recover(const TickInput& in) noexcept;                       // in Fault after the ramp: recover when allowed
   void log_event(EventKind k, Trip t) noexcept;
@@ -261,6 +266,7 @@ class Supervisor {
   control::ControllerCounters last_limits_{};
   bool pose_known_{false};
   std::size_t pose_set_{0};  // the set the pose's region wants (pose_scheduled)
+  std::size_t speed_refused_set_{1};  // the speed schedule's set last refused (sets_.size(): none)
 
   // Recovery: which trips may recover (bit per Trip), whether this fault may, its timers, the probation
   // after the last recovery and the recoveries' times (a ring of max_recoveries, allocated at construction).

@@ -8,6 +8,7 @@
 #include "analysis/notch_speed_map.hpp"
 
 #include "runtime/parameter_requests.hpp"
+#include "runtime/speed_sets.hpp"
 #include "sim_plant/excitation.hpp"
 
 namespace robodamp::runtime {
@@ -247,6 +248,9 @@ Status Cell::configure_parameter_sets() {
   mounting_sets_.clear();
   mounting_sets_.emplace_back(cfg_.actuator.mounting, 0);
   try {
+    if (const auto& speed = cfg_.controller.speed_schedule)  // the bands' controllers: sets 1..n, in order
+      for (std::size_t i = 1; i <= speed->controllers.size(); ++i)
+        (void)add_parameter_set(config::speed_controller_config(cfg_, i), false);
     for (const auto& ref : cfg_.parameter_sets) {
       const config::Config other = config::load_config_file(ref.resolved_path);
       if (other.loop.rate_hz != cfg_.loop.rate_hz)
@@ -254,11 +258,16 @@ Status Cell::configure_parameter_sets() {
                                     "= '" + ref.path + "' runs at loop.rate_hz = " + std::to_string(other.loop.rate_hz) +
                                         " Hz; every set must run at this configuration's " +
                                         std::to_string(cfg_.loop.rate_hz) + " Hz"}});
-      const std::size_t idx = add_parameter_set(other);
+      if (other.controller.speed_schedule && !other.controller.speed_schedule->controllers.empty())
+        throw config::ConfigError({{cfg_.source, {}, "parameter_sets." + ref.mounting,
+                                    "= '" + ref.path + "' schedules its controller by spindle speed "
+                                    "(controller.speed_schedule.controllers): a mounting's set may schedule K alone"}});
+      const std::size_t idx = add_parameter_set(other, true);
       const auto mounting = ref.mounting == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal;
       std::erase_if(mounting_sets_, [&](const auto& p) { return p.first == mounting; });
       mounting_sets_.emplace_back(mounting, idx);
     }
+    check_speed_bands(*supervisor_, set_configs_);
   } catch (const config::ConfigError& e) {
     for (Component* d : components()) (void)d->cleanup();
     return {StatusKind::kConfigError, e.what()};
@@ -266,12 +275,15 @@ Status Cell::configure_parameter_sets() {
   return {};
 }
 
-std::size_t Cell::add_parameter_set(const config::Config& cfg) {
+std::size_t Cell::add_parameter_set(const config::Config& cfg, bool own_schedule) {
   const analysis::LoopModel m(cfg);
   set_configs_.push_back(cfg);
   const int polarity = cfg.controller.polarity;
   const auto k_max = analysis::max_stable_gain(m, polarity);
-  return supervisor_->add_parameter_set({with_notch_speed_map(cfg, m.chain().params), m.stable(cfg.controller.gain_ns_per_m, polarity),
+  control::ControllerParams p = with_notch_speed_map(cfg, m.chain().params);
+  // A mounting's own K schedule names set 0 for "this set"; a speed schedule's controllers carry the cell's.
+  if (own_schedule) own_speed_bands(p, set_configs_.size() - 1);
+  return supervisor_->add_parameter_set({p, m.stable(cfg.controller.gain_ns_per_m, polarity),
                                          k_max.value_or(control::kMaxGainNsPerM), delay_margin_s(m, cfg, k_max)});
 }
 
@@ -410,6 +422,11 @@ void Cell::finish_summary() {
   s.events.assign(supervisor_->events(), supervisor_->events() + supervisor_->events_logged());
   s.events_total = supervisor_->events_total();
   s.spindle_rpm = supervisor_->controller().spindle_rpm();
+  const control::ControllerParams& cp = supervisor_->controller().params();
+  s.speed_bands = cp.speed_band_count;
+  if (const std::size_t band = cp.speed_band_of(supervisor_->controller().schedule_rpm()); band < cp.speed_band_count)
+    s.speed_band = band;
+  s.gain_ns_per_m = supervisor_->controller().target_gain_ns_per_m();
   s.notch_centre_hz = supervisor_->controller().notches().settings().enabled ? supervisor_->controller().notches().centre_hz() : 0.0;
   s.final_state = rt::to_string(supervisor_->state());
   s.active_parameter_set = supervisor_->active_parameter_set();

@@ -86,7 +86,7 @@ class Cell {
 
   // Inactive (configured): another controller parameter set (designed and analysed from cfg, same loop
   // rate) that a select_params command may hand over to. Returns its index.
-  std::size_t add_parameter_set(const config::Config& cfg);
+  std::size_t add_parameter_set(const config::Config& cfg, bool own_schedule = true);
   // Inactive: an operator command at a given tick (deterministic on the virtual clock).
   void schedule(std::uint64_t tick, const rt::OperatorCommand& c) { loop_->schedule(tick, c); }
   // Active, any non-real-time thread: an operator command for the next tick boundary.

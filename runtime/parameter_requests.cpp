@@ -14,6 +14,13 @@ namespace {
 CheckedRequest check_gain(const rt::Supervisor& sup, const config::Config& cfg, double value) {
   char b[256];
   const std::size_t set = sup.active_parameter_set();
+  if (sup.controller().in_speed_band()) {
+    std::snprintf(b, sizeof b, "gain_ns_per_m = %g N s/m is refused: at %g rpm the spindle speed sets K (controller.speed_schedule, "
+                  "band %zu: K %g N s/m, never worse than no damper); disarm to take the damper out", value,
+                  sup.controller().schedule_rpm(), sup.controller().params().speed_band_of(sup.controller().schedule_rpm()),
+                  sup.controller().target_gain_ns_per_m());
+    return {{false, b}, {}};
+  }
   const double limit = std::min(sup.gain_limit_ns_per_m(), control::kMaxGainNsPerM);
   std::snprintf(b, sizeof b, "supervision.max_gain_fraction = %g x the analysed maximum stable K of parameter set %zu",
                 cfg.supervision.max_gain_fraction, set);
@@ -24,6 +31,12 @@ CheckedRequest check_gain(const rt::Supervisor& sup, const config::Config& cfg, 
 
 CheckedRequest check_select(const rt::Supervisor& sup, const config::Config& cfg, double value) {
   const auto& sets = sup.parameter_sets();
+  if (sup.controller().params().speed_chooses_set()) {
+    char b[200];
+    std::snprintf(b, sizeof b, "parameter_set = %g is refused: the spindle speed chooses the set (controller.speed_schedule; "
+                  "set %zu runs at %g rpm)", value, sup.active_parameter_set(), sup.controller().schedule_rpm());
+    return {{false, b}, {}};
+  }
   if (!(value >= 0.0 && value == std::floor(value) && value < static_cast<double>(sets.size()))) {
     char b[256];
     std::snprintf(b, sizeof b, "parameter_set = %g is not a configured set: allowed 0 <= value <= %zu (0 = %s, then parameter_sets)",

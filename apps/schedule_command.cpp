@@ -1,0 +1,139 @@
+// `robodamp schedule`: the controller and K by spindle speed (tune/speed_schedule.hpp, docs/tuning.md): for a
+// cell and its milling job, the deepest damped limit at every speed, K = 0 included, so that the damper is
+// never worse than none; the verdict in the machinist's terms; --out writes the cell's configuration with its
+// controller.speed_schedule, checked by the configuration's own rules and the cell's analysis before writing.
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "apps/cli.hpp"
+#include "apps/gnuplot.hpp"
+#include "config/file_paths.hpp"
+#include "config/milling_config.hpp"
+#include "tune/speed_schedule.hpp"
+#include "tune/speed_schedule_report.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+struct ScheduleArgs {
+  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string job_path;
+  std::vector<std::string> controllers;
+  std::string out_path;
+  JsonOut json;
+  std::string plot_dir;
+  tune::ScheduleSettings settings;
+};
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.10g", v);
+  return b;
+}
+
+// The command that writes the file again (the options that differ from their defaults).
+std::string command_line(const ScheduleArgs& a) {
+  const tune::ScheduleSettings d;
+  const tune::ScheduleSettings& s = a.settings;
+  std::string c = "robodamp schedule --config " + a.config_path + (a.job_path.empty() ? "" : " --job " + a.job_path);
+  for (const auto& p : a.controllers) c += " --controller " + p;
+  if (s.speeds != d.speeds) c += " --speeds " + std::to_string(s.speeds);
+  if (s.gains_per_controller != d.gains_per_controller) c += " --gains " + std::to_string(s.gains_per_controller);
+  if (s.gain_margin_min_db != d.gain_margin_min_db) c += " --gain-margin-db " + num(s.gain_margin_min_db);
+  if (s.phase_margin_min_deg != d.phase_margin_min_deg) c += " --phase-margin-deg " + num(s.phase_margin_min_deg);
+  if (s.delay_margin_min_ms != d.delay_margin_min_ms) c += " --delay-margin-ms " + num(s.delay_margin_min_ms);
+  return c + " --out " + a.out_path;
+}
+
+// A header this command wrote before (a file scheduled again): it is replaced, not stacked.
+std::string without_schedule_header(const std::string& text) {
+  const std::string start = "# robodamp schedule wrote", end = "'s, whose header follows.\n#\n";
+  if (text.rfind(start, 0) != 0) return text;
+  const std::size_t e = text.find(end);
+  return e == std::string::npos ? text : text.substr(e + end.size());
+}
+
+// The cell's text with the schedule, moved to --out (its relative paths rebased), checked before it is written.
+int write_config(const ScheduleArgs& a, config::Config cell, const tune::SpeedSchedule& s) {
+  cell.yaml_text = without_schedule_header(cell.yaml_text);
+  const config::EditedYaml edited = tune::scheduled_config_text(cell, s);
+  if (!edited.comments_kept)
+    std::fprintf(stderr, "schedule: %s could not be edited in place; written again from its data, without its comments\n",
+                 a.config_path.c_str());
+  std::ostringstream header;
+  header << "# robodamp schedule wrote the speed schedule into " << a.config_path << " (docs/tuning.md):\n#   "
+         << command_line(a) << "\n"
+         << tune::schedule_header(s) << "# Everything else is " << a.config_path << "'s, whose header follows.\n#\n";
+  const std::string text = header.str() + config::rebase_file_paths(edited.text, cell.source, a.out_path).text;
+  (void)config::parse_config(text, a.out_path);  // throws (exit 2) before anything is written
+  std::ofstream out(a.out_path);
+  out << text;
+  if (!out.good()) {
+    std::cerr << "robodamp schedule: cannot write " << a.out_path << '\n';
+    return 1;
+  }
+  std::printf("wrote %s\n", a.out_path.c_str());
+  return 0;
+}
+
+// 0 scheduled (and written), 3 the schedule is worse than the open loop somewhere (nothing written), 2 bad input.
+int run_schedule(const ScheduleArgs& a) {
+  const config::Config cell = config::load_config_file(a.config_path);
+  const std::string job_path = !a.job_path.empty() ? a.job_path : cell.spindle.job_resolved;
+  if (job_path.empty())
+    throw config::ConfigError({{a.config_path, {}, "--job",
+                                "missing: give the milling job (config/milling/*.yaml) or set spindle.job in the configuration"}});
+  const config::MillingConfig job = config::load_milling_config(job_path);
+  const config::StructureConfig* structure = job.find_structure(job.structure);
+  if (structure == nullptr) throw config::ConfigError({{job_path, {}, "structure", "names no structure of the job"}});
+  tune::ScheduleSettings s = a.settings;
+  s.progress = [last = std::string()](const std::string& what, std::size_t done, std::size_t of) mutable {
+    if (what != last || done == of || done % 50 == 0) std::cerr << "[schedule] " << what << ": " << done << "/" << of << '\n';
+    last = what;
+  };
+  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, a.controllers, job, *structure, s);
+  const std::string text = tune::schedule_text(sched, a.config_path, job_path);
+  const std::string plot = plot_file(a.plot_dir, "", "schedule_lobes.png");
+  const int printed = print_report(tune::schedule_json(sched).dump(2), a.json, "schedule", text, plot, [&] {
+    const auto [data, script] = tune::schedule_plot(sched, "Limiting depth by spindle speed: " + job_path);
+    return run_gnuplot(script, data, plot);
+  }, plot);
+  if (printed != 0) return printed;
+  if (sched.summary.scheduled_worse_share > 0.0) {
+    std::cerr << "robodamp schedule: the schedule is worse than the open loop at some speeds (above): nothing written\n";
+    return 3;
+  }
+  return a.out_path.empty() ? 0 : write_config(a, cell, sched);
+}
+
+}  // namespace
+
+void register_schedule(Registry& r) {
+  auto a = std::make_shared<ScheduleArgs>();
+  CLI::App* sub = r.add("schedule",
+                        "The controller and K by spindle speed: the deepest damped limit at every speed of the job (K = 0 "
+                        "included), so the damper is never worse than none; --out writes controller.speed_schedule",
+                        [a] { return run_schedule(*a); });
+  sub->add_option("--config", a->config_path, "The cell's configuration (YAML)")->check(CLI::ExistingFile);
+  sub->add_option("--job", a->job_path, "Milling job (config/milling/*.yaml); default the configuration's spindle.job")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--controller", a->controllers,
+                  "Another configuration whose controller (chain, polarity) a band may run, with the cell's robot "
+                  "(repeat for more)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--out", a->out_path, "Write the configuration with its speed schedule here (only when never worse)");
+  r.json(sub, a->json, "Every speed's depths (open, as configured, scheduled), the bands and the verdict");
+  r.plot_dir(sub, a->plot_dir, "schedule_lobes.png: the open loop, the configured controller and the schedule by speed,");
+  r.whole_number(sub, "--speeds", a->settings.speeds, {"(speeds)", 2, 5000},
+                 "Grid speeds over the job's lobes range (default its time_domain.sdm_points); checks are added between");
+  r.whole_number(sub, "--gains", a->settings.gains_per_controller, {"(gains per controller)", 1, 24},
+                 "Gains tried per controller, log-spaced up to the largest that keeps the margins");
+  r.number(sub, "--gain-margin-db", a->settings.gain_margin_min_db, {"dB", 0.0, 40.0}, "Smallest gain margin of any gain used");
+  r.number(sub, "--phase-margin-deg", a->settings.phase_margin_min_deg, {"deg", 0.0, 90.0}, "Smallest phase margin of any gain used");
+  r.number(sub, "--delay-margin-ms", a->settings.delay_margin_min_ms, {"ms", 0.0, 1000.0}, "Smallest delay margin of any gain used");
+}
+
+}  // namespace robodamp::apps

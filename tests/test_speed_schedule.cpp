@@ -1,0 +1,203 @@
+// The controller scheduled by spindle speed (config/speed_schedule_config.hpp, tune/speed_schedule.hpp,
+// tune/scheduled_cut.hpp; docs/tuning.md "A controller that follows the spindle"): the configuration's
+// refusals, the controller and the supervisor following the spindle, a recording that replays, the synthesis
+// on an arm no preset describes, and the default preset's schedule in time with the real supervisor.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "analysis/loop_model.hpp"
+#include "cell_util.hpp"
+#include "config/milling_config.hpp"
+#include "control/controller.hpp"
+#include "milling/accurate_stability.hpp"
+#include "milling/structure.hpp"
+#include "rt/recording.hpp"
+#include "rt/supervisor.hpp"
+#include "runtime/cell.hpp"
+#include "test_util.hpp"
+#include "tune/scheduled_cut.hpp"
+#include "tune/speed_schedule.hpp"
+
+namespace robodamp {
+namespace {
+
+std::string source(const std::string& rel) { return std::string(ROBODAMP_SOURCE_DIR) + "/" + rel; }
+
+// The C2 preset without its schedule, with the schedule given (block text under controller:).
+config::Config with_schedule(const std::string& schedule_yaml, const std::string& name = "scheduled.yaml") {
+  std::string text = test::read_file(test::preset("horizontal_c2"));
+  const auto at = text.find("  speed_schedule:");
+  const auto end = text.find("\nrobot:", at);
+  text.erase(at, end - at);
+  test::replace_or_throw(text, "  gain_ramp_s: 0.5\n", "  gain_ramp_s: 0.5\n" + schedule_yaml);
+  return config::parse_config(text, source("config/presets/" + name));
+}
+
+std::string problems(const std::string& schedule_yaml) {
+  try {
+    (void)with_schedule(schedule_yaml);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SpeedScheduleConfig, BandsAscendAndEveryKeyIsNamedWithItsUnitAndRangeWhenRefused) {
+  // Block and flow styles read the same.
+  const auto block = with_schedule("  speed_schedule:\n    controllers:\n      - polarity: -1\n        compensator:\n"
+                                   "          kind: compensator\n          model: c1\n          corner_hz: 0.5\n    bands:\n"
+                                   "      - rpm_min: 100\n        rpm_max: 400\n        controller: 1\n        gain_ns_per_m: 2000\n"
+                                   "      - {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}\n");
+  const auto flow = with_schedule("  speed_schedule: {controllers: [{polarity: -1, compensator: {kind: compensator, model: c1, corner_hz: 0.5, corner_damping_ratio: 1.0}}], bands: [{rpm_min: 100, rpm_max: 400, "
+                                  "controller: 1, gain_ns_per_m: 2000}, {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}]}\n");
+  for (const auto* c : {&block, &flow}) {
+    ASSERT_TRUE(c->controller.speed_schedule);
+    const auto& s = *c->controller.speed_schedule;
+    ASSERT_EQ(s.bands.size(), 2U);
+    EXPECT_EQ(s.bands[0].controller, 1);
+    EXPECT_EQ(s.bands[1].controller, 0);
+    EXPECT_DOUBLE_EQ(s.bands[0].gain_ns_per_m, 2000.0);
+    ASSERT_EQ(s.controllers.size(), 1U);
+    EXPECT_EQ(s.controllers[0].polarity, -1);
+    EXPECT_EQ(s.controllers[0].compensator.front().model, config::CompensatorModel::kC1);
+    EXPECT_DOUBLE_EQ(s.controllers[0].compensator.front().corner_hz, 0.5);
+    // Band 0 runs C1 in the C2 preset's chain: only the compensator block and the polarity differ.
+    const config::Config c1 = config::speed_controller_config(*c, 1);
+    const config::Config preset_c1 = config::load_config_file(test::preset("horizontal_c1"));
+    EXPECT_EQ(c1.controller.polarity, preset_c1.controller.polarity);
+    EXPECT_EQ(c1.controller.chain.size(), preset_c1.controller.chain.size());
+    EXPECT_EQ(analysis::LoopModel(c1).chain().params.sections.count, analysis::LoopModel(preset_c1).chain().params.sections.count);
+    EXPECT_EQ(config::speed_band_of(s.bands, 399.99), 0U);
+    EXPECT_EQ(config::speed_band_of(s.bands, 400.0), 1U);
+    EXPECT_EQ(config::speed_band_of(s.bands, 900.0), 1U);  // the last band holds its top
+    EXPECT_FALSE(config::speed_band_of(s.bands, 99.0));
+    EXPECT_FALSE(config::speed_band_of(s.bands, std::nan("")));
+  }
+  const std::string bands = "  speed_schedule:\n    bands:\n";
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 2000}\n"
+                             "      - {rpm_min: 300, rpm_max: 500, gain_ns_per_m: 0}\n")
+                .find("bands[1].rpm_min = 300 rpm overlaps the band before it"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 400, rpm_max: 400, gain_ns_per_m: 2000}\n").find("bands[0].rpm_max = 400 rpm must exceed"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, controller: 1, gain_ns_per_m: 2000}\n")
+                .find("bands[0].controller = 1 (0 = this configuration's, i = controllers[i - 1]) is out of range"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: -5}\n").find("bands[0].gain_ns_per_m = -5 N s/m is out of range"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 40000, gain_ns_per_m: 5}\n").find("above spindle.rpm_max = 30000 rpm"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain: 5}\n").find("bands[0].gain: unknown key"), std::string::npos);
+  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: notch, center_hz: 3, bandwidth_hz: 4}}]\n"
+                     "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
+                .find("controllers[0].compensator.kind = 'notch': it must be a compensator"),
+            std::string::npos);
+  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1}]\n    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
+                .find("controllers[0].compensator: missing"),
+            std::string::npos);
+  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: 2, compensator: {kind: compensator, model: c3}}]\n"
+                     "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
+                .find("controllers[0].polarity"),
+            std::string::npos);
+  EXPECT_NE(problems("  speed_schedule:\n    bands: []\n").find("must be a non-empty list"), std::string::npos);
+  std::string many = bands;
+  for (int i = 0; i < 65; ++i)
+    many += "      - {rpm_min: " + std::to_string(100 + 10 * i) + ", rpm_max: " + std::to_string(105 + 10 * i) + ", gain_ns_per_m: 0}\n";
+  EXPECT_NE(problems(many).find("has 65 bands: allowed at most 64"), std::string::npos);
+}
+
+control::ControllerParams k_only_params() {
+  auto c = with_schedule("  speed_schedule:\n    bands:\n      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 3000}\n"
+                         "      - {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}\n");
+  return analysis::LoopModel(c).chain().params;
+}
+
+TEST(SpeedScheduleController, TheSpindleSpeedSetsKThroughTheRampAndAGainRequestOnlyOutsideTheBands) {
+  control::Controller ctl(k_only_params());
+  const double ramp_ticks = ctl.params().gain_ramp_s * ctl.params().fs_hz;
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 2000.0);  // stopped: outside every band, the configured K
+  ASSERT_EQ(ctl.set_spindle_rpm(250.0), control::RequestStatus::kAccepted);
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 3000.0);
+  EXPECT_TRUE(ctl.in_speed_band());
+  for (int i = 0; i < static_cast<int>(ramp_ticks / 2); ++i) (void)ctl.update(0.0);
+  EXPECT_NEAR(ctl.gain_ns_per_m(), 2500.0, 5.0) << "halfway through the ramp";
+  for (int i = 0; i < static_cast<int>(ramp_ticks); ++i) (void)ctl.update(0.0);
+  EXPECT_DOUBLE_EQ(ctl.gain_ns_per_m(), 3000.0);
+  EXPECT_EQ(ctl.set_gain(1000.0), control::RequestStatus::kRejectedOutOfRange) << "inside a band K is the band's";
+  ASSERT_EQ(ctl.set_spindle_rpm(600.0), control::RequestStatus::kAccepted);
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 0.0) << "the band where the damper is worse than none";
+  ASSERT_EQ(ctl.set_spindle_rpm(0.0), control::RequestStatus::kAccepted);
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 2000.0);
+  ASSERT_EQ(ctl.set_gain(1500.0), control::RequestStatus::kAccepted) << "outside the bands a request sets K there";
+  ASSERT_EQ(ctl.set_spindle_rpm(300.0), control::RequestStatus::kAccepted);
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 3000.0);
+  ASSERT_EQ(ctl.set_spindle_rpm(2000.0), control::RequestStatus::kAccepted);
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 1500.0);
+  ASSERT_EQ(ctl.set_spindle_rpm(-3.0), control::RequestStatus::kRejectedOutOfRange);
+  EXPECT_DOUBLE_EQ(ctl.target_gain_ns_per_m(), 1500.0) << "an impossible speed is outside every band";
+}
+
+// A cell whose bands run C1 at 100-400 rpm, its own C2 at 400-900 and K = 0 above: the supervisor hands over
+// as the spindle moves, refuses gain and set requests inside a band, and the recording replays bit for bit.
+TEST(SpeedScheduleCell, TheSupervisorHandsOverAsTheSpindleMovesAndTheRecordingReplays) {
+  const auto cfg = with_schedule("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: compensator, model: c1, corner_hz: 0.5, corner_damping_ratio: 1.0}}]\n    bands:\n"
+                                 "      - {rpm_min: 100, rpm_max: 400, controller: 1, gain_ns_per_m: 3000}\n"
+                                 "      - {rpm_min: 400, rpm_max: 900, controller: 0, gain_ns_per_m: 1000}\n"
+                                 "      - {rpm_min: 900, rpm_max: 1500, controller: 1, gain_ns_per_m: 0}\n");
+  runtime::CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  o.keep_frames = true;
+  o.impact_every_s = 0.5;
+  o.record_path = ::testing::TempDir() + "/speed_schedule.rec";
+  runtime::Cell cell(cfg, o);
+  test::configure(cell);
+  ASSERT_EQ(cell.supervisor().parameter_sets().size(), 2U);
+  EXPECT_EQ(cell.supervisor().parameter_sets()[1].params.polarity, -1) << "C1's chain and polarity";
+  // A hand-over warms the incoming chain up for its settling time (C1's 0.5 Hz corner: about 2 s), then fades
+  // out and in over gain_ramp_s each: every speed below holds long enough for it.
+  cell.schedule(5000, {rt::CommandKind::kSetSpindle, 300.0});     // C1 at 3000: a hand-over
+  cell.schedule(25000, {rt::CommandKind::kSetGain, 500.0});       // refused: inside a band
+  cell.schedule(25001, {rt::CommandKind::kSelectParams, 0.0});    // refused: the spindle chooses the set
+  cell.schedule(26000, {rt::CommandKind::kSetSpindle, 600.0});    // back to C2 at 1000: a hand-over
+  cell.schedule(29000, {rt::CommandKind::kSetSpindle, 650.0});    // the same band, the hand-over still running
+  cell.schedule(50000, {rt::CommandKind::kSetSpindle, 1200.0});   // K 0 with C1
+  ASSERT_TRUE(cell.run(14.0).ok());
+  const auto& s = cell.summary();
+  EXPECT_EQ(s.trip, "none");
+  EXPECT_EQ(s.supervisor.speed_handovers, 3U);
+  EXPECT_EQ(s.supervisor.speed_handovers_refused, 0U);
+  EXPECT_EQ(s.supervisor.gain_refused, 1U);
+  EXPECT_EQ(s.supervisor.params_refused, 1U);
+  ASSERT_TRUE(s.speed_band);
+  EXPECT_EQ(*s.speed_band, 2U);
+  EXPECT_EQ(s.active_parameter_set, 1U);
+  const auto& f = cell.frames();
+  EXPECT_NEAR(f[24999].gain_ns_per_m, 3000.0, 1e-9) << "C1 at its band's K after the hand-over";
+  EXPECT_NEAR(f[49999].gain_ns_per_m, 1000.0, 1e-9) << "C2 at its band's K";
+  EXPECT_NEAR(f[69999].gain_ns_per_m, 0.0, 1e-9) << "K 0 where the damper is worse than none";
+  // K never exceeds what the band it runs in asks (no band's K on another band's chain during a hand-over).
+  for (std::size_t i = 26000; i < 50000; ++i) ASSERT_LE(f[i].gain_ns_per_m, 3000.0 + 1e-9) << i;
+  for (std::size_t i = 5000; i < 69000; ++i) ASSERT_EQ(f[i].state, static_cast<std::uint8_t>(rt::State::kActive)) << i;
+  const rt::ReplayResult r = rt::replay(rt::read_recording(o.record_path));
+  EXPECT_EQ(r.mismatches, 0U);
+  EXPECT_EQ(r.frames, f.size());
+  std::filesystem::remove(o.record_path);
+}
+
+TEST(SpeedScheduleCell, ABandAboveItsControllersLimitIsRefusedAtConfigurationWithItsKey) {
+  // C2's analysed K_max is 4805 N s/m; supervision.max_gain_fraction 0.9 of it is 4324.
+  runtime::Cell cell(with_schedule("  speed_schedule:\n    bands:\n      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 4500}\n"),
+                     runtime::CellOptions{});
+  const runtime::Status st = cell.configure();
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message.find("controller.speed_schedule.bands[0].gain_ns_per_m"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("4500"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find("maximum stable K 4804.8 N s/m"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace robodamp

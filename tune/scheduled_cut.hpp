@@ -1,0 +1,49 @@
+// A speed schedule in time (docs/tuning.md, "Checked in time"): the scheduled cell's parameter sets under the
+// real supervisor and controller (rt::Supervisor, control::Controller: the same code the loop runs), the
+// simulated robot and actuator (sim::Plant), and the time-domain cut, with the spindle moving from one speed
+// to the next while the damper runs. At each speed the supervisor follows the schedule (K ramps, another
+// band's controller is handed over) and a cut runs at the depth asked. What each cut did (stable or chatter,
+// by the chatter detector), what the damper ran there, and the actuator's peak force over everything, the
+// switches included. Off the real-time path.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "config/config.hpp"
+#include "config/milling_config.hpp"
+#include "milling/chatter.hpp"
+
+namespace robodamp::tune {
+
+struct ScheduledCutStep {
+  double rpm{0.0};        // asked for
+  double depth_mm{0.0};
+};
+
+struct ScheduledCutSegment {
+  double rpm{0.0};              // as cut (a whole number of loop periods per tooth period)
+  double depth_mm{0.0};
+  std::size_t set{0};           // the supervisor's set when the cut ended
+  double gain_ns_per_m{0.0};    // K asked for there
+  milling::ChatterVerdict verdict;
+  double peak_force_command_n{0.0};   // the controller's force command over the segment, the switch included
+  std::uint64_t limited_ticks{0};     // ticks at a controller limit (force, voltage, slew)
+  std::string state, trip;            // the supervisor's at the end
+};
+
+struct ScheduledCut {
+  std::vector<ScheduledCutSegment> segments;
+  double force_limit_n{0.0};          // the actuator's (actuator.force_limit_n)
+  std::uint64_t handovers{0}, handovers_refused{0};
+  [[nodiscard]] bool all_stable() const;
+  [[nodiscard]] bool within_limits() const;  // no controller limit acted and the force stayed below the limit
+};
+
+// cell: a configuration with controller.speed_schedule; the cuts run in the order given, the damper armed
+// before the first and running throughout. revolutions: per cut after the switch has settled.
+[[nodiscard]] ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConfig& job,
+                                         const std::vector<ScheduledCutStep>& steps, int revolutions = 60);
+
+}  // namespace robodamp::tune

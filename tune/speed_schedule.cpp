@@ -1,0 +1,475 @@
+#include "tune/speed_schedule.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "config/number_range.hpp"
+#include "control/controller.hpp"
+#include "milling/accurate_stability.hpp"
+#include "milling/lobes.hpp"
+#include "milling/structure.hpp"
+#include "tune/tuned_file.hpp"
+
+namespace robodamp::tune {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The numbers written are the ones verified: gains to 3 significant figures, band edges to 0.01 rpm.
+double three_figures(double x) {
+  if (!(x > 0.0)) return x;
+  const double scale = std::pow(10.0, std::floor(std::log10(x)) - 2.0);
+  return std::floor(x / scale) * scale;  // down: the margins hold
+}
+double edge(double a, double b) {
+  const double m = std::round(50.0 * (a + b)) / 100.0;
+  return m > a && m < b ? m : 0.5 * (a + b);
+}
+
+// The largest K whose loop keeps every margin (log scan, then bisection): what a candidate may go up to.
+void set_top_gain(ScheduleController& c, const config::Config& cell, const ScheduleSettings& s) {
+  c.k_max_ns_per_m = analysis::max_stable_gain(*c.model, c.polarity);
+  const double ceiling = cell.supervision.max_gain_fraction * c.k_max_ns_per_m.value_or(control::kMaxGainNsPerM);
+  std::string why;
+  auto ok = [&](double k) {
+    if (!c.model->stable(k, c.polarity)) return why = "the loop is unstable", false;
+    const analysis::Margins m = analysis::margins(*c.model, k, c.polarity, c.k_max_ns_per_m);
+    if (m.gain_margin_db && *m.gain_margin_db < s.gain_margin_min_db) return why = "gain margin", false;
+    if (m.phase_margin_deg && *m.phase_margin_deg < s.phase_margin_min_deg) return why = "phase margin", false;
+    if (m.delay_margin_ms && *m.delay_margin_ms < s.delay_margin_min_ms) return why = "delay margin", false;
+    return true;
+  };
+  constexpr double kFloor = 1.0;
+  if (!ok(kFloor)) {
+    c.top_gain_reason = "no K keeps the margins (" + why + ")";
+    return;
+  }
+  double lo = kFloor, hi = ceiling;
+  std::string fail_reason = "supervision.max_gain_fraction of K_max";
+  for (int i = 1; i <= 48; ++i) {  // the first failure on a log scan, then bisection below it
+    const double k = kFloor * std::pow(ceiling / kFloor, i / 48.0);
+    if (!ok(k)) {
+      hi = k;
+      fail_reason = why;
+      break;
+    }
+    lo = k;
+  }
+  if (lo < hi && hi < ceiling) {
+    while (hi / lo > 1.001) {
+      const double mid = std::sqrt(lo * hi);
+      (ok(mid) ? lo : hi) = mid;
+    }
+  }
+  c.top_gain_ns_per_m = lo;
+  c.top_gain_reason = fail_reason;
+  for (int i = 0; i < s.gains_per_controller; ++i)
+    c.gains.push_back(three_figures(lo / std::pow(16.0, static_cast<double>(s.gains_per_controller - 1 - i) /
+                                                            std::max(1, s.gains_per_controller - 1))));
+  c.gains.erase(std::unique(c.gains.begin(), c.gains.end()), c.gains.end());
+}
+
+std::vector<ScheduleController> controllers_for(const config::Config& cell, const std::vector<std::string>& others,
+                                                const ScheduleSettings& s) {
+  std::vector<ScheduleController> out;
+  auto add = [&](const std::string& file, config::Config cfg) {
+    cfg.controller.speed_schedule.reset();
+    ScheduleController c;
+    c.file = file;
+    c.polarity = cfg.controller.polarity;
+    c.model = std::make_shared<const analysis::LoopModel>(cfg);
+    c.config = std::move(cfg);
+    set_top_gain(c, cell, s);
+    out.push_back(std::move(c));
+  };
+  add("", cell);
+  for (const auto& f : others) {
+    const config::SpeedControllerConfig entry = config::speed_controller_of(config::load_config_file(f));
+    add(f, config::with_speed_controller(cell, entry));
+    out.back().entry = entry;
+  }
+  return out;
+}
+
+// The depths, computed once per (speed, candidate): candidate 0 the open loop, 1.. the damped ones; the
+// fixed configuration (the cell as it is) is the last.
+class Depths {
+ public:
+  Depths(const std::vector<ScheduleController>& controllers, const std::vector<ScheduleCandidate>& candidates,
+         const config::Config& cell, const config::MillingConfig& job, const config::StructureConfig& structure,
+         const ScheduleSettings& s)
+      : job_(job), s_(s) {
+    const auto& own = controllers.front();
+    structures_.push_back(std::make_unique<milling::Structure>(
+        structure, false, milling::Structure::LiveLoop{own.model, 0.0, own.polarity}));
+    for (std::size_t i = 1; i < candidates.size(); ++i) {
+      const auto& c = controllers[candidates[i].controller];
+      structures_.push_back(std::make_unique<milling::Structure>(
+          structure, true, milling::Structure::LiveLoop{c.model, candidates[i].gain_ns_per_m, c.polarity}));
+    }
+    structures_.push_back(std::make_unique<milling::Structure>(
+        structure, true, milling::Structure::LiveLoop{own.model, cell.controller.gain_ns_per_m, own.polarity}));
+    for (const auto& st : structures_) methods_.push_back(std::make_unique<milling::AccurateStability>(*st, job));
+    config::LobesConfig lobes = job.lobes;
+    preview_ = std::make_unique<milling::LobeModel>(*structures_.front(),
+                                                    milling::chatter_process(job.tool, job.material, job.cut), lobes);
+  }
+  [[nodiscard]] std::size_t fixed() const { return methods_.size() - 1; }
+  [[nodiscard]] const milling::AccurateStability& damped_method() const { return *methods_.back(); }
+  [[nodiscard]] std::string method() const { return methods_.back()->method() + " (damped), " + methods_.front()->method() + " (open loop)"; }
+
+  // Computes what is missing for these speeds and candidates (the open loop first: it is the others' guess).
+  void fill(const std::vector<double>& rpm, const std::vector<std::size_t>& which, const std::string& what) {
+    std::vector<std::size_t> order = which;
+    std::stable_sort(order.begin(), order.end(), [](std::size_t a, std::size_t b) { return a == 0 && b != 0; });
+    std::size_t total = 0, done = 0;
+    std::vector<std::vector<double>> todo(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k)
+      for (double r : rpm)
+        if (!cache_.count({r, order[k]})) todo[k].push_back(r);
+    for (const auto& t : todo) total += t.size();
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      if (todo[k].empty()) continue;
+      std::vector<double> guess;
+      for (double r : todo[k]) guess.push_back(order[k] == 0 ? open_guess(r) : depth(r, 0));
+      const auto pts = methods_[order[k]]->critical(todo[k], guess, s_.threads, 1e-3, [&](std::size_t n) {
+        if (s_.progress) s_.progress(what, done + n, total);
+      });
+      done += todo[k].size();
+      for (std::size_t i = 0; i < pts.size(); ++i) cache_[{todo[k][i], order[k]}] = pts[i].critical_depth_mm;
+    }
+  }
+  [[nodiscard]] double depth(double rpm, std::size_t candidate) const { return cache_.at({rpm, candidate}); }
+
+ private:
+  double open_guess(double rpm) const {
+    const auto p = preview_->limit_at(rpm);
+    return p && std::isfinite(p->b_lim_mm) && p->b_lim_mm > 0.0 ? p->b_lim_mm : job_.cut.axial_mm;
+  }
+  const config::MillingConfig& job_;
+  const ScheduleSettings& s_;
+  std::vector<std::unique_ptr<milling::Structure>> structures_;
+  std::vector<std::unique_ptr<milling::AccurateStability>> methods_;
+  std::unique_ptr<milling::LobeModel> preview_;
+  std::map<std::pair<double, std::size_t>, double> cache_;
+};
+
+struct Grid {
+  std::vector<double> rpm;                 // ascending, the grid speeds as the sampled loop runs them
+  std::vector<std::size_t> choice;         // candidate per grid speed
+};
+
+// The deepest candidate at one grid speed: the open loop unless a damped one beats it by gain_min_pct; the
+// previous speed's kept while within keep_within_pct of the best.
+std::size_t choose(const Depths& d, double rpm, std::size_t n_candidates, std::optional<std::size_t> previous,
+                   const ScheduleSettings& s) {
+  const double open = d.depth(rpm, 0);
+  std::size_t best = 0;
+  double best_mm = open;
+  for (std::size_t c = 1; c < n_candidates; ++c)
+    if (d.depth(rpm, c) > best_mm) best = c, best_mm = d.depth(rpm, c);
+  if (best != 0 && best_mm < open * (1.0 + 0.01 * s.gain_min_pct)) best = 0, best_mm = open;
+  if (previous && *previous != best) {
+    const double prev_mm = d.depth(rpm, *previous);
+    const bool prev_ok = *previous == 0 || prev_mm >= open * (1.0 + 0.01 * s.gain_min_pct);
+    if (prev_ok && prev_mm >= best_mm * (1.0 - 0.01 * s.keep_within_pct)) return *previous;
+  }
+  return best;
+}
+
+// A band per run of equal choices, changing halfway between grid speeds; the first and last reach the range.
+std::vector<config::SpeedBandConfig> bands_of(const Grid& g, const std::vector<ScheduleCandidate>& cands, double lo, double hi) {
+  std::vector<config::SpeedBandConfig> bands;
+  for (std::size_t i = 0; i < g.rpm.size(); ++i) {
+    const double from = i == 0 ? lo : edge(g.rpm[i - 1], g.rpm[i]);
+    const double to = i + 1 == g.rpm.size() ? hi : edge(g.rpm[i], g.rpm[i + 1]);
+    const ScheduleCandidate& c = cands[g.choice[i]];
+    if (!bands.empty() && i > 0 && g.choice[i] == g.choice[i - 1]) {
+      bands.back().rpm_max = to;
+      continue;
+    }
+    bands.push_back({from, to, static_cast<int>(c.controller), c.gain_ns_per_m});
+  }
+  // The open loop's bands run the controller before them (K = 0: the chain does not act), so that no hand-over
+  // happens where nothing changes.
+  for (std::size_t i = 1; i < bands.size(); ++i)
+    if (bands[i].gain_ns_per_m == 0.0) bands[i].controller = bands[i - 1].controller;
+  return bands;
+}
+
+// Which candidate the bands run at rpm.
+std::size_t candidate_at(const Grid& g, double rpm) {
+  std::size_t i = 0;
+  while (i + 1 < g.rpm.size() && rpm >= edge(g.rpm[i], g.rpm[i + 1])) ++i;
+  return g.choice[i];
+}
+
+}  // namespace
+
+namespace {
+
+// Fewer bands than the controller holds: the run whose speeds lose least (to the open loop) when they take
+// a neighbour's candidate takes it, the narrowest first among equals.
+void fit_band_count(Grid& g, const Depths& d, const std::vector<ScheduleCandidate>& cands, double lo, double hi) {
+  while (bands_of(g, cands, lo, hi).size() > config::kMaxSpeedBands) {
+    std::vector<std::pair<std::size_t, std::size_t>> runs;  // [first, last] grid index
+    for (std::size_t i = 0; i < g.rpm.size(); ++i)
+      if (i == 0 || g.choice[i] != g.choice[i - 1]) runs.push_back({i, i});
+      else runs.back().second = i;
+    double best_loss = kInf, best_width = kInf;
+    std::size_t best_run = 0, best_to = 0;
+    for (std::size_t r = 0; r < runs.size(); ++r)
+      for (const std::size_t n : {r == 0 ? r : r - 1, r + 1 < runs.size() ? r + 1 : r}) {
+        if (n == r) continue;
+        const std::size_t to = g.choice[runs[n].first];
+        double loss = 0.0;
+        for (std::size_t i = runs[r].first; i <= runs[r].second; ++i)
+          loss = std::max(loss, 1.0 - d.depth(g.rpm[i], to) / d.depth(g.rpm[i], 0));
+        const double width = g.rpm[runs[r].second] - g.rpm[runs[r].first];
+        if (loss < best_loss - 1e-12 || (loss <= best_loss + 1e-12 && width < best_width))
+          best_loss = loss, best_width = width, best_run = r, best_to = to;
+      }
+    for (std::size_t i = runs[best_run].first; i <= runs[best_run].second; ++i) g.choice[i] = best_to;
+  }
+}
+
+std::vector<std::size_t> every(std::size_t n) {
+  std::vector<std::size_t> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = i;
+  return v;
+}
+
+// Two speeds between each pair of grid speeds (a quarter and three quarters of the way), as the sampled loop
+// runs them, not already known.
+std::vector<double> checks_between(const Grid& g, const milling::AccurateStability& damped, const std::set<double>& known) {
+  std::vector<double> out;
+  for (std::size_t i = 0; i + 1 < g.rpm.size(); ++i)
+    for (const double f : {0.25, 0.75}) {
+      const double r = damped.stepped_rpm(g.rpm[i] + f * (g.rpm[i + 1] - g.rpm[i]));
+      if (r > g.rpm[i] && r < g.rpm[i + 1] && !known.count(r)) out.push_back(r);
+    }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+// The depth of the schedule's candidate at every checked speed (computed where missing, per candidate).
+void fill_scheduled(Depths& d, const Grid& g, const std::vector<double>& speeds) {
+  std::map<std::size_t, std::vector<double>> by;
+  for (double r : speeds) by[candidate_at(g, r)].push_back(r);
+  for (const auto& [c, rs] : by) d.fill(rs, {c}, "checking the bands");
+}
+
+// Checks between the grid speeds; those where the bands are worse than the open loop join the grid (every
+// candidate computed, chosen afresh), for refine_rounds rounds. Returns every speed checked.
+std::set<double> refine(Grid& g, Depths& d, std::size_t n_cands, const milling::AccurateStability& damped,
+                        const ScheduleSettings& s, std::size_t& refined) {
+  std::set<double> checked;
+  for (int round = 0; round <= s.refine_rounds; ++round) {
+    std::set<double> known(g.rpm.begin(), g.rpm.end());
+    known.insert(checked.begin(), checked.end());
+    const std::vector<double> checks = checks_between(g, damped, known);
+    if (checks.empty()) break;
+    d.fill(checks, {0}, "checking the bands");
+    fill_scheduled(d, g, checks);
+    checked.insert(checks.begin(), checks.end());
+    std::vector<double> worse;
+    for (double r : checks)
+      if (d.depth(r, candidate_at(g, r)) < d.depth(r, 0) * (1.0 - 0.01 * s.worse_tolerance_pct)) worse.push_back(r);
+    if (worse.empty() || round == s.refine_rounds) break;
+    d.fill(worse, every(n_cands), "refining the bands");
+    for (double r : worse) {
+      const auto at = std::lower_bound(g.rpm.begin(), g.rpm.end(), r);
+      const auto i = static_cast<std::size_t>(at - g.rpm.begin());
+      const std::size_t c = choose(d, r, n_cands, std::nullopt, s);
+      g.rpm.insert(at, r);
+      g.choice.insert(g.choice.begin() + static_cast<std::ptrdiff_t>(i), c);
+      checked.erase(r);
+      ++refined;
+    }
+  }
+  return checked;
+}
+
+}  // namespace
+
+namespace {
+
+void summarise(SpeedSchedule& out, const Depths& d, const config::MillingConfig& job, double job_rpm, const Grid& g) {
+  ScheduleSummary& m = out.summary;
+  const double tol = 1.0 - 0.01 * out.settings.worse_tolerance_pct, better = 1.0 + 0.01 * out.settings.gain_min_pct;
+  m.open_min_mm = m.fixed_min_mm = m.scheduled_min_mm = kInf;
+  m.fixed_worst_ratio = m.scheduled_worst_ratio = kInf;
+  double fixed_sum = 0.0, sched_sum = 0.0;
+  std::size_t fixed_worse = 0, sched_worse = 0, sched_better = 0;
+  for (const ScheduleSpeed& p : out.speeds) {
+    if (p.open_mm < m.open_min_mm) m.open_min_mm = p.open_mm, m.open_min_rpm = p.rpm;
+    if (p.fixed_mm < m.fixed_min_mm) m.fixed_min_mm = p.fixed_mm, m.fixed_min_rpm = p.rpm;
+    if (p.scheduled_mm < m.scheduled_min_mm) m.scheduled_min_mm = p.scheduled_mm, m.scheduled_min_rpm = p.rpm;
+    const double rf = p.fixed_mm / p.open_mm, rs = p.scheduled_mm / p.open_mm;
+    fixed_sum += rf, sched_sum += rs;
+    if (rf < m.fixed_worst_ratio) m.fixed_worst_ratio = rf, m.fixed_worst_rpm = p.rpm;
+    if (rs < m.scheduled_worst_ratio) m.scheduled_worst_ratio = rs, m.scheduled_worst_rpm = p.rpm;
+    fixed_worse += rf < tol ? 1U : 0U;
+    sched_worse += rs < tol ? 1U : 0U;
+    sched_better += rs >= better ? 1U : 0U;
+    m.grid_speeds += p.grid ? 1U : 0U;
+  }
+  const auto n = static_cast<double>(out.speeds.size());
+  m.speeds = out.speeds.size();
+  m.fixed_mean_ratio = fixed_sum / n;
+  m.scheduled_mean_ratio = sched_sum / n;
+  m.fixed_worse_share = static_cast<double>(fixed_worse) / n;
+  m.scheduled_worse_share = static_cast<double>(sched_worse) / n;
+  m.scheduled_better_share = static_cast<double>(sched_better) / n;
+  if (job_rpm > 0.0) {
+    m.job_rpm = job_rpm;
+    m.job_open_mm = d.depth(job_rpm, 0);
+    m.job_fixed_mm = d.depth(job_rpm, d.fixed());
+    m.job_scheduled_mm = d.depth(job_rpm, candidate_at(g, job_rpm));
+  }
+  (void)job;
+}
+
+std::string describe(const ScheduleController& c) {
+  return c.file.empty() ? "the configuration's own controller" : c.file;
+}
+
+}  // namespace
+
+SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<std::string>& other_controllers,
+                              const config::MillingConfig& job, const config::StructureConfig& structure,
+                              const ScheduleSettings& s) {
+  SpeedSchedule out;
+  out.settings = s;
+  out.controllers = controllers_for(cell, other_controllers, s);
+  out.candidates.push_back({0, 0.0});
+  for (std::size_t c = 0; c < out.controllers.size(); ++c) {
+    if (out.controllers[c].gains.empty())
+      out.notes.push_back(describe(out.controllers[c]) + ": " + out.controllers[c].top_gain_reason + "; not used");
+    for (double k : out.controllers[c].gains) out.candidates.push_back({c, k});
+  }
+  Depths d(out.controllers, out.candidates, cell, job, structure, s);
+  out.method = d.method();
+  const milling::AccurateStability& damped = d.damped_method();
+  const int n = s.speeds > 0 ? s.speeds : job.time_domain.sdm_points;
+  const double lo = job.lobes.rpm_min, hi = std::min(job.lobes.rpm_max, damped.max_rpm());
+  if (hi < job.lobes.rpm_max)
+    out.notes.push_back("above " + config::format_number(hi) + " rpm the sampled loop has fewer than 10 ticks per tooth "
+                        "period: the schedule stops there, and K there is controller.gain_ns_per_m");
+  std::set<double> grid_rpm;
+  for (int i = 0; i < n; ++i) grid_rpm.insert(damped.stepped_rpm(lo + (hi - lo) * i / std::max(1, n - 1)));
+  Grid g;
+  g.rpm.assign(grid_rpm.begin(), grid_rpm.end());
+  std::vector<std::size_t> all = every(out.candidates.size());
+  all.push_back(d.fixed());
+  d.fill(g.rpm, all, "every candidate on the grid");
+  for (std::size_t i = 0; i < g.rpm.size(); ++i)
+    g.choice.push_back(choose(d, g.rpm[i], out.candidates.size(), i ? std::optional(g.choice[i - 1]) : std::nullopt, s));
+  fit_band_count(g, d, out.candidates, lo, hi);
+  const std::set<double> checked = refine(g, d, out.candidates.size(), damped, s, out.refined_speeds);
+  fit_band_count(g, d, out.candidates, lo, hi);
+
+  std::vector<double> speeds(g.rpm.begin(), g.rpm.end());
+  speeds.insert(speeds.end(), checked.begin(), checked.end());
+  const double job_rpm = job.cut.spindle_rpm > 0.0 && job.cut.spindle_rpm <= damped.max_rpm() ? damped.stepped_rpm(job.cut.spindle_rpm) : 0.0;
+  if (job_rpm > 0.0) d.fill({job_rpm}, {0, d.fixed()}, "the job's speed");
+  d.fill(speeds, {0, d.fixed()}, "checking the bands");
+  fill_scheduled(d, g, job_rpm > 0.0 ? std::vector<double>{job_rpm} : std::vector<double>{});
+  fill_scheduled(d, g, speeds);
+  std::sort(speeds.begin(), speeds.end());
+  out.bands = bands_of(g, out.candidates, lo, hi);
+  const std::set<double> on_grid(g.rpm.begin(), g.rpm.end());
+  for (double r : speeds) {
+    ScheduleSpeed p;
+    p.rpm = r;
+    p.ticks_per_tooth = static_cast<int>(std::lround(60.0 * cell.loop.rate_hz / (r * job.tool.teeth)));
+    p.grid = on_grid.count(r) > 0;
+    p.open_mm = d.depth(r, 0);
+    p.fixed_mm = d.depth(r, d.fixed());
+    p.candidate = candidate_at(g, r);
+    p.scheduled_mm = d.depth(r, p.candidate);
+    p.band = config::speed_band_of(out.bands, r).value_or(0);
+    out.speeds.push_back(p);
+  }
+  summarise(out, d, job, job_rpm, g);
+  return out;
+}
+
+namespace {
+
+// A band's controller as the schedule writes it: the compensator block and polarity that replace the chain's.
+std::string controller_text(const config::SpeedControllerConfig& c) {
+  const config::BlockConfig& b = c.compensator.front();
+  std::ostringstream o;
+  o << "{polarity: " << (c.polarity > 0 ? "+1" : "-1");
+  if (c.match_freq_hz) o << ", match_freq_hz: " << exact(*c.match_freq_hz);
+  o << ", compensator: {kind: compensator, model: " << config::to_string(b.model);
+  if (b.model == config::CompensatorModel::kC1)
+    o << ", corner_hz: " << exact(b.corner_hz) << ", corner_damping_ratio: " << exact(b.corner_damping_ratio);
+  auto list = [&](const char* key, const std::vector<double>& v) {
+    o << ", " << key << ": [";
+    for (std::size_t i = 0; i < v.size(); ++i) o << (i ? ", " : "") << exact(v[i]);
+    o << "]";
+  };
+  if (b.model == config::CompensatorModel::kRational) list("numerator", b.numerator), list("denominator", b.denominator);
+  if (b.prewarp_hz) o << ", prewarp_hz: " << exact(*b.prewarp_hz);
+  o << "}}";
+  return o.str();
+}
+
+// The schedule in block style, a band per line, at the indentation of the key it replaces.
+std::string schedule_block(const std::string& indent, const SpeedSchedule& s) {
+  std::ostringstream o;
+  o << indent << "speed_schedule:   # robodamp schedule: the controller and K by spindle speed (docs/tuning.md)\n";
+  if (s.controllers.size() > 1) {
+    o << indent << "  controllers:    # a band's controller i >= 1: this chain with controllers[i - 1]'s compensator\n";
+    for (std::size_t i = 1; i < s.controllers.size(); ++i)
+      o << indent << "    - " << controller_text(*s.controllers[i].entry) << "   # from " << s.controllers[i].file << "\n";
+  }
+  o << indent << "  bands:\n";
+  for (const auto& b : s.bands)
+    o << indent << "    - {rpm_min: " << exact(b.rpm_min) << ", rpm_max: " << exact(b.rpm_max) << ", controller: " << b.controller
+      << ", gain_ns_per_m: " << exact(b.gain_ns_per_m) << "}\n";
+  return o.str();
+}
+
+}  // namespace
+
+config::EditedYaml scheduled_config_text(const config::Config& cell, const SpeedSchedule& s) {
+  YAML::Node schedule(YAML::NodeType::Map);
+  YAML::Node controllers(YAML::NodeType::Sequence);
+  for (std::size_t i = 1; i < s.controllers.size(); ++i) controllers.push_back(YAML::Load(controller_text(*s.controllers[i].entry)));
+  if (controllers.size() > 0) schedule["controllers"] = controllers;
+  YAML::Node bands(YAML::NodeType::Sequence);
+  for (const auto& b : s.bands) {
+    YAML::Node band(YAML::NodeType::Map);
+    band.SetStyle(YAML::EmitterStyle::Flow);
+    band["rpm_min"] = exact(b.rpm_min);
+    band["rpm_max"] = exact(b.rpm_max);
+    band["controller"] = b.controller;
+    band["gain_ns_per_m"] = exact(b.gain_ns_per_m);
+    bands.push_back(band);
+  }
+  schedule["bands"] = bands;
+  config::EditedYaml out = config::edit_yaml(cell.yaml_text, {{{"controller", "speed_schedule"}, schedule}});
+  // The edit writes a collection as one flow line; a person reads the block form, which reads back the same.
+  const std::size_t at = out.text.find("speed_schedule: {");
+  if (!out.comments_kept || at == std::string::npos) return out;
+  const std::size_t line = out.text.rfind('\n', at) + 1;
+  const std::size_t end = out.text.find('\n', at);
+  std::string text = out.text.substr(0, line) + schedule_block(out.text.substr(line, at - line), s) +
+                     (end == std::string::npos ? "" : out.text.substr(end + 1));
+  const YAML::Node back = config::yaml_at(YAML::Load(text), {"controller", "speed_schedule", "bands"});
+  if (!back.IsSequence() || back.size() != s.bands.size()) return out;
+  out.text = std::move(text);
+  return out;
+}
+
+}  // namespace robodamp::tune
