@@ -8,6 +8,8 @@
 
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/pose_schedule.hpp"
+#include "analysis/speed_schedule_check.hpp"
+#include "apps/milling_report.hpp"
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
 #include "milling/live_stability.hpp"
@@ -87,9 +89,15 @@ std::string analysis_table(const json& r) {
      << fmt(r["spectral_radius"], "%.6f") << ", Nyquist encirclements " << r["nyquist_encirclements"].get<int>() << ")\n";
   os << "  continuous loop: " << (r["stable_continuous"].get<bool>() ? "stable" : "unstable") << "\n";
   os << "  max stable K " << fmt(r["max_stable_gain_ns_per_m"], "%.1f") << " N s/m, gain margin "
-     << fmt(r["gain_margin_db"], "%.2f") << " dB, phase margin " << fmt(r["phase_margin_deg"], "%.1f")
-     << " deg at " << fmt(r["gain_crossover_hz"], "%.2f") << " Hz, delay margin " << fmt(r["delay_margin_ms"], "%.2f")
-     << " ms\n";
+     << fmt(r["gain_margin_db"], "%.2f") << " dB, "
+     << (r["gain_crossover_hz"].is_null()
+             ? std::string("no gain crossover (the loop gain stays below 1: no phase margin to state)")
+             : "phase margin " + fmt(r["phase_margin_deg"], "%.1f") + " deg at " + fmt(r["gain_crossover_hz"], "%.2f") + " Hz")
+     << ", delay margin " << fmt(r["delay_margin_ms"], "%.2f") << " ms\n";
+  if (!r["gain_margin_db"].is_null() && r["gain_margin_db"].get<double>() < 6.0)
+    os << "  WARNING: gain margin " << fmt(r["gain_margin_db"], "%.2f") << " dB, below 6 dB\n";
+  if (!r["phase_margin_deg"].is_null() && r["phase_margin_deg"].get<double>() < 45.0)
+    os << "  WARNING: phase margin " << fmt(r["phase_margin_deg"], "%.1f") << " deg, below 45 deg\n";
   if (r.contains("spindle")) {
     const auto& sp = r["spindle"];
     std::snprintf(line, sizeof line, "  spindle %.0f rpm x %.0f teeth = %.2f Hz: %zu harmonic notches in the loop\n",
@@ -115,9 +123,11 @@ std::string analysis_table(const json& r) {
   os << "  recommended polarity " << std::showpos << r["recommended_polarity"].get<int>() << std::noshowpos << ": "
      << r["polarity_reason"].get<std::string>() << "\n";
   for (const auto& mp : r["modes"]) {
-    std::snprintf(line, sizeof line, "    mode %6.2f Hz: feedback force at %7.1f deg from -velocity: %s\n",
+    const bool edge = mp["damps"].get<bool>() && std::abs(mp["feedback_phase_deg"].get<double>()) > 80.0;
+    std::snprintf(line, sizeof line, "    mode %6.2f Hz: feedback force at %7.1f deg from -velocity: %s%s\n",
                   mp["freq_hz"].get<double>(), mp["feedback_phase_deg"].get<double>(),
-                  mp["damps"].get<bool>() ? "damps" : "does NOT damp");
+                  mp["damps"].get<bool>() ? "damps" : "does NOT damp",
+                  edge ? " (WARNING: within 10 deg of the damping window's edge at 90 deg)" : "");
     os << line;
   }
   std::snprintf(line, sizeof line, "  %-22s %14s %10s %14s %10s %12s %14s\n", "FRF", "open peak m/N", "at Hz",
@@ -223,6 +233,8 @@ struct AnalyzeArgs {
   std::optional<double> spindle_rpm;
   bool spindle_sweep{false};
   bool base{false};
+  std::string job_path;  // the cut the verdict is about (default spindle.job)
+  int cut_speeds{60};
 };
 
 // The speed map as JSON: every speed with the notches' phase at each mode, and the refused ranges.
@@ -344,6 +356,31 @@ void add_job_limits(const analysis::LoopModel& m, std::optional<double> rpm, jso
                                      {"damped_valid", l.damped_valid}};
 }
 
+// controller.speed_schedule: each controller and K its bands run, checked as a loop, with its weak points.
+std::string speed_schedule_section(const config::Config& cfg, json& report) {
+  if (!cfg.controller.speed_schedule) return {};
+  std::ostringstream os;
+  const auto loops = analysis::check_speed_schedule(cfg);
+  os << "  speed schedule: " << cfg.controller.speed_schedule->bands.size() << " bands (robodamp schedule; K = 0 in a band "
+     << "where the damper is worse than none); each controller and K they run, as a loop:\n";
+  json j = json::array();
+  for (const auto& l : loops) {
+    char line[300];
+    std::snprintf(line, sizeof line, "    controller %zu at K %6.0f N s/m (%zu bands from %.0f rpm): %s, GM %s dB, %s\n", l.controller,
+                  l.gain_ns_per_m, l.bands, l.rpm_from, l.stable ? "stable" : "UNSTABLE",
+                  l.margins.gain_margin_db ? fmt(json(*l.margins.gain_margin_db), "%.1f").c_str() : "-",
+                  l.margins.phase_margin_deg ? ("PM " + fmt(json(*l.margins.phase_margin_deg), "%.1f") + " deg").c_str()
+                                             : "no gain crossover");
+    os << line;
+    for (const auto& w : l.warnings) os << "      WARNING: " << w << "\n";
+    j.push_back({{"controller", l.controller}, {"gain_ns_per_m", l.gain_ns_per_m}, {"bands", l.bands}, {"stable", l.stable},
+                 {"gain_margin_db", optional_number(l.margins.gain_margin_db)},
+                 {"phase_margin_deg", optional_number(l.margins.phase_margin_deg)}, {"warnings", l.warnings}});
+  }
+  report["speed_schedule"] = j;
+  return os.str();
+}
+
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
   if (a.spindle_sweep) return print_speed_map(config::load_config_file(a.config_path), a.json);
@@ -353,7 +390,14 @@ int run_analyze(const AnalyzeArgs& a) {
   const auto result = analysis::analyse(model);
   auto report = analysis_report(model, result);
   add_job_limits(model, a.spindle_rpm, report);
-  if (print_report(report.dump(2), a.json, "analyze", analysis_table(report), a.plot_dir,
+  std::string table = analysis_table(report) + speed_schedule_section(model.config(), report);
+  const std::string job = !a.job_path.empty() ? a.job_path : model.config().spindle.job_resolved;
+  if (!job.empty() && result.stable) {
+    const milling::CutVerdict v = milling::cut_verdict(model.config(), config::load_milling_config(job), a.cut_speeds);
+    table += milling::cut_verdict_text(v);
+    report["cut"] = cut_verdict_json(v);
+  }
+  if (print_report(report.dump(2), a.json, "analyze", table, a.plot_dir,
                    [&] { return plot_analysis(model, result, a.plot_dir); },
                    "frf_open_closed.png, nyquist.png, gain_sweep.png in " + a.plot_dir) != 0)
     return 1;
@@ -367,6 +411,11 @@ void register_analyze(Registry& r) {
   CLI::App* sub = r.add("analyze", "Closed-loop stability, margins, polarity and predicted improvement",
                         [a] { return run_analyze(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  sub->add_option("--job", a->job_path,
+                  "Milling job (config/milling/*.yaml): what the damper (and its speed schedule) does for that cut, by the "
+                  "accurate method; default the configuration's spindle.job")
+      ->check(CLI::ExistingFile);
+  r.whole_number(sub, "--cut-speeds", a->cut_speeds, {"(speeds)", 2, 5000}, "Speeds over the job's range the cut verdict checks");
   r.json(sub, a->json, "The analysis (or the pose schedule's regions, or the --spindle-sweep map)");
   r.plot_dir(sub, a->plot_dir, "frf_open_closed.png, nyquist.png and gain_sweep.png");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0},

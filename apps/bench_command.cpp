@@ -8,6 +8,8 @@
 #include "apps/analyze_command.hpp"
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/milling_report.hpp"
+#include "milling/cut_verdict.hpp"
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -146,7 +148,7 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
   std::snprintf(line, sizeof line, "\n%.0f s simulated in %.2f s wall (%.0fx real time)\n", r.simulated_s, r.wall_s,
                 r.simulated_s / r.wall_s);
   os << line;
-  os << "VERDICT: " << r.verdict << "\n";
+  os << "MODEL AGREEMENT (the simulated bench against the analysis, not the cut): " << r.verdict << "\n";
   return os.str();
 }
 
@@ -199,6 +201,8 @@ namespace {
 
 struct BenchArgs {
   std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string job_path;  // the cut the verdict is about (default the configuration's spindle.job)
+  int cut_speeds{60};
   JsonOut json;
   std::string plot_dir;
   int jobs{0};  // threads for the independent runs; 0 = one per core
@@ -210,7 +214,17 @@ int run_bench(const BenchArgs& a) {
   const auto report = bench.run([](const std::string& line) { std::cerr << "[bench] " << line << std::endl; },
                                 static_cast<std::size_t>(a.jobs));
   std::cout << bench_table(bench, report);
-  if (!emit_json(a.json, bench_report_json(bench, report).dump(2), "bench")) return 1;
+  json j = bench_report_json(bench, report);
+  const config::Config& cfg = bench.model().config();
+  const std::string job = !a.job_path.empty() ? a.job_path : cfg.spindle.job_resolved;
+  if (!job.empty() && report.ran_closed_loop) {
+    const milling::CutVerdict v = milling::cut_verdict(cfg, config::load_milling_config(job), a.cut_speeds);
+    std::cout << "\n" << milling::cut_verdict_text(v);
+    j["cut"] = cut_verdict_json(v);
+  } else {
+    std::cout << "(no milling job: give --job, or spindle.job in the configuration, for what the damper does for a cut)\n";
+  }
+  if (!emit_json(a.json, j.dump(2), "bench")) return 1;
   if (a.json.to_file()) std::cout << "wrote " << a.json.path << '\n';
   if (!a.plot_dir.empty()) {
     std::string err = plot_analysis(bench.model(), report.analysis, a.plot_dir);
@@ -232,6 +246,11 @@ void register_bench(Registry& r) {
   CLI::App* sub = r.add("bench", "Simulated-plant bench run: impact tests control off/on, saturation, gain sweep",
                         [a] { return run_bench(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
+  sub->add_option("--job", a->job_path,
+                  "Milling job (config/milling/*.yaml) the verdict is about: what the damper (and its speed schedule) does "
+                  "for that cut; default the configuration's spindle.job")
+      ->check(CLI::ExistingFile);
+  r.whole_number(sub, "--cut-speeds", a->cut_speeds, {"(speeds)", 2, 5000}, "Speeds over the job's range the cut verdict checks");
   r.json(sub, a->json, "The report");
   r.plot_dir(sub, a->plot_dir, "the FRFs, Nyquist, gain sweep and bench plots");
   r.whole_number(sub, "--jobs", a->jobs, {"(threads)", 0, 256, false, false, "0 = one per core"},

@@ -15,6 +15,7 @@
 #include "config/milling_config.hpp"
 #include "milling/lobes.hpp"
 #include "milling/accurate_stability.hpp"
+#include "milling/scheduled_lobes.hpp"
 #include "milling/sle.hpp"
 #include "milling/studies.hpp"
 
@@ -121,7 +122,19 @@ std::string lobes_table(const json& r) {
     one(r["damped"], "damped");
     os << "  change with active damping: minimum limiting depth " << fmt(r["gain"]["min_b_lim_change_pct"], "%+.1f")
        << " %, at the spindle speed " << fmt(r["gain"]["at_spindle_rpm"], "%.0f") << " rpm "
-       << fmt(r["gain"]["at_spindle_change_pct"], "%+.1f") << " %\n";
+       << fmt(r["gain"]["at_spindle_change_pct"], "%+.1f") << " %"
+       << (r["gain"]["at_spindle_change_pct"].is_number() && r["gain"]["at_spindle_change_pct"].get<double>() < 0.0
+               ? " (the damper at this fixed gain LOWERS the limit at the job's speed)"
+               : "")
+       << "\n";
+  }
+  if (r.contains("scheduled")) {
+    const json& s = r["scheduled"];
+    one(s, "sched.");
+    os << "  change with the speed schedule (" << s["bands"].get<std::size_t>() << " bands of " << s["config"].get<std::string>()
+       << "): minimum limiting depth " << fmt(r["gain"]["scheduled_min_b_lim_change_pct"], "%+.1f") << " %, at the spindle speed "
+       << fmt(r["gain"]["scheduled_at_spindle_change_pct"], "%+.1f") << " %; below the open loop (by > 0.5 %) at "
+       << s["below_open"].get<std::size_t>() << " of " << s["curve"].size() << " speeds\n";
   }
   for (const auto& n : r["notes"]) os << "  note: " << n.get<std::string>() << '\n';
   if (r.contains("damped"))
@@ -131,13 +144,13 @@ std::string lobes_table(const json& r) {
 
 std::string plot_lobes(const json& r, const std::string& path) {
   std::ostringstream data;
-  const bool damped = r.contains("damped");
+  const bool damped = r.contains("damped"), scheduled = r.contains("scheduled");
   double y_max = 0.0;
   for (const json* d : {&r, damped ? &r["damped"] : nullptr})
     if (d && !(*d)["min_b_lim_mm"].is_null()) y_max = std::max(y_max, 6.0 * (*d)["min_b_lim_mm"].get<double>());
-  // One data block per diagram (index 0 open, 1 damped): their speeds differ where the damped method
-  // steps the speed to the loop rate. Full precision: the plotted data is the report's.
-  for (const json* d : {&r, damped ? &r["damped"] : nullptr}) {
+  // One data block per diagram (index 0 open, 1 damped, 2 the speed schedule): their speeds differ where the
+  // damped method steps the speed to the loop rate. Full precision: the plotted data is the report's.
+  for (const json* d : {&r, damped ? &r["damped"] : nullptr, scheduled ? &r["scheduled"] : nullptr}) {
     if (!d) continue;
     for (const auto& p : (*d)["curve"]) {
       char line[96];
@@ -156,8 +169,11 @@ std::string plot_lobes(const json& r, const std::string& path) {
   s << "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop, " << r["method"].get<std::string>() << " (min "
     << fmt(r["min_b_lim_mm"], "%.3f") << " mm)'";
   if (damped)
-    s << ", DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'active damping, " << r["damped"]["method"].get<std::string>()
+    s << ", DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'active damping at a fixed K, " << r["damped"]["method"].get<std::string>()
       << " (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f") << " mm)'";
+  if (scheduled)
+    s << ", DATA index 2 u 1:2 w l lw 2.5 lc rgb '#27ae60' t 'active damping by the speed schedule (min "
+      << fmt(r["scheduled"]["min_b_lim_mm"], "%.3f") << " mm)'";
   s << '\n';
   return run_gnuplot(s.str(), data.str(), path);
 }
@@ -317,8 +333,38 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
                  {"at_spindle_rpm", cfg.cut.spindle_rpm},
                  {"at_spindle_change_pct",
                   finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"], r["damped"]["at_rpm"].back()["b_lim_mm"]))}};
+    // The damping configuration's speed schedule, beside the fixed gain: each speed with its band's controller.
+    if (o.method == "sdm")
+      if (const auto sl = milling::scheduled_lobe_study(sc, cfg, rpms, [](std::size_t done, std::size_t of) {
+            if (done % 40 == 0 || done == of) std::cerr << "[lobes speed schedule] " << done << "/" << of << '\n';
+          })) {
+        json j = lobes_json(sl->study);
+        j["open_b_lim_mm"] = sl->open_mm;
+        j["below_open"] = sl->below_open;
+        j["bands"] = sl->bands;
+        j["config"] = sl->config;
+        r["scheduled"] = j;
+        r["gain"]["scheduled_min_b_lim_change_pct"] = finite_or_null(pct_change(r["min_b_lim_mm"], j["min_b_lim_mm"]));
+        r["gain"]["scheduled_at_spindle_change_pct"] =
+            finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"], j["at_rpm"].back()["b_lim_mm"]));
+      }
   }
   return r;
+}
+
+json cut_verdict_json(const milling::CutVerdict& v) {
+  auto curve = [](const milling::CutCurve& c) {
+    return json{{"min_mm", c.min_mm},           {"min_rpm", c.min_rpm},
+                {"mean_ratio", c.mean_ratio},   {"worse_share", c.worse_share},
+                {"worst_ratio", c.worst_ratio}, {"worst_rpm", c.worst_rpm},
+                {"better_share", c.better_share}, {"at_job_mm", c.at_job_mm},
+                {"limit_mm", c.mm}};
+  };
+  json j = {{"job", v.job}, {"method", v.method}, {"tolerance", v.tolerance}, {"rpm", v.rpm}, {"job_rpm", v.job_rpm},
+            {"open", curve(v.open)}, {"fixed", curve(v.fixed)}, {"fixed_gain_ns_per_m", v.fixed_gain_ns_per_m},
+            {"verdict", milling::cut_verdict_line(v)}};
+  if (v.scheduled) j["scheduled"] = curve(*v.scheduled), j["bands"] = v.bands;
+  return j;
 }
 
 int print_lobes(const json& r, const MillingOptions& o) { return finish(r, o, "lobes", lobes_table(r), plot_lobes); }

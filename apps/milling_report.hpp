@@ -10,6 +10,7 @@
 
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
+#include "milling/cut_verdict.hpp"
 
 namespace robodamp::apps {
 
@@ -43,6 +44,8 @@ void add_milling_options(Registry& r, CLI::App* sub, MillingOptions& o, const st
 [[nodiscard]] nlohmann::json sle_report(const config::MillingConfig& cfg, const MillingOptions& o);
 // The table or JSON on stdout, then the plot: 0, or 1 when the plot failed.
 [[nodiscard]] int print_lobes(const nlohmann::json& r, const MillingOptions& o);
+// What the damper does for a cut (milling/cut_verdict.hpp) as the reports' JSON "cut" block.
+[[nodiscard]] nlohmann::json cut_verdict_json(const milling::CutVerdict& v);
 [[nodiscard]] int print_sle(const nlohmann::json& r, const MillingOptions& o);
 
 }  // namespace robodamp::apps

@@ -15,6 +15,22 @@ std::optional<std::size_t> speed_band_of(const std::vector<SpeedBandConfig>& ban
   return std::nullopt;  // NaN too
 }
 
+double scheduled_gain_ns_per_m(const Config& set_cfg, std::size_t set, double rpm) {
+  const auto& s = set_cfg.controller.speed_schedule;
+  if (!s) return set_cfg.controller.gain_ns_per_m;
+  const auto b = speed_band_of(s->bands, rpm);
+  if (!b) return set_cfg.controller.gain_ns_per_m;
+  const SpeedBandConfig& band = s->bands[*b];
+  return s->controllers.empty() || static_cast<std::size_t>(band.controller) == set ? band.gain_ns_per_m : 0.0;
+}
+
+std::size_t scheduled_set(const Config& set_cfg, std::size_t set, double rpm) {
+  const auto& s = set_cfg.controller.speed_schedule;
+  if (!s || s->controllers.empty()) return set;
+  const auto b = speed_band_of(s->bands, rpm);
+  return b ? static_cast<std::size_t>(s->bands[*b].controller) : 0;
+}
+
 Config with_speed_controller(const Config& cell, const SpeedControllerConfig& c) {
   Config out = cell;
   for (BlockConfig& b : out.controller.chain) {

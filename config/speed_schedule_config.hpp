@@ -52,6 +52,15 @@ struct Config;
 // cell with the controller's compensator, polarity and match frequency.
 [[nodiscard]] Config with_speed_controller(const Config& cell, const SpeedControllerConfig& c);
 
+// The K parameter set `set` of a cell runs at this spindle speed (set_cfg: that set's configuration; the
+// cell's own is set 0, a band's controller i is set i): without a schedule controller.gain_ns_per_m; in a band
+// its K when the band names this set (a schedule of K alone names every set's own), 0 when it names another;
+// outside every band the set's controller.gain_ns_per_m (0 on a band's controller: set 0 runs there).
+[[nodiscard]] double scheduled_gain_ns_per_m(const Config& set_cfg, std::size_t set, double rpm);
+// The set that runs at this speed when `set` (configured by set_cfg) is active: a band's controller, set 0
+// outside every band of a schedule that chooses controllers, `set` itself otherwise.
+[[nodiscard]] std::size_t scheduled_set(const Config& set_cfg, std::size_t set, double rpm);
+
 // The band holding rpm (rpm_min <= rpm < rpm_max; the last band also holds its rpm_max), or none.
 [[nodiscard]] std::optional<std::size_t> speed_band_of(const std::vector<SpeedBandConfig>& bands, double rpm);
 

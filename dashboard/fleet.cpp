@@ -77,7 +77,7 @@ json to_json(const msg::Lobes& l) {
   for (const double v : l.damped_limit_mm()) damped.push_back(finite(v));
   return {{"time_s", l.time_s()}, {"parameter_set", l.parameter_set()}, {"gain_ns_per_m", l.gain_ns_per_m()},
           {"method", l.method()}, {"depth_mm", l.depth_mm()}, {"rpm", l.rpm()}, {"open_limit_mm", open},
-          {"damped_limit_mm", damped}};
+          {"damped_limit_mm", damped}, {"speed_scheduled", l.speed_scheduled()}};
 }
 
 }  // namespace

@@ -274,6 +274,7 @@ void Bridge::publish_lobes() {
   out.rpm(first(l->rpm));
   out.open_limit_mm(first(l->open_limit_mm));
   out.damped_limit_mm(first(l->damped_limit_mm));
+  out.speed_scheduled(l->speed_scheduled);
   if (lobes_writer_->write(&out)) ++n_lobes_;
 }
 

@@ -93,6 +93,7 @@ struct LobesSample {
   std::string method;
   double depth_mm{0.0};
   std::vector<double> rpm, open_limit_mm, damped_limit_mm;  // by speed, at most 256
+  bool speed_scheduled{false};  // each speed with its band's controller and K (parameter_set, gain not one)
 };
 
 struct BridgeSources {

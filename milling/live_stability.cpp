@@ -95,6 +95,22 @@ std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per
   return out;
 }
 
+void LiveStability::sweep(const std::vector<SweepPoint>& points) {
+  std::lock_guard<std::mutex> lock(m_);
+  sweep_.clear();
+  for (const SweepPoint& p : points)
+    if (p.rpm > 0.0) sweep_.push_back(key(p.rpm, p.set, p.gain_ns_per_m));
+  cv_.notify_all();
+}
+
+std::vector<LiveLimits> LiveStability::known(const std::vector<SweepPoint>& points) const {
+  std::vector<LiveLimits> out;
+  std::lock_guard<std::mutex> lock(m_);
+  for (const SweepPoint& p : points)
+    if (const auto it = cache_.find(key(p.rpm, p.set, p.gain_ns_per_m)); p.rpm > 0.0 && it != cache_.end()) out.push_back(it->second);
+  return out;
+}
+
 std::uint64_t LiveStability::computations() const {
   std::lock_guard<std::mutex> lock(m_);
   return computations_;
@@ -176,6 +192,12 @@ LiveLimits LiveStability::evaluate(const Key& k) const {
   out.open_chatter_hz = o.chatter_hz;
   out.open_method = "SDM";
   out.analysed_rpm = out.rpm;
+  if (gain <= 0.0) {  // K 0 (a speed schedule's open-loop band): the damper commands nothing, the cut sees the open loop
+    out.damped_mm = out.open_mm;
+    out.damped_chatter_hz = out.open_chatter_hz;
+    out.method = "SDM (K = 0: the open loop)";
+    return out;
+  }
   try {
     const Structure damped(structure_, true,
                            {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});

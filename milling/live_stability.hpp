@@ -65,6 +65,15 @@ class LiveStability {
   void sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm);
   // Any thread: every limit computed so far for (set, gain), by speed.
   [[nodiscard]] std::vector<LiveLimits> known(std::size_t set, double gain_ns_per_m) const;
+  // The same for a speed schedule (controller.speed_schedule): each speed with the set and K it runs there.
+  struct SweepPoint {
+    double rpm{0.0};
+    std::size_t set{0};
+    double gain_ns_per_m{0.0};
+  };
+  void sweep(const std::vector<SweepPoint>& points);
+  // Any thread: the limits computed so far of these points, in their order.
+  [[nodiscard]] std::vector<LiveLimits> known(const std::vector<SweepPoint>& points) const;
 
   [[nodiscard]] double depth_mm() const { return job_.cut.axial_mm; }
   [[nodiscard]] const config::MillingConfig& job() const { return job_; }

@@ -102,7 +102,8 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
       a.reason = "cancelled after " + std::to_string(a.evaluated) + " speeds";
       return a;
     }
-    const LiveLimits l = stability.compute(c.rpm, request.set, request.gain_ns_per_m);
+    const auto [set, gain] = request.controller_at ? request.controller_at(c.rpm) : std::pair{request.set, request.gain_ns_per_m};
+    const LiveLimits l = stability.compute(c.rpm, set, gain);
     ++a.evaluated;
     if (request.damped && !l.damped_valid) continue;  // the loop itself unstable there
     const double limit = limit_of(l);

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "milling/live_stability.hpp"
@@ -33,6 +34,9 @@ struct SpeedAdviceRequest {
   double depth_mm{0.0};         // the job's axial depth
   std::size_t set{0};           // the active parameter set and its gain: the damped limit's loop
   double gain_ns_per_m{0.0};
+  // A speed schedule (controller.speed_schedule): the set and K the cell runs at a speed, so that each
+  // candidate is judged with the controller it would get there. Empty: set and gain at every speed.
+  std::function<std::pair<std::size_t, double>(double rpm)> controller_at{};
   bool damped{true};            // the damper active: the damped limits apply, else the open ones
   double chatter_hz{0.0};       // measured (the chatter indicator's strongest line); 0: none measured
   std::string trigger;          // "chatter", or "depth above the limit"

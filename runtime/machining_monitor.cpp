@@ -33,7 +33,7 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
                                    std::function<double()> robot_depth_mm)
     : teeth_(cfg.spindle.teeth), active_set_(std::move(active_set)), robot_depth_mm_(std::move(robot_depth_mm)),
       chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
-  for (const auto& s : sets) set_gains_.push_back(s.controller.gain_ns_per_m);
+  set_configs_ = sets;
   config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
   if (job.tool.teeth != cfg.spindle.teeth)
     throw config::ConfigError({config::Problem{cfg.source, {}, "spindle.teeth",
@@ -63,11 +63,12 @@ dds::MachiningSample MachiningMonitor::sample() { return view().sample; }
 
 std::pair<std::size_t, double> MachiningMonitor::set_and_gain() {
   std::size_t set = active_set_ ? active_set_() : 0;
-  if (set >= set_gains_.size()) set = 0;
+  if (set >= set_configs_.size()) set = 0;
   std::lock_guard<std::mutex> lock(m_);
-  // The damper's limit at the gain it has (ramping included), or, while it is off, at the set's gain.
+  // The damper's limit at the gain it has (ramping included, 0 included: a speed schedule's open-loop band), or,
+  // while it is off, at the set's gain at this speed (controller.speed_schedule).
   const bool active = static_cast<rt::State>(last_.state) == rt::State::kActive;
-  return {set, active && last_.gain_ns_per_m > 0.0 ? last_.gain_ns_per_m : set_gains_[set]};
+  return {set, active ? last_.gain_ns_per_m : config::scheduled_gain_ns_per_m(set_configs_[set], set, rpm_)};
 }
 
 AdviceView MachiningMonitor::view() {
@@ -101,11 +102,54 @@ AdviceView MachiningMonitor::view() {
     }
   v.parameter_set = set;
   v.gain_ns_per_m = gain;
+  if (set_configs_[set].controller.speed_schedule)  // the set and K the schedule runs at each candidate speed
+    v.controller_at = [sets = &set_configs_, set = set](double rpm) {
+      std::size_t at = config::scheduled_set((*sets)[set], set, rpm);
+      if (at >= sets->size()) at = 0;
+      return std::pair{at, config::scheduled_gain_ns_per_m((*sets)[at], at, rpm)};
+    };
   return v;
+}
+
+// A speed schedule's envelope: each lobe speed with the set and K the schedule runs there (independent of what
+// runs now, so swept once).
+std::optional<dds::LobesSample> MachiningMonitor::scheduled_lobes(std::size_t active) {
+  std::vector<milling::LiveStability::SweepPoint> points;
+  for (const double rpm : lobe_rpm_) {
+    std::size_t at = config::scheduled_set(set_configs_[active], active, rpm);
+    if (at >= set_configs_.size()) at = 0;
+    points.push_back({rpm, at, config::scheduled_gain_ns_per_m(set_configs_[at], at, rpm)});
+  }
+  if (!lobes_swept_) stability_->sweep(points), lobes_swept_ = true;
+  const std::vector<milling::LiveLimits> known = stability_->known(points);
+  if (known.size() == lobes_published_) return std::nullopt;
+  lobes_published_ = known.size();
+  dds::LobesSample out;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    out.time_s = last_.time_s;
+  }
+  out.speed_scheduled = true;
+  out.depth_mm = stability_->depth_mm();
+  for (const auto& l : known) {
+    out.rpm.push_back(l.rpm);
+    out.open_limit_mm.push_back(l.open_mm);
+    out.damped_limit_mm.push_back(l.damped_mm);
+  }
+  out.method = "sampled-loop SDM, speed schedule";
+  return out;
 }
 
 std::optional<dds::LobesSample> MachiningMonitor::lobes() {
   const auto [set, gain] = set_and_gain();
+  if (set_configs_[set].controller.speed_schedule) {
+    // The envelope depends on the schedule, not on the K passing now (a schedule of K alone: on the set).
+    const bool chooses = !set_configs_[set].controller.speed_schedule->controllers.empty();
+    const std::size_t owner = chooses ? 0 : set;
+    if (!lobes_scheduled_ || owner != lobes_set_) lobes_scheduled_ = true, lobes_set_ = owner, lobes_swept_ = false, lobes_published_ = 0;
+    return scheduled_lobes(owner);
+  }
+  lobes_scheduled_ = false;
   if (set != lobes_set_ || gain != lobes_gain_) {  // a new state, or a ramp: wait for it to hold
     lobes_set_ = set, lobes_gain_ = gain;
     lobes_swept_ = false, lobes_published_ = 0;

@@ -46,10 +46,11 @@ class MachiningMonitor {
   [[nodiscard]] std::optional<AdviceRecord> advice() const { return advisor_->latest(); }
 
  private:
+  [[nodiscard]] std::optional<dds::LobesSample> scheduled_lobes(std::size_t active);
   [[nodiscard]] AdviceView view();
   [[nodiscard]] std::pair<std::size_t, double> set_and_gain();  // the active set and the gain its limits are for
   int teeth_;
-  std::vector<double> set_gains_;
+  std::vector<config::Config> set_configs_;  // every parameter set's configuration (their K by speed)
   std::function<std::size_t()> active_set_;
   std::function<double()> robot_depth_mm_;
   std::unique_ptr<milling::LiveStability> stability_;
@@ -61,6 +62,7 @@ class MachiningMonitor {
   std::size_t lobes_set_{0};       // the status thread's
   double lobes_gain_{-1.0};
   bool lobes_swept_{false};
+  bool lobes_scheduled_{false};    // the last lobes were a speed schedule's envelope
   std::size_t lobes_published_{0};
   std::unique_ptr<SpeedAdvisor> advisor_;  // last: its thread reads the members above
 };

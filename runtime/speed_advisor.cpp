@@ -88,6 +88,7 @@ std::optional<milling::SpeedAdviceRequest> SpeedAdvisor::wanted(const AdviceView
   r.depth_mm = m.depth_mm;
   r.set = v.parameter_set;
   r.gain_ns_per_m = v.gain_ns_per_m;
+  r.controller_at = v.controller_at;
   r.damped = m.loop_active;
   return r;
 }

@@ -31,6 +31,7 @@ struct AdviceView {
   dds::MachiningSample sample;
   std::size_t parameter_set{0};
   double gain_ns_per_m{0.0};   // the gain the damped limit is for
+  std::function<std::pair<std::size_t, double>(double rpm)> controller_at{};  // a speed schedule's (empty: none)
 };
 
 // The record as the DDS advice topic carries it.

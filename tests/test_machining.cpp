@@ -310,7 +310,10 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_EQ(m.depth_mm, depth);
     ASSERT_TRUE(m.limits_ready);
     EXPECT_NEAR(m.open_limit_mm, 1.111, 0.002);   // SDM
-    EXPECT_NEAR(m.damped_limit_mm, 0.782, 0.002);  // the sampled loop's SDM
+    // The sampled loop's SDM with the preset's speed schedule at 700 rpm: C1 at K 3040 (the header's 2.350 mm;
+    // C2 at the fixed K 2000 gave 0.782 mm, below the open loop).
+    EXPECT_NEAR(m.damped_limit_mm, 2.350, 0.002);
+    EXPECT_EQ(cell.supervisor().active_parameter_set(), 1U) << "the band's controller";
     EXPECT_EQ(m.limit_method, "sampled-loop SDM");
     EXPECT_FALSE(m.loop_active) << "the run has ended: the damper is off";
     EXPECT_EQ(m.limit_mm, m.open_limit_mm);
@@ -319,7 +322,8 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_FALSE(m.chatter) << "no cut in the simulated plant";
     // While the damper is active the damped limit applies: 1.5 mm is above it.
     milling::LiveStability& live = cell.machining()->stability();
-    EXPECT_EQ(live.compute(700.0, 0, cfg.controller.gain_ns_per_m).damped_mm, m.damped_limit_mm);
+    EXPECT_EQ(live.compute(700.0, 1, config::scheduled_gain_ns_per_m(config::speed_controller_config(cfg, 1), 1, 700.0)).damped_mm,
+              m.damped_limit_mm);
   }
 }
 

@@ -340,7 +340,9 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   unstable.controller.gain_ns_per_m = 3000.0;
   CellOptions o = virtual_clock();
   o.record_path = ::testing::TempDir() + "/select_params.rec";
-  Cell session(c2(), o);
+  auto cfg = c2();
+  cfg.controller.speed_schedule.reset();  // sets an operator selects (the spindle chooses a scheduled cell's)
+  Cell session(cfg, o);
   test::configure(session);
   const std::size_t c3 = session.add_parameter_set(config::load_config_file(test::preset("horizontal_c3")));
   const std::size_t bad = session.add_parameter_set(unstable);

@@ -3,6 +3,7 @@
 // refusals, the controller and the supervisor following the spindle, a recording that replays, the synthesis
 // on an arm no preset describes, and the default preset's schedule in time with the real supervisor.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "config/milling_config.hpp"
 #include "control/controller.hpp"
 #include "milling/accurate_stability.hpp"
+#include "milling/scheduled_lobes.hpp"
 #include "milling/structure.hpp"
 #include "rt/recording.hpp"
 #include "rt/supervisor.hpp"
@@ -197,6 +199,115 @@ TEST(SpeedScheduleCell, ABandAboveItsControllersLimitIsRefusedAtConfigurationWit
   EXPECT_NE(st.message.find("controller.speed_schedule.bands[0].gain_ns_per_m"), std::string::npos) << st.message;
   EXPECT_NE(st.message.find("4500"), std::string::npos) << st.message;
   EXPECT_NE(st.message.find("maximum stable K 4804.8 N s/m"), std::string::npos) << st.message;
+}
+
+}  // namespace
+}  // namespace robodamp
+
+namespace robodamp {
+namespace {
+
+// An arm of our own: the C2 preset's robot with its modes moved (9.2 -> 12.4 Hz and so on), damping changed,
+// and a job on it; the schedule's controllers are its own C2 and the C1 chain.
+struct OwnArm {
+  std::string dir, config, job;
+};
+
+OwnArm own_arm() {
+  OwnArm a;
+  a.dir = ::testing::TempDir() + "robodamp_schedule_arm_" + std::to_string(::getpid());
+  std::filesystem::create_directories(a.dir);
+  std::string text = test::read_file(test::preset("horizontal_c2"));
+  text.erase(text.find("  speed_schedule:"), text.find("\nrobot:") - text.find("  speed_schedule:"));
+  test::replace_or_throw(text, "natural_freq_hz: 9.2,", "natural_freq_hz: 12.4,");
+  test::replace_or_throw(text, "natural_freq_hz: 21.0,", "natural_freq_hz: 26.0,");
+  test::replace_or_throw(text, "natural_freq_hz: 23.5,", "natural_freq_hz: 33.0,");
+  test::replace_or_throw(text, "damping_ratio: 0.020,", "damping_ratio: 0.030,");
+  a.config = a.dir + "/arm.yaml";
+  std::ofstream(a.config) << text;
+  std::string job = test::read_file(source("config/milling/active_damping_c2.yaml"));
+  test::replace_or_throw(job, "../presets/horizontal_c2.yaml", a.config);
+  test::replace_or_throw(job, "rpm_max: 1500\n  points: 2000", "rpm_max: 1800\n  points: 2000");
+  a.job = a.dir + "/job.yaml";
+  std::ofstream(a.job) << job;
+  return a;
+}
+
+TEST(SpeedSchedule, OnAnArmOfOurOwnTheScheduleIsNeverWorseThanTheOpenLoopAndKeepsEveryMargin) {
+  const OwnArm a = own_arm();
+  const config::Config cell = config::load_config_file(a.config);
+  const config::MillingConfig job = config::load_milling_config(a.job);
+  tune::ScheduleSettings s;
+  s.speeds = 40;
+  s.gains_per_controller = 3;
+  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, {test::preset("horizontal_c1")}, job, job.selected_structure(), s);
+  const tune::ScheduleSummary& m = sched.summary;
+  ASSERT_GE(m.speeds, 40U);
+  EXPECT_GT(m.speeds, m.grid_speeds) << "checked between the grid speeds too";
+  // As configured (C2 at a fixed K 2000) the damper lowers the limit at some speeds; the schedule nowhere.
+  EXPECT_GT(m.fixed_worse_share, 0.1);
+  EXPECT_EQ(m.scheduled_worse_share, 0.0);
+  for (const auto& p : sched.speeds) EXPECT_GE(p.scheduled_mm, 0.995 * p.open_mm) << p.rpm << " rpm";
+  EXPECT_GE(m.scheduled_min_mm, m.fixed_min_mm);
+  EXPECT_GT(m.scheduled_mean_ratio, m.fixed_mean_ratio);
+  EXPECT_GT(m.scheduled_better_share, 0.5);
+  // Every band's K keeps the margins asked for on its own controller's loop.
+  for (const auto& b : sched.bands) {
+    if (b.gain_ns_per_m == 0.0) continue;
+    const auto& c = sched.controllers.at(static_cast<std::size_t>(b.controller));
+    const analysis::Margins mg = analysis::margins(*c.model, b.gain_ns_per_m, c.polarity, c.k_max_ns_per_m);
+    ASSERT_TRUE(c.model->stable(b.gain_ns_per_m, c.polarity));
+    if (mg.gain_margin_db) EXPECT_GE(*mg.gain_margin_db, s.gain_margin_min_db - 1e-6) << b.rpm_min;
+    if (mg.phase_margin_deg) EXPECT_GE(*mg.phase_margin_deg, s.phase_margin_min_deg - 1e-6) << b.rpm_min;
+    EXPECT_LE(b.gain_ns_per_m, c.top_gain_ns_per_m);
+  }
+  // Written into the arm's file: it parses, carries exactly these bands, and a cell configures with it.
+  const std::string text = tune::scheduled_config_text(cell, sched).text;
+  const config::Config written = config::parse_config(text, a.config);
+  ASSERT_TRUE(written.controller.speed_schedule);
+  ASSERT_EQ(written.controller.speed_schedule->bands.size(), sched.bands.size());
+  for (std::size_t i = 0; i < sched.bands.size(); ++i) {
+    EXPECT_EQ(written.controller.speed_schedule->bands[i].rpm_min, sched.bands[i].rpm_min);
+    EXPECT_EQ(written.controller.speed_schedule->bands[i].gain_ns_per_m, sched.bands[i].gain_ns_per_m);
+    EXPECT_EQ(written.controller.speed_schedule->bands[i].controller, sched.bands[i].controller);
+  }
+  runtime::Cell configured(written, runtime::CellOptions{});
+  EXPECT_TRUE(configured.configure().ok());
+  std::filesystem::remove_all(a.dir);
+}
+
+// The default preset's schedule in time: the real supervisor and controller follow the spindle through bands
+// of both controllers and of K = 0 while cutting at 0.95 x the scheduled limit at each speed (the sampled loop's
+// SDM with each band's controller); every cut is stable and no switch drives the actuator to a limit. A cut at
+// 1.1 x the limit chatters (the check can fail).
+TEST(ScheduledCut, TheRealSupervisorFollowsTheSpindleAndEveryCutAtNinetyFivePercentOfTheScheduledLimitIsStable) {
+  const config::Config cell = config::load_config_file(test::preset("horizontal_c2"));
+  const config::MillingConfig job = config::load_milling_config(source("config/milling/active_damping_c2.yaml"));
+  // A ramp through the range: C1 at 3040, C2 at 2400, C1, K = 0 (the open loop), C2 at 2400, K = 0.
+  const std::vector<double> rpm{130.0, 230.0, 600.0, 1050.0, 1200.0, 1420.0};
+  const auto limits = milling::scheduled_lobe_study(job.selected_structure(), job, rpm);
+  ASSERT_TRUE(limits);
+  std::vector<tune::ScheduledCutStep> steps;
+  for (const auto& a : limits->study.at_rpm) steps.push_back({a.rpm, 0.95 * a.b_lim_mm});
+  const tune::ScheduledCut cut = tune::scheduled_cut(cell, job, steps, 40);
+  ASSERT_EQ(cut.segments.size(), rpm.size());
+  const std::vector<std::size_t> sets{1, 0, 1, 1, 0, 0};  // the bands' controllers (K = 0 keeps the one before)
+  const std::vector<double> gains{3040.0, 2400.0, 3040.0, 0.0, 2400.0, 0.0};
+  for (std::size_t i = 0; i < cut.segments.size(); ++i) {
+    const auto& s = cut.segments[i];
+    EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm << " mm: " << milling::to_string(s.verdict.classification);
+    EXPECT_EQ(s.set, sets[i]) << s.rpm << " rpm";
+    EXPECT_DOUBLE_EQ(s.gain_ns_per_m, gains[i]) << s.rpm << " rpm";
+    EXPECT_EQ(s.limited_ticks, 0U) << s.rpm << " rpm";
+    EXPECT_LT(s.peak_force_command_n, cut.force_limit_n) << s.rpm << " rpm";
+    EXPECT_EQ(s.trip, "none") << s.rpm << " rpm";
+    EXPECT_EQ(s.state, "active") << s.rpm << " rpm";
+  }
+  EXPECT_TRUE(cut.all_stable());
+  EXPECT_TRUE(cut.within_limits());
+  EXPECT_EQ(cut.handovers, 4U);  // to C1, to C2, to C1, and to C2 at 1200 rpm (the K = 0 bands keep the set before)
+  const tune::ScheduledCut over = tune::scheduled_cut(cell, job, {{600.0, 1.10 * limits->study.at_rpm[2].b_lim_mm}}, 40);
+  EXPECT_FALSE(over.segments.front().verdict.stable) << "1.1 x the scheduled limit at 600 rpm";
 }
 
 }  // namespace

@@ -298,18 +298,21 @@ function plotLobes(l, m, a) {
   const options = a && a.found ? a.options : [];
   options.forEach((o) => rows.push([o.rpm, null, null, null, null, a.depth_mm]));
   rows.sort((x, y) => x[0] - y[0]);
-  draw('plot-lobes', ['rpm', 'open loop', 'damped', 'job depth', 'cutting now', 'advised'], rows, {
+  draw('plot-lobes', ['rpm', 'open loop', l.speed_scheduled ? 'damped (schedule)' : 'damped', 'job depth', 'cutting now', 'advised'], rows, {
     xlabel: 'spindle speed (rpm)', ylabel: 'limiting depth (mm)', connectSeparatedPoints: true,
     valueRange: [0, Math.max(3, 6 * l.depth_mm)],  // the lobes near the job's depth (zoom with the mouse)
     colors: ['#7a8494', '#2e9e4f', '#1d2430', '#d0342c', '#e67c00'],
     series: { 'job depth': { strokePattern: [6, 4] }, 'cutting now': { strokeWidth: 0, drawPoints: true, pointSize: 6 },
               advised: { strokeWidth: 0, drawPoints: true, pointSize: 5 } },
   });
-  $('lobes-note').textContent = l.method + ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m, ' + l.rpm.length + ' speeds';
+  $('lobes-note').textContent = l.method + (l.speed_scheduled ? ' (each speed with its band\'s controller and K; K = 0 where the damper is worse than none)'
+    : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds';
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
     (a.found ? 'go to ' + fmt(a.advised_rpm, 1) + ' rpm, limit ' + fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')' : esc(a.reason)) +
     ' – ' + esc(a.method)) : 'no advice asked for';
-  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, advised: options.length };
+  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, advised: options.length,
+    scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
+      l.damped_limit_mm[i] < 0.995 * l.open_limit_mm[i]).length };
   window.robodamp.updates.lobes++;
 }
 

@@ -81,10 +81,11 @@ class Fleet:
         self.cells = {"a": "brw-a-" + suffix, "b": "brw-b-" + suffix}
         with open(os.path.join(SOURCE, "config/presets/horizontal_c2.yaml")) as f:
             preset = f.read()
-        # Cell A cuts 1.0 mm at 700 rpm, above its damped limit there (0.78 mm): a depth warning and an advice.
+        # Cell A cuts 2.5 mm at 700 rpm, above the limit its speed schedule gives there (C1 at K 3040: 2.35 mm):
+        # a depth warning and an advice.
         with open(os.path.join(SOURCE, "config/milling/active_damping_c2.yaml")) as f:
             job_text = f.read().replace("../presets/", os.path.join(SOURCE, "config/presets") + "/")
-        jobs = {"a": job_text.replace("axial_mm: 0.5 ", "axial_mm: 1.0 "), "b": job_text}
+        jobs = {"a": job_text.replace("axial_mm: 0.5 ", "axial_mm: 2.5 "), "b": job_text}
         for key, name in self.cells.items():
             job = os.path.join(self.dir, f"job_{key}.yaml")
             with open(job, "w") as f:
@@ -204,7 +205,7 @@ class DashboardInABrowser(unittest.TestCase):
         for key, rpm in (("a", "700 rpm"), ("b", "600 rpm")):
             until(lambda: (self.tile(key) or {}).get("state") == "active", 90, f"cell {key} active")
             until(lambda: rpm in self.tile(key)["text"], 60, f"cell {key} at {rpm}")
-        until(lambda: "1.00 mm of 0.78 mm" in self.tile("a")["text"], 60, "cell a's depth against its damped limit")
+        until(lambda: "2.50 mm of 2.35 mm" in self.tile("a")["text"], 90, "cell a's depth against its scheduled damped limit")
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
 
         self.open_cell("a")
@@ -221,6 +222,11 @@ class DashboardInABrowser(unittest.TestCase):
         lobes = until(lambda: (lambda l: l if l and l["speeds"] >= 20 else None)(self.js("return window.robodamp.plotted.lobes")),
                       120, "20 speeds of live lobes")
         self.assertEqual(lobes["operating_rpm"], 700)
+        # The preset's speed schedule: the live lobes are its envelope (each speed its band's controller and K),
+        # never below the open loop (0.5 % for the cell's cache of speed and K).
+        self.assertTrue(lobes["scheduled"])
+        self.assertEqual(lobes["damped_below_open"], 0)
+        self.assertIn("speed schedule", self.browser.find_element(By.ID, "lobes-note").text)
         # The depth above the limit asked for an advice: the advised speeds on the lobes, the advice in words.
         until(lambda: self.js("return window.robodamp.plotted.lobes.advised") >= 1, 120, "the advised speeds on the lobes")
         self.assertIn("go to", self.browser.find_element(By.ID, "advice").text)
@@ -293,7 +299,7 @@ class DashboardInABrowser(unittest.TestCase):
         cell = self.fleet.cells["b"]
         status = until(lambda: (lambda s: s if s.get("state") == "active" else None)(
             http(self.fleet.port, f"/api/cells/{cell}")[1]["status"]), 60, "cell b active")
-        self.assertEqual(status["parameter_sets"], 1)
+        self.assertEqual(status["parameter_sets"], 2)  # the preset's own C2 and its speed schedule's C1
         self.assertEqual(status["spindle_rpm_max"], 30000)  # spindle.rpm_max's default
         self.open_cell("b")
         self.login("alice", "alice-operator-1")
@@ -303,7 +309,7 @@ class DashboardInABrowser(unittest.TestCase):
             "gain": [("", "is empty"), ("   ", "is empty"), ("1,5", "decimal mark"), ("1.500,5", "decimal mark"),
                      ("abc", "not a number"), ("0x10", "not a number"), ("1e400", "too large"), ("-5", "negative"),
                      ("99999999", "above the cell's gain limit")],
-            "set": [("", "is empty"), ("0.5", "not a whole number"), ("-1", "negative"), ("1", "above the last configured set"),
+            "set": [("", "is empty"), ("0.5", "not a whole number"), ("-1", "negative"), ("2", "above the last configured set"),
                     ("1,0", "decimal mark")],
             "spindle": [("", "is empty"), ("  ", "is empty"), ("650,5", "decimal mark"), ("200000", "above the spindle's"),
                         ("-700", "negative"), ("1e999", "too large"), ("seven hundred", "not a number")],
@@ -315,8 +321,26 @@ class DashboardInABrowser(unittest.TestCase):
                 self.assertIn("nothing was sent", said, f"{action} {text!r}")
                 self.assertEqual((kind, confirming), ("bad", False), f"{action} {text!r}")
         self.assertEqual(self.sent(), before, "a hostile value reached the dashboard's server or the cell")
+        # At 600 rpm the speed schedule sets K: a gain request, confirmed, is refused by the cell with the reason.
+        said, _, confirming = self.type_and_press("gain", "1000")
+        self.assertTrue(confirming)
+        self.browser.find_element(By.ID, "confirm-yes").click()
+        refused = until(lambda: (lambda t: t if "refused by the cell" in t else None)(self.browser.find_element(By.ID, "message").text),
+                        30, "the cell's refusal")
+        self.assertIn("at 600 rpm the spindle speed sets K (controller.speed_schedule", refused)
+        # The spindle stopped (asked, confirmed): outside every band the cell's own set runs at its configured K.
+        said, _, confirming = self.type_and_press("spindle", "0")
+        self.assertTrue(confirming)
+        self.assertIn("spindle 600 → 0 rpm", self.browser.find_element(By.ID, "confirm-text").text)
+        self.browser.find_element(By.ID, "confirm-yes").click()
+        until(lambda: "accepted" in self.browser.find_element(By.ID, "message").text, 30, "the spindle stopped")
+        status = until(lambda: (lambda s: s if s["parameter_set"] == 0 and abs(s["gain_ns_per_m"] - 2000.0) < 1e-6 else None)(
+            http(self.fleet.port, f"/api/cells/{cell}")[1]["status"]), 60, "cell b back on its own set at K 2000")
+        until(lambda: "gain K / limit" in self.browser.find_element(By.ID, "counters").text and
+              "2000 /" in self.browser.find_element(By.ID, "counters").text, 30, "the page at K 2000")
         # A gain below the one running reduces the damping: said, and sent only on confirmation.
         k_now = status["gain_ns_per_m"]
+        before = self.sent()
         lower = round(k_now / 4)
         said, _, confirming = self.type_and_press("gain", f"{lower}")
         self.assertTrue(confirming)

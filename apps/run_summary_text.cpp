@@ -1,0 +1,333 @@
+#include "apps/run_summary_text.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "apps/advice_view.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+// The hardware devices' counters (CAN, Modbus, DDS), a line each.
+[[nodiscard]] std::string devices_text(const runtime::RunSummary& s) {
+  std::ostringstream os;
+  char b[512];
+  if (s.can) {
+    const auto& c = *s.can;
+    std::snprintf(b, sizeof b,
+                  "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
+                  "%llu bus-off, %llu held over / %llu skipped (de-jitter; %llu resyncs backed off), %llu reconnects; %llu commands sent (%llu queue full, "
+                  "%llu errors, %llu skipped)\n",
+                  static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
+                  static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
+                  static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
+                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
+                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.resync_backoffs),
+                  static_cast<unsigned long long>(c.reconnects),
+                  static_cast<unsigned long long>(c.tx_frames),
+                  static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
+                  static_cast<unsigned long long>(c.tx_skipped));
+    os << b;
+  }
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    std::snprintf(b, sizeof b,
+                  "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
+                  "%llu link faults, %llu mounting changes, %llu pose changes (%llu polls out of the map, %llu not available, "
+                  "%llu link losses), %llu speed advices written\n",
+                  static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
+                  static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
+                  static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
+                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes),
+                  static_cast<unsigned long long>(m.pose_changes), static_cast<unsigned long long>(m.pose_out_of_map_polls),
+                  static_cast<unsigned long long>(m.pose_unavailable_polls), static_cast<unsigned long long>(m.pose_link_losses),
+                  static_cast<unsigned long long>(m.advice_writes));
+    os << b;
+  }
+  if (s.dds) {
+    std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
+                  static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
+                  static_cast<unsigned long long>(s.dds->requests), static_cast<unsigned long long>(s.dds->refused));
+    os << b;
+  }
+  return os.str();
+}
+
+}  // namespace
+
+// long: one entry per field of the run summary (the documented JSON shape)
+nlohmann::json summary_json(const runtime::RunSummary& s) {
+  using nlohmann::json;
+  auto hist = [](const rt::TimingHistogram& h) {
+    return json{{"count", h.count()},           {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
+                {"p999_us", h.percentile_us(0.999)}, {"max_us", h.max_us()},       {"mean_us", h.mean_us()}};
+  };
+  json trips = json::object();
+  for (std::size_t i = 1; i < rt::kTripCount; ++i)
+    trips[rt::to_string(static_cast<rt::Trip>(i))] = s.supervisor.trips[i];
+  const auto ticks = static_cast<double>(std::max<std::uint64_t>(1, s.loop.ticks_run + s.loop.missed_ticks));
+  json j = {{"config", s.config},
+          {"clock", s.clock},
+          {"rate_hz", s.rate_hz},
+          {"duration_s", s.duration_s},
+          {"elapsed_s", s.loop.elapsed_s},
+          {"final_state", s.final_state},
+          {"trip", s.trip},
+          {"trip_description", s.trip_description},
+          {"analysis_stable", s.analysis_stable},
+          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
+          {"ticks_run", s.loop.ticks_run},
+          {"missed_ticks", s.loop.missed_ticks},
+          {"overruns", s.loop.overruns},
+          {"overrun_pct", 100.0 * static_cast<double>(s.loop.overruns) / ticks},
+          {"wake_latency", hist(s.loop.wake_latency)},
+          {"compute", hist(s.loop.compute)},
+          {"telemetry", {{"frames", s.telemetry_frames}, {"ring_drops", s.loop.ring_drops}, {"ring_waits", s.loop.ring_waits}}},
+          {"recording", {{"path", s.record_path}, {"frames", s.recorded_frames}, {"write_errors", s.record_errors}}},
+          {"supervisor",
+           {{"trips", trips},
+            {"stale_ticks", s.supervisor.stale_ticks},
+            {"invalid_samples", s.supervisor.invalid_samples},
+            {"saturated_ticks", s.supervisor.saturated_ticks},
+            {"arm_refused", s.supervisor.arm_refused},
+            {"gain_refused", s.supervisor.gain_refused},
+            {"params_selected", s.supervisor.params_selected},
+            {"params_refused", s.supervisor.params_refused},
+            {"speed_handovers", s.supervisor.speed_handovers},
+            {"speed_handovers_refused", s.supervisor.speed_handovers_refused},
+            {"spindle_refused", s.supervisor.spindle_refused},
+            {"pose_regions", s.supervisor.pose_regions},
+            {"pose_out_of_map", s.supervisor.pose_out_of_map},
+            {"active_parameter_set", s.active_parameter_set},
+            {"recoveries", s.supervisor.recoveries},
+            {"overrun_runs_ridden", s.supervisor.overrun_runs_ridden},
+            {"sensor_holds", s.supervisor.sensor_holds},
+            {"sensor_hold_ticks", s.supervisor.sensor_hold_ticks},
+            {"longest_sensor_hold_ticks", s.supervisor.longest_sensor_hold_ticks},
+            {"budget_latches", s.supervisor.budget_latches},
+            {"probation_latches", s.supervisor.probation_latches}}},
+          {"realtime",
+           {{"memory_locked", s.realtime.memory_locked},
+            {"sched_fifo", s.realtime.fifo},
+            {"priority", s.realtime.priority},
+            {"affinity", s.realtime.affinity},
+            {"timer_slack_1ns", s.realtime.timer_slack},
+            {"cpu_dma_latency_held", s.realtime.dma_latency_held},
+            {"warnings", s.realtime.warnings}}},
+          {"sensor_rms_mps2", s.sensor_rms_mps2},
+          {"peak_command_v", s.peak_command_v},
+          {"spindle", {{"rpm", s.spindle_rpm}, {"notch_centre_hz", s.notch_centre_hz}}},
+          {"gain_ns_per_m", s.gain_ns_per_m}};
+  if (s.speed_bands > 0)
+    j["speed_schedule"] = {{"bands", s.speed_bands}, {"band", s.speed_band ? json(*s.speed_band) : json(nullptr)},
+                           {"handovers", s.supervisor.speed_handovers},
+                           {"handovers_refused", s.supervisor.speed_handovers_refused}};
+  j["backend"] = s.backend;
+  j["events"] = json::array();
+  for (const auto& e : s.events)
+    j["events"].push_back({{"time_s", e.time_s}, {"event", rt::to_string(e.kind)}, {"trip", rt::to_string(e.trip)}});
+  j["events_total"] = s.events_total;
+  j["arming"] = {{"enabled", s.arming.enabled},
+                 {"outcome", runtime::to_string(s.arming.outcome)},
+                 {"attempts", s.arming.attempts},
+                 {"last_refusal", rt::to_string(s.arming.last_refusal)},
+                 {"deadline_s", s.arming.deadline_s}};
+  auto t = [](double v) { return v >= 0.0 ? json(v) : json(nullptr); };
+  j["trip_timing"] = {{"last_fresh_s", t(s.trip_timing.last_fresh_s)},
+                      {"trip_s", t(s.trip_timing.trip_s)},
+                      {"safe_s", t(s.trip_timing.safe_s)},
+                      {"ticks_to_safe", s.trip_timing.ticks_to_safe >= 0 ? json(s.trip_timing.ticks_to_safe) : json(nullptr)}};
+  {
+    const auto& a = s.availability;
+    json trip_list = json::array();
+    for (const auto& tr : a.trips)
+      trip_list.push_back({{"trip", tr.trip}, {"trip_s", tr.trip_s}, {"safe_s", t(tr.safe_s)},
+                       {"rearmed_s", t(tr.rearmed_s)}, {"full_gain_again_s", t(tr.full_gain_again_s)},
+                       {"safe_after_s", tr.safe_s >= 0.0 ? json(tr.safe_s - tr.trip_s) : json(nullptr)},
+                       {"rearmed_after_s", tr.rearmed_s >= 0.0 ? json(tr.rearmed_s - tr.trip_s) : json(nullptr)},
+                       {"full_gain_after_s", tr.full_gain_again_s >= 0.0 ? json(tr.full_gain_again_s - tr.trip_s) : json(nullptr)}});
+    j["availability"] = {{"asked_s", a.asked_s},         {"active_full_gain_s", a.active_s},
+                         {"missed_ticks_while_active_s", a.missed_while_active_s},
+                         {"sensor_held_s", a.sensor_held_s},
+                         {"share", a.share()},           {"first_full_gain_s", t(a.first_full_gain_s)},
+                         {"trips_total", a.trips_total}, {"trips", trip_list}};
+  }
+  if (s.can) {
+    const auto& c = *s.can;
+    j["can"] = {{"rx_frames", c.rx_frames},       {"rx_other", c.rx_other},     {"rx_malformed", c.rx_malformed},
+                {"lost_frames", c.lost_frames},   {"stale_frames", c.stale_frames}, {"error_frames", c.error_frames},
+                {"bus_off", c.bus_off},           {"restarts", c.restarts},     {"rx_errors", c.rx_errors},
+                {"tx_frames", c.tx_frames},       {"tx_queue_full", c.tx_queue_full}, {"tx_errors", c.tx_errors},
+                {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}, {"rx_held", c.rx_held},
+                {"rx_skipped", c.rx_skipped},     {"reconnects", c.reconnects}, {"resync_backoffs", c.resync_backoffs}};
+  }
+  if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
+                         {"refused", s.dds->refused}, {"machining", s.dds->machining}, {"advice", s.dds->advice}};
+  if (s.machining) {
+    const auto& m = *s.machining;
+    auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    j["machining"] = {{"spindle_rpm", m.spindle_rpm},         {"depth_mm", m.depth_mm},
+                      {"limits_ready", m.limits_ready},       {"open_limit_mm", finite(m.open_limit_mm)},
+                      {"damped_limit_mm", finite(m.damped_limit_mm)}, {"limit_method", m.limit_method}, {"loop_active", m.loop_active},
+                      {"limit_mm", finite(m.limit_mm)},       {"depth_warning", m.depth_warning},
+                      {"indicator_valid", m.indicator_valid}, {"once_per_rev_ratio", m.once_per_rev_ratio},
+                      {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
+                      {"chatter", m.chatter}};
+  }
+  if (s.advice) j["advice"] = advice_json(runtime::to_sample(*s.advice));
+  if (s.modbus) {
+    const auto& m = *s.modbus;
+    j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
+                   {"connects", m.connects},               {"connect_failures", m.connect_failures},
+                   {"errors", m.errors},                   {"timeouts", m.timeouts},
+                   {"link_faults", m.link_faults},         {"coil_writes", m.coil_writes},
+                   {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown},
+                   {"spindle_changes", m.spindle_changes}, {"spindle_link_parks", m.spindle_link_parks},
+                   {"pose_changes", m.pose_changes},       {"pose_out_of_map_polls", m.pose_out_of_map_polls},
+                   {"pose_unavailable_polls", m.pose_unavailable_polls}, {"pose_link_losses", m.pose_link_losses},
+                   {"advice_writes", m.advice_writes}};
+  }
+  return j;
+}
+
+// long: one line per field of the run summary, in the order an operator reads them
+std::string summary_text(const runtime::RunSummary& s) {
+  std::ostringstream os;
+  char b[512];
+  const auto& st = s.loop;
+  const double all = static_cast<double>(std::max<std::uint64_t>(1, st.ticks_run + st.missed_ticks));
+  std::snprintf(b, sizeof b, "robodamp run: %s, %s, %s clock, %.0f Hz, %.3f s (%.3f s elapsed)\n",
+                s.config.c_str(), s.backend.c_str(), s.clock.c_str(), s.rate_hz, s.duration_s, st.elapsed_s);
+  os << b;
+  if (s.clock == "wall") {
+    os << "  real time: " << (s.realtime.fifo ? "SCHED_FIFO " + std::to_string(s.realtime.priority) : "SCHED_OTHER")
+       << (s.realtime.memory_locked ? ", memory locked" : "") << (s.realtime.dma_latency_held ? ", cpu_dma_latency 0" : "")
+       << (s.realtime.timer_slack ? ", timer slack 1 ns" : "") << (s.realtime.affinity ? ", pinned" : "") << '\n';
+  }
+  os << "  state: " << s.final_state;
+  if (s.trip != "none") os << "  (tripped: " << s.trip << " - " << s.trip_description << ")";
+  os << '\n';
+  if (s.arming.enabled) {
+    os << "  arming: " << runtime::to_string(s.arming.outcome) << " after " << s.arming.attempts << " attempt(s)";
+    if (s.arming.last_refusal != rt::ArmRefusal::kNone) os << "; last refusal: " << rt::to_string(s.arming.last_refusal);
+    os << '\n';
+  }
+  std::snprintf(b, sizeof b, "  ticks %llu, missed %llu, overruns %llu (%.4f %%)\n",
+                static_cast<unsigned long long>(st.ticks_run), static_cast<unsigned long long>(st.missed_ticks),
+                static_cast<unsigned long long>(st.overruns), 100.0 * static_cast<double>(st.overruns) / all);
+  os << b;
+  if (s.clock == "wall") {
+    const auto& h = st.wake_latency;
+    std::snprintf(b, sizeof b, "  wake-up latency: p50 %.0f us, p99 %.0f us, p99.9 %.0f us, max %.1f us\n",
+                  h.percentile_us(0.5), h.percentile_us(0.99), h.percentile_us(0.999), h.max_us());
+    os << b;
+  }
+  std::snprintf(b, sizeof b, "  compute per tick: mean %.2f us, p99 %.0f us, max %.1f us\n", st.compute.mean_us(),
+                st.compute.percentile_us(0.99), st.compute.max_us());
+  os << b;
+  std::string trips;
+  for (std::size_t i = 1; i < rt::kTripCount; ++i)
+    if (s.supervisor.trips[i] > 0)
+      trips += std::string(trips.empty() ? "" : ", ") + rt::to_string(static_cast<rt::Trip>(i)) + " " +
+               std::to_string(s.supervisor.trips[i]);
+  std::snprintf(b, sizeof b, "  supervisor: stale %llu, invalid %llu, saturated %llu ticks, arm refused %llu, gain refused %llu; trips: %s\n",
+                static_cast<unsigned long long>(s.supervisor.stale_ticks),
+                static_cast<unsigned long long>(s.supervisor.invalid_samples),
+                static_cast<unsigned long long>(s.supervisor.saturated_ticks),
+                static_cast<unsigned long long>(s.supervisor.arm_refused),
+                static_cast<unsigned long long>(s.supervisor.gain_refused), trips.empty() ? "none" : trips.c_str());
+  os << b;
+  if (s.events_total > 0) {
+    std::snprintf(b, sizeof b, "  recovery: %llu recovered, %llu latched by the budget, %llu by the probation; events:",
+                  static_cast<unsigned long long>(s.supervisor.recoveries),
+                  static_cast<unsigned long long>(s.supervisor.budget_latches),
+                  static_cast<unsigned long long>(s.supervisor.probation_latches));
+    os << b;
+    for (const auto& e : s.events) {
+      std::snprintf(b, sizeof b, " %.3f s %s %s;", e.time_s, rt::to_string(e.kind), rt::to_string(e.trip));
+      os << b;
+    }
+    if (s.events_total > s.events.size()) os << " (" << s.events_total - s.events.size() << " more)";
+    os << '\n';
+  }
+  std::snprintf(b, sizeof b, "  vibration at the sensor: %.4f m/s^2 RMS; peak command %.3f V; K_max %.0f N s/m\n",
+                s.sensor_rms_mps2, s.peak_command_v, s.max_stable_gain_ns_per_m);
+  os << b;
+  std::snprintf(b, sizeof b, "  telemetry: %llu frames, %llu dropped", static_cast<unsigned long long>(s.telemetry_frames),
+                static_cast<unsigned long long>(st.ring_drops));
+  os << b;
+  if (!s.record_path.empty())
+    os << "; recorded " << s.recorded_frames << " frames to " << s.record_path
+       << (s.record_errors ? " (" + std::to_string(s.record_errors) + " write errors)" : "");
+  os << '\n';
+  os << devices_text(s);
+  if (s.supervisor.overrun_runs_ridden > 0) {
+    std::snprintf(b, sizeof b, "  overruns: %llu runs of supervision.overrun_cycles or more ridden through within the delay margin\n",
+                  static_cast<unsigned long long>(s.supervisor.overrun_runs_ridden));
+    os << b;
+  }
+  if (s.supervisor.sensor_holds > 0) {
+    std::snprintf(b, sizeof b,
+                  "  stale or invalid samples while driving: %llu runs, %llu ticks (the longest %llu), ridden through with "
+                  "the controller's command zero\n",
+                  static_cast<unsigned long long>(s.supervisor.sensor_holds),
+                  static_cast<unsigned long long>(s.supervisor.sensor_hold_ticks),
+                  static_cast<unsigned long long>(s.supervisor.longest_sensor_hold_ticks));
+    os << b;
+  }
+  if (s.availability.first_full_gain_s >= 0.0) {
+    const auto& a = s.availability;
+    std::size_t rearmed = 0;
+    double worst = 0.0;
+    for (const auto& tr : a.trips)
+      if (tr.full_gain_again_s >= 0.0) ++rearmed, worst = std::max(worst, tr.full_gain_again_s - tr.trip_s);
+    std::snprintf(b, sizeof b,
+                  "  availability: at full gain %.4f %% of the %.1f s asked (from %.3f s; %.4f %% of it missed ticks, the "
+                  "command held; %.4f %% more on stale samples, not counted); %llu trips, %zu back at full gain (the "
+                  "slowest after %.2f s)\n",
+                  100.0 * a.share(), a.asked_s, a.first_full_gain_s,
+                  a.asked_s > 0.0 ? 100.0 * a.missed_while_active_s / a.asked_s : 0.0,
+                  a.asked_s > 0.0 ? 100.0 * a.sensor_held_s / a.asked_s : 0.0,
+                  static_cast<unsigned long long>(a.trips_total), rearmed, worst);
+    os << b;
+  }
+  if (s.trip_timing.trip_s >= 0.0) {
+    std::snprintf(b, sizeof b, "  trip at %.4f s (last fresh sample %.4f s), safe at %.4f s (%lld ticks after it)\n",
+                  s.trip_timing.trip_s, s.trip_timing.last_fresh_s, s.trip_timing.safe_s,
+                  static_cast<long long>(s.trip_timing.ticks_to_safe));
+    os << b;
+  }
+  if (s.speed_bands > 0) {
+    std::snprintf(b, sizeof b, "  speed schedule: %zu bands; at the end %s, set %zu at K %.0f N s/m; %llu hand-overs as the "
+                  "spindle moved%s\n", s.speed_bands,
+                  s.speed_band ? ("band " + std::to_string(*s.speed_band)).c_str() : "outside every band",
+                  s.active_parameter_set, s.gain_ns_per_m, static_cast<unsigned long long>(s.supervisor.speed_handovers),
+                  s.supervisor.speed_handovers_refused ? " (some REFUSED: K held at 0 there)" : "");
+    os << b;
+  }
+  if (s.machining) {
+    const auto& m = *s.machining;
+    if (m.spindle_rpm <= 0.0) {
+      os << "  machining: spindle stopped at the end; depth " << m.depth_mm << " mm\n";
+    } else {
+      std::snprintf(b, sizeof b,
+                    "  machining at the end: %.0f rpm, depth %.3f mm; limit open %.3f mm (SDM), damped %.3f mm (%s)%s; chatter "
+                    "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)\n",
+                    m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm, m.limit_method.c_str(),
+                    !m.limits_ready ? " (not computed)" : m.depth_warning ? ": WARNING, depth above the limit" : "",
+                    !m.indicator_valid ? "not ready" : m.chatter ? "CHATTER" : "quiet", m.once_per_rev_ratio,
+                    100.0 * m.nonharmonic_share);
+      os << b;
+    }
+  }
+  if (s.advice) os << advice_text(runtime::to_sample(*s.advice));
+  if (!s.realtime.warnings.empty())
+    os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
+  return os.str();
+}
+
+
+}  // namespace robodamp::apps
