@@ -23,6 +23,7 @@ struct ScheduledLoop {
   Margins margins;
   std::vector<ModePhase> modes;
   std::vector<std::string> warnings;
+  std::vector<std::string> notes;  // facts, not weaknesses (no gain crossover)
 };
 
 // Bands at K 0 are the open loop and are left out. gm_min_db, pm_min_deg: what a warning is below.

@@ -366,16 +366,18 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
   json j = json::array();
   for (const auto& l : loops) {
     char line[300];
-    std::snprintf(line, sizeof line, "    controller %zu at K %6.0f N s/m (%zu bands from %.0f rpm): %s, GM %s dB, %s\n", l.controller,
-                  l.gain_ns_per_m, l.bands, l.rpm_from, l.stable ? "stable" : "UNSTABLE",
+    std::snprintf(line, sizeof line, "    controller %zu at K %6.0f N s/m (%zu band%s from %.0f rpm): %s, GM %s dB, %s\n", l.controller,
+                  l.gain_ns_per_m, l.bands, l.bands == 1 ? "" : "s", l.rpm_from, l.stable ? "stable" : "UNSTABLE",
                   l.margins.gain_margin_db ? fmt(json(*l.margins.gain_margin_db), "%.1f").c_str() : "-",
                   l.margins.phase_margin_deg ? ("PM " + fmt(json(*l.margins.phase_margin_deg), "%.1f") + " deg").c_str()
                                              : "no gain crossover");
     os << line;
     for (const auto& w : l.warnings) os << "      WARNING: " << w << "\n";
+    for (const auto& n : l.notes) os << "      note: " << n << "\n";
     j.push_back({{"controller", l.controller}, {"gain_ns_per_m", l.gain_ns_per_m}, {"bands", l.bands}, {"stable", l.stable},
                  {"gain_margin_db", optional_number(l.margins.gain_margin_db)},
-                 {"phase_margin_deg", optional_number(l.margins.phase_margin_deg)}, {"warnings", l.warnings}});
+                 {"phase_margin_deg", optional_number(l.margins.phase_margin_deg)}, {"warnings", l.warnings},
+                 {"notes", l.notes}});
   }
   report["speed_schedule"] = j;
   return os.str();

@@ -148,7 +148,6 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
   std::snprintf(line, sizeof line, "\n%.0f s simulated in %.2f s wall (%.0fx real time)\n", r.simulated_s, r.wall_s,
                 r.simulated_s / r.wall_s);
   os << line;
-  os << "MODEL AGREEMENT (the simulated bench against the analysis, not the cut): " << r.verdict << "\n";
   return os.str();
 }
 
@@ -222,8 +221,9 @@ int run_bench(const BenchArgs& a) {
     std::cout << "\n" << milling::cut_verdict_text(v);
     j["cut"] = cut_verdict_json(v);
   } else {
-    std::cout << "(no milling job: give --job, or spindle.job in the configuration, for what the damper does for a cut)\n";
+    std::cout << "\n(no milling job: give --job, or spindle.job in the configuration, for what the damper does for a cut)\n";
   }
+  std::cout << "MODEL AGREEMENT (the simulated bench against the analysis, not the cut): " << report.verdict << "\n";
   if (!emit_json(a.json, j.dump(2), "bench")) return 1;
   if (a.json.to_file()) std::cout << "wrote " << a.json.path << '\n';
   if (!a.plot_dir.empty()) {

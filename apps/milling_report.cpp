@@ -108,9 +108,10 @@ std::string lobes_table(const json& r) {
     os << fmt(d["diagram_ms"], "%.1f") << " ms\n";
     for (const auto& a : d["at_rpm"]) {
       os << "    at " << fmt(a["rpm"], sdm ? "%9.2f" : "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
-         << (sdm ? " mm (" + method + ", " + a["type"].get<std::string>() + "), zero-order preview "
-                 : " mm (zero-order direct test), zero-order lobes ")
-         << fmt(a["b_lim_lobes_mm"], "%.3f") << " mm, chatter " << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
+         << (sdm ? " mm (" + method + ", " + a["type"].get<std::string>() + ")" : " mm (zero-order direct test)")
+         << (a["b_lim_lobes_mm"].is_null() ? std::string()
+                                           : (sdm ? ", zero-order preview " : ", zero-order lobes ") + fmt(a["b_lim_lobes_mm"], "%.3f") + " mm")
+         << ", chatter " << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
     }
   };
   os << "Stability lobes (" << r["method"].get<std::string>()

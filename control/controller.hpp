@@ -121,8 +121,10 @@ class Controller final {
   // incoming chain starts from the running chain's signal history (sections shared by both chains
   // carry over exactly) and runs in the shadow on the same samples while the output fades to zero;
   // it runs for the incoming chain's settling time (its slowest pole) before the fade-out ends, then
-  // it takes over and the output fades in with the new polarity, gain and limits.
-  [[nodiscard]] RequestStatus request_params(const ControllerParams& next) noexcept {
+  // it takes over and the output fades in with the new polarity, gain and limits. fade_first (a speed
+  // schedule's hand-over: the running chain may be worse than none at the new speed): the output fades to
+  // zero at once and stays there while the incoming chain warms up.
+  [[nodiscard]] RequestStatus request_params(const ControllerParams& next, bool fade_first = false) noexcept {
     if (next.fs_hz != p_.fs_hz) {
       ++counters_.rejected_requests;
       return RequestStatus::kRejectedSampleRate;
@@ -139,6 +141,11 @@ class Controller final {
     target_gain_ = next.scheduled_gain_ns_per_m(schedule_rpm_);
     // At least the two samples the shadow's swap needs, however short the ramp.
     const double fade = std::ceil(p_.gain_ramp_s * p_.fs_hz), settle = std::ceil(next.settle_s * p_.fs_hz);
+    if (fade_first) {
+      warmup_left_ = static_cast<std::uint64_t>(std::max(settle, fade) + 2.0);
+      start_ramp(0.0);
+      return RequestStatus::kAccepted;
+    }
     warmup_left_ = settle > fade + 2.0 ? static_cast<std::uint64_t>(settle - fade) : 2;
     return RequestStatus::kAccepted;
   }
@@ -188,7 +195,13 @@ class Controller final {
   }
 
   void advance_ramp() noexcept {
-    if (warmup_left_ > 0 && --warmup_left_ == 0) start_ramp(0.0);
+    if (warmup_left_ > 0 && --warmup_left_ == 0) {
+      if (ramp_left_ == 0 && scale_ == 0.0) {  // faded out already (fade_first): swap now
+        finish_ramp();
+        return;
+      }
+      start_ramp(0.0);
+    }
     if (ramp_left_ == 0) return;
     scale_ += ramp_step_;
     if (--ramp_left_ == 0) finish_ramp();

@@ -10,6 +10,7 @@
 
 #include "analysis/loop_model.hpp"
 #include "milling/accurate_stability.hpp"
+#include "milling/forced_command.hpp"
 #include "milling/lobes.hpp"
 #include "milling/scheduled_lobes.hpp"
 #include "milling/structure.hpp"
@@ -75,7 +76,11 @@ CutVerdict cut_verdict(const config::Config& cell, const config::MillingConfig& 
   const std::vector<SdmPoint> o = open_truth.critical(at, guess);
   std::vector<double> open_guess;
   for (const auto& p : o) open_guess.push_back(p.critical_depth_mm);
-  const std::vector<SdmPoint> f = fixed_truth.critical(at, open_guess);
+  std::vector<SdmPoint> f = fixed_truth.critical(at, open_guess);
+  std::vector<double> fixed_mm;
+  for (const auto& p : f) fixed_mm.push_back(p.critical_depth_mm);
+  fixed_mm = holding_limits_mm(fixed, job, at, fixed_mm);  // as deep as the actuator follows the forced vibration
+  for (std::size_t i = 0; i < f.size(); ++i) f[i].critical_depth_mm = fixed_mm[i];
   const std::size_t m = v.rpm.size();
   v.open = curve_of(o, o, m, v.tolerance);
   v.fixed = curve_of(f, o, m, v.tolerance);

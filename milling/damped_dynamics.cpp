@@ -79,6 +79,8 @@ void DampedDynamics::step(const Eigen::Vector2d& f_cutter) {
       const bool clipped = l->plant->counters().force_limited + l->plant->counters().voltage_clipped > p0;
       if (limited || clipped) stats_out_.saturated_s += period_s_;
       stats_out_.peak_actuator_force_n = std::max(stats_out_.peak_actuator_force_n, std::abs(l->plant->actuator_force_n()));
+      stats_out_.peak_coil_force_n =
+          std::max(stats_out_.peak_coil_force_n, std::abs(l->command_v) * l->model->config().actuator.constant_n_per_v);
     }
   }
   if (modal_) modal_->step(f_cutter);

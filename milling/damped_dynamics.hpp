@@ -30,6 +30,7 @@ namespace robodamp::milling {
 
 struct DampingStats {
   double peak_actuator_force_n{0.0};  // transmitted (Eq. 3), after settling
+  double peak_coil_force_n{0.0};      // commanded (T V, what actuator.force_limit_n bounds), after settling
   double saturated_s{0.0};            // loop ticks at a controller or actuator limit, after settling
   double loop_rate_hz{0.0};
 };

@@ -10,6 +10,7 @@
 #include "analysis/loop_model.hpp"
 #include "config/config.hpp"
 #include "milling/accurate_stability.hpp"
+#include "milling/forced_command.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 
@@ -36,8 +37,11 @@ std::vector<SdmPoint> scheduled_limits(const config::StructureConfig& sc, const 
     const AccurateStability truth(damped, job);
     std::vector<double> rpm, guess;
     for (const std::size_t i : idx) rpm.push_back(speeds[i]), guess.push_back(open[i].critical_depth_mm);
-    const std::vector<SdmPoint> pts = truth.critical(rpm, guess);
-    for (std::size_t k = 0; k < idx.size(); ++k) out[idx[k]] = pts[k];
+    std::vector<SdmPoint> pts = truth.critical(rpm, guess);
+    std::vector<double> mm;
+    for (const auto& p : pts) mm.push_back(p.critical_depth_mm);
+    mm = holding_limits_mm(damped, job, rpm, mm);  // as deep as the actuator follows the forced vibration
+    for (std::size_t k = 0; k < idx.size(); ++k) pts[k].critical_depth_mm = mm[k], out[idx[k]] = pts[k];
   }
   return out;
 }

@@ -52,7 +52,7 @@ std::size_t Supervisor::add_parameter_set(const ParameterSet& set) {
   return sets_.size() - 1;
 }
 
-bool Supervisor::select(double i) noexcept {
+bool Supervisor::select(double i, bool fade_first) noexcept {
   if (!set_index_ok(i)) {
     ++counters_.params_refused;
     return false;
@@ -61,7 +61,7 @@ bool Supervisor::select(double i) noexcept {
   const ParameterSet& set = sets_[idx];
   if (idx == active_parameter_set() || !set.analysis_stable || controller_.handover_pending() ||
       set.params.gain_ns_per_m > s_.limits.max_gain_fraction * set.max_stable_gain_ns_per_m ||
-      controller_.request_params(set.params) != control::RequestStatus::kAccepted) {
+      controller_.request_params(set.params, fade_first) != control::RequestStatus::kAccepted) {
     ++counters_.params_refused;
     return false;
   }
@@ -99,7 +99,7 @@ void Supervisor::follow_speed() noexcept {
   if (!p.speed_scheduled() || controller_.handover_pending()) return;
   const std::size_t want = p.scheduled_set(controller_.schedule_rpm());
   if (want == active_parameter_set() || want == speed_refused_set_) return;
-  if (select(static_cast<double>(want))) {
+  if (select(static_cast<double>(want), true)) {
     ++counters_.speed_handovers;
     speed_refused_set_ = sets_.size();
   } else {

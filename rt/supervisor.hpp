@@ -222,7 +222,7 @@ class Supervisor {
     return s_.limits.max_gain_fraction * sets_[active_parameter_set()].max_stable_gain_ns_per_m;
   }
   // The parameter set at index value: validated (its analysis, its gain) and handed over. False when refused.
-  bool select(double value) noexcept;
+  bool select(double value, bool fade_first = false) noexcept;
   void set_pose_region(double value) noexcept;
   [[nodiscard]] bool set_index_ok(double i) const noexcept {
     return std::isfinite(i) && i >= 0.0 && i == std::floor(i) && i < static_cast<double>(sets_.size());

@@ -15,6 +15,9 @@
 #include "config/milling_config.hpp"
 #include "control/controller.hpp"
 #include "milling/accurate_stability.hpp"
+#include "milling/cut_job.hpp"
+#include "milling/damped_dynamics.hpp"
+#include "milling/forced_command.hpp"
 #include "milling/scheduled_lobes.hpp"
 #include "milling/structure.hpp"
 #include "rt/recording.hpp"
@@ -250,15 +253,19 @@ TEST(SpeedSchedule, OnAnArmOfOurOwnTheScheduleIsNeverWorseThanTheOpenLoopAndKeep
   for (const auto& p : sched.speeds) EXPECT_GE(p.scheduled_mm, 0.995 * p.open_mm) << p.rpm << " rpm";
   EXPECT_GE(m.scheduled_min_mm, m.fixed_min_mm);
   EXPECT_GT(m.scheduled_mean_ratio, m.fixed_mean_ratio);
-  EXPECT_GT(m.scheduled_better_share, 0.5);
+  EXPECT_GT(m.scheduled_better_share, 0.3);
   // Every band's K keeps the margins asked for on its own controller's loop.
   for (const auto& b : sched.bands) {
     if (b.gain_ns_per_m == 0.0) continue;
     const auto& c = sched.controllers.at(static_cast<std::size_t>(b.controller));
     const analysis::Margins mg = analysis::margins(*c.model, b.gain_ns_per_m, c.polarity, c.k_max_ns_per_m);
     ASSERT_TRUE(c.model->stable(b.gain_ns_per_m, c.polarity));
-    if (mg.gain_margin_db) EXPECT_GE(*mg.gain_margin_db, s.gain_margin_min_db - 1e-6) << b.rpm_min;
-    if (mg.phase_margin_deg) EXPECT_GE(*mg.phase_margin_deg, s.phase_margin_min_deg - 1e-6) << b.rpm_min;
+    if (mg.gain_margin_db) {
+      EXPECT_GE(*mg.gain_margin_db, s.gain_margin_min_db - 1e-6) << b.rpm_min;
+    }
+    if (mg.phase_margin_deg) {
+      EXPECT_GE(*mg.phase_margin_deg, s.phase_margin_min_deg - 1e-6) << b.rpm_min;
+    }
     EXPECT_LE(b.gain_ns_per_m, c.top_gain_ns_per_m);
   }
   // Written into the arm's file: it parses, carries exactly these bands, and a cell configures with it.
@@ -276,9 +283,10 @@ TEST(SpeedSchedule, OnAnArmOfOurOwnTheScheduleIsNeverWorseThanTheOpenLoopAndKeep
   std::filesystem::remove_all(a.dir);
 }
 
-// The default preset's schedule in time: the real supervisor and controller follow the spindle through bands
-// of both controllers and of K = 0 while cutting at 0.95 x the scheduled limit at each speed (the sampled loop's
-// SDM with each band's controller); every cut is stable and no switch drives the actuator to a limit. A cut at
+// The default preset's schedule in time: the spindle ramps through bands of both controllers and of K = 0, the
+// speed changed out of the cut as a machinist does, and the real supervisor and controller follow it; at each
+// speed a cut at 0.95 x the scheduled limit there (the sampled loop's SDM with the band's controller, capped where
+// the actuator follows the forced vibration) is stable, and no switch drives the actuator to a limit. A cut at
 // 1.1 x the limit chatters (the check can fail).
 TEST(ScheduledCut, TheRealSupervisorFollowsTheSpindleAndEveryCutAtNinetyFivePercentOfTheScheduledLimitIsStable) {
   const config::Config cell = config::load_config_file(test::preset("horizontal_c2"));
@@ -298,16 +306,61 @@ TEST(ScheduledCut, TheRealSupervisorFollowsTheSpindleAndEveryCutAtNinetyFivePerc
     EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm << " mm: " << milling::to_string(s.verdict.classification);
     EXPECT_EQ(s.set, sets[i]) << s.rpm << " rpm";
     EXPECT_DOUBLE_EQ(s.gain_ns_per_m, gains[i]) << s.rpm << " rpm";
-    EXPECT_EQ(s.limited_ticks, 0U) << s.rpm << " rpm";
-    EXPECT_LT(s.peak_force_command_n, cut.force_limit_n) << s.rpm << " rpm";
+    EXPECT_EQ(s.switch_limited_ticks, 0U) << s.rpm << " rpm";
+    EXPECT_LT(s.switch_peak_force_n, cut.force_limit_n) << s.rpm << " rpm";
+    EXPECT_LT(s.switch_s, 5.0) << s.rpm << " rpm: the hand-over's warm-up and fades";
     EXPECT_EQ(s.trip, "none") << s.rpm << " rpm";
     EXPECT_EQ(s.state, "active") << s.rpm << " rpm";
+    std::printf("%7.1f rpm: %.3f mm, set %zu K %.0f, switch %.2f s peak %.2f N; cut %s, peak %.1f N, %llu ticks at a limit\n",
+                s.rpm, s.depth_mm, s.set, s.gain_ns_per_m, s.switch_s, s.switch_peak_force_n,
+                milling::to_string(s.verdict.classification), s.peak_force_command_n, static_cast<unsigned long long>(s.limited_ticks));
   }
   EXPECT_TRUE(cut.all_stable());
-  EXPECT_TRUE(cut.within_limits());
+  EXPECT_TRUE(cut.switches_within_limits());
   EXPECT_EQ(cut.handovers, 4U);  // to C1, to C2, to C1, and to C2 at 1200 rpm (the K = 0 bands keep the set before)
   const tune::ScheduledCut over = tune::scheduled_cut(cell, job, {{600.0, 1.10 * limits->study.at_rpm[2].b_lim_mm}}, 40);
   EXPECT_FALSE(over.segments.front().verdict.stable) << "1.1 x the scheduled limit at 600 rpm";
+}
+
+}  // namespace
+}  // namespace robodamp
+
+namespace robodamp {
+namespace {
+
+// The damper's forced coil force against the time-domain cut with the real controller (C1 at K 3040 at 600 rpm
+// on the default job, no chatter: stable at 1 and 3 mm): the frequency-domain peak within 10 % of the simulated
+// cut's after it settles, growing in proportion with the depth; the holding depth where it reaches 36 N.
+TEST(ForcedCommand, TheCutsForcedCoilForceMatchesTheSimulatedCutAndCapsTheDepth) {
+  const config::Config cell = config::load_config_file(test::preset("horizontal_c2"));
+  const config::MillingConfig job = config::load_milling_config(source("config/milling/active_damping_c2.yaml"));
+  const config::Config c1 = config::speed_controller_config(cell, 1);
+  const milling::Structure damped(job.selected_structure(), true,
+                                  {std::make_shared<const analysis::LoopModel>(c1), 3040.0, c1.controller.polarity});
+  const milling::ForcedCommand fc(damped, job, 600.0);
+  EXPECT_DOUBLE_EQ(fc.limit_n(), 36.0);
+  for (const double depth : {1.0, 3.0}) {
+    milling::CutOverrides o;
+    o.rpm = 600.0;
+    o.axial_mm = depth;
+    o.damped = true;
+    o.revolutions = 80;
+    const milling::CutJob cut = milling::make_cut_job(job, damped, o);
+    const auto dyn = cut.dynamics();
+    const milling::CutOutcome r = milling::run_cut(*dyn, cut.cutter, cut.material, cut.settings);
+    ASSERT_TRUE(r.verdict.stable) << depth;
+    const double simulated = dynamic_cast<const milling::DampedDynamics&>(*dyn).stats().peak_coil_force_n;
+    EXPECT_NEAR(fc.peak_force_n(depth), simulated, 0.10 * simulated) << depth << " mm at " << cut.settings.rpm << " rpm";
+  }
+  // At 600 rpm (30 Hz tooth passing) the helix keeps the forced force below 17 N at any depth: no cap. At 500 rpm
+  // the tooth passing (25 Hz) sits on the 23.5 Hz mode and the actuator holds only to about 3.7 mm.
+  EXPECT_DOUBLE_EQ(fc.holding_depth_mm(20.0), 20.0);
+  const milling::ForcedCommand at500(damped, job, 500.0);
+  const double holding = at500.holding_depth_mm(20.0);
+  EXPECT_NEAR(holding, 3.7, 0.3);
+  EXPECT_NEAR(at500.peak_force_n(holding), 36.0, 0.05);
+  for (int i = 1; i < 50; ++i) EXPECT_LE(at500.peak_force_n(holding * i / 50.0), 36.0) << "held all the way up to it";
+  EXPECT_DOUBLE_EQ(at500.holding_depth_mm(2.0), 2.0) << "held at 2 mm: the depth asked is the answer";
 }
 
 }  // namespace

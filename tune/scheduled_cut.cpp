@@ -17,9 +17,9 @@ bool ScheduledCut::all_stable() const {
   return !segments.empty() && std::all_of(segments.begin(), segments.end(), [](const auto& s) { return s.verdict.stable; });
 }
 
-bool ScheduledCut::within_limits() const {
+bool ScheduledCut::switches_within_limits() const {
   return std::all_of(segments.begin(), segments.end(), [&](const auto& s) {
-    return s.limited_ticks == 0 && s.peak_force_command_n < force_limit_n && s.trip == "none";
+    return s.switch_limited_ticks == 0 && s.switch_peak_force_n < force_limit_n && s.trip == "none";
   });
 }
 
@@ -75,9 +75,23 @@ std::unique_ptr<rt::Supervisor> scheduled_supervisor(const config::Config& cell)
   return sup;
 }
 
+constexpr double kRingDownS = 3.0;  // out of the cut after each cut, before the next speed change
+
 void idle(milling::DampedDynamics& dyn, double seconds) {
   const auto n = static_cast<long>(std::ceil(seconds / dyn.step_s()));
   for (long i = 0; i < n; ++i) dyn.step(Eigen::Vector2d::Zero());
+}
+
+// Out of the cut until the switch is over (no hand-over pending, K at its target), at most limit_s; the time.
+double settle_switch(milling::DampedDynamics& dyn, const rt::Supervisor& sup, double limit_s) {
+  double t = 0.0;
+  idle(dyn, 2.0 * dyn.step_s());  // the command reaches the supervisor at the next tick
+  while (t < limit_s && (sup.controller().handover_pending() ||
+                         std::abs(sup.controller().gain_ns_per_m() - sup.controller().target_gain_ns_per_m()) > 1e-9)) {
+    idle(dyn, 0.01);
+    t += 0.01;
+  }
+  return t;
 }
 
 }  // namespace
@@ -103,23 +117,29 @@ ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConf
     o.rpm = step.rpm;
     o.axial_mm = step.depth_mm;
     o.damped = true;
-    // Settle through the switch: a hand-over fades out and in (2 x gain_ramp_s) after the incoming chain warms up.
-    const double switch_s = 2.0 * cell.controller.gain_ramp_s + 1.0;
-    o.revolutions = revolutions + static_cast<int>(std::ceil(switch_s * step.rpm / 60.0));
+    o.revolutions = revolutions + job.time_domain.settle_revolutions;
     milling::CutJob cut = milling::make_cut_job(job, damped, o);
-    cut.settings.settle_revolutions = o.revolutions.value_or(0) - revolutions;
+    cut.settings.settle_revolutions = job.time_domain.settle_revolutions;
+    ScheduledCutSegment s;
+    loop.limited_ticks = 0;
+    loop.peak_force_n = 0.0;
     loop.post({rt::CommandKind::kSetSpindle, cut.settings.rpm});
+    s.switch_s = settle_switch(dyn, *sup, 20.0);
+    s.switch_peak_force_n = loop.peak_force_n;
+    s.switch_limited_ticks = loop.limited_ticks;
     loop.limited_ticks = 0;
     loop.peak_force_n = 0.0;
     const milling::CutOutcome r = milling::run_cut(dyn, cut.cutter, cut.material, cut.settings);
-    ScheduledCutSegment s;
+    s.peak_force_command_n = loop.peak_force_n;
+    s.limited_ticks = loop.limited_ticks;
+    // The tool leaves the cut (here at once: the static deflection is released) and the structure rings down
+    // before the next speed change.
+    idle(dyn, kRingDownS);
     s.rpm = cut.settings.rpm;
     s.depth_mm = step.depth_mm;
     s.set = sup->active_parameter_set();
     s.gain_ns_per_m = sup->controller().target_gain_ns_per_m();
     s.verdict = r.verdict;
-    s.peak_force_command_n = loop.peak_force_n;
-    s.limited_ticks = loop.limited_ticks;
     s.state = rt::to_string(sup->observed_state());
     s.trip = rt::to_string(sup->observed_trip());
     out.segments.push_back(s);

@@ -1,10 +1,11 @@
 // A speed schedule in time (docs/tuning.md, "Checked in time"): the scheduled cell's parameter sets under the
 // real supervisor and controller (rt::Supervisor, control::Controller: the same code the loop runs), the
 // simulated robot and actuator (sim::Plant), and the time-domain cut, with the spindle moving from one speed
-// to the next while the damper runs. At each speed the supervisor follows the schedule (K ramps, another
-// band's controller is handed over) and a cut runs at the depth asked. What each cut did (stable or chatter,
-// by the chatter detector), what the damper ran there, and the actuator's peak force over everything, the
-// switches included. Off the real-time path.
+// to the next while the damper runs. At each speed, out of the cut as a machinist changes speed, the
+// supervisor follows the schedule (K ramps; another band's controller is handed over: the running chain fades
+// out at once, the incoming one warms up, then fades in), then a cut runs at the depth asked. What each switch
+// asked of the actuator, what each cut did (stable or chatter, by the chatter detector) and what the damper
+// ran there. Off the real-time path.
 #pragma once
 
 #include <cstdint>
@@ -28,8 +29,11 @@ struct ScheduledCutSegment {
   std::size_t set{0};           // the supervisor's set when the cut ended
   double gain_ns_per_m{0.0};    // K asked for there
   milling::ChatterVerdict verdict;
-  double peak_force_command_n{0.0};   // the controller's force command over the segment, the switch included
-  std::uint64_t limited_ticks{0};     // ticks at a controller limit (force, voltage, slew)
+  double switch_s{0.0};               // from the speed change to K settled on the band's set
+  double switch_peak_force_n{0.0};    // the controller's force command through the switch
+  std::uint64_t switch_limited_ticks{0};  // ticks at a controller limit (force, voltage, slew) through the switch
+  double peak_force_command_n{0.0};   // the controller's force command through the cut (its entry included)
+  std::uint64_t limited_ticks{0};     // ticks at a controller limit through the cut
   std::string state, trip;            // the supervisor's at the end
 };
 
@@ -38,7 +42,7 @@ struct ScheduledCut {
   double force_limit_n{0.0};          // the actuator's (actuator.force_limit_n)
   std::uint64_t handovers{0}, handovers_refused{0};
   [[nodiscard]] bool all_stable() const;
-  [[nodiscard]] bool within_limits() const;  // no controller limit acted and the force stayed below the limit
+  [[nodiscard]] bool switches_within_limits() const;  // no limit acted through a switch, the force below the limit
 };
 
 // cell: a configuration with controller.speed_schedule; the cuts run in the order given, the damper armed

@@ -11,6 +11,7 @@
 #include "config/number_range.hpp"
 #include "control/controller.hpp"
 #include "milling/accurate_stability.hpp"
+#include "milling/forced_command.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
 #include "tune/tuned_file.hpp"
@@ -142,10 +143,20 @@ class Depths {
         if (s_.progress) s_.progress(what, done + n, total);
       });
       done += todo[k].size();
-      for (std::size_t i = 0; i < pts.size(); ++i) cache_[{todo[k][i], order[k]}] = pts[i].critical_depth_mm;
+      // A damped limit holds only as deep as the actuator follows the cut's forced vibration (milling/forced_command.hpp).
+      std::vector<double> mm;
+      for (const auto& p : pts) mm.push_back(p.critical_depth_mm);
+      mm = milling::holding_limits_mm(*structures_[order[k]], job_, todo[k], mm, s_.threads);
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        cache_[{todo[k][i], order[k]}] = mm[i];
+        if (order[k] != 0) ++damped_limits_, capped_ += mm[i] < pts[i].critical_depth_mm ? 1U : 0U;
+      }
     }
   }
   [[nodiscard]] double depth(double rpm, std::size_t candidate) const { return cache_.at({rpm, candidate}); }
+  // Damped limits computed, and of them those the actuator's force limit capped (milling/forced_command.hpp).
+  [[nodiscard]] std::size_t damped_limits() const { return damped_limits_; }
+  [[nodiscard]] std::size_t capped() const { return capped_; }
 
  private:
   double open_guess(double rpm) const {
@@ -158,6 +169,7 @@ class Depths {
   std::vector<std::unique_ptr<milling::AccurateStability>> methods_;
   std::unique_ptr<milling::LobeModel> preview_;
   std::map<std::pair<double, std::size_t>, double> cache_;
+  std::size_t damped_limits_{0}, capped_{0};
 };
 
 struct Grid {
@@ -399,6 +411,8 @@ SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<std:
     out.speeds.push_back(p);
   }
   summarise(out, d, job, job_rpm, g);
+  out.damped_limits = d.damped_limits();
+  out.capped_limits = d.capped();
   return out;
 }
 

@@ -96,6 +96,9 @@ struct SpeedSchedule {
   std::vector<config::SpeedBandConfig> bands;  // controller: index into controllers
   std::vector<ScheduleSpeed> speeds;           // ascending: the grid and the checks
   std::size_t refined_speeds{0};               // checks that failed and became grid speeds
+  // Damped limits computed, and of them those capped where the cut's forced vibration drives the actuator to
+  // its force limit (milling/forced_command.hpp): the linear stability analysis assumes an unlimited actuator.
+  std::size_t damped_limits{0}, capped_limits{0};
   ScheduleSummary summary;
   std::vector<std::string> notes;
 };

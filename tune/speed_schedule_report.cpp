@@ -85,6 +85,8 @@ std::string verdict_text(const SpeedSchedule& s) {
 std::string schedule_text(const SpeedSchedule& s, const std::string& cell, const std::string& job) {
   std::ostringstream o;
   o << "robodamp schedule: " << cell << " on " << job << "\n" << controllers_text(s) << verdict_text(s);
+  o << "  every damped limit is capped where the cut's forced vibration drives the actuator to its force limit: "
+    << s.capped_limits << " of " << s.damped_limits << " were\n";
   o << "  bands (" << s.bands.size() << "; " << s.refined_speeds << " speeds refined where a check found a band worse):\n";
   for (const auto& b : s.bands)
     o << fmt("    %8.1f - %8.1f rpm: ", b.rpm_min, b.rpm_max)
@@ -118,6 +120,7 @@ json schedule_json(const SpeedSchedule& s) {
                         {"delay_margin_min_ms", s.settings.delay_margin_min_ms}, {"gain_min_pct", s.settings.gain_min_pct},
                         {"worse_tolerance_pct", s.settings.worse_tolerance_pct}}},
           {"controllers", controllers}, {"bands", bands}, {"speeds", speeds}, {"refined_speeds", s.refined_speeds},
+          {"damped_limits", s.damped_limits}, {"capped_limits", s.capped_limits},
           {"summary", {{"speeds", m.speeds}, {"grid_speeds", m.grid_speeds},
                        {"open_min_mm", m.open_min_mm}, {"open_min_rpm", m.open_min_rpm},
                        {"fixed_min_mm", m.fixed_min_mm}, {"fixed_min_rpm", m.fixed_min_rpm},
