@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <sstream>
 
 #include "analysis/loop_model.hpp"
 #include "cell_util.hpp"
@@ -361,6 +363,57 @@ TEST(ForcedCommand, TheCutsForcedCoilForceMatchesTheSimulatedCutAndCapsTheDepth)
   EXPECT_NEAR(at500.peak_force_n(holding), 36.0, 0.05);
   for (int i = 1; i < 50; ++i) EXPECT_LE(at500.peak_force_n(holding * i / 50.0), 36.0) << "held all the way up to it";
   EXPECT_DOUBLE_EQ(at500.holding_depth_mm(2.0), 2.0) << "held at 2 mm: the depth asked is the answer";
+}
+
+}  // namespace
+}  // namespace robodamp
+
+namespace robodamp {
+namespace {
+
+// The numbers of a schedule header's verification lines (minimum, mean, worse share, the job's speed...).
+std::vector<double> promises(const std::string& text) {
+  std::vector<double> out;
+  const auto from = text.find("# The speed schedule (controller.speed_schedule) was verified");
+  const auto to = text.find("# Everything else is", from);
+  const std::string block = text.substr(from, to - from);
+  const std::regex number(R"([0-9]+\.[0-9]+)");
+  for (auto it = std::sregex_iterator(block.begin(), block.end(), number); it != std::sregex_iterator(); ++it)
+    out.push_back(std::stod(it->str()));
+  return out;
+}
+
+// Each scheduled preset's recorded command (its header's second line) run again writes the file again: the same
+// bands and the same promises within 1 %, from the file itself (the command schedules in place).
+TEST(SpeedSchedule, EachScheduledPresetsRecordedCommandWritesItAgain) {
+  const std::string dir = ::testing::TempDir() + "robodamp_schedule_rerun_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  for (const std::string name : {"horizontal_c2", "tuned_horizontal"}) {
+    const std::string text = test::read_file(test::preset(name));
+    std::istringstream lines(text);
+    std::string first, command;
+    std::getline(lines, first);
+    std::getline(lines, command);
+    ASSERT_EQ(first.rfind("# robodamp schedule wrote", 0), 0U) << name;
+    ASSERT_EQ(command.rfind("#   robodamp schedule ", 0), 0U) << name;
+    command = command.substr(std::string("#   robodamp ").size());
+    const std::string out = dir + "/" + name + ".yaml";
+    command = std::regex_replace(command, std::regex(" --out \\S+$"), " --out " + out);
+    const std::string run = "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + command + " > " + dir +
+                            "/log.txt 2>&1";
+    ASSERT_EQ(std::system(run.c_str()), 0) << run << "\n" << test::read_file(dir + "/log.txt");
+    const std::string again = test::read_file(out);
+    const std::vector<double> was = promises(text), now = promises(again);
+    ASSERT_EQ(was.size(), now.size()) << name;
+    ASSERT_GE(was.size(), 8U) << name;
+    for (std::size_t i = 0; i < was.size(); ++i) EXPECT_NEAR(now[i], was[i], 0.01 * std::abs(was[i]) + 1e-9) << name << " #" << i;
+    const config::Config a = config::parse_config(text, test::preset(name)), b = config::parse_config(again, out);
+    ASSERT_EQ(a.controller.speed_schedule->bands.size(), b.controller.speed_schedule->bands.size()) << name;
+    // Deterministic: the same file, but for the --out of the command it records.
+    const std::regex out_path(" --out \\S+\n");
+    EXPECT_EQ(std::regex_replace(again, out_path, " --out X\n"), std::regex_replace(text, out_path, " --out X\n")) << name;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -456,7 +456,41 @@ std::string schedule_block(const std::string& indent, const SpeedSchedule& s) {
 
 }  // namespace
 
-config::EditedYaml scheduled_config_text(const config::Config& cell, const SpeedSchedule& s) {
+// The text without an existing controller.speed_schedule block (a file scheduled again): its key's line and
+// every line indented deeper, so the new schedule is written in the block form again, not as an edit in place.
+std::string without_schedule_block(const std::string& text) {
+  std::istringstream in(text);
+  std::ostringstream out;
+  std::string line;
+  std::size_t key_indent = std::string::npos;
+  std::string blanks;  // blank lines inside the block, kept if the block ends after them
+  while (std::getline(in, line)) {
+    const std::size_t indent = line.find_first_not_of(' ');
+    if (key_indent != std::string::npos) {
+      if (indent == std::string::npos) {
+        blanks += line + '\n';
+        continue;
+      }
+      if (indent > key_indent || line[indent] == '#') {
+        blanks.clear();
+        continue;
+      }
+      key_indent = std::string::npos;
+      out << blanks;
+      blanks.clear();
+    }
+    if (indent != std::string::npos && line.compare(indent, 15, "speed_schedule:") == 0) {
+      key_indent = indent;
+      continue;
+    }
+    out << line << '\n';
+  }
+  return out.str();
+}
+
+config::EditedYaml scheduled_config_text(const config::Config& cell_in, const SpeedSchedule& s) {
+  config::Config cell = cell_in;
+  if (cell.controller.speed_schedule) cell.yaml_text = without_schedule_block(cell.yaml_text);
   YAML::Node schedule(YAML::NodeType::Map);
   YAML::Node controllers(YAML::NodeType::Sequence);
   for (std::size_t i = 1; i < s.controllers.size(); ++i) controllers.push_back(YAML::Load(controller_text(*s.controllers[i].entry)));
