@@ -31,6 +31,9 @@ std::string command_line(const CommissionArgs& a) {
   if (s.global_evaluations != d.global_evaluations) c += " --evaluations " + std::to_string(s.global_evaluations);
   if (s.local_evaluations != d.local_evaluations) c += " --polish " + std::to_string(s.local_evaluations);
   if (s.seed != d.seed) c += " --seed " + std::to_string(s.seed);
+  const commission::CommissionSettings ds;
+  if (a.settings.schedule_speeds != ds.schedule_speeds) c += " --schedule-speeds " + std::to_string(a.settings.schedule_speeds);
+  if (a.settings.schedule_gains != ds.schedule_gains) c += " --schedule-gains " + std::to_string(a.settings.schedule_gains);
   return c;
 }
 
@@ -82,6 +85,11 @@ void register_commission(Registry& r) {
   r.whole_number(sub, "--cut-revs", a->settings.cut_revolutions, {"(revolutions)", 60, 100000},
                  "Revolutions of each regenerative cut in the HIL emulator's check (a cell behind can.interface unix:...)");
   r.whole_number(sub, "--seed", a->settings.tune.seed, {"(seed)", 0, 999999}, "The global search's seed");
+  r.whole_number(sub, "--schedule-speeds", a->settings.schedule_speeds, {"(speeds)", 2, 5000},
+                 "Grid speeds of the speed schedule over the job's range (checks are added between)");
+  r.whole_number(sub, "--schedule-gains", a->settings.schedule_gains, {"(gains per controller)", 1, 24},
+                 "Gains the speed schedule tries per controller");
+  sub->add_option("--operator", a->settings.operator_name, "Who commissions (the report; default the login name)");
 }
 
 }  // namespace robodamp::apps

@@ -94,7 +94,9 @@ int run_schedule(const ScheduleArgs& a) {
     if (what != last || done == of || done % 50 == 0) std::cerr << "[schedule] " << what << ": " << done << "/" << of << '\n';
     last = what;
   };
-  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, a.controllers, job, *structure, s);
+  std::vector<tune::NamedController> others;
+  for (const auto& f : a.controllers) others.push_back(tune::controller_of_file(f));
+  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, others, job, *structure, s);
   const std::string text = tune::schedule_text(sched, a.config_path, job_path);
   const std::string plot = plot_file(a.plot_dir, "", "schedule_lobes.png");
   const int printed = print_report(tune::schedule_json(sched).dump(2), a.json, "schedule", text, plot, [&] {

@@ -16,6 +16,7 @@
 #include "commission/measurement.hpp"
 #include "commission/report.hpp"
 #include "config/milling_config.hpp"
+#include "tune/speed_schedule_report.hpp"
 #include "tune/tuned_file.hpp"
 
 namespace robodamp::commission {
@@ -163,6 +164,7 @@ class Run {
                             ? fmt("the largest stable K is %.0f N s/m)", e.k_max_ns_per_m)
                             : std::string("no gain is stable with this polarity)")) +
                        ": run from tune"};
+      schedule();
       return;
     }
     const tune::TuneResult t = tune::tune(refs, s_.tune, [this](const std::string& l) { say_("commission: " + l); });
@@ -179,6 +181,42 @@ class Run {
              "on a quiet cell %.4f V RMS (the instability detector's floor %.3f V)",
              t.best.candidate.gain_ns_per_m, t.best.candidate.polarity, t.best.gain_margin_db, t.best.phase_margin_deg,
              t.best.quiet_command_rms_v, r_.identified->config.supervision.instability_floor_v));
+    schedule();
+  }
+
+  // The speed schedule over the job's range: the tuned controller and C1 and C2 drawn in the identified chain
+  // (their polarity the analysis recommends), each at the gains that keep the tune's margins; K = 0 where none
+  // beats the open loop. Never worse than the open loop at the speeds checked, or the commissioning stops.
+  void schedule() {
+    const config::Config& tuned = *r_.tuned_config;
+    std::vector<tune::NamedController> hand;
+    for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2}) {
+      config::Config c = tuned;
+      for (auto& b : c.controller.chain)
+        if (b.kind == config::BlockKind::kCompensator) b.model = model, b.numerator.clear(), b.denominator.clear();
+      c.controller.polarity = analysis::analyse(analysis::LoopModel(c)).recommended_polarity;
+      hand.push_back({std::string(config::to_string(model)) + " drawn in the identified chain", config::speed_controller_of(c)});
+    }
+    tune::ScheduleSettings ss;
+    ss.speeds = s_.schedule_speeds;
+    ss.gains_per_controller = s_.schedule_gains;
+    ss.gain_margin_min_db = s_.tune.gain_margin_min_db;
+    ss.phase_margin_min_deg = s_.tune.phase_margin_min_deg;
+    ss.delay_margin_min_ms = s_.tune.delay_margin_min_ms;
+    const auto t0 = Clock::now();
+    r_.schedule = tune::schedule_speeds(tuned, hand, job_, job_.selected_structure(), ss);
+    const tune::ScheduleSummary& m = r_.schedule->summary;
+    say_(fmt("commission: speed schedule, %zu bands over %zu speeds: minimum %.3f mm (open loop %.3f, the tuned controller "
+             "alone %.3f), mean x%.3f the open loop (alone x%.3f), worse than the open loop at %.1f %% (alone %.1f %%) (%.1f s)",
+             r_.schedule->bands.size(), m.speeds, m.scheduled_min_mm, m.open_min_mm, m.fixed_min_mm, m.scheduled_mean_ratio,
+             m.fixed_mean_ratio, 100.0 * m.scheduled_worse_share, 100.0 * m.fixed_worse_share, seconds_since(t0)));
+    if (m.scheduled_worse_share > 0.0)
+      throw Stop{Stage::kTune, Outcome::kNotVerified,
+                 fmt("the speed schedule is worse than the open loop at %.1f %% of the speeds (the worst x%.3f at %.0f rpm)",
+                     100.0 * m.scheduled_worse_share, m.scheduled_worst_ratio, m.scheduled_worst_rpm)};
+    const std::string text = tune::scheduled_config_text(tuned, *r_.schedule).text;
+    r_.scheduled_config = config::parse_config(text, (dir_ / "scheduled.yaml").string());
+    std::ofstream(dir_ / "scheduled.yaml") << text;
   }
 
   void verify() {
@@ -203,6 +241,39 @@ class Run {
                f.predicted_improvement_pct, f.coherence_min));
     say_("commission: on " + c.cell + ": " + c.cut_summary(v));
     if (const std::string f = c.failure(v); !f.empty()) throw Stop{Stage::kVerify, Outcome::kNotVerified, f};
+    verify_schedule_in_time();
+  }
+
+  // The schedule in time on the identified model, with the real supervisor: the spindle through up to six
+  // speeds where the schedule damps (K > 0), spread over the range, the job's speed among them (changed out of
+  // the cut), a cut at 0.95 x the scheduled limit at each. Bands at K = 0 carry the open loop's own limit.
+  void verify_schedule_in_time() {
+    if (!r_.schedule) return;
+    std::vector<tune::ScheduleSpeed> damped;
+    for (const auto& p : r_.schedule->speeds)
+      if (r_.schedule->candidates[p.candidate].gain_ns_per_m > 0.0) damped.push_back(p);
+    if (damped.empty()) return;
+    std::vector<tune::ScheduledCutStep> steps;
+    const std::size_t n = std::min<std::size_t>(5, damped.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& p = damped[(damped.size() - 1) * (2 * i + 1) / (2 * n)];
+      steps.push_back({p.rpm, 0.95 * p.scheduled_mm});
+    }
+    const double job_rpm = r_.schedule->summary.job_rpm;
+    if (const auto at = config::speed_band_of(r_.schedule->bands, job_rpm); job_rpm > 0.0 && at && r_.schedule->bands[*at].gain_ns_per_m > 0.0)
+      steps.push_back({job_rpm, 0.95 * r_.schedule->summary.job_scheduled_mm});
+    const auto t0 = Clock::now();
+    r_.schedule_in_time = tune::scheduled_cut(*r_.scheduled_config, job_, steps, 40);
+    const tune::ScheduledCut& c = *r_.schedule_in_time;
+    for (const auto& s : c.segments)
+      say_(fmt("commission: the schedule in time at %.1f rpm, %.3f mm (0.95 x its limit): %s; the switch %.2f N, the cut %.1f N "
+               "of the actuator's %.0f N",
+               s.rpm, s.depth_mm, milling::to_string(s.verdict.classification), s.switch_peak_force_n,
+               s.peak_force_command_n, c.force_limit_n));
+    say_(fmt("commission: the schedule in time: %.1f s", seconds_since(t0)));
+    if (!c.all_stable() || !c.switches_within_limits())
+      throw Stop{Stage::kVerify, Outcome::kNotVerified,
+                 "the speed schedule in time: a cut at 0.95 x its limit chattered, or a switch drove the actuator to a limit"};
   }
 
   void write() {
@@ -221,8 +292,10 @@ class Run {
       h << fmt("\n# On a quiet cell the command is %.4f V RMS (the discrete loop's prediction; the instability "
                "detector's floor %.3f V).",
                r_.tuned_nominal->quiet_command_rms_v, r_.tuned_config->supervision.instability_floor_v);
-    h << "\n#\n";
-    std::ifstream in(dir_ / "tuned.yaml");
+    h << "\n";
+    if (r_.schedule) h << tune::schedule_header(*r_.schedule);
+    h << "#\n";
+    std::ifstream in(dir_ / (r_.schedule ? "scheduled.yaml" : "tuned.yaml"));
     const std::string tuned((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::string text = h.str() + tuned;
     (void)config::parse_config(text, (dir_ / "configuration.yaml").string());

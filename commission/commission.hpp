@@ -20,6 +20,8 @@
 #include "commission/cell_check.hpp"
 #include "identify/commissioning.hpp"
 #include "tune/compensator_search.hpp"
+#include "tune/scheduled_cut.hpp"
+#include "tune/speed_schedule.hpp"
 #include "tune/verification.hpp"
 
 namespace robodamp::commission {
@@ -49,6 +51,10 @@ struct CommissionSettings {
   std::string command_line;  // how it was called, for the files' headers and the report
   std::string robodamp_binary;  // the emulator's executable for a HIL cell (default: this process's)
   int cut_revolutions{300};     // each regenerative cut in the HIL emulator's check
+  // The speed schedule over the job's range (tune/speed_schedule.hpp): grid speeds and gains per controller.
+  int schedule_speeds{80};
+  int schedule_gains{4};
+  std::string operator_name;    // who commissioned (the report; default the login name)
 };
 
 enum class Outcome { kVerified, kBadInput, kNotVerified, kTripped, kFailed };
@@ -75,6 +81,11 @@ struct CommissionResult {
   std::optional<tune::Verification> promise;
   std::optional<CellCheck> cell;
   std::vector<std::pair<double, double>> open_curve_mm;  // the identified plant's open-loop lobes (SDM)
+  // The speed schedule made after the tune (the tuned controller, C1 and C2 drawn in the identified chain) and
+  // its check in time with the real supervisor on the identified model; the configuration it is written in.
+  std::optional<tune::SpeedSchedule> schedule;
+  std::optional<tune::ScheduledCut> schedule_in_time;
+  std::optional<config::Config> scheduled_config;
   std::string configuration_path;  // written when verified
   std::string report_path;
 };

@@ -1,6 +1,10 @@
 #include "commission/report.hpp"
 
+#include <openssl/evp.h>
+
 #include <cmath>
+#include <cstdlib>
+#include <ctime>
 #include <complex>
 #include <cstdio>
 #include <filesystem>
@@ -8,6 +12,8 @@
 #include <sstream>
 
 #include "plot/gnuplot.hpp"
+#include "rt/version.hpp"
+#include "tune/speed_schedule_report.hpp"
 
 namespace robodamp::commission {
 
@@ -36,6 +42,20 @@ std::string esc(const std::string& s) {
 }
 
 double deg(std::complex<double> z) { return std::arg(z) * 180.0 / M_PI; }
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string sha256_hex(const std::string& bytes) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &n, EVP_sha256(), nullptr) != 1) return "(not computed)";
+  std::string hex;
+  for (unsigned int i = 0; i < n; ++i) hex += fmt("%02x", static_cast<unsigned>(digest[i]));
+  return hex;
+}
 
 // One plot: its PNG and its data file in dir, returned as an <img> (or the reason in the page).
 class Plots {
@@ -240,6 +260,50 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
   return h.str();
 }
 
+// What the damper does for the job, first, in the machinist's terms, with the one picture that says it.
+std::string cut_section(const CommissionResult& r, Plots& p) {
+  if (!r.schedule) return {};
+  const tune::SpeedSchedule& s = *r.schedule;
+  const tune::ScheduleSummary& m = s.summary;
+  std::ostringstream h;
+  h << "<h2>What the damper does for this job</h2>\n<p>By the accurate method (" << esc(s.method) << ") at " << m.speeds
+    << " speeds over the job's range, on the identified model. ";
+  if (m.job_rpm > 0.0)
+    h << fmt("At the job's %.1f rpm the open loop allows %.3f mm; the tuned controller at its fixed K allows %.3f mm (%+.1f %%); "
+             "the speed schedule written allows <b>%.3f mm (%+.1f %%)</b>. ",
+             m.job_rpm, m.job_open_mm, m.job_fixed_mm, 100.0 * (m.job_fixed_mm / m.job_open_mm - 1.0), m.job_scheduled_mm,
+             100.0 * (m.job_scheduled_mm / m.job_open_mm - 1.0));
+  h << fmt("Over the range the schedule's minimum is <b>%.3f mm</b> (open loop %.3f mm, the tuned controller alone %.3f mm), "
+           "its mean <b>x%.3f</b> the open loop's (alone x%.3f). ",
+           m.scheduled_min_mm, m.open_min_mm, m.fixed_min_mm, m.scheduled_mean_ratio, m.fixed_mean_ratio);
+  if (m.fixed_worse_share > 0.0)
+    h << fmt("<span class=bad>The tuned controller alone would be worse than no damper at %.0f %% of the speeds (down to x%.2f at "
+             "%.0f rpm)</span>; ",
+             100.0 * m.fixed_worse_share, m.fixed_worst_ratio, m.fixed_worst_rpm);
+  h << (m.scheduled_worse_share > 0.0
+            ? fmt("<span class=bad>the schedule is worse than no damper at %.1f %% of them</span>.", 100.0 * m.scheduled_worse_share)
+            : fmt("<span class=ok>the schedule is never worse than no damper</span> (by %.1f %%) at the speeds checked: "
+                  "it runs K = 0 where no controller beats the open loop.",
+                  s.settings.worse_tolerance_pct))
+    << fmt(" %zu bands; every damped limit is capped where the actuator holds the cut's forced vibration (%zu of %zu were).</p>\n",
+           s.bands.size(), s.capped_limits, s.damped_limits);
+  const auto [data, script] = tune::schedule_plot(s, "What the damper does for the job: limiting depth by spindle speed");
+  h << p.img("schedule_lobes", script, data, "open loop (SDM), the tuned controller at its fixed K and the speed schedule "
+                                               "(sampled-loop SDM), identified model");
+  return h.str();
+}
+
+// Date (UTC), software version and commit, who, and the SHA-256 of the cell's configuration file.
+std::string provenance(const CommissionSettings& s) {
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
+  std::string who = s.operator_name;
+  if (who.empty()) who = std::getenv("USER") ? std::getenv("USER") : "(unknown: set --operator)";
+  return "<p>" + std::string(date) + "; robodamp " + rt::version() + " (" + rt::git_commit() + "); operator " + esc(who) +
+         "; configuration SHA-256 <code>" + sha256_hex(read_text(s.config_path)) + "</code></p>\n";
+}
+
 }  // namespace
 
 std::string write_report(const CommissionSettings& s, const CommissionResult& r, const std::string& path) {
@@ -251,12 +315,13 @@ std::string write_report(const CommissionSettings& s, const CommissionResult& r,
        ".ok{color:#1e8449}.bad{color:#c0392b;font-weight:bold}.banner{padding:0.6em;font-size:1.2em;border-radius:4px}"
        ".pass{background:#d5f5e3}.fail{background:#fadbd8}img{max-width:100%}code{background:#f4f4f4}</style></head><body>\n";
   h << "<h1>robodamp commission</h1>\n<p>Cell <code>" << esc(s.config_path) << "</code>, job <code>" << esc(s.job_path)
-    << "</code>.<br>Command: <code>" << esc(s.command_line) << "</code></p>\n";
+    << "</code>.<br>Command: <code>" << esc(s.command_line) << "</code></p>\n" << provenance(s);
   if (r.outcome == Outcome::kVerified)
     h << "<p class=\"banner pass\">VERIFIED: " << esc(r.configuration_path) << " written.</p>\n";
   else
     h << "<p class=\"banner fail\">NOT VERIFIED: stopped at the " << to_string(r.stage) << " stage: " << esc(r.reason)
       << ". Nothing written as configuration.yaml.</p>\n";
+  h << cut_section(r, p);
   h << "<h2>1. Stages</h2>\n<table><tr><th>stage</th><th>wall time (s)</th><th></th></tr>\n";
   for (const auto& t : r.times)
     h << "<tr><td>" << to_string(t.stage) << "</td><td>" << fmt("%.1f", t.wall_s) << "</td><td>"

@@ -95,6 +95,18 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   EXPECT_EQ(written.controller.gain_ns_per_m, r.tuned_config->controller.gain_ns_per_m);
   const std::string text = test::read_file((dir / "configuration.yaml").string());
   EXPECT_NE(text.find("Verified on the simulated plant in process: the damped cut in time"), std::string::npos) << text;
+  // With its speed schedule over the job's range: never worse than the open loop at the speeds checked, checked
+  // in time at 0.95 x its limit where it damps, and written with its promises.
+  ASSERT_TRUE(r.schedule);
+  EXPECT_EQ(r.schedule->summary.scheduled_worse_share, 0.0);
+  EXPECT_GE(r.schedule->summary.scheduled_min_mm, r.schedule->summary.open_min_mm);
+  EXPECT_GE(r.schedule->summary.scheduled_mean_ratio, r.schedule->summary.fixed_mean_ratio);
+  ASSERT_TRUE(r.schedule_in_time);
+  EXPECT_TRUE(r.schedule_in_time->all_stable());
+  EXPECT_TRUE(r.schedule_in_time->switches_within_limits());
+  ASSERT_TRUE(written.controller.speed_schedule);
+  EXPECT_EQ(written.controller.speed_schedule->bands.size(), r.schedule->bands.size());
+  EXPECT_NE(text.find("# The speed schedule (controller.speed_schedule) was verified"), std::string::npos) << text;
   // Every file commission writes is valid input again, as written and in block and flow style: a tune of it
   // (the next commissioning) writes a file that reads back.
   for (const char* file : {"identified.yaml", "tuned.yaml", "configuration.yaml"}) {
@@ -111,11 +123,26 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   // The report: self-contained (every plot inlined), verified, and its plotted data are the computed series.
   const std::string html = test::read_file(r.report_path);
   EXPECT_NE(html.find("VERIFIED"), std::string::npos);
+  // It opens with what the damper does for the job (before the stages), in words and one picture, and says
+  // when, with what and for whom.
+  const auto opens = html.find("<h2>What the damper does for this job</h2>"), stages = html.find("<h2>1. Stages</h2>");
+  ASSERT_NE(opens, std::string::npos);
+  EXPECT_LT(opens, stages);
+  EXPECT_NE(html.find("the schedule is never worse than no damper"), std::string::npos);
+  EXPECT_NE(html.find("configuration SHA-256 <code>"), std::string::npos);
+  EXPECT_NE(html.find("operator "), std::string::npos);
+  const auto sched_rows = rows_of(dir / "plots" / "schedule_lobes.dat");
+  ASSERT_EQ(sched_rows.size(), r.schedule->speeds.size());
+  for (std::size_t i = 0; i < sched_rows.size(); ++i) {
+    EXPECT_NEAR(sched_rows[i][0], r.schedule->speeds[i].rpm, 1e-8 * r.schedule->speeds[i].rpm);  // written to 10 digits
+    EXPECT_NEAR(sched_rows[i][3], r.schedule->speeds[i].scheduled_mm, 1e-8 * r.schedule->speeds[i].scheduled_mm);
+    EXPECT_GE(sched_rows[i][3], 0.995 * sched_rows[i][1]) << "the plotted schedule below the plotted open loop at " << sched_rows[i][0];
+  }
   std::size_t images = 0;
   for (std::size_t p = html.find("data:image/png;base64,"); p != std::string::npos;
        p = html.find("data:image/png;base64,", p + 1))
     ++images;
-  EXPECT_EQ(images, 3u * 3u + 2u);  // per FRF: fit, stabilisation, cell; the actuator; the lobes
+  EXPECT_EQ(images, 3u * 3u + 3u);  // per FRF: fit, stabilisation, cell; the actuator; the lobes; the schedule
   const auto& f0 = r.identified->frfs.front();
   const auto fit_rows = rows_of(dir / "plots" / (f0.name + "_fit.dat"));
   ASSERT_EQ(fit_rows.size(), f0.data.f_hz.size());

@@ -245,7 +245,8 @@ TEST(SpeedSchedule, OnAnArmOfOurOwnTheScheduleIsNeverWorseThanTheOpenLoopAndKeep
   tune::ScheduleSettings s;
   s.speeds = 40;
   s.gains_per_controller = 3;
-  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, {test::preset("horizontal_c1")}, job, job.selected_structure(), s);
+  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, {tune::controller_of_file(test::preset("horizontal_c1"))}, job,
+                                                             job.selected_structure(), s);
   const tune::ScheduleSummary& m = sched.summary;
   ASSERT_GE(m.speeds, 40U);
   EXPECT_GT(m.speeds, m.grid_speeds) << "checked between the grid speeds too";

@@ -103,10 +103,17 @@ struct SpeedSchedule {
   std::vector<std::string> notes;
 };
 
-// cell: the configuration scheduled (its own controller is controller 0); other_controllers: configuration
-// files whose chains a band may run; job and structure: the cut, whose controller parts take each candidate's
-// loop. Throws config::ConfigError for a controller it cannot use (another loop rate, no stable gain).
-[[nodiscard]] SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<std::string>& other_controllers,
+// Another controller a band may run, and where it came from (a file, "C1 hand design", ...).
+struct NamedController {
+  std::string name;
+  config::SpeedControllerConfig controller;
+};
+// The controller of another configuration file (its compensator block, polarity, match frequency).
+[[nodiscard]] NamedController controller_of_file(const std::string& path);
+
+// cell: the configuration scheduled (its own controller is controller 0); others: the compensators a band may
+// run instead, in cell's chain; job and structure: the cut, whose controller parts take each candidate's loop.
+[[nodiscard]] SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<NamedController>& others,
                                             const config::MillingConfig& job, const config::StructureConfig& structure,
                                             const ScheduleSettings& settings);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 namespace robodamp::tune {
@@ -157,12 +158,20 @@ std::string schedule_header(const SpeedSchedule& s) {
 std::pair<std::string, std::string> schedule_plot(const SpeedSchedule& s, const std::string& title) {
   std::ostringstream data;
   for (const auto& p : s.speeds) data << fmt("%.10g %.10g %.10g %.10g\n", p.rpm, p.open_mm, p.fixed_mm, p.scheduled_mm);
-  double y_max = 0.0;
-  for (const auto& p : s.speeds) y_max = std::max(y_max, p.scheduled_mm);
-  y_max = std::min(y_max * 1.1, 6.0 * s.summary.scheduled_min_mm);
+  // A logarithmic depth axis: the limits span two decades (the minima near the modes' lobes, the pockets between).
+  double y_min = std::numeric_limits<double>::infinity(), y_max = 0.0;
+  for (const auto& p : s.speeds) {
+    for (const double v : {p.open_mm, p.fixed_mm, p.scheduled_mm})
+      if (std::isfinite(v) && v > 0.0) y_min = std::min(y_min, v);
+    if (std::isfinite(p.scheduled_mm)) y_max = std::max(y_max, p.scheduled_mm);
+  }
+  y_min = 0.8 * y_min;
+  y_max = std::min(1.25 * y_max, 100.0 * y_min);
   std::ostringstream g;
-  g << "set title '" << title << "' noenhanced\nset grid\nset xlabel 'spindle speed (rpm)'\n"
-    << "set ylabel 'limiting axial depth (mm)'\nset key top left opaque box\nset yrange [0:" << y_max << "]\n"
+  g << "set title '" << title << "' noenhanced\nset grid xtics ytics mytics\nset xlabel 'spindle speed (rpm)'\n"
+    << "set ylabel 'limiting axial depth (mm, logarithmic)'\nset logscale y\nset key bottom right opaque box\n"
+    << "set ytics ('0.05' 0.05, '0.1' 0.1, '0.2' 0.2, '0.5' 0.5, '1' 1, '2' 2, '5' 5, '10' 10, '20' 20, '50' 50, '100' 100)\n"
+    << "set yrange [" << y_min << ":" << y_max << "]\n"
     << "plot DATA u 1:2 w l lw 2 lc rgb '#7f8c8d' t 'open loop (SDM)', "
     << "DATA u 1:3 w l lw 1.5 lc rgb '#e67e22' t 'as configured (sampled-loop SDM)', "
     << "DATA u 1:4 w l lw 2.5 lc rgb '#27ae60' t 'scheduled by speed (sampled-loop SDM)'\n";
