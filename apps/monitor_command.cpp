@@ -73,7 +73,7 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
                 "  saturation %.1f %% of the last window, %llu ticks in all\n"
                 "  timing     wake-up p50 %.0f us, p99 %.0f us, max %.1f us; compute mean %.2f us, max %.1f us\n"
                 "             ticks %llu, missed %llu, overruns %llu, stale %llu, ring drops %llu\n"
-                "  damping    at full gain %.3f %% of the time asked; %u trips, %u back at full gain; last trip %s\n"
+                "  damping    %.3f %% of the time asked (%.3f %% derated%s); %u trips, %u back at full gain; last trip %s\n"
                 "  samples    %llu telemetry, %llu status; parameter writes %s\n",
                 ns ? s.cell().c_str() : t.cell().c_str(), nt ? t.time_s() : s.time_s(), ns ? s.backend().c_str() : "no status yet", state, trip,
                 t.accel_rms_mps2(), t.accel_mps2(), t.filtered_mps(), t.command_v(), t.command_peak_v(),
@@ -82,7 +82,8 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
                 s.wake_p99_us(), s.wake_max_us(), s.compute_mean_us(), s.compute_max_us(),
                 static_cast<unsigned long long>(s.ticks()), static_cast<unsigned long long>(s.missed_ticks()),
                 static_cast<unsigned long long>(s.overruns()), static_cast<unsigned long long>(s.stale_ticks()),
-                static_cast<unsigned long long>(s.ring_drops()), s.availability_pct(), s.trips(), s.back_at_full_gain(),
+                static_cast<unsigned long long>(s.ring_drops()), s.availability_pct(), s.derated_pct(),
+                s.derated() ? ", DERATED now" : "", s.trips(), s.back_at_full_gain(),
                 s.last_trip_s() >= 0.0 ? (std::to_string(s.last_trip_s()) + " s").c_str() : "none",
                 static_cast<unsigned long long>(nt),
                 static_cast<unsigned long long>(ns), ns ? (s.parameter_writes() ? "on" : "off") : "-");

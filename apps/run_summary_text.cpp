@@ -108,7 +108,14 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
             {"sensor_hold_ticks", s.supervisor.sensor_hold_ticks},
             {"longest_sensor_hold_ticks", s.supervisor.longest_sensor_hold_ticks},
             {"budget_latches", s.supervisor.budget_latches},
-            {"probation_latches", s.supervisor.probation_latches}}},
+            {"probation_latches", s.supervisor.probation_latches},
+            {"derate",
+             {{"probes", s.supervisor.derate_probes},
+              {"growth_process", s.supervisor.growth_process},
+              {"growth_gain_fed", s.supervisor.growth_gain_fed},
+              {"saturation_derates", s.supervisor.saturation_derates},
+              {"restores", s.supervisor.derate_restores},
+              {"derated_ticks", s.supervisor.derated_ticks}}}}},
           {"realtime",
            {{"memory_locked", s.realtime.memory_locked},
             {"sched_fifo", s.realtime.fifo},
@@ -152,6 +159,7 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
     j["availability"] = {{"asked_s", a.asked_s},         {"active_full_gain_s", a.active_s},
                          {"missed_ticks_while_active_s", a.missed_while_active_s},
                          {"sensor_held_s", a.sensor_held_s},
+                         {"derated_s", a.derated_s},
                          {"share", a.share()},           {"first_full_gain_s", t(a.first_full_gain_s)},
                          {"trips_total", a.trips_total}, {"trips", trip_list}};
   }
@@ -240,6 +248,15 @@ std::string summary_text(const runtime::RunSummary& s) {
                 static_cast<unsigned long long>(s.supervisor.arm_refused),
                 static_cast<unsigned long long>(s.supervisor.gain_refused), trips.empty() ? "none" : trips.c_str());
   os << b;
+  if (const auto& v = s.supervisor; v.derate_probes + v.saturation_derates > 0) {
+    std::snprintf(b, sizeof b,
+                  "  derating (the spindle turning): %llu growth probes (%llu the process's: damping at full gain, %llu "
+                  "fed by the gain: held lowered), %llu saturation derates, %llu back to full gain; %llu ticks derated\n",
+                  static_cast<unsigned long long>(v.derate_probes), static_cast<unsigned long long>(v.growth_process),
+                  static_cast<unsigned long long>(v.growth_gain_fed), static_cast<unsigned long long>(v.saturation_derates),
+                  static_cast<unsigned long long>(v.derate_restores), static_cast<unsigned long long>(v.derated_ticks));
+    os << b;
+  }
   if (s.events_total > 0) {
     std::snprintf(b, sizeof b, "  recovery: %llu recovered, %llu latched by the budget, %llu by the probation; events:",
                   static_cast<unsigned long long>(s.supervisor.recoveries),
@@ -285,11 +302,12 @@ std::string summary_text(const runtime::RunSummary& s) {
     for (const auto& tr : a.trips)
       if (tr.full_gain_again_s >= 0.0) ++rearmed, worst = std::max(worst, tr.full_gain_again_s - tr.trip_s);
     std::snprintf(b, sizeof b,
-                  "  availability: at full gain %.4f %% of the %.1f s asked (from %.3f s; %.4f %% of it missed ticks, the "
-                  "command held; %.4f %% more on stale samples, not counted); %llu trips, %zu back at full gain (the "
-                  "slowest after %.2f s)\n",
+                  "  availability: damping (active past the fade-in) %.4f %% of the %.1f s asked (from %.3f s; %.4f %% of it missed ticks, the "
+                  "command held; %.4f %% derated; %.4f %% more on stale samples, not counted); %llu trips, %zu back at "
+                  "full gain (the slowest after %.2f s)\n",
                   100.0 * a.share(), a.asked_s, a.first_full_gain_s,
                   a.asked_s > 0.0 ? 100.0 * a.missed_while_active_s / a.asked_s : 0.0,
+                  a.asked_s > 0.0 ? 100.0 * a.derated_s / a.asked_s : 0.0,
                   a.asked_s > 0.0 ? 100.0 * a.sensor_held_s / a.asked_s : 0.0,
                   static_cast<unsigned long long>(a.trips_total), rearmed, worst);
     os << b;

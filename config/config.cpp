@@ -473,6 +473,23 @@ RecoveryConfig read_recovery(MapReader& top) {
   return c;
 }
 
+DerateConfig read_derate(MapReader& top) {
+  MapReader r(top.diagnostics(), top.child("derate", false, ""), "supervision.derate", top.mark());
+  DerateConfig c;
+  if (auto v = read_bool(r, "enabled", c.enabled)) c.enabled = *v;
+  if (auto v = read_int(r, "probe_blocks", {"(instability blocks)", 1, 1000}, c.probe_blocks)) c.probe_blocks = *v;
+  if (auto v = r.number("probe_factor", {"(x K)", 0.0, 1.0, false, true}, c.probe_factor)) c.probe_factor = *v;
+  if (auto v = r.number("hold_factor", {"(x K)", 0.0, 1.0, false, true}, c.hold_factor)) c.hold_factor = *v;
+  if (auto v = r.number("probe_ramp_s", {"s", 0.0, 1.0}, c.probe_ramp_s)) c.probe_ramp_s = *v;
+  if (auto v = r.number("quiet_s", {"s", 0.0, 600.0}, c.quiet_s)) c.quiet_s = *v;
+  if (auto v = r.number("restore_s", {"s", 0.0, 600.0}, c.restore_s)) c.restore_s = *v;
+  if (auto v = r.number("saturation_factor", {"(ratio)", 0.0, 1.0, true, true}, c.saturation_factor))
+    c.saturation_factor = *v;
+  if (auto v = r.number("min_factor", {"(x K)", 0.0, 1.0, true, true}, c.min_factor)) c.min_factor = *v;
+  r.finish();
+  return c;
+}
+
 SupervisionConfig read_supervision(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("supervision", false, ""), "supervision", top.mark());
   SupervisionConfig c;
@@ -504,6 +521,7 @@ SupervisionConfig read_supervision(MapReader& top) {
   if (auto v = r.number("max_gain_fraction", {"(x maximum stable K)", 0.0, 1.0, true}, c.max_gain_fraction))
     c.max_gain_fraction = *v;
   c.recovery = read_recovery(r);
+  c.derate = read_derate(r);
   r.finish();
   return c;
 }

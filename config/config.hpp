@@ -86,6 +86,23 @@ struct RecoveryConfig {
 inline const std::vector<std::string> kRecoverableTripNames{"overruns", "sensor_stale", "sample_invalid", "sensor_driver",
                                                              "actuator_driver", "amplifier_not_ready"};
 
+// Keeping damping through chatter (docs/realtime_loop.md, "Keeping damping when the cut chatters"): with the
+// spindle turning, growth and saturation derate the gain instead of tripping, as long as a probe says the gain
+// is not what feeds them. With the spindle stopped nothing but the loop can feed a growth: it trips as before.
+struct DerateConfig {
+  bool enabled{true};
+  // Where the instability rule would trip, the gain goes to probe_factor (x K) over probe_ramp_s for probe_blocks
+  // instability blocks instead; decaying there (the structure's motion not growing): the gain fed it, ...
+  int probe_blocks{4};
+  double probe_factor{0.0};
+  double hold_factor{0.5};       // ... and the gain is held at this (x K) until quiet (growing on: the process's)
+  double probe_ramp_s{0.02};
+  double quiet_s{1.0};           // no growth and the saturation duty under a quarter of its limit this long: ...
+  double restore_s{2.0};         // ... back to full gain over this ramp
+  double saturation_factor{0.5}; // each saturation duty over the limit multiplies the derating by this ...
+  double min_factor{0.0625};     // ... down to this; below it the saturation trips as before
+};
+
 struct SupervisionConfig {
   int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample: trip
   // While the sample is stale or invalid the controller's part of the command is zero and the controller
@@ -115,6 +132,7 @@ struct SupervisionConfig {
   double amplifier_ready_timeout_s{0.2};
   double max_gain_fraction{0.9};     // gain requests up to this x the analysed maximum stable K
   RecoveryConfig recovery;
+  DerateConfig derate;
 };
 
 struct TelemetryConfig {

@@ -2,6 +2,7 @@
 // member after construction is RT-safe: no allocation, locking, exceptions or logging.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -41,7 +42,8 @@ class Controller final {
     filtered_ = shaped;
     if (pending_) (void)shadow_.process(accel_mps2);  // the incoming chain warms up on the same signal
     advance_ramp();
-    double force_n = scale_ * shaped;  // polarity * K * chain(accel), newtons
+    advance_derate();
+    double force_n = derate_ * scale_ * shaped;  // derating * polarity * K * chain(accel), newtons
     if (std::abs(force_n) > p_.force_limit_n) {
       force_n = std::copysign(p_.force_limit_n, force_n);
       ++counters_.force_limited;
@@ -114,6 +116,18 @@ class Controller final {
     target_gain_ = gain_ns_per_m;
     if (!pending_) start_ramp(output_scale(p_, target_gain_));  // during a hand-over: applied at fade-in
   }
+  // RT-safe. The supervisor's derating (docs/realtime_loop.md, "Keeping damping when the cut chatters"): a
+  // factor in [0, 1] on the force command before the limits, reached linearly over ramp_s (0: at once). K,
+  // its ramps, hand-overs and the speed schedule are untouched: derating multiplies whatever they give.
+  void set_derate(double factor, double ramp_s) noexcept {
+    derate_target_ = std::isfinite(factor) ? std::clamp(factor, 0.0, 1.0) : 0.0;
+    const double n = std::isfinite(ramp_s) && ramp_s > 0.0 ? std::ceil(ramp_s * p_.fs_hz) : 0.0;
+    derate_left_ = static_cast<std::uint64_t>(n);
+    derate_step_ = derate_left_ > 0 ? (derate_target_ - derate_) / n : 0.0;
+    if (derate_left_ == 0) derate_ = derate_target_;
+  }
+  [[nodiscard]] double derate() const noexcept { return derate_; }
+  [[nodiscard]] double derate_target() const noexcept { return derate_target_; }
   // A speed schedule's band holds the spindle's speed (K is the band's).
   [[nodiscard]] bool in_speed_band() const noexcept { return p_.speed_band_of(schedule_rpm_) < p_.speed_band_count; }
 
@@ -194,6 +208,12 @@ class Controller final {
     if (ramp_left_ == 0) finish_ramp();
   }
 
+  void advance_derate() noexcept {
+    if (derate_left_ == 0) return;
+    derate_ += derate_step_;
+    if (--derate_left_ == 0) derate_ = derate_target_;
+  }
+
   void advance_ramp() noexcept {
     if (warmup_left_ > 0 && --warmup_left_ == 0) {
       if (ramp_left_ == 0 && scale_ == 0.0) {  // faded out already (fade_first): swap now
@@ -236,6 +256,8 @@ class Controller final {
   bool pending_{false};
   double command_v_{0.0};
   double force_n_{0.0};
+  double derate_{1.0}, derate_target_{1.0}, derate_step_{0.0};
+  std::uint64_t derate_left_{0};
   double filtered_{0.0};
   mutable ControllerCounters counters_{};
 };

@@ -39,7 +39,8 @@ json to_json(const msg::Status& s) {
           {"wake_p50_us", s.wake_p50_us()}, {"wake_p99_us", s.wake_p99_us()}, {"wake_max_us", s.wake_max_us()},
           {"compute_mean_us", s.compute_mean_us()}, {"compute_max_us", s.compute_max_us()},
           {"availability_pct", s.availability_pct()}, {"trips", s.trips()}, {"back_at_full_gain", s.back_at_full_gain()},
-          {"last_trip_s", s.last_trip_s()}, {"wake_histogram", s.wake_histogram()}, {"compute_histogram", s.compute_histogram()},
+          {"last_trip_s", s.last_trip_s()}, {"derated", s.derated()}, {"derated_pct", s.derated_pct()},
+          {"wake_histogram", s.wake_histogram()}, {"compute_histogram", s.compute_histogram()},
           {"histogram_edges_us", std::vector<double>(std::begin(dds::kHistogramEdgesUs), std::end(dds::kHistogramEdgesUs))}};
 }
 
@@ -302,6 +303,8 @@ json Fleet::overview() {
       t["trip_description"] = c->status["trip_description"];
       t["availability_pct"] = c->status["availability_pct"];
       t["trips"] = c->status["trips"];
+      t["derated"] = c->status["derated"];
+      t["derated_pct"] = c->status["derated_pct"];
       t["backend"] = c->status["backend"];
       t["status_source_ms"] = c->status_source_ms;
       t["status_received_ms"] = c->status_received_ms;

@@ -167,6 +167,8 @@ void Bridge::publish_status() {
     for (const auto& t : a.trips) back += t.full_gain_again_s >= 0.0 ? 1U : 0U;
     s.back_at_full_gain(back);
     s.last_trip_s(a.trips.empty() ? -1.0 : a.trips.back().trip_s);
+    s.derated((f.flags & rt::kFlagDerated) != 0);
+    s.derated_pct(static_cast<float>(a.asked_s > 0.0 ? 100.0 * a.derated_s / a.asked_s : 0.0));
     s.wake_histogram(coarse_histogram(wake_));
     s.compute_histogram(coarse_histogram(compute_));
     published_state_ = f.state;

@@ -24,6 +24,7 @@ void AvailabilityMeter::on_frame(const TelemetryFrame& f) {
       a_.active_s += static_cast<double>(held ? ticks - 1 : ticks) * period_s_;
       a_.missed_while_active_s += static_cast<double>(ticks - 1) * period_s_;
       if (held) a_.sensor_held_s += period_s_;
+      if (f.flags & kFlagDerated) a_.derated_s += period_s_;
     }
   }
   have_prev_ = true;

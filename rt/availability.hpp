@@ -3,7 +3,7 @@
 //  - asked: from the first tick the loop reached full gain (armed, and gain_ramp_s after it became active)
 //    to the end of the run; the start-up's arming and fade are not an outage. Ticks stopping or disabled
 //    with no trip (the run's end, an operator's disarm) are not asked.
-//  - active: the time of it in the active state at full gain (the "armed and at full gain"), with
+//  - active: the time of it in the active state past the fade-in, derated or not (derated_s apart) (the "armed and at full gain"), with
 //    the ticks the loop missed meanwhile (a stall: the amplifier held the last command) also counted apart;
 //    ticks on a stale or invalid sample (the command zero, ridden through) are not active, counted apart.
 //  - each trip: its class, when it tripped, when the command was zero with the amplifier off (safe), and
@@ -32,6 +32,8 @@ struct Availability {
   // At full gain on a stale or invalid sample, the controller's part of the command zero: not damping,
   // so not in active_s (a stale sensor ridden through without a trip).
   double sensor_held_s{0.0};
+  // Of active_s: the command derated (supervision.derate: armed and damping, at a lowered gain).
+  double derated_s{0.0};
   double first_full_gain_s{-1.0};  // -1: never at full gain
   std::uint64_t trips_total{0};
   std::vector<TripRecord> trips;   // the first kMaxTrips

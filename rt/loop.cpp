@@ -154,7 +154,7 @@ void Loop::publish(const Pace& p, const TickInput& in, const TickOutput& out) no
       (in.actuator_saturated ? kFlagActuatorSaturated : 0) | (in.amplifier_ready ? kFlagAmplifierReady : 0) |
       (in.amplifier_fault ? kFlagAmplifierFault : 0) | (in.overrun ? kFlagOverrun : 0) |
       (in.shutdown ? kFlagShutdown : 0) | (out.amplifier_enable ? kFlagAmplifierEnable : 0) |
-      (out.saturated ? kFlagSaturated : 0));
+      (out.saturated ? kFlagSaturated : 0) | (out.derated ? kFlagDerated : 0));
   f.state = static_cast<std::uint8_t>(out.state);
   f.trip = static_cast<std::uint8_t>(out.trip);
   f.command_kind = static_cast<std::uint8_t>(in.command.kind);

@@ -130,6 +130,16 @@ json to_json(const SupervisorSettings& s) {
             {"max_recoveries", l.recovery.max_recoveries},
             {"window_s", l.recovery.window_s},
             {"probation_s", l.recovery.probation_s}}},
+          {"derate",
+           {{"enabled", l.derate.enabled},
+            {"probe_blocks", l.derate.probe_blocks},
+            {"probe_factor", l.derate.probe_factor},
+            {"hold_factor", l.derate.hold_factor},
+            {"probe_ramp_s", l.derate.probe_ramp_s},
+            {"quiet_s", l.derate.quiet_s},
+            {"restore_s", l.derate.restore_s},
+            {"saturation_factor", l.derate.saturation_factor},
+            {"min_factor", l.derate.min_factor}}},
           {"fs_hz", s.fs_hz},
           {"resolved_sample_limit_mps2", s.sample_limit_mps2},
           {"fade_s", s.fade_s},
@@ -197,6 +207,20 @@ SupervisorSettings supervisor_settings_from(const json& j) {
     l.recovery.probation_s = r.at("probation_s");
   } else {
     l.recovery.recoverable.clear();  // recorded before recovery existed: every trip latched
+  }
+  if (j.contains("derate")) {
+    const json& d = j.at("derate");
+    l.derate.enabled = d.at("enabled");
+    l.derate.probe_blocks = d.at("probe_blocks");
+    l.derate.probe_factor = d.at("probe_factor");
+    l.derate.hold_factor = d.at("hold_factor");
+    l.derate.probe_ramp_s = d.at("probe_ramp_s");
+    l.derate.quiet_s = d.at("quiet_s");
+    l.derate.restore_s = d.at("restore_s");
+    l.derate.saturation_factor = d.at("saturation_factor");
+    l.derate.min_factor = d.at("min_factor");
+  } else {
+    l.derate.enabled = false;  // recorded before derating existed: growth and saturation tripped
   }
   s.fs_hz = j.at("fs_hz");
   s.sample_limit_mps2 = j.at("resolved_sample_limit_mps2");

@@ -87,6 +87,7 @@ struct TickOutput {
   State state{State::kDisabled};
   Trip trip{Trip::kNone};
   bool saturated{false};  // this tick counted as saturated
+  bool derated{false};    // the controller's command derated this tick (supervision.derate)
 };
 
 struct SupervisorCounters {
@@ -121,11 +122,22 @@ struct SupervisorCounters {
   std::uint64_t recoveries{0};
   std::uint64_t budget_latches{0};
   std::uint64_t probation_latches{0};
+  // Keeping damping through chatter (supervision.derate, the spindle turning): growth probes (the gain lowered
+  // to probe_factor), their verdicts (the process's growth: full gain again; fed by the gain: held lowered;
+  // the same speed's gain feeding a growth twice trips instability), saturation derates (instead of the
+  // saturation trip), restores to full gain once quiet, and the ticks active with the command derated.
+  std::uint64_t derate_probes{0};
+  std::uint64_t growth_process{0};
+  std::uint64_t growth_gain_fed{0};
+  std::uint64_t saturation_derates{0};
+  std::uint64_t derate_restores{0};
+  std::uint64_t derated_ticks{0};
 };
 
 // What the supervisor did about faults, with its time (the supervisor's clock: the sum of the measured
 // dt since the start), in a fixed log of the first kEventLogSize events.
-enum class EventKind : std::uint8_t { kTrip, kRecovered, kLatched };
+// kProbe .. kRestored: the derating (supervision.derate); their trip is the one they stand in for.
+enum class EventKind : std::uint8_t { kTrip, kRecovered, kLatched, kProbe, kProcessGrowth, kGainFedGrowth, kSaturationDerate, kRestored };
 struct SupervisorEvent {
   double time_s{0.0};
   EventKind kind{EventKind::kTrip};
@@ -203,7 +215,18 @@ class Supervisor {
   void trip(Trip t) noexcept;
   [[nodiscard]] Trip check_trips(const TickInput& in) const noexcept;
   bool record_saturation(bool saturated) noexcept;  // true: duty exceeded
-  bool instability(double controller_v) noexcept;     // true: growing oscillation
+  bool instability(double growth_v, double accel_mps2) noexcept;  // true: growing oscillation (trip)
+  // The derating (rt/derating.cpp): the growth's verdict with the spindle turning (true: trip), the return
+  // to full gain once quiet, a saturation derate (false: none left, trip), the factor to the controller.
+  enum class Growth : std::uint8_t { kNone, kProbe, kGainFed };
+  [[nodiscard]] bool derating_on() const noexcept;
+  bool judge_growth(double rms, double accel_rms, bool grown) noexcept;
+  void process_growth() noexcept;
+  void restore_when_quiet() noexcept;
+  bool derate_saturation() noexcept;
+  void apply_derate(double ramp_s) noexcept;
+  void reset_derate() noexcept;
+  [[nodiscard]] double growth_signal_v(double controller_v) const noexcept;
   void reset_detectors() noexcept;
   void count_hold(bool held) noexcept;  // a tick driving on a held (zero) controller part, or not
   // step()'s stages, in order (RT-safe, noexcept, allocation-free).
@@ -288,6 +311,16 @@ class Supervisor {
   double block_sum_sq_{0.0};
   double last_block_rms_{0.0}, run_start_rms_{0.0};
   int growth_run_{0};
+
+  Growth growth_{Growth::kNone};
+  bool process_{false};            // a growth judged the process's since the last quiet spell
+  double probe_rms_{0.0};          // the block's RMS (and the acceleration's) when the probe started
+  double probe_accel_rms_{0.0};
+  double block_accel_sum_sq_{0.0};
+  int probe_blocks_{0};            // blocks since
+  double saturation_derate_{1.0};  // the product of the saturation derates since the last restore
+  std::uint64_t quiet_blocks_{0};
+  double gain_fed_rpm_{-1.0};      // the speed the gain last fed a growth at (-1: none)
 };
 
 }  // namespace robodamp::rt

@@ -68,6 +68,11 @@ const char* to_string(EventKind k) {
     case EventKind::kTrip: return "trip";
     case EventKind::kRecovered: return "recovered";
     case EventKind::kLatched: return "latched";
+    case EventKind::kProbe: return "derate_probe";
+    case EventKind::kProcessGrowth: return "process_growth";
+    case EventKind::kGainFedGrowth: return "gain_fed_growth";
+    case EventKind::kSaturationDerate: return "saturation_derate";
+    case EventKind::kRestored: return "restored_full_gain";
   }
   return "?";
 }

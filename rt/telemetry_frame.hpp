@@ -26,6 +26,7 @@ enum FrameFlag : std::uint16_t {
   kFlagShutdown = 1U << 7,
   kFlagAmplifierEnable = 1U << 8,  // output
   kFlagSaturated = 1U << 9,        // output: counted as saturated
+  kFlagDerated = 1U << 10,         // output: the command derated (supervision.derate)
 };
 
 struct TelemetryFrame {

@@ -122,7 +122,7 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   Client client(cfg.domain_id);
   ASSERT_TRUE(eventually([&] { return client.matched(); }, 60.0));
   // One second of loop frames: a 2 m/s^2 square wave's RMS, 3 ticks in 10 saturated, state active but for
-  // a stale-sensor trip from 0.4 to 0.6 s.
+  // a stale-sensor trip from 0.4 to 0.6 s, the command derated from 0.8 s on.
   for (std::uint64_t k = 0; k < 5000; ++k) {
     rt::TelemetryFrame f;
     f.tick = k;
@@ -133,7 +133,8 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
     const bool tripped = k >= 2000 && k < 3000;
     f.state = static_cast<std::uint8_t>(tripped ? rt::State::kFault : rt::State::kActive);
     f.trip = static_cast<std::uint8_t>(tripped ? rt::Trip::kSensorStale : rt::Trip::kNone);
-    f.flags = static_cast<std::uint16_t>(rt::kFlagFresh | ((k % 10 < 3) ? rt::kFlagSaturated : 0));
+    f.flags = static_cast<std::uint16_t>(rt::kFlagFresh | ((k % 10 < 3) ? rt::kFlagSaturated : 0) |
+                                         (k >= 4000 ? rt::kFlagDerated : 0));
     f.wake_latency_us = 12.0F;
     f.compute_us = 3.0F;
     bridge.on_frame(f);
@@ -161,6 +162,8 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   EXPECT_EQ(s.trips(), 1U);
   EXPECT_EQ(s.back_at_full_gain(), 1U);
   EXPECT_NEAR(s.last_trip_s(), 0.4, 1e-9);
+  EXPECT_TRUE(s.derated());
+  EXPECT_NEAR(s.derated_pct(), 20.0, 0.1);  // 0.2 s of the 1 s asked
 
   const auto reply = client.ask(1, msg::SET_GAIN, 2500.0);
   EXPECT_FALSE(reply.accepted());

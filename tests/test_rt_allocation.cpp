@@ -397,6 +397,33 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
   EXPECT_EQ(r.mismatches, 0U);
 }
 
+// The derating (supervision.derate): a loop unstable on its own (the actuator 3 x stronger than configured) with
+// the spindle turning is probed, held at half gain, restored and probed again (then trips): no allocation, no lock.
+TEST(RealTimePath, TheDeratingProbesHoldsAndRestoresWithoutAllocating) {
+  runtime::CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  o.arm_at_start = false;
+  o.impact_every_s = 0.0;
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  cfg.controller.speed_schedule.reset();
+  config::Config real = cfg;
+  real.actuator.constant_n_per_v *= 3.0;
+  o.plant_config = real;
+  runtime::Cell session(cfg, o);
+  test::configure(session);
+  rt::Loop& loop = session.loop();
+  loop.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
+  loop.schedule(1000, {rt::CommandKind::kArm, 0.0});
+  const LoopThreadCounts counts = run_counted(loop, 12 * 5000);
+  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
+  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
+  const auto& c = session.supervisor().counters();
+  EXPECT_GE(c.derate_probes, 2U);
+  EXPECT_GE(c.growth_gain_fed, 1U);
+  EXPECT_GE(c.derate_restores, 1U);
+  EXPECT_GT(c.derated_ticks, 0U);
+}
+
 // robodamp measure's loop: the loop's chirp with K = 0 and the plant-side impact test
 // (analysis::ModalTest on the simulated backend's step hook) through the whole commissioning plan: the
 // loop thread allocates nothing and takes no lock.

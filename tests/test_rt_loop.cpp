@@ -244,6 +244,7 @@ TEST(Loop, InstabilityTripsBeforeTheCommandDiverges) {
   const std::size_t fault = first_state(r, State::kFault);
   ASSERT_LT(fault, r.frames.size());
   EXPECT_EQ(r.frames[fault].saturated_ticks, 0U) << "tripped before any limit was reached";
+  EXPECT_EQ(r.s.supervisor.derate_probes, 0U) << "the spindle stopped: only the loop can feed a growth, no probe";
   double peak = 0.0;
   for (std::size_t i = 0; i < fault; ++i) peak = std::max(peak, std::abs(r.frames[i].command_v));
   const double limit_v = c2().actuator.force_limit_n / c2().actuator.constant_n_per_v;

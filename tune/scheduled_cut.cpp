@@ -29,7 +29,8 @@ namespace {
 // and a ready amplifier, an operator command posted for the next tick.
 class SupervisedLoop final : public milling::LoopDriver {
  public:
-  SupervisedLoop(rt::Supervisor& sup, double fs_hz) : sup_(sup), dt_s_(1.0 / fs_hz) {}
+  SupervisedLoop(rt::Supervisor& sup, double fs_hz, bool leads_swapped)
+      : sup_(sup), dt_s_(1.0 / fs_hz), sign_(leads_swapped ? -1.0 : 1.0) {}
   double tick(double accel_mps2, bool& limited) override {
     rt::TickInput in;
     in.dt_s = dt_s_;
@@ -45,15 +46,22 @@ class SupervisedLoop final : public milling::LoopDriver {
               before.force_limited + before.voltage_limited + before.slew_limited;
     limited_ticks += limited ? 1U : 0U;
     peak_force_n = std::max(peak_force_n, std::abs(sup_.controller().force_command_n()));
-    return out.command_v;
+    lowest_derate = std::min(lowest_derate, sup_.controller().derate());
+    if (out.derated) derated_s += dt_s_;
+    time_s += dt_s_;
+    if (out.trip != rt::Trip::kNone && trip_s < 0.0) trip_s = time_s;
+    return sign_ * out.command_v;
   }
   void post(rt::OperatorCommand c) { pending_ = c; }
   std::uint64_t limited_ticks{0};
   double peak_force_n{0.0};
+  double lowest_derate{1.0}, derated_s{0.0};
+  double time_s{0.0}, trip_s{-1.0};
 
  private:
   rt::Supervisor& sup_;
   double dt_s_;
+  double sign_;
   rt::OperatorCommand pending_{};
 };
 
@@ -66,7 +74,8 @@ std::unique_ptr<rt::Supervisor> scheduled_supervisor(const config::Config& cell)
   auto sup = std::make_unique<rt::Supervisor>(
       rt::supervisor_settings(cell, m0.stable(cell.controller.gain_ns_per_m, pol), k0.value_or(control::kMaxGainNsPerM)),
       m0.chain().params);
-  for (std::size_t i = 1; i <= cell.controller.speed_schedule->controllers.size(); ++i) {
+  const std::size_t controllers = cell.controller.speed_schedule ? cell.controller.speed_schedule->controllers.size() : 0;
+  for (std::size_t i = 1; i <= controllers; ++i) {
     const config::Config c = config::speed_controller_config(cell, i);
     const analysis::LoopModel m(c);
     const auto k = analysis::max_stable_gain(m, c.controller.polarity);
@@ -99,12 +108,21 @@ double settle_switch(milling::DampedDynamics& dyn, const rt::Supervisor& sup, do
 ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConfig& job,
                            const std::vector<ScheduledCutStep>& steps, int revolutions) {
   if (!cell.controller.speed_schedule) throw std::invalid_argument("scheduled_cut: the configuration has no speed schedule");
+  SupervisedCutOptions o;
+  o.revolutions = revolutions;
+  return supervised_cut(cell, job, steps, o);
+}
+
+// long: the cell armed, then each step's switch, cut and ring-down in the order a machinist runs them
+ScheduledCut supervised_cut(const config::Config& cell, const config::MillingConfig& job,
+                            const std::vector<ScheduledCutStep>& steps, const SupervisedCutOptions& opt) {
+  const int revolutions = opt.revolutions;
   const std::unique_ptr<rt::Supervisor> sup = scheduled_supervisor(cell);
-  const auto model = std::make_shared<const analysis::LoopModel>(cell);
+  const auto model = std::make_shared<const analysis::LoopModel>(opt.plant ? *opt.plant : cell);
   const milling::Structure damped(job.selected_structure(), true,
                                   {model, cell.controller.gain_ns_per_m, cell.controller.polarity});
   milling::DampedDynamics dyn(damped, job.cut.feed_axis);
-  SupervisedLoop loop(*sup, cell.loop.rate_hz);
+  SupervisedLoop loop(*sup, cell.loop.rate_hz, opt.leads_swapped);
   dyn.drive_with(&loop);
   ScheduledCut out;
   out.force_limit_n = dyn.actuator_force_limit_n();
@@ -129,7 +147,13 @@ ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConf
     s.switch_limited_ticks = loop.limited_ticks;
     loop.limited_ticks = 0;
     loop.peak_force_n = 0.0;
+    loop.lowest_derate = 1.0;
+    loop.derated_s = 0.0;
+    loop.time_s = 0.0;
     const milling::CutOutcome r = milling::run_cut(dyn, cut.cutter, cut.material, cut.settings);
+    s.lowest_derate = loop.lowest_derate;
+    s.derated_s = loop.derated_s;
+    s.trip_s = loop.trip_s;
     s.peak_force_command_n = loop.peak_force_n;
     s.limited_ticks = loop.limited_ticks;
     // The tool leaves the cut (here at once: the static deflection is released) and the structure rings down
@@ -143,7 +167,9 @@ ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConf
     s.state = rt::to_string(sup->observed_state());
     s.trip = rt::to_string(sup->observed_trip());
     out.segments.push_back(s);
+    if (sup->observed_trip() != rt::Trip::kNone) break;
   }
+  out.counters = sup->counters();
   out.handovers = sup->counters().speed_handovers;
   out.handovers_refused = sup->counters().speed_handovers_refused;
   return out;

@@ -15,6 +15,7 @@
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
 #include "milling/chatter.hpp"
+#include "rt/supervisor.hpp"
 
 namespace robodamp::tune {
 
@@ -35,12 +36,16 @@ struct ScheduledCutSegment {
   double peak_force_command_n{0.0};   // the controller's force command through the cut (its entry included)
   std::uint64_t limited_ticks{0};     // ticks at a controller limit through the cut
   std::string state, trip;            // the supervisor's at the end
+  double lowest_derate{1.0};          // the supervisor's derating through the cut (1: none)
+  double derated_s{0.0};              // time through the cut with the command derated
+  double trip_s{-1.0};                // from the cut's start to a trip (-1: none)
 };
 
 struct ScheduledCut {
   std::vector<ScheduledCutSegment> segments;
   double force_limit_n{0.0};          // the actuator's (actuator.force_limit_n)
   std::uint64_t handovers{0}, handovers_refused{0};
+  rt::SupervisorCounters counters;    // the supervisor's at the end
   [[nodiscard]] bool all_stable() const;
   [[nodiscard]] bool switches_within_limits() const;  // no limit acted through a switch, the force below the limit
 };
@@ -49,5 +54,16 @@ struct ScheduledCut {
 // before the first and running throughout. revolutions: per cut after the switch has settled.
 [[nodiscard]] ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConfig& job,
                                          const std::vector<ScheduledCutStep>& steps, int revolutions = 60);
+
+// The same with any cell (a speed schedule or not) and a robot that may differ from it: plant (null: the cell's
+// own) is what the structure, the actuator and its limits really are; the supervisor and controller run the
+// cell's configuration and analysis. A trip ends the steps (the segments so far are returned).
+struct SupervisedCutOptions {
+  const config::Config* plant{nullptr};
+  bool leads_swapped{false};  // the amplifier's output wired reversed: the loop's polarity flipped on the cell
+  int revolutions{60};
+};
+[[nodiscard]] ScheduledCut supervised_cut(const config::Config& cell, const config::MillingConfig& job,
+                                          const std::vector<ScheduledCutStep>& steps, const SupervisedCutOptions& o);
 
 }  // namespace robodamp::tune

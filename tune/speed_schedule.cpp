@@ -293,17 +293,21 @@ std::set<double> refine(Grid& g, Depths& d, std::size_t n_cands, const milling::
     std::vector<double> worse;
     for (double r : checks)
       if (d.depth(r, candidate_at(g, r)) < d.depth(r, 0) * (1.0 - 0.01 * s.worse_tolerance_pct)) worse.push_back(r);
-    if (worse.empty() || round == s.refine_rounds) break;
-    d.fill(worse, every(n_cands), "refining the bands");
+    if (worse.empty()) break;
+    // The last round: what is still worse gets the open loop's band (K = 0: never worse), which only shrinks the
+    // bands on either side, so every speed left to them stays a checked candidate's.
+    const bool last = round == s.refine_rounds;
+    if (!last) d.fill(worse, every(n_cands), "refining the bands");
     for (double r : worse) {
       const auto at = std::lower_bound(g.rpm.begin(), g.rpm.end(), r);
       const auto i = static_cast<std::size_t>(at - g.rpm.begin());
-      const std::size_t c = choose(d, r, n_cands, std::nullopt, s);
+      const std::size_t c = last ? 0 : choose(d, r, n_cands, std::nullopt, s);
       g.rpm.insert(at, r);
       g.choice.insert(g.choice.begin() + static_cast<std::ptrdiff_t>(i), c);
       checked.erase(r);
       ++refined;
     }
+    if (last) break;
   }
   return checked;
 }

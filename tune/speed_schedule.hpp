@@ -10,8 +10,9 @@
 // gain_min_pct; the previous speed's kept while within keep_within_pct of the best, for fewer bands). Bands
 // change halfway between grid speeds. Then the bands are checked at two speeds between each pair of grid
 // speeds: a check where the band's candidate is worse than the open loop becomes a grid speed of its own
-// (every candidate computed there, its band split off), for refine_rounds rounds. What stays worse is reported,
-// never hidden. Off the real-time path.
+// (every candidate computed there, its band split off), for refine_rounds rounds; a check still worse after the
+// last round gets a band of the open loop's (K = 0) around it, which only shrinks its neighbours' bands. What
+// the summary finds worse (between the checks) is reported, never hidden. Off the real-time path.
 #pragma once
 
 #include <cstddef>

@@ -194,7 +194,9 @@ function tile(c) {
       (c.publishers > 1 ? '<p class="trip">' + c.publishers + ' publishers call themselves ' + esc(c.cell) + '</p>' : '') +
       (fault || (c.trip && c.trip !== 'none') ? '<p class="trip" data-field="trip">trip: ' + esc(c.trip) + ' – ' + esc(c.trip_description) + '</p>' : '') +
       '<dl>' +
-      '<dt>damping</dt><dd>' + fmt(c.active_s, 1) + ' s active, ' + fmt(c.availability_pct, 1) + ' % of the time asked; ' + (c.trips || 0) + ' trips</dd>' +
+      '<dt>damping</dt><dd>' + fmt(c.active_s, 1) + ' s active, ' + fmt(c.availability_pct, 1) + ' % of the time asked' +
+      (c.derated_pct > 0 ? ' (' + fmt(c.derated_pct, 1) + ' % derated)' : '') + '; ' + (c.trips || 0) + ' trips' +
+      (c.derated ? ' <span class="derated" data-field="derated" title="the cut grew or saturated the actuator: the gain is lowered until it is quiet (docs/realtime_loop.md)">DERATED</span>' : '') + '</dd>' +
       '<dt>vibration</dt><dd>' + fmt(c.accel_rms_mps2, 4) + ' m/s² RMS</dd>' +
       '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
       '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' + (m.limits_ready ? fmt(limit, 2) + ' mm' : '…') +
@@ -337,7 +339,8 @@ function renderCounters(d) {
     ['telemetry ring drops', s.ring_drops], ['trips', s.trips], ['back at full gain', s.back_at_full_gain],
     ['wake-up p50 / p99 / max', fmt(s.wake_p50_us, 0) + ' / ' + fmt(s.wake_p99_us, 0) + ' / ' + fmt(s.wake_max_us, 1) + ' µs'],
     ['compute mean / max', fmt(s.compute_mean_us, 2) + ' / ' + fmt(s.compute_max_us, 1) + ' µs'],
-    ['availability', fmt(s.availability_pct, 2) + ' %'], ['parameter set', s.parameter_set],
+    ['availability', fmt(s.availability_pct, 2) + ' %'], ['derated now / share', (s.derated ? 'yes' : 'no') + ' / ' + fmt(s.derated_pct, 2) + ' %'],
+    ['parameter set', s.parameter_set],
     ['gain K / limit', fmt(s.gain_ns_per_m, 0) + ' / ' + fmt(s.max_gain_ns_per_m, 0) + ' N s/m'],
     ['parameter writes', s.parameter_writes ? 'on' : 'off (the cell refuses actions)']];
   $('counters').innerHTML = rows.map((r) => '<tr><td>' + esc(r[0]) + '</td><td data-counter="' + esc(r[0]) + '">' + esc(r[1] === undefined ? '–' : r[1]) + '</td></tr>').join('');
