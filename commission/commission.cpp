@@ -189,6 +189,14 @@ class Run {
   // beats the open loop. Never worse than the open loop at the speeds checked, or the commissioning stops.
   void schedule() {
     const config::Config& tuned = *r_.tuned_config;
+    r_.robustness = tune::robustness(tuned);
+    const tune::Robustness& rb = *r_.robustness;
+    say_(fmt("commission: the tuned loop stays stable and damps its modes from %.1f %% to +%.1f %% of mode shift",
+             -rb.down.pct, rb.up.pct) + (rb.down.reason.empty() ? "" : "; " + rb.down.reason) +
+         (rb.up.reason.empty() ? "" : "; " + rb.up.reason) +
+         (rb.pct() < tune::kRobustShiftWarnPct
+              ? fmt(" (WARNING: under +-%.0f %%: a pose or tool change may move the modes further)", tune::kRobustShiftWarnPct)
+              : ""));
     std::vector<tune::NamedController> hand;
     for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2}) {
       config::Config c = tuned;

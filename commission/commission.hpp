@@ -20,6 +20,7 @@
 #include "commission/cell_check.hpp"
 #include "identify/commissioning.hpp"
 #include "tune/compensator_search.hpp"
+#include "tune/robustness.hpp"
 #include "tune/scheduled_cut.hpp"
 #include "tune/speed_schedule.hpp"
 #include "tune/verification.hpp"
@@ -78,6 +79,7 @@ struct CommissionResult {
   std::optional<tune::Evaluation> tuned;           // worst case over the plants
   std::optional<tune::Evaluation> tuned_nominal;   // on the identified plant
   std::optional<config::Config> tuned_config;
+  std::optional<tune::Robustness> robustness;      // the tuned loop on the identified plant, modes shifted
   std::optional<tune::Verification> promise;
   std::optional<CellCheck> cell;
   std::vector<std::pair<double, double>> open_curve_mm;  // the identified plant's open-loop lobes (SDM)

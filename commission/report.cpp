@@ -132,6 +132,16 @@ std::string tuned_section(const CommissionResult& r) {
   std::ostringstream h;
   h << "<h2>3. Tuned controller</h2>\n<p>Robust over the identified plant and its modes shifted by &plusmn;"
     << fmt("%.2f", r.shift_pct) << " % (" << esc(r.shift_reason) << ").</p>\n";
+  if (r.robustness) {
+    const tune::Robustness& rb = *r.robustness;
+    const bool weak = rb.pct() < tune::kRobustShiftWarnPct;
+    h << "<p" << (weak ? " class=\"warn\"><b>WARNING:</b> " : ">") << "Measured on the identified plant: the tuned loop stays "
+      << "stable and damps the modes it damps from " << fmt("%.1f", -rb.down.pct) << " % to +" << fmt("%.1f", rb.up.pct)
+      << " % of mode shift (steps of 0.5 %, at most 20 %)";
+    for (const auto* l : {&rb.down, &rb.up})
+      if (!l->reason.empty()) h << "; " << esc(l->reason);
+    h << "." << (weak ? " A pose or tool change may move the modes further than that." : "") << "</p>\n";
+  }
   if (!r.tuned) return h.str() + "<p>Not reached.</p>\n";
   const auto& e = *r.tuned;
   const auto& c = e.candidate;
@@ -312,7 +322,7 @@ std::string write_report(const CommissionSettings& s, const CommissionResult& r,
   h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>robodamp commission: " << esc(s.config_path)
     << "</title>\n<style>body{font-family:sans-serif;max-width:1250px;margin:auto;padding:1em}table{border-collapse:collapse;"
        "margin:0.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}td:first-child{text-align:left}"
-       ".ok{color:#1e8449}.bad{color:#c0392b;font-weight:bold}.banner{padding:0.6em;font-size:1.2em;border-radius:4px}"
+       ".ok{color:#1e8449}.warn{color:#b36b00}.bad{color:#c0392b;font-weight:bold}.banner{padding:0.6em;font-size:1.2em;border-radius:4px}"
        ".pass{background:#d5f5e3}.fail{background:#fadbd8}img{max-width:100%}code{background:#f4f4f4}</style></head><body>\n";
   h << "<h1>robodamp commission</h1>\n<p>Cell <code>" << esc(s.config_path) << "</code>, job <code>" << esc(s.job_path)
     << "</code>.<br>Command: <code>" << esc(s.command_line) << "</code></p>\n" << provenance(s);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -131,6 +132,18 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   EXPECT_NE(html.find("the schedule is never worse than no damper"), std::string::npos);
   EXPECT_NE(html.find("configuration SHA-256 <code>"), std::string::npos);
   EXPECT_NE(html.find("operator "), std::string::npos);
+  // How far the modes may move is measured and said (a warning under +-5 %), matching the loop model.
+  ASSERT_TRUE(r.robustness);
+  char held[96];
+  std::snprintf(held, sizeof held, "damps the modes it damps from %.1f %% to +%.1f %% of mode shift", -r.robustness->down.pct,
+                r.robustness->up.pct);
+  EXPECT_NE(html.find(held), std::string::npos) << held;
+  EXPECT_EQ(html.find("<b>WARNING:</b> Measured on the identified plant") != std::string::npos,
+            r.robustness->pct() < tune::kRobustShiftWarnPct);
+  for (const auto* l : {&r.robustness->down, &r.robustness->up})
+    if (!l->reached_max)
+      EXPECT_TRUE(l->reason.find("the loop unstable") != std::string::npos || l->reason.find("not damped") != std::string::npos)
+          << l->reason;
   const auto sched_rows = rows_of(dir / "plots" / "schedule_lobes.dat");
   ASSERT_EQ(sched_rows.size(), r.schedule->speeds.size());
   for (std::size_t i = 0; i < sched_rows.size(); ++i) {

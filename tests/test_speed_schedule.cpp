@@ -24,6 +24,8 @@
 #include "milling/structure.hpp"
 #include "rt/recording.hpp"
 #include "rt/supervisor.hpp"
+#include "tune/compensator_search.hpp"
+#include "tune/robustness.hpp"
 #include "runtime/cell.hpp"
 #include "test_util.hpp"
 #include "tune/scheduled_cut.hpp"
@@ -415,6 +417,33 @@ TEST(SpeedSchedule, EachScheduledPresetsRecordedCommandWritesItAgain) {
     EXPECT_EQ(std::regex_replace(again, out_path, " --out X\n"), std::regex_replace(text, out_path, " --out X\n")) << name;
   }
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace robodamp
+
+namespace robodamp {
+namespace {
+
+// How far the modes may move before the tuned loop stops being good: the default preset's C2 (its schedule off)
+// at K = 2000 N s/m holds the whole +-20 %; at 4500 N s/m (0.94 x K_max) the modes 7 % lower make it unstable,
+// and the loop model says so at exactly the step the scan names (stable at -6.5 %, not at -7 %).
+TEST(Robustness, TheModeShiftATunedLoopHoldsIsMeasuredToTheStep) {
+  config::Config c = config::load_config_file(test::preset("horizontal_c2"));
+  c.controller.speed_schedule.reset();
+  const tune::Robustness easy = tune::robustness(c);
+  EXPECT_TRUE(easy.down.reached_max && easy.up.reached_max);
+  EXPECT_DOUBLE_EQ(easy.pct(), 20.0);
+  c.controller.gain_ns_per_m = 4500.0;
+  const tune::Robustness tight = tune::robustness(c);
+  EXPECT_DOUBLE_EQ(tight.down.pct, 6.5);
+  EXPECT_EQ(tight.down.reason, "at -7.0 %: the loop unstable");
+  EXPECT_TRUE(tight.up.reached_max);
+  EXPECT_LT(tight.pct(), tune::kRobustShiftWarnPct + 2.0);
+  for (const auto& [factor, stable] : {std::pair{0.935, true}, std::pair{0.93, false}}) {
+    const config::Config shifted = tune::with_shifted_modes(c, factor);
+    EXPECT_EQ(analysis::LoopModel(shifted).stable(4500.0, c.controller.polarity), stable) << factor;
+  }
 }
 
 }  // namespace
