@@ -1,5 +1,6 @@
 // `robodamp check-config FILE`: validate a controller configuration (chain design and the plant's
-// physical consistency) or a milling job (its structures, controller parts included), every problem at once.
+// physical consistency), a milling job (its structures, controller parts included) or the dashboard's file,
+// every problem at once.
 #include <iostream>
 #include <memory>
 
@@ -7,6 +8,7 @@
 
 #include "apps/cli.hpp"
 #include "config/config.hpp"
+#include "config/dashboard_config.hpp"
 #include "config/milling_config.hpp"
 #include "control/chain_design.hpp"
 #include "milling/structure.hpp"
@@ -16,13 +18,25 @@ namespace robodamp::apps {
 
 namespace {
 
-// A milling job (config/milling/) has a top-level `tool`; its controller parts are loaded and checked too.
-bool is_milling_job(const std::string& path) {
+// What a file is by its top-level keys: a milling job (config/milling/) has `tool`, the dashboard's file
+// (docs/dashboard.md) `dashboard`; anything else is a cell's configuration.
+enum class Kind { kCell, kMillingJob, kDashboard };
+Kind kind_of(const std::string& path) {
   try {
-    return YAML::LoadFile(path)["tool"].IsDefined();
+    const YAML::Node n = YAML::LoadFile(path);
+    if (!n.IsMap()) return Kind::kCell;
+    if (n["tool"].IsDefined()) return Kind::kMillingJob;
+    if (n["dashboard"].IsDefined()) return Kind::kDashboard;
   } catch (const YAML::Exception&) {
-    return false;  // the configuration parser reports the syntax error
   }
+  return Kind::kCell;  // the configuration parser reports a syntax error
+}
+
+int check_dashboard(const std::string& path) {
+  const auto d = config::load_dashboard_config(path);
+  std::cout << path << ": OK (dashboard, " << d.listen_address << ":" << d.port << ", DDS domain " << d.dds.domain_id
+            << (d.credentials.empty() ? ", no credentials: nobody may act" : ", credentials " + d.credentials) << ")\n";
+  return 0;
 }
 
 int check_milling(const std::string& path) {
@@ -34,7 +48,11 @@ int check_milling(const std::string& path) {
 }
 
 int check_config(const std::string& path) {
-  if (is_milling_job(path)) return check_milling(path);
+  switch (kind_of(path)) {
+    case Kind::kMillingJob: return check_milling(path);
+    case Kind::kDashboard: return check_dashboard(path);
+    case Kind::kCell: break;
+  }
   const auto cfg = config::load_config_file(path);
   const auto d = control::design_chain(cfg);
   if (!cfg.robot.frfs.empty()) (void)sim::build_plant_model(cfg);  // the plant's physical consistency
@@ -47,7 +65,7 @@ int check_config(const std::string& path) {
 
 void register_check_config(Registry& r) {
   auto path = std::make_shared<std::string>();
-  CLI::App* sub = r.add("check-config", "Validate a configuration (controller or milling job) and report every problem at once",
+  CLI::App* sub = r.add("check-config", "Validate a configuration (a cell's, a milling job or the dashboard's) and report every problem at once",
                         [path] { return check_config(*path); });
   sub->add_option("file", *path, "Configuration file (YAML)")->required();
 }

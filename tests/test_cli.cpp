@@ -106,6 +106,22 @@ TEST(Cli, CheckConfigAcceptsEveryPreset) {
   }
 }
 
+// The dashboard's own file (docs/dashboard.md's example) is checked as one, with its keys' units and ranges.
+TEST(Cli, CheckConfigChecksTheDashboardsFile) {
+  const std::string path = temp_path("dashboard.yaml");
+  std::ofstream(path) << "dashboard:\n  port: 8090\ndds:\n  domain_id: 3\n";
+  const Result ok = run("check-config " + path);
+  EXPECT_EQ(ok.status, 0) << ok.out;
+  EXPECT_NE(ok.out.find(": OK (dashboard, 127.0.0.1:8090, DDS domain 3, no credentials: nobody may act)"), std::string::npos) << ok.out;
+  std::ofstream(path) << "dashboard:\n  port: 70000\n  stale_after: 2\n  credentials: nobody.yaml\ndds:\n  domain_id: 0\n";
+  const Result bad = run("check-config " + path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(bad.status, 2) << bad.out;
+  EXPECT_NE(bad.out.find("dashboard.port = 70000"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("dashboard.stale_after: unknown key"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("nobody.yaml': no such file (robodamp dashboard-user makes one)"), std::string::npos) << bad.out;
+}
+
 TEST(Cli, CheckConfigReportsAllProblemsAtOnce) {
   std::ifstream in(robodamp::test::preset("horizontal_c2"));
   std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
