@@ -145,6 +145,10 @@ std::string advice_view(const msg::Advice& m) {
 
 }  // namespace
 
+// Nothing new for this long: the monitor says the loop is out of contact (the dashboard's stale_after_s is 2 s;
+// the status alone comes at dds.status_rate_hz, 5 Hz by default).
+constexpr double kNoContactS = 3.0;
+
 // 0 when it saw the loop (telemetry or status), 1 when nothing came.
 int run_monitor(const DdsClientOptions& o) {
   rt::install_shutdown_handlers();
@@ -163,13 +167,30 @@ int run_monitor(const DdsClientOptions& o) {
             << "), waiting for a loop; Ctrl-C ends\n";
   const auto end = Clock::now() + std::chrono::duration<double>(o.duration_s);
   std::uint64_t shown = 0;
+  auto heard = Clock::now();
+  bool silent = false;  // said "no contact" and heard nothing since
   while (rt::shutdown_signal().load() == 0 && (o.duration_s <= 0.0 || Clock::now() < end)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     const auto [t, nt] = telemetry.get();
     const auto [s, ns] = status.get();
     const auto [m, nm] = machining.get();
     const auto [a, na] = advice.get();
-    if (nt + ns + nm + na == shown) continue;
+    if (nt + ns + nm + na == shown) {
+      // A loop that stops publishing (ended, crashed, the link down) is said, not shown frozen.
+      const double quiet_s = std::chrono::duration<double>(Clock::now() - heard).count();
+      if (shown > 0 && !silent && quiet_s >= kNoContactS) {
+        silent = true;
+        std::cout << "robodamp monitor: NO CONTACT: nothing from " << (ns ? s.cell().c_str() : t.cell().c_str()) << " for "
+                  << static_cast<int>(quiet_s) << " s: the loop stopped or the link is down (last seen: state "
+                  << (nt ? rt::to_string(static_cast<rt::State>(t.state())) : s.state().c_str()) << " at loop time "
+                  << (nt ? t.time_s() : s.time_s()) << " s); the view above is old\n"
+                  << std::flush;
+      }
+      continue;
+    }
+    if (silent) std::cout << "robodamp monitor: contact again\n";
+    silent = false;
+    heard = Clock::now();
     shown = nt + ns + nm + na;
     if (tty) std::cout << "\x1b[H\x1b[2J";  // redraw in place
     std::cout << view(t, nt, s, ns) << (nm ? machining_view(m) : "") << (na ? advice_view(a) : "") << (tty ? "" : "\n")

@@ -268,11 +268,21 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   test::Child request({"request", "--config", dir + "/dds.yaml", "--gain", "2500", "--timeout", "60"}, dir + "/request.log");
   EXPECT_EQ(request.wait_for(120.0), std::optional<int>(3)) << test::read_file(dir + "/request.log");
   EXPECT_NE(test::read_file(dir + "/request.log").find("refused: parameter writes are off"), std::string::npos);
+  // A monitor watching when the loop ends says so instead of freezing (issue 52).
+  test::Child watching({"monitor", "--config", dir + "/dds.yaml", "--duration", "300"}, dir + "/watching.log");
+  EXPECT_TRUE(eventually([&] { return test::read_file(dir + "/watching.log").find("state      active") != std::string::npos; }, 60.0))
+      << test::read_file(dir + "/watching.log");
   run.kill(SIGINT);
   EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
+  EXPECT_TRUE(eventually([&] { return test::read_file(dir + "/watching.log").find("NO CONTACT: nothing from") != std::string::npos; }, 60.0))
+      << test::read_file(dir + "/watching.log");
+  EXPECT_NE(test::read_file(dir + "/watching.log").find("the loop stopped or the link is down"), std::string::npos);
+  watching.kill(SIGINT);
+  EXPECT_TRUE(watching.wait_for(60.0).has_value());
   const std::string log = test::read_file(dir + "/run.log");
   EXPECT_NE(log.find("tripped: signal"), std::string::npos) << log;
   EXPECT_NE(log.find("arming: armed"), std::string::npos) << log;
+  std::system(("rm -rf " + dir).c_str());
 }
 
 // Live stability on DDS: `robodamp run` with a milling job (spindle.job), the spindle speed from a DDS
