@@ -163,6 +163,10 @@ class Cell {
   double sum_sq_{0.0};
   std::uint64_t n_samples_{0};
   std::int64_t n_frames_{0}, last_fresh_frame_{-1};
+  // The loop's state, trip and derating as the drain last saw them: each change is logged when it happens.
+  std::uint8_t seen_state_{255}, seen_trip_{0};
+  bool seen_derated_{false};
+  void log_changes(const rt::TelemetryFrame& f);
   std::optional<rt::AvailabilityMeter> availability_;  // fed on the drain thread
   std::vector<rt::TelemetryFrame> frames_;
 };

@@ -282,6 +282,10 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   const std::string log = test::read_file(dir + "/run.log");
   EXPECT_NE(log.find("tripped: signal"), std::string::npos) << log;
   EXPECT_NE(log.find("arming: armed"), std::string::npos) << log;
+  // The loop's changes are logged as they happen (the drain thread), not only in the summary at the end.
+  EXPECT_NE(log.find("loop: active at"), std::string::npos) << log;
+  EXPECT_NE(log.find("loop: tripped signal at"), std::string::npos) << log;
+  EXPECT_LT(log.find("loop: tripped signal at"), log.find("tripped: signal")) << "before the summary";
   std::system(("rm -rf " + dir).c_str());
 }
 
