@@ -199,12 +199,14 @@ function tile(c) {
       (c.derated ? ' <span class="derated" data-field="derated" title="the cut grew or saturated the actuator: the gain is lowered until it is quiet (docs/realtime_loop.md)">DERATED</span>' : '') + '</dd>' +
       '<dt>vibration</dt><dd>' + fmt(c.accel_rms_mps2, 4) + ' m/s² RMS</dd>' +
       '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
-      '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' + (m.limits_ready ? fmt(limit, 2) + ' mm' : '…') +
+      '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' +
+        (m.limits_ready ? fmt(limit, 2) + ' mm' + (m.loop_active ? ' (damped)' : ' (open loop: the damper is off)') : '…') +
         (m.depth_warning ? ' <span class="chatter">above the limit</span>' : '') +
         '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
-      (c.advice ? '<dt>advice</dt><dd>' + (c.advice.found ? 'go to ' + fmt(c.advice.advised_rpm, 1) + ' rpm' : 'no stable speed in range') +
-        ' (#' + c.advice.seq + ')</dd>' : '') +
+      (c.advice ? '<dt>advice</dt><dd>' + (!c.advice.found ? 'no stable speed in range'
+        : Math.abs((m.spindle_rpm || 0) - c.advice.advised_rpm) < 0.5 ? 'at the advised ' + fmt(c.advice.advised_rpm, 1) + ' rpm'
+        : 'go to ' + fmt(c.advice.advised_rpm, 1) + ' rpm') + ' (#' + c.advice.seq + ')</dd>' : '') +
       '</dl>',
   };
 }

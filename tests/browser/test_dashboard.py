@@ -205,7 +205,8 @@ class DashboardInABrowser(unittest.TestCase):
         for key, rpm in (("a", "700 rpm"), ("b", "600 rpm")):
             until(lambda: (self.tile(key) or {}).get("state") == "active", 90, f"cell {key} active")
             until(lambda: rpm in self.tile(key)["text"], 60, f"cell {key} at {rpm}")
-        until(lambda: "2.50 mm of 2.35 mm" in self.tile("a")["text"], 90, "cell a's depth against its scheduled damped limit")
+        # The limit says whose it is: the damper active, so the damped one.
+        until(lambda: "2.50 mm of 2.35 mm (damped)" in self.tile("a")["text"], 90, "cell a's depth against its scheduled damped limit")
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
 
         self.open_cell("a")
