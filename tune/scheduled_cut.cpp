@@ -29,8 +29,7 @@ namespace {
 // and a ready amplifier, an operator command posted for the next tick.
 class SupervisedLoop final : public milling::LoopDriver {
  public:
-  SupervisedLoop(rt::Supervisor& sup, double fs_hz, bool leads_swapped)
-      : sup_(sup), dt_s_(1.0 / fs_hz), sign_(leads_swapped ? -1.0 : 1.0) {}
+  SupervisedLoop(rt::Supervisor& sup, double fs_hz) : sup_(sup), dt_s_(1.0 / fs_hz) {}
   double tick(double accel_mps2, bool& limited) override {
     rt::TickInput in;
     in.dt_s = dt_s_;
@@ -50,7 +49,7 @@ class SupervisedLoop final : public milling::LoopDriver {
     if (out.derated) derated_s += dt_s_;
     time_s += dt_s_;
     if (out.trip != rt::Trip::kNone && trip_s < 0.0) trip_s = time_s;
-    return sign_ * out.command_v;
+    return out.command_v;
   }
   void post(rt::OperatorCommand c) { pending_ = c; }
   std::uint64_t limited_ticks{0};
@@ -61,7 +60,6 @@ class SupervisedLoop final : public milling::LoopDriver {
  private:
   rt::Supervisor& sup_;
   double dt_s_;
-  double sign_;
   rt::OperatorCommand pending_{};
 };
 
@@ -122,7 +120,7 @@ ScheduledCut supervised_cut(const config::Config& cell, const config::MillingCon
   const milling::Structure damped(job.selected_structure(), true,
                                   {model, cell.controller.gain_ns_per_m, cell.controller.polarity});
   milling::DampedDynamics dyn(damped, job.cut.feed_axis);
-  SupervisedLoop loop(*sup, cell.loop.rate_hz, opt.leads_swapped);
+  SupervisedLoop loop(*sup, cell.loop.rate_hz);
   dyn.drive_with(&loop);
   ScheduledCut out;
   out.force_limit_n = dyn.actuator_force_limit_n();

@@ -60,7 +60,6 @@ struct ScheduledCut {
 // cell's configuration and analysis. A trip ends the steps (the segments so far are returned).
 struct SupervisedCutOptions {
   const config::Config* plant{nullptr};
-  bool leads_swapped{false};  // the amplifier's output wired reversed: the loop's polarity flipped on the cell
   int revolutions{60};
 };
 [[nodiscard]] ScheduledCut supervised_cut(const config::Config& cell, const config::MillingConfig& job,
