@@ -18,6 +18,8 @@
 #include "apps/identify_command.hpp"
 #include "identify/cutting_coefficients.hpp"
 #include "identify/modal_fit.hpp"
+#include "identify/uff_frf.hpp"
+#include "measfiles/uff.hpp"
 
 namespace robodamp::apps {
 
@@ -65,11 +67,31 @@ int run_modes(const IdentifyArgs& a) {
       throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
     if (a.frf_path.empty() == a.series_path.empty())
       throw std::invalid_argument("give either --frf (an FRF) or --series (force and response in time)");
-    if (!a.frf_path.empty()) {
+    const bool dof_response = a.response.find_first_of("0123456789") != std::string::npos;
+    if (!dof_response && a.response != "acceleration" && a.response != "velocity" && a.response != "displacement")
+      throw std::invalid_argument("--response '" + a.response + "': allowed acceleration, velocity, displacement (--series) or NODE:DIR (a universal file's record)");
+    if (!a.frf_path.empty() && identify::looks_like_uff(a.frf_path)) {
+      identify::UffSelection sel;
+      sel.record = a.record;
+      if (dof_response) sel.response = identify::parse_dof(a.response);
+      if (!a.reference.empty()) sel.reference = identify::parse_dof(a.reference);
+      const measfiles::UffFile file = measfiles::read_uff(a.frf_path);
+      const identify::UffFrf frf = identify::frf_from_uff(file, a.frf_path, sel);
+      if (frf.units.per_volt)
+        throw std::invalid_argument(a.frf_path + ": record " + std::to_string(frf.record) + " is per volt (an actuator's FRF); identify modes reads an FRF per force");
+      std::printf("record %d: %s / %s, %s, %zu points%s\n", frf.record,
+                  identify::dof_text(frf.function->response_node, frf.function->response_direction).c_str(),
+                  identify::dof_text(frf.function->reference_node, frf.function->reference_direction).c_str(), frf.units.shown.c_str(),
+                  frf.data.f_hz.size(), frf.data.coherence.empty() ? ", no coherence record" : ", with its coherence");
+      d = frf.data;
+    } else if (!a.frf_path.empty()) {
+      if (a.record || dof_response || !a.reference.empty())
+        throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " + a.frf_path + " is a table");
       const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
                         : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
       d = identify::read_frf_csv(a.frf_path, kind);
     } else {
+      if (dof_response) throw std::invalid_argument("--response with --series: acceleration, velocity or displacement");
       const auto kind = a.response == "velocity" ? identify::FrfKind::kMobility
                         : a.response == "acceleration" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
       d = identify::frf_from_time_series_csv(a.series_path, kind, a.segment_s, a.overlap,
@@ -176,11 +198,17 @@ void register_identify(Registry& r) {
   sub->add_option("what", a->what, "What to identify: modes, actuator, all or cutting")
       ->required()
       ->check(CLI::IsMember({"modes", "actuator", "all", "cutting"}));
-  sub->add_option("--frf", a->frf_path, "modes: FRF CSV freq_hz,re_m_per_n,im_m_per_n[,coherence]")->check(CLI::ExistingFile);
+  sub->add_option("--frf", a->frf_path,
+                  "modes: an FRF table freq_hz,re_m_per_n,im_m_per_n[,coherence] (any delimiter, decimal comma, header or none) "
+                  "or a universal file (dataset 58/58b; its header gives the kind and the units)")
+      ->check(CLI::ExistingFile);
+  r.whole_number(sub, "--record", a->record, {"(record)", 1, 1000000}, "modes: the universal file's Nth function record");
+  sub->add_option("--reference", a->reference, "modes: the universal file's record by its reference DOF NODE:DIR (e.g. 2:+Y)");
   sub->add_option("--series", a->series_path, "modes: time series CSV time_s,force_n,response (H1 by Welch)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--response", a->response, "modes: the --series response (acceleration, velocity, displacement)")
-      ->check(CLI::IsMember({"acceleration", "velocity", "displacement"}));
+  sub->add_option("--response", a->response,
+                  "modes: the --series response (acceleration, velocity, displacement), or a universal file's record by its "
+                  "response DOF NODE:DIR (e.g. 1:+Y)");
   r.number(sub, "--segment-s", a->segment_s, {"s", 0.0, 1e5, true, false}, "modes, actuator: Welch segment length for --series / --csv");
   r.number(sub, "--overlap", a->overlap, {"(fraction)", 0.0, 0.9, false, false}, "modes: Welch segment overlap for --series");
   sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));

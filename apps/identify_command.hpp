@@ -23,6 +23,8 @@ struct IdentifyArgs {
   // modes
   std::string frf_path, kind{"receptance"}, plot_dir;
   std::string series_path, response{"acceleration"};
+  std::optional<int> record;  // a universal file's function record
+  std::string reference;      // a universal file's reference DOF
   double segment_s{10.0}, overlap{0.5};
   std::vector<double> band_hz;
   std::optional<int> max_order;  // default: 40 for one FRF, CommissioningSettings{}.max_order for all

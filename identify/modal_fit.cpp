@@ -1,4 +1,5 @@
 #include "identify/modal_fit.hpp"
+#include "measfiles/table.hpp"
 
 #include <algorithm>
 #include <fstream>
@@ -406,10 +407,8 @@ ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
 
 FrfData read_frf_csv(const std::string& path, FrfKind kind) {
   const std::string prefix = "freq_hz,re_m_per_n,im_m_per_n";
-  std::ifstream probe(path);
-  std::string first;
-  std::getline(probe, first);
-  const bool with_coherence = first.rfind(prefix + ",coherence", 0) == 0;
+  const measfiles::Table t = measfiles::read_table(path);
+  const bool with_coherence = t.names.empty() ? t.columns >= 4 : t.names.size() >= 4 && measfiles::normalised(t.names[3]) == "coherence";
   const NumericCsv csv = read_numeric_csv(path, prefix, prefix + "[,coherence]", with_coherence ? 4 : 3);
   FrfData d;
   for (const auto& v : csv.rows) {

@@ -1,5 +1,7 @@
 #include "identify/numeric_csv.hpp"
 
+#include "measfiles/table.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -10,30 +12,23 @@ namespace robodamp::identify {
 
 NumericCsv read_numeric_csv(const std::string& path, const std::string& header_prefix, const std::string& header_shown,
                             std::size_t columns) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(path + ": cannot be read");
+  const measfiles::Table t = measfiles::read_table(path);
+  std::vector<measfiles::ColumnSpec> wanted;
+  std::istringstream names(header_prefix);
+  for (std::string n; wanted.size() < columns && std::getline(names, n, ',');) wanted.push_back({{n}, std::nullopt});
+  if (!t.names.empty()) {
+    for (std::size_t k = 0; k < wanted.size(); ++k)
+      if (k >= t.names.size() || measfiles::normalised(t.names[k]) != wanted[k].names.front())
+        throw std::invalid_argument(path + ":" + std::to_string(t.header_line) + ": the header must be " + header_shown +
+                                    " (or no header, the columns in that order)");
+  } else if (t.columns < columns) {
+    throw std::invalid_argument(path + ":" + std::to_string(t.lines.front()) + ": " + std::to_string(columns) + " values expected");
+  }
   NumericCsv csv;
-  int number = 1;
-  while (std::getline(in, csv.header) && !csv.header.empty() && csv.header[0] == '#') ++number;  // comments first
-  if (csv.header.substr(0, header_prefix.size()) != header_prefix)
-    throw std::invalid_argument(path + ":" + std::to_string(number) + ": the header must be " + header_shown);
-  std::string line;
-  for (++number; std::getline(in, line); ++number) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream row(line);
-    std::string cell;
-    std::vector<double> values;
-    while (values.size() < columns && std::getline(row, cell, ',')) {
-      char* end = nullptr;
-      const double v = std::strtod(cell.c_str(), &end);
-      if (cell.empty() || end == cell.c_str() || *end != '\0')
-        throw std::invalid_argument(path + ":" + std::to_string(number) + ": '" + cell + "' is not a number");
-      values.push_back(v);
-    }
-    if (values.size() != columns)
-      throw std::invalid_argument(path + ":" + std::to_string(number) + ": " + std::to_string(columns) + " values expected");
-    csv.rows.push_back(std::move(values));
-    csv.lines.push_back(number);
+  for (std::size_t k = 0; k < t.names.size(); ++k) csv.header += (k > 0 ? "," : "") + t.names[k];
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    csv.rows.emplace_back(t.rows[i].begin(), t.rows[i].begin() + static_cast<long>(columns));
+    csv.lines.push_back(t.lines[i]);
   }
   return csv;
 }
