@@ -235,6 +235,12 @@ void register_identify(Registry& r) {
       ->check(CLI::ExistingFile);
   sub->add_option("--in", a->in_dir, "all: the directory robodamp measure wrote")->check(CLI::ExistingDirectory);
   sub->add_option("--out", a->out_path, "all: write the identified configuration (YAML) here");
+  sub->add_option("--uff", a->uff_path,
+                  "all: a universal file instead of --in: an FRF per force between every pair of locations and the "
+                  "actuator's acceleration per volt at the sensor (what measure and commission export)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--config", a->config_path, "all --uff: the configuration the measurement ran with")->check(CLI::ExistingFile);
+  sub->add_option("--modes-uff", a->modes_uff_path, "all: also write the identified modes as a universal file (datasets 15, 55)");
   r.json(sub, a->json, "The result and its quality figures");
   sub->add_option("--yaml", a->yaml_path, "Write a modes: list (modes) or a material: block (cutting)");
 }

@@ -34,6 +34,7 @@ struct IdentifyArgs {
   int order{3};
   // actuator and all
   std::string recording_path, structure_path, in_dir, out_path;
+  std::string uff_path, config_path, modes_uff_path;  // all: from a universal file
 };
 
 // Measured against fitted magnitude and phase (<prefix>_fit.png) and the stabilisation diagram

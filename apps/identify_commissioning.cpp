@@ -1,4 +1,7 @@
 // `robodamp identify actuator`: Eq. 3 (T, natural frequency, damping, delay) from a chirp recorded by
+
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
 // robodamp measure (with the structure's FRF at the sensor) or from a CSV of command and transmitted
 // force. `robodamp identify all`: a complete configuration from a robodamp measure directory.
 // docs/identification.md.
@@ -117,22 +120,28 @@ int run_identify_actuator(const IdentifyArgs& a) {
 }
 
 int run_identify_all(const IdentifyArgs& a) {
-  if (a.in_dir.empty() || a.out_path.empty()) {
-    std::cerr << "robodamp identify all: --in (a robodamp measure directory) and --out (the configuration to write) are "
-                 "required\n";
+  if (a.in_dir.empty() == a.uff_path.empty() || a.out_path.empty() || a.uff_path.empty() != a.config_path.empty()) {
+    std::cerr << "robodamp identify all: --in (a robodamp measure directory) or --uff (a universal file) with --config (the "
+                 "configuration it was measured with), and --out (the configuration to write) are required\n";
     return 2;
   }
   identify::CommissioningSettings s;
   if (a.max_order) s.max_order = *a.max_order;
   identify::CommissioningResult r;
   try {
-    r = identify::identify_all(a.in_dir, s);
+    const identify::CommissioningInputs in =
+        a.uff_path.empty() ? identify::read_measurement_dir(a.in_dir) : identify::read_measurement_uff(a.uff_path, a.config_path);
+    r = identify::identify_all(in, s);
+    if (!a.modes_uff_path.empty()) {
+      measfiles::write_uff(a.modes_uff_path, identify::modes_to_uff(r), measfiles::UffEncoding::kAscii);
+      std::printf("wrote %s\n", a.modes_uff_path.c_str());
+    }
   } catch (const std::exception& e) {
     std::cerr << "robodamp identify all: " << e.what() << '\n';
     return 2;
   }
-  std::printf("robodamp identify all: %s (%s, measured with %s)\n", a.in_dir.c_str(), r.manifest.backend.c_str(),
-              r.manifest.config_source.c_str());
+  std::printf("robodamp identify all: %s (%s, measured with %s)\n", (a.uff_path.empty() ? a.in_dir : a.uff_path).c_str(),
+              r.manifest.backend.c_str(), r.manifest.config_source.c_str());
   std::cout << identify::summary_text(r);
   {
     std::ofstream out(a.out_path);

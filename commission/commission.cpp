@@ -1,5 +1,8 @@
 #include "commission/commission.hpp"
 
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
+
 #include "commission/emulated_cell.hpp"
 
 #include <algorithm>
@@ -111,10 +114,15 @@ class Run {
                  "the chirp saturated the actuator over " + std::to_string(sat) +
                      " ticks: the measurement is not linear; lower commissioning.chirp_force_fraction"};
     identify::CommissioningSettings cs;
-    r_.identified = identify::identify_all((dir_ / "measurement").string(), cs);
+    const identify::CommissioningInputs inputs = identify::read_measurement_dir((dir_ / "measurement").string());
+    r_.identified = identify::identify_all(inputs, cs);
     const auto& id = *r_.identified;
     std::ofstream(dir_ / "identified.yaml") << id.yaml;
     std::ofstream(dir_ / "identified.json") << identify::to_json(id).dump(2) << '\n';
+    // What a modal package opens: every FRF measured with its coherence, and the identified modes.
+    measfiles::write_uff((dir_ / "measurement" / identify::kMeasurementUffName).string(), identify::measurement_to_uff(inputs),
+                         measfiles::UffEncoding::kAscii);
+    measfiles::write_uff((dir_ / identify::kModesUffName).string(), identify::modes_to_uff(id), measfiles::UffEncoding::kAscii);
     say_("commission: identified " + std::to_string(id.frfs.size()) + " FRFs; " +
          fmt("actuator T %.3f N/V, %.3f Hz, zeta %.4f, delay %.3f ms", id.actuator.force_constant_n_per_v,
              id.actuator.natural_freq_hz, id.actuator.damping_ratio, id.actuator.delay_ms));

@@ -1,5 +1,8 @@
 #include "commission/measurement.hpp"
 
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -199,6 +202,16 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
   } else if (s.record_errors > 0) {
     out.status = MeasureStatus::kWriteError;
     out.message = "the recording had " + std::to_string(s.record_errors) + " write errors";
+  } else if (test) {
+    // The measurement as a universal file for a modal package (with hardware the plant side writes the
+    // impact FRFs later: identify all and commission export them).
+    const std::string uff = (fs::path(out_dir) / identify::kMeasurementUffName).string();
+    try {
+      measfiles::write_uff(uff, identify::measurement_to_uff(identify::read_measurement_dir(out_dir)), measfiles::UffEncoding::kAscii);
+    } catch (const std::exception& e) {
+      out.status = MeasureStatus::kWriteError;
+      out.message = uff + ": " + e.what();
+    }
   }
   return out;
 }

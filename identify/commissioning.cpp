@@ -35,13 +35,10 @@ std::string frf_name(const config::Config& cfg, int g, int h) {
   return name;
 }
 
-// The robot's FRFs: one per pair of locations (the lower triangle; the upper follows by reciprocity).
-std::vector<IdentifiedFrf> fit_frfs(const std::string& dir, const MeasurementManifest& m, const config::Config& cfg,
-                                    const CommissioningSettings& s, std::string& pole_fit) {
+// The robot's FRFs from the directory: one per pair of locations (the lower triangle; the upper follows
+// by reciprocity).
+std::vector<IdentifiedFrf> read_frfs(const std::string& dir, const MeasurementManifest& m, const config::Config& cfg) {
   std::vector<IdentifiedFrf> out;
-  ModalFitSettings ms;
-  ms.band_lo_hz = cfg.analysis.band_min_hz, ms.band_hi_hz = cfg.analysis.band_max_hz;
-  ms.max_order = s.max_order, ms.min_coherence = s.min_coherence;
   for (std::size_t h = 0; h < m.locations.size(); ++h) {
     for (std::size_t g = h; g < m.locations.size(); ++g) {
       IdentifiedFrf f;
@@ -56,6 +53,14 @@ std::vector<IdentifiedFrf> fit_frfs(const std::string& dir, const MeasurementMan
       out.push_back(std::move(f));
     }
   }
+  return out;
+}
+
+// Each FRF's modes.
+void fit_frfs(std::vector<IdentifiedFrf>& out, const config::Config& cfg, const CommissioningSettings& s, std::string& pole_fit) {
+  ModalFitSettings ms;
+  ms.band_lo_hz = cfg.analysis.band_min_hz, ms.band_hi_hz = cfg.analysis.band_max_hz;
+  ms.max_order = s.max_order, ms.min_coherence = s.min_coherence;
   // The poles common to all of them (a close pair one FRF shows as one peak is apart in another), each
   // FRF's residues its own; one by one when the band is too wide for one common fit.
   std::vector<FrfData> data;
@@ -64,7 +69,7 @@ std::vector<IdentifiedFrf> fit_frfs(const std::string& dir, const MeasurementMan
     const std::vector<ModalFit> fits = fit_modes_common(data, ms);
     for (std::size_t i = 0; i < out.size(); ++i) out[i].fit = fits[i];
     pole_fit = "common poles over " + std::to_string(out.size()) + " FRFs";
-    return out;
+    return;
   } catch (const std::invalid_argument&) {
     pole_fit = "poles per FRF";
   }
@@ -75,7 +80,6 @@ std::vector<IdentifiedFrf> fit_frfs(const std::string& dir, const MeasurementMan
       throw std::invalid_argument(f.file + " (" + f.name + "): " + e.what());
     }
   }
-  return out;
 }
 
 const IdentifiedFrf& path_between(const std::vector<IdentifiedFrf>& frfs, int a, int b) {
@@ -302,11 +306,26 @@ MeasurementManifest read_manifest(const std::string& dir) {
   }
 }
 
+CommissioningInputs read_measurement_dir(const std::string& dir) {
+  CommissioningInputs in;
+  in.manifest = read_manifest(dir);
+  const config::Config measured = config::parse_config(in.manifest.config_text, in.manifest.config_source);
+  in.frfs = read_frfs(dir, in.manifest, measured);
+  in.chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string(), in.manifest.config_source);
+  in.identified_path = (fs::path(dir) / "identified.yaml").string();
+  return in;
+}
+
 CommissioningResult identify_all(const std::string& dir, const CommissioningSettings& s) {
+  return identify_all(read_measurement_dir(dir), s);
+}
+
+CommissioningResult identify_all(const CommissioningInputs& in, const CommissioningSettings& s) {
   CommissioningResult r;
-  r.manifest = read_manifest(dir);
+  r.manifest = in.manifest;
   const config::Config measured = config::parse_config(r.manifest.config_text, r.manifest.config_source);
-  r.frfs = fit_frfs(dir, r.manifest, measured, s, r.pole_fit);
+  r.frfs = in.frfs;
+  fit_frfs(r.frfs, measured, s, r.pole_fit);
 
   // The structure between the actuator and the sensor: the dominant mode, and the path the chirp
   // went through.
@@ -316,7 +335,7 @@ CommissioningResult identify_all(const std::string& dir, const CommissioningSett
     if (mode_peak(m) > best) best = mode_peak(m), r.dominant_mode_hz = m.natural_freq_hz;
 
   // The actuator against the identified structure (the measured configuration's actuator meanwhile).
-  const ChirpMeasurement chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string(), r.manifest.config_source);
+  const ChirpMeasurement& chirp = in.chirp;
   r.actuator_periods = chirp.periods_averaged;
   r.actuator.force_constant_n_per_v = measured.actuator.constant_n_per_v;
   r.actuator.natural_freq_hz = measured.actuator.natural_freq_hz;
@@ -329,7 +348,7 @@ CommissioningResult identify_all(const std::string& dir, const CommissioningSett
   // The configuration: first with the measured polarity, then with the one the analysis recommends.
   for (int pass = 0; pass < 2; ++pass) {
     r.yaml = compose_yaml(r, r.polarity);
-    r.config = config::parse_config(r.yaml, (fs::path(dir) / "identified.yaml").string());
+    r.config = config::parse_config(r.yaml, in.identified_path);
     const analysis::LoopModel model(r.config);
     const int recommended = analysis::analyse(model).recommended_polarity;
     if (recommended == r.polarity) break;

@@ -100,9 +100,21 @@ struct CommissioningResult {
   std::vector<std::pair<std::string, double>> improvements_pct;  // discrete loop, per FRF
 };
 
+// What identify all works from: a robodamp measure directory (read_measurement_dir) or a universal file
+// and the configuration measured with (identify/uff_commissioning.hpp).
+struct CommissioningInputs {
+  MeasurementManifest manifest;
+  std::vector<IdentifiedFrf> frfs;  // one per pair of locations, data only
+  ChirpMeasurement chirp;
+  std::string identified_path;      // where relative names of the identified configuration resolve from
+};
+// Throws std::invalid_argument naming what is missing or bad, or rt::RecordingError.
+[[nodiscard]] CommissioningInputs read_measurement_dir(const std::string& dir);
+
 // Throws std::invalid_argument (bad or missing measurement, a fit that fails) or config::ConfigError
 // (the identified configuration does not validate).
 [[nodiscard]] CommissioningResult identify_all(const std::string& dir, const CommissioningSettings& s);
+[[nodiscard]] CommissioningResult identify_all(const CommissioningInputs& in, const CommissioningSettings& s);
 
 [[nodiscard]] nlohmann::json to_json(const CommissioningResult& r);
 [[nodiscard]] std::string summary_text(const CommissioningResult& r);

@@ -179,9 +179,11 @@ UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, con
     const double hz = f.x[k] * x_scale;
     const std::complex<double> iw(0.0, kTwoPi * hz);
     std::complex<double> h = f.y[k] * out.units.to_si;
-    if (out.units.kind != FrfKind::kReceptance && !(hz > 0.0)) continue;  // no receptance at 0 Hz from a rate
-    if (out.units.kind == FrfKind::kMobility) h /= iw;
-    if (out.units.kind == FrfKind::kAccelerance) h /= iw * iw;
+    if (s.to_receptance) {
+      if (out.units.kind != FrfKind::kReceptance && !(hz > 0.0)) continue;  // no receptance at 0 Hz from a rate
+      if (out.units.kind == FrfKind::kMobility) h /= iw;
+      if (out.units.kind == FrfKind::kAccelerance) h /= iw * iw;
+    }
     out.data.f_hz.push_back(hz), out.data.h.push_back(h);
     if (coherence != nullptr) out.data.coherence.push_back(coherence->y[k].real());
   }

@@ -24,6 +24,7 @@ struct Dof {
 struct UffSelection {
   std::optional<int> record;  // the Nth function record of the file (1-based)
   std::optional<Dof> response, reference;
+  bool to_receptance{true};  // false: the ordinate as measured, in SI (m, m/s or m/s^2 per N or V)
 };
 
 // What an FRF record's ordinate and denominator are, in SI.

@@ -13,6 +13,8 @@
 
 #include <unistd.h>
 
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
 #include "commission/commission.hpp"
 #include "commission/cell_check.hpp"
 #include "commission/measurement.hpp"
@@ -121,6 +123,13 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
           << file;
     }
   }
+  // What a modal package opens (issue 48): every FRF measured with its coherence and the identified modes.
+  {
+    const measfiles::UffFile measured = measfiles::read_uff((dir / "measurement" / identify::kMeasurementUffName).string());
+    EXPECT_EQ(measured.functions.size(), 2u * (r.identified->frfs.size() + 1));
+    const measfiles::UffFile modes = measfiles::read_uff((dir / identify::kModesUffName).string());
+    EXPECT_EQ(modes.modes.size(), 2u);
+  }
   // The report: self-contained (every plot inlined), verified, and its plotted data are the computed series.
   const std::string html = test::read_file(r.report_path);
   EXPECT_NE(html.find("VERIFIED"), std::string::npos);
@@ -140,10 +149,12 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   EXPECT_NE(html.find(held), std::string::npos) << held;
   EXPECT_EQ(html.find("<b>WARNING:</b> Measured on the identified plant") != std::string::npos,
             r.robustness->pct() < tune::kRobustShiftWarnPct);
-  for (const auto* l : {&r.robustness->down, &r.robustness->up})
-    if (!l->reached_max)
+  for (const auto* l : {&r.robustness->down, &r.robustness->up}) {
+    if (!l->reached_max) {
       EXPECT_TRUE(l->reason.find("the loop unstable") != std::string::npos || l->reason.find("not damped") != std::string::npos)
           << l->reason;
+    }
+  }
   const auto sched_rows = rows_of(dir / "plots" / "schedule_lobes.dat");
   ASSERT_EQ(sched_rows.size(), r.schedule->speeds.size());
   for (std::size_t i = 0; i < sched_rows.size(); ++i) {

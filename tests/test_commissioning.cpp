@@ -24,6 +24,8 @@
 #include "hil_files.hpp"
 #include "identify/actuator_fit.hpp"
 #include "identify/commissioning.hpp"
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
 #include "rt/excitation.hpp"
 #include "rt/supervisor.hpp"
 #include "test_util.hpp"
@@ -193,6 +195,55 @@ void expect_round_trip(const std::string& dir, const std::string& measured_confi
   for (const auto& f : j["frfs"]) EXPECT_LT(f["fit_error_pct"].get<double>(), 5.0) << f["name"];
 }
 
+// Issue 48: what measure exported as a universal file gives identify all the configuration robodamp's own
+// directory gives: to the digit from the binary form (58b holds the doubles), within the ASCII form's 12
+// significant digits (and its abscissa step's 6) otherwise; and the modes file holds the identified modes.
+void expect_uff_round_trip(const std::string& dir, const std::string& measured_config) {
+  const std::string uff = dir + "/" + identify::kMeasurementUffName;
+  ASSERT_TRUE(std::filesystem::exists(uff));
+  const measfiles::UffFile file = measfiles::read_uff(uff);
+  EXPECT_EQ(file.functions.size(), 2u * (3u + 1u));  // H11, H21, H22 and the actuator, each with its coherence
+  const identify::CommissioningSettings s;
+  const identify::CommissioningInputs own = identify::read_measurement_dir(dir);
+  const identify::CommissioningResult from_dir = identify::identify_all(own, s);
+  const std::string binary = dir + "/binary.uff";
+  measfiles::write_uff(binary, identify::measurement_to_uff(own), measfiles::UffEncoding::kBinary);
+  const identify::CommissioningResult from_binary = identify::identify_all(identify::read_measurement_uff(binary, measured_config), s);
+  EXPECT_EQ(from_binary.yaml, from_dir.yaml);
+  // The command, from the ASCII file.
+  const std::string out = dir + "/from_uff.yaml", modes = dir + "/modes.uff", log = dir + "/identify_uff.log";
+  Child identify({"identify", "all", "--uff", uff, "--config", measured_config, "--out", out, "--modes-uff", modes}, log);
+  ASSERT_EQ(identify.wait(), 0) << test::read_file(log);
+  const config::Config a = config::load_config_file(out), b = from_dir.config;
+  ASSERT_EQ(a.robot.frfs.size(), b.robot.frfs.size());
+  for (std::size_t i = 0; i < a.robot.frfs.size(); ++i) {
+    ASSERT_EQ(a.robot.frfs[i].modes.size(), b.robot.frfs[i].modes.size());
+    for (std::size_t k = 0; k < a.robot.frfs[i].modes.size(); ++k) {
+      const auto &x = a.robot.frfs[i].modes[k], &y = b.robot.frfs[i].modes[k];
+      EXPECT_NEAR(x.natural_freq_hz, y.natural_freq_hz, 1e-5 * y.natural_freq_hz);
+      EXPECT_NEAR(x.damping_ratio, y.damping_ratio, 1e-4 * y.damping_ratio);
+      EXPECT_LT(std::abs(Complex(x.residue_re_m_per_n - y.residue_re_m_per_n, x.residue_im_m_per_n - y.residue_im_m_per_n)),
+                1e-4 * std::abs(Complex(y.residue_re_m_per_n, y.residue_im_m_per_n)));
+    }
+  }
+  EXPECT_NEAR(a.actuator.constant_n_per_v, b.actuator.constant_n_per_v, 1e-5 * b.actuator.constant_n_per_v);
+  EXPECT_NEAR(a.actuator.natural_freq_hz, b.actuator.natural_freq_hz, 1e-5 * b.actuator.natural_freq_hz);
+  EXPECT_NEAR(a.actuator.delay_s, b.actuator.delay_s, 1e-9);
+  EXPECT_EQ(a.controller.polarity, b.controller.polarity);
+  // The modes: the actuator's driving point residue is psi_a^2 with modal A = 1.
+  const measfiles::UffFile m = measfiles::read_uff(modes);
+  const auto& driving = from_dir.frfs.back();  // H22: the actuator's location with itself
+  ASSERT_EQ(driving.response_id, 2);
+  ASSERT_EQ(driving.excitation_id, 2);
+  ASSERT_EQ(m.modes.size(), driving.fit.modes.size());
+  for (std::size_t k = 0; k < m.modes.size(); ++k) {
+    const Complex psi = m.modes[k].shape[1].second[1];
+    const Complex r(driving.fit.modes[k].residue_re, driving.fit.modes[k].residue_im);
+    EXPECT_LT(std::abs(psi * psi - r), 1e-4 * std::abs(r)) << k;
+    EXPECT_NEAR(std::abs(m.modes[k].eigenvalue) / (2.0 * M_PI), driving.fit.modes[k].natural_freq_hz, 1e-4 * driving.fit.modes[k].natural_freq_hz);
+  }
+}
+
 TEST(Commissioning, SimulatedPlantRoundTripRecoversThePreset) {
   const std::string dir = temp_dir("sim");
   const std::string preset = test::preset("horizontal_c2");
@@ -206,6 +257,7 @@ TEST(Commissioning, SimulatedPlantRoundTripRecoversThePreset) {
   ASSERT_EQ(replay.wait(), 0) << test::read_file(dir + "/replay.log");
   EXPECT_NE(test::read_file(dir + "/replay.log").find("bit for bit"), std::string::npos);
   expect_round_trip(dir, preset);
+  expect_uff_round_trip(dir, preset);
 }
 
 TEST(Commissioning, HilEmulatorRoundTripRecoversThePreset) {
