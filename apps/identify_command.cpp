@@ -25,8 +25,6 @@ namespace robodamp::apps {
 
 namespace {
 
-nlohmann::json estimate(const identify::Estimate& e) { return {{"value", e.value}, {"ci95", e.ci95}}; }
-
 }  // namespace
 
 std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir,
@@ -139,51 +137,7 @@ int run_identify(const IdentifyArgs& a) {
   if (a.what == "actuator") return run_identify_actuator(a);
   if (a.what == "all") return run_identify_all(a);
   if (a.ball_end) return run_identify_ball_end(a);
-  if (a.csv_path.empty() || a.teeth == 0 || a.diameter_mm == 0.0 || a.axial_mm == 0.0 || a.radial_mm == 0.0) {
-    std::cerr << "robodamp identify cutting: --csv, --teeth, --diameter-mm, --axial-mm and --radial-mm are required\n";
-    return 2;
-  }
-  identify::CuttingTest t{a.teeth, a.diameter_mm, a.axial_mm, a.radial_mm,
-                          a.mode == "up" ? config::MillingMode::kUp : config::MillingMode::kDown};
-  identify::CuttingFit f;
-  try {
-    if (a.radial_mm > a.diameter_mm)
-      throw std::invalid_argument("--radial-mm = " + config::format_number(a.radial_mm) +
-                                  " mm is out of range: allowed 0 < value <= --diameter-mm = " +
-                                  config::format_number(a.diameter_mm) + " mm");
-    f = identify::identify_cutting(identify::read_mean_forces_csv(a.csv_path), t);
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "robodamp identify cutting: " << e.what() << '\n';
-    return 2;
-  }
-  std::printf("Cutting coefficients from %d feeds (%d teeth, %.3g mm, %.3g mm axial, %.3g mm radial, %s milling):\n",
-              f.samples, a.teeth, a.diameter_mm, a.axial_mm, a.radial_mm, a.mode.c_str());
-  auto line = [](const char* name, const identify::Estimate& e, const char* unit) {
-    std::printf("  %-4s %10.3f +- %.3f %s (95 %%)\n", name, e.value, e.ci95, unit);
-  };
-  line("Ktc", f.ktc, "N/mm^2"), line("Krc", f.krc, "N/mm^2"), line("Kac", f.kac, "N/mm^2");
-  line("Kte", f.kte, "N/mm"), line("Kre", f.kre, "N/mm"), line("Kae", f.kae, "N/mm");
-  std::printf("  R^2 %.6f (x, y) %.6f (z), residual RMS %.4g N, condition number %.3g (refused above %.0e)\n", f.r2_xy,
-              f.r2_z, f.residual_rms_n, f.condition_number, identify::kMaxConditionNumber);
-  if (a.json.given) {
-    const nlohmann::json j = {{"ktc_n_per_mm2", estimate(f.ktc)}, {"krc_n_per_mm2", estimate(f.krc)},
-                              {"kac_n_per_mm2", estimate(f.kac)}, {"kte_n_per_mm", estimate(f.kte)},
-                              {"kre_n_per_mm", estimate(f.kre)},  {"kae_n_per_mm", estimate(f.kae)},
-                              {"r2_xy", f.r2_xy}, {"r2_z", f.r2_z}, {"residual_rms_n", f.residual_rms_n},
-                              {"condition_number", f.condition_number}, {"samples", f.samples}};
-    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
-    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
-  }
-  if (!a.yaml_path.empty()) {
-    std::ofstream y(a.yaml_path);
-    y << "material:                 # robodamp identify cutting, " << f.samples << " feeds, R^2 " << f.r2_xy << "\n"
-      << "  name: identified from " << a.csv_path << "\n"
-      << "  kt_n_per_mm2: " << f.ktc.value << "\n  kn_n_per_mm2: " << f.krc.value << "\n  kte_n_per_mm: " << f.kte.value
-      << "\n  kne_n_per_mm: " << f.kre.value << "\n  kac_n_per_mm2: " << f.kac.value << "\n"
-      << "  # Kae = " << f.kae.value << " N/mm (axial edge; the 2D milling models do not use it)\n";
-    std::printf("wrote %s\n", a.yaml_path.c_str());
-  }
-  return 0;
+  return run_identify_cutting(a);
 }
 
 }  // namespace
@@ -217,6 +171,18 @@ void register_identify(Registry& r) {
   r.plot_dir(sub, a->plot_dir, "modes, all: the fits and the stabilisation diagrams");
   sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
       ->check(CLI::ExistingFile);
+  sub->add_option("--records", a->records,
+                  "cutting: force records, one per test (files, or a directory's files in name order): time, Fx, Fy, Fz as a "
+                  "dynamometer or logger exports them (any delimiter, decimal comma, preamble, units in the header)");
+  sub->add_option("--tests", a->tests_path, "cutting: a table of the tests: file, feed_per_tooth_mm, spindle_rpm (files relative to it)")
+      ->check(CLI::ExistingFile);
+  r.numbers(sub, "--feeds-mm", a->feeds_mm, {"mm", 0.0, 10.0, false, false}, "cutting --records: the feed per tooth of each record, in order");
+  r.number(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, false, false}, "cutting --records: the spindle speed of the tests");
+  sub->add_option("--axes", a->axes,
+                  "cutting --records: the cutter's x (feed), y (normal), z (tool axis) from the record's Fx, Fy, Fz, e.g. -fy,fx,fz "
+                  "(default fx,fy,fz)");
+  sub->add_option("--force-on", a->force_on, "cutting --records: what the dynamometer measures the force on (default: workpiece)")
+      ->check(CLI::IsMember({"workpiece", "tool"}));
   r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");
   r.number(sub, "--diameter-mm", a->diameter_mm, {"mm", 0.0, 200.0, true, false}, "cutting: tool diameter");
   r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "cutting: axial depth of the tests");

@@ -20,6 +20,11 @@ struct IdentifyArgs {
   int teeth{0};
   double diameter_mm{0.0}, axial_mm{0.0}, radial_mm{0.0};
   std::string mode{"down"};
+  // cutting from force records
+  std::vector<std::string> records;
+  std::string tests_path, axes{"fx,fy,fz"}, force_on{"workpiece"};
+  std::vector<double> feeds_mm;
+  double rpm{0.0};
   // modes
   std::string frf_path, kind{"receptance"}, plot_dir;
   std::string series_path, response{"acceleration"};
@@ -45,5 +50,6 @@ struct IdentifyArgs {
 [[nodiscard]] int run_identify_actuator(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_ball_end(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_all(const IdentifyArgs& a);
+[[nodiscard]] int run_identify_cutting(const IdentifyArgs& a);
 
 }  // namespace robodamp::apps

@@ -86,6 +86,14 @@ CuttingFit identify_cutting(const std::vector<MeanForces>& samples, const Cuttin
   f.ktc = {a.theta(0), a.ci95(0)}, f.krc = {a.theta(1), a.ci95(1)}, f.kte = {a.theta(2), a.ci95(2)}, f.kre = {a.theta(3), a.ci95(3)};
   f.kac = {b.theta(0), b.ci95(0)}, f.kae = {b.theta(1), b.ci95(1)};
   f.r2_xy = a.tss > 0.0 ? 1.0 - a.rss / a.tss : 1.0;
+  const Eigen::VectorXd fitted = xy * a.theta;
+  for (int axis = 0; axis < 2; ++axis) {
+    double mean = 0.0, rss = 0.0, tss = 0.0;
+    for (Eigen::Index r = 0; r < n; ++r) mean += fxy(2 * r + axis) / static_cast<double>(n);
+    for (Eigen::Index r = 0; r < n; ++r)
+      rss += std::pow(fxy(2 * r + axis) - fitted(2 * r + axis), 2), tss += std::pow(fxy(2 * r + axis) - mean, 2);
+    (axis == 0 ? f.r2_x : f.r2_y) = tss > 0.0 ? 1.0 - rss / tss : 1.0;
+  }
   f.r2_z = b.tss > 0.0 ? 1.0 - b.rss / b.tss : 1.0;
   f.residual_rms_n = std::sqrt((a.rss + b.rss) / static_cast<double>(3 * n));
   f.samples = static_cast<int>(n);

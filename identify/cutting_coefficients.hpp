@@ -11,6 +11,7 @@
 // Off the real-time path.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,7 @@ struct CuttingFit {
   Estimate ktc, krc, kac;  // N/mm^2
   Estimate kte, kre, kae;  // N/mm
   double r2_xy{0.0}, r2_z{0.0};
+  double r2_x{0.0}, r2_y{0.0};  // each axis alone (r2_z is z alone)
   double residual_rms_n{0.0};
   double condition_number{0.0};  // of the feed-force regression, columns scaled to unit length
   int samples{0};
@@ -56,6 +58,21 @@ inline constexpr double kMaxConditionNumber = 1e4;
 // Throws std::invalid_argument naming what is wrong: too few feeds, a non-finite value (its row), a test
 // outside its ranges, or collinear regressors (with the condition number).
 [[nodiscard]] CuttingFit identify_cutting(const std::vector<MeanForces>& samples, const CuttingTest& test);
+
+// Whether each axis's mean force is linear in the feed, as the model says: a quadratic in the feed fitted
+// beside the line; an axis is not linear when its curvature is significant at 95 % and moves the force by
+// more than 1 % of its largest value within the feeds. Needs 4 feeds or more (none checked below).
+struct LinearityCheck {
+  char axis{'x'};
+  double r2{1.0};  // of the line
+  bool linear{true};
+  std::vector<std::pair<double, double>> residuals_n;  // feed (mm), measured minus the line (N)
+  double linear_up_to_mm{0.0};       // the feeds up to here fit a line (0: no three do)
+  std::optional<CuttingFit> linear_range_fit;  // the fit over those feeds
+  std::string message;               // empty when linear
+};
+[[nodiscard]] std::vector<LinearityCheck> check_linearity(const std::vector<MeanForces>& samples, const CuttingTest& test,
+                                                          const CuttingFit& fit);
 
 // Reads `feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n` (header required); throws std::invalid_argument
 // with the file and line of the first problem.
