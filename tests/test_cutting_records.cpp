@@ -258,4 +258,44 @@ TEST(CuttingRecords, RecordsThatHoldNoCutAreRefusedByName) {
   EXPECT_NE(cli.out.find("1 records and 2 feeds"), std::string::npos) << cli.out;
 }
 
+// Random damage to a force record is refused with a reason or read into finite means, never a crash.
+TEST(CuttingRecords, FuzzedRecordsAreRefusedCleanly) {
+  const TempDir tmp;
+  write_record(tmp.file("cut.txt"), 0.1, 11);
+  // The header and 0.25 s of the steady cut (12 revolutions).
+  std::string good;
+  {
+    std::istringstream in(robodamp::test::read_file(tmp.file("cut.txt")));
+    std::string line;
+    for (int n = 0; std::getline(in, line); ++n)
+      if (n < 3 || (n >= 5600 && n < 8100)) good += line + "\n";
+  }
+  ASSERT_NO_THROW((void)id::steady_cut(id::read_force_record(tmp.file("cut.txt")), kRpm, 0.1, id::RecordSettings{}));
+  std::mt19937 rng(248);
+  int refused = 0, read = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    std::string t = good;
+    for (int e = 0; e < 1 + static_cast<int>(rng() % 4); ++e) {
+      const std::size_t at = rng() % t.size();
+      switch (rng() % 3) {
+        case 0: t[at] = ";,.\t\n-e9"[rng() % 9]; break;
+        case 1: t.erase(at, 1 + rng() % 30); break;
+        default: t = t.substr(0, at) + std::string(1 + rng() % 3, "0\t,\n"[rng() % 4]) + t.substr(at); break;
+      }
+      if (t.empty()) t.push_back('x');
+    }
+    const std::string path = tmp.file("fuzz.txt");
+    std::ofstream(path, std::ios::binary) << t;
+    try {
+      const id::SteadyCut c = id::steady_cut(id::read_force_record(path), kRpm, 0.1, id::RecordSettings{});
+      EXPECT_TRUE(std::isfinite(c.means.fx_n) && std::isfinite(c.means.fy_n) && std::isfinite(c.means.fz_n));
+      ++read;
+    } catch (const std::invalid_argument&) {
+      ++refused;
+    }
+  }
+  std::printf("[ fuzz records ] 150 damaged records: %d read, %d refused\n", read, refused);
+  EXPECT_GT(refused, 50);
+}
+
 }  // namespace

@@ -263,10 +263,10 @@ TEST(Uff, FuzzedFilesAreRefusedCleanly) {
         switch (rng() % 4) {
           case 0: t[at] = static_cast<char>(rng() % 256); break;
           case 1: t.erase(at, 1 + rng() % 40); break;
-          case 2: t.insert(at, std::string(1 + rng() % 5, "-1 \n.E+9b"[rng() % 9])); break;
+          case 2: t = t.substr(0, at) + std::string(1 + rng() % 5, "-1 \n.E+9b"[rng() % 9]) + t.substr(at); break;
           default: t.resize(at); break;
         }
-        if (t.empty()) t = "x";
+        if (t.empty()) t.push_back('x');
       }
       try {
         const UffFile f = mf::parse_uff(t, "fuzz.uff");
@@ -317,6 +317,33 @@ TEST(Table, ReadsTheDelimitersDecimalMarksHeadersAndUnitsPeopleSave) {
   refused("time [s],fx [mm],fy [N]\n0,1,2\n", "column 'fx' is in 'mm', not a unit of N");
   refused("time,fx,fy\n0,1,2\n1,,2\n", "t.csv:3: '' is not a number (an empty field)");
   refused("0,1\n", "2 columns and no header");
+}
+
+// Random damage to tables as people save them is refused with a reason or read consistently.
+TEST(Table, FuzzedTablesAreRefusedCleanly) {
+  std::mt19937 rng(148);
+  const std::vector<mf::ColumnSpec> wanted = {{{"time"}, mf::Quantity::kTime}, {{"fx"}, mf::Quantity::kForce}, {{"fy"}, mf::Quantity::kForce}};
+  const std::string good = "\xEF\xBB\xBFpreamble: 1 kHz\r\nTime [ms];Fx [kN];Fy [N]\r\n0;1,5;-2\r\n1;2,5;-0,125\r\n2;3;4\r\n";
+  int refused = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string t = good;
+    for (int e = 0; e < 1 + static_cast<int>(rng() % 3); ++e) {
+      const std::size_t at = rng() % t.size();
+      switch (rng() % 3) {
+        case 0: t[at] = ";,.\t\n\r -e[]()#x9"[rng() % 17]; break;
+        case 1: t.erase(at, 1 + rng() % 6); break;
+        default: t = t.substr(0, at) + static_cast<char>(rng() % 256) + t.substr(at); break;
+      }
+      if (t.empty()) t.push_back(';');
+    }
+    try {
+      const mf::Table table = mf::parse_table(t, "fuzz.csv");
+      for (const auto& row : mf::select_columns(table, wanted, "fuzz.csv", "time, fx, fy")) EXPECT_EQ(row.size(), 3u);
+    } catch (const std::invalid_argument&) {
+      ++refused;
+    }
+  }
+  EXPECT_GT(refused, 300);
 }
 
 struct Result {
