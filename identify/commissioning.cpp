@@ -343,7 +343,14 @@ CommissioningResult identify_all(const CommissioningInputs& in, const Commission
   r.actuator.delay_ms = measured.actuator.delay_s * 1e3;
   r.polarity = measured.controller.polarity;
   const config::Config structure = config::parse_config(compose_yaml(r, r.polarity), "the identified structure");
-  r.actuator = identify_actuator(chirp, structure, 0.0, 0.0, s.actuator_min_coherence);
+  if (in.force_per_volt) {
+    ActuatorFitSettings as;
+    as.band_lo_hz = measured.analysis.band_min_hz, as.band_hi_hz = measured.analysis.band_max_hz;
+    as.min_coherence = s.actuator_min_coherence;
+    r.actuator = fit_actuator(*in.force_per_volt, as);
+  } else {
+    r.actuator = identify_actuator(chirp, structure, 0.0, 0.0, s.actuator_min_coherence);
+  }
 
   // The configuration: first with the measured polarity, then with the one the analysis recommends.
   for (int pass = 0; pass < 2; ++pass) {

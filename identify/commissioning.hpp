@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,9 @@ struct CommissioningInputs {
   MeasurementManifest manifest;
   std::vector<IdentifiedFrf> frfs;  // one per pair of locations, data only
   ChirpMeasurement chirp;
+  // The actuator's force per volt measured directly (a modal lab's blocked-force test): fitted as it is,
+  // in place of the chirp's acceleration per volt through the identified structure.
+  std::optional<ActuatorFrf> force_per_volt;
   std::string identified_path;      // where relative names of the identified configuration resolve from
 };
 // Throws std::invalid_argument naming what is missing or bad, or rt::RecordingError.

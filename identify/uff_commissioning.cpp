@@ -55,6 +55,13 @@ const IdentifiedFrf* between(const std::vector<IdentifiedFrf>& frfs, int a, int 
   return nullptr;
 }
 
+// The chirp's settings without a chirp (the actuator came as a force per volt).
+void c_config_only(CommissioningInputs& in, const config::Config& cfg) {
+  in.chirp.config = cfg;
+  in.chirp.fs_hz = cfg.loop.rate_hz;
+  in.chirp.f0_hz = cfg.commissioning.chirp_f0_hz, in.chirp.f1_hz = cfg.commissioning.chirp_f1_hz;
+}
+
 }  // namespace
 
 measfiles::UffFile measurement_to_uff(const CommissioningInputs& in) {
@@ -136,7 +143,7 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
         UffSelection s;
         s.record = static_cast<int>(i + 1), s.to_receptance = !per_volt;
         UffFrf u = frf_from_uff(file, uff_path, s);
-        if (u.units.per_volt != per_volt) continue;
+        if (u.units.per_volt != per_volt || u.units.force_per_volt) continue;
         ++found, hit = std::move(u);
       }
       if (found > 1)
@@ -165,10 +172,26 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
     }
   }
   const auto a = frf_record(m.sensor_location_id, m.actuator_location_id, true);
-  if (!a)
-    throw std::invalid_argument(uff_path + ": no FRF per volt with response node " + std::to_string(m.sensor_location_id) +
-                                " (the sensor) and reference node " + std::to_string(m.actuator_location_id) +
-                                " (the actuator): the actuator's chirp; the file holds:\n" + describe_functions(file));
+  if (!a) {
+    // A force per volt of the actuator (reference node: the actuator's location) instead.
+    for (std::size_t i = 0; i < file.functions.size() && !in.force_per_volt; ++i) {
+      const auto& f = file.functions[i];
+      if (f.function_type != measfiles::kUffFrf || f.reference_node != m.actuator_location_id) continue;
+      UffSelection s;
+      s.record = static_cast<int>(i + 1), s.to_receptance = false;
+      const UffFrf u = frf_from_uff(file, uff_path, s);
+      if (!u.units.force_per_volt) continue;
+      in.force_per_volt = ActuatorFrf{u.data.f_hz, u.data.h, u.data.coherence};
+    }
+    if (!in.force_per_volt)
+      throw std::invalid_argument(uff_path + ": the actuator needs an FRF per volt with reference node " +
+                                  std::to_string(m.actuator_location_id) + " (the actuator): the acceleration at node " +
+                                  std::to_string(m.sensor_location_id) + " (the sensor, what robodamp measures with its chirp) "
+                                  "or the actuator's force; the file holds:\n" + describe_functions(file));
+    c_config_only(in, cfg);
+    in.identified_path = (fs::absolute(uff_path).parent_path() / "identified.yaml").string();
+    return in;
+  }
   if (a->units.kind != FrfKind::kAccelerance)
     throw std::invalid_argument(uff_path + ": record " + std::to_string(a->record) + ": the actuator's FRF must be an acceleration per volt");
   ChirpMeasurement& c = in.chirp;

@@ -105,6 +105,11 @@ FrfUnits frf_units(const UffFunction& f, int record) {
     throw std::invalid_argument("record " + std::to_string(record) + ": the denominator is in " + measfiles::si_unit(d.quantity) +
                                 ": an FRF per force (N) or per voltage (V) is read");
   u.per_volt = d.quantity == Quantity::kVoltage;
+  if (u.per_volt && n.quantity == Quantity::kForce) {
+    u.force_per_volt = true, u.to_si = n.to_si / d.to_si;
+    u.shown = "force per volt " + (known(num).empty() ? std::string("(SI)") : num) + "/" + (known(den).empty() ? "(SI)" : den) + " read as N/V";
+    return u;
+  }
   if (n.quantity == Quantity::kLength) u.kind = FrfKind::kReceptance;
   else if (n.quantity == Quantity::kVelocity) u.kind = FrfKind::kMobility;
   else if (n.quantity == Quantity::kAcceleration) u.kind = FrfKind::kAccelerance;
@@ -179,7 +184,7 @@ UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, con
     const double hz = f.x[k] * x_scale;
     const std::complex<double> iw(0.0, kTwoPi * hz);
     std::complex<double> h = f.y[k] * out.units.to_si;
-    if (s.to_receptance) {
+    if (s.to_receptance && !out.units.force_per_volt) {
       if (out.units.kind != FrfKind::kReceptance && !(hz > 0.0)) continue;  // no receptance at 0 Hz from a rate
       if (out.units.kind == FrfKind::kMobility) h /= iw;
       if (out.units.kind == FrfKind::kAccelerance) h /= iw * iw;

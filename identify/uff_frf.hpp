@@ -32,6 +32,7 @@ struct FrfUnits {
   FrfKind kind{FrfKind::kReceptance};
   double to_si{1.0};      // multiply the ordinate by it for m/N, m/s/N or m/s^2/N
   bool per_volt{false};   // the denominator is a voltage (an actuator's FRF), not a force
+  bool force_per_volt{false};  // an actuator's force per volt (N/V): the ordinate is a force
   std::string shown;      // "accelerance, g/lbf read as (m/s^2)/N"
 };
 // Throws std::invalid_argument naming the record and the unit it does not know.

@@ -19,6 +19,7 @@
 #include "measfiles/table.hpp"
 #include "measfiles/uff.hpp"
 #include "modal/receptance.hpp"
+#include "sim_plant/plant_model.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -411,6 +412,76 @@ TEST(Uff, IdentifyModesReadsTheRecordTheUserChooses) {
   const Result bad_dof = run("identify modes --frf " + uff + " --response 2:+Q");
   EXPECT_EQ(bad_dof.status, 2) << bad_dof.out;
   EXPECT_NE(bad_dof.out.find("'2:+Q' is not a DOF"), std::string::npos) << bad_dof.out;
+}
+
+// Issue 48: a modal package's export commissions a robot: the FRFs between the TCP and the actuator's
+// location (H12 written as response 1, reference 2: reciprocity), in mm/N, with coherence, and the
+// actuator's blocked force per volt in lbf/V (Eq. 3) instead of robodamp's chirp. identify all gives the
+// robot's modes and the actuator's parameters.
+TEST(Uff, IdentifyAllCommissionsFromAModalPackagesExport) {
+  const TempDir tmp;
+  const std::string preset = robodamp::test::preset("horizontal_c2");
+  const auto cfg = robodamp::config::load_config_file(preset);
+  const robodamp::sim::PlantModel plant = robodamp::sim::build_plant_model(cfg);
+  UffFile file;
+  auto grid = [](UffFunction& f) {
+    f.abscissa = {mf::kUffFrequency, 0, 0, 0, "Frequency", "Hz"};
+    for (int k = 20; k <= 3000; ++k) f.x.push_back(0.05 * k);
+  };
+  for (const auto& [g, h] : {std::pair{1, 1}, std::pair{1, 2}, std::pair{2, 2}}) {
+    UffFunction f;
+    f.id[0] = "tap test H" + std::to_string(g) + std::to_string(h);
+    f.response_node = g, f.response_direction = 2, f.reference_node = h, f.reference_direction = 2;
+    f.ordinate = {mf::kUffDisplacement, 0, 0, 0, "Displacement", "mm"};
+    f.denominator = {mf::kUffExcitationForce, 0, 0, 0, "Force", "N"};
+    grid(f);
+    for (double hz : f.x) f.y.push_back(1e3 * plant.receptance(plant.index_of(g), plant.index_of(h), hz));
+    UffFunction c = f;
+    c.function_type = mf::kUffCoherence, c.is_complex = false;
+    c.y.assign(f.x.size(), {0.998, 0.0});
+    file.functions.push_back(f), file.functions.push_back(c);
+  }
+  UffFunction act;
+  act.id[0] = "shaker blocked force per volt";
+  act.response_node = 2, act.response_direction = 2, act.reference_node = 2, act.reference_direction = 2;
+  act.ordinate = {mf::kUffReactionForce, 0, 0, 0, "Force", "lbf"};
+  act.denominator = {mf::kUffGeneral, 0, 0, 0, "Voltage", "V"};
+  grid(act);
+  const auto& a = cfg.actuator;
+  for (double hz : act.x) {
+    const std::complex<double> s(0.0, 2.0 * M_PI * hz);
+    const double wa = 2.0 * M_PI * a.natural_freq_hz;
+    const std::complex<double> g = a.constant_n_per_v * s * s / (s * s + 2.0 * a.damping_ratio * wa * s + wa * wa) * std::exp(-s * a.delay_s);
+    act.y.push_back(g / 4.4482216152605);
+  }
+  file.functions.push_back(act);
+  const std::string uff = tmp.file("export.uff"), out = tmp.file("identified.yaml");
+  mf::write_uff(uff, file, mf::UffEncoding::kAscii);
+  const Result r = run("identify all --uff " + uff + " --config " + preset + " --out " + out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto id = robodamp::config::load_config_file(out);
+  EXPECT_NEAR(id.actuator.constant_n_per_v, a.constant_n_per_v, 0.01 * a.constant_n_per_v);
+  EXPECT_NEAR(id.actuator.natural_freq_hz, a.natural_freq_hz, 0.01 * a.natural_freq_hz);
+  EXPECT_NEAR(id.actuator.damping_ratio, a.damping_ratio, 0.02 * a.damping_ratio);
+  EXPECT_NEAR(id.actuator.delay_s, a.delay_s, 2e-5);
+  ASSERT_EQ(id.robot.frfs.size(), 3u);
+  for (const auto& f : id.robot.frfs) {
+    const robodamp::config::FrfConfig* truth = nullptr;
+    for (const auto& t : cfg.robot.frfs)
+      if ((t.response_location == f.response_location && t.excitation_location == f.excitation_location) ||
+          (t.response_location == f.excitation_location && t.excitation_location == f.response_location))
+        truth = &t;
+    ASSERT_NE(truth, nullptr) << f.name;
+    ASSERT_EQ(f.modes.size(), truth->modes.size()) << f.name << "\n" << r.out;
+    for (std::size_t k = 0; k < f.modes.size(); ++k)
+      EXPECT_NEAR(f.modes[k].natural_freq_hz, truth->modes[k].natural_freq_hz, 0.005 * truth->modes[k].natural_freq_hz) << f.name;
+  }
+  // Without the actuator's record: refused, naming what is needed.
+  file.functions.pop_back();
+  mf::write_uff(uff, file, mf::UffEncoding::kAscii);
+  const Result missing = run("identify all --uff " + uff + " --config " + preset + " --out " + out);
+  EXPECT_EQ(missing.status, 2) << missing.out;
+  EXPECT_NE(missing.out.find("the actuator needs an FRF per volt with reference node 2"), std::string::npos) << missing.out;
 }
 
 }  // namespace
