@@ -55,13 +55,6 @@ const IdentifiedFrf* between(const std::vector<IdentifiedFrf>& frfs, int a, int 
   return nullptr;
 }
 
-// The chirp's settings without a chirp (the actuator came as a force per volt).
-void c_config_only(CommissioningInputs& in, const config::Config& cfg) {
-  in.chirp.config = cfg;
-  in.chirp.fs_hz = cfg.loop.rate_hz;
-  in.chirp.f0_hz = cfg.commissioning.chirp_f0_hz, in.chirp.f1_hz = cfg.commissioning.chirp_f1_hz;
-}
-
 }  // namespace
 
 measfiles::UffFile measurement_to_uff(const CommissioningInputs& in) {
@@ -120,6 +113,67 @@ measfiles::UffFile modes_to_uff(const CommissioningResult& r) {
   return file;
 }
 
+namespace {
+
+// The FRF record between two nodes (either way round for a force; the sensor's response to the actuator's
+// voltage for a volt); nullopt when the file holds none.
+std::optional<UffFrf> frf_between(const measfiles::UffFile& file, const std::string& path, int response, int reference,
+                                  bool per_volt) {
+  for (const auto& [g, h] : {std::pair{response, reference}, std::pair{reference, response}}) {
+    int found = 0;
+    std::optional<UffFrf> hit;
+    for (std::size_t i = 0; i < file.functions.size(); ++i) {
+      const auto& f = file.functions[i];
+      if (f.function_type != measfiles::kUffFrf || f.response_node != g || f.reference_node != h) continue;
+      UffSelection s;
+      s.record = static_cast<int>(i + 1), s.to_receptance = !per_volt;
+      UffFrf u = frf_from_uff(file, path, s);
+      if (u.units.per_volt != per_volt || u.units.force_per_volt) continue;
+      ++found, hit = std::move(u);
+    }
+    if (found > 1)
+      throw std::invalid_argument(path + ": " + std::to_string(found) + " FRF records between nodes " + std::to_string(g) + " and " +
+                                  std::to_string(h) + (per_volt ? " per volt" : " per force") + "; keep one");
+    if (hit) return hit;
+    if (per_volt) break;
+  }
+  return std::nullopt;
+}
+
+// The actuator: the sensor's acceleration per volt (robodamp's chirp), or else its force per volt.
+void read_actuator(const measfiles::UffFile& file, const std::string& path, const config::Config& cfg, CommissioningInputs& in) {
+  const MeasurementManifest& m = in.manifest;
+  ChirpMeasurement& c = in.chirp;
+  c.config = cfg;
+  c.fs_hz = cfg.loop.rate_hz;
+  c.f0_hz = cfg.commissioning.chirp_f0_hz, c.f1_hz = cfg.commissioning.chirp_f1_hz;
+  if (const auto a = frf_between(file, path, m.sensor_location_id, m.actuator_location_id, true)) {
+    if (a->units.kind != FrfKind::kAccelerance)
+      throw std::invalid_argument(path + ": record " + std::to_string(a->record) + ": the actuator's FRF must be an acceleration per volt");
+    c.accel_per_volt.f_hz = a->data.f_hz, c.accel_per_volt.h1 = a->data.h;
+    c.accel_per_volt.coherence = a->data.coherence.empty() ? std::vector<double>(a->data.f_hz.size(), 1.0) : a->data.coherence;
+    const std::string& note = a->function->id[4];
+    if (const std::size_t at = note.find("periods averaged "); at != std::string::npos) c.periods_averaged = std::atoi(note.c_str() + at + 17);
+    return;
+  }
+  for (std::size_t i = 0; i < file.functions.size(); ++i) {
+    const auto& f = file.functions[i];
+    if (f.function_type != measfiles::kUffFrf || f.reference_node != m.actuator_location_id) continue;
+    UffSelection s;
+    s.record = static_cast<int>(i + 1), s.to_receptance = false;
+    const UffFrf u = frf_from_uff(file, path, s);
+    if (!u.units.force_per_volt) continue;
+    in.force_per_volt = ActuatorFrf{u.data.f_hz, u.data.h, u.data.coherence};
+    return;
+  }
+  throw std::invalid_argument(path + ": the actuator needs an FRF per volt with reference node " + std::to_string(m.actuator_location_id) +
+                              " (the actuator): the acceleration at node " + std::to_string(m.sensor_location_id) +
+                              " (the sensor, what robodamp measures with its chirp) or the actuator's force; the file holds:\n" +
+                              describe_functions(file));
+}
+
+}  // namespace
+
 CommissioningInputs read_measurement_uff(const std::string& uff_path, const std::string& config_path) {
   CommissioningInputs in;
   const config::Config cfg = config::load_config_file(config_path);
@@ -133,35 +187,16 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
   m.sensor_location_id = cfg.sensor.location;
   m.actuator_location_id = model.locations[model.actuator.location].id;
   const measfiles::UffFile file = measfiles::read_uff(uff_path);
-  auto frf_record = [&](int response, int reference, bool per_volt) -> std::optional<UffFrf> {
-    for (const auto& [g, h] : {std::pair{response, reference}, std::pair{reference, response}}) {
-      int found = 0;
-      std::optional<UffFrf> hit;
-      for (std::size_t i = 0; i < file.functions.size(); ++i) {
-        const auto& f = file.functions[i];
-        if (f.function_type != measfiles::kUffFrf || f.response_node != g || f.reference_node != h) continue;
-        UffSelection s;
-        s.record = static_cast<int>(i + 1), s.to_receptance = !per_volt;
-        UffFrf u = frf_from_uff(file, uff_path, s);
-        if (u.units.per_volt != per_volt || u.units.force_per_volt) continue;
-        ++found, hit = std::move(u);
-      }
-      if (found > 1)
-        throw std::invalid_argument(uff_path + ": " + std::to_string(found) + " FRF records between nodes " + std::to_string(g) +
-                                    " and " + std::to_string(h) + (per_volt ? " per volt" : " per force") + "; keep one");
-      if (hit) return hit;
-      if (per_volt) break;  // the actuator's record is the sensor's response to the actuator's voltage
-    }
-    return std::nullopt;
-  };
   for (std::size_t h = 0; h < m.locations.size(); ++h) {
     for (std::size_t g = h; g < m.locations.size(); ++g) {
       IdentifiedFrf f;
       f.response_id = m.locations[g].first, f.excitation_id = m.locations[h].first;
-      f.name = "H" + std::to_string(f.response_id) + std::to_string(f.excitation_id);
+      f.name = "H";
+      f.name += std::to_string(f.response_id);
+      f.name += std::to_string(f.excitation_id);
       for (const auto& c : cfg.robot.frfs)
         if (c.response_location == f.response_id && c.excitation_location == f.excitation_id) f.name = c.name;
-      const auto u = frf_record(f.response_id, f.excitation_id, false);
+      const auto u = frf_between(file, uff_path, f.response_id, f.excitation_id, false);
       if (!u)
         throw std::invalid_argument(uff_path + ": no FRF per force between nodes " + std::to_string(f.response_id) + " and " +
                                     std::to_string(f.excitation_id) + " (the configuration's locations); the file holds:\n" +
@@ -171,37 +206,7 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
       in.frfs.push_back(std::move(f));
     }
   }
-  const auto a = frf_record(m.sensor_location_id, m.actuator_location_id, true);
-  if (!a) {
-    // A force per volt of the actuator (reference node: the actuator's location) instead.
-    for (std::size_t i = 0; i < file.functions.size() && !in.force_per_volt; ++i) {
-      const auto& f = file.functions[i];
-      if (f.function_type != measfiles::kUffFrf || f.reference_node != m.actuator_location_id) continue;
-      UffSelection s;
-      s.record = static_cast<int>(i + 1), s.to_receptance = false;
-      const UffFrf u = frf_from_uff(file, uff_path, s);
-      if (!u.units.force_per_volt) continue;
-      in.force_per_volt = ActuatorFrf{u.data.f_hz, u.data.h, u.data.coherence};
-    }
-    if (!in.force_per_volt)
-      throw std::invalid_argument(uff_path + ": the actuator needs an FRF per volt with reference node " +
-                                  std::to_string(m.actuator_location_id) + " (the actuator): the acceleration at node " +
-                                  std::to_string(m.sensor_location_id) + " (the sensor, what robodamp measures with its chirp) "
-                                  "or the actuator's force; the file holds:\n" + describe_functions(file));
-    c_config_only(in, cfg);
-    in.identified_path = (fs::absolute(uff_path).parent_path() / "identified.yaml").string();
-    return in;
-  }
-  if (a->units.kind != FrfKind::kAccelerance)
-    throw std::invalid_argument(uff_path + ": record " + std::to_string(a->record) + ": the actuator's FRF must be an acceleration per volt");
-  ChirpMeasurement& c = in.chirp;
-  c.config = cfg;
-  c.fs_hz = cfg.loop.rate_hz;
-  c.f0_hz = cfg.commissioning.chirp_f0_hz, c.f1_hz = cfg.commissioning.chirp_f1_hz;
-  c.accel_per_volt.f_hz = a->data.f_hz, c.accel_per_volt.h1 = a->data.h;
-  c.accel_per_volt.coherence = a->data.coherence.empty() ? std::vector<double>(a->data.f_hz.size(), 1.0) : a->data.coherence;
-  const std::string& note = a->function->id[4];
-  if (const std::size_t at = note.find("periods averaged "); at != std::string::npos) c.periods_averaged = std::atoi(note.c_str() + at + 17);
+  read_actuator(file, uff_path, cfg, in);
   in.identified_path = (fs::absolute(uff_path).parent_path() / "identified.yaml").string();
   return in;
 }
