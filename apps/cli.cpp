@@ -232,7 +232,7 @@ int dispatch(int argc, const char* const* argv) {
   app.require_subcommand(1);
   Registry r(app);
   for (auto reg : {register_bench, register_analyze, register_filters, register_check_config, register_run,
-                   register_replay, register_csv, register_lobes, register_sle, register_cut, register_identify, register_measure, register_commission, register_pose, register_tune, register_schedule, register_plant, register_monitor,
+                   register_replay, register_csv, register_lobes, register_sle, register_cut, register_identify, register_measure, register_commission, register_pose, register_tune, register_schedule, register_chatter, register_plant, register_monitor,
                    register_request, register_dashboard})
     reg(r);
   app.set_version_flag("--version", [] { return version_text(); }, "robodamp's version and the dependencies it was built against");

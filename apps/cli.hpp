@@ -109,5 +109,6 @@ void register_commission(Registry& r);
 void register_pose(Registry& r);
 void register_tune(Registry& r);
 void register_schedule(Registry& r);
+void register_chatter(Registry& r);
 
 }  // namespace robodamp::apps

@@ -54,6 +54,50 @@ std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit
 
 namespace {
 
+// The FRF the options name: a universal file's record, a table, or time series (a table or a universal
+// file's time histories) through Welch. Throws std::invalid_argument.
+identify::FrfData frf_of(const IdentifyArgs& a) {
+  const bool dof_response = a.response.find_first_of("0123456789") != std::string::npos;
+  if (!dof_response && a.response != "acceleration" && a.response != "velocity" && a.response != "displacement")
+    throw std::invalid_argument("--response '" + a.response + "': allowed acceleration, velocity, displacement (--series) or NODE:DIR (a universal file's record)");
+  if (!a.frf_path.empty() && identify::looks_like_uff(a.frf_path)) {
+    identify::UffSelection sel;
+    sel.record = a.record;
+    if (dof_response) sel.response = identify::parse_dof(a.response);
+    if (!a.reference.empty()) sel.reference = identify::parse_dof(a.reference);
+    const measfiles::UffFile file = measfiles::read_uff(a.frf_path);
+    const identify::UffFrf frf = identify::frf_from_uff(file, a.frf_path, sel);
+    if (frf.units.per_volt)
+      throw std::invalid_argument(a.frf_path + ": record " + std::to_string(frf.record) + " is per volt (an actuator's FRF); identify modes reads an FRF per force");
+    std::printf("record %d: %s / %s, %s, %zu points%s\n", frf.record,
+                identify::dof_text(frf.function->response_node, frf.function->response_direction).c_str(),
+                identify::dof_text(frf.function->reference_node, frf.function->reference_direction).c_str(), frf.units.shown.c_str(),
+                frf.data.f_hz.size(), frf.data.coherence.empty() ? ", no coherence record" : ", with its coherence");
+    return frf.data;
+  } else if (!a.frf_path.empty()) {
+    if (a.record || dof_response || !a.reference.empty())
+      throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " + a.frf_path + " is a table");
+    const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
+                      : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+    return identify::read_frf_csv(a.frf_path, kind);
+  } else if (identify::looks_like_uff(a.series_path)) {
+    identify::UffSelection sel;
+    sel.record = a.record;
+    if (dof_response) sel.response = identify::parse_dof(a.response);
+    const measfiles::UffFile file = measfiles::read_uff(a.series_path);
+    const identify::UffSeries s = identify::time_series_from_uff(file, a.series_path, sel);
+    std::printf("records %d (force) and %d (response), %zu samples at %.6g Hz\n", s.force_record, s.response_record,
+                s.series.input.size(), s.series.fs_hz);
+    return identify::frf_from_time_series(s.series, s.kind, a.segment_s, a.overlap, a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
+  } else {
+    if (dof_response) throw std::invalid_argument("--response with --series: acceleration, velocity or displacement");
+    const auto kind = a.response == "velocity" ? identify::FrfKind::kMobility
+                      : a.response == "acceleration" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+    return identify::frf_from_time_series_csv(a.series_path, kind, a.segment_s, a.overlap,
+                                              a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
+  }
+}
+
 int run_modes(const IdentifyArgs& a) {
   identify::ModalFitSettings s;
   if (a.band_hz.size() == 2) s.band_lo_hz = a.band_hz[0], s.band_hi_hz = a.band_hz[1];
@@ -65,36 +109,7 @@ int run_modes(const IdentifyArgs& a) {
       throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
     if (a.frf_path.empty() == a.series_path.empty())
       throw std::invalid_argument("give either --frf (an FRF) or --series (force and response in time)");
-    const bool dof_response = a.response.find_first_of("0123456789") != std::string::npos;
-    if (!dof_response && a.response != "acceleration" && a.response != "velocity" && a.response != "displacement")
-      throw std::invalid_argument("--response '" + a.response + "': allowed acceleration, velocity, displacement (--series) or NODE:DIR (a universal file's record)");
-    if (!a.frf_path.empty() && identify::looks_like_uff(a.frf_path)) {
-      identify::UffSelection sel;
-      sel.record = a.record;
-      if (dof_response) sel.response = identify::parse_dof(a.response);
-      if (!a.reference.empty()) sel.reference = identify::parse_dof(a.reference);
-      const measfiles::UffFile file = measfiles::read_uff(a.frf_path);
-      const identify::UffFrf frf = identify::frf_from_uff(file, a.frf_path, sel);
-      if (frf.units.per_volt)
-        throw std::invalid_argument(a.frf_path + ": record " + std::to_string(frf.record) + " is per volt (an actuator's FRF); identify modes reads an FRF per force");
-      std::printf("record %d: %s / %s, %s, %zu points%s\n", frf.record,
-                  identify::dof_text(frf.function->response_node, frf.function->response_direction).c_str(),
-                  identify::dof_text(frf.function->reference_node, frf.function->reference_direction).c_str(), frf.units.shown.c_str(),
-                  frf.data.f_hz.size(), frf.data.coherence.empty() ? ", no coherence record" : ", with its coherence");
-      d = frf.data;
-    } else if (!a.frf_path.empty()) {
-      if (a.record || dof_response || !a.reference.empty())
-        throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " + a.frf_path + " is a table");
-      const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
-                        : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
-      d = identify::read_frf_csv(a.frf_path, kind);
-    } else {
-      if (dof_response) throw std::invalid_argument("--response with --series: acceleration, velocity or displacement");
-      const auto kind = a.response == "velocity" ? identify::FrfKind::kMobility
-                        : a.response == "acceleration" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
-      d = identify::frf_from_time_series_csv(a.series_path, kind, a.segment_s, a.overlap,
-                                             a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
-    }
+    d = frf_of(a);
     fit = identify::fit_modes(d, s);
   } catch (const std::invalid_argument& e) {
     std::cerr << "robodamp identify modes: " << e.what() << '\n';

@@ -424,7 +424,10 @@ FrfData read_frf_csv(const std::string& path, FrfKind kind) {
 
 FrfData frf_from_time_series_csv(const std::string& path, FrfKind kind, double segment_s, double overlap,
                                  double max_hz) {
-  const TimeSeries ts = read_time_series_csv(path, "time_s,force_n,response");
+  return frf_from_time_series(read_time_series_csv(path, "time_s,force_n,response"), kind, segment_s, overlap, max_hz);
+}
+
+FrfData frf_from_time_series(const TimeSeries& ts, FrfKind kind, double segment_s, double overlap, double max_hz) {
   const double fs = ts.fs_hz;
   const std::vector<double>& x = ts.input;
   const std::vector<double>& y = ts.output;

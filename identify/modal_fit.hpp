@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "identify/numeric_csv.hpp"
+
 namespace robodamp::identify {
 
 using Complex = std::complex<double>;
@@ -72,5 +74,8 @@ enum class FrfKind { kReceptance, kMobility, kAccelerance };
 // std::invalid_argument with the file and line of the first problem, or for an uneven time step.
 [[nodiscard]] FrfData frf_from_time_series_csv(const std::string& path, FrfKind response_kind, double segment_s,
                                                double overlap, double max_hz);
+// The same from the force and response already read (a universal file's time histories).
+[[nodiscard]] FrfData frf_from_time_series(const TimeSeries& series, FrfKind response_kind, double segment_s, double overlap,
+                                           double max_hz);
 
 }  // namespace robodamp::identify

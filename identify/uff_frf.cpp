@@ -195,6 +195,51 @@ UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, con
   return out;
 }
 
+UffSeries time_series_from_uff(const measfiles::UffFile& file, const std::string& name, const UffSelection& s) {
+  const std::string listing = "; the file holds:\n" + describe_functions(file);
+  UffSeries out;
+  const UffFunction* force = nullptr;
+  const UffFunction* response = nullptr;
+  double force_si = 1.0, response_si = 1.0;
+  int forces = 0, responses = 0;
+  for (std::size_t i = 0; i < file.functions.size(); ++i) {
+    const UffFunction& f = file.functions[i];
+    if (f.function_type != measfiles::kUffTimeResponse || f.is_complex) continue;
+    const auto by_type = quantity_of_type(f.ordinate.data_type);
+    const auto unit = measfiles::unit_scale(f.ordinate.units);
+    const std::optional<Quantity> q = unit ? std::optional<Quantity>(unit->quantity) : by_type;
+    const double si = unit ? unit->to_si : 1.0;
+    if (q == Quantity::kForce) {
+      ++forces, force = &f, force_si = si, out.force_record = static_cast<int>(i + 1);
+    } else if ((q == Quantity::kLength || q == Quantity::kVelocity || q == Quantity::kAcceleration) &&
+               matches(f, s.response, std::nullopt) && (!s.record || *s.record == static_cast<int>(i + 1))) {
+      ++responses, response = &f, response_si = si, out.response_record = static_cast<int>(i + 1);
+      out.kind = q == Quantity::kLength ? FrfKind::kReceptance : q == Quantity::kVelocity ? FrfKind::kMobility : FrfKind::kAccelerance;
+    }
+  }
+  if (forces != 1)
+    throw std::invalid_argument(name + ": " + std::to_string(forces) + " time histories of a force (the hammer's): one is needed" + listing);
+  if (responses != 1)
+    throw std::invalid_argument(name + ": " + std::to_string(responses) +
+                                " time histories of a response match; choose one with --response NODE:DIR or --record N" + listing);
+  if (force->x.size() != response->x.size() || force->x.size() < 64)
+    throw std::invalid_argument(name + ": records " + std::to_string(out.force_record) + " and " + std::to_string(out.response_record) +
+                                " hold " + std::to_string(force->x.size()) + " and " + std::to_string(response->x.size()) +
+                                " samples: the same number, at least 64, is needed");
+  const double dt = (force->x.back() - force->x.front()) / static_cast<double>(force->x.size() - 1);
+  for (std::size_t k = 0; k < force->x.size(); ++k)
+    if (std::abs(force->x[k] - response->x[k]) > 1e-6 * dt || (k > 0 && std::abs(force->x[k] - force->x[k - 1] - dt) > 1e-3 * dt))
+      throw std::invalid_argument(name + ": records " + std::to_string(out.force_record) + " and " + std::to_string(out.response_record) +
+                                  " are not sampled together at a constant rate (sample " + std::to_string(k + 1) + ")");
+  if (!(dt > 0.0)) throw std::invalid_argument(name + ": the time does not increase");
+  double t_scale = 1.0;
+  if (const auto u = measfiles::unit_scale(force->abscissa.units); u && u->quantity == Quantity::kTime) t_scale = u->to_si;
+  out.series.fs_hz = 1.0 / (dt * t_scale);
+  for (std::size_t k = 0; k < force->x.size(); ++k)
+    out.series.input.push_back(force->y[k].real() * force_si), out.series.output.push_back(response->y[k].real() * response_si);
+  return out;
+}
+
 bool looks_like_uff(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;

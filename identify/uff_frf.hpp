@@ -8,6 +8,7 @@
 #include <string>
 
 #include "identify/modal_fit.hpp"
+#include "identify/numeric_csv.hpp"
 #include "measfiles/uff.hpp"
 
 namespace robodamp::identify {
@@ -51,6 +52,17 @@ struct UffFrf {
 // The FRF record selected (the file's only FRF when nothing is selected). Throws std::invalid_argument
 // naming the file and listing its records when the selection matches none or several.
 [[nodiscard]] UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, const UffSelection& s);
+
+// A hammer test's time histories (dataset 58, function type 1): the force record (its ordinate a force)
+// and the response record (a displacement, velocity or acceleration; chosen by s.response when the file
+// holds several), in SI, on one even time axis. kind: what the response is. Throws std::invalid_argument
+// naming the file and listing its records.
+struct UffSeries {
+  TimeSeries series;
+  FrfKind kind{FrfKind::kAccelerance};
+  int force_record{0}, response_record{0};
+};
+[[nodiscard]] UffSeries time_series_from_uff(const measfiles::UffFile& file, const std::string& name, const UffSelection& s);
 
 // Whether a file is a universal file (its first non-blank line holds -1).
 [[nodiscard]] bool looks_like_uff(const std::string& path);

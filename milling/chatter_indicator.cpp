@@ -119,6 +119,7 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   // The share by displacement (each line's energy / f^2): the accelerometer weights the tooth-passing
   // harmonics by f^2 over a robot mode's chatter below them; the floor is on the acceleration.
   double total = 0.0, off = 0.0, total_a = 0.0, off_a = 0.0, best = 0.0;
+  std::size_t best_k = 0;
   for (std::size_t k = 1; k < fft_->bins(); ++k) {
     const double f = static_cast<double>(k) * df;
     if (f < s_.band_min_hz || f > 0.45 * fs_) continue;
@@ -127,7 +128,16 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     const double f_line = f_sp * s_.lines_per_revolution, h = std::round(f / f_line);
     if (std::abs(f - h * f_line) <= 2.0 * df + 1e-12) continue;
     off += e, off_a += e_a;
-    if (e > best) best = e, out.chatter_hz = f;
+    if (e > best) best = e, out.chatter_hz = f, best_k = k;
+  }
+  // Between the bins: the peak of a parabola through the log magnitudes of the best bin and its
+  // neighbours (a Hann window's line is nearly Gaussian): a few hundredths of a bin, where the bin
+  // itself is up to half a bin (0.25 Hz in a 2 s window) off.
+  if (best_k > 1 && best_k + 1 < fft_->bins()) {
+    const double a = std::log(std::abs(X[best_k - 1]) + 1e-300), b = std::log(std::abs(X[best_k]) + 1e-300),
+                 c = std::log(std::abs(X[best_k + 1]) + 1e-300);
+    const double denom = a - 2.0 * b + c;
+    if (denom < 0.0) out.chatter_hz += std::clamp(0.5 * (a - c) / denom, -0.5, 0.5) * df;
   }
   out.valid = true;
   out.nonharmonic_share = total > 0.0 ? off / total : 0.0;

@@ -53,7 +53,7 @@ def sources():
 # lower layers (docs/architecture.md). A new library must be placed here.
 LAYERS = [
     ("foundation", ["units"]),
-    ("data and numbers", ["filters", "config", "plot"]),
+    ("data and numbers", ["filters", "config", "plot", "measfiles"]),
     ("physics", ["modal", "robot"]),
     ("controller and plant", ["control", "sim_plant"]),
     ("analysis and the loop", ["analysis", "rt"]),

@@ -19,6 +19,8 @@
 #include "measfiles/table.hpp"
 #include "measfiles/uff.hpp"
 #include "modal/receptance.hpp"
+#include "sim_plant/excitation.hpp"
+#include "sim_plant/plant.hpp"
 #include "sim_plant/plant_model.hpp"
 #include "test_util.hpp"
 
@@ -482,6 +484,54 @@ TEST(Uff, IdentifyAllCommissionsFromAModalPackagesExport) {
   const Result missing = run("identify all --uff " + uff + " --config " + preset + " --out " + out);
   EXPECT_EQ(missing.status, 2) << missing.out;
   EXPECT_NE(missing.out.find("the actuator needs an FRF per volt with reference node 2"), std::string::npos) << missing.out;
+}
+
+// A hammer test's time histories in a universal file (binary, the time in ms, the force in kN, the
+// acceleration in g): `identify modes --series FILE.uff` gives the preset's H11yy modes, as the CSV route
+// (Cli.IdentifyModesFromTimeSeriesOfTheSimulatedPlant) does.
+TEST(Uff, IdentifyModesFromTimeHistoriesInAUniversalFile) {
+  const TempDir tmp;
+  const auto cfg = robodamp::config::load_config_file(robodamp::test::preset("horizontal_c2"));
+  const robodamp::sim::PlantModel model = robodamp::sim::build_plant_model(cfg);
+  robodamp::sim::Plant plant(model, cfg);
+  const std::size_t hammer = plant.add_excitation(std::make_unique<robodamp::sim::Noise>(0, 20.0, 5, 2.0, 60.0, cfg.loop.rate_hz));
+  UffFunction force, accel;
+  force.function_type = accel.function_type = mf::kUffTimeResponse;
+  force.is_complex = accel.is_complex = false;
+  force.abscissa = accel.abscissa = {mf::kUffTime, 0, 0, 0, "Time", "ms"};
+  force.ordinate = {mf::kUffExcitationForce, 0, 0, 0, "Force", "kN"};
+  accel.ordinate = {mf::kUffAcceleration, 0, 0, 0, "Acceleration", "g"};
+  force.response_node = 1, force.response_direction = 2, accel.response_node = 1, accel.response_direction = 2;
+  for (int k = 0; k < 1000000; ++k) {
+    const double a = plant.acceleration_mps2(0);
+    plant.step(0.0);
+    if (k % 10 != 0) continue;
+    const double t_ms = 1e3 * k / cfg.loop.rate_hz;
+    force.x.push_back(t_ms), accel.x.push_back(t_ms);
+    force.y.emplace_back(plant.excitation_force_n(hammer) / 1e3, 0.0), accel.y.emplace_back(a / 9.80665, 0.0);
+  }
+  UffFile file;
+  file.functions = {force, accel};
+  const std::string uff = tmp.file("hammer.uff"), json = tmp.file("modes.json");
+  mf::write_uff(uff, file, mf::UffEncoding::kBinary);
+  const Result r = run("identify modes --series " + uff + " --segment-s 20 --band-hz 5 40 --json " + json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("records 1 (force) and 2 (response), 100000 samples at 500 Hz"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  const auto& frf = cfg.robot.frfs[0];  // H11yy
+  ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
+  for (std::size_t i = 0; i < frf.modes.size(); ++i) {
+    EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz, 0.01 * frf.modes[i].natural_freq_hz) << r.out;
+    EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.1 * frf.modes[i].damping_ratio) << r.out;
+  }
+  // Two responses and no choice: refused, listing them.
+  file.functions.push_back(accel);
+  mf::write_uff(uff, file, mf::UffEncoding::kBinary);
+  const Result two = run("identify modes --series " + uff + " --segment-s 20");
+  EXPECT_EQ(two.status, 2) << two.out;
+  EXPECT_NE(two.out.find("2 time histories of a response match; choose one with --response NODE:DIR or --record N"), std::string::npos) << two.out;
+  const Result chosen = run("identify modes --series " + uff + " --record 3 --segment-s 20 --band-hz 5 40");
+  EXPECT_EQ(chosen.status, 0) << chosen.out;
 }
 
 }  // namespace

@@ -1,0 +1,161 @@
+// `robodamp chatter --signal FILE`: a recorded cut's vibration or sound (a table, a WAV, a universal file's
+// time history, a robodamp recording) -> chatter over time, its frequency, and the speeds to try next
+// (milling/chatter_listen.hpp). docs/milling.md, "Listening to a recorded cut".
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/cli.hpp"
+#include "apps/gnuplot.hpp"
+#include "identify/recorded_signal.hpp"
+#include "milling/chatter_listen.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+struct ChatterArgs {
+  std::string signal, column, response, plot_dir;
+  std::optional<double> rate_hz, rpm, floor, full_scale_mps2;
+  int channel{1}, teeth{0};
+  std::optional<int> record;
+  std::vector<double> rpm_range;  // empty: 100 .. 30000
+  double window_s{2.0}, max_hz{1000.0};
+  JsonOut json;
+};
+
+nlohmann::json to_json(const milling::ListenReport& r) {
+  nlohmann::json w = nlohmann::json::array();
+  for (const auto& x : r.windows)
+    w.push_back({{"start_s", x.start_s}, {"end_s", x.end_s}, {"verdict", milling::to_string(x.verdict)},
+                 {"chatter_hz", x.chatter_hz}, {"chatter_share", x.chatter_share}, {"rms", x.rms},
+                 {"once_per_rev_ratio", x.indicator.once_per_rev_ratio}});
+  nlohmann::json speeds = nlohmann::json::array();
+  for (const auto& s : r.speeds) speeds.push_back({{"rpm", s.rpm}, {"lobe", s.lobe}});
+  nlohmann::json j = {{"windows", w}, {"chatter_hz", r.chatter_hz}, {"rpm", r.rpm}, {"rpm_source", r.rpm_source},
+                      {"rate_hz", r.rate_hz}, {"analysed_rate_hz", r.analysed_rate_hz}, {"samples", r.samples},
+                      {"warnings", r.warnings}, {"speeds_to_try", speeds}};
+  j["onset_s"] = r.onset_s ? nlohmann::json(*r.onset_s) : nlohmann::json(nullptr);
+  j["end_s"] = r.end_s ? nlohmann::json(*r.end_s) : nlohmann::json(nullptr);
+  return j;
+}
+
+std::string plots(const milling::ListenReport& r, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::ostringstream sp;
+  for (std::size_t c = 0; c < r.spectrogram_db.size(); ++c) {
+    for (std::size_t k = 0; k < r.spectrogram_hz.size(); ++k)
+      sp << plot::num(r.spectrogram_t_s[c]) << ' ' << plot::num(r.spectrogram_hz[k]) << ' ' << plot::num(r.spectrogram_db[c][k]) << '\n';
+    sp << '\n';
+  }
+  const double duration_s = r.windows.empty() ? 0.0 : r.windows.back().end_s;
+  const double top_hz = r.spectrogram_hz.empty() ? 1.0 : r.spectrogram_hz.back();
+  char title[160];
+  if (r.chatter_hz > 0.0) std::snprintf(title, sizeof title, "Spectrogram (%.0f rpm, chatter at %.2f Hz)", r.rpm, r.chatter_hz);
+  else std::snprintf(title, sizeof title, "Spectrogram (%.0f rpm, no chatter)", r.rpm);
+  std::ostringstream s;
+  s << "set title '" << title << "'\nset xlabel 'time (s)'\nset ylabel 'frequency (Hz)'\nset cblabel 'magnitude (dB)'\n"
+    << "set xrange [0:" << plot::num(duration_s) << "]\nset yrange [0:" << plot::num(top_hz) << "]\n"
+    << "plot DATA u 1:2:3 with image notitle\n";
+  if (auto e = run_gnuplot(s.str(), sp.str(), dir + "/chatter_spectrogram.png"); !e.empty()) return e;
+  std::ostringstream v;
+  for (const auto& w : r.windows) {
+    const int level = w.verdict == milling::WindowVerdict::kChatter ? 2 : w.verdict == milling::WindowVerdict::kStable ? 1 : 0;
+    v << plot::num(w.start_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz) << '\n'
+      << plot::num(w.end_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz) << '\n';
+  }
+  std::string onset;
+  if (r.onset_s)
+    onset = "set arrow from " + plot::num(*r.onset_s) + ", graph 0 to " + plot::num(*r.onset_s) +
+            ", graph 1 nohead dt 2 lc rgb 'red'\nset label 'onset " + plot::num(std::round(*r.onset_s * 100.0) / 100.0) + " s' at " +
+            plot::num(*r.onset_s) + ", graph 0.9 offset 0.5,0 tc rgb 'red'\n";
+  const std::string s2 =
+      "set multiplot layout 2,1 title 'Chatter over time'\nset grid\nset ylabel 'verdict'\n" + onset +
+      "set ytics ('not enough signal' 0, 'stable' 1, 'chatter' 2)\nset yrange [-0.3:2.3]\n"
+      "plot DATA u 1:2 w l lw 3 t 'verdict per window'\nset ytics auto\nset yrange [*:*]\nset xlabel 'time (s)'\n"
+      "set key bottom right\nset ylabel 'non-harmonic share'\nset yrange [0:1.05]\nset y2label 'chatter frequency (Hz)'\nset y2tics\nset y2range [0:*]\n"
+      "plot DATA u 1:3 w l t 'non-harmonic share of the energy', DATA u 1:($4 > 0 ? $4 : 1/0) axes x1y2 w p pt 7 t 'chatter frequency'\n"
+      "unset multiplot\n";
+  return run_gnuplot(s2, v.str(), dir + "/chatter_verdict.png");
+}
+
+int run_chatter(const ChatterArgs& a) {
+  milling::ListenReport r;
+  std::string described;
+  try {
+    if (a.teeth == 0) throw std::invalid_argument("--teeth: the cutter's teeth are required (the tooth-passing lines)");
+    const std::vector<double> range = a.rpm_range.empty() ? std::vector<double>{100.0, 30000.0} : a.rpm_range;
+    if (range.size() != 2 || !(range[1] > range[0])) throw std::invalid_argument("--rpm-range: two speeds, LO < HI");
+    identify::SignalOptions o;
+    o.column = a.column, o.rate_hz = a.rate_hz, o.channel = a.channel, o.full_scale_mps2 = a.full_scale_mps2, o.record = a.record;
+    if (!a.response.empty()) o.response = identify::parse_dof(a.response);
+    const milling::RecordedSignal sig = identify::read_recorded_signal(a.signal, o, described);
+    milling::ListenSettings s;
+    s.teeth = a.teeth, s.rpm = a.rpm, s.rpm_min = range[0], s.rpm_max = range[1];
+    s.window_s = a.window_s, s.max_hz = a.max_hz, s.floor = a.floor;
+    r = milling::listen(sig, s);
+  } catch (const std::exception& e) {
+    std::cerr << "robodamp chatter: " << e.what() << '\n';
+    return 2;
+  }
+  std::ostringstream t;
+  t << "robodamp chatter: " << a.signal << " (" << described << "), " << r.samples << " samples at " << r.rate_hz << " Hz, analysed at "
+    << r.analysed_rate_hz << " Hz\n  spindle " << r.rpm << " rpm (" << r.rpm_source << ")\n";
+  for (const auto& w : r.warnings) t << "  NOTE: " << w << '\n';
+  std::size_t counts[3] = {0, 0, 0};
+  for (const auto& w : r.windows) {
+    ++counts[static_cast<int>(w.verdict)];
+    char line[200];
+    char hz[32] = "";
+    if (w.verdict == milling::WindowVerdict::kChatter) std::snprintf(hz, sizeof hz, ", %.2f Hz", w.chatter_hz);
+    std::snprintf(line, sizeof line, "  %7.2f-%7.2f s  %-17s  non-harmonic %5.1f %%%s\n", w.start_s, w.end_s, milling::to_string(w.verdict),
+                  100.0 * w.chatter_share, hz);
+    t << line;
+  }
+  if (r.onset_s) {
+    char head[200];
+    std::snprintf(head, sizeof head, "CHATTER from %.2f s to %.2f s at %.2f Hz (%zu of %zu windows). Speeds to try (the tooth frequency at "
+                  "%.2f Hz / k):", *r.onset_s, *r.end_s, r.chatter_hz, counts[1], r.windows.size(), r.chatter_hz);
+    t << head;
+    for (const auto& s : r.speeds) t << ' ' << std::lround(s.rpm) << " rpm (k " << s.lobe << ")";
+    t << (r.speeds.empty() ? " none within the range" : "") << "\n";
+  } else {
+    t << "NO CHATTER in " << counts[0] << " windows judged (" << counts[2] << " without enough signal)\n";
+  }
+  return print_report(to_json(r).dump(2), a.json, "chatter", t.str(), a.plot_dir, [&] { return plots(r, a.plot_dir); },
+                      "plots in " + a.plot_dir);
+}
+
+}  // namespace
+
+void register_chatter(Registry& r) {
+  auto a = std::make_shared<ChatterArgs>();
+  CLI::App* sub = r.add("chatter",
+                        "Listen to a recorded cut: chatter over time, its frequency and the speeds to try (a table, WAV, "
+                        "universal file or robodamp recording)",
+                        [a] { return run_chatter(*a); });
+  sub->add_option("--signal", a->signal, "The recording: a table (time column or --rate-hz), a WAV, a universal file's time history, a robodamp recording")
+      ->required()
+      ->check(CLI::ExistingFile);
+  r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "The cutter's teeth");
+  r.number(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, false, false}, "The spindle speed (default: estimated from the signal's harmonics)");
+  r.numbers(sub, "--rpm-range", a->rpm_range, {"rpm", 1.0, 200000.0}, "Where the estimate searches and the speeds to try lie: LO HI (default 100 30000)");
+  sub->add_option("--column", a->column, "A table's column: its name or number (default: the first that is not time)");
+  r.number(sub, "--rate-hz", a->rate_hz, {"Hz", 0.0, 1e7, false, false}, "A table's sample rate when it has no time column");
+  r.whole_number(sub, "--channel", a->channel, {"(channel)", 1, 64}, "A sound file's channel (default 1)");
+  r.number(sub, "--full-scale-mps2", a->full_scale_mps2, {"m/s^2", 0.0, 1e6, false, false}, "A sound file's acceleration at full scale (an accelerometer recorded as sound)");
+  r.whole_number(sub, "--record", a->record, {"(record)", 1, 1000000}, "A universal file's function record");
+  sub->add_option("--response", a->response, "A universal file's record by its response DOF NODE:DIR");
+  r.number(sub, "--window-s", a->window_s, {"s", 0.2, 60.0}, "One verdict per window of this length (default 2)");
+  r.number(sub, "--max-hz", a->max_hz, {"Hz", 10.0, 1e5}, "The band analysed (default 1000: a robot's modes and their tooth-passing lines)");
+  r.number(sub, "--floor", a->floor, {"(the signal's unit)", 0.0, 1e9}, "Non-harmonic RMS below this is not chatter (default 0.05 m/s^2 for an acceleration)");
+  r.json(sub, a->json, "Per window: start_s, end_s, verdict, chatter_hz, chatter_share; onset_s, end_s, chatter_hz, rpm, rpm_source, rate_hz, samples");
+  r.plot_dir(sub, a->plot_dir, "chatter_spectrogram.png and chatter_verdict.png");
+}
+
+}  // namespace robodamp::apps

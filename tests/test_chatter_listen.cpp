@@ -1,0 +1,230 @@
+// Issue 50: `robodamp chatter` on recorded signals with a known truth (milling/chatter_listen.hpp,
+// identify/recorded_signal.hpp): a cut at 700 rpm with three teeth and runout, stable for 6 s, then
+// chatter at 17.3 Hz growing to a limit cycle, written at 10, 25.6 and 48 kHz as a table (semicolons,
+// decimal commas, the time in ms), a 24-bit WAV and a universal file's time history.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "identify/recorded_signal.hpp"
+#include "measfiles/uff.hpp"
+#include "milling/chatter_listen.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+namespace ml = robodamp::milling;
+
+struct TempDir {
+  std::string path;
+  TempDir() {
+    char tmpl[] = "/tmp/robodamp-chatter-XXXXXX";
+    path = mkdtemp(tmpl);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  [[nodiscard]] std::string file(const std::string& name) const { return path + "/" + name; }
+};
+
+constexpr double kRpm = 700.0, kChatterHz = 17.3, kOnsetS = 6.0;
+constexpr int kTeeth = 3;
+
+// Acceleration, m/s^2: the spindle's and the teeth's forced lines (runout: every spindle harmonic), noise,
+// and from kOnsetS chatter growing to a limit cycle.
+std::vector<double> cut_signal(double rate_hz, double duration_s, bool chatter, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const double f_sp = kRpm / 60.0;
+  std::vector<double> x;
+  for (int i = 0; i < static_cast<int>(duration_s * rate_hz); ++i) {
+    const double t = i / rate_hz;
+    double v = noise(rng);
+    for (int k = 1; k <= 30; ++k) v += (k % kTeeth == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
+    if (chatter && t > kOnsetS) v += std::min(0.05 * std::exp(3.0 * (t - kOnsetS)), 1.5) * std::sin(2.0 * M_PI * kChatterHz * t);
+    x.push_back(v);
+  }
+  return x;
+}
+
+ml::ListenSettings settings() {
+  ml::ListenSettings s;
+  s.teeth = kTeeth;
+  s.rpm_min = 300.0, s.rpm_max = 3000.0;
+  return s;
+}
+
+// The verdicts against the truth: stable windows wholly before the onset, chatter from the first window
+// after the onset on (the growth takes about 1 s to pass the floor).
+void expect_truth(const ml::ListenReport& r, bool chatter, const std::string& what) {
+  int right = 0, judged = 0;
+  for (const auto& w : r.windows) {
+    if (chatter && w.end_s > kOnsetS && w.start_s < kOnsetS + 1.0) continue;  // the onset's window: either
+    ++judged;
+    const bool should = chatter && w.start_s >= kOnsetS;
+    right += (w.verdict == (should ? ml::WindowVerdict::kChatter : ml::WindowVerdict::kStable));
+    if (w.verdict == ml::WindowVerdict::kChatter) {
+      EXPECT_NEAR(w.chatter_hz, kChatterHz, 0.01 * kChatterHz) << what << " " << w.start_s;
+    }
+  }
+  EXPECT_GE(right, (95 * judged + 99) / 100) << what;
+  if (chatter) {
+    ASSERT_TRUE(r.onset_s.has_value()) << what;
+    EXPECT_NEAR(*r.onset_s, kOnsetS, 0.2) << what;
+    EXPECT_NEAR(r.chatter_hz, kChatterHz, 0.01 * kChatterHz) << what;
+  } else {
+    EXPECT_FALSE(r.onset_s.has_value()) << what;
+  }
+}
+
+TEST(ChatterListen, KnownCutsAtThreeRatesGiveTheVerdictsTheOnsetAndTheFrequency) {
+  for (const double rate : {10000.0, 25600.0, 48000.0}) {
+    for (const bool chatter : {false, true}) {
+      ml::RecordedSignal sig;
+      sig.source = "synthetic", sig.rate_hz = rate, sig.samples = cut_signal(rate, 20.0, chatter, 5);
+      const ml::ListenReport r = ml::listen(sig, settings());
+      const std::string what = std::to_string(rate) + (chatter ? " chatter" : " stable");
+      EXPECT_EQ(r.windows.size(), 10u) << what;
+      EXPECT_NEAR(r.rpm, kRpm, 0.01 * kRpm) << what << ": " << r.rpm_source;  // estimated: not given
+      expect_truth(r, chatter, what);
+      if (chatter) {
+        ASSERT_FALSE(r.speeds.empty());
+        // The pockets: the tooth frequency at 17.3 Hz / k; the nearest to 700 rpm is k = 1 (346 rpm) or none
+        // above; all within the range.
+        for (const auto& s : r.speeds) EXPECT_NEAR(s.rpm * kTeeth / 60.0 * s.lobe, r.chatter_hz, 1e-9);
+      }
+      // The spectrogram's plotted data: in the last chatter column the loudest row below 30 Hz is the chatter.
+      if (chatter) {
+        const auto& col = r.spectrogram_db.back();
+        std::size_t best = 0;
+        for (std::size_t k = 0; k < col.size(); ++k)
+          if (r.spectrogram_hz[k] > 5.0 && r.spectrogram_hz[k] < 30.0 && (best == 0 || col[k] > col[best])) best = k;
+        EXPECT_NEAR(r.spectrogram_hz[best], kChatterHz, 1.5) << what;
+      }
+    }
+  }
+}
+
+TEST(ChatterListen, AwkwardRecordingsAreSaidPlainly) {
+  ml::RecordedSignal sig;
+  sig.source = "awkward", sig.rate_hz = 10000.0, sig.samples = cut_signal(10000.0, 12.0, true, 9);
+  for (std::size_t i = 30000; i < 30300; ++i) sig.samples[i] = NAN;  // a dropout: 1.5 % of a window
+  for (double& v : sig.samples) v = std::clamp(v + 3.0, 1.0, 4.0);  // a DC offset, and clipped at 4
+  const ml::ListenReport r = ml::listen(sig, settings());
+  std::string all;
+  for (const auto& w : r.warnings) all += w + "\n";
+  EXPECT_NE(all.find("300 samples are not finite (dropouts)"), std::string::npos) << all;
+  EXPECT_NE(all.find("a DC offset of"), std::string::npos) << all;
+  EXPECT_NE(all.find("clipped:"), std::string::npos) << all;
+  EXPECT_EQ(r.windows[1].verdict, ml::WindowVerdict::kNoSignal);  // the window with the dropout (over 1 % held)
+  // Too short, no teeth, a rate too low: refused with the reason.
+  ml::RecordedSignal shorter = sig;
+  shorter.samples.resize(5000);
+  EXPECT_THROW((void)ml::listen(shorter, settings()), std::invalid_argument);
+  ml::ListenSettings no_teeth = settings();
+  no_teeth.teeth = 0;
+  EXPECT_THROW((void)ml::listen(sig, no_teeth), std::invalid_argument);
+  // Air: the spindle turning, no cut: noise only, below the floor.
+  ml::RecordedSignal air;
+  air.source = "air", air.rate_hz = 10000.0;
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0.0, 0.01);
+  for (int i = 0; i < 80000; ++i) air.samples.push_back(n(rng));
+  ml::ListenSettings given = settings();
+  given.rpm = kRpm;
+  for (const auto& w : ml::listen(air, given).windows) EXPECT_EQ(w.verdict, ml::WindowVerdict::kNoSignal);
+}
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+Result run(const std::string& args) {
+  FILE* p = popen((std::string(ROBODAMP_BINARY) + " " + args + " 2>&1").c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t k = std::fread(buf, 1, sizeof buf, p)) out.append(buf, k);
+  const int rc = pclose(p);
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
+}
+
+void write_wav24(const std::string& path, const std::vector<double>& x, double rate, double full_scale) {
+  std::ofstream f(path, std::ios::binary);
+  auto u32 = [&](std::uint32_t v) { f.write(reinterpret_cast<const char*>(&v), 4); };
+  auto u16 = [&](std::uint16_t v) { f.write(reinterpret_cast<const char*>(&v), 2); };
+  const auto bytes = static_cast<std::uint32_t>(x.size() * 3);
+  f << "RIFF";
+  u32(36 + bytes);
+  f << "WAVEfmt ";
+  u32(16), u16(1), u16(1), u32(static_cast<std::uint32_t>(rate)), u32(static_cast<std::uint32_t>(rate) * 3), u16(3), u16(24);
+  f << "data";
+  u32(bytes);
+  for (double v : x) {
+    const auto s = static_cast<std::int32_t>(std::lround(std::clamp(v / full_scale, -1.0, 1.0) * 8388607.0));
+    const char b[3] = {static_cast<char>(s & 0xff), static_cast<char>((s >> 8) & 0xff), static_cast<char>((s >> 16) & 0xff)};
+    f.write(b, 3);
+  }
+}
+
+// The command on the formats a user has, with the JSON and the plots.
+TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
+  const TempDir tmp;
+  const double rate = 25600.0;
+  const std::vector<double> x = cut_signal(rate, 12.0, true, 21);
+  {
+    std::ofstream csv(tmp.file("cut.csv"));
+    csv << "Messung 27.11.2026\nZeit [ms];Beschleunigung [g]\n";
+    char line[80];
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      std::snprintf(line, sizeof line, "%.4f;%.7f\n", 1e3 * static_cast<double>(i) / rate, x[i] / 9.80665);
+      std::string s = line;
+      for (char& c : s)
+        if (c == '.') c = ',';
+      csv << s;
+    }
+  }
+  write_wav24(tmp.file("cut.wav"), x, rate, 20.0);
+  {
+    robodamp::measfiles::UffFunction f;
+    f.function_type = robodamp::measfiles::kUffTimeResponse, f.is_complex = false;
+    f.response_node = 1, f.response_direction = 2;
+    f.abscissa = {robodamp::measfiles::kUffTime, 0, 0, 0, "Time", "s"};
+    f.ordinate = {robodamp::measfiles::kUffAcceleration, 0, 0, 0, "Acceleration", "m/s^2"};
+    for (std::size_t i = 0; i < x.size(); ++i) f.x.push_back(static_cast<double>(i) / rate), f.y.emplace_back(x[i], 0.0);
+    robodamp::measfiles::UffFile file;
+    file.functions = {f};
+    robodamp::measfiles::write_uff(tmp.file("cut.uff"), file, robodamp::measfiles::UffEncoding::kBinary);
+  }
+  const std::string json = tmp.file("c.json"), plots = tmp.file("plots");
+  for (const std::string input : {"cut.csv --column 2", "cut.wav --full-scale-mps2 20", "cut.uff"}) {
+    const Result r = run("chatter --signal " + tmp.path + "/" + input + " --teeth 3 --rpm-range 300 3000 --json " + json +
+                         " --plot-dir " + plots);
+    ASSERT_EQ(r.status, 0) << input << "\n" << r.out;
+    EXPECT_NE(r.out.find("CHATTER from"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+    EXPECT_NEAR(j["chatter_hz"].get<double>(), kChatterHz, 0.01 * kChatterHz) << input;
+    EXPECT_NEAR(j["rpm"].get<double>(), kRpm, 0.01 * kRpm) << input;
+    EXPECT_NEAR(j["rate_hz"].get<double>(), rate, 0.01) << input;
+    EXPECT_EQ(j["windows"].size(), 6u) << input;
+    EXPECT_EQ(j["windows"][0]["verdict"], "stable") << input;
+    EXPECT_EQ(j["windows"][5]["verdict"], "chatter") << input;
+    for (const char* png : {"chatter_spectrogram.png", "chatter_verdict.png"})
+      EXPECT_GT(std::filesystem::file_size(plots + "/" + png), 5000u) << png;
+  }
+  const Result no_teeth = run("chatter --signal " + tmp.file("cut.uff"));
+  EXPECT_EQ(no_teeth.status, 2) << no_teeth.out;
+  EXPECT_NE(no_teeth.out.find("--teeth"), std::string::npos) << no_teeth.out;
+  const Result bad_channel = run("chatter --signal " + tmp.file("cut.wav") + " --teeth 3 --channel 2");
+  EXPECT_EQ(bad_channel.status, 2) << bad_channel.out;
+  EXPECT_NE(bad_channel.out.find("channel 2: the file has 1"), std::string::npos) << bad_channel.out;
+}
+
+}  // namespace
