@@ -123,6 +123,8 @@ std::vector<Sub> subcommands() {
         {"--reference", {"1:+Y", "2:-Z"}}, {"--axes", {"fx,fy,fz", "-fy,fx,fz"}}, {"--force-on", {"workpiece", "tool"}}},
        {"--csv", "--frf", "--series", "--recording", "--structure", "--records", "--tests", "--uff", "--config"}, false},
       {"measure", {}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
+      {"chatter", {"--teeth", "--rpm", "--rpm-range", "--rate-hz", "--channel", "--full-scale-mps2", "--record", "--window-s",
+                   "--max-hz", "--floor"}, {"--json"}, {{"--response", {"1:+Y"}}, {"--column", {"2", "accel"}}}, {"--signal"}, false},
       {"tune", {"--gain-margin-db", "--phase-margin-deg", "--delay-margin-ms", "--depth-at-speed-mm", "--evaluations",
                  "--polish", "--seed", "--restarts", "--shift-pct", "--impact-n", "--impact-ms"}, {}, {},
        {"--config", "--job", "--also"}, false},
