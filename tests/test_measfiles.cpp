@@ -216,6 +216,44 @@ TEST(Uff, ReadsHandWrittenLayoutsOfTheSpecification) {
   EXPECT_EQ(all.functions[2].dataset_index, 5);
 }
 
+// Nodes and modes written by hand from the specification: dataset 15 (4I10,1P3E13.5), 2411 (4I10 then
+// 1P3D25.16), 55 with normal modes (analysis type 2: frequency, modal mass, damping; real data) and with
+// complex modes (type 3) spaced freely.
+TEST(Uff, ReadsHandWrittenNodesAndModes) {
+  const std::string text =
+      "    -1\n    15\n"
+      "         1         0         0        11  1.00000E+00  2.00000E+00  3.00000E+00\n"
+      "         2         0         0        11 -5.00000E-01  0.00000E+00  1.25000E+00\n"
+      "    -1\n    -1\n  2411\n"
+      "         3         1         1        11\n"
+      "   4.0000000000000000D+00   5.0000000000000000D-01  -6.0000000000000000D+00\n"
+      "    -1\n    -1\n    55\nmode 1\nNONE\nNONE\nNONE\nNONE\n"
+      "         1         2         2         8         2         3\n"
+      "         2         4         1         1\n"
+      "  1.20000E+01  2.50000E+00  3.00000E-02  0.00000E+00\n"
+      "         1\n  1.00000E+00  0.00000E+00 -2.50000E-01\n"
+      "         2\n  0.00000E+00  5.00000E-01  0.00000E+00\n"
+      "    -1\n    -1\n    55\nmode 2\n\n\n\n\n"
+      "1 3 2 8 5 3\n2 6 1 2\n-1.5 62.8 1.0 0.0 0.0 0.0\n"
+      "1\n0.0 0.0 1.0E-3 -2.0E-4 0.0 0.0\n"
+      "    -1\n";
+  const UffFile f = mf::parse_uff(text, "nodes.uff");
+  ASSERT_EQ(f.nodes.size(), 3u);
+  EXPECT_EQ(f.nodes[1].label, 2);
+  EXPECT_DOUBLE_EQ(f.nodes[1].xyz[2], 1.25);
+  EXPECT_EQ(f.nodes[2].label, 3);
+  EXPECT_DOUBLE_EQ(f.nodes[2].xyz[2], -6.0);
+  ASSERT_EQ(f.modes.size(), 2u);
+  const double wn = 2.0 * M_PI * 12.0;
+  EXPECT_NEAR(f.modes[0].eigenvalue.real(), -0.03 * wn, 1e-9);
+  EXPECT_NEAR(std::abs(f.modes[0].eigenvalue), wn, 1e-9);
+  EXPECT_DOUBLE_EQ(f.modes[0].modal_a.real(), 2.5);  // the modal mass
+  ASSERT_EQ(f.modes[0].shape.size(), 2u);
+  EXPECT_EQ(f.modes[0].shape[0].second[2], std::complex<double>(-0.25, 0.0));
+  EXPECT_EQ(f.modes[1].number, 2);
+  EXPECT_EQ(f.modes[1].shape[0].second[1], std::complex<double>(1e-3, -2e-4));
+}
+
 // What the reader cannot take is refused naming the file, the dataset, the record and the field.
 TEST(Uff, RefusesWhatItCannotTakeNamingTheRecordAndField) {
   const std::string good = mf::format_uff(sample_file(), mf::UffEncoding::kAscii);
