@@ -33,6 +33,8 @@ echo "milling in time (cut, damped cut, critical depth, SDM diagram), one core:"
 taskset -c 0 ./build/benchmarks/benchmark_cut --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 echo "== modal identification of the robot SLE study's 46-mode FRF (x and y), one core"
 taskset -c 0 ./build/benchmarks/benchmark_identify
+echo "== robodamp chatter: 60 s at 48 kHz"
+taskset -c 0 ./build/benchmarks/benchmark_chatter
 echo
 echo "milling analyses, one core: a 2000-speed lobe diagram of the 37-mode robot FRF (the robot SLE study), the direct test's"
 echo "critical depth at one speed, SLE at one speed (40 slices, 64 harmonics):"
