@@ -12,7 +12,11 @@
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "identify/recorded_signal.hpp"
+#include "config/config.hpp"
+#include "config/milling_config.hpp"
 #include "milling/chatter_listen.hpp"
+#include "milling/live_stability.hpp"
+#include "milling/speed_advice.hpp"
 
 namespace robodamp::apps {
 
@@ -23,10 +27,46 @@ struct ChatterArgs {
   std::optional<double> rate_hz, rpm, floor, full_scale_mps2;
   int channel{1}, teeth{0};
   std::optional<int> record;
-  std::vector<double> rpm_range;  // empty: 100 .. 30000
+  std::vector<double> rpm_range;  // empty: 100 .. 30000, or the job's
+  // The speeds checked by the accurate method: the cell's configuration, its job (default spindle.job),
+  // the recorded depth (default the job's) and whether the damper ran.
+  std::string config_path, job_path;
+  std::optional<double> depth_mm;
+  bool damped{false};
   double window_s{2.0}, max_hz{1000.0};
   JsonOut json;
 };
+
+// Each speed to try checked as the cell's advisor checks it: the accurate limit at the recorded depth there.
+struct Cell {
+  config::Config cfg;
+  config::MillingConfig job;
+};
+
+std::optional<Cell> cell_of(const ChatterArgs& a) {
+  if (a.config_path.empty()) {
+    if (!a.job_path.empty() || a.depth_mm || a.damped) throw std::invalid_argument("--job, --depth-mm and --damped need --config (the cell)");
+    return std::nullopt;
+  }
+  config::Config cfg = config::load_config_file(a.config_path);
+  const std::string job_path = !a.job_path.empty() ? a.job_path : cfg.spindle.job_resolved;
+  if (job_path.empty()) throw std::invalid_argument(a.config_path + ": no spindle.job: give --job");
+  Cell c{std::move(cfg), config::load_milling_config(job_path)};
+  if (c.job.tool.teeth != a.teeth)
+    throw std::invalid_argument("--teeth " + std::to_string(a.teeth) + " but the job " + job_path + " cuts with tool.teeth = " +
+                                std::to_string(c.job.tool.teeth));
+  return c;
+}
+
+milling::SpeedAdvice checked_speeds(const ChatterArgs& a, const Cell& c, const milling::ListenReport& r, const std::vector<double>& range) {
+  const config::Config& cfg = c.cfg;
+  config::MillingConfig job = c.job;
+  milling::SpeedAdviceRequest q;
+  q.rpm = r.rpm, q.depth_mm = a.depth_mm.value_or(job.cut.axial_mm), q.set = 0, q.gain_ns_per_m = cfg.controller.gain_ns_per_m;
+  q.damped = a.damped, q.chatter_hz = r.chatter_hz, q.trigger = "chatter";
+  milling::LiveStability stability(std::move(job), cfg.spindle.structure, {cfg});
+  return milling::advise_speed(stability, q, range[0], range[1]);
+}
 
 nlohmann::json to_json(const milling::ListenReport& r) {
   nlohmann::json w = nlohmann::json::array();
@@ -86,11 +126,15 @@ std::string plots(const milling::ListenReport& r, const std::string& dir) {
 
 int run_chatter(const ChatterArgs& a) {
   milling::ListenReport r;
+  std::vector<double> range;
+  std::optional<milling::SpeedAdvice> advice;
   std::string described;
   try {
     if (a.teeth == 0) throw std::invalid_argument("--teeth: the cutter's teeth are required (the tooth-passing lines)");
-    const std::vector<double> range = a.rpm_range.empty() ? std::vector<double>{100.0, 30000.0} : a.rpm_range;
+    range = a.rpm_range.empty() ? std::vector<double>{100.0, 30000.0} : a.rpm_range;
     if (range.size() != 2 || !(range[1] > range[0])) throw std::invalid_argument("--rpm-range: two speeds, LO < HI");
+    const std::optional<Cell> cell = cell_of(a);
+    if (cell && a.rpm_range.empty()) range = {cell->job.lobes.rpm_min, std::min(cell->job.lobes.rpm_max, cell->cfg.spindle.rpm_max)};
     identify::SignalOptions o;
     o.column = a.column, o.rate_hz = a.rate_hz, o.channel = a.channel, o.full_scale_mps2 = a.full_scale_mps2, o.record = a.record;
     if (!a.response.empty()) o.response = identify::parse_dof(a.response);
@@ -99,6 +143,7 @@ int run_chatter(const ChatterArgs& a) {
     s.teeth = a.teeth, s.rpm = a.rpm, s.rpm_min = range[0], s.rpm_max = range[1];
     s.window_s = a.window_s, s.max_hz = a.max_hz, s.floor = a.floor;
     r = milling::listen(sig, s);
+    if (cell && r.chatter_hz > 0.0) advice = checked_speeds(a, *cell, r, range);
   } catch (const std::exception& e) {
     std::cerr << "robodamp chatter: " << e.what() << '\n';
     return 2;
@@ -124,10 +169,32 @@ int run_chatter(const ChatterArgs& a) {
     t << head;
     for (const auto& s : r.speeds) t << ' ' << std::lround(s.rpm) << " rpm (k " << s.lobe << ")";
     t << (r.speeds.empty() ? " none within the range" : "") << "\n";
+    if (advice) {
+      char check[200];
+      std::snprintf(check, sizeof check, "Checked by %s at %.3g mm (%s): the limit here is %.3g mm.", advice->method.c_str(), advice->depth_mm,
+                    a.damped ? "damped" : "open loop", advice->limit_now_mm);
+      t << check;
+      if (advice->depth_from_chatter)
+        t << " The cut chattered at a speed whose limit is above the depth given, so it was at least that deep (or the model is "
+             "optimistic there): the margins are against the limit.";
+      if (!advice->found) t << " No speed qualifies: " << advice->reason << "\n";
+      for (const auto& o : advice->options) {
+        std::snprintf(check, sizeof check, "\n  %.0f rpm: limit %.3g mm, margin x%.2f (%s)", o.rpm, o.limit_mm, o.margin, o.source.c_str());
+        t << check;
+      }
+      if (advice->found) t << "\n";
+    }
   } else {
     t << "NO CHATTER in " << counts[0] << " windows judged (" << counts[2] << " without enough signal)\n";
   }
-  return print_report(to_json(r).dump(2), a.json, "chatter", t.str(), a.plot_dir, [&] { return plots(r, a.plot_dir); },
+  nlohmann::json j = to_json(r);
+  if (advice) {
+    nlohmann::json opts = nlohmann::json::array();
+    for (const auto& o : advice->options) opts.push_back({{"rpm", o.rpm}, {"limit_mm", o.limit_mm}, {"margin", o.margin}, {"source", o.source}});
+    j["checked"] = {{"method", advice->method}, {"depth_mm", advice->depth_mm}, {"limit_now_mm", advice->limit_now_mm}, {"found", advice->found},
+                    {"options", opts}, {"reason", advice->reason}, {"damped", a.damped}};
+  }
+  return print_report(j.dump(2), a.json, "chatter", t.str(), a.plot_dir, [&] { return plots(r, a.plot_dir); },
                       "plots in " + a.plot_dir);
 }
 
@@ -154,6 +221,11 @@ void register_chatter(Registry& r) {
   r.number(sub, "--window-s", a->window_s, {"s", 0.2, 60.0}, "One verdict per window of this length (default 2)");
   r.number(sub, "--max-hz", a->max_hz, {"Hz", 10.0, 1e5}, "The band analysed (default 1000: a robot's modes and their tooth-passing lines)");
   r.number(sub, "--floor", a->floor, {"(the signal's unit)", 0.0, 1e9}, "Non-harmonic RMS below this is not chatter (default 0.05 m/s^2 for an acceleration)");
+  sub->add_option("--config", a->config_path, "The cell's configuration: the speeds to try are checked by the accurate method on its job")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--job", a->job_path, "The milling job (default the configuration's spindle.job)")->check(CLI::ExistingFile);
+  r.number(sub, "--depth-mm", a->depth_mm, {"mm", 0.0, 100.0, false, false}, "The recorded cut's axial depth (default the job's)");
+  sub->add_flag("--damped", a->damped, "The recording was made with the damper on: the damped limits apply");
   r.json(sub, a->json, "Per window: start_s, end_s, verdict, chatter_hz, chatter_share; onset_s, end_s, chatter_hz, rpm, rpm_source, rate_hz, samples");
   r.plot_dir(sub, a->plot_dir, "chatter_spectrogram.png and chatter_verdict.png");
 }

@@ -219,6 +219,23 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
     for (const char* png : {"chatter_spectrogram.png", "chatter_verdict.png"})
       EXPECT_GT(std::filesystem::file_size(plots + "/" + png), 5000u) << png;
   }
+  // With the cell and its job: each speed to try checked by the accurate method, as the cell's advisor does.
+  const Result checked = run("chatter --signal " + tmp.file("cut.uff") + " --teeth 3 --config " + robodamp::test::preset("horizontal_c2") +
+                             " --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml --depth-mm 1.0 --json " + json);
+  ASSERT_EQ(checked.status, 0) << checked.out;
+  EXPECT_NE(checked.out.find("Checked by SDM at"), std::string::npos) << checked.out;
+  const auto c = nlohmann::json::parse(robodamp::test::read_file(json))["checked"];
+  EXPECT_TRUE(c["found"].get<bool>()) << checked.out;
+  ASSERT_FALSE(c["options"].empty());
+  for (const auto& o : c["options"]) {
+    EXPECT_GE(o["margin"].get<double>(), 1.3) << checked.out;  // the advisor's margin where the cut chattered
+    EXPECT_GE(o["rpm"].get<double>(), 100.0);
+    EXPECT_LE(o["rpm"].get<double>(), 1500.0);  // the job's range
+  }
+  const Result wrong_teeth = run("chatter --signal " + tmp.file("cut.uff") + " --teeth 4 --config " + robodamp::test::preset("horizontal_c2") +
+                                 " --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  EXPECT_EQ(wrong_teeth.status, 2) << wrong_teeth.out;
+  EXPECT_NE(wrong_teeth.out.find("--teeth 4 but the job"), std::string::npos) << wrong_teeth.out;
   const Result no_teeth = run("chatter --signal " + tmp.file("cut.uff"));
   EXPECT_EQ(no_teeth.status, 2) << no_teeth.out;
   EXPECT_NE(no_teeth.out.find("--teeth"), std::string::npos) << no_teeth.out;
