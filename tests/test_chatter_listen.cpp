@@ -15,9 +15,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "config/milling_config.hpp"
 #include "identify/recorded_signal.hpp"
 #include "measfiles/uff.hpp"
 #include "milling/chatter_listen.hpp"
+#include "milling/cut_job.hpp"
+#include "milling/structure.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -242,6 +245,60 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
   const Result bad_channel = run("chatter --signal " + tmp.file("cut.wav") + " --teeth 3 --channel 2");
   EXPECT_EQ(bad_channel.status, 2) << bad_channel.out;
   EXPECT_NE(bad_channel.out.find("channel 2: the file has 1"), std::string::npos) << bad_channel.out;
+}
+
+// Cuts simulated in time (milling::run_job, config/milling/active_damping_c2.yaml open loop at 700 rpm:
+// stable at 1.0 mm, chatter at 2.5 mm, the limit 1.66 mm), the wall-normal acceleration resampled to 10 kHz
+// as a recorder would hold it: the verdicts and the simulation's own chatter frequency.
+TEST(ChatterListen, CutsSimulatedInTimeAreJudgedAsTheSimulationSays) {
+  const robodamp::config::MillingConfig job =
+      robodamp::config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  const ml::Structure open(*job.find_structure(job.structure), false);
+  for (const double depth : {1.0, 2.5}) {
+    ml::CutOverrides o;
+    o.rpm = 700.0, o.axial_mm = depth, o.revolutions = 140;
+    const ml::CutOutcome cut = ml::run_job(ml::make_cut_job(job, open, o));
+    const double fs = 1.0 / cut.record.step_s;
+    const auto& y = cut.record.y_m;
+    std::vector<double> a;
+    for (std::size_t i = 2; i < y.size(); ++i) a.push_back((y[i] - 2.0 * y[i - 1] + y[i - 2]) * fs * fs);
+    ml::RecordedSignal sig;
+    sig.source = "simulated cut", sig.rate_hz = 10000.0;
+    for (double t = 0.0; t < static_cast<double>(a.size() - 1) / fs; t += 1.0 / sig.rate_hz) {
+      const auto k = static_cast<std::size_t>(t * fs);
+      const double w = t * fs - static_cast<double>(k);
+      sig.samples.push_back((1.0 - w) * a[k] + w * a[k + 1]);
+    }
+    ml::ListenSettings s = settings();
+    s.rpm = 700.0;
+    const ml::ListenReport r = ml::listen(sig, s);
+    const bool chatter = !cut.verdict.stable;
+    EXPECT_EQ(chatter, depth > 1.66) << depth;
+    int right = 0;
+    for (std::size_t i = 1; i < r.windows.size(); ++i)  // the first window holds the cut's start
+      right += r.windows[i].verdict == (chatter ? ml::WindowVerdict::kChatter : ml::WindowVerdict::kStable);
+    EXPECT_EQ(right, static_cast<int>(r.windows.size()) - 1) << depth << " mm";
+    if (chatter) {
+      EXPECT_NEAR(r.chatter_hz, cut.verdict.chatter_hz, 0.01 * cut.verdict.chatter_hz) << depth;
+    }
+    std::printf("%.1f mm: %zu windows, %d right; chatter %.3f Hz, the simulation's %.3f Hz\n", depth, r.windows.size(), right,
+                r.chatter_hz, cut.verdict.chatter_hz);
+  }
+}
+
+// Without runout only the tooth-passing comb is there: the speed is the comb's fundamental / teeth.
+TEST(ChatterListen, TheSpeedFromATeethOnlyComb) {
+  std::vector<double> x;
+  const double rate = 2500.0, f_tooth = 3.0 * kRpm / 60.0;
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int i = 0; i < 20000; ++i)
+    x.push_back(noise(rng) + 0.4 * std::sin(2.0 * M_PI * f_tooth * i / rate) + 0.2 * std::sin(2.0 * M_PI * 2.0 * f_tooth * i / rate + 1.0) +
+                0.1 * std::sin(2.0 * M_PI * 3.0 * f_tooth * i / rate + 2.0));
+  const auto e = ml::estimate_rpm(x, rate, kTeeth, 300.0, 3000.0);
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(e->rpm, kRpm, 0.01 * kRpm) << e->how;
+  EXPECT_NE(e->how.find("tooth-passing harmonics"), std::string::npos) << e->how;
 }
 
 }  // namespace
