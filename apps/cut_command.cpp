@@ -162,6 +162,11 @@ int run_cut(const CutArgs& a) {
     const milling::Structure structure(chosen, false);
     milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
     std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
+    // The job's speed range, as lobes checks it: a speed outside it is one the job does not describe.
+    const config::Range job_speeds{"rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false,
+                                   "the job's lobes.rpm_min .. lobes.rpm_max"};
+    for (double rpm : a.rpm)
+      if (auto p = config::range_problem("--rpm", rpm, job_speeds)) throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p}});
     json out;
     if (!a.critical) {
       if (speeds.size() > 1)
@@ -252,7 +257,8 @@ void register_cut(Registry& r) {
   sub->add_option("--config", a->config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
   sub->add_option("--structure", a->structure, "Which of the job's structures (default: its `structure`)");
   r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
-  r.numbers(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, true, false}, "Spindle speed (several with --critical)");
+  r.numbers(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, true, false, "and within the job's lobes speed range"},
+            "Spindle speed (several with --critical)");
   r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "Axial depth (default: the job's)");
   r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 1000.0, true, false, "and at most the tool's diameter"},
            "Radial depth (default: the job's)");

@@ -35,7 +35,7 @@ void register_lobes(Registry& r) {
   add_milling_options(r, sub, *o, "lobes");
   sub->add_option("--method", o->method, "sdm (default): semi-discretization of what runs, open loop and the sampled damped loop (time_domain.sdm_*); zoa: the zero-order method, a fast preview")
       ->check(CLI::IsMember({"zoa", "sdm"}));
-  r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 1e6, true, false, "and within the job's lobes speed range"},
+  r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 200000.0, true, false, "and within the job's lobes speed range"},
             "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
   r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
 }

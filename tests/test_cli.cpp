@@ -792,6 +792,15 @@ TEST(Cli, LobesRefusesSpeedsWithTheUnitAndTheAllowedRange) {
                            "lobes.rpm_max)"),
             std::string::npos)
       << below.out;
+  // cut: the same range (issue 52: it allowed 200 000 rpm on any job), lobes the same outer bound.
+  const Result cut = run("cut --rpm 16000 --revs 2");
+  EXPECT_EQ(cut.status, 2) << cut.out;
+  EXPECT_NE(cut.out.find("--rpm = 16000 rpm is out of range: allowed 500 <= value <= 15000 rpm (the job's lobes.rpm_min .. "
+                         "lobes.rpm_max)"),
+            std::string::npos)
+      << cut.out;
+  const Result huge = run("lobes --rpm 500000");
+  EXPECT_NE(huge.out.find("allowed 0 < value <= 200000 rpm"), std::string::npos) << huge.out;
 }
 
 TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
@@ -967,7 +976,7 @@ std::vector<std::string> subcommands() {
 TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
   const std::vector<std::string> subs = subcommands();
   ASSERT_GE(subs.size(), 20U);
-  const std::set<std::string> writes_json{"analyze", "bench", "cut", "filters", "identify", "lobes",
+  const std::set<std::string> writes_json{"analyze", "bench", "chatter", "cut", "filters", "identify", "lobes",
                                           "plant",   "pose",  "run", "schedule", "sle", "tune"};
   std::set<std::string> has_json;
   for (const std::string& sub : subs) {
