@@ -23,7 +23,7 @@ namespace robodamp::apps {
 namespace {
 
 struct ChatterArgs {
-  std::string signal, column, response, plot_dir;
+  std::string signal, column, rpm_column, response, plot_dir;
   std::optional<double> rate_hz, rpm, floor, full_scale_mps2;
   int channel{1}, teeth{0};
   std::optional<int> record;
@@ -73,7 +73,7 @@ nlohmann::json to_json(const milling::ListenReport& r) {
   for (const auto& x : r.windows)
     w.push_back({{"start_s", x.start_s}, {"end_s", x.end_s}, {"verdict", milling::to_string(x.verdict)},
                  {"chatter_hz", x.chatter_hz}, {"chatter_share", x.chatter_share}, {"rms", x.rms},
-                 {"once_per_rev_ratio", x.indicator.once_per_rev_ratio}});
+                 {"once_per_rev_ratio", x.indicator.once_per_rev_ratio}, {"rpm", x.rpm}});
   nlohmann::json speeds = nlohmann::json::array();
   for (const auto& s : r.speeds) speeds.push_back({{"rpm", s.rpm}, {"lobe", s.lobe}});
   nlohmann::json j = {{"windows", w}, {"chatter_hz", r.chatter_hz}, {"rpm", r.rpm}, {"rpm_source", r.rpm_source},
@@ -136,7 +136,7 @@ int run_chatter(const ChatterArgs& a) {
     const std::optional<Cell> cell = cell_of(a);
     if (cell && a.rpm_range.empty()) range = {cell->job.lobes.rpm_min, std::min(cell->job.lobes.rpm_max, cell->cfg.spindle.rpm_max)};
     identify::SignalOptions o;
-    o.column = a.column, o.rate_hz = a.rate_hz, o.channel = a.channel, o.full_scale_mps2 = a.full_scale_mps2, o.record = a.record;
+    o.column = a.column, o.rpm_column = a.rpm_column, o.rate_hz = a.rate_hz, o.channel = a.channel, o.full_scale_mps2 = a.full_scale_mps2, o.record = a.record;
     if (!a.response.empty()) o.response = identify::parse_dof(a.response);
     const milling::RecordedSignal sig = identify::read_recorded_signal(a.signal, o, described);
     milling::ListenSettings s;
@@ -212,6 +212,7 @@ void register_chatter(Registry& r) {
   r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "The cutter's teeth");
   r.number(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, false, false}, "The spindle speed (default: estimated from the signal's harmonics)");
   r.numbers(sub, "--rpm-range", a->rpm_range, {"rpm", 1.0, 200000.0}, "Where the estimate searches and the speeds to try lie: LO HI (default 100 30000)");
+  sub->add_option("--rpm-column", a->rpm_column, "A table's spindle-speed column (rpm), name or number: each window judged at its own speed");
   sub->add_option("--column", a->column, "A table's column: its name or number (default: the first that is not time)");
   r.number(sub, "--rate-hz", a->rate_hz, {"Hz", 0.0, 1e7, false, false}, "A table's sample rate when it has no time column");
   r.whole_number(sub, "--channel", a->channel, {"(channel)", 1, 64}, "A sound file's channel (default 1)");

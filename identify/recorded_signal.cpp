@@ -33,6 +33,20 @@ milling::RecordedSignal from_recording(const std::string& path, std::string& des
   const std::uint64_t first = rec.frames.front().tick;
   s.samples.assign(rec.frames.back().tick - first + 1, NAN);  // a missed tick: a dropout
   for (const auto& f : rec.frames) s.samples[f.tick - first] = f.accel_mps2;
+  // The spindle speed the loop was told (set_spindle commands), held between them; none told: not known.
+  bool told = false;
+  for (const auto& f : rec.frames) told = told || rt::spindle_rpm_set(f).has_value();
+  if (told) {
+    double rpm = 0.0;
+    s.rpm.assign(s.samples.size(), 0.0);
+    std::size_t at = 0;
+    for (const auto& f : rec.frames) {
+      for (; at < f.tick - first; ++at) s.rpm[at] = rpm;
+      if (const auto set = rt::spindle_rpm_set(f)) rpm = *set;
+    }
+    for (; at < s.rpm.size(); ++at) s.rpm[at] = rpm;
+    s.rpm_from = "the recording's spindle commands";
+  }
   described = "robodamp recording, the loop's accelerometer";
   return s;
 }
@@ -79,6 +93,16 @@ milling::RecordedSignal from_uff(const std::string& path, const SignalOptions& o
   return s;
 }
 
+// A column by its name or 1-based number; nullopt when none.
+std::optional<std::size_t> column_of(const measfiles::Table& t, const std::string& wanted) {
+  char* end = nullptr;
+  const long number = std::strtol(wanted.c_str(), &end, 10);
+  if (*end == '\0' && number >= 1 && static_cast<std::size_t>(number) <= t.columns) return static_cast<std::size_t>(number - 1);
+  for (std::size_t k = 0; k < t.names.size(); ++k)
+    if (measfiles::normalised(t.names[k]) == measfiles::normalised(wanted)) return k;
+  return std::nullopt;
+}
+
 milling::RecordedSignal from_table(const std::string& path, const SignalOptions& o, std::string& described) {
   const measfiles::Table t = measfiles::read_table(path);
   std::optional<std::size_t> time_col, value_col;
@@ -87,11 +111,7 @@ milling::RecordedSignal from_table(const std::string& path, const SignalOptions&
     if (n == "time" || n == "t" || n == "time_s" || n == "zeit") time_col = k;
   }
   if (!o.column.empty()) {
-    char* end = nullptr;
-    const long number = std::strtol(o.column.c_str(), &end, 10);
-    if (*end == '\0' && number >= 1 && static_cast<std::size_t>(number) <= t.columns) value_col = static_cast<std::size_t>(number - 1);
-    for (std::size_t k = 0; k < t.names.size() && !value_col; ++k)
-      if (measfiles::normalised(t.names[k]) == measfiles::normalised(o.column)) value_col = k;
+    value_col = column_of(t, o.column);
     if (!value_col) throw std::invalid_argument(path + ": no column '" + o.column + "' (a name in the header or 1 .. " + std::to_string(t.columns) + ")");
   } else {
     value_col = time_col == std::size_t{0} && t.columns > 1 ? 1 : 0;
@@ -108,6 +128,12 @@ milling::RecordedSignal from_table(const std::string& path, const SignalOptions&
   s.acceleration_mps2 = u && u->quantity == Quantity::kAcceleration;
   s.unit = s.acceleration_mps2 ? "m/s^2" : unit;
   for (const auto& r : t.rows) s.samples.push_back(r[*value_col] * (s.acceleration_mps2 ? u->to_si : 1.0));
+  if (!o.rpm_column.empty()) {
+    const auto c = column_of(t, o.rpm_column);
+    if (!c) throw std::invalid_argument(path + ": no spindle-speed column '" + o.rpm_column + "'");
+    for (const auto& r : t.rows) s.rpm.push_back(r[*c]);
+    s.rpm_from = "the column '" + (*c < t.names.size() ? t.names[*c] : std::to_string(*c + 1)) + "'";
+  }
   if (o.rate_hz) {
     s.rate_hz = *o.rate_hz;
   } else if (time_col) {

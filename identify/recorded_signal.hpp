@@ -15,6 +15,7 @@ namespace robodamp::identify {
 
 struct SignalOptions {
   std::string column;                  // a table's column: its name or 1-based number (default: the first not time)
+  std::string rpm_column;              // a table's spindle-speed column (rpm), name or number; empty: none
   std::optional<double> rate_hz;       // a table without a time column
   int channel{1};                      // a sound file's channel, 1-based
   std::optional<double> full_scale_mps2;  // a sound file: the acceleration at full scale (else not an acceleration)

@@ -220,8 +220,15 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   const auto d = static_cast<std::size_t>(std::max(1.0, std::floor(sig.rate_hz / (2.5 * s.max_hz))));
   decimate(x, gap, d);
   r.analysed_rate_hz = sig.rate_hz / static_cast<double>(d);
+  // The recording's own speeds, decimated with it (the value at each kept sample).
+  std::vector<double> rpm_at;
+  for (std::size_t i = 0; i < sig.rpm.size() && !s.rpm; i += d) rpm_at.push_back(sig.rpm[i]);
   if (s.rpm) {
     r.rpm = *s.rpm, r.rpm_source = "given";
+  } else if (!rpm_at.empty()) {
+    std::vector<double> sorted = rpm_at;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    r.rpm = sorted[sorted.size() / 2], r.rpm_source = "from " + sig.rpm_from + " (median; each window at its own)";
   } else {
     const auto e = estimate_rpm(x, r.analysed_rate_hz, s.teeth, s.rpm_min, s.rpm_max);
     if (!e) throw std::invalid_argument(sig.source + ": no spindle speed found in the signal's harmonics; give --rpm");
@@ -242,28 +249,38 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   ChatterMonitor monitor(r.analysed_rate_hz, is);
   const auto n = static_cast<std::size_t>(std::floor(s.window_s * r.analysed_rate_hz));
   std::vector<double> found;
+  double onset_rpm = r.rpm;
   for (std::size_t b = 0; b + n <= x.size(); b += n) {
     monitor.reset();
     for (std::size_t i = b; i < b + n; ++i) monitor.push(x[i], !gap[i]);
     ListenWindow w;
     w.start_s = static_cast<double>(b) / r.analysed_rate_hz, w.end_s = static_cast<double>(b + n) / r.analysed_rate_hz;
-    w.indicator = monitor.evaluate(r.rpm);
+    w.rpm = r.rpm;
+    if (rpm_at.size() >= b + n) {  // the speed that held over the window (the median: a change mid-window shows as the larger part)
+      std::vector<double> in(rpm_at.begin() + static_cast<long>(b), rpm_at.begin() + static_cast<long>(b + n));
+      std::nth_element(in.begin(), in.begin() + static_cast<long>(in.size() / 2), in.end());
+      w.rpm = in[in.size() / 2];
+    }
+    w.indicator = w.rpm > 0.0 ? monitor.evaluate(w.rpm) : ChatterIndicator{};
     w.rms = w.indicator.rms_mps2, w.chatter_share = w.indicator.nonharmonic_share;
     if (!w.indicator.valid || w.rms < is.floor_mps2) w.verdict = WindowVerdict::kNoSignal;
     else w.verdict = w.indicator.chatter ? WindowVerdict::kChatter : WindowVerdict::kStable;
     if (w.verdict == WindowVerdict::kChatter) {
       w.chatter_hz = w.indicator.chatter_hz, found.push_back(w.chatter_hz);
-      if (!r.onset_s) r.onset_s = w.start_s;
+      if (!r.onset_s) r.onset_s = w.start_s, onset_rpm = w.rpm;
       r.end_s = w.end_s;
     }
     r.windows.push_back(w);
   }
-  if (r.onset_s) r.onset_s = refined_onset(x, r.analysed_rate_hz, r.rpm, *r.onset_s, is.floor_mps2);
+  if (r.onset_s) r.onset_s = refined_onset(x, r.analysed_rate_hz, onset_rpm, *r.onset_s, is.floor_mps2);
   spectrogram(x, r.analysed_rate_hz, n, std::min(s.max_hz, 0.5 * r.analysed_rate_hz), r);
   if (!found.empty()) {
     std::nth_element(found.begin(), found.begin() + static_cast<long>(found.size() / 2), found.end());
     r.chatter_hz = found[found.size() / 2];
-    r.speeds = pockets(r.chatter_hz, s.teeth, r.rpm, s.rpm_min, s.rpm_max);
+    double rpm_chatter = r.rpm;  // the speed the cut chattered at: its last chatter window's
+    for (const auto& w : r.windows)
+      if (w.verdict == WindowVerdict::kChatter) rpm_chatter = w.rpm;
+    r.speeds = pockets(r.chatter_hz, s.teeth, rpm_chatter, s.rpm_min, s.rpm_max);
   }
   return r;
 }

@@ -21,6 +21,10 @@ struct RecordedSignal {
   std::vector<double> samples;
   bool acceleration_mps2{true};  // in m/s^2 (the indicator's floor applies); false: another quantity
   std::string unit;              // as the file said ("m/s^2", "Pa", "" unknown)
+  // The spindle speed per sample when the recording holds it (a speed column, a robodamp recording's
+  // spindle commands); empty: one speed for the whole recording.
+  std::vector<double> rpm;
+  std::string rpm_from;          // where it came from
 };
 
 struct ListenSettings {
@@ -39,6 +43,7 @@ enum class WindowVerdict { kStable, kChatter, kNoSignal };
 
 struct ListenWindow {
   double start_s{0.0}, end_s{0.0};
+  double rpm{0.0};            // the speed the window was judged at
   WindowVerdict verdict{WindowVerdict::kNoSignal};
   double chatter_hz{0.0};
   double chatter_share{0.0};  // the non-harmonic share of the displacement's energy

@@ -301,4 +301,45 @@ TEST(ChatterListen, TheSpeedFromATeethOnlyComb) {
   EXPECT_NE(e->how.find("tooth-passing harmonics"), std::string::npos) << e->how;
 }
 
+// The speed changes in the recording (a speed column; a robodamp recording's spindle commands): each window
+// is judged at the speed that held over it. 700 rpm with chatter for 8 s, then 900 rpm stable: at one
+// speed for the whole recording, the 900 rpm lines would read as non-harmonic.
+TEST(ChatterListen, EachWindowAtTheSpeedTheRecordingHeld) {
+  const TempDir tmp;
+  const double rate = 5000.0;
+  std::mt19937 rng(8);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  {
+    std::ofstream csv(tmp.file("two_speeds.csv"));
+    csv << "t,accel_mps2,spindle_rpm\n";
+    for (int i = 0; i < static_cast<int>(16.0 * rate); ++i) {
+      const double t = i / rate, rpm = t < 8.0 ? 700.0 : 900.0, f_sp = rpm / 60.0;
+      double v = noise(rng);
+      for (int k = 1; k <= 30; ++k) v += (k % kTeeth == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
+      if (t < 8.0) v += 1.5 * std::sin(2.0 * M_PI * kChatterHz * t);
+      csv << t << ',' << v << ',' << rpm << '\n';
+    }
+  }
+  const std::string json = tmp.file("c.json");
+  const Result r = run("chatter --signal " + tmp.file("two_speeds.csv") + " --teeth 3 --rpm-column spindle_rpm --json " + json);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
+  ASSERT_EQ(j["windows"].size(), 8u);
+  for (std::size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(j["windows"][i]["rpm"].get<double>(), i < 4 ? 700.0 : 900.0) << i;
+    EXPECT_EQ(j["windows"][i]["verdict"], i < 4 ? "chatter" : "stable") << i << "\n" << r.out;
+  }
+  EXPECT_NE(j["rpm_source"].get<std::string>().find("the column 'spindle_rpm'"), std::string::npos);
+  // A robodamp recording: its spindle command gives the speed.
+  const std::string rec = tmp.file("run.rdrec");
+  const Result ran = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 5 --clock virtual --spindle-rpm 700 --record " + rec);
+  ASSERT_EQ(ran.status, 0) << ran.out;
+  const Result heard = run("chatter --signal " + rec + " --teeth 3 --json " + json);
+  ASSERT_EQ(heard.status, 0) << heard.out;
+  const auto h = nlohmann::json::parse(robodamp::test::read_file(json));
+  EXPECT_NE(h["rpm_source"].get<std::string>().find("the recording's spindle commands"), std::string::npos) << heard.out;
+  EXPECT_EQ(h["windows"].back()["rpm"].get<double>(), 700.0) << heard.out;
+  EXPECT_EQ(h["rate_hz"].get<double>(), 5000.0);
+}
+
 }  // namespace
