@@ -50,7 +50,7 @@ std::vector<identify::RecordTest> record_tests(const IdentifyArgs& a) {
   return out;
 }
 
-std::vector<identify::MeanForces> means_from_records(const IdentifyArgs& a, const identify::CuttingTest& t, nlohmann::json& j) {
+std::vector<identify::MeanForces> means_from_records(const IdentifyArgs& a, nlohmann::json& j) {
   identify::RecordSettings s;
   s.axes = identify::parse_axes(a.axes);
   s.force_on_workpiece = a.force_on == "workpiece";
@@ -69,7 +69,6 @@ std::vector<identify::MeanForces> means_from_records(const IdentifyArgs& a, cons
                  {"fx_mean_n", c.means.fx_n}, {"fy_mean_n", c.means.fy_n}, {"fz_mean_n", c.means.fz_n}});
     out.push_back(c.means);
   }
-  (void)t;
   return out;
 }
 
@@ -93,7 +92,7 @@ int run_identify_cutting(const IdentifyArgs& a) {
                                   " mm is out of range: allowed 0 < value <= --diameter-mm = " +
                                   config::format_number(a.diameter_mm) + " mm");
     if (records) std::printf("Force records (the force on the %s, axes %s):\n", a.force_on.c_str(), a.axes.c_str());
-    samples = records ? means_from_records(a, t, record_json) : identify::read_mean_forces_csv(a.csv_path);
+    samples = records ? means_from_records(a, record_json) : identify::read_mean_forces_csv(a.csv_path);
     f = identify::identify_cutting(samples, t);
   } catch (const std::invalid_argument& e) {
     std::cerr << "robodamp identify cutting: " << e.what() << '\n';

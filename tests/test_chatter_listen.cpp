@@ -27,14 +27,8 @@ namespace {
 
 namespace ml = robodamp::milling;
 
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/robodamp-chatter-XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  [[nodiscard]] std::string file(const std::string& name) const { return path + "/" + name; }
+struct TempDir : robodamp::test::ScratchDir {
+  TempDir() : ScratchDir("chatter") {}
 };
 
 constexpr double kRpm = 700.0, kChatterHz = 17.3, kOnsetS = 6.0;
@@ -145,19 +139,9 @@ TEST(ChatterListen, AwkwardRecordingsAreSaidPlainly) {
   for (const auto& w : ml::listen(air, given).windows) EXPECT_EQ(w.verdict, ml::WindowVerdict::kNoSignal);
 }
 
-struct Result {
-  int status;
-  std::string out;
-};
+using Result = robodamp::test::CommandResult;
 
-Result run(const std::string& args) {
-  FILE* p = popen((std::string(ROBODAMP_BINARY) + " " + args + " 2>&1").c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t k = std::fread(buf, 1, sizeof buf, p)) out.append(buf, k);
-  const int rc = pclose(p);
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
-}
+Result run(const std::string& args) { return robodamp::test::run_robodamp(args); }
 
 void write_wav24(const std::string& path, const std::vector<double>& x, double rate, double full_scale) {
   std::ofstream f(path, std::ios::binary);

@@ -25,14 +25,8 @@ namespace {
 
 namespace id = robodamp::identify;
 
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/robodamp-records-XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  [[nodiscard]] std::string file(const std::string& name) const { return path + "/" + name; }
+struct TempDir : robodamp::test::ScratchDir {
+  TempDir() : ScratchDir("records") {}
 };
 
 struct Truth {
@@ -100,19 +94,9 @@ void write_record(const std::string& path, double feed_mm, unsigned seed, const 
 
 const std::vector<double> kFeeds = {0.05, 0.08, 0.11, 0.14, 0.17, 0.20};
 
-struct Result {
-  int status;
-  std::string out;
-};
+using Result = robodamp::test::CommandResult;
 
-Result run(const std::string& args) {
-  FILE* p = popen((std::string(ROBODAMP_BINARY) + " " + args + " 2>&1").c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int rc = pclose(p);
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
-}
+Result run(const std::string& args) { return robodamp::test::run_robodamp(args); }
 
 const std::string kGeometry = " --teeth 3 --diameter-mm 12 --axial-mm 2 --radial-mm 6 --mode down";
 

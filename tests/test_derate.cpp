@@ -75,7 +75,9 @@ TEST(Derate, AChatteringCutNeverSwitchesTheDamperOff) {
       EXPECT_GE(r.counters.growth_process, 1U) << depth << " mm: the growth probed and found the process's";
       EXPECT_LT(s.derated_s, 0.1 * 10.3) << depth << " mm: at full gain but for the probe";
     }
-    if (depth > 5.0) EXPECT_GE(r.counters.saturation_derates, 1U) << depth << " mm: the saturation derated, not tripped";
+    if (depth > 5.0) {
+      EXPECT_GE(r.counters.saturation_derates, 1U) << depth << " mm: the saturation derated, not tripped";
+    }
   }
 }
 

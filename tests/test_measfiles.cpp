@@ -31,14 +31,8 @@ using robodamp::measfiles::UffFile;
 using robodamp::measfiles::UffFunction;
 namespace mf = robodamp::measfiles;
 
-struct TempDir {
-  std::string path;
-  TempDir() {
-    char tmpl[] = "/tmp/robodamp-measfiles-XXXXXX";
-    path = mkdtemp(tmpl);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  [[nodiscard]] std::string file(const std::string& name) const { return path + "/" + name; }
+struct TempDir : robodamp::test::ScratchDir {
+  TempDir() : ScratchDir("measfiles") {}
 };
 
 // A value as the ASCII writer prints it: E20.12 (12 significant digits) or E13.5 (6).
@@ -387,19 +381,9 @@ TEST(Table, FuzzedTablesAreRefusedCleanly) {
   EXPECT_GT(refused, 300);
 }
 
-struct Result {
-  int status;
-  std::string out;
-};
+using Result = robodamp::test::CommandResult;
 
-Result run(const std::string& args) {
-  FILE* p = popen((std::string(ROBODAMP_BINARY) + " " + args + " 2>&1").c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  const int rc = pclose(p);
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
-}
+Result run(const std::string& args) { return robodamp::test::run_robodamp(args); }
 
 // Issue 48: `identify modes --frf FILE.uff` on a file of several records, chosen by number and by DOFs;
 // the accelerance in g/lbf converted from its header gives the preset's H21yy modes as the CSV route does.

@@ -1,6 +1,12 @@
 #pragma once
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <thread>
@@ -13,6 +19,36 @@
 #include "config/yaml_edit.hpp"
 
 namespace robodamp::test {
+
+// A directory of the test's own under /tmp, removed with everything in it when the object goes.
+struct ScratchDir {
+  std::string path;
+  explicit ScratchDir(const std::string& name) {
+    std::string tmpl = "/tmp/robodamp-" + name + "-XXXXXX";
+    path = mkdtemp(tmpl.data());
+  }
+  ~ScratchDir() { std::filesystem::remove_all(path); }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  [[nodiscard]] std::string file(const std::string& f) const { return path + "/" + f; }
+};
+
+struct CommandResult {
+  int status;       // exit status, -1 when the process did not exit
+  std::string out;  // stdout and stderr together
+};
+
+#ifdef ROBODAMP_BINARY
+// `robodamp ARGS`, its output and exit status.
+inline CommandResult run_robodamp(const std::string& args) {
+  FILE* p = popen((std::string(ROBODAMP_BINARY) + " " + args + " 2>&1").c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int rc = pclose(p);
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, out};
+}
+#endif
 
 inline std::string preset(const std::string& name) {
   return std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/" + name + ".yaml";
