@@ -19,6 +19,7 @@ struct CommissionArgs {
   std::string out_dir;
   std::string from{"measure"};
   std::optional<double> shift_pct;
+  bool dry_run{false};
   commission::CommissionSettings settings;
 };
 
@@ -34,10 +35,21 @@ std::string command_line(const CommissionArgs& a) {
   const commission::CommissionSettings ds;
   if (a.settings.schedule_speeds != ds.schedule_speeds) c += " --schedule-speeds " + std::to_string(a.settings.schedule_speeds);
   if (a.settings.schedule_gains != ds.schedule_gains) c += " --schedule-gains " + std::to_string(a.settings.schedule_gains);
+  for (const auto& t : a.settings.tap_tests) c += " --tap-tests " + t;
   return c;
 }
 
 int run_commission(CommissionArgs& a) {
+  if (a.dry_run) {
+    commission::MeasureOptions o;
+    o.impacts = a.settings.tap_tests.empty();
+    std::cout << "robodamp commission --dry-run: stage 1, measure:\n" << commission::measurement_plan(a.config_path, o);
+    std::cout << (o.impacts ? "Stage 4, verify: the impacts again with the tuned controller, then the regenerative cuts "
+                              "(through the emulator) or the damped cut in time (the simulated plant).\n"
+                            : "Stage 4, verify: the same chirp with the tuned controller running (control ON), no hammer, "
+                              "no cut.\n");
+    return 0;
+  }
   commission::CommissionSettings s = a.settings;
   s.config_path = a.config_path;
   s.job_path = a.job_path;
@@ -90,6 +102,14 @@ void register_commission(Registry& r) {
   r.whole_number(sub, "--schedule-gains", a->settings.schedule_gains, {"(gains per controller)", 1, 24},
                  "Gains the speed schedule tries per controller");
   sub->add_option("--operator", a->settings.operator_name, "Who commissions (the report; default the login name)");
+  sub->add_option("--tap-tests", a->settings.tap_tests,
+                  "A real cell: your modal kit's tap tests between the cell's locations (universal files, nodes = the "
+                  "configuration's location ids, or frf_<response>_<excitation>.csv); robodamp then measures with the "
+                  "actuator's chirp only, orders no hammer blow and no cut, and verifies with the chirp, control off and on")
+      ->check(CLI::ExistingFile);
+  r.number(sub, "--tap-tolerance-pct", a->settings.tap_tolerance_pct, {"%", 0.1, 20.0},
+           "How far a tapped mode may sit from the same mode in the actuator's chirp");
+  sub->add_flag("--dry-run", a->dry_run, "Print what would run on the cell (levels, durations, what moves) and stop");
 }
 
 }  // namespace robodamp::apps

@@ -18,15 +18,22 @@ struct MeasureArgs {
   std::string clock;
   std::vector<double> pose_deg;
   std::string poses_file;
+  bool no_hammer{false}, control_on{false}, dry_run{false};
 };
 
 int report(const commission::MeasureOutcome& r, const std::string& out_dir) {
   if (r.status == commission::MeasureStatus::kConfigError || r.status == commission::MeasureStatus::kFailed ||
+      r.status == commission::MeasureStatus::kNotReady || r.status == commission::MeasureStatus::kSaturated ||
+      r.status == commission::MeasureStatus::kAborted ||
       (r.status == commission::MeasureStatus::kWriteError && r.final_state.empty())) {
     std::cerr << "robodamp measure: " << r.message << '\n';
     return commission::exit_code(r.status);
   }
-  if (r.manifest.backend == "simulated plant")
+  if (!r.manifest.run.value("impacts", true))
+    std::cout << "robodamp measure: the actuator's chirp only (no hammer), control "
+              << (r.manifest.run.value("control_on", false) ? "ON" : "off") << "; the cell at rest at " << r.rest_accel_rms_mps2
+              << " m/s^2 RMS before it\n";
+  else if (r.manifest.backend == "simulated plant")
     std::cout << "robodamp measure: " << r.impact_records << " of " << r.impact_records_planned
               << " impact records; wrote " << r.frf_files << " FRFs to " << out_dir << '\n';
   else
@@ -42,6 +49,12 @@ int report(const commission::MeasureOutcome& r, const std::string& out_dir) {
 
 int measure(const MeasureArgs& a) {
   commission::MeasureOptions o{a.clock, a.pose_deg, {}};
+  o.impacts = !a.no_hammer;
+  o.control_on = a.control_on;
+  if (a.dry_run) {
+    std::cout << commission::measurement_plan(a.config_path, o);
+    return 0;
+  }
   if (a.poses_file.empty()) return report(commission::measure(a.config_path, a.out_dir, o), a.out_dir);
   const auto poses = commission::read_measurement_poses(a.config_path, a.poses_file);  // all checked first
   int status = 0;
@@ -74,6 +87,12 @@ void register_measure(Registry& r) {
                   "file), each into --out/<name>/, indexed in --out/poses.json")
       ->check(CLI::ExistingFile)
       ->excludes(pose);
+  sub->add_flag("--no-hammer", a->no_hammer,
+                "The actuator's chirp only, no impacts (a real cell: your modal kit's tap tests give the other FRFs)");
+  sub->add_flag("--control-on", a->control_on,
+                "Run the configuration's controller through the chirp (the closed loop at the actuator and the loop gain; "
+                "implies nothing about impacts)");
+  sub->add_flag("--dry-run", a->dry_run, "Print what would run (levels, durations, what moves) and stop");
 }
 
 }  // namespace robodamp::apps

@@ -55,13 +55,21 @@ class Run {
     std::error_code ec;
     fs::remove(dir_ / "configuration.yaml", ec);  // only this run's verified result may stand there
     cell_ = config::load_config_file(s_.config_path);
-    if (const std::string why = hardware_refusal(cell_); !why.empty()) throw Stop{Stage::kMeasure, Outcome::kBadInput, why};
-    emulated_ = cell_.can.has_value();
+    real_ = !s_.tap_tests.empty();
+    r_.real_cell = real_;
+    if (const std::string why = hardware_refusal(cell_); !why.empty() && !real_)
+      throw Stop{Stage::kMeasure, Outcome::kBadInput, why};
+    emulated_ = cell_.can && cell_.can->interface.rfind("unix:", 0) == 0;
     if (emulated_) {
       binary_ = s_.robodamp_binary.empty() ? this_executable() : s_.robodamp_binary;
       say_("commission: the cell is the HIL emulator on " + cell_.can->interface +
-           ": `robodamp plant` runs as a second process for each run on the cell (lockstep)");
+           ": `robodamp plant` runs as a second process for each run on the cell (lockstep)" +
+           (real_ ? ", told it is a real cell: no impacts, no cut" : ""));
     }
+    if (real_)
+      say_("commission: a real cell: the actuator is the shaker (its chirp, control off then on), the FRFs between the "
+           "locations come from " + std::to_string(s_.tap_tests.size()) + " tap-test file(s); robodamp orders no hammer "
+           "blow and no cut");
     job_ = config::load_milling_config(s_.job_path);
     stage(Stage::kMeasure, [this] { measure(); });
     stage(Stage::kIdentify, [this] { identify(); });
@@ -87,22 +95,35 @@ class Run {
   void measure() {
     const fs::path m = dir_ / "measurement";
     if (!reuse_) {
-      const MeasureOutcome o = emulated_ ? measure_through_emulator(s_.config_path, m.string(), binary_)
-                                         : commission::measure(s_.config_path, m.string());
+      MeasureOptions mo;
+      mo.impacts = !real_;
+      const MeasureOutcome o = emulated_ ? measure_through_emulator(s_.config_path, m.string(), binary_, {mo, std::nullopt})
+                                         : commission::measure(s_.config_path, m.string(), mo);
       // The measurement turns SIGINT / SIGTERM into a trip of its loop; the stages after it have no loop
       // to stop, so the signals end the process again (nothing half-written: the result is renamed into
       // place at the end).
       std::signal(SIGINT, SIG_DFL);
       std::signal(SIGTERM, SIG_DFL);
-      if (o.status == MeasureStatus::kTripped) throw Stop{Stage::kMeasure, Outcome::kTripped, o.message};
-      if (o.status == MeasureStatus::kConfigError) throw Stop{Stage::kMeasure, Outcome::kBadInput, o.message};
-      if (o.status != MeasureStatus::kOk) throw Stop{Stage::kMeasure, Outcome::kFailed, o.message};
+      throw_unless_ok(o, Stage::kMeasure);
       say_(fmt("commission: measured %d of %d impact records, chirp active over %.1f %% of its ticks, peak command "
-               "%.3f V", o.impact_records, o.impact_records_planned, 100.0 * o.chirp_active_share, o.peak_command_v));
+               "%.3f V, the cell at rest at %.4f m/s^2 RMS before it", o.impact_records, o.impact_records_planned,
+               100.0 * o.chirp_active_share, o.peak_command_v, o.rest_accel_rms_mps2));
     } else if (!fs::exists(m / identify::kManifestName)) {
       throw Stop{Stage::kMeasure, Outcome::kBadInput,
                  "--from " + std::string(to_string(s_.from)) + ": " + (m / identify::kManifestName).string() +
                      " does not exist: run from measure"};
+    }
+  }
+
+  static void throw_unless_ok(const MeasureOutcome& o, Stage st) {
+    switch (o.status) {
+      case MeasureStatus::kOk: return;
+      case MeasureStatus::kTripped: throw Stop{st, Outcome::kTripped, o.message};
+      case MeasureStatus::kConfigError: throw Stop{st, Outcome::kBadInput, o.message};
+      case MeasureStatus::kNotReady:
+      case MeasureStatus::kSaturated: throw Stop{st, Outcome::kRefused, o.message};
+      case MeasureStatus::kAborted: throw Stop{st, Outcome::kAborted, o.message};
+      default: throw Stop{st, Outcome::kFailed, o.message};
     }
   }
 
@@ -114,9 +135,17 @@ class Run {
                  "the chirp saturated the actuator over " + std::to_string(sat) +
                      " ticks: the measurement is not linear; lower commissioning.chirp_force_fraction"};
     identify::CommissioningSettings cs;
-    const identify::CommissioningInputs inputs = identify::read_measurement_dir((dir_ / "measurement").string());
+    identify::TapTests taps;
+    const identify::CommissioningInputs inputs =
+        real_ ? real_cell_inputs((dir_ / "measurement").string(), s_.tap_tests, taps)
+              : identify::read_measurement_dir((dir_ / "measurement").string());
     r_.identified = identify::identify_all(inputs, cs);
     const auto& id = *r_.identified;
+    if (real_) {
+      r_.tap_check = identify::check_tap_tests(inputs, id, taps, s_.tap_tolerance_pct);
+      say_("commission: the tap tests against the actuator's chirp: " + r_.tap_check->summary());
+      if (const std::string f = r_.tap_check->failure(); !f.empty()) throw Stop{Stage::kIdentify, Outcome::kBadInput, f};
+    }
     std::ofstream(dir_ / "identified.yaml") << id.yaml;
     std::ofstream(dir_ / "identified.json") << identify::to_json(id).dump(2) << '\n';
     // What a modal package opens: every FRF measured with its coherence, and the identified modes.
@@ -246,6 +275,7 @@ class Run {
     if (!v.time_domain_agrees())
       throw Stop{Stage::kVerify, Outcome::kNotVerified,
                  "on the identified model the time-domain cut disagrees with the " + v.method + " by more than 5 %"};
+    if (real_) return verify_real_cell();
     r_.cell = emulated_ ? check_through_emulator(cell_, *r_.tuned_config, v,
                                                  {binary_, s_.config_path, s_.job_path, (dir_ / "measurement").string(),
                                                   (dir_ / "verify").string(), s_.cut_revolutions})
@@ -263,6 +293,39 @@ class Run {
   // The schedule in time on the identified model, with the real supervisor: the spindle through up to six
   // speeds where the schedule damps (K > 0), spread over the range, the job's speed among them (changed out of
   // the cut), a cut at 0.95 x the scheduled limit at each. Bands at K = 0 carry the open loop's own limit.
+  void verify_real_cell() {
+    const auto& id = *r_.identified;
+    std::vector<double> modes_hz;
+    for (const auto& f : id.frfs)
+      if ((f.response_id == id.manifest.sensor_location_id && f.excitation_id == id.manifest.actuator_location_id) ||
+          (f.response_id == id.manifest.actuator_location_id && f.excitation_id == id.manifest.sensor_location_id))
+        for (const auto& m : f.fit.modes) modes_hz.push_back(m.natural_freq_hz);
+    MeasureOutcome on;
+    r_.real_check = verify_on_real_cell(cell_, *r_.tuned_config, modes_hz,
+                                        {s_.config_path, (dir_ / "measurement").string(), (dir_ / "verify").string(),
+                                         emulated_ ? binary_ : std::string()},
+                                        on);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    throw_unless_ok(on, Stage::kVerify);
+    const RealCellCheck& c = *r_.real_check;
+    for (const auto& m : c.modes)
+      say_(fmt("commission: on the cell, the mode at %.2f Hz at the actuator: improvement %.1f %% measured, %.1f %% predicted",
+               m.freq_hz, m.measured_improvement_pct, m.predicted_improvement_pct));
+    const LoopGainCheck& g = c.loop_gain;
+    say_(fmt("commission: the loop gain measured on the cell (the chirp injected at the plant's input, %d points): within "
+             "%.2f dB and %.1f deg of the analysis; margins measured GM %s, PM %s; the analysis on the same lines GM %s, PM %s",
+             g.compared_points, g.max_error_db, g.max_error_deg, margin_text(g.measured_gm_db, "dB").c_str(),
+             margin_text(g.measured_pm_deg, "deg").c_str(), margin_text(g.predicted_gm_db, "dB").c_str(),
+             margin_text(g.predicted_pm_deg, "deg").c_str()));
+    if (const std::string f = c.failure(); !f.empty()) throw Stop{Stage::kVerify, Outcome::kNotVerified, f};
+    verify_schedule_in_time();
+  }
+
+  static std::string margin_text(const std::optional<double>& v, const char* unit) {
+    return v ? fmt("%.1f %s", *v, unit) : std::string("(no crossover in the chirp's band)");
+  }
+
   void verify_schedule_in_time() {
     if (!r_.schedule) return;
     std::vector<tune::ScheduleSpeed> damped;
@@ -294,16 +357,12 @@ class Run {
 
   void write() {
     const tune::Verification& v = *r_.promise;
-    const CellCheck& c = *r_.cell;
     std::ostringstream h;
     h << "# robodamp commission wrote this (docs/identification.md) for the cell " << s_.config_path << " and the job "
       << s_.job_path << ":\n#   " << s_.command_line << "\n";
     h << fmt("# Promised (%s, identified model): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's %.1f rpm.\n",
              v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm)
-      << "# Verified on " << c.cell << ": " << c.cut_summary(v) << ";";
-    for (const auto& f : c.frfs)
-      h << " " << f.name << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
-                                f.predicted_improvement_pct);
+      << verified_on_text();
     if (r_.tuned_nominal)
       h << fmt("\n# On a quiet cell the command is %.4f V RMS (the discrete loop's prediction; the instability "
                "detector's floor %.3f V).",
@@ -325,6 +384,28 @@ class Run {
     r_.configuration_path = (dir_ / "configuration.yaml").string();
   }
 
+  // The configuration's header line: what was checked on the cell itself.
+  std::string verified_on_text() const {
+    std::ostringstream h;
+    if (r_.real_check) {
+      const RealCellCheck& c = *r_.real_check;
+      h << "# Verified on " << c.cell << " with the actuator's chirp, control off and on:";
+      for (const auto& m : c.modes)
+        h << fmt(" the mode at %.2f Hz at the actuator improved %.1f %% (%.1f %% predicted);", m.freq_hz,
+                 m.measured_improvement_pct, m.predicted_improvement_pct);
+      h << fmt(" the loop gain within %.2f dB and %.1f deg of the analysis.\n# No hammer and no cut on the machine: the depths "
+               "above are the identified model's promise; cut a test part with `robodamp chatter` listening to check them.",
+               c.loop_gain.max_error_db, c.loop_gain.max_error_deg);
+      return h.str();
+    }
+    const CellCheck& c = *r_.cell;
+    h << "# Verified on " << c.cell << ": " << c.cut_summary(*r_.promise) << ";";
+    for (const auto& f : c.frfs)
+      h << " " << f.name << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
+                                f.predicted_improvement_pct);
+    return h.str();
+  }
+
   const CommissionSettings& s_;
   const std::function<void(const std::string&)>& say_;
   CommissionResult& r_;
@@ -333,6 +414,7 @@ class Run {
   config::Config cell_;
   config::MillingConfig job_;
   bool emulated_{false};  // the cell is the HIL emulator (a can: section with a unix: interface)
+  bool real_{false};      // a real cell: tap tests in place of robodamp's hammer, no cut
   std::string binary_;    // robodamp, for the emulator's process
 };
 
@@ -362,6 +444,8 @@ int exit_code(Outcome o) {
     case Outcome::kNotVerified: return 3;
     case Outcome::kTripped: return 4;
     case Outcome::kFailed: return 1;
+    case Outcome::kRefused: return 6;
+    case Outcome::kAborted: return 8;
   }
   return 1;
 }

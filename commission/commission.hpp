@@ -10,6 +10,14 @@
 //               (commission/cell_check.hpp)
 //   5 write     DIR/configuration.yaml only when every check held; DIR/report.html always.
 // Each stage's output is kept in DIR; --from STAGE reuses the earlier ones. Off the real-time path.
+//
+// A real cell (tap_tests given; the only way on a CAN bus, and the HIL emulator told it is real): robodamp
+// orders no hammer blow and no cut. measure is the actuator's chirp alone (commission/measurement.hpp, its
+// readiness, rest, saturation and abort watch); identify takes the tool tip's and the other FRFs from the
+// user's tap tests and checks them against the chirp (identify/tap_tests.hpp: refused when they
+// contradict it); verify runs the chirp again with the tuned controller and checks the improvement at the
+// actuator and the loop gain against the analysis (commission/real_cell_check.hpp); the damped depths stay
+// the model's promise, checked by the accurate method and the time-domain cut on the identified model.
 #pragma once
 
 #include <functional>
@@ -18,7 +26,9 @@
 #include <vector>
 
 #include "commission/cell_check.hpp"
+#include "commission/real_cell_check.hpp"
 #include "identify/commissioning.hpp"
+#include "identify/tap_tests.hpp"
 #include "tune/compensator_search.hpp"
 #include "tune/robustness.hpp"
 #include "tune/scheduled_cut.hpp"
@@ -56,9 +66,13 @@ struct CommissionSettings {
   int schedule_speeds{80};
   int schedule_gains{4};
   std::string operator_name;    // who commissioned (the report; default the login name)
+  // A real cell: the integrator's tap tests (UFF or robodamp FRF CSVs) in place of robodamp's hammer.
+  std::vector<std::string> tap_tests;
+  double tap_tolerance_pct{2.0};  // a tapped mode against the chirp's
 };
 
-enum class Outcome { kVerified, kBadInput, kNotVerified, kTripped, kFailed };
+// kRefused: the cell was not ready or at rest, or the excitation saturated; kAborted: the operator stopped it.
+enum class Outcome { kVerified, kBadInput, kNotVerified, kTripped, kFailed, kRefused, kAborted };
 
 struct StageTime {
   Stage stage;
@@ -82,6 +96,10 @@ struct CommissionResult {
   std::optional<tune::Robustness> robustness;      // the tuned loop on the identified plant, modes shifted
   std::optional<tune::Verification> promise;
   std::optional<CellCheck> cell;
+  // A real cell: the tap tests against the chirp, and the verification by the actuator's chirp.
+  bool real_cell{false};
+  std::optional<identify::TapTestConsistency> tap_check;
+  std::optional<RealCellCheck> real_check;
   std::vector<std::pair<double, double>> open_curve_mm;  // the identified plant's open-loop lobes (SDM)
   // The speed schedule made after the tune (the tuned controller, C1 and C2 drawn in the identified chain) and
   // its check in time with the real supervisor on the identified model; the configuration it is written in.
@@ -97,7 +115,8 @@ struct CommissionResult {
 [[nodiscard]] CommissionResult commission(const CommissionSettings& s,
                                           const std::function<void(const std::string&)>& progress);
 
-// 0 verified, 2 bad input, 3 not verified, 4 the loop tripped while measuring, 1 otherwise.
+// 0 verified, 2 bad input, 3 not verified, 4 the loop tripped while measuring, 6 refused (not ready, not at
+// rest, the excitation saturated), 8 aborted by the operator, 1 otherwise.
 [[nodiscard]] int exit_code(Outcome o);
 
 // The shift of the modal frequencies the identified fits allow: 3 x the largest relative spread of one

@@ -259,24 +259,25 @@ std::string EmulatorProcess::log_tail(std::size_t lines) const {
 std::string hardware_refusal(const config::Config& cell) {
   if (!cell.can || cell.can->interface.rfind("unix:", 0) == 0) return {};
   return "the cell is a CAN bus (can.interface = " + cell.can->interface +
-         "): commissioning needs hammer impacts and a cut that robodamp can run, which it can on the simulated plant "
-         "(no can: section) or through the HIL emulator (can.interface: unix:PATH), not on a real cell yet; measure "
-         "there with `robodamp measure` and your modal hammer, then `robodamp identify all` and `robodamp tune`";
+         "): robodamp orders no hammer blow and no cut on a real cell; give your modal kit's tap tests with --tap-tests "
+         "FILE... (UFF or frf_<response>_<excitation>.csv) and it commissions with the actuator as the shaker";
 }
 
 MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
-                                        const std::string& binary) {
+                                        const std::string& binary, const EmulatedMeasure& e) {
   fs::create_directories(out_dir);
   const fs::path dir(out_dir);
-  EmulatorProcess plant(binary,
-                        {"plant", "--config", cell_path, "--pacing", "lockstep", "--measure-out", out_dir, "--json",
-                         (dir / "plant.json").string()},
-                        (dir / "plant.log").string());
+  std::vector<std::string> args{"plant", "--config", cell_path, "--pacing", "lockstep", "--json", (dir / "plant.json").string()};
+  if (e.options.impacts) args.insert(args.end(), {"--measure-out", out_dir});
+  else args.emplace_back("--no-impacts");  // a real cell: nobody swings robodamp's hammer
+  EmulatorProcess plant(binary, args, (dir / "plant.log").string());
   MeasureOutcome o;
   {
     const PinnedToOneCpu pinned;
     pinned.pin(plant.pid());
-    o = measure(cell_path, out_dir, {"virtual", {}, {}});
+    MeasureOptions mo = e.options;
+    mo.clock = "virtual";
+    o = e.controller ? measure(*e.controller, cell_path, out_dir, mo) : measure(cell_path, out_dir, mo);
   }
   const int rc = plant.wait(kEmulatorEndS);
   if (rc != 0) {
@@ -286,6 +287,7 @@ MeasureOutcome measure_through_emulator(const std::string& cell_path, const std:
                  ": " + plant.log_tail();
     return o;
   }
+  if (!e.options.impacts) return o;
   const auto j = nlohmann::json::parse(text_of(dir / "plant.json"));
   o.impact_records = j["measurement"]["records"].get<int>();
   o.impact_records_planned = j["measurement"]["records_planned"].get<int>();

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <sys/types.h>
 #include <vector>
@@ -47,13 +48,20 @@ class EmulatorProcess {
 };
 
 // Whether a cell is commissioned through the emulator: its can.interface is the emulator's unix: socket.
-// A cell with another interface (a real CAN bus) has no hammer and no cut that robodamp drives: refused
-// with this reason (empty: through the emulator, or the simulated plant without can:).
+// A cell with another interface (a real CAN bus) has no hammer and no cut that robodamp drives: without tap
+// tests it is refused with this reason (empty: through the emulator, or the simulated plant without can:).
 [[nodiscard]] std::string hardware_refusal(const config::Config& cell);
 
-// robodamp measure's run with the emulator as the plant side (it writes the FRFs into out_dir).
+// robodamp measure's run with the emulator as the plant side (it writes the impact FRFs into out_dir). With
+// options.impacts false the emulator is a real cell: no impacts served, no cut; only the actuator's chirp.
+// controller: the loop's configuration (none: the cell's own; the verification's tuned controller on the
+// cell's wires otherwise).
+struct EmulatedMeasure {
+  MeasureOptions options;
+  std::optional<config::Config> controller;
+};
 [[nodiscard]] MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
-                                                       const std::string& binary);
+                                                       const std::string& binary, const EmulatedMeasure& e = {});
 
 struct EmulatedCheckFiles {
   std::string binary;

@@ -23,13 +23,63 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One progress line per phase of the plan, from the drained frames' loop time.
+// One progress line per phase of the plan, from the drained frames' loop time; and the run's safety
+// watch: not ready or not at rest when the chirp is due, a limited tick during the chirp: the cell stops
+// at once (on the drain thread, a few ticks later) with the reason.
 class Progress {
  public:
   Progress(const analysis::CommissioningPlan& p, const std::vector<std::pair<int, std::string>>& locations,
-           double chirp_period_s)
-      : plan_(p), locations_(locations), period_s_(chirp_period_s) {}
+           const config::CommissioningConfig& c)
+      : plan_(p), locations_(locations), period_s_(c.chirp_period_s), rest_limit_(c.rest_accel_rms_mps2),
+        f0_hz_(c.chirp_f0_hz), f1_hz_(c.chirp_f1_hz) {}
+  void attach(runtime::Cell* cell) { cell_ = cell; }
+  [[nodiscard]] const std::optional<std::pair<MeasureStatus, std::string>>& stopped() const { return stopped_; }
+  [[nodiscard]] double rest_rms_mps2() const { return rest_n_ == 0 ? 0.0 : std::sqrt(rest_sum_sq_ / static_cast<double>(rest_n_)); }
   void on_frame(const rt::TelemetryFrame& f) {
+    watch(f);
+    log_phase(f);
+  }
+
+ private:
+  void stop(MeasureStatus s, std::string why) {
+    if (stopped_) return;
+    stopped_.emplace(s, std::move(why));
+    spdlog::warn("robodamp measure: {}", stopped_->second);
+    if (cell_ != nullptr) cell_->request_stop();
+  }
+  void watch(const rt::TelemetryFrame& f) {
+    if (f.time_s >= plan_.chirp_start_s - 1.0 && f.time_s < plan_.chirp_start_s && std::isfinite(f.accel_mps2))
+      rest_sum_sq_ += f.accel_mps2 * f.accel_mps2, ++rest_n_;
+    if (f.time_s < plan_.chirp_start_s || f.time_s >= plan_.chirp_end_s) return;
+    if (!started_) {
+      started_ = true;
+      sat0_ = f.saturated_ticks;
+      const auto state = static_cast<rt::State>(f.state);
+      char b[256];
+      if (state != rt::State::kActive) {
+        std::snprintf(b, sizeof b, "not ready: the loop is %s when the chirp is due at %.1f s (the amplifier ready, a fresh "
+                      "sensor and the robot's state are needed; the run's arming refusals say which)", rt::to_string(state),
+                      plan_.chirp_start_s);
+        stop(MeasureStatus::kNotReady, b);
+      } else if (rest_rms_mps2() > rest_limit_) {
+        std::snprintf(b, sizeof b, "not ready: the cell is not at rest, %.3f m/s^2 RMS at the sensor over the second before the "
+                      "chirp (commissioning.rest_accel_rms_mps2 = %g): a moving robot, a turning spindle or a cut", rest_rms_mps2(),
+                      rest_limit_);
+        stop(MeasureStatus::kNotReady, b);
+      }
+      return;
+    }
+    if (f.saturated_ticks > sat0_) {
+      const double tau = std::fmod(f.time_s - plan_.chirp_start_s, period_s_);
+      const double f_hz = f0_hz_ + (f1_hz_ - f0_hz_) * tau / period_s_;
+      char b[320];
+      std::snprintf(b, sizeof b, "the excitation saturates: the supervisor limited the command at %.3f s (the chirp near %.1f Hz, "
+                    "%.3f V): the measurement would not be linear; stopped. Lower commissioning.chirp_force_fraction or "
+                    "look at amplifier.slew_rate_v_per_s and the actuator's limits", f.time_s, f_hz, f.command_v);
+      stop(MeasureStatus::kSaturated, b);
+    }
+  }
+  void log_phase(const rt::TelemetryFrame& f) {
     const int phase = phase_at(f.time_s);
     if (phase == last_) return;
     last_ = phase;
@@ -57,7 +107,15 @@ class Progress {
   analysis::CommissioningPlan plan_;
   std::vector<std::pair<int, std::string>> locations_;
   double period_s_;
+  double rest_limit_;
   int last_{-1};
+  runtime::Cell* cell_{nullptr};
+  std::optional<std::pair<MeasureStatus, std::string>> stopped_;
+  bool started_{false};
+  std::uint32_t sat0_{0};
+  double rest_sum_sq_{0.0};
+  std::size_t rest_n_{0};
+  double f0_hz_, f1_hz_;
 };
 
 // The share of the chirp's ticks with the loop active (the test signal only plays there).
@@ -90,6 +148,60 @@ std::optional<std::string> apply_pose(const config::Config& cfg, const MeasureOp
   return std::nullopt;
 }
 
+// The plan of a run with these options: without impacts the run ends a second after the chirp.
+analysis::CommissioningPlan plan_for(const config::Config& cfg, const sim::PlantModel& model, const MeasureOptions& o) {
+  analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg, model);
+  if (!o.impacts) {
+    plan.impacts_start_s.clear();
+    plan.duration_s = plan.chirp_end_s + 1.0;
+  }
+  return plan;
+}
+
+// The configuration the loop runs: control off (every set's gain 0) unless the chirp verifies the controller.
+config::Config running_config(const config::Config& cfg, const MeasureOptions& o) {
+  config::Config c = cfg;
+  if (o.control_on) return c;
+  c.controller.gain_ns_per_m = 0.0;
+  if (c.pose_schedule)  // each region's set carries its own gain: off as well, or the loop damps what it measures
+    for (auto& r : c.pose_schedule->regions) r.gain_ns_per_m = 0.0;
+  return c;
+}
+
+void fill_manifest(identify::MeasurementManifest& m, const std::string& config_path, const config::Config& cfg,
+                   const sim::PlantModel& model, const analysis::CommissioningPlan& plan) {
+  m.config_source = fs::absolute(config_path).lexically_normal().string();
+  m.config_text = cfg.yaml_text;
+  m.loop_rate_hz = cfg.loop.rate_hz;
+  m.plan = plan;
+  for (const auto& l : cfg.robot.locations) m.locations.emplace_back(l.id, l.name);
+  m.sensor_location_id = cfg.sensor.location;
+  m.actuator_location_id = model.locations[model.actuator.location].id;
+}
+
+// The run's verdict, in order: the watch's stop, the operator's abort, a trip, an incomplete chirp, the
+// recording's errors.
+void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& watch) {
+  if (watch.stopped()) {
+    out.status = watch.stopped()->first;
+    out.message = watch.stopped()->second;
+  } else if (const int sig = rt::shutdown_signal().load(); sig != 0) {
+    out.status = MeasureStatus::kAborted;
+    out.message = "aborted by the operator (signal " + std::to_string(sig) + "): the command ramped to 0 through the "
+                  "safe state; the measurement is incomplete";
+  } else if (s.trip != "none") {
+    out.status = MeasureStatus::kTripped;
+    out.message = "the loop tripped (" + s.trip + " - " + s.trip_description + "): the measurement is incomplete";
+  } else if (out.chirp_active_share < 1.0) {
+    out.status = MeasureStatus::kIncomplete;
+    out.message = "the loop was not active for the whole chirp (" + std::to_string(100.0 * out.chirp_active_share) +
+                  " % of its ticks): raise commissioning.settle_s or look at the arming refusals";
+  } else if (s.record_errors > 0) {
+    out.status = MeasureStatus::kWriteError;
+    out.message = "the recording had " + std::to_string(s.record_errors) + " write errors";
+  }
+}
+
 }  // namespace
 
 int exit_code(MeasureStatus s) {
@@ -98,24 +210,64 @@ int exit_code(MeasureStatus s) {
     case MeasureStatus::kConfigError: return 2;
     case MeasureStatus::kTripped: return 4;
     case MeasureStatus::kIncomplete: return 5;
+    case MeasureStatus::kNotReady: return 6;
+    case MeasureStatus::kSaturated: return 7;
+    case MeasureStatus::kAborted: return 8;
     case MeasureStatus::kFailed:
     case MeasureStatus::kWriteError: return 1;
   }
   return 1;
 }
 
+std::string measurement_plan(const std::string& config_path, const MeasureOptions& o) {
+  return measurement_plan(config::load_config_file(config_path), config_path, o);
+}
+
+std::string measurement_plan(const config::Config& cfg, const std::string& config_path, const MeasureOptions& o) {
+  const sim::PlantModel model = sim::build_plant_model(cfg);
+  const analysis::CommissioningPlan p = plan_for(cfg, model, o);
+  const auto& c = cfg.commissioning;
+  char b[1024];
+  std::string t = "robodamp measure plan for " + config_path + " (" + (cfg.can ? "the cell behind " + cfg.can->interface : std::string("the simulated plant")) + "):\n";
+  std::snprintf(b, sizeof b,
+                "  0.0 - %.1f s   the loop arms, control %s (K = %.0f N s/m); the chirp waits until the loop is active "
+                "(amplifier ready, sensor fresh, robot state known) and the cell at rest (< %g m/s^2 RMS at the sensor)\n",
+                p.chirp_start_s, o.control_on ? "ON" : "off", o.control_on ? cfg.controller.gain_ns_per_m : 0.0, c.rest_accel_rms_mps2);
+  t += b;
+  std::snprintf(b, sizeof b,
+                "  %.1f - %.1f s  what moves: the inertial actuator's mass only; %d periods of a %.1f-%.1f Hz chirp, %.1f s each, "
+                "at %.3f V (%.0f %% of the amplifier's %.1f V), ramped up over the first %.1f s; predicted peak actuator force "
+                "%.1f N of its %.0f N limit\n",
+                p.chirp_start_s, p.chirp_end_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz, c.chirp_period_s, p.chirp_amplitude_v,
+                100.0 * p.chirp_amplitude_v / cfg.amplifier.voltage_limit_v, cfg.amplifier.voltage_limit_v, 0.5 * c.chirp_period_s,
+                p.predicted_peak_force_n, cfg.actuator.force_limit_n);
+  t += b;
+  if (o.impacts) {
+    std::snprintf(b, sizeof b, "  %.1f - %.1f s  hammer impacts of %.0f N, %d at each of %zu locations (the plant side's hammer)\n",
+                  p.impacts_start_s.empty() ? p.chirp_end_s : p.impacts_start_s.front(), p.duration_s - 1.0, cfg.bench.impact_peak_n,
+                  c.impacts_per_location, model.locations.size());
+    t += b;
+  } else {
+    t += "  no hammer: the tool tip's FRFs come from your tap tests (commission --tap-tests)\n";
+  }
+  std::snprintf(b, sizeof b, "  %.1f s in all. The robot must stand still and the spindle be stopped throughout.\n", p.duration_s);
+  t += b;
+  t += "  It stops at once, through the safe state, on Ctrl-C (SIGINT) or SIGTERM, on any trip, when the loop is not ready "
+       "or the cell not at rest when the chirp is due, and when the supervisor limits a command during the chirp.\n";
+  return t;
+}
+
 // long: the measurement's sequence on a cell (configure, hook, run, write), one rollback path; left for a later pass
 MeasureOutcome measure(const std::string& config_path, const std::string& out_dir, const MeasureOptions& opt) {
-  const config::Config cfg = config::load_config_file(config_path);
+  return measure(config::load_config_file(config_path), config_path, out_dir, opt);
+}
+
+MeasureOutcome measure(const config::Config& cfg, const std::string& config_path, const std::string& out_dir,
+                       const MeasureOptions& opt) {
   const sim::PlantModel model = sim::build_plant_model(cfg);
-  const analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg, model);
+  const analysis::CommissioningPlan plan = plan_for(cfg, model, opt);
   fs::create_directories(out_dir);
   MeasureOutcome out;
-
-  config::Config off = cfg;  // control off: the loop runs, the controller's gain is 0
-  off.controller.gain_ns_per_m = 0.0;
-  if (off.pose_schedule)  // each region's set carries its own gain: off as well, or the loop damps what it measures
-    for (auto& r : off.pose_schedule->regions) r.gain_ns_per_m = 0.0;
   const auto& c = cfg.commissioning;
   runtime::CellOptions o;
   if (!opt.clock.empty()) o.clock = opt.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
@@ -128,38 +280,29 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
     return out;
   }
   o.chirp = {true, plan.chirp_start_s, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz,
-             plan.chirp_amplitude_v};
+             plan.chirp_amplitude_v, 0.5 * c.chirp_period_s};
   identify::MeasurementManifest& m = out.manifest;
-  m.config_source = fs::absolute(config_path).lexically_normal().string();
-  m.config_text = cfg.yaml_text;
-  m.loop_rate_hz = cfg.loop.rate_hz;
-  m.plan = plan;
-  for (const auto& l : cfg.robot.locations) m.locations.emplace_back(l.id, l.name);
-  m.sensor_location_id = cfg.sensor.location;
-  m.actuator_location_id = model.locations[model.actuator.location].id;
-  Progress progress(plan, m.locations, c.chirp_period_s);
+  fill_manifest(m, config_path, cfg, model, plan);
+  Progress progress(plan, m.locations, c);
   o.on_frame = [&progress](const rt::TelemetryFrame& f) { progress.on_frame(f); };
 
-  runtime::Cell cell(off, o);
+  runtime::Cell cell(running_config(cfg, opt), o);
   if (runtime::Status s = cell.configure(); !s.ok()) {
     out.status = s.kind == runtime::StatusKind::kConfigError ? MeasureStatus::kConfigError : MeasureStatus::kFailed;
     out.message = s.message;
     return out;
   }
+  progress.attach(&cell);
   m.backend = cell.hardware() ? "hardware" : "simulated plant";
   std::unique_ptr<analysis::ModalTest> test;
   std::unique_ptr<ModalTestHook> hook;
-  if (!cell.hardware()) {
+  if (!cell.hardware() && opt.impacts) {
     test = std::make_unique<analysis::ModalTest>(cfg, cell.plant(), plan);
     hook = std::make_unique<ModalTestHook>(*test);
     cell.sim_backend().set_step_hook(hook.get());
   }
   rt::install_shutdown_handlers();
-  spdlog::info("robodamp measure: {} on {}, {:.0f} s: control off, chirp {:.1f}-{:.1f} Hz at {:.3f} V from {:.1f} s "
-               "(predicted peak actuator force {:.1f} N of {:.0f} N), then {} impacts of {:.0f} N at each of {} locations",
-               config_path, m.backend, plan.duration_s, c.chirp_f0_hz, c.chirp_f1_hz, plan.chirp_amplitude_v,
-               plan.chirp_start_s, plan.predicted_peak_force_n, cfg.actuator.force_limit_n, c.impacts_per_location,
-               cfg.bench.impact_peak_n, m.locations.size());
+  spdlog::info("{}", measurement_plan(cfg, config_path, opt));
   if (runtime::Status s = cell.activate(plan.duration_s); !s.ok()) {
     out.status = MeasureStatus::kFailed;
     out.message = s.message;
@@ -174,15 +317,21 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
   out.saturated_ticks = s.supervisor.saturated_ticks;
   out.peak_command_v = s.peak_command_v;
   out.recorded_frames = s.recorded_frames;
+  out.rest_accel_rms_mps2 = progress.rest_rms_mps2();
   m.run = {{"final_state", s.final_state}, {"trip", s.trip}, {"saturated_ticks", s.supervisor.saturated_ticks},
            {"peak_command_v", s.peak_command_v}, {"chirp_active_share", out.chirp_active_share},
-           {"recorded_frames", s.recorded_frames}, {"record_errors", s.record_errors}};
+           {"recorded_frames", s.recorded_frames}, {"record_errors", s.record_errors},
+           {"impacts", opt.impacts}, {"control_on", opt.control_on},
+           {"gain_ns_per_m", opt.control_on ? cfg.controller.gain_ns_per_m : 0.0},
+           {"rest_accel_rms_mps2", out.rest_accel_rms_mps2}};
   if (test) {
     out.frf_files = test->write_frf_csvs(out_dir).size();
     out.impact_records = test->records();
     out.impact_records_planned = test->records_planned();
     m.run["impact_records"] = test->records();
   }
+  judge(out, s, progress);
+  if (out.status != MeasureStatus::kOk) m.run["refused"] = out.message;
   {
     std::ofstream f(fs::path(out_dir) / identify::kManifestName);
     f << identify::to_json(m).dump(2) << '\n';
@@ -192,17 +341,7 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
       return out;
     }
   }
-  if (s.trip != "none") {
-    out.status = MeasureStatus::kTripped;
-    out.message = "the loop tripped (" + s.trip + " - " + s.trip_description + "): the measurement is incomplete";
-  } else if (out.chirp_active_share < 1.0) {
-    out.status = MeasureStatus::kIncomplete;
-    out.message = "the loop was not active for the whole chirp (" + std::to_string(100.0 * out.chirp_active_share) +
-                  " % of its ticks): raise commissioning.settle_s or look at the arming refusals";
-  } else if (s.record_errors > 0) {
-    out.status = MeasureStatus::kWriteError;
-    out.message = "the recording had " + std::to_string(s.record_errors) + " write errors";
-  } else if (test) {
+  if (out.status == MeasureStatus::kOk && test) {
     // The measurement as a universal file for a modal package (with hardware the plant side writes the
     // impact FRFs later: identify all and commission export them).
     const std::string uff = (fs::path(out_dir) / identify::kMeasurementUffName).string();

@@ -24,6 +24,8 @@ CommissioningConfig read_commissioning(MapReader& top) {
   if (auto v = read_int(r, "impacts_per_location", {"(impacts)", 1, 1000}, c.impacts_per_location))
     c.impacts_per_location = *v;
   if (auto v = r.number("record_s", {"s", 0.5, 600.0}, c.record_s)) c.record_s = *v;
+  if (auto v = r.number("rest_accel_rms_mps2", {"m/s^2 RMS", 0.0, 1000.0, true}, c.rest_accel_rms_mps2))
+    c.rest_accel_rms_mps2 = *v;
   r.finish();
   return c;
 }

@@ -16,6 +16,9 @@ struct CommissioningConfig {
   double quiet_s{2.0};                // between the chirp and the first impact
   int impacts_per_location{6};
   double record_s{8.0};               // per impact (plus up to 1 s irregular gap)
+  // The cell is at rest before the actuator excites it: the control accelerometer's RMS over the last
+  // second before the chirp below this (a moving robot, a turning spindle or a cut: not ready).
+  double rest_accel_rms_mps2{1.0};
 };
 
 }  // namespace robodamp::config

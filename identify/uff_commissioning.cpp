@@ -113,11 +113,7 @@ measfiles::UffFile modes_to_uff(const CommissioningResult& r) {
   return file;
 }
 
-namespace {
-
-// The FRF record between two nodes (either way round for a force; the sensor's response to the actuator's
-// voltage for a volt); nullopt when the file holds none.
-std::optional<UffFrf> frf_between(const measfiles::UffFile& file, const std::string& path, int response, int reference,
+std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std::string& path, int response, int reference,
                                   bool per_volt) {
   for (const auto& [g, h] : {std::pair{response, reference}, std::pair{reference, response}}) {
     int found = 0;
@@ -140,6 +136,8 @@ std::optional<UffFrf> frf_between(const measfiles::UffFile& file, const std::str
   return std::nullopt;
 }
 
+namespace {
+
 // The actuator: the sensor's acceleration per volt (robodamp's chirp), or else its force per volt.
 void read_actuator(const measfiles::UffFile& file, const std::string& path, const config::Config& cfg, CommissioningInputs& in) {
   const MeasurementManifest& m = in.manifest;
@@ -147,7 +145,7 @@ void read_actuator(const measfiles::UffFile& file, const std::string& path, cons
   c.config = cfg;
   c.fs_hz = cfg.loop.rate_hz;
   c.f0_hz = cfg.commissioning.chirp_f0_hz, c.f1_hz = cfg.commissioning.chirp_f1_hz;
-  if (const auto a = frf_between(file, path, m.sensor_location_id, m.actuator_location_id, true)) {
+  if (const auto a = uff_frf_between(file, path, m.sensor_location_id, m.actuator_location_id, true)) {
     if (a->units.kind != FrfKind::kAccelerance)
       throw std::invalid_argument(path + ": record " + std::to_string(a->record) + ": the actuator's FRF must be an acceleration per volt");
     c.accel_per_volt.f_hz = a->data.f_hz, c.accel_per_volt.h1 = a->data.h;
@@ -196,7 +194,7 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
       f.name += std::to_string(f.excitation_id);
       for (const auto& c : cfg.robot.frfs)
         if (c.response_location == f.response_id && c.excitation_location == f.excitation_id) f.name = c.name;
-      const auto u = frf_between(file, uff_path, f.response_id, f.excitation_id, false);
+      const auto u = uff_frf_between(file, uff_path, f.response_id, f.excitation_id, false);
       if (!u)
         throw std::invalid_argument(uff_path + ": no FRF per force between nodes " + std::to_string(f.response_id) + " and " +
                                     std::to_string(f.excitation_id) + " (the configuration's locations); the file holds:\n" +

@@ -11,9 +11,11 @@
 // is psi_g psi_h).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "identify/commissioning.hpp"
+#include "identify/uff_frf.hpp"
 #include "measfiles/uff.hpp"
 
 namespace robodamp::identify {
@@ -24,6 +26,11 @@ inline constexpr const char* kVoltageEntity = "VOLTAGE";
 
 [[nodiscard]] measfiles::UffFile measurement_to_uff(const CommissioningInputs& in);
 [[nodiscard]] measfiles::UffFile modes_to_uff(const CommissioningResult& r);
+
+// The FRF record between two nodes (either way round for a force; the sensor's response to the actuator's
+// voltage for a volt); nullopt when the file holds none. Throws std::invalid_argument when it holds two.
+[[nodiscard]] std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std::string& path, int response,
+                                                    int reference, bool per_volt);
 
 // identify all's inputs from a universal file and the configuration the measurement ran with: an FRF
 // per force between every pair of the configuration's locations (either way round), and the actuator's

@@ -20,12 +20,16 @@ struct PeriodicChirp {
   int periods{0};
   double f0_hz{0.0}, f1_hz{0.0};
   double amplitude_v{0.0};
+  // The amplitude rises linearly from 0 over this time from the start (a real cell is never stepped to
+  // the full level; the first period, the transient, is discarded anyway). 0: no ramp.
+  double ramp_s{0.0};
   // The signal at time t_s since the first tick (0 outside [start, start + periods x period)).
   [[nodiscard]] double value_v(double t_s) const noexcept {
     if (!enabled || t_s < start_s || t_s >= end_s()) return 0.0;
     const double tau = std::fmod(t_s - start_s, period_s);
     const double phase = kTwoPi * (f0_hz * tau + 0.5 * (f1_hz - f0_hz) * tau * tau / period_s);
-    return amplitude_v * std::sin(phase);
+    const double level = ramp_s > 0.0 && t_s - start_s < ramp_s ? (t_s - start_s) / ramp_s : 1.0;
+    return level * amplitude_v * std::sin(phase);
   }
   [[nodiscard]] double end_s() const noexcept { return start_s + period_s * periods; }
 };

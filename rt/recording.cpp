@@ -152,7 +152,8 @@ json to_json(const SupervisorSettings& s) {
 
 json to_json(const PeriodicChirp& c) {
   return {{"enabled", c.enabled}, {"start_s", c.start_s}, {"period_s", c.period_s}, {"periods", c.periods},
-          {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},     {"amplitude_v", c.amplitude_v}};
+          {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},     {"amplitude_v", c.amplitude_v},
+          {"ramp_s", c.ramp_s}};
 }
 
 namespace {
@@ -166,6 +167,7 @@ PeriodicChirp chirp_from(const json& t) {
   c.f0_hz = t.at("f0_hz");
   c.f1_hz = t.at("f1_hz");
   c.amplitude_v = t.at("amplitude_v");
+  c.ramp_s = t.value("ramp_s", 0.0);  // recorded before the ramp existed: none
   return c;
 }
 
