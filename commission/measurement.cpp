@@ -74,8 +74,8 @@ class Progress {
       const double f_hz = f0_hz_ + (f1_hz_ - f0_hz_) * tau / period_s_;
       char b[320];
       std::snprintf(b, sizeof b, "the excitation saturates: the supervisor limited the command at %.3f s (the chirp near %.1f Hz, "
-                    "%.3f V): the measurement would not be linear; stopped. Lower commissioning.chirp_force_fraction or "
-                    "look at amplifier.slew_rate_v_per_s and the actuator's limits", f.time_s, f_hz, f.command_v);
+                    "%.3f V): the measurement would not be linear; stopped. Lower commissioning.chirp_force_fraction (the "
+                    "chirp's level) or, with control on, the gain", f.time_s, f_hz, f.command_v);
       stop(MeasureStatus::kSaturated, b);
     }
   }

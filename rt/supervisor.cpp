@@ -388,12 +388,15 @@ void Supervisor::drive(const TickInput& in, const ControlStep& c, TickOutput& ou
     case State::kActive: {
       fade_ = s_.fade_s > 0.0 ? std::min(1.0, fade_ + in.dt_s / s_.fade_s) : 1.0;
       command_v_ = fade_ * c.driving_v;
+      bool clamped = false;  // the test signal and the controller together beyond the amplifier's limit
       if (in.excitation_v != 0.0) {
         const double lim = s_.command_limit_v;
-        command_v_ = std::clamp(fade_ * (c.driving_v + in.excitation_v), -lim, lim);
+        const double sum_v = fade_ * (c.driving_v + in.excitation_v);
+        command_v_ = std::clamp(sum_v, -lim, lim);
+        clamped = command_v_ != sum_v;
       }
       out.amplifier_enable = true;
-      out.saturated = c.limited || in.actuator_saturated;
+      out.saturated = c.limited || in.actuator_saturated || clamped;
       if (out.saturated) ++counters_.saturated_ticks;
       out.derated = controller_.derate() < 1.0;
       if (out.derated) ++counters_.derated_ticks;
