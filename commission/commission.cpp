@@ -309,21 +309,9 @@ class Run {
     std::signal(SIGTERM, SIG_DFL);
     throw_unless_ok(on, Stage::kVerify);
     const RealCellCheck& c = *r_.real_check;
-    for (const auto& m : c.modes)
-      say_(fmt("commission: on the cell, the mode at %.2f Hz at the actuator: improvement %.1f %% measured, %.1f %% predicted",
-               m.freq_hz, m.measured_improvement_pct, m.predicted_improvement_pct));
-    const LoopGainCheck& g = c.loop_gain;
-    say_(fmt("commission: the loop gain measured on the cell (the chirp injected at the plant's input, %d points): within "
-             "%.2f dB and %.1f deg of the analysis; margins measured GM %s, PM %s; the analysis on the same lines GM %s, PM %s",
-             g.compared_points, g.max_error_db, g.max_error_deg, margin_text(g.measured_gm_db, "dB").c_str(),
-             margin_text(g.measured_pm_deg, "deg").c_str(), margin_text(g.predicted_gm_db, "dB").c_str(),
-             margin_text(g.predicted_pm_deg, "deg").c_str()));
+    for (const auto& line : c.progress_lines()) say_("commission: " + line);
     if (const std::string f = c.failure(); !f.empty()) throw Stop{Stage::kVerify, Outcome::kNotVerified, f};
     verify_schedule_in_time();
-  }
-
-  static std::string margin_text(const std::optional<double>& v, const char* unit) {
-    return v ? fmt("%.1f %s", *v, unit) : std::string("(no crossover in the chirp's band)");
   }
 
   void verify_schedule_in_time() {
@@ -387,17 +375,7 @@ class Run {
   // The configuration's header line: what was checked on the cell itself.
   std::string verified_on_text() const {
     std::ostringstream h;
-    if (r_.real_check) {
-      const RealCellCheck& c = *r_.real_check;
-      h << "# Verified on " << c.cell << " with the actuator's chirp, control off and on:";
-      for (const auto& m : c.modes)
-        h << fmt(" the mode at %.2f Hz at the actuator improved %.1f %% (%.1f %% predicted);", m.freq_hz,
-                 m.measured_improvement_pct, m.predicted_improvement_pct);
-      h << fmt(" the loop gain within %.2f dB and %.1f deg of the analysis.\n# No hammer and no cut on the machine: the depths "
-               "above are the identified model's promise; cut a test part with `robodamp chatter` listening to check them.",
-               c.loop_gain.max_error_db, c.loop_gain.max_error_deg);
-      return h.str();
-    }
+    if (r_.real_check) return r_.real_check->header_lines();
     const CellCheck& c = *r_.cell;
     h << "# Verified on " << c.cell << ": " << c.cut_summary(*r_.promise) << ";";
     for (const auto& f : c.frfs)

@@ -57,8 +57,10 @@ class Progress {
       const auto state = static_cast<rt::State>(f.state);
       char b[256];
       if (state != rt::State::kActive) {
-        std::snprintf(b, sizeof b, "not ready: the loop is %s when the chirp is due at %.1f s (the amplifier ready, a fresh "
-                      "sensor and the robot's state are needed; the run's arming refusals say which)", rt::to_string(state),
+        const auto trip = static_cast<rt::Trip>(f.trip);
+        std::snprintf(b, sizeof b, "not ready: the loop is %s%s%s when the chirp is due at %.1f s (the amplifier ready, a "
+                      "fresh sensor and the robot's state are needed)", rt::to_string(state),
+                      trip == rt::Trip::kNone ? "" : ", tripped ", trip == rt::Trip::kNone ? "" : rt::to_string(trip),
                       plan_.chirp_start_s);
         stop(MeasureStatus::kNotReady, b);
       } else if (rest_rms_mps2() > rest_limit_) {
@@ -202,6 +204,31 @@ void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& wa
   }
 }
 
+// measurement.json (with the refusal, if any), and with the impacts measured here the measurement as a
+// universal file for a modal package (with hardware the plant side writes the impact FRFs later:
+// identify all and commission export them).
+void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts_here) {
+  identify::MeasurementManifest& m = out.manifest;
+  if (out.status != MeasureStatus::kOk) m.run["refused"] = out.message;
+  {
+    std::ofstream f(fs::path(out_dir) / identify::kManifestName);
+    f << identify::to_json(m).dump(2) << '\n';
+    if (!f) {
+      out.status = MeasureStatus::kWriteError;
+      out.message = "cannot write " + (fs::path(out_dir) / identify::kManifestName).string();
+      return;
+    }
+  }
+  if (out.status != MeasureStatus::kOk || !impacts_here) return;
+  const std::string uff = (fs::path(out_dir) / identify::kMeasurementUffName).string();
+  try {
+    measfiles::write_uff(uff, identify::measurement_to_uff(identify::read_measurement_dir(out_dir)), measfiles::UffEncoding::kAscii);
+  } catch (const std::exception& e) {
+    out.status = MeasureStatus::kWriteError;
+    out.message = uff + ": " + e.what();
+  }
+}
+
 }  // namespace
 
 int exit_code(MeasureStatus s) {
@@ -257,11 +284,11 @@ std::string measurement_plan(const config::Config& cfg, const std::string& confi
   return t;
 }
 
-// long: the measurement's sequence on a cell (configure, hook, run, write), one rollback path; left for a later pass
 MeasureOutcome measure(const std::string& config_path, const std::string& out_dir, const MeasureOptions& opt) {
   return measure(config::load_config_file(config_path), config_path, out_dir, opt);
 }
 
+// long: the measurement's sequence on a cell (configure, hook, run, judge), one rollback path
 MeasureOutcome measure(const config::Config& cfg, const std::string& config_path, const std::string& out_dir,
                        const MeasureOptions& opt) {
   const sim::PlantModel model = sim::build_plant_model(cfg);
@@ -331,27 +358,7 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
     m.run["impact_records"] = test->records();
   }
   judge(out, s, progress);
-  if (out.status != MeasureStatus::kOk) m.run["refused"] = out.message;
-  {
-    std::ofstream f(fs::path(out_dir) / identify::kManifestName);
-    f << identify::to_json(m).dump(2) << '\n';
-    if (!f) {
-      out.status = MeasureStatus::kWriteError;
-      out.message = "cannot write " + (fs::path(out_dir) / identify::kManifestName).string();
-      return out;
-    }
-  }
-  if (out.status == MeasureStatus::kOk && test) {
-    // The measurement as a universal file for a modal package (with hardware the plant side writes the
-    // impact FRFs later: identify all and commission export them).
-    const std::string uff = (fs::path(out_dir) / identify::kMeasurementUffName).string();
-    try {
-      measfiles::write_uff(uff, identify::measurement_to_uff(identify::read_measurement_dir(out_dir)), measfiles::UffEncoding::kAscii);
-    } catch (const std::exception& e) {
-      out.status = MeasureStatus::kWriteError;
-      out.message = uff + ": " + e.what();
-    }
-  }
+  write_outputs(out, out_dir, test != nullptr);
   return out;
 }
 

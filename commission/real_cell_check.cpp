@@ -137,6 +137,45 @@ std::string RealCellCheck::failure() const {
   return {};
 }
 
+std::vector<std::string> RealCellCheck::progress_lines() const {
+  std::vector<std::string> out;
+  char b[512];
+  for (const auto& m : modes) {
+    std::snprintf(b, sizeof b, "on the cell, the mode at %.2f Hz at the actuator: improvement %.1f %% measured, %.1f %% predicted",
+                  m.freq_hz, m.measured_improvement_pct, m.predicted_improvement_pct);
+    out.emplace_back(b);
+  }
+  const LoopGainCheck& g = loop_gain;
+  auto margin = [](const std::optional<double>& v, const char* unit) {
+    char m[64];
+    std::snprintf(m, sizeof m, "%.1f %s", v.value_or(0.0), unit);
+    return v ? std::string(m) : std::string("(no crossover in the chirp's band)");
+  };
+  std::snprintf(b, sizeof b, "the loop gain measured on the cell (the chirp injected at the plant's input, %d lines): within "
+                "%.2f dB and %.1f deg of the analysis; margins measured GM %s, PM %s; the analysis on the same lines GM %s, PM %s",
+                g.compared_points, g.max_error_db, g.max_error_deg, margin(g.measured_gm_db, "dB").c_str(),
+                margin(g.measured_pm_deg, "deg").c_str(), margin(g.predicted_gm_db, "dB").c_str(),
+                margin(g.predicted_pm_deg, "deg").c_str());
+  out.emplace_back(b);
+  return out;
+}
+
+std::string RealCellCheck::header_lines() const {
+  std::string h = "# Verified on " + cell + " with the actuator's chirp, control off and on:";
+  char b[200];
+  for (const auto& m : modes) {
+    std::snprintf(b, sizeof b, " the mode at %.2f Hz at the actuator improved %.1f %% (%.1f %% predicted);", m.freq_hz,
+                  m.measured_improvement_pct, m.predicted_improvement_pct);
+    h += b;
+  }
+  std::snprintf(b, sizeof b, " the loop gain within %.2f dB and %.1f deg of the analysis.", loop_gain.max_error_db,
+                loop_gain.max_error_deg);
+  h += b;
+  h += "\n# No hammer and no cut on the machine: the depths above are the identified model's promise; cut a test part "
+       "with `robodamp chatter` listening to check them.";
+  return h;
+}
+
 RealCellCheck check_real_cell(const ChirpLoopFrfs& off, const ChirpLoopFrfs& on, const config::Config& tuned,
                               const std::vector<double>& modes_hz, double min_coherence) {
   if (off.accel.f_hz.size() != on.accel.f_hz.size())

@@ -66,6 +66,9 @@ struct RealCellCheck {
   double improvement_tolerance_points{5.0};
   double wall_s{0.0};
   [[nodiscard]] std::string failure() const;  // empty when everything held
+  // The log's lines (each mode, the loop gain), and the written configuration's comment lines.
+  [[nodiscard]] std::vector<std::string> progress_lines() const;
+  [[nodiscard]] std::string header_lines() const;
 };
 
 // off / on: the control-off and the control-on chirp's recordings; tuned: the identified, tuned

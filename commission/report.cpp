@@ -184,6 +184,102 @@ std::pair<double, double> depth_range(const CommissionResult& r, const tune::Ver
 }
 
 // long: one HTML section, the verification table row by row
+std::string tap_test_table(const identify::TapTestConsistency& t) {
+  std::ostringstream h;
+  h << "<h3>The tap tests against the actuator's chirp</h3>\n<table><tr><th>mode tapped (Hz)</th><th>in the chirp (Hz)</th>"
+       "<th>apart (%)</th><th>allowed (%)</th></tr>\n";
+  for (const auto& m : t.modes)
+    h << "<tr><td>" << fmt("%.3f", m.tap_hz) << "</td><td>" << (m.chirp_hz ? fmt("%.3f", *m.chirp_hz) : "none") << "</td><td class="
+      << (m.ok ? "ok" : "bad") << ">" << fmt("%.2f", m.difference_pct) << "</td><td>" << fmt("%.1f", t.tolerance_pct) << "</td></tr>\n";
+  h << "</table>\n<p>" << esc(t.chirp_fit) << fmt(". Through the tapped structure the chirp implies an actuator that Eq. 3 "
+                                                   "fits to %.2f %% RMS (allowed %.0f %%).", t.chirp_residual_pct, t.residual_limit_pct);
+  for (const auto& r : t.reciprocity) h << " " << esc(r.pair) << fmt(" reciprocal within %.1f %% (allowed %.0f %%).", r.difference_pct, t.reciprocity_limit_pct);
+  return h.str() + "</p>\n";
+}
+
+// A real cell: what ran on the machine (the actuator's chirp, control off and on), the improvement at the
+// actuator and the loop gain measured beside the analysis, with their plots.
+std::string real_cell_section(const CommissionResult& r, Plots& p) {
+  const RealCellCheck& c = *r.real_check;
+  std::ostringstream h;
+  h << "<h3>Verification on a real cell</h3>\n<p>On " << esc(c.cell) << ". Ran on the machine: the actuator's chirp with "
+       "control off (the measure stage) and with the tuned controller (" << fmt("%.1f", c.wall_s) << " s). Not run: a hammer "
+       "test (the tool tip's FRFs are the user's tap tests) and a cut; the depths above are the identified model's promise. "
+       "Cut a test part with <code>robodamp chatter</code> listening to check them.</p>\n";
+  if (r.tap_check) h << tap_test_table(*r.tap_check);
+  h << "<table><tr><th>mode at the actuator (Hz)</th><th>measured improvement (%)</th><th>predicted (%)</th><th>difference "
+       "(points)</th></tr>\n";
+  for (const auto& m : c.modes) {
+    const double d = m.measured_improvement_pct - m.predicted_improvement_pct;
+    h << "<tr><td>" << fmt("%.2f", m.freq_hz) << "</td><td>" << fmt("%.1f", m.measured_improvement_pct) << "</td><td>"
+      << fmt("%.1f", m.predicted_improvement_pct) << "</td><td class=" << (std::abs(d) <= c.improvement_tolerance_points ? "ok" : "bad")
+      << ">" << fmt("%+.1f", d) << "</td></tr>\n";
+  }
+  const LoopGainCheck& g = c.loop_gain;
+  auto m = [](const std::optional<double>& v, const char* u) { return v ? fmt("%.1f %s", *v, u) : std::string("no crossover"); };
+  h << "</table>\n<p>The loop gain by injection (L = -(c/e)/(u/e), the chirp e at the plant's input): " << g.compared_points
+    << fmt(" lines compared where 0.1 &le; |L| &le; 10; the largest differences %.2f dB at %.1f Hz and %.1f deg at %.1f Hz "
+           "(allowed %.0f dB, %.0f deg). ", g.max_error_db, g.error_db_at_hz, g.max_error_deg, g.error_deg_at_hz, g.tolerance_db,
+           g.tolerance_deg)
+    << "Over the chirp's band: measured GM " << m(g.measured_gm_db, "dB") << ", PM " << m(g.measured_pm_deg, "deg")
+    << "; the analysis GM " << m(g.predicted_gm_db, "dB") << ", PM " << m(g.predicted_pm_deg, "deg") << ".</p>\n";
+  std::ostringstream d, l;
+  for (std::size_t i = 0; i < c.f_hz.size(); ++i)
+    d << num(c.f_hz[i]) << ' ' << num(c.measured_open[i]) << ' ' << num(c.measured_closed[i]) << ' ' << num(c.predicted_open[i])
+      << ' ' << num(c.predicted_closed[i]) << '\n';
+  for (std::size_t i = 0; i < g.f_hz.size(); ++i)
+    l << num(g.f_hz[i]) << ' ' << num(std::abs(g.measured[i])) << ' ' << num(std::abs(g.predicted[i])) << ' '
+      << num(deg(g.measured[i])) << ' ' << num(deg(g.predicted[i])) << '\n';
+  h << p.img("actuator_chirp", "set title 'At the actuator: acceleration per volt of chirp, control off and on, measured and "
+                               "predicted'\nset grid\nset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel '|y/e| (m/s^2 per V)'\n"
+                               "plot DATA u 1:2 w l lc rgb '#95a5a6' t 'off, measured', DATA u 1:4 w l dt 2 lw 2 lc rgb '#34495e' "
+                               "t 'off, predicted', DATA u 1:3 w l lc rgb '#e59866' t 'on, measured', DATA u 1:5 w l dt 2 lw 2 lc "
+                               "rgb '#c0392b' t 'on, predicted'\n",
+                 d.str(), "The actuator's chirp on the cell, control off and on, beside the tuned model");
+  h << p.img("loop_gain", "set multiplot layout 2,1 title 'The loop gain L measured on the cell (injection) and the analysis'\n"
+                          "set grid\nset logscale y\nset format y '%g'\nset ylabel '|L|'\nplot DATA u 1:2 w l lw 2 lc rgb '#e67e22' t 'measured', "
+                          "DATA u 1:3 w l dt 2 lw 2 lc rgb '#2c3e50' t 'analysis', 1 w l lc rgb '#c0392b' t '|L| = 1'\n"
+                          "unset logscale y\nset ylabel 'arg L (deg)'\nset xlabel 'frequency (Hz)'\nset yrange [-180:180]\n"
+                          "plot DATA u 1:4 w l lw 2 lc rgb '#e67e22' t 'measured', DATA u 1:5 w l dt 2 lw 2 lc rgb '#2c3e50' "
+                          "t 'analysis'\nunset multiplot\n",
+                 l.str(), "The loop gain, measured by injection on the cell and predicted by the analysis");
+  return h.str();
+}
+
+// The impact tests on the cell with control off and on, beside the tuned model.
+std::string impact_check_section(const CellCheck& c, const tune::Verification& v, Plots& p) {
+  std::ostringstream h;
+  h << "<p>The cell: " << esc(c.cell) << ". " << esc(c.cut_summary(v)) << ".</p>\n";
+  h << "<h3>Impact tests on the cell, control off and on</h3>\n<table><tr><th>FRF</th><th>open peak (m/N at Hz)</th>"
+       "<th>closed peak (m/N at Hz)</th><th>measured improvement (%)</th><th>predicted (%)</th><th>difference (points)</th>"
+       "<th>coherence min</th></tr>\n";
+  for (const auto& f : c.frfs) {
+    const double diff = f.measured_improvement_pct - f.predicted_improvement_pct;
+    h << "<tr><td>" << esc(f.name) << "</td><td>" << fmt("%.4g at %.2f", f.open_peak_m_per_n, f.open_peak_hz) << "</td><td>"
+      << fmt("%.4g at %.2f", f.closed_peak_m_per_n, f.closed_peak_hz) << "</td><td>" << fmt("%.1f", f.measured_improvement_pct)
+      << "</td><td>" << fmt("%.1f", f.predicted_improvement_pct) << "</td><td class="
+      << (std::abs(diff) <= c.improvement_tolerance_points ? "ok" : "bad") << ">" << fmt("%+.1f", diff) << "</td><td>"
+      << fmt("%.3f", f.coherence_min) << "</td></tr>\n";
+  }
+  h << "</table>\n<p>The loop was active over " << fmt("%.1f", 100.0 * c.closed_active_share)
+    << " % of the impact tests with the tuned controller; trips: " << esc(c.open_trip) << " (off), " << esc(c.closed_trip)
+    << " (on); " << c.closed_saturated_ticks << " saturated ticks; " << fmt("%.1f", c.wall_s) << " s.</p>\n";
+  for (const auto& f : c.frfs) {
+    std::ostringstream d;
+    for (std::size_t i = 0; i < f.f_hz.size(); ++i)
+      d << num(f.f_hz[i]) << ' ' << num(f.measured_open[i]) << ' ' << num(f.measured_closed[i]) << ' '
+        << num(f.predicted_open[i]) << ' ' << num(f.predicted_closed[i]) << '\n';
+    const std::string s = "set title '" + f.name + ": receptance on the cell, control off and on, measured (impacts) and "
+                          "predicted (identified model, discrete loop)'\nset grid\nset logscale y\nset format y '%.0e'\n"
+                          "set xlabel 'frequency (Hz)'\nset ylabel '|H| (m/N)'\nset key top right\n"
+                          "plot DATA u 1:2 w l lc rgb '#95a5a6' t 'open, measured', DATA u 1:4 w l dt 2 lw 2 lc rgb '#34495e' "
+                          "t 'open, predicted', DATA u 1:3 w l lc rgb '#e59866' t 'closed, measured', DATA u 1:5 w l dt 2 lw 2 "
+                          "lc rgb '#c0392b' t 'closed, predicted'\n";
+    h << p.img(f.name + "_cell", s, d.str(), f.name + ": open and closed loop on the cell, measured and predicted");
+  }
+  return h.str();
+}
+
 std::string verify_section(const CommissionResult& r, Plots& p) {
   std::ostringstream h;
   h << "<h2>4. Verification</h2>\n";
@@ -193,10 +289,10 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
   h << "<table><tr><th></th><th>speed (rpm)</th><th>promised (" << esc(v.method)
     << ", identified model) (mm)</th><th>time-domain cut, identified model (mm)</th><th>"
     << (hil ? "the regenerative cut in the HIL emulator at the promise less 5 % (mm)"
-            : "time-domain cut on the cell, critical (mm)")
+            : r.real_cell ? "on the cell (a real cell: robodamp cuts nothing)" : "time-domain cut on the cell, critical (mm)")
     << "</th></tr>\n";
   auto on_cell = [&](std::size_t i, double mm) {
-    if (!r.cell) return std::string("-");
+    if (!r.cell) return std::string(r.real_cell ? "not cut" : "-");
     if (!hil) return fmt("%.3f", mm);
     const CutTrial& t = r.cell->cut_trials.at(i);
     return fmt("%.3f at %.1f rpm: ", t.depth_mm, t.rpm) + (t.held() ? std::string("stable") : esc(t.classification));
@@ -237,36 +333,8 @@ std::string verify_section(const CommissionResult& r, Plots& p) {
                                : std::string("time-domain cut on the cell, critical")) + "'\n";
     h << p.img("lobes", s, d.str(), "Stability lobes, open and damped, with the time-domain checks");
   }
-  if (!r.cell) return h.str();
-  const auto& c = *r.cell;
-  h << "<p>The cell: " << esc(c.cell) << ". " << esc(c.cut_summary(v)) << ".</p>\n";
-  h << "<h3>Impact tests on the cell, control off and on</h3>\n<table><tr><th>FRF</th><th>open peak (m/N at Hz)</th>"
-       "<th>closed peak (m/N at Hz)</th><th>measured improvement (%)</th><th>predicted (%)</th><th>difference (points)</th>"
-       "<th>coherence min</th></tr>\n";
-  for (const auto& f : c.frfs) {
-    const double diff = f.measured_improvement_pct - f.predicted_improvement_pct;
-    h << "<tr><td>" << esc(f.name) << "</td><td>" << fmt("%.4g at %.2f", f.open_peak_m_per_n, f.open_peak_hz) << "</td><td>"
-      << fmt("%.4g at %.2f", f.closed_peak_m_per_n, f.closed_peak_hz) << "</td><td>" << fmt("%.1f", f.measured_improvement_pct)
-      << "</td><td>" << fmt("%.1f", f.predicted_improvement_pct) << "</td><td class="
-      << (std::abs(diff) <= c.improvement_tolerance_points ? "ok" : "bad") << ">" << fmt("%+.1f", diff) << "</td><td>"
-      << fmt("%.3f", f.coherence_min) << "</td></tr>\n";
-  }
-  h << "</table>\n<p>The loop was active over " << fmt("%.1f", 100.0 * c.closed_active_share)
-    << " % of the impact tests with the tuned controller; trips: " << esc(c.open_trip) << " (off), " << esc(c.closed_trip)
-    << " (on); " << c.closed_saturated_ticks << " saturated ticks; " << fmt("%.1f", c.wall_s) << " s.</p>\n";
-  for (const auto& f : c.frfs) {
-    std::ostringstream d;
-    for (std::size_t i = 0; i < f.f_hz.size(); ++i)
-      d << num(f.f_hz[i]) << ' ' << num(f.measured_open[i]) << ' ' << num(f.measured_closed[i]) << ' '
-        << num(f.predicted_open[i]) << ' ' << num(f.predicted_closed[i]) << '\n';
-    const std::string s = "set title '" + f.name + ": receptance on the cell, control off and on, measured (impacts) and "
-                          "predicted (identified model, discrete loop)'\nset grid\nset logscale y\nset format y '%.0e'\n"
-                          "set xlabel 'frequency (Hz)'\nset ylabel '|H| (m/N)'\nset key top right\n"
-                          "plot DATA u 1:2 w l lc rgb '#95a5a6' t 'open, measured', DATA u 1:4 w l dt 2 lw 2 lc rgb '#34495e' "
-                          "t 'open, predicted', DATA u 1:3 w l lc rgb '#e59866' t 'closed, measured', DATA u 1:5 w l dt 2 lw 2 "
-                          "lc rgb '#c0392b' t 'closed, predicted'\n";
-    h << p.img(f.name + "_cell", s, d.str(), f.name + ": open and closed loop on the cell, measured and predicted");
-  }
+  if (r.real_check) h << real_cell_section(r, p);
+  if (r.cell) h << impact_check_section(*r.cell, v, p);
   return h.str();
 }
 

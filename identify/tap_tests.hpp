@@ -39,9 +39,10 @@ struct TapTestConsistency {
   std::vector<TapModeCheck> modes;         // the tapped path between the actuator and the sensor, in the band
   double tolerance_pct{0.0};               // a mode's frequency, tap test against chirp
   std::string chirp_fit;                   // how the chirp was fitted, or why it could not be
-  // |chirp measured - identified actuator x tapped structure| RMS over |chirp| RMS, coherent band.
+  // The actuator's fit error: the force per volt the chirp implies through the tapped structure against
+  // Eq. 3 (RMS |G - G_fit| over RMS |G| in the coherent band).
   double chirp_residual_pct{0.0};
-  double residual_limit_pct{25.0};
+  double residual_limit_pct{10.0};
   struct Reciprocity {
     std::string pair;
     double difference_pct{0.0};  // RMS of |H_gh - H_hg| over RMS |H_gh|, coherent band

@@ -16,6 +16,8 @@
 #include "commission/commission.hpp"
 #include "commission/emulated_cell.hpp"
 #include "config/config.hpp"
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
 #include "hil_files.hpp"
 #include "test_util.hpp"
 
@@ -129,6 +131,125 @@ TEST(CommissionHil, AnEmulatorThatGoesSilentEndsTheCutWithTheReason) {
   EXPECT_NE(what.find("the lockstep stalled: no fresh sensor sample for 30 s"), std::string::npos) << what;
   EXPECT_NE(what.find(f.dir + "/cut/plant.log"), std::string::npos) << what;
   EXPECT_NE(what.find("controller connected"), std::string::npos) << what;  // the log's tail
+}
+
+// Robot A behind the emulator's wires, its own socket and port, a shorter plan; `extra` appended.
+test::HilFiles robot_a_hil(const std::string& name, const std::string& extra) {
+  const test::HilFiles f = test::hil_files(name, {{"unix:/tmp/robodamp-hil-commission.sock", "unix:/PLACEHOLDER"}},
+                                           "commissioning/robot_a_two_modes_hil");
+  std::string text = test::read_file(f.config);
+  test::replace_all(text, "unix:/PLACEHOLDER", "unix:" + f.dir + "/can.sock");
+  test::replace_all(text, "port: 1512", "port: " + std::to_string(test::free_tcp_port()));
+  std::ofstream(f.config) << text << "\ncommissioning: {chirp_periods: 3, chirp_period_s: 8}\n" << extra;
+  return f;
+}
+
+// The integrator's modal kit: an impact test of robot A on the simulated plant (another noise seed),
+// exported as a binary universal file with every FRF 2 % off (the kit's calibration), without the actuator.
+std::string modal_kit_export(const std::string& dir) {
+  std::string robot = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes.yaml");
+  test::replace_all(robot, "  seed: 1", "  seed: 29");
+  std::ofstream(dir + "/kit_robot.yaml") << robot;
+  const commission::MeasureOutcome m = commission::measure(dir + "/kit_robot.yaml", dir + "/kit");
+  EXPECT_EQ(m.status, commission::MeasureStatus::kOk) << m.message;
+  measfiles::UffFile u = measfiles::read_uff(dir + "/kit/" + identify::kMeasurementUffName);
+  std::vector<measfiles::UffFunction> kept;
+  for (auto& fn : u.functions) {
+    if (fn.reference_entity == identify::kVoltageEntity) continue;
+    if (fn.function_type == measfiles::kUffFrf)
+      for (auto& y : fn.y) y *= 1.02;
+    kept.push_back(fn);
+  }
+  u.functions = kept;
+  measfiles::write_uff(dir + "/tap_tests.uff", u, measfiles::UffEncoding::kBinary);
+  return dir + "/tap_tests.uff";
+}
+
+// A real cell (the emulator told so: no impacts served, no cut): the actuator is the shaker, the tool tip's
+// FRFs come from the user's tap tests. Identified within 1 %, verified by the chirp with control off and on:
+// the improvement at the actuator within 5 points of the prediction, the loop gain measured by injection
+// within 1 dB and 5 deg of the analysis.
+TEST(CommissionHil, ARealCellIsCommissionedWithTheActuatorAsTheShakerAndTheUsersTapTests) {
+  const test::HilFiles f = robot_a_hil("commission_real", "");
+  commission::CommissionSettings s;
+  s.config_path = f.config;
+  s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
+  s.out_dir = f.dir + "/out";
+  s.command_line = "test";
+  s.robodamp_binary = ROBODAMP_BINARY;
+  s.tune.global_evaluations = 40;
+  s.tune.local_evaluations = 10;
+  s.tap_tests = {modal_kit_export(f.dir)};
+  std::vector<std::string> lines;
+  const commission::CommissionResult r = commission::commission(s, [&](const std::string& l) { lines.push_back(l); });
+  ASSERT_EQ(r.outcome, commission::Outcome::kVerified)
+      << commission::to_string(r.stage) << ": " << r.reason << "\nemulator logs in " << f.dir;
+  EXPECT_TRUE(r.real_cell);
+
+  // No hammer and no cut in the emulator, in either run on the cell.
+  for (const char* run : {"/measurement/plant.json", "/verify/chirp_on/plant.json"}) {
+    const auto j = nlohmann::json::parse(test::read_file(s.out_dir + run));
+    EXPECT_EQ(j["impacts"]["records"], 0) << run;
+    EXPECT_FALSE(j["impacts"]["started"].get<bool>()) << run;
+    EXPECT_TRUE(j["regenerative_cut"].is_null()) << run;
+  }
+  // Identified from the tap tests, within 1 % of the robot's modes; the tap tests agree with the chirp.
+  ASSERT_TRUE(r.identified && r.tap_check);
+  for (const auto& fr : r.identified->frfs) {
+    ASSERT_EQ(fr.fit.modes.size(), 2u) << fr.name;
+    EXPECT_NEAR(fr.fit.modes[0].natural_freq_hz, 5.5, 0.055) << fr.name;
+    EXPECT_NEAR(fr.fit.modes[1].natural_freq_hz, 16.0, 0.16) << fr.name;
+    EXPECT_NE(fr.file.find("tap_tests.uff record"), std::string::npos) << fr.file;
+  }
+  EXPECT_EQ(r.tap_check->failure(), "");
+  ASSERT_EQ(r.tap_check->modes.size(), 2u);
+
+  // Verified on the cell by the chirp: the improvement at the actuator and the loop gain.
+  ASSERT_TRUE(r.real_check);
+  const commission::RealCellCheck& c = *r.real_check;
+  EXPECT_NE(c.cell.find("the HIL emulator as a real cell"), std::string::npos) << c.cell;
+  EXPECT_EQ(c.closed_trip, "none");
+  EXPECT_DOUBLE_EQ(c.closed_active_share, 1.0);
+  ASSERT_EQ(c.modes.size(), 2u);
+  bool damps = false;
+  for (const auto& m : c.modes) {
+    EXPECT_NEAR(m.measured_improvement_pct, m.predicted_improvement_pct, 5.0) << m.freq_hz;
+    damps = damps || m.predicted_improvement_pct > 5.0;
+  }
+  EXPECT_TRUE(damps) << "the tuned loop damps neither mode at the actuator";
+  const commission::LoopGainCheck& g = c.loop_gain;
+  EXPECT_GT(g.compared_points, 10);
+  EXPECT_LE(g.max_error_db, 1.0);
+  EXPECT_LE(g.max_error_deg, 5.0);
+  ASSERT_TRUE(g.measured_gm_db && g.predicted_gm_db);
+  EXPECT_NEAR(*g.measured_gm_db, *g.predicted_gm_db, 1.0);
+  EXPECT_FALSE(r.cell);  // no impact check, no cut in the emulator
+
+  const std::string written = test::read_file(s.out_dir + "/configuration.yaml");
+  EXPECT_NE(written.find("No hammer and no cut on the machine"), std::string::npos);
+  EXPECT_NE(test::read_file(s.out_dir + "/report.html").find("Verification on a real cell"), std::string::npos);
+}
+
+// An amplifier that is not ready when the chirp is due (the emulator's takes 10 s, the loop gives it 2): the
+// commissioning is refused at the measurement, before the actuator moved, and nothing is written.
+TEST(CommissionHil, ARealCellThatIsNotReadyIsRefusedBeforeTheActuatorMoves) {
+  const test::HilFiles f = robot_a_hil("commission_not_ready", "");
+  std::string text = test::read_file(f.config);
+  test::replace_all(text, "amplifier_ready_delay_s: 0.005", "amplifier_ready_delay_s: 10");
+  std::ofstream(f.config) << text;
+  commission::CommissionSettings s;
+  s.config_path = f.config;
+  s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
+  s.out_dir = f.dir + "/out";
+  s.robodamp_binary = ROBODAMP_BINARY;
+  std::ofstream(f.dir + "/taps.uff") << "";  // never read: the measurement stops first
+  s.tap_tests = {f.dir + "/taps.uff"};
+  const commission::CommissionResult r = commission::commission(s, [](const std::string&) {});
+  EXPECT_EQ(r.outcome, commission::Outcome::kRefused) << r.reason;
+  EXPECT_EQ(r.stage, commission::Stage::kMeasure);
+  EXPECT_NE(r.reason.find("not ready: the loop is"), std::string::npos) << r.reason;
+  EXPECT_EQ(commission::exit_code(r.outcome), 6);
+  EXPECT_FALSE(fs::exists(s.out_dir + "/configuration.yaml"));
 }
 
 }  // namespace
