@@ -221,6 +221,11 @@ void register_identify(Registry& r) {
                   "actuator's acceleration per volt at the sensor (what measure and commission export)")
       ->check(CLI::ExistingFile);
   sub->add_option("--config", a->config_path, "all --uff: the configuration the measurement ran with")->check(CLI::ExistingFile);
+  sub->add_option("--tap-tests", a->tap_tests,
+                  "all: with --in, the FRFs between the locations from your modal kit's tap tests (universal files or "
+                  "frf_<response>_<excitation>.csv) and the actuator from --in's chirp (robodamp measure --no-hammer); "
+                  "refused when they contradict the chirp")
+      ->check(CLI::ExistingFile);
   sub->add_option("--modes-uff", a->modes_uff_path, "all: also write the identified modes as a universal file (datasets 15, 55)");
   r.json(sub, a->json, "The result and its quality figures");
   sub->add_option("--yaml", a->yaml_path, "Write a modes: list (modes) or a material: block (cutting)");

@@ -40,6 +40,7 @@ struct IdentifyArgs {
   // actuator and all
   std::string recording_path, structure_path, in_dir, out_path;
   std::string uff_path, config_path, modes_uff_path;  // all: from a universal file
+  std::vector<std::string> tap_tests;                 // all: --in's chirp with the user's tap tests
 };
 
 // Measured against fitted magnitude and phase (<prefix>_fit.png) and the stabilisation diagram

@@ -1,5 +1,6 @@
 // `robodamp identify actuator`: Eq. 3 (T, natural frequency, damping, delay) from a chirp recorded by
 
+#include "identify/tap_tests.hpp"
 #include "identify/uff_commissioning.hpp"
 #include "measfiles/uff.hpp"
 // robodamp measure (with the structure's FRF at the sensor) or from a CSV of command and transmitted
@@ -129,9 +130,17 @@ int run_identify_all(const IdentifyArgs& a) {
   if (a.max_order) s.max_order = *a.max_order;
   identify::CommissioningResult r;
   try {
+    identify::TapTests taps;
     const identify::CommissioningInputs in =
-        a.uff_path.empty() ? identify::read_measurement_dir(a.in_dir) : identify::read_measurement_uff(a.uff_path, a.config_path);
+        !a.uff_path.empty()    ? identify::read_measurement_uff(a.uff_path, a.config_path)
+        : !a.tap_tests.empty() ? identify::inputs_with_tap_tests(a.in_dir, a.tap_tests, taps)
+                               : identify::read_measurement_dir(a.in_dir);
     r = identify::identify_all(in, s);
+    if (!a.tap_tests.empty()) {
+      const identify::TapTestConsistency c = identify::check_tap_tests(in, r, taps);
+      std::printf("robodamp identify all: the tap tests against the actuator's chirp: %s\n", c.summary().c_str());
+      if (const std::string f = c.failure(); !f.empty()) throw std::invalid_argument(f);
+    }
     if (!a.modes_uff_path.empty()) {
       measfiles::write_uff(a.modes_uff_path, identify::modes_to_uff(r), measfiles::UffEncoding::kAscii);
       std::printf("wrote %s\n", a.modes_uff_path.c_str());

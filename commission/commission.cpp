@@ -137,7 +137,7 @@ class Run {
     identify::CommissioningSettings cs;
     identify::TapTests taps;
     const identify::CommissioningInputs inputs =
-        real_ ? real_cell_inputs((dir_ / "measurement").string(), s_.tap_tests, taps)
+        real_ ? identify::inputs_with_tap_tests((dir_ / "measurement").string(), s_.tap_tests, taps)
               : identify::read_measurement_dir((dir_ / "measurement").string());
     r_.identified = identify::identify_all(inputs, cs);
     const auto& id = *r_.identified;

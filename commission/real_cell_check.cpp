@@ -217,19 +217,6 @@ RealCellCheck check_real_cell(const ChirpLoopFrfs& off, const ChirpLoopFrfs& on,
   return r;
 }
 
-identify::CommissioningInputs real_cell_inputs(const std::string& dir, const std::vector<std::string>& files,
-                                              identify::TapTests& taps) {
-  identify::CommissioningInputs in;
-  in.manifest = identify::read_manifest(dir);
-  const config::Config measured = config::parse_config(in.manifest.config_text, in.manifest.config_source);
-  taps = identify::read_tap_tests(files, in.manifest, measured);
-  in.frfs = taps.frfs;
-  in.chirp = identify::read_chirp_measurement((std::filesystem::path(dir) / identify::kRecordingName).string(),
-                                              in.manifest.config_source);
-  in.identified_path = (std::filesystem::path(dir) / "identified.yaml").string();
-  return in;
-}
-
 RealCellCheck verify_on_real_cell(const config::Config& cell, const config::Config& tuned, const std::vector<double>& modes_hz,
                                   const RealCellRun& run, MeasureOutcome& chirp_on) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -82,12 +82,6 @@ struct RealCellCheck {
 [[nodiscard]] std::pair<std::optional<double>, std::optional<double>> margins_on_grid(
     const std::vector<double>& f_hz, const std::vector<std::complex<double>>& l);
 
-// identify's inputs on a real cell: the manifest and the chirp of the measure stage's directory, the FRFs
-// of the tap tests (read against the measured configuration). Throws std::invalid_argument.
-[[nodiscard]] identify::CommissioningInputs real_cell_inputs(const std::string& measurement_dir,
-                                                             const std::vector<std::string>& tap_test_files,
-                                                             identify::TapTests& taps);
-
 // The verify stage on a real cell: the chirp with the tuned controller on the cell's wires (through the
 // emulator, told it is real, when binary is not empty; else this process's loop and drivers), checked
 // against the control-off chirp of measurement_dir. chirp_on: how that run went (refusals, trips).

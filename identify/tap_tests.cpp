@@ -157,6 +157,17 @@ TapTests read_tap_tests(const std::vector<std::string>& files, const Measurement
   return t;
 }
 
+CommissioningInputs inputs_with_tap_tests(const std::string& dir, const std::vector<std::string>& files, TapTests& taps) {
+  CommissioningInputs in;
+  in.manifest = read_manifest(dir);
+  const config::Config measured = config::parse_config(in.manifest.config_text, in.manifest.config_source);
+  taps = read_tap_tests(files, in.manifest, measured);
+  in.frfs = taps.frfs;
+  in.chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string(), in.manifest.config_source);
+  in.identified_path = (fs::path(dir) / "identified.yaml").string();
+  return in;
+}
+
 std::string TapTestConsistency::failure() const {
   char b[400];
   for (const auto& m : modes) {

@@ -28,6 +28,11 @@ struct TapTests {
 [[nodiscard]] TapTests read_tap_tests(const std::vector<std::string>& files, const MeasurementManifest& m,
                                       const config::Config& cfg);
 
+// identify all's inputs on a real cell: the manifest and the chirp of a robodamp measure directory (the
+// actuator's chirp, with or without impacts), the FRFs of the tap tests. Throws std::invalid_argument.
+[[nodiscard]] CommissioningInputs inputs_with_tap_tests(const std::string& measurement_dir,
+                                                        const std::vector<std::string>& tap_test_files, TapTests& taps);
+
 struct TapModeCheck {
   double tap_hz{0.0}, tap_damping{0.0};
   std::optional<double> chirp_hz, chirp_damping;  // the nearest pole of the chirp's own fit

@@ -72,7 +72,7 @@ struct Identified {
 
 Identified identify_with(const std::string& chirp_dir, const std::vector<std::string>& taps) {
   Identified r;
-  r.inputs = commission::real_cell_inputs(chirp_dir, taps, r.taps);
+  r.inputs = identify::inputs_with_tap_tests(chirp_dir, taps, r.taps);
   r.result = identify::identify_all(r.inputs, {});
   r.check = identify::check_tap_tests(r.inputs, r.result, r.taps);
   return r;
@@ -118,6 +118,24 @@ TEST(RealCell, TapTestsOfTheSameRobotAgreeWithTheChirpAndAnotherRobotsAreRefused
   EXPECT_GT(other.check.chirp_residual_pct, 3.0 * same.check.chirp_residual_pct) << other.check.summary() << " / " << same.check.summary();
 }
 
+// The same from the command line: identify all --in (the chirp) --tap-tests, whose output tune reads.
+TEST(RealCell, IdentifyAllTakesTapTestsAndRefusesContradictingOnes) {
+  const test::ScratchDir dir("real-cell-cli");
+  const std::string chirp = chirp_only(dir, kRobotA, "chirp");
+  const std::string taps = tap_test_export(dir, kRobotA, "kit", 1.0);
+  const auto ok = test::run_robodamp("identify all --in " + chirp + " --tap-tests " + taps + " --out " + dir.file("id.yaml"));
+  EXPECT_EQ(ok.status, 0) << ok.out;
+  EXPECT_NE(ok.out.find("the tap tests against the actuator's chirp: 5.500 Hz tapped"), std::string::npos) << ok.out;
+  EXPECT_NEAR(config::load_config_file(dir.file("id.yaml")).robot.frfs.at(0).modes.at(1).natural_freq_hz, 16.0, 0.16);
+  std::vector<std::pair<std::string, std::string>> shift;
+  for (int i = 0; i < 3; ++i) shift.emplace_back("natural_freq_hz: 16.0,", "natural_freq_hz: 16.48,");
+  const std::string other = tap_test_export(dir, robot_a(dir, "shifted", shift), "other", 1.0);
+  const auto bad = test::run_robodamp("identify all --in " + chirp + " --tap-tests " + other + " --out " + dir.file("id2.yaml"));
+  EXPECT_EQ(bad.status, 2) << bad.out;
+  EXPECT_NE(bad.out.find("the tap tests contradict the actuator's chirp: their mode at 16.48 Hz"), std::string::npos) << bad.out;
+  EXPECT_FALSE(fs::exists(dir.file("id2.yaml")));
+}
+
 TEST(RealCell, TapTestsComeAsUniversalFilesOrFrfCsvsAndReciprocityIsChecked) {
   const test::ScratchDir dir("real-cell-csv");
   const std::string chirp = chirp_only(dir, kRobotA, "chirp");
@@ -154,13 +172,13 @@ TEST(RealCell, TapTestsComeAsUniversalFilesOrFrfCsvsAndReciprocityIsChecked) {
   // A pair nobody tapped, and a pair tapped twice, are refused by name.
   identify::TapTests t;
   try {
-    (void)commission::real_cell_inputs(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_2.csv"}, t);
+    (void)identify::inputs_with_tap_tests(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_2.csv"}, t);
     ADD_FAILURE() << "a missing pair was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("no FRF between locations 2 and 1"), std::string::npos) << e.what();
   }
   try {
-    (void)commission::real_cell_inputs(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", sim + "/frf_2_2.csv",
+    (void)identify::inputs_with_tap_tests(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", sim + "/frf_2_2.csv",
                                                sim + "/" + identify::kMeasurementUffName}, t);
     ADD_FAILURE() << "a pair given twice was accepted";
   } catch (const std::invalid_argument& e) {
