@@ -204,10 +204,11 @@ void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& wa
   }
 }
 
-// measurement.json (with the refusal, if any), and with the impacts measured here the measurement as a
-// universal file for a modal package (with hardware the plant side writes the impact FRFs later:
-// identify all and commission export them).
-void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts_here) {
+// measurement.json (with the refusal, if any), and the measurement as a universal file for a modal
+// package: with the impacts measured here all of it; with the chirp alone (a real cell) the actuator's
+// FRF at the sensor with its coherence; with hardware's impacts the plant side writes their FRFs later
+// (identify all and commission export them).
+void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts_here, bool chirp_only) {
   identify::MeasurementManifest& m = out.manifest;
   if (out.status != MeasureStatus::kOk) m.run["refused"] = out.message;
   {
@@ -219,10 +220,17 @@ void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts
       return;
     }
   }
-  if (out.status != MeasureStatus::kOk || !impacts_here) return;
+  if (out.status != MeasureStatus::kOk || !(impacts_here || chirp_only)) return;
   const std::string uff = (fs::path(out_dir) / identify::kMeasurementUffName).string();
   try {
-    measfiles::write_uff(uff, identify::measurement_to_uff(identify::read_measurement_dir(out_dir)), measfiles::UffEncoding::kAscii);
+    identify::CommissioningInputs in;
+    if (impacts_here) {
+      in = identify::read_measurement_dir(out_dir);
+    } else {
+      in.manifest = m;
+      in.chirp = identify::read_chirp_measurement((fs::path(out_dir) / identify::kRecordingName).string(), m.config_source);
+    }
+    measfiles::write_uff(uff, identify::measurement_to_uff(in), measfiles::UffEncoding::kAscii);
   } catch (const std::exception& e) {
     out.status = MeasureStatus::kWriteError;
     out.message = uff + ": " + e.what();
@@ -358,7 +366,7 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
     m.run["impact_records"] = test->records();
   }
   judge(out, s, progress);
-  write_outputs(out, out_dir, test != nullptr);
+  write_outputs(out, out_dir, test != nullptr, !opt.impacts);
   return out;
 }
 

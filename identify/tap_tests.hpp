@@ -45,8 +45,9 @@ struct TapTestConsistency {
   double tolerance_pct{0.0};               // a mode's frequency, tap test against chirp
   std::string chirp_fit;                   // how the chirp was fitted, or why it could not be
   // The actuator's fit error: the force per volt the chirp implies through the tapped structure against
-  // Eq. 3 (RMS |G - G_fit| over RMS |G| in the coherent band).
+  // Eq. 3, weighed in the acceleration (RMS over the coherent band).
   double chirp_residual_pct{0.0};
+  int residual_lines_left_out{0};  // lone lines ten times both neighbours' error (a periodic disturbance)
   double residual_limit_pct{10.0};
   struct Reciprocity {
     std::string pair;

@@ -86,6 +86,10 @@ std::string chirp_only(const test::ScratchDir& dir, const std::string& robot, co
   EXPECT_EQ(m.status, commission::MeasureStatus::kOk) << m.message;
   EXPECT_EQ(m.impact_records, 0);
   EXPECT_FALSE(fs::exists(out + "/frf_1_1.csv"));  // no hammer
+  // The actuator's FRF at the sensor, with its coherence, for a modal package: nothing else.
+  const measfiles::UffFile u = measfiles::read_uff(out + "/" + identify::kMeasurementUffName);
+  EXPECT_EQ(u.functions.size(), 2u);
+  if (!u.functions.empty()) EXPECT_EQ(u.functions[0].reference_entity, identify::kVoltageEntity);
   return out;
 }
 
