@@ -56,8 +56,11 @@ CriticalDepth critical_depth(const DynamicsFactory& dynamics, const Cutter& cutt
   ChatterVerdict above;
   const ChatterVerdict first = trial(guess_mm);
   if (first.stable) {
+    // First 5 % above the guess, then doubling: stability need not be monotone in depth (a flip island of a
+    // low-immersion cut sits between stable depths), and a guess from the accurate method lies at the
+    // lowest boundary, which one doubling would step over.
     lo = guess_mm;
-    for (hi = 2.0 * guess_mm; c.simulations < 12; hi *= 2.0) {
+    for (hi = 1.05 * guess_mm; c.simulations < 12; hi *= hi < 1.1 * guess_mm ? 2.0 / 1.05 : 2.0) {
       above = trial(hi);
       if (!above.stable) break;
       lo = hi;

@@ -35,8 +35,9 @@ struct CriticalDepth {
   int simulations{0};
 };
 
-// Bisection from a first guess (e.g. the zero-order limit): doubled or halved until the verdict changes,
-// then halved to rel_tol. progress (optional) gets one line per simulation.
+// Bisection from a first guess (e.g. the zero-order limit): raised 5 % and then doubled, or halved, until
+// the verdict changes, then halved to rel_tol: the boundary just above a stable guess (stability need not
+// be monotone in depth: flip islands). progress (optional) gets one line per simulation.
 [[nodiscard]] CriticalDepth critical_depth(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                                            const config::MaterialConfig& material, CutSettings settings,
                                            double guess_mm, double rel_tol = 2e-3,
