@@ -98,11 +98,14 @@ TEST(Loop, ArmsOnceLiveFadesInDampsAndDisarmsToDisabled) {
 
 // The commissioning chirp is the loop's command source beside the controller: with K = 0 the command is
 // the faded chirp evaluated on the sum of the frames' dt, clamped to amplifier.voltage_limit_v (a 3 V
-// chirp against 2 V, inside the actuator's force limit), zero outside its window, and a recording of it replays bit for bit.
+// chirp against 2 V, inside the actuator's force limit), zero outside its window, every clamped tick
+// counted as saturated (the duty trip off here: robodamp measure stops at the first one itself), and a
+// recording of it replays bit for bit.
 TEST(Loop, TheChirpIsACommandSourceOfTheLoopClampedAndReplayed) {
   config::Config cfg = c2();
   cfg.controller.gain_ns_per_m = 0.0;
   cfg.amplifier.voltage_limit_v = 2.0;
+  cfg.supervision.saturation_duty_max = 1.0;
   CellOptions o = virtual_clock();
   o.chirp = {true, 1.0, 0.5, 2, 5.0, 40.0, 3.0};
   o.record_path = ::testing::TempDir() + "/chirp_loop.rec";
@@ -132,6 +135,7 @@ TEST(Loop, TheChirpIsACommandSourceOfTheLoopClampedAndReplayed) {
   }
   EXPECT_GE(inside, static_cast<std::size_t>(0.99 * o.chirp.period_s * o.chirp.periods * cfg.loop.rate_hz));  // its window, active
   EXPECT_GT(clamped, 100U);
+  EXPECT_EQ(r.s.supervisor.saturated_ticks, clamped);
   EXPECT_EQ(peak_v, 2.0);
   const ReplayResult rp = replay(read_recording(o.record_path));
   EXPECT_EQ(rp.frames, r.frames.size());
