@@ -309,12 +309,20 @@ function plotLobes(l, m, a) {
     series: { 'job depth': { strokePattern: [6, 4] }, 'cutting now': { strokeWidth: 0, drawPoints: true, pointSize: 6 },
               advised: { strokeWidth: 0, drawPoints: true, pointSize: 5 } },
   });
-  $('lobes-note').textContent = l.method + (l.speed_scheduled ? ' (each speed with its band\'s controller and K; K = 0 where the damper is worse than none)'
-    : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds';
+  // The curve is about the state it was computed for: while the cell runs another set or K (a request, a ramp)
+  // the note says so until the new sweep arrives; with the damper off the open loop is what applies.
+  const s = cellStatus;
+  const other = s && !l.speed_scheduled && (s.parameter_set !== l.parameter_set || Math.abs(s.gain_ns_per_m - l.gain_ns_per_m) > 0.5);
+  const off = s && s.state !== 'active';
+  $('lobes-note').textContent = (other ? 'recomputing for set ' + s.parameter_set + ', K = ' + fmt(s.gain_ns_per_m, 0) + ' N s/m; shown: ' : '') +
+    l.method + (l.speed_scheduled ? ' (each speed with its band\'s controller and K; K = 0 where the damper is worse than none)'
+    : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds' +
+    (off ? '; the damper is ' + s.state + ': the open loop applies' : '');
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
     (a.found ? 'go to ' + fmt(a.advised_rpm, 1) + ' rpm, limit ' + fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')' : esc(a.reason)) +
     ' – ' + esc(a.method)) : 'no advice asked for';
   window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, advised: options.length,
+    gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off,
     scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
       l.damped_limit_mm[i] < 0.995 * l.open_limit_mm[i]).length };
   window.robodamp.updates.lobes++;

@@ -360,6 +360,20 @@ class DashboardInABrowser(unittest.TestCase):
         until(lambda: "accepted" in self.browser.find_element(By.ID, "message").text, 30, "the confirmed gain")
         until(lambda: abs(http(self.fleet.port, f"/api/cells/{cell}")[1]["status"]["gain_ns_per_m"] - lower) < 1e-6, 30,
               f"cell b at K = {lower}")
+        # The live lobes are about the state the cell is in. Cell b's are its speed schedule's envelope (what
+        # runs at each speed, whatever K passes now): they say so. A fixed-K curve computed for another K than
+        # the cell's (the page's own drawing, fed the cell's status as it is now) says it is recomputing.
+        until(lambda: abs(self.js("return cellStatus ? cellStatus.gain_ns_per_m : -1") - lower) < 1e-6, 10,
+              "the page's status at the new K")
+        self.assertIn("speed schedule (each speed with its band's controller and K",
+                      self.browser.find_element(By.ID, "lobes-note").text)
+        fixed = "{method: 'sampled-loop SDM', parameter_set: 0, gain_ns_per_m: %s, rpm: [500, 600], open_limit_mm: [1, 1], " \
+                "damped_limit_mm: [2, 2], depth_mm: 0.5}"
+        stale = self.js("plotLobes(%s, cellMachining, null); return document.getElementById('lobes-note').textContent" % (fixed % k_now))
+        self.assertIn(f"recomputing for set 0, K = {lower} N s/m; shown: sampled-loop SDM, parameter set 0, K = {k_now:.0f} N s/m", stale)
+        fresh = self.js("plotLobes(%s, cellMachining, null); return document.getElementById('lobes-note').textContent" % (fixed % lower))
+        self.assertNotIn("recomputing", fresh)
+        self.assertIn(f"K = {lower} N s/m", fresh)
         # Disarming asks too; raising the gain back is sent at once.
         said, _, confirming = self.type_and_press("gain", f"{k_now:.0f}")
         self.assertFalse(confirming)
