@@ -40,9 +40,8 @@ Result run_shell(const std::string& cmd) {
 
 Result run(const std::string& args) { return run_shell(std::string(ROBODAMP_BINARY) + " " + args); }
 
-std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("robodamp-test-" + std::to_string(getpid()) + "-" + name)).string();
-}
+// Under the process's temporary directory (tests/test_main.cpp: removed when its tests end).
+std::string temp_path(const std::string& name) { return ::testing::TempDir() + name; }
 
 TEST(Cli, FiltersJsonHasTheDocumentedShape) {
   const Result r = run("filters --config " + robodamp::test::preset("horizontal_c1") + " --freq 9.2 --json");
@@ -389,7 +388,7 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   const Result far = run("pose frf --joints -100 200 -20");
   EXPECT_EQ(far.status, 2);
   EXPECT_NE(far.out.find("joint 2 = 200 deg is out of range: allowed 0 <= value <= 170 deg"), std::string::npos) << far.out;
-  const std::string dir = ::testing::TempDir() + "robodamp_pose_" + std::to_string(getpid());
+  const std::string dir = temp_path("pose");
   std::system(("mkdir -p " + dir).c_str());
   std::string measured;
   const char* poses[3][2] = {{"pose 1", "-120.13,133.37,-14.13"}, {"pose 2", "-100.59,119.81,-19.55"}, {"pose 3", "-84.75,104.63,-20.08"}};
@@ -484,7 +483,7 @@ TEST(Cli, PoseScheduleAnalyzeRunAndBadPoses) {
 // robodamp tune's refusals: an unreachable objective (exit 3, nothing written), a job without a damping
 // location and a chain without a compensator (exit 2, by name).
 TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
-  const std::string dir = ::testing::TempDir() + "robodamp_tune_" + std::to_string(getpid());
+  const std::string dir = temp_path("tune");
   std::system(("mkdir -p " + dir).c_str());
   const std::string out = dir + "/tuned.yaml";
   const Result unreachable = run("tune --evaluations 10 --polish 0 --gain-margin-db 40 --phase-margin-deg 90 --out " + out);

@@ -38,7 +38,7 @@ template <typename T>
 const T& one_of(Rng& rng, const std::vector<T>& v) { return v[below(rng, v.size())]; }
 
 fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("robodamp-fuzz-" + std::to_string(getpid())) / name;
+  const fs::path p = fs::path(::testing::TempDir()) / name;  // the process's own (tests/test_main.cpp)
   fs::create_directories(p.parent_path());
   return p;
 }

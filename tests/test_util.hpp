@@ -20,11 +20,12 @@
 
 namespace robodamp::test {
 
-// A directory of the test's own under /tmp, removed with everything in it when the object goes.
+// A directory of the test's own under the process's temporary directory (tests/test_main.cpp), removed
+// with everything in it when the object goes.
 struct ScratchDir {
   std::string path;
   explicit ScratchDir(const std::string& name) {
-    std::string tmpl = "/tmp/robodamp-" + name + "-XXXXXX";
+    std::string tmpl = (std::filesystem::temp_directory_path() / ("robodamp-" + name + "-XXXXXX")).string();
     path = mkdtemp(tmpl.data());
   }
   ~ScratchDir() { std::filesystem::remove_all(path); }

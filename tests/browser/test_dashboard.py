@@ -12,6 +12,7 @@ import signal
 import socket
 import subprocess
 import sys
+import shutil
 import tempfile
 import threading
 import time
@@ -160,6 +161,7 @@ class DashboardInABrowser(unittest.TestCase):
             cls.browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
         except Exception:
             cls.fleet.stop()
+            shutil.rmtree(cls.fleet.dir, ignore_errors=True)
             raise
         cls.browser.set_page_load_timeout(60)
         cls.url = f"http://127.0.0.1:{cls.fleet.port}/"
@@ -170,6 +172,7 @@ class DashboardInABrowser(unittest.TestCase):
             cls.browser.quit()
         finally:
             cls.fleet.stop()
+            shutil.rmtree(cls.fleet.dir, ignore_errors=True)  # the cells' files and the browser's profile
 
     def js(self, script):
         return self.browser.execute_script(script)
