@@ -103,8 +103,9 @@ std::vector<IdentifiedMode> chirp_modes(const ChirpMeasurement& c, double lo, do
   s.min_coherence = 0.9;
   try {
     const ModalFit fit = fit_modes(d, s);
-    char b[160];
-    std::snprintf(b, sizeof b, "the chirp's FRF fitted on its own over %.1f-%.1f Hz: %zu poles, fit error %.2f %%", lo, hi,
+    char b[320];
+    std::snprintf(b, sizeof b, "the chirp's FRF fitted on its own over %.1f-%.1f Hz for its poles: %zu (only the poles are "
+                  "compared: the actuator's dynamics in it are not of the modal form, the residues fit it to %.0f %%)", lo, hi,
                   fit.modes.size(), fit.fit_error_pct);
     how = b;
     return fit.modes;

@@ -311,6 +311,7 @@ void Cell::on_frame(const rt::TelemetryFrame& f) {
   if (std::isfinite(f.accel_mps2)) sum_sq_ += f.accel_mps2 * f.accel_mps2, ++n_samples_;
   summary_.peak_command_v = std::max(summary_.peak_command_v, std::abs(f.command_v));
   TripTiming& tt = summary_.trip_timing;
+  if (tt.trip_s >= 0.0 && f.trip == 0) tt = TripTiming{};  // recovered: the timing is the next trip's (the run's own)
   if (tt.trip_s < 0.0 && (f.flags & rt::kFlagFresh)) tt.last_fresh_s = f.time_s, last_fresh_frame_ = n_frames_;
   if (tt.trip_s < 0.0 && f.trip != 0) tt.trip_s = f.time_s;
   if (tt.trip_s >= 0.0 && tt.safe_s < 0.0 && f.command_v == 0.0 && !(f.flags & rt::kFlagAmplifierEnable)) {

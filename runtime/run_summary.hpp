@@ -20,9 +20,11 @@
 namespace robodamp::runtime {
 
 // When the run lost its sensor and went safe (from the telemetry frames; loop time since the start).
+// The latest trip: one that recovered is replaced by the next, so that with the run's `trip` (the one latched at
+// the end) the timing is that trip's.
 struct TripTiming {
   double last_fresh_s{-1.0};  // the last fresh sensor sample before the trip
-  double trip_s{-1.0};        // the first tick with a latched trip
+  double trip_s{-1.0};        // the first tick with the trip latched
   double safe_s{-1.0};        // the first tick after it with zero command and the amplifier enable off
   // Ticks the loop ran from the last fresh sample to safe: what the supervisor bounds (stale_sensor_cycles
   // + the trip ramp); in time it is longer by any ticks a loaded machine made the loop skip.
