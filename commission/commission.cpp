@@ -296,10 +296,8 @@ class Run {
   void verify_real_cell() {
     const auto& id = *r_.identified;
     std::vector<double> modes_hz;
-    for (const auto& f : id.frfs)
-      if ((f.response_id == id.manifest.sensor_location_id && f.excitation_id == id.manifest.actuator_location_id) ||
-          (f.response_id == id.manifest.actuator_location_id && f.excitation_id == id.manifest.sensor_location_id))
-        for (const auto& m : f.fit.modes) modes_hz.push_back(m.natural_freq_hz);
+    for (const auto& m : identify::path_between(id.frfs, id.manifest.sensor_location_id, id.manifest.actuator_location_id).fit.modes)
+      modes_hz.push_back(m.natural_freq_hz);
     MeasureOutcome on;
     r_.real_check = verify_on_real_cell(cell_, *r_.tuned_config, modes_hz,
                                         {s_.config_path, (dir_ / "measurement").string(), (dir_ / "verify").string(),

@@ -82,13 +82,6 @@ void fit_frfs(std::vector<IdentifiedFrf>& out, const config::Config& cfg, const 
   }
 }
 
-const IdentifiedFrf& path_between(const std::vector<IdentifiedFrf>& frfs, int a, int b) {
-  for (const auto& f : frfs)
-    if ((f.response_id == a && f.excitation_id == b) || (f.response_id == b && f.excitation_id == a)) return f;
-  throw std::invalid_argument("no FRF between locations " + std::to_string(a) + " and " + std::to_string(b) +
-                              " was measured");
-}
-
 double mode_peak(const IdentifiedMode& m) {
   return std::hypot(m.residue_re, m.residue_im) / (m.damping_ratio * kTwoPi * m.natural_freq_hz);
 }
@@ -177,6 +170,13 @@ void analyse_into(CommissioningResult& r) {
 }
 
 }  // namespace
+
+const IdentifiedFrf& path_between(const std::vector<IdentifiedFrf>& frfs, int a, int b) {
+  for (const auto& f : frfs)
+    if ((f.response_id == a && f.excitation_id == b) || (f.response_id == b && f.excitation_id == a)) return f;
+  throw std::invalid_argument("no FRF between locations " + std::to_string(a) + " and " + std::to_string(b) +
+                              " was measured");
+}
 
 ChirpMeasurement read_chirp_measurement(const std::string& path, const std::string& config_source) {
   if (!fs::exists(path)) throw std::invalid_argument(path + " is missing: robodamp measure records the loop there");

@@ -101,6 +101,9 @@ struct CommissioningResult {
   std::vector<std::pair<std::string, double>> improvements_pct;  // discrete loop, per FRF
 };
 
+// The FRF between two locations, either way round. Throws std::invalid_argument naming them when none is.
+[[nodiscard]] const IdentifiedFrf& path_between(const std::vector<IdentifiedFrf>& frfs, int a, int b);
+
 // What identify all works from: a robodamp measure directory (read_measurement_dir) or a universal file
 // and the configuration measured with (identify/uff_commissioning.hpp).
 struct CommissioningInputs {

@@ -122,15 +122,15 @@ std::vector<IdentifiedMode> chirp_modes(const ChirpMeasurement& c, double lo, do
 // its neighbours' is left out and counted: a periodic disturbance on one line (a robot's drives at 3 Hz
 // repeat with the chirp's period and pass its averaging), where a structure that is not the chirp's
 // leaves a band of lines around each of its modes.
-double actuator_residual_pct(const CommissioningResult& r, const ModalFit* path, int& lines_left_out) {
+double actuator_residual_pct(const CommissioningResult& r, const ModalFit& path, int& lines_left_out) {
   const ActuatorFit& a = r.actuator;
   lines_left_out = 0;
-  if (path == nullptr || a.f_hz.empty()) return a.fit_error_pct;
+  if (a.f_hz.empty()) return a.fit_error_pct;
   const std::size_t n = a.f_hz.size();
   std::vector<double> weight(n), err(n);
   for (std::size_t i = 0; i < n; ++i) {
     const double w = kTwoPi * a.f_hz[i];
-    weight[i] = std::norm(w * w * fitted_receptance(*path, a.f_hz[i]));
+    weight[i] = std::norm(w * w * fitted_receptance(path, a.f_hz[i]));
     err[i] = weight[i] * std::norm(a.measured[i] - a.fitted[i]);
   }
   double num = 0.0, den = 0.0;
@@ -253,23 +253,17 @@ TapTestConsistency check_tap_tests(const CommissioningInputs& in, const Commissi
   const config::Config& cfg = r.config;
   const double lo = std::max(cfg.analysis.band_min_hz, in.chirp.f0_hz), hi = std::min(cfg.analysis.band_max_hz, in.chirp.f1_hz);
   const std::vector<IdentifiedMode> poles = chirp_modes(in.chirp, lo, hi, c.chirp_fit);
-  const int s = r.manifest.sensor_location_id, a = r.manifest.actuator_location_id;
-  const ModalFit* path_fit = nullptr;
-  for (const auto& f : r.frfs) {
-    if (!((f.response_id == s && f.excitation_id == a) || (f.response_id == a && f.excitation_id == s))) continue;
-    path_fit = &f.fit;
-    for (const auto& m : f.fit.modes) {
-      if (m.natural_freq_hz < lo || m.natural_freq_hz > hi) continue;
-      TapModeCheck t;
-      t.tap_hz = m.natural_freq_hz, t.tap_damping = m.damping_ratio;
-      for (const auto& p : poles)
-        if (!t.chirp_hz || std::abs(p.natural_freq_hz - t.tap_hz) < std::abs(*t.chirp_hz - t.tap_hz))
-          t.chirp_hz = p.natural_freq_hz, t.chirp_damping = p.damping_ratio;
-      if (t.chirp_hz) t.difference_pct = 100.0 * std::abs(*t.chirp_hz - t.tap_hz) / t.tap_hz;
-      t.ok = t.chirp_hz && t.difference_pct <= tolerance_pct;
-      c.modes.push_back(t);
-    }
-    break;
+  const ModalFit& path_fit = path_between(r.frfs, r.manifest.sensor_location_id, r.manifest.actuator_location_id).fit;
+  for (const auto& m : path_fit.modes) {
+    if (m.natural_freq_hz < lo || m.natural_freq_hz > hi) continue;
+    TapModeCheck t;
+    t.tap_hz = m.natural_freq_hz, t.tap_damping = m.damping_ratio;
+    for (const auto& p : poles)
+      if (!t.chirp_hz || std::abs(p.natural_freq_hz - t.tap_hz) < std::abs(*t.chirp_hz - t.tap_hz))
+        t.chirp_hz = p.natural_freq_hz, t.chirp_damping = p.damping_ratio;
+    if (t.chirp_hz) t.difference_pct = 100.0 * std::abs(*t.chirp_hz - t.tap_hz) / t.tap_hz;
+    t.ok = t.chirp_hz && t.difference_pct <= tolerance_pct;
+    c.modes.push_back(t);
   }
   // The chirp against the identified actuator on the tapped structure: the force per volt the chirp implies
   // through the tapped structure (the loop's sensor and output path taken out) against Eq. 3's fit of it,

@@ -19,6 +19,7 @@
 #include "identify/uff_commissioning.hpp"
 #include "measfiles/uff.hpp"
 #include "hil_files.hpp"
+#include "modal_kit.hpp"
 #include "test_util.hpp"
 
 namespace robodamp {
@@ -26,25 +27,34 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(CommissionHil, ARobotNoPresetDescribesIsCommissionedAndVerifiedThroughTheEmulator) {
-  const std::string robot = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes_hil.yaml";
-  // Its own socket and port; a shorter plan (3 chirp periods, 4 impacts of 6 s per location).
-  const test::HilFiles f = test::hil_files(
-      "commission", {{"unix:/tmp/robodamp-hil-commission.sock", "unix:/PLACEHOLDER"}}, "commissioning/robot_a_two_modes_hil");
+// Robot A behind the emulator's wires, its own socket and port, a shorter plan (`commissioning` keys).
+test::HilFiles robot_a_hil(const std::string& name, const std::string& commissioning) {
+  const test::HilFiles f = test::hil_files(name, {{"unix:/tmp/robodamp-hil-commission.sock", "unix:/PLACEHOLDER"}},
+                                           "commissioning/robot_a_two_modes_hil");
   std::string text = test::read_file(f.config);
   test::replace_all(text, "unix:/PLACEHOLDER", "unix:" + f.dir + "/can.sock");
   test::replace_all(text, "port: 1512", "port: " + std::to_string(test::free_tcp_port()));
-  text += "\ncommissioning: {chirp_periods: 3, chirp_period_s: 8, impacts_per_location: 4, record_s: 6}\n";
-  std::ofstream(f.config) << text;
+  std::ofstream(f.config) << text << "\ncommissioning: {" << commissioning << "}\n";
+  return f;
+}
 
+// Commissioning robot A's cell for job A with a short search (the tests are the chain, not the optimum).
+commission::CommissionSettings short_commission(const test::HilFiles& f) {
   commission::CommissionSettings s;
   s.config_path = f.config;
   s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
   s.out_dir = f.dir + "/out";
   s.command_line = "test";
   s.robodamp_binary = ROBODAMP_BINARY;
-  s.tune.global_evaluations = 40;  // the test is the chain through the emulator, not the optimum
+  s.tune.global_evaluations = 40;
   s.tune.local_evaluations = 10;
+  return s;
+}
+
+TEST(CommissionHil, ARobotNoPresetDescribesIsCommissionedAndVerifiedThroughTheEmulator) {
+  // Its own socket and port; a shorter plan (3 chirp periods, 4 impacts of 6 s per location).
+  const test::HilFiles f = robot_a_hil("commission", "chirp_periods: 3, chirp_period_s: 8, impacts_per_location: 4, record_s: 6");
+  commission::CommissionSettings s = short_commission(f);
   s.cut_revolutions = 120;
   std::vector<std::string> lines;
   const commission::CommissionResult r = commission::commission(s, [&](const std::string& l) { lines.push_back(l); });
@@ -133,36 +143,13 @@ TEST(CommissionHil, AnEmulatorThatGoesSilentEndsTheCutWithTheReason) {
   EXPECT_NE(what.find("controller connected"), std::string::npos) << what;  // the log's tail
 }
 
-// Robot A behind the emulator's wires, its own socket and port, a shorter plan; `extra` appended.
-test::HilFiles robot_a_hil(const std::string& name, const std::string& extra) {
-  const test::HilFiles f = test::hil_files(name, {{"unix:/tmp/robodamp-hil-commission.sock", "unix:/PLACEHOLDER"}},
-                                           "commissioning/robot_a_two_modes_hil");
-  std::string text = test::read_file(f.config);
-  test::replace_all(text, "unix:/PLACEHOLDER", "unix:" + f.dir + "/can.sock");
-  test::replace_all(text, "port: 1512", "port: " + std::to_string(test::free_tcp_port()));
-  std::ofstream(f.config) << text << "\ncommissioning: {chirp_periods: 3, chirp_period_s: 8}\n" << extra;
-  return f;
-}
-
 // The integrator's modal kit: an impact test of robot A on the simulated plant (another noise seed),
-// exported as a binary universal file with every FRF 2 % off (the kit's calibration), without the actuator.
+// exported with every FRF 2 % off (the kit's calibration), without the actuator (tests/modal_kit.hpp).
 std::string modal_kit_export(const std::string& dir) {
   std::string robot = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes.yaml");
   test::replace_all(robot, "  seed: 1", "  seed: 29");
   std::ofstream(dir + "/kit_robot.yaml") << robot;
-  const commission::MeasureOutcome m = commission::measure(dir + "/kit_robot.yaml", dir + "/kit");
-  EXPECT_EQ(m.status, commission::MeasureStatus::kOk) << m.message;
-  measfiles::UffFile u = measfiles::read_uff(dir + "/kit/" + identify::kMeasurementUffName);
-  std::vector<measfiles::UffFunction> kept;
-  for (auto& fn : u.functions) {
-    if (fn.reference_entity == identify::kVoltageEntity) continue;
-    if (fn.function_type == measfiles::kUffFrf)
-      for (auto& y : fn.y) y *= 1.02;
-    kept.push_back(fn);
-  }
-  u.functions = kept;
-  measfiles::write_uff(dir + "/tap_tests.uff", u, measfiles::UffEncoding::kBinary);
-  return dir + "/tap_tests.uff";
+  return test::modal_kit_export(dir + "/kit_robot.yaml", dir + "/kit", dir + "/tap_tests.uff", 1.02);
 }
 
 // A real cell (the emulator told so: no impacts served, no cut): the actuator is the shaker, the tool tip's
@@ -170,15 +157,8 @@ std::string modal_kit_export(const std::string& dir) {
 // the improvement at the actuator within 5 points of the prediction, the loop gain measured by injection
 // within 1 dB and 5 deg of the analysis.
 TEST(CommissionHil, ARealCellIsCommissionedWithTheActuatorAsTheShakerAndTheUsersTapTests) {
-  const test::HilFiles f = robot_a_hil("commission_real", "");
-  commission::CommissionSettings s;
-  s.config_path = f.config;
-  s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
-  s.out_dir = f.dir + "/out";
-  s.command_line = "test";
-  s.robodamp_binary = ROBODAMP_BINARY;
-  s.tune.global_evaluations = 40;
-  s.tune.local_evaluations = 10;
+  const test::HilFiles f = robot_a_hil("commission_real", "chirp_periods: 3, chirp_period_s: 8");
+  commission::CommissionSettings s = short_commission(f);
   s.tap_tests = {modal_kit_export(f.dir)};
   std::vector<std::string> lines;
   const commission::CommissionResult r = commission::commission(s, [&](const std::string& l) { lines.push_back(l); });
@@ -233,15 +213,11 @@ TEST(CommissionHil, ARealCellIsCommissionedWithTheActuatorAsTheShakerAndTheUsers
 // An amplifier that is not ready when the chirp is due (the emulator's takes 10 s, the loop gives it 2): the
 // commissioning is refused at the measurement, before the actuator moved, and nothing is written.
 TEST(CommissionHil, ARealCellThatIsNotReadyIsRefusedBeforeTheActuatorMoves) {
-  const test::HilFiles f = robot_a_hil("commission_not_ready", "");
+  const test::HilFiles f = robot_a_hil("commission_not_ready", "chirp_periods: 3, chirp_period_s: 8");
   std::string text = test::read_file(f.config);
   test::replace_all(text, "amplifier_ready_delay_s: 0.005", "amplifier_ready_delay_s: 10");
   std::ofstream(f.config) << text;
-  commission::CommissionSettings s;
-  s.config_path = f.config;
-  s.job_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/job_a_two_modes.yaml";
-  s.out_dir = f.dir + "/out";
-  s.robodamp_binary = ROBODAMP_BINARY;
+  commission::CommissionSettings s = short_commission(f);
   std::ofstream(f.dir + "/taps.uff") << "";  // never read: the measurement stops first
   s.tap_tests = {f.dir + "/taps.uff"};
   const commission::CommissionResult r = commission::commission(s, [](const std::string&) {});

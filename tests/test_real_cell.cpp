@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "modal_kit.hpp"
 #include "commission/measurement.hpp"
 #include "commission/real_cell_check.hpp"
 #include "identify/tap_tests.hpp"
@@ -42,25 +43,9 @@ std::string robot_a(const test::ScratchDir& dir, const std::string& name,
   return path;
 }
 
-// A modal kit's export: the FRFs between the locations of a simulated impact test (robodamp measure on the
-// simulated plant), every ordinate scaled by `calibration` (the kit's sensitivity error), written as a
-// binary universal file; the actuator's own record dropped (the kit has no actuator).
+// The modal kit's export of a simulated impact test of `robot` (tests/modal_kit.hpp), in dir.
 std::string tap_test_export(const test::ScratchDir& dir, const std::string& robot, const std::string& name, double calibration) {
-  const std::string out = dir.file(name);
-  const commission::MeasureOutcome m = commission::measure(robot, out);
-  EXPECT_EQ(m.status, commission::MeasureStatus::kOk) << m.message;
-  measfiles::UffFile f = measfiles::read_uff(out + "/" + identify::kMeasurementUffName);
-  std::vector<measfiles::UffFunction> kept;
-  for (auto& fn : f.functions) {
-    if (fn.reference_entity == identify::kVoltageEntity) continue;
-    if (fn.function_type == measfiles::kUffFrf)
-      for (auto& y : fn.y) y *= calibration;
-    kept.push_back(fn);
-  }
-  f.functions = kept;
-  const std::string path = dir.file(name + ".uff");
-  measfiles::write_uff(path, f, measfiles::UffEncoding::kBinary);
-  return path;
+  return test::modal_kit_export(robot, dir.file(name), dir.file(name + ".uff"), calibration);
 }
 
 struct Identified {
@@ -89,7 +74,9 @@ std::string chirp_only(const test::ScratchDir& dir, const std::string& robot, co
   // The actuator's FRF at the sensor, with its coherence, for a modal package: nothing else.
   const measfiles::UffFile u = measfiles::read_uff(out + "/" + identify::kMeasurementUffName);
   EXPECT_EQ(u.functions.size(), 2u);
-  if (!u.functions.empty()) EXPECT_EQ(u.functions[0].reference_entity, identify::kVoltageEntity);
+  if (!u.functions.empty()) {
+    EXPECT_EQ(u.functions[0].reference_entity, identify::kVoltageEntity);
+  }
   return out;
 }
 
