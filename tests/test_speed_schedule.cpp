@@ -28,6 +28,7 @@
 #include "tune/robustness.hpp"
 #include "runtime/cell.hpp"
 #include "test_util.hpp"
+#include "tune/schedule_in_time.hpp"
 #include "tune/scheduled_cut.hpp"
 #include "tune/speed_schedule.hpp"
 
@@ -366,6 +367,35 @@ TEST(ForcedCommand, TheCutsForcedCoilForceMatchesTheSimulatedCutAndCapsTheDepth)
   EXPECT_NEAR(at500.peak_force_n(holding), 36.0, 0.05);
   for (int i = 1; i < 50; ++i) EXPECT_LE(at500.peak_force_n(holding * i / 50.0), 36.0) << "held all the way up to it";
   EXPECT_DOUBLE_EQ(at500.holding_depth_mm(2.0), 2.0) << "held at 2 mm: the depth asked is the answer";
+}
+
+// The schedule's check in time (tune/schedule_in_time.hpp): the default preset's C2 at 2400 N s/m at 390.6 rpm has
+// a sampled-loop SDM limit of 1.214 mm (searched up from the open loop's limit, as the schedule searches it) that
+// the cut in time does not hold at 0.95 x (it chatters from about 1.1 mm); the check lowers it to the time domain's critical depth, which then holds, and keeps a limit that holds.
+TEST(LimitsInTime, ALimitTheCutDoesNotHoldIsLoweredToTheTimeDomainsAndOneItHoldsIsKept) {
+  config::Config c2 = config::load_config_file(test::preset("horizontal_c2"));
+  c2.controller.speed_schedule.reset();
+  const config::MillingConfig job = config::load_milling_config(source("config/milling/active_damping_c2.yaml"));
+  const milling::Structure damped(job.selected_structure(), true,
+                                  {std::make_shared<const analysis::LoopModel>(c2), 2400.0, c2.controller.polarity});
+  const milling::AccurateStability accurate(damped, job);
+  const double rpm = accurate.stepped_rpm(390.6);
+  const auto model = std::make_shared<const analysis::LoopModel>(c2);
+  const milling::Structure open(job.selected_structure(), false, {model, 0.0, c2.controller.polarity});
+  const double open_mm = milling::AccurateStability(open, job).critical(rpm, 0.3).critical_depth_mm;  // the schedule's guess
+  const double sdm_mm = milling::holding_limits_mm(damped, job, {rpm}, {accurate.critical(rpm, open_mm).critical_depth_mm}, 1).front();
+  ASSERT_NEAR(sdm_mm, 1.214, 0.01);
+  const auto first = tune::limits_in_time(job, {{rpm, &damped, sdm_mm}, {rpm, &damped, 1.0}}, 2);
+  ASSERT_EQ(first.size(), 2U);
+  EXPECT_FALSE(first[0].held);
+  EXPECT_LT(first[0].limit_mm, 0.95 * sdm_mm);
+  EXPECT_GT(first[0].limit_mm, 0.8 * sdm_mm);
+  EXPECT_GT(first[0].simulations, 3);
+  EXPECT_TRUE(first[1].held);
+  EXPECT_DOUBLE_EQ(first[1].limit_mm, 1.0);
+  EXPECT_EQ(first[1].simulations, 1);
+  const auto again = tune::limits_in_time(job, {{rpm, &damped, first[0].limit_mm}}, 1);
+  EXPECT_TRUE(again.front().held) << "the lowered limit holds at 0.95 x: " << first[0].limit_mm << " mm";
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "milling/forced_command.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
+#include "tune/schedule_in_time.hpp"
 #include "tune/tuned_file.hpp"
 
 namespace robodamp::tune {
@@ -153,6 +154,12 @@ class Depths {
     }
   }
   [[nodiscard]] double depth(double rpm, std::size_t candidate) const { return cache_.at({rpm, candidate}); }
+  [[nodiscard]] const milling::Structure& structure(std::size_t candidate) const { return *structures_[candidate]; }
+  // Where the cut in time chattered below it (tune/schedule_in_time.hpp), the time domain's limit.
+  void lower(double rpm, std::size_t candidate, double mm) {
+    double& v = cache_.at({rpm, candidate});
+    v = std::min(v, mm);
+  }
   // Damped limits computed, and of them those the actuator's force limit capped (milling/forced_command.hpp).
   [[nodiscard]] std::size_t damped_limits() const { return damped_limits_; }
   [[nodiscard]] std::size_t capped() const { return capped_; }
@@ -312,6 +319,91 @@ std::set<double> refine(Grid& g, Depths& d, std::size_t n_cands, const milling::
   return checked;
 }
 
+// Which speeds of the schedule need a candidate chosen afresh: those whose band's candidate chattered in time
+// at 0.95 x its limit (the limit lowered to the time domain's) or is now worse than the open loop. Cuts in
+// time only where the candidate damps and its limit was not yet checked at that depth.
+class InTime {
+ public:
+  InTime(Depths& d, const config::MillingConfig& job, const ScheduleSettings& s) : d_(d), job_(job), s_(s) {}
+  std::vector<double> to_choose_again(const Grid& g, const std::vector<double>& speeds) {
+    fill_scheduled(d_, g, speeds);
+    std::vector<LimitInTime> todo;
+    std::vector<std::pair<double, std::size_t>> keys;
+    for (double r : speeds)
+      if (const std::size_t c = candidate_at(g, r); c != 0 && checked_depth(r, c) != d_.depth(r, c)) {
+        todo.push_back({r, &d_.structure(c), d_.depth(r, c)});
+        keys.emplace_back(r, c);
+      }
+    if (s_.progress && !todo.empty()) s_.progress("the damped limits in time", 0, todo.size());
+    const std::vector<LimitInTimeResult> res = limits_in_time(job_, todo, s_.threads);
+    std::set<double> again;
+    for (std::size_t i = 0; i < res.size(); ++i) {
+      ++checks_;
+      checked_[keys[i]] = d_.depth(keys[i].first, keys[i].second);  // a lowered limit is checked again if chosen again
+      if (res[i].held) continue;
+      lowered_.push_back({keys[i].first, keys[i].second, d_.depth(keys[i].first, keys[i].second), res[i].limit_mm});
+      d_.lower(keys[i].first, keys[i].second, res[i].limit_mm);
+      again.insert(keys[i].first);
+    }
+    for (double r : speeds)
+      if (d_.depth(r, candidate_at(g, r)) < d_.depth(r, 0) * (1.0 - 0.01 * s_.worse_tolerance_pct)) again.insert(r);
+    return {again.begin(), again.end()};
+  }
+  [[nodiscard]] std::size_t checks() const { return checks_; }
+  [[nodiscard]] const std::vector<LoweredLimit>& lowered() const { return lowered_; }
+
+ private:
+  double checked_depth(double rpm, std::size_t c) const {
+    const auto it = checked_.find({rpm, c});
+    return it == checked_.end() ? -1.0 : it->second;
+  }
+  Depths& d_;
+  const config::MillingConfig& job_;
+  const ScheduleSettings& s_;
+  std::map<std::pair<double, std::size_t>, double> checked_;
+  std::size_t checks_{0};
+  std::vector<LoweredLimit> lowered_;
+};
+
+// The schedule's damped limits in time, for refine_rounds rounds: where a speed needs a candidate chosen
+// afresh it joins the grid (every candidate computed there); after the last round, the open loop's (K = 0).
+// Then the limits are checked once more, and what is lowered then is reported in the summary, never hidden.
+void check_in_time(SpeedSchedule& out, Grid& g, std::set<double>& checked, Depths& d, const config::MillingConfig& job,
+                   double job_rpm, double lo, double hi) {
+  const ScheduleSettings& s = out.settings;
+  InTime in_time(d, job, s);
+  auto speeds = [&] {
+    std::set<double> all(g.rpm.begin(), g.rpm.end());
+    all.insert(checked.begin(), checked.end());
+    if (job_rpm > 0.0) all.insert(job_rpm);
+    return std::vector<double>(all.begin(), all.end());
+  };
+  for (int round = 0; round <= s.refine_rounds; ++round) {
+    const std::vector<double> again = in_time.to_choose_again(g, speeds());
+    if (again.empty()) break;
+    const bool last = round == s.refine_rounds;
+    if (!last) d.fill(again, every(out.candidates.size()), "choosing again after the cuts in time");
+    for (double r : again) {
+      const std::size_t c = last ? 0 : choose(d, r, out.candidates.size(), std::nullopt, s);
+      const auto at = std::lower_bound(g.rpm.begin(), g.rpm.end(), r);
+      const auto i = static_cast<std::size_t>(at - g.rpm.begin());
+      if (at != g.rpm.end() && *at == r) {
+        g.choice[i] = c;
+      } else {
+        g.rpm.insert(at, r);
+        g.choice.insert(g.choice.begin() + static_cast<std::ptrdiff_t>(i), c);
+        checked.erase(r);
+        ++out.refined_speeds;
+      }
+    }
+    fit_band_count(g, d, out.candidates, lo, hi);
+  }
+  (void)in_time.to_choose_again(g, speeds());
+  out.limits_in_time = in_time.checks();
+  out.lowered_in_time = in_time.lowered().size();
+  out.lowered = in_time.lowered();
+}
+
 }  // namespace
 
 namespace {
@@ -392,13 +484,14 @@ SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<Name
   for (std::size_t i = 0; i < g.rpm.size(); ++i)
     g.choice.push_back(choose(d, g.rpm[i], out.candidates.size(), i ? std::optional(g.choice[i - 1]) : std::nullopt, s));
   fit_band_count(g, d, out.candidates, lo, hi);
-  const std::set<double> checked = refine(g, d, out.candidates.size(), damped, s, out.refined_speeds);
+  std::set<double> checked = refine(g, d, out.candidates.size(), damped, s, out.refined_speeds);
   fit_band_count(g, d, out.candidates, lo, hi);
+  const double job_rpm = job.cut.spindle_rpm > 0.0 && job.cut.spindle_rpm <= damped.max_rpm() ? damped.stepped_rpm(job.cut.spindle_rpm) : 0.0;
+  if (job_rpm > 0.0) d.fill({job_rpm}, {0, d.fixed()}, "the job's speed");
+  check_in_time(out, g, checked, d, job, job_rpm, lo, hi);
 
   std::vector<double> speeds(g.rpm.begin(), g.rpm.end());
   speeds.insert(speeds.end(), checked.begin(), checked.end());
-  const double job_rpm = job.cut.spindle_rpm > 0.0 && job.cut.spindle_rpm <= damped.max_rpm() ? damped.stepped_rpm(job.cut.spindle_rpm) : 0.0;
-  if (job_rpm > 0.0) d.fill({job_rpm}, {0, d.fixed()}, "the job's speed");
   d.fill(speeds, {0, d.fixed()}, "checking the bands");
   fill_scheduled(d, g, job_rpm > 0.0 ? std::vector<double>{job_rpm} : std::vector<double>{});
   fill_scheduled(d, g, speeds);

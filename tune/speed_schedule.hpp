@@ -89,6 +89,14 @@ struct ScheduleSummary {
   double job_rpm{0.0}, job_open_mm{0.0}, job_fixed_mm{0.0}, job_scheduled_mm{0.0};
 };
 
+// A damped limit the cut in time did not hold at 0.95 x (tune/schedule_in_time.hpp).
+struct LoweredLimit {
+  double rpm{0.0};
+  std::size_t candidate{0};
+  double accurate_mm{0.0};  // the accurate method's
+  double time_mm{0.0};      // the time domain's critical depth there: the limit used
+};
+
 struct SpeedSchedule {
   std::string method;  // of the depths
   ScheduleSettings settings;
@@ -97,6 +105,10 @@ struct SpeedSchedule {
   std::vector<config::SpeedBandConfig> bands;  // controller: index into controllers
   std::vector<ScheduleSpeed> speeds;           // ascending: the grid and the checks
   std::size_t refined_speeds{0};               // checks that failed and became grid speeds
+  // The damped limits of the schedule's speeds checked in time (tune/schedule_in_time.hpp): cuts at 0.95 x the
+  // limit, and of them those that chattered (the limit lowered to the time domain's, the speed chosen again).
+  std::size_t limits_in_time{0}, lowered_in_time{0};
+  std::vector<LoweredLimit> lowered;
   // Damped limits computed, and of them those capped where the cut's forced vibration drives the actuator to
   // its force limit (milling/forced_command.hpp): the linear stability analysis assumes an unlimited actuator.
   std::size_t damped_limits{0}, capped_limits{0};
