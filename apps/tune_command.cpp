@@ -34,6 +34,7 @@ struct TuneArgs {
   std::string plot_dir, plot_path;
   std::vector<std::string> also_paths;  // more plants: the worst case is tuned
   std::optional<double> shift_pct;      // each plant also with its modes shifted by -/+ this
+  std::string start_path;               // resume from this configuration's tuned compensator, K and polarity
   tune::TuneSettings settings;
 };
 
@@ -85,6 +86,7 @@ std::string command_line(const TuneArgs& a) {
   std::string c = "robodamp tune --config " + a.config_path + (a.job_path.empty() ? "" : " --job " + a.job_path);
   for (const auto& p : a.also_paths) c += " --also " + p;
   if (a.shift_pct) c += " --shift-pct " + num(*a.shift_pct);
+  if (!a.start_path.empty()) c += " --start " + a.start_path;
   const tune::TuneSettings& s = a.settings;
   if (s.gain_margin_min_db != d.gain_margin_min_db) c += " --gain-margin-db " + num(s.gain_margin_min_db);
   if (s.phase_margin_min_deg != d.phase_margin_min_deg) c += " --phase-margin-deg " + num(s.phase_margin_min_deg);
@@ -101,7 +103,7 @@ std::string command_line(const TuneArgs& a) {
 }
 
 // The written file's header: where it comes from, the command that writes it again, and what was verified.
-std::string tuned_header(const TuneArgs& a, const std::optional<tune::Verification>& v) {
+std::string tuned_header(const TuneArgs& a, const std::optional<tune::Verification>& v, bool scheduled) {
   std::ostringstream h;
   h << "# robodamp tune wrote this (docs/tuning.md) from " << a.config_path;
   if (!a.job_path.empty()) h << " for " << a.job_path;
@@ -115,6 +117,9 @@ std::string tuned_header(const TuneArgs& a, const std::optional<tune::Verificati
                   v->speed_rpm, v->time_domain_at_min_mm, v->time_domain_at_speed_mm);
     h << b;
   }
+  if (scheduled)
+    h << "# " << a.config_path << "'s controller.speed_schedule is not kept: it chose K for the controller tuned here "
+         "(robodamp schedule writes one for this file).\n";
   h << "# Everything else is " << a.config_path << "'s, whose header follows.\n#\n";
   return h.str();
 }
@@ -244,6 +249,16 @@ std::string plot_lobes(const tune::Evaluator& p, const std::vector<Compared>& ro
   return run_gnuplot(s.str(), data.str(), path);
 }
 
+// --start's candidate: a configuration robodamp tune wrote (its chain's rational compensator, K, polarity).
+tune::Candidate start_candidate(const std::string& path) {
+  const config::Config c = config::load_config_file(path);
+  if (const auto start = tune::candidate_of(c)) return *start;
+  throw config::ConfigError({config::Problem{path, {}, "--start",
+                              "--start " + path + ": its chain's compensator is not the form robodamp tune writes (model: "
+                              "rational, a cubic over a cubic with every root in the left half plane); start from a "
+                              "file robodamp tune wrote, or leave --start out"}});
+}
+
 // 0 tuned and written (or no --out), 3 no candidate met every constraint (nothing written), 2 bad input.
 int run_tune(const TuneArgs& a) {
   std::optional<config::MillingConfig> job;
@@ -251,7 +266,9 @@ int run_tune(const TuneArgs& a) {
   const std::vector<tune::Evaluator> plants = make_plants(a, job);
   std::vector<const tune::Evaluator*> refs;
   for (const auto& p : plants) refs.push_back(&p);
-  const tune::TuneResult r = tune::tune(refs, a.settings, [](const std::string& l) { std::cerr << l << '\n'; });
+  const auto progress = [](const std::string& l) { std::cerr << l << '\n'; };
+  const tune::TuneResult r = a.start_path.empty() ? tune::tune(refs, a.settings, progress)
+                                                  : tune::tune_from(refs, start_candidate(a.start_path), a.settings, progress);
   std::printf("robodamp tune: %s%s, %zu plant%s, %zu evaluations\n", a.config_path.c_str(),
               job ? (" on " + a.job_path).c_str() : "", plants.size(), plants.size() == 1 ? "" : "s", r.history.size());
   json report{{"config", a.config_path}, {"also", a.also_paths}, {"job", a.job_path}, {"best", evaluation_json_with_plants(r.best)}};
@@ -313,7 +330,7 @@ int run_tune(const TuneArgs& a) {
                    a.config_path.c_str());
     // Written beside another file than the one read: its relative file paths rebased (config/file_paths.hpp).
     const std::string text =
-        tuned_header(a, verified) + config::rebase_file_paths(edited.text, plants.front().base().source, a.out_path).text;
+        tuned_header(a, verified, plants.front().base().controller.speed_schedule.has_value()) + config::rebase_file_paths(edited.text, plants.front().base().source, a.out_path).text;
     const config::Config check = config::parse_config(text, a.out_path);  // throws (exit 2) before writing
     if (!analysis::LoopModel(check).stable(check.controller.gain_ns_per_m, check.controller.polarity))
       throw std::runtime_error("the written configuration's loop is not stable: nothing written");
@@ -345,6 +362,10 @@ void register_tune(Registry& r) {
       ->check(CLI::ExistingFile);
   r.number(sub, "--shift-pct", a->shift_pct, {"%", 0.0, 50.0, true},
            "Also tune for every plant with all its modal frequencies shifted down and up by this");
+  sub->add_option("--start", a->start_path,
+                  "Resume from this configuration's tuned compensator, K and polarity (a file robodamp tune wrote): the "
+                  "search at its polarity from it, never worse than it")
+      ->check(CLI::ExistingFile);
   r.number(sub, "--impact-n", a->settings.impact_peak_n, {"N", 0.0, 100000.0},
            "The impact (half-sine at every location) the actuator's limits must hold for; default the configuration's "
            "bench.impact_peak_n, 0 = no such constraint");

@@ -112,7 +112,11 @@ std::optional<Splice> splice_for(const std::string& t, const YAML::Node& root, c
   if (at.IsDefined()) {
     const std::size_t end = node_end(t, at);
     if (end == kUnknown) return std::nullopt;
-    return Splice{static_cast<std::size_t>(at.Mark().pos), end, flow(e.value)};
+    Splice s{static_cast<std::size_t>(at.Mark().pos), end, flow(e.value)};
+    const std::size_t line_end = std::min(t.find('\n', end), t.size());
+    const std::size_t rest = t.find_first_not_of(" \t", end);
+    if (!e.comment.empty() && (rest >= line_end || t[rest] == '#')) s.to = line_end, s.text += "   # " + e.comment;
+    return s;
   }
   // A missing key: added to its mapping.
   const auto* key = std::get_if<std::string>(&e.path.back());

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -20,8 +21,13 @@ namespace robodamp::config {
 using YamlPathItem = std::variant<std::string, std::size_t>;
 
 struct YamlEdit {
+  YamlEdit(std::vector<YamlPathItem> p, YAML::Node v, std::string c = {})
+      : path(std::move(p)), value(std::move(v)), comment(std::move(c)) {}
   std::vector<YamlPathItem> path;
   YAML::Node value;
+  // When not empty and the value ends its line: the line's comment becomes "# " + comment (the old one said
+  // where the replaced value came from).
+  std::string comment;
 };
 
 struct EditedYaml {

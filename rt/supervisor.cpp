@@ -317,6 +317,7 @@ TickOutput Supervisor::step(const TickInput& in) noexcept {
   out.trip = trip_;
   observed_state_.store(state_, std::memory_order_relaxed);
   observed_trip_.store(trip_, std::memory_order_relaxed);
+  running_set_.store(controller_.params().set_index, std::memory_order_relaxed);
   return out;
 }
 

@@ -184,6 +184,9 @@ class Supervisor {
   [[nodiscard]] double gain_limit_ns_per_m() const noexcept { return max_gain_ns_per_m(); }
   // Safe to read from any thread (relaxed atomic; DDS status and parameter requests read it).
   [[nodiscard]] std::size_t active_parameter_set() const noexcept { return active_set_.load(std::memory_order_relaxed); }
+  // The set whose chain acts now: during a hand-over the outgoing one (fading out, then at K = 0 while the
+  // incoming chain warms up) until the swap; the live limits are for this chain at the K it runs (any thread).
+  [[nodiscard]] std::size_t running_parameter_set() const noexcept { return running_set_.load(std::memory_order_relaxed); }
 
   // RT-safe.
   [[nodiscard]] TickOutput step(const TickInput& in) noexcept;
@@ -262,6 +265,7 @@ class Supervisor {
   SupervisorSettings s_;
   std::vector<ParameterSet> sets_;  // [0]: the set it starts with
   std::atomic<std::size_t> active_set_{0};
+  std::atomic<std::size_t> running_set_{0};
   std::atomic<State> observed_state_{State::kDisabled};
   std::atomic<Trip> observed_trip_{Trip::kNone};
   control::Controller controller_;

@@ -122,7 +122,7 @@ Status Cell::compose_devices() {
   if (cfg_.spindle.job.empty()) return {};
   try {
     machining_ = std::make_unique<MachiningMonitor>(
-        cfg_, set_configs_, [this] { return supervisor_->active_parameter_set(); },
+        cfg_, set_configs_, [this] { return supervisor_->running_parameter_set(); },
         [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
           if (modbus_)
             modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,

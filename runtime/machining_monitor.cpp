@@ -65,8 +65,9 @@ std::pair<std::size_t, double> MachiningMonitor::set_and_gain() {
   std::size_t set = active_set_ ? active_set_() : 0;
   if (set >= set_configs_.size()) set = 0;
   std::lock_guard<std::mutex> lock(m_);
-  // The damper's limit at the gain it has (ramping included, 0 included: a speed schedule's open-loop band), or,
-  // while it is off, at the set's gain at this speed (controller.speed_schedule).
+  // The damper's limit for the chain that runs (during a hand-over the outgoing one, fading to K = 0 while the
+  // incoming one warms up) at the gain it has (ramping included, 0 included: a speed schedule's open-loop band),
+  // or, while it is off, at the set's gain at this speed (controller.speed_schedule).
   const bool active = static_cast<rt::State>(last_.state) == rt::State::kActive;
   return {set, active ? last_.gain_ns_per_m : config::scheduled_gain_ns_per_m(set_configs_[set], set, rpm_)};
 }

@@ -252,10 +252,12 @@ TEST(PoseSchedule, SupervisorArmsOnlyInARegionFollowsThePoseAndTripsOutOfTheMap)
   EXPECT_EQ(sup.last_arm_refusal(), rt::ArmRefusal::kPoseUnknown);
   run(10, {rt::CommandKind::kSetPoseRegion, 1.0});  // stretched: hand-over from set 0
   EXPECT_EQ(sup.active_parameter_set(), 1u);
+  EXPECT_EQ(sup.running_parameter_set(), 0u) << "set 0's chain runs until the swap (the live limits are its)";
   run(10, {rt::CommandKind::kArm, 0.0});
   EXPECT_EQ(sup.last_arm_refusal(), rt::ArmRefusal::kPoseUnknown) << "armed during the hand-over";
   run(100000);  // the hand-over's fade and the new chain's settling
   ASSERT_FALSE(sup.controller().handover_pending());
+  EXPECT_EQ(sup.running_parameter_set(), 1u) << "swapped";
   run(2000, {rt::CommandKind::kArm, 0.0});
   EXPECT_EQ(sup.state(), rt::State::kActive);
   run(10, {rt::CommandKind::kSetPoseRegion, 0.0});  // back to folded while active

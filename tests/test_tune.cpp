@@ -4,8 +4,14 @@
 // depths, and the refusals.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <complex>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+#include <sstream>
 #include <string>
 
 #include "analysis/bench_run.hpp"
@@ -439,6 +445,7 @@ TEST(Tune, TheTunedFileReadsBackFromEveryPresetInEveryStyle) {
       const config::Config got = config::parse_config(out.text, test::preset(name));
       EXPECT_EQ(got.controller.gain_ns_per_m, want.controller.gain_ns_per_m) << name << " " << style;
       EXPECT_EQ(got.controller.polarity, -1) << name << " " << style;
+      EXPECT_FALSE(got.controller.speed_schedule) << name << " " << style << ": the schedule chose K for the chain replaced";
       ASSERT_EQ(got.controller.chain.size(), want.controller.chain.size()) << name << " " << style;
       for (std::size_t i = 0; i < got.controller.chain.size(); ++i) {
         const auto& g = got.controller.chain[i];
@@ -467,4 +474,64 @@ TEST(Tune, TheTunedFileReadsBackFromEveryPresetInEveryStyle) {
   }
   EXPECT_EQ(files, 21);
 }
+}  // namespace robodamp
+
+namespace robodamp {
+namespace {
+
+// The numbers of a tune header's "Verified" lines: the minimum, its speed, the depth at the job's speed, that
+// speed, and the time-domain cut's two depths.
+std::vector<double> tune_promises(const std::string& text) {
+  std::vector<double> out;
+  const auto from = text.find("# Verified (", text.find("# robodamp tune wrote this"));
+  const auto to = text.find(" there.", from);
+  const std::string block = text.substr(from, to - from);
+  const std::regex number(R"([0-9]+\.[0-9]+)");
+  for (auto it = std::sregex_iterator(block.begin(), block.end(), number); it != std::sregex_iterator(); ++it)
+    out.push_back(std::stod(it->str()));
+  return out;
+}
+
+// The search resumes from a file robodamp tune wrote: its compensator read back as the candidate gives the
+// same controller (the same loop, the same K), and a preset in C1's form has none.
+TEST(Tune, ACandidateReadBackFromATunedFileIsTheSameController) {
+  const config::Config tuned = config::load_config_file(test::preset("tuned_horizontal"));
+  const auto c = tune::candidate_of(tuned);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->polarity, tuned.controller.polarity);
+  EXPECT_DOUBLE_EQ(c->gain_ns_per_m, tuned.controller.gain_ns_per_m);
+  const config::Config again = tune::with_candidate(tuned, *c);
+  const analysis::LoopModel a(tuned), b(again);
+  for (const double f_hz : {1.0, 9.2, 21.0, 23.5, 100.0})
+    EXPECT_NEAR(std::abs(b.chain().chain_digital(f_hz) / a.chain().chain_digital(f_hz) - 1.0), 0.0, 1e-9) << f_hz << " Hz";
+  EXPECT_FALSE(tune::candidate_of(config::load_config_file(test::preset("horizontal_c1"))));
+}
+
+// Each tuned preset's recorded command (the line after "# robodamp tune wrote this") run again writes the same
+// promises within 1 %: the minimum and the depth at the job's speed, by the accurate method and in time.
+TEST(Tune, EachTunedPresetsRecordedCommandWritesItAgain) {
+  const std::string dir = ::testing::TempDir() + "robodamp_tune_rerun_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  for (const std::string name : {"tuned_horizontal", "tuned_vertical"}) {
+    const std::string text = test::read_file(test::preset(name));
+    std::istringstream lines(text.substr(text.find("# robodamp tune wrote this")));
+    std::string first, command;
+    std::getline(lines, first);
+    std::getline(lines, command);
+    ASSERT_EQ(command.rfind("#   robodamp tune ", 0), 0U) << name;
+    command = command.substr(std::string("#   robodamp ").size());
+    const std::string out = dir + "/" + name + ".yaml";
+    command = std::regex_replace(command, std::regex(" --out \\S+$"), " --out " + out);
+    const std::string run = "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + command + " > " + dir +
+                            "/log.txt 2>&1";
+    ASSERT_EQ(std::system(run.c_str()), 0) << run << "\n" << test::read_file(dir + "/log.txt");
+    const std::vector<double> was = tune_promises(text), now = tune_promises(test::read_file(out));
+    ASSERT_EQ(was.size(), 6U) << name;
+    ASSERT_EQ(now.size(), was.size()) << name;
+    for (std::size_t i = 0; i < was.size(); ++i) EXPECT_NEAR(now[i], was[i], 0.01 * std::abs(was[i])) << name << " #" << i;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
 }  // namespace robodamp

@@ -4,6 +4,7 @@
 #include <nlopt.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstdio>
@@ -122,6 +123,45 @@ std::complex<double> compensator_response(const Candidate& c, double f_hz) {
 double compensator_gain_ratio(const Candidate& c, double match_hz, double nyquist_hz) {
   const auto [num, den] = candidate_rational(c);
   return largest_gain_ratio(rational(num, den), match_hz, nyquist_hz);
+}
+
+namespace {
+
+// A cubic's roots as the search's second-order pair (f, zeta) and first-order corner f: the pair is the complex
+// pair, or of three real roots the two nearest each other.
+std::optional<std::array<double, 3>> pair_and_corner(const std::vector<double>& descending) {
+  if (descending.size() != 4 || descending.front() == 0.0) return std::nullopt;
+  std::vector<std::complex<double>> r = filters::Polynomial::from_descending(descending).roots();
+  if (r.size() != 3) return std::nullopt;
+  for (const auto& x : r)
+    if (!(x.real() < 0.0)) return std::nullopt;
+  std::size_t lone = 0;  // the real root left over
+  double closest = kInf;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& a = r[(i + 1) % 3];
+    const auto& b = r[(i + 2) % 3];
+    const bool conjugate = std::abs(a - std::conj(b)) <= 1e-9 * std::abs(a) && a.imag() != 0.0;
+    const double d = conjugate ? -1.0 : std::abs(a - b);
+    if (r[i].imag() == 0.0 && d < closest) closest = d, lone = i;
+  }
+  const auto& a = r[(lone + 1) % 3];
+  const auto& b = r[(lone + 2) % 3];
+  const double w = std::sqrt(std::abs(a * b));
+  return std::array<double, 3>{w / kTwoPi, -(a + b).real() / (2.0 * w), -r[lone].real() / kTwoPi};
+}
+
+}  // namespace
+
+std::optional<Candidate> candidate_of(const config::Config& cfg) {
+  for (const auto& b : cfg.controller.chain) {
+    if (b.kind != config::BlockKind::kCompensator) continue;
+    if (b.model != config::CompensatorModel::kRational) return std::nullopt;
+    const auto zeros = pair_and_corner(b.numerator), poles = pair_and_corner(b.denominator);
+    if (!zeros || !poles) return std::nullopt;
+    return Candidate{cfg.controller.gain_ns_per_m, (*zeros)[0], (*zeros)[1], (*poles)[0], (*poles)[1],
+                     (*zeros)[2], (*poles)[2], cfg.controller.polarity};
+  }
+  return std::nullopt;
 }
 
 double unity_gain_hz(const config::Config& cfg) {

@@ -59,6 +59,11 @@ inline constexpr double kZetaMin = 0.05, kZetaMax = 1.5;
 // The same controller (compensator and gain) with K stated at to_hz instead of from_hz: a set tuned with one
 // match frequency, as a start for a configuration with another; K kept inside the search's range.
 [[nodiscard]] Candidate restated(const Candidate& c, double from_hz, double to_hz);
+// The candidate a configuration runs: its chain's rational compensator of the search's form (a cubic over a
+// cubic: one pair of zeros or of real roots and one real root each, in the left half plane), its gain and
+// polarity; what `robodamp tune --start` resumes from. Nothing when the chain's compensator is not of that form
+// (C1, C2, C3, or another order).
+[[nodiscard]] std::optional<Candidate> candidate_of(const config::Config& cfg);
 // The match frequency (controller.match_freq_hz, else the dominant robot mode).
 [[nodiscard]] double unity_gain_hz(const config::Config& cfg);
 // The configuration with the candidate's compensator, gain and polarity. Throws config::ConfigError when

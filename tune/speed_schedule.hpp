@@ -133,6 +133,13 @@ struct NamedController {
 // The schedule as the configuration's controller.speed_schedule, in the cell's text (config/yaml_edit.hpp),
 // other controllers' paths relative to the cell's folder (config::rebase_file_paths moves them with the
 // file). Throws std::invalid_argument when the text cannot be edited to read back.
+// The text without its controller.speed_schedule block (the key's line and every line indented deeper): a file
+// scheduled again, or tuned (the schedule chose K for the controller the tune replaces).
+[[nodiscard]] std::string without_schedule_block(const std::string& text);
+// And without the header robodamp schedule wrote on top of it (from "# robodamp schedule wrote" to its "# Everything
+// else is ...'s, whose header follows." and the "#" line after), when the text starts with one.
+[[nodiscard]] std::string without_schedule(const std::string& text);
+
 [[nodiscard]] config::EditedYaml scheduled_config_text(const config::Config& cell, const SpeedSchedule& s);
 
 }  // namespace robodamp::tune

@@ -48,8 +48,7 @@ std::string schedule_block(const std::string& indent, const SpeedSchedule& s) {
 
 }  // namespace
 
-// The text without an existing controller.speed_schedule block (a file scheduled again): its key's line and
-// every line indented deeper, so the new schedule is written in the block form again, not as an edit in place.
+// So the new schedule is written in the block form again, not as an edit in place.
 std::string without_schedule_block(const std::string& text) {
   std::istringstream in(text);
   std::ostringstream out;
@@ -78,6 +77,23 @@ std::string without_schedule_block(const std::string& text) {
     out << line << '\n';
   }
   return out.str();
+}
+
+std::string without_schedule(const std::string& text) {
+  std::string out = without_schedule_block(text);
+  if (YAML::Node doc = YAML::Load(out); doc["controller"].IsMap() && doc["controller"]["speed_schedule"]) {
+    doc["controller"].remove("speed_schedule");  // not in block style: the document emitted again, without it
+    YAML::Emitter e;
+    e << doc;
+    return std::string(e.c_str()) + "\n";
+  }
+  if (out.rfind("# robodamp schedule wrote", 0) != 0) return out;
+  const std::size_t end = out.find("# Everything else is ");
+  if (end == std::string::npos) return out;
+  std::size_t next = out.find('\n', end);
+  next = next == std::string::npos ? out.size() : next + 1;
+  if (out.compare(next, 2, "#\n") == 0) next += 2;
+  return out.substr(next);
 }
 
 config::EditedYaml scheduled_config_text(const config::Config& cell_in, const SpeedSchedule& s) {

@@ -15,7 +15,8 @@ namespace robodamp::tune {
 [[nodiscard]] std::string exact(double x);
 
 // base: a configuration with a compensator in its chain (Evaluator refuses one without); base.yaml_text is
-// edited. Throws std::invalid_argument when the text cannot be edited to read back.
+// edited, without its controller.speed_schedule (it chose K for the controller the tune replaces; run robodamp
+// schedule on the tuned file). Throws std::invalid_argument when the text cannot be edited to read back.
 [[nodiscard]] config::EditedYaml tuned_config_text(const config::Config& base, const Candidate& c);
 
 }  // namespace robodamp::tune
