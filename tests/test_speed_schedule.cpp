@@ -421,7 +421,7 @@ std::vector<double> promises(const std::string& text) {
 TEST(SpeedSchedule, EachScheduledPresetsRecordedCommandWritesItAgain) {
   const std::string dir = ::testing::TempDir() + "robodamp_schedule_rerun_" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
-  for (const std::string name : {"horizontal_c2", "tuned_horizontal"}) {
+  for (const std::string name : {"horizontal_c2", "tuned_horizontal", "tuned_vertical"}) {
     const std::string text = test::read_file(test::preset(name));
     std::istringstream lines(text);
     std::string first, command;
