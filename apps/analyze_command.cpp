@@ -13,6 +13,7 @@
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
 #include "milling/live_stability.hpp"
+#include "tune/robustness.hpp"
 #include "apps/gnuplot.hpp"
 #include <memory>
 
@@ -383,6 +384,25 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
   return os.str();
 }
 
+// How far the loop holds as the modes move (tune/robustness.hpp), with a warning under +-5 %.
+std::string robustness_section(const config::Config& cfg, json& report) {
+  const tune::Robustness rb = tune::robustness(cfg);
+  report["robustness"] = {{"down_pct", rb.down.pct}, {"up_pct", rb.up.pct}, {"down_reason", rb.down.reason},
+                          {"up_reason", rb.up.reason}, {"warn_below_pct", tune::kRobustShiftWarnPct}};
+  char line[160];
+  std::snprintf(line, sizeof line, "  modes shifted together: the loop stays stable and damps its modes from -%.1f %% to +%.1f %%",
+                rb.down.pct, rb.up.pct);
+  std::string out = line;
+  for (const auto* s : {&rb.down, &rb.up})
+    if (!s->reason.empty()) out += "; " + s->reason;
+  if (rb.pct() < tune::kRobustShiftWarnPct) {
+    std::snprintf(line, sizeof line, "\n  WARNING: robust to only +-%.1f %% of mode shift (under +-%.0f %%: a pose or tool change may "
+                  "move the modes further)", rb.pct(), tune::kRobustShiftWarnPct);
+    out += line;
+  }
+  return out + "\n";
+}
+
 // 0 stable, 3 unstable at the configured K, 1 plot failed.
 int run_analyze(const AnalyzeArgs& a) {
   if (a.spindle_sweep) return print_speed_map(config::load_config_file(a.config_path), a.json);
@@ -392,7 +412,8 @@ int run_analyze(const AnalyzeArgs& a) {
   const auto result = analysis::analyse(model);
   auto report = analysis_report(model, result);
   add_job_limits(model, a.spindle_rpm, report);
-  std::string table = analysis_table(report) + speed_schedule_section(model.config(), report);
+  std::string table = analysis_table(report) + (result.stable ? robustness_section(model.config(), report) : std::string()) +
+                      speed_schedule_section(model.config(), report);
   const std::string job = !a.job_path.empty() ? a.job_path : model.config().spindle.job_resolved;
   if (!job.empty() && result.stable) {
     const milling::CutVerdict v = milling::cut_verdict(model.config(), config::load_milling_config(job), a.cut_speeds);

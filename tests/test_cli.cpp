@@ -160,6 +160,27 @@ TEST(Cli, AnalyzeJsonHasTheDocumentedShapeAndPlots) {
   std::filesystem::remove_all(dir);
 }
 
+// How far the loop holds as the modes move is stated, and a weak point is a warning: C2 at 2000 N s/m holds the
+// whole +-20 %; at 4600 N s/m (0.96 x K_max) the modes 4.5 % lower make it unstable.
+TEST(Cli, AnalyzeSaysHowFarTheModesMayMoveAndWarnsUnderFivePercent) {
+  const Result easy = run("analyze --config " + robodamp::test::preset("horizontal_c2"));
+  ASSERT_EQ(easy.status, 0) << easy.out;
+  EXPECT_NE(easy.out.find("damps its modes from -20.0 % to +20.0 %"), std::string::npos) << easy.out;
+  EXPECT_EQ(easy.out.find("WARNING: robust to only"), std::string::npos) << easy.out;
+  std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
+  robodamp::test::replace_or_throw(yaml, "gain_ns_per_m: 2000 ", "gain_ns_per_m: 4600 ");
+  const std::string path = temp_path("tight.yaml");
+  std::ofstream(path) << yaml;
+  const Result tight = run("analyze --config " + path + " --json");
+  ASSERT_EQ(tight.status, 0) << tight.out;
+  const auto j = nlohmann::json::parse(tight.out.substr(0, tight.out.rfind("}\n") + 1));
+  EXPECT_DOUBLE_EQ(j["robustness"]["down_pct"].get<double>(), 4.0);
+  EXPECT_EQ(j["robustness"]["down_reason"], "at -4.5 %: the loop unstable");
+  const Result text = run("analyze --config " + path);
+  EXPECT_NE(text.out.find("WARNING: robust to only +-4.0 % of mode shift"), std::string::npos) << text.out;
+  std::filesystem::remove(path);
+}
+
 TEST(Cli, AnalyzeReportsAnUnstableConfigurationWithItsOwnExitCode) {
   std::string yaml = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
   yaml.replace(yaml.find("gain_ns_per_m: 2000"), 19, "gain_ns_per_m: 9000");
