@@ -105,7 +105,9 @@ std::string machining_view(const msg::Machining& m) {
   else if (m.limits_ready())
     limits = "open " + mm(m.open_limit_mm()) + " (SDM), damped " + mm(m.damped_limit_mm()) + " (" + m.limit_method() + "); now " + mm(m.limit_mm()) +
              (m.loop_active() ? " (damper active)" : " (damper off)") +
-             (m.depth_warning() ? "  WARNING: depth above the limit" : "  depth within");
+             (m.depth_warning() ? (m.depth_measured() ? "  WARNING: depth above the limit"
+                                                      : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
+                                : "  depth within");
   std::string indicator = "-";
   if (m.indicator_valid()) {
     char c[200];
@@ -116,10 +118,11 @@ std::string machining_view(const msg::Machining& m) {
     indicator = "collecting revolutions";
   }
   std::snprintf(b, sizeof b,
-                "  spindle    %.0f rpm (tooth passing %.1f Hz), depth %.3f mm\n"
+                "  spindle    %.0f rpm (tooth passing %.1f Hz), depth %.3f mm%s\n"
                 "  stability  %s\n"
                 "  chatter    %s\n",
-                m.spindle_rpm(), m.tooth_passing_hz(), m.depth_mm(), limits.c_str(), indicator.c_str());
+                m.spindle_rpm(), m.tooth_passing_hz(), m.depth_mm(), m.depth_measured() ? " (the robot's)" : " (the job's plan)",
+                limits.c_str(), indicator.c_str());
   return b;
 }
 

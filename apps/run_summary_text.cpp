@@ -181,6 +181,7 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                       {"limits_ready", m.limits_ready},       {"open_limit_mm", finite(m.open_limit_mm)},
                       {"damped_limit_mm", finite(m.damped_limit_mm)}, {"limit_method", m.limit_method}, {"loop_active", m.loop_active},
                       {"limit_mm", finite(m.limit_mm)},       {"depth_warning", m.depth_warning},
+                      {"depth_measured", m.depth_measured},
                       {"indicator_valid", m.indicator_valid}, {"once_per_rev_ratio", m.once_per_rev_ratio},
                       {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
                       {"chatter", m.chatter}};
@@ -335,7 +336,10 @@ std::string summary_text(const runtime::RunSummary& s) {
                     "  machining at the end: %.0f rpm, depth %.3f mm; limit open %.3f mm (SDM), damped %.3f mm (%s)%s; chatter "
                     "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)\n",
                     m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm, m.limit_method.c_str(),
-                    !m.limits_ready ? " (not computed)" : m.depth_warning ? ": WARNING, depth above the limit" : "",
+                    !m.limits_ready   ? " (not computed)"
+                    : !m.depth_warning ? ""
+                    : m.depth_measured ? ": WARNING, depth above the limit"
+                                       : ": WARNING, the job's planned depth is above the limit (the robot reports no depth)",
                     !m.indicator_valid ? "not ready" : m.chatter ? "CHATTER" : "quiet", m.once_per_rev_ratio,
                     100.0 * m.nonharmonic_share);
       os << b;

@@ -48,7 +48,7 @@ json to_json(const msg::Machining& m) {
   return {{"time_s", m.time_s()}, {"spindle_rpm", m.spindle_rpm()}, {"tooth_passing_hz", m.tooth_passing_hz()},
           {"depth_mm", m.depth_mm()}, {"limits_ready", m.limits_ready()}, {"open_limit_mm", finite(m.open_limit_mm())},
           {"damped_limit_mm", finite(m.damped_limit_mm())}, {"limit_method", m.limit_method()}, {"loop_active", m.loop_active()},
-          {"limit_mm", finite(m.limit_mm())}, {"depth_warning", m.depth_warning()}, {"indicator_valid", m.indicator_valid()},
+          {"limit_mm", finite(m.limit_mm())}, {"depth_warning", m.depth_warning()}, {"depth_measured", m.depth_measured()}, {"indicator_valid", m.indicator_valid()},
           {"once_per_rev_ratio", m.once_per_rev_ratio()}, {"nonharmonic_share", m.nonharmonic_share()},
           {"chatter_hz", m.chatter_hz()}, {"chatter", m.chatter()}};
 }

@@ -193,6 +193,7 @@ void Bridge::publish_machining() {
   out.spindle_rpm(m.spindle_rpm);
   out.tooth_passing_hz(m.tooth_passing_hz);
   out.depth_mm(m.depth_mm);
+  out.depth_measured(m.depth_measured);
   out.limits_ready(m.limits_ready);
   out.open_limit_mm(m.open_limit_mm);
   out.damped_limit_mm(m.damped_limit_mm);

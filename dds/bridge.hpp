@@ -47,6 +47,7 @@ struct MachiningSample {
   std::uint64_t tick{0};
   double time_s{0.0};
   double spindle_rpm{0.0}, tooth_passing_hz{0.0}, depth_mm{0.0};
+  bool depth_measured{false};  // depth_mm is the robot's; else the job's planned depth
   bool limits_ready{false};
   double open_limit_mm{0.0}, damped_limit_mm{0.0};
   std::string limit_method;  // which method made damped_limit_mm (milling::LiveLimits::method)

@@ -91,7 +91,8 @@ AdviceView MachiningMonitor::view() {
   }
   s.tooth_passing_hz = s.spindle_rpm * teeth_ / 60.0;
   const double robot_depth = robot_depth_mm_ ? robot_depth_mm_() : std::nan("");
-  s.depth_mm = std::isfinite(robot_depth) ? robot_depth : stability_->depth_mm();  // 0: the tool is out of the cut
+  s.depth_measured = std::isfinite(robot_depth);
+  s.depth_mm = s.depth_measured ? robot_depth : stability_->depth_mm();  // the robot's 0: the tool is out of the cut
   if (s.spindle_rpm > 0.0)
     if (const auto l = stability_->lookup(s.spindle_rpm, set, gain)) {
       s.limits_ready = true;

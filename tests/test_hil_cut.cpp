@@ -224,6 +224,9 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
     EXPECT_TRUE(cut["complete"].get<bool>()) << cut.dump(1);
     EXPECT_EQ(last["classification"], "stable") << cut.dump(1);
     EXPECT_EQ(cut["classification"], "stable");
+    // The depth on the screens is the one the robot reports (modbus.robot.depth_register), not the job's plan.
+    ASSERT_TRUE(r.run.contains("machining")) << r.run.dump(1);
+    EXPECT_TRUE(r.run["machining"]["depth_measured"].get<bool>()) << r.run["machining"].dump();
     // The controller's view: the advice it wrote is the one the robot read.
     EXPECT_EQ(r.run["advice"]["seq"].get<unsigned>(), advice.back()["seq"].get<unsigned>()) << r.run["advice"].dump(1);
   }

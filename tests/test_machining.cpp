@@ -308,6 +308,7 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_EQ(m.spindle_rpm, 700.0);
     EXPECT_NEAR(m.tooth_passing_hz, 35.0, 1e-9);
     EXPECT_EQ(m.depth_mm, depth);
+    EXPECT_FALSE(m.depth_measured) << "no robot reports a depth: the job's planned depth, said as such";
     ASSERT_TRUE(m.limits_ready);
     EXPECT_NEAR(m.open_limit_mm, 1.111, 0.002);   // SDM
     // The sampled loop's SDM with the preset's speed schedule at 700 rpm: C1 at K 3040 (the header's 2.350 mm;

@@ -252,12 +252,14 @@ std::set<double> refine(Grid& g, Depths& d, std::size_t n_cands, const milling::
 }
 
 // Which speeds of the schedule need a candidate chosen afresh: those whose band's candidate chattered in time
-// at 0.95 x its limit (the limit lowered to the time domain's) or is now worse than the open loop. Cuts in
-// time only where the candidate damps and its limit was not yet checked at that depth.
+// at 0.95 x its limit or is worse than the open loop. A candidate that chattered is not used at that speed any
+// more (its depth there 0): the cell's live limits are the accurate method's, so a band must not run where the
+// cut holds less than that. In the last pass (keep) its limit is lowered to the time domain's instead, and the
+// band keeps it: reported, never hidden. Cuts in time only where the candidate damps, once per speed.
 class InTime {
  public:
   InTime(Depths& d, const config::MillingConfig& job, const ScheduleSettings& s) : d_(d), job_(job), s_(s) {}
-  std::vector<double> to_choose_again(const Grid& g, const std::vector<double>& speeds) {
+  std::vector<double> to_choose_again(const Grid& g, const std::vector<double>& speeds, bool keep = false) {
     fill_scheduled(d_, g, speeds);
     std::vector<LimitInTime> todo;
     std::vector<std::pair<double, std::size_t>> keys;
@@ -271,10 +273,10 @@ class InTime {
     std::set<double> again;
     for (std::size_t i = 0; i < res.size(); ++i) {
       ++checks_;
-      checked_[keys[i]] = d_.depth(keys[i].first, keys[i].second);  // a lowered limit is checked again if chosen again
+      checked_[keys[i]] = d_.depth(keys[i].first, keys[i].second);
       if (res[i].held) continue;
-      lowered_.push_back({keys[i].first, keys[i].second, d_.depth(keys[i].first, keys[i].second), res[i].limit_mm});
-      d_.lower(keys[i].first, keys[i].second, res[i].limit_mm);
+      lowered_.push_back({keys[i].first, keys[i].second, d_.depth(keys[i].first, keys[i].second), res[i].limit_mm, keep});
+      d_.lower(keys[i].first, keys[i].second, keep ? res[i].limit_mm : 0.0);
       again.insert(keys[i].first);
     }
     for (double r : speeds)
@@ -330,7 +332,7 @@ void check_in_time(SpeedSchedule& out, Grid& g, std::set<double>& checked, Depth
     }
     fit_band_count(g, d, out.candidates, lo, hi);
   }
-  (void)in_time.to_choose_again(g, speeds());
+  (void)in_time.to_choose_again(g, speeds(), true);
   out.limits_in_time = in_time.checks();
   out.lowered_in_time = in_time.lowered().size();
   out.lowered = in_time.lowered();

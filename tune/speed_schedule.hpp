@@ -94,7 +94,8 @@ struct LoweredLimit {
   double rpm{0.0};
   std::size_t candidate{0};
   double accurate_mm{0.0};  // the accurate method's
-  double time_mm{0.0};      // the time domain's critical depth there: the limit used
+  double time_mm{0.0};      // the time domain's critical depth there
+  bool kept{false};         // still run there (found in the last pass), at time_mm; else another candidate runs there
 };
 
 struct SpeedSchedule {
@@ -106,7 +107,7 @@ struct SpeedSchedule {
   std::vector<ScheduleSpeed> speeds;           // ascending: the grid and the checks
   std::size_t refined_speeds{0};               // checks that failed and became grid speeds
   // The damped limits of the schedule's speeds checked in time (tune/schedule_in_time.hpp): cuts at 0.95 x the
-  // limit, and of them those that chattered (the limit lowered to the time domain's, the speed chosen again).
+  // limit, and of them those that chattered (that candidate not used there: the speed chosen again).
   std::size_t limits_in_time{0}, lowered_in_time{0};
   std::vector<LoweredLimit> lowered;
   // Damped limits computed, and of them those capped where the cut's forced vibration drives the actuator to

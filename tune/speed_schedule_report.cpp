@@ -89,11 +89,13 @@ std::string schedule_text(const SpeedSchedule& s, const std::string& cell, const
   o << "  every damped limit is capped where the cut's forced vibration drives the actuator to its force limit: "
     << s.capped_limits << " of " << s.damped_limits << " were\n";
   o << "  every damped limit the bands run is checked in time (the real Controller, a cut at 0.95 x the limit): "
-    << s.lowered_in_time << " of " << s.limits_in_time << " chattered and were lowered to the time domain's limit\n";
+    << s.lowered_in_time << " of " << s.limits_in_time << " chattered, and another candidate runs there\n";
   for (const auto& l : s.lowered)
     o << fmt("    at %.1f rpm, controller ", l.rpm) << controller_name(s, s.candidates[l.candidate].controller)
-      << fmt(" at K %.0f N s/m: %.3f mm by the accurate method, %.3f mm in time\n", s.candidates[l.candidate].gain_ns_per_m,
-             l.accurate_mm, l.time_mm);
+      << fmt(" at K %.0f N s/m: %.3f mm by the accurate method, %.3f mm in time", s.candidates[l.candidate].gain_ns_per_m,
+             l.accurate_mm, l.time_mm)
+      << (l.kept ? "; WARNING: still run there (found after the last round): the live limits show the accurate method's"
+                 : "") << "\n";
   o << "  bands (" << s.bands.size() << "; " << s.refined_speeds << " speeds refined where a check found a band worse):\n";
   for (const auto& b : s.bands)
     o << fmt("    %8.1f - %8.1f rpm: ", b.rpm_min, b.rpm_max)
@@ -148,7 +150,7 @@ std::string schedule_header(const SpeedSchedule& s) {
   std::ostringstream o;
   o << "# The speed schedule (controller.speed_schedule) was verified with " << s.method << " at " << m.speeds
     << " speeds, each damped limit checked in time (a cut at 0.95 x it, the real Controller; "
-    << s.lowered_in_time << " of " << s.limits_in_time << " lowered to the time domain's):\n"
+    << s.lowered_in_time << " of " << s.limits_in_time << " chattered: another candidate runs there):\n"
     << fmt("#   minimum %.3f mm at %.0f rpm (open loop %.3f mm, as configured %.3f mm); ", m.scheduled_min_mm,
            m.scheduled_min_rpm, m.open_min_mm, m.fixed_min_mm)
     << fmt("mean x%.3f the open loop (as configured x%.3f);\n", m.scheduled_mean_ratio, m.fixed_mean_ratio)

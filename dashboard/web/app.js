@@ -201,7 +201,9 @@ function tile(c) {
       '<dt>spindle</dt><dd>' + (m.spindle_rpm !== undefined ? fmt(m.spindle_rpm, 0) + ' rpm' : '–') + '</dd>' +
       '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' +
         (m.limits_ready ? fmt(limit, 2) + ' mm' + (m.loop_active ? ' (damped)' : ' (open loop: the damper is off)') : '…') +
-        (m.depth_warning ? ' <span class="chatter">above the limit</span>' : '') +
+        (m.depth_warning ? (m.depth_measured ? ' <span class="chatter">above the limit</span>'
+          : ' <span class="chatter" data-field="plan-above">the job\'s planned depth is above the limit here</span>') : '') +
+        (m.depth_measured ? '' : ' <span class="note" data-field="depth-source">(the job\'s plan: the robot reports no depth)</span>') +
         '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
       (c.advice ? '<dt>advice</dt><dd>' + (!c.advice.found ? 'no stable speed in range'
