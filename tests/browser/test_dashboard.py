@@ -210,6 +210,11 @@ class DashboardInABrowser(unittest.TestCase):
             until(lambda: rpm in self.tile(key)["text"], 60, f"cell {key} at {rpm}")
         # The limit says whose it is: the damper active, so the damped one.
         until(lambda: "2.50 mm of 2.35 mm (damped)" in self.tile("a")["text"], 90, "cell a's depth against its scheduled damped limit")
+        # No robot reports a depth to these cells: the depth is the job's plan, and the tile says so.
+        text = self.tile("a")["text"]
+        self.assertIn("the job's planned depth is above the limit here", text)
+        self.assertIn("(the job's plan: the robot reports no depth)", text)
+        self.assertNotIn(" above the limit\n", text)
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
 
         self.open_cell("a")
