@@ -250,6 +250,16 @@ std::string plot_lobes(const tune::Evaluator& p, const std::vector<Compared>& ro
   return run_gnuplot(s.str(), data.str(), path);
 }
 
+// How far the tuned loop holds as the modes move (a weak point is a warning, as in commission and analyze).
+void report_robustness(const config::Config& tuned, json& report) {
+  const tune::Robustness rb = tune::robustness(tuned);
+  std::printf("the tuned loop stays stable and damps its modes from -%.1f %% to +%.1f %% of mode shift%s%s%s\n", rb.down.pct,
+              rb.up.pct, rb.down.reason.empty() ? "" : ("; " + rb.down.reason).c_str(),
+              rb.up.reason.empty() ? "" : ("; " + rb.up.reason).c_str(),
+              rb.pct() < tune::kRobustShiftWarnPct ? " (WARNING: under +-5 %: a pose or tool change may move the modes further)" : "");
+  report["robustness"] = {{"down_pct", rb.down.pct}, {"up_pct", rb.up.pct}, {"down_reason", rb.down.reason}, {"up_reason", rb.up.reason}};
+}
+
 // --start's candidate: a configuration robodamp tune wrote (its chain's rational compensator, K, polarity).
 tune::Candidate start_candidate(const std::string& path) {
   const config::Config c = config::load_config_file(path);
@@ -295,13 +305,7 @@ int run_tune(const TuneArgs& a) {
     if (!emit_json(a.json, report.dump(2), "tune")) return 1;
     return 3;
   }
-  // How far the tuned loop holds as the modes move (a weak point is a warning, as in commission and analyze).
-  const tune::Robustness rb = tune::robustness(tune::with_candidate(plants.front().base(), r.best.candidate));
-  std::printf("the tuned loop stays stable and damps its modes from -%.1f %% to +%.1f %% of mode shift%s%s%s\n", rb.down.pct,
-              rb.up.pct, rb.down.reason.empty() ? "" : ("; " + rb.down.reason).c_str(),
-              rb.up.reason.empty() ? "" : ("; " + rb.up.reason).c_str(),
-              rb.pct() < tune::kRobustShiftWarnPct ? " (WARNING: under +-5 %: a pose or tool change may move the modes further)" : "");
-  report["robustness"] = {{"down_pct", rb.down.pct}, {"up_pct", rb.up.pct}, {"down_reason", rb.down.reason}, {"up_reason", rb.up.reason}};
+  report_robustness(tune::with_candidate(plants.front().base(), r.best.candidate), report);
   // Every promise verified by the accurate method, and the time-domain cut with the real Controller.
   std::optional<tune::Verification> verified;
   if (job) {

@@ -329,7 +329,8 @@ class Run {
     if (const auto at = config::speed_band_of(r_.schedule->bands, job_rpm); job_rpm > 0.0 && at && r_.schedule->bands[*at].gain_ns_per_m > 0.0)
       steps.push_back({job_rpm, 0.95 * r_.schedule->summary.job_scheduled_mm});
     const auto t0 = Clock::now();
-    r_.schedule_in_time = tune::scheduled_cut(*r_.scheduled_config, job_, steps, 40);
+    // As many revolutions as the schedule's own check in time (the job's): fewer read a slow decay near the limit as chatter.
+    r_.schedule_in_time = tune::scheduled_cut(*r_.scheduled_config, job_, steps, job_.time_domain.revolutions);
     const tune::ScheduledCut& c = *r_.schedule_in_time;
     for (const auto& s : c.segments)
       say_(fmt("commission: the schedule in time at %.1f rpm, %.3f mm (0.95 x its limit): %s; the switch %.2f N, the cut %.1f N "
