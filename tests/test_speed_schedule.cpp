@@ -424,18 +424,10 @@ void expect_recorded_schedule_writes_it_again(const std::string& name) {
   std::filesystem::create_directories(dir);
   {
     const std::string text = test::read_file(test::preset(name));
-    std::istringstream lines(text);
-    std::string first, command;
-    std::getline(lines, first);
-    std::getline(lines, command);
-    ASSERT_EQ(first.rfind("# robodamp schedule wrote", 0), 0U) << name;
-    ASSERT_EQ(command.rfind("#   robodamp schedule ", 0), 0U) << name;
-    command = command.substr(std::string("#   robodamp ").size());
-    const std::string out = dir + "/" + name + ".yaml";
-    command = std::regex_replace(command, std::regex(" --out \\S+$"), " --out " + out);
-    const std::string run = "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + command + " > " + dir +
-                            "/log.txt 2>&1";
-    ASSERT_EQ(std::system(run.c_str()), 0) << run << "\n" << test::read_file(dir + "/log.txt");
+    ASSERT_EQ(text.rfind("# robodamp schedule wrote", 0), 0U) << name;
+    std::string why;
+    const std::string out = test::rerun_recorded_command(text, "# robodamp schedule wrote", "schedule", dir, name, why);
+    ASSERT_FALSE(out.empty()) << name << ": " << why;
     const std::string again = test::read_file(out);
     const std::vector<double> was = promises(text), now = promises(again);
     ASSERT_EQ(was.size(), now.size()) << name;

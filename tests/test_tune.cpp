@@ -514,17 +514,9 @@ TEST(Tune, EachTunedPresetsRecordedCommandWritesItAgain) {
   std::filesystem::create_directories(dir);
   for (const std::string name : {"tuned_horizontal", "tuned_vertical"}) {
     const std::string text = test::read_file(test::preset(name));
-    std::istringstream lines(text.substr(text.find("# robodamp tune wrote this")));
-    std::string first, command;
-    std::getline(lines, first);
-    std::getline(lines, command);
-    ASSERT_EQ(command.rfind("#   robodamp tune ", 0), 0U) << name;
-    command = command.substr(std::string("#   robodamp ").size());
-    const std::string out = dir + "/" + name + ".yaml";
-    command = std::regex_replace(command, std::regex(" --out \\S+$"), " --out " + out);
-    const std::string run = "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + command + " > " + dir +
-                            "/log.txt 2>&1";
-    ASSERT_EQ(std::system(run.c_str()), 0) << run << "\n" << test::read_file(dir + "/log.txt");
+    std::string why;
+    const std::string out = test::rerun_recorded_command(text, "# robodamp tune wrote this", "tune", dir, name, why);
+    ASSERT_FALSE(out.empty()) << name << ": " << why;
     const std::vector<double> was = tune_promises(text), now = tune_promises(test::read_file(out));
     ASSERT_EQ(was.size(), 6U) << name;
     ASSERT_EQ(now.size(), was.size()) << name;

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <regex>
 #include <thread>
 #include <sstream>
 #include <stdexcept>
@@ -98,6 +99,26 @@ inline std::string read_file(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+// The command a file's header records on the line after `header` ("#   robodamp COMMAND ... --out FILE"), run
+// again from the source folder with --out dir/name.yaml (its output in dir/log.txt). Returns that path, or ""
+// with what went wrong in why.
+inline std::string rerun_recorded_command(const std::string& text, const std::string& header, const std::string& command,
+                                          const std::string& dir, const std::string& name, std::string& why) {
+  const auto at = text.find(header);
+  if (at == std::string::npos) return why = "no \"" + header + "\" in the file", "";
+  std::istringstream lines(text.substr(at));
+  std::string first, line;
+  std::getline(lines, first);
+  std::getline(lines, line);
+  if (line.rfind("#   robodamp " + command + " ", 0) != 0) return why = "not a robodamp " + command + " command: " + line, "";
+  const std::string out = dir + "/" + name + ".yaml";
+  line = std::regex_replace(line.substr(std::string("#   robodamp ").size()), std::regex(" --out \\S+$"), " --out " + out);
+  const std::string run = "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + line + " > " + dir +
+                          "/log.txt 2>&1";
+  if (std::system(run.c_str()) != 0) return why = run + "\n" + read_file(dir + "/log.txt"), "";
+  return out;
 }
 
 // Wrapped phase difference in degrees.
