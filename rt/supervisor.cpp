@@ -131,6 +131,7 @@ void Supervisor::reset_detectors() noexcept {
   block_sum_sq_ = block_accel_sum_sq_ = 0.0;
   last_block_rms_ = run_start_rms_ = 0.0;
   growth_run_ = 0;
+  block_history_.fill(0.0);
   reset_derate();
 }
 
@@ -289,10 +290,41 @@ bool Supervisor::instability(double controller_v, double accel_mps2) noexcept {
     growth_run_ = 0;
   }
   last_block_rms_ = rms;
+  block_history_[block_history_pos_] = rms;
+  block_history_pos_ = (block_history_pos_ + 1) % kBlockHistory;
   const bool grown = growth_run_ >= l.instability_blocks && rms >= l.instability_floor_v &&
-                     rms >= l.instability_growth_factor * run_start_rms_;
+                     rms >= l.instability_growth_factor * run_start_rms_ &&
+                     !(controller_.schedule_rpm() > 0.0 && (building_up() || beating()));
   restore_when_quiet();
   return derating_on() ? judge_growth(rms, accel_rms, grown) : grown;
+}
+
+// With the spindle turning, a cut's entry builds up a forced vibration and a cut near its limit beats: the
+// tooth-passing response and the slowly decaying free vibration of the chatter mode (the loop's or the cut's,
+// near the boundary) add and cancel in turn. At a tooth-passing frequency near a mode the command rises block
+// after block for a second or more, and the growth rule alone called that an instability (the default job's
+// C2 at K 1380 at 198 rpm, 3 x 9.9 Hz beside the 9.2 Hz mode, a cut at 0.8-0.95 x its limit: the probes
+// switched the damping off again and again, and the cut chattered). A loop's instability or a chatter grows
+// exponentially, the same ratio block after block, beyond anything before it, until a limit. So:
+// - a build-up slows down: over the run's last blocks (at most 16), the later half's growth (in log) under 0.7 x
+//   the earlier half's is not a growth;
+// - a beat falls back: a run whose RMS is not above every block before it in the history (kBlockHistory blocks
+//   before the run) is not a growth.
+// A chatter rising out of a build-up or a beat grows faster later and beyond the beat's peaks: it stays one.
+bool Supervisor::building_up() const noexcept {
+  const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(growth_run_), 16);
+  const std::size_t h = n / 2;
+  if (h == 0) return false;
+  const double earlier = std::log(history_back(n - h) / history_back(n));
+  const double later = std::log(history_back(0) / history_back(h));
+  return later < 0.7 * earlier;
+}
+
+bool Supervisor::beating() const noexcept {
+  double before = 0.0;
+  for (std::size_t k = static_cast<std::size_t>(growth_run_) + 1; k < kBlockHistory; ++k)
+    before = std::max(before, history_back(k));
+  return history_back(0) <= before;
 }
 
 TickOutput Supervisor::step(const TickInput& in) noexcept {

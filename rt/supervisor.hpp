@@ -315,6 +315,16 @@ class Supervisor {
   double block_sum_sq_{0.0};
   double last_block_rms_{0.0}, run_start_rms_{0.0};
   int growth_run_{0};
+  // The last blocks' RMS (newest at block_history_pos_ - 1), to tell a growth from a build-up or a beat
+  // (instability()).
+  static constexpr std::size_t kBlockHistory = 64;
+  std::array<double, kBlockHistory> block_history_{};
+  std::size_t block_history_pos_{0};
+  [[nodiscard]] double history_back(std::size_t k) const noexcept {  // the block RMS k blocks before the newest
+    return block_history_[(block_history_pos_ + kBlockHistory - 1 - k) % kBlockHistory];
+  }
+  [[nodiscard]] bool building_up() const noexcept;
+  [[nodiscard]] bool beating() const noexcept;
 
   Growth growth_{Growth::kNone};
   bool process_{false};            // a growth judged the process's since the last quiet spell

@@ -49,9 +49,10 @@ void print(const char* name, const tune::ScheduledCut& r) {
 
 // C2 at K = 2000 at 699.3 rpm lowers the default job's limit to 0.782 mm (open loop 1.106 mm). Cuts above it: 0.95 mm
 // (the damper's own chatter), 1.3 mm (above the open loop's too), 1.56 mm (2 x the damped limit) and 10 mm (the
-// actuator at its 36 N limit). Without derating 1.3, 1.56 and 10 mm trip instability (latched: the damper off for
-// the rest of the run); with it none trips and the damper stays armed: the growth probed and judged the process's,
-// 10 mm's saturation derated instead of tripping.
+// actuator at its 36 N limit). Without derating 1.3 and 1.56 mm trip instability, 10 mm saturation (its forced
+// vibration builds up to the force limit within a second: a build-up, not a growth) (latched: the damper off for
+// the rest of the run); with derating none trips and the damper stays armed: the growth probed and judged the
+// process's, 10 mm's saturation derated instead of tripping.
 TEST(Derate, AChatteringCutNeverSwitchesTheDamperOff) {
   config::Config off = fixed_c2();
   off.supervision.derate.enabled = false;
@@ -59,8 +60,8 @@ TEST(Derate, AChatteringCutNeverSwitchesTheDamperOff) {
     const auto r = cut_at_700(off, depth);
     print("derating off", r);
     ASSERT_EQ(r.segments.size(), 1U);
-    EXPECT_EQ(r.segments[0].trip, "instability") << depth << " mm: the trip the derating replaces";
-    EXPECT_FALSE(r.segments[0].verdict.stable);
+    EXPECT_EQ(r.segments[0].trip, depth > 5.0 ? "saturation" : "instability") << depth << " mm: the trip the derating replaces";
+    if (depth < 5.0) EXPECT_FALSE(r.segments[0].verdict.stable) << depth << " mm";
   }
   for (const double depth : {0.95, 1.3, 1.56, 10.0}) {
     const auto r = cut_at_700(fixed_c2(), depth);

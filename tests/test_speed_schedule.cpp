@@ -477,3 +477,79 @@ TEST(Robustness, TheModeShiftATunedLoopHoldsIsMeasuredToTheStep) {
 
 }  // namespace
 }  // namespace robodamp
+
+namespace robodamp {
+namespace {
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A ramp up through a preset's schedule with the real supervisor: the middle of every band at least 4 rpm wide
+// (the narrow ones are a grid step or two between wider ones), a cut at 0.95 x the limit the cell publishes there.
+void expect_schedule_holds_in_time(const config::Config& cell, const config::MillingConfig& job) {
+  ASSERT_TRUE(cell.controller.speed_schedule);
+  std::vector<double> rpm;
+  std::size_t zero_gain = 0, handed_over = 0;
+  for (const auto& b : cell.controller.speed_schedule->bands) {
+    if (b.rpm_max - b.rpm_min < 4.0) continue;
+    rpm.push_back(0.5 * (b.rpm_min + b.rpm_max));
+    zero_gain += b.gain_ns_per_m == 0.0 ? 1 : 0;
+  }
+  ASSERT_GE(rpm.size(), 10U);
+  const auto limits = milling::scheduled_lobe_study(job.selected_structure(), job, rpm);
+  ASSERT_TRUE(limits);
+  std::vector<tune::ScheduledCutStep> steps;
+  for (const auto& a : limits->study.at_rpm) steps.push_back({a.rpm, 0.95 * a.b_lim_mm});
+  const tune::ScheduledCut cut = tune::scheduled_cut(cell, job, steps, 40);
+  ASSERT_EQ(cut.segments.size(), rpm.size());
+  std::size_t previous_set = cut.segments.front().set;
+  for (const auto& s : cut.segments) {
+    const auto band = config::speed_band_of(cell.controller.speed_schedule->bands, s.rpm);
+    ASSERT_TRUE(band) << s.rpm << " rpm";
+    const auto& b = cell.controller.speed_schedule->bands[*band];
+    EXPECT_DOUBLE_EQ(s.gain_ns_per_m, b.gain_ns_per_m) << s.rpm << " rpm";
+    if (b.gain_ns_per_m > 0.0) EXPECT_EQ(s.set, static_cast<std::size_t>(b.controller)) << s.rpm << " rpm";
+    handed_over += s.set != previous_set ? 1 : 0;
+    previous_set = s.set;
+    EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm << " mm: " << milling::to_string(s.verdict.classification);
+    EXPECT_EQ(s.switch_limited_ticks, 0U) << s.rpm << " rpm";
+    EXPECT_LT(s.switch_peak_force_n, cut.force_limit_n) << s.rpm << " rpm";
+    EXPECT_EQ(s.trip, "none") << s.rpm << " rpm";
+    EXPECT_EQ(s.state, "active") << s.rpm << " rpm";
+    std::printf("%7.1f rpm: %.3f mm, set %zu K %.0f, switch %.2f s peak %.2f N; cut %s, peak %.1f N\n", s.rpm,
+                s.depth_mm, s.set, s.gain_ns_per_m, s.switch_s, s.switch_peak_force_n,
+                milling::to_string(s.verdict.classification), s.peak_force_command_n);
+  }
+  EXPECT_TRUE(cut.all_stable());
+  EXPECT_TRUE(cut.switches_within_limits());
+  EXPECT_GE(handed_over, 2U) << "the ramp crosses bands of other controllers";
+  EXPECT_GE(zero_gain, 1U) << "the ramp crosses a band where the damper commands nothing";
+  EXPECT_EQ(cut.handovers_refused, 0U);
+}
+
+TEST(ScheduledCut, TheTunedHorizontalPresetsScheduleHoldsAtNinetyFivePercentAsTheSpindleRampsThroughIt) {
+  const config::Config cell = config::load_config_file(test::preset("tuned_horizontal"));
+  const config::MillingConfig job = config::load_milling_config(source("config/milling/active_damping_tuned.yaml"));
+  expect_schedule_holds_in_time(cell, job);
+}
+
+TEST(ScheduledCut, TheTunedVerticalPresetsScheduleHoldsAtNinetyFivePercentAsTheSpindleRampsThroughIt) {
+  // The vertical preset's recorded command verifies it on the default job: that job with this preset closing the loop.
+  const test::ScratchDir dir("tuned-vertical-ramp");
+  std::string text = read_text(source("config/milling/active_damping_c2.yaml"));
+  const std::string from = "../presets/horizontal_c2.yaml";
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), test::preset("tuned_vertical"));
+  std::ofstream(dir.file("job.yaml")) << text;
+  const config::Config cell = config::load_config_file(test::preset("tuned_vertical"));
+  const config::MillingConfig job = config::load_milling_config(dir.file("job.yaml"));
+  expect_schedule_holds_in_time(cell, job);
+}
+
+}  // namespace
+}  // namespace robodamp
