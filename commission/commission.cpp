@@ -252,10 +252,10 @@ class Run {
     r_.schedule = tune::schedule_speeds(tuned, hand, job_, job_.selected_structure(), ss);
     const tune::ScheduleSummary& m = r_.schedule->summary;
     say_(fmt("commission: speed schedule, %zu bands over %zu speeds: minimum %.3f mm (open loop %.3f, the tuned controller "
-             "alone %.3f), mean x%.3f the open loop (alone x%.3f), worse than the open loop at %.1f %% (alone %.1f %%); %zu of %zu damped limits chattered in time (another candidate runs there) (%.1f s)",
+             "alone %.3f), mean x%.3f the open loop (alone x%.3f), worse than the open loop at %.1f %% (alone %.1f %%); %zu of %zu damped limits chattered in time (another candidate runs there, or the same at its limit in time; bands with a depth limit: %zu) (%.1f s)",
              r_.schedule->bands.size(), m.speeds, m.scheduled_min_mm, m.open_min_mm, m.fixed_min_mm, m.scheduled_mean_ratio,
              m.fixed_mean_ratio, 100.0 * m.scheduled_worse_share, 100.0 * m.fixed_worse_share, r_.schedule->lowered_in_time,
-             r_.schedule->limits_in_time, seconds_since(t0)));
+             r_.schedule->limits_in_time, r_.schedule->limited_bands(), seconds_since(t0)));
     if (m.scheduled_worse_share > 0.0)
       throw Stop{Stage::kTune, Outcome::kNotVerified,
                  fmt("the speed schedule is worse than the open loop at %.1f %% of the speeds (the worst x%.3f at %.0f rpm)",

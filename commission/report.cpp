@@ -365,8 +365,8 @@ std::string cut_section(const CommissionResult& r, Plots& p) {
                   s.settings.worse_tolerance_pct))
     << fmt(" %zu bands; every damped limit is capped where the actuator holds the cut's forced vibration (%zu of %zu were), "
            "and each the bands run is checked by a cut in time at 0.95 x it (%zu of %zu chattered; another candidate runs "
-           "there).</p>\n",
-           s.bands.size(), s.capped_limits, s.damped_limits, s.lowered_in_time, s.limits_in_time);
+           "there, or the same at its limit in time; bands with a depth limit: %zu).</p>\n",
+           s.bands.size(), s.capped_limits, s.damped_limits, s.lowered_in_time, s.limits_in_time, s.limited_bands());
   const auto [data, script] = tune::schedule_plot(s, "What the damper does for the job: limiting depth by spindle speed");
   h << p.img("schedule_lobes", script, data, "open loop (SDM), the tuned controller at its fixed K and the speed schedule "
                                                "(sampled-loop SDM), identified model");

@@ -31,6 +31,14 @@ std::size_t scheduled_set(const Config& set_cfg, std::size_t set, double rpm) {
   return b ? static_cast<std::size_t>(s->bands[*b].controller) : 0;
 }
 
+std::optional<double> scheduled_depth_limit_mm(const Config& set_cfg, std::size_t set, double rpm) {
+  const auto& s = set_cfg.controller.speed_schedule;
+  if (!s) return std::nullopt;
+  const auto b = speed_band_of(s->bands, rpm);
+  if (!b || scheduled_gain_ns_per_m(set_cfg, set, rpm) <= 0.0) return std::nullopt;
+  return s->bands[*b].depth_limit_mm;
+}
+
 Config with_speed_controller(const Config& cell, const SpeedControllerConfig& c) {
   Config out = cell;
   for (BlockConfig& b : out.controller.chain) {
@@ -116,13 +124,15 @@ std::optional<SpeedBandConfig> read_band(Diagnostics& d, const YAML::Node& item,
   const auto k = r.number("gain_ns_per_m", {"N s/m", 0.0, 1e5});
   const auto c = read_int(r, "controller",
                           {"(0 = this configuration's, i = controllers[i - 1])", 0, static_cast<double>(controllers)}, 0);
+  const bool capped = present(r.child("depth_limit_mm", false, ""));
+  const std::optional<double> cap = capped ? r.number("depth_limit_mm", {"mm", 0.0, 1000.0, true}) : std::nullopt;
   r.finish();
-  if (!lo || !hi || !k || !c) return std::nullopt;
+  if (!lo || !hi || !k || !c || (capped && !cap)) return std::nullopt;
   if (!(*hi > *lo)) {
     d.add(item.Mark(), key + ".rpm_max", "= " + format_number(*hi) + " rpm must exceed rpm_min = " + format_number(*lo) + " rpm");
     return std::nullopt;
   }
-  return SpeedBandConfig{*lo, *hi, *c, *k};
+  return SpeedBandConfig{*lo, *hi, *c, *k, cap};
 }
 
 }  // namespace

@@ -23,6 +23,10 @@ struct SpeedBandConfig {
   double rpm_min{0.0}, rpm_max{0.0};  // [rpm_min, rpm_max): ascending and disjoint across the bands
   int controller{0};                  // 0: this configuration's; i: speed_schedule.controllers[i - 1]
   double gain_ns_per_m{0.0};
+  // The deepest cut the band vouches for at any of its speeds, where the accurate method's limit is deeper than
+  // the cut in time holds (robodamp schedule checks every limit in time): the limits the cell publishes, the
+  // lobes and the cut's verdict take the smaller of the two. None: the accurate method's limit.
+  std::optional<double> depth_limit_mm;
 };
 
 // Another controller a band may run: this configuration's chain with its compensator block replaced.
@@ -60,6 +64,8 @@ struct Config;
 // The set that runs at this speed when `set` (configured by set_cfg) is active: a band's controller, set 0
 // outside every band of a schedule that chooses controllers, `set` itself otherwise.
 [[nodiscard]] std::size_t scheduled_set(const Config& set_cfg, std::size_t set, double rpm);
+// The depth_limit_mm of the band holding rpm where set (configured by set_cfg) runs it at K > 0, or none.
+[[nodiscard]] std::optional<double> scheduled_depth_limit_mm(const Config& set_cfg, std::size_t set, double rpm);
 
 // The band holding rpm (rpm_min <= rpm < rpm_max; the last band also holds its rpm_max), or none.
 [[nodiscard]] std::optional<std::size_t> speed_band_of(const std::vector<SpeedBandConfig>& bands, double rpm);

@@ -209,6 +209,14 @@ LiveLimits LiveStability::evaluate(const Key& k) const {
       out.damped_chatter_hz = d.chatter_hz;
       out.analysed_rpm = d.rpm;
       out.method = truth.method();
+      // A speed schedule's band that vouches for less than the accurate method (its limit chattered in time).
+      const std::size_t set = std::get<1>(k);
+      if (const auto cap = config::scheduled_depth_limit_mm(cfg, set, out.rpm);
+          cap && *cap < out.damped_mm &&
+          std::abs(config::scheduled_gain_ns_per_m(cfg, set, out.rpm) - gain) <= 0.5 * s_.gain_step_ns_per_m) {
+        out.damped_mm = *cap;
+        out.method += ", capped at the band's depth_limit_mm (the cut in time)";
+      }
     } else {
       out.method = "zero-order preview";
       if (zoa) out.damped_mm = zoa->b_lim_mm, out.damped_chatter_hz = zoa->chatter_hz;

@@ -41,6 +41,8 @@ std::vector<SdmPoint> scheduled_limits(const config::StructureConfig& sc, const 
     std::vector<double> mm;
     for (const auto& p : pts) mm.push_back(p.critical_depth_mm);
     mm = holding_limits_mm(damped, job, rpm, mm);  // as deep as the actuator follows the forced vibration
+    for (std::size_t k = 0; k < rpm.size(); ++k)      // no deeper than the band vouches for (the cut in time)
+      if (const auto cap = config::scheduled_depth_limit_mm(sets[set], set, rpm[k]); cap && *cap < mm[k]) mm[k] = *cap;
     for (std::size_t k = 0; k < idx.size(); ++k) pts[k].critical_depth_mm = mm[k], out[idx[k]] = pts[k];
   }
   return out;

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,8 +32,17 @@ inline int free_tcp_port() {
   return ntohs(a.sin_port);
 }
 
+// Every occurrence; returns how many.
+inline std::size_t replace_all_present(std::string& s, const std::string& from, const std::string& to) {
+  std::size_t n = 0;
+  for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size()), ++n) s.replace(p, from.size(), to);
+  return n;
+}
+
+// A test's own edit: every occurrence, and at least one (an edit that matches nothing would leave the file as it
+// was, and the test would check something else than it says).
 inline void replace_all(std::string& s, const std::string& from, const std::string& to) {
-  for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
+  if (replace_all_present(s, from, to) == 0) throw std::runtime_error("the edit's text is not in the file: '" + from + "'");
 }
 
 struct HilFiles {
@@ -46,12 +56,13 @@ inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<s
   f.dir = ::testing::TempDir() + "robodamp_hil_" + name + "_" + std::to_string(getpid());
   mkdir(f.dir.c_str(), 0755);
   std::string text = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/" + base + ".yaml");
-  replace_all(text, "unix:/tmp/robodamp-hil.sock", "unix:" + f.dir + "/can.sock");
-  replace_all(text, "unix:/tmp/robodamp-hil-cut.sock", "unix:" + f.dir + "/can.sock");
-  replace_all(text, "job: milling/", std::string("job: ") + ROBODAMP_SOURCE_DIR + "/config/milling/");
-  replace_all(text, "model: robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
-  replace_all(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
-  replace_all(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
+  // Each base file has some of these.
+  replace_all_present(text, "unix:/tmp/robodamp-hil.sock", "unix:" + f.dir + "/can.sock");
+  replace_all_present(text, "unix:/tmp/robodamp-hil-cut.sock", "unix:" + f.dir + "/can.sock");
+  replace_all_present(text, "job: milling/", std::string("job: ") + ROBODAMP_SOURCE_DIR + "/config/milling/");
+  replace_all_present(text, "model: robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
+  replace_all_present(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
+  replace_all_present(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
   for (const auto& [from, to] : edits) replace_all(text, from, to);
   f.config = f.dir + "/hil.yaml";
   std::ofstream(f.config) << text;

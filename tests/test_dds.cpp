@@ -579,6 +579,18 @@ TEST(DdsSecurity, AnUnauthenticatedParticipantsRequestsNeverReachTheLoop) {
   EXPECT_EQ(loop.bridge->counters().requests, 0U);
   EXPECT_EQ(intruder.replies.size(), 0U);
   EXPECT_EQ(intruder.telemetry.size(), 0U) << "Fast DDS 2.9: no unauthenticated participant at all";
+  // The positive control: the same secured loop, up all along, answers an authorised operator in the same domain;
+  // so the intruder's silence is the security's doing, not a loop that never came up.
+  Client op(loop.cfg.domain_id, identity("operator"));
+  ASSERT_TRUE(eventually([&] { return op.matched(); }, 60.0)) << "authentication and matching";
+  const auto asked = op.ask_until_answered(100, msg::SET_GAIN, 2500.0);
+  const auto r = op.reply(asked.back());
+  ASSERT_TRUE(r);
+  EXPECT_TRUE(r->accepted()) << r->reason();
+  EXPECT_NE(std::string(r->reason()).find("K = 2500"), std::string::npos) << r->reason() << ": the operator's value, not the intruder's 4000";
+  EXPECT_GE(loop.handled.load(), 1);
+  EXPECT_LE(loop.handled.load(), static_cast<int>(asked.size())) << "only the operator's requests reached the loop";
+  EXPECT_EQ(intruder.replies.size(), 0U);
 }
 
 TEST(DdsSecurity, TheSecuritySectionIsValidated) {

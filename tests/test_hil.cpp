@@ -111,7 +111,11 @@ TEST(Hil, RealtimeRunKeepsTimingAndPullingThePlugTripsSafe) {
   EXPECT_GE(ticks + r["missed_ticks"].get<std::uint64_t>(), 180000U);
   EXPECT_EQ(r["wake_latency"]["count"].get<std::uint64_t>(), ticks);
   EXPECT_EQ(r["compute"]["count"].get<std::uint64_t>(), ticks);
+  // Kept its timing: at most 1 % of the ticks missed, and 99 % of the wake-ups within a period (19 us p99
+  // measured here, docs/hardware.md; the overrun trip is off only so that a loaded machine ends the run by the plug).
+  EXPECT_LE(r["missed_ticks"].get<std::uint64_t>(), ticks / 100);
   EXPECT_GT(r["wake_latency"]["p99_us"].get<double>(), 0.0);
+  EXPECT_LT(r["wake_latency"]["p99_us"].get<double>(), 1e6 / cfg.loop.rate_hz);
   EXPECT_GT(r["can"]["rx_frames"].get<std::uint64_t>(), 150000U);
 
   // Tripped on the lost sensor (frames stop: stale; the socket closes: driver fault) and safe within the
@@ -392,10 +396,14 @@ TEST(HilFaults, CanBusOffTripsToTheSafeStateAtOnce) {
   const double trip_after_s = r.tick_monotonic_s(frames[t.trip].time_s) - injected_s;
   const double safe_after_s = r.tick_monotonic_s(frames[t.safe].time_s) - injected_s;
   // The error frame trips at the tick that reads it; the ramp takes trip_ramp_s in ticks. How long the
-  // frame takes to cross between processes is the machine's: reported, and only bounded loosely.
+  // frame takes to cross between processes is the machine's (9.9 ms measured): bounded by the stale check's
+  // window (500 cycles here, 100 ms), which would otherwise have tripped first as sensor_stale.
   const auto ramp_ticks = static_cast<std::size_t>(std::ceil(r.cfg.supervision.trip_ramp_s * r.cfg.loop.rate_hz));
+  const double stale_window_s = r.cfg.supervision.stale_sensor_cycles / r.cfg.loop.rate_hz;
   EXPECT_LE(t.safe - t.trip, ramp_ticks + 1);
-  EXPECT_LE(safe_after_s, 0.5);
+  EXPECT_GT(trip_after_s, -1.0 / r.cfg.loop.rate_hz) << "the trip follows the error frame (to a tick's time)";
+  EXPECT_LE(trip_after_s, stale_window_s) << "the error frame, not the silence after it, tripped the loop";
+  EXPECT_LE(safe_after_s, stale_window_s + r.cfg.supervision.trip_ramp_s + 1.0 / r.cfg.loop.rate_hz);
   std::printf("[ hil bus  ] bus-off: trip %.1f ms, safe %.1f ms after the error frame was sent\n", 1e3 * trip_after_s,
               1e3 * safe_after_s);
 }

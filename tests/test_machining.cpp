@@ -12,6 +12,7 @@
 #include "milling/lobes.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/live_stability.hpp"
+#include "milling/scheduled_lobes.hpp"
 #include "milling/speed_advice.hpp"
 #include "milling/structure.hpp"
 #include "runtime/cell.hpp"
@@ -74,9 +75,42 @@ TEST(LiveStability, LimitsAtASpeedAreTheJobsAccurateLimitsThere) {
   EXPECT_NEAR(l700.damped_mm, 0.782, 0.002);
   // The gain is part of the state: at 700 rpm the 23.5 Hz mode's lobe limits, and C2's feedback there is
   // outside the damping window (docs/milling.md), so less gain leaves more depth.
-  EXPECT_GT(live.compute(700.0, 0, 500.0).damped_mm, l700.damped_mm + 0.2);
+  const double at_500 = live.compute(700.0, 0, 500.0).damped_mm;
+  EXPECT_GT(at_500, l700.damped_mm + 0.2);
+  std::printf("700 rpm, K 500 N s/m: %.3f mm damped (docs/harmonic_notch.md)\n", at_500);
   // Above the speeds the sampled loop can step (10 526 rpm here), the preview, labelled.
   EXPECT_EQ(live.compute(12000.0, 0, 2000.0).method, "zero-order preview");
+}
+
+// A speed schedule's band with a depth_limit_mm (robodamp schedule wrote it where the cut in time held less than
+// the accurate method's limit): the cell publishes the smaller, says so, and only for the band's own K; the
+// schedule's lobes (lobes --damped, the cut's verdict) take it too.
+TEST(LiveStability, ABandsDepthLimitCapsTheLimitTheCellPublishesThere) {
+  const config::MillingConfig job = config::load_milling_config(job_path());
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  ASSERT_TRUE(cfg.controller.speed_schedule);
+  auto& bands = cfg.controller.speed_schedule->bands;
+  const auto at = config::speed_band_of(bands, 390.6);
+  ASSERT_TRUE(at);
+  bands[*at].controller = 0;
+  bands[*at].gain_ns_per_m = 2400.0;
+  bands[*at].depth_limit_mm.reset();
+  milling::LiveStability plain(job, "", {cfg});
+  const milling::LiveLimits free = plain.compute(390.6, 0, 2400.0);
+  ASSERT_GT(free.damped_mm, 1.0) << "C2 at K 2400 at 390.6 rpm: 1.214 mm by the sampled loop's SDM (docs/tuning.md)";
+  bands[*at].depth_limit_mm = 0.9;
+  milling::LiveStability capped(job, "", {cfg});
+  const milling::LiveLimits l = capped.compute(390.6, 0, 2400.0);
+  EXPECT_DOUBLE_EQ(l.damped_mm, 0.9);
+  EXPECT_NE(l.method.find("capped at the band's depth_limit_mm"), std::string::npos) << l.method;
+  EXPECT_DOUBLE_EQ(l.open_mm, free.open_mm);
+  EXPECT_DOUBLE_EQ(capped.compute(390.6, 0, 1000.0).damped_mm, plain.compute(390.6, 0, 1000.0).damped_mm)
+      << "another K than the band's: not the limit the band vouches for";
+  EXPECT_DOUBLE_EQ(capped.compute(700.0, 0, 2000.0).damped_mm, plain.compute(700.0, 0, 2000.0).damped_mm) << "another band";
+  // The schedule's lobes at the same speed, as `lobes --damped` and the cut's verdict compute them.
+  config::StructureConfig sc = *job.find_structure(job.structure);
+  const std::vector<milling::SdmPoint> open(1, milling::SdmPoint{390.6, free.open_mm});
+  EXPECT_DOUBLE_EQ(milling::scheduled_limits(sc, job, cfg, {390.6}, open).front().critical_depth_mm, 0.9);
 }
 
 // The notches at the speed are in the damped loop: at 700 rpm (tooth passing 35 Hz, harmonics at 70 and
@@ -89,6 +123,8 @@ TEST(LiveStability, HarmonicNotchesAtTheSpeedEnterTheDampedLimit) {
   const auto a700 = a.compute(700.0, 0, 2000.0), b700 = b.compute(700.0, 0, 2000.0);
   EXPECT_EQ(a700.open_mm, b700.open_mm);
   EXPECT_GT(std::abs(b700.damped_mm / a700.damped_mm - 1.0), 1e-3) << a700.damped_mm << " " << b700.damped_mm;
+  std::printf("700 rpm: open %.3f mm, damped %.3f mm, with the notches %.3f mm (docs/harmonic_notch.md)\n", a700.open_mm,
+              a700.damped_mm, b700.damped_mm);
   const auto a12k = a.compute(12000.0, 0, 2000.0), b12k = b.compute(12000.0, 0, 2000.0);
   EXPECT_NEAR(b12k.damped_mm / a12k.damped_mm, 1.0, 1e-3);
 }
@@ -265,16 +301,21 @@ TEST(ChatterIndicator, ForcedVibrationIsQuietAndAnOffHarmonicModeIsChatter) {
   EXPECT_FALSE(quiet.evaluate(NAN).valid);
 }
 
-// Simulated cuts of the job at 700 rpm (time domain, docs/milling.md): the indicator on the wall-normal
-// acceleration is quiet below the open-loop limit (1.66 mm) and indicates chatter above it.
+// Simulated cuts of the job at 700 rpm (time domain, docs/milling.md): the limit is 1.113 mm in time (1.111 mm by
+// SDM; the zero-order method's 1.661 mm, which this test once used, is wrong). The indicator on the wall-normal
+// acceleration is quiet at 1.0 mm and indicates chatter at 2.5 mm. Between, at 1.2 and 1.5 mm (8 and 35 % over
+// the limit, chattering in time), it does not yet: their non-harmonic share (0.010, 0.045) stays under its 0.1
+// threshold, as the 23.7 Hz chatter sits beside the 23.3 Hz spindle harmonic (chatter_indicator.hpp; issue 50).
+// It grows with the depth.
 TEST(ChatterIndicator, SimulatedCutsBelowAndAboveTheLimit) {
   const config::MillingConfig job = config::load_milling_config(job_path());
   const milling::Structure open(*job.find_structure(job.structure), false);
-  for (const double depth : {1.0, 2.5}) {
+  double share_before = 0.0;
+  for (const double depth : {1.0, 1.2, 1.5, 2.5}) {
     milling::CutOverrides o;
     o.rpm = 700.0;
     o.axial_mm = depth;
-    o.revolutions = 60;
+    o.revolutions = 150;  // 12.9 s: near the limit the chatter grows slowly
     const milling::CutJob cut = milling::make_cut_job(job, open, o);
     const milling::CutOutcome r = milling::run_job(cut);
     const double fs = 1.0 / r.record.step_s;
@@ -283,12 +324,18 @@ TEST(ChatterIndicator, SimulatedCutsBelowAndAboveTheLimit) {
     for (std::size_t i = 2; i < y.size(); ++i) m.push((y[i] - 2.0 * y[i - 1] + y[i - 2]) * fs * fs);
     const auto v = m.evaluate(r.record.rpm);
     ASSERT_TRUE(v.valid) << depth;
-    EXPECT_EQ(v.chatter, !r.verdict.stable) << depth << " mm: once-per-rev " << v.once_per_rev_ratio << ", non-harmonic "
-                                           << v.nonharmonic_share << ", " << v.nonharmonic_rms_mps2 << " m/s^2";
-    EXPECT_EQ(r.verdict.stable, depth < 1.66) << depth;
-    if (!r.verdict.stable) {
+    EXPECT_EQ(r.verdict.stable, depth < 1.113) << depth;
+    if (depth < 1.1 || depth > 2.0) {
+      EXPECT_EQ(v.chatter, !r.verdict.stable) << depth << " mm: once-per-rev " << v.once_per_rev_ratio << ", non-harmonic "
+                                             << v.nonharmonic_share << ", " << v.nonharmonic_rms_mps2 << " m/s^2";
+    }
+    EXPECT_GT(v.nonharmonic_share, share_before) << depth << " mm: the non-harmonic share grows with the depth";
+    share_before = v.nonharmonic_share;
+    if (v.chatter) {
       EXPECT_NEAR(v.chatter_hz, r.verdict.chatter_hz, 1.0 / 3.0);  // within the window's bins
     }
+    std::printf("%.1f mm: cut %s, indicator %s (non-harmonic share %.3f, once-per-rev %.3f)\n", depth,
+                r.verdict.stable ? "stable" : "chatters", v.chatter ? "chatter" : "quiet", v.nonharmonic_share, v.once_per_rev_ratio);
   }
 }
 

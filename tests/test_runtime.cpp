@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <filesystem>
 #include <stdexcept>
 
 #include "cell_util.hpp"
@@ -224,12 +225,21 @@ TEST(CellLifecycle, TransitionsInOrderAndDeactivateEndsARunEarly) {
   EXPECT_EQ(cell.state(), LifecycleState::kUnconfigured);
 }
 
+// The process's threads (/proc/self/task): ctest runs each test in a process of its own.
+std::size_t thread_count() {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator("/proc/self/task")) ++n;
+  return n;
+}
+
 TEST(CellLifecycle, DestroyingAnActiveCellStopsAndJoinsEverything) {
+  const std::size_t before = thread_count();
   auto cell = std::make_unique<Cell>(c2(), wall_clock_no_rt());
   test::configure(*cell);
   ASSERT_TRUE(cell->activate(3600.0).ok());
+  EXPECT_GT(thread_count(), before) << "the active cell runs its loop and workers on threads of its own";
   cell.reset();  // a test that returns early does this: no std::terminate, no thread left
-  SUCCEED();
+  EXPECT_EQ(thread_count(), before) << "every thread the cell started was joined by its destructor";
 }
 
 TEST(CellLifecycle, ADeviceThatCannotBeOpenedIsADeviceErrorAndNothingIsLeftOpen) {

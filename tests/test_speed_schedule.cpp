@@ -102,6 +102,14 @@ TEST(SpeedScheduleConfig, BandsAscendAndEveryKeyIsNamedWithItsUnitAndRangeWhenRe
   EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 40000, gain_ns_per_m: 5}\n").find("above spindle.rpm_max = 30000 rpm"),
             std::string::npos);
   EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain: 5}\n").find("bands[0].gain: unknown key"), std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: 0}\n")
+                .find("bands[0].depth_limit_mm = 0 mm is out of range"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: -1}\n")
+                .find("bands[0].depth_limit_mm = -1 mm is out of range"),
+            std::string::npos);
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: lots}\n").find("bands[0].depth_limit_mm"),
+            std::string::npos);
   EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: notch, center_hz: 3, bandwidth_hz: 4}}]\n"
                      "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
                 .find("controllers[0].compensator.kind = 'notch': it must be a compensator"),
@@ -512,7 +520,9 @@ void expect_schedule_holds_in_time(const config::Config& cell, const config::Mil
     ASSERT_TRUE(band) << s.rpm << " rpm";
     const auto& b = cell.controller.speed_schedule->bands[*band];
     EXPECT_DOUBLE_EQ(s.gain_ns_per_m, b.gain_ns_per_m) << s.rpm << " rpm";
-    if (b.gain_ns_per_m > 0.0) EXPECT_EQ(s.set, static_cast<std::size_t>(b.controller)) << s.rpm << " rpm";
+    if (b.gain_ns_per_m > 0.0) {
+      EXPECT_EQ(s.set, static_cast<std::size_t>(b.controller)) << s.rpm << " rpm";
+    }
     handed_over += s.set != previous_set ? 1 : 0;
     previous_set = s.set;
     EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm << " mm: " << milling::to_string(s.verdict.classification);

@@ -91,6 +91,11 @@ class Depths {
   void lower(double rpm, std::size_t candidate, double mm) {
     double& v = cache_.at({rpm, candidate});
     v = std::min(v, mm);
+    lowered_[{rpm, candidate}] = v;
+  }
+  [[nodiscard]] std::optional<double> lowered(double rpm, std::size_t candidate) const {
+    const auto it = lowered_.find({rpm, candidate});
+    return it == lowered_.end() ? std::nullopt : std::optional(it->second);
   }
   // Damped limits computed, and of them those the actuator's force limit capped (milling/forced_command.hpp).
   [[nodiscard]] std::size_t damped_limits() const { return damped_limits_; }
@@ -107,6 +112,7 @@ class Depths {
   std::vector<std::unique_ptr<milling::AccurateStability>> methods_;
   std::unique_ptr<milling::LobeModel> preview_;
   std::map<std::pair<double, std::size_t>, double> cache_;
+  std::map<std::pair<double, std::size_t>, double> lowered_;
   std::size_t damped_limits_{0}, capped_{0};
 };
 
@@ -133,18 +139,29 @@ std::size_t choose(const Depths& d, double rpm, std::size_t n_candidates, std::o
   return best;
 }
 
-// A band per run of equal choices, changing halfway between grid speeds; the first and last reach the range.
-std::vector<config::SpeedBandConfig> bands_of(const Grid& g, const std::vector<ScheduleCandidate>& cands, double lo, double hi) {
+// The depth each grid speed's band vouches for: the limit in time where its candidate's chattered there.
+std::vector<std::optional<double>> caps_of(const Grid& g, const Depths& d) {
+  std::vector<std::optional<double>> caps(g.rpm.size());
+  for (std::size_t i = 0; i < g.rpm.size(); ++i)
+    if (g.choice[i] != 0) caps[i] = d.lowered(g.rpm[i], g.choice[i]);
+  return caps;
+}
+
+// A band per run of equal choices, changing halfway between grid speeds; the first and last reach the range. A
+// grid speed whose candidate's limit was lowered to the time domain's is a band of its own with that depth limit,
+// so that the limit binds only about the speed where it was found.
+std::vector<config::SpeedBandConfig> bands_of(const Grid& g, const std::vector<std::optional<double>>& caps,
+                                              const std::vector<ScheduleCandidate>& cands, double lo, double hi) {
   std::vector<config::SpeedBandConfig> bands;
   for (std::size_t i = 0; i < g.rpm.size(); ++i) {
     const double from = i == 0 ? lo : edge(g.rpm[i - 1], g.rpm[i]);
     const double to = i + 1 == g.rpm.size() ? hi : edge(g.rpm[i], g.rpm[i + 1]);
     const ScheduleCandidate& c = cands[g.choice[i]];
-    if (!bands.empty() && i > 0 && g.choice[i] == g.choice[i - 1]) {
+    if (!bands.empty() && i > 0 && g.choice[i] == g.choice[i - 1] && !caps[i] && !caps[i - 1]) {
       bands.back().rpm_max = to;
       continue;
     }
-    bands.push_back({from, to, static_cast<int>(c.controller), c.gain_ns_per_m});
+    bands.push_back({from, to, static_cast<int>(c.controller), c.gain_ns_per_m, caps[i]});
   }
   // The open loop's bands run the controller before them (K = 0: the chain does not act), so that no hand-over
   // happens where nothing changes.
@@ -153,11 +170,21 @@ std::vector<config::SpeedBandConfig> bands_of(const Grid& g, const std::vector<S
   return bands;
 }
 
-// Which candidate the bands run at rpm.
-std::size_t candidate_at(const Grid& g, double rpm) {
+// The grid speed whose band holds rpm, and the candidate the bands run there.
+std::size_t grid_index_at(const Grid& g, double rpm) {
   std::size_t i = 0;
   while (i + 1 < g.rpm.size() && rpm >= edge(g.rpm[i], g.rpm[i + 1])) ++i;
-  return g.choice[i];
+  return i;
+}
+std::size_t candidate_at(const Grid& g, double rpm) { return g.choice[grid_index_at(g, rpm)]; }
+
+// The limit the bands give at rpm: their candidate's, no deeper than the band's depth limit (as the cell
+// publishes it: milling/scheduled_lobes.hpp, milling/live_stability.hpp).
+double scheduled_at(const Grid& g, const Depths& d, double rpm) {
+  const std::size_t i = grid_index_at(g, rpm), c = g.choice[i];
+  const double mm = d.depth(rpm, c);
+  const auto cap = c == 0 ? std::nullopt : d.lowered(g.rpm[i], c);
+  return cap ? std::min(mm, *cap) : mm;
 }
 
 }  // namespace
@@ -167,7 +194,7 @@ namespace {
 // Fewer bands than the controller holds: the run whose speeds lose least (to the open loop) when they take
 // a neighbour's candidate takes it, the narrowest first among equals.
 void fit_band_count(Grid& g, const Depths& d, const std::vector<ScheduleCandidate>& cands, double lo, double hi) {
-  while (bands_of(g, cands, lo, hi).size() > config::kMaxSpeedBands) {
+  while (bands_of(g, caps_of(g, d), cands, lo, hi).size() > config::kMaxSpeedBands) {
     std::vector<std::pair<std::size_t, std::size_t>> runs;  // [first, last] grid index
     for (std::size_t i = 0; i < g.rpm.size(); ++i)
       if (i == 0 || g.choice[i] != g.choice[i - 1]) runs.push_back({i, i});
@@ -252,20 +279,20 @@ std::set<double> refine(Grid& g, Depths& d, std::size_t n_cands, const milling::
 }
 
 // Which speeds of the schedule need a candidate chosen afresh: those whose band's candidate chattered in time
-// at 0.95 x its limit or is worse than the open loop. A candidate that chattered is not used at that speed any
-// more (its depth there 0): the cell's live limits are the accurate method's, so a band must not run where the
-// cut holds less than that. In the last pass (keep) its limit is lowered to the time domain's instead, and the
-// band keeps it: reported, never hidden. Cuts in time only where the candidate damps, once per speed.
+// at 0.95 x its limit or is worse than the open loop. A candidate that chattered there keeps the time domain's
+// limit (to the micrometre below) as its depth at that speed and competes again at it; where the bands then run
+// it, that speed is a band of its own with the limit as its depth_limit_mm, which the cell's live limits, the
+// lobes and the cut's verdict honour. Cuts in time only where the candidate damps, once per speed and depth.
 class InTime {
  public:
   InTime(Depths& d, const config::MillingConfig& job, const ScheduleSettings& s) : d_(d), job_(job), s_(s) {}
-  std::vector<double> to_choose_again(const Grid& g, const std::vector<double>& speeds, bool keep = false) {
+  std::vector<double> to_choose_again(const Grid& g, const std::vector<double>& speeds) {
     fill_scheduled(d_, g, speeds);
     std::vector<LimitInTime> todo;
     std::vector<std::pair<double, std::size_t>> keys;
     for (double r : speeds)
-      if (const std::size_t c = candidate_at(g, r); c != 0 && checked_depth(r, c) != d_.depth(r, c)) {
-        todo.push_back({r, &d_.structure(c), d_.depth(r, c)});
+      if (const std::size_t c = candidate_at(g, r); c != 0 && checked_depth(r, c) != scheduled_at(g, d_, r)) {
+        todo.push_back({r, &d_.structure(c), scheduled_at(g, d_, r)});
         keys.emplace_back(r, c);
       }
     if (s_.progress && !todo.empty()) s_.progress("the damped limits in time", 0, todo.size());
@@ -273,14 +300,15 @@ class InTime {
     std::set<double> again;
     for (std::size_t i = 0; i < res.size(); ++i) {
       ++checks_;
-      checked_[keys[i]] = d_.depth(keys[i].first, keys[i].second);
+      checked_[keys[i]] = todo[i].limit_mm;
       if (res[i].held) continue;
-      lowered_.push_back({keys[i].first, keys[i].second, d_.depth(keys[i].first, keys[i].second), res[i].limit_mm, keep});
-      d_.lower(keys[i].first, keys[i].second, keep ? res[i].limit_mm : 0.0);
+      const double held_mm = std::floor(res[i].limit_mm * 1000.0) / 1000.0;
+      lowered_.push_back({keys[i].first, keys[i].second, todo[i].limit_mm, held_mm, false});
+      d_.lower(keys[i].first, keys[i].second, held_mm);
       again.insert(keys[i].first);
     }
     for (double r : speeds)
-      if (d_.depth(r, candidate_at(g, r)) < d_.depth(r, 0) * (1.0 - 0.01 * s_.worse_tolerance_pct)) again.insert(r);
+      if (scheduled_at(g, d_, r) < d_.depth(r, 0) * (1.0 - 0.01 * s_.worse_tolerance_pct)) again.insert(r);
     return {again.begin(), again.end()};
   }
   [[nodiscard]] std::size_t checks() const { return checks_; }
@@ -312,30 +340,40 @@ void check_in_time(SpeedSchedule& out, Grid& g, std::set<double>& checked, Depth
     if (job_rpm > 0.0) all.insert(job_rpm);
     return std::vector<double>(all.begin(), all.end());
   };
-  for (int round = 0; round <= s.refine_rounds; ++round) {
+  const double tol = 1.0 - 0.01 * s.worse_tolerance_pct;
+  auto place = [&](double r, std::size_t c) {  // r on the grid with candidate c
+    const auto at = std::lower_bound(g.rpm.begin(), g.rpm.end(), r);
+    const auto i = static_cast<std::size_t>(at - g.rpm.begin());
+    if (at != g.rpm.end() && *at == r) {
+      g.choice[i] = c;
+      return;
+    }
+    g.rpm.insert(at, r);
+    g.choice.insert(g.choice.begin() + static_cast<std::ptrdiff_t>(i), c);
+    checked.erase(r);
+    ++out.refined_speeds;
+  };
+  // refine_rounds rounds of choosing again among every candidate; then a speed keeps its band's candidate at
+  // its limit in time (a band of its own), or the open loop's where that is worse; the cuts in time check what
+  // that changed once more, and what they lower then is kept the same way without another check.
+  for (int round = 0;; ++round) {
     const std::vector<double> again = in_time.to_choose_again(g, speeds());
     if (again.empty()) break;
-    const bool last = round == s.refine_rounds;
-    if (!last) d.fill(again, every(out.candidates.size()), "choosing again after the cuts in time");
+    const bool choose_again = round < s.refine_rounds;
+    if (choose_again) d.fill(again, every(out.candidates.size()), "choosing again after the cuts in time");
     for (double r : again) {
-      const std::size_t c = last ? 0 : choose(d, r, out.candidates.size(), std::nullopt, s);
-      const auto at = std::lower_bound(g.rpm.begin(), g.rpm.end(), r);
-      const auto i = static_cast<std::size_t>(at - g.rpm.begin());
-      if (at != g.rpm.end() && *at == r) {
-        g.choice[i] = c;
-      } else {
-        g.rpm.insert(at, r);
-        g.choice.insert(g.choice.begin() + static_cast<std::ptrdiff_t>(i), c);
-        checked.erase(r);
-        ++out.refined_speeds;
-      }
+      std::size_t c = candidate_at(g, r);
+      if (choose_again) c = choose(d, r, out.candidates.size(), std::nullopt, s);
+      else if (d.depth(r, c) < d.depth(r, 0) * tol) c = 0;
+      place(r, c);
     }
     fit_band_count(g, d, out.candidates, lo, hi);
+    if (round > s.refine_rounds) break;
   }
-  (void)in_time.to_choose_again(g, speeds(), true);
   out.limits_in_time = in_time.checks();
   out.lowered_in_time = in_time.lowered().size();
   out.lowered = in_time.lowered();
+  for (LoweredLimit& l : out.lowered) l.kept = candidate_at(g, l.rpm) == l.candidate;
 }
 
 }  // namespace
@@ -373,7 +411,7 @@ void summarise(SpeedSchedule& out, const Depths& d, const config::MillingConfig&
     m.job_rpm = job_rpm;
     m.job_open_mm = d.depth(job_rpm, 0);
     m.job_fixed_mm = d.depth(job_rpm, d.fixed());
-    m.job_scheduled_mm = d.depth(job_rpm, candidate_at(g, job_rpm));
+    m.job_scheduled_mm = scheduled_at(g, d, job_rpm);
   }
   (void)job;
 }
@@ -430,7 +468,7 @@ SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<Name
   fill_scheduled(d, g, job_rpm > 0.0 ? std::vector<double>{job_rpm} : std::vector<double>{});
   fill_scheduled(d, g, speeds);
   std::sort(speeds.begin(), speeds.end());
-  out.bands = bands_of(g, out.candidates, lo, hi);
+  out.bands = bands_of(g, caps_of(g, d), out.candidates, lo, hi);
   const std::set<double> on_grid(g.rpm.begin(), g.rpm.end());
   for (double r : speeds) {
     ScheduleSpeed p;
@@ -440,7 +478,7 @@ SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<Name
     p.open_mm = d.depth(r, 0);
     p.fixed_mm = d.depth(r, d.fixed());
     p.candidate = candidate_at(g, r);
-    p.scheduled_mm = d.depth(r, p.candidate);
+    p.scheduled_mm = scheduled_at(g, d, r);
     p.band = config::speed_band_of(out.bands, r).value_or(0);
     out.speeds.push_back(p);
   }

@@ -110,6 +110,12 @@ struct SpeedSchedule {
   // limit, and of them those that chattered (that candidate not used there: the speed chosen again).
   std::size_t limits_in_time{0}, lowered_in_time{0};
   std::vector<LoweredLimit> lowered;
+  // Bands with a depth_limit_mm (a limit in time below the accurate method's).
+  [[nodiscard]] std::size_t limited_bands() const {
+    std::size_t n = 0;
+    for (const auto& b : bands) n += b.depth_limit_mm ? 1U : 0U;
+    return n;
+  }
   // Damped limits computed, and of them those capped where the cut's forced vibration drives the actuator to
   // its force limit (milling/forced_command.hpp): the linear stability analysis assumes an unlimited actuator.
   std::size_t damped_limits{0}, capped_limits{0};

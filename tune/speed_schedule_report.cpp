@@ -89,20 +89,20 @@ std::string schedule_text(const SpeedSchedule& s, const std::string& cell, const
   o << "  every damped limit is capped where the cut's forced vibration drives the actuator to its force limit: "
     << s.capped_limits << " of " << s.damped_limits << " were\n";
   o << "  every damped limit the bands run is checked in time (the real Controller, a cut at 0.95 x the limit): "
-    << s.lowered_in_time << " of " << s.limits_in_time << " chattered, and another candidate runs there\n";
+    << s.lowered_in_time << " of " << s.limits_in_time << " chattered: there another candidate runs, or the same at its "
+    << "limit in time (bands with a depth_limit_mm, which the cell's limits honour: " << s.limited_bands() << ")\n";
   for (const auto& l : s.lowered)
     o << fmt("    at %.1f rpm, controller ", l.rpm) << controller_name(s, s.candidates[l.candidate].controller)
       << fmt(" at K %.0f N s/m: %.3f mm by the accurate method, %.3f mm in time", s.candidates[l.candidate].gain_ns_per_m,
              l.accurate_mm, l.time_mm)
-      << (l.kept ? "; WARNING: still run there (found after the last round): the live limits show the accurate method's"
-                 : "") << "\n";
+      << (l.kept ? "; runs there at its limit in time" : "; another candidate runs there") << "\n";
   o << "  bands (" << s.bands.size() << "; " << s.refined_speeds << " speeds refined where a check found a band worse):\n";
   for (const auto& b : s.bands)
     o << fmt("    %8.1f - %8.1f rpm: ", b.rpm_min, b.rpm_max)
       << (b.gain_ns_per_m == 0.0 ? std::string("K 0 (the open loop)")
                                  : "controller " + controller_name(s, static_cast<std::size_t>(b.controller)) +
                                        fmt(" at K %.0f N s/m", b.gain_ns_per_m))
-      << "\n";
+      << (b.depth_limit_mm ? fmt(", at most %.3f mm (its limit in time)", *b.depth_limit_mm) : std::string()) << "\n";
   const double tol = 1.0 - 0.01 * s.settings.worse_tolerance_pct;
   for (const auto& p : s.speeds)
     if (p.scheduled_mm < p.open_mm * tol)
@@ -120,7 +120,8 @@ json schedule_json(const SpeedSchedule& s) {
                            {"top_gain_ns_per_m", c.top_gain_ns_per_m}, {"top_gain_reason", c.top_gain_reason},
                            {"gains_ns_per_m", c.gains}});
   for (const auto& b : s.bands)
-    bands.push_back({{"rpm_min", b.rpm_min}, {"rpm_max", b.rpm_max}, {"controller", b.controller}, {"gain_ns_per_m", b.gain_ns_per_m}});
+    bands.push_back({{"rpm_min", b.rpm_min}, {"rpm_max", b.rpm_max}, {"controller", b.controller}, {"gain_ns_per_m", b.gain_ns_per_m},
+                     {"depth_limit_mm", b.depth_limit_mm ? json(*b.depth_limit_mm) : json(nullptr)}});
   for (const auto& p : s.speeds)
     speeds.push_back({{"rpm", p.rpm}, {"grid", p.grid}, {"open_mm", p.open_mm}, {"fixed_mm", p.fixed_mm},
                       {"scheduled_mm", p.scheduled_mm}, {"band", p.band}, {"candidate", p.candidate}});
@@ -150,7 +151,8 @@ std::string schedule_header(const SpeedSchedule& s) {
   std::ostringstream o;
   o << "# The speed schedule (controller.speed_schedule) was verified with " << s.method << " at " << m.speeds
     << " speeds, each damped limit checked in time (a cut at 0.95 x it, the real Controller; "
-    << s.lowered_in_time << " of " << s.limits_in_time << " chattered: another candidate runs there):\n"
+    << s.lowered_in_time << " of " << s.limits_in_time << " chattered: another candidate runs there, or the same at its limit "
+    << "in time; bands with depth_limit_mm: " << s.limited_bands() << "):\n"
     << fmt("#   minimum %.3f mm at %.0f rpm (open loop %.3f mm, as configured %.3f mm); ", m.scheduled_min_mm,
            m.scheduled_min_rpm, m.open_min_mm, m.fixed_min_mm)
     << fmt("mean x%.3f the open loop (as configured x%.3f);\n", m.scheduled_mean_ratio, m.fixed_mean_ratio)
@@ -167,7 +169,11 @@ std::string schedule_header(const SpeedSchedule& s) {
 
 std::pair<std::string, std::string> schedule_plot(const SpeedSchedule& s, const std::string& title) {
   std::ostringstream data;
-  for (const auto& p : s.speeds) data << fmt("%.10g %.10g %.10g %.10g\n", p.rpm, p.open_mm, p.fixed_mm, p.scheduled_mm);
+  // Columns: rpm, open, as configured, scheduled, the band's depth_limit_mm (-1: none).
+  for (const auto& p : s.speeds) {
+    const auto& cap = p.band < s.bands.size() ? s.bands[p.band].depth_limit_mm : std::nullopt;
+    data << fmt("%.10g %.10g %.10g %.10g", p.rpm, p.open_mm, p.fixed_mm, p.scheduled_mm) << fmt(" %.10g\n", cap ? *cap : -1.0);
+  }
   // A logarithmic depth axis: the limits span two decades (the minima near the modes' lobes, the pockets between).
   double y_min = std::numeric_limits<double>::infinity(), y_max = 0.0;
   for (const auto& p : s.speeds) {
@@ -184,7 +190,8 @@ std::pair<std::string, std::string> schedule_plot(const SpeedSchedule& s, const 
     << "set yrange [" << y_min << ":" << y_max << "]\n"
     << "plot DATA u 1:2 w l lw 2 lc rgb '#7f8c8d' t 'open loop (SDM)', "
     << "DATA u 1:3 w l lw 1.5 lc rgb '#e67e22' t 'as configured (sampled-loop SDM)', "
-    << "DATA u 1:4 w l lw 2.5 lc rgb '#27ae60' t 'scheduled by speed (sampled-loop SDM)'\n";
+    << "DATA u 1:4 w l lw 2.5 lc rgb '#27ae60' t 'scheduled by speed (sampled-loop SDM, each limit checked in time)', "
+    << "DATA u 1:($5 > 0 ? $4 : 1/0) w p pt 7 ps 1.3 lc rgb '#c0392b' t 'a band limited to its depth in time (depth_limit_mm)'\n";
   return {data.str(), g.str()};
 }
 

@@ -42,7 +42,9 @@ std::string schedule_block(const std::string& indent, const SpeedSchedule& s) {
   o << indent << "  bands:\n";
   for (const auto& b : s.bands)
     o << indent << "    - {rpm_min: " << exact(b.rpm_min) << ", rpm_max: " << exact(b.rpm_max) << ", controller: " << b.controller
-      << ", gain_ns_per_m: " << exact(b.gain_ns_per_m) << "}\n";
+      << ", gain_ns_per_m: " << exact(b.gain_ns_per_m)
+      << (b.depth_limit_mm ? ", depth_limit_mm: " + exact(*b.depth_limit_mm) : std::string()) << "}"
+      << (b.depth_limit_mm ? "   # the cut in time holds less than the accurate method's limit" : "") << "\n";
   return o.str();
 }
 
@@ -111,6 +113,7 @@ config::EditedYaml scheduled_config_text(const config::Config& cell_in, const Sp
     band["rpm_max"] = exact(b.rpm_max);
     band["controller"] = b.controller;
     band["gain_ns_per_m"] = exact(b.gain_ns_per_m);
+    if (b.depth_limit_mm) band["depth_limit_mm"] = exact(*b.depth_limit_mm);
     bands.push_back(band);
   }
   schedule["bands"] = bands;
