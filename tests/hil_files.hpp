@@ -9,7 +9,6 @@
 #include <unistd.h>
 
 #include <fstream>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -39,11 +38,6 @@ inline std::size_t replace_all_present(std::string& s, const std::string& from, 
   return n;
 }
 
-// A test's own edit: every occurrence, and at least one (an edit that matches nothing would leave the file as it
-// was, and the test would check something else than it says).
-inline void replace_all(std::string& s, const std::string& from, const std::string& to) {
-  if (replace_all_present(s, from, to) == 0) throw std::runtime_error("the edit's text is not in the file: '" + from + "'");
-}
 
 struct HilFiles {
   std::string dir, config, plant_json, run_json, plant_log, run_log;
@@ -63,7 +57,7 @@ inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<s
   replace_all_present(text, "model: robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
   replace_all_present(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
   replace_all_present(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
-  for (const auto& [from, to] : edits) replace_all(text, from, to);
+  for (const auto& [from, to] : edits) replace_or_throw(text, from, to);  // a test's own edit must match
   f.config = f.dir + "/hil.yaml";
   std::ofstream(f.config) << text;
   f.plant_json = f.dir + "/plant.json";

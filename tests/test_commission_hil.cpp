@@ -32,8 +32,8 @@ test::HilFiles robot_a_hil(const std::string& name, const std::string& commissio
   const test::HilFiles f = test::hil_files(name, {{"unix:/tmp/robodamp-hil-commission.sock", "unix:/PLACEHOLDER"}},
                                            "commissioning/robot_a_two_modes_hil");
   std::string text = test::read_file(f.config);
-  test::replace_all(text, "unix:/PLACEHOLDER", "unix:" + f.dir + "/can.sock");
-  test::replace_all(text, "port: 1512", "port: " + std::to_string(test::free_tcp_port()));
+  test::replace_or_throw(text, "unix:/PLACEHOLDER", "unix:" + f.dir + "/can.sock");
+  test::replace_or_throw(text, "port: 1512", "port: " + std::to_string(test::free_tcp_port()));
   std::ofstream(f.config) << text << "\ncommissioning: {" << commissioning << "}\n";
   return f;
 }
@@ -147,7 +147,7 @@ TEST(CommissionHil, AnEmulatorThatGoesSilentEndsTheCutWithTheReason) {
 // exported with every FRF 2 % off (the kit's calibration), without the actuator (tests/modal_kit.hpp).
 std::string modal_kit_export(const std::string& dir) {
   std::string robot = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes.yaml");
-  test::replace_all(robot, "  seed: 1", "  seed: 29");
+  test::replace_or_throw(robot, "  seed: 1", "  seed: 29");
   std::ofstream(dir + "/kit_robot.yaml") << robot;
   return test::modal_kit_export(dir + "/kit_robot.yaml", dir + "/kit", dir + "/tap_tests.uff", 1.02);
 }
@@ -215,7 +215,7 @@ TEST(CommissionHil, ARealCellIsCommissionedWithTheActuatorAsTheShakerAndTheUsers
 TEST(CommissionHil, ARealCellThatIsNotReadyIsRefusedBeforeTheActuatorMoves) {
   const test::HilFiles f = robot_a_hil("commission_not_ready", "chirp_periods: 3, chirp_period_s: 8");
   std::string text = test::read_file(f.config);
-  test::replace_all(text, "amplifier_ready_delay_s: 0.005", "amplifier_ready_delay_s: 10");
+  test::replace_or_throw(text, "amplifier_ready_delay_s: 0.005", "amplifier_ready_delay_s: 10");
   std::ofstream(f.config) << text;
   commission::CommissionSettings s = short_commission(f);
   std::ofstream(f.dir + "/taps.uff") << "";  // never read: the measurement stops first

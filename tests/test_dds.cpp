@@ -492,17 +492,24 @@ struct SecureLoop {
   }
 };
 
+// op (an authorised operator in the loop's domain) matches and asks for K = 2500 N s/m (ids from first_id) until
+// answered: accepted with its own value, and only its requests reached the loop, each at most once.
+void expect_operator_answered(SecureLoop& loop, Client& op, std::uint32_t first_id) {
+  ASSERT_TRUE(eventually([&] { return op.matched(); }, 60.0)) << "authentication and matching";
+  const auto asked = op.ask_until_answered(first_id, msg::SET_GAIN, 2500.0);
+  const auto r = op.reply(asked.back());
+  ASSERT_TRUE(r);
+  EXPECT_TRUE(r->accepted()) << r->reason();
+  EXPECT_NE(std::string(r->reason()).find("K = 2500"), std::string::npos) << r->reason() << ": the operator's value";
+  EXPECT_GE(loop.handled.load(), 1);
+  EXPECT_LE(loop.handled.load(), static_cast<int>(asked.size())) << "only the operator's requests, each at most once";
+}
+
 TEST(DdsSecurity, AnAuthorisedOperatorsRequestReachesTheLoop) {
   ASSERT_FALSE(security_dir().empty()) << "scripts/dds_security.sh failed (openssl)";
   SecureLoop loop(test_domain(4));
   Client op(loop.cfg.domain_id, identity("operator"));
-  ASSERT_TRUE(eventually([&] { return op.matched(); }, 60.0)) << "authentication and matching";
-  const auto asked = op.ask_until_answered(1, msg::SET_GAIN, 2500.0);
-  const auto r = op.reply(asked.back());
-  ASSERT_TRUE(r);
-  EXPECT_TRUE(r->accepted()) << r->reason();
-  EXPECT_GE(loop.handled.load(), 1);
-  EXPECT_LE(loop.handled.load(), static_cast<int>(asked.size())) << "each request reaches the loop at most once";
+  ASSERT_NO_FATAL_FAILURE(expect_operator_answered(loop, op, 1));
   EXPECT_TRUE(eventually([&] { return loop.publish_frames(250), op.telemetry.size() > 0; }, 60.0));
 }
 
@@ -582,14 +589,7 @@ TEST(DdsSecurity, AnUnauthenticatedParticipantsRequestsNeverReachTheLoop) {
   // The positive control: the same secured loop, up all along, answers an authorised operator in the same domain;
   // so the intruder's silence is the security's doing, not a loop that never came up.
   Client op(loop.cfg.domain_id, identity("operator"));
-  ASSERT_TRUE(eventually([&] { return op.matched(); }, 60.0)) << "authentication and matching";
-  const auto asked = op.ask_until_answered(100, msg::SET_GAIN, 2500.0);
-  const auto r = op.reply(asked.back());
-  ASSERT_TRUE(r);
-  EXPECT_TRUE(r->accepted()) << r->reason();
-  EXPECT_NE(std::string(r->reason()).find("K = 2500"), std::string::npos) << r->reason() << ": the operator's value, not the intruder's 4000";
-  EXPECT_GE(loop.handled.load(), 1);
-  EXPECT_LE(loop.handled.load(), static_cast<int>(asked.size())) << "only the operator's requests reached the loop";
+  ASSERT_NO_FATAL_FAILURE(expect_operator_answered(loop, op, 100));  // the operator's 2500, not the intruder's 4000
   EXPECT_EQ(intruder.replies.size(), 0U);
 }
 

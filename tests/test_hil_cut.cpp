@@ -240,18 +240,18 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
 TEST(HilCut, NoStableSpeedOrOneTheSpindleCannotReachKeepsTheSpeed) {
   test::HilFiles none_files = advice_cell("advice_none");
   std::string job = test::read_file(kJob);
-  test::replace_all(job, "  rpm_min: 100\n  rpm_max: 1500\n  points: 2000", "  rpm_min: 690\n  rpm_max: 710\n  points: 2000");
-  test::replace_all(job, "config: ../presets/", std::string("config: ") + ROBODAMP_SOURCE_DIR + "/config/presets/");
+  test::replace_or_throw(job, "  rpm_min: 100\n  rpm_max: 1500\n  points: 2000", "  rpm_min: 690\n  rpm_max: 710\n  points: 2000");
+  test::replace_or_throw(job, "config: ../presets/", std::string("config: ") + ROBODAMP_SOURCE_DIR + "/config/presets/");
   const std::string narrow_job = none_files.dir + "/narrow_job.yaml";
   std::ofstream(narrow_job) << job;
   std::string cell = test::read_file(none_files.config);
-  test::replace_all(cell, "  job: " + kJob, "  job: " + narrow_job);
+  test::replace_or_throw(cell, "  job: " + kJob, "  job: " + narrow_job);
   std::ofstream(none_files.config) << cell;
   AdviceCase none = start_advice_case(none_files, "0.85", false);
 
   test::HilFiles slow_files = advice_cell("advice_slow");
   std::string text = test::read_file(slow_files.config);  // the emulator's copy: the same socket and port
-  test::replace_all(text, "  rpm_max: 1500\n", "  rpm_max: 430\n");
+  test::replace_or_throw(text, "  rpm_max: 1500\n", "  rpm_max: 430\n");
   const std::string slow_plant_config = slow_files.dir + "/hil_plant.yaml";
   std::ofstream(slow_plant_config) << text;
   AdviceCase slow = start_advice_case(slow_files, "0.85", false, slow_plant_config, "424");

@@ -195,12 +195,12 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
                    "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}"}},
       "hil_pose_schedule");
   std::string robot = test::read_file(src + "/config/robots/compact_three_link.yaml");
-  test::replace_all(robot, "stiffness_nm_per_rad: 2.2e5", "stiffness_nm_per_rad: 2.64e5");
-  test::replace_all(robot, "stiffness_nm_per_rad: 2.6e3", "stiffness_nm_per_rad: 2.21e3");
+  test::replace_or_throw(robot, "stiffness_nm_per_rad: 2.2e5", "stiffness_nm_per_rad: 2.64e5");
+  test::replace_or_throw(robot, "stiffness_nm_per_rad: 2.6e3", "stiffness_nm_per_rad: 2.21e3");
   const std::string truth = f.dir + "/true_robot.yaml";
   std::ofstream(truth) << robot;
   std::string cell = test::read_file(f.config);
-  test::replace_all(cell, "model: " + src + "/config/robots/planar_three_link.yaml", "model: " + truth);
+  test::replace_or_throw(cell, "model: " + src + "/config/robots/planar_three_link.yaml", "model: " + truth);
   std::ofstream(f.config) << cell;
   // Written as a person would: flow and block styles mixed.
   std::ofstream(f.dir + "/poses.yaml") << "poses:\n  - {name: a, joints_deg: [-90, 30, 30]}\n  - {name: b, joints_deg: [-90, 50, 29.5]}\n"
@@ -252,7 +252,7 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
   std::string plant_cell = test::read_file(tuned);
   const std::string fitted_as_written = plant_cell.find(f.dir + "/fitted.yaml") != std::string::npos ? f.dir + "/fitted.yaml" : "fitted.yaml";
   ASSERT_NE(plant_cell.find("model: " + fitted_as_written), std::string::npos) << plant_cell;
-  test::replace_all(plant_cell, "model: " + fitted_as_written, "model: " + truth);
+  test::replace_or_throw(plant_cell, "model: " + fitted_as_written, "model: " + truth);
   std::ofstream(f.dir + "/plant.yaml") << plant_cell;
   const std::vector<std::string> trajectory{"--pose-at", "0:-90,50,29.5",  "--pose-at", "24:-90,50,29.5", "--pose-at", "30:-90,90,30",
                                             "--pose-at", "54:-90,90,30", "--pose-at", "58:-90.25,110,29.5", "--pose-at", "82:-90.25,110,29.5"};

@@ -48,11 +48,11 @@ Workspace true_robot_cell(const std::string& name, double k2 = 5.6e5, double k3 
   fs::remove_all(w.dir);
   fs::create_directories(w.dir);
   std::string robot = test::read_file(kNominal);
-  test::replace_all(robot, "stiffness_nm_per_rad: 4.05e5", "stiffness_nm_per_rad: " + std::to_string(k2));
-  test::replace_all(robot, "stiffness_nm_per_rad: 3.99e3", "stiffness_nm_per_rad: " + std::to_string(k3));
+  test::replace_or_throw(robot, "stiffness_nm_per_rad: 4.05e5", "stiffness_nm_per_rad: " + std::to_string(k2));
+  test::replace_or_throw(robot, "stiffness_nm_per_rad: 3.99e3", "stiffness_nm_per_rad: " + std::to_string(k3));
   std::ofstream(w.dir + "/true_robot.yaml") << robot;
   std::string cell = test::read_file(kSource + "/config/presets/pose_scheduled_c2.yaml");
-  test::replace_all(cell, "model: ../robots/planar_three_link.yaml", "model: true_robot.yaml");
+  test::replace_or_throw(cell, "model: ../robots/planar_three_link.yaml", "model: true_robot.yaml");
   w.cell = w.dir + "/cell.yaml";
   std::ofstream(w.cell) << cell;
   // Written as a person would: a comment, block and flow styles mixed.
@@ -177,7 +177,7 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   fs::rename(soft.dir + "/there", soft.dir + "/there_soft");
   std::string manifest = test::read_file(soft.dir + "/there_soft/measurement.json");
   auto model_of = [](const std::string& dir) { return (fs::path(dir) / "true_robot.yaml").lexically_normal().string(); };
-  test::replace_all(manifest, model_of(soft.dir), model_of(w.dir));
+  test::replace_or_throw(manifest, model_of(soft.dir), model_of(w.dir));
   std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
   r = robodamp({"pose", "fit", "--measurements", w.dir + "/here", soft.dir + "/there_soft"}, w.dir + "/h.log");
   EXPECT_EQ(r.status, 2);
@@ -186,7 +186,7 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   // Two poses, not one: the soft robot's measurement labelled 1.5 deg away along joint 3 (a pose read
   // wrong). The models put 15 % (nominal) and 33 % (the cell's) between the two poses' FRFs, the data 106 %:
   // refused by fit and by pose tune, naming both poses, and nothing written.
-  test::replace_all(manifest, "-20.0", "-18.5");
+  test::replace_or_throw(manifest, "-20.0", "-18.5");
   std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
   for (const std::vector<std::string>& cmd :
        {std::vector<std::string>{"pose", "fit", "--model", kNominal, "--measurements", w.dir + "/here", soft.dir + "/there_soft"},

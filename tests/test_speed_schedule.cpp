@@ -102,14 +102,13 @@ TEST(SpeedScheduleConfig, BandsAscendAndEveryKeyIsNamedWithItsUnitAndRangeWhenRe
   EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 40000, gain_ns_per_m: 5}\n").find("above spindle.rpm_max = 30000 rpm"),
             std::string::npos);
   EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain: 5}\n").find("bands[0].gain: unknown key"), std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: 0}\n")
-                .find("bands[0].depth_limit_mm = 0 mm is out of range"),
-            std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: -1}\n")
-                .find("bands[0].depth_limit_mm = -1 mm is out of range"),
-            std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: lots}\n").find("bands[0].depth_limit_mm"),
-            std::string::npos);
+  for (const auto& [limit, says] : std::vector<std::pair<std::string, std::string>>{
+           {"0", "bands[0].depth_limit_mm = 0 mm is out of range"},
+           {"-1", "bands[0].depth_limit_mm = -1 mm is out of range"},
+           {"lots", "bands[0].depth_limit_mm"}}) {
+    const std::string band = "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: " + limit + "}\n";
+    EXPECT_NE(problems(bands + band).find(says), std::string::npos) << limit << ": " << problems(bands + band);
+  }
   EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: notch, center_hz: 3, bandwidth_hz: 4}}]\n"
                      "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
                 .find("controllers[0].compensator.kind = 'notch': it must be a compensator"),
@@ -489,13 +488,6 @@ TEST(Robustness, TheModeShiftATunedLoopHoldsIsMeasuredToTheStep) {
 namespace robodamp {
 namespace {
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // A ramp up through a preset's schedule with the real supervisor: the middle of every band at least 4 rpm wide
 // (the narrow ones are a grid step or two between wider ones), a cut at 0.95 x the limit the cell publishes there.
 void expect_schedule_holds_in_time(const config::Config& cell, const config::MillingConfig& job) {
@@ -550,11 +542,8 @@ TEST(ScheduledCut, TheTunedHorizontalPresetsScheduleHoldsAtNinetyFivePercentAsTh
 TEST(ScheduledCut, TheTunedVerticalPresetsScheduleHoldsAtNinetyFivePercentAsTheSpindleRampsThroughIt) {
   // The vertical preset's recorded command verifies it on the default job: that job with this preset closing the loop.
   const test::ScratchDir dir("tuned-vertical-ramp");
-  std::string text = read_text(source("config/milling/active_damping_c2.yaml"));
-  const std::string from = "../presets/horizontal_c2.yaml";
-  const auto at = text.find(from);
-  ASSERT_NE(at, std::string::npos);
-  text.replace(at, from.size(), test::preset("tuned_vertical"));
+  std::string text = test::read_file(source("config/milling/active_damping_c2.yaml"));
+  test::replace_or_throw(text, "../presets/horizontal_c2.yaml", test::preset("tuned_vertical"));
   std::ofstream(dir.file("job.yaml")) << text;
   const config::Config cell = config::load_config_file(test::preset("tuned_vertical"));
   const config::MillingConfig job = config::load_milling_config(dir.file("job.yaml"));

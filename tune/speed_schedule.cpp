@@ -290,11 +290,14 @@ class InTime {
     fill_scheduled(d_, g, speeds);
     std::vector<LimitInTime> todo;
     std::vector<std::pair<double, std::size_t>> keys;
-    for (double r : speeds)
-      if (const std::size_t c = candidate_at(g, r); c != 0 && checked_depth(r, c) != scheduled_at(g, d_, r)) {
-        todo.push_back({r, &d_.structure(c), scheduled_at(g, d_, r)});
+    for (double r : speeds) {
+      const std::size_t c = candidate_at(g, r);
+      if (c == 0) continue;
+      if (const double mm = scheduled_at(g, d_, r); checked_depth(r, c) != mm) {
+        todo.push_back({r, &d_.structure(c), mm});
         keys.emplace_back(r, c);
       }
+    }
     if (s_.progress && !todo.empty()) s_.progress("the damped limits in time", 0, todo.size());
     const std::vector<LimitInTimeResult> res = limits_in_time(job_, todo, s_.threads);
     std::set<double> again;
