@@ -40,7 +40,8 @@ struct RunArgs {
 };
 
 // "--fault amplifier_fault:8" or "sensor_nan:5:0.2": the plant's fault injector from loop time START_S for
-// DURATION_S (default: to the end). Nothing, after saying why, when the text is not one.
+// DURATION_S (default: to the end); actuator_saturated takes the force it still gives, FORCE_N (default 0: none),
+// after the duration. Nothing, after saying why, when the text is not one.
 std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   const auto fail = [&](const std::string& why) -> std::optional<sim::Fault> {
     std::cerr << "robodamp run: --fault = '" << text << "' " << why << '\n';
@@ -49,7 +50,7 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   std::vector<std::string> parts;
   std::stringstream ss(text);
   for (std::string p; std::getline(ss, p, ':');) parts.push_back(p);
-  if (parts.size() < 2 || parts.size() > 3) return fail("is not KIND:START_S[:DURATION_S]");
+  if (parts.size() < 2 || parts.size() > 4) return fail("is not KIND:START_S[:DURATION_S] (actuator_saturated:START_S:DURATION_S[:FORCE_N])");
   sim::Fault f;
   bool known = false;
   std::string kinds;
@@ -61,11 +62,15 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   if (!known) return fail("names no fault: allowed " + kinds);
   double start = 0.0, duration = std::numeric_limits<double>::infinity();
   if (auto p = parse_number("--fault start", parts[1], {"s", 0.0, run_s, false, false, "within --duration"}, false, start)) return fail(*p);
-  if (parts.size() == 3)
+  if (parts.size() >= 3)
     if (auto p = parse_number("--fault duration", parts[2], {"s", 0.0, 604800.0, true}, false, duration)) return fail(*p);
   f.start_s = start;
   f.duration_s = duration;
   if (f.kind == sim::FaultKind::kActuatorSaturated) f.magnitude = 0.0;
+  if (parts.size() == 4) {
+    if (f.kind != sim::FaultKind::kActuatorSaturated) return fail("has a fourth field: only actuator_saturated takes one (FORCE_N)");
+    if (auto p = parse_number("--fault force", parts[3], {"N", 0.0, 1e6}, false, f.magnitude)) return fail(*p);
+  }
   return f;
 }
 
@@ -178,7 +183,8 @@ void register_run(Registry& r) {
             "pose_schedule, simulated plant: the robot stands at these joint angles (one per joint)");
   sub->add_option("--fault", a->faults,
                   "Simulated plant, a fault drill: KIND:START_S[:DURATION_S] (sensor_nan, amplifier_fault, ... from loop "
-                  "time START_S; repeatable)");
+                  "time START_S; repeatable); actuator_saturated:START_S:DURATION_S:FORCE_N limits the actuator to FORCE_N "
+                  "(default 0)");
   sub->add_flag("--no-pose-schedule", a->no_pose_schedule,
                 "pose_schedule: run the first region's set at every pose and ignore the joint angles (scheduling off)");
 }

@@ -363,6 +363,12 @@ PlantConfig read_plant(MapReader& top) {
   PlantConfig c;
   if (auto v = read_int(r, "oversampling", {"(internal steps per loop period)", 1, 64}, c.oversampling))
     c.oversampling = *v;
+  if (auto v = read_int(r, "actuator_wiring", {"(1 as configured, -1 leads swapped)", -1, 1}, c.actuator_wiring)) {
+    if (*v == 0)
+      r.diagnostics().add(r.mark(), "plant.actuator_wiring", "= 0 is not a wiring: allowed 1 (as configured) or -1 (leads swapped)");
+    else
+      c.actuator_wiring = *v;
+  }
   r.finish();
   return c;
 }

@@ -241,6 +241,9 @@ struct SensorConfig {
 // The simulated plant's numerical settings.
 struct PlantConfig {
   int oversampling{1};  // internal steps per loop period
+  // The amplifier's leads as the simulated robot is wired: 1 as configured, -1 swapped (the actuator pushes
+  // the other way from the command: a fault the supervisor must trip on, docs/realtime_loop.md).
+  int actuator_wiring{1};
 };
 
 // Disturbances present in bench runs.

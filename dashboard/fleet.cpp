@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <thread>
@@ -290,13 +291,19 @@ void Fleet::watch_contact() {
   }
 }
 
+std::size_t Fleet::live_writers(const Cell& c, Clock::time_point now) const {
+  return static_cast<std::size_t>(std::count_if(c.status_writers.begin(), c.status_writers.end(), [&](const auto& w) {
+    return now - w.second <= std::chrono::duration<double>(stale_after_s_);
+  }));
+}
+
 json Fleet::overview() {
   std::lock_guard<std::mutex> lock(m_);
   const auto now = Clock::now();
   json tiles = json::array();
   for (const auto& [name, c] : cells_) {
     json t = {{"cell", name}, {"live", c->live}, {"quiet_s", std::chrono::duration<double>(now - c->heard).count()},
-              {"publishers", c->status_writers.size()}, {"active_s", c->active_s}, {"state_source_ms", c->state_source_ms}};
+              {"publishers", live_writers(*c, now)}, {"active_s", c->active_s}, {"state_source_ms", c->state_source_ms}};
     if (!c->status.is_null()) {
       t["state"] = c->status["state"];  // without telemetry, the status's word
       t["trip"] = c->status["trip"];
@@ -343,7 +350,7 @@ std::optional<json> Fleet::detail(const std::string& cell, std::uint64_t since_s
   }
   tel["last_seq"] = c.seq;
   json out = {{"cell", cell}, {"live", c.live}, {"status", c.status}, {"machining", c.machining}, {"advice", c.advice},
-              {"telemetry", tel}, {"active_s", c.active_s}, {"publishers", c.status_writers.size()}};
+              {"telemetry", tel}, {"active_s", c.active_s}, {"publishers", live_writers(c, Clock::now())}};
   if (with_spectrum_and_lobes) out["spectrum"] = c.spectrum, out["lobes"] = c.lobes;
   return out;
 }

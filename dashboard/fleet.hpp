@@ -85,6 +85,9 @@ class Fleet {
 
  private:
   struct Cell;
+  // The status writers heard within stale_after_s: more than one is a name clash (a restarted cell's old
+  // writer, quiet since, is not).
+  [[nodiscard]] std::size_t live_writers(const Cell& c, std::chrono::steady_clock::time_point now) const;
   template <typename T>
   class Listener;
   class ReplyListener;

@@ -1,28 +1,59 @@
 // Keeping damping when the cut chatters (docs/realtime_loop.md): the supervisor's derating. With the
 // spindle turning, a growing command may be the loop's (the damper's fault: trip) or the cut's (a
 // regenerative chatter the damper should keep damping). The loop's signals cannot tell the two apart at one
-// frequency, so the supervisor asks the loop: it lowers the gain and watches. Growth that goes on at a
-// quarter of the gain is not the gain's (the process's: full gain again, and saturation derates instead of
-// tripping); growth that stops was fed by the gain (the gain is held lowered; the same speed's gain feeding a
-// growth again trips instability, latched). With the spindle stopped only the loop can feed a growth: it trips
-// as it always did. RT-safe: arithmetic on members, no allocation.
+// frequency, so the supervisor asks the loop: it takes the gain away and watches. Growth that goes on without
+// the gain is not the gain's (the process's: full gain again, and saturation derates instead of tripping);
+// growth that decays was fed by the gain (inside a speed schedule's band: trip instability at once; elsewhere
+// the gain is held lowered, and the same speed's gain feeding a growth again trips, latched). With the spindle
+// stopped only the loop can feed a growth: it trips as it always did. RT-safe: arithmetic on members, no
+// allocation.
 #include <algorithm>
+#include <cmath>
 
 #include "rt/supervisor.hpp"
 
 namespace robodamp::rt {
 
 namespace {
-// A probe's verdict: the growth was the gain's when a block's RMS falls under kProbeDecay of the block's before
-// the probe (at once), or under kProbeSettled of it at the probe's end (probe_blocks blocks at the lowered gain),
-// and the acceleration itself has not grown by more than kProbeAccelGrowth meanwhile (the chain does not pass
-// every frequency: a chatter that moves to one it rejects must not look like a decay). A loop 1.25 x over its
-// stable gain decays to about 0.7 in 0.3 s without the gain (the default preset's 23.5 Hz mode); a chatter that
-// grows on or holds its limit cycle stays above.
+// A probe's verdict. The growth was the gain's when a block's RMS falls under kProbeDecay of the block's before
+// the probe (at once), or when, after probe_blocks blocks at the lowered gain, the straight line through the
+// logarithms of the probe's blocks (least squares) ends under kProbeSettled of it; and the acceleration itself
+// has not grown by more than kProbeAccelGrowth meanwhile (the chain does not pass every frequency: a chatter
+// that moves to one it rejects must not look like a decay). A line rather than the last block: a chatter's
+// limit cycle wanders by +/-20 % from block to block (measured at 1205 rpm, 20 mm), and one low block was
+// read as a decay. While the line still falls (kProbeFalling) the probe goes on, up to kProbeLonger x probe_blocks (a lightly
+// damped mode rings down slowly without the gain: swapped leads on the 9 Hz mode, 10 % a block); a line that
+// does not fall is the process's. A loop 1.25 x over its stable gain decays to about 0.7 in 0.3 s without
+// the gain (the default preset's 23.5 Hz mode); a chatter grows on or holds.
 constexpr double kProbeDecay = 0.5;
 constexpr double kProbeSettled = 0.8;
 constexpr double kProbeAccelGrowth = 1.1;
+constexpr int kProbeLonger = 3;
+constexpr double kProbeFalling = -0.03;  // ln RMS per block: a line falling by 3 % a block or more still falls
+// A cut's entry (a block more than kImpulseJump x the one before) rings down for most of a second whatever the
+// gain: a saturation within kEntrySettleS of it derates at once, and is probed only when it comes again after.
+constexpr double kEntrySettleS = 1.0;
 }  // namespace
+
+// The least-squares line through (block, ln RMS) of the probe's blocks so far: its slope per block and its
+// value at the newest block (as an RMS).
+Supervisor::ProbeTrend Supervisor::ProbeFit::add(double rms) noexcept {
+  const double x = n, y = std::log(std::max(rms, 1e-12));
+  n += 1.0;
+  sx += x;
+  sy += y;
+  sxx += x * x;
+  sxy += x * y;
+  const double den = n * sxx - sx * sx;
+  const double slope = den > 0.0 ? (n * sxy - sx * sy) / den : 0.0;
+  const double mean_x = sx / n, mean_y = sy / n;
+  return {slope, std::exp(mean_y + slope * (x - mean_x))};
+}
+
+bool Supervisor::in_scheduled_band() const noexcept {
+  const control::ControllerParams& p = controller_.params();
+  return p.speed_scheduled() && p.speed_band_of(controller_.schedule_rpm()) < p.speed_band_count;
+}
 
 bool Supervisor::derating_on() const noexcept {
   return s_.limits.derate.enabled && controller_.schedule_rpm() > 0.0;
@@ -72,32 +103,34 @@ bool Supervisor::judge_growth(double rms, double accel_rms, bool grown) noexcept
   switch (growth_) {
     case Growth::kNone:
     case Growth::kGainFed:  // held lowered, it grows again: probe again
-      if (grown) {  // where the instability rule trips with the spindle stopped
-        growth_ = Growth::kProbe;
-        probe_rms_ = rms;
-        probe_accel_rms_ = accel_rms;
-        probe_blocks_ = 0;
-        apply_derate(d.probe_ramp_s);
-        ++counters_.derate_probes;
-        log_event(EventKind::kProbe, Trip::kInstability);
-      }
+      if (grown) start_probe(rms, accel_rms, false);  // where the instability rule trips with the spindle stopped
       break;
-    case Growth::kProbe:
+    case Growth::kProbe: {
+      const ProbeTrend t = probe_fit_.add(rms);
       ++probe_blocks_;
-      if (const bool end = probe_blocks_ >= d.probe_blocks;
-          rms < (end ? kProbeSettled : kProbeDecay) * probe_rms_ && accel_rms <= kProbeAccelGrowth * probe_accel_rms_) {
-        // it decays at the lowered gain: the gain fed it
-        if (gain_fed_rpm_ == rpm) return true;  // at this speed for the second time: the loop's own, trip
+      const bool judged = probe_blocks_ >= d.probe_blocks;
+      const bool decayed = rms < kProbeDecay * probe_rms_ || (judged && t.end < kProbeSettled * probe_rms_);
+      const bool end = judged && (t.slope >= kProbeFalling || probe_blocks_ >= kProbeLonger * d.probe_blocks);
+      if (decayed && accel_rms <= kProbeAccelGrowth * probe_accel_rms_) {
+        // it decays at the lowered gain: the gain fed it. Inside a speed schedule's band the tune verified
+        // that the band's gain does not lower the cut's limit: a growth the gain feeds there is the loop's
+        // own (or the cell is not the one commissioned), and switching the gain off cannot make the cut
+        // worse: trip at once. A saturation's probe holds instead (a saturated actuator is past what the
+        // band's linear check promises), as does any probe elsewhere (a gain fixed over all speeds may feed
+        // the chatter of a speed it does not suit); the same speed's gain feeding a growth again trips.
+        ++counters_.growth_gain_fed;
+        log_event(EventKind::kGainFedGrowth, Trip::kInstability);
+        if (gain_fed_rpm_ == rpm || (in_scheduled_band() && !probe_saturation_)) return true;
         gain_fed_rpm_ = rpm;
         growth_ = Growth::kGainFed;
         growth_run_ = 0;
         apply_derate(d.probe_ramp_s);
-        ++counters_.growth_gain_fed;
-        log_event(EventKind::kGainFedGrowth, Trip::kInstability);
       } else if (end) {
         process_growth();  // it grew on, or held, without the gain: the process's
+        if (probe_saturation_) (void)derate_saturation();  // an external force saturates the actuator (the first: 0.5)
       }
       break;
+    }
   }
   return false;
 }
@@ -121,6 +154,38 @@ void Supervisor::restore_when_quiet() noexcept {
   controller_.set_derate(1.0, s_.limits.derate.restore_s);
   ++counters_.derate_restores;
   log_event(EventKind::kRestored, Trip::kNone);
+}
+
+// The gain taken away for probe_blocks blocks (or longer while the motion falls) to see whether the growth, or
+// the saturation, goes on without it.
+void Supervisor::start_probe(double rms, double accel_rms, bool saturation) noexcept {
+  growth_ = Growth::kProbe;
+  probe_saturation_ = saturation;
+  probe_rms_ = rms;
+  probe_accel_rms_ = accel_rms;
+  probe_fit_ = {};
+  probe_blocks_ = 0;
+  apply_derate(s_.limits.derate.probe_ramp_s);
+  ++counters_.derate_probes;
+  log_event(EventKind::kProbe, saturation ? Trip::kSaturation : Trip::kInstability);
+}
+
+// The saturation duty over its limit; false when the trip stands. With the spindle stopped it trips (as it
+// always did). With it turning, the first saturation since the last quiet spell is probed as a growth is:
+// the gain fed it (a loop that pushes the structure harder than any cut: trip, as a growth fed by the gain
+// does) or an external force drives the actuator there (the process's: derated by saturation_factor).
+// During a probe the controller commands nothing to saturate (the window starts afresh); once a growth or
+// saturation was judged the process's, or the gain is held lowered, later saturations derate at once.
+bool Supervisor::saturated_while_turning() noexcept {
+  if (!derating_on()) return false;
+  const bool settled = blocks_since_jump_ * block_len_ >= static_cast<std::uint64_t>(kEntrySettleS * s_.fs_hz);
+  if (growth_ == Growth::kProbe || (growth_ == Growth::kNone && !process_ && settled)) {
+    if (growth_ == Growth::kNone) start_probe(last_block_rms_, last_accel_rms_, true);
+    std::fill(sat_window_.begin(), sat_window_.end(), std::uint8_t{0});
+    sat_count_ = 0;
+    return true;
+  }
+  return derate_saturation();
 }
 
 // The saturation duty over its limit with the spindle turning: the command derated by saturation_factor

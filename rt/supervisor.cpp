@@ -290,6 +290,8 @@ bool Supervisor::instability(double controller_v, double accel_mps2) noexcept {
     growth_run_ = 0;
   }
   last_block_rms_ = rms;
+  last_accel_rms_ = accel_rms;
+  blocks_since_jump_ = jump ? 0 : blocks_since_jump_ + 1;
   block_history_[block_history_pos_] = rms;
   block_history_pos_ = (block_history_pos_ + 1) % kBlockHistory;
   const bool grown = growth_run_ >= l.instability_blocks && rms >= l.instability_floor_v &&
@@ -434,7 +436,7 @@ void Supervisor::drive(const TickInput& in, const ControlStep& c, TickOutput& ou
       out.derated = controller_.derate() < 1.0;
       if (out.derated) ++counters_.derated_ticks;
       if (record_saturation(out.saturated)) {
-        if (!derate_saturation()) trip(Trip::kSaturation);
+        if (!saturated_while_turning()) trip(Trip::kSaturation);
       } else if (instability(growth_signal_v(c.controller_v), last_valid_mps2_)) {
         trip(Trip::kInstability);
       }

@@ -227,6 +227,8 @@ class Supervisor {
   void process_growth() noexcept;
   void restore_when_quiet() noexcept;
   bool derate_saturation() noexcept;
+  bool saturated_while_turning() noexcept;
+  void start_probe(double rms, double accel_rms, bool saturation) noexcept;
   void apply_derate(double ramp_s) noexcept;
   void reset_derate() noexcept;
   [[nodiscard]] double growth_signal_v(double controller_v) const noexcept;
@@ -314,6 +316,8 @@ class Supervisor {
   std::uint64_t block_ticks_{0}, block_len_{1};
   double block_sum_sq_{0.0};
   double last_block_rms_{0.0}, run_start_rms_{0.0};
+  double last_accel_rms_{0.0};     // the acceleration's RMS over the last block
+  std::uint64_t blocks_since_jump_{0};  // blocks since the last blow or a cut's entry (spindle turning)
   int growth_run_{0};
   // The last blocks' RMS (newest at block_history_pos_ - 1), to tell a growth from a build-up or a beat
   // (instability()).
@@ -324,12 +328,23 @@ class Supervisor {
     return block_history_[(block_history_pos_ + kBlockHistory - 1 - k) % kBlockHistory];
   }
   [[nodiscard]] bool building_up() const noexcept;
+  [[nodiscard]] bool in_scheduled_band() const noexcept;  // the spindle inside a band of a speed schedule
   [[nodiscard]] bool beating() const noexcept;
 
   Growth growth_{Growth::kNone};
   bool process_{false};            // a growth judged the process's since the last quiet spell
   double probe_rms_{0.0};          // the block's RMS (and the acceleration's) when the probe started
   double probe_accel_rms_{0.0};
+  struct ProbeTrend {
+    double slope{0.0};  // ln RMS per block
+    double end{0.0};    // the line's RMS at the newest block
+  };
+  struct ProbeFit {  // the least-squares line through (block, ln RMS) of a probe's blocks
+    double n{0.0}, sx{0.0}, sy{0.0}, sxx{0.0}, sxy{0.0};
+    ProbeTrend add(double rms) noexcept;
+  };
+  ProbeFit probe_fit_;
+  bool probe_saturation_{false};   // the probe started at a saturation, not a growth
   double block_accel_sum_sq_{0.0};
   int probe_blocks_{0};            // blocks since
   double saturation_derate_{1.0};  // the product of the saturation derates since the last restore

@@ -40,7 +40,7 @@ const char* describe(Trip t) {
     case Trip::kSampleInvalid: return "non-finite or out-of-range acceleration samples: check the sensor, its cable and supervision.sample_limit_mps2";
     case Trip::kOverruns: return "consecutive loop overruns: the loop cannot keep its rate on this machine (see the timing statistics; isolate a CPU, lower loop.rate_hz)";
     case Trip::kSaturation: return "actuator at its limit for more than supervision.saturation_duty_max of the window: the disturbance is too large for the actuator, or the gain too high";
-    case Trip::kInstability: return "growing oscillation in the loop: the gain is too high for this pose (re-run the analysis, lower controller.gain_ns_per_m)";
+    case Trip::kInstability: return "growing oscillation in the loop: the gain is too high for this pose, or the actuator is stronger or wired other than configured (re-run the analysis, lower controller.gain_ns_per_m, check the amplifier's leads)";
     case Trip::kSensorDriver: return "the sensor driver reports a fault";
     case Trip::kActuatorDriver: return "the actuator driver could not deliver the command, or the amplifier's supervisory (Modbus) link was lost while it was needed";
     case Trip::kAmplifierFault: return "the amplifier reports a fault (temperature, current, link)";

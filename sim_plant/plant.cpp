@@ -22,8 +22,9 @@ Plant::Plant(PlantModel model, const config::Config& cfg)
   zoh_ = discretise_zoh_delayed(model_.ss.a, b.leftCols(1), h_s_, model_.actuator.delay_s);
   const Zoh forces = discretise_zoh(model_.ss.a, b.rightCols(nl), h_s_);
   step_ = ModalStep(model_.ss, zoh_, forces.gamma);
-  nominal_limit_v_ = model_.actuator.force_limit_n / model_.actuator.constant_n_per_v;
+  nominal_limit_v_ = model_.actuator.force_limit_n / std::abs(model_.actuator.constant_n_per_v);
   inv_oversampling_ = 1.0 / oversampling_;
+  wiring_ = cfg.plant.actuator_wiring;
   force_.assign(static_cast<std::size_t>(nl), 0.0);
   u_.assign(static_cast<std::size_t>(nu), 0.0);
   coil_history_.assign(static_cast<std::size_t>(zoh_.steps) + 2, 0.0);
@@ -78,14 +79,14 @@ void Plant::step(double drive_v) noexcept {
     double vi = v;
     const double limit_v = faults_.empty() ? nominal_limit_v_
                                            : faults_.actuator_force_limit_n(t, model_.actuator.force_limit_n) /
-                                                 model_.actuator.constant_n_per_v;
+                                                 std::abs(model_.actuator.constant_n_per_v);
     if (std::abs(vi) > limit_v) {
       vi = std::copysign(limit_v, vi);
       ++counters_.force_limited;
     }
     if (clipped) ++counters_.voltage_clipped;
     // Ring of the coil drive: u[k - delay] and u[k - delay - 1].
-    coil_history_[history_pos_] = vi;
+    coil_history_[history_pos_] = wiring_ * vi;  // swapped leads push the other way
     const std::size_t late = history_pos_ >= delay ? history_pos_ - delay : history_pos_ + hist - delay;
     const std::size_t early = late == 0 ? hist - 1 : late - 1;
     if (++history_pos_ == hist) history_pos_ = 0;

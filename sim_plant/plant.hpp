@@ -85,6 +85,7 @@ class Plant {
   int oversampling_;
   double h_s_;
   double inv_oversampling_{1.0};
+  double wiring_{1.0};           // plant.actuator_wiring: -1 when the amplifier's leads are swapped
   double nominal_limit_v_{0.0};  // the actuator's force limit as coil voltage, V
   DelayedZoh zoh_;
   // One internal step in modal block form: x[k+1] = phi x + gamma_late u[k-d] + gamma_early u[k-d-1]

@@ -266,6 +266,57 @@ TEST(HilCut, NoStableSpeedOrOneTheSpindleCannotReachKeepsTheSpeed) {
   }
 }
 
+// Keeping damping when the cut chatters, across processes (docs/realtime_loop.md): the controller reads the
+// spindle speed the emulated robot publishes, so its supervisor derates rather than trips. wiring: the
+// emulator's plant.actuator_wiring (its own copy of the configuration; -1: the amplifier's leads swapped).
+struct DerateRun {
+  json run, plant;
+};
+DerateRun derate_across_processes(const std::string& name, const std::string& depth_mm, const std::string& wiring,
+                                  const std::string& duration_s) {
+  const test::HilFiles f = test::hil_files(
+      name, {{"    mounting_register: 0\n", "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"}});
+  std::string text = test::read_file(f.config);  // the emulator's copy: the same socket and port
+  test::replace_or_throw(text, "\nplant:\n", "\nplant:\n  actuator_wiring: " + wiring + "\n");
+  const std::string plant_config = f.dir + "/hil_plant.yaml";
+  std::ofstream(plant_config) << text;
+  Child plant({"plant", "--config", plant_config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", "700",
+               "--cut-axial-mm", depth_mm, "--cut-revs", "120", "--cut-at", "2", "--json", f.plant_json},
+              f.plant_log);
+  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", duration_s, "--json", f.run_json}, f.run_log);
+  const int run_exit = run.wait(), plant_exit = plant.wait();
+  const std::string logs = test::read_file(f.plant_log) + test::read_file(f.run_log);
+  EXPECT_EQ(plant_exit, 0) << logs;
+  (void)run_exit;  // 0, or the trip's status: the tests judge the summary
+  DerateRun r;
+  r.run = json::parse(test::read_file(f.run_json));
+  r.plant = json::parse(test::read_file(f.plant_json));
+  return r;
+}
+
+// A cut above both limits at 700 rpm (1.3 mm; C2 at K = 2000 lowers the limit to 0.782 mm, the open loop's is
+// 1.106 mm): in process (Derate.AChatteringCutNeverSwitchesTheDamperOff) the growth is probed and judged the
+// process's, with no trip; across processes the same, the damper armed through the cut.
+TEST(HilDerate, AChatteringCutIsProbedAndKeepsTheDamperArmedAcrossProcesses) {
+  const DerateRun r = derate_across_processes("derate_chatter", "1.3", "1", "16");
+  EXPECT_NE(r.plant["regenerative_cut"]["classification"], "stable") << r.plant["regenerative_cut"].dump(1);
+  const json& d = r.run["supervisor"]["derate"];
+  EXPECT_GE(d["probes"].get<int>(), 1) << r.run.dump(1);
+  EXPECT_GE(d["growth_process"].get<int>(), 1) << d.dump();
+  EXPECT_EQ(r.run["trip"], "none") << r.run.dump(1);
+  EXPECT_GT(r.run["availability"]["derated_s"].get<double>(), 0.0);
+}
+
+// The amplifier's leads swapped in the emulated robot (the controller configured as always), the spindle
+// turning and a 0.3 mm cut: the supervisor probes, finds the gain feeding the growth, holds it lowered, and
+// trips instability when it feeds a growth again at the same speed (no speed schedule in this cell).
+TEST(HilDerate, SwappedLeadsTripAcrossProcessesWithTheSpindleTurning) {
+  const DerateRun r = derate_across_processes("derate_swapped", "0.3", "-1", "20");
+  EXPECT_EQ(r.run["trip"], "instability") << r.run.dump(1);
+  const json& d = r.run["supervisor"]["derate"];
+  EXPECT_GE(d["growth_gain_fed"].get<int>(), 1) << d.dump();
+}
+
 // `robodamp plant` with these options refused with exit 2 before serving, its message holding each of `says`.
 void expect_refused(const test::HilFiles& f, const std::string& name, const std::vector<std::string>& options,
                     const std::vector<std::string>& says) {

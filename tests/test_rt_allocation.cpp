@@ -424,6 +424,36 @@ TEST(RealTimePath, TheDeratingProbesHoldsAndRestoresWithoutAllocating) {
   EXPECT_GT(c.derated_ticks, 0U);
 }
 
+// The saturation's derating on the loop thread: a 400 N sine force at the TCP on the 9.2 Hz mode (an external
+// force, as a deep cut's) with the spindle turning drives the actuator into its 36 N limit again and again.
+// The first saturations (the arming's transient) derate at once, a later one is probed (the gain taken away,
+// the window cleared), judged the process's and derated: nothing allocated, no lock taken.
+TEST(RealTimePath, TheSaturationDeratingAllocatesNothing) {
+  runtime::CellOptions o;
+  o.clock = config::ClockKind::kVirtual;
+  o.arm_at_start = false;
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  cfg.controller.speed_schedule.reset();
+  runtime::Cell session(cfg, o);
+  test::configure(session);
+  session.plant().add_excitation(std::make_unique<sim::Sine>(0, 400.0, 9.2, 0.0));  // at the TCP, on the 9.2 Hz mode
+  rt::Loop& loop = session.loop();
+  loop.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
+  loop.schedule(1000, {rt::CommandKind::kArm, 0.0});
+  const LoopThreadCounts counts = run_counted(loop, 12 * 5000);
+  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
+  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
+  const auto& c = session.supervisor().counters();
+  std::printf("[ rt path  ] saturation: %llu probes, %llu saturation derates, %llu restores, %llu saturated ticks, trip %s\n",
+              static_cast<unsigned long long>(c.derate_probes), static_cast<unsigned long long>(c.saturation_derates),
+              static_cast<unsigned long long>(c.derate_restores), static_cast<unsigned long long>(c.saturated_ticks),
+              rt::to_string(session.supervisor().observed_trip()));
+  EXPECT_GE(c.derate_probes, 1U);
+  EXPECT_GE(c.growth_process, 1U);
+  EXPECT_GE(c.saturation_derates, 2U);
+  EXPECT_EQ(session.supervisor().observed_trip(), rt::Trip::kNone);
+}
+
 // robodamp measure's loop: the loop's chirp with K = 0 and the plant-side impact test
 // (analysis::ModalTest on the simulated backend's step hook) through the whole commissioning plan: the
 // loop thread allocates nothing and takes no lock.

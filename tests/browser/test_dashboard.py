@@ -444,6 +444,25 @@ class DashboardInABrowser(unittest.TestCase):
         self.assertIn("no contact", self.tile("a")["text"])
         self.assertGreaterEqual(http(self.fleet.port, "/api/health")[1]["dds"]["cells_lost"], 1)
 
+    def test_7_a_saturated_actuator_is_derated_on_the_tile_not_tripped(self):
+        """Cell B again with its actuator giving no more than 0.3 N from 2 s on (the plant clips it and says so):
+        with the spindle turning the supervisor derates the gain instead of tripping (docs/realtime_loop.md), and
+        the tile says DERATED beside the share of time derated, the cell still active."""
+        self.fleet.cell_b.send_signal(signal.SIGINT)
+        self.fleet.cell_b.wait(timeout=30)
+        self.fleet.cell_b = self.fleet.start_b(["--fault", "actuator_saturated:2:600:0.3"], "cell_b_saturated.log")
+        self.browser.get(self.url)
+        until(lambda: (self.tile("b") or {}).get("state") == "active", 90, "cell b active")
+        derated = until(lambda: (lambda t: t if t and "DERATED" in t["text"] else None)(self.tile("b")), 90,
+                        "cell b's tile saying DERATED")
+        self.assertEqual(derated["state"], "active", derated["text"])
+        # The stopped process's writer went quiet: after dashboard.stale_after_s no name clash is shown.
+        until(lambda: "publishers call themselves" not in self.tile("b")["text"], 30, "the restarted cell as one publisher")
+        self.assertRegex(derated["text"], r"\(\d+\.\d % derated\)")
+        self.assertEqual(self.js(f'return document.querySelectorAll(\'.tile[data-cell="{self.fleet.cells["b"]}"] '
+                                 '[data-field="derated"]\').length'), 1)
+        self.browser.save_screenshot(os.path.join(OUT, "dashboard_derated.png"))
+
 
 def give_up():
     """Under a CPU hog on both cores this test hung twice in three ctest runs until ctest's 600 s (and passed
