@@ -384,8 +384,9 @@ TEST(Fuzz, TenThousandMutatedConfigurationsAreRefusedWithFileAndLine) {
     } catch (const config::ConfigError& e) {
       ++c.refused;
       c.problems += static_cast<int>(e.problems().size());
-      // A file a job refers to (a damping configuration) reports its own file.
-      const bool other_file = !e.problems().empty() && e.problems().front().file != file;
+      // A file a job refers to (a damping configuration) reports its own file: one that exists, named.
+      const std::string other = e.problems().empty() ? std::string() : e.problems().front().file;
+      const bool other_file = !other.empty() && other != file && fs::exists(other);
       if (!other_file) expect_located(e, file, text, failures);
     } catch (const std::exception& e) {
       if (++failures <= 10) ADD_FAILURE() << "#" << i << ": not a ConfigError: " << e.what() << "\n--- input ---\n" << text.substr(0, 2000);
@@ -395,6 +396,9 @@ TEST(Fuzz, TenThousandMutatedConfigurationsAreRefusedWithFileAndLine) {
   std::printf("[ fuzz cfg ] 10000 mutated files (%zu bases, 10 huge) in %.1f s: %d accepted, %d refused with %d problems, "
               "every one at file:line: %s\n",
               bases.size(), s, c.accepted, c.refused, c.problems, failures == 0 ? "yes" : "NO");
+  // Most mutations break a file (measured: 8066 of 10000); a fuzzer that refused nothing tested nothing.
+  EXPECT_GT(c.refused, 5000);
+  EXPECT_GE(c.problems, c.refused);
 }
 
 // --- recordings ---------------------------------------------------------------------------------------------
