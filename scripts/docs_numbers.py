@@ -15,6 +15,10 @@ Markers (an HTML comment, invisible on the rendered page, on the line before the
                                           printed digit.
   <!-- docs-numbers: output (wall ms) ARGS... -->   the same, but numbers followed by " ms" are the
                                           computer's time: rewritten, not compared.
+  <!-- docs-numbers: transcript -->       each "$ robodamp ARGS..." line of the fenced block below is run, and
+                                          the lines after it (to the next "$ ") are matched as above against
+                                          what it printed on either stream, whatever its exit status (the
+                                          refusals of hostile input).
   <!-- docs-numbers: bench-table -->      the four-preset bench table: each row's preset through `robodamp
                                           bench --json` (polarity, K_max, the measured / predicted improvement
                                           of each FRF, the saturating H22yy), to the digits printed.
@@ -26,6 +30,7 @@ import argparse
 import json
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -109,9 +114,9 @@ class Runner:
         self.dir = tempfile.mkdtemp(prefix="robodamp-docs-numbers-")
         os.symlink(os.path.join(ROOT, "config"), os.path.join(self.dir, "config"))
 
-    def run(self, args):
+    def run(self, args, both=False):
         r = subprocess.run([self.binary] + args, cwd=self.dir, capture_output=True, text=True, timeout=600)
-        return r.returncode, r.stdout
+        return r.returncode, (r.stdout + r.stderr) if both else r.stdout
 
     def close(self):
         shutil.rmtree(self.dir, ignore_errors=True)
@@ -189,8 +194,27 @@ def process(path, runner, write):
             problems += p
             out += [lines[k]] + written + ["```"]
             k = end + 1
+        elif what[0] == "transcript" and lines[k].startswith("```"):
+            end = lines.index("```", k + 1) if "```" in lines[k + 1:] else len(lines)
+            out.append(lines[k])
+            at = k + 1
+            while at < end:
+                stop = next((j for j in range(at + 1, end) if lines[j].startswith("$ ")), end)
+                typed = lines[at]
+                args = shlex.split(typed[2:].split("  #")[0])[1:] if typed.startswith("$ robodamp") else None
+                if args is None:
+                    problems.append(f"{where}: a transcript line that is not '$ robodamp ...': {typed}")
+                    out += lines[at:stop]
+                else:
+                    _, printed = runner.run(args, both=True)
+                    p, written = match_block(lines[at + 1:stop], printed.split("\n"), f"{where} ({typed})")
+                    problems += p
+                    out += [typed] + written
+                at = stop
+            out.append("```")
+            k = end + 1
         else:
-            problems.append(f"{where}: unknown marker '{what[0]}' (output, bench-table)")
+            problems.append(f"{where}: unknown marker '{what[0]}' (output, transcript, bench-table)")
     if write and out != lines:
         open(path, "w", encoding="utf-8").write("\n".join(out))
     return problems, checked
