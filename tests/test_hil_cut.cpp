@@ -272,10 +272,21 @@ TEST(HilCut, NoStableSpeedOrOneTheSpindleCannotReachKeepsTheSpeed) {
 struct DerateRun {
   json run, plant;
 };
+// scheduled: the cell runs the default preset's speed schedule (its block copied into the HIL configuration, the
+// mounting's parameter sets taken out).
 DerateRun derate_across_processes(const std::string& name, const std::string& depth_mm, const std::string& wiring,
-                                  const std::string& duration_s) {
-  const test::HilFiles f = test::hil_files(
-      name, {{"    mounting_register: 0\n", "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"}});
+                                  const std::string& duration_s, bool scheduled = false) {
+  std::vector<std::pair<std::string, std::string>> edits{
+      {"    mounting_register: 0\n", "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"}};
+  if (scheduled) {
+    const std::string preset = test::read_file(test::preset("horizontal_c2"));
+    const std::size_t from = preset.find("\n  speed_schedule:") + 1, to = preset.find("\nrobot:", from) + 1;
+    edits.push_back({"  gain_ramp_s: 0.5\n", "  gain_ramp_s: 0.5\n" + preset.substr(from, to - from)});
+    // Chosen by speed, not also by the mounting (the configuration refuses both).
+    edits.push_back({"parameter_sets:            # the robot's mounting register selects the set (with the supervisor's fade)\n"
+                     "  vertical: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/vertical_c1.yaml\n", ""});
+  }
+  const test::HilFiles f = test::hil_files(name, edits);
   std::string text = test::read_file(f.config);  // the emulator's copy: the same socket and port
   test::replace_or_throw(text, "\nplant:\n", "\nplant:\n  actuator_wiring: " + wiring + "\n");
   const std::string plant_config = f.dir + "/hil_plant.yaml";
@@ -307,11 +318,12 @@ TEST(HilDerate, AChatteringCutIsProbedAndKeepsTheDamperArmedAcrossProcesses) {
   EXPECT_GT(r.run["availability"]["derated_s"].get<double>(), 0.0);
 }
 
-// The amplifier's leads swapped in the emulated robot (the controller configured as always), the spindle
-// turning and a 0.3 mm cut: the supervisor probes, finds the gain feeding the growth, holds it lowered, and
-// trips instability when it feeds a growth again at the same speed (no speed schedule in this cell).
+// The amplifier's leads swapped in the emulated robot (the controller configured as always), a cell with the
+// default preset's speed schedule, the spindle at 700 rpm (its band: C1 at K = 3040) and a 0.3 mm cut: the
+// supervisor probes, finds the gain feeding the growth inside a band, and trips instability at once. (Without a
+// schedule the gain is held at half instead, which the swapped loop may survive for long: tried, 35 s.)
 TEST(HilDerate, SwappedLeadsTripAcrossProcessesWithTheSpindleTurning) {
-  const DerateRun r = derate_across_processes("derate_swapped", "0.3", "-1", "20");
+  const DerateRun r = derate_across_processes("derate_swapped", "0.3", "-1", "20", true);
   EXPECT_EQ(r.run["trip"], "instability") << r.run.dump(1);
   const json& d = r.run["supervisor"]["derate"];
   EXPECT_GE(d["growth_gain_fed"].get<int>(), 1) << d.dump();
