@@ -43,7 +43,7 @@ struct ChatterIndicatorSettings {
   int lines_per_revolution{1};
   // Simulated cuts of config/milling/active_damping_c2.yaml at 700 rpm (tests/test_machining.cpp): 1.0 mm,
   // stable: 0.001 and 0.000; 1.2 mm, chatter at 23.7 Hz: 0.22 and 0.93; 2.5 mm: 0.33 and 0.98.
-  double once_per_rev_threshold{0.2};
+  double once_per_rev_threshold{0.1};
   double nonharmonic_threshold{0.1};
   double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
   // Quietest / loudest quarter of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
