@@ -320,9 +320,12 @@ function plotLobes(l, m, a) {
     l.method + (l.speed_scheduled ? ' (each speed with its band\'s controller and K; K = 0 where the damper is worse than none)'
     : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds' +
     (off ? '; the damper is ' + s.state + ': the open loop applies' : '');
+  // An advice the spindle has followed is not an instruction any more: said as done (the tile does the same).
+  const followed = a && a.found && m && Math.abs((m.spindle_rpm || 0) - a.advised_rpm) < 0.5;
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
-    (a.found ? 'go to ' + fmt(a.advised_rpm, 1) + ' rpm, limit ' + fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')' : esc(a.reason)) +
-    ' – ' + esc(a.method)) : 'no advice asked for';
+    (!a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
+      fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method)) : 'no advice asked for';
+  $('advice').dataset.followed = followed ? 'true' : 'false';
   window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, advised: options.length,
     gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off,
     scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&

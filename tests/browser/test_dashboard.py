@@ -384,6 +384,18 @@ class DashboardInABrowser(unittest.TestCase):
         fresh = self.js("plotLobes(%s, cellMachining, null); return document.getElementById('lobes-note').textContent" % (fixed % lower))
         self.assertNotIn("recomputing", fresh)
         self.assertIn(f"K = {lower} N s/m", fresh)
+        # An advice the spindle has followed is said as done, not as an instruction (the page's own drawing, fed
+        # an advice to 666.7 rpm with the spindle there and away from it).
+        advice = "{seq: 7, found: true, trigger: 'chatter', spindle_rpm: 700, advised_rpm: 666.7, advised_limit_mm: 2.1, " \
+                 "margin: 1.5, method: 'sampled-loop SDM', depth_mm: 0.5, options: [{rpm: 666.7}]}"
+        at = self.js("plotLobes(%s, {spindle_rpm: %s, depth_mm: 0.5}, %s); const e = document.getElementById('advice');"
+                     "return [e.textContent, e.dataset.followed]" % (fixed % lower, "666.7", advice))
+        self.assertEqual(at[1], "true", at[0])
+        self.assertIn("followed: at the advised 666.7 rpm", at[0])
+        away = self.js("plotLobes(%s, {spindle_rpm: %s, depth_mm: 0.5}, %s); const e = document.getElementById('advice');"
+                       "return [e.textContent, e.dataset.followed]" % (fixed % lower, "700", advice))
+        self.assertEqual(away[1], "false", away[0])
+        self.assertIn("go to 666.7 rpm", away[0])
         # Disarming asks too; raising the gain back is sent at once.
         said, _, confirming = self.type_and_press("gain", f"{k_now:.0f}")
         self.assertFalse(confirming)
