@@ -21,9 +21,9 @@ namespace {
 // has not grown by more than kProbeAccelGrowth meanwhile (the chain does not pass every frequency: a chatter
 // that moves to one it rejects must not look like a decay). A line rather than the last block: a chatter's
 // limit cycle wanders by +/-20 % from block to block (measured at 1205 rpm, 20 mm), and one low block was
-// read as a decay. While the line still falls (kProbeFalling) the probe goes on, up to kProbeLonger x probe_blocks (a lightly
-// damped mode rings down slowly without the gain: swapped leads on the 9 Hz mode, 10 % a block); a line that
-// does not fall is the process's. A loop 1.25 x over its stable gain decays to about 0.7 in 0.3 s without
+// read as a decay. While the line still falls (kProbeFalling) the probe goes on, up to kProbeLonger x
+// probe_blocks (a lightly damped mode rings down slowly without the gain: swapped leads on the 9 Hz mode, 10 % a
+// block); a line that does not fall is the process's. A loop 1.25 x over its stable gain decays to about 0.7 in 0.3 s without
 // the gain (the default preset's 23.5 Hz mode); a chatter grows on or holds.
 constexpr double kProbeDecay = 0.5;
 constexpr double kProbeSettled = 0.8;
@@ -171,9 +171,10 @@ void Supervisor::start_probe(double rms, double accel_rms, bool saturation) noex
 }
 
 // The saturation duty over its limit; false when the trip stands. With the spindle stopped it trips (as it
-// always did). With it turning, the first saturation since the last quiet spell is probed as a growth is:
-// the gain fed it (a loop that pushes the structure harder than any cut: trip, as a growth fed by the gain
-// does) or an external force drives the actuator there (the process's: derated by saturation_factor).
+// always did). With it turning, the first saturation since the last quiet spell (and over 1 s after a cut's
+// entry) is probed as a growth is: the gain fed it (held lowered, even in a band: a saturated actuator is past
+// the band's linear check) or an external force drives the actuator there (the process's: derated by
+// saturation_factor).
 // During a probe the controller commands nothing to saturate (the window starts afresh); once a growth or
 // saturation was judged the process's, or the gain is held lowered, later saturations derate at once.
 bool Supervisor::saturated_while_turning() noexcept {
