@@ -23,8 +23,8 @@ namespace {
 // limit cycle wanders by +/-20 % from block to block (measured at 1205 rpm, 20 mm), and one low block was
 // read as a decay. While the line still falls (kProbeFalling) the probe goes on, up to kProbeLonger x
 // probe_blocks (a lightly damped mode rings down slowly without the gain: swapped leads on the 9 Hz mode, 10 % a
-// block); a line that does not fall is the process's. A loop 1.25 x over its stable gain decays to about 0.7 in 0.3 s without
-// the gain (the default preset's 23.5 Hz mode); a chatter grows on or holds.
+// block); a line that does not fall is the process's. A loop 1.25 x over its stable gain decays to about 0.7
+// in 0.3 s without the gain (the default preset's 23.5 Hz mode); a chatter grows on or holds.
 constexpr double kProbeDecay = 0.5;
 constexpr double kProbeSettled = 0.8;
 constexpr double kProbeAccelGrowth = 1.1;
