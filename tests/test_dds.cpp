@@ -317,6 +317,9 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
           "\n  transport: udp_loopback\n  telemetry_rate_hz: 20\n  parameter_writes: true\n";
   text += "supervision:\n  overrun_cycles: 5000\n";
   text += "spindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
+  // A name of its own: the monitor follows the configuration's cell, and another test's cell on a colliding
+  // domain (test_domain is one of 200) is named after the host too (the hogged suite once showed that one).
+  text += "cell:\n  name: dds-monitor-" + std::to_string(getpid()) + "\n";
   std::ofstream(dir + "/dds.yaml") << text;
   test::Child run({"run", "--config", dir + "/dds.yaml", "--duration", "600"}, dir + "/run.log");
   // The speed, asked until the loop is there to take it.
