@@ -397,6 +397,15 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
   EXPECT_EQ(r.mismatches, 0U);
 }
 
+// The spindle at 700 rpm from tick 100, the loop armed at tick 1000, 12 s on the loop thread: no lock, no allocation.
+void expect_none_with_the_spindle_turning(rt::Loop& loop) {
+  loop.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
+  loop.schedule(1000, {rt::CommandKind::kArm, 0.0});
+  const LoopThreadCounts counts = run_counted(loop, 12 * 5000);
+  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
+  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
+}
+
 // The derating (supervision.derate): a loop unstable on its own (the actuator 3 x stronger than configured) with
 // the spindle turning is probed, held at half gain, restored and probed again (then trips): no allocation, no lock.
 TEST(RealTimePath, TheDeratingProbesHoldsAndRestoresWithoutAllocating) {
@@ -411,12 +420,7 @@ TEST(RealTimePath, TheDeratingProbesHoldsAndRestoresWithoutAllocating) {
   o.plant_config = real;
   runtime::Cell session(cfg, o);
   test::configure(session);
-  rt::Loop& loop = session.loop();
-  loop.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
-  loop.schedule(1000, {rt::CommandKind::kArm, 0.0});
-  const LoopThreadCounts counts = run_counted(loop, 12 * 5000);
-  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
-  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
+  expect_none_with_the_spindle_turning(session.loop());
   const auto& c = session.supervisor().counters();
   EXPECT_GE(c.derate_probes, 2U);
   EXPECT_GE(c.growth_gain_fed, 1U);
@@ -437,12 +441,7 @@ TEST(RealTimePath, TheSaturationDeratingAllocatesNothing) {
   runtime::Cell session(cfg, o);
   test::configure(session);
   session.plant().add_excitation(std::make_unique<sim::Sine>(0, 400.0, 9.2, 0.0));  // at the TCP, on the 9.2 Hz mode
-  rt::Loop& loop = session.loop();
-  loop.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
-  loop.schedule(1000, {rt::CommandKind::kArm, 0.0});
-  const LoopThreadCounts counts = run_counted(loop, 12 * 5000);
-  EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
-  EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
+  expect_none_with_the_spindle_turning(session.loop());
   const auto& c = session.supervisor().counters();
   std::printf("[ rt path  ] saturation: %llu probes, %llu saturation derates, %llu restores, %llu saturated ticks, trip %s\n",
               static_cast<unsigned long long>(c.derate_probes), static_cast<unsigned long long>(c.saturation_derates),
