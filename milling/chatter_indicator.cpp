@@ -35,48 +35,7 @@ void ChatterMonitor::push(double accel_mps2, bool fresh) {
   count_ = std::min(count_ + 1, ring_.size());
 }
 
-// The synchronous average of the span over its forced periods (period_samples samples each; the average on a
-// grid of ceil(period_samples) points a period, each sample shared between its two neighbours), and the span
-// without it: what is not periodic with the spindle, into residual_.
-void ChatterMonitor::synchronous_residual(double period_samples) {
-  const std::size_t n = window_.size();
-  const auto m = static_cast<std::size_t>(std::ceil(period_samples));
-  sync_sum_.assign(m, 0.0);
-  sync_weight_.assign(m, 0.0);
-  const auto place = [&](std::size_t i, std::size_t& j0, std::size_t& j1, double& frac) {
-    const double u = std::fmod(static_cast<double>(i), period_samples) * static_cast<double>(m) / period_samples;
-    j0 = std::min(m - 1, static_cast<std::size_t>(u));
-    j1 = (j0 + 1) % m;
-    frac = u - static_cast<double>(j0);
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    std::size_t j0 = 0, j1 = 0;
-    double frac = 0.0;
-    place(i, j0, j1, frac);
-    sync_sum_[j0] += (1.0 - frac) * window_[i], sync_weight_[j0] += 1.0 - frac;
-    sync_sum_[j1] += frac * window_[i], sync_weight_[j1] += frac;
-  }
-  for (std::size_t j = 0; j < m; ++j) sync_sum_[j] = sync_weight_[j] > 0.0 ? sync_sum_[j] / sync_weight_[j] : 0.0;
-  residual_.resize(n);
-  periodic_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    std::size_t j0 = 0, j1 = 0;
-    double frac = 0.0;
-    place(i, j0, j1, frac);
-    periodic_[i] = sync_sum_[j0] * (1.0 - frac) + sync_sum_[j1] * frac;
-    residual_[i] = window_[i] - periodic_[i];
-  }
-}
-
-const std::complex<double>* ChatterMonitor::hann_spectrum(const std::vector<double>& x) {
-  double* in = fft_->input();
-  const std::size_t n = x.size();
-  for (std::size_t i = 0; i < n; ++i)
-    in[i] = x[i] * (0.5 - 0.5 * std::cos(kTwoPi * static_cast<double>(i) / static_cast<double>(n)));
-  return fft_->forward();
-}
-
-// long: one span's evaluation (window, revolutions, quarters, the synchronous residual's spectrum, verdict) on reused buffers; left for a later pass
+// long: one spectrum's evaluation (window, FFT, tooth harmonics, peaks, verdict) on preallocated buffers; left for a later pass
 ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   ChatterIndicator out;
   if (!(spindle_rpm > 0.0)) return out;
@@ -150,34 +109,24 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   out.growing = true;
   for (int q = 1; q < 4; ++q) out.growing = out.growing && q_rms[q] > s_.growing_step * q_rms[q - 1];
 
-  // Spectra (Hann) of the span and of what is not periodic with the forced period, by displacement (each
-  // line's energy / f^2): the accelerometer weights the tooth-passing harmonics by f^2 over a robot mode's
-  // chatter below them; the floor is on the acceleration.
-  synchronous_residual(rev_samples);
+  // Spectrum (Hann), energy away from the spindle harmonics.
   if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
+  double* in = fft_->input();
+  for (std::size_t i = 0; i < n; ++i)
+    in[i] = window_[i] * (0.5 - 0.5 * std::cos(kTwoPi * static_cast<double>(i) / static_cast<double>(n)));
+  const std::complex<double>* X = fft_->forward();
   const double df = fs_ / static_cast<double>(n);
-  const auto band = [&](std::size_t k) {
-    const double f = static_cast<double>(k) * df;
-    return f >= s_.band_min_hz && f <= 0.45 * fs_;
-  };
+  // The share by displacement (each line's energy / f^2): the accelerometer weights the tooth-passing
+  // harmonics by f^2 over a robot mode's chatter below them; the floor is on the acceleration.
   double total = 0.0, off = 0.0, total_a = 0.0, off_a = 0.0, best = 0.0;
-  const std::complex<double>* X = hann_spectrum(window_);
-  for (std::size_t k = 1; k < fft_->bins(); ++k) {
-    if (!band(k)) continue;
-    const double f = static_cast<double>(k) * df, e_a = std::norm(X[k]);
-    total += e_a / (f * f), total_a += e_a;
-  }
   std::size_t best_k = 0;
-  X = hann_spectrum(periodic_);
-  double periodic = 0.0;
   for (std::size_t k = 1; k < fft_->bins(); ++k) {
     const double f = static_cast<double>(k) * df;
-    if (band(k)) periodic += std::norm(X[k]) / (f * f);
-  }
-  X = hann_spectrum(residual_);
-  for (std::size_t k = 1; k < fft_->bins(); ++k) {
-    if (!band(k)) continue;
-    const double f = static_cast<double>(k) * df, e_a = std::norm(X[k]), e = e_a / (f * f);
+    if (f < s_.band_min_hz || f > 0.45 * fs_) continue;
+    const double e_a = std::norm(X[k]), e = e_a / (f * f);
+    total += e, total_a += e_a;
+    const double f_line = f_sp * s_.lines_per_revolution, h = std::round(f / f_line);
+    if (std::abs(f - h * f_line) <= 2.0 * df + 1e-12) continue;
     off += e, off_a += e_a;
     if (e > best) best = e, out.chatter_hz = f, best_k = k;
   }
@@ -191,9 +140,7 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     if (denom < 0.0) out.chatter_hz += std::clamp(0.5 * (a - c) / denom, -0.5, 0.5) * df;
   }
   out.valid = true;
-  // Against the periodic part's energy rather than the span's: a chatter that grows through the span does not
-  // average away over its periods, and the average it leaves is taken from the residual as a forced line.
-  out.nonharmonic_share = off + periodic > 0.0 ? off / (off + periodic) : 0.0;
+  out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
   out.nonharmonic_rms_mps2 = total_a > 0.0 ? out.rms_mps2 * std::sqrt(off_a / total_a) : 0.0;
   out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
                 out.nonharmonic_rms_mps2 > s_.floor_mps2 &&

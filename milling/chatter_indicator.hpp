@@ -5,12 +5,11 @@
 //     interpolation between loop samples) repeats in a forced, stable cut; the RMS of the differences of
 //     consecutive revolution samples over the RMS of the signal is near 0 then and near sqrt(2) for a
 //     vibration unrelated to the spindle;
-//   - the non-harmonic energy share: the window without its synchronous average over the forced periods
-//     (what repeats from one period to the next: the forced lines whatever their number, runout included),
-//     its spectral energy in [band_min_hz, 0.45 x the loop rate] over that and the average's (Hann
-//     window), and its strongest frequency; by displacement (the acceleration's lines / f^2), as the
-//     tooth-passing harmonics above a robot mode's chatter would otherwise outweigh it by (f / f_chatter)^2.
-//     A chatter 0.4 Hz beside a spindle harmonic, within two bins of it, is seen (issue 50);
+//   - the non-harmonic energy share: of the spectral energy in [band_min_hz, 0.45 x the loop rate], the
+//     share more than two bins away from every spindle harmonic (Hann window; runout makes every
+//     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency; by
+//     displacement (the acceleration's lines / f^2), as the tooth-passing harmonics above a robot mode's
+//     chatter would otherwise outweigh it by (f / f_chatter)^2;
 // Chatter is indicated when both exceed their thresholds, the non-harmonic vibration exceeds a floor
 // (sensor noise alone is not chatter) and it persists across the window (its quietest quarter at
 // least 0.4 of its loudest: a hammer impact's decaying ring is not chatter) or grows through it (each
@@ -19,7 +18,6 @@
 // push() per sample on the drain thread, evaluate() at the status rate; buffers allocated at construction.
 #pragma once
 
-#include <complex>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -37,13 +35,13 @@ struct ChatterIndicatorSettings {
   int min_revolutions{12};
   double band_min_hz{5.0};
   // The forced lines: every spindle harmonic (1: a spindle with runout, each tooth cutting its own chip)
-  // or every tooth-passing harmonic (the teeth: no runout): the period of the synchronous average and of
-  // the once-per-period statistic (chatter near a spindle harmonic aliases to almost nothing once per
-  // revolution).
+  // or every tooth-passing harmonic (the teeth: no runout). Chatter near a spindle harmonic (at 700 rpm
+  // on config/milling/active_damping_c2.yaml, 23.7 Hz against the second, 23.3 Hz) hides behind the
+  // first within the window's resolution.
   int lines_per_revolution{1};
   // Simulated cuts of config/milling/active_damping_c2.yaml at 700 rpm (tests/test_machining.cpp): 1.0 mm,
-  // stable: 0.001 and 0.000; 1.2 mm, chatter at 23.7 Hz: 0.22 and 0.93; 2.5 mm: 0.33 and 0.98.
-  double once_per_rev_threshold{0.1};
+  // stable: 0.02 and 0.0001; 2.5 mm, chatter at 24.1 Hz: 0.33 and 0.26.
+  double once_per_rev_threshold{0.2};
   double nonharmonic_threshold{0.1};
   double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
   // Quietest / loudest quarter of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
@@ -110,11 +108,6 @@ class ChatterMonitor {
   std::vector<std::uint8_t> gap_;
   std::size_t head_{0}, count_{0};
   std::vector<double> window_;  // the analysed span, oldest first
-  std::vector<double> residual_;  // the span without its synchronous average
-  std::vector<double> periodic_;  // the synchronous average along the span
-  std::vector<double> sync_sum_, sync_weight_;
-  void synchronous_residual(double period_samples);
-  const std::complex<double>* hann_spectrum(const std::vector<double>& x);
   std::unique_ptr<analysis::RealFft> fft_;
   std::size_t fft_n_{0};
 };

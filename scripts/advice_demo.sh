@@ -17,14 +17,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 pacing="${1:-realtime}"
-bash scripts/setup.sh
-out=build/advice_demo
-rm -rf "$out"
-mkdir -p "$out"
-robodamp="$out/robodamp"
-cp build/apps/robodamp "$robodamp"  # a rebuild during the run does not pull it away
-job="$PWD/config/milling/active_damping_c2.yaml"
-port=$((20000 + RANDOM % 20000))
+source scripts/hil_demo_setup.sh
+hil_demo_setup build/advice_demo
 
 # case name, gain (N s/m), depth register (yes/no), cut depth (mm), drives (on/off)
 cases=("damped_depth_register 2000 yes 0.85 on"

@@ -16,14 +16,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 pacing="${1:-lockstep}"
 duration_s="${2:-600}"
-bash scripts/setup.sh
-out=build/derate_soak
-rm -rf "$out"
-mkdir -p "$out"
-robodamp="$out/robodamp"
-cp build/apps/robodamp "$robodamp"  # a rebuild during the run does not pull it away
-job="$PWD/config/milling/active_damping_c2.yaml"
-port=$((20000 + RANDOM % 20000))
+source scripts/hil_demo_setup.sh
+hil_demo_setup build/derate_soak
 sed -e "s|unix:/tmp/robodamp-hil.sock|unix:$PWD/$out/can.sock|" -e "s|port: 1502|port: $port|" \
     -e "s|^    mounting_register: 0$|&\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1|" \
     -e "s|vertical: presets/|vertical: $PWD/config/presets/|" -e "s|model: robots/|model: $PWD/config/robots/|" \
