@@ -33,7 +33,7 @@ struct ChatterArgs {
   std::string config_path, job_path;
   std::optional<double> depth_mm;
   bool damped{false};
-  double window_s{2.0}, max_hz{1000.0};
+  double window_s{4.0}, max_hz{1000.0};
   JsonOut json;
 };
 
@@ -219,7 +219,7 @@ void register_chatter(Registry& r) {
   r.number(sub, "--full-scale-mps2", a->full_scale_mps2, {"m/s^2", 0.0, 1e6, false, false}, "A sound file's acceleration at full scale (an accelerometer recorded as sound)");
   r.whole_number(sub, "--record", a->record, {"(record)", 1, 1000000}, "A universal file's function record");
   sub->add_option("--response", a->response, "A universal file's record by its response DOF NODE:DIR");
-  r.number(sub, "--window-s", a->window_s, {"s", 0.2, 60.0}, "One verdict per window of this length (default 2)");
+  r.number(sub, "--window-s", a->window_s, {"s", 0.2, 60.0}, "One verdict per window of this length (default 4, the cell's live indicator's span)");
   r.number(sub, "--max-hz", a->max_hz, {"Hz", 10.0, 1e5}, "The band analysed (default 1000: a robot's modes and their tooth-passing lines)");
   r.number(sub, "--floor", a->floor, {"(the signal's unit)", 0.0, 1e9}, "Non-harmonic RMS below this is not chatter (default 0.05 m/s^2 for an acceleration)");
   sub->add_option("--config", a->config_path, "The cell's configuration: the speeds to try are checked by the accurate method on its job")

@@ -21,6 +21,7 @@ ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s
   ring_.assign(static_cast<std::size_t>(std::ceil(s_.max_window_s * fs_)), 0.0);
   gap_.assign(ring_.size(), 0);
   window_.reserve(ring_.size());
+  off_bins_.reserve(ring_.size() / 2 + 1);
 }
 
 ChatterMonitor::~ChatterMonitor() = default;
@@ -65,24 +66,13 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   out.rms_mps2 = std::sqrt(ss / static_cast<double>(n));
   if (out.rms_mps2 <= 0.0) return out;
 
-  // Once per revolution.
-  // Sampled once per forced period: a revolution, or a tooth period when only the tooth harmonics are
-  // forced (chatter near a spindle harmonic aliases to almost nothing once per revolution).
+  // Once per forced period (a revolution, or a tooth period when only the tooth harmonics are forced: chatter
+  // near a spindle harmonic changes little from one revolution to the next): x(t) - x(t - one period) at
+  // every sample (the forced, periodic part cancels). Its RMS over the signal's is the once-per-revolution
+  // ratio; its RMS in the window's quarters, the smallest over the largest, the persistence. A decaying
+  // transient (a hammer impact, a step of the cut) leaves a quiet quarter before it or after it; chatter
+  // fills the window.
   const double rev_samples = fs_ / (f_sp * s_.lines_per_revolution);
-  double prev = window_[0], sd = 0.0;
-  std::size_t revs = 0;
-  for (double t = rev_samples; t <= static_cast<double>(n - 1); t += rev_samples) {
-    const auto i = static_cast<std::size_t>(t);
-    const double frac = t - static_cast<double>(i);
-    const double s = i + 1 < n ? window_[i] * (1.0 - frac) + window_[i + 1] * frac : window_[i];
-    ++revs;
-    sd += (s - prev) * (s - prev);
-    prev = s;
-  }
-  out.once_per_rev_ratio = revs > 0 ? std::sqrt(sd / static_cast<double>(revs)) / out.rms_mps2 : 0.0;
-  // Persistence: x(t) - x(t - one revolution) at every sample (the forced, periodic part cancels), RMS in
-  // the window's quarters, the smallest over the largest. A decaying transient (a hammer impact, a step of
-  // the cut) leaves a quiet quarter before it or after it; chatter fills the window.
   double part_ss[4] = {0.0, 0.0, 0.0, 0.0};
   std::size_t part_n[4] = {0, 0, 0, 0};
   const auto first = static_cast<std::size_t>(std::ceil(rev_samples));
@@ -94,6 +84,8 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     const std::size_t q = std::min<std::size_t>(3, 4 * (i - first) / (n - first));
     part_ss[q] += e * e, ++part_n[q];
   }
+  const double diff_ss = part_ss[0] + part_ss[1] + part_ss[2] + part_ss[3];
+  out.once_per_rev_ratio = n > first ? std::sqrt(diff_ss / static_cast<double>(n - first)) / out.rms_mps2 : 0.0;
   double q_min = INFINITY, q_max = 0.0, q_rms[4] = {0.0, 0.0, 0.0, 0.0};
   for (int q = 0; q < 4; ++q) {
     const double r = part_n[q] ? std::sqrt(part_ss[q] / static_cast<double>(part_n[q])) : 0.0;
@@ -118,16 +110,21 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   const double df = fs_ / static_cast<double>(n);
   // The share by displacement (each line's energy / f^2): the accelerometer weights the tooth-passing
   // harmonics by f^2 over a robot mode's chatter below them; the floor is on the acceleration.
-  double total = 0.0, off = 0.0, total_a = 0.0, off_a = 0.0, best = 0.0;
-  std::size_t best_k = 0;
+  double total = 0.0, off = 0.0, total_a = 0.0, off_a = 0.0, best = 0.0, on_a = 0.0;
+  std::size_t best_k = 0, on_bins = 0;
+  off_bins_.clear();
   for (std::size_t k = 1; k < fft_->bins(); ++k) {
     const double f = static_cast<double>(k) * df;
     if (f < s_.band_min_hz || f > 0.45 * fs_) continue;
     const double e_a = std::norm(X[k]), e = e_a / (f * f);
     total += e, total_a += e_a;
     const double f_line = f_sp * s_.lines_per_revolution, h = std::round(f / f_line);
-    if (std::abs(f - h * f_line) <= 2.0 * df + 1e-12) continue;
+    if (std::abs(f - h * f_line) <= 2.0 * df + 1e-12) {
+      on_a += e_a, ++on_bins;
+      continue;
+    }
     off += e, off_a += e_a;
+    off_bins_.push_back(e_a);
     if (e > best) best = e, out.chatter_hz = f, best_k = k;
   }
   // Between the bins: the peak of a parabola through the log magnitudes of the best bin and its
@@ -139,6 +136,12 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     const double denom = a - 2.0 * b + c;
     if (denom < 0.0) out.chatter_hz += std::clamp(0.5 * (a - c) / denom, -0.5, 0.5) * df;
   }
+  if (on_bins > 0 && !off_bins_.empty()) {
+    const auto mid = off_bins_.begin() + static_cast<std::ptrdiff_t>(off_bins_.size() / 2);
+    std::nth_element(off_bins_.begin(), mid, off_bins_.end());
+    out.forced_lines_snr = *mid > 0.0 ? on_a / static_cast<double>(on_bins) / *mid : INFINITY;
+  }
+  out.forced_lines = out.forced_lines_snr >= s_.forced_lines_threshold;
   out.valid = true;
   out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
   out.nonharmonic_rms_mps2 = total_a > 0.0 ? out.rms_mps2 * std::sqrt(off_a / total_a) : 0.0;

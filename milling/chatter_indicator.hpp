@@ -1,10 +1,11 @@
 // The online chatter indicator (docs/harmonic_notch.md, "Chatter indicator"): from the control
 // accelerometer's samples as the telemetry drain receives them, over the last few seconds,
-//   - the once-per-revolution statistic: the signal resampled once per spindle revolution (or per tooth
-//     period when only the tooth harmonics are forced, lines_per_revolution; linear
-//     interpolation between loop samples) repeats in a forced, stable cut; the RMS of the differences of
-//     consecutive revolution samples over the RMS of the signal is near 0 then and near sqrt(2) for a
-//     vibration unrelated to the spindle;
+//   - the once-per-revolution statistic: a forced, stable cut repeats every spindle revolution (or every
+//     tooth period when only the tooth harmonics are forced, lines_per_revolution); the RMS of
+//     x(t) - x(t - one revolution) over the RMS of the signal is near 0 then and near sqrt(2) for a
+//     vibration unrelated to the spindle. Taken at every sample (linear interpolation for the fractional
+//     revolution), not at one phase of the revolution: sampled at one phase, a flip chatter at half the tooth
+//     frequency vanishes whenever that phase meets its zero crossings (a microphone's phase shift did);
 //   - the non-harmonic energy share: of the spectral energy in [band_min_hz, 0.45 x the loop rate], the
 //     share more than two bins away from every spindle harmonic (Hann window; runout makes every
 //     multiple of the spindle frequency a forced line), and the strongest non-harmonic frequency; by
@@ -29,8 +30,13 @@ class RealFft;
 namespace robodamp::milling {
 
 struct ChatterIndicatorSettings {
-  double window_s{2.0};              // analysed span (at least min_revolutions revolutions when longer);
-                                     // no verdict until the span is full (after a reset too)
+  // The analysed span (at least min_revolutions revolutions when longer); no verdict until it is full (after
+  // a reset too). 4 s: the spectrum's bins are 0.25 Hz, and the two bins kept clear around each spindle
+  // harmonic +/-0.5 Hz. With 2 s (+/-1 Hz) a Hopf chatter 0.6 Hz from the second spindle harmonic
+  // (config/milling/active_damping_c2.yaml at 700 rpm, 1.5 mm, 1.35 x the limit, runout) kept only 5-10 %
+  // of the displacement's energy off the harmonics, and 7 of 8 windows of a chattering cut read stable
+  // (tests/test_chatter_listen.cpp); with 4 s, 47-51 %.
+  double window_s{4.0};
   double max_window_s{8.0};          // the buffer
   int min_revolutions{12};
   double band_min_hz{5.0};
@@ -59,6 +65,8 @@ struct ChatterIndicatorSettings {
   // there is no verdict. A loaded 2-core machine's HIL run had 7 % stale ticks, and the held samples read
   // as chatter at 25 and 56 Hz where the emulator's cut was stable.
   double max_gap_share{0.01};
+  // forced_lines_snr at or above this: the spindle's lines are there (the tool is cutting).
+  double forced_lines_threshold{10.0};
 };
 
 struct ChatterIndicator {
@@ -68,6 +76,11 @@ struct ChatterIndicator {
   double nonharmonic_rms_mps2{0.0};
   double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
   double rms_mps2{0.0};
+  // The forced lines over the noise: the mean energy per bin on the spindle harmonics (the two bins either
+  // side of each) over the median per bin elsewhere (the noise floor; a chatter peak barely moves a median).
+  // About 1 without a cut (an air cut, the spindle turning free); a cut's tooth-passing lines are far above.
+  double forced_lines_snr{0.0};
+  bool forced_lines{false};          // forced_lines_snr >= forced_lines_threshold
   double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest quarter / the loudest
   double trend{0.0};                 // the same, the last quarter / the first
   bool growing{false};               // each quarter louder than the one before (growing_step)
@@ -108,6 +121,7 @@ class ChatterMonitor {
   std::vector<std::uint8_t> gap_;
   std::size_t head_{0}, count_{0};
   std::vector<double> window_;  // the analysed span, oldest first
+  std::vector<double> off_bins_;  // the energies of the bins off the harmonics (their median)
   std::unique_ptr<analysis::RealFft> fft_;
   std::size_t fft_n_{0};
 };

@@ -263,7 +263,9 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
     }
     w.indicator = w.rpm > 0.0 ? monitor.evaluate(w.rpm) : ChatterIndicator{};
     w.rms = w.indicator.rms_mps2, w.chatter_share = w.indicator.nonharmonic_share;
-    if (!w.indicator.valid || w.rms < is.floor_mps2) w.verdict = WindowVerdict::kNoSignal;
+    // Not enough signal: no verdict (dropouts, not a full window), or no cut heard (neither chatter nor the
+    // spindle's forced lines above the noise: an air cut). A quiet cut whose lines stand out is stable.
+    if (!w.indicator.valid || (!w.indicator.chatter && !w.indicator.forced_lines)) w.verdict = WindowVerdict::kNoSignal;
     else w.verdict = w.indicator.chatter ? WindowVerdict::kChatter : WindowVerdict::kStable;
     if (w.verdict == WindowVerdict::kChatter) {
       w.chatter_hz = w.indicator.chatter_hz, found.push_back(w.chatter_hz);

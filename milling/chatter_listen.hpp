@@ -32,7 +32,7 @@ struct ListenSettings {
   std::optional<double> rpm;          // nullopt: estimated
   double rpm_min{100.0}, rpm_max{30000.0};  // where the estimate searches (and the speeds to try lie)
   double max_hz{1000.0};              // the band analysed: decimated to about 2.5 x this
-  double window_s{2.0};               // one verdict per window
+  double window_s{4.0};               // one verdict per window (the indicator's span: chatter_indicator.hpp)
   std::optional<double> floor;        // non-harmonic RMS below it is not chatter, in the signal's unit
                                       // (default: the indicator's 0.05 m/s^2 for an acceleration)
   ChatterIndicatorSettings indicator;
