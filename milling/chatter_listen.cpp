@@ -204,6 +204,30 @@ std::vector<SpeedToTry> pockets(double chatter_hz, int teeth, double rpm_now, do
   return out;
 }
 
+namespace {
+
+// The speed the recording is judged at (r.rpm, r.rpm_source): given, the recording's own (returned per kept
+// sample after decimating by d, for each window's), or estimated from the analysed signal x.
+std::vector<double> listening_speed(const RecordedSignal& sig, const ListenSettings& s, const std::vector<double>& x,
+                                    std::size_t d, ListenReport& r) {
+  std::vector<double> rpm_at;
+  for (std::size_t i = 0; i < sig.rpm.size() && !s.rpm; i += d) rpm_at.push_back(sig.rpm[i]);
+  if (s.rpm) {
+    r.rpm = *s.rpm, r.rpm_source = "given";
+  } else if (!rpm_at.empty()) {
+    std::vector<double> sorted = rpm_at;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    r.rpm = sorted[sorted.size() / 2], r.rpm_source = "from " + sig.rpm_from + " (median; each window at its own)";
+  } else {
+    const auto e = estimate_rpm(x, r.analysed_rate_hz, s.teeth, s.rpm_min, s.rpm_max);
+    if (!e) throw std::invalid_argument(sig.source + ": no spindle speed found in the signal's harmonics; give --rpm");
+    r.rpm = e->rpm, r.rpm_source = e->how;
+  }
+  return rpm_at;
+}
+
+}  // namespace
+
 ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   if (s.teeth < 1 || s.teeth > 32) throw std::invalid_argument("teeth = " + std::to_string(s.teeth) + ": allowed 1 .. 32");
   if (!(sig.rate_hz > 0.0)) throw std::invalid_argument(sig.source + ": no sample rate");
@@ -220,20 +244,7 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   const auto d = static_cast<std::size_t>(std::max(1.0, std::floor(sig.rate_hz / (2.5 * s.max_hz))));
   decimate(x, gap, d);
   r.analysed_rate_hz = sig.rate_hz / static_cast<double>(d);
-  // The recording's own speeds, decimated with it (the value at each kept sample).
-  std::vector<double> rpm_at;
-  for (std::size_t i = 0; i < sig.rpm.size() && !s.rpm; i += d) rpm_at.push_back(sig.rpm[i]);
-  if (s.rpm) {
-    r.rpm = *s.rpm, r.rpm_source = "given";
-  } else if (!rpm_at.empty()) {
-    std::vector<double> sorted = rpm_at;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
-    r.rpm = sorted[sorted.size() / 2], r.rpm_source = "from " + sig.rpm_from + " (median; each window at its own)";
-  } else {
-    const auto e = estimate_rpm(x, r.analysed_rate_hz, s.teeth, s.rpm_min, s.rpm_max);
-    if (!e) throw std::invalid_argument(sig.source + ": no spindle speed found in the signal's harmonics; give --rpm");
-    r.rpm = e->rpm, r.rpm_source = e->how;
-  }
+  const std::vector<double> rpm_at = listening_speed(sig, s, x, d, r);
   const double tooth_hz = s.teeth * r.rpm / 60.0;
   if (tooth_hz > 0.45 * r.analysed_rate_hz)
     r.warnings.push_back(fmt("the tooth-passing frequency (%.4g Hz) is above the analysed band (%.4g Hz): only the spindle's "

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <thread>
 
+#include <spdlog/spdlog.h>
+
 #include "config/milling_config.hpp"
 #include "rt/supervisor.hpp"
 #include "rt/telemetry_frame.hpp"
@@ -15,6 +17,7 @@ namespace {
 
 constexpr int kLobeSpeeds = 80;  // the live lobes' sweep: 81 speeds over the job's range
 constexpr std::uint64_t kMaxHeldTicks = 100000;  // longer than the indicator's buffer (8 s at 5 kHz)
+constexpr double kChatterLogPeriodS = 0.25;       // the indicator's verdict for the log, in loop time
 
 // The job's spindle: without runout (time_domain.runout_um all zero) only the tooth harmonics are forced.
 milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) {
@@ -57,9 +60,29 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
     for (std::uint64_t k = std::min<std::uint64_t>(f.tick - last_.tick - 1, kMaxHeldTicks); k > 0; --k) chatter_.push(0.0, false);
   chatter_.push(f.accel_mps2, (f.flags & rt::kFlagFresh) != 0);
   last_ = f;
+  // The log's verdicts every kChatterLogPeriodS of loop time, whoever else asks (the status thread, the
+  // advisor on the wall clock): the same instants on any machine, in lockstep too.
+  if (f.time_s >= next_chatter_log_s_) {
+    next_chatter_log_s_ = f.time_s + kChatterLogPeriodS;
+    if (rpm_ > 0.0) log_chatter(chatter_.evaluate(rpm_));
+  }
 }
 
 dds::MachiningSample MachiningMonitor::sample() { return view().sample; }
+
+// Under m_, on the drain thread: the indicator's verdict changed (a valid verdict only: a restarting window
+// says nothing), one line each way, with the loop time of the window's last sample.
+void MachiningMonitor::log_chatter(const milling::ChatterIndicator& c) {
+  if (!c.valid || c.chatter == chatter_logged_) return;
+  chatter_logged_ = c.chatter;
+  if (c.chatter)
+    spdlog::warn("machining: chatter at {:.2f} Hz at {:.3f} s, {:.0f} rpm (the live indicator over the last {:.1f} s: "
+                 "once-per-rev {:.2f}, non-harmonic share {:.2f}, {:.3f} m/s^2)",
+                 c.chatter_hz, last_.time_s, rpm_, chatter_.settings().window_s, c.once_per_rev_ratio, c.nonharmonic_share,
+                 c.nonharmonic_rms_mps2);
+  else
+    spdlog::info("machining: chatter ended at {:.3f} s, {:.0f} rpm (the live indicator)", last_.time_s, rpm_);
+}
 
 std::pair<std::size_t, double> MachiningMonitor::set_and_gain() {
   std::size_t set = active_set_ ? active_set_() : 0;

@@ -49,6 +49,7 @@ class MachiningMonitor {
   [[nodiscard]] std::optional<dds::LobesSample> scheduled_lobes(std::size_t active);
   [[nodiscard]] AdviceView view();
   [[nodiscard]] std::pair<std::size_t, double> set_and_gain();  // the active set and the gain its limits are for
+  void log_chatter(const milling::ChatterIndicator& c);
   int teeth_;
   std::vector<config::Config> set_configs_;  // every parameter set's configuration (their K by speed)
   std::function<std::size_t()> active_set_;
@@ -56,6 +57,8 @@ class MachiningMonitor {
   std::unique_ptr<milling::LiveStability> stability_;
   std::mutex m_;
   milling::ChatterMonitor chatter_;
+  bool chatter_logged_{false};  // the last verdict logged
+  double next_chatter_log_s_{0.0};
   rt::TelemetryFrame last_{};
   double rpm_{0.0};
   std::vector<double> lobe_rpm_;  // the sweep's speeds

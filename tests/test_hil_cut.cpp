@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "rt/recording.hpp"
 #include "hil_files.hpp"
 #include "test_util.hpp"
 
@@ -122,13 +123,14 @@ TEST(HilCut, TheRobotProgramChangesSpeedAndDepthDuringTheCut) {
 // The cell that cuts and follows the advice: the robot publishes the spindle speed, the depth it cuts and
 // reads the advice block; spindle.job gives robodamp run the live limits; the emulated robot follows.
 // gain: the damper's (0: open loop); rpm_max: the spindle's.
-test::HilFiles advice_cell(const std::string& name, const std::string& gain = "2000", const std::string& rpm_max = "1500") {
+test::HilFiles advice_cell(const std::string& name, const std::string& gain = "2000", const std::string& rpm_max = "1500",
+                           const std::string& apply_advice = "true") {
   return test::hil_files(name, {{"    mounting_register: 0\n",
                                  "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"
                                  "    depth_register: 2\n    advice_register: 4\n"},
                                 {"  gain_ns_per_m: 2000 ", "  gain_ns_per_m: " + gain + " "},
                                 {"\nhil: ", "\nspindle:\n  teeth: 3\n  rpm_max: " + rpm_max + "\n  job: " + kJob +
-                                               "\n  apply_advice: true\n\nhil: "}});
+                                               "\n  apply_advice: " + apply_advice + "\n\nhil: "}});
 }
 
 struct AdviceRun {
@@ -230,6 +232,65 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
     // The controller's view: the advice it wrote is the one the robot read.
     EXPECT_EQ(r.run["advice"]["seq"].get<unsigned>(), advice.back()["seq"].get<unsigned>()) << r.run["advice"].dump(1);
   }
+}
+
+// The cell's live indicator and `robodamp chatter` on the same signal (issue 50): the damped cut of 0.95 mm at
+// 700 rpm (limit 0.782 mm: it chatters) from 2 s for 150 revolutions, lockstep, the controller on the virtual
+// clock recording every tick, its advice not applied; the robot program turns the spindle to 666.7 rpm (stable
+// there) at 14 s. The live indicator logs its verdict as it changes ("machining: chatter at ..." / "chatter
+// ended"; it looks every 0.25 s of loop time); `robodamp chatter` on the recording gives one per 4 s window, the
+// live indicator's span. At each window's end the live verdict is the window's, except within 0.3 s of a
+// change the log shows (the live window ends up to 0.25 s off the recording's) and where the window holds the
+// speed change (the live window restarts there; the recording's window is judged at its median speed).
+TEST(HilCut, TheLiveIndicatorAndRobodampChatterAgreeOnARecordedRun) {
+  const test::HilFiles f = advice_cell("listen_live", "2000", "1500", "false");
+  const std::string rec = f.dir + "/run.rdrec", listened = f.dir + "/chatter.json";
+  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", "700",
+               "--cut-axial-mm", "0.95", "--cut-revs", "320", "--cut-at", "2", "--spindle", "14:666.7", "--json", f.plant_json},
+              f.plant_log);
+  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", "30", "--record", rec, "--json", f.run_json},
+            f.run_log);
+  ASSERT_EQ(run.wait(), 0) << test::read_file(f.run_log);
+  plant.kill(SIGINT);
+  plant.wait();
+  const std::string log = test::read_file(f.run_log);
+  // The live verdicts: (loop time, chatter) at each change.
+  std::vector<std::pair<double, bool>> live;
+  for (std::size_t at = log.find("machining: chatter"); at != std::string::npos; at = log.find("machining: chatter", at + 1)) {
+    const bool ended = log.compare(at, 24, "machining: chatter ended") == 0;
+    const std::size_t t = ended ? at + 28 : log.find(" Hz at ", at) + 7;
+    live.emplace_back(std::stod(log.substr(t)), !ended);
+  }
+  ASSERT_FALSE(live.empty()) << "the live indicator never saw chatter:\n" << log;
+  Child heard({"chatter", "--signal", rec, "--teeth", "3", "--json", listened}, f.dir + "/chatter.log");
+  ASSERT_EQ(heard.wait(), 0) << test::read_file(f.dir + "/chatter.log");
+  const json windows = json::parse(test::read_file(listened))["windows"];
+  const double t0 = rt::read_recording(rec).frames.front().time_s;  // the recording's first tick, loop time
+  int judged = 0, same = 0, chatter = 0;
+  std::string table = "the live indicator's changes:";
+  for (const auto& [t, c] : live) table += " " + std::to_string(t) + (c ? " chatter," : " quiet,");
+  table += "\n";
+  for (const auto& w : windows) {
+    const double end = t0 + w["end_s"].get<double>();
+    bool near_change = false, state = false;
+    for (const auto& [t, c] : live) {
+      near_change = near_change || std::abs(t - end) < 0.3;
+      if (t <= end) state = c;
+    }
+    table += std::to_string(end) + " s: " + w["verdict"].get<std::string>() + ", live " + (state ? "chatter" : "quiet") +
+             (near_change ? " (near a change)\n" : "\n");
+    const bool speed_change = end - 4.0 < 14.1 && end > 14.0;  // the register's 50 ms
+    if (near_change || speed_change || w["verdict"] == "not enough signal") continue;
+    ++judged;
+    same += (w["verdict"] == "chatter") == state;
+    chatter += state;
+  }
+  std::printf("%s", table.c_str());
+  EXPECT_GE(judged, 5) << table;
+  EXPECT_GE(chatter, 2) << table;
+  EXPECT_LE(chatter, judged - 2) << table;  // and stable at 666.7 rpm
+  EXPECT_EQ(same, judged) << table << log;
+  EXPECT_NEAR(json::parse(test::read_file(listened))["chatter_hz"].get<double>(), 23.7, 0.3);
 }
 
 // No speed in the range takes the depth: the job's speed range narrowed to 690-710 rpm (a copy of the
