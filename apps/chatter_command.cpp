@@ -87,27 +87,37 @@ nlohmann::json to_json(const milling::ListenReport& r) {
 std::string plots(const milling::ListenReport& r, const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
+  // pm3d colours each quadrangle by its lower-left corner (corners2color c1): a column, centred on its
+  // window, is drawn from half a hop before its centre to half a hop after.
   std::ostringstream sp;
+  const double half_hop_s =
+      r.spectrogram_t_s.size() > 1 ? 0.5 * (r.spectrogram_t_s[1] - r.spectrogram_t_s[0]) : 0.0;
   for (std::size_t c = 0; c < r.spectrogram_db.size(); ++c) {
     for (std::size_t k = 0; k < r.spectrogram_hz.size(); ++k)
-      sp << plot::num(r.spectrogram_t_s[c]) << ' ' << plot::num(r.spectrogram_hz[k]) << ' ' << plot::num(r.spectrogram_db[c][k]) << '\n';
+      sp << plot::num(r.spectrogram_t_s[c] - half_hop_s) << ' ' << plot::num(r.spectrogram_hz[k]) << ' '
+         << plot::num(r.spectrogram_db[c][k]) << '\n';
     sp << '\n';
   }
   const double duration_s = r.windows.empty() ? 0.0 : r.windows.back().end_s;
   const double top_hz = r.spectrogram_hz.empty() ? 1.0 : r.spectrogram_hz.back();
+  const double bottom_hz = r.spectrogram_hz.empty() ? 0.1 : r.spectrogram_hz.front();
   char title[160];
   if (r.chatter_hz > 0.0) std::snprintf(title, sizeof title, "Spectrogram (%.0f rpm, chatter at %.2f Hz)", r.rpm, r.chatter_hz);
   else std::snprintf(title, sizeof title, "Spectrogram (%.0f rpm, no chatter)", r.rpm);
   std::ostringstream s;
   s << "set title '" << title << "'\nset xlabel 'time (s)'\nset ylabel 'frequency (Hz)'\nset cblabel 'magnitude (dB)'\n"
-    << "set xrange [0:" << plot::num(duration_s) << "]\nset yrange [0:" << plot::num(top_hz) << "]\n"
-    << "plot DATA u 1:2:3 with image notitle\n";
+    << "set xrange [0:" << plot::num(duration_s) << "]\nset yrange [" << plot::num(bottom_hz) << ":" << plot::num(top_hz)
+    << "]\nset logscale y\nset view map\nset pm3d map corners2color c1\nset palette defined (0 'black', 1 'purple', 2 'red', 3 'yellow')\n"
+    << "splot DATA u 1:2:3 with pm3d notitle\n";
   if (auto e = run_gnuplot(s.str(), sp.str(), dir + "/chatter_spectrogram.png"); !e.empty()) return e;
   std::ostringstream v;
   for (const auto& w : r.windows) {
     const int level = w.verdict == milling::WindowVerdict::kChatter ? 2 : w.verdict == milling::WindowVerdict::kStable ? 1 : 0;
-    v << plot::num(w.start_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz) << '\n'
-      << plot::num(w.end_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz) << '\n';
+    const double mid_s = 0.5 * (w.start_s + w.end_s);  // where the window's chatter frequency is drawn
+    v << plot::num(w.start_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz) << ' '
+      << plot::num(mid_s) << '\n'
+      << plot::num(w.end_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz) << ' '
+      << plot::num(mid_s) << '\n';
   }
   std::string onset;
   if (r.onset_s)
@@ -119,7 +129,7 @@ std::string plots(const milling::ListenReport& r, const std::string& dir) {
       "set ytics ('not enough signal' 0, 'stable' 1, 'chatter' 2)\nset yrange [-0.3:2.3]\n"
       "plot DATA u 1:2 w l lw 3 t 'verdict per window'\nset ytics auto\nset yrange [*:*]\nset xlabel 'time (s)'\n"
       "set key bottom right\nset ylabel 'non-harmonic share'\nset yrange [0:1.05]\nset y2label 'chatter frequency (Hz)'\nset y2tics\nset y2range [0:*]\n"
-      "plot DATA u 1:3 w l t 'non-harmonic share of the energy', DATA u 1:($4 > 0 ? $4 : 1/0) axes x1y2 w p pt 7 t 'chatter frequency'\n"
+      "plot DATA u 1:3 w l t 'non-harmonic share of the energy', DATA u 5:($4 > 0 ? $4 : 1/0) axes x1y2 w p pt 7 t 'chatter frequency (per window)'\n"
       "unset multiplot\n";
   return run_gnuplot(s2, v.str(), dir + "/chatter_verdict.png");
 }

@@ -82,22 +82,29 @@ double line(const std::vector<double>& p, double df, double f) {
   return v;
 }
 
-// Half-window Hann spectra of the analysed signal, up to max_hz, grouped to at most 400 rows.
+// Half-window Hann spectra of the analysed signal, from two bins up to max_hz, in at most 400 rows spaced
+// evenly in log frequency (each the largest bin within it): a robot's 5-30 Hz chatter and the spindle harmonic
+// half a hertz beside it fall on rows of their own, where rows of equal width (2.5 Hz up to 1 kHz) merged them.
 void spectrogram(const std::vector<double>& x, double rate_hz, std::size_t n, double max_hz, ListenReport& r) {
   const std::size_t hop = std::max<std::size_t>(n / 2, 1), len = hop * 2;
   analysis::RealFft fft(len);
   const double df = rate_hz / static_cast<double>(len);
   const auto bins = std::min(fft.bins(), static_cast<std::size_t>(max_hz / df) + 1);
-  const std::size_t group = std::max<std::size_t>(1, (bins + 399) / 400);
-  for (std::size_t g = 0; g * group < bins; ++g) r.spectrogram_hz.push_back((static_cast<double>(g * group) + 0.5 * static_cast<double>(group - 1)) * df);
+  // Row g holds the bins [first[g], first[g + 1]): at least one each.
+  std::vector<std::size_t> first{2};
+  const double ratio = std::pow(static_cast<double>(bins) / 2.0, 1.0 / 400.0);
+  for (double edge = 2.0 * ratio; first.back() < bins; edge *= ratio)
+    if (const auto k = std::min(bins, static_cast<std::size_t>(std::ceil(edge))); k > first.back()) first.push_back(k);
+  for (std::size_t g = 0; g + 1 < first.size(); ++g)
+    r.spectrogram_hz.push_back(std::sqrt(static_cast<double>(first[g]) * static_cast<double>(first[g + 1] - 1)) * df);
   for (std::size_t b = 0; b + len <= x.size(); b += hop) {
     for (std::size_t i = 0; i < len; ++i)
       fft.input()[i] = x[b + i] * 0.5 * (1.0 - std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(len)));
     const std::complex<double>* X = fft.forward();
     std::vector<double> col;
-    for (std::size_t g = 0; g * group < bins; ++g) {
+    for (std::size_t g = 0; g + 1 < first.size(); ++g) {
       double m = 0.0;
-      for (std::size_t k = g * group; k < std::min(bins, (g + 1) * group); ++k) m = std::max(m, std::abs(X[k]) * 4.0 / static_cast<double>(len));
+      for (std::size_t k = first[g]; k < first[g + 1]; ++k) m = std::max(m, std::abs(X[k]) * 4.0 / static_cast<double>(len));
       col.push_back(20.0 * std::log10(std::max(m, 1e-12)));
     }
     r.spectrogram_t_s.push_back((static_cast<double>(b) + 0.5 * static_cast<double>(len)) / rate_hz);

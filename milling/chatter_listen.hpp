@@ -67,7 +67,8 @@ struct ListenReport {
   std::vector<std::string> warnings;     // what is awkward about the recording, said plainly
   std::vector<SpeedToTry> speeds;        // the pockets 60 f_c / (N k) within [rpm_min, rpm_max], nearest first
   // The spectrogram of the analysed signal: one column per half window (Hann), its magnitude in dB at
-  // spectrogram_hz (up to max_hz, at most 400 rows: the largest bin of each group).
+  // spectrogram_hz (two bins up to max_hz, at most 400 rows evenly spaced in log frequency: the largest bin
+  // of each).
   std::vector<double> spectrogram_t_s, spectrogram_hz;
   std::vector<std::vector<double>> spectrogram_db;  // [column][row]
 };
