@@ -129,6 +129,14 @@ TEST(ChatterListen, AwkwardRecordingsAreSaidPlainly) {
   ml::ListenSettings no_teeth = settings();
   no_teeth.teeth = 0;
   EXPECT_THROW((void)ml::listen(sig, no_teeth), std::invalid_argument);
+  ml::RecordedSignal slow;  // 30 Hz: no room for a chatter band from 5 Hz
+  slow.source = "slow", slow.rate_hz = 30.0, slow.samples.assign(3000, 0.1);
+  try {
+    (void)ml::listen(slow, settings());
+    ADD_FAILURE() << "a 30 Hz recording was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("too low a rate for a chatter band from 5 Hz"), std::string::npos) << e.what();
+  }
   // Air: the spindle turning, no cut: noise only, below the floor.
   ml::RecordedSignal air;
   air.source = "air", air.rate_hz = 10000.0;
