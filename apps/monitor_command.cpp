@@ -106,10 +106,14 @@ std::string machining_view(const msg::Machining& m) {
     limits = "open " + mm(m.open_limit_mm()) + " (SDM), damped " + mm(m.damped_limit_mm()) + " (" + m.limit_method() + "); now " + mm(m.limit_mm()) +
              (m.loop_active() ? " (damper active)" : " (damper off)") +
              (m.depth_warning() ? (m.depth_measured() ? "  WARNING: depth above the limit"
-                                                      : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
+                                   : m.cutting() == dds::kNotCutting
+                                       ? "  the job's planned depth is above the limit here (not cutting now)"
+                                       : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
                                 : "  depth within");
   std::string indicator = "-";
-  if (m.indicator_valid()) {
+  if (m.cutting() == dds::kNotCutting) {
+    indicator = "not cutting (" + m.cutting_reason() + ")";
+  } else if (m.indicator_valid()) {
     char c[200];
     std::snprintf(c, sizeof c, "once-per-rev %.2f, non-harmonic %.0f %% (strongest %.1f Hz): %s", m.once_per_rev_ratio(),
                   100.0 * m.nonharmonic_share(), m.chatter_hz(), m.chatter() ? "CHATTER" : "no chatter");

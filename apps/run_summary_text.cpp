@@ -184,6 +184,7 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                       {"depth_measured", m.depth_measured},
                       {"indicator_valid", m.indicator_valid}, {"once_per_rev_ratio", m.once_per_rev_ratio},
                       {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
+                      {"cutting", dds::cutting_name(m.cutting)}, {"cutting_reason", m.cutting_reason},
                       {"chatter", m.chatter}};
   }
   if (s.advice) j["advice"] = advice_json(runtime::to_sample(*s.advice));
@@ -334,14 +335,17 @@ std::string summary_text(const runtime::RunSummary& s) {
     } else {
       std::snprintf(b, sizeof b,
                     "  machining at the end: %.0f rpm, depth %.3f mm; limit open %.3f mm (SDM), damped %.3f mm (%s)%s; chatter "
-                    "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)\n",
+                    "indicator %s (once-per-rev %.2f, non-harmonic %.0f %%)%s\n",
                     m.spindle_rpm, m.depth_mm, m.open_limit_mm, m.damped_limit_mm, m.limit_method.c_str(),
                     !m.limits_ready   ? " (not computed)"
                     : !m.depth_warning ? ""
                     : m.depth_measured ? ": WARNING, depth above the limit"
+                    : m.cutting == dds::kNotCutting ? ": the job's planned depth is above the limit here (not cutting)"
                                        : ": WARNING, the job's planned depth is above the limit (the robot reports no depth)",
                     !m.indicator_valid ? "not ready" : m.chatter ? "CHATTER" : "quiet", m.once_per_rev_ratio,
-                    100.0 * m.nonharmonic_share);
+                    100.0 * m.nonharmonic_share, m.cutting == dds::kCutting ? "; cutting"
+                                                 : m.cutting == dds::kNotCutting ? ("; NOT CUTTING (" + m.cutting_reason + ")").c_str()
+                                                                                 : "");
       os << b;
     }
   }

@@ -10,6 +10,7 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "dds/bridge.hpp"
 #include "dds/messages.hpp"
 #include "dds/participant.hpp"
 #include "rt/supervisor.hpp"
@@ -51,7 +52,8 @@ json to_json(const msg::Machining& m) {
           {"damped_limit_mm", finite(m.damped_limit_mm())}, {"limit_method", m.limit_method()}, {"loop_active", m.loop_active()},
           {"limit_mm", finite(m.limit_mm())}, {"depth_warning", m.depth_warning()}, {"depth_measured", m.depth_measured()}, {"indicator_valid", m.indicator_valid()},
           {"once_per_rev_ratio", m.once_per_rev_ratio()}, {"nonharmonic_share", m.nonharmonic_share()},
-          {"chatter_hz", m.chatter_hz()}, {"chatter", m.chatter()}};
+          {"chatter_hz", m.chatter_hz()}, {"chatter", m.chatter()}, {"cutting", dds::cutting_name(m.cutting())},
+          {"cutting_reason", m.cutting_reason()}};
 }
 
 json to_json(const msg::Advice& a) {

@@ -206,6 +206,8 @@ void Bridge::publish_machining() {
   out.nonharmonic_share(static_cast<float>(m.nonharmonic_share));
   out.chatter_hz(static_cast<float>(m.chatter_hz));
   out.chatter(m.chatter);
+  out.cutting(m.cutting);
+  out.cutting_reason(m.cutting_reason);
   if (machining_writer_->write(&out)) ++n_machining_;
 }
 

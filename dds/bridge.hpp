@@ -57,7 +57,13 @@ struct MachiningSample {
   bool indicator_valid{false};
   double once_per_rev_ratio{0.0}, nonharmonic_share{0.0}, chatter_hz{0.0};
   bool chatter{false};
+  std::uint8_t cutting{0};     // kCuttingUnknown, kCutting, kNotCutting
+  std::string cutting_reason;  // what says so
 };
+inline constexpr std::uint8_t kCuttingUnknown = 0, kCutting = 1, kNotCutting = 2;
+[[nodiscard]] inline const char* cutting_name(std::uint8_t c) {
+  return c == kCutting ? "cutting" : c == kNotCutting ? "not cutting" : "not known yet";
+}
 
 // What the Advice_ topic carries (dds/robodamp.idl), filled from the cell's speed advisor.
 struct AdviceSample {

@@ -68,6 +68,16 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
   }
 }
 
+Cutting cutting_state(double spindle_rpm, bool depth_measured, double depth_mm, const milling::ChatterIndicator& c) {
+  if (!(spindle_rpm > 0.0)) return {dds::kNotCutting, "spindle stopped"};
+  if (depth_measured)
+    return depth_mm > 0.0 ? Cutting{dds::kCutting, "the robot's depth"} : Cutting{dds::kNotCutting, "the robot's depth is 0"};
+  if (!c.valid) return {dds::kCuttingUnknown, "the indicator's window is not full yet"};
+  if (c.chatter) return {dds::kCutting, "chatter"};
+  if (c.forced_lines) return {dds::kCutting, "tooth-passing lines in the vibration"};
+  return {dds::kNotCutting, "no tooth-passing lines in the vibration"};
+}
+
 dds::MachiningSample MachiningMonitor::sample() { return view().sample; }
 
 // Under m_, on the drain thread: the indicator's verdict changed (a valid verdict only: a restarting window
@@ -99,13 +109,14 @@ AdviceView MachiningMonitor::view() {
   AdviceView v;
   dds::MachiningSample& s = v.sample;
   const auto [set, gain] = set_and_gain();
+  milling::ChatterIndicator c;
   {
     std::lock_guard<std::mutex> lock(m_);
     s.tick = last_.tick;
     s.time_s = last_.time_s;
     s.spindle_rpm = rpm_;
     s.loop_active = static_cast<rt::State>(last_.state) == rt::State::kActive;
-    const milling::ChatterIndicator c = chatter_.evaluate(rpm_);
+    c = chatter_.evaluate(rpm_);
     s.indicator_valid = c.valid;
     s.once_per_rev_ratio = c.once_per_rev_ratio;
     s.nonharmonic_share = c.nonharmonic_share;
@@ -116,6 +127,8 @@ AdviceView MachiningMonitor::view() {
   const double robot_depth = robot_depth_mm_ ? robot_depth_mm_() : std::nan("");
   s.depth_measured = std::isfinite(robot_depth);
   s.depth_mm = s.depth_measured ? robot_depth : stability_->depth_mm();  // the robot's 0: the tool is out of the cut
+  const Cutting cutting = cutting_state(s.spindle_rpm, s.depth_measured, s.depth_mm, c);
+  s.cutting = cutting.state, s.cutting_reason = cutting.reason;
   if (s.spindle_rpm > 0.0)
     if (const auto l = stability_->lookup(s.spindle_rpm, set, gain)) {
       s.limits_ready = true;

@@ -21,6 +21,18 @@
 
 namespace robodamp::runtime {
 
+// Whether the tool is in the cut, and what says so (dds::kCutting ...), first match:
+//   - the spindle stopped: not cutting;
+//   - the robot's depth (modbus.robot.depth_register): 0 not cutting, above 0 cutting;
+//   - the chatter indicator's window: chatter, or the spindle's forced lines 10 x above the noise, cutting;
+//     neither, not cutting (the spindle turning in the air);
+//   - otherwise (the window not full yet): not known.
+struct Cutting {
+  std::uint8_t state{dds::kCuttingUnknown};
+  std::string reason;
+};
+[[nodiscard]] Cutting cutting_state(double spindle_rpm, bool depth_measured, double depth_mm, const milling::ChatterIndicator& c);
+
 class MachiningMonitor {
  public:
   // cfg: the cell's configuration (spindle.job names the job); sets: every parameter set's configuration

@@ -16,6 +16,7 @@
 #include "milling/speed_advice.hpp"
 #include "milling/structure.hpp"
 #include "runtime/cell.hpp"
+#include "runtime/machining_monitor.hpp"
 #include "runtime/speed_advisor.hpp"
 #include "test_util.hpp"
 
@@ -366,11 +367,46 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_EQ(m.depth_warning, depth > m.open_limit_mm);
     EXPECT_TRUE(m.indicator_valid);
     EXPECT_FALSE(m.chatter) << "no cut in the simulated plant";
+    // The simulated plant does not cut: the spindle turns, but no tooth-passing lines stand out of the noise.
+    EXPECT_EQ(m.cutting, dds::kNotCutting) << m.cutting_reason;
+    EXPECT_EQ(m.cutting_reason, "no tooth-passing lines in the vibration");
     // While the damper is active the damped limit applies: 1.5 mm is above it.
     milling::LiveStability& live = cell.machining()->stability();
     EXPECT_EQ(live.compute(700.0, 1, config::scheduled_gain_ns_per_m(config::speed_controller_config(cfg, 1), 1, 700.0)).damped_mm,
               m.damped_limit_mm);
   }
+}
+
+// Whether the tool cuts, and what says so: the spindle first, then the robot's depth, then the vibration.
+TEST(MachiningMonitor, TheCuttingStateSaysWhatSaysSo) {
+  milling::ChatterIndicator quiet, lines, chatter, collecting;
+  quiet.valid = true;
+  lines.valid = true, lines.forced_lines = true;
+  chatter.valid = true, chatter.chatter = true;
+  EXPECT_EQ(runtime::cutting_state(0.0, true, 1.0, lines).reason, "spindle stopped");
+  EXPECT_EQ(runtime::cutting_state(0.0, true, 1.0, lines).state, dds::kNotCutting);
+  EXPECT_EQ(runtime::cutting_state(700.0, true, 0.0, chatter).state, dds::kNotCutting) << "the robot says it is out of the cut";
+  EXPECT_EQ(runtime::cutting_state(700.0, true, 0.8, quiet).state, dds::kCutting) << "the robot says it cuts";
+  EXPECT_EQ(runtime::cutting_state(700.0, false, 0.8, collecting).state, dds::kCuttingUnknown);
+  EXPECT_EQ(runtime::cutting_state(700.0, false, 0.8, lines).state, dds::kCutting);
+  EXPECT_EQ(runtime::cutting_state(700.0, false, 0.8, chatter).state, dds::kCutting);
+  EXPECT_EQ(runtime::cutting_state(700.0, false, 0.8, quiet).state, dds::kNotCutting);
+  EXPECT_EQ(runtime::cutting_state(NAN, false, 0.8, lines).state, dds::kNotCutting);
+  // The indicator's own figure on signals: a cut's forced lines stand 10 x above the noise, an air cut's do not.
+  const double fs = 5000.0, f_sp = 700.0 / 60.0;
+  std::mt19937 rng(6);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  milling::ChatterMonitor cut(fs), air(fs);
+  for (int i = 0; i < 4 * 5000; ++i) {
+    double forced = 0.0;
+    for (int k = 1; k <= 12; ++k) forced += (0.02 / k) * std::sin(2.0 * M_PI * k * f_sp * i / fs + 0.3 * k);
+    cut.push(forced + noise(rng));
+    air.push(noise(rng));
+  }
+  const auto c = cut.evaluate(700.0), a = air.evaluate(700.0);
+  EXPECT_TRUE(c.forced_lines) << c.forced_lines_snr;
+  EXPECT_FALSE(a.forced_lines) << a.forced_lines_snr;
+  EXPECT_LT(a.forced_lines_snr, 3.0);
 }
 
 // What asks for advice: chatter (with its frequency), or a depth above the limit that applies; never a

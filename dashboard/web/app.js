@@ -184,8 +184,12 @@ function tile(c) {
   const fault = state === 'fault';
   const limit = m.limit_mm;
   const pct = (limit && m.depth_mm !== undefined) ? Math.min(100, 100 * m.depth_mm / limit) : 0;
-  const chatter = m.indicator_valid ? (m.chatter ? '<span class="chatter">CHATTER ' + fmt(m.chatter_hz, 1) + ' Hz</span>' : 'quiet')
-                                     : (m.spindle_rpm > 0 ? 'listening…' : '–');
+  // Not cutting (the spindle stopped, the robot's depth 0, no tooth-passing lines): neither "quiet" nor a
+  // depth above the limit describes the cut; the limit stays, as the plan's.
+  const idle = m.cutting === 'not cutting';
+  const chatter = idle ? '<span class="note" data-field="not-cutting">not cutting (' + esc(m.cutting_reason || '') + ')</span>'
+    : m.indicator_valid ? (m.chatter ? '<span class="chatter">CHATTER ' + fmt(m.chatter_hz, 1) + ' Hz</span>' : 'quiet')
+    : (m.spindle_rpm > 0 ? 'listening…' : '–');
   return {
     className: 'tile ' + state + (c.live ? '' : ' quiet'),
     data: { cell: c.cell, state, trip: c.trip, live: String(c.live) },
@@ -202,9 +206,10 @@ function tile(c) {
       '<dt>depth</dt><dd>' + (m.depth_mm !== undefined ? fmt(m.depth_mm, 2) + ' mm of ' +
         (m.limits_ready ? fmt(limit, 2) + ' mm' + (m.loop_active ? ' (damped)' : ' (open loop: the damper is off)') : '…') +
         (m.depth_warning ? (m.depth_measured ? ' <span class="chatter">above the limit</span>'
+          : idle ? ' <span class="note" data-field="plan-above">the job\'s planned depth is above the limit here (not cutting now)</span>'
           : ' <span class="chatter" data-field="plan-above">the job\'s planned depth is above the limit here</span>') : '') +
         (m.depth_measured ? '' : ' <span class="note" data-field="depth-source">(the job\'s plan: the robot reports no depth)</span>') +
-        '<div class="bar' + (m.depth_warning ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
+        '<div class="bar' + (m.depth_warning && !idle ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
       (c.advice ? '<dt>advice</dt><dd>' + (!c.advice.found ? 'no stable speed in range'
         : Math.abs((m.spindle_rpm || 0) - c.advice.advised_rpm) < 0.5 ? 'at the advised ' + fmt(c.advice.advised_rpm, 1) + ' rpm'
@@ -304,12 +309,15 @@ function plotLobes(l, m, a) {
   const options = a && a.found ? a.options : [];
   options.forEach((o) => rows.push([o.rpm, null, null, null, null, a.depth_mm]));
   rows.sort((x, y) => x[0] - y[0]);
-  draw('plot-lobes', ['rpm', 'open loop', l.speed_scheduled ? 'damped (schedule)' : 'damped', 'job depth', 'cutting now', 'advised'], rows, {
+  // The operating point says whether the tool is in the cut (the cell's cutting state).
+  const now = !m || m.cutting === 'cutting' ? 'cutting now' : m.cutting === 'not cutting' ? 'speed now (not cutting)' : 'speed now';
+  const series = { 'job depth': { strokePattern: [6, 4] }, advised: { strokeWidth: 0, drawPoints: true, pointSize: 5 } };
+  series[now] = { strokeWidth: 0, drawPoints: true, pointSize: 6 };
+  draw('plot-lobes', ['rpm', 'open loop', l.speed_scheduled ? 'damped (schedule)' : 'damped', 'job depth', now, 'advised'], rows, {
     xlabel: 'spindle speed (rpm)', ylabel: 'limiting depth (mm)', connectSeparatedPoints: true,
     valueRange: [0, Math.max(3, 6 * l.depth_mm)],  // the lobes near the job's depth (zoom with the mouse)
     colors: ['#7a8494', '#2e9e4f', '#1d2430', '#d0342c', '#e67c00'],
-    series: { 'job depth': { strokePattern: [6, 4] }, 'cutting now': { strokeWidth: 0, drawPoints: true, pointSize: 6 },
-              advised: { strokeWidth: 0, drawPoints: true, pointSize: 5 } },
+    series,
   });
   // The curve is about the state it was computed for: while the cell runs another set or K (a request, a ramp)
   // the note says so until the new sweep arrives; with the damper off the open loop is what applies.
@@ -326,7 +334,7 @@ function plotLobes(l, m, a) {
     (!a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
       fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method)) : 'no advice asked for';
   $('advice').dataset.followed = followed ? 'true' : 'false';
-  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, advised: options.length,
+  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, operating_label: now, advised: options.length,
     gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off,
     scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
       l.damped_limit_mm[i] < 0.995 * l.open_limit_mm[i]).length };

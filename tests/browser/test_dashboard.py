@@ -215,6 +215,14 @@ class DashboardInABrowser(unittest.TestCase):
         self.assertIn("the job's planned depth is above the limit here", text)
         self.assertIn("(the job's plan: the robot reports no depth)", text)
         self.assertNotIn(" above the limit\n", text)
+        # The simulated plant does not cut: once the indicator's 4 s window is full the tile says "not cutting"
+        # (no tooth-passing lines in the vibration), not "quiet", and the plan's depth is not a warning now.
+        text = until(lambda: (lambda t: t if t and "not cutting (no tooth-passing lines in the vibration)" in t["text"] else None)(
+            self.tile("a")), 60, "cell a not cutting")["text"]
+        self.assertIn("the job's planned depth is above the limit here (not cutting now)", text)
+        self.assertNotIn("quiet", text)
+        self.assertEqual(self.js(f'return document.querySelectorAll(\'.tile[data-cell="{self.fleet.cells["a"]}"] '
+                                 '.bar.warn\').length'), 0)
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
 
         self.open_cell("a")
@@ -234,6 +242,8 @@ class DashboardInABrowser(unittest.TestCase):
         lobes = until(lambda: (lambda l: l if l and l["speeds"] >= 20 else None)(self.js("return window.robodamp.plotted.lobes")),
                       240, "20 speeds of live lobes")
         self.assertEqual(lobes["operating_rpm"], 700)
+        until(lambda: self.js("return window.robodamp.plotted.lobes.operating_label") == "speed now (not cutting)", 30,
+              "the operating point labelled as not cutting (the simulated plant does not cut)")
         # The preset's speed schedule: the live lobes are its envelope (each speed its band's controller and K),
         # never below the open loop (0.5 % for the cell's cache of speed and K).
         self.assertTrue(lobes["scheduled"])
