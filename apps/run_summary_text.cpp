@@ -47,6 +47,16 @@ namespace {
                   static_cast<unsigned long long>(m.advice_writes));
     os << b;
   }
+  if (s.joint_states) {
+    const auto& j = *s.joint_states;
+    std::snprintf(b, sizeof b,
+                  "  DDS joint states: %llu messages (%llu refused: a joint missing or not finite), %llu out of the map, "
+                  "%llu pose changes, %llu silences\n",
+                  static_cast<unsigned long long>(j.messages), static_cast<unsigned long long>(j.refused),
+                  static_cast<unsigned long long>(j.out_of_map), static_cast<unsigned long long>(j.changes),
+                  static_cast<unsigned long long>(j.losses));
+    os << b;
+  }
   if (s.dds) {
     std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
                   static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
@@ -199,6 +209,11 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                    {"pose_changes", m.pose_changes},       {"pose_out_of_map_polls", m.pose_out_of_map_polls},
                    {"pose_unavailable_polls", m.pose_unavailable_polls}, {"pose_link_losses", m.pose_link_losses},
                    {"advice_writes", m.advice_writes}};
+  }
+  if (s.joint_states) {
+    const auto& c = *s.joint_states;
+    j["joint_states"] = {{"messages", c.messages}, {"refused", c.refused}, {"out_of_map", c.out_of_map},
+                         {"changes", c.changes}, {"losses", c.losses}};
   }
   return j;
 }

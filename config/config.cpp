@@ -686,6 +686,23 @@ void check_location_refs(Diagnostics& d, const Config& c, const YAML::Node& root
 
 namespace {
 
+// dds.joint_states against pose_schedule and Modbus: a name per joint, one source of the pose.
+void check_joint_states(detail::Diagnostics& d, const Config& c) {
+  const SourceMark here{};
+  if (!c.dds || !c.dds->joint_states) return;
+  const JointStatesConfig& j = *c.dds->joint_states;
+  if (!c.pose_schedule) {
+    d.add(here, "dds.joint_states", "is set without pose_schedule: the joint angles would select nothing");
+    return;
+  }
+  if (!j.names.empty() && j.names.size() != c.pose_schedule->joints())
+    d.add(here, "dds.joint_states.names", "has " + std::to_string(j.names.size()) + " names; pose_schedule has " +
+                                              std::to_string(c.pose_schedule->joints()) + " joints: one name per joint, in order");
+  if (c.modbus && c.modbus->robot.joints_register >= 0)
+    d.add(here, "dds.joint_states", "and modbus.robot.joints_register = " + std::to_string(c.modbus->robot.joints_register) +
+                                        " both give the pose: choose one source");
+}
+
 // modbus.robot.joints_register against pose_schedule: one register per joint, clear of the others.
 void check_joint_registers(detail::Diagnostics& d, const Config& c) {
   const SourceMark here{};  // located() gives it the key's line
@@ -767,6 +784,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
                 format_number(c.spindle.rpm_max) + " rpm");
   }
   check_joint_registers(d, c);
+  check_joint_states(d, c);
   top.finish();
   check_location_refs(d, c, root);
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

@@ -56,4 +56,23 @@ struct PoseScheduleConfig {
 // "[a, b, c] deg"
 [[nodiscard]] std::string describe_pose(const std::vector<double>& joints_deg);
 
+// A pose source's settling (the Modbus joint registers, a DDS joint state): a region (-1: out of the map) is
+// reported once it has been seen `needed` times in a row and differs from the one reported.
+struct PoseSettling {
+  long candidate{-2}, reported{-2};  // -2: nothing yet
+  int same{0};
+  // True when region has now settled and is to be reported (then it is the reported one).
+  [[nodiscard]] bool settled(long region, int needed) {
+    same = region == candidate ? same + 1 : 1;
+    candidate = region;
+    if (same < needed || region == reported) return false;
+    reported = region;
+    return true;
+  }
+  void restart() { candidate = -2, same = 0; }
+  [[nodiscard]] std::optional<std::size_t> current() const {
+    return reported >= 0 ? std::optional(static_cast<std::size_t>(reported)) : std::nullopt;
+  }
+};
+
 }  // namespace robodamp::config

@@ -1,5 +1,6 @@
 #include "config/supervisory_config.hpp"
 
+#include <algorithm>
 #include <unistd.h>
 
 #include <cctype>
@@ -190,6 +191,30 @@ std::optional<DdsSecurityConfig> read_dds_security(MapReader& dds, const std::st
   return c;
 }
 
+std::optional<JointStatesConfig> read_joint_states(MapReader& dds) {
+  const YAML::Node node = dds.child("joint_states", false, "");
+  if (!present(node)) return std::nullopt;
+  MapReader r(dds.diagnostics(), node, "dds.joint_states", dds.mark());
+  JointStatesConfig c;
+  if (auto v = r.text("topic", c.topic)) c.topic = *v;
+  const YAML::Node names = r.child("names", true, "the pose schedule's joints by the names the robot's driver publishes");
+  if (present(names) && !names.IsSequence())
+    r.diagnostics().add(to_mark(names.Mark()), "dds.joint_states.names", "must be a list of joint names, e.g. [joint_1, joint_2]");
+  else if (present(names))
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const std::string key = "dds.joint_states.names[" + std::to_string(i) + "]";
+      const std::string name = names[i].IsScalar() ? names[i].as<std::string>() : "";
+      if (name.empty()) r.diagnostics().add(to_mark(names[i].Mark()), key, "must be a joint's name (text)");
+      else if (std::find(c.names.begin(), c.names.end(), name) != c.names.end())
+        r.diagnostics().add(to_mark(names[i].Mark()), key, "= '" + name + "' is named twice: each joint once");
+      else c.names.push_back(name);
+    }
+  if (auto v = r.number("timeout_s", {"s", 0.01, 60.0}, c.timeout_s)) c.timeout_s = *v;
+  if (auto v = read_int(r, "settle_samples", {"(messages)", 1, 1000}, c.settle_samples)) c.settle_samples = *v;
+  r.finish();
+  return c;
+}
+
 std::optional<DdsConfig> read_dds(MapReader& top) {
   const YAML::Node node = top.child("dds", false, "");
   if (!present(node)) return std::nullopt;
@@ -204,6 +229,7 @@ std::optional<DdsConfig> read_dds(MapReader& top) {
   if (auto v = r.number("status_rate_hz", {"Hz", 0.0, 100.0, true}, c.status_rate_hz)) c.status_rate_hz = *v;
   if (auto v = read_bool(r, "parameter_writes", c.parameter_writes)) c.parameter_writes = *v;
   c.security = read_dds_security(r, top.diagnostics().file());
+  c.joint_states = read_joint_states(r);
   r.finish();
   return c;
 }

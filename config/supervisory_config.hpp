@@ -97,6 +97,15 @@ struct DdsSecurityConfig {
   std::string permissions;           // S/MIME-signed XML: what this participant may publish and subscribe
 };
 
+// The robot's joint angles over DDS as a ROS 2 robot driver publishes them (sensor_msgs/msg/JointState,
+// positions in radians; docs/pose_dynamics.md, "The pose over DDS"): the pose schedule's joints by name.
+struct JointStatesConfig {
+  std::string topic{"rt/joint_states"};  // DDS name: ROS 2's /joint_states
+  std::vector<std::string> names;        // pose_schedule's joints, in its order, as the driver names them
+  double timeout_s{0.5};                 // no message for this long: the pose is unknown
+  int settle_samples{3};                 // a region counts once this many messages in a row fall in it
+};
+
 struct DdsConfig {
   int domain_id{0};
   DdsTransport transport{DdsTransport::kDefault};
@@ -104,6 +113,7 @@ struct DdsConfig {
   double status_rate_hz{5.0};
   bool parameter_writes{false};    // parameter requests are refused unless this is on
   std::optional<DdsSecurityConfig> security;  // absent: no authentication (a closed cell network)
+  std::optional<JointStatesConfig> joint_states;  // absent: the pose comes from Modbus, or not at all
 };
 
 // The cell's identity on the network (docs/dashboard.md): every DDS topic carries it, a dashboard tells

@@ -61,6 +61,21 @@ class Bridge::RequestListener : public DataReaderListener {
   Bridge& b_;
 };
 
+// dds.joint_states: each valid message's names and positions to the cell (a ROS 2 driver's joint states).
+class Bridge::JointStateListener : public DataReaderListener {
+ public:
+  explicit JointStateListener(Bridge& b) : b_(b) {}
+  void on_data_available(DataReader* reader) override {
+    msg::JointState js;
+    SampleInfo info;
+    while (reader->take_next_sample(&js, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) b_.src_.joint_state(js.name(), js.position());
+  }
+
+ private:
+  Bridge& b_;
+};
+
 Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources)
     : cfg_(cfg), source_(config_source), src_(std::move(sources)), availability_(loop_rate_hz, src_.gain_ramp_s) {
   window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
@@ -289,6 +304,11 @@ void Bridge::start() {
     if (running_) return;
     running_ = true;
   }
+  // The joint states from start on (the cell's loop is there to take the pose's region).
+  if (cfg_.joint_states && src_.joint_state && !joint_state_listener_) {
+    joint_state_listener_ = std::make_unique<JointStateListener>(*this);
+    participant_->joint_state_reader(cfg_.joint_states->topic, joint_state_listener_.get());
+  }
   status_thread_ = std::thread([this] {
     const auto period = std::chrono::duration<double>(1.0 / cfg_.status_rate_hz);
     std::unique_lock<std::mutex> lock(m_);
@@ -300,6 +320,7 @@ void Bridge::start() {
       publish_advice();
       publish_spectrum();
       publish_lobes();
+      if (src_.joint_state_check) src_.joint_state_check();
       lock.lock();
     }
   });

@@ -116,6 +116,10 @@ struct BridgeSources {
   double gain_ramp_s{0.0};                         // controller.gain_ramp_s: when the loop is at full gain
   std::function<std::size_t()> parameter_sets{};   // how many sets a select request may choose from (any thread)
   double spindle_rpm_max{0.0};                     // spindle.rpm_max: what a spindle request may ask for
+  // dds.joint_states: each message's names and positions (rad), on the reader's thread; the silence check,
+  // on the status thread. Empty: no joint-state reader.
+  std::function<void(const std::vector<std::string>&, const std::vector<double>&)> joint_state{};
+  std::function<void()> joint_state_check{};
 };
 
 struct BridgeCounters {
@@ -139,6 +143,7 @@ class Bridge {
 
  private:
   class RequestListener;
+  class JointStateListener;
   void publish_status();
   void publish_machining();
   void publish_advice();  // a new advice (its seq) once
@@ -160,6 +165,7 @@ class Bridge {
   eprosima::fastdds::dds::DataWriter* lobes_writer_{nullptr};
   std::uint64_t published_advice_{0};  // status thread
   std::unique_ptr<RequestListener> listener_;
+  std::unique_ptr<JointStateListener> joint_state_listener_;
   rt::AvailabilityMeter availability_;  // under m_
 
   // Decimation window (drain thread).

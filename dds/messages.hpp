@@ -33,3 +33,9 @@ using dds_::SET_GAIN;
 using dds_::SET_SPINDLE_RPM;
 
 }  // namespace robodamp::msg
+
+namespace robodamp::msg {
+// ROS 2's sensor_msgs/msg/JointState (dds.joint_states).
+using JointState = ::sensor_msgs::msg::dds_::JointState_;
+using JointStatePubSubType = ::sensor_msgs::msg::dds_::JointState_PubSubType;
+}  // namespace robodamp::msg

@@ -125,3 +125,44 @@ DataReader* Participant::reader(TopicKind t, DataReaderListener* listener) {
 }
 
 }  // namespace robodamp::dds
+
+namespace robodamp::dds {
+
+Topic* Participant::joint_state_topic(const std::string& topic_name) {
+  if (joint_states_ != nullptr) {
+    if (joint_states_->get_name() != topic_name)
+      throw std::runtime_error("DDS: joint states on " + topic_name + " and " + joint_states_->get_name() + ": one topic");
+    return joint_states_;
+  }
+  TypeSupport type(new msg::JointStatePubSubType());
+  type.register_type(participant_);
+  joint_states_ = participant_->create_topic(topic_name, type.get_type_name(), TOPIC_QOS_DEFAULT);
+  if (joint_states_ == nullptr) throw std::runtime_error("DDS: cannot create topic " + topic_name);
+  return joint_states_;
+}
+
+DataReader* Participant::joint_state_reader(const std::string& topic_name, DataReaderListener* listener) {
+  DataReaderQos q = DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;  // matches a reliable writer and a best-effort one
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 8;
+  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+  DataReader* r = subscriber_->create_datareader(joint_state_topic(topic_name), q, listener);
+  if (r == nullptr) throw std::runtime_error("DDS: cannot create a reader on " + topic_name);
+  return r;
+}
+
+DataWriter* Participant::joint_state_writer(const std::string& topic_name) {
+  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 10;
+  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+  DataWriter* w = publisher_->create_datawriter(joint_state_topic(topic_name), q);
+  if (w == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic_name);
+  return w;
+}
+
+}  // namespace robodamp::dds

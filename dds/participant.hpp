@@ -52,6 +52,13 @@ class Participant {
   eprosima::fastdds::dds::DataWriter* writer(TopicKind t, eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   eprosima::fastdds::dds::DataReader* reader(TopicKind t, eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
+  // ROS 2's sensor_msgs/msg/JointState on topic_name (dds.joint_states.topic): a reader that takes any
+  // driver's writer (best effort, volatile, the last 8), and a writer as a ROS 2 driver has one (reliable,
+  // volatile, the last 10: ROS 2's default QoS; tests and the HIL emulator).
+  eprosima::fastdds::dds::DataReader* joint_state_reader(const std::string& topic_name,
+                                                         eprosima::fastdds::dds::DataReaderListener* listener);
+  eprosima::fastdds::dds::DataWriter* joint_state_writer(const std::string& topic_name);
+
   [[nodiscard]] int domain_id() const { return domain_id_; }
   // The topic (its DDS name and type name: ROS 2's, see above).
   [[nodiscard]] eprosima::fastdds::dds::Topic* topic(TopicKind t);
@@ -63,6 +70,8 @@ class Participant {
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};
   eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};
   eprosima::fastdds::dds::Topic* topics_[kTopicCount]{};
+  eprosima::fastdds::dds::Topic* joint_state_topic(const std::string& topic_name);
+  eprosima::fastdds::dds::Topic* joint_states_{nullptr};  // created on first use
 };
 
 }  // namespace robodamp::dds

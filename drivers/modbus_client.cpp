@@ -341,19 +341,14 @@ bool ModbusClient::poll_pose(modbus_t* ctx, PoseWatch& w) {
     joints_deg_ = q;
   }
   if (!available) ++pose_unavailable_polls_;
-  std::optional<std::size_t> current;
-  if (w.reported >= 0) current = static_cast<std::size_t>(w.reported);
-  const auto region = config::region_of(*schedule_, q.data(), n, current);
+  const auto region = config::region_of(*schedule_, q.data(), n, w.settling.current());
   if (!region) ++pose_out_of_map_polls_;
   const long id = region ? static_cast<long>(*region) : -1;
-  w.same = id == w.candidate ? w.same + 1 : 1;
-  w.candidate = id;
-  if (w.same >= r.settle_polls && id != w.reported) report_pose(w, id);
+  if (w.settling.settled(id, r.settle_polls)) report_pose(id);
   return true;
 }
 
-void ModbusClient::report_pose(PoseWatch& w, long region) {
-  w.reported = region;
+void ModbusClient::report_pose(long region) {
   ++pose_changes_;
   if (region >= 0)
     spdlog::info("modbus robot: pose in region '{}'", schedule_->regions[static_cast<std::size_t>(region)].name);
@@ -364,12 +359,13 @@ void ModbusClient::report_pose(PoseWatch& w, long region) {
 
 void ModbusClient::pose_unknown_if_lost(PoseWatch& w) {
   if (cfg_.robot.joints_register < 0 || !schedule_ || w.lost) return;
-  w.candidate = -2, w.same = 0;
+  w.settling.restart();
   if (ModbusLink::Clock::now() - w.last_ok < std::chrono::duration<double>(cfg_.link_timeout_s)) return;
   w.lost = true;
   ++pose_link_losses_;
   spdlog::warn("modbus robot: no joint angles for {} s: the pose is unknown", cfg_.link_timeout_s);
-  report_pose(w, -1);
+  w.settling.reported = -1;
+  report_pose(-1);
 }
 
 std::vector<double> ModbusClient::joints_deg() const {

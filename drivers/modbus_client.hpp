@@ -146,14 +146,13 @@ class ModbusClient final : public rt::AmplifierIo {
   void park_spindle_if_lost(SpindleWatch& w);
   // The joint registers' settling (robot thread only). Region -1: out of the map; -2: nothing yet.
   struct PoseWatch {
-    long candidate{-2}, reported{-2};
-    int same{0};
+    config::PoseSettling settling;
     bool lost{false};
     std::chrono::steady_clock::time_point last_ok{std::chrono::steady_clock::now()};
   };
   bool poll_pose(modbus_t* ctx, PoseWatch& w);  // false: the read failed
   void pose_unknown_if_lost(PoseWatch& w);
-  void report_pose(PoseWatch& w, long region);
+  void report_pose(long region);
   bool sleep_for(std::chrono::duration<double> d);  // false when stopping
   bool write_advice(modbus_t* ctx);  // the pending advice, if any; false: the write failed
   bool poll_depth(modbus_t* ctx);    // false: the read failed

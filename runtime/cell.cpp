@@ -165,6 +165,9 @@ Status Cell::configure_devices() {
     sim_ = std::make_unique<SimBackendComponent>(plant_model, plant_cfg, o_.backend);
     backend_name_ = "simulated plant";
   }
+  if (cfg_.dds && cfg_.dds->joint_states && cfg_.pose_schedule && !o_.pose_schedule_off)
+    joint_pose_ = std::make_unique<JointStatePose>(*cfg_.dds->joint_states, *cfg_.pose_schedule,
+                                                   [this](std::optional<std::size_t> region) { post_pose_region(region); });
   if (cfg_.dds) {
     dds_ = std::make_unique<DdsEndpoint>(
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
@@ -183,7 +186,13 @@ Status Cell::configure_devices() {
                            cfg_.spindle.job.empty() ? std::function<std::optional<dds::LobesSample>()>{}
                                                     : [this] { return machining_->lobes(); },
                            cfg_.controller.gain_ramp_s,
-                           [this] { return supervisor_->parameter_sets().size(); }, cfg_.spindle.rpm_max});
+                           [this] { return supervisor_->parameter_sets().size(); }, cfg_.spindle.rpm_max,
+                           joint_pose_ ? std::function<void(const std::vector<std::string>&, const std::vector<double>&)>(
+                                             [this](const std::vector<std::string>& n, const std::vector<double>& q) {
+                                               joint_pose_->on_message(n, q);
+                                             })
+                                       : nullptr,
+                           joint_pose_ ? std::function<void()>([this] { joint_pose_->check(); }) : nullptr});
     spectrum_ = std::make_unique<SpectrumMonitor>(cfg_);
   }
   for (Component* c : components()) {
@@ -412,6 +421,7 @@ void Cell::finish_summary() {
   RunSummary& s = summary_;
   if (dds_) s.dds = dds_->bridge().counters();
   if (modbus_) s.modbus = modbus_->client().counters();
+  if (joint_pose_) s.joint_states = joint_pose_->counters();
   if (can_) s.can = can_->driver().counters();
   if (recorder_) {
     recorder_->close();
@@ -461,6 +471,9 @@ void Cell::release() {
   machining_.reset();
   for (Component* c : components())
     if (c->state() == LifecycleState::kInactive) (void)c->cleanup();
+  // The DDS endpoint before the loop: its listeners (a parameter request, a joint state) post to the loop.
+  dds_.reset();
+  joint_pose_.reset();
   loop_.reset();
   arming_.reset();
   ring_.reset();
@@ -468,7 +481,6 @@ void Cell::release() {
   sim_.reset();
   can_.reset();
   modbus_.reset();
-  dds_.reset();
   spectrum_.reset();
   model_.reset();
   mounting_sets_.clear();

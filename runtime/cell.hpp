@@ -38,6 +38,7 @@
 #include "runtime/arming_policy.hpp"
 #include "runtime/components.hpp"
 #include "runtime/lifecycle.hpp"
+#include "runtime/joint_state_pose.hpp"
 #include "runtime/machining_monitor.hpp"
 #include "runtime/spectrum_monitor.hpp"
 #include "runtime/run_summary.hpp"
@@ -141,6 +142,7 @@ class Cell {
   std::unique_ptr<SimBackendComponent> sim_;
   std::unique_ptr<CanBus> can_;
   std::unique_ptr<ModbusComponent> modbus_;
+  std::unique_ptr<JointStatePose> joint_pose_;  // dds.joint_states: the pose from a ROS 2 driver (outlives dds_)
   std::unique_ptr<DdsEndpoint> dds_;
   std::vector<std::pair<config::Mounting, std::size_t>> mounting_sets_;
   std::string backend_name_;

@@ -10,6 +10,7 @@
 #include "dds/bridge.hpp"
 #include "drivers/can_driver.hpp"
 #include "drivers/modbus_client.hpp"
+#include "runtime/joint_state_pose.hpp"
 #include "rt/loop.hpp"
 #include "rt/realtime.hpp"
 #include "rt/supervisor.hpp"
@@ -60,6 +61,7 @@ struct RunSummary {
   std::optional<drivers::CanCounters> can;
   std::optional<drivers::ModbusCounters> modbus;
   std::optional<dds::BridgeCounters> dds;
+  std::optional<JointStateCounters> joint_states;  // dds.joint_states
   TripTiming trip_timing;
   rt::Availability availability;  // the share of the asked time at full gain; every trip's safe and re-arm times
   std::string record_path;

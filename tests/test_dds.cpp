@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <optional>
@@ -15,6 +16,8 @@
 #include <mutex>
 #include <sys/wait.h>
 #include <thread>
+
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -391,7 +394,9 @@ std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& i
   std::istringstream body(idl.substr(idl.find('{', at) + 1, end - idl.find('{', at) - 1));
   const std::vector<std::pair<std::string, std::string>> types = {
       {"unsigned long long", "uint64"}, {"unsigned long", "uint32"}, {"double", "float64"},
-      {"float", "float32"},             {"octet", "uint8"},          {"boolean", "bool"}};
+      {"float", "float32"},             {"octet", "uint8"},          {"boolean", "bool"},
+      {"long", "int32"},                {"std_msgs::msg::dds_::Header_", "std_msgs/Header"},
+      {"builtin_interfaces::msg::dds_::Time_", "builtin_interfaces/Time"}};
   std::vector<std::pair<std::string, std::string>> out;
   for (std::string line; std::getline(body, line);) {
     line = line.substr(0, line.find("//"));
@@ -402,10 +407,10 @@ std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& i
     std::string type = line.substr(0, space), field = line.substr(space + 1);
     if (type.rfind("string<", 0) == 0) type = "string<=" + type.substr(7, type.size() - 8);
     std::string bound;  // sequence<T, N>: ROS 2's T[<=N]
-    if (type.rfind("sequence<", 0) == 0) {
+    if (type.rfind("sequence<", 0) == 0) {  // sequence<T>: ROS 2's T[]
       const std::size_t comma = type.find(',');
-      bound = "[<=" + type.substr(comma + 2, type.size() - comma - 3) + "]";
-      type = type.substr(9, comma - 9);
+      bound = comma == std::string::npos ? "[]" : "[<=" + type.substr(comma + 2, type.size() - comma - 3) + "]";
+      type = type.substr(9, (comma == std::string::npos ? type.size() - 1 : comma) - 9);
     }
     for (const auto& [idl_type, ros_type] : types)
       if (type == idl_type) type = ros_type;
@@ -444,6 +449,110 @@ TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   EXPECT_NE(request.find("uint8 ENABLE=" + std::to_string(msg::ENABLE)), std::string::npos);
   EXPECT_NE(request.find("uint8 SET_SPINDLE_RPM=" + std::to_string(msg::SET_SPINDLE_RPM)), std::string::npos);
   EXPECT_NE(request.find("uint8 RESET_FAULT=" + std::to_string(msg::RESET_FAULT)), std::string::npos);
+}
+
+// The joint states are ROS 2's sensor_msgs/msg/JointState as its definition has it (the message and the two it
+// holds), under the type and topic names a ROS 2 driver's /joint_states has on DDS.
+TEST(Dds, JointStateIsRos2sMessageFieldForField) {
+  using Fields = std::vector<std::pair<std::string, std::string>>;
+  const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
+  // sensor_msgs/msg/JointState.msg, std_msgs/msg/Header.msg, builtin_interfaces/msg/Time.msg (ROS 2).
+  EXPECT_EQ(idl_fields(idl, "JointState"), (Fields{{"std_msgs/Header", "header"}, {"string[]", "name"}, {"float64[]", "position"},
+                                                   {"float64[]", "velocity"}, {"float64[]", "effort"}}));
+  EXPECT_EQ(idl_fields(idl, "Header"), (Fields{{"builtin_interfaces/Time", "stamp"}, {"string", "frame_id"}}));
+  EXPECT_EQ(idl_fields(idl, "Time"), (Fields{{"int32", "sec"}, {"uint32", "nanosec"}}));
+  dds::Participant p(test_domain(6), config::DdsTransport::kUdpLoopback, "joint state names", std::nullopt);
+  DataWriter* w = p.joint_state_writer("rt/joint_states");
+  EXPECT_EQ(w->get_topic()->get_name(), "rt/joint_states");
+  EXPECT_EQ(w->get_topic()->get_type_name(), "sensor_msgs::msg::dds_::JointState_");
+}
+
+// A ROS 2 robot driver's joint states select the pose schedule's set, as the Modbus joint registers do
+// (docs/pose_dynamics.md, "The pose over DDS"): `robodamp run` on config/presets/pose_scheduled_c2.yaml with
+// dds.joint_states naming its three joints; a driver of the test's own publishes at 50 Hz, in radians, its
+// joints in another order and with a gripper the schedule does not know. Folded: the loop arms on the folded
+// set; stretched: handed over; a message without the elbow: the pose unknown (the loop trips out of the
+// map); silence: said. Every wait has a deadline.
+TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
+  const int domain = test_domain(7);
+  const std::string dir = ::testing::TempDir() + "robodamp_dds_joints_" + std::to_string(getpid());
+  std::system(("mkdir -p " + dir).c_str());
+  std::string text = test::read_file(test::preset("pose_scheduled_c2"));
+  test::replace_or_throw(text, "model: ../robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
+  text += "\ncell:\n  name: joints-" + std::to_string(getpid()) + "\ndds:\n  domain_id: " + std::to_string(domain) +
+          "\n  transport: udp_loopback\n  joint_states:\n    names: [shoulder, elbow, wrist]\n    timeout_s: 0.5\n"
+          "supervision:\n  overrun_cycles: 5000\n";
+  std::ofstream(dir + "/cell.yaml") << text;
+  test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--json", dir + "/run.json"}, dir + "/run.log");
+  dds::Participant driver(domain, config::DdsTransport::kUdpLoopback, "test robot driver", std::nullopt);
+  DataWriter* w = driver.joint_state_writer("rt/joint_states");
+  Collect<msg::Status> status;  // the cell's own word on the set that runs
+  driver.reader(dds::TopicKind::kStatus, &status);
+  const std::string cell = "joints-" + std::to_string(getpid());
+  const auto running_set = [&](std::uint32_t set) {
+    return eventually([&] {
+      for (const auto& s : status.all())
+        if (s.cell() == cell && s.state() == "active" && s.parameter_set() == set) return true;
+      return false;
+    }, 60.0);
+  };
+  std::mutex m;
+  std::vector<std::string> names{"wrist", "gripper", "shoulder", "elbow"};
+  std::vector<double> deg{90.0, 12.0, -100.0, 10.0};  // folded
+  std::atomic<bool> publishing{true}, stop{false};
+  std::thread publisher([&] {
+    while (!stop) {
+      if (publishing) {
+        msg::JointState js;
+        {
+          std::lock_guard lock(m);
+          js.name(names);
+          std::vector<double> rad;
+          for (double d : deg) rad.push_back(d * M_PI / 180.0);
+          js.position(rad);
+        }
+        js.header().frame_id("base_link");
+        w->write(&js);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const auto log_has = [&](const std::string& s, double deadline_s) {
+    return eventually([&] { return test::read_file(dir + "/run.log").find(s) != std::string::npos; }, deadline_s);
+  };
+  EXPECT_TRUE(log_has("dds joint states: pose [-100, 10, 90] deg in region 'folded'", 60.0)) << test::read_file(dir + "/run.log");
+  EXPECT_TRUE(log_has("loop: active at", 60.0)) << test::read_file(dir + "/run.log");
+  EXPECT_TRUE(running_set(0)) << "the folded region's set";
+  {
+    std::lock_guard lock(m);
+    deg = {90.0, 12.0, -100.0, 80.0};  // stretched
+  }
+  EXPECT_TRUE(log_has("pose [-100, 80, 90] deg in region 'stretched'", 60.0)) << test::read_file(dir + "/run.log");
+  EXPECT_TRUE(running_set(1)) << "handed over to the stretched region's set\n" << test::read_file(dir + "/run.log");
+  {
+    std::lock_guard lock(m);
+    names = {"wrist", "gripper", "shoulder"}, deg = {90.0, 12.0, -100.0};  // the elbow missing
+  }
+  EXPECT_TRUE(log_has("a message with no joint 'elbow' (dds.joint_states.names): the pose is unknown", 60.0))
+      << test::read_file(dir + "/run.log");
+  EXPECT_TRUE(log_has("loop: tripped pose_out_of_map", 60.0)) << test::read_file(dir + "/run.log");
+  publishing = false;
+  EXPECT_TRUE(log_has("dds joint states on rt/joint_states: none for 0.5 s: the pose is unknown", 60.0))
+      << test::read_file(dir + "/run.log");
+  stop = true;
+  publisher.join();
+  run.kill(SIGINT);
+  EXPECT_TRUE(run.wait_for(60.0).has_value()) << test::read_file(dir + "/run.log");
+  const auto summary = nlohmann::json::parse(test::read_file(dir + "/run.json"));
+  const auto& js = summary["joint_states"];
+  EXPECT_GT(js["messages"].get<int>(), 20) << js.dump();
+  EXPECT_GT(js["refused"].get<int>(), 0) << js.dump();
+  EXPECT_GE(js["changes"].get<int>(), 3) << js.dump();  // folded, stretched, unknown
+  EXPECT_EQ(js["losses"].get<int>(), 1) << js.dump();
+  std::istringstream lines(test::read_file(dir + "/run.log"));
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("joint") != std::string::npos || line.find("loop:") != std::string::npos) std::printf("%s\n", line.c_str());
+  std::system(("rm -rf " + dir).c_str());
 }
 
 // --- DDS Security ------------------------------------------------------------------------------------------

@@ -8,5 +8,6 @@ namespace robodamp {
 
 inline constexpr double kTwoPi = 2.0 * std::numbers::pi;  // rad per revolution; Hz to rad/s
 inline constexpr double kMmPerM = 1000.0;                 // millimetres per metre
+inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;  // degrees per radian (a ROS joint state's rad)
 
 }  // namespace robodamp
