@@ -207,7 +207,7 @@ std::optional<JointStatesConfig> read_joint_states(MapReader& dds) {
       if (name.empty()) r.diagnostics().add(to_mark(names[i].Mark()), key, "must be a joint's name (text)");
       else if (std::find(c.names.begin(), c.names.end(), name) != c.names.end())
         r.diagnostics().add(to_mark(names[i].Mark()), key, "= '" + name + "' is named twice: each joint once");
-      else c.names.push_back(name);
+      if (!name.empty()) c.names.push_back(name);  // kept, so the count is the file's
     }
   if (auto v = r.number("timeout_s", {"s", 0.01, 60.0}, c.timeout_s)) c.timeout_s = *v;
   if (auto v = read_int(r, "settle_samples", {"(messages)", 1, 1000}, c.settle_samples)) c.settle_samples = *v;

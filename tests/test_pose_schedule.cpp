@@ -120,6 +120,48 @@ TEST(PoseScheduleConfig, JointRegistersMustNotOverlapTheOtherRobotRegisters) {
   }
 }
 
+// The pose over DDS (dds.joint_states): one name per joint, each once, with a pose schedule, and not beside the
+// Modbus joint registers; each refused by key with the reason.
+TEST(PoseScheduleConfig, JointStatesNameEachJointOnceAndAreTheOnlySourceOfThePose) {
+  const std::string path = test::preset(kPreset);
+  const std::string base = test::read_file(path);
+  const auto error_of = [&](const std::string& text) {
+    try {
+      (void)config::parse_config(text, path);
+    } catch (const config::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const config::Config ok = config::parse_config(base + "\ndds:\n  joint_states: {names: [a1, a2, a3], timeout_s: 0.2}\n", path);
+  ASSERT_TRUE(ok.dds && ok.dds->joint_states);
+  EXPECT_EQ(ok.dds->joint_states->names, (std::vector<std::string>{"a1", "a2", "a3"}));
+  EXPECT_EQ(ok.dds->joint_states->topic, "rt/joint_states");
+  EXPECT_EQ(ok.dds->joint_states->timeout_s, 0.2);
+  EXPECT_EQ(ok.dds->joint_states->settle_samples, 3);
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2]}\n")
+                .find("dds.joint_states.names: has 2 names; pose_schedule has 3 joints"), std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2, a1]}\n")
+                .find("dds.joint_states.names[2] = 'a1' is named twice: each joint once"), std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: a1}\n").find("dds.joint_states.names: must be a list"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2, a3], timeout_s: 0}\n").find("dds.joint_states.timeout_s"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {topic: rt/joint_states}\n").find("dds.joint_states.names"), std::string::npos);
+  const std::string hil = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_pose_schedule.yaml";
+  std::string both = test::read_file(hil);
+  replace(both, "  parameter_writes: false", "  joint_states: {names: [a1, a2, a3]}\n  parameter_writes: false");
+  try {
+    (void)config::parse_config(both, hil);
+    ADD_FAILURE() << "two sources of the pose accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("and modbus.robot.joints_register = 10 both give the pose: choose one source"),
+              std::string::npos) << e.what();
+  }
+  const std::string no_schedule = test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  joint_states: {names: [a1]}\n";
+  EXPECT_NE(error_of(no_schedule).find("dds.joint_states: is set without pose_schedule"), std::string::npos) << error_of(no_schedule);
+}
+
 // The robot model's modes as the loop's modal table: the modal-stiffness form with damping from each
 // mode's loss factor reproduces the assembled model's TCP receptance along the axis at the dominant peak.
 TEST(PoseSchedule, PoseModesReproduceTheRobotModelsReceptanceAtTheDominantPeak) {
