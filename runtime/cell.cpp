@@ -171,28 +171,7 @@ Status Cell::configure_devices() {
   if (cfg_.dds) {
     dds_ = std::make_unique<DdsEndpoint>(
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
-        dds::BridgeSources{config::cell_name(cfg_.cell), backend_name_, [this] { return supervisor_->active_parameter_set(); },
-                           [this] { return std::min(supervisor_->gain_limit_ns_per_m(), control::kMaxGainNsPerM); },
-                           [this](dds::RequestKind k, double v) { return handle_request(k, v); },
-                           cfg_.spindle.job.empty() ? std::function<dds::MachiningSample()>{}
-                                                    : [this] { return machining_->sample(); },
-                           cfg_.spindle.job.empty()
-                               ? std::function<std::optional<dds::AdviceSample>()>{}
-                               : [this]() -> std::optional<dds::AdviceSample> {
-                                   const auto a = machining_->advice();
-                                   return a ? std::optional(to_sample(*a)) : std::nullopt;
-                                 },
-                           [this] { return spectrum_->next(); },
-                           cfg_.spindle.job.empty() ? std::function<std::optional<dds::LobesSample>()>{}
-                                                    : [this] { return machining_->lobes(); },
-                           cfg_.controller.gain_ramp_s,
-                           [this] { return supervisor_->parameter_sets().size(); }, cfg_.spindle.rpm_max,
-                           joint_pose_ ? std::function<void(const std::vector<std::string>&, const std::vector<double>&)>(
-                                             [this](const std::vector<std::string>& n, const std::vector<double>& q) {
-                                               joint_pose_->on_message(n, q);
-                                             })
-                                       : nullptr,
-                           joint_pose_ ? std::function<void()>([this] { joint_pose_->check(); }) : nullptr});
+        bridge_sources());
     spectrum_ = std::make_unique<SpectrumMonitor>(cfg_);
   }
   for (Component* c : components()) {
