@@ -93,6 +93,8 @@ const kTyped = {
 const kNumberText = /^[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?$/;
 let cellStatus = null;     // the current cell's last status (its limits) and machining sample
 let cellMachining = null;
+let cellLobes = null;      // its last lobes (they come with the spectrum, about once a second)
+let lobesDrawn = '';       // what the lobes panel was last drawn for
 
 function typedValue(action, text, status) {
   const spec = kTyped[action];
@@ -389,7 +391,13 @@ function connect() {
     if (d.status && d.status.state !== undefined) cellStatus = d.status;
     if (d.machining && d.machining.spindle_rpm !== undefined) cellMachining = d.machining;
     plotTime(d.telemetry);
-    if (d.spectrum !== undefined) { plotSpectrum(d.spectrum); plotLobes(d.lobes, d.machining, d.advice); }
+    if (d.spectrum !== undefined) { plotSpectrum(d.spectrum); cellLobes = d.lobes; }
+    // The lobes panel (the operating point, the advice and whether it is followed, the note on the state) is
+    // redrawn when what it shows changes, not only when new lobes come: a followed advice says so at once.
+    const m = d.machining || {}, s = cellStatus || {};
+    const drawn = JSON.stringify([cellLobes && cellLobes.rpm ? cellLobes.rpm.length : 0, cellLobes && cellLobes.gain_ns_per_m,
+      m.spindle_rpm, m.depth_mm, m.cutting, d.advice && d.advice.seq, s.state, s.parameter_set, s.gain_ns_per_m]);
+    if (d.spectrum !== undefined || drawn !== lobesDrawn) { lobesDrawn = drawn; plotLobes(cellLobes, d.machining, d.advice); }
     plotTiming(d.status);
     renderCounters(d);
   }));
@@ -401,6 +409,8 @@ function route() {
   cancelPending();
   cellStatus = null;
   cellMachining = null;
+  cellLobes = null;
+  lobesDrawn = '';
   $('fleet-view').hidden = !!currentCell;
   $('cell-view').hidden = !currentCell;
   $('where').textContent = currentCell ? 'cell ' + currentCell : 'fleet';
