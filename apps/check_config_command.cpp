@@ -1,6 +1,6 @@
 // `robodamp check-config FILE`: validate a controller configuration (chain design and the plant's
-// physical consistency), a milling job (its structures, controller parts included) or the dashboard's file,
-// every problem at once.
+// physical consistency), a milling job (its structures, controller parts included), a robot model (its
+// poses against its joints) or the dashboard's file, every problem at once.
 #include <iostream>
 #include <memory>
 
@@ -10,6 +10,7 @@
 #include "config/config.hpp"
 #include "config/dashboard_config.hpp"
 #include "config/milling_config.hpp"
+#include "config/robot_model_config.hpp"
 #include "control/chain_design.hpp"
 #include "milling/structure.hpp"
 #include "sim_plant/plant_model.hpp"
@@ -18,15 +19,17 @@ namespace robodamp::apps {
 
 namespace {
 
-// What a file is by its top-level keys: a milling job (config/milling/) has `tool`, the dashboard's file
-// (docs/dashboard.md) `dashboard`; anything else is a cell's configuration.
-enum class Kind { kCell, kMillingJob, kDashboard };
+// What a file is by its top-level keys: a milling job (config/milling/) has `tool`, a robot model
+// (config/robots/) `links`, the dashboard's file (docs/dashboard.md) `dashboard`; anything else is a cell's
+// configuration.
+enum class Kind { kCell, kMillingJob, kRobotModel, kDashboard };
 Kind kind_of(const std::string& path) {
   try {
     const YAML::Node n = YAML::LoadFile(path);
     if (!n.IsMap()) return Kind::kCell;
     if (n["tool"].IsDefined()) return Kind::kMillingJob;
     if (n["dashboard"].IsDefined()) return Kind::kDashboard;
+    if (n["links"].IsDefined()) return Kind::kRobotModel;
   } catch (const YAML::Exception&) {
   }
   return Kind::kCell;  // the configuration parser reports a syntax error
@@ -47,9 +50,17 @@ int check_milling(const std::string& path) {
   return 0;
 }
 
+int check_robot_model(const std::string& path) {
+  const auto m = config::load_robot_model(path);
+  std::cout << path << ": OK (robot model '" << m.name << "', " << m.links.size() << " links, " << m.joints.size()
+            << " joints, " << m.poses.size() << " pose(s))\n";
+  return 0;
+}
+
 int check_config(const std::string& path) {
   switch (kind_of(path)) {
     case Kind::kMillingJob: return check_milling(path);
+    case Kind::kRobotModel: return check_robot_model(path);
     case Kind::kDashboard: return check_dashboard(path);
     case Kind::kCell: break;
   }
@@ -65,7 +76,7 @@ int check_config(const std::string& path) {
 
 void register_check_config(Registry& r) {
   auto path = std::make_shared<std::string>();
-  CLI::App* sub = r.add("check-config", "Validate a configuration (a cell's, a milling job or the dashboard's) and report every problem at once",
+  CLI::App* sub = r.add("check-config", "Validate a configuration (a cell's, a milling job, a robot model or the dashboard's) and report every problem at once",
                         [path] { return check_config(*path); });
   sub->add_option("file", *path, "Configuration file (YAML)")->required();
 }

@@ -103,6 +103,20 @@ TEST(Cli, CheckConfigAcceptsEveryPreset) {
     EXPECT_EQ(r.status, 0) << r.out;
     EXPECT_NE(r.out.find(": OK (milling job"), std::string::npos) << r.out;
   }
+  // The robot models (config/robots/): every kind of configuration robodamp reads (issue 52).
+  for (const char* m : {"planar_three_link", "compact_three_link"}) {
+    const Result r = run("check-config " + std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/" + m + ".yaml");
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find(": OK (robot model '"), std::string::npos) << r.out;
+  }
+  const std::string bad = temp_path("bad_robot.yaml");
+  std::string text = robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
+  robodamp::test::replace_or_throw(text, "min_deg: 0, max_deg: 170", "min_deg: 0, max_deg: 400");
+  std::ofstream(bad) << text;
+  const Result r = run("check-config " + bad);
+  std::filesystem::remove(bad);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("joints[1].max_deg = 400 deg is out of range: allowed -360 <= value <= 360 deg"), std::string::npos) << r.out;
 }
 
 // The dashboard's own file (docs/dashboard.md's example) is checked as one, with its keys' units and ranges.
