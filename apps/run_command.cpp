@@ -106,6 +106,11 @@ int run_loop(const RunArgs& a) {
   o.record_path = a.record_path;
   o.pose_deg = a.pose_deg;
   o.pose_schedule_off = a.no_pose_schedule;
+  if (a.spindle_rpm > cfg.spindle.rpm_max) {  // the loop would refuse the command: said before anything runs
+    std::cerr << "robodamp run: --spindle-rpm = " << a.spindle_rpm << " rpm is above spindle.rpm_max = " << cfg.spindle.rpm_max
+              << " rpm of " << a.config_path << " (allowed 0 <= value <= " << cfg.spindle.rpm_max << " rpm)\n";
+    return 2;
+  }
   if ((!a.pose_deg.empty() || a.no_pose_schedule) && !cfg.pose_schedule) {
     std::cerr << "robodamp run: --pose and --no-pose-schedule need a configuration with pose_schedule\n";
     return 2;

@@ -735,6 +735,10 @@ TEST(Cli, RunRejectsBadInputWithClearErrors) {
   const Result d = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 0");
   EXPECT_EQ(d.status, 2) << d.out;
   EXPECT_NE(d.out.find("--duration"), std::string::npos);
+  // A speed the configuration's spindle cannot reach: refused before anything runs (the loop would drop it).
+  const Result fast = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 1 --clock virtual --spindle-rpm 50000");
+  EXPECT_EQ(fast.status, 2) << fast.out;
+  EXPECT_NE(fast.out.find("--spindle-rpm = 50000 rpm is above spindle.rpm_max = 30000 rpm"), std::string::npos) << fast.out;
   const Result rp = run("replay " + robodamp::test::preset("horizontal_c2"));
   EXPECT_EQ(rp.status, 2) << rp.out;
   EXPECT_NE(rp.out.find("not a robodamp recording"), std::string::npos) << rp.out;
