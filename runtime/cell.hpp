@@ -122,8 +122,8 @@ class Cell {
 
  private:
   Status plan_analysis();    // configure(): the analysis and the supervisor
-  Status compose_devices();
-  dds::BridgeSources bridge_sources();  // runtime/cell_dds.cpp  // configure(): the devices, the loop and what runs beside it
+  Status compose_devices();  // configure(): the devices, the loop and what runs beside it
+  dds::BridgeSources bridge_sources();  // what the DDS bridge publishes and whom it calls (runtime/cell_dds.cpp)
   void release();            // configure's rollback and cleanup(): everything configure built
   Status configure_devices();
   Status configure_parameter_sets();
