@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -268,7 +269,11 @@ TEST(HilCut, TheLiveIndicatorAndRobodampChatterAgreeOnARecordedRun) {
   const double t0 = rt::read_recording(rec).frames.front().time_s;  // the recording's first tick, loop time
   int judged = 0, same = 0, chatter = 0;
   std::string table = "the live indicator's changes:";
-  for (const auto& [t, c] : live) table += " " + std::to_string(t) + (c ? " chatter," : " quiet,");
+  for (const auto& [t, c] : live) {
+    char at[64];
+    std::snprintf(at, sizeof at, " %.3f s %s,", t, c ? "chatter" : "quiet");
+    table += at;
+  }
   table += "\n";
   for (const auto& w : windows) {
     const double end = t0 + w["end_s"].get<double>();
