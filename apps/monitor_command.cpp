@@ -111,9 +111,7 @@ std::string machining_view(const msg::Machining& m) {
                                        : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
                                 : "  depth within");
   std::string indicator = "-";
-  if (m.cutting() == dds::kNotCutting) {
-    indicator = "not cutting (" + m.cutting_reason() + ")";
-  } else if (m.indicator_valid()) {
+  if (m.indicator_valid()) {
     char c[200];
     std::snprintf(c, sizeof c, "once-per-rev %.2f, non-harmonic %.0f %% (strongest %.1f Hz): %s", m.once_per_rev_ratio(),
                   100.0 * m.nonharmonic_share(), m.chatter_hz(), m.chatter() ? "CHATTER" : "no chatter");
@@ -121,6 +119,9 @@ std::string machining_view(const msg::Machining& m) {
   } else if (m.spindle_rpm() > 0.0) {
     indicator = "collecting revolutions";
   }
+  // Not cutting: said first, the indicator's figures after it (an engineer still reads them).
+  if (m.cutting() == dds::kNotCutting)
+    indicator = "not cutting (" + m.cutting_reason() + ")" + (m.indicator_valid() ? "; " + indicator : "");
   std::snprintf(b, sizeof b,
                 "  spindle    %.0f rpm (tooth passing %.1f Hz), depth %.3f mm%s\n"
                 "  stability  %s\n"
