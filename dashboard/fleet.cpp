@@ -96,6 +96,7 @@ struct Fleet::Cell {
   std::int64_t state_source_ms{0};  // the writer's wall clock when the state or trip shown last changed
   std::deque<TelemetryPoint> telemetry;
   std::uint64_t seq{0};
+  std::uint64_t restarts{0};  // runs heard after the first (a new status writer once the old one was quiet)
   double active_s{0.0}, last_time_s{-1.0};
   std::uint8_t state{255}, trip{255};
 };
@@ -228,8 +229,18 @@ void Fleet::on_status(const void* p, const std::string& writer, std::int64_t sou
   const bool news = rt::to_string(static_cast<rt::State>(c->state)) != s.state().to_string() ||
                     rt::to_string(static_cast<rt::Trip>(c->trip)) != s.trip().to_string();  // before the telemetry said it
   if (urgent && news) c->state_source_ms = source_ms;
+  // A writer not heard before while none is live: the cell restarted. What its last run published (the
+  // advice, the machining state, the spectrum, the lobes, the telemetry) is not about this run: dropped, so
+  // that no screen shows, and no operator follows, an old run's advice.
+  const auto now = Clock::now();
+  if (!c->status.is_null() && c->status_writers.count(writer) == 0 && live_writers(*c, now) == 0) {
+    c->machining = c->advice = c->spectrum = c->lobes = json();
+    c->telemetry.clear();
+    ++n_.cells_restarted;
+    ++c->restarts;
+  }
   c->status = to_json(s);
-  c->status_writers[writer] = Clock::now();
+  c->status_writers[writer] = now;
   c->status_source_ms = source_ms;
   c->status_received_ms = wall_ms();
   bump(urgent);
@@ -352,7 +363,8 @@ std::optional<json> Fleet::detail(const std::string& cell, std::uint64_t since_s
   }
   tel["last_seq"] = c.seq;
   json out = {{"cell", cell}, {"live", c.live}, {"status", c.status}, {"machining", c.machining}, {"advice", c.advice},
-              {"telemetry", tel}, {"active_s", c.active_s}, {"publishers", live_writers(c, Clock::now())}};
+              {"telemetry", tel}, {"active_s", c.active_s}, {"publishers", live_writers(c, Clock::now())},
+              {"restarts", c.restarts}};
   if (with_spectrum_and_lobes) out["spectrum"] = c.spectrum, out["lobes"] = c.lobes;
   return out;
 }

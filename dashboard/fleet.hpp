@@ -46,6 +46,7 @@ struct FleetCounters {
   std::uint64_t foreign_replies{0};  // replies to another client (another dashboard, a robodamp request)
   std::uint64_t requests{0}, replies{0}, reply_timeouts{0};
   std::uint64_t cells_lost{0};       // times a cell went quiet for stale_after_s
+  std::uint64_t cells_restarted{0};  // a new status writer after the old one went quiet: the last run's data dropped
   std::uint64_t cells_refused{0};    // samples of a new name beyond the 256 cells kept
 };
 

@@ -265,7 +265,7 @@ json WebServer::health() const {
           {"dds", {{"client", fleet_.client_name()}, {"samples", f.samples}, {"bad_cell_names", f.bad_cell_names},
                    {"foreign_replies", f.foreign_replies}, {"requests", f.requests}, {"replies", f.replies},
                    {"reply_timeouts", f.reply_timeouts}, {"cells_lost", f.cells_lost},
-                   {"cells_refused", f.cells_refused}}},
+                   {"cells_restarted", f.cells_restarted},                    {"cells_refused", f.cells_refused}}},
           {"auth", {{"logins", a.logins}, {"wrong_passwords", a.wrong_passwords}, {"throttled", a.throttled},
                     {"bad_tokens", a.bad_tokens}, {"logouts", a.logouts}, {"operators_configured", auth_.anyone_may_act()}}},
           {"action_log", log_.path()}};

@@ -44,6 +44,10 @@ Participant::Participant(int domain_id, config::DdsTransport transport, const st
     pq.transport().use_builtin_transports = false;
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
     udp->interfaceWhiteList.emplace_back("127.0.0.1");
+    // The loopback has no multicast: discovery announces to the initial peer's ports of participant ids 0 to
+    // this range. Fast DDS's default (4) never found a sixth participant on the host (a cell, two dashboards,
+    // a monitor, a robot driver; DashboardFleet.ARestartedCellsLastRunIsDropped, the third fleet of its process).
+    udp->maxInitialPeersRange = kLoopbackParticipants;
     pq.transport().user_transports.push_back(udp);
     eprosima::fastrtps::rtps::Locator_t peer;
     eprosima::fastrtps::rtps::IPLocator::setIPv4(peer, "127.0.0.1");

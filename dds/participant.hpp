@@ -22,6 +22,8 @@
 // request and reply topics and leaves telemetry and status readable (docs/hardware.md).
 #pragma once
 
+#include <cstdint>
+
 #include <optional>
 #include <string>
 
@@ -38,6 +40,9 @@ namespace robodamp::dds {
 
 enum class TopicKind { kTelemetry, kStatus, kRequest, kReply, kMachining, kAdvice, kSpectrum, kLobes };
 inline constexpr int kTopicCount = 8;
+// dds.transport: udp_loopback finds the participants on this host with ids 0 to this (Fast DDS numbers a
+// host's participants from 0 in the order they start; an id above it is never discovered).
+inline constexpr std::uint32_t kLoopbackParticipants = 32;
 
 class Participant {
  public:

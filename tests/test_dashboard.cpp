@@ -144,7 +144,7 @@ struct NamedCell {
   std::atomic<int> handled{0};
   std::atomic<int> resets{0};
   dds::Bridge bridge;
-  NamedCell(const std::string& name, const config::DdsConfig& cfg)
+  NamedCell(const std::string& name, const config::DdsConfig& cfg, std::optional<dds::AdviceSample> advice = {})
       : bridge(cfg, 5000.0, name + ".yaml",
                {name, "simulated plant", [] { return std::size_t{0}; }, [] { return 4000.0; },
                 [this](dds::RequestKind k, double) {
@@ -152,7 +152,10 @@ struct NamedCell {
                   if (k == dds::RequestKind::kResetFault) ++resets;
                   return dds::Decision{true, "ok"};
                 },
-                {}}) {
+                {}, advice ? std::function<std::optional<dds::AdviceSample>()>([advice]() mutable {
+                  ++advice->seq;  // a new one each time: the bridge publishes an advice once
+                  return advice;
+                }) : std::function<std::optional<dds::AdviceSample>()>()}) {
     bridge.start();
   }
   void frames(std::uint64_t from, int n, rt::State state) {
@@ -236,6 +239,46 @@ TEST(DashboardFleet, TwoLiveCellsUnderOneNameAreAClashUntilOneStops) {
   EXPECT_TRUE(eventually([&] { beat(); return publishers() == 2; }, 60.0)) << publishers();
   second.reset();  // stopped: quiet from now on
   EXPECT_TRUE(eventually([&] { beat(); return publishers() == 1; }, 3.5)) << publishers();
+}
+
+// A cell that restarts is a new run: what its last run published is dropped when the new run's first status
+// comes, so that no screen shows, and no operator follows, the old run's advice (the browser test once followed
+// a killed run's advice and sent the speed to a cell still starting). A second run under the same name while
+// the first still publishes is a clash, not a restart: nothing is dropped.
+TEST(DashboardFleet, ARestartedCellsLastRunIsDropped) {
+  config::DdsConfig cfg;
+  cfg.domain_id = static_cast<int>((getpid() * 7 + 41) % 200) + 20;
+  cfg.transport = config::DdsTransport::kUdpLoopback;
+  cfg.status_rate_hz = 20.0;
+  dashboard::Fleet fleet(cfg, 1.0);
+  dds::AdviceSample advice;
+  advice.seq = 3, advice.found = true, advice.advised_rpm = 666.7, advice.trigger = "depth";
+  auto first = std::make_unique<NamedCell>("again", cfg, advice);
+  const auto detail = [&] { return fleet.detail("again", 0).value_or(nlohmann::json::object()); };
+  ASSERT_TRUE(eventually([&] {
+    first->frames(0, 50, rt::State::kActive);
+    return detail().contains("advice") && !detail()["advice"].is_null();
+  }, 60.0)) << detail();
+  EXPECT_EQ(detail()["advice"]["advised_rpm"].get<double>(), 666.7);
+  EXPECT_EQ(detail()["restarts"].get<std::uint64_t>(), 0U);
+  // The same name again while the first still runs: a clash (two publishers), the advice kept.
+  auto clash = std::make_unique<NamedCell>("again", cfg);
+  ASSERT_TRUE(eventually([&] {
+    first->frames(100, 50, rt::State::kActive), clash->frames(100, 50, rt::State::kActive);
+    return detail()["publishers"].get<std::size_t>() == 2;
+  }, 60.0));
+  EXPECT_EQ(detail()["restarts"].get<std::uint64_t>(), 0U);
+  EXPECT_FALSE(detail()["advice"].is_null());
+  first.reset(), clash.reset();
+  // Both stopped; stale_after_s (1 s) later a new run under the name: the old run's advice is gone.
+  ASSERT_TRUE(eventually([&] { return !detail()["live"].get<bool>(); }, 30.0));
+  auto second = std::make_unique<NamedCell>("again", cfg);
+  ASSERT_TRUE(eventually([&] {
+    second->frames(0, 50, rt::State::kActive);
+    return detail()["restarts"].get<std::uint64_t>() == 1U;
+  }, 60.0));
+  EXPECT_TRUE(detail()["advice"].is_null()) << detail()["advice"];
+  EXPECT_GE(fleet.counters().cells_restarted, 1U);
 }
 
 // More open pages than dashboard.max_event_streams are refused (503) and counted; a sample whose cell name is

@@ -501,9 +501,14 @@ class DashboardInABrowser(unittest.TestCase):
         """One scripted scenario (issue 52): an advice followed, the gain the speed schedule sets at the new speed,
         a trip and the recovery from it; each on the page within 2 s of the cell's own status."""
         fleet = self.fleet
+        api = lambda key: http(fleet.port, f"/api/cells/{fleet.cells[key]}")[1]
+        restarts = api("a")["restarts"]
         fleet.cell_a = fleet.start([BINARY, "run", "--config", os.path.join(fleet.dir, "cell_a.yaml"), "--duration", "900",
                                     "--spindle-rpm", "700"], "cell_a_again.log")
-        api = lambda key: http(fleet.port, f"/api/cells/{fleet.cells[key]}")[1]
+        # The new run heard: the killed run's advice, machining state and lobes are dropped with it (an operator
+        # must not follow an old run's advice; this test once did, and sent the speed to a cell still starting).
+        # (DashboardFleet.ARestartedCellsLastRunIsDropped checks the dropping itself.)
+        until(lambda: api("a")["restarts"] > restarts, 90, "cell a's new run")
         self.open_cell("a")
         self.login("alice", "alice-operator-1")
         # Cell a cuts 2.5 mm at 700 rpm, above the limit: its advice, then the page asks to follow it.
@@ -522,7 +527,8 @@ class DashboardInABrowser(unittest.TestCase):
         def settled_gain():
             gains.append(api("a")["status"]["gain_ns_per_m"])
             time.sleep(0.5)
-            return len(gains) >= 3 and gains[-1] == gains[-2] == gains[-3]
+            # K is 0 while the start-up hand-over to the band's set fades in (seen three times running once in CI).
+            return len(gains) >= 3 and gains[-1] == gains[-2] == gains[-3] > 0.0
         until(settled_gain, 60, "cell a's gain settled")
         k = gains[-1]
         self.follows(f"K = {k:.0f} N s/m", lambda: api("a")["status"]["gain_ns_per_m"] == k,
