@@ -14,6 +14,7 @@
 #include "identify/recorded_signal.hpp"
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
+#include "milling/chatter.hpp"
 #include "milling/chatter_listen.hpp"
 #include "milling/live_stability.hpp"
 #include "milling/speed_advice.hpp"
@@ -68,15 +69,18 @@ milling::SpeedAdvice checked_speeds(const ChatterArgs& a, const Cell& c, const m
   return milling::advise_speed(stability, q, range[0], range[1]);
 }
 
-nlohmann::json to_json(const milling::ListenReport& r) {
+nlohmann::json to_json(const milling::ListenReport& r, int teeth) {
+  const double tooth_hz = r.rpm * teeth / 60.0;  // the chatter's family: milling/chatter.hpp
   nlohmann::json w = nlohmann::json::array();
   for (const auto& x : r.windows)
     w.push_back({{"start_s", x.start_s}, {"end_s", x.end_s}, {"verdict", milling::to_string(x.verdict)},
-                 {"chatter_hz", x.chatter_hz}, {"chatter_share", x.chatter_share}, {"rms", x.rms},
+                 {"chatter_hz", x.chatter_hz}, {"chatter_family_hz", milling::chatter_family_hz(x.chatter_hz, tooth_hz)},
+                 {"chatter_share", x.chatter_share}, {"rms", x.rms},
                  {"once_per_rev_ratio", x.indicator.once_per_rev_ratio}, {"rpm", x.rpm}});
   nlohmann::json speeds = nlohmann::json::array();
   for (const auto& s : r.speeds) speeds.push_back({{"rpm", s.rpm}, {"lobe", s.lobe}});
-  nlohmann::json j = {{"windows", w}, {"chatter_hz", r.chatter_hz}, {"rpm", r.rpm}, {"rpm_source", r.rpm_source},
+  nlohmann::json j = {{"windows", w}, {"chatter_hz", r.chatter_hz},
+                      {"chatter_family_hz", milling::chatter_family_hz(r.chatter_hz, tooth_hz)}, {"tooth_hz", tooth_hz}, {"rpm", r.rpm}, {"rpm_source", r.rpm_source},
                       {"rate_hz", r.rate_hz}, {"analysed_rate_hz", r.analysed_rate_hz}, {"samples", r.samples},
                       {"warnings", r.warnings}, {"speeds_to_try", speeds}};
   j["onset_s"] = r.onset_s ? nlohmann::json(*r.onset_s) : nlohmann::json(nullptr);
@@ -173,9 +177,9 @@ int run_chatter(const ChatterArgs& a) {
     t << line;
   }
   if (r.onset_s) {
-    char head[200];
-    std::snprintf(head, sizeof head, "CHATTER from %.2f s to %.2f s at %.2f Hz (%zu of %zu windows). Speeds to try (the tooth frequency at "
-                  "%.2f Hz / k):", *r.onset_s, *r.end_s, r.chatter_hz, counts[1], r.windows.size(), r.chatter_hz);
+    char head[320];
+    std::snprintf(head, sizeof head, "CHATTER from %.2f s to %.2f s at %.2f Hz (%zu of %zu windows; the same chatter as k x %.2f Hz +/- %.2f Hz). Speeds to try (the tooth frequency at %.2f Hz / k):", *r.onset_s, *r.end_s, r.chatter_hz, counts[1],
+                  r.windows.size(), r.rpm * a.teeth / 60.0, milling::chatter_family_hz(r.chatter_hz, r.rpm * a.teeth / 60.0), r.chatter_hz);
     t << head;
     for (const auto& s : r.speeds) t << ' ' << std::lround(s.rpm) << " rpm (k " << s.lobe << ")";
     t << (r.speeds.empty() ? " none within the range" : "") << "\n";
@@ -197,7 +201,7 @@ int run_chatter(const ChatterArgs& a) {
   } else {
     t << "NO CHATTER in " << counts[0] << " windows judged (" << counts[2] << " without enough signal)\n";
   }
-  nlohmann::json j = to_json(r);
+  nlohmann::json j = to_json(r, a.teeth);
   if (advice) {
     nlohmann::json opts = nlohmann::json::array();
     for (const auto& o : advice->options) opts.push_back({{"rpm", o.rpm}, {"limit_mm", o.limit_mm}, {"margin", o.margin}, {"source", o.source}});

@@ -21,6 +21,7 @@
 #include "apps/gnuplot.hpp"
 #include "apps/milling_report.hpp"
 #include "commission/emulated_cell.hpp"
+#include "milling/chatter.hpp"
 #include "milling/cut_job.hpp"
 #include "milling/cut_stability.hpp"
 #include "milling/lobes.hpp"
@@ -73,6 +74,15 @@ json hil_critical(const CutArgs& a, const milling::CutJob& job, double rpm, doub
 }
 
 
+// Beside a frequency the simulated cut found, how it relates to the accurate method's (milling/chatter.hpp).
+const char* alias_note(double cut_hz, double accurate_hz, double tooth_hz) {
+  // Within 0.5 % of the larger (the frequency moves with the depth) and 1 % of the tooth frequency.
+  const double tol_hz = 0.005 * std::max(std::abs(cut_hz), std::abs(accurate_hz)) + 0.01 * tooth_hz;
+  if (std::abs(cut_hz - accurate_hz) <= tol_hz) return "";
+  return milling::same_chatter(cut_hz, accurate_hz, tooth_hz, tol_hz) ? " (another alias of the same chatter)"
+                                                                      : " (not the accurate method's chatter)";
+}
+
 json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double wall_s) {
   const auto& r = o.record;
   const auto& v = o.verdict;
@@ -83,6 +93,7 @@ json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double w
           {"classification", milling::to_string(v.classification)},
           {"mechanism", milling::to_string(v.mechanism)},
           {"chatter_hz", v.stable ? json(nullptr) : json(v.chatter_hz)},
+          {"chatter_family_hz", v.stable ? json(nullptr) : json(milling::chatter_family_hz(v.chatter_hz, r.rpm * job.cutter.teeth / 60.0))},
           {"once_per_tooth_ratio", v.once_per_period_ratio},
           {"nonharmonic_energy_ratio", v.nonharmonic_energy_ratio},
           {"growth_per_tooth", finite_or_null(v.growth_per_period)},
@@ -220,18 +231,23 @@ int run_cut(const CutArgs& a) {
             job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
             [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double tooth_hz = rpm * job.cutter.teeth / 60.0;  // the chatter's family: milling/chatter.hpp
         out["critical"].push_back({{"rpm", rpm}, {"simulated_rpm", job.settings.rpm}, {"damped", a.damped},
                                    {"critical_depth_mm", c.depth_mm}, {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
                                    {"accurate_method", truth.method()}, {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
                                    {"accurate_rpm", sdm.rpm}, {"accurate_chatter_hz", sdm.chatter_hz},
+                                   {"accurate_chatter_family_hz", milling::chatter_family_hz(sdm.chatter_hz, tooth_hz)},
+                                   {"chatter_family_hz", milling::chatter_family_hz(c.chatter_hz, tooth_hz)},
                                    {"accurate_type", milling::to_string(sdm.type)},
                                    {"classification", milling::to_string(c.above)}, {"mechanism", milling::to_string(c.mechanism)},
                                    {"chatter_hz", c.chatter_hz}, {"simulations", c.simulations}, {"wall_s", wall}});
         std::printf("%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
-                    "above it %s (%s) at %.1f Hz; %d cuts in %.2f s\n",
+                    "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
                     rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm, (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0,
                     milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism),
-                    c.chatter_hz, c.simulations, wall);
+                    c.chatter_hz,
+                    alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz),
+                    c.simulations, wall);
         if (!a.hil_path.empty()) out["critical"].back()["hil"] = hil_critical(a, job, rpm, c.depth_mm);
       }
     }

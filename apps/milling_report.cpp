@@ -13,6 +13,7 @@
 #include "apps/gnuplot.hpp"
 #include "config/robot_model_config.hpp"
 #include "config/milling_config.hpp"
+#include "milling/chatter.hpp"
 #include "milling/lobes.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/scheduled_lobes.hpp"
@@ -40,7 +41,7 @@ json optional_json(const std::optional<T>& v) {
 }
 
 // One lobe study (open or damped, milling/studies.hpp) as the report's JSON.
-json lobes_json(const milling::LobeStudy& s) {
+json lobes_json(const milling::LobeStudy& s, int teeth) {
   json j;
   j["structure"] = s.structure;
   j["closed_loop"] = s.closed_loop;
@@ -61,6 +62,7 @@ json lobes_json(const milling::LobeStudy& s) {
   for (const auto& a : s.at_rpm) {
     json r = {{"rpm", a.rpm}, {"b_lim_mm", finite_or_null(a.b_lim_mm)}, {"b_lim_lobes_mm", optional_json(a.b_lim_lobes_mm)},
               {"chatter_hz", optional_json(a.chatter_hz)}};
+    if (a.chatter_hz) r["chatter_family_hz"] = milling::chatter_family_hz(*a.chatter_hz, a.rpm * teeth / 60.0);
     if (s.accurate) r["requested_rpm"] = *a.requested_rpm, r["type"] = *a.type;
     else r["lobe"] = optional_json(a.lobe);
     j["at_rpm"].push_back(r);
@@ -74,12 +76,12 @@ json lobes_json(const milling::LobeStudy& s) {
 // minutes).
 json lobes_json(const milling::Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms,
                 const std::string& method) {
-  if (method != "sdm") return lobes_json(milling::zero_order_lobe_study(structure, cfg, rpms));
+  if (method != "sdm") return lobes_json(milling::zero_order_lobe_study(structure, cfg, rpms), cfg.tool.teeth);
   return lobes_json(milling::accurate_lobe_study(
       structure, cfg, rpms, [](const std::string& name, std::size_t done, std::size_t of, double s) {
         if (done % 20 == 0 || done == of)
           std::cerr << "[lobes " << name << "] " << done << "/" << of << " speeds, " << s << " s\n";
-      }));
+      }), cfg.tool.teeth);
 }
 
 double pct_change(const json& open, const json& damped) {
@@ -339,7 +341,7 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
       if (const auto sl = milling::scheduled_lobe_study(sc, cfg, rpms, [](std::size_t done, std::size_t of) {
             if (done % 40 == 0 || done == of) std::cerr << "[lobes speed schedule] " << done << "/" << of << '\n';
           })) {
-        json j = lobes_json(sl->study);
+        json j = lobes_json(sl->study, cfg.tool.teeth);
         j["open_b_lim_mm"] = sl->open_mm;
         j["below_open"] = sl->below_open;
         j["bands"] = sl->bands;

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "analysis/fft.hpp"
+#include "milling/sdm.hpp"
 #include "units/units.hpp"
 
 namespace robodamp::milling {
@@ -29,6 +30,7 @@ struct OneSignal {
   double ratio{0.0}, growth{-1e300}, nonharmonic{0.0}, chatter_hz{0.0}, chatter_energy{0.0};
   double persistence{0.0};  // RMS of the differences in the last quarter over the second
   std::complex<double> root{0.0};  // the dominant multiplier's estimate
+  Eigen::VectorXcd roots;          // the autoregressive model's roots (root is the largest)
   bool settled{true};
 };
 
@@ -38,13 +40,13 @@ double rms(const std::vector<double>& v, std::size_t a, std::size_t b) {
   return b > a ? std::sqrt(s / static_cast<double>(b - a)) : 0.0;
 }
 
-// ln |largest root| of an autoregressive model of order 4 fitted by least squares to the second half of
-// the differences: the dominant Floquet multiplier's magnitude, even when several decaying and growing
-// components are mixed (a ratio of RMS values is not).
-std::complex<double> dominant_root(const std::vector<double>& d) {
+// The roots of an autoregressive model of order 4 fitted by least squares to the second half of the
+// differences; the largest is the dominant Floquet multiplier, even when several decaying and growing
+// components are mixed (a ratio of RMS values is not). Empty when too short or all zero.
+Eigen::VectorXcd ar_roots(const std::vector<double>& d) {
   constexpr int p = 4;
   const std::size_t from = d.size() / 2;
-  if (d.size() - from < 4 * p) return 0.0;
+  if (d.size() - from < 4 * p) return {};
   const auto rows = static_cast<Eigen::Index>(d.size() - from - p);
   Eigen::MatrixXd a(rows, p);
   Eigen::VectorXd b(rows);
@@ -54,16 +56,57 @@ std::complex<double> dominant_root(const std::vector<double>& d) {
     for (int k = 0; k < p; ++k) a(r, k) = d[i - 1 - static_cast<std::size_t>(k)];
   }
   const double scale = a.cwiseAbs().maxCoeff();
-  if (!(scale > 0.0)) return 0.0;
+  if (!(scale > 0.0)) return {};
   const Eigen::VectorXd coef = (a / scale).colPivHouseholderQr().solve(b / scale);
   Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(p, p);
   companion.row(0) = coef.transpose();
   for (int k = 1; k < p; ++k) companion(k, k - 1) = 1.0;
-  const Eigen::VectorXcd roots = Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues();
-  std::complex<double> largest(0.0);
+  return Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues();
+}
+
+std::complex<double> largest(const Eigen::VectorXcd& roots) {
+  std::complex<double> out(0.0);
   for (Eigen::Index k = 0; k < roots.size(); ++k)
-    if (std::abs(roots(k)) > std::abs(largest)) largest = roots(k);
-  return largest;
+    if (std::abs(roots(k)) > std::abs(out)) out = roots(k);
+  return out;
+}
+
+// The dominant Floquet mode's shape over one period, from every phase s of the period: its part of the
+// differences d_s(k) = x(start + s + (k+1) N) - x(start + s + k N) is Re(q(s) mu^k), with
+// q(s) = C mu^(s/N) (mu - 1) p(s) and p the mode's periodic factor. q(s) by least squares over the last half
+// of the periods, the autoregressive model's other roots fitted beside it (the decaying transients of other
+// modes, which the spectrum cannot tell from the chatter). Returns q(s), s = 0 .. N - 1 (empty if no fit).
+Eigen::VectorXcd floquet_shape(const std::vector<double>& x, std::size_t start, std::size_t n, std::size_t periods,
+                               const Eigen::VectorXcd& roots, std::complex<double> mu) {
+  // One root of each conjugate pair, the dominant one as mu itself (its conjugate gives the same mode).
+  std::vector<std::complex<double>> basis{mu};
+  for (Eigen::Index j = 0; j < roots.size(); ++j) {
+    const std::complex<double> r = roots(j);
+    const bool same = std::abs(r - mu) <= 1e-9 * std::abs(mu) || std::abs(r - std::conj(mu)) <= 1e-9 * std::abs(mu);
+    if (!same && r.imag() >= 0.0 && std::abs(r) > 0.0) basis.push_back(r);
+  }
+  const std::size_t first = periods / 2, rows = periods - 1 - first;
+  if (rows < 2 * basis.size() + 4) return {};
+  Eigen::MatrixXd a(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(2 * basis.size()));
+  for (std::size_t r = 0; r < rows; ++r)
+    for (std::size_t j = 0; j < basis.size(); ++j) {
+      // Each column at most 1 in magnitude: a growing root counted back from the last row, a decaying one
+      // from the first (a whole column's factor changes q by one constant for every phase, not its shape).
+      const double from = std::abs(basis[j]) >= 1.0 ? static_cast<double>(rows - 1) : 0.0;
+      const std::complex<double> z = std::pow(basis[j], static_cast<double>(r) - from);
+      a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(2 * j)) = z.real();
+      a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(2 * j + 1)) = z.imag();
+    }
+  Eigen::MatrixXd b(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(n));
+  for (std::size_t r = 0; r < rows; ++r)
+    for (std::size_t s = 0; s < n; ++s) {
+      const std::size_t i = start + s + (first + r) * n;
+      b(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(s)) = x[i + n] - x[i];
+    }
+  const Eigen::MatrixXd coef = a.completeOrthogonalDecomposition().solve(b);
+  Eigen::VectorXcd q(static_cast<Eigen::Index>(n));
+  for (Eigen::Index s = 0; s < q.size(); ++s) q(s) = std::complex<double>(coef(0, s), -coef(1, s));  // Re(q z) = a Re z - b Im z
+  return q;
 }
 
 OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t period, std::size_t base, double fs,
@@ -88,7 +131,8 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
   o.ratio = ac > 0.0 ? rms(d, d.size() / 2, d.size()) / ac : 0.0;
   o.settled = r4 <= t.settled_ratio * std::max(scale, 1e-300);
   o.persistence = r2 > 0.0 ? r4 / r2 : 0.0;
-  o.root = dominant_root(d);
+  o.roots = ar_roots(d);
+  o.root = largest(o.roots);
   o.growth = std::abs(o.root) > 0.0 ? std::log(std::abs(o.root)) : -1e300;
   // Spectrum of the last half (a whole number of harmonic base periods, so the harmonics sit on bins).
   const std::size_t whole = ((end - half) / (period * base)) * period * base;
@@ -129,7 +173,35 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
   return o;
 }
 
+// The chatter frequency of the dominant Floquet mode (multiplier mu) the signals share, as SDM takes it from
+// its critical eigenvector: the strongest harmonic of the mode's periodic factor, the x and y displacements'
+// energies summed (floquet_chatter_hz). 0 when the mode cannot be fitted.
+double shape_chatter_hz(const std::vector<const std::vector<double>*>& signals, const std::vector<Eigen::VectorXcd>& roots,
+                        std::size_t start, std::size_t n, double fs, std::complex<double> mu) {
+  if (signals.empty() || signals.size() > 2 || !(std::abs(mu) > 0.0)) return 0.0;
+  const std::size_t periods = (signals[0]->size() - start) / n;
+  Eigen::VectorXcd history = Eigen::VectorXcd::Zero(static_cast<Eigen::Index>(2 * n));
+  for (std::size_t c = 0; c < signals.size(); ++c) {
+    const Eigen::VectorXcd q = floquet_shape(*signals[c], start, n, periods, roots[c], mu);
+    if (q.size() == 0) return 0.0;
+    for (std::size_t s = 0; s < n; ++s) history(static_cast<Eigen::Index>(2 * s + c)) = q(static_cast<Eigen::Index>(s));
+  }
+  std::vector<double> t(n);
+  for (std::size_t s = 0; s < n; ++s) t[s] = static_cast<double>(s) / static_cast<double>(n);
+  return floquet_chatter_hz(mu, t, history, fs / static_cast<double>(n));
+}
+
 }  // namespace
+
+double chatter_family_hz(double chatter_hz, double period_hz) {
+  if (!(period_hz > 0.0) || !std::isfinite(chatter_hz)) return chatter_hz;
+  const double r = std::fmod(std::abs(chatter_hz), period_hz);
+  return std::min(r, period_hz - r);
+}
+
+bool same_chatter(double a_hz, double b_hz, double period_hz, double tol_hz) {
+  return std::abs(chatter_family_hz(a_hz, period_hz) - chatter_family_hz(b_hz, period_hz)) <= tol_hz;
+}
 
 ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& signals, std::size_t start,
                               int samples_per_period, int harmonic_base_periods, double fs, double out_of_cut_share,
@@ -139,6 +211,7 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
   bool settled = true;
   double chatter_energy = -1.0, persistence = 0.0;
   std::complex<double> root(0.0);
+  std::vector<Eigen::VectorXcd> roots;
   v.growth_per_period = -1e300;
   for (const auto* s : signals) {
     const OneSignal o = analyse(*s, start, static_cast<std::size_t>(samples_per_period),
@@ -148,6 +221,7 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
     v.once_per_period_ratio = std::max(v.once_per_period_ratio, o.ratio);
     v.nonharmonic_energy_ratio = std::max(v.nonharmonic_energy_ratio, o.nonharmonic);
     if (o.growth > v.growth_per_period) v.growth_per_period = o.growth, root = o.root;
+    roots.push_back(o.roots);
     if (o.chatter_energy > chatter_energy) chatter_energy = o.chatter_energy, v.chatter_hz = o.chatter_hz;
   }
   // A cut whose once-per-period samples have settled is periodic, hence stable, even if its edges leave the
@@ -163,6 +237,10 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
     v.chatter_hz = 0.0;
     return v;
   }
+  // The chatter frequency as SDM defines it (floquet_chatter_hz): the growing Floquet mode's strongest harmonic.
+  // The spectrum's strongest candidate stays where the mode cannot be fitted.
+  if (const double hz = shape_chatter_hz(signals, roots, start, static_cast<std::size_t>(samples_per_period), fs, root); hz > 0.0)
+    v.chatter_hz = hz;
   // Period doubling: the dominant multiplier real and negative (within 3 degrees of -1's direction).
   const bool flip = root.real() < 0.0 && std::abs(root.imag()) < t.flip_angle * std::abs(root);
   v.mechanism = flip ? CutClass::kFlip : CutClass::kHopf;
