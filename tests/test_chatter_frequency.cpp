@@ -93,7 +93,9 @@ TEST(ChatterFrequency, SdmTheDetectorAndTheIndicatorNameOneAlias) {
     // A band below the strongest harmonic (`robodamp chatter`'s default 1 kHz at 10 700 rpm): the indicator
     // says stable (the 141 Hz alias is under 0.1 % of the displacement there, the spindle's lines the rest),
     // never another frequency.
-    if (f.low_band_hz > 0.0) EXPECT_TRUE(ml::same_chatter(f.low_band_hz, f.sdm_hz, f.tooth_hz, 0.01 * f.tooth_hz)) << c.what;
+    if (f.low_band_hz > 0.0) {
+      EXPECT_TRUE(ml::same_chatter(f.low_band_hz, f.sdm_hz, f.tooth_hz, 0.01 * f.tooth_hz)) << c.what;
+    }
   }
 }
 
