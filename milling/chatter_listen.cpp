@@ -256,6 +256,11 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   if (tooth_hz > 0.45 * r.analysed_rate_hz)
     r.warnings.push_back(fmt("the tooth-passing frequency (%.4g Hz) is above the analysed band (%.4g Hz): only the spindle's "
                              "lower harmonics are seen", tooth_hz, 0.45 * r.analysed_rate_hz));
+  // A band narrower than the recording's: a chatter above it is not seen (docs/milling.md, "One chatter
+  // frequency": the industrial robot's 5.5 kHz chatter read stable in a 1 kHz band).
+  if (0.5 * sig.rate_hz > 1.5 * s.max_hz)
+    r.warnings.push_back(fmt("analysed up to %.4g Hz of the %.4g Hz the recording holds (--max-hz): a chatter above it (a spindle or "
+                             "tool mode's) is not seen", s.max_hz, 0.5 * sig.rate_hz));
   ChatterIndicatorSettings is = s.indicator;
   is.window_s = s.window_s, is.max_window_s = std::max(is.max_window_s, s.window_s);
   if (s.floor) is.floor_mps2 = *s.floor;

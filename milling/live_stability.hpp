@@ -60,7 +60,7 @@ class LiveStability {
   // Blocking, for tests and the command line: computes (or finds) the limits.
   [[nodiscard]] LiveLimits compute(double rpm, std::size_t set, double gain_ns_per_m);
 
-  // Low priority (the live lobes): a thread of its own at the lowest priority (nice 19) computes these speeds
+  // Low priority (the live lobes): a thread of its own below the cell's others (nice 10) computes these speeds
   // for (set, gain) into the cache; a new sweep replaces the one before. Any thread.
   void sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm);
   // Any thread: every limit computed so far for (set, gain), by speed.

@@ -69,7 +69,12 @@ Frequencies measure(const Case& c) {
   s.teeth = job.tool.teeth, s.rpm = c.rpm, s.window_s = c.window_s, s.max_hz = c.max_hz;
   f.indicator_hz = ml::listen(sig, s).chatter_hz;
   s.max_hz = 1000.0;  // `robodamp chatter`'s default band
-  f.low_band_hz = ml::listen(sig, s).chatter_hz;
+  const ml::ListenReport low = ml::listen(sig, s);
+  f.low_band_hz = low.chatter_hz;
+  std::string notes;
+  for (const auto& w : low.warnings) notes += w + "\n";
+  // The user is told when the recording holds more than the band (1.5 x).
+  EXPECT_EQ(notes.find("analysed up to 1000 Hz of the") != std::string::npos, 0.5 * sig.rate_hz > 1500.0) << c.what << ": " << notes;
   std::printf("%-44s SDM %.1f mm at %.1f Hz; detector %.1f Hz at it, %.1f Hz above; indicator %.1f Hz (band %.0f Hz), %.1f Hz (band 1 kHz); "
               "families %.1f %.1f %.1f %.1f Hz (f_p %.1f Hz)\n",
               c.what, sdm.critical_depth_mm, f.sdm_hz, f.detector_hz, f.long_detector_hz, f.indicator_hz, c.max_hz, f.low_band_hz,
