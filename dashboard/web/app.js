@@ -368,8 +368,10 @@ function renderCounters(d) {
     ['parameter set', s.parameter_set],
     ['gain K / limit', fmt(s.gain_ns_per_m, 0) + ' / ' + fmt(s.max_gain_ns_per_m, 0) + ' N s/m'],
     ['parameter writes', s.parameter_writes ? 'on' : 'off (the cell refuses actions)']];
-  $('counters').innerHTML = rows.map((r) => '<tr><td>' + esc(r[0]) + '</td><td data-counter="' + esc(r[0]) + '">' + esc(r[1] === undefined ? '–' : r[1]) + '</td></tr>').join('');
+  const html = rows.map((r) => '<tr><td>' + esc(r[0]) + '</td><td data-counter="' + esc(r[0]) + '">' + esc(r[1] === undefined ? '–' : r[1]) + '</td></tr>').join('');
+  if (html !== countersShown) countersShown = html, $('counters').innerHTML = html;  // rewritten only when it changes
 }
+let countersShown = '';
 
 async function loadActions() {
   const r = await api('/api/actions');
