@@ -390,8 +390,8 @@ function connect() {
   source.addEventListener('cell', timed((ev) => {
     const d = JSON.parse(ev.data);
     if (d.cell !== currentCell) return;
-    // Drawn once the events already queued are taken: a page behind the stream (a busy machine: 6 s behind
-    // under a CPU hog on both cores, each 100 ms event drawn in turn) merges them and draws the newest once.
+    // Drawn once the events already queued are taken: a page behind the stream (a busy machine, an event each
+    // 100 ms) merges them and draws the newest once instead of drawing each in turn.
     // (A timer, not an animation frame: a page in a background tab gets no frames, and would only merge.)
     if (pendingCell) pendingCell = mergeCell(pendingCell, d);
     else pendingCell = d, setTimeout(renderCell, 0);
