@@ -545,7 +545,10 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   EXPECT_TRUE(run.wait_for(60.0).has_value()) << test::read_file(dir + "/run.log");
   const auto summary = nlohmann::json::parse(test::read_file(dir + "/run.json"));
   const auto& js = summary["joint_states"];
-  EXPECT_GT(js["messages"].get<int>(), 20) << js.dump();
+  // Each region's pose settles over dds.joint_states.settle_samples (3) messages, and one at least was refused:
+  // 7 or more. (It was "more than 20", which counted on the test's steps taking 0.4 s or more: in a fresh
+  // clone's run they took 0.3 s and 11 came.)
+  EXPECT_GE(js["messages"].get<int>(), 2 * 3 + js["refused"].get<int>()) << js.dump();
   EXPECT_GT(js["refused"].get<int>(), 0) << js.dump();
   EXPECT_GE(js["changes"].get<int>(), 3) << js.dump();  // folded, stretched, unknown
   EXPECT_EQ(js["losses"].get<int>(), 1) << js.dump();
