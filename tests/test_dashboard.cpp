@@ -139,6 +139,14 @@ TEST(DashboardConfig, EveryKeyIsCheckedWithItsUnitAndRange) {
   }
 }
 
+// A DDS domain of this test's own on the loopback (salt: one per test, so tests of one process do not meet).
+config::DdsConfig loopback_dds(int salt) {
+  config::DdsConfig cfg;
+  cfg.domain_id = static_cast<int>((getpid() * 7 + salt) % 200) + 20;
+  cfg.transport = config::DdsTransport::kUdpLoopback;
+  return cfg;
+}
+
 // A loop's bridge as a cell publishes it, fed with frames here.
 struct NamedCell {
   std::atomic<int> handled{0};
@@ -171,9 +179,7 @@ struct NamedCell {
 };
 
 TEST(DashboardFleet, TwoNamedCellsOnOneDomainAreToldApartAndARequestReachesOnlyItsCell) {
-  config::DdsConfig cfg;
-  cfg.domain_id = static_cast<int>((getpid() * 7 + 13) % 200) + 20;
-  cfg.transport = config::DdsTransport::kUdpLoopback;
+  config::DdsConfig cfg = loopback_dds(13);
   cfg.parameter_writes = true;
   cfg.status_rate_hz = 20.0;
   NamedCell a("cell-a", cfg);
@@ -219,9 +225,7 @@ TEST(DashboardFleet, TwoNamedCellsOnOneDomainAreToldApartAndARequestReachesOnlyI
 // every writer it remembered: a restarted cell showed "2 publishers" for 5 s (the browser test's screenshot;
 // this test fails so, tried). Within 3.5 s here: 2.5 s for the bridges' samples on a loaded machine.
 TEST(DashboardFleet, TwoLiveCellsUnderOneNameAreAClashUntilOneStops) {
-  config::DdsConfig cfg;
-  cfg.domain_id = static_cast<int>((getpid() * 7 + 29) % 200) + 20;
-  cfg.transport = config::DdsTransport::kUdpLoopback;
+  config::DdsConfig cfg = loopback_dds(29);
   cfg.status_rate_hz = 20.0;
   dashboard::Fleet fleet(cfg, 1.0);
   const auto publishers = [&] {
@@ -246,9 +250,7 @@ TEST(DashboardFleet, TwoLiveCellsUnderOneNameAreAClashUntilOneStops) {
 // a killed run's advice and sent the speed to a cell still starting). A second run under the same name while
 // the first still publishes is a clash, not a restart: nothing is dropped.
 TEST(DashboardFleet, ARestartedCellsLastRunIsDropped) {
-  config::DdsConfig cfg;
-  cfg.domain_id = static_cast<int>((getpid() * 7 + 41) % 200) + 20;
-  cfg.transport = config::DdsTransport::kUdpLoopback;
+  config::DdsConfig cfg = loopback_dds(41);
   cfg.status_rate_hz = 20.0;
   dashboard::Fleet fleet(cfg, 1.0);
   dds::AdviceSample advice;
