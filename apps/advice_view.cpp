@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "config/pose_schedule_config.hpp"
+
 namespace robodamp::apps {
 
 std::string advice_text(const dds::AdviceSample& a) {
@@ -13,6 +15,7 @@ std::string advice_text(const dds::AdviceSample& a) {
                 static_cast<unsigned long long>(a.seq), a.time_s, a.trigger.c_str(), a.spindle_rpm, chatter.c_str(),
                 a.depth_mm, a.damped ? "damped" : "open-loop", a.limit_now_mm, a.method.c_str());
   std::string out = b;
+  if (!a.pose_deg.empty()) out += " at the robot's pose " + config::describe_pose(a.pose_deg) + ":";
   if (!a.found) return out + " " + a.reason + "\n";
   for (std::size_t i = 0; i < a.option_rpm.size(); ++i) {
     std::snprintf(b, sizeof b, "%s %.0f rpm (%.3f mm, margin %.2f)", i == 0 ? "" : ";", a.option_rpm[i],
@@ -45,7 +48,8 @@ nlohmann::json advice_json(const dds::AdviceSample& a) {
           {"best_limit_mm", finite(a.best_limit_mm)},
           {"reason", a.reason},
           {"rpm_min", a.rpm_min},
-          {"rpm_max", a.rpm_max}};
+          {"rpm_max", a.rpm_max},
+          {"pose_deg", a.pose_deg}};
 }
 
 }  // namespace robodamp::apps

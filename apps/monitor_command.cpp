@@ -14,6 +14,7 @@
 #include "apps/advice_view.hpp"
 #include "apps/cli.hpp"
 #include "apps/dds_client.hpp"
+#include "config/pose_schedule_config.hpp"
 #include "dds/participant.hpp"
 #include "dds/messages.hpp"
 #include "rt/signals.hpp"
@@ -99,7 +100,7 @@ std::string mm(double v) {
 
 // The machining lines (spindle.job): speed, depth, limits, chatter indicator.
 std::string machining_view(const msg::Machining& m) {
-  char b[900];
+  char b[1200];
   std::string limits = "computing";
   if (m.spindle_rpm() <= 0.0) limits = "spindle stopped";
   else if (m.limits_ready())
@@ -110,6 +111,10 @@ std::string machining_view(const msg::Machining& m) {
                                        ? "  the job's planned depth is above the limit here (not cutting now)"
                                        : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
                                 : "  depth within");
+  if (m.spindle_rpm() > 0.0 && !m.limits_pose_deg().empty()) {
+    limits += "\n             at the robot's pose " + config::describe_pose(m.limits_pose_deg()) +
+              (m.limits_ready() ? "" : " (recomputing: the robot moved)");
+  }
   std::string indicator = "-";
   if (m.indicator_valid()) {
     char c[200];
@@ -148,6 +153,7 @@ std::string advice_view(const msg::Advice& m) {
   a.option_limit_mm = m.option_limit_mm();
   a.option_limit_mm.resize(a.option_rpm.size(), 0.0);
   a.reason = m.reason();
+  a.pose_deg = m.pose_deg();
   return advice_text(a);
 }
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "apps/advice_view.hpp"
+#include "config/pose_schedule_config.hpp"
 
 namespace robodamp::apps {
 
@@ -196,6 +197,20 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                       {"nonharmonic_share", m.nonharmonic_share}, {"chatter_hz", m.chatter_hz},
                       {"cutting", dds::cutting_name(m.cutting)}, {"cutting_reason", m.cutting_reason},
                       {"chatter", m.chatter}};
+    if (!m.pose_deg.empty() || !m.limits_pose_deg.empty())
+      j["machining"]["pose_deg"] = m.pose_deg, j["machining"]["limits_pose_deg"] = m.limits_pose_deg;
+  }
+  if (!s.limits_trail.empty()) {
+    json trail = json::array();
+    for (const auto& r : s.limits_trail)
+      trail.push_back({{"time_s", r.time_s}, {"pose_deg", r.limits.pose_deg}, {"spindle_rpm", r.limits.rpm},
+                       {"parameter_set", r.set}, {"gain_ns_per_m", r.gain_ns_per_m},
+                       {"open_limit_mm", std::isfinite(r.limits.open_mm) ? json(r.limits.open_mm) : json(nullptr)},
+                       {"damped_limit_mm", std::isfinite(r.limits.damped_mm) ? json(r.limits.damped_mm) : json(nullptr)},
+                       {"method", r.limits.method}, {"problem", r.limits.problem},
+                       {"axis_open_limit_mm", std::isfinite(r.limits.axis_open_mm) ? json(r.limits.axis_open_mm) : json(nullptr)},
+                       {"axis_verified", r.limits.axis_verified}});
+    j["limits_along_path"] = trail;
   }
   if (s.advice) j["advice"] = advice_json(runtime::to_sample(*s.advice));
   if (s.modbus) {
@@ -361,6 +376,17 @@ std::string summary_text(const runtime::RunSummary& s) {
                     100.0 * m.nonharmonic_share, m.cutting == dds::kCutting ? "; cutting"
                                                  : m.cutting == dds::kNotCutting ? ("; NOT CUTTING (" + m.cutting_reason + ")").c_str()
                                                                                  : "");
+      os << b;
+      if (!m.limits_pose_deg.empty()) os << "  the limits are at the robot's pose " << config::describe_pose(m.limits_pose_deg) << "\n";
+    }
+  }
+  if (!s.limits_trail.empty()) {
+    os << "  limits along the path (" << s.limits_trail.size() << " states):\n";
+    for (const auto& r : s.limits_trail) {
+      std::snprintf(b, sizeof b, "    %8.2f s  %-24s %6.0f rpm  set %zu  K %5.0f N s/m: open %.3f mm, damped %.3f mm%s\n", r.time_s,
+                    r.limits.pose_deg.empty() ? "pose not known" : config::describe_pose(r.limits.pose_deg).c_str(), r.limits.rpm,
+                    r.set, r.gain_ns_per_m, r.limits.open_mm, r.limits.damped_mm,
+                    r.limits.axis_verified ? "" : " (the damped model is not verified here: not claimed)");
       os << b;
     }
   }

@@ -39,6 +39,7 @@ SpindleConfig read_spindle(MapReader& top, const std::string& source) {
       r.diagnostics().add(r.mark(), "spindle.job", "= '" + c.job + "': no such file (looked for " + c.job_resolved + ")");
   }
   if (auto v = r.text("structure", "")) c.structure = *v;
+  if (auto v = r.number("pose_step_deg", {"deg", 0.1, 45.0}, c.pose_step_deg)) c.pose_step_deg = *v;
   if (auto v = read_bool(r, "apply_advice", c.apply_advice)) c.apply_advice = *v;
   r.finish();
   return c;

@@ -26,6 +26,9 @@ struct SpindleConfig {
   std::string job;              // as written; empty = no live stability
   std::string job_resolved;
   std::string structure;        // the job's structure to use (empty: the job's own)
+  // With pose_schedule: the live limits are for the robot at its pose, rounded to this grid (a new grid
+  // point is a new computation; docs/pose_dynamics.md, "Live stability at the pose").
+  double pose_step_deg{2.0};
   // The HIL emulator's robot follows robodamp's spindle-speed advice (modbus.robot.advice_register) in
   // its regenerative cut: an advised speed inside 0 < rpm <= rpm_max replaces the program's speed.
   bool apply_advice{false};

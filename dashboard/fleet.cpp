@@ -53,7 +53,7 @@ json to_json(const msg::Machining& m) {
           {"limit_mm", finite(m.limit_mm())}, {"depth_warning", m.depth_warning()}, {"depth_measured", m.depth_measured()}, {"indicator_valid", m.indicator_valid()},
           {"once_per_rev_ratio", m.once_per_rev_ratio()}, {"nonharmonic_share", m.nonharmonic_share()},
           {"chatter_hz", m.chatter_hz()}, {"chatter", m.chatter()}, {"cutting", dds::cutting_name(m.cutting())},
-          {"cutting_reason", m.cutting_reason()}};
+          {"cutting_reason", m.cutting_reason()}, {"pose_deg", m.pose_deg()}, {"limits_pose_deg", m.limits_pose_deg()}};
 }
 
 json to_json(const msg::Advice& a) {
@@ -65,7 +65,7 @@ json to_json(const msg::Advice& a) {
           {"limit_now_mm", finite(a.limit_now_mm())}, {"method", a.method()}, {"found", a.found()},
           {"advised_rpm", a.advised_rpm()}, {"advised_limit_mm", finite(a.advised_limit_mm())}, {"margin", finite(a.margin())},
           {"options", options}, {"best_rpm", a.best_rpm()}, {"best_limit_mm", finite(a.best_limit_mm())},
-          {"reason", a.reason()}, {"rpm_min", a.rpm_min()}, {"rpm_max", a.rpm_max()}};
+          {"reason", a.reason()}, {"rpm_min", a.rpm_min()}, {"rpm_max", a.rpm_max()}, {"pose_deg", a.pose_deg()}};
 }
 
 json to_json(const msg::Spectrum& s) {
@@ -81,7 +81,7 @@ json to_json(const msg::Lobes& l) {
   for (const double v : l.damped_limit_mm()) damped.push_back(finite(v));
   return {{"time_s", l.time_s()}, {"parameter_set", l.parameter_set()}, {"gain_ns_per_m", l.gain_ns_per_m()},
           {"method", l.method()}, {"depth_mm", l.depth_mm()}, {"rpm", l.rpm()}, {"open_limit_mm", open},
-          {"damped_limit_mm", damped}, {"speed_scheduled", l.speed_scheduled()}};
+          {"damped_limit_mm", damped}, {"speed_scheduled", l.speed_scheduled()}, {"pose_deg", l.pose_deg()}};
 }
 
 }  // namespace

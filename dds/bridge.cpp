@@ -198,6 +198,15 @@ void Bridge::publish_status() {
   if (status_writer_->write(&s)) ++n_status_;
 }
 
+namespace {
+
+// A pose on a bounded sequence<double, 16>: a robot has fewer joints.
+std::vector<double> first16(const std::vector<double>& v) {
+  return {v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(16, v.size()))};
+}
+
+}  // namespace
+
 void Bridge::publish_machining() {
   if (machining_writer_ == nullptr) return;
   const MachiningSample m = src_.machining();
@@ -223,6 +232,8 @@ void Bridge::publish_machining() {
   out.chatter(m.chatter);
   out.cutting(m.cutting);
   out.cutting_reason(m.cutting_reason);
+  out.pose_deg(first16(m.pose_deg));
+  out.limits_pose_deg(first16(m.limits_pose_deg));
   if (machining_writer_->write(&out)) ++n_machining_;
 }
 
@@ -254,6 +265,7 @@ void Bridge::publish_advice() {
   out.reason(a->reason);
   out.rpm_min(a->rpm_min);
   out.rpm_max(a->rpm_max);
+  out.pose_deg(first16(a->pose_deg));
   if (advice_writer_->write(&out)) {
     ++n_advice_;
     published_advice_ = a->seq;
@@ -295,6 +307,7 @@ void Bridge::publish_lobes() {
   out.open_limit_mm(first(l->open_limit_mm));
   out.damped_limit_mm(first(l->damped_limit_mm));
   out.speed_scheduled(l->speed_scheduled);
+  out.pose_deg(first16(l->pose_deg));
   if (lobes_writer_->write(&out)) ++n_lobes_;
 }
 

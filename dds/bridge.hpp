@@ -59,6 +59,8 @@ struct MachiningSample {
   bool chatter{false};
   std::uint8_t cutting{0};     // kCuttingUnknown, kCutting, kNotCutting
   std::string cutting_reason;  // what says so
+  std::vector<double> pose_deg;         // a pose-scheduled cell: the robot's joints now (empty: not known)
+  std::vector<double> limits_pose_deg;  // the pose the limits are for (on the live stability's grid)
 };
 inline constexpr std::uint8_t kCuttingUnknown = 0, kCutting = 1, kNotCutting = 2;
 [[nodiscard]] inline const char* cutting_name(std::uint8_t c) {
@@ -80,6 +82,7 @@ struct AdviceSample {
   double best_rpm{0.0}, best_limit_mm{0.0};
   std::string reason;
   double rpm_min{0.0}, rpm_max{0.0};
+  std::vector<double> pose_deg;  // the pose the candidates were checked at (empty: none)
 };
 
 // What the Spectrum_ topic carries (dds/robodamp.idl), from the cell's spectrum monitor.
@@ -101,6 +104,7 @@ struct LobesSample {
   double depth_mm{0.0};
   std::vector<double> rpm, open_limit_mm, damped_limit_mm;  // by speed, at most 256
   bool speed_scheduled{false};  // each speed with its band's controller and K (parameter_set, gain not one)
+  std::vector<double> pose_deg;  // the pose the limits are for (empty: none)
 };
 
 struct BridgeSources {

@@ -362,6 +362,10 @@ void ModbusClient::pose_unknown_if_lost(PoseWatch& w) {
   w.settling.restart();
   if (ModbusLink::Clock::now() - w.last_ok < std::chrono::duration<double>(cfg_.link_timeout_s)) return;
   w.lost = true;
+  {
+    std::lock_guard lk(m_);
+    joints_deg_.clear();  // unknown, as the region
+  }
   ++pose_link_losses_;
   spdlog::warn("modbus robot: no joint angles for {} s: the pose is unknown", cfg_.link_timeout_s);
   w.settling.reported = -1;

@@ -113,7 +113,8 @@ class ModbusClient final : public rt::AmplifierIo {
   // Any thread: the axial depth the robot cuts (modbus.robot.depth_register), mm; NaN: no register, no
   // poll yet, not available (65535) or the link lost for link_timeout_s.
   [[nodiscard]] double depth_mm() const { return depth_mm_.load(); }
-  // The joint angles of the last successful poll, deg (empty before one; NaN where not available).
+  // The joint angles of the last successful poll, deg (empty before one and after the link is lost for
+  // link_timeout_s; NaN where not available).
   [[nodiscard]] std::vector<double> joints_deg() const;
 
   void start();

@@ -4,9 +4,11 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "analysis/loop_model.hpp"
+#include "analysis/pose_schedule.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/structure.hpp"
@@ -15,13 +17,18 @@ namespace robodamp::milling {
 
 namespace {
 
-config::StructureConfig pick_structure(const config::MillingConfig& job, const std::string& name) {
+// The job's structure, or with PoseDynamics the robot through the cell's loop beside its modal parts.
+config::StructureConfig pick_structure(const config::MillingConfig& job, const std::string& name,
+                                       const config::Config& cell, const std::optional<PoseDynamics>& pose,
+                                       bool needs_controller = true) {
   const std::string wanted = name.empty() ? job.structure : name;
   const config::StructureConfig* s = job.find_structure(wanted);
   if (s == nullptr && name.empty() && !job.structures.empty()) s = &job.structures.front();
   if (s == nullptr)
     throw config::ConfigError({config::Problem{job.source, {}, "structure",
                                                "the job has no structure named '" + wanted + "'"}});
+  if (pose) return robot_through_cell(*s, cell.actuator.location, pose->axis, cell.source);
+  if (!needs_controller) return *s;
   bool has_controller = false;
   for (const auto& p : s->parts) has_controller = has_controller || p.controller.has_value();
   if (!has_controller)
@@ -34,10 +41,12 @@ config::StructureConfig pick_structure(const config::MillingConfig& job, const s
 }  // namespace
 
 LiveStability::LiveStability(config::MillingConfig job, const std::string& structure, std::vector<config::Config> sets,
-                             LiveStabilitySettings s)
-    : job_(std::move(job)), structure_(pick_structure(job_, structure)), sets_(std::move(sets)), s_(s) {
+                             LiveStabilitySettings s, std::optional<PoseDynamics> pose)
+    : job_(std::move(job)), sets_(std::move(sets)), s_(s), pose_(std::move(pose)) {
   if (sets_.empty())
     throw config::ConfigError({config::Problem{job_.source, {}, "", "live stability needs a loop configuration"}});
+  structure_ = pick_structure(job_, structure, sets_.front(), pose_);
+  if (pose_) job_structure_ = pick_structure(job_, structure, sets_.front(), std::nullopt, false);
   thread_ = std::thread([this] { worker(); });
   sweep_thread_ = std::thread([this] { sweeper(); });
 }
@@ -52,12 +61,32 @@ LiveStability::~LiveStability() {
   sweep_thread_.join();
 }
 
-LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain) const {
-  return {std::lround(rpm / s_.rpm_step), set < sets_.size() ? set : 0, std::lround(gain / s_.gain_step_ns_per_m)};
+LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg) const {
+  Key k{std::lround(rpm / s_.rpm_step), set < sets_.size() ? set : 0, std::lround(gain / s_.gain_step_ns_per_m), {}};
+  if (pose_)
+    for (const double q : pose_deg) k.pose.push_back(std::isfinite(q) ? std::lround(q / s_.pose_step_deg) : 0);
+  return k;
 }
 
-std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, double gain_ns_per_m) {
-  const Key k = key(rpm, set, gain_ns_per_m);
+std::vector<double> LiveStability::pose_of(const Key& k) const {
+  std::vector<double> out;
+  for (const long q : k.pose) out.push_back(static_cast<double>(q) * s_.pose_step_deg);
+  return out;
+}
+
+std::vector<double> LiveStability::grid_pose(const std::vector<double>& pose_deg) const {
+  return pose_of(key(0.0, 0, 0.0, pose_deg));
+}
+
+config::Config LiveStability::loop_config(std::size_t set, const std::vector<double>& pose_deg) const {
+  const config::Config& base = sets_[set < sets_.size() ? set : 0];
+  if (!pose_ || pose_deg.empty()) return base;
+  return analysis::config_at_pose(base, analysis::pose_modes(pose_->model, pose_deg, pose_->axis, pose_->modes));
+}
+
+std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, double gain_ns_per_m,
+                                                const std::vector<double>& pose_deg) {
+  const Key k = key(rpm, set, gain_ns_per_m, pose_deg);
   std::lock_guard<std::mutex> lock(m_);
   if (const auto it = cache_.find(k); it != cache_.end()) return it->second;
   wanted_ = k;
@@ -65,8 +94,8 @@ std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, dou
   return std::nullopt;
 }
 
-LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_per_m) {
-  const Key k = key(rpm, set, gain_ns_per_m);
+LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_per_m, const std::vector<double>& pose_deg) {
+  const Key k = key(rpm, set, gain_ns_per_m, pose_deg);
   {
     std::lock_guard<std::mutex> lock(m_);
     if (const auto it = cache_.find(k); it != cache_.end()) return it->second;
@@ -78,20 +107,21 @@ LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_pe
   return l;
 }
 
-void LiveStability::sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm) {
+void LiveStability::sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm,
+                          const std::vector<double>& pose_deg) {
   std::lock_guard<std::mutex> lock(m_);
   sweep_.clear();
   for (const double r : rpm)
-    if (r > 0.0) sweep_.push_back(key(r, set, gain_ns_per_m));
+    if (r > 0.0) sweep_.push_back(key(r, set, gain_ns_per_m, pose_deg));
   cv_.notify_all();
 }
 
-std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per_m) const {
-  const Key k = key(0.0, set, gain_ns_per_m);
+std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per_m, const std::vector<double>& pose_deg) const {
+  const Key k = key(0.0, set, gain_ns_per_m, pose_deg);
   std::vector<LiveLimits> out;
   std::lock_guard<std::mutex> lock(m_);
   for (const auto& [key, l] : cache_)  // the key orders by speed first
-    if (std::get<1>(key) == std::get<1>(k) && std::get<2>(key) == std::get<2>(k) && std::get<0>(key) > 0) out.push_back(l);
+    if (key.set == k.set && key.gain == k.gain && key.pose == k.pose && key.rpm > 0) out.push_back(l);
   return out;
 }
 
@@ -99,7 +129,7 @@ void LiveStability::sweep(const std::vector<SweepPoint>& points) {
   std::lock_guard<std::mutex> lock(m_);
   sweep_.clear();
   for (const SweepPoint& p : points)
-    if (p.rpm > 0.0) sweep_.push_back(key(p.rpm, p.set, p.gain_ns_per_m));
+    if (p.rpm > 0.0) sweep_.push_back(key(p.rpm, p.set, p.gain_ns_per_m, p.pose_deg));
   cv_.notify_all();
 }
 
@@ -107,7 +137,8 @@ std::vector<LiveLimits> LiveStability::known(const std::vector<SweepPoint>& poin
   std::vector<LiveLimits> out;
   std::lock_guard<std::mutex> lock(m_);
   for (const SweepPoint& p : points)
-    if (const auto it = cache_.find(key(p.rpm, p.set, p.gain_ns_per_m)); p.rpm > 0.0 && it != cache_.end()) out.push_back(it->second);
+    if (const auto it = cache_.find(key(p.rpm, p.set, p.gain_ns_per_m, p.pose_deg)); p.rpm > 0.0 && it != cache_.end())
+      out.push_back(it->second);
   return out;
 }
 
@@ -136,7 +167,8 @@ LiveLimits LiveStability::evaluate_reported(const Key& k) const {
     return evaluate(k);
   } catch (const std::exception& e) {  // a model that cannot be built: reported, never thrown at the cell
     LiveLimits l;
-    l.rpm = static_cast<double>(std::get<0>(k)) * s_.rpm_step;
+    l.rpm = static_cast<double>(k.rpm) * s_.rpm_step;
+    l.pose_deg = pose_of(k);
     l.open_mm = l.damped_mm = 0.0;
     l.damped_valid = false;
     l.problem = e.what();
@@ -171,10 +203,47 @@ void LiveStability::sweeper() {
 }
 
 LiveLimits LiveStability::evaluate(const Key& k) const {
+  LiveLimits out = evaluate_on_axis(k);
+  if (pose_ && !out.pose_deg.empty() && out.rpm > 0.0) check_axis_model(out, k.gain > 0);
+  return out;
+}
+
+void LiveStability::check_axis_model(LiveLimits& l, bool damping) const {
+  config::StructureConfig whole;  // the job's modal parts and the robot model at the pose
+  whole.name = "robot_model_at_pose";
+  for (const auto& part : job_structure_.parts)
+    if (!part.pose && !part.controller) whole.parts.push_back(part);
+  config::StructurePartConfig robot;
+  robot.name = "robot";
+  robot.pose = config::PosePartConfig{pose_->model_path, l.pose_deg};
+  whole.parts.push_back(robot);
+  const SdmPoint o = AccurateStability(Structure(whole, false), job_).critical(l.rpm, std::isfinite(l.open_mm) ? l.open_mm : 1.0);
+  l.axis_open_mm = l.open_mm;
+  l.open_mm = o.critical_depth_mm;
+  l.open_chatter_hz = o.chatter_hz;
+  l.open_method = "SDM, the robot model at the pose";
+  l.axis_verified = std::abs(l.axis_open_mm / l.open_mm - 1.0) <= s_.axis_tolerance;
+  if (!damping) l.damped_mm = l.open_mm, l.damped_chatter_hz = l.open_chatter_hz;  // K = 0: the open loop
+  if (l.axis_verified || !l.damped_valid || !damping) return;
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "at this pose the robot's compliance off the actuator's axis (or above the loop's %d modes) sets the limit: "
+                "open %.3f mm by the robot model, %.3f mm by the loop's axis model, more than %.0f %% apart; the damper's "
+                "effect is not claimed",
+                pose_->modes, l.open_mm, l.axis_open_mm, 100.0 * s_.axis_tolerance);
+  l.problem = b;
+  l.damped_mm = l.open_mm;
+  l.damped_chatter_hz = l.open_chatter_hz;
+  l.analysed_rpm = l.rpm;
+  l.method = "open loop (the damped model is not verified at this pose)";
+}
+
+LiveLimits LiveStability::evaluate_on_axis(const Key& k) const {
   LiveLimits out;
-  out.rpm = static_cast<double>(std::get<0>(k)) * s_.rpm_step;
-  const config::Config& cfg = sets_[std::get<1>(k)];
-  const double gain = static_cast<double>(std::get<2>(k)) * s_.gain_step_ns_per_m;
+  out.rpm = static_cast<double>(k.rpm) * s_.rpm_step;
+  out.pose_deg = pose_of(k);
+  const config::Config cfg = loop_config(k.set, out.pose_deg);
+  const double gain = static_cast<double>(k.gain) * s_.gain_step_ns_per_m;
   const double inf = std::numeric_limits<double>::infinity();
   out.open_mm = out.damped_mm = inf;
   if (out.rpm <= 0.0) return out;
@@ -212,7 +281,7 @@ LiveLimits LiveStability::evaluate(const Key& k) const {
       out.analysed_rpm = d.rpm;
       out.method = truth.method();
       // A speed schedule's band that vouches for less than the accurate method (its limit chattered in time).
-      const std::size_t set = std::get<1>(k);
+      const std::size_t set = k.set;
       if (const auto cap = config::scheduled_depth_limit_mm(cfg, set, out.rpm);
           cap && *cap < out.damped_mm &&
           std::abs(config::scheduled_gain_ns_per_m(cfg, set, out.rpm) - gain) <= 0.5 * s_.gain_step_ns_per_m) {

@@ -85,7 +85,7 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.rpm_min = rpm_min;
   a.rpm_max = rpm_max;
   auto limit_of = [&](const LiveLimits& l) { return request.damped ? l.damped_mm : l.open_mm; };
-  const LiveLimits now = stability.compute(request.rpm, request.set, request.gain_ns_per_m);
+  const LiveLimits now = stability.compute(request.rpm, request.set, request.gain_ns_per_m, request.pose_deg);
   a.limit_now_mm = limit_of(now);
   a.method = request.damped ? now.method : now.open_method;
   a.depth_mm = request.depth_mm;
@@ -96,14 +96,14 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.best.margin = -1.0;
   for (const SpeedCandidate& c : advice_candidates(rpm_min, rpm_max, teeth, request.chatter_hz,
                                                    mode_frequencies(stability.structure(),
-                                                                    stability.sets().at(request.set < stability.sets().size() ? request.set : 0)),
+                                                                    stability.loop_config(request.set, request.pose_deg)),
                                                    s.grid_points)) {
     if (s.cancelled && s.cancelled()) {
       a.reason = "cancelled after " + std::to_string(a.evaluated) + " speeds";
       return a;
     }
     const auto [set, gain] = request.controller_at ? request.controller_at(c.rpm) : std::pair{request.set, request.gain_ns_per_m};
-    const LiveLimits l = stability.compute(c.rpm, set, gain);
+    const LiveLimits l = stability.compute(c.rpm, set, gain, request.pose_deg);
     ++a.evaluated;
     if (request.damped && !l.damped_valid) continue;  // the loop itself unstable there
     const double limit = limit_of(l);

@@ -40,6 +40,7 @@ struct SpeedAdviceRequest {
   bool damped{true};            // the damper active: the damped limits apply, else the open ones
   double chatter_hz{0.0};       // measured (the chatter indicator's strongest line); 0: none measured
   std::string trigger;          // "chatter", or "depth above the limit"
+  std::vector<double> pose_deg; // the robot's joints (a pose-scheduled cell): every candidate checked at that pose
 };
 
 struct SpeedCandidate {

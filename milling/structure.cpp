@@ -17,6 +17,22 @@ void add_resonances(std::vector<Resonance>& out, const config::FrfConfig& frf) {
 
 }  // namespace
 
+config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis, const std::string& source) {
+  config::StructureConfig st;
+  st.name = "robot_at_pose";
+  for (const auto& part : s.parts)
+    if (!part.pose && !part.controller) st.parts.push_back(part);
+  config::StructurePartConfig robot;
+  robot.name = "robot";
+  config::ControllerPartConfig c;
+  c.config_path = source;
+  c.location = location;
+  c.direction = axis == 0 ? config::Axis::kX : config::Axis::kY;
+  robot.controller = c;
+  st.parts.push_back(robot);
+  return st;
+}
+
 Structure::Structure(std::array<std::vector<config::ModeConfig>, 4> modes, std::string name) : name_(std::move(name)) {
   for (std::size_t k = 0; k < 4; ++k) {
     modal_[k].modes = std::move(modes[k]);

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "analysis/loop_model.hpp"
+#include "config/config.hpp"
 #include "config/milling_config.hpp"
 #include "robot/planar_chain.hpp"
 
@@ -94,5 +95,14 @@ class Structure {
   void add_controller(const std::string& part, const std::string& source, const config::ControllerPartConfig& pc,
                       std::shared_ptr<const analysis::LoopModel> model, double gain_ns_per_m, int polarity);
 };
+
+// The structure with its robot replaced by the robot a pose-scheduled cell damps (docs/pose_dynamics.md, "Tuning
+// across the workspace" and "Live stability at the pose"): one part "robot", the cell's loop at the
+// actuator's location along pose_schedule.axis (every location of a pose's set is the TCP), beside the
+// structure's modal parts (a workpiece); its robot pose and controller parts are dropped. The loop's plant at
+// the pose is the caller's (Structure's LiveLoop). location: the actuator's (actuator.location); axis: 0 = x,
+// 1 = y; source: the cell's configuration file (for messages).
+[[nodiscard]] config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis,
+                                                         const std::string& source);
 
 }  // namespace robodamp::milling

@@ -121,14 +121,20 @@ Status Cell::compose_devices() {
   if (Status s = configure_parameter_sets(); !s.ok()) return s;
   if (cfg_.spindle.job.empty()) return {};
   try {
-    machining_ = std::make_unique<MachiningMonitor>(
-        cfg_, set_configs_, [this] { return supervisor_->running_parameter_set(); },
-        [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
-          if (modbus_)
-            modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
-                                    r.advice.found ? r.advice.options.front().margin : 0.0);
-        },
-        [this] { return modbus_ ? modbus_->robot_depth_mm() : std::nan(""); });
+    MachiningInputs in;
+    in.active_set = [this] { return supervisor_->running_parameter_set(); };
+    in.on_advice = [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
+      if (modbus_)
+        modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
+                                r.advice.found ? r.advice.options.front().margin : 0.0);
+    };
+    in.robot_depth_mm = [this] { return modbus_ ? modbus_->robot_depth_mm() : std::nan(""); };
+    if (cfg_.pose_schedule) {
+      in.pose = milling::PoseDynamics{cfg_.pose_schedule->model_resolved, pose_schedule_.model, cfg_.pose_schedule->axis,
+                                      cfg_.pose_schedule->modes};
+      in.pose_deg = [this] { return robot_pose_deg(); };
+    }
+    machining_ = std::make_unique<MachiningMonitor>(cfg_, set_configs_, std::move(in));
   } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
     return {StatusKind::kConfigError, std::string("spindle.job: ") + e.what()};
   }
@@ -221,6 +227,15 @@ void Cell::configure_pose_sets() {
     supervisor_->add_parameter_set({with_notch_speed_map(r.config, m.chain().params), true, r.k_max_ns_per_m,
                                     delay_margin_s(m, r.config, r.k_max_ns_per_m)});
   }
+}
+
+std::vector<double> Cell::robot_pose_deg() const {
+  std::vector<double> q = o_.pose_deg;  // the simulated robot stands there
+  if (joint_pose_) q = joint_pose_->joints_deg();
+  else if (modbus_ && cfg_.modbus->robot.joints_register >= 0) q = modbus_->client().joints_deg();
+  for (const double v : q)
+    if (!std::isfinite(v)) return {};  // a joint not available: the pose is not known
+  return q;
 }
 
 void Cell::post_pose_region(std::optional<std::size_t> region) {
@@ -432,6 +447,7 @@ void Cell::finish_summary() {
   if (machining_) {
     s.machining = machining_->settled_sample(kMachiningSummaryWaitS);
     s.advice = machining_->advice();
+    s.limits_trail = machining_->trail();
   }
 }
 

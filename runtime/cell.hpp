@@ -130,6 +130,9 @@ class Cell {
   Status configure_pose_schedule();  // before the supervisor: region 0's set becomes set 0
   void configure_pose_sets();        // after it: regions 1.. as sets 1..
   void post_pose_region(std::optional<std::size_t> region);
+  // The robot's joints now (any thread): the DDS joint states, else the Modbus joint registers, else the
+  // simulated robot's --pose; empty while not known.
+  [[nodiscard]] std::vector<double> robot_pose_deg() const;
   std::vector<Component*> components();
   void on_frame(const rt::TelemetryFrame& f);
   void finish_summary();

@@ -34,6 +34,7 @@ void JointStatePose::on_message(const std::vector<std::string>& names, const std
     if (problem != last_problem_)  // once per kind of problem, not 50 times a second
       spdlog::warn("dds joint states on {}: a message with {} (dds.joint_states.names): the pose is unknown", cfg_.topic, problem);
     last_problem_ = problem;
+    joints_deg_.clear();
     settling_.restart();
     if (settling_.settled(-1, 1)) report(-1);
     return;
@@ -49,6 +50,7 @@ void JointStatePose::check(Clock::time_point now) {
   std::lock_guard lock(m_);
   if (!heard_ || lost_ || now - last_ < std::chrono::duration<double>(cfg_.timeout_s)) return;
   lost_ = true;
+  joints_deg_.clear();
   ++n_.losses;
   spdlog::warn("dds joint states on {}: none for {} s: the pose is unknown", cfg_.topic, cfg_.timeout_s);
   settling_.restart();

@@ -40,7 +40,8 @@ class JointStatePose {
   // The silence check (any thread, periodically).
   void check(Clock::time_point now = Clock::now());
 
-  [[nodiscard]] std::vector<double> joints_deg() const;  // the last accepted pose (empty before one)
+  // The last accepted pose; empty before one and while the pose is unknown (a refused message, a silence).
+  [[nodiscard]] std::vector<double> joints_deg() const;
   [[nodiscard]] JointStateCounters counters() const;
 
  private:

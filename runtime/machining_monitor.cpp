@@ -30,12 +30,9 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 
 }  // namespace
 
-MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets,
-                                   std::function<std::size_t()> active_set,
-                                   std::function<void(const AdviceRecord&)> on_advice,
-                                   std::function<double()> robot_depth_mm)
-    : teeth_(cfg.spindle.teeth), active_set_(std::move(active_set)), robot_depth_mm_(std::move(robot_depth_mm)),
-      chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
+MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, MachiningInputs in)
+    : teeth_(cfg.spindle.teeth), active_set_(std::move(in.active_set)), robot_depth_mm_(std::move(in.robot_depth_mm)),
+      pose_deg_(std::move(in.pose_deg)), chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
   set_configs_ = sets;
   config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
   if (job.tool.teeth != cfg.spindle.teeth)
@@ -45,8 +42,11 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
                                                    std::to_string(job.tool.teeth)}});
   const double rpm_min = job.lobes.rpm_min, rpm_max = std::min(job.lobes.rpm_max, cfg.spindle.rpm_max);
   for (int i = 0; i <= kLobeSpeeds; ++i) lobe_rpm_.push_back(rpm_min + (rpm_max - rpm_min) * i / kLobeSpeeds);
-  stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets));
-  advisor_ = std::make_unique<SpeedAdvisor>(*stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(on_advice));
+  milling::LiveStabilitySettings ls;
+  ls.pose_step_deg = cfg.spindle.pose_step_deg;
+  stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets), ls,
+                                                        std::move(in.pose));
+  advisor_ = std::make_unique<SpeedAdvisor>(*stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(in.on_advice));
 }
 
 void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
@@ -105,6 +105,35 @@ std::pair<std::size_t, double> MachiningMonitor::set_and_gain() {
   return {set, active ? last_.gain_ns_per_m : config::scheduled_gain_ns_per_m(set_configs_[set], set, rpm_)};
 }
 
+std::vector<double> MachiningMonitor::pose_now() const {
+  return pose_deg_ && stability_->pose_dependent() ? pose_deg_() : std::vector<double>{};
+}
+
+void MachiningMonitor::add_to_trail(double time_s, std::size_t set, double gain, const milling::LiveLimits& l) {
+  std::lock_guard<std::mutex> lock(m_);
+  const bool same = latest_ && latest_->set == set && latest_->gain_ns_per_m == gain && latest_->limits.rpm == l.rpm &&
+                    latest_->limits.pose_deg == l.pose_deg;
+  latest_ = milling::LiveLimitsRecord{time_s, set, gain, l};
+  if (same || trail_.size() >= kTrailEntries) return;
+  trail_.push_back(*latest_);
+  spdlog::info("machining: at pose {}, {:.0f} rpm, set {}, K {:.0f} N s/m: limit open {:.3f} mm ({}), damped {:.3f} mm ({}){}{}",
+               l.pose_deg.empty() ? std::string("not known (the set's own plant)") : config::describe_pose(l.pose_deg),
+               l.rpm, set, gain, l.open_mm, l.open_method, l.damped_mm, l.method, l.problem.empty() ? "" : ": ", l.problem);
+}
+
+std::optional<milling::LiveLimits> MachiningMonitor::moved_from(double rpm, std::size_t set, double gain) const {
+  std::lock_guard<std::mutex> lock(m_);
+  if (!latest_) return std::nullopt;
+  const milling::LiveLimitsRecord& last = *latest_;
+  if (last.set != set || std::abs(last.gain_ns_per_m - gain) > 5.0 || std::abs(last.limits.rpm - rpm) > 0.5) return std::nullopt;
+  return last.limits;
+}
+
+std::vector<milling::LiveLimitsRecord> MachiningMonitor::trail() const {
+  std::lock_guard<std::mutex> lock(m_);
+  return trail_;
+}
+
 AdviceView MachiningMonitor::view() {
   AdviceView v;
   dds::MachiningSample& s = v.sample;
@@ -129,15 +158,24 @@ AdviceView MachiningMonitor::view() {
   s.depth_mm = s.depth_measured ? robot_depth : stability_->depth_mm();  // the robot's 0: the tool is out of the cut
   const Cutting cutting = cutting_state(s.spindle_rpm, s.depth_measured, s.depth_mm, c);
   s.cutting = cutting.state, s.cutting_reason = cutting.reason;
-  if (s.spindle_rpm > 0.0)
-    if (const auto l = stability_->lookup(s.spindle_rpm, set, gain)) {
-      s.limits_ready = true;
+  s.pose_deg = pose_now();
+  s.limits_pose_deg = stability_->grid_pose(s.pose_deg);
+  if (s.spindle_rpm > 0.0) {
+    auto l = stability_->lookup(s.spindle_rpm, set, gain, s.pose_deg);
+    s.limits_ready = l.has_value();
+    if (l && stability_->pose_dependent()) add_to_trail(s.time_s, set, gain, *l);
+    // The robot moved on to a grid point not computed yet: the limits at the last pose, for the same speed,
+    // set and K, with that pose (limits_ready false says they are being recomputed).
+    if (!l) l = moved_from(s.spindle_rpm, set, gain);
+    if (l) {
+      s.limits_pose_deg = l->pose_deg;
       s.open_limit_mm = l->open_mm;
       s.damped_limit_mm = l->damped_mm;
       s.limit_method = l->method;
       s.limit_mm = s.loop_active ? l->damped_mm : l->open_mm;
       s.depth_warning = s.depth_mm > s.limit_mm;
     }
+  }
   v.parameter_set = set;
   v.gain_ns_per_m = gain;
   if (set_configs_[set].controller.speed_schedule)  // the set and K the schedule runs at each candidate speed
@@ -156,7 +194,7 @@ std::optional<dds::LobesSample> MachiningMonitor::scheduled_lobes(std::size_t ac
   for (const double rpm : lobe_rpm_) {
     std::size_t at = config::scheduled_set(set_configs_[active], active, rpm);
     if (at >= set_configs_.size()) at = 0;
-    points.push_back({rpm, at, config::scheduled_gain_ns_per_m(set_configs_[at], at, rpm)});
+    points.push_back({rpm, at, config::scheduled_gain_ns_per_m(set_configs_[at], at, rpm), lobes_pose_});
   }
   if (!lobes_swept_) stability_->sweep(points), lobes_swept_ = true;
   const std::vector<milling::LiveLimits> known = stability_->known(points);
@@ -168,6 +206,7 @@ std::optional<dds::LobesSample> MachiningMonitor::scheduled_lobes(std::size_t ac
     out.time_s = last_.time_s;
   }
   out.speed_scheduled = true;
+  out.pose_deg = lobes_pose_;
   out.depth_mm = stability_->depth_mm();
   for (const auto& l : known) {
     out.rpm.push_back(l.rpm);
@@ -180,21 +219,23 @@ std::optional<dds::LobesSample> MachiningMonitor::scheduled_lobes(std::size_t ac
 
 std::optional<dds::LobesSample> MachiningMonitor::lobes() {
   const auto [set, gain] = set_and_gain();
+  const std::vector<double> pose = stability_->grid_pose(pose_now());
   if (set_configs_[set].controller.speed_schedule) {
     // The envelope depends on the schedule, not on the K passing now (a schedule of K alone: on the set).
     const bool chooses = !set_configs_[set].controller.speed_schedule->controllers.empty();
     const std::size_t owner = chooses ? 0 : set;
-    if (!lobes_scheduled_ || owner != lobes_set_) lobes_scheduled_ = true, lobes_set_ = owner, lobes_swept_ = false, lobes_published_ = 0;
+    if (!lobes_scheduled_ || owner != lobes_set_ || pose != lobes_pose_)
+      lobes_scheduled_ = true, lobes_set_ = owner, lobes_pose_ = pose, lobes_swept_ = false, lobes_published_ = 0;
     return scheduled_lobes(owner);
   }
   lobes_scheduled_ = false;
-  if (set != lobes_set_ || gain != lobes_gain_) {  // a new state, or a ramp: wait for it to hold
-    lobes_set_ = set, lobes_gain_ = gain;
+  if (set != lobes_set_ || gain != lobes_gain_ || pose != lobes_pose_) {  // a new state, a ramp, a move: wait for it to hold
+    lobes_set_ = set, lobes_gain_ = gain, lobes_pose_ = pose;
     lobes_swept_ = false, lobes_published_ = 0;
     return std::nullopt;
   }
-  if (!lobes_swept_) stability_->sweep(set, gain, lobe_rpm_), lobes_swept_ = true;
-  const std::vector<milling::LiveLimits> known = stability_->known(set, gain);
+  if (!lobes_swept_) stability_->sweep(set, gain, lobe_rpm_, pose), lobes_swept_ = true;
+  const std::vector<milling::LiveLimits> known = stability_->known(set, gain, pose);
   if (known.size() == lobes_published_) return std::nullopt;
   lobes_published_ = known.size();
   dds::LobesSample out;
@@ -204,6 +245,7 @@ std::optional<dds::LobesSample> MachiningMonitor::lobes() {
   }
   out.parameter_set = set;
   out.gain_ns_per_m = gain;
+  out.pose_deg = pose;
   out.depth_mm = stability_->depth_mm();
   for (const auto& l : known) {
     out.rpm.push_back(l.rpm);

@@ -33,15 +33,22 @@ struct Cutting {
 };
 [[nodiscard]] Cutting cutting_state(double spindle_rpm, bool depth_measured, double depth_mm, const milling::ChatterIndicator& c);
 
+// What the monitor reads of the cell (any thread each, all optional but active_set).
+struct MachiningInputs {
+  std::function<std::size_t()> active_set;             // the supervisor's running set
+  std::function<void(const AdviceRecord&)> on_advice;  // each new spindle-speed advice, on the advisor's thread
+  std::function<double()> robot_depth_mm;              // the robot's depth (0: out of the cut; NaN: the job's)
+  // A pose-scheduled cell: the robot's joints now (empty: not known) and the model its sets are designed on;
+  // the limits, the live lobes and the advice are then for the robot at that pose (milling::PoseDynamics).
+  std::function<std::vector<double>()> pose_deg;
+  std::optional<milling::PoseDynamics> pose;
+};
+
 class MachiningMonitor {
  public:
   // cfg: the cell's configuration (spindle.job names the job); sets: every parameter set's configuration
-  // (index 0 = cfg); active_set: the supervisor's active set (any thread). Throws config::ConfigError
-  // when the job cannot be read or does not fit.
-  // on_advice: each new spindle-speed advice, on the advisor's thread (optional). robot_depth_mm: the
-  // depth the robot reports cutting (any thread; 0: out of the cut; NaN or absent: the job's cut.axial_mm).
-  MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, std::function<std::size_t()> active_set,
-                   std::function<void(const AdviceRecord&)> on_advice = {}, std::function<double()> robot_depth_mm = {});
+  // (index 0 = cfg). Throws config::ConfigError when the job cannot be read or does not fit.
+  MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, MachiningInputs in);
 
   // The drain thread, every frame.
   void on_frame(const rt::TelemetryFrame& f);
@@ -54,6 +61,10 @@ class MachiningMonitor {
   // (a sweep over the job's speed range is asked for on the first call with a settled gain), when more
   // speeds are known than were last returned.
   [[nodiscard]] std::optional<dds::LobesSample> lobes();
+  // Any thread: a pose-scheduled cell's limits at each new state met (pose grid point, speed, set, gain), in
+  // order, the first kTrailEntries (each also logged, one line).
+  [[nodiscard]] std::vector<milling::LiveLimitsRecord> trail() const;
+  static constexpr std::size_t kTrailEntries = 64;
   // Any thread: the latest spindle-speed advice (runtime/speed_advisor.hpp), if any was asked for.
   [[nodiscard]] std::optional<AdviceRecord> advice() const { return advisor_->latest(); }
 
@@ -61,13 +72,20 @@ class MachiningMonitor {
   [[nodiscard]] std::optional<dds::LobesSample> scheduled_lobes(std::size_t active);
   [[nodiscard]] AdviceView view();
   [[nodiscard]] std::pair<std::size_t, double> set_and_gain();  // the active set and the gain its limits are for
+  [[nodiscard]] std::vector<double> pose_now() const;            // the robot's joints (empty: not known, no pose)
   void log_chatter(const milling::ChatterIndicator& c);
+  void add_to_trail(double time_s, std::size_t set, double gain, const milling::LiveLimits& l);
+  // The last limits found when they are for this speed, set and K (at another pose).
+  [[nodiscard]] std::optional<milling::LiveLimits> moved_from(double rpm, std::size_t set, double gain) const;
   int teeth_;
   std::vector<config::Config> set_configs_;  // every parameter set's configuration (their K by speed)
   std::function<std::size_t()> active_set_;
   std::function<double()> robot_depth_mm_;
+  std::function<std::vector<double>()> pose_deg_;
   std::unique_ptr<milling::LiveStability> stability_;
-  std::mutex m_;
+  mutable std::mutex m_;
+  std::vector<milling::LiveLimitsRecord> trail_;  // guarded by m_
+  std::optional<milling::LiveLimitsRecord> latest_;  // the last limits found at a pose (guarded by m_)
   milling::ChatterMonitor chatter_;
   bool chatter_logged_{false};  // the last verdict logged
   double next_chatter_log_s_{0.0};
@@ -76,6 +94,7 @@ class MachiningMonitor {
   std::vector<double> lobe_rpm_;  // the sweep's speeds
   std::size_t lobes_set_{0};       // the status thread's
   double lobes_gain_{-1.0};
+  std::vector<double> lobes_pose_;  // on the stability's grid
   bool lobes_swept_{false};
   bool lobes_scheduled_{false};    // the last lobes were a speed schedule's envelope
   std::size_t lobes_published_{0};

@@ -76,6 +76,7 @@ struct RunSummary {
   double gain_ns_per_m{0.0};       // K asked for at the end (the schedule's, a request's or the configured)
   std::optional<dds::MachiningSample> machining;  // spindle.job: speed, depth, limits, indicator at the end
   std::optional<AdviceRecord> advice;             // spindle.job: the latest spindle-speed advice, if one was asked for
+  std::vector<milling::LiveLimitsRecord> limits_trail;  // spindle.job with pose_schedule: the limits at each pose met
 
   // The arming policy gave up, or the run ended before the loop was ever active while arming was wanted.
   [[nodiscard]] bool never_armed() const {

@@ -14,7 +14,7 @@ namespace {
 // The state an advice is for: the same one is not advised twice in a row.
 auto state_key(const milling::SpeedAdviceRequest& r) {
   return std::make_tuple(std::lround(r.rpm), std::lround(r.depth_mm * 1e3), r.set, std::lround(r.gain_ns_per_m / 10.0),
-                         r.damped, r.trigger);
+                         r.damped, r.trigger, r.pose_deg);
 }
 
 }  // namespace
@@ -43,6 +43,7 @@ dds::AdviceSample to_sample(const AdviceRecord& r) {
   s.reason = a.reason;
   s.rpm_min = a.rpm_min;
   s.rpm_max = a.rpm_max;
+  s.pose_deg = a.request.pose_deg;
   return s;
 }
 
@@ -90,6 +91,7 @@ std::optional<milling::SpeedAdviceRequest> SpeedAdvisor::wanted(const AdviceView
   r.gain_ns_per_m = v.gain_ns_per_m;
   r.controller_at = v.controller_at;
   r.damped = m.loop_active;
+  r.pose_deg = m.limits_pose_deg;
   return r;
 }
 

@@ -14,7 +14,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/pose_schedule.hpp"
 #include "child_process.hpp"
+#include "config/config.hpp"
+#include "config/milling_config.hpp"
+#include "milling/live_stability.hpp"
 #include "hil_files.hpp"
 #include "rt/recording.hpp"
 #include "rt/supervisor.hpp"
@@ -52,6 +56,37 @@ Exits run_along_path(const HilFiles& f, const std::string& plant_config, const s
   return e;
 }
 
+// The run's limits along the path (the summary's limits_along_path): at each dwell's pose, with the set and K
+// that run there, the in-process live stability's limits; the summary's last limits at the stretched pose.
+void live_limits_followed_the_pose(const std::string& config_path, const json& run, const std::string& log) {
+  const config::Config cfg = config::load_config_file(config_path);
+  const analysis::PoseScheduleAnalysis schedule = analysis::analyse_pose_schedule(cfg);
+  std::vector<config::Config> sets;
+  for (const auto& r : schedule.regions) sets.push_back(r.config);
+  milling::LiveStability live(config::load_milling_config(cfg.spindle.job_resolved), "", sets, {},
+                              milling::PoseDynamics{cfg.pose_schedule->model_resolved, schedule.model, cfg.pose_schedule->axis,
+                                                    cfg.pose_schedule->modes});
+  ASSERT_TRUE(run.contains("limits_along_path")) << run.dump();
+  const json& trail = run["limits_along_path"];
+  std::cout << "limits along the path: " << trail.size() << " states\n";
+  for (const auto& [region, pose] : {std::pair<std::size_t, std::vector<double>>{0, {-100.0, 10.0, 90.0}}, {1, {-100.0, 100.0, 90.0}}}) {
+    const double k = schedule.regions[region].gain_ns_per_m;
+    const auto at = std::find_if(trail.begin(), trail.end(), [&](const json& e) {
+      return e["pose_deg"].get<std::vector<double>>() == pose && e["parameter_set"] == region &&
+             std::abs(e["gain_ns_per_m"].get<double>() - k) < 5.0;
+    });
+    ASSERT_NE(at, trail.end()) << "no limits at " << config::describe_pose(pose) << " with set " << region << ": " << trail.dump();
+    const milling::LiveLimits l = live.compute(700.0, region, k, pose);
+    std::cout << config::describe_pose(pose) << ", set " << region << ": open " << (*at)["open_limit_mm"] << " mm, damped "
+              << (*at)["damped_limit_mm"] << " mm in the run; " << l.open_mm << " / " << l.damped_mm << " mm in process\n";
+    EXPECT_NEAR((*at)["open_limit_mm"].get<double>(), l.open_mm, 1e-9 * l.open_mm);
+    EXPECT_NEAR((*at)["damped_limit_mm"].get<double>(), l.damped_mm, 1e-9 * l.damped_mm);
+    EXPECT_NE(log.find("machining: at pose " + config::describe_pose(pose)), std::string::npos) << "the log does not say it";
+  }
+  EXPECT_EQ(run["machining"]["limits_pose_deg"].get<std::vector<double>>(), (std::vector<double>{-100.0, 100.0, 90.0}));
+  EXPECT_EQ(run["machining"]["pose_deg"].get<std::vector<double>>(), (std::vector<double>{-100.0, 100.0, 90.0}));
+}
+
 // The robot (the planar-robot study's model, config/hil_pose_schedule.yaml) dwells folded (joint 2 at 10 deg), moves
 // over 6 s to stretched (100 deg) and dwells there; its dominant mode along the actuator moves from 9.2
 // to 19.8 Hz. The controller in the other process reads the joint registers and hands over from the
@@ -59,16 +94,25 @@ Exits run_along_path(const HilFiles& f, const std::string& plant_config, const s
 // impacts, stays within 10 % of the analysis at that pose; the hand-over's largest command step is no
 // larger than twice the largest in the second before it (a swap without the fade jumps by the whole
 // command). With scheduling off, the folded set runs on at the stretched pose and the loop trips safely.
+// Scheduled, the robot's spindle turns at 700 rpm and the cell knows its job (spindle.job, the planar robot's
+// wall cut): the live limits follow the robot (docs/pose_dynamics.md, "Live stability at the pose"), the
+// same at each dwell as the in-process live stability gives at that pose with the set and K that run there.
 TEST(Hil, PoseTrajectoryHandsOverBetweenRegionsAndSchedulingOffTrips) {
   const std::vector<std::string> trajectory{"--pose-at", "0:-100,10,90",  "--pose-at", "22:-100,10,90",
-                                            "--pose-at", "28:-100,100,90", "--pose-at", "50:-100,100,90"};
+                                      "--pose-at", "28:-100,100,90", "--pose-at", "50:-100,100,90"};
+  const std::vector<std::pair<std::string, std::string>> job{
+      {"    joints_register: 10", "    spindle_rpm_register: 1\n    rpm_per_count: 10\n    joints_register: 10"},
+      {"\npose_schedule:\n", "\nspindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) +
+                                 "/config/milling/planar_three_link_wall_x.yaml\npose_schedule:\n"}};
   std::map<std::string, json> plant, run;
-  std::string record;
+  std::string record, config_on, log_on;
   for (const std::string mode : {"on", "off"}) {
-    const HilFiles f = hil_files("pose_" + mode, {}, "hil_pose_schedule");
+    const HilFiles f = hil_files("pose_" + mode, mode == "on" ? job : decltype(job){}, "hil_pose_schedule");
     std::vector<std::string> extra{"--no-pose-schedule"};
-    if (mode == "on") record = f.dir + "/run.rec", extra = {"--record", record};
-    const Exits e = run_along_path(f, f.config, f.config, trajectory, "50", extra);
+    if (mode == "on") record = f.dir + "/run.rec", extra = {"--record", record}, config_on = f.config, log_on = f.run_log;
+    std::vector<std::string> path = trajectory;
+    if (mode == "on") path.insert(path.end(), {"--spindle", "0:700"});
+    const Exits e = run_along_path(f, f.config, f.config, path, "50", extra);
     ASSERT_EQ(e.plant, 0) << test::read_file(f.plant_log);
     ASSERT_EQ(e.run, mode == "on" ? 0 : 4) << test::read_file(f.run_log);
     plant[mode] = read_json(f.plant_json);
@@ -128,6 +172,7 @@ TEST(Hil, PoseTrajectoryHandsOverBetweenRegionsAndSchedulingOffTrips) {
   EXPECT_EQ(off["final_state"], "fault");
   EXPECT_LE(off["trip_timing"]["ticks_to_safe"].get<int>(), 100);
   EXPECT_EQ(off["supervisor"]["pose_regions"], 0);
+  live_limits_followed_the_pose(config_on, on, test::read_file(log_on));
 }
 
 // The schedule `robodamp pose tune` drew and tuned for the planar robot (config/hil_pose_tuned.yaml, its

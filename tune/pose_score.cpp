@@ -9,6 +9,7 @@
 #include "analysis/loop_model.hpp"
 #include "analysis/mode_improvement.hpp"
 #include "analysis/pose_schedule.hpp"
+#include "milling/structure.hpp"
 
 namespace robodamp::tune {
 
@@ -20,18 +21,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // actuator's axis (the Evaluator's live loop), beside the structure's modal parts (a workpiece).
 config::MillingConfig job_at_poses(const config::MillingConfig& job, const config::Config& cell) {
   config::MillingConfig out = job;
-  config::StructureConfig st;
-  st.name = "robot_at_pose";
-  for (const auto& part : job.selected_structure().parts)
-    if (!part.pose && !part.controller) st.parts.push_back(part);
-  config::StructurePartConfig robot;
-  robot.name = "robot";
-  config::ControllerPartConfig c;
-  c.config_path = cell.source;
-  c.location = cell.actuator.location;
-  c.direction = cell.pose_schedule->axis == 0 ? config::Axis::kX : config::Axis::kY;
-  robot.controller = c;
-  st.parts.push_back(robot);
+  const config::StructureConfig st = milling::robot_through_cell(job.selected_structure(), cell.actuator.location,
+                                                                    cell.pose_schedule->axis, cell.source);
   out.structures = {st};
   out.structure = st.name;
   return out;

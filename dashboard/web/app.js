@@ -179,6 +179,9 @@ $('confirm-yes').addEventListener('click', () => {
 });
 $('confirm-no').addEventListener('click', () => cancelPending('cancelled'));
 
+// A pose as the cell's log writes it: "[-100, 10, 90] deg".
+function poseText(q) { return '[' + q.map((v) => fmt(v, 1)).join(', ') + '] deg'; }
+
 // A tile's class, data attributes (what the browser tests read) and inner HTML.
 function tile(c) {
   const m = c.machining || {};
@@ -212,6 +215,8 @@ function tile(c) {
           : ' <span class="chatter" data-field="plan-above">the job\'s planned depth is above the limit here</span>') : '') +
         (m.depth_measured ? '' : ' <span class="note" data-field="depth-source">(the job\'s plan: the robot reports no depth)</span>') +
         '<div class="bar' + (m.depth_warning && !idle ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
+      (m.limits_pose_deg && m.limits_pose_deg.length ? '<dt>pose</dt><dd data-field="pose">' + poseText(m.limits_pose_deg) +
+        (m.limits_ready ? ': the limit is for this pose' : ' <span class="note">(recomputing: the robot moved)</span>') + '</dd>' : '') +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
       (c.advice ? '<dt>advice</dt><dd>' + (!c.advice.found ? 'no stable speed in range'
         : Math.abs((m.spindle_rpm || 0) - c.advice.advised_rpm) < 0.5 ? 'at the advised ' + fmt(c.advice.advised_rpm, 1) + ' rpm'
@@ -324,11 +329,13 @@ function plotLobes(l, m, a) {
   // The curve is about the state it was computed for: while the cell runs another set or K (a request, a ramp)
   // the note says so until the new sweep arrives; with the damper off the open loop is what applies.
   const s = cellStatus;
+  const moved = m && l.pose_deg && l.pose_deg.length && JSON.stringify(m.limits_pose_deg || []) !== JSON.stringify(l.pose_deg);
   const other = s && !l.speed_scheduled && (s.parameter_set !== l.parameter_set || Math.abs(s.gain_ns_per_m - l.gain_ns_per_m) > 0.5);
   const off = s && s.state !== 'active';
   $('lobes-note').textContent = (other ? 'recomputing for set ' + s.parameter_set + ', K = ' + fmt(s.gain_ns_per_m, 0) + ' N s/m; shown: ' : '') +
     l.method + (l.speed_scheduled ? ' (each speed with its band\'s controller and K; K = 0 where the damper is worse than none)'
     : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds' +
+    (l.pose_deg && l.pose_deg.length ? ', the robot at ' + poseText(l.pose_deg) + (moved ? ' (it has moved: recomputing)' : '') : '') +
     (off ? '; the damper is ' + s.state + ': the open loop applies' : '');
   // An advice the spindle has followed is not an instruction any more: said as done (the tile does the same).
   const followed = a && a.found && m && Math.abs((m.spindle_rpm || 0) - a.advised_rpm) < 0.5;
@@ -337,7 +344,7 @@ function plotLobes(l, m, a) {
       fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method)) : 'no advice asked for';
   $('advice').dataset.followed = followed ? 'true' : 'false';
   window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, operating_label: now, advised: options.length,
-    gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off,
+    gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off, pose_deg: l.pose_deg || [], pose_moved: !!moved,
     scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
       l.damped_limit_mm[i] < 0.995 * l.open_limit_mm[i]).length };
   window.robodamp.updates.lobes++;
@@ -422,7 +429,8 @@ function renderCell() {
     // redrawn when what it shows changes, not only when new lobes come: a followed advice says so at once.
     const m = d.machining || {}, s = cellStatus || {};
     const drawn = JSON.stringify([cellLobes && cellLobes.rpm ? cellLobes.rpm.length : 0, cellLobes && cellLobes.gain_ns_per_m,
-      m.spindle_rpm, m.depth_mm, m.cutting, d.advice && d.advice.seq, s.state, s.parameter_set, s.gain_ns_per_m]);
+      m.spindle_rpm, m.depth_mm, m.cutting, d.advice && d.advice.seq, s.state, s.parameter_set, s.gain_ns_per_m,
+      m.limits_pose_deg, cellLobes && cellLobes.pose_deg]);
     if (d.spectrum !== undefined || drawn !== lobesDrawn) { lobesDrawn = drawn; plotLobes(cellLobes, d.machining, d.advice); }
     plotTiming(d.status);
     renderCounters(d);
