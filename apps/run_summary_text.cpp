@@ -386,7 +386,9 @@ std::string summary_text(const runtime::RunSummary& s) {
       std::snprintf(b, sizeof b, "    %8.2f s  %-24s %6.0f rpm  set %zu  K %5.0f N s/m: open %.3f mm, damped %.3f mm%s\n", r.time_s,
                     r.limits.pose_deg.empty() ? "pose not known" : config::describe_pose(r.limits.pose_deg).c_str(), r.limits.rpm,
                     r.set, r.gain_ns_per_m, r.limits.open_mm, r.limits.damped_mm,
-                    r.limits.axis_verified ? "" : " (the damped model is not verified here: not claimed)");
+                    !r.limits.damped_valid    ? " (the loop is unstable here)"
+                    : r.limits.axis_verified ? ""
+                                             : " (the damped model is not verified here: not claimed)");
       os << b;
     }
   }

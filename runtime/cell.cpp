@@ -201,25 +201,6 @@ Status Cell::configure_devices() {
   return {};
 }
 
-Status Cell::configure_pose_schedule() {
-  pose_schedule_ = {};
-  if (!cfg_.pose_schedule) return {};
-  try {
-    pose_schedule_ = analysis::analyse_pose_schedule(cfg_);
-    for (const auto& r : pose_schedule_.regions)
-      spdlog::info("pose region '{}': matched at {:.2f} Hz (dominant mode {:.2f}-{:.2f} Hz over {} poses), K = {} N s/m, "
-                   "polarity {}, K_max {:.0f} N s/m",
-                   r.name, r.dominant_hz, r.dominant_min_hz, r.dominant_max_hz, r.grid_poses, r.gain_ns_per_m, r.polarity,
-                   r.k_max_ns_per_m);
-    if (!o_.pose_deg.empty())
-      if (auto p = config::pose_problem(pose_schedule_.model, o_.pose_deg))
-        throw config::ConfigError({config::Problem{cfg_.source, {}, "--pose", *p}});
-  } catch (const config::ConfigError& e) {
-    return {StatusKind::kConfigError, e.what()};
-  }
-  return {};
-}
-
 void Cell::configure_pose_sets() {
   for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i) {
     const auto& r = pose_schedule_.regions[i];
@@ -227,21 +208,6 @@ void Cell::configure_pose_sets() {
     supervisor_->add_parameter_set({with_notch_speed_map(r.config, m.chain().params), true, r.k_max_ns_per_m,
                                     delay_margin_s(m, r.config, r.k_max_ns_per_m)});
   }
-}
-
-std::vector<double> Cell::robot_pose_deg() const {
-  std::vector<double> q = o_.pose_deg;  // the simulated robot stands there
-  if (joint_pose_) q = joint_pose_->joints_deg();
-  else if (modbus_ && cfg_.modbus->robot.joints_register >= 0) q = modbus_->client().joints_deg();
-  for (const double v : q)
-    if (!std::isfinite(v)) return {};  // a joint not available: the pose is not known
-  return q;
-}
-
-void Cell::post_pose_region(std::optional<std::size_t> region) {
-  const double set = region ? static_cast<double>(*region) : -1.0;
-  if (!loop_->post({rt::CommandKind::kSetPoseRegion, set}))
-    spdlog::warn("the robot's pose moved: the command queue is full, dropped");
 }
 
 Status Cell::configure_parameter_sets() {

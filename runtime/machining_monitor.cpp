@@ -118,7 +118,8 @@ void MachiningMonitor::add_to_trail(double time_s, std::size_t set, double gain,
   trail_.push_back(*latest_);
   spdlog::info("machining: at pose {}, {:.0f} rpm, set {}, K {:.0f} N s/m: limit open {:.3f} mm ({}), damped {:.3f} mm ({}){}{}",
                l.pose_deg.empty() ? std::string("not known (the set's own plant)") : config::describe_pose(l.pose_deg),
-               l.rpm, set, gain, l.open_mm, l.open_method, l.damped_mm, l.method, l.problem.empty() ? "" : ": ", l.problem);
+               l.rpm, set, gain, l.open_mm, l.open_method, l.damped_mm, l.method.empty() ? "no damped FRF" : l.method,
+               l.problem.empty() ? "" : ": ", l.problem);
 }
 
 std::optional<milling::LiveLimits> MachiningMonitor::moved_from(double rpm, std::size_t set, double gain) const {

@@ -283,6 +283,44 @@ TEST(DashboardFleet, ARestartedCellsLastRunIsDropped) {
   EXPECT_GE(fleet.counters().cells_restarted, 1U);
 }
 
+// A pose-scheduled cell's machining sample, live lobes and advice carry the robot's pose over DDS to the
+// dashboard's JSON (what the page's pose row and lobes note read).
+TEST(DashboardFleet, ThePoseTheLimitsAreForReachesThePage) {
+  config::DdsConfig cfg = loopback_dds(43);
+  cfg.status_rate_hz = 20.0;
+  dashboard::Fleet fleet(cfg, 1.0);
+  const std::vector<double> now{-100.3, 99.2, 90.1}, grid{-100.0, 100.0, 90.0};
+  dds::MachiningSample m;
+  m.spindle_rpm = 700.0, m.limits_ready = true, m.open_limit_mm = 0.098, m.damped_limit_mm = 0.098;
+  m.pose_deg = now, m.limits_pose_deg = grid;
+  dds::LobesSample l;
+  l.rpm = {600.0, 700.0}, l.open_limit_mm = {0.1, 0.098}, l.damped_limit_mm = {0.1, 0.098}, l.pose_deg = grid;
+  dds::AdviceSample a;
+  a.seq = 1, a.found = true, a.advised_rpm = 650.0, a.pose_deg = grid;
+  dds::Bridge bridge(cfg, 5000.0, "posed.yaml",
+                     {"posed", "simulated plant", [] { return std::size_t{0}; }, [] { return 4000.0; },
+                      [](dds::RequestKind, double) { return dds::Decision{true, "ok"}; }, [m] { return m; },
+                      [a]() mutable { return std::optional(a); }, {}, [l]() mutable { return std::optional(l); }});
+  bridge.start();
+  const auto detail = [&] { return fleet.detail("posed", 0, true).value_or(nlohmann::json::object()); };
+  std::uint64_t tick = 0;
+  ASSERT_TRUE(eventually([&] {
+    for (int i = 0; i < 50; ++i, ++tick) {
+      rt::TelemetryFrame f;
+      f.tick = tick, f.time_s = static_cast<double>(tick) / 5000.0, f.state = static_cast<std::uint8_t>(rt::State::kActive);
+      bridge.on_frame(f);
+    }
+    const auto d = detail();
+    return d.contains("machining") && d["machining"].contains("pose_deg") && d.contains("lobes") && d["lobes"].is_object() &&
+           d.contains("advice") && d["advice"].is_object();
+  }, 60.0)) << detail();
+  const auto d = detail();
+  EXPECT_EQ(d["machining"]["pose_deg"].get<std::vector<double>>(), now);
+  EXPECT_EQ(d["machining"]["limits_pose_deg"].get<std::vector<double>>(), grid);
+  EXPECT_EQ(d["lobes"]["pose_deg"].get<std::vector<double>>(), grid);
+  EXPECT_EQ(d["advice"]["pose_deg"].get<std::vector<double>>(), grid);
+}
+
 // More open pages than dashboard.max_event_streams are refused (503) and counted; a sample whose cell name is
 // not a name is dropped and counted; the server stops with a page still open.
 TEST(DashboardServer, ExtraPagesAndBadCellNamesAreRefusedAndCounted) {
