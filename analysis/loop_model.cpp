@@ -102,15 +102,15 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
   inputs << gamma_late_, gamma_early_, gamma_force_;
   resolvent_ = Resolvent(phi_, inputs, c_accel_);
 
-  open_loop_unit_ = open_loop(std::nullopt);
+  open_loop_unit_ = open_loop({});
 }
 
-DiscreteSs LoopModel::open_loop(std::optional<std::size_t> force_at) const {
-  // Controller output -> (computation delay + actuator delay) -> plant -> sensor -> chain (unit K). With a
-  // force location, the plant keeps the last held force as a state too: the sampled acceleration feels it
-  // directly (the same left limit as the coil drive's, plant_response).
-  DiscreteSs plant;  // input w[k] = coil drive, state [x; w[k-1] (; f[k-1])], output sampled acceleration
-  const Eigen::Index n = phi_.rows(), extra = force_at ? 2 : 1;
+DiscreteSs LoopModel::open_loop(const std::vector<std::size_t>& forces_at) const {
+  // Controller output -> (computation delay + actuator delay) -> plant -> sensor -> chain (unit K). With
+  // force locations, the plant keeps the last held force at each as a state too: the sampled acceleration
+  // feels it directly (the same left limit as the coil drive's, plant_response).
+  DiscreteSs plant;  // input w[k] = coil drive, state [x; w[k-1] (; f_i[k-1] ...)], output sampled acceleration
+  const Eigen::Index n = phi_.rows(), extra = 1 + static_cast<Eigen::Index>(forces_at.size());
   plant.a = MatrixXd::Zero(n + extra, n + extra);
   plant.a.topLeftCorner(n, n) = phi_;
   plant.a.block(0, n, n, 1) = gamma_early_;
@@ -121,7 +121,9 @@ DiscreteSs LoopModel::open_loop(std::optional<std::size_t> force_at) const {
   plant.c.leftCols(n) = c_accel_.row(static_cast<Eigen::Index>(sensor_));
   plant.c(0, n) = d_accel_coil_(static_cast<Eigen::Index>(sensor_), 0);
   plant.d = MatrixXd::Zero(1, 1);
-  if (force_at) plant.c(0, n + 1) = d_accel_force_(static_cast<Eigen::Index>(sensor_), static_cast<Eigen::Index>(*force_at));
+  for (std::size_t i = 0; i < forces_at.size(); ++i)
+    plant.c(0, n + 1 + static_cast<Eigen::Index>(i)) =
+        d_accel_force_(static_cast<Eigen::Index>(sensor_), static_cast<Eigen::Index>(forces_at[i]));
   DiscreteSs sensor;
   if (sensor_model_.has_highpass()) {
     const double g = sensor_model_.highpass_gain(), p = sensor_model_.highpass_pole();
@@ -140,17 +142,26 @@ DiscreteSs LoopModel::open_loop(std::optional<std::size_t> force_at) const {
 }
 
 SampledPath LoopModel::sampled_path(std::size_t location, double gain, int polarity) const {
-  if (location >= plant_.locations.size()) throw std::invalid_argument("LoopModel::sampled_path: no such location");
-  const DiscreteSs o = open_loop(location);
+  const SampledPaths m = sampled_paths({location}, gain, polarity);
+  return {m.a, m.b.col(0), m.c.row(0)};
+}
+
+SampledPaths LoopModel::sampled_paths(const std::vector<std::size_t>& locations, double gain, int polarity) const {
+  for (const std::size_t l : locations)
+    if (l >= plant_.locations.size()) throw std::invalid_argument("LoopModel::sampled_paths: no such location");
+  const DiscreteSs o = open_loop(locations);
   const Eigen::Index n = phi_.rows(), plant_at = 1 + delay_steps_;  // the delay line's states come first
-  const auto h = static_cast<Eigen::Index>(location);
-  SampledPath p;
+  const auto m = static_cast<Eigen::Index>(locations.size());
+  SampledPaths p;
   p.a = o.a + (polarity * gain) * o.b * o.c;
-  p.b = Eigen::VectorXd::Zero(o.a.rows());
-  p.b.segment(plant_at, n) = gamma_force_.col(h);
-  p.b(plant_at + n + 1) = 1.0;
-  p.c = Eigen::RowVectorXd::Zero(o.a.rows());
-  p.c.segment(plant_at, n) = plant_.ss.c.row(static_cast<Eigen::Index>(plant_.output_displacement(location)));
+  p.b = MatrixXd::Zero(o.a.rows(), m);
+  p.c = MatrixXd::Zero(m, o.a.rows());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const std::size_t l = locations[static_cast<std::size_t>(i)];
+    p.b.col(i).segment(plant_at, n) = gamma_force_.col(static_cast<Eigen::Index>(l));
+    p.b(plant_at + n + 1 + i, i) = 1.0;
+    p.c.row(i).segment(plant_at, n) = plant_.ss.c.row(static_cast<Eigen::Index>(plant_.output_displacement(l)));
+  }
   return p;
 }
 

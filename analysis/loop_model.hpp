@@ -35,6 +35,9 @@ struct SampledPath {
   Eigen::VectorXd b;
   Eigen::RowVectorXd c;
 };
+struct SampledPaths {
+  Eigen::MatrixXd a, b, c;
+};
 
 // The plant's discrete transfers at one frequency: sampled acceleration at each location per held
 // coil voltage and per held external force at each location (sample at t_k per input held over [k, k+1)).
@@ -104,6 +107,10 @@ class LoopModel {
   // The loop that runs, closed at gain K and polarity, from a force held over each tick at `location` to
   // the displacement there (milling/sampled_sdm.hpp: the damped cut's semi-discretization).
   [[nodiscard]] SampledPath sampled_path(std::size_t location, double gain_ns_per_m, int polarity) const;
+  // The same from forces held at several locations to the displacements there (b: a column per location,
+  // c: a row): a controller part that acts on the robot in both directions of the plane.
+  [[nodiscard]] SampledPaths sampled_paths(const std::vector<std::size_t>& locations, double gain_ns_per_m,
+                                           int polarity) const;
 
   // Closed-loop state matrix of the discrete loop and its eigenvalues.
   [[nodiscard]] Eigen::MatrixXd closed_loop_matrix(double gain_ns_per_m, int polarity) const;
@@ -130,7 +137,7 @@ class LoopModel {
   Resolvent resolvent_;  // c_accel_ (z I - phi_)^-1 [gamma_late_, gamma_early_, gamma_force_]
   DiscreteSs open_loop_unit_;  // controller output -> controller output at K = 1, polarity +1 (no gain yet)
   // The same, with the last held force at force_at as one more plant state (sampled_path).
-  [[nodiscard]] DiscreteSs open_loop(std::optional<std::size_t> force_at) const;
+  [[nodiscard]] DiscreteSs open_loop(const std::vector<std::size_t>& forces_at) const;
 };
 
 // --- Results -------------------------------------------------------------------------------------

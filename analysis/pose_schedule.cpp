@@ -85,6 +85,36 @@ config::Config config_at_pose(const config::Config& base, const PoseModes& modes
   return c;
 }
 
+config::Config config_in_plane_at_pose(const config::Config& base, const config::RobotModelConfig& model,
+                                      const std::vector<double>& q, int axis, int count) {
+  (void)pose_modes(model, q, axis, count);  // the same refusals (travel, no mode along the axis)
+  const robot::PlanarChain chain = robot::at_pose(model, q);
+  config::Config c = base;
+  c.robot.locations = {{1, "TCP along the actuator", 1}, {2, "TCP across", 1}};
+  c.robot.frfs.clear();
+  const int across = 1 - axis;
+  for (const auto& [name, response, excitation] : {std::tuple{"H11", 1, 1}, std::tuple{"H21", 2, 1}, std::tuple{"H22", 2, 2}}) {
+    config::FrfConfig f;
+    f.name = name;
+    f.response_location = response, f.excitation_location = excitation;
+    for (const robot::Mode& md : chain.modes(static_cast<std::size_t>(count))) {
+      const double shapes = md.tcp_shape(response == 1 ? axis : across) * md.tcp_shape(excitation == 1 ? axis : across);
+      const double w = kTwoPi * md.freq_hz;
+      if (!(std::abs(shapes) > 0.0) || !(w > 0.0)) continue;
+      config::ModeConfig m;
+      m.form = config::ModeForm::kStiffness;
+      m.natural_freq_hz = md.freq_hz;
+      m.damping_ratio = robot::modal_damping_ratio(md);
+      m.stiffness_n_per_m = w * w / shapes;
+      f.modes.push_back(m);
+    }
+    if (!f.modes.empty()) c.robot.frfs.push_back(f);
+  }
+  c.actuator.location = 1;
+  c.sensor.location = 1;
+  return c;
+}
+
 void with_region_compensator(config::Config& set, const config::RegionCompensatorConfig& c) {
   for (config::BlockConfig& b : set.controller.chain) {
     if (b.kind != config::BlockKind::kCompensator) continue;

@@ -36,6 +36,14 @@ struct PoseModes {
 // The middle of the region's box.
 [[nodiscard]] std::vector<double> region_centre(const config::PoseRegionConfig& r);
 
+// base with the robot's table replaced by the model's lowest `count` modes at the pose in its plane: location
+// 1 the TCP along `axis` (the actuator and the sensor there), location 2 the TCP along the other axis, the
+// tables H11, H21 and H22 (modal-stiffness form, mass-normalised TCP shapes; a cross term's stiffness is
+// negative where the shapes' signs differ). Its loop is the 1-D set's (H11 is pose_modes' table); the cut
+// sees the robot in both directions (milling::LiveStability at a pose). Throws as pose_modes.
+[[nodiscard]] config::Config config_in_plane_at_pose(const config::Config& base, const config::RobotModelConfig& model,
+                                                     const std::vector<double>& joints_deg, int axis, int count);
+
 // Every pose of a points^n grid over the region's box (its ends included; points >= 2).
 [[nodiscard]] std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, int points);
 

@@ -208,8 +208,8 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                        {"open_limit_mm", std::isfinite(r.limits.open_mm) ? json(r.limits.open_mm) : json(nullptr)},
                        {"damped_limit_mm", std::isfinite(r.limits.damped_mm) ? json(r.limits.damped_mm) : json(nullptr)},
                        {"method", r.limits.method}, {"problem", r.limits.problem},
-                       {"axis_open_limit_mm", std::isfinite(r.limits.axis_open_mm) ? json(r.limits.axis_open_mm) : json(nullptr)},
-                       {"axis_verified", r.limits.axis_verified}});
+                       {"loop_model_open_limit_mm", std::isfinite(r.limits.loop_open_mm) ? json(r.limits.loop_open_mm) : json(nullptr)},
+                       {"loop_model_verified", r.limits.loop_model_verified}});
     j["limits_along_path"] = trail;
   }
   if (s.advice) j["advice"] = advice_json(runtime::to_sample(*s.advice));
@@ -387,7 +387,7 @@ std::string summary_text(const runtime::RunSummary& s) {
                     r.limits.pose_deg.empty() ? "pose not known" : config::describe_pose(r.limits.pose_deg).c_str(), r.limits.rpm,
                     r.set, r.gain_ns_per_m, r.limits.open_mm, r.limits.damped_mm,
                     !r.limits.damped_valid    ? " (the loop is unstable here)"
-                    : r.limits.axis_verified ? ""
+                    : r.limits.loop_model_verified ? ""
                                              : " (the damped model is not verified here: not claimed)");
       os << b;
     }

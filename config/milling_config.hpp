@@ -59,6 +59,9 @@ struct ControllerPartConfig {
   std::string config_path;  // resolved against the milling file's directory
   int location{1};
   Axis direction{Axis::kY};
+  // In memory only (live stability at a pose, analysis::config_in_plane_at_pose): the same point along the
+  // other machine axis (0: none): the part is then the loop's robot in both directions, cross terms included.
+  int across_location{0};
 };
 
 // The robot's TCP receptance from a robot model at a pose (docs/pose_dynamics.md), in the machine frame.

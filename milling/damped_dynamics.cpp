@@ -16,6 +16,7 @@ struct DampedDynamics::Loop {
 
 DampedDynamics::DampedDynamics(const Structure& structure, config::Axis feed_axis) : feed_axis_(feed_axis) {
   for (const auto& part : structure.controller_parts()) {
+    if (part.across) throw std::invalid_argument("DampedDynamics: a controller part across the plane (not simulated in time)");
     auto loop = std::make_shared<Loop>();
     loop->model = part.model;
     loop->location = part.location;

@@ -20,6 +20,7 @@ ForcedCommand::ForcedCommand(const Structure& damped, const config::MillingConfi
   limit_n_ = std::numeric_limits<double>::infinity();
   const double tooth_hz = rpm * job.tool.teeth / 60.0;
   for (const auto& p : damped.controller_parts()) {
+    if (p.across) throw std::invalid_argument("ForcedCommand: a controller part across the plane is not supported");
     const analysis::LoopModel& m = *p.model;
     const config::Config& c = m.config();
     limit_n_ = std::min({limit_n_, c.actuator.force_limit_n, c.amplifier.voltage_limit_v * c.actuator.constant_n_per_v});

@@ -46,7 +46,12 @@ LiveStability::LiveStability(config::MillingConfig job, const std::string& struc
   if (sets_.empty())
     throw config::ConfigError({config::Problem{job_.source, {}, "", "live stability needs a loop configuration"}});
   structure_ = pick_structure(job_, structure, sets_.front(), pose_);
-  if (pose_) job_structure_ = pick_structure(job_, structure, sets_.front(), std::nullopt, false);
+  if (pose_) {
+    job_structure_ = pick_structure(job_, structure, sets_.front(), std::nullopt, false);
+    // At a pose the loop's plant is the model's in its plane (config_in_plane_at_pose: location 1 the TCP along
+    // the actuator, 2 across): the robot through the loop in both directions.
+    plane_structure_ = robot_through_cell(job_structure_, 1, pose_->axis, sets_.front().source, 2);
+  }
   thread_ = std::thread([this] { worker(); });
   sweep_thread_ = std::thread([this] { sweeper(); });
 }
@@ -81,7 +86,7 @@ std::vector<double> LiveStability::grid_pose(const std::vector<double>& pose_deg
 config::Config LiveStability::loop_config(std::size_t set, const std::vector<double>& pose_deg) const {
   const config::Config& base = sets_[set < sets_.size() ? set : 0];
   if (!pose_ || pose_deg.empty()) return base;
-  return analysis::config_at_pose(base, analysis::pose_modes(pose_->model, pose_deg, pose_->axis, pose_->modes));
+  return analysis::config_in_plane_at_pose(base, pose_->model, pose_deg, pose_->axis, pose_->modes);
 }
 
 std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, double gain_ns_per_m,
@@ -203,12 +208,12 @@ void LiveStability::sweeper() {
 }
 
 LiveLimits LiveStability::evaluate(const Key& k) const {
-  LiveLimits out = evaluate_on_axis(k);
-  if (pose_ && !out.pose_deg.empty() && out.rpm > 0.0) check_axis_model(out, k.gain > 0);
+  LiveLimits out = evaluate_loop(k);
+  if (pose_ && !out.pose_deg.empty() && out.rpm > 0.0) check_loop_model(out, k.gain > 0);
   return out;
 }
 
-void LiveStability::check_axis_model(LiveLimits& l, bool damping) const {
+void LiveStability::check_loop_model(LiveLimits& l, bool damping) const {
   config::StructureConfig whole;  // the job's modal parts and the robot model at the pose
   whole.name = "robot_model_at_pose";
   for (const auto& part : job_structure_.parts)
@@ -218,19 +223,18 @@ void LiveStability::check_axis_model(LiveLimits& l, bool damping) const {
   robot.pose = config::PosePartConfig{pose_->model_path, l.pose_deg};
   whole.parts.push_back(robot);
   const SdmPoint o = AccurateStability(Structure(whole, false), job_).critical(l.rpm, std::isfinite(l.open_mm) ? l.open_mm : 1.0);
-  l.axis_open_mm = l.open_mm;
+  l.loop_open_mm = l.open_mm;
   l.open_mm = o.critical_depth_mm;
   l.open_chatter_hz = o.chatter_hz;
   l.open_method = "SDM, the robot model at the pose";
-  l.axis_verified = std::abs(l.axis_open_mm / l.open_mm - 1.0) <= s_.axis_tolerance;
+  l.loop_model_verified = std::abs(l.loop_open_mm / l.open_mm - 1.0) <= s_.loop_model_tolerance;
   if (!damping) l.damped_mm = l.open_mm, l.damped_chatter_hz = l.open_chatter_hz;  // K = 0: the open loop
-  if (l.axis_verified || !l.damped_valid || !damping) return;
+  if (l.loop_model_verified || !l.damped_valid || !damping) return;
   char b[400];
   std::snprintf(b, sizeof b,
-                "at this pose the robot's compliance off the actuator's axis (or above the loop's %d modes) sets the limit: "
-                "open %.3f mm by the robot model, %.3f mm by the loop's axis model, more than %.0f %% apart; the damper's "
-                "effect is not claimed",
-                pose_->modes, l.open_mm, l.axis_open_mm, 100.0 * s_.axis_tolerance);
+                "at this pose the robot's modes above the loop's %d set the limit: open %.3f mm by the robot model, %.3f mm by "
+                "the loop's model, more than %.0f %% apart (pose_schedule.modes); the damper's effect is not claimed",
+                pose_->modes, l.open_mm, l.loop_open_mm, 100.0 * s_.loop_model_tolerance);
   l.problem = b;
   l.damped_mm = l.open_mm;
   l.damped_chatter_hz = l.open_chatter_hz;
@@ -238,7 +242,7 @@ void LiveStability::check_axis_model(LiveLimits& l, bool damping) const {
   l.method = "open loop (the damped model is not verified at this pose)";
 }
 
-LiveLimits LiveStability::evaluate_on_axis(const Key& k) const {
+LiveLimits LiveStability::evaluate_loop(const Key& k) const {
   LiveLimits out;
   out.rpm = static_cast<double>(k.rpm) * s_.rpm_step;
   out.pose_deg = pose_of(k);
@@ -256,7 +260,8 @@ LiveLimits LiveStability::evaluate_on_axis(const Key& k) const {
 
   // The zero-order limits are the accurate method's first guesses (and, labelled, the answer where the
   // sampled loop cannot step the speed).
-  const Structure open(structure_, false, {std::make_shared<const analysis::LoopModel>(cfg), gain, polarity});
+  const config::StructureConfig& st = out.pose_deg.empty() ? structure_ : plane_structure_;
+  const Structure open(st, false, {std::make_shared<const analysis::LoopModel>(cfg), gain, polarity});
   const auto open_zoa = LobeModel(open, process, lobes).limit_at(out.rpm);
   const SdmPoint o = AccurateStability(open, job_).critical(out.rpm, open_zoa ? open_zoa->b_lim_mm : 1.0);
   out.open_mm = o.critical_depth_mm;
@@ -270,7 +275,7 @@ LiveLimits LiveStability::evaluate_on_axis(const Key& k) const {
     return out;
   }
   try {
-    const Structure damped(structure_, true,
+    const Structure damped(st, true,
                            {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});
     const auto zoa = LobeModel(damped, process, lobes).limit_at(out.rpm);
     const AccurateStability truth(damped, job_);

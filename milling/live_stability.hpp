@@ -6,9 +6,10 @@
 // thread of its own and cached per (speed, parameter set, gain, pose); lookup() never waits for a computation,
 // so the telemetry drain and the DDS status thread can ask at their own rate.
 // A pose-scheduled cell (PoseDynamics, docs/pose_dynamics.md, "Live stability at the pose"): the limits are
-// for the robot at its pose now, rounded to a grid of pose_step_deg: the job's robot replaced by the robot
-// through the cell's loop (milling::robot_through_cell), the loop's plant the model's lowest modes at the
-// pose (analysis::config_at_pose), so the open limit, the damped limit and the set's loop all move with it.
+// for the robot at its pose now, rounded to a grid of pose_step_deg: the open limit the robot model's whole
+// receptance there, the damped one the robot through the cell's loop (milling::robot_through_cell) whose plant
+// is the model's lowest modes at the pose in its plane (analysis::config_in_plane_at_pose), believed where
+// that plant's open limit agrees with the whole model's.
 // Off the real-time path.
 #pragma once
 
@@ -40,12 +41,13 @@ struct LiveLimits {
   std::string method;          // of the damped limit: "sampled-loop SDM", or "zero-order preview" above its speeds
   std::string open_method;     // of the open limit: "SDM"
   std::vector<double> pose_deg;  // the pose grid's point the limits are for (empty: no pose: the sets' own plants)
-  // At a pose: the open limit is the robot model's whole receptance's (every mode, both directions); the
-  // damped one comes from the loop's plant along the actuator's axis, trusted where that axis model's open
-  // limit (axis_open_mm) agrees with it within LiveStabilitySettings::axis_tolerance. Where it does not, the
-  // damper's effect is not claimed: damped_mm is the open limit and problem says why.
-  double axis_open_mm{0.0};
-  bool axis_verified{true};
+  // At a pose: the open limit is the robot model's whole receptance's (every mode of the chain, both
+  // directions); the damped one comes from the loop's plant (the model's lowest pose_schedule.modes modes in
+  // its plane), trusted where that plant's open limit (loop_open_mm) agrees with the whole model's within
+  // LiveStabilitySettings::loop_model_tolerance. Where it does not, the damper's effect is not claimed:
+  // damped_mm is the open limit and problem says why.
+  double loop_open_mm{0.0};
+  bool loop_model_verified{true};
 };
 
 // Limits as a cell met them (the run summary's trail along the robot's path): when, for which set and K.
@@ -68,7 +70,7 @@ struct LiveStabilitySettings {
   double rpm_step{1.0};        // speeds are rounded to this for the cache
   double gain_step_ns_per_m{10.0};
   double pose_step_deg{2.0};   // joint angles are rounded to this (PoseDynamics)
-  double axis_tolerance{0.10}; // the axis model's open limit against the whole model's (PoseDynamics)
+  double loop_model_tolerance{0.10};  // the loop's plant's open limit against the whole model's (PoseDynamics)
   std::size_t cache_entries{4096};
 };
 
@@ -133,8 +135,8 @@ class LiveStability {
   [[nodiscard]] Key key(double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg) const;
   [[nodiscard]] std::vector<double> pose_of(const Key& k) const;
   [[nodiscard]] LiveLimits evaluate(const Key& k) const;
-  [[nodiscard]] LiveLimits evaluate_on_axis(const Key& k) const;  // the structure_ (and its loop) at the key
-  void check_axis_model(LiveLimits& l, bool damping) const;      // at a pose: the whole model's open limit
+  [[nodiscard]] LiveLimits evaluate_loop(const Key& k) const;  // through the loop's plant at the key's pose
+  void check_loop_model(LiveLimits& l, bool damping) const;   // at a pose: the whole model's open limit
   [[nodiscard]] LiveLimits evaluate_reported(const Key& k) const;  // a failure as a result with its problem
   void store(const Key& k, LiveLimits l);                          // under m_
   void worker();
@@ -142,7 +144,8 @@ class LiveStability {
 
   config::MillingConfig job_;
   config::StructureConfig structure_;
-  config::StructureConfig job_structure_;  // as the job gives it (PoseDynamics: its modal parts are kept)
+  config::StructureConfig job_structure_;    // as the job gives it (PoseDynamics: its modal parts are kept)
+  config::StructureConfig plane_structure_;  // PoseDynamics at a pose: the robot through the loop in its plane
   std::vector<config::Config> sets_;
   LiveStabilitySettings s_;
   std::optional<PoseDynamics> pose_;

@@ -101,9 +101,18 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
   for (const auto& part : parts_) {
     std::shared_ptr<const analysis::LoopModel> model = part.model;
     if (per_speed_ && rpm > 0.0) model = std::make_shared<const analysis::LoopModel>(part.model->config(), rpm);
-    const analysis::SampledPath p = model->sampled_path(part.location, part.gain_ns_per_m, part.polarity);
     const auto d = static_cast<Eigen::Index>(part.direction);
-    append_block(s.a, s.b, s.c, p.a, p.b * r.row(d), r.transpose().col(d) * p.c);
+    if (!part.across) {
+      const analysis::SampledPath p = model->sampled_path(part.location, part.gain_ns_per_m, part.polarity);
+      append_block(s.a, s.b, s.c, p.a, p.b * r.row(d), r.transpose().col(d) * p.c);
+      continue;
+    }
+    // Across the plane: forces along both machine axes in, displacements along both out (machine frame).
+    const analysis::SampledPaths p = model->sampled_paths({part.location, *part.across}, part.gain_ns_per_m, part.polarity);
+    MatrixXd bm(p.b.rows(), 2), cm(2, p.c.cols());
+    bm.col(d) = p.b.col(0), bm.col(1 - d) = p.b.col(1);
+    cm.row(d) = p.c.row(0), cm.row(1 - d) = p.c.row(1);
+    append_block(s.a, s.b, s.c, p.a, bm * r, r.transpose() * cm);
   }
   if (!tables_.empty()) {
     const ToolDynamics dyn(tables_, tick_s_);

@@ -17,7 +17,8 @@ void add_resonances(std::vector<Resonance>& out, const config::FrfConfig& frf) {
 
 }  // namespace
 
-config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis, const std::string& source) {
+config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis, const std::string& source,
+                                           int across_location) {
   config::StructureConfig st;
   st.name = "robot_at_pose";
   for (const auto& part : s.parts)
@@ -28,6 +29,7 @@ config::StructureConfig robot_through_cell(const config::StructureConfig& s, int
   c.config_path = source;
   c.location = location;
   c.direction = axis == 0 ? config::Axis::kX : config::Axis::kY;
+  c.across_location = across_location;
   robot.controller = c;
   st.parts.push_back(robot);
   return st;
@@ -88,6 +90,7 @@ void Structure::add_controller(const std::string& part, const std::string& sourc
   ControllerPart c;
   c.location = model->plant().index_of(pc.location);
   c.direction = pc.direction == config::Axis::kX ? 0 : 1;
+  if (pc.across_location > 0) c.across = model->plant().index_of(pc.across_location);
   c.gain_ns_per_m = gain_ns_per_m;
   c.polarity = polarity;
   for (const auto& f : model->config().robot.frfs) add_resonances(resonances_, f);
@@ -122,8 +125,14 @@ bool Structure::has_controller() const { return !controllers_.empty(); }
 
 std::vector<Structure::ControllerPath> Structure::controller_paths() const {
   std::vector<ControllerPath> out;
-  for (const auto& c : controllers_)
-    if (const sim::FrfPath* p = c.model->plant().path(c.location, c.location)) out.push_back({c.direction, *p});
+  for (const auto& c : controllers_) {
+    if (const sim::FrfPath* p = c.model->plant().path(c.location, c.location)) out.push_back({c.direction, c.direction, *p});
+    if (!c.across) continue;
+    const std::size_t o = 1 - c.direction;
+    for (const auto& [g, h, dg, dh] : {std::tuple{*c.across, c.location, o, c.direction}, std::tuple{c.location, *c.across, c.direction, o},
+                                       std::tuple{*c.across, *c.across, o, o}})
+      if (const sim::FrfPath* p = c.model->plant().path(g, h)) out.push_back({dg, dh, *p});
+  }
   return out;
 }
 
@@ -134,9 +143,14 @@ Eigen::Matrix2cd Structure::frf(double f_hz) const {
         modal_[k].modes.empty() ? Complex(0.0) : modal::frf_receptance(modal_[k], f_hz);
   for (const auto& p : poses_) g += p->tcp_frf_direct(f_hz);
   for (const auto& c : controllers_) {
-    const auto d = static_cast<Eigen::Index>(c.direction);
-    g(d, d) += damped_ ? c.model->closed_sampled(c.location, c.location, f_hz, c.gain_ns_per_m, c.polarity)
-                       : c.model->open_continuous(c.location, c.location, f_hz);
+    auto add = [&](std::size_t resp, std::size_t exc, std::size_t dr, std::size_t de) {
+      g(static_cast<Eigen::Index>(dr), static_cast<Eigen::Index>(de)) +=
+          damped_ ? c.model->closed_sampled(resp, exc, f_hz, c.gain_ns_per_m, c.polarity) : c.model->open_continuous(resp, exc, f_hz);
+    };
+    add(c.location, c.location, c.direction, c.direction);
+    if (!c.across) continue;
+    const std::size_t o = 1 - c.direction;
+    add(*c.across, c.location, o, c.direction), add(c.location, *c.across, c.direction, o), add(*c.across, *c.across, o, o);
   }
   return g;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,7 @@ class Structure {
     std::shared_ptr<const analysis::LoopModel> model;
     std::size_t location{0};
     std::size_t direction{1};
+    std::optional<std::size_t> across;  // the location along the other axis (ControllerPartConfig::across_location)
     double gain_ns_per_m{0.0};
     int polarity{1};
   };
@@ -70,7 +72,8 @@ class Structure {
   // Each controller part's open-loop robot FRF at its location (physical frame) and its direction
   // (0 = x, 1 = y): the structure a time-domain model needs besides the modal tables.
   struct ControllerPath {
-    std::size_t direction{1};
+    std::size_t direction{1};             // of the response
+    std::size_t excitation_direction{1};  // of the force (a part across the plane has all four pairs)
     sim::FrfPath path;
   };
   [[nodiscard]] std::vector<ControllerPath> controller_paths() const;
@@ -103,6 +106,6 @@ class Structure {
 // the pose is the caller's (Structure's LiveLoop). location: the actuator's (actuator.location); axis: 0 = x,
 // 1 = y; source: the cell's configuration file (for messages).
 [[nodiscard]] config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis,
-                                                         const std::string& source);
+                                                         const std::string& source, int across_location = 0);
 
 }  // namespace robodamp::milling

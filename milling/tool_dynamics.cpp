@@ -38,10 +38,8 @@ std::vector<CutterModalTerm> cutter_modal_terms(const Structure& structure, conf
           if (const double a = md.tcp_shape(r) * md.tcp_shape(e); a != 0.0 && wn > 0.0) add(out, r, e, wn, zeta, a, 0.0);
     }
   for (const auto& c : structure.controller_paths())
-    for (const auto& m : c.path.modes) {
-      const int d = static_cast<int>(c.direction);
-      add(out, d, d, m.wn_rad_per_s, m.damping_ratio, m.a, m.b);
-    }
+    for (const auto& m : c.path.modes)
+      add(out, static_cast<int>(c.direction), static_cast<int>(c.excitation_direction), m.wn_rad_per_s, m.damping_ratio, m.a, m.b);
   return out;
 }
 
