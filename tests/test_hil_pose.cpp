@@ -99,7 +99,7 @@ void live_limits_followed_the_pose(const std::string& config_path, const json& r
 // same at each dwell as the in-process live stability gives at that pose with the set and K that run there.
 TEST(Hil, PoseTrajectoryHandsOverBetweenRegionsAndSchedulingOffTrips) {
   const std::vector<std::string> trajectory{"--pose-at", "0:-100,10,90",  "--pose-at", "22:-100,10,90",
-                                      "--pose-at", "28:-100,100,90", "--pose-at", "50:-100,100,90"};
+                                            "--pose-at", "28:-100,100,90", "--pose-at", "50:-100,100,90"};
   const std::vector<std::pair<std::string, std::string>> job{
       {"    joints_register: 10", "    spindle_rpm_register: 1\n    rpm_per_count: 10\n    joints_register: 10"},
       {"\npose_schedule:\n", "\nspindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) +
