@@ -133,6 +133,9 @@ class Cell {
   // The robot's joints now (any thread): the DDS joint states, else the Modbus joint registers, else the
   // simulated robot's --pose; empty while not known.
   [[nodiscard]] std::vector<double> robot_pose_deg() const;
+  // The spectrum monitor's next spectrum; with pose_schedule and a known pose its mode marks are the robot
+  // model's modes along the actuator at that pose (the configuration's table otherwise).
+  [[nodiscard]] std::optional<dds::SpectrumSample> spectrum_at_pose();
   std::vector<Component*> components();
   void on_frame(const rt::TelemetryFrame& f);
   void finish_summary();

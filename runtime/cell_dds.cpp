@@ -18,7 +18,7 @@ dds::BridgeSources Cell::bridge_sources() {
                                    const auto a = machining_->advice();
                                    return a ? std::optional(to_sample(*a)) : std::nullopt;
                                  },
-                           [this] { return spectrum_->next(); },
+                           [this] { return spectrum_at_pose(); },
                            cfg_.spindle.job.empty() ? std::function<std::optional<dds::LobesSample>()>{}
                                                     : [this] { return machining_->lobes(); },
                            cfg_.controller.gain_ramp_s,

@@ -36,6 +36,20 @@ std::vector<double> Cell::robot_pose_deg() const {
   return q;
 }
 
+std::optional<dds::SpectrumSample> Cell::spectrum_at_pose() {
+  std::optional<dds::SpectrumSample> s = spectrum_->next();
+  if (!s || !cfg_.pose_schedule || pose_schedule_.regions.empty()) return s;
+  const std::vector<double> q = robot_pose_deg();
+  if (q.empty()) return s;  // not known: the configuration's table
+  try {
+    const analysis::PoseModes pm = analysis::pose_modes(pose_schedule_.model, q, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes);
+    s->mode_hz.clear();
+    for (const auto& m : pm.modes) s->mode_hz.push_back(static_cast<float>(m.natural_freq_hz));
+  } catch (const std::exception&) {  // a pose outside the model's travel: the configuration's table
+  }
+  return s;
+}
+
 void Cell::post_pose_region(std::optional<std::size_t> region) {
   const double set = region ? static_cast<double>(*region) : -1.0;
   if (!loop_->post({rt::CommandKind::kSetPoseRegion, set}))

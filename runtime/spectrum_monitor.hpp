@@ -1,9 +1,9 @@
 // The control accelerometer's spectrum for the operator's screen (the DDS spectrum topic, docs/dashboard.md):
 // the drain thread's frames averaged down to about 1 kHz in blocks (a display, not a measurement: the block
 // mean is the anti-alias filter), the last seconds kept, and Welch's average of Hann windows computed at
-// most once a second of loop time. With the robot modes of the configuration and the spindle's tooth
-// passing frequency (from the set_spindle commands in the frames) to mark on the plot. Off the real-time
-// path.
+// most once a second of loop time. With the robot modes of the configuration (a pose-scheduled cell puts the
+// modes at the robot's pose in their place: runtime::Cell::spectrum_at_pose) and the spindle's tooth passing
+// frequency (from the set_spindle commands in the frames) to mark on the plot. Off the real-time path.
 #pragma once
 
 #include <cstddef>

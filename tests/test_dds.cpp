@@ -22,7 +22,10 @@
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "analysis/pose_schedule.hpp"
 #include "cell_util.hpp"
+#include "config/config.hpp"
+#include "config/robot_model_config.hpp"
 #include "child_process.hpp"
 #include "dashboard/fleet.hpp"
 #include "dds/bridge.hpp"
@@ -488,6 +491,8 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   DataWriter* w = driver.joint_state_writer("rt/joint_states");
   Collect<msg::Status> status;  // the cell's own word on the set that runs
   driver.reader(dds::TopicKind::kStatus, &status);
+  Collect<msg::Spectrum> spectrum;  // its mode marks: the robot's modes at the pose
+  driver.reader(dds::TopicKind::kSpectrum, &spectrum);
   const std::string cell = "joints-" + std::to_string(getpid());
   const auto running_set = [&](std::uint32_t set) {
     return eventually([&] {
@@ -529,6 +534,18 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   }
   EXPECT_TRUE(log_has("pose [-100, 80, 90] deg in region 'stretched'", 60.0)) << test::read_file(dir + "/run.log");
   EXPECT_TRUE(running_set(1)) << "handed over to the stretched region's set\n" << test::read_file(dir + "/run.log");
+  {
+    const config::Config cfg = config::load_config_file(dir + "/cell.yaml");
+    const auto model = config::load_robot_model(cfg.pose_schedule->model_resolved);
+    std::vector<float> stretched;
+    for (const auto& md : analysis::pose_modes(model, {-100.0, 80.0, 90.0}, cfg.pose_schedule->axis, cfg.pose_schedule->modes).modes)
+      stretched.push_back(static_cast<float>(md.natural_freq_hz));
+    EXPECT_TRUE(eventually([&] {
+      for (const auto& s : spectrum.all())
+        if (s.cell() == cell && s.mode_hz() == stretched) return true;
+      return false;
+    }, 60.0)) << "the spectrum's mode marks at the stretched pose, " << stretched.front() << " Hz first";
+  }
   {
     std::lock_guard lock(m);
     names = {"wrist", "gripper", "shoulder"}, deg = {90.0, 12.0, -100.0};  // the elbow missing
