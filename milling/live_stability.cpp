@@ -68,8 +68,11 @@ LiveStability::~LiveStability() {
 
 LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg) const {
   Key k{std::lround(rpm / s_.rpm_step), set < sets_.size() ? set : 0, std::lround(gain / s_.gain_step_ns_per_m), {}};
-  if (pose_)
-    for (const double q : pose_deg) k.pose.push_back(std::isfinite(q) ? std::lround(q / s_.pose_step_deg) : 0);
+  if (!pose_) return k;
+  for (const double q : pose_deg) {
+    if (!std::isfinite(q)) return {k.rpm, k.set, k.gain, {}};  // a joint not known: the pose is not known
+    k.pose.push_back(std::lround(q / s_.pose_step_deg));
+  }
   return k;
 }
 
