@@ -16,13 +16,14 @@ std::string advice_text(const dds::AdviceSample& a) {
                 a.depth_mm, a.damped ? "damped" : "open-loop", a.limit_now_mm, a.method.c_str());
   std::string out = b;
   if (!a.pose_deg.empty()) out += " at the robot's pose " + config::describe_pose(a.pose_deg) + ":";
-  if (!a.found) return out + " " + a.reason + "\n";
+  const std::string status = a.status == "current" ? "" : " [" + a.status + ": " + a.status_reason + "]";
+  if (!a.found) return out + " " + a.reason + status + "\n";
   for (std::size_t i = 0; i < a.option_rpm.size(); ++i) {
     std::snprintf(b, sizeof b, "%s %.0f rpm (%.3f mm, margin %.2f)", i == 0 ? "" : ";", a.option_rpm[i],
                   a.option_limit_mm[i], a.option_limit_mm[i] / a.depth_mm);
     out += b;
   }
-  return out + "\n";
+  return out + status + "\n";
 }
 
 nlohmann::json advice_json(const dds::AdviceSample& a) {
@@ -49,7 +50,9 @@ nlohmann::json advice_json(const dds::AdviceSample& a) {
           {"reason", a.reason},
           {"rpm_min", a.rpm_min},
           {"rpm_max", a.rpm_max},
-          {"pose_deg", a.pose_deg}};
+          {"pose_deg", a.pose_deg},
+          {"status", a.status},
+          {"status_reason", a.status_reason}};
 }
 
 }  // namespace robodamp::apps

@@ -240,7 +240,7 @@ void Bridge::publish_machining() {
 void Bridge::publish_advice() {
   if (advice_writer_ == nullptr) return;
   const std::optional<AdviceSample> a = src_.advice();
-  if (!a || a->seq == published_advice_) return;
+  if (!a || (a->seq == published_advice_ && a->status == published_advice_status_)) return;
   msg::Advice out;
   out.cell(src_.cell);
   out.seq(a->seq);
@@ -266,9 +266,12 @@ void Bridge::publish_advice() {
   out.rpm_min(a->rpm_min);
   out.rpm_max(a->rpm_max);
   out.pose_deg(first16(a->pose_deg));
+  out.status(a->status);
+  out.status_reason(a->status_reason);
   if (advice_writer_->write(&out)) {
     ++n_advice_;
     published_advice_ = a->seq;
+    published_advice_status_ = a->status;
   }
 }
 

@@ -83,6 +83,8 @@ struct AdviceSample {
   std::string reason;
   double rpm_min{0.0}, rpm_max{0.0};
   std::vector<double> pose_deg;  // the pose the candidates were checked at (empty: none)
+  std::string status{"current"};  // "current", "followed" or "expired" (runtime::AdviceStatus)
+  std::string status_reason;
 };
 
 // What the Spectrum_ topic carries (dds/robodamp.idl), from the cell's spectrum monitor.
@@ -150,7 +152,7 @@ class Bridge {
   class JointStateListener;
   void publish_status();
   void publish_machining();
-  void publish_advice();  // a new advice (its seq) once
+  void publish_advice();  // a new advice (its seq), and each change of its status, once
   void publish_spectrum();
   void publish_lobes();
   Decision decide(RequestKind kind, double value);
@@ -168,6 +170,7 @@ class Bridge {
   eprosima::fastdds::dds::DataWriter* spectrum_writer_{nullptr};
   eprosima::fastdds::dds::DataWriter* lobes_writer_{nullptr};
   std::uint64_t published_advice_{0};  // status thread
+  std::string published_advice_status_;
   std::unique_ptr<RequestListener> listener_;
   std::unique_ptr<JointStateListener> joint_state_listener_;
   rt::AvailabilityMeter availability_;  // under m_

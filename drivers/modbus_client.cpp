@@ -261,6 +261,13 @@ void ModbusClient::publish_advice(std::uint64_t seq, bool found, double rpm, dou
   advice_pending_ = true;
 }
 
+void ModbusClient::withdraw_advice(std::uint64_t seq) {
+  if (cfg_.robot.advice_register < 0 || !robot_link_) return;
+  std::lock_guard<std::mutex> lock(m_);
+  advice_regs_ = modbus_codec::encode_withdrawn(seq);
+  advice_pending_ = true;
+}
+
 bool ModbusClient::write_advice(modbus_t* ctx) {
   std::array<std::uint16_t, 4> regs{};
   {

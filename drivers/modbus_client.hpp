@@ -110,6 +110,8 @@ class ModbusClient final : public rt::AmplifierIo {
   // Any thread: a new spindle-speed advice for modbus.robot.advice_register (the robot thread writes it
   // at its next poll; a failed write is tried again). found false: no stable speed in the range.
   void publish_advice(std::uint64_t seq, bool found, double rpm, double margin);
+  // Any thread: advice seq withdrawn (status 3: the state it was for is gone before the spindle followed).
+  void withdraw_advice(std::uint64_t seq);
   // Any thread: the axial depth the robot cuts (modbus.robot.depth_register), mm; NaN: no register, no
   // poll yet, not available (65535) or the link lost for link_timeout_s.
   [[nodiscard]] double depth_mm() const { return depth_mm_.load(); }

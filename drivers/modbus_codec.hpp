@@ -51,7 +51,7 @@ inline constexpr std::int16_t kJointUnavailable = INT16_MIN;  // joint register:
 
 // The spindle-speed advice block robodamp writes (modbus.robot.advice_register, 4 registers): sequence
 // number, speed in rpm counts, margin x 100 (65535: not finite), status 1 = a stable speed found,
-// 2 = none.
+// 2 = none, 3 = withdrawn (the state it was for is gone before the spindle followed it: do not follow).
 struct Advice {
   unsigned seq{0};
   unsigned status{0};
@@ -64,6 +64,9 @@ struct Advice {
   return {static_cast<std::uint16_t>(seq & 0xFFFFU), found ? count(rpm / rpm_per_count) : std::uint16_t{0},
           found && std::isfinite(margin) ? count(100.0 * margin) : static_cast<std::uint16_t>(found ? 65535 : 0),
           static_cast<std::uint16_t>(found ? 1 : 2)};
+}
+[[nodiscard]] inline std::array<std::uint16_t, 4> encode_withdrawn(std::uint64_t seq) {
+  return {static_cast<std::uint16_t>(seq & 0xFFFFU), 0, 0, 3};
 }
 [[nodiscard]] inline Advice decode_advice(const std::array<std::uint16_t, 4>& a, double rpm_per_count) {
   return {a[0], a[3], a[1] * rpm_per_count, a[2] / 100.0};

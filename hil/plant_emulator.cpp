@@ -287,7 +287,8 @@ void PlantEmulator::read_advice(double t) {
   const drivers::modbus_codec::Advice d = drivers::modbus_codec::decode_advice(*a, regs_.rpm_per_count());
   AdviceSeen seen{t, advice_seq_, static_cast<int>(d.status), d.rpm, d.margin, {}};
   if (seen.status == 2) seen.action = "kept the speed: no stable speed";
-  else if (seen.status != 1) seen.action = "refused: status " + std::to_string(seen.status) + " (allowed 1 or 2)";
+  else if (seen.status == 3) seen.action = "kept the speed: withdrawn (the state it was for is gone)";
+  else if (seen.status != 1) seen.action = "refused: status " + std::to_string(seen.status) + " (allowed 1, 2 or 3)";
   else if (!(seen.rpm > 0.0) || seen.rpm > cfg_.spindle.rpm_max)
     seen.action = fmt::format("refused: {} rpm outside the spindle's 0 < rpm <= {} rpm (spindle.rpm_max)", seen.rpm,
                               cfg_.spindle.rpm_max);

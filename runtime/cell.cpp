@@ -124,7 +124,9 @@ Status Cell::compose_devices() {
     MachiningInputs in;
     in.active_set = [this] { return supervisor_->running_parameter_set(); };
     in.on_advice = [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
-      if (modbus_)
+      if (!modbus_ || r.status == AdviceStatus::kFollowed) return;
+      if (r.status == AdviceStatus::kExpired) modbus_->withdraw_advice(r.seq);
+      else
         modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
                                 r.advice.found ? r.advice.options.front().margin : 0.0);
     };

@@ -116,6 +116,11 @@ void ModbusComponent::publish_advice(std::uint64_t seq, bool found, double rpm, 
   if (client_) client_->publish_advice(seq, found, rpm, margin);
 }
 
+void ModbusComponent::withdraw_advice(std::uint64_t seq) {
+  std::lock_guard<std::mutex> lock(client_m_);
+  if (client_) client_->withdraw_advice(seq);
+}
+
 double ModbusComponent::robot_depth_mm() const {
   std::lock_guard<std::mutex> lock(client_m_);
   return client_ ? client_->depth_mm() : std::numeric_limits<double>::quiet_NaN();

@@ -88,6 +88,7 @@ class ModbusComponent final : public Component {
   // Any thread, in any state (the machining monitor's advisor runs from the cell's configure on, before
   // this component's on_configure and until the cell's cleanup): nothing while there is no client.
   void publish_advice(std::uint64_t seq, bool found, double rpm, double margin);
+  void withdraw_advice(std::uint64_t seq);
   [[nodiscard]] double robot_depth_mm() const;  // NaN without a client
 
  private:

@@ -36,7 +36,7 @@ struct Cutting {
 // What the monitor reads of the cell (any thread each, all optional but active_set).
 struct MachiningInputs {
   std::function<std::size_t()> active_set;             // the supervisor's running set
-  std::function<void(const AdviceRecord&)> on_advice;  // each new spindle-speed advice, on the advisor's thread
+  std::function<void(const AdviceRecord&)> on_advice;  // each new spindle-speed advice and each change of its status, on the advisor's thread
   std::function<double()> robot_depth_mm;              // the robot's depth (0: out of the cut; NaN: the job's)
   // A pose-scheduled cell: the robot's joints now (empty: not known) and the model its sets are designed on;
   // the limits, the live lobes and the advice are then for the robot at that pose (milling::PoseDynamics).

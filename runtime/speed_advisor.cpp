@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <tuple>
 
@@ -17,7 +18,22 @@ auto state_key(const milling::SpeedAdviceRequest& r) {
                          r.damped, r.trigger, r.pose_deg);
 }
 
+std::string fmt(const char* f, double a, double b = 0.0) {
+  char s[200];
+  std::snprintf(s, sizeof s, f, a, b);
+  return s;
+}
+
 }  // namespace
+
+const char* to_string(AdviceStatus s) {
+  switch (s) {
+    case AdviceStatus::kCurrent: return "current";
+    case AdviceStatus::kFollowed: return "followed";
+    case AdviceStatus::kExpired: return "expired";
+  }
+  return "?";
+}
 
 dds::AdviceSample to_sample(const AdviceRecord& r) {
   const milling::SpeedAdvice& a = r.advice;
@@ -44,6 +60,8 @@ dds::AdviceSample to_sample(const AdviceRecord& r) {
   s.rpm_min = a.rpm_min;
   s.rpm_max = a.rpm_max;
   s.pose_deg = a.request.pose_deg;
+  s.status = to_string(r.status);
+  s.status_reason = r.status_reason;
   return s;
 }
 
@@ -95,6 +113,49 @@ std::optional<milling::SpeedAdviceRequest> SpeedAdvisor::wanted(const AdviceView
   return r;
 }
 
+std::pair<AdviceStatus, std::string> SpeedAdvisor::status_in(const AdviceRecord& r, const AdviceView& v) {
+  const milling::SpeedAdviceRequest& q = r.advice.request;
+  const dds::MachiningSample& m = v.sample;
+  const double rpm = m.spindle_rpm;
+  if (r.advice.found && rpm > 0.0 &&
+      std::abs(rpm - r.advice.options.front().rpm) <= same_speed_rpm(r.advice.options.front().rpm))
+    return {AdviceStatus::kFollowed, fmt("the spindle at the advised %.1f rpm", rpm)};
+  if (!(rpm > 0.0)) return {AdviceStatus::kExpired, "the spindle stopped"};
+  // A spindle ramping from the speed it was asked at to the advised one is following it, not elsewhere.
+  const double to = r.advice.found ? r.advice.options.front().rpm : q.rpm;
+  const bool on_the_way = rpm >= std::min(q.rpm, to) - same_speed_rpm(q.rpm) && rpm <= std::max(q.rpm, to) + same_speed_rpm(q.rpm);
+  if (!on_the_way)
+    return {AdviceStatus::kExpired, fmt("the spindle at %.1f rpm, not the %.1f rpm it was for", rpm, q.rpm)};
+  if (v.parameter_set != q.set)
+    return {AdviceStatus::kExpired, fmt("parameter set %.0f runs, not set %.0f", static_cast<double>(v.parameter_set),
+                                        static_cast<double>(q.set))};
+  if (std::abs(v.gain_ns_per_m - q.gain_ns_per_m) > std::max(10.0, 0.01 * std::abs(q.gain_ns_per_m)))
+    return {AdviceStatus::kExpired, fmt("K = %.0f N s/m, not the %.0f N s/m it was for", v.gain_ns_per_m, q.gain_ns_per_m)};
+  if (m.loop_active != q.damped) return {AdviceStatus::kExpired, m.loop_active ? "the damper active now" : "the damper off now"};
+  if (std::abs(m.depth_mm - q.depth_mm) > 1e-3)
+    return {AdviceStatus::kExpired, fmt("the depth %.3f mm, not the %.3f mm it was for", m.depth_mm, q.depth_mm)};
+  if (m.limits_pose_deg != q.pose_deg) return {AdviceStatus::kExpired, "the robot moved to another pose"};
+  if (m.indicator_valid && !m.chatter && m.limits_ready && !m.depth_warning)
+    return {AdviceStatus::kExpired, "no chatter and the depth within the limit now"};
+  return {AdviceStatus::kCurrent, ""};
+}
+
+// Under no lock: the latest advice's status in the view now; a change is logged, stored and handed on (the
+// robot's registers withdraw an expired advice). Followed and expired are final: the state an expired advice
+// was for may come back, and then it is asked for again (returns true: forget the last state advised).
+bool SpeedAdvisor::follow_status(const AdviceView& v) {
+  std::unique_lock<std::mutex> lock(m_);
+  if (!latest_ || latest_->status != AdviceStatus::kCurrent) return false;
+  auto [status, reason] = status_in(*latest_, v);
+  if (status == AdviceStatus::kCurrent) return false;
+  latest_->status = status, latest_->status_reason = std::move(reason), latest_->status_time_s = v.sample.time_s;
+  const AdviceRecord rec = *latest_;
+  lock.unlock();
+  spdlog::info("speed advice #{} {} at {:.3f} s: {}", rec.seq, to_string(rec.status), rec.status_time_s, rec.status_reason);
+  if (on_advice_) on_advice_(rec);
+  return status == AdviceStatus::kExpired;
+}
+
 void SpeedAdvisor::run() {
   std::optional<decltype(state_key(milling::SpeedAdviceRequest{}))> last;
   std::uint64_t seq = 0;
@@ -105,6 +166,7 @@ void SpeedAdvisor::run() {
     const AdviceView v = view_();
     const bool settled = std::abs(v.gain_ns_per_m - last_gain) <= 1e-3 * std::abs(v.gain_ns_per_m);
     last_gain = v.gain_ns_per_m;
+    if (follow_status(v)) last.reset();
     const auto r = wanted(v, settled);
     if (r && state_key(*r) != last) {
       last = state_key(*r);

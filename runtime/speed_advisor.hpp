@@ -3,9 +3,12 @@
 // above the limit that applies at the speed now, works out the advice for that state once
 // (milling::advise_speed: the accurate limits at each candidate speed, seconds). Each new advice gets the
 // next sequence number; the DDS advice topic, the robot's Modbus registers and the run summary carry the
-// latest. Off the real-time path.
+// latest. The latest advice has a status, looked at every period: current while the state it was for holds,
+// followed once the spindle turns at the advised speed, expired (with the reason) when the state it was for
+// is gone without it; each change is logged and published. Off the real-time path.
 #pragma once
 
+#include <algorithm>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -13,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "dds/bridge.hpp"
 #include "milling/live_stability.hpp"
@@ -20,10 +24,16 @@
 
 namespace robodamp::runtime {
 
+enum class AdviceStatus : std::uint8_t { kCurrent, kFollowed, kExpired };
+[[nodiscard]] const char* to_string(AdviceStatus s);
+
 struct AdviceRecord {
   std::uint64_t seq{0};        // 1, 2, ...: one per new advice
   double time_s{0.0};          // the loop time of the view that asked for it
   milling::SpeedAdvice advice;
+  AdviceStatus status{AdviceStatus::kCurrent};
+  std::string status_reason;   // followed or expired: what the advisor saw (empty while current)
+  double status_time_s{0.0};   // the loop time of the view that changed the status
 };
 
 // What the advisor reads of the cell's machining view, and the state an advice is for.
@@ -52,9 +62,19 @@ class SpeedAdvisor {
   // Whether the view now asks for advice, and for which request (the trigger set), or not. gain_settled:
   // the gain the same as a period ago (an advice during a fade would be for a passing state).
   [[nodiscard]] static std::optional<milling::SpeedAdviceRequest> wanted(const AdviceView& v, bool gain_settled);
+  // The advice's status in the view now: followed at the advised speed (within same_speed_rpm); expired
+  // when the spindle stopped or turns at another speed (not on its way to the advised one), the set, the gain, the damper, the depth or the pose
+  // changed, or neither chatter nor a depth above the limit asks any more; else current. With the reason
+  // (empty while current).
+  [[nodiscard]] static std::pair<AdviceStatus, std::string> status_in(const AdviceRecord& r, const AdviceView& v);
+  // How far a spindle's speed may be from a speed and still be it: 0.2 % (0.5 rpm at least). A spindle turns
+  // at what its drive can: the HIL emulator at a whole number of its 5 kHz samples per tooth, 666.7 rpm for
+  // an advised 666.0 (0.1 %); the register's resolution is 0.1 rpm.
+  [[nodiscard]] static double same_speed_rpm(double rpm) { return std::max(0.5, 0.002 * rpm); }
 
  private:
   void run();
+  bool follow_status(const AdviceView& v);
 
   milling::LiveStability& stability_;
   std::function<AdviceView()> view_;

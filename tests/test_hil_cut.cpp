@@ -232,6 +232,8 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
     EXPECT_TRUE(r.run["machining"]["depth_measured"].get<bool>()) << r.run["machining"].dump();
     // The controller's view: the advice it wrote is the one the robot read.
     EXPECT_EQ(r.run["advice"]["seq"].get<unsigned>(), advice.back()["seq"].get<unsigned>()) << r.run["advice"].dump(1);
+    // And it knows the robot followed it (runtime::AdviceStatus): the spindle at the advised speed.
+    EXPECT_EQ(r.run["advice"]["status"], "followed") << r.run["advice"].dump(1);
   }
 }
 

@@ -218,8 +218,10 @@ function tile(c) {
       (m.limits_pose_deg && m.limits_pose_deg.length ? '<dt>pose</dt><dd data-field="pose">' + poseText(m.limits_pose_deg) +
         (m.limits_ready ? ': the limit is for this pose' : ' <span class="note">(recomputing: the robot moved)</span>') + '</dd>' : '') +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
-      (c.advice ? '<dt>advice</dt><dd>' + (!c.advice.found ? 'no stable speed in range'
-        : Math.abs((m.spindle_rpm || 0) - c.advice.advised_rpm) < 0.5 ? 'at the advised ' + fmt(c.advice.advised_rpm, 1) + ' rpm'
+      (c.advice ? '<dt>advice</dt><dd data-field="advice" data-status="' + adviceState(c.advice, m) + '">' +
+        (adviceState(c.advice, m) === 'expired' ? 'expired: ' + esc(c.advice.status_reason)
+        : !c.advice.found ? 'no stable speed in range'
+        : adviceState(c.advice, m) === 'followed' ? 'at the advised ' + fmt(c.advice.advised_rpm, 1) + ' rpm'
         : 'go to ' + fmt(c.advice.advised_rpm, 1) + ' rpm') + ' (#' + c.advice.seq + ')</dd>' : '') +
       '</dl>',
   };
@@ -309,11 +311,21 @@ function plotSpectrum(s) {
   window.robodamp.updates.spectrum++;
 }
 
+// The advice as the cell says it stands (runtime/speed_advisor.hpp: current, followed, expired); a spindle
+// already at the advised speed (SpeedAdvisor::same_speed_rpm: 0.2 %, 0.5 rpm at least) reads as followed at
+// once, before the cell's next look (0.2 s).
+function adviceState(a, m) {
+  if (!a) return 'none';
+  if (a.status === 'expired' || a.status === 'followed') return a.status;
+  const near = Math.max(0.5, 0.002 * a.advised_rpm);
+  return a.found && m && Math.abs((m.spindle_rpm || 0) - a.advised_rpm) <= near ? 'followed' : 'current';
+}
+
 function plotLobes(l, m, a) {
   if (!l || !l.rpm || l.rpm.length === 0) return;
   const rows = l.rpm.map((r, i) => [r, l.open_limit_mm[i], l.damped_limit_mm[i], l.depth_mm, null, null]);
   if (m && m.spindle_rpm > 0) rows.push([m.spindle_rpm, null, null, null, m.depth_mm, null]);
-  const options = a && a.found ? a.options : [];
+  const options = a && a.found && adviceState(a, m) !== 'expired' ? a.options : [];
   options.forEach((o) => rows.push([o.rpm, null, null, null, null, a.depth_mm]));
   rows.sort((x, y) => x[0] - y[0]);
   // The operating point says whether the tool is in the cut (the cell's cutting state).
@@ -337,12 +349,15 @@ function plotLobes(l, m, a) {
     : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds' +
     (l.pose_deg && l.pose_deg.length ? ', the robot at ' + poseText(l.pose_deg) + (moved ? ' (it has moved: recomputing)' : '') : '') +
     (off ? '; the damper is ' + s.state + ': the open loop applies' : '');
-  // An advice the spindle has followed is not an instruction any more: said as done (the tile does the same).
-  const followed = a && a.found && m && Math.abs((m.spindle_rpm || 0) - a.advised_rpm) < 0.5;
+  // An advice the spindle has followed is not an instruction any more: said as done (the tile does the same);
+  // one the cell has expired (the state it was for is gone) says why, and its speeds are not drawn.
+  const state = adviceState(a, m), followed = state === 'followed';
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
-    (!a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
+    (state === 'expired' ? 'expired: ' + esc(a.status_reason) + ' (it was ' + (a.found ? fmt(a.advised_rpm, 1) + ' rpm' : 'no speed') + ')'
+    : !a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
       fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method)) : 'no advice asked for';
   $('advice').dataset.followed = followed ? 'true' : 'false';
+  $('advice').dataset.status = state;
   window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, operating_label: now, advised: options.length,
     gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off, pose_deg: l.pose_deg || [], pose_moved: !!moved,
     scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
@@ -429,7 +444,7 @@ function renderCell() {
     // redrawn when what it shows changes, not only when new lobes come: a followed advice says so at once.
     const m = d.machining || {}, s = cellStatus || {};
     const drawn = JSON.stringify([cellLobes && cellLobes.rpm ? cellLobes.rpm.length : 0, cellLobes && cellLobes.gain_ns_per_m,
-      m.spindle_rpm, m.depth_mm, m.cutting, d.advice && d.advice.seq, s.state, s.parameter_set, s.gain_ns_per_m,
+      m.spindle_rpm, m.depth_mm, m.cutting, d.advice && d.advice.seq, d.advice && d.advice.status, s.state, s.parameter_set, s.gain_ns_per_m,
       m.limits_pose_deg, cellLobes && cellLobes.pose_deg]);
     if (d.spectrum !== undefined || drawn !== lobesDrawn) { lobesDrawn = drawn; plotLobes(cellLobes, d.machining, d.advice); }
     plotTiming(d.status);

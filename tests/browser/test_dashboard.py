@@ -406,6 +406,14 @@ class DashboardInABrowser(unittest.TestCase):
                        "return [e.textContent, e.dataset.followed]" % (fixed % lower, "700", advice))
         self.assertEqual(away[1], "false", away[0])
         self.assertIn("go to 666.7 rpm", away[0])
+        # One the cell has expired (the state it was for is gone) says why, and its speeds leave the plot.
+        expired = advice[:-1] + ", status: 'expired', status_reason: 'the spindle at 720.0 rpm, not the 700.0 rpm it was for'}"
+        gone = self.js("plotLobes(%s, {spindle_rpm: %s, depth_mm: 0.5}, %s); const e = document.getElementById('advice');"
+                       "return [e.textContent, e.dataset.status, window.robodamp.plotted.lobes.advised]" % (fixed % lower, "720", expired))
+        self.assertEqual(gone[1], "expired", gone[0])
+        self.assertIn("expired: the spindle at 720.0 rpm, not the 700.0 rpm it was for", gone[0])
+        self.assertNotIn("go to", gone[0])
+        self.assertEqual(gone[2], 0, "an expired advice's speeds drawn")
         # Disarming asks too; raising the gain back is sent at once.
         said, _, confirming = self.type_and_press("gain", f"{k_now:.0f}")
         self.assertFalse(confirming)
@@ -522,6 +530,10 @@ class DashboardInABrowser(unittest.TestCase):
                      lambda: abs(api("a")["machining"].get("spindle_rpm", 0) - advised) < 0.5,
                      lambda: self.js("return document.getElementById('advice').dataset.followed") == "true")
         self.assertIn("followed: at the advised", self.browser.find_element(By.ID, "advice").text)
+        # The cell knows it too (runtime::AdviceStatus), and the page shows the cell's word.
+        self.follows("the advice followed by the cell's word",
+                     lambda: ((api("a") or {}).get("advice") or {}).get("status") == "followed",
+                     lambda: self.js("return document.getElementById('advice').dataset.status") == "followed")
         # The speed schedule's K at the new speed: once the cell's gain has settled, the page shows it.
         gains = []
         def settled_gain():
