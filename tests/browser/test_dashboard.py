@@ -414,6 +414,7 @@ class DashboardInABrowser(unittest.TestCase):
         self.assertIn("expired: the spindle at 720.0 rpm, not the 700.0 rpm it was for", gone[0])
         self.assertNotIn("go to", gone[0])
         self.assertEqual(gone[2], 0, "an expired advice's speeds drawn")
+        self.browser.save_screenshot(os.path.join(OUT, "dashboard_advice_expired.png"))
         # Disarming asks too; raising the gain back is sent at once.
         said, _, confirming = self.type_and_press("gain", f"{k_now:.0f}")
         self.assertFalse(confirming)
