@@ -16,6 +16,21 @@ int forced_lines_per_revolution(const config::MillingConfig& job) {
   return runout ? 1 : job.tool.teeth;
 }
 
+std::vector<double> modes_above_band(const config::MillingConfig& job, const std::string& structure_name,
+                                     double sample_rate_hz) {
+  std::vector<double> above;
+  const config::StructureConfig* structure = job.find_structure(structure_name.empty() ? job.structure : structure_name);
+  if (structure == nullptr && structure_name.empty() && !job.structures.empty()) structure = &job.structures.front();
+  if (structure != nullptr)
+    for (const auto& part : structure->parts)
+      for (const auto& direction : part.modes)
+        for (const auto& m : direction)
+          if (m.natural_freq_hz > indicator_band_max_hz(sample_rate_hz)) above.push_back(m.natural_freq_hz);
+  std::sort(above.begin(), above.end());
+  above.erase(std::unique(above.begin(), above.end()), above.end());
+  return above;
+}
+
 ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s)
     : fs_(sample_rate_hz), s_(s) {
   ring_.assign(static_cast<std::size_t>(std::ceil(s_.max_window_s * fs_)), 0.0);
@@ -115,7 +130,7 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   off_bins_.clear();
   for (std::size_t k = 1; k < fft_->bins(); ++k) {
     const double f = static_cast<double>(k) * df;
-    if (f < s_.band_min_hz || f > 0.45 * fs_) continue;
+    if (f < s_.band_min_hz || f > indicator_band_max_hz(fs_)) continue;
     const double e_a = std::norm(X[k]), e = e_a / (f * f);
     total += e, total_a += e_a;
     const double f_line = f_sp * s_.lines_per_revolution, h = std::round(f / f_line);

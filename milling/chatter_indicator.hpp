@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace robodamp::analysis {
@@ -98,6 +99,15 @@ namespace robodamp::milling {
 
 // The job's forced lines per revolution: its teeth without runout (time_domain.runout_um all zero), else 1.
 [[nodiscard]] int forced_lines_per_revolution(const config::MillingConfig& job);
+
+// The top of the band the indicator hears: 0.45 x the sample rate (below the anti-alias filter's edge).
+[[nodiscard]] constexpr double indicator_band_max_hz(double sample_rate_hz) { return 0.45 * sample_rate_hz; }
+// The modal frequencies of the job's structure (structure_name, or the job's own when empty; every part and
+// direction; modal terms only, not a damping configuration's or a robot model's) above that band,
+// ascending, each once: a chatter on one of them is not heard by an indicator at this rate (a spindle or
+// tool mode's chatter at kHz, on a 5 kHz loop).
+[[nodiscard]] std::vector<double> modes_above_band(const config::MillingConfig& job, const std::string& structure_name,
+                                                   double sample_rate_hz);
 
 class ChatterMonitor {
  public:

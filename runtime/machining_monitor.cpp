@@ -40,6 +40,14 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
                                                "= " + std::to_string(cfg.spindle.teeth) + " but the job " +
                                                    cfg.spindle.job + " cuts with tool.teeth = " +
                                                    std::to_string(job.tool.teeth)}});
+  unheard_modes_hz_ = milling::modes_above_band(job, cfg.spindle.structure, cfg.loop.rate_hz);
+  if (const auto& u = unheard_modes_hz_; !u.empty())
+    spdlog::warn("machining: the live chatter indicator hears up to {:.0f} Hz (0.45 x the {:.0f} Hz loop rate); {} above "
+                 "it: a chatter there is not seen here (record the cut with a microphone or a fast accelerometer and run "
+                 "robodamp chatter)",
+                 milling::indicator_band_max_hz(cfg.loop.rate_hz), cfg.loop.rate_hz,
+                 u.size() == 1 ? fmt::format("the job's mode at {:.0f} Hz is", u[0])
+                               : fmt::format("{} of the job's modes, {:.0f}-{:.0f} Hz, are", u.size(), u.front(), u.back()));
   const double rpm_min = job.lobes.rpm_min, rpm_max = std::min(job.lobes.rpm_max, cfg.spindle.rpm_max);
   for (int i = 0; i <= kLobeSpeeds; ++i) lobe_rpm_.push_back(rpm_min + (rpm_max - rpm_min) * i / kLobeSpeeds);
   milling::LiveStabilitySettings ls;

@@ -67,6 +67,8 @@ class MachiningMonitor {
   static constexpr std::size_t kTrailEntries = 64;
   // Any thread: the latest spindle-speed advice (runtime/speed_advisor.hpp), if any was asked for.
   [[nodiscard]] std::optional<AdviceRecord> advice() const { return advisor_->latest(); }
+  // The job's modes above the live indicator's band (milling::modes_above_band; warned at construction).
+  [[nodiscard]] const std::vector<double>& unheard_modes_hz() const { return unheard_modes_hz_; }
 
  private:
   [[nodiscard]] std::optional<dds::LobesSample> scheduled_lobes(std::size_t active);
@@ -78,6 +80,7 @@ class MachiningMonitor {
   // The last limits found when they are for this speed, set and K (at another pose).
   [[nodiscard]] std::optional<milling::LiveLimits> moved_from(double rpm, std::size_t set, double gain) const;
   int teeth_;
+  std::vector<double> unheard_modes_hz_;
   std::vector<config::Config> set_configs_;  // every parameter set's configuration (their K by speed)
   std::function<std::size_t()> active_set_;
   std::function<double()> robot_depth_mm_;

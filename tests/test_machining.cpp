@@ -2,6 +2,7 @@
 // chatter indicator (milling/chatter_indicator) and the cell's machining view (runtime/machining_monitor).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -468,6 +469,30 @@ TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
     EXPECT_EQ(sample.advised_rpm, a->advice.options.front().rpm);
     EXPECT_EQ(sample.option_rpm.size(), a->advice.options.size());
   }
+}
+
+// The live indicator hears up to 0.45 x the loop rate: a job whose modes go above that (the industrial
+// robot's spindle modes at 2.4-6.6 kHz; its SDM chatter at 10 700 rpm is at 5486 Hz) is said at once, the
+// modes named; the default job's (9.2-23.5 Hz) are all heard. Only the structure the cell uses counts.
+TEST(MachiningMonitor, TheJobsModesAboveTheIndicatorsBandAreSaid) {
+  const config::MillingConfig robot = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) +
+                                                                  "/config/milling/industrial_robot_aluminium.yaml");
+  const std::vector<double> above = milling::modes_above_band(robot, "", 5000.0);
+  ASSERT_EQ(above.size(), 14U);  // of robot_workpiece's, 2404-6629 Hz (2223.8 Hz is heard)
+  EXPECT_EQ(above.front(), 2404.0);
+  EXPECT_EQ(above.back(), 6629.3);
+  EXPECT_TRUE(std::is_sorted(above.begin(), above.end()));
+  EXPECT_NE(std::find(above.begin(), above.end(), 5434.3), above.end());
+  EXPECT_EQ(std::adjacent_find(above.begin(), above.end()), above.end()) << "each once";
+  const std::vector<double> at_50k = milling::modes_above_band(robot, "", 50000.0);
+  EXPECT_TRUE(at_50k.empty()) << at_50k.front();
+  EXPECT_TRUE(milling::modes_above_band(config::load_milling_config(job_path()), "", 5000.0).empty());
+  // The cell with the default job: nothing unheard.
+  const config::Config cfg = cell_with_job("robodamp_unheard_", 0.5);
+  runtime::MachiningInputs in;
+  in.active_set = [] { return std::size_t{0}; };
+  runtime::MachiningMonitor quiet(cfg, {cfg}, std::move(in));
+  EXPECT_TRUE(quiet.unheard_modes_hz().empty());
 }
 
 TEST(MachiningMonitor, AJobThatDoesNotFitTheCellIsAConfigurationError) {
