@@ -1,6 +1,9 @@
 #include "config/file_paths.hpp"
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
+#include <sstream>
 
 namespace robodamp::config {
 
@@ -22,6 +25,60 @@ const std::vector<std::vector<YamlPathItem>>& file_path_keys() {
       {"dashboard", "action_log"},
   };
   return keys;
+}
+
+std::vector<std::string> data_dirs() {
+  std::vector<std::string> dirs;
+  auto add = [&](const std::string& list) {
+    std::stringstream in(list);
+    for (std::string d; std::getline(in, d, ':');)
+      if (!d.empty() && std::find(dirs.begin(), dirs.end(), d) == dirs.end()) dirs.push_back(d);
+  };
+  if (const char* env = std::getenv("ROBODAMP_DATA_PATH"); env != nullptr) add(env);
+  add(ROBODAMP_DATA_DIRS);
+  return dirs;
+}
+
+std::string FoundFile::looked_text() const {
+  if (rest.empty()) return beside;
+  std::string dirs;
+  for (const auto& d : searched) dirs += (dirs.empty() ? "" : ", ") + d;
+  return beside + ", then " + rest + " in " + (dirs.empty() ? std::string("no data folder") : dirs + " and the folders in them");
+}
+
+FoundFile find_named_file(const std::string& source_dir, const std::string& written) {
+  FoundFile f;
+  const fs::path p(written);
+  std::error_code ec;
+  auto is_file = [&](const fs::path& c) { return fs::is_regular_file(c, ec); };
+  f.path = f.beside = (p.is_absolute() ? p : fs::path(source_dir) / p).lexically_normal().string();
+  if (is_file(f.path) || p.is_absolute() || written.empty()) {
+    f.found = is_file(f.path);
+    return f;
+  }
+  fs::path rest;  // the path without its leading ../ and ./
+  bool leading = true;
+  for (const auto& part : p.lexically_normal()) {
+    if (leading && (part == ".." || part == ".")) continue;
+    leading = false;
+    rest /= part;
+  }
+  f.rest = rest.string();
+  for (const auto& dir : data_dirs()) {
+    f.searched.push_back(dir);
+    std::vector<fs::path> places{fs::path(dir)};
+    for (const auto& e : fs::directory_iterator(dir, ec))
+      if (e.is_directory(ec)) places.push_back(e.path());
+    std::sort(places.begin() + 1, places.end());
+    for (const auto& place : places) {
+      const fs::path candidate = (place / rest).lexically_normal();
+      if (is_file(candidate)) {
+        f.path = candidate.string(), f.found = true;
+        return f;
+      }
+    }
+  }
+  return f;
 }
 
 EditedYaml rebase_file_paths(const std::string& text, const std::string& from_source, const std::string& to_path) {

@@ -14,6 +14,23 @@ namespace robodamp::config {
 
 [[nodiscard]] const std::vector<std::vector<YamlPathItem>>& file_path_keys();
 
+// A file a configuration names, as found. written relative: first beside the configuration (source_dir),
+// as it always was; where it is not there, in the data folders (ROBODAMP_DATA_PATH, ':'-separated, then the
+// installed /usr/share/robodamp and the source tree's config/), with its leading "../" and "./" dropped,
+// in each data folder and each folder inside it: a job copied out of the tree that names
+// ../presets/horizontal_c2.yaml finds the shipped preset. Absolute paths are taken as written.
+struct FoundFile {
+  std::string path;                 // where it was found, or (not found) the path beside the configuration
+  bool found{false};
+  std::string beside;                // the path beside the configuration (tried first)
+  std::string rest;                  // what was looked for in the data folders (empty: they were not searched)
+  std::vector<std::string> searched;  // the data folders searched, in order
+  [[nodiscard]] std::string looked_text() const;  // "A, then B in D1, D2 and the folders in them"
+};
+[[nodiscard]] FoundFile find_named_file(const std::string& source_dir, const std::string& written);
+// The data folders searched, in order.
+[[nodiscard]] std::vector<std::string> data_dirs();
+
 // `text` read from `from_source` (a file path; its directory resolves the relative paths), rewritten to be
 // written at `to_path`: each relative file path becomes relative to to_path's directory (absolute when no
 // relative form exists). Absolute paths and the rest of the text stay as they are (config/yaml_edit.hpp).

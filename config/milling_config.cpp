@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "config/file_paths.hpp"
 #include "config/robot_model_config.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -113,12 +114,6 @@ CutConfig read_cut(MapReader& top, const ToolConfig& tool) {
   return c;
 }
 
-// A path as written in the job, relative to the job file's directory unless absolute.
-std::string resolve_against(const std::string& base_dir, const std::string& written) {
-  const std::filesystem::path p = std::filesystem::path(written).is_absolute() ? std::filesystem::path(written)
-                                                                               : std::filesystem::path(base_dir) / written;
-  return p.lexically_normal().string();
-}
 
 std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const std::string& base_dir) {
   Diagnostics& d = pr.diagnostics();
@@ -127,9 +122,9 @@ std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const st
   MapReader r(d, n, pr.path_of("controller"), pr.mark());
   ControllerPartConfig c;
   if (auto v = r.text("config", std::nullopt)) {
-    c.config_path = resolve_against(base_dir, *v);
-    if (!std::ifstream(c.config_path))
-      d.add(n.Mark(), r.path_of("config"), "= '" + *v + "': cannot open " + c.config_path);
+    const FoundFile f = find_named_file(base_dir, *v);
+    c.config_path = f.path;
+    if (!f.found) d.add(n.Mark(), r.path_of("config"), "= '" + *v + "': no such file (looked for " + f.looked_text() + ")");
   }
   if (auto v = read_int(r, "location", {"(location id)", 1, 64}, 1)) c.location = *v;
   if (auto v = r.choice("direction", {"x", "y"}, "y")) c.direction = axis_from(*v);
@@ -145,7 +140,12 @@ std::optional<PosePartConfig> read_pose_part(MapReader& pr, const std::string& b
   MapReader r(d, n, pr.path_of("pose"), pr.mark());
   PosePartConfig c;
   if (auto v = r.text("model", std::nullopt)) {
-    c.model_path = resolve_against(base_dir, *v);
+    const FoundFile f = find_named_file(base_dir, *v);
+    c.model_path = f.path;
+    if (!f.found) {
+      d.add(n.Mark(), r.path_of("model"), "= '" + *v + "': no such file (looked for " + f.looked_text() + ")");
+      c.model_path.clear();
+    }
   }
   c.joints_deg = r.number_list("joints_deg", "deg").value_or(std::vector<double>{});
   r.finish();

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "config/config.hpp"
+#include "config/file_paths.hpp"
 #include "config/robot_model_config.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -147,9 +148,8 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   PoseScheduleConfig c;
   std::optional<RobotModelConfig> model;
   if (auto v = r.text("model", std::nullopt)) {
-    const std::filesystem::path p(*v);
     c.model = *v;
-    c.model_resolved = (p.is_absolute() ? p : std::filesystem::path(source).parent_path() / p).string();
+    c.model_resolved = find_named_file(std::filesystem::path(source).parent_path().string(), *v).path;
     try {
       model = load_robot_model(c.model_resolved);
     } catch (const ConfigError& e) {

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "config/config.hpp"
+#include "config/file_paths.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace robodamp::config::detail {
@@ -31,12 +32,11 @@ SpindleConfig read_spindle(MapReader& top, const std::string& source) {
   if (auto v = read_int(r, "teeth", {"(teeth)", 1, 32}, c.teeth)) c.teeth = *v;
   if (auto v = r.number("rpm_max", {"rpm", 0.0, 200000.0, true}, c.rpm_max)) c.rpm_max = *v;
   if (auto v = r.text("job", ""); v && !v->empty()) {
-    const std::filesystem::path p(*v);
     c.job = *v;
-    c.job_resolved = (p.is_absolute() ? p : std::filesystem::path(source).parent_path() / p).string();
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(c.job_resolved, ec))
-      r.diagnostics().add(r.mark(), "spindle.job", "= '" + c.job + "': no such file (looked for " + c.job_resolved + ")");
+    const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), *v);
+    c.job_resolved = f.path;
+    if (!f.found)
+      r.diagnostics().add(r.mark(), "spindle.job", "= '" + c.job + "': no such file (looked for " + f.looked_text() + ")");
   }
   if (auto v = r.text("structure", "")) c.structure = *v;
   if (auto v = r.number("pose_step_deg", {"deg", 0.1, 45.0}, c.pose_step_deg)) c.pose_step_deg = *v;

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "config/config.hpp"
+#include "config/file_paths.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace robodamp::config {
@@ -156,11 +157,11 @@ std::vector<ParameterSetRef> read_parameter_sets(MapReader& top, const std::stri
   for (const char* m : {"horizontal", "vertical"}) {
     const auto p = r.text(m, "");
     if (!p || p->empty()) continue;
-    ParameterSetRef s{m, *p, (std::filesystem::path(*p).is_absolute() ? std::filesystem::path(*p) : dir / *p).string()};
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(s.resolved_path, ec))
+    const FoundFile f = find_named_file(dir.string(), *p);
+    ParameterSetRef s{m, *p, f.path};
+    if (!f.found)
       r.diagnostics().add(r.mark(), "parameter_sets." + s.mounting,
-                          "= '" + s.path + "': no such file (looked for " + s.resolved_path + ")");
+                          "= '" + s.path + "': no such file (looked for " + f.looked_text() + ")");
     else
       sets.push_back(std::move(s));
   }

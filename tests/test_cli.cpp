@@ -119,6 +119,55 @@ TEST(Cli, CheckConfigAcceptsEveryPreset) {
   EXPECT_NE(r.out.find("joints[1].max_deg = 400 deg is out of range: allowed -360 <= value <= 360 deg"), std::string::npos) << r.out;
 }
 
+// A user copies a shipped file to a folder of their own (issue 53): every job, preset, commissioning file
+// and HIL configuration still reads, its presets, robot models and jobs found in the data folders
+// (config/file_paths.hpp: here the source tree's config/, installed /usr/share/robodamp) when they are not
+// beside it; one copied job runs. A file found nowhere is refused with every place looked in; a data
+// folder of the user's own (ROBODAMP_DATA_PATH) comes first.
+TEST(Cli, ShippedFilesCopiedOutOfTheTreeStillRead) {
+  namespace fs = std::filesystem;
+  const robodamp::test::ScratchDir home("copied");
+  const fs::path tree = fs::path(ROBODAMP_SOURCE_DIR) / "config";
+  std::vector<fs::path> shipped;
+  for (const char* dir : {"", "presets", "milling", "commissioning", "robots"})
+    for (const auto& e : fs::directory_iterator(tree / dir))
+      if (e.path().extension() == ".yaml") shipped.push_back(e.path());
+  ASSERT_GE(shipped.size(), 30U);
+  for (const auto& from : shipped) {
+    const std::string to = home.file(from.filename().string());
+    fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+  }
+  for (const auto& from : shipped) {
+    const Result r = run("check-config " + home.file(from.filename().string()));
+    EXPECT_EQ(r.status, 0) << from << "\n" << r.out;
+  }
+  const Result lobes = run("lobes --config " + home.file("active_damping_c2.yaml") + " --rpm 700 --json");
+  ASSERT_EQ(lobes.status, 0) << lobes.out;
+  // Found nowhere: every place said.
+  std::string job = robodamp::test::read_file((tree / "milling" / "active_damping_c2.yaml").string());
+  robodamp::test::replace_or_throw(job, "../presets/horizontal_c2.yaml", "../presets/no_such_preset.yaml");
+  std::ofstream(home.file("lost.yaml")) << job;
+  const Result lost = run("check-config " + home.file("lost.yaml"));
+  EXPECT_EQ(lost.status, 2) << lost.out;
+  EXPECT_NE(lost.out.find("'../presets/no_such_preset.yaml': no such file (looked for " +
+                          (fs::path(home.path).parent_path() / "presets/no_such_preset.yaml").string() +
+                          ", then presets/no_such_preset.yaml in "),
+            std::string::npos)
+      << lost.out;
+  EXPECT_NE(lost.out.find(tree.string() + " and the folders in them"), std::string::npos) << lost.out;
+  // The user's own data folder first: their preset of that name, not the shipped one (a gain the shipped
+  // file does not have, seen by check-config's summary of the job's controller).
+  fs::create_directories(home.file("mine/presets"));
+  std::string preset = robodamp::test::read_file((tree / "presets" / "horizontal_c2.yaml").string());
+  robodamp::test::replace_or_throw(preset, "  gain_ns_per_m: 2000 ", "  gain_ns_per_m: 1234 ");
+  std::ofstream(home.file("mine/presets/horizontal_c2.yaml")) << preset;
+  fs::remove(home.file("horizontal_c2.yaml"));
+  const Result mine = run_shell("ROBODAMP_DATA_PATH=" + home.file("mine") + " " + ROBODAMP_BINARY + " lobes --config " +
+                                home.file("active_damping_c2.yaml") + " --damped --rpm 700 --json");
+  ASSERT_EQ(mine.status, 0) << mine.out;
+  EXPECT_NE(mine.out.find("1234"), std::string::npos) << mine.out.substr(0, 2000);
+}
+
 // The dashboard's own file (docs/dashboard.md's example) is checked as one, with its keys' units and ranges.
 TEST(Cli, CheckConfigChecksTheDashboardsFile) {
   const std::string path = temp_path("dashboard.yaml");
