@@ -93,6 +93,9 @@ EditedYaml rebase_file_paths(const std::string& text, const std::string& from_so
     const fs::path p = v.Scalar();
     if (p.is_absolute()) continue;
     const fs::path file = (from_dir / p).lexically_normal();
+    // Not beside the configuration: found (or not) in the data folders, from the new place as from the old.
+    std::error_code ec;
+    if (!fs::exists(file, ec)) continue;
     fs::path moved = file.lexically_relative(to_dir);
     if (moved.empty()) moved = file;
     if (moved == p) continue;

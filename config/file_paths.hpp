@@ -33,7 +33,8 @@ struct FoundFile {
 
 // `text` read from `from_source` (a file path; its directory resolves the relative paths), rewritten to be
 // written at `to_path`: each relative file path becomes relative to to_path's directory (absolute when no
-// relative form exists). Absolute paths and the rest of the text stay as they are (config/yaml_edit.hpp).
+// relative form exists). Absolute paths, a relative one that is not beside the configuration (found in the
+// data folders: find_named_file) and the rest of the text stay as they are (config/yaml_edit.hpp).
 [[nodiscard]] EditedYaml rebase_file_paths(const std::string& text, const std::string& from_source,
                                            const std::string& to_path);
 

@@ -202,23 +202,36 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
 }
 
 // A configuration moved to another directory names the same files: relative paths rebased, absolute ones
-// and the rest of the text (comments, flow style) kept.
+// and the rest of the text (comments, flow style) kept; a relative path not beside the configuration (found
+// in the data folders, config/file_paths.hpp, from the new place as from the old) kept as written.
 TEST(ConfigFilePaths, AMovedConfigurationStillNamesTheSameFiles) {
+  const test::ScratchDir s("rebase");
+  const std::string a = s.path;
+  fs::create_directories(a + "/b/robots");
+  fs::create_directories(a + "/b/cells/sets");
+  std::ofstream(a + "/b/robots/r.yaml") << "# a robot\n";
+  std::ofstream(a + "/b/cells/sets/h.yaml") << "# a set\n";
   const std::string text =
       "# the cell\npose_schedule: {model: ../robots/r.yaml, axis: x}  # flow\nspindle:\n  job: /abs/job.yaml\n"
       "parameter_sets:\n  horizontal: sets/h.yaml\n";
-  const config::EditedYaml e = config::rebase_file_paths(text, "/a/b/cells/cell.yaml", "/a/out/deep/cell.yaml");
+  const config::EditedYaml e = config::rebase_file_paths(text, a + "/b/cells/cell.yaml", a + "/out/deep/cell.yaml");
   EXPECT_TRUE(e.comments_kept);
   EXPECT_NE(e.text.find("# the cell"), std::string::npos) << e.text;
   EXPECT_NE(e.text.find("model: ../../b/robots/r.yaml"), std::string::npos) << e.text;
   EXPECT_NE(e.text.find("job: /abs/job.yaml"), std::string::npos) << e.text;
   EXPECT_NE(e.text.find("horizontal: ../../b/cells/sets/h.yaml"), std::string::npos) << e.text;
-  EXPECT_EQ(config::rebase_file_paths(text, "/a/b/cells/cell.yaml", "/a/b/cells/other.yaml").text, text);
+  EXPECT_EQ(config::rebase_file_paths(text, a + "/b/cells/cell.yaml", a + "/b/cells/other.yaml").text, text);
+  const std::string shipped = "spindle:\n  job: ../milling/active_damping_c2.yaml\n";
+  EXPECT_EQ(config::rebase_file_paths(shipped, a + "/b/cells/cell.yaml", a + "/out/deep/cell.yaml").text, shipped);
   // Bare file names (tune --out tuned.yaml in the working directory) are in the working directory.
+  const fs::path was = fs::current_path();
+  fs::current_path(a + "/b/cells");
   const std::string cwd = fs::current_path().lexically_normal().string();
-  EXPECT_NE(config::rebase_file_paths(text, "cell.yaml", cwd + "/sub/tuned.yaml").text.find("model: ../../robots/r.yaml"),
-            std::string::npos);
-  EXPECT_EQ(config::rebase_file_paths(text, "cell.yaml", "tuned.yaml").text, text);
+  const std::string sub = config::rebase_file_paths(text, "cell.yaml", cwd + "/sub/tuned.yaml").text;
+  const std::string same = config::rebase_file_paths(text, "cell.yaml", "tuned.yaml").text;
+  fs::current_path(was);
+  EXPECT_NE(sub.find("model: ../../robots/r.yaml"), std::string::npos) << sub;
+  EXPECT_EQ(same, text);
 }
 
 }  // namespace
