@@ -126,6 +126,8 @@ std::pair<AdviceStatus, std::string> SpeedAdvisor::status_in(const AdviceRecord&
   const bool on_the_way = rpm >= std::min(q.rpm, to) - same_speed_rpm(q.rpm) && rpm <= std::max(q.rpm, to) + same_speed_rpm(q.rpm);
   if (!on_the_way)
     return {AdviceStatus::kExpired, fmt("the spindle at %.1f rpm, not the %.1f rpm it was for", rpm, q.rpm)};
+  // On its way, a speed schedule's set and K follow the speed: what else it was for counts at its own speed.
+  if (std::abs(rpm - q.rpm) > same_speed_rpm(q.rpm)) return {AdviceStatus::kCurrent, ""};
   if (v.parameter_set != q.set)
     return {AdviceStatus::kExpired, fmt("parameter set %.0f runs, not set %.0f", static_cast<double>(v.parameter_set),
                                         static_cast<double>(q.set))};

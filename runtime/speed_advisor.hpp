@@ -63,7 +63,8 @@ class SpeedAdvisor {
   // the gain the same as a period ago (an advice during a fade would be for a passing state).
   [[nodiscard]] static std::optional<milling::SpeedAdviceRequest> wanted(const AdviceView& v, bool gain_settled);
   // The advice's status in the view now: followed at the advised speed (within same_speed_rpm); expired
-  // when the spindle stopped or turns at another speed (not on its way to the advised one), the set, the gain, the damper, the depth or the pose
+  // when the spindle stopped or turns at another speed (not on its way to the advised one; on its way the
+  // rest is not looked at: a speed schedule changes the set and K with the speed), or at its speed the set, the gain, the damper, the depth or the pose
   // changed, or neither chatter nor a depth above the limit asks any more; else current. With the reason
   // (empty while current).
   [[nodiscard]] static std::pair<AdviceStatus, std::string> status_in(const AdviceRecord& r, const AdviceView& v);

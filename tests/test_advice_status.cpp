@@ -57,6 +57,9 @@ TEST(AdviceStatus, EachChangeOfTheStateItWasForExpiresItWithTheReason) {
   expect(v, AdviceStatus::kFollowed, "the spindle at the advised 667.9 rpm");
   v.sample.spindle_rpm = 685.0;  // ramping from 700 to the advised 666.7 rpm: on its way
   expect(v, AdviceStatus::kCurrent, "");
+  v.parameter_set = 0, v.gain_ns_per_m = 3040.0;  // a speed schedule's band crossed on the way
+  expect(v, AdviceStatus::kCurrent, "");
+  v.parameter_set = 1, v.gain_ns_per_m = 2000.0;
   v.sample.spindle_rpm = 665.2;
   expect(v, AdviceStatus::kExpired, "the spindle at 665.2 rpm, not the 700.0 rpm it was for");
   v.sample.spindle_rpm = 702.0;
