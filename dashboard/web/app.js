@@ -353,7 +353,7 @@ function plotLobes(l, m, a) {
   // one the cell has expired (the state it was for is gone) says why, and its speeds are not drawn.
   const state = adviceState(a, m), followed = state === 'followed';
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
-    (state === 'expired' ? 'expired: ' + esc(a.status_reason) + ' (it was ' + (a.found ? fmt(a.advised_rpm, 1) + ' rpm' : 'no speed') + ')'
+    (state === 'expired' ? 'expired: ' + esc(a.status_reason) + ' (it was ' + (a.found ? fmt(a.advised_rpm, 1) + ' rpm' : 'none in range') + ')'
     : !a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
       fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method)) : 'no advice asked for';
   $('advice').dataset.followed = followed ? 'true' : 'false';
