@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <tuple>
 
@@ -16,12 +15,6 @@ namespace {
 auto state_key(const milling::SpeedAdviceRequest& r) {
   return std::make_tuple(std::lround(r.rpm), std::lround(r.depth_mm * 1e3), r.set, std::lround(r.gain_ns_per_m / 10.0),
                          r.damped, r.trigger, r.pose_deg);
-}
-
-std::string fmt(const char* f, double a, double b = 0.0) {
-  char s[200];
-  std::snprintf(s, sizeof s, f, a, b);
-  return s;
 }
 
 }  // namespace
@@ -119,23 +112,22 @@ std::pair<AdviceStatus, std::string> SpeedAdvisor::status_in(const AdviceRecord&
   const double rpm = m.spindle_rpm;
   if (r.advice.found && rpm > 0.0 &&
       std::abs(rpm - r.advice.options.front().rpm) <= same_speed_rpm(r.advice.options.front().rpm))
-    return {AdviceStatus::kFollowed, fmt("the spindle at the advised %.1f rpm", rpm)};
+    return {AdviceStatus::kFollowed, fmt::format("the spindle at the advised {:.1f} rpm", rpm)};
   if (!(rpm > 0.0)) return {AdviceStatus::kExpired, "the spindle stopped"};
   // A spindle ramping from the speed it was asked at to the advised one is following it, not elsewhere.
-  const double to = r.advice.found ? r.advice.options.front().rpm : q.rpm;
-  const bool on_the_way = rpm >= std::min(q.rpm, to) - same_speed_rpm(q.rpm) && rpm <= std::max(q.rpm, to) + same_speed_rpm(q.rpm);
+  const double to = r.advice.found ? r.advice.options.front().rpm : q.rpm, near = same_speed_rpm(q.rpm);
+  const bool on_the_way = rpm >= std::min(q.rpm, to) - near && rpm <= std::max(q.rpm, to) + near;
   if (!on_the_way)
-    return {AdviceStatus::kExpired, fmt("the spindle at %.1f rpm, not the %.1f rpm it was for", rpm, q.rpm)};
+    return {AdviceStatus::kExpired, fmt::format("the spindle at {:.1f} rpm, not the {:.1f} rpm it was for", rpm, q.rpm)};
   // On its way, a speed schedule's set and K follow the speed: what else it was for counts at its own speed.
-  if (std::abs(rpm - q.rpm) > same_speed_rpm(q.rpm)) return {AdviceStatus::kCurrent, ""};
+  if (std::abs(rpm - q.rpm) > near) return {AdviceStatus::kCurrent, ""};
   if (v.parameter_set != q.set)
-    return {AdviceStatus::kExpired, fmt("parameter set %.0f runs, not set %.0f", static_cast<double>(v.parameter_set),
-                                        static_cast<double>(q.set))};
+    return {AdviceStatus::kExpired, fmt::format("parameter set {} runs, not set {}", v.parameter_set, q.set)};
   if (std::abs(v.gain_ns_per_m - q.gain_ns_per_m) > std::max(10.0, 0.01 * std::abs(q.gain_ns_per_m)))
-    return {AdviceStatus::kExpired, fmt("K = %.0f N s/m, not the %.0f N s/m it was for", v.gain_ns_per_m, q.gain_ns_per_m)};
+    return {AdviceStatus::kExpired, fmt::format("K = {:.0f} N s/m, not the {:.0f} N s/m it was for", v.gain_ns_per_m, q.gain_ns_per_m)};
   if (m.loop_active != q.damped) return {AdviceStatus::kExpired, m.loop_active ? "the damper active now" : "the damper off now"};
   if (std::abs(m.depth_mm - q.depth_mm) > 1e-3)
-    return {AdviceStatus::kExpired, fmt("the depth %.3f mm, not the %.3f mm it was for", m.depth_mm, q.depth_mm)};
+    return {AdviceStatus::kExpired, fmt::format("the depth {:.3f} mm, not the {:.3f} mm it was for", m.depth_mm, q.depth_mm)};
   if (m.limits_pose_deg != q.pose_deg) return {AdviceStatus::kExpired, "the robot moved to another pose"};
   if (m.indicator_valid && !m.chatter && m.limits_ready && !m.depth_warning)
     return {AdviceStatus::kExpired, "no chatter and the depth within the limit now"};
