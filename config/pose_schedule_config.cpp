@@ -149,9 +149,11 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   std::optional<RobotModelConfig> model;
   if (auto v = r.text("model", std::nullopt)) {
     c.model = *v;
-    c.model_resolved = find_named_file(std::filesystem::path(source).parent_path().string(), *v).path;
+    const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), *v);
+    c.model_resolved = f.path;
     try {
-      model = load_robot_model(c.model_resolved);
+      if (!f.found) d.add(r.mark(), "pose_schedule.model", "= '" + c.model + "': no such file (looked for " + f.looked_text() + ")");
+      else model = load_robot_model(c.model_resolved);
     } catch (const ConfigError& e) {
       const std::string why = e.problems().empty() ? e.what() : e.problems().front().to_string();
       d.add(r.mark(), "pose_schedule.model", "= '" + c.model + "': " + why);
