@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 
 #include "analysis/loop_model.hpp"
 #include "analysis/mode_improvement.hpp"
@@ -25,6 +28,19 @@ std::string fmt(double v) {
 config::ConfigError region_error(const config::Config& cfg, std::size_t i, const std::string& message) {
   return config::ConfigError(config::located(
       {config::Problem{cfg.source, {}, "pose_schedule.regions[" + std::to_string(i) + "]", message}}, cfg.yaml_text));
+}
+
+// The modal map of a model with measured modes, built once per model, axis and count (it solves the model
+// at every measured pose): pose_modes is asked thousands of times in a pose tune, from several threads.
+std::shared_ptr<const robot::ModalMap> modal_map_for(const config::RobotModelConfig& model, int axis, int count) {
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_ptr<const robot::ModalMap>> maps;
+  const std::string key = config::robot_model_yaml(model) + "\n#" + std::to_string(axis) + "," + std::to_string(count);
+  const std::lock_guard lock(mutex);
+  auto it = maps.find(key);
+  if (it != maps.end()) return it->second;
+  if (maps.size() >= 16) maps.clear();  // a few models per process; a fit's trials have no measured modes
+  return maps[key] = std::make_shared<const robot::ModalMap>(model, axis, count);
 }
 
 }  // namespace
@@ -57,24 +73,37 @@ std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, 
 }
 
 PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
-  const robot::PlanarChain chain = robot::at_pose(model, q);
   PoseModes out;
-  double best = std::numeric_limits<double>::infinity();
-  for (const robot::Mode& md : chain.modes(static_cast<std::size_t>(count))) {
-    const double phi = md.tcp_shape(axis);
-    const double w = kTwoPi * md.freq_hz;
-    if (!(std::abs(phi) > 0.0) || !(w > 0.0)) continue;  // a mode that does not move the TCP along the axis
+  const std::vector<robot::AxisMode> prior = robot::axis_modes(model, q, axis, count);
+  for (const robot::AxisMode& md : prior) {
     config::ModeConfig c;
     c.form = config::ModeForm::kStiffness;
     c.natural_freq_hz = md.freq_hz;
-    c.damping_ratio = robot::modal_damping_ratio(md);
-    c.stiffness_n_per_m = w * w / (phi * phi);
-    if (c.stiffness_n_per_m * c.damping_ratio < best) best = c.stiffness_n_per_m * c.damping_ratio, out.dominant = out.modes.size();
+    c.damping_ratio = md.damping_ratio;
+    c.stiffness_n_per_m = md.stiffness_n_per_m;
     out.modes.push_back(c);
   }
   if (out.modes.empty())
     throw config::ConfigError({config::Problem{model.source, {}, "pose", "no mode of " + model.name + " at " +
                                                                              config::describe_pose(q) + " moves the TCP along the axis"}});
+  if (model.measured_modes) {  // the mapped modes in place of the model's (robot::ModalMap)
+    const std::shared_ptr<const robot::ModalMap> map = modal_map_for(model, axis, count);
+    out.corrections = map->at(q, prior);
+    out.modes.clear();
+    for (const robot::ModeCorrection& c : out.corrections) {
+      config::ModeConfig m;
+      m.form = config::ModeForm::kStiffness;
+      m.natural_freq_hz = c.freq_hz;
+      m.damping_ratio = c.damping_ratio;
+      m.stiffness_n_per_m = c.stiffness_n_per_m;
+      out.modes.push_back(m);
+    }
+    out.nearest_measured_deg = map->nearest_measured_deg(q);
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < out.modes.size(); ++i)
+    if (out.modes[i].stiffness_n_per_m * out.modes[i].damping_ratio < best)
+      best = out.modes[i].stiffness_n_per_m * out.modes[i].damping_ratio, out.dominant = i;
   return out;
 }
 
@@ -87,7 +116,10 @@ config::Config config_at_pose(const config::Config& base, const PoseModes& modes
 
 config::Config config_in_plane_at_pose(const config::Config& base, const config::RobotModelConfig& model,
                                       const std::vector<double>& q, int axis, int count) {
-  (void)pose_modes(model, q, axis, count);  // the same refusals (travel, no mode along the axis)
+  // The same refusals (travel, no mode along the axis); its corrections from measured modes apply in the
+  // plane too: the frequency and damping as they are, the stiffness of every table by the same scale (the
+  // shape scaled alike in both directions).
+  const PoseModes along = pose_modes(model, q, axis, count);
   const robot::PlanarChain chain = robot::at_pose(model, q);
   config::Config c = base;
   c.robot.locations = {{1, "TCP along the actuator", 1}, {2, "TCP across", 1}};
@@ -97,17 +129,28 @@ config::Config config_in_plane_at_pose(const config::Config& base, const config:
     config::FrfConfig f;
     f.name = name;
     f.response_location = response, f.excitation_location = excitation;
+    std::size_t along_index = 0;  // the mode's index in pose_modes' list (the modes that move the TCP along the axis)
     for (const robot::Mode& md : chain.modes(static_cast<std::size_t>(count))) {
       const double shapes = md.tcp_shape(response == 1 ? axis : across) * md.tcp_shape(excitation == 1 ? axis : across);
       const double w = kTwoPi * md.freq_hz;
+      const bool moves_along = std::abs(md.tcp_shape(axis)) > 0.0 && w > 0.0;
+      robot::ModeCorrection corr;  // the mapped mode that corrects this one, if any (scales 1: none)
+      for (const robot::ModeCorrection& c : along.corrections)
+        if (moves_along && c.model_index == static_cast<int>(along_index)) corr = c;
+      if (moves_along) ++along_index;
       if (!(std::abs(shapes) > 0.0) || !(w > 0.0)) continue;
       config::ModeConfig m;
       m.form = config::ModeForm::kStiffness;
-      m.natural_freq_hz = md.freq_hz;
-      m.damping_ratio = robot::modal_damping_ratio(md);
-      m.stiffness_n_per_m = w * w / shapes;
+      m.natural_freq_hz = md.freq_hz * corr.freq_scale;
+      m.damping_ratio = robot::modal_damping_ratio(md) * corr.damping_scale;
+      m.stiffness_n_per_m = w * w / shapes * corr.stiffness_scale;
       f.modes.push_back(m);
     }
+    // The modes the map has from the measurements alone: measured along the axis only, so in H11 alone (their
+    // shape across is unknown).
+    if (response == 1 && excitation == 1)
+      for (std::size_t i = 0; i < along.modes.size(); ++i)
+        if (i < along.corrections.size() && along.corrections[i].measured_only()) f.modes.push_back(along.modes[i]);
     if (!f.modes.empty()) c.robot.frfs.push_back(f);
   }
   c.actuator.location = 1;

@@ -20,16 +20,21 @@
 
 #include "config/config.hpp"
 #include "config/robot_model_config.hpp"
+#include "robot/modal_map.hpp"
 
 namespace robodamp::analysis {
 
-// The robot model's modes at a pose along one axis, lowest first.
+// The robot model's modes at a pose along one axis, lowest first. When the model file has measured_modes
+// (robodamp pose modes), they are the mapped modes (robot::ModalMap), lowest first, each with its uncertainty.
 struct PoseModes {
   std::vector<config::ModeConfig> modes;  // modal-stiffness form, damping from each mode's loss factor / 2
   std::size_t dominant{0};                // the largest peak receptance along the axis (smallest k zeta)
+  std::vector<robot::ModeCorrection> corrections;  // one per mode; empty: the model alone
+  double nearest_measured_deg{0.0};       // with corrections: the joint-space distance to the nearest measured pose
   [[nodiscard]] double dominant_hz() const { return modes.empty() ? 0.0 : modes[dominant].natural_freq_hz; }
 };
-// Throws config::ConfigError (a pose outside the travel) or std::invalid_argument (a non-physical model).
+// Throws config::ConfigError (a pose outside the travel) or std::invalid_argument (a non-physical model, or
+// measured_modes along another axis).
 [[nodiscard]] PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
                                    int axis, int count);
 

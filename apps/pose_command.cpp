@@ -3,6 +3,8 @@
 //   pose table --model F: the model's first mode at each named pose beside the published values
 //   pose fit  --model F --measured Q1,Q2,Q3:FRF.csv ... [--direction yy] [--out fitted.yaml]: the joints'
 //             stiffness and damping from measured TCP FRFs at poses (particle swarm, then BOBYQA)
+//   pose modes --model F (--measurements DIR [--hold-out NAME ...] --out F2 | --joints Q | --pose NAME): the
+//             modes measured at poses as the model's measured_modes, or the mapped modes at a pose
 //   pose map  --model F --vary J1 J2 [--steps N] [--job JOB] [--json F] [--plot PNG]: first-mode frequency,
 //             modal stiffness and (with a job) the minimum limiting depth over a grid of two joints
 #include <algorithm>
@@ -18,6 +20,7 @@
 
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/pose_modes_command.hpp"
 #include "apps/pose_tune_command.hpp"
 #include "identify/modal_fit.hpp"
 #include "identify/pose_measurements.hpp"
@@ -59,6 +62,7 @@ struct PoseArgs {
   std::string method{"sdm"};  // map: the accurate method, or "zoa" (the zero-order preview)
   PoseTuneArgs tune;          // tune (apps/pose_tune_command.hpp)
   bool model_given{false};
+  bool modes_given{false};
 };
 
 bool also_json_out(const PoseArgs& a, const json& j);
@@ -381,6 +385,9 @@ int run_pose(const PoseArgs& given) {
     if (a.what == "frf") return run_frf(m, a);
     if (a.what == "table") return run_table(m, a);
     if (a.what == "fit") return run_fit(m, a);
+    if (a.what == "modes")
+      return run_pose_modes(m, {a.measurements, a.hold_out, a.joints_deg, a.pose_name, a.modes_given ? a.modes : 3, a.out_path, a.json,
+                                a.plot_path, a.vary.empty() ? 2 : a.vary[0]});
     return run_map(m, a);
   } catch (const config::ConfigError& e) {
     std::cerr << e.what() << '\n';
@@ -396,11 +403,11 @@ int run_pose(const PoseArgs& given) {
 void register_pose(Registry& r) {
   auto a = std::make_shared<PoseArgs>();
   CLI::App* sub = r.add("pose",
-                        "Pose-dependent robot dynamics (the planar-robot study): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose table` "
-                        "(the first mode at the model's named poses), `pose map` (first mode over two joints), `pose tune` (a robust set and a "
+                        "Pose-dependent robot dynamics (the planar-robot study): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose modes` "
+                        "(the modes measured at poses into the model, or the mapped modes at a pose), `pose table` (the first mode at the model's named poses), `pose map` (first mode over two joints), `pose tune` (a robust set and a "
                         "schedule drawn from the data over a configuration's workspace, the better written)",
                         [a] { return run_pose(*a); });
-  sub->add_option("what", a->what, "frf, table, fit, map or tune")->required()->check(CLI::IsMember({"frf", "table", "fit", "map", "tune"}));
+  sub->add_option("what", a->what, "frf, table, fit, modes, map or tune")->required()->check(CLI::IsMember({"frf", "table", "fit", "modes", "map", "tune"}));
   sub->add_option("--model", a->model_path, "Robot model file (config/robots/*.yaml); tune: the pose-indexed model (default the configuration's pose_schedule.model)")
       ->check(CLI::ExistingFile)
       ->each([a](const std::string&) { a->model_given = true; });
@@ -412,15 +419,16 @@ void register_pose(Registry& r) {
   r.number(sub, "--overlap-deg", a->tune.overlap_deg, {"deg", 0.0, 30.0}, "tune: neighbouring regions overlap by this (the hand-over's hysteresis)");
   r.number(sub, "--worse-mode-pct", a->tune.worse_mode_pct, {"%", 0.0, 20.0},
            "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default 0: never worse)");
-  r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map: the pose, one relative angle per joint");
-  sub->add_option("--pose", a->pose_name, "frf, map: a pose the model file names");
-  r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes");
+  r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map, modes: the pose, one relative angle per joint");
+  sub->add_option("--pose", a->pose_name, "frf, map, modes: a pose the model file names");
+  r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes (default 4); modes: how many of the model's (default 3)")
+      ->each([a](const std::string&) { a->modes_given = true; });
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e4, true, false}, "frf: FRF band LO HI");
   r.json(sub, a->json, "The result (modes, the table, the fit or the map)");
   r.deprecated(sub->add_option("--json-out", a->json_out_path, "Also write the JSON to this file"), "--json FILE");
-  r.plot_dir(sub, a->plot_dir, "frf, map: pose_frf.png or pose_map.png");
+  r.plot_dir(sub, a->plot_dir, "frf, map, modes: pose_frf.png, pose_map.png or pose_modes.png (the modes along --vary's first joint)");
   r.deprecated(sub->add_option("--plot", a->plot_path, "frf, map: write the plot to this file (PNG)"), "--plot-dir DIR");
-  sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based)");
+  sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based); modes: the first, the plot's joint");
   sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose); tune: the job scored over the workspace map")
       ->check(CLI::ExistingFile);
   sub->add_option("--method", a->method, "map: sdm (default): the job's minimum by semi-discretization over its SDM speeds; zoa: the zero-order method, a fast preview")
@@ -428,11 +436,11 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
   sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
   sub->add_option("--measurements", a->measurements,
-                  "fit: robodamp measure --pose directories (or a --poses directory: all its poses), their joint angles "
+                  "fit, modes: robodamp measure --pose directories (or a --poses directory: all its poses), their joint angles "
                   "and driving-point FRFs; the direction is their configuration's pose_schedule.axis")
       ->check(CLI::ExistingDirectory);
   sub->add_option("--hold-out", a->hold_out,
-                  "fit: pose names (of --measurements) kept out of the fit: the fitted model's error is reported there");
+                  "fit, modes: pose names (of --measurements) kept out of the fit or the map: the error is reported there");
   sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
   r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (the planar-robot study: 10 30)");
   r.whole_number(sub, "--fit-modes", a->fit_modes, {"(modes)", 0, 20},
@@ -442,7 +450,7 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--particles", a->particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
   r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
   r.whole_number(sub, "--seed", a->seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
-  sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here; tune: the configuration with the chosen controller");
+  sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here; modes: the model with its measured modes; tune: the configuration with the chosen controller");
   sub->add_option("--csv", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz");
   r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv frequency step");
 }

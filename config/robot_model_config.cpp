@@ -28,6 +28,7 @@ RobotJointConfig read_joint(MapReader& r) {
   if (auto v = r.number("damping_ratio", {"", 0.0, 1.0, false, true}, 0.02)) c.damping_ratio = *v;
   if (auto v = r.number("min_deg", {"deg", -360.0, 360.0}, -180.0)) c.min_deg = *v;
   if (auto v = r.number("max_deg", {"deg", -360.0, 360.0}, 180.0)) c.max_deg = *v;
+  if (auto v = r.number("translational_stiffness_n_per_m", {"N/m", 0.0, 1e13}, 0.0)) c.translational_stiffness_n_per_m = *v;
   if (c.min_deg >= c.max_deg)
     r.diagnostics().add(r.mark(), r.path_of("max_deg"),
                         "= " + format_number(c.max_deg) + " deg must be above min_deg = " + format_number(c.min_deg) + " deg");
@@ -86,6 +87,42 @@ std::vector<RobotPoseConfig> read_poses(Diagnostics& d, MapReader& top, const Ro
   return out;
 }
 
+// measured_modes: {axis: x|y, poses: [{name, joints_deg, modes: [{natural_freq_hz, damping_ratio,
+// stiffness_n_per_m}, ...]}, ...]}, each pose checked against the joints.
+std::optional<MeasuredModesConfig> read_measured_modes(Diagnostics& d, MapReader& top, const RobotModelConfig& model) {
+  const YAML::Node n = top.child("measured_modes", false, "");
+  if (!present(n)) return std::nullopt;
+  MapReader r(d, n, "measured_modes", top.mark());
+  MeasuredModesConfig c;
+  if (auto v = r.choice("axis", {"x", "y"}, "y")) c.axis = *v == "x" ? 0 : 1;
+  const YAML::Node poses = r.child("poses", true, "the measured poses, each {name, joints_deg, modes}");
+  if (present(poses) && (!poses.IsSequence() || poses.size() == 0)) d.add(poses.Mark(), "measured_modes.poses", "must be a non-empty list");
+  for (std::size_t i = 0; poses.IsSequence() && i < poses.size(); ++i) {
+    const std::string key = "measured_modes.poses[" + std::to_string(i) + "]";
+    MapReader pr(d, poses[i], key, poses.Mark());
+    MeasuredPoseModes p;
+    p.name = pr.text("name", "pose " + std::to_string(i + 1)).value_or("");
+    p.joints_deg = pr.number_list("joints_deg", "deg").value_or(std::vector<double>{});
+    if (auto problem = pose_problem(model, p.joints_deg)) d.add(poses[i].Mark(), key + ".joints_deg", *problem);
+    const YAML::Node modes = pr.child("modes", true, "the modes identified there, lowest first");
+    if (present(modes) && (!modes.IsSequence() || modes.size() == 0)) d.add(poses[i].Mark(), key + ".modes", "must be a non-empty list");
+    for (std::size_t k = 0; modes.IsSequence() && k < modes.size(); ++k) {
+      MapReader mr(d, modes[k], key + ".modes[" + std::to_string(k) + "]", modes.Mark());
+      ModeConfig m;
+      m.form = ModeForm::kStiffness;
+      if (auto v = mr.number("natural_freq_hz", {"Hz", 0.0, 1e4, true})) m.natural_freq_hz = *v;
+      if (auto v = mr.number("damping_ratio", {"", 0.0, 1.0, true, true})) m.damping_ratio = *v;
+      if (auto v = mr.number("stiffness_n_per_m", {"N/m", 0.0, 1e13, true})) m.stiffness_n_per_m = *v;
+      mr.finish();
+      p.modes.push_back(m);
+    }
+    pr.finish();
+    c.poses.push_back(std::move(p));
+  }
+  r.finish();
+  return c;
+}
+
 }  // namespace
 
 RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::string& source_name) {
@@ -108,6 +145,7 @@ RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::stri
     h.finish();
   }
   c.poses = read_poses(d, top, c, false);
+  if (c.joints.size() == c.links.size() && !c.joints.empty()) c.measured_modes = read_measured_modes(d, top, c);
   top.finish();
   if (!d.problems().empty()) throw ConfigError(d.problems());
   return c;
@@ -119,7 +157,7 @@ std::vector<RobotPoseConfig> parse_pose_list(const std::string& yaml_text, const
   const YAML::Node root = detail::load_top_map(d, yaml_text, "name, links, joints, head, poses");
   MapReader top(d, root, "", root.Mark());
   std::vector<RobotPoseConfig> poses = read_poses(d, top, model, true);
-  for (const char* other : {"name", "links", "joints", "head"}) (void)top.child(other, false, "");  // a model file's
+  for (const char* other : {"name", "links", "joints", "head", "measured_modes"}) (void)top.child(other, false, "");  // a model file's
   top.finish();
   std::vector<std::string> names;
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -150,7 +188,8 @@ std::string robot_model_yaml(const RobotModelConfig& m) {
   s += "joints:\n";
   for (const auto& j : m.joints)
     s += "  - {stiffness_nm_per_rad: " + n(j.stiffness_nm_per_rad) + ", damping_ratio: " + n(j.damping_ratio) +
-         ", min_deg: " + n(j.min_deg) + ", max_deg: " + n(j.max_deg) + "}\n";
+         ", min_deg: " + n(j.min_deg) + ", max_deg: " + n(j.max_deg) +
+         (j.translational_stiffness_n_per_m > 0.0 ? ", translational_stiffness_n_per_m: " + n(j.translational_stiffness_n_per_m) : "") + "}\n";
   s += "head: {mass_kg: " + n(m.head_mass_kg) + ", inertia_kgm2: " + n(m.head_inertia_kgm2) + "}\n";
   if (!m.poses.empty()) s += "poses:\n";
   for (const auto& p : m.poses) {
@@ -160,6 +199,17 @@ std::string robot_model_yaml(const RobotModelConfig& m) {
     if (p.measured_f1_hz) s += ", measured_f1_hz: " + n(*p.measured_f1_hz);
     if (p.predicted_f1_hz) s += ", predicted_f1_hz: " + n(*p.predicted_f1_hz);
     s += "}\n";
+  }
+  if (!m.measured_modes) return s;
+  s += "measured_modes:  # identified at measured poses (robodamp pose modes); the model's modes are corrected towards them\n";
+  s += std::string("  axis: ") + (m.measured_modes->axis == 0 ? "x" : "y") + "\n  poses:\n";
+  for (const auto& p : m.measured_modes->poses) {
+    s += "    - name: " + p.name + "\n      joints_deg: [";
+    for (std::size_t i = 0; i < p.joints_deg.size(); ++i) s += (i ? ", " : "") + n(p.joints_deg[i]);
+    s += "]\n      modes:\n";
+    for (const auto& md : p.modes)
+      s += "        - {natural_freq_hz: " + n(md.natural_freq_hz) + ", damping_ratio: " + n(md.damping_ratio) +
+           ", stiffness_n_per_m: " + n(md.stiffness_n_per_m) + "}\n";
   }
   return s;
 }

@@ -23,12 +23,27 @@ struct RobotJointConfig {
   double stiffness_nm_per_rad{1e5};
   double damping_ratio{0.02};
   double min_deg{-180.0}, max_deg{180.0};  // the joint's travel: a pose outside it is refused
+  double translational_stiffness_n_per_m{0.0};  // its bearings in x and y; 0 (the default): rigid
 };
 
 struct RobotPoseConfig {
   std::string name;
   std::vector<double> joints_deg;
   std::optional<double> measured_f1_hz, predicted_f1_hz;  // published values to report beside the model's
+};
+
+// The modes identified at one measured pose along the measured axis (modal-stiffness form), lowest first.
+struct MeasuredPoseModes {
+  std::string name;
+  std::vector<double> joints_deg;
+  std::vector<ModeConfig> modes;
+};
+
+// Modes measured across the workspace (`robodamp pose modes --out`): the model's modes at a pose are
+// corrected towards them (robot/modal_map.hpp; docs/pose_dynamics.md, "Modes between measured poses").
+struct MeasuredModesConfig {
+  int axis{1};  // 0: x, 1: y: the TCP direction they were measured along
+  std::vector<MeasuredPoseModes> poses;
 };
 
 struct RobotModelConfig {
@@ -39,6 +54,7 @@ struct RobotModelConfig {
   double head_mass_kg{0.0};
   double head_inertia_kgm2{0.0};
   std::vector<RobotPoseConfig> poses;
+  std::optional<MeasuredModesConfig> measured_modes;
 };
 
 // Throws ConfigError holding every problem (key, value, unit, allowed range).

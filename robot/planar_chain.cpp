@@ -27,6 +27,10 @@ void check(bool ok, const std::string& what) {
 }
 
 Complex joint_stiffness(const Joint& j) { return {j.stiffness_nm_per_rad, 2.0 * j.damping_ratio * j.stiffness_nm_per_rad}; }
+Complex joint_translational_stiffness(const Joint& j) {
+  return {j.translational_stiffness_n_per_m, 2.0 * j.damping_ratio * j.translational_stiffness_n_per_m};
+}
+bool translation_rigid(const Joint& j) { return !(j.translational_stiffness_n_per_m > 0.0); }
 
 }  // namespace
 
@@ -74,6 +78,8 @@ PlanarChain::PlanarChain(ChainModel model, std::vector<double> joint_angles_rad)
     check(l.elements >= 1 && l.elements <= 64, "link " + n + ": elements must be 1..64");
     check(j.stiffness_nm_per_rad > 0.0 && std::isfinite(j.stiffness_nm_per_rad), "joint " + n + ": stiffness must be > 0 N m/rad");
     check(j.damping_ratio >= 0.0 && j.damping_ratio < 1.0, "joint " + n + ": damping ratio must be in [0, 1)");
+    check(j.translational_stiffness_n_per_m >= 0.0 && std::isfinite(j.translational_stiffness_n_per_m),
+          "joint " + n + ": translational stiffness must be >= 0 N/m (0: rigid)");
   }
   check(m_.head_mass_kg >= 0.0 && m_.head_inertia_kgm2 >= 0.0, "head: mass and inertia must be >= 0");
   double a = 0.0;
@@ -93,8 +99,9 @@ Eigen::Vector2d PlanarChain::tcp_position_m() const {
 }
 
 void PlanarChain::assemble() {
-  // DOF numbering: each node has its own rotation; translations are shared at the joints (link i's
-  // first node is link i-1's last) and fixed at the base.
+  // DOF numbering: each node has its own rotation; translations are shared at a rigid joint (link i's
+  // first node is link i-1's last) and fixed at the base; a joint with translational stiffness gives
+  // link i's first node translations of its own, tied to link i-1's last (or the base) by that spring.
   struct NodeDofs {
     int x, rot;  // x = -1: fixed translation
   };
@@ -104,7 +111,7 @@ void PlanarChain::assemble() {
   for (std::size_t i = 0; i < m_.links.size(); ++i) {
     for (int j = 0; j <= m_.links[i].elements; ++j) {
       NodeDofs d{};
-      if (j == 0) d.x = prev_x;
+      if (j == 0 && translation_rigid(m_.joints[i])) d.x = prev_x;
       else d.x = n, n += 2;
       d.rot = n++;
       nodes[i].push_back(d);
@@ -131,6 +138,15 @@ void PlanarChain::assemble() {
     }
     // Joint i: between the previous link's last rotation (or the base) and this link's first.
     const Complex kj = joint_stiffness(m_.joints[i]);
+    if (!translation_rigid(m_.joints[i])) {
+      const Complex kt = joint_translational_stiffness(m_.joints[i]);
+      const int own = nodes[i].front().x, shared = i > 0 ? nodes[i - 1].back().x : -1;
+      for (int c = 0; c < 2; ++c) {
+        k_(own + c, own + c) += kt;
+        if (shared < 0) continue;
+        k_(shared + c, shared + c) += kt, k_(shared + c, own + c) -= kt, k_(own + c, shared + c) -= kt;
+      }
+    }
     const int b = nodes[i].front().rot;
     k_(b, b) += kj;
     if (i > 0) {
@@ -222,10 +238,11 @@ Eigen::Matrix2cd PlanarChain::tcp_frf_rcsa(double f_hz) const {
     h.bottomRows(3) = cols.bottomRows(3);
     const Eigen::Matrix3cd hss = h.block(0, 0, 3, 3), hse = h.block(0, 3, 3, 3), hes = h.block(3, 0, 3, 3),
                            hee = h.block(3, 3, 3, 3);
-    // The joint: translations rigid, rotation through the spring's compliance. The base is rigid (its
-    // receptance is zero); otherwise the assembly's end receptance adds to the link's start.
+    // The joint: rotation through the spring's compliance, translations rigid or through theirs. The
+    // base is rigid (its receptance is zero); otherwise the assembly's end receptance adds to the link's start.
     Eigen::Matrix3cd c = Eigen::Matrix3cd::Zero();
     c(2, 2) = 1.0 / joint_stiffness(m_.joints[i]);
+    if (!translation_rigid(m_.joints[i])) c(0, 0) = c(1, 1) = 1.0 / joint_translational_stiffness(m_.joints[i]);
     const Eigen::Matrix3cd sum = (i == 0 ? Eigen::Matrix3cd::Zero() : g_end) + hss + c;
     g_end = hee - hes * sum.partialPivLu().solve(hse);
   }

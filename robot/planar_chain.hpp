@@ -30,6 +30,9 @@ struct Link {
 struct Joint {
   double stiffness_nm_per_rad{1e5};
   double damping_ratio{0.02};        // hysteretic: the spring is k (1 + 2 i zeta)
+  // The joint's bearings in translation (x and y alike, the same hysteretic damping): 0 = rigid, the
+  // translations shared. A compliance the torsional-only model lacks (docs/pose_dynamics.md).
+  double translational_stiffness_n_per_m{0.0};
 };
 
 struct ChainModel {

@@ -47,7 +47,9 @@ TEST(AdviceStatus, EachChangeOfTheStateItWasForExpiresItWithTheReason) {
     const auto [status, said] = runtime::SpeedAdvisor::status_in(r, v);
     EXPECT_EQ(runtime::to_string(status), std::string(runtime::to_string(s))) << reason;
     EXPECT_NE(said.find(reason), std::string::npos) << said;
-    if (s == AdviceStatus::kCurrent) EXPECT_TRUE(said.empty()) << said;
+    if (s == AdviceStatus::kCurrent) {
+      EXPECT_TRUE(said.empty()) << said;
+    }
   };
   runtime::AdviceView v = state_asked();
   expect(v, AdviceStatus::kCurrent, "");

@@ -63,6 +63,31 @@ TEST(RobotModel, ReceptanceCouplingEqualsTheAssembledModel) {
   EXPECT_LT(std::abs(g(0, 1) - g(1, 0)) / std::abs(g(0, 0)), 1e-9);
 }
 
+// A joint whose bearings give in translation (a compliance the torsional-only model lacks): the two
+// ways still agree, the modes soften, and a very stiff bearing is the rigid joint again.
+TEST(RobotModel, AJointsTranslationalComplianceIsCoupledAlikeBothWays) {
+  robot::ChainModel soft = three_links();
+  soft.joints[0].translational_stiffness_n_per_m = 4e6;  // to the base
+  soft.joints[1].translational_stiffness_n_per_m = 2e6;  // the elbow
+  const std::vector<double> q{-120.13 * kDeg, 133.37 * kDeg, -14.13 * kDeg};
+  const robot::PlanarChain c(soft, q);
+  double worst = 0.0;
+  for (double f = 0.5; f < 400.0; f *= 1.07) {
+    const Eigen::Matrix2cd d = c.tcp_frf_direct(f), r = c.tcp_frf_rcsa(f);
+    worst = std::max(worst, (d - r).norm() / d.norm());
+  }
+  for (const auto& md : c.modes(4)) worst = std::max(worst, (c.tcp_frf_direct(md.freq_hz) - c.tcp_frf_rcsa(md.freq_hz)).norm() /
+                                                                c.tcp_frf_direct(md.freq_hz).norm());
+  EXPECT_LT(worst, 1e-6);
+  const robot::PlanarChain rigid(three_links(), q);
+  EXPECT_LT(c.modes(1)[0].freq_hz, rigid.modes(1)[0].freq_hz * 0.999);  // softer
+  soft.joints[0].translational_stiffness_n_per_m = soft.joints[1].translational_stiffness_n_per_m = 1e13;
+  const robot::PlanarChain stiff(soft, q);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(stiff.modes(3)[i].freq_hz, rigid.modes(3)[i].freq_hz, 1e-4 * rigid.modes(3)[i].freq_hz);
+  soft.joints[1].translational_stiffness_n_per_m = -1.0;
+  EXPECT_THROW(robot::PlanarChain(soft, q), std::invalid_argument);
+}
+
 TEST(RobotModel, NonPhysicalModelsAndPosesAreRefusedByName) {
   auto refused = [](robot::ChainModel m, std::vector<double> q, const std::string& what) {
     try {

@@ -1,0 +1,204 @@
+#include "apps/pose_modes_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "analysis/pose_mode_check.hpp"
+#include "analysis/pose_schedule.hpp"
+#include "apps/gnuplot.hpp"
+#include "identify/pose_modes.hpp"
+
+namespace robodamp::apps {
+
+namespace {
+
+using nlohmann::json;
+
+double error_pct(double value, double truth) { return 100.0 * (value / truth - 1.0); }
+
+json row_json(const analysis::ModeCheckRow& r) {
+  auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"pose", r.pose},
+          {"joints_deg", r.joints_deg},
+          {"role", r.held_out ? "held out" : "map"},
+          {"measured_hz", r.measured_hz},
+          {"measured_damping_ratio", r.measured_damping_ratio},
+          {"measured_stiffness_n_per_m", r.measured_stiffness_n_per_m},
+          {"model_hz", num(r.model_hz)},
+          {"model_stiffness_n_per_m", num(r.model_stiffness_n_per_m)},
+          {"mapped_hz", num(r.mapped_hz)},
+          {"mapped_damping_ratio", num(r.mapped_damping_ratio)},
+          {"mapped_stiffness_n_per_m", num(r.mapped_stiffness_n_per_m)},
+          {"freq_sigma_pct", num(r.freq_sigma_pct)},
+          {"damping_sigma_pct", num(r.damping_sigma_pct)},
+          {"stiffness_sigma_pct", num(r.stiffness_sigma_pct)},
+          {"nearest_measured_deg", r.nearest_measured_deg}};
+}
+
+void row_text(const analysis::ModeCheckRow& r, std::ostringstream& t) {
+  char b[320];
+  std::snprintf(b, sizeof b, "  %-10s %-9s %8.2f %8.2f %+7.2f %8.2f %+7.2f %6.2f   %+7.1f %+7.1f %6.1f %7.1f\n", r.pose.c_str(),
+                r.held_out ? "held out" : "map", r.measured_hz, r.model_hz, error_pct(r.model_hz, r.measured_hz), r.mapped_hz,
+                error_pct(r.mapped_hz, r.measured_hz), r.freq_sigma_pct, error_pct(r.model_stiffness_n_per_m, r.measured_stiffness_n_per_m),
+                error_pct(r.mapped_stiffness_n_per_m, r.measured_stiffness_n_per_m), r.stiffness_sigma_pct, r.nearest_measured_deg);
+  t << b;
+}
+
+int build_map(const config::RobotModelConfig& model, const PoseModesArgs& a) {
+  identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
+  identify::check_against_model(pm, model);
+  const identify::PoseModesIdentified id = identify::identify_pose_modes(pm, a.hold_out);
+  const int count = pm.modes > 0 ? pm.modes : a.modes;
+  config::RobotModelConfig prior = model, mapped = model;
+  prior.measured_modes.reset();
+  mapped.measured_modes = id.measured;
+  const int axis = id.measured.axis;
+  std::vector<analysis::ModeCheckRow> rows = analysis::check_pose_modes(prior, mapped, id.measured.poses, false, axis, count);
+  for (auto& r : analysis::check_pose_modes(prior, mapped, id.held_out, true, axis, count)) rows.push_back(std::move(r));
+  std::ostringstream t;
+  t << "robot " << model.name << ": modes identified at " << id.measured.poses.size() << " measured pose(s) along "
+    << (axis == 0 ? "x" : "y") << " (" << pm.band_min_hz << "-" << pm.band_max_hz << " Hz), the model's " << count
+    << " lowest corrected towards them; " << id.held_out.size() << " held out\n"
+    << "  frequency: measured, the model's and the map's (error %, one sigma %); modal stiffness: the model's and the\n"
+    << "  map's error %, the map's sigma %; the distance to the nearest pose in the map (deg)\n"
+    << "  pose       role      measured    model   err %   mapped   err %  sigma   k model k mapped sigma nearest\n";
+  json out_rows = json::array();
+  double worst_model = 0.0, worst_mapped = 0.0;
+  int model_missed = 0, map_missed = 0;  // held-out modes with no mode within 25 %
+  for (const auto& r : rows) {
+    row_text(r, t);
+    out_rows.push_back(row_json(r));
+    if (!r.held_out) continue;
+    if (std::isfinite(r.model_hz)) worst_model = std::max(worst_model, std::abs(error_pct(r.model_hz, r.measured_hz)));
+    else ++model_missed;
+    if (std::isfinite(r.mapped_hz)) worst_mapped = std::max(worst_mapped, std::abs(error_pct(r.mapped_hz, r.measured_hz)));
+    else ++map_missed;
+  }
+  if (!id.held_out.empty()) {
+    char b[300];
+    std::snprintf(b, sizeof b, "  at the held-out poses the largest frequency error: the model %.2f %% (%d mode(s) it has not within 25 %%), "
+                  "the map %.2f %% (%d)\n", worst_model, model_missed, worst_mapped, map_missed);
+    t << b;
+  }
+  json r = {{"model", model.source}, {"axis", axis == 0 ? "x" : "y"}, {"modes", count}, {"band_hz", {pm.band_min_hz, pm.band_max_hz}},
+            {"rows", out_rows}, {"modal_fit_error_pct", id.fit_error_pct}};
+  if (!id.held_out.empty()) {
+    r["held_out_worst_freq_error_pct"] = {{"model", worst_model}, {"mapped", worst_mapped}};
+    r["held_out_modes_missed"] = {{"model", model_missed}, {"mapped", map_missed}};
+  }
+  if (!a.out_path.empty()) {
+    std::ofstream f(a.out_path);
+    f << config::robot_model_yaml(mapped);
+    if (!f) {
+      std::cerr << "--out " << a.out_path << ": cannot write\n";
+      return 1;
+    }
+    t << "  wrote the model with its measured modes to " << a.out_path << '\n';
+  }
+  return print_report(r.dump(2), a.json, "pose", t.str(), "", {}, "");
+}
+
+std::vector<double> pose_to_show(const config::RobotModelConfig& m, const PoseModesArgs& a) {
+  if (!a.joints_deg.empty()) return a.joints_deg;
+  for (const auto& p : m.poses)
+    if (p.name == a.pose_name) return p.joints_deg;
+  if (m.measured_modes)
+    for (const auto& p : m.measured_modes->poses)
+      if (p.name == a.pose_name) return p.joints_deg;
+  if (!a.pose_name.empty())
+    throw config::ConfigError({config::Problem{m.source, {}, "poses", "--pose = '" + a.pose_name + "' is not a pose the file names"}});
+  if (m.poses.empty()) throw config::ConfigError({config::Problem{m.source, {}, "poses", "give --joints (the file names no pose)"}});
+  return m.poses.front().joints_deg;
+}
+
+int show_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
+  if (!model.measured_modes)
+    throw config::ConfigError({config::Problem{model.source, {}, "measured_modes",
+                                               "the model has no measured modes: give --measurements (robodamp measure --poses) to add them"}});
+  const std::vector<double> q = pose_to_show(model, a);
+  const int axis = model.measured_modes->axis;
+  config::RobotModelConfig prior = model;
+  prior.measured_modes.reset();
+  const analysis::PoseModes before = analysis::pose_modes(prior, q, axis, a.modes), after = analysis::pose_modes(model, q, axis, a.modes);
+  std::ostringstream t;
+  char b[320];
+  std::snprintf(b, sizeof b, "robot %s at %s: its %zu lowest modes along %s, corrected by the modes measured at %zu pose(s); the\n"
+                "  nearest %.1f deg away in joint space. Mapped value (one sigma %%)\n",
+                model.name.c_str(), config::describe_pose(q).c_str(), after.modes.size(), axis == 0 ? "x" : "y",
+                model.measured_modes->poses.size(), after.nearest_measured_deg);
+  t << b << "  mode   model Hz   mapped Hz  sigma %   damping ratio  sigma %   stiffness N/m  sigma %   measured at\n";
+  json modes = json::array();
+  for (std::size_t i = 0; i < after.modes.size(); ++i) {
+    const auto& m = after.modes[i];
+    const robot::ModeCorrection c = i < after.corrections.size() ? after.corrections[i] : robot::ModeCorrection{};
+    const double model_hz = c.measured_only() || static_cast<std::size_t>(c.model_index) >= before.modes.size()
+                                ? NAN
+                                : before.modes[static_cast<std::size_t>(c.model_index)].natural_freq_hz;
+    std::snprintf(b, sizeof b, "  %4zu   %8.2f    %8.2f  %7.2f   %13.4f  %7.1f   %13.4g  %7.1f   %d pose(s)%s\n", i + 1,
+                  model_hz, m.natural_freq_hz, 100.0 * c.freq_sigma, m.damping_ratio, 100.0 * c.damping_sigma,
+                  m.stiffness_n_per_m, 100.0 * c.stiffness_sigma, c.measured_poses,
+                  c.measured_only() ? ", from the measurements alone" : "");
+    t << b;
+    modes.push_back({{"model_hz", std::isfinite(model_hz) ? json(model_hz) : json(nullptr)}, {"measured_only", c.measured_only()}, {"freq_hz", m.natural_freq_hz}, {"freq_sigma_pct", 100.0 * c.freq_sigma},
+                     {"damping_ratio", m.damping_ratio}, {"damping_sigma_pct", 100.0 * c.damping_sigma},
+                     {"stiffness_n_per_m", m.stiffness_n_per_m}, {"stiffness_sigma_pct", 100.0 * c.stiffness_sigma},
+                     {"measured_poses", c.measured_poses}});
+  }
+  json r = {{"model", model.source}, {"joints_deg", q}, {"axis", axis == 0 ? "x" : "y"},
+            {"nearest_measured_deg", after.nearest_measured_deg}, {"modes", modes}};
+  if (a.plot_path.empty()) return print_report(r.dump(2), a.json, "pose", t.str(), "", {}, "");
+  if (a.vary_joint < 1 || static_cast<std::size_t>(a.vary_joint) > q.size())
+    throw std::invalid_argument("--vary " + std::to_string(a.vary_joint) + ": the plot's joint is one of 1.." + std::to_string(q.size()));
+  const std::size_t joint = static_cast<std::size_t>(a.vary_joint - 1);
+  const auto sweep = analysis::sweep_pose_modes(prior, model, q, joint, 121, axis, a.modes);
+  std::ostringstream data;
+  json points = json::array();
+  std::size_t curves = 0;
+  for (const auto& p : sweep) curves = std::max(curves, p.mapped_hz.size());
+  for (const auto& p : sweep) {
+    data << p.joint_deg;
+    for (std::size_t k = 0; k < curves; ++k) {
+      const double f = k < p.mapped_hz.size() ? p.mapped_hz[k] : NAN, s = k < p.mapped_hz.size() ? p.freq_sigma_pct[k] / 100.0 : 0.0;
+      data << ' ' << plot::num(k < p.model_hz.size() ? p.model_hz[k] : NAN) << ' ' << plot::num(f) << ' '
+           << plot::num(f * std::exp(-2.0 * s)) << ' ' << plot::num(f * std::exp(2.0 * s));
+    }
+    data << '\n';
+    points.push_back({{"joint_deg", p.joint_deg}, {"model_hz", p.model_hz}, {"mapped_hz", p.mapped_hz}, {"freq_sigma_pct", p.freq_sigma_pct}});
+  }
+  data << "\n\n";
+  for (const auto& p : model.measured_modes->poses)
+    for (const auto& m : p.modes) data << p.joints_deg[joint] << ' ' << m.natural_freq_hz << '\n';
+  r["sweep"] = {{"joint", a.vary_joint}, {"points", points}};
+  return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
+    std::ostringstream gp;
+    gp << "set grid; set key top left; set xlabel 'joint " << a.vary_joint << " (deg), the others at the pose shown'; "
+       << "set ylabel 'frequency (Hz)'; set title 'modes along joint " << a.vary_joint
+       << ": the map (line, band 2 sigma), the model alone (dashed), measured (points)'; plot ";
+    const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};
+    for (int k = 0; k < static_cast<int>(curves); ++k) {
+      const int c = 2 + 4 * k;
+      const std::string colour = colours[k % 6];
+      gp << (k ? ", " : "") << "DATA index 0 u 1:" << c + 2 << ":" << c + 3 << " w filledcurves fs transparent solid 0.2 lc rgb '"
+         << colour << "' notitle, '' index 0 u 1:" << c + 1 << " w l lw 2 lc rgb '" << colour << "' t 'mode " << k + 1
+         << " mapped', '' index 0 u 1:" << c << " w l dt 2 lc rgb '" << colour << "' t 'mode " << k + 1 << " model'";
+    }
+    gp << ", DATA index 1 u 1:2 w p pt 7 ps 1.5 lc rgb 'black' t 'measured'";
+    return run_gnuplot(gp.str(), data.str(), a.plot_path);
+  }, a.plot_path);
+}
+
+}  // namespace
+
+int run_pose_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
+  if (!a.measurements.empty()) return build_map(model, a);
+  if (!a.out_path.empty() || !a.hold_out.empty())
+    throw std::invalid_argument("pose modes: --out and --hold-out go with --measurements (the poses to map)");
+  return show_modes(model, a);
+}
+
+}  // namespace robodamp::apps

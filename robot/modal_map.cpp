@@ -1,0 +1,260 @@
+#include "robot/modal_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "robot/robot_model.hpp"
+
+namespace robodamp::robot {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+constexpr double kDegToRad = M_PI / 180.0;
+// A measured mode stands for a model mode when their frequencies are within 25 %.
+const double kMatchLogRatio = std::log(1.25);
+// The identification's scatter of each log ratio (one standard deviation): a fitted mode's frequency to
+// about 0.3 %, its modal stiffness to 3 %, its damping ratio to 10 % (docs/identification.md's repeats).
+constexpr double kFreqNoise = 0.003, kDampingNoise = 0.10, kStiffnessNoise = 0.03;
+// A mode's participation along the axis, w^2 / k (1/kg: the mass-normalised shape squared) is what is
+// interpolated for its stiffness: it is smooth through a pose where the mode turns across the axis (there k
+// goes to infinity and its logarithm with it). A mapped participation below this share of the model's is held
+// there (the mode hardly moves the TCP along the axis); a relative spread is at most kMaxRelativeSigma.
+constexpr double kParticipationFloor = 1e-3, kMaxRelativeSigma = 10.0;
+double participation(double f_hz, double k_n_per_m) {
+  const double w = kTwoPi * f_hz;
+  return w * w / k_n_per_m;
+}
+// The length scales tried (rad over the joints): from one joint's few degrees to the whole travel.
+constexpr double kLengthScalesRad[] = {0.05, 0.08, 0.12, 0.18, 0.25, 0.35, 0.5, 0.7, 1.0, 1.5, 2.5};
+
+Eigen::VectorXd radians(const std::vector<double>& q_deg) {
+  Eigen::VectorXd x(static_cast<Eigen::Index>(q_deg.size()));
+  for (std::size_t i = 0; i < q_deg.size(); ++i) x(static_cast<Eigen::Index>(i)) = q_deg[i] * kDegToRad;
+  return x;
+}
+
+Eigen::MatrixXd correlation(const std::vector<Eigen::VectorXd>& x, double length_rad, double nugget) {
+  const auto n = static_cast<Eigen::Index>(x.size());
+  Eigen::MatrixXd r(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j)
+      r(i, j) = std::exp(-0.5 * (x[static_cast<std::size_t>(i)] - x[static_cast<std::size_t>(j)]).squaredNorm() /
+                         (length_rad * length_rad)) + (i == j ? nugget : 0.0);
+  return r;
+}
+
+// The measured modes' indices among the model's: as many pairs within 25 % as possible, then the smallest
+// sum of |log frequency ratio|. Small counts (a few modes each): searched exhaustively.
+void best_assignment(const std::vector<double>& measured_hz, const std::vector<double>& model_hz, std::size_t i,
+                     std::vector<int>& now, std::vector<bool>& used, int pairs, double cost, int& best_pairs, double& best_cost,
+                     std::vector<int>& best) {
+  if (i == measured_hz.size()) {
+    if (pairs > best_pairs || (pairs == best_pairs && cost < best_cost)) best_pairs = pairs, best_cost = cost, best = now;
+    return;
+  }
+  now[i] = -1;
+  best_assignment(measured_hz, model_hz, i + 1, now, used, pairs, cost, best_pairs, best_cost, best);
+  for (std::size_t m = 0; m < model_hz.size(); ++m) {
+    const double d = std::abs(std::log(measured_hz[i] / model_hz[m]));
+    if (used[m] || !(d < kMatchLogRatio)) continue;
+    used[m] = true, now[i] = static_cast<int>(m);
+    best_assignment(measured_hz, model_hz, i + 1, now, used, pairs + 1, cost + d, best_pairs, best_cost, best);
+    used[m] = false;
+  }
+  now[i] = -1;
+}
+
+std::vector<int> match_modes(const std::vector<double>& measured_hz, const std::vector<double>& model_hz) {
+  std::vector<int> now(measured_hz.size(), -1), best(measured_hz.size(), -1);
+  std::vector<bool> used(model_hz.size(), false);
+  int best_pairs = -1;
+  double best_cost = std::numeric_limits<double>::infinity();
+  best_assignment(measured_hz, model_hz, 0, now, used, 0, 0.0, best_pairs, best_cost, best);
+  return best;
+}
+
+}  // namespace
+
+std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
+  const PlanarChain chain = at_pose(model, q);
+  std::vector<AxisMode> out;
+  for (const Mode& md : chain.modes(static_cast<std::size_t>(count))) {
+    const double phi = md.tcp_shape(axis);
+    const double w = kTwoPi * md.freq_hz;
+    if (!(std::abs(phi) > 0.0) || !(w > 0.0)) continue;  // a mode that does not move the TCP along the axis
+    out.push_back({md.freq_hz, modal_damping_ratio(md), w * w / (phi * phi), md.tcp_shape});
+  }
+  return out;
+}
+
+ModalMap::Field::Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, double noise, bool about_mean) : x_(std::move(x)) {
+  const auto n = static_cast<Eigen::Index>(y.size());
+  const Eigen::VectorXd yv = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
+  noise_var_ = noise * noise;
+  // Far from every measurement the model is no better than its whole error there: the signal's variance
+  // is at least the mean square of the ratios (and at least the noise's).
+  const double centre = about_mean ? yv.mean() : 0.0;
+  const double floor_var = std::max((yv.array() - centre).square().sum() / static_cast<double>(n), noise_var_);
+  double best_l = kLengthScalesRad[0], best_ll = -std::numeric_limits<double>::infinity(), best_var = floor_var;
+  for (const double l : kLengthScalesRad) {
+    double var = floor_var;
+    double ll = 0.0;
+    for (int it = 0; it < 4; ++it) {  // the signal's variance profiled; the nugget follows it
+      const Eigen::LDLT<Eigen::MatrixXd> r(correlation(x_, l, noise_var_ / var));
+      const Eigen::VectorXd ri1 = r.solve(ones);
+      const double mu = ones.dot(r.solve(yv)) / ones.dot(ri1);
+      const Eigen::VectorXd e = yv - mu * ones;
+      const double s2 = n > 1 ? e.dot(r.solve(e)) / static_cast<double>(n - 1) : floor_var;
+      var = std::max(s2, noise_var_);
+      const Eigen::VectorXd d = r.vectorD();
+      double log_det = 0.0;
+      for (Eigen::Index i = 0; i < n; ++i) log_det += std::log(std::max(d(i), 1e-300));
+      ll = -0.5 * (static_cast<double>(n - 1) * std::log(var) + log_det + std::log(ones.dot(ri1)));
+    }
+    if (ll > best_ll) best_ll = ll, best_l = l, best_var = var;
+  }
+  length_ = best_l;
+  signal_var_ = std::max(best_var, floor_var);
+  r_.compute(correlation(x_, length_, noise_var_ / signal_var_));
+  r_ones_ = r_.solve(ones);
+  ones_r_ones_ = ones.dot(r_ones_);
+  mu_ = ones.dot(r_.solve(yv)) / ones_r_ones_;
+  alpha_ = r_.solve(yv - mu_ * ones);
+}
+
+Eigen::VectorXd ModalMap::Field::kernel_column(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd c(static_cast<Eigen::Index>(x_.size()));
+  for (std::size_t i = 0; i < x_.size(); ++i)
+    c(static_cast<Eigen::Index>(i)) = std::exp(-0.5 * (x - x_[i]).squaredNorm() / (length_ * length_));
+  return c;
+}
+
+double ModalMap::Field::mean(const Eigen::VectorXd& x) const {
+  if (x_.empty()) return 0.0;
+  return mu_ + kernel_column(x).dot(alpha_);
+}
+
+double ModalMap::Field::sigma(const Eigen::VectorXd& x) const {
+  if (x_.empty()) return 0.0;
+  const Eigen::VectorXd c = kernel_column(x);
+  const double trend = 1.0 - r_ones_.dot(c);
+  const double v = 1.0 - c.dot(r_.solve(c)) + trend * trend / ones_r_ones_;
+  return std::sqrt(std::max(0.0, signal_var_ * v));
+}
+
+ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) : count_(count) {
+  if (!model.measured_modes || model.measured_modes->poses.empty())
+    throw std::invalid_argument(model.source + ": no measured_modes to interpolate");
+  if (model.measured_modes->axis != axis)
+    throw std::invalid_argument(model.source + ": measured_modes are along " + (model.measured_modes->axis == 0 ? "x" : "y") +
+                                ", the schedule's axis is " + (axis == 0 ? "x" : "y") + ": measure along the actuator's axis");
+  struct Sample {
+    Eigen::VectorXd x;
+    double f_hz, zeta, k, model_f_hz, model_zeta, model_k;
+    int model_index;
+  };
+  std::vector<std::vector<Sample>> tracks;  // the k-th lowest measured mode of each pose
+  for (const config::MeasuredPoseModes& p : model.measured_modes->poses) {
+    const std::vector<AxisMode> prior = axis_modes(model, p.joints_deg, axis, count);
+    std::vector<config::ModeConfig> measured = p.modes;
+    std::sort(measured.begin(), measured.end(), [](const auto& l, const auto& r) { return l.natural_freq_hz < r.natural_freq_hz; });
+    std::vector<double> measured_hz, model_hz;
+    for (const auto& m : measured) measured_hz.push_back(m.natural_freq_hz);
+    for (const auto& m : prior) model_hz.push_back(m.freq_hz);
+    PoseMatch match{p.name, match_modes(measured_hz, model_hz)};
+    if (tracks.size() < measured.size()) tracks.resize(measured.size());
+    for (std::size_t k = 0; k < measured.size(); ++k) {
+      const int j = match.model_of_measured[k];
+      const AxisMode a = j >= 0 ? prior[static_cast<std::size_t>(j)] : AxisMode{};
+      tracks[k].push_back({radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m,
+                           a.freq_hz, a.damping_ratio, a.stiffness_n_per_m, j});
+    }
+    matches_.push_back(std::move(match));
+    measured_deg_.push_back(p.joints_deg);
+  }
+  for (const std::vector<Sample>& t : tracks) {
+    if (2 * t.size() < model.measured_modes->poses.size()) continue;  // seen at too few poses to stand for a mode
+    Track tr;
+    tr.model_index = t.front().model_index;
+    for (const Sample& s : t)
+      if (s.model_index != tr.model_index) tr.model_index = -1;  // no one model mode follows it
+    const bool own = tr.model_index < 0;
+    std::vector<Eigen::VectorXd> x;
+    std::vector<double> f, z, pk;
+    double p_scale = 0.0;
+    for (const Sample& s : t) {
+      x.push_back(s.x);
+      f.push_back(std::log(own ? s.f_hz : s.f_hz / s.model_f_hz));
+      z.push_back(std::log(own ? s.zeta : s.zeta / s.model_zeta));
+      pk.push_back(participation(s.f_hz, s.k) - (own ? 0.0 : participation(s.model_f_hz, s.model_k)));
+      p_scale = std::max(p_scale, participation(s.f_hz, s.k));
+    }
+    tr.freq = Field(x, f, kFreqNoise, own);
+    tr.damping = Field(x, z, kDampingNoise, own);
+    tr.stiffness = Field(std::move(x), pk, kStiffnessNoise * p_scale, own);
+    tracks_.push_back(std::move(tr));
+  }
+}
+
+std::vector<ModeCorrection> ModalMap::at(const std::vector<double>& q_deg, const std::vector<AxisMode>& prior) const {
+  const Eigen::VectorXd x = radians(q_deg);
+  std::vector<ModeCorrection> out;
+  std::vector<bool> followed(prior.size(), false);
+  for (const Track& t : tracks_) {
+    const bool own = t.model_index < 0 || static_cast<std::size_t>(t.model_index) >= prior.size();
+    const AxisMode a = own ? AxisMode{} : prior[static_cast<std::size_t>(t.model_index)];
+    ModeCorrection c;
+    c.measured_poses = static_cast<int>(t.freq.points());
+    c.model_index = own ? -1 : t.model_index;
+    if (!own) followed[static_cast<std::size_t>(t.model_index)] = true;
+    c.freq_scale = std::exp(t.freq.mean(x));
+    c.damping_scale = std::exp(t.damping.mean(x));
+    c.freq_hz = own ? c.freq_scale : a.freq_hz * c.freq_scale;
+    c.damping_ratio = own ? c.damping_scale : a.damping_ratio * c.damping_scale;
+    c.freq_sigma = t.freq.sigma(x);
+    c.damping_sigma = t.damping.sigma(x);
+    // The participation w^2 / k: the model's plus the regression's (or its own); the stiffness from it at the
+    // mapped frequency.
+    const double p_model = own ? 0.0 : participation(a.freq_hz, a.stiffness_n_per_m);
+    const double p = p_model + t.stiffness.mean(x);
+    const double p_floor = kParticipationFloor * std::max(p_model, std::abs(p)) + std::numeric_limits<double>::min();
+    const double w = kTwoPi * c.freq_hz;
+    c.stiffness_n_per_m = w * w / std::max(p, p_floor);
+    c.stiffness_scale = own ? 1.0 : c.stiffness_n_per_m / a.stiffness_n_per_m;
+    if (own) c.freq_scale = c.damping_scale = 1.0;
+    c.stiffness_sigma = std::min(kMaxRelativeSigma, t.stiffness.sigma(x) / std::max(p, p_floor));
+    out.push_back(c);
+  }
+  // The model's modes no track follows, above every track: below the highest, the measurements would have
+  // seen them.
+  double highest_track_hz = 0.0;
+  for (const ModeCorrection& c : out) highest_track_hz = std::max(highest_track_hz, c.freq_hz);
+  for (std::size_t i = 0; i < prior.size(); ++i) {
+    if (followed[i] || prior[i].freq_hz <= highest_track_hz) continue;
+    ModeCorrection c;
+    c.freq_hz = prior[i].freq_hz;
+    c.damping_ratio = prior[i].damping_ratio;
+    c.stiffness_n_per_m = prior[i].stiffness_n_per_m;
+    c.model_index = static_cast<int>(i);
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end(), [](const auto& l, const auto& r) { return l.freq_hz < r.freq_hz; });
+  if (out.size() > static_cast<std::size_t>(count_)) out.resize(static_cast<std::size_t>(count_));  // the plant's N lowest
+  return out;
+}
+
+double ModalMap::nearest_measured_deg(const std::vector<double>& q_deg) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& m : measured_deg_) {
+    double s = 0.0;
+    for (std::size_t i = 0; i < m.size() && i < q_deg.size(); ++i) s += (m[i] - q_deg[i]) * (m[i] - q_deg[i]);
+    best = std::min(best, std::sqrt(s));
+  }
+  return best;
+}
+
+}  // namespace robodamp::robot

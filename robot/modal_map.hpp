@@ -1,0 +1,104 @@
+// The robot's modes at any pose from modes measured at a few (docs/pose_dynamics.md, "Modes between measured
+// poses"). The robot model (fitted or not) is the prior: at each measured pose its modes along the measured
+// axis are matched to the measured ones, and the log ratios measured / model of each mode's frequency,
+// damping ratio and modal stiffness are interpolated over joint space by Gaussian-process regression
+// (ordinary kriging: a constant mean, a squared-exponential kernel over the joint angles in rad, its length
+// scale chosen by the restricted marginal likelihood); the stiffness along the axis through the mode's
+// participation w^2 / k, the difference measured - model interpolated. At a measured pose the corrected modes are the measured
+// ones (to the measurement's noise); far from every measured pose the correction tends to the mean ratio and
+// its uncertainty to the model's scatter about it, so the spread grows away from the measurements.
+// Off the real-time path.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "config/robot_model_config.hpp"
+
+namespace robodamp::robot {
+
+// One of the model's modes as it moves the TCP along an axis (modal-stiffness form, lowest first): the
+// modes that do not move the TCP along the axis are left out.
+struct AxisMode {
+  double freq_hz{0.0};
+  double damping_ratio{0.0};       // half the joints' loss factor (modal_damping_ratio)
+  double stiffness_n_per_m{0.0};   // w^2 / phi_axis^2
+  Eigen::Vector2d tcp_shape{0.0, 0.0};
+};
+// Throws config::ConfigError (a pose outside the travel) or std::invalid_argument (a non-physical model).
+[[nodiscard]] std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
+                                               int axis, int count);
+
+// One mode at a pose, mapped. A track is the k-th lowest measured mode of every measured pose. Where at every
+// pose it was measured the same model mode lies within 25 % of it, that mode is its prior: the ratios measured /
+// model of its frequency and damping and the difference of its participation w^2 / k are interpolated and
+// applied to the model's mode at the pose (model_index >= 0). Where not (the model lacks the mode, or its modes
+// reorder between the poses), the track's own values are interpolated (model_index -1). The model's modes no
+// track follows and above every track stay as the model has them (measured_poses 0, no spread); below, where
+// the measurements would have seen them, they are not there.
+// sigma_*: one standard deviation of the log value (x 100: about a percentage); the stiffness's from its
+// participation's, relative to the mapped one.
+struct ModeCorrection {
+  double freq_hz{0.0}, damping_ratio{0.0}, stiffness_n_per_m{0.0};  // the mapped mode
+  double freq_scale{1.0}, damping_scale{1.0}, stiffness_scale{1.0};  // against the model's mode model_index
+  double freq_sigma{0.0}, damping_sigma{0.0}, stiffness_sigma{0.0};
+  int measured_poses{0};  // the track's poses (0: the model's mode as it is)
+  int model_index{-1};    // the model's mode (in axis_modes' order) it corrects; -1: the measurements' own
+  [[nodiscard]] bool measured_only() const { return model_index < 0; }
+};
+
+// Which model mode each measured mode at a measured pose lies nearest (-1: none within 25 %).
+struct PoseMatch {
+  std::string pose;
+  std::vector<int> model_of_measured;
+};
+
+class ModalMap {
+ public:
+  // model.measured_modes must be set; its axis must be `axis`. count: the model's modes (pose_schedule.modes).
+  // Throws std::invalid_argument naming the reason (another axis, no measured pose).
+  ModalMap(const config::RobotModelConfig& model, int axis, int count);
+
+  // The mapped modes at a pose, the `count` lowest of: every track (kept when measured at half the poses at
+  // least) and the model's modes no track follows. prior: axis_modes(model, joints_deg, axis, count).
+  [[nodiscard]] std::vector<ModeCorrection> at(const std::vector<double>& joints_deg, const std::vector<AxisMode>& prior) const;
+  [[nodiscard]] const std::vector<PoseMatch>& matches() const { return matches_; }
+  // The distance in joint space (deg) from a pose to the nearest measured pose.
+  [[nodiscard]] double nearest_measured_deg(const std::vector<double>& joints_deg) const;
+
+  // One quantity of one mode over the measured poses (public for the tests).
+  class Field {
+   public:
+    Field() = default;
+    // x: the poses (rad), y: the log ratios there, noise: the measurement's standard deviation of y. Far
+    // from the data the spread is at least the root mean square of y (a ratio: the model's whole error), or
+    // with about_mean, of y about its mean (a value of its own).
+    Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, double noise, bool about_mean = false);
+    [[nodiscard]] double mean(const Eigen::VectorXd& x) const;
+    [[nodiscard]] double sigma(const Eigen::VectorXd& x) const;
+    [[nodiscard]] double length_scale_rad() const { return length_; }
+    [[nodiscard]] bool empty() const { return x_.empty(); }
+    [[nodiscard]] std::size_t points() const { return x_.size(); }
+
+   private:
+    [[nodiscard]] Eigen::VectorXd kernel_column(const Eigen::VectorXd& x) const;
+    std::vector<Eigen::VectorXd> x_;
+    double length_{0.5}, signal_var_{0.0}, noise_var_{0.0}, mu_{0.0}, ones_r_ones_{1.0};
+    Eigen::LDLT<Eigen::MatrixXd> r_;
+    Eigen::VectorXd alpha_, r_ones_;
+  };
+
+ private:
+  struct Track {
+    Field freq, damping, stiffness;
+    int model_index{-1};
+  };
+  std::vector<Track> tracks_;
+  int count_{0};
+  std::vector<PoseMatch> matches_;
+  std::vector<std::vector<double>> measured_deg_;
+};
+
+}  // namespace robodamp::robot

@@ -1,0 +1,208 @@
+// The modes between measured poses (robot/modal_map.*, analysis::pose_modes with measured_modes;
+// docs/pose_dynamics.md, "Modes between measured poses"): the regression itself, a robot whose model is wrong
+// in form (a joint's translational compliance the model lacks) mapped from a few poses and checked at poses
+// held out, and the file's section read, written and refused.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+
+#include "analysis/pose_schedule.hpp"
+#include "config/config.hpp"
+#include "config/pose_schedule_config.hpp"
+#include "config/robot_model_config.hpp"
+#include "robot/modal_map.hpp"
+#include "test_util.hpp"
+
+namespace robodamp {
+namespace {
+
+// The regression passes through its data (to the noise), its uncertainty is smallest there and grows away
+// from it towards the model's whole scatter, and far away it tends to the mean ratio.
+TEST(ModalMap, TheRegressionPassesThroughItsDataAndItsSpreadGrowsAwayFromIt) {
+  std::vector<Eigen::VectorXd> x;
+  std::vector<double> y;
+  for (const double q : {0.0, 0.4, 0.8, 1.2}) {
+    x.push_back(Eigen::VectorXd::Constant(1, q));
+    y.push_back(0.05 * std::sin(2.0 * q) + 0.02);
+  }
+  const robot::ModalMap::Field f(x, y, 0.003);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    EXPECT_NEAR(f.mean(x[i]), y[i], 0.004) << i;
+    EXPECT_LT(f.sigma(x[i]), 0.004) << i;
+  }
+  // Outside the data the spread grows with the distance.
+  const auto at = [](double q) { return Eigen::VectorXd::Constant(1, q); };
+  EXPECT_GT(f.sigma(at(1.6)), f.sigma(at(1.3)));
+  EXPECT_GT(f.sigma(at(3.0)), f.sigma(at(1.6)));
+  double mean_sq = 0.0;
+  for (double v : y) mean_sq += v * v / 4.0;
+  // Far away: a constant within the data's range (the regression's mean ratio).
+  EXPECT_GT(f.mean(at(20.0)), *std::min_element(y.begin(), y.end()));
+  EXPECT_LT(f.mean(at(20.0)), *std::max_element(y.begin(), y.end()));
+  EXPECT_GE(f.sigma(at(20.0)), std::sqrt(mean_sq) * 0.99);  // at least the model's whole error far away
+  // One point: the ratio there everywhere, no better than that point's size away from it.
+  const robot::ModalMap::Field one({at(0.5)}, {0.04}, 0.003);
+  EXPECT_NEAR(one.mean(at(0.5)), 0.04, 1e-9);
+  EXPECT_NEAR(one.mean(at(2.0)), 0.04, 1e-9);
+  EXPECT_GE(one.sigma(at(2.0)), 0.0399);
+}
+
+const std::string kSource = ROBODAMP_SOURCE_DIR;
+
+// The compact arm of config/robots/compact_three_link.yaml as its file says (the model), and the robot it
+// stands for (the truth): the elbow's bearings give 1.7 um per N in translation, a compliance the model's
+// torsional-only joints do not have, so no choice of its joint stiffnesses reproduces the truth's modes at
+// every pose.
+struct WrongInForm {
+  config::RobotModelConfig model = config::load_robot_model(kSource + "/config/robots/compact_three_link.yaml");
+  config::RobotModelConfig truth = [this] {
+    config::RobotModelConfig t = model;
+    t.joints[1].translational_stiffness_n_per_m = 6e5;
+    return t;
+  }();
+  static constexpr int kAxis = 0, kModes = 3;
+};
+
+// What a modal test measures at a pose: the truth's modes along the axis, each frequency and stiffness off by
+// a fixed +-0.2 % and +-2 % (the identification's scatter), damping by +-5 %.
+config::MeasuredPoseModes measured_at(const WrongInForm& w, const std::string& name, const std::vector<double>& q) {
+  config::MeasuredPoseModes p{name, q, {}};
+  int sign = 1;
+  for (const robot::AxisMode& m : robot::axis_modes(w.truth, q, w.kAxis, w.kModes)) {
+    config::ModeConfig c;
+    c.form = config::ModeForm::kStiffness;
+    c.natural_freq_hz = m.freq_hz * (1.0 + 0.002 * sign);
+    c.damping_ratio = m.damping_ratio * (1.0 - 0.05 * sign);
+    c.stiffness_n_per_m = m.stiffness_n_per_m * (1.0 + 0.02 * sign);
+    p.modes.push_back(c);
+    sign = -sign;
+  }
+  return p;
+}
+
+// The nearest mode's frequency error, %.
+double freq_error_pct(const analysis::PoseModes& got, double truth_hz) {
+  double best = INFINITY;
+  for (const auto& m : got.modes)
+    if (std::abs(m.natural_freq_hz / truth_hz - 1.0) < std::abs(best)) best = m.natural_freq_hz / truth_hz - 1.0;
+  return 100.0 * best;
+}
+
+// Issue 51 item 2, in process, with the model file as the prior (not fitted): measured at five poses of the
+// HIL path (joint 2 30, 65, 80, 100, 130 deg), the map puts every mode of the truth at three poses between them
+// within 2 % (the model file is up to 28 % off and lacks a mode), the damped improvement a set designed on the
+// map predicts there within 6 points of the truth's, and outside the measured poses its spread is larger than
+// at any of them.
+TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithinTwoPercent) {
+  const WrongInForm w;
+  config::RobotModelConfig mapped = w.model;
+  mapped.measured_modes = config::MeasuredModesConfig{w.kAxis, {}};
+  const std::vector<std::pair<std::string, std::vector<double>>> in_map{{"a", {-90, 30, 30}}, {"c", {-90, 65, 30.5}}, {"g", {-90, 80, 30}}, {"h", {-90, 100, 30}}, {"f", {-90, 130, 30}}};
+  const std::vector<std::pair<std::string, std::vector<double>>> held{{"b", {-90, 50, 29.5}}, {"d", {-90, 90, 30}}, {"e", {-90.25, 110, 29.5}}};
+  for (const auto& [name, q] : in_map) mapped.measured_modes->poses.push_back(measured_at(w, name, q));
+  // The set: the configuration's controller designed for one region over the path (the analysis's polarity
+  // and match frequency at its centre), on the map's modes.
+  config::Config cfg = config::load_config_file(kSource + "/config/hil_pose_schedule.yaml");
+  cfg.pose_schedule->regions = {config::PoseRegionConfig{"path", {-91, 30, 29}, {-89, 130, 31}, 100.0, {}, {}, {}}};
+  cfg.pose_schedule->workspace_min_deg = {-91, 30, 29};
+  cfg.pose_schedule->workspace_max_deg = {-89, 130, 31};
+  const analysis::RegionSet set = analysis::design_region(cfg, mapped, 0);
+  double worst_mapped = 0.0, worst_model = 0.0, worst_points = 0.0;
+  // Each measured mode's frequency spread (lowest first): the largest at a measured pose.
+  std::vector<double> largest_map_sigma(3, 0.0);
+  const auto spreads = [](const analysis::PoseModes& pm) {
+    std::vector<double> out;
+    for (const auto& c : pm.corrections)
+      if (c.measured_poses > 0) out.push_back(c.freq_sigma);
+    return out;
+  };
+  for (const auto& [name, q] : held) {
+    const analysis::PoseModes got = analysis::pose_modes(mapped, q, w.kAxis, w.kModes);
+    const analysis::PoseModes model = analysis::pose_modes(w.model, q, w.kAxis, w.kModes);
+    for (const robot::AxisMode& t : robot::axis_modes(w.truth, q, w.kAxis, w.kModes)) {
+      const double e_map = freq_error_pct(got, t.freq_hz), e_model = freq_error_pct(model, t.freq_hz);
+      std::cout << name << " " << t.freq_hz << " Hz: model " << e_model << " %, map " << e_map << " %\n";
+      worst_mapped = std::max(worst_mapped, std::abs(e_map));
+      worst_model = std::max(worst_model, std::abs(e_model));
+    }
+
+    const double p_map = analysis::predicted_improvement_pct(set.config, mapped, *cfg.pose_schedule, q);
+    const double p_truth = analysis::predicted_improvement_pct(set.config, w.truth, *cfg.pose_schedule, q);
+    const double p_model = analysis::predicted_improvement_pct(set.config, w.model, *cfg.pose_schedule, q);
+    std::cout << name << ": damped improvement predicted on the map " << p_map << " %, the truth " << p_truth << " %, the model file "
+              << p_model << " %\n";
+    worst_points = std::max(worst_points, std::abs(p_map - p_truth));
+  }
+  for (const auto& [name, q] : in_map) {
+    const analysis::PoseModes got = analysis::pose_modes(mapped, q, w.kAxis, w.kModes);
+    const config::MeasuredPoseModes m = measured_at(w, name, q);
+    for (const auto& mm : m.modes) EXPECT_LT(std::abs(freq_error_pct(got, mm.natural_freq_hz)), 0.5) << name;
+    const std::vector<double> sg = spreads(got);
+    ASSERT_EQ(sg.size(), 3U);
+    for (std::size_t i = 0; i < 3; ++i) largest_map_sigma[i] = std::max(largest_map_sigma[i], sg[i]);
+  }
+  std::cout << "held out: the map's largest frequency error " << worst_mapped << " %, the model file's " << worst_model
+            << " %; the damped improvement within " << worst_points << " points of the truth's\n";
+  EXPECT_LT(worst_mapped, 2.0);
+  EXPECT_GT(worst_model, 2.0);  // the case is one the model file alone does not meet
+  EXPECT_LT(worst_points, 6.0);  // measured: 1.4, 0.2 and 5.5 points (docs/pose_dynamics.md)
+  // Outside the measured poses (joint 2 at the ends of its travel, 20 and 30 deg beyond them) the spread is
+  // larger than anywhere measured.
+  for (const double q2 : {10.0, 160.0}) {
+    const std::vector<double> sg = spreads(analysis::pose_modes(mapped, {-90, q2, 30}, w.kAxis, w.kModes));
+    ASSERT_EQ(sg.size(), 3U);
+    for (std::size_t i = 0; i < 3; ++i) {
+      std::cout << "mode " << i + 1 << ": frequency sigma at the measured poses <= " << 100 * largest_map_sigma[i] << " %, at joint 2 = "
+                << q2 << " deg " << 100 * sg[i] << " %\n";
+      EXPECT_GT(sg[i], largest_map_sigma[i]) << i;
+    }
+  }
+}
+
+// The section read back as written, in a block style a person writes, and refused where it is wrong, by key.
+TEST(ModalMap, TheMeasuredModesSectionIsReadWrittenAndRefusedByKey) {
+  const WrongInForm w;
+  config::RobotModelConfig m = w.model;
+  m.measured_modes = config::MeasuredModesConfig{0, {measured_at(w, "a", {-90, 30, 30}), measured_at(w, "f", {-90, 130, 30})}};
+  const config::RobotModelConfig back = config::parse_robot_model(config::robot_model_yaml(m), "written");
+  ASSERT_TRUE(back.measured_modes);
+  EXPECT_EQ(back.measured_modes->axis, 0);
+  ASSERT_EQ(back.measured_modes->poses.size(), 2U);
+  EXPECT_EQ(back.measured_modes->poses[1].name, "f");
+  // Written to 10 significant digits.
+  EXPECT_NEAR(back.measured_modes->poses[1].modes[0].natural_freq_hz / m.measured_modes->poses[1].modes[0].natural_freq_hz, 1.0, 1e-9);
+  EXPECT_NEAR(back.measured_modes->poses[1].modes[2].stiffness_n_per_m / m.measured_modes->poses[1].modes[2].stiffness_n_per_m, 1.0, 1e-9);
+  const std::string base = test::read_file(kSource + "/config/robots/compact_three_link.yaml");
+  const auto refused = [&](const std::string& section, const std::string& what) {
+    try {
+      (void)config::parse_robot_model(base + section, "mine.yaml");
+      ADD_FAILURE() << "accepted: " << section;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused("measured_modes:\n  axis: z\n  poses:\n    - name: a\n      joints_deg: [-90, 30, 30]\n      modes:\n"
+          "        - natural_freq_hz: 12\n          damping_ratio: 0.02\n          stiffness_n_per_m: 1e6\n",
+          "measured_modes.axis");
+  refused("measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 200, 30], modes: [{natural_freq_hz: 12, damping_ratio: 0.02, "
+          "stiffness_n_per_m: 1e6}]}\n",
+          "measured_modes.poses[0].joints_deg");
+  refused("measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 30, 30], modes: [{natural_freq_hz: 12, damping_ratio: 0, "
+          "stiffness_n_per_m: 1e6}]}\n",
+          "measured_modes.poses[0].modes[0].damping_ratio");
+  refused("measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 30, 30]}\n", "measured_modes.poses[0].modes");
+  // Measured along y, asked along x: refused with both.
+  config::RobotModelConfig y = m;
+  y.measured_modes->axis = 1;
+  try {
+    (void)analysis::pose_modes(y, {-90, 50, 30}, 0, 3);
+    ADD_FAILURE() << "another axis accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("measured_modes are along y"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace robodamp
