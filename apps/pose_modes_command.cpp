@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -40,12 +41,23 @@ json row_json(const analysis::ModeCheckRow& r) {
           {"nearest_measured_deg", r.nearest_measured_deg}};
 }
 
+// A number in a column, "-" where there is none (no model mode within 25 %).
+std::string cell(double v, const char* format, int width) {
+  char b[32];
+  if (std::isfinite(v)) std::snprintf(b, sizeof b, format, v);
+  else std::snprintf(b, sizeof b, "%*s", width, "-");
+  return b;
+}
+
 void row_text(const analysis::ModeCheckRow& r, std::ostringstream& t) {
   char b[320];
-  std::snprintf(b, sizeof b, "  %-10s %-9s %8.2f %8.2f %+7.2f %8.2f %+7.2f %6.2f   %+7.1f %+7.1f %6.1f %7.1f\n", r.pose.c_str(),
-                r.held_out ? "held out" : "map", r.measured_hz, r.model_hz, error_pct(r.model_hz, r.measured_hz), r.mapped_hz,
-                error_pct(r.mapped_hz, r.measured_hz), r.freq_sigma_pct, error_pct(r.model_stiffness_n_per_m, r.measured_stiffness_n_per_m),
-                error_pct(r.mapped_stiffness_n_per_m, r.measured_stiffness_n_per_m), r.stiffness_sigma_pct, r.nearest_measured_deg);
+  std::snprintf(b, sizeof b, "  %-10s %-9s %8.2f %s %s %s %s %s   %s %s %s %7.1f\n", r.pose.c_str(), r.held_out ? "held out" : "map",
+                r.measured_hz, cell(r.model_hz, "%8.2f", 8).c_str(), cell(error_pct(r.model_hz, r.measured_hz), "%+7.2f", 7).c_str(),
+                cell(r.mapped_hz, "%8.2f", 8).c_str(), cell(error_pct(r.mapped_hz, r.measured_hz), "%+7.2f", 7).c_str(),
+                cell(r.freq_sigma_pct, "%6.2f", 6).c_str(),
+                cell(error_pct(r.model_stiffness_n_per_m, r.measured_stiffness_n_per_m), "%+7.1f", 7).c_str(),
+                cell(error_pct(r.mapped_stiffness_n_per_m, r.measured_stiffness_n_per_m), "%+7.1f", 7).c_str(),
+                cell(r.stiffness_sigma_pct, "%6.1f", 6).c_str(), r.nearest_measured_deg);
   t << b;
 }
 
@@ -139,8 +151,10 @@ int show_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
     const double model_hz = c.measured_only() || static_cast<std::size_t>(c.model_index) >= before.modes.size()
                                 ? NAN
                                 : before.modes[static_cast<std::size_t>(c.model_index)].natural_freq_hz;
-    std::snprintf(b, sizeof b, "  %4zu   %8.2f    %8.2f  %7.2f   %13.4f  %7.1f   %13.4g  %7.1f   %d pose(s)%s\n", i + 1,
-                  model_hz, m.natural_freq_hz, 100.0 * c.freq_sigma, m.damping_ratio, 100.0 * c.damping_sigma,
+    char model_col[16] = "       -";
+    if (std::isfinite(model_hz)) std::snprintf(model_col, sizeof model_col, "%8.2f", model_hz);
+    std::snprintf(b, sizeof b, "  %4zu   %s    %8.2f  %7.2f   %13.4f  %7.1f   %13.4g  %7.1f   %d pose(s)%s\n", i + 1,
+                  model_col, m.natural_freq_hz, 100.0 * c.freq_sigma, m.damping_ratio, 100.0 * c.damping_sigma,
                   m.stiffness_n_per_m, 100.0 * c.stiffness_sigma, c.measured_poses,
                   c.measured_only() ? ", from the measurements alone" : "");
     t << b;
@@ -176,7 +190,7 @@ int show_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
   r["sweep"] = {{"joint", a.vary_joint}, {"points", points}};
   return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
     std::ostringstream gp;
-    gp << "set grid; set key top left; set xlabel 'joint " << a.vary_joint << " (deg), the others at the pose shown'; "
+    gp << "set grid; set key outside right; set xlabel 'joint " << a.vary_joint << " (deg), the others at the pose shown'; "
        << "set ylabel 'frequency (Hz)'; set title 'modes along joint " << a.vary_joint
        << ": the map (line, band 2 sigma), the model alone (dashed), measured (points)'; plot ";
     const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};

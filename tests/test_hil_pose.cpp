@@ -333,5 +333,81 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
   EXPECT_EQ(damped, 3);
 }
 
+// Issue 51 item 2 through the HIL: a robot wrong in form (the compact arm whose elbow bearing gives in
+// translation, a mode the model's torsional joints cannot make) measured at eight poses (`measure --poses`), its
+// measured modes at five written into the model file as it is (`pose modes`, the file's model the prior, not
+// fitted). The controller runs the hand-drawn schedule on the mapped model; the emulator moves the TRUE robot
+// through the three held-out poses. At b and d the improvement the emulator measures is within 5 points of
+// what the analysis predicts there from the map; at e within 10 (measured 8.5: there the open peak is the 19.5
+// Hz mode's and the closed one the 12.1 Hz mode's, so the improvement is the ratio of two modes' peaks, and the
+// map's stiffnesses there are 1-4 % off with 2-5 % spreads; docs/pose_dynamics.md). No trip.
+TEST(Hil, ARobotWrongInFormIsDampedAtHeldOutPosesAsItsMeasuredModesPredict) {
+  const std::string src = ROBODAMP_SOURCE_DIR;
+  const HilFiles f = hil_files(
+      "mapped", {{"settle_s: 3 ", "settle_s: 6 "},
+                 {"workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}", "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}"},
+                 {"{name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
+                  "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}"},
+                 {"{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
+                  "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}"}},
+      "hil_pose_schedule");
+  const std::string model_file = src + "/config/robots/compact_three_link.yaml";
+  std::string robot = test::read_file(model_file);
+  test::replace_or_throw(robot, "{stiffness_nm_per_rad: 2.2e5, damping_ratio: 0.02, min_deg: 10, max_deg: 160}",
+                         "{stiffness_nm_per_rad: 2.2e5, damping_ratio: 0.02, min_deg: 10, max_deg: 160, translational_stiffness_n_per_m: 6e5}");
+  const std::string truth = f.dir + "/true_robot.yaml", mapped = f.dir + "/mapped.yaml";
+  std::ofstream(truth) << robot;
+  std::string cell = test::read_file(f.config);
+  test::replace_or_throw(cell, "model: " + src + "/config/robots/planar_three_link.yaml", "model: " + truth);
+  std::ofstream(f.config) << cell;  // the emulator's: the truth
+  std::ofstream(f.dir + "/poses.yaml") << "poses:\n  - {name: a, joints_deg: [-90, 30, 30]}\n  - {name: b, joints_deg: [-90, 50, 29.5]}\n"
+                                          "  - {name: c, joints_deg: [-90, 65, 30.5]}\n  - {name: g, joints_deg: [-90, 80, 30]}\n"
+                                          "  - {name: d, joints_deg: [-90, 90, 30]}\n  - {name: h, joints_deg: [-90, 100, 30]}\n"
+                                          "  - {name: e, joints_deg: [-90.25, 110, 29.5]}\n  - {name: f, joints_deg: [-90, 130, 30]}\n";
+  const auto ok = [&](const std::vector<std::string>& args, const std::string& log) {
+    Child c(args, f.dir + "/" + log);
+    const int status = c.wait();
+    EXPECT_EQ(status, 0) << test::read_file(f.dir + "/" + log);
+    return status == 0;
+  };
+  const std::size_t can = cell.find("\ncan:"), hil = cell.find("\nhil:");
+  ASSERT_LT(can, hil);
+  std::ofstream(f.dir + "/measure.yaml") << cell.substr(0, can) + cell.substr(hil);
+  ASSERT_TRUE(ok({"measure", "--config", f.dir + "/measure.yaml", "--poses", f.dir + "/poses.yaml", "--out", f.dir + "/m"}, "measure.log"));
+  ASSERT_TRUE(ok({"pose", "modes", "--model", model_file, "--measurements", f.dir + "/m", "--hold-out", "b", "d", "e", "--out", mapped},
+                 "modes.log"));
+  std::string controller = cell;
+  test::replace_or_throw(controller, "model: " + truth, "model: " + mapped);
+  const std::string run_config = f.dir + "/run.yaml";
+  std::ofstream(run_config) << controller;
+  // The sets the controller builds from its configuration, and what the analysis predicts each does at a pose
+  // on the mapped model.
+  const config::Config cfg = config::load_config_file(run_config);
+  const analysis::PoseScheduleAnalysis schedule = analysis::analyse_pose_schedule(cfg);
+  const std::vector<std::string> trajectory{"--pose-at", "0:-90,50,29.5",  "--pose-at", "24:-90,50,29.5", "--pose-at", "30:-90,90,30",
+                                            "--pose-at", "54:-90,90,30", "--pose-at", "58:-90.25,110,29.5", "--pose-at", "82:-90.25,110,29.5"};
+  const Exits e = run_along_path(f, f.config, run_config, trajectory, "82");
+  ASSERT_EQ(e.plant, 0) << test::read_file(f.plant_log);
+  ASSERT_EQ(e.run, 0) << test::read_file(f.run_log);
+  const json run = read_json(f.run_json), plant = read_json(f.plant_json);
+  EXPECT_EQ(run["trip"], "none");
+  const json& dwells = plant["pose"]["dwells"];
+  ASSERT_EQ(dwells.size(), 3U);
+  const std::vector<std::vector<double>> poses{{-90, 50, 29.5}, {-90, 90, 30}, {-90.25, 110, 29.5}};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const json& d = dwells[i];
+    const auto region = std::find_if(schedule.regions.begin(), schedule.regions.end(),
+                                     [&](const analysis::RegionSet& r) { return r.name == d["region"].get<std::string>(); });
+    ASSERT_NE(region, schedule.regions.end()) << d.dump();
+    const double predicted = analysis::predicted_improvement_pct(region->config, schedule.model, *cfg.pose_schedule, poses[i]);
+    const double measured = d["measured_improvement_pct"].get<double>();
+    std::cout << "held out " << "bde"[i] << " (" << d["region"] << "): dominant (true) " << d["dominant_hz"] << " Hz, improvement "
+              << measured << " % measured with the true robot, " << predicted << " % predicted on the map, "
+              << d["predicted_improvement_pct"] << " % by the true model\n";
+    EXPECT_GE(d["records"].get<int>(), 2);
+    EXPECT_NEAR(measured, predicted, i == 2 ? 10.0 : 5.0) << d.dump();
+  }
+}
+
 }  // namespace
 }  // namespace robodamp

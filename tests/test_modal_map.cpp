@@ -147,7 +147,7 @@ TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithi
             << " %; the damped improvement within " << worst_points << " points of the truth's\n";
   EXPECT_LT(worst_mapped, 2.0);
   EXPECT_GT(worst_model, 2.0);  // the case is one the model file alone does not meet
-  EXPECT_LT(worst_points, 6.0);  // measured: 1.4, 0.2 and 5.5 points (docs/pose_dynamics.md)
+  EXPECT_LT(worst_points, 5.0);  // measured: 1.6, 0.2 and 2.7 points (docs/pose_dynamics.md)
   // Outside the measured poses (joint 2 at the ends of its travel, 20 and 30 deg beyond them) the spread is
   // larger than anywhere measured.
   for (const double q2 : {10.0, 160.0}) {
