@@ -75,14 +75,7 @@ std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, 
 PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
   PoseModes out;
   const std::vector<robot::AxisMode> prior = robot::axis_modes(model, q, axis, count);
-  for (const robot::AxisMode& md : prior) {
-    config::ModeConfig c;
-    c.form = config::ModeForm::kStiffness;
-    c.natural_freq_hz = md.freq_hz;
-    c.damping_ratio = md.damping_ratio;
-    c.stiffness_n_per_m = md.stiffness_n_per_m;
-    out.modes.push_back(c);
-  }
+  for (const robot::AxisMode& md : prior) out.modes.push_back(config::stiffness_mode(md.freq_hz, md.damping_ratio, md.stiffness_n_per_m));
   if (out.modes.empty())
     throw config::ConfigError({config::Problem{model.source, {}, "pose", "no mode of " + model.name + " at " +
                                                                              config::describe_pose(q) + " moves the TCP along the axis"}});
@@ -90,14 +83,8 @@ PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<do
     const std::shared_ptr<const robot::ModalMap> map = modal_map_for(model, axis, count);
     out.corrections = map->at(q, prior);
     out.modes.clear();
-    for (const robot::ModeCorrection& c : out.corrections) {
-      config::ModeConfig m;
-      m.form = config::ModeForm::kStiffness;
-      m.natural_freq_hz = c.freq_hz;
-      m.damping_ratio = c.damping_ratio;
-      m.stiffness_n_per_m = c.stiffness_n_per_m;
-      out.modes.push_back(m);
-    }
+    for (const robot::ModeCorrection& c : out.corrections)
+      out.modes.push_back(config::stiffness_mode(c.freq_hz, c.damping_ratio, c.stiffness_n_per_m));
     out.nearest_measured_deg = map->nearest_measured_deg(q);
   }
   double best = std::numeric_limits<double>::infinity();

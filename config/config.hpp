@@ -206,6 +206,11 @@ struct ModeConfig {
   double stiffness_n_per_m{0.0};
 };
 
+// A mode in modal-stiffness form.
+[[nodiscard]] inline ModeConfig stiffness_mode(double natural_freq_hz, double damping_ratio, double stiffness_n_per_m) {
+  return {ModeForm::kStiffness, natural_freq_hz, damping_ratio, 0.0, 0.0, stiffness_n_per_m};
+}
+
 // A structural degree of freedom (a point and a direction). axis_sign is the sign of the tabulated
 // FRFs' response axis at this location relative to the common frame: the physical FRF is
 // axis_sign(response) * tabulated (docs/physics.md §1: Table 1's location-2 axis is reversed, -1).

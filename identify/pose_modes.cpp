@@ -28,12 +28,7 @@ config::MeasuredPoseModes identify_one(const robot::MeasuredFrf& f, const PoseMe
   p.joints_deg = f.joints_deg;
   for (const IdentifiedMode& m : fit.modes) {
     if (!(m.stiffness_n_per_m > 0.0) || !(m.damping_ratio > 0.0)) continue;  // not a real, damped mode
-    config::ModeConfig c;
-    c.form = config::ModeForm::kStiffness;
-    c.natural_freq_hz = m.natural_freq_hz;
-    c.damping_ratio = m.damping_ratio;
-    c.stiffness_n_per_m = m.stiffness_n_per_m;
-    p.modes.push_back(c);
+    p.modes.push_back(config::stiffness_mode(m.natural_freq_hz, m.damping_ratio, m.stiffness_n_per_m));
   }
   std::sort(p.modes.begin(), p.modes.end(), [](const auto& a, const auto& b) { return a.natural_freq_hz < b.natural_freq_hz; });
   if (p.modes.empty()) throw std::invalid_argument("pose '" + f.name + "' (" + dir + "): no real mode with damping identified");

@@ -56,6 +56,19 @@ Exits run_along_path(const HilFiles& f, const std::string& plant_config, const s
   return e;
 }
 
+// The HIL cell (config/hil_pose_schedule.yaml) over the compact arm's path: joint 2 30-130 deg (joints 1 and
+// 3 +-0.5 and +-1 deg), two hand-drawn regions at K 100 N s/m each, a 6 s settle.
+HilFiles compact_arm_cell(const std::string& name) {
+  return hil_files(
+      name, {{"settle_s: 3 ", "settle_s: 6 "},
+             {"workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}", "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}"},
+             {"{name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
+              "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}"},
+             {"{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
+              "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}"}},
+      "hil_pose_schedule");
+}
+
 // The run's limits along the path (the summary's limits_along_path): at each dwell's pose, with the set and K
 // that run there, the in-process live stability's limits; the summary's last limits at the stretched pose.
 void live_limits_followed_the_pose(const std::string& config_path, const json& run, const std::string& log) {
@@ -231,14 +244,7 @@ TEST(Hil, TunedScheduleAtPosesNobodyMeasuredDampsAsPredicted) {
 TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
   namespace fs = std::filesystem;
   const std::string src = ROBODAMP_SOURCE_DIR;
-  const HilFiles f = hil_files(
-      "compact", {{"settle_s: 3 ", "settle_s: 6 "},
-                  {"workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}", "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}"},
-                  {"{name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
-                   "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}"},
-                  {"{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
-                   "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}"}},
-      "hil_pose_schedule");
+  const HilFiles f = compact_arm_cell("compact");
   std::string robot = test::read_file(src + "/config/robots/compact_three_link.yaml");
   test::replace_or_throw(robot, "stiffness_nm_per_rad: 2.2e5", "stiffness_nm_per_rad: 2.64e5");
   test::replace_or_throw(robot, "stiffness_nm_per_rad: 2.6e3", "stiffness_nm_per_rad: 2.21e3");
@@ -343,14 +349,7 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
 // map's stiffnesses there are 1-4 % off with 2-5 % spreads; docs/pose_dynamics.md). No trip.
 TEST(Hil, ARobotWrongInFormIsDampedAtHeldOutPosesAsItsMeasuredModesPredict) {
   const std::string src = ROBODAMP_SOURCE_DIR;
-  const HilFiles f = hil_files(
-      "mapped", {{"settle_s: 3 ", "settle_s: 6 "},
-                 {"workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}", "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}"},
-                 {"{name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
-                  "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}"},
-                 {"{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
-                  "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}"}},
-      "hil_pose_schedule");
+  const HilFiles f = compact_arm_cell("mapped");
   const std::string model_file = src + "/config/robots/compact_three_link.yaml";
   std::string robot = test::read_file(model_file);
   test::replace_or_throw(robot, "{stiffness_nm_per_rad: 2.2e5, damping_ratio: 0.02, min_deg: 10, max_deg: 160}",

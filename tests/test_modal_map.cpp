@@ -71,12 +71,8 @@ config::MeasuredPoseModes measured_at(const WrongInForm& w, const std::string& n
   config::MeasuredPoseModes p{name, q, {}};
   int sign = 1;
   for (const robot::AxisMode& m : robot::axis_modes(w.truth, q, w.kAxis, w.kModes)) {
-    config::ModeConfig c;
-    c.form = config::ModeForm::kStiffness;
-    c.natural_freq_hz = m.freq_hz * (1.0 + 0.002 * sign);
-    c.damping_ratio = m.damping_ratio * (1.0 - 0.05 * sign);
-    c.stiffness_n_per_m = m.stiffness_n_per_m * (1.0 + 0.02 * sign);
-    p.modes.push_back(c);
+    p.modes.push_back(config::stiffness_mode(m.freq_hz * (1.0 + 0.002 * sign), m.damping_ratio * (1.0 - 0.05 * sign),
+                                             m.stiffness_n_per_m * (1.0 + 0.02 * sign)));
     sign = -sign;
   }
   return p;
