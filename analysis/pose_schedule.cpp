@@ -122,8 +122,8 @@ config::Config config_in_plane_at_pose(const config::Config& base, const config:
       const double w = kTwoPi * md.freq_hz;
       const bool moves_along = std::abs(md.tcp_shape(axis)) > 0.0 && w > 0.0;
       robot::ModeCorrection corr;  // the mapped mode that corrects this one, if any (scales 1: none)
-      for (const robot::ModeCorrection& c : along.corrections)
-        if (moves_along && c.model_index == static_cast<int>(along_index)) corr = c;
+      for (const robot::ModeCorrection& mc : along.corrections)
+        if (moves_along && mc.model_index == static_cast<int>(along_index)) corr = mc;
       if (moves_along) ++along_index;
       if (!(std::abs(shapes) > 0.0) || !(w > 0.0)) continue;
       config::ModeConfig m;

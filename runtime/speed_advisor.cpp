@@ -165,7 +165,10 @@ void SpeedAdvisor::run() {
     if (r && state_key(*r) != last) {
       last = state_key(*r);
       try {
-        AdviceRecord rec{++seq, v.sample.time_s, milling::advise_speed(stability_, *r, rpm_min_, rpm_max_, s_)};
+        AdviceRecord rec;
+        rec.seq = ++seq;
+        rec.time_s = v.sample.time_s;
+        rec.advice = milling::advise_speed(stability_, *r, rpm_min_, rpm_max_, s_);
         const auto& a = rec.advice;
         if (s_.cancelled()) return;
         if (a.found)
