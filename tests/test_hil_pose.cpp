@@ -69,6 +69,24 @@ HilFiles compact_arm_cell(const std::string& name) {
       "hil_pose_schedule");
 }
 
+// A robodamp command run to its end in f.dir, its log there; false (and a test failure with the log) unless 0.
+bool succeeds(const HilFiles& f, const std::vector<std::string>& args, const std::string& log) {
+  Child c(args, f.dir + "/" + log);
+  const int status = c.wait();
+  EXPECT_EQ(status, 0) << test::read_file(f.dir + "/" + log);
+  return status == 0;
+}
+
+// `measure --poses` at f.dir/poses.yaml into f.dir/m on the simulated plant (it moves the robot between the
+// poses itself): the cell without its CAN and Modbus transports.
+bool measure_poses(const HilFiles& f, const std::string& cell) {
+  const std::size_t can = cell.find("\ncan:"), hil = cell.find("\nhil:");
+  EXPECT_LT(can, hil);
+  if (!(can < hil)) return false;
+  std::ofstream(f.dir + "/measure.yaml") << cell.substr(0, can) + cell.substr(hil);
+  return succeeds(f, {"measure", "--config", f.dir + "/measure.yaml", "--poses", f.dir + "/poses.yaml", "--out", f.dir + "/m"}, "measure.log");
+}
+
 // The run's limits along the path (the summary's limits_along_path): at each dwell's pose, with the set and K
 // that run there, the in-process live stability's limits; the summary's last limits at the stretched pose.
 void live_limits_followed_the_pose(const std::string& config_path, const json& run, const std::string& log) {
@@ -257,18 +275,8 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
   std::ofstream(f.dir + "/poses.yaml") << "poses:\n  - {name: a, joints_deg: [-90, 30, 30]}\n  - {name: b, joints_deg: [-90, 50, 29.5]}\n"
                                           "  - name: c\n    joints_deg: [-90, 70, 30.5]\n  - {name: d, joints_deg: [-90, 90, 30]}\n"
                                           "  - {name: e, joints_deg: [-90.25, 110, 29.5]}\n  - {name: f, joints_deg: [-90, 130, 30]}\n";
-  const auto ok = [&](const std::vector<std::string>& args, const std::string& log) {
-    Child c(args, f.dir + "/" + log);
-    const int status = c.wait();
-    EXPECT_EQ(status, 0) << test::read_file(f.dir + "/" + log);
-    return status == 0;
-  };
-  // Measured on the simulated plant (--poses moves the robot between the poses itself): the cell without
-  // its CAN and Modbus transports.
-  const std::size_t can = cell.find("\ncan:"), hil = cell.find("\nhil:");
-  ASSERT_LT(can, hil);
-  std::ofstream(f.dir + "/measure.yaml") << cell.substr(0, can) + cell.substr(hil);
-  ASSERT_TRUE(ok({"measure", "--config", f.dir + "/measure.yaml", "--poses", f.dir + "/poses.yaml", "--out", f.dir + "/m"}, "measure.log"));
+  const auto ok = [&](const std::vector<std::string>& args, const std::string& log) { return succeeds(f, args, log); };
+  ASSERT_TRUE(measure_poses(f, cell));
   ASSERT_TRUE(ok({"pose", "fit", "--model", src + "/config/robots/compact_three_link.yaml", "--measurements", f.dir + "/m",
                   "--hold-out", "b", "d", "e", "--restarts", "1", "--out", f.dir + "/fitted.yaml", "--json", f.dir + "/fit.json"},
                  "fit.log"));
@@ -363,16 +371,8 @@ TEST(Hil, ARobotWrongInFormIsDampedAtHeldOutPosesAsItsMeasuredModesPredict) {
                                           "  - {name: c, joints_deg: [-90, 65, 30.5]}\n  - {name: g, joints_deg: [-90, 80, 30]}\n"
                                           "  - {name: d, joints_deg: [-90, 90, 30]}\n  - {name: h, joints_deg: [-90, 100, 30]}\n"
                                           "  - {name: e, joints_deg: [-90.25, 110, 29.5]}\n  - {name: f, joints_deg: [-90, 130, 30]}\n";
-  const auto ok = [&](const std::vector<std::string>& args, const std::string& log) {
-    Child c(args, f.dir + "/" + log);
-    const int status = c.wait();
-    EXPECT_EQ(status, 0) << test::read_file(f.dir + "/" + log);
-    return status == 0;
-  };
-  const std::size_t can = cell.find("\ncan:"), hil = cell.find("\nhil:");
-  ASSERT_LT(can, hil);
-  std::ofstream(f.dir + "/measure.yaml") << cell.substr(0, can) + cell.substr(hil);
-  ASSERT_TRUE(ok({"measure", "--config", f.dir + "/measure.yaml", "--poses", f.dir + "/poses.yaml", "--out", f.dir + "/m"}, "measure.log"));
+  const auto ok = [&](const std::vector<std::string>& args, const std::string& log) { return succeeds(f, args, log); };
+  ASSERT_TRUE(measure_poses(f, cell));
   ASSERT_TRUE(ok({"pose", "modes", "--model", model_file, "--measurements", f.dir + "/m", "--hold-out", "b", "d", "e", "--out", mapped},
                  "modes.log"));
   std::string controller = cell;
