@@ -84,30 +84,35 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   // Once per forced period (a revolution, or a tooth period when only the tooth harmonics are forced: chatter
   // near a spindle harmonic changes little from one revolution to the next): x(t) - x(t - one period) at
   // every sample (the forced, periodic part cancels). Its RMS over the signal's is the once-per-revolution
-  // ratio; its RMS in the window's quarters, the smallest over the largest, the persistence. A decaying
-  // transient (a hammer impact, a step of the cut) leaves a quiet quarter before it or after it; chatter
-  // fills the window.
+  // ratio; its RMS in the window's eighths, the smallest over the largest, the persistence. A decaying
+  // transient (a hammer impact, a step of the cut) leaves a quiet stretch before it or after it; chatter
+  // fills the window. Eighths, not quarters: `run`'s hammer hits every 2 s in a 4 s window left no quiet
+  // quarter when a hit fell near a quarter's end (its ring split over two quarters), and the live
+  // indicator read CHATTER on a plant that was not cutting, at every other window (a CI run's monitor).
+  constexpr int kParts = 8;
   const double rev_samples = fs_ / (f_sp * s_.lines_per_revolution);
-  double part_ss[4] = {0.0, 0.0, 0.0, 0.0};
-  std::size_t part_n[4] = {0, 0, 0, 0};
+  double part_ss[kParts] = {};
+  std::size_t part_n[kParts] = {};
   const auto first = static_cast<std::size_t>(std::ceil(rev_samples));
   for (std::size_t i = first; i < n; ++i) {
     const double back = static_cast<double>(i) - rev_samples;
     const auto b = static_cast<std::size_t>(back);
     const double frac = back - static_cast<double>(b);
     const double e = window_[i] - (window_[b] * (1.0 - frac) + window_[b + 1] * frac);
-    const std::size_t q = std::min<std::size_t>(3, 4 * (i - first) / (n - first));
+    const std::size_t q = std::min<std::size_t>(kParts - 1, kParts * (i - first) / (n - first));
     part_ss[q] += e * e, ++part_n[q];
   }
-  const double diff_ss = part_ss[0] + part_ss[1] + part_ss[2] + part_ss[3];
+  double diff_ss = 0.0;
+  for (const double ss_part : part_ss) diff_ss += ss_part;
   out.once_per_rev_ratio = n > first ? std::sqrt(diff_ss / static_cast<double>(n - first)) / out.rms_mps2 : 0.0;
-  double q_min = INFINITY, q_max = 0.0, q_rms[4] = {0.0, 0.0, 0.0, 0.0};
-  for (int q = 0; q < 4; ++q) {
-    const double r = part_n[q] ? std::sqrt(part_ss[q] / static_cast<double>(part_n[q])) : 0.0;
-    q_rms[q] = r;
-    q_min = std::min(q_min, r), q_max = std::max(q_max, r);
+  const auto rms_of = [](double ss_part, std::size_t count) { return count ? std::sqrt(ss_part / static_cast<double>(count)) : 0.0; };
+  double p_min = INFINITY, p_max = 0.0, q_rms[4] = {0.0, 0.0, 0.0, 0.0};
+  for (int p = 0; p < kParts; ++p) {
+    const double r = rms_of(part_ss[p], part_n[p]);
+    p_min = std::min(p_min, r), p_max = std::max(p_max, r);
   }
-  out.persistence = q_max > 0.0 ? q_min / q_max : 0.0;
+  for (int q = 0; q < 4; ++q) q_rms[q] = rms_of(part_ss[2 * q] + part_ss[2 * q + 1], part_n[2 * q] + part_n[2 * q + 1]);
+  out.persistence = p_max > 0.0 ? p_min / p_max : 0.0;
   // Trend: the last quarter over the first. Chatter holds (a limit cycle) or grows; the marks an unstable
   // cut left fade after a change to a stable speed (the wavy surface regenerates, less each pass).
   out.trend = q_rms[0] > 0.0 ? q_rms[3] / q_rms[0] : 0.0;

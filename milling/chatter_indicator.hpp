@@ -12,7 +12,7 @@
 //     displacement (the acceleration's lines / f^2), as the tooth-passing harmonics above a robot mode's
 //     chatter would otherwise outweigh it by (f / f_chatter)^2;
 // Chatter is indicated when both exceed their thresholds, the non-harmonic vibration exceeds a floor
-// (sensor noise alone is not chatter) and it persists across the window (its quietest quarter at
+// (sensor noise alone is not chatter) and it persists across the window (its quietest eighth at
 // least 0.4 of its loudest: a hammer impact's decaying ring is not chatter) or grows through it (each
 // quarter louder than the one before), and it is not fading (the last quarter above 0.7 of the first:
 // the marks of a cut that chattered, after a change to a stable speed). Off the real-time path:
@@ -51,8 +51,9 @@ struct ChatterIndicatorSettings {
   double once_per_rev_threshold{0.2};
   double nonharmonic_threshold{0.1};
   double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
-  // Quietest / loudest quarter of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
-  // 0.87 s) in a 2 s window gives at most about exp(-1 s / 0.87 s) = 0.32.
+  // Quietest / loudest eighth of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
+  // 0.87 s), hit every 2 s (`run`'s default), leaves the eighth before the next hit 1.5 s after the last:
+  // about exp(-1.5 s / 0.87 s) = 0.18.
   double persistence_threshold{0.4};
   // Last quarter / first quarter of the window at or below this: fading, not chatter. A speed change
   // that ends chatter leaves the old marks on the surface, which regenerate less each pass: at 667 rpm
@@ -82,7 +83,7 @@ struct ChatterIndicator {
   // About 1 without a cut (an air cut, the spindle turning free); a cut's tooth-passing lines are far above.
   double forced_lines_snr{0.0};
   bool forced_lines{false};          // forced_lines_snr >= forced_lines_threshold
-  double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest quarter / the loudest
+  double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest eighth / the loudest
   double trend{0.0};                 // the same, the last quarter / the first
   bool growing{false};               // each quarter louder than the one before (growing_step)
   double gap_share{0.0};             // held (not fresh) samples in the window
