@@ -228,7 +228,7 @@ namespace robodamp::apps {
 namespace {
 
 struct AnalyzeArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   JsonOut json;
   std::string plot_dir;
   std::optional<double> spindle_rpm;

@@ -199,7 +199,7 @@ namespace robodamp::apps {
 namespace {
 
 struct BenchArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   std::string job_path;  // the cut the verdict is about (default the configuration's spindle.job)
   int cut_speeds{60};
   JsonOut json;

@@ -14,7 +14,7 @@ namespace robodamp::apps {
 namespace {
 
 struct CommissionArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   std::string job_path;
   std::string out_dir;
   std::string from{"measure"};

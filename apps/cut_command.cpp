@@ -37,7 +37,7 @@ constexpr double kHilRelTol = 1e-2;  // each step of the emulator's bisection is
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 struct CutArgs {
-  std::string config_path{ROBODAMP_DEFAULT_MILLING_CONFIG};
+  std::string config_path{default_job()};
   std::string structure;
   std::optional<double> axial_mm, radial_mm;
   std::vector<double> rpm;

@@ -12,6 +12,7 @@
 #include "dashboard/auth.hpp"
 #include "dashboard/fleet.hpp"
 #include "dashboard/server.hpp"
+#include "dashboard/tls.hpp"
 #include "rt/signals.hpp"
 
 namespace robodamp::apps {
@@ -24,6 +25,7 @@ struct DashboardArgs {
   std::optional<int> port, domain;
   std::string transport;
   double duration_s{0.0};
+  bool insecure_http{false};
 };
 
 int run_dashboard(const DashboardArgs& a) {
@@ -40,6 +42,13 @@ int run_dashboard(const DashboardArgs& a) {
   if (a.transport == "udp_loopback") cfg.dds.transport = config::DdsTransport::kUdpLoopback;
   if (a.transport == "shared_memory") cfg.dds.transport = config::DdsTransport::kSharedMemory;
   if (a.transport == "default") cfg.dds.transport = config::DdsTransport::kDefault;
+  if (const std::string why = dashboard::plain_http_refusal(cfg, a.insecure_http); !why.empty()) {
+    std::cerr << "robodamp dashboard: " << why << '\n';
+    return 2;
+  }
+  if (!cfg.tls() && !dashboard::is_loopback_address(cfg.listen_address))
+    spdlog::warn("dashboard: plain HTTP on {} (--insecure-http): passwords and session tokens cross the network readable",
+                 cfg.listen_address);
   std::vector<dashboard::User> users;
   try {
     if (!cfg.credentials.empty()) users = dashboard::load_users(cfg.credentials);
@@ -54,8 +63,12 @@ int run_dashboard(const DashboardArgs& a) {
     dashboard::Fleet fleet(cfg.dds, cfg.stale_after_s);
     dashboard::WebServer server(cfg, fleet, auth, log);
     const int port = server.bind();
-    std::thread serving([&] { server.serve(); });
-    std::cout << "robodamp dashboard: http://" << cfg.listen_address << ":" << port << "/  (DDS domain " << cfg.dds.domain_id
+    std::jthread serving([&] { server.serve(); });
+    struct StopOnExit {
+      dashboard::WebServer& s;
+      ~StopOnExit() { s.stop(); }  // before `serving` joins, on every path
+    } stop_on_exit{server};
+    std::cout << "robodamp dashboard: " << (cfg.tls() ? "https://" : "http://") << cfg.listen_address << ":" << port << "/  (DDS domain " << cfg.dds.domain_id
               << ", " << config::to_string(cfg.dds.transport) << (cfg.dds.security ? ", secured" : "") << "; "
               << (auth.anyone_may_act() ? std::to_string(users.size()) + " users from " + cfg.credentials
                                         : std::string("no operator configured: view only")) << "; Ctrl-C ends)" << std::endl;
@@ -69,6 +82,26 @@ int run_dashboard(const DashboardArgs& a) {
     std::cerr << "robodamp dashboard: " << e.what() << '\n';
     return 1;
   }
+  return 0;
+}
+
+struct CertArgs {
+  std::string certificate, key;
+  dashboard::SelfSignedRequest request;
+};
+
+int run_dashboard_cert(const CertArgs& a) {
+  try {
+    dashboard::write_self_signed(a.certificate, a.key, a.request);
+  } catch (const std::exception& e) {
+    std::cerr << "robodamp dashboard-cert: " << e.what() << '\n';
+    return 2;
+  }
+  std::string hosts;
+  for (const auto& h : a.request.hosts) hosts += (hosts.empty() ? "" : ", ") + h;
+  std::cout << "robodamp dashboard-cert: " << a.certificate << " (self-signed for " << hosts << ", " << a.request.days
+            << " days) and its key " << a.key << " (mode 0600); in the dashboard's configuration:\n"
+            << "  dashboard:\n    tls_certificate: " << a.certificate << "\n    tls_private_key: " << a.key << '\n';
   return 0;
 }
 
@@ -110,6 +143,21 @@ void register_dashboard(Registry& r) {
   sub->add_option("--transport", a->transport, "default, udp_loopback or shared_memory")
       ->check(CLI::IsMember({"default", "udp_loopback", "shared_memory"}));
   r.number(sub, "--duration", a->duration_s, {"s", 0.0, 1e7, false, false, "0 = until Ctrl-C"}, "Stop after S seconds");
+  sub->add_flag("--insecure-http", a->insecure_http,
+                "Serve plain HTTP on an address other hosts reach (without dashboard.tls_*): passwords and session "
+                "tokens then cross the network readable");
+
+  auto cert = std::make_shared<CertArgs>();
+  CLI::App* c = r.add("dashboard-cert",
+                      "Make a self-signed certificate and key for the dashboard's HTTPS (ECDSA P-256; for a first "
+                      "install: browsers warn until it is trusted; the cell's PKI can issue a real one)",
+                      [cert] { return run_dashboard_cert(*cert); });
+  c->add_option("--cert", cert->certificate, "The certificate file to write (PEM)")->required();
+  c->add_option("--key", cert->key, "The private key file to write (PEM, mode 0600)")->required();
+  c->add_option("--host", cert->request.hosts,
+                "The names and addresses the dashboard is reached by (default localhost 127.0.0.1)");
+  r.whole_number(c, "--days", cert->request.days, {"days", 1, 3650}, "Valid for this many days (default 825)");
+  c->add_flag("--overwrite", cert->request.overwrite, "Replace existing files");
 
   auto file = std::make_shared<std::string>();
   auto user = std::make_shared<std::string>();

@@ -125,7 +125,7 @@ namespace robodamp::apps {
 namespace {
 
 struct FiltersArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   double freq_hz{9.2};
   JsonOut json;
   std::string plot_dir, plot;

@@ -13,7 +13,7 @@ namespace robodamp::apps {
 namespace {
 
 struct MeasureArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   std::string out_dir;
   std::string clock;
   std::vector<double> pose_deg;

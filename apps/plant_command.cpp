@@ -17,7 +17,7 @@ namespace robodamp::apps {
 namespace {
 
 struct PlantArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   std::string pacing;
   double duration_s{0.0};
   JsonOut json;

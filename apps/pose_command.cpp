@@ -39,7 +39,7 @@ using nlohmann::json;
 
 struct PoseArgs {
   std::string what;
-  std::string model_path{std::string(ROBODAMP_SOURCE_DIR_FOR_CLI) + "/config/robots/planar_three_link.yaml"};
+  std::string model_path{config::shipped_file("robots/planar_three_link.yaml")};
   std::vector<double> joints_deg;
   std::string pose_name;
   JsonOut json;

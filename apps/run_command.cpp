@@ -24,7 +24,7 @@ namespace robodamp::apps {
 namespace {
 
 struct RunArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   double duration_s{10.0};
   std::string record_path;
   JsonOut json;

@@ -19,7 +19,7 @@ namespace robodamp::apps {
 namespace {
 
 struct ScheduleArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   std::string job_path;
   std::vector<std::string> controllers;
   std::string out_path;

@@ -28,7 +28,7 @@ namespace {
 using nlohmann::json;
 
 struct TuneArgs {
-  std::string config_path{ROBODAMP_DEFAULT_CONFIG};
+  std::string config_path{default_cell_config()};
   std::string job_path;
   std::string out_path;
   JsonOut json;

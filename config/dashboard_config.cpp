@@ -22,6 +22,8 @@ void read_dashboard(MapReader& top, DashboardConfig& c) {
   if (auto v = detail::read_int(r, "port", {"(TCP port)", 0, 65535, false, false, "0 = any free port"}, c.port)) c.port = *v;
   if (auto v = r.text("credentials", std::string{})) c.credentials = resolve(*v, c.source);
   if (auto v = r.text("action_log", std::string{})) c.action_log = resolve(*v, c.source);
+  if (auto v = r.text("tls_certificate", std::string{})) c.tls_certificate = resolve(*v, c.source);
+  if (auto v = r.text("tls_private_key", std::string{})) c.tls_private_key = resolve(*v, c.source);
   if (auto v = r.number("session_idle_s", {"s", 1.0, 7 * 86400.0}, c.session_idle_s)) c.session_idle_s = *v;
   if (auto v = r.number("stale_after_s", {"s", 0.1, 3600.0}, c.stale_after_s)) c.stale_after_s = *v;
   if (auto v = r.number("reply_timeout_s", {"s", 0.1, 60.0}, c.reply_timeout_s)) c.reply_timeout_s = *v;
@@ -29,11 +31,15 @@ void read_dashboard(MapReader& top, DashboardConfig& c) {
   if (auto v = detail::read_int(r, "max_body_bytes", {"bytes", 256, 1 << 20}, static_cast<int>(c.max_body_bytes)))
     c.max_body_bytes = static_cast<std::size_t>(*v);
   r.finish();
-  if (!c.credentials.empty()) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(c.credentials, ec))
-      top.diagnostics().add(r.mark(), "dashboard.credentials", "= '" + c.credentials + "': no such file (robodamp dashboard-user makes one)");
-  }
+  std::error_code ec;
+  if (!c.credentials.empty() && !std::filesystem::is_regular_file(c.credentials, ec))
+    top.diagnostics().add(r.mark(), "dashboard.credentials", "= '" + c.credentials + "': no such file (robodamp dashboard-user makes one)");
+  if (c.tls_certificate.empty() != c.tls_private_key.empty())
+    top.diagnostics().add(r.mark(), c.tls_certificate.empty() ? "dashboard.tls_certificate" : "dashboard.tls_private_key",
+                          "not given: HTTPS needs both the certificate and its private key");
+  for (const auto& [key, path] : {std::pair{"dashboard.tls_certificate", c.tls_certificate}, {"dashboard.tls_private_key", c.tls_private_key}})
+    if (!path.empty() && !std::filesystem::is_regular_file(path, ec))
+      top.diagnostics().add(r.mark(), key, "= '" + path + "': no such file (robodamp dashboard-cert makes a self-signed pair)");
 }
 
 }  // namespace

@@ -23,6 +23,8 @@ const std::vector<std::vector<YamlPathItem>>& file_path_keys() {
       {"dds", "security", "permissions"},
       {"dashboard", "credentials"},
       {"dashboard", "action_log"},
+      {"dashboard", "tls_certificate"},
+      {"dashboard", "tls_private_key"},
   };
   return keys;
 }
@@ -37,6 +39,14 @@ std::vector<std::string> data_dirs() {
   if (const char* env = std::getenv("ROBODAMP_DATA_PATH"); env != nullptr) add(env);
   add(ROBODAMP_DATA_DIRS);
   return dirs;
+}
+
+std::string shipped_file(const std::string& name) {
+  const std::vector<std::string> dirs = data_dirs();
+  std::error_code ec;
+  for (const auto& d : dirs)
+    if (fs::is_regular_file(fs::path(d) / name, ec)) return (fs::path(d) / name).string();
+  return dirs.empty() ? name : (fs::path(dirs.front()) / name).string();
 }
 
 std::string FoundFile::looked_text() const {

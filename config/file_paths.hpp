@@ -30,6 +30,10 @@ struct FoundFile {
 [[nodiscard]] FoundFile find_named_file(const std::string& source_dir, const std::string& written);
 // The data folders searched, in order.
 [[nodiscard]] std::vector<std::string> data_dirs();
+// A shipped file by its name in the data folders ("presets/horizontal_c2.yaml"): the first data folder that
+// has it, or (none has it) its place in the first data folder, which a refusal then names. The commands'
+// defaults: an installed robodamp (/usr/share/robodamp) and a source build find their own.
+[[nodiscard]] std::string shipped_file(const std::string& name);
 
 // `text` read from `from_source` (a file path; its directory resolves the relative paths), rewritten to be
 // written at `to_path`: each relative file path becomes relative to to_path's directory (absolute when no

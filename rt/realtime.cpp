@@ -29,10 +29,18 @@ __attribute__((noinline)) void prefault_stack(std::size_t bytes) {
   volatile unsigned char* p = static_cast<volatile unsigned char*>(alloca(bytes));
   for (std::size_t i = 0; i < bytes; i += 4096) p[i] = 0;
 }
+// A sanitizer build (scripts/sanitize.sh) maps terabytes of shadow memory: mlockall would try to lock it.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitizerShadow = true;
+#else
+constexpr bool kSanitizerShadow = false;
+#endif
 }  // namespace
 
 RealtimeProcess::RealtimeProcess(const config::RealtimeConfig& c, RealtimeStatus& status) {
-  if (c.lock_memory) {
+  if (c.lock_memory && kSanitizerShadow) {
+    warn(status, "a sanitizer build: memory not locked (its shadow mappings are terabytes); pages may fault");
+  } else if (c.lock_memory) {
     if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
       locked_ = status.memory_locked = true;
     } else {

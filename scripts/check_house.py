@@ -22,7 +22,7 @@ OUTSIDE = re.compile(r"\.\./shared|shared/reference|REFERENCE\.md|[Ss]eed[ _]?00
 
 def files():
     for d, dirs, names in os.walk(ROOT):
-        dirs[:] = sorted(x for x in dirs if x not in SKIP_DIRS)
+        dirs[:] = sorted(x for x in dirs if x not in SKIP_DIRS and not x.startswith("build-"))  # build-package, build-thread ...
         for n in sorted(names):
             if n.endswith(TEXT) or n in ("CMakeLists.txt", "run"):
                 yield os.path.join(d, n)

@@ -19,7 +19,7 @@ SKIP = {"build", "tests", ".git", "ros2", "benchmarks"}
 
 def sources():
     for d, dirs, files in os.walk(ROOT):
-        dirs[:] = sorted(x for x in dirs if x not in SKIP)
+        dirs[:] = sorted(x for x in dirs if x not in SKIP and not x.startswith("build-"))  # build-package, build-thread ...
         for f in sorted(files):
             if f.endswith((".cpp", ".hpp")):
                 yield os.path.relpath(os.path.join(d, f), ROOT)

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <thread>
@@ -19,6 +20,7 @@
 #include "dashboard/auth.hpp"
 #include "dashboard/fleet.hpp"
 #include "dashboard/server.hpp"
+#include "dashboard/tls.hpp"
 #include "dds/bridge.hpp"
 #include "dds/messages.hpp"
 #include "dds/participant.hpp"
@@ -130,6 +132,15 @@ TEST(DashboardConfig, EveryKeyIsCheckedWithItsUnitAndRange) {
     EXPECT_NE(w.find("dashboard.stale_after_s"), std::string::npos) << w;
     EXPECT_NE(w.find("colour"), std::string::npos) << w;
     EXPECT_NE(w.find("/nonexistent/users.yaml"), std::string::npos) << w;
+  }
+  // HTTPS: both files or neither, each one there.
+  try {
+    (void)config::parse_dashboard_config("dashboard:\n  tls_certificate: /nonexistent/cert.pem\n", "d.yaml");
+    FAIL() << "refused";
+  } catch (const config::ConfigError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("dashboard.tls_private_key: not given: HTTPS needs both the certificate and its private key"), std::string::npos) << w;
+    EXPECT_NE(w.find("dashboard.tls_certificate = '/nonexistent/cert.pem': no such file (robodamp dashboard-cert"), std::string::npos) << w;
   }
   try {
     (void)config::parse_config(std::string("cell:\n  name: 'no spaces allowed'\n"), "c.yaml");
@@ -358,6 +369,87 @@ TEST(DashboardServer, ExtraPagesAndBadCellNamesAreRefusedAndCounted) {
   server.stop();
   serving.join();
   page.join();
+}
+
+// HTTPS (docs/dashboard.md, "HTTPS"): a pair from dashboard-cert serves the page to a client that verifies it
+// against that certificate (by address and by name), with the secure headers on every response and no caching
+// of the API's data; a plain client gets nothing; a key that is not the certificate's is refused by name;
+// an existing file is not overwritten; plain HTTP is allowed on loopback only unless asked for.
+TEST(DashboardServer, ServesHttpsWithItsCertificateAndSecureHeaders) {
+  const std::string dir = temp("tls");
+  std::filesystem::create_directories(dir);
+  dashboard::write_self_signed(dir + "/cert.pem", dir + "/key.pem", {});
+  dashboard::write_self_signed(dir + "/other.pem", dir + "/other.key", {});
+  struct stat st {};
+  ASSERT_EQ(::stat((dir + "/key.pem").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600U);
+  try {
+    dashboard::write_self_signed(dir + "/cert.pem", dir + "/new.key", {});
+    ADD_FAILURE() << "an existing certificate was overwritten";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cert.pem: exists"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/new.key"));
+
+  config::DashboardConfig cfg;
+  cfg.port = 0;
+  cfg.dds.domain_id = static_cast<int>((getpid() * 11 + 5) % 200) + 20;
+  cfg.dds.transport = config::DdsTransport::kUdpLoopback;
+  cfg.tls_certificate = dir + "/cert.pem";
+  cfg.tls_private_key = dir + "/other.key";
+  dashboard::Fleet fleet(cfg.dds, 2.0);
+  dashboard::Authenticator auth({}, 60.0);
+  dashboard::ActionLog log("");
+  try {
+    dashboard::WebServer mismatched(cfg, fleet, auth, log);
+    ADD_FAILURE() << "a key that is not the certificate's was taken";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("dashboard.tls_private_key '" + dir + "/other.key'"), std::string::npos) << e.what();
+  }
+  cfg.tls_private_key = dir + "/key.pem";
+  dashboard::WebServer server(cfg, fleet, auth, log);
+  const int port = server.bind();
+  std::jthread serving([&] { server.serve(); });
+  for (const char* host : {"127.0.0.1", "localhost"}) {
+    httplib::SSLClient c(host, port);
+    c.set_ca_cert_path((dir + "/cert.pem").c_str());
+    c.enable_server_certificate_verification(true);
+    c.set_connection_timeout(30, 0);
+    c.set_read_timeout(30, 0);
+    for (const char* path : {"/", "/api/health", "/no-such-page"}) {
+      const auto r = c.Get(path);
+      ASSERT_TRUE(r) << host << path << ": " << httplib::to_string(r.error()) << " (verify " << c.get_openssl_verify_result() << ")";
+      EXPECT_EQ(r->status, std::string(path) == "/no-such-page" ? 404 : 200) << path;
+      EXPECT_NE(r->get_header_value("Content-Security-Policy").find("frame-ancestors 'none'"), std::string::npos) << path;
+      EXPECT_EQ(r->get_header_value("X-Content-Type-Options"), "nosniff") << path;
+      EXPECT_EQ(r->get_header_value("X-Frame-Options"), "DENY") << path;
+      EXPECT_EQ(r->get_header_value("Referrer-Policy"), "no-referrer") << path;
+      if (std::string(path) != "/") EXPECT_EQ(r->get_header_value("Cache-Control"), "no-store") << path;
+    }
+  }
+  // Verified against another certificate: refused.
+  httplib::SSLClient wrong("127.0.0.1", port);
+  wrong.set_ca_cert_path((dir + "/other.pem").c_str());
+  wrong.enable_server_certificate_verification(true);
+  EXPECT_FALSE(wrong.Get("/api/health"));
+  httplib::Client plain("127.0.0.1", port);
+  plain.set_read_timeout(10, 0);
+  EXPECT_FALSE(plain.Get("/api/health")) << "plain HTTP answered on the HTTPS port";
+  server.stop();
+  serving.join();
+
+  config::DashboardConfig open;
+  for (const char* loopback : {"127.0.0.1", "127.3.2.1", "::1", "localhost"}) {
+    open.listen_address = loopback;
+    EXPECT_EQ(dashboard::plain_http_refusal(open, false), "") << loopback;
+  }
+  open.listen_address = "0.0.0.0";
+  EXPECT_NE(dashboard::plain_http_refusal(open, false).find("plain HTTP on 0.0.0.0 is refused: passwords and session tokens"),
+            std::string::npos);
+  EXPECT_EQ(dashboard::plain_http_refusal(open, true), "") << "--insecure-http";
+  open.tls_certificate = dir + "/cert.pem", open.tls_private_key = dir + "/key.pem";
+  EXPECT_EQ(dashboard::plain_http_refusal(open, false), "");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(DashboardSpectrum, TheAccelerometersSpectrumPeaksAtItsSineWithTheModesAndToothPassing) {

@@ -2,7 +2,9 @@
 """robodamp dashboard in a real browser (docs/dashboard.md): headless Chromium driven through Selenium's
 WebDriver against `robodamp dashboard` and two `robodamp run` cells on a DDS domain of their own, all started
 here and stopped on every path. Waits are for conditions with deadlines (the suite runs on a loaded 2-core
-machine). Usage: test_dashboard.py ROBODAMP_BINARY SOURCE_DIR OUTPUT_DIR"""
+machine). The dashboard serves HTTPS with a pair from `robodamp dashboard-cert`: this script's requests verify
+it against that certificate; the browser accepts it as a user who clicked through the warning would.
+Usage: test_dashboard.py ROBODAMP_BINARY SOURCE_DIR OUTPUT_DIR"""
 
 import faulthandler
 import json
@@ -10,6 +12,7 @@ import os
 import re
 import signal
 import socket
+import ssl
 import subprocess
 import sys
 import shutil
@@ -28,6 +31,7 @@ from selenium.webdriver.common.by import By
 BINARY, SOURCE, OUT = sys.argv[1], sys.argv[2], sys.argv[3]
 DOMAIN = 220 + os.getpid() % 12  # the C++ tests use 20..219
 TRIP_AT_S = 20.0                 # the second cell B's amplifier fault, its loop time (started after the page loaded)
+TLS = {}                         # "context": verifies the dashboard's certificate (set when the fleet starts)
 
 
 def until(fn, timeout_s, what, period_s=0.1):
@@ -46,12 +50,13 @@ def until(fn, timeout_s, what, period_s=0.1):
 
 def http(port, path, body=None, token=None, raw=None):
     """(status, JSON or text) of one request to the dashboard."""
-    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", data=raw if raw is not None else
+    req = urllib.request.Request(f"https://127.0.0.1:{port}{path}", data=raw if raw is not None else
                                  (json.dumps(body).encode() if body is not None else None))
     if token:
         req.add_header("Authorization", "Bearer " + token)
     try:
-        with urllib.request.urlopen(req, timeout=30) as r:
+        with urllib.request.build_opener(urllib.request.ProxyHandler({}),
+                                         urllib.request.HTTPSHandler(context=TLS["context"])).open(req, timeout=30) as r:
             text = r.read().decode()
             return r.status, json.loads(text) if text.startswith(("{", "[")) else text
     except urllib.error.HTTPError as e:
@@ -61,7 +66,8 @@ def http(port, path, body=None, token=None, raw=None):
 
 def raw_request(port, data):
     """Sends bytes as they are and returns the first line of the answer (a malformed request's status)."""
-    with socket.create_connection(("127.0.0.1", port), timeout=30) as s:
+    with socket.create_connection(("127.0.0.1", port), timeout=30) as plain, \
+            TLS["context"].wrap_socket(plain, server_hostname="127.0.0.1") as s:
         s.sendall(data)
         answer = b""
         while not answer.endswith(b"\n") and len(answer) < 4096:
@@ -99,8 +105,12 @@ class Fleet:
         for user, role, password in (("alice", "operator", "alice-operator-1"), ("bob", "observer", "bob-observer-1")):
             subprocess.run([BINARY, "dashboard-user", "--file", os.path.join(self.dir, "users.yaml"), "--user", user,
                             "--role", role], input=password + "\n", text=True, check=True, capture_output=True)
+        subprocess.run([BINARY, "dashboard-cert", "--cert", os.path.join(self.dir, "cert.pem"), "--key",
+                        os.path.join(self.dir, "key.pem")], check=True, capture_output=True)
+        TLS["context"] = ssl.create_default_context(cafile=os.path.join(self.dir, "cert.pem"))
         with open(os.path.join(self.dir, "dashboard.yaml"), "w") as f:
             f.write(f"dashboard:\n  port: 0\n  credentials: users.yaml\n  stale_after_s: 2\n"
+                    f"  tls_certificate: cert.pem\n  tls_private_key: key.pem\n"
                     f"dds:\n  domain_id: {DOMAIN}\n  transport: udp_loopback\n")
         self.cell_a = self.start([BINARY, "run", "--config", os.path.join(self.dir, "cell_a.yaml"), "--duration", "900",
                                   "--spindle-rpm", "700"], "cell_a.log")
@@ -129,7 +139,7 @@ class Fleet:
         path = os.path.join(self.dir, log)
         def address():
             with open(path) as f:
-                return re.search(r"http://127\.0\.0\.1:(\d+)/", f.read())
+                return re.search(r"https://127\.0\.0\.1:(\d+)/", f.read())
         line = until(address, 60, "the dashboard's address")
         return int(line.group(1))
 
@@ -157,6 +167,8 @@ class DashboardInABrowser(unittest.TestCase):
         for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1000",
                   f"--user-data-dir={cls.fleet.dir}/chromium"):
             options.add_argument(a)
+        options.accept_insecure_certs = True  # self-signed: a user clicks through the warning once
+        options.set_capability("goog:loggingPrefs", {"browser": "ALL"})  # the console: CSP violations
         try:
             cls.browser = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
         except Exception:
@@ -164,7 +176,7 @@ class DashboardInABrowser(unittest.TestCase):
             shutil.rmtree(cls.fleet.dir, ignore_errors=True)
             raise
         cls.browser.set_page_load_timeout(60)
-        cls.url = f"http://127.0.0.1:{cls.fleet.port}/"
+        cls.url = f"https://127.0.0.1:{cls.fleet.port}/"
 
     @classmethod
     def tearDownClass(cls):
@@ -257,6 +269,10 @@ class DashboardInABrowser(unittest.TestCase):
         counters = self.browser.find_element(By.ID, "counters").text
         self.assertIn("simulated plant", counters)
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_cell.png"))
+        # Over HTTPS, and the page's content security policy blocked nothing it needs (the console says so).
+        self.assertTrue(self.browser.current_url.startswith("https://"), self.browser.current_url)
+        blocked = [e["message"] for e in self.browser.get_log("browser") if "Content Security Policy" in e["message"]]
+        self.assertEqual(blocked, [], "the page broke its own content security policy")
 
     def test_2_a_trip_shows_within_a_second(self):
         self.browser.get(self.url)
@@ -436,6 +452,16 @@ class DashboardInABrowser(unittest.TestCase):
     def test_5_hostile_requests_are_answered_counted_and_survived(self):
         port = self.fleet.port
         self.assertIn(" 400 ", raw_request(port, b"GARBAGE\r\n\r\n") + " ")
+        # Plain HTTP on the HTTPS port: no page, no data.
+        with socket.create_connection(("127.0.0.1", port), timeout=30) as plain:
+            plain.sendall(b"GET /api/fleet HTTP/1.1\r\nHost: x\r\n\r\n")
+            self.assertNotIn(b"cells", plain.recv(4096))
+        # A dashboard asked to serve plain HTTP where other hosts reach it: refused, with the reason.
+        r = subprocess.run([BINARY, "dashboard", "--listen", "0.0.0.0", "--port", "0", "--duration", "1"],
+                           capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("plain HTTP on 0.0.0.0 is refused: passwords and session tokens would cross the network readable",
+                      r.stderr)
         self.assertIn(" 400 ", raw_request(port, b"\x00\xff\x10junk" * 200 + b"\r\n\r\n") + " ")
         self.assertIn(" 400 ", raw_request(port, b"GET /api/fleet HTTP/1.1\r\nHost: x\r\nX: " + b"a" * 20000 + b"\r\n\r\n") + " ")
         status, _ = http(port, "/api/login", raw=b"x" * 100000)

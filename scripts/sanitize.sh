@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# The suite under a sanitizer, in a build directory of its own (README, "Sanitizers"):
+#   bash scripts/sanitize.sh address   [ctest options]   AddressSanitizer (leaks too)   -> build-address
+#   bash scripts/sanitize.sh undefined [ctest options]   UndefinedBehaviorSanitizer     -> build-undefined
+#   bash scripts/sanitize.sh thread    [ctest options]   ThreadSanitizer                -> build-thread
+# e.g. `bash scripts/sanitize.sh thread -R 'Dds|Dashboard|Hil|Monitor|RtLoop'`. Every finding stops its test
+# (halt on error) with the report in the test's output. Not run: test_rt_allocation (it replaces malloc,
+# which is the sanitizer's), the benchmarks. The real-time set-up does not lock memory in a sanitizer build
+# (rt/realtime.cpp: the shadow mappings are terabytes). Suppressions: scripts/sanitizers/*.supp, each with
+# its reason. Installs what is missing first (scripts/setup.sh's packages); idempotent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+kind="${1:-}"
+case "$kind" in
+  address|undefined|thread) shift ;;
+  *) echo "usage: sanitize.sh address|undefined|thread [ctest options]" >&2; exit 2 ;;
+esac
+bash scripts/setup.sh >/dev/null
+dir="build-$kind"
+mkdir -p "$dir/.cmake/api/v1/query" && touch "$dir/.cmake/api/v1/query/codemodel-v2"
+cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBODAMP_SANITIZE="$kind" \
+      -DROBODAMP_BUILD_BENCH=OFF >/dev/null
+cmake --build "$dir" --parallel "$(nproc)" | { grep -vE '^(\[[0-9]+/[0-9]+\] |ninja: no work to do)' || true; }
+supp="$PWD/scripts/sanitizers"
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1"
+export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp:print_suppressions=0"
+cd "$dir"
+ctest --parallel "$(nproc)" --timeout 3600 --output-on-failure "$@"
