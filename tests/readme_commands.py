@@ -8,7 +8,7 @@ The commands run in order, each in one scratch directory whose `config` and `bui
 PATH line: a bare `robodamp` works) and /tmp/ moved into the scratch directory: nothing is written into the
 tree. Each must end with status 0 within 180 s. Set aside, and listed: lines with a placeholder (FILE, JOB,
 [--option], a|b, ...), blocks that start a second process with `&` (the HIL pairs: tests/test_hil*.cpp), the
-set-up scripts themselves (CI runs them from a fresh clone), and the commands that take minutes (named below;
+set-up scripts themselves (CI runs them from a fresh clone), installing the package (apt-get), and the commands that take minutes (named below;
 their tests are named too).
 """
 import os
@@ -63,6 +63,8 @@ def reason_to_skip(command, in_background_block):
         return "a block with a second process (`&`): the HIL pairs, tests/test_hil*.cpp"
     if code.startswith("bash scripts/") or code.startswith("echo ") or code.startswith("printf "):
         return "set-up or the dashboard's users: CI runs the scripts from a fresh clone (.ci/run)"
+    if code.startswith("apt-get "):
+        return "installs on the machine: scripts/package.sh --try-install does (docs/deployment.md, section 6)"
     if PLACEHOLDER.search(code):
         return "a placeholder to fill in"
     words = code.split()
