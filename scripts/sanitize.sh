@@ -22,7 +22,11 @@ cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROBODAMP_SANIT
       -DROBODAMP_BUILD_BENCH=OFF >/dev/null
 cmake --build "$dir" --parallel "$(nproc)" | { grep -vE '^(\[[0-9]+/[0-9]+\] |ninja: no work to do)' || true; }
 supp="$PWD/scripts/sanitizers"
-export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1"
+# new_delete_type_mismatch=0: Debian's Fast DDS 2.9.1 allocates 64 bytes in StatisticsReaderImpl's constructor
+# and frees them as 56 in ~RTPSReader, both inside libfastrtps (found by test_dashboard's first DDS
+# participant to end): not ours to fix, and ASan cannot suppress one report of this kind by place. The price:
+# a mismatch of our own would not be reported either (the compiler's -Wdelete-non-virtual-dtor still is).
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1:new_delete_type_mismatch=0"
 export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp:print_suppressions=0"
