@@ -46,7 +46,7 @@ int run_dashboard(const DashboardArgs& a) {
     std::cerr << "robodamp dashboard: " << why << '\n';
     return 2;
   }
-  if (!cfg.tls() && !dashboard::is_loopback_address(cfg.listen_address))
+  if (!dashboard::plain_http_refusal(cfg, false).empty())  // served anyway: --insecure-http
     spdlog::warn("dashboard: plain HTTP on {} (--insecure-http): passwords and session tokens cross the network readable",
                  cfg.listen_address);
   std::vector<dashboard::User> users;

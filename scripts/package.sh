@@ -44,7 +44,7 @@ lintian --fail-on error --info "$deb" || { echo "package.sh: lintian reports err
 echo "lintian: no errors"
 
 $try_install || exit 0
-if ! dpkg-query -W -f='${Status}' robodamp 2>/dev/null | grep -q "not-installed" && dpkg-query -W robodamp >/dev/null 2>&1; then
+if dpkg-query -W -f='${Status}' robodamp 2>/dev/null | grep -q "install ok installed"; then
   echo "package.sh: robodamp is installed already; --try-install removes what it installs: remove it first" >&2
   exit 2
 fi
