@@ -7,6 +7,9 @@
 #include "config/milling_config.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/lobes.hpp"
+#include "milling/sdm.hpp"
+#include "milling/structure.hpp"
+#include "milling/tool_dynamics.hpp"
 #include "milling/sle.hpp"
 
 namespace {
@@ -50,6 +53,25 @@ void BM_DirectTestCriticalDepth(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(m.critical_depth_mm(10700.0));
 }
 BENCHMARK(BM_DirectTestCriticalDepth)->Unit(benchmark::kMillisecond);
+
+// The open-loop semi-discretization of the whole 46-mode industrial robot (robot and workpiece), issue 57:
+// one monodromy matrix (40 intervals, 172 states) and one speed's critical depth from a first guess of 3 mm.
+void BM_OpenSdm46ModesMultiplier(benchmark::State& state) {
+  const milling::Structure s(job().selected_structure(), false);
+  const milling::SdmModel sdm(milling::cutter_modal_terms(s, job().cut.feed_axis), milling::cutter_from(job().tool),
+                              job().material, job().cut.mode, job().cut.radial_mm, job().time_domain.axial_slices,
+                              job().time_domain.sdm_steps_per_period);
+  const double rpm = static_cast<double>(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(sdm.multiplier(3.0, rpm));
+}
+BENCHMARK(BM_OpenSdm46ModesMultiplier)->Arg(1156)->Arg(10700)->Unit(benchmark::kMillisecond);
+
+void BM_OpenSdm46ModesCriticalDepth(benchmark::State& state) {
+  const milling::Structure s(job().selected_structure(), false);
+  const milling::AccurateStability truth(s, job());
+  for (auto _ : state) benchmark::DoNotOptimize(truth.critical(static_cast<double>(state.range(0)), 3.0));
+}
+BENCHMARK(BM_OpenSdm46ModesCriticalDepth)->Arg(1156)->Arg(10700)->Unit(benchmark::kMillisecond);
 
 // The accurate damped lobes (issue 27): the sampled loop's semi-discretization of active_damping_c2.yaml with
 // C2 closed, over the job's 200 SDM speeds, each from the zero-order limit; threads: the speeds' task pool.

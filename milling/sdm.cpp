@@ -1,4 +1,5 @@
 #include "milling/sdm.hpp"
+#include "milling/interval_exp.hpp"
 #include "units/units.hpp"
 
 #include <cmath>
@@ -6,7 +7,6 @@
 #include <stdexcept>
 
 #include <Eigen/Eigenvalues>
-#include <unsupported/Eigen/MatrixFunctions>
 
 namespace robodamp::milling {
 
@@ -16,6 +16,23 @@ SdmModel::SdmModel(const std::vector<CutterModalTerm>& terms, const Cutter& cutt
   if (m_ < 2) throw std::invalid_argument("SdmModel: needs at least 2 steps per period");
   const ToolDynamics dyn(terms, 1.0);  // only its continuous model is used
   a_ = dyn.a(), b_ = dyn.b(), c_ = dyn.c();
+  // Each mode's state (q, q') as (wn q, q'): the same monodromy up to a similarity (the same multipliers and
+  // displacements), but a block [[0, wn], [-wn, -2 zeta wn]] of norm ~wn instead of wn^2. The matrix
+  // exponential's scaling and squaring then needs ~log2(wn) fewer squarings per interval (17 fewer at
+  // 1156 rpm on the 46-mode industrial robot, whose highest mode is 6.6 kHz).
+  for (Eigen::Index k = 0; k + 1 < a_.rows(); k += 2) {
+    const double wn2 = -a_(k + 1, k);
+    if (!(wn2 > 0.0) || a_(k, k + 1) != 1.0 || a_(k, k) != 0.0) continue;  // not a mode's block: left as it is
+    const double wn = std::sqrt(wn2);
+    a_(k, k + 1) = wn, a_(k + 1, k) = -wn;
+    b_.row(k) *= wn;
+    c_.col(k) /= wn;
+  }
+  // ToolDynamics builds one 2 x 2 block per mode; the interval's exponential relies on it.
+  for (Eigen::Index k = 0; k < a_.rows(); k += 2) blocks_.emplace_back(a_.block(k, k, 2, 2));
+  Eigen::MatrixXd check = Eigen::MatrixXd::Zero(a_.rows(), a_.cols());
+  for (Eigen::Index k = 0; k < a_.rows(); k += 2) check.block(k, k, 2, 2) = a_.block(k, k, 2, 2);
+  if (a_.rows() % 2 != 0 || check != a_) throw std::logic_error("SdmModel: the structure's model is not block diagonal");
 }
 
 DirectionalMatrix::DirectionalMatrix(const Cutter& cutter, const config::MaterialConfig& material,
@@ -68,30 +85,45 @@ double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t,
 }
 
 std::complex<double> SdmModel::multiplier(double axial_mm, double rpm, double* chatter_hz) const {
+  return dominant(monodromy(axial_mm, rpm), rpm, chatter_hz);
+}
+
+Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
   const Eigen::Index n = a_.rows(), d = n + 2 * m_;
   const double h = 60.0 / (rpm * cutter_.teeth) / m_;
-  Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d);
-  Eigen::MatrixXd big = Eigen::MatrixXd::Zero(n + 4, n + 4);
+  Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d), e;
+  IntervalExp interval(blocks_, c_);
+  const std::vector<Eigen::Matrix2d> free = interval.free_blocks(h);
   const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, slices_, axial_mm);
   const double dphi = kTwoPi / (cutter_.teeth * m_);  // spindle angle per interval
   constexpr int kSub = 8;
   for (int i = 0; i < m_; ++i) {
     const Eigen::Matrix2d mi = directional.mean(i * dphi, dphi, kSub);
     // x' = (A + B M C) x - B M q(t - tau); the delayed q goes linearly from q_{i-m} to q_{i-m+1}.
-    big.setZero();
-    big.topLeftCorner(n, n) = a_ + b_ * mi * c_;
-    big.block(0, n, n, 2) = -b_ * mi;
-    big.block(n, n + 2, 2, 2).setIdentity();
-    const Eigen::MatrixXd e = (big * h).exp();
-    const Eigen::MatrixXd phi = e.topLeftCorner(n, n), held = e.block(0, n, n, 2), ramp = e.block(0, n + 2, n, 2) / h;
     const auto old_x = z.topRows(n);
-    const auto q_oldest = z.middleRows(n + 2 * (m_ - 1), 2);          // q_{i-m}
-    const Eigen::MatrixXd q_next = z.middleRows(n + 2 * (m_ - 2), 2);  // q_{i-m+1}
-    next.topRows(n) = phi * old_x + (held - ramp) * q_oldest + ramp * q_next;
-    next.middleRows(n, 2) = c_ * old_x;                                 // q_i
+    if (mi.isZero(0.0)) {  // no tooth cuts: each mode on its own
+      for (std::size_t k = 0; k < free.size(); ++k) {
+        const auto r = static_cast<Eigen::Index>(2 * k);
+        next.middleRows(r, 2).noalias() = free[k] * z.middleRows(r, 2);
+      }
+    } else {
+      interval.compute(b_ * mi, h, e);
+      const auto q_oldest = z.middleRows(n + 2 * (m_ - 1), 2);  // q_{i-m}
+      const auto q_next = z.middleRows(n + 2 * (m_ - 2), 2);    // q_{i-m+1}
+      const Eigen::MatrixXd ramp = e.block(0, n + 2, n, 2) / h, held_less_ramp = e.block(0, n, n, 2) - ramp;
+      next.topRows(n).noalias() = e.topLeftCorner(n, n) * old_x;
+      next.topRows(n).noalias() += held_less_ramp * q_oldest;
+      next.topRows(n).noalias() += ramp * q_next;
+    }
+    next.middleRows(n, 2).noalias() = c_ * old_x;  // q_i
     next.middleRows(n + 2, 2 * (m_ - 1)) = z.middleRows(n, 2 * (m_ - 1));
     z.swap(next);
   }
+  return z;
+}
+
+std::complex<double> SdmModel::dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const {
+  const Eigen::Index n = a_.rows();
   const Eigen::EigenSolver<Eigen::MatrixXd> es(z, chatter_hz != nullptr);
   const Eigen::VectorXcd ev = es.eigenvalues();
   Eigen::Index best = 0;
@@ -155,7 +187,15 @@ DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, dou
 
 SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
   if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
-  const DepthBracket br = find_critical_depth([&](double b) { return std::log(std::abs(multiplier(b, rpm))); }, guess_mm, rel_tol);
+  Eigen::MatrixXd z_hi;  // the monodromy matrix at the last unstable depth: the bracket's hi at the end
+  const DepthBracket br = find_critical_depth(
+      [&](double b) {
+        Eigen::MatrixXd z = monodromy(b, rpm);
+        const double ln_mu = std::log(std::abs(dominant(z, rpm, nullptr)));
+        if (ln_mu >= 0.0) z_hi.swap(z);
+        return ln_mu;
+      },
+      guess_mm, rel_tol);
   SdmPoint p;
   p.rpm = rpm;
   p.critical_depth_mm = br.lo_mm;
@@ -163,8 +203,7 @@ SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
     p.critical_depth_mm = br.hi_mm;
     return p;
   }
-  const double hi = br.hi_mm;
-  const std::complex<double> mu = multiplier(hi, rpm, &p.chatter_hz);
+  const std::complex<double> mu = dominant(z_hi, rpm, &p.chatter_hz);
   // Period doubling when the critical multiplier is (nearly) real and negative.
   p.type = mu.real() < 0.0 && std::abs(mu.imag()) < 1e-3 * std::abs(mu) ? CutClass::kFlip : CutClass::kHopf;
   return p;

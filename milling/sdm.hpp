@@ -78,7 +78,12 @@ class SdmModel {
   [[nodiscard]] int steps_per_period() const { return m_; }
 
  private:
-  Eigen::MatrixXd a_, b_, c_;
+  // The monodromy matrix over one tooth period; its dominant eigenvalue (and chatter frequency).
+  [[nodiscard]] Eigen::MatrixXd monodromy(double axial_mm, double rpm) const;
+  [[nodiscard]] std::complex<double> dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const;
+
+  Eigen::MatrixXd a_, b_, c_;            // modes' states as (wn q, q'), A block diagonal
+  std::vector<Eigen::Matrix2d> blocks_;  // A's blocks
   Cutter cutter_;
   config::MaterialConfig material_;
   config::MillingMode mode_;
