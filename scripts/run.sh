@@ -3,7 +3,7 @@
 # `robodamp ARGS...` instead (e.g. scripts/run.sh check-config config/presets/vertical_c1.yaml).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+bash scripts/setup.sh robodamp
 if (($#)); then exec ./build/apps/robodamp "$@"; fi
 # The main job: the simulated-plant bench run on the default preset (impact tests with control off and
 # on, saturating impacts, gain sweep), what the damper and its speed schedule do for the default job's cut

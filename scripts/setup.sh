@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what robodamp needs on Debian 12 (only what is missing; quiet when all is there), then
-# configures and builds in ./build (Release). Used by run.sh and test.sh; idempotent.
+# configures and builds in ./build (Release): the targets named (run.sh: only the executable, 190 of the 250
+# translation units, about 73 % of the compiler's time), or everything (test.sh). Idempotent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,4 +28,6 @@ touch build/.cmake/api/v1/query/codemodel-v2
 if [[ ! -f build/CMakeCache.txt ]]; then
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
-cmake --build build --parallel "$(nproc)" | { grep -vE '^(\[[0-9]+/[0-9]+\] |ninja: no work to do)' || true; }
+targets=()
+for t in "$@"; do targets+=(--target "$t"); done
+cmake --build build --parallel "$(nproc)" "${targets[@]}" | { grep -vE '^(\[[0-9]+/[0-9]+\] |ninja: no work to do)' || true; }
