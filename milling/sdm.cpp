@@ -40,25 +40,34 @@ DirectionalMatrix::DirectionalMatrix(const Cutter& cutter, const config::Materia
     : teeth_(cutter.teeth), kt_(material.kt_n_per_mm2 * 1e6), kr_(material.kr_n_per_mm2 * 1e6) {
   for (const Slice& s : slices(cutter, axial_mm, axial_slices)) {
     const double local_radial = slice_radial_mm(cutter, s, radial_mm);
-    if (local_radial > 0.0) slices_.push_back({s, engagement(s.radius_mm, local_radial, mode)});
+    if (local_radial <= 0.0) continue;
+    EngagedSlice es{s, engagement(s.radius_mm, local_radial, mode), std::sin(s.kappa_rad), {}};
+    for (int j = 0; j < teeth_; ++j) {
+      const double offset = kTwoPi * j / teeth_ - s.lag_rad;
+      es.teeth.push_back({offset, std::sin(offset), std::cos(offset)});
+    }
+    slices_.push_back(std::move(es));
   }
 }
 
 Eigen::Matrix2d DirectionalMatrix::mean(double phi0, double dphi, int sub) const {
   Eigen::Matrix2d mean = Eigen::Matrix2d::Zero();
-  for (const EngagedSlice& es : slices_) {
-    const Slice& s = es.slice;
-    const Engagement& e = es.engagement;
-    const double sk = std::sin(s.kappa_rad), db = s.height_mm * 1e-3;
-    for (int i = 0; i < sub; ++i) {
-      const double spindle = phi0 + (i + 0.5) / sub * dphi;
-      for (int j = 0; j < teeth_; ++j) {
-        double phi = std::fmod(spindle + kTwoPi * j / teeth_ - s.lag_rad, kTwoPi);
+  for (int i = 0; i < sub; ++i) {
+    const double spindle = phi0 + (i + 0.5) / sub * dphi;
+    const double ss = std::sin(spindle), cs = std::cos(spindle);
+    for (const EngagedSlice& es : slices_) {
+      const Engagement& e = es.engagement;
+      const double sk = es.sin_kappa, w = es.slice.height_mm * 1e-3 * sk / sub;
+      for (const ToothOffset& t : es.teeth) {
+        double phi = std::fmod(spindle + t.rad, kTwoPi);
         if (phi < 0.0) phi += kTwoPi;
         if (phi < e.start_rad || phi > e.exit_rad) continue;
-        const double sp = std::sin(phi), cp = std::cos(phi);
-        const Eigen::Vector2d force(-kt_ * cp - kr_ * sk * sp, kt_ * sp - kr_ * sk * cp);
-        mean += db * sk * force * Eigen::RowVector2d(sp, cp) / sub;
+        // sin and cos of spindle + offset by the angle sum: one sine and cosine per sub-sample, not per tooth
+        // and slice.
+        const double sp = ss * t.cos + cs * t.sin, cp = cs * t.cos - ss * t.sin;
+        const double fx = -kt_ * cp - kr_ * sk * sp, fy = kt_ * sp - kr_ * sk * cp;
+        mean(0, 0) += w * fx * sp, mean(0, 1) += w * fx * cp;
+        mean(1, 0) += w * fy * sp, mean(1, 1) += w * fy * cp;
       }
     }
   }

@@ -33,9 +33,14 @@ class DirectionalMatrix {
   [[nodiscard]] Eigen::Matrix2d mean(double phi0_rad, double dphi_rad, int sub) const;
 
  private:
+  struct ToothOffset {
+    double rad, sin, cos;  // a tooth's angle behind the spindle's, with the slice's helix lag
+  };
   struct EngagedSlice {
     Slice slice;
     Engagement engagement;
+    double sin_kappa;
+    std::vector<ToothOffset> teeth;
   };
   std::vector<EngagedSlice> slices_;
   int teeth_;
