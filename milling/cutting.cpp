@@ -2,6 +2,7 @@
 #include "units/units.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace robodamp::milling {
@@ -54,13 +55,6 @@ std::vector<Slice> slices(const Cutter& c, double axial_mm, int count) {
 
 namespace {
 
-// Integral of exp(i q phi) over [a, b].
-Complex exp_integral(double q, double a, double b) {
-  if (std::abs(q) < 1e-12) return {b - a, 0.0};
-  const Complex i(0.0, 1.0);
-  return (std::exp(i * (q * b)) - std::exp(i * (q * a))) / (i * q);
-}
-
 // A force component A sin^2 + B sin cos + C sin + D cos as coefficients of exp(i m phi), m = -2..2.
 std::array<Complex, 5> exponential_form(double A, double B, double C, double D) {
   const Complex i(0.0, 1.0);
@@ -85,7 +79,6 @@ ForceSpectrum force_spectrum(const Cutter& c, const config::MaterialConfig& mat,
   out.fx.assign(static_cast<std::size_t>(harmonics) + 1, Complex(0.0));
   out.fy.assign(static_cast<std::size_t>(harmonics) + 1, Complex(0.0));
   const int n = c.teeth;
-  const Complex i(0.0, 1.0);
   for (const Slice& s : slices(c, cut.axial_mm, axial_slices)) {
     const double local_radial = slice_radial_mm(c, s, cut.radial_mm);
     if (local_radial <= 0.0) continue;
@@ -99,19 +92,31 @@ ForceSpectrum force_spectrum(const Cutter& c, const config::MaterialConfig& mat,
     // Fy =  Ft sin - Fr cos =  tc sin^2 + te sin - rc sin cos - re cos
     const auto ex = exponential_form(-rc, -tc, -re, -te);
     const auto ey = exponential_form(tc, -rc, te, -re);
-    // The slice's edge reaches angle phi at t = (phi + lag) / Omega.
+    // The integral of exp(i q phi) over the engagement [a, b] for q = m - k n is
+    // (exp(i m b) exp(-i k n b) - exp(i m a) exp(-i k n a)) / (i q): the factors in m once per slice, those in k
+    // by a running product of unit phasors (one rounding per harmonic, no sine or cosine per harmonic).
+    const double a = e.start_rad, b = e.exit_rad;
+    std::array<Complex, 5> ema{}, emb{};
+    for (int m = -2; m <= 2; ++m) {
+      ema[static_cast<std::size_t>(m + 2)] = std::polar(1.0, m * a);
+      emb[static_cast<std::size_t>(m + 2)] = std::polar(1.0, m * b);
+    }
+    const Complex step_a = std::polar(1.0, -n * a), step_b = std::polar(1.0, -n * b), step_lag = std::polar(1.0, -n * s.lag_rad);
+    Complex eka(1.0), ekb(1.0), shift(1.0);  // exp(-i k n a), exp(-i k n b), exp(-i k n lag): the edge reaches phi at (phi + lag) / Omega
+    const double scale = n / (kTwoPi);
     for (int k = 0; k <= harmonics; ++k) {
-      const double kn = static_cast<double>(k) * n;
-      const Complex shift = std::exp(-i * (kn * s.lag_rad));
       Complex sx(0.0), sy(0.0);
       for (int m = -2; m <= 2; ++m) {
-        const Complex integral = exp_integral(m - kn, e.start_rad, e.exit_rad);
-        sx += ex[static_cast<std::size_t>(m + 2)] * integral;
-        sy += ey[static_cast<std::size_t>(m + 2)] * integral;
+        const int q = m - k * n;
+        const auto im = static_cast<std::size_t>(m + 2);
+        const Complex d = emb[im] * ekb - ema[im] * eka;  // divided by i q below
+        const Complex integral = q == 0 ? Complex(b - a, 0.0) : Complex(d.imag() / q, -d.real() / q);
+        sx += ex[im] * integral;
+        sy += ey[im] * integral;
       }
-      const double scale = n / (kTwoPi);
       out.fx[static_cast<std::size_t>(k)] += scale * sx * shift;
       out.fy[static_cast<std::size_t>(k)] += scale * sy * shift;
+      eka *= step_a, ekb *= step_b, shift *= step_lag;
     }
   }
   return out;

@@ -1,6 +1,7 @@
 #include "milling/forced_command.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -13,7 +14,17 @@ namespace robodamp::milling {
 
 namespace {
 constexpr int kHarmonics = 16;        // of the tooth-passing frequency: the force's spectrum falls fast beyond
-constexpr int kSamplesPerPeriod = 256;
+constexpr std::size_t kSamplesPerPeriod = 256;
+
+// exp(i 2 pi j / kSamplesPerPeriod): harmonic k at sample n is entry k n mod kSamplesPerPeriod.
+const std::array<Complex, kSamplesPerPeriod>& unit_phasors() {
+  static const auto table = [] {
+    std::array<Complex, kSamplesPerPeriod> t{};
+    for (std::size_t j = 0; j < kSamplesPerPeriod; ++j) t[j] = std::polar(1.0, robodamp::kTwoPi * static_cast<double>(j) / kSamplesPerPeriod);
+    return t;
+  }();
+  return table;
+}
 }  // namespace
 
 ForcedCommand::ForcedCommand(const Structure& damped, const config::MillingConfig& job, double rpm) : job_(job), rpm_(rpm) {
@@ -50,10 +61,10 @@ double ForcedCommand::peak_force_n(double axial_mm) const {
       const Complex along = job_.cut.feed_axis == config::Axis::kX ? (p.direction == 0 ? fx : fy) : (p.direction == 0 ? -fy : fx);
       c[k] = p.newton_per_newton[k] * along;
     }
-    for (int n = 0; n < kSamplesPerPeriod; ++n) {
-      const double phase = robodamp::kTwoPi * n / kSamplesPerPeriod;
+    const auto& unit = unit_phasors();
+    for (std::size_t n = 0; n < kSamplesPerPeriod; ++n) {
       double v = 0.0;
-      for (std::size_t k = 1; k <= kHarmonics; ++k) v += 2.0 * (c[k] * std::polar(1.0, static_cast<double>(k) * phase)).real();
+      for (std::size_t k = 1; k <= kHarmonics; ++k) v += 2.0 * (c[k] * unit[(k * n) % kSamplesPerPeriod]).real();
       peak = std::max(peak, std::abs(v));
     }
   }

@@ -139,7 +139,7 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
 }
 
 // long: one monodromy matrix over a tooth period on preallocated blocks (the hot loop of the accurate method)
-SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int ticks, bool want_vector) const {
+SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks, bool want_vector) const {
   const Eigen::Index n = sys.a.rows();
   const double period_s = ticks * tick_s_;
   const int k = std::min(ticks, std::max(settings_.min_grid_per_period,
@@ -157,15 +157,19 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int
   const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, settings_.axial_slices, axial_mm);
   const double dphi = kTwoPi / (cutter_.teeth * ticks);
   const int sub = std::max(2, static_cast<int>(std::ceil(400.0 / ticks)));
-  std::map<int, MatrixXd> powers;
   auto power = [&](int m) -> const MatrixXd& {
-    auto it = powers.find(m);
-    if (it == powers.end()) {
+    auto it = cache.a_pow.find(m);
+    if (it == cache.a_pow.end()) {
       MatrixXd p = MatrixXd::Identity(n, n);
       for (int i = 0; i < m; ++i) p = sys.a * p;
-      it = powers.emplace(m, std::move(p)).first;
+      it = cache.a_pow.emplace(m, std::move(p)).first;
     }
     return it->second;
+  };
+  auto power_b = [&](int r) -> const MatrixXd& {  // A^r B
+    if (cache.a_pow_b.empty()) cache.a_pow_b.push_back(sys.b);
+    while (static_cast<int>(cache.a_pow_b.size()) <= r) cache.a_pow_b.push_back(sys.a * cache.a_pow_b.back());
+    return cache.a_pow_b[static_cast<std::size_t>(r)];
   };
   // Columns: [s_0, g_-1, ..., g_-(k+1)]; rows of each grid value as a function of them.
   MatrixXd x = MatrixXd::Zero(n, dim);
@@ -183,20 +187,22 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, double axial_mm, int
     const int first = res.grid[static_cast<std::size_t>(j)], last = res.grid[static_cast<std::size_t>(j) + 1];
     // References: current j-1, j, j+1 (+), delayed j-k-1, j-k, j-k+1 (-): F = K (q - q(t - tau)).
     const int refs[6] = {j - 1, j, j + 1, j - k - 1, j - k, j - k + 1};
+    // w = sum over the interval's ticks l of A^(last - 1 - l) B K_l [cur(l), -del(l)]: each tick's rank-2 input
+    // through its propagator A^r B (n x 2), not the n x 12 sum through A at every tick.
     w.setZero();
     bool any = false;
     for (int l = first; l < last; ++l) {
-      if (any) w = sys.a * w;
       const Eigen::Matrix2d kl = directional.mean(l * dphi, dphi, sub);
       if (kl.isZero(0.0)) continue;
       const double t = l + 0.5;
       const Eigen::Vector3d cur = lagrange(grid_tick(j - 1), grid_tick(j), grid_tick(j + 1), t);
       const Eigen::Vector3d del = lagrange(grid_tick(j - k - 1), grid_tick(j - k), grid_tick(j - k + 1), t - ticks);
-      const MatrixXd bk = sys.b * kl;
+      Eigen::Matrix<double, 2, 12> input;
       for (int i = 0; i < 3; ++i) {
-        w.middleCols(2 * i, 2) += cur(i) * bk;
-        w.middleCols(6 + 2 * i, 2) -= del(i) * bk;
+        input.middleCols<2>(2 * i) = cur(i) * kl;
+        input.middleCols<2>(6 + 2 * i) = -del(i) * kl;
       }
+      w.noalias() += power_b(last - 1 - l) * input;
       any = true;
     }
     y.noalias() = power(last - first) * x;
@@ -239,15 +245,17 @@ std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const {
   if (!(axial_mm > 0.0) || !std::isfinite(axial_mm))
     throw std::invalid_argument("axial depth = " + fmt(axial_mm) + " mm: must be > 0 and finite");
   const int ticks = ticks_per_tooth(rpm);
-  return monodromy(per_speed_ ? system_at(stepped_rpm(rpm)) : base_, axial_mm, ticks, false).mu;
+  Propagators cache;
+  return monodromy(per_speed_ ? system_at(stepped_rpm(rpm)) : base_, cache, axial_mm, ticks, false).mu;
 }
 
 SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const {
   const int ticks = ticks_per_tooth(rpm);
   const double at_rpm = stepped_rpm(rpm);
   const System sys = per_speed_ ? system_at(at_rpm) : base_;
+  Propagators cache;
   const DepthBracket br = find_critical_depth(
-      [&](double b) { return std::log(std::abs(monodromy(sys, b, ticks, false).mu)); }, guess_mm, rel_tol);
+      [&](double b) { return std::log(std::abs(monodromy(sys, cache, b, ticks, false).mu)); }, guess_mm, rel_tol);
   SdmPoint p;
   p.rpm = at_rpm;
   p.critical_depth_mm = br.lo_mm;
@@ -256,7 +264,7 @@ SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const
     return p;
   }
   const double hi = br.hi_mm;
-  const Result r = monodromy(sys, hi, ticks, true);
+  const Result r = monodromy(sys, cache, hi, ticks, true);
   p.type = r.mu.real() < 0.0 && std::abs(r.mu.imag()) < 1e-3 * std::abs(r.mu) ? CutClass::kFlip : CutClass::kHopf;
   p.chatter_hz = chatter_hz(r, ticks);
   return p;

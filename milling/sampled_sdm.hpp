@@ -74,8 +74,14 @@ class SampledSdm {
     Eigen::VectorXcd history;          // the critical eigenvector's grid displacements g_{-1} .. g_{-k}
     std::vector<int> grid;             // tick index of each grid point 0..k
   };
+  // A^m and A^r B of one System, made as the monodromy needs them and kept across the depths of one search
+  // (one per System and thread).
+  struct Propagators {
+    std::map<int, Eigen::MatrixXd> a_pow;      // A^m, by m
+    std::vector<Eigen::MatrixXd> a_pow_b;      // A^r B, r = 0, 1, ...
+  };
   [[nodiscard]] System system_at(double rpm) const;
-  [[nodiscard]] Result monodromy(const System& sys, double axial_mm, int ticks, bool want_vector) const;
+  [[nodiscard]] Result monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks, bool want_vector) const;
   [[nodiscard]] double chatter_hz(const Result& r, int ticks) const;
 
   std::vector<Structure::ControllerPart> parts_;
