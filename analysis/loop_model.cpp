@@ -1,5 +1,7 @@
 // long: the discrete and the continuous loop models share their state-space pieces; splitting them is left for a later pass
 #include "analysis/loop_model.hpp"
+
+#include "analysis/gain_path.hpp"
 #include "analysis/quiet_command.hpp"
 
 #include <algorithm>
@@ -376,12 +378,14 @@ Peak find_peak(const std::vector<double>& grid, const std::vector<double>& v, co
 }
 
 std::optional<double> max_stable_gain(const LoopModel& m, int polarity) {
+  const GainPath path(m.open_loop_unit());  // the poles at ~140 gains: the Hessenberg reduction once
+  const auto stable = [&](double k) { return path.spectral_radius(k, polarity) < 1.0; };
   const double k_max = control::kMaxGainNsPerM;
   double lo = 0.0, hi = 0.0;
   const int n = 120;  // log scan 1 .. k_max N s/m
   for (int i = 0; i <= n; ++i) {
     const double k = std::pow(k_max, static_cast<double>(i) / n);
-    if (!m.stable(k, polarity)) {
+    if (!stable(k)) {
       hi = k;
       break;
     }
@@ -390,7 +394,7 @@ std::optional<double> max_stable_gain(const LoopModel& m, int polarity) {
   if (hi == 0.0) return std::nullopt;
   while (hi - lo > 1e-6 * hi) {
     const double mid = 0.5 * (lo + hi);
-    (m.stable(mid, polarity) ? lo : hi) = mid;
+    (stable(mid) ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }

@@ -117,6 +117,8 @@ class LoopModel {
   [[nodiscard]] Eigen::VectorXcd closed_loop_poles(double gain_ns_per_m, int polarity) const;
   [[nodiscard]] double spectral_radius(double gain_ns_per_m, int polarity) const;
   [[nodiscard]] bool stable(double gain_ns_per_m, int polarity) const { return spectral_radius(gain_ns_per_m, polarity) < 1.0; }
+  // Controller output -> controller output at K = 1, polarity +1: the closed loop is a + polarity K b c.
+  [[nodiscard]] const DiscreteSs& open_loop_unit() const { return open_loop_unit_; }
   // Net clockwise encirclements of -1 by L(e^{jwT}) over the whole unit circle (0 for a stable loop,
   // all open-loop poles being inside the unit circle).
   [[nodiscard]] int nyquist_encirclements(double gain_ns_per_m, int polarity) const;

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "modal/receptance.hpp"
+#include "analysis/gain_path.hpp"
 #include "analysis/loop_model.hpp"
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/resolvent.hpp"
@@ -70,6 +71,34 @@ TEST(LoopModel, PolesAndNyquistAgreeAcrossTheGainLimit) {
     for (double factor : {0.3, 0.9, 0.99, 1.01, 1.2, 3.0}) {
       const double k = factor * *k_max;
       EXPECT_EQ(m.nyquist_encirclements(k, pol) == 0, m.stable(k, pol)) << name << " K = " << k;
+    }
+  }
+}
+
+// The controller-Hessenberg path (one reduction, then the QR iterations per gain) gives the dense solve's
+// spectral radius: on the presets' loops at both polarities, and on random one-input systems of our own.
+TEST(GainPath, SpectralRadiusIsTheDenseEigenvaluesAtEveryGain) {
+  for (const char* name : {"horizontal_c2", "vertical_c1", "tuned_vertical"}) {
+    const auto m = model(name);
+    const analysis::GainPath path(m.open_loop_unit());
+    for (int pol : {1, -1})
+      for (double k : {0.0, 10.0, 300.0, 2000.0, 9000.0, 60000.0})
+        EXPECT_NEAR(path.spectral_radius(k, pol), m.spectral_radius(k, pol), 1e-11 * m.spectral_radius(k, pol) + 1e-14)
+            << name << " K " << k << " polarity " << pol;
+  }
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 3 + trial * 2;
+    analysis::DiscreteSs s;
+    s.a = Eigen::MatrixXd::NullaryExpr(n, n, [&] { return g(rng); }) / std::sqrt(static_cast<double>(n));
+    s.b = Eigen::MatrixXd::NullaryExpr(n, 1, [&] { return g(rng); });
+    s.c = Eigen::MatrixXd::NullaryExpr(1, n, [&] { return g(rng); });
+    const analysis::GainPath path(s);
+    for (double k : {0.0, 0.01, 0.3, 2.0}) {
+      const Eigen::MatrixXd closed = s.a - k * s.b * s.c;
+      const double dense = Eigen::EigenSolver<Eigen::MatrixXd>(closed, false).eigenvalues().cwiseAbs().maxCoeff();
+      EXPECT_NEAR(path.spectral_radius(k, -1), dense, 1e-10 * dense) << "n " << n << " K " << k;
     }
   }
 }
