@@ -285,6 +285,41 @@ Evaluation Evaluator::operator()(const Candidate& cand, bool constraints_only) c
   return e;
 }
 
+namespace {
+
+// The loop's checks of one candidate, which do not depend on each other: on the cores there are, each task
+// writing only its own result (the same as one after the other). An unstable loop gets its gain limit and
+// margins only.
+struct LoopChecks {
+  std::optional<double> k_max;
+  analysis::Margins margins;  // its gain margin from k_max
+  std::vector<analysis::ModePhase> phases;
+  std::optional<analysis::ModeImprovement> worst;
+  std::optional<analysis::CommandPeak> peak;
+  std::optional<double> quiet_rms_v;
+};
+
+LoopChecks check_loop(const analysis::LoopModel& m, double k, int polarity, bool stable, const TuneSettings& s,
+                      analysis::ImpactCommand* impact, double floor_v) {
+  LoopChecks c;
+  std::vector<std::function<void()>> tasks{[&] { c.k_max = analysis::max_stable_gain(m, polarity); },
+                                           [&] { c.margins = analysis::margins(m, k, polarity, std::nullopt); }};
+  if (stable) {
+    if (impact) tasks.emplace_back([&] { c.peak = impact->peak(m, k, polarity); });
+    tasks.emplace_back([&] {
+      c.phases = analysis::mode_phases(m, k, polarity);
+      if (s.no_worse_mode || s.worst_mode_objective)
+        c.worst = analysis::worst_mode(analysis::mode_improvements(m, k, polarity), s.mode_band_min_hz, s.mode_band_max_hz);
+      if (floor_v > 0.0) c.quiet_rms_v = analysis::quiet_command(m, k, polarity).rms_v;
+    });
+  }
+  analysis::run_tasks(tasks, analysis::task_threads(0));
+  if (c.k_max) c.margins.gain_margin_db = 20.0 * std::log10(*c.k_max / k);  // as analysis::margins writes it
+  return c;
+}
+
+}  // namespace
+
 // long: every constraint of one candidate in the order the report names them; left for a later pass
 Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) const {
   Evaluation e;
@@ -294,29 +329,11 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   const auto m = std::make_shared<const analysis::LoopModel>(cfg);
   const double k = cand.gain_ns_per_m;
   e.stable = m->stable(k, cand.polarity);
-  // The loop's checks do not depend on each other: on the cores there are, each task writing only its own
-  // result (the same evaluation as one after the other). An unstable loop gets its gain limit and margins only.
-  std::optional<double> k_max;
-  analysis::Margins mg;
-  std::vector<analysis::ModePhase> phases;
-  std::optional<analysis::ModeImprovement> worst;
-  std::optional<analysis::CommandPeak> peak;
-  std::optional<double> quiet_rms_v;
-  const double floor_v = cfg.supervision.instability_floor_v;
-  std::vector<std::function<void()>> checks{[&] { k_max = analysis::max_stable_gain(*m, cand.polarity); },
-                                            [&] { mg = analysis::margins(*m, k, cand.polarity, std::nullopt); }};
-  if (e.stable) {
-    if (impact_) checks.emplace_back([&] { peak = impact_->command.peak(*m, k, cand.polarity); });
-    checks.emplace_back([&] {
-      phases = analysis::mode_phases(*m, k, cand.polarity);
-      if (s_.no_worse_mode || s_.worst_mode_objective)
-        worst = analysis::worst_mode(analysis::mode_improvements(*m, k, cand.polarity), s_.mode_band_min_hz, s_.mode_band_max_hz);
-      if (floor_v > 0.0) quiet_rms_v = analysis::quiet_command(*m, k, cand.polarity).rms_v;
-    });
-  }
-  analysis::run_tasks(checks, analysis::task_threads(0));
+  const LoopChecks checks = check_loop(*m, k, cand.polarity, e.stable, s_, impact_ ? &impact_->command : nullptr,
+                                       cfg.supervision.instability_floor_v);
+  const std::optional<double>& k_max = checks.k_max;
+  const analysis::Margins& mg = checks.margins;
   e.k_max_ns_per_m = k_max.value_or(kInf);
-  if (k_max) mg.gain_margin_db = 20.0 * std::log10(*k_max / k);  // as analysis::margins writes it
   e.gain_margin_db = mg.gain_margin_db.value_or(kInf);
   e.phase_margin_deg = mg.phase_margin_deg.value_or(180.0);
   e.delay_margin_ms = mg.delay_margin_ms.value_or(kInf);
@@ -328,10 +345,10 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
   add_violation(e, (s_.gain_margin_min_db - e.gain_margin_db) / s_.gain_margin_min_db, "gain margin");
   add_violation(e, (s_.phase_margin_min_deg - e.phase_margin_deg) / s_.phase_margin_min_deg, "phase margin");
   add_violation(e, (s_.delay_margin_min_ms - e.delay_margin_ms) / s_.delay_margin_min_ms, "delay margin");
-  for (const auto& mode : phases) e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
+  for (const auto& mode : checks.phases) e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
   if (s_.damping_window) add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
   if (s_.no_worse_mode || s_.worst_mode_objective) {
-    e.worst_mode_improvement_pct = worst ? worst->improvement_pct : kInf;
+    e.worst_mode_improvement_pct = checks.worst ? checks.worst->improvement_pct : kInf;
     if (s_.no_worse_mode)
       add_violation(e, -(e.worst_mode_improvement_pct + s_.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
   }
@@ -339,13 +356,13 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
     e.compensator_gain_ratio = compensator_gain_ratio(cfg);
     add_violation(e, e.compensator_gain_ratio / s_.compensator_gain_max - 1.0, "the compensator's gain away from the match frequency");
   }
-  if (quiet_rms_v) {
-    e.quiet_command_rms_v = *quiet_rms_v;
-    add_violation(e, e.quiet_command_rms_v / (kQuietShareOfFloor * floor_v) - 1.0,
+  if (checks.quiet_rms_v) {
+    e.quiet_command_rms_v = *checks.quiet_rms_v;
+    add_violation(e, e.quiet_command_rms_v / (kQuietShareOfFloor * cfg.supervision.instability_floor_v) - 1.0,
                   "the quiet cell's command against the instability detector's floor");
   }
-  if (peak) {
-    const analysis::CommandPeak& p = *peak;
+  if (checks.peak) {
+    const analysis::CommandPeak& p = *checks.peak;
     e.peak_command_v = p.voltage_v;
     e.peak_coil_force_n = p.coil_force_n;
     e.peak_slew_v_per_s = p.slew_v_per_s;
