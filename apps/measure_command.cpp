@@ -6,6 +6,7 @@
 
 #include "apps/cli.hpp"
 #include "commission/measurement.hpp"
+#include "commission/path_measurement.hpp"
 #include "commission/pose_measurements.hpp"
 
 namespace robodamp::apps {
@@ -19,6 +20,9 @@ struct MeasureArgs {
   std::vector<double> pose_deg;
   std::string poses_file;
   bool no_hammer{false}, control_on{false}, dry_run{false};
+  bool along_path{false};
+  int dwells{1};
+  double duration_s{3600.0}, still_deg{0.05};
 };
 
 int report(const commission::MeasureOutcome& r, const std::string& out_dir) {
@@ -47,6 +51,24 @@ int report(const commission::MeasureOutcome& r, const std::string& out_dir) {
   return commission::exit_code(r.status);
 }
 
+int measure_along_path(const MeasureArgs& a, const commission::MeasureOptions& o) {
+  commission::PathMeasureOptions p{o, a.dwells, a.duration_s, a.still_deg};
+  const config::Config cfg = config::load_config_file(a.config_path);
+  const commission::PathMeasureOutcome r = commission::measure_along_path(cfg, a.config_path, a.out_dir, p);
+  for (const auto& d : r.dwells) {
+    if (d.measured)
+      std::printf("robodamp measure: %s at %s (still from %.2f s): the chirp %.2f-%.2f s -> %s\n", d.name.c_str(),
+                  config::describe_pose(d.joints_deg).c_str(), d.still_s, d.chirp_start_s, d.chirp_end_s, d.dir.c_str());
+    else
+      std::printf("robodamp measure: %s (still from %.2f s) not measured: %s\n", d.name.c_str(), d.still_s, d.skipped.c_str());
+  }
+  std::printf("robodamp measure: %d of %d dwells measured along the path; state %s, trip %s, %llu saturated ticks, peak "
+              "command %.3f V; index %s/poses.json\n", r.measured(), a.dwells, r.run.final_state.c_str(), r.run.trip.c_str(),
+              r.run.saturated_ticks, r.run.peak_command_v, a.out_dir.c_str());
+  if (r.run.status != commission::MeasureStatus::kOk) std::cerr << "robodamp measure: " << r.run.message << '\n';
+  return commission::exit_code(r.run.status);
+}
+
 int measure(const MeasureArgs& a) {
   commission::MeasureOptions o{a.clock, a.pose_deg, {}};
   o.impacts = !a.no_hammer;
@@ -55,6 +77,7 @@ int measure(const MeasureArgs& a) {
     std::cout << commission::measurement_plan(a.config_path, o);
     return 0;
   }
+  if (a.along_path) return measure_along_path(a, o);
   if (a.poses_file.empty()) return report(commission::measure(a.config_path, a.out_dir, o), a.out_dir);
   const auto poses = commission::read_measurement_poses(a.config_path, a.poses_file);  // all checked first
   int status = 0;
@@ -87,6 +110,17 @@ void register_measure(Registry& r) {
                   "file), each into --out/<name>/, indexed in --out/poses.json")
       ->check(CLI::ExistingFile)
       ->excludes(pose);
+  auto* path = sub->add_flag("--along-path", a->along_path,
+                             "Measure at each stop of the moving robot (its joints read from the robot: modbus.robot."
+                             "joints_register or dds.joint_states): the chirp once it has stood still for commissioning."
+                             "settle_s, the plant side's hammer after it; each stop into --out/dwell_<k>/, indexed in "
+                             "--out/poses.json")
+                   ->excludes(pose);
+  sub->get_option("--poses")->excludes(path);
+  r.whole_number(sub, "--dwells", a->dwells, {"dwells", 1, 1000}, "--along-path: the run ends once this many stops are measured");
+  r.number(sub, "--duration", a->duration_s, {"s", 1.0, 86400.0}, "--along-path: the run ends after this long at most");
+  r.number(sub, "--still-deg", a->still_deg, {"deg", 0.0, 10.0, true},
+           "--along-path: a joint further than this from where it stopped: the robot moves");
   sub->add_flag("--no-hammer", a->no_hammer,
                 "The actuator's chirp only, no impacts (a real cell: your modal kit's tap tests give the other FRFs)");
   sub->add_flag("--control-on", a->control_on,

@@ -164,7 +164,8 @@ void register_plant(Registry& r) {
   r.json(sub, a->json, "The report (frames, timing, measured FRFs)");
   sub->add_flag("!--no-impacts", a->impacts, "Do not run the impact schedule");
   sub->add_option("--measure-out", a->measure_out,
-                  "The plant side of robodamp measure: the commissioning impacts at every location, FRFs written here");
+                  "The plant side of robodamp measure: the commissioning impacts at every location, FRFs written here; with "
+                  "--pose-at, at each dwell from its start on a stopped measurement's times, into DIR/dwell_<k> (measure --along-path)");
   r.whole_number(sub, "--impact-location", a->impact_location,
                  {"(location id)", 0, 1000, false, false, "0 = the first FRF's excitation"}, "Location id the hammer hits");
   r.number(sub, "--bus-off-at", a->bus_off_at_s, {"s", 0.0, 604800.0},

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "analysis/modal_test.hpp"
+#include "commission/measurement_detail.hpp"
 #include "commission/modal_test_hook.hpp"
 #include "config/robot_model_config.hpp"
 #include "rt/signals.hpp"
@@ -160,27 +161,6 @@ analysis::CommissioningPlan plan_for(const config::Config& cfg, const sim::Plant
   return plan;
 }
 
-// The configuration the loop runs: control off (every set's gain 0) unless the chirp verifies the controller.
-config::Config running_config(const config::Config& cfg, const MeasureOptions& o) {
-  config::Config c = cfg;
-  if (o.control_on) return c;
-  c.controller.gain_ns_per_m = 0.0;
-  if (c.pose_schedule)  // each region's set carries its own gain: off as well, or the loop damps what it measures
-    for (auto& r : c.pose_schedule->regions) r.gain_ns_per_m = 0.0;
-  return c;
-}
-
-void fill_manifest(identify::MeasurementManifest& m, const std::string& config_path, const config::Config& cfg,
-                   const sim::PlantModel& model, const analysis::CommissioningPlan& plan) {
-  m.config_source = fs::absolute(config_path).lexically_normal().string();
-  m.config_text = cfg.yaml_text;
-  m.loop_rate_hz = cfg.loop.rate_hz;
-  m.plan = plan;
-  for (const auto& l : cfg.robot.locations) m.locations.emplace_back(l.id, l.name);
-  m.sensor_location_id = cfg.sensor.location;
-  m.actuator_location_id = model.locations[model.actuator.location].id;
-}
-
 // The run's verdict, in order: the watch's stop, the operator's abort, a trip, an incomplete chirp, the
 // recording's errors.
 void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& watch) {
@@ -202,6 +182,31 @@ void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& wa
     out.status = MeasureStatus::kWriteError;
     out.message = "the recording had " + std::to_string(s.record_errors) + " write errors";
   }
+}
+
+}  // namespace
+
+namespace detail {
+
+// The configuration the loop runs: control off (every set's gain 0) unless the chirp verifies the controller.
+config::Config running_config(const config::Config& cfg, const MeasureOptions& o) {
+  config::Config c = cfg;
+  if (o.control_on) return c;
+  c.controller.gain_ns_per_m = 0.0;
+  if (c.pose_schedule)  // each region's set carries its own gain: off as well, or the loop damps what it measures
+    for (auto& r : c.pose_schedule->regions) r.gain_ns_per_m = 0.0;
+  return c;
+}
+
+void fill_manifest(identify::MeasurementManifest& m, const std::string& config_path, const config::Config& cfg,
+                   const sim::PlantModel& model, const analysis::CommissioningPlan& plan) {
+  m.config_source = fs::absolute(config_path).lexically_normal().string();
+  m.config_text = cfg.yaml_text;
+  m.loop_rate_hz = cfg.loop.rate_hz;
+  m.plan = plan;
+  for (const auto& l : cfg.robot.locations) m.locations.emplace_back(l.id, l.name);
+  m.sensor_location_id = cfg.sensor.location;
+  m.actuator_location_id = model.locations[model.actuator.location].id;
 }
 
 // measurement.json (with the refusal, if any), and the measurement as a universal file for a modal
@@ -228,7 +233,8 @@ void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts
       in = identify::read_measurement_dir(out_dir);
     } else {
       in.manifest = m;
-      in.chirp = identify::read_chirp_measurement((fs::path(out_dir) / identify::kRecordingName).string(), m.config_source);
+      in.chirp = identify::read_chirp_measurement((fs::path(out_dir) / identify::kRecordingName).string(), m.config_source,
+                                                  m.plan.chirp_start_s);
     }
     measfiles::write_uff(uff, identify::measurement_to_uff(in), measfiles::UffEncoding::kAscii);
   } catch (const std::exception& e) {
@@ -237,7 +243,7 @@ void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts
   }
 }
 
-}  // namespace
+}  // namespace detail
 
 int exit_code(MeasureStatus s) {
   switch (s) {
@@ -317,11 +323,11 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
   o.chirp = {true, plan.chirp_start_s, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz,
              plan.chirp_amplitude_v, 0.5 * c.chirp_period_s};
   identify::MeasurementManifest& m = out.manifest;
-  fill_manifest(m, config_path, cfg, model, plan);
+  detail::fill_manifest(m, config_path, cfg, model, plan);
   Progress progress(plan, m.locations, c);
   o.on_frame = [&progress](const rt::TelemetryFrame& f) { progress.on_frame(f); };
 
-  runtime::Cell cell(running_config(cfg, opt), o);
+  runtime::Cell cell(detail::running_config(cfg, opt), o);
   if (runtime::Status s = cell.configure(); !s.ok()) {
     out.status = s.kind == runtime::StatusKind::kConfigError ? MeasureStatus::kConfigError : MeasureStatus::kFailed;
     out.message = s.message;
@@ -366,7 +372,7 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
     m.run["impact_records"] = test->records();
   }
   judge(out, s, progress);
-  write_outputs(out, out_dir, test != nullptr, !opt.impacts);
+  detail::write_outputs(out, out_dir, test != nullptr, !opt.impacts);
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -75,10 +76,17 @@ PlantEmulator::PlantEmulator(const config::Config& cfg, const EmulatorOptions& o
   setup_cut();
   rep_.modbus = regs_.describe();
   regs_.set_temperature(cfg.hil.ambient_c);
+  check_measure_dwells();
   if (trajectory_) {
     regs_.set_joints(trajectory_->at(0.0));
     retunes_ = trajectory_->retunes(o.pose_update_s);
   }
+}
+
+// --measure-out along a trajectory: every stop long enough for a stopped measurement's plan.
+void PlantEmulator::check_measure_dwells() const {
+  if (!o_.measure_out.empty() && trajectory_)
+    check_measurement_stops(*trajectory_, analysis::commissioning_plan(cfg_, model_));
 }
 
 // The spindle (steps and ramps) and the cut at its speed: checked before any controller is served.
@@ -134,15 +142,27 @@ void PlantEmulator::connect() {
 // Allocated now: starting them later only schedules the hits (the realtime pacing never stalls for it).
 void PlantEmulator::setup_campaigns() {
   if (!o_.measure_out.empty()) {
-    modal_test_ = std::make_unique<analysis::ModalTest>(cfg_, plant_, analysis::commissioning_plan(cfg_, model_));
-    rep_.measure_records_planned = modal_test_->records_planned();
-    spdlog::info("robodamp plant: commissioning measurement: {} impacts at each location from {:.1f} s, FRFs to {}",
-                 cfg_.commissioning.impacts_per_location, analysis::commissioning_plan(cfg_, model_).impacts_start_s.front(),
-                 o_.measure_out);
+    const analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg_, model_);
+    if (!trajectory_) {
+      modal_tests_.emplace_back(o_.measure_out, std::make_unique<analysis::ModalTest>(cfg_, plant_, plan));
+      spdlog::info("robodamp plant: commissioning measurement: {} impacts at each location from {:.1f} s, FRFs to {}",
+                   cfg_.commissioning.impacts_per_location, plan.impacts_start_s.front(), o_.measure_out);
+    }
+    std::size_t k = 0;
+    for (const PoseDwell& d : trajectory_ ? trajectory_->stops() : std::vector<PoseDwell>{}) {
+      analysis::CommissioningPlan at = plan;  // a stopped measurement's times from the robot's stop
+      for (double& t : at.impacts_start_s) t += d.t0_s;
+      const std::string dir = o_.measure_out + "/dwell_" + std::to_string(++k);
+      modal_tests_.emplace_back(dir, std::make_unique<analysis::ModalTest>(cfg_, plant_, at));
+      spdlog::info("robodamp plant: commissioning measurement at dwell {} ({}): {} impacts at each location from {:.1f} s, "
+                   "FRFs to {}", k, config::describe_pose(d.joints_deg), cfg_.commissioning.impacts_per_location,
+                   at.impacts_start_s.front(), dir);
+    }
+    for (const auto& [dir, test] : modal_tests_) rep_.measure_records_planned += test->records_planned();
   } else if (o_.impacts && !trajectory_) {
     campaign_.emplace(cfg_, plant_, test_);
   }
-  if (trajectory_ && o_.impacts) {
+  if (trajectory_ && o_.impacts && o_.measure_out.empty()) {
     dwell_campaigns_.emplace(cfg_, plant_, *trajectory_, test_);
     rep_.records_planned = 0;
     spdlog::info("robodamp plant: the robot moves along {} waypoints; impacts at {} dwells", o_.pose_trajectory.size(),
@@ -334,7 +354,7 @@ void PlantEmulator::step_plant() {
   const double t = static_cast<double>(k) * dt_;
   if (campaign_) campaign_->before_step(k);
   if (dwell_campaigns_) dwell_campaigns_->before_step(k);
-  if (modal_test_) modal_test_->before_step(k);
+  for (auto& [dir, test] : modal_tests_) test->before_step(k);
   move_robot(t);
   (void)turn_spindle(t);
   plant_.step(ready_ ? applied_v_ : 0.0);
@@ -352,7 +372,7 @@ void PlantEmulator::after_step(std::size_t k, double t) {
   }
   cutting_->after_step(ready_ ? applied_v_ : 0.0, dt_);
   if (dwell_campaigns_) dwell_campaigns_->after_step(k);
-  if (modal_test_) modal_test_->after_step(k);
+  for (auto& [dir, test] : modal_tests_) test->after_step(k);
   if (campaign_) {
     campaign_->after_step(k);
     if (campaign_->done(k + 1) && !rep_.campaign_complete) {
@@ -414,11 +434,12 @@ EmulatorReport PlantEmulator::finish() {
   rep_.cutting = cutting_->report();
   if (regenerative_) rep_.regenerative_cut = regenerative_->report();
   if (dwell_campaigns_) rep_.pose_dwells = dwell_campaigns_->finish();
-  if (modal_test_) {
-    rep_.measure_records = modal_test_->records();
-    rep_.measure_files = modal_test_->write_frf_csvs(o_.measure_out);
-    spdlog::info("robodamp plant: {} of {} impact records; wrote {} FRFs to {}", rep_.measure_records,
-                 rep_.measure_records_planned, rep_.measure_files.size(), o_.measure_out);
+  for (const auto& [dir, test] : modal_tests_) {
+    rep_.measure_records += test->records();
+    std::filesystem::create_directories(dir);
+    for (const std::string& f : test->write_frf_csvs(dir))
+      rep_.measure_files.push_back(dir == o_.measure_out ? f : std::filesystem::path(dir).filename().string() + "/" + f);
+    spdlog::info("robodamp plant: {} of {} impact records; FRFs written to {}", test->records(), test->records_planned(), dir);
   }
   if (campaign_ && campaign_->started()) open_loop_reference();
   return std::move(rep_);

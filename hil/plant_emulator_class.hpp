@@ -65,6 +65,7 @@ class PlantEmulator {
   void amplifier(std::size_t k, double t);
   void robot_reports(double t);
   void open_loop_reference();
+  void check_measure_dwells() const;
 
   const config::Config& cfg_;
   const EmulatorOptions& o_;
@@ -90,7 +91,8 @@ class PlantEmulator {
   rt::RealtimeStatus rts_;
   std::optional<rt::RealtimeProcess> rt_process_;
   std::optional<analysis::ImpactCampaign> campaign_;
-  std::unique_ptr<analysis::ModalTest> modal_test_;
+  // --measure-out: one commissioning test, or one per dwell of the trajectory (into measure_out/dwell_<k>).
+  std::vector<std::pair<std::string, std::unique_ptr<analysis::ModalTest>>> modal_tests_;
   std::optional<DwellCampaigns> dwell_campaigns_;
   // The run.
   double published_rpm_{-1.0}, published_at_s_{-1.0};

@@ -53,6 +53,27 @@ std::vector<PoseDwell> PoseTrajectory::dwells() const {
   return out;
 }
 
+std::vector<PoseDwell> PoseTrajectory::stops() const {
+  std::vector<PoseDwell> out;
+  for (const PoseDwell& d : dwells()) {
+    if (!out.empty() && out.back().t1_s == d.t0_s && out.back().joints_deg == d.joints_deg) out.back().t1_s = d.t1_s;
+    else out.push_back(d);
+  }
+  return out;
+}
+
+void check_measurement_stops(const PoseTrajectory& t, const analysis::CommissioningPlan& plan) {
+  const std::vector<PoseDwell> stops = t.stops();
+  if (stops.empty())
+    throw trajectory_error(t.config(), "has no dwell (two waypoints at the same pose): --measure-out measures at the robot's stops");
+  for (std::size_t k = 0; k < stops.size(); ++k)
+    if (stops[k].t1_s - stops[k].t0_s < plan.duration_s)
+      throw trajectory_error(t.config(), "dwell " + std::to_string(k + 1) + " at " + config::describe_pose(stops[k].joints_deg) +
+                                    " lasts " + config::format_number(stops[k].t1_s - stops[k].t0_s) +
+                                    " s: the commissioning measurement at a stop needs " + config::format_number(plan.duration_s) +
+                                    " s (commissioning: settle_s, the chirp, quiet_s, the impacts at every location)");
+}
+
 sim::PlantModel PoseTrajectory::plant_at(const std::vector<double>& q) const {
   const auto& s = *cfg_.pose_schedule;
   return sim::build_plant_model(analysis::config_at_pose(cfg_, analysis::pose_modes(schedule_.model, q, s.axis, s.modes)));

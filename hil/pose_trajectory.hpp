@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "analysis/bench_run.hpp"
+#include "analysis/modal_test.hpp"
 
 #include "analysis/pose_schedule.hpp"
 #include "config/config.hpp"
@@ -50,6 +51,9 @@ class PoseTrajectory {
   PoseTrajectory(const config::Config& cfg, std::vector<PoseWaypoint> points);
   [[nodiscard]] std::vector<double> at(double t_s) const;
   [[nodiscard]] std::vector<PoseDwell> dwells() const;
+  // The robot's stops as a controller reading its joints counts them: dwells in a row at one pose are one.
+  [[nodiscard]] std::vector<PoseDwell> stops() const;
+  [[nodiscard]] const config::Config& config() const { return cfg_; }
   // The plant's structure at a pose (the configuration's actuator, sensor and locations).
   [[nodiscard]] sim::PlantModel plant_at(const std::vector<double>& joints_deg) const;
   // Built before the run (about 0.25 ms each, longer than a loop period): the structure at every multiple
@@ -86,6 +90,11 @@ class DwellCampaigns {
   std::deque<config::Config> configs_;  // each campaign's (its averages); the campaigns hold references
   std::vector<std::unique_ptr<analysis::ImpactCampaign>> campaigns_;
 };
+
+// --measure-out along the trajectory (measure --along-path's plant side): every stop at least as long as a
+// stopped measurement's plan (the loop's chirp after commissioning.settle_s, then the hammer at every
+// location). Throws config::ConfigError naming the stop, its length and the plan's.
+void check_measurement_stops(const PoseTrajectory& t, const analysis::CommissioningPlan& plan);
 
 // "T:Q1,Q2,Q3" (s, deg): one waypoint; nothing (and why in error) when malformed.
 [[nodiscard]] bool parse_waypoint(const std::string& item, PoseWaypoint& out, std::string& error);

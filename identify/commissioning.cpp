@@ -178,7 +178,27 @@ const IdentifiedFrf& path_between(const std::vector<IdentifiedFrf>& frfs, int a,
                               " was measured");
 }
 
-ChirpMeasurement read_chirp_measurement(const std::string& path, const std::string& config_source) {
+namespace {
+
+// Where a recording's chirp starts (s): its start time, or the tick after the chosen start command.
+double chirp_start_s(const rt::Recording& rec, const rt::PeriodicChirp& sig, double fs_hz, std::optional<double> wanted_s,
+                     const std::string& path) {
+  if (!sig.on_command) return sig.start_s;
+  std::vector<double> starts;
+  for (const auto& f : rec.frames)
+    if (static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kStartExcitation)
+      starts.push_back(static_cast<double>(f.tick + 1) / fs_hz);
+  if (starts.empty()) throw std::invalid_argument(path + ": its chirp waits for a command and none came (no dwell measured)");
+  if (!wanted_s) return starts.front();
+  for (const double t : starts)
+    if (std::abs(t - *wanted_s) <= 0.5 / fs_hz) return t;
+  throw std::invalid_argument(path + ": no chirp starts at " + std::to_string(*wanted_s) + " s (the measurement.json's "
+                              "plan.chirp_start_s); its chirps start at " + std::to_string(starts.size()) + " other times");
+}
+
+}  // namespace
+
+ChirpMeasurement read_chirp_measurement(const std::string& path, const std::string& config_source, std::optional<double> start_s) {
   if (!fs::exists(path)) throw std::invalid_argument(path + " is missing: robodamp measure records the loop there");
   const rt::Recording rec = rt::read_recording(path);
   ChirpMeasurement m;
@@ -199,7 +219,7 @@ ChirpMeasurement read_chirp_measurement(const std::string& path, const std::stri
     next = f.tick + 1;
   }
   const auto period_n = static_cast<std::size_t>(std::lround(sig.period_s * m.fs_hz));
-  const auto first = static_cast<std::size_t>(std::lround(sig.start_s * m.fs_hz)) + period_n;
+  const auto first = static_cast<std::size_t>(std::lround(chirp_start_s(rec, sig, m.fs_hz, start_s, path) * m.fs_hz)) + period_n;
   m.periods_averaged = sig.periods - 1;  // the first period is the transient
   m.f0_hz = sig.f0_hz, m.f1_hz = sig.f1_hz;
   m.accel_per_volt = periodic_frf(u, y, first, period_n, m.periods_averaged, m.fs_hz, sig.f1_hz);
@@ -311,7 +331,8 @@ CommissioningInputs read_measurement_dir(const std::string& dir) {
   in.manifest = read_manifest(dir);
   const config::Config measured = config::parse_config(in.manifest.config_text, in.manifest.config_source);
   in.frfs = read_frfs(dir, in.manifest, measured);
-  in.chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string(), in.manifest.config_source);
+  in.chirp = read_chirp_measurement((fs::path(dir) / kRecordingName).string(), in.manifest.config_source,
+                                    in.manifest.plan.chirp_start_s);
   in.identified_path = (fs::path(dir) / "identified.yaml").string();
   return in;
 }

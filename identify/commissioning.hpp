@@ -52,9 +52,12 @@ struct ChirpMeasurement {
 };
 // Throws std::invalid_argument (no such file, no test signal, too short) or rt::RecordingError.
 // config_source: where the recorded configuration's relative paths resolve from (empty: the recording's
-// own record of it).
+// own record of it). A chirp on command (measure --along-path: one per dwell) starts at the tick after a
+// start_excitation command: the one starting at start_s (a dwell's measurement.json plan, within half a
+// tick), or the first without it.
 [[nodiscard]] ChirpMeasurement read_chirp_measurement(const std::string& recording_path,
-                                                      const std::string& config_source = {});
+                                                      const std::string& config_source = {},
+                                                      std::optional<double> start_s = std::nullopt);
 
 // Eq. 3 from the chirp: force per volt through the structure's receptance (sensor per actuator force),
 // the configured sensor's coupling and the loop's hold (identify/actuator_fit.hpp), fitted over the

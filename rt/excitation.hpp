@@ -23,6 +23,8 @@ struct PeriodicChirp {
   // The amplitude rises linearly from 0 over this time from the start (a real cell is never stepped to
   // the full level; the first period, the transient, is discarded anyway). 0: no ramp.
   double ramp_s{0.0};
+  // true: start_s is not a time but waits for a start_excitation command (ExcitationClock::start_next_tick).
+  bool on_command{false};
   // The signal at time t_s since the first tick (0 outside [start, start + periods x period)).
   [[nodiscard]] double value_v(double t_s) const noexcept {
     if (!enabled || t_s < start_s || t_s >= end_s()) return 0.0;
@@ -37,15 +39,23 @@ struct PeriodicChirp {
 // The chirp's clock: value then advance, once per tick, in the loop and in replay alike.
 class ExcitationClock {
  public:
-  explicit ExcitationClock(const PeriodicChirp& chirp) noexcept : chirp_(chirp) {}
+  explicit ExcitationClock(const PeriodicChirp& chirp) noexcept : chirp_(chirp) {
+    if (chirp_.on_command) chirp_.start_s = kNever;
+  }
   [[nodiscard]] double next_v(double dt_s) noexcept {
     const double v = chirp_.value_v(t_s_);
     t_s_ += dt_s;
     return v;
   }
+  // An on-command chirp starts (again) at the next tick: called after next_v of the tick that applies the
+  // command. Nothing for a chirp with a start time.
+  void start_next_tick() noexcept {
+    if (chirp_.on_command) chirp_.start_s = t_s_;
+  }
   [[nodiscard]] const PeriodicChirp& chirp() const noexcept { return chirp_; }
 
  private:
+  static constexpr double kNever = 1e300;  // an on-command chirp's start before its first command
   PeriodicChirp chirp_;
   double t_s_{0.0};  // the sum of dt before this tick
 };

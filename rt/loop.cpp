@@ -43,6 +43,7 @@ void Loop::run(std::uint64_t duration_ticks) noexcept {
     const Pace p = pace(r);
     TickInput in = inputs(r, p);
     in.command = next_command(r);
+    if (in.command.kind == CommandKind::kStartExcitation) excitation_.start_next_tick();
     const TickOutput out = sup_.step(in);
     r.actuator = actuator_.write(out.command_v, tick_);
     io_.request_amplifier_enable(out.amplifier_enable);

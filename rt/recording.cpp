@@ -153,7 +153,7 @@ json to_json(const SupervisorSettings& s) {
 json to_json(const PeriodicChirp& c) {
   return {{"enabled", c.enabled}, {"start_s", c.start_s}, {"period_s", c.period_s}, {"periods", c.periods},
           {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},     {"amplitude_v", c.amplitude_v},
-          {"ramp_s", c.ramp_s}};
+          {"ramp_s", c.ramp_s},   {"on_command", c.on_command}};
 }
 
 namespace {
@@ -168,6 +168,7 @@ PeriodicChirp chirp_from(const json& t) {
   c.f1_hz = t.at("f1_hz");
   c.amplitude_v = t.at("amplitude_v");
   c.ramp_s = t.value("ramp_s", 0.0);  // recorded before the ramp existed: none
+  c.on_command = t.value("on_command", false);  // recorded before measure --along-path: a start time
   return c;
 }
 
@@ -381,6 +382,7 @@ ReplayResult replay(const Recording& r) {
   for (const auto& f : r.frames) {
     TickInput in = tick_input(f);
     in.excitation_v = excitation.next_v(in.dt_s);
+    if (in.command.kind == CommandKind::kStartExcitation) excitation.start_next_tick();
     const TickOutput out = sup.step(in);
     ++res.frames;
     const bool same = std::memcmp(&out.command_v, &f.command_v, sizeof(double)) == 0 &&

@@ -235,6 +235,7 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
         (void)select(c.value);
       break;
     case CommandKind::kSetPoseRegion: set_pose_region(c.value); break;
+    case CommandKind::kStartExcitation: break;  // the loop's excitation clock, not a decision of the supervisor
     case CommandKind::kSetSpindle:  // validated by the controller: refused speeds park the notches
       if (controller_.set_spindle_rpm(c.value) != control::RequestStatus::kAccepted) ++counters_.spindle_refused;
       break;

@@ -47,8 +47,11 @@ inline constexpr std::size_t kTripCount = 12;
 
 enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable, kPoseUnknown };
 
-enum class CommandKind : std::uint8_t { kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams, kSetSpindle, kSetPoseRegion };
-inline constexpr CommandKind kLastCommandKind = CommandKind::kSetPoseRegion;
+enum class CommandKind : std::uint8_t {
+  kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams, kSetSpindle, kSetPoseRegion,
+  kStartExcitation,  // the loop's: its on-command chirp starts at the next tick (rt/excitation.hpp); not the supervisor's
+};
+inline constexpr CommandKind kLastCommandKind = CommandKind::kStartExcitation;
 
 struct OperatorCommand {
   CommandKind kind{CommandKind::kNone};

@@ -87,6 +87,7 @@ const char* to_string(CommandKind k) {
     case CommandKind::kSelectParams: return "select_params";
     case CommandKind::kSetSpindle: return "set_spindle";
     case CommandKind::kSetPoseRegion: return "set_pose_region";
+    case CommandKind::kStartExcitation: return "start_excitation";
   }
   return "?";
 }

@@ -173,9 +173,12 @@ Status Cell::configure_devices() {
     sim_ = std::make_unique<SimBackendComponent>(plant_model, plant_cfg, o_.backend);
     backend_name_ = "simulated plant";
   }
-  if (cfg_.dds && cfg_.dds->joint_states && cfg_.pose_schedule && !o_.pose_schedule_off)
-    joint_pose_ = std::make_unique<JointStatePose>(*cfg_.dds->joint_states, *cfg_.pose_schedule,
-                                                   [this](std::optional<std::size_t> region) { post_pose_region(region); });
+  const bool read_joints = !o_.pose_schedule_off || o_.watch_joints;
+  const auto on_region = [this](std::optional<std::size_t> region) {
+    if (!o_.pose_schedule_off) post_pose_region(region);  // watched only: no set follows the pose
+  };
+  if (cfg_.dds && cfg_.dds->joint_states && cfg_.pose_schedule && read_joints)
+    joint_pose_ = std::make_unique<JointStatePose>(*cfg_.dds->joint_states, *cfg_.pose_schedule, on_region);
   if (cfg_.dds) {
     dds_ = std::make_unique<DdsEndpoint>(
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
@@ -189,9 +192,8 @@ Status Cell::configure_devices() {
       return s;
     }
   }
-  if (modbus_ && cfg_.modbus->robot.joints_register >= 0 && cfg_.pose_schedule && !o_.pose_schedule_off)
-    modbus_->client().set_pose_callback(*cfg_.pose_schedule,
-                                        [this](std::optional<std::size_t> region) { post_pose_region(region); });
+  if (modbus_ && cfg_.modbus->robot.joints_register >= 0 && cfg_.pose_schedule && read_joints)
+    modbus_->client().set_pose_callback(*cfg_.pose_schedule, on_region);
   if (modbus_ && cfg_.modbus->robot.spindle_rpm_register >= 0) {
     // The robot's spindle register: each settled speed (0 when the link is lost) becomes a set_spindle
     // command; the controller validates it against spindle.rpm_max.

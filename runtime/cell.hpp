@@ -65,6 +65,9 @@ struct CellOptions {
   //    damper tuned at one pose does elsewhere).
   std::vector<double> pose_deg;
   bool pose_schedule_off{false};
+  // With pose_schedule_off: the joints are still read (robot_pose_deg), no set follows them (measure
+  // --along-path: the gain is 0 and a pose outside every region is worth measuring).
+  bool watch_joints{false};
   // Every drained frame, on the drain thread (progress lines); must not block for long.
   std::function<void(const rt::TelemetryFrame&)> on_frame;
 };
@@ -117,6 +120,9 @@ class Cell {
   [[nodiscard]] const analysis::LoopModel& model() const { return *model_; }
   [[nodiscard]] const config::Config& config() const { return cfg_; }
   [[nodiscard]] const std::vector<rt::TelemetryFrame>& frames() const { return frames_; }
+  // The robot's joints now (any thread): the DDS joint states, else the Modbus joint registers, else the
+  // simulated robot's --pose; empty while not known.
+  [[nodiscard]] std::vector<double> robot_pose_deg() const;
   // With spindle.job: the live machining view (nullptr without).
   [[nodiscard]] MachiningMonitor* machining() { return machining_.get(); }
 
@@ -130,9 +136,6 @@ class Cell {
   Status configure_pose_schedule();  // before the supervisor: region 0's set becomes set 0
   void configure_pose_sets();        // after it: regions 1.. as sets 1..
   void post_pose_region(std::optional<std::size_t> region);
-  // The robot's joints now (any thread): the DDS joint states, else the Modbus joint registers, else the
-  // simulated robot's --pose; empty while not known.
-  [[nodiscard]] std::vector<double> robot_pose_deg() const;
   // The spectrum monitor's next spectrum; with pose_schedule and a known pose its mode marks are the robot
   // model's modes along the actuator at that pose (the configuration's table otherwise).
   [[nodiscard]] std::optional<dds::SpectrumSample> spectrum_at_pose();

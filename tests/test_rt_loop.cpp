@@ -142,6 +142,48 @@ TEST(Loop, TheChirpIsACommandSourceOfTheLoopClampedAndReplayed) {
   EXPECT_EQ(rp.mismatches, 0U);
 }
 
+// An on-command chirp (measure --along-path): silent until the loop applies a start_excitation command, then
+// the chirp from the next tick on, again from its start at a second command; the recording holds the
+// commands and replays bit for bit.
+TEST(Loop, AnOnCommandChirpStartsAtTheTickAfterEachStartCommandAndReplays) {
+  config::Config cfg = c2();
+  cfg.controller.gain_ns_per_m = 0.0;
+  CellOptions o = virtual_clock();
+  o.chirp = {true, 0.0, 0.25, 2, 5.0, 40.0, 0.5, 0.0, true};
+  o.record_path = ::testing::TempDir() + "/chirp_on_command.rec";
+  const std::uint64_t first = 5000, second = 9000;  // 1.0 s and 1.8 s at 5 kHz: the loop is active by then
+  const auto r = run(cfg, 2.5, [&](Cell& c) {
+    c.schedule(first, {CommandKind::kStartExcitation, 0.0});
+    c.schedule(second, {CommandKind::kStartExcitation, 0.0});
+  }, o);
+  ASSERT_EQ(r.s.trip, "none") << r.s.final_state;
+  const double fs = cfg.loop.rate_hz;
+  rt::PeriodicChirp from = o.chirp;
+  from.start_s = 1e300;  // not yet
+  std::size_t nonzero = 0;
+  double t_s = 0.0;  // the loop's clock: the sum of dt
+  for (std::size_t i = 0; i < r.frames.size(); ++i) {
+    const TelemetryFrame& f = r.frames[i];
+    const double want = from.value_v(t_s);
+    t_s += f.dt_s;
+    if (f.tick == first || f.tick == second) {
+      EXPECT_EQ(static_cast<CommandKind>(f.command_kind), CommandKind::kStartExcitation);
+      EXPECT_NEAR(t_s, static_cast<double>(f.tick + 1) / fs, 1e-9);  // the next tick's time
+      from.start_s = t_s;
+    }
+    if (f.tick >= first && f.tick < 12500) ASSERT_EQ(f.state, static_cast<std::uint8_t>(State::kActive)) << i;
+    EXPECT_NEAR(f.command_v, want, 1e-9) << "tick " << f.tick;
+    nonzero += f.command_v != 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(nonzero, static_cast<std::size_t>(0.9 * 2 * o.chirp.period_s * o.chirp.periods * fs));  // both chirps played
+  const Recording rec = read_recording(o.record_path);
+  EXPECT_EQ(rec.header.at("commands").back(), "start_excitation");
+  EXPECT_TRUE(rec.header.at("excitation").at("chirp").at("on_command").get<bool>());
+  const ReplayResult rp = replay(rec);
+  EXPECT_EQ(rp.frames, r.frames.size());
+  EXPECT_EQ(rp.mismatches, 0U);
+}
+
 TEST(Loop, ArmingRefusedUntilSensorLive) {
   CellOptions o = virtual_clock();
   o.arm_at_start = false;
