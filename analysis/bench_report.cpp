@@ -43,14 +43,6 @@ class OrderedProgress {
   std::size_t next_{0};
 };
 
-// One gain of the sweep: the divergence run and, below the predicted limit, an impact test at the
-// actuator's driving point with the improvement the analysis predicts there.
-struct SweepRun {
-  DivergenceRun run;
-  std::optional<ImpactTestResult> impact;
-  std::vector<FrfResult> predicted, predicted_continuous;
-};
-
 }  // namespace
 
 std::string Bench::test_line(int number, int tests, const ImpactTest& t, const std::string& what,
@@ -108,124 +100,147 @@ std::string Bench::verdict(const BenchReport& rep) const {
   return v.str();
 }
 
-// long: the bench's two parallel phases share the per-location results and the progress order; splitting them is left for a later pass (issue 32 note)
-BenchReport Bench::run(const Progress& progress, std::size_t jobs) const {
-  const auto wall0 = std::chrono::steady_clock::now();
-  const std::size_t threads = task_threads(jobs);
+// One gain of the sweep: the divergence run and, below the predicted limit, an impact test at the
+// actuator's driving point with the improvement the analysis predicts there.
+struct BenchSweepRun {
+  DivergenceRun run;
+  std::optional<ImpactTestResult> impact;
+  std::vector<FrfResult> predicted, predicted_continuous;
+};
+
+// What the phases of a bench run share: the impact locations the configured FRFs need, the tests' results
+// per location, the sweep's runs, the progress and the report being filled.
+struct Bench::RunState {
+  const Progress& progress;
+  std::size_t threads;
   BenchReport rep;
-  rep.config = cfg_.source;
+  std::vector<std::size_t> locations;  // in the order the analysis lists the FRFs' excitations
+  std::vector<ImpactTestResult> off, on, sat;
+  std::vector<double> factors;         // of K_max, the gain sweep's
+  std::vector<BenchSweepRun> sweep;
+  std::optional<std::size_t> dp;       // the actuator's driving-point FRF
+  int tests{0};
+  [[nodiscard]] std::size_t index_of(std::size_t excitation) const {
+    return static_cast<std::size_t>(std::find(locations.begin(), locations.end(), excitation) - locations.begin());
+  }
+};
+
+namespace {
+
+ImpactTest test_at(const config::BenchConfig& b, std::size_t location, bool on, bool saturating, double k, int pol) {
+  return ImpactTest{location, saturating ? b.saturating_impact_peak_n : b.impact_peak_n,
+                    saturating ? b.saturating_impact_duration_ms : b.impact_duration_ms, on, on ? k : 0.0, pol};
+}
+
+}  // namespace
+
+// The analysis and the open-loop tests, which do not need it, in parallel; the open loop's measured peaks.
+void Bench::run_open(RunState& st) const {
+  const double gain = cfg_.controller.gain_ns_per_m;
+  const int pol = cfg_.controller.polarity;
+  const std::size_t nl = st.locations.size();
+  st.off.resize(nl), st.on.resize(nl), st.sat.resize(nl);
+  std::vector<std::function<void()>> first{[&] { st.rep.analysis = analyse(model_, gain, pol); }};
+  for (std::size_t i = 0; i < nl; ++i)
+    first.emplace_back([&, i] { st.off[i] = impact_test(test_at(cfg_.bench, st.locations[i], false, false, 0.0, pol)); });
+  run_tasks(first, st.threads);
+  const auto& an = st.rep.analysis;
+  st.tests = static_cast<int>(nl) * (an.stable ? 3 : 1);
+  for (std::size_t i = 0; i < nl; ++i) {
+    st.rep.simulated_s += st.off[i].simulated_s;
+    if (st.progress)
+      st.progress(test_line(static_cast<int>(i) + 1, st.tests, test_at(cfg_.bench, st.locations[i], false, false, 0.0, pol),
+                            "control off", st.off[i]));
+  }
+  const double lo = cfg_.analysis.band_min_hz, hi = cfg_.analysis.band_max_hz;
+  for (const auto& f : an.frfs_discrete) {
+    const MeasuredPeak p = measured_peak(st.off[st.index_of(f.excitation)].receptance[f.response], lo, hi);
+    st.rep.open_loop.push_back({f.name, f.open_peak_m_per_n, p.magnitude_m_per_n,
+                                20.0 * std::log10(p.magnitude_m_per_n / f.open_peak_m_per_n), p.coherence_min});
+  }
+}
+
+// The closed-loop tests (nominal and saturating) and the gain sweep across the predicted limit, in
+// parallel, their progress lines in the serial run's order.
+void Bench::run_closed(RunState& st) const {
   const double gain = cfg_.controller.gain_ns_per_m;
   const int pol = cfg_.controller.polarity;
   const auto& b = cfg_.bench;
-  const double lo = cfg_.analysis.band_min_hz, hi = cfg_.analysis.band_max_hz;
-  if (progress) progress("analysing the loop (K = " + fixed(gain, 0) + " N s/m, polarity " + std::to_string(pol) + ")");
-
-  // Which impact locations the configured FRFs need (the analysis lists the FRFs in this order too).
-  std::vector<std::size_t> locations;
-  for (const auto& f : cfg_.robot.frfs) {
-    const std::size_t e = model_.plant().index_of(f.excitation_location);
-    if (std::find(locations.begin(), locations.end(), e) == locations.end()) locations.push_back(e);
-  }
-  auto loc_index = [&](std::size_t excitation) {
-    return static_cast<std::size_t>(std::find(locations.begin(), locations.end(), excitation) - locations.begin());
-  };
-  const std::size_t nl = locations.size();
-  auto test_at = [&](std::size_t li, bool on, bool saturating, double k) {
-    return ImpactTest{locations[li], saturating ? b.saturating_impact_peak_n : b.impact_peak_n,
-                      saturating ? b.saturating_impact_duration_ms : b.impact_duration_ms, on, on ? k : 0.0, pol};
-  };
-
-  // The analysis and the open-loop tests, which do not need it.
-  std::vector<ImpactTestResult> off(nl), on(nl), sat(nl);
-  std::vector<std::function<void()>> first{[&] { rep.analysis = analyse(model_, gain, pol); }};
-  for (std::size_t i = 0; i < nl; ++i) first.emplace_back([&, i] { off[i] = impact_test(test_at(i, false, false, 0.0)); });
-  run_tasks(first, threads);
-  const auto& an = rep.analysis;
-  const int tests = static_cast<int>(nl) * (an.stable ? 3 : 1);
-  for (std::size_t i = 0; i < nl; ++i) {
-    rep.simulated_s += off[i].simulated_s;
-    if (progress) progress(test_line(static_cast<int>(i) + 1, tests, test_at(i, false, false, 0.0), "control off", off[i]));
-  }
-  for (const auto& f : an.frfs_discrete) {
-    const MeasuredPeak p = measured_peak(off[loc_index(f.excitation)].receptance[f.response], lo, hi);
-    rep.open_loop.push_back({f.name, f.open_peak_m_per_n, p.magnitude_m_per_n,
-                             20.0 * std::log10(p.magnitude_m_per_n / f.open_peak_m_per_n), p.coherence_min});
-  }
-  if (!an.stable) {
-    rep.verdict = "UNSTABLE: the analysis finds the loop unstable at K = " + fixed(gain, 0) + " N s/m (spectral radius " +
-                  fixed(an.spectral_radius, 6) + "); closed-loop tests were not run";
-    rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    return rep;
-  }
-  rep.ran_closed_loop = true;
-
-  // The closed-loop tests and the gain sweep across the predicted limit.
-  const std::size_t act = model_.actuator_location();
-  std::optional<std::size_t> dp;  // the actuator's driving-point FRF
+  const auto& an = st.rep.analysis;
+  const std::size_t nl = st.locations.size(), act = model_.actuator_location();
   for (std::size_t i = 0; i < an.frfs_discrete.size(); ++i)
-    if (an.frfs_discrete[i].response == act && an.frfs_discrete[i].excitation == act) dp = i;
-  const std::vector<double> factors = an.max_stable_gain_ns_per_m ? b.sweep_gain_factors : std::vector<double>{};
-  std::vector<SweepRun> sweep(factors.size());
-  OrderedProgress ordered(progress, 2 * nl + factors.size());
+    if (an.frfs_discrete[i].response == act && an.frfs_discrete[i].excitation == act) st.dp = i;
+  st.factors = an.max_stable_gain_ns_per_m ? b.sweep_gain_factors : std::vector<double>{};
+  st.sweep.resize(st.factors.size());
+  OrderedProgress ordered(st.progress, 2 * nl + st.factors.size());
   std::vector<std::function<void()>> second;
   for (std::size_t i = 0; i < nl; ++i) {
     second.emplace_back([&, i] {
-      on[i] = impact_test(test_at(i, true, false, gain));
-      ordered.post(i, test_line(static_cast<int>(nl + i) + 1, tests, test_at(i, true, false, gain), "control on", on[i]));
+      const ImpactTest t = test_at(b, st.locations[i], true, false, gain, pol);
+      st.on[i] = impact_test(t);
+      ordered.post(i, test_line(static_cast<int>(nl + i) + 1, st.tests, t, "control on", st.on[i]));
     });
     second.emplace_back([&, i] {
-      sat[i] = impact_test(test_at(i, true, true, gain));
-      ordered.post(nl + i, test_line(static_cast<int>(2 * nl + i) + 1, tests, test_at(i, true, true, gain),
-                                     "control on, saturating", sat[i]));
+      const ImpactTest t = test_at(b, st.locations[i], true, true, gain, pol);
+      st.sat[i] = impact_test(t);
+      ordered.post(nl + i, test_line(static_cast<int>(2 * nl + i) + 1, st.tests, t, "control on, saturating", st.sat[i]));
     });
   }
-  for (std::size_t j = 0; j < factors.size(); ++j)
+  for (std::size_t j = 0; j < st.factors.size(); ++j)
     second.emplace_back([&, j] {
-      const double k = factors[j] * *an.max_stable_gain_ns_per_m;
-      SweepRun& sp = sweep[j];
+      const double k = st.factors[j] * *an.max_stable_gain_ns_per_m;
+      BenchSweepRun& sp = st.sweep[j];
       sp.run = divergence_run(k, pol);
-      ordered.post(2 * nl + j, "gain sweep K = " + fixed(k, 0) + " N s/m (" + fixed(factors[j], 2) + " x K_max): predicted " +
+      ordered.post(2 * nl + j, "gain sweep K = " + fixed(k, 0) + " N s/m (" + fixed(st.factors[j], 2) + " x K_max): predicted " +
                                    (sp.run.predicted_unstable ? "unstable" : "stable") + ", simulated " +
                                    (sp.run.diverged ? "diverges" : "decays") + " (end/start RMS " +
                                    fixed(sp.run.growth_ratio, 3) + ")");
-      if (dp && !sp.run.predicted_unstable) {
+      if (st.dp && !sp.run.predicted_unstable) {
         sp.impact = impact_test({act, b.impact_peak_n, b.impact_duration_ms, true, k, pol});
         sp.predicted = improvements(model_, k, pol, true);
         sp.predicted_continuous = improvements(model_, k, pol, false);
       }
     });
-  run_tasks(second, threads);
-  for (std::size_t i = 0; i < nl; ++i) rep.simulated_s += on[i].simulated_s;
-  for (std::size_t i = 0; i < nl; ++i) rep.simulated_s += sat[i].simulated_s;
+  run_tasks(second, st.threads);
+  for (std::size_t i = 0; i < nl; ++i) st.rep.simulated_s += st.on[i].simulated_s;
+  for (std::size_t i = 0; i < nl; ++i) st.rep.simulated_s += st.sat[i].simulated_s;
+}
 
+// The closed-loop rows (nominal within 5 % of the prediction, saturating) and the sweep's rows and verdicts.
+void Bench::report_closed(RunState& st) const {
+  const double gain = cfg_.controller.gain_ns_per_m;
+  const auto& b = cfg_.bench;
+  const auto& an = st.rep.analysis;
+  BenchReport& rep = st.rep;
   bool within = true;
   for (std::size_t i = 0; i < an.frfs_discrete.size(); ++i) {
-    const std::size_t li = loc_index(an.frfs_discrete[i].excitation);
-    BenchRow row = make_row(an, i, off[li], on[li], b.impact_peak_n, "nominal", gain, &an.frfs_discrete[i], &an.frfs_continuous[i]);
+    const std::size_t li = st.index_of(an.frfs_discrete[i].excitation);
+    BenchRow row = make_row(an, i, st.off[li], st.on[li], b.impact_peak_n, "nominal", gain, &an.frfs_discrete[i],
+                            &an.frfs_continuous[i]);
     within = within && std::abs(*row.measured_improvement_pct - *row.predicted_improvement_pct) <=
                            0.05 * std::abs(*row.predicted_improvement_pct);
     rep.rows.push_back(row);
   }
   for (std::size_t i = 0; i < an.frfs_discrete.size(); ++i) {
-    const std::size_t li = loc_index(an.frfs_discrete[i].excitation);
-    rep.rows.push_back(make_row(an, i, off[li], sat[li], b.saturating_impact_peak_n, "saturating", gain,
+    const std::size_t li = st.index_of(an.frfs_discrete[i].excitation);
+    rep.rows.push_back(make_row(an, i, st.off[li], st.sat[li], b.saturating_impact_peak_n, "saturating", gain,
                                 &an.frfs_discrete[i], &an.frfs_continuous[i]));
   }
   rep.improvement_within_5pct = within;
-
   rep.sweep_agrees = true;
-  if (factors.empty()) rep.notes.push_back("no gain sweep: the loop is stable up to the product's gain limit");
-  for (SweepRun& sp : sweep) {
+  if (st.factors.empty()) rep.notes.push_back("no gain sweep: the loop is stable up to the product's gain limit");
+  const std::size_t act = model_.actuator_location();
+  for (BenchSweepRun& sp : st.sweep) {
     DivergenceRun& d = sp.run;
     rep.simulated_s += b.sweep_duration_s;
     rep.sweep_agrees = rep.sweep_agrees && d.diverged == d.predicted_unstable;
     if (sp.impact) {
       rep.simulated_s += sp.impact->simulated_s;
-      rep.rows.push_back(make_row(an, *dp, off[loc_index(act)], *sp.impact, b.impact_peak_n, "sweep", d.gain_ns_per_m,
-                                  &sp.predicted[*dp], &sp.predicted_continuous[*dp]));
-    } else if (dp) {
+      rep.rows.push_back(make_row(an, *st.dp, st.off[st.index_of(act)], *sp.impact, b.impact_peak_n, "sweep", d.gain_ns_per_m,
+                                  &sp.predicted[*st.dp], &sp.predicted_continuous[*st.dp]));
+    } else if (st.dp) {
       BenchRow row;
-      row.name = an.frfs_discrete[*dp].name;
+      row.name = an.frfs_discrete[*st.dp].name;
       row.kind = "sweep";
       row.gain_ns_per_m = d.gain_ns_per_m;
       row.impact_peak_n = b.impact_peak_n;
@@ -236,9 +251,36 @@ BenchReport Bench::run(const Progress& progress, std::size_t jobs) const {
     }
     rep.sweep.push_back(std::move(d));
   }
-  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  rep.verdict = verdict(rep);
-  return rep;
+}
+
+// The analysis and the open-loop tests; unless the loop is unstable, the closed-loop tests and the sweep;
+// the report with its verdict.
+BenchReport Bench::run(const Progress& progress, std::size_t jobs) const {
+  const auto wall0 = std::chrono::steady_clock::now();
+  RunState st{.progress = progress, .threads = task_threads(jobs)};
+  st.rep.config = cfg_.source;
+  const double gain = cfg_.controller.gain_ns_per_m;
+  if (progress)
+    progress("analysing the loop (K = " + fixed(gain, 0) + " N s/m, polarity " + std::to_string(cfg_.controller.polarity) + ")");
+  // Which impact locations the configured FRFs need (the analysis lists the FRFs in this order too).
+  for (const auto& f : cfg_.robot.frfs) {
+    const std::size_t e = model_.plant().index_of(f.excitation_location);
+    if (std::find(st.locations.begin(), st.locations.end(), e) == st.locations.end()) st.locations.push_back(e);
+  }
+  run_open(st);
+  const auto& an = st.rep.analysis;
+  if (!an.stable) {
+    st.rep.verdict = "UNSTABLE: the analysis finds the loop unstable at K = " + fixed(gain, 0) + " N s/m (spectral radius " +
+                     fixed(an.spectral_radius, 6) + "); closed-loop tests were not run";
+    st.rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    return st.rep;
+  }
+  st.rep.ran_closed_loop = true;
+  run_closed(st);
+  report_closed(st);
+  st.rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  st.rep.verdict = verdict(st.rep);
+  return st.rep;
 }
 
 }  // namespace robodamp::analysis

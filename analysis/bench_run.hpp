@@ -161,6 +161,12 @@ class Bench {
                                   const ImpactTestResult& closed_r, double peak_n, const std::string& kind, double k,
                                   const FrfResult* predicted, const FrfResult* predicted_c) const;
   [[nodiscard]] std::string verdict(const BenchReport& rep) const;
+  // run's phases on one shared state (bench_report.cpp): the analysis with the open-loop tests, the
+  // closed-loop tests with the gain sweep, then the rows and the sweep's report.
+  struct RunState;
+  void run_open(RunState& st) const;
+  void run_closed(RunState& st) const;
+  void report_closed(RunState& st) const;
 
   config::Config cfg_;
   LoopModel model_;

@@ -1,6 +1,7 @@
 // `robodamp cut`: one simulated cut of a milling job in time, with the chatter detector's verdict, the
 // forces, the machined wall and plots; or, with --critical, the time-domain critical depth at speeds next
 // to the zero-order limit (docs/milling.md, "Time domain").
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -158,7 +159,93 @@ std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
   return {};
 }
 
-// long: the cut command's three modes (one cut, --critical, --hil) and their reports; left for a later pass
+// One cut at one speed (no --critical): its verdict, the damper's limits, the plots.
+std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, const milling::Structure& structure,
+                           milling::CutOverrides ov, const std::vector<double>& speeds, json& out) {
+  if (speeds.size() > 1)
+    throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", "--rpm: one speed for a cut (several with --critical)"}});
+  if (!a.rpm.empty()) ov.rpm = speeds.front();
+  const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
+  const auto t0 = std::chrono::steady_clock::now();
+  const milling::CutOutcome o = milling::run_job(job);
+  out = cut_json(job, o, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  std::printf("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
+              out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
+              out["classification"].get<std::string>().c_str());
+  if (!o.verdict.stable) std::printf(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
+  std::printf("; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f s\n",
+              o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
+              out["simulated_s"].get<double>(), out["wall_s"].get<double>());
+  if (job.damped)
+    std::printf("  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole number of loop periods)\n",
+                o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
+                o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
+  if (!a.plot_dir.empty()) {
+    if (auto e = plot_cut(o, a.plot_dir); !e.empty()) {
+      std::cerr << "plot: " << e << '\n';
+      return 1;
+    }
+    std::printf("wrote plots in %s\n", a.plot_dir.c_str());
+  }
+  return std::nullopt;
+}
+
+// --critical at one speed: the time-domain critical depth beside the accurate method's and the zero-order
+// preview, its JSON entry and its line.
+json critical_at(const CutArgs& a, const config::MillingConfig& cfg, const milling::CutJob& job, const milling::LobeModel& lobes,
+                 const milling::AccurateStability& truth, double rpm) {
+  const double zoa_mm = lobes.critical_depth_mm(rpm);
+  milling::SdmPoint sdm;
+  try {
+    sdm = truth.critical(rpm, zoa_mm);
+  } catch (const std::invalid_argument& e) {
+    throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", e.what()}});
+  }
+  std::cerr << "[cut] critical depth at " << rpm << " rpm (" << truth.method() << " " << sdm.critical_depth_mm
+            << " mm, zero-order preview " << zoa_mm << " mm):\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm : std::isfinite(zoa_mm) ? zoa_mm : 1.0;
+  const milling::CriticalDepth c = milling::critical_depth(
+      job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
+      [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double tooth_hz = rpm * job.cutter.teeth / 60.0;  // the chatter's family: milling/chatter.hpp
+  json entry = {{"rpm", rpm}, {"simulated_rpm", job.settings.rpm}, {"damped", a.damped},
+                {"critical_depth_mm", c.depth_mm}, {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
+                {"accurate_method", truth.method()}, {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
+                {"accurate_rpm", sdm.rpm}, {"accurate_chatter_hz", sdm.chatter_hz},
+                {"accurate_chatter_family_hz", milling::chatter_family_hz(sdm.chatter_hz, tooth_hz)},
+                {"chatter_family_hz", milling::chatter_family_hz(c.chatter_hz, tooth_hz)},
+                {"accurate_type", milling::to_string(sdm.type)},
+                {"classification", milling::to_string(c.above)}, {"mechanism", milling::to_string(c.mechanism)},
+                {"chatter_hz", c.chatter_hz}, {"simulations", c.simulations}, {"wall_s", wall}};
+  std::printf("%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
+              "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
+              rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm, (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0,
+              milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism),
+              c.chatter_hz, alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz), c.simulations, wall);
+  if (!a.hil_path.empty()) entry["hil"] = hil_critical(a, job, rpm, c.depth_mm);
+  return entry;
+}
+
+// --critical: the three methods at every speed asked for.
+void critical_study(const CutArgs& a, const config::MillingConfig& cfg, const config::StructureConfig& chosen,
+                    const milling::Structure& structure, milling::CutOverrides ov, const std::vector<double>& speeds,
+                    json& out) {
+  // The accurate verdict (what lobes and tune promise) beside the simulation, and its first guess.
+  const milling::Structure model_structure(chosen, a.damped);
+  const milling::LobeModel lobes(model_structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
+  config::MillingConfig at_cut = cfg;
+  if (a.radial_mm) at_cut.cut.radial_mm = *a.radial_mm;
+  const milling::AccurateStability truth(model_structure, at_cut);
+  out["critical"] = json::array();
+  for (double rpm : speeds) {
+    ov.rpm = rpm;
+    out["critical"].push_back(critical_at(a, cfg, milling::make_cut_job(cfg, structure, ov), lobes, truth, rpm));
+  }
+}
+
+// The job with the options applied and checked, then one cut or the critical-depth study.
 int run_cut(const CutArgs& a) {
   try {
     config::MillingConfig cfg = config::load_milling_config(a.config_path);
@@ -171,8 +258,8 @@ int run_cut(const CutArgs& a) {
                                                  "--controller or --pose): the emulator cuts the job as its file says"}});
     const config::StructureConfig chosen = selected_structure(cfg, a.structure, a.controller_path);
     const milling::Structure structure(chosen, false);
-    milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
-    std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
+    const milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
+    const std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
     // The job's speed range, as lobes checks it: a speed outside it is one the job does not describe.
     const config::Range job_speeds{"rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false,
                                    "the job's lobes.rpm_min .. lobes.rpm_max"};
@@ -180,76 +267,9 @@ int run_cut(const CutArgs& a) {
       if (auto p = config::range_problem("--rpm", rpm, job_speeds)) throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p}});
     json out;
     if (!a.critical) {
-      if (speeds.size() > 1)
-        throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", "--rpm: one speed for a cut (several with --critical)"}});
-      if (!a.rpm.empty()) ov.rpm = speeds.front();
-      const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
-      const auto t0 = std::chrono::steady_clock::now();
-      const milling::CutOutcome o = milling::run_job(job);
-      out = cut_json(job, o, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      std::printf("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
-                  out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
-                  out["classification"].get<std::string>().c_str());
-      if (!o.verdict.stable) std::printf(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
-      std::printf("; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f s\n",
-                  o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
-                  out["simulated_s"].get<double>(), out["wall_s"].get<double>());
-      if (job.damped)
-        std::printf("  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole number of loop periods)\n",
-                    o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
-                    o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
-      if (!a.plot_dir.empty()) {
-        if (auto e = plot_cut(o, a.plot_dir); !e.empty()) {
-          std::cerr << "plot: " << e << '\n';
-          return 1;
-        }
-        std::printf("wrote plots in %s\n", a.plot_dir.c_str());
-      }
+      if (const auto failed = one_cut(a, cfg, structure, ov, speeds, out)) return *failed;
     } else {
-      // The accurate verdict (what lobes and tune promise) beside the simulation, and its first guess.
-      const milling::Structure model_structure(chosen, a.damped);
-      const milling::LobeModel lobes(model_structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
-      config::MillingConfig at_cut = cfg;
-      if (a.radial_mm) at_cut.cut.radial_mm = *a.radial_mm;
-      const milling::AccurateStability truth(model_structure, at_cut);
-      out["critical"] = json::array();
-      for (double rpm : speeds) {
-        ov.rpm = rpm;
-        const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
-        const double zoa_mm = lobes.critical_depth_mm(rpm);
-        milling::SdmPoint sdm;
-        try {
-          sdm = truth.critical(rpm, zoa_mm);
-        } catch (const std::invalid_argument& e) {
-          throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", e.what()}});
-        }
-        std::cerr << "[cut] critical depth at " << rpm << " rpm (" << truth.method() << " " << sdm.critical_depth_mm
-                  << " mm, zero-order preview " << zoa_mm << " mm):\n";
-        const auto t0 = std::chrono::steady_clock::now();
-        const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm : std::isfinite(zoa_mm) ? zoa_mm : 1.0;
-        const milling::CriticalDepth c = milling::critical_depth(
-            job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
-            [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const double tooth_hz = rpm * job.cutter.teeth / 60.0;  // the chatter's family: milling/chatter.hpp
-        out["critical"].push_back({{"rpm", rpm}, {"simulated_rpm", job.settings.rpm}, {"damped", a.damped},
-                                   {"critical_depth_mm", c.depth_mm}, {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
-                                   {"accurate_method", truth.method()}, {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
-                                   {"accurate_rpm", sdm.rpm}, {"accurate_chatter_hz", sdm.chatter_hz},
-                                   {"accurate_chatter_family_hz", milling::chatter_family_hz(sdm.chatter_hz, tooth_hz)},
-                                   {"chatter_family_hz", milling::chatter_family_hz(c.chatter_hz, tooth_hz)},
-                                   {"accurate_type", milling::to_string(sdm.type)},
-                                   {"classification", milling::to_string(c.above)}, {"mechanism", milling::to_string(c.mechanism)},
-                                   {"chatter_hz", c.chatter_hz}, {"simulations", c.simulations}, {"wall_s", wall}});
-        std::printf("%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
-                    "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
-                    rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm, (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0,
-                    milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism),
-                    c.chatter_hz,
-                    alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz),
-                    c.simulations, wall);
-        if (!a.hil_path.empty()) out["critical"].back()["hil"] = hil_critical(a, job, rpm, c.depth_mm);
-      }
+      critical_study(a, cfg, chosen, structure, ov, speeds, out);
     }
     out["config"] = cfg.source;
     out["structure"] = structure.name();

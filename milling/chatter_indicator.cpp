@@ -51,21 +51,18 @@ void ChatterMonitor::push(double accel_mps2, bool fresh) {
   count_ = std::min(count_ + 1, ring_.size());
 }
 
-// long: one spectrum's evaluation (window, FFT, tooth harmonics, peaks, verdict) on preallocated buffers; left for a later pass
-ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
-  ChatterIndicator out;
-  if (!(spindle_rpm > 0.0)) return out;
-  const double f_sp = spindle_rpm / 60.0;
+// The span to analyse (a full window, few held samples), oldest first, mean removed, and its RMS.
+bool ChatterMonitor::fill_window(double f_sp, ChatterIndicator& out) {
   const double want_s = std::min(s_.max_window_s, std::max(s_.window_s, s_.min_revolutions / f_sp));
   const auto n = std::min(count_, static_cast<std::size_t>(want_s * fs_));
   // A full window only: after a reset (another speed) the cut's transient, which decays, fills a
   // shorter span and would look persistent.
-  if (static_cast<double>(n) < std::floor(want_s * fs_) || n < 64) return out;
+  if (static_cast<double>(n) < std::floor(want_s * fs_) || n < 64) return false;
   // Held samples put steps into the signal, which spread over the spectrum: too many, no verdict.
   std::size_t gaps = 0;
   for (std::size_t i = 0, at = (head_ + ring_.size() - n) % ring_.size(); i < n; ++i) gaps += gap_[(at + i) % ring_.size()];
   out.gap_share = static_cast<double>(gaps) / static_cast<double>(n);
-  if (out.gap_share > s_.max_gap_share) return out;
+  if (out.gap_share > s_.max_gap_share) return false;
 
   // The span, oldest first, mean removed.
   window_.resize(n);
@@ -79,8 +76,13 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     ss += v * v;
   }
   out.rms_mps2 = std::sqrt(ss / static_cast<double>(n));
-  if (out.rms_mps2 <= 0.0) return out;
+  if (out.rms_mps2 <= 0.0) return false;
+  return true;
+}
 
+// In time: the once-per-period difference's share, its persistence over the window's eighths, the trend and growth.
+void ChatterMonitor::time_measures(double f_sp, ChatterIndicator& out) const {
+  const std::size_t n = window_.size();
   // Once per forced period (a revolution, or a tooth period when only the tooth harmonics are forced: chatter
   // near a spindle harmonic changes little from one revolution to the next): x(t) - x(t - one period) at
   // every sample (the forced, periodic part cancels). Its RMS over the signal's is the once-per-revolution
@@ -120,7 +122,11 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   // late in the window raises only the last quarter).
   out.growing = true;
   for (int q = 1; q < 4; ++q) out.growing = out.growing && q_rms[q] > s_.growing_step * q_rms[q - 1];
+}
 
+// The spectrum: the energy away from the forced lines (by displacement), the chatter's line, the lines' SNR.
+void ChatterMonitor::spectrum_measures(double f_sp, ChatterIndicator& out) {
+  const std::size_t n = window_.size();
   // Spectrum (Hann), energy away from the spindle harmonics.
   if (fft_n_ != n) fft_ = std::make_unique<analysis::RealFft>(n), fft_n_ = n;
   double* in = fft_->input();
@@ -162,13 +168,24 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
     out.forced_lines_snr = *mid > 0.0 ? on_a / static_cast<double>(on_bins) / *mid : INFINITY;
   }
   out.forced_lines = out.forced_lines_snr >= s_.forced_lines_threshold;
-  out.valid = true;
   out.nonharmonic_share = total > 0.0 ? off / total : 0.0;
   out.nonharmonic_rms_mps2 = total_a > 0.0 ? out.rms_mps2 * std::sqrt(off_a / total_a) : 0.0;
+  if (off <= 0.0) out.chatter_hz = 0.0;
+}
+
+// One window's verdict: chatter where the vibration is not the forced lines', repeats from one period to the
+// next, fills the window (or grows) and does not fade.
+ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
+  ChatterIndicator out;
+  if (!(spindle_rpm > 0.0)) return out;
+  const double f_sp = spindle_rpm / 60.0;
+  if (!fill_window(f_sp, out)) return out;
+  time_measures(f_sp, out);
+  spectrum_measures(f_sp, out);
+  out.valid = true;
   out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
                 out.nonharmonic_rms_mps2 > s_.floor_mps2 &&
                 (out.persistence > s_.persistence_threshold || out.growing) && out.trend > s_.fading_threshold;
-  if (off <= 0.0) out.chatter_hz = 0.0;
   return out;
 }
 

@@ -126,6 +126,10 @@ class ChatterMonitor {
   [[nodiscard]] const ChatterIndicatorSettings& settings() const { return s_; }
 
  private:
+  // evaluate's steps: the window (false: no verdict from it), the measures in time, the spectrum's.
+  bool fill_window(double f_sp, ChatterIndicator& out);
+  void time_measures(double f_sp, ChatterIndicator& out) const;
+  void spectrum_measures(double f_sp, ChatterIndicator& out);
   double fs_;
   ChatterIndicatorSettings s_;
   std::vector<double> ring_;

@@ -1,7 +1,5 @@
-// long: the candidate, its evaluation and the NLopt search share the evaluator's state; left for a later pass
+// The candidate's compensator and its evaluation on one plant (the search over plants: tune/search.cpp).
 #include "tune/compensator_search.hpp"
-
-#include <nlopt.h>
 
 #include <algorithm>
 #include <array>
@@ -318,43 +316,22 @@ LoopChecks check_loop(const analysis::LoopModel& m, double k, int polarity, bool
   return c;
 }
 
-}  // namespace
-
-// long: every constraint of one candidate in the order the report names them; left for a later pass
-Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) const {
-  Evaluation e;
-  e.candidate.gain_ns_per_m = cfg.controller.gain_ns_per_m;
-  e.candidate.polarity = cfg.controller.polarity;
-  const Candidate& cand = e.candidate;
-  const auto m = std::make_shared<const analysis::LoopModel>(cfg);
-  const double k = cand.gain_ns_per_m;
-  e.stable = m->stable(k, cand.polarity);
-  const LoopChecks checks = check_loop(*m, k, cand.polarity, e.stable, s_, impact_ ? &impact_->command : nullptr,
-                                       cfg.supervision.instability_floor_v);
-  const std::optional<double>& k_max = checks.k_max;
-  const analysis::Margins& mg = checks.margins;
-  e.k_max_ns_per_m = k_max.value_or(kInf);
-  e.gain_margin_db = mg.gain_margin_db.value_or(kInf);
-  e.phase_margin_deg = mg.phase_margin_deg.value_or(180.0);
-  e.delay_margin_ms = mg.delay_margin_ms.value_or(kInf);
-  if (!e.stable) {
-    add_violation(e, 10.0 + std::log10(k / std::max(1.0, e.k_max_ns_per_m)), "stability");
-    e.objective = -kInf;
-    return e;
-  }
-  add_violation(e, (s_.gain_margin_min_db - e.gain_margin_db) / s_.gain_margin_min_db, "gain margin");
-  add_violation(e, (s_.phase_margin_min_deg - e.phase_margin_deg) / s_.phase_margin_min_deg, "phase margin");
-  add_violation(e, (s_.delay_margin_min_ms - e.delay_margin_ms) / s_.delay_margin_min_ms, "delay margin");
+// The loop's constraints of a stable candidate, in the order the report names them: margins, the modes'
+// window and peaks, the compensator's gain, the quiet cell's command, the actuator at the impact.
+void add_loop_constraints(Evaluation& e, const LoopChecks& checks, const config::Config& cfg, const TuneSettings& s) {
+  add_violation(e, (s.gain_margin_min_db - e.gain_margin_db) / s.gain_margin_min_db, "gain margin");
+  add_violation(e, (s.phase_margin_min_deg - e.phase_margin_deg) / s.phase_margin_min_deg, "phase margin");
+  add_violation(e, (s.delay_margin_min_ms - e.delay_margin_ms) / s.delay_margin_min_ms, "delay margin");
   for (const auto& mode : checks.phases) e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
-  if (s_.damping_window) add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
-  if (s_.no_worse_mode || s_.worst_mode_objective) {
+  if (s.damping_window) add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
+  if (s.no_worse_mode || s.worst_mode_objective) {
     e.worst_mode_improvement_pct = checks.worst ? checks.worst->improvement_pct : kInf;
-    if (s_.no_worse_mode)
-      add_violation(e, -(e.worst_mode_improvement_pct + s_.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
+    if (s.no_worse_mode)
+      add_violation(e, -(e.worst_mode_improvement_pct + s.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
   }
-  if (s_.compensator_gain_max > 0.0) {
+  if (s.compensator_gain_max > 0.0) {
     e.compensator_gain_ratio = compensator_gain_ratio(cfg);
-    add_violation(e, e.compensator_gain_ratio / s_.compensator_gain_max - 1.0, "the compensator's gain away from the match frequency");
+    add_violation(e, e.compensator_gain_ratio / s.compensator_gain_max - 1.0, "the compensator's gain away from the match frequency");
   }
   if (checks.quiet_rms_v) {
     e.quiet_command_rms_v = *checks.quiet_rms_v;
@@ -370,13 +347,48 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
                                p.slew_v_per_s / cfg.amplifier.slew_rate_v_per_s});
     add_violation(e, e.actuator_use - 1.0, "the actuator's limits at the impact");
   }
+}
+
+}  // namespace
+
+// Every constraint of one candidate in the order the report names them, then its objective: the loop's
+// checks, then the job's depths (or, without a job, the closed-loop peak or the worst mode).
+Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) const {
+  Evaluation e;
+  e.candidate.gain_ns_per_m = cfg.controller.gain_ns_per_m;
+  e.candidate.polarity = cfg.controller.polarity;
+  const Candidate& cand = e.candidate;
+  const auto m = std::make_shared<const analysis::LoopModel>(cfg);
+  const double k = cand.gain_ns_per_m;
+  e.stable = m->stable(k, cand.polarity);
+  const LoopChecks checks = check_loop(*m, k, cand.polarity, e.stable, s_, impact_ ? &impact_->command : nullptr,
+                                       cfg.supervision.instability_floor_v);
+  const analysis::Margins& mg = checks.margins;
+  e.k_max_ns_per_m = checks.k_max.value_or(kInf);
+  e.gain_margin_db = mg.gain_margin_db.value_or(kInf);
+  e.phase_margin_deg = mg.phase_margin_deg.value_or(180.0);
+  e.delay_margin_ms = mg.delay_margin_ms.value_or(kInf);
+  if (!e.stable) {
+    add_violation(e, 10.0 + std::log10(k / std::max(1.0, e.k_max_ns_per_m)), "stability");
+    e.objective = -kInf;
+    return e;
+  }
+  add_loop_constraints(e, checks, cfg, s_);
   if (constraints_only) return e;
   if (!job_) {
     e.peak_m_per_n = closed_peak(*m, k, cand.polarity);
     e.objective = s_.worst_mode_objective ? e.worst_mode_improvement_pct / 100.0 : -std::log10(e.peak_m_per_n);
     return e;
   }
-  const milling::Structure damped(job_structure(*job_), true, {m, k, cand.polarity});
+  score_on_job(e, m);
+  return e;
+}
+
+// The job's depths with the damped loop: the accurate limits at the job's speed and where the damped and
+// the open lobes dip (the objective and the floors' constraints), the zero-order lobes as first guesses.
+void Evaluator::score_on_job(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const {
+  const Candidate& cand = e.candidate;
+  const milling::Structure damped(job_structure(*job_), true, {m, cand.gain_ns_per_m, cand.polarity});
   const milling::LobeModel lobes(damped, *process_, job_->lobes);
   const milling::LobeDiagram d = lobes.diagram();
   e.min_depth_mm = d.minimum.b_lim_mm;
@@ -417,66 +429,6 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
     e.at_open_minima_mm.push_back(at == d.curve.end() ? kInf : at->b_lim_mm);
   }
   add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
-  return e;
-}
-
-bool better(const Evaluation& a, const Evaluation& b) {
-  if (a.feasible() != b.feasible()) return a.feasible();
-  if (!a.feasible()) return a.violation < b.violation;
-  return a.objective > b.objective;
-}
-
-Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Candidate& c,
-                          bool skip_infeasible_objective) {
-  std::vector<Evaluation> per;
-  if (skip_infeasible_objective) {
-    for (const Evaluator* p : plants) {
-      per.push_back((*p)(c, true));
-      per.back().plant = p->name();
-    }
-    if (std::none_of(per.begin(), per.end(), [](const Evaluation& e) { return e.violation > 0.0; })) per.clear();
-  }
-  if (per.empty())
-    for (const Evaluator* p : plants) {
-      per.push_back((*p)(c));
-      per.back().plant = p->name();
-    }
-  if (per.size() == 1) return per.front();
-  // The worst: the most violating plant, else the one with the smallest objective (among the plants that
-  // compute one; a constraints-only plant contributes its constraints and margins).
-  const auto full = [&](std::size_t i) { return !plants[i]->constraints_only(); };
-  std::size_t lowest = per.size();
-  for (std::size_t i = 0; i < per.size(); ++i)
-    if (full(i) && (lowest == per.size() || per[i].objective < per[lowest].objective)) lowest = i;
-  std::size_t wi = lowest == per.size() ? 0 : lowest;
-  for (std::size_t i = 0; i < per.size(); ++i)
-    if (per[i].violation > per[wi].violation) wi = i;
-  Evaluation w = per[wi];
-  if (!full(wi) && lowest != per.size()) w.objective = per[lowest].objective;
-  if (!w.binding.empty()) w.binding = w.plant + ": " + w.binding;
-  // Margins and depths: the smallest over the plants; peaks and shares of a limit: the largest.
-  constexpr double Evaluation::*kMargins[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
-                                             &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
-                                             &Evaluation::worst_mode_improvement_pct};
-  constexpr double Evaluation::*kDepths[] = {&Evaluation::min_depth_mm, &Evaluation::depth_at_speed_mm,
-                                            &Evaluation::floor_ratio, &Evaluation::accurate_min_mm,
-                                            &Evaluation::open_minima_ratio};
-  constexpr double Evaluation::*kLargest[] = {&Evaluation::worst_mode_phase_deg, &Evaluation::peak_m_per_n,
-                                             &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
-                                             &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use,
-                                             &Evaluation::quiet_command_rms_v};
-  if (!full(wi) && lowest != per.size())
-    for (const auto field : kDepths) w.*field = per[lowest].*field;
-  for (std::size_t i = 0; i < per.size(); ++i) {
-    const Evaluation& e = per[i];
-    w.stable = w.stable && e.stable;
-    for (const auto field : kMargins) w.*field = std::min(w.*field, e.*field);
-    if (full(i))
-      for (const auto field : kDepths) w.*field = std::min(w.*field, e.*field);
-    for (const auto field : kLargest) w.*field = std::max(w.*field, e.*field);
-  }
-  w.per_plant = std::move(per);
-  return w;
 }
 
 config::Config with_shifted_modes(const config::Config& base, double factor) {
@@ -511,125 +463,6 @@ std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::
 
 std::vector<ModeImprovement> Evaluator::mode_improvements(const config::Config& cfg) const {
   return analysis::mode_improvements(analysis::LoopModel(cfg), cfg.controller.gain_ns_per_m, cfg.controller.polarity);
-}
-
-namespace {
-
-// x = [log10 K, log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb]
-constexpr unsigned kDims = 7;
-const double kLower[kDims] = {std::log10(kGainMinNsPerM), std::log10(kPairMinHz), kZetaMin, std::log10(kPairMinHz), kZetaMin,
-                              std::log10(kFirstOrderMinHz), std::log10(kFirstOrderMinHz)};
-const double kUpper[kDims] = {std::log10(kGainMaxNsPerM), std::log10(kPairMaxHz), kZetaMax, std::log10(kPairMaxHz), kZetaMax,
-                              std::log10(kFirstOrderMaxHz), std::log10(kFirstOrderMaxHz)};
-
-Candidate candidate_of(const double* x, int polarity) {
-  return {std::pow(10.0, x[0]), std::pow(10.0, x[1]), x[2], std::pow(10.0, x[3]), x[4], std::pow(10.0, x[5]),
-          std::pow(10.0, x[6]), polarity};
-}
-
-struct Search {
-  const std::vector<const Evaluator*>* plants;
-  int polarity;
-  TuneResult* result;
-  const std::function<void(const std::string&)>* progress;
-  const char* phase;
-  int budget;
-  int count{0};
-};
-
-double penalised(unsigned /*n*/, const double* x, double* /*grad*/, void* data) {
-  auto& s = *static_cast<Search*>(data);
-  const Evaluation e = evaluate_worst(*s.plants, candidate_of(x, s.polarity), true);
-  s.result->history.push_back(e);
-  if (s.result->history.size() == 1 || better(e, s.result->best)) s.result->best = e;
-  ++s.count;
-  if (*s.progress && (s.count % 20 == 0 || s.count == s.budget)) {
-    const Evaluation& b = s.result->best;
-    char line[200];
-    std::snprintf(line, sizeof line, "tune: polarity %+d, %s %d/%d; best so far %s %.4g, %s", s.polarity, s.phase, s.count,
-                  s.budget, b.peak_m_per_n > 0.0 ? "-log10 peak" : "min depth mm", b.objective,
-                  b.feasible() ? "feasible" : ("violates " + b.binding).c_str());
-    (*s.progress)(line);
-  }
-  // Larger is better; a violated constraint costs more than any objective can gain.
-  const double objective = std::isfinite(e.objective) ? e.objective : -1e3;
-  return objective - 1e3 * e.violation;
-}
-
-void run(nlopt_algorithm algorithm, Search& s, std::vector<double>& x) {
-  nlopt_opt opt = nlopt_create(algorithm, kDims);
-  nlopt_set_lower_bounds(opt, kLower);
-  nlopt_set_upper_bounds(opt, kUpper);
-  nlopt_set_max_objective(opt, penalised, &s);
-  nlopt_set_maxeval(opt, s.budget);
-  double f = 0.0;
-  (void)nlopt_optimize(opt, x.data(), &f);  // the best point is kept in s.result whatever the return code
-  nlopt_destroy(opt);
-}
-
-std::vector<double> x_of(const Candidate& c) {
-  return {std::log10(c.gain_ns_per_m), std::log10(c.fz_hz), c.zeta_z, std::log10(c.fp_hz), c.zeta_p, std::log10(c.fa_hz),
-          std::log10(c.fb_hz)};
-}
-
-}  // namespace
-
-TuneResult tune(const config::Config& base, const std::optional<config::MillingConfig>& job, const TuneSettings& s,
-                const std::function<void(const std::string&)>& progress) {
-  const Evaluator evaluate(base, job, s);
-  return tune(std::vector<const Evaluator*>{&evaluate}, s, progress);
-}
-
-namespace {
-
-// One polarity's search (seeded global, then the polish), its evaluations and best added to `result`.
-void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSettings& s, int polarity,
-                     const std::function<void(const std::string&)>& progress, const std::string& tag, TuneResult& result,
-                     const std::optional<Candidate>& start = std::nullopt) {
-  const config::Config& base = plants.front()->base();
-  TuneResult per;
-  const std::string global_phase = "global search" + tag, local_phase = "local polish" + tag;
-  Search global{&plants, polarity, &per, &progress, global_phase.c_str(), s.global_evaluations};
-  // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
-  const Candidate c1{std::clamp(base.controller.gain_ns_per_m, kGainMinNsPerM, kGainMaxNsPerM), base.actuator.natural_freq_hz,
-                     base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
-  std::vector<double> x = x_of(start ? *start : c1);
-  for (unsigned i = 0; i < kDims; ++i) x[i] = std::clamp(x[i], kLower[i], kUpper[i]);
-  run(NLOPT_GN_CRS2_LM, global, x);
-  if (s.local_evaluations > 0) {  // NLopt reads a budget of 0 as no limit
-    Search local{&plants, polarity, &per, &progress, local_phase.c_str(), s.local_evaluations};
-    x = x_of(per.best.candidate);
-    run(NLOPT_LN_BOBYQA, local, x);
-  }
-  const bool first = result.history.empty();
-  result.history.insert(result.history.end(), per.history.begin(), per.history.end());
-  if (first || better(per.best, result.best)) result.best = per.best;
-}
-
-}  // namespace
-
-TuneResult tune_from(const std::vector<const Evaluator*>& plants, const Candidate& start, const TuneSettings& s,
-                     const std::function<void(const std::string&)>& progress) {
-  if (plants.empty()) throw std::invalid_argument("robodamp tune: no plant to tune for");
-  TuneResult result;
-  result.best = evaluate_worst(plants, start);
-  result.history.push_back(result.best);
-  nlopt_srand(static_cast<unsigned long>(s.seed));
-  search_polarity(plants, s, start.polarity, progress, "", result, start);
-  return result;
-}
-
-TuneResult tune(const std::vector<const Evaluator*>& plants, const TuneSettings& s,
-                const std::function<void(const std::string&)>& progress) {
-  if (plants.empty()) throw std::invalid_argument("robodamp tune: no plant to tune for");
-  TuneResult result;
-  for (int restart = 0; restart < std::max(1, s.restarts); ++restart) {
-    const int seed = s.seed + restart;
-    nlopt_srand(static_cast<unsigned long>(seed));  // CRS2's population: seeded, so a tune repeats exactly
-    const std::string tag = s.restarts > 1 ? " (seed " + std::to_string(seed) + ")" : "";
-    for (const int polarity : {1, -1}) search_polarity(plants, s, polarity, progress, tag, result);
-  }
-  return result;
 }
 
 }  // namespace robodamp::tune

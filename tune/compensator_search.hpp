@@ -30,6 +30,10 @@
 #include "config/milling_config.hpp"
 #include "milling/lobes.hpp"
 
+namespace robodamp::analysis {
+class LoopModel;
+}  // namespace robodamp::analysis
+
 namespace robodamp::tune {
 
 struct Candidate {
@@ -188,6 +192,8 @@ class Evaluator {
 
  private:
   struct Impact;
+  // assess's last step with a job: the damped depths, the objective and the floors' constraints.
+  void score_on_job(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const;
   config::Config base_;
   std::string name_;
   std::unique_ptr<Impact> impact_;  // the actuator-limit check's precomputed plant (one thread at a time)
