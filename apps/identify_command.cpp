@@ -15,6 +15,7 @@
 
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "plot/frf_figure.hpp"
 #include "apps/identify_command.hpp"
 #include "identify/cutting_coefficients.hpp"
 #include "identify/modal_fit.hpp"
@@ -31,20 +32,20 @@ std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit
                        const std::string& prefix) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  // The fit over the whole band it was made for (not only the sub-bands' cores), at full precision.
-  std::ostringstream data;
-  for (std::size_t i = 0; i < d.f_hz.size(); ++i) {
-    const bool in = d.f_hz[i] >= fit.band_lo_hz && d.f_hz[i] <= fit.band_hi_hz;
-    const std::complex<double> h = in ? identify::fitted_receptance(fit, d.f_hz[i]) : std::complex<double>(NAN, NAN);
-    data << plot::num(d.f_hz[i]) << ' ' << plot::num(std::abs(d.h[i])) << ' ' << plot::num(std::arg(d.h[i]) * 180.0 / M_PI)
-         << ' ' << plot::num(std::abs(h)) << ' ' << plot::num(std::arg(h) * 180.0 / M_PI) << '\n';
-  }
-  std::ostringstream s;
-  s << "set multiplot layout 2,1 title 'Measured and fitted receptance (fit error " << fit.fit_error_pct << " %)'\n"
-    << "set grid\nset logscale y\nset ylabel '|H| (m/N)'\nplot DATA u 1:2 w l t 'measured', DATA u 1:4 w l lw 2 t 'fit'\n"
-    << "unset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\n"
-    << "plot DATA u 1:3 w l t 'measured', DATA u 1:5 w l lw 2 t 'fit'\nunset multiplot\n";
-  if (auto e = run_gnuplot(s.str(), data.str(), dir + "/" + prefix + "_fit.png"); !e.empty()) return e;
+  // The fit over the whole band it was made for (not only the sub-bands' cores), at full precision, and
+  // the measurement over that band with its coherence (plot/frf_figure.hpp).
+  plot::FrfFigureInput in;
+  char error[32];
+  std::snprintf(error, sizeof error, "%.2f", fit.fit_error_pct);
+  in.title = std::string("Measured and fitted receptance (fit error ") + error + " %)";
+  in.f_hz = d.f_hz, in.measured = d.h, in.coherence = d.coherence;
+  in.band_lo_hz = fit.band_lo_hz, in.band_hi_hz = fit.band_hi_hz;
+  for (const double f : d.f_hz)
+    in.fitted.push_back(f >= fit.band_lo_hz && f <= fit.band_hi_hz ? identify::fitted_receptance(fit, f)
+                                                                   : std::complex<double>(NAN, NAN));
+  const plot::FrfFigure fig = plot::frf_figure(in);
+  std::ofstream(dir + "/" + prefix + "_fit.dat") << fig.data;
+  if (auto e = run_gnuplot(fig.script, fig.data, dir + "/" + prefix + "_fit.png"); !e.empty()) return e;
   std::ostringstream diag;
   for (const auto& p : fit.diagram) diag << plot::num(p.freq_hz) << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
   const std::string s2 = "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"

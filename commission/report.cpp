@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "plot/frf_figure.hpp"
 #include "plot/gnuplot.hpp"
 #include "rt/version.hpp"
 #include "tune/speed_schedule_report.hpp"
@@ -93,21 +94,15 @@ std::string identified_section(const identify::CommissioningResult& id, Plots& p
     << fmt("%.3g-%.3g", a.band_lo_hz, a.band_hi_hz) << " Hz (" << a.points << " points, " << id.actuator_periods
     << " chirp periods averaged).</p>\n";
   for (const auto& f : id.frfs) {
-    std::ostringstream d;
-    for (std::size_t i = 0; i < f.data.f_hz.size(); ++i) {
-      const double fh = f.data.f_hz[i];
-      const bool in = fh >= f.fit.band_lo_hz && fh <= f.fit.band_hi_hz;
-      const std::complex<double> fit = in ? identify::fitted_receptance(f.fit, fh) : std::complex<double>(NAN, NAN);
-      d << num(fh) << ' ' << num(std::abs(f.data.h[i])) << ' ' << num(deg(f.data.h[i])) << ' ' << num(std::abs(fit)) << ' '
-        << num(deg(fit)) << '\n';
-    }
-    const std::string s =
-        "set multiplot layout 2,1 title '" + f.name + ": measured receptance and the fitted modes (fit error " +
-        fmt("%.2f", f.fit.fit_error_pct) + " %)'\nset grid\nset logscale y\nset format y '%.0e'\nset ylabel '|H| (m/N)'\n"
-        "plot DATA u 1:2 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:4 w l lw 2 lc rgb '#c0392b' t 'fitted'\n"
-        "unset logscale y\nset format y '%g'\nset xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nset yrange [-180:180]\n"
-        "plot DATA u 1:3 w l lc rgb '#7f8c8d' t 'measured', DATA u 1:5 w l lw 2 lc rgb '#c0392b' t 'fitted'\nunset multiplot\n";
-    h << p.img(f.name + "_fit", s, d.str(), f.name + ": measured and fitted receptance, magnitude and phase");
+    plot::FrfFigureInput in;  // over the fitted band, with the coherence (plot/frf_figure.hpp)
+    in.title = f.name + ": measured receptance and the fitted modes (fit error " + fmt("%.2f", f.fit.fit_error_pct) + " %)";
+    in.f_hz = f.data.f_hz, in.measured = f.data.h, in.coherence = f.data.coherence;
+    in.band_lo_hz = f.fit.band_lo_hz, in.band_hi_hz = f.fit.band_hi_hz;
+    for (const double fh : f.data.f_hz)
+      in.fitted.push_back(fh >= f.fit.band_lo_hz && fh <= f.fit.band_hi_hz ? identify::fitted_receptance(f.fit, fh)
+                                                                           : std::complex<double>(NAN, NAN));
+    const plot::FrfFigure fig = plot::frf_figure(in);
+    h << p.img(f.name + "_fit", fig.script, fig.data, f.name + ": measured and fitted receptance, magnitude, phase and coherence");
     std::ostringstream g;
     for (const auto& q : f.fit.diagram) g << num(q.freq_hz) << ' ' << q.order << ' ' << (q.stable ? 1 : 0) << '\n';
     const std::string s2 = "set title '" + f.name + ": stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\n"

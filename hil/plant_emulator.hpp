@@ -46,7 +46,9 @@ struct EmulatorOptions {
   int impact_location{0};
   // robodamp measure's plant side (analysis/modal_test.hpp): instead of the bench's impact schedule, the
   // commissioning plan's impacts at every location (plant time from the first step), and the FRFs
-  // written to this directory when the run ends. Empty = off.
+  // written to this directory when the run ends. With a pose trajectory, the plan at each of its stops
+  // (from the stop's start) into measure_out/dwell_<k> (measure --along-path); a stop shorter than the plan
+  // is refused. Empty = off.
   std::string measure_out;                   // location id; 0 = the first configured FRF's excitation
   // Robot mounting register changes: (plant time s, mounting).
   std::vector<std::pair<double, config::Mounting>> mounting_schedule;

@@ -689,6 +689,19 @@ TEST(Cli, IdentifyModesRecoversThePresetsModesFromAnAccelerance) {
   EXPECT_NE(robodamp::test::read_file(yaml).find("residue_re_m_per_n:"), std::string::npos);
   for (const char* png : {"modes_fit.png", "modes_stabilisation.png"})
     EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
+  {  // the plotted data: the fitted band alone (5-40 Hz), on a logarithmic axis limited to it
+    std::istringstream data(robodamp::test::read_file(dir + "/modes_fit.dat"));
+    std::string line;
+    double f_min = 1e300, f_max = 0.0;
+    while (std::getline(data, line) && !line.empty()) {
+      const double f = std::stod(line.substr(0, line.find(' ')));
+      f_min = std::min(f_min, f), f_max = std::max(f_max, f);
+    }
+    EXPECT_GE(f_min, 5.0);
+    EXPECT_LT(f_min, 5.5);
+    EXPECT_LE(f_max, 40.0);
+    EXPECT_GT(f_max, 39.5);
+  }
   // Too few coherent points: a clear refusal.
   const Result narrow = run("identify modes --frf " + csv + " --band-hz 2 2.1");
   EXPECT_EQ(narrow.status, 2) << narrow.out;

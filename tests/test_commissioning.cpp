@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -24,6 +25,7 @@
 #include "hil_files.hpp"
 #include "identify/actuator_fit.hpp"
 #include "identify/commissioning.hpp"
+#include "plot/frf_figure.hpp"
 #include "identify/uff_commissioning.hpp"
 #include "measfiles/uff.hpp"
 #include "rt/excitation.hpp"
@@ -99,6 +101,85 @@ TEST(ActuatorFit, PeriodicFrfOfAPureDelayIsExact) {
   EXPECT_THROW((void)identify::periodic_frf(u, y, period, period, 5, fs, 100.0), std::invalid_argument);
 }
 
+// An FRF plot's data (plot/frf_figure.hpp): the analysed band alone, the fit beside the measurement, the
+// coherence in [0, 1], the phase in (-270, 90] with the line broken at each wrap.
+std::size_t expect_frf_plot_data(const std::string& path, const config::AnalysisConfig& band) {
+  std::istringstream in(test::read_file(path));
+  std::string line;
+  int block = 0, blanks = 0;
+  std::size_t rows = 0, fitted = 0, breaks = 0;
+  double f_min = 1e300, f_max = 0.0, last_phase = NAN;
+  while (std::getline(in, line)) {
+    if (line.empty()) {
+      if (++blanks == 2) ++block, --breaks;  // two blank lines: the next block (the first counted as a break)
+      else ++breaks;
+      last_phase = NAN;
+      continue;
+    }
+    blanks = 0;
+    std::istringstream row(line);
+    double f = 0.0;
+    row >> f;
+    f_min = std::min(f_min, f), f_max = std::max(f_max, f);
+    if (block == 0) {
+      std::string mag, fit, coh;
+      row >> mag >> fit >> coh;
+      ++rows;
+      fitted += fit != "NaN" ? 1 : 0;
+      EXPECT_NE(coh, "NaN") << path << ": " << line;
+      EXPECT_GE(std::stod(coh), 0.0);
+      EXPECT_LE(std::stod(coh), 1.0 + 1e-12);
+    } else {
+      double p = 0.0;
+      row >> p;
+      EXPECT_GT(p, -270.0) << line;
+      EXPECT_LE(p, 90.0) << line;
+      if (!std::isnan(last_phase)) EXPECT_LE(std::abs(p - last_phase), 180.0) << "a wrap without a break: " << line;
+      last_phase = p;
+    }
+  }
+  EXPECT_EQ(block, 2) << path;
+  EXPECT_GT(rows, 100U) << path;
+  EXPECT_EQ(fitted, rows) << path;
+  EXPECT_GE(f_min, band.band_min_hz) << path;
+  EXPECT_LE(f_max, band.band_max_hz) << path;
+  EXPECT_LT(f_min, band.band_min_hz + 1.0) << path;
+  EXPECT_GT(f_max, band.band_max_hz - 1.0) << path;
+  std::cout << path << ": " << rows << " rows over " << f_min << "-" << f_max << " Hz, " << breaks << " phase wraps broken\n";
+  return breaks;
+}
+
+// The FRF figure's data on a receptance of two modes behind a delay, whose phase wraps: only the band, a break at each wrap.
+TEST(FrfFigure, TheBandAloneThePhaseWrappedWithItsLineBrokenTheCoherenceBeside) {
+  plot::FrfFigureInput in;
+  in.title = "two modes";
+  for (int i = 1; i <= 2000; ++i) {
+    const double f = 0.1 * i;
+    Complex h(0.0, 0.0);
+    for (const auto& [fn, zeta] : {std::pair{10.0, 0.02}, std::pair{40.0, 0.02}})
+      h += 1.0 / Complex(fn * fn - f * f, 2.0 * zeta * fn * f);
+    h *= std::exp(Complex(0.0, -2.0 * M_PI * f * 0.02));  // 20 ms of delay: the phase wraps every 50 Hz
+    in.f_hz.push_back(f), in.measured.push_back(h), in.fitted.push_back(h), in.coherence.push_back(f < 5.0 ? 0.3 : 0.99);
+  }
+  in.band_lo_hz = 5.0, in.band_hi_hz = 100.0;
+  const plot::FrfFigure fig = plot::frf_figure(in);
+  EXPECT_EQ(fig.rows, 951U);  // 5.0 .. 100.0 Hz in 0.1 Hz steps
+  const std::string path = ::testing::TempDir() + "frf_figure_" + std::to_string(::getpid()) + ".dat";
+  std::ofstream(path) << fig.data;
+  config::AnalysisConfig band;
+  band.band_min_hz = 5.0, band.band_max_hz = 100.0;
+  EXPECT_GE(expect_frf_plot_data(path, band), 2U);  // the delay's wraps, each a break in both phases' lines
+  std::filesystem::remove(path);
+  EXPECT_NE(fig.data.find("\n\n\n"), std::string::npos);  // blocks
+  EXPECT_NE(fig.script.find("set xrange [5:100]"), std::string::npos) << fig.script;
+  EXPECT_NE(fig.script.find("set logscale x"), std::string::npos);
+  EXPECT_NE(fig.script.find("layout 3,1"), std::string::npos);
+  EXPECT_EQ(plot::wrapped_phase_deg(Complex(-1.0, 0.0)), -180.0);  // a mass line's phase stays at -180
+  EXPECT_EQ(plot::wrapped_phase_deg(Complex(0.0, 1.0)), 90.0);
+  EXPECT_NEAR(plot::wrapped_phase_deg(Complex(-1.0, 0.01)), -180.0 - 0.573, 1e-3);
+  EXPECT_THROW((void)plot::frf_figure({"none", "", {1.0}, {Complex(1.0, 0.0)}, {}, {}, 5.0, 10.0}), std::invalid_argument);
+}
+
 TEST(PeriodicChirp, IsAPeriodicChirpOnlyInsideItsWindow) {
   const rt::PeriodicChirp s{true, 1.0, 2.0, 3, 2.0, 50.0, 1.5};
   EXPECT_EQ(s.value_v(0.999), 0.0);
@@ -172,6 +253,7 @@ void expect_round_trip(const std::string& dir, const std::string& measured_confi
   ASSERT_EQ(identify.wait(), 0) << test::read_file(log);
   for (const char* png : {"H11yy_fit.png", "H21yy_stabilisation.png", "H22yy_fit.png", "actuator_fit.png"})
     EXPECT_GT(std::filesystem::file_size(dir + "/plots/" + png), 1000U) << png;
+  expect_frf_plot_data(dir + "/plots/H11yy_fit.dat", config::load_config_file(measured_config).analysis);
   Child check({"check-config", out}, dir + "/check.log");
   ASSERT_EQ(check.wait(), 0) << test::read_file(dir + "/check.log");
   const config::Config identified = config::load_config_file(out);
