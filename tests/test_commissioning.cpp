@@ -134,7 +134,9 @@ std::size_t expect_frf_plot_data(const std::string& path, const config::Analysis
       row >> p;
       EXPECT_GT(p, -270.0) << line;
       EXPECT_LE(p, 90.0) << line;
-      if (!std::isnan(last_phase)) EXPECT_LE(std::abs(p - last_phase), 180.0) << "a wrap without a break: " << line;
+      if (!std::isnan(last_phase)) {
+        EXPECT_LE(std::abs(p - last_phase), 180.0) << "a wrap without a break: " << line;
+      }
       last_phase = p;
     }
   }
