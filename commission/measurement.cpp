@@ -151,16 +151,6 @@ std::optional<std::string> apply_pose(const config::Config& cfg, const MeasureOp
   return std::nullopt;
 }
 
-// The plan of a run with these options: without impacts the run ends a second after the chirp.
-analysis::CommissioningPlan plan_for(const config::Config& cfg, const sim::PlantModel& model, const MeasureOptions& o) {
-  analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg, model);
-  if (!o.impacts) {
-    plan.impacts_start_s.clear();
-    plan.duration_s = plan.chirp_end_s + 1.0;
-  }
-  return plan;
-}
-
 // The run's verdict, in order: the watch's stop, the operator's abort, a trip, an incomplete chirp, the
 // recording's errors.
 void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& watch) {
@@ -187,6 +177,16 @@ void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& wa
 }  // namespace
 
 namespace detail {
+
+// The plan of a run with these options: without impacts the run ends a second after the chirp.
+analysis::CommissioningPlan plan_for(const config::Config& cfg, const sim::PlantModel& model, const MeasureOptions& o) {
+  analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg, model);
+  if (!o.impacts) {
+    plan.impacts_start_s.clear();
+    plan.duration_s = plan.chirp_end_s + 1.0;
+  }
+  return plan;
+}
 
 // The configuration the loop runs: control off (every set's gain 0) unless the chirp verifies the controller.
 config::Config running_config(const config::Config& cfg, const MeasureOptions& o) {
@@ -266,7 +266,7 @@ std::string measurement_plan(const std::string& config_path, const MeasureOption
 
 std::string measurement_plan(const config::Config& cfg, const std::string& config_path, const MeasureOptions& o) {
   const sim::PlantModel model = sim::build_plant_model(cfg);
-  const analysis::CommissioningPlan p = plan_for(cfg, model, o);
+  const analysis::CommissioningPlan p = detail::plan_for(cfg, model, o);
   const auto& c = cfg.commissioning;
   char b[1024];
   std::string t = "robodamp measure plan for " + config_path + " (" + (cfg.can ? "the cell behind " + cfg.can->interface : std::string("the simulated plant")) + "):\n";
@@ -306,7 +306,7 @@ MeasureOutcome measure(const std::string& config_path, const std::string& out_di
 MeasureOutcome measure(const config::Config& cfg, const std::string& config_path, const std::string& out_dir,
                        const MeasureOptions& opt) {
   const sim::PlantModel model = sim::build_plant_model(cfg);
-  const analysis::CommissioningPlan plan = plan_for(cfg, model, opt);
+  const analysis::CommissioningPlan plan = detail::plan_for(cfg, model, opt);
   fs::create_directories(out_dir);
   MeasureOutcome out;
   const auto& c = cfg.commissioning;

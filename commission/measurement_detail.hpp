@@ -8,6 +8,10 @@
 
 namespace robodamp::commission::detail {
 
+// The plan of a run with these options: without impacts the run ends a second after the chirp.
+[[nodiscard]] analysis::CommissioningPlan plan_for(const config::Config& cfg, const sim::PlantModel& model,
+                                                   const MeasureOptions& o);
+
 // The configuration the loop runs: control off (every set's gain 0) unless the chirp verifies the controller.
 [[nodiscard]] config::Config running_config(const config::Config& cfg, const MeasureOptions& o);
 

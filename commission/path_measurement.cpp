@@ -24,6 +24,10 @@ constexpr double kPosePollS = 0.01;     // loop time between two readings of the
 constexpr double kStillWindowS = 0.25;  // the joints unchanged this long: the robot stopped (polls, register steps)
 constexpr double kRestWindowS = 1.0;    // the rest check's window before a chirp (as a stopped measurement's)
 
+int measured_stops(const std::vector<DwellMeasurement>& dwells) {
+  return static_cast<int>(std::count_if(dwells.begin(), dwells.end(), [](const auto& d) { return d.measured; }));
+}
+
 // Finds the robot's stops from the joints it reports, starts the chirp at each, watches it (on the drain
 // thread, one call per frame), and stops the run once enough dwells are measured or the chirp saturates.
 class DwellWatch {
@@ -140,7 +144,7 @@ class DwellWatch {
       case Phase::kHolding:
         if (t < dwells_.back().still_s + plan_.duration_s) return;  // the plant side's hammer, on a stopped plan's times
         phase_ = Phase::kDone;
-        if (measured() >= o_.dwells) cell_->request_stop();
+        if (measured_stops(dwells_) >= o_.dwells) cell_->request_stop();
         return;
       case Phase::kDone: return;
     }
@@ -169,9 +173,6 @@ class DwellWatch {
     if (q.size() != d.joints_deg.size()) return;
     ++pose_n_;
     for (std::size_t i = 0; i < q.size(); ++i) d.joints_deg[i] += (q[i] - d.joints_deg[i]) / static_cast<double>(pose_n_);
-  }
-  [[nodiscard]] int measured() const {
-    return static_cast<int>(std::count_if(dwells_.begin(), dwells_.end(), [](const auto& d) { return d.measured; }));
   }
 
   analysis::CommissioningPlan plan_;
@@ -269,17 +270,14 @@ void write_index(const std::string& out_dir, const std::string& config_path, con
 
 }  // namespace
 
-int PathMeasureOutcome::measured() const {
-  return static_cast<int>(std::count_if(dwells.begin(), dwells.end(), [](const auto& d) { return d.measured; }));
-}
+int PathMeasureOutcome::measured() const { return measured_stops(dwells); }
 
 // The run: configured, watched, run, judged, then one directory per measured stop.
 PathMeasureOutcome measure_along_path(const config::Config& cfg, const std::string& config_path, const std::string& out_dir,
                                       const PathMeasureOptions& opt) {
   check_options(cfg, opt);
   const sim::PlantModel model = sim::build_plant_model(cfg);
-  analysis::CommissioningPlan plan = analysis::commissioning_plan(cfg, model);
-  if (!opt.measure.impacts) plan.impacts_start_s.clear(), plan.duration_s = plan.chirp_end_s + 1.0;
+  const analysis::CommissioningPlan plan = detail::plan_for(cfg, model, opt.measure);
   fs::create_directories(out_dir);
   PathMeasureOutcome result;
   MeasureOutcome& out = result.run;
