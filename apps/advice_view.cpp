@@ -15,7 +15,13 @@ std::string advice_text(const dds::AdviceSample& a) {
                 static_cast<unsigned long long>(a.seq), a.time_s, a.trigger.c_str(), a.spindle_rpm, chatter.c_str(),
                 a.depth_mm, a.damped ? "damped" : "open-loop", a.limit_now_mm, a.method.c_str());
   std::string out = b;
-  if (!a.pose_deg.empty()) out += " at the robot's pose " + config::describe_pose(a.pose_deg) + ":";
+  if (!a.pose_deg.empty()) {
+    out += " at the robot's pose " + config::describe_pose(a.pose_deg);
+    if (a.poses_ahead > 0)
+      out += " and " + std::to_string(a.poses_ahead) + " pose" + (a.poses_ahead == 1 ? "" : "s") + " of the path ahead" +
+             (a.limiting_pose_deg.empty() ? std::string() : " (the lowest limit at " + config::describe_pose(a.limiting_pose_deg) + ")");
+    out += ":";
+  }
   const std::string status = a.status == "current" ? "" : " [" + a.status + ": " + a.status_reason + "]";
   if (!a.found) return out + " " + a.reason + status + "\n";
   for (std::size_t i = 0; i < a.option_rpm.size(); ++i) {
@@ -51,6 +57,8 @@ nlohmann::json advice_json(const dds::AdviceSample& a) {
           {"rpm_min", a.rpm_min},
           {"rpm_max", a.rpm_max},
           {"pose_deg", a.pose_deg},
+          {"poses_ahead", a.poses_ahead},
+          {"limiting_pose_deg", a.limiting_pose_deg},
           {"status", a.status},
           {"status_reason", a.status_reason}};
 }

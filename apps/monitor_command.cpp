@@ -154,6 +154,8 @@ std::string advice_view(const msg::Advice& m) {
   a.option_limit_mm.resize(a.option_rpm.size(), 0.0);
   a.reason = m.reason();
   a.pose_deg = m.pose_deg();
+  a.poses_ahead = m.poses_ahead();
+  a.limiting_pose_deg = m.limiting_pose_deg();
   a.status = m.status();
   a.status_reason = m.status_reason();
   return advice_text(a);

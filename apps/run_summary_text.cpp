@@ -58,6 +58,11 @@ namespace {
                   static_cast<unsigned long long>(j.losses));
     os << b;
   }
+  if (s.path_ahead) {
+    std::snprintf(b, sizeof b, "  DDS path ahead: %llu trajectories (%llu refused: a joint missing, a point short or not finite)\n",
+                  static_cast<unsigned long long>(s.path_ahead->messages), static_cast<unsigned long long>(s.path_ahead->refused));
+    os << b;
+  }
   if (s.dds) {
     std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
                   static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
@@ -230,6 +235,7 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
     j["joint_states"] = {{"messages", c.messages}, {"refused", c.refused}, {"out_of_map", c.out_of_map},
                          {"changes", c.changes}, {"losses", c.losses}};
   }
+  if (s.path_ahead) j["path_ahead"] = {{"messages", s.path_ahead->messages}, {"refused", s.path_ahead->refused}};
   return j;
 }
 

@@ -703,6 +703,24 @@ void check_joint_states(detail::Diagnostics& d, const Config& c) {
                                         " both give the pose: choose one source");
 }
 
+// dds.path_ahead against pose_schedule: a name per joint (its own or dds.joint_states').
+void check_path_ahead(detail::Diagnostics& d, const Config& c) {
+  const SourceMark here{};
+  if (!c.dds || !c.dds->path_ahead) return;
+  const PathAheadConfig& p = *c.dds->path_ahead;
+  if (!c.pose_schedule) {
+    d.add(here, "dds.path_ahead", "is set without pose_schedule: the advice has no robot model to check the poses on");
+    return;
+  }
+  const std::vector<std::string>& names = !p.names.empty() || !c.dds->joint_states ? p.names : c.dds->joint_states->names;
+  if (names.size() != c.pose_schedule->joints())
+    d.add(here, p.names.empty() && !c.dds->joint_states ? "dds.path_ahead" : "dds.path_ahead.names",
+          p.names.empty() && !c.dds->joint_states
+              ? "needs names (pose_schedule's joints as the robot program names them) without dds.joint_states"
+              : "has " + std::to_string(names.size()) + " names; pose_schedule has " + std::to_string(c.pose_schedule->joints()) +
+                    " joints: one name per joint, in order");
+}
+
 // modbus.robot.joints_register against pose_schedule: one register per joint, clear of the others.
 void check_joint_registers(detail::Diagnostics& d, const Config& c) {
   const SourceMark here{};  // located() gives it the key's line
@@ -785,6 +803,7 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   }
   check_joint_registers(d, c);
   check_joint_states(d, c);
+  check_path_ahead(d, c);
   top.finish();
   check_location_refs(d, c, root);
   if (!d.problems().empty()) throw ConfigError(located(d.problems(), yaml_text));

@@ -192,24 +192,42 @@ std::optional<DdsSecurityConfig> read_dds_security(MapReader& dds, const std::st
   return c;
 }
 
+// A list of joint names at `key` of r (each once, text), into out.
+void read_joint_names(MapReader& r, const std::string& key, const char* what, std::vector<std::string>& out) {
+  const YAML::Node names = r.child("names", false, what);
+  if (present(names) && !names.IsSequence())
+    r.diagnostics().add(to_mark(names.Mark()), key, "must be a list of joint names, e.g. [joint_1, joint_2]");
+  else if (present(names))
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const std::string at = key + "[" + std::to_string(i) + "]";
+      const std::string name = names[i].IsScalar() ? names[i].as<std::string>() : "";
+      if (name.empty()) r.diagnostics().add(to_mark(names[i].Mark()), at, "must be a joint's name (text)");
+      else if (std::find(out.begin(), out.end(), name) != out.end())
+        r.diagnostics().add(to_mark(names[i].Mark()), at, "= '" + name + "' is named twice: each joint once");
+      if (!name.empty()) out.push_back(name);  // kept, so the count is the file's
+    }
+}
+
+std::optional<PathAheadConfig> read_path_ahead(MapReader& dds) {
+  const YAML::Node node = dds.child("path_ahead", false, "");
+  if (!present(node)) return std::nullopt;
+  MapReader r(dds.diagnostics(), node, "dds.path_ahead", dds.mark());
+  PathAheadConfig c;
+  if (auto v = r.text("topic", c.topic)) c.topic = *v;
+  read_joint_names(r, "dds.path_ahead.names", "the pose schedule's joints by the names the robot program publishes", c.names);
+  if (auto v = r.number("hold_s", {"s", 0.1, 3600.0}, c.hold_s)) c.hold_s = *v;
+  r.finish();
+  return c;
+}
+
 std::optional<JointStatesConfig> read_joint_states(MapReader& dds) {
   const YAML::Node node = dds.child("joint_states", false, "");
   if (!present(node)) return std::nullopt;
   MapReader r(dds.diagnostics(), node, "dds.joint_states", dds.mark());
   JointStatesConfig c;
   if (auto v = r.text("topic", c.topic)) c.topic = *v;
-  const YAML::Node names = r.child("names", true, "the pose schedule's joints by the names the robot's driver publishes");
-  if (present(names) && !names.IsSequence())
-    r.diagnostics().add(to_mark(names.Mark()), "dds.joint_states.names", "must be a list of joint names, e.g. [joint_1, joint_2]");
-  else if (present(names))
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      const std::string key = "dds.joint_states.names[" + std::to_string(i) + "]";
-      const std::string name = names[i].IsScalar() ? names[i].as<std::string>() : "";
-      if (name.empty()) r.diagnostics().add(to_mark(names[i].Mark()), key, "must be a joint's name (text)");
-      else if (std::find(c.names.begin(), c.names.end(), name) != c.names.end())
-        r.diagnostics().add(to_mark(names[i].Mark()), key, "= '" + name + "' is named twice: each joint once");
-      if (!name.empty()) c.names.push_back(name);  // kept, so the count is the file's
-    }
+  (void)r.child("names", true, "the pose schedule's joints by the names the robot's driver publishes");
+  read_joint_names(r, "dds.joint_states.names", "", c.names);
   if (auto v = r.number("timeout_s", {"s", 0.01, 60.0}, c.timeout_s)) c.timeout_s = *v;
   if (auto v = read_int(r, "settle_samples", {"(messages)", 1, 1000}, c.settle_samples)) c.settle_samples = *v;
   r.finish();
@@ -231,6 +249,7 @@ std::optional<DdsConfig> read_dds(MapReader& top) {
   if (auto v = read_bool(r, "parameter_writes", c.parameter_writes)) c.parameter_writes = *v;
   c.security = read_dds_security(r, top.diagnostics().file());
   c.joint_states = read_joint_states(r);
+  c.path_ahead = read_path_ahead(r);
   r.finish();
   return c;
 }

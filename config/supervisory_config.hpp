@@ -106,6 +106,15 @@ struct JointStatesConfig {
   int settle_samples{3};                 // a region counts once this many messages in a row fall in it
 };
 
+// The robot program's next poses over DDS (docs/pose_dynamics.md, "Advice along the path ahead"): ROS 2's
+// trajectory_msgs/msg/JointTrajectory as a program sends it to its joint trajectory controller (positions in
+// radians, each point's time_from_start); the speed advisor checks its candidates at those poses too.
+struct PathAheadConfig {
+  std::string topic{"rt/joint_trajectory"};  // DDS name: ROS 2's /joint_trajectory
+  std::vector<std::string> names;  // pose_schedule's joints as the program names them (empty: dds.joint_states.names)
+  double hold_s{10.0};             // an untimed point (time_from_start 0) stays ahead this long after the message
+};
+
 struct DdsConfig {
   int domain_id{0};
   DdsTransport transport{DdsTransport::kDefault};
@@ -114,6 +123,7 @@ struct DdsConfig {
   bool parameter_writes{false};    // parameter requests are refused unless this is on
   std::optional<DdsSecurityConfig> security;  // absent: no authentication (a closed cell network)
   std::optional<JointStatesConfig> joint_states;  // absent: the pose comes from Modbus, or not at all
+  std::optional<PathAheadConfig> path_ahead;      // absent: the advice looks at the pose now only
 };
 
 // The cell's identity on the network (docs/dashboard.md): every DDS topic carries it, a dashboard tells

@@ -66,7 +66,7 @@ json to_json(const msg::Advice& a) {
           {"advised_rpm", a.advised_rpm()}, {"advised_limit_mm", finite(a.advised_limit_mm())}, {"margin", finite(a.margin())},
           {"options", options}, {"best_rpm", a.best_rpm()}, {"best_limit_mm", finite(a.best_limit_mm())},
           {"reason", a.reason()}, {"rpm_min", a.rpm_min()}, {"rpm_max", a.rpm_max()}, {"pose_deg", a.pose_deg()},
-          {"status", a.status()}, {"status_reason", a.status_reason()}};
+          {"poses_ahead", a.poses_ahead()}, {"limiting_pose_deg", a.limiting_pose_deg()}, {"status", a.status()}, {"status_reason", a.status_reason()}};
 }
 
 json to_json(const msg::Spectrum& s) {

@@ -76,6 +76,27 @@ class Bridge::JointStateListener : public DataReaderListener {
   Bridge& b_;
 };
 
+// dds.path_ahead: each valid trajectory's joint names and points to the cell (a robot program's next poses).
+class Bridge::TrajectoryListener : public DataReaderListener {
+ public:
+  explicit TrajectoryListener(Bridge& b) : b_(b) {}
+  void on_data_available(DataReader* reader) override {
+    msg::JointTrajectory t;
+    SampleInfo info;
+    while (reader->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      std::vector<TrajectoryPoint> points;
+      points.reserve(t.points().size());
+      for (const msg::JointTrajectoryPoint& p : t.points())
+        points.push_back({p.positions(), p.time_from_start().sec() + 1e-9 * p.time_from_start().nanosec()});
+      b_.src_.trajectory(t.joint_names(), points);
+    }
+  }
+
+ private:
+  Bridge& b_;
+};
+
 Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources)
     : cfg_(cfg), source_(config_source), src_(std::move(sources)), availability_(loop_rate_hz, src_.gain_ramp_s) {
   window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
@@ -266,6 +287,8 @@ void Bridge::publish_advice() {
   out.rpm_min(a->rpm_min);
   out.rpm_max(a->rpm_max);
   out.pose_deg(first16(a->pose_deg));
+  out.poses_ahead(a->poses_ahead);
+  out.limiting_pose_deg(first16(a->limiting_pose_deg));
   out.status(a->status);
   out.status_reason(a->status_reason);
   if (advice_writer_->write(&out)) {
@@ -324,6 +347,10 @@ void Bridge::start() {
   if (cfg_.joint_states && src_.joint_state && !joint_state_listener_) {
     joint_state_listener_ = std::make_unique<JointStateListener>(*this);
     participant_->joint_state_reader(cfg_.joint_states->topic, joint_state_listener_.get());
+  }
+  if (cfg_.path_ahead && src_.trajectory && !trajectory_listener_) {
+    trajectory_listener_ = std::make_unique<TrajectoryListener>(*this);
+    participant_->trajectory_reader(cfg_.path_ahead->topic, trajectory_listener_.get());
   }
   status_thread_ = std::thread([this] {
     const auto period = std::chrono::duration<double>(1.0 / cfg_.status_rate_hz);

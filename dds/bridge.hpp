@@ -67,6 +67,12 @@ inline constexpr std::uint8_t kCuttingUnknown = 0, kCutting = 1, kNotCutting = 2
   return c == kCutting ? "cutting" : c == kNotCutting ? "not cutting" : "not known yet";
 }
 
+// One point of a robot program's trajectory (dds.path_ahead), as the message carries it.
+struct TrajectoryPoint {
+  std::vector<double> position_rad;
+  double time_from_start_s{0.0};
+};
+
 // What the Advice_ topic carries (dds/robodamp.idl), filled from the cell's speed advisor.
 struct AdviceSample {
   std::uint64_t seq{0};
@@ -83,6 +89,8 @@ struct AdviceSample {
   std::string reason;
   double rpm_min{0.0}, rpm_max{0.0};
   std::vector<double> pose_deg;  // the pose the candidates were checked at (empty: none)
+  std::uint32_t poses_ahead{0};  // ... and this many poses of the path ahead
+  std::vector<double> limiting_pose_deg;  // where the advised (else the best) speed's limit is lowest
   std::string status{"current"};  // "current", "followed" or "expired" (runtime::AdviceStatus)
   std::string status_reason;
 };
@@ -126,6 +134,8 @@ struct BridgeSources {
   // on the status thread. Empty: no joint-state reader.
   std::function<void(const std::vector<std::string>&, const std::vector<double>&)> joint_state{};
   std::function<void()> joint_state_check{};
+  // dds.path_ahead: each trajectory's joint names and points, on the reader's thread. Empty: no reader.
+  std::function<void(const std::vector<std::string>&, const std::vector<TrajectoryPoint>&)> trajectory{};
 };
 
 struct BridgeCounters {
@@ -150,6 +160,7 @@ class Bridge {
  private:
   class RequestListener;
   class JointStateListener;
+  class TrajectoryListener;
   void publish_status();
   void publish_machining();
   void publish_advice();  // a new advice (its seq), and each change of its status, once
@@ -173,6 +184,7 @@ class Bridge {
   std::string published_advice_status_;
   std::unique_ptr<RequestListener> listener_;
   std::unique_ptr<JointStateListener> joint_state_listener_;
+  std::unique_ptr<TrajectoryListener> trajectory_listener_;
   rt::AvailabilityMeter availability_;  // under m_
 
   // Decimation window (drain thread).

@@ -38,4 +38,8 @@ namespace robodamp::msg {
 // ROS 2's sensor_msgs/msg/JointState (dds.joint_states).
 using JointState = ::sensor_msgs::msg::dds_::JointState_;
 using JointStatePubSubType = ::sensor_msgs::msg::dds_::JointState_PubSubType;
+// ROS 2's trajectory_msgs/msg/JointTrajectory (dds.path_ahead).
+using JointTrajectory = ::trajectory_msgs::msg::dds_::JointTrajectory_;
+using JointTrajectoryPoint = ::trajectory_msgs::msg::dds_::JointTrajectoryPoint_;
+using JointTrajectoryPubSubType = ::trajectory_msgs::msg::dds_::JointTrajectory_PubSubType;
 }  // namespace robodamp::msg

@@ -169,4 +169,41 @@ DataWriter* Participant::joint_state_writer(const std::string& topic_name) {
   return w;
 }
 
+Topic* Participant::trajectory_topic(const std::string& topic_name) {
+  if (trajectories_ != nullptr) {
+    if (trajectories_->get_name() != topic_name)
+      throw std::runtime_error("DDS: trajectories on " + topic_name + " and " + trajectories_->get_name() + ": one topic");
+    return trajectories_;
+  }
+  TypeSupport type(new msg::JointTrajectoryPubSubType());
+  type.register_type(participant_);
+  trajectories_ = participant_->create_topic(topic_name, type.get_type_name(), TOPIC_QOS_DEFAULT);
+  if (trajectories_ == nullptr) throw std::runtime_error("DDS: cannot create topic " + topic_name);
+  return trajectories_;
+}
+
+DataReader* Participant::trajectory_reader(const std::string& topic_name, DataReaderListener* listener) {
+  DataReaderQos q = DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;  // matches a reliable writer and a best-effort one
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 4;
+  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+  DataReader* r = subscriber_->create_datareader(trajectory_topic(topic_name), q, listener);
+  if (r == nullptr) throw std::runtime_error("DDS: cannot create a reader on " + topic_name);
+  return r;
+}
+
+DataWriter* Participant::trajectory_writer(const std::string& topic_name) {
+  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 10;
+  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+  DataWriter* w = publisher_->create_datawriter(trajectory_topic(topic_name), q);
+  if (w == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic_name);
+  return w;
+}
+
 }  // namespace robodamp::dds

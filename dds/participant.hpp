@@ -63,6 +63,11 @@ class Participant {
   eprosima::fastdds::dds::DataReader* joint_state_reader(const std::string& topic_name,
                                                          eprosima::fastdds::dds::DataReaderListener* listener);
   eprosima::fastdds::dds::DataWriter* joint_state_writer(const std::string& topic_name);
+  // ROS 2's trajectory_msgs/msg/JointTrajectory on topic_name (dds.path_ahead.topic): a reader that takes any
+  // program's writer (best effort, volatile, the last 4), and a writer as a ROS 2 program has one (tests).
+  eprosima::fastdds::dds::DataReader* trajectory_reader(const std::string& topic_name,
+                                                        eprosima::fastdds::dds::DataReaderListener* listener);
+  eprosima::fastdds::dds::DataWriter* trajectory_writer(const std::string& topic_name);
 
   [[nodiscard]] int domain_id() const { return domain_id_; }
   // The topic (its DDS name and type name: ROS 2's, see above).
@@ -77,6 +82,8 @@ class Participant {
   eprosima::fastdds::dds::Topic* topics_[kTopicCount]{};
   eprosima::fastdds::dds::Topic* joint_state_topic(const std::string& topic_name);
   eprosima::fastdds::dds::Topic* joint_states_{nullptr};  // created on first use
+  eprosima::fastdds::dds::Topic* trajectory_topic(const std::string& topic_name);
+  eprosima::fastdds::dds::Topic* trajectories_{nullptr};  // created on first use
 };
 
 }  // namespace robodamp::dds

@@ -7,6 +7,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "config/pose_schedule_config.hpp"
+
 namespace robodamp::milling {
 
 namespace {
@@ -35,7 +37,49 @@ std::vector<double> mode_frequencies(const config::StructureConfig& s, const con
   return out;
 }
 
+// A candidate's limit at every pose checked (the pose now first): the lowest, with its pose; not valid when
+// the damped loop is unstable at any of them.
+struct AlongPath {
+  LiveLimits at_lowest;
+  double limit_mm{0.0};
+  std::vector<double> pose_deg;
+  bool valid{true};
+};
+
+AlongPath limit_along(LiveStability& stability, const SpeedAdviceRequest& request, const std::vector<std::vector<double>>& poses,
+                      double rpm) {
+  AlongPath out;
+  bool first = true;
+  const auto now = request.controller_at ? request.controller_at(rpm) : std::pair{request.set, request.gain_ns_per_m};
+  for (std::size_t i = 0; i < std::max<std::size_t>(poses.size(), 1); ++i) {
+    const std::vector<double> pose = poses.empty() ? std::vector<double>{} : poses[i];
+    const auto [set, gain] = i > 0 && request.controller_at_pose ? request.controller_at_pose(pose, rpm) : now;
+    const LiveLimits l = stability.compute(rpm, set, gain, pose);
+    if (request.damped && !l.damped_valid) {
+      out.valid = false;
+      out.at_lowest = l, out.pose_deg = pose;
+      return out;
+    }
+    const double limit = request.damped ? l.damped_mm : l.open_mm;
+    if (first || limit < out.limit_mm) out.at_lowest = l, out.limit_mm = limit, out.pose_deg = pose;
+    first = false;
+  }
+  return out;
+}
+
 }  // namespace
+
+std::vector<std::vector<double>> thin_path(const std::vector<std::vector<double>>& path, std::size_t count) {
+  if (path.size() <= count) return path;
+  std::vector<std::vector<double>> out;
+  if (count == 0) return out;
+  // Poses (size - 1) j / (count - 1), j = 0 .. count - 1: evenly along it, its first and last among them.
+  for (std::size_t j = 0; j < count; ++j) {
+    const std::size_t i = count == 1 ? path.size() - 1 : (path.size() - 1) * j / (count - 1);
+    if (out.empty() || out.back() != path[i]) out.push_back(path[i]);
+  }
+  return out;
+}
 
 std::vector<SpeedCandidate> advice_candidates(double rpm_min, double rpm_max, int teeth, double chatter_hz,
                                               const std::vector<double>& mode_hz, std::size_t grid_points) {
@@ -92,23 +136,31 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   if (request.chatter_hz > 0.0 && a.limit_now_mm > request.depth_mm) a.depth_mm = a.limit_now_mm, a.depth_from_chatter = true;
   const double margin = a.depth_from_chatter ? s.chatter_depth_margin : s.depth_margin;
   const int teeth = stability.job().tool.teeth;
+  if (!request.pose_deg.empty()) {
+    a.poses_checked.push_back(request.pose_deg);
+    for (auto& p : thin_path(request.path_ahead_deg, s.max_path_poses))
+      if (p != request.pose_deg) a.poses_checked.push_back(std::move(p));
+  }
+  // The pockets of the modes at every pose checked.
+  std::vector<double> modes;
+  for (std::size_t i = 0; i < std::max<std::size_t>(a.poses_checked.size(), 1); ++i) {
+    const std::vector<double> pose = a.poses_checked.empty() ? std::vector<double>{} : a.poses_checked[i];
+    for (const double f : mode_frequencies(stability.structure(), stability.loop_config(request.set, pose)))
+      if (std::none_of(modes.begin(), modes.end(), [&](double g) { return std::abs(g - f) < 0.005; })) modes.push_back(f);
+  }
   std::vector<SpeedOption> qualified;
   a.best.margin = -1.0;
-  for (const SpeedCandidate& c : advice_candidates(rpm_min, rpm_max, teeth, request.chatter_hz,
-                                                   mode_frequencies(stability.structure(),
-                                                                    stability.loop_config(request.set, request.pose_deg)),
-                                                   s.grid_points)) {
+  for (const SpeedCandidate& c : advice_candidates(rpm_min, rpm_max, teeth, request.chatter_hz, modes, s.grid_points)) {
     if (s.cancelled && s.cancelled()) {
       a.reason = "cancelled after " + std::to_string(a.evaluated) + " speeds";
       return a;
     }
-    const auto [set, gain] = request.controller_at ? request.controller_at(c.rpm) : std::pair{request.set, request.gain_ns_per_m};
-    const LiveLimits l = stability.compute(c.rpm, set, gain, request.pose_deg);
+    const AlongPath l = limit_along(stability, request, a.poses_checked, c.rpm);
     ++a.evaluated;
-    if (request.damped && !l.damped_valid) continue;  // the loop itself unstable there
-    const double limit = limit_of(l);
+    if (!l.valid) continue;  // the loop itself unstable there (at a pose checked)
     // The damped verdict is for the speed the sampled loop steps (whole loop periods per tooth period).
-    const SpeedOption o{request.damped ? l.analysed_rpm : l.rpm, limit, limit / a.depth_mm, c.source};
+    const SpeedOption o{request.damped ? l.at_lowest.analysed_rpm : l.at_lowest.rpm, l.limit_mm, l.limit_mm / a.depth_mm,
+                        c.source, l.pose_deg};
     if (o.margin > a.best.margin) a.best = o;
     if (o.margin >= margin && std::abs(o.rpm - request.rpm) > 0.5) qualified.push_back(o);
   }
@@ -123,7 +175,9 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
                number(a.depth_mm, "%.3f") + " mm" + (a.depth_from_chatter ? " (the limit where it chatters)" : "") + " with " + number(100.0 * (margin - 1.0), "%.0f") +
                " % margin (" + std::to_string(a.evaluated) + " speeds analysed; the best, " +
                number(a.best.rpm, "%.0f") + " rpm, allows " + number(a.best.limit_mm, "%.3f") +
-               " mm): reduce the depth";
+               " mm" + (a.poses_checked.size() > 1 ? " at " + config::describe_pose(a.best.limiting_pose_deg) : std::string()) +
+               "): reduce the depth" + (a.poses_checked.size() > 1 ? " (checked at the pose now and " + std::to_string(a.poses_checked.size() - 1) +
+                                                                         " of the path ahead)" : std::string());
   a.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return a;
 }

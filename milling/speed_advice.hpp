@@ -26,6 +26,7 @@ struct SpeedAdviceSettings {
   double chatter_depth_margin{1.3};
   std::size_t grid_points{48};  // uniform candidates over the range, beside the pockets
   std::size_t max_options{3};
+  std::size_t max_path_poses{6};  // of the path ahead: at most this many poses, evenly along it
   std::function<bool()> cancelled;  // checked between candidates (the cell is shutting down): stop there
 };
 
@@ -41,6 +42,11 @@ struct SpeedAdviceRequest {
   double chatter_hz{0.0};       // measured (the chatter indicator's strongest line); 0: none measured
   std::string trigger;          // "chatter", or "depth above the limit"
   std::vector<double> pose_deg; // the robot's joints (a pose-scheduled cell): every candidate checked at that pose
+  // The next part of the path, as the robot program publishes it (dds.path_ahead): every candidate is also
+  // checked at these poses, with the set and K that would run at each (controller_at_pose; empty: the
+  // current set and K), and its limit is the lowest met. Only with a pose.
+  std::vector<std::vector<double>> path_ahead_deg;
+  std::function<std::pair<std::size_t, double>(const std::vector<double>& pose_deg, double rpm)> controller_at_pose{};
 };
 
 struct SpeedCandidate {
@@ -50,9 +56,10 @@ struct SpeedCandidate {
 
 struct SpeedOption {
   double rpm{0.0};              // the speed analysed (the damped loop: whole loop periods per tooth period)
-  double limit_mm{0.0};         // the accurate limit there (damped or open, as the request)
+  double limit_mm{0.0};         // the accurate limit there (damped or open, as the request); along a path, the lowest
   double margin{0.0};           // limit / depth
   std::string source;
+  std::vector<double> limiting_pose_deg;  // where the limit is lowest (the pose now, or one ahead); empty: no pose
 };
 
 struct SpeedAdvice {
@@ -70,6 +77,9 @@ struct SpeedAdvice {
   SpeedOption best;             // the candidate with the largest margin (also when none qualifies)
   std::string reason;           // not found: why, with the numbers
   std::size_t evaluated{0};     // candidate speeds analysed
+  // The poses each candidate was checked at: the pose now, then those of the path ahead (at most
+  // max_path_poses of the request's); empty without a pose.
+  std::vector<std::vector<double>> poses_checked;
   double compute_s{0.0};        // wall time it took
 };
 
@@ -78,6 +88,9 @@ struct SpeedAdvice {
 [[nodiscard]] std::vector<SpeedCandidate> advice_candidates(double rpm_min, double rpm_max, int teeth, double chatter_hz,
                                                             const std::vector<double>& mode_hz,
                                                             std::size_t grid_points);
+
+// At most `count` of the path's poses, evenly along it, its first and last among them.
+[[nodiscard]] std::vector<std::vector<double>> thin_path(const std::vector<std::vector<double>>& path, std::size_t count);
 
 // The allowed range: the job's lobes range within the spindle's maximum. Throws std::invalid_argument
 // (value, unit, range) for a request that cannot be answered (a speed or depth not finite or not positive).

@@ -135,6 +135,8 @@ Status Cell::compose_devices() {
       in.pose = milling::PoseDynamics{cfg_.pose_schedule->model_resolved, pose_schedule_.model, cfg_.pose_schedule->axis,
                                       cfg_.pose_schedule->modes};
       in.pose_deg = [this] { return robot_pose_deg(); };
+      in.schedule = *cfg_.pose_schedule;
+      if (path_ahead_) in.path_ahead_deg = [this] { return path_ahead_->poses_deg(); };
     }
     machining_ = std::make_unique<MachiningMonitor>(cfg_, set_configs_, std::move(in));
   } catch (const std::exception& e) {  // ConfigError, or a job file that does not parse
@@ -179,6 +181,10 @@ Status Cell::configure_devices() {
   };
   if (cfg_.dds && cfg_.dds->joint_states && cfg_.pose_schedule && read_joints)
     joint_pose_ = std::make_unique<JointStatePose>(*cfg_.dds->joint_states, *cfg_.pose_schedule, on_region);
+  if (cfg_.dds && cfg_.dds->path_ahead && cfg_.pose_schedule && !cfg_.spindle.job.empty()) {
+    const config::PathAheadConfig& p = *cfg_.dds->path_ahead;
+    path_ahead_ = std::make_unique<PathAhead>(p, !p.names.empty() || !cfg_.dds->joint_states ? p.names : cfg_.dds->joint_states->names);
+  }
   if (cfg_.dds) {
     dds_ = std::make_unique<DdsEndpoint>(
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
@@ -386,6 +392,7 @@ void Cell::finish_summary() {
   if (dds_) s.dds = dds_->bridge().counters();
   if (modbus_) s.modbus = modbus_->client().counters();
   if (joint_pose_) s.joint_states = joint_pose_->counters();
+  if (path_ahead_) s.path_ahead = path_ahead_->counters();
   if (can_) s.can = can_->driver().counters();
   if (recorder_) {
     recorder_->close();
@@ -439,6 +446,7 @@ void Cell::release() {
   // The DDS endpoint before the loop: its listeners (a parameter request, a joint state) post to the loop.
   dds_.reset();
   joint_pose_.reset();
+  path_ahead_.reset();
   loop_.reset();
   arming_.reset();
   ring_.reset();

@@ -39,6 +39,7 @@
 #include "runtime/components.hpp"
 #include "runtime/lifecycle.hpp"
 #include "runtime/joint_state_pose.hpp"
+#include "runtime/path_ahead.hpp"
 #include "runtime/machining_monitor.hpp"
 #include "runtime/spectrum_monitor.hpp"
 #include "runtime/run_summary.hpp"
@@ -153,6 +154,7 @@ class Cell {
   std::unique_ptr<CanBus> can_;
   std::unique_ptr<ModbusComponent> modbus_;
   std::unique_ptr<JointStatePose> joint_pose_;  // dds.joint_states: the pose from a ROS 2 driver (outlives dds_)
+  std::unique_ptr<PathAhead> path_ahead_;       // dds.path_ahead: the robot program's next poses (outlives dds_)
   std::unique_ptr<DdsEndpoint> dds_;
   std::vector<std::pair<config::Mounting, std::size_t>> mounting_sets_;
   std::string backend_name_;

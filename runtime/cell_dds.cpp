@@ -28,7 +28,12 @@ dds::BridgeSources Cell::bridge_sources() {
                                                joint_pose_->on_message(n, q);
                                              })
                                        : nullptr,
-                           joint_pose_ ? std::function<void()>([this] { joint_pose_->check(); }) : nullptr};
+                           joint_pose_ ? std::function<void()>([this] { joint_pose_->check(); }) : nullptr,
+                           path_ahead_ ? std::function<void(const std::vector<std::string>&, const std::vector<dds::TrajectoryPoint>&)>(
+                                             [this](const std::vector<std::string>& n, const std::vector<dds::TrajectoryPoint>& p) {
+                                               path_ahead_->on_message(n, p);
+                                             })
+                                       : nullptr};
 }
 
 }  // namespace robodamp::runtime

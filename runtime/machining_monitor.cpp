@@ -32,7 +32,8 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 
 MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, MachiningInputs in)
     : teeth_(cfg.spindle.teeth), active_set_(std::move(in.active_set)), robot_depth_mm_(std::move(in.robot_depth_mm)),
-      pose_deg_(std::move(in.pose_deg)), chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
+      pose_deg_(std::move(in.pose_deg)), path_ahead_deg_(std::move(in.path_ahead_deg)), schedule_(std::move(in.schedule)),
+      chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
   set_configs_ = sets;
   config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
   if (job.tool.teeth != cfg.spindle.teeth)
@@ -193,6 +194,17 @@ AdviceView MachiningMonitor::view() {
       if (at >= sets->size()) at = 0;
       return std::pair{at, config::scheduled_gain_ns_per_m((*sets)[at], at, rpm)};
     };
+  if (path_ahead_deg_ && !s.limits_pose_deg.empty()) {
+    v.path_ahead_deg = path_ahead_deg_();
+    // A pose ahead: the region that holds it (the current one while it does: the hand-over's hysteresis), its
+    // set and K; outside every region, region 0's, as the schedule runs there.
+    if (schedule_)
+      v.controller_at_pose = [sets = &set_configs_, schedule = &*schedule_, set = set](const std::vector<double>& pose, double) {
+        std::size_t at = config::region_of(*schedule, pose.data(), pose.size(), set).value_or(0);
+        if (at >= sets->size()) at = 0;
+        return std::pair{at, (*sets)[at].controller.gain_ns_per_m};
+      };
+  }
   return v;
 }
 

@@ -42,6 +42,10 @@ struct MachiningInputs {
   // the limits, the live lobes and the advice are then for the robot at that pose (milling::PoseDynamics).
   std::function<std::vector<double>()> pose_deg;
   std::optional<milling::PoseDynamics> pose;
+  // The robot program's next poses (dds.path_ahead; empty: none published): the advice checks its
+  // candidates there too, with the region's set and K the pose schedule (`schedule`) would run at each.
+  std::function<std::vector<std::vector<double>>()> path_ahead_deg;
+  std::optional<config::PoseScheduleConfig> schedule;
 };
 
 class MachiningMonitor {
@@ -85,6 +89,8 @@ class MachiningMonitor {
   std::function<std::size_t()> active_set_;
   std::function<double()> robot_depth_mm_;
   std::function<std::vector<double>()> pose_deg_;
+  std::function<std::vector<std::vector<double>>()> path_ahead_deg_;
+  std::optional<config::PoseScheduleConfig> schedule_;
   std::unique_ptr<milling::LiveStability> stability_;
   mutable std::mutex m_;
   std::vector<milling::LiveLimitsRecord> trail_;  // guarded by m_

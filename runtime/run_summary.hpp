@@ -11,6 +11,7 @@
 #include "drivers/can_driver.hpp"
 #include "drivers/modbus_client.hpp"
 #include "runtime/joint_state_pose.hpp"
+#include "runtime/path_ahead.hpp"
 #include "rt/loop.hpp"
 #include "rt/realtime.hpp"
 #include "rt/supervisor.hpp"
@@ -62,6 +63,7 @@ struct RunSummary {
   std::optional<drivers::ModbusCounters> modbus;
   std::optional<dds::BridgeCounters> dds;
   std::optional<JointStateCounters> joint_states;  // dds.joint_states
+  std::optional<PathAheadCounters> path_ahead;     // dds.path_ahead
   TripTiming trip_timing;
   rt::Availability availability;  // the share of the asked time at full gain; every trip's safe and re-arm times
   std::string record_path;

@@ -14,7 +14,7 @@ namespace {
 // The state an advice is for: the same one is not advised twice in a row.
 auto state_key(const milling::SpeedAdviceRequest& r) {
   return std::make_tuple(std::lround(r.rpm), std::lround(r.depth_mm * 1e3), r.set, std::lround(r.gain_ns_per_m / 10.0),
-                         r.damped, r.trigger, r.pose_deg);
+                         r.damped, r.trigger, r.pose_deg, r.path_ahead_deg);
 }
 
 }  // namespace
@@ -53,6 +53,8 @@ dds::AdviceSample to_sample(const AdviceRecord& r) {
   s.rpm_min = a.rpm_min;
   s.rpm_max = a.rpm_max;
   s.pose_deg = a.request.pose_deg;
+  s.poses_ahead = a.poses_checked.empty() ? 0U : static_cast<std::uint32_t>(a.poses_checked.size() - 1);
+  s.limiting_pose_deg = a.found ? a.options.front().limiting_pose_deg : a.best.limiting_pose_deg;
   s.status = to_string(r.status);
   s.status_reason = r.status_reason;
   return s;
@@ -103,6 +105,7 @@ std::optional<milling::SpeedAdviceRequest> SpeedAdvisor::wanted(const AdviceView
   r.controller_at = v.controller_at;
   r.damped = m.loop_active;
   r.pose_deg = m.limits_pose_deg;
+  if (!r.pose_deg.empty()) r.path_ahead_deg = v.path_ahead_deg, r.controller_at_pose = v.controller_at_pose;
   return r;
 }
 

@@ -42,6 +42,10 @@ struct AdviceView {
   std::size_t parameter_set{0};
   double gain_ns_per_m{0.0};   // the gain the damped limit is for
   std::function<std::pair<std::size_t, double>(double rpm)> controller_at{};  // a speed schedule's (empty: none)
+  // The robot program's next poses (dds.path_ahead; empty: none published) and the set and K the pose
+  // schedule would run at each (milling::SpeedAdviceRequest).
+  std::vector<std::vector<double>> path_ahead_deg;
+  std::function<std::pair<std::size_t, double>(const std::vector<double>& pose_deg, double rpm)> controller_at_pose{};
 };
 
 // The record as the DDS advice topic carries it.

@@ -28,7 +28,7 @@ runtime::AdviceRecord advised() {
   milling::SpeedAdviceRequest& q = r.advice.request;
   q.rpm = 700.0, q.depth_mm = 1.0, q.set = 1, q.gain_ns_per_m = 2000.0, q.damped = true, q.trigger = "depth above the limit";
   r.advice.found = true;
-  r.advice.options.push_back({666.7, 1.74, 1.74, "mode"});
+  r.advice.options.push_back({666.7, 1.74, 1.74, "mode", {}});
   return r;
 }
 

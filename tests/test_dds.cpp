@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <sys/wait.h>
@@ -399,7 +400,9 @@ std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& i
       {"unsigned long long", "uint64"}, {"unsigned long", "uint32"}, {"double", "float64"},
       {"float", "float32"},             {"octet", "uint8"},          {"boolean", "bool"},
       {"long", "int32"},                {"std_msgs::msg::dds_::Header_", "std_msgs/Header"},
-      {"builtin_interfaces::msg::dds_::Time_", "builtin_interfaces/Time"}};
+      {"builtin_interfaces::msg::dds_::Time_", "builtin_interfaces/Time"},
+      {"builtin_interfaces::msg::dds_::Duration_", "builtin_interfaces/Duration"},
+      {"trajectory_msgs::msg::dds_::JointTrajectoryPoint_", "trajectory_msgs/JointTrajectoryPoint"}};
   std::vector<std::pair<std::string, std::string>> out;
   for (std::string line; std::getline(body, line);) {
     line = line.substr(0, line.find("//"));
@@ -573,6 +576,95 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   for (std::string line; std::getline(lines, line);)
     if (line.find("joint") != std::string::npos || line.find("loop:") != std::string::npos) std::printf("%s\n", line.c_str());
   std::system(("rm -rf " + dir).c_str());
+}
+
+// The robot program's trajectory (ROS 2's trajectory_msgs/msg/JointTrajectory) as its definition has it, under the
+// type and topic names a ROS 2 program's /joint_trajectory has on DDS.
+TEST(Dds, JointTrajectoryIsRos2sMessageFieldForField) {
+  using Fields = std::vector<std::pair<std::string, std::string>>;
+  const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
+  // trajectory_msgs/msg/JointTrajectory.msg, JointTrajectoryPoint.msg, builtin_interfaces/msg/Duration.msg (ROS 2).
+  EXPECT_EQ(idl_fields(idl, "JointTrajectory"),
+            (Fields{{"std_msgs/Header", "header"}, {"string[]", "joint_names"}, {"trajectory_msgs/JointTrajectoryPoint[]", "points"}}));
+  EXPECT_EQ(idl_fields(idl, "JointTrajectoryPoint"),
+            (Fields{{"float64[]", "positions"}, {"float64[]", "velocities"}, {"float64[]", "accelerations"}, {"float64[]", "effort"},
+                    {"builtin_interfaces/Duration", "time_from_start"}}));
+  EXPECT_EQ(idl_fields(idl, "Duration"), (Fields{{"int32", "sec"}, {"uint32", "nanosec"}}));
+  dds::Participant p(test_domain(8), config::DdsTransport::kUdpLoopback, "trajectory names", std::nullopt);
+  DataWriter* w = p.trajectory_writer("rt/joint_trajectory");
+  EXPECT_EQ(w->get_topic()->get_name(), "rt/joint_trajectory");
+  EXPECT_EQ(w->get_topic()->get_type_name(), "trajectory_msgs::msg::dds_::JointTrajectory_");
+}
+
+// The advice along the path ahead across processes (docs/pose_dynamics.md, "Advice along the path ahead"):
+// `robodamp run` on the pose-scheduled preset with the planar robot's wall cut 0.4 mm deep at 700 rpm (above
+// its limit: the cell asks for advice), the pose from a driver of the test's own (folded) and the robot
+// program's trajectory on to stretched. The cell's advice is checked at the pose and the poses ahead, says so
+// on the Advice topic with the pose where the limit is lowest, and the run summary counts the trajectories.
+TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
+  const int domain = test_domain(9);
+  const std::string dir = ::testing::TempDir() + "robodamp_dds_path_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  std::string job = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_wall_x.yaml");
+  test::replace_or_throw(job, "model: ../robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
+  test::replace_or_throw(job, "axial_mm: 0.1", "axial_mm: 0.4");
+  std::ofstream(dir + "/job.yaml") << job;
+  std::string text = test::read_file(test::preset("pose_scheduled_c2"));
+  test::replace_or_throw(text, "model: ../robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
+  const std::string cell = "path-" + std::to_string(getpid());
+  text += "\ncell:\n  name: " + cell + "\nspindle:\n  teeth: 3\n  job: " + dir + "/job.yaml\ndds:\n  domain_id: " + std::to_string(domain) +
+          "\n  transport: udp_loopback\n  joint_states:\n    names: [shoulder, elbow, wrist]\n  path_ahead: {}\n"
+          "supervision:\n  overrun_cycles: 5000\n";
+  std::ofstream(dir + "/cell.yaml") << text;
+  test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--spindle-rpm", "700", "--json", dir + "/run.json"},
+                  dir + "/run.log");
+  dds::Participant program(domain, config::DdsTransport::kUdpLoopback, "test robot program", std::nullopt);
+  DataWriter* joints = program.joint_state_writer("rt/joint_states");
+  DataWriter* trajectory = program.trajectory_writer("rt/joint_trajectory");
+  Collect<msg::Advice> advice;
+  program.reader(dds::TopicKind::kAdvice, &advice);
+  const double r = M_PI / 180.0;
+  std::atomic<bool> stop{false};
+  std::thread publisher([&] {
+    for (int i = 0; !stop; ++i) {
+      msg::JointState js;
+      js.name({"shoulder", "elbow", "wrist"});
+      js.position({-100 * r, 10 * r, 90 * r});  // folded
+      joints->write(&js);
+      if (i % 25 == 0) {  // the program's next poses, twice a second: on to stretched in 20 and 40 s
+        msg::JointTrajectory t;
+        t.joint_names({"wrist", "elbow", "shoulder"});
+        for (const auto& [elbow, due_s] : {std::pair{10.0, 0}, {56.0, 20}, {100.0, 40}}) {
+          msg::JointTrajectoryPoint p;
+          p.positions({90 * r, elbow * r, -100 * r});
+          p.time_from_start().sec(due_s);
+          t.points().push_back(p);
+        }
+        trajectory->write(&t);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  std::optional<msg::Advice> along;
+  const bool heard = eventually([&] {
+    for (const auto& a : advice.all())
+      if (a.cell() == cell && a.poses_ahead() > 0) along = a;
+    return along.has_value();
+  }, 240.0);
+  stop = true;
+  publisher.join();
+  run.kill(SIGINT);
+  EXPECT_TRUE(run.wait_for(60.0).has_value()) << test::read_file(dir + "/run.log");
+  ASSERT_TRUE(heard) << "no advice checked along the path\n" << test::read_file(dir + "/run.log");
+  EXPECT_EQ(along->pose_deg(), (std::vector<double>{-100.0, 10.0, 90.0}));
+  EXPECT_EQ(along->poses_ahead(), 2U);  // the pose now, repeated first in the trajectory, is checked once
+  EXPECT_EQ(along->limiting_pose_deg().size(), 3U);
+  const auto summary = nlohmann::json::parse(test::read_file(dir + "/run.json"));
+  EXPECT_GT(summary["path_ahead"]["messages"].get<int>(), 0) << summary.dump();
+  EXPECT_EQ(summary["path_ahead"]["refused"].get<int>(), 0) << summary.dump();
+  std::cout << "advice #" << along->seq() << ": " << (along->found() ? "found " + std::to_string(along->advised_rpm()) + " rpm" : along->reason())
+            << "; lowest limit at " << config::describe_pose(along->limiting_pose_deg()) << "\n";
+  std::filesystem::remove_all(dir);
 }
 
 // --- DDS Security ------------------------------------------------------------------------------------------

@@ -166,6 +166,71 @@ TEST(LivePose, TheAdviceChecksEveryCandidateAtThePose) {
   EXPECT_GT(a.evaluated, s.grid_points + candidates.size() - 1);
 }
 
+// Along the path ahead (docs/pose_dynamics.md, "Advice along the path ahead"): the robot folded now, the program
+// taking it to stretched next. Every candidate is checked at both poses and its limit is the lower one, with its
+// pose; a speed that would serve the folded pose alone but not the stretched one ahead is not advised.
+TEST(LivePose, TheAdviceChecksEveryCandidateAlongThePathAhead) {
+  const PoseCell c;
+  milling::LiveStability live(c.job, "", c.sets(), {}, c.dynamics());
+  const double k = c.schedule.regions[0].gain_ns_per_m;
+  milling::SpeedAdviceRequest r;
+  r.rpm = kRpm;
+  r.set = 0;
+  r.gain_ns_per_m = k;
+  r.pose_deg = kFolded;
+  r.damped = false;
+  r.trigger = "depth above the limit";
+  milling::SpeedAdviceSettings s;
+  s.grid_points = 8;
+  const std::vector<double> between{-100.0, 55.0, 90.0};
+  int asked_at = 0;
+  const auto controller_at_pose = [&](const std::vector<double>& pose, double) {
+    ++asked_at;
+    return pose == kStretched ? std::pair<std::size_t, double>{1, c.schedule.regions[1].gain_ns_per_m} : std::pair<std::size_t, double>{0, k};
+  };
+  // A depth some speeds allow along the whole path: the best speed's limit along it, less 20 %.
+  milling::SpeedAdviceRequest probe = r;
+  probe.depth_mm = live.compute(kRpm, 0, k, kFolded).open_mm;
+  probe.path_ahead_deg = {kFolded, between, kStretched};
+  probe.controller_at_pose = controller_at_pose;
+  r.depth_mm = milling::advise_speed(live, probe, 100.0, 1500.0, s).best.limit_mm / (1.2 * s.depth_margin);
+  const milling::SpeedAdvice here = milling::advise_speed(live, r, 100.0, 1500.0, s);
+  r.path_ahead_deg = {kFolded, between, kStretched};  // the pose now, repeated by the program, is checked once
+  r.controller_at_pose = controller_at_pose;
+  asked_at = 0;
+  const milling::SpeedAdvice along = milling::advise_speed(live, r, 100.0, 1500.0, s);
+  ASSERT_TRUE(along.found) << along.reason;
+  ASSERT_EQ(along.poses_checked.size(), 3U);
+  EXPECT_EQ(along.poses_checked[0], kFolded);
+  EXPECT_EQ(along.poses_checked[2], kStretched);
+  EXPECT_EQ(asked_at, 2 * static_cast<int>(along.evaluated));
+  EXPECT_EQ(along.limit_now_mm, here.limit_now_mm);
+  const double k1 = c.schedule.regions[1].gain_ns_per_m;
+  auto open_at = [&](double rpm, const std::vector<double>& pose) {
+    return pose == kStretched ? live.compute(rpm, 1, k1, pose).open_mm : live.compute(rpm, 0, k, pose).open_mm;
+  };
+  for (const auto& o : along.options) {
+    const double lowest = std::min({open_at(o.rpm, kFolded), open_at(o.rpm, between), open_at(o.rpm, kStretched)});
+    EXPECT_DOUBLE_EQ(o.limit_mm, lowest) << o.rpm << " rpm";
+    EXPECT_DOUBLE_EQ(open_at(o.rpm, o.limiting_pose_deg), lowest) << o.rpm << " rpm";
+    EXPECT_GE(open_at(o.rpm, kStretched), s.depth_margin * along.depth_mm) << o.rpm << " rpm: not stable ahead";
+  }
+  // At the folded pose alone some advised speeds would not hold at the stretched pose ahead.
+  int fail_ahead = 0;
+  for (const auto& o : here.options) fail_ahead += open_at(o.rpm, kStretched) < s.depth_margin * here.depth_mm ? 1 : 0;
+  std::cout << "folded alone: " << here.options.size() << " options, " << fail_ahead << " not stable at the stretched pose ahead; "
+            << "along the path: " << along.options.size() << " options" << (along.found ? "" : ": " + along.reason) << "\n";
+  EXPECT_GT(fail_ahead, 0);
+  // Thinned evenly, first and last kept.
+  std::vector<std::vector<double>> ten;
+  for (int i = 0; i < 10; ++i) ten.push_back({static_cast<double>(i)});
+  const auto six = milling::thin_path(ten, 6);
+  ASSERT_EQ(six.size(), 6U);
+  EXPECT_EQ(six.front(), ten.front());
+  EXPECT_EQ(six.back(), ten.back());
+  EXPECT_EQ(milling::thin_path(ten, 12).size(), 10U);
+}
+
 // The loop across the plane (sampled_paths with two locations, the cutter frame from both machine axes) is
 // the 1-D loop beside an open table where the two directions do not couple: the plane's table without its
 // cross term H21, against the loop along x with H22 as a modal table along y. Open and damped, by the

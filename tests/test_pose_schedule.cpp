@@ -160,6 +160,21 @@ TEST(PoseScheduleConfig, JointStatesNameEachJointOnceAndAreTheOnlySourceOfThePos
   }
   const std::string no_schedule = test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  joint_states: {names: [a1]}\n";
   EXPECT_NE(error_of(no_schedule).find("dds.joint_states: is set without pose_schedule"), std::string::npos) << error_of(no_schedule);
+  // dds.path_ahead: the robot program's trajectory, its names its own or the joint states'.
+  const config::Config ahead = config::parse_config(base + "\ndds:\n  path_ahead:\n    names: [a1, a2, a3]\n    hold_s: 4\n", path);
+  ASSERT_TRUE(ahead.dds && ahead.dds->path_ahead);
+  EXPECT_EQ(ahead.dds->path_ahead->topic, "rt/joint_trajectory");
+  EXPECT_EQ(ahead.dds->path_ahead->hold_s, 4.0);
+  EXPECT_NO_THROW((void)config::parse_config(base + "\ndds:\n  joint_states: {names: [a1, a2, a3]}\n  path_ahead: {}\n", path));
+  EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {}\n").find("dds.path_ahead: needs names"), std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2]}\n")
+                .find("dds.path_ahead.names: has 2 names; pose_schedule has 3 joints"), std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2, a3], hold_s: 0}\n").find("dds.path_ahead.hold_s"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2, a2]}\n").find("dds.path_ahead.names[2] = 'a2' is named twice"),
+            std::string::npos);
+  const std::string no_schedule_path = test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  path_ahead: {names: [a1]}\n";
+  EXPECT_NE(error_of(no_schedule_path).find("dds.path_ahead: is set without pose_schedule"), std::string::npos);
 }
 
 // The robot model's modes as the loop's modal table: the modal-stiffness form with damping from each

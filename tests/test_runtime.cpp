@@ -17,6 +17,7 @@
 #include "rt/availability.hpp"
 #include "runtime/lifecycle.hpp"
 #include "runtime/parameter_requests.hpp"
+#include "runtime/path_ahead.hpp"
 #include "test_util.hpp"
 
 namespace robodamp::runtime {
@@ -51,6 +52,49 @@ class FakeDevice final : public Component {
     return {};
   }
 };
+
+// The robot program's trajectory (dds.path_ahead): the schedule's joints found by name in any order and turned to
+// degrees; a timed point ahead until it is due, an untimed one for hold_s; a trajectory that lacks a joint, or
+// has a point of the wrong length or not finite, refused whole (the last path kept).
+TEST(PathAhead, TheProgramsNextPosesByNameUntilTheyAreDue) {
+  config::PathAheadConfig cfg;
+  cfg.hold_s = 3.0;
+  PathAhead ahead(cfg, {"shoulder", "elbow", "wrist"});
+  const auto t0 = PathAhead::Clock::now();
+  const auto at = [&](double s) { return t0 + std::chrono::duration_cast<PathAhead::Clock::duration>(std::chrono::duration<double>(s)); };
+  const double r = M_PI / 180.0;
+  const std::vector<std::string> names{"wrist", "gripper", "elbow", "shoulder"};
+  ahead.on_message(names, {{{90 * r, 0.0, 20 * r, -100 * r}, 1.0}, {{91 * r, 0.0, 60 * r, -100 * r}, 2.5}, {{92 * r, 0.0, 100 * r, -100 * r}, 0.0}},
+                   t0);
+  auto near = [](const std::vector<double>& a, const std::vector<double>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (std::abs(a[i] - b[i]) > 1e-9) return false;
+    return true;
+  };
+  auto poses = ahead.poses_deg(at(0.5));
+  ASSERT_EQ(poses.size(), 3U);
+  EXPECT_TRUE(near(poses[0], {-100.0, 20.0, 90.0}));
+  EXPECT_TRUE(near(poses[2], {-100.0, 100.0, 92.0}));
+  poses = ahead.poses_deg(at(1.5));  // the first is due
+  ASSERT_EQ(poses.size(), 2U);
+  EXPECT_TRUE(near(poses[0], {-100.0, 60.0, 91.0}));
+  EXPECT_EQ(ahead.poses_deg(at(2.8)).size(), 1U);  // the untimed one, held for 3 s
+  EXPECT_TRUE(ahead.poses_deg(at(3.2)).empty());
+  // Refused whole, the last path kept: no elbow; a short point; a position not finite.
+  ahead.on_message({"wrist", "shoulder"}, {{{0.0, 0.0}, 1.0}}, t0);
+  ahead.on_message(names, {{{0.0, 0.0, 0.0}, 1.0}}, t0);
+  ahead.on_message(names, {{{0.0, 0.0, std::nan(""), 0.0}, 1.0}}, t0);
+  ahead.on_message(names, {{{0.0, 0.0, 0.0, 0.0}, -1.0}}, t0);
+  EXPECT_EQ(ahead.poses_deg(at(0.5)).size(), 3U);
+  EXPECT_EQ(ahead.counters().messages, 5U);
+  EXPECT_EQ(ahead.counters().refused, 4U);
+  // A new trajectory replaces the path; an empty one clears it.
+  ahead.on_message(names, {{{0.0, 0.0, 0.0, 0.0}, 1.0}}, t0);
+  EXPECT_EQ(ahead.poses_deg(at(0.5)).size(), 1U);
+  ahead.on_message(names, {}, t0);
+  EXPECT_TRUE(ahead.poses_deg(at(0.5)).empty());
+}
 
 TEST(Lifecycle, TransitionsFollowTheStatesAndRefuseTheWrongOnes) {
   FakeDevice d;

@@ -355,8 +355,11 @@ function plotLobes(l, m, a) {
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
     (state === 'expired' ? 'expired: ' + esc(a.status_reason) + ' (it was ' + (a.found ? fmt(a.advised_rpm, 1) + ' rpm' : 'none in range') + ')'
     : !a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
-      fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method)) : 'no advice asked for';
+      fmt(a.advised_limit_mm, 2) + ' mm (margin ' + fmt(a.margin, 2) + ')') + ' – ' + esc(a.method) +
+    (a.poses_ahead > 0 ? '; checked at the pose now and ' + a.poses_ahead + ' of the path ahead' +
+      (a.limiting_pose_deg && a.limiting_pose_deg.length ? ', lowest at ' + poseText(a.limiting_pose_deg) : '') : '')) : 'no advice asked for';
   $('advice').dataset.followed = followed ? 'true' : 'false';
+  $('advice').dataset.posesAhead = a ? String(a.poses_ahead || 0) : '0';
   $('advice').dataset.status = state;
   window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, operating_label: now, advised: options.length,
     gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off, pose_deg: l.pose_deg || [], pose_moved: !!moved,
