@@ -114,6 +114,12 @@ std::string machining_view(const msg::Machining& m) {
   if (m.spindle_rpm() > 0.0 && !m.limits_pose_deg().empty()) {
     limits += "\n             at the robot's pose " + config::describe_pose(m.limits_pose_deg()) +
               (m.limits_ready() ? "" : " (recomputing: the robot moved)");
+    if (m.mode_spread_pct() >= 0.0) {
+      char spread[160];
+      std::snprintf(spread, sizeof spread, "; its modes +-%.1f %% (one sigma), %.0f deg from the nearest measured pose", m.mode_spread_pct(),
+                    m.nearest_measured_deg());
+      limits += spread;
+    }
   }
   std::string indicator = "-";
   if (m.indicator_valid()) {

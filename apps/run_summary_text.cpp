@@ -204,6 +204,8 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                       {"chatter", m.chatter}};
     if (!m.pose_deg.empty() || !m.limits_pose_deg.empty())
       j["machining"]["pose_deg"] = m.pose_deg, j["machining"]["limits_pose_deg"] = m.limits_pose_deg;
+    if (m.mode_spread_pct >= 0.0)
+      j["machining"]["mode_spread_pct"] = m.mode_spread_pct, j["machining"]["nearest_measured_deg"] = m.nearest_measured_deg;
   }
   if (!s.limits_trail.empty()) {
     json trail = json::array();
@@ -384,6 +386,13 @@ std::string summary_text(const runtime::RunSummary& s) {
                                                                                  : "");
       os << b;
       if (!m.limits_pose_deg.empty()) os << "  the limits are at the robot's pose " << config::describe_pose(m.limits_pose_deg) << "\n";
+      if (m.mode_spread_pct >= 0.0) {
+        char spread[160];
+        std::snprintf(spread, sizeof spread,
+                      "  its modes there from the measured map: +-%.2f %% in frequency (one sigma), %.1f deg from the nearest measured pose\n",
+                      m.mode_spread_pct, m.nearest_measured_deg);
+        os << spread;
+      }
     }
   }
   if (!s.limits_trail.empty()) {

@@ -53,7 +53,8 @@ json to_json(const msg::Machining& m) {
           {"limit_mm", finite(m.limit_mm())}, {"depth_warning", m.depth_warning()}, {"depth_measured", m.depth_measured()}, {"indicator_valid", m.indicator_valid()},
           {"once_per_rev_ratio", m.once_per_rev_ratio()}, {"nonharmonic_share", m.nonharmonic_share()},
           {"chatter_hz", m.chatter_hz()}, {"chatter", m.chatter()}, {"cutting", dds::cutting_name(m.cutting())},
-          {"cutting_reason", m.cutting_reason()}, {"pose_deg", m.pose_deg()}, {"limits_pose_deg", m.limits_pose_deg()}};
+          {"cutting_reason", m.cutting_reason()}, {"pose_deg", m.pose_deg()}, {"limits_pose_deg", m.limits_pose_deg()},
+          {"mode_spread_pct", m.mode_spread_pct()}, {"nearest_measured_deg", m.nearest_measured_deg()}};
 }
 
 json to_json(const msg::Advice& a) {

@@ -255,6 +255,8 @@ void Bridge::publish_machining() {
   out.cutting_reason(m.cutting_reason);
   out.pose_deg(first16(m.pose_deg));
   out.limits_pose_deg(first16(m.limits_pose_deg));
+  out.mode_spread_pct(m.mode_spread_pct);
+  out.nearest_measured_deg(m.nearest_measured_deg);
   if (machining_writer_->write(&out)) ++n_machining_;
 }
 

@@ -61,6 +61,9 @@ struct MachiningSample {
   std::string cutting_reason;  // what says so
   std::vector<double> pose_deg;         // a pose-scheduled cell: the robot's joints now (empty: not known)
   std::vector<double> limits_pose_deg;  // the pose the limits are for (on the live stability's grid)
+  // A measured map (pose modes): the largest one-sigma frequency spread of the modes at limits_pose_deg, %, and
+  // how far that pose is from the nearest measured one; -1 each: the model alone (no measured modes).
+  double mode_spread_pct{-1.0}, nearest_measured_deg{-1.0};
 };
 inline constexpr std::uint8_t kCuttingUnknown = 0, kCutting = 1, kNotCutting = 2;
 [[nodiscard]] inline const char* cutting_name(std::uint8_t c) {

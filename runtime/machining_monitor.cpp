@@ -7,6 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "analysis/pose_schedule.hpp"
 #include "config/milling_config.hpp"
 #include "rt/supervisor.hpp"
 #include "rt/telemetry_frame.hpp"
@@ -32,7 +33,7 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 
 MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, MachiningInputs in)
     : teeth_(cfg.spindle.teeth), active_set_(std::move(in.active_set)), robot_depth_mm_(std::move(in.robot_depth_mm)),
-      pose_deg_(std::move(in.pose_deg)), path_ahead_deg_(std::move(in.path_ahead_deg)), schedule_(std::move(in.schedule)),
+      pose_deg_(std::move(in.pose_deg)), path_ahead_deg_(std::move(in.path_ahead_deg)), pose_(in.pose), schedule_(std::move(in.schedule)),
       chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
   set_configs_ = sets;
   config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
@@ -144,6 +145,25 @@ std::vector<milling::LiveLimitsRecord> MachiningMonitor::trail() const {
   return trail_;
 }
 
+void MachiningMonitor::mode_spread(dds::MachiningSample& s) {
+  if (!pose_ || !pose_->model.measured_modes || s.limits_pose_deg.empty()) return;
+  std::lock_guard<std::mutex> lock(m_);
+  if (s.limits_pose_deg != spread_pose_) {
+    spread_pose_ = s.limits_pose_deg;
+    spread_pct_ = spread_nearest_deg_ = -1.0;
+    try {
+      const analysis::PoseModes pm = analysis::pose_modes(pose_->model, spread_pose_, pose_->axis, pose_->modes);
+      if (!pm.corrections.empty()) {
+        spread_pct_ = 0.0;
+        for (const auto& c : pm.corrections) spread_pct_ = std::max(spread_pct_, 100.0 * c.freq_sigma);
+        spread_nearest_deg_ = pm.nearest_measured_deg;
+      }
+    } catch (const std::exception&) {  // a pose outside the model's travel: no spread to say
+    }
+  }
+  s.mode_spread_pct = spread_pct_, s.nearest_measured_deg = spread_nearest_deg_;
+}
+
 AdviceView MachiningMonitor::view() {
   AdviceView v;
   dds::MachiningSample& s = v.sample;
@@ -186,6 +206,7 @@ AdviceView MachiningMonitor::view() {
       s.depth_warning = s.depth_mm > s.limit_mm;
     }
   }
+  mode_spread(s);
   v.parameter_set = set;
   v.gain_ns_per_m = gain;
   if (set_configs_[set].controller.speed_schedule)  // the set and K the schedule runs at each candidate speed

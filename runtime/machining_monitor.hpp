@@ -90,6 +90,11 @@ class MachiningMonitor {
   std::function<double()> robot_depth_mm_;
   std::function<std::vector<double>()> pose_deg_;
   std::function<std::vector<std::vector<double>>()> path_ahead_deg_;
+  // A measured map's spread at a pose (dds::MachiningSample::mode_spread_pct), the last pose's kept.
+  void mode_spread(dds::MachiningSample& s);
+  std::optional<milling::PoseDynamics> pose_;
+  std::vector<double> spread_pose_;
+  double spread_pct_{-1.0}, spread_nearest_deg_{-1.0};
   std::optional<config::PoseScheduleConfig> schedule_;
   std::unique_ptr<milling::LiveStability> stability_;
   mutable std::mutex m_;

@@ -424,7 +424,9 @@ TEST(DashboardServer, ServesHttpsWithItsCertificateAndSecureHeaders) {
       EXPECT_EQ(r->get_header_value("X-Content-Type-Options"), "nosniff") << path;
       EXPECT_EQ(r->get_header_value("X-Frame-Options"), "DENY") << path;
       EXPECT_EQ(r->get_header_value("Referrer-Policy"), "no-referrer") << path;
-      if (std::string(path) != "/") EXPECT_EQ(r->get_header_value("Cache-Control"), "no-store") << path;
+      if (std::string(path) != "/") {
+        EXPECT_EQ(r->get_header_value("Cache-Control"), "no-store") << path;
+      }
     }
   }
   // Verified against another certificate: refused.

@@ -4,6 +4,7 @@
 // checked at the three held out; the mapped modes at a pose shown with their uncertainty; the refusals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -96,6 +97,26 @@ TEST(PoseModes, ARobotWrongInFormIsMappedFromItsMeasuredPosesAndMeetsTheHeldOutO
       EXPECT_GT(m["freq_sigma_pct"].get<double>(), 0.0);
     }
   EXPECT_EQ(measured, 3);
+  // A cell on the mapped model says the spread at the robot's pose (the machining topic, the monitor, the run
+  // summary): the largest frequency sigma of its modes there, and how far the nearest measured pose is.
+  std::string job = test::read_file(kSource + "/config/milling/planar_three_link_wall_x.yaml");
+  test::replace_or_throw(job, "model: ../robots/", "model: " + kSource + "/config/robots/");
+  std::ofstream(d + "/job.yaml") << job;
+  std::string on_map = cell;
+  test::replace_or_throw(on_map, "model: true_robot.yaml", "model: mapped.yaml");
+  std::ofstream(d + "/cell_mapped.yaml") << on_map << "\nspindle:\n  teeth: 3\n  job: job.yaml\n";
+  // (The stretched region's set is handed over from region 0's at the start: armed after about 4 s.)
+  const Outcome run = robodamp({"run", "--config", d + "/cell_mapped.yaml", "--pose", "-90", "90", "30", "--spindle-rpm", "700",
+                                "--clock", "virtual", "--duration", "8", "--json", d + "/run.json"},
+                               d + "/run.log");
+  ASSERT_EQ(run.status, 0) << run.log;
+  const json machining = json::parse(test::read_file(d + "/run.json"))["machining"];
+  double widest = 0.0;
+  for (const auto& m : s["modes"]) widest = std::max(widest, m["freq_sigma_pct"].get<double>());
+  ASSERT_TRUE(machining.contains("mode_spread_pct")) << machining.dump();
+  EXPECT_NEAR(machining["mode_spread_pct"].get<double>(), widest, 1e-9 * widest) << machining.dump();
+  EXPECT_NEAR(machining["nearest_measured_deg"].get<double>(), 10.0, 0.1) << machining.dump();
+  EXPECT_NE(run.log.find("its modes there from the measured map: +-"), std::string::npos) << run.log;
   // Refused: a model with no measured modes to show, and --out without --measurements.
   const Outcome none = robodamp({"pose", "modes", "--model", d + "/fitted.yaml", "--joints", "-90", "90", "30"}, d + "/none.log");
   EXPECT_EQ(none.status, 2);

@@ -171,7 +171,9 @@ TEST(Loop, AnOnCommandChirpStartsAtTheTickAfterEachStartCommandAndReplays) {
       EXPECT_NEAR(t_s, static_cast<double>(f.tick + 1) / fs, 1e-9);  // the next tick's time
       from.start_s = t_s;
     }
-    if (f.tick >= first && f.tick < 12500) ASSERT_EQ(f.state, static_cast<std::uint8_t>(State::kActive)) << i;
+    if (f.tick >= first && f.tick < 12500) {
+      ASSERT_EQ(f.state, static_cast<std::uint8_t>(State::kActive)) << i;
+    }
     EXPECT_NEAR(f.command_v, want, 1e-9) << "tick " << f.tick;
     nonzero += f.command_v != 0.0 ? 1 : 0;
   }

@@ -216,7 +216,9 @@ function tile(c) {
         (m.depth_measured ? '' : ' <span class="note" data-field="depth-source">(the job\'s plan: the robot reports no depth)</span>') +
         '<div class="bar' + (m.depth_warning && !idle ? ' warn' : '') + '"><span style="width:' + pct.toFixed(0) + '%"></span></div>' : '–') + '</dd>' +
       (m.limits_pose_deg && m.limits_pose_deg.length ? '<dt>pose</dt><dd data-field="pose">' + poseText(m.limits_pose_deg) +
-        (m.limits_ready ? ': the limit is for this pose' : ' <span class="note">(recomputing: the robot moved)</span>') + '</dd>' : '') +
+        (m.limits_ready ? ': the limit is for this pose' : ' <span class="note">(recomputing: the robot moved)</span>') +
+        (m.mode_spread_pct >= 0 ? '<br><span class="note" data-field="mode-spread">its modes ±' + fmt(m.mode_spread_pct, 1) +
+          ' % (one sigma), ' + fmt(m.nearest_measured_deg, 0) + '° from the nearest measured pose</span>' : '') + '</dd>' : '') +
       '<dt>chatter</dt><dd>' + chatter + '</dd>' +
       (c.advice ? '<dt>advice</dt><dd data-field="advice" data-status="' + adviceState(c.advice, m) + '">' +
         (adviceState(c.advice, m) === 'expired' ? 'expired: ' + esc(c.advice.status_reason)
