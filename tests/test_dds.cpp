@@ -662,6 +662,11 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
   const auto summary = nlohmann::json::parse(test::read_file(dir + "/run.json"));
   EXPECT_GT(summary["path_ahead"]["messages"].get<int>(), 0) << summary.dump();
   EXPECT_EQ(summary["path_ahead"]["refused"].get<int>(), 0) << summary.dump();
+  // The run summary's advice (as `robodamp monitor` prints the topic's) says where it was checked.
+  EXPECT_EQ(summary["advice"]["poses_ahead"].get<int>(), 2) << summary["advice"].dump();
+  EXPECT_NE(test::read_file(dir + "/run.log").find("at the robot's pose [-100, 10, 90] deg and 2 poses of the path ahead (the lowest limit at"),
+            std::string::npos)
+      << test::read_file(dir + "/run.log");
   std::cout << "advice #" << along->seq() << ": " << (along->found() ? "found " + std::to_string(along->advised_rpm()) + " rpm" : along->reason())
             << "; lowest limit at " << config::describe_pose(along->limiting_pose_deg()) << "\n";
   std::filesystem::remove_all(dir);
