@@ -132,78 +132,75 @@ DataReader* Participant::reader(TopicKind t, DataReaderListener* listener) {
 
 namespace robodamp::dds {
 
-Topic* Participant::joint_state_topic(const std::string& topic_name) {
-  if (joint_states_ != nullptr) {
-    if (joint_states_->get_name() != topic_name)
-      throw std::runtime_error("DDS: joint states on " + topic_name + " and " + joint_states_->get_name() + ": one topic");
-    return joint_states_;
+namespace {
+
+// A ROS 2 message's topic under the name the configuration gives (one per participant and message), created on
+// first use.
+template <typename PubSubType>
+Topic* ros_topic(DomainParticipant* participant, Topic*& slot, const std::string& topic_name, const char* what) {
+  if (slot != nullptr) {
+    if (slot->get_name() != topic_name)
+      throw std::runtime_error(std::string("DDS: ") + what + " on " + topic_name + " and " + slot->get_name() + ": one topic");
+    return slot;
   }
-  TypeSupport type(new msg::JointStatePubSubType());
-  type.register_type(participant_);
-  joint_states_ = participant_->create_topic(topic_name, type.get_type_name(), TOPIC_QOS_DEFAULT);
-  if (joint_states_ == nullptr) throw std::runtime_error("DDS: cannot create topic " + topic_name);
-  return joint_states_;
+  TypeSupport type(new PubSubType());
+  type.register_type(participant);
+  slot = participant->create_topic(topic_name, type.get_type_name(), TOPIC_QOS_DEFAULT);
+  if (slot == nullptr) throw std::runtime_error("DDS: cannot create topic " + topic_name);
+  return slot;
+}
+
+// A reader that takes any ROS 2 writer (best effort matches a reliable writer and a best-effort one; volatile;
+// the last `depth`), and a writer as a ROS 2 node has one (reliable, volatile, the last 10: ROS 2's default QoS).
+DataReader* ros_reader(Subscriber* subscriber, Topic* topic, DataReaderListener* listener, config::DdsTransport transport,
+                       int depth) {
+  DataReaderQos q = DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = depth;
+  if (transport == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+  DataReader* r = subscriber->create_datareader(topic, q, listener);
+  if (r == nullptr) throw std::runtime_error("DDS: cannot create a reader on " + topic->get_name());
+  return r;
+}
+
+DataWriter* ros_writer(Publisher* publisher, Topic* topic, config::DdsTransport transport) {
+  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 10;
+  if (transport == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
+  DataWriter* w = publisher->create_datawriter(topic, q);
+  if (w == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic->get_name());
+  return w;
+}
+
+}  // namespace
+
+Topic* Participant::joint_state_topic(const std::string& topic_name) {
+  return ros_topic<msg::JointStatePubSubType>(participant_, joint_states_, topic_name, "joint states");
 }
 
 DataReader* Participant::joint_state_reader(const std::string& topic_name, DataReaderListener* listener) {
-  DataReaderQos q = DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;  // matches a reliable writer and a best-effort one
-  q.durability().kind = VOLATILE_DURABILITY_QOS;
-  q.history().kind = KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 8;
-  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
-  DataReader* r = subscriber_->create_datareader(joint_state_topic(topic_name), q, listener);
-  if (r == nullptr) throw std::runtime_error("DDS: cannot create a reader on " + topic_name);
-  return r;
+  return ros_reader(subscriber_, joint_state_topic(topic_name), listener, transport_, 8);
 }
 
 DataWriter* Participant::joint_state_writer(const std::string& topic_name) {
-  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = VOLATILE_DURABILITY_QOS;
-  q.history().kind = KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 10;
-  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
-  DataWriter* w = publisher_->create_datawriter(joint_state_topic(topic_name), q);
-  if (w == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic_name);
-  return w;
+  return ros_writer(publisher_, joint_state_topic(topic_name), transport_);
 }
 
 Topic* Participant::trajectory_topic(const std::string& topic_name) {
-  if (trajectories_ != nullptr) {
-    if (trajectories_->get_name() != topic_name)
-      throw std::runtime_error("DDS: trajectories on " + topic_name + " and " + trajectories_->get_name() + ": one topic");
-    return trajectories_;
-  }
-  TypeSupport type(new msg::JointTrajectoryPubSubType());
-  type.register_type(participant_);
-  trajectories_ = participant_->create_topic(topic_name, type.get_type_name(), TOPIC_QOS_DEFAULT);
-  if (trajectories_ == nullptr) throw std::runtime_error("DDS: cannot create topic " + topic_name);
-  return trajectories_;
+  return ros_topic<msg::JointTrajectoryPubSubType>(participant_, trajectories_, topic_name, "trajectories");
 }
 
 DataReader* Participant::trajectory_reader(const std::string& topic_name, DataReaderListener* listener) {
-  DataReaderQos q = DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;  // matches a reliable writer and a best-effort one
-  q.durability().kind = VOLATILE_DURABILITY_QOS;
-  q.history().kind = KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 4;
-  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
-  DataReader* r = subscriber_->create_datareader(trajectory_topic(topic_name), q, listener);
-  if (r == nullptr) throw std::runtime_error("DDS: cannot create a reader on " + topic_name);
-  return r;
+  return ros_reader(subscriber_, trajectory_topic(topic_name), listener, transport_, 4);
 }
 
 DataWriter* Participant::trajectory_writer(const std::string& topic_name) {
-  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = VOLATILE_DURABILITY_QOS;
-  q.history().kind = KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 10;
-  if (transport_ == config::DdsTransport::kUdpLoopback) q.data_sharing().off();
-  DataWriter* w = publisher_->create_datawriter(trajectory_topic(topic_name), q);
-  if (w == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic_name);
-  return w;
+  return ros_writer(publisher_, trajectory_topic(topic_name), transport_);
 }
 
 }  // namespace robodamp::dds
