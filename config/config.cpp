@@ -712,13 +712,12 @@ void check_path_ahead(detail::Diagnostics& d, const Config& c) {
     d.add(here, "dds.path_ahead", "is set without pose_schedule: the advice has no robot model to check the poses on");
     return;
   }
-  const std::vector<std::string>& names = !p.names.empty() || !c.dds->joint_states ? p.names : c.dds->joint_states->names;
-  if (names.size() != c.pose_schedule->joints())
-    d.add(here, p.names.empty() && !c.dds->joint_states ? "dds.path_ahead" : "dds.path_ahead.names",
-          p.names.empty() && !c.dds->joint_states
-              ? "needs names (pose_schedule's joints as the robot program names them) without dds.joint_states"
-              : "has " + std::to_string(names.size()) + " names; pose_schedule has " + std::to_string(c.pose_schedule->joints()) +
-                    " joints: one name per joint, in order");
+  // (Names not given are dds.joint_states', filled in as the section is read.)
+  if (p.names.empty())
+    d.add(here, "dds.path_ahead", "needs names (pose_schedule's joints as the robot program names them) without dds.joint_states");
+  else if (p.names.size() != c.pose_schedule->joints())
+    d.add(here, "dds.path_ahead.names", "has " + std::to_string(p.names.size()) + " names; pose_schedule has " +
+                                            std::to_string(c.pose_schedule->joints()) + " joints: one name per joint, in order");
 }
 
 // modbus.robot.joints_register against pose_schedule: one register per joint, clear of the others.

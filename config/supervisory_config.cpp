@@ -250,6 +250,7 @@ std::optional<DdsConfig> read_dds(MapReader& top) {
   c.security = read_dds_security(r, top.diagnostics().file());
   c.joint_states = read_joint_states(r);
   c.path_ahead = read_path_ahead(r);
+  if (c.path_ahead && c.path_ahead->names.empty() && c.joint_states) c.path_ahead->names = c.joint_states->names;
   r.finish();
   return c;
 }

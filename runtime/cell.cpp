@@ -181,10 +181,8 @@ Status Cell::configure_devices() {
   };
   if (cfg_.dds && cfg_.dds->joint_states && cfg_.pose_schedule && read_joints)
     joint_pose_ = std::make_unique<JointStatePose>(*cfg_.dds->joint_states, *cfg_.pose_schedule, on_region);
-  if (cfg_.dds && cfg_.dds->path_ahead && cfg_.pose_schedule && !cfg_.spindle.job.empty()) {
-    const config::PathAheadConfig& p = *cfg_.dds->path_ahead;
-    path_ahead_ = std::make_unique<PathAhead>(p, !p.names.empty() || !cfg_.dds->joint_states ? p.names : cfg_.dds->joint_states->names);
-  }
+  if (cfg_.dds && cfg_.dds->path_ahead && cfg_.pose_schedule && !cfg_.spindle.job.empty())
+    path_ahead_ = std::make_unique<PathAhead>(*cfg_.dds->path_ahead, cfg_.dds->path_ahead->names);
   if (cfg_.dds) {
     dds_ = std::make_unique<DdsEndpoint>(
         *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
