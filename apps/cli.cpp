@@ -187,6 +187,14 @@ CLI::Option* Registry::deprecated(CLI::Option* option, const std::string& replac
   return option;
 }
 
+CLI::Option* Registry::job(CLI::App* sub, std::string& target) {
+  CLI::Option* job = sub->add_option("--job", target, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
+  CLI::Option* old = sub->add_option("--config", target, "The milling job, as --job")->check(CLI::ExistingFile);
+  deprecated(old, "--job JOB (--config is the cell's configuration in every other command)");
+  job->excludes(old);
+  return job;
+}
+
 int Registry::run_parsed() const {
   for (const auto& [sub, handler] : handlers_) {
     if (!sub->parsed()) continue;

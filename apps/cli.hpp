@@ -60,6 +60,9 @@ class Registry {
   CLI::Option* plot_dir(CLI::App* sub, std::string& target, const std::string& what);
   // An old spelling kept for one release: still works, says on stderr what replaces it.
   CLI::Option* deprecated(CLI::Option* option, const std::string& replacement);
+  // --job FILE, the milling job (config/milling/), as every command names it; and the old --config JOB of
+  // lobes, sle and cut, deprecated: --config is the cell everywhere else (docs/cli.md).
+  CLI::Option* job(CLI::App* sub, std::string& target);
 
   // After parsing: the problems of the numbers given to `sub`, each in the configuration's wording.
   [[nodiscard]] std::vector<std::string> number_problems(const CLI::App* sub) const;

@@ -38,7 +38,7 @@ constexpr double kHilRelTol = 1e-2;  // each step of the emulator's bisection is
 json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
 struct CutArgs {
-  std::string config_path{default_job()};
+  std::string job_path{default_job()};  // --job (the deprecated --config)
   std::string structure;
   std::optional<double> axial_mm, radial_mm;
   std::vector<double> rpm;
@@ -63,7 +63,7 @@ json hil_critical(const CutArgs& a, const milling::CutJob& job, double rpm, doub
                               .string();
   const auto t0 = std::chrono::steady_clock::now();
   const commission::EmulatedCritical c = commission::critical_through_emulator(
-      cell, controller, {commission::this_executable(), a.hil_path, a.config_path, job.settings.revolutions}, rpm,
+      cell, controller, {commission::this_executable(), a.hil_path, a.job_path, job.settings.revolutions}, rpm,
       in_process_mm, kHilRelTol, dir, [](const std::string& line) { std::cerr << "[cut hil] " << line << '\n'; });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("          through the HIL emulator (%s): critical %.4f mm at %.1f rpm (%+.1f %% against in process), above it "
@@ -248,7 +248,7 @@ void critical_study(const CutArgs& a, const config::MillingConfig& cfg, const co
 // The job with the options applied and checked, then one cut or the critical-depth study.
 int run_cut(const CutArgs& a) {
   try {
-    config::MillingConfig cfg = config::load_milling_config(a.config_path);
+    config::MillingConfig cfg = config::load_milling_config(a.job_path);
     MillingOptions pose;
     pose.pose_deg = a.pose_deg;
     apply_pose(cfg, pose);
@@ -290,7 +290,7 @@ void register_cut(Registry& r) {
   auto a = std::make_shared<CutArgs>();
   CLI::App* sub = r.add("cut", "Time-domain cut with chatter detection; --critical: critical depth by simulation",
                         [a] { return run_cut(*a); });
-  sub->add_option("--config", a->config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
+  r.job(sub, a->job_path);
   sub->add_option("--structure", a->structure, "Which of the job's structures (default: its `structure`)");
   r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
   r.numbers(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, true, false, "and within the job's lobes speed range"},

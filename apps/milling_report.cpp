@@ -388,7 +388,7 @@ json sle_report(const config::MillingConfig& cfg, const MillingOptions& o) {
 int print_sle(const json& r, const MillingOptions& o) { return finish(r, o, "sle", sle_table(r), plot_sle); }
 
 void add_milling_options(Registry& r, CLI::App* sub, MillingOptions& o, const std::string& command) {
-  sub->add_option("--config", o.config_path, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
+  r.job(sub, o.job_path);
   sub->add_option("--structure", o.structure, "Which of the job's structures (default: its `structure`)");
   r.json(sub, o.json, "The report (every speed, the limits and their methods)");
   r.plot_dir(sub, o.plot_dir, command + ".png");

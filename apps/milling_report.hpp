@@ -15,7 +15,7 @@
 namespace robodamp::apps {
 
 struct MillingOptions {
-  std::string config_path{default_job()};
+  std::string job_path{default_job()};  // --job (the deprecated --config)
   std::string structure;          // empty: the configuration's choice
   JsonOut json;
   std::string plot_dir;           // --plot-dir: DIR/lobes.png or DIR/sle.png

@@ -199,7 +199,7 @@ std::vector<double> pose_of(const config::RobotModelConfig& m, const PoseArgs& a
       if (p.name == a.pose_name) return p.joints_deg;
     std::string known;
     for (const auto& p : m.poses) known += (known.empty() ? "" : ", ") + p.name;
-    throw config::ConfigError({config::Problem{m.source, {}, "poses", "--pose = '" + a.pose_name + "' is not one of: " + known}});
+    throw config::ConfigError({config::Problem{m.source, {}, "poses", "--pose-name = '" + a.pose_name + "' is not one of: " + known}});
   }
   if (!a.joints_deg.empty()) return a.joints_deg;
   if (m.poses.empty())
@@ -246,7 +246,7 @@ int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
       csv << f << ',' << h.real() << ',' << h.imag() << '\n';
     }
     if (!csv) {
-      std::cerr << "--csv " << a.csv_path << ": cannot write\n";
+      std::cerr << "--csv-out " << a.csv_path << ": cannot write\n";
       return 1;
     }
   }
@@ -420,7 +420,10 @@ void register_pose(Registry& r) {
   r.number(sub, "--worse-mode-pct", a->tune.worse_mode_pct, {"%", 0.0, 20.0},
            "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default 0: never worse)");
   r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map, modes: the pose, one relative angle per joint");
-  sub->add_option("--pose", a->pose_name, "frf, map, modes: a pose the model file names");
+  auto* name = sub->add_option("--pose-name", a->pose_name, "frf, map, modes: a pose the model file names");
+  // --pose is the joint angles in run, cut, lobes, sle and measure: here it named a pose (docs/cli.md).
+  name->excludes(r.deprecated(sub->add_option("--pose", a->pose_name, "frf, map, modes: a pose the model file names"),
+                              "--pose-name NAME (--pose is joint angles in every other command)"));
   r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes (default 4); modes: how many of the model's (default 3)")
       ->each([a](const std::string&) { a->modes_given = true; });
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e4, true, false}, "frf: FRF band LO HI");
@@ -441,7 +444,7 @@ void register_pose(Registry& r) {
       ->check(CLI::ExistingDirectory);
   sub->add_option("--hold-out", a->hold_out,
                   "fit, modes: pose names (of --measurements) kept out of the fit or the map: the error is reported there");
-  sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
+  sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv-out writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
   r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (the planar-robot study: 10 30)");
   r.whole_number(sub, "--fit-modes", a->fit_modes, {"(modes)", 0, 20},
                  "fit: compare the model as its N lowest modes with viscous damping, the plant a schedule predicts with "
@@ -451,8 +454,11 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
   r.whole_number(sub, "--seed", a->seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
   sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here; modes: the model with its measured modes; tune: the configuration with the chosen controller");
-  sub->add_option("--csv", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz");
-  r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv frequency step");
+  auto* csv = sub->add_option("--csv-out", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz");
+  // --csv is a table read in identify and chatter: here it was one written.
+  csv->excludes(r.deprecated(sub->add_option("--csv", a->csv_path, "frf: write the receptance to this table"),
+                             "--csv-out FILE (--csv is a table read in every other command)"));
+  r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv-out frequency step");
 }
 
 }  // namespace robodamp::apps

@@ -10,7 +10,7 @@ namespace robodamp::apps {
 void register_sle(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
   CLI::App* sub = r.add("sle", "Surface location error over speed and at the test conditions, with compensation", [o] {
-    config::MillingConfig cfg = config::load_milling_config(o->config_path);
+    config::MillingConfig cfg = config::load_milling_config(o->job_path);
     apply_pose(cfg, *o);
     return print_sle(sle_report(cfg, *o), *o);
   });

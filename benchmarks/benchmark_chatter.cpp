@@ -1,4 +1,4 @@
-// `robodamp chatter`'s analysis of a long recording (README: listening to a recorded cut): 60 s at 48 kHz
+// `robodamp chatter`'s analysis of a long recording (docs/performance.md: listening to a recorded cut): 60 s at 48 kHz
 // (2.88 million samples), the spindle speed estimated, 30 windows judged by the live indicator's code.
 #include <benchmark/benchmark.h>
 

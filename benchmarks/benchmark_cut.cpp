@@ -1,4 +1,4 @@
-// Time-domain milling and semi-discretization, one core (README: milling in time): simulated seconds per
+// Time-domain milling and semi-discretization, one core (docs/performance.md: milling in time): simulated seconds per
 // wall second of one cut of the industrial-robot job (the robot SLE study's robot and workpiece, 3 teeth, 20 axial
 // slices) and of the damped job (the real Controller and plant at 5 kHz); the time-domain critical depth
 // at one speed; a 200-speed semi-discretization diagram of a single-mode structure.

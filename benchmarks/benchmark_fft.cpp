@@ -2,7 +2,7 @@
 // 50 000 samples, zero-padded x8 to 400 000, real input) by Eigen's FFT module on kissfft (what the
 // estimator used before; a new Eigen::FFT per transform as it did, and one reused with the half spectrum)
 // and by FFTW (analysis::RealFft: r2c, planned once with FFTW_ESTIMATE). pocketfft is not packaged by
-// Debian 12. README: "Main job: what each part costs".
+// Debian 12. docs/performance.md: "Main job: what each part costs".
 #include <benchmark/benchmark.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Modal identification of the robot SLE study's robot and workpiece (README: identification): the tool-workpiece
+// Modal identification of the robot SLE study's robot and workpiece (docs/performance.md: identification): the tool-workpiece
 // FRF of config/milling/industrial_robot_aluminium.yaml in x (25 modes) and y (21 modes), 2-8000 Hz at
 // 0.5 Hz with 0.5 % seeded complex noise, fitted in sub-bands (identify/modal_fit.hpp). One core.
 // Counters: modes identified, and how many of the table's modes have one within 1 % in frequency.

@@ -1,4 +1,4 @@
-// Lobe diagram, direct test and SLE timing (README: milling analyses). The target: a 2000-speed
+// Lobe diagram, direct test and SLE timing (docs/performance.md: milling analyses). The target: a 2000-speed
 // lobe diagram of a 37-mode FRF in well under a second on one core.
 #include <benchmark/benchmark.h>
 

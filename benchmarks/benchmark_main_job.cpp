@@ -1,7 +1,7 @@
 // What each part of the main job (`robodamp bench` on the default preset) costs, one core each: loading
 // the configuration and building the loop model, the closed-loop analysis, one impact test's simulation
 // (10 hits, ~110 s simulated, control on) and its H1 estimate (the FFTs), one gain-sweep run (20 s), and
-// the whole bench run, serial and on two threads. README: "Main job: what each part costs".
+// the whole bench run, serial and on two threads. docs/performance.md: "Main job: what each part costs".
 #include <benchmark/benchmark.h>
 
 #include <string>

@@ -2,7 +2,7 @@
 // plant (exact ZOH in modal block form, delayed actuator, control accelerometer with noise, the 3 Hz drive
 // vibration) and the real-time Controller, one loop tick per iteration, one core; at oversampling 1 (the
 // preset) and 4. Beside it, the plant alone (a fixed command sequence instead of the controller), with and
-// without the sensor's noise generator, to show where a tick's time goes (README: plant speed).
+// without the sensor's noise generator, to show where a tick's time goes (docs/performance.md: plant speed).
 #include <benchmark/benchmark.h>
 
 #include <string>

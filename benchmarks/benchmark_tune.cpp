@@ -1,4 +1,4 @@
-// What one robodamp tune evaluation costs (README: compensator synthesis): a candidate analysed against the
+// What one robodamp tune evaluation costs (docs/performance.md: compensator synthesis): a candidate analysed against the
 // discrete loop with its margins, damping window and command at the impact, with and without the damped
 // lobes of a job; the impact's inverse-FFT prediction alone, and its set-up (the plant on the grid, once
 // per plant).

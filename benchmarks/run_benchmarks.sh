@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces the README's performance numbers: Google Benchmark ns/sample and callgrind
+# Reproduces docs/performance.md's numbers: Google Benchmark ns/sample and callgrind
 # instructions/sample for the plain cascade, the product's chain and the controller step; the simulated
 # plant; the FFT back-ends; the parts of the main job; the milling analyses.
 set -euo pipefail

@@ -29,6 +29,7 @@
 #include "identify/modal_fit.hpp"
 #include "runtime/cell.hpp"
 #include "sim_plant/plant_model.hpp"
+#include "threads/worker.hpp"
 
 extern char** environ;
 
@@ -97,27 +98,21 @@ constexpr double kStallWallS = 30.0;
 // Ends the cell's run when no fresh sensor sample has arrived for kStallWallS; joined on every path.
 class StallWatch {
  public:
-  explicit StallWatch(runtime::Cell& cell) : thread_([this, &cell] { watch(cell); }) {}
-  ~StallWatch() {
-    {
-      const std::lock_guard<std::mutex> lock(m_);
-      done_ = true;
-    }
-    cv_.notify_all();
-    thread_.join();
+  explicit StallWatch(runtime::Cell& cell) {
+    worker_.start("rd-stall-watch", [this, &cell](std::stop_token stop) { watch(cell, stop); });
   }
+  ~StallWatch() { worker_.stop(); }
   StallWatch(const StallWatch&) = delete;
   StallWatch& operator=(const StallWatch&) = delete;
   void fresh() noexcept { fresh_.fetch_add(1, std::memory_order_relaxed); }
   [[nodiscard]] bool stalled() const noexcept { return stalled_.load(); }
 
  private:
-  void watch(runtime::Cell& cell) {
+  void watch(runtime::Cell& cell, std::stop_token stop) {
     using Clock = std::chrono::steady_clock;
     std::uint64_t seen = fresh_.load();
     auto since = Clock::now();
-    std::unique_lock<std::mutex> lock(m_);
-    while (!cv_.wait_for(lock, std::chrono::milliseconds(200), [this] { return done_; })) {
+    while (worker_.sleep_for(stop, std::chrono::milliseconds(200))) {
       if (const std::uint64_t now = fresh_.load(); now != seen) {
         seen = now, since = Clock::now();
       } else if (std::chrono::duration<double>(Clock::now() - since).count() > kStallWallS) {
@@ -129,10 +124,7 @@ class StallWatch {
   }
   std::atomic<std::uint64_t> fresh_{0};
   std::atomic<bool> stalled_{false};
-  std::mutex m_;
-  std::condition_variable cv_;
-  bool done_{false};
-  std::thread thread_;
+  threads::Worker worker_;  // last: started after what it reads
 };
 
 ControllerRun run_controller(const config::Config& cfg, double duration_s, double from_s, double to_s,

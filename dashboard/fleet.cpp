@@ -160,16 +160,16 @@ Fleet::Fleet(const config::DdsConfig& dds, double stale_after_s, std::size_t tel
     request_writer_ = nullptr;
     view_only_ = std::string("this dashboard's DDS identity may not write parameter requests (") + e.what() + ")";
   }
-  contact_thread_ = std::thread([this] { watch_contact(); });
+  contact_.start("rd-fleet-watch", [this](std::stop_token stop) { watch_contact(stop); });
 }
 
 Fleet::~Fleet() {
   {
     std::lock_guard<std::mutex> lock(m_);
-    stop_ = true;
+    stop_ = true;  // the pages' and requests' waits return
   }
   cv_.notify_all();
-  contact_thread_.join();
+  contact_.stop();
   participant_.reset();  // no listener is called after this
 }
 
@@ -289,10 +289,9 @@ void Fleet::on_reply(const void* p) {
   cv_.notify_all();
 }
 
-void Fleet::watch_contact() {
-  std::unique_lock<std::mutex> lock(m_);
-  while (!stop_) {
-    cv_.wait_for(lock, std::chrono::milliseconds(100));
+void Fleet::watch_contact(std::stop_token stop) {
+  while (contact_.sleep_for(stop, std::chrono::milliseconds(100))) {
+    std::lock_guard<std::mutex> lock(m_);
     const auto now = Clock::now();
     for (auto& [name, c] : cells_) {
       if (c->live && now - c->heard > std::chrono::duration<double>(stale_after_s_)) {

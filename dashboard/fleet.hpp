@@ -14,12 +14,14 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <stop_token>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "config/supervisory_config.hpp"
 #include "dds/bridge.hpp"
+#include "threads/worker.hpp"
 
 namespace robodamp::dds {
 class Participant;
@@ -101,7 +103,7 @@ class Fleet {
   void on_spectrum(const void* msg);
   void on_lobes(const void* msg);
   void on_reply(const void* msg);
-  void watch_contact();  // thread: marks cells quiet after stale_after_s
+  void watch_contact(std::stop_token stop);  // thread: marks cells quiet after stale_after_s
 
   double stale_after_s_;
   std::size_t telemetry_points_;
@@ -113,8 +115,8 @@ class Fleet {
   FleetCounters n_;
   std::uint32_t next_request_id_{1};
   std::map<std::uint32_t, RequestOutcome> replies_;
-  bool stop_{false};
-  std::thread contact_thread_;
+  bool stop_{false};  // guarded by m_: the waits of the pages and the requests end
+  threads::Worker contact_;  // watch_contact (stopped in the destructor before the participant goes)
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> listeners_;  // outlive the participant
   std::unique_ptr<dds::Participant> participant_;
   eprosima::fastdds::dds::DataWriter* request_writer_{nullptr};

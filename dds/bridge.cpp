@@ -354,19 +354,16 @@ void Bridge::start() {
     trajectory_listener_ = std::make_unique<TrajectoryListener>(*this);
     participant_->trajectory_reader(cfg_.path_ahead->topic, trajectory_listener_.get());
   }
-  status_thread_ = std::thread([this] {
+  status_.start("rd-dds-status", [this](std::stop_token stop) {
     const auto period = std::chrono::duration<double>(1.0 / cfg_.status_rate_hz);
-    std::unique_lock<std::mutex> lock(m_);
-    while (running_) {
-      cv_.wait_for(lock, period, [this] { return !running_; });
-      lock.unlock();
+    for (bool more = true; more;) {  // once more after the stop: the state the cell stopped in
+      more = status_.sleep_for(stop, period);
       publish_status();
       publish_machining();
       publish_advice();
       publish_spectrum();
       publish_lobes();
       if (src_.joint_state_check) src_.joint_state_check();
-      lock.lock();
     }
   });
 }
@@ -377,8 +374,7 @@ void Bridge::stop() {
     if (!running_) return;
     running_ = false;
   }
-  cv_.notify_all();
-  status_thread_.join();
+  status_.stop();
 }
 
 BridgeCounters Bridge::counters() const {

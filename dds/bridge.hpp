@@ -6,7 +6,6 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <iterator>
@@ -14,13 +13,14 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <stop_token>
 #include <vector>
-#include <thread>
 
 #include "config/supervisory_config.hpp"
 #include "rt/availability.hpp"
 #include "rt/telemetry_frame.hpp"
 #include "rt/timing_histogram.hpp"
+#include "threads/worker.hpp"
 
 namespace eprosima::fastdds::dds {
 class DataWriter;
@@ -198,15 +198,14 @@ class Bridge {
   std::uint32_t last_saturated_total_{0};
 
   mutable std::mutex m_;  // the status snapshot
-  std::condition_variable cv_;
   rt::TelemetryFrame last_{};
   bool have_frame_{false};
   rt::TimingHistogram wake_, compute_;
   std::uint8_t published_state_{255}, published_trip_{255};
-  bool running_{false};
-  std::thread status_thread_;
+  bool running_{false};  // guarded by m_: between start() and stop()
   std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0}, n_advice_{0},
       n_spectrum_{0}, n_lobes_{0}, n_other_cells_{0};
+  threads::Worker status_;  // status, machining, advice, spectrum and lobes at status_rate_hz (last: stopped first)
 };
 
 }  // namespace robodamp::dds

@@ -93,8 +93,8 @@ void ModbusClient::start() {
     if (running_) return;
     running_ = true;
   }
-  amp_thread_ = std::thread([this] { amplifier_thread(); });
-  if (robot_link_) robot_thread_ = std::thread([this] { robot_thread(); });
+  amp_.start("rd-modbus-amp", [this](std::stop_token stop) { amplifier_thread(stop); });
+  if (robot_link_) robot_.start("rd-modbus-robot", [this](std::stop_token stop) { robot_thread(stop); });
 }
 
 void ModbusClient::stop() {
@@ -103,20 +103,14 @@ void ModbusClient::stop() {
     if (!running_) return;
     running_ = false;
   }
-  cv_.notify_all();
-  if (amp_thread_.joinable()) amp_thread_.join();
-  if (robot_thread_.joinable()) robot_thread_.join();
-}
-
-bool ModbusClient::sleep_for(std::chrono::duration<double> d) {
-  std::unique_lock<std::mutex> lock(m_);
-  cv_.wait_for(lock, d, [this] { return !running_; });
-  return running_;
+  amp_seen_.notify_all();
+  amp_.stop();
+  robot_.stop();
 }
 
 bool ModbusClient::wait_for_amplifier(std::chrono::duration<double> timeout) const {
   std::unique_lock<std::mutex> lock(m_);
-  return cv_.wait_for(lock, timeout, [this] { return last_ok_ns_.load() >= 0 || !running_; }) && last_ok_ns_.load() >= 0;
+  return amp_seen_.wait_for(lock, timeout, [this] { return last_ok_ns_.load() >= 0 || !running_; }) && last_ok_ns_.load() >= 0;
 }
 
 void ModbusClient::request_amplifier_enable(bool on) noexcept { requested_.store(on, std::memory_order_relaxed); }
@@ -142,7 +136,7 @@ rt::AmplifierStatus ModbusClient::amplifier_status() noexcept {
   return s;
 }
 
-void ModbusClient::amplifier_thread() {
+void ModbusClient::amplifier_thread(std::stop_token stop) {
   const auto& r = cfg_.amplifier;
   const int in_lo = std::min(r.ready_input, r.fault_input), in_n = std::abs(r.ready_input - r.fault_input) + 1;
   std::vector<std::uint8_t> inputs(static_cast<std::size_t>(in_n));
@@ -153,7 +147,7 @@ void ModbusClient::amplifier_thread() {
     modbus_t* ctx = amp_link_.connect(now);
     amp_up_.store(ctx != nullptr);
     if (ctx == nullptr) {
-      running = sleep_for(std::min<std::chrono::duration<double>>(period, amp_link_.retry_at() - now));
+      running = amp_.sleep_for(stop, std::min<std::chrono::duration<double>>(period, amp_link_.retry_at() - now));
       continue;
     }
     const bool want = requested_.load(std::memory_order_relaxed);
@@ -171,7 +165,7 @@ void ModbusClient::amplifier_thread() {
       amp_up_.store(false);
       spdlog::warn("modbus amplifier {}: {} (reconnect in {:.3f} s)", config::describe(cfg_.amplifier_link),
                    amp_link_.last_error(), amp_link_.backoff().count() / 2.0);
-      running = sleep_for(std::chrono::duration<double>(0.0));
+      running = amp_.sleep_for(stop, std::chrono::duration<double>(0.0));
       continue;
     }
     amp_link_.succeeded();
@@ -185,16 +179,16 @@ void ModbusClient::amplifier_thread() {
       std::lock_guard<std::mutex> lock(m_);
       last_ok_ns_.store(rt::monotonic_ns(), std::memory_order_release);
     }
-    cv_.notify_all();
+    amp_seen_.notify_all();
     ++amp_polls_;
-    running = sleep_for(period);
+    running = amp_.sleep_for(stop, period);
   }
   // Leave the amplifier off: the loop has disarmed (or died); one last write if the link is up.
   if (modbus_t* ctx = amp_link_.connected() ? amp_link_.connect(ModbusLink::Clock::now()) : nullptr)
     modbus_write_bit(ctx, r.enable_coil, 0);
 }
 
-void ModbusClient::robot_thread() {
+void ModbusClient::robot_thread(std::stop_token stop) {
   const auto& r = cfg_.robot;
   const auto period = std::chrono::duration<double>(cfg_.poll_period_s);
   int candidate = -1, same = 0;
@@ -217,7 +211,7 @@ void ModbusClient::robot_thread() {
       park_spindle_if_lost(spindle);
       pose_unknown_if_lost(pose);
       depth_mm_.store(std::numeric_limits<double>::quiet_NaN());  // unknown while the link is down
-      running = sleep_for(std::min<std::chrono::duration<double>>(period, robot_link_->retry_at() - now));
+      running = robot_.sleep_for(stop, std::min<std::chrono::duration<double>>(period, robot_link_->retry_at() - now));
       continue;
     }
     std::uint16_t v = 0;
@@ -225,14 +219,14 @@ void ModbusClient::robot_thread() {
       read_failed();
       park_spindle_if_lost(spindle);
       pose_unknown_if_lost(pose);
-      running = sleep_for(std::chrono::duration<double>(0.0));
+      running = robot_.sleep_for(stop, std::chrono::duration<double>(0.0));
       continue;
     }
     if (!write_advice(ctx)) {
       robot_link_->failed(ModbusLink::Clock::now());
       robot_up_.store(false);
       spdlog::warn("modbus robot {}: advice: {}", config::describe(*cfg_.robot_link), robot_link_->last_error());
-      running = sleep_for(std::chrono::duration<double>(0.0));
+      running = robot_.sleep_for(stop, std::chrono::duration<double>(0.0));
       continue;
     }
     robot_link_->succeeded();
@@ -249,7 +243,7 @@ void ModbusClient::robot_thread() {
       spdlog::info("modbus robot: actuator mounting now {}", config::to_string(static_cast<config::Mounting>(m)));
       if (on_mounting_) on_mounting_(static_cast<config::Mounting>(m));
     }
-    running = sleep_for(period);
+    running = robot_.sleep_for(stop, period);
   }
 }
 

@@ -29,11 +29,12 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
+#include <stop_token>
 #include <vector>
 
 #include "config/config.hpp"
 #include "rt/io.hpp"
+#include "threads/worker.hpp"
 
 typedef struct _modbus modbus_t;
 
@@ -136,8 +137,8 @@ class ModbusClient final : public rt::AmplifierIo {
   bool wait_for_amplifier(std::chrono::duration<double> timeout) const;
 
  private:
-  void amplifier_thread();
-  void robot_thread();
+  void amplifier_thread(std::stop_token stop);
+  void robot_thread(std::stop_token stop);
   // The spindle register's settling (robot thread only).
   struct SpindleWatch {
     int candidate{-1}, same{0};
@@ -156,7 +157,6 @@ class ModbusClient final : public rt::AmplifierIo {
   bool poll_pose(modbus_t* ctx, PoseWatch& w);  // false: the read failed
   void pose_unknown_if_lost(PoseWatch& w);
   void report_pose(long region);
-  bool sleep_for(std::chrono::duration<double> d);  // false when stopping
   bool write_advice(modbus_t* ctx);  // the pending advice, if any; false: the write failed
   bool poll_depth(modbus_t* ctx);    // false: the read failed
 
@@ -172,10 +172,9 @@ class ModbusClient final : public rt::AmplifierIo {
   std::atomic<double> depth_mm_{std::numeric_limits<double>::quiet_NaN()};
   ModbusLink amp_link_;
   std::optional<ModbusLink> robot_link_;
-  std::thread amp_thread_, robot_thread_;
   mutable std::mutex m_;
-  mutable std::condition_variable cv_;
-  bool running_{false};
+  mutable std::condition_variable amp_seen_;  // a good amplifier poll, or stop (wait_for_amplifier)
+  bool running_{false};                       // guarded by m_: between start() and stop()
 
   std::atomic<bool> requested_{false};
   std::atomic<bool> enabled_{false}, ready_{false}, fault_{false};
@@ -188,6 +187,7 @@ class ModbusClient final : public rt::AmplifierIo {
       mounting_unknown_{0}, spindle_changes_{0}, spindle_link_parks_{0}, pose_changes_{0}, pose_out_of_map_polls_{0},
       pose_unavailable_polls_{0}, pose_link_losses_{0};
   std::int64_t link_timeout_ns_;
+  threads::Worker amp_, robot_;  // the two pollers (last: stopped before what they use goes)
 };
 
 }  // namespace robodamp::drivers

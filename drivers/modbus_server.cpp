@@ -26,7 +26,7 @@ ModbusServer::~ModbusServer() {
 }
 
 int ModbusServer::start(const std::string& host, int port) {
-  if (running_) return port_;
+  if (worker_.running()) return port_;
   ctx_ = modbus_new_tcp(host.c_str(), port);
   if (ctx_ == nullptr) throw std::runtime_error("Modbus server " + host + ":" + std::to_string(port) + ": " + modbus_strerror(errno));
   listen_fd_ = modbus_tcp_listen(ctx_, 8);
@@ -40,14 +40,13 @@ int ModbusServer::start(const std::string& host, int port) {
   socklen_t len = sizeof addr;
   getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len);
   port_ = ntohs(addr.sin_port);
-  running_ = true;
-  thread_ = std::thread([this] { serve(); });
+  worker_.start("rd-modbus-srv", [this](std::stop_token stop) { serve(stop); });
   return port_;
 }
 
 void ModbusServer::stop() {
-  if (!running_.exchange(false)) return;
-  thread_.join();
+  if (!worker_.running()) return;
+  worker_.stop();
   for (int fd : clients_) close(fd);
   clients_.clear();
   close(listen_fd_);
@@ -56,9 +55,9 @@ void ModbusServer::stop() {
   ctx_ = nullptr;
 }
 
-void ModbusServer::serve() {
+void ModbusServer::serve(std::stop_token stop) {
   std::vector<std::uint8_t> query(MODBUS_TCP_MAX_ADU_LENGTH);
-  while (running_) {
+  while (!stop.stop_requested()) {
     if (drop_.exchange(false)) {
       for (int fd : clients_) close(fd);
       clients_.clear();

@@ -7,9 +7,11 @@
 #include <atomic>
 #include <cstdint>
 #include <mutex>
+#include <stop_token>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "threads/worker.hpp"
 
 typedef struct _modbus modbus_t;
 typedef struct _modbus_mapping_t modbus_mapping_t;
@@ -48,16 +50,16 @@ class ModbusServer {
   [[nodiscard]] std::uint64_t connections() const { return connections_.load(); }
 
  private:
-  void serve();
+  void serve(std::stop_token stop);
   modbus_t* ctx_{nullptr};
   modbus_mapping_t* map_{nullptr};
   mutable std::mutex m_;
   int listen_fd_{-1};
   int port_{0};
   std::vector<int> clients_;
-  std::thread thread_;
-  std::atomic<bool> running_{false}, responding_{true}, drop_{false};
+  std::atomic<bool> responding_{true}, drop_{false};
   std::atomic<std::uint64_t> requests_{0}, connections_{0};
+  threads::Worker worker_;  // the select loop (last: stopped before what it serves goes)
 };
 
 }  // namespace robodamp::drivers

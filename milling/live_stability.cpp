@@ -52,18 +52,13 @@ LiveStability::LiveStability(config::MillingConfig job, const std::string& struc
     // the actuator, 2 across): the robot through the loop in both directions.
     plane_structure_ = robot_through_cell(job_structure_, 1, pose_->axis, sets_.front().source, 2);
   }
-  thread_ = std::thread([this] { worker(); });
-  sweep_thread_ = std::thread([this] { sweeper(); });
+  worker_.start("rd-live-limits", [this](std::stop_token stop) { worker(stop); });
+  sweeper_.start("rd-live-sweep", [this](std::stop_token stop) { sweeper(stop); });
 }
 
 LiveStability::~LiveStability() {
-  {
-    std::lock_guard<std::mutex> lock(m_);
-    stop_ = true;
-  }
-  cv_.notify_all();
-  thread_.join();
-  sweep_thread_.join();
+  sweeper_.stop();
+  worker_.stop();
 }
 
 LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg) const {
@@ -98,7 +93,7 @@ std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, dou
   std::lock_guard<std::mutex> lock(m_);
   if (const auto it = cache_.find(k); it != cache_.end()) return it->second;
   wanted_ = k;
-  cv_.notify_all();
+  worker_.notify();
   return std::nullopt;
 }
 
@@ -121,7 +116,7 @@ void LiveStability::sweep(std::size_t set, double gain_ns_per_m, const std::vect
   sweep_.clear();
   for (const double r : rpm)
     if (r > 0.0) sweep_.push_back(key(r, set, gain_ns_per_m, pose_deg));
-  cv_.notify_all();
+  sweeper_.notify();
 }
 
 std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per_m, const std::vector<double>& pose_deg) const {
@@ -138,7 +133,7 @@ void LiveStability::sweep(const std::vector<SweepPoint>& points) {
   sweep_.clear();
   for (const SweepPoint& p : points)
     if (p.rpm > 0.0) sweep_.push_back(key(p.rpm, p.set, p.gain_ns_per_m, p.pose_deg));
-  cv_.notify_all();
+  sweeper_.notify();
 }
 
 std::vector<LiveLimits> LiveStability::known(const std::vector<SweepPoint>& points) const {
@@ -155,11 +150,9 @@ std::uint64_t LiveStability::computations() const {
   return computations_;
 }
 
-void LiveStability::worker() {
+void LiveStability::worker(std::stop_token stop) {
   std::unique_lock<std::mutex> lock(m_);
-  for (;;) {
-    cv_.wait(lock, [this] { return stop_ || wanted_.has_value(); });
-    if (stop_) return;
+  while (worker_.wait(lock, stop, [this] { return wanted_.has_value(); })) {
     const Key k = *wanted_;
     wanted_.reset();
     if (cache_.count(k) != 0) continue;
@@ -190,16 +183,14 @@ void LiveStability::store(const Key& k, LiveLimits l) {
   cache_.emplace(k, std::move(l));
 }
 
-void LiveStability::sweeper() {
+void LiveStability::sweeper(std::stop_token stop) {
   // Below every other thread of the cell (nice 10: about 10 % of a core against a busy nice-0 thread), so the
   // sweep yields to the cell's drivers, its telemetry and the advice (the loop itself is real time) but still
   // moves on a loaded machine. At nice 19 (1.5 %) the browser test's cell drew fewer than 20 speeds in 240 s
   // under a CPU hog on both cores.
   (void)setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 10);
   std::unique_lock<std::mutex> lock(m_);
-  for (;;) {
-    cv_.wait(lock, [this] { return stop_ || !sweep_.empty(); });
-    if (stop_) return;
+  while (sweeper_.wait(lock, stop, [this] { return !sweep_.empty(); })) {
     const Key k = sweep_.front();
     sweep_.pop_front();
     if (cache_.count(k) != 0) continue;

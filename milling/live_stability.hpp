@@ -13,7 +13,6 @@
 // Off the real-time path.
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -21,12 +20,13 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
+#include <stop_token>
 #include <vector>
 
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
 #include "config/robot_model_config.hpp"
+#include "threads/worker.hpp"
 
 namespace robodamp::milling {
 
@@ -139,8 +139,8 @@ class LiveStability {
   void check_loop_model(LiveLimits& l, bool damping) const;   // at a pose: the whole model's open limit
   [[nodiscard]] LiveLimits evaluate_reported(const Key& k) const;  // a failure as a result with its problem
   void store(const Key& k, LiveLimits l);                          // under m_
-  void worker();
-  void sweeper();
+  void worker(std::stop_token stop);
+  void sweeper(std::stop_token stop);
 
   config::MillingConfig job_;
   config::StructureConfig structure_;
@@ -151,14 +151,12 @@ class LiveStability {
   std::optional<PoseDynamics> pose_;
 
   mutable std::mutex m_;
-  std::condition_variable cv_;
   std::map<Key, LiveLimits> cache_;
   std::optional<Key> wanted_;
   std::deque<Key> sweep_;
-  bool stop_{false};
   std::uint64_t computations_{0};
-  std::thread thread_;
-  std::thread sweep_thread_;  // last: started after everything it reads
+  threads::Worker worker_;   // the limits asked for now (lookup)
+  threads::Worker sweeper_;  // last: started after everything it reads; the sweep's speeds, at low priority
 };
 
 }  // namespace robodamp::milling

@@ -11,20 +11,16 @@ TelemetryDrain::TelemetryDrain(SpscRing<TelemetryFrame>& ring, std::vector<Consu
 TelemetryDrain::~TelemetryDrain() { stop(); }
 
 void TelemetryDrain::start() {
-  if (running_.exchange(true)) return;
-  thread_ = std::thread([this] {
-    while (running_.load(std::memory_order_relaxed)) {
+  if (worker_.running()) return;
+  worker_.start("rd-telemetry", [this](std::stop_token stop) {
+    do {
       drain_all();
-      std::this_thread::sleep_for(poll_);
-    }
-    drain_all();
+    } while (worker_.sleep_for(stop, poll_));
+    drain_all();  // what the loop pushed before it stopped
   });
 }
 
-void TelemetryDrain::stop() {
-  if (!running_.exchange(false)) return;
-  if (thread_.joinable()) thread_.join();
-}
+void TelemetryDrain::stop() { worker_.stop(); }
 
 void TelemetryDrain::drain_all() {
   TelemetryFrame f;

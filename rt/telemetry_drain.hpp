@@ -7,12 +7,12 @@
 #include <chrono>
 #include <functional>
 #include <mutex>
-#include <thread>
 #include <vector>
 
 #include "rt/spsc_ring.hpp"
 #include "rt/telemetry_frame.hpp"
 #include "rt/timing_histogram.hpp"
+#include "threads/worker.hpp"
 
 namespace robodamp::rt {
 
@@ -36,9 +36,8 @@ class TelemetryDrain {
   SpscRing<TelemetryFrame>& ring_;
   std::vector<Consumer> consumers_;
   std::chrono::microseconds poll_;
-  std::atomic<bool> running_{false};
   std::atomic<std::uint64_t> frames_{0};
-  std::thread thread_;
+  threads::Worker worker_;  // last: stopped before the consumers go
 };
 
 // A consumer: the loop's timing as telemetry sees it (histograms of the frames' wake-up latency and

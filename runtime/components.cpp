@@ -51,37 +51,27 @@ Status CanBus::on_activate() {
     flushed_ = driver_->flush();
     if (flushed_ > 0) spdlog::info("CAN: {} frames queued before the loop started, discarded", flushed_);
   }
-  if (cfg_.interface.rfind("unix:", 0) == 0) {
-    stopping_ = false;
-    reconnect_ = std::thread([this] { reconnect_loop(); });
-  }
+  if (cfg_.interface.rfind("unix:", 0) == 0)
+    reconnect_.start("rd-can-reconn", [this](std::stop_token stop) { reconnect_loop(stop); });
   return {};
 }
 
-void CanBus::reconnect_loop() {
+void CanBus::reconnect_loop(std::stop_token stop) {
   const std::string path = cfg_.interface.substr(5);
-  std::unique_lock<std::mutex> lock(m_);
-  while (!cv_.wait_for(lock, std::chrono::milliseconds(20), [this] { return stopping_; })) {
+  while (reconnect_.sleep_for(stop, std::chrono::milliseconds(20))) {
     if (const int fd = driver_->take_retired_fd(); fd >= 0) ::close(fd);
     if (!driver_->link_lost()) continue;
-    lock.unlock();
     try {
       drivers::CanChannel c = drivers::CanChannel::connect_unix(path, 0.05);
       if (driver_->offer_channel(std::move(c))) spdlog::warn("CAN: {} reconnected (the trip stays latched until reset)", cfg_.interface);
     } catch (const std::exception&) {
       // nobody listening yet: try again at the next round
     }
-    lock.lock();
   }
 }
 
 void CanBus::stop_reconnecting() {
-  {
-    std::lock_guard<std::mutex> lock(m_);
-    stopping_ = true;
-  }
-  cv_.notify_all();
-  if (reconnect_.joinable()) reconnect_.join();
+  reconnect_.stop();
   if (driver_)
     if (const int fd = driver_->take_retired_fd(); fd >= 0) ::close(fd);
 }

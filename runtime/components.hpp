@@ -11,10 +11,9 @@
 //   DdsEndpoint          participant and topics         status thread                    last status, stop
 #pragma once
 
-#include <condition_variable>
 #include <functional>
 #include <mutex>
-#include <thread>
+#include <stop_token>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,6 +27,7 @@
 #include "runtime/lifecycle.hpp"
 #include "sim_plant/plant.hpp"
 #include "sim_plant/plant_model.hpp"
+#include "threads/worker.hpp"
 
 namespace robodamp::runtime {
 
@@ -64,18 +64,15 @@ class CanBus final : public Component {
   Status on_activate() override;
   Status on_deactivate() override;
   Status on_cleanup() override;
-  void reconnect_loop();
+  void reconnect_loop(std::stop_token stop);
   void stop_reconnecting();
   config::CanConfig cfg_;
   double rate_hz_;
-  std::thread reconnect_;
-  std::mutex m_;
-  std::condition_variable cv_;
-  bool stopping_{false};
   config::ClockKind clock_;
   double connect_timeout_s_;
   std::unique_ptr<drivers::CanDriver> driver_;
   std::uint64_t flushed_{0};
+  threads::Worker reconnect_;  // a lost unix: link dialled again every 20 ms (last: stopped before the driver goes)
 };
 
 // The Modbus client (drivers::ModbusClient): amplifier enable, ready, fault, temperature; the robot's mounting.

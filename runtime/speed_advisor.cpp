@@ -65,21 +65,10 @@ SpeedAdvisor::SpeedAdvisor(milling::LiveStability& stability, std::function<Advi
                            milling::SpeedAdviceSettings s)
     : stability_(stability), view_(std::move(view)), on_advice_(std::move(on_advice)), rpm_min_(rpm_min),
       rpm_max_(rpm_max), period_s_(period_s), s_(std::move(s)) {
-  s_.cancelled = [this] {
-    std::lock_guard<std::mutex> lock(m_);
-    return stop_;
-  };
-  thread_ = std::thread([this] { run(); });
+  worker_.start("rd-speed-advice", [this](std::stop_token stop) { run(stop); });
 }
 
-SpeedAdvisor::~SpeedAdvisor() {
-  {
-    std::lock_guard<std::mutex> lock(m_);
-    stop_ = true;
-  }
-  cv_.notify_all();
-  thread_.join();
-}
+SpeedAdvisor::~SpeedAdvisor() { worker_.stop(); }
 
 std::optional<AdviceRecord> SpeedAdvisor::latest() const {
   std::lock_guard<std::mutex> lock(m_);
@@ -153,13 +142,12 @@ bool SpeedAdvisor::follow_status(const AdviceView& v) {
   return status == AdviceStatus::kExpired;
 }
 
-void SpeedAdvisor::run() {
+void SpeedAdvisor::run(std::stop_token stop) {
   std::optional<decltype(state_key(milling::SpeedAdviceRequest{}))> last;
   std::uint64_t seq = 0;
   double last_gain = -1.0;
-  std::unique_lock<std::mutex> lock(m_);
-  while (!cv_.wait_for(lock, std::chrono::duration<double>(period_s_), [this] { return stop_; })) {
-    lock.unlock();
+  s_.cancelled = [stop] { return stop.stop_requested(); };  // the cell shutting down ends a search between candidates
+  while (worker_.sleep_for(stop, std::chrono::duration<double>(period_s_))) {
     const AdviceView v = view_();
     const bool settled = std::abs(v.gain_ns_per_m - last_gain) <= 1e-3 * std::abs(v.gain_ns_per_m);
     last_gain = v.gain_ns_per_m;
@@ -181,14 +169,12 @@ void SpeedAdvisor::run() {
         else
           spdlog::warn("speed advice #{} ({} at {:.0f} rpm): {}", rec.seq, r->trigger, r->rpm, a.reason);
         if (on_advice_) on_advice_(rec);
-        lock.lock();
+        std::lock_guard<std::mutex> lock(m_);
         latest_ = std::move(rec);
-        lock.unlock();
       } catch (const std::exception& e) {  // a request the analysis cannot answer: said, never thrown at the cell
         spdlog::warn("speed advice: {}", e.what());
       }
     }
-    lock.lock();
   }
 }
 

@@ -9,18 +9,18 @@
 #pragma once
 
 #include <algorithm>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
+#include <stop_token>
 #include <utility>
 
 #include "dds/bridge.hpp"
 #include "milling/live_stability.hpp"
 #include "milling/speed_advice.hpp"
+#include "threads/worker.hpp"
 
 namespace robodamp::runtime {
 
@@ -78,7 +78,7 @@ class SpeedAdvisor {
   [[nodiscard]] static double same_speed_rpm(double rpm) { return std::max(0.5, 0.002 * rpm); }
 
  private:
-  void run();
+  void run(std::stop_token stop);
   bool follow_status(const AdviceView& v);
 
   milling::LiveStability& stability_;
@@ -87,10 +87,8 @@ class SpeedAdvisor {
   double rpm_min_, rpm_max_, period_s_;
   milling::SpeedAdviceSettings s_;
   mutable std::mutex m_;
-  std::condition_variable cv_;
-  bool stop_{false};
   std::optional<AdviceRecord> latest_;
-  std::thread thread_;
+  threads::Worker worker_;  // last: started after everything it reads
 };
 
 }  // namespace robodamp::runtime

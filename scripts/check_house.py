@@ -4,6 +4,7 @@
   python3 scripts/check_house.py sources              # nothing cites a file outside the repository
   python3 scripts/check_house.py layers BUILD_DIR     # every library links and includes only downwards
   python3 scripts/check_house.py picture CMAKE.dot OUT.dot  # the layered picture from CMake's graphviz
+  python3 scripts/check_house.py links                # every link between README.md and docs/ resolves
 """
 import glob
 import json
@@ -52,7 +53,7 @@ def sources():
 # The architecture: each library's layer, bottom first. A library may link and include only libraries of
 # lower layers (docs/architecture.md). A new library must be placed here.
 LAYERS = [
-    ("foundation", ["units"]),
+    ("foundation", ["units", "threads"]),
     ("data and numbers", ["filters", "config", "plot", "measfiles"]),
     ("physics", ["modal", "robot"]),
     ("controller and plant", ["control", "sim_plant"]),
@@ -64,6 +65,11 @@ LAYERS = [
 ]
 # Folder -> CMake target (the folder's name with the robodamp_ prefix, but for these).
 TARGET = {"sim_plant": "robodamp_sim", "apps": "robodamp_cli"}
+
+
+# Header-only INTERFACE libraries: CMake's code model lists no build dependency on them, so a use is not
+# checked against the links; its layer still is.
+HEADER_ONLY = {"units", "threads"}
 
 
 def layer_of():
@@ -127,7 +133,7 @@ def layers(build_dir):
                 bad.append(f"{lib} (layer {level[lib]}, {LAYERS[level[lib]][0]}) links {d} "
                            f"(layer {level[d]}, {LAYERS[level[d]][0]}): a library links only downwards")
         for used, where in sorted(includes(lib)):
-            if used != lib and used in level and used not in deps and used != "units":
+            if used != lib and used in level and used not in deps and used not in HEADER_ONLY:
                 bad.append(f"{where} includes {used}/, which {lib} does not link")
             elif used != lib and used in level and level[used] >= level[lib]:
                 bad.append(f"{where} includes {used}/ (layer {level[used]}) from layer {level[lib]}")
@@ -166,8 +172,44 @@ def picture(cmake_dot, out_dot):
     return 0
 
 
+def heading_anchors(path):
+    """The anchors a Markdown renderer gives the page's headings (GitHub's rule: lower case, punctuation
+    other than '-' and '_' dropped, spaces to '-')."""
+    out, fence = set(), False
+    for line in open(path, encoding="utf-8"):
+        fence = fence != line.startswith("```")
+        m = None if fence else re.match(r"^#+\s+(.*)", line)
+        if m:
+            out.add(re.sub(r"[^\w\- ]", "", m.group(1).strip().lower()).replace(" ", "-"))
+    return out
+
+
+def links():
+    """Every relative link of README.md and docs/*.md names a file that exists and, with '#', a heading of it."""
+    bad, count = [], 0
+    for page in ["README.md"] + sorted(os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "docs", "*.md"))):
+        fence = False
+        for n, line in enumerate(open(os.path.join(ROOT, page), encoding="utf-8"), 1):
+            fence = fence != line.startswith("```")
+            for m in ([] if fence else re.finditer(r"\]\(([^)\s]+)\)", line)):
+                url = m.group(1)
+                if re.match(r"^[a-z]+:", url):
+                    continue
+                count += 1
+                path, _, anchor = url.partition("#")
+                target = os.path.normpath(os.path.join(ROOT, os.path.dirname(page), path)) if path else os.path.join(ROOT, page)
+                if not os.path.exists(target):
+                    bad.append(f"{page}:{n}: {url}: no such file")
+                elif anchor and target.endswith(".md") and anchor not in heading_anchors(target):
+                    bad.append(f"{page}:{n}: {url}: no heading with that anchor")
+    for b in bad:
+        print(b)
+    print(f"{len(bad)} of {count} links do not resolve" if bad else f"all {count} links resolve")
+    return 1 if bad else 0
+
+
 if __name__ == "__main__":
-    checks = {"sources": (sources, 0), "layers": (layers, 1), "picture": (picture, 2)}
+    checks = {"sources": (sources, 0), "layers": (layers, 1), "picture": (picture, 2), "links": (links, 0)}
     if len(sys.argv) < 2 or sys.argv[1] not in checks or len(sys.argv) != 2 + checks[sys.argv[1]][1]:
         print(__doc__)
         sys.exit(2)

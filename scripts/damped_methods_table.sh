@@ -24,13 +24,13 @@ echo "| controller | rpm | analysed rpm | time domain (mm) | SDM (mm) | SDM erro
 echo "|---|---|---|---|---|---|---|---|"
 for g in "${groups[@]}"; do
   # shellcheck disable=SC2086
-  ./build/apps/robodamp cut --config "$job" --critical --revs "${g#*:}" --rpm ${g%:*} --json "$tmp/open.json" >/dev/null 2>&1
+  ./build/apps/robodamp cut --job "$job" --critical --revs "${g#*:}" --rpm ${g%:*} --json "$tmp/open.json" >/dev/null 2>&1
   row "open loop" "$tmp/open.json"
 done
 for c in horizontal_c1 horizontal_c2 horizontal_c3 tuned_horizontal tuned_vertical; do
   for g in "${groups[@]}"; do
     # shellcheck disable=SC2086
-    ./build/apps/robodamp cut --config "$job" --controller "config/presets/$c.yaml" --critical --damped --revs "${g#*:}" \
+    ./build/apps/robodamp cut --job "$job" --controller "config/presets/$c.yaml" --critical --damped --revs "${g#*:}" \
       --rpm ${g%:*} --json "$tmp/$c.json" >/dev/null 2>&1
     row "$c" "$tmp/$c.json"
   done

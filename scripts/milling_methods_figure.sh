@@ -12,11 +12,11 @@ fi
 job=config/milling/single_mode_low_immersion.yaml
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-./build/apps/robodamp lobes --config "$job" --method zoa --json > "$tmp/zoa.json"
-./build/apps/robodamp lobes --config "$job" --method sdm --json > "$tmp/sdm.json"
+./build/apps/robodamp lobes --job "$job" --method zoa --json > "$tmp/zoa.json"
+./build/apps/robodamp lobes --job "$job" --method sdm --json > "$tmp/sdm.json"
 speeds=$(seq 11000 1500 39500 | tr '\n' ' ')
 # shellcheck disable=SC2086
-./build/apps/robodamp cut --config "$job" --critical --rpm $speeds --json "$tmp/td.json" 2>/dev/null >/dev/null
+./build/apps/robodamp cut --job "$job" --critical --rpm $speeds --json "$tmp/td.json" 2>/dev/null >/dev/null
 for m in zoa sdm; do
   jq -r '.curve[] | select(.b_lim_mm != null) | "\(.rpm) \(.b_lim_mm)"' "$tmp/$m.json" > "$tmp/$m.dat"
 done

@@ -33,15 +33,15 @@ run analyze_notch_hil analyze --config config/hil_cutting_c2.yaml --spindle-rpm 
 for j in config/milling/*.yaml config/commissioning/job_*.yaml; do
   n=$(basename "$j" .yaml)
   run "check_$n" check-config "$j"
-  run "lobes_zoa_$n" lobes --config "$j" --method zoa --json
-  run "sle_$n" sle --config "$j" --json
+  run "lobes_zoa_$n" lobes --job "$j" --method zoa --json
+  run "sle_$n" sle --job "$j" --json
 done
-run lobes_sdm_c2 lobes --config config/milling/active_damping_c2.yaml --damped --json
-run lobes_sdm_tuned lobes --config config/milling/active_damping_tuned.yaml --damped --json
-run lobes_zoa_damped_c2 lobes --config config/milling/active_damping_c2.yaml --damped --method zoa --json
-run sle_damped_c2 sle --config config/milling/active_damping_c2.yaml --damped --json
-run cut_c2 cut --config config/milling/active_damping_c2.yaml --json "$out/cut_c2.json"
-run cut_damped_c2 cut --config config/milling/active_damping_c2.yaml --damped --rpm 700 --axial-mm 1 --revs 40 \
+run lobes_sdm_c2 lobes --job config/milling/active_damping_c2.yaml --damped --json
+run lobes_sdm_tuned lobes --job config/milling/active_damping_tuned.yaml --damped --json
+run lobes_zoa_damped_c2 lobes --job config/milling/active_damping_c2.yaml --damped --method zoa --json
+run sle_damped_c2 sle --job config/milling/active_damping_c2.yaml --damped --json
+run cut_c2 cut --job config/milling/active_damping_c2.yaml --json "$out/cut_c2.json"
+run cut_damped_c2 cut --job config/milling/active_damping_c2.yaml --damped --rpm 700 --axial-mm 1 --revs 40 \
   --json "$out/cut_damped_c2.json"
 run pose_table pose table --model config/robots/planar_three_link.yaml --json
 run pose_frf pose frf --model config/robots/planar_three_link.yaml --joints -100.59 119.81 -19.55 --json

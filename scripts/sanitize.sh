@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The suite under a sanitizer, in a build directory of its own (README, "Sanitizers"):
+# The suite under a sanitizer, in a build directory of its own (docs/tests.md, "Sanitizers"):
 #   bash scripts/sanitize.sh address   [ctest options]   AddressSanitizer (leaks too)   -> build-address
 #   bash scripts/sanitize.sh undefined [ctest options]   UndefinedBehaviorSanitizer     -> build-undefined
 #   bash scripts/sanitize.sh thread    [ctest options]   ThreadSanitizer                -> build-thread

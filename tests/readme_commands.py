@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Every command the README shows in a ```sh block runs as written (issue 55), or is set aside with its reason.
+"""Every command the README and docs/commands.md (the commands one by one, moved out of the README) show in a
+```sh block runs as written (issue 55), or is set aside with its reason.
 
-  python3 tests/readme_commands.py BINARY_DIR [README]
+  python3 tests/readme_commands.py BINARY_DIR [FILE.md ...]
 
 The commands run in order, each in one scratch directory whose `config` and `build` are the repository's (so
 `./build/apps/robodamp` and `config/...` resolve as in a clone), with BINARY_DIR first on PATH (the README's
@@ -80,14 +81,16 @@ def reason_to_skip(command, in_background_block):
 
 def main():
     binary_dir = os.path.abspath(sys.argv[1])
-    readme = sys.argv[2] if len(sys.argv) > 2 else os.path.join(ROOT, "README.md")
+    pages = sys.argv[2:] or [os.path.join(ROOT, "README.md"), os.path.join(ROOT, "docs", "commands.md")]
     scratch = tempfile.mkdtemp(prefix="robodamp-readme-")
     for name in ("config", "build"):
         os.symlink(os.path.join(ROOT, name), os.path.join(scratch, name))
     env = dict(os.environ, PATH=binary_dir + os.pathsep + os.environ.get("PATH", ""))
     ran, failed, skipped = 0, [], []
     try:
-        for line, command, background, _ in commands(readme):
+        blocks = [(os.path.relpath(page, ROOT),) + c for page in pages for c in commands(page)]
+        for page, line, command, background, _ in blocks:
+            line = f"{page}:{line}"
             why = reason_to_skip(command, background)
             if why:
                 skipped.append((line, command, why))
@@ -100,18 +103,18 @@ def main():
             except subprocess.TimeoutExpired:
                 status, tail = "timeout (180 s)", ""
             ran += 1
-            print(f"README:{line}: {'ok' if status == 0 else 'FAILED'}: {command}")
+            print(f"{line}: {'ok' if status == 0 else 'FAILED'}: {command}")
             if status != 0:
                 failed.append((line, command, status, tail))
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     for line, command, why in skipped:
-        print(f"README:{line}: set aside ({why}): {command}")
+        print(f"{line}: set aside ({why}): {command}")
     for line, command, status, tail in failed:
-        print(f"\nREADME:{line}: `{command}` ended with {status}:\n{tail}")
+        print(f"\n{line}: `{command}` ended with {status}:\n{tail}")
     print(f"readme_commands: {ran} run, {len(failed)} failed, {len(skipped)} set aside")
     if ran < 9:
-        print("readme_commands: fewer than 9 commands ran: the README's blocks were not read as expected")
+        print("readme_commands: fewer than 9 commands ran: the pages' blocks were not read as expected")
         return 1
     return 1 if failed else 0
 

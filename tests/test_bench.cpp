@@ -46,7 +46,7 @@ TEST(Bench, OpenLoopImpactsMatchTheModalModelWithoutNoise) {
 }
 
 TEST(Bench, OpenLoopImpactsMatchTheModalModelWithNoiseAndDrives) {
-  // Stated in the README: 1000 N impacts, 10 averages of 10 s records, noise 3 ug/sqrt(Hz), 3 Hz drives on.
+  // Stated in docs/commands.md: 1000 N impacts, 10 averages of 10 s records, noise 3 ug/sqrt(Hz), 3 Hz drives on.
   const analysis::Bench bench(config::load_config_file(test::preset("horizontal_c2")));
   expect_open_loop_matches(bench, 0.1, 0.99);
 }

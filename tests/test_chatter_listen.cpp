@@ -322,7 +322,7 @@ double truth_onset_s(const SimulatedCut& c, bool mic, double floor) {
 // recorded at 10, 25.6 and 48 kHz, by an accelerometer and by a microphone (its band and no floor of its own:
 // --floor in pascals). The speed is estimated from the recording. The open loop's limits by SDM: 1.111 mm at
 // 700 rpm (Hopf, 23.8 Hz), 0.220 mm at 381 rpm (flip, 9.5 Hz); damped at K = 2000 N s/m: 0.782 mm at
-// 699.3 rpm (`lobes --config config/milling/active_damping_c2.yaml --damped --rpm 700 381`). The speed is
+// 699.3 rpm (`lobes --job config/milling/active_damping_c2.yaml --damped --rpm 700 381`). The speed is
 // estimated from the recording, except for the flip: its lines (half the tooth frequency and its odd
 // multiples) and the teeth's make a comb at half the spindle speed, so the recording alone says 190 rpm as
 // well as 381 (`estimate_rpm` finds neither within 300-3000 rpm and says to give --rpm).

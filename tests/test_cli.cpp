@@ -92,6 +92,47 @@ TEST(Cli, FiltersPlotWritesAPng) {
   std::filesystem::remove(png);
 }
 
+// lobes, sle and cut read the milling job with --job, as every command does; their old --config JOB still runs
+// with the same answer and says what replaces it; both together are refused (docs/cli.md, "Inputs").
+TEST(Cli, TheMillingJobIsJobEverywhereAndTheOldConfigStillRuns) {
+  const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
+  const Result now = run("lobes --job " + job + " --method zoa --json");
+  const Result old = run("lobes --config " + job + " --method zoa --json");
+  ASSERT_EQ(now.status, 0) << now.out;
+  ASSERT_EQ(old.status, 0) << old.out;
+  EXPECT_EQ(now.out.find("deprecated"), std::string::npos) << now.out;
+  EXPECT_NE(old.out.find("--config is deprecated (kept for one release): use --job JOB"), std::string::npos) << old.out;
+  // The same diagram either way (its computing time aside).
+  const auto diagram = [](const std::string& out) {
+    nlohmann::json j = nlohmann::json::parse(out.substr(out.find('{')));
+    j.erase("diagram_ms");
+    return j;
+  };
+  EXPECT_GT(diagram(now.out).at("min_b_lim_mm").get<double>(), 0.0);
+  EXPECT_EQ(diagram(now.out), diagram(old.out));
+  const Result both = run("lobes --job " + job + " --config " + job);
+  EXPECT_EQ(both.status, 2) << both.out;
+  EXPECT_NE(both.out.find("excludes"), std::string::npos) << both.out;
+  // pose's --pose named a pose where every other command's --pose is joint angles, and its --csv wrote a table
+  // where every other command's reads one: --pose-name and --csv-out now, the old spellings still run.
+  const std::string csv_now = temp_path("frf_now.csv"), csv_old = temp_path("frf_old.csv");
+  const Result pose_now = run("pose frf --pose-name 'pose 2' --band-hz 5 40 --csv-out " + csv_now);
+  const Result pose_old = run("pose frf --pose 'pose 2' --band-hz 5 40 --csv " + csv_old);
+  ASSERT_EQ(pose_now.status, 0) << pose_now.out;
+  ASSERT_EQ(pose_old.status, 0) << pose_old.out;
+  EXPECT_EQ(pose_now.out.find("deprecated"), std::string::npos) << pose_now.out;
+  EXPECT_NE(pose_old.out.find("--pose is deprecated (kept for one release): use --pose-name NAME"), std::string::npos) << pose_old.out;
+  EXPECT_NE(pose_old.out.find("--csv is deprecated (kept for one release): use --csv-out FILE"), std::string::npos) << pose_old.out;
+  const auto text_of = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_GT(text_of(csv_now).size(), 1000U);
+  EXPECT_EQ(text_of(csv_now), text_of(csv_old));
+  std::filesystem::remove(csv_now);
+  std::filesystem::remove(csv_old);
+}
+
 TEST(Cli, CheckConfigAcceptsEveryPreset) {
   for (const char* p : {"horizontal_c2", "horizontal_c1", "horizontal_c3", "vertical_c1"}) {
     const Result r = run("check-config " + robodamp::test::preset(p));
@@ -141,7 +182,7 @@ TEST(Cli, ShippedFilesCopiedOutOfTheTreeStillRead) {
     const Result r = run("check-config " + home.file(from.filename().string()));
     EXPECT_EQ(r.status, 0) << from << "\n" << r.out;
   }
-  const Result lobes = run("lobes --config " + home.file("active_damping_c2.yaml") + " --rpm 700 --json");
+  const Result lobes = run("lobes --job " + home.file("active_damping_c2.yaml") + " --rpm 700 --json");
   ASSERT_EQ(lobes.status, 0) << lobes.out;
   // Found nowhere: every place said.
   std::string job = robodamp::test::read_file((tree / "milling" / "active_damping_c2.yaml").string());
@@ -162,7 +203,7 @@ TEST(Cli, ShippedFilesCopiedOutOfTheTreeStillRead) {
   robodamp::test::replace_or_throw(preset, "  gain_ns_per_m: 2000 ", "  gain_ns_per_m: 1234 ");
   std::ofstream(home.file("mine/presets/horizontal_c2.yaml")) << preset;
   fs::remove(home.file("horizontal_c2.yaml"));
-  const Result mine = run_shell("ROBODAMP_DATA_PATH=" + home.file("mine") + " " + ROBODAMP_BINARY + " lobes --config " +
+  const Result mine = run_shell("ROBODAMP_DATA_PATH=" + home.file("mine") + " " + ROBODAMP_BINARY + " lobes --job " +
                                 home.file("active_damping_c2.yaml") + " --damped --rpm 700 --json");
   ASSERT_EQ(mine.status, 0) << mine.out;
   EXPECT_NE(mine.out.find("1234"), std::string::npos) << mine.out.substr(0, 2000);
@@ -336,7 +377,7 @@ TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
   const std::string open_json = temp_path("cut-open.json"), damped_json = temp_path("cut-damped.json"),
                     dir = temp_path("cut-plots");
-  const Result open = run("cut --config " + job + " --rpm 252 --axial-mm 0.6 --json " + open_json + " --plot-dir " + dir);
+  const Result open = run("cut --job " + job + " --rpm 252 --axial-mm 0.6 --json " + open_json + " --plot-dir " + dir);
   ASSERT_EQ(open.status, 0) << open.out;
   const auto o = nlohmann::json::parse(robodamp::test::read_file(open_json));
   for (const char* key : {"rpm", "axial_mm", "stable", "classification", "chatter_hz", "once_per_tooth_ratio",
@@ -347,7 +388,7 @@ TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
   EXPECT_GT(o["nonharmonic_energy_ratio"].get<double>(), 0.5);
   for (const char* png : {"cut_displacement.png", "cut_force.png", "cut_spectrum.png", "cut_surface.png"})
     EXPECT_GT(std::filesystem::file_size(dir + "/" + png), 1000u) << png;
-  const Result damped = run("cut --config " + job + " --rpm 252 --axial-mm 0.6 --damped --json " + damped_json);
+  const Result damped = run("cut --job " + job + " --rpm 252 --axial-mm 0.6 --damped --json " + damped_json);
   ASSERT_EQ(damped.status, 0) << damped.out;
   const auto d = nlohmann::json::parse(robodamp::test::read_file(damped_json));
   EXPECT_TRUE(d["stable"].get<bool>()) << damped.out;
@@ -355,7 +396,7 @@ TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
   EXPECT_GT(d["peak_actuator_force_n"].get<double>(), 0.1);  // the damper works during the cut
   EXPECT_FALSE(d["actuator_saturated"].get<bool>());
   // Deep enough, the damped cut chatters too and drives the actuator into its limit: it shows.
-  const Result deep = run("cut --config " + job + " --rpm 252 --axial-mm 4 --damped --json " + damped_json);
+  const Result deep = run("cut --job " + job + " --rpm 252 --axial-mm 4 --damped --json " + damped_json);
   const auto deep_j = nlohmann::json::parse(robodamp::test::read_file(damped_json));
   EXPECT_FALSE(deep_j["stable"].get<bool>());
   EXPECT_TRUE(deep_j["actuator_saturated"].get<bool>()) << deep.out;
@@ -368,12 +409,12 @@ TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
 TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
   const std::string cut_json = temp_path("critical.json");
-  const Result c = run("cut --config " + job + " --critical --rpm 282 700 --json " + cut_json);
+  const Result c = run("cut --job " + job + " --critical --rpm 282 700 --json " + cut_json);
   ASSERT_EQ(c.status, 0) << c.out;
   const auto crit = nlohmann::json::parse(robodamp::test::read_file(cut_json))["critical"];
   ASSERT_EQ(crit.size(), 2u);
   // The default method is the accurate one, open loop and damped, and says so.
-  const Result l = run("lobes --config " + job + " --rpm 282 700 --json --damped");
+  const Result l = run("lobes --job " + job + " --rpm 282 700 --json --damped");
   ASSERT_EQ(l.status, 0) << l.out;
   const auto sdm = nlohmann::json::parse(l.out.substr(l.out.find('{')));
   EXPECT_EQ(sdm["method"], "SDM");
@@ -388,7 +429,7 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
   }
   // Damped: the sampled loop's SDM is the time-domain cut's with the real Controller (at the stepped speed),
   // where the zero-order preview is 37 % too deep.
-  const Result d = run("cut --config " + job + " --critical --damped --revs 300 --rpm 700 --json " + cut_json);
+  const Result d = run("cut --job " + job + " --critical --damped --revs 300 --rpm 700 --json " + cut_json);
   ASSERT_EQ(d.status, 0) << d.out;
   const auto dc = nlohmann::json::parse(robodamp::test::read_file(cut_json))["critical"][0];
   const auto& da = sdm["damped"]["at_rpm"][1];
@@ -409,18 +450,18 @@ TEST(Cli, DampedStabilityRefusesASpeedTheLoopCannotStepAndAnUnstableController) 
   yaml.replace(yaml.find("rpm_max: 1500"), 13, "rpm_max: 15000");
   const std::string job = temp_path("fast.yaml");
   std::ofstream(job) << yaml;
-  const Result lobes = run("lobes --config " + job + " --damped --rpm 12000");
+  const Result lobes = run("lobes --job " + job + " --damped --rpm 12000");
   EXPECT_EQ(lobes.status, 2) << lobes.out;
   EXPECT_NE(lobes.out.find("12000 rpm"), std::string::npos) << lobes.out;
   EXPECT_NE(lobes.out.find("(0, 10526.3] rpm"), std::string::npos) << lobes.out;
-  const Result cut = run("cut --config " + job + " --critical --damped --rpm 12000");
+  const Result cut = run("cut --job " + job + " --critical --damped --rpm 12000");
   EXPECT_EQ(cut.status, 2) << cut.out;
   EXPECT_NE(cut.out.find("allowed range (0, 10526.3] rpm"), std::string::npos) << cut.out;
   std::string unstable = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
   unstable.replace(unstable.find("gain_ns_per_m: 2000"), 19, "gain_ns_per_m: 9000");
   const std::string controller = temp_path("unstable.yaml");
   std::ofstream(controller) << unstable;
-  const Result bad = run("lobes --config " + job + " --damped --controller " + controller);
+  const Result bad = run("lobes --job " + job + " --damped --controller " + controller);
   EXPECT_EQ(bad.status, 2) << bad.out;
   EXPECT_NE(bad.out.find("the damping loop is unstable at K = 9000"), std::string::npos) << bad.out;
   std::filesystem::remove(job);
@@ -444,7 +485,7 @@ TEST(Cli, AnalyzeAtASpindleSpeedGivesTheJobsLimitsWithTheirMethod) {
 
 TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
-  const Result wide = run("cut --config " + job + " --radial-mm 13");
+  const Result wide = run("cut --job " + job + " --radial-mm 13");
   EXPECT_EQ(wide.status, 2) << wide.out;
   EXPECT_NE(wide.out.find("--radial-mm = 13 mm is out of range: allowed 0 < value <= 12.7 mm (the tool's diameter)"),
             std::string::npos) << wide.out;
@@ -453,7 +494,7 @@ TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   yaml += "\ntime_domain: {steps_per_tooth: 2}\n";
   const std::string path = temp_path("coarse.yaml");
   std::ofstream(path) << yaml;
-  const Result coarse = run("cut --config " + path);
+  const Result coarse = run("cut --job " + path);
   EXPECT_EQ(coarse.status, 2) << coarse.out;
   EXPECT_NE(coarse.out.find("time_domain.steps_per_tooth = 2 steps is too coarse for the modes: allowed >= "), std::string::npos)
       << coarse.out;
@@ -478,7 +519,7 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   const char* poses[3][2] = {{"pose 1", "-120.13,133.37,-14.13"}, {"pose 2", "-100.59,119.81,-19.55"}, {"pose 3", "-84.75,104.63,-20.08"}};
   for (int i = 0; i < 3; ++i) {
     const std::string csv = dir + "/p" + std::to_string(i + 1) + ".csv";
-    const Result frf = run("pose frf --pose '" + std::string(poses[i][0]) + "' --band-hz 5 40 --csv " + csv);
+    const Result frf = run("pose frf --pose-name '" + std::string(poses[i][0]) + "' --band-hz 5 40 --csv-out " + csv);
     ASSERT_EQ(frf.status, 0) << frf.out;
     EXPECT_NE(frf.out.find("receptance coupling (RCSA) within"), std::string::npos) << frf.out;
     measured += std::string(" --measured=") + poses[i][1] + ":" + csv;
@@ -492,7 +533,7 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   const Result at3 = run("lobes --method zoa --config " + job + " --pose -84.75 104.63 -20.08");
   ASSERT_EQ(at3.status, 0) << at3.out;
   EXPECT_NE(at3.out.find("at joints -84.75 104.63 -20.08 deg"), std::string::npos) << at3.out;
-  const Result out_of_travel = run("lobes --config " + job + " --pose -84.75 204.63 -20.08");
+  const Result out_of_travel = run("lobes --job " + job + " --pose -84.75 204.63 -20.08");
   EXPECT_EQ(out_of_travel.status, 2);
   EXPECT_NE(out_of_travel.out.find("--pose: joint 2 = 204.63 deg is out of range"), std::string::npos) << out_of_travel.out;
   const Result no_pose = run("lobes --pose -84.75 104.63 -20.08");
@@ -973,7 +1014,7 @@ TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
   std::filesystem::remove(png);
   // Another compensator through --controller, by the accurate default: C1 also raises the 23.5 Hz lobe
   // where C2 lowers it.
-  const Result c1 = run("lobes --config " + milling_job("active_damping_c2") + " --json --damped --controller " +
+  const Result c1 = run("lobes --job " + milling_job("active_damping_c2") + " --json --damped --controller " +
                         robodamp::test::preset("horizontal_c1"));
   ASSERT_EQ(c1.status, 0) << c1.out;
   const auto j1 = nlohmann::json::parse(c1.out.substr(c1.out.find('{')));
@@ -992,10 +1033,10 @@ TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
     EXPECT_EQ(b.status, 0) << b.out;
     EXPECT_NE(b.out.find("minimum limiting depth"), std::string::npos) << b.out;
   }
-  const Result bad = run("lobes --config " + milling_job("orthopaedic_bone") + " --structure position_9");
+  const Result bad = run("lobes --job " + milling_job("orthopaedic_bone") + " --structure position_9");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.out.find("'position_9' is not one of: position_1"), std::string::npos) << bad.out;
-  const Result undamped = run("lobes --config " + milling_job("orthopaedic_bone") + " --damped");
+  const Result undamped = run("lobes --job " + milling_job("orthopaedic_bone") + " --damped");
   EXPECT_EQ(undamped.status, 2);
   EXPECT_NE(undamped.out.find("--damped needs a part with a controller"), std::string::npos) << undamped.out;
 }
@@ -1009,7 +1050,7 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   job.replace(at, std::strlen("  points: 300"), "  points: 30");
   const std::string job_path = temp_path("sle_job.yaml"), png = temp_path("sle_plots") + "/sle.png";
   std::ofstream(job_path) << job;
-  const Result r = run("sle --config " + job_path + " --json --plot-dir " + temp_path("sle_plots"));
+  const Result r = run("sle --job " + job_path + " --json --plot-dir " + temp_path("sle_plots"));
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
   EXPECT_EQ(j["map"].size(), 30u);
@@ -1032,7 +1073,7 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   EXPECT_EQ(j["conditions"][1]["surface_normal"], "x");
   EXPECT_GT(std::filesystem::file_size(png), 10000u);
   std::filesystem::remove(png);
-  const Result d = run("sle --config " + milling_job("active_damping_c2") + " --json --damped");
+  const Result d = run("sle --job " + milling_job("active_damping_c2") + " --json --damped");
   ASSERT_EQ(d.status, 0) << d.out;
   const auto jd = nlohmann::json::parse(d.out);
   EXPECT_EQ(jd["damped"]["map"].size(), jd["map"].size());
@@ -1068,11 +1109,32 @@ std::vector<std::string> subcommands() {
   return out;
 }
 
+// Each option of a help text as one line: "--name TYPE ... description", its description's continuation lines
+// (CLI11 moves a description below an option with Excludes:) joined to it.
+std::vector<std::string> option_entries(const std::string& help) {
+  std::vector<std::string> out;
+  std::istringstream in(help);
+  bool open = false;
+  for (std::string line; std::getline(in, line);) {
+    const std::size_t first = line.find_first_not_of(' ');
+    if (first != std::string::npos && line.compare(first, 2, "--") == 0) {
+      out.push_back(line);
+      open = true;
+    } else if (open && first != std::string::npos && first >= 10) {
+      out.back() += " " + line.substr(first);
+    } else {
+      open = false;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 // One command-line convention (docs/cli.md), checked on every subcommand's help: each one's --json takes
 // an optional FILE (bare or -: stdout), plots go to --plot-dir DIR, an old spelling is marked deprecated
-// and names what replaces it, and every command that writes JSON still offers it.
+// and names what replaces it, and every command that writes JSON still offers it. --config is never a
+// milling job and --pose never anything but joint angles, except as a deprecated spelling.
 TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
   const std::vector<std::string> subs = subcommands();
   ASSERT_GE(subs.size(), 20U);
@@ -1082,11 +1144,9 @@ TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
   for (const std::string& sub : subs) {
     const Result h = run(sub + " --help");
     EXPECT_EQ(h.status, 0) << sub;
-    std::istringstream in(h.out);
     bool plot_dir = false, plot_file = false;
-    for (std::string line; std::getline(in, line);) {
+    for (const std::string& line : option_entries(h.out)) {
       const std::size_t at = line.find("--");
-      if (at == std::string::npos || line.find_first_not_of(' ') != at) continue;  // option lines only
       const std::string name = line.substr(at, line.find_first_of(" ,=", at) - at);
       if (name == "--json") {
         has_json.insert(sub);
@@ -1098,6 +1158,10 @@ TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
       } else if (name == "--plot" || name == "--json-out") {
         plot_file = plot_file || name == "--plot";
         EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": " << line;
+      } else if (name == "--config" && line.find("illing job") != std::string::npos) {
+        EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": --config is the cell; the job is --job: " << line;
+      } else if (name == "--pose" && line.find("joint angles") == std::string::npos) {
+        EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": --pose is joint angles: " << line;
       }
     }
     if (plot_file) {

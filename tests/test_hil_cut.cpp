@@ -42,7 +42,7 @@ Verdicts cut_both_ways(const std::string& name, const std::string& depth_mm) {
   EXPECT_EQ(run.wait(), 0) << test::read_file(f.run_log);
   EXPECT_EQ(plant.wait(), 0) << test::read_file(f.plant_log);
   const std::string in_process_json = f.dir + "/cut.json";
-  Child cut({"cut", "--config", kJob, "--rpm", "700", "--axial-mm", depth_mm, "--revs", "150", "--damped", "--json",
+  Child cut({"cut", "--job", kJob, "--rpm", "700", "--axial-mm", depth_mm, "--revs", "150", "--damped", "--json",
              in_process_json},
             f.dir + "/cut.log");
   EXPECT_EQ(cut.wait(), 0) << test::read_file(f.dir + "/cut.log");
@@ -79,7 +79,7 @@ TEST(HilCut, TheEmulatorsRegenerativeCutAgreesWithTheInProcessCutBothWays) {
 TEST(HilCut, TheCriticalDepthAcrossProcessesMatchesTheInProcessOne) {
   const test::HilFiles f = test::hil_files("regen_critical");
   const std::string out = f.dir + "/critical.json";
-  Child cut({"cut", "--config", kJob, "--rpm", "700", "--damped", "--critical", "--hil", f.config, "--json", out},
+  Child cut({"cut", "--job", kJob, "--rpm", "700", "--damped", "--critical", "--hil", f.config, "--json", out},
             f.dir + "/critical.log");
   ASSERT_EQ(cut.wait(), 0) << test::read_file(f.dir + "/critical.log");
   const json c = json::parse(test::read_file(out))["critical"][0];

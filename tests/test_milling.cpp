@@ -329,7 +329,7 @@ TEST(Milling, ConfigurationErrorsAreSpecific) {
   }
 }
 
-// The active-damping preset: the controller moves the lobes (model prediction for the README).
+// The active-damping preset: the controller moves the lobes (model prediction for docs/commands.md).
 TEST(Milling, ActiveDampingRaisesTheMinimumStableDepthOfThePreset) {
   const auto job = cfg::load_milling_config(milling_preset("active_damping_c2"));
   const auto& sc = *job.find_structure(job.structure);

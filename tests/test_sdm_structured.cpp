@@ -135,7 +135,7 @@ TEST(Sdm, TheStructuredMonodromyHasTheDenseFormulasMultipliersAndDepthsOnTheFort
       [&](double b) { return std::log(std::abs(dense_multiplier(r, b, 1156.0, m))); }, 3.0, 1e-3);
   const SdmPoint got = sdm.critical(1156.0, 3.0);
   EXPECT_NEAR(got.critical_depth_mm, truth.lo_mm, 1e-7 * truth.lo_mm);
-  EXPECT_NEAR(got.critical_depth_mm, 3.478, 0.0005);  // README's minimum of the 200-speed diagram
+  EXPECT_NEAR(got.critical_depth_mm, 3.478, 0.0005);  // docs/tests.md's minimum of the 200-speed diagram
   EXPECT_NEAR(got.chatter_hz, 28.9, 0.05);
 }
 
