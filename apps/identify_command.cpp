@@ -126,7 +126,7 @@ int run_modes(const IdentifyArgs& a) {
     std::printf("  %9.4f Hz  zeta %.5f  sigma %+.4e %+.4ei m/N  (k %.4g N/m)\n", m.natural_freq_hz, m.damping_ratio,
                 m.residue_re, m.residue_im, m.stiffness_n_per_m);
     j["modes"].push_back({{"natural_freq_hz", m.natural_freq_hz}, {"damping_ratio", m.damping_ratio},
-                          {"residue_re", m.residue_re}, {"residue_im", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
+                          {"residue_re_m_per_n", m.residue_re}, {"residue_im_m_per_n", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
     yaml << "  - {natural_freq_hz: " << m.natural_freq_hz << ", damping_ratio: " << m.damping_ratio
          << ", residue_re_m_per_n: " << m.residue_re << ", residue_im_m_per_n: " << m.residue_im << "}\n";
   }

@@ -392,7 +392,7 @@ json to_json(const CommissioningResult& r) {
     json modes = json::array();
     for (const auto& m : f.fit.modes)
       modes.push_back({{"natural_freq_hz", m.natural_freq_hz}, {"damping_ratio", m.damping_ratio},
-                       {"residue_re", m.residue_re}, {"residue_im", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
+                       {"residue_re_m_per_n", m.residue_re}, {"residue_im_m_per_n", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
     frfs.push_back({{"name", f.name}, {"response_location", f.response_id}, {"excitation_location", f.excitation_id},
                     {"file", f.file}, {"modes", modes}, {"fit_error_pct", f.fit.fit_error_pct},
                     {"band_hz", {f.fit.band_lo_hz, f.fit.band_hi_hz}}});
