@@ -126,7 +126,17 @@ Decision Bridge::refuse(std::string reason) {
 Decision Bridge::decide(RequestKind kind, double value) {
   ++n_requests_;
   Decision d;
-  if (!cfg_.parameter_writes)
+  bool running = false;
+  {
+    // The request reader listens from the bridge's construction, while the cell still builds the loop its
+    // requests go to (ThreadSanitizer found one reaching Cell::handle_request then): they reach the cell
+    // only between start() and stop(), ordered after what the cell built by this lock.
+    std::lock_guard<std::mutex> lock(m_);
+    running = running_;
+  }
+  if (!running)
+    d = {false, "the cell is not running (starting or stopped): try again once it runs"};
+  else if (!cfg_.parameter_writes)
     d = {false, "parameter writes are off: dds.parameter_writes is false in " + source_};
   else
     d = src_.handle(kind, value);

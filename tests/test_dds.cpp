@@ -490,11 +490,13 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
           "supervision:\n  overrun_cycles: 5000\n";
   std::ofstream(dir + "/cell.yaml") << text;
   test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--json", dir + "/run.json"}, dir + "/run.log");
+  // The listeners first: they outlive the participant whose threads call them (ThreadSanitizer found them
+  // destroyed while its reader thread still delivered).
+  Collect<msg::Status> status;      // the cell's own word on the set that runs
+  Collect<msg::Spectrum> spectrum;  // its mode marks: the robot's modes at the pose
   dds::Participant driver(domain, config::DdsTransport::kUdpLoopback, "test robot driver", std::nullopt);
   DataWriter* w = driver.joint_state_writer("rt/joint_states");
-  Collect<msg::Status> status;  // the cell's own word on the set that runs
   driver.reader(dds::TopicKind::kStatus, &status);
-  Collect<msg::Spectrum> spectrum;  // its mode marks: the robot's modes at the pose
   driver.reader(dds::TopicKind::kSpectrum, &spectrum);
   const std::string cell = "joints-" + std::to_string(getpid());
   const auto running_set = [&](std::uint32_t set) {
@@ -618,10 +620,10 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
   std::ofstream(dir + "/cell.yaml") << text;
   test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--spindle-rpm", "700", "--json", dir + "/run.json"},
                   dir + "/run.log");
+  Collect<msg::Advice> advice;  // first: it outlives the participant whose thread calls it
   dds::Participant program(domain, config::DdsTransport::kUdpLoopback, "test robot program", std::nullopt);
   DataWriter* joints = program.joint_state_writer("rt/joint_states");
   DataWriter* trajectory = program.trajectory_writer("rt/joint_trajectory");
-  Collect<msg::Advice> advice;
   program.reader(dds::TopicKind::kAdvice, &advice);
   const double r = M_PI / 180.0;
   std::atomic<bool> stop{false};
