@@ -57,6 +57,8 @@ LiveStability::LiveStability(config::MillingConfig job, const std::string& struc
 }
 
 LiveStability::~LiveStability() {
+  sweeper_.request_stop();  // both asked first: neither starts another limit while the other is joined
+  worker_.request_stop();
   sweeper_.stop();
   worker_.stop();
 }

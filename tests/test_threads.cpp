@@ -70,6 +70,31 @@ TEST(Worker, NotifyWakesTheBodyOnceWhatItWaitsForHolds) {
   EXPECT_EQ(served, 100);
 }
 
+// A stop wins over work still queued: a body whose predicate always holds (a long sweep's queue) gets false
+// from its wait once a stop is asked, and leaves; the pieces of work it did are the ones before the stop.
+TEST(Worker, AStopWinsOverWorkStillQueued) {
+  std::mutex m;
+  std::atomic<int> done{0};
+  std::atomic<bool> asked{false};
+  int done_at_stop = -1;
+  Worker w;
+  w.start("rd-test-queue", [&](std::stop_token stop) {
+    std::unique_lock<std::mutex> lock(m);
+    while (w.wait(lock, stop, [] { return true; }) && done < 1000) {  // always more to do (bounded: a failure, not a hang)
+      lock.unlock();
+      ++done;
+      while (!asked && done >= 3) std::this_thread::yield();  // hold the third piece until the stop is asked
+      lock.lock();
+    }
+  });
+  ASSERT_TRUE(eventually([&] { return done.load() >= 3; }));
+  w.request_stop();
+  done_at_stop = done.load();
+  asked = true;
+  w.stop();
+  EXPECT_EQ(done.load(), done_at_stop);  // nothing more after the stop, though the queue never emptied
+}
+
 TEST(Worker, ATimedWaitAndASleepEndOnTheirTimeoutAndEarlyOnAStop) {
   std::mutex m;
   std::atomic<int> rounds{0};

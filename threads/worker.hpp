@@ -43,22 +43,29 @@ class Worker {
     thread_.join();
   }
 
+  // Asks without waiting: an owner of several workers asks them all, then joins each (stop()), so that
+  // none keeps working while another is joined.
+  void request_stop() {
+    if (thread_.joinable()) thread_.request_stop();
+  }
+
   [[nodiscard]] bool running() const { return thread_.joinable(); }
 
   // Wakes the body's wait (after the caller changed what its predicate reads, under the same mutex).
   void notify() { cv_.notify_all(); }
 
-  // For the body: waits on `lock` (the owner's mutex) until wake() holds or a stop is requested. Returns
-  // wake()'s value: false means stopped.
+  // For the body: waits on `lock` (the owner's mutex) until wake() holds or a stop is requested. True: there
+  // is work (wake() holds) and no stop was asked; false: stop. A stop wins over work still queued (a sweep
+  // of eighty speeds is not finished on the way out).
   template <class Lock, class Wake>
   bool wait(Lock& lock, std::stop_token stop, Wake wake) {
-    return cv_.wait(lock, stop, std::move(wake));
+    return cv_.wait(lock, stop, std::move(wake)) && !stop.stop_requested();
   }
 
-  // The same with a timeout: false on the timeout or a stop with wake() false (check stop.stop_requested()).
+  // The same with a timeout: false on the timeout or a stop (check stop.stop_requested() to tell them apart).
   template <class Lock, class Rep, class Period, class Wake>
   bool wait_for(Lock& lock, std::stop_token stop, std::chrono::duration<Rep, Period> timeout, Wake wake) {
-    return cv_.wait_for(lock, stop, timeout, std::move(wake));
+    return cv_.wait_for(lock, stop, timeout, std::move(wake)) && !stop.stop_requested();
   }
 
   // A pause of `period` that a stop request ends early; true when it was not stopped.
