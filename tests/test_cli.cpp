@@ -530,7 +530,7 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   // Lobes at a pose: the job's pose part takes --pose; a pose out of the travel, or --pose on a job without
   // a pose part, is refused by name.
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml";
-  const Result at3 = run("lobes --method zoa --config " + job + " --pose -84.75 104.63 -20.08");
+  const Result at3 = run("lobes --method zoa --job " + job + " --pose -84.75 104.63 -20.08");
   ASSERT_EQ(at3.status, 0) << at3.out;
   EXPECT_NE(at3.out.find("at joints -84.75 104.63 -20.08 deg"), std::string::npos) << at3.out;
   const Result out_of_travel = run("lobes --job " + job + " --pose -84.75 204.63 -20.08");
@@ -559,7 +559,7 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   {  // the first grid pose again, as `lobes --pose` computes its SDM diagram
     std::string q;
     for (const auto& v : grid[0]["joints_deg"]) q += " " + std::to_string(v.get<double>());
-    const Result lobes = run("lobes --json --config " + dir + "/small_job.yaml --pose" + q);
+    const Result lobes = run("lobes --json --job " + dir + "/small_job.yaml --pose" + q);
     ASSERT_EQ(lobes.status, 0) << lobes.out;
     const auto l = nlohmann::json::parse(lobes.out.substr(lobes.out.find('{')));
     EXPECT_EQ(l["method"], "SDM");
@@ -999,7 +999,7 @@ void expect_lobe_shape(const nlohmann::json& j, std::size_t points) {
 
 TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
   const std::string png = temp_path("lobes_plots") + "/lobes.png";
-  const Result r = run("lobes --method zoa --config " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot-dir " +
+  const Result r = run("lobes --method zoa --job " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot-dir " +
                        temp_path("lobes_plots"));
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
@@ -1025,11 +1025,11 @@ TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
 }
 
 TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
-  const Result r = run("lobes --method zoa --config " + milling_job("industrial_robot_aluminium") + " --json --rpm 3000");
+  const Result r = run("lobes --method zoa --job " + milling_job("industrial_robot_aluminium") + " --json --rpm 3000");
   ASSERT_EQ(r.status, 0) << r.out;
   expect_lobe_shape(nlohmann::json::parse(r.out), 2000);
   for (int p = 1; p <= 5; ++p) {
-    const Result b = run("lobes --method zoa --config " + milling_job("orthopaedic_bone") + " --structure position_" + std::to_string(p));
+    const Result b = run("lobes --method zoa --job " + milling_job("orthopaedic_bone") + " --structure position_" + std::to_string(p));
     EXPECT_EQ(b.status, 0) << b.out;
     EXPECT_NE(b.out.find("minimum limiting depth"), std::string::npos) << b.out;
   }
