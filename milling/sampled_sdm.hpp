@@ -25,6 +25,7 @@
 
 #include <Eigen/Dense>
 
+#include "milling/dominant_multiplier.hpp"
 #include "milling/sdm.hpp"
 #include "milling/structure.hpp"
 
@@ -75,10 +76,11 @@ class SampledSdm {
     std::vector<int> grid;             // tick index of each grid point 0..k
   };
   // A^m and A^r B of one System, made as the monodromy needs them and kept across the depths of one search
-  // (one per System and thread).
+  // (one per System and thread), and the search's dominant-multiplier finder.
   struct Propagators {
     std::map<int, Eigen::MatrixXd> a_pow;      // A^m, by m
     std::vector<Eigen::MatrixXd> a_pow_b;      // A^r B, r = 0, 1, ...
+    DominantMultiplier dominant;
   };
   [[nodiscard]] System system_at(double rpm) const;
   [[nodiscard]] Result monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks, bool want_vector) const;

@@ -1,4 +1,5 @@
 #include "milling/sdm.hpp"
+#include "milling/dominant_multiplier.hpp"
 #include "milling/interval_exp.hpp"
 #include "units/units.hpp"
 
@@ -94,7 +95,9 @@ double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t,
 }
 
 std::complex<double> SdmModel::multiplier(double axial_mm, double rpm, double* chatter_hz) const {
-  return dominant(monodromy(axial_mm, rpm), rpm, chatter_hz);
+  const Eigen::MatrixXd z = monodromy(axial_mm, rpm);
+  if (chatter_hz == nullptr) return DominantMultiplier{}(z);
+  return dominant(z, rpm, chatter_hz);
 }
 
 Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
@@ -197,10 +200,11 @@ DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, dou
 SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
   if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
   Eigen::MatrixXd z_hi;  // the monodromy matrix at the last unstable depth: the bracket's hi at the end
+  DominantMultiplier largest;
   const DepthBracket br = find_critical_depth(
       [&](double b) {
         Eigen::MatrixXd z = monodromy(b, rpm);
-        const double ln_mu = std::log(std::abs(dominant(z, rpm, nullptr)));
+        const double ln_mu = std::log(std::abs(largest(z)));
         if (ln_mu >= 0.0) z_hi.swap(z);
         return ln_mu;
       },

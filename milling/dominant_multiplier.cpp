@@ -1,0 +1,49 @@
+#include "milling/dominant_multiplier.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+// GCC 12 reports a use after free inside Spectra's UpperHessenbergEigen (Eigen's aligned_free of a temporary
+// in a loop, where the inliner sees the freed pointer reassigned, not used): a false positive of the
+// middle-end's -Wuse-after-free on code we do not own. Off for the Spectra headers and this file's use of them.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#include <Spectra/GenEigsSolver.h>
+#include <Spectra/MatOp/DenseGenMatProd.h>
+
+namespace robodamp::milling {
+
+std::complex<double> dense_dominant_multiplier(const Eigen::MatrixXd& z) {
+  if (z.rows() != z.cols() || z.rows() == 0) throw std::invalid_argument("dominant multiplier: the matrix must be square");
+  const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(z, false).eigenvalues();
+  Eigen::Index best = 0;
+  for (Eigen::Index i = 1; i < ev.size(); ++i)
+    if (std::abs(ev(i)) > std::abs(ev(best))) best = i;
+  return ev(best);
+}
+
+std::complex<double> DominantMultiplier::operator()(const Eigen::MatrixXd& z) {
+  if (z.rows() >= kMinArnoldiSize && z.rows() == z.cols() && !arnoldi_gave_up_) {
+    Spectra::DenseGenMatProd<double> product(z);
+    const auto basis = static_cast<Eigen::Index>(std::min<Eigen::Index>(kBasis, z.rows()));
+    Spectra::GenEigsSolver<Spectra::DenseGenMatProd<double>> arnoldi(product, kWanted, basis);
+    arnoldi.init();
+    const Eigen::Index converged = arnoldi.compute(Spectra::SortRule::LargestMagn, kMaxRestarts, kTolerance);
+    if (arnoldi.info() == Spectra::CompInfo::Successful && converged >= kWanted) {
+      const Eigen::VectorXcd ev = arnoldi.eigenvalues();  // largest magnitude first
+      if (ev.size() > 0 && std::isfinite(ev(0).real()) && std::isfinite(ev(0).imag())) {
+        ++arnoldi_;
+        return ev(0);
+      }
+    }
+    arnoldi_gave_up_ = true;
+  }
+  ++dense_;
+  return dense_dominant_multiplier(z);
+}
+
+}  // namespace robodamp::milling
+
+#pragma GCC diagnostic pop

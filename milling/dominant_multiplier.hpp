@@ -1,0 +1,41 @@
+// The Floquet multiplier of largest magnitude of a monodromy matrix, for the depth searches of the accurate
+// methods (milling/sdm.hpp, milling/sampled_sdm.hpp; docs/milling.md, "How fast"). A search needs only that
+// one eigenvalue at each depth, not the whole spectrum a dense QR gives (Eigen's EigenSolver: a Hessenberg
+// reduction and Francis steps, 45 % of the sampled loop's SDM). Implicitly restarted Arnoldi (Spectra's
+// GenEigsSolver, the method of ARPACK; a fixed starting vector, so the same matrix gives the same answer)
+// finds it from products of the matrix with vectors when the multipliers near the unit circle are few, as
+// in the damped loop, whose controller damps most of its modes within a tooth period. When they crowd the
+// circle (the 46 lightly damped modes of the industrial robot over a short tooth period) Arnoldi needs
+// hundreds of restarts: after kMaxRestarts without convergence it gives up, the dense QR answers, and this
+// object's later calls (the rest of one speed's search) go to the dense QR at once. Off the real-time path.
+#pragma once
+
+#include <complex>
+
+#include <Eigen/Dense>
+
+namespace robodamp::milling {
+
+class DominantMultiplier {
+ public:
+  static constexpr Eigen::Index kMinArnoldiSize = 60;  // below, the dense QR is as fast
+  static constexpr int kWanted = 4;                    // Ritz values converged: a complex pair and the next
+  static constexpr int kBasis = 40;                    // Arnoldi basis
+  static constexpr int kMaxRestarts = 10;
+  static constexpr double kTolerance = 1e-12;          // relative residual of the converged Ritz values
+
+  // The eigenvalue of largest magnitude of the square matrix z (of a complex pair, either).
+  [[nodiscard]] std::complex<double> operator()(const Eigen::MatrixXd& z);
+
+  [[nodiscard]] int arnoldi_answers() const { return arnoldi_; }
+  [[nodiscard]] int dense_answers() const { return dense_; }
+
+ private:
+  bool arnoldi_gave_up_{false};
+  int arnoldi_{0}, dense_{0};
+};
+
+// By the dense QR alone (Eigen's EigenSolver): the reference the tests compare with.
+[[nodiscard]] std::complex<double> dense_dominant_multiplier(const Eigen::MatrixXd& z);
+
+}  // namespace robodamp::milling
