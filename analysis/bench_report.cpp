@@ -113,12 +113,12 @@ struct BenchSweepRun {
 struct Bench::RunState {
   const Progress& progress;
   std::size_t threads;
-  BenchReport rep;
-  std::vector<std::size_t> locations;  // in the order the analysis lists the FRFs' excitations
-  std::vector<ImpactTestResult> off, on, sat;
-  std::vector<double> factors;         // of K_max, the gain sweep's
-  std::vector<BenchSweepRun> sweep;
-  std::optional<std::size_t> dp;       // the actuator's driving-point FRF
+  BenchReport rep{};
+  std::vector<std::size_t> locations{};  // in the order the analysis lists the FRFs' excitations
+  std::vector<ImpactTestResult> off{}, on{}, sat{};
+  std::vector<double> factors{};         // of K_max, the gain sweep's
+  std::vector<BenchSweepRun> sweep{};
+  std::optional<std::size_t> dp{};       // the actuator's driving-point FRF
   int tests{0};
   [[nodiscard]] std::size_t index_of(std::size_t excitation) const {
     return static_cast<std::size_t>(std::find(locations.begin(), locations.end(), excitation) - locations.begin());

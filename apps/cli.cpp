@@ -187,12 +187,16 @@ CLI::Option* Registry::deprecated(CLI::Option* option, const std::string& replac
   return option;
 }
 
+CLI::Option* Registry::renamed(CLI::Option* now, const std::string& value, CLI::Option* old, const std::string& why) {
+  deprecated(old, now->get_name() + " " + value + " (" + why + ")");
+  now->excludes(old);
+  return now;
+}
+
 CLI::Option* Registry::job(CLI::App* sub, std::string& target) {
-  CLI::Option* job = sub->add_option("--job", target, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile);
-  CLI::Option* old = sub->add_option("--config", target, "The milling job, as --job")->check(CLI::ExistingFile);
-  deprecated(old, "--job JOB (--config is the cell's configuration in every other command)");
-  job->excludes(old);
-  return job;
+  return renamed(sub->add_option("--job", target, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile), "JOB",
+                 sub->add_option("--config", target, "The milling job, as --job")->check(CLI::ExistingFile),
+                 "--config is the cell's configuration in every other command");
 }
 
 int Registry::run_parsed() const {

@@ -60,6 +60,10 @@ class Registry {
   CLI::Option* plot_dir(CLI::App* sub, std::string& target, const std::string& what);
   // An old spelling kept for one release: still works, says on stderr what replaces it.
   CLI::Option* deprecated(CLI::Option* option, const std::string& replacement);
+  // An option renamed: `now` (its value shown as `value`, e.g. FILE) and the `old` spelling of the same value,
+  // deprecated for one release (`why` the old name went, in the deprecation note); giving both is refused.
+  // Returns `now`.
+  CLI::Option* renamed(CLI::Option* now, const std::string& value, CLI::Option* old, const std::string& why);
   // --job FILE, the milling job (config/milling/), as every command names it; and the old --config JOB of
   // lobes, sle and cut, deprecated: --config is the cell everywhere else (docs/cli.md).
   CLI::Option* job(CLI::App* sub, std::string& target);

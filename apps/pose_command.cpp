@@ -420,10 +420,10 @@ void register_pose(Registry& r) {
   r.number(sub, "--worse-mode-pct", a->tune.worse_mode_pct, {"%", 0.0, 20.0},
            "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default 0: never worse)");
   r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map, modes: the pose, one relative angle per joint");
-  auto* name = sub->add_option("--pose-name", a->pose_name, "frf, map, modes: a pose the model file names");
   // --pose is the joint angles in run, cut, lobes, sle and measure: here it named a pose (docs/cli.md).
-  name->excludes(r.deprecated(sub->add_option("--pose", a->pose_name, "frf, map, modes: a pose the model file names"),
-                              "--pose-name NAME (--pose is joint angles in every other command)"));
+  r.renamed(sub->add_option("--pose-name", a->pose_name, "frf, map, modes: a pose the model file names"), "NAME",
+            sub->add_option("--pose", a->pose_name, "frf, map, modes: a pose the model file names"),
+            "--pose is joint angles in every other command");
   r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes (default 4); modes: how many of the model's (default 3)")
       ->each([a](const std::string&) { a->modes_given = true; });
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e4, true, false}, "frf: FRF band LO HI");
@@ -454,10 +454,10 @@ void register_pose(Registry& r) {
   r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
   r.whole_number(sub, "--seed", a->seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
   sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here; modes: the model with its measured modes; tune: the configuration with the chosen controller");
-  auto* csv = sub->add_option("--csv-out", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz");
   // --csv is a table read in identify and chatter: here it was one written.
-  csv->excludes(r.deprecated(sub->add_option("--csv", a->csv_path, "frf: write the receptance to this table"),
-                             "--csv-out FILE (--csv is a table read in every other command)"));
+  r.renamed(sub->add_option("--csv-out", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz"),
+            "FILE", sub->add_option("--csv", a->csv_path, "frf: write the receptance to this table"),
+            "--csv is a table read in every other command");
   r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv-out frequency step");
 }
 
