@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
-# Set up, build, and run the whole test suite.
+# Set up, build, and run the whole test suite. With CI=true (as CI runs it), also the libraries' unit tests
+# built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh address,undefined --unit,
+# in build-address-undefined; docs/tests.md "Sanitizers").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cd build
-ctest --output-on-failure --parallel "$(nproc)" --timeout 600
+(cd build && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
+if [ "${CI:-}" = true ]; then
+  bash scripts/sanitize.sh address,undefined --unit
+fi
