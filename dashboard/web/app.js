@@ -351,9 +351,20 @@ function plotLobes(l, m, a) {
     : ', parameter set ' + l.parameter_set + ', K = ' + fmt(l.gain_ns_per_m, 0) + ' N s/m') + ', ' + l.rpm.length + ' speeds' +
     (l.pose_deg && l.pose_deg.length ? ', the robot at ' + poseText(l.pose_deg) + (moved ? ' (it has moved: recomputing)' : '') : '') +
     (off ? '; the damper is ' + s.state + ': the open loop applies' : '');
+  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, operating_label: now, advised: options.length,
+    gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off, pose_deg: l.pose_deg || [], pose_moved: !!moved,
+    scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
+      l.damped_limit_mm[i] < 0.995 * l.open_limit_mm[i]).length };
+  window.robodamp.updates.lobes++;
+}
+
+// The advice line, drawn whether or not the cell's lobes have come: a restarted cell advises before its first
+// sweep of live lobes is done (under load that took longer than the operator's 30 s, and the page showed
+// the old line; CI saw it once).
+function renderAdvice(a, m) {
+  const state = adviceState(a, m), followed = state === 'followed';
   // An advice the spindle has followed is not an instruction any more: said as done (the tile does the same);
   // one the cell has expired (the state it was for is gone) says why, and its speeds are not drawn.
-  const state = adviceState(a, m), followed = state === 'followed';
   $('advice').innerHTML = a ? ('advice #' + a.seq + ' (' + esc(a.trigger) + ' at ' + fmt(a.spindle_rpm, 0) + ' rpm): ' +
     (state === 'expired' ? 'expired: ' + esc(a.status_reason) + ' (it was ' + (a.found ? fmt(a.advised_rpm, 1) + ' rpm' : 'none in range') + ')'
     : !a.found ? esc(a.reason) : (followed ? 'followed: at the advised ' : 'go to ') + fmt(a.advised_rpm, 1) + ' rpm, limit ' +
@@ -363,11 +374,6 @@ function plotLobes(l, m, a) {
   $('advice').dataset.followed = followed ? 'true' : 'false';
   $('advice').dataset.posesAhead = a ? String(a.poses_ahead || 0) : '0';
   $('advice').dataset.status = state;
-  window.robodamp.plotted.lobes = { speeds: l.rpm.length, operating_rpm: m ? m.spindle_rpm : 0, operating_label: now, advised: options.length,
-    gain_ns_per_m: l.gain_ns_per_m, recomputing: !!other, damper_off: !!off, pose_deg: l.pose_deg || [], pose_moved: !!moved,
-    scheduled: !!l.speed_scheduled, damped_below_open: l.rpm.filter((r, i) => l.damped_limit_mm[i] !== null && l.open_limit_mm[i] !== null &&
-      l.damped_limit_mm[i] < 0.995 * l.open_limit_mm[i]).length };
-  window.robodamp.updates.lobes++;
 }
 
 function plotTiming(s) {
@@ -451,7 +457,7 @@ function renderCell() {
     const drawn = JSON.stringify([cellLobes && cellLobes.rpm ? cellLobes.rpm.length : 0, cellLobes && cellLobes.gain_ns_per_m,
       m.spindle_rpm, m.depth_mm, m.cutting, d.advice && d.advice.seq, d.advice && d.advice.status, s.state, s.parameter_set, s.gain_ns_per_m,
       m.limits_pose_deg, cellLobes && cellLobes.pose_deg]);
-    if (d.spectrum !== undefined || drawn !== lobesDrawn) { lobesDrawn = drawn; plotLobes(cellLobes, d.machining, d.advice); }
+    if (d.spectrum !== undefined || drawn !== lobesDrawn) { lobesDrawn = drawn; plotLobes(cellLobes, d.machining, d.advice); renderAdvice(d.advice, d.machining); }
     plotTiming(d.status);
     renderCounters(d);
   }
