@@ -1,5 +1,6 @@
 #include "apps/pose_modes_command.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "analysis/pose_schedule.hpp"
 #include "apps/gnuplot.hpp"
 #include "identify/pose_modes.hpp"
+#include "robot/modal_map.hpp"
 
 namespace robodamp::apps {
 
@@ -61,6 +63,44 @@ void row_text(const analysis::ModeCheckRow& r, std::ostringstream& t) {
   t << b;
 }
 
+// How each measured mode is interpolated between the poses (robot::TrackForm): each quantity against the
+// model's mode or as the measured values, the form that predicted the measured poses better when each was
+// left out in turn, with both forms' errors.
+json print_forms(const std::vector<robot::TrackForm>& forms, const std::vector<config::MeasuredPoseModes>& poses, std::ostringstream& t) {
+  json out = json::array();
+  t << "  interpolated between the poses (each quantity in the form that predicts each measured pose better from the\n"
+       "  others: against the model's mode, or the measured values on their own; leave-one-out RMS in brackets):\n";
+  std::size_t k = 0;
+  for (const robot::TrackForm& f : forms) {
+    // The track is the k-th lowest measured mode of every pose that has one; tracks seen at too few poses are
+    // not kept, so the k-th kept track is found by its pose count.
+    while (k < 64 && static_cast<int>(std::count_if(poses.begin(), poses.end(), [&](const auto& p) { return p.modes.size() > k; })) != f.measured_poses) ++k;
+    double lo = INFINITY, hi = 0.0;
+    for (const auto& p : poses)
+      if (p.modes.size() > k) lo = std::min(lo, p.modes[k].natural_freq_hz), hi = std::max(hi, p.modes[k].natural_freq_hz);
+    ++k;
+    const auto form = [&](const char* what, const robot::QuantityForm& q, double scale, const char* unit) {
+      char b[200];
+      std::snprintf(b, sizeof b, "%s %s (own %.3g, against the model %.3g%s)", what, q.own ? "own" : "against the model",
+                    scale * q.own_rms, scale * q.model_rms, unit);
+      return std::string(b);
+    };
+    char head[160];
+    std::snprintf(head, sizeof head, "    %.2f-%.2f Hz (%d poses", lo, hi, f.measured_poses);
+    if (f.model_index < 0)
+      t << head << ", no model mode follows it): every quantity the measured values on their own\n";
+    else
+      t << head << ", the model's mode " << f.model_index + 1 << "): " << form("frequency", f.freq, 100.0, " %") << "; "
+        << form("damping", f.damping, 100.0, " %") << ";\n      " << form("participation", f.stiffness, 1.0, " 1/kg") << '\n';
+    const auto qj = [](const robot::QuantityForm& q) {
+      return json{{"form", q.own ? "own" : "against the model"}, {"own_loo_rms", q.own_rms}, {"model_loo_rms", q.model_rms}};
+    };
+    out.push_back({{"freq_hz", {lo, hi}}, {"measured_poses", f.measured_poses}, {"model_mode", f.model_index < 0 ? json(nullptr) : json(f.model_index + 1)},
+                   {"frequency", qj(f.freq)}, {"damping", qj(f.damping)}, {"participation", qj(f.stiffness)}});
+  }
+  return out;
+}
+
 int build_map(const config::RobotModelConfig& model, const PoseModesArgs& a) {
   identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
   identify::check_against_model(pm, model);
@@ -97,8 +137,9 @@ int build_map(const config::RobotModelConfig& model, const PoseModesArgs& a) {
                   "the map %.2f %% (%d)\n", worst_model, model_missed, worst_mapped, map_missed);
     t << b;
   }
+  const json forms = print_forms(robot::ModalMap(mapped, axis, count).forms(), id.measured.poses, t);
   json r = {{"model", model.source}, {"axis", axis == 0 ? "x" : "y"}, {"modes", count}, {"band_hz", {pm.band_min_hz, pm.band_max_hz}},
-            {"rows", out_rows}, {"modal_fit_error_pct", id.fit_error_pct}};
+            {"rows", out_rows}, {"modal_fit_error_pct", id.fit_error_pct}, {"interpolated", forms}};
   if (!id.held_out.empty()) {
     r["held_out_worst_freq_error_pct"] = {{"model", worst_model}, {"mapped", worst_mapped}};
     r["held_out_modes_missed"] = {{"model", model_missed}, {"mapped", map_missed}};

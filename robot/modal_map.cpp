@@ -17,8 +17,7 @@ constexpr double kDegToRad = M_PI / 180.0;
 const double kMatchLogRatio = std::log(1.25);
 // The identification's scatter assumed (one standard deviation; the regression's nugget): a fitted mode's
 // frequency 0.3 %, its damping ratio 3 %, its participation 1 % of the track's largest. Larger values smooth
-// more: with 10 % and 3 % the damped improvement at the HIL path's pose e was 8.4 points from the emulator's,
-// with these 1-3 (docs/pose_dynamics.md).
+// more.
 constexpr double kFreqNoise = 0.003, kDampingNoise = 0.03, kStiffnessNoise = 0.01;
 // A mode's participation along the axis, w^2 / k (1/kg: the mass-normalised shape squared) is what is
 // interpolated for its stiffness: it is smooth through a pose where the mode turns across the axis (there k
@@ -46,6 +45,35 @@ Eigen::MatrixXd correlation(const std::vector<Eigen::VectorXd>& x, double length
       r(i, j) = std::exp(-0.5 * (x[static_cast<std::size_t>(i)] - x[static_cast<std::size_t>(j)]).squaredNorm() /
                          (length_rad * length_rad)) + (i == j ? nugget : 0.0);
   return r;
+}
+
+// One quantity's regression in the form that predicts the measured poses best: against the model's mode
+// (prior: the quantity minus the model's, in the same units) or the track's own values, scored by leaving each
+// measured pose out in turn (the regression fitted anew on the others, its length scale too) and summing the
+// squared errors there. The model is the prior by default: its own form must predict better, and it is tried
+// from three poses on (with two, leaving one out says nothing about the shape between). On the robot wrong in
+// form (docs/pose_dynamics.md) the model's damping varies with the pose where the measured damping is flat, and
+// its participation passes through zero where the measured one peaks: there the track's own form wins.
+double leave_one_out_sse(const std::vector<Eigen::VectorXd>& x, const std::vector<double>& y, double noise, bool about_mean) {
+  double sse = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    std::vector<Eigen::VectorXd> xs;
+    std::vector<double> ys;
+    for (std::size_t j = 0; j < x.size(); ++j)
+      if (j != i) xs.push_back(x[j]), ys.push_back(y[j]);
+    const double e = ModalMap::Field(std::move(xs), std::move(ys), noise, about_mean).mean(x[i]) - y[i];
+    sse += e * e;
+  }
+  return sse;
+}
+
+ModalMap::Field fitted_form(const std::vector<Eigen::VectorXd>& x, const std::vector<double>& own,
+                            const std::vector<double>& against_model, double noise, QuantityForm& form) {
+  const double n = static_cast<double>(x.size());
+  form.own_rms = x.size() >= 2 ? std::sqrt(leave_one_out_sse(x, own, noise, true) / n) : 0.0;
+  form.model_rms = !against_model.empty() && x.size() >= 2 ? std::sqrt(leave_one_out_sse(x, against_model, noise, false) / n) : 0.0;
+  form.own = against_model.empty() || (x.size() >= 3 && form.own_rms < form.model_rms);
+  return form.own ? ModalMap::Field(x, own, noise, true) : ModalMap::Field(x, against_model, noise, false);
 }
 
 // The measured modes' indices among the model's: as many pairs within 25 % as possible, then the smallest
@@ -184,20 +212,35 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
     tr.model_index = t.front().model_index;
     for (const Sample& s : t)
       if (s.model_index != tr.model_index) tr.model_index = -1;  // no one model mode follows it
-    const bool own = tr.model_index < 0;
+    const bool matched = tr.model_index >= 0;
     std::vector<Eigen::VectorXd> x;
-    std::vector<double> f, z, pk;
+    // Each quantity in both forms: against the model's mode (a log ratio, or the participation's difference)
+    // and as the track's own values.
+    std::vector<double> f_own, f_prior, z_own, z_prior, p_own, p_prior, p_model;
     double p_scale = 0.0;
     for (const Sample& s : t) {
       x.push_back(s.x);
-      f.push_back(std::log(own ? s.f_hz : s.f_hz / s.model_f_hz));
-      z.push_back(std::log(own ? s.zeta : s.zeta / s.model_zeta));
-      pk.push_back(participation(s.f_hz, s.k) - (own ? 0.0 : participation(s.model_f_hz, s.model_k)));
+      f_own.push_back(std::log(s.f_hz));
+      z_own.push_back(std::log(s.zeta));
+      p_own.push_back(participation(s.f_hz, s.k));
+      if (matched) {
+        f_prior.push_back(std::log(s.model_f_hz));
+        z_prior.push_back(std::log(s.model_zeta));
+        p_model.push_back(participation(s.model_f_hz, s.model_k));
+      }
       p_scale = std::max(p_scale, participation(s.f_hz, s.k));
     }
-    tr.freq = Field(x, f, kFreqNoise, own);
-    tr.damping = Field(x, z, kDampingNoise, own);
-    tr.stiffness = Field(std::move(x), pk, kStiffnessNoise * p_scale, own);
+    const auto difference = [](const std::vector<double>& a, const std::vector<double>& b) {
+      std::vector<double> d(a.size());
+      for (std::size_t i = 0; i < a.size(); ++i) d[i] = a[i] - b[i];
+      return d;
+    };
+    tr.freq = fitted_form(x, f_own, matched ? difference(f_own, f_prior) : std::vector<double>{}, kFreqNoise, tr.form.freq);
+    tr.damping = fitted_form(x, z_own, matched ? difference(z_own, z_prior) : std::vector<double>{}, kDampingNoise, tr.form.damping);
+    tr.stiffness = fitted_form(x, p_own, matched ? difference(p_own, p_model) : std::vector<double>{}, kStiffnessNoise * p_scale,
+                               tr.form.stiffness);
+    tr.form.model_index = tr.model_index;
+    tr.form.measured_poses = static_cast<int>(t.size());
     tracks_.push_back(std::move(tr));
   }
 }
@@ -213,21 +256,23 @@ std::vector<ModeCorrection> ModalMap::at(const std::vector<double>& q_deg, const
     c.measured_poses = static_cast<int>(t.freq.points());
     c.model_index = own ? -1 : t.model_index;
     if (!own) followed[static_cast<std::size_t>(t.model_index)] = true;
-    c.freq_scale = std::exp(t.freq.mean(x));
-    c.damping_scale = std::exp(t.damping.mean(x));
-    c.freq_hz = own ? c.freq_scale : a.freq_hz * c.freq_scale;
-    c.damping_ratio = own ? c.damping_scale : a.damping_ratio * c.damping_scale;
+    // A quantity in its own form is the track's value; against the model, the model's times the ratio (or plus
+    // the participation's difference).
+    const double f_model = own ? 1.0 : a.freq_hz, z_model = own ? 1.0 : a.damping_ratio;
+    c.freq_hz = (own || t.form.freq.own ? 1.0 : f_model) * std::exp(t.freq.mean(x));
+    c.damping_ratio = (own || t.form.damping.own ? 1.0 : z_model) * std::exp(t.damping.mean(x));
+    c.freq_scale = own ? 1.0 : c.freq_hz / f_model;
+    c.damping_scale = own ? 1.0 : c.damping_ratio / z_model;
     c.freq_sigma = t.freq.sigma(x);
     c.damping_sigma = t.damping.sigma(x);
     // The participation w^2 / k: the model's plus the regression's (or its own); the stiffness from it at the
     // mapped frequency.
     const double p_model = own ? 0.0 : participation(a.freq_hz, a.stiffness_n_per_m);
-    const double p = p_model + t.stiffness.mean(x);
+    const double p = (t.form.stiffness.own ? 0.0 : p_model) + t.stiffness.mean(x);
     const double p_floor = kParticipationFloor * std::max(p_model, std::abs(p)) + std::numeric_limits<double>::min();
     const double w = kTwoPi * c.freq_hz;
     c.stiffness_n_per_m = w * w / std::max(p, p_floor);
     c.stiffness_scale = own ? 1.0 : c.stiffness_n_per_m / a.stiffness_n_per_m;
-    if (own) c.freq_scale = c.damping_scale = 1.0;
     c.stiffness_sigma = std::min(kMaxRelativeSigma, t.stiffness.sigma(x) / std::max(p, p_floor));
     out.push_back(c);
   }
@@ -246,6 +291,12 @@ std::vector<ModeCorrection> ModalMap::at(const std::vector<double>& q_deg, const
   }
   std::sort(out.begin(), out.end(), [](const auto& l, const auto& r) { return l.freq_hz < r.freq_hz; });
   if (out.size() > static_cast<std::size_t>(count_)) out.resize(static_cast<std::size_t>(count_));  // the plant's N lowest
+  return out;
+}
+
+std::vector<TrackForm> ModalMap::forms() const {
+  std::vector<TrackForm> out;
+  for (const Track& t : tracks_) out.push_back(t.form);
   return out;
 }
 

@@ -1,12 +1,15 @@
 // The robot's modes at any pose from modes measured at a few (docs/pose_dynamics.md, "Modes between measured
 // poses"). The robot model (fitted or not) is the prior: at each measured pose its modes along the measured
-// axis are matched to the measured ones, and the log ratios measured / model of each mode's frequency,
-// damping ratio and modal stiffness are interpolated over joint space by Gaussian-process regression
-// (ordinary kriging: a constant mean, a squared-exponential kernel over the joint angles in rad, its length
-// scale chosen by the restricted marginal likelihood); the stiffness along the axis through the mode's
-// participation w^2 / k, the difference measured - model interpolated. At a measured pose the corrected modes are the measured
-// ones (to the measurement's noise); far from every measured pose the correction tends to the mean ratio and
-// its uncertainty to the model's scatter about it, so the spread grows away from the measurements.
+// axis are matched to the measured ones. Each measured mode's frequency, damping ratio and participation along
+// the axis (w^2 / k) is interpolated over joint space by Gaussian-process regression (ordinary kriging: a
+// constant mean, a squared-exponential kernel over the joint angles in rad, its length scale chosen by the
+// restricted marginal likelihood), in one of two forms: against the model's mode (the log ratio measured /
+// model, the participation's difference), or as the measured values themselves, whichever predicts each
+// measured pose better from the others (leave-one-out). A model right in form carries the shape between
+// the poses; one wrong in form (its damping varying where the measured is flat, its participation through zero
+// where the measured peaks) is left out of the quantities it predicts worse. At a measured pose the mapped modes are
+// the measured ones (to the measurement's noise); far from every measured pose the regression tends to its mean
+// and its uncertainty to the values' scatter, so the spread grows away from the measurements.
 // Off the real-time path.
 #pragma once
 
@@ -32,10 +35,9 @@ struct AxisMode {
                                                int axis, int count);
 
 // One mode at a pose, mapped. A track is the k-th lowest measured mode of every measured pose. Where at every
-// pose it was measured the same model mode lies within 25 % of it, that mode is its prior: the ratios measured /
-// model of its frequency and damping and the difference of its participation w^2 / k are interpolated and
-// applied to the model's mode at the pose (model_index >= 0). Where not (the model lacks the mode, or its modes
-// reorder between the poses), the track's own values are interpolated (model_index -1). The model's modes no
+// pose it was measured the same model mode lies within 25 % of it, that mode is its prior (model_index >= 0):
+// each quantity is interpolated against it or as its own values (TrackForm). Where not (the model lacks the
+// mode, or its modes reorder between the poses), the track's own values are interpolated (model_index -1). The model's modes no
 // track follows and above every track stay as the model has them (measured_poses 0, no spread); below, where
 // the measurements would have seen them, they are not there.
 // sigma_*: one standard deviation of the log value (x 100: about a percentage); the stiffness's from its
@@ -55,6 +57,20 @@ struct PoseMatch {
   std::vector<int> model_of_measured;
 };
 
+// How one quantity of a track is interpolated: against the model's mode (the log ratio, or the participation's
+// difference) or as the track's own values, whichever predicts the measured poses better when each is left out
+// in turn (the root mean square of those errors, in the quantity's regression units: log for the frequency and
+// the damping, 1/kg for the participation w^2 / k; 0 where not computed).
+struct QuantityForm {
+  bool own{true};
+  double own_rms{0.0}, model_rms{0.0};
+};
+struct TrackForm {
+  int model_index{-1};  // the model's mode the track follows (-1: none)
+  int measured_poses{0};
+  QuantityForm freq, damping, stiffness;
+};
+
 class ModalMap {
  public:
   // model.measured_modes must be set; its axis must be `axis`. count: the model's modes (pose_schedule.modes).
@@ -65,6 +81,8 @@ class ModalMap {
   // least) and the model's modes no track follows. prior: axis_modes(model, joints_deg, axis, count).
   [[nodiscard]] std::vector<ModeCorrection> at(const std::vector<double>& joints_deg, const std::vector<AxisMode>& prior) const;
   [[nodiscard]] const std::vector<PoseMatch>& matches() const { return matches_; }
+  // Each track's forms, lowest measured mode first.
+  [[nodiscard]] std::vector<TrackForm> forms() const;
   // The distance in joint space (deg) from a pose to the nearest measured pose.
   [[nodiscard]] double nearest_measured_deg(const std::vector<double>& joints_deg) const;
 
@@ -93,6 +111,7 @@ class ModalMap {
  private:
   struct Track {
     Field freq, damping, stiffness;
+    TrackForm form;
     int model_index{-1};
   };
   std::vector<Track> tracks_;

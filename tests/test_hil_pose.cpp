@@ -351,10 +351,11 @@ TEST(Hil, ARobotOfOurOwnMeasuredFittedTunedAndDampedAtItsHeldOutPoses) {
 // translation, a mode the model's torsional joints cannot make) measured at eight poses (`measure --poses`), its
 // measured modes at five written into the model file as it is (`pose modes`, the file's model the prior, not
 // fitted). The controller runs the hand-drawn schedule on the mapped model; the emulator moves the TRUE robot
-// through the three held-out poses. At b and d the improvement the emulator measures is within 5 points of
-// what the analysis predicts there from the map; at e within 10 (measured 8.5: there the open peak is the 19.5
-// Hz mode's and the closed one the 12.1 Hz mode's, so the improvement is the ratio of two modes' peaks, and the
-// map's stiffnesses there are 1-4 % off with 2-5 % spreads; docs/pose_dynamics.md). No trip.
+// through the three held-out poses. At each the improvement the emulator measures is within 5 points of what
+// the analysis predicts there from the map (measured 0.8, 0.07 and 0.6 points). At e the open peak is the 19.5
+// Hz mode's and the closed one the 12.1 Hz mode's, so the improvement is the ratio of two modes' peaks: the
+// earlier map, every quantity against the model, was 8.5 points off there, its damping carrying the model's
+// variation with the pose where the measured damping is flat (docs/pose_dynamics.md). No trip.
 TEST(Hil, ARobotWrongInFormIsDampedAtHeldOutPosesAsItsMeasuredModesPredict) {
   const std::string src = ROBODAMP_SOURCE_DIR;
   const HilFiles f = compact_arm_cell("mapped");
@@ -404,7 +405,7 @@ TEST(Hil, ARobotWrongInFormIsDampedAtHeldOutPosesAsItsMeasuredModesPredict) {
               << measured << " % measured with the true robot, " << predicted << " % predicted on the map, "
               << d["predicted_improvement_pct"] << " % by the true model\n";
     EXPECT_GE(d["records"].get<int>(), 2);
-    EXPECT_NEAR(measured, predicted, i == 2 ? 10.0 : 5.0) << d.dump();
+    EXPECT_NEAR(measured, predicted, 5.0) << d.dump();
   }
 }
 
