@@ -104,8 +104,10 @@ config::Config config_at_pose(const config::Config& base, const PoseModes& modes
 config::Config config_in_plane_at_pose(const config::Config& base, const config::RobotModelConfig& model,
                                       const std::vector<double>& q, int axis, int count) {
   // The same refusals (travel, no mode along the axis); its corrections from measured modes apply in the
-  // plane too: the frequency and damping as they are, the stiffness of every table by the same scale (the
-  // shape scaled alike in both directions).
+  // plane too: the frequency and damping as they are; the shape along the axis as the measured stiffness along
+  // it says (w^2 / k), the shape across it the model's (nothing measured it; scaling it alike made a mode the
+  // measurements barely saw along x, its participation interpolated up from poses where it moves along x,
+  // a spring of a few N/m across at the folded pose, and the cut's limit there zero).
   const PoseModes along = pose_modes(model, q, axis, count);
   const robot::PlanarChain chain = robot::at_pose(model, q);
   config::Config c = base;
@@ -130,7 +132,15 @@ config::Config config_in_plane_at_pose(const config::Config& base, const config:
       m.form = config::ModeForm::kStiffness;
       m.natural_freq_hz = md.freq_hz * corr.freq_scale;
       m.damping_ratio = robot::modal_damping_ratio(md) * corr.damping_scale;
-      m.stiffness_n_per_m = w * w / shapes * corr.stiffness_scale;
+      // Mass-normalised shapes at the mapped frequency: along the axis from the mapped stiffness along it,
+      // across it the model's.
+      const double w_mapped = kTwoPi * m.natural_freq_hz;
+      const double phi_along = md.tcp_shape(axis), k_along = moves_along ? w * w / (phi_along * phi_along) * corr.stiffness_scale : 0.0;
+      const auto shape = [&](int location) {
+        if (location == 2) return md.tcp_shape(across);
+        return moves_along ? std::copysign(w_mapped / std::sqrt(k_along), phi_along) : phi_along;
+      };
+      m.stiffness_n_per_m = w_mapped * w_mapped / (shape(response) * shape(excitation));
       f.modes.push_back(m);
     }
     // The modes the map has from the measurements alone: measured along the axis only, so in H11 alone (their

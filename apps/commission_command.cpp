@@ -8,6 +8,7 @@
 
 #include "apps/cli.hpp"
 #include "commission/commission.hpp"
+#include "commission/path_commission.hpp"
 
 namespace robodamp::apps {
 
@@ -21,6 +22,11 @@ struct CommissionArgs {
   std::optional<double> shift_pct;
   bool dry_run{false};
   commission::CommissionSettings settings;
+  // Along the robot's path (commission/path_commission.hpp).
+  bool along_path{false};
+  commission::PathCommissionSettings path;
+  bool evaluations_given{false}, polish_given{false};
+  double peak_tolerance_pct{10.0};
 };
 
 std::string command_line(const CommissionArgs& a) {
@@ -39,7 +45,61 @@ std::string command_line(const CommissionArgs& a) {
   return c;
 }
 
+std::string path_command_line(const CommissionArgs& a, const commission::PathCommissionSettings& p) {
+  std::string c = "robodamp commission --config " + a.config_path + " --job " + a.job_path + " --out " + a.out_dir +
+                  " --along-path --dwells " + std::to_string(p.dwells);
+  for (const auto& w : p.trajectory) c += " --pose-at " + w;
+  if (!p.hold_out.empty()) {
+    c += " --hold-out";
+    for (const auto& h : p.hold_out) c += " " + h;
+  }
+  c += " --evaluations " + std::to_string(p.pose_tune.tune.global_evaluations) + " --polish " +
+       std::to_string(p.pose_tune.tune.local_evaluations) + " --map-points " + std::to_string(p.map_points) + " --max-regions " +
+       std::to_string(p.pose_tune.max_regions) + " --seed " + std::to_string(p.pose_tune.tune.seed);
+  return c;
+}
+
+int run_along_path(const CommissionArgs& a) {
+  commission::PathCommissionSettings s = a.path;
+  s.config_path = a.config_path;
+  s.job_path = a.job_path;
+  s.out_dir = a.out_dir;
+  s.peak_tolerance = a.peak_tolerance_pct / 100.0;
+  try {
+    s.from = commission::stage_from_string(a.from);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "robodamp commission: " << e.what() << '\n';
+    return 2;
+  }
+  // The pose tune's own budgets (60 / 30 a set) unless given: a schedule tunes a set per region.
+  s.pose_tune.tune.global_evaluations = a.evaluations_given ? a.settings.tune.global_evaluations : 60;
+  s.pose_tune.tune.local_evaluations = a.polish_given ? a.settings.tune.local_evaluations : 30;
+  s.pose_tune.tune.seed = a.settings.tune.seed;
+  s.command_line = path_command_line(a, s);
+  const commission::PathCommissionResult r = commission::commission_along_path(s, [](const std::string& l) { spdlog::info("{}", l); });
+  if (r.outcome == commission::Outcome::kVerified)
+    std::printf("robodamp commission: VERIFIED along the path at %zu stops in %.1f s: wrote %s\n", r.stops.size(), r.wall_s,
+                r.configuration_path.c_str());
+  else
+    std::fprintf(stderr, "robodamp commission: stopped at the %s stage after %.1f s: %s; no configuration written\n",
+                 commission::to_string(r.stage), r.wall_s, r.reason.c_str());
+  if (!r.report_path.empty()) std::printf("robodamp commission: the report is %s\n", r.report_path.c_str());
+  return commission::exit_code(r.outcome);
+}
+
 int run_commission(CommissionArgs& a) {
+  if (a.along_path) {
+    if (a.dry_run || !a.settings.tap_tests.empty() || a.shift_pct) {
+      std::cerr << "robodamp commission: --along-path takes none of --dry-run, --tap-tests, --shift-pct (the stops are "
+                   "measured by robodamp's hammer in the HIL emulator, and the tune is robust over the map's poses)\n";
+      return 2;
+    }
+    return run_along_path(a);
+  }
+  if (!a.path.trajectory.empty() || !a.path.hold_out.empty()) {
+    std::cerr << "robodamp commission: --pose-at and --hold-out belong to --along-path\n";
+    return 2;
+  }
   if (a.dry_run) {
     commission::MeasureOptions o;
     o.impacts = a.settings.tap_tests.empty();
@@ -110,6 +170,26 @@ void register_commission(Registry& r) {
   r.number(sub, "--tap-tolerance-pct", a->settings.tap_tolerance_pct, {"%", 0.1, 20.0},
            "How far a tapped mode may sit from the same mode in the actuator's chirp");
   sub->add_flag("--dry-run", a->dry_run, "Print what would run on the cell (levels, durations, what moves) and stop");
+  sub->add_flag("--along-path", a->along_path,
+                "Commission a pose-scheduled cell along the robot's path (docs/pose_dynamics.md): measure at each stop the "
+                "robot makes, map the modes between the stops, tune the pose schedule on the map, verify it along the same "
+                "path; through the HIL emulator");
+  r.whole_number(sub, "--dwells", a->path.dwells, {"(stops)", 1, 1000}, "--along-path: the stops to measure");
+  sub->add_option("--pose-at", a->path.trajectory,
+                  "--along-path: the robot's path in the HIL emulator, waypoints T:Q1,Q2,... (s and deg, as robodamp plant "
+                  "takes them); a stop is two waypoints at one pose");
+  sub->add_option("--hold-out", a->path.hold_out, "--along-path: stops (dwell_<k>) kept out of the map and checked against it");
+  r.whole_number(sub, "--map-points", a->path.map_points, {"(points per joint)", 2, 41},
+                 "--along-path: the workspace map's grid along the joints that move the dominant mode");
+  r.whole_number(sub, "--max-regions", a->path.pose_tune.max_regions, {"(regions)", 1, 16},
+                 "--along-path: the scheduled controller's regions at most");
+  r.number(sub, "--improvement-tolerance", a->path.improvement_tolerance_points, {"points", 0.5, 50.0},
+           "--along-path: the improvement measured at a stop against the map's prediction there");
+  r.number(sub, "--peak-tolerance-pct", a->peak_tolerance_pct, {"%", 1.0, 100.0},
+           "--along-path: ... or the damped peak measured at a stop against the predicted one (a set that takes a peak down "
+           "several times is checked on what is left of it)");
+  sub->get_option("--evaluations")->each([a](const std::string&) { a->evaluations_given = true; });
+  sub->get_option("--polish")->each([a](const std::string&) { a->polish_given = true; });
 }
 
 }  // namespace robodamp::apps

@@ -66,19 +66,12 @@ void row_text(const analysis::ModeCheckRow& r, std::ostringstream& t) {
 // How each measured mode is interpolated between the poses (robot::TrackForm): each quantity against the
 // model's mode or as the measured values, the form that predicted the measured poses better when each was
 // left out in turn, with both forms' errors.
-json print_forms(const std::vector<robot::TrackForm>& forms, const std::vector<config::MeasuredPoseModes>& poses, std::ostringstream& t) {
+json print_forms(const std::vector<robot::TrackForm>& forms, std::ostringstream& t) {
   json out = json::array();
   t << "  interpolated between the poses (each quantity in the form that predicts each measured pose better from the\n"
        "  others: against the model's mode, or the measured values on their own; leave-one-out RMS in brackets):\n";
-  std::size_t k = 0;
   for (const robot::TrackForm& f : forms) {
-    // The track is the k-th lowest measured mode of every pose that has one; tracks seen at too few poses are
-    // not kept, so the k-th kept track is found by its pose count.
-    while (k < 64 && static_cast<int>(std::count_if(poses.begin(), poses.end(), [&](const auto& p) { return p.modes.size() > k; })) != f.measured_poses) ++k;
-    double lo = INFINITY, hi = 0.0;
-    for (const auto& p : poses)
-      if (p.modes.size() > k) lo = std::min(lo, p.modes[k].natural_freq_hz), hi = std::max(hi, p.modes[k].natural_freq_hz);
-    ++k;
+    const double lo = f.min_hz, hi = f.max_hz;
     const auto form = [&](const char* what, const robot::QuantityForm& q, double scale, const char* unit) {
       char b[200];
       std::snprintf(b, sizeof b, "%s %s (own %.3g, against the model %.3g%s)", what, q.own ? "own" : "against the model",
@@ -137,7 +130,7 @@ int build_map(const config::RobotModelConfig& model, const PoseModesArgs& a) {
                   "the map %.2f %% (%d)\n", worst_model, model_missed, worst_mapped, map_missed);
     t << b;
   }
-  const json forms = print_forms(robot::ModalMap(mapped, axis, count).forms(), id.measured.poses, t);
+  const json forms = print_forms(robot::ModalMap(mapped, axis, count).forms(), t);
   json r = {{"model", model.source}, {"axis", axis == 0 ? "x" : "y"}, {"modes", count}, {"band_hz", {pm.band_min_hz, pm.band_max_hz}},
             {"rows", out_rows}, {"modal_fit_error_pct", id.fit_error_pct}, {"interpolated", forms}};
   if (!id.held_out.empty()) {

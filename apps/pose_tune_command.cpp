@@ -3,21 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <regex>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
-#include <yaml-cpp/yaml.h>
-
-#include "analysis/pose_schedule.hpp"
-#include "config/file_paths.hpp"
-#include "config/yaml_edit.hpp"
 #include "identify/pose_measurements.hpp"
 #include "tune/pose_score.hpp"
 #include "tune/pose_tune.hpp"
+#include "tune/pose_tune_file.hpp"
 #include "tune/tuned_file.hpp"
 
 namespace robodamp::apps {
@@ -48,58 +41,6 @@ void read_poses(const PoseTuneArgs& a, const config::RobotModelConfig& model, st
     held.push_back(*it);
     measured.erase(it);
   }
-}
-
-YAML::Node numbers(const std::vector<double>& v) {
-  YAML::Node n(YAML::NodeType::Sequence);
-  n.SetStyle(YAML::EmitterStyle::Flow);
-  for (double x : v) n.push_back(exact(x));
-  return n;
-}
-
-YAML::Node region_node(const config::PoseRegionConfig& r) {
-  YAML::Node n(YAML::NodeType::Map);
-  n["name"] = r.name;
-  n["min_deg"] = numbers(r.min_deg);
-  n["max_deg"] = numbers(r.max_deg);
-  n["gain_ns_per_m"] = exact(*r.gain_ns_per_m);
-  n["polarity"] = *r.polarity > 0 ? "+1" : "-1";
-  n["match_freq_hz"] = exact(*r.match_freq_hz);
-  YAML::Node c(YAML::NodeType::Map);
-  c["numerator"] = numbers(r.compensator->numerator);
-  c["denominator"] = numbers(r.compensator->denominator);
-  n["compensator"] = c;
-  return n;
-}
-
-// The cell's text with the chosen regions (and the model the sets were tuned on), its relative paths
-// rebased to --out; read back and its schedule analysed before it is written.
-// chosen: the tuned regions; empty: the configuration's own schedule won and its regions stay as written.
-std::string written_text(const PoseTuneArgs& a, const config::Config& cell, const std::vector<tune::TunedRegion>& chosen,
-                         const std::string& header) {
-  std::vector<config::YamlEdit> edits;
-  if (!chosen.empty()) {
-    YAML::Node regions(YAML::NodeType::Sequence);
-    for (const auto& r : chosen) regions.push_back(region_node(r.region));
-    edits.push_back({{"pose_schedule", "regions"}, regions});
-  }
-  if (!a.model_path.empty())
-    edits.push_back({{"pose_schedule", "model"}, YAML::Node(std::filesystem::absolute(a.model_path).string())});
-  config::EditedYaml e = config::edit_yaml(cell.yaml_text, edits);
-  // The regions' old comment describes the regions that were there.
-  if (!chosen.empty()) e.text = std::regex_replace(e.text, std::regex(R"(\n(  regions:)[ \t]*#[^\n]*)"), "\n$1");
-  const std::string text = header + config::rebase_file_paths(e.text, cell.source, a.out_path).text;
-  if (const auto parent = std::filesystem::path(a.out_path).parent_path(); !parent.empty()) std::filesystem::create_directories(parent);
-  const std::string check = a.out_path + ".check.yaml";
-  { std::ofstream(check) << text; }
-  try {
-    (void)analysis::analyse_pose_schedule(config::load_config_file(check));
-  } catch (...) {
-    std::filesystem::remove(check);
-    throw;
-  }
-  std::filesystem::rename(check, a.out_path);
-  return text;
 }
 
 // The command that reproduces the file (its header).
@@ -199,18 +140,11 @@ int run_pose_tune(const PoseTuneArgs& a) {
     s.tune.global_evaluations = a.evaluations, s.tune.local_evaluations = a.polish, s.tune.seed = a.seed;
     s.max_regions = a.max_regions, s.overlap_deg = a.overlap_deg, s.worse_mode_tolerance_pct = a.worse_mode_pct;
     const auto progress = [](const std::string& m) { std::cerr << "robodamp pose tune: " << m << '\n'; };
-    const tune::TunedRegion robust = tune::tune_robust(in, s, progress);
-    const std::vector<tune::TunedRegion> scheduled = tune::tune_schedule(in, robust, s, progress);
-    const int points = a.map_points;
-    const tune::MapScores scores = tune::score_on_map(
-        in, tune::workspace_map(in, points, held),
-        {{"robust", tune::schedule_of(*in.cell.pose_schedule, {robust})},
-         {"scheduled", tune::schedule_of(*in.cell.pose_schedule, scheduled)},
-         {"as given", *in.cell.pose_schedule}}, job, progress);
-    const std::size_t best = tune::better_controller(scores, s.worse_mode_tolerance_pct);
-    // The configuration's own schedule (the third) is written back as it is when it scores best.
-    const std::vector<tune::TunedRegion> chosen =
-        best == 0 ? std::vector<tune::TunedRegion>{robust} : best == 1 ? scheduled : std::vector<tune::TunedRegion>{};
+    const tune::WorkspaceTune w = tune::tune_workspace(in, held, job, s, a.map_points, progress);
+    const tune::TunedRegion& robust = w.robust;
+    const std::vector<tune::TunedRegion>& scheduled = w.scheduled;
+    const tune::MapScores& scores = w.scores;
+    const std::size_t best = w.best;
     std::ostringstream t;
     t << "robodamp pose tune: " << a.config_path << ", the robot " << in.model.name << " (" << in.model.source << "), "
       << in.measured.size() << " measured pose(s) tuned at, " << held.size() << " held out; the damping band "
@@ -235,9 +169,9 @@ int run_pose_tune(const PoseTuneArgs& a) {
       summary.push_back(cj);
     }
     t << "chosen: " << scores.controllers[best].name << '\n';
-    if (const double w = scores.controllers[best].worst_mode_improvement_pct; w < 0.0)
-      t << "  note: a mode in the damping band ends " << pct(w) << " % against open loop at a map pose, worse ("
-        << (w >= -s.worse_mode_tolerance_pct ? "within" : "BEYOND") << " --worse-mode-pct "
+    if (const double worst = scores.controllers[best].worst_mode_improvement_pct; worst < 0.0)
+      t << "  note: a mode in the damping band ends " << pct(worst) << " % against open loop at a map pose, worse ("
+        << (worst >= -s.worse_mode_tolerance_pct ? "within" : "BEYOND") << " --worse-mode-pct "
         << config::format_number(s.worse_mode_tolerance_pct) << ")\n";
     json regions_robust = json::array({region_json(robust)}), regions_sched = json::array();
     for (const auto& r : scheduled) regions_sched.push_back(region_json(r));
@@ -254,7 +188,7 @@ int run_pose_tune(const PoseTuneArgs& a) {
       const std::string header = "# robodamp pose tune: the " + scores.controllers[best].name + " controller over the workspace of " +
                                  a.config_path + ", written by\n#   " + command_line(a) +
                                  "\n# (the comparison of the robust, the scheduled and the given controllers: the same with --json)\n";
-      (void)written_text(a, in.cell, chosen, header);
+      (void)tune::write_pose_tuned_config(in.cell, w.chosen(), a.model_path, a.out_path, header);
       t << "wrote " << a.out_path << " (read back, every region's set analysed over its grid)\n";
       out["out"] = a.out_path;
     }

@@ -88,6 +88,7 @@ struct ControllerRun {
   std::string trip{"none"};
   double active_share{0.0};
   unsigned long long saturated_ticks{0};
+  unsigned long long pose_out_of_map{0};
 };
 
 // How long (wall time) the lockstep may go without a fresh sensor sample before the run is ended as stalled:
@@ -161,6 +162,7 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   ControllerRun r;
   r.trip = cell.summary().trip;
   r.saturated_ticks = cell.summary().supervisor.saturated_ticks;
+  r.pose_out_of_map = cell.summary().supervisor.pose_out_of_map;
   r.active_share = in == 0 ? 0.0 : static_cast<double>(active) / static_cast<double>(in);
   return r;
 }
@@ -290,6 +292,65 @@ MeasureOutcome measure_through_emulator(const std::string& cell_path, const std:
                 std::to_string(o.impact_records_planned) + " impact records";
   }
   return o;
+}
+
+std::vector<std::string> with_trajectory(std::vector<std::string> args, const std::vector<std::string>& trajectory) {
+  for (const auto& w : trajectory) args.insert(args.end(), {"--pose-at", w});
+  return args;
+}
+
+PathMeasureOutcome measure_along_path_through_emulator(const config::Config& cell, const std::string& cell_path,
+                                                       const std::string& out_dir, const std::string& binary,
+                                                       const std::vector<std::string>& trajectory, const PathMeasureOptions& o) {
+  fs::create_directories(out_dir);
+  const fs::path dir(out_dir);
+  EmulatorProcess plant(binary,
+                        with_trajectory({"plant", "--config", cell_path, "--pacing", "lockstep", "--measure-out", out_dir,
+                                         "--json", (dir / "plant.json").string()},
+                                        trajectory),
+                        (dir / "plant.log").string());
+  PathMeasureOutcome r;
+  {
+    const PinnedToOneCpu pinned;
+    pinned.pin(plant.pid());
+    PathMeasureOptions po = o;
+    po.measure.clock = "virtual";
+    r = measure_along_path(cell, cell_path, out_dir, po);
+  }
+  if (r.run.status != MeasureStatus::kOk) return r;  // the emulator ends with the controller gone (killed if not)
+  expect_exit_zero(plant, "the measurement along the path");
+  return r;
+}
+
+EmulatedPathRun run_along_path_through_emulator(const config::Config& controller, const std::string& cell_path,
+                                                const std::string& binary, const std::vector<std::string>& trajectory,
+                                                double duration_s, const std::string& dir) {
+  const fs::path d(dir);
+  fs::create_directories(d);
+  EmulatorProcess plant(binary,
+                        with_trajectory({"plant", "--config", cell_path, "--pacing", "lockstep", "--json", (d / "plant.json").string()},
+                                        trajectory),
+                        (d / "plant.log").string());
+  const double from_s = controller.hil.settle_s;
+  const ControllerRun c = run_controller(controller, duration_s, from_s, duration_s, plant);
+  expect_exit_zero(plant, "the run along the path");
+  EmulatedPathRun r;
+  r.trip = c.trip;
+  r.active_share = c.active_share;
+  r.saturated_ticks = c.saturated_ticks;
+  r.pose_out_of_map = c.pose_out_of_map;
+  const nlohmann::json report = nlohmann::json::parse(text_of(d / "plant.json"));  // held: the loop reads into it
+  for (const auto& j : report["pose"]["dwells"]) {
+    EmulatedDwell w;
+    w.joints_deg = j["joints_deg"].get<std::vector<double>>();
+    w.t0_s = j["t0_s"].get<double>(), w.t1_s = j["t1_s"].get<double>();
+    w.records = j["records"].get<int>();
+    w.measured_improvement_pct = j["measured_improvement_pct"].get<double>();
+    w.coherence_min = j["coherence_min"].get<double>();
+    w.dominant_hz = j["dominant_hz"].get<double>();
+    r.dwells.push_back(std::move(w));
+  }
+  return r;
 }
 
 CutTrial cut_through_emulator(const config::Config& cell, const config::Config& controller, const EmulatedCut& e,

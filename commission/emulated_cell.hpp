@@ -18,6 +18,7 @@
 
 #include "commission/cell_check.hpp"
 #include "commission/measurement.hpp"
+#include "commission/path_measurement.hpp"
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
 #include "tune/verification.hpp"
@@ -62,6 +63,37 @@ struct EmulatedMeasure {
 };
 [[nodiscard]] MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
                                                        const std::string& binary, const EmulatedMeasure& e = {});
+
+// measure_along_path with the emulator as the robot and its hammer: `robodamp plant --pose-at ...
+// --measure-out DIR` moves the robot through the trajectory (T:Q1,Q2,... waypoints) and hammers at each stop;
+// the controller side finds the stops from the joint registers. Throws std::runtime_error when the emulator
+// fails or does not end.
+[[nodiscard]] PathMeasureOutcome measure_along_path_through_emulator(const config::Config& cell, const std::string& cell_path,
+                                                                     const std::string& out_dir, const std::string& binary,
+                                                                     const std::vector<std::string>& trajectory,
+                                                                     const PathMeasureOptions& o);
+
+// A controller run along the trajectory through the emulator, which at each dwell hits the driving point with
+// the controller running and again on the robot standing there with the amplifier off (hil/pose_trajectory.hpp).
+struct EmulatedDwell {
+  std::vector<double> joints_deg;
+  double t0_s{0.0}, t1_s{0.0};
+  int records{0};
+  double measured_improvement_pct{0.0};
+  double coherence_min{0.0};
+  double dominant_hz{0.0};
+};
+struct EmulatedPathRun {
+  std::string trip{"none"};
+  double active_share{0.0};  // of the ticks after the first settle
+  unsigned long long saturated_ticks{0}, pose_out_of_map{0};
+  std::vector<EmulatedDwell> dwells;
+};
+// duration_s: the run's loop time (the trajectory's last waypoint). Files and logs in dir. Throws
+// std::runtime_error when the controller cannot reach the emulator, the lockstep stalls or the emulator fails.
+[[nodiscard]] EmulatedPathRun run_along_path_through_emulator(const config::Config& controller, const std::string& cell_path,
+                                                              const std::string& binary, const std::vector<std::string>& trajectory,
+                                                              double duration_s, const std::string& dir);
 
 struct EmulatedCheckFiles {
   std::string binary;

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "config/robot_model_config.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace robodamp::config {
@@ -782,6 +783,21 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   if (c.pose_schedule && !c.parameter_sets.empty())
     d.add(root.Mark(), "pose_schedule",
           "and parameter_sets select parameter sets both: a configuration schedules by pose or by mounting, not both");
+  if (!c.hil.robot_model.empty()) {
+    if (!c.pose_schedule)
+      d.add(root.Mark(), "hil.robot_model",
+            "is set without pose_schedule: the emulator moves a robot model along a pose trajectory only");
+    else if (!c.hil.robot_model_resolved.empty() && !c.pose_schedule->model_resolved.empty())
+      try {
+        const std::size_t n = load_robot_model(c.hil.robot_model_resolved).joints.size();
+        if (n != c.pose_schedule->joints())
+          d.add(root.Mark(), "hil.robot_model",
+                "has " + std::to_string(n) + " joints; pose_schedule.model has " + std::to_string(c.pose_schedule->joints()) +
+                    ": the emulated robot and the configured model are read with the same joint angles");
+      } catch (const ConfigError&) {
+        // reported where hil.robot_model was read
+      }
+  }
   if (const auto& s = c.controller.speed_schedule) {
     if (c.pose_schedule)
       d.add(root.Mark(), "controller.speed_schedule",

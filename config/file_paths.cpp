@@ -12,6 +12,7 @@ namespace fs = std::filesystem;
 const std::vector<std::vector<YamlPathItem>>& file_path_keys() {
   static const std::vector<std::vector<YamlPathItem>> keys = {
       {"pose_schedule", "model"},
+      {"hil", "robot_model"},
       {"spindle", "job"},
       {"parameter_sets", "horizontal"},
       {"parameter_sets", "vertical"},

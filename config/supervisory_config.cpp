@@ -8,6 +8,7 @@
 
 #include "config/config.hpp"
 #include "config/file_paths.hpp"
+#include "config/robot_model_config.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace robodamp::config {
@@ -268,9 +269,21 @@ CellConfig read_cell(MapReader& top) {
   return c;
 }
 
-HilConfig read_hil(MapReader& top) {
+HilConfig read_hil(MapReader& top, const std::string& source) {
   MapReader r(top.diagnostics(), top.child("hil", false, ""), "hil", top.mark());
   HilConfig c;
+  if (auto v = r.text("robot_model", std::string()); v && !v->empty()) {
+    c.robot_model = *v;
+    const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), *v);
+    c.robot_model_resolved = f.path;
+    try {
+      if (!f.found) r.diagnostics().add(r.mark(), "hil.robot_model", "= '" + c.robot_model + "': no such file (looked for " + f.looked_text() + ")");
+      else (void)load_robot_model(c.robot_model_resolved);
+    } catch (const ConfigError& e) {
+      const std::string why = e.problems().empty() ? e.what() : e.problems().front().to_string();
+      r.diagnostics().add(r.mark(), "hil.robot_model", "= '" + c.robot_model + "': " + why);
+    }
+  }
   if (auto v = r.choice("pacing", {"realtime", "lockstep"}, "realtime"))
     c.pacing = *v == "lockstep" ? HilPacing::kLockstep : HilPacing::kRealtime;
   if (auto v = r.number("settle_s", {"s", 0.0, 600.0}, c.settle_s)) c.settle_s = *v;
@@ -292,7 +305,7 @@ void read_supervisory(MapReader& top, Config& c) {
   c.parameter_sets = read_parameter_sets(top, c.source);
   c.dds = read_dds(top);
   c.cell = read_cell(top);
-  c.hil = read_hil(top);
+  c.hil = read_hil(top, c.source);
   if (!c.parameter_sets.empty() && !(c.modbus && c.modbus->robot_link))
     top.diagnostics().add(top.mark(), "parameter_sets",
                           "needs modbus.robot: the robot's mounting register is what selects a set");

@@ -149,6 +149,10 @@ struct HilConfig {
   double amplifier_ready_delay_s{0.005};
   double ambient_c{35.0};
   double heating_c_per_v2{0.5};     // amplifier temperature above ambient per mean-square volt
+  // The robot the emulator moves (a robot model file; empty: pose_schedule.model): a HIL cell that stands for
+  // a robot its configured model does not describe, as a real robot is not its model file.
+  std::string robot_model;           // as written
+  std::string robot_model_resolved;  // resolved against the configuration file
 };
 
 [[nodiscard]] const char* to_string(ModbusTransport t);

@@ -475,7 +475,14 @@ void PlantEmulator::open_loop_reference() {
 
 }  // namespace detail
 
-EmulatorReport run_emulator(const config::Config& cfg, const EmulatorOptions& o) {
+EmulatorReport run_emulator(const config::Config& configured, const EmulatorOptions& o) {
+  // hil.robot_model: the robot the emulator moves is not the model the controller is configured with.
+  config::Config cfg = configured;
+  if (cfg.pose_schedule && !cfg.hil.robot_model_resolved.empty()) {
+    cfg.pose_schedule->model_resolved = cfg.hil.robot_model_resolved;
+    spdlog::info("robodamp plant: the robot moved is {} (hil.robot_model), not the controller's {}", cfg.hil.robot_model_resolved,
+                 configured.pose_schedule->model_resolved);
+  }
   detail::PlantEmulator emulator(cfg, o);
   emulator.connect();
   emulator.run();

@@ -1,6 +1,7 @@
 #include "modal/receptance.hpp"
 #include "milling/structure.hpp"
 
+#include "analysis/pose_schedule.hpp"
 #include "robot/robot_model.hpp"
 #include "units/units.hpp"
 
@@ -72,6 +73,10 @@ Structure::Structure(const config::StructureConfig& cfg, bool damped, const Live
 
 void Structure::add_pose(const std::string& part, const config::PosePartConfig& pc) {
   const config::RobotModelConfig m = config::load_robot_model(pc.model_path);
+  if (m.measured_modes) {
+    add_mapped_pose(part, pc, m);
+    return;
+  }
   auto chain = std::make_shared<const robot::PlanarChain>(robot::at_pose(m, pc.joints_deg));
   double zeta = 1.0;
   for (const auto& j : m.joints) zeta = std::min(zeta, std::max(j.damping_ratio, 1e-3));
@@ -82,6 +87,29 @@ void Structure::add_pose(const std::string& part, const config::PosePartConfig& 
   os << " deg";
   notes_.push_back(os.str());
   poses_.push_back(std::move(chain));
+}
+
+// A model with measured modes: the modes mapped to the pose (robot/modal_map.hpp) in the robot's plane
+// (analysis::config_in_plane_at_pose), the model's lowest kPoseModesForCut with the map's corrections, as modal
+// terms: along the measured axis (H11), across it (H22) and between (H21, both ways). A mode the measurements
+// alone know moves the TCP along the measured axis only. The chain itself would be the model without what the
+// measurements corrected.
+void Structure::add_mapped_pose(const std::string& part, const config::PosePartConfig& pc, const config::RobotModelConfig& m) {
+  const int axis = m.measured_modes->axis, across = 1 - axis;
+  const config::Config plane = analysis::config_in_plane_at_pose(config::Config{}, m, pc.joints_deg, axis,
+                                                                 static_cast<int>(kPoseModesForCut));
+  for (const config::FrfConfig& f : plane.robot.frfs) {
+    const int r = f.response_location == 1 ? axis : across, e = f.excitation_location == 1 ? axis : across;
+    for (const std::size_t k : {static_cast<std::size_t>(2 * r + e), static_cast<std::size_t>(2 * e + r)}) {
+      modal_[k].modes.insert(modal_[k].modes.end(), f.modes.begin(), f.modes.end());
+      if (r == e) break;
+    }
+  }
+  std::ostringstream os;
+  os << part << ": " << m.name << " (" << pc.model_path << ", its measured modes mapped) at joints";
+  for (double q : pc.joints_deg) os << ' ' << q;
+  os << " deg";
+  notes_.push_back(os.str());
 }
 
 void Structure::add_controller(const std::string& part, const std::string& source,

@@ -13,6 +13,7 @@
 #include "analysis/loop_model.hpp"
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
+#include "config/robot_model_config.hpp"
 #include "robot/planar_chain.hpp"
 
 namespace robodamp::milling {
@@ -95,6 +96,7 @@ class Structure {
   std::vector<std::string> notes_;
 
   void add_pose(const std::string& part, const config::PosePartConfig& pc);
+  void add_mapped_pose(const std::string& part, const config::PosePartConfig& pc, const config::RobotModelConfig& m);
   void add_controller(const std::string& part, const std::string& source, const config::ControllerPartConfig& pc,
                       std::shared_ptr<const analysis::LoopModel> model, double gain_ns_per_m, int polarity);
 };

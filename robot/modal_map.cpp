@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "robot/robot_model.hpp"
@@ -18,6 +19,8 @@ const double kMatchLogRatio = std::log(1.25);
 // The identification's scatter assumed (one standard deviation; the regression's nugget): a fitted mode's
 // frequency 0.3 %, its damping ratio 3 %, its participation 1 % of the track's largest. Larger values smooth
 // more.
+// The tracks' keys: a model mode's index, or this plus the rank among the modes no model mode matches.
+constexpr int kUnmatchedKey = 1 << 20;
 constexpr double kFreqNoise = 0.003, kDampingNoise = 0.03, kStiffnessNoise = 0.01;
 // A mode's participation along the axis, w^2 / k (1/kg: the mass-normalised shape squared) is what is
 // interpolated for its stiffness: it is smooth through a pose where the mode turns across the axis (there k
@@ -74,6 +77,51 @@ ModalMap::Field fitted_form(const std::vector<Eigen::VectorXd>& x, const std::ve
   form.model_rms = !against_model.empty() && x.size() >= 2 ? std::sqrt(leave_one_out_sse(x, against_model, noise, false) / n) : 0.0;
   form.own = against_model.empty() || (x.size() >= 3 && form.own_rms < form.model_rms);
   return form.own ? ModalMap::Field(x, own, noise, true) : ModalMap::Field(x, against_model, noise, false);
+}
+
+// A measured mode at one pose, with the model's mode it was matched to there (model_index -1: none).
+struct Sample {
+  Eigen::VectorXd x;
+  double f_hz, zeta, k, model_f_hz, model_zeta, model_k;
+  int model_index;
+};
+
+// One measured mode over the poses (a track): each quantity in the form leave-one-out chooses, its model mode
+// (-1 where no one model mode follows it at every pose), its frequencies.
+void fit_track(const std::vector<Sample>& t, ModalMap::Field& freq, ModalMap::Field& damping, ModalMap::Field& stiffness,
+               TrackForm& form) {
+  form.model_index = t.front().model_index;
+  for (const Sample& s : t)
+    if (s.model_index != form.model_index) form.model_index = -1;
+  const bool matched = form.model_index >= 0;
+  std::vector<Eigen::VectorXd> x;
+  // Each quantity in both forms: against the model's mode (a log ratio, or the participation's difference)
+  // and as the track's own values.
+  std::vector<double> f_own, f_prior, z_own, z_prior, p_own, p_model;
+  double p_scale = 0.0;
+  for (const Sample& s : t) {
+    x.push_back(s.x);
+    f_own.push_back(std::log(s.f_hz));
+    z_own.push_back(std::log(s.zeta));
+    p_own.push_back(participation(s.f_hz, s.k));
+    if (matched) {
+      f_prior.push_back(std::log(s.model_f_hz));
+      z_prior.push_back(std::log(s.model_zeta));
+      p_model.push_back(participation(s.model_f_hz, s.model_k));
+    }
+    p_scale = std::max(p_scale, participation(s.f_hz, s.k));
+  }
+  const auto difference = [matched](const std::vector<double>& a, const std::vector<double>& b) {
+    std::vector<double> d;
+    for (std::size_t i = 0; matched && i < a.size(); ++i) d.push_back(a[i] - b[i]);
+    return d;
+  };
+  freq = fitted_form(x, f_own, difference(f_own, f_prior), kFreqNoise, form.freq);
+  damping = fitted_form(x, z_own, difference(z_own, z_prior), kDampingNoise, form.damping);
+  stiffness = fitted_form(x, p_own, difference(p_own, p_model), kStiffnessNoise * p_scale, form.stiffness);
+  form.measured_poses = static_cast<int>(t.size());
+  form.min_hz = INFINITY;
+  for (const Sample& s : t) form.min_hz = std::min(form.min_hz, s.f_hz), form.max_hz = std::max(form.max_hz, s.f_hz);
 }
 
 // The measured modes' indices among the model's: as many pairs within 25 % as possible, then the smallest
@@ -182,12 +230,10 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
   if (model.measured_modes->axis != axis)
     throw std::invalid_argument(model.source + ": measured_modes are along " + (model.measured_modes->axis == 0 ? "x" : "y") +
                                 ", the schedule's axis is " + (axis == 0 ? "x" : "y") + ": measure along the actuator's axis");
-  struct Sample {
-    Eigen::VectorXd x;
-    double f_hz, zeta, k, model_f_hz, model_zeta, model_k;
-    int model_index;
-  };
-  std::vector<std::vector<Sample>> tracks;  // the k-th lowest measured mode of each pose
+  // The tracks: a measured mode matched to a model mode joins that mode's track (the model's order is the prior's
+  // identity of a mode: a mode a driving point misses at some poses does not shift the others); the modes the
+  // model has no match for, by their rank among the unmatched at each pose.
+  std::map<int, std::vector<Sample>> by_key;
   for (const config::MeasuredPoseModes& p : model.measured_modes->poses) {
     const std::vector<AxisMode> prior = axis_modes(model, p.joints_deg, axis, count);
     std::vector<config::ModeConfig> measured = p.modes;
@@ -196,51 +242,30 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
     for (const auto& m : measured) measured_hz.push_back(m.natural_freq_hz);
     for (const auto& m : prior) model_hz.push_back(m.freq_hz);
     PoseMatch match{p.name, match_modes(measured_hz, model_hz)};
-    if (tracks.size() < measured.size()) tracks.resize(measured.size());
+    int unmatched = 0;
     for (std::size_t k = 0; k < measured.size(); ++k) {
       const int j = match.model_of_measured[k];
       const AxisMode a = j >= 0 ? prior[static_cast<std::size_t>(j)] : AxisMode{};
-      tracks[k].push_back({radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m,
-                           a.freq_hz, a.damping_ratio, a.stiffness_n_per_m, j});
+      by_key[j >= 0 ? j : kUnmatchedKey + unmatched++].push_back(
+          {radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m, a.freq_hz,
+           a.damping_ratio, a.stiffness_n_per_m, j});
     }
     matches_.push_back(std::move(match));
     measured_deg_.push_back(p.joints_deg);
   }
+  std::vector<std::vector<Sample>> tracks;
+  for (auto& [key, t] : by_key) tracks.push_back(std::move(t));
+  const auto mean_hz = [](const std::vector<Sample>& t) {
+    double sum = 0.0;
+    for (const Sample& x : t) sum += x.f_hz;
+    return sum / static_cast<double>(t.size());
+  };
+  std::sort(tracks.begin(), tracks.end(), [&](const auto& a, const auto& b) { return mean_hz(a) < mean_hz(b); });
   for (const std::vector<Sample>& t : tracks) {
     if (2 * t.size() < model.measured_modes->poses.size()) continue;  // seen at too few poses to stand for a mode
     Track tr;
-    tr.model_index = t.front().model_index;
-    for (const Sample& s : t)
-      if (s.model_index != tr.model_index) tr.model_index = -1;  // no one model mode follows it
-    const bool matched = tr.model_index >= 0;
-    std::vector<Eigen::VectorXd> x;
-    // Each quantity in both forms: against the model's mode (a log ratio, or the participation's difference)
-    // and as the track's own values.
-    std::vector<double> f_own, f_prior, z_own, z_prior, p_own, p_prior, p_model;
-    double p_scale = 0.0;
-    for (const Sample& s : t) {
-      x.push_back(s.x);
-      f_own.push_back(std::log(s.f_hz));
-      z_own.push_back(std::log(s.zeta));
-      p_own.push_back(participation(s.f_hz, s.k));
-      if (matched) {
-        f_prior.push_back(std::log(s.model_f_hz));
-        z_prior.push_back(std::log(s.model_zeta));
-        p_model.push_back(participation(s.model_f_hz, s.model_k));
-      }
-      p_scale = std::max(p_scale, participation(s.f_hz, s.k));
-    }
-    const auto difference = [](const std::vector<double>& a, const std::vector<double>& b) {
-      std::vector<double> d(a.size());
-      for (std::size_t i = 0; i < a.size(); ++i) d[i] = a[i] - b[i];
-      return d;
-    };
-    tr.freq = fitted_form(x, f_own, matched ? difference(f_own, f_prior) : std::vector<double>{}, kFreqNoise, tr.form.freq);
-    tr.damping = fitted_form(x, z_own, matched ? difference(z_own, z_prior) : std::vector<double>{}, kDampingNoise, tr.form.damping);
-    tr.stiffness = fitted_form(x, p_own, matched ? difference(p_own, p_model) : std::vector<double>{}, kStiffnessNoise * p_scale,
-                               tr.form.stiffness);
-    tr.form.model_index = tr.model_index;
-    tr.form.measured_poses = static_cast<int>(t.size());
+    fit_track(t, tr.freq, tr.damping, tr.stiffness, tr.form);
+    tr.model_index = tr.form.model_index;
     tracks_.push_back(std::move(tr));
   }
 }

@@ -34,10 +34,11 @@ struct AxisMode {
 [[nodiscard]] std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
                                                int axis, int count);
 
-// One mode at a pose, mapped. A track is the k-th lowest measured mode of every measured pose. Where at every
-// pose it was measured the same model mode lies within 25 % of it, that mode is its prior (model_index >= 0):
-// each quantity is interpolated against it or as its own values (TrackForm). Where not (the model lacks the
-// mode, or its modes reorder between the poses), the track's own values are interpolated (model_index -1). The model's modes no
+// One mode at a pose, mapped. A track is one mode over the measured poses: the measured modes matched to the
+// same model mode (the nearest within 25 %), or those the model has no match for, by their rank among the
+// unmatched at each pose. A matched track has that model mode as its prior (model_index >= 0): each quantity
+// is interpolated against it or as its own values (TrackForm); an unmatched one from its own values
+// (model_index -1). The model's modes no
 // track follows and above every track stay as the model has them (measured_poses 0, no spread); below, where
 // the measurements would have seen them, they are not there.
 // sigma_*: one standard deviation of the log value (x 100: about a percentage); the stiffness's from its
@@ -68,6 +69,7 @@ struct QuantityForm {
 struct TrackForm {
   int model_index{-1};  // the model's mode the track follows (-1: none)
   int measured_poses{0};
+  double min_hz{0.0}, max_hz{0.0};  // its measured frequencies
   QuantityForm freq, damping, stiffness;
 };
 
