@@ -45,6 +45,28 @@ std::string command_line(const CommissionArgs& a) {
   return c;
 }
 
+bool stage_from(const std::string& text, commission::Stage& out) {
+  try {
+    out = commission::stage_from_string(text);
+    return true;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "robodamp commission: " << e.what() << '\n';
+    return false;
+  }
+}
+
+// The verdict line, the report's path and the exit status of either commissioning.
+template <class Result>
+int finish(const Result& r, const std::string& where) {
+  if (r.outcome == commission::Outcome::kVerified)
+    std::printf("robodamp commission: VERIFIED%s in %.1f s: wrote %s\n", where.c_str(), r.wall_s, r.configuration_path.c_str());
+  else
+    std::fprintf(stderr, "robodamp commission: stopped at the %s stage after %.1f s: %s; no configuration written\n",
+                 commission::to_string(r.stage), r.wall_s, r.reason.c_str());
+  if (!r.report_path.empty()) std::printf("robodamp commission: the report is %s\n", r.report_path.c_str());
+  return commission::exit_code(r.outcome);
+}
+
 std::string path_command_line(const CommissionArgs& a, const commission::PathCommissionSettings& p) {
   std::string c = "robodamp commission --config " + a.config_path + " --job " + a.job_path + " --out " + a.out_dir +
                   " --along-path --dwells " + std::to_string(p.dwells);
@@ -65,26 +87,14 @@ int run_along_path(const CommissionArgs& a) {
   s.job_path = a.job_path;
   s.out_dir = a.out_dir;
   s.peak_tolerance = a.peak_tolerance_pct / 100.0;
-  try {
-    s.from = commission::stage_from_string(a.from);
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "robodamp commission: " << e.what() << '\n';
-    return 2;
-  }
+  if (!stage_from(a.from, s.from)) return 2;
   // The pose tune's own budgets (60 / 30 a set) unless given: a schedule tunes a set per region.
   s.pose_tune.tune.global_evaluations = a.evaluations_given ? a.settings.tune.global_evaluations : 60;
   s.pose_tune.tune.local_evaluations = a.polish_given ? a.settings.tune.local_evaluations : 30;
   s.pose_tune.tune.seed = a.settings.tune.seed;
   s.command_line = path_command_line(a, s);
   const commission::PathCommissionResult r = commission::commission_along_path(s, [](const std::string& l) { spdlog::info("{}", l); });
-  if (r.outcome == commission::Outcome::kVerified)
-    std::printf("robodamp commission: VERIFIED along the path at %zu stops in %.1f s: wrote %s\n", r.stops.size(), r.wall_s,
-                r.configuration_path.c_str());
-  else
-    std::fprintf(stderr, "robodamp commission: stopped at the %s stage after %.1f s: %s; no configuration written\n",
-                 commission::to_string(r.stage), r.wall_s, r.reason.c_str());
-  if (!r.report_path.empty()) std::printf("robodamp commission: the report is %s\n", r.report_path.c_str());
-  return commission::exit_code(r.outcome);
+  return finish(r, " along the path at " + std::to_string(r.stops.size()) + " stops");
 }
 
 int run_commission(CommissionArgs& a) {
@@ -115,22 +125,10 @@ int run_commission(CommissionArgs& a) {
   s.job_path = a.job_path;
   s.out_dir = a.out_dir;
   s.shift_pct = a.shift_pct;
-  try {
-    s.from = commission::stage_from_string(a.from);
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "robodamp commission: " << e.what() << '\n';
-    return 2;
-  }
+  if (!stage_from(a.from, s.from)) return 2;
   s.command_line = command_line(a);
   const commission::CommissionResult r = commission::commission(s, [](const std::string& l) { spdlog::info("{}", l); });
-  if (r.outcome == commission::Outcome::kVerified) {
-    std::printf("robodamp commission: VERIFIED in %.1f s: wrote %s\n", r.wall_s, r.configuration_path.c_str());
-  } else {
-    std::fprintf(stderr, "robodamp commission: stopped at the %s stage after %.1f s: %s; no configuration written\n",
-                 commission::to_string(r.stage), r.wall_s, r.reason.c_str());
-  }
-  if (!r.report_path.empty()) std::printf("robodamp commission: the report is %s\n", r.report_path.c_str());
-  return commission::exit_code(r.outcome);
+  return finish(r, "");
 }
 
 }  // namespace

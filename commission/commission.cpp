@@ -18,6 +18,7 @@
 #include "analysis/loop_model.hpp"
 #include "commission/measurement.hpp"
 #include "commission/report.hpp"
+#include "commission/stage_detail.hpp"
 #include "config/milling_config.hpp"
 #include "tune/speed_schedule_report.hpp"
 #include "tune/tuned_file.hpp"
@@ -27,28 +28,15 @@ namespace robodamp::commission {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-template <class... A>
-std::string fmt(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
-
-// A stop: the stage, the outcome, the reason.
-struct Stop {
-  Stage stage;
-  Outcome outcome;
-  std::string reason;
-};
+using detail::Clock;
+using detail::fmt;
+using detail::seconds_since;
+using detail::Stop;
 
 class Run {
  public:
   Run(const CommissionSettings& s, const std::function<void(const std::string&)>& progress, CommissionResult& r)
-      : s_(s), say_(progress), r_(r), dir_(s.out_dir) {}
+      : s_(s), say_(progress), r_(r), dir_(s.out_dir), stage_(s.from, s.out_dir, say_, r.stage, r.times) {}
 
   void all() {
     fs::create_directories(dir_);
@@ -71,30 +59,18 @@ class Run {
            "locations come from " + std::to_string(s_.tap_tests.size()) + " tap-test file(s); robodamp orders no hammer "
            "blow and no cut");
     job_ = config::load_milling_config(s_.job_path);
-    stage(Stage::kMeasure, [this] { measure(); });
-    stage(Stage::kIdentify, [this] { identify(); });
-    stage(Stage::kTune, [this] { tune(); });
-    stage(Stage::kVerify, [this] { verify(); });
-    stage(Stage::kWrite, [this] { write(); });
+    stage_(Stage::kMeasure, [this] { measure(); });
+    stage_(Stage::kIdentify, [this] { identify(); });
+    stage_(Stage::kTune, [this] { tune(); });
+    stage_(Stage::kVerify, [this] { verify(); });
+    stage_(Stage::kWrite, [this] { write(); });
   }
 
  private:
-  template <class F>
-  void stage(Stage st, F&& f) {
-    r_.stage = st;
-    const auto t0 = Clock::now();
-    const bool reuse = st < s_.from && st != Stage::kIdentify;  // identifying again is quick and deterministic
-    say_(std::string("commission: stage ") + std::to_string(static_cast<int>(st)) + "/5 " + to_string(st) +
-         (reuse ? " (reusing " + dir_.string() + ")" : ""));
-    reuse_ = reuse;
-    f();
-    r_.times.push_back({st, seconds_since(t0), reuse});
-    say_(fmt("commission: %s done in %.1f s", to_string(st), seconds_since(t0)));
-  }
 
   void measure() {
     const fs::path m = dir_ / "measurement";
-    if (!reuse_) {
+    if (!stage_.reuse()) {
       MeasureOptions mo;
       mo.impacts = !real_;
       const MeasureOutcome o = emulated_ ? measure_through_emulator(s_.config_path, m.string(), binary_, {mo, std::nullopt})
@@ -104,7 +80,7 @@ class Run {
       // place at the end).
       std::signal(SIGINT, SIG_DFL);
       std::signal(SIGTERM, SIG_DFL);
-      throw_unless_ok(o, Stage::kMeasure);
+      detail::throw_unless_measured(o, Stage::kMeasure);
       say_(fmt("commission: measured %d of %d impact records, chirp active over %.1f %% of its ticks, peak command "
                "%.3f V, the cell at rest at %.4f m/s^2 RMS before it", o.impact_records, o.impact_records_planned,
                100.0 * o.chirp_active_share, o.peak_command_v, o.rest_accel_rms_mps2));
@@ -112,18 +88,6 @@ class Run {
       throw Stop{Stage::kMeasure, Outcome::kBadInput,
                  "--from " + std::string(to_string(s_.from)) + ": " + (m / identify::kManifestName).string() +
                      " does not exist: run from measure"};
-    }
-  }
-
-  static void throw_unless_ok(const MeasureOutcome& o, Stage st) {
-    switch (o.status) {
-      case MeasureStatus::kOk: return;
-      case MeasureStatus::kTripped: throw Stop{st, Outcome::kTripped, o.message};
-      case MeasureStatus::kConfigError: throw Stop{st, Outcome::kBadInput, o.message};
-      case MeasureStatus::kNotReady:
-      case MeasureStatus::kSaturated: throw Stop{st, Outcome::kRefused, o.message};
-      case MeasureStatus::kAborted: throw Stop{st, Outcome::kAborted, o.message};
-      default: throw Stop{st, Outcome::kFailed, o.message};
     }
   }
 
@@ -187,7 +151,7 @@ class Run {
     for (const auto& e : p) refs.push_back(&e);
     r_.open_curve_mm = p.front().open_curve_mm();
     const fs::path tuned_path = dir_ / "tuned.yaml";
-    if (reuse_) {
+    if (stage_.reuse()) {
       if (!fs::exists(tuned_path))
         throw Stop{Stage::kTune, Outcome::kBadInput, "--from verify: " + tuned_path.string() + " does not exist: run from tune"};
       r_.tuned_config = config::load_config_file(tuned_path.string());
@@ -306,7 +270,7 @@ class Run {
                                         on);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
-    throw_unless_ok(on, Stage::kVerify);
+    detail::throw_unless_measured(on, Stage::kVerify);
     const RealCellCheck& c = *r_.real_check;
     for (const auto& line : c.progress_lines()) say_("commission: " + line);
     if (const std::string f = c.failure(); !f.empty()) throw Stop{Stage::kVerify, Outcome::kNotVerified, f};
@@ -358,18 +322,7 @@ class Run {
     h << "\n";
     if (r_.schedule) h << tune::schedule_header(*r_.schedule);
     h << "#\n";
-    std::ifstream in(dir_ / (r_.schedule ? "scheduled.yaml" : "tuned.yaml"));
-    const std::string tuned((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string text = h.str() + tuned;
-    (void)config::parse_config(text, (dir_ / "configuration.yaml").string());
-    const fs::path tmp = dir_ / "configuration.yaml.partial";
-    {
-      std::ofstream out(tmp);
-      out << text;
-      if (!out) throw Stop{Stage::kWrite, Outcome::kFailed, "cannot write " + tmp.string()};
-    }
-    fs::rename(tmp, dir_ / "configuration.yaml");
-    r_.configuration_path = (dir_ / "configuration.yaml").string();
+    r_.configuration_path = detail::write_configuration(dir_, (r_.schedule ? "scheduled.yaml" : "tuned.yaml"), h.str());
   }
 
   // The configuration's header line: what was checked on the cell itself.
@@ -388,7 +341,7 @@ class Run {
   const std::function<void(const std::string&)>& say_;
   CommissionResult& r_;
   fs::path dir_;
-  bool reuse_{false};
+  detail::StageRunner stage_;
   config::Config cell_;
   config::MillingConfig job_;
   bool emulated_{false};  // the cell is the HIL emulator (a can: section with a unix: interface)
@@ -457,23 +410,7 @@ std::pair<double, std::string> modal_uncertainty_pct(const identify::Commissioni
 CommissionResult commission(const CommissionSettings& s, const std::function<void(const std::string&)>& progress) {
   CommissionResult r;
   const auto t0 = Clock::now();
-  try {
-    Run(s, progress, r).all();
-    r.outcome = Outcome::kVerified;
-  } catch (const Stop& stop) {
-    r.stage = stop.stage;
-    r.outcome = stop.outcome;
-    r.reason = stop.reason;
-  } catch (const config::ConfigError& e) {
-    r.outcome = Outcome::kBadInput;
-    r.reason = e.what();
-  } catch (const std::invalid_argument& e) {
-    r.outcome = Outcome::kBadInput;
-    r.reason = e.what();
-  } catch (const std::exception& e) {
-    r.outcome = Outcome::kFailed;
-    r.reason = e.what();
-  }
+  detail::run_to_outcome(r, [&] { Run(s, progress, r).all(); });
   r.wall_s = seconds_since(t0);
   r.report_path = (fs::path(s.out_dir) / "report.html").string();
   std::error_code ec;

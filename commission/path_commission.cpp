@@ -13,6 +13,7 @@
 #include "analysis/pose_schedule.hpp"
 #include "commission/emulated_cell.hpp"
 #include "commission/path_report.hpp"
+#include "commission/stage_detail.hpp"
 #include "config/file_paths.hpp"
 #include "config/yaml_edit.hpp"
 #include "hil/pose_trajectory.hpp"
@@ -33,22 +34,10 @@ bool PathStop::improvement_held(double tolerance_points, double peak_tolerance) 
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-template <class... A>
-std::string fmt(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
-
-struct Stop {
-  Stage stage;
-  Outcome outcome;
-  std::string reason;
-};
+using detail::Clock;
+using detail::fmt;
+using detail::seconds_since;
+using detail::Stop;
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -134,7 +123,7 @@ std::vector<std::string> waypoint_texts(const std::vector<hil::PoseWaypoint>& pa
 class PathRun {
  public:
   PathRun(const PathCommissionSettings& s, const std::function<void(const std::string&)>& progress, PathCommissionResult& r)
-      : s_(s), say_(progress), r_(r), dir_(s.out_dir) {}
+      : s_(s), say_(progress), r_(r), dir_(s.out_dir), stage_(s.from, s.out_dir, say_, r.stage, r.times) {}
 
   void all() {
     fs::create_directories(dir_);
@@ -160,28 +149,17 @@ class PathRun {
     r_.job_rpm = job_.cut.spindle_rpm;
     say_("commission: along the path through the HIL emulator on " + cell_.can->interface + ": " +
          std::to_string(s_.dwells) + " stops, " + std::to_string(s_.hold_out.size()) + " held out of the map");
-    stage(Stage::kMeasure, [this] { measure(); });
-    stage(Stage::kIdentify, [this] { identify(); });
-    stage(Stage::kTune, [this] { tune(); });
-    stage(Stage::kVerify, [this] { verify(); });
-    stage(Stage::kWrite, [this] { write(); });
+    stage_(Stage::kMeasure, [this] { measure(); });
+    stage_(Stage::kIdentify, [this] { identify(); });
+    stage_(Stage::kTune, [this] { tune(); });
+    stage_(Stage::kVerify, [this] { verify(); });
+    stage_(Stage::kWrite, [this] { write(); });
   }
 
  private:
-  template <class F>
-  void stage(Stage st, F&& f) {
-    r_.stage = st;
-    const auto t0 = Clock::now();
-    reuse_ = st < s_.from && st != Stage::kIdentify;
-    say_(std::string("commission: stage ") + std::to_string(static_cast<int>(st)) + "/5 " + to_string(st) +
-         (reuse_ ? " (reusing " + dir_.string() + ")" : ""));
-    f();
-    r_.times.push_back({st, seconds_since(t0), reuse_});
-    say_(fmt("commission: %s done in %.1f s", to_string(st), seconds_since(t0)));
-  }
 
   void measure() {
-    if (reuse_) {
+    if (stage_.reuse()) {
       if (!fs::exists(dir_ / "measurement" / "poses.json"))
         throw Stop{Stage::kMeasure, Outcome::kBadInput,
                    "--from " + std::string(to_string(s_.from)) + ": " + (dir_ / "measurement" / "poses.json").string() +
@@ -200,15 +178,7 @@ class PathRun {
     for (const auto& d : o.dwells)
       say_("commission:   " + d.name + " at " + config::describe_pose(d.joints_deg) +
            (d.measured ? fmt(": measured (the chirp %.1f-%.1f s)", d.chirp_start_s, d.chirp_end_s) : ": not measured: " + d.skipped));
-    switch (o.run.status) {
-      case MeasureStatus::kOk: break;
-      case MeasureStatus::kTripped: throw Stop{Stage::kMeasure, Outcome::kTripped, o.run.message};
-      case MeasureStatus::kConfigError: throw Stop{Stage::kMeasure, Outcome::kBadInput, o.run.message};
-      case MeasureStatus::kNotReady:
-      case MeasureStatus::kSaturated: throw Stop{Stage::kMeasure, Outcome::kRefused, o.run.message};
-      case MeasureStatus::kAborted: throw Stop{Stage::kMeasure, Outcome::kAborted, o.run.message};
-      default: throw Stop{Stage::kMeasure, Outcome::kFailed, o.run.message};
-    }
+    detail::throw_unless_measured(o.run, Stage::kMeasure);
     if (o.measured() < s_.dwells)
       throw Stop{Stage::kMeasure, Outcome::kFailed,
                  fmt("%d of %d stops measured: the robot stopped too few times, or too briefly, within the run", o.measured(),
@@ -295,7 +265,7 @@ class PathRun {
   }
 
   void tune() {
-    if (reuse_) {
+    if (stage_.reuse()) {
       if (!fs::exists(dir_ / "tuned.yaml"))
         throw Stop{Stage::kTune, Outcome::kBadInput, "--from verify: " + (dir_ / "tuned.yaml").string() + " does not exist: run from tune"};
       r_.chosen = "reused from " + (dir_ / "tuned.yaml").string();
@@ -412,30 +382,19 @@ class PathRun {
                config::describe_pose(st.joints_deg).c_str(), st.measured_improvement_pct, st.predicted_improvement_pct,
                st.damped_limit_mm, st.open_limit_mm);
     h << "\n#\n";
-    std::ifstream in(dir_ / "tuned.yaml");
-    const std::string tuned((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string text = h.str() + tuned;
-    (void)config::parse_config(text, (dir_ / "configuration.yaml").string());
-    const fs::path tmp = dir_ / "configuration.yaml.partial";
-    {
-      std::ofstream out(tmp);
-      out << text;
-      if (!out) throw Stop{Stage::kWrite, Outcome::kFailed, "cannot write " + tmp.string()};
-    }
-    fs::rename(tmp, dir_ / "configuration.yaml");
-    r_.configuration_path = (dir_ / "configuration.yaml").string();
+    r_.configuration_path = detail::write_configuration(dir_, "tuned.yaml", h.str());
   }
 
   const PathCommissionSettings& s_;
   const std::function<void(const std::string&)>& say_;
   PathCommissionResult& r_;
   fs::path dir_;
+  detail::StageRunner stage_;
   config::Config cell_, identified_, tuned_;
   config::MillingConfig job_;
   config::RobotModelConfig mapped_;
   std::vector<hil::PoseWaypoint> path_;
   std::string binary_;
-  bool reuse_{false};
 };
 
 }  // namespace
@@ -444,18 +403,7 @@ PathCommissionResult commission_along_path(const PathCommissionSettings& s,
                                            const std::function<void(const std::string&)>& progress) {
   PathCommissionResult r;
   const auto t0 = Clock::now();
-  try {
-    PathRun(s, progress, r).all();
-    r.outcome = Outcome::kVerified;
-  } catch (const Stop& stop) {
-    r.stage = stop.stage, r.outcome = stop.outcome, r.reason = stop.reason;
-  } catch (const config::ConfigError& e) {
-    r.outcome = Outcome::kBadInput, r.reason = e.what();
-  } catch (const std::invalid_argument& e) {
-    r.outcome = Outcome::kBadInput, r.reason = e.what();
-  } catch (const std::exception& e) {
-    r.outcome = Outcome::kFailed, r.reason = e.what();
-  }
+  detail::run_to_outcome(r, [&] { PathRun(s, progress, r).all(); });
   r.wall_s = seconds_since(t0);
   std::error_code ec;
   if (fs::is_directory(s.out_dir, ec)) {

@@ -9,6 +9,7 @@
 
 #include "analysis/pose_schedule.hpp"
 #include "commission/path_commission.hpp"
+#include "commission/stage_detail.hpp"
 #include "hil/pose_trajectory.hpp"
 #include "plot/gnuplot.hpp"
 #include "rt/version.hpp"
@@ -21,24 +22,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using plot::num;
 
-template <class... A>
-std::string fmt(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
-
-std::string esc(const std::string& s) {
-  std::string o;
-  for (const char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
-  }
-  return o;
-}
+using detail::esc;
+using detail::fmt;
 
 std::string figure(const fs::path& dir, const std::string& name, const std::string& script, const std::string& data,
                    const std::string& caption) {

@@ -1,5 +1,7 @@
 #include "commission/report.hpp"
 
+#include "commission/stage_detail.hpp"
+
 #include <openssl/evp.h>
 
 #include <cmath>
@@ -23,24 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 using plot::num;
 
-template <class... A>
-std::string fmt(const char* f, A... a) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, f, a...);
-  return buf;
-}
-
-std::string esc(const std::string& s) {
-  std::string o;
-  for (const char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
-  }
-  return o;
-}
+using detail::esc;
+using detail::fmt;
 
 double deg(std::complex<double> z) { return std::arg(z) * 180.0 / M_PI; }
 

@@ -147,18 +147,7 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   MapReader r(d, node, "pose_schedule", top.mark());
   PoseScheduleConfig c;
   std::optional<RobotModelConfig> model;
-  if (auto v = r.text("model", std::nullopt)) {
-    c.model = *v;
-    const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), *v);
-    c.model_resolved = f.path;
-    try {
-      if (!f.found) d.add(r.mark(), "pose_schedule.model", "= '" + c.model + "': no such file (looked for " + f.looked_text() + ")");
-      else model = load_robot_model(c.model_resolved);
-    } catch (const ConfigError& e) {
-      const std::string why = e.problems().empty() ? e.what() : e.problems().front().to_string();
-      d.add(r.mark(), "pose_schedule.model", "= '" + c.model + "': " + why);
-    }
-  }
+  if (auto v = r.text("model", std::nullopt)) model = read_robot_model_file(r, "pose_schedule.model", source, *v, c.model, c.model_resolved);
   if (auto v = r.choice("axis", {"x", "y"}, "y")) c.axis = *v == "x" ? 0 : 1;
   if (auto v = read_int(r, "modes", {"(modes)", 1, 12}, c.modes)) c.modes = *v;
   if (auto v = read_int(r, "grid_points", {"(points per joint)", 2, 9}, c.grid_points)) c.grid_points = *v;

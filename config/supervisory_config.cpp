@@ -272,18 +272,8 @@ CellConfig read_cell(MapReader& top) {
 HilConfig read_hil(MapReader& top, const std::string& source) {
   MapReader r(top.diagnostics(), top.child("hil", false, ""), "hil", top.mark());
   HilConfig c;
-  if (auto v = r.text("robot_model", std::string()); v && !v->empty()) {
-    c.robot_model = *v;
-    const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), *v);
-    c.robot_model_resolved = f.path;
-    try {
-      if (!f.found) r.diagnostics().add(r.mark(), "hil.robot_model", "= '" + c.robot_model + "': no such file (looked for " + f.looked_text() + ")");
-      else (void)load_robot_model(c.robot_model_resolved);
-    } catch (const ConfigError& e) {
-      const std::string why = e.problems().empty() ? e.what() : e.problems().front().to_string();
-      r.diagnostics().add(r.mark(), "hil.robot_model", "= '" + c.robot_model + "': " + why);
-    }
-  }
+  if (auto v = r.text("robot_model", std::string()); v && !v->empty())
+    (void)read_robot_model_file(r, "hil.robot_model", source, *v, c.robot_model, c.robot_model_resolved);
   if (auto v = r.choice("pacing", {"realtime", "lockstep"}, "realtime"))
     c.pacing = *v == "lockstep" ? HilPacing::kLockstep : HilPacing::kRealtime;
   if (auto v = r.number("settle_s", {"s", 0.0, 600.0}, c.settle_s)) c.settle_s = *v;

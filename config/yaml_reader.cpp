@@ -4,7 +4,10 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <filesystem>
 #include <sstream>
+
+#include "config/file_paths.hpp"
 
 namespace robodamp::config::detail {
 
@@ -225,6 +228,21 @@ ModeConfig read_mode(MapReader& mr, const Range& frequency_range) {
   }
   mr.finish();
   return m;
+}
+
+std::optional<RobotModelConfig> read_robot_model_file(MapReader& r, const std::string& key, const std::string& source,
+                                                    const std::string& value, std::string& written, std::string& resolved) {
+  written = value;
+  const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), value);
+  resolved = f.path;
+  try {
+    if (f.found) return load_robot_model(resolved);
+    r.diagnostics().add(r.mark(), key, "= '" + value + "': no such file (looked for " + f.looked_text() + ")");
+  } catch (const ConfigError& e) {
+    const std::string why = e.problems().empty() ? e.what() : e.problems().front().to_string();
+    r.diagnostics().add(r.mark(), key, "= '" + value + "': " + why);
+  }
+  return std::nullopt;
 }
 
 }  // namespace robodamp::config::detail

@@ -11,6 +11,7 @@
 
 #include "config/config.hpp"
 #include "config/number_range.hpp"
+#include "config/robot_model_config.hpp"
 
 namespace robodamp::config::detail {
 
@@ -96,5 +97,11 @@ void read_supervisory(MapReader& top, Config& c);
 [[nodiscard]] CommissioningConfig read_commissioning(MapReader& top);
 // One mode in residue (Eq. 1) or modal-stiffness form; natural_freq_hz checked against frequency_range.
 [[nodiscard]] ModeConfig read_mode(MapReader& mr, const Range& frequency_range);
+
+// A key naming a robot model file: found (the configuration's folder, then the data folders: file_paths.hpp)
+// and read; what is wrong with it is reported at the key (key: its full name). written and resolved are set.
+[[nodiscard]] std::optional<RobotModelConfig> read_robot_model_file(MapReader& r, const std::string& key, const std::string& source,
+                                                                    const std::string& value, std::string& written,
+                                                                    std::string& resolved);
 
 }  // namespace robodamp::config::detail
