@@ -518,8 +518,21 @@ TEST(Loop, OverrunsWithinTheDelayMarginAreRiddenThrough) {
   const auto cfg = c2();
   const double dm = preset_delay_margin_s(cfg);
   ASSERT_GT(dm, 0.02);
+  // On the wall clock a loaded machine stalls the loop by itself now and then; a stall of its own longer than the
+  // delay margin trips the loop before the injected ones start (at 1 s), as it should (a suite on both cores did
+  // it once, 0.28 s before the injection). Such a run is not the one this test is about: it is said and run
+  // again, three times at most.
+  const auto run_clean = [&](double duration_s, double stall_s) {
+    for (int attempt = 1;; ++attempt) {
+      auto r = run(cfg, duration_s, [stall_s](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, stall_s, 3e-4}); }, o);
+      const std::size_t fault = first_state(r, State::kFault);
+      if (fault == r.frames.size() || r.frames[fault].time_s >= 1.0 || attempt == 3) return r;
+      std::printf("[ overruns ] the machine's own stall tripped the loop at %.3f s, before the injection: run again\n",
+                  r.frames[fault].time_s);
+    }
+  };
   // 8 ms of 0.3 ms stalls: about 27 consecutive overruns, more than overrun_cycles, a third of the margin.
-  const auto r = run(cfg, 2.0, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.008, 3e-4}); }, o);
+  const auto r = run_clean(2.0, 0.008);
   expect_nothing_lost(r);
   EXPECT_EQ(r.s.trip, "none");
   EXPECT_GE(r.s.supervisor.overruns, 20U);
@@ -527,7 +540,7 @@ TEST(Loop, OverrunsWithinTheDelayMarginAreRiddenThrough) {
   EXPECT_EQ(first_state(r, State::kFault), r.frames.size()) << "never in fault";
 
   // 0.2 s of them: the run outlasts the margin and trips, not before the margin has passed.
-  const auto t = run(cfg, 1.5, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  const auto t = run_clean(1.5, 0.2);
   EXPECT_EQ(t.s.trip, "overruns");
   const std::size_t fault = first_state(t, State::kFault);
   ASSERT_LT(fault, t.frames.size());
