@@ -79,6 +79,18 @@ def reason_to_skip(command, in_background_block):
     return None
 
 
+TIMING_TRIES = 3
+
+
+def run_once(run, scratch, env):
+    """One run of a command in the scratch folder: its exit status, the tail of its output and 1 (the tries)."""
+    try:
+        r = subprocess.run(["bash", "-c", run], cwd=scratch, env=env, capture_output=True, text=True, timeout=180)
+        return r.returncode, (r.stdout + r.stderr)[-1500:], 1
+    except subprocess.TimeoutExpired:
+        return "timeout (180 s)", "", 1
+
+
 def main():
     binary_dir = os.path.abspath(sys.argv[1])
     pages = sys.argv[2:] or [os.path.join(ROOT, "README.md"), os.path.join(ROOT, "docs", "commands.md")]
@@ -97,11 +109,14 @@ def main():
                 continue
             run = command.replace("/tmp/", scratch + "/tmp/")
             os.makedirs(os.path.join(scratch, "tmp"), exist_ok=True)
-            try:
-                r = subprocess.run(["bash", "-c", run], cwd=scratch, env=env, capture_output=True, text=True, timeout=180)
-                status, tail = r.returncode, (r.stdout + r.stderr)[-1500:]
-            except subprocess.TimeoutExpired:
-                status, tail = "timeout (180 s)", ""
+            status, tail, tries = run_once(run, scratch, env)
+            # A wall-clock run on a machine whose other cores run the rest of the suite can lose its rate: the loop
+            # then trips `overruns` (exit 4), as the product should. That says nothing about the command as written,
+            # so such a run is tried again, at most TIMING_TRIES times, and the retries are printed.
+            while status == 4 and "tripped: overruns" in tail and tries < TIMING_TRIES:
+                print(f"{line}: the wall-clock loop lost its rate on this loaded machine (tripped: overruns): again")
+                status, tail, _ = run_once(run, scratch, env)
+                tries += 1
             ran += 1
             print(f"{line}: {'ok' if status == 0 else 'FAILED'}: {command}")
             if status != 0:
