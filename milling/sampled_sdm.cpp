@@ -183,6 +183,11 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, 
     return e;
   };
   MatrixXd w(n, 12), y(n, dim);
+  // The history columns are reached from the oldest: before interval j only g_-(k+1) .. g_-(k-j) have entered
+  // (the delayed references) and g_-1 (the first interval's current one), so the columns from n + 2 up to
+  // `live` are still zero and the propagator's product skips them (a third of the work at k = 40).
+  const Eigen::Index head = n + 2;
+  Eigen::Index live = dim;
   for (int j = 0; j < k; ++j) {
     const int first = res.grid[static_cast<std::size_t>(j)], last = res.grid[static_cast<std::size_t>(j) + 1];
     // References: current j-1, j, j+1 (+), delayed j-k-1, j-k, j-k+1 (-): F = K (q - q(t - tau)).
@@ -205,7 +210,11 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, 
       w.noalias() += power_b(last - 1 - l) * input;
       any = true;
     }
-    y.noalias() = power(last - first) * x;
+    const MatrixXd& propagator = power(last - first);
+    y.leftCols(head).noalias() = propagator * x.leftCols(head);
+    if (live < dim) y.rightCols(dim - live).noalias() = propagator * x.rightCols(dim - live);
+    y.middleCols(head, live - head).setZero();
+    live = std::max(head, std::min(live, n + 2 * static_cast<Eigen::Index>(std::max(0, k - j - 2))));
     if (any) {
       for (int i : {0, 1, 3, 4, 5}) y.noalias() += w.middleCols(2 * i, 2) * ref(refs[i]);
       const MatrixXd wu = w.middleCols(4, 2);
