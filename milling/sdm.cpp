@@ -100,10 +100,21 @@ std::complex<double> SdmModel::multiplier(double axial_mm, double rpm, double* c
   return dominant(z, rpm, chatter_hz);
 }
 
+// long: one monodromy matrix over a tooth period (the hot loop of the open loop's accurate method)
 Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
   const Eigen::Index n = a_.rows(), d = n + 2 * m_;
   const double h = 60.0 / (rpm * cutter_.teeth) / m_;
-  Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), next(d, d), e;
+  // Rows: the modes' states, then the delayed displacements q_{i-1} .. q_{i-m} in a ring of m slots of two rows
+  // (slot (first + j) mod m holds q_{i-1-j}): each interval writes its new sample over the oldest instead of
+  // moving the whole history down (the copy was half the work of a few-mode structure). The ring is put back
+  // in order at the end; the arithmetic is the same.
+  Eigen::MatrixXd z = Eigen::MatrixXd::Identity(d, d), x_next(n, d), e;
+  auto slot = [&](int j) { return n + 2 * static_cast<Eigen::Index>(j % m_); };
+  int first = 0;
+  // The history enters from its oldest samples: before interval i only the oldest i + 2 slots have been read,
+  // so the states' columns of the others are still zero and the products skip them (live: the first column
+  // that may not be).
+  Eigen::Index live = d;
   IntervalExp interval(blocks_, c_);
   const std::vector<Eigen::Matrix2d> free = interval.free_blocks(h);
   const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, slices_, axial_mm);
@@ -113,25 +124,36 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
     const Eigen::Matrix2d mi = directional.mean(i * dphi, dphi, kSub);
     // x' = (A + B M C) x - B M q(t - tau); the delayed q goes linearly from q_{i-m} to q_{i-m+1}.
     const auto old_x = z.topRows(n);
+    const Eigen::Index oldest = slot(first + m_ - 1), next_oldest = slot(first + m_ - 2);  // q_{i-m}, q_{i-m+1}
+    const Eigen::Index tail = d - live;
     if (mi.isZero(0.0)) {  // no tooth cuts: each mode on its own
       for (std::size_t k = 0; k < free.size(); ++k) {
         const auto r = static_cast<Eigen::Index>(2 * k);
-        next.middleRows(r, 2).noalias() = free[k] * z.middleRows(r, 2);
+        x_next.block(r, 0, 2, n).noalias() = free[k] * z.block(r, 0, 2, n);
+        if (tail) x_next.block(r, live, 2, tail).noalias() = free[k] * z.block(r, live, 2, tail);
       }
     } else {
       interval.compute(b_ * mi, h, e);
-      const auto q_oldest = z.middleRows(n + 2 * (m_ - 1), 2);  // q_{i-m}
-      const auto q_next = z.middleRows(n + 2 * (m_ - 2), 2);    // q_{i-m+1}
       const Eigen::MatrixXd ramp = e.block(0, n + 2, n, 2) / h, held_less_ramp = e.block(0, n, n, 2) - ramp;
-      next.topRows(n).noalias() = e.topLeftCorner(n, n) * old_x;
-      next.topRows(n).noalias() += held_less_ramp * q_oldest;
-      next.topRows(n).noalias() += ramp * q_next;
+      // The delayed samples reach their own columns, at 2 (m - 1 - i) and 2 (m - 2 - i) past n, first here.
+      live = std::min(live, n + 2 * static_cast<Eigen::Index>(std::max(0, m_ - 2 - i)));
+      const Eigen::Index now = d - live;
+      x_next.leftCols(n).noalias() = e.topLeftCorner(n, n) * old_x.leftCols(n);
+      x_next.rightCols(now).noalias() = e.topLeftCorner(n, n) * old_x.rightCols(now);
+      x_next.leftCols(n).noalias() += held_less_ramp * z.block(oldest, 0, 2, n);
+      x_next.rightCols(now).noalias() += held_less_ramp * z.block(oldest, live, 2, now);
+      x_next.leftCols(n).noalias() += ramp * z.block(next_oldest, 0, 2, n);
+      x_next.rightCols(now).noalias() += ramp * z.block(next_oldest, live, 2, now);
     }
-    next.middleRows(n, 2).noalias() = c_ * old_x;  // q_i
-    next.middleRows(n + 2, 2 * (m_ - 1)) = z.middleRows(n, 2 * (m_ - 1));
-    z.swap(next);
+    z.middleRows(oldest, 2).noalias() = c_ * old_x;  // q_i over q_{i-m}, which is no longer needed
+    first = (first + m_ - 1) % m_;                   // q_i is the newest now
+    z.block(0, 0, n, n) = x_next.leftCols(n);
+    z.block(0, live, n, d - live) = x_next.rightCols(d - live);
   }
-  return z;
+  Eigen::MatrixXd ordered(d, d);
+  ordered.topRows(n) = z.topRows(n);
+  for (int j = 0; j < m_; ++j) ordered.middleRows(n + 2 * j, 2) = z.middleRows(slot(first + j), 2);
+  return ordered;
 }
 
 std::complex<double> SdmModel::dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const {
