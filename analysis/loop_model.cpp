@@ -68,7 +68,7 @@ DiscreteSs section_ss(const filters::BiquadCoefficients& q, double scale) {
 LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rpm)
     : cfg_(cfg),
       plant_(sim::build_plant_model(cfg)),
-      chain_(control::design_chain(cfg)),
+      chain_(analysis::design_chain(cfg)),
       sensor_model_(cfg.sensor, cfg.loop.rate_hz, 0),
       sensor_(plant_.index_of(cfg.sensor.location)) {
   const double t = 1.0 / cfg.loop.rate_hz;

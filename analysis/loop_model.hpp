@@ -15,7 +15,7 @@
 
 #include "analysis/resolvent.hpp"
 #include "config/config.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "sim_plant/plant_model.hpp"
 #include "sim_plant/sensor.hpp"
 
@@ -54,7 +54,7 @@ class LoopModel {
   explicit LoopModel(const config::Config& cfg, std::optional<double> spindle_rpm = std::nullopt);
 
   [[nodiscard]] const sim::PlantModel& plant() const { return plant_; }
-  [[nodiscard]] const control::ChainDesign& chain() const { return chain_; }
+  [[nodiscard]] const analysis::ChainDesign& chain() const { return chain_; }
   [[nodiscard]] const config::Config& config() const { return cfg_; }
   [[nodiscard]] std::size_t sensor_location() const { return sensor_; }
   [[nodiscard]] std::size_t actuator_location() const { return plant_.actuator.location; }
@@ -128,7 +128,7 @@ class LoopModel {
   filters::SosCoefficients notches_{};
   std::optional<double> spindle_rpm_;
   sim::PlantModel plant_;
-  control::ChainDesign chain_;
+  analysis::ChainDesign chain_;
   sim::Accelerometer sensor_model_;
   std::size_t sensor_;
   // Closed-loop receptance g <- h for a feedback force q per displacement at the sensor.

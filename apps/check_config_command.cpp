@@ -11,7 +11,7 @@
 #include "config/dashboard_config.hpp"
 #include "config/milling_config.hpp"
 #include "config/robot_model_config.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "milling/structure.hpp"
 #include "sim_plant/plant_model.hpp"
 
@@ -65,7 +65,7 @@ int check_config(const std::string& path) {
     case Kind::kCell: break;
   }
   const auto cfg = config::load_config_file(path);
-  const auto d = control::design_chain(cfg);
+  const auto d = analysis::design_chain(cfg);
   if (!cfg.robot.frfs.empty()) (void)sim::build_plant_model(cfg);  // the plant's physical consistency
   std::cout << path << ": OK (" << d.blocks.size() << " blocks, " << d.params.sections.count
             << " second-order sections at " << d.params.fs_hz << " Hz)\n";

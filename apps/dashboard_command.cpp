@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "apps/cli.hpp"
+#include "config/config.hpp"
 #include "config/dashboard_config.hpp"
 #include "dashboard/auth.hpp"
 #include "dashboard/fleet.hpp"

@@ -21,7 +21,7 @@ nlohmann::json bode_point(Complex h) { return {{"mag_db", magnitude_db(h)}, {"ph
 
 }  // namespace
 
-nlohmann::json filters_report(const control::ChainDesign& d, double freq_hz) {
+nlohmann::json filters_report(const analysis::ChainDesign& d, double freq_hz) {
   const auto& p = d.params;
   nlohmann::json blocks = nlohmann::json::array();
   for (std::size_t i = 0; i < d.blocks.size(); ++i) {
@@ -85,7 +85,7 @@ std::string filters_table(const nlohmann::json& r) {
   return os.str();
 }
 
-std::string plot_filters(const control::ChainDesign& d, const std::string& png_path) {
+std::string plot_filters(const analysis::ChainDesign& d, const std::string& png_path) {
   // Columns: f, then (mag, phase) of each block (analog), then the whole chain analog and digital in
   // volts per m/s^2 (with K, polarity and 1/T).
   std::ostringstream data;
@@ -132,7 +132,7 @@ struct FiltersArgs {
 };
 
 int run_filters(const FiltersArgs& a) {
-  const control::ChainDesign d = control::design_chain(config::load_config_file(a.config_path));
+  const analysis::ChainDesign d = analysis::design_chain(config::load_config_file(a.config_path));
   // The frequency's upper bound depends on the configuration's loop rate, so it is checked here.
   if (auto p = config::range_problem("--freq", a.freq_hz,
                                      {"Hz", 0.0, 0.5 * d.params.fs_hz, true, true, "below Nyquist of loop.rate_hz"})) {

@@ -6,13 +6,13 @@
 #include <cmath>
 
 #include "config/config.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "control/controller.hpp"
 
 namespace robodamp::bench {
 
-inline control::ChainDesign default_design() {
-  return control::design_chain(config::load_config_file(ROBODAMP_SOURCE_DIR "/config/presets/horizontal_c2.yaml"));
+inline analysis::ChainDesign default_design() {
+  return analysis::design_chain(config::load_config_file(ROBODAMP_SOURCE_DIR "/config/presets/horizontal_c2.yaml"));
 }
 
 // The default design with 8 spindle-locked notches (3000 rpm x 3 teeth: 150 to 1200 Hz), running.

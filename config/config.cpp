@@ -1,5 +1,6 @@
 // long: every key of a cell's configuration with its unit and range, section by section; the sections with their own files are split out (can, modbus, spindle, pose schedule)
 #include "config/config.hpp"
+#include "units/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -108,7 +109,7 @@ const char* to_string(CompensatorModel model) {
   return "?";
 }
 
-const char* to_string(ClockKind clock) { return clock == ClockKind::kWall ? "wall" : "virtual"; }
+
 
 const char* to_string(Mounting mounting) { return mounting == Mounting::kHorizontal ? "horizontal" : "vertical"; }
 
@@ -458,15 +459,16 @@ RecoveryConfig read_recovery(MapReader& top) {
       for (std::size_t i = 0; i < list.size(); ++i) {
         const std::string key = "supervision.recovery.recoverable[" + std::to_string(i) + "]";
         const std::string name = list[i].IsScalar() ? list[i].Scalar() : std::string();
-        if (std::find(kRecoverableTripNames.begin(), kRecoverableTripNames.end(), name) == kRecoverableTripNames.end())
+        const std::optional<rt::Trip> trip = rt::trip_named(name);
+        if (!trip || !rt::may_recover(*trip))
           top.diagnostics().add(list[i].Mark(), key,
                                 "= '" + name + "' cannot recover by itself: allowed are overruns, sensor_stale, sample_invalid, "
                                 "sensor_driver, actuator_driver, amplifier_not_ready (instability, saturation, amplifier_fault, "
                                 "pose_out_of_map and signal always latch)");
-        else if (std::find(c.recoverable.begin(), c.recoverable.end(), name) != c.recoverable.end())
+        else if (std::find(c.recoverable.begin(), c.recoverable.end(), *trip) != c.recoverable.end())
           top.diagnostics().add(list[i].Mark(), key, "= '" + name + "' is listed twice");
         else
-          c.recoverable.push_back(name);
+          c.recoverable.push_back(*trip);
       }
     }
   }
@@ -832,5 +834,21 @@ const LocationConfig* find_location(const RobotConfig& robot, int id) {
     if (l.id == id) return &l;
   return nullptr;
 }
+
+rt::SupervisorSettings supervisor_settings(const Config& cfg, bool analysis_stable, double max_stable_gain_ns_per_m,
+                                       double delay_margin_s) {
+  rt::SupervisorSettings s;
+  s.limits = cfg.supervision;
+  s.fs_hz = cfg.loop.rate_hz;
+  s.sample_limit_mps2 = cfg.supervision.sample_limit_mps2 > 0.0 ? cfg.supervision.sample_limit_mps2
+                                                                : cfg.sensor.range_g * kStandardGravityMps2;
+  s.fade_s = cfg.controller.gain_ramp_s;
+  s.analysis_stable = analysis_stable;
+  s.max_stable_gain_ns_per_m = max_stable_gain_ns_per_m;
+  s.delay_margin_s = delay_margin_s;
+  s.command_limit_v = cfg.amplifier.voltage_limit_v;
+  return s;
+}
+
 
 }  // namespace robodamp::config

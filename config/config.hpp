@@ -16,6 +16,7 @@
 #include "config/speed_schedule_config.hpp"
 #include "config/spindle_config.hpp"
 #include "config/supervisory_config.hpp"
+#include "rt_settings/rt_settings.hpp"
 
 namespace robodamp::config {
 
@@ -46,8 +47,9 @@ class ConfigError : public std::runtime_error {
   std::vector<Problem> problems_;
 };
 
-enum class ClockKind { kWall, kVirtual };
-[[nodiscard]] const char* to_string(ClockKind clock);
+// The real-time core's own settings (rt_settings/rt_settings.hpp), which this library fills from the file.
+using ClockKind = rt::ClockKind;
+using rt::to_string;
 
 struct LoopConfig {
   double rate_hz{5000.0};
@@ -56,84 +58,10 @@ struct LoopConfig {
   ClockKind clock{ClockKind::kWall};
 };
 
-// Start-up of the real-time thread. Each step that is not permitted falls back with a warning.
-struct RealtimeConfig {
-  int priority{80};              // SCHED_FIFO 1-99; 0 = stay SCHED_OTHER
-  int cpu{-1};                   // CPU affinity; -1 = any
-  bool lock_memory{true};        // mlockall(MCL_CURRENT | MCL_FUTURE)
-  int stack_prefault_kib{256};   // stack touched before activation
-  bool hold_cpu_dma_latency{true};  // /dev/cpu_dma_latency held at 0 us while running
-};
-
-// The supervisor's trips and ramps (rt/supervisor.hpp).
-// Automatic recovery from a transient fault (docs/runtime.md, "Recovery"): after a trip of a recoverable
-// class the safe state as always, then once the cool-down is over and the cell has been healthy for
-// healthy_for_s (sensor live, ticks on time, actuator path and amplifier without fault, the active set's
-// analysis stable, the pose in a region where scheduled) the supervisor re-arms through the gain ramp.
-// At most max_recoveries within window_s; a trip within probation_s of a recovery, or of a class not
-// listed, latches until an operator resets it.
-struct RecoveryConfig {
-  // Trip classes that may recover (rt::to_string names); empty: every trip latches.
-  std::vector<std::string> recoverable{"overruns", "sensor_stale", "sample_invalid", "sensor_driver", "actuator_driver"};
-  double cool_down_s{1.0};
-  double healthy_for_s{2.0};
-  int max_recoveries{3};
-  double window_s{600.0};
-  double probation_s{10.0};
-};
-// The trip classes that may be recoverable; the others (instability, saturation, amplifier_fault,
-// pose_out_of_map, signal) the damper may have caused, or an operator must see.
-inline const std::vector<std::string> kRecoverableTripNames{"overruns", "sensor_stale", "sample_invalid", "sensor_driver",
-                                                             "actuator_driver", "amplifier_not_ready"};
-
-// Keeping damping through chatter (docs/realtime_loop.md, "Keeping damping when the cut chatters"): with the
-// spindle turning, growth and saturation derate the gain instead of tripping, as long as a probe says the gain
-// is not what feeds them. With the spindle stopped nothing but the loop can feed a growth: it trips as before.
-struct DerateConfig {
-  bool enabled{true};
-  // Where the instability rule would trip, the gain goes to probe_factor (x K) over probe_ramp_s for probe_blocks
-  // instability blocks instead; decaying there (the structure's motion not growing): the gain fed it, ...
-  int probe_blocks{4};
-  double probe_factor{0.0};
-  double hold_factor{0.5};       // ... and the gain is held at this (x K) until quiet (growing on: the process's)
-  double probe_ramp_s{0.02};
-  double quiet_s{1.0};           // no growth and the saturation duty under a quarter of its limit this long: ...
-  double restore_s{2.0};         // ... back to full gain over this ramp
-  double saturation_factor{0.5}; // each saturation duty over the limit multiplies the derating by this ...
-  double min_factor{0.0625};     // ... down to this; below it the saturation trips as before
-};
-
-struct SupervisionConfig {
-  int stale_sensor_cycles{5};        // consecutive ticks without a fresh sample: trip
-  // While the sample is stale or invalid the controller's part of the command is zero and the controller
-  // is fed no acceleration (docs/realtime_loop.md, "Riding through a stale sensor"). Not a configuration
-  // key: a recording made before it replays with false (the last valid sample held, as it ran).
-  bool zero_command_while_stale{true};
-  int invalid_sample_cycles{1};      // consecutive non-finite or out-of-range samples
-  double sample_limit_mps2{0.0};     // out of range beyond this; 0 = the sensor's range (sensor.range_g)
-  int overrun_cycles{10};            // consecutive overruns (compute past the period or missed ticks) ...
-  // ... lasting, in measured time, at least this share of the active set's delay margin (the extra delay
-  // the loop tolerates for good, analysis/loop_model.hpp): a stall shorter than that cannot destabilise
-  // the loop, so it is ridden through (counted). 0 = overrun_cycles alone.
-  double overrun_delay_margin_share{1.0};
-  double saturation_window_s{0.5};
-  double saturation_duty_max{0.2};   // fraction of the window's ticks at a controller or actuator limit
-  double instability_block_s{0.1};   // command RMS per block
-  int instability_blocks{8};         // growth in every one of this many consecutive blocks ...
-  double instability_growth_factor{1.5};  // ... and by at least this factor overall
-  double instability_floor_v{0.02};  // RMS below this is never called unstable
-  double trip_ramp_s{0.01};          // a trip ramps the command to zero within this time
-  int arming_live_cycles{50};        // fresh, valid samples needed before arming
-  // The arming policy (runtime/arming_policy.hpp), the same for every backend: arm once the sensor can
-  // be live, retry every arm_retry_s while refused, give up after arm_deadline_s of loop time (the run
-  // then ends with the last refusal and a non-zero exit status).
-  double arm_retry_s{0.5};
-  double arm_deadline_s{10.0};
-  double amplifier_ready_timeout_s{0.2};
-  double max_gain_fraction{0.9};     // gain requests up to this x the analysed maximum stable K
-  RecoveryConfig recovery;
-  DerateConfig derate;
-};
+using RealtimeConfig = rt::RealtimeSettings;        // realtime.*
+using RecoveryConfig = rt::RecoverySettings;        // supervision.recovery.*
+using DerateConfig = rt::DerateSettings;            // supervision.derate.*
+using SupervisionConfig = rt::SupervisionLimits;    // supervision.*
 
 struct TelemetryConfig {
   int ring_frames{65536};  // lock-free ring between the loop and the drain thread (power of two)
@@ -317,5 +245,10 @@ struct Config {
 [[nodiscard]] Config load_config_file(const std::string& path);
 
 [[nodiscard]] const LocationConfig* find_location(const RobotConfig& robot, int id);
+
+// The supervisor's settings for a configuration (its supervision limits, the loop's rate, the sensor's
+// range, the gain ramp, the amplifier's voltage limit), given what the analysis found.
+[[nodiscard]] rt::SupervisorSettings supervisor_settings(const Config& cfg, bool analysis_stable,
+                                                         double max_stable_gain_ns_per_m, double delay_margin_s = 0.0);
 
 }  // namespace robodamp::config

@@ -70,7 +70,7 @@ double Supervisor::growth_signal_v(double controller_v) const noexcept {
 }
 
 void Supervisor::apply_derate(double ramp_s) noexcept {
-  const config::DerateConfig& d = s_.limits.derate;
+  const DerateSettings& d = s_.limits.derate;
   const double f = growth_ == Growth::kProbe ? d.probe_factor : growth_ == Growth::kGainFed ? d.hold_factor : 1.0;
   controller_.set_derate(f * saturation_derate_, ramp_s);
 }
@@ -98,7 +98,7 @@ void Supervisor::process_growth() noexcept {
 
 // One instability block with the spindle turning: grown is the detector's trip verdict without derating.
 bool Supervisor::judge_growth(double rms, double accel_rms, bool grown) noexcept {
-  const config::DerateConfig& d = s_.limits.derate;
+  const DerateSettings& d = s_.limits.derate;
   const double rpm = controller_.schedule_rpm();
   switch (growth_) {
     case Growth::kNone:
@@ -192,7 +192,7 @@ bool Supervisor::saturated_while_turning() noexcept {
 // The saturation duty over its limit with the spindle turning: the command derated by saturation_factor
 // (the window starts afresh), down to min_factor; false when there is none left (the trip stands).
 bool Supervisor::derate_saturation() noexcept {
-  const config::DerateConfig& d = s_.limits.derate;
+  const DerateSettings& d = s_.limits.derate;
   if (!derating_on() || saturation_derate_ * d.saturation_factor < d.min_factor) return false;
   saturation_derate_ *= d.saturation_factor;
   apply_derate(d.probe_ramp_s);

@@ -12,7 +12,7 @@ namespace {
 std::uint32_t sat32(std::uint64_t v) noexcept { return v > 0xFFFFFFFFULL ? 0xFFFFFFFFU : static_cast<std::uint32_t>(v); }
 }  // namespace
 
-Loop::Loop(double rate_hz, config::ClockKind clock, Supervisor& supervisor, SensorSource& sensor,
+Loop::Loop(double rate_hz, ClockKind clock, Supervisor& supervisor, SensorSource& sensor,
            ActuatorSink& actuator, AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry)
     : period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
       clock_(clock),
@@ -61,7 +61,7 @@ void Loop::run(std::uint64_t duration_ticks) noexcept {
 // Wall clock: sleep to the deadline, skip whole periods missed (never a burst); virtual: no wait.
 Loop::Pace Loop::pace(Run& r) noexcept {
   Pace p;
-  if (clock_ == config::ClockKind::kWall) {
+  if (clock_ == ClockKind::kWall) {
     const DeadlinePacer::Wake w = r.pacer.wait();
     p.wake_ns = w.wake_ns, p.latency_ns = w.late_ns, p.missed = w.missed;
     tick_ += w.missed;
@@ -113,7 +113,7 @@ OperatorCommand Loop::next_command(Run& r) noexcept {
 // The tick's timing: compute time, overruns (late wake-up or work past the next deadline).
 void Loop::account(Run& r, const Pace& p, const TickInput& in) noexcept {
   LoopStats& st = *stats_;
-  const bool wall = clock_ == config::ClockKind::kWall;
+  const bool wall = clock_ == ClockKind::kWall;
   const std::int64_t end = monotonic_ns();
   const std::int64_t compute = end - p.wake_ns;
   r.overrun = wall && end > r.pacer.deadline_ns() + period_ns_;
@@ -130,7 +130,7 @@ void Loop::account(Run& r, const Pace& p, const TickInput& in) noexcept {
 void Loop::publish(const Pace& p, const TickInput& in, const TickOutput& out) noexcept {
   if (telemetry_ == nullptr) return;
   LoopStats& st = *stats_;
-  const bool wall = clock_ == config::ClockKind::kWall;
+  const bool wall = clock_ == ClockKind::kWall;
   const SupervisorCounters& sc = sup_.counters();
   TelemetryFrame f;
   f.tick = tick_;

@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "config/config.hpp"
+#include "rt_settings/rt_settings.hpp"
 #include "rt/clock.hpp"
 #include "rt/excitation.hpp"
 #include "rt/io.hpp"
@@ -47,7 +47,7 @@ struct LoopStats {
 
 class Loop {
  public:
-  Loop(double rate_hz, config::ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
+  Loop(double rate_hz, ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
        AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry);
 
   // From any non-real-time thread (operator, Modbus pose, DDS parameter requests): queue a command for
@@ -77,7 +77,7 @@ class Loop {
 
   [[nodiscard]] const LoopStats& stats() const noexcept { return *stats_; }
   [[nodiscard]] double period_s() const noexcept { return static_cast<double>(period_ns_) * 1e-9; }
-  [[nodiscard]] config::ClockKind clock() const noexcept { return clock_; }
+  [[nodiscard]] ClockKind clock() const noexcept { return clock_; }
 
  private:
   // One run's state between ticks (on the stack of run(); nothing allocated).
@@ -104,7 +104,7 @@ class Loop {
   void publish(const Pace& p, const TickInput& in, const TickOutput& out) noexcept;
 
   std::int64_t period_ns_;
-  config::ClockKind clock_;
+  ClockKind clock_;
   Supervisor& sup_;
   SensorSource& sensor_;
   ActuatorSink& actuator_;

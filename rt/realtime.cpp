@@ -37,7 +37,7 @@ constexpr bool kSanitizerShadow = false;
 #endif
 }  // namespace
 
-RealtimeProcess::RealtimeProcess(const config::RealtimeConfig& c, RealtimeStatus& status) {
+RealtimeProcess::RealtimeProcess(const RealtimeSettings& c, RealtimeStatus& status) {
   if (c.lock_memory && kSanitizerShadow) {
     warn(status, "a sanitizer build: memory not locked (its shadow mappings are terabytes); pages may fault");
   } else if (c.lock_memory) {
@@ -70,7 +70,7 @@ RealtimeProcess::~RealtimeProcess() {
   if (locked_) munlockall();
 }
 
-void setup_realtime_thread(const config::RealtimeConfig& c, RealtimeStatus& status) {
+void setup_realtime_thread(const RealtimeSettings& c, RealtimeStatus& status) {
   if (c.priority > 0) {
     sched_param sp{};
     sp.sched_priority = c.priority;

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "config/config.hpp"
+#include "rt_settings/rt_settings.hpp"
 
 namespace robodamp::rt {
 
@@ -24,7 +24,7 @@ struct RealtimeStatus {
 
 class RealtimeProcess {
  public:
-  RealtimeProcess(const config::RealtimeConfig& c, RealtimeStatus& status);
+  RealtimeProcess(const RealtimeSettings& c, RealtimeStatus& status);
   ~RealtimeProcess();
   RealtimeProcess(const RealtimeProcess&) = delete;
   RealtimeProcess& operator=(const RealtimeProcess&) = delete;
@@ -35,6 +35,6 @@ class RealtimeProcess {
 };
 
 // On the calling thread.
-void setup_realtime_thread(const config::RealtimeConfig& c, RealtimeStatus& status);
+void setup_realtime_thread(const RealtimeSettings& c, RealtimeStatus& status);
 
 }  // namespace robodamp::rt

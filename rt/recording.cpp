@@ -124,7 +124,7 @@ json to_json(const SupervisorSettings& s) {
           {"amplifier_ready_timeout_s", l.amplifier_ready_timeout_s},
           {"max_gain_fraction", l.max_gain_fraction},
           {"recovery",
-           {{"recoverable", l.recovery.recoverable},
+           {{"recoverable", trip_names(l.recovery.recoverable)},
             {"cool_down_s", l.recovery.cool_down_s},
             {"healthy_for_s", l.recovery.healthy_for_s},
             {"max_recoveries", l.recovery.max_recoveries},
@@ -202,7 +202,7 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   l.max_gain_fraction = j.at("max_gain_fraction");
   if (j.contains("recovery")) {
     const json& r = j.at("recovery");
-    l.recovery.recoverable = r.at("recoverable").get<std::vector<std::string>>();
+    l.recovery.recoverable = trips_named(r.at("recoverable").get<std::vector<std::string>>());
     l.recovery.cool_down_s = r.at("cool_down_s");
     l.recovery.healthy_for_s = r.at("healthy_for_s");
     l.recovery.max_recoveries = r.at("max_recoveries");
@@ -238,7 +238,23 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   return s;
 }
 
-json recording_header(const config::Config& cfg, const Supervisor& supervisor, config::ClockKind clock,
+std::vector<std::string> trip_names(const std::vector<Trip>& trips) {
+  std::vector<std::string> out;
+  for (const Trip t : trips) out.emplace_back(trip_name(t));
+  return out;
+}
+
+std::vector<Trip> trips_named(const std::vector<std::string>& names) {
+  std::vector<Trip> out;
+  for (const std::string& n : names) {
+    const std::optional<Trip> t = trip_named(n);
+    if (!t) throw RecordingError("the recording's supervisor.recovery.recoverable names no trip: '" + n + "'");
+    out.push_back(*t);
+  }
+  return out;
+}
+
+json recording_header(const RecordedConfig& cfg, const Supervisor& supervisor, ClockKind clock,
                       const PeriodicChirp& excitation) {
   json fields = json::array();
   for (const auto& f : frame_fields())
@@ -262,12 +278,12 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
   const std::time_t now = std::time(nullptr);
   std::tm tm{};
   gmtime_r(&now, &tm);
-  if (clock == config::ClockKind::kWall) std::strftime(created, sizeof created, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  if (clock == ClockKind::kWall) std::strftime(created, sizeof created, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return {{"format", "robodamp-recording"},
           {"format_version", kRecordingFormatVersion},
           {"robodamp_version", version()},
           {"git_commit", git_commit()},
-          {"created_utc", clock == config::ClockKind::kWall ? json(created) : json(nullptr)},
+          {"created_utc", clock == ClockKind::kWall ? json(created) : json(nullptr)},
           {"byte_order", "little"},
           {"frame_bytes", sizeof(TelemetryFrame)},
           {"fields", fields},
@@ -278,9 +294,9 @@ json recording_header(const config::Config& cfg, const Supervisor& supervisor, c
           {"trips", trips},
           {"commands", commands},
           {"clock", to_string(clock)},
-          {"rate_hz", cfg.loop.rate_hz},
+          {"rate_hz", cfg.rate_hz},
           {"config_source", cfg.source},
-          {"config_yaml", cfg.yaml_text},
+          {"config_yaml", cfg.yaml},
           {"controller_params", to_json(supervisor.initial_params())},
           {"parameter_sets", sets},
           {"supervisor", to_json(supervisor.settings())},

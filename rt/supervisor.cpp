@@ -7,27 +7,11 @@
 namespace robodamp::rt {
 
 namespace {
-constexpr double kStandardGravity = 9.80665;  // m/s^2 per g
 // A block's RMS this many times the block's before: a blow (a hammer, a tool's entry), not a growing oscillation.
 // A loop 1.25 x over its stable gain grows about 1.2 x a block of 0.1 s; the default job's chatter at 2 x its
 // damped limit about 1.3 x.
 constexpr double kImpulseJump = 3.0;
 }  // namespace
-
-SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable, double max_stable_gain_ns_per_m,
-                                       double delay_margin_s) {
-  SupervisorSettings s;
-  s.limits = cfg.supervision;
-  s.fs_hz = cfg.loop.rate_hz;
-  s.sample_limit_mps2 = cfg.supervision.sample_limit_mps2 > 0.0 ? cfg.supervision.sample_limit_mps2
-                                                                : cfg.sensor.range_g * kStandardGravity;
-  s.fade_s = cfg.controller.gain_ramp_s;
-  s.analysis_stable = analysis_stable;
-  s.max_stable_gain_ns_per_m = max_stable_gain_ns_per_m;
-  s.delay_margin_s = delay_margin_s;
-  s.command_limit_v = cfg.amplifier.voltage_limit_v;
-  return s;
-}
 
 Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerParams& params)
     : s_(s), controller_(params), pose_known_(!s.pose_scheduled) {
@@ -38,9 +22,7 @@ Supervisor::Supervisor(const SupervisorSettings& s, const control::ControllerPar
   sat_window_.assign(window, 0);
   sat_threshold_ = static_cast<std::uint64_t>(std::floor(s.limits.saturation_duty_max * static_cast<double>(window)));
   block_len_ = static_cast<std::uint64_t>(std::max(1.0, std::round(s.limits.instability_block_s * s.fs_hz)));
-  for (const std::string& name : s.limits.recovery.recoverable)
-    for (std::size_t t = 0; t < kTripCount; ++t)
-      if (name == to_string(static_cast<Trip>(t))) recoverable_mask_ |= 1U << t;
+  for (const Trip t : s.limits.recovery.recoverable) recoverable_mask_ |= 1U << static_cast<unsigned>(t);
   recovery_times_.assign(static_cast<std::size_t>(std::max(0, s.limits.recovery.max_recoveries)), -1e300);
 }
 
@@ -165,7 +147,7 @@ ArmRefusal Supervisor::arm_refusal(bool live) const noexcept {
 }
 
 void Supervisor::recover(const TickInput& in) noexcept {
-  const config::RecoveryConfig& r = s_.limits.recovery;
+  const RecoverySettings& r = s_.limits.recovery;
   fault_safe_s_ += in.dt_s;
   const auto& l = s_.limits;
   // Healthy: none of the sensor's trip conditions building up (a lone repeated sample, which a CAN

@@ -22,28 +22,14 @@
 #include <cstdint>
 #include <vector>
 
-#include "config/config.hpp"
 #include "control/controller.hpp"
+#include "rt_settings/rt_settings.hpp"
 
 namespace robodamp::rt {
 
 enum class State : std::uint8_t { kDisabled, kArming, kActive, kStopping, kFault };
 
-enum class Trip : std::uint8_t {
-  kNone,
-  kSensorStale,       // no fresh sample for stale_sensor_cycles ticks
-  kSampleInvalid,     // non-finite or out-of-range samples for invalid_sample_cycles ticks
-  kOverruns,          // overrun_cycles consecutive overruns
-  kSaturation,        // more than saturation_duty_max of the window's ticks at a limit
-  kInstability,       // the loop signal grew in instability_blocks consecutive blocks
-  kSensorDriver,      // the sensor driver reports a fault
-  kActuatorDriver,    // the actuator driver could not deliver the command
-  kAmplifierFault,    // the amplifier reports a fault
-  kAmplifierNotReady, // enabled but not ready within amplifier_ready_timeout_s
-  kSignal,            // SIGINT / SIGTERM: shut down through the safe state
-  kPoseOutOfMap,      // pose_schedule: the pose is outside every region, or unknown, or its set was refused
-};
-inline constexpr std::size_t kTripCount = 12;
+// Trip, its names and kTripCount: rt_settings/rt_settings.hpp.
 
 enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable, kPoseUnknown };
 
@@ -149,20 +135,8 @@ struct SupervisorEvent {
 inline constexpr std::size_t kEventLogSize = 64;
 [[nodiscard]] const char* to_string(EventKind k);
 
-// What the supervisor needs beyond the controller's parameters; a recording stores it.
-struct SupervisorSettings {
-  config::SupervisionConfig limits;
-  double fs_hz{5000.0};
-  double sample_limit_mps2{0.0};     // resolved (never 0)
-  double fade_s{0.5};                // activation / disarm fade (controller.gain_ramp_s)
-  bool analysis_stable{false};       // the analysis found the configured loop stable
-  double max_stable_gain_ns_per_m{0.0};
-  double delay_margin_s{0.0};        // the analysis' delay margin at the configured gain (0: none known)
-  double command_limit_v{10.0};      // the amplifier's voltage limit: a command with excitation is clamped to it
-  // pose_schedule: arming waits for a pose in a region (set_pose_region), the supervisor hands over to
-  // each region's set as the pose moves, and a pose out of the map trips (kPoseOutOfMap).
-  bool pose_scheduled{false};
-};
+// SupervisorSettings (what the supervisor needs beyond the controller's parameters; a recording stores it):
+// rt_settings/rt_settings.hpp; config::supervisor_settings fills it from a configuration.
 
 // A controller parameter set with the analysis verdict for it (e.g. the horizontal and the vertical
 // mounting's chains). Set 0 is the one the supervisor starts with.
@@ -173,9 +147,6 @@ struct ParameterSet {
   double delay_margin_s{0.0};  // at its gain; 0: none known (the overrun trip is overrun_cycles alone)
 };
 
-// The settings for a configuration, given what the analysis found.
-[[nodiscard]] SupervisorSettings supervisor_settings(const config::Config& cfg, bool analysis_stable,
-                                                     double max_stable_gain_ns_per_m, double delay_margin_s = 0.0);
 
 class Supervisor {
  public:

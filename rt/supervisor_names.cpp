@@ -15,23 +15,7 @@ const char* to_string(State s) {
   return "?";
 }
 
-const char* to_string(Trip t) {
-  switch (t) {
-    case Trip::kNone: return "none";
-    case Trip::kSensorStale: return "sensor_stale";
-    case Trip::kSampleInvalid: return "sample_invalid";
-    case Trip::kOverruns: return "overruns";
-    case Trip::kSaturation: return "saturation";
-    case Trip::kInstability: return "instability";
-    case Trip::kSensorDriver: return "sensor_driver";
-    case Trip::kActuatorDriver: return "actuator_driver";
-    case Trip::kAmplifierFault: return "amplifier_fault";
-    case Trip::kAmplifierNotReady: return "amplifier_not_ready";
-    case Trip::kSignal: return "signal";
-    case Trip::kPoseOutOfMap: return "pose_out_of_map";
-  }
-  return "?";
-}
+const char* to_string(Trip t) { return trip_name(t).data(); }  // kTripNames: literals, each ends in a NUL
 
 const char* describe(Trip t) {
   switch (t) {

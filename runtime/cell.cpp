@@ -95,7 +95,7 @@ Status Cell::plan_analysis() {
     max_stable_gain_ = k_max;
   }
   rt::SupervisorSettings settings =
-      rt::supervisor_settings(cfg_, stable_, k_max, delay_margin_s(*model_, set0, max_stable_gain_));
+      config::supervisor_settings(cfg_, stable_, k_max, delay_margin_s(*model_, set0, max_stable_gain_));
   settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
   supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(set0, model_->chain().params));
   if (settings.pose_scheduled) configure_pose_sets();
@@ -331,7 +331,7 @@ Status Cell::activate(double duration_s) {
   try {
     if (!o_.record_path.empty())
       recorder_ = std::make_unique<rt::Recorder>(o_.record_path,
-                                                 rt::recording_header(cfg_, *supervisor_, cfg_.loop.clock, loop_->excitation()));
+                                                 rt::recording_header({cfg_.loop.rate_hz, cfg_.source, cfg_.yaml_text}, *supervisor_, cfg_.loop.clock, loop_->excitation()));
   } catch (const std::exception& e) {
     return {StatusKind::kDeviceError, std::string("--record: ") + e.what()};
   }

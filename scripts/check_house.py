@@ -5,6 +5,7 @@
   python3 scripts/check_house.py layers BUILD_DIR     # every library links and includes only downwards
   python3 scripts/check_house.py picture CMAKE.dot OUT.dot  # the layered picture from CMake's graphviz
   python3 scripts/check_house.py links                # every link between README.md and docs/ resolves
+  python3 scripts/check_house.py parser-free          # rt/, control/, rt_settings/ use no config/ and no yaml-cpp
 """
 import glob
 import json
@@ -53,7 +54,7 @@ def sources():
 # The architecture: each library's layer, bottom first. A library may link and include only libraries of
 # lower layers (docs/architecture.md). A new library must be placed here.
 LAYERS = [
-    ("foundation", ["units", "threads"]),
+    ("foundation", ["units", "threads", "rt_settings"]),
     ("data and numbers", ["filters", "config", "plot", "measfiles"]),
     ("physics", ["modal", "robot"]),
     ("controller and plant", ["control", "sim_plant"]),
@@ -69,7 +70,7 @@ TARGET = {"sim_plant": "robodamp_sim", "apps": "robodamp_cli"}
 
 # Header-only INTERFACE libraries: CMake's code model lists no build dependency on them, so a use is not
 # checked against the links; its layer still is.
-HEADER_ONLY = {"units", "threads"}
+HEADER_ONLY = {"units", "threads", "rt_settings", "control"}
 
 
 def layer_of():
@@ -115,6 +116,49 @@ def includes(folder):
                     if m and os.path.isdir(os.path.join(ROOT, m.group(1))):
                         used.add((m.group(1), os.path.relpath(os.path.join(d, n), ROOT)))
     return used
+
+
+# The real-time core knows no configuration file (issue 54): these folders neither include config/ or yaml-cpp
+# nor link, through any library they link, robodamp_config or yaml-cpp. config/ fills their plain settings
+# (rt_settings/rt_settings.hpp).
+PARSER_FREE = ["rt_settings", "control", "rt"]
+
+
+def linked(folder, seen=None):
+    """Every target a folder's library links, through the libraries it links, read from the CMakeLists.txt."""
+    seen = set() if seen is None else seen
+    path = os.path.join(ROOT, folder, "CMakeLists.txt")
+    if not os.path.exists(path):
+        return seen
+    text = open(path, encoding="utf-8").read()
+    for m in re.finditer(r"target_link_libraries\(\s*robodamp_\w+([^)]*)\)", text):
+        for token in m.group(1).split():
+            if token in ("PUBLIC", "PRIVATE", "INTERFACE") or token in seen:
+                continue
+            seen.add(token)
+            if token.startswith("robodamp_"):
+                inv = {v: k for k, v in TARGET.items()}
+                linked(inv.get(token, token[len("robodamp_"):]), seen)
+    return seen
+
+
+def parser_free():
+    bad = []
+    include = re.compile(r'^\s*#\s*include\s+[<"](config/|yaml-cpp/)')
+    for folder in PARSER_FREE:
+        for d, _, names in os.walk(os.path.join(ROOT, folder)):
+            for n in names:
+                if n.endswith((".cpp", ".hpp")):
+                    for i, line in enumerate(open(os.path.join(d, n), encoding="utf-8", errors="replace"), 1):
+                        if include.match(line):
+                            bad.append(f"{os.path.relpath(os.path.join(d, n), ROOT)}:{i}: {line.strip()}")
+        for t in sorted(linked(folder) & {"robodamp_config", "yaml-cpp"}):
+            bad.append(f"{folder}/ links {t} (through the libraries it links)")
+    for b in bad:
+        print(b)
+    print(f"{len(bad)} use(s) of the parser in the real-time core" if bad else
+          f"{', '.join(f + '/' for f in PARSER_FREE)} include and link no configuration parser and no yaml-cpp")
+    return 1 if bad else 0
 
 
 def layers(build_dir):
@@ -209,7 +253,8 @@ def links():
 
 
 if __name__ == "__main__":
-    checks = {"sources": (sources, 0), "layers": (layers, 1), "picture": (picture, 2), "links": (links, 0)}
+    checks = {"sources": (sources, 0), "layers": (layers, 1), "picture": (picture, 2), "links": (links, 0),
+              "parser-free": (parser_free, 0)}
     if len(sys.argv) < 2 or sys.argv[1] not in checks or len(sys.argv) != 2 + checks[sys.argv[1]][1]:
         print(__doc__)
         sys.exit(2)

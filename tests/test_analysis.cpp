@@ -10,7 +10,7 @@
 #include "analysis/loop_model.hpp"
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/resolvent.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "control/controller.hpp"
 #include "filters/harmonic_notch.hpp"
 #include "analysis/spectral.hpp"
@@ -231,7 +231,7 @@ TEST(Analysis, AnalysedNotchesAreTheRunningBanksAtEverySpeed) {
   n.harmonics = 6, n.bandwidth_hz = 15.0, n.depth_db = 25.0, n.min_hz = 12.0;
   cfg.controller.harmonic_notch = n;
   cfg.spindle.teeth = 2;
-  const auto designed = control::design_chain(cfg).params.harmonic_notch;
+  const auto designed = analysis::design_chain(cfg).params.harmonic_notch;
   ASSERT_TRUE(designed.enabled);
   int saw_parked = 0, saw_cut = 0, saw_all = 0;
   for (const double rpm : {300.0, 359.0, 361.0, 3000.0, 20000.0, 33000.0, 44000.0, 67400.0, 90000.0}) {
@@ -280,7 +280,7 @@ TEST(Analysis, NotchSpeedMapRefusesSpeedsThatPushADampedModeOutOfItsWindow) {
       EXPECT_NE(p.reason.find("out of its damping window"), std::string::npos) << p.reason;
     }
   }
-  control::ControllerParams params = control::design_chain(cfg).params;
+  control::ControllerParams params = analysis::design_chain(cfg).params;
   analysis::apply_refused_speeds(map, params);
   control::Controller c(params);
   EXPECT_EQ(c.set_spindle_rpm(250.0), control::RequestStatus::kRejectedOutOfRange);

@@ -7,7 +7,7 @@
 #include "modal/receptance.hpp"
 #include "config/config.hpp"
 #include "config/yaml_edit.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "test_util.hpp"
 
 namespace robodamp::config {
@@ -47,7 +47,7 @@ std::string edited(const std::string& from, const std::string& to) {
 
 std::vector<Problem> problems_of(const std::string& yaml) {
   try {
-    (void)control::design_chain(parse_config(yaml, "bad.yaml"));
+    (void)analysis::design_chain(parse_config(yaml, "bad.yaml"));
   } catch (const ConfigError& e) {
     return e.problems();
   }
@@ -75,7 +75,7 @@ TEST(Config, AllPresetsLoadAndDesign) {
     EXPECT_DOUBLE_EQ(c.robot.frfs[0].modes[0].residue_im_m_per_n, -3.63e-5);
     EXPECT_DOUBLE_EQ(c.robot.frfs[2].modes[0].residue_im_m_per_n, 4.06e-5);  // H22 = H21 (Table 1)
     EXPECT_NEAR(*modal::dominant_mode_hz(c.robot), 9.2, 1e-12);
-    const auto d = control::design_chain(c);
+    const auto d = analysis::design_chain(c);
     EXPECT_EQ(d.match_freq_hz, 9.2);
   }
   EXPECT_EQ(load_config_file(test::preset("vertical_c1")).actuator.natural_freq_hz, 14.0);
@@ -336,12 +336,13 @@ TEST(Config, LoopSupervisionRealtimeAndTelemetryAreValidated) {
 TEST(Config, RecoveryIsValidatedByKeyWithItsUnitAndRange) {
   const Config defaults = parse_config(kValid, "ok.yaml");
   const auto& d = defaults.supervision.recovery;
-  EXPECT_EQ(d.recoverable, (std::vector<std::string>{"overruns", "sensor_stale", "sample_invalid", "sensor_driver", "actuator_driver"}));
+  EXPECT_EQ(d.recoverable, (std::vector<rt::Trip>{rt::Trip::kOverruns, rt::Trip::kSensorStale, rt::Trip::kSampleInvalid,
+                                                  rt::Trip::kSensorDriver, rt::Trip::kActuatorDriver}));
   EXPECT_EQ(d.max_recoveries, 3);
   const Config v = parse_config(kValid + std::string("supervision:\n  recovery:\n    recoverable: [overruns]\n"
                                                      "    cool_down_s: 0.5\n    max_recoveries: 5\n"),
                                 "ok.yaml");
-  EXPECT_EQ(v.supervision.recovery.recoverable, std::vector<std::string>{"overruns"});
+  EXPECT_EQ(v.supervision.recovery.recoverable, std::vector<rt::Trip>{rt::Trip::kOverruns});
   EXPECT_DOUBLE_EQ(v.supervision.recovery.cool_down_s, 0.5);
   EXPECT_EQ(v.supervision.recovery.max_recoveries, 5);
   EXPECT_TRUE(parse_config(kValid + std::string("supervision: {recovery: {recoverable: []}}\n"), "ok.yaml")

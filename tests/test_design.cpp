@@ -165,7 +165,7 @@ TEST(BilinearDesign, RejectsWhatCannotRun) {
 TEST(ChainDesign, PublishedPhasesFromTheDigitalBlocks) {
   for (double fs : {1000.0, 5000.0, 10000.0}) {
     SCOPED_TRACE(fs);
-    auto phase_of = [&](const control::ChainDesign& d, const std::string& name) {
+    auto phase_of = [&](const analysis::ChainDesign& d, const std::string& name) {
       for (std::size_t i = 0; i < d.blocks.size(); ++i)
         if (d.blocks[i].name == name) return phase_deg(d.block_digital(i, 9.2));
       ADD_FAILURE() << "no block " << name;

@@ -21,7 +21,7 @@
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
 #include "cell_util.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "milling/structure.hpp"
 #include "rt/recording.hpp"
 #include "sim_plant/plant_model.hpp"
@@ -377,7 +377,7 @@ TEST(Fuzz, TenThousandMutatedConfigurationsAreRefusedWithFileAndLine) {
         for (const auto& s : job.structures) (void)milling::Structure(s, false);
       } else {
         const auto cfg = config::load_config_file(file);
-        (void)control::design_chain(cfg);
+        (void)analysis::design_chain(cfg);
         if (!cfg.robot.frfs.empty()) (void)sim::build_plant_model(cfg);
       }
       ++c.accepted;

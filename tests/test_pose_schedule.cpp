@@ -292,7 +292,7 @@ rt::TickInput live_tick(double accel = 0.0) {
 TEST(PoseSchedule, SupervisorArmsOnlyInARegionFollowsThePoseAndTripsOutOfTheMap) {
   const config::Config cfg = config::load_config_file(test::preset(kPreset));
   const analysis::PoseScheduleAnalysis a = analysis::analyse_pose_schedule(cfg);
-  rt::SupervisorSettings s = rt::supervisor_settings(a.regions[0].config, true, a.regions[0].k_max_ns_per_m);
+  rt::SupervisorSettings s = config::supervisor_settings(a.regions[0].config, true, a.regions[0].k_max_ns_per_m);
   s.pose_scheduled = true;
   rt::Supervisor sup(s, set_of(a.regions[0]).params);
   ASSERT_EQ(sup.add_parameter_set(set_of(a.regions[1])), 1u);

@@ -327,7 +327,7 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   loop.schedule(31 * 5000, {rt::CommandKind::kSetGain, 1e9});
   loop.schedule(180 * 5000, {rt::CommandKind::kDisarm, 0.0});
   const std::string path = ::testing::TempDir() + "/alloc_loop.rec";
-  rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kVirtual));
+  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(), config::ClockKind::kVirtual));
   rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
   drain.start();
 
@@ -379,7 +379,7 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
   loop.schedule(at(22.0), {rt::CommandKind::kResetFault, 0.0});
   loop.schedule(at(22.1), {rt::CommandKind::kSetPoseRegion, 0.0});
   const std::string path = ::testing::TempDir() + "/alloc_pose.rec";
-  rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kVirtual));
+  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(), config::ClockKind::kVirtual));
   rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
   drain.start();
   const LoopThreadCounts counts = run_counted(loop, at(25.0));
@@ -513,7 +513,7 @@ TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   session.plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, 1000.0, 1e-3, hits));
   rt::Loop& loop = session.loop();  // wall clock (loop.clock), armed at tick 51
   const std::string path = ::testing::TempDir() + "/soak.rec";
-  rt::Recorder recorder(path, rt::recording_header(cfg, session.supervisor(), config::ClockKind::kWall));
+  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(), config::ClockKind::kWall));
   rt::LiveTiming live;
   rt::TelemetryDrain drain(session.telemetry_ring(),
                           {[&](const rt::TelemetryFrame& f) { recorder.write(f); }, std::ref(live)});

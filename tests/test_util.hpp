@@ -16,7 +16,7 @@
 #include <string>
 
 #include "config/config.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 #include "config/yaml_edit.hpp"
 
 namespace robodamp::test {
@@ -56,10 +56,10 @@ inline std::string preset(const std::string& name) {
   return std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/" + name + ".yaml";
 }
 
-inline control::ChainDesign design_preset(const std::string& name, double rate_hz = 0.0) {
+inline analysis::ChainDesign design_preset(const std::string& name, double rate_hz = 0.0) {
   config::Config c = config::load_config_file(preset(name));
   if (rate_hz > 0.0) c.loop.rate_hz = rate_hz;
-  return control::design_chain(c);
+  return analysis::design_chain(c);
 }
 
 // tuned_vertical.yaml as `robodamp tune` first wrote it (before the quiet-command constraint): a stable

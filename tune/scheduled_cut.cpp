@@ -70,7 +70,7 @@ std::unique_ptr<rt::Supervisor> scheduled_supervisor(const config::Config& cell)
   const int pol = cell.controller.polarity;
   const auto k0 = analysis::max_stable_gain(m0, pol);
   auto sup = std::make_unique<rt::Supervisor>(
-      rt::supervisor_settings(cell, m0.stable(cell.controller.gain_ns_per_m, pol), k0.value_or(control::kMaxGainNsPerM)),
+      config::supervisor_settings(cell, m0.stable(cell.controller.gain_ns_per_m, pol), k0.value_or(control::kMaxGainNsPerM)),
       m0.chain().params);
   const std::size_t controllers = cell.controller.speed_schedule ? cell.controller.speed_schedule->controllers.size() : 0;
   for (std::size_t i = 1; i <= controllers; ++i) {

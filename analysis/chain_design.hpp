@@ -10,7 +10,7 @@
 #include "filters/design.hpp"
 #include "filters/transfer_function.hpp"
 
-namespace robodamp::control {
+namespace robodamp::analysis {
 
 struct ChainBlock {
   std::string name;
@@ -35,7 +35,7 @@ struct ChainDesign {
   std::vector<ChainBlock> blocks;  // in configured order
   std::vector<RealisedGroup> groups;
   double match_freq_hz{0.0};       // default pre-warp of compensators
-  ControllerParams params;         // what the real-time controller runs
+  control::ControllerParams params;  // what the real-time controller runs
 
   // Responses of the filter blocks only (accel in, shaped velocity out; no K, polarity, 1/T).
   [[nodiscard]] filters::Complex filters_analog(double f_hz) const;
@@ -51,4 +51,4 @@ struct ChainDesign {
 // Throws config::ConfigError naming the block (key, line) for a design that cannot run.
 [[nodiscard]] ChainDesign design_chain(const config::Config& cfg);
 
-}  // namespace robodamp::control
+}  // namespace robodamp::analysis

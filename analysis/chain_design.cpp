@@ -1,13 +1,14 @@
 #include "modal/receptance.hpp"
-#include "control/chain_design.hpp"
+#include "analysis/chain_design.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-namespace robodamp::control {
+namespace robodamp::analysis {
 
 using config::BlockKind;
+using control::ControllerParams;
 using filters::Complex;
 using filters::TransferFunction;
 
@@ -212,4 +213,4 @@ Complex ChainDesign::block_digital(std::size_t i, double f_hz) const {
   return filters::bilinear_response(blocks[i].analog, f_hz, params.fs_hz, g.digital.prewarp_hz);
 }
 
-}  // namespace robodamp::control
+}  // namespace robodamp::analysis
