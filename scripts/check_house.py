@@ -73,6 +73,14 @@ TARGET = {"sim_plant": "robodamp_sim", "apps": "robodamp_cli"}
 HEADER_ONLY = {"units", "threads", "rt_settings", "control"}
 
 
+def report(bad, failed, passed):
+    """Each finding, then the verdict: failed (exit status 1) when there is one, passed (0) when none."""
+    for b in bad:
+        print(b)
+    print(failed if bad else passed)
+    return 1 if bad else 0
+
+
 def layer_of():
     out = {}
     for i, (_, folders) in enumerate(LAYERS):
@@ -154,11 +162,8 @@ def parser_free():
                             bad.append(f"{os.path.relpath(os.path.join(d, n), ROOT)}:{i}: {line.strip()}")
         for t in sorted(linked(folder) & {"robodamp_config", "yaml-cpp"}):
             bad.append(f"{folder}/ links {t} (through the libraries it links)")
-    for b in bad:
-        print(b)
-    print(f"{len(bad)} use(s) of the parser in the real-time core" if bad else
-          f"{', '.join(f + '/' for f in PARSER_FREE)} include and link no configuration parser and no yaml-cpp")
-    return 1 if bad else 0
+    return report(bad, f"{len(bad)} use(s) of the parser in the real-time core",
+                  f"{', '.join(f + '/' for f in PARSER_FREE)} include and link no configuration parser and no yaml-cpp")
 
 
 def layers(build_dir):
@@ -181,11 +186,8 @@ def layers(build_dir):
                 bad.append(f"{where} includes {used}/, which {lib} does not link")
             elif used != lib and used in level and level[used] >= level[lib]:
                 bad.append(f"{where} includes {used}/ (layer {level[used]}) from layer {level[lib]}")
-    for b in bad:
-        print(b)
-    print(f"{len(bad)} link(s) or include(s) against the layers" if bad else
-          f"{len(graph)} libraries link and include only downwards ({len(LAYERS)} layers)")
-    return 1 if bad else 0
+    return report(bad, f"{len(bad)} link(s) or include(s) against the layers",
+                  f"{len(graph)} libraries link and include only downwards ({len(LAYERS)} layers)")
 
 
 def picture(cmake_dot, out_dot):
@@ -246,10 +248,7 @@ def links():
                     bad.append(f"{page}:{n}: {url}: no such file")
                 elif anchor and target.endswith(".md") and anchor not in heading_anchors(target):
                     bad.append(f"{page}:{n}: {url}: no heading with that anchor")
-    for b in bad:
-        print(b)
-    print(f"{len(bad)} of {count} links do not resolve" if bad else f"all {count} links resolve")
-    return 1 if bad else 0
+    return report(bad, f"{len(bad)} of {count} links do not resolve", f"all {count} links resolve")
 
 
 if __name__ == "__main__":
