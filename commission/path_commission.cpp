@@ -114,7 +114,10 @@ std::vector<std::string> waypoint_texts(const std::vector<hil::PoseWaypoint>& pa
   std::vector<std::string> out;
   for (const auto& w : path) {
     std::string t = config::format_number(w.t_s) + ":";
-    for (std::size_t j = 0; j < w.joints_deg.size(); ++j) t += (j ? "," : "") + config::format_number(w.joints_deg[j]);
+    for (std::size_t j = 0; j < w.joints_deg.size(); ++j) {
+      if (j > 0) t += ',';  // not (j ? "," : "") + a string: GCC 12's false -Wrestrict on that concatenation
+      t += config::format_number(w.joints_deg[j]);
+    }
     out.push_back(t);
   }
   return out;
