@@ -109,8 +109,6 @@ const char* to_string(CompensatorModel model) {
   return "?";
 }
 
-
-
 const char* to_string(Mounting mounting) { return mounting == Mounting::kHorizontal ? "horizontal" : "vertical"; }
 
 namespace {
@@ -836,7 +834,7 @@ const LocationConfig* find_location(const RobotConfig& robot, int id) {
 }
 
 rt::SupervisorSettings supervisor_settings(const Config& cfg, bool analysis_stable, double max_stable_gain_ns_per_m,
-                                       double delay_margin_s) {
+                                           double delay_margin_s) {
   rt::SupervisorSettings s;
   s.limits = cfg.supervision;
   s.fs_hz = cfg.loop.rate_hz;
@@ -849,6 +847,5 @@ rt::SupervisorSettings supervisor_settings(const Config& cfg, bool analysis_stab
   s.command_limit_v = cfg.amplifier.voltage_limit_v;
   return s;
 }
-
 
 }  // namespace robodamp::config
