@@ -7,69 +7,22 @@
 
 #include "apps/advice_view.hpp"
 #include "config/pose_schedule_config.hpp"
+#include "fields/json.hpp"
 
 namespace robodamp::apps {
 
 namespace {
 
-// The hardware devices' counters (CAN, Modbus, DDS), a line each.
+// The hardware devices' counters (CAN, Modbus, DDS), a line each, from their field lists.
 [[nodiscard]] std::string devices_text(const runtime::RunSummary& s) {
-  std::ostringstream os;
-  char b[512];
-  if (s.can) {
-    const auto& c = *s.can;
-    std::snprintf(b, sizeof b,
-                  "  CAN: %llu sensor frames (%llu lost, %llu stale, %llu malformed, %llu other ids), %llu error frames, "
-                  "%llu bus-off, %llu held over / %llu skipped (de-jitter; %llu resyncs backed off), %llu reconnects; %llu commands sent (%llu queue full, "
-                  "%llu errors, %llu skipped)\n",
-                  static_cast<unsigned long long>(c.rx_frames), static_cast<unsigned long long>(c.lost_frames),
-                  static_cast<unsigned long long>(c.stale_frames), static_cast<unsigned long long>(c.rx_malformed),
-                  static_cast<unsigned long long>(c.rx_other), static_cast<unsigned long long>(c.error_frames),
-                  static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.rx_held),
-                  static_cast<unsigned long long>(c.rx_skipped), static_cast<unsigned long long>(c.resync_backoffs),
-                  static_cast<unsigned long long>(c.reconnects),
-                  static_cast<unsigned long long>(c.tx_frames),
-                  static_cast<unsigned long long>(c.tx_queue_full), static_cast<unsigned long long>(c.tx_errors),
-                  static_cast<unsigned long long>(c.tx_skipped));
-    os << b;
-  }
-  if (s.modbus) {
-    const auto& m = *s.modbus;
-    std::snprintf(b, sizeof b,
-                  "  Modbus: %llu amplifier and %llu robot polls, %llu connects (%llu failed), %llu errors (%llu timeouts), "
-                  "%llu link faults, %llu mounting changes, %llu pose changes (%llu polls out of the map, %llu not available, "
-                  "%llu link losses), %llu speed advices written\n",
-                  static_cast<unsigned long long>(m.amplifier_polls), static_cast<unsigned long long>(m.robot_polls),
-                  static_cast<unsigned long long>(m.connects), static_cast<unsigned long long>(m.connect_failures),
-                  static_cast<unsigned long long>(m.errors), static_cast<unsigned long long>(m.timeouts),
-                  static_cast<unsigned long long>(m.link_faults), static_cast<unsigned long long>(m.mounting_changes),
-                  static_cast<unsigned long long>(m.pose_changes), static_cast<unsigned long long>(m.pose_out_of_map_polls),
-                  static_cast<unsigned long long>(m.pose_unavailable_polls), static_cast<unsigned long long>(m.pose_link_losses),
-                  static_cast<unsigned long long>(m.advice_writes));
-    os << b;
-  }
-  if (s.joint_states) {
-    const auto& j = *s.joint_states;
-    std::snprintf(b, sizeof b,
-                  "  DDS joint states: %llu messages (%llu refused: a joint missing or not finite), %llu out of the map, "
-                  "%llu pose changes, %llu silences\n",
-                  static_cast<unsigned long long>(j.messages), static_cast<unsigned long long>(j.refused),
-                  static_cast<unsigned long long>(j.out_of_map), static_cast<unsigned long long>(j.changes),
-                  static_cast<unsigned long long>(j.losses));
-    os << b;
-  }
-  if (s.path_ahead) {
-    std::snprintf(b, sizeof b, "  DDS path ahead: %llu trajectories (%llu refused: a joint missing, a point short or not finite)\n",
-                  static_cast<unsigned long long>(s.path_ahead->messages), static_cast<unsigned long long>(s.path_ahead->refused));
-    os << b;
-  }
-  if (s.dds) {
-    std::snprintf(b, sizeof b, "  DDS: %llu telemetry and %llu status samples published; %llu parameter requests (%llu refused)\n",
-                  static_cast<unsigned long long>(s.dds->telemetry), static_cast<unsigned long long>(s.dds->status),
-                  static_cast<unsigned long long>(s.dds->requests), static_cast<unsigned long long>(s.dds->refused));
-    os << b;
-  }
-  return os.str();
+  std::string out;
+  auto line = [&out](const char* name, const std::string& counters) { out += "  " + std::string(name) + ": " + counters + "\n"; };
+  if (s.can) line("CAN", fields::text(*s.can));
+  if (s.modbus) line("Modbus", fields::text(*s.modbus));
+  if (s.joint_states) line("DDS joint states", fields::text(*s.joint_states));
+  if (s.path_ahead) line("DDS path ahead", fields::text(*s.path_ahead));
+  if (s.dds) line("DDS", fields::text(*s.dds));
+  return out;
 }
 
 }  // namespace
@@ -81,9 +34,8 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
     return json{{"count", h.count()},           {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
                 {"p999_us", h.percentile_us(0.999)}, {"max_us", h.max_us()},       {"mean_us", h.mean_us()}};
   };
-  json trips = json::object();
-  for (std::size_t i = 1; i < rt::kTripCount; ++i)
-    trips[rt::to_string(static_cast<rt::Trip>(i))] = s.supervisor.trips[i];
+  json supervisor = fields::to_json(s.supervisor);
+  supervisor["active_parameter_set"] = s.active_parameter_set;
   const auto ticks = static_cast<double>(std::max<std::uint64_t>(1, s.loop.ticks_run + s.loop.missed_ticks));
   json j = {{"config", s.config},
           {"clock", s.clock},
@@ -103,35 +55,7 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
           {"compute", hist(s.loop.compute)},
           {"telemetry", {{"frames", s.telemetry_frames}, {"ring_drops", s.loop.ring_drops}, {"ring_waits", s.loop.ring_waits}}},
           {"recording", {{"path", s.record_path}, {"frames", s.recorded_frames}, {"write_errors", s.record_errors}}},
-          {"supervisor",
-           {{"trips", trips},
-            {"stale_ticks", s.supervisor.stale_ticks},
-            {"invalid_samples", s.supervisor.invalid_samples},
-            {"saturated_ticks", s.supervisor.saturated_ticks},
-            {"arm_refused", s.supervisor.arm_refused},
-            {"gain_refused", s.supervisor.gain_refused},
-            {"params_selected", s.supervisor.params_selected},
-            {"params_refused", s.supervisor.params_refused},
-            {"speed_handovers", s.supervisor.speed_handovers},
-            {"speed_handovers_refused", s.supervisor.speed_handovers_refused},
-            {"spindle_refused", s.supervisor.spindle_refused},
-            {"pose_regions", s.supervisor.pose_regions},
-            {"pose_out_of_map", s.supervisor.pose_out_of_map},
-            {"active_parameter_set", s.active_parameter_set},
-            {"recoveries", s.supervisor.recoveries},
-            {"overrun_runs_ridden", s.supervisor.overrun_runs_ridden},
-            {"sensor_holds", s.supervisor.sensor_holds},
-            {"sensor_hold_ticks", s.supervisor.sensor_hold_ticks},
-            {"longest_sensor_hold_ticks", s.supervisor.longest_sensor_hold_ticks},
-            {"budget_latches", s.supervisor.budget_latches},
-            {"probation_latches", s.supervisor.probation_latches},
-            {"derate",
-             {{"probes", s.supervisor.derate_probes},
-              {"growth_process", s.supervisor.growth_process},
-              {"growth_gain_fed", s.supervisor.growth_gain_fed},
-              {"saturation_derates", s.supervisor.saturation_derates},
-              {"restores", s.supervisor.derate_restores},
-              {"derated_ticks", s.supervisor.derated_ticks}}}}},
+          {"supervisor", supervisor},
           {"realtime",
            {{"memory_locked", s.realtime.memory_locked},
             {"sched_fifo", s.realtime.fifo},
@@ -179,17 +103,8 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
                          {"share", a.share()},           {"first_full_gain_s", t(a.first_full_gain_s)},
                          {"trips_total", a.trips_total}, {"trips", trip_list}};
   }
-  if (s.can) {
-    const auto& c = *s.can;
-    j["can"] = {{"rx_frames", c.rx_frames},       {"rx_other", c.rx_other},     {"rx_malformed", c.rx_malformed},
-                {"lost_frames", c.lost_frames},   {"stale_frames", c.stale_frames}, {"error_frames", c.error_frames},
-                {"bus_off", c.bus_off},           {"restarts", c.restarts},     {"rx_errors", c.rx_errors},
-                {"tx_frames", c.tx_frames},       {"tx_queue_full", c.tx_queue_full}, {"tx_errors", c.tx_errors},
-                {"tx_skipped", c.tx_skipped},     {"tx_clipped", c.tx_clipped}, {"rx_held", c.rx_held},
-                {"rx_skipped", c.rx_skipped},     {"reconnects", c.reconnects}, {"resync_backoffs", c.resync_backoffs}};
-  }
-  if (s.dds) j["dds"] = {{"telemetry", s.dds->telemetry}, {"status", s.dds->status}, {"requests", s.dds->requests},
-                         {"refused", s.dds->refused}, {"machining", s.dds->machining}, {"advice", s.dds->advice}};
+  if (s.can) j["can"] = fields::to_json(*s.can);
+  if (s.dds) j["dds"] = fields::to_json(*s.dds);
   if (s.machining) {
     const auto& m = *s.machining;
     auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
@@ -220,24 +135,9 @@ nlohmann::json summary_json(const runtime::RunSummary& s) {
     j["limits_along_path"] = trail;
   }
   if (s.advice) j["advice"] = advice_json(runtime::to_sample(*s.advice));
-  if (s.modbus) {
-    const auto& m = *s.modbus;
-    j["modbus"] = {{"amplifier_polls", m.amplifier_polls}, {"robot_polls", m.robot_polls},
-                   {"connects", m.connects},               {"connect_failures", m.connect_failures},
-                   {"errors", m.errors},                   {"timeouts", m.timeouts},
-                   {"link_faults", m.link_faults},         {"coil_writes", m.coil_writes},
-                   {"mounting_changes", m.mounting_changes}, {"mounting_unknown", m.mounting_unknown},
-                   {"spindle_changes", m.spindle_changes}, {"spindle_link_parks", m.spindle_link_parks},
-                   {"pose_changes", m.pose_changes},       {"pose_out_of_map_polls", m.pose_out_of_map_polls},
-                   {"pose_unavailable_polls", m.pose_unavailable_polls}, {"pose_link_losses", m.pose_link_losses},
-                   {"advice_writes", m.advice_writes}};
-  }
-  if (s.joint_states) {
-    const auto& c = *s.joint_states;
-    j["joint_states"] = {{"messages", c.messages}, {"refused", c.refused}, {"out_of_map", c.out_of_map},
-                         {"changes", c.changes}, {"losses", c.losses}};
-  }
-  if (s.path_ahead) j["path_ahead"] = {{"messages", s.path_ahead->messages}, {"refused", s.path_ahead->refused}};
+  if (s.modbus) j["modbus"] = fields::to_json(*s.modbus);
+  if (s.joint_states) j["joint_states"] = fields::to_json(*s.joint_states);
+  if (s.path_ahead) j["path_ahead"] = fields::to_json(*s.path_ahead);
   return j;
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "config/supervisory_config.hpp"
+#include "fields/fields.hpp"
 #include "rt/availability.hpp"
 #include "rt/telemetry_frame.hpp"
 #include "rt/timing_histogram.hpp"
@@ -145,6 +146,22 @@ struct BridgeCounters {
   std::uint64_t telemetry{0}, status{0}, requests{0}, refused{0}, machining{0}, advice{0}, spectrum{0}, lobes{0};
   std::uint64_t other_cells{0};  // requests for another cell, ignored
 };
+
+// BridgeCounters' JSON keys (the run summary's "dds") and their words in its text line.
+[[nodiscard]] constexpr auto field_list(fields::Tag<BridgeCounters>) {
+  using B = BridgeCounters;
+  using F = fields::Field<B, std::uint64_t>;
+  return std::tuple{F{"telemetry", &B::telemetry, "telemetry samples published"},
+                    F{"status", &B::status, "status samples"},
+                    F{"requests", &B::requests, "parameter requests"},
+                    F{"refused", &B::refused, "refused"},
+                    F{"machining", &B::machining, "machining samples"},
+                    F{"advice", &B::advice, "speed advices"},
+                    F{"spectrum", &B::spectrum, "spectra"},
+                    F{"lobes", &B::lobes, "lobe diagrams"},
+                    F{"other_cells", &B::other_cells, "requests for other cells ignored"}};
+}
+static_assert(fields::lists_every_member<BridgeCounters>(), "each counter in BridgeCounters' field list");
 
 class Bridge {
  public:

@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "config/can_config.hpp"
+#include "fields/fields.hpp"
 #include "drivers/can_channel.hpp"
 #include "drivers/can_codec.hpp"
 #include "rt/io.hpp"
@@ -41,6 +42,31 @@ struct CanCounters {
   std::uint64_t reconnects{0};      // transports handed over after the peer went away (offer_channel)
   std::uint64_t resync_backoffs{0}; // de-jitter: a resync left a tick without a frame; its interval doubled
 };
+
+// CanCounters' JSON keys (the run summary's "can") and their words in its text line.
+[[nodiscard]] constexpr auto field_list(fields::Tag<CanCounters>) {
+  using C = CanCounters;
+  using F = fields::Field<C, std::uint64_t>;
+  return std::tuple{F{"rx_frames", &C::rx_frames, "sensor frames"},
+                    F{"rx_other", &C::rx_other, "other ids"},
+                    F{"rx_malformed", &C::rx_malformed, "malformed"},
+                    F{"lost_frames", &C::lost_frames, "lost"},
+                    F{"stale_frames", &C::stale_frames, "stale"},
+                    F{"error_frames", &C::error_frames, "error frames"},
+                    F{"bus_off", &C::bus_off, "bus-off"},
+                    F{"restarts", &C::restarts, "restarts"},
+                    F{"rx_errors", &C::rx_errors, "receive errors"},
+                    F{"tx_frames", &C::tx_frames, "commands sent"},
+                    F{"tx_queue_full", &C::tx_queue_full, "queue full"},
+                    F{"tx_errors", &C::tx_errors, "send errors"},
+                    F{"tx_skipped", &C::tx_skipped, "commands skipped"},
+                    F{"tx_clipped", &C::tx_clipped, "commands clipped"},
+                    F{"rx_held", &C::rx_held, "held over (de-jitter)"},
+                    F{"rx_skipped", &C::rx_skipped, "skipped (de-jitter)"},
+                    F{"reconnects", &C::reconnects, "reconnects"},
+                    F{"resync_backoffs", &C::resync_backoffs, "resyncs backed off"}};
+}
+static_assert(fields::lists_every_member<CanCounters>(), "each counter in CanCounters' field list");
 
 class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
  public:

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "config/config.hpp"
+#include "fields/fields.hpp"
 #include "rt/io.hpp"
 #include "threads/worker.hpp"
 
@@ -86,6 +87,32 @@ struct ModbusCounters {
   std::uint64_t depth_changes{0};      // new depths read from modbus.robot.depth_register
   std::uint64_t depth_unavailable_polls{0};  // polls with the depth register at 65535 (not available)
 };
+
+// ModbusCounters' JSON keys (the run summary's "modbus") and their words in its text line.
+[[nodiscard]] constexpr auto field_list(fields::Tag<ModbusCounters>) {
+  using M = ModbusCounters;
+  using F = fields::Field<M, std::uint64_t>;
+  return std::tuple{F{"amplifier_polls", &M::amplifier_polls, "amplifier polls"},
+                    F{"robot_polls", &M::robot_polls, "robot polls"},
+                    F{"connects", &M::connects, "connects"},
+                    F{"connect_failures", &M::connect_failures, "connects failed"},
+                    F{"errors", &M::errors, "errors"},
+                    F{"timeouts", &M::timeouts, "timeouts"},
+                    F{"link_faults", &M::link_faults, "link faults"},
+                    F{"coil_writes", &M::coil_writes, "coil writes"},
+                    F{"mounting_changes", &M::mounting_changes, "mounting changes"},
+                    F{"mounting_unknown", &M::mounting_unknown, "mountings unknown"},
+                    F{"spindle_changes", &M::spindle_changes, "spindle speed changes"},
+                    F{"spindle_link_parks", &M::spindle_link_parks, "notches parked (robot link lost)"},
+                    F{"pose_changes", &M::pose_changes, "pose changes"},
+                    F{"pose_out_of_map_polls", &M::pose_out_of_map_polls, "polls out of the map"},
+                    F{"pose_unavailable_polls", &M::pose_unavailable_polls, "polls with the pose not available"},
+                    F{"pose_link_losses", &M::pose_link_losses, "pose link losses"},
+                    F{"advice_writes", &M::advice_writes, "speed advices written"},
+                    F{"depth_changes", &M::depth_changes, "depth changes"},
+                    F{"depth_unavailable_polls", &M::depth_unavailable_polls, "polls with the depth not available"}};
+}
+static_assert(fields::lists_every_member<ModbusCounters>(), "each counter in ModbusCounters' field list");
 
 class ModbusClient final : public rt::AmplifierIo {
  public:

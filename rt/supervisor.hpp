@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "control/controller.hpp"
+#include "fields/fields.hpp"
 #include "rt_settings/rt_settings.hpp"
 
 namespace robodamp::rt {
@@ -122,6 +123,43 @@ struct SupervisorCounters {
   std::uint64_t derate_restores{0};
   std::uint64_t derated_ticks{0};
 };
+
+// SupervisorCounters' JSON keys (the run summary's "supervisor" object) and their words in text.
+[[nodiscard]] constexpr auto field_list(fields::Tag<SupervisorCounters>) {
+  using S = SupervisorCounters;
+  using fields::Field;
+  return std::tuple{
+      fields::NamedCounts<S, kTripCount>{"trips", &S::trips, +[](std::size_t i) { return trip_name(static_cast<Trip>(i)); }},
+      Field<S, std::uint64_t>{"ticks", &S::ticks, "ticks"},
+      Field<S, std::uint64_t>{"stale_ticks", &S::stale_ticks, "stale ticks"},
+      Field<S, std::uint64_t>{"invalid_samples", &S::invalid_samples, "invalid samples"},
+      Field<S, std::uint64_t>{"overruns", &S::overruns, "overruns"},
+      Field<S, std::uint64_t>{"overrun_runs_ridden", &S::overrun_runs_ridden, "overrun runs ridden through"},
+      Field<S, std::uint64_t>{"sensor_hold_ticks", &S::sensor_hold_ticks, "ticks on a held sample"},
+      Field<S, std::uint64_t>{"sensor_holds", &S::sensor_holds, "runs on a held sample"},
+      Field<S, std::uint64_t>{"longest_sensor_hold_ticks", &S::longest_sensor_hold_ticks, "ticks the longest"},
+      Field<S, std::uint64_t>{"saturated_ticks", &S::saturated_ticks, "saturated ticks"},
+      Field<S, std::uint64_t>{"arm_refused", &S::arm_refused, "arms refused"},
+      Field<S, std::uint64_t>{"gain_refused", &S::gain_refused, "gains refused"},
+      Field<S, std::uint64_t>{"params_refused", &S::params_refused, "parameter sets refused"},
+      Field<S, std::uint64_t>{"params_selected", &S::params_selected, "parameter sets selected"},
+      Field<S, std::uint64_t>{"spindle_refused", &S::spindle_refused, "spindle speeds refused"},
+      Field<S, std::uint64_t>{"pose_out_of_map", &S::pose_out_of_map, "poses out of the map"},
+      Field<S, std::uint64_t>{"pose_regions", &S::pose_regions, "pose regions"},
+      Field<S, std::uint64_t>{"speed_handovers", &S::speed_handovers, "speed hand-overs"},
+      Field<S, std::uint64_t>{"speed_handovers_refused", &S::speed_handovers_refused, "speed hand-overs refused"},
+      Field<S, std::uint64_t>{"commands", &S::commands, "operator commands"},
+      Field<S, std::uint64_t>{"recoveries", &S::recoveries, "recoveries"},
+      Field<S, std::uint64_t>{"budget_latches", &S::budget_latches, "latched by the budget"},
+      Field<S, std::uint64_t>{"probation_latches", &S::probation_latches, "latched by the probation"},
+      Field<S, std::uint64_t>{"derate/probes", &S::derate_probes, "growth probes"},
+      Field<S, std::uint64_t>{"derate/growth_process", &S::growth_process, "the process's growth"},
+      Field<S, std::uint64_t>{"derate/growth_gain_fed", &S::growth_gain_fed, "fed by the gain"},
+      Field<S, std::uint64_t>{"derate/saturation_derates", &S::saturation_derates, "saturation derates"},
+      Field<S, std::uint64_t>{"derate/restores", &S::derate_restores, "back to full gain"},
+      Field<S, std::uint64_t>{"derate/derated_ticks", &S::derated_ticks, "ticks derated"}};
+}
+static_assert(fields::lists_every_member<SupervisorCounters>(), "each counter in SupervisorCounters' field list");
 
 // What the supervisor did about faults, with its time (the supervisor's clock: the sum of the measured
 // dt since the start), in a fixed log of the first kEventLogSize events.

@@ -31,6 +31,7 @@ const char* describe(Trip t) {
     case Trip::kAmplifierNotReady: return "the amplifier did not become ready within supervision.amplifier_ready_timeout_s after enable";
     case Trip::kSignal: return "SIGINT/SIGTERM: shut down through the safe state";
     case Trip::kPoseOutOfMap: return "the robot's pose is outside every region of pose_schedule, or unknown (the joint angles lost, not available or not finite, from the Modbus registers or the DDS joint states): no analysed parameter set applies there";
+    case Trip::kCount: break;  // not a trip: the enum's count
   }
   return "?";
 }

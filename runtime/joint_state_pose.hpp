@@ -17,6 +17,7 @@
 
 #include "config/pose_schedule_config.hpp"
 #include "config/supervisory_config.hpp"
+#include "fields/fields.hpp"
 
 namespace robodamp::runtime {
 
@@ -27,6 +28,18 @@ struct JointStateCounters {
   std::uint64_t changes{0};      // regions reported (out of the map included)
   std::uint64_t losses{0};       // silences of timeout_s
 };
+
+// JointStateCounters' JSON keys (the run summary's "joint_states") and their words in its text line.
+[[nodiscard]] constexpr auto field_list(fields::Tag<JointStateCounters>) {
+  using J = JointStateCounters;
+  using F = fields::Field<J, std::uint64_t>;
+  return std::tuple{F{"messages", &J::messages, "messages"},
+                    F{"refused", &J::refused, "refused (a joint missing or not finite)"},
+                    F{"out_of_map", &J::out_of_map, "out of the map"},
+                    F{"changes", &J::changes, "pose changes"},
+                    F{"losses", &J::losses, "silences"}};
+}
+static_assert(fields::lists_every_member<JointStateCounters>(), "each counter in JointStateCounters' field list");
 
 class JointStatePose {
  public:

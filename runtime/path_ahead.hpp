@@ -16,6 +16,7 @@
 
 #include "config/supervisory_config.hpp"
 #include "dds/bridge.hpp"
+#include "fields/fields.hpp"
 
 namespace robodamp::runtime {
 
@@ -23,6 +24,15 @@ struct PathAheadCounters {
   std::uint64_t messages{0};
   std::uint64_t refused{0};
 };
+
+// PathAheadCounters' JSON keys (the run summary's "path_ahead") and their words in its text line.
+[[nodiscard]] constexpr auto field_list(fields::Tag<PathAheadCounters>) {
+  using P = PathAheadCounters;
+  using F = fields::Field<P, std::uint64_t>;
+  return std::tuple{F{"messages", &P::messages, "trajectories"},
+                    F{"refused", &P::refused, "refused (a joint missing, a point short or not finite)"}};
+}
+static_assert(fields::lists_every_member<PathAheadCounters>(), "each counter in PathAheadCounters' field list");
 
 using TrajectoryPoint = dds::TrajectoryPoint;  // one point as the message carries it
 

@@ -29,6 +29,9 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/bench_run.hpp"
+#include "drivers/can_driver.hpp"
+#include "drivers/modbus_client.hpp"
+#include "fields/json.hpp"
 #include "rt/recording.hpp"
 #include "rt/supervisor.hpp"
 #include "cell_util.hpp"
@@ -64,6 +67,17 @@ TEST(Hil, LockstepImprovementMatchesTheInProcessBench) {
   EXPECT_EQ(p["frames"]["commands"], r["can"]["tx_frames"]);
   ASSERT_TRUE(p["impacts"]["complete"].get<bool>());
   ASSERT_EQ(p["impacts"]["records"], 10);
+  // The summary's counters are their field lists' forms (fields/): each counter in the JSON and no other key,
+  // and the text's device lines say the same numbers.
+  EXPECT_EQ(fields::to_json(fields::from_json<drivers::CanCounters>(r["can"])), r["can"]);
+  EXPECT_EQ(fields::to_json(fields::from_json<drivers::ModbusCounters>(r["modbus"])), r["modbus"]);
+  json supervisor = r["supervisor"];
+  supervisor.erase("active_parameter_set");
+  EXPECT_EQ(fields::to_json(fields::from_json<rt::SupervisorCounters>(supervisor)), supervisor);
+  const std::string text = test::read_file(f.run_log);
+  EXPECT_NE(text.find("  CAN: " + fields::text(fields::from_json<drivers::CanCounters>(r["can"])) + "\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  Modbus: " + fields::text(fields::from_json<drivers::ModbusCounters>(r["modbus"])) + "\n"), std::string::npos) << text;
+  EXPECT_NE(text.find(std::to_string(r["can"]["rx_frames"].get<std::uint64_t>()) + " sensor frames"), std::string::npos) << text;
 
   // The same impact test in process: the bench's plant and controller at the configured K.
   const config::Config cfg = config::load_config_file(f.config);

@@ -1,0 +1,82 @@
+// The JSON form of a struct with a field list (fields/fields.hpp): an object of its fields by key, a key
+// with '/' nested ("derate/probes" is {"derate": {"probes": ...}}), and back.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+#include <nlohmann/json.hpp>
+
+#include "fields/fields.hpp"
+
+namespace robodamp::fields {
+
+namespace detail {
+// The object at the key's path (created), and the key's last part.
+inline nlohmann::json& slot(nlohmann::json& j, std::string_view key) {
+  nlohmann::json* at = &j;
+  for (std::size_t slash = key.find('/'); slash != std::string_view::npos; slash = key.find('/')) {
+    at = &(*at)[std::string(key.substr(0, slash))];
+    key.remove_prefix(slash + 1);
+  }
+  return (*at)[std::string(key)];
+}
+inline const nlohmann::json* find(const nlohmann::json& j, std::string_view key) {
+  const nlohmann::json* at = &j;
+  for (;;) {
+    const std::size_t slash = key.find('/');
+    const std::string part(key.substr(0, slash));
+    if (!at->is_object() || !at->contains(part)) return nullptr;
+    at = &at->at(part);
+    if (slash == std::string_view::npos) return at;
+    key.remove_prefix(slash + 1);
+  }
+}
+}  // namespace detail
+
+// Adds s's fields to j (an object).
+template <class S>
+void add_json(nlohmann::json& j, const S& s) {
+  for_each_field(s, [&](const auto& field, const auto& value) {
+    if constexpr (std::is_integral_v<std::decay_t<decltype(value)>>) {
+      detail::slot(j, field.key) = value;
+    } else {
+      nlohmann::json named = nlohmann::json::object();
+      for (std::size_t i = 1; i < value.size(); ++i) named[std::string(field.name_of(i))] = value[i];
+      detail::slot(j, field.key) = named;
+    }
+  });
+}
+
+template <class S>
+[[nodiscard]] nlohmann::json to_json(const S& s) {
+  nlohmann::json j = nlohmann::json::object();
+  add_json(j, s);
+  return j;
+}
+
+// s from j; a field j does not hold keeps s's value (a summary written before the field existed).
+template <class S>
+[[nodiscard]] S from_json(const nlohmann::json& j) {
+  S s{};
+  std::apply(
+      [&](const auto&... field) {
+        auto read = [&](const auto& f) {
+          const nlohmann::json* v = detail::find(j, f.key);
+          if (v == nullptr) return;
+          auto& member = s.*(f.member);
+          if constexpr (std::is_integral_v<std::decay_t<decltype(member)>>) {
+            member = v->template get<std::decay_t<decltype(member)>>();
+          } else {
+            for (std::size_t i = 1; i < member.size(); ++i)
+              member[i] = v->value(std::string(f.name_of(i)), std::uint64_t{0});
+          }
+        };
+        (read(field), ...);
+      },
+      list_of<S>());
+  return s;
+}
+
+}  // namespace robodamp::fields
