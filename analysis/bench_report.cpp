@@ -88,15 +88,15 @@ std::string Bench::verdict(const BenchReport& rep) const {
     v << " (" << dp_row->name << " " << fixed(*dp_row->measured_improvement_pct, 1) << " % measured, "
       << fixed(*dp_row->predicted_improvement_pct, 1) << " % predicted)";
   if (an.max_stable_gain_ns_per_m)
-    v << "; gain sweep " << (rep.sweep_agrees ? "agrees" : "DISAGREES") << " with K_max = "
-      << fixed(*an.max_stable_gain_ns_per_m, 0) << " N s/m";
+    v << "; gain sweep " << (rep.sweep_agrees ? "agrees" : "DISAGREES")
+      << " with K_max = " << fixed(*an.max_stable_gain_ns_per_m, 0) << " N s/m";
   double sat_min = 1e300;
   for (const auto& r : rep.rows)
     if (r.kind == "saturating") sat_min = std::min(sat_min, *r.measured_improvement_pct);
   if (sat_min < 1e300)
     v << "; " << fixed(cfg_.bench.saturating_impact_peak_n, 0) << " N impacts saturate the "
-      << fixed(model_.plant().actuator.force_limit_n, 0) << " N actuator and cut the improvement to " << fixed(sat_min, 1)
-      << " %";
+      << fixed(model_.plant().actuator.force_limit_n, 0) << " N actuator and cut the improvement to "
+      << fixed(sat_min, 1) << " %";
   return v.str();
 }
 
@@ -116,9 +116,9 @@ struct Bench::RunState {
   BenchReport rep{};
   std::vector<std::size_t> locations{};  // in the order the analysis lists the FRFs' excitations
   std::vector<ImpactTestResult> off{}, on{}, sat{};
-  std::vector<double> factors{};         // of K_max, the gain sweep's
+  std::vector<double> factors{};  // of K_max, the gain sweep's
   std::vector<BenchSweepRun> sweep{};
-  std::optional<std::size_t> dp{};       // the actuator's driving-point FRF
+  std::optional<std::size_t> dp{};  // the actuator's driving-point FRF
   int tests{0};
   [[nodiscard]] std::size_t index_of(std::size_t excitation) const {
     return static_cast<std::size_t>(std::find(locations.begin(), locations.end(), excitation) - locations.begin());
@@ -128,8 +128,12 @@ struct Bench::RunState {
 namespace {
 
 ImpactTest test_at(const config::BenchConfig& b, std::size_t location, bool on, bool saturating, double k, int pol) {
-  return ImpactTest{location, saturating ? b.saturating_impact_peak_n : b.impact_peak_n,
-                    saturating ? b.saturating_impact_duration_ms : b.impact_duration_ms, on, on ? k : 0.0, pol};
+  return ImpactTest{location,
+                    saturating ? b.saturating_impact_peak_n : b.impact_peak_n,
+                    saturating ? b.saturating_impact_duration_ms : b.impact_duration_ms,
+                    on,
+                    on ? k : 0.0,
+                    pol};
 }
 
 }  // namespace
@@ -142,15 +146,16 @@ void Bench::run_open(RunState& st) const {
   st.off.resize(nl), st.on.resize(nl), st.sat.resize(nl);
   std::vector<std::function<void()>> first{[&] { st.rep.analysis = analyse(model_, gain, pol); }};
   for (std::size_t i = 0; i < nl; ++i)
-    first.emplace_back([&, i] { st.off[i] = impact_test(test_at(cfg_.bench, st.locations[i], false, false, 0.0, pol)); });
+    first.emplace_back(
+        [&, i] { st.off[i] = impact_test(test_at(cfg_.bench, st.locations[i], false, false, 0.0, pol)); });
   run_tasks(first, st.threads);
   const auto& an = st.rep.analysis;
   st.tests = static_cast<int>(nl) * (an.stable ? 3 : 1);
   for (std::size_t i = 0; i < nl; ++i) {
     st.rep.simulated_s += st.off[i].simulated_s;
     if (st.progress)
-      st.progress(test_line(static_cast<int>(i) + 1, st.tests, test_at(cfg_.bench, st.locations[i], false, false, 0.0, pol),
-                            "control off", st.off[i]));
+      st.progress(test_line(static_cast<int>(i) + 1, st.tests,
+                            test_at(cfg_.bench, st.locations[i], false, false, 0.0, pol), "control off", st.off[i]));
   }
   const double lo = cfg_.analysis.band_min_hz, hi = cfg_.analysis.band_max_hz;
   for (const auto& f : an.frfs_discrete) {
@@ -183,7 +188,8 @@ void Bench::run_closed(RunState& st) const {
     second.emplace_back([&, i] {
       const ImpactTest t = test_at(b, st.locations[i], true, true, gain, pol);
       st.sat[i] = impact_test(t);
-      ordered.post(nl + i, test_line(static_cast<int>(2 * nl + i) + 1, st.tests, t, "control on, saturating", st.sat[i]));
+      ordered.post(nl + i,
+                   test_line(static_cast<int>(2 * nl + i) + 1, st.tests, t, "control on, saturating", st.sat[i]));
     });
   }
   for (std::size_t j = 0; j < st.factors.size(); ++j)
@@ -191,9 +197,9 @@ void Bench::run_closed(RunState& st) const {
       const double k = st.factors[j] * *an.max_stable_gain_ns_per_m;
       BenchSweepRun& sp = st.sweep[j];
       sp.run = divergence_run(k, pol);
-      ordered.post(2 * nl + j, "gain sweep K = " + fixed(k, 0) + " N s/m (" + fixed(st.factors[j], 2) + " x K_max): predicted " +
-                                   (sp.run.predicted_unstable ? "unstable" : "stable") + ", simulated " +
-                                   (sp.run.diverged ? "diverges" : "decays") + " (end/start RMS " +
+      ordered.post(2 * nl + j, "gain sweep K = " + fixed(k, 0) + " N s/m (" + fixed(st.factors[j], 2) +
+                                   " x K_max): predicted " + (sp.run.predicted_unstable ? "unstable" : "stable") +
+                                   ", simulated " + (sp.run.diverged ? "diverges" : "decays") + " (end/start RMS " +
                                    fixed(sp.run.growth_ratio, 3) + ")");
       if (st.dp && !sp.run.predicted_unstable) {
         sp.impact = impact_test({act, b.impact_peak_n, b.impact_duration_ms, true, k, pol});
@@ -236,8 +242,8 @@ void Bench::report_closed(RunState& st) const {
     rep.sweep_agrees = rep.sweep_agrees && d.diverged == d.predicted_unstable;
     if (sp.impact) {
       rep.simulated_s += sp.impact->simulated_s;
-      rep.rows.push_back(make_row(an, *st.dp, st.off[st.index_of(act)], *sp.impact, b.impact_peak_n, "sweep", d.gain_ns_per_m,
-                                  &sp.predicted[*st.dp], &sp.predicted_continuous[*st.dp]));
+      rep.rows.push_back(make_row(an, *st.dp, st.off[st.index_of(act)], *sp.impact, b.impact_peak_n, "sweep",
+                                  d.gain_ns_per_m, &sp.predicted[*st.dp], &sp.predicted_continuous[*st.dp]));
     } else if (st.dp) {
       BenchRow row;
       row.name = an.frfs_discrete[*st.dp].name;
@@ -261,7 +267,8 @@ BenchReport Bench::run(const Progress& progress, std::size_t jobs) const {
   st.rep.config = cfg_.source;
   const double gain = cfg_.controller.gain_ns_per_m;
   if (progress)
-    progress("analysing the loop (K = " + fixed(gain, 0) + " N s/m, polarity " + std::to_string(cfg_.controller.polarity) + ")");
+    progress("analysing the loop (K = " + fixed(gain, 0) + " N s/m, polarity " +
+             std::to_string(cfg_.controller.polarity) + ")");
   // Which impact locations the configured FRFs need (the analysis lists the FRFs in this order too).
   for (const auto& f : cfg_.robot.frfs) {
     const std::size_t e = model_.plant().index_of(f.excitation_location);
@@ -270,8 +277,8 @@ BenchReport Bench::run(const Progress& progress, std::size_t jobs) const {
   run_open(st);
   const auto& an = st.rep.analysis;
   if (!an.stable) {
-    st.rep.verdict = "UNSTABLE: the analysis finds the loop unstable at K = " + fixed(gain, 0) + " N s/m (spectral radius " +
-                     fixed(an.spectral_radius, 6) + "); closed-loop tests were not run";
+    st.rep.verdict = "UNSTABLE: the analysis finds the loop unstable at K = " + fixed(gain, 0) +
+                     " N s/m (spectral radius " + fixed(an.spectral_radius, 6) + "); closed-loop tests were not run";
     st.rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     return st.rep;
   }

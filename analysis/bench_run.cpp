@@ -113,7 +113,8 @@ void ImpactCampaign::after_step(std::size_t k) noexcept {
 std::vector<FrfEstimate> ImpactCampaign::receptance() const {
   FrfAccumulator acc(record_n_, cfg_.loop.rate_hz, cfg_.bench.zero_pad, Window::kRectangular,
                      cfg_.analysis.band_max_hz * 1.5, meas_.size());
-  for (int r = 0; r < records_; ++r) acc.add(force_[static_cast<std::size_t>(r)], response_[static_cast<std::size_t>(r)]);
+  for (int r = 0; r < records_; ++r)
+    acc.add(force_[static_cast<std::size_t>(r)], response_[static_cast<std::size_t>(r)]);
   std::vector<FrfEstimate> out;
   for (std::size_t l = 0; l < meas_.size(); ++l) {
     out.push_back(acc.result(l));
@@ -142,7 +143,8 @@ ImpactTestResult Bench::impact_test(const ImpactTest& t) const {
       const auto c0 = controller.counters();
       next = controller.update(s.accel_mps2);
       const auto& c1 = controller.counters();
-      if (c1.force_limited + c1.voltage_limited + c1.slew_limited > c0.force_limited + c0.voltage_limited + c0.slew_limited)
+      if (c1.force_limited + c1.voltage_limited + c1.slew_limited >
+          c0.force_limited + c0.voltage_limited + c0.slew_limited)
         ++saturated_ticks;
     }
     const auto limited0 = plant.counters().force_limited + plant.counters().voltage_clipped;
@@ -171,7 +173,8 @@ DivergenceRun Bench::divergence_run(double gain, int polarity) const {
   sim::Plant plant = make_plant();
   const double t_hit = 1.0;
   plant.add_excitation(std::make_unique<sim::ImpactHammer>(model_.actuator_location(), cfg_.bench.impact_peak_n,
-                                                           cfg_.bench.impact_duration_ms * 1e-3, std::vector<double>{t_hit}));
+                                                           cfg_.bench.impact_duration_ms * 1e-3,
+                                                           std::vector<double>{t_hit}));
   control::Controller controller(controller_params(gain, polarity));
   const auto n = static_cast<std::size_t>(std::lround(cfg_.bench.sweep_duration_s * fs));
   const auto win = static_cast<std::size_t>(std::lround(d.window_s * fs));
@@ -182,7 +185,8 @@ DivergenceRun Bench::divergence_run(double gain, int polarity) const {
   for (std::size_t k = 0; k < n; ++k) {
     const auto c0 = controller.counters().force_limited + controller.counters().voltage_limited;
     const double next = controller.update(plant.sense().accel_mps2);
-    if (controller.counters().force_limited + controller.counters().voltage_limited > c0) ++saturated, sat_in_window = true;
+    if (controller.counters().force_limited + controller.counters().voltage_limited > c0)
+      ++saturated, sat_in_window = true;
     plant.step(command);
     command = next;
     d.peak_actuator_force_n = std::max(d.peak_actuator_force_n, std::abs(plant.actuator_force_n()));

@@ -31,7 +31,7 @@ struct ImpactTest {
 struct ImpactTestResult {
   std::vector<FrfEstimate> receptance;  // per response location (measurement accelerometers, H1 / -w^2)
   double peak_actuator_force_n{0.0};
-  double peak_command_v{0.0};      // largest |command| the controller sent (after its limits)
+  double peak_command_v{0.0};     // largest |command| the controller sent (after its limits)
   double saturation_time_s{0.0};  // loop ticks at a controller or actuator limit
   double simulated_s{0.0};
   double wall_s{0.0};
@@ -81,13 +81,13 @@ struct DivergenceRun {
   bool predicted_unstable{false};
   double predicted_growth_per_s{0.0};  // fs ln(spectral radius)
   bool diverged{false};
-  double growth_ratio{0.0};             // command RMS at the end / just after the impact
-  double measured_growth_per_s{0.0};    // slope of ln RMS after the impact, before any saturation (NaN if
-                                        // the loop saturated too soon to measure it)
+  double growth_ratio{0.0};           // command RMS at the end / just after the impact
+  double measured_growth_per_s{0.0};  // slope of ln RMS after the impact, before any saturation (NaN if
+                                      // the loop saturated too soon to measure it)
   bool final_window_saturated{false};
   double peak_actuator_force_n{0.0};
   double saturation_time_s{0.0};
-  std::vector<double> envelope_v;       // command RMS per window
+  std::vector<double> envelope_v;  // command RMS per window
   double window_s{0.25};
 };
 
@@ -105,7 +105,7 @@ struct BenchRow {
   double gain_ns_per_m{0.0};
   double impact_peak_n{0.0};
   std::optional<double> measured_improvement_pct;
-  std::optional<double> predicted_improvement_pct;            // discrete loop that runs
+  std::optional<double> predicted_improvement_pct;             // discrete loop that runs
   std::optional<double> predicted_continuous_improvement_pct;  // docs/physics.md equations
   bool saturated{false};
   double saturation_time_s{0.0};

@@ -22,18 +22,25 @@ std::string format_hz(double v) {
 
 TransferFunction analog_of(const config::BlockConfig& b, const config::ActuatorConfig& act) {
   switch (b.kind) {
-    case BlockKind::kLowpass2: return filters::lowpass2(b.cutoff_hz, b.damping_ratio);
-    case BlockKind::kHighpass2: return filters::highpass2(b.cutoff_hz, b.damping_ratio);
-    case BlockKind::kNotch: return filters::notch(b.center_hz, b.bandwidth_hz);
-    case BlockKind::kIntegrator: return filters::integrator(b.leak_hz);
+    case BlockKind::kLowpass2:
+      return filters::lowpass2(b.cutoff_hz, b.damping_ratio);
+    case BlockKind::kHighpass2:
+      return filters::highpass2(b.cutoff_hz, b.damping_ratio);
+    case BlockKind::kNotch:
+      return filters::notch(b.center_hz, b.bandwidth_hz);
+    case BlockKind::kIntegrator:
+      return filters::integrator(b.leak_hz);
     case BlockKind::kCompensator:
       switch (b.model) {
         case config::CompensatorModel::kC1:
           return filters::compensator_c1(act.natural_freq_hz, act.damping_ratio, b.corner_hz, b.corner_damping_ratio);
-        case config::CompensatorModel::kC2: return filters::compensator_c2();
-        case config::CompensatorModel::kC3: return filters::compensator_c3();
+        case config::CompensatorModel::kC2:
+          return filters::compensator_c2();
+        case config::CompensatorModel::kC3:
+          return filters::compensator_c3();
         case config::CompensatorModel::kRational:
-          return {filters::Polynomial::from_descending(b.numerator), filters::Polynomial::from_descending(b.denominator)};
+          return {filters::Polynomial::from_descending(b.numerator),
+                  filters::Polynomial::from_descending(b.denominator)};
       }
   }
   return {};
@@ -49,11 +56,12 @@ void choose_match_frequency(const config::Config& cfg, ChainDesign& d, Problems&
   } else if (auto dom = modal::dominant_mode_hz(cfg.robot, cfg.actuator.location)) {
     d.match_freq_hz = *dom;
   } else {
-    const bool needs = std::any_of(chain.begin(), chain.end(), [](const auto& b) {
-      return b.kind == BlockKind::kCompensator && !b.prewarp_hz;
-    });
+    const bool needs = std::any_of(chain.begin(), chain.end(),
+                                   [](const auto& b) { return b.kind == BlockKind::kCompensator && !b.prewarp_hz; });
     if (needs)
-      problems.push_back({cfg.source, {}, "controller.match_freq_hz",
+      problems.push_back({cfg.source,
+                          {},
+                          "controller.match_freq_hz",
                           "missing: compensators are pre-warped at the dominant robot mode, and there is no robot "
                           "modal data; set match_freq_hz (Hz, below Nyquist)"});
   }
@@ -67,14 +75,20 @@ void analog_blocks(const config::Config& cfg, std::ptrdiff_t partner, ChainDesig
     ChainBlock cb{b.name, b.kind, analog_of(b, cfg.actuator), 0.0, 0};
     switch (b.kind) {
       case BlockKind::kLowpass2:
-      case BlockKind::kHighpass2: cb.prewarp_hz = b.cutoff_hz; break;
-      case BlockKind::kNotch: cb.prewarp_hz = b.center_hz; break;
+      case BlockKind::kHighpass2:
+        cb.prewarp_hz = b.cutoff_hz;
+        break;
+      case BlockKind::kNotch:
+        cb.prewarp_hz = b.center_hz;
+        break;
       case BlockKind::kIntegrator:
         cb.prewarp_hz = partner >= 0 ? chain[static_cast<std::size_t>(partner)].prewarp_hz.value_or(
                                            chain[static_cast<std::size_t>(partner)].cutoff_hz)
                                      : d.match_freq_hz;
         break;
-      case BlockKind::kCompensator: cb.prewarp_hz = d.match_freq_hz; break;
+      case BlockKind::kCompensator:
+        cb.prewarp_hz = d.match_freq_hz;
+        break;
     }
     if (b.prewarp_hz) cb.prewarp_hz = *b.prewarp_hz;
     d.blocks.push_back(std::move(cb));
@@ -151,7 +165,8 @@ void fill_params(const config::Config& cfg, const std::vector<filters::BiquadCoe
       if (p.speed_band_count == ControllerParams::kMaxSpeedBands) break;  // the configuration refuses more
       // The band's controller is its parameter set: 0 this configuration's, i the schedule's controllers[i - 1]
       // (the cell adds them in that order, right after set 0).
-      p.speed_bands[p.speed_band_count++] = {b.rpm_min, b.rpm_max, b.gain_ns_per_m, static_cast<std::size_t>(b.controller)};
+      p.speed_bands[p.speed_band_count++] = {b.rpm_min, b.rpm_max, b.gain_ns_per_m,
+                                             static_cast<std::size_t>(b.controller)};
     }
 }
 
@@ -179,7 +194,9 @@ ChainDesign design_chain(const config::Config& cfg) {
     gain *= g.digital.gain;
   }
   if (problems.empty() && sections.size() > filters::kMaxSections)
-    problems.push_back({cfg.source, {}, "controller.chain",
+    problems.push_back({cfg.source,
+                        {},
+                        "controller.chain",
                         "needs " + std::to_string(sections.size()) + " second-order sections, at most " +
                             std::to_string(filters::kMaxSections) + " are supported"});
   if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
@@ -194,8 +211,9 @@ Complex ChainDesign::filters_analog(double f_hz) const {
 }
 
 Complex ChainDesign::filters_digital(double f_hz) const {
-  std::vector<filters::BiquadCoefficients> v(params.sections.sections.begin(),
-                                             params.sections.sections.begin() + static_cast<std::ptrdiff_t>(params.sections.count));
+  std::vector<filters::BiquadCoefficients> v(
+      params.sections.sections.begin(),
+      params.sections.sections.begin() + static_cast<std::ptrdiff_t>(params.sections.count));
   return filters::digital_response(v, params.sections_gain, f_hz, params.fs_hz);
 }
 

@@ -34,7 +34,7 @@ struct ChainDesign {
   std::string source;
   std::vector<ChainBlock> blocks;  // in configured order
   std::vector<RealisedGroup> groups;
-  double match_freq_hz{0.0};       // default pre-warp of compensators
+  double match_freq_hz{0.0};         // default pre-warp of compensators
   control::ControllerParams params;  // what the real-time controller runs
 
   // Responses of the filter blocks only (accel in, shaped velocity out; no K, polarity, 1/T).

@@ -19,8 +19,8 @@ class GainPath {
   [[nodiscard]] double spectral_radius(double gain_ns_per_m, int polarity) const;
 
  private:
-  Eigen::MatrixXd h_;            // Q^T A Q, upper Hessenberg
-  Eigen::RowVectorXd first_row_; // beta (c Q): the closed loop adds K polarity times this to H's first row
+  Eigen::MatrixXd h_;             // Q^T A Q, upper Hessenberg
+  Eigen::RowVectorXd first_row_;  // beta (c Q): the closed loop adds K polarity times this to H's first row
 };
 
 }  // namespace robodamp::analysis

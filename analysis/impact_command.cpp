@@ -9,9 +9,7 @@
 namespace robodamp::analysis {
 
 ImpactCommand::ImpactCommand(const LoopModel& plant, double peak_n, double duration_s, std::size_t samples)
-    : fs_(plant.loop_rate_hz()),
-      locations_(plant.plant().locations.size()),
-      inverse_(samples) {
+    : fs_(plant.loop_rate_hz()), locations_(plant.plant().locations.size()), inverse_(samples) {
   if (samples < 1024 || (samples & (samples - 1)) != 0)
     throw std::invalid_argument("ImpactCommand: the record must be a power of two of at least 1024 samples");
   const double t = 1.0 / fs_;
@@ -35,7 +33,8 @@ CommandPeak ImpactCommand::peak(const LoopModel& m, double gain, int polarity) {
     Complex* v = inverse_.input();
     v[0] = 0.0;
     for (std::size_t k = 0; k < responses_.size(); ++k)
-      v[k + 1] = m.command_per_force(responses_[k], chain[k], h, gain, polarity) * force_[k + 1] / static_cast<double>(n);
+      v[k + 1] =
+          m.command_per_force(responses_[k], chain[k], h, gain, polarity) * force_[k + 1] / static_cast<double>(n);
     const double* x = inverse_.inverse();
     double peak = 0.0, slew = 0.0, tail = 0.0;
     std::size_t at = 0;

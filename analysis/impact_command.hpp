@@ -37,8 +37,8 @@ class ImpactCommand {
  private:
   double fs_;
   std::size_t locations_;
-  std::vector<PlantResponse> responses_;      // per bin from 1 (DC carries no command)
-  std::vector<std::complex<double>> force_;   // per bin: the DFT of the held force samples
+  std::vector<PlantResponse> responses_;     // per bin from 1 (DC carries no command)
+  std::vector<std::complex<double>> force_;  // per bin: the DFT of the held force samples
   RealInverseFft inverse_;
 };
 

@@ -26,7 +26,8 @@ std::vector<double> linear_grid(double lo, double hi, double step) {
   return g;
 }
 
-Peak find_peak(const std::vector<double>& grid, const std::vector<double>& v, const std::function<double(double)>& refine) {
+Peak find_peak(const std::vector<double>& grid, const std::vector<double>& v,
+               const std::function<double(double)>& refine) {
   Peak best{grid.front(), v.front()};
   const std::size_t n = grid.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -247,8 +248,9 @@ AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
     std::ostringstream os;
     os.precision(3);
     os << "at the dominant mode " << dominant << " Hz the feedback force with polarity +1 is at "
-       << std::arg(c_plus) * 180.0 / M_PI << " deg from -velocity: "
-       << (r.recommended_polarity == 1 ? "inside" : "outside") << " the damping window (-90, 90) deg";
+       << std::arg(c_plus) * 180.0 / M_PI
+       << " deg from -velocity: " << (r.recommended_polarity == 1 ? "inside" : "outside")
+       << " the damping window (-90, 90) deg";
     r.polarity_reason = os.str();
   }
   if (r.recommended_polarity != polarity)

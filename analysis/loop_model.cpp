@@ -170,15 +170,15 @@ SampledPaths LoopModel::sampled_paths(const std::vector<std::size_t>& locations,
 
 Complex LoopModel::notch_response(double f_hz) const {
   if (notches_.count == 0) return 1.0;
-  const std::vector<filters::BiquadCoefficients> v(notches_.sections.begin(),
-                                                   notches_.sections.begin() + static_cast<std::ptrdiff_t>(notches_.count));
+  const std::vector<filters::BiquadCoefficients> v(
+      notches_.sections.begin(), notches_.sections.begin() + static_cast<std::ptrdiff_t>(notches_.count));
   return filters::digital_response(v, 1.0, f_hz, cfg_.loop.rate_hz);
 }
 
 Complex LoopModel::feedback_continuous(double f_hz, double gain, int polarity) const {
   const Complex s(0.0, kTwoPi * f_hz);
-  return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_analog(f_hz) * notch_response(f_hz) *
-         plant_.actuator.n_per_v(f_hz) * sensor_model_.analog_response(f_hz) * s * s;
+  return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_analog(f_hz) *
+         notch_response(f_hz) * plant_.actuator.n_per_v(f_hz) * sensor_model_.analog_response(f_hz) * s * s;
 }
 
 Complex LoopModel::loop_continuous(double f_hz, double gain, int polarity) const {
@@ -227,23 +227,24 @@ PlantResponse LoopModel::plant_response(double f_hz) const {
   for (Eigen::Index g = 0; g < nl; ++g) {
     p.accel_per_volt[static_cast<std::size_t>(g)] = (y(g, 0) + d_accel_coil_(g, 0) * zi) * delay;
     for (Eigen::Index h = 0; h < nl; ++h)
-      p.accel_per_force[static_cast<std::size_t>(g)][static_cast<std::size_t>(h)] = y(g, 1 + h) + d_accel_force_(g, h) * zi;
+      p.accel_per_force[static_cast<std::size_t>(g)][static_cast<std::size_t>(h)] =
+          y(g, 1 + h) + d_accel_force_(g, h) * zi;
   }
   return p;
 }
 
 namespace {
 // Volts per m/s^2 of sampled acceleration that the controller commands, with the computation delay.
-Complex discrete_feedback(const PlantResponse& p, Complex filters, double gain, int polarity, double fs, double t_n_per_v,
-                          Complex sensor) {
+Complex discrete_feedback(const PlantResponse& p, Complex filters, double gain, int polarity, double fs,
+                          double t_n_per_v, Complex sensor) {
   const Complex zi = std::exp(Complex(0.0, -kTwoPi * p.f_hz / fs));
   return zi * (polarity * gain / t_n_per_v) * filters * sensor;
 }
 }  // namespace
 
 Complex LoopModel::loop_discrete(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
-                                     sensor_model_.response(p.f_hz));
+  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
+                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
   return -q * p.accel_per_volt[sensor_];
 }
 
@@ -258,8 +259,8 @@ Complex LoopModel::open_discrete(const PlantResponse& p, std::size_t g, std::siz
 
 Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std::size_t g, std::size_t h, double gain,
                                    int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
-                                      sensor_model_.response(p.f_hz));
+  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
+                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
   const Complex a = p.accel_per_force[g][h] +
                     p.accel_per_volt[g] * q * p.accel_per_force[sensor_][h] / (1.0 - q * p.accel_per_volt[sensor_]);
   const double w = kTwoPi * p.f_hz;
@@ -268,21 +269,21 @@ Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std:
 
 Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, std::size_t h, double gain,
                                      int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
-                                      sensor_model_.response(p.f_hz));
+  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
+                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
   return q * p.accel_per_force[sensor_][h] / (1.0 - q * p.accel_per_volt[sensor_]);
 }
 
 Complex LoopModel::command_per_sensor_noise(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const Complex q_noise = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                           chain_.params.actuator_constant_n_per_v, 1.0);
+  const Complex q_noise =
+      discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v, 1.0);
   const Complex q = q_noise * sensor_model_.response(p.f_hz);
   return q_noise / (1.0 - q * p.accel_per_volt[sensor_]);
 }
 
 Complex LoopModel::command_per_open_accel(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
-                                     sensor_model_.response(p.f_hz));
+  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
+                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
   return q / (1.0 - q * p.accel_per_volt[sensor_]);
 }
 

@@ -43,7 +43,7 @@ struct SampledPaths {
 // coil voltage and per held external force at each location (sample at t_k per input held over [k, k+1)).
 struct PlantResponse {
   double f_hz{0.0};
-  std::vector<Complex> accel_per_volt;              // [location]
+  std::vector<Complex> accel_per_volt;                // [location]
   std::vector<std::vector<Complex>> accel_per_force;  // [response][excitation]
 };
 
@@ -116,7 +116,9 @@ class LoopModel {
   [[nodiscard]] Eigen::MatrixXd closed_loop_matrix(double gain_ns_per_m, int polarity) const;
   [[nodiscard]] Eigen::VectorXcd closed_loop_poles(double gain_ns_per_m, int polarity) const;
   [[nodiscard]] double spectral_radius(double gain_ns_per_m, int polarity) const;
-  [[nodiscard]] bool stable(double gain_ns_per_m, int polarity) const { return spectral_radius(gain_ns_per_m, polarity) < 1.0; }
+  [[nodiscard]] bool stable(double gain_ns_per_m, int polarity) const {
+    return spectral_radius(gain_ns_per_m, polarity) < 1.0;
+  }
   // Controller output -> controller output at K = 1, polarity +1: the closed loop is a + polarity K b c.
   [[nodiscard]] const DiscreteSs& open_loop_unit() const { return open_loop_unit_; }
   // Net clockwise encirclements of -1 by L(e^{jwT}) over the whole unit circle (0 for a stable loop,
@@ -136,7 +138,7 @@ class LoopModel {
   // Loop-rate discretisation of the plant with the actuator delay.
   Eigen::MatrixXd phi_, gamma_late_, gamma_early_, gamma_force_, c_accel_, d_accel_coil_, d_accel_force_;
   int delay_steps_{0};
-  Resolvent resolvent_;  // c_accel_ (z I - phi_)^-1 [gamma_late_, gamma_early_, gamma_force_]
+  Resolvent resolvent_;        // c_accel_ (z I - phi_)^-1 [gamma_late_, gamma_early_, gamma_force_]
   DiscreteSs open_loop_unit_;  // controller output -> controller output at K = 1, polarity +1 (no gain yet)
   // The same, with the last held force at force_at as one more plant state (sampled_path).
   [[nodiscard]] DiscreteSs open_loop(const std::vector<std::size_t>& forces_at) const;
@@ -145,12 +147,12 @@ class LoopModel {
 // --- Results -------------------------------------------------------------------------------------
 
 struct FrfResult {
-  std::string name;           // as configured (e.g. H22yy)
+  std::string name;  // as configured (e.g. H22yy)
   std::size_t response{0}, excitation{0};
   double open_peak_m_per_n{0.0};
   double closed_peak_m_per_n{0.0};
   double open_peak_freq_hz{0.0};
-  double peak_freq_hz{0.0};   // of the closed-loop peak
+  double peak_freq_hz{0.0};  // of the closed-loop peak
   double improvement_pct{0.0};
 };
 
@@ -161,11 +163,11 @@ struct ModePhase {
 };
 
 struct Margins {
-  std::optional<double> gain_margin_db;     // 20 log10(K_max / K); none if stable up to the gain limit
-  std::optional<double> phase_margin_deg;   // smallest angular distance of L from -1 at a gain crossover
+  std::optional<double> gain_margin_db;    // 20 log10(K_max / K); none if stable up to the gain limit
+  std::optional<double> phase_margin_deg;  // smallest angular distance of L from -1 at a gain crossover
   std::optional<double> phase_crossover_hz;
   std::optional<double> gain_crossover_hz;
-  std::optional<double> delay_margin_ms;    // smallest extra pure delay that turns L onto -1 at a crossover
+  std::optional<double> delay_margin_ms;  // smallest extra pure delay that turns L onto -1 at a crossover
 };
 
 struct AnalysisResult {
@@ -215,8 +217,7 @@ struct SweepPoint {
 
 // Smallest K > 0 at which the discrete loop becomes unstable (log scan, then bisection to 1e-6).
 [[nodiscard]] std::optional<double> max_stable_gain(const LoopModel& m, int polarity);
-[[nodiscard]] Margins margins(const LoopModel& m, double gain_ns_per_m, int polarity,
-                              std::optional<double> max_gain);
+[[nodiscard]] Margins margins(const LoopModel& m, double gain_ns_per_m, int polarity, std::optional<double> max_gain);
 [[nodiscard]] std::vector<FrfResult> improvements(const LoopModel& m, double gain_ns_per_m, int polarity,
                                                   bool discrete);
 // Phase of the feedback force against the velocity at each mode of the loop's own FRF (continuous loop).

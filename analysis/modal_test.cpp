@@ -9,8 +9,8 @@
 namespace robodamp::analysis {
 
 namespace {
-constexpr double kMaxGapS = 1.0;   // ImpactCampaign: each hit after a seeded gap of up to 1 s
-constexpr double kTailS = 1.0;     // after the last record
+constexpr double kMaxGapS = 1.0;  // ImpactCampaign: each hit after a seeded gap of up to 1 s
+constexpr double kTailS = 1.0;    // after the last record
 constexpr int kAmplitudeGrid = 2000;
 }  // namespace
 
@@ -71,9 +71,7 @@ int ModalTest::records() const {
   return n;
 }
 
-int ModalTest::records_planned() const {
-  return static_cast<int>(campaigns_.size()) * cfg_.bench.averages;
-}
+int ModalTest::records_planned() const { return static_cast<int>(campaigns_.size()) * cfg_.bench.averages; }
 
 std::vector<std::vector<FrfEstimate>> ModalTest::receptance() const {
   std::vector<std::vector<FrfEstimate>> out;

@@ -22,7 +22,7 @@ namespace robodamp::analysis {
 struct CommissioningPlan {
   double chirp_start_s{0.0}, chirp_end_s{0.0};
   double chirp_amplitude_v{0.0};
-  double predicted_peak_force_n{0.0};  // by the configured actuator (Eq. 3) at the chirp's amplitude
+  double predicted_peak_force_n{0.0};   // by the configured actuator (Eq. 3) at the chirp's amplitude
   std::vector<double> impacts_start_s;  // per location index: the first record's earliest start
   double duration_s{0.0};               // the run: every record complete, plus a second
 };

@@ -17,8 +17,9 @@ std::vector<ModeImprovement> mode_improvements(const LoopModel& m, double gain_n
     for (double f = 0.9 * mi.freq_hz; f <= 1.1 * mi.freq_hz; f += 0.005 * mi.freq_hz) {
       const PlantResponse p = m.plant_response(f);
       mi.open_peak_m_per_n = std::max(mi.open_peak_m_per_n, std::abs(m.open_discrete(p, g, h)));
-      mi.closed_peak_m_per_n = std::max(
-          mi.closed_peak_m_per_n, std::abs(m.closed_discrete(p, m.chain_filters_digital(f), g, h, gain_ns_per_m, polarity)));
+      mi.closed_peak_m_per_n =
+          std::max(mi.closed_peak_m_per_n,
+                   std::abs(m.closed_discrete(p, m.chain_filters_digital(f), g, h, gain_ns_per_m, polarity)));
     }
     mi.improvement_pct = 100.0 * (mi.open_peak_m_per_n / mi.closed_peak_m_per_n - 1.0);
     out.push_back(mi);
@@ -30,7 +31,8 @@ std::optional<ModeImprovement> worst_mode(const std::vector<ModeImprovement>& mo
                                           bool inside) {
   std::optional<ModeImprovement> out;
   for (const ModeImprovement& mi : modes)
-    if ((mi.freq_hz >= min_hz && mi.freq_hz <= max_hz) == inside && (!out || mi.improvement_pct < out->improvement_pct)) out = mi;
+    if ((mi.freq_hz >= min_hz && mi.freq_hz <= max_hz) == inside && (!out || mi.improvement_pct < out->improvement_pct))
+      out = mi;
   return out;
 }
 

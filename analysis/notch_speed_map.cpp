@@ -10,11 +10,11 @@ namespace robodamp::analysis {
 
 namespace {
 
-
 // Damping at each mode of the loop's own path: the feedback force against -velocity in (-90, 90) deg.
 std::vector<bool> damps(const LoopModel& m, const std::vector<double>& modes_hz, double gain, int polarity) {
   std::vector<bool> out;
-  for (double f : modes_hz) out.push_back((-m.feedback_continuous(f, gain, polarity) / Complex(0.0, kTwoPi * f)).real() > 0.0);
+  for (double f : modes_hz)
+    out.push_back((-m.feedback_continuous(f, gain, polarity) / Complex(0.0, kTwoPi * f)).real() > 0.0);
   return out;
 }
 
@@ -46,12 +46,14 @@ NotchSpeedMap notch_speed_map(const config::Config& cfg, int points) {
       p.notch_phase_deg.push_back(std::arg(m.notch_response(modes_hz[k])) * 180.0 / M_PI);
       if (base[k] && !now[k] && p.reason.empty()) {
         char b[160];
-        std::snprintf(b, sizeof b, "the notches push the %.2f Hz mode out of its damping window (%.1f deg)", modes_hz[k],
-                      p.notch_phase_deg.back());
+        std::snprintf(b, sizeof b, "the notches push the %.2f Hz mode out of its damping window (%.1f deg)",
+                      modes_hz[k], p.notch_phase_deg.back());
         p.reason = b;
       }
     }
-    if (!p.stable) p.reason = "the loop is unstable at K with the notches here (spectral radius " + std::to_string(p.spectral_radius) + ")";
+    if (!p.stable)
+      p.reason =
+          "the loop is unstable at K with the notches here (spectral radius " + std::to_string(p.spectral_radius) + ")";
     p.refused = !p.reason.empty();
     map.points.push_back(std::move(p));
   }
@@ -61,7 +63,8 @@ NotchSpeedMap notch_speed_map(const config::Config& cfg, int points) {
     if (!pts[i].refused) continue;
     std::size_t j = i;
     while (j + 1 < pts.size() && pts[j + 1].refused) ++j;
-    map.refused_rpm.emplace_back(i > 0 ? pts[i - 1].rpm : 0.0, j + 1 < pts.size() ? pts[j + 1].rpm : cfg.spindle.rpm_max);
+    map.refused_rpm.emplace_back(i > 0 ? pts[i - 1].rpm : 0.0,
+                                 j + 1 < pts.size() ? pts[j + 1].rpm : cfg.spindle.rpm_max);
     i = j;
   }
   return map;

@@ -22,7 +22,8 @@ int nearest(const std::vector<config::ModeConfig>& modes, double f_hz) {
 
 }  // namespace
 
-std::vector<ModeCheckRow> check_pose_modes(const config::RobotModelConfig& prior, const config::RobotModelConfig& mapped,
+std::vector<ModeCheckRow> check_pose_modes(const config::RobotModelConfig& prior,
+                                           const config::RobotModelConfig& mapped,
                                            const std::vector<config::MeasuredPoseModes>& poses, bool held_out, int axis,
                                            int count) {
   std::vector<ModeCheckRow> rows;
@@ -61,9 +62,10 @@ std::vector<ModeCheckRow> check_pose_modes(const config::RobotModelConfig& prior
   return rows;
 }
 
-std::vector<ModeSweepPoint> sweep_pose_modes(const config::RobotModelConfig& prior, const config::RobotModelConfig& mapped,
-                                             const std::vector<double>& base_deg, std::size_t joint, int steps, int axis,
-                                             int count) {
+std::vector<ModeSweepPoint> sweep_pose_modes(const config::RobotModelConfig& prior,
+                                             const config::RobotModelConfig& mapped,
+                                             const std::vector<double>& base_deg, std::size_t joint, int steps,
+                                             int axis, int count) {
   std::vector<ModeSweepPoint> out;
   const config::RobotJointConfig& j = mapped.joints.at(joint);
   for (int i = 0; i < steps; ++i) {

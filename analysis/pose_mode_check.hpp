@@ -25,8 +25,8 @@ struct ModeCheckRow {
 // prior: the model alone (no measured_modes); mapped: the same model with them. One row per measured mode.
 [[nodiscard]] std::vector<ModeCheckRow> check_pose_modes(const config::RobotModelConfig& prior,
                                                          const config::RobotModelConfig& mapped,
-                                                         const std::vector<config::MeasuredPoseModes>& poses, bool held_out,
-                                                         int axis, int count);
+                                                         const std::vector<config::MeasuredPoseModes>& poses,
+                                                         bool held_out, int axis, int count);
 
 // The modes along one joint's travel, the others held at base_deg: the model's and the mapped ones with their
 // one-sigma frequency spread (the picture of where the measurements hold the map and where the model alone
@@ -35,8 +35,9 @@ struct ModeSweepPoint {
   double joint_deg{0.0};
   std::vector<double> model_hz, mapped_hz, freq_sigma_pct;
 };
-[[nodiscard]] std::vector<ModeSweepPoint> sweep_pose_modes(const config::RobotModelConfig& prior, const config::RobotModelConfig& mapped,
-                                                           const std::vector<double>& base_deg, std::size_t joint, int steps,
-                                                           int axis, int count);
+[[nodiscard]] std::vector<ModeSweepPoint> sweep_pose_modes(const config::RobotModelConfig& prior,
+                                                           const config::RobotModelConfig& mapped,
+                                                           const std::vector<double>& base_deg, std::size_t joint,
+                                                           int steps, int axis, int count);
 
 }  // namespace robodamp::analysis

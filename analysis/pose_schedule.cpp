@@ -75,10 +75,14 @@ std::vector<std::vector<double>> region_grid(const config::PoseRegionConfig& r, 
 PoseModes pose_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
   PoseModes out;
   const std::vector<robot::AxisMode> prior = robot::axis_modes(model, q, axis, count);
-  for (const robot::AxisMode& md : prior) out.modes.push_back(config::stiffness_mode(md.freq_hz, md.damping_ratio, md.stiffness_n_per_m));
+  for (const robot::AxisMode& md : prior)
+    out.modes.push_back(config::stiffness_mode(md.freq_hz, md.damping_ratio, md.stiffness_n_per_m));
   if (out.modes.empty())
-    throw config::ConfigError({config::Problem{model.source, {}, "pose", "no mode of " + model.name + " at " +
-                                                                             config::describe_pose(q) + " moves the TCP along the axis"}});
+    throw config::ConfigError({config::Problem{
+        model.source,
+        {},
+        "pose",
+        "no mode of " + model.name + " at " + config::describe_pose(q) + " moves the TCP along the axis"}});
   if (model.measured_modes) {  // the mapped modes in place of the model's (robot::ModalMap)
     const std::shared_ptr<const robot::ModalMap> map = modal_map_for(model, axis, count);
     out.corrections = map->at(q, prior);
@@ -102,7 +106,7 @@ config::Config config_at_pose(const config::Config& base, const PoseModes& modes
 }
 
 config::Config config_in_plane_at_pose(const config::Config& base, const config::RobotModelConfig& model,
-                                      const std::vector<double>& q, int axis, int count) {
+                                       const std::vector<double>& q, int axis, int count) {
   // The same refusals (travel, no mode along the axis); its corrections from measured modes apply in the
   // plane too: the frequency and damping as they are; the shape along the axis as the measured stiffness along
   // it says (w^2 / k), the shape across it the model's (nothing measured it; scaling it alike made a mode the
@@ -114,7 +118,8 @@ config::Config config_in_plane_at_pose(const config::Config& base, const config:
   c.robot.locations = {{1, "TCP along the actuator", 1}, {2, "TCP across", 1}};
   c.robot.frfs.clear();
   const int across = 1 - axis;
-  for (const auto& [name, response, excitation] : {std::tuple{"H11", 1, 1}, std::tuple{"H21", 2, 1}, std::tuple{"H22", 2, 2}}) {
+  for (const auto& [name, response, excitation] :
+       {std::tuple{"H11", 1, 1}, std::tuple{"H21", 2, 1}, std::tuple{"H22", 2, 2}}) {
     config::FrfConfig f;
     f.name = name;
     f.response_location = response, f.excitation_location = excitation;
@@ -135,7 +140,8 @@ config::Config config_in_plane_at_pose(const config::Config& base, const config:
       // Mass-normalised shapes at the mapped frequency: along the axis from the mapped stiffness along it,
       // across it the model's.
       const double w_mapped = kTwoPi * m.natural_freq_hz;
-      const double phi_along = md.tcp_shape(axis), k_along = moves_along ? w * w / (phi_along * phi_along) * corr.stiffness_scale : 0.0;
+      const double phi_along = md.tcp_shape(axis),
+                   k_along = moves_along ? w * w / (phi_along * phi_along) * corr.stiffness_scale : 0.0;
       const auto shape = [&](int location) {
         if (location == 2) return md.tcp_shape(across);
         return moves_along ? std::copysign(w_mapped / std::sqrt(k_along), phi_along) : phi_along;
@@ -163,8 +169,8 @@ void with_region_compensator(config::Config& set, const config::RegionCompensato
     b.denominator = c.denominator;
     return;
   }
-  throw config::ConfigError({config::Problem{set.source, {}, "controller.chain",
-                                             "has no compensator block for a pose region's compensator to replace"}});
+  throw config::ConfigError({config::Problem{
+      set.source, {}, "controller.chain", "has no compensator block for a pose region's compensator to replace"}});
 }
 
 RegionSet design_region(const config::Config& cfg, const config::RobotModelConfig& model, std::size_t i) {
@@ -212,15 +218,18 @@ void check_region(const config::Config& cfg, const config::RobotModelConfig& mod
     if (k_max < set.k_max_ns_per_m) set.k_max_ns_per_m = k_max, set.k_max_pose_deg = q;
     ++set.grid_poses;
     const std::string where = "region '" + set.name + "' at " + config::describe_pose(q) + " (dominant mode " +
-                              fmt(pm.dominant_hz()) + " Hz; the set is matched at " + fmt(set.dominant_hz) + " Hz, polarity " +
-                              std::to_string(set.polarity) + ")";
+                              fmt(pm.dominant_hz()) + " Hz; the set is matched at " + fmt(set.dominant_hz) +
+                              " Hz, polarity " + std::to_string(set.polarity) + ")";
     if (!m.stable(set.gain_ns_per_m, set.polarity))
-      throw region_error(cfg, i, "has no stable set: " + where + " the loop is unstable at K = " + fmt(set.gain_ns_per_m) +
-                                     " N s/m (K_max there " + fmt(k_max) + " N s/m): split the region or lower its gain_ns_per_m");
+      throw region_error(cfg, i,
+                         "has no stable set: " + where + " the loop is unstable at K = " + fmt(set.gain_ns_per_m) +
+                             " N s/m (K_max there " + fmt(k_max) +
+                             " N s/m): split the region or lower its gain_ns_per_m");
     if (set.gain_ns_per_m > fraction * k_max)
-      throw region_error(cfg, i, "has no set with margin: " + where + " K = " + fmt(set.gain_ns_per_m) +
-                                     " N s/m is above supervision.max_gain_fraction x K_max = " + fmt(fraction) + " x " +
-                                     fmt(k_max) + " N s/m: split the region or lower its gain_ns_per_m");
+      throw region_error(cfg, i,
+                         "has no set with margin: " + where + " K = " + fmt(set.gain_ns_per_m) +
+                             " N s/m is above supervision.max_gain_fraction x K_max = " + fmt(fraction) + " x " +
+                             fmt(k_max) + " N s/m: split the region or lower its gain_ns_per_m");
     if (band.add(mode_improvements(m, set.gain_ns_per_m, set.polarity), s.damping_band_min_hz, s.damping_band_max_hz))
       set.worst_mode_pose_deg = q;
   }

@@ -27,10 +27,10 @@ namespace robodamp::analysis {
 // The robot model's modes at a pose along one axis, lowest first. When the model file has measured_modes
 // (robodamp pose modes), they are the mapped modes (robot::ModalMap), lowest first, each with its uncertainty.
 struct PoseModes {
-  std::vector<config::ModeConfig> modes;  // modal-stiffness form, damping from each mode's loss factor / 2
-  std::size_t dominant{0};                // the largest peak receptance along the axis (smallest k zeta)
+  std::vector<config::ModeConfig> modes;           // modal-stiffness form, damping from each mode's loss factor / 2
+  std::size_t dominant{0};                         // the largest peak receptance along the axis (smallest k zeta)
   std::vector<robot::ModeCorrection> corrections;  // one per mode; empty: the model alone
-  double nearest_measured_deg{0.0};       // with corrections: the joint-space distance to the nearest measured pose
+  double nearest_measured_deg{0.0};  // with corrections: the joint-space distance to the nearest measured pose
   [[nodiscard]] double dominant_hz() const { return modes.empty() ? 0.0 : modes[dominant].natural_freq_hz; }
 };
 // Throws config::ConfigError (a pose outside the travel) or std::invalid_argument (a non-physical model, or
@@ -63,14 +63,14 @@ void with_region_compensator(config::Config& set, const config::RegionCompensato
 struct RegionSet {
   std::string name;
   std::vector<double> centre_deg;
-  double dominant_hz{0.0};            // at the centre: the compensators' match frequency
+  double dominant_hz{0.0};  // at the centre: the compensators' match frequency
   double gain_ns_per_m{0.0};
-  int polarity{1};                    // recommended by the analysis at the centre
-  config::Config config;              // the set (plant at the centre)
-  double k_max_ns_per_m{0.0};         // smallest over the grid
-  std::vector<double> k_max_pose_deg; // where
+  int polarity{1};                                    // recommended by the analysis at the centre
+  config::Config config;                              // the set (plant at the centre)
+  double k_max_ns_per_m{0.0};                         // smallest over the grid
+  std::vector<double> k_max_pose_deg;                 // where
   double dominant_min_hz{0.0}, dominant_max_hz{0.0};  // over the grid
-  double improvement_centre_pct{0.0}; // predicted driving-point improvement at the centre (discrete loop)
+  double improvement_centre_pct{0.0};  // predicted driving-point improvement at the centre (discrete loop)
   // The smallest improvement of any robot mode's peak in pose_schedule's damping band over the grid
   // (analysis/mode_improvement.hpp): negative where the set makes a mode worse than open loop; where and
   // which mode. Outside the band: the smallest, if a mode lies there.

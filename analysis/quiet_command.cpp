@@ -26,11 +26,12 @@ QuietCommand quiet_command(const LoopModel& m, double gain, int polarity) {
   }
   out.noise_rms_v = std::sqrt(power);
   const auto& dist = cfg.disturbances;
-  if (dist.drives_on && dist.drive_vibration_mps2 > 0.0 && dist.drive_vibration_hz > 0.0 && dist.drive_vibration_hz < nyquist) {
+  if (dist.drives_on && dist.drive_vibration_mps2 > 0.0 && dist.drive_vibration_hz > 0.0 &&
+      dist.drive_vibration_hz < nyquist) {
     const double f = dist.drive_vibration_hz;
     const PlantResponse p = m.plant_response(f);
-    out.vibration_rms_v =
-        std::abs(m.command_per_open_accel(p, m.chain_filters_digital(f), gain, polarity)) * dist.drive_vibration_mps2 / std::sqrt(2.0);
+    out.vibration_rms_v = std::abs(m.command_per_open_accel(p, m.chain_filters_digital(f), gain, polarity)) *
+                          dist.drive_vibration_mps2 / std::sqrt(2.0);
   }
   out.rms_v = std::hypot(out.noise_rms_v, out.vibration_rms_v);
   return out;

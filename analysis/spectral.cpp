@@ -11,10 +11,12 @@ FrfAccumulator::FrfAccumulator(std::size_t segment_samples, double fs_hz, int ze
                                std::size_t outputs)
     : n_(segment_samples), nfft_(segment_samples * static_cast<std::size_t>(std::max(zero_pad, 1))), fs_hz_(fs_hz) {
   if (n_ < 8) throw std::invalid_argument("FrfAccumulator: segments need at least 8 samples");
-  bins_ = std::min(nfft_ / 2 + 1, static_cast<std::size_t>(std::floor(max_hz / (fs_hz / static_cast<double>(nfft_)))) + 1);
+  bins_ =
+      std::min(nfft_ / 2 + 1, static_cast<std::size_t>(std::floor(max_hz / (fs_hz / static_cast<double>(nfft_)))) + 1);
   window_.assign(n_, 1.0);
   if (window == Window::kHann)
-    for (std::size_t i = 0; i < n_; ++i) window_[i] = 0.5 - 0.5 * std::cos(kTwoPi * static_cast<double>(i) / static_cast<double>(n_));
+    for (std::size_t i = 0; i < n_; ++i)
+      window_[i] = 0.5 - 0.5 * std::cos(kTwoPi * static_cast<double>(i) / static_cast<double>(n_));
   sxy_.assign(outputs, std::vector<std::complex<double>>(bins_, 0.0));
   sxx_.assign(bins_, 0.0);
   syy_.assign(outputs, std::vector<double>(bins_, 0.0));
@@ -68,10 +70,13 @@ FrfEstimate welch_frf(const std::vector<double>& x, const std::vector<double>& y
   if (x.size() != y.size() || x.size() < segment_samples)
     throw std::invalid_argument("welch_frf: records must be equally long and hold one segment");
   FrfAccumulator acc(segment_samples, fs_hz, 1, Window::kHann, max_hz);
-  const auto hop = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround((1.0 - overlap) * static_cast<double>(segment_samples))));
+  const auto hop = std::max<std::size_t>(
+      1, static_cast<std::size_t>(std::lround((1.0 - overlap) * static_cast<double>(segment_samples))));
   for (std::size_t start = 0; start + segment_samples <= x.size(); start += hop)
-    acc.add(std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(start), x.begin() + static_cast<std::ptrdiff_t>(start + segment_samples)),
-            std::vector<double>(y.begin() + static_cast<std::ptrdiff_t>(start), y.begin() + static_cast<std::ptrdiff_t>(start + segment_samples)));
+    acc.add(std::vector<double>(x.begin() + static_cast<std::ptrdiff_t>(start),
+                                x.begin() + static_cast<std::ptrdiff_t>(start + segment_samples)),
+            std::vector<double>(y.begin() + static_cast<std::ptrdiff_t>(start),
+                                y.begin() + static_cast<std::ptrdiff_t>(start + segment_samples)));
   return acc.result();
 }
 

@@ -21,12 +21,14 @@ void warn(ScheduledLoop& l, double gm_min_db, double pm_min_deg) {
   if (l.margins.phase_margin_deg && *l.margins.phase_margin_deg < pm_min_deg)
     l.warnings.push_back(fmt("phase margin %.1f deg, below %.1f deg", *l.margins.phase_margin_deg, pm_min_deg));
   if (!l.margins.gain_crossover_hz)
-    l.notes.push_back("no gain crossover: the loop gain stays below 1, so there is no phase margin to state (not 180 deg)");
+    l.notes.push_back(
+        "no gain crossover: the loop gain stays below 1, so there is no phase margin to state (not 180 deg)");
   for (const ModePhase& m : l.modes)
     if (m.damps && std::abs(m.feedback_phase_deg) > 80.0)
-      l.warnings.push_back(fmt("the %.2f Hz mode's feedback is at %.1f deg from -velocity, within 10 deg of the damping "
-                               "window's edge (90 deg): a small shift of the mode or the delay makes it stop damping",
-                               m.freq_hz, m.feedback_phase_deg));
+      l.warnings.push_back(
+          fmt("the %.2f Hz mode's feedback is at %.1f deg from -velocity, within 10 deg of the damping "
+              "window's edge (90 deg): a small shift of the mode or the delay makes it stop damping",
+              m.freq_hz, m.feedback_phase_deg));
 }
 
 }  // namespace

@@ -14,10 +14,10 @@
 namespace robodamp::analysis {
 
 struct ScheduledLoop {
-  std::size_t controller{0};   // 0: the configuration's own, i: speed_schedule.controllers[i - 1]
+  std::size_t controller{0};  // 0: the configuration's own, i: speed_schedule.controllers[i - 1]
   double gain_ns_per_m{0.0};
-  std::size_t bands{0};        // how many bands run it
-  double rpm_from{0.0};        // the first band's start
+  std::size_t bands{0};  // how many bands run it
+  double rpm_from{0.0};  // the first band's start
   bool stable{false};
   std::optional<double> k_max_ns_per_m;
   Margins margins;

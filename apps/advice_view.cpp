@@ -10,16 +10,20 @@ namespace robodamp::apps {
 std::string advice_text(const dds::AdviceSample& a) {
   char b[512];
   std::string chatter;
-  if (a.chatter_hz > 0.0) chatter = ", chatter at " + std::to_string(static_cast<int>(std::lround(a.chatter_hz))) + " Hz";
-  std::snprintf(b, sizeof b, "  speed advice #%llu at %.3f s (%s at %.0f rpm%s; %.3f mm against a %s limit of %.3f mm, %s):",
+  if (a.chatter_hz > 0.0)
+    chatter = ", chatter at " + std::to_string(static_cast<int>(std::lround(a.chatter_hz))) + " Hz";
+  std::snprintf(b, sizeof b,
+                "  speed advice #%llu at %.3f s (%s at %.0f rpm%s; %.3f mm against a %s limit of %.3f mm, %s):",
                 static_cast<unsigned long long>(a.seq), a.time_s, a.trigger.c_str(), a.spindle_rpm, chatter.c_str(),
                 a.depth_mm, a.damped ? "damped" : "open-loop", a.limit_now_mm, a.method.c_str());
   std::string out = b;
   if (!a.pose_deg.empty()) {
     out += " at the robot's pose " + config::describe_pose(a.pose_deg);
     if (a.poses_ahead > 0)
-      out += " and " + std::to_string(a.poses_ahead) + " pose" + (a.poses_ahead == 1 ? "" : "s") + " of the path ahead" +
-             (a.limiting_pose_deg.empty() ? std::string() : " (the lowest limit at " + config::describe_pose(a.limiting_pose_deg) + ")");
+      out +=
+          " and " + std::to_string(a.poses_ahead) + " pose" + (a.poses_ahead == 1 ? "" : "s") + " of the path ahead" +
+          (a.limiting_pose_deg.empty() ? std::string()
+                                       : " (the lowest limit at " + config::describe_pose(a.limiting_pose_deg) + ")");
     out += ":";
   }
   const std::string status = a.status == "current" ? "" : " [" + a.status + ": " + a.status_reason + "]";

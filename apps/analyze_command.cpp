@@ -63,11 +63,15 @@ json analysis_report(const analysis::LoopModel& m, const analysis::AnalysisResul
   j["polarity_reason"] = r.polarity_reason;
   j["modes"] = json::array();
   for (const auto& mp : r.modes)
-    j["modes"].push_back({{"freq_hz", mp.freq_hz}, {"feedback_phase_deg", mp.feedback_phase_deg}, {"damps", mp.damps},
+    j["modes"].push_back({{"freq_hz", mp.freq_hz},
+                          {"feedback_phase_deg", mp.feedback_phase_deg},
+                          {"damps", mp.damps},
                           {"notch_phase_deg", std::arg(m.notch_response(mp.freq_hz)) * 180.0 / M_PI}});
   if (m.spindle_rpm()) {
     const double teeth = m.config().spindle.teeth;
-    j["spindle"] = {{"rpm", *m.spindle_rpm()}, {"teeth", teeth}, {"tooth_hz", *m.spindle_rpm() * teeth / 60.0},
+    j["spindle"] = {{"rpm", *m.spindle_rpm()},
+                    {"teeth", teeth},
+                    {"tooth_hz", *m.spindle_rpm() * teeth / 60.0},
                     {"notches", m.notch_count()}};
   }
   j["frfs"] = json::array();  // the discrete loop that runs
@@ -87,13 +91,15 @@ std::string analysis_table(const json& r) {
      << " N s/m, polarity " << std::showpos << r["polarity"].get<int>() << std::noshowpos << ", "
      << r["loop_rate_hz"].get<double>() << " Hz)\n";
   os << "  discrete loop:   " << (r["stable"].get<bool>() ? "STABLE" : "UNSTABLE") << " (spectral radius "
-     << fmt(r["spectral_radius"], "%.6f") << ", Nyquist encirclements " << r["nyquist_encirclements"].get<int>() << ")\n";
+     << fmt(r["spectral_radius"], "%.6f") << ", Nyquist encirclements " << r["nyquist_encirclements"].get<int>()
+     << ")\n";
   os << "  continuous loop: " << (r["stable_continuous"].get<bool>() ? "stable" : "unstable") << "\n";
   os << "  max stable K " << fmt(r["max_stable_gain_ns_per_m"], "%.1f") << " N s/m, gain margin "
      << fmt(r["gain_margin_db"], "%.2f") << " dB, "
      << (r["gain_crossover_hz"].is_null()
              ? std::string("no gain crossover (the loop gain stays below 1: no phase margin to state)")
-             : "phase margin " + fmt(r["phase_margin_deg"], "%.1f") + " deg at " + fmt(r["gain_crossover_hz"], "%.2f") + " Hz")
+             : "phase margin " + fmt(r["phase_margin_deg"], "%.1f") + " deg at " + fmt(r["gain_crossover_hz"], "%.2f") +
+                   " Hz")
      << ", delay margin " << fmt(r["delay_margin_ms"], "%.2f") << " ms\n";
   if (!r["gain_margin_db"].is_null() && r["gain_margin_db"].get<double>() < 6.0)
     os << "  WARNING: gain margin " << fmt(r["gain_margin_db"], "%.2f") << " dB, below 6 dB\n";
@@ -102,7 +108,8 @@ std::string analysis_table(const json& r) {
   if (r.contains("spindle")) {
     const auto& sp = r["spindle"];
     std::snprintf(line, sizeof line, "  spindle %.0f rpm x %.0f teeth = %.2f Hz: %zu harmonic notches in the loop\n",
-                  sp["rpm"].get<double>(), sp["teeth"].get<double>(), sp["tooth_hz"].get<double>(), sp["notches"].get<std::size_t>());
+                  sp["rpm"].get<double>(), sp["teeth"].get<double>(), sp["tooth_hz"].get<double>(),
+                  sp["notches"].get<std::size_t>());
     os << line;
     for (const auto& mp : r["modes"]) {
       std::snprintf(line, sizeof line, "    the notches' phase at %.2f Hz: %+.3f deg\n", mp["freq_hz"].get<double>(),
@@ -115,8 +122,8 @@ std::string analysis_table(const json& r) {
     auto mm = [](const json& v) { return v.is_null() ? std::string("none below 1 m") : fmt(v, "%.3f") + " mm"; };
     os << "  the job (spindle.job) at " << fmt(l["rpm"], "%.0f") << " rpm, depth " << fmt(l["depth_mm"], "%.3f")
        << " mm: limit open " << mm(l["open_mm"]) << " (" << l["open_method"].get<std::string>() << "), damped "
-       << mm(l["damped_mm"]) << " (" << l["damped_method"].get<std::string>() << " at " << fmt(l["analysed_rpm"], "%.2f")
-       << " rpm)\n";
+       << mm(l["damped_mm"]) << " (" << l["damped_method"].get<std::string>() << " at "
+       << fmt(l["analysed_rpm"], "%.2f") << " rpm)\n";
   }
   if (r["stable"].get<bool>())
     os << "  quiet cell: command " << fmt(r["quiet_command_rms_v"], "%.4f") << " V RMS (density peak at "
@@ -137,10 +144,11 @@ std::string analysis_table(const json& r) {
   for (std::size_t i = 0; i < r["frfs"].size(); ++i) {
     const auto& f = r["frfs"][i];
     const auto& c = r["frfs_continuous"][i];
-    std::snprintf(line, sizeof line, "  %-22s %14s %10s %14s %10s %11s%% %13s%%\n", f["name"].get<std::string>().c_str(),
-                  fmt(f["open_peak_m_per_n"], "%.4g").c_str(), fmt(f["open_peak_freq_hz"], "%.2f").c_str(),
-                  fmt(f["closed_peak_m_per_n"], "%.4g").c_str(), fmt(f["peak_freq_hz"], "%.2f").c_str(),
-                  fmt(f["improvement_pct"], "%.1f").c_str(), fmt(c["improvement_pct"], "%.1f").c_str());
+    std::snprintf(line, sizeof line, "  %-22s %14s %10s %14s %10s %11s%% %13s%%\n",
+                  f["name"].get<std::string>().c_str(), fmt(f["open_peak_m_per_n"], "%.4g").c_str(),
+                  fmt(f["open_peak_freq_hz"], "%.2f").c_str(), fmt(f["closed_peak_m_per_n"], "%.4g").c_str(),
+                  fmt(f["peak_freq_hz"], "%.2f").c_str(), fmt(f["improvement_pct"], "%.1f").c_str(),
+                  fmt(c["improvement_pct"], "%.1f").c_str());
     os << line;
   }
   for (const auto& n : r["notes"]) os << "  note: " << n.get<std::string>() << "\n";
@@ -168,7 +176,8 @@ std::string plot_analysis(const analysis::LoopModel& m, const analysis::Analysis
       data << '\n';
     }
     std::ostringstream s;
-    s << "set title 'Receptance, control off vs on (K = " << k << " N s/m, polarity " << pol << ")" << (r.stable ? "" : " UNSTABLE")
+    s << "set title 'Receptance, control off vs on (K = " << k << " N s/m, polarity " << pol << ")"
+      << (r.stable ? "" : " UNSTABLE")
       << "'\nset logscale xy\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel '|H| (m/N)'\nset key top right\nplot ";
     for (std::size_t i = 0; i < r.frfs_discrete.size(); ++i)
       s << (i ? ", " : "") << "DATA u 1:" << 2 + 2 * i << " w l lw 1.5 dt 2 lc " << i + 1 << " t '"
@@ -242,13 +251,18 @@ struct AnalyzeArgs {
 json speed_map_json(const config::Config& cfg, const analysis::NotchSpeedMap& map) {
   json points = json::array();
   for (const auto& p : map.points)
-    points.push_back({{"rpm", p.rpm}, {"stable", p.stable}, {"refused", p.refused}, {"reason", p.reason},
+    points.push_back({{"rpm", p.rpm},
+                      {"stable", p.stable},
+                      {"refused", p.refused},
+                      {"reason", p.reason},
                       {"notch_phase_deg", p.notch_phase_deg}});
   json refused = json::array();
   for (const auto& [lo, hi] : map.refused_rpm) refused.push_back({{"from_rpm", lo}, {"to_rpm", hi}});
-  return {{"config", cfg.source}, {"teeth", cfg.spindle.teeth},
+  return {{"config", cfg.source},
+          {"teeth", cfg.spindle.teeth},
           {"mode_hz", map.points.empty() ? json::array() : json(map.points.front().mode_hz)},
-          {"points", points}, {"refused", refused}};
+          {"points", points},
+          {"refused", refused}};
 }
 
 // The harmonic notches across spindle.rpm range: the refused speeds and the worst phase at each mode.
@@ -266,7 +280,8 @@ int print_speed_map(const config::Config& cfg, const JsonOut& out) {
     double worst = 0.0, at = 0.0;
     for (const auto& p : map.points)
       if (std::abs(p.notch_phase_deg[k]) > std::abs(worst)) worst = p.notch_phase_deg[k], at = p.rpm;
-    std::printf("  %.2f Hz mode: the notches cost at most %+.1f deg (at %.0f rpm)\n", map.points.front().mode_hz[k], worst, at);
+    std::printf("  %.2f Hz mode: the notches cost at most %+.1f deg (at %.0f rpm)\n", map.points.front().mode_hz[k],
+                worst, at);
   }
   if (map.refused_rpm.empty()) std::printf("  no speed refused\n");
   for (const auto& [lo, hi] : map.refused_rpm) {
@@ -309,8 +324,11 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
                        {"outside_band_hz", r.outside_band_hz ? json(*r.outside_band_hz) : json(nullptr)}});
   }
   const config::PoseScheduleConfig& sched = *cfg.pose_schedule;
-  const json report = {{"config", cfg.source}, {"model", ps.model.source}, {"axis", sched.axis ? "y" : "x"},
-                       {"damping_band_hz", {sched.damping_band_min_hz, sched.damping_band_max_hz}}, {"regions", regions}};
+  const json report = {{"config", cfg.source},
+                       {"model", ps.model.source},
+                       {"axis", sched.axis ? "y" : "x"},
+                       {"damping_band_hz", {sched.damping_band_min_hz, sched.damping_band_max_hz}},
+                       {"regions", regions}};
   if (!emit_json(out, report.dump(2), "analyze")) return 1;
   if (out.to_stdout()) return 0;
   std::printf("pose schedule of %s: robot model %s, actuator along %s\n", cfg.source.c_str(), ps.model.source.c_str(),
@@ -322,22 +340,27 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
     char dom[40];
     std::snprintf(dom, sizeof dom, "%.2f-%.2f", r["dominant_min_hz"].get<double>(), r["dominant_max_hz"].get<double>());
     std::printf("%-12s %-26s %-18s %9.2f %+4d %9.0f %11.0f %9s %9s %8.1f\n", r["name"].get<std::string>().c_str(),
-                centre.c_str(), dom, r["dominant_hz"].get<double>(), r["polarity"].get<int>(), r["gain_ns_per_m"].get<double>(),
-                r["k_max_ns_per_m"].get<double>(), fmt(r["centre_gain_margin_db"], "%.1f").c_str(),
-                fmt(r["centre_phase_margin_deg"], "%.1f").c_str(), r["improvement_centre_pct"].get<double>());
+                centre.c_str(), dom, r["dominant_hz"].get<double>(), r["polarity"].get<int>(),
+                r["gain_ns_per_m"].get<double>(), r["k_max_ns_per_m"].get<double>(),
+                fmt(r["centre_gain_margin_db"], "%.1f").c_str(), fmt(r["centre_phase_margin_deg"], "%.1f").c_str(),
+                r["improvement_centre_pct"].get<double>());
   }
   std::printf("K_max is the smallest over each region's %d^%zu grid; margins and improvement at its centre\n",
               cfg.pose_schedule->grid_points, cfg.pose_schedule->joints());
-  std::printf("the worst mode in the damping band %g-%g Hz over each region's grid (the smallest improvement of a robot mode's "
-              "peak, %s within +-10 %%):\n",
-              sched.damping_band_min_hz, sched.damping_band_max_hz, cfg.robot.frfs.empty() ? "-" : cfg.robot.frfs.front().name.c_str());
+  std::printf(
+      "the worst mode in the damping band %g-%g Hz over each region's grid (the smallest improvement of a robot mode's "
+      "peak, %s within +-10 %%):\n",
+      sched.damping_band_min_hz, sched.damping_band_max_hz,
+      cfg.robot.frfs.empty() ? "-" : cfg.robot.frfs.front().name.c_str());
   for (const auto& r : regions) {
     const double w = r["worst_mode_improvement_pct"];
-    std::printf("  %-12s %+7.1f %% at %.2f Hz at %s%s", r["name"].get<std::string>().c_str(), w, r["worst_mode_hz"].get<double>(),
+    std::printf("  %-12s %+7.1f %% at %.2f Hz at %s%s", r["name"].get<std::string>().c_str(), w,
+                r["worst_mode_hz"].get<double>(),
                 config::describe_pose(r["worst_mode_pose_deg"].get<std::vector<double>>()).c_str(),
                 w < 0.0 ? ": worse than open loop there" : "");
     if (!r["outside_band_pct"].is_null())
-      std::printf("; outside the band %+.1f %% at %.2f Hz", r["outside_band_pct"].get<double>(), r["outside_band_hz"].get<double>());
+      std::printf("; outside the band %+.1f %% at %.2f Hz", r["outside_band_pct"].get<double>(),
+                  r["outside_band_hz"].get<double>());
     std::printf("\n");
   }
   return 0;
@@ -351,10 +374,14 @@ void add_job_limits(const analysis::LoopModel& m, std::optional<double> rpm, jso
   milling::LiveStability live(config::load_milling_config(cfg.spindle.job_resolved), cfg.spindle.structure, {cfg});
   const milling::LiveLimits l = live.compute(*rpm, 0, cfg.controller.gain_ns_per_m);
   auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  report["job_limits"] = {{"rpm", *rpm}, {"depth_mm", live.depth_mm()},          {"open_mm", finite(l.open_mm)},
-                                     {"open_method", l.open_method},         {"damped_mm", finite(l.damped_mm)},
-                                     {"damped_method", l.method},            {"analysed_rpm", l.analysed_rpm},
-                                     {"damped_valid", l.damped_valid}};
+  report["job_limits"] = {{"rpm", *rpm},
+                          {"depth_mm", live.depth_mm()},
+                          {"open_mm", finite(l.open_mm)},
+                          {"open_method", l.open_method},
+                          {"damped_mm", finite(l.damped_mm)},
+                          {"damped_method", l.method},
+                          {"analysed_rpm", l.analysed_rpm},
+                          {"damped_valid", l.damped_valid}};
 }
 
 // controller.speed_schedule: each controller and K its bands run, checked as a loop, with its weak points.
@@ -362,12 +389,14 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
   if (!cfg.controller.speed_schedule) return {};
   std::ostringstream os;
   const auto loops = analysis::check_speed_schedule(cfg);
-  os << "  speed schedule: " << cfg.controller.speed_schedule->bands.size() << " bands (robodamp schedule; K = 0 in a band "
+  os << "  speed schedule: " << cfg.controller.speed_schedule->bands.size()
+     << " bands (robodamp schedule; K = 0 in a band "
      << "where the damper is worse than none); each controller and K they run, as a loop:\n";
   json j = json::array();
   for (const auto& l : loops) {
     char line[300];
-    std::snprintf(line, sizeof line, "    controller %zu at K %6.0f N s/m (%zu band%s from %.0f rpm): %s, GM %s dB, %s\n", l.controller,
+    std::snprintf(line, sizeof line,
+                  "    controller %zu at K %6.0f N s/m (%zu band%s from %.0f rpm): %s, GM %s dB, %s\n", l.controller,
                   l.gain_ns_per_m, l.bands, l.bands == 1 ? "" : "s", l.rpm_from, l.stable ? "stable" : "UNSTABLE",
                   l.margins.gain_margin_db ? fmt(json(*l.margins.gain_margin_db), "%.1f").c_str() : "-",
                   l.margins.phase_margin_deg ? ("PM " + fmt(json(*l.margins.phase_margin_deg), "%.1f") + " deg").c_str()
@@ -375,9 +404,13 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
     os << line;
     for (const auto& w : l.warnings) os << "      WARNING: " << w << "\n";
     for (const auto& n : l.notes) os << "      note: " << n << "\n";
-    j.push_back({{"controller", l.controller}, {"gain_ns_per_m", l.gain_ns_per_m}, {"bands", l.bands}, {"stable", l.stable},
+    j.push_back({{"controller", l.controller},
+                 {"gain_ns_per_m", l.gain_ns_per_m},
+                 {"bands", l.bands},
+                 {"stable", l.stable},
                  {"gain_margin_db", optional_number(l.margins.gain_margin_db)},
-                 {"phase_margin_deg", optional_number(l.margins.phase_margin_deg)}, {"warnings", l.warnings},
+                 {"phase_margin_deg", optional_number(l.margins.phase_margin_deg)},
+                 {"warnings", l.warnings},
                  {"notes", l.notes}});
   }
   report["speed_schedule"] = j;
@@ -387,17 +420,23 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
 // How far the loop holds as the modes move (tune/robustness.hpp), with a warning under +-5 %.
 std::string robustness_section(const config::Config& cfg, json& report) {
   const tune::Robustness rb = tune::robustness(cfg);
-  report["robustness"] = {{"down_pct", rb.down.pct}, {"up_pct", rb.up.pct}, {"down_reason", rb.down.reason},
-                          {"up_reason", rb.up.reason}, {"warn_below_pct", tune::kRobustShiftWarnPct}};
+  report["robustness"] = {{"down_pct", rb.down.pct},
+                          {"up_pct", rb.up.pct},
+                          {"down_reason", rb.down.reason},
+                          {"up_reason", rb.up.reason},
+                          {"warn_below_pct", tune::kRobustShiftWarnPct}};
   char line[160];
-  std::snprintf(line, sizeof line, "  modes shifted together: the loop stays stable and damps its modes from -%.1f %% to +%.1f %%",
+  std::snprintf(line, sizeof line,
+                "  modes shifted together: the loop stays stable and damps its modes from -%.1f %% to +%.1f %%",
                 rb.down.pct, rb.up.pct);
   std::string out = line;
   for (const auto* s : {&rb.down, &rb.up})
     if (!s->reason.empty()) out += "; " + s->reason;
   if (rb.pct() < tune::kRobustShiftWarnPct) {
-    std::snprintf(line, sizeof line, "\n  WARNING: robust to only +-%.1f %% of mode shift (under +-%.0f %%: a pose or tool change may "
-                  "move the modes further)", rb.pct(), tune::kRobustShiftWarnPct);
+    std::snprintf(line, sizeof line,
+                  "\n  WARNING: robust to only +-%.1f %% of mode shift (under +-%.0f %%: a pose or tool change may "
+                  "move the modes further)",
+                  rb.pct(), tune::kRobustShiftWarnPct);
     out += line;
   }
   return out + "\n";
@@ -412,7 +451,8 @@ int run_analyze(const AnalyzeArgs& a) {
   const auto result = analysis::analyse(model);
   auto report = analysis_report(model, result);
   add_job_limits(model, a.spindle_rpm, report);
-  std::string table = analysis_table(report) + (result.stable ? robustness_section(model.config(), report) : std::string()) +
+  std::string table = analysis_table(report) +
+                      (result.stable ? robustness_section(model.config(), report) : std::string()) +
                       speed_schedule_section(model.config(), report);
   const std::string job = !a.job_path.empty() ? a.job_path : model.config().spindle.job_resolved;
   if (!job.empty() && result.stable) {
@@ -420,9 +460,10 @@ int run_analyze(const AnalyzeArgs& a) {
     table += milling::cut_verdict_text(v);
     report["cut"] = cut_verdict_json(v);
   }
-  if (print_report(report.dump(2), a.json, "analyze", table, a.plot_dir,
-                   [&] { return plot_analysis(model, result, a.plot_dir); },
-                   "frf_open_closed.png, nyquist.png, gain_sweep.png in " + a.plot_dir) != 0)
+  if (print_report(
+          report.dump(2), a.json, "analyze", table, a.plot_dir,
+          [&] { return plot_analysis(model, result, a.plot_dir); },
+          "frf_open_closed.png, nyquist.png, gain_sweep.png in " + a.plot_dir) != 0)
     return 1;
   return result.stable ? 0 : 3;
 }
@@ -434,11 +475,13 @@ void register_analyze(Registry& r) {
   CLI::App* sub = r.add("analyze", "Closed-loop stability, margins, polarity and predicted improvement",
                         [a] { return run_analyze(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
-  sub->add_option("--job", a->job_path,
-                  "Milling job (config/milling/*.yaml): what the damper (and its speed schedule) does for that cut, by the "
-                  "accurate method; default the configuration's spindle.job")
+  sub->add_option(
+         "--job", a->job_path,
+         "Milling job (config/milling/*.yaml): what the damper (and its speed schedule) does for that cut, by the "
+         "accurate method; default the configuration's spindle.job")
       ->check(CLI::ExistingFile);
-  r.whole_number(sub, "--cut-speeds", a->cut_speeds, {"(speeds)", 2, 5000}, "Speeds over the job's range the cut verdict checks");
+  r.whole_number(sub, "--cut-speeds", a->cut_speeds, {"(speeds)", 2, 5000},
+                 "Speeds over the job's range the cut verdict checks");
   r.json(sub, a->json, "The analysis (or the pose schedule's regions, or the --spindle-sweep map)");
   r.plot_dir(sub, a->plot_dir, "frf_open_closed.png, nyquist.png and gain_sweep.png");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0},

@@ -57,27 +57,29 @@ json bench_report_json(const analysis::Bench& bench, const analysis::BenchReport
                                     {"coherence_min", o.coherence_min}});
   j["rows"] = json::array();
   for (const auto& row : r.rows)
-    j["rows"].push_back({{"name", row.name},
-                         {"kind", row.kind},
-                         {"control_gain_ns_per_m", row.gain_ns_per_m},
-                         {"impact_peak_n", row.impact_peak_n},
-                         {"measured_improvement_pct", opt(row.measured_improvement_pct)},
-                         {"predicted_improvement_pct", opt(row.predicted_improvement_pct)},
-                         {"predicted_continuous_improvement_pct", opt(row.predicted_continuous_improvement_pct)},
-                         {"saturated", row.saturated},
-                         {"saturation_time_s", row.saturation_time_s},
-                         {"peak_actuator_force_n", row.peak_actuator_force_n},
-                         {"coherence_min", row.measured_improvement_pct ? json(row.coherence_min) : json(nullptr)},
-                         {"open_peak_m_per_n", row.measured_improvement_pct ? json(row.open.magnitude_m_per_n) : json(nullptr)},
-                         {"closed_peak_m_per_n", row.measured_improvement_pct ? json(row.closed.magnitude_m_per_n) : json(nullptr)},
-                         {"closed_peak_freq_hz", row.measured_improvement_pct ? json(row.closed.freq_hz) : json(nullptr)}});
+    j["rows"].push_back(
+        {{"name", row.name},
+         {"kind", row.kind},
+         {"control_gain_ns_per_m", row.gain_ns_per_m},
+         {"impact_peak_n", row.impact_peak_n},
+         {"measured_improvement_pct", opt(row.measured_improvement_pct)},
+         {"predicted_improvement_pct", opt(row.predicted_improvement_pct)},
+         {"predicted_continuous_improvement_pct", opt(row.predicted_continuous_improvement_pct)},
+         {"saturated", row.saturated},
+         {"saturation_time_s", row.saturation_time_s},
+         {"peak_actuator_force_n", row.peak_actuator_force_n},
+         {"coherence_min", row.measured_improvement_pct ? json(row.coherence_min) : json(nullptr)},
+         {"open_peak_m_per_n", row.measured_improvement_pct ? json(row.open.magnitude_m_per_n) : json(nullptr)},
+         {"closed_peak_m_per_n", row.measured_improvement_pct ? json(row.closed.magnitude_m_per_n) : json(nullptr)},
+         {"closed_peak_freq_hz", row.measured_improvement_pct ? json(row.closed.freq_hz) : json(nullptr)}});
   j["sweep"] = json::array();
   for (const auto& d : r.sweep)
     j["sweep"].push_back({{"control_gain_ns_per_m", d.gain_ns_per_m},
                           {"predicted_unstable", d.predicted_unstable},
                           {"predicted_growth_per_s", d.predicted_growth_per_s},
                           {"diverged", d.diverged},
-                          {"measured_growth_per_s", std::isfinite(d.measured_growth_per_s) ? json(d.measured_growth_per_s) : json(nullptr)},
+                          {"measured_growth_per_s",
+                           std::isfinite(d.measured_growth_per_s) ? json(d.measured_growth_per_s) : json(nullptr)},
                           {"final_window_saturated", d.final_window_saturated},
                           {"end_to_start_rms_ratio", d.growth_ratio},
                           {"saturation_time_s", d.saturation_time_s}});
@@ -109,14 +111,16 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
                   o.name.c_str(), o.model_peak_m_per_n, o.measured_peak_m_per_n, o.error_db, o.coherence_min);
     os << line;
   }
-  std::snprintf(line, sizeof line, "\n  %-10s %-10s %8s %9s %10s %10s %12s %9s %9s %10s %9s\n", "FRF", "kind", "K N s/m",
-                "impact N", "measured", "predicted", "(continuous)", "saturated", "sat. s", "peak F N", "coh. min");
+  std::snprintf(line, sizeof line, "\n  %-10s %-10s %8s %9s %10s %10s %12s %9s %9s %10s %9s\n", "FRF", "kind",
+                "K N s/m", "impact N", "measured", "predicted", "(continuous)", "saturated", "sat. s", "peak F N",
+                "coh. min");
   os << line;
   for (const auto& row : r.rows) {
-    std::snprintf(line, sizeof line, "  %-10s %-10s %8.0f %9.0f %10s %10s %12s %9s %9.3f %10.2f %9s\n", row.name.c_str(),
-                  row.kind.c_str(), row.gain_ns_per_m, row.impact_peak_n, pct(row.measured_improvement_pct).c_str(),
-                  pct(row.predicted_improvement_pct).c_str(), pct(row.predicted_continuous_improvement_pct).c_str(),
-                  row.saturated ? "yes" : "no", row.saturation_time_s, row.peak_actuator_force_n,
+    std::snprintf(line, sizeof line, "  %-10s %-10s %8.0f %9.0f %10s %10s %12s %9s %9.3f %10.2f %9s\n",
+                  row.name.c_str(), row.kind.c_str(), row.gain_ns_per_m, row.impact_peak_n,
+                  pct(row.measured_improvement_pct).c_str(), pct(row.predicted_improvement_pct).c_str(),
+                  pct(row.predicted_continuous_improvement_pct).c_str(), row.saturated ? "yes" : "no",
+                  row.saturation_time_s, row.peak_actuator_force_n,
                   row.measured_improvement_pct ? std::to_string(row.coherence_min).substr(0, 6).c_str() : "-");
     os << line;
   }
@@ -139,10 +143,13 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
   bool saturating = false;
   for (const auto& row : r.rows) saturating = saturating || (row.kind == "saturating" && row.saturated);
   if (saturating)
-    os << "\nSaturating rows: the " << cfg.bench.saturating_impact_peak_n << " N impacts drive the force command into the "
-       << cfg.actuator.force_limit_n << " N actuator limit; clipped feedback adds less damping than the linear analysis\n"
-       << "assumes, so the measured improvement falls below the prediction (the paper's experiments saturated at 36 N).\n"
-       << "'peak F' is the force transmitted to the structure (Eq. 3); the limit acts on the commanded coil force T V,\n"
+    os << "\nSaturating rows: the " << cfg.bench.saturating_impact_peak_n
+       << " N impacts drive the force command into the " << cfg.actuator.force_limit_n
+       << " N actuator limit; clipped feedback adds less damping than the linear analysis\n"
+       << "assumes, so the measured improvement falls below the prediction (the paper's experiments saturated at 36 "
+          "N).\n"
+       << "'peak F' is the force transmitted to the structure (Eq. 3); the limit acts on the commanded coil force T "
+          "V,\n"
        << "which near the actuator's own resonance is transmitted up to 1 / (2 zeta_a) times larger.\n";
   for (const auto& n : r.notes) os << "note: " << n << "\n";
   std::snprintf(line, sizeof line, "\n%.0f s simulated in %.2f s wall (%.0fx real time)\n", r.simulated_s, r.wall_s,
@@ -160,7 +167,8 @@ std::string plot_bench(const analysis::Bench& bench, const analysis::BenchReport
     for (const auto& d : r.sweep) n = std::max(n, d.envelope_v.size());
     for (std::size_t w = 0; w < n; ++w) {
       data << (static_cast<double>(w) + 0.5) * r.sweep.front().window_s;
-      for (const auto& d : r.sweep) data << ' ' << (w < d.envelope_v.size() && d.envelope_v[w] > 0 ? d.envelope_v[w] : NAN);
+      for (const auto& d : r.sweep)
+        data << ' ' << (w < d.envelope_v.size() && d.envelope_v[w] > 0 ? d.envelope_v[w] : NAN);
       data << '\n';
     }
     s << "set title 'Gain sweep in the time domain: command RMS after an impact'\nset logscale y\nset grid\n"
@@ -179,10 +187,12 @@ std::string plot_bench(const analysis::Bench& bench, const analysis::BenchReport
     int i = 0;
     for (const auto& row : r.rows) {
       if (!row.measured_improvement_pct) continue;
-      data << i++ << " \"" << row.name << "\\n" << row.kind << "\\nK " << static_cast<int>(row.gain_ns_per_m) << "\" "
-           << *row.measured_improvement_pct << ' ' << row.predicted_improvement_pct.value_or(NAN) << '\n';
+      data << i++ << " \"" << row.name << "\\n"
+           << row.kind << "\\nK " << static_cast<int>(row.gain_ns_per_m) << "\" " << *row.measured_improvement_pct
+           << ' ' << row.predicted_improvement_pct.value_or(NAN) << '\n';
     }
-    s << "set title 'Dynamic stiffness improvement: bench (measured) vs analysis (predicted)'\nset style data histogram\n"
+    s << "set title 'Dynamic stiffness improvement: bench (measured) vs analysis (predicted)'\nset style data "
+         "histogram\n"
          "set style histogram clustered gap 1\nset style fill solid 0.8 border -1\nset grid ytics\n"
          "set ylabel 'improvement (%)'\nset xtics rotate by -45 font ',8'\nset key top right\n"
          "plot DATA u 3:xtic(2) t 'measured', DATA u 4 t 'predicted (discrete loop)'\n";
@@ -221,7 +231,8 @@ int run_bench(const BenchArgs& a) {
     std::cout << "\n" << milling::cut_verdict_text(v);
     j["cut"] = cut_verdict_json(v);
   } else {
-    std::cout << "\n(no milling job: give --job, or spindle.job in the configuration, for what the damper does for a cut)\n";
+    std::cout
+        << "\n(no milling job: give --job, or spindle.job in the configuration, for what the damper does for a cut)\n";
   }
   std::cout << "MODEL AGREEMENT (the simulated bench against the analysis, not the cut): " << report.verdict << "\n";
   if (!emit_json(a.json, j.dump(2), "bench")) return 1;
@@ -246,11 +257,13 @@ void register_bench(Registry& r) {
   CLI::App* sub = r.add("bench", "Simulated-plant bench run: impact tests control off/on, saturation, gain sweep",
                         [a] { return run_bench(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
-  sub->add_option("--job", a->job_path,
-                  "Milling job (config/milling/*.yaml) the verdict is about: what the damper (and its speed schedule) does "
-                  "for that cut; default the configuration's spindle.job")
+  sub->add_option(
+         "--job", a->job_path,
+         "Milling job (config/milling/*.yaml) the verdict is about: what the damper (and its speed schedule) does "
+         "for that cut; default the configuration's spindle.job")
       ->check(CLI::ExistingFile);
-  r.whole_number(sub, "--cut-speeds", a->cut_speeds, {"(speeds)", 2, 5000}, "Speeds over the job's range the cut verdict checks");
+  r.whole_number(sub, "--cut-speeds", a->cut_speeds, {"(speeds)", 2, 5000},
+                 "Speeds over the job's range the cut verdict checks");
   r.json(sub, a->json, "The report");
   r.plot_dir(sub, a->plot_dir, "the FRFs, Nyquist, gain sweep and bench plots");
   r.whole_number(sub, "--jobs", a->jobs, {"(threads)", 0, 256, false, false, "0 = one per core"},

@@ -12,6 +12,7 @@ namespace robodamp::apps {
 [[nodiscard]] nlohmann::json bench_report_json(const analysis::Bench& bench, const analysis::BenchReport& r);
 [[nodiscard]] std::string bench_table(const analysis::Bench& bench, const analysis::BenchReport& r);
 // bench_sweep.png (command envelopes of the gain sweep) and bench_improvement.png in dir.
-[[nodiscard]] std::string plot_bench(const analysis::Bench& bench, const analysis::BenchReport& r, const std::string& dir);
+[[nodiscard]] std::string plot_bench(const analysis::Bench& bench, const analysis::BenchReport& r,
+                                     const std::string& dir);
 
 }  // namespace robodamp::apps

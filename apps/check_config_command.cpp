@@ -30,8 +30,7 @@ Kind kind_of(const std::string& path) {
     if (n["tool"].IsDefined()) return Kind::kMillingJob;
     if (n["dashboard"].IsDefined()) return Kind::kDashboard;
     if (n["links"].IsDefined()) return Kind::kRobotModel;
-  } catch (const YAML::Exception&) {
-  }
+  } catch (const YAML::Exception&) {}
   return Kind::kCell;  // the configuration parser reports a syntax error
 }
 
@@ -59,10 +58,14 @@ int check_robot_model(const std::string& path) {
 
 int check_config(const std::string& path) {
   switch (kind_of(path)) {
-    case Kind::kMillingJob: return check_milling(path);
-    case Kind::kRobotModel: return check_robot_model(path);
-    case Kind::kDashboard: return check_dashboard(path);
-    case Kind::kCell: break;
+    case Kind::kMillingJob:
+      return check_milling(path);
+    case Kind::kRobotModel:
+      return check_robot_model(path);
+    case Kind::kDashboard:
+      return check_dashboard(path);
+    case Kind::kCell:
+      break;
   }
   const auto cfg = config::load_config_file(path);
   const auto d = analysis::design_chain(cfg);
@@ -76,7 +79,9 @@ int check_config(const std::string& path) {
 
 void register_check_config(Registry& r) {
   auto path = std::make_shared<std::string>();
-  CLI::App* sub = r.add("check-config", "Validate a configuration (a cell's, a milling job, a robot model or the dashboard's) and report every problem at once",
+  CLI::App* sub = r.add("check-config",
+                        "Validate a configuration (a cell's, a milling job, a robot model or the dashboard's) and "
+                        "report every problem at once",
                         [path] { return check_config(*path); });
   sub->add_option("file", *path, "Configuration file (YAML)")->required();
 }

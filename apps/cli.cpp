@@ -48,7 +48,9 @@ CLI::Option* Registry::text_option(CLI::App* sub, const std::string& flag, const
 }
 
 namespace {
-std::string first_name(const CLI::Option* opt) { return opt->get_name(false, true).substr(0, opt->get_name(false, true).find(',')); }
+std::string first_name(const CLI::Option* opt) {
+  return opt->get_name(false, true).substr(0, opt->get_name(false, true).find(','));
+}
 }  // namespace
 
 CLI::Option* Registry::scalar(CLI::App* sub, const std::string& flag, const config::Range& range, bool whole,
@@ -169,8 +171,9 @@ bool emit_json(const JsonOut& out, const std::string& text, const std::string& c
 
 CLI::Option* Registry::json(CLI::App* sub, JsonOut& target, const std::string& what) {
   CLI::Option* o = sub->add_option("--json", target.path,
-                                   what + ": --json FILE writes it to FILE; --json alone or --json - prints it on "
-                                          "stdout instead of the text (docs/cli.md)")
+                                   what +
+                                       ": --json FILE writes it to FILE; --json alone or --json - prints it on "
+                                       "stdout instead of the text (docs/cli.md)")
                        ->expected(0, 1)
                        ->type_name("[FILE]");
   json_.emplace_back(o, &target);
@@ -194,8 +197,8 @@ CLI::Option* Registry::renamed(CLI::Option* now, const std::string& value, CLI::
 }
 
 CLI::Option* Registry::job(CLI::App* sub, std::string& target) {
-  return renamed(sub->add_option("--job", target, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile), "JOB",
-                 sub->add_option("--config", target, "The milling job, as --job")->check(CLI::ExistingFile),
+  return renamed(sub->add_option("--job", target, "Milling job (YAML, config/milling/)")->check(CLI::ExistingFile),
+                 "JOB", sub->add_option("--config", target, "The milling job, as --job")->check(CLI::ExistingFile),
                  "--config is the cell's configuration in every other command");
 }
 
@@ -212,8 +215,8 @@ int Registry::run_parsed() const {
     }
     for (const auto& [opt, replacement] : deprecated_)
       if (opt->count() > 0)
-        std::cerr << "robodamp " << sub->get_name() << ": " << opt->get_name() << " is deprecated (kept for one release): use "
-                  << replacement << '\n';
+        std::cerr << "robodamp " << sub->get_name() << ": " << opt->get_name()
+                  << " is deprecated (kept for one release): use " << replacement << '\n';
     const StdoutForJson redirect(json_to_stdout);
     try {
       return handler();
@@ -243,11 +246,14 @@ int dispatch(int argc, const char* const* argv) {
   CLI::App app{"robodamp: real-time active vibration damping for robotic milling"};
   app.require_subcommand(1);
   Registry r(app);
-  for (auto reg : {register_bench, register_analyze, register_filters, register_check_config, register_run,
-                   register_replay, register_csv, register_lobes, register_sle, register_cut, register_identify, register_measure, register_commission, register_pose, register_tune, register_schedule, register_chatter, register_plant, register_monitor,
-                   register_request, register_dashboard})
+  for (auto reg : {register_bench,    register_analyze, register_filters,    register_check_config, register_run,
+                   register_replay,   register_csv,     register_lobes,      register_sle,          register_cut,
+                   register_identify, register_measure, register_commission, register_pose,         register_tune,
+                   register_schedule, register_chatter, register_plant,      register_monitor,      register_request,
+                   register_dashboard})
     reg(r);
-  app.set_version_flag("--version", [] { return version_text(); }, "robodamp's version and the dependencies it was built against");
+  app.set_version_flag(
+      "--version", [] { return version_text(); }, "robodamp's version and the dependencies it was built against");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForVersion& e) {
@@ -257,7 +263,8 @@ int dispatch(int argc, const char* const* argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "robodamp: " << e.what() << " (robodamp --help lists the commands, robodamp COMMAND --help the options)\n";
+    std::cerr << "robodamp: " << e.what()
+              << " (robodamp --help lists the commands, robodamp COMMAND --help the options)\n";
     return 2;
   }
   return r.run_parsed();

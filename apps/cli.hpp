@@ -20,7 +20,9 @@ namespace robodamp::apps {
 
 // The commands' defaults, found in the data folders (an installed /usr/share/robodamp, else this tree's).
 [[nodiscard]] inline std::string default_cell_config() { return config::shipped_file("presets/horizontal_c2.yaml"); }
-[[nodiscard]] inline std::string default_job() { return config::shipped_file("milling/industrial_robot_aluminium.yaml"); }
+[[nodiscard]] inline std::string default_job() {
+  return config::shipped_file("milling/industrial_robot_aluminium.yaml");
+}
 
 // The one --json of every command (docs/cli.md): `--json FILE` writes the JSON to FILE and the command
 // prints its text as usual; `--json` alone or `--json -` prints the JSON on stdout, and then stdout

@@ -66,14 +66,14 @@ json hil_critical(const CutArgs& a, const milling::CutJob& job, double rpm, doub
       cell, controller, {commission::this_executable(), a.hil_path, a.job_path, job.settings.revolutions}, rpm,
       in_process_mm, kHilRelTol, dir, [](const std::string& line) { std::cerr << "[cut hil] " << line << '\n'; });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("          through the HIL emulator (%s): critical %.4f mm at %.1f rpm (%+.1f %% against in process), above it "
-              "%s at %.1f Hz; %d cuts across processes in %.1f s\n",
-              a.hil_path.c_str(), c.depth_mm, c.rpm, (c.depth_mm / in_process_mm - 1.0) * 100.0, c.above.c_str(),
-              c.chatter_hz, c.cuts, wall);
-  return {{"cell", a.hil_path}, {"rpm", c.rpm}, {"critical_depth_mm", c.depth_mm}, {"above", c.above},
-          {"chatter_hz", c.chatter_hz}, {"cuts", c.cuts}, {"rel_tol", kHilRelTol}, {"wall_s", wall}};
+  std::printf(
+      "          through the HIL emulator (%s): critical %.4f mm at %.1f rpm (%+.1f %% against in process), above it "
+      "%s at %.1f Hz; %d cuts across processes in %.1f s\n",
+      a.hil_path.c_str(), c.depth_mm, c.rpm, (c.depth_mm / in_process_mm - 1.0) * 100.0, c.above.c_str(), c.chatter_hz,
+      c.cuts, wall);
+  return {{"cell", a.hil_path},         {"rpm", c.rpm},   {"critical_depth_mm", c.depth_mm}, {"above", c.above},
+          {"chatter_hz", c.chatter_hz}, {"cuts", c.cuts}, {"rel_tol", kHilRelTol},           {"wall_s", wall}};
 }
-
 
 // Beside a frequency the simulated cut found, how it relates to the accurate method's (milling/chatter.hpp).
 const char* alias_note(double cut_hz, double accurate_hz, double tooth_hz) {
@@ -94,7 +94,8 @@ json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double w
           {"classification", milling::to_string(v.classification)},
           {"mechanism", milling::to_string(v.mechanism)},
           {"chatter_hz", v.stable ? json(nullptr) : json(v.chatter_hz)},
-          {"chatter_family_hz", v.stable ? json(nullptr) : json(milling::chatter_family_hz(v.chatter_hz, r.rpm * job.cutter.teeth / 60.0))},
+          {"chatter_family_hz",
+           v.stable ? json(nullptr) : json(milling::chatter_family_hz(v.chatter_hz, r.rpm * job.cutter.teeth / 60.0))},
           {"once_per_tooth_ratio", v.once_per_period_ratio},
           {"nonharmonic_energy_ratio", v.nonharmonic_energy_ratio},
           {"growth_per_tooth", finite_or_null(v.growth_per_period)},
@@ -120,18 +121,20 @@ std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
   {  // displacement and force after settling
     std::ostringstream d;
     for (std::size_t k = from; k < n; ++k)
-      d << static_cast<double>(k) * r.step_s << ' ' << r.x_m[k] * 1e6 << ' ' << r.y_m[k] * 1e6 << ' ' << r.fx_n[k] << ' '
-        << r.fy_n[k] << '\n';
+      d << static_cast<double>(k) * r.step_s << ' ' << r.x_m[k] * 1e6 << ' ' << r.y_m[k] * 1e6 << ' ' << r.fx_n[k]
+        << ' ' << r.fy_n[k] << '\n';
     const std::string s1 =
         "set title 'Tool displacement (cutter frame)'\nset grid\nset xlabel 'time (s)'\nset ylabel 'um'\n"
         "plot DATA u 1:2 w l t 'x (feed)', DATA u 1:3 w l t 'y (wall normal)'\n";
     if (auto e = run_gnuplot(s1, d.str(), dir + "/cut_displacement.png"); !e.empty()) return e;
-    const std::string s2 = "set title 'Cutting force on the tool'\nset grid\nset xlabel 'time (s)'\nset ylabel 'N'\n"
-                           "plot DATA u 1:4 w l t 'Fx', DATA u 1:5 w l t 'Fy'\n";
+    const std::string s2 =
+        "set title 'Cutting force on the tool'\nset grid\nset xlabel 'time (s)'\nset ylabel 'N'\n"
+        "plot DATA u 1:4 w l t 'Fx', DATA u 1:5 w l t 'Fy'\n";
     if (auto e = run_gnuplot(s2, d.str(), dir + "/cut_force.png"); !e.empty()) return e;
   }
   {  // spectrum of y after settling, tooth-passing harmonics marked
-    const std::size_t len = ((n - from) / static_cast<std::size_t>(r.steps_per_tooth)) * static_cast<std::size_t>(r.steps_per_tooth);
+    const std::size_t len =
+        ((n - from) / static_cast<std::size_t>(r.steps_per_tooth)) * static_cast<std::size_t>(r.steps_per_tooth);
     analysis::RealFft fft(len);
     double mean = 0.0;
     for (std::size_t i = 0; i < len; ++i) mean += r.y_m[n - len + i] / static_cast<double>(len);
@@ -145,15 +148,17 @@ std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
     s << "set title 'Spectrum of the wall-normal displacement (" << milling::to_string(o.verdict.classification)
       << ")'\nset grid\nset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel 'amplitude (um)'\n";
     for (int h = 1; h * tooth_hz <= f_max; ++h)
-      s << "set arrow from " << h * tooth_hz << ", graph 0 to " << h * tooth_hz << ", graph 1 nohead dt 3 lc rgb 'gray50'\n";
+      s << "set arrow from " << h * tooth_hz << ", graph 0 to " << h * tooth_hz
+        << ", graph 1 nohead dt 3 lc rgb 'gray50'\n";
     s << "plot DATA u 1:2 w l lw 2 t 'y (tooth-passing harmonics dotted)'\n";
     if (auto e = run_gnuplot(s.str(), d.str(), dir + "/cut_spectrum.png"); !e.empty()) return e;
   }
   {  // the machined wall per revolution
     std::ostringstream d;
     for (std::size_t i = 0; i < r.wall_per_rev_um.size(); ++i) d << i << ' ' << r.wall_per_rev_um[i] << '\n';
-    const std::string s = "set title 'Machined wall: surface location error per revolution (+ = undercut)'\nset grid\n"
-                          "set xlabel 'revolution after settling'\nset ylabel 'um'\nplot DATA u 1:2 w lp t 'SLE'\n";
+    const std::string s =
+        "set title 'Machined wall: surface location error per revolution (+ = undercut)'\nset grid\n"
+        "set xlabel 'revolution after settling'\nset ylabel 'um'\nplot DATA u 1:2 w lp t 'SLE'\n";
     if (auto e = run_gnuplot(s, d.str(), dir + "/cut_surface.png"); !e.empty()) return e;
   }
   return {};
@@ -163,7 +168,8 @@ std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
 std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, const milling::Structure& structure,
                            milling::CutOverrides ov, const std::vector<double>& speeds, json& out) {
   if (speeds.size() > 1)
-    throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", "--rpm: one speed for a cut (several with --critical)"}});
+    throw config::ConfigError(
+        {config::Problem{cfg.source, {}, "--rpm", "--rpm: one speed for a cut (several with --critical)"}});
   if (!a.rpm.empty()) ov.rpm = speeds.front();
   const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
   const auto t0 = std::chrono::steady_clock::now();
@@ -172,14 +178,19 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
   std::printf("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
               out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
               out["classification"].get<std::string>().c_str());
-  if (!o.verdict.stable) std::printf(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
-  std::printf("; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f s\n",
-              o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
-              out["simulated_s"].get<double>(), out["wall_s"].get<double>());
+  if (!o.verdict.stable)
+    std::printf(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
+  std::printf(
+      "; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f "
+      "s\n",
+      o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
+      out["simulated_s"].get<double>(), out["wall_s"].get<double>());
   if (job.damped)
-    std::printf("  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole number of loop periods)\n",
-                o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
-                o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
+    std::printf(
+        "  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole "
+        "number of loop periods)\n",
+        o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
+        o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
   if (!a.plot_dir.empty()) {
     if (auto e = plot_cut(o, a.plot_dir); !e.empty()) {
       std::cerr << "plot: " << e << '\n';
@@ -192,8 +203,8 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
 
 // --critical at one speed: the time-domain critical depth beside the accurate method's and the zero-order
 // preview, its JSON entry and its line.
-json critical_at(const CutArgs& a, const config::MillingConfig& cfg, const milling::CutJob& job, const milling::LobeModel& lobes,
-                 const milling::AccurateStability& truth, double rpm) {
+json critical_at(const CutArgs& a, const config::MillingConfig& cfg, const milling::CutJob& job,
+                 const milling::LobeModel& lobes, const milling::AccurateStability& truth, double rpm) {
   const double zoa_mm = lobes.critical_depth_mm(rpm);
   milling::SdmPoint sdm;
   try {
@@ -204,26 +215,38 @@ json critical_at(const CutArgs& a, const config::MillingConfig& cfg, const milli
   std::cerr << "[cut] critical depth at " << rpm << " rpm (" << truth.method() << " " << sdm.critical_depth_mm
             << " mm, zero-order preview " << zoa_mm << " mm):\n";
   const auto t0 = std::chrono::steady_clock::now();
-  const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm : std::isfinite(zoa_mm) ? zoa_mm : 1.0;
-  const milling::CriticalDepth c = milling::critical_depth(
-      job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
-      [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
+  const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm
+                       : std::isfinite(zoa_mm)              ? zoa_mm
+                                                            : 1.0;
+  const milling::CriticalDepth c =
+      milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
+                              [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double tooth_hz = rpm * job.cutter.teeth / 60.0;  // the chatter's family: milling/chatter.hpp
-  json entry = {{"rpm", rpm}, {"simulated_rpm", job.settings.rpm}, {"damped", a.damped},
-                {"critical_depth_mm", c.depth_mm}, {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
-                {"accurate_method", truth.method()}, {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
-                {"accurate_rpm", sdm.rpm}, {"accurate_chatter_hz", sdm.chatter_hz},
+  json entry = {{"rpm", rpm},
+                {"simulated_rpm", job.settings.rpm},
+                {"damped", a.damped},
+                {"critical_depth_mm", c.depth_mm},
+                {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
+                {"accurate_method", truth.method()},
+                {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
+                {"accurate_rpm", sdm.rpm},
+                {"accurate_chatter_hz", sdm.chatter_hz},
                 {"accurate_chatter_family_hz", milling::chatter_family_hz(sdm.chatter_hz, tooth_hz)},
                 {"chatter_family_hz", milling::chatter_family_hz(c.chatter_hz, tooth_hz)},
                 {"accurate_type", milling::to_string(sdm.type)},
-                {"classification", milling::to_string(c.above)}, {"mechanism", milling::to_string(c.mechanism)},
-                {"chatter_hz", c.chatter_hz}, {"simulations", c.simulations}, {"wall_s", wall}};
-  std::printf("%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
-              "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
-              rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm, (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0,
-              milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm, milling::to_string(c.above), milling::to_string(c.mechanism),
-              c.chatter_hz, alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz), c.simulations, wall);
+                {"classification", milling::to_string(c.above)},
+                {"mechanism", milling::to_string(c.mechanism)},
+                {"chatter_hz", c.chatter_hz},
+                {"simulations", c.simulations},
+                {"wall_s", wall}};
+  std::printf(
+      "%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
+      "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
+      rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm,
+      (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0, milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm,
+      milling::to_string(c.above), milling::to_string(c.mechanism), c.chatter_hz,
+      alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz), c.simulations, wall);
   if (!a.hil_path.empty()) entry["hil"] = hil_critical(a, job, rpm, c.depth_mm);
   return entry;
 }
@@ -252,19 +275,24 @@ int run_cut(const CutArgs& a) {
     MillingOptions pose;
     pose.pose_deg = a.pose_deg;
     apply_pose(cfg, pose);
-    if (!a.hil_path.empty() && (!a.critical || !a.structure.empty() || !a.controller_path.empty() || !a.pose_deg.empty()))
-      throw config::ConfigError({config::Problem{cfg.source, {}, "--hil",
-                                                 "--hil goes with --critical and the job's own structure (no --structure, "
-                                                 "--controller or --pose): the emulator cuts the job as its file says"}});
+    if (!a.hil_path.empty() &&
+        (!a.critical || !a.structure.empty() || !a.controller_path.empty() || !a.pose_deg.empty()))
+      throw config::ConfigError(
+          {config::Problem{cfg.source,
+                           {},
+                           "--hil",
+                           "--hil goes with --critical and the job's own structure (no --structure, "
+                           "--controller or --pose): the emulator cuts the job as its file says"}});
     const config::StructureConfig chosen = selected_structure(cfg, a.structure, a.controller_path);
     const milling::Structure structure(chosen, false);
     const milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
     const std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;
     // The job's speed range, as lobes checks it: a speed outside it is one the job does not describe.
-    const config::Range job_speeds{"rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false,
-                                   "the job's lobes.rpm_min .. lobes.rpm_max"};
+    const config::Range job_speeds{
+        "rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false, "the job's lobes.rpm_min .. lobes.rpm_max"};
     for (double rpm : a.rpm)
-      if (auto p = config::range_problem("--rpm", rpm, job_speeds)) throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p}});
+      if (auto p = config::range_problem("--rpm", rpm, job_speeds))
+        throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", *p}});
     json out;
     if (!a.critical) {
       if (const auto failed = one_cut(a, cfg, structure, ov, speeds, out)) return *failed;
@@ -292,7 +320,8 @@ void register_cut(Registry& r) {
                         [a] { return run_cut(*a); });
   r.job(sub, a->job_path);
   sub->add_option("--structure", a->structure, "Which of the job's structures (default: its `structure`)");
-  r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
+  r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0},
+            "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
   r.numbers(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, true, false, "and within the job's lobes speed range"},
             "Spindle speed (several with --critical)");
   r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "Axial depth (default: the job's)");
@@ -303,11 +332,13 @@ void register_cut(Registry& r) {
   sub->add_flag("--damped", a->damped,
                 "With the damping controller running: the real Controller, the simulated plant with its actuator, "
                 "limits and sensor, at the configuration's loop rate");
-  sub->add_option("--controller", a->controller_path, "Damping configuration to use instead of the job's (compare compensators)")
+  sub->add_option("--controller", a->controller_path,
+                  "Damping configuration to use instead of the job's (compare compensators)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--hil", a->hil_path,
-                  "With --critical: also the critical depth through the HIL emulator, a cell configuration for the job's "
-                  "robot with can.interface unix:... (robodamp plant and the controller as two processes, lockstep)")
+  sub->add_option(
+         "--hil", a->hil_path,
+         "With --critical: also the critical depth through the HIL emulator, a cell configuration for the job's "
+         "robot with can.interface unix:... (robodamp plant and the controller as two processes, lockstep)")
       ->check(CLI::ExistingFile);
   r.json(sub, a->json, "The result");
   r.plot_dir(sub, a->plot_dir, "displacement, force, spectrum and surface plots");

@@ -48,8 +48,9 @@ int run_dashboard(const DashboardArgs& a) {
     return 2;
   }
   if (!dashboard::plain_http_refusal(cfg, false).empty())  // served anyway: --insecure-http
-    spdlog::warn("dashboard: plain HTTP on {} (--insecure-http): passwords and session tokens cross the network readable",
-                 cfg.listen_address);
+    spdlog::warn(
+        "dashboard: plain HTTP on {} (--insecure-http): passwords and session tokens cross the network readable",
+        cfg.listen_address);
   std::vector<dashboard::User> users;
   try {
     if (!cfg.credentials.empty()) users = dashboard::load_users(cfg.credentials);
@@ -69,10 +70,12 @@ int run_dashboard(const DashboardArgs& a) {
       dashboard::WebServer& s;
       ~StopOnExit() { s.stop(); }  // before `serving` joins, on every path
     } stop_on_exit{server};
-    std::cout << "robodamp dashboard: " << (cfg.tls() ? "https://" : "http://") << cfg.listen_address << ":" << port << "/  (DDS domain " << cfg.dds.domain_id
-              << ", " << config::to_string(cfg.dds.transport) << (cfg.dds.security ? ", secured" : "") << "; "
+    std::cout << "robodamp dashboard: " << (cfg.tls() ? "https://" : "http://") << cfg.listen_address << ":" << port
+              << "/  (DDS domain " << cfg.dds.domain_id << ", " << config::to_string(cfg.dds.transport)
+              << (cfg.dds.security ? ", secured" : "") << "; "
               << (auth.anyone_may_act() ? std::to_string(users.size()) + " users from " + cfg.credentials
-                                        : std::string("no operator configured: view only")) << "; Ctrl-C ends)" << std::endl;
+                                        : std::string("no operator configured: view only"))
+              << "; Ctrl-C ends)" << std::endl;
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.duration_s);
     while (rt::shutdown_signal().load() == 0 && (a.duration_s <= 0.0 || std::chrono::steady_clock::now() < end))
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -113,7 +116,8 @@ int run_dashboard_user(const std::string& file, const std::string& user, const s
   }
   std::string password;
   if (!std::getline(std::cin, password) || password.size() < 8) {
-    std::cerr << "robodamp dashboard-user: give the password on the first line of standard input (at least 8 characters)\n";
+    std::cerr
+        << "robodamp dashboard-user: give the password on the first line of standard input (at least 8 characters)\n";
     return 2;
   }
   try {
@@ -131,10 +135,11 @@ int run_dashboard_user(const std::string& file, const std::string& user, const s
 
 void register_dashboard(Registry& r) {
   auto a = std::make_shared<DashboardArgs>();
-  CLI::App* sub = r.add("dashboard",
-                        "Web page for every robodamp cell on the DDS domain: fleet tiles, a cell's live plots and counters, "
-                        "operator actions after a login (docs/dashboard.md)",
-                        [a] { return run_dashboard(*a); });
+  CLI::App* sub =
+      r.add("dashboard",
+            "Web page for every robodamp cell on the DDS domain: fleet tiles, a cell's live plots and counters, "
+            "operator actions after a login (docs/dashboard.md)",
+            [a] { return run_dashboard(*a); });
   sub->add_option("--config", a->config_path, "Dashboard configuration (dashboard and dds sections; docs/dashboard.md)")
       ->check(CLI::ExistingFile);
   sub->add_option("--listen", a->listen, "Address to serve on (default dashboard.listen_address, else 127.0.0.1)");

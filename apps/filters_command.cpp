@@ -37,11 +37,19 @@ nlohmann::json filters_report(const analysis::ChainDesign& d, double freq_hz) {
     blocks.push_back(std::move(j));
   }
   const Complex k(p.gain_ns_per_m);
-  blocks.push_back({{"name", "K"}, {"kind", "gain"}, {"unit", "N s/m"}, {"value", p.gain_ns_per_m},
-                    {"analog", bode_point(k)}, {"digital", bode_point(k)}});
+  blocks.push_back({{"name", "K"},
+                    {"kind", "gain"},
+                    {"unit", "N s/m"},
+                    {"value", p.gain_ns_per_m},
+                    {"analog", bode_point(k)},
+                    {"digital", bode_point(k)}});
   const Complex out(p.polarity / p.actuator_constant_n_per_v);
-  blocks.push_back({{"name", "polarity/T"}, {"kind", "gain"}, {"unit", "V/N"}, {"value", out.real()},
-                    {"analog", bode_point(out)}, {"digital", bode_point(out)}});
+  blocks.push_back({{"name", "polarity/T"},
+                    {"kind", "gain"},
+                    {"unit", "V/N"},
+                    {"value", out.real()},
+                    {"analog", bode_point(out)},
+                    {"digital", bode_point(out)}});
   return {{"source", d.source},
           {"fs_hz", p.fs_hz},
           {"freq_hz", freq_hz},
@@ -57,11 +65,10 @@ nlohmann::json filters_report(const analysis::ChainDesign& d, double freq_hz) {
 std::string filters_table(const nlohmann::json& r) {
   std::ostringstream os;
   char line[256];
-  os << "robodamp filters: " << r["source"].get<std::string>() << "\n  loop " << r["fs_hz"].get<double>()
-     << " Hz, " << r["sections"].get<int>() << " second-order sections, response at " << r["freq_hz"].get<double>()
-     << " Hz\n\n";
-  std::snprintf(line, sizeof line, "  %-16s %-12s %11s %11s %11s %11s  %s\n", "block", "kind", "analog dB", "analog deg",
-                "digital dB", "digital deg", "realised as (pre-warp)");
+  os << "robodamp filters: " << r["source"].get<std::string>() << "\n  loop " << r["fs_hz"].get<double>() << " Hz, "
+     << r["sections"].get<int>() << " second-order sections, response at " << r["freq_hz"].get<double>() << " Hz\n\n";
+  std::snprintf(line, sizeof line, "  %-16s %-12s %11s %11s %11s %11s  %s\n", "block", "kind", "analog dB",
+                "analog deg", "digital dB", "digital deg", "realised as (pre-warp)");
   os << line;
   auto row = [&](const nlohmann::json& b, const std::string& name, const std::string& kind, const std::string& note) {
     std::snprintf(line, sizeof line, "  %-16s %-12s %11.3f %11.2f %11.3f %11.2f  %s\n", name.c_str(), kind.c_str(),
@@ -97,7 +104,8 @@ std::string plot_filters(const analysis::ChainDesign& d, const std::string& png_
       const Complex h = b.analog.at_hz(f);
       data << ' ' << magnitude_db(h) << ' ' << phase_deg(h);
     }
-    for (const Complex h : {d.chain_analog(f), d.chain_digital(f)}) data << ' ' << magnitude_db(h) << ' ' << phase_deg(h);
+    for (const Complex h : {d.chain_analog(f), d.chain_digital(f)})
+      data << ' ' << magnitude_db(h) << ' ' << phase_deg(h);
     data << '\n';
   }
   std::ostringstream s;
@@ -141,8 +149,9 @@ int run_filters(const FiltersArgs& a) {
   }
   const auto report = filters_report(d, a.freq_hz);
   const std::string target = plot_file(a.plot_dir, a.plot, "filters.png");
-  return print_report(report.dump(2), a.json, "filters", filters_table(report), target,
-                      [&] { return plot_filters(d, target); }, target);
+  return print_report(
+      report.dump(2), a.json, "filters", filters_table(report), target, [&] { return plot_filters(d, target); },
+      target);
 }
 
 }  // namespace
@@ -152,7 +161,8 @@ void register_filters(Registry& r) {
   CLI::App* sub = r.add("filters", "Magnitude and phase of each block and the chain, analog and digital",
                         [a] { return run_filters(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
-  r.number(sub, "--freq", a->freq_hz, {"Hz", 0.0, 1e6, true, false, "and below Nyquist of loop.rate_hz"}, "Frequency in Hz");
+  r.number(sub, "--freq", a->freq_hz, {"Hz", 0.0, 1e6, true, false, "and below Nyquist of loop.rate_hz"},
+           "Frequency in Hz");
   r.json(sub, a->json, "The blocks' and the chain's magnitude and phase");
   r.plot_dir(sub, a->plot_dir, "filters.png, the Bode diagram of the blocks and the chain,");
   r.deprecated(sub->add_option("--plot", a->plot, "Write the Bode diagram to this file (PNG)"), "--plot-dir DIR");

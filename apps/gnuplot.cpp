@@ -5,8 +5,9 @@
 
 namespace robodamp::apps {
 
-int print_report(const std::string& json_text, const JsonOut& json, const std::string& command, const std::string& table,
-                 const std::string& plot_target, const std::function<std::string()>& plot, const std::string& wrote) {
+int print_report(const std::string& json_text, const JsonOut& json, const std::string& command,
+                 const std::string& table, const std::string& plot_target, const std::function<std::string()>& plot,
+                 const std::string& wrote) {
   if (!emit_json(json, json_text, command)) return 1;
   if (!json.to_stdout()) std::cout << table;
   if (!plot_target.empty()) {

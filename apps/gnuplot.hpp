@@ -20,6 +20,7 @@ using plot::run_gnuplot;
 
 // Where a command's one plot goes: DIR/name with --plot-dir DIR (the directory made), else the deprecated
 // --plot FILE (empty: no plot).
-[[nodiscard]] std::string plot_file(const std::string& plot_dir, const std::string& legacy_file, const std::string& name);
+[[nodiscard]] std::string plot_file(const std::string& plot_dir, const std::string& legacy_file,
+                                    const std::string& name);
 
 }  // namespace robodamp::apps

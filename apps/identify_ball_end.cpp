@@ -16,7 +16,8 @@ namespace robodamp::apps {
 
 namespace {
 
-constexpr double kTableKappaRad = 1.0;  // Tian et al. (2024)'s single values are the ball-end bone study's at kappa = 1 rad
+constexpr double kTableKappaRad =
+    1.0;  // Tian et al. (2024)'s single values are the ball-end bone study's at kappa = 1 rad
 
 double at(const std::vector<identify::Estimate>& poly, double kappa) {
   double v = 0.0, kp = 1.0;
@@ -45,8 +46,10 @@ int run_identify_ball_end(const IdentifyArgs& a) {
     std::cerr << "robodamp identify cutting --ball-end: " << e.what() << '\n';
     return 2;
   }
-  std::printf("Ball-end cutting coefficients from %d slot runs (%d teeth, %.3g mm, helix %.3g deg), shear terms of order %d "
-              "in kappa (rad):\n", f.runs, a.teeth, a.diameter_mm, a.helix_deg, a.order);
+  std::printf(
+      "Ball-end cutting coefficients from %d slot runs (%d teeth, %.3g mm, helix %.3g deg), shear terms of order %d "
+      "in kappa (rad):\n",
+      f.runs, a.teeth, a.diameter_mm, a.helix_deg, a.order);
   auto poly = [](const char* name, const std::vector<identify::Estimate>& p) {
     std::printf("  %s:", name);
     for (std::size_t i = 0; i < p.size(); ++i) std::printf("  k%zu %.4g +- %.3g", i, p[i].value, p[i].ci95);
@@ -64,12 +67,18 @@ int run_identify_ball_end(const IdentifyArgs& a) {
     for (const auto& e : *p) wide = wide || e.ci95 > std::abs(e.value);
   if (wide) std::printf("  note: some 95 %% intervals are wider than their values: the runs do not determine them\n");
   if (a.json.given) {
-    const nlohmann::json j = {{"ktc_n_per_mm2", terms(f.ktc)}, {"krc_n_per_mm2", terms(f.krc)}, {"kac_n_per_mm2", terms(f.kac)},
+    const nlohmann::json j = {{"ktc_n_per_mm2", terms(f.ktc)},
+                              {"krc_n_per_mm2", terms(f.krc)},
+                              {"kac_n_per_mm2", terms(f.kac)},
                               {"kte_n_per_mm", {{"value", f.kte.value}, {"ci95", f.kte.ci95}}},
                               {"kre_n_per_mm", {{"value", f.kre.value}, {"ci95", f.kre.ci95}}},
                               {"kae_n_per_mm", {{"value", f.kae.value}, {"ci95", f.kae.ci95}}},
-                              {"r2_y", f.r2_y}, {"r2_xz", f.r2_xz}, {"residual_rms_n", f.residual_rms_n},
-                              {"condition_number", f.condition_number}, {"runs", f.runs}, {"order", a.order}};
+                              {"r2_y", f.r2_y},
+                              {"r2_xz", f.r2_xz},
+                              {"residual_rms_n", f.residual_rms_n},
+                              {"condition_number", f.condition_number},
+                              {"runs", f.runs},
+                              {"order", a.order}};
     if (!emit_json(a.json, j.dump(2), "identify")) return 1;
     if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }

@@ -24,9 +24,7 @@
 
 namespace robodamp::apps {
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir,
                        const std::string& prefix) {
@@ -48,8 +46,9 @@ std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit
   if (auto e = run_gnuplot(fig.script, fig.data, dir + "/" + prefix + "_fit.png"); !e.empty()) return e;
   std::ostringstream diag;
   for (const auto& p : fit.diagram) diag << plot::num(p.freq_hz) << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
-  const std::string s2 = "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
-                         "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
+  const std::string s2 =
+      "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
+      "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
   return run_gnuplot(s2, diag.str(), dir + "/" + prefix + "_stabilisation.png");
 }
 
@@ -60,7 +59,9 @@ namespace {
 identify::FrfData frf_of(const IdentifyArgs& a) {
   const bool dof_response = a.response.find_first_of("0123456789") != std::string::npos;
   if (!dof_response && a.response != "acceleration" && a.response != "velocity" && a.response != "displacement")
-    throw std::invalid_argument("--response '" + a.response + "': allowed acceleration, velocity, displacement (--series) or NODE:DIR (a universal file's record)");
+    throw std::invalid_argument(
+        "--response '" + a.response +
+        "': allowed acceleration, velocity, displacement (--series) or NODE:DIR (a universal file's record)");
   if (!a.frf_path.empty() && identify::looks_like_uff(a.frf_path)) {
     identify::UffSelection sel;
     sel.record = a.record;
@@ -69,17 +70,21 @@ identify::FrfData frf_of(const IdentifyArgs& a) {
     const measfiles::UffFile file = measfiles::read_uff(a.frf_path);
     const identify::UffFrf frf = identify::frf_from_uff(file, a.frf_path, sel);
     if (frf.units.per_volt)
-      throw std::invalid_argument(a.frf_path + ": record " + std::to_string(frf.record) + " is per volt (an actuator's FRF); identify modes reads an FRF per force");
+      throw std::invalid_argument(a.frf_path + ": record " + std::to_string(frf.record) +
+                                  " is per volt (an actuator's FRF); identify modes reads an FRF per force");
     std::printf("record %d: %s / %s, %s, %zu points%s\n", frf.record,
                 identify::dof_text(frf.function->response_node, frf.function->response_direction).c_str(),
-                identify::dof_text(frf.function->reference_node, frf.function->reference_direction).c_str(), frf.units.shown.c_str(),
-                frf.data.f_hz.size(), frf.data.coherence.empty() ? ", no coherence record" : ", with its coherence");
+                identify::dof_text(frf.function->reference_node, frf.function->reference_direction).c_str(),
+                frf.units.shown.c_str(), frf.data.f_hz.size(),
+                frf.data.coherence.empty() ? ", no coherence record" : ", with its coherence");
     return frf.data;
   } else if (!a.frf_path.empty()) {
     if (a.record || dof_response || !a.reference.empty())
-      throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " + a.frf_path + " is a table");
-    const auto kind = a.kind == "mobility" ? identify::FrfKind::kMobility
-                      : a.kind == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+      throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " +
+                                  a.frf_path + " is a table");
+    const auto kind = a.kind == "mobility"      ? identify::FrfKind::kMobility
+                      : a.kind == "accelerance" ? identify::FrfKind::kAccelerance
+                                                : identify::FrfKind::kReceptance;
     return identify::read_frf_csv(a.frf_path, kind);
   } else if (identify::looks_like_uff(a.series_path)) {
     identify::UffSelection sel;
@@ -89,11 +94,13 @@ identify::FrfData frf_of(const IdentifyArgs& a) {
     const identify::UffSeries s = identify::time_series_from_uff(file, a.series_path, sel);
     std::printf("records %d (force) and %d (response), %zu samples at %.6g Hz\n", s.force_record, s.response_record,
                 s.series.input.size(), s.series.fs_hz);
-    return identify::frf_from_time_series(s.series, s.kind, a.segment_s, a.overlap, a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
+    return identify::frf_from_time_series(s.series, s.kind, a.segment_s, a.overlap,
+                                          a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
   } else {
     if (dof_response) throw std::invalid_argument("--response with --series: acceleration, velocity or displacement");
-    const auto kind = a.response == "velocity" ? identify::FrfKind::kMobility
-                      : a.response == "acceleration" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+    const auto kind = a.response == "velocity"       ? identify::FrfKind::kMobility
+                      : a.response == "acceleration" ? identify::FrfKind::kAccelerance
+                                                     : identify::FrfKind::kReceptance;
     return identify::frf_from_time_series_csv(a.series_path, kind, a.segment_s, a.overlap,
                                               a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
   }
@@ -118,15 +125,21 @@ int run_modes(const IdentifyArgs& a) {
   }
   std::printf("%zu modes in %.3g-%.3g Hz, fit error %.3f %% (RMS |H - fit| / RMS |H|):\n", fit.modes.size(),
               fit.band_lo_hz, fit.band_hi_hz, fit.fit_error_pct);
-  nlohmann::json j{{"fit_error_pct", fit.fit_error_pct}, {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}}, {"modes", nlohmann::json::array()}};
+  nlohmann::json j{{"fit_error_pct", fit.fit_error_pct},
+                   {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}},
+                   {"modes", nlohmann::json::array()}};
   std::ostringstream yaml;
   yaml << "# robodamp identify modes " << a.frf_path << ": fit error " << fit.fit_error_pct
-       << " %; Eq. 1 residue form in the table's frame. Paste under a robot.frfs entry or a milling part's pair.\nmodes:\n";
+       << " %; Eq. 1 residue form in the table's frame. Paste under a robot.frfs entry or a milling part's "
+          "pair.\nmodes:\n";
   for (const auto& m : fit.modes) {
     std::printf("  %9.4f Hz  zeta %.5f  sigma %+.4e %+.4ei m/N  (k %.4g N/m)\n", m.natural_freq_hz, m.damping_ratio,
                 m.residue_re, m.residue_im, m.stiffness_n_per_m);
-    j["modes"].push_back({{"natural_freq_hz", m.natural_freq_hz}, {"damping_ratio", m.damping_ratio},
-                          {"residue_re_m_per_n", m.residue_re}, {"residue_im_m_per_n", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
+    j["modes"].push_back({{"natural_freq_hz", m.natural_freq_hz},
+                          {"damping_ratio", m.damping_ratio},
+                          {"residue_re_m_per_n", m.residue_re},
+                          {"residue_im_m_per_n", m.residue_im},
+                          {"stiffness_n_per_m", m.stiffness_n_per_m}});
     yaml << "  - {natural_freq_hz: " << m.natural_freq_hz << ", damping_ratio: " << m.damping_ratio
          << ", residue_re_m_per_n: " << m.residue_re << ", residue_im_m_per_n: " << m.residue_im << "}\n";
   }
@@ -158,78 +171,121 @@ int run_identify(const IdentifyArgs& a) {
 
 }  // namespace
 
+namespace {
+void add_cutting_options(Registry& r, CLI::App* sub, IdentifyArgs& a);
+void add_other_options(Registry& r, CLI::App* sub, IdentifyArgs& a);
+}  // namespace
+
 void register_identify(Registry& r) {
   auto a = std::make_shared<IdentifyArgs>();
-  CLI::App* sub = r.add("identify",
-                        "Identify from measurements: `identify modes` (modes of an FRF), `identify actuator` (Eq. 3 from a "
-                        "chirp), `identify all` (a configuration from a `measure` directory), `identify cutting` "
-                        "(cutting coefficients from mean forces)",
-                        [a] { return run_identify(*a); });
+  CLI::App* sub =
+      r.add("identify",
+            "Identify from measurements: `identify modes` (modes of an FRF), `identify actuator` (Eq. 3 from a "
+            "chirp), `identify all` (a configuration from a `measure` directory), `identify cutting` "
+            "(cutting coefficients from mean forces)",
+            [a] { return run_identify(*a); });
   sub->add_option("what", a->what, "What to identify: modes, actuator, all or cutting")
       ->required()
       ->check(CLI::IsMember({"modes", "actuator", "all", "cutting"}));
-  sub->add_option("--frf", a->frf_path,
-                  "modes: an FRF table freq_hz,re_m_per_n,im_m_per_n[,coherence] (any delimiter, decimal comma, header or none) "
-                  "or a universal file (dataset 58/58b; its header gives the kind and the units)")
+  sub->add_option(
+         "--frf", a->frf_path,
+         "modes: an FRF table freq_hz,re_m_per_n,im_m_per_n[,coherence] (any delimiter, decimal comma, header or none) "
+         "or a universal file (dataset 58/58b; its header gives the kind and the units)")
       ->check(CLI::ExistingFile);
-  r.whole_number(sub, "--record", a->record, {"(record)", 1, 1000000}, "modes: the universal file's Nth function record");
-  sub->add_option("--reference", a->reference, "modes: the universal file's record by its reference DOF NODE:DIR (e.g. 2:+Y)");
+  r.whole_number(sub, "--record", a->record, {"(record)", 1, 1000000},
+                 "modes: the universal file's Nth function record");
+  sub->add_option("--reference", a->reference,
+                  "modes: the universal file's record by its reference DOF NODE:DIR (e.g. 2:+Y)");
   sub->add_option("--series", a->series_path, "modes: time series CSV time_s,force_n,response (H1 by Welch)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--response", a->response,
-                  "modes: the --series response (acceleration, velocity, displacement), or a universal file's record by its "
-                  "response DOF NODE:DIR (e.g. 1:+Y)");
-  r.number(sub, "--segment-s", a->segment_s, {"s", 0.0, 1e5, true, false}, "modes, actuator: Welch segment length for --series / --csv");
-  r.number(sub, "--overlap", a->overlap, {"(fraction)", 0.0, 0.9, false, false}, "modes: Welch segment overlap for --series");
-  sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
-  r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false}, "modes, actuator: fit band LO HI (default: the whole FRF; actuator: the chirp within analysis.band)");
-  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200}, "modes, all: highest order of the stabilisation diagram (even; default 40 for modes, 60 for all: a close pair common to several FRFs separates slowly with the order)");
+  sub->add_option(
+      "--response", a->response,
+      "modes: the --series response (acceleration, velocity, displacement), or a universal file's record by its "
+      "response DOF NODE:DIR (e.g. 1:+Y)");
+  r.number(sub, "--segment-s", a->segment_s, {"s", 0.0, 1e5, true, false},
+           "modes, actuator: Welch segment length for --series / --csv");
+  r.number(sub, "--overlap", a->overlap, {"(fraction)", 0.0, 0.9, false, false},
+           "modes: Welch segment overlap for --series");
+  sub->add_option("--kind", a->kind, "modes: what the FRF CSV holds")
+      ->check(CLI::IsMember({"receptance", "mobility", "accelerance"}));
+  r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e6, false, false},
+            "modes, actuator: fit band LO HI (default: the whole FRF; actuator: the chirp within analysis.band)");
+  r.whole_number(sub, "--max-order", a->max_order, {"(model order)", 4, 200},
+                 "modes, all: highest order of the stabilisation diagram (even; default 40 for modes, 60 for all: a "
+                 "close pair common to several FRFs separates slowly with the order)");
   r.plot_dir(sub, a->plot_dir, "modes, all: the fits and the stabilisation diagrams");
-  sub->add_option("--csv", a->csv_path, "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
+  add_cutting_options(r, sub, *a);
+  add_other_options(r, sub, *a);
+}
+
+namespace {
+
+// identify cutting's options: the mean forces or the force records, and the tests' tool and cut.
+void add_cutting_options(Registry& r, CLI::App* sub, IdentifyArgs& a) {
+  sub->add_option(
+         "--csv", a.csv_path,
+         "cutting: mean forces feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n; actuator: time_s,command_v,force_n")
       ->check(CLI::ExistingFile);
-  sub->add_option("--records", a->records,
-                  "cutting: force records, one per test (files, or a directory's files in name order): time, Fx, Fy, Fz as a "
-                  "dynamometer or logger exports them (any delimiter, decimal comma, preamble, units in the header)");
-  sub->add_option("--tests", a->tests_path, "cutting: a table of the tests: file, feed_per_tooth_mm, spindle_rpm (files relative to it)")
+  sub->add_option(
+      "--records", a.records,
+      "cutting: force records, one per test (files, or a directory's files in name order): time, Fx, Fy, Fz as a "
+      "dynamometer or logger exports them (any delimiter, decimal comma, preamble, units in the header)");
+  sub->add_option("--tests", a.tests_path,
+                  "cutting: a table of the tests: file, feed_per_tooth_mm, spindle_rpm (files relative to it)")
       ->check(CLI::ExistingFile);
-  r.numbers(sub, "--feeds-mm", a->feeds_mm, {"mm", 0.0, 10.0, false, false}, "cutting --records: the feed per tooth of each record, in order");
-  r.number(sub, "--rpm", a->rpm, {"rpm", 0.0, 200000.0, false, false}, "cutting --records: the spindle speed of the tests");
-  sub->add_option("--axes", a->axes,
-                  "cutting --records: the cutter's x (feed), y (normal), z (tool axis) from the record's Fx, Fy, Fz, e.g. -fy,fx,fz "
+  r.numbers(sub, "--feeds-mm", a.feeds_mm, {"mm", 0.0, 10.0, false, false},
+            "cutting --records: the feed per tooth of each record, in order");
+  r.number(sub, "--rpm", a.rpm, {"rpm", 0.0, 200000.0, false, false},
+           "cutting --records: the spindle speed of the tests");
+  sub->add_option("--axes", a.axes,
+                  "cutting --records: the cutter's x (feed), y (normal), z (tool axis) from the record's Fx, Fy, Fz, "
+                  "e.g. -fy,fx,fz "
                   "(default fx,fy,fz)");
-  sub->add_option("--force-on", a->force_on, "cutting --records: what the dynamometer measures the force on (default: workpiece)")
+  sub->add_option("--force-on", a.force_on,
+                  "cutting --records: what the dynamometer measures the force on (default: workpiece)")
       ->check(CLI::IsMember({"workpiece", "tool"}));
-  r.whole_number(sub, "--teeth", a->teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");
-  r.number(sub, "--diameter-mm", a->diameter_mm, {"mm", 0.0, 200.0, true, false}, "cutting: tool diameter");
-  r.number(sub, "--axial-mm", a->axial_mm, {"mm", 0.0, 100.0, true, false}, "cutting: axial depth of the tests");
-  r.number(sub, "--radial-mm", a->radial_mm, {"mm", 0.0, 200.0, true, false, "and at most --diameter-mm"},
+  r.whole_number(sub, "--teeth", a.teeth, {"(teeth)", 1, 32}, "cutting: teeth of the tool");
+  r.number(sub, "--diameter-mm", a.diameter_mm, {"mm", 0.0, 200.0, true, false}, "cutting: tool diameter");
+  r.number(sub, "--axial-mm", a.axial_mm, {"mm", 0.0, 100.0, true, false}, "cutting: axial depth of the tests");
+  r.number(sub, "--radial-mm", a.radial_mm, {"mm", 0.0, 200.0, true, false, "and at most --diameter-mm"},
            "cutting: radial depth of the tests (the diameter: slotting)");
-  sub->add_flag("--ball-end", a->ball_end,
-                "cutting: a ball-end mill from slot-milling mean forces axial_mm,feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n");
-  r.number(sub, "--helix-deg", a->helix_deg, {"deg", 0.0, 89.0}, "cutting --ball-end: helix angle at the ball's equator");
-  r.whole_number(sub, "--order", a->order, {"(polynomial order)", 0, 3},
-                 "cutting --ball-end: order of the shear coefficients' polynomial in the axial angle (the ball-end bone study: 3)");
-  sub->add_option("--mode", a->mode, "cutting: down or up milling")->check(CLI::IsMember({"down", "up"}));
-  sub->add_option("--recording", a->recording_path, "actuator: a robodamp measure recording (the chirp and the sensor)")
+  sub->add_flag("--ball-end", a.ball_end,
+                "cutting: a ball-end mill from slot-milling mean forces "
+                "axial_mm,feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n");
+  r.number(sub, "--helix-deg", a.helix_deg, {"deg", 0.0, 89.0},
+           "cutting --ball-end: helix angle at the ball's equator");
+  r.whole_number(sub, "--order", a.order, {"(polynomial order)", 0, 3},
+                 "cutting --ball-end: order of the shear coefficients' polynomial in the axial angle (the ball-end "
+                 "bone study: 3)");
+  sub->add_option("--mode", a.mode, "cutting: down or up milling")->check(CLI::IsMember({"down", "up"}));
+}
+
+// identify actuator's and identify all's options, and the outputs.
+void add_other_options(Registry& r, CLI::App* sub, IdentifyArgs& a) {
+  sub->add_option("--recording", a.recording_path, "actuator: a robodamp measure recording (the chirp and the sensor)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--structure", a->structure_path,
+  sub->add_option("--structure", a.structure_path,
                   "actuator: FRF CSV of the structure at the sensor for a force at the actuator (--kind applies)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--in", a->in_dir, "all: the directory robodamp measure wrote")->check(CLI::ExistingDirectory);
-  sub->add_option("--out", a->out_path, "all: write the identified configuration (YAML) here");
-  sub->add_option("--uff", a->uff_path,
+  sub->add_option("--in", a.in_dir, "all: the directory robodamp measure wrote")->check(CLI::ExistingDirectory);
+  sub->add_option("--out", a.out_path, "all: write the identified configuration (YAML) here");
+  sub->add_option("--uff", a.uff_path,
                   "all: a universal file instead of --in: an FRF per force between every pair of locations and the "
                   "actuator's acceleration per volt at the sensor (what measure and commission export)")
       ->check(CLI::ExistingFile);
-  sub->add_option("--config", a->config_path, "all --uff: the configuration the measurement ran with")->check(CLI::ExistingFile);
-  sub->add_option("--tap-tests", a->tap_tests,
+  sub->add_option("--config", a.config_path, "all --uff: the configuration the measurement ran with")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--tap-tests", a.tap_tests,
                   "all: with --in, the FRFs between the locations from your modal kit's tap tests (universal files or "
                   "frf_<response>_<excitation>.csv) and the actuator from --in's chirp (robodamp measure --no-hammer); "
                   "refused when they contradict the chirp")
       ->check(CLI::ExistingFile);
-  sub->add_option("--modes-uff", a->modes_uff_path, "all: also write the identified modes as a universal file (datasets 15, 55)");
-  r.json(sub, a->json, "The result and its quality figures");
-  sub->add_option("--yaml", a->yaml_path, "Write a modes: list (modes) or a material: block (cutting)");
+  sub->add_option("--modes-uff", a.modes_uff_path,
+                  "all: also write the identified modes as a universal file (datasets 15, 55)");
+  r.json(sub, a.json, "The result and its quality figures");
+  sub->add_option("--yaml", a.yaml_path, "Write a modes: list (modes) or a material: block (cutting)");
 }
+
+}  // namespace
 
 }  // namespace robodamp::apps

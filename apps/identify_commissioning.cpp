@@ -29,8 +29,9 @@ namespace {
 constexpr double kActuatorMinCoherence = 0.9;
 
 identify::FrfKind kind_of(const std::string& k) {
-  return k == "mobility" ? identify::FrfKind::kMobility
-         : k == "accelerance" ? identify::FrfKind::kAccelerance : identify::FrfKind::kReceptance;
+  return k == "mobility"      ? identify::FrfKind::kMobility
+         : k == "accelerance" ? identify::FrfKind::kAccelerance
+                              : identify::FrfKind::kReceptance;
 }
 
 // From a CSV of the amplifier command and the transmitted force (Welch).
@@ -40,7 +41,8 @@ identify::ActuatorFit actuator_from_force_csv(const IdentifyArgs& a) {
   if (segment < 16 || segment > ts.input.size())
     throw std::invalid_argument("--segment-s = " + std::to_string(a.segment_s) + " s = " + std::to_string(segment) +
                                 " samples: allowed 16 .. the record's " + std::to_string(ts.input.size()));
-  const analysis::FrfEstimate e = analysis::welch_frf(ts.input, ts.output, ts.fs_hz, segment, a.overlap, 0.45 * ts.fs_hz);
+  const analysis::FrfEstimate e =
+      analysis::welch_frf(ts.input, ts.output, ts.fs_hz, segment, a.overlap, 0.45 * ts.fs_hz);
   identify::ActuatorFrf g;
   for (std::size_t k = 1; k < e.f_hz.size(); ++k)
     g.f_hz.push_back(e.f_hz[k]), g.n_per_v.push_back(e.h1[k]), g.coherence.push_back(e.coherence[k]);
@@ -59,10 +61,11 @@ std::string plot_actuator(const identify::ActuatorFit& fit, const std::string& d
     data << fit.f_hz[i] << ' ' << std::abs(fit.measured[i]) << ' ' << std::arg(fit.measured[i]) * 180.0 / M_PI << ' '
          << std::abs(fit.fitted[i]) << ' ' << std::arg(fit.fitted[i]) * 180.0 / M_PI << '\n';
   std::ostringstream s;
-  s << "set multiplot layout 2,1 title 'Actuator force per volt: measured and Eq. 3 fitted (fit error " << fit.fit_error_pct
-    << " %)'\nset grid\nset logscale x\nset ylabel '|F/V| (N/V)'\n"
+  s << "set multiplot layout 2,1 title 'Actuator force per volt: measured and Eq. 3 fitted (fit error "
+    << fit.fit_error_pct << " %)'\nset grid\nset logscale x\nset ylabel '|F/V| (N/V)'\n"
     << "plot DATA u 1:2 w l t 'measured (hold as 1.5 periods)', DATA u 1:4 w l lw 2 t 'fit (exactly sampled)'\n"
-    << "set xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nplot DATA u 1:3 w l t 'measured (hold as 1.5 periods)', DATA u 1:5 w l lw 2 t 'fit (exactly sampled)'\n"
+    << "set xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nplot DATA u 1:3 w l t 'measured (hold as 1.5 periods)', "
+       "DATA u 1:5 w l lw 2 t 'fit (exactly sampled)'\n"
     << "unset multiplot\n";
   return run_gnuplot(s.str(), data.str(), dir + "/" + name);
 }
@@ -76,18 +79,21 @@ int run_identify_actuator(const IdentifyArgs& a) {
     if (!a.band_hz.empty() && (a.band_hz.size() != 2 || !(a.band_hz[1] > a.band_hz[0])))
       throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
     if (a.recording_path.empty() == a.csv_path.empty())
-      throw std::invalid_argument("give either --recording (a robodamp measure recording, with --structure) or --csv "
-                                  "(time_s,command_v,force_n)");
+      throw std::invalid_argument(
+          "give either --recording (a robodamp measure recording, with --structure) or --csv "
+          "(time_s,command_v,force_n)");
     if (!a.recording_path.empty()) {
       if (a.structure_path.empty())
-        throw std::invalid_argument("--recording needs --structure: the FRF at the sensor for a force at the actuator "
-                                    "(frf_<sensor>_<actuator>.csv of the same measurement)");
+        throw std::invalid_argument(
+            "--recording needs --structure: the FRF at the sensor for a force at the actuator "
+            "(frf_<sensor>_<actuator>.csv of the same measurement)");
       const identify::ChirpMeasurement m = identify::read_chirp_measurement(a.recording_path);
       mounting = config::to_string(m.config.actuator.mounting);
       identify::ModalFitSettings ms;
       ms.band_lo_hz = m.config.analysis.band_min_hz, ms.band_hi_hz = m.config.analysis.band_max_hz;
       ms.max_order = a.max_order.value_or(40);
-      const identify::ModalFit structure = identify::fit_modes(identify::read_frf_csv(a.structure_path, kind_of(a.kind)), ms);
+      const identify::ModalFit structure =
+          identify::fit_modes(identify::read_frf_csv(a.structure_path, kind_of(a.kind)), ms);
       const double lo = a.band_hz.size() == 2 ? a.band_hz[0] : 0.0, hi = a.band_hz.size() == 2 ? a.band_hz[1] : 0.0;
       fit = identify::identify_actuator(m, identify::with_collocated_structure(m.config, structure), lo, hi,
                                         kActuatorMinCoherence);
@@ -101,10 +107,11 @@ int run_identify_actuator(const IdentifyArgs& a) {
     std::cerr << "robodamp identify actuator: " << e.what() << '\n';
     return 2;
   }
-  std::printf("Actuator (%s mounting): T %.4f N/V, natural frequency %.4f Hz, damping ratio %.4f, delay %.4f ms\n"
-              "  fit error %.3f %% (RMS |G - fit| / RMS |G|) over %.3g-%.3g Hz, %d points with coherence >= %.2f\n",
-              mounting.c_str(), fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, fit.delay_ms,
-              fit.fit_error_pct, fit.band_lo_hz, fit.band_hi_hz, fit.points, kActuatorMinCoherence);
+  std::printf(
+      "Actuator (%s mounting): T %.4f N/V, natural frequency %.4f Hz, damping ratio %.4f, delay %.4f ms\n"
+      "  fit error %.3f %% (RMS |G - fit| / RMS |G|) over %.3g-%.3g Hz, %d points with coherence >= %.2f\n",
+      mounting.c_str(), fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, fit.delay_ms,
+      fit.fit_error_pct, fit.band_lo_hz, fit.band_hi_hz, fit.points, kActuatorMinCoherence);
   if (a.json.given) {
     const nlohmann::json j = {{"mounting", mounting},
                               {"force_constant_n_per_v", fit.force_constant_n_per_v},
@@ -122,8 +129,9 @@ int run_identify_actuator(const IdentifyArgs& a) {
 
 int run_identify_all(const IdentifyArgs& a) {
   if (a.in_dir.empty() == a.uff_path.empty() || a.out_path.empty() || a.uff_path.empty() != a.config_path.empty()) {
-    std::cerr << "robodamp identify all: --in (a robodamp measure directory) or --uff (a universal file) with --config (the "
-                 "configuration it was measured with), and --out (the configuration to write) are required\n";
+    std::cerr
+        << "robodamp identify all: --in (a robodamp measure directory) or --uff (a universal file) with --config (the "
+           "configuration it was measured with), and --out (the configuration to write) are required\n";
     return 2;
   }
   identify::CommissioningSettings s;
@@ -149,8 +157,9 @@ int run_identify_all(const IdentifyArgs& a) {
     std::cerr << "robodamp identify all: " << e.what() << '\n';
     return 2;
   }
-  std::printf("robodamp identify all: %s (%s, measured with %s)\n", (a.uff_path.empty() ? a.in_dir : a.uff_path).c_str(),
-              r.manifest.backend.c_str(), r.manifest.config_source.c_str());
+  std::printf("robodamp identify all: %s (%s, measured with %s)\n",
+              (a.uff_path.empty() ? a.in_dir : a.uff_path).c_str(), r.manifest.backend.c_str(),
+              r.manifest.config_source.c_str());
   std::cout << identify::summary_text(r);
   {
     std::ofstream out(a.out_path);

@@ -42,9 +42,10 @@ std::vector<identify::RecordTest> record_tests(const IdentifyArgs& a) {
     }
   }
   if (files.size() != a.feeds_mm.size() || a.rpm <= 0.0)
-    throw std::invalid_argument(std::to_string(files.size()) + " records and " + std::to_string(a.feeds_mm.size()) +
-                                " feeds: give one --feeds-mm value per record (in name order) and --rpm, or a --tests table "
-                                "(file, feed_per_tooth_mm, spindle_rpm)");
+    throw std::invalid_argument(
+        std::to_string(files.size()) + " records and " + std::to_string(a.feeds_mm.size()) +
+        " feeds: give one --feeds-mm value per record (in name order) and --rpm, or a --tests table "
+        "(file, feed_per_tooth_mm, spindle_rpm)");
   std::vector<identify::RecordTest> out;
   for (std::size_t i = 0; i < files.size(); ++i) out.push_back({files[i], a.feeds_mm[i], a.rpm});
   return out;
@@ -59,14 +60,24 @@ std::vector<identify::MeanForces> means_from_records(const IdentifyArgs& a, nloh
   for (const auto& test : record_tests(a)) {
     const identify::ForceRecord r = identify::read_force_record(test.file);
     const identify::SteadyCut c = identify::steady_cut(r, test.spindle_rpm, test.feed_per_tooth_mm, s);
-    std::printf("  %s: %.4g mm/tooth at %.0f rpm: steady %.3f-%.3f s (%d whole revolutions of %d cutting; means within %.2f %%), "
-                "drift from %s; on the tool Fx %.2f Fy %.2f Fz %.2f N\n",
-                test.file.c_str(), test.feed_per_tooth_mm, test.spindle_rpm, c.start_s, c.end_s, c.revolutions,
-                c.cutting_revolutions, c.spread_pct, c.drift_from.c_str(), c.means.fx_n, c.means.fy_n, c.means.fz_n);
-    j.push_back({{"file", test.file}, {"feed_per_tooth_mm", test.feed_per_tooth_mm}, {"spindle_rpm", test.spindle_rpm},
-                 {"start_s", c.start_s}, {"end_s", c.end_s}, {"revolutions", c.revolutions},
-                 {"drift_from", c.drift_from}, {"drift_n_per_s", c.drift_n_per_s}, {"offset_n", c.offset_n},
-                 {"fx_mean_n", c.means.fx_n}, {"fy_mean_n", c.means.fy_n}, {"fz_mean_n", c.means.fz_n}});
+    std::printf(
+        "  %s: %.4g mm/tooth at %.0f rpm: steady %.3f-%.3f s (%d whole revolutions of %d cutting; means within %.2f "
+        "%%), "
+        "drift from %s; on the tool Fx %.2f Fy %.2f Fz %.2f N\n",
+        test.file.c_str(), test.feed_per_tooth_mm, test.spindle_rpm, c.start_s, c.end_s, c.revolutions,
+        c.cutting_revolutions, c.spread_pct, c.drift_from.c_str(), c.means.fx_n, c.means.fy_n, c.means.fz_n);
+    j.push_back({{"file", test.file},
+                 {"feed_per_tooth_mm", test.feed_per_tooth_mm},
+                 {"spindle_rpm", test.spindle_rpm},
+                 {"start_s", c.start_s},
+                 {"end_s", c.end_s},
+                 {"revolutions", c.revolutions},
+                 {"drift_from", c.drift_from},
+                 {"drift_n_per_s", c.drift_n_per_s},
+                 {"offset_n", c.offset_n},
+                 {"fx_mean_n", c.means.fx_n},
+                 {"fy_mean_n", c.means.fy_n},
+                 {"fz_mean_n", c.means.fz_n}});
     out.push_back(c.means);
   }
   return out;
@@ -76,7 +87,8 @@ std::vector<identify::MeanForces> means_from_records(const IdentifyArgs& a, nloh
 
 int run_identify_cutting(const IdentifyArgs& a) {
   const bool records = !a.records.empty() || !a.tests_path.empty();
-  if (a.csv_path.empty() == !records || a.teeth == 0 || a.diameter_mm == 0.0 || a.axial_mm == 0.0 || a.radial_mm == 0.0) {
+  if (a.csv_path.empty() == !records || a.teeth == 0 || a.diameter_mm == 0.0 || a.axial_mm == 0.0 ||
+      a.radial_mm == 0.0) {
     std::cerr << "robodamp identify cutting: --csv (mean forces) or --records / --tests (force records), and --teeth, "
                  "--diameter-mm, --axial-mm and --radial-mm are required\n";
     return 2;
@@ -88,9 +100,9 @@ int run_identify_cutting(const IdentifyArgs& a) {
   nlohmann::json record_json;
   try {
     if (a.radial_mm > a.diameter_mm)
-      throw std::invalid_argument("--radial-mm = " + config::format_number(a.radial_mm) +
-                                  " mm is out of range: allowed 0 < value <= --diameter-mm = " +
-                                  config::format_number(a.diameter_mm) + " mm");
+      throw std::invalid_argument(
+          "--radial-mm = " + config::format_number(a.radial_mm) +
+          " mm is out of range: allowed 0 < value <= --diameter-mm = " + config::format_number(a.diameter_mm) + " mm");
     if (records) std::printf("Force records (the force on the %s, axes %s):\n", a.force_on.c_str(), a.axes.c_str());
     samples = records ? means_from_records(a, record_json) : identify::read_mean_forces_csv(a.csv_path);
     f = identify::identify_cutting(samples, t);
@@ -105,21 +117,34 @@ int run_identify_cutting(const IdentifyArgs& a) {
   };
   line("Ktc", f.ktc, "N/mm^2"), line("Krc", f.krc, "N/mm^2"), line("Kac", f.kac, "N/mm^2");
   line("Kte", f.kte, "N/mm"), line("Kre", f.kre, "N/mm"), line("Kae", f.kae, "N/mm");
-  std::printf("  R^2 %.6f (x), %.6f (y), %.6f (z); %.6f (x and y together), residual RMS %.4g N, condition number %.3g "
-              "(refused above %.0e)\n", f.r2_x, f.r2_y, f.r2_z, f.r2_xy, f.residual_rms_n, f.condition_number,
-              identify::kMaxConditionNumber);
+  std::printf(
+      "  R^2 %.6f (x), %.6f (y), %.6f (z); %.6f (x and y together), residual RMS %.4g N, condition number %.3g "
+      "(refused above %.0e)\n",
+      f.r2_x, f.r2_y, f.r2_z, f.r2_xy, f.residual_rms_n, f.condition_number, identify::kMaxConditionNumber);
   const std::vector<identify::LinearityCheck> linearity = identify::check_linearity(samples, t, f);
   if (samples.size() < 4) std::printf("  linearity in the feed not checked: 4 feeds or more are needed\n");
   nlohmann::json warnings = nlohmann::json::array();
   for (const auto& c : linearity)
-    if (!c.linear) std::printf("WARNING: %s\n", c.message.c_str()), warnings.push_back({{"axis", std::string(1, c.axis)}, {"r2", c.r2}, {"linear_up_to_mm", c.linear_up_to_mm}, {"message", c.message}});
+    if (!c.linear)
+      std::printf("WARNING: %s\n", c.message.c_str()), warnings.push_back({{"axis", std::string(1, c.axis)},
+                                                                           {"r2", c.r2},
+                                                                           {"linear_up_to_mm", c.linear_up_to_mm},
+                                                                           {"message", c.message}});
   if (a.json.given) {
-    nlohmann::json j = {{"ktc_n_per_mm2", estimate(f.ktc)}, {"krc_n_per_mm2", estimate(f.krc)},
-                        {"kac_n_per_mm2", estimate(f.kac)}, {"kte_n_per_mm", estimate(f.kte)},
-                        {"kre_n_per_mm", estimate(f.kre)},  {"kae_n_per_mm", estimate(f.kae)},
-                        {"r2_xy", f.r2_xy}, {"r2_x", f.r2_x}, {"r2_y", f.r2_y}, {"r2_z", f.r2_z},
-                        {"residual_rms_n", f.residual_rms_n}, {"condition_number", f.condition_number},
-                        {"samples", f.samples}, {"not_linear", warnings}};
+    nlohmann::json j = {{"ktc_n_per_mm2", estimate(f.ktc)},
+                        {"krc_n_per_mm2", estimate(f.krc)},
+                        {"kac_n_per_mm2", estimate(f.kac)},
+                        {"kte_n_per_mm", estimate(f.kte)},
+                        {"kre_n_per_mm", estimate(f.kre)},
+                        {"kae_n_per_mm", estimate(f.kae)},
+                        {"r2_xy", f.r2_xy},
+                        {"r2_x", f.r2_x},
+                        {"r2_y", f.r2_y},
+                        {"r2_z", f.r2_z},
+                        {"residual_rms_n", f.residual_rms_n},
+                        {"condition_number", f.condition_number},
+                        {"samples", f.samples},
+                        {"not_linear", warnings}};
     if (records) j["records"] = record_json;
     if (!emit_json(a.json, j.dump(2), "identify")) return 1;
     if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
@@ -127,7 +152,8 @@ int run_identify_cutting(const IdentifyArgs& a) {
   if (!a.yaml_path.empty()) {
     std::ofstream y(a.yaml_path);
     y << "material:                 # robodamp identify cutting, " << f.samples << " feeds, R^2 " << f.r2_x << " (x) "
-      << f.r2_y << " (y) " << f.r2_z << " (z)" << (warnings.empty() ? "" : "; NOT LINEAR in the feed, see its warnings") << "\n"
+      << f.r2_y << " (y) " << f.r2_z << " (z)" << (warnings.empty() ? "" : "; NOT LINEAR in the feed, see its warnings")
+      << "\n"
       << "  name: identified from " << (records ? std::string("force records") : a.csv_path) << "\n"
       << "  kt_n_per_mm2: " << f.ktc.value << "\n  kn_n_per_mm2: " << f.krc.value << "\n  kte_n_per_mm: " << f.kte.value
       << "\n  kne_n_per_mm: " << f.kre.value << "\n  kac_n_per_mm2: " << f.kac.value << "\n"

@@ -15,8 +15,8 @@ int run_lobes(const MillingOptions& o) {
   config::MillingConfig cfg = config::load_milling_config(o.job_path);
   apply_pose(cfg, o);
   // The direct test is defined where the job computes its lobes.
-  const config::Range speeds{"rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false,
-                             "the job's lobes.rpm_min .. lobes.rpm_max"};
+  const config::Range speeds{
+      "rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false, "the job's lobes.rpm_min .. lobes.rpm_max"};
   for (double rpm : o.rpm) {
     if (auto p = config::range_problem("--rpm", rpm, speeds)) {
       std::cerr << "robodamp lobes: " << *p << '\n';
@@ -30,14 +30,18 @@ int run_lobes(const MillingOptions& o) {
 
 void register_lobes(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
-  CLI::App* sub = r.add("lobes", "Stability lobes (semi-discretization of what runs, or a zero-order preview), open loop and --damped",
-                        [o] { return run_lobes(*o); });
+  CLI::App* sub = r.add(
+      "lobes", "Stability lobes (semi-discretization of what runs, or a zero-order preview), open loop and --damped",
+      [o] { return run_lobes(*o); });
   add_milling_options(r, sub, *o, "lobes");
-  sub->add_option("--method", o->method, "sdm (default): semi-discretization of what runs, open loop and the sampled damped loop (time_domain.sdm_*); zoa: the zero-order method, a fast preview")
+  sub->add_option("--method", o->method,
+                  "sdm (default): semi-discretization of what runs, open loop and the sampled damped loop "
+                  "(time_domain.sdm_*); zoa: the zero-order method, a fast preview")
       ->check(CLI::IsMember({"zoa", "sdm"}));
   r.numbers(sub, "--rpm", o->rpm, {"rpm", 0.0, 200000.0, true, false, "and within the job's lobes speed range"},
             "Limiting depth at these speeds by the direct test (the spindle speed is always included)");
-  r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
+  r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0},
+            "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
 }
 
 }  // namespace robodamp::apps

@@ -51,8 +51,10 @@ json lobes_json(const milling::LobeStudy& s, int teeth) {
   j["curve"] = json::array();
   for (const auto& p : s.curve) {
     json c = {{"rpm", p.rpm}, {"b_lim_mm", finite_or_null(p.b_lim_mm)}, {"chatter_hz", optional_json(p.chatter_hz)}};
-    if (s.accurate) c["type"] = *p.type;
-    else c["lobe"] = *p.lobe;
+    if (s.accurate)
+      c["type"] = *p.type;
+    else
+      c["lobe"] = *p.lobe;
     j["curve"].push_back(c);
   }
   j["min_b_lim_mm"] = finite_or_null(s.min_b_lim_mm);
@@ -60,11 +62,15 @@ json lobes_json(const milling::LobeStudy& s, int teeth) {
   j["min_chatter_hz"] = s.min_chatter_hz;
   j["at_rpm"] = json::array();
   for (const auto& a : s.at_rpm) {
-    json r = {{"rpm", a.rpm}, {"b_lim_mm", finite_or_null(a.b_lim_mm)}, {"b_lim_lobes_mm", optional_json(a.b_lim_lobes_mm)},
+    json r = {{"rpm", a.rpm},
+              {"b_lim_mm", finite_or_null(a.b_lim_mm)},
+              {"b_lim_lobes_mm", optional_json(a.b_lim_lobes_mm)},
               {"chatter_hz", optional_json(a.chatter_hz)}};
     if (a.chatter_hz) r["chatter_family_hz"] = milling::chatter_family_hz(*a.chatter_hz, a.rpm * teeth / 60.0);
-    if (s.accurate) r["requested_rpm"] = *a.requested_rpm, r["type"] = *a.type;
-    else r["lobe"] = optional_json(a.lobe);
+    if (s.accurate)
+      r["requested_rpm"] = *a.requested_rpm, r["type"] = *a.type;
+    else
+      r["lobe"] = optional_json(a.lobe);
     j["at_rpm"].push_back(r);
   }
   j["diagram_ms"] = s.diagram_ms;
@@ -78,10 +84,12 @@ json lobes_json(const milling::Structure& structure, const config::MillingConfig
                 const std::string& method) {
   if (method != "sdm") return lobes_json(milling::zero_order_lobe_study(structure, cfg, rpms), cfg.tool.teeth);
   return lobes_json(milling::accurate_lobe_study(
-      structure, cfg, rpms, [](const std::string& name, std::size_t done, std::size_t of, double s) {
-        if (done % 20 == 0 || done == of)
-          std::cerr << "[lobes " << name << "] " << done << "/" << of << " speeds, " << s << " s\n";
-      }), cfg.tool.teeth);
+                        structure, cfg, rpms,
+                        [](const std::string& name, std::size_t done, std::size_t of, double s) {
+                          if (done % 20 == 0 || done == of)
+                            std::cerr << "[lobes " << name << "] " << done << "/" << of << " speeds, " << s << " s\n";
+                        }),
+                    cfg.tool.teeth);
 }
 
 double pct_change(const json& open, const json& damped) {
@@ -111,8 +119,9 @@ std::string lobes_table(const json& r) {
     for (const auto& a : d["at_rpm"]) {
       os << "    at " << fmt(a["rpm"], sdm ? "%9.2f" : "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
          << (sdm ? " mm (" + method + ", " + a["type"].get<std::string>() + ")" : " mm (zero-order direct test)")
-         << (a["b_lim_lobes_mm"].is_null() ? std::string()
-                                           : (sdm ? ", zero-order preview " : ", zero-order lobes ") + fmt(a["b_lim_lobes_mm"], "%.3f") + " mm")
+         << (a["b_lim_lobes_mm"].is_null()
+                 ? std::string()
+                 : (sdm ? ", zero-order preview " : ", zero-order lobes ") + fmt(a["b_lim_lobes_mm"], "%.3f") + " mm")
          << ", chatter " << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
     }
   };
@@ -134,8 +143,9 @@ std::string lobes_table(const json& r) {
   if (r.contains("scheduled")) {
     const json& s = r["scheduled"];
     one(s, "sched.");
-    os << "  change with the speed schedule (" << s["bands"].get<std::size_t>() << " bands of " << s["config"].get<std::string>()
-       << "): minimum limiting depth " << fmt(r["gain"]["scheduled_min_b_lim_change_pct"], "%+.1f") << " %, at the spindle speed "
+    os << "  change with the speed schedule (" << s["bands"].get<std::size_t>() << " bands of "
+       << s["config"].get<std::string>() << "): minimum limiting depth "
+       << fmt(r["gain"]["scheduled_min_b_lim_change_pct"], "%+.1f") << " %, at the spindle speed "
        << fmt(r["gain"]["scheduled_at_spindle_change_pct"], "%+.1f") << " %; below the open loop (by > 0.5 %) at "
        << s["below_open"].get<std::size_t>() << " of " << s["curve"].size() << " speeds\n";
   }
@@ -172,8 +182,8 @@ std::string plot_lobes(const json& r, const std::string& path) {
   s << "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop, " << r["method"].get<std::string>() << " (min "
     << fmt(r["min_b_lim_mm"], "%.3f") << " mm)'";
   if (damped)
-    s << ", DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'active damping at a fixed K, " << r["damped"]["method"].get<std::string>()
-      << " (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f") << " mm)'";
+    s << ", DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'active damping at a fixed K, "
+      << r["damped"]["method"].get<std::string>() << " (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f") << " mm)'";
   if (scheduled)
     s << ", DATA index 2 u 1:2 w l lw 2.5 lc rgb '#27ae60' t 'active damping by the speed schedule (min "
       << fmt(r["scheduled"]["min_b_lim_mm"], "%.3f") << " mm)'";
@@ -183,15 +193,16 @@ std::string plot_lobes(const json& r, const std::string& path) {
 
 std::string tool_text(const config::MillingConfig& c) {
   std::ostringstream os;
-  os << c.tool.diameter_mm << " mm " << c.tool.teeth << "-tooth " << to_string(c.tool.kind) << ", "
-     << c.cut.radial_mm << " mm radial " << to_string(c.cut.mode) << " milling, " << c.material.name;
+  os << c.tool.diameter_mm << " mm " << c.tool.teeth << "-tooth " << to_string(c.tool.kind) << ", " << c.cut.radial_mm
+     << " mm radial " << to_string(c.cut.mode) << " milling, " << c.material.name;
   return os.str();
 }
 
 int finish(const json& report, const MillingOptions& o, const std::string& command, const std::string& table,
            std::string (*plot)(const json&, const std::string&)) {
   const std::string target = plot_file(o.plot_dir, o.plot_path, command + ".png");
-  return print_report(report.dump(2), o.json, command, table, target, [&] { return plot(report, target); }, target);
+  return print_report(
+      report.dump(2), o.json, command, table, target, [&] { return plot(report, target); }, target);
 }
 
 // --- SLE -------------------------------------------------------------------------------------------
@@ -203,8 +214,12 @@ json sle_json(const milling::SleStudy& s) {
   j["closed_loop"] = s.closed_loop;
   j["map"] = json::array();
   for (const auto& p : s.map)
-    j["map"].push_back({{"rpm", p.rpm}, {"sle_um", p.sle_um}, {"sle_min_um", p.sle_min_um}, {"sle_max_um", p.sle_max_um},
-                        {"b_lim_preview_mm", finite_or_null(p.b_lim_preview_mm)}, {"stable", p.stable},
+    j["map"].push_back({{"rpm", p.rpm},
+                        {"sle_um", p.sle_um},
+                        {"sle_min_um", p.sle_min_um},
+                        {"sle_max_um", p.sle_max_um},
+                        {"b_lim_preview_mm", finite_or_null(p.b_lim_preview_mm)},
+                        {"stable", p.stable},
                         {"stability_method", p.stability_method}});
   j["map_unstable_points"] = s.map_unstable_points;
   j["stability_method"] = s.stability_method;  // the map's and the conditions' stable flags (docs/milling.md)
@@ -239,9 +254,11 @@ std::string sle_table(const json& r) {
      << r["structure"].get<std::string>() << ", " << r["tool"].get<std::string>() << ")\n";
   auto one = [&](const json& d, const char* label) {
     double lo = 1e300, hi = -1e300;
-    for (const auto& p : d["map"]) lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
-    os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-" << fmt(d["map"].back()["rpm"], "%.0f")
-       << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to " << fmt(json(hi), "%.1f") << " um";
+    for (const auto& p : d["map"])
+      lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
+    os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-"
+       << fmt(d["map"].back()["rpm"], "%.0f") << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to "
+       << fmt(json(hi), "%.1f") << " um";
     if (const int u = d["map_unstable_points"].get<int>(); u > 0)
       os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds by the "
          << d["stability_method"].get<std::string>() << ": SLE not meaningful there)";
@@ -253,13 +270,16 @@ std::string sle_table(const json& r) {
     os << "    cond  rpm    axial  radial  ft     normal  SLE(um)  dyn(um)  offset  radial_cmd(mm)  iter  stable\n";
     for (const auto& c : d["conditions"]) {
       char line[200];
-      std::snprintf(line, sizeof line, "    %-5s %-6.0f %-6.2f %-7.2f %-6.3f %-7s %-8.1f %-8.1f %-7.1f %-15.4f %-5d %s\n",
-                    c["name"].get<std::string>().c_str(), c["rpm"].get<double>(), c["axial_mm"].get<double>(),
-                    c["radial_mm"].get<double>(), c["ft_mm"].get<double>(), c["surface_normal"].get<std::string>().c_str(),
-                    c["sle_um"].get<double>(), c["sle_dynamic_um"].get<double>(), c["path_offset_um"].get<double>(),
-                    c["compensated_radial_mm"].get<double>(), c["compensation_iterations"].get<int>(),
-                    (c["stable"].get<bool>() ? "yes (" + c["stability_method"].get<std::string>() + ")"
-                                             : "NO (chatter by the " + c["stability_method"].get<std::string>() + ": SLE not meaningful)").c_str());
+      std::snprintf(
+          line, sizeof line, "    %-5s %-6.0f %-6.2f %-7.2f %-6.3f %-7s %-8.1f %-8.1f %-7.1f %-15.4f %-5d %s\n",
+          c["name"].get<std::string>().c_str(), c["rpm"].get<double>(), c["axial_mm"].get<double>(),
+          c["radial_mm"].get<double>(), c["ft_mm"].get<double>(), c["surface_normal"].get<std::string>().c_str(),
+          c["sle_um"].get<double>(), c["sle_dynamic_um"].get<double>(), c["path_offset_um"].get<double>(),
+          c["compensated_radial_mm"].get<double>(), c["compensation_iterations"].get<int>(),
+          (c["stable"].get<bool>()
+               ? "yes (" + c["stability_method"].get<std::string>() + ")"
+               : "NO (chatter by the " + c["stability_method"].get<std::string>() + ": SLE not meaningful)")
+              .c_str());
       os << line;
     }
   };
@@ -279,8 +299,10 @@ std::string plot_sle(const json& r, const std::string& path) {
   // Columns: rpm, open SLE, open SLE where the cut chatters (NaN elsewhere), and the same damped.
   auto chattering = [](const json& p) { return p["stable"].get<bool>() ? NAN : p["sle_um"].get<double>(); };
   for (std::size_t i = 0; i < r["map"].size(); ++i) {
-    data << r["map"][i]["rpm"].get<double>() << ' ' << r["map"][i]["sle_um"].get<double>() << ' ' << chattering(r["map"][i]);
-    if (damped) data << ' ' << r["damped"]["map"][i]["sle_um"].get<double>() << ' ' << chattering(r["damped"]["map"][i]);
+    data << r["map"][i]["rpm"].get<double>() << ' ' << r["map"][i]["sle_um"].get<double>() << ' '
+         << chattering(r["map"][i]);
+    if (damped)
+      data << ' ' << r["damped"]["map"][i]["sle_um"].get<double>() << ' ' << chattering(r["damped"]["map"][i]);
     data << '\n';
   }
   std::ostringstream s;
@@ -310,7 +332,8 @@ config::StructureConfig selected_structure(const config::MillingConfig& cfg, con
   }
   std::string known;
   for (const auto& s : cfg.structures) known += (known.empty() ? "" : ", ") + s.name;
-  throw config::ConfigError({config::Problem{cfg.source, {}, "--structure", "= '" + name + "' is not one of: " + known}});
+  throw config::ConfigError(
+      {config::Problem{cfg.source, {}, "--structure", "= '" + name + "' is not one of: " + known}});
 }
 
 json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
@@ -319,23 +342,24 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   rpms.push_back(cfg.cut.spindle_rpm);
   const milling::Structure open(sc, false);
   if (o.damped && !open.has_controller())
-    throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
-                                               "--damped needs a part with a controller (a damping configuration)"}});
+    throw config::ConfigError({config::Problem{
+        cfg.source, {}, "structures." + sc.name, "--damped needs a part with a controller (a damping configuration)"}});
   json r = lobes_json(open, cfg, rpms, o.method);
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
   r["spindle_rpm"] = cfg.cut.spindle_rpm;
   if (cfg.cut.mode == config::MillingMode::kUp)
-    r["notes"].push_back("up milling starts each chip at zero thickness: a start-up transient can take the tool out of "
-                         "the cut and chatter below these linear limits (docs/milling.md); `robodamp cut --critical` "
-                         "simulates it");
+    r["notes"].push_back(
+        "up milling starts each chip at zero thickness: a start-up transient can take the tool out of "
+        "the cut and chatter below these linear limits (docs/milling.md); `robodamp cut --critical` "
+        "simulates it");
   if (o.damped) {
     const milling::Structure closed(sc, true);
     r["damped"] = lobes_json(closed, cfg, rpms, o.method);
     r["gain"] = {{"min_b_lim_change_pct", finite_or_null(pct_change(r["min_b_lim_mm"], r["damped"]["min_b_lim_mm"]))},
                  {"at_spindle_rpm", cfg.cut.spindle_rpm},
-                 {"at_spindle_change_pct",
-                  finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"], r["damped"]["at_rpm"].back()["b_lim_mm"]))}};
+                 {"at_spindle_change_pct", finite_or_null(pct_change(r["at_rpm"].back()["b_lim_mm"],
+                                                                     r["damped"]["at_rpm"].back()["b_lim_mm"]))}};
     // The damping configuration's speed schedule, beside the fixed gain: each speed with its band's controller.
     if (o.method == "sdm")
       if (const auto sl = milling::scheduled_lobe_study(sc, cfg, rpms, [](std::size_t done, std::size_t of) {
@@ -357,14 +381,24 @@ json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o) {
 
 json cut_verdict_json(const milling::CutVerdict& v) {
   auto curve = [](const milling::CutCurve& c) {
-    return json{{"min_mm", c.min_mm},           {"min_rpm", c.min_rpm},
-                {"mean_ratio", c.mean_ratio},   {"worse_share", c.worse_share},
-                {"worst_ratio", c.worst_ratio}, {"worst_rpm", c.worst_rpm},
-                {"better_share", c.better_share}, {"at_job_mm", c.at_job_mm},
+    return json{{"min_mm", c.min_mm},
+                {"min_rpm", c.min_rpm},
+                {"mean_ratio", c.mean_ratio},
+                {"worse_share", c.worse_share},
+                {"worst_ratio", c.worst_ratio},
+                {"worst_rpm", c.worst_rpm},
+                {"better_share", c.better_share},
+                {"at_job_mm", c.at_job_mm},
                 {"limit_mm", c.mm}};
   };
-  json j = {{"job", v.job}, {"method", v.method}, {"tolerance", v.tolerance}, {"rpm", v.rpm}, {"job_rpm", v.job_rpm},
-            {"open", curve(v.open)}, {"fixed", curve(v.fixed)}, {"fixed_gain_ns_per_m", v.fixed_gain_ns_per_m},
+  json j = {{"job", v.job},
+            {"method", v.method},
+            {"tolerance", v.tolerance},
+            {"rpm", v.rpm},
+            {"job_rpm", v.job_rpm},
+            {"open", curve(v.open)},
+            {"fixed", curve(v.fixed)},
+            {"fixed_gain_ns_per_m", v.fixed_gain_ns_per_m},
             {"verdict", milling::cut_verdict_line(v)}};
   if (v.scheduled) j["scheduled"] = curve(*v.scheduled), j["bands"] = v.bands;
   return j;
@@ -376,8 +410,8 @@ json sle_report(const config::MillingConfig& cfg, const MillingOptions& o) {
   const auto sc = selected(cfg, o);
   const milling::Structure open(sc, false);
   if (o.damped && !open.has_controller())
-    throw config::ConfigError({config::Problem{cfg.source, {}, "structures." + sc.name,
-                                               "--damped needs a part with a controller (a damping configuration)"}});
+    throw config::ConfigError({config::Problem{
+        cfg.source, {}, "structures." + sc.name, "--damped needs a part with a controller (a damping configuration)"}});
   json r = sle_json(milling::sle_study(open, cfg));
   r["config"] = cfg.source;
   r["tool"] = tool_text(cfg);
@@ -394,7 +428,8 @@ void add_milling_options(Registry& r, CLI::App* sub, MillingOptions& o, const st
   r.plot_dir(sub, o.plot_dir, command + ".png");
   r.deprecated(sub->add_option("--plot", o.plot_path, "Write the plot to this file (PNG)"), "--plot-dir DIR");
   sub->add_flag("--damped", o.damped, "Also with the damping controller's loop closed, overlaid");
-  sub->add_option("--controller", o.controller_path, "Damping configuration to use instead of the job's (compare compensators)")
+  sub->add_option("--controller", o.controller_path,
+                  "Damping configuration to use instead of the job's (compare compensators)")
       ->check(CLI::ExistingFile);
 }
 
@@ -411,8 +446,8 @@ void apply_pose(config::MillingConfig& cfg, const MillingOptions& o) {
       part.pose->joints_deg = o.pose_deg;
     }
   if (!any)
-    throw config::ConfigError({config::Problem{cfg.source, {}, "--pose",
-                                               "the job has no robot pose part (a part with pose: {model, joints_deg})"}});
+    throw config::ConfigError({config::Problem{
+        cfg.source, {}, "--pose", "the job has no robot pose part (a part with pose: {model, joints_deg})"}});
 }
 
 }  // namespace robodamp::apps

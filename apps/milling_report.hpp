@@ -16,15 +16,15 @@ namespace robodamp::apps {
 
 struct MillingOptions {
   std::string job_path{default_job()};  // --job (the deprecated --config)
-  std::string structure;          // empty: the configuration's choice
+  std::string structure;                // empty: the configuration's choice
   JsonOut json;
-  std::string plot_dir;           // --plot-dir: DIR/lobes.png or DIR/sle.png
-  std::string plot_path;          // the deprecated --plot FILE (PNG)
-  bool damped{false};             // also with the controller's loop closed, overlaid
-  std::vector<double> rpm;        // lobes: extra speeds for the direct test
-  std::string controller_path;    // replaces every controller part's damping configuration
-  std::string method{"sdm"};      // lobes: sdm (semi-discretization of what runs: the promise) or zoa (preview)
-  std::vector<double> pose_deg;   // replaces the joints of every robot pose part (docs/pose_dynamics.md)
+  std::string plot_dir;          // --plot-dir: DIR/lobes.png or DIR/sle.png
+  std::string plot_path;         // the deprecated --plot FILE (PNG)
+  bool damped{false};            // also with the controller's loop closed, overlaid
+  std::vector<double> rpm;       // lobes: extra speeds for the direct test
+  std::string controller_path;   // replaces every controller part's damping configuration
+  std::string method{"sdm"};     // lobes: sdm (semi-discretization of what runs: the promise) or zoa (preview)
+  std::vector<double> pose_deg;  // replaces the joints of every robot pose part (docs/pose_dynamics.md)
 };
 
 // --pose into the job: every pose part takes the joints, checked against its model's travel. Throws

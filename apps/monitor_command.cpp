@@ -25,7 +25,6 @@ namespace robodamp::apps {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
-
 namespace {
 
 // The latest sample of one cell: the one named, else the first seen.
@@ -66,28 +65,29 @@ std::string view(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s
   char b[1200];
   const char* state = ns ? s.state().c_str() : nt ? rt::to_string(static_cast<rt::State>(t.state())) : "-";
   const char* trip = ns ? s.trip().c_str() : nt ? rt::to_string(static_cast<rt::Trip>(t.trip())) : "-";
-  std::snprintf(b, sizeof b,
-                "robodamp monitor  cell %s  t = %.2f s  (%s)\n"
-                "  state      %-10s trip %s\n"
-                "  vibration  %.5f m/s^2 RMS (last %.5f m/s^2), velocity estimate %.3g m/s\n"
-                "  command    %+.4f V (peak %.4f V), K = %.0f N s/m (limit %.0f), parameter set %u\n"
-                "  saturation %.1f %% of the last window, %llu ticks in all\n"
-                "  timing     wake-up p50 %.0f us, p99 %.0f us, max %.1f us; compute mean %.2f us, max %.1f us\n"
-                "             ticks %llu, missed %llu, overruns %llu, stale %llu, ring drops %llu\n"
-                "  damping    %.3f %% of the time asked (%.3f %% derated%s); %u trips, %u back at full gain; last trip %s\n"
-                "  samples    %llu telemetry, %llu status; parameter writes %s\n",
-                ns ? s.cell().c_str() : t.cell().c_str(), nt ? t.time_s() : s.time_s(), ns ? s.backend().c_str() : "no status yet", state, trip,
-                t.accel_rms_mps2(), t.accel_mps2(), t.filtered_mps(), t.command_v(), t.command_peak_v(),
-                nt ? t.gain_ns_per_m() : s.gain_ns_per_m(), s.max_gain_ns_per_m(), s.parameter_set(),
-                100.0 * t.saturated_fraction(), static_cast<unsigned long long>(s.saturated_ticks()), s.wake_p50_us(),
-                s.wake_p99_us(), s.wake_max_us(), s.compute_mean_us(), s.compute_max_us(),
-                static_cast<unsigned long long>(s.ticks()), static_cast<unsigned long long>(s.missed_ticks()),
-                static_cast<unsigned long long>(s.overruns()), static_cast<unsigned long long>(s.stale_ticks()),
-                static_cast<unsigned long long>(s.ring_drops()), s.availability_pct(), s.derated_pct(),
-                s.derated() ? ", DERATED now" : "", s.trips(), s.back_at_full_gain(),
-                s.last_trip_s() >= 0.0 ? (std::to_string(s.last_trip_s()) + " s").c_str() : "none",
-                static_cast<unsigned long long>(nt),
-                static_cast<unsigned long long>(ns), ns ? (s.parameter_writes() ? "on" : "off") : "-");
+  std::snprintf(
+      b, sizeof b,
+      "robodamp monitor  cell %s  t = %.2f s  (%s)\n"
+      "  state      %-10s trip %s\n"
+      "  vibration  %.5f m/s^2 RMS (last %.5f m/s^2), velocity estimate %.3g m/s\n"
+      "  command    %+.4f V (peak %.4f V), K = %.0f N s/m (limit %.0f), parameter set %u\n"
+      "  saturation %.1f %% of the last window, %llu ticks in all\n"
+      "  timing     wake-up p50 %.0f us, p99 %.0f us, max %.1f us; compute mean %.2f us, max %.1f us\n"
+      "             ticks %llu, missed %llu, overruns %llu, stale %llu, ring drops %llu\n"
+      "  damping    %.3f %% of the time asked (%.3f %% derated%s); %u trips, %u back at full gain; last trip %s\n"
+      "  samples    %llu telemetry, %llu status; parameter writes %s\n",
+      ns ? s.cell().c_str() : t.cell().c_str(), nt ? t.time_s() : s.time_s(),
+      ns ? s.backend().c_str() : "no status yet", state, trip, t.accel_rms_mps2(), t.accel_mps2(), t.filtered_mps(),
+      t.command_v(), t.command_peak_v(), nt ? t.gain_ns_per_m() : s.gain_ns_per_m(), s.max_gain_ns_per_m(),
+      s.parameter_set(), 100.0 * t.saturated_fraction(), static_cast<unsigned long long>(s.saturated_ticks()),
+      s.wake_p50_us(), s.wake_p99_us(), s.wake_max_us(), s.compute_mean_us(), s.compute_max_us(),
+      static_cast<unsigned long long>(s.ticks()), static_cast<unsigned long long>(s.missed_ticks()),
+      static_cast<unsigned long long>(s.overruns()), static_cast<unsigned long long>(s.stale_ticks()),
+      static_cast<unsigned long long>(s.ring_drops()), s.availability_pct(), s.derated_pct(),
+      s.derated() ? ", DERATED now" : "", s.trips(), s.back_at_full_gain(),
+      s.last_trip_s() >= 0.0 ? (std::to_string(s.last_trip_s()) + " s").c_str() : "none",
+      static_cast<unsigned long long>(nt), static_cast<unsigned long long>(ns),
+      ns ? (s.parameter_writes() ? "on" : "off") : "-");
   return b;
 }
 
@@ -102,30 +102,33 @@ std::string mm(double v) {
 std::string machining_view(const msg::Machining& m) {
   char b[1200];
   std::string limits = "computing";
-  if (m.spindle_rpm() <= 0.0) limits = "spindle stopped";
+  if (m.spindle_rpm() <= 0.0)
+    limits = "spindle stopped";
   else if (m.limits_ready())
-    limits = "open " + mm(m.open_limit_mm()) + " (SDM), damped " + mm(m.damped_limit_mm()) + " (" + m.limit_method() + "); now " + mm(m.limit_mm()) +
-             (m.loop_active() ? " (damper active)" : " (damper off)") +
-             (m.depth_warning() ? (m.depth_measured() ? "  WARNING: depth above the limit"
-                                   : m.cutting() == dds::kNotCutting
-                                       ? "  the job's planned depth is above the limit here (not cutting now)"
-                                       : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
-                                : "  depth within");
+    limits = "open " + mm(m.open_limit_mm()) + " (SDM), damped " + mm(m.damped_limit_mm()) + " (" + m.limit_method() +
+             "); now " + mm(m.limit_mm()) + (m.loop_active() ? " (damper active)" : " (damper off)") +
+             (m.depth_warning()
+                  ? (m.depth_measured() ? "  WARNING: depth above the limit"
+                     : m.cutting() == dds::kNotCutting
+                         ? "  the job's planned depth is above the limit here (not cutting now)"
+                         : "  WARNING: the job's planned depth is above the limit (the robot reports no depth)")
+                  : "  depth within");
   if (m.spindle_rpm() > 0.0 && !m.limits_pose_deg().empty()) {
     limits += "\n             at the robot's pose " + config::describe_pose(m.limits_pose_deg()) +
               (m.limits_ready() ? "" : " (recomputing: the robot moved)");
     if (m.mode_spread_pct() >= 0.0) {
       char spread[160];
-      std::snprintf(spread, sizeof spread, "; its modes +-%.1f %% (one sigma), %.0f deg from the nearest measured pose", m.mode_spread_pct(),
-                    m.nearest_measured_deg());
+      std::snprintf(spread, sizeof spread, "; its modes +-%.1f %% (one sigma), %.0f deg from the nearest measured pose",
+                    m.mode_spread_pct(), m.nearest_measured_deg());
       limits += spread;
     }
   }
   std::string indicator = "-";
   if (m.indicator_valid()) {
     char c[200];
-    std::snprintf(c, sizeof c, "once-per-rev %.2f, non-harmonic %.0f %% (strongest %.1f Hz): %s", m.once_per_rev_ratio(),
-                  100.0 * m.nonharmonic_share(), m.chatter_hz(), m.chatter() ? "CHATTER" : "no chatter");
+    std::snprintf(c, sizeof c, "once-per-rev %.2f, non-harmonic %.0f %% (strongest %.1f Hz): %s",
+                  m.once_per_rev_ratio(), 100.0 * m.nonharmonic_share(), m.chatter_hz(),
+                  m.chatter() ? "CHATTER" : "no chatter");
     indicator = c;
   } else if (m.spindle_rpm() > 0.0) {
     indicator = "collecting revolutions";
@@ -137,8 +140,8 @@ std::string machining_view(const msg::Machining& m) {
                 "  spindle    %.0f rpm (tooth passing %.1f Hz), depth %.3f mm%s\n"
                 "  stability  %s\n"
                 "  chatter    %s\n",
-                m.spindle_rpm(), m.tooth_passing_hz(), m.depth_mm(), m.depth_measured() ? " (the robot's)" : " (the job's plan)",
-                limits.c_str(), indicator.c_str());
+                m.spindle_rpm(), m.tooth_passing_hz(), m.depth_mm(),
+                m.depth_measured() ? " (the robot's)" : " (the job's plan)", limits.c_str(), indicator.c_str());
   return b;
 }
 
@@ -177,7 +180,7 @@ constexpr double kNoContactS = 3.0;
 int run_monitor(const DdsClientOptions& o) {
   rt::install_shutdown_handlers();
   auto cell = std::make_shared<std::string>(o.cell);  // empty: the first cell heard
-  Latest<msg::Telemetry> telemetry(cell);  // before the participant: it outlives the readers that call it
+  Latest<msg::Telemetry> telemetry(cell);             // before the participant: it outlives the readers that call it
   Latest<msg::Status> status(cell);
   Latest<msg::Machining> machining(cell);
   Latest<msg::Advice> advice(cell);
@@ -204,8 +207,9 @@ int run_monitor(const DdsClientOptions& o) {
       const double quiet_s = std::chrono::duration<double>(Clock::now() - heard).count();
       if (shown > 0 && !silent && quiet_s >= kNoContactS) {
         silent = true;
-        std::cout << "robodamp monitor: NO CONTACT: nothing from " << (ns ? s.cell().c_str() : t.cell().c_str()) << " for "
-                  << static_cast<int>(quiet_s) << " s: the loop stopped or the link is down (last seen: state "
+        std::cout << "robodamp monitor: NO CONTACT: nothing from " << (ns ? s.cell().c_str() : t.cell().c_str())
+                  << " for " << static_cast<int>(quiet_s)
+                  << " s: the loop stopped or the link is down (last seen: state "
                   << (nt ? rt::to_string(static_cast<rt::State>(t.state())) : s.state().c_str()) << " at loop time "
                   << (nt ? t.time_s() : s.time_s()) << " s); the view above is old\n"
                   << std::flush;
@@ -225,13 +229,17 @@ int run_monitor(const DdsClientOptions& o) {
 
 void register_monitor(Registry& r) {
   auto o = std::make_shared<DdsClientArgs>();
-  CLI::App* sub = r.add("monitor", "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, timing; with spindle.job the speed, depth, open and damped limits, the chatter indicator and the latest spindle-speed advice)",
+  CLI::App* sub = r.add("monitor",
+                        "Live text view of a running loop from its DDS topics (state, vibration, command, saturation, "
+                        "timing; with spindle.job the speed, depth, open and damped limits, the chatter indicator and "
+                        "the latest spindle-speed advice)",
                         [o] {
                           const auto opts = resolve(*o);
                           return opts ? run_monitor(*opts) : 2;
                         });
   add_dds_options(r, sub, *o);
-  r.number(sub, "--duration", o->options.duration_s, {"s", 0.0, 86400.0, false, false, "0 = until Ctrl-C"}, "Stop after S seconds");
+  r.number(sub, "--duration", o->options.duration_s, {"s", 0.0, 86400.0, false, false, "0 = until Ctrl-C"},
+           "Stop after S seconds");
 }
 
 }  // namespace robodamp::apps

@@ -37,7 +37,7 @@ struct PlantArgs {
   std::optional<int> cut_revolutions;
   bool drives_off{false};
   double spindle_register_period_s{0.05};
-  std::vector<std::string> pose_at;            // "T:Q1,Q2,..." waypoints
+  std::vector<std::string> pose_at;  // "T:Q1,Q2,..." waypoints
   double pose_register_period_s{0.05}, pose_update_s{0.02};
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
@@ -72,9 +72,10 @@ std::optional<hil::SpindleChange> parse_change(const char* option, const std::st
   if (!ramp) c.t1_s = c.t0_s;
   if (ok) return c;
   const std::string v = std::string(value.unit == "rpm" ? "RPM" : "MM");
-  std::cerr << "robodamp plant: " << option << " = '" << item << "': expected " << (ramp ? "T0_S:T1_S:" : "TIME_S:") << v
-            << ", allowed 0 <= " << (ramp ? "T0_S <= T1_S" : "TIME_S") << " <= 1e+07 s and " << config::format_number(value.min)
-            << " <= " << v << " <= " << config::format_number(value.max) << ' ' << value.unit << '\n';
+  std::cerr << "robodamp plant: " << option << " = '" << item << "': expected " << (ramp ? "T0_S:T1_S:" : "TIME_S:")
+            << v << ", allowed 0 <= " << (ramp ? "T0_S <= T1_S" : "TIME_S") << " <= 1e+07 s and "
+            << config::format_number(value.min) << " <= " << v << " <= " << config::format_number(value.max) << ' '
+            << value.unit << '\n';
   return std::nullopt;
 }
 
@@ -84,7 +85,8 @@ int run_plant(const PlantArgs& a) {
   config::Config cfg = config::load_config_file(a.config_path);
   if (a.drives_off) cfg.disturbances.drives_on = false;
   hil::EmulatorOptions eo;
-  if (!a.pacing.empty()) eo.pacing = a.pacing == "lockstep" ? config::HilPacing::kLockstep : config::HilPacing::kRealtime;
+  if (!a.pacing.empty())
+    eo.pacing = a.pacing == "lockstep" ? config::HilPacing::kLockstep : config::HilPacing::kRealtime;
   eo.max_duration_s = a.duration_s;
   eo.impacts = a.impacts;
   eo.measure_out = a.measure_out;
@@ -121,7 +123,8 @@ int run_plant(const PlantArgs& a) {
       out->push_back(*c);
     }
   eo.cut_job = a.cut_job;
-  eo.cut_model = a.cut_model == "forced" ? hil::EmulatorOptions::CutModel::kForced : hil::EmulatorOptions::CutModel::kRegenerative;
+  eo.cut_model =
+      a.cut_model == "forced" ? hil::EmulatorOptions::CutModel::kForced : hil::EmulatorOptions::CutModel::kRegenerative;
   eo.regenerative.rpm = a.cut_rpm;
   eo.regenerative.axial_mm = a.cut_axial_mm;
   eo.regenerative.revolutions = a.cut_revolutions;
@@ -152,22 +155,27 @@ int run_plant(const PlantArgs& a) {
 
 void register_plant(Registry& r) {
   auto a = std::make_shared<PlantArgs>();
-  CLI::App* sub = r.add("plant", "HIL plant emulator: the simulated plant behind CAN frames and Modbus registers, "
-                                 "in its own process, for `robodamp run` to control",
+  CLI::App* sub = r.add("plant",
+                        "HIL plant emulator: the simulated plant behind CAN frames and Modbus registers, "
+                        "in its own process, for `robodamp run` to control",
                         [a] { return run_plant(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML) with can, modbus and hil sections")
       ->check(CLI::ExistingFile);
-  sub->add_option("--pacing", a->pacing, "Override hil.pacing: realtime (true HIL) or lockstep (one step per command frame)")
+  sub->add_option("--pacing", a->pacing,
+                  "Override hil.pacing: realtime (true HIL) or lockstep (one step per command frame)")
       ->check(CLI::IsMember({"realtime", "lockstep"}));
   r.number(sub, "--duration", a->duration_s, {"s", 0.0, 604800.0, false, false, "0 = when the controller leaves"},
            "Stop after this much plant time");
   r.json(sub, a->json, "The report (frames, timing, measured FRFs)");
   sub->add_flag("!--no-impacts", a->impacts, "Do not run the impact schedule");
-  sub->add_option("--measure-out", a->measure_out,
-                  "The plant side of robodamp measure: the commissioning impacts at every location, FRFs written here; with "
-                  "--pose-at, at each dwell from its start on a stopped measurement's times, into DIR/dwell_<k> (measure --along-path)");
+  sub->add_option(
+      "--measure-out", a->measure_out,
+      "The plant side of robodamp measure: the commissioning impacts at every location, FRFs written here; with "
+      "--pose-at, at each dwell from its start on a stopped measurement's times, into DIR/dwell_<k> (measure "
+      "--along-path)");
   r.whole_number(sub, "--impact-location", a->impact_location,
-                 {"(location id)", 0, 1000, false, false, "0 = the first FRF's excitation"}, "Location id the hammer hits");
+                 {"(location id)", 0, 1000, false, false, "0 = the first FRF's excitation"},
+                 "Location id the hammer hits");
   r.number(sub, "--bus-off-at", a->bus_off_at_s, {"s", 0.0, 604800.0},
            "Fault injection: the CAN bus goes off at this plant time (error frame, no sensor frames, then a restart)");
   r.number(sub, "--bus-off-for", a->bus_off_for_s, {"s", 0.001, 3600.0}, "How long the bus stays off");
@@ -187,28 +195,34 @@ void register_plant(Registry& r) {
   sub->add_option("--cut", a->cut_job,
                   "Milling job (config/milling/*.yaml) cut against the robot at its controller part's location")
       ->check(CLI::ExistingFile);
-  sub->add_option("--cut-model", a->cut_model,
-                  "regenerative (default): the time-domain cut with surface memory, which can chatter, at --cut-rpm and "
-                  "--cut-axial-mm then the --spindle / --depth program (and the advice with spindle.apply_advice); "
-                  "forced: the rigid tool's force harmonics at the --spindle / --spindle-ramp speed")
+  sub->add_option(
+         "--cut-model", a->cut_model,
+         "regenerative (default): the time-domain cut with surface memory, which can chatter, at --cut-rpm and "
+         "--cut-axial-mm then the --spindle / --depth program (and the advice with spindle.apply_advice); "
+         "forced: the rigid tool's force harmonics at the --spindle / --spindle-ramp speed")
       ->check(CLI::IsMember({"regenerative", "forced"}));
-  r.number(sub, "--cut-rpm", a->cut_rpm, {"rpm", 0.0, 200000.0, true}, "The regenerative cut's spindle speed (default: the job's)");
-  r.number(sub, "--cut-axial-mm", a->cut_axial_mm, {"mm", 0.0, 100.0, true}, "The regenerative cut's axial depth (default: the job's)");
+  r.number(sub, "--cut-rpm", a->cut_rpm, {"rpm", 0.0, 200000.0, true},
+           "The regenerative cut's spindle speed (default: the job's)");
+  r.number(sub, "--cut-axial-mm", a->cut_axial_mm, {"mm", 0.0, 100.0, true},
+           "The regenerative cut's axial depth (default: the job's)");
   r.whole_number(sub, "--cut-revs", a->cut_revolutions, {"(revolutions)", 2, 100000},
                  "Revolutions of the regenerative cut (default: the job's, at least 300)");
   sub->add_flag("--drives-off", a->drives_off,
                 "The robot's drive vibration off for this run (disturbances.drives_on), as the in-process cut has it");
-  r.number(sub, "--cut-until", a->cut_until_s, {"s", 0.0, 604800.0, false, false, "0 = no bound"},
-           "The regenerative cut goes on at least until this plant time (the robot's path), then until its last speed and "
-           "depth have had --cut-revs revolutions");
+  r.number(
+      sub, "--cut-until", a->cut_until_s, {"s", 0.0, 604800.0, false, false, "0 = no bound"},
+      "The regenerative cut goes on at least until this plant time (the robot's path), then until its last speed and "
+      "depth have had --cut-revs revolutions");
   sub->add_flag("--cut-until-advice", a->cut_until_advice,
                 "The robot program waits for robodamp's word: the regenerative cut goes on until the robot has read a "
                 "spindle-speed advice (modbus.robot.advice_register), then --cut-revs at the speed it ends at");
   r.number(sub, "--cut-at", a->cut_at_s, {"s", 0.0, 604800.0},
-           "Plant time the regenerative cut starts (default: hil.settle_s + controller.gain_ramp_s after the amplifier is ready)");
-  sub->add_option("--pose-at", a->pose_at,
-                  "The robot's pose trajectory, a waypoint TIME_S:Q1,Q2,... (plant time, joint angles in deg; linear between "
-                  "waypoints; two with the same pose make a dwell, measured by impacts), repeatable; needs pose_schedule");
+           "Plant time the regenerative cut starts (default: hil.settle_s + controller.gain_ramp_s after the amplifier "
+           "is ready)");
+  sub->add_option(
+      "--pose-at", a->pose_at,
+      "The robot's pose trajectory, a waypoint TIME_S:Q1,Q2,... (plant time, joint angles in deg; linear between "
+      "waypoints; two with the same pose make a dwell, measured by impacts), repeatable; needs pose_schedule");
   r.number(sub, "--pose-register-period", a->pose_register_period_s, {"s", 0.0, 10.0},
            "How often the robot updates its joint registers (plant time)");
   r.number(sub, "--pose-update", a->pose_update_s, {"s", 0.0002, 10.0},

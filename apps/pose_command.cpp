@@ -20,6 +20,7 @@
 
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
+#include "apps/pose_command.hpp"
 #include "apps/pose_modes_command.hpp"
 #include "apps/pose_tune_command.hpp"
 #include "identify/modal_fit.hpp"
@@ -37,169 +38,14 @@ namespace {
 
 using nlohmann::json;
 
-struct PoseArgs {
-  std::string what;
-  std::string model_path{config::shipped_file("robots/planar_three_link.yaml")};
-  std::vector<double> joints_deg;
-  std::string pose_name;
-  JsonOut json;
-  std::string json_out_path;  // the deprecated --json-out FILE: the JSON also there
-  std::string plot_dir, plot_path;
-  int modes{4};
-  std::vector<double> band_hz{2.0, 60.0};
-  std::vector<int> vary{2, 3};
-  int steps{21};
-  std::vector<std::string> measured;  // "Q1,Q2,Q3:path"
-  std::vector<std::string> measurements, hold_out;  // fit: measure directories; pose names kept out of the fit
-  std::string direction{"yy"};
-  std::vector<double> fit_band_hz{10.0, 30.0};
-  int restarts{3}, particles{40}, iterations{150}, seed{1};
-  std::optional<int> fit_modes;  // fit: the model's form (robot::PoseFitSettings::modes)
-  std::string out_path;
-  std::string csv_path;
-  double csv_step_hz{0.1};
-  std::string job_path;  // map: a milling job with a pose part: its minimum limiting depth at each pose
-  std::string method{"sdm"};  // map: the accurate method, or "zoa" (the zero-order preview)
-  PoseTuneArgs tune;          // tune (apps/pose_tune_command.hpp)
-  bool model_given{false};
-  bool modes_given{false};
-};
-
-bool also_json_out(const PoseArgs& a, const json& j);
-
-// "Q1,Q2,Q3:path" -> the pose and the FRF (a freq_hz,re_m_per_n,im_m_per_n[,coherence] receptance CSV).
-robot::MeasuredFrf measured_frf(const std::string& item) {
-  const auto colon = item.find(':');
-  if (colon == std::string::npos)
-    throw std::invalid_argument("--measured = '" + item + "': expected Q1,Q2,...:FRF.csv (joint angles in deg)");
-  robot::MeasuredFrf m;
-  std::stringstream qs(item.substr(0, colon));
-  for (std::string tok; std::getline(qs, tok, ',');) {
-    double v = 0.0;
-    if (auto p = parse_number("--measured", tok, {"deg", -360.0, 360.0}, false, v))
-      throw std::invalid_argument(*p + " (in '" + item + "')");
-    m.joints_deg.push_back(v);
-  }
-  m.name = item.substr(colon + 1);
-  const identify::FrfData d = identify::read_frf_csv(m.name, identify::FrfKind::kReceptance);
-  m.freq_hz = d.f_hz;
-  m.receptance_m_per_n = d.h;
-  return m;
-}
-
-struct FitData {
-  std::vector<robot::MeasuredFrf> fit, held;
-  std::optional<robot::FrfDirection> direction;  // from the measurements' configuration
-  int modes{0};                                   // its pose_schedule.modes
-};
-
-// --measured items and --measurements directories (checked against the model: identify::check_against_model),
-// the --hold-out poses set apart.
-FitData fit_data(const PoseArgs& a, const config::RobotModelConfig& model) {
-  FitData d;
-  for (const auto& item : a.measured) d.fit.push_back(measured_frf(item));
-  if (!a.measurements.empty()) {
-    identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
-    identify::check_against_model(pm, model);
-    d.direction = pm.direction;
-    d.modes = pm.modes;
-    for (auto& f : pm.frfs) d.fit.push_back(std::move(f));
-  }
-  for (const auto& name : a.hold_out) {
-    const auto it = std::find_if(d.fit.begin(), d.fit.end(), [&](const auto& f) { return f.name == name; });
-    if (it == d.fit.end()) throw std::invalid_argument("--hold-out '" + name + "': no measured pose of that name");
-    d.held.push_back(std::move(*it));
-    d.fit.erase(it);
-  }
-  if (d.fit.empty())
-    throw std::invalid_argument("robodamp pose fit: give --measured Q1,Q2,...:FRF.csv or --measurements DIR, and keep at "
-                                "least one pose in the fit");
-  return d;
-}
-
-robot::PoseFitSettings fit_settings(const PoseArgs& a, const FitData& d) {
-  robot::PoseFitSettings s;
-  s.direction = a.direction == "xx" ? robot::FrfDirection::kXX : a.direction == "xy" ? robot::FrfDirection::kXY : robot::FrfDirection::kYY;
-  if (d.direction) s.direction = *d.direction;
-  s.band_min_hz = a.fit_band_hz[0], s.band_max_hz = a.fit_band_hz[1];
-  s.modes = a.fit_modes.value_or(d.modes);
-  s.restarts = a.restarts;
-  s.pso.particles = a.particles, s.pso.iterations = a.iterations, s.pso.seed = static_cast<std::uint64_t>(a.seed);
-  return s;
-}
-
-// Each pose: its role, the model's error before and after the fit, the receptance's peak frequency.
-json pose_rows(const config::RobotModelConfig& nominal, const config::RobotModelConfig& fitted,
-               const std::vector<robot::MeasuredFrf>& data, const robot::PoseFitSettings& s, const char* role,
-               std::ostringstream& t) {
-  json rows = json::array();
-  if (data.empty()) return rows;
-  const std::vector<double> before = robot::model_errors(nominal, data, s), after = robot::model_errors(fitted, data, s);
-  const std::vector<double> f_data = robot::peak_hz(nullptr, data, s), f_before = robot::peak_hz(&nominal, data, s),
-                            f_after = robot::peak_hz(&fitted, data, s);
-  char b[240];
-  for (std::size_t p = 0; p < data.size(); ++p) {
-    std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %9.2f %9.2f   %8.2f %8.2f %8.2f\n", data[p].name.c_str(),
-                  config::describe_pose(data[p].joints_deg).c_str(), role, 100.0 * before[p], 100.0 * after[p], f_data[p],
-                  f_before[p], f_after[p]);
-    t << b;
-    rows.push_back({{"frf", data[p].name}, {"joints_deg", data[p].joints_deg}, {"role", role},
-                    {"nominal_error_pct", 100.0 * before[p]}, {"error_pct", 100.0 * after[p]},
-                    {"peak_hz", f_data[p]}, {"nominal_peak_hz", f_before[p]}, {"fitted_peak_hz", f_after[p]}});
-  }
-  return rows;
-}
-
-int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
-  const FitData d = fit_data(a, m);
-  const robot::PoseFitSettings s = fit_settings(a, d);
-  const robot::PoseFitResult r = robot::fit_joints(m, d.fit, s);
-  const char* dir = s.direction == robot::FrfDirection::kXX ? "xx" : s.direction == robot::FrfDirection::kXY ? "xy" : "yy";
-  std::ostringstream t;
-  char b[240];
-  const std::string form = s.modes > 0 ? "its " + std::to_string(s.modes) + " lowest modes" : "its own receptance";
-  std::snprintf(b, sizeof b, "robot %s (as %s) fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
-                m.name.c_str(), form.c_str(), d.fit.size(), dir, s.band_min_hz, s.band_max_hz, r.evaluations,
-                r.converged_restarts, s.restarts);
-  t << b << "  joint   stiffness N m/rad   spread %   damping ratio\n";
-  json joints = json::array();
-  for (std::size_t j = 0; j < r.stiffness_nm_per_rad.size(); ++j) {
-    std::snprintf(b, sizeof b, "  %5zu   %17.5g   %8.3f   %13.4f\n", j + 1, r.stiffness_nm_per_rad[j], r.stiffness_spread_pct[j],
-                  r.damping_ratio[j]);
-    t << b;
-    joints.push_back({{"stiffness_nm_per_rad", r.stiffness_nm_per_rad[j]}, {"spread_pct", r.stiffness_spread_pct[j]},
-                      {"damping_ratio", r.damping_ratio[j]}});
-  }
-  t << "  the TCP receptance against the model file as given (nominal) and fitted: the weighted relative error and\n"
-       "  the frequency of the largest receptance in the band\n";
-  std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %19s   %26s\n  %-10s %-30s %-9s %9s %9s   %8s %8s %8s\n", "", "", "",
-                "error %", "peak Hz", "pose", "joints", "role", "nominal", "fitted", "measured", "nominal", "fitted");
-  t << b;
-  json poses = pose_rows(m, r.fitted, d.fit, s, "fit", t);
-  for (auto& row : pose_rows(m, r.fitted, d.held, s, "held out", t)) poses.push_back(std::move(row));
-  const json out = {{"model", m.source}, {"direction", dir}, {"modes", s.modes}, {"joints", joints}, {"poses", poses},
-                    {"restart_costs", r.restart_costs}, {"evaluations", r.evaluations},
-                    {"converged_restarts", r.converged_restarts}};
-  if (!a.out_path.empty()) {
-    std::ofstream f(a.out_path);
-    f << config::robot_model_yaml(r.fitted);
-    if (!f) {
-      std::cerr << "--out " << a.out_path << ": cannot write\n";
-      return 1;
-    }
-    t << "  wrote the fitted model to " << a.out_path << '\n';
-  }
-  if (!also_json_out(a, out)) return 1;
-  return print_report(out.dump(2), a.json, "pose", t.str(), "", {}, "");
-}
-
 std::vector<double> pose_of(const config::RobotModelConfig& m, const PoseArgs& a) {
   if (!a.pose_name.empty()) {
     for (const auto& p : m.poses)
       if (p.name == a.pose_name) return p.joints_deg;
     std::string known;
     for (const auto& p : m.poses) known += (known.empty() ? "" : ", ") + p.name;
-    throw config::ConfigError({config::Problem{m.source, {}, "poses", "--pose-name = '" + a.pose_name + "' is not one of: " + known}});
+    throw config::ConfigError(
+        {config::Problem{m.source, {}, "poses", "--pose-name = '" + a.pose_name + "' is not one of: " + known}});
   }
   if (!a.joints_deg.empty()) return a.joints_deg;
   if (m.poses.empty())
@@ -220,7 +66,9 @@ int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
   const std::vector<double> q = pose_of(m, a);
   const robot::PlanarChain c = robot::at_pose(m, q);
   const auto modes = c.modes(static_cast<std::size_t>(a.modes));
-  json r = {{"model", m.source}, {"joints_deg", q}, {"tcp_m", {c.tcp_position_m().x(), c.tcp_position_m().y()}},
+  json r = {{"model", m.source},
+            {"joints_deg", q},
+            {"tcp_m", {c.tcp_position_m().x(), c.tcp_position_m().y()}},
             {"modes", modes_json(modes)}};
   // The FRF on a log grid across the band, direct; RCSA's largest difference from it reported.
   json frf = json::array();
@@ -267,19 +115,24 @@ int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
                 a.band_hz[0], a.band_hz[1], worst);
   t << b;
   if (!also_json_out(a, r)) return 1;
-  return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
-    const std::string s = "set terminal pngcairo size 900,600; set output '" + a.plot_path +
-                          "'; set logscale xy; set grid; set xlabel 'frequency (Hz)'; set ylabel '|receptance| (m/N)';"
-                          " set title 'TCP receptance at the pose'; plot DATA u 1:2 w l lw 2 t 'xx', '' u 1:3 w l lw 2 t 'yy',"
-                          " '' u 1:4 w l t 'xy'";
-    return run_gnuplot(s, data.str(), a.plot_path);
-  }, a.plot_path);
+  return print_report(
+      r.dump(2), a.json, "pose", t.str(), a.plot_path,
+      [&] {
+        const std::string s =
+            "set terminal pngcairo size 900,600; set output '" + a.plot_path +
+            "'; set logscale xy; set grid; set xlabel 'frequency (Hz)'; set ylabel '|receptance| (m/N)';"
+            " set title 'TCP receptance at the pose'; plot DATA u 1:2 w l lw 2 t 'xx', '' u 1:3 w l lw 2 t 'yy',"
+            " '' u 1:4 w l t 'xy'";
+        return run_gnuplot(s, data.str(), a.plot_path);
+      },
+      a.plot_path);
 }
 
 int run_table(const config::RobotModelConfig& m, const PoseArgs& a) {
   json rows = json::array();
   std::ostringstream t;
-  t << "robot " << m.name << ": the first mode at each named pose\n  pose        joints deg                    model Hz  "
+  t << "robot " << m.name
+    << ": the first mode at each named pose\n  pose        joints deg                    model Hz  "
        "published predicted Hz  measured Hz\n";
   for (const auto& p : m.poses) {
     const robot::PlanarChain c = robot::at_pose(m, p.joints_deg);
@@ -294,7 +147,9 @@ int run_table(const config::RobotModelConfig& m, const PoseArgs& a) {
                   p.predicted_f1_hz ? config::format_number(*p.predicted_f1_hz).c_str() : "-",
                   p.measured_f1_hz ? config::format_number(*p.measured_f1_hz).c_str() : "-");
     t << b;
-    rows.push_back({{"name", p.name}, {"joints_deg", p.joints_deg}, {"modes", modes_json(modes)},
+    rows.push_back({{"name", p.name},
+                    {"joints_deg", p.joints_deg},
+                    {"modes", modes_json(modes)},
                     {"predicted_f1_hz", p.predicted_f1_hz ? json(*p.predicted_f1_hz) : json(nullptr)},
                     {"measured_f1_hz", p.measured_f1_hz ? json(*p.measured_f1_hz) : json(nullptr)}});
   }
@@ -331,12 +186,12 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
     json point = {{"joints_deg", p.joints_deg}, {"f1_hz", p.f1_hz}, {"k1_n_per_m", p.k1_n_per_m}};
     if (p.min_depth_mm) point["min_depth_mm"] = *p.min_depth_mm, point["min_depth_rpm"] = *p.min_depth_rpm;
     grid.push_back(point);
-    data << p.joints_deg[req.joint_a] << ' ' << p.joints_deg[req.joint_b] << ' ' << p.f1_hz << ' ' << p.k1_n_per_m << ' '
-         << p.min_depth_mm.value_or(NAN) << '\n';
+    data << p.joints_deg[req.joint_a] << ' ' << p.joints_deg[req.joint_b] << ' ' << p.f1_hz << ' ' << p.k1_n_per_m
+         << ' ' << p.min_depth_mm.value_or(NAN) << '\n';
     if ((i + 1) % static_cast<std::size_t>(a.steps) == 0) data << '\n';
   }
-  json r = {{"model", m.source}, {"vary", a.vary}, {"steps", a.steps}, {"grid", grid},
-                  {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
+  json r = {{"model", m.source}, {"vary", a.vary},     {"steps", a.steps},
+            {"grid", grid},      {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
   std::ostringstream t;
   char b[200];
   std::snprintf(b, sizeof b, "robot %s: first mode over joints %d and %d (%d x %d poses): %.2f to %.2f Hz\n",
@@ -351,25 +206,27 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
     r["min_depth_max_mm"] = b_max;
   }
   if (!also_json_out(a, r)) return 1;
-  return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
-    const std::string s = "set terminal pngcairo size " + std::string(job ? "2000" : "1400") + ",600; set output '" + a.plot_path +
-                          "'; set multiplot layout 1," + std::string(job ? "3" : "2") + "; set view map; set xlabel 'joint " + std::to_string(a.vary[0]) +
-                          " (deg)'; set ylabel 'joint " + std::to_string(a.vary[1]) +
-                          " (deg)'; set title 'first mode (Hz)'; splot DATA u 1:2:3 w pm3d notitle;"
-                          " set title 'TCP modal stiffness of the first mode (N/m)'; set format cb '%.1e';"
-                          " splot DATA u 1:2:4 w pm3d notitle;" +
-                          std::string(job ? " set format cb '%g'; set title 'minimum limiting depth (mm, " + method + ")';"
-                                            " splot DATA u 1:2:5 w pm3d notitle;" : "") +
-                          " unset multiplot";
-    return run_gnuplot(s, data.str(), a.plot_path);
-  }, a.plot_path);
+  return print_report(
+      r.dump(2), a.json, "pose", t.str(), a.plot_path,
+      [&] {
+        const std::string s =
+            "set terminal pngcairo size " + std::string(job ? "2000" : "1400") + ",600; set output '" + a.plot_path +
+            "'; set multiplot layout 1," + std::string(job ? "3" : "2") + "; set view map; set xlabel 'joint " +
+            std::to_string(a.vary[0]) + " (deg)'; set ylabel 'joint " + std::to_string(a.vary[1]) +
+            " (deg)'; set title 'first mode (Hz)'; splot DATA u 1:2:3 w pm3d notitle;"
+            " set title 'TCP modal stiffness of the first mode (N/m)'; set format cb '%.1e';"
+            " splot DATA u 1:2:4 w pm3d notitle;" +
+            std::string(job ? " set format cb '%g'; set title 'minimum limiting depth (mm, " + method +
+                                  ")';"
+                                  " splot DATA u 1:2:5 w pm3d notitle;"
+                            : "") +
+            " unset multiplot";
+        return run_gnuplot(s, data.str(), a.plot_path);
+      },
+      a.plot_path);
 }
 
 // The deprecated --json-out FILE: the JSON written there as well.
-bool also_json_out(const PoseArgs& a, const json& j) {
-  if (a.json_out_path.empty()) return true;
-  return emit_json(JsonOut{a.json_out_path, true}, j.dump(2), "pose");
-}
 
 int run_pose(const PoseArgs& given) {
   PoseArgs a = given;
@@ -386,8 +243,8 @@ int run_pose(const PoseArgs& given) {
     if (a.what == "table") return run_table(m, a);
     if (a.what == "fit") return run_fit(m, a);
     if (a.what == "modes")
-      return run_pose_modes(m, {a.measurements, a.hold_out, a.joints_deg, a.pose_name, a.modes_given ? a.modes : 3, a.out_path, a.json,
-                                a.plot_path, a.vary.empty() ? 2 : a.vary[0]});
+      return run_pose_modes(m, {a.measurements, a.hold_out, a.joints_deg, a.pose_name, a.modes_given ? a.modes : 3,
+                                a.out_path, a.json, a.plot_path, a.vary.empty() ? 2 : a.vary[0]});
     return run_map(m, a);
   } catch (const config::ConfigError& e) {
     std::cerr << e.what() << '\n';
@@ -400,65 +257,109 @@ int run_pose(const PoseArgs& given) {
 
 }  // namespace
 
+namespace {
+void add_fit_options(Registry& r, CLI::App* sub, PoseArgs& a);
+}  // namespace
+
 void register_pose(Registry& r) {
   auto a = std::make_shared<PoseArgs>();
-  CLI::App* sub = r.add("pose",
-                        "Pose-dependent robot dynamics (the planar-robot study): `pose frf` (modes and TCP FRF at a pose), `pose fit` (joints from measured FRFs), `pose modes` "
-                        "(the modes measured at poses into the model, or the mapped modes at a pose), `pose table` (the first mode at the model's named poses), `pose map` (first mode over two joints), `pose tune` (a robust set and a "
-                        "schedule drawn from the data over a configuration's workspace, the better written)",
-                        [a] { return run_pose(*a); });
-  sub->add_option("what", a->what, "frf, table, fit, modes, map or tune")->required()->check(CLI::IsMember({"frf", "table", "fit", "modes", "map", "tune"}));
-  sub->add_option("--model", a->model_path, "Robot model file (config/robots/*.yaml); tune: the pose-indexed model (default the configuration's pose_schedule.model)")
+  CLI::App* sub =
+      r.add("pose",
+            "Pose-dependent robot dynamics (the planar-robot study): `pose frf` (modes and TCP FRF at a pose), `pose "
+            "fit` (joints from measured FRFs), `pose modes` "
+            "(the modes measured at poses into the model, or the mapped modes at a pose), `pose table` (the first mode "
+            "at the model's named poses), `pose map` (first mode over two joints), `pose tune` (a robust set and a "
+            "schedule drawn from the data over a configuration's workspace, the better written)",
+            [a] { return run_pose(*a); });
+  sub->add_option("what", a->what, "frf, table, fit, modes, map or tune")
+      ->required()
+      ->check(CLI::IsMember({"frf", "table", "fit", "modes", "map", "tune"}));
+  sub->add_option("--model", a->model_path,
+                  "Robot model file (config/robots/*.yaml); tune: the pose-indexed model (default the configuration's "
+                  "pose_schedule.model)")
       ->check(CLI::ExistingFile)
       ->each([a](const std::string&) { a->model_given = true; });
-  sub->add_option("--config", a->tune.config_path, "tune: the configuration with a pose_schedule (model, axis, workspace)")->check(CLI::ExistingFile);
-  r.whole_number(sub, "--evaluations", a->tune.evaluations, {"(evaluations per polarity)", 10, 5000}, "tune: each set's global search");
+  sub->add_option("--config", a->tune.config_path,
+                  "tune: the configuration with a pose_schedule (model, axis, workspace)")
+      ->check(CLI::ExistingFile);
+  r.whole_number(sub, "--evaluations", a->tune.evaluations, {"(evaluations per polarity)", 10, 5000},
+                 "tune: each set's global search");
   r.whole_number(sub, "--polish", a->tune.polish, {"(evaluations)", 0, 5000}, "tune: each set's local polish");
-  r.whole_number(sub, "--max-regions", a->tune.max_regions, {"(regions)", 1, 16}, "tune: the scheduled controller's regions at most");
-  r.whole_number(sub, "--map-points", a->tune.map_points, {"(points per joint)", 2, 41}, "tune: the workspace map's grid along the joints that move the dominant mode (default 9)");
-  r.number(sub, "--overlap-deg", a->tune.overlap_deg, {"deg", 0.0, 30.0}, "tune: neighbouring regions overlap by this (the hand-over's hysteresis)");
+  r.whole_number(sub, "--max-regions", a->tune.max_regions, {"(regions)", 1, 16},
+                 "tune: the scheduled controller's regions at most");
+  r.whole_number(sub, "--map-points", a->tune.map_points, {"(points per joint)", 2, 41},
+                 "tune: the workspace map's grid along the joints that move the dominant mode (default 9)");
+  r.number(sub, "--overlap-deg", a->tune.overlap_deg, {"deg", 0.0, 30.0},
+           "tune: neighbouring regions overlap by this (the hand-over's hysteresis)");
   r.number(sub, "--worse-mode-pct", a->tune.worse_mode_pct, {"%", 0.0, 20.0},
-           "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default 0: never worse)");
-  r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0}, "frf, map, modes: the pose, one relative angle per joint");
+           "tune: a set serves while no mode in the damping band is more than this much worse than open loop (default "
+           "0: never worse)");
+  r.numbers(sub, "--joints", a->joints_deg, {"deg", -360.0, 360.0},
+            "frf, map, modes: the pose, one relative angle per joint");
   // --pose is the joint angles in run, cut, lobes, sle and measure: here it named a pose (docs/cli.md).
   r.renamed(sub->add_option("--pose-name", a->pose_name, "frf, map, modes: a pose the model file names"), "NAME",
             sub->add_option("--pose", a->pose_name, "frf, map, modes: a pose the model file names"),
             "--pose is joint angles in every other command");
-  r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20}, "frf: how many modes (default 4); modes: how many of the model's (default 3)")
+  r.whole_number(sub, "--modes", a->modes, {"(modes)", 1, 20},
+                 "frf: how many modes (default 4); modes: how many of the model's (default 3)")
       ->each([a](const std::string&) { a->modes_given = true; });
   r.numbers(sub, "--band-hz", a->band_hz, {"Hz", 0.0, 1e4, true, false}, "frf: FRF band LO HI");
   r.json(sub, a->json, "The result (modes, the table, the fit or the map)");
   r.deprecated(sub->add_option("--json-out", a->json_out_path, "Also write the JSON to this file"), "--json FILE");
-  r.plot_dir(sub, a->plot_dir, "frf, map, modes: pose_frf.png, pose_map.png or pose_modes.png (the modes along --vary's first joint)");
-  r.deprecated(sub->add_option("--plot", a->plot_path, "frf, map: write the plot to this file (PNG)"), "--plot-dir DIR");
-  sub->add_option("--vary", a->vary, "map: the two joints to vary over their travel (1-based); modes: the first, the plot's joint");
-  sub->add_option("--job", a->job_path, "map: a milling job whose structure has a robot pose part (its minimum depth per pose); tune: the job scored over the workspace map")
+  r.plot_dir(sub, a->plot_dir,
+             "frf, map, modes: pose_frf.png, pose_map.png or pose_modes.png (the modes along --vary's first joint)");
+  r.deprecated(sub->add_option("--plot", a->plot_path, "frf, map: write the plot to this file (PNG)"),
+               "--plot-dir DIR");
+  sub->add_option("--vary", a->vary,
+                  "map: the two joints to vary over their travel (1-based); modes: the first, the plot's joint");
+  sub->add_option("--job", a->job_path,
+                  "map: a milling job whose structure has a robot pose part (its minimum depth per pose); tune: the "
+                  "job scored over the workspace map")
       ->check(CLI::ExistingFile);
-  sub->add_option("--method", a->method, "map: sdm (default): the job's minimum by semi-discretization over its SDM speeds; zoa: the zero-order method, a fast preview")
+  sub->add_option("--method", a->method,
+                  "map: sdm (default): the job's minimum by semi-discretization over its SDM speeds; zoa: the "
+                  "zero-order method, a fast preview")
       ->check(CLI::IsMember({"sdm", "zoa"}));
   r.whole_number(sub, "--steps", a->steps, {"(steps per joint)", 2, 201}, "map: grid steps per joint");
-  sub->add_option("--measured", a->measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
-  sub->add_option("--measurements", a->measurements,
-                  "fit, modes: robodamp measure --pose directories (or a --poses directory: all its poses), their joint angles "
-                  "and driving-point FRFs; the direction is their configuration's pose_schedule.axis")
-      ->check(CLI::ExistingDirectory);
-  sub->add_option("--hold-out", a->hold_out,
-                  "fit, modes: pose names (of --measurements) kept out of the fit or the map: the error is reported there");
-  sub->add_option("--direction", a->direction, "fit: which TCP receptance the FRFs are; frf: which one --csv-out writes")->check(CLI::IsMember({"xx", "yy", "xy"}));
-  r.numbers(sub, "--fit-band-hz", a->fit_band_hz, {"Hz", 0.0, 1e4, true, false}, "fit: band LO HI (the planar-robot study: 10 30)");
-  r.whole_number(sub, "--fit-modes", a->fit_modes, {"(modes)", 0, 20},
-                 "fit: compare the model as its N lowest modes with viscous damping, the plant a schedule predicts with "
-                 "(default: the measurements' pose_schedule.modes; 0, and for --measured: the model's own receptance)");
-  r.whole_number(sub, "--restarts", a->restarts, {"(restarts)", 1, 100}, "fit: swarms with seeds seed, seed+1, ...");
-  r.whole_number(sub, "--particles", a->particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
-  r.whole_number(sub, "--iterations", a->iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
-  r.whole_number(sub, "--seed", a->seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
-  sub->add_option("--out", a->out_path, "fit: write the fitted robot model file here; modes: the model with its measured modes; tune: the configuration with the chosen controller");
-  // --csv is a table read in identify and chatter: here it was one written.
-  r.renamed(sub->add_option("--csv-out", a->csv_path, "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz"),
-            "FILE", sub->add_option("--csv", a->csv_path, "frf: write the receptance to this table"),
-            "--csv is a table read in every other command");
-  r.number(sub, "--csv-step-hz", a->csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv-out frequency step");
+  add_fit_options(r, sub, *a);
 }
+
+namespace {
+
+// pose fit's options (and --out, --csv-out, which fit, modes, tune and frf share).
+void add_fit_options(Registry& r, CLI::App* sub, PoseArgs& a) {
+  sub->add_option("--measured", a.measured, "fit: a measured TCP receptance at a pose, Q1,Q2,...:FRF.csv (repeatable)");
+  sub->add_option(
+         "--measurements", a.measurements,
+         "fit, modes: robodamp measure --pose directories (or a --poses directory: all its poses), their joint angles "
+         "and driving-point FRFs; the direction is their configuration's pose_schedule.axis")
+      ->check(CLI::ExistingDirectory);
+  sub->add_option(
+      "--hold-out", a.hold_out,
+      "fit, modes: pose names (of --measurements) kept out of the fit or the map: the error is reported there");
+  sub->add_option("--direction", a.direction, "fit: which TCP receptance the FRFs are; frf: which one --csv-out writes")
+      ->check(CLI::IsMember({"xx", "yy", "xy"}));
+  r.numbers(sub, "--fit-band-hz", a.fit_band_hz, {"Hz", 0.0, 1e4, true, false},
+            "fit: band LO HI (the planar-robot study: 10 30)");
+  r.whole_number(
+      sub, "--fit-modes", a.fit_modes, {"(modes)", 0, 20},
+      "fit: compare the model as its N lowest modes with viscous damping, the plant a schedule predicts with "
+      "(default: the measurements' pose_schedule.modes; 0, and for --measured: the model's own receptance)");
+  r.whole_number(sub, "--restarts", a.restarts, {"(restarts)", 1, 100}, "fit: swarms with seeds seed, seed+1, ...");
+  r.whole_number(sub, "--particles", a.particles, {"(particles)", 4, 1000}, "fit: particles per swarm");
+  r.whole_number(sub, "--iterations", a.iterations, {"(iterations)", 1, 10000}, "fit: iterations per swarm");
+  r.whole_number(sub, "--seed", a.seed, {"(seed)", 0, 2147483647}, "fit: the first swarm's seed");
+  sub->add_option("--out", a.out_path,
+                  "fit: write the fitted robot model file here; modes: the model with its measured modes; tune: the "
+                  "configuration with the chosen controller");
+  // --csv is a table read in identify and chatter: here it was one written.
+  r.renamed(sub->add_option("--csv-out", a.csv_path,
+                            "frf: write the --direction receptance as freq_hz,re_m_per_n,im_m_per_n over --band-hz"),
+            "FILE", sub->add_option("--csv", a.csv_path, "frf: write the receptance to this table"),
+            "--csv is a table read in every other command");
+  r.number(sub, "--csv-step-hz", a.csv_step_hz, {"Hz", 0.0, 1e3, true, false}, "frf: the --csv-out frequency step");
+}
+
+}  // namespace
 
 }  // namespace robodamp::apps

@@ -46,16 +46,19 @@ json row_json(const analysis::ModeCheckRow& r) {
 // A number in a column, "-" where there is none (no model mode within 25 %).
 std::string cell(double v, const char* format, int width) {
   char b[32];
-  if (std::isfinite(v)) std::snprintf(b, sizeof b, format, v);
-  else std::snprintf(b, sizeof b, "%*s", width, "-");
+  if (std::isfinite(v))
+    std::snprintf(b, sizeof b, format, v);
+  else
+    std::snprintf(b, sizeof b, "%*s", width, "-");
   return b;
 }
 
 void row_text(const analysis::ModeCheckRow& r, std::ostringstream& t) {
   char b[320];
-  std::snprintf(b, sizeof b, "  %-10s %-9s %8.2f %s %s %s %s %s   %s %s %s %7.1f\n", r.pose.c_str(), r.held_out ? "held out" : "map",
-                r.measured_hz, cell(r.model_hz, "%8.2f", 8).c_str(), cell(error_pct(r.model_hz, r.measured_hz), "%+7.2f", 7).c_str(),
-                cell(r.mapped_hz, "%8.2f", 8).c_str(), cell(error_pct(r.mapped_hz, r.measured_hz), "%+7.2f", 7).c_str(),
+  std::snprintf(b, sizeof b, "  %-10s %-9s %8.2f %s %s %s %s %s   %s %s %s %7.1f\n", r.pose.c_str(),
+                r.held_out ? "held out" : "map", r.measured_hz, cell(r.model_hz, "%8.2f", 8).c_str(),
+                cell(error_pct(r.model_hz, r.measured_hz), "%+7.2f", 7).c_str(), cell(r.mapped_hz, "%8.2f", 8).c_str(),
+                cell(error_pct(r.mapped_hz, r.measured_hz), "%+7.2f", 7).c_str(),
                 cell(r.freq_sigma_pct, "%6.2f", 6).c_str(),
                 cell(error_pct(r.model_stiffness_n_per_m, r.measured_stiffness_n_per_m), "%+7.1f", 7).c_str(),
                 cell(error_pct(r.mapped_stiffness_n_per_m, r.measured_stiffness_n_per_m), "%+7.1f", 7).c_str(),
@@ -74,8 +77,8 @@ json print_forms(const std::vector<robot::TrackForm>& forms, std::ostringstream&
     const double lo = f.min_hz, hi = f.max_hz;
     const auto form = [&](const char* what, const robot::QuantityForm& q, double scale, const char* unit) {
       char b[200];
-      std::snprintf(b, sizeof b, "%s %s (own %.3g, against the model %.3g%s)", what, q.own ? "own" : "against the model",
-                    scale * q.own_rms, scale * q.model_rms, unit);
+      std::snprintf(b, sizeof b, "%s %s (own %.3g, against the model %.3g%s)", what,
+                    q.own ? "own" : "against the model", scale * q.own_rms, scale * q.model_rms, unit);
       return std::string(b);
     };
     char head[160];
@@ -84,12 +87,18 @@ json print_forms(const std::vector<robot::TrackForm>& forms, std::ostringstream&
       t << head << ", no model mode follows it): every quantity the measured values on their own\n";
     else
       t << head << ", the model's mode " << f.model_index + 1 << "): " << form("frequency", f.freq, 100.0, " %") << "; "
-        << form("damping", f.damping, 100.0, " %") << ";\n      " << form("participation", f.stiffness, 1.0, " 1/kg") << '\n';
+        << form("damping", f.damping, 100.0, " %") << ";\n      " << form("participation", f.stiffness, 1.0, " 1/kg")
+        << '\n';
     const auto qj = [](const robot::QuantityForm& q) {
-      return json{{"form", q.own ? "own" : "against the model"}, {"own_loo_rms", q.own_rms}, {"model_loo_rms", q.model_rms}};
+      return json{
+          {"form", q.own ? "own" : "against the model"}, {"own_loo_rms", q.own_rms}, {"model_loo_rms", q.model_rms}};
     };
-    out.push_back({{"freq_hz", {lo, hi}}, {"measured_poses", f.measured_poses}, {"model_mode", f.model_index < 0 ? json(nullptr) : json(f.model_index + 1)},
-                   {"frequency", qj(f.freq)}, {"damping", qj(f.damping)}, {"participation", qj(f.stiffness)}});
+    out.push_back({{"freq_hz", {lo, hi}},
+                   {"measured_poses", f.measured_poses},
+                   {"model_mode", f.model_index < 0 ? json(nullptr) : json(f.model_index + 1)},
+                   {"frequency", qj(f.freq)},
+                   {"damping", qj(f.damping)},
+                   {"participation", qj(f.stiffness)}});
   }
   return out;
 }
@@ -103,8 +112,10 @@ int build_map(const config::RobotModelConfig& model, const PoseModesArgs& a) {
   prior.measured_modes.reset();
   mapped.measured_modes = id.measured;
   const int axis = id.measured.axis;
-  std::vector<analysis::ModeCheckRow> rows = analysis::check_pose_modes(prior, mapped, id.measured.poses, false, axis, count);
-  for (auto& r : analysis::check_pose_modes(prior, mapped, id.held_out, true, axis, count)) rows.push_back(std::move(r));
+  std::vector<analysis::ModeCheckRow> rows =
+      analysis::check_pose_modes(prior, mapped, id.measured.poses, false, axis, count);
+  for (auto& r : analysis::check_pose_modes(prior, mapped, id.held_out, true, axis, count))
+    rows.push_back(std::move(r));
   std::ostringstream t;
   t << "robot " << model.name << ": modes identified at " << id.measured.poses.size() << " measured pose(s) along "
     << (axis == 0 ? "x" : "y") << " (" << pm.band_min_hz << "-" << pm.band_max_hz << " Hz), the model's " << count
@@ -119,20 +130,29 @@ int build_map(const config::RobotModelConfig& model, const PoseModesArgs& a) {
     row_text(r, t);
     out_rows.push_back(row_json(r));
     if (!r.held_out) continue;
-    if (std::isfinite(r.model_hz)) worst_model = std::max(worst_model, std::abs(error_pct(r.model_hz, r.measured_hz)));
-    else ++model_missed;
-    if (std::isfinite(r.mapped_hz)) worst_mapped = std::max(worst_mapped, std::abs(error_pct(r.mapped_hz, r.measured_hz)));
-    else ++map_missed;
+    if (std::isfinite(r.model_hz))
+      worst_model = std::max(worst_model, std::abs(error_pct(r.model_hz, r.measured_hz)));
+    else
+      ++model_missed;
+    if (std::isfinite(r.mapped_hz))
+      worst_mapped = std::max(worst_mapped, std::abs(error_pct(r.mapped_hz, r.measured_hz)));
+    else
+      ++map_missed;
   }
   if (!id.held_out.empty()) {
     char b[300];
-    std::snprintf(b, sizeof b, "  at the held-out poses the largest frequency error: the model %.2f %% (%d mode(s) it has not within 25 %%), "
-                  "the map %.2f %% (%d)\n", worst_model, model_missed, worst_mapped, map_missed);
+    std::snprintf(
+        b, sizeof b,
+        "  at the held-out poses the largest frequency error: the model %.2f %% (%d mode(s) it has not within 25 %%), "
+        "the map %.2f %% (%d)\n",
+        worst_model, model_missed, worst_mapped, map_missed);
     t << b;
   }
   const json forms = print_forms(robot::ModalMap(mapped, axis, count).forms(), t);
-  json r = {{"model", model.source}, {"axis", axis == 0 ? "x" : "y"}, {"modes", count}, {"band_hz", {pm.band_min_hz, pm.band_max_hz}},
-            {"rows", out_rows}, {"modal_fit_error_pct", id.fit_error_pct}, {"interpolated", forms}};
+  json r = {{"model", model.source}, {"axis", axis == 0 ? "x" : "y"},
+            {"modes", count},        {"band_hz", {pm.band_min_hz, pm.band_max_hz}},
+            {"rows", out_rows},      {"modal_fit_error_pct", id.fit_error_pct},
+            {"interpolated", forms}};
   if (!id.held_out.empty()) {
     r["held_out_worst_freq_error_pct"] = {{"model", worst_model}, {"mapped", worst_mapped}};
     r["held_out_modes_missed"] = {{"model", model_missed}, {"mapped", map_missed}};
@@ -157,23 +177,34 @@ std::vector<double> pose_to_show(const config::RobotModelConfig& m, const PoseMo
     for (const auto& p : m.measured_modes->poses)
       if (p.name == a.pose_name) return p.joints_deg;
   if (!a.pose_name.empty())
-    throw config::ConfigError({config::Problem{m.source, {}, "poses", "--pose = '" + a.pose_name + "' is not a pose the file names"}});
-  if (m.poses.empty()) throw config::ConfigError({config::Problem{m.source, {}, "poses", "give --joints (the file names no pose)"}});
+    throw config::ConfigError(
+        {config::Problem{m.source, {}, "poses", "--pose = '" + a.pose_name + "' is not a pose the file names"}});
+  if (m.poses.empty())
+    throw config::ConfigError({config::Problem{m.source, {}, "poses", "give --joints (the file names no pose)"}});
   return m.poses.front().joints_deg;
 }
 
+int plot_modes_along_joint(const config::RobotModelConfig& prior, const config::RobotModelConfig& model,
+                           const std::vector<double>& q, int axis, const PoseModesArgs& a, json& r,
+                           const std::string& table);
+
 int show_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
   if (!model.measured_modes)
-    throw config::ConfigError({config::Problem{model.source, {}, "measured_modes",
-                                               "the model has no measured modes: give --measurements (robodamp measure --poses) to add them"}});
+    throw config::ConfigError({config::Problem{
+        model.source,
+        {},
+        "measured_modes",
+        "the model has no measured modes: give --measurements (robodamp measure --poses) to add them"}});
   const std::vector<double> q = pose_to_show(model, a);
   const int axis = model.measured_modes->axis;
   config::RobotModelConfig prior = model;
   prior.measured_modes.reset();
-  const analysis::PoseModes before = analysis::pose_modes(prior, q, axis, a.modes), after = analysis::pose_modes(model, q, axis, a.modes);
+  const analysis::PoseModes before = analysis::pose_modes(prior, q, axis, a.modes),
+                            after = analysis::pose_modes(model, q, axis, a.modes);
   std::ostringstream t;
   char b[320];
-  std::snprintf(b, sizeof b, "robot %s at %s: its %zu lowest modes along %s, corrected by the modes measured at %zu pose(s); the\n"
+  std::snprintf(b, sizeof b,
+                "robot %s at %s: its %zu lowest modes along %s, corrected by the modes measured at %zu pose(s); the\n"
                 "  nearest %.1f deg away in joint space. Mapped value (one sigma %%)\n",
                 model.name.c_str(), config::describe_pose(q).c_str(), after.modes.size(), axis == 0 ? "x" : "y",
                 model.measured_modes->poses.size(), after.nearest_measured_deg);
@@ -192,16 +223,32 @@ int show_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
                   m.stiffness_n_per_m, 100.0 * c.stiffness_sigma, c.measured_poses,
                   c.measured_only() ? ", from the measurements alone" : "");
     t << b;
-    modes.push_back({{"model_hz", std::isfinite(model_hz) ? json(model_hz) : json(nullptr)}, {"measured_only", c.measured_only()}, {"freq_hz", m.natural_freq_hz}, {"freq_sigma_pct", 100.0 * c.freq_sigma},
-                     {"damping_ratio", m.damping_ratio}, {"damping_sigma_pct", 100.0 * c.damping_sigma},
-                     {"stiffness_n_per_m", m.stiffness_n_per_m}, {"stiffness_sigma_pct", 100.0 * c.stiffness_sigma},
+    modes.push_back({{"model_hz", std::isfinite(model_hz) ? json(model_hz) : json(nullptr)},
+                     {"measured_only", c.measured_only()},
+                     {"freq_hz", m.natural_freq_hz},
+                     {"freq_sigma_pct", 100.0 * c.freq_sigma},
+                     {"damping_ratio", m.damping_ratio},
+                     {"damping_sigma_pct", 100.0 * c.damping_sigma},
+                     {"stiffness_n_per_m", m.stiffness_n_per_m},
+                     {"stiffness_sigma_pct", 100.0 * c.stiffness_sigma},
                      {"measured_poses", c.measured_poses}});
   }
-  json r = {{"model", model.source}, {"joints_deg", q}, {"axis", axis == 0 ? "x" : "y"},
-            {"nearest_measured_deg", after.nearest_measured_deg}, {"modes", modes}};
+  json r = {{"model", model.source},
+            {"joints_deg", q},
+            {"axis", axis == 0 ? "x" : "y"},
+            {"nearest_measured_deg", after.nearest_measured_deg},
+            {"modes", modes}};
   if (a.plot_path.empty()) return print_report(r.dump(2), a.json, "pose", t.str(), "", {}, "");
+  return plot_modes_along_joint(prior, model, q, axis, a, r, t.str());
+}
+
+// The mapped modes along --vary's joint (the others at the pose shown), the report with the plot's data.
+int plot_modes_along_joint(const config::RobotModelConfig& prior, const config::RobotModelConfig& model,
+                           const std::vector<double>& q, int axis, const PoseModesArgs& a, json& r,
+                           const std::string& table) {
   if (a.vary_joint < 1 || static_cast<std::size_t>(a.vary_joint) > q.size())
-    throw std::invalid_argument("--vary " + std::to_string(a.vary_joint) + ": the plot's joint is one of 1.." + std::to_string(q.size()));
+    throw std::invalid_argument("--vary " + std::to_string(a.vary_joint) + ": the plot's joint is one of 1.." +
+                                std::to_string(q.size()));
   const std::size_t joint = static_cast<std::size_t>(a.vary_joint - 1);
   const auto sweep = analysis::sweep_pose_modes(prior, model, q, joint, 121, axis, a.modes);
   std::ostringstream data;
@@ -211,33 +258,42 @@ int show_modes(const config::RobotModelConfig& model, const PoseModesArgs& a) {
   for (const auto& p : sweep) {
     data << p.joint_deg;
     for (std::size_t k = 0; k < curves; ++k) {
-      const double f = k < p.mapped_hz.size() ? p.mapped_hz[k] : NAN, s = k < p.mapped_hz.size() ? p.freq_sigma_pct[k] / 100.0 : 0.0;
+      const double f = k < p.mapped_hz.size() ? p.mapped_hz[k] : NAN,
+                   s = k < p.mapped_hz.size() ? p.freq_sigma_pct[k] / 100.0 : 0.0;
       data << ' ' << plot::num(k < p.model_hz.size() ? p.model_hz[k] : NAN) << ' ' << plot::num(f) << ' '
            << plot::num(f * std::exp(-2.0 * s)) << ' ' << plot::num(f * std::exp(2.0 * s));
     }
     data << '\n';
-    points.push_back({{"joint_deg", p.joint_deg}, {"model_hz", p.model_hz}, {"mapped_hz", p.mapped_hz}, {"freq_sigma_pct", p.freq_sigma_pct}});
+    points.push_back({{"joint_deg", p.joint_deg},
+                      {"model_hz", p.model_hz},
+                      {"mapped_hz", p.mapped_hz},
+                      {"freq_sigma_pct", p.freq_sigma_pct}});
   }
   data << "\n\n";
   for (const auto& p : model.measured_modes->poses)
     for (const auto& m : p.modes) data << p.joints_deg[joint] << ' ' << m.natural_freq_hz << '\n';
   r["sweep"] = {{"joint", a.vary_joint}, {"points", points}};
-  return print_report(r.dump(2), a.json, "pose", t.str(), a.plot_path, [&] {
-    std::ostringstream gp;
-    gp << "set grid; set key outside right; set xlabel 'joint " << a.vary_joint << " (deg), the others at the pose shown'; "
-       << "set ylabel 'frequency (Hz)'; set title 'modes along joint " << a.vary_joint
-       << ": the map (line, band 2 sigma), the model alone (dashed), measured (points)'; plot ";
-    const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};
-    for (int k = 0; k < static_cast<int>(curves); ++k) {
-      const int c = 2 + 4 * k;
-      const std::string colour = colours[k % 6];
-      gp << (k ? ", " : "") << "DATA index 0 u 1:" << c + 2 << ":" << c + 3 << " w filledcurves fs transparent solid 0.2 lc rgb '"
-         << colour << "' notitle, '' index 0 u 1:" << c + 1 << " w l lw 2 lc rgb '" << colour << "' t 'mode " << k + 1
-         << " mapped', '' index 0 u 1:" << c << " w l dt 2 lc rgb '" << colour << "' t 'mode " << k + 1 << " model'";
-    }
-    gp << ", DATA index 1 u 1:2 w p pt 7 ps 1.5 lc rgb 'black' t 'measured'";
-    return run_gnuplot(gp.str(), data.str(), a.plot_path);
-  }, a.plot_path);
+  return print_report(
+      r.dump(2), a.json, "pose", table, a.plot_path,
+      [&] {
+        std::ostringstream gp;
+        gp << "set grid; set key outside right; set xlabel 'joint " << a.vary_joint
+           << " (deg), the others at the pose shown'; "
+           << "set ylabel 'frequency (Hz)'; set title 'modes along joint " << a.vary_joint
+           << ": the map (line, band 2 sigma), the model alone (dashed), measured (points)'; plot ";
+        const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b", "#e377c2"};
+        for (int k = 0; k < static_cast<int>(curves); ++k) {
+          const int c = 2 + 4 * k;
+          const std::string colour = colours[k % 6];
+          gp << (k ? ", " : "") << "DATA index 0 u 1:" << c + 2 << ":" << c + 3
+             << " w filledcurves fs transparent solid 0.2 lc rgb '" << colour << "' notitle, '' index 0 u 1:" << c + 1
+             << " w l lw 2 lc rgb '" << colour << "' t 'mode " << k + 1 << " mapped', '' index 0 u 1:" << c
+             << " w l dt 2 lc rgb '" << colour << "' t 'mode " << k + 1 << " model'";
+        }
+        gp << ", DATA index 1 u 1:2 w p pt 7 ps 1.5 lc rgb 'black' t 'measured'";
+        return run_gnuplot(gp.str(), data.str(), a.plot_path);
+      },
+      a.plot_path);
 }
 
 }  // namespace

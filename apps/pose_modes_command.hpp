@@ -17,11 +17,11 @@ struct PoseModesArgs {
   std::vector<std::string> measurements, hold_out;
   std::vector<double> joints_deg;  // the pose to show (empty: pose_name, else the model's first pose)
   std::string pose_name;
-  int modes{3};                    // without measurements: how many of the model's modes
+  int modes{3};  // without measurements: how many of the model's modes
   std::string out_path;
   JsonOut json;
-  std::string plot_path;           // without measurements: the modes along one joint's travel (PNG)
-  int vary_joint{2};               // that joint (1-based); the others at the pose shown
+  std::string plot_path;  // without measurements: the modes along one joint's travel (PNG)
+  int vary_joint{2};      // that joint (1-based); the others at the pose shown
 };
 
 // 0: done; 1: cannot write; 2: bad input (reported on stderr by the caller's handler: throws).

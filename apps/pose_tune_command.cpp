@@ -58,29 +58,40 @@ std::string command_line(const PoseTuneArgs& a) {
   if (!a.job_path.empty()) c += " --job " + a.job_path;
   c += " --evaluations " + std::to_string(a.evaluations) + " --polish " + std::to_string(a.polish) + " --max-regions " +
        std::to_string(a.max_regions) + " --map-points " + std::to_string(a.map_points) + " --overlap-deg " +
-       config::format_number(a.overlap_deg) + " --worse-mode-pct " + config::format_number(a.worse_mode_pct) + " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
+       config::format_number(a.overlap_deg) + " --worse-mode-pct " + config::format_number(a.worse_mode_pct) +
+       " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
   return c;
 }
 
 json region_json(const tune::TunedRegion& r) {
-  return {{"name", r.region.name}, {"min_deg", r.region.min_deg}, {"max_deg", r.region.max_deg},
-          {"poses", r.poses.size()}, {"dominant_min_hz", r.dominant_min_hz}, {"dominant_max_hz", r.dominant_max_hz},
-          {"gain_ns_per_m", *r.region.gain_ns_per_m}, {"polarity", *r.region.polarity},
-          {"match_freq_hz", *r.region.match_freq_hz}, {"gain_margin_db", r.worst.gain_margin_db},
-          {"phase_margin_deg", r.worst.phase_margin_deg}, {"worst_mode_improvement_pct", r.worst.worst_mode_improvement_pct},
-          {"serves", r.serves()}, {"binding", r.worst.binding}};
+  return {{"name", r.region.name},
+          {"min_deg", r.region.min_deg},
+          {"max_deg", r.region.max_deg},
+          {"poses", r.poses.size()},
+          {"dominant_min_hz", r.dominant_min_hz},
+          {"dominant_max_hz", r.dominant_max_hz},
+          {"gain_ns_per_m", *r.region.gain_ns_per_m},
+          {"polarity", *r.region.polarity},
+          {"match_freq_hz", *r.region.match_freq_hz},
+          {"gain_margin_db", r.worst.gain_margin_db},
+          {"phase_margin_deg", r.worst.phase_margin_deg},
+          {"worst_mode_improvement_pct", r.worst.worst_mode_improvement_pct},
+          {"serves", r.serves()},
+          {"binding", r.worst.binding}};
 }
 
 void print_regions(std::ostringstream& t, const char* what, const std::vector<tune::TunedRegion>& rs) {
   char b[320];
   t << what << '\n';
-  t << "  region      joints from / to deg                            poses  dominant Hz    K N s/m  pol  GM dB  PM deg  worst mode %  serves\n";
+  t << "  region      joints from / to deg                            poses  dominant Hz    K N s/m  pol  GM dB  PM "
+       "deg  worst mode %  serves\n";
   for (const auto& r : rs) {
     std::snprintf(b, sizeof b, "  %-10s  %-22s %-22s  %5zu  %5.2f-%-5.2f  %9.0f  %+3d  %5.1f  %6.1f  %12s  %s\n",
                   r.region.name.c_str(), config::describe_pose(r.region.min_deg).c_str(),
                   config::describe_pose(r.region.max_deg).c_str(), r.poses.size(), r.dominant_min_hz, r.dominant_max_hz,
                   *r.region.gain_ns_per_m, *r.region.polarity, r.worst.gain_margin_db, r.worst.phase_margin_deg,
-                  pct(r.worst.worst_mode_improvement_pct).c_str(), r.serves() ? "yes" : ("no: " + r.worst.binding).c_str());
+                  pct(r.worst.worst_mode_improvement_pct).c_str(),
+                  r.serves() ? "yes" : ("no: " + r.worst.binding).c_str());
     t << b;
   }
 }
@@ -98,12 +109,14 @@ json print_map(std::ostringstream& t, const tune::MapScores& s) {
     std::snprintf(b, sizeof b, "  %-29s %-9s  %10.2f  %8s", m.pose.name.c_str(), m.role.c_str(), m.dominant_hz,
                   m.open_min_mm ? exact(std::round(*m.open_min_mm * 1e4) / 1e4).c_str() : "-");
     t << b;
-    json row = {{"pose", m.pose.name}, {"joints_deg", m.pose.joints_deg}, {"role", m.role}, {"dominant_hz", m.dominant_hz}};
+    json row = {
+        {"pose", m.pose.name}, {"joints_deg", m.pose.joints_deg}, {"role", m.role}, {"dominant_hz", m.dominant_hz}};
     if (m.open_min_mm) row["open_min_mm"] = *m.open_min_mm;
     for (const auto& c : s.controllers) {
       const tune::PoseScore& p = c.poses[i];
       std::snprintf(b, sizeof b, "  | %*s%8s %8s %10s", static_cast<int>(c.name.size()) - 4, "",
-                    p.regions.empty() ? "outside" : pct(p.worst_mode_improvement_pct).c_str(), pct(p.improvement_pct).c_str(),
+                    p.regions.empty() ? "outside" : pct(p.worst_mode_improvement_pct).c_str(),
+                    pct(p.improvement_pct).c_str(),
                     p.damped_min_mm ? exact(std::round(*p.damped_min_mm * 1e4) / 1e4).c_str() : "-");
       t << b;
       json pj = {{"regions", p.regions}, {"stable", p.stable}};
@@ -130,7 +143,8 @@ int run_pose_tune(const PoseTuneArgs& a) {
     if (a.config_path.empty()) throw std::invalid_argument("give --config: a configuration with a pose_schedule");
     tune::PoseTuneInput in{config::load_config_file(a.config_path), {}, {}};
     if (!in.cell.pose_schedule)
-      throw std::invalid_argument("--config " + a.config_path + " has no pose_schedule (its model, axis and workspace)");
+      throw std::invalid_argument("--config " + a.config_path +
+                                  " has no pose_schedule (its model, axis and workspace)");
     in.model = config::load_robot_model(a.model_path.empty() ? in.cell.pose_schedule->model_resolved : a.model_path);
     std::vector<tune::NamedPose> held;
     read_poses(a, in.model, in.measured, held);
@@ -149,22 +163,30 @@ int run_pose_tune(const PoseTuneArgs& a) {
     t << "robodamp pose tune: " << a.config_path << ", the robot " << in.model.name << " (" << in.model.source << "), "
       << in.measured.size() << " measured pose(s) tuned at, " << held.size() << " held out; the damping band "
       << config::format_number(in.cell.pose_schedule->damping_band_min_hz) << "-"
-      << config::format_number(in.cell.pose_schedule->damping_band_max_hz) << " Hz (a set serves while no mode in it is more than "
-      << config::format_number(s.worse_mode_tolerance_pct) << " % worse than open loop: --worse-mode-pct)\n";
+      << config::format_number(in.cell.pose_schedule->damping_band_max_hz)
+      << " Hz (a set serves while no mode in it is more than " << config::format_number(s.worse_mode_tolerance_pct)
+      << " % worse than open loop: --worse-mode-pct)\n";
     print_regions(t, "robust: one set over the workspace", {robust});
-    print_regions(t, ("scheduled: " + std::to_string(scheduled.size()) + " region(s) drawn where one set stops serving").c_str(), scheduled);
+    print_regions(
+        t, ("scheduled: " + std::to_string(scheduled.size()) + " region(s) drawn where one set stops serving").c_str(),
+        scheduled);
     json map = print_map(t, scores);
     json summary = json::array();
     for (const auto& c : scores.controllers) {
       t << "  " << c.name << ": " << (c.stable_everywhere ? "stable at every pose" : "UNSTABLE at a pose")
         << ", worst mode in the damping band " << pct(c.worst_mode_improvement_pct) << " %";
-      if (c.outside_band_pct) t << " (outside it " << pct(*c.outside_band_pct) << " % at " << config::format_number(std::round(*c.outside_band_hz * 100) / 100) << " Hz)";
+      if (c.outside_band_pct)
+        t << " (outside it " << pct(*c.outside_band_pct) << " % at "
+          << config::format_number(std::round(*c.outside_band_hz * 100) / 100) << " Hz)";
       t << ", worst driving point " << pct(c.worst_improvement_pct) << " %";
-      if (c.damped_min_mm) t << ", the job's smallest damped depth " << *c.damped_min_mm << " mm (" << scores.method << ")";
+      if (c.damped_min_mm)
+        t << ", the job's smallest damped depth " << *c.damped_min_mm << " mm (" << scores.method << ")";
       t << '\n';
-      json cj = {{"name", c.name}, {"stable_everywhere", c.stable_everywhere},
-                 {"worst_mode_improvement_pct", c.stable_everywhere ? json(c.worst_mode_improvement_pct) : json(nullptr)},
-                 {"outside_band_pct", c.stable_everywhere && c.outside_band_pct ? json(*c.outside_band_pct) : json(nullptr)}};
+      json cj = {
+          {"name", c.name},
+          {"stable_everywhere", c.stable_everywhere},
+          {"worst_mode_improvement_pct", c.stable_everywhere ? json(c.worst_mode_improvement_pct) : json(nullptr)},
+          {"outside_band_pct", c.stable_everywhere && c.outside_band_pct ? json(*c.outside_band_pct) : json(nullptr)}};
       if (c.damped_min_mm) cj["damped_min_mm"] = *c.damped_min_mm;
       summary.push_back(cj);
     }
@@ -175,9 +197,14 @@ int run_pose_tune(const PoseTuneArgs& a) {
         << config::format_number(s.worse_mode_tolerance_pct) << ")\n";
     json regions_robust = json::array({region_json(robust)}), regions_sched = json::array();
     for (const auto& r : scheduled) regions_sched.push_back(region_json(r));
-    json out = {{"config", a.config_path}, {"model", in.model.source}, {"robust", regions_robust},
-                {"scheduled", regions_sched}, {"map", map}, {"controllers", summary},
-                {"chosen", scores.controllers[best].name}, {"model_of_promises", "the pose-indexed robot model, discrete loop"},
+    json out = {{"config", a.config_path},
+                {"model", in.model.source},
+                {"robust", regions_robust},
+                {"scheduled", regions_sched},
+                {"map", map},
+                {"controllers", summary},
+                {"chosen", scores.controllers[best].name},
+                {"model_of_promises", "the pose-indexed robot model, discrete loop"},
                 {"worse_mode_pct", s.worse_mode_tolerance_pct}};
     if (job) out["method"] = scores.method, out["job"] = a.job_path;
     if (!scores.controllers[best].stable_everywhere) {
@@ -185,9 +212,10 @@ int run_pose_tune(const PoseTuneArgs& a) {
       return 1;
     }
     if (!a.out_path.empty()) {
-      const std::string header = "# robodamp pose tune: the " + scores.controllers[best].name + " controller over the workspace of " +
-                                 a.config_path + ", written by\n#   " + command_line(a) +
-                                 "\n# (the comparison of the robust, the scheduled and the given controllers: the same with --json)\n";
+      const std::string header =
+          "# robodamp pose tune: the " + scores.controllers[best].name + " controller over the workspace of " +
+          a.config_path + ", written by\n#   " + command_line(a) +
+          "\n# (the comparison of the robust, the scheduled and the given controllers: the same with --json)\n";
       (void)tune::write_pose_tuned_config(in.cell, w.chosen(), a.model_path, a.out_path, header);
       t << "wrote " << a.out_path << " (read back, every region's set analysed over its grid)\n";
       out["out"] = a.out_path;

@@ -11,13 +11,13 @@
 namespace robodamp::apps {
 
 struct PoseTuneArgs {
-  std::string config_path;                    // the cell, with a pose_schedule
-  std::string model_path;                     // the pose-indexed model; default pose_schedule.model
+  std::string config_path;  // the cell, with a pose_schedule
+  std::string model_path;   // the pose-indexed model; default pose_schedule.model
   std::vector<std::string> measurements, hold_out;
   std::string job_path;
   int evaluations{60}, polish{30}, max_regions{4}, map_points{9}, seed{1};
   double overlap_deg{4.0};
-  double worse_mode_pct{0.0};                 // a mode in the damping band this much worse than open loop still serves
+  double worse_mode_pct{0.0};  // a mode in the damping band this much worse than open loop still serves
   std::string out_path;
   JsonOut json;
 };

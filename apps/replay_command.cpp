@@ -21,8 +21,8 @@ int run_replay(const std::string& path) {
               << r.header.value("git_commit", "?") << ")\n";
     if (r.trailing_bytes > 0)
       std::cout << "  note: " << r.trailing_bytes << " trailing bytes of a partial frame ignored\n";
-    std::cout << "  replayed through the same supervisor and controller: final state " << res.final_state
-              << ", trip " << res.final_trip << '\n';
+    std::cout << "  replayed through the same supervisor and controller: final state " << res.final_state << ", trip "
+              << res.final_trip << '\n';
     if (res.mismatches == 0) {
       std::cout << "  commands reproduced bit for bit\n";
       return 0;
@@ -43,8 +43,9 @@ int run_replay(const std::string& path) {
 
 void register_replay(Registry& r) {
   auto path = std::make_shared<std::string>();
-  CLI::App* sub = r.add("replay", "Feed a recording's inputs through the same controller; check the commands bit for bit",
-                        [path] { return run_replay(*path); });
+  CLI::App* sub =
+      r.add("replay", "Feed a recording's inputs through the same controller; check the commands bit for bit",
+            [path] { return run_replay(*path); });
   sub->add_option("file", *path, "Recording (from run --record)")->required()->check(CLI::ExistingFile);
 }
 

@@ -61,8 +61,8 @@ class Replies : public DataReaderListener {
 
 // 0 accepted, 3 refused (the reason is printed), 1 no loop or no reply, 2 bad options.
 int run_request(const DdsClientOptions& o, const RequestOptions& r) {
-  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0) + (r.spindle_rpm ? 1 : 0) +
-                    (r.reset ? 1 : 0);
+  const int given = (r.gain_ns_per_m ? 1 : 0) + (r.parameter_set ? 1 : 0) + (r.enable ? 1 : 0) +
+                    (r.spindle_rpm ? 1 : 0) + (r.reset ? 1 : 0);
   if (given != 1) {
     std::cerr << "robodamp request: give exactly one of --gain, --select, --enable, --spindle-rpm, --reset\n";
     return 2;
@@ -114,19 +114,22 @@ int run_request(const DdsClientOptions& o, const RequestOptions& r) {
 void register_request(Registry& r) {
   auto o = std::make_shared<DdsClientArgs>();
   auto req = std::make_shared<RequestOptions>();
-  CLI::App* sub = r.add("request", "One supervised parameter request over DDS (needs dds.parameter_writes: true)", [o, req] {
-    const auto opts = resolve(*o);
-    return opts ? run_request(*opts, *req) : 2;
-  });
+  CLI::App* sub =
+      r.add("request", "One supervised parameter request over DDS (needs dds.parameter_writes: true)", [o, req] {
+        const auto opts = resolve(*o);
+        return opts ? run_request(*opts, *req) : 2;
+      });
   add_dds_options(r, sub, *o);
-  r.number(sub, "--gain", req->gain_ns_per_m, {"N s/m", 0.0, 1e6}, "Set the gain K, N s/m (the loop checks it against its own limit)");
-  r.whole_number(sub, "--select", req->parameter_set, {"(parameter set)", 0, 255, false, false, "0 = the configuration's own"},
-                 "Select a parameter set");
+  r.number(sub, "--gain", req->gain_ns_per_m, {"N s/m", 0.0, 1e6},
+           "Set the gain K, N s/m (the loop checks it against its own limit)");
+  r.whole_number(sub, "--select", req->parameter_set,
+                 {"(parameter set)", 0, 255, false, false, "0 = the configuration's own"}, "Select a parameter set");
   r.whole_number(sub, "--enable", req->enable, {"(1 = arm, 0 = disarm)", 0, 1}, "1 = arm, 0 = disarm");
   r.number(sub, "--spindle-rpm", req->spindle_rpm, {"rpm", 0.0, 200000.0},
            "The spindle speed the harmonic notches follow (0 = stopped; the loop checks spindle.rpm_max)");
   sub->add_flag("--reset", req->reset, "Reset a latched trip (the loop is then disabled: arm it with --enable 1)");
-  r.number(sub, "--timeout", o->options.duration_s, {"s", 0.1, 3600.0}, "Wait this long for the loop and the reply (default 10 s)");
+  r.number(sub, "--timeout", o->options.duration_s, {"s", 0.1, 3600.0},
+           "Wait this long for the loop and the reply (default 10 s)");
 }
 
 }  // namespace robodamp::apps

@@ -50,7 +50,8 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   std::vector<std::string> parts;
   std::stringstream ss(text);
   for (std::string p; std::getline(ss, p, ':');) parts.push_back(p);
-  if (parts.size() < 2 || parts.size() > 4) return fail("is not KIND:START_S[:DURATION_S] (actuator_saturated:START_S:DURATION_S[:FORCE_N])");
+  if (parts.size() < 2 || parts.size() > 4)
+    return fail("is not KIND:START_S[:DURATION_S] (actuator_saturated:START_S:DURATION_S[:FORCE_N])");
   sim::Fault f;
   bool known = false;
   std::string kinds;
@@ -61,14 +62,18 @@ std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
   }
   if (!known) return fail("names no fault: allowed " + kinds);
   double start = 0.0, duration = std::numeric_limits<double>::infinity();
-  if (auto p = parse_number("--fault start", parts[1], {"s", 0.0, run_s, false, false, "within --duration"}, false, start)) return fail(*p);
+  if (auto p =
+          parse_number("--fault start", parts[1], {"s", 0.0, run_s, false, false, "within --duration"}, false, start))
+    return fail(*p);
   if (parts.size() >= 3)
-    if (auto p = parse_number("--fault duration", parts[2], {"s", 0.0, 604800.0, true}, false, duration)) return fail(*p);
+    if (auto p = parse_number("--fault duration", parts[2], {"s", 0.0, 604800.0, true}, false, duration))
+      return fail(*p);
   f.start_s = start;
   f.duration_s = duration;
   if (f.kind == sim::FaultKind::kActuatorSaturated) f.magnitude = 0.0;
   if (parts.size() == 4) {
-    if (f.kind != sim::FaultKind::kActuatorSaturated) return fail("has a fourth field: only actuator_saturated takes one (FORCE_N)");
+    if (f.kind != sim::FaultKind::kActuatorSaturated)
+      return fail("has a fourth field: only actuator_saturated takes one (FORCE_N)");
     if (auto p = parse_number("--fault force", parts[3], {"N", 0.0, 1e6}, false, f.magnitude)) return fail(*p);
   }
   return f;
@@ -107,8 +112,9 @@ int run_loop(const RunArgs& a) {
   o.pose_deg = a.pose_deg;
   o.pose_schedule_off = a.no_pose_schedule;
   if (a.spindle_rpm > cfg.spindle.rpm_max) {  // the loop would refuse the command: said before anything runs
-    std::cerr << "robodamp run: --spindle-rpm = " << a.spindle_rpm << " rpm is above spindle.rpm_max = " << cfg.spindle.rpm_max
-              << " rpm of " << a.config_path << " (allowed 0 <= value <= " << cfg.spindle.rpm_max << " rpm)\n";
+    std::cerr << "robodamp run: --spindle-rpm = " << a.spindle_rpm
+              << " rpm is above spindle.rpm_max = " << cfg.spindle.rpm_max << " rpm of " << a.config_path
+              << " (allowed 0 <= value <= " << cfg.spindle.rpm_max << " rpm)\n";
     return 2;
   }
   if ((!a.pose_deg.empty() || a.no_pose_schedule) && !cfg.pose_schedule) {
@@ -153,8 +159,9 @@ int run_loop(const RunArgs& a) {
   if (s.trip == "signal") return 0;
   if (s.trip != "none") return 4;
   if (s.never_armed()) {
-    std::cerr << "robodamp run: the loop never armed: " << s.arming.attempts << " attempt(s) within supervision.arm_deadline_s = "
-              << s.arming.deadline_s << " s, last refusal: " << rt::to_string(s.arming.last_refusal) << '\n';
+    std::cerr << "robodamp run: the loop never armed: " << s.arming.attempts
+              << " attempt(s) within supervision.arm_deadline_s = " << s.arming.deadline_s
+              << " s, last refusal: " << rt::to_string(s.arming.last_refusal) << '\n';
     return 5;
   }
   return 0;
@@ -164,8 +171,9 @@ int run_loop(const RunArgs& a) {
 
 void register_run(Registry& r) {
   auto a = std::make_shared<RunArgs>();
-  CLI::App* sub = r.add("run", "The real-time loop against the simulated plant, or the hardware (can + modbus sections: "
-                               "a CAN interface or the HIL emulator); Ctrl-C ends it safely",
+  CLI::App* sub = r.add("run",
+                        "The real-time loop against the simulated plant, or the hardware (can + modbus sections: "
+                        "a CAN interface or the HIL emulator); Ctrl-C ends it safely",
                         [a] { return run_loop(*a); });
   sub->add_option("--config", a->config_path, "Configuration file (YAML)")->check(CLI::ExistingFile);
   r.number(sub, "--duration", a->duration_s, {"s", 0.0, 604800.0, true, false, "one week"}, "Run time in seconds");
@@ -177,19 +185,21 @@ void register_run(Registry& r) {
       ->check(CLI::IsMember({"wall", "virtual"}));
   r.number(sub, "--impact-every", a->impact_every_s, {"s", 0.0, 86400.0, false, false, "0 = none"},
            "Simulated plant: a hammer hit at the TCP every S seconds (bench.impact_peak_n)");
-  sub->add_option("--job", a->job_path,
-                  "Milling job (config/milling/*.yaml) for live stability and the chatter indicator; overrides spindle.job")
+  sub->add_option(
+         "--job", a->job_path,
+         "Milling job (config/milling/*.yaml) for live stability and the chatter indicator; overrides spindle.job")
       ->check(CLI::ExistingFile);
   sub->add_flag("--no-harmonic-notch", a->no_harmonic_notch,
-               "Run without the configuration's controller.harmonic_notch (to compare the bank on and off)");
+                "Run without the configuration's controller.harmonic_notch (to compare the bank on and off)");
   r.number(sub, "--spindle-rpm", a->spindle_rpm, {"rpm", 0.0, 200000.0, false, false, "0 = stopped"},
            "The spindle speed from the start (as the robot's register or a DDS request would set it)");
   r.numbers(sub, "--pose", a->pose_deg, {"deg", -360.0, 360.0},
             "pose_schedule, simulated plant: the robot stands at these joint angles (one per joint)");
-  sub->add_option("--fault", a->faults,
-                  "Simulated plant, a fault drill: KIND:START_S[:DURATION_S] (sensor_nan, amplifier_fault, ... from loop "
-                  "time START_S; repeatable); actuator_saturated:START_S:DURATION_S:FORCE_N limits the actuator to FORCE_N "
-                  "(default 0)");
+  sub->add_option(
+      "--fault", a->faults,
+      "Simulated plant, a fault drill: KIND:START_S[:DURATION_S] (sensor_nan, amplifier_fault, ... from loop "
+      "time START_S; repeatable); actuator_saturated:START_S:DURATION_S:FORCE_N limits the actuator to FORCE_N "
+      "(default 0)");
   sub->add_flag("--no-pose-schedule", a->no_pose_schedule,
                 "pose_schedule: run the first region's set at every pose and ignore the joint angles (scheduling off)");
 }

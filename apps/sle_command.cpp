@@ -15,7 +15,8 @@ void register_sle(Registry& r) {
     return print_sle(sle_report(cfg, *o), *o);
   });
   add_milling_options(r, sub, *o, "sle");
-  r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0}, "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
+  r.numbers(sub, "--pose", o->pose_deg, {"deg", -360.0, 360.0},
+            "The robot's joint angles for the job's pose parts (config/robots/*.yaml)");
 }
 
 }  // namespace robodamp::apps

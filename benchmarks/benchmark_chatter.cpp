@@ -18,7 +18,8 @@ robodamp::milling::RecordedSignal recording(double rate_hz, double duration_s) {
   for (int i = 0; i < static_cast<int>(duration_s * rate_hz); ++i) {
     const double t = i / rate_hz;
     double v = noise(rng);
-    for (int k = 1; k <= 30; ++k) v += (k % 3 == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
+    for (int k = 1; k <= 30; ++k)
+      v += (k % 3 == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
     if (t > 30.0) v += std::min(0.05 * std::exp(3.0 * (t - 30.0)), 1.5) * std::sin(2.0 * M_PI * 17.3 * t);
     s.samples.push_back(v);
   }

@@ -59,10 +59,12 @@ BENCHMARK(BM_CutDamped)->Unit(benchmark::kMillisecond);
 void BM_CriticalDepthIndustrialRobot(benchmark::State& state) {
   Loaded l = load("industrial_robot_aluminium.yaml");
   const milling::CutJob job = milling::make_cut_job(l.cfg, l.structure, {});
-  const milling::LobeModel lobes(l.structure, milling::chatter_process(l.cfg.tool, l.cfg.material, l.cfg.cut), l.cfg.lobes);
+  const milling::LobeModel lobes(l.structure, milling::chatter_process(l.cfg.tool, l.cfg.material, l.cfg.cut),
+                                 l.cfg.lobes);
   const double guess = lobes.critical_depth_mm(job.settings.rpm);
   for (auto _ : state) {
-    const milling::CriticalDepth c = milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, guess);
+    const milling::CriticalDepth c =
+        milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, guess);
     benchmark::DoNotOptimize(c.depth_mm);
   }
 }
@@ -74,7 +76,8 @@ void BM_CriticalDepthDamped(benchmark::State& state) {
   o.rpm = 282.0, o.damped = true;
   const milling::CutJob job = milling::make_cut_job(l.cfg, l.structure, o);
   for (auto _ : state) {
-    const milling::CriticalDepth c = milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, 0.84);
+    const milling::CriticalDepth c =
+        milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, 0.84);
     benchmark::DoNotOptimize(c.depth_mm);
   }
 }

@@ -37,7 +37,7 @@ void BM_LobeDiagram37Modes(benchmark::State& state) {
   std::size_t grid = 0;
   for (auto _ : state) {
     const milling::LobeModel m(s, process, lobes);  // frequency grid, eigenvalues, branch tracking
-    const auto d = m.diagram();                      // 2000 speeds
+    const auto d = m.diagram();                     // 2000 speeds
     grid = d.frequency_points;
     benchmark::DoNotOptimize(d.minimum.b_lim_mm);
   }
@@ -81,7 +81,8 @@ void BM_DampedSdmLobes(benchmark::State& state) {
   const milling::Structure damped(j.structures.front(), true);
   config::LobesConfig grid = j.lobes;
   grid.points = j.time_domain.sdm_points;
-  const milling::LobeDiagram guess = milling::LobeModel(damped, milling::chatter_process(j.tool, j.material, j.cut), grid).diagram();
+  const milling::LobeDiagram guess =
+      milling::LobeModel(damped, milling::chatter_process(j.tool, j.material, j.cut), grid).diagram();
   std::vector<double> rpm, mm;
   for (const auto& p : guess.curve) rpm.push_back(p.rpm), mm.push_back(p.b_lim_mm);
   const milling::AccurateStability truth(damped, j);
@@ -103,7 +104,8 @@ BENCHMARK(BM_DampedSdmCriticalDepth)->Unit(benchmark::kMillisecond);
 void BM_SleOneSpeed(benchmark::State& state) {
   const milling::Structure s(*job().find_structure("robot_workpiece"), false);
   const auto cutter = milling::cutter_from(job().tool);
-  const milling::CutConditions cut{job().cut.mode, job().cut.radial_mm, job().cut.axial_mm, job().cut.feed_per_tooth_mm};
+  const milling::CutConditions cut{job().cut.mode, job().cut.radial_mm, job().cut.axial_mm,
+                                   job().cut.feed_per_tooth_mm};
   for (auto _ : state)
     benchmark::DoNotOptimize(milling::surface_location_error(s, cutter, job().material, cut, config::Axis::kX, 10700.0,
                                                              job().sle.axial_slices, job().sle.harmonics));

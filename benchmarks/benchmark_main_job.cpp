@@ -38,8 +38,8 @@ BENCHMARK(BM_Analysis)->Unit(benchmark::kMillisecond);
 void BM_ImpactTest(benchmark::State& state) {
   const config::Config cfg = config::load_config_file(kPreset);
   const analysis::Bench bench(cfg);
-  const analysis::ImpactTest t{0, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, true,
-                               cfg.controller.gain_ns_per_m, cfg.controller.polarity};
+  const analysis::ImpactTest t{0,    cfg.bench.impact_peak_n,      cfg.bench.impact_duration_ms,
+                               true, cfg.controller.gain_ns_per_m, cfg.controller.polarity};
   double simulated_s = 0.0;
   for (auto _ : state) {
     const analysis::ImpactTestResult r = bench.impact_test(t);
@@ -81,8 +81,8 @@ void BM_DivergenceRun(benchmark::State& state) {
     const analysis::DivergenceRun d = bench.divergence_run(1.1 * 4804.8, cfg.controller.polarity);
     benchmark::DoNotOptimize(d.growth_ratio);
   }
-  state.counters["x_real_time"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * cfg.bench.sweep_duration_s, benchmark::Counter::kIsRate);
+  state.counters["x_real_time"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * cfg.bench.sweep_duration_s, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_DivergenceRun)->Unit(benchmark::kMillisecond);
 

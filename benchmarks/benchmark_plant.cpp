@@ -18,8 +18,7 @@ namespace {
 using namespace robodamp;
 
 config::Config preset(int oversampling) {
-  config::Config c =
-      config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/horizontal_c2.yaml");
+  config::Config c = config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/horizontal_c2.yaml");
   c.plant.oversampling = oversampling;
   return c;
 }
@@ -27,8 +26,8 @@ config::Config preset(int oversampling) {
 void set_counters(benchmark::State& state, const config::Config& cfg, const sim::Plant& plant, int ticks) {
   state.SetItemsProcessed(state.iterations() * ticks);
   // Simulated seconds per wall second = ticks per second / loop rate.
-  state.counters["x_real_time"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * ticks / cfg.loop.rate_hz, benchmark::Counter::kIsRate);
+  state.counters["x_real_time"] = benchmark::Counter(static_cast<double>(state.iterations()) * ticks / cfg.loop.rate_hz,
+                                                     benchmark::Counter::kIsRate);
   state.counters["states"] = static_cast<double>(plant.state_count());
 }
 
@@ -107,7 +106,8 @@ void BM_PoseRetunePrebuilt(benchmark::State& state) {
   const config::RobotModelConfig model = config::load_robot_model(cfg.pose_schedule->model_resolved);
   std::vector<sim::PlantModel> models;
   for (double q2 = 10.0; q2 < 130.0; q2 += 1.0)
-    models.push_back(sim::build_plant_model(analysis::config_at_pose(cfg, analysis::pose_modes(model, {-100.0, q2, 90.0}, 0, 3))));
+    models.push_back(
+        sim::build_plant_model(analysis::config_at_pose(cfg, analysis::pose_modes(model, {-100.0, q2, 90.0}, 0, 3))));
   sim::Plant plant(models.front(), cfg);
   std::size_t i = 0;
   for (auto _ : state) {

@@ -24,7 +24,8 @@ const config::Config& preset() {
 }
 
 void BM_TuneEvaluationWithJob(benchmark::State& state) {
-  const tune::Evaluator evaluate(preset(), config::load_milling_config(kDir + "/config/milling/active_damping_c2.yaml"), {});
+  const tune::Evaluator evaluate(preset(), config::load_milling_config(kDir + "/config/milling/active_damping_c2.yaml"),
+                                 {});
   for (auto _ : state) benchmark::DoNotOptimize(evaluate.assess(preset()).min_depth_mm);
 }
 BENCHMARK(BM_TuneEvaluationWithJob)->Unit(benchmark::kMillisecond);
@@ -38,7 +39,8 @@ BENCHMARK(BM_TuneEvaluationWithoutJob)->Unit(benchmark::kMillisecond);
 void BM_ImpactCommandPeak(benchmark::State& state) {
   const analysis::LoopModel m(preset());
   analysis::ImpactCommand predict(m, 1000.0, 1e-3);
-  for (auto _ : state) benchmark::DoNotOptimize(predict.peak(m, preset().controller.gain_ns_per_m, preset().controller.polarity));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(predict.peak(m, preset().controller.gain_ns_per_m, preset().controller.polarity));
 }
 BENCHMARK(BM_ImpactCommandPeak)->Unit(benchmark::kMillisecond);
 

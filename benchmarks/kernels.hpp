@@ -68,7 +68,8 @@ class PlainCascade {
 // Closed-loop dependency: each input depends on the last output, so samples cannot be overlapped.
 inline std::array<double, 1024> excitation() {
   std::array<double, 1024> u{};
-  for (std::size_t i = 0; i < u.size(); ++i) u[i] = std::sin(0.0116 * static_cast<double>(i)) + 0.1 * std::sin(1.7 * static_cast<double>(i));
+  for (std::size_t i = 0; i < u.size(); ++i)
+    u[i] = std::sin(0.0116 * static_cast<double>(i)) + 0.1 * std::sin(1.7 * static_cast<double>(i));
   return u;
 }
 

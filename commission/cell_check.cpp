@@ -81,7 +81,8 @@ config::Config with_controller_of(const config::Config& cell, const config::Conf
 bool CellCheck::improvement_ok() const {
   if (frfs.empty() || open_trip != "none" || closed_trip != "none" || closed_active_share < 1.0) return false;
   for (const auto& f : frfs)
-    if (!(std::abs(f.measured_improvement_pct - f.predicted_improvement_pct) <= improvement_tolerance_points)) return false;
+    if (!(std::abs(f.measured_improvement_pct - f.predicted_improvement_pct) <= improvement_tolerance_points))
+      return false;
   return true;
 }
 
@@ -100,22 +101,25 @@ std::string CellCheck::failure(const tune::Verification& p) const {
   if (closed_trip != "none") return "the cell tripped with the tuned controller (" + closed_trip + ")";
   if (open_trip != "none") return "the cell tripped with control off (" + open_trip + ")";
   if (closed_active_share < 1.0) {
-    std::snprintf(b, sizeof b, "the loop was active over only %.1f %% of the impact tests", 100.0 * closed_active_share);
+    std::snprintf(b, sizeof b, "the loop was active over only %.1f %% of the impact tests",
+                  100.0 * closed_active_share);
     return b;
   }
   for (const auto& f : frfs)
     if (!(std::abs(f.measured_improvement_pct - f.predicted_improvement_pct) <= improvement_tolerance_points)) {
       std::snprintf(b, sizeof b, "%s: measured improvement %.1f %% against %.1f %% predicted (allowed +-%.0f points)",
-                    f.name.c_str(), f.measured_improvement_pct, f.predicted_improvement_pct, improvement_tolerance_points);
+                    f.name.c_str(), f.measured_improvement_pct, f.predicted_improvement_pct,
+                    improvement_tolerance_points);
       return b;
     }
   if (!depth_ok(p) && !cut_trials.empty()) return "the damped cut on the cell: " + cut_summary(p);
   if (!depth_ok(p)) {
-    std::snprintf(b, sizeof b,
-                  "the damped cut on the cell: %.3f mm at %.1f rpm (promised %.3f mm) and %.3f mm at %.1f rpm (promised "
-                  "%.3f mm); allowed %.0f %% below",
-                  time_domain_at_min_mm, p.min_rpm, p.min_depth_mm, time_domain_at_speed_mm, p.speed_rpm,
-                  p.depth_at_speed_mm, 100.0 * depth_tolerance);
+    std::snprintf(
+        b, sizeof b,
+        "the damped cut on the cell: %.3f mm at %.1f rpm (promised %.3f mm) and %.3f mm at %.1f rpm (promised "
+        "%.3f mm); allowed %.0f %% below",
+        time_domain_at_min_mm, p.min_rpm, p.min_depth_mm, time_domain_at_speed_mm, p.speed_rpm, p.depth_at_speed_mm,
+        100.0 * depth_tolerance);
     return b;
   }
   return {};
@@ -124,22 +128,25 @@ std::string CellCheck::failure(const tune::Verification& p) const {
 std::string CellCheck::cut_summary(const tune::Verification& p) const {
   char b[300];
   if (cut_trials.empty()) {
-    std::snprintf(b, sizeof b,
-                  "the damped cut in time in process (the real Controller on the cell's plant): critical %.3f mm at %.1f "
-                  "rpm (promised %.3f mm), %.3f mm at %.1f rpm (promised %.3f mm)",
-                  time_domain_at_min_mm, p.min_rpm, p.min_depth_mm, time_domain_at_speed_mm, p.speed_rpm, p.depth_at_speed_mm);
+    std::snprintf(
+        b, sizeof b,
+        "the damped cut in time in process (the real Controller on the cell's plant): critical %.3f mm at %.1f "
+        "rpm (promised %.3f mm), %.3f mm at %.1f rpm (promised %.3f mm)",
+        time_domain_at_min_mm, p.min_rpm, p.min_depth_mm, time_domain_at_speed_mm, p.speed_rpm, p.depth_at_speed_mm);
     return b;
   }
-  std::string s = "the regenerative cut in the HIL emulator (its drive vibration off, as the in-process cut) with the tuned "
-                  "controller across processes, at the promise less " +
-                  std::to_string(static_cast<int>(std::lround(100.0 * depth_tolerance))) + " %:";
+  std::string s =
+      "the regenerative cut in the HIL emulator (its drive vibration off, as the in-process cut) with the tuned "
+      "controller across processes, at the promise less " +
+      std::to_string(static_cast<int>(std::lround(100.0 * depth_tolerance))) + " %:";
   for (std::size_t i = 0; i < cut_trials.size(); ++i) {
     const CutTrial& t = cut_trials[i];
     std::snprintf(b, sizeof b, "%s %.3f mm at %.1f rpm %s", i ? ";" : "", t.depth_mm, t.rpm,
                   t.held() ? "stable" : t.classification.c_str());
     s += b;
     if (!t.held() && t.chatter_hz > 0.0) std::snprintf(b, sizeof b, " at %.2f Hz", t.chatter_hz), s += b;
-    if (t.trip != "none") s += " (the controller tripped: " + t.trip + ")";
+    if (t.trip != "none")
+      s += " (the controller tripped: " + t.trip + ")";
     else if (t.complete && t.active_share < 1.0)
       std::snprintf(b, sizeof b, " (the loop active over %.1f %% of it)", 100.0 * t.active_share), s += b;
   }
@@ -201,11 +208,16 @@ CellCheck check_on_cell(const config::Config& cell, const config::Config& tuned,
   const sim::PlantModel cell_plant = sim::build_plant_model(cell);
   out.frfs = frf_checks(
       tuned,
-      [&](int e, int r) -> const analysis::FrfEstimate& { return open.receptance.at(index_of(cell_plant, e)).at(index_of(cell_plant, r)); },
-      [&](int e, int r) -> const analysis::FrfEstimate& { return closed.receptance.at(index_of(cell_plant, e)).at(index_of(cell_plant, r)); });
+      [&](int e, int r) -> const analysis::FrfEstimate& {
+        return open.receptance.at(index_of(cell_plant, e)).at(index_of(cell_plant, r));
+      },
+      [&](int e, int r) -> const analysis::FrfEstimate& {
+        return closed.receptance.at(index_of(cell_plant, e)).at(index_of(cell_plant, r));
+      });
   const config::Config on_cell = with_controller_of(cell, tuned);
   out.time_domain_at_min_mm = tune::time_domain_critical_mm(on_cell, job, promise.min_rpm, promise.min_depth_mm);
-  out.time_domain_at_speed_mm = tune::time_domain_critical_mm(on_cell, job, promise.speed_rpm, promise.depth_at_speed_mm);
+  out.time_domain_at_speed_mm =
+      tune::time_domain_critical_mm(on_cell, job, promise.speed_rpm, promise.depth_at_speed_mm);
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

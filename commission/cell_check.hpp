@@ -35,8 +35,8 @@ struct CutTrial {
   bool complete{false}, stable{false};
   std::string classification{"not run"};
   double chatter_hz{0.0};
-  std::string trip{"none"};       // the controller's
-  double active_share{0.0};       // of the cut's ticks with the loop active
+  std::string trip{"none"};  // the controller's
+  double active_share{0.0};  // of the cut's ticks with the loop active
   [[nodiscard]] bool held() const { return complete && stable && trip == "none" && active_share >= 1.0; }
 };
 
@@ -44,13 +44,13 @@ struct CellCheck {
   std::string cell{"the simulated plant in process"};
   std::vector<FrfCheck> frfs;
   std::string open_trip{"none"}, closed_trip{"none"};
-  double closed_active_share{0.0};          // of the impact phase's ticks with the loop active at full gain
+  double closed_active_share{0.0};  // of the impact phase's ticks with the loop active at full gain
   unsigned long long closed_saturated_ticks{0};
   // In process: the damped cut's critical depth in time by bisection (the real Controller on the cell's
   // plant). Through the emulator: the depth its cut held at (cut_trials), 0 where it chattered.
-  double time_domain_at_min_mm{0.0};        // at the promise's lobe-minimum speed
-  double time_domain_at_speed_mm{0.0};      // at the job's speed
-  std::vector<CutTrial> cut_trials;         // through the emulator: [0] the lobe minimum, [1] the job's speed
+  double time_domain_at_min_mm{0.0};    // at the promise's lobe-minimum speed
+  double time_domain_at_speed_mm{0.0};  // at the job's speed
+  std::vector<CutTrial> cut_trials;     // through the emulator: [0] the lobe minimum, [1] the job's speed
   double improvement_tolerance_points{5.0};
   double depth_tolerance{0.05};
   double wall_s{0.0};

@@ -55,9 +55,12 @@ class Run {
            (real_ ? ", told it is a real cell: no impacts, no cut" : ""));
     }
     if (real_)
-      say_("commission: a real cell: the actuator is the shaker (its chirp, control off then on), the FRFs between the "
-           "locations come from " + std::to_string(s_.tap_tests.size()) + " tap-test file(s); robodamp orders no hammer "
-           "blow and no cut");
+      say_(
+          "commission: a real cell: the actuator is the shaker (its chirp, control off then on), the FRFs between the "
+          "locations come from " +
+          std::to_string(s_.tap_tests.size()) +
+          " tap-test file(s); robodamp orders no hammer "
+          "blow and no cut");
     job_ = config::load_milling_config(s_.job_path);
     stage_(Stage::kMeasure, [this] { measure(); });
     stage_(Stage::kIdentify, [this] { identify(); });
@@ -67,23 +70,25 @@ class Run {
   }
 
  private:
-
   void measure() {
     const fs::path m = dir_ / "measurement";
     if (!stage_.reuse()) {
       MeasureOptions mo;
       mo.impacts = !real_;
-      const MeasureOutcome o = emulated_ ? measure_through_emulator(s_.config_path, m.string(), binary_, {mo, std::nullopt})
-                                         : commission::measure(s_.config_path, m.string(), mo);
+      const MeasureOutcome o = emulated_
+                                   ? measure_through_emulator(s_.config_path, m.string(), binary_, {mo, std::nullopt})
+                                   : commission::measure(s_.config_path, m.string(), mo);
       // The measurement turns SIGINT / SIGTERM into a trip of its loop; the stages after it have no loop
       // to stop, so the signals end the process again (nothing half-written: the result is renamed into
       // place at the end).
       std::signal(SIGINT, SIG_DFL);
       std::signal(SIGTERM, SIG_DFL);
       detail::throw_unless_measured(o, Stage::kMeasure);
-      say_(fmt("commission: measured %d of %d impact records, chirp active over %.1f %% of its ticks, peak command "
-               "%.3f V, the cell at rest at %.4f m/s^2 RMS before it", o.impact_records, o.impact_records_planned,
-               100.0 * o.chirp_active_share, o.peak_command_v, o.rest_accel_rms_mps2));
+      say_(
+          fmt("commission: measured %d of %d impact records, chirp active over %.1f %% of its ticks, peak command "
+              "%.3f V, the cell at rest at %.4f m/s^2 RMS before it",
+              o.impact_records, o.impact_records_planned, 100.0 * o.chirp_active_share, o.peak_command_v,
+              o.rest_accel_rms_mps2));
     } else if (!fs::exists(m / identify::kManifestName)) {
       throw Stop{Stage::kMeasure, Outcome::kBadInput,
                  "--from " + std::string(to_string(s_.from)) + ": " + (m / identify::kManifestName).string() +
@@ -108,14 +113,16 @@ class Run {
     if (real_) {
       r_.tap_check = identify::check_tap_tests(inputs, id, taps, s_.tap_tolerance_pct);
       say_("commission: the tap tests against the actuator's chirp: " + r_.tap_check->summary());
-      if (const std::string f = r_.tap_check->failure(); !f.empty()) throw Stop{Stage::kIdentify, Outcome::kBadInput, f};
+      if (const std::string f = r_.tap_check->failure(); !f.empty())
+        throw Stop{Stage::kIdentify, Outcome::kBadInput, f};
     }
     std::ofstream(dir_ / "identified.yaml") << id.yaml;
     std::ofstream(dir_ / "identified.json") << identify::to_json(id).dump(2) << '\n';
     // What a modal package opens: every FRF measured with its coherence, and the identified modes.
-    measfiles::write_uff((dir_ / "measurement" / identify::kMeasurementUffName).string(), identify::measurement_to_uff(inputs),
+    measfiles::write_uff((dir_ / "measurement" / identify::kMeasurementUffName).string(),
+                         identify::measurement_to_uff(inputs), measfiles::UffEncoding::kAscii);
+    measfiles::write_uff((dir_ / identify::kModesUffName).string(), identify::modes_to_uff(id),
                          measfiles::UffEncoding::kAscii);
-    measfiles::write_uff((dir_ / identify::kModesUffName).string(), identify::modes_to_uff(id), measfiles::UffEncoding::kAscii);
     say_("commission: identified " + std::to_string(id.frfs.size()) + " FRFs; " +
          fmt("actuator T %.3f N/V, %.3f Hz, zeta %.4f, delay %.3f ms", id.actuator.force_constant_n_per_v,
              id.actuator.natural_freq_hz, id.actuator.damping_ratio, id.actuator.delay_ms));
@@ -153,17 +160,18 @@ class Run {
     const fs::path tuned_path = dir_ / "tuned.yaml";
     if (stage_.reuse()) {
       if (!fs::exists(tuned_path))
-        throw Stop{Stage::kTune, Outcome::kBadInput, "--from verify: " + tuned_path.string() + " does not exist: run from tune"};
+        throw Stop{Stage::kTune, Outcome::kBadInput,
+                   "--from verify: " + tuned_path.string() + " does not exist: run from tune"};
       r_.tuned_config = config::load_config_file(tuned_path.string());
       r_.tuned_nominal = p.front().assess(*r_.tuned_config);
       r_.tuned = r_.tuned_nominal;
       if (const tune::Evaluation& e = *r_.tuned_nominal; !e.stable)
         throw Stop{Stage::kTune, Outcome::kBadInput,
-                   tuned_path.string() + fmt(": its loop is unstable on the identified model (K = %.0f N s/m, polarity %+d; ",
-                                             e.candidate.gain_ns_per_m, e.candidate.polarity) +
-                       (std::isfinite(e.k_max_ns_per_m)
-                            ? fmt("the largest stable K is %.0f N s/m)", e.k_max_ns_per_m)
-                            : std::string("no gain is stable with this polarity)")) +
+                   tuned_path.string() +
+                       fmt(": its loop is unstable on the identified model (K = %.0f N s/m, polarity %+d; ",
+                           e.candidate.gain_ns_per_m, e.candidate.polarity) +
+                       (std::isfinite(e.k_max_ns_per_m) ? fmt("the largest stable K is %.0f N s/m)", e.k_max_ns_per_m)
+                                                        : std::string("no gain is stable with this polarity)")) +
                        ": run from tune"};
       schedule();
       return;
@@ -171,17 +179,20 @@ class Run {
     const tune::TuneResult t = tune::tune(refs, s_.tune, [this](const std::string& l) { say_("commission: " + l); });
     r_.tuned = t.best;
     if (!t.best.feasible())
-      throw Stop{Stage::kTune, Outcome::kNotVerified, "no candidate met every constraint; the closest violates " + t.best.binding};
+      throw Stop{Stage::kTune, Outcome::kNotVerified,
+                 "no candidate met every constraint; the closest violates " + t.best.binding};
     r_.tuned_nominal = t.best.per_plant.empty() ? t.best : t.best.per_plant.front();
     const config::EditedYaml edited = tune::tuned_config_text(r_.identified->config, t.best.candidate);
-    const std::string text = "# robodamp commission tuned this (docs/identification.md) from the identified cell:\n#   " +
-                             s_.command_line + "\n#\n" + edited.text;
+    const std::string text =
+        "# robodamp commission tuned this (docs/identification.md) from the identified cell:\n#   " + s_.command_line +
+        "\n#\n" + edited.text;
     r_.tuned_config = config::parse_config(text, tuned_path.string());
     std::ofstream(tuned_path) << text;
-    say_(fmt("commission: tuned K %.0f N s/m, polarity %+d; worst over the plants GM %.1f dB, PM %.1f deg, the command "
-             "on a quiet cell %.4f V RMS (the instability detector's floor %.3f V)",
-             t.best.candidate.gain_ns_per_m, t.best.candidate.polarity, t.best.gain_margin_db, t.best.phase_margin_deg,
-             t.best.quiet_command_rms_v, r_.identified->config.supervision.instability_floor_v));
+    say_(
+        fmt("commission: tuned K %.0f N s/m, polarity %+d; worst over the plants GM %.1f dB, PM %.1f deg, the command "
+            "on a quiet cell %.4f V RMS (the instability detector's floor %.3f V)",
+            t.best.candidate.gain_ns_per_m, t.best.candidate.polarity, t.best.gain_margin_db, t.best.phase_margin_deg,
+            t.best.quiet_command_rms_v, r_.identified->config.supervision.instability_floor_v));
     schedule();
   }
 
@@ -193,10 +204,11 @@ class Run {
     r_.robustness = tune::robustness(tuned);
     const tune::Robustness& rb = *r_.robustness;
     say_(fmt("commission: the tuned loop stays stable and damps its modes from %.1f %% to +%.1f %% of mode shift",
-             -rb.down.pct, rb.up.pct) + (rb.down.reason.empty() ? "" : "; " + rb.down.reason) +
-         (rb.up.reason.empty() ? "" : "; " + rb.up.reason) +
+             -rb.down.pct, rb.up.pct) +
+         (rb.down.reason.empty() ? "" : "; " + rb.down.reason) + (rb.up.reason.empty() ? "" : "; " + rb.up.reason) +
          (rb.pct() < tune::kRobustShiftWarnPct
-              ? fmt(" (WARNING: under +-%.0f %%: a pose or tool change may move the modes further)", tune::kRobustShiftWarnPct)
+              ? fmt(" (WARNING: under +-%.0f %%: a pose or tool change may move the modes further)",
+                    tune::kRobustShiftWarnPct)
               : ""));
     std::vector<tune::NamedController> hand;
     for (const auto model : {config::CompensatorModel::kC1, config::CompensatorModel::kC2}) {
@@ -204,7 +216,8 @@ class Run {
       for (auto& b : c.controller.chain)
         if (b.kind == config::BlockKind::kCompensator) b.model = model, b.numerator.clear(), b.denominator.clear();
       c.controller.polarity = analysis::analyse(analysis::LoopModel(c)).recommended_polarity;
-      hand.push_back({std::string(config::to_string(model)) + " drawn in the identified chain", config::speed_controller_of(c)});
+      hand.push_back(
+          {std::string(config::to_string(model)) + " drawn in the identified chain", config::speed_controller_of(c)});
     }
     tune::ScheduleSettings ss;
     ss.speeds = s_.schedule_speeds;
@@ -215,15 +228,19 @@ class Run {
     const auto t0 = Clock::now();
     r_.schedule = tune::schedule_speeds(tuned, hand, job_, job_.selected_structure(), ss);
     const tune::ScheduleSummary& m = r_.schedule->summary;
-    say_(fmt("commission: speed schedule, %zu bands over %zu speeds: minimum %.3f mm (open loop %.3f, the tuned controller "
-             "alone %.3f), mean x%.3f the open loop (alone x%.3f), worse than the open loop at %.1f %% (alone %.1f %%); %zu of %zu damped limits chattered in time (another candidate runs there, or the same at its limit in time; bands with a depth limit: %zu) (%.1f s)",
-             r_.schedule->bands.size(), m.speeds, m.scheduled_min_mm, m.open_min_mm, m.fixed_min_mm, m.scheduled_mean_ratio,
-             m.fixed_mean_ratio, 100.0 * m.scheduled_worse_share, 100.0 * m.fixed_worse_share, r_.schedule->lowered_in_time,
-             r_.schedule->limits_in_time, r_.schedule->limited_bands(), seconds_since(t0)));
+    say_(fmt(
+        "commission: speed schedule, %zu bands over %zu speeds: minimum %.3f mm (open loop %.3f, the tuned controller "
+        "alone %.3f), mean x%.3f the open loop (alone x%.3f), worse than the open loop at %.1f %% (alone %.1f %%); %zu "
+        "of %zu damped limits chattered in time (another candidate runs there, or the same at its limit in time; bands "
+        "with a depth limit: %zu) (%.1f s)",
+        r_.schedule->bands.size(), m.speeds, m.scheduled_min_mm, m.open_min_mm, m.fixed_min_mm, m.scheduled_mean_ratio,
+        m.fixed_mean_ratio, 100.0 * m.scheduled_worse_share, 100.0 * m.fixed_worse_share, r_.schedule->lowered_in_time,
+        r_.schedule->limits_in_time, r_.schedule->limited_bands(), seconds_since(t0)));
     if (m.scheduled_worse_share > 0.0)
-      throw Stop{Stage::kTune, Outcome::kNotVerified,
-                 fmt("the speed schedule is worse than the open loop at %.1f %% of the speeds (the worst x%.3f at %.0f rpm)",
-                     100.0 * m.scheduled_worse_share, m.scheduled_worst_ratio, m.scheduled_worst_rpm)};
+      throw Stop{
+          Stage::kTune, Outcome::kNotVerified,
+          fmt("the speed schedule is worse than the open loop at %.1f %% of the speeds (the worst x%.3f at %.0f rpm)",
+              100.0 * m.scheduled_worse_share, m.scheduled_worst_ratio, m.scheduled_worst_rpm)};
     const std::string text = tune::scheduled_config_text(tuned, *r_.schedule).text;
     r_.scheduled_config = config::parse_config(text, (dir_ / "scheduled.yaml").string());
     std::ofstream(dir_ / "scheduled.yaml") << text;
@@ -233,10 +250,11 @@ class Run {
     const auto t0 = Clock::now();
     r_.promise = tune::verify(*r_.tuned_config, job_);
     const tune::Verification& v = *r_.promise;
-    say_(fmt("commission: promise (%s, identified model): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's "
-             "%.1f rpm; the time-domain cut there %.3f / %.3f mm (%.1f s)",
-             v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm, v.time_domain_at_min_mm,
-             v.time_domain_at_speed_mm, seconds_since(t0)));
+    say_(
+        fmt("commission: promise (%s, identified model): damped minimum %.3f mm at %.1f rpm, %.3f mm at the job's "
+            "%.1f rpm; the time-domain cut there %.3f / %.3f mm (%.1f s)",
+            v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm, v.time_domain_at_min_mm,
+            v.time_domain_at_speed_mm, seconds_since(t0)));
     if (!v.time_domain_agrees())
       throw Stop{Stage::kVerify, Outcome::kNotVerified,
                  "on the identified model the time-domain cut disagrees with the " + v.method + " by more than 5 %"};
@@ -261,7 +279,8 @@ class Run {
   void verify_real_cell() {
     const auto& id = *r_.identified;
     std::vector<double> modes_hz;
-    for (const auto& m : identify::path_between(id.frfs, id.manifest.sensor_location_id, id.manifest.actuator_location_id).fit.modes)
+    for (const auto& m :
+         identify::path_between(id.frfs, id.manifest.sensor_location_id, id.manifest.actuator_location_id).fit.modes)
       modes_hz.push_back(m.natural_freq_hz);
     MeasureOutcome on;
     r_.real_check = verify_on_real_cell(cell_, *r_.tuned_config, modes_hz,
@@ -290,21 +309,25 @@ class Run {
       steps.push_back({p.rpm, 0.95 * p.scheduled_mm});
     }
     const double job_rpm = r_.schedule->summary.job_rpm;
-    if (const auto at = config::speed_band_of(r_.schedule->bands, job_rpm); job_rpm > 0.0 && at && r_.schedule->bands[*at].gain_ns_per_m > 0.0)
+    if (const auto at = config::speed_band_of(r_.schedule->bands, job_rpm);
+        job_rpm > 0.0 && at && r_.schedule->bands[*at].gain_ns_per_m > 0.0)
       steps.push_back({job_rpm, 0.95 * r_.schedule->summary.job_scheduled_mm});
     const auto t0 = Clock::now();
     // As many revolutions as the schedule's own check in time (the job's): fewer read a slow decay near the limit as chatter.
     r_.schedule_in_time = tune::scheduled_cut(*r_.scheduled_config, job_, steps, job_.time_domain.revolutions);
     const tune::ScheduledCut& c = *r_.schedule_in_time;
     for (const auto& s : c.segments)
-      say_(fmt("commission: the schedule in time at %.1f rpm, %.3f mm (0.95 x its limit): %s; the switch %.2f N, the cut %.1f N "
-               "of the actuator's %.0f N",
-               s.rpm, s.depth_mm, milling::to_string(s.verdict.classification), s.switch_peak_force_n,
-               s.peak_force_command_n, c.force_limit_n));
+      say_(
+          fmt("commission: the schedule in time at %.1f rpm, %.3f mm (0.95 x its limit): %s; the switch %.2f N, the "
+              "cut %.1f N "
+              "of the actuator's %.0f N",
+              s.rpm, s.depth_mm, milling::to_string(s.verdict.classification), s.switch_peak_force_n,
+              s.peak_force_command_n, c.force_limit_n));
     say_(fmt("commission: the schedule in time: %.1f s", seconds_since(t0)));
     if (!c.all_stable() || !c.switches_within_limits())
-      throw Stop{Stage::kVerify, Outcome::kNotVerified,
-                 "the speed schedule in time: a cut at 0.95 x its limit chattered, or a switch drove the actuator to a limit"};
+      throw Stop{
+          Stage::kVerify, Outcome::kNotVerified,
+          "the speed schedule in time: a cut at 0.95 x its limit chattered, or a switch drove the actuator to a limit"};
   }
 
   void write() {
@@ -316,9 +339,10 @@ class Run {
              v.method.c_str(), v.min_depth_mm, v.min_rpm, v.depth_at_speed_mm, v.speed_rpm)
       << verified_on_text();
     if (r_.tuned_nominal)
-      h << fmt("\n# On a quiet cell the command is %.4f V RMS (the discrete loop's prediction; the instability "
-               "detector's floor %.3f V).",
-               r_.tuned_nominal->quiet_command_rms_v, r_.tuned_config->supervision.instability_floor_v);
+      h << fmt(
+          "\n# On a quiet cell the command is %.4f V RMS (the discrete loop's prediction; the instability "
+          "detector's floor %.3f V).",
+          r_.tuned_nominal->quiet_command_rms_v, r_.tuned_config->supervision.instability_floor_v);
     h << "\n";
     if (r_.schedule) h << tune::schedule_header(*r_.schedule);
     h << "#\n";
@@ -332,8 +356,9 @@ class Run {
     const CellCheck& c = *r_.cell;
     h << "# Verified on " << c.cell << ": " << c.cut_summary(*r_.promise) << ";";
     for (const auto& f : c.frfs)
-      h << " " << f.name << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
-                                f.predicted_improvement_pct);
+      h << " " << f.name
+        << fmt(" improvement %.1f %% measured, %.1f %% predicted;", f.measured_improvement_pct,
+               f.predicted_improvement_pct);
     return h.str();
   }
 
@@ -353,11 +378,16 @@ class Run {
 
 const char* to_string(Stage s) {
   switch (s) {
-    case Stage::kMeasure: return "measure";
-    case Stage::kIdentify: return "identify";
-    case Stage::kTune: return "tune";
-    case Stage::kVerify: return "verify";
-    case Stage::kWrite: return "write";
+    case Stage::kMeasure:
+      return "measure";
+    case Stage::kIdentify:
+      return "identify";
+    case Stage::kTune:
+      return "tune";
+    case Stage::kVerify:
+      return "verify";
+    case Stage::kWrite:
+      return "write";
   }
   return "?";
 }
@@ -370,13 +400,20 @@ Stage stage_from_string(const std::string& s) {
 
 int exit_code(Outcome o) {
   switch (o) {
-    case Outcome::kVerified: return 0;
-    case Outcome::kBadInput: return 2;
-    case Outcome::kNotVerified: return 3;
-    case Outcome::kTripped: return 4;
-    case Outcome::kFailed: return 1;
-    case Outcome::kRefused: return 6;
-    case Outcome::kAborted: return 8;
+    case Outcome::kVerified:
+      return 0;
+    case Outcome::kBadInput:
+      return 2;
+    case Outcome::kNotVerified:
+      return 3;
+    case Outcome::kTripped:
+      return 4;
+    case Outcome::kFailed:
+      return 1;
+    case Outcome::kRefused:
+      return 6;
+    case Outcome::kAborted:
+      return 8;
   }
   return 1;
 }
@@ -392,7 +429,8 @@ std::pair<double, std::string> modal_uncertainty_pct(const identify::Commissioni
       for (std::size_t i = 1; i < r.frfs.size(); ++i) {  // the same mode: the nearest one, within 5 %
         const identify::IdentifiedMode* near = nullptr;
         for (const auto& o : r.frfs[i].fit.modes)
-          if (!near || std::abs(o.natural_freq_hz - m.natural_freq_hz) < std::abs(near->natural_freq_hz - m.natural_freq_hz))
+          if (!near ||
+              std::abs(o.natural_freq_hz - m.natural_freq_hz) < std::abs(near->natural_freq_hz - m.natural_freq_hz))
             near = &o;
         if (near && std::abs(near->natural_freq_hz / m.natural_freq_hz - 1.0) < 0.05)
           lo = std::min(lo, near->natural_freq_hz), hi = std::max(hi, near->natural_freq_hz), ++seen;

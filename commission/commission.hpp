@@ -59,13 +59,13 @@ struct CommissionSettings {
   double min_shift_pct{1.0};
   double max_shift_pct{10.0};
   tune::TuneSettings tune{commission_tune_defaults()};
-  std::string command_line;  // how it was called, for the files' headers and the report
+  std::string command_line;     // how it was called, for the files' headers and the report
   std::string robodamp_binary;  // the emulator's executable for a HIL cell (default: this process's)
   int cut_revolutions{300};     // each regenerative cut in the HIL emulator's check
   // The speed schedule over the job's range (tune/speed_schedule.hpp): grid speeds and gains per controller.
   int schedule_speeds{80};
   int schedule_gains{4};
-  std::string operator_name;    // who commissioned (the report; default the login name)
+  std::string operator_name;  // who commissioned (the report; default the login name)
   // A real cell: the integrator's tap tests (UFF or robodamp FRF CSVs) in place of robodamp's hammer.
   std::vector<std::string> tap_tests;
   double tap_tolerance_pct{2.0};  // a tapped mode against the chirp's
@@ -90,10 +90,10 @@ struct CommissionResult {
   std::optional<identify::CommissioningResult> identified;
   double shift_pct{0.0};
   std::string shift_reason;
-  std::optional<tune::Evaluation> tuned;           // worst case over the plants
-  std::optional<tune::Evaluation> tuned_nominal;   // on the identified plant
+  std::optional<tune::Evaluation> tuned;          // worst case over the plants
+  std::optional<tune::Evaluation> tuned_nominal;  // on the identified plant
   std::optional<config::Config> tuned_config;
-  std::optional<tune::Robustness> robustness;      // the tuned loop on the identified plant, modes shifted
+  std::optional<tune::Robustness> robustness;  // the tuned loop on the identified plant, modes shifted
   std::optional<tune::Verification> promise;
   std::optional<CellCheck> cell;
   // A real cell: the tap tests against the chirp, and the verification by the actuator's chirp.

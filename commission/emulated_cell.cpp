@@ -40,8 +40,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr double kEmulatorEndS = 60.0;     // after the controller leaves: the emulator writes its files and ends
-constexpr double kRampMarginS = 2.0;       // after settle and the gain ramp: the loop at full gain
+constexpr double kEmulatorEndS = 60.0;  // after the controller leaves: the emulator writes its files and ends
+constexpr double kRampMarginS = 2.0;    // after settle and the gain ramp: the loop at full gain
 
 std::string text_of(const fs::path& p) {
   std::ifstream in(p);
@@ -134,7 +134,7 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   pinned.pin(emulator.pid());
   runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
-  std::uint64_t in = 0, active = 0;  // written on the drain thread, read after wait()
+  std::uint64_t in = 0, active = 0;         // written on the drain thread, read after wait()
   std::atomic<StallWatch*> watch{nullptr};  // set once the loop runs, cleared after the drain has stopped
   o.on_frame = [&](const rt::TelemetryFrame& f) {
     if (StallWatch* w = watch.load(); w != nullptr && (f.flags & rt::kFlagFresh)) w->fresh();
@@ -170,10 +170,11 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
 void expect_exit_zero(EmulatorProcess& p, const std::string& what) {
   const int rc = p.wait(kEmulatorEndS);
   if (rc != 0)
-    throw std::runtime_error("the emulator (" + what + ") " +
-                             (rc < 0 ? "did not end within " + config::format_number(kEmulatorEndS) + " s of the controller"
-                                     : "exited with " + std::to_string(rc)) +
-                             "; its log " + p.log_path() + ": " + p.log_tail());
+    throw std::runtime_error(
+        "the emulator (" + what + ") " +
+        (rc < 0 ? "did not end within " + config::format_number(kEmulatorEndS) + " s of the controller"
+                : "exited with " + std::to_string(rc)) +
+        "; its log " + p.log_path() + ": " + p.log_tail());
 }
 
 analysis::FrfEstimate read_estimate(const fs::path& p) {
@@ -190,7 +191,8 @@ analysis::FrfEstimate read_estimate(const fs::path& p) {
 std::string this_executable() {
   // The running executable itself, even when a rebuild has replaced the file at its path since it started
   // (the path would then start another version).
-  if (::access("/proc/self/exe", X_OK) != 0) throw std::runtime_error("cannot run this executable again (/proc/self/exe)");
+  if (::access("/proc/self/exe", X_OK) != 0)
+    throw std::runtime_error("cannot run this executable again (/proc/self/exe)");
   return "/proc/self/exe";
 }
 
@@ -250,20 +252,16 @@ std::string EmulatorProcess::log_tail(std::size_t lines) const {
   return s.empty() ? "(empty)" : s;
 }
 
-std::string hardware_refusal(const config::Config& cell) {
-  if (!cell.can || cell.can->interface.rfind("unix:", 0) == 0) return {};
-  return "the cell is a CAN bus (can.interface = " + cell.can->interface +
-         "): robodamp orders no hammer blow and no cut on a real cell; give your modal kit's tap tests with --tap-tests "
-         "FILE... (UFF or frf_<response>_<excitation>.csv) and it commissions with the actuator as the shaker";
-}
-
 MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
                                         const std::string& binary, const EmulatedMeasure& e) {
   fs::create_directories(out_dir);
   const fs::path dir(out_dir);
-  std::vector<std::string> args{"plant", "--config", cell_path, "--pacing", "lockstep", "--json", (dir / "plant.json").string()};
-  if (e.options.impacts) args.insert(args.end(), {"--measure-out", out_dir});
-  else args.emplace_back("--no-impacts");  // a real cell: nobody swings robodamp's hammer
+  std::vector<std::string> args{
+      "plant", "--config", cell_path, "--pacing", "lockstep", "--json", (dir / "plant.json").string()};
+  if (e.options.impacts)
+    args.insert(args.end(), {"--measure-out", out_dir});
+  else
+    args.emplace_back("--no-impacts");  // a real cell: nobody swings robodamp's hammer
   EmulatorProcess plant(binary, args, (dir / "plant.log").string());
   MeasureOutcome o;
   {
@@ -301,12 +299,13 @@ std::vector<std::string> with_trajectory(std::vector<std::string> args, const st
 
 PathMeasureOutcome measure_along_path_through_emulator(const config::Config& cell, const std::string& cell_path,
                                                        const std::string& out_dir, const std::string& binary,
-                                                       const std::vector<std::string>& trajectory, const PathMeasureOptions& o) {
+                                                       const std::vector<std::string>& trajectory,
+                                                       const PathMeasureOptions& o) {
   fs::create_directories(out_dir);
   const fs::path dir(out_dir);
   EmulatorProcess plant(binary,
-                        with_trajectory({"plant", "--config", cell_path, "--pacing", "lockstep", "--measure-out", out_dir,
-                                         "--json", (dir / "plant.json").string()},
+                        with_trajectory({"plant", "--config", cell_path, "--pacing", "lockstep", "--measure-out",
+                                         out_dir, "--json", (dir / "plant.json").string()},
                                         trajectory),
                         (dir / "plant.log").string());
   PathMeasureOutcome r;
@@ -327,10 +326,11 @@ EmulatedPathRun run_along_path_through_emulator(const config::Config& controller
                                                 double duration_s, const std::string& dir) {
   const fs::path d(dir);
   fs::create_directories(d);
-  EmulatorProcess plant(binary,
-                        with_trajectory({"plant", "--config", cell_path, "--pacing", "lockstep", "--json", (d / "plant.json").string()},
-                                        trajectory),
-                        (d / "plant.log").string());
+  EmulatorProcess plant(
+      binary,
+      with_trajectory({"plant", "--config", cell_path, "--pacing", "lockstep", "--json", (d / "plant.json").string()},
+                      trajectory),
+      (d / "plant.log").string());
   const double from_s = controller.hil.settle_s;
   const ControllerRun c = run_controller(controller, duration_s, from_s, duration_s, plant);
   expect_exit_zero(plant, "the run along the path");
@@ -363,9 +363,10 @@ CutTrial cut_through_emulator(const config::Config& cell, const config::Config& 
   const double start_s = cell.commissioning.settle_s + controller.controller.gain_ramp_s + kRampMarginS;
   const double cut_s = e.revolutions * 60.0 / rpm;
   EmulatorProcess plant(e.binary,
-                        {"plant", "--config", e.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off", "--cut",
-                         e.job_path, "--cut-rpm", config::format_number(rpm), "--cut-axial-mm", config::format_number(depth_mm), "--cut-revs",
-                         std::to_string(e.revolutions), "--cut-at", config::format_number(start_s), "--json", (d / "plant.json").string()},
+                        {"plant", "--config", e.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off",
+                         "--cut", e.job_path, "--cut-rpm", config::format_number(rpm), "--cut-axial-mm",
+                         config::format_number(depth_mm), "--cut-revs", std::to_string(e.revolutions), "--cut-at",
+                         config::format_number(start_s), "--json", (d / "plant.json").string()},
                         (d / "plant.log").string());
   // The emulator's speed is within half a loop period per tooth of the request: 2 % more time covers it.
   const ControllerRun c = run_controller(controller, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant);
@@ -390,11 +391,15 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
   auto trial = [&](double depth) {
     CutTrial t = cut_through_emulator(cell, controller, e, rpm, depth, dir + "/cut_" + std::to_string(++n));
     // A cut that chatters hard enough trips the damper (instability, saturation): not stable either.
-    if (t.trip != "none") t.stable = false, t.classification = "tripped the damper (" + t.trip + ")";
-    else if (!t.complete) throw std::runtime_error("the emulator's cut at " + config::format_number(depth) + " mm did not complete");
+    if (t.trip != "none")
+      t.stable = false, t.classification = "tripped the damper (" + t.trip + ")";
+    else if (!t.complete)
+      throw std::runtime_error("the emulator's cut at " + config::format_number(depth) + " mm did not complete");
     r.rpm = t.rpm;
-    if (progress) progress("depth " + config::format_number(depth) + " mm: " + (t.stable ? std::string("stable") : t.classification +
-                                                                  " at " + config::format_number(t.chatter_hz) + " Hz"));
+    if (progress)
+      progress(
+          "depth " + config::format_number(depth) + " mm: " +
+          (t.stable ? std::string("stable") : t.classification + " at " + config::format_number(t.chatter_hz) + " Hz"));
     return t;
   };
   // Doubled or halved from the guess until the verdict changes, then halved to rel_tol, as in process.
@@ -404,7 +409,10 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
     lo = guess_mm;
     for (double d = 2.0 * guess_mm;; d *= 2.0) {
       t = trial(d);
-      if (!t.stable) { hi = d; break; }
+      if (!t.stable) {
+        hi = d;
+        break;
+      }
       lo = d;
       if (n > 12) throw std::runtime_error("no chatter up to " + config::format_number(d) + " mm");
     }
@@ -412,7 +420,10 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
     hi = guess_mm;
     for (double d = 0.5 * guess_mm;; d *= 0.5) {
       t = trial(d);
-      if (t.stable) { lo = d; break; }
+      if (t.stable) {
+        lo = d;
+        break;
+      }
       hi = d;
       if (n > 12) throw std::runtime_error("chatter down to " + config::format_number(d) + " mm");
     }
@@ -421,8 +432,10 @@ EmulatedCritical critical_through_emulator(const config::Config& cell, const con
   while (hi - lo > rel_tol * hi) {
     const double mid = 0.5 * (lo + hi);
     t = trial(mid);
-    if (t.stable) lo = mid;
-    else hi = mid, above = t;
+    if (t.stable)
+      lo = mid;
+    else
+      hi = mid, above = t;
   }
   if (above.classification == "not run") above = trial(hi);
   r.depth_mm = lo;
@@ -447,7 +460,8 @@ CellCheck check_through_emulator(const config::Config& cell, const config::Confi
                           {"plant", "--config", f.cell_path, "--pacing", "lockstep", "--measure-out",
                            (work / "impacts").string(), "--json", (work / "impacts" / "plant.json").string()},
                           (work / "impacts" / "plant.log").string());
-    const ControllerRun c = run_controller(tuned, plan.duration_s, plan.impacts_start_s.front(), plan.duration_s - 1.0, plant);
+    const ControllerRun c =
+        run_controller(tuned, plan.duration_s, plan.impacts_start_s.front(), plan.duration_s - 1.0, plant);
     expect_exit_zero(plant, "impacts");
     out.closed_trip = c.trip;
     out.closed_active_share = c.active_share;
@@ -470,8 +484,9 @@ CellCheck check_through_emulator(const config::Config& cell, const config::Confi
   const std::pair<double, double> points[] = {{promise.min_rpm, promise.min_depth_mm},
                                               {promise.speed_rpm, promise.depth_at_speed_mm}};
   for (std::size_t i = 0; i < 2; ++i) {
-    const CutTrial t = cut_through_emulator(cell, tuned, ec, points[i].first, (1.0 - out.depth_tolerance) * points[i].second,
-                                            (work / ("cut_" + std::to_string(i + 1))).string());
+    const CutTrial t =
+        cut_through_emulator(cell, tuned, ec, points[i].first, (1.0 - out.depth_tolerance) * points[i].second,
+                             (work / ("cut_" + std::to_string(i + 1))).string());
     spdlog::info("commission: the regenerative cut in the emulator, {:.3f} mm at {:.1f} rpm: {}", t.depth_mm, t.rpm,
                  t.classification);
     out.cut_trials.push_back(t);

@@ -62,16 +62,15 @@ struct EmulatedMeasure {
   std::optional<config::Config> controller;
 };
 [[nodiscard]] MeasureOutcome measure_through_emulator(const std::string& cell_path, const std::string& out_dir,
-                                                       const std::string& binary, const EmulatedMeasure& e = {});
+                                                      const std::string& binary, const EmulatedMeasure& e = {});
 
 // measure_along_path with the emulator as the robot and its hammer: `robodamp plant --pose-at ...
 // --measure-out DIR` moves the robot through the trajectory (T:Q1,Q2,... waypoints) and hammers at each stop;
 // the controller side finds the stops from the joint registers. Throws std::runtime_error when the emulator
 // fails or does not end.
-[[nodiscard]] PathMeasureOutcome measure_along_path_through_emulator(const config::Config& cell, const std::string& cell_path,
-                                                                     const std::string& out_dir, const std::string& binary,
-                                                                     const std::vector<std::string>& trajectory,
-                                                                     const PathMeasureOptions& o);
+[[nodiscard]] PathMeasureOutcome measure_along_path_through_emulator(
+    const config::Config& cell, const std::string& cell_path, const std::string& out_dir, const std::string& binary,
+    const std::vector<std::string>& trajectory, const PathMeasureOptions& o);
 
 // A controller run along the trajectory through the emulator, which at each dwell hits the driving point with
 // the controller running and again on the robot standing there with the amplifier off (hil/pose_trajectory.hpp).
@@ -91,8 +90,9 @@ struct EmulatedPathRun {
 };
 // duration_s: the run's loop time (the trajectory's last waypoint). Files and logs in dir. Throws
 // std::runtime_error when the controller cannot reach the emulator, the lockstep stalls or the emulator fails.
-[[nodiscard]] EmulatedPathRun run_along_path_through_emulator(const config::Config& controller, const std::string& cell_path,
-                                                              const std::string& binary, const std::vector<std::string>& trajectory,
+[[nodiscard]] EmulatedPathRun run_along_path_through_emulator(const config::Config& controller,
+                                                              const std::string& cell_path, const std::string& binary,
+                                                              const std::vector<std::string>& trajectory,
                                                               double duration_s, const std::string& dir);
 
 struct EmulatedCheckFiles {
@@ -110,15 +110,16 @@ struct EmulatedCut {
   int revolutions{300};
 };
 [[nodiscard]] CutTrial cut_through_emulator(const config::Config& cell, const config::Config& controller,
-                                            const EmulatedCut& cut, double rpm, double depth_mm, const std::string& dir);
+                                            const EmulatedCut& cut, double rpm, double depth_mm,
+                                            const std::string& dir);
 
 // The critical depth at a speed through the emulator by bisection on such cuts (from a guess, doubled or
 // halved until the verdict changes, then halved to rel_tol), as milling::critical_depth does in process.
 // Throws std::runtime_error when the controller trips or a cut does not complete.
 struct EmulatedCritical {
-  double rpm{0.0};        // the emulator's (a whole number of loop periods per tooth)
-  double depth_mm{0.0};   // the largest stable depth found
-  std::string above;      // the verdict just above it
+  double rpm{0.0};       // the emulator's (a whole number of loop periods per tooth)
+  double depth_mm{0.0};  // the largest stable depth found
+  std::string above;     // the verdict just above it
   double chatter_hz{0.0};
   int cuts{0};
 };

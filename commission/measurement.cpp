@@ -31,11 +31,17 @@ class Progress {
  public:
   Progress(const analysis::CommissioningPlan& p, const std::vector<std::pair<int, std::string>>& locations,
            const config::CommissioningConfig& c)
-      : plan_(p), locations_(locations), period_s_(c.chirp_period_s), rest_limit_(c.rest_accel_rms_mps2),
-        f0_hz_(c.chirp_f0_hz), f1_hz_(c.chirp_f1_hz) {}
+      : plan_(p),
+        locations_(locations),
+        period_s_(c.chirp_period_s),
+        rest_limit_(c.rest_accel_rms_mps2),
+        f0_hz_(c.chirp_f0_hz),
+        f1_hz_(c.chirp_f1_hz) {}
   void attach(runtime::Cell* cell) { cell_ = cell; }
   [[nodiscard]] const std::optional<std::pair<MeasureStatus, std::string>>& stopped() const { return stopped_; }
-  [[nodiscard]] double rest_rms_mps2() const { return rest_n_ == 0 ? 0.0 : std::sqrt(rest_sum_sq_ / static_cast<double>(rest_n_)); }
+  [[nodiscard]] double rest_rms_mps2() const {
+    return rest_n_ == 0 ? 0.0 : std::sqrt(rest_sum_sq_ / static_cast<double>(rest_n_));
+  }
   void on_frame(const rt::TelemetryFrame& f) {
     watch(f);
     log_phase(f);
@@ -59,15 +65,17 @@ class Progress {
       char b[256];
       if (state != rt::State::kActive) {
         const auto trip = static_cast<rt::Trip>(f.trip);
-        std::snprintf(b, sizeof b, "not ready: the loop is %s%s%s when the chirp is due at %.1f s (the amplifier ready, a "
-                      "fresh sensor and the robot's state are needed)", rt::to_string(state),
-                      trip == rt::Trip::kNone ? "" : ", tripped ", trip == rt::Trip::kNone ? "" : rt::to_string(trip),
-                      plan_.chirp_start_s);
+        std::snprintf(b, sizeof b,
+                      "not ready: the loop is %s%s%s when the chirp is due at %.1f s (the amplifier ready, a "
+                      "fresh sensor and the robot's state are needed)",
+                      rt::to_string(state), trip == rt::Trip::kNone ? "" : ", tripped ",
+                      trip == rt::Trip::kNone ? "" : rt::to_string(trip), plan_.chirp_start_s);
         stop(MeasureStatus::kNotReady, b);
       } else if (rest_rms_mps2() > rest_limit_) {
-        std::snprintf(b, sizeof b, "not ready: the cell is not at rest, %.3f m/s^2 RMS at the sensor over the second before the "
-                      "chirp (commissioning.rest_accel_rms_mps2 = %g): a moving robot, a turning spindle or a cut", rest_rms_mps2(),
-                      rest_limit_);
+        std::snprintf(b, sizeof b,
+                      "not ready: the cell is not at rest, %.3f m/s^2 RMS at the sensor over the second before the "
+                      "chirp (commissioning.rest_accel_rms_mps2 = %g): a moving robot, a turning spindle or a cut",
+                      rest_rms_mps2(), rest_limit_);
         stop(MeasureStatus::kNotReady, b);
       }
       return;
@@ -76,9 +84,12 @@ class Progress {
       const double tau = std::fmod(f.time_s - plan_.chirp_start_s, period_s_);
       const double f_hz = f0_hz_ + (f1_hz_ - f0_hz_) * tau / period_s_;
       char b[320];
-      std::snprintf(b, sizeof b, "the excitation saturates: the supervisor limited the command at %.3f s (the chirp near %.1f Hz, "
-                    "%.3f V): the measurement would not be linear; stopped. Lower commissioning.chirp_force_fraction (the "
-                    "chirp's level) or, with control on, the gain", f.time_s, f_hz, f.command_v);
+      std::snprintf(
+          b, sizeof b,
+          "the excitation saturates: the supervisor limited the command at %.3f s (the chirp near %.1f Hz, "
+          "%.3f V): the measurement would not be linear; stopped. Lower commissioning.chirp_force_fraction (the "
+          "chirp's level) or, with control on, the gain",
+          f.time_s, f_hz, f.command_v);
       stop(MeasureStatus::kSaturated, b);
     }
   }
@@ -140,7 +151,8 @@ std::optional<std::string> apply_pose(const config::Config& cfg, const MeasureOp
   if (opt.pose_deg.empty()) return std::nullopt;
   const std::string pose = config::describe_pose(opt.pose_deg);
   if (!cfg.pose_schedule)
-    return "--pose " + pose + ": " + cfg.source + " has no pose_schedule.model, the robot model whose joints the pose names";
+    return "--pose " + pose + ": " + cfg.source +
+           " has no pose_schedule.model, the robot model whose joints the pose names";
   const config::RobotModelConfig model = config::load_robot_model(cfg.pose_schedule->model_resolved);
   if (auto p = config::pose_problem(model, opt.pose_deg)) return "--pose " + pose + ": " + *p;
   o.pose_deg = opt.pose_deg;
@@ -159,7 +171,8 @@ void judge(MeasureOutcome& out, const runtime::RunSummary& s, const Progress& wa
     out.message = watch.stopped()->second;
   } else if (const int sig = rt::shutdown_signal().load(); sig != 0) {
     out.status = MeasureStatus::kAborted;
-    out.message = "aborted by the operator (signal " + std::to_string(sig) + "): the command ramped to 0 through the "
+    out.message = "aborted by the operator (signal " + std::to_string(sig) +
+                  "): the command ramped to 0 through the "
                   "safe state; the measurement is incomplete";
   } else if (s.trip != "none") {
     out.status = MeasureStatus::kTripped;
@@ -233,8 +246,8 @@ void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts
       in = identify::read_measurement_dir(out_dir);
     } else {
       in.manifest = m;
-      in.chirp = identify::read_chirp_measurement((fs::path(out_dir) / identify::kRecordingName).string(), m.config_source,
-                                                  m.plan.chirp_start_s);
+      in.chirp = identify::read_chirp_measurement((fs::path(out_dir) / identify::kRecordingName).string(),
+                                                  m.config_source, m.plan.chirp_start_s);
     }
     measfiles::write_uff(uff, identify::measurement_to_uff(in), measfiles::UffEncoding::kAscii);
   } catch (const std::exception& e) {
@@ -247,15 +260,23 @@ void write_outputs(MeasureOutcome& out, const std::string& out_dir, bool impacts
 
 int exit_code(MeasureStatus s) {
   switch (s) {
-    case MeasureStatus::kOk: return 0;
-    case MeasureStatus::kConfigError: return 2;
-    case MeasureStatus::kTripped: return 4;
-    case MeasureStatus::kIncomplete: return 5;
-    case MeasureStatus::kNotReady: return 6;
-    case MeasureStatus::kSaturated: return 7;
-    case MeasureStatus::kAborted: return 8;
+    case MeasureStatus::kOk:
+      return 0;
+    case MeasureStatus::kConfigError:
+      return 2;
+    case MeasureStatus::kTripped:
+      return 4;
+    case MeasureStatus::kIncomplete:
+      return 5;
+    case MeasureStatus::kNotReady:
+      return 6;
+    case MeasureStatus::kSaturated:
+      return 7;
+    case MeasureStatus::kAborted:
+      return 8;
     case MeasureStatus::kFailed:
-    case MeasureStatus::kWriteError: return 1;
+    case MeasureStatus::kWriteError:
+      return 1;
   }
   return 1;
 }
@@ -269,31 +290,39 @@ std::string measurement_plan(const config::Config& cfg, const std::string& confi
   const analysis::CommissioningPlan p = detail::plan_for(cfg, model, o);
   const auto& c = cfg.commissioning;
   char b[1024];
-  std::string t = "robodamp measure plan for " + config_path + " (" + (cfg.can ? "the cell behind " + cfg.can->interface : std::string("the simulated plant")) + "):\n";
-  std::snprintf(b, sizeof b,
-                "  0.0 - %.1f s   the loop arms, control %s (K = %.0f N s/m); the chirp waits until the loop is active "
-                "(amplifier ready, sensor fresh, robot state known) and the cell at rest (< %g m/s^2 RMS at the sensor)\n",
-                p.chirp_start_s, o.control_on ? "ON" : "off", o.control_on ? cfg.controller.gain_ns_per_m : 0.0, c.rest_accel_rms_mps2);
+  std::string t = "robodamp measure plan for " + config_path + " (" +
+                  (cfg.can ? "the cell behind " + cfg.can->interface : std::string("the simulated plant")) + "):\n";
+  std::snprintf(
+      b, sizeof b,
+      "  0.0 - %.1f s   the loop arms, control %s (K = %.0f N s/m); the chirp waits until the loop is active "
+      "(amplifier ready, sensor fresh, robot state known) and the cell at rest (< %g m/s^2 RMS at the sensor)\n",
+      p.chirp_start_s, o.control_on ? "ON" : "off", o.control_on ? cfg.controller.gain_ns_per_m : 0.0,
+      c.rest_accel_rms_mps2);
   t += b;
-  std::snprintf(b, sizeof b,
-                "  %.1f - %.1f s  what moves: the inertial actuator's mass only; %d periods of a %.1f-%.1f Hz chirp, %.1f s each, "
-                "at %.3f V (%.0f %% of the amplifier's %.1f V), ramped up over the first %.1f s; predicted peak actuator force "
-                "%.1f N of its %.0f N limit\n",
-                p.chirp_start_s, p.chirp_end_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz, c.chirp_period_s, p.chirp_amplitude_v,
-                100.0 * p.chirp_amplitude_v / cfg.amplifier.voltage_limit_v, cfg.amplifier.voltage_limit_v, 0.5 * c.chirp_period_s,
-                p.predicted_peak_force_n, cfg.actuator.force_limit_n);
+  std::snprintf(
+      b, sizeof b,
+      "  %.1f - %.1f s  what moves: the inertial actuator's mass only; %d periods of a %.1f-%.1f Hz chirp, %.1f s "
+      "each, "
+      "at %.3f V (%.0f %% of the amplifier's %.1f V), ramped up over the first %.1f s; predicted peak actuator force "
+      "%.1f N of its %.0f N limit\n",
+      p.chirp_start_s, p.chirp_end_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz, c.chirp_period_s,
+      p.chirp_amplitude_v, 100.0 * p.chirp_amplitude_v / cfg.amplifier.voltage_limit_v, cfg.amplifier.voltage_limit_v,
+      0.5 * c.chirp_period_s, p.predicted_peak_force_n, cfg.actuator.force_limit_n);
   t += b;
   if (o.impacts) {
-    std::snprintf(b, sizeof b, "  %.1f - %.1f s  hammer impacts of %.0f N, %d at each of %zu locations (the plant side's hammer)\n",
-                  p.impacts_start_s.empty() ? p.chirp_end_s : p.impacts_start_s.front(), p.duration_s - 1.0, cfg.bench.impact_peak_n,
-                  c.impacts_per_location, model.locations.size());
+    std::snprintf(b, sizeof b,
+                  "  %.1f - %.1f s  hammer impacts of %.0f N, %d at each of %zu locations (the plant side's hammer)\n",
+                  p.impacts_start_s.empty() ? p.chirp_end_s : p.impacts_start_s.front(), p.duration_s - 1.0,
+                  cfg.bench.impact_peak_n, c.impacts_per_location, model.locations.size());
     t += b;
   } else {
     t += "  no hammer: the tool tip's FRFs come from your tap tests (commission --tap-tests)\n";
   }
-  std::snprintf(b, sizeof b, "  %.1f s in all. The robot must stand still and the spindle be stopped throughout.\n", p.duration_s);
+  std::snprintf(b, sizeof b, "  %.1f s in all. The robot must stand still and the spindle be stopped throughout.\n",
+                p.duration_s);
   t += b;
-  t += "  It stops at once, through the safe state, on Ctrl-C (SIGINT) or SIGTERM, on any trip, when the loop is not ready "
+  t += "  It stops at once, through the safe state, on Ctrl-C (SIGINT) or SIGTERM, on any trip, when the loop is not "
+       "ready "
        "or the cell not at rest when the chirp is due, and when the supervisor limits a command during the chirp.\n";
   return t;
 }
@@ -311,8 +340,10 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
   MeasureOutcome out;
   const auto& c = cfg.commissioning;
   runtime::CellOptions o;
-  if (!opt.clock.empty()) o.clock = opt.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
-  else if (!cfg.can) o.clock = config::ClockKind::kVirtual;  // the simulated plant: nothing to pace
+  if (!opt.clock.empty())
+    o.clock = opt.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
+  else if (!cfg.can)
+    o.clock = config::ClockKind::kVirtual;  // the simulated plant: nothing to pace
   o.record_path = (fs::path(out_dir) / identify::kRecordingName).string();
   o.keep_frames = true;
   if (const auto refused = apply_pose(cfg, opt, o, out.manifest)) {
@@ -320,8 +351,8 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
     out.message = *refused;
     return out;
   }
-  o.chirp = {true, plan.chirp_start_s, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz,
-             plan.chirp_amplitude_v, 0.5 * c.chirp_period_s};
+  o.chirp = {true,          plan.chirp_start_s, c.chirp_period_s,       c.chirp_periods,
+             c.chirp_f0_hz, c.chirp_f1_hz,      plan.chirp_amplitude_v, 0.5 * c.chirp_period_s};
   identify::MeasurementManifest& m = out.manifest;
   detail::fill_manifest(m, config_path, cfg, model, plan);
   Progress progress(plan, m.locations, c);
@@ -359,10 +390,15 @@ MeasureOutcome measure(const config::Config& cfg, const std::string& config_path
   out.peak_command_v = s.peak_command_v;
   out.recorded_frames = s.recorded_frames;
   out.rest_accel_rms_mps2 = progress.rest_rms_mps2();
-  m.run = {{"final_state", s.final_state}, {"trip", s.trip}, {"saturated_ticks", s.supervisor.saturated_ticks},
-           {"peak_command_v", s.peak_command_v}, {"chirp_active_share", out.chirp_active_share},
-           {"recorded_frames", s.recorded_frames}, {"record_errors", s.record_errors},
-           {"impacts", opt.impacts}, {"control_on", opt.control_on},
+  m.run = {{"final_state", s.final_state},
+           {"trip", s.trip},
+           {"saturated_ticks", s.supervisor.saturated_ticks},
+           {"peak_command_v", s.peak_command_v},
+           {"chirp_active_share", out.chirp_active_share},
+           {"recorded_frames", s.recorded_frames},
+           {"record_errors", s.record_errors},
+           {"impacts", opt.impacts},
+           {"control_on", opt.control_on},
            {"gain_ns_per_m", opt.control_on ? cfg.controller.gain_ns_per_m : 0.0},
            {"rest_accel_rms_mps2", out.rest_accel_rms_mps2}};
   if (test) {

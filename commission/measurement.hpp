@@ -30,7 +30,17 @@ struct MeasureOptions {
   bool control_on{false};  // true: the configuration's controller runs through the chirp (the verification)
 };
 
-enum class MeasureStatus { kOk, kConfigError, kFailed, kTripped, kIncomplete, kWriteError, kNotReady, kSaturated, kAborted };
+enum class MeasureStatus {
+  kOk,
+  kConfigError,
+  kFailed,
+  kTripped,
+  kIncomplete,
+  kWriteError,
+  kNotReady,
+  kSaturated,
+  kAborted
+};
 
 struct MeasureOutcome {
   MeasureStatus status{MeasureStatus::kOk};
@@ -48,15 +58,16 @@ struct MeasureOutcome {
 // What a measurement with these options will do on this cell, for --dry-run and the log: what moves, the
 // levels against the limits, the durations, what stops it. Throws config::ConfigError.
 [[nodiscard]] std::string measurement_plan(const std::string& config_path, const MeasureOptions& o = {});
-[[nodiscard]] std::string measurement_plan(const config::Config& cfg, const std::string& config_path, const MeasureOptions& o);
+[[nodiscard]] std::string measurement_plan(const config::Config& cfg, const std::string& config_path,
+                                           const MeasureOptions& o);
 
 // Runs the measurement into out_dir (created). Progress lines go to spdlog. Throws config::ConfigError for
 // a configuration that does not validate.
 [[nodiscard]] MeasureOutcome measure(const std::string& config_path, const std::string& out_dir,
                                      const MeasureOptions& o = {});
 // The same with a configuration in hand (config_path: where it is said to come from, for the manifest).
-[[nodiscard]] MeasureOutcome measure(const config::Config& cfg, const std::string& config_path, const std::string& out_dir,
-                                     const MeasureOptions& o = {});
+[[nodiscard]] MeasureOutcome measure(const config::Config& cfg, const std::string& config_path,
+                                     const std::string& out_dir, const MeasureOptions& o = {});
 
 // The exit code the commands use: 0 ok, 2 configuration, 4 tripped, 5 incomplete, 6 not ready, 7 the
 // excitation saturated, 8 aborted by the operator, 1 otherwise.

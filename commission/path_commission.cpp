@@ -28,7 +28,8 @@ namespace robodamp::commission {
 
 bool PathStop::improvement_held(double tolerance_points, double peak_tolerance) const {
   return on_cell && records >= 2 &&
-         (std::abs(measured_improvement_pct - predicted_improvement_pct) <= tolerance_points || std::abs(peak_error()) <= peak_tolerance);
+         (std::abs(measured_improvement_pct - predicted_improvement_pct) <= tolerance_points ||
+          std::abs(peak_error()) <= peak_tolerance);
 }
 
 namespace {
@@ -74,7 +75,8 @@ std::vector<std::optional<std::size_t>> regions_along(const config::PoseSchedule
                                                       const std::vector<std::vector<double>>& stops) {
   std::vector<std::optional<std::size_t>> out(stops.size());
   if (path.empty()) return out;
-  std::optional<std::size_t> current = config::region_of(s, path.front().joints_deg.data(), path.front().joints_deg.size());
+  std::optional<std::size_t> current =
+      config::region_of(s, path.front().joints_deg.data(), path.front().joints_deg.size());
   const auto note = [&](const std::vector<double>& q) {
     for (std::size_t i = 0; i < stops.size(); ++i)
       if (!out[i] && same_pose(q, stops[i], 0.05)) out[i] = current;
@@ -125,7 +127,8 @@ std::vector<std::string> waypoint_texts(const std::vector<hil::PoseWaypoint>& pa
 
 class PathRun {
  public:
-  PathRun(const PathCommissionSettings& s, const std::function<void(const std::string&)>& progress, PathCommissionResult& r)
+  PathRun(const PathCommissionSettings& s, const std::function<void(const std::string&)>& progress,
+          PathCommissionResult& r)
       : s_(s), say_(progress), r_(r), dir_(s.out_dir), stage_(s.from, s.out_dir, say_, r.stage, r.times) {}
 
   void all() {
@@ -135,13 +138,15 @@ class PathRun {
     cell_ = config::load_config_file(s_.config_path);
     if (!cell_.pose_schedule)
       throw Stop{Stage::kMeasure, Outcome::kBadInput,
-                 s_.config_path + " has no pose_schedule: along the path robodamp schedules the controller by pose "
-                                  "(its model is the prior between the stops)"};
+                 s_.config_path +
+                     " has no pose_schedule: along the path robodamp schedules the controller by pose "
+                     "(its model is the prior between the stops)"};
     if (!cell_.can || cell_.can->interface.rfind("unix:", 0) != 0)
-      throw Stop{Stage::kMeasure, Outcome::kBadInput,
-                 "along the path robodamp's hammer hits at each stop, and only the HIL emulator (can.interface unix:...) "
-                 "has one; on a real cell measure with `robodamp measure --along-path --no-hammer`, tap at each stop "
-                 "with your modal kit and map the modes with `robodamp pose modes`"};
+      throw Stop{
+          Stage::kMeasure, Outcome::kBadInput,
+          "along the path robodamp's hammer hits at each stop, and only the HIL emulator (can.interface unix:...) "
+          "has one; on a real cell measure with `robodamp measure --along-path --no-hammer`, tap at each stop "
+          "with your modal kit and map the modes with `robodamp pose modes`"};
     if (s_.trajectory.empty())
       throw Stop{Stage::kMeasure, Outcome::kBadInput,
                  "give the robot's path in the emulator: --pose-at T:Q1,Q2,... (the robot program's waypoints, as "
@@ -160,7 +165,6 @@ class PathRun {
   }
 
  private:
-
   void measure() {
     if (stage_.reuse()) {
       if (!fs::exists(dir_ / "measurement" / "poses.json"))
@@ -174,18 +178,19 @@ class PathRun {
     po.dwells = s_.dwells;
     po.max_run_s = s_.max_run_s;
     po.still_deg = s_.still_deg;
-    const PathMeasureOutcome o =
-        measure_along_path_through_emulator(cell_, s_.config_path, (dir_ / "measurement").string(), binary_, s_.trajectory, po);
+    const PathMeasureOutcome o = measure_along_path_through_emulator(
+        cell_, s_.config_path, (dir_ / "measurement").string(), binary_, s_.trajectory, po);
     std::signal(SIGINT, SIG_DFL);  // the measurement's loop turned them into a trip; no loop runs now
     std::signal(SIGTERM, SIG_DFL);
     for (const auto& d : o.dwells)
       say_("commission:   " + d.name + " at " + config::describe_pose(d.joints_deg) +
-           (d.measured ? fmt(": measured (the chirp %.1f-%.1f s)", d.chirp_start_s, d.chirp_end_s) : ": not measured: " + d.skipped));
+           (d.measured ? fmt(": measured (the chirp %.1f-%.1f s)", d.chirp_start_s, d.chirp_end_s)
+                       : ": not measured: " + d.skipped));
     detail::throw_unless_measured(o.run, Stage::kMeasure);
     if (o.measured() < s_.dwells)
       throw Stop{Stage::kMeasure, Outcome::kFailed,
-                 fmt("%d of %d stops measured: the robot stopped too few times, or too briefly, within the run", o.measured(),
-                     s_.dwells)};
+                 fmt("%d of %d stops measured: the robot stopped too few times, or too briefly, within the run",
+                     o.measured(), s_.dwells)};
   }
 
   // Each stop on its own, then the map between them; the tune's base: the cell with the actuator identified.
@@ -202,14 +207,17 @@ class PathRun {
       st.actuator_hz = id.actuator.natural_freq_hz;
       acts.push_back(id.actuator);
       r_.stops.push_back(st);
-      say_(fmt("commission:   %s at %s: actuator %.3f N/V, %.3f Hz, zeta %.4f, delay %.3f ms; dominant mode %.2f Hz%s", st.name.c_str(),
-               config::describe_pose(st.joints_deg).c_str(), id.actuator.force_constant_n_per_v, id.actuator.natural_freq_hz,
-               id.actuator.damping_ratio, id.actuator.delay_ms, id.dominant_mode_hz, st.held_out ? " (held out of the map)" : ""));
+      say_(fmt("commission:   %s at %s: actuator %.3f N/V, %.3f Hz, zeta %.4f, delay %.3f ms; dominant mode %.2f Hz%s",
+               st.name.c_str(), config::describe_pose(st.joints_deg).c_str(), id.actuator.force_constant_n_per_v,
+               id.actuator.natural_freq_hz, id.actuator.damping_ratio, id.actuator.delay_ms, id.dominant_mode_hz,
+               st.held_out ? " (held out of the map)" : ""));
     }
     if (acts.empty()) throw Stop{Stage::kIdentify, Outcome::kFailed, "no stop was measured"};
     std::vector<double> f_hz;
     for (const auto& a : acts) f_hz.push_back(a.natural_freq_hz);
-    r_.actuator_spread_pct = 100.0 * (*std::max_element(f_hz.begin(), f_hz.end()) - *std::min_element(f_hz.begin(), f_hz.end())) / median(f_hz);
+    r_.actuator_spread_pct =
+        100.0 * (*std::max_element(f_hz.begin(), f_hz.end()) - *std::min_element(f_hz.begin(), f_hz.end())) /
+        median(f_hz);
     map(pm);
     write_identified_cell(acts);
   }
@@ -229,19 +237,21 @@ class PathRun {
     r_.map_rows = analysis::check_pose_modes(prior, mapped_, id.measured.poses, false, axis, count);
     for (auto& row : analysis::check_pose_modes(prior, mapped_, id.held_out, true, axis, count)) {
       if (std::isfinite(row.mapped_hz))
-        r_.held_out_worst_freq_error_pct = std::max(r_.held_out_worst_freq_error_pct, std::abs(100.0 * (row.mapped_hz / row.measured_hz - 1.0)));
+        r_.held_out_worst_freq_error_pct =
+            std::max(r_.held_out_worst_freq_error_pct, std::abs(100.0 * (row.mapped_hz / row.measured_hz - 1.0)));
       else
         ++r_.held_out_modes_missed;
       r_.map_rows.push_back(std::move(row));
     }
-    say_(fmt("commission: the modes of %zu stops mapped (%s, the model the prior between them)", id.measured.poses.size(),
-             r_.mapped_model_path.c_str()) +
+    say_(fmt("commission: the modes of %zu stops mapped (%s, the model the prior between them)",
+             id.measured.poses.size(), r_.mapped_model_path.c_str()) +
          (id.held_out.empty() ? std::string()
-                              : fmt("; at the %zu held out the largest frequency error %.2f %%, %d mode(s) missed", id.held_out.size(),
-                                    r_.held_out_worst_freq_error_pct, r_.held_out_modes_missed)));
+                              : fmt("; at the %zu held out the largest frequency error %.2f %%, %d mode(s) missed",
+                                    id.held_out.size(), r_.held_out_worst_freq_error_pct, r_.held_out_modes_missed)));
     if (r_.held_out_modes_missed > 0 || r_.held_out_worst_freq_error_pct > s_.held_out_freq_tolerance_pct)
       throw Stop{Stage::kIdentify, Outcome::kNotVerified,
-                 fmt("the map misses a stop held out of it (the largest frequency error %.2f %%, allowed %.1f %%; %d mode(s) with "
+                 fmt("the map misses a stop held out of it (the largest frequency error %.2f %%, allowed %.1f %%; %d "
+                     "mode(s) with "
                      "no mapped mode within 25 %%): measure more stops, closer together",
                      r_.held_out_worst_freq_error_pct, s_.held_out_freq_tolerance_pct, r_.held_out_modes_missed)};
   }
@@ -254,15 +264,25 @@ class PathRun {
       for (const auto& a : acts) v.push_back(field(a));
       return tune::exact(median(v));
     };
-    const std::vector<config::YamlEdit> edits{
-        {{"actuator", "constant_n_per_v"}, YAML::Node(med([](const auto& a) { return a.force_constant_n_per_v; })), "identified along the path"},
-        {{"actuator", "natural_freq_hz"}, YAML::Node(med([](const auto& a) { return a.natural_freq_hz; })), "identified along the path"},
-        {{"actuator", "damping_ratio"}, YAML::Node(med([](const auto& a) { return a.damping_ratio; })), "identified along the path"},
-        {{"actuator", "delay_s"}, YAML::Node(med([](const auto& a) { return a.delay_ms * 1e-3; })), "identified along the path"},
-        {{"pose_schedule", "model"}, YAML::Node(r_.mapped_model_path), "the model with the modes measured along the path"}};
+    const std::vector<config::YamlEdit> edits{{{"actuator", "constant_n_per_v"},
+                                               YAML::Node(med([](const auto& a) { return a.force_constant_n_per_v; })),
+                                               "identified along the path"},
+                                              {{"actuator", "natural_freq_hz"},
+                                               YAML::Node(med([](const auto& a) { return a.natural_freq_hz; })),
+                                               "identified along the path"},
+                                              {{"actuator", "damping_ratio"},
+                                               YAML::Node(med([](const auto& a) { return a.damping_ratio; })),
+                                               "identified along the path"},
+                                              {{"actuator", "delay_s"},
+                                               YAML::Node(med([](const auto& a) { return a.delay_ms * 1e-3; })),
+                                               "identified along the path"},
+                                              {{"pose_schedule", "model"},
+                                               YAML::Node(r_.mapped_model_path),
+                                               "the model with the modes measured along the path"}};
     const fs::path out = dir_ / "identified.yaml";
-    const std::string text = "# robodamp commission --along-path: " + s_.config_path + " with what the stops identified\n" +
-                             config::rebase_file_paths(config::edit_yaml(cell_.yaml_text, edits).text, cell_.source, out.string()).text;
+    const std::string text =
+        "# robodamp commission --along-path: " + s_.config_path + " with what the stops identified\n" +
+        config::rebase_file_paths(config::edit_yaml(cell_.yaml_text, edits).text, cell_.source, out.string()).text;
     identified_ = config::parse_config(text, out.string());
     std::ofstream(out) << text;
   }
@@ -270,7 +290,8 @@ class PathRun {
   void tune() {
     if (stage_.reuse()) {
       if (!fs::exists(dir_ / "tuned.yaml"))
-        throw Stop{Stage::kTune, Outcome::kBadInput, "--from verify: " + (dir_ / "tuned.yaml").string() + " does not exist: run from tune"};
+        throw Stop{Stage::kTune, Outcome::kBadInput,
+                   "--from verify: " + (dir_ / "tuned.yaml").string() + " does not exist: run from tune"};
       r_.chosen = "reused from " + (dir_ / "tuned.yaml").string();
       return;
     }
@@ -283,18 +304,20 @@ class PathRun {
     r_.chosen = w.best_score().name;
     r_.method = w.scores.method;
     for (const auto& c : w.scores.controllers)
-      say_("commission: " + c.name + ": " + (c.stable_everywhere ? "stable at every map pose" : "UNSTABLE at a map pose") +
+      say_("commission: " + c.name + ": " +
+           (c.stable_everywhere ? "stable at every map pose" : "UNSTABLE at a map pose") +
            fmt(", worst mode in the damping band %+.1f %%, worst driving point %+.1f %%", c.worst_mode_improvement_pct,
                c.worst_improvement_pct) +
            (c.damped_min_mm ? fmt(", the job's smallest damped depth %.4f mm", *c.damped_min_mm) : std::string()));
     if (!w.best_score().stable_everywhere)
       throw Stop{Stage::kTune, Outcome::kNotVerified, "no controller is stable at every pose of the workspace map"};
-    const std::string header = "# robodamp commission --along-path tuned this (the " + r_.chosen + " controller) from " +
-                               std::to_string(in.measured.size()) + " stops' modes:\n#   " + s_.command_line + "\n";
+    const std::string header = "# robodamp commission --along-path tuned this (the " + r_.chosen +
+                               " controller) from " + std::to_string(in.measured.size()) + " stops' modes:\n#   " +
+                               s_.command_line + "\n";
     const std::string tuned_path = (dir_ / "tuned.yaml").string();
     (void)tune::write_pose_tuned_config(identified_, w.chosen(), "", tuned_path, header);
-    say_("commission: chose the " + r_.chosen + " controller (" + std::to_string(w.chosen().empty() ? identified_.pose_schedule->regions.size()
-                                                                                                       : w.chosen().size()) +
+    say_("commission: chose the " + r_.chosen + " controller (" +
+         std::to_string(w.chosen().empty() ? identified_.pose_schedule->regions.size() : w.chosen().size()) +
          " region(s))");
     std::vector<std::vector<double>> poses;
     for (const auto& m : w.scores.map) poses.push_back(m.pose.joints_deg);
@@ -310,9 +333,10 @@ class PathRun {
     for (const auto& n : nw.notes) say_("commission: " + n);
     r_.lowered = nw.notes;
     if (!nw.changed()) return;
-    (void)tune::write_pose_regions(tuned, nw.regions, "", tuned_path,
-                                   "# robodamp commission --along-path: the damper off where its set makes the job's cut worse "
-                                   "(tune/never_worse.hpp)\n");
+    (void)tune::write_pose_regions(
+        tuned, nw.regions, "", tuned_path,
+        "# robodamp commission --along-path: the damper off where its set makes the job's cut worse "
+        "(tune/never_worse.hpp)\n");
   }
 
   void verify() {
@@ -323,63 +347,83 @@ class PathRun {
     for (const auto& st : r_.stops) stop_poses.push_back(st.joints_deg);
     const std::vector<std::optional<std::size_t>> ran = regions_along(ps, path_, stop_poses);
     constexpr int kRecords = 3;  // per stop, as the emulator's dwell campaign averages them
-    const std::vector<hil::PoseWaypoint> path = shortened(path_, tuned_.hil.settle_s + (kRecords + 0.5) * tuned_.bench.record_s);
-    say_(fmt("commission: the controller along the same path, each stop held %.0f s (hil.settle_s, then %d impact records), "
-             "%.0f s in all", tuned_.hil.settle_s + (kRecords + 0.5) * tuned_.bench.record_s, kRecords, path.back().t_s));
+    const std::vector<hil::PoseWaypoint> path =
+        shortened(path_, tuned_.hil.settle_s + (kRecords + 0.5) * tuned_.bench.record_s);
+    say_(fmt(
+        "commission: the controller along the same path, each stop held %.0f s (hil.settle_s, then %d impact records), "
+        "%.0f s in all",
+        tuned_.hil.settle_s + (kRecords + 0.5) * tuned_.bench.record_s, kRecords, path.back().t_s));
     const EmulatedPathRun run = run_along_path_through_emulator(tuned_, s_.config_path, binary_, waypoint_texts(path),
                                                                 path.back().t_s, (dir_ / "verify").string());
     r_.trip = run.trip, r_.pose_out_of_map = run.pose_out_of_map, r_.saturated_ticks = run.saturated_ticks;
     std::vector<config::Config> sets;
     for (const auto& rs : sched.regions) sets.push_back(rs.config);
-    milling::LiveStability live(job_, "", sets, {}, milling::PoseDynamics{ps.model_resolved, sched.model, ps.axis, ps.modes});
+    milling::LiveStability live(job_, "", sets, {},
+                                milling::PoseDynamics{ps.model_resolved, sched.model, ps.axis, ps.modes});
     for (std::size_t i = 0; i < r_.stops.size(); ++i) {
       PathStop& st = r_.stops[i];
-      if (!ran[i]) throw Stop{Stage::kVerify, Outcome::kNotVerified, st.name + " at " + config::describe_pose(st.joints_deg) +
-                                                                        ": no region of the tuned schedule holds it"};
+      if (!ran[i])
+        throw Stop{
+            Stage::kVerify, Outcome::kNotVerified,
+            st.name + " at " + config::describe_pose(st.joints_deg) + ": no region of the tuned schedule holds it"};
       const analysis::RegionSet& set = sched.regions[*ran[i]];
       st.region = set.name;
       st.gain_ns_per_m = set.gain_ns_per_m;
       st.predicted_improvement_pct = analysis::predicted_improvement_pct(set.config, sched.model, ps, st.joints_deg);
-      const auto d = std::find_if(run.dwells.begin(), run.dwells.end(), [&](const EmulatedDwell& e) { return same_pose(e.joints_deg, st.joints_deg, 0.05); });
+      const auto d = std::find_if(run.dwells.begin(), run.dwells.end(),
+                                  [&](const EmulatedDwell& e) { return same_pose(e.joints_deg, st.joints_deg, 0.05); });
       if (d != run.dwells.end())
-        st.on_cell = true, st.records = d->records, st.measured_improvement_pct = d->measured_improvement_pct, st.coherence_min = d->coherence_min;
+        st.on_cell = true, st.records = d->records, st.measured_improvement_pct = d->measured_improvement_pct,
+        st.coherence_min = d->coherence_min;
       const milling::LiveLimits l = live.compute(r_.job_rpm, *ran[i], set.gain_ns_per_m, st.joints_deg);
       st.open_limit_mm = l.open_mm;
       st.loop_open_limit_mm = l.loop_open_mm > 0.0 ? l.loop_open_mm : l.open_mm;
       st.damped_limit_mm = l.damped_valid ? l.damped_mm : 0.0;
       r_.method = l.method + " (the robot in its plane, on the mapped model)";
       if (!l.damped_valid || !l.loop_model_verified) st.limit_note = l.problem;
-      say_(fmt("commission:   %s (%s): improvement %.1f %% measured, %.1f %% predicted on the map (%d records); the job at %.0f rpm: "
-               "%.3f mm damped, %.3f mm open loop", st.name.c_str(), st.region.c_str(), st.measured_improvement_pct,
-               st.predicted_improvement_pct, st.records, r_.job_rpm, st.damped_limit_mm, st.open_limit_mm) +
+      say_(fmt("commission:   %s (%s): improvement %.1f %% measured, %.1f %% predicted on the map (%d records); the "
+               "job at %.0f rpm: "
+               "%.3f mm damped, %.3f mm open loop",
+               st.name.c_str(), st.region.c_str(), st.measured_improvement_pct, st.predicted_improvement_pct,
+               st.records, r_.job_rpm, st.damped_limit_mm, st.open_limit_mm) +
            (st.limit_note.empty() ? std::string() : " (" + st.limit_note + ")"));
     }
     if (std::all_of(r_.stops.begin(), r_.stops.end(), [](const PathStop& st) { return st.gain_ns_per_m == 0.0; }))
-      throw Stop{Stage::kVerify, Outcome::kNotVerified,
-                 fmt("at no stop does the damper run: every set that was tuned makes the job's cut at %.0f rpm shallower than "
-                     "the open loop somewhere in its region, down to K = 0 (try more regions: --max-regions)", r_.job_rpm)};
-    if (run.trip != "none") throw Stop{Stage::kVerify, Outcome::kNotVerified, "the controller tripped along the path: " + run.trip};
+      throw Stop{
+          Stage::kVerify, Outcome::kNotVerified,
+          fmt("at no stop does the damper run: every set that was tuned makes the job's cut at %.0f rpm shallower than "
+              "the open loop somewhere in its region, down to K = 0 (try more regions: --max-regions)",
+              r_.job_rpm)};
+    if (run.trip != "none")
+      throw Stop{Stage::kVerify, Outcome::kNotVerified, "the controller tripped along the path: " + run.trip};
     if (run.pose_out_of_map > 0)
-      throw Stop{Stage::kVerify, Outcome::kNotVerified, fmt("the pose left the tuned map %llu times along the path", run.pose_out_of_map)};
+      throw Stop{Stage::kVerify, Outcome::kNotVerified,
+                 fmt("the pose left the tuned map %llu times along the path", run.pose_out_of_map)};
     for (const auto& st : r_.stops) {
       if (!st.improvement_held(s_.improvement_tolerance_points, s_.peak_tolerance))
-        throw Stop{Stage::kVerify, Outcome::kNotVerified,
-                   st.name + (st.on_cell ? fmt(": the improvement measured on the cell, %.1f %% (%d records), is not within %.1f points "
-                                               "of the map's %.1f %%, nor the damped peak within %.0f %% of the predicted (%+.1f %%)",
-                                               st.measured_improvement_pct, st.records, s_.improvement_tolerance_points,
-                                               st.predicted_improvement_pct, 100.0 * s_.peak_tolerance, 100.0 * st.peak_error())
-                                         : std::string(": the emulator measured nothing there (the stop too short for a record)"))};
+        throw Stop{
+            Stage::kVerify, Outcome::kNotVerified,
+            st.name +
+                (st.on_cell
+                     ? fmt(": the improvement measured on the cell, %.1f %% (%d records), is not within %.1f points "
+                           "of the map's %.1f %%, nor the damped peak within %.0f %% of the predicted (%+.1f %%)",
+                           st.measured_improvement_pct, st.records, s_.improvement_tolerance_points,
+                           st.predicted_improvement_pct, 100.0 * s_.peak_tolerance, 100.0 * st.peak_error())
+                     : std::string(": the emulator measured nothing there (the stop too short for a record)"))};
       if (!st.cut_not_worse())
-        throw Stop{Stage::kVerify, Outcome::kNotVerified,
-                   st.name + fmt(": the damper makes the job's cut worse there: %.3f mm damped against %.3f mm open loop (the "
-                                 "same model) at %.0f rpm", st.damped_limit_mm, st.loop_open_limit_mm, r_.job_rpm)};
+        throw Stop{
+            Stage::kVerify, Outcome::kNotVerified,
+            st.name + fmt(": the damper makes the job's cut worse there: %.3f mm damped against %.3f mm open loop (the "
+                          "same model) at %.0f rpm",
+                          st.damped_limit_mm, st.loop_open_limit_mm, r_.job_rpm)};
     }
   }
 
   void write() {
     std::ostringstream h;
     h << "# robodamp commission --along-path wrote this (docs/pose_dynamics.md) for the cell " << s_.config_path
-      << " and the job " << s_.job_path << ":\n#   " << s_.command_line << "\n# Verified on the HIL emulator along the path:";
+      << " and the job " << s_.job_path << ":\n#   " << s_.command_line
+      << "\n# Verified on the HIL emulator along the path:";
     for (const auto& st : r_.stops)
       h << fmt(" %s %s %.1f %% measured / %.1f %% predicted, the job %.3f / %.3f mm damped / open;", st.name.c_str(),
                config::describe_pose(st.joints_deg).c_str(), st.measured_improvement_pct, st.predicted_improvement_pct,

@@ -29,48 +29,50 @@
 namespace robodamp::commission {
 
 struct PathCommissionSettings {
-  std::string config_path;  // the cell, with a pose_schedule (its model is the prior between the stops)
+  std::string config_path;      // the cell, with a pose_schedule (its model is the prior between the stops)
   Stage from{Stage::kMeasure};  // the stages before it reuse DIR's files (identify always runs again: quick)
   std::string job_path;
   std::string out_dir;
-  int dwells{3};                         // the stops to measure
-  std::vector<std::string> hold_out;     // stops (dwell_<k>) kept out of the map, checked against it
-  std::vector<std::string> trajectory;   // the HIL emulator's robot path: T:Q1,Q2,... (robodamp plant --pose-at)
+  int dwells{3};                        // the stops to measure
+  std::vector<std::string> hold_out;    // stops (dwell_<k>) kept out of the map, checked against it
+  std::vector<std::string> trajectory;  // the HIL emulator's robot path: T:Q1,Q2,... (robodamp plant --pose-at)
   double still_deg{0.05};
   double max_run_s{3600.0};
-  tune::PoseTuneSettings pose_tune{};    // the sets' budgets, regions, overlap
-  int map_points{5};                     // the workspace map's grid per joint (pose tune --map-points)
+  tune::PoseTuneSettings pose_tune{};  // the sets' budgets, regions, overlap
+  int map_points{5};                   // the workspace map's grid per joint (pose tune --map-points)
   // Measured against predicted at each stop: the improvement within this many points, or the damped peak
   // itself (the open one over 1 + the improvement) within peak_tolerance of the predicted (a set that takes
   // a peak down 4 times is checked on what is left of it).
   double improvement_tolerance_points{5.0};
   double peak_tolerance{0.10};
-  double held_out_freq_tolerance_pct{2.0};   // the map against a stop held out of it
+  double held_out_freq_tolerance_pct{2.0};  // the map against a stop held out of it
   std::string command_line;
   std::string robodamp_binary;  // the emulator's executable (default: this process's)
 };
 
 // One stop: what was measured there, what the map and the chosen controller predict, what the cell did.
 struct PathStop {
-  std::string name;                  // dwell_<k>
+  std::string name;  // dwell_<k>
   std::vector<double> joints_deg;
   bool held_out{false};
-  double actuator_hz{0.0};           // identified at this stop (the actuator does not move with the pose)
-  std::string region;                // the tuned set that ran there (the hand-over's hysteresis along the path)
-  double gain_ns_per_m{0.0};         // its K (0: the damper off there)
+  double actuator_hz{0.0};                // identified at this stop (the actuator does not move with the pose)
+  std::string region;                     // the tuned set that ran there (the hand-over's hysteresis along the path)
+  double gain_ns_per_m{0.0};              // its K (0: the damper off there)
   double predicted_improvement_pct{0.0};  // the driving point, the set on the mapped model (discrete loop)
   double measured_improvement_pct{0.0};   // the emulator's impacts, control on against off
   double coherence_min{0.0};
   int records{0};
-  bool on_cell{false};               // the verify run measured it
+  bool on_cell{false};  // the verify run measured it
   // The job at its speed at this pose on the mapped model, the robot in its plane: open loop by SDM over the
   // model's modes (open_limit_mm) and over the loop's plant alone (loop_open_limit_mm, pose_schedule.modes),
   // damped by the sampled loop's SDM on that plant. Worse or not is judged against the same plant's open loop.
   double open_limit_mm{0.0}, loop_open_limit_mm{0.0}, damped_limit_mm{0.0};
-  std::string limit_note;            // why the damper's effect on the cut is not claimed there, if it is not
+  std::string limit_note;  // why the damper's effect on the cut is not claimed there, if it is not
   [[nodiscard]] bool improvement_held(double tolerance_points, double peak_tolerance) const;
   // The damped peak measured over the predicted one, minus one.
-  [[nodiscard]] double peak_error() const { return (100.0 + predicted_improvement_pct) / (100.0 + measured_improvement_pct) - 1.0; }
+  [[nodiscard]] double peak_error() const {
+    return (100.0 + predicted_improvement_pct) / (100.0 + measured_improvement_pct) - 1.0;
+  }
   [[nodiscard]] bool cut_not_worse() const {  // kNotWorse; with the damper off the cut is the open loop's
     return gain_ns_per_m == 0.0 || damped_limit_mm >= 0.995 * loop_open_limit_mm;
   }
@@ -86,13 +88,13 @@ struct PathCommissionResult {
   std::vector<analysis::ModeCheckRow> map_rows;  // the map at the measured and held-out stops
   double held_out_worst_freq_error_pct{0.0};
   int held_out_modes_missed{0};
-  double actuator_spread_pct{0.0};               // the actuator's natural frequency over the stops
+  double actuator_spread_pct{0.0};  // the actuator's natural frequency over the stops
   std::string mapped_model_path;
   std::optional<tune::WorkspaceTune> tuned;
-  std::string chosen;                            // "robust", "scheduled" or "as given"
-  std::vector<std::string> lowered;              // regions whose K was lowered: never worse than the open loop
+  std::string chosen;                // "robust", "scheduled" or "as given"
+  std::vector<std::string> lowered;  // regions whose K was lowered: never worse than the open loop
   double job_rpm{0.0};
-  std::string method;                            // of the limits
+  std::string method;  // of the limits
   std::string trip{"none"};
   unsigned long long pose_out_of_map{0}, saturated_ticks{0};
   std::string configuration_path, report_path;

@@ -33,8 +33,12 @@ int measured_stops(const std::vector<DwellMeasurement>& dwells) {
 class DwellWatch {
  public:
   DwellWatch(const config::Config& cfg, const analysis::CommissioningPlan& plan, const PathMeasureOptions& o)
-      : plan_(plan), o_(o), settle_s_(cfg.commissioning.settle_s), rest_limit_(cfg.commissioning.rest_accel_rms_mps2),
-        chirp_s_(cfg.commissioning.chirp_period_s * cfg.commissioning.chirp_periods), fs_hz_(cfg.loop.rate_hz),
+      : plan_(plan),
+        o_(o),
+        settle_s_(cfg.commissioning.settle_s),
+        rest_limit_(cfg.commissioning.rest_accel_rms_mps2),
+        chirp_s_(cfg.commissioning.chirp_period_s * cfg.commissioning.chirp_periods),
+        fs_hz_(cfg.loop.rate_hz),
         rest_sq_(static_cast<std::size_t>(std::lround(kRestWindowS * cfg.loop.rate_hz)), 0.0) {}
   void attach(runtime::Cell* cell) { cell_ = cell; }
   [[nodiscard]] const std::optional<std::pair<MeasureStatus, std::string>>& stopped() const { return stopped_; }
@@ -74,7 +78,8 @@ class DwellWatch {
     return rest_n_ == 0 ? 0.0 : std::sqrt(std::max(0.0, rest_sum_) / static_cast<double>(rest_n_));
   }
   void watch_chirp(const rt::TelemetryFrame& f) {
-    if (phase_ == Phase::kStartPosted && static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kStartExcitation) {
+    if (phase_ == Phase::kStartPosted &&
+        static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kStartExcitation) {
       DwellMeasurement& d = dwells_.back();
       d.chirp_start_s = static_cast<double>(f.tick + 1) / fs_hz_;  // the chirp's first sample is the next tick's
       d.chirp_end_s = d.chirp_start_s + chirp_s_;
@@ -85,7 +90,8 @@ class DwellWatch {
     }
     if (phase_ == Phase::kChirping && f.saturated_ticks > saturated0_) {
       char b[256];
-      std::snprintf(b, sizeof b, "the excitation saturates at dwell %d: the supervisor limited the command at %.3f s "
+      std::snprintf(b, sizeof b,
+                    "the excitation saturates at dwell %d: the supervisor limited the command at %.3f s "
                     "(%.3f V): the measurement would not be linear; stopped. Lower commissioning.chirp_force_fraction",
                     dwells_.back().index, f.time_s, f.command_v);
       stop(MeasureStatus::kSaturated, b);
@@ -107,16 +113,21 @@ class DwellWatch {
     d.moved_s = t_s;
     char b[200];
     if (phase_ == Phase::kStill || phase_ == Phase::kStartPosted) {
-      std::snprintf(b, sizeof b, "the robot moved %.2f s after it stopped, before the chirp (it needs commissioning.settle_s "
-                    "= %g s of stillness)", t_s - d.still_s, settle_s_);
+      std::snprintf(b, sizeof b,
+                    "the robot moved %.2f s after it stopped, before the chirp (it needs commissioning.settle_s "
+                    "= %g s of stillness)",
+                    t_s - d.still_s, settle_s_);
       skip(b);
     } else if (phase_ == Phase::kChirping) {
-      std::snprintf(b, sizeof b, "the robot moved at %.2f s, during the chirp (%.2f-%.2f s)", t_s, d.chirp_start_s, d.chirp_end_s);
+      std::snprintf(b, sizeof b, "the robot moved at %.2f s, during the chirp (%.2f-%.2f s)", t_s, d.chirp_start_s,
+                    d.chirp_end_s);
       d.measured = false;
       skip(b);
     } else if (phase_ == Phase::kHolding) {
-      spdlog::warn("robodamp measure: dwell {}: the robot left at {:.2f} s, {:.2f} s before the hammer's window ended: the "
-                   "plant side's impacts there may be incomplete", d.index, t_s, d.still_s + plan_.duration_s - t_s);
+      spdlog::warn(
+          "robodamp measure: dwell {}: the robot left at {:.2f} s, {:.2f} s before the hammer's window ended: the "
+          "plant side's impacts there may be incomplete",
+          d.index, t_s, d.still_s + plan_.duration_s - t_s);
     }
     phase_ = Phase::kMoving;
   }
@@ -133,8 +144,10 @@ class DwellWatch {
                      config::describe_pose(ref_), still_since_s_);
         phase_ = Phase::kStill;
         return;
-      case Phase::kStill: return start_chirp(f);
-      case Phase::kStartPosted: return;
+      case Phase::kStill:
+        return start_chirp(f);
+      case Phase::kStartPosted:
+        return;
       case Phase::kChirping:
         accumulate_pose();
         if (t < dwells_.back().chirp_end_s) return;
@@ -142,24 +155,30 @@ class DwellWatch {
         phase_ = Phase::kHolding;
         return;
       case Phase::kHolding:
-        if (t < dwells_.back().still_s + plan_.duration_s) return;  // the plant side's hammer, on a stopped plan's times
+        if (t < dwells_.back().still_s + plan_.duration_s)
+          return;  // the plant side's hammer, on a stopped plan's times
         phase_ = Phase::kDone;
         if (measured_stops(dwells_) >= o_.dwells) cell_->request_stop();
         return;
-      case Phase::kDone: return;
+      case Phase::kDone:
+        return;
     }
   }
   void start_chirp(const rt::TelemetryFrame& f) {
     if (f.time_s < still_since_s_ + settle_s_) return;
     char b[256];
     if (static_cast<rt::State>(f.state) != rt::State::kActive) {
-      std::snprintf(b, sizeof b, "the loop is %s when the chirp is due at %.2f s (the amplifier ready and a fresh sensor are "
-                    "needed)", rt::to_string(static_cast<rt::State>(f.state)), f.time_s);
+      std::snprintf(b, sizeof b,
+                    "the loop is %s when the chirp is due at %.2f s (the amplifier ready and a fresh sensor are "
+                    "needed)",
+                    rt::to_string(static_cast<rt::State>(f.state)), f.time_s);
       skip(b);
       phase_ = Phase::kDone;
     } else if (rest_rms_mps2() > rest_limit_) {
-      std::snprintf(b, sizeof b, "the cell is not at rest when the chirp is due, %.3f m/s^2 RMS over the last second "
-                    "(commissioning.rest_accel_rms_mps2 = %g)", rest_rms_mps2(), rest_limit_);
+      std::snprintf(b, sizeof b,
+                    "the cell is not at rest when the chirp is due, %.3f m/s^2 RMS over the last second "
+                    "(commissioning.rest_accel_rms_mps2 = %g)",
+                    rest_rms_mps2(), rest_limit_);
       skip(b);
       phase_ = Phase::kDone;
     } else if (cell_->post({rt::CommandKind::kStartExcitation, 0.0})) {
@@ -172,7 +191,8 @@ class DwellWatch {
     const std::vector<double> q = cell_->robot_pose_deg();
     if (q.size() != d.joints_deg.size()) return;
     ++pose_n_;
-    for (std::size_t i = 0; i < q.size(); ++i) d.joints_deg[i] += (q[i] - d.joints_deg[i]) / static_cast<double>(pose_n_);
+    for (std::size_t i = 0; i < q.size(); ++i)
+      d.joints_deg[i] += (q[i] - d.joints_deg[i]) / static_cast<double>(pose_n_);
   }
 
   analysis::CommissioningPlan plan_;
@@ -213,10 +233,12 @@ void judge(MeasureOutcome& out, const runtime::RunSummary& s, const DwellWatch& 
     out.status = watch.stopped()->first, out.message = watch.stopped()->second;
   } else if (const int sig = rt::shutdown_signal().load(); sig != 0) {
     out.status = MeasureStatus::kAborted;
-    out.message = "aborted by the operator (signal " + std::to_string(sig) + "): the dwells measured before it are kept";
+    out.message =
+        "aborted by the operator (signal " + std::to_string(sig) + "): the dwells measured before it are kept";
   } else if (s.trip != "none") {
     out.status = MeasureStatus::kTripped;
-    out.message = "the loop tripped (" + s.trip + " - " + s.trip_description + "): the dwells measured before it are kept";
+    out.message =
+        "the loop tripped (" + s.trip + " - " + s.trip_description + "): the dwells measured before it are kept";
   } else if (measured < o.dwells) {
     out.status = MeasureStatus::kIncomplete;
     out.message = std::to_string(measured) + " of " + std::to_string(o.dwells) + " dwells measured in the run's " +
@@ -246,19 +268,27 @@ void write_dwell(const MeasureOutcome& run, DwellMeasurement& d, const std::stri
   for (double& t : m.plan.impacts_start_s) t += shift_s;
   m.pose_deg = d.joints_deg, m.pose_name = d.name;
   m.robot_model = fs::absolute(cfg.pose_schedule->model_resolved).lexically_normal().string();
-  m.run["dwell"] = {{"index", d.index}, {"still_s", d.still_s}, {"chirp_start_s", d.chirp_start_s},
-                    {"chirp_end_s", d.chirp_end_s}, {"moved_s", d.moved_s}};
+  m.run["dwell"] = {{"index", d.index},
+                    {"still_s", d.still_s},
+                    {"chirp_start_s", d.chirp_start_s},
+                    {"chirp_end_s", d.chirp_end_s},
+                    {"moved_s", d.moved_s}};
   detail::write_outputs(o, d.dir, false, !impacts);
   if (o.status != MeasureStatus::kOk) throw std::runtime_error(o.message);
 }
 
-void write_index(const std::string& out_dir, const std::string& config_path, const std::vector<DwellMeasurement>& dwells) {
-  nlohmann::json index = {{"format", "robodamp-pose-measurements"}, {"format_version", 1},
+void write_index(const std::string& out_dir, const std::string& config_path,
+                 const std::vector<DwellMeasurement>& dwells) {
+  nlohmann::json index = {{"format", "robodamp-pose-measurements"},
+                          {"format_version", 1},
                           {"config_source", fs::absolute(config_path).lexically_normal().string()},
-                          {"along_path", true}, {"poses", nlohmann::json::array()}, {"skipped", nlohmann::json::array()}};
+                          {"along_path", true},
+                          {"poses", nlohmann::json::array()},
+                          {"skipped", nlohmann::json::array()}};
   for (const auto& d : dwells) {
     if (d.measured)
-      index["poses"].push_back({{"name", d.name}, {"joints_deg", d.joints_deg}, {"dir", d.name}, {"status", 0}, {"message", ""}});
+      index["poses"].push_back(
+          {{"name", d.name}, {"joints_deg", d.joints_deg}, {"dir", d.name}, {"status", 0}, {"message", ""}});
     else
       index["skipped"].push_back({{"name", d.name}, {"still_s", d.still_s}, {"reason", d.skipped}});
   }
@@ -273,8 +303,8 @@ void write_index(const std::string& out_dir, const std::string& config_path, con
 int PathMeasureOutcome::measured() const { return measured_stops(dwells); }
 
 // The run: configured, watched, run, judged, then one directory per measured stop.
-PathMeasureOutcome measure_along_path(const config::Config& cfg, const std::string& config_path, const std::string& out_dir,
-                                      const PathMeasureOptions& opt) {
+PathMeasureOutcome measure_along_path(const config::Config& cfg, const std::string& config_path,
+                                      const std::string& out_dir, const PathMeasureOptions& opt) {
   check_options(cfg, opt);
   const sim::PlantModel model = sim::build_plant_model(cfg);
   const analysis::CommissioningPlan plan = detail::plan_for(cfg, model, opt.measure);
@@ -283,11 +313,13 @@ PathMeasureOutcome measure_along_path(const config::Config& cfg, const std::stri
   MeasureOutcome& out = result.run;
   const auto& c = cfg.commissioning;
   runtime::CellOptions o;
-  if (!opt.measure.clock.empty()) o.clock = opt.measure.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
+  if (!opt.measure.clock.empty())
+    o.clock = opt.measure.clock == "wall" ? config::ClockKind::kWall : config::ClockKind::kVirtual;
   o.record_path = (fs::path(out_dir) / identify::kRecordingName).string();
   o.pose_schedule_off = true, o.watch_joints = true;
-  o.chirp = {true, 0.0, c.chirp_period_s, c.chirp_periods, c.chirp_f0_hz, c.chirp_f1_hz, plan.chirp_amplitude_v,
-             0.5 * c.chirp_period_s, true};
+  o.chirp = {true,          0.0,           c.chirp_period_s,       c.chirp_periods,
+             c.chirp_f0_hz, c.chirp_f1_hz, plan.chirp_amplitude_v, 0.5 * c.chirp_period_s,
+             true};
   detail::fill_manifest(out.manifest, config_path, cfg, model, plan);
   DwellWatch watch(cfg, plan, opt);
   o.on_frame = [&watch](const rt::TelemetryFrame& f) { watch.on_frame(f); };
@@ -300,10 +332,12 @@ PathMeasureOutcome measure_along_path(const config::Config& cfg, const std::stri
   watch.attach(&cell);
   out.manifest.backend = cell.hardware() ? "hardware" : "simulated plant";
   rt::install_shutdown_handlers();
-  spdlog::info("robodamp measure: along the path, {} dwells at most {} s: at each stop of the robot (its joints within {} deg "
-               "for commissioning.settle_s = {} s) the chirp, {} periods of {} s at {:.3f} V, then the plant side's hammer "
-               "until {:.1f} s after the stop", opt.dwells, opt.max_run_s, opt.still_deg, c.settle_s, c.chirp_periods,
-               c.chirp_period_s, plan.chirp_amplitude_v, plan.duration_s);
+  spdlog::info(
+      "robodamp measure: along the path, {} dwells at most {} s: at each stop of the robot (its joints within {} deg "
+      "for commissioning.settle_s = {} s) the chirp, {} periods of {} s at {:.3f} V, then the plant side's hammer "
+      "until {:.1f} s after the stop",
+      opt.dwells, opt.max_run_s, opt.still_deg, c.settle_s, c.chirp_periods, c.chirp_period_s, plan.chirp_amplitude_v,
+      plan.duration_s);
   if (runtime::Status s = cell.activate(opt.max_run_s); !s.ok()) {
     out.status = MeasureStatus::kFailed;
     out.message = s.message;
@@ -315,10 +349,15 @@ PathMeasureOutcome measure_along_path(const config::Config& cfg, const std::stri
   out.final_state = s.final_state, out.trip = s.trip;
   out.saturated_ticks = s.supervisor.saturated_ticks, out.peak_command_v = s.peak_command_v;
   out.recorded_frames = s.recorded_frames;
-  out.manifest.run = {{"final_state", s.final_state}, {"trip", s.trip}, {"saturated_ticks", s.supervisor.saturated_ticks},
-                      {"peak_command_v", s.peak_command_v}, {"recorded_frames", s.recorded_frames},
-                      {"record_errors", s.record_errors}, {"impacts", opt.measure.impacts},
-                      {"control_on", opt.measure.control_on}, {"along_path", true},
+  out.manifest.run = {{"final_state", s.final_state},
+                      {"trip", s.trip},
+                      {"saturated_ticks", s.supervisor.saturated_ticks},
+                      {"peak_command_v", s.peak_command_v},
+                      {"recorded_frames", s.recorded_frames},
+                      {"record_errors", s.record_errors},
+                      {"impacts", opt.measure.impacts},
+                      {"control_on", opt.measure.control_on},
+                      {"along_path", true},
                       {"gain_ns_per_m", opt.measure.control_on ? cfg.controller.gain_ns_per_m : 0.0}};
   result.dwells = watch.dwells();
   judge(out, s, watch, opt, result.measured());

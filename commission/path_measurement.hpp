@@ -21,26 +21,26 @@
 namespace robodamp::commission {
 
 struct PathMeasureOptions {
-  MeasureOptions measure;  // clock, impacts (the plant side's hammer), control_on; pose_deg must be empty
-  int dwells{1};           // the run ends once this many dwells are measured
+  MeasureOptions measure;    // clock, impacts (the plant side's hammer), control_on; pose_deg must be empty
+  int dwells{1};             // the run ends once this many dwells are measured
   double max_run_s{3600.0};  // ... or after this long, whatever was measured
   double still_deg{0.05};    // a joint further than this from the dwell's pose: the robot moves
 };
 
 struct DwellMeasurement {
-  int index{0};          // 1: the robot's first stop since the run began
-  std::string name;      // dwell_<index>
-  std::string dir;       // absolute; empty when the dwell was not measured
+  int index{0};                    // 1: the robot's first stop since the run began
+  std::string name;                // dwell_<index>
+  std::string dir;                 // absolute; empty when the dwell was not measured
   std::vector<double> joints_deg;  // the mean of the joints read during the chirp
-  double still_s{0.0};   // loop time the joints stood still from
+  double still_s{0.0};             // loop time the joints stood still from
   double chirp_start_s{0.0}, chirp_end_s{0.0};
   double moved_s{-1.0};  // when the robot left (-1: it did not before the run ended)
   bool measured{false};
-  std::string skipped;   // why not, when not measured
+  std::string skipped;  // why not, when not measured
 };
 
 struct PathMeasureOutcome {
-  MeasureOutcome run;    // the run as a whole (status, message, state, trip, saturation, frames)
+  MeasureOutcome run;                    // the run as a whole (status, message, state, trip, saturation, frames)
   std::vector<DwellMeasurement> dwells;  // every stop seen, measured or not
   [[nodiscard]] int measured() const;
 };

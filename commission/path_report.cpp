@@ -85,15 +85,17 @@ std::string modes_figure(const PathCommissionSettings& s, const PathCommissionRe
   }
   std::ostringstream p;
   p << "set terminal pngcairo noenhanced size 1100,520 font ',10'\nset grid\nset key outside right\n"
-       "set xlabel 'joint " << j + 1 << " (deg)'\nset ylabel 'mode frequency (Hz)'\nplot ";
+       "set xlabel 'joint "
+    << j + 1 << " (deg)'\nset ylabel 'mode frequency (Hz)'\nplot ";
   for (std::size_t m = 0; m < modes; ++m)
-    p << "DATA index 0 using 1:" << m + 2 << " with lines lw 2 lc rgb '#3367d6' title '" << (m == 0 ? "mapped along the path" : "")
-      << "', ";
+    p << "DATA index 0 using 1:" << m + 2 << " with lines lw 2 lc rgb '#3367d6' title '"
+      << (m == 0 ? "mapped along the path" : "") << "', ";
   p << "DATA index 1 using 1:2 with points pt 7 ps 1.4 lc rgb '#1d2430' title 'measured, in the map', "
        "DATA index 2 using 1:2 with points pt 6 ps 1.8 lw 2 lc rgb '#d0342c' title 'measured, held out'\n";
-  return figure(dir, "path_modes", p.str(), d.str(),
-                "The modes along the path: the map (lines) through the modes identified at the stops in it (filled), checked "
-                "at the stops held out (open)");
+  return figure(
+      dir, "path_modes", p.str(), d.str(),
+      "The modes along the path: the map (lines) through the modes identified at the stops in it (filled), checked "
+      "at the stops held out (open)");
 }
 
 // At each stop: the driving point's improvement measured on the cell and predicted on the map; the job's limit
@@ -103,19 +105,23 @@ std::string stops_figure(const PathCommissionResult& r, const fs::path& dir) {
   const std::size_t j = moving_joint(r.stops);
   std::ostringstream d;
   for (const auto& s : r.stops)
-    d << num(s.joints_deg[j]) << ' ' << num(s.on_cell ? s.measured_improvement_pct : NAN) << ' ' << num(s.predicted_improvement_pct)
-      << ' ' << num(s.damped_limit_mm) << ' ' << num(s.open_limit_mm) << '\n';
+    d << num(s.joints_deg[j]) << ' ' << num(s.on_cell ? s.measured_improvement_pct : NAN) << ' '
+      << num(s.predicted_improvement_pct) << ' ' << num(s.damped_limit_mm) << ' ' << num(s.open_limit_mm) << '\n';
   std::ostringstream p;
-  p << "set terminal pngcairo noenhanced size 1100,760 font ',10'\nset multiplot layout 2,1\nset grid\nset key outside right\n"
-       "set xlabel 'joint " << j + 1 << " (deg)'\nset ylabel 'driving-point improvement (%)'\n"
+  p << "set terminal pngcairo noenhanced size 1100,760 font ',10'\nset multiplot layout 2,1\nset grid\nset key outside "
+       "right\n"
+       "set xlabel 'joint "
+    << j + 1
+    << " (deg)'\nset ylabel 'driving-point improvement (%)'\n"
        "plot DATA using 1:3 with points pt 6 ps 2 lw 2 lc rgb '#3367d6' title 'predicted on the map', "
        "DATA using 1:2 with points pt 7 ps 1.3 lc rgb '#1d2430' title 'measured on the cell'\n"
        "set ylabel 'the job at its speed (mm)'\nset yrange [0:*]\n"
        "plot DATA using 1:4 with points pt 7 ps 1.5 lc rgb '#2e9e4f' title 'damped', "
        "DATA using 1:5 with points pt 4 ps 1.5 lw 2 lc rgb '#7a8494' title 'open loop'\nunset multiplot\n";
-  return figure(dir, "path_stops", p.str(), d.str(),
-                "At each stop: the improvement measured on the cell against the map's prediction (top); the job's limiting "
-                "depth at its speed, damped and open loop (bottom)");
+  return figure(
+      dir, "path_stops", p.str(), d.str(),
+      "At each stop: the improvement measured on the cell against the map's prediction (top); the job's limiting "
+      "depth at its speed, damped and open loop (bottom)");
 }
 
 std::string stops_table(const PathCommissionSettings& s, const PathCommissionResult& r) {
@@ -126,40 +132,50 @@ std::string stops_table(const PathCommissionSettings& s, const PathCommissionRes
   for (const auto& st : r.stops) {
     const bool held = st.improvement_held(s.improvement_tolerance_points, s.peak_tolerance), cut = st.cut_not_worse();
     h << "<tr><td>" << esc(st.name) << "</td><td>" << esc(config::describe_pose(st.joints_deg)) << "</td><td>"
-      << (st.held_out ? "held out" : "in it") << "</td><td>" << fmt("%.3f", st.actuator_hz) << "</td><td>" << esc(st.region) << fmt(", K %.0f", st.gain_ns_per_m)
-      << "</td><td>" << (st.on_cell ? fmt("%.1f", st.measured_improvement_pct) : std::string("-")) << "</td><td>"
+      << (st.held_out ? "held out" : "in it") << "</td><td>" << fmt("%.3f", st.actuator_hz) << "</td><td>"
+      << esc(st.region) << fmt(", K %.0f", st.gain_ns_per_m) << "</td><td>"
+      << (st.on_cell ? fmt("%.1f", st.measured_improvement_pct) : std::string("-")) << "</td><td>"
       << fmt("%.1f", st.predicted_improvement_pct) << "</td><td>" << st.records << "</td><td>"
-      << fmt("%.3f / %.3f", st.damped_limit_mm, st.open_limit_mm) << "</td><td>" << fmt("%.3f", st.loop_open_limit_mm) << "</td><td class=" << (held && cut ? "ok" : "bad") << ">"
+      << fmt("%.3f / %.3f", st.damped_limit_mm, st.open_limit_mm) << "</td><td>" << fmt("%.3f", st.loop_open_limit_mm)
+      << "</td><td class=" << (held && cut ? "ok" : "bad") << ">"
       << (!st.on_cell ? "not measured on the cell"
-                      : !held ? fmt("off by %.1f points, the damped peak %+.0f %%", st.measured_improvement_pct - st.predicted_improvement_pct,
-                                    100.0 * st.peak_error())
-                              : !cut ? std::string("the damper makes the cut worse") : std::string("held"))
+          : !held     ? fmt("off by %.1f points, the damped peak %+.0f %%",
+                            st.measured_improvement_pct - st.predicted_improvement_pct, 100.0 * st.peak_error())
+          : !cut      ? std::string("the damper makes the cut worse")
+                      : std::string("held"))
       << "</td></tr>\n";
   }
-  h << "</table>\n<p>The improvement: the driving point's receptance peak, open over closed, minus one, from the emulator's "
+  h << "</table>\n<p>The improvement: the driving point's receptance peak, open over closed, minus one, from the "
+       "emulator's "
        "impacts at each stop with the controller running against the same impacts on the robot standing there with the "
-       "amplifier off; predicted by the set that runs there (the hand-over's hysteresis along the path) on the mapped model "
-       "(discrete loop); allowed " << fmt("%.1f", s.improvement_tolerance_points) << " points, or the damped peak within "
+       "amplifier off; predicted by the set that runs there (the hand-over's hysteresis along the path) on the mapped "
+       "model "
+       "(discrete loop); allowed "
+    << fmt("%.1f", s.improvement_tolerance_points) << " points, or the damped peak within "
     << fmt("%.0f", 100.0 * s.peak_tolerance) << " % of the predicted. The job: its limiting depth at "
-    << fmt("%.0f", r.job_rpm) << " rpm by " << esc(r.method) << "; the open loop over the model's modes, and over the loop's plant alone (its lowest "
+    << fmt("%.0f", r.job_rpm) << " rpm by " << esc(r.method)
+    << "; the open loop over the model's modes, and over the loop's plant alone (its lowest "
        "modes, as the damped limit sees them): the damper is worse where the damped limit is below the latter.</p>\n";
   return h.str();
 }
 
 std::string map_table(const PathCommissionResult& r) {
   std::ostringstream h;
-  h << "<h2>The map</h2>\n<p>The modes of " << esc(r.mapped_model_path) << " against those identified at each stop (at a "
+  h << "<h2>The map</h2>\n<p>The modes of " << esc(r.mapped_model_path)
+    << " against those identified at each stop (at a "
        "stop held out of it, the map's check: the largest frequency error "
     << fmt("%.2f %%, %d mode(s) missed", r.held_out_worst_freq_error_pct, r.held_out_modes_missed)
-    << "). The actuator identified at each stop spreads " << fmt("%.2f %%", r.actuator_spread_pct) << " in frequency.</p>\n"
-    << "<table><tr><th>stop</th><th>role</th><th>measured (Hz)</th><th>mapped (Hz)</th><th>error (%)</th><th>sigma (%)</th>"
+    << "). The actuator identified at each stop spreads " << fmt("%.2f %%", r.actuator_spread_pct)
+    << " in frequency.</p>\n"
+    << "<table><tr><th>stop</th><th>role</th><th>measured (Hz)</th><th>mapped (Hz)</th><th>error (%)</th><th>sigma "
+       "(%)</th>"
        "<th>stiffness error (%)</th><th>nearest stop in the map (deg)</th></tr>\n";
   for (const auto& row : r.map_rows)
     h << "<tr><td>" << esc(row.pose) << "</td><td>" << (row.held_out ? "held out" : "in the map") << "</td><td>"
       << fmt("%.3f", row.measured_hz) << "</td><td>" << fmt("%.3f", row.mapped_hz) << "</td><td>"
       << fmt("%+.2f", 100.0 * (row.mapped_hz / row.measured_hz - 1.0)) << "</td><td>" << fmt("%.2f", row.freq_sigma_pct)
-      << "</td><td>" << fmt("%+.1f", 100.0 * (row.mapped_stiffness_n_per_m / row.measured_stiffness_n_per_m - 1.0)) << "</td><td>"
-      << fmt("%.1f", row.nearest_measured_deg) << "</td></tr>\n";
+      << "</td><td>" << fmt("%+.1f", 100.0 * (row.mapped_stiffness_n_per_m / row.measured_stiffness_n_per_m - 1.0))
+      << "</td><td>" << fmt("%.1f", row.nearest_measured_deg) << "</td></tr>\n";
   h << "</table>\n";
   return h.str();
 }
@@ -167,20 +183,24 @@ std::string map_table(const PathCommissionResult& r) {
 std::string tuned_table(const PathCommissionResult& r) {
   if (!r.tuned) return {};
   std::ostringstream h;
-  h << "<h2>The controllers compared on the workspace map</h2>\n<table><tr><th>controller</th><th>regions</th><th>stable at every "
-       "map pose</th><th>worst mode in the damping band (%)</th><th>worst driving point (%)</th><th>the job's smallest damped "
+  h << "<h2>The controllers compared on the workspace "
+       "map</h2>\n<table><tr><th>controller</th><th>regions</th><th>stable at every "
+       "map pose</th><th>worst mode in the damping band (%)</th><th>worst driving point (%)</th><th>the job's smallest "
+       "damped "
        "depth (mm)</th></tr>\n";
   for (std::size_t i = 0; i < r.tuned->scores.controllers.size(); ++i) {
     const tune::ControllerScore& c = r.tuned->scores.controllers[i];
     const std::size_t regions = i == 0 ? 1 : i == 1 ? r.tuned->scheduled.size() : 0;
     h << "<tr><td>" << esc(c.name) << (i == r.tuned->best ? " (chosen)" : "") << "</td><td>"
-      << (i < 2 ? std::to_string(regions) : std::string("as configured")) << "</td><td>" << (c.stable_everywhere ? "yes" : "NO")
-      << "</td><td>" << fmt("%+.1f", c.worst_mode_improvement_pct) << "</td><td>" << fmt("%+.1f", c.worst_improvement_pct)
-      << "</td><td>" << (c.damped_min_mm ? fmt("%.4f", *c.damped_min_mm) : std::string("-")) << "</td></tr>\n";
+      << (i < 2 ? std::to_string(regions) : std::string("as configured")) << "</td><td>"
+      << (c.stable_everywhere ? "yes" : "NO") << "</td><td>" << fmt("%+.1f", c.worst_mode_improvement_pct)
+      << "</td><td>" << fmt("%+.1f", c.worst_improvement_pct) << "</td><td>"
+      << (c.damped_min_mm ? fmt("%.4f", *c.damped_min_mm) : std::string("-")) << "</td></tr>\n";
   }
   h << "</table>\n";
   if (!r.lowered.empty()) {
-    h << "<p>Never worse than no damper at the job's speed (tune/never_worse.hpp: each set checked along its region and at "
+    h << "<p>Never worse than no damper at the job's speed (tune/never_worse.hpp: each set checked along its region "
+         "and at "
          "every map pose and stop inside it):";
     for (const auto& l : r.lowered) h << " " << esc(l) << ";";
     h << "</p>\n";
@@ -193,54 +213,85 @@ std::string tuned_table(const PathCommissionResult& r) {
 json to_json(const PathCommissionResult& r) {
   json stops = json::array();
   for (const auto& s : r.stops)
-    stops.push_back({{"name", s.name}, {"joints_deg", s.joints_deg}, {"held_out", s.held_out}, {"actuator_hz", s.actuator_hz},
-                     {"region", s.region}, {"gain_ns_per_m", s.gain_ns_per_m}, {"predicted_improvement_pct", s.predicted_improvement_pct},
+    stops.push_back({{"name", s.name},
+                     {"joints_deg", s.joints_deg},
+                     {"held_out", s.held_out},
+                     {"actuator_hz", s.actuator_hz},
+                     {"region", s.region},
+                     {"gain_ns_per_m", s.gain_ns_per_m},
+                     {"predicted_improvement_pct", s.predicted_improvement_pct},
                      {"measured_improvement_pct", s.on_cell ? json(s.measured_improvement_pct) : json(nullptr)},
                      {"damped_peak_error_pct", s.on_cell ? json(100.0 * s.peak_error()) : json(nullptr)},
-                     {"records", s.records}, {"coherence_min", s.coherence_min}, {"open_limit_mm", s.open_limit_mm}, {"loop_open_limit_mm", s.loop_open_limit_mm},
+                     {"records", s.records},
+                     {"coherence_min", s.coherence_min},
+                     {"open_limit_mm", s.open_limit_mm},
+                     {"loop_open_limit_mm", s.loop_open_limit_mm},
                      {"damped_limit_mm", s.damped_limit_mm}});
   json rows = json::array();
   for (const auto& row : r.map_rows)
-    rows.push_back({{"pose", row.pose}, {"joints_deg", row.joints_deg}, {"held_out", row.held_out}, {"measured_hz", row.measured_hz},
+    rows.push_back({{"pose", row.pose},
+                    {"joints_deg", row.joints_deg},
+                    {"held_out", row.held_out},
+                    {"measured_hz", row.measured_hz},
                     {"mapped_hz", std::isfinite(row.mapped_hz) ? json(row.mapped_hz) : json(nullptr)},
-                    {"freq_sigma_pct", row.freq_sigma_pct}, {"measured_stiffness_n_per_m", row.measured_stiffness_n_per_m},
+                    {"freq_sigma_pct", row.freq_sigma_pct},
+                    {"measured_stiffness_n_per_m", row.measured_stiffness_n_per_m},
                     {"mapped_stiffness_n_per_m", row.mapped_stiffness_n_per_m}});
   json times = json::array();
   for (const auto& t : r.times) times.push_back({{"stage", to_string(t.stage)}, {"wall_s", t.wall_s}});
-  json out = {{"outcome", r.outcome == Outcome::kVerified ? "verified" : "not verified"}, {"stage", to_string(r.stage)},
-              {"reason", r.reason}, {"wall_s", r.wall_s}, {"times", times}, {"stops", stops}, {"map", rows},
-              {"held_out_worst_freq_error_pct", r.held_out_worst_freq_error_pct}, {"held_out_modes_missed", r.held_out_modes_missed},
-              {"actuator_spread_pct", r.actuator_spread_pct}, {"mapped_model", r.mapped_model_path}, {"chosen", r.chosen},
+  json out = {{"outcome", r.outcome == Outcome::kVerified ? "verified" : "not verified"},
+              {"stage", to_string(r.stage)},
+              {"reason", r.reason},
+              {"wall_s", r.wall_s},
+              {"times", times},
+              {"stops", stops},
+              {"map", rows},
+              {"held_out_worst_freq_error_pct", r.held_out_worst_freq_error_pct},
+              {"held_out_modes_missed", r.held_out_modes_missed},
+              {"actuator_spread_pct", r.actuator_spread_pct},
+              {"mapped_model", r.mapped_model_path},
+              {"chosen", r.chosen},
               {"gains_lowered", r.lowered},
-              {"job_rpm", r.job_rpm}, {"method", r.method}, {"trip", r.trip}, {"pose_out_of_map", r.pose_out_of_map},
-              {"saturated_ticks", r.saturated_ticks}, {"configuration", r.configuration_path}};
+              {"job_rpm", r.job_rpm},
+              {"method", r.method},
+              {"trip", r.trip},
+              {"pose_out_of_map", r.pose_out_of_map},
+              {"saturated_ticks", r.saturated_ticks},
+              {"configuration", r.configuration_path}};
   return out;
 }
 
-std::string write_path_report(const PathCommissionSettings& s, const PathCommissionResult& r, const std::string& html_path) {
+std::string write_path_report(const PathCommissionSettings& s, const PathCommissionResult& r,
+                              const std::string& html_path) {
   const fs::path dir = fs::path(html_path).parent_path();
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>robodamp commission along the path: " << esc(s.config_path)
-    << "</title>\n<style>body{font-family:sans-serif;max-width:1250px;margin:auto;padding:1em}table{border-collapse:collapse;"
-       "margin:0.5em 0}td,th{border:1px solid #bbb;padding:3px 8px;text-align:right}th{background:#eee}td:first-child{text-align:left}"
+  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>robodamp commission along the path: "
+    << esc(s.config_path)
+    << "</"
+       "title>\n<style>body{font-family:sans-serif;max-width:1250px;margin:auto;padding:1em}table{border-collapse:"
+       "collapse;"
+       "margin:0.5em 0}td,th{border:1px solid #bbb;padding:3px "
+       "8px;text-align:right}th{background:#eee}td:first-child{text-align:left}"
        ".ok{color:#1e8449}.bad{color:#c0392b;font-weight:bold}.banner{padding:0.6em;font-size:1.2em;border-radius:4px}"
-       ".pass{background:#d5f5e3}.fail{background:#fadbd8}img{max-width:100%}code{background:#f4f4f4}</style></head><body>\n"
+       ".pass{background:#d5f5e3}.fail{background:#fadbd8}img{max-width:100%}code{background:#f4f4f4}</style></"
+       "head><body>\n"
     << "<h1>robodamp commission along the path</h1>\n<p>Cell <code>" << esc(s.config_path) << "</code>, job <code>"
     << esc(s.job_path) << "</code>; robodamp " << rt::version() << " (" << rt::git_commit() << ").<br>Command: <code>"
     << esc(s.command_line) << "</code></p>\n";
   if (r.outcome == Outcome::kVerified)
-    h << "<p class=\"banner pass\">VERIFIED at every stop: " << esc(r.configuration_path) << " written (the " << esc(r.chosen)
-      << " controller).</p>\n";
+    h << "<p class=\"banner pass\">VERIFIED at every stop: " << esc(r.configuration_path) << " written (the "
+      << esc(r.chosen) << " controller).</p>\n";
   else
     h << "<p class=\"banner fail\">NOT VERIFIED: stopped at the " << to_string(r.stage) << " stage: " << esc(r.reason)
       << ". Nothing written as configuration.yaml.</p>\n";
   h << "<table><tr><th>stage</th><th>wall time (s)</th></tr>\n";
   for (const auto& t : r.times)
-    h << "<tr><td>" << to_string(t.stage) << (t.reused ? " (reused from the directory)" : "") << "</td><td>" << fmt("%.1f", t.wall_s)
-      << "</td></tr>\n";
+    h << "<tr><td>" << to_string(t.stage) << (t.reused ? " (reused from the directory)" : "") << "</td><td>"
+      << fmt("%.1f", t.wall_s) << "</td></tr>\n";
   h << "<tr><td>total</td><td>" << fmt("%.1f", r.wall_s) << "</td></tr></table>\n";
   try {
-    h << stops_table(s, r) << stops_figure(r, dir / "plots") << map_table(r) << modes_figure(s, r, dir / "plots") << tuned_table(r);
+    h << stops_table(s, r) << stops_figure(r, dir / "plots") << map_table(r) << modes_figure(s, r, dir / "plots")
+      << tuned_table(r);
   } catch (const std::exception& e) {
     h << "<p class=bad>" << esc(e.what()) << "</p>\n";
   }

@@ -18,13 +18,19 @@ std::vector<config::RobotPoseConfig> read_measurement_poses(const std::string& c
                                                             const std::string& poses_file) {
   const config::Config cfg = config::load_config_file(config_path);
   if (cfg.can)
-    throw config::ConfigError({config::Problem{cfg.source, {}, "can",
-                                               "is set: --poses measures one pose after the other without stopping, which "
-                                               "only the simulated plant can follow; on hardware move the robot and run "
-                                               "robodamp measure --pose Q1 Q2 ... --out DIR/<pose> at each pose"}});
+    throw config::ConfigError(
+        {config::Problem{cfg.source,
+                         {},
+                         "can",
+                         "is set: --poses measures one pose after the other without stopping, which "
+                         "only the simulated plant can follow; on hardware move the robot and run "
+                         "robodamp measure --pose Q1 Q2 ... --out DIR/<pose> at each pose"}});
   if (!cfg.pose_schedule)
-    throw config::ConfigError({config::Problem{cfg.source, {}, "pose_schedule.model",
-                                               "is missing: --poses needs the robot model whose joints the poses name"}});
+    throw config::ConfigError(
+        {config::Problem{cfg.source,
+                         {},
+                         "pose_schedule.model",
+                         "is missing: --poses needs the robot model whose joints the poses name"}});
   const config::RobotModelConfig model = config::load_robot_model(cfg.pose_schedule->model_resolved);
   return config::parse_pose_list(config::detail::read_config_text(poses_file), poses_file, model);
 }
@@ -47,22 +53,28 @@ void write_index(const std::string& out_dir, const nlohmann::json& index) {
 }  // namespace
 
 std::vector<PoseMeasurement> measure_poses(const std::string& config_path,
-                                           const std::vector<config::RobotPoseConfig>& poses, const std::string& out_dir,
-                                           const MeasureOptions& o, const std::function<void(const PoseMeasurement&)>& each) {
+                                           const std::vector<config::RobotPoseConfig>& poses,
+                                           const std::string& out_dir, const MeasureOptions& o,
+                                           const std::function<void(const PoseMeasurement&)>& each) {
   std::vector<PoseMeasurement> done;
-  nlohmann::json index = {{"format", "robodamp-pose-measurements"}, {"format_version", 1},
+  nlohmann::json index = {{"format", "robodamp-pose-measurements"},
+                          {"format_version", 1},
                           {"config_source", fs::absolute(config_path).lexically_normal().string()},
                           {"poses", nlohmann::json::array()}};
   fs::create_directories(out_dir);
   for (const auto& p : poses) {
-    PoseMeasurement m{p.name, p.joints_deg, fs::absolute(fs::path(out_dir) / pose_dir_name(p.name)).lexically_normal().string(), {}};
+    PoseMeasurement m{
+        p.name, p.joints_deg, fs::absolute(fs::path(out_dir) / pose_dir_name(p.name)).lexically_normal().string(), {}};
     spdlog::info("robodamp measure: pose '{}' {} into {}", p.name, config::describe_pose(p.joints_deg), m.dir);
     MeasureOptions at = o;
     at.pose_deg = p.joints_deg;
     at.pose_name = p.name;
     m.outcome = measure(config_path, m.dir, at);
-    index["poses"].push_back({{"name", m.name}, {"joints_deg", m.joints_deg}, {"dir", fs::path(m.dir).filename().string()},
-                              {"status", exit_code(m.outcome.status)}, {"message", m.outcome.message}});
+    index["poses"].push_back({{"name", m.name},
+                              {"joints_deg", m.joints_deg},
+                              {"dir", fs::path(m.dir).filename().string()},
+                              {"status", exit_code(m.outcome.status)},
+                              {"message", m.outcome.message}});
     write_index(out_dir, index);  // after each pose: an interrupted sequence keeps what it measured
     done.push_back(m);
     if (each) each(done.back());

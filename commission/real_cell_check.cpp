@@ -33,7 +33,9 @@ double peak_near(const std::vector<double>& f_hz, const std::vector<double>& mag
   return best;
 }
 
-Complex ratio(const analysis::FrfEstimate& a, const analysis::FrfEstimate& b, std::size_t i) { return a.h1[i] / b.h1[i]; }
+Complex ratio(const analysis::FrfEstimate& a, const analysis::FrfEstimate& b, std::size_t i) {
+  return a.h1[i] / b.h1[i];
+}
 
 void compare_loop(LoopGainCheck& c, double min_coherence) {
   for (std::size_t i = 0; i < c.f_hz.size(); ++i) {
@@ -50,10 +52,12 @@ void compare_loop(LoopGainCheck& c, double min_coherence) {
 }  // namespace
 
 ChirpLoopFrfs read_chirp_loop(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw std::invalid_argument(path + " is missing: robodamp measure records the loop there");
+  if (!std::filesystem::exists(path))
+    throw std::invalid_argument(path + " is missing: robodamp measure records the loop there");
   const rt::Recording rec = rt::read_recording(path);
   const rt::PeriodicChirp chirp = rt::excitation_from(rec.header);
-  if (!chirp.enabled) throw std::invalid_argument(path + " holds no chirp (a robodamp run recording, not a robodamp measure one)");
+  if (!chirp.enabled)
+    throw std::invalid_argument(path + " holds no chirp (a robodamp run recording, not a robodamp measure one)");
   if (rec.frames.empty()) throw std::invalid_argument(path + " holds no frames");
   ChirpLoopFrfs m;
   m.fs_hz = rec.header.at("rate_hz");
@@ -70,7 +74,8 @@ ChirpLoopFrfs read_chirp_loop(const std::string& path) {
     next = f.tick + 1;
   }
   const auto period_n = static_cast<std::size_t>(std::lround(chirp.period_s * m.fs_hz));
-  const auto first = static_cast<std::size_t>(std::lround(chirp.start_s * m.fs_hz)) + period_n;  // the first period: transient
+  const auto first =
+      static_cast<std::size_t>(std::lround(chirp.start_s * m.fs_hz)) + period_n;  // the first period: transient
   m.periods_averaged = chirp.periods - 1;
   if (first + period_n * static_cast<std::size_t>(m.periods_averaged) > n)
     throw std::invalid_argument(path + ": the recording ends before the chirp's last period");
@@ -116,22 +121,26 @@ std::string RealCellCheck::failure() const {
   if (closed_trip != "none") return "the cell tripped with the tuned controller (" + closed_trip + ")";
   if (open_trip != "none") return "the cell tripped with control off (" + open_trip + ")";
   if (closed_active_share < 1.0) {
-    std::snprintf(b, sizeof b, "the loop was active over only %.1f %% of the control-on chirp", 100.0 * closed_active_share);
+    std::snprintf(b, sizeof b, "the loop was active over only %.1f %% of the control-on chirp",
+                  100.0 * closed_active_share);
     return b;
   }
   for (const auto& m : modes)
     if (!(std::abs(m.measured_improvement_pct - m.predicted_improvement_pct) <= improvement_tolerance_points)) {
-      std::snprintf(b, sizeof b, "the mode at %.2f Hz at the actuator: measured improvement %.1f %% against %.1f %% predicted "
-                    "(allowed +-%.0f points)", m.freq_hz, m.measured_improvement_pct, m.predicted_improvement_pct,
-                    improvement_tolerance_points);
+      std::snprintf(b, sizeof b,
+                    "the mode at %.2f Hz at the actuator: measured improvement %.1f %% against %.1f %% predicted "
+                    "(allowed +-%.0f points)",
+                    m.freq_hz, m.measured_improvement_pct, m.predicted_improvement_pct, improvement_tolerance_points);
       return b;
     }
   const LoopGainCheck& l = loop_gain;
   if (l.compared_points == 0) return "the loop gain: no coherent point between |L| = 0.1 and 10 in the chirp's band";
   if (!l.holds()) {
-    std::snprintf(b, sizeof b, "the measured loop gain differs from the analysis by %.2f dB (at %.1f Hz) and %.1f deg (at %.1f "
-                  "Hz); allowed %.0f dB and %.0f deg", l.max_error_db, l.error_db_at_hz, l.max_error_deg, l.error_deg_at_hz,
-                  l.tolerance_db, l.tolerance_deg);
+    std::snprintf(b, sizeof b,
+                  "the measured loop gain differs from the analysis by %.2f dB (at %.1f Hz) and %.1f deg (at %.1f "
+                  "Hz); allowed %.0f dB and %.0f deg",
+                  l.max_error_db, l.error_db_at_hz, l.max_error_deg, l.error_deg_at_hz, l.tolerance_db,
+                  l.tolerance_deg);
     return b;
   }
   return {};
@@ -141,7 +150,8 @@ std::vector<std::string> RealCellCheck::progress_lines() const {
   std::vector<std::string> out;
   char b[512];
   for (const auto& m : modes) {
-    std::snprintf(b, sizeof b, "on the cell, the mode at %.2f Hz at the actuator: improvement %.1f %% measured, %.1f %% predicted",
+    std::snprintf(b, sizeof b,
+                  "on the cell, the mode at %.2f Hz at the actuator: improvement %.1f %% measured, %.1f %% predicted",
                   m.freq_hz, m.measured_improvement_pct, m.predicted_improvement_pct);
     out.emplace_back(b);
   }
@@ -151,8 +161,10 @@ std::vector<std::string> RealCellCheck::progress_lines() const {
     std::snprintf(m, sizeof m, "%.1f %s", v.value_or(0.0), unit);
     return v ? std::string(m) : std::string("(no crossover in the chirp's band)");
   };
-  std::snprintf(b, sizeof b, "the loop gain measured on the cell (the chirp injected at the plant's input, %d lines): within "
-                "%.2f dB and %.1f deg of the analysis; margins measured GM %s, PM %s; the analysis on the same lines GM %s, PM %s",
+  std::snprintf(b, sizeof b,
+                "the loop gain measured on the cell (the chirp injected at the plant's input, %d lines): within "
+                "%.2f dB and %.1f deg of the analysis; margins measured GM %s, PM %s; the analysis on the same lines "
+                "GM %s, PM %s",
                 g.compared_points, g.max_error_db, g.max_error_deg, margin(g.measured_gm_db, "dB").c_str(),
                 margin(g.measured_pm_deg, "deg").c_str(), margin(g.predicted_gm_db, "dB").c_str(),
                 margin(g.predicted_pm_deg, "deg").c_str());
@@ -209,7 +221,8 @@ RealCellCheck check_real_cell(const ChirpLoopFrfs& off, const ChirpLoopFrfs& on,
     if (f0 < lo || f0 > hi) continue;
     ModeCheckAtActuator m;
     m.freq_hz = f0;
-    m.measured_improvement_pct = 100.0 * (peak_near(r.f_hz, r.measured_open, f0) / peak_near(r.f_hz, r.measured_closed, f0) - 1.0);
+    m.measured_improvement_pct =
+        100.0 * (peak_near(r.f_hz, r.measured_open, f0) / peak_near(r.f_hz, r.measured_closed, f0) - 1.0);
     m.predicted_improvement_pct =
         100.0 * (peak_near(r.f_hz, r.predicted_open, f0) / peak_near(r.f_hz, r.predicted_closed, f0) - 1.0);
     r.modes.push_back(m);
@@ -217,8 +230,9 @@ RealCellCheck check_real_cell(const ChirpLoopFrfs& off, const ChirpLoopFrfs& on,
   return r;
 }
 
-RealCellCheck verify_on_real_cell(const config::Config& cell, const config::Config& tuned, const std::vector<double>& modes_hz,
-                                  const RealCellRun& run, MeasureOutcome& chirp_on) {
+RealCellCheck verify_on_real_cell(const config::Config& cell, const config::Config& tuned,
+                                  const std::vector<double>& modes_hz, const RealCellRun& run,
+                                  MeasureOutcome& chirp_on) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::string out = (std::filesystem::path(run.work_dir) / "chirp_on").string();
   MeasureOptions o;
@@ -234,15 +248,27 @@ RealCellCheck verify_on_real_cell(const config::Config& cell, const config::Conf
     r.closed_trip = chirp_on.trip;
     return r;
   }
-  RealCellCheck r = check_real_cell(read_chirp_loop(run.measurement_dir + rec), read_chirp_loop(out + rec), tuned, modes_hz);
-  r.cell = run.binary.empty() ? (cell.can ? "the cell on " + cell.can->interface + " (no hammer, no cut)"
-                                          : std::string("the simulated plant in process, as a real cell (no hammer, no cut)"))
-                              : "the HIL emulator as a real cell (robodamp plant --no-impacts, no cut) through the CAN and Modbus drivers";
+  RealCellCheck r =
+      check_real_cell(read_chirp_loop(run.measurement_dir + rec), read_chirp_loop(out + rec), tuned, modes_hz);
+  r.cell =
+      run.binary.empty()
+          ? (cell.can ? "the cell on " + cell.can->interface + " (no hammer, no cut)"
+                      : std::string("the simulated plant in process, as a real cell (no hammer, no cut)"))
+          : "the HIL emulator as a real cell (robodamp plant --no-impacts, no cut) through the CAN and Modbus drivers";
   r.open_trip = identify::read_manifest(run.measurement_dir).run.value("trip", std::string("none"));
   r.closed_trip = chirp_on.trip;
   r.closed_active_share = chirp_on.chirp_active_share;
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
+}
+
+// Why a cell may not be measured with robodamp's own hammer (empty: it may, the emulator's CAN over a socket).
+std::string hardware_refusal(const config::Config& cell) {
+  if (!cell.can || cell.can->interface.rfind("unix:", 0) == 0) return {};
+  return "the cell is a CAN bus (can.interface = " + cell.can->interface +
+         "): robodamp orders no hammer blow and no cut on a real cell; give your modal kit's tap tests with "
+         "--tap-tests "
+         "FILE... (UFF or frf_<response>_<excitation>.csv) and it commissions with the actuator as the shaker";
 }
 
 }  // namespace robodamp::commission

@@ -36,7 +36,7 @@ struct ChirpLoopFrfs {
 [[nodiscard]] ChirpLoopFrfs read_chirp_loop(const std::string& recording_path);
 
 struct ModeCheckAtActuator {
-  double freq_hz{0.0};  // the identified mode's
+  double freq_hz{0.0};                                                   // the identified mode's
   double measured_improvement_pct{0.0}, predicted_improvement_pct{0.0};  // open peak / closed peak - 1
 };
 
@@ -56,7 +56,7 @@ struct LoopGainCheck {
 };
 
 struct RealCellCheck {
-  std::string cell;            // what ran: the CAN bus or the HIL emulator told it is a real cell
+  std::string cell;  // what ran: the CAN bus or the HIL emulator told it is a real cell
   std::string open_trip{"none"}, closed_trip{"none"};
   std::string run_problem;  // the control-on chirp did not complete (refused, tripped, aborted)
   double closed_active_share{0.0};
@@ -74,8 +74,9 @@ struct RealCellCheck {
 // off / on: the control-off and the control-on chirp's recordings; tuned: the identified, tuned
 // configuration (its controller ran; its model predicts); modes_hz: the identified modes of the path
 // between the actuator and the sensor.
-[[nodiscard]] RealCellCheck check_real_cell(const ChirpLoopFrfs& off, const ChirpLoopFrfs& on, const config::Config& tuned,
-                                            const std::vector<double>& modes_hz, double min_coherence = 0.9);
+[[nodiscard]] RealCellCheck check_real_cell(const ChirpLoopFrfs& off, const ChirpLoopFrfs& on,
+                                            const config::Config& tuned, const std::vector<double>& modes_hz,
+                                            double min_coherence = 0.9);
 
 // Gain margin (dB, from -1 / L at the phase crossovers) and phase margin (deg, at the gain crossovers) of
 // a loop sampled on a grid, by linear interpolation between points; nullopt where no crossover is.

@@ -39,13 +39,19 @@ struct Stop {
 // Nothing when the measurement ran; else the stop its status is at `stage`.
 inline void throw_unless_measured(const MeasureOutcome& o, Stage stage) {
   switch (o.status) {
-    case MeasureStatus::kOk: return;
-    case MeasureStatus::kTripped: throw Stop{stage, Outcome::kTripped, o.message};
-    case MeasureStatus::kConfigError: throw Stop{stage, Outcome::kBadInput, o.message};
+    case MeasureStatus::kOk:
+      return;
+    case MeasureStatus::kTripped:
+      throw Stop{stage, Outcome::kTripped, o.message};
+    case MeasureStatus::kConfigError:
+      throw Stop{stage, Outcome::kBadInput, o.message};
     case MeasureStatus::kNotReady:
-    case MeasureStatus::kSaturated: throw Stop{stage, Outcome::kRefused, o.message};
-    case MeasureStatus::kAborted: throw Stop{stage, Outcome::kAborted, o.message};
-    default: throw Stop{stage, Outcome::kFailed, o.message};
+    case MeasureStatus::kSaturated:
+      throw Stop{stage, Outcome::kRefused, o.message};
+    case MeasureStatus::kAborted:
+      throw Stop{stage, Outcome::kAborted, o.message};
+    default:
+      throw Stop{stage, Outcome::kFailed, o.message};
   }
 }
 
@@ -98,7 +104,8 @@ class StageRunner {
 
 // DIR/configuration.yaml: the header, then the file the tune wrote (DIR/from), read back as a configuration
 // first and renamed into place whole (nothing half-written stands there). Returns its path.
-inline std::string write_configuration(const std::filesystem::path& dir, const std::string& from, const std::string& header) {
+inline std::string write_configuration(const std::filesystem::path& dir, const std::string& from,
+                                       const std::string& header) {
   std::ifstream in(dir / from);
   const std::string tuned((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string text = header + tuned;
@@ -116,11 +123,16 @@ inline std::string write_configuration(const std::filesystem::path& dir, const s
 inline std::string esc(const std::string& s) {
   std::string o;
   for (const char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else if (c == '"') o += "&quot;";
-    else o += c;
+    if (c == '<')
+      o += "&lt;";
+    else if (c == '>')
+      o += "&gt;";
+    else if (c == '&')
+      o += "&amp;";
+    else if (c == '"')
+      o += "&quot;";
+    else
+      o += c;
   }
   return o;
 }

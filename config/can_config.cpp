@@ -7,8 +7,8 @@ namespace robodamp::config {
 double can_frame_time_s(const CanFrameMapping& f, bool fd, double bitrate, double data_bitrate) {
   const double n = f.length_bytes;
   if (!fd) {
-    const double bits = f.extended_id ? 8 * n + 67 + std::floor((54 + 8 * n - 1) / 4)
-                                      : 8 * n + 47 + std::floor((34 + 8 * n - 1) / 4);
+    const double bits =
+        f.extended_id ? 8 * n + 67 + std::floor((54 + 8 * n - 1) / 4) : 8 * n + 47 + std::floor((34 + 8 * n - 1) / 4);
     return bits / bitrate;
   }
   // Arbitration: SOF, identifier, RRS, IDE, FDF, res, BRS (+ SRR and the 18-bit extension), stuffed.

@@ -37,7 +37,7 @@ struct CanFrameMapping {
 };
 
 struct CanConfig {
-  std::string interface{"can0"};  // PF_CAN raw socket bound to it (production)
+  std::string interface { "can0" };  // PF_CAN raw socket bound to it (production)
   double bitrate_bps{1'000'000.0};
   bool fd{false};
   double data_bitrate_bps{0.0};  // CAN FD data phase (bit-rate switch); 0 = no switch
@@ -53,7 +53,8 @@ struct CanConfig {
 // Classic CAN: Davis et al. (2007), 8n + 47 + floor((34 + 8n - 1)/4) bits (standard id), 8n + 67 +
 // floor((54 + 8n - 1)/4) (extended). CAN FD: arbitration and end of frame at the nominal rate, the data
 // phase (DLC, data, stuff count, CRC) at the data rate with one stuff bit per 4 bits.
-[[nodiscard]] double can_frame_time_s(const CanFrameMapping& frame, bool fd, double bitrate_bps, double data_bitrate_bps);
+[[nodiscard]] double can_frame_time_s(const CanFrameMapping& frame, bool fd, double bitrate_bps,
+                                      double data_bitrate_bps);
 // Share of the bus that both frames take at the loop rate.
 [[nodiscard]] double can_bus_load(const CanConfig& can, double loop_rate_hz);
 

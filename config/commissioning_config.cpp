@@ -13,8 +13,8 @@ CommissioningConfig read_commissioning(MapReader& top) {
   if (auto v = r.number("chirp_f1_hz", {"Hz", 0.1, 1000.0}, c.chirp_f1_hz)) c.chirp_f1_hz = *v;
   if (c.chirp_f1_hz <= c.chirp_f0_hz)
     r.diagnostics().add(r.mark(), "commissioning.chirp_f1_hz",
-                        "= " + format_number(c.chirp_f1_hz) + " Hz must be above chirp_f0_hz = " +
-                            format_number(c.chirp_f0_hz) + " Hz");
+                        "= " + format_number(c.chirp_f1_hz) +
+                            " Hz must be above chirp_f0_hz = " + format_number(c.chirp_f0_hz) + " Hz");
   if (auto v = r.number("chirp_period_s", {"s", 1.0, 600.0}, c.chirp_period_s)) c.chirp_period_s = *v;
   if (auto v = read_int(r, "chirp_periods", {"(periods, the first discarded)", 2, 100}, c.chirp_periods))
     c.chirp_periods = *v;

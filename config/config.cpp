@@ -19,8 +19,8 @@ namespace robodamp::config {
 using detail::Diagnostics;
 using detail::format_number;
 using detail::MapReader;
-using detail::Range;
 using detail::present;
+using detail::Range;
 using detail::read_bool;
 using detail::read_int;
 using detail::read_mode;
@@ -46,8 +46,7 @@ std::vector<Problem> located(std::vector<Problem> problems, const std::string& y
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception&) {
-  }
+  } catch (const YAML::Exception&) {}
   for (Problem& p : problems) {
     if (p.mark.line > 0) continue;
     p.mark = {1, 1};
@@ -83,11 +82,16 @@ ConfigError::ConfigError(std::vector<Problem> problems)
 
 const char* to_string(BlockKind kind) {
   switch (kind) {
-    case BlockKind::kLowpass2: return "lowpass2";
-    case BlockKind::kHighpass2: return "highpass2";
-    case BlockKind::kNotch: return "notch";
-    case BlockKind::kIntegrator: return "integrator";
-    case BlockKind::kCompensator: return "compensator";
+    case BlockKind::kLowpass2:
+      return "lowpass2";
+    case BlockKind::kHighpass2:
+      return "highpass2";
+    case BlockKind::kNotch:
+      return "notch";
+    case BlockKind::kIntegrator:
+      return "integrator";
+    case BlockKind::kCompensator:
+      return "compensator";
   }
   return "?";
 }
@@ -101,10 +105,14 @@ std::optional<BlockKind> block_kind_from(const std::string& name) {
 
 const char* to_string(CompensatorModel model) {
   switch (model) {
-    case CompensatorModel::kC1: return "c1";
-    case CompensatorModel::kC2: return "c2";
-    case CompensatorModel::kC3: return "c3";
-    case CompensatorModel::kRational: return "rational";
+    case CompensatorModel::kC1:
+      return "c1";
+    case CompensatorModel::kC2:
+      return "c2";
+    case CompensatorModel::kC3:
+      return "c3";
+    case CompensatorModel::kRational:
+      return "rational";
   }
   return "?";
 }
@@ -112,7 +120,6 @@ const char* to_string(CompensatorModel model) {
 const char* to_string(Mounting mounting) { return mounting == Mounting::kHorizontal ? "horizontal" : "vertical"; }
 
 namespace {
-
 
 // Limits shared by several keys. The loop rate range is the product's (1-20 kHz).
 constexpr double kMinRateHz = 1000.0;
@@ -122,8 +129,8 @@ constexpr double kMaxRateHz = 20000.0;
 // invalid, the widest possible Nyquist is used and the rate's own problem is reported.
 Range below_nyquist(std::optional<double> rate_hz) {
   const double nyq = 0.5 * rate_hz.value_or(kMaxRateHz);
-  return {"Hz", 0.0, nyq, true, true,
-          rate_hz ? "below Nyquist, loop.rate_hz = " + format_number(*rate_hz) + " Hz" : "below Nyquist"};
+  return {"Hz", 0.0,  nyq,
+          true, true, rate_hz ? "below Nyquist, loop.rate_hz = " + format_number(*rate_hz) + " Hz" : "below Nyquist"};
 }
 
 const Range kDamping{"(dimensionless)", 0.0, 10.0, true, false};
@@ -133,13 +140,13 @@ LoopConfig read_loop(MapReader& top, std::optional<double>& rate) {
   LoopConfig c;
   rate = r.number("rate_hz", {"Hz", kMinRateHz, kMaxRateHz});
   if (rate) c.rate_hz = *rate;
-  if (auto v = r.choice("clock", {"wall", "virtual"}, "wall")) c.clock = *v == "wall" ? ClockKind::kWall : ClockKind::kVirtual;
+  if (auto v = r.choice("clock", {"wall", "virtual"}, "wall"))
+    c.clock = *v == "wall" ? ClockKind::kWall : ClockKind::kVirtual;
   r.finish();
   return c;
 }
 
 const Range kLocationId{"(location id)", 1, 64};
-
 
 ActuatorConfig read_actuator(MapReader& top, std::optional<double> rate) {
   MapReader r(top.diagnostics(), top.child("actuator", true, "map, Eq. 3 parameters"), "actuator", top.mark());
@@ -256,10 +263,12 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
       }
       const YAML::Mark m = chain.Mark();
       if (counts[static_cast<int>(BlockKind::kIntegrator)] != 1)
-        d.add(m, "controller.chain", "needs exactly one integrator block (DVF feeds back velocity, Eq. 8), found " +
-                                         std::to_string(counts[static_cast<int>(BlockKind::kIntegrator)]));
+        d.add(m, "controller.chain",
+              "needs exactly one integrator block (DVF feeds back velocity, Eq. 8), found " +
+                  std::to_string(counts[static_cast<int>(BlockKind::kIntegrator)]));
       for (const auto& b : c.chain)
-        if (b.kind == BlockKind::kIntegrator && b.leak_hz == 0.0 && counts[static_cast<int>(BlockKind::kHighpass2)] == 0)
+        if (b.kind == BlockKind::kIntegrator && b.leak_hz == 0.0 &&
+            counts[static_cast<int>(BlockKind::kHighpass2)] == 0)
           d.add(b.mark, b.key + ".leak_hz",
                 "= 0 Hz with no highpass2 in the chain: an ideal integrator would drift without bound on a sensor "
                 "offset; add a highpass2 or set leak_hz (allowed 0 < value <= 1 Hz)");
@@ -268,8 +277,6 @@ ControllerConfig read_controller(MapReader& top, std::optional<double> rate) {
   r.finish();
   return c;
 }
-
-
 
 RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
   Diagnostics& d = top.diagnostics();
@@ -287,7 +294,8 @@ RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
       LocationConfig l;
       if (auto v = read_int(lr, "id", kLocationId)) {
         l.id = *v;
-        if (!ids.insert(l.id).second) d.add(locs[i].Mark(), key + ".id", "= " + std::to_string(l.id) + " is used twice");
+        if (!ids.insert(l.id).second)
+          d.add(locs[i].Mark(), key + ".id", "= " + std::to_string(l.id) + " is used twice");
       }
       l.name = lr.text("name", "location " + std::to_string(l.id)).value_or("");
       if (auto v = read_sign(lr, "axis_sign", 1)) l.axis_sign = *v;
@@ -311,11 +319,13 @@ RobotConfig read_robot(MapReader& top, std::optional<double> rate) {
       if (g) f.response_location = *g;
       if (h) f.excitation_location = *h;
       if (g && h && !paths.insert({*g, *h}).second)
-        d.add(frfs[i].Mark(), key, "a second FRF for response " + std::to_string(*g) + ", excitation " +
-                                       std::to_string(*h) + ": one FRF per path");
+        d.add(frfs[i].Mark(), key,
+              "a second FRF for response " + std::to_string(*g) + ", excitation " + std::to_string(*h) +
+                  ": one FRF per path");
       const YAML::Node modes = fr.child("modes", true, "list of modes");
       if (modes.IsDefined() && (!modes.IsSequence() || modes.size() == 0))
-        d.add(modes.Mark().is_null() ? frfs[i].Mark() : modes.Mark(), key + ".modes", "must be a non-empty list of modes");
+        d.add(modes.Mark().is_null() ? frfs[i].Mark() : modes.Mark(), key + ".modes",
+              "must be a non-empty list of modes");
       for (std::size_t k = 0; modes.IsSequence() && k < modes.size(); ++k) {
         MapReader mr(d, modes[k], key + ".modes[" + std::to_string(k) + "]", modes.Mark());
         f.modes.push_back(read_mode(mr, below_nyquist(rate)));
@@ -365,7 +375,8 @@ PlantConfig read_plant(MapReader& top) {
     c.oversampling = *v;
   if (auto v = read_int(r, "actuator_wiring", {"(1 as configured, -1 leads swapped)", -1, 1}, c.actuator_wiring)) {
     if (*v == 0)
-      r.diagnostics().add(r.mark(), "plant.actuator_wiring", "= 0 is not a wiring: allowed 1 (as configured) or -1 (leads swapped)");
+      r.diagnostics().add(r.mark(), "plant.actuator_wiring",
+                          "= 0 is not a wiring: allowed 1 (as configured) or -1 (leads swapped)");
     else
       c.actuator_wiring = *v;
   }
@@ -377,7 +388,8 @@ DisturbanceConfig read_disturbances(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("disturbances", false, ""), "disturbances", top.mark());
   DisturbanceConfig c;
   if (auto v = r.choice("drives_on", {"true", "false"}, "true")) c.drives_on = *v == "true";
-  if (auto v = r.number("drive_vibration_hz", {"Hz", 0.0, 100.0, true}, c.drive_vibration_hz)) c.drive_vibration_hz = *v;
+  if (auto v = r.number("drive_vibration_hz", {"Hz", 0.0, 100.0, true}, c.drive_vibration_hz))
+    c.drive_vibration_hz = *v;
   if (auto v = r.number("drive_vibration_mps2", {"m/s^2", 0.0, 100.0}, c.drive_vibration_mps2))
     c.drive_vibration_mps2 = *v;
   if (auto v = read_int(r, "drive_vibration_location", kLocationId, c.drive_vibration_location))
@@ -395,8 +407,8 @@ AnalysisConfig read_analysis(MapReader& top, std::optional<double> rate) {
   if (auto v = r.number("band_max_hz", band, c.band_max_hz)) c.band_max_hz = *v;
   if (c.band_max_hz <= c.band_min_hz)
     r.diagnostics().add(r.mark(), "analysis.band_max_hz",
-                        "= " + format_number(c.band_max_hz) + " Hz must be above analysis.band_min_hz = " +
-                            format_number(c.band_min_hz) + " Hz");
+                        "= " + format_number(c.band_max_hz) +
+                            " Hz must be above analysis.band_min_hz = " + format_number(c.band_min_hz) + " Hz");
   r.finish();
   return c;
 }
@@ -429,7 +441,6 @@ BenchConfig read_bench(MapReader& top) {
   return c;
 }
 
-
 RealtimeConfig read_realtime(MapReader& top) {
   MapReader r(top.diagnostics(), top.child("realtime", false, ""), "realtime", top.mark());
   RealtimeConfig c;
@@ -450,19 +461,22 @@ RecoveryConfig read_recovery(MapReader& top) {
     const YAML::Node list = node["recoverable"];
     c.recoverable.clear();
     if (!list.IsSequence()) {
-      top.diagnostics().add(list.Mark(), "supervision.recovery.recoverable",
-                            "must be a list of trip classes (any of: overruns, sensor_stale, sample_invalid, sensor_driver, "
-                            "actuator_driver, amplifier_not_ready; [] = every trip latches)");
+      top.diagnostics().add(
+          list.Mark(), "supervision.recovery.recoverable",
+          "must be a list of trip classes (any of: overruns, sensor_stale, sample_invalid, sensor_driver, "
+          "actuator_driver, amplifier_not_ready; [] = every trip latches)");
     } else {
       for (std::size_t i = 0; i < list.size(); ++i) {
         const std::string key = "supervision.recovery.recoverable[" + std::to_string(i) + "]";
         const std::string name = list[i].IsScalar() ? list[i].Scalar() : std::string();
         const std::optional<rt::Trip> trip = rt::trip_named(name);
         if (!trip || !rt::may_recover(*trip))
-          top.diagnostics().add(list[i].Mark(), key,
-                                "= '" + name + "' cannot recover by itself: allowed are overruns, sensor_stale, sample_invalid, "
-                                "sensor_driver, actuator_driver, amplifier_not_ready (instability, saturation, amplifier_fault, "
-                                "pose_out_of_map and signal always latch)");
+          top.diagnostics().add(
+              list[i].Mark(), key,
+              "= '" + name +
+                  "' cannot recover by itself: allowed are overruns, sensor_stale, sample_invalid, "
+                  "sensor_driver, actuator_driver, amplifier_not_ready (instability, saturation, amplifier_fault, "
+                  "pose_out_of_map and signal always latch)");
         else if (std::find(c.recoverable.begin(), c.recoverable.end(), *trip) != c.recoverable.end())
           top.diagnostics().add(list[i].Mark(), key, "= '" + name + "' is listed twice");
         else
@@ -507,15 +521,16 @@ SupervisionConfig read_supervision(MapReader& top) {
                         c.sample_limit_mps2))
     c.sample_limit_mps2 = *v;
   if (auto v = read_int(r, "overrun_cycles", cycles, c.overrun_cycles)) c.overrun_cycles = *v;
-  if (auto v = r.number("overrun_delay_margin_share", {"(share of the delay margin)", 0.0, 1.0, false, false,
-                                                       "0 = overrun_cycles alone"},
+  if (auto v = r.number("overrun_delay_margin_share",
+                        {"(share of the delay margin)", 0.0, 1.0, false, false, "0 = overrun_cycles alone"},
                         c.overrun_delay_margin_share))
     c.overrun_delay_margin_share = *v;
   if (auto v = r.number("saturation_window_s", {"s", 0.001, 10.0}, c.saturation_window_s)) c.saturation_window_s = *v;
   if (auto v = r.number("saturation_duty_max", {"(fraction of the window)", 0.0, 1.0, true}, c.saturation_duty_max))
     c.saturation_duty_max = *v;
   if (auto v = r.number("instability_block_s", {"s", 0.005, 10.0}, c.instability_block_s)) c.instability_block_s = *v;
-  if (auto v = read_int(r, "instability_blocks", {"(blocks)", 2, 1000}, c.instability_blocks)) c.instability_blocks = *v;
+  if (auto v = read_int(r, "instability_blocks", {"(blocks)", 2, 1000}, c.instability_blocks))
+    c.instability_blocks = *v;
   if (auto v = r.number("instability_growth_factor", {"(ratio)", 1.0, 1e6, true}, c.instability_growth_factor))
     c.instability_growth_factor = *v;
   if (auto v = r.number("instability_floor_v", {"V", 0.0, 100.0}, c.instability_floor_v)) c.instability_floor_v = *v;
@@ -555,12 +570,12 @@ std::optional<std::uint32_t> read_can_id(MapReader& r, bool extended) {
     std::size_t used = 0;
     const unsigned long v = std::stoul(n.Scalar(), &used, 0);
     if (used == n.Scalar().size() && v <= max) return static_cast<std::uint32_t>(v);
-  } catch (const std::exception&) {
-  }
+  } catch (const std::exception&) {}
   char lim[16];
   std::snprintf(lim, sizeof lim, "0x%X", max);
-  r.diagnostics().add(n.Mark(), r.path_of("id"), "= '" + n.Scalar() + "' is not allowed: an identifier 0 <= id <= " +
-                                                     lim + (extended ? " (29-bit, extended_id)" : " (11-bit)"));
+  r.diagnostics().add(n.Mark(), r.path_of("id"),
+                      "= '" + n.Scalar() + "' is not allowed: an identifier 0 <= id <= " + lim +
+                          (extended ? " (29-bit, extended_id)" : " (11-bit)"));
   return std::nullopt;
 }
 
@@ -572,24 +587,29 @@ std::optional<CanSignal> read_can_signal(MapReader& parent, const std::string& k
   if (auto v = read_int(r, "start_byte", {"(byte)", 0, 63})) s.start_byte = *v;
   if (auto v = read_int(r, "size_bytes", {"(bytes)", 1, 4}, 2)) s.size_bytes = *v;
   if (auto v = read_bool(r, "signed", true)) s.is_signed = *v;
-  if (auto v = r.choice("byte_order", {"little", "big"}, "little")) s.byte_order = *v == "little" ? ByteOrder::kLittle : ByteOrder::kBig;
+  if (auto v = r.choice("byte_order", {"little", "big"}, "little"))
+    s.byte_order = *v == "little" ? ByteOrder::kLittle : ByteOrder::kBig;
   if (auto v = r.number("scale_" + unit + "_per_count", {unit, -1e6, 1e6}, std::nullopt)) s.scale = *v;
-  if (s.scale == 0.0) r.diagnostics().add(r.mark(), r.path_of("scale_" + unit + "_per_count"), "= 0 would lose the signal");
+  if (s.scale == 0.0)
+    r.diagnostics().add(r.mark(), r.path_of("scale_" + unit + "_per_count"), "= 0 would lose the signal");
   if (auto v = r.number("offset_" + unit, {unit, -1e6, 1e6}, 0.0)) s.offset = *v;
   r.finish();
   if (s.start_byte + s.size_bytes > frame_bytes)
-    parent.diagnostics().add(r.mark(), parent.path_of(key), "bytes " + std::to_string(s.start_byte) + ".." +
-                                                                std::to_string(s.start_byte + s.size_bytes - 1) +
-                                                                " do not fit in length_bytes = " + std::to_string(frame_bytes));
+    parent.diagnostics().add(r.mark(), parent.path_of(key),
+                             "bytes " + std::to_string(s.start_byte) + ".." +
+                                 std::to_string(s.start_byte + s.size_bytes - 1) +
+                                 " do not fit in length_bytes = " + std::to_string(frame_bytes));
   return s;
 }
 
 CanFrameMapping read_can_frame(MapReader& top, const std::string& key, const std::string& unit, bool fd) {
-  MapReader r(top.diagnostics(), top.child(key, true, "map with id, length_bytes, value"), top.path_of(key), top.mark());
+  MapReader r(top.diagnostics(), top.child(key, true, "map with id, length_bytes, value"), top.path_of(key),
+              top.mark());
   CanFrameMapping f;
   if (auto v = read_bool(r, "extended_id", false)) f.extended_id = *v;
   if (auto v = read_can_id(r, f.extended_id)) f.id = *v;
-  if (auto v = read_int(r, "length_bytes", {"(bytes)", 1.0, fd ? 64.0 : 8.0, false, false, fd ? "CAN FD" : "classic CAN"}, 8)) {
+  if (auto v = read_int(r, "length_bytes",
+                        {"(bytes)", 1.0, fd ? 64.0 : 8.0, false, false, fd ? "CAN FD" : "classic CAN"}, 8)) {
     const bool fd_len = *v <= 8 || *v == 12 || *v == 16 || *v == 20 || *v == 24 || *v == 32 || *v == 48 || *v == 64;
     if (!fd_len)
       r.diagnostics().add(r.mark(), r.path_of("length_bytes"),
@@ -606,8 +626,10 @@ CanFrameMapping read_can_frame(MapReader& top, const std::string& key, const std
     if (auto v = read_int(cr, "size_bytes", {"(bytes)", 1, 4}, 1)) c.size_bytes = *v;
     cr.finish();
     if (c.start_byte + c.size_bytes > f.length_bytes)
-      r.diagnostics().add(cn.Mark(), r.path_of("counter"), "does not fit in length_bytes = " + std::to_string(f.length_bytes));
-    const bool overlap = c.start_byte < f.value.start_byte + f.value.size_bytes && f.value.start_byte < c.start_byte + c.size_bytes;
+      r.diagnostics().add(cn.Mark(), r.path_of("counter"),
+                          "does not fit in length_bytes = " + std::to_string(f.length_bytes));
+    const bool overlap =
+        c.start_byte < f.value.start_byte + f.value.size_bytes && f.value.start_byte < c.start_byte + c.size_bytes;
     if (overlap) r.diagnostics().add(cn.Mark(), r.path_of("counter"), "overlaps the value's bytes");
     f.counter = c;
   }
@@ -624,30 +646,37 @@ std::optional<CanConfig> read_can(MapReader& top, std::optional<double> rate) {
   if (auto v = read_bool(r, "fd", false)) c.fd = *v;
   if (auto v = r.number("bitrate_bps", {"bit/s", 10e3, 1e6}, c.bitrate_bps)) c.bitrate_bps = *v;
   if (c.fd) {
-    if (auto v = r.number("data_bitrate_bps", {"bit/s", 0.0, 12e6, false, false, "CAN FD data phase; 0 = no bit-rate switch"}, 0.0))
+    if (auto v = r.number("data_bitrate_bps",
+                          {"bit/s", 0.0, 12e6, false, false, "CAN FD data phase; 0 = no bit-rate switch"}, 0.0))
       c.data_bitrate_bps = *v;
   }
   c.sensor = read_can_frame(r, "sensor", "mps2", c.fd);
   c.command = read_can_frame(r, "command", "v", c.fd);
   if (c.sensor.id == c.command.id && c.sensor.extended_id == c.command.extended_id)
     r.diagnostics().add(r.mark(), "can.command.id", "is the sensor frame's identifier too: they must differ");
-  if (auto v = r.number("bus_load_max", {"(fraction of bus time)", 0.0, 1.0, true, false}, c.bus_load_max)) c.bus_load_max = *v;
-  if (auto v = read_int(r, "lost_frames_fault", {"(frames per second)", 1, 1024}, c.lost_frames_fault)) c.lost_frames_fault = *v;
-  if (auto v = r.number("backoff_initial_s", {"s", 0.0, 10.0, true, false}, c.backoff_initial_s)) c.backoff_initial_s = *v;
+  if (auto v = r.number("bus_load_max", {"(fraction of bus time)", 0.0, 1.0, true, false}, c.bus_load_max))
+    c.bus_load_max = *v;
+  if (auto v = read_int(r, "lost_frames_fault", {"(frames per second)", 1, 1024}, c.lost_frames_fault))
+    c.lost_frames_fault = *v;
+  if (auto v = r.number("backoff_initial_s", {"s", 0.0, 10.0, true, false}, c.backoff_initial_s))
+    c.backoff_initial_s = *v;
   if (auto v = r.number("backoff_max_s", {"s", 0.0, 600.0, true, false}, c.backoff_max_s)) c.backoff_max_s = *v;
   r.finish();
   if (rate) {
     const double load = can_bus_load(c, *rate);
     if (load > c.bus_load_max) {
       char msg[400];
-      std::snprintf(msg, sizeof msg,
-                    "the bus cannot carry this loop: %.0f Hz x (%.1f us sensor + %.1f us command frame, worst-case "
-                    "stuffing) = %.0f %% of the bus at %.0f kbit/s%s, above can.bus_load_max = %.0f %%; the highest loop "
-                    "rate is %.0f Hz",
-                    *rate, 1e6 * can_frame_time_s(c.sensor, c.fd, c.bitrate_bps, c.data_bitrate_bps),
-                    1e6 * can_frame_time_s(c.command, c.fd, c.bitrate_bps, c.data_bitrate_bps), 100.0 * load,
-                    c.bitrate_bps / 1e3, c.fd && c.data_bitrate_bps > 0 ? (" / " + std::to_string(static_cast<int>(c.data_bitrate_bps / 1e3)) + " kbit/s data").c_str() : "",
-                    100.0 * c.bus_load_max, std::floor(*rate * c.bus_load_max / load));
+      std::snprintf(
+          msg, sizeof msg,
+          "the bus cannot carry this loop: %.0f Hz x (%.1f us sensor + %.1f us command frame, worst-case "
+          "stuffing) = %.0f %% of the bus at %.0f kbit/s%s, above can.bus_load_max = %.0f %%; the highest loop "
+          "rate is %.0f Hz",
+          *rate, 1e6 * can_frame_time_s(c.sensor, c.fd, c.bitrate_bps, c.data_bitrate_bps),
+          1e6 * can_frame_time_s(c.command, c.fd, c.bitrate_bps, c.data_bitrate_bps), 100.0 * load, c.bitrate_bps / 1e3,
+          c.fd && c.data_bitrate_bps > 0
+              ? (" / " + std::to_string(static_cast<int>(c.data_bitrate_bps / 1e3)) + " kbit/s data").c_str()
+              : "",
+          100.0 * c.bus_load_max, std::floor(*rate * c.bus_load_max / load));
       r.diagnostics().add(r.mark(), "loop.rate_hz", msg);
     }
   }
@@ -663,18 +692,17 @@ SourceMark mark_of(const YAML::Node& root, const std::string& dotted) {
       if (const YAML::Node field = section[dotted.substr(dot + 1)]) return detail::to_mark(field.Mark());
       return detail::to_mark(section.Mark());
     }
-  } catch (const YAML::Exception&) {
-  }
+  } catch (const YAML::Exception&) {}
   return detail::to_mark(root.Mark());
 }
 
 // Locations named outside the robot section must exist in it.
 void check_location_refs(Diagnostics& d, const Config& c, const YAML::Node& root) {
   if (c.robot.frfs.empty()) return;
-  const std::pair<const char*, int> refs[] = {{"actuator.location", c.actuator.location},
-                                              {"sensor.location", c.sensor.location},
-                                              {"disturbances.drive_vibration_location",
-                                               c.disturbances.drive_vibration_location}};
+  const std::pair<const char*, int> refs[] = {
+      {"actuator.location", c.actuator.location},
+      {"sensor.location", c.sensor.location},
+      {"disturbances.drive_vibration_location", c.disturbances.drive_vibration_location}};
   for (const auto& [key, id] : refs)
     if (!find_location(c.robot, id)) {
       std::string known;
@@ -697,11 +725,13 @@ void check_joint_states(detail::Diagnostics& d, const Config& c) {
     return;
   }
   if (!j.names.empty() && j.names.size() != c.pose_schedule->joints())
-    d.add(here, "dds.joint_states.names", "has " + std::to_string(j.names.size()) + " names; pose_schedule has " +
-                                              std::to_string(c.pose_schedule->joints()) + " joints: one name per joint, in order");
+    d.add(here, "dds.joint_states.names",
+          "has " + std::to_string(j.names.size()) + " names; pose_schedule has " +
+              std::to_string(c.pose_schedule->joints()) + " joints: one name per joint, in order");
   if (c.modbus && c.modbus->robot.joints_register >= 0)
-    d.add(here, "dds.joint_states", "and modbus.robot.joints_register = " + std::to_string(c.modbus->robot.joints_register) +
-                                        " both give the pose: choose one source");
+    d.add(here, "dds.joint_states",
+          "and modbus.robot.joints_register = " + std::to_string(c.modbus->robot.joints_register) +
+              " both give the pose: choose one source");
 }
 
 // dds.path_ahead against pose_schedule: a name per joint (its own or dds.joint_states').
@@ -715,10 +745,12 @@ void check_path_ahead(detail::Diagnostics& d, const Config& c) {
   }
   // (Names not given are dds.joint_states', filled in as the section is read.)
   if (p.names.empty())
-    d.add(here, "dds.path_ahead", "needs names (pose_schedule's joints as the robot program names them) without dds.joint_states");
+    d.add(here, "dds.path_ahead",
+          "needs names (pose_schedule's joints as the robot program names them) without dds.joint_states");
   else if (p.names.size() != c.pose_schedule->joints())
-    d.add(here, "dds.path_ahead.names", "has " + std::to_string(p.names.size()) + " names; pose_schedule has " +
-                                            std::to_string(c.pose_schedule->joints()) + " joints: one name per joint, in order");
+    d.add(here, "dds.path_ahead.names",
+          "has " + std::to_string(p.names.size()) + " names; pose_schedule has " +
+              std::to_string(c.pose_schedule->joints()) + " joints: one name per joint, in order");
 }
 
 // modbus.robot.joints_register against pose_schedule: one register per joint, clear of the others.
@@ -729,18 +761,21 @@ void check_joint_registers(detail::Diagnostics& d, const Config& c) {
   if (r.joints_register < 0) return;
   if (!c.pose_schedule) {
     d.add(here, "modbus.robot.joints_register",
-          "= " + std::to_string(r.joints_register) + " is set without pose_schedule: the joint angles would select nothing");
+          "= " + std::to_string(r.joints_register) +
+              " is set without pose_schedule: the joint angles would select nothing");
     return;
   }
   const int first = r.joints_register, last = first + static_cast<int>(c.pose_schedule->joints()) - 1;
-  for (const auto& [key, reg] : {std::pair{"mounting_register", r.mounting_register},
-                                 std::pair{"spindle_rpm_register", r.spindle_rpm_register}})
+  for (const auto& [key, reg] :
+       {std::pair{"mounting_register", r.mounting_register}, std::pair{"spindle_rpm_register", r.spindle_rpm_register}})
     if (reg >= first && reg <= last)
       d.add(here, "modbus.robot.joints_register",
             "= " + std::to_string(first) + " covers registers " + std::to_string(first) + "-" + std::to_string(last) +
-                " (one per joint), which holds modbus.robot." + key + " = " + std::to_string(reg) + ": they must differ");
+                " (one per joint), which holds modbus.robot." + key + " = " + std::to_string(reg) +
+                ": they must differ");
   if (last > 65535)
-    d.add(here, "modbus.robot.joints_register", "= " + std::to_string(first) + ": the joints' registers run past 65535");
+    d.add(here, "modbus.robot.joints_register",
+          "= " + std::to_string(first) + ": the joints' registers run past 65535");
 }
 
 }  // namespace
@@ -792,7 +827,8 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
         const std::size_t n = load_robot_model(c.hil.robot_model_resolved).joints.size();
         if (n != c.pose_schedule->joints())
           d.add(root.Mark(), "hil.robot_model",
-                "has " + std::to_string(n) + " joints; pose_schedule.model has " + std::to_string(c.pose_schedule->joints()) +
+                "has " + std::to_string(n) + " joints; pose_schedule.model has " +
+                    std::to_string(c.pose_schedule->joints()) +
                     ": the emulated robot and the configured model are read with the same joint angles");
       } catch (const ConfigError&) {
         // reported where hil.robot_model was read
@@ -801,20 +837,20 @@ Config parse_config(const std::string& yaml_text, const std::string& source_name
   if (const auto& s = c.controller.speed_schedule) {
     if (c.pose_schedule)
       d.add(root.Mark(), "controller.speed_schedule",
-            "and pose_schedule both choose the controller: a configuration schedules by spindle speed or by pose, not both");
+            "and pose_schedule both choose the controller: a configuration schedules by spindle speed or by pose, not "
+            "both");
     if (!s->controllers.empty() && !c.parameter_sets.empty())
       d.add(root.Mark(), "controller.speed_schedule.controllers",
             "and parameter_sets both choose the controller: a configuration schedules by spindle speed or by mounting, "
             "not both (a schedule of K alone may stand beside parameter_sets)");
-    if (!s->controllers.empty() &&
-        std::none_of(c.controller.chain.begin(), c.controller.chain.end(),
-                     [](const BlockConfig& b) { return b.kind == BlockKind::kCompensator; }))
+    if (!s->controllers.empty() && std::none_of(c.controller.chain.begin(), c.controller.chain.end(),
+                                                [](const BlockConfig& b) { return b.kind == BlockKind::kCompensator; }))
       d.add(root.Mark(), "controller.speed_schedule.controllers",
             "each replace the chain's compensator block, and controller.chain has none");
     if (!s->bands.empty() && s->bands.back().rpm_max > c.spindle.rpm_max)
       d.add(root.Mark(), "controller.speed_schedule.bands",
-            "reach " + format_number(s->bands.back().rpm_max) + " rpm, above spindle.rpm_max = " +
-                format_number(c.spindle.rpm_max) + " rpm");
+            "reach " + format_number(s->bands.back().rpm_max) +
+                " rpm, above spindle.rpm_max = " + format_number(c.spindle.rpm_max) + " rpm");
   }
   check_joint_registers(d, c);
   check_joint_states(d, c);

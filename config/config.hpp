@@ -58,10 +58,10 @@ struct LoopConfig {
   ClockKind clock{ClockKind::kWall};
 };
 
-using RealtimeConfig = rt::RealtimeSettings;        // realtime.*
-using RecoveryConfig = rt::RecoverySettings;        // supervision.recovery.*
-using DerateConfig = rt::DerateSettings;            // supervision.derate.*
-using SupervisionConfig = rt::SupervisionLimits;    // supervision.*
+using RealtimeConfig = rt::RealtimeSettings;      // realtime.*
+using RecoveryConfig = rt::RecoverySettings;      // supervision.recovery.*
+using DerateConfig = rt::DerateSettings;          // supervision.derate.*
+using SupervisionConfig = rt::SupervisionLimits;  // supervision.*
 
 struct TelemetryConfig {
   int ring_frames{65536};  // lock-free ring between the loop and the drain thread (power of two)
@@ -164,11 +164,11 @@ struct RobotConfig {
 struct SensorConfig {
   int location{2};
   double sensitivity_mv_per_g{10.0};
-  double range_g{500.0};                   // the sensor clips beyond this
-  double noise_density_ug_per_rthz{3.0};   // broadband, white
-  double highpass_hz{1.6};                 // IEPE coupling, first order: within 5 % above 5 Hz
+  double range_g{500.0};                  // the sensor clips beyond this
+  double noise_density_ug_per_rthz{3.0};  // broadband, white
+  double highpass_hz{1.6};                // IEPE coupling, first order: within 5 % above 5 Hz
   int adc_bits{24};
-  double adc_range_v{30.0};                // +- full scale
+  double adc_range_v{30.0};  // +- full scale
 };
 
 // The simulated plant's numerical settings.
@@ -181,10 +181,10 @@ struct PlantConfig {
 
 // Disturbances present in bench runs.
 struct DisturbanceConfig {
-  bool drives_on{true};                 // the robot's inherent vibration is present with the drives on
+  bool drives_on{true};  // the robot's inherent vibration is present with the drives on
   double drive_vibration_hz{3.0};
-  double drive_vibration_mps2{0.05};    // amplitude of acceleration at the sensor location, control off
-  int drive_vibration_location{1};      // where the equivalent force acts
+  double drive_vibration_mps2{0.05};  // amplitude of acceleration at the sensor location, control off
+  int drive_vibration_location{1};    // where the equivalent force acts
   std::uint64_t seed{1};
 };
 
@@ -196,8 +196,8 @@ struct AnalysisConfig {
 
 // The bench run: averaged impact tests control off and on, and a gain sweep.
 struct BenchConfig {
-  double impact_peak_n{1000.0};          // small enough not to saturate the actuator
-  double impact_duration_ms{1.0};        // half-sine
+  double impact_peak_n{1000.0};    // small enough not to saturate the actuator
+  double impact_duration_ms{1.0};  // half-sine
   double saturating_impact_peak_n{8000.0};
   double saturating_impact_duration_ms{5.0};  // soft tip: more impulse at the robot modes
   int averages{6};
@@ -224,14 +224,14 @@ struct Config {
   DisturbanceConfig disturbances;
   AnalysisConfig analysis;
   BenchConfig bench;
-  std::optional<CanConfig> can;  // hardware: the CAN link (drivers/can_*); absent for the simulated plant
-  std::optional<ModbusConfig> modbus;          // hardware: amplifier and robot registers
-  std::vector<ParameterSetRef> parameter_sets; // other mountings' configurations, selected by the robot
-  std::optional<DdsConfig> dds;                // telemetry and supervised parameters over Fast DDS
-  CellConfig cell;                             // the cell's name on the network (cell.name)
-  HilConfig hil;                               // read by the plant emulator (robodamp plant)
-  CommissioningConfig commissioning;           // robodamp measure and the plant side of it
-  SpindleConfig spindle;                       // tooth count and speed range (the harmonic notches)
+  std::optional<CanConfig> can;        // hardware: the CAN link (drivers/can_*); absent for the simulated plant
+  std::optional<ModbusConfig> modbus;  // hardware: amplifier and robot registers
+  std::vector<ParameterSetRef> parameter_sets;      // other mountings' configurations, selected by the robot
+  std::optional<DdsConfig> dds;                     // telemetry and supervised parameters over Fast DDS
+  CellConfig cell;                                  // the cell's name on the network (cell.name)
+  HilConfig hil;                                    // read by the plant emulator (robodamp plant)
+  CommissioningConfig commissioning;                // robodamp measure and the plant side of it
+  SpindleConfig spindle;                            // tooth count and speed range (the harmonic notches)
   std::optional<PoseScheduleConfig> pose_schedule;  // parameter sets by pose region (analysis/pose_schedule)
 };
 

@@ -22,12 +22,12 @@ struct DashboardConfig {
   // self-signed pair for a first install; the cell's PKI (dds.security) can issue one.
   std::string tls_certificate;
   std::string tls_private_key;
-  double session_idle_s{8 * 3600.0};        // a session ends after this long unused
-  double stale_after_s{2.0};                // a cell not heard from for this long shows "no contact"
-  double reply_timeout_s{5.0};              // an action waits this long for the cell's reply
-  int max_event_streams{16};                // open live pages at once
-  std::size_t max_body_bytes{4096};         // request bodies beyond this are refused (413)
-  DdsConfig dds;                            // domain, transport, security (the operator identity)
+  double session_idle_s{8 * 3600.0};  // a session ends after this long unused
+  double stale_after_s{2.0};          // a cell not heard from for this long shows "no contact"
+  double reply_timeout_s{5.0};        // an action waits this long for the cell's reply
+  int max_event_streams{16};          // open live pages at once
+  std::size_t max_body_bytes{4096};   // request bodies beyond this are refused (413)
+  DdsConfig dds;                      // domain, transport, security (the operator identity)
   [[nodiscard]] bool tls() const { return !tls_certificate.empty(); }
 };
 

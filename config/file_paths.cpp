@@ -54,7 +54,8 @@ std::string FoundFile::looked_text() const {
   if (rest.empty()) return beside;
   std::string dirs;
   for (const auto& d : searched) dirs += (dirs.empty() ? "" : ", ") + d;
-  return beside + ", then " + rest + " in " + (dirs.empty() ? std::string("no data folder") : dirs + " and the folders in them");
+  return beside + ", then " + rest + " in " +
+         (dirs.empty() ? std::string("no data folder") : dirs + " and the folders in them");
 }
 
 FoundFile find_named_file(const std::string& source_dir, const std::string& written) {

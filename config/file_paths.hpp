@@ -20,10 +20,10 @@ namespace robodamp::config {
 // in each data folder and each folder inside it: a job copied out of the tree that names
 // ../presets/horizontal_c2.yaml finds the shipped preset. Absolute paths are taken as written.
 struct FoundFile {
-  std::string path;                 // where it was found, or (not found) the path beside the configuration
+  std::string path;  // where it was found, or (not found) the path beside the configuration
   bool found{false};
-  std::string beside;                // the path beside the configuration (tried first)
-  std::string rest;                  // what was looked for in the data folders (empty: they were not searched)
+  std::string beside;                 // the path beside the configuration (tried first)
+  std::string rest;                   // what was looked for in the data folders (empty: they were not searched)
   std::vector<std::string> searched;  // the data folders searched, in order
   [[nodiscard]] std::string looked_text() const;  // "A, then B in D1, D2 and the folders in them"
 };

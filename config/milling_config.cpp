@@ -70,8 +70,8 @@ std::optional<double> one_of(MapReader& r, const std::string& a, const std::stri
     return std::nullopt;
   }
   if (!has_a && !has_b && !def) {
-    r.diagnostics().add(r.mark(), r.path_of(a), "missing (required: " + a + " or " + b + ", " +
-                                                    std::string(range.unit) + ")");
+    r.diagnostics().add(r.mark(), r.path_of(a),
+                        "missing (required: " + a + " or " + b + ", " + std::string(range.unit) + ")");
     return std::nullopt;
   }
   return r.number(has_b ? b : a, range, def);
@@ -97,7 +97,8 @@ MaterialConfig read_material(MapReader& top) {
 }
 
 Range radial_range(const ToolConfig& t) {
-  return {"mm", 0.0, t.diameter_mm, true, false, "up to tool.diameter_mm = " + format_number(t.diameter_mm) + " (slotting)"};
+  return {"mm", 0.0,   t.diameter_mm,
+          true, false, "up to tool.diameter_mm = " + format_number(t.diameter_mm) + " (slotting)"};
 }
 
 CutConfig read_cut(MapReader& top, const ToolConfig& tool) {
@@ -114,7 +115,6 @@ CutConfig read_cut(MapReader& top, const ToolConfig& tool) {
   return c;
 }
 
-
 std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const std::string& base_dir) {
   Diagnostics& d = pr.diagnostics();
   const YAML::Node n = pr.child("controller", false, "");
@@ -124,7 +124,8 @@ std::optional<ControllerPartConfig> read_controller_part(MapReader& pr, const st
   if (auto v = r.text("config", std::nullopt)) {
     const FoundFile f = find_named_file(base_dir, *v);
     c.config_path = f.path;
-    if (!f.found) d.add(n.Mark(), r.path_of("config"), "= '" + *v + "': no such file (looked for " + f.looked_text() + ")");
+    if (!f.found)
+      d.add(n.Mark(), r.path_of("config"), "= '" + *v + "': no such file (looked for " + f.looked_text() + ")");
   }
   if (auto v = read_int(r, "location", {"(location id)", 1, 64}, 1)) c.location = *v;
   if (auto v = r.choice("direction", {"x", "y"}, "y")) c.direction = axis_from(*v);
@@ -181,7 +182,8 @@ StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std
       if (!present(modes)) continue;
       any = true;
       if (!modes.IsSequence() || modes.size() == 0) {
-        d.add(modes.Mark().is_null() ? pr.mark() : modes.Mark(), pr.path_of(kPairs[k]), "must be a non-empty list of modes");
+        d.add(modes.Mark().is_null() ? pr.mark() : modes.Mark(), pr.path_of(kPairs[k]),
+              "must be a non-empty list of modes");
         continue;
       }
       for (std::size_t m = 0; m < modes.size(); ++m) {
@@ -189,7 +191,8 @@ StructureConfig read_structure(Diagnostics& d, const YAML::Node& node, const std
         p.modes[k].push_back(read_mode(mr, kModeFrequency));
       }
     }
-    if (!any) d.add(parts[i].Mark(), pk, "has no FRF: give modes under xx, xy, yx, yy, a controller location or a robot pose");
+    if (!any)
+      d.add(parts[i].Mark(), pk, "has no FRF: give modes under xx, xy, yx, yy, a controller location or a robot pose");
     pr.finish();
     s.parts.push_back(std::move(p));
   }
@@ -202,8 +205,9 @@ void read_speed_range(MapReader& r, double& rpm_min, double& rpm_max) {
   if (auto v = r.number("rpm_min", kRpm, rpm_min)) rpm_min = *v;
   if (auto v = r.number("rpm_max", kRpm, rpm_max)) rpm_max = *v;
   if (rpm_max <= rpm_min)
-    r.diagnostics().add(r.mark(), r.path_of("rpm_max"), "= " + format_number(rpm_max) + " rpm must exceed " +
-                                                            r.path_of("rpm_min") + " = " + format_number(rpm_min) + " rpm");
+    r.diagnostics().add(r.mark(), r.path_of("rpm_max"),
+                        "= " + format_number(rpm_max) + " rpm must exceed " + r.path_of("rpm_min") + " = " +
+                            format_number(rpm_min) + " rpm");
 }
 
 LobesConfig read_lobes(MapReader& top) {
@@ -244,24 +248,28 @@ SleConfig read_sle(MapReader& top) {
 TimeDomainConfig read_time_domain(MapReader& top, const ToolConfig& tool) {
   MapReader r(top.diagnostics(), top.child("time_domain", false, ""), "time_domain", top.mark());
   TimeDomainConfig c;
-  if (auto v = read_int(r, "steps_per_tooth", {"(steps, 0 = automatic)", 0, 100000}, c.steps_per_tooth)) c.steps_per_tooth = *v;
+  if (auto v = read_int(r, "steps_per_tooth", {"(steps, 0 = automatic)", 0, 100000}, c.steps_per_tooth))
+    c.steps_per_tooth = *v;
   if (auto v = read_int(r, "min_steps_per_mode_period", {"(steps)", 8, 10000}, c.min_steps_per_mode_period))
     c.min_steps_per_mode_period = *v;
   if (auto v = read_int(r, "revolutions", {"(revolutions)", 2, 100000}, c.revolutions)) c.revolutions = *v;
-  if (auto v = read_int(r, "settle_revolutions", {"(revolutions)", 1, 100000}, c.settle_revolutions)) c.settle_revolutions = *v;
+  if (auto v = read_int(r, "settle_revolutions", {"(revolutions)", 1, 100000}, c.settle_revolutions))
+    c.settle_revolutions = *v;
   if (c.settle_revolutions >= c.revolutions)
     r.diagnostics().add(r.mark(), r.path_of("settle_revolutions"),
                         "= " + std::to_string(c.settle_revolutions) + " must be less than " + r.path_of("revolutions") +
                             " = " + std::to_string(c.revolutions) + " (statistics need revolutions after settling)");
   if (auto v = read_int(r, "axial_slices", {"(slices)", 1, 1000}, c.axial_slices)) c.axial_slices = *v;
-  if (auto v = read_int(r, "sdm_steps_per_period", {"(steps)", 4, 1000}, c.sdm_steps_per_period)) c.sdm_steps_per_period = *v;
+  if (auto v = read_int(r, "sdm_steps_per_period", {"(steps)", 4, 1000}, c.sdm_steps_per_period))
+    c.sdm_steps_per_period = *v;
   if (auto v = read_int(r, "sdm_points", {"(speeds)", 10, 100000}, c.sdm_points)) c.sdm_points = *v;
   const YAML::Node runout = r.child("runout_um", false, "");
   if (present(runout)) {
     bool ok = runout.IsSequence() && static_cast<int>(runout.size()) == tool.teeth;
     for (std::size_t i = 0; ok && i < runout.size(); ++i) {
       double v = 0.0;
-      ok = runout[i].IsScalar() && YAML::convert<double>::decode(runout[i], v) && std::isfinite(v) && std::abs(v) <= 1000.0;
+      ok = runout[i].IsScalar() && YAML::convert<double>::decode(runout[i], v) && std::isfinite(v) &&
+           std::abs(v) <= 1000.0;
       if (ok) c.runout_um.push_back(v);
     }
     if (!ok)
@@ -275,7 +283,8 @@ TimeDomainConfig read_time_domain(MapReader& top, const ToolConfig& tool) {
     double sum = 0.0;
     for (std::size_t i = 0; ok && i < pitch.size(); ++i) {
       double v = 0.0;
-      ok = pitch[i].IsScalar() && YAML::convert<double>::decode(pitch[i], v) && std::isfinite(v) && v > 0.0 && v < 360.0;
+      ok =
+          pitch[i].IsScalar() && YAML::convert<double>::decode(pitch[i], v) && std::isfinite(v) && v > 0.0 && v < 360.0;
       if (ok) c.pitch_deg.push_back(v), sum += v;
     }
     if (!ok || std::abs(sum - 360.0) > 1e-6)

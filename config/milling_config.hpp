@@ -66,7 +66,7 @@ struct ControllerPartConfig {
 
 // The robot's TCP receptance from a robot model at a pose (docs/pose_dynamics.md), in the machine frame.
 struct PosePartConfig {
-  std::string model_path;        // resolved against the milling file's directory
+  std::string model_path;  // resolved against the milling file's directory
   std::vector<double> joints_deg;
 };
 
@@ -88,11 +88,11 @@ struct StructureConfig {
 struct LobesConfig {
   double rpm_min{1000.0};
   double rpm_max{20000.0};
-  int points{2000};                    // speeds of the lobe diagram
+  int points{2000};  // speeds of the lobe diagram
   bool log_spacing{false};
-  std::optional<double> freq_max_hz;   // chatter-frequency search limit; default 4 x the highest resonance
-                                       // and at least 4 x the top tooth-passing frequency
-  int points_per_mode{160};            // fine chatter-frequency grid across each mode's resonance
+  std::optional<double> freq_max_hz;  // chatter-frequency search limit; default 4 x the highest resonance
+                                      // and at least 4 x the top tooth-passing frequency
+  int points_per_mode{160};           // fine chatter-frequency grid across each mode's resonance
 };
 
 struct SleConfig {
@@ -100,23 +100,23 @@ struct SleConfig {
   double rpm_max{20000.0};
   int points{400};
   int axial_slices{40};
-  int harmonics{64};                   // of the tooth-passing frequency
-  double tolerance_um{2.0};            // compensation stops below this part error
+  int harmonics{64};         // of the tooth-passing frequency
+  double tolerance_um{2.0};  // compensation stops below this part error
   int max_iterations{30};
   std::vector<Axis> surface_normals{Axis::kY};  // conditions are evaluated for each
 };
 
 // Time-domain cut simulation (milling/cut_simulation.hpp) and semi-discretization (milling/sdm.hpp).
 struct TimeDomainConfig {
-  int steps_per_tooth{0};               // 0: the fewest giving min_steps_per_mode_period (and >= 40)
-  int min_steps_per_mode_period{20};    // steps per period of the structure's highest mode
-  int revolutions{60};                  // simulated, start-up included
-  int settle_revolutions{20};           // not used by the statistics (start-up transient)
+  int steps_per_tooth{0};             // 0: the fewest giving min_steps_per_mode_period (and >= 40)
+  int min_steps_per_mode_period{20};  // steps per period of the structure's highest mode
+  int revolutions{60};                // simulated, start-up included
+  int settle_revolutions{20};         // not used by the statistics (start-up transient)
   int axial_slices{20};
-  std::vector<double> runout_um;        // per tooth, radial (empty: none)
-  std::vector<double> pitch_deg;        // from each tooth to the next, summing to 360 (empty: even pitch)
-  int sdm_steps_per_period{40};         // semi-discretization intervals per tooth period
-  int sdm_points{200};                  // speeds of `lobes --method sdm` over the lobes range
+  std::vector<double> runout_um;  // per tooth, radial (empty: none)
+  std::vector<double> pitch_deg;  // from each tooth to the next, summing to 360 (empty: even pitch)
+  int sdm_steps_per_period{40};   // semi-discretization intervals per tooth period
+  int sdm_points{200};            // speeds of `lobes --method sdm` over the lobes range
 };
 
 // An SLE test condition (the robot SLE study Table 7) with the measured path offset the published predictions add.

@@ -14,8 +14,8 @@ std::string format_number(double v) {
 
 std::string describe_range(const Range& r) {
   std::ostringstream os;
-  os << "allowed " << format_number(r.min) << (r.min_open ? " < " : " <= ") << "value"
-     << (r.max_open ? " < " : " <= ") << format_number(r.max) << ' ' << r.unit;
+  os << "allowed " << format_number(r.min) << (r.min_open ? " < " : " <= ") << "value" << (r.max_open ? " < " : " <= ")
+     << format_number(r.max) << ' ' << r.unit;
   if (!r.note.empty()) os << " (" << r.note << ')';
   return os.str();
 }

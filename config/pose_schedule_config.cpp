@@ -68,8 +68,8 @@ void check_box(MapReader& r, const std::string& what, const std::vector<double>&
                const RobotModelConfig* model) {
   if (lo.size() != hi.size()) {
     r.diagnostics().add(r.mark(), r.path_of(what + "max_deg"),
-                        "has " + std::to_string(hi.size()) + " angles for " + std::to_string(lo.size()) +
-                            " in " + what + "min_deg: one per joint");
+                        "has " + std::to_string(hi.size()) + " angles for " + std::to_string(lo.size()) + " in " +
+                            what + "min_deg: one per joint");
     return;
   }
   if (model && lo.size() != model->joints.size())
@@ -78,14 +78,15 @@ void check_box(MapReader& r, const std::string& what, const std::vector<double>&
                             std::to_string(model->joints.size()) + " joints");
   for (std::size_t i = 0; i < lo.size(); ++i) {
     if (!(lo[i] <= hi[i]))
-      r.diagnostics().add(r.mark(), r.path_of(what + "max_deg") + "[" + std::to_string(i) + "]",
-                          "= " + format_number(hi[i]) + " deg is below " + what + "min_deg = " + format_number(lo[i]) + " deg");
+      r.diagnostics().add(
+          r.mark(), r.path_of(what + "max_deg") + "[" + std::to_string(i) + "]",
+          "= " + format_number(hi[i]) + " deg is below " + what + "min_deg = " + format_number(lo[i]) + " deg");
     if (model && i < model->joints.size()) {
       const auto& j = model->joints[i];
       for (const auto& [key, v] : {std::pair{what + "min_deg", lo[i]}, std::pair{what + "max_deg", hi[i]}})
         if (auto p = range_problem(r.path_of(key) + "[" + std::to_string(i) + "]", v,
-                                   {"deg", j.min_deg, j.max_deg, false, false, "joint " + std::to_string(i + 1) +
-                                                                                  "'s travel in " + model->source}))
+                                   {"deg", j.min_deg, j.max_deg, false, false,
+                                    "joint " + std::to_string(i + 1) + "'s travel in " + model->source}))
           r.diagnostics().add(r.mark(), r.path_of(key) + "[" + std::to_string(i) + "]", *p);
     }
   }
@@ -104,8 +105,11 @@ std::optional<RegionCompensatorConfig> read_region_compensator(MapReader& region
   if (!num || !den) return std::nullopt;
   c.numerator = *num, c.denominator = *den;
   const std::size_t before = region.diagnostics().problems().size();
-  auto refuse = [&](const std::string& key, const std::string& why) { region.diagnostics().add(r.mark(), r.path_of(key), why); };
-  if (c.numerator.empty() || c.denominator.empty()) refuse("denominator", "and numerator must not be empty");
+  auto refuse = [&](const std::string& key, const std::string& why) {
+    region.diagnostics().add(r.mark(), r.path_of(key), why);
+  };
+  if (c.numerator.empty() || c.denominator.empty())
+    refuse("denominator", "and numerator must not be empty");
   else if (c.numerator.size() > c.denominator.size())
     refuse("numerator", "has " + std::to_string(c.numerator.size()) + " coefficients, more than the denominator's " +
                             std::to_string(c.denominator.size()) + ": the compensator must be proper");
@@ -113,14 +117,16 @@ std::optional<RegionCompensatorConfig> read_region_compensator(MapReader& region
     if (!std::isfinite(c.numerator[i])) refuse("numerator[" + std::to_string(i) + "]", "is not a finite number");
   for (std::size_t i = 0; i < c.denominator.size(); ++i)
     if (!(c.denominator[i] > 0.0) || !std::isfinite(c.denominator[i]))
-      refuse("denominator[" + std::to_string(i) + "]", "= " + format_number(c.denominator[i]) +
-                                                           " is not allowed: every coefficient must be positive and finite "
-                                                           "(a stable, minimum-phase compensator, as robodamp pose tune writes)");
+      refuse("denominator[" + std::to_string(i) + "]",
+             "= " + format_number(c.denominator[i]) +
+                 " is not allowed: every coefficient must be positive and finite "
+                 "(a stable, minimum-phase compensator, as robodamp pose tune writes)");
   if (region.diagnostics().problems().size() != before) return std::nullopt;
   return c;
 }
 
-PoseRegionConfig read_region(Diagnostics& d, const YAML::Node& n, const std::string& key, const RobotModelConfig* model) {
+PoseRegionConfig read_region(Diagnostics& d, const YAML::Node& n, const std::string& key,
+                             const RobotModelConfig* model) {
   MapReader r(d, n, key, n.Mark());
   PoseRegionConfig c;
   c.name = r.text("name", std::nullopt).value_or(key);
@@ -147,7 +153,8 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   MapReader r(d, node, "pose_schedule", top.mark());
   PoseScheduleConfig c;
   std::optional<RobotModelConfig> model;
-  if (auto v = r.text("model", std::nullopt)) model = read_robot_model_file(r, "pose_schedule.model", source, *v, c.model, c.model_resolved);
+  if (auto v = r.text("model", std::nullopt))
+    model = read_robot_model_file(r, "pose_schedule.model", source, *v, c.model, c.model_resolved);
   if (auto v = r.choice("axis", {"x", "y"}, "y")) c.axis = *v == "x" ? 0 : 1;
   if (auto v = read_int(r, "modes", {"(modes)", 1, 12}, c.modes)) c.modes = *v;
   if (auto v = read_int(r, "grid_points", {"(points per joint)", 2, 9}, c.grid_points)) c.grid_points = *v;
@@ -156,8 +163,8 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   if (auto v = r.number("damping_band_max_hz", band, c.damping_band_max_hz)) c.damping_band_max_hz = *v;
   if (c.damping_band_max_hz <= c.damping_band_min_hz)
     d.add(r.mark(), "pose_schedule.damping_band_max_hz",
-          "= " + format_number(c.damping_band_max_hz) + " Hz must be above pose_schedule.damping_band_min_hz = " +
-              format_number(c.damping_band_min_hz) + " Hz");
+          "= " + format_number(c.damping_band_max_hz) +
+              " Hz must be above pose_schedule.damping_band_min_hz = " + format_number(c.damping_band_min_hz) + " Hz");
   const YAML::Node ws = r.child("workspace", true, "the joint-angle box the robot works in: min_deg, max_deg");
   if (present(ws)) {
     MapReader w(d, ws, "pose_schedule.workspace", r.mark());
@@ -170,8 +177,8 @@ std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::
   if (present(regions) && (!regions.IsSequence() || regions.size() == 0))
     d.add(regions.Mark(), "pose_schedule.regions", "must be a non-empty list of regions (name, min_deg, max_deg)");
   for (std::size_t i = 0; regions.IsSequence() && i < regions.size(); ++i)
-    c.regions.push_back(read_region(d, regions[i], "pose_schedule.regions[" + std::to_string(i) + "]",
-                                    model ? &*model : nullptr));
+    c.regions.push_back(
+        read_region(d, regions[i], "pose_schedule.regions[" + std::to_string(i) + "]", model ? &*model : nullptr));
   r.finish();
   const std::size_t n = c.workspace_min_deg.size();
   const bool shapes_ok = n > 0 && c.workspace_max_deg.size() == n && !c.regions.empty() &&

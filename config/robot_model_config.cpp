@@ -28,10 +28,12 @@ RobotJointConfig read_joint(MapReader& r) {
   if (auto v = r.number("damping_ratio", {"", 0.0, 1.0, false, true}, 0.02)) c.damping_ratio = *v;
   if (auto v = r.number("min_deg", {"deg", -360.0, 360.0}, -180.0)) c.min_deg = *v;
   if (auto v = r.number("max_deg", {"deg", -360.0, 360.0}, 180.0)) c.max_deg = *v;
-  if (auto v = r.number("translational_stiffness_n_per_m", {"N/m", 0.0, 1e13}, 0.0)) c.translational_stiffness_n_per_m = *v;
+  if (auto v = r.number("translational_stiffness_n_per_m", {"N/m", 0.0, 1e13}, 0.0))
+    c.translational_stiffness_n_per_m = *v;
   if (c.min_deg >= c.max_deg)
-    r.diagnostics().add(r.mark(), r.path_of("max_deg"),
-                        "= " + format_number(c.max_deg) + " deg must be above min_deg = " + format_number(c.min_deg) + " deg");
+    r.diagnostics().add(
+        r.mark(), r.path_of("max_deg"),
+        "= " + format_number(c.max_deg) + " deg must be above min_deg = " + format_number(c.min_deg) + " deg");
   return c;
 }
 
@@ -55,8 +57,8 @@ std::optional<std::string> pose_problem(const RobotModelConfig& m, const std::ve
     return "a pose needs " + std::to_string(m.joints.size()) + " joint angles (deg), got " + std::to_string(q.size());
   for (std::size_t i = 0; i < q.size(); ++i) {
     const auto& j = m.joints[i];
-    if (auto p = range_problem("joint " + std::to_string(i + 1), q[i], {"deg", j.min_deg, j.max_deg, false, false,
-                                                                       "the joint's travel in " + m.source}))
+    if (auto p = range_problem("joint " + std::to_string(i + 1), q[i],
+                               {"deg", j.min_deg, j.max_deg, false, false, "the joint's travel in " + m.source}))
       return p;
   }
   return std::nullopt;
@@ -96,7 +98,8 @@ std::optional<MeasuredModesConfig> read_measured_modes(Diagnostics& d, MapReader
   MeasuredModesConfig c;
   if (auto v = r.choice("axis", {"x", "y"}, "y")) c.axis = *v == "x" ? 0 : 1;
   const YAML::Node poses = r.child("poses", true, "the measured poses, each {name, joints_deg, modes}");
-  if (present(poses) && (!poses.IsSequence() || poses.size() == 0)) d.add(poses.Mark(), "measured_modes.poses", "must be a non-empty list");
+  if (present(poses) && (!poses.IsSequence() || poses.size() == 0))
+    d.add(poses.Mark(), "measured_modes.poses", "must be a non-empty list");
   for (std::size_t i = 0; poses.IsSequence() && i < poses.size(); ++i) {
     const std::string key = "measured_modes.poses[" + std::to_string(i) + "]";
     MapReader pr(d, poses[i], key, poses.Mark());
@@ -105,7 +108,8 @@ std::optional<MeasuredModesConfig> read_measured_modes(Diagnostics& d, MapReader
     p.joints_deg = pr.number_list("joints_deg", "deg").value_or(std::vector<double>{});
     if (auto problem = pose_problem(model, p.joints_deg)) d.add(poses[i].Mark(), key + ".joints_deg", *problem);
     const YAML::Node modes = pr.child("modes", true, "the modes identified there, lowest first");
-    if (present(modes) && (!modes.IsSequence() || modes.size() == 0)) d.add(poses[i].Mark(), key + ".modes", "must be a non-empty list");
+    if (present(modes) && (!modes.IsSequence() || modes.size() == 0))
+      d.add(poses[i].Mark(), key + ".modes", "must be a non-empty list");
     for (std::size_t k = 0; modes.IsSequence() && k < modes.size(); ++k) {
       MapReader mr(d, modes[k], key + ".modes[" + std::to_string(k) + "]", modes.Mark());
       ModeConfig m;
@@ -135,8 +139,9 @@ RobotModelConfig parse_robot_model(const std::string& yaml_text, const std::stri
   c.links = read_list<RobotLinkConfig>(d, top, "links", "the links from the base, each a map", read_link);
   c.joints = read_list<RobotJointConfig>(d, top, "joints", "one joint per link, from the base", read_joint);
   if (!c.links.empty() && c.joints.size() != c.links.size())
-    d.add(top.mark(), "joints", "has " + std::to_string(c.joints.size()) + " entries for " +
-                                    std::to_string(c.links.size()) + " links: one joint drives each link");
+    d.add(top.mark(), "joints",
+          "has " + std::to_string(c.joints.size()) + " entries for " + std::to_string(c.links.size()) +
+              " links: one joint drives each link");
   const YAML::Node head = top.child("head", false, "");
   if (present(head)) {
     MapReader h(d, head, "head", top.mark());
@@ -157,7 +162,8 @@ std::vector<RobotPoseConfig> parse_pose_list(const std::string& yaml_text, const
   const YAML::Node root = detail::load_top_map(d, yaml_text, "name, links, joints, head, poses");
   MapReader top(d, root, "", root.Mark());
   std::vector<RobotPoseConfig> poses = read_poses(d, top, model, true);
-  for (const char* other : {"name", "links", "joints", "head", "measured_modes"}) (void)top.child(other, false, "");  // a model file's
+  for (const char* other : {"name", "links", "joints", "head", "measured_modes"})
+    (void)top.child(other, false, "");  // a model file's
   top.finish();
   std::vector<std::string> names;
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -182,14 +188,17 @@ std::string robot_model_yaml(const RobotModelConfig& m) {
   std::string s = "# robodamp robot model (docs/pose_dynamics.md)\nname: " + m.name + "\nlinks:\n";
   auto n = [](double v) { return format_number(v); };
   for (const auto& l : m.links)
-    s += "  - {length_m: " + n(l.length_m) + ", mass_kg: " + n(l.mass_kg) + ", bending_stiffness_nm2: " +
-         n(l.bending_stiffness_nm2) + ", axial_stiffness_n: " + n(l.axial_stiffness_n) +
+    s += "  - {length_m: " + n(l.length_m) + ", mass_kg: " + n(l.mass_kg) +
+         ", bending_stiffness_nm2: " + n(l.bending_stiffness_nm2) + ", axial_stiffness_n: " + n(l.axial_stiffness_n) +
          ", elements: " + std::to_string(l.elements) + "}\n";
   s += "joints:\n";
   for (const auto& j : m.joints)
     s += "  - {stiffness_nm_per_rad: " + n(j.stiffness_nm_per_rad) + ", damping_ratio: " + n(j.damping_ratio) +
          ", min_deg: " + n(j.min_deg) + ", max_deg: " + n(j.max_deg) +
-         (j.translational_stiffness_n_per_m > 0.0 ? ", translational_stiffness_n_per_m: " + n(j.translational_stiffness_n_per_m) : "") + "}\n";
+         (j.translational_stiffness_n_per_m > 0.0
+              ? ", translational_stiffness_n_per_m: " + n(j.translational_stiffness_n_per_m)
+              : "") +
+         "}\n";
   s += "head: {mass_kg: " + n(m.head_mass_kg) + ", inertia_kgm2: " + n(m.head_inertia_kgm2) + "}\n";
   if (!m.poses.empty()) s += "poses:\n";
   for (const auto& p : m.poses) {
@@ -201,7 +210,8 @@ std::string robot_model_yaml(const RobotModelConfig& m) {
     s += "}\n";
   }
   if (!m.measured_modes) return s;
-  s += "measured_modes:  # identified at measured poses (robodamp pose modes); the model's modes are corrected towards them\n";
+  s += "measured_modes:  # identified at measured poses (robodamp pose modes); the model's modes are corrected towards "
+       "them\n";
   s += std::string("  axis: ") + (m.measured_modes->axis == 0 ? "x" : "y") + "\n  poses:\n";
   for (const auto& p : m.measured_modes->poses) {
     s += "    - name: " + p.name + "\n      joints_deg: [";

@@ -22,7 +22,7 @@ struct RobotLinkConfig {
 struct RobotJointConfig {
   double stiffness_nm_per_rad{1e5};
   double damping_ratio{0.02};
-  double min_deg{-180.0}, max_deg{180.0};  // the joint's travel: a pose outside it is refused
+  double min_deg{-180.0}, max_deg{180.0};       // the joint's travel: a pose outside it is refused
   double translational_stiffness_n_per_m{0.0};  // its bearings in x and y; 0 (the default): rigid
 };
 

@@ -75,21 +75,24 @@ namespace detail {
 
 namespace {
 
-std::optional<SpeedControllerConfig> read_controller_entry(Diagnostics& d, const YAML::Node& item, const std::string& key,
-                                                           std::optional<double> rate_hz) {
+std::optional<SpeedControllerConfig> read_controller_entry(Diagnostics& d, const YAML::Node& item,
+                                                           const std::string& key, std::optional<double> rate_hz) {
   MapReader r(d, item, key, item.Mark());
   SpeedControllerConfig c;
   const std::size_t before = d.problems().size();
   if (auto p = read_sign(r, "polarity", 1)) c.polarity = *p;
-  if (auto v = r.number("match_freq_hz", {"Hz", 0.0, rate_hz ? 0.5 * *rate_hz : 1e6, true, true, "below Nyquist"}, -1.0);
+  if (auto v =
+          r.number("match_freq_hz", {"Hz", 0.0, rate_hz ? 0.5 * *rate_hz : 1e6, true, true, "below Nyquist"}, -1.0);
       v && *v > 0.0)
     c.match_freq_hz = *v;
-  const YAML::Node block = r.child("compensator", true, "the block that replaces the chain's compensator (kind: compensator)");
+  const YAML::Node block =
+      r.child("compensator", true, "the block that replaces the chain's compensator (kind: compensator)");
   r.finish();
   if (present(block)) {
     auto b = read_chain_block(d, block, key + ".compensator", rate_hz);
     if (b && b->kind != BlockKind::kCompensator)
-      d.add(block.Mark(), key + ".compensator.kind", "= '" + std::string(to_string(b->kind)) + "': it must be a compensator");
+      d.add(block.Mark(), key + ".compensator.kind",
+            "= '" + std::string(to_string(b->kind)) + "': it must be a compensator");
     else if (b)
       c.compensator.assign(1, *b);
   }
@@ -108,9 +111,11 @@ void read_controllers(MapReader& r, SpeedScheduleConfig& s, std::optional<double
   }
   if (node.size() > kMaxSpeedControllers - 1)
     d.add(node.Mark(), "controller.speed_schedule.controllers",
-          "has " + std::to_string(node.size()) + " controllers: allowed at most " + std::to_string(kMaxSpeedControllers - 1));
+          "has " + std::to_string(node.size()) + " controllers: allowed at most " +
+              std::to_string(kMaxSpeedControllers - 1));
   for (std::size_t i = 0; i < node.size(); ++i) {
-    auto c = read_controller_entry(d, node[i], "controller.speed_schedule.controllers[" + std::to_string(i) + "]", rate_hz);
+    auto c =
+        read_controller_entry(d, node[i], "controller.speed_schedule.controllers[" + std::to_string(i) + "]", rate_hz);
     s.controllers.push_back(c.value_or(SpeedControllerConfig{}));  // keeps the numbering of the bands' references
   }
 }
@@ -122,14 +127,15 @@ std::optional<SpeedBandConfig> read_band(Diagnostics& d, const YAML::Node& item,
   const auto lo = r.number("rpm_min", {"rpm", 0.0, 200000.0});
   const auto hi = r.number("rpm_max", {"rpm", 0.0, 200000.0, true});
   const auto k = r.number("gain_ns_per_m", {"N s/m", 0.0, 1e5});
-  const auto c = read_int(r, "controller",
-                          {"(0 = this configuration's, i = controllers[i - 1])", 0, static_cast<double>(controllers)}, 0);
+  const auto c = read_int(
+      r, "controller", {"(0 = this configuration's, i = controllers[i - 1])", 0, static_cast<double>(controllers)}, 0);
   const bool capped = present(r.child("depth_limit_mm", false, ""));
   const std::optional<double> cap = capped ? r.number("depth_limit_mm", {"mm", 0.0, 1000.0, true}) : std::nullopt;
   r.finish();
   if (!lo || !hi || !k || !c || (capped && !cap)) return std::nullopt;
   if (!(*hi > *lo)) {
-    d.add(item.Mark(), key + ".rpm_max", "= " + format_number(*hi) + " rpm must exceed rpm_min = " + format_number(*lo) + " rpm");
+    d.add(item.Mark(), key + ".rpm_max",
+          "= " + format_number(*hi) + " rpm must exceed rpm_min = " + format_number(*lo) + " rpm");
     return std::nullopt;
   }
   return SpeedBandConfig{*lo, *hi, *c, *k, cap};

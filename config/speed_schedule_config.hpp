@@ -31,9 +31,10 @@ struct SpeedBandConfig {
 
 // Another controller a band may run: this configuration's chain with its compensator block replaced.
 struct SpeedControllerConfig {
-  std::vector<BlockConfig> compensator;  // exactly one block, kind compensator (a vector: BlockConfig is declared later)
+  std::vector<BlockConfig>
+      compensator;  // exactly one block, kind compensator (a vector: BlockConfig is declared later)
   int polarity{1};
-  std::optional<double> match_freq_hz;   // default the configuration's
+  std::optional<double> match_freq_hz;  // default the configuration's
 };
 
 struct SpeedScheduleConfig {

@@ -36,7 +36,8 @@ SpindleConfig read_spindle(MapReader& top, const std::string& source) {
     const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), *v);
     c.job_resolved = f.path;
     if (!f.found)
-      r.diagnostics().add(r.mark(), "spindle.job", "= '" + c.job + "': no such file (looked for " + f.looked_text() + ")");
+      r.diagnostics().add(r.mark(), "spindle.job",
+                          "= '" + c.job + "': no such file (looked for " + f.looked_text() + ")");
   }
   if (auto v = r.text("structure", "")) c.structure = *v;
   if (auto v = r.number("pose_step_deg", {"deg", 0.1, 45.0}, c.pose_step_deg)) c.pose_step_deg = *v;

@@ -22,9 +22,12 @@ using detail::read_int;
 const char* to_string(ModbusTransport t) { return t == ModbusTransport::kTcp ? "tcp" : "rtu"; }
 const char* to_string(DdsTransport t) {
   switch (t) {
-    case DdsTransport::kUdpLoopback: return "udp_loopback";
-    case DdsTransport::kSharedMemory: return "shared_memory";
-    case DdsTransport::kDefault: break;
+    case DdsTransport::kUdpLoopback:
+      return "udp_loopback";
+    case DdsTransport::kSharedMemory:
+      return "shared_memory";
+    case DdsTransport::kDefault:
+      break;
   }
   return "default";
 }
@@ -38,7 +41,8 @@ std::string describe(const ModbusEndpoint& e) {
 }
 
 std::optional<std::string> gain_request_problem(double gain_ns_per_m, double max_ns_per_m, const std::string& why) {
-  return detail::range_problem("controller.gain_ns_per_m", gain_ns_per_m, {"N s/m", 0.0, max_ns_per_m, false, false, why});
+  return detail::range_problem("controller.gain_ns_per_m", gain_ns_per_m,
+                               {"N s/m", 0.0, max_ns_per_m, false, false, why});
 }
 
 namespace detail {
@@ -56,11 +60,13 @@ ModbusEndpoint read_endpoint(MapReader& r) {
   } else {
     e.device = r.text("device", std::nullopt).value_or(e.device);
     if (auto v = read_int(r, "baud", {"bit/s", 1200, 4'000'000}, e.baud)) e.baud = *v;
-    if (auto v = r.choice("parity", {"none", "even", "odd"}, "none")) e.parity = *v == "none" ? 'N' : *v == "even" ? 'E' : 'O';
+    if (auto v = r.choice("parity", {"none", "even", "odd"}, "none"))
+      e.parity = *v == "none" ? 'N' : *v == "even" ? 'E' : 'O';
     if (auto v = read_int(r, "data_bits", {"bits", 7, 8}, e.data_bits)) e.data_bits = *v;
     if (auto v = read_int(r, "stop_bits", {"bits", 1, 2}, e.stop_bits)) e.stop_bits = *v;
   }
-  if (auto v = read_int(r, "unit_id", {"(Modbus unit id)", e.transport == ModbusTransport::kTcp ? 0.0 : 1.0, 247}, e.unit_id))
+  if (auto v = read_int(r, "unit_id", {"(Modbus unit id)", e.transport == ModbusTransport::kTcp ? 0.0 : 1.0, 247},
+                        e.unit_id))
     e.unit_id = *v;
   return e;
 }
@@ -77,23 +83,24 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
   if (auto v = r.number("backoff_max_s", {"s", 0.001, 600.0}, c.backoff_max_s)) c.backoff_max_s = *v;
   if (c.backoff_max_s < c.backoff_initial_s)
     r.diagnostics().add(r.mark(), "modbus.backoff_max_s",
-                        "= " + format_number(c.backoff_max_s) + " s is below modbus.backoff_initial_s = " +
-                            format_number(c.backoff_initial_s) + " s");
+                        "= " + format_number(c.backoff_max_s) +
+                            " s is below modbus.backoff_initial_s = " + format_number(c.backoff_initial_s) + " s");
   if (auto v = r.number("link_timeout_s", {"s", 0.001, 60.0}, c.link_timeout_s)) c.link_timeout_s = *v;
   if (c.link_timeout_s < c.poll_period_s)
     r.diagnostics().add(r.mark(), "modbus.link_timeout_s",
                         "= " + format_number(c.link_timeout_s) + " s is shorter than modbus.poll_period_s = " +
                             format_number(c.poll_period_s) + " s: every poll would count as a lost link");
 
-  MapReader a(r.diagnostics(), r.child("amplifier", true, "the amplifier's endpoint and registers"), "modbus.amplifier", r.mark());
+  MapReader a(r.diagnostics(), r.child("amplifier", true, "the amplifier's endpoint and registers"), "modbus.amplifier",
+              r.mark());
   c.amplifier_link = read_endpoint(a);
   auto& ar = c.amplifier;
   if (auto v = read_int(a, "enable_coil", kAddress, ar.enable_coil)) ar.enable_coil = *v;
   if (auto v = read_int(a, "ready_input", kAddress, ar.ready_input)) ar.ready_input = *v;
   if (auto v = read_int(a, "fault_input", kAddress, ar.fault_input)) ar.fault_input = *v;
   if (ar.ready_input == ar.fault_input)
-    a.diagnostics().add(a.mark(), "modbus.amplifier.fault_input", "= " + std::to_string(ar.fault_input) +
-                                                                      " is the ready input's address too: they must differ");
+    a.diagnostics().add(a.mark(), "modbus.amplifier.fault_input",
+                        "= " + std::to_string(ar.fault_input) + " is the ready input's address too: they must differ");
   if (auto v = read_int(a, "temperature_register", kAddress, ar.temperature_register)) ar.temperature_register = *v;
   if (auto v = a.number("temperature_c_per_count", {"degC per count", 0.0, 100.0, true}, ar.temperature_c_per_count))
     ar.temperature_c_per_count = *v;
@@ -106,8 +113,10 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
     c.robot_link = read_endpoint(b);
     auto& rr = c.robot;
     if (auto v = read_int(b, "mounting_register", kAddress, rr.mounting_register)) rr.mounting_register = *v;
-    if (auto v = read_int(b, "horizontal_value", {"(register value)", 0, 65535}, rr.horizontal_value)) rr.horizontal_value = *v;
-    if (auto v = read_int(b, "vertical_value", {"(register value)", 0, 65535}, rr.vertical_value)) rr.vertical_value = *v;
+    if (auto v = read_int(b, "horizontal_value", {"(register value)", 0, 65535}, rr.horizontal_value))
+      rr.horizontal_value = *v;
+    if (auto v = read_int(b, "vertical_value", {"(register value)", 0, 65535}, rr.vertical_value))
+      rr.vertical_value = *v;
     if (rr.horizontal_value == rr.vertical_value)
       b.diagnostics().add(b.mark(), "modbus.robot.vertical_value",
                           "= " + std::to_string(rr.vertical_value) + " is the horizontal value too: they must differ");
@@ -116,9 +125,11 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
                           rr.spindle_rpm_register))
       rr.spindle_rpm_register = *v;
     if (rr.spindle_rpm_register >= 0 && rr.spindle_rpm_register == rr.mounting_register)
-      b.diagnostics().add(b.mark(), "modbus.robot.spindle_rpm_register",
-                          "= " + std::to_string(rr.spindle_rpm_register) + " is the mounting register too: they must differ");
-    if (auto v = b.number("rpm_per_count", {"rpm per count", 0.0, 1000.0, true}, rr.rpm_per_count)) rr.rpm_per_count = *v;
+      b.diagnostics().add(
+          b.mark(), "modbus.robot.spindle_rpm_register",
+          "= " + std::to_string(rr.spindle_rpm_register) + " is the mounting register too: they must differ");
+    if (auto v = b.number("rpm_per_count", {"rpm per count", 0.0, 1000.0, true}, rr.rpm_per_count))
+      rr.rpm_per_count = *v;
     if (auto v = read_int(b, "joints_register", {"(register address, zero-based; -1 = none)", -1, 65535},
                           rr.joints_register))
       rr.joints_register = *v;
@@ -126,23 +137,26 @@ std::optional<ModbusConfig> read_modbus(MapReader& top) {
     if (auto v = read_int(b, "advice_register", {"(register address, zero-based, 4 registers; -1 = none)", -1, 65532},
                           rr.advice_register))
       rr.advice_register = *v;
-    if (auto v = read_int(b, "depth_register", {"(register address, zero-based; -1 = none)", -1, 65535}, rr.depth_register))
+    if (auto v =
+            read_int(b, "depth_register", {"(register address, zero-based; -1 = none)", -1, 65535}, rr.depth_register))
       rr.depth_register = *v;
     if (auto v = b.number("depth_mm_per_count", {"mm per count", 0.0, 1.0, true}, rr.depth_mm_per_count))
       rr.depth_mm_per_count = *v;
     for (const auto& [key, reg] : {std::pair{"mounting_register", rr.mounting_register},
                                    std::pair{"spindle_rpm_register", rr.spindle_rpm_register}})
       if (rr.depth_register >= 0 && reg == rr.depth_register)
-        b.diagnostics().add(b.mark(), "modbus.robot.depth_register",
-                            "= " + std::to_string(rr.depth_register) + " is modbus.robot." + key + " too: they must differ");
-    for (const auto& [key, reg] : {std::pair{"mounting_register", rr.mounting_register},
-                                   std::pair{"spindle_rpm_register", rr.spindle_rpm_register},
-                                   std::pair{"depth_register", rr.depth_register}})
+        b.diagnostics().add(
+            b.mark(), "modbus.robot.depth_register",
+            "= " + std::to_string(rr.depth_register) + " is modbus.robot." + key + " too: they must differ");
+    for (const auto& [key, reg] :
+         {std::pair{"mounting_register", rr.mounting_register},
+          std::pair{"spindle_rpm_register", rr.spindle_rpm_register}, std::pair{"depth_register", rr.depth_register}})
       if (rr.advice_register >= 0 && reg >= rr.advice_register && reg < rr.advice_register + 4)
         b.diagnostics().add(b.mark(), "modbus.robot.advice_register",
                             "= " + std::to_string(rr.advice_register) + " covers registers " +
                                 std::to_string(rr.advice_register) + "-" + std::to_string(rr.advice_register + 3) +
-                                ", which holds modbus.robot." + key + " = " + std::to_string(reg) + ": they must differ");
+                                ", which holds modbus.robot." + key + " = " + std::to_string(reg) +
+                                ": they must differ");
     b.finish();
   }
   r.finish();
@@ -177,16 +191,18 @@ std::optional<DdsSecurityConfig> read_dds_security(MapReader& dds, const std::st
   const std::filesystem::path dir = std::filesystem::path(source).parent_path();
   DdsSecurityConfig c;
   const std::pair<const char*, std::string*> files[] = {
-      {"identity_ca", &c.identity_ca},       {"identity_certificate", &c.identity_certificate},
-      {"private_key", &c.private_key},       {"permissions_ca", &c.permissions_ca},
-      {"governance", &c.governance},         {"permissions", &c.permissions}};
+      {"identity_ca", &c.identity_ca}, {"identity_certificate", &c.identity_certificate},
+      {"private_key", &c.private_key}, {"permissions_ca", &c.permissions_ca},
+      {"governance", &c.governance},   {"permissions", &c.permissions}};
   for (const auto& [key, out] : files) {
     const auto p = r.text(key, std::nullopt);
     if (!p) continue;
-    const std::filesystem::path resolved = std::filesystem::path(*p).is_absolute() ? std::filesystem::path(*p) : dir / *p;
+    const std::filesystem::path resolved =
+        std::filesystem::path(*p).is_absolute() ? std::filesystem::path(*p) : dir / *p;
     std::error_code ec;
     if (!std::filesystem::is_regular_file(resolved, ec))
-      r.diagnostics().add(r.mark(), r.path_of(key), "= '" + *p + "': no such file (looked for " + resolved.string() + ")");
+      r.diagnostics().add(r.mark(), r.path_of(key),
+                          "= '" + *p + "': no such file (looked for " + resolved.string() + ")");
     *out = resolved.string();
   }
   r.finish();
@@ -202,7 +218,8 @@ void read_joint_names(MapReader& r, const std::string& key, const char* what, st
     for (std::size_t i = 0; i < names.size(); ++i) {
       const std::string at = key + "[" + std::to_string(i) + "]";
       const std::string name = names[i].IsScalar() ? names[i].as<std::string>() : "";
-      if (name.empty()) r.diagnostics().add(to_mark(names[i].Mark()), at, "must be a joint's name (text)");
+      if (name.empty())
+        r.diagnostics().add(to_mark(names[i].Mark()), at, "must be a joint's name (text)");
       else if (std::find(out.begin(), out.end(), name) != out.end())
         r.diagnostics().add(to_mark(names[i].Mark()), at, "= '" + name + "' is named twice: each joint once");
       if (!name.empty()) out.push_back(name);  // kept, so the count is the file's
@@ -215,7 +232,8 @@ std::optional<PathAheadConfig> read_path_ahead(MapReader& dds) {
   MapReader r(dds.diagnostics(), node, "dds.path_ahead", dds.mark());
   PathAheadConfig c;
   if (auto v = r.text("topic", c.topic)) c.topic = *v;
-  read_joint_names(r, "dds.path_ahead.names", "the pose schedule's joints by the names the robot program publishes", c.names);
+  read_joint_names(r, "dds.path_ahead.names", "the pose schedule's joints by the names the robot program publishes",
+                   c.names);
   if (auto v = r.number("hold_s", {"s", 0.1, 3600.0}, c.hold_s)) c.hold_s = *v;
   r.finish();
   return c;
@@ -242,7 +260,7 @@ std::optional<DdsConfig> read_dds(MapReader& top) {
   DdsConfig c;
   if (auto v = read_int(r, "domain_id", {"(DDS domain)", 0, 232}, c.domain_id)) c.domain_id = *v;
   if (auto v = r.choice("transport", {"default", "udp_loopback", "shared_memory"}, "default"))
-    c.transport = *v == "udp_loopback" ? DdsTransport::kUdpLoopback
+    c.transport = *v == "udp_loopback"    ? DdsTransport::kUdpLoopback
                   : *v == "shared_memory" ? DdsTransport::kSharedMemory
                                           : DdsTransport::kDefault;
   if (auto v = r.number("telemetry_rate_hz", {"Hz", 0.0, 1000.0, true}, c.telemetry_rate_hz)) c.telemetry_rate_hz = *v;

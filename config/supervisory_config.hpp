@@ -27,10 +27,10 @@ struct ModbusEndpoint {
 
 // The amplifier's register map (zero-based protocol addresses).
 struct AmplifierRegisters {
-  int enable_coil{0};             // coil, written: 1 = enabled
-  int ready_input{0};             // discrete input: enabled and able to drive
-  int fault_input{1};             // discrete input: over-current, over-temperature, internal fault
-  int temperature_register{0};    // input register, signed 16-bit count
+  int enable_coil{0};           // coil, written: 1 = enabled
+  int ready_input{0};           // discrete input: enabled and able to drive
+  int fault_input{1};           // discrete input: over-current, over-temperature, internal fault
+  int temperature_register{0};  // input register, signed 16-bit count
   double temperature_c_per_count{0.1};
   double temperature_max_c{80.0};  // hotter than this is treated as an amplifier fault
 };
@@ -40,7 +40,7 @@ struct RobotRegisters {
   int mounting_register{0};  // holding register
   int horizontal_value{0};
   int vertical_value{1};
-  int settle_polls{3};       // the same value this many polls running before a set is selected
+  int settle_polls{3};  // the same value this many polls running before a set is selected
   // The spindle speed (docs/harmonic_notch.md): a holding register (-1 = none), scaled, with the same
   // settling; the robot link lost for modbus.link_timeout_s parks the harmonic notches.
   int spindle_rpm_register{-1};
@@ -120,8 +120,8 @@ struct DdsConfig {
   DdsTransport transport{DdsTransport::kDefault};
   double telemetry_rate_hz{50.0};  // decimated loop frames
   double status_rate_hz{5.0};
-  bool parameter_writes{false};    // parameter requests are refused unless this is on
-  std::optional<DdsSecurityConfig> security;  // absent: no authentication (a closed cell network)
+  bool parameter_writes{false};                   // parameter requests are refused unless this is on
+  std::optional<DdsSecurityConfig> security;      // absent: no authentication (a closed cell network)
   std::optional<JointStatesConfig> joint_states;  // absent: the pose comes from Modbus, or not at all
   std::optional<PathAheadConfig> path_ahead;      // absent: the advice looks at the pose now only
 };
@@ -144,11 +144,11 @@ enum class HilPacing { kRealtime, kLockstep };
 
 struct HilConfig {
   HilPacing pacing{HilPacing::kRealtime};
-  double settle_s{3.0};             // after the amplifier is enabled, before the first impact
-  double accept_timeout_s{30.0};    // waiting for the controller to connect
+  double settle_s{3.0};           // after the amplifier is enabled, before the first impact
+  double accept_timeout_s{30.0};  // waiting for the controller to connect
   double amplifier_ready_delay_s{0.005};
   double ambient_c{35.0};
-  double heating_c_per_v2{0.5};     // amplifier temperature above ambient per mean-square volt
+  double heating_c_per_v2{0.5};  // amplifier temperature above ambient per mean-square volt
   // The robot the emulator moves (a robot model file; empty: pose_schedule.model): a HIL cell that stands for
   // a robot its configured model does not describe, as a real robot is not its model file.
   std::string robot_model;           // as written

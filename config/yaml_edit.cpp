@@ -40,16 +40,20 @@ std::size_t scalar_end(const std::string& t, const YAML::Node& n) {
   if (pos >= t.size()) return kUnknown;
   if (t[pos] == '"') {
     for (std::size_t i = pos + 1; i < t.size(); ++i) {
-      if (t[i] == '\\') ++i;
-      else if (t[i] == '"') return i + 1;
+      if (t[i] == '\\')
+        ++i;
+      else if (t[i] == '"')
+        return i + 1;
     }
     return kUnknown;
   }
   if (t[pos] == '\'') {
     for (std::size_t i = pos + 1; i < t.size(); ++i)
       if (t[i] == '\'') {
-        if (i + 1 < t.size() && t[i + 1] == '\'') ++i;
-        else return i + 1;
+        if (i + 1 < t.size() && t[i + 1] == '\'')
+          ++i;
+        else
+          return i + 1;
       }
     return kUnknown;
   }
@@ -64,8 +68,10 @@ int open_brackets(const std::string& t, std::size_t a, std::size_t b) {
   for (std::size_t i = a; i < b; ++i) {
     const char c = t[i];
     if (quote) {
-      if (quote == '"' && c == '\\') ++i;
-      else if (c == quote) quote = 0;
+      if (quote == '"' && c == '\\')
+        ++i;
+      else if (c == quote)
+        quote = 0;
     } else if (c == '"' || c == '\'') {
       quote = c;
     } else if (c == '#' && (i == a || t[i - 1] == ' ' || t[i - 1] == '\t')) {
@@ -93,7 +99,8 @@ std::size_t node_end(const std::string& t, const YAML::Node& n) {
     end = std::max({end, e1, e2});
   }
   for (int open = open_brackets(t, start, end); open > 0; --open) {
-    while (end < t.size() && (t[end] == ' ' || t[end] == '\t' || t[end] == '\n' || t[end] == '\r' || t[end] == ',')) ++end;
+    while (end < t.size() && (t[end] == ' ' || t[end] == '\t' || t[end] == '\n' || t[end] == '\r' || t[end] == ','))
+      ++end;
     if (end >= t.size() || (t[end] != ']' && t[end] != '}')) return kUnknown;
     ++end;
   }
@@ -155,7 +162,8 @@ void check_path(const YAML::Node& root, const std::vector<YamlPathItem>& path) {
     } else if (!c.IsMap()) {
       throw std::invalid_argument(path_text(path) + ": not a mapping in the document");
     }
-    const YAML::Node next = std::holds_alternative<std::size_t>(p) ? c[std::get<std::size_t>(p)] : c[std::get<std::string>(p)];
+    const YAML::Node next =
+        std::holds_alternative<std::size_t>(p) ? c[std::get<std::size_t>(p)] : c[std::get<std::string>(p)];
     if (!next.IsDefined()) return;  // created by the edit
     n.reset(next);
   }
@@ -168,12 +176,16 @@ std::string emitted_again(const std::string& text, const std::vector<YamlEdit>& 
     n.reset(root);
     for (std::size_t k = 0; k + 1 < e.path.size(); ++k) {
       YAML::Node next;
-      if (const auto* i = std::get_if<std::size_t>(&e.path[k])) next.reset(n[*i]);
-      else next.reset(n[std::get<std::string>(e.path[k])]);
+      if (const auto* i = std::get_if<std::size_t>(&e.path[k]))
+        next.reset(n[*i]);
+      else
+        next.reset(n[std::get<std::string>(e.path[k])]);
       n.reset(next);
     }
-    if (const auto* i = std::get_if<std::size_t>(&e.path.back())) n[*i] = e.value;
-    else n[std::get<std::string>(e.path.back())] = e.value;
+    if (const auto* i = std::get_if<std::size_t>(&e.path.back()))
+      n[*i] = e.value;
+    else
+      n[std::get<std::string>(e.path.back())] = e.value;
   }
   YAML::Emitter out;
   out << root;
@@ -193,7 +205,8 @@ YAML::Node yaml_at(const YAML::Node& root, const std::vector<YamlPathItem>& path
       return YAML::Node(YAML::NodeType::Undefined);
     }
     // A missing key gives an invalid node, which reset() refuses: test it first.
-    const YAML::Node next = std::holds_alternative<std::size_t>(p) ? c[std::get<std::size_t>(p)] : c[std::get<std::string>(p)];
+    const YAML::Node next =
+        std::holds_alternative<std::size_t>(p) ? c[std::get<std::size_t>(p)] : c[std::get<std::string>(p)];
     if (!next.IsDefined()) return YAML::Node(YAML::NodeType::Undefined);
     n.reset(next);
   }
@@ -209,8 +222,10 @@ EditedYaml edit_yaml(const std::string& text, const std::vector<YamlEdit>& edits
   std::vector<Splice> splices;
   bool exact = true;
   for (const auto& e : edits) {
-    if (auto s = splice_for(text, root, e)) splices.push_back(*s);
-    else exact = false;
+    if (auto s = splice_for(text, root, e))
+      splices.push_back(*s);
+    else
+      exact = false;
   }
   if (exact) {
     std::sort(splices.begin(), splices.end(), [](const Splice& a, const Splice& b) { return a.from > b.from; });

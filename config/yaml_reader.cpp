@@ -37,8 +37,8 @@ std::string joined(const std::vector<std::string>& v) {
 MapReader::MapReader(Diagnostics& d, const YAML::Node& node, std::string path, const YAML::Mark& parent_mark)
     : d_(d), node_(node), path_(std::move(path)), mark_(node.IsDefined() ? node.Mark() : parent_mark) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap()) {
-    d_.add(node_.Mark(), path_, "expected a map of keys, found " +
-                                    std::string(node_.IsSequence() ? "a list" : "a single value"));
+    d_.add(node_.Mark(), path_,
+           "expected a map of keys, found " + std::string(node_.IsSequence() ? "a list" : "a single value"));
     node_ = YAML::Node();
   }
   quiet_ = !node_.IsDefined() || !node_.IsMap();
@@ -93,8 +93,9 @@ std::optional<std::string> MapReader::choice(const std::string& key, const std::
     return std::nullopt;
   }
   if (!n.IsScalar() || std::find(allowed.begin(), allowed.end(), n.Scalar()) == allowed.end()) {
-    d_.add(n.Mark(), k, "= '" + (n.IsScalar() ? n.Scalar() : std::string("<not a scalar>")) +
-                            "' is not allowed: one of " + joined(allowed));
+    d_.add(n.Mark(), k,
+           "= '" + (n.IsScalar() ? n.Scalar() : std::string("<not a scalar>")) + "' is not allowed: one of " +
+               joined(allowed));
     return std::nullopt;
   }
   return n.Scalar();
@@ -154,7 +155,6 @@ void MapReader::finish() {
   }
 }
 
-
 std::string read_config_text(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError({Problem{path, {}, "(file)", "cannot be opened for reading"}});
@@ -173,7 +173,8 @@ YAML::Node load_top_map(Diagnostics& d, const std::string& yaml_text, const std:
   }
   if (!root.IsMap()) {
     // An empty document has no mark: its problem is at its first line.
-    d.add(root.Mark().is_null() ? SourceMark{1, 1} : to_mark(root.Mark()), "(top level)", "expected a map with " + expected);
+    d.add(root.Mark().is_null() ? SourceMark{1, 1} : to_mark(root.Mark()), "(top level)",
+          "expected a map with " + expected);
     throw ConfigError(d.problems());
   }
   return root;
@@ -231,7 +232,8 @@ ModeConfig read_mode(MapReader& mr, const Range& frequency_range) {
 }
 
 std::optional<RobotModelConfig> read_robot_model_file(MapReader& r, const std::string& key, const std::string& source,
-                                                    const std::string& value, std::string& written, std::string& resolved) {
+                                                      const std::string& value, std::string& written,
+                                                      std::string& resolved) {
   written = value;
   const FoundFile f = find_named_file(std::filesystem::path(source).parent_path().string(), value);
   resolved = f.path;

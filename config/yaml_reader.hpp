@@ -28,10 +28,10 @@ class Diagnostics {
   std::vector<Problem> problems_;
 };
 
-using config::Range;
-using config::format_number;
 using config::describe_range;
+using config::format_number;
 using config::in_range;
+using config::Range;
 using config::range_problem;
 
 [[nodiscard]] SourceMark to_mark(const YAML::Mark& m);
@@ -85,12 +85,14 @@ void read_supervisory(MapReader& top, Config& c);
 // The dds section alone (the dashboard's file has one too).
 [[nodiscard]] std::optional<DdsConfig> read_dds_section(MapReader& top);
 // The controller's optional harmonic_notch map and the optional spindle section (config/spindle_config.hpp).
-[[nodiscard]] std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller, std::optional<double> rate_hz);
+[[nodiscard]] std::optional<HarmonicNotchConfig> read_harmonic_notch(MapReader& controller,
+                                                                     std::optional<double> rate_hz);
 [[nodiscard]] SpindleConfig read_spindle(MapReader& top, const std::string& source);
-[[nodiscard]] std::optional<SpeedScheduleConfig> read_speed_schedule(MapReader& controller, std::optional<double> rate_hz);
+[[nodiscard]] std::optional<SpeedScheduleConfig> read_speed_schedule(MapReader& controller,
+                                                                     std::optional<double> rate_hz);
 // One block of controller.chain (or a block that replaces one), checked like the chain's.
-[[nodiscard]] std::optional<BlockConfig> read_chain_block(Diagnostics& d, const YAML::Node& node, const std::string& key,
-                                                          std::optional<double> rate_hz);
+[[nodiscard]] std::optional<BlockConfig> read_chain_block(Diagnostics& d, const YAML::Node& node,
+                                                          const std::string& key, std::optional<double> rate_hz);
 // The optional pose_schedule section (config/pose_schedule_config.hpp); the robot model it names is loaded.
 [[nodiscard]] std::optional<PoseScheduleConfig> read_pose_schedule(MapReader& top, const std::string& source);
 // The optional commissioning section (config/commissioning_config.hpp).
@@ -100,8 +102,8 @@ void read_supervisory(MapReader& top, Config& c);
 
 // A key naming a robot model file: found (the configuration's folder, then the data folders: file_paths.hpp)
 // and read; what is wrong with it is reported at the key (key: its full name). written and resolved are set.
-[[nodiscard]] std::optional<RobotModelConfig> read_robot_model_file(MapReader& r, const std::string& key, const std::string& source,
-                                                                    const std::string& value, std::string& written,
-                                                                    std::string& resolved);
+[[nodiscard]] std::optional<RobotModelConfig> read_robot_model_file(MapReader& r, const std::string& key,
+                                                                    const std::string& source, const std::string& value,
+                                                                    std::string& written, std::string& resolved);
 
 }  // namespace robodamp::config::detail

@@ -13,13 +13,13 @@ namespace robodamp::control {
 
 struct ControllerCounters {
   std::uint64_t samples{0};
-  std::uint64_t nonfinite_inputs{0};      // never entered the filter state
-  std::uint64_t filter_state_resets{0};   // non-finite filter output (overflow), state cleared
-  std::uint64_t force_limited{0};         // command force clipped at the actuator force limit
-  std::uint64_t voltage_limited{0};       // clipped at the amplifier voltage range
-  std::uint64_t slew_limited{0};          // clipped at the slew-rate limit
-  std::uint64_t rejected_requests{0};     // gain or parameter requests refused (out of range, other rate)
-  std::uint64_t spindle_refused{0};       // spindle speeds refused (NaN, negative, above rpm_max): notches parked
+  std::uint64_t nonfinite_inputs{0};     // never entered the filter state
+  std::uint64_t filter_state_resets{0};  // non-finite filter output (overflow), state cleared
+  std::uint64_t force_limited{0};        // command force clipped at the actuator force limit
+  std::uint64_t voltage_limited{0};      // clipped at the amplifier voltage range
+  std::uint64_t slew_limited{0};         // clipped at the slew-rate limit
+  std::uint64_t rejected_requests{0};    // gain or parameter requests refused (out of range, other rate)
+  std::uint64_t spindle_refused{0};      // spindle speeds refused (NaN, negative, above rpm_max): notches parked
 };
 
 enum class RequestStatus { kAccepted, kRejectedOutOfRange, kRejectedSampleRate };
@@ -247,8 +247,8 @@ class Controller final {
   filters::BiquadCascade shadow_;
   filters::HarmonicNotchBank notches_;
   double dt_s_;
-  double spindle_rpm_{0.0};    // what the notches follow (0: parked)
-  double schedule_rpm_{0.0};   // what the speed schedule follows: the spindle's speed, parked or not
+  double spindle_rpm_{0.0};   // what the notches follow (0: parked)
+  double schedule_rpm_{0.0};  // what the speed schedule follows: the spindle's speed, parked or not
   double target_gain_{0.0};
   double scale_{0.0}, target_scale_{0.0}, ramp_step_{0.0};
   std::uint64_t ramp_left_{0};

@@ -23,7 +23,7 @@ namespace robodamp::dashboard {
 
 namespace {
 
-constexpr int kFreeFailures = 3;       // then locked out: 1 s, 2 s, 4 s ... per further failure
+constexpr int kFreeFailures = 3;  // then locked out: 1 s, 2 s, 4 s ... per further failure
 constexpr double kMaxLockout_s = 300.0;
 
 std::string hex(const unsigned char* p, std::size_t n) {
@@ -37,7 +37,9 @@ std::optional<std::vector<unsigned char>> unhex(const std::string& s) {
   if (s.size() % 2 != 0) return std::nullopt;
   std::vector<unsigned char> out;
   for (std::size_t i = 0; i < s.size(); i += 2) {
-    const auto v = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1; };
+    const auto v = [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c)) ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+    };
     const int hi = v(s[i]), lo = v(s[i + 1]);
     if (hi < 0 || lo < 0) return std::nullopt;
     out.push_back(static_cast<unsigned char>(hi * 16 + lo));
@@ -72,7 +74,8 @@ std::string user_name_problem(const std::string& name) { return config::name_pro
 std::string hash_password(const std::string& password, int iterations) {
   const auto salt = random_bytes(16);
   const auto key = pbkdf2(password, salt, iterations);
-  return "pbkdf2-sha256$" + std::to_string(iterations) + "$" + hex(salt.data(), salt.size()) + "$" + hex(key.data(), key.size());
+  return "pbkdf2-sha256$" + std::to_string(iterations) + "$" + hex(salt.data(), salt.size()) + "$" +
+         hex(key.data(), key.size());
 }
 
 bool verify_password(const std::string& password, const std::string& hash) {
@@ -99,18 +102,22 @@ std::vector<User> load_users(const std::string& path) {
   } catch (const YAML::Exception& e) {
     refuse(path, "(file)", std::string("cannot be read as YAML: ") + e.what());
   }
-  if (!root["users"] || !root["users"].IsSequence()) refuse(path, "users", "missing (required: a list of {name, role, hash})");
+  if (!root["users"] || !root["users"].IsSequence())
+    refuse(path, "users", "missing (required: a list of {name, role, hash})");
   std::vector<User> out;
   for (std::size_t i = 0; i < root["users"].size(); ++i) {
     const YAML::Node u = root["users"][i];
     const std::string key = "users[" + std::to_string(i) + "]";
     if (!u.IsMap() || !u["name"] || !u["role"] || !u["hash"]) refuse(path, key, "needs name, role and hash");
     User user{u["name"].as<std::string>(), Role::kObserver, u["hash"].as<std::string>()};
-    if (const auto p = user_name_problem(user.name); !p.empty()) refuse(path, key + ".name", "= '" + user.name + "' " + p);
+    if (const auto p = user_name_problem(user.name); !p.empty())
+      refuse(path, key + ".name", "= '" + user.name + "' " + p);
     const std::string role = u["role"].as<std::string>();
-    if (role != "operator" && role != "observer") refuse(path, key + ".role", "= '" + role + "': allowed operator or observer");
+    if (role != "operator" && role != "observer")
+      refuse(path, key + ".role", "= '" + role + "': allowed operator or observer");
     user.role = role == "operator" ? Role::kOperator : Role::kObserver;
-    if (user.hash.rfind("pbkdf2-sha256$", 0) != 0) refuse(path, key + ".hash", "is not a pbkdf2-sha256 hash (robodamp dashboard-user writes one)");
+    if (user.hash.rfind("pbkdf2-sha256$", 0) != 0)
+      refuse(path, key + ".hash", "is not a pbkdf2-sha256 hash (robodamp dashboard-user writes one)");
     if (std::any_of(out.begin(), out.end(), [&](const User& o) { return o.name == user.name; }))
       refuse(path, key + ".name", "= '" + user.name + "' appears twice");
     out.push_back(std::move(user));
@@ -119,7 +126,8 @@ std::vector<User> load_users(const std::string& path) {
 }
 
 void save_user(const std::string& path, const User& user) {
-  if (const auto p = user_name_problem(user.name); !p.empty()) throw std::runtime_error("user name '" + user.name + "' " + p);
+  if (const auto p = user_name_problem(user.name); !p.empty())
+    throw std::runtime_error("user name '" + user.name + "' " + p);
   std::vector<User> users;
   std::ifstream probe(path);
   if (probe.good()) users = load_users(path);
@@ -137,7 +145,8 @@ void save_user(const std::string& path, const User& user) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::trunc);
-    out << "# robodamp dashboard users (robodamp dashboard-user writes this file; PBKDF2-HMAC-SHA256 hashes)\n" << e.c_str() << '\n';
+    out << "# robodamp dashboard users (robodamp dashboard-user writes this file; PBKDF2-HMAC-SHA256 hashes)\n"
+        << e.c_str() << '\n';
     if (!out) throw std::runtime_error("cannot write " + tmp);
   }
   ::chmod(tmp.c_str(), 0600);
@@ -178,8 +187,10 @@ LoginResult Authenticator::login(const std::string& user, const std::string& pas
   }
   const auto it = std::find_if(users_.begin(), users_.end(), [&](const User& u) { return u.name == user; });
   // The hash is computed for an unknown user too: the time does not tell which part was wrong.
-  const bool ok = verify_password(password, it != users_.end() ? it->hash : std::string(
-      "pbkdf2-sha256$200000$00000000000000000000000000000000$0000000000000000000000000000000000000000000000000000000000000000"));
+  const bool ok = verify_password(
+      password, it != users_.end() ? it->hash
+                                   : std::string("pbkdf2-sha256$200000$00000000000000000000000000000000$"
+                                                 "0000000000000000000000000000000000000000000000000000000000000000"));
   std::lock_guard<std::mutex> lock(m_);
   if (!ok || it == users_.end()) {
     ++n_.wrong_passwords;
@@ -235,9 +246,9 @@ std::string now_utc_iso8601() {
 ActionLog::ActionLog(std::string path) : path_(std::move(path)) {}
 
 void ActionLog::append(const ActionRecord& r) {
-  const nlohmann::json j = {{"time", r.time_utc}, {"user", r.user},   {"role", r.role},         {"address", r.address},
-                            {"cell", r.cell},     {"action", r.action}, {"value", r.value},     {"accepted", r.accepted},
-                            {"reason", r.reason}};
+  const nlohmann::json j = {{"time", r.time_utc},   {"user", r.user},         {"role", r.role},
+                            {"address", r.address}, {"cell", r.cell},         {"action", r.action},
+                            {"value", r.value},     {"accepted", r.accepted}, {"reason", r.reason}};
   std::lock_guard<std::mutex> lock(m_);
   if (!path_.empty()) {
     std::ofstream out(path_, std::ios::app);

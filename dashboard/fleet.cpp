@@ -26,64 +26,119 @@ namespace {
 constexpr std::size_t kMaxCells = 256;
 
 std::int64_t wall_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 json finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }  // JSON has no inf: null
 
 json to_json(const msg::Status& s) {
-  return {{"time_s", s.time_s()}, {"state", s.state().to_string()}, {"trip", s.trip().to_string()}, {"trip_description", s.trip_description().to_string()},
-          {"backend", s.backend().to_string()}, {"parameter_set", s.parameter_set()}, {"gain_ns_per_m", s.gain_ns_per_m()},
-          {"max_gain_ns_per_m", s.max_gain_ns_per_m()}, {"parameter_writes", s.parameter_writes()},
-          {"parameter_sets", s.parameter_sets()}, {"spindle_rpm_max", s.spindle_rpm_max()}, {"ticks", s.ticks()},
-          {"missed_ticks", s.missed_ticks()}, {"overruns", s.overruns()}, {"stale_ticks", s.stale_ticks()},
-          {"invalid_samples", s.invalid_samples()}, {"saturated_ticks", s.saturated_ticks()}, {"ring_drops", s.ring_drops()},
-          {"wake_p50_us", s.wake_p50_us()}, {"wake_p99_us", s.wake_p99_us()}, {"wake_max_us", s.wake_max_us()},
-          {"compute_mean_us", s.compute_mean_us()}, {"compute_max_us", s.compute_max_us()},
-          {"availability_pct", s.availability_pct()}, {"trips", s.trips()}, {"back_at_full_gain", s.back_at_full_gain()},
-          {"last_trip_s", s.last_trip_s()}, {"derated", s.derated()}, {"derated_pct", s.derated_pct()},
-          {"wake_histogram", s.wake_histogram()}, {"compute_histogram", s.compute_histogram()},
-          {"histogram_edges_us", std::vector<double>(std::begin(dds::kHistogramEdgesUs), std::end(dds::kHistogramEdgesUs))}};
+  return {{"time_s", s.time_s()},
+          {"state", s.state().to_string()},
+          {"trip", s.trip().to_string()},
+          {"trip_description", s.trip_description().to_string()},
+          {"backend", s.backend().to_string()},
+          {"parameter_set", s.parameter_set()},
+          {"gain_ns_per_m", s.gain_ns_per_m()},
+          {"max_gain_ns_per_m", s.max_gain_ns_per_m()},
+          {"parameter_writes", s.parameter_writes()},
+          {"parameter_sets", s.parameter_sets()},
+          {"spindle_rpm_max", s.spindle_rpm_max()},
+          {"ticks", s.ticks()},
+          {"missed_ticks", s.missed_ticks()},
+          {"overruns", s.overruns()},
+          {"stale_ticks", s.stale_ticks()},
+          {"invalid_samples", s.invalid_samples()},
+          {"saturated_ticks", s.saturated_ticks()},
+          {"ring_drops", s.ring_drops()},
+          {"wake_p50_us", s.wake_p50_us()},
+          {"wake_p99_us", s.wake_p99_us()},
+          {"wake_max_us", s.wake_max_us()},
+          {"compute_mean_us", s.compute_mean_us()},
+          {"compute_max_us", s.compute_max_us()},
+          {"availability_pct", s.availability_pct()},
+          {"trips", s.trips()},
+          {"back_at_full_gain", s.back_at_full_gain()},
+          {"last_trip_s", s.last_trip_s()},
+          {"derated", s.derated()},
+          {"derated_pct", s.derated_pct()},
+          {"wake_histogram", s.wake_histogram()},
+          {"compute_histogram", s.compute_histogram()},
+          {"histogram_edges_us",
+           std::vector<double>(std::begin(dds::kHistogramEdgesUs), std::end(dds::kHistogramEdgesUs))}};
 }
 
 json to_json(const msg::Machining& m) {
-  return {{"time_s", m.time_s()}, {"spindle_rpm", m.spindle_rpm()}, {"tooth_passing_hz", m.tooth_passing_hz()},
-          {"depth_mm", m.depth_mm()}, {"limits_ready", m.limits_ready()}, {"open_limit_mm", finite(m.open_limit_mm())},
-          {"damped_limit_mm", finite(m.damped_limit_mm())}, {"limit_method", m.limit_method()}, {"loop_active", m.loop_active()},
-          {"limit_mm", finite(m.limit_mm())}, {"depth_warning", m.depth_warning()}, {"depth_measured", m.depth_measured()}, {"indicator_valid", m.indicator_valid()},
-          {"once_per_rev_ratio", m.once_per_rev_ratio()}, {"nonharmonic_share", m.nonharmonic_share()},
-          {"chatter_hz", m.chatter_hz()}, {"chatter", m.chatter()}, {"cutting", dds::cutting_name(m.cutting())},
-          {"cutting_reason", m.cutting_reason()}, {"pose_deg", m.pose_deg()}, {"limits_pose_deg", m.limits_pose_deg()},
-          {"mode_spread_pct", m.mode_spread_pct()}, {"nearest_measured_deg", m.nearest_measured_deg()}};
+  return {{"time_s", m.time_s()},
+          {"spindle_rpm", m.spindle_rpm()},
+          {"tooth_passing_hz", m.tooth_passing_hz()},
+          {"depth_mm", m.depth_mm()},
+          {"limits_ready", m.limits_ready()},
+          {"open_limit_mm", finite(m.open_limit_mm())},
+          {"damped_limit_mm", finite(m.damped_limit_mm())},
+          {"limit_method", m.limit_method()},
+          {"loop_active", m.loop_active()},
+          {"limit_mm", finite(m.limit_mm())},
+          {"depth_warning", m.depth_warning()},
+          {"depth_measured", m.depth_measured()},
+          {"indicator_valid", m.indicator_valid()},
+          {"once_per_rev_ratio", m.once_per_rev_ratio()},
+          {"nonharmonic_share", m.nonharmonic_share()},
+          {"chatter_hz", m.chatter_hz()},
+          {"chatter", m.chatter()},
+          {"cutting", dds::cutting_name(m.cutting())},
+          {"cutting_reason", m.cutting_reason()},
+          {"pose_deg", m.pose_deg()},
+          {"limits_pose_deg", m.limits_pose_deg()},
+          {"mode_spread_pct", m.mode_spread_pct()},
+          {"nearest_measured_deg", m.nearest_measured_deg()}};
 }
 
 json to_json(const msg::Advice& a) {
   json options = json::array();
   for (std::size_t i = 0; i < a.option_rpm().size() && i < a.option_limit_mm().size(); ++i)
     options.push_back({{"rpm", a.option_rpm()[i]}, {"limit_mm", finite(a.option_limit_mm()[i])}});
-  return {{"seq", a.seq()}, {"time_s", a.time_s()}, {"trigger", a.trigger()}, {"spindle_rpm", a.spindle_rpm()},
-          {"depth_mm", a.depth_mm()}, {"damped", a.damped()}, {"chatter_hz", a.chatter_hz()},
-          {"limit_now_mm", finite(a.limit_now_mm())}, {"method", a.method()}, {"found", a.found()},
-          {"advised_rpm", a.advised_rpm()}, {"advised_limit_mm", finite(a.advised_limit_mm())}, {"margin", finite(a.margin())},
-          {"options", options}, {"best_rpm", a.best_rpm()}, {"best_limit_mm", finite(a.best_limit_mm())},
-          {"reason", a.reason()}, {"rpm_min", a.rpm_min()}, {"rpm_max", a.rpm_max()}, {"pose_deg", a.pose_deg()},
-          {"poses_ahead", a.poses_ahead()}, {"limiting_pose_deg", a.limiting_pose_deg()}, {"status", a.status()}, {"status_reason", a.status_reason()}};
+  return {{"seq", a.seq()},
+          {"time_s", a.time_s()},
+          {"trigger", a.trigger()},
+          {"spindle_rpm", a.spindle_rpm()},
+          {"depth_mm", a.depth_mm()},
+          {"damped", a.damped()},
+          {"chatter_hz", a.chatter_hz()},
+          {"limit_now_mm", finite(a.limit_now_mm())},
+          {"method", a.method()},
+          {"found", a.found()},
+          {"advised_rpm", a.advised_rpm()},
+          {"advised_limit_mm", finite(a.advised_limit_mm())},
+          {"margin", finite(a.margin())},
+          {"options", options},
+          {"best_rpm", a.best_rpm()},
+          {"best_limit_mm", finite(a.best_limit_mm())},
+          {"reason", a.reason()},
+          {"rpm_min", a.rpm_min()},
+          {"rpm_max", a.rpm_max()},
+          {"pose_deg", a.pose_deg()},
+          {"poses_ahead", a.poses_ahead()},
+          {"limiting_pose_deg", a.limiting_pose_deg()},
+          {"status", a.status()},
+          {"status_reason", a.status_reason()}};
 }
 
 json to_json(const msg::Spectrum& s) {
   json asd = json::array();
   for (const float v : s.accel_asd()) asd.push_back(finite(v));
-  return {{"time_s", s.time_s()}, {"bin_hz", s.bin_hz()}, {"record_s", s.record_s()}, {"accel_asd", asd},
-          {"mode_hz", s.mode_hz()}, {"tooth_passing_hz", s.tooth_passing_hz()}};
+  return {{"time_s", s.time_s()}, {"bin_hz", s.bin_hz()},   {"record_s", s.record_s()},
+          {"accel_asd", asd},     {"mode_hz", s.mode_hz()}, {"tooth_passing_hz", s.tooth_passing_hz()}};
 }
 
 json to_json(const msg::Lobes& l) {
   json open = json::array(), damped = json::array();
   for (const double v : l.open_limit_mm()) open.push_back(finite(v));
   for (const double v : l.damped_limit_mm()) damped.push_back(finite(v));
-  return {{"time_s", l.time_s()}, {"parameter_set", l.parameter_set()}, {"gain_ns_per_m", l.gain_ns_per_m()},
-          {"method", l.method()}, {"depth_mm", l.depth_mm()}, {"rpm", l.rpm()}, {"open_limit_mm", open},
-          {"damped_limit_mm", damped}, {"speed_scheduled", l.speed_scheduled()}, {"pose_deg", l.pose_deg()}};
+  return {{"time_s", l.time_s()},    {"parameter_set", l.parameter_set()}, {"gain_ns_per_m", l.gain_ns_per_m()},
+          {"method", l.method()},    {"depth_mm", l.depth_mm()},           {"rpm", l.rpm()},
+          {"open_limit_mm", open},   {"damped_limit_mm", damped},          {"speed_scheduled", l.speed_scheduled()},
+          {"pose_deg", l.pose_deg()}};
 }
 
 }  // namespace
@@ -129,12 +184,15 @@ Fleet::Fleet(const config::DdsConfig& dds, double stale_after_s, std::size_t tel
     return listeners_.back().get();
   };
   auto* telemetry = add(std::function<void(const msg::Telemetry&, const SampleInfo&)>(
-      [this](const msg::Telemetry& v, const SampleInfo& i) { on_telemetry(&v, i.source_timestamp.to_ns() / 1000000); }));
-  auto* status = add(std::function<void(const msg::Status&, const SampleInfo&)>([this](const msg::Status& v, const SampleInfo& i) {
-    std::ostringstream guid;
-    guid << i.sample_identity.writer_guid();
-    on_status(&v, guid.str(), i.source_timestamp.to_ns() / 1000000);
-  }));
+      [this](const msg::Telemetry& v, const SampleInfo& i) {
+        on_telemetry(&v, i.source_timestamp.to_ns() / 1000000);
+      }));
+  auto* status =
+      add(std::function<void(const msg::Status&, const SampleInfo&)>([this](const msg::Status& v, const SampleInfo& i) {
+        std::ostringstream guid;
+        guid << i.sample_identity.writer_guid();
+        on_status(&v, guid.str(), i.source_timestamp.to_ns() / 1000000);
+      }));
   auto* machining = add(std::function<void(const msg::Machining&, const SampleInfo&)>(
       [this](const msg::Machining& v, const SampleInfo&) { on_machining(&v); }));
   auto* advice = add(std::function<void(const msg::Advice&, const SampleInfo&)>(
@@ -227,9 +285,11 @@ void Fleet::on_status(const void* p, const std::string& writer, std::int64_t sou
   bool bad = false;
   Cell* c = cell_for(s.cell().to_string(), bad);
   if (c == nullptr) return;
-  const bool urgent = c->status.is_null() || c->status["state"] != s.state().to_string() || c->status["trip"] != s.trip().to_string();
-  const bool news = rt::to_string(static_cast<rt::State>(c->state)) != s.state().to_string() ||
-                    rt::to_string(static_cast<rt::Trip>(c->trip)) != s.trip().to_string();  // before the telemetry said it
+  const bool urgent =
+      c->status.is_null() || c->status["state"] != s.state().to_string() || c->status["trip"] != s.trip().to_string();
+  const bool news =
+      rt::to_string(static_cast<rt::State>(c->state)) != s.state().to_string() ||
+      rt::to_string(static_cast<rt::Trip>(c->trip)) != s.trip().to_string();  // before the telemetry said it
   if (urgent && news) c->state_source_ms = source_ms;
   // A writer not heard before while none is live: the cell restarted. What its last run published (the
   // advice, the machining state, the spectrum, the lobes, the telemetry) is not about this run: dropped, so
@@ -300,7 +360,8 @@ void Fleet::watch_contact(std::stop_token stop) {
         bump(true);
       }
       for (auto it = c->status_writers.begin(); it != c->status_writers.end();)  // writers gone quiet
-        it = now - it->second > std::chrono::duration<double>(stale_after_s_ * 5.0) ? c->status_writers.erase(it) : std::next(it);
+        it = now - it->second > std::chrono::duration<double>(stale_after_s_ * 5.0) ? c->status_writers.erase(it)
+                                                                                    : std::next(it);
     }
   }
 }
@@ -316,8 +377,12 @@ json Fleet::overview() {
   const auto now = Clock::now();
   json tiles = json::array();
   for (const auto& [name, c] : cells_) {
-    json t = {{"cell", name}, {"live", c->live}, {"quiet_s", std::chrono::duration<double>(now - c->heard).count()},
-              {"publishers", live_writers(*c, now)}, {"active_s", c->active_s}, {"state_source_ms", c->state_source_ms}};
+    json t = {{"cell", name},
+              {"live", c->live},
+              {"quiet_s", std::chrono::duration<double>(now - c->heard).count()},
+              {"publishers", live_writers(*c, now)},
+              {"active_s", c->active_s},
+              {"state_source_ms", c->state_source_ms}};
     if (!c->status.is_null()) {
       t["state"] = c->status["state"];  // without telemetry, the status's word
       t["trip"] = c->status["trip"];
@@ -339,8 +404,9 @@ json Fleet::overview() {
       t["time_s"] = p.time_s;
     }
     if (!c->machining.is_null()) t["machining"] = c->machining;
-    if (!c->advice.is_null()) t["advice"] = {{"seq", c->advice["seq"]}, {"found", c->advice["found"]},
-                                             {"advised_rpm", c->advice["advised_rpm"]}};
+    if (!c->advice.is_null())
+      t["advice"] = {
+          {"seq", c->advice["seq"]}, {"found", c->advice["found"]}, {"advised_rpm", c->advice["advised_rpm"]}};
     tiles.push_back(std::move(t));
   }
   return tiles;
@@ -351,7 +417,7 @@ std::optional<json> Fleet::detail(const std::string& cell, std::uint64_t since_s
   const auto it = cells_.find(cell);
   if (it == cells_.end()) return std::nullopt;
   const Cell& c = *it->second;
-  json tel = {{"time_s", json::array()}, {"accel_mps2", json::array()}, {"accel_rms_mps2", json::array()},
+  json tel = {{"time_s", json::array()},    {"accel_mps2", json::array()},    {"accel_rms_mps2", json::array()},
               {"command_v", json::array()}, {"gain_ns_per_m", json::array()}, {"saturated_fraction", json::array()}};
   for (const auto& p : c.telemetry) {
     if (p.seq <= since_seq) continue;
@@ -363,8 +429,10 @@ std::optional<json> Fleet::detail(const std::string& cell, std::uint64_t since_s
     tel["saturated_fraction"].push_back(p.saturated_fraction);
   }
   tel["last_seq"] = c.seq;
-  json out = {{"cell", cell}, {"live", c.live}, {"status", c.status}, {"machining", c.machining}, {"advice", c.advice},
-              {"telemetry", tel}, {"active_s", c.active_s}, {"publishers", live_writers(c, Clock::now())},
+  json out = {{"cell", cell},           {"live", c.live},
+              {"status", c.status},     {"machining", c.machining},
+              {"advice", c.advice},     {"telemetry", tel},
+              {"active_s", c.active_s}, {"publishers", live_writers(c, Clock::now())},
               {"restarts", c.restarts}};
   if (with_spectrum_and_lobes) out["spectrum"] = c.spectrum, out["lobes"] = c.lobes;
   return out;
@@ -407,7 +475,8 @@ RequestOutcome Fleet::request(const std::string& cell, dds::RequestKind kind, do
   cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return stop_ || replies_[id].answered; });
   RequestOutcome out = replies_[id];
   replies_.erase(id);
-  if (!out.answered) ++n_.reply_timeouts, out.reason = "no reply from cell " + cell + " within " + std::to_string(timeout_s) + " s";
+  if (!out.answered)
+    ++n_.reply_timeouts, out.reason = "no reply from cell " + cell + " within " + std::to_string(timeout_s) + " s";
   return out;
 }
 

@@ -79,8 +79,8 @@ class Fleet {
   [[nodiscard]] std::uint64_t version();
 
   // Sends a parameter request to the cell and waits for its reply (up to timeout_s). who: for the client name.
-  [[nodiscard]] RequestOutcome request(const std::string& cell, dds::RequestKind kind, double value, const std::string& who,
-                                       double timeout_s);
+  [[nodiscard]] RequestOutcome request(const std::string& cell, dds::RequestKind kind, double value,
+                                       const std::string& who, double timeout_s);
   [[nodiscard]] FleetCounters counters();
   [[nodiscard]] const std::string& client_name() const { return client_; }
   // Why this dashboard cannot act (its DDS identity's permissions), or empty.
@@ -115,7 +115,7 @@ class Fleet {
   FleetCounters n_;
   std::uint32_t next_request_id_{1};
   std::map<std::uint32_t, RequestOutcome> replies_;
-  bool stop_{false};  // guarded by m_: the waits of the pages and the requests end
+  bool stop_{false};         // guarded by m_: the waits of the pages and the requests end
   threads::Worker contact_;  // watch_contact (stopped in the destructor before the participant goes)
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> listeners_;  // outlive the participant
   std::unique_ptr<dds::Participant> participant_;

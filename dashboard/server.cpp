@@ -94,8 +94,7 @@ WebServer::WebServer(const config::DashboardConfig& cfg, Fleet& fleet, Authentic
       if (ep) std::rethrow_exception(ep);
     } catch (const std::exception& e) {
       what = e.what();
-    } catch (...) {
-    }
+    } catch (...) {}
     refuse(res, 500, what);
   });
   http_->set_error_handler([](const httplib::Request&, httplib::Response& res) {
@@ -157,8 +156,13 @@ void WebServer::routes() {
   http_->Get("/api/actions", [this](const httplib::Request&, httplib::Response& res) {
     json out = json::array();
     for (const auto& a : log_.recent(50))
-      out.push_back({{"time", a.time_utc}, {"user", a.user}, {"cell", a.cell}, {"action", a.action}, {"value", a.value},
-                     {"accepted", a.accepted}, {"reason", a.reason}});
+      out.push_back({{"time", a.time_utc},
+                     {"user", a.user},
+                     {"cell", a.cell},
+                     {"action", a.action},
+                     {"value", a.value},
+                     {"accepted", a.accepted},
+                     {"reason", a.reason}});
     reply(res, 200, out);
   });
   http_->Post("/api/login", [this](const httplib::Request& req, httplib::Response& res) {
@@ -169,7 +173,9 @@ void WebServer::routes() {
     const LoginResult r = auth_.login(body["user"], body["password"], req.remote_addr);
     if (r.outcome == LoginOutcome::kThrottled) {
       res.set_header("Retry-After", std::to_string(static_cast<int>(std::ceil(r.retry_after_s))));
-      return refuse(res, 429, "too many wrong passwords: try again in " + std::to_string(static_cast<int>(std::ceil(r.retry_after_s))) + " s");
+      return refuse(res, 429,
+                    "too many wrong passwords: try again in " +
+                        std::to_string(static_cast<int>(std::ceil(r.retry_after_s))) + " s");
     }
     if (r.outcome == LoginOutcome::kWrong) return refuse(res, 401, "wrong user or password");
     reply(res, 200, {{"token", r.token}, {"user", body["user"]}, {"role", to_string(r.role)}});
@@ -181,9 +187,11 @@ void WebServer::routes() {
   });
   http_->Get("/api/whoami", [this](const httplib::Request& req, httplib::Response& res) {
     const auto s = session_of(req);
-    reply(res, 200, s ? json{{"user", s->user}, {"role", to_string(s->role)}} : json{{"user", nullptr}, {"role", "observer"}});
+    reply(res, 200,
+          s ? json{{"user", s->user}, {"role", to_string(s->role)}} : json{{"user", nullptr}, {"role", "observer"}});
   });
-  http_->Post(R"(/api/cells/([^/]+)/action)", [this](const httplib::Request& req, httplib::Response& res) { action(req, res); });
+  http_->Post(R"(/api/cells/([^/]+)/action)",
+              [this](const httplib::Request& req, httplib::Response& res) { action(req, res); });
   http_->Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) { events(req, res); });
 }
 
@@ -199,37 +207,51 @@ void WebServer::action(const httplib::Request& req, httplib::Response& res) {
   if (!body.is_discarded() && body.is_object() && body.contains("action") && body["action"].is_string())
     for (const auto& k : kActions)
       if (body["action"] == k.name) kind = &k;
-  if (kind == nullptr) return refuse(res, 400, "an action is {\"action\": arm|disarm|reset|gain|set|spindle, \"value\": number}");
+  if (kind == nullptr)
+    return refuse(res, 400, "an action is {\"action\": arm|disarm|reset|gain|set|spindle, \"value\": number}");
   double value = kind->name == std::string("arm") ? 1.0 : 0.0;
   if (kind->needs_value) {
     if (!body.contains("value") || !body["value"].is_number() || !std::isfinite(body["value"].get<double>()))
-      return refuse(res, 400, std::string(kind->name) + " needs a finite number \"value\" (" +
-                                  (kind->kind == dds::RequestKind::kSetGain ? "N s/m" : kind->kind == dds::RequestKind::kSetSpindleRpm ? "rpm" : "set index") + ")");
+      return refuse(res, 400,
+                    std::string(kind->name) + " needs a finite number \"value\" (" +
+                        (kind->kind == dds::RequestKind::kSetGain         ? "N s/m"
+                         : kind->kind == dds::RequestKind::kSetSpindleRpm ? "rpm"
+                                                                          : "set index") +
+                        ")");
     value = body["value"].get<double>();
   }
   ActionRecord rec{now_utc_iso8601(), s->user, to_string(s->role), req.remote_addr, cell, kind->name, value, false, {}};
   if (s->role != Role::kOperator) {
     ++n_->forbidden;
-    rec.reason = "refused by the dashboard: " + s->user + " is an observer (observers see everything and change nothing)";
+    rec.reason =
+        "refused by the dashboard: " + s->user + " is an observer (observers see everything and change nothing)";
     log_.append(rec);
     return refuse(res, 403, rec.reason);
   }
-  if (!fleet_.known(cell)) return refuse(res, 404, "no cell named '" + cell.substr(0, 64) + "' has been heard on the domain");
+  if (!fleet_.known(cell))
+    return refuse(res, 404, "no cell named '" + cell.substr(0, 64) + "' has been heard on the domain");
   ++n_->actions;
   const RequestOutcome r = fleet_.request(cell, kind->kind, value, s->user, cfg_.reply_timeout_s);
   rec.accepted = r.accepted;
   rec.reason = r.reason;
   log_.append(rec);
   if (r.accepted) ++n_->actions_accepted;
-  reply(res, r.answered ? 200 : 504, {{"cell", cell}, {"action", kind->name}, {"value", value}, {"answered", r.answered},
-                                     {"accepted", r.accepted}, {"reason", r.reason}, {"user", s->user}});
+  reply(res, r.answered ? 200 : 504,
+        {{"cell", cell},
+         {"action", kind->name},
+         {"value", value},
+         {"answered", r.answered},
+         {"accepted", r.accepted},
+         {"reason", r.reason},
+         {"user", s->user}});
 }
 
 void WebServer::events(const httplib::Request& req, httplib::Response& res) {
   if (streams_.fetch_add(1) >= cfg_.max_event_streams) {
     --streams_;
     ++n_->streams_refused;
-    return refuse(res, 503, "too many open pages (dashboard.max_event_streams = " + std::to_string(cfg_.max_event_streams) + ")");
+    return refuse(res, 503,
+                  "too many open pages (dashboard.max_event_streams = " + std::to_string(cfg_.max_event_streams) + ")");
   }
   ++n_->streams_opened;
   struct Stream {
@@ -251,8 +273,12 @@ void WebServer::events(const httplib::Request& req, httplib::Response& res) {
         const std::uint64_t version = fleet_.version();
         std::string out;
         if (is_urgent || (version != st->version && now - st->fleet_at >= std::chrono::milliseconds(200))) {
-          out += "event: fleet\ndata: " + dump({{"cells", fleet_.overview()}, {"sent_ms", std::chrono::duration_cast<std::chrono::milliseconds>(
-                                                                                    std::chrono::system_clock::now().time_since_epoch()).count()}}) + "\n\n";
+          out += "event: fleet\ndata: " +
+                 dump({{"cells", fleet_.overview()},
+                       {"sent_ms", std::chrono::duration_cast<std::chrono::milliseconds>(
+                                       std::chrono::system_clock::now().time_since_epoch())
+                                       .count()}}) +
+                 "\n\n";
           st->fleet_at = now;
         }
         if (!st->cell.empty() && (is_urgent || now - st->cell_at >= std::chrono::milliseconds(100))) {
@@ -276,25 +302,47 @@ void WebServer::events(const httplib::Request& req, httplib::Response& res) {
 }
 
 ServerCounters WebServer::counters() const {
-  return {n_->requests, n_->client_errors, n_->server_errors, n_->too_large, n_->not_found, n_->unauthenticated,
-          n_->forbidden, n_->actions, n_->actions_accepted, n_->streams_opened, n_->streams_refused, n_->events};
+  return {n_->requests,         n_->client_errors,   n_->server_errors,   n_->too_large,
+          n_->not_found,        n_->unauthenticated, n_->forbidden,       n_->actions,
+          n_->actions_accepted, n_->streams_opened,  n_->streams_refused, n_->events};
 }
 
 json WebServer::health() const {
   const ServerCounters c = counters();
   const FleetCounters f = fleet_.counters();
   const AuthCounters a = auth_.counters();
-  return {{"http", {{"requests", c.requests}, {"client_errors", c.client_errors}, {"server_errors", c.server_errors},
-                    {"too_large", c.too_large}, {"not_found", c.not_found}, {"unauthenticated", c.unauthenticated},
-                    {"forbidden", c.forbidden}, {"actions", c.actions}, {"actions_accepted", c.actions_accepted},
-                    {"streams_open", streams_.load()}, {"streams_opened", c.streams_opened},
-                    {"streams_refused", c.streams_refused}, {"events", c.events}}},
-          {"dds", {{"client", fleet_.client_name()}, {"samples", f.samples}, {"bad_cell_names", f.bad_cell_names},
-                   {"foreign_replies", f.foreign_replies}, {"requests", f.requests}, {"replies", f.replies},
-                   {"reply_timeouts", f.reply_timeouts}, {"cells_lost", f.cells_lost},
-                   {"cells_restarted", f.cells_restarted},                    {"cells_refused", f.cells_refused}}},
-          {"auth", {{"logins", a.logins}, {"wrong_passwords", a.wrong_passwords}, {"throttled", a.throttled},
-                    {"bad_tokens", a.bad_tokens}, {"logouts", a.logouts}, {"operators_configured", auth_.anyone_may_act()}}},
+  return {{"http",
+           {{"requests", c.requests},
+            {"client_errors", c.client_errors},
+            {"server_errors", c.server_errors},
+            {"too_large", c.too_large},
+            {"not_found", c.not_found},
+            {"unauthenticated", c.unauthenticated},
+            {"forbidden", c.forbidden},
+            {"actions", c.actions},
+            {"actions_accepted", c.actions_accepted},
+            {"streams_open", streams_.load()},
+            {"streams_opened", c.streams_opened},
+            {"streams_refused", c.streams_refused},
+            {"events", c.events}}},
+          {"dds",
+           {{"client", fleet_.client_name()},
+            {"samples", f.samples},
+            {"bad_cell_names", f.bad_cell_names},
+            {"foreign_replies", f.foreign_replies},
+            {"requests", f.requests},
+            {"replies", f.replies},
+            {"reply_timeouts", f.reply_timeouts},
+            {"cells_lost", f.cells_lost},
+            {"cells_restarted", f.cells_restarted},
+            {"cells_refused", f.cells_refused}}},
+          {"auth",
+           {{"logins", a.logins},
+            {"wrong_passwords", a.wrong_passwords},
+            {"throttled", a.throttled},
+            {"bad_tokens", a.bad_tokens},
+            {"logouts", a.logouts},
+            {"operators_configured", auth_.anyone_may_act()}}},
           {"action_log", log_.path()}};
 }
 

@@ -85,7 +85,8 @@ std::FILE* open_new(const std::string& path, mode_t mode, bool overwrite) {
 
 void write_self_signed(const std::string& certificate_path, const std::string& key_path, const SelfSignedRequest& r) {
   if (r.hosts.empty()) throw std::runtime_error("a certificate needs at least one host name or address");
-  if (r.days < 1 || r.days > 3650) throw std::runtime_error("days = " + std::to_string(r.days) + " is out of range: allowed 1 <= value <= 3650 days");
+  if (r.days < 1 || r.days > 3650)
+    throw std::runtime_error("days = " + std::to_string(r.days) + " is out of range: allowed 1 <= value <= 3650 days");
   const Key key(EVP_EC_gen("P-256"));
   if (!key) throw std::runtime_error("cannot make an EC P-256 key");
   const Cert cert = self_signed(key.get(), r);

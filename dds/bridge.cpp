@@ -38,14 +38,16 @@ class Bridge::RequestListener : public DataReaderListener {
         ++b_.n_other_cells_;
         continue;
       }
-      const std::optional<RequestKind> kind = req.kind() == msg::SET_GAIN               ? RequestKind::kSetGain
-                                              : req.kind() == msg::SELECT_PARAMETER_SET ? RequestKind::kSelectParameterSet
-                                              : req.kind() == msg::SET_SPINDLE_RPM      ? RequestKind::kSetSpindleRpm
-                                              : req.kind() == msg::ENABLE               ? RequestKind::kEnable
-                                              : req.kind() == msg::RESET_FAULT          ? RequestKind::kResetFault
-                                                                                        : std::optional<RequestKind>{};
+      const std::optional<RequestKind> kind = req.kind() == msg::SET_GAIN ? RequestKind::kSetGain
+                                              : req.kind() == msg::SELECT_PARAMETER_SET
+                                                  ? RequestKind::kSelectParameterSet
+                                              : req.kind() == msg::SET_SPINDLE_RPM ? RequestKind::kSetSpindleRpm
+                                              : req.kind() == msg::ENABLE          ? RequestKind::kEnable
+                                              : req.kind() == msg::RESET_FAULT     ? RequestKind::kResetFault
+                                                                                   : std::optional<RequestKind>{};
       const Decision d = kind ? b_.decide(*kind, req.value())
-                              : b_.refuse("kind = " + std::to_string(req.kind()) + " is not a request kind: allowed 0 to 4 "
+                              : b_.refuse("kind = " + std::to_string(req.kind()) +
+                                          " is not a request kind: allowed 0 to 4 "
                                           "(dds/robodamp.idl)");
       msg::ParameterReply reply;
       reply.cell(b_.src_.cell);
@@ -97,9 +99,11 @@ class Bridge::TrajectoryListener : public DataReaderListener {
   Bridge& b_;
 };
 
-Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source, BridgeSources sources)
+Bridge::Bridge(const config::DdsConfig& cfg, double loop_rate_hz, const std::string& config_source,
+               BridgeSources sources)
     : cfg_(cfg), source_(config_source), src_(std::move(sources)), availability_(loop_rate_hz, src_.gain_ramp_s) {
-  window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
+  window_ticks_ =
+      std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz / cfg.telemetry_rate_hz)));
   participant_ = std::make_unique<Participant>(cfg.domain_id, cfg.transport, "robodamp loop", cfg.security);
   telemetry_writer_ = participant_->writer(TopicKind::kTelemetry);
   status_writer_ = participant_->writer(TopicKind::kStatus);
@@ -320,10 +324,12 @@ void Bridge::publish_spectrum() {
   out.time_s(sp->time_s);
   out.bin_hz(sp->bin_hz);
   out.record_s(sp->record_s);
-  out.accel_asd(std::vector<float>(sp->accel_asd.begin(), sp->accel_asd.begin() + static_cast<std::ptrdiff_t>(
-                                                                                   std::min<std::size_t>(1024, sp->accel_asd.size()))));
-  out.mode_hz(std::vector<float>(sp->mode_hz.begin(),
-                                 sp->mode_hz.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(16, sp->mode_hz.size()))));
+  out.accel_asd(std::vector<float>(
+      sp->accel_asd.begin(),
+      sp->accel_asd.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(1024, sp->accel_asd.size()))));
+  out.mode_hz(std::vector<float>(
+      sp->mode_hz.begin(),
+      sp->mode_hz.begin() + static_cast<std::ptrdiff_t>(std::min<std::size_t>(16, sp->mode_hz.size()))));
   out.tooth_passing_hz(sp->tooth_passing_hz);
   if (spectrum_writer_->write(&out)) ++n_spectrum_;
 }
@@ -333,7 +339,9 @@ void Bridge::publish_lobes() {
   const std::optional<LobesSample> l = src_.lobes();
   if (!l) return;
   const std::size_t n = std::min<std::size_t>({256, l->rpm.size(), l->open_limit_mm.size(), l->damped_limit_mm.size()});
-  auto first = [n](const std::vector<double>& v) { return std::vector<double>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)); };
+  auto first = [n](const std::vector<double>& v) {
+    return std::vector<double>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n));
+  };
   msg::Lobes out;
   out.cell(src_.cell);
   out.time_s(l->time_s);
@@ -388,8 +396,8 @@ void Bridge::stop() {
 }
 
 BridgeCounters Bridge::counters() const {
-  return {n_telemetry_.load(), n_status_.load(), n_requests_.load(), n_refused_.load(), n_machining_.load(),
-          n_advice_.load(), n_spectrum_.load(), n_lobes_.load(), n_other_cells_.load()};
+  return {n_telemetry_.load(), n_status_.load(),   n_requests_.load(), n_refused_.load(),    n_machining_.load(),
+          n_advice_.load(),    n_spectrum_.load(), n_lobes_.load(),    n_other_cells_.load()};
 }
 
 }  // namespace robodamp::dds

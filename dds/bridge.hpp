@@ -58,8 +58,8 @@ struct MachiningSample {
   bool indicator_valid{false};
   double once_per_rev_ratio{0.0}, nonharmonic_share{0.0}, chatter_hz{0.0};
   bool chatter{false};
-  std::uint8_t cutting{0};     // kCuttingUnknown, kCutting, kNotCutting
-  std::string cutting_reason;  // what says so
+  std::uint8_t cutting{0};              // kCuttingUnknown, kCutting, kNotCutting
+  std::string cutting_reason;           // what says so
   std::vector<double> pose_deg;         // a pose-scheduled cell: the robot's joints now (empty: not known)
   std::vector<double> limits_pose_deg;  // the pose the limits are for (on the live stability's grid)
   // A measured map (pose modes): the largest one-sigma frequency spread of the modes at limits_pose_deg, %, and
@@ -92,10 +92,10 @@ struct AdviceSample {
   double best_rpm{0.0}, best_limit_mm{0.0};
   std::string reason;
   double rpm_min{0.0}, rpm_max{0.0};
-  std::vector<double> pose_deg;  // the pose the candidates were checked at (empty: none)
-  std::uint32_t poses_ahead{0};  // ... and this many poses of the path ahead
+  std::vector<double> pose_deg;           // the pose the candidates were checked at (empty: none)
+  std::uint32_t poses_ahead{0};           // ... and this many poses of the path ahead
   std::vector<double> limiting_pose_deg;  // where the advised (else the best) speed's limit is lowest
-  std::string status{"current"};  // "current", "followed" or "expired" (runtime::AdviceStatus)
+  std::string status{"current"};          // "current", "followed" or "expired" (runtime::AdviceStatus)
   std::string status_reason;
 };
 
@@ -117,23 +117,23 @@ struct LobesSample {
   std::string method;
   double depth_mm{0.0};
   std::vector<double> rpm, open_limit_mm, damped_limit_mm;  // by speed, at most 256
-  bool speed_scheduled{false};  // each speed with its band's controller and K (parameter_set, gain not one)
+  bool speed_scheduled{false};   // each speed with its band's controller and K (parameter_set, gain not one)
   std::vector<double> pose_deg;  // the pose the limits are for (empty: none)
 };
 
 struct BridgeSources {
-  std::string cell;                                // cell.name: on every topic; requests for other cells are ignored
-  std::string backend;                             // for the status
-  std::function<std::size_t()> parameter_set;      // the active set (any thread)
-  std::function<double()> gain_limit_ns_per_m;     // what a gain request may ask for now
-  std::function<Decision(RequestKind, double)> handle;  // validate and queue (parameter writes on)
-  std::function<MachiningSample()> machining;      // empty: no machining topic (no spindle.job)
-  std::function<std::optional<AdviceSample>()> advice{};  // the latest speed advice; empty: no advice topic
+  std::string cell;                             // cell.name: on every topic; requests for other cells are ignored
+  std::string backend;                          // for the status
+  std::function<std::size_t()> parameter_set;   // the active set (any thread)
+  std::function<double()> gain_limit_ns_per_m;  // what a gain request may ask for now
+  std::function<Decision(RequestKind, double)> handle;        // validate and queue (parameter writes on)
+  std::function<MachiningSample()> machining;                 // empty: no machining topic (no spindle.job)
+  std::function<std::optional<AdviceSample>()> advice{};      // the latest speed advice; empty: no advice topic
   std::function<std::optional<SpectrumSample>()> spectrum{};  // a new spectrum, if one is due; empty: no topic
   std::function<std::optional<LobesSample>()> lobes{};        // the lobes, if they changed; empty: no topic
-  double gain_ramp_s{0.0};                         // controller.gain_ramp_s: when the loop is at full gain
-  std::function<std::size_t()> parameter_sets{};   // how many sets a select request may choose from (any thread)
-  double spindle_rpm_max{0.0};                     // spindle.rpm_max: what a spindle request may ask for
+  double gain_ramp_s{0.0};                                    // controller.gain_ramp_s: when the loop is at full gain
+  std::function<std::size_t()> parameter_sets{};  // how many sets a select request may choose from (any thread)
+  double spindle_rpm_max{0.0};                    // spindle.rpm_max: what a spindle request may ask for
   // dds.joint_states: each message's names and positions (rad), on the reader's thread; the silence check,
   // on the status thread. Empty: no joint-state reader.
   std::function<void(const std::vector<std::string>&, const std::vector<double>&)> joint_state{};
@@ -220,8 +220,8 @@ class Bridge {
   rt::TimingHistogram wake_, compute_;
   std::uint8_t published_state_{255}, published_trip_{255};
   bool running_{false};  // guarded by m_: between start() and stop()
-  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0}, n_advice_{0},
-      n_spectrum_{0}, n_lobes_{0}, n_other_cells_{0};
+  std::atomic<std::uint64_t> n_telemetry_{0}, n_status_{0}, n_requests_{0}, n_refused_{0}, n_machining_{0},
+      n_advice_{0}, n_spectrum_{0}, n_lobes_{0}, n_other_cells_{0};
   threads::Worker status_;  // status, machining, advice, spectrum and lobes at status_rate_hz (last: stopped first)
 };
 

@@ -16,11 +16,10 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 // ROS 2's names for the topics /robodamp/telemetry ... (ROS 2 prefixes its topics with rt/ in DDS).
-constexpr const char* kTopicNames[kTopicCount] = {"rt/robodamp/telemetry", "rt/robodamp/status",
-                                                  "rt/robodamp/parameter_request", "rt/robodamp/parameter_reply",
-                                                  "rt/robodamp/machining", "rt/robodamp/advice",
-                                                  "rt/robodamp/spectrum", "rt/robodamp/lobes"};
-}
+constexpr const char* kTopicNames[kTopicCount] = {
+    "rt/robodamp/telemetry", "rt/robodamp/status", "rt/robodamp/parameter_request", "rt/robodamp/parameter_reply",
+    "rt/robodamp/machining", "rt/robodamp/advice", "rt/robodamp/spectrum",          "rt/robodamp/lobes"};
+}  // namespace
 
 Participant::Participant(int domain_id, config::DdsTransport transport, const std::string& name,
                          const std::optional<config::DdsSecurityConfig>& security)
@@ -78,7 +77,8 @@ Participant::Participant(int domain_id, config::DdsTransport transport, const st
   }
   publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
-  if (publisher_ == nullptr || subscriber_ == nullptr) throw std::runtime_error("DDS: cannot create publisher / subscriber");
+  if (publisher_ == nullptr || subscriber_ == nullptr)
+    throw std::runtime_error("DDS: cannot create publisher / subscriber");
 }
 
 Participant::~Participant() {
@@ -116,7 +116,8 @@ DataWriter* Participant::writer(TopicKind t, DataWriterListener* listener) {
   DataWriterQos q = DATAWRITER_QOS_DEFAULT;
   apply(q, t, transport_, false);
   DataWriter* w = publisher_->create_datawriter(topic(t), q, listener);
-  if (w == nullptr) throw std::runtime_error(std::string("DDS: cannot create a writer on ") + kTopicNames[static_cast<int>(t)]);
+  if (w == nullptr)
+    throw std::runtime_error(std::string("DDS: cannot create a writer on ") + kTopicNames[static_cast<int>(t)]);
   return w;
 }
 
@@ -124,7 +125,8 @@ DataReader* Participant::reader(TopicKind t, DataReaderListener* listener) {
   DataReaderQos q = DATAREADER_QOS_DEFAULT;
   apply(q, t, transport_, true);
   DataReader* r = subscriber_->create_datareader(topic(t), q, listener);
-  if (r == nullptr) throw std::runtime_error(std::string("DDS: cannot create a reader on ") + kTopicNames[static_cast<int>(t)]);
+  if (r == nullptr)
+    throw std::runtime_error(std::string("DDS: cannot create a reader on ") + kTopicNames[static_cast<int>(t)]);
   return r;
 }
 
@@ -140,7 +142,8 @@ template <typename PubSubType>
 Topic* ros_topic(DomainParticipant* participant, Topic*& slot, const std::string& topic_name, const char* what) {
   if (slot != nullptr) {
     if (slot->get_name() != topic_name)
-      throw std::runtime_error(std::string("DDS: ") + what + " on " + topic_name + " and " + slot->get_name() + ": one topic");
+      throw std::runtime_error(std::string("DDS: ") + what + " on " + topic_name + " and " + slot->get_name() +
+                               ": one topic");
     return slot;
   }
   TypeSupport type(new PubSubType());
@@ -152,8 +155,8 @@ Topic* ros_topic(DomainParticipant* participant, Topic*& slot, const std::string
 
 // A reader that takes any ROS 2 writer (best effort matches a reliable writer and a best-effort one; volatile;
 // the last `depth`), and a writer as a ROS 2 node has one (reliable, volatile, the last 10: ROS 2's default QoS).
-DataReader* ros_reader(Subscriber* subscriber, Topic* topic, DataReaderListener* listener, config::DdsTransport transport,
-                       int depth) {
+DataReader* ros_reader(Subscriber* subscriber, Topic* topic, DataReaderListener* listener,
+                       config::DdsTransport transport, int depth) {
   DataReaderQos q = DATAREADER_QOS_DEFAULT;
   q.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;
   q.durability().kind = VOLATILE_DURABILITY_QOS;

@@ -54,8 +54,10 @@ class Participant {
   Participant& operator=(const Participant&) = delete;
 
   // Writers and readers with the topic's QoS (listener may be null). Deleted with the participant.
-  eprosima::fastdds::dds::DataWriter* writer(TopicKind t, eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
-  eprosima::fastdds::dds::DataReader* reader(TopicKind t, eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
+  eprosima::fastdds::dds::DataWriter* writer(TopicKind t,
+                                             eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
+  eprosima::fastdds::dds::DataReader* reader(TopicKind t,
+                                             eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
   // ROS 2's sensor_msgs/msg/JointState on topic_name (dds.joint_states.topic): a reader that takes any
   // driver's writer (best effort, volatile, the last 8), and a writer as a ROS 2 driver has one (reliable,

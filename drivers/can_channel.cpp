@@ -26,13 +26,15 @@ namespace {
 }
 }  // namespace
 
-CanChannel CanChannel::open_interface(const std::string& interface, bool fd_frames, std::uint32_t rx_id, bool rx_extended) {
+CanChannel CanChannel::open_interface(const std::string& interface, bool fd_frames, std::uint32_t rx_id,
+                                      bool rx_extended) {
   const int s = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
   if (s < 0) fail(-1, "CAN interface '" + interface + "': socket(PF_CAN, SOCK_RAW, CAN_RAW)");
   const int on = 1;
   if (fd_frames && ::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on) < 0)
     fail(s, "CAN interface '" + interface + "': CAN_RAW_FD_FRAMES (does the interface support CAN FD?)");
-  const can_filter filter{rx_id | (rx_extended ? CAN_EFF_FLAG : 0u), (rx_extended ? CAN_EFF_MASK : CAN_SFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG};
+  const can_filter filter{rx_id | (rx_extended ? CAN_EFF_FLAG : 0u),
+                          (rx_extended ? CAN_EFF_MASK : CAN_SFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG};
   if (::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, &filter, sizeof filter) < 0) fail(s, "CAN_RAW_FILTER");
   const can_err_mask_t errors = CAN_ERR_MASK;
   if (::setsockopt(s, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &errors, sizeof errors) < 0) fail(s, "CAN_RAW_ERR_FILTER");
@@ -43,7 +45,8 @@ CanChannel CanChannel::open_interface(const std::string& interface, bool fd_fram
   sockaddr_can addr{};
   addr.can_family = AF_CAN;
   addr.can_ifindex = ifr.ifr_ifindex;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) fail(s, "CAN interface '" + interface + "': bind");
+  if (::bind(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0)
+    fail(s, "CAN interface '" + interface + "': bind");
   return CanChannel(s, true);
 }
 
@@ -92,7 +95,8 @@ CanListener::CanListener(const std::string& path) : path_(path) {
   fd_ = ::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
   if (fd_ < 0) fail(-1, "CAN transport unix:" + path + ": socket");
   ::unlink(path.c_str());  // a stale socket file of an emulator that died
-  if (::bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) < 0) fail(fd_, "CAN transport unix:" + path + ": bind");
+  if (::bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) < 0)
+    fail(fd_, "CAN transport unix:" + path + ": bind");
   if (::listen(fd_, 1) < 0) fail(fd_, "CAN transport unix:" + path + ": listen");
 }
 
@@ -131,7 +135,7 @@ int CanChannel::receive(canfd_frame& frame, std::int64_t& timestamp_ns) noexcept
   msg.msg_controllen = sizeof control;
   const ssize_t n = ::recvmsg(fd_, &msg, MSG_DONTWAIT);
   if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK) ? 0 : -errno;
-  if (n == 0) return -ENOTCONN;  // a stream or SEQPACKET peer closed
+  if (n == 0) return -ENOTCONN;                                              // a stream or SEQPACKET peer closed
   if (msg.msg_flags & MSG_TRUNC) return static_cast<int>(sizeof frame) + 1;  // larger than any CAN frame
   timestamp_ns = -1;
   for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c))

@@ -4,7 +4,8 @@
 
 namespace robodamp::drivers {
 
-std::int64_t unpack_field(const std::uint8_t* data, int start, int size, bool is_signed, config::ByteOrder order) noexcept {
+std::int64_t unpack_field(const std::uint8_t* data, int start, int size, bool is_signed,
+                          config::ByteOrder order) noexcept {
   std::uint64_t raw = 0;
   for (int i = 0; i < size; ++i) {
     const int byte = order == config::ByteOrder::kLittle ? start + size - 1 - i : start + i;
@@ -47,7 +48,8 @@ Decoded decode(const config::CanFrameMapping& m, const canfd_frame& f, int frame
     return d;
   }
   const auto& v = m.value;
-  d.value = static_cast<double>(unpack_field(f.data, v.start_byte, v.size_bytes, v.is_signed, v.byte_order)) * v.scale + v.offset;
+  d.value = static_cast<double>(unpack_field(f.data, v.start_byte, v.size_bytes, v.is_signed, v.byte_order)) * v.scale +
+            v.offset;
   if (m.counter)
     d.counter = static_cast<std::uint32_t>(
         unpack_field(f.data, m.counter->start_byte, m.counter->size_bytes, false, config::ByteOrder::kLittle));
@@ -71,7 +73,8 @@ Encoded encode(const config::CanFrameMapping& m, bool fd, double value, std::uin
   }
   pack_field(e.frame.data, v.start_byte, v.size_bytes, v.byte_order,
              static_cast<std::uint64_t>(static_cast<std::int64_t>(counts)));
-  if (m.counter) pack_field(e.frame.data, m.counter->start_byte, m.counter->size_bytes, config::ByteOrder::kLittle, counter);
+  if (m.counter)
+    pack_field(e.frame.data, m.counter->start_byte, m.counter->size_bytes, config::ByteOrder::kLittle, counter);
   return e;
 }
 

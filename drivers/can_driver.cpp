@@ -9,16 +9,18 @@
 namespace robodamp::drivers {
 
 namespace {
-constexpr int kMaxFramesPerTick = 64;   // bounded work per tick however much is queued
-constexpr int kTxFailuresToFault = 3;   // consecutive full queues before the actuator is reported faulty
+constexpr int kMaxFramesPerTick = 64;  // bounded work per tick however much is queued
+constexpr int kTxFailuresToFault = 3;  // consecutive full queues before the actuator is reported faulty
 }  // namespace
 
 CanDriver::CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz)
     : cfg_(cfg), channel_(std::move(channel)), rate_hz_(loop_rate_hz) {
   if (cfg_.sensor.counter) counter_mask_ = counter_mask(*cfg_.sensor.counter);
   window_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(loop_rate_hz)));
-  backoff_initial_ticks_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(cfg_.backoff_initial_s * loop_rate_hz)));
-  backoff_max_ticks_ = std::max(backoff_initial_ticks_, static_cast<std::uint64_t>(std::llround(cfg_.backoff_max_s * loop_rate_hz)));
+  backoff_initial_ticks_ =
+      std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(cfg_.backoff_initial_s * loop_rate_hz)));
+  backoff_max_ticks_ =
+      std::max(backoff_initial_ticks_, static_cast<std::uint64_t>(std::llround(cfg_.backoff_max_s * loop_rate_hz)));
 }
 
 CanDriver::~CanDriver() {
@@ -67,7 +69,8 @@ rt::SensorSample CanDriver::read(std::uint64_t tick) noexcept {
     canfd_frame f{};
     std::int64_t ts = 0;
     int n = channel_.receive(f, ts);
-    if (n == 0 && i == 0 && lockstep_wait_ns_ > 0 && channel_.wait_readable(lockstep_wait_ns_)) n = channel_.receive(f, ts);
+    if (n == 0 && i == 0 && lockstep_wait_ns_ > 0 && channel_.wait_readable(lockstep_wait_ns_))
+      n = channel_.receive(f, ts);
     if (n == 0) break;
     if (n == -ENOTCONN) {
       link_lost_.store(true, std::memory_order_relaxed);
@@ -196,10 +199,10 @@ std::uint64_t CanDriver::flush() noexcept {
 
 CanCounters CanDriver::counters() const noexcept {
   auto l = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
-  return {l(n_.rx_frames),  l(n_.rx_other),   l(n_.rx_malformed),  l(n_.lost_frames), l(n_.stale_frames),
-          l(n_.error_frames), l(n_.bus_off),  l(n_.restarts),      l(n_.rx_errors),   l(n_.tx_frames),
-          l(n_.tx_queue_full), l(n_.tx_errors), l(n_.tx_skipped),  l(n_.tx_clipped), l(n_.rx_held), l(n_.rx_skipped), l(n_.reconnects),
-          l(n_.resync_backoffs)};
+  return {l(n_.rx_frames),     l(n_.rx_other),   l(n_.rx_malformed),   l(n_.lost_frames), l(n_.stale_frames),
+          l(n_.error_frames),  l(n_.bus_off),    l(n_.restarts),       l(n_.rx_errors),   l(n_.tx_frames),
+          l(n_.tx_queue_full), l(n_.tx_errors),  l(n_.tx_skipped),     l(n_.tx_clipped),  l(n_.rx_held),
+          l(n_.rx_skipped),    l(n_.reconnects), l(n_.resync_backoffs)};
 }
 
 }  // namespace robodamp::drivers

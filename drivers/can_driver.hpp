@@ -23,24 +23,24 @@
 namespace robodamp::drivers {
 
 struct CanCounters {
-  std::uint64_t rx_frames{0};       // sensor frames decoded
-  std::uint64_t rx_other{0};        // frames with another identifier (fd transport: no kernel filter)
-  std::uint64_t rx_malformed{0};    // short, oversize, remote or non-FD frames for the sensor mapping
-  std::uint64_t lost_frames{0};     // counter gaps
-  std::uint64_t stale_frames{0};    // repeated counters
+  std::uint64_t rx_frames{0};     // sensor frames decoded
+  std::uint64_t rx_other{0};      // frames with another identifier (fd transport: no kernel filter)
+  std::uint64_t rx_malformed{0};  // short, oversize, remote or non-FD frames for the sensor mapping
+  std::uint64_t lost_frames{0};   // counter gaps
+  std::uint64_t stale_frames{0};  // repeated counters
   std::uint64_t error_frames{0};
-  std::uint64_t bus_off{0};         // bus-off events
-  std::uint64_t restarts{0};        // controller restarted after bus-off
-  std::uint64_t rx_errors{0};       // receive calls that failed (other than nothing waiting)
+  std::uint64_t bus_off{0};    // bus-off events
+  std::uint64_t restarts{0};   // controller restarted after bus-off
+  std::uint64_t rx_errors{0};  // receive calls that failed (other than nothing waiting)
   std::uint64_t tx_frames{0};
-  std::uint64_t tx_queue_full{0};   // ENOBUFS / EAGAIN
-  std::uint64_t tx_errors{0};       // other send failures
-  std::uint64_t tx_skipped{0};      // commands not sent while backing off
-  std::uint64_t tx_clipped{0};      // commands outside the command field's range
-  std::uint64_t rx_held{0};         // de-jitter: frames held over to the next tick
-  std::uint64_t rx_skipped{0};      // de-jitter: frames skipped (backlog, or resync to the newest)
-  std::uint64_t reconnects{0};      // transports handed over after the peer went away (offer_channel)
-  std::uint64_t resync_backoffs{0}; // de-jitter: a resync left a tick without a frame; its interval doubled
+  std::uint64_t tx_queue_full{0};    // ENOBUFS / EAGAIN
+  std::uint64_t tx_errors{0};        // other send failures
+  std::uint64_t tx_skipped{0};       // commands not sent while backing off
+  std::uint64_t tx_clipped{0};       // commands outside the command field's range
+  std::uint64_t rx_held{0};          // de-jitter: frames held over to the next tick
+  std::uint64_t rx_skipped{0};       // de-jitter: frames skipped (backlog, or resync to the newest)
+  std::uint64_t reconnects{0};       // transports handed over after the peer went away (offer_channel)
+  std::uint64_t resync_backoffs{0};  // de-jitter: a resync left a tick without a frame; its interval doubled
 };
 
 // CanCounters' JSON keys (the run summary's "can") and their words in its text line.
@@ -71,7 +71,7 @@ static_assert(fields::lists_every_member<CanCounters>(), "each counter in CanCou
 class CanDriver final : public rt::SensorSource, public rt::ActuatorSink {
  public:
   CanDriver(const config::CanConfig& cfg, CanChannel channel, double loop_rate_hz);
-  ~CanDriver();
+  ~CanDriver() override;
   CanDriver(const CanDriver&) = delete;
   CanDriver& operator=(const CanDriver&) = delete;
 

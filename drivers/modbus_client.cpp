@@ -110,7 +110,8 @@ void ModbusClient::stop() {
 
 bool ModbusClient::wait_for_amplifier(std::chrono::duration<double> timeout) const {
   std::unique_lock<std::mutex> lock(m_);
-  return amp_seen_.wait_for(lock, timeout, [this] { return last_ok_ns_.load() >= 0 || !running_; }) && last_ok_ns_.load() >= 0;
+  return amp_seen_.wait_for(lock, timeout, [this] { return last_ok_ns_.load() >= 0 || !running_; }) &&
+         last_ok_ns_.load() >= 0;
 }
 
 void ModbusClient::request_amplifier_enable(bool on) noexcept { requested_.store(on, std::memory_order_relaxed); }
@@ -232,9 +233,12 @@ void ModbusClient::robot_thread(std::stop_token stop) {
     robot_link_->succeeded();
     ++robot_polls_;
     int m = -1;
-    if (v == r.horizontal_value) m = static_cast<int>(config::Mounting::kHorizontal);
-    else if (v == r.vertical_value) m = static_cast<int>(config::Mounting::kVertical);
-    else ++mounting_unknown_;
+    if (v == r.horizontal_value)
+      m = static_cast<int>(config::Mounting::kHorizontal);
+    else if (v == r.vertical_value)
+      m = static_cast<int>(config::Mounting::kVertical);
+    else
+      ++mounting_unknown_;
     same = m == candidate ? same + 1 : 1;
     candidate = m;
     if (m >= 0 && same >= r.settle_polls && m != mounting_.load()) {
@@ -286,8 +290,10 @@ bool ModbusClient::poll_depth(modbus_t* ctx) {
   const double was = depth_mm_.exchange(mm);
   if (!(mm == was) && !(std::isnan(mm) && std::isnan(was))) {
     ++depth_changes_;
-    if (std::isnan(mm)) spdlog::warn("modbus robot: depth not available (65535): the job's depth applies");
-    else spdlog::info("modbus robot: cutting {:.3f} mm deep", mm);
+    if (std::isnan(mm))
+      spdlog::warn("modbus robot: depth not available (65535): the job's depth applies");
+    else
+      spdlog::info("modbus robot: cutting {:.3f} mm deep", mm);
   }
   return true;
 }

@@ -37,7 +37,8 @@
 #include "rt/io.hpp"
 #include "threads/worker.hpp"
 
-typedef struct _modbus modbus_t;
+// libmodbus's own names (its modbus.h), declared here so that the header does not pull libmodbus in.
+typedef struct _modbus modbus_t;  // NOLINT(bugprone-reserved-identifier)
 
 namespace robodamp::drivers {
 
@@ -73,18 +74,18 @@ class ModbusLink {
 struct ModbusCounters {
   std::uint64_t amplifier_polls{0}, robot_polls{0};
   std::uint64_t connects{0}, connect_failures{0}, errors{0}, timeouts{0};
-  std::uint64_t link_faults{0};        // times the amplifier's status became unknown while it mattered
+  std::uint64_t link_faults{0};  // times the amplifier's status became unknown while it mattered
   std::uint64_t coil_writes{0};
-  std::uint64_t mounting_changes{0};   // selections handed to the callback
-  std::uint64_t mounting_unknown{0};   // polls with a value that is neither horizontal nor vertical
-  std::uint64_t spindle_changes{0};    // settled spindle speeds handed to the callback
-  std::uint64_t spindle_link_parks{0}; // robot link lost for link_timeout_s: speed 0 handed over (notches parked)
-  std::uint64_t pose_changes{0};       // settled regions (or out of the map) handed to the callback
-  std::uint64_t pose_out_of_map_polls{0};  // polls with the pose outside every region
-  std::uint64_t pose_unavailable_polls{0}; // polls with a joint register at -32768 (not available)
-  std::uint64_t pose_link_losses{0};   // robot link lost for link_timeout_s: the pose became unknown
-  std::uint64_t advice_writes{0};      // spindle-speed advices written to modbus.robot.advice_register
-  std::uint64_t depth_changes{0};      // new depths read from modbus.robot.depth_register
+  std::uint64_t mounting_changes{0};         // selections handed to the callback
+  std::uint64_t mounting_unknown{0};         // polls with a value that is neither horizontal nor vertical
+  std::uint64_t spindle_changes{0};          // settled spindle speeds handed to the callback
+  std::uint64_t spindle_link_parks{0};       // robot link lost for link_timeout_s: speed 0 handed over (notches parked)
+  std::uint64_t pose_changes{0};             // settled regions (or out of the map) handed to the callback
+  std::uint64_t pose_out_of_map_polls{0};    // polls with the pose outside every region
+  std::uint64_t pose_unavailable_polls{0};   // polls with a joint register at -32768 (not available)
+  std::uint64_t pose_link_losses{0};         // robot link lost for link_timeout_s: the pose became unknown
+  std::uint64_t advice_writes{0};            // spindle-speed advices written to modbus.robot.advice_register
+  std::uint64_t depth_changes{0};            // new depths read from modbus.robot.depth_register
   std::uint64_t depth_unavailable_polls{0};  // polls with the depth register at 65535 (not available)
 };
 
@@ -192,7 +193,7 @@ class ModbusClient final : public rt::AmplifierIo {
   SpindleCallback on_spindle_;
   std::optional<config::PoseScheduleConfig> schedule_;
   PoseCallback on_pose_;
-  std::vector<double> joints_deg_;  // guarded by m_
+  std::vector<double> joints_deg_;              // guarded by m_
   std::array<std::uint16_t, 4> advice_regs_{};  // guarded by m_
   bool advice_pending_{false};                  // guarded by m_
   std::atomic<std::uint64_t> advice_writes_{0}, depth_changes_{0}, depth_unavailable_polls_{0};

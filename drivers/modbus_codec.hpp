@@ -11,7 +11,7 @@
 
 namespace robodamp::drivers::modbus_codec {
 
-inline constexpr std::uint16_t kDepthUnavailable = 65535;  // depth register: the robot does not say
+inline constexpr std::uint16_t kDepthUnavailable = 65535;     // depth register: the robot does not say
 inline constexpr std::int16_t kJointUnavailable = INT16_MIN;  // joint register: the angle is not known
 
 // Spindle speed: unsigned counts of rpm_per_count.
@@ -58,8 +58,8 @@ struct Advice {
   double rpm{0.0};
   double margin{0.0};
 };
-[[nodiscard]] inline std::array<std::uint16_t, 4> encode_advice(std::uint64_t seq, bool found, double rpm, double margin,
-                                                                double rpm_per_count) {
+[[nodiscard]] inline std::array<std::uint16_t, 4> encode_advice(std::uint64_t seq, bool found, double rpm,
+                                                                double margin, double rpm_per_count) {
   auto count = [](double v) { return static_cast<std::uint16_t>(std::clamp(std::lround(v), 0L, 65535L)); };
   return {static_cast<std::uint16_t>(seq & 0xFFFFU), found ? count(rpm / rpm_per_count) : std::uint16_t{0},
           found && std::isfinite(margin) ? count(100.0 * margin) : static_cast<std::uint16_t>(found ? 65535 : 0),

@@ -28,7 +28,8 @@ ModbusServer::~ModbusServer() {
 int ModbusServer::start(const std::string& host, int port) {
   if (worker_.running()) return port_;
   ctx_ = modbus_new_tcp(host.c_str(), port);
-  if (ctx_ == nullptr) throw std::runtime_error("Modbus server " + host + ":" + std::to_string(port) + ": " + modbus_strerror(errno));
+  if (ctx_ == nullptr)
+    throw std::runtime_error("Modbus server " + host + ":" + std::to_string(port) + ": " + modbus_strerror(errno));
   listen_fd_ = modbus_tcp_listen(ctx_, 8);
   if (listen_fd_ < 0) {
     const std::string why = modbus_strerror(errno);

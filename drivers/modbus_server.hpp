@@ -13,8 +13,9 @@
 
 #include "threads/worker.hpp"
 
-typedef struct _modbus modbus_t;
-typedef struct _modbus_mapping_t modbus_mapping_t;
+// libmodbus's own names (its modbus.h), declared here so that the header does not pull libmodbus in.
+typedef struct _modbus modbus_t;                    // NOLINT(bugprone-reserved-identifier)
+typedef struct _modbus_mapping_t modbus_mapping_t;  // NOLINT(bugprone-reserved-identifier)
 
 namespace robodamp::drivers {
 

@@ -26,8 +26,7 @@ rt::SensorSample SimBackend::read(std::uint64_t tick) noexcept {
   auto& faults = plant_.faults();
   if (faults.active(sim::FaultKind::kDriverStall, t)) {  // a driver call that blocks: real time passes
     const double until = rt::monotonic_s() + faults.magnitude(sim::FaultKind::kDriverStall, t);
-    while (rt::monotonic_s() < until) {
-    }
+    while (rt::monotonic_s() < until) {}
   }
   const sim::SensorReading r = plant_.sense();
   return {r.accel_mps2, r.fresh, !faults.active(sim::FaultKind::kSensorDriverError, t)};

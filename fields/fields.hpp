@@ -83,7 +83,8 @@ template <class S>
     } else {
       std::string named;
       for (std::size_t i = 1; i < value.size(); ++i)
-        if (value[i] > 0) named += (named.empty() ? "" : ", ") + std::string(field.name_of(i)) + " " + std::to_string(value[i]);
+        if (value[i] > 0)
+          named += (named.empty() ? "" : ", ") + std::string(field.name_of(i)) + " " + std::to_string(value[i]);
       add(std::string(field.key) + ": " + (named.empty() ? "none" : named));
     }
   });

@@ -110,7 +110,6 @@ class BiquadCascade final {
   }
 
  private:
-
   double finish(double v) noexcept {
     if (!std::isfinite(v)) [[unlikely]] {
       ++state_resets_;

@@ -106,7 +106,8 @@ DigitalDesign bilinear_sos(const TransferFunction& tf, double fs_hz, double prew
   out.prewarp_hz = prewarp_hz;
   double k = gain.real();
   while (!pd.empty()) {
-    const auto far = std::max_element(pd.begin(), pd.end(), [](Complex a, Complex b) { return std::abs(a) < std::abs(b); });
+    const auto far =
+        std::max_element(pd.begin(), pd.end(), [](Complex a, Complex b) { return std::abs(a) < std::abs(b); });
     const auto [p1, p2] = take_pair(pd, *far);
     const auto [z1, z2] = take_pair(zd, p1);
     BiquadCoefficients s{1.0, -(z1 + z2).real(), (z1 * z2).real(), -(p1 + p2).real(), (p1 * p2).real()};

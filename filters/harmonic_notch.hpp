@@ -31,11 +31,11 @@ inline constexpr int kMaxHarmonics = 8;
 
 struct HarmonicNotchSettings {
   bool enabled{false};
-  int harmonics{3};                 // notches at 1..harmonics x the tooth frequency
-  double bandwidth_hz{10.0};        // -3 dB width of each notch
-  double depth_db{30.0};            // attenuation at each centre
-  double slew_fraction{0.05};       // largest centre move per update, relative to the centre
-  double min_hz{10.0};              // below it (or an unknown speed) the bank parks and fades out
+  int harmonics{3};            // notches at 1..harmonics x the tooth frequency
+  double bandwidth_hz{10.0};   // -3 dB width of each notch
+  double depth_db{30.0};       // attenuation at each centre
+  double slew_fraction{0.05};  // largest centre move per update, relative to the centre
+  double min_hz{10.0};         // below it (or an unknown speed) the bank parks and fades out
   double fade_s{0.2};
   double update_hz{100.0};
   double max_fraction_of_fs{0.45};  // harmonics at or above this fraction of the sample rate are off
@@ -58,7 +58,8 @@ class HarmonicNotchBank final {
     s_ = s;
     s_.harmonics = std::clamp(s_.harmonics, 1, kMaxHarmonics);
     fs_hz_ = fs_hz;
-    update_every_ = std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::lround(fs_hz / std::max(s_.update_hz, 1e-3))));
+    update_every_ =
+        std::max<std::uint32_t>(1, static_cast<std::uint32_t>(std::lround(fs_hz / std::max(s_.update_hz, 1e-3))));
     const double update_s = update_every_ / fs_hz;
     fade_step_ = s_.fade_s > 0.0 ? update_s / s_.fade_s : 1.0;
     depth_ratio_ = std::pow(10.0, -s_.depth_db / 20.0);
@@ -123,7 +124,8 @@ class HarmonicNotchBank final {
   }
 
   // One notch's coefficients (pre-warped bilinear of N(s) above).
-  [[nodiscard]] static BiquadCoefficients design(double centre_hz, double bandwidth_hz, double depth_db, double fs_hz) noexcept {
+  [[nodiscard]] static BiquadCoefficients design(double centre_hz, double bandwidth_hz, double depth_db,
+                                                 double fs_hz) noexcept {
     return design_warped(std::tan(M_PI * centre_hz / fs_hz), centre_hz, bandwidth_hz, std::pow(10.0, -depth_db / 20.0));
   }
   // The same from the pre-warped centre w = tan(pi centre / fs) and the depth as a ratio.
@@ -187,7 +189,8 @@ class HarmonicNotchBank final {
     for (int k = 0; k < s_.harmonics; ++k) {
       const double target = harmonic_on(k) ? 1.0 : 0.0;  // each harmonic fades at the same rate
       const double own = own_[static_cast<std::size_t>(k)];
-      own_[static_cast<std::size_t>(k)] = target > own ? std::min(target, own + fade_step_) : std::max(target, own - fade_step_);
+      own_[static_cast<std::size_t>(k)] =
+          target > own ? std::min(target, own + fade_step_) : std::max(target, own - fade_step_);
       const double g = fade_ * own_[static_cast<std::size_t>(k)];
       changed = changed || g != gain_[static_cast<std::size_t>(k)];
       gain_[static_cast<std::size_t>(k)] = g;

@@ -49,9 +49,7 @@ TransferFunction notch(double center_hz, double bandwidth_hz) {
   return {Polynomial({w * w, 0.0, 1.0}), Polynomial({w * w, hz_to_rad_per_s(bandwidth_hz), 1.0})};
 }
 
-TransferFunction integrator(double leak_hz) {
-  return {Polynomial({1.0}), Polynomial({hz_to_rad_per_s(leak_hz), 1.0})};
-}
+TransferFunction integrator(double leak_hz) { return {Polynomial({1.0}), Polynomial({hz_to_rad_per_s(leak_hz), 1.0})}; }
 
 TransferFunction actuator(double constant_n_per_v, double natural_freq_hz, double damping_ratio) {
   return {Polynomial({0.0, 0.0, constant_n_per_v}), second_order(hz_to_rad_per_s(natural_freq_hz), damping_ratio)};

@@ -59,8 +59,8 @@ TransferFunction actuator(double constant_n_per_v, double natural_freq_hz, doubl
 }
 // Eq. 4 with the correction of docs/physics.md: numerator = the actuator denominator; denominator
 // s^2 + 2 z_c w_c s + w_c^2 with w_c = 2 pi corner_hz. The paper's -75.44 deg at 9.2 Hz needs z_c = 1.
-TransferFunction compensator_c1(double actuator_freq_hz, double actuator_damping_ratio,
-                                double corner_hz = 0.5, double corner_damping_ratio = 1.0);
+TransferFunction compensator_c1(double actuator_freq_hz, double actuator_damping_ratio, double corner_hz = 0.5,
+                                double corner_damping_ratio = 1.0);
 // Eq. 6, pole-zero placement; constant corrected to 211110.1 (printed 2111101).
 TransferFunction compensator_c2();
 // Eq. 7, pole-zero placement.

@@ -16,8 +16,10 @@ double SpindleProfile::rpm(double t_s) const {
   double rpm = 0.0;
   for (const auto& c : changes_) {
     if (t_s < c.t0_s) break;
-    if (t_s >= c.t1_s || c.t1_s <= c.t0_s) rpm = c.rpm;
-    else rpm += (c.rpm - rpm) * (t_s - c.t0_s) / (c.t1_s - c.t0_s);
+    if (t_s >= c.t1_s || c.t1_s <= c.t0_s)
+      rpm = c.rpm;
+    else
+      rpm += (c.rpm - rpm) * (t_s - c.t0_s) / (c.t1_s - c.t0_s);
   }
   return rpm;
 }
@@ -31,8 +33,8 @@ CutLoad cut_load_from_job(const std::string& job_path, const sim::PlantModel& mo
     for (const auto& p : s->parts)
       if (p.controller) part = &*p.controller;
   if (part == nullptr)
-    throw config::ConfigError({config::Problem{job_path, {}, "structures",
-                                               "the cut needs a part with a controller: where the tool is on the robot"}});
+    throw config::ConfigError({config::Problem{
+        job_path, {}, "structures", "the cut needs a part with a controller: where the tool is on the robot"}});
   const milling::Cutter cutter = milling::cutter_from(job.tool);
   const milling::CutConditions cc{job.cut.mode, job.cut.radial_mm, job.cut.axial_mm, job.cut.feed_per_tooth_mm};
   const milling::ForceSpectrum f = milling::force_spectrum(cutter, job.material, cc, job.sle.axial_slices, harmonics);
@@ -97,7 +99,8 @@ CuttingReport CuttingLoad::report() const {
   r.in_cut_s = in_cut_s_;
   r.measured_s = measured_s_;
   r.saturated_in_cut_s = saturated_s_;
-  for (std::size_t k = 1; k < cut_->harmonics_n.size(); ++k) r.force_harmonics_n.push_back(std::abs(cut_->harmonics_n[k]));
+  for (std::size_t k = 1; k < cut_->harmonics_n.size(); ++k)
+    r.force_harmonics_n.push_back(std::abs(cut_->harmonics_n[k]));
   for (const auto& l : lockin_)
     r.command_harmonics_v.push_back(lockin_n_ ? 2.0 * std::abs(l) / static_cast<double>(lockin_n_) : 0.0);
   return r;

@@ -38,10 +38,10 @@ class SpindleProfile {
 
 // The cut: a job's force harmonics in the direction the plant models, at a location.
 struct CutLoad {
-  std::string job;                                 // the milling job it came from
-  std::size_t location{0};                         // plant location index
+  std::string job;          // the milling job it came from
+  std::size_t location{0};  // plant location index
   int teeth{3};
-  std::vector<std::complex<double>> harmonics_n;   // c_0 (mean) .. c_K, one-sided (F = Re sum c_k e^{i k phi})
+  std::vector<std::complex<double>> harmonics_n;  // c_0 (mean) .. c_K, one-sided (F = Re sum c_k e^{i k phi})
 };
 // From a milling job file (its tool, material and cut; the wall-normal force at the location of its
 // controller part). Throws config::ConfigError when the job cannot be read or has no controller part.
@@ -52,10 +52,10 @@ struct CuttingReport {
   std::string job;
   int teeth{0};
   double in_cut_s{0.0};
-  double measured_s{0.0};               // of it at a steady speed (the lock-in's span)
-  double saturated_in_cut_s{0.0};       // periods with the amplifier at its voltage range or the coil at its force limit
-  std::vector<double> force_harmonics_n;   // |c_k|, k = 1..
-  std::vector<double> command_harmonics_v; // amplitude of the command at k x the tooth frequency, k = 1..
+  double measured_s{0.0};          // of it at a steady speed (the lock-in's span)
+  double saturated_in_cut_s{0.0};  // periods with the amplifier at its voltage range or the coil at its force limit
+  std::vector<double> force_harmonics_n;    // |c_k|, k = 1..
+  std::vector<double> command_harmonics_v;  // amplitude of the command at k x the tooth frequency, k = 1..
   double last_rpm{0.0};
 };
 

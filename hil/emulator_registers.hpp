@@ -38,12 +38,14 @@ class EmulatorRegisters {
   [[nodiscard]] bool enable() const { return amp_->coil(m_.amplifier.enable_coil); }
   void set_spindle_rpm(double rpm) {
     if (m_.robot_link && m_.robot.spindle_rpm_register >= 0)
-      robot_->set_holding_register(m_.robot.spindle_rpm_register, modbus_codec::encode_rpm(rpm, m_.robot.rpm_per_count));
+      robot_->set_holding_register(m_.robot.spindle_rpm_register,
+                                   modbus_codec::encode_rpm(rpm, m_.robot.rpm_per_count));
   }
   // The depth the robot program cuts: unsigned counts of depth_mm_per_count; 65535 = not available.
   void set_depth_mm(double mm) {
     if (!m_.robot_link || m_.robot.depth_register < 0) return;
-    robot_->set_holding_register(m_.robot.depth_register, modbus_codec::encode_depth_mm(mm, m_.robot.depth_mm_per_count));
+    robot_->set_holding_register(m_.robot.depth_register,
+                                 modbus_codec::encode_depth_mm(mm, m_.robot.depth_mm_per_count));
   }
   // The advice block robodamp run writes (modbus.robot.advice_register): seq, rpm counts, margin x 100,
   // status; nothing without the block.
@@ -61,9 +63,10 @@ class EmulatorRegisters {
   }
   void set_mounting(config::Mounting m) {
     if (m_.robot_link)
-      robot_->set_holding_register(m_.robot.mounting_register, static_cast<std::uint16_t>(
-                                                                   m == config::Mounting::kVertical ? m_.robot.vertical_value
-                                                                                                    : m_.robot.horizontal_value));
+      robot_->set_holding_register(
+          m_.robot.mounting_register,
+          static_cast<std::uint16_t>(m == config::Mounting::kVertical ? m_.robot.vertical_value
+                                                                      : m_.robot.horizontal_value));
   }
   // The joint angles in the robot's registers: signed counts of deg_per_count; -32768 = not available.
   void set_joints(const std::vector<double>& q) {

@@ -52,53 +52,58 @@ nlohmann::json report_json(const EmulatorReport& r) {
                       {"predicted_improvement_pct", d.predicted_pct},
                       {"coherence_min", d.coherence_min}});
   const auto& h = r.wake_latency;
-  return {{"config", r.config},
-          {"pose", {{"retunes", r.pose_retunes}, {"dwells", dwells}}},
-          {"pacing", r.pacing},
-          {"transport", r.transport},
-          {"modbus", r.modbus},
-          {"ticks", r.ticks},
-          {"plant_time_s", r.plant_time_s},
-          {"elapsed_s", r.elapsed_s},
-          {"end_reason", r.end_reason},
-          {"cutting", cutting_json(r.cutting)},
-          {"regenerative_cut", regenerative_cut_json(r.regenerative_cut)},
-          {"advice", advice_json(r.advice)},
-          {"measurement",
-           {{"records", r.measure_records}, {"records_planned", r.measure_records_planned}, {"files", r.measure_files}}},
-          {"frames",
-           {{"sensor_sent", r.sensor_frames_sent},
-            {"send_errors", r.send_errors},
-            {"commands", r.command_frames},
-            {"commands_lost", r.commands_lost},
-            {"malformed", r.frames_malformed},
-            {"other_ids", r.frames_other},
-            {"held_periods", r.held_periods}}},
-          {"amplifier",
-           {{"enable_changes", r.enable_changes},
-            {"enabled_s", r.enabled_s},
-            {"peak_command_v", r.peak_command_v},
-            {"peak_temperature_c", r.peak_temperature_c}}},
-          {"robot", {{"mounting_changes", r.mounting_changes}, {"spindle_changes", r.spindle_changes}}},
-          {"injected", [&r] {
-             json a = json::array();
-             for (const auto& f : r.injected)
-               a.push_back({{"kind", f.kind}, {"plant_time_s", f.plant_time_s}, {"monotonic_ns", f.monotonic_ns}});
-             return a;
-           }()},
-          {"modbus_requests", r.modbus_requests},
-          {"timing",
-           {{"wake_latency", {{"count", h.count()}, {"p50_us", h.percentile_us(0.5)}, {"p99_us", h.percentile_us(0.99)},
-                              {"max_us", h.max_us()}}},
-            {"overruns", r.overruns}}},
-          {"impacts",
-           {{"location", r.impact_location},
-            {"started", r.campaign_started},
-            {"complete", r.campaign_complete},
-            {"start_s", r.campaign_start_s},
-            {"records", r.records},
-            {"records_planned", r.records_planned},
-            {"frfs", frfs}}}};
+  return {
+      {"config", r.config},
+      {"pose", {{"retunes", r.pose_retunes}, {"dwells", dwells}}},
+      {"pacing", r.pacing},
+      {"transport", r.transport},
+      {"modbus", r.modbus},
+      {"ticks", r.ticks},
+      {"plant_time_s", r.plant_time_s},
+      {"elapsed_s", r.elapsed_s},
+      {"end_reason", r.end_reason},
+      {"cutting", cutting_json(r.cutting)},
+      {"regenerative_cut", regenerative_cut_json(r.regenerative_cut)},
+      {"advice", advice_json(r.advice)},
+      {"measurement",
+       {{"records", r.measure_records}, {"records_planned", r.measure_records_planned}, {"files", r.measure_files}}},
+      {"frames",
+       {{"sensor_sent", r.sensor_frames_sent},
+        {"send_errors", r.send_errors},
+        {"commands", r.command_frames},
+        {"commands_lost", r.commands_lost},
+        {"malformed", r.frames_malformed},
+        {"other_ids", r.frames_other},
+        {"held_periods", r.held_periods}}},
+      {"amplifier",
+       {{"enable_changes", r.enable_changes},
+        {"enabled_s", r.enabled_s},
+        {"peak_command_v", r.peak_command_v},
+        {"peak_temperature_c", r.peak_temperature_c}}},
+      {"robot", {{"mounting_changes", r.mounting_changes}, {"spindle_changes", r.spindle_changes}}},
+      {"injected",
+       [&r] {
+         json a = json::array();
+         for (const auto& f : r.injected)
+           a.push_back({{"kind", f.kind}, {"plant_time_s", f.plant_time_s}, {"monotonic_ns", f.monotonic_ns}});
+         return a;
+       }()},
+      {"modbus_requests", r.modbus_requests},
+      {"timing",
+       {{"wake_latency",
+         {{"count", h.count()},
+          {"p50_us", h.percentile_us(0.5)},
+          {"p99_us", h.percentile_us(0.99)},
+          {"max_us", h.max_us()}}},
+        {"overruns", r.overruns}}},
+      {"impacts",
+       {{"location", r.impact_location},
+        {"started", r.campaign_started},
+        {"complete", r.campaign_complete},
+        {"start_s", r.campaign_start_s},
+        {"records", r.records},
+        {"records_planned", r.records_planned},
+        {"frfs", frfs}}}};
 }
 
 // long: one line per field of the emulator's report, in reading order
@@ -111,12 +116,13 @@ std::string report_text(const EmulatorReport& r) {
   std::snprintf(b, sizeof b, "  %llu plant steps (%.3f s plant time) in %.3f s; ended: %s\n",
                 static_cast<unsigned long long>(r.ticks), r.plant_time_s, r.elapsed_s, r.end_reason.c_str());
   os << b;
-  std::snprintf(b, sizeof b,
-                "  frames: %llu sensor sent (%llu send errors), %llu commands (%llu lost, %llu malformed, %llu other ids)%s\n",
-                static_cast<unsigned long long>(r.sensor_frames_sent), static_cast<unsigned long long>(r.send_errors),
-                static_cast<unsigned long long>(r.command_frames), static_cast<unsigned long long>(r.commands_lost),
-                static_cast<unsigned long long>(r.frames_malformed), static_cast<unsigned long long>(r.frames_other),
-                r.pacing == "realtime" ? (", " + std::to_string(r.held_periods) + " periods held the last command").c_str() : "");
+  std::snprintf(
+      b, sizeof b,
+      "  frames: %llu sensor sent (%llu send errors), %llu commands (%llu lost, %llu malformed, %llu other ids)%s\n",
+      static_cast<unsigned long long>(r.sensor_frames_sent), static_cast<unsigned long long>(r.send_errors),
+      static_cast<unsigned long long>(r.command_frames), static_cast<unsigned long long>(r.commands_lost),
+      static_cast<unsigned long long>(r.frames_malformed), static_cast<unsigned long long>(r.frames_other),
+      r.pacing == "realtime" ? (", " + std::to_string(r.held_periods) + " periods held the last command").c_str() : "");
   os << b;
   if (r.pacing == "realtime") {
     const auto& h = r.wake_latency;
@@ -124,7 +130,8 @@ std::string report_text(const EmulatorReport& r) {
                   h.percentile_us(0.5), h.percentile_us(0.99), h.max_us(), static_cast<unsigned long long>(r.overruns));
     os << b;
   }
-  std::snprintf(b, sizeof b, "  amplifier: enabled %.3f s (%llu changes), peak drive %.3f V, peak %.1f degC; %llu Modbus requests\n",
+  std::snprintf(b, sizeof b,
+                "  amplifier: enabled %.3f s (%llu changes), peak drive %.3f V, peak %.1f degC; %llu Modbus requests\n",
                 r.enabled_s, static_cast<unsigned long long>(r.enable_changes), r.peak_command_v, r.peak_temperature_c,
                 static_cast<unsigned long long>(r.modbus_requests));
   os << b;
@@ -138,10 +145,11 @@ std::string report_text(const EmulatorReport& r) {
                   r.records_planned, r.campaign_complete ? "" : " (incomplete: the controller left first)");
     os << b;
     for (const auto& f : r.frfs) {
-      std::snprintf(b, sizeof b,
-                    "    %-8s open %.4g m/N at %.2f Hz, closed %.4g m/N at %.2f Hz: improvement %.1f %% (coherence min %.4f)\n",
-                    f.name.c_str(), f.open_peak_m_per_n, f.open_peak_hz, f.closed_peak_m_per_n, f.closed_peak_hz,
-                    f.improvement_pct, f.coherence_min);
+      std::snprintf(
+          b, sizeof b,
+          "    %-8s open %.4g m/N at %.2f Hz, closed %.4g m/N at %.2f Hz: improvement %.1f %% (coherence min %.4f)\n",
+          f.name.c_str(), f.open_peak_m_per_n, f.open_peak_hz, f.closed_peak_m_per_n, f.closed_peak_hz,
+          f.improvement_pct, f.coherence_min);
       os << b;
     }
   }
@@ -156,29 +164,32 @@ std::string report_text(const EmulatorReport& r) {
       if (!q.empty()) q += ' ';
       q += std::to_string(std::lround(v));
     }
-    std::snprintf(b, sizeof b,
-                  "    dwell %.1f-%.1f s at [%s] deg (region '%s', dominant mode %.2f Hz): %d records, open %.4g m/N, closed "
-                  "%.4g m/N at %.2f Hz: improvement %.1f %% measured, %.1f %% predicted (coherence min %.3f)\n",
-                  d.t0_s, d.t1_s, q.c_str(), d.region.c_str(), d.dominant_hz, d.records, d.open_peak_m_per_n,
-                  d.closed_peak_m_per_n, d.closed_peak_hz, d.improvement_pct, d.predicted_pct, d.coherence_min);
+    std::snprintf(
+        b, sizeof b,
+        "    dwell %.1f-%.1f s at [%s] deg (region '%s', dominant mode %.2f Hz): %d records, open %.4g m/N, closed "
+        "%.4g m/N at %.2f Hz: improvement %.1f %% measured, %.1f %% predicted (coherence min %.3f)\n",
+        d.t0_s, d.t1_s, q.c_str(), d.region.c_str(), d.dominant_hz, d.records, d.open_peak_m_per_n,
+        d.closed_peak_m_per_n, d.closed_peak_hz, d.improvement_pct, d.predicted_pct, d.coherence_min);
     os << b;
   }
   if (r.cutting.cut) {
     const auto& c = r.cutting;
     const auto at = [](const std::vector<double>& v, std::size_t i) { return i < v.size() ? v[i] : 0.0; };
-    std::snprintf(b, sizeof b,
-                  "  cutting %s: %.3f s in the cut (last %.0f rpm), %.3f s of it at the actuator's limits; command at "
-                  "1/2/3 x tooth passing %.3g / %.3g / %.3g V over %.1f s at a steady speed (force %.1f / %.1f / %.1f N)\n",
-                  c.job.c_str(), c.in_cut_s, c.last_rpm, c.saturated_in_cut_s, at(c.command_harmonics_v, 0),
-                  at(c.command_harmonics_v, 1), at(c.command_harmonics_v, 2), c.measured_s, at(c.force_harmonics_n, 0),
-                  at(c.force_harmonics_n, 1), at(c.force_harmonics_n, 2));
+    std::snprintf(
+        b, sizeof b,
+        "  cutting %s: %.3f s in the cut (last %.0f rpm), %.3f s of it at the actuator's limits; command at "
+        "1/2/3 x tooth passing %.3g / %.3g / %.3g V over %.1f s at a steady speed (force %.1f / %.1f / %.1f N)\n",
+        c.job.c_str(), c.in_cut_s, c.last_rpm, c.saturated_in_cut_s, at(c.command_harmonics_v, 0),
+        at(c.command_harmonics_v, 1), at(c.command_harmonics_v, 2), c.measured_s, at(c.force_harmonics_n, 0),
+        at(c.force_harmonics_n, 1), at(c.force_harmonics_n, 2));
     os << b;
   }
   if (r.regenerative_cut.cut) {
     const auto& c = r.regenerative_cut;
     const auto& v = c.verdict;
     if (!c.complete)
-      std::snprintf(b, sizeof b, "  regenerative cut %s: %.3f mm at %.1f rpm from %.3f s: incomplete (the run ended at %.3f s)\n",
+      std::snprintf(b, sizeof b,
+                    "  regenerative cut %s: %.3f mm at %.1f rpm from %.3f s: incomplete (the run ended at %.3f s)\n",
                     c.job.c_str(), c.axial_mm, c.rpm, c.start_s, c.end_s);
     else
       std::snprintf(b, sizeof b,
@@ -190,16 +201,17 @@ std::string report_text(const EmulatorReport& r) {
     os << b;
     if (c.segments.size() > 1)
       for (const auto& g : c.segments) {
-        std::snprintf(b, sizeof b, "    %.3f-%.3f s (%s): %.3f mm at %.1f rpm, %.1f revolutions: %s%s\n", g.start_s, g.end_s,
-                      g.cause.c_str(), g.axial_mm, g.rpm, g.revolutions,
-                      g.judged ? milling::to_string(g.verdict.classification) : "too short to judge",
-                      g.judged && g.verdict.chatter_hz > 0.0 ? fmt::format(" at {:.2f} Hz", g.verdict.chatter_hz).c_str() : "");
+        std::snprintf(
+            b, sizeof b, "    %.3f-%.3f s (%s): %.3f mm at %.1f rpm, %.1f revolutions: %s%s\n", g.start_s, g.end_s,
+            g.cause.c_str(), g.axial_mm, g.rpm, g.revolutions,
+            g.judged ? milling::to_string(g.verdict.classification) : "too short to judge",
+            g.judged && g.verdict.chatter_hz > 0.0 ? fmt::format(" at {:.2f} Hz", g.verdict.chatter_hz).c_str() : "");
         os << b;
       }
   }
   for (const auto& a : r.advice) {
-    std::snprintf(b, sizeof b, "  advice #%u read at %.3f s: status %d, %.1f rpm, margin %.2f: %s\n", a.seq, a.plant_time_s,
-                  a.status, a.rpm, a.margin, a.action.c_str());
+    std::snprintf(b, sizeof b, "  advice #%u read at %.3f s: status %d, %.1f rpm, margin %.2f: %s\n", a.seq,
+                  a.plant_time_s, a.status, a.rpm, a.margin, a.action.c_str());
     os << b;
   }
   for (const auto& f : r.injected) {

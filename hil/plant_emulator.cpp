@@ -33,21 +33,24 @@ constexpr double kSilentControllerS = 10.0;  // lockstep: no command for this lo
 constexpr double kTemperatureTauS = 10.0;    // amplifier heating time constant
 constexpr double kAdvicePollS = 0.01;        // how often the robot program reads the advice block (plant time)
 
+}  // namespace
+
+namespace detail {
+
 sim::Plant make_plant(const config::Config& cfg, const sim::PlantModel& model) {
   sim::Plant plant(model, cfg);
   if (cfg.disturbances.drives_on) plant.add_excitation(sim::make_drive_vibration(model, cfg));
   return plant;
 }
 
-}  // namespace
-
-namespace detail {
-
 const config::CanConfig& can_section(const config::Config& cfg) {
   if (!cfg.can || !cfg.modbus)
-    throw config::ConfigError({{cfg.source, {}, cfg.can ? "modbus" : "can",
-                                cfg.can ? "missing: the emulator serves the amplifier's registers from the modbus section"
-                                        : "missing: the emulator sends and receives the frames of the can section"}});
+    throw config::ConfigError(
+        {{cfg.source,
+          {},
+          cfg.can ? "modbus" : "can",
+          cfg.can ? "missing: the emulator serves the amplifier's registers from the modbus section"
+                  : "missing: the emulator sends and receives the frames of the can section"}});
   return *cfg.can;
 }
 
@@ -58,14 +61,15 @@ PlantEmulator::PlantEmulator(const config::Config& cfg, const EmulatorOptions& o
       pacing_(o.pacing.value_or(cfg.hil.pacing)),
       fs_(cfg.loop.rate_hz),
       dt_(1.0 / cfg.loop.rate_hz),
-      trajectory_(o.pose_trajectory.empty() ? std::nullopt : std::make_optional<PoseTrajectory>(cfg, o.pose_trajectory)),
+      trajectory_(o.pose_trajectory.empty() ? std::nullopt
+                                            : std::make_optional<PoseTrajectory>(cfg, o.pose_trajectory)),
       model_(trajectory_ ? trajectory_->plant_at(trajectory_->at(0.0)) : sim::build_plant_model(cfg)),
       plant_(make_plant(cfg, model_)),
       impact_id_(o.impact_location > 0 ? o.impact_location
-                                        : (cfg.robot.frfs.empty() ? 1 : cfg.robot.frfs.front().excitation_location)),
+                                       : (cfg.robot.frfs.empty() ? 1 : cfg.robot.frfs.front().excitation_location)),
       impact_index_(model_.index_of(impact_id_)),
-      test_{impact_index_, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, true, cfg.controller.gain_ns_per_m,
-            cfg.controller.polarity},
+      test_{impact_index_, cfg.bench.impact_peak_n,      cfg.bench.impact_duration_ms,
+            true,          cfg.controller.gain_ns_per_m, cfg.controller.polarity},
       regs_(cfg),
       temperature_c_(cfg.hil.ambient_c) {
   rep_.config = cfg.source;
@@ -102,14 +106,16 @@ void PlantEmulator::setup_cut() {
     changes_.clear();  // the cut's own program: the register shows the speed it turns at
     regenerative_.emplace(cfg_, plant_, ro);
     const RegenerativeCutReport head = regenerative_->report();
-    spdlog::info("robodamp plant: regenerative cut {}: {:.3f} mm at {:.1f} rpm ({} steps per tooth), {} revolutions{}{}",
-                 o_.cut_job, head.axial_mm, head.rpm, head.steps_per_tooth, head.revolutions,
-                 head.start_s >= 0.0 ? fmt::format(" from {:.3f} s", head.start_s) : std::string(" once the loop is at full gain"),
-                 ro.spindle.empty() && ro.depth.empty() ? "" : " after the program's last change");
+    spdlog::info(
+        "robodamp plant: regenerative cut {}: {:.3f} mm at {:.1f} rpm ({} steps per tooth), {} revolutions{}{}",
+        o_.cut_job, head.axial_mm, head.rpm, head.steps_per_tooth, head.revolutions,
+        head.start_s >= 0.0 ? fmt::format(" from {:.3f} s", head.start_s)
+                            : std::string(" once the loop is at full gain"),
+        ro.spindle.empty() && ro.depth.empty() ? "" : " after the program's last change");
   } else if (!o_.cut_job.empty()) {
     cut = cut_load_from_job(o_.cut_job, model_, o_.cut_harmonics);
-    spdlog::info("robodamp plant: cutting {} ({} teeth) at the {}: tooth harmonics {:.1f}, {:.1f}, {:.1f} N", o_.cut_job,
-                 cut->teeth, model_.locations[cut->location].name, std::abs(cut->harmonics_n[1]),
+    spdlog::info("robodamp plant: cutting {} ({} teeth) at the {}: tooth harmonics {:.1f}, {:.1f}, {:.1f} N",
+                 o_.cut_job, cut->teeth, model_.locations[cut->location].name, std::abs(cut->harmonics_n[1]),
                  std::abs(cut->harmonics_n[2]), std::abs(cut->harmonics_n[3]));
   }
   cutting_.emplace(plant_, std::move(cut), SpindleProfile(std::move(changes_)));
@@ -120,13 +126,16 @@ void PlantEmulator::setup_cut() {
 void PlantEmulator::connect() {
   if (can_.interface.rfind("unix:", 0) == 0) {
     listener_.emplace(can_.interface.substr(5));
-    spdlog::info("robodamp plant: waiting for the controller on {} ({}), Modbus {}", can_.interface, rep_.pacing, rep_.modbus);
+    spdlog::info("robodamp plant: waiting for the controller on {} ({}), Modbus {}", can_.interface, rep_.pacing,
+                 rep_.modbus);
     const int fd = listener_->accept(cfg_.hil.accept_timeout_s);
-    if (fd < 0) throw std::runtime_error("no controller connected to " + can_.interface + " within hil.accept_timeout_s = " +
-                                         std::to_string(cfg_.hil.accept_timeout_s) + " s");
+    if (fd < 0)
+      throw std::runtime_error("no controller connected to " + can_.interface +
+                               " within hil.accept_timeout_s = " + std::to_string(cfg_.hil.accept_timeout_s) + " s");
     channel_.emplace(drivers::CanChannel::adopt(fd));
   } else {
-    channel_.emplace(drivers::CanChannel::open_interface(can_.interface, can_.fd, can_.command.id, can_.command.extended_id));
+    channel_.emplace(
+        drivers::CanChannel::open_interface(can_.interface, can_.fd, can_.command.id, can_.command.extended_id));
   }
   spdlog::info("robodamp plant: controller connected");
   if (pacing_ == config::HilPacing::kRealtime && o_.realtime_setup) {
@@ -154,9 +163,11 @@ void PlantEmulator::setup_campaigns() {
       for (double& t : at.impacts_start_s) t += d.t0_s;
       const std::string dir = o_.measure_out + "/dwell_" + std::to_string(++k);
       modal_tests_.emplace_back(dir, std::make_unique<analysis::ModalTest>(cfg_, plant_, at));
-      spdlog::info("robodamp plant: commissioning measurement at dwell {} ({}): {} impacts at each location from {:.1f} s, "
-                   "FRFs to {}", k, config::describe_pose(d.joints_deg), cfg_.commissioning.impacts_per_location,
-                   at.impacts_start_s.front(), dir);
+      spdlog::info(
+          "robodamp plant: commissioning measurement at dwell {} ({}): {} impacts at each location from {:.1f} s, "
+          "FRFs to {}",
+          k, config::describe_pose(d.joints_deg), cfg_.commissioning.impacts_per_location, at.impacts_start_s.front(),
+          dir);
     }
     for (const auto& [dir, test] : modal_tests_) rep_.measure_records_planned += test->records_planned();
   } else if (o_.impacts && !trajectory_) {
@@ -176,8 +187,10 @@ void PlantEmulator::run() {
   if (o_.max_duration_s > 0.0) max_ticks_ = static_cast<std::uint64_t>(std::llround(o_.max_duration_s * fs_));
   send_sensor();  // tick 0's sample
   rep_.end_reason = "the controller disconnected";
-  if (pacing_ == config::HilPacing::kLockstep) run_lockstep();
-  else run_realtime();
+  if (pacing_ == config::HilPacing::kLockstep)
+    run_lockstep();
+  else
+    run_realtime();
   if (rep_.ticks >= max_ticks_) rep_.end_reason = "--duration reached";
 }
 
@@ -266,8 +279,10 @@ void PlantEmulator::send_sensor() {
   const sim::SensorReading s = plant_.sense();
   if (regenerative_) regenerative_->sensed(s.accel_mps2, static_cast<double>(rep_.ticks) * dt_);
   const drivers::Encoded e = drivers::encode(can_.sensor, can_.fd, s.accel_mps2, sensor_counter_++);
-  if (channel_->send(e.frame, e.frame_bytes) == 0) ++rep_.sensor_frames_sent;
-  else ++rep_.send_errors;
+  if (channel_->send(e.frame, e.frame_bytes) == 0)
+    ++rep_.sensor_frames_sent;
+  else
+    ++rep_.send_errors;
 }
 
 bool PlantEmulator::receive_commands(bool& got) {
@@ -289,7 +304,8 @@ bool PlantEmulator::receive_commands(bool& got) {
     }
     if (can_.command.counter) {
       if (have_cmd_counter_)
-        rep_.commands_lost += drivers::counter_step(last_cmd_counter_, d.counter, drivers::counter_mask(*can_.command.counter)).lost;
+        rep_.commands_lost +=
+            drivers::counter_step(last_cmd_counter_, d.counter, drivers::counter_mask(*can_.command.counter)).lost;
       last_cmd_counter_ = d.counter, have_cmd_counter_ = true;
     }
     ++rep_.command_frames;
@@ -306,18 +322,24 @@ void PlantEmulator::read_advice(double t) {
   advice_seq_ = (*a)[0];
   const drivers::modbus_codec::Advice d = drivers::modbus_codec::decode_advice(*a, regs_.rpm_per_count());
   AdviceSeen seen{t, advice_seq_, static_cast<int>(d.status), d.rpm, d.margin, {}};
-  if (seen.status == 2) seen.action = "kept the speed: no stable speed";
-  else if (seen.status == 3) seen.action = "kept the speed: withdrawn (the state it was for is gone)";
-  else if (seen.status != 1) seen.action = "refused: status " + std::to_string(seen.status) + " (allowed 1, 2 or 3)";
+  if (seen.status == 2)
+    seen.action = "kept the speed: no stable speed";
+  else if (seen.status == 3)
+    seen.action = "kept the speed: withdrawn (the state it was for is gone)";
+  else if (seen.status != 1)
+    seen.action = "refused: status " + std::to_string(seen.status) + " (allowed 1, 2 or 3)";
   else if (!(seen.rpm > 0.0) || seen.rpm > cfg_.spindle.rpm_max)
     seen.action = fmt::format("refused: {} rpm outside the spindle's 0 < rpm <= {} rpm (spindle.rpm_max)", seen.rpm,
                               cfg_.spindle.rpm_max);
-  else if (!cfg_.spindle.apply_advice) seen.action = "not followed (spindle.apply_advice false)";
-  else if (regenerative_->ended()) seen.action = "not followed: the cut has ended";
-  else seen.action = "followed", regenerative_->follow_advice(seen.rpm, t);
+  else if (!cfg_.spindle.apply_advice)
+    seen.action = "not followed (spindle.apply_advice false)";
+  else if (regenerative_->ended())
+    seen.action = "not followed: the cut has ended";
+  else
+    seen.action = "followed", regenerative_->follow_advice(seen.rpm, t);
   regenerative_->advice_read(t);
-  spdlog::info("robodamp plant: advice #{} at {:.3f} s: status {}, {:.1f} rpm, margin {:.2f}: {}", seen.seq, t, seen.status,
-               seen.rpm, seen.margin, seen.action);
+  spdlog::info("robodamp plant: advice #{} at {:.3f} s: status {}, {:.1f} rpm, margin {:.2f}: {}", seen.seq, t,
+               seen.status, seen.rpm, seen.margin, seen.action);
   rep_.advice.push_back(std::move(seen));
 }
 
@@ -415,7 +437,8 @@ void PlantEmulator::amplifier(std::size_t k, double t) {
 void PlantEmulator::robot_reports(double t) {
   while (next_spindle_ < o_.spindle_schedule.size() && o_.spindle_schedule[next_spindle_].first <= t) {
     ++rep_.spindle_changes;
-    spdlog::info("robodamp plant: robot reports the spindle at {} rpm at {:.3f} s", o_.spindle_schedule[next_spindle_].second, t);
+    spdlog::info("robodamp plant: robot reports the spindle at {} rpm at {:.3f} s",
+                 o_.spindle_schedule[next_spindle_].second, t);
     ++next_spindle_;
   }
   while (next_mounting_ < o_.mounting_schedule.size() && o_.mounting_schedule[next_mounting_].first <= t) {
@@ -427,52 +450,6 @@ void PlantEmulator::robot_reports(double t) {
   }
 }
 
-EmulatorReport PlantEmulator::finish() {
-  rep_.plant_time_s = static_cast<double>(rep_.ticks) * dt_;
-  rep_.elapsed_s = std::chrono::duration<double>(Clock::now() - wall0_).count();
-  rep_.modbus_requests = regs_.requests();
-  rep_.cutting = cutting_->report();
-  if (regenerative_) rep_.regenerative_cut = regenerative_->report();
-  if (dwell_campaigns_) rep_.pose_dwells = dwell_campaigns_->finish();
-  for (const auto& [dir, test] : modal_tests_) {
-    rep_.measure_records += test->records();
-    std::filesystem::create_directories(dir);
-    for (const std::string& f : test->write_frf_csvs(dir))
-      rep_.measure_files.push_back(dir == o_.measure_out ? f : std::filesystem::path(dir).filename().string() + "/" + f);
-    spdlog::info("robodamp plant: {} of {} impact records; FRFs written to {}", test->records(), test->records_planned(), dir);
-  }
-  if (campaign_ && campaign_->started()) open_loop_reference();
-  return std::move(rep_);
-}
-
-// The impact campaign's records against the same schedule with the amplifier off (the open-loop
-// reference, in process): each FRF's peak open and closed.
-void PlantEmulator::open_loop_reference() {
-  rep_.records = campaign_->records();
-  rep_.closed_receptance = campaign_->receptance();
-  sim::Plant open = make_plant(cfg_, model_);
-  analysis::ImpactCampaign ref(cfg_, open, test_);
-  ref.start(rep_.campaign_start_s);
-  for (std::size_t k = 0; k < ref.end_tick(); ++k) {
-    ref.before_step(k);
-    (void)open.sense();  // the control sensor's noise stream advances as in the closed-loop run
-    open.step(0.0);
-    ref.after_step(k);
-  }
-  rep_.open_receptance = ref.receptance();
-  if (rep_.records == 0) return;
-  const double lo = cfg_.analysis.band_min_hz, hi = cfg_.analysis.band_max_hz;
-  for (const auto& f : cfg_.robot.frfs) {
-    if (f.excitation_location != impact_id_) continue;
-    const std::size_t resp = model_.index_of(f.response_location);
-    const auto op = analysis::measured_peak(rep_.open_receptance[resp], lo, hi);
-    const auto cl = analysis::measured_peak(rep_.closed_receptance[resp], lo, hi);
-    rep_.frfs.push_back({f.name, op.magnitude_m_per_n, op.freq_hz, cl.magnitude_m_per_n, cl.freq_hz,
-                         (op.magnitude_m_per_n / cl.magnitude_m_per_n - 1.0) * 100.0,
-                         std::min(op.coherence_min, cl.coherence_min)});
-  }
-}
-
 }  // namespace detail
 
 EmulatorReport run_emulator(const config::Config& configured, const EmulatorOptions& o) {
@@ -480,8 +457,8 @@ EmulatorReport run_emulator(const config::Config& configured, const EmulatorOpti
   config::Config cfg = configured;
   if (cfg.pose_schedule && !cfg.hil.robot_model_resolved.empty()) {
     cfg.pose_schedule->model_resolved = cfg.hil.robot_model_resolved;
-    spdlog::info("robodamp plant: the robot moved is {} (hil.robot_model), not the controller's {}", cfg.hil.robot_model_resolved,
-                 configured.pose_schedule->model_resolved);
+    spdlog::info("robodamp plant: the robot moved is {} (hil.robot_model), not the controller's {}",
+                 cfg.hil.robot_model_resolved, configured.pose_schedule->model_resolved);
   }
   detail::PlantEmulator emulator(cfg, o);
   emulator.connect();

@@ -49,7 +49,7 @@ struct EmulatorOptions {
   // written to this directory when the run ends. With a pose trajectory, the plan at each of its stops
   // (from the stop's start) into measure_out/dwell_<k> (measure --along-path); a stop shorter than the plan
   // is refused. Empty = off.
-  std::string measure_out;                   // location id; 0 = the first configured FRF's excitation
+  std::string measure_out;  // location id; 0 = the first configured FRF's excitation
   // Robot mounting register changes: (plant time s, mounting).
   std::vector<std::pair<double, config::Mounting>> mounting_schedule;
   // Spindle speed register changes: (plant time s, rpm), written to modbus.robot.spindle_rpm_register
@@ -79,7 +79,7 @@ struct EmulatorOptions {
   std::vector<PoseWaypoint> pose_trajectory;
   double pose_register_period_s{0.05};
   double pose_update_s{0.02};
-  bool realtime_setup{true};                // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
+  bool realtime_setup{true};  // realtime pacing: SCHED_FIFO etc. (one below the loop's priority)
   // Faults injected at plant times (s; negative = none), to measure how the controller gets to its safe
   // state: the CAN bus goes off (an error frame with CAN_ERR_BUSOFF, no sensor frames for bus_off_for_s,
   // then CAN_ERR_RESTARTED, as a SocketCAN interface with restart-ms reports it), and the Modbus device
@@ -99,7 +99,7 @@ struct FrfReport {
 };
 
 struct InjectedFault {
-  std::string kind;           // "bus_off", "bus_restarted", "modbus_hang"
+  std::string kind;  // "bus_off", "bus_restarted", "modbus_hang"
   double plant_time_s{0.0};
   std::int64_t monotonic_ns{0};  // CLOCK_MONOTONIC, comparable with the controller's on the same machine
 };
@@ -109,10 +109,10 @@ struct InjectedFault {
 struct AdviceSeen {
   double plant_time_s{0.0};
   unsigned seq{0};
-  int status{0};           // 1: a speed, 2: no stable speed in the range
+  int status{0};  // 1: a speed, 2: no stable speed in the range
   double rpm{0.0}, margin{0.0};
-  std::string action;      // "followed", "kept the speed: no stable speed", "not followed (spindle.apply_advice
-                           // false)", "refused: ..." (a value out of range)
+  std::string action;  // "followed", "kept the speed: no stable speed", "not followed (spindle.apply_advice
+                       // false)", "refused: ..." (a value out of range)
 };
 
 struct EmulatorReport {

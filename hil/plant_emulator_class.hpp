@@ -28,6 +28,8 @@ namespace robodamp::hil::detail {
 using Clock = std::chrono::steady_clock;
 
 const config::CanConfig& can_section(const config::Config& cfg);
+// The emulated plant with the configuration's drive vibration (the closed loop's and the open-loop reference's).
+sim::Plant make_plant(const config::Config& cfg, const sim::PlantModel& model);
 
 // The simulated plant as the DAQ node and the amplifier on CAN, the amplifier and the robot on Modbus:
 // built from the configuration and the options (the plant, the cut, the registers), connected to one

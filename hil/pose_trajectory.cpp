@@ -20,12 +20,14 @@ config::ConfigError trajectory_error(const config::Config& cfg, const std::strin
 
 PoseTrajectory::PoseTrajectory(const config::Config& cfg, std::vector<PoseWaypoint> points)
     : cfg_(cfg), points_(std::move(points)) {
-  if (!cfg.pose_schedule) throw trajectory_error(cfg, "a pose trajectory needs the configuration's pose_schedule (the robot model)");
+  if (!cfg.pose_schedule)
+    throw trajectory_error(cfg, "a pose trajectory needs the configuration's pose_schedule (the robot model)");
   if (points_.empty()) throw trajectory_error(cfg, "no waypoint");
   schedule_ = analysis::analyse_pose_schedule(cfg);
   for (std::size_t i = 0; i < points_.size(); ++i) {
     if (auto p = config::pose_problem(schedule_.model, points_[i].joints_deg))
-      throw trajectory_error(cfg, "waypoint " + std::to_string(i + 1) + " at " + config::format_number(points_[i].t_s) + " s: " + *p);
+      throw trajectory_error(
+          cfg, "waypoint " + std::to_string(i + 1) + " at " + config::format_number(points_[i].t_s) + " s: " + *p);
     if (i > 0 && points_[i].t_s < points_[i - 1].t_s)
       throw trajectory_error(cfg, "waypoint " + std::to_string(i + 1) + " at " + config::format_number(points_[i].t_s) +
                                       " s comes before the one before it: waypoints go in time order");
@@ -56,8 +58,10 @@ std::vector<PoseDwell> PoseTrajectory::dwells() const {
 std::vector<PoseDwell> PoseTrajectory::stops() const {
   std::vector<PoseDwell> out;
   for (const PoseDwell& d : dwells()) {
-    if (!out.empty() && out.back().t1_s == d.t0_s && out.back().joints_deg == d.joints_deg) out.back().t1_s = d.t1_s;
-    else out.push_back(d);
+    if (!out.empty() && out.back().t1_s == d.t0_s && out.back().joints_deg == d.joints_deg)
+      out.back().t1_s = d.t1_s;
+    else
+      out.push_back(d);
   }
   return out;
 }
@@ -65,18 +69,22 @@ std::vector<PoseDwell> PoseTrajectory::stops() const {
 void check_measurement_stops(const PoseTrajectory& t, const analysis::CommissioningPlan& plan) {
   const std::vector<PoseDwell> stops = t.stops();
   if (stops.empty())
-    throw trajectory_error(t.config(), "has no dwell (two waypoints at the same pose): --measure-out measures at the robot's stops");
+    throw trajectory_error(
+        t.config(), "has no dwell (two waypoints at the same pose): --measure-out measures at the robot's stops");
   for (std::size_t k = 0; k < stops.size(); ++k)
     if (stops[k].t1_s - stops[k].t0_s < plan.duration_s)
-      throw trajectory_error(t.config(), "dwell " + std::to_string(k + 1) + " at " + config::describe_pose(stops[k].joints_deg) +
-                                    " lasts " + config::format_number(stops[k].t1_s - stops[k].t0_s) +
-                                    " s: the commissioning measurement at a stop needs " + config::format_number(plan.duration_s) +
-                                    " s (commissioning: settle_s, the chirp, quiet_s, the impacts at every location)");
+      throw trajectory_error(t.config(),
+                             "dwell " + std::to_string(k + 1) + " at " + config::describe_pose(stops[k].joints_deg) +
+                                 " lasts " + config::format_number(stops[k].t1_s - stops[k].t0_s) +
+                                 " s: the commissioning measurement at a stop needs " +
+                                 config::format_number(plan.duration_s) +
+                                 " s (commissioning: settle_s, the chirp, quiet_s, the impacts at every location)");
 }
 
 sim::PlantModel PoseTrajectory::plant_at(const std::vector<double>& q) const {
   const auto& s = *cfg_.pose_schedule;
-  return sim::build_plant_model(analysis::config_at_pose(cfg_, analysis::pose_modes(schedule_.model, q, s.axis, s.modes)));
+  return sim::build_plant_model(
+      analysis::config_at_pose(cfg_, analysis::pose_modes(schedule_.model, q, s.axis, s.modes)));
 }
 
 std::vector<std::pair<double, sim::PlantModel>> PoseTrajectory::retunes(double update_s) const {
@@ -109,9 +117,10 @@ DwellCampaigns::DwellCampaigns(const config::Config& cfg, sim::Plant& plant, con
     const double start = d.t0_s + cfg.hil.settle_s;
     const int records = static_cast<int>(std::floor((d.t1_s - start) / cfg.bench.record_s));
     if (records < 1) {
-      spdlog::warn("robodamp plant: the dwell at {} from {:.1f} to {:.1f} s is too short for one {} s record after "
-                   "hil.settle_s = {} s: not measured", config::describe_pose(d.joints_deg), d.t0_s, d.t1_s,
-                   cfg.bench.record_s, cfg.hil.settle_s);
+      spdlog::warn(
+          "robodamp plant: the dwell at {} from {:.1f} to {:.1f} s is too short for one {} s record after "
+          "hil.settle_s = {} s: not measured",
+          config::describe_pose(d.joints_deg), d.t0_s, d.t1_s, cfg.bench.record_s, cfg.hil.settle_s);
       continue;
     }
     config::Config& c = configs_.emplace_back(cfg);

@@ -36,12 +36,12 @@ struct PoseDwell {
 struct PoseDwellReport {
   std::vector<double> joints_deg;
   double t0_s{0.0}, t1_s{0.0};
-  std::string region;                 // the schedule's region for the pose ("" outside every region)
-  double dominant_hz{0.0};            // of the robot model at the pose
+  std::string region;       // the schedule's region for the pose ("" outside every region)
+  double dominant_hz{0.0};  // of the robot model at the pose
   int records{0};
   double open_peak_m_per_n{0.0}, closed_peak_m_per_n{0.0}, closed_peak_hz{0.0};
-  double improvement_pct{0.0};        // measured: open peak / closed peak - 1
-  double predicted_pct{0.0};          // the region's set at this pose (discrete loop)
+  double improvement_pct{0.0};  // measured: open peak / closed peak - 1
+  double predicted_pct{0.0};    // the region's set at this pose (discrete loop)
   double coherence_min{0.0};
 };
 

@@ -83,11 +83,13 @@ RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, c
   const config::MillingConfig job = config::load_milling_config(o.job_path);
   // The job's structure with its controller part on this cell: the part's location and direction are where
   // the cut acts on the plant; its loop rate is the cut's step.
-  const milling::Structure structure(job.selected_structure(), false,
-                                     {std::make_shared<const analysis::LoopModel>(cfg), cfg.controller.gain_ns_per_m,
-                                      cfg.controller.polarity});
+  const milling::Structure structure(
+      job.selected_structure(), false,
+      {std::make_shared<const analysis::LoopModel>(cfg), cfg.controller.gain_ns_per_m, cfg.controller.polarity});
   if (structure.controller_parts().empty())
-    throw config::ConfigError({{job.source, {}, "structures." + job.structure,
+    throw config::ConfigError({{job.source,
+                                {},
+                                "structures." + job.structure,
                                 "the emulator's cut acts on the robot at the structure's controller part; structures." +
                                     job.structure + " has none"}});
   milling::CutOverrides co;
@@ -101,7 +103,8 @@ RegenerativeCut::RegenerativeCut(const config::Config& cfg, sim::Plant& plant, c
   if (auto p = config::range_problem(o.rpm ? "--cut-rpm" : "cut.spindle_rpm", cj.requested_rpm, speeds))
     problems.push_back({job.source, {}, o.rpm ? "--cut-rpm" : "cut.spindle_rpm", *p});
   for (const auto& c : o.spindle)
-    if (auto p = config::range_problem("--spindle", c.rpm, speeds)) problems.push_back({job.source, {}, "--spindle", *p});
+    if (auto p = config::range_problem("--spindle", c.rpm, speeds))
+      problems.push_back({job.source, {}, "--spindle", *p});
   for (const auto& c : o.depth)
     if (auto p = config::range_problem("--depth", c.rpm, depths)) problems.push_back({job.source, {}, "--depth", *p});
   if (!problems.empty()) throw config::ConfigError(problems);
@@ -253,7 +256,8 @@ void RegenerativeCut::sensed(double accel_mps2, double t_s) {
   if (c.chatter && h.indicator_chatter_s < 0.0) h.indicator_chatter_s = t_s;
   // Quiet: the first clear evaluation in a segment after one that chattered.
   const bool before_chattered = segments_.size() > 1 && segments_[segments_.size() - 2].head.indicator_chatter_s >= 0.0;
-  if (!c.chatter && h.indicator_quiet_s < 0.0 && h.indicator_chatter_s < 0.0 && before_chattered) h.indicator_quiet_s = t_s;
+  if (!c.chatter && h.indicator_quiet_s < 0.0 && h.indicator_chatter_s < 0.0 && before_chattered)
+    h.indicator_quiet_s = t_s;
 }
 
 CutSegment RegenerativeCut::judged(const Segment& s) const {
@@ -287,8 +291,10 @@ RegenerativeCutReport RegenerativeCut::report() const {
   for (const Segment& s : segments_) r.segments.push_back(judged(s));
   if (!r.complete) r.end_s = t_s_;
   const CutSegment& last = r.segments.back();
-  if (last.judged) r.verdict = last.verdict;
-  else r.complete = false;  // the cut's end too short to judge
+  if (last.judged)
+    r.verdict = last.verdict;
+  else
+    r.complete = false;  // the cut's end too short to judge
   r.sle_um = process_->sle_um();
   return r;
 }
@@ -300,20 +306,21 @@ nlohmann::json segments_json(const std::vector<CutSegment>& segments) {
   auto time_or_null = [](double t) { return t >= 0.0 ? nlohmann::json(t) : nlohmann::json(nullptr); };
   for (const CutSegment& s : segments) {
     const auto& v = s.verdict;
-    out.push_back({{"cause", s.cause},
-                   {"start_s", s.start_s},
-                   {"end_s", s.end_s},
-                   {"requested_rpm", s.requested_rpm},
-                   {"rpm", s.rpm},
-                   {"axial_mm", s.axial_mm},
-                   {"revolutions", s.revolutions},
-                   {"classification", s.judged ? milling::to_string(v.classification) : "too short"},
-                   {"stable", s.judged ? nlohmann::json(v.stable) : nlohmann::json(nullptr)},
-                   {"chatter_hz", s.judged && v.chatter_hz > 0.0 ? nlohmann::json(v.chatter_hz) : nlohmann::json(nullptr)},
-                   {"growth_per_tooth", s.judged ? nlohmann::json(v.growth_per_period) : nlohmann::json(nullptr)},
-                   {"nonharmonic_energy_ratio", s.judged ? nlohmann::json(v.nonharmonic_energy_ratio) : nlohmann::json(nullptr)},
-                   {"indicator_chatter_s", time_or_null(s.indicator_chatter_s)},
-                   {"indicator_quiet_s", time_or_null(s.indicator_quiet_s)}});
+    out.push_back(
+        {{"cause", s.cause},
+         {"start_s", s.start_s},
+         {"end_s", s.end_s},
+         {"requested_rpm", s.requested_rpm},
+         {"rpm", s.rpm},
+         {"axial_mm", s.axial_mm},
+         {"revolutions", s.revolutions},
+         {"classification", s.judged ? milling::to_string(v.classification) : "too short"},
+         {"stable", s.judged ? nlohmann::json(v.stable) : nlohmann::json(nullptr)},
+         {"chatter_hz", s.judged && v.chatter_hz > 0.0 ? nlohmann::json(v.chatter_hz) : nlohmann::json(nullptr)},
+         {"growth_per_tooth", s.judged ? nlohmann::json(v.growth_per_period) : nlohmann::json(nullptr)},
+         {"nonharmonic_energy_ratio", s.judged ? nlohmann::json(v.nonharmonic_energy_ratio) : nlohmann::json(nullptr)},
+         {"indicator_chatter_s", time_or_null(s.indicator_chatter_s)},
+         {"indicator_quiet_s", time_or_null(s.indicator_quiet_s)}});
   }
   return out;
 }

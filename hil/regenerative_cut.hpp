@@ -75,7 +75,7 @@ struct RegenerativeCutReport {
   std::string job;
   double requested_rpm{0.0}, rpm{0.0};  // rpm: the tooth period a whole number of loop periods
   double axial_mm{0.0}, radial_mm{0.0};
-  std::vector<CutSegment> segments;     // in order; the last is the one the fields above describe
+  std::vector<CutSegment> segments;  // in order; the last is the one the fields above describe
   int teeth{0}, steps_per_tooth{0}, revolutions{0}, settle_revolutions{0};
   double start_s{0.0}, end_s{0.0};
   bool complete{false};  // every revolution cut before the run ended
@@ -143,7 +143,8 @@ class RegenerativeCut {
   RegenerativeCutReport rep_;
   bool started_{false}, ended_{false};
   double t_s_{0.0};
-  Eigen::Vector2d f_{Eigen::Vector2d::Zero()}, q_start_{Eigen::Vector2d::Zero()}, last_{Eigen::Vector2d::Zero()}, previous_{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d f_{Eigen::Vector2d::Zero()}, q_start_{Eigen::Vector2d::Zero()}, last_{Eigen::Vector2d::Zero()},
+      previous_{Eigen::Vector2d::Zero()};
   double drive_hz_{0.0};  // the drives' vibration: its lines are fitted and taken out before each verdict
 };
 

@@ -137,7 +137,7 @@ ActuatorFit refine_actuator_discrete(const ActuatorFit& start, const analysis::F
     const bool found = !fa.empty() && std::abs(accel_per_volt.h1[k]) > 0.0;
     out.fitted[i] = found ? out.measured[i] / accel_per_volt.h1[k] * recorded(m, sensor, fa[k])
                           : filters::actuator_n_per_v(out.f_hz[i], out.force_constant_n_per_v, out.natural_freq_hz,
-                                             out.damping_ratio, out.delay_ms * 1e-3);
+                                                      out.damping_ratio, out.delay_ms * 1e-3);
   }
   return out;
 }

@@ -18,7 +18,8 @@ namespace robodamp::identify {
 
 // structure: a configuration holding the identified robot (its actuator values are replaced); the
 // chirp's acceleration per volt at structure.sensor. Points: those the continuous fit used.
-[[nodiscard]] ActuatorFit refine_actuator_discrete(const ActuatorFit& start, const analysis::FrfEstimate& accel_per_volt,
+[[nodiscard]] ActuatorFit refine_actuator_discrete(const ActuatorFit& start,
+                                                   const analysis::FrfEstimate& accel_per_volt,
                                                    const config::Config& structure);
 
 // The sampled acceleration per volt the loop records (sensor included, output latch included) for a

@@ -86,7 +86,10 @@ ActuatorFit fit_actuator(const ActuatorFrf& frf, const ActuatorFitSettings& s) {
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   for (int it = 0; it < 40; ++it) {
     const double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-    if (solve_at(pts, x1).rel_error < solve_at(pts, x2).rel_error) hi = x2; else lo = x1;
+    if (solve_at(pts, x1).rel_error < solve_at(pts, x2).rel_error)
+      hi = x2;
+    else
+      lo = x1;
   }
   const Trial refined = solve_at(pts, 0.5 * (lo + hi));
   if (refined.rel_error < best.rel_error) best = refined;
@@ -102,7 +105,8 @@ ActuatorFit fit_actuator(const ActuatorFrf& frf, const ActuatorFitSettings& s) {
   double err = 0.0, ref = 0.0;
   for (const Point& p : pts) {
     const double f = p.w / kTwoPi;
-    const Complex m = filters::actuator_n_per_v(f, fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, best.tau);
+    const Complex m =
+        filters::actuator_n_per_v(f, fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, best.tau);
     fit.f_hz.push_back(f), fit.measured.push_back(p.g), fit.fitted.push_back(m);
     err += std::norm(m - p.g), ref += std::norm(p.g);
   }

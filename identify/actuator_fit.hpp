@@ -40,7 +40,7 @@ struct ActuatorFit {
   double fit_error_pct{0.0};  // RMS |G - G_fit| / RMS |G| over the points used, %
   double band_lo_hz{0.0}, band_hi_hz{0.0};
   int points{0};
-  std::vector<double> f_hz;       // the points used
+  std::vector<double> f_hz;  // the points used
   std::vector<Complex> measured, fitted;
 };
 

@@ -27,21 +27,21 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> regressors(const BallEndTest& t, double
   const double dk = kmax / kKappaPoints, scale = t.teeth / (kTwoPi);
   for (int i = 0; i < kKappaPoints; ++i) {
     const double k = (i + 0.5) * dk, sk = std::sin(k), ck = std::cos(k);
-    const double shear = c_mm * sk * r0 * dk * scale;                                       // h db / sin(psi)
-    const double edge = r0 * std::sqrt(1.0 + std::pow(sk, 4) * tanb * tanb) * dk * scale;   // dS
+    const double shear = c_mm * sk * r0 * dk * scale;                                      // h db / sin(psi)
+    const double edge = r0 * std::sqrt(1.0 + std::pow(sk, 4) * tanb * tanb) * dk * scale;  // dS
     double kp = 1.0;
     for (int j = 0; j < p; ++j, kp *= k) {
-      m(1, j) += M_PI / 2.0 * shear * kp;                                 // Ktc_j: Fy
-      m(0, p + j) += -sk * M_PI / 2.0 * shear * kp;                       // Krc_j: Fx
-      m(2, p + j) += ck * 2.0 * shear * kp;                               //        Fz
-      m(0, 2 * p + j) += ck * M_PI / 2.0 * shear * kp;                    // Kac_j: Fx
-      m(2, 2 * p + j) += sk * 2.0 * shear * kp;                           //        Fz
+      m(1, j) += M_PI / 2.0 * shear * kp;               // Ktc_j: Fy
+      m(0, p + j) += -sk * M_PI / 2.0 * shear * kp;     // Krc_j: Fx
+      m(2, p + j) += ck * 2.0 * shear * kp;             //        Fz
+      m(0, 2 * p + j) += ck * M_PI / 2.0 * shear * kp;  // Kac_j: Fx
+      m(2, 2 * p + j) += sk * 2.0 * shear * kp;         //        Fz
     }
-    m(1, 3 * p) += 2.0 * edge;                  // Kte: Fy
-    m(0, 3 * p + 1) += -sk * 2.0 * edge;        // Kre: Fx
-    m(2, 3 * p + 1) += ck * M_PI * edge;        //      Fz
-    m(0, 3 * p + 2) += ck * 2.0 * edge;         // Kae: Fx
-    m(2, 3 * p + 2) += sk * M_PI * edge;        //      Fz
+    m(1, 3 * p) += 2.0 * edge;            // Kte: Fy
+    m(0, 3 * p + 1) += -sk * 2.0 * edge;  // Kre: Fx
+    m(2, 3 * p + 1) += ck * M_PI * edge;  //      Fz
+    m(0, 3 * p + 2) += ck * 2.0 * edge;   // Kae: Fx
+    m(2, 3 * p + 2) += sk * M_PI * edge;  //      Fz
   }
   return m;
 }
@@ -79,10 +79,12 @@ BallEndFit identify_ball_end(const std::vector<BallEndRun>& runs, const BallEndT
   for (int i = 0; i < n; ++i) {
     const BallEndRun& r = runs[static_cast<std::size_t>(i)];
     for (double v : {r.axial_mm, r.feed_per_tooth_mm, r.fx_n, r.fy_n, r.fz_n})
-      if (!std::isfinite(v)) throw std::invalid_argument("run " + std::to_string(i + 1) + ": a value is not a finite number");
+      if (!std::isfinite(v))
+        throw std::invalid_argument("run " + std::to_string(i + 1) + ": a value is not a finite number");
     if (!(r.axial_mm > 0.0 && r.axial_mm <= r0))
       throw std::invalid_argument("run " + std::to_string(i + 1) + ": axial depth " + std::to_string(r.axial_mm) +
-                                  " mm is out of range: allowed 0 < value <= the ball's radius " + std::to_string(r0) + " mm");
+                                  " mm is out of range: allowed 0 < value <= the ball's radius " + std::to_string(r0) +
+                                  " mm");
     if (!(r.feed_per_tooth_mm > 0.0))
       throw std::invalid_argument("run " + std::to_string(i + 1) + ": the feed per tooth must be > 0 mm");
     const auto m = regressors(t, r.axial_mm, r.feed_per_tooth_mm);
@@ -103,8 +105,8 @@ BallEndFit identify_ball_end(const std::vector<BallEndRun>& runs, const BallEndT
   f.condition_number = std::max(a.condition, b.condition);
   if (!(f.condition_number <= kMaxConditionNumber)) {
     std::ostringstream os;
-    os << "collinear regressors: the condition number of the regression is " << f.condition_number << " (accepted up to "
-       << kMaxConditionNumber << "); the runs cannot separate the order-" << t.order
+    os << "collinear regressors: the condition number of the regression is " << f.condition_number
+       << " (accepted up to " << kMaxConditionNumber << "); the runs cannot separate the order-" << t.order
        << " polynomial's terms: lower --order or add runs at other axial depths and feeds";
     throw std::invalid_argument(os.str());
   }

@@ -39,7 +39,7 @@ struct BallEndFit {
   Estimate kte, kre, kae;               // N/mm
   double r2_y{0.0}, r2_xz{0.0};
   double residual_rms_n{0.0};
-  double condition_number{0.0};         // the larger of the two regressions', columns scaled
+  double condition_number{0.0};  // the larger of the two regressions', columns scaled
   int runs{0};
 };
 

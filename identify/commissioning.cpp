@@ -25,7 +25,6 @@ using nlohmann::json;
 
 namespace {
 
-
 std::string frf_name(const config::Config& cfg, int g, int h) {
   for (const auto& f : cfg.robot.frfs)
     if (f.response_location == g && f.excitation_location == h) return f.name;
@@ -47,8 +46,10 @@ std::vector<IdentifiedFrf> read_frfs(const std::string& dir, const MeasurementMa
       f.file = analysis::frf_file_name(f.response_id, f.excitation_id);
       const std::string path = (fs::path(dir) / f.file).string();
       if (!fs::exists(path))
-        throw std::invalid_argument(path + " is missing: the plant side of robodamp measure writes it (the simulated "
-                                    "plant in process, or robodamp plant --measure-out " + dir + " with hardware)");
+        throw std::invalid_argument(path +
+                                    " is missing: the plant side of robodamp measure writes it (the simulated "
+                                    "plant in process, or robodamp plant --measure-out " +
+                                    dir + " with hardware)");
       f.data = read_frf_csv(path, FrfKind::kReceptance);
       out.push_back(std::move(f));
     }
@@ -57,7 +58,8 @@ std::vector<IdentifiedFrf> read_frfs(const std::string& dir, const MeasurementMa
 }
 
 // Each FRF's modes.
-void fit_frfs(std::vector<IdentifiedFrf>& out, const config::Config& cfg, const CommissioningSettings& s, std::string& pole_fit) {
+void fit_frfs(std::vector<IdentifiedFrf>& out, const config::Config& cfg, const CommissioningSettings& s,
+              std::string& pole_fit) {
   ModalFitSettings ms;
   ms.band_lo_hz = cfg.analysis.band_min_hz, ms.band_hi_hz = cfg.analysis.band_max_hz;
   ms.max_order = s.max_order, ms.min_coherence = s.min_coherence;
@@ -150,7 +152,8 @@ std::string compose_yaml(const CommissioningResult& r, int polarity) {
   out << root;
   std::ostringstream os;
   os << "# robodamp identify all: the configuration " << r.manifest.config_source
-     << " with the robot's FRFs, the actuator and the\n# compensator's match frequency identified from a robodamp measure "
+     << " with the robot's FRFs, the actuator and the\n# compensator's match frequency identified from a robodamp "
+        "measure "
         "run (docs/identification.md).\n"
      << out.c_str() << '\n';
   return os.str();
@@ -181,24 +184,28 @@ const IdentifiedFrf& path_between(const std::vector<IdentifiedFrf>& frfs, int a,
 namespace {
 
 // Where a recording's chirp starts (s): its start time, or the tick after the chosen start command.
-double chirp_start_s(const rt::Recording& rec, const rt::PeriodicChirp& sig, double fs_hz, std::optional<double> wanted_s,
-                     const std::string& path) {
+double chirp_start_s(const rt::Recording& rec, const rt::PeriodicChirp& sig, double fs_hz,
+                     std::optional<double> wanted_s, const std::string& path) {
   if (!sig.on_command) return sig.start_s;
   std::vector<double> starts;
   for (const auto& f : rec.frames)
     if (static_cast<rt::CommandKind>(f.command_kind) == rt::CommandKind::kStartExcitation)
       starts.push_back(static_cast<double>(f.tick + 1) / fs_hz);
-  if (starts.empty()) throw std::invalid_argument(path + ": its chirp waits for a command and none came (no dwell measured)");
+  if (starts.empty())
+    throw std::invalid_argument(path + ": its chirp waits for a command and none came (no dwell measured)");
   if (!wanted_s) return starts.front();
   for (const double t : starts)
     if (std::abs(t - *wanted_s) <= 0.5 / fs_hz) return t;
-  throw std::invalid_argument(path + ": no chirp starts at " + std::to_string(*wanted_s) + " s (the measurement.json's "
-                              "plan.chirp_start_s); its chirps start at " + std::to_string(starts.size()) + " other times");
+  throw std::invalid_argument(path + ": no chirp starts at " + std::to_string(*wanted_s) +
+                              " s (the measurement.json's "
+                              "plan.chirp_start_s); its chirps start at " +
+                              std::to_string(starts.size()) + " other times");
 }
 
 }  // namespace
 
-ChirpMeasurement read_chirp_measurement(const std::string& path, const std::string& config_source, std::optional<double> start_s) {
+ChirpMeasurement read_chirp_measurement(const std::string& path, const std::string& config_source,
+                                        std::optional<double> start_s) {
   if (!fs::exists(path)) throw std::invalid_argument(path + " is missing: robodamp measure records the loop there");
   const rt::Recording rec = rt::read_recording(path);
   ChirpMeasurement m;
@@ -219,7 +226,8 @@ ChirpMeasurement read_chirp_measurement(const std::string& path, const std::stri
     next = f.tick + 1;
   }
   const auto period_n = static_cast<std::size_t>(std::lround(sig.period_s * m.fs_hz));
-  const auto first = static_cast<std::size_t>(std::lround(chirp_start_s(rec, sig, m.fs_hz, start_s, path) * m.fs_hz)) + period_n;
+  const auto first =
+      static_cast<std::size_t>(std::lround(chirp_start_s(rec, sig, m.fs_hz, start_s, path) * m.fs_hz)) + period_n;
   m.periods_averaged = sig.periods - 1;  // the first period is the transient
   m.f0_hz = sig.f0_hz, m.f1_hz = sig.f1_hz;
   m.accel_per_volt = periodic_frf(u, y, first, period_n, m.periods_averaged, m.fs_hz, sig.f1_hz);
@@ -244,8 +252,8 @@ ActuatorFit identify_actuator(const ChirpMeasurement& m, const config::Config& s
 
 config::Config with_collocated_structure(const config::Config& base, const ModalFit& fit) {
   if (base.sensor.location != base.actuator.location)
-    throw std::invalid_argument("the sensor (location " + std::to_string(base.sensor.location) + ") and the actuator (location " +
-                                std::to_string(base.actuator.location) +
+    throw std::invalid_argument("the sensor (location " + std::to_string(base.sensor.location) +
+                                ") and the actuator (location " + std::to_string(base.actuator.location) +
                                 ") are not collocated: one FRF does not describe the structure; use identify all");
   config::Config c = base;
   c.robot.locations = {{base.sensor.location, "sensor and actuator", 1}};
@@ -285,8 +293,9 @@ json to_json(const MeasurementManifest& m) {
           {"locations", locs},
           {"sensor_location_id", m.sensor_location_id},
           {"actuator_location_id", m.actuator_location_id},
-          {"pose", m.pose_deg.empty() ? json(nullptr)
-                                      : json{{"name", m.pose_name}, {"joints_deg", m.pose_deg}, {"robot_model", m.robot_model}}},
+          {"pose", m.pose_deg.empty()
+                       ? json(nullptr)
+                       : json{{"name", m.pose_name}, {"joints_deg", m.pose_deg}, {"robot_model", m.robot_model}}},
           {"run", m.run}};
 }
 
@@ -310,7 +319,8 @@ MeasurementManifest read_manifest(const std::string& dir) {
     m.plan.predicted_peak_force_n = p.at("predicted_peak_force_n");
     m.plan.impacts_start_s = p.at("impacts_start_s").get<std::vector<double>>();
     m.plan.duration_s = p.at("duration_s");
-    for (const auto& l : j.at("locations")) m.locations.emplace_back(l.at("id").get<int>(), l.at("name").get<std::string>());
+    for (const auto& l : j.at("locations"))
+      m.locations.emplace_back(l.at("id").get<int>(), l.at("name").get<std::string>());
     m.sensor_location_id = j.at("sensor_location_id");
     m.actuator_location_id = j.at("actuator_location_id");
     m.run = j.value("run", json::object());
@@ -391,16 +401,24 @@ json to_json(const CommissioningResult& r) {
   for (const auto& f : r.frfs) {
     json modes = json::array();
     for (const auto& m : f.fit.modes)
-      modes.push_back({{"natural_freq_hz", m.natural_freq_hz}, {"damping_ratio", m.damping_ratio},
-                       {"residue_re_m_per_n", m.residue_re}, {"residue_im_m_per_n", m.residue_im}, {"stiffness_n_per_m", m.stiffness_n_per_m}});
-    frfs.push_back({{"name", f.name}, {"response_location", f.response_id}, {"excitation_location", f.excitation_id},
-                    {"file", f.file}, {"modes", modes}, {"fit_error_pct", f.fit.fit_error_pct},
+      modes.push_back({{"natural_freq_hz", m.natural_freq_hz},
+                       {"damping_ratio", m.damping_ratio},
+                       {"residue_re_m_per_n", m.residue_re},
+                       {"residue_im_m_per_n", m.residue_im},
+                       {"stiffness_n_per_m", m.stiffness_n_per_m}});
+    frfs.push_back({{"name", f.name},
+                    {"response_location", f.response_id},
+                    {"excitation_location", f.excitation_id},
+                    {"file", f.file},
+                    {"modes", modes},
+                    {"fit_error_pct", f.fit.fit_error_pct},
                     {"band_hz", {f.fit.band_lo_hz, f.fit.band_hi_hz}}});
   }
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   json imp = json::object();
   for (const auto& [name, pct] : r.improvements_pct) imp[name] = pct;
-  return {{"frfs", frfs}, {"pole_fit", r.pole_fit},
+  return {{"frfs", frfs},
+          {"pole_fit", r.pole_fit},
           {"actuator",
            {{"mounting", config::to_string(r.config.actuator.mounting)},
             {"force_constant_n_per_v", r.actuator.force_constant_n_per_v},
@@ -427,12 +445,12 @@ std::string summary_text(const CommissioningResult& r) {
   char b[256];
   os << "  modes: " << r.pole_fit << "\n";
   for (const auto& f : r.frfs) {
-    std::snprintf(b, sizeof b, "  %s (%s): %zu modes, fit error %.2f %% over %.1f-%.1f Hz\n", f.name.c_str(), f.file.c_str(),
-                  f.fit.modes.size(), f.fit.fit_error_pct, f.fit.band_lo_hz, f.fit.band_hi_hz);
+    std::snprintf(b, sizeof b, "  %s (%s): %zu modes, fit error %.2f %% over %.1f-%.1f Hz\n", f.name.c_str(),
+                  f.file.c_str(), f.fit.modes.size(), f.fit.fit_error_pct, f.fit.band_lo_hz, f.fit.band_hi_hz);
     os << b;
     for (const auto& m : f.fit.modes) {
-      std::snprintf(b, sizeof b, "    %7.3f Hz  zeta %.4f  residue %+.4g %+.4gi m/N\n", m.natural_freq_hz, m.damping_ratio,
-                    m.residue_re, m.residue_im);
+      std::snprintf(b, sizeof b, "    %7.3f Hz  zeta %.4f  residue %+.4g %+.4gi m/N\n", m.natural_freq_hz,
+                    m.damping_ratio, m.residue_re, m.residue_im);
       os << b;
     }
   }
@@ -440,13 +458,15 @@ std::string summary_text(const CommissioningResult& r) {
   std::snprintf(b, sizeof b,
                 "  actuator (%s): T %.4g N/V, %.3f Hz, zeta %.4f, delay %.3f ms; fit error %.2f %% over %.1f-%.1f Hz "
                 "(%d points, %d periods)\n",
-                config::to_string(r.config.actuator.mounting), a.force_constant_n_per_v, a.natural_freq_hz, a.damping_ratio,
-                a.delay_ms, a.fit_error_pct, a.band_lo_hz, a.band_hi_hz, a.points, r.actuator_periods);
+                config::to_string(r.config.actuator.mounting), a.force_constant_n_per_v, a.natural_freq_hz,
+                a.damping_ratio, a.delay_ms, a.fit_error_pct, a.band_lo_hz, a.band_hi_hz, a.points, r.actuator_periods);
   os << b;
-  std::snprintf(b, sizeof b, "  compensator matched at %.3f Hz (dominant mode), polarity %+d\n", r.dominant_mode_hz, r.polarity);
+  std::snprintf(b, sizeof b, "  compensator matched at %.3f Hz (dominant mode), polarity %+d\n", r.dominant_mode_hz,
+                r.polarity);
   os << b;
   std::snprintf(b, sizeof b, "  analysis: %s at K = %.0f N s/m; K_max %s N s/m", r.stable ? "stable" : "UNSTABLE",
-                r.gain_ns_per_m, r.max_stable_gain_ns_per_m ? std::to_string(std::lround(*r.max_stable_gain_ns_per_m)).c_str() : "none");
+                r.gain_ns_per_m,
+                r.max_stable_gain_ns_per_m ? std::to_string(std::lround(*r.max_stable_gain_ns_per_m)).c_str() : "none");
   os << b;
   if (r.phase_margin_deg) os << ", phase margin " << std::lround(*r.phase_margin_deg) << " deg";
   os << '\n';

@@ -81,22 +81,22 @@ struct IdentifiedFrf {
 };
 
 struct CommissioningSettings {
-  int max_order{60};  // the common-pole fit: a close pair 2 % apart settles from about order 50
-  double min_coherence{0.8};        // modal fits
+  int max_order{60};          // the common-pole fit: a close pair 2 % apart settles from about order 50
+  double min_coherence{0.8};  // modal fits
   double actuator_min_coherence{0.9};
 };
 
 struct CommissioningResult {
   MeasurementManifest manifest;
   std::vector<IdentifiedFrf> frfs;
-  std::string pole_fit;                // "common poles over N FRFs" or "poles per FRF"
+  std::string pole_fit;  // "common poles over N FRFs" or "poles per FRF"
   ActuatorFit actuator;
-  int actuator_periods{0};             // chirp periods averaged
+  int actuator_periods{0};  // chirp periods averaged
   double dominant_mode_hz{0.0};
   int polarity{1};
   std::string polarity_reason;
-  std::string yaml;                    // the identified configuration
-  config::Config config;               // it, parsed and validated
+  std::string yaml;       // the identified configuration
+  config::Config config;  // it, parsed and validated
   bool stable{false};
   std::optional<double> max_stable_gain_ns_per_m;
   double gain_ns_per_m{0.0};
@@ -116,7 +116,7 @@ struct CommissioningInputs {
   // The actuator's force per volt measured directly (a modal lab's blocked-force test): fitted as it is,
   // in place of the chirp's acceleration per volt through the identified structure.
   std::optional<ActuatorFrf> force_per_volt;
-  std::string identified_path;      // where relative names of the identified configuration resolve from
+  std::string identified_path;  // where relative names of the identified configuration resolve from
 };
 // Throws std::invalid_argument naming what is missing or bad, or rt::RecordingError.
 [[nodiscard]] CommissioningInputs read_measurement_dir(const std::string& dir);

@@ -51,7 +51,8 @@ std::vector<Pole> common_lscf_poles(const std::vector<Points>& pts, int p, doubl
     }
   }
   const Eigen::VectorXd norms = a.colwise().norm().cwiseMax(1e-300);
-  const Eigen::VectorXd x = (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(rhs).cwiseQuotient(norms);
+  const Eigen::VectorXd x =
+      (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(rhs).cwiseQuotient(norms);
   Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(p, p);
   for (int j = 0; j < p; ++j) companion(0, j) = -x(den0 + (p - 1 - j));
   for (int j = 1; j < p; ++j) companion(j, j - 1) = 1.0;
@@ -82,7 +83,8 @@ std::vector<ModalFit> fit_modes_common(const std::vector<FrfData>& frfs, const M
     for (const Complex& v : all[i].h) ms += std::norm(v);
     thin[i].weight = 1.0 / std::sqrt(ms / static_cast<double>(all[i].h.size()));
     const std::size_t stride = std::max<std::size_t>(1, (all[i].f.size() + kMaxPointsPerFrf - 1) / kMaxPointsPerFrf);
-    for (std::size_t k = 0; k < all[i].f.size(); k += stride) thin[i].f.push_back(all[i].f[k]), thin[i].h.push_back(all[i].h[k]);
+    for (std::size_t k = 0; k < all[i].f.size(); k += stride)
+      thin[i].f.push_back(all[i].f[k]), thin[i].h.push_back(all[i].h[k]);
   }
   if (hi / lo > s.wide_band_ratio)
     throw std::invalid_argument("the band is too wide for one common LSCF: fit the FRFs one by one");

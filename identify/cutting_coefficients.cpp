@@ -31,7 +31,8 @@ Integrals integrals(const CuttingTest& t) {
 
 void check_test(const CuttingTest& t) {
   auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
-  if (t.teeth < 1 || t.teeth > 32) bad("teeth = " + std::to_string(t.teeth) + " is out of range: allowed 1 <= value <= 32");
+  if (t.teeth < 1 || t.teeth > 32)
+    bad("teeth = " + std::to_string(t.teeth) + " is out of range: allowed 1 <= value <= 32");
   if (!(t.diameter_mm > 0.0 && t.diameter_mm <= 200.0)) bad("diameter must be 0 < value <= 200 mm");
   if (!(t.axial_mm > 0.0 && t.axial_mm <= 100.0)) bad("axial depth must be 0 < value <= 100 mm");
   if (!(t.radial_mm > 0.0 && t.radial_mm <= t.diameter_mm)) bad("radial depth must be 0 < value <= the diameter");
@@ -51,13 +52,16 @@ CuttingFit identify_cutting(const std::vector<MeanForces>& samples, const Cuttin
   check_test(t);
   const auto n = static_cast<Eigen::Index>(samples.size());
   if (n < 3)
-    throw std::invalid_argument("too few feeds: " + std::to_string(n) + " given, at least 3 needed (6 unknowns, and "
+    throw std::invalid_argument("too few feeds: " + std::to_string(n) +
+                                " given, at least 3 needed (6 unknowns, and "
                                 "degrees of freedom left for the confidence intervals)");
   for (Eigen::Index r = 0; r < n; ++r) {
     const MeanForces& s = samples[static_cast<std::size_t>(r)];
-    if (!std::isfinite(s.feed_per_tooth_mm) || !std::isfinite(s.fx_n) || !std::isfinite(s.fy_n) || !std::isfinite(s.fz_n))
+    if (!std::isfinite(s.feed_per_tooth_mm) || !std::isfinite(s.fx_n) || !std::isfinite(s.fy_n) ||
+        !std::isfinite(s.fz_n))
       throw std::invalid_argument("row " + std::to_string(r + 1) + ": a value is not a finite number");
-    if (!(s.feed_per_tooth_mm > 0.0)) throw std::invalid_argument("row " + std::to_string(r + 1) + ": feed per tooth must be > 0 mm");
+    if (!(s.feed_per_tooth_mm > 0.0))
+      throw std::invalid_argument("row " + std::to_string(r + 1) + ": feed per tooth must be > 0 mm");
   }
   const Integrals i = integrals(t);
   const double k = t.teeth * t.axial_mm / (kTwoPi);
@@ -83,7 +87,8 @@ CuttingFit identify_cutting(const std::vector<MeanForces>& samples, const Cuttin
        << "); the feeds are too close together to separate the cutting coefficients from the edge ones";
     throw std::invalid_argument(os.str());
   }
-  f.ktc = {a.theta(0), a.ci95(0)}, f.krc = {a.theta(1), a.ci95(1)}, f.kte = {a.theta(2), a.ci95(2)}, f.kre = {a.theta(3), a.ci95(3)};
+  f.ktc = {a.theta(0), a.ci95(0)}, f.krc = {a.theta(1), a.ci95(1)}, f.kte = {a.theta(2), a.ci95(2)},
+  f.kre = {a.theta(3), a.ci95(3)};
   f.kac = {b.theta(0), b.ci95(0)}, f.kae = {b.theta(1), b.ci95(1)};
   f.r2_xy = a.tss > 0.0 ? 1.0 - a.rss / a.tss : 1.0;
   const Eigen::VectorXd fitted = xy * a.theta;

@@ -67,12 +67,12 @@ struct LinearityCheck {
   double r2{1.0};  // of the line
   bool linear{true};
   std::vector<std::pair<double, double>> residuals_n;  // feed (mm), measured minus the line (N)
-  double linear_up_to_mm{0.0};       // the feeds up to here fit a line (0: no three do)
-  std::optional<CuttingFit> linear_range_fit;  // the fit over those feeds
-  std::string message;               // empty when linear
+  double linear_up_to_mm{0.0};                         // the feeds up to here fit a line (0: no three do)
+  std::optional<CuttingFit> linear_range_fit;          // the fit over those feeds
+  std::string message;                                 // empty when linear
 };
-[[nodiscard]] std::vector<LinearityCheck> check_linearity(const std::vector<MeanForces>& samples, const CuttingTest& test,
-                                                          const CuttingFit& fit);
+[[nodiscard]] std::vector<LinearityCheck> check_linearity(const std::vector<MeanForces>& samples,
+                                                          const CuttingTest& test, const CuttingFit& fit);
 
 // Reads `feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n` (header required); throws std::invalid_argument
 // with the file and line of the first problem.

@@ -56,8 +56,8 @@ std::string interval(const char* name, const Estimate& e, const char* unit) {
 
 std::string coefficients(const CuttingFit& f, int axis) {
   if (axis == 2) return interval("Kac", f.kac, "N/mm^2") + ", " + interval("Kae", f.kae, "N/mm");
-  return interval("Ktc", f.ktc, "N/mm^2") + ", " + interval("Krc", f.krc, "N/mm^2") + ", " + interval("Kte", f.kte, "N/mm") +
-         ", " + interval("Kre", f.kre, "N/mm");
+  return interval("Ktc", f.ktc, "N/mm^2") + ", " + interval("Krc", f.krc, "N/mm^2") + ", " +
+         interval("Kte", f.kte, "N/mm") + ", " + interval("Kre", f.kre, "N/mm");
 }
 
 }  // namespace
@@ -65,7 +65,8 @@ std::string coefficients(const CuttingFit& f, int axis) {
 std::vector<LinearityCheck> check_linearity(const std::vector<MeanForces>& samples_in, const CuttingTest& test,
                                             const CuttingFit& fit) {
   std::vector<MeanForces> s = samples_in;
-  std::sort(s.begin(), s.end(), [](const MeanForces& a, const MeanForces& b) { return a.feed_per_tooth_mm < b.feed_per_tooth_mm; });
+  std::sort(s.begin(), s.end(),
+            [](const MeanForces& a, const MeanForces& b) { return a.feed_per_tooth_mm < b.feed_per_tooth_mm; });
   std::vector<LinearityCheck> out;
   for (int axis = 0; axis < 3; ++axis) {
     LinearityCheck c;
@@ -87,8 +88,10 @@ std::vector<LinearityCheck> check_linearity(const std::vector<MeanForces>& sampl
         c.linear_range_fit.reset();
       }
       char head[160];
-      std::snprintf(head, sizeof head, "F%c is not linear in the feed (R^2 %.3f; its curvature is significant at 95 %%): measured minus the line",
-                    c.axis, c.r2);
+      std::snprintf(
+          head, sizeof head,
+          "F%c is not linear in the feed (R^2 %.3f; its curvature is significant at 95 %%): measured minus the line",
+          c.axis, c.r2);
       c.message = head;
       for (const auto& [feed, r] : c.residuals_n) {
         char b[48];
@@ -97,12 +100,14 @@ std::vector<LinearityCheck> check_linearity(const std::vector<MeanForces>& sampl
       }
       c.message.back() = '.';
       c.message += " The model's force is linear in the feed, so the coefficients from F" + std::string(1, c.axis) +
-                   " carry a model error their 95 % intervals do not hold (all feeds: " + coefficients(fit, axis) + ").";
+                   " carry a model error their 95 % intervals do not hold (all feeds: " + coefficients(fit, axis) +
+                   ").";
       char range[96];
       std::snprintf(range, sizeof range, " Over the feeds up to %.4g mm (%zu of %zu", c.linear_up_to_mm, m, s.size());
       c.message += range;
       c.message += m >= 4 ? ", linear): " : ", too few to test their linearity): ";
-      c.message += c.linear_range_fit ? coefficients(*c.linear_range_fit, axis) : std::string("too few or too close to fit");
+      c.message +=
+          c.linear_range_fit ? coefficients(*c.linear_range_fit, axis) : std::string("too few or too close to fit");
       c.message += ". Fit over the linear range (fewer feeds) or model the chip-thickness dependence.";
     }
     out.push_back(std::move(c));

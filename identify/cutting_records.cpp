@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "measfiles/table.hpp"
 
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 struct Revolution {
   std::size_t begin{0}, end{0};  // samples [begin, end)
   std::array<double, 3> mean{};
-  double fluctuation_n{0.0};     // within-revolution standard deviation, all axes together
+  double fluctuation_n{0.0};  // within-revolution standard deviation, all axes together
   double centre_s{0.0};
 };
 
@@ -27,7 +28,8 @@ std::vector<Revolution> revolutions(const ForceRecord& r, double period_s) {
   std::vector<Revolution> out;
   const double per = period_s * r.fs_hz;
   for (int k = 0;; ++k) {
-    const auto b = static_cast<std::size_t>(std::lround(k * per)), e = static_cast<std::size_t>(std::lround((k + 1) * per));
+    const auto b = static_cast<std::size_t>(std::lround(k * per)),
+               e = static_cast<std::size_t>(std::lround((k + 1) * per));
     if (e > r.t_s.size()) break;
     Revolution v;
     v.begin = b, v.end = e;
@@ -82,12 +84,12 @@ std::pair<std::array<double, 3>, double> average(const std::vector<Revolution>& 
 }
 
 // The offset and drift from the air before and after the cut: a line through both, a constant from one.
-void remove_drift(std::vector<Revolution>& revs, const std::vector<bool>& air, std::size_t first_cut, std::size_t last_cut,
-                  SteadyCut& out) {
+void remove_drift(std::vector<Revolution>& revs, const std::vector<bool>& air, std::size_t first_cut,
+                  std::size_t last_cut, SteadyCut& out) {
   std::size_t b0 = first_cut, e1 = last_cut + 1;
   while (b0 > 0 && air[b0 - 1]) --b0;
   while (e1 < revs.size() && air[e1]) ++e1;
-  const bool before = b0 < first_cut, after = e1 > last_cut + 1;
+  const bool before = b0<first_cut, after = e1> last_cut + 1;
   if (!before && !after) {
     out.drift_from = "none: the record holds no air cut, its offset and drift stay in the means";
     return;
@@ -113,7 +115,8 @@ AxisMap parse_axes(const std::string& text) {
   std::string part;
   std::array<bool, 3> used{};
   for (std::size_t k = 0; k < 3; ++k) {
-    if (!std::getline(in, part, ',')) throw std::invalid_argument("--axes '" + text + "': three of fx, fy, fz with signs, e.g. -fy,fx,fz");
+    if (!std::getline(in, part, ','))
+      throw std::invalid_argument("--axes '" + text + "': three of fx, fy, fz with signs, e.g. -fy,fx,fz");
     double sign = 1.0;
     if (!part.empty() && (part[0] == '-' || part[0] == '+')) sign = part[0] == '-' ? -1.0 : 1.0, part.erase(0, 1);
     const int column = part == "fx" ? 0 : part == "fy" ? 1 : part == "fz" ? 2 : -1;
@@ -129,41 +132,69 @@ AxisMap parse_axes(const std::string& text) {
 ForceRecord read_force_record(const std::string& path) {
   const measfiles::Table t = measfiles::read_table(path);
   using measfiles::Quantity;
-  const std::vector<measfiles::ColumnSpec> wanted = {
-      {{"time", "t", "time_s", "zeit"}, Quantity::kTime},
-      {{"fx", "fx_n", "force_x", "f_x"}, Quantity::kForce},
-      {{"fy", "fy_n", "force_y", "f_y"}, Quantity::kForce},
-      {{"fz", "fz_n", "force_z", "f_z"}, Quantity::kForce}};
-  const auto rows = measfiles::select_columns(t, wanted, path, "time, Fx, Fy, Fz (by name, or in that order without a header)");
+  const std::vector<measfiles::ColumnSpec> wanted = {{{"time", "t", "time_s", "zeit"}, Quantity::kTime},
+                                                     {{"fx", "fx_n", "force_x", "f_x"}, Quantity::kForce},
+                                                     {{"fy", "fy_n", "force_y", "f_y"}, Quantity::kForce},
+                                                     {{"fz", "fz_n", "force_z", "f_z"}, Quantity::kForce}};
+  const auto rows =
+      measfiles::select_columns(t, wanted, path, "time, Fx, Fy, Fz (by name, or in that order without a header)");
   ForceRecord r;
   r.source = path;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     for (double v : rows[i])
-      if (!std::isfinite(v)) throw std::invalid_argument(path + ":" + std::to_string(t.lines[i]) + ": a value is not a finite number");
+      if (!std::isfinite(v))
+        throw std::invalid_argument(path + ":" + std::to_string(t.lines[i]) + ": a value is not a finite number");
     r.t_s.push_back(rows[i][0]);
     for (std::size_t a = 0; a < 3; ++a) r.f_n[a].push_back(rows[i][a + 1]);
   }
-  if (r.t_s.size() < 64) throw std::invalid_argument(path + ": too few samples (" + std::to_string(r.t_s.size()) + ", at least 64)");
+  if (r.t_s.size() < 64)
+    throw std::invalid_argument(path + ": too few samples (" + std::to_string(r.t_s.size()) + ", at least 64)");
   // The first step against every other (time written to a few digits: a thousandth of a step tolerated),
   // then the rate from the whole record.
   const double step = r.t_s[1] - r.t_s[0];
-  if (!(step > 0.0)) throw std::invalid_argument(path + ":" + std::to_string(t.lines[1]) + ": the time does not increase");
+  if (!(step > 0.0))
+    throw std::invalid_argument(path + ":" + std::to_string(t.lines[1]) + ": the time does not increase");
   for (std::size_t i = 1; i < r.t_s.size(); ++i)
     if (!(std::abs(r.t_s[i] - r.t_s[i - 1] - step) <= 1e-2 * step))
-      throw std::invalid_argument(path + ":" + std::to_string(t.lines[i]) + ": the time step changes (a constant sample rate is needed)");
+      throw std::invalid_argument(path + ":" + std::to_string(t.lines[i]) +
+                                  ": the time step changes (a constant sample rate is needed)");
   r.fs_hz = static_cast<double>(r.t_s.size() - 1) / (r.t_s.back() - r.t_s.front());
   return r;
 }
 
+namespace {
+
+// The longest run [begin, end) of consecutive indices in [b, e) where holds(index); the first of equal runs.
+template <class Holds>
+std::pair<std::size_t, std::size_t> longest_run(std::size_t b, std::size_t e, Holds holds) {
+  std::size_t best_b = 0, best_e = 0;
+  for (std::size_t k = b; k < e;) {
+    if (!holds(k)) {
+      ++k;
+      continue;
+    }
+    std::size_t end = k;
+    while (end < e && holds(end)) ++end;
+    if (end - k > best_e - best_b) best_b = k, best_e = end;
+    k = end;
+  }
+  return {best_b, best_e};
+}
+
+}  // namespace
+
 SteadyCut steady_cut(const ForceRecord& r, double spindle_rpm, double feed_per_tooth_mm, const RecordSettings& s) {
   if (!(spindle_rpm > 0.0 && spindle_rpm <= 200000.0))
-    throw std::invalid_argument(r.source + ": spindle speed " + std::to_string(spindle_rpm) + " rpm: allowed 0 < value <= 200000 rpm");
+    throw std::invalid_argument(r.source + ": spindle speed " + std::to_string(spindle_rpm) +
+                                " rpm: allowed 0 < value <= 200000 rpm");
   const double period_s = 60.0 / spindle_rpm;
   if (period_s * r.fs_hz < 8.0)
-    throw std::invalid_argument(r.source + ": " + std::to_string(r.fs_hz) + " Hz samples a revolution of " + std::to_string(spindle_rpm) +
-                                " rpm fewer than 8 times");
+    throw std::invalid_argument(r.source + ": " + std::to_string(r.fs_hz) + " Hz samples a revolution of " +
+                                std::to_string(spindle_rpm) + " rpm fewer than 8 times");
   std::vector<Revolution> revs = revolutions(r, period_s);
-  if (revs.size() < 5) throw std::invalid_argument(r.source + ": " + std::to_string(revs.size()) + " revolutions recorded, at least 5 needed");
+  if (revs.size() < 5)
+    throw std::invalid_argument(r.source + ": " + std::to_string(revs.size()) +
+                                " revolutions recorded, at least 5 needed");
   // Air: the quietest revolutions (their fluctuation is the noise); cutting: three times that or more.
   std::vector<double> fl;
   for (const auto& v : revs) fl.push_back(v.fluctuation_n);
@@ -177,14 +208,7 @@ SteadyCut steady_cut(const ForceRecord& r, double spindle_rpm, double feed_per_t
     std::fill(cutting.begin(), cutting.end(), true), std::fill(air.begin(), air.end(), false);
   }
   // The longest run of cutting revolutions.
-  std::size_t best_b = 0, best_e = 0;
-  for (std::size_t k = 0; k < revs.size();) {
-    if (!cutting[k]) { ++k; continue; }
-    std::size_t e = k;
-    while (e < revs.size() && cutting[e]) ++e;
-    if (e - k > best_e - best_b) best_b = k, best_e = e;
-    k = e;
-  }
+  const auto [best_b, best_e] = longest_run(0, revs.size(), [&](std::size_t k) { return cutting[k]; });
   SteadyCut out;
   out.cutting_revolutions = static_cast<int>(best_e - best_b);
   remove_drift(revs, air, best_b, best_e - 1, out);
@@ -199,34 +223,30 @@ SteadyCut steady_cut(const ForceRecord& r, double spindle_rpm, double feed_per_t
   }
   const double per = period_s * r.fs_hz;
   const double tol = 0.02 * magnitude(median) + 4.0 * quiet / std::sqrt(per);
-  std::size_t sb = 0, se = 0;
-  for (std::size_t k = best_b; k < best_e;) {
-    auto near = [&](std::size_t j) {
-      return magnitude({revs[j].mean[0] - median[0], revs[j].mean[1] - median[1], revs[j].mean[2] - median[2]}) <= tol;
-    };
-    if (!near(k)) { ++k; continue; }
-    std::size_t e = k;
-    while (e < best_e && near(e)) ++e;
-    if (e - k > se - sb) sb = k, se = e;
-    k = e;
-  }
+  auto [sb, se] = longest_run(best_b, best_e, [&](std::size_t j) {
+    return magnitude({revs[j].mean[0] - median[0], revs[j].mean[1] - median[1], revs[j].mean[2] - median[2]}) <= tol;
+  });
   if (se - sb >= 5) ++sb, --se;  // the entry's and the exit's last partial engagement
   if (se - sb < 3)
-    throw std::invalid_argument(r.source + ": no steady cut of 3 revolutions or more (" + std::to_string(best_e - best_b) +
-                                " revolutions cut, their means differ by more than " + std::to_string(tol) + " N)");
+    throw std::invalid_argument(r.source + ": no steady cut of 3 revolutions or more (" +
+                                std::to_string(best_e - best_b) + " revolutions cut, their means differ by more than " +
+                                std::to_string(tol) + " N)");
   out.periodic_share = periodic_share(r, revs, sb, se);
   if (out.periodic_share < kMinPeriodicShare) {
     char b[200];
-    std::snprintf(b, sizeof b, ": %.0f %% of the force's variance repeats with each revolution of %.6g rpm (at least %.0f %% for a cut): "
-                  "no cutting at that speed (is the spindle speed right? is the record a cut?)", 100.0 * out.periodic_share,
-                  spindle_rpm, 100.0 * kMinPeriodicShare);
+    std::snprintf(
+        b, sizeof b,
+        ": %.0f %% of the force's variance repeats with each revolution of %.6g rpm (at least %.0f %% for a cut): "
+        "no cutting at that speed (is the spindle speed right? is the record a cut?)",
+        100.0 * out.periodic_share, spindle_rpm, 100.0 * kMinPeriodicShare);
     throw std::invalid_argument(r.source + b);
   }
   const auto [m, t] = average(revs, sb, se);
   (void)t;
   for (std::size_t k = sb; k < se; ++k)
-    out.spread_pct = std::max(out.spread_pct, 100.0 * magnitude({revs[k].mean[0] - m[0], revs[k].mean[1] - m[1], revs[k].mean[2] - m[2]}) /
-                                                  std::max(magnitude(m), 1e-12));
+    out.spread_pct = std::max(
+        out.spread_pct, 100.0 * magnitude({revs[k].mean[0] - m[0], revs[k].mean[1] - m[1], revs[k].mean[2] - m[2]}) /
+                            std::max(magnitude(m), 1e-12));
   std::array<double, 3> tool{};
   for (std::size_t k = 0; k < 3; ++k)
     tool[k] = (s.force_on_workpiece ? -1.0 : 1.0) * s.axes.sign[k] * m[static_cast<std::size_t>(s.axes.column[k])];
@@ -245,7 +265,9 @@ std::vector<RecordTest> read_record_tests(const std::string& path) {
     if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') continue;
-    const char delimiter = line.find('\t') != std::string::npos ? '\t' : line.find(';') != std::string::npos ? ';' : ',';
+    const char delimiter = line.find('\t') != std::string::npos  ? '\t'
+                           : line.find(';') != std::string::npos ? ';'
+                                                                 : ',';
     std::vector<std::string> f;
     std::istringstream row(line);
     for (std::string cell; std::getline(row, cell, delimiter);) {

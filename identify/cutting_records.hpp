@@ -41,13 +41,13 @@ struct ForceRecord {
 [[nodiscard]] ForceRecord read_force_record(const std::string& path);
 
 struct SteadyCut {
-  MeanForces means;              // on the tool, in the cutter frame
+  MeanForces means;  // on the tool, in the cutter frame
   double start_s{0.0}, end_s{0.0};
-  int revolutions{0};            // whole revolutions averaged
-  int cutting_revolutions{0};    // revolutions with cutting in them
+  int revolutions{0};                                 // whole revolutions averaged
+  int cutting_revolutions{0};                         // revolutions with cutting in them
   std::array<double, 3> offset_n{}, drift_n_per_s{};  // removed, in the record's axes
-  std::string drift_from;        // where the offset and drift were measured
-  double spread_pct{0.0};        // largest revolution mean's departure from the average, % of its magnitude
+  std::string drift_from;                             // where the offset and drift were measured
+  double spread_pct{0.0};  // largest revolution mean's departure from the average, % of its magnitude
   // The share of the force's variance in the steady cut that repeats with every revolution (the
   // revolution-synchronous average's): near 1 for a cut at the stated speed, near 0 for noise.
   double periodic_share{0.0};

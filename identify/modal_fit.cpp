@@ -28,8 +28,8 @@ constexpr double kAntiresonanceFloor = 0.05;
 
 // LSCF at one order: the common denominator A(W) = sum a_j W^j (a_p = 1) with W = e^{-i w dt}, fitted with
 // the numerator by linear least squares on B(W_k) - H_k A(W_k) = 0; the poles are A's roots.
-std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Complex>& h, int p, double dt,
-                             double f_lo, double f_hi) {
+std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Complex>& h, int p, double dt, double f_lo,
+                             double f_hi) {
   const auto k = static_cast<Eigen::Index>(f.size());
   Eigen::MatrixXd a(2 * k, 2 * p + 1);
   Eigen::VectorXd rhs(2 * k);
@@ -50,7 +50,8 @@ std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Com
     }
   }
   const Eigen::VectorXd norms = a.colwise().norm().cwiseMax(1e-300);
-  const Eigen::VectorXd x = (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(rhs).cwiseQuotient(norms);
+  const Eigen::VectorXd x =
+      (a * norms.cwiseInverse().asDiagonal()).colPivHouseholderQr().solve(rhs).cwiseQuotient(norms);
   Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(p, p);  // monic: W^p + a_{p-1} W^{p-1} + ... + a_0
   for (int j = 0; j < p; ++j) companion(0, j) = -x(p + 1 + (p - 1 - j));
   for (int j = 1; j < p; ++j) companion(j, j - 1) = 1.0;
@@ -85,10 +86,14 @@ void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std
     }
     const Complex lower = 1.0 / (s * s);
     switch (col - 2 * m) {
-      case 0: return lower;
-      case 1: return Complex(0.0, 1.0) * lower;
-      case 2: return 1.0;
-      default: return Complex(0.0, 1.0);
+      case 0:
+        return lower;
+      case 1:
+        return Complex(0.0, 1.0) * lower;
+      case 2:
+        return 1.0;
+      default:
+        return Complex(0.0, 1.0);
     }
   };
   for (Eigen::Index r = 0; r < k; ++r) {
@@ -185,7 +190,12 @@ void refine(const std::vector<double>& f, const std::vector<Complex>& h, ModalFi
   const double w_lo = kTwoPi * f.front(), w_hi = kTwoPi * f.back();
   double peak = 0.0;
   for (const Complex& v : h) peak = std::max(peak, std::abs(v));
-  Refinement fn{&f, &h, fit.modes.size(), sigma_scale, sigma_scale * w_lo, sigma_scale / w_hi,
+  Refinement fn{&f,
+                &h,
+                fit.modes.size(),
+                sigma_scale,
+                sigma_scale * w_lo,
+                sigma_scale / w_hi,
                 std::max(kAntiresonanceFloor * peak, 1e-300)};
   Eigen::VectorXd x(fn.inputs());
   for (std::size_t i = 0; i < fit.modes.size(); ++i) {
@@ -262,13 +272,14 @@ PoleSelection stable_poles(const std::function<std::vector<Pole>(int)>& poles_at
   }
   PoleSelection out;
   auto near = [](const std::vector<Pole>& set, const Pole& q, double rel) {
-    return std::any_of(set.begin(), set.end(), [&](const Pole& c) { return std::abs(c.freq_hz() - q.freq_hz()) < rel * q.freq_hz(); });
+    return std::any_of(set.begin(), set.end(),
+                       [&](const Pole& c) { return std::abs(c.freq_hz() - q.freq_hz()) < rel * q.freq_hz(); });
   };
   for (std::size_t i = 0; i < last.size(); ++i)
     if (last_chain[i] >= s.stable_orders && !near(out.stable, last[i], 2e-3)) out.stable.push_back(last[i]);
   for (std::size_t i = 0; i < last.size(); ++i)
-    if (last_chain[i] < s.stable_orders && last_loose[i] >= s.stable_orders && !near(out.stable, last[i], s.stable_freq) &&
-        !near(out.candidates, last[i], s.stable_freq))
+    if (last_chain[i] < s.stable_orders && last_loose[i] >= s.stable_orders &&
+        !near(out.stable, last[i], s.stable_freq) && !near(out.candidates, last[i], s.stable_freq))
       out.candidates.push_back(last[i]);
   if (out.stable.empty())
     throw std::invalid_argument("no pole stays put over " + std::to_string(s.stable_orders) +
@@ -304,16 +315,15 @@ ModalFit fit_band(const std::vector<double>& f, const std::vector<Complex>& h, c
     refine(f, h, trial);
     return trial;
   };
-  const std::vector<Pole> chosen =
-      selection.candidates.empty() ? selection.stable
-                                   : with_supported_candidates(selection, [&](const std::vector<Pole>& poles) {
-                                       return fitted(poles).fit_error_pct;
-                                     });
+  const std::vector<Pole> chosen = selection.candidates.empty()
+                                       ? selection.stable
+                                       : with_supported_candidates(selection, [&](const std::vector<Pole>& poles) {
+                                           return fitted(poles).fit_error_pct;
+                                         });
   ModalFit out = fitted(chosen);
   out.diagram = std::move(fit.diagram);
   return out;
 }
-
 
 // A band spanning decades (the robot SLE study's robot: 46 modes from 8 Hz to 6.6 kHz). One LSCF over it needs a
 // high order, is slow and ill-conditioned at the low end, so it is cut into sub-bands (a frequency ratio
@@ -352,8 +362,10 @@ ModalFit fit_wide_band(const std::vector<double>& f, const std::vector<Complex>&
   fit.band_lo_hz = f.front(), fit.band_hi_hz = f.back();
   for (std::size_t b = 0; b + 1 < edges.size(); ++b) {
     const double core_lo = f[edges[b]], core_hi = f[edges[b + 1]];
-    const auto lo = static_cast<std::size_t>(std::lower_bound(f.begin(), f.end(), core_lo / kSubBandOverlap) - f.begin());
-    const auto hi = static_cast<std::size_t>(std::upper_bound(f.begin(), f.end(), core_hi * kSubBandOverlap) - f.begin());
+    const auto lo =
+        static_cast<std::size_t>(std::lower_bound(f.begin(), f.end(), core_lo / kSubBandOverlap) - f.begin());
+    const auto hi =
+        static_cast<std::size_t>(std::upper_bound(f.begin(), f.end(), core_hi * kSubBandOverlap) - f.begin());
     std::vector<double> fb;
     std::vector<Complex> hb;
     for (std::size_t i : thinned(lo, hi, kSubBandMaxPoints)) fb.push_back(f[i]), hb.push_back(h[i]);
@@ -408,7 +420,8 @@ ModalFit fit_modes(const FrfData& d, const ModalFitSettings& s) {
 FrfData read_frf_csv(const std::string& path, FrfKind kind) {
   const std::string prefix = "freq_hz,re_m_per_n,im_m_per_n";
   const measfiles::Table t = measfiles::read_table(path);
-  const bool with_coherence = t.names.empty() ? t.columns >= 4 : t.names.size() >= 4 && measfiles::normalised(t.names[3]) == "coherence";
+  const bool with_coherence =
+      t.names.empty() ? t.columns >= 4 : t.names.size() >= 4 && measfiles::normalised(t.names[3]) == "coherence";
   const NumericCsv csv = read_numeric_csv(path, prefix, prefix + "[,coherence]", with_coherence ? 4 : 3);
   FrfData d;
   for (const auto& v : csv.rows) {

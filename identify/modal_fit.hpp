@@ -19,8 +19,8 @@ using Complex = std::complex<double>;
 
 struct FrfData {
   std::vector<double> f_hz;
-  std::vector<Complex> h;          // receptance, m/N
-  std::vector<double> coherence;   // empty: all 1
+  std::vector<Complex> h;         // receptance, m/N
+  std::vector<double> coherence;  // empty: all 1
 };
 
 struct ModalFitSettings {
@@ -75,7 +75,7 @@ enum class FrfKind { kReceptance, kMobility, kAccelerance };
 [[nodiscard]] FrfData frf_from_time_series_csv(const std::string& path, FrfKind response_kind, double segment_s,
                                                double overlap, double max_hz);
 // The same from the force and response already read (a universal file's time histories).
-[[nodiscard]] FrfData frf_from_time_series(const TimeSeries& series, FrfKind response_kind, double segment_s, double overlap,
-                                           double max_hz);
+[[nodiscard]] FrfData frf_from_time_series(const TimeSeries& series, FrfKind response_kind, double segment_s,
+                                           double overlap, double max_hz);
 
 }  // namespace robodamp::identify

@@ -12,7 +12,6 @@
 
 namespace robodamp::identify::detail {
 
-
 struct Pole {
   Complex s;  // rad/s
   [[nodiscard]] double freq_hz() const { return std::abs(s) / kTwoPi; }
@@ -22,8 +21,8 @@ struct Pole {
 // The points a fit uses: finite (else std::invalid_argument naming the row), in the band, coherent.
 void usable_points(const FrfData& d, const ModalFitSettings& s, std::vector<double>& f, std::vector<Complex>& h);
 // LSCF poles at order p within [f_lo, f_hi].
-[[nodiscard]] std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Complex>& h, int p, double dt,
-                                           double f_lo, double f_hi);
+[[nodiscard]] std::vector<Pole> lscf_poles(const std::vector<double>& f, const std::vector<Complex>& h, int p,
+                                           double dt, double f_lo, double f_hi);
 // A column of the diagram whose damping scatters more than ModalFitSettings::stable_damping allows but less
 // than this (relative, order to order) while its frequency holds is a candidate mode ...
 inline constexpr double kLooseStableDamping = 0.25;
@@ -41,8 +40,8 @@ struct PoleSelection {
                                          const ModalFitSettings& s, std::vector<StabilisationPoint>& diagram);
 // The stable poles and each candidate whose addition lowers fit_error (of the poles, sorted by frequency)
 // below kCandidateErrorRatio times the error without it.
-[[nodiscard]] std::vector<Pole> with_supported_candidates(const PoleSelection& selection,
-                                                          const std::function<double(const std::vector<Pole>&)>& fit_error);
+[[nodiscard]] std::vector<Pole> with_supported_candidates(
+    const PoleSelection& selection, const std::function<double(const std::vector<Pole>&)>& fit_error);
 // LSFD residues of the poles with residual terms; weight_floor > 0 weighs rows to relative error.
 void lsfd(const std::vector<double>& f, const std::vector<Complex>& h, const std::vector<Pole>& poles, ModalFit& fit,
           double weight_floor = 0.0);

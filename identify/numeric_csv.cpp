@@ -19,10 +19,11 @@ NumericCsv read_numeric_csv(const std::string& path, const std::string& header_p
   if (!t.names.empty()) {
     for (std::size_t k = 0; k < wanted.size(); ++k)
       if (k >= t.names.size() || measfiles::normalised(t.names[k]) != wanted[k].names.front())
-        throw std::invalid_argument(path + ":" + std::to_string(t.header_line) + ": the header must be " + header_shown +
-                                    " (or no header, the columns in that order)");
+        throw std::invalid_argument(path + ":" + std::to_string(t.header_line) + ": the header must be " +
+                                    header_shown + " (or no header, the columns in that order)");
   } else if (t.columns < columns) {
-    throw std::invalid_argument(path + ":" + std::to_string(t.lines.front()) + ": " + std::to_string(columns) + " values expected");
+    throw std::invalid_argument(path + ":" + std::to_string(t.lines.front()) + ": " + std::to_string(columns) +
+                                " values expected");
   }
   NumericCsv csv;
   for (std::size_t k = 0; k < t.names.size(); ++k) csv.header += (k > 0 ? "," : "") + t.names[k];
@@ -43,11 +44,13 @@ TimeSeries read_time_series_csv(const std::string& path, const std::string& head
       throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) + ": a value is not a finite number");
     t.push_back(v[0]), ts.input.push_back(v[1]), ts.output.push_back(v[2]);
   }
-  if (t.size() < 64) throw std::invalid_argument(path + ": too few samples (" + std::to_string(t.size()) + ", at least 64)");
+  if (t.size() < 64)
+    throw std::invalid_argument(path + ": too few samples (" + std::to_string(t.size()) + ", at least 64)");
   const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   for (std::size_t i = 1; i < t.size(); ++i)
     if (!(std::abs(t[i] - t[i - 1] - dt) <= 1e-6 * dt))
-      throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) + ": the time step changes (a constant sample rate is needed)");
+      throw std::invalid_argument(path + ":" + std::to_string(csv.lines[i]) +
+                                  ": the time step changes (a constant sample rate is needed)");
   ts.fs_hz = 1.0 / dt;
   return ts;
 }

@@ -8,9 +8,9 @@
 namespace robodamp::identify {
 
 struct NumericCsv {
-  std::string header;                    // the file's first line
+  std::string header;                     // the file's first line
   std::vector<std::vector<double>> rows;  // each exactly `columns` numbers (NaN and inf are passed on)
-  std::vector<int> lines;                // each row's line number in the file
+  std::vector<int> lines;                 // each row's line number in the file
 };
 
 // Lines starting with # are comments. The header must start with header_prefix; every non-empty row must hold `columns` numbers. Throws

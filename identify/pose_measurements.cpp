@@ -75,11 +75,11 @@ void check_consistent(const PoseMeasurements& r) {
       const double f = std::max(peak_hz(a, r.band_min_hz, r.band_max_hz), peak_hz(b, r.band_min_hz, r.band_max_hz));
       const double d = frf_difference(a, b, std::max(r.band_min_hz, 0.5 * f), std::min(r.band_max_hz, 2.0 * f));
       if (d > 0.2)
-        throw std::invalid_argument(r.dirs[i] + " and " + r.dirs[k] + " were measured at the same pose " +
-                                    config::describe_pose(a.joints_deg) + " and their FRFs differ by " +
-                                    std::to_string(static_cast<int>(std::lround(100.0 * d))) +
-                                    " % around the " + std::to_string(static_cast<int>(std::lround(f))) +
-                                    " Hz peak: contradicting data (a robot moved, a loose mount?); measure that pose again");
+        throw std::invalid_argument(
+            r.dirs[i] + " and " + r.dirs[k] + " were measured at the same pose " + config::describe_pose(a.joints_deg) +
+            " and their FRFs differ by " + std::to_string(static_cast<int>(std::lround(100.0 * d))) + " % around the " +
+            std::to_string(static_cast<int>(std::lround(f))) +
+            " Hz peak: contradicting data (a robot moved, a loose mount?); measure that pose again");
     }
 }
 
@@ -88,7 +88,8 @@ void check_consistent(const PoseMeasurements& r) {
 void check_against_model(const PoseMeasurements& r, const config::RobotModelConfig& model) {
   constexpr double kMeasuredApart = 0.2, kTimesTheModel = 3.0;
   std::vector<robot::MeasuredFrf> modelled;  // the model at each pose, once, on its measurement's frequencies
-  for (const auto& f : r.frfs) modelled.push_back(robot::model_frf(model, f, r.direction, r.band_min_hz, r.band_max_hz, r.modes));
+  for (const auto& f : r.frfs)
+    modelled.push_back(robot::model_frf(model, f, r.direction, r.band_min_hz, r.band_max_hz, r.modes));
   for (std::size_t i = 0; i < r.frfs.size(); ++i)
     for (std::size_t k = 0; k < i; ++k) {
       const auto &a = r.frfs[i], &b = r.frfs[k];
@@ -98,12 +99,13 @@ void check_against_model(const PoseMeasurements& r, const config::RobotModelConf
       const double d = frf_difference(a, b, lo, hi);
       if (d <= std::max(kMeasuredApart, kTimesTheModel * d_model)) continue;
       const auto pct = [](double v) { return std::to_string(static_cast<int>(std::lround(100.0 * v))) + " %"; };
-      throw std::invalid_argument(
-          r.dirs[i] + " (pose '" + a.name + "' " + config::describe_pose(a.joints_deg) + ") and " + r.dirs[k] + " (pose '" +
-          b.name + "' " + config::describe_pose(b.joints_deg) + "): their measured FRFs differ by " + pct(d) + " around the " +
-          std::to_string(static_cast<int>(std::lround(f))) +
-          " Hz peak, more than 3 times the " + pct(d_model) + " the robot model " + model.name +
-          " puts between the two poses: contradicting data (a pose read wrong, a robot moved, a loose mount?); measure one of them again");
+      throw std::invalid_argument(r.dirs[i] + " (pose '" + a.name + "' " + config::describe_pose(a.joints_deg) +
+                                  ") and " + r.dirs[k] + " (pose '" + b.name + "' " +
+                                  config::describe_pose(b.joints_deg) + "): their measured FRFs differ by " + pct(d) +
+                                  " around the " + std::to_string(static_cast<int>(std::lround(f))) +
+                                  " Hz peak, more than 3 times the " + pct(d_model) + " the robot model " + model.name +
+                                  " puts between the two poses: contradicting data (a pose read wrong, a robot moved, "
+                                  "a loose mount?); measure one of them again");
     }
 }
 
@@ -119,7 +121,8 @@ double frf_difference(const robot::MeasuredFrf& a, const robot::MeasuredFrf& b, 
     if (it == b.freq_hz.begin() || it == b.freq_hz.end()) continue;
     const auto k = static_cast<std::size_t>(it - b.freq_hz.begin());
     const double t = (f - b.freq_hz[k - 1]) / (b.freq_hz[k] - b.freq_hz[k - 1]);
-    const std::complex<double> hb = b.receptance_m_per_n[k - 1] + t * (b.receptance_m_per_n[k] - b.receptance_m_per_n[k - 1]);
+    const std::complex<double> hb =
+        b.receptance_m_per_n[k - 1] + t * (b.receptance_m_per_n[k] - b.receptance_m_per_n[k - 1]);
     const double w = peak > 0.0 ? std::abs(a.receptance_m_per_n[i]) / peak : 0.0;
     num += w * std::norm(a.receptance_m_per_n[i] - hb);
     den += w * std::norm(a.receptance_m_per_n[i]);
@@ -132,13 +135,15 @@ PoseMeasurements read_pose_measurements(const std::vector<std::string>& dirs, in
   for (const std::string& dir : expand(dirs)) {
     const MeasurementManifest m = read_manifest(dir);  // throws naming the file
     if (m.pose_deg.empty())
-      throw std::invalid_argument(dir + ": its measurement.json holds no joint angles (measured without --pose): the "
-                                        "pose-indexed model needs the pose of every measurement; measure it again with "
-                                        "robodamp measure --pose or --poses");
+      throw std::invalid_argument(dir +
+                                  ": its measurement.json holds no joint angles (measured without --pose): the "
+                                  "pose-indexed model needs the pose of every measurement; measure it again with "
+                                  "robodamp measure --pose or --poses");
     const int id = driving_point(m, location_id, dir);
     const std::string csv = (fs::path(dir) / analysis::frf_file_name(id, id)).string();
     if (!fs::exists(csv))
-      throw std::invalid_argument(dir + ": no " + fs::path(csv).filename().string() + " (location " + std::to_string(id) +
+      throw std::invalid_argument(dir + ": no " + fs::path(csv).filename().string() + " (location " +
+                                  std::to_string(id) +
                                   "'s driving-point FRF; on hardware robodamp plant --measure-out writes it)");
     const FrfData d = read_frf_csv(csv, FrfKind::kReceptance);
     robot::MeasuredFrf f;
@@ -156,8 +161,7 @@ PoseMeasurements read_pose_measurements(const std::vector<std::string>& dirs, in
         r.direction = measured.pose_schedule->axis == 0 ? robot::FrfDirection::kXX : robot::FrfDirection::kYY;
         r.modes = measured.pose_schedule->modes;
       }
-    }
-    else if (m.robot_model != r.robot_model)
+    } else if (m.robot_model != r.robot_model)
       throw std::invalid_argument(dir + ": measured against the robot model " + m.robot_model + ", " + r.dirs.front() +
                                   " against " + r.robot_model + ": one model's joints, one set of measurements");
   }

@@ -12,11 +12,11 @@
 namespace robodamp::identify {
 
 struct PoseMeasurements {
-  std::vector<robot::MeasuredFrf> frfs;  // name: the pose's name (or its directory's)
-  std::vector<std::string> dirs;         // the measurement directory of each
-  std::string robot_model;               // the model file the joint angles refer to (the first's)
+  std::vector<robot::MeasuredFrf> frfs;                     // name: the pose's name (or its directory's)
+  std::vector<std::string> dirs;                            // the measurement directory of each
+  std::string robot_model;                                  // the model file the joint angles refer to (the first's)
   robot::FrfDirection direction{robot::FrfDirection::kYY};  // the measured configuration's pose_schedule.axis
-  double band_min_hz{5.0}, band_max_hz{100.0};               // its analysis band: where the FRFs are trusted
+  double band_min_hz{5.0}, band_max_hz{100.0};              // its analysis band: where the FRFs are trusted
   int modes{0};  // its pose_schedule.modes: the plant's form the fit compares (robot::PoseFitSettings::modes)
 };
 

@@ -30,8 +30,10 @@ config::MeasuredPoseModes identify_one(const robot::MeasuredFrf& f, const PoseMe
     if (!(m.stiffness_n_per_m > 0.0) || !(m.damping_ratio > 0.0)) continue;  // not a real, damped mode
     p.modes.push_back(config::stiffness_mode(m.natural_freq_hz, m.damping_ratio, m.stiffness_n_per_m));
   }
-  std::sort(p.modes.begin(), p.modes.end(), [](const auto& a, const auto& b) { return a.natural_freq_hz < b.natural_freq_hz; });
-  if (p.modes.empty()) throw std::invalid_argument("pose '" + f.name + "' (" + dir + "): no real mode with damping identified");
+  std::sort(p.modes.begin(), p.modes.end(),
+            [](const auto& a, const auto& b) { return a.natural_freq_hz < b.natural_freq_hz; });
+  if (p.modes.empty())
+    throw std::invalid_argument("pose '" + f.name + "' (" + dir + "): no real mode with damping identified");
   return p;
 }
 
@@ -39,7 +41,8 @@ config::MeasuredPoseModes identify_one(const robot::MeasuredFrf& f, const PoseMe
 
 PoseModesIdentified identify_pose_modes(const PoseMeasurements& pm, const std::vector<std::string>& hold_out) {
   if (pm.direction == robot::FrfDirection::kXY)
-    throw std::invalid_argument("the measurements are a cross receptance (xy): the modes are identified on a driving point");
+    throw std::invalid_argument(
+        "the measurements are a cross receptance (xy): the modes are identified on a driving point");
   for (const auto& name : hold_out)
     if (std::none_of(pm.frfs.begin(), pm.frfs.end(), [&](const auto& f) { return f.name == name; }))
       throw std::invalid_argument("--hold-out '" + name + "': no measured pose of that name");
@@ -53,7 +56,8 @@ PoseModesIdentified identify_pose_modes(const PoseMeasurements& pm, const std::v
     (held ? out.held_out : out.measured.poses).push_back(std::move(p));
     (held ? held_errors : out.fit_error_pct).push_back(error);
   }
-  if (out.measured.poses.empty()) throw std::invalid_argument("every measured pose is held out: keep at least one in the map");
+  if (out.measured.poses.empty())
+    throw std::invalid_argument("every measured pose is held out: keep at least one in the map");
   out.fit_error_pct.insert(out.fit_error_pct.end(), held_errors.begin(), held_errors.end());
   return out;
 }

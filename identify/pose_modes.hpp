@@ -13,13 +13,14 @@
 namespace robodamp::identify {
 
 struct PoseModesIdentified {
-  config::MeasuredModesConfig measured;          // the poses kept in the map
+  config::MeasuredModesConfig measured;             // the poses kept in the map
   std::vector<config::MeasuredPoseModes> held_out;  // identified as well, to check the map against
-  std::vector<double> fit_error_pct;              // each pose's modal fit, in the order measured then held out
+  std::vector<double> fit_error_pct;                // each pose's modal fit, in the order measured then held out
 };
 
 // Throws std::invalid_argument: a cross receptance (xy), a hold-out name that is no measured pose, every
 // pose held out, or a pose whose FRF has no identifiable mode (naming it and the fit's reason).
-[[nodiscard]] PoseModesIdentified identify_pose_modes(const PoseMeasurements& pm, const std::vector<std::string>& hold_out);
+[[nodiscard]] PoseModesIdentified identify_pose_modes(const PoseMeasurements& pm,
+                                                      const std::vector<std::string>& hold_out);
 
 }  // namespace robodamp::identify

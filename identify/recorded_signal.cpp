@@ -60,7 +60,8 @@ milling::RecordedSignal from_sound(const std::string& path, const SignalOptions&
   if (o.full_scale_mps2)
     for (double& v : s.samples) v *= *o.full_scale_mps2;
   char b[160];
-  std::snprintf(b, sizeof b, "%s, channel %d of %d, peak %.3g of full scale", snd.format.c_str(), o.channel, snd.channels, snd.peak);
+  std::snprintf(b, sizeof b, "%s, channel %d of %d, peak %.3g of full scale", snd.format.c_str(), o.channel,
+                snd.channels, snd.peak);
   described = b;
   return s;
 }
@@ -72,24 +73,30 @@ milling::RecordedSignal from_uff(const std::string& path, const SignalOptions& o
   for (std::size_t i = 0; i < file.functions.size(); ++i) {
     const auto& f = file.functions[i];
     if (o.record ? *o.record != static_cast<int>(i + 1) : f.function_type != measfiles::kUffTimeResponse) continue;
-    if (o.response && !(f.response_node == o.response->node && (o.response->direction == 0 || o.response->direction == f.response_direction)))
+    if (o.response && !(f.response_node == o.response->node &&
+                        (o.response->direction == 0 || o.response->direction == f.response_direction)))
       continue;
     ++found, pick = &f;
   }
   if (found != 1 || pick->is_complex || pick->x.size() < 2)
-    throw std::invalid_argument(path + ": " + std::to_string(found) + " time histories match; choose one with --record N or "
-                                "--response NODE:DIR; the file holds:\n" + describe_functions(file));
+    throw std::invalid_argument(path + ": " + std::to_string(found) +
+                                " time histories match; choose one with --record N or "
+                                "--response NODE:DIR; the file holds:\n" +
+                                describe_functions(file));
   milling::RecordedSignal s;
   s.source = path;
   double t_scale = 1.0;
-  if (const auto u = measfiles::unit_scale(pick->abscissa.units); u && u->quantity == Quantity::kTime) t_scale = u->to_si;
+  if (const auto u = measfiles::unit_scale(pick->abscissa.units); u && u->quantity == Quantity::kTime)
+    t_scale = u->to_si;
   s.rate_hz = static_cast<double>(pick->x.size() - 1) / ((pick->x.back() - pick->x.front()) * t_scale);
   const auto u = measfiles::unit_scale(pick->ordinate.units);
-  s.acceleration_mps2 = (u && u->quantity == Quantity::kAcceleration) || (!u && pick->ordinate.data_type == measfiles::kUffAcceleration);
+  s.acceleration_mps2 =
+      (u && u->quantity == Quantity::kAcceleration) || (!u && pick->ordinate.data_type == measfiles::kUffAcceleration);
   const double k = u && s.acceleration_mps2 ? u->to_si : 1.0;
   s.unit = s.acceleration_mps2 ? "m/s^2" : pick->ordinate.units;
   for (const auto& y : pick->y) s.samples.push_back(y.real() * k);
-  described = "universal file, time history " + dof_text(pick->response_node, pick->response_direction) + " '" + pick->id[0] + "'";
+  described = "universal file, time history " + dof_text(pick->response_node, pick->response_direction) + " '" +
+              pick->id[0] + "'";
   return s;
 }
 
@@ -97,7 +104,8 @@ milling::RecordedSignal from_uff(const std::string& path, const SignalOptions& o
 std::optional<std::size_t> column_of(const measfiles::Table& t, const std::string& wanted) {
   char* end = nullptr;
   const long number = std::strtol(wanted.c_str(), &end, 10);
-  if (*end == '\0' && number >= 1 && static_cast<std::size_t>(number) <= t.columns) return static_cast<std::size_t>(number - 1);
+  if (*end == '\0' && number >= 1 && static_cast<std::size_t>(number) <= t.columns)
+    return static_cast<std::size_t>(number - 1);
   for (std::size_t k = 0; k < t.names.size(); ++k)
     if (measfiles::normalised(t.names[k]) == measfiles::normalised(wanted)) return k;
   return std::nullopt;
@@ -112,11 +120,14 @@ milling::RecordedSignal from_table(const std::string& path, const SignalOptions&
   }
   if (!o.column.empty()) {
     value_col = column_of(t, o.column);
-    if (!value_col) throw std::invalid_argument(path + ": no column '" + o.column + "' (a name in the header or 1 .. " + std::to_string(t.columns) + ")");
+    if (!value_col)
+      throw std::invalid_argument(path + ": no column '" + o.column + "' (a name in the header or 1 .. " +
+                                  std::to_string(t.columns) + ")");
   } else {
     value_col = time_col == std::size_t{0} && t.columns > 1 ? 1 : 0;
   }
-  if (!time_col && t.names.empty() && !o.rate_hz && t.columns > 1 && *value_col != 0) time_col = 0;  // no header: time first
+  if (!time_col && t.names.empty() && !o.rate_hz && t.columns > 1 && *value_col != 0)
+    time_col = 0;  // no header: time first
   milling::RecordedSignal s;
   s.source = path;
   std::string unit = *value_col < t.units.size() ? t.units[*value_col] : "";
@@ -138,16 +149,21 @@ milling::RecordedSignal from_table(const std::string& path, const SignalOptions&
     s.rate_hz = *o.rate_hz;
   } else if (time_col) {
     double k = 1.0;
-    if (const auto tu = measfiles::unit_scale(*time_col < t.units.size() ? t.units[*time_col] : ""); tu && tu->quantity == Quantity::kTime) k = tu->to_si;
-    const double dt = (t.rows.back()[*time_col] - t.rows.front()[*time_col]) * k / static_cast<double>(t.rows.size() - 1);
+    if (const auto tu = measfiles::unit_scale(*time_col < t.units.size() ? t.units[*time_col] : "");
+        tu && tu->quantity == Quantity::kTime)
+      k = tu->to_si;
+    const double dt =
+        (t.rows.back()[*time_col] - t.rows.front()[*time_col]) * k / static_cast<double>(t.rows.size() - 1);
     for (std::size_t i = 1; i < t.rows.size(); ++i)
       if (!(std::abs((t.rows[i][*time_col] - t.rows[i - 1][*time_col]) * k - dt) <= 0.01 * dt))
-        throw std::invalid_argument(path + ":" + std::to_string(t.lines[i]) + ": the time step changes (a constant sample rate is needed)");
+        throw std::invalid_argument(path + ":" + std::to_string(t.lines[i]) +
+                                    ": the time step changes (a constant sample rate is needed)");
     s.rate_hz = 1.0 / dt;
   } else {
     throw std::invalid_argument(path + ": no time column (time, t, time_s): give --rate-hz");
   }
-  described = "table, column " + (*value_col < t.names.size() ? "'" + t.names[*value_col] + "'" : std::to_string(*value_col + 1)) +
+  described = "table, column " +
+              (*value_col < t.names.size() ? "'" + t.names[*value_col] + "'" : std::to_string(*value_col + 1)) +
               (unit.empty() ? std::string(", no unit") : ", in " + unit);
   return s;
 }

@@ -24,8 +24,8 @@ std::string pair_text(Pair p) { return "H" + std::to_string(p.first) + std::to_s
 void add(std::map<Pair, IdentifiedFrf>& found, IdentifiedFrf f) {
   const Pair p{f.response_id, f.excitation_id};
   if (const auto it = found.find(p); it != found.end())
-    throw std::invalid_argument("two tap tests from node " + std::to_string(p.second) + " to node " + std::to_string(p.first) +
-                                ": " + it->second.file + " and " + f.file + "; keep one");
+    throw std::invalid_argument("two tap tests from node " + std::to_string(p.second) + " to node " +
+                                std::to_string(p.first) + ": " + it->second.file + " and " + f.file + "; keep one");
   found.emplace(p, std::move(f));
 }
 
@@ -104,9 +104,10 @@ std::vector<IdentifiedMode> chirp_modes(const ChirpMeasurement& c, double lo, do
   try {
     const ModalFit fit = fit_modes(d, s);
     char b[320];
-    std::snprintf(b, sizeof b, "the chirp's FRF fitted on its own over %.1f-%.1f Hz for its poles: %zu (only the poles are "
-                  "compared: the actuator's dynamics in it are not of the modal form, the residues fit it to %.0f %%)", lo, hi,
-                  fit.modes.size(), fit.fit_error_pct);
+    std::snprintf(b, sizeof b,
+                  "the chirp's FRF fitted on its own over %.1f-%.1f Hz for its poles: %zu (only the poles are "
+                  "compared: the actuator's dynamics in it are not of the modal form, the residues fit it to %.0f %%)",
+                  lo, hi, fit.modes.size(), fit.fit_error_pct);
     how = b;
     return fit.modes;
   } catch (const std::invalid_argument& e) {
@@ -149,7 +150,8 @@ double actuator_residual_pct(const CommissioningResult& r, const ModalFit& path,
 
 }  // namespace
 
-TapTests read_tap_tests(const std::vector<std::string>& files, const MeasurementManifest& m, const config::Config& cfg) {
+TapTests read_tap_tests(const std::vector<std::string>& files, const MeasurementManifest& m,
+                        const config::Config& cfg) {
   if (files.empty()) throw std::invalid_argument("no tap-test file given");
   std::vector<int> ids;
   for (const auto& l : m.locations) ids.push_back(l.first);
@@ -176,9 +178,10 @@ TapTests read_tap_tests(const std::vector<std::string>& files, const Measurement
       if (it == found.end()) it = other;
       if (it == found.end())
         throw std::invalid_argument("the tap tests hold no FRF between locations " + std::to_string(ids[g]) + " and " +
-                                    std::to_string(ids[h]) + " (either way round; UFF nodes are the configuration's location "
-                                    "ids, CSVs are named frf_<response>_<excitation>.csv) in " + std::to_string(files.size()) +
-                                    " file(s)");
+                                    std::to_string(ids[h]) +
+                                    " (either way round; UFF nodes are the configuration's location "
+                                    "ids, CSVs are named frf_<response>_<excitation>.csv) in " +
+                                    std::to_string(files.size()) + " file(s)");
       IdentifiedFrf f = it->second;
       f.name = pair_text({f.response_id, f.excitation_id});
       for (const auto& c : cfg.robot.frfs)
@@ -190,7 +193,8 @@ TapTests read_tap_tests(const std::vector<std::string>& files, const Measurement
   return t;
 }
 
-CommissioningInputs inputs_with_tap_tests(const std::string& dir, const std::vector<std::string>& files, TapTests& taps) {
+CommissioningInputs inputs_with_tap_tests(const std::string& dir, const std::vector<std::string>& files,
+                                          TapTests& taps) {
   CommissioningInputs in;
   in.manifest = read_manifest(dir);
   const config::Config measured = config::parse_config(in.manifest.config_text, in.manifest.config_source);
@@ -209,16 +213,19 @@ std::string TapTestConsistency::failure() const {
       std::snprintf(b, sizeof b, "the tap tests' mode at %.2f Hz: the actuator's chirp shows no pole (%s)", m.tap_hz,
                     chirp_fit.c_str());
     else
-      std::snprintf(b, sizeof b, "the tap tests contradict the actuator's chirp: their mode at %.2f Hz is at %.2f Hz in the chirp "
-                    "(%.1f %% apart, allowed %.1f %%): another pose, another tool, or another robot?", m.tap_hz, *m.chirp_hz,
-                    m.difference_pct, tolerance_pct);
+      std::snprintf(b, sizeof b,
+                    "the tap tests contradict the actuator's chirp: their mode at %.2f Hz is at %.2f Hz in the chirp "
+                    "(%.1f %% apart, allowed %.1f %%): another pose, another tool, or another robot?",
+                    m.tap_hz, *m.chirp_hz, m.difference_pct, tolerance_pct);
     return b;
   }
   if (chirp_residual_pct > residual_limit_pct) {
-    std::snprintf(b, sizeof b, "the tap tests contradict the actuator's chirp: through the tapped structure the chirp implies an "
-                  "actuator Eq. 3 fits only to %.1f %% RMS (allowed %.0f %%): another structure, or a mode just outside "
-                  "analysis.band_min_hz-band_max_hz that the identified structure leaves out", chirp_residual_pct,
-                  residual_limit_pct);
+    std::snprintf(
+        b, sizeof b,
+        "the tap tests contradict the actuator's chirp: through the tapped structure the chirp implies an "
+        "actuator Eq. 3 fits only to %.1f %% RMS (allowed %.0f %%): another structure, or a mode just outside "
+        "analysis.band_min_hz-band_max_hz that the identified structure leaves out",
+        chirp_residual_pct, residual_limit_pct);
     return b;
   }
   for (const auto& r : reciprocity)
@@ -234,15 +241,20 @@ std::string TapTestConsistency::summary() const {
   std::string s;
   char b[200];
   for (const auto& m : modes) {
-    if (m.chirp_hz) std::snprintf(b, sizeof b, "%s%.3f Hz tapped, %.3f Hz in the chirp (%.2f %%)", s.empty() ? "" : "; ", m.tap_hz,
-                                  *m.chirp_hz, m.difference_pct);
-    else std::snprintf(b, sizeof b, "%s%.3f Hz tapped, none in the chirp", s.empty() ? "" : "; ", m.tap_hz);
+    if (m.chirp_hz)
+      std::snprintf(b, sizeof b, "%s%.3f Hz tapped, %.3f Hz in the chirp (%.2f %%)", s.empty() ? "" : "; ", m.tap_hz,
+                    *m.chirp_hz, m.difference_pct);
+    else
+      std::snprintf(b, sizeof b, "%s%.3f Hz tapped, none in the chirp", s.empty() ? "" : "; ", m.tap_hz);
     s += b;
   }
-  std::snprintf(b, sizeof b, "; through the tapped structure the chirp implies an actuator Eq. 3 fits to %.2f %% RMS (%d lone "
-                "line(s) left out)", chirp_residual_pct, residual_lines_left_out);
+  std::snprintf(b, sizeof b,
+                "; through the tapped structure the chirp implies an actuator Eq. 3 fits to %.2f %% RMS (%d lone "
+                "line(s) left out)",
+                chirp_residual_pct, residual_lines_left_out);
   s += b;
-  for (const auto& r : reciprocity) std::snprintf(b, sizeof b, "; %s reciprocal within %.1f %%", r.pair.c_str(), r.difference_pct), s += b;
+  for (const auto& r : reciprocity)
+    std::snprintf(b, sizeof b, "; %s reciprocal within %.1f %%", r.pair.c_str(), r.difference_pct), s += b;
   return s;
 }
 
@@ -251,7 +263,8 @@ TapTestConsistency check_tap_tests(const CommissioningInputs& in, const Commissi
   TapTestConsistency c;
   c.tolerance_pct = tolerance_pct;
   const config::Config& cfg = r.config;
-  const double lo = std::max(cfg.analysis.band_min_hz, in.chirp.f0_hz), hi = std::min(cfg.analysis.band_max_hz, in.chirp.f1_hz);
+  const double lo = std::max(cfg.analysis.band_min_hz, in.chirp.f0_hz),
+               hi = std::min(cfg.analysis.band_max_hz, in.chirp.f1_hz);
   const std::vector<IdentifiedMode> poles = chirp_modes(in.chirp, lo, hi, c.chirp_fit);
   const ModalFit& path_fit = path_between(r.frfs, r.manifest.sensor_location_id, r.manifest.actuator_location_id).fit;
   for (const auto& m : path_fit.modes) {

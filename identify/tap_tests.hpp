@@ -41,9 +41,9 @@ struct TapModeCheck {
 };
 
 struct TapTestConsistency {
-  std::vector<TapModeCheck> modes;         // the tapped path between the actuator and the sensor, in the band
-  double tolerance_pct{0.0};               // a mode's frequency, tap test against chirp
-  std::string chirp_fit;                   // how the chirp was fitted, or why it could not be
+  std::vector<TapModeCheck> modes;  // the tapped path between the actuator and the sensor, in the band
+  double tolerance_pct{0.0};        // a mode's frequency, tap test against chirp
+  std::string chirp_fit;            // how the chirp was fitted, or why it could not be
   // The actuator's fit error: the force per volt the chirp implies through the tapped structure against
   // Eq. 3, weighed in the acceleration (RMS over the coherent band).
   double chirp_residual_pct{0.0};

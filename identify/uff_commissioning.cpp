@@ -70,8 +70,9 @@ measfiles::UffFile measurement_to_uff(const CommissioningInputs& in) {
     if (!frf.data.coherence.empty()) file.functions.push_back(coherence_of(f, frf.data.coherence));
   }
   const ChirpMeasurement& c = in.chirp;
-  UffFunction a = function_record("actuator: acceleration per volt (chirp)", in.manifest.config_source,
-                                  in.manifest.sensor_location_id, in.manifest.actuator_location_id, c.accel_per_volt.f_hz);
+  UffFunction a =
+      function_record("actuator: acceleration per volt (chirp)", in.manifest.config_source,
+                      in.manifest.sensor_location_id, in.manifest.actuator_location_id, c.accel_per_volt.f_hz);
   a.reference_entity = kVoltageEntity;
   a.id[4] = "chirp " + std::to_string(c.f0_hz) + " .. " + std::to_string(c.f1_hz) + " Hz, periods averaged " +
             std::to_string(c.periods_averaged);
@@ -88,7 +89,8 @@ measfiles::UffFile modes_to_uff(const CommissioningResult& r) {
   const int ref = r.manifest.actuator_location_id;
   for (const auto& [id, name] : r.manifest.locations) file.nodes.push_back({id, {0.0, 0.0, 0.0}});
   const IdentifiedFrf* driving = between(r.frfs, ref, ref);
-  if (driving == nullptr) throw std::invalid_argument("no driving-point FRF at the actuator's location " + std::to_string(ref));
+  if (driving == nullptr)
+    throw std::invalid_argument("no driving-point FRF at the actuator's location " + std::to_string(ref));
   int number = 0;
   for (const auto& m : driving->fit.modes) {
     const double wn = 2.0 * M_PI * m.natural_freq_hz;
@@ -113,8 +115,8 @@ measfiles::UffFile modes_to_uff(const CommissioningResult& r) {
   return file;
 }
 
-std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std::string& path, int response, int reference,
-                                  bool per_volt) {
+std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std::string& path, int response,
+                                      int reference, bool per_volt) {
   for (const auto& [g, h] : {std::pair{response, reference}, std::pair{reference, response}}) {
     int found = 0;
     std::optional<UffFrf> hit;
@@ -128,8 +130,9 @@ std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std:
       ++found, hit = std::move(u);
     }
     if (found > 1)
-      throw std::invalid_argument(path + ": " + std::to_string(found) + " FRF records between nodes " + std::to_string(g) + " and " +
-                                  std::to_string(h) + (per_volt ? " per volt" : " per force") + "; keep one");
+      throw std::invalid_argument(path + ": " + std::to_string(found) + " FRF records between nodes " +
+                                  std::to_string(g) + " and " + std::to_string(h) +
+                                  (per_volt ? " per volt" : " per force") + "; keep one");
     if (hit) return hit;
     if (per_volt) break;
   }
@@ -139,7 +142,8 @@ std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std:
 namespace {
 
 // The actuator: the sensor's acceleration per volt (robodamp's chirp), or else its force per volt.
-void read_actuator(const measfiles::UffFile& file, const std::string& path, const config::Config& cfg, CommissioningInputs& in) {
+void read_actuator(const measfiles::UffFile& file, const std::string& path, const config::Config& cfg,
+                   CommissioningInputs& in) {
   const MeasurementManifest& m = in.manifest;
   ChirpMeasurement& c = in.chirp;
   c.config = cfg;
@@ -147,11 +151,14 @@ void read_actuator(const measfiles::UffFile& file, const std::string& path, cons
   c.f0_hz = cfg.commissioning.chirp_f0_hz, c.f1_hz = cfg.commissioning.chirp_f1_hz;
   if (const auto a = uff_frf_between(file, path, m.sensor_location_id, m.actuator_location_id, true)) {
     if (a->units.kind != FrfKind::kAccelerance)
-      throw std::invalid_argument(path + ": record " + std::to_string(a->record) + ": the actuator's FRF must be an acceleration per volt");
+      throw std::invalid_argument(path + ": record " + std::to_string(a->record) +
+                                  ": the actuator's FRF must be an acceleration per volt");
     c.accel_per_volt.f_hz = a->data.f_hz, c.accel_per_volt.h1 = a->data.h;
-    c.accel_per_volt.coherence = a->data.coherence.empty() ? std::vector<double>(a->data.f_hz.size(), 1.0) : a->data.coherence;
+    c.accel_per_volt.coherence =
+        a->data.coherence.empty() ? std::vector<double>(a->data.f_hz.size(), 1.0) : a->data.coherence;
     const std::string& note = a->function->id[4];
-    if (const std::size_t at = note.find("periods averaged "); at != std::string::npos) c.periods_averaged = std::atoi(note.c_str() + at + 17);
+    if (const std::size_t at = note.find("periods averaged "); at != std::string::npos)
+      c.periods_averaged = std::atoi(note.c_str() + at + 17);
     return;
   }
   for (std::size_t i = 0; i < file.functions.size(); ++i) {
@@ -164,10 +171,11 @@ void read_actuator(const measfiles::UffFile& file, const std::string& path, cons
     in.force_per_volt = ActuatorFrf{u.data.f_hz, u.data.h, u.data.coherence};
     return;
   }
-  throw std::invalid_argument(path + ": the actuator needs an FRF per volt with reference node " + std::to_string(m.actuator_location_id) +
-                              " (the actuator): the acceleration at node " + std::to_string(m.sensor_location_id) +
-                              " (the sensor, what robodamp measures with its chirp) or the actuator's force; the file holds:\n" +
-                              describe_functions(file));
+  throw std::invalid_argument(
+      path + ": the actuator needs an FRF per volt with reference node " + std::to_string(m.actuator_location_id) +
+      " (the actuator): the acceleration at node " + std::to_string(m.sensor_location_id) +
+      " (the sensor, what robodamp measures with its chirp) or the actuator's force; the file holds:\n" +
+      describe_functions(file));
 }
 
 }  // namespace
@@ -196,9 +204,9 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
         if (c.response_location == f.response_id && c.excitation_location == f.excitation_id) f.name = c.name;
       const auto u = uff_frf_between(file, uff_path, f.response_id, f.excitation_id, false);
       if (!u)
-        throw std::invalid_argument(uff_path + ": no FRF per force between nodes " + std::to_string(f.response_id) + " and " +
-                                    std::to_string(f.excitation_id) + " (the configuration's locations); the file holds:\n" +
-                                    describe_functions(file));
+        throw std::invalid_argument(uff_path + ": no FRF per force between nodes " + std::to_string(f.response_id) +
+                                    " and " + std::to_string(f.excitation_id) +
+                                    " (the configuration's locations); the file holds:\n" + describe_functions(file));
       f.file = uff_path + " record " + std::to_string(u->record);
       f.data = u->data;
       in.frfs.push_back(std::move(f));

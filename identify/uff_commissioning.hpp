@@ -29,8 +29,8 @@ inline constexpr const char* kVoltageEntity = "VOLTAGE";
 
 // The FRF record between two nodes (either way round for a force; the sensor's response to the actuator's
 // voltage for a volt); nullopt when the file holds none. Throws std::invalid_argument when it holds two.
-[[nodiscard]] std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std::string& path, int response,
-                                                    int reference, bool per_volt);
+[[nodiscard]] std::optional<UffFrf> uff_frf_between(const measfiles::UffFile& file, const std::string& path,
+                                                    int response, int reference, bool per_volt);
 
 // identify all's inputs from a universal file and the configuration the measurement ran with: an FRF
 // per force between every pair of the configuration's locations (either way round), and the actuator's

@@ -18,12 +18,17 @@ constexpr double kTwoPi = 2.0 * M_PI;
 
 std::optional<Quantity> quantity_of_type(int data_type) {
   switch (data_type) {
-    case measfiles::kUffDisplacement: return Quantity::kLength;
-    case measfiles::kUffVelocity: return Quantity::kVelocity;
-    case measfiles::kUffAcceleration: return Quantity::kAcceleration;
+    case measfiles::kUffDisplacement:
+      return Quantity::kLength;
+    case measfiles::kUffVelocity:
+      return Quantity::kVelocity;
+    case measfiles::kUffAcceleration:
+      return Quantity::kAcceleration;
     case measfiles::kUffExcitationForce:
-    case measfiles::kUffReactionForce: return Quantity::kForce;
-    default: return std::nullopt;
+    case measfiles::kUffReactionForce:
+      return Quantity::kForce;
+    default:
+      return std::nullopt;
   }
 }
 
@@ -42,15 +47,18 @@ measfiles::UnitScale axis_scale(const std::string& label, int data_type, std::op
     return *u;
   }
   if (!known(label).empty())
-    throw std::invalid_argument("record " + std::to_string(record) + ": the " + what + " unit '" + label +
-                                "' is not one robodamp knows (m, mm, um, in, m/s, mm/s, in/s, m/s^2, g, N, kN, lbf, V, mV)");
+    throw std::invalid_argument(
+        "record " + std::to_string(record) + ": the " + what + " unit '" + label +
+        "' is not one robodamp knows (m, mm, um, in, m/s, mm/s, in/s, m/s^2, g, N, kN, lbf, V, mV)");
   if (by_type) return {*by_type, 1.0};
   if (fallback) return {*fallback, 1.0};
-  throw std::invalid_argument("record " + std::to_string(record) + ": the " + what + " has neither a unit nor a data type (8, 11, 12) saying what it is");
+  throw std::invalid_argument("record " + std::to_string(record) + ": the " + what +
+                              " has neither a unit nor a data type (8, 11, 12) saying what it is");
 }
 
 const char* direction_name(int d) {
-  static const char* const kNames[] = {"-RZ", "-RY", "-RX", "-Z", "-Y", "-X", "S", "+X", "+Y", "+Z", "+RX", "+RY", "+RZ"};
+  static const char* const kNames[] = {"-RZ", "-RY", "-RX", "-Z",  "-Y",  "-X", "S",
+                                       "+X",  "+Y",  "+Z",  "+RX", "+RY", "+RZ"};
   return d >= -6 && d <= 6 ? kNames[d + 6] : "?";
 }
 
@@ -58,7 +66,8 @@ bool matches(const UffFunction& f, const std::optional<Dof>& response, const std
   auto same = [](const std::optional<Dof>& want, int node, int dir) {
     return !want || (want->node == node && (want->direction == 0 || want->direction == dir));
   };
-  return same(response, f.response_node, f.response_direction) && same(reference, f.reference_node, f.reference_direction);
+  return same(response, f.response_node, f.response_direction) &&
+         same(reference, f.reference_node, f.reference_direction);
 }
 
 }  // namespace
@@ -74,14 +83,20 @@ Dof parse_dof(const std::string& text) {
       std::string dir = text.substr(colon + 1);
       int sign = 1;
       if (!dir.empty() && (dir[0] == '+' || dir[0] == '-')) sign = dir[0] == '-' ? -1 : 1, dir.erase(0, 1);
-      if (dir == "x" || dir == "X") d.direction = sign * 1;
-      else if (dir == "y" || dir == "Y") d.direction = sign * 2;
-      else if (dir == "z" || dir == "Z") d.direction = sign * 3;
-      else if (dir.size() == 1 && dir[0] >= '0' && dir[0] <= '6') d.direction = sign * (dir[0] - '0');
-      else throw std::invalid_argument("direction");
+      if (dir == "x" || dir == "X")
+        d.direction = sign * 1;
+      else if (dir == "y" || dir == "Y")
+        d.direction = sign * 2;
+      else if (dir == "z" || dir == "Z")
+        d.direction = sign * 3;
+      else if (dir.size() == 1 && dir[0] >= '0' && dir[0] <= '6')
+        d.direction = sign * (dir[0] - '0');
+      else
+        throw std::invalid_argument("direction");
     }
   } catch (const std::exception&) {
-    throw std::invalid_argument("'" + text + "' is not a DOF: NODE:DIR with DIR one of X, Y, Z, -X, -Y, -Z (or 1..6 with a sign), e.g. 12:+Y");
+    throw std::invalid_argument(
+        "'" + text + "' is not a DOF: NODE:DIR with DIR one of X, Y, Z, -X, -Y, -Z (or 1..6 with a sign), e.g. 12:+Y");
   }
   return d;
 }
@@ -102,23 +117,30 @@ FrfUnits frf_units(const UffFunction& f, int record) {
   const measfiles::UnitScale d = axis_scale(den, f.denominator.data_type, Quantity::kForce, record, "denominator");
   FrfUnits u;
   if (d.quantity != Quantity::kForce && d.quantity != Quantity::kVoltage)
-    throw std::invalid_argument("record " + std::to_string(record) + ": the denominator is in " + measfiles::si_unit(d.quantity) +
-                                ": an FRF per force (N) or per voltage (V) is read");
+    throw std::invalid_argument("record " + std::to_string(record) + ": the denominator is in " +
+                                measfiles::si_unit(d.quantity) + ": an FRF per force (N) or per voltage (V) is read");
   u.per_volt = d.quantity == Quantity::kVoltage;
   if (u.per_volt && n.quantity == Quantity::kForce) {
     u.force_per_volt = true, u.to_si = n.to_si / d.to_si;
-    u.shown = "force per volt " + (known(num).empty() ? std::string("(SI)") : num) + "/" + (known(den).empty() ? "(SI)" : den) + " read as N/V";
+    u.shown = "force per volt " + (known(num).empty() ? std::string("(SI)") : num) + "/" +
+              (known(den).empty() ? "(SI)" : den) + " read as N/V";
     return u;
   }
-  if (n.quantity == Quantity::kLength) u.kind = FrfKind::kReceptance;
-  else if (n.quantity == Quantity::kVelocity) u.kind = FrfKind::kMobility;
-  else if (n.quantity == Quantity::kAcceleration) u.kind = FrfKind::kAccelerance;
-  else throw std::invalid_argument("record " + std::to_string(record) + ": the ordinate is in " + measfiles::si_unit(n.quantity) +
-                                   ": displacement, velocity or acceleration is read");
+  if (n.quantity == Quantity::kLength)
+    u.kind = FrfKind::kReceptance;
+  else if (n.quantity == Quantity::kVelocity)
+    u.kind = FrfKind::kMobility;
+  else if (n.quantity == Quantity::kAcceleration)
+    u.kind = FrfKind::kAccelerance;
+  else
+    throw std::invalid_argument("record " + std::to_string(record) + ": the ordinate is in " +
+                                measfiles::si_unit(n.quantity) + ": displacement, velocity or acceleration is read");
   u.to_si = n.to_si / d.to_si;
-  const char* kind = u.kind == FrfKind::kReceptance ? "receptance" : u.kind == FrfKind::kMobility ? "mobility" : "accelerance";
-  u.shown = std::string(kind) + " " + (known(num).empty() ? "(SI)" : num) + "/" + (known(den).empty() ? "(SI)" : den) + " read as " +
-            measfiles::si_unit(n.quantity) + "/" + measfiles::si_unit(d.quantity);
+  const char* kind = u.kind == FrfKind::kReceptance ? "receptance"
+                     : u.kind == FrfKind::kMobility ? "mobility"
+                                                    : "accelerance";
+  u.shown = std::string(kind) + " " + (known(num).empty() ? "(SI)" : num) + "/" + (known(den).empty() ? "(SI)" : den) +
+            " read as " + measfiles::si_unit(n.quantity) + "/" + measfiles::si_unit(d.quantity);
   return u;
 }
 
@@ -126,8 +148,10 @@ std::string describe_functions(const measfiles::UffFile& file) {
   std::string s;
   for (std::size_t i = 0; i < file.functions.size(); ++i) {
     const UffFunction& f = file.functions[i];
-    const char* type = f.function_type == measfiles::kUffFrf ? "FRF" : f.function_type == measfiles::kUffCoherence ? "coherence"
-                       : f.function_type == measfiles::kUffTimeResponse ? "time history" : "function";
+    const char* type = f.function_type == measfiles::kUffFrf            ? "FRF"
+                       : f.function_type == measfiles::kUffCoherence    ? "coherence"
+                       : f.function_type == measfiles::kUffTimeResponse ? "time history"
+                                                                        : "function";
     char line[256];
     std::snprintf(line, sizeof line, "  record %zu: %s %s / %s, %zu points %.6g .. %.6g, %s '%s'\n", i + 1, type,
                   dof_text(f.response_node, f.response_direction).c_str(),
@@ -149,7 +173,8 @@ UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, con
   } else {
     int found = 0;
     for (std::size_t i = 0; i < file.functions.size(); ++i)
-      if (file.functions[i].function_type == measfiles::kUffFrf && matches(file.functions[i], s.response, s.reference)) ++found, at = i;
+      if (file.functions[i].function_type == measfiles::kUffFrf && matches(file.functions[i], s.response, s.reference))
+        ++found, at = i;
     if (found != 1)
       throw std::invalid_argument(name + ": " + std::to_string(found) + " FRF records match" +
                                   (s.response || s.reference ? " the --response and --reference given" : "") +
@@ -165,7 +190,8 @@ UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, con
   double x_scale = 1.0;
   if (const auto u = measfiles::unit_scale(f.abscissa.units)) {
     if (u->quantity != Quantity::kFrequency)
-      throw std::invalid_argument(name + ": record " + std::to_string(record) + ": the abscissa is in '" + f.abscissa.units + "', not a frequency");
+      throw std::invalid_argument(name + ": record " + std::to_string(record) + ": the abscissa is in '" +
+                                  f.abscissa.units + "', not a frequency");
     x_scale = u->to_si;
   }
   UffFrf out;
@@ -177,8 +203,9 @@ UffFrf frf_from_uff(const measfiles::UffFile& file, const std::string& name, con
   }
   const UffFunction* coherence = nullptr;
   for (const auto& c : file.functions)
-    if (c.function_type == measfiles::kUffCoherence && c.response_node == f.response_node && c.reference_node == f.reference_node &&
-        c.response_direction == f.response_direction && c.reference_direction == f.reference_direction && c.x.size() == f.x.size())
+    if (c.function_type == measfiles::kUffCoherence && c.response_node == f.response_node &&
+        c.reference_node == f.reference_node && c.response_direction == f.response_direction &&
+        c.reference_direction == f.reference_direction && c.x.size() == f.x.size())
       coherence = &c;
   for (std::size_t k = 0; k < f.x.size(); ++k) {
     const double hz = f.x[k] * x_scale;
@@ -214,29 +241,38 @@ UffSeries time_series_from_uff(const measfiles::UffFile& file, const std::string
     } else if ((q == Quantity::kLength || q == Quantity::kVelocity || q == Quantity::kAcceleration) &&
                matches(f, s.response, std::nullopt) && (!s.record || *s.record == static_cast<int>(i + 1))) {
       ++responses, response = &f, response_si = si, out.response_record = static_cast<int>(i + 1);
-      out.kind = q == Quantity::kLength ? FrfKind::kReceptance : q == Quantity::kVelocity ? FrfKind::kMobility : FrfKind::kAccelerance;
+      out.kind = q == Quantity::kLength     ? FrfKind::kReceptance
+                 : q == Quantity::kVelocity ? FrfKind::kMobility
+                                            : FrfKind::kAccelerance;
     }
   }
   if (forces != 1)
-    throw std::invalid_argument(name + ": " + std::to_string(forces) + " time histories of a force (the hammer's): one is needed" + listing);
+    throw std::invalid_argument(name + ": " + std::to_string(forces) +
+                                " time histories of a force (the hammer's): one is needed" + listing);
   if (responses != 1)
-    throw std::invalid_argument(name + ": " + std::to_string(responses) +
-                                " time histories of a response match; choose one with --response NODE:DIR or --record N" + listing);
+    throw std::invalid_argument(
+        name + ": " + std::to_string(responses) +
+        " time histories of a response match; choose one with --response NODE:DIR or --record N" + listing);
   if (force->x.size() != response->x.size() || force->x.size() < 64)
-    throw std::invalid_argument(name + ": records " + std::to_string(out.force_record) + " and " + std::to_string(out.response_record) +
-                                " hold " + std::to_string(force->x.size()) + " and " + std::to_string(response->x.size()) +
+    throw std::invalid_argument(name + ": records " + std::to_string(out.force_record) + " and " +
+                                std::to_string(out.response_record) + " hold " + std::to_string(force->x.size()) +
+                                " and " + std::to_string(response->x.size()) +
                                 " samples: the same number, at least 64, is needed");
   const double dt = (force->x.back() - force->x.front()) / static_cast<double>(force->x.size() - 1);
   for (std::size_t k = 0; k < force->x.size(); ++k)
-    if (std::abs(force->x[k] - response->x[k]) > 1e-6 * dt || (k > 0 && std::abs(force->x[k] - force->x[k - 1] - dt) > 1e-3 * dt))
-      throw std::invalid_argument(name + ": records " + std::to_string(out.force_record) + " and " + std::to_string(out.response_record) +
-                                  " are not sampled together at a constant rate (sample " + std::to_string(k + 1) + ")");
+    if (std::abs(force->x[k] - response->x[k]) > 1e-6 * dt ||
+        (k > 0 && std::abs(force->x[k] - force->x[k - 1] - dt) > 1e-3 * dt))
+      throw std::invalid_argument(
+          name + ": records " + std::to_string(out.force_record) + " and " + std::to_string(out.response_record) +
+          " are not sampled together at a constant rate (sample " + std::to_string(k + 1) + ")");
   if (!(dt > 0.0)) throw std::invalid_argument(name + ": the time does not increase");
   double t_scale = 1.0;
-  if (const auto u = measfiles::unit_scale(force->abscissa.units); u && u->quantity == Quantity::kTime) t_scale = u->to_si;
+  if (const auto u = measfiles::unit_scale(force->abscissa.units); u && u->quantity == Quantity::kTime)
+    t_scale = u->to_si;
   out.series.fs_hz = 1.0 / (dt * t_scale);
   for (std::size_t k = 0; k < force->x.size(); ++k)
-    out.series.input.push_back(force->y[k].real() * force_si), out.series.output.push_back(response->y[k].real() * response_si);
+    out.series.input.push_back(force->y[k].real() * force_si),
+        out.series.output.push_back(response->y[k].real() * response_si);
   return out;
 }
 

@@ -31,10 +31,10 @@ struct UffSelection {
 // What an FRF record's ordinate and denominator are, in SI.
 struct FrfUnits {
   FrfKind kind{FrfKind::kReceptance};
-  double to_si{1.0};      // multiply the ordinate by it for m/N, m/s/N or m/s^2/N
-  bool per_volt{false};   // the denominator is a voltage (an actuator's FRF), not a force
+  double to_si{1.0};           // multiply the ordinate by it for m/N, m/s/N or m/s^2/N
+  bool per_volt{false};        // the denominator is a voltage (an actuator's FRF), not a force
   bool force_per_volt{false};  // an actuator's force per volt (N/V): the ordinate is a force
-  std::string shown;      // "accelerance, g/lbf read as (m/s^2)/N"
+  std::string shown;           // "accelerance, g/lbf read as (m/s^2)/N"
 };
 // Throws std::invalid_argument naming the record and the unit it does not know.
 [[nodiscard]] FrfUnits frf_units(const measfiles::UffFunction& f, int record);
@@ -62,7 +62,8 @@ struct UffSeries {
   FrfKind kind{FrfKind::kAccelerance};
   int force_record{0}, response_record{0};
 };
-[[nodiscard]] UffSeries time_series_from_uff(const measfiles::UffFile& file, const std::string& name, const UffSelection& s);
+[[nodiscard]] UffSeries time_series_from_uff(const measfiles::UffFile& file, const std::string& name,
+                                             const UffSelection& s);
 
 // Whether a file is a universal file (its first non-blank line holds -1).
 [[nodiscard]] bool looks_like_uff(const std::string& path);

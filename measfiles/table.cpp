@@ -20,7 +20,8 @@ std::string trim(const std::string& s) {
 
 std::string unquoted(std::string s) {
   s = trim(s);
-  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front()) s = trim(s.substr(1, s.size() - 2));
+  if (s.size() >= 2 && (s.front() == '"' || s.front() == '\'') && s.back() == s.front())
+    s = trim(s.substr(1, s.size() - 2));
   return s;
 }
 
@@ -113,7 +114,8 @@ bool all_units(const std::vector<std::string>& fields) {
 
 std::string normalised(const std::string& name) {
   std::string s;
-  for (char c : trim(name)) s += c == ' ' || c == '-' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  for (char c : trim(name))
+    s += c == ' ' || c == '-' ? '_' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
 }
 
@@ -148,14 +150,14 @@ Table parse_table(const std::string& text_in, const std::string& name) {
     for (std::size_t k = 0; k < f.size(); ++k) {
       double d = 0.0;
       if (!number(f[k], layout->decimal_comma, d))
-        throw std::invalid_argument(name + ":" + std::to_string(i + 1) + ": '" + unquoted(f[k]).substr(0, 40) + "' is not a number" +
-                                    (unquoted(f[k]).empty() ? " (an empty field)" : ""));
+        throw std::invalid_argument(name + ":" + std::to_string(i + 1) + ": '" + unquoted(f[k]).substr(0, 40) +
+                                    "' is not a number" + (unquoted(f[k]).empty() ? " (an empty field)" : ""));
       v.push_back(d);
     }
     if (t.columns == 0) t.columns = v.size();
     if (v.size() != t.columns)
-      throw std::invalid_argument(name + ":" + std::to_string(i + 1) + ": " + std::to_string(v.size()) + " fields where the first row has " +
-                                  std::to_string(t.columns));
+      throw std::invalid_argument(name + ":" + std::to_string(i + 1) + ": " + std::to_string(v.size()) +
+                                  " fields where the first row has " + std::to_string(t.columns));
     t.rows.push_back(std::move(v));
     t.lines.push_back(static_cast<int>(i + 1));
   }
@@ -193,8 +195,8 @@ Table read_table(const std::string& path) {
   return parse_table(s.str(), path);
 }
 
-std::vector<std::vector<double>> select_columns(const Table& t, const std::vector<ColumnSpec>& wanted, const std::string& name,
-                                                const std::string& shown) {
+std::vector<std::vector<double>> select_columns(const Table& t, const std::vector<ColumnSpec>& wanted,
+                                                const std::string& name, const std::string& shown) {
   std::vector<std::size_t> index;
   std::vector<double> scale;
   for (const auto& w : wanted) {
@@ -210,15 +212,17 @@ std::vector<std::vector<double>> select_columns(const Table& t, const std::vecto
                                     "' (the header has " + have + "); the columns are " + shown);
       }
     } else if (at >= t.columns) {
-      throw std::invalid_argument(name + ": " + std::to_string(t.columns) + " columns and no header; the columns are " + shown);
+      throw std::invalid_argument(name + ": " + std::to_string(t.columns) + " columns and no header; the columns are " +
+                                  shown);
     }
     double k = 1.0;
     const std::string unit = at < t.units.size() ? t.units[at] : "";
     if (!unit.empty() && w.quantity) {
       const auto u = unit_scale(unit);
       if (!u || u->quantity != *w.quantity)
-        throw std::invalid_argument(name + ":" + std::to_string(t.header_line) + ": column '" + w.names.front() + "' is in '" + unit +
-                                    "', not a unit of " + si_unit(*w.quantity) + " robodamp knows");
+        throw std::invalid_argument(name + ":" + std::to_string(t.header_line) + ": column '" + w.names.front() +
+                                    "' is in '" + unit + "', not a unit of " + si_unit(*w.quantity) +
+                                    " robodamp knows");
       k = u->to_si;
     }
     index.push_back(at), scale.push_back(k);

@@ -14,14 +14,14 @@
 namespace robodamp::measfiles {
 
 struct Table {
-  std::vector<std::string> names;  // per column as written, units removed (empty: the file has no header)
-  std::vector<std::string> units;  // per column as written ("" when none)
+  std::vector<std::string> names;         // per column as written, units removed (empty: the file has no header)
+  std::vector<std::string> units;         // per column as written ("" when none)
   std::vector<std::vector<double>> rows;  // every row has names.size() or columns values
   std::vector<int> lines;                 // each row's line in the file
   std::size_t columns{0};
   char delimiter{','};  // ' ' for spaces
   bool decimal_comma{false};
-  int header_line{0};   // 0: none
+  int header_line{0};  // 0: none
 };
 
 // Throws std::invalid_argument naming the file and line: no data, a row whose field count differs from

@@ -58,8 +58,8 @@ struct UffFunction {
   bool even{true};  // even abscissa: x = min + k step (record 7), not stored per point
   double z_value{0.0};
   UffAxis abscissa, ordinate, denominator, z_axis;
-  std::vector<double> x;                  // the abscissa, always filled
-  std::vector<std::complex<double>> y;    // the ordinate (imaginary 0 for real data)
+  std::vector<double> x;                // the abscissa, always filled
+  std::vector<std::complex<double>> y;  // the ordinate (imaginary 0 for real data)
   // Where it was read from (0 when built in memory).
   int dataset_index{0}, line{0};
   bool binary{false};

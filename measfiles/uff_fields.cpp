@@ -80,12 +80,12 @@ void numbers_in(const std::string& line, std::vector<double>& out, const Context
     // A sign that does not follow an exponent letter starts the next number.
     std::size_t start = 0;
     for (std::size_t i = 1; i <= w.size(); ++i) {
-      const bool cut = i == w.size() || ((w[i] == '-' || w[i] == '+') && std::string("EeDd").find(w[i - 1]) == std::string::npos);
+      const bool cut =
+          i == w.size() || ((w[i] == '-' || w[i] == '+') && std::string("EeDd").find(w[i - 1]) == std::string::npos);
       if (!cut) continue;
       double v = 0.0;
       const std::string part = w.substr(start, i - start);
-      if (!to_double(part, v))
-        throw UffError(c.where(0) + "'" + part.substr(0, 30) + "' is not a number");
+      if (!to_double(part, v)) throw UffError(c.where(0) + "'" + part.substr(0, 30) + "' is not a number");
       out.push_back(v);
       start = i;
     }
@@ -94,13 +94,14 @@ void numbers_in(const std::string& line, std::vector<double>& out, const Context
 
 Record6 record6_fields(const std::string& line, const Context& c) {
   Record6 r;
-  static const char* const kNames[] = {"function type", "function id", "version", "load case", "response node",
-                                       "response direction", "reference node", "reference direction"};
+  static const char* const kNames[] = {"function type", "function id",        "version",        "load case",
+                                       "response node", "response direction", "reference node", "reference direction"};
   const std::vector<std::string> w = words(line);
   if (w.size() == 10) {
     const int at[8] = {0, 1, 2, 3, 5, 6, 8, 9};
     bool ok = true;
-    for (int i = 0; i < 8 && ok; ++i) ok = to_int(w[static_cast<std::size_t>(at[i])], r.ints[static_cast<std::size_t>(i)]);
+    for (int i = 0; i < 8 && ok; ++i)
+      ok = to_int(w[static_cast<std::size_t>(at[i])], r.ints[static_cast<std::size_t>(i)]);
     if (ok) {
       r.response_entity = w[4], r.reference_entity = w[7];
       return r;
@@ -117,8 +118,8 @@ Record6 record6_fields(const std::string& line, const Context& c) {
 }
 
 Record7 record7_fields(const std::string& line, const Context& c) {
-  static const char* const kNames[] = {"ordinate data type", "number of values", "abscissa spacing",
-                                       "abscissa minimum", "abscissa increment", "z-axis value"};
+  static const char* const kNames[] = {"ordinate data type", "number of values",   "abscissa spacing",
+                                       "abscissa minimum",   "abscissa increment", "z-axis value"};
   std::vector<double> v;
   try {
     numbers_in(line, v, c);
@@ -138,7 +139,8 @@ Record7 record7_fields(const std::string& line, const Context& c) {
   }
   for (std::size_t i = 0; i < 3; ++i)
     if (v[i] != std::floor(v[i]) || std::abs(v[i]) > 2e9)
-      throw UffError(c.where(7) + "field " + std::to_string(i + 1) + " (" + kNames[i] + ") = " + shown(v[i]) + " is not an integer");
+      throw UffError(c.where(7) + "field " + std::to_string(i + 1) + " (" + kNames[i] + ") = " + shown(v[i]) +
+                     " is not an integer");
   return {static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<int>(v[2]), v[3], v[4], v[5]};
 }
 

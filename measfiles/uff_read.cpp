@@ -71,12 +71,13 @@ std::vector<double> binary_values(const std::string& data, std::size_t element, 
   return out;
 }
 
-void fill_values(UffFunction& f, const std::vector<double>& v, std::size_t n, double min, double step, const Context& c) {
+void fill_values(UffFunction& f, const std::vector<double>& v, std::size_t n, double min, double step,
+                 const Context& c) {
   const std::size_t per_point = (f.is_complex ? 2 : 1) + (f.even ? 0 : 1);
   if (v.size() != n * per_point)
-    throw UffError(c.where(12) + std::to_string(n * per_point) + " values expected (" + std::to_string(n) + " points, " +
-                   (f.is_complex ? "complex" : "real") + ", " + (f.even ? "even" : "uneven") + " abscissa), found " +
-                   std::to_string(v.size()));
+    throw UffError(c.where(12) + std::to_string(n * per_point) + " values expected (" + std::to_string(n) +
+                   " points, " + (f.is_complex ? "complex" : "real") + ", " + (f.even ? "even" : "uneven") +
+                   " abscissa), found " + std::to_string(v.size()));
   f.x.resize(n), f.y.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const double* p = v.data() + k * per_point;
@@ -95,7 +96,8 @@ void fill_values(UffFunction& f, const std::vector<double>& v, std::size_t n, do
 // Dataset 58: records 1-11 in ASCII, then record 12 in ASCII (data_lines) or binary (data_bytes).
 UffFunction read_function(const std::vector<std::string>& ascii, const std::vector<std::string>& data_lines,
                           const std::string* data_bytes, bool big_endian, const Context& c) {
-  if (ascii.size() < 11) throw UffError(c.where(0) + "11 header records expected, found " + std::to_string(ascii.size()));
+  if (ascii.size() < 11)
+    throw UffError(c.where(0) + "11 header records expected, found " + std::to_string(ascii.size()));
   UffFunction f;
   for (int i = 0; i < 5; ++i) f.id[i] = trimmed(ascii[i]);
   auto at = [&](int record) {  // the record's own line (binary data has none)
@@ -115,11 +117,13 @@ UffFunction read_function(const std::vector<std::string>& ascii, const std::vect
   if (r7.points <= 0 || r7.points > 100'000'000)
     throw UffError(at(7).where(7) + "field 2 (number of values) = " + std::to_string(r7.points) + ": allowed 1 .. 1e8");
   if (r7.spacing != 0 && r7.spacing != 1)
-    throw UffError(at(7).where(7) + "field 3 (abscissa spacing) = " + std::to_string(r7.spacing) + ": allowed 0 (uneven), 1 (even)");
+    throw UffError(at(7).where(7) + "field 3 (abscissa spacing) = " + std::to_string(r7.spacing) +
+                   ": allowed 0 (uneven), 1 (even)");
   f.is_complex = type >= 5, f.double_precision = type == 4 || type == 6, f.even = r7.spacing == 1;
   f.z_value = r7.z_value;
   if (f.even && !(std::isfinite(r7.min) && std::isfinite(r7.step) && r7.step > 0.0))
-    throw UffError(at(7).where(7) + "field 5 (abscissa increment) = " + detail::shown(r7.step) + ": an even abscissa needs a step > 0");
+    throw UffError(at(7).where(7) + "field 5 (abscissa increment) = " + detail::shown(r7.step) +
+                   ": an even abscissa needs a step > 0");
   f.abscissa = read_axis(ascii[7], at(8), 8), f.ordinate = read_axis(ascii[8], at(9), 9);
   f.denominator = read_axis(ascii[9], at(10), 10), f.z_axis = read_axis(ascii[10], at(11), 11);
   const auto n = static_cast<std::size_t>(r7.points);
@@ -145,7 +149,9 @@ std::vector<UffNode> read_nodes_15(const std::vector<std::string>& lines, const 
     std::vector<double> v;
     numbers_in(lines[i], v, lc);
     if (v.empty()) continue;
-    if (v.size() != 7) throw UffError(lc.where(1) + "a node needs 7 fields (label, 3 systems and colour, x, y, z), found " + std::to_string(v.size()));
+    if (v.size() != 7)
+      throw UffError(lc.where(1) + "a node needs 7 fields (label, 3 systems and colour, x, y, z), found " +
+                     std::to_string(v.size()));
     out.push_back({static_cast<int>(v[0]), {v[4], v[5], v[6]}});
   }
   return out;
@@ -176,14 +182,17 @@ std::vector<double> numbers_of(const std::string& line, const Context& c, int re
 
 // Dataset 55: normal modes (analysis type 2, real) or complex eigenvalues (3), three translations per node.
 UffMode read_mode(const std::vector<std::string>& lines, const Context& c) {
-  if (lines.size() < 8) throw UffError(c.where(0) + "at least 8 records expected, found " + std::to_string(lines.size()));
+  if (lines.size() < 8)
+    throw UffError(c.where(0) + "at least 8 records expected, found " + std::to_string(lines.size()));
   UffMode m;
   for (int i = 0; i < 5; ++i) m.id[i] = trimmed(lines[i]);
   const std::vector<double> r6 = numbers_of(lines[5], c, 6, 6);
-  const int analysis = static_cast<int>(r6[1]), characteristic = static_cast<int>(r6[2]), data_type = static_cast<int>(r6[4]);
+  const int analysis = static_cast<int>(r6[1]), characteristic = static_cast<int>(r6[2]),
+            data_type = static_cast<int>(r6[4]);
   const auto ndv = static_cast<std::size_t>(r6[5]);
   if (analysis != 2 && analysis != 3)
-    throw UffError(c.where(6) + "field 2 (analysis type) = " + std::to_string(analysis) + ": allowed 2 (normal mode), 3 (complex eigenvalue)");
+    throw UffError(c.where(6) + "field 2 (analysis type) = " + std::to_string(analysis) +
+                   ": allowed 2 (normal mode), 3 (complex eigenvalue)");
   if ((characteristic != 2 && characteristic != 3) || ndv < 3 || ndv > 6)
     throw UffError(c.where(6) + "fields 3 and 6 (data characteristic, values per node): allowed 3 or 6 DOF per node");
   const bool complex_data = data_type == 5;
@@ -234,11 +243,15 @@ Header read_header(const std::string& line, const Context& c) {
     h.binary = true;
     std::vector<double> v;
     numbers_in(t.substr(used + 1), v, c);
-    if (v.size() < 4) throw UffError(c.where(0) + "a binary dataset's header needs byte order, float format, lines and bytes");
+    if (v.size() < 4)
+      throw UffError(c.where(0) + "a binary dataset's header needs byte order, float format, lines and bytes");
     const int order = static_cast<int>(v[0]), format = static_cast<int>(v[1]);
     if (order != 1 && order != 2)
-      throw UffError(c.where(0) + "field 3 (byte ordering) = " + std::to_string(order) + ": allowed 1 (little-endian), 2 (big-endian)");
-    if (format != 2) throw UffError(c.where(0) + "field 4 (floating point format) = " + std::to_string(format) + ": only 2 (IEEE 754) is read");
+      throw UffError(c.where(0) + "field 3 (byte ordering) = " + std::to_string(order) +
+                     ": allowed 1 (little-endian), 2 (big-endian)");
+    if (format != 2)
+      throw UffError(c.where(0) + "field 4 (floating point format) = " + std::to_string(format) +
+                     ": only 2 (IEEE 754) is read");
     h.big_endian = order == 2, h.ascii_lines = static_cast<int>(v[2]), h.bytes = static_cast<long long>(v[3]);
     if (h.ascii_lines != 11 || h.bytes < 0)
       throw UffError(c.where(0) + "fields 5 and 6 (ASCII lines, bytes) = " + std::to_string(h.ascii_lines) + ", " +
@@ -267,7 +280,8 @@ UffFile parse_uff(const std::string& bytes, const std::string& name) {
     std::string data;
     bool closed = false;
     if (h.binary) {
-      if (h.number != 58) throw UffError(c.where(0) + "binary dataset " + std::to_string(h.number) + " is not read (58b is)");
+      if (h.number != 58)
+        throw UffError(c.where(0) + "binary dataset " + std::to_string(h.number) + " is not read (58b is)");
       for (int i = 0; i < h.ascii_lines; ++i)
         if (cur.next(line)) lines.push_back(line);
       if (cur.pos + static_cast<std::size_t>(h.bytes) > bytes.size())

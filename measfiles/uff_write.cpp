@@ -70,7 +70,8 @@ std::string function_dataset(const UffFunction& f, UffEncoding encoding) {
   if (binary) {
     for (double x : v) put_double(data, x);
   } else if (even) {  // 4E20.12
-    for (std::size_t i = 0; i < v.size(); ++i) data += printf_line("%20.11E", v[i]).substr(0, 20) + ((i % 4 == 3 || i + 1 == v.size()) ? "\n" : "");
+    for (std::size_t i = 0; i < v.size(); ++i)
+      data += printf_line("%20.11E", v[i]).substr(0, 20) + ((i % 4 == 3 || i + 1 == v.size()) ? "\n" : "");
   } else {  // real: 2(E13.5,E20.12); complex: E13.5,2E20.12
     const std::size_t per = f.is_complex ? 3 : 2, per_line = f.is_complex ? 3 : 4;
     for (std::size_t i = 0; i < v.size(); ++i) {

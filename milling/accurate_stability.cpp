@@ -25,8 +25,9 @@ AccurateStability::AccurateStability(const Structure& structure, const config::M
     sampled_ = std::make_unique<SampledSdm>(structure, cutter, job.material, cut.mode, cut.radial_mm, cut.feed_axis, s);
   } else {
     method_ = "SDM";
-    open_ = std::make_unique<SdmModel>(cutter_modal_terms(structure, cut.feed_axis), cutter, job.material, cut.mode,
-                                       cut.radial_mm, job.time_domain.axial_slices, job.time_domain.sdm_steps_per_period);
+    open_ =
+        std::make_unique<SdmModel>(cutter_modal_terms(structure, cut.feed_axis), cutter, job.material, cut.mode,
+                                   cut.radial_mm, job.time_domain.axial_slices, job.time_domain.sdm_steps_per_period);
   }
 }
 
@@ -36,7 +37,8 @@ double AccurateStability::max_rpm() const {
 
 std::optional<std::string> AccurateStability::speed_problem(double rpm) const {
   if (sampled_) return sampled_speed_problem(rpm, teeth_, sampled_->loop_rate_hz());
-  if (!(rpm > 0.0) || !std::isfinite(rpm)) return "spindle speed = " + std::to_string(rpm) + " rpm: must be > 0 and finite";
+  if (!(rpm > 0.0) || !std::isfinite(rpm))
+    return "spindle speed = " + std::to_string(rpm) + " rpm: must be > 0 and finite";
   return std::nullopt;
 }
 
@@ -69,11 +71,13 @@ std::complex<double> AccurateStability::multiplier(double axial_mm, double rpm) 
   return sampled_ ? sampled_->multiplier(axial_mm, rpm) : open_->multiplier(axial_mm, rpm);
 }
 
-std::vector<bool> AccurateStability::stable(double axial_mm, const std::vector<double>& rpm, std::size_t threads) const {
+std::vector<bool> AccurateStability::stable(double axial_mm, const std::vector<double>& rpm,
+                                            std::size_t threads) const {
   std::vector<char> out(rpm.size(), 0);  // not vector<bool>: the tasks write their own elements
   std::vector<std::function<void()>> tasks;
   tasks.reserve(rpm.size());
-  for (std::size_t i = 0; i < rpm.size(); ++i) tasks.emplace_back([&, i] { out[i] = stable(axial_mm, rpm[i]) ? 1 : 0; });
+  for (std::size_t i = 0; i < rpm.size(); ++i)
+    tasks.emplace_back([&, i] { out[i] = stable(axial_mm, rpm[i]) ? 1 : 0; });
   analysis::run_tasks(tasks, analysis::task_threads(threads));
   return {out.begin(), out.end()};
 }

@@ -50,7 +50,8 @@ class AccurateStability {
   [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
   [[nodiscard]] bool stable(double axial_mm, double rpm) const { return std::abs(multiplier(axial_mm, rpm)) < 1.0; }
   // The same at many speeds on `threads` threads (0: one per core); every speed must be analysable.
-  [[nodiscard]] std::vector<bool> stable(double axial_mm, const std::vector<double>& rpm, std::size_t threads = 0) const;
+  [[nodiscard]] std::vector<bool> stable(double axial_mm, const std::vector<double>& rpm,
+                                         std::size_t threads = 0) const;
 
  private:
   std::string method_;
@@ -64,15 +65,15 @@ class AccurateStability {
 // job's lobes range (those the method can step; the sampled loop stops at max_rpm()), each from the
 // zero-order limit there as the first guess, on `threads` threads (0: one per core).
 struct AccurateDiagram {
-  std::string method;                // AccurateStability::method()
+  std::string method;  // AccurateStability::method()
   int grid_per_period{0};
-  std::vector<SdmPoint> curve;       // by speed
-  SdmPoint minimum;                  // the curve's shallowest point (critical_depth_mm infinite if none)
-  std::size_t speeds_left_out{0};    // above the method's highest speed
+  std::vector<SdmPoint> curve;     // by speed
+  SdmPoint minimum;                // the curve's shallowest point (critical_depth_mm infinite if none)
+  std::size_t speeds_left_out{0};  // above the method's highest speed
   double max_rpm{0.0};
 };
-[[nodiscard]] AccurateDiagram accurate_diagram(const Structure& structure, const config::MillingConfig& job,
-                                               std::size_t threads = 0,
-                                               const std::function<void(std::size_t done, std::size_t of)>& progress = {});
+[[nodiscard]] AccurateDiagram accurate_diagram(
+    const Structure& structure, const config::MillingConfig& job, std::size_t threads = 0,
+    const std::function<void(std::size_t done, std::size_t of)>& progress = {});
 
 }  // namespace robodamp::milling

@@ -16,10 +16,14 @@ namespace robodamp::milling {
 
 const char* to_string(CutClass c) {
   switch (c) {
-    case CutClass::kStable: return "stable";
-    case CutClass::kHopf: return "hopf";
-    case CutClass::kFlip: return "flip";
-    case CutClass::kOutOfCut: return "out_of_cut";
+    case CutClass::kStable:
+      return "stable";
+    case CutClass::kHopf:
+      return "hopf";
+    case CutClass::kFlip:
+      return "flip";
+    case CutClass::kOutOfCut:
+      return "out_of_cut";
   }
   return "?";
 }
@@ -28,7 +32,7 @@ namespace {
 
 struct OneSignal {
   double ratio{0.0}, growth{-1e300}, nonharmonic{0.0}, chatter_hz{0.0}, chatter_energy{0.0};
-  double persistence{0.0};  // RMS of the differences in the last quarter over the second
+  double persistence{0.0};         // RMS of the differences in the last quarter over the second
   std::complex<double> root{0.0};  // the dominant multiplier's estimate
   Eigen::VectorXcd roots;          // the autoregressive model's roots (root is the largest)
   bool settled{true};
@@ -105,7 +109,8 @@ Eigen::VectorXcd floquet_shape(const std::vector<double>& x, std::size_t start, 
     }
   const Eigen::MatrixXd coef = a.completeOrthogonalDecomposition().solve(b);
   Eigen::VectorXcd q(static_cast<Eigen::Index>(n));
-  for (Eigen::Index s = 0; s < q.size(); ++s) q(s) = std::complex<double>(coef(0, s), -coef(1, s));  // Re(q z) = a Re z - b Im z
+  for (Eigen::Index s = 0; s < q.size(); ++s)
+    q(s) = std::complex<double>(coef(0, s), -coef(1, s));  // Re(q z) = a Re z - b Im z
   return q;
 }
 
@@ -158,7 +163,7 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
     // (a large transient of a slow mode elsewhere in the spectrum is not one of them).
     if (std::abs(o.root) > 0.0) {
       const double fp = fs / static_cast<double>(period), df = fs / static_cast<double>(whole);
-      const double alias_hz = std::abs(std::arg(o.root)) / (kTwoPi) * fp;
+      const double alias_hz = std::abs(std::arg(o.root)) / (kTwoPi)*fp;
       double best_candidate = -1.0;
       for (std::size_t k = 0; (static_cast<double>(k) + 1.0) * fp <= 0.5 * fs; ++k)
         for (const double f : {static_cast<double>(k) * fp + alias_hz, static_cast<double>(k + 1) * fp - alias_hz}) {
@@ -176,8 +181,9 @@ OneSignal analyse(const std::vector<double>& x, std::size_t start, std::size_t p
 // The chatter frequency of the dominant Floquet mode (multiplier mu) the signals share, as SDM takes it from
 // its critical eigenvector: the strongest harmonic of the mode's periodic factor, the x and y displacements'
 // energies summed (floquet_chatter_hz). 0 when the mode cannot be fitted.
-double shape_chatter_hz(const std::vector<const std::vector<double>*>& signals, const std::vector<Eigen::VectorXcd>& roots,
-                        std::size_t start, std::size_t n, double fs, std::complex<double> mu) {
+double shape_chatter_hz(const std::vector<const std::vector<double>*>& signals,
+                        const std::vector<Eigen::VectorXcd>& roots, std::size_t start, std::size_t n, double fs,
+                        std::complex<double> mu) {
   if (signals.empty() || signals.size() > 2 || !(std::abs(mu) > 0.0)) return 0.0;
   const std::size_t periods = (signals[0]->size() - start) / n;
   Eigen::VectorXcd history = Eigen::VectorXcd::Zero(static_cast<Eigen::Index>(2 * n));
@@ -239,7 +245,8 @@ ChatterVerdict detect_chatter(const std::vector<const std::vector<double>*>& sig
   }
   // The chatter frequency as SDM defines it (floquet_chatter_hz): the growing Floquet mode's strongest harmonic.
   // The spectrum's strongest candidate stays where the mode cannot be fitted.
-  if (const double hz = shape_chatter_hz(signals, roots, start, static_cast<std::size_t>(samples_per_period), fs, root); hz > 0.0)
+  if (const double hz = shape_chatter_hz(signals, roots, start, static_cast<std::size_t>(samples_per_period), fs, root);
+      hz > 0.0)
     v.chatter_hz = hz;
   // Period doubling: the dominant multiplier real and negative (within 3 degrees of -1's direction).
   const bool flip = root.real() < 0.0 && std::abs(root.imag()) < t.flip_angle * std::abs(root);

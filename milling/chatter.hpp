@@ -20,13 +20,13 @@ enum class CutClass { kStable, kHopf, kFlip, kOutOfCut };
 [[nodiscard]] const char* to_string(CutClass c);
 
 struct ChatterThresholds {
-  double growth_per_period{0.0};      // growth of the once-per-period differences above which it chatters
-  double neutral_growth{1e-3};        // margin on growth_per_period (the multiplier's magnitude is estimated)
-  double persistence{0.9};            // differences keeping this share of their RMS over half the window ...
-  double limit_cycle_ratio{0.1};      // ... at this share of the motion or more: a limit cycle, chatter
-  double out_of_cut_share{1e-3};      // chatter with more engaged steps without a chip is "out of cut"
-  double settled_ratio{1e-6};         // differences below this share of the signal are settled (stable)
-  double flip_angle{0.05};            // dominant multiplier's |imag| / |mu| below this, real part < 0: flip
+  double growth_per_period{0.0};  // growth of the once-per-period differences above which it chatters
+  double neutral_growth{1e-3};    // margin on growth_per_period (the multiplier's magnitude is estimated)
+  double persistence{0.9};        // differences keeping this share of their RMS over half the window ...
+  double limit_cycle_ratio{0.1};  // ... at this share of the motion or more: a limit cycle, chatter
+  double out_of_cut_share{1e-3};  // chatter with more engaged steps without a chip is "out of cut"
+  double settled_ratio{1e-6};     // differences below this share of the signal are settled (stable)
+  double flip_angle{0.05};        // dominant multiplier's |imag| / |mu| below this, real part < 0: flip
 };
 
 struct ChatterVerdict {
@@ -36,10 +36,10 @@ struct ChatterVerdict {
   // dominant multiplier is real and negative (the once-per-period samples alternate), kHopf otherwise;
   // kStable for a stable cut.
   CutClass mechanism{CutClass::kStable};
-  double chatter_hz{0.0};                 // the growing mode's strongest harmonic (0 when stable)
-  double once_per_period_ratio{0.0};      // RMS of the differences over the signal's RMS (last half)
-  double nonharmonic_energy_ratio{0.0};   // 0..1, DC excluded
-  double growth_per_period{0.0};          // ln(multiplier): < 0 decays, > 0 grows
+  double chatter_hz{0.0};                // the growing mode's strongest harmonic (0 when stable)
+  double once_per_period_ratio{0.0};     // RMS of the differences over the signal's RMS (last half)
+  double nonharmonic_energy_ratio{0.0};  // 0..1, DC excluded
+  double growth_per_period{0.0};         // ln(multiplier): < 0 decays, > 0 grows
   double out_of_cut_share{0.0};
 };
 

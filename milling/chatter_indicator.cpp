@@ -19,7 +19,8 @@ int forced_lines_per_revolution(const config::MillingConfig& job) {
 std::vector<double> modes_above_band(const config::MillingConfig& job, const std::string& structure_name,
                                      double sample_rate_hz) {
   std::vector<double> above;
-  const config::StructureConfig* structure = job.find_structure(structure_name.empty() ? job.structure : structure_name);
+  const config::StructureConfig* structure =
+      job.find_structure(structure_name.empty() ? job.structure : structure_name);
   if (structure == nullptr && structure_name.empty() && !job.structures.empty()) structure = &job.structures.front();
   if (structure != nullptr)
     for (const auto& part : structure->parts)
@@ -31,8 +32,7 @@ std::vector<double> modes_above_band(const config::MillingConfig& job, const std
   return above;
 }
 
-ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s)
-    : fs_(sample_rate_hz), s_(s) {
+ChatterMonitor::ChatterMonitor(double sample_rate_hz, ChatterIndicatorSettings s) : fs_(sample_rate_hz), s_(s) {
   ring_.assign(static_cast<std::size_t>(std::ceil(s_.max_window_s * fs_)), 0.0);
   gap_.assign(ring_.size(), 0);
   window_.reserve(ring_.size());
@@ -60,7 +60,8 @@ bool ChatterMonitor::fill_window(double f_sp, ChatterIndicator& out) {
   if (static_cast<double>(n) < std::floor(want_s * fs_) || n < 64) return false;
   // Held samples put steps into the signal, which spread over the spectrum: too many, no verdict.
   std::size_t gaps = 0;
-  for (std::size_t i = 0, at = (head_ + ring_.size() - n) % ring_.size(); i < n; ++i) gaps += gap_[(at + i) % ring_.size()];
+  for (std::size_t i = 0, at = (head_ + ring_.size() - n) % ring_.size(); i < n; ++i)
+    gaps += gap_[(at + i) % ring_.size()];
   out.gap_share = static_cast<double>(gaps) / static_cast<double>(n);
   if (out.gap_share > s_.max_gap_share) return false;
 
@@ -107,7 +108,9 @@ void ChatterMonitor::time_measures(double f_sp, ChatterIndicator& out) const {
   double diff_ss = 0.0;
   for (const double ss_part : part_ss) diff_ss += ss_part;
   out.once_per_rev_ratio = n > first ? std::sqrt(diff_ss / static_cast<double>(n - first)) / out.rms_mps2 : 0.0;
-  const auto rms_of = [](double ss_part, std::size_t count) { return count ? std::sqrt(ss_part / static_cast<double>(count)) : 0.0; };
+  const auto rms_of = [](double ss_part, std::size_t count) {
+    return count ? std::sqrt(ss_part / static_cast<double>(count)) : 0.0;
+  };
   double p_min = INFINITY, p_max = 0.0, q_rms[4] = {0.0, 0.0, 0.0, 0.0};
   for (int p = 0; p < kParts; ++p) {
     const double r = rms_of(part_ss[p], part_n[p]);
@@ -183,8 +186,8 @@ ChatterIndicator ChatterMonitor::evaluate(double spindle_rpm) {
   time_measures(f_sp, out);
   spectrum_measures(f_sp, out);
   out.valid = true;
-  out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold && out.nonharmonic_share > s_.nonharmonic_threshold &&
-                out.nonharmonic_rms_mps2 > s_.floor_mps2 &&
+  out.chatter = out.once_per_rev_ratio > s_.once_per_rev_threshold &&
+                out.nonharmonic_share > s_.nonharmonic_threshold && out.nonharmonic_rms_mps2 > s_.floor_mps2 &&
                 (out.persistence > s_.persistence_threshold || out.growing) && out.trend > s_.fading_threshold;
   return out;
 }

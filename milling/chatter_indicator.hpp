@@ -38,7 +38,7 @@ struct ChatterIndicatorSettings {
   // of the displacement's energy off the harmonics, and 7 of 8 windows of a chattering cut read stable
   // (tests/test_chatter_listen.cpp); with 4 s, 47-51 %.
   double window_s{4.0};
-  double max_window_s{8.0};          // the buffer
+  double max_window_s{8.0};  // the buffer
   int min_revolutions{12};
   double band_min_hz{5.0};
   // The forced lines: every spindle harmonic (1: a spindle with runout, each tooth cutting its own chip)
@@ -50,7 +50,7 @@ struct ChatterIndicatorSettings {
   // stable: 0.02 and 0.0001; 2.5 mm, chatter at 24.1 Hz: 0.33 and 0.26.
   double once_per_rev_threshold{0.2};
   double nonharmonic_threshold{0.1};
-  double floor_mps2{0.05};           // non-harmonic RMS below this is not chatter
+  double floor_mps2{0.05};  // non-harmonic RMS below this is not chatter
   // Quietest / loudest eighth of the window: an impact ringing on the undamped 9.2 Hz mode (decay time
   // 0.87 s), hit every 2 s (`run`'s default), leaves the eighth before the next hit 1.5 s after the last:
   // about exp(-1.5 s / 0.87 s) = 0.18.
@@ -72,21 +72,21 @@ struct ChatterIndicatorSettings {
 };
 
 struct ChatterIndicator {
-  bool valid{false};                 // enough samples at a turning spindle
+  bool valid{false};  // enough samples at a turning spindle
   double once_per_rev_ratio{0.0};
-  double nonharmonic_share{0.0};     // 0..1, of the displacement's energy
+  double nonharmonic_share{0.0};  // 0..1, of the displacement's energy
   double nonharmonic_rms_mps2{0.0};
-  double chatter_hz{0.0};            // strongest non-harmonic line (0 when none)
+  double chatter_hz{0.0};  // strongest non-harmonic line (0 when none)
   double rms_mps2{0.0};
   // The forced lines over the noise: the mean energy per bin on the spindle harmonics (the two bins either
   // side of each) over the median per bin elsewhere (the noise floor; a chatter peak barely moves a median).
   // About 1 without a cut (an air cut, the spindle turning free); a cut's tooth-passing lines are far above.
   double forced_lines_snr{0.0};
-  bool forced_lines{false};          // forced_lines_snr >= forced_lines_threshold
-  double persistence{0.0};           // x(t) - x(t - 1 rev): RMS of the quietest eighth / the loudest
-  double trend{0.0};                 // the same, the last quarter / the first
-  bool growing{false};               // each quarter louder than the one before (growing_step)
-  double gap_share{0.0};             // held (not fresh) samples in the window
+  bool forced_lines{false};  // forced_lines_snr >= forced_lines_threshold
+  double persistence{0.0};   // x(t) - x(t - 1 rev): RMS of the quietest eighth / the loudest
+  double trend{0.0};         // the same, the last quarter / the first
+  bool growing{false};       // each quarter louder than the one before (growing_step)
+  double gap_share{0.0};     // held (not fresh) samples in the window
   bool chatter{false};
 };
 
@@ -135,7 +135,7 @@ class ChatterMonitor {
   std::vector<double> ring_;
   std::vector<std::uint8_t> gap_;
   std::size_t head_{0}, count_{0};
-  std::vector<double> window_;  // the analysed span, oldest first
+  std::vector<double> window_;    // the analysed span, oldest first
   std::vector<double> off_bins_;  // the energies of the bins off the harmonics (their median)
   std::unique_ptr<analysis::RealFft> fft_;
   std::size_t fft_n_{0};

@@ -29,10 +29,13 @@ std::vector<bool> clean(std::vector<double>& x, ListenReport& r) {
   }
   const double n = static_cast<double>(x.size()), mean = sum / n, rms = std::sqrt(std::max(0.0, sq / n - mean * mean));
   if (bad > 0)
-    r.warnings.push_back(fmt("%zu samples are not finite (dropouts): held at the last value; a window with more than 1 %% of them "
-                             "gets no verdict", bad));
+    r.warnings.push_back(
+        fmt("%zu samples are not finite (dropouts): held at the last value; a window with more than 1 %% of them "
+            "gets no verdict",
+            bad));
   if (std::abs(mean) > 0.1 * rms && rms > 0.0)
-    r.warnings.push_back(fmt("a DC offset of %.4g (%.0f %% of the signal's RMS) was removed", mean, 100.0 * std::abs(mean) / rms));
+    r.warnings.push_back(
+        fmt("a DC offset of %.4g (%.0f %% of the signal's RMS) was removed", mean, 100.0 * std::abs(mean) / rms));
   for (double& v : x) v -= mean;
   // Clipping: runs of 3 or more samples at the record's extreme value.
   const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
@@ -41,8 +44,10 @@ std::vector<bool> clean(std::vector<double>& x, ListenReport& r) {
     for (const double edge : {*lo, *hi})
       if (x[i] == edge && x[i - 1] == edge && x[i - 2] == edge) ++clipped;
   if (clipped > x.size() / 1000)
-    r.warnings.push_back(fmt("clipped: %.2f %% of the samples sit at the recorder's limit (%.4g / %.4g): the vibration there is "
-                             "larger than recorded", 100.0 * static_cast<double>(clipped) / n, *lo + mean, *hi + mean));
+    r.warnings.push_back(
+        fmt("clipped: %.2f %% of the samples sit at the recorder's limit (%.4g / %.4g): the vibration there is "
+            "larger than recorded",
+            100.0 * static_cast<double>(clipped) / n, *lo + mean, *hi + mean));
   return gap;
 }
 
@@ -99,12 +104,14 @@ void spectrogram(const std::vector<double>& x, double rate_hz, std::size_t n, do
     r.spectrogram_hz.push_back(std::sqrt(static_cast<double>(first[g]) * static_cast<double>(first[g + 1] - 1)) * df);
   for (std::size_t b = 0; b + len <= x.size(); b += hop) {
     for (std::size_t i = 0; i < len; ++i)
-      fft.input()[i] = x[b + i] * 0.5 * (1.0 - std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(len)));
+      fft.input()[i] =
+          x[b + i] * 0.5 * (1.0 - std::cos(2.0 * M_PI * static_cast<double>(i) / static_cast<double>(len)));
     const std::complex<double>* X = fft.forward();
     std::vector<double> col;
     for (std::size_t g = 0; g + 1 < first.size(); ++g) {
       double m = 0.0;
-      for (std::size_t k = first[g]; k < first[g + 1]; ++k) m = std::max(m, std::abs(X[k]) * 4.0 / static_cast<double>(len));
+      for (std::size_t k = first[g]; k < first[g + 1]; ++k)
+        m = std::max(m, std::abs(X[k]) * 4.0 / static_cast<double>(len));
       col.push_back(20.0 * std::log10(std::max(m, 1e-12)));
     }
     r.spectrogram_t_s.push_back((static_cast<double>(b) + 0.5 * static_cast<double>(len)) / rate_hz);
@@ -140,14 +147,18 @@ double refined_onset(const std::vector<double>& x, double rate_hz, double rpm, d
 
 const char* to_string(WindowVerdict v) {
   switch (v) {
-    case WindowVerdict::kStable: return "stable";
-    case WindowVerdict::kChatter: return "chatter";
-    case WindowVerdict::kNoSignal: return "not enough signal";
+    case WindowVerdict::kStable:
+      return "stable";
+    case WindowVerdict::kChatter:
+      return "chatter";
+    case WindowVerdict::kNoSignal:
+      return "not enough signal";
   }
   return "";
 }
 
-std::optional<RpmEstimate> estimate_rpm(const std::vector<double>& x, double rate_hz, int teeth, double rpm_min, double rpm_max) {
+std::optional<RpmEstimate> estimate_rpm(const std::vector<double>& x, double rate_hz, int teeth, double rpm_min,
+                                        double rpm_max) {
   const double top = 0.4 * rate_hz;
   const auto segment = static_cast<std::size_t>(std::min<double>(static_cast<double>(x.size()), 8.0 * rate_hz));
   if (segment < 64) return std::nullopt;
@@ -189,10 +200,14 @@ std::optional<RpmEstimate> estimate_rpm(const std::vector<double>& x, double rat
   for (int k = 1; k < teeth; ++k) below = std::max(below, line(p, df, k * f0));
   const bool spindle = teeth > 1 && teeth * f0 < top && line(p, df, teeth * f0) > below;
   out.rpm = 60.0 * (spindle ? f0 : f0 / teeth);
-  out.how = spindle ? fmt("estimated from the spindle's harmonics (%.4g Hz; its harmonic %d is the tooth-passing line), %.0f %% "
-                          "of the spectrum on the comb", f0, teeth, 100.0 * out.comb_share)
-                    : fmt("estimated from the tooth-passing harmonics (%.4g Hz for %d teeth), %.0f %% of the spectrum on the comb",
-                          f0, teeth, 100.0 * out.comb_share);
+  out.how =
+      spindle
+          ? fmt("estimated from the spindle's harmonics (%.4g Hz; its harmonic %d is the tooth-passing line), %.0f %% "
+                "of the spectrum on the comb",
+                f0, teeth, 100.0 * out.comb_share)
+          : fmt("estimated from the tooth-passing harmonics (%.4g Hz for %d teeth), %.0f %% of the spectrum on the "
+                "comb",
+                f0, teeth, 100.0 * out.comb_share);
   if (out.rpm < rpm_min || out.rpm > rpm_max) return std::nullopt;
   return out;
 }
@@ -235,8 +250,38 @@ std::vector<double> listening_speed(const RecordedSignal& sig, const ListenSetti
 
 }  // namespace
 
+namespace {
+
+// The window of n samples from b: its speed (rpm_at's median over it, else rpm), its indicator and verdict.
+ListenWindow judge_window(ChatterMonitor& monitor, const std::vector<double>& x, const std::vector<bool>& gap,
+                          const std::vector<double>& rpm_at, std::size_t b, std::size_t n, double rate_hz, double rpm) {
+  monitor.reset();
+  for (std::size_t i = b; i < b + n; ++i) monitor.push(x[i], !gap[i]);
+  ListenWindow w;
+  w.start_s = static_cast<double>(b) / rate_hz, w.end_s = static_cast<double>(b + n) / rate_hz;
+  w.rpm = rpm;
+  // The speed that held over the window (the median: a change mid-window shows as the larger part).
+  if (rpm_at.size() >= b + n) {
+    std::vector<double> in(rpm_at.begin() + static_cast<long>(b), rpm_at.begin() + static_cast<long>(b + n));
+    std::nth_element(in.begin(), in.begin() + static_cast<long>(in.size() / 2), in.end());
+    w.rpm = in[in.size() / 2];
+  }
+  w.indicator = w.rpm > 0.0 ? monitor.evaluate(w.rpm) : ChatterIndicator{};
+  w.rms = w.indicator.rms_mps2, w.chatter_share = w.indicator.nonharmonic_share;
+  // Not enough signal: no verdict (dropouts, not a full window), or no cut heard (neither chatter nor the
+  // spindle's forced lines above the noise: an air cut). A quiet cut whose lines stand out is stable.
+  if (!w.indicator.valid || (!w.indicator.chatter && !w.indicator.forced_lines))
+    w.verdict = WindowVerdict::kNoSignal;
+  else
+    w.verdict = w.indicator.chatter ? WindowVerdict::kChatter : WindowVerdict::kStable;
+  return w;
+}
+
+}  // namespace
+
 ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
-  if (s.teeth < 1 || s.teeth > 32) throw std::invalid_argument("teeth = " + std::to_string(s.teeth) + ": allowed 1 .. 32");
+  if (s.teeth < 1 || s.teeth > 32)
+    throw std::invalid_argument("teeth = " + std::to_string(s.teeth) + ": allowed 1 .. 32");
   if (!(sig.rate_hz > 0.0)) throw std::invalid_argument(sig.source + ": no sample rate");
   ListenReport r;
   r.rate_hz = sig.rate_hz, r.samples = sig.samples.size();
@@ -244,8 +289,8 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   if (duration_s < s.window_s)
     throw std::invalid_argument(sig.source + fmt(": %.3g s recorded; one window needs %.3g s", duration_s, s.window_s));
   if (sig.rate_hz < 2.0 * s.indicator.band_min_hz * 4.0)
-    throw std::invalid_argument(sig.source + fmt(": %.4g Hz is too low a rate for a chatter band from %.3g Hz", sig.rate_hz,
-                                                   s.indicator.band_min_hz));
+    throw std::invalid_argument(sig.source + fmt(": %.4g Hz is too low a rate for a chatter band from %.3g Hz",
+                                                 sig.rate_hz, s.indicator.band_min_hz));
   std::vector<double> x = sig.samples;
   std::vector<bool> gap = clean(x, r);
   const auto d = static_cast<std::size_t>(std::max(1.0, std::floor(sig.rate_hz / (2.5 * s.max_hz))));
@@ -254,19 +299,25 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   const std::vector<double> rpm_at = listening_speed(sig, s, x, d, r);
   const double tooth_hz = s.teeth * r.rpm / 60.0;
   if (tooth_hz > 0.45 * r.analysed_rate_hz)
-    r.warnings.push_back(fmt("the tooth-passing frequency (%.4g Hz) is above the analysed band (%.4g Hz): only the spindle's "
-                             "lower harmonics are seen", tooth_hz, 0.45 * r.analysed_rate_hz));
+    r.warnings.push_back(
+        fmt("the tooth-passing frequency (%.4g Hz) is above the analysed band (%.4g Hz): only the spindle's "
+            "lower harmonics are seen",
+            tooth_hz, 0.45 * r.analysed_rate_hz));
   // A band narrower than the recording's: a chatter above it is not seen (docs/milling.md, "One chatter
   // frequency": the industrial robot's 5.5 kHz chatter read stable in a 1 kHz band).
   if (0.5 * sig.rate_hz > 1.5 * s.max_hz)
-    r.warnings.push_back(fmt("analysed up to %.4g Hz of the %.4g Hz the recording holds (--max-hz): a chatter above it (a spindle or "
-                             "tool mode's) is not seen", s.max_hz, 0.5 * sig.rate_hz));
+    r.warnings.push_back(
+        fmt("analysed up to %.4g Hz of the %.4g Hz the recording holds (--max-hz): a chatter above it (a spindle or "
+            "tool mode's) is not seen",
+            s.max_hz, 0.5 * sig.rate_hz));
   ChatterIndicatorSettings is = s.indicator;
   is.window_s = s.window_s, is.max_window_s = std::max(is.max_window_s, s.window_s);
-  if (s.floor) is.floor_mps2 = *s.floor;
+  if (s.floor)
+    is.floor_mps2 = *s.floor;
   else if (!sig.acceleration_mps2) {
     is.floor_mps2 = 0.0;
-    r.warnings.push_back("the signal is not an acceleration in m/s^2 (" + (sig.unit.empty() ? std::string("no unit") : sig.unit) +
+    r.warnings.push_back("the signal is not an acceleration in m/s^2 (" +
+                         (sig.unit.empty() ? std::string("no unit") : sig.unit) +
                          "): no floor, so noise alone may read as chatter; give --floor in its unit");
   }
   ChatterMonitor monitor(r.analysed_rate_hz, is);
@@ -274,22 +325,7 @@ ListenReport listen(const RecordedSignal& sig, const ListenSettings& s) {
   std::vector<double> found;
   double onset_rpm = r.rpm;
   for (std::size_t b = 0; b + n <= x.size(); b += n) {
-    monitor.reset();
-    for (std::size_t i = b; i < b + n; ++i) monitor.push(x[i], !gap[i]);
-    ListenWindow w;
-    w.start_s = static_cast<double>(b) / r.analysed_rate_hz, w.end_s = static_cast<double>(b + n) / r.analysed_rate_hz;
-    w.rpm = r.rpm;
-    if (rpm_at.size() >= b + n) {  // the speed that held over the window (the median: a change mid-window shows as the larger part)
-      std::vector<double> in(rpm_at.begin() + static_cast<long>(b), rpm_at.begin() + static_cast<long>(b + n));
-      std::nth_element(in.begin(), in.begin() + static_cast<long>(in.size() / 2), in.end());
-      w.rpm = in[in.size() / 2];
-    }
-    w.indicator = w.rpm > 0.0 ? monitor.evaluate(w.rpm) : ChatterIndicator{};
-    w.rms = w.indicator.rms_mps2, w.chatter_share = w.indicator.nonharmonic_share;
-    // Not enough signal: no verdict (dropouts, not a full window), or no cut heard (neither chatter nor the
-    // spindle's forced lines above the noise: an air cut). A quiet cut whose lines stand out is stable.
-    if (!w.indicator.valid || (!w.indicator.chatter && !w.indicator.forced_lines)) w.verdict = WindowVerdict::kNoSignal;
-    else w.verdict = w.indicator.chatter ? WindowVerdict::kChatter : WindowVerdict::kStable;
+    ListenWindow w = judge_window(monitor, x, gap, rpm_at, b, n, r.analysed_rate_hz, r.rpm);
     if (w.verdict == WindowVerdict::kChatter) {
       w.chatter_hz = w.indicator.chatter_hz, found.push_back(w.chatter_hz);
       if (!r.onset_s) r.onset_s = w.start_s, onset_rpm = w.rpm;

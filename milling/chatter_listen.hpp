@@ -24,17 +24,17 @@ struct RecordedSignal {
   // The spindle speed per sample when the recording holds it (a speed column, a robodamp recording's
   // spindle commands); empty: one speed for the whole recording.
   std::vector<double> rpm;
-  std::string rpm_from;          // where it came from
+  std::string rpm_from;  // where it came from
 };
 
 struct ListenSettings {
-  int teeth{0};                       // required
-  std::optional<double> rpm;          // nullopt: estimated
+  int teeth{0};                             // required
+  std::optional<double> rpm;                // nullopt: estimated
   double rpm_min{100.0}, rpm_max{30000.0};  // where the estimate searches (and the speeds to try lie)
-  double max_hz{1000.0};              // the band analysed: decimated to about 2.5 x this
-  double window_s{4.0};               // one verdict per window (the indicator's span: chatter_indicator.hpp)
-  std::optional<double> floor;        // non-harmonic RMS below it is not chatter, in the signal's unit
-                                      // (default: the indicator's 0.05 m/s^2 for an acceleration)
+  double max_hz{1000.0};                    // the band analysed: decimated to about 2.5 x this
+  double window_s{4.0};                     // one verdict per window (the indicator's span: chatter_indicator.hpp)
+  std::optional<double> floor;              // non-harmonic RMS below it is not chatter, in the signal's unit
+                                            // (default: the indicator's 0.05 m/s^2 for an acceleration)
   ChatterIndicatorSettings indicator;
 };
 
@@ -43,12 +43,12 @@ enum class WindowVerdict { kStable, kChatter, kNoSignal };
 
 struct ListenWindow {
   double start_s{0.0}, end_s{0.0};
-  double rpm{0.0};            // the speed the window was judged at
+  double rpm{0.0};  // the speed the window was judged at
   WindowVerdict verdict{WindowVerdict::kNoSignal};
   double chatter_hz{0.0};
-  double chatter_share{0.0};  // the non-harmonic share of the displacement's energy
-  double rms{0.0};            // in the signal's unit
-  ChatterIndicator indicator; // the indicator's figures
+  double chatter_share{0.0};   // the non-harmonic share of the displacement's energy
+  double rms{0.0};             // in the signal's unit
+  ChatterIndicator indicator;  // the indicator's figures
 };
 
 struct SpeedToTry {
@@ -61,11 +61,11 @@ struct ListenReport {
   std::optional<double> onset_s, end_s;  // the first chatter window's start, the last one's end
   double chatter_hz{0.0};                // median over the chatter windows (0: none)
   double rpm{0.0};
-  std::string rpm_source;                // "given", or how it was estimated and how sure
+  std::string rpm_source;  // "given", or how it was estimated and how sure
   double rate_hz{0.0}, analysed_rate_hz{0.0};
   std::size_t samples{0};
-  std::vector<std::string> warnings;     // what is awkward about the recording, said plainly
-  std::vector<SpeedToTry> speeds;        // the pockets 60 f_c / (N k) within [rpm_min, rpm_max], nearest first
+  std::vector<std::string> warnings;  // what is awkward about the recording, said plainly
+  std::vector<SpeedToTry> speeds;     // the pockets 60 f_c / (N k) within [rpm_min, rpm_max], nearest first
   // The spectrogram of the analysed signal: one column per half window (Hann), its magnitude in dB at
   // spectrogram_hz (two bins up to max_hz, at most 400 rows evenly spaced in log frequency: the largest bin
   // of each).
@@ -84,11 +84,12 @@ struct RpmEstimate {
   double comb_share{0.0};
   std::string how;
 };
-[[nodiscard]] std::optional<RpmEstimate> estimate_rpm(const std::vector<double>& x, double rate_hz, int teeth, double rpm_min,
-                                                      double rpm_max);
+[[nodiscard]] std::optional<RpmEstimate> estimate_rpm(const std::vector<double>& x, double rate_hz, int teeth,
+                                                      double rpm_min, double rpm_max);
 
 // The stable pockets of a chatter frequency: the tooth frequency at f_c / k, k = 1, 2, ..., in range,
 // nearest the current speed first.
-[[nodiscard]] std::vector<SpeedToTry> pockets(double chatter_hz, int teeth, double rpm_now, double rpm_min, double rpm_max);
+[[nodiscard]] std::vector<SpeedToTry> pockets(double chatter_hz, int teeth, double rpm_now, double rpm_min,
+                                              double rpm_max);
 
 }  // namespace robodamp::milling

@@ -19,7 +19,9 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   j.material = cfg.material;
   j.terms = cutter_modal_terms(structure, cfg.cut.feed_axis);
   if (j.terms.empty())
-    problems.push_back({cfg.source, {}, "structures." + structure.name(),
+    problems.push_back({cfg.source,
+                        {},
+                        "structures." + structure.name(),
                         "structures." + structure.name() + " has no modes to simulate"});
   for (const auto& t : j.terms) j.highest_mode_hz = std::max(j.highest_mode_hz, t.wn_rad_per_s / (kTwoPi));
   const config::TimeDomainConfig& td = cfg.time_domain;
@@ -43,7 +45,9 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
   j.damped = o.damped;
   j.requested_rpm = s.rpm;
   if (o.damped && structure.controller_parts().empty())
-    problems.push_back({cfg.source, {}, "--damped",
+    problems.push_back({cfg.source,
+                        {},
+                        "--damped",
                         "--damped needs a structure part with a controller (a damping configuration); structures." +
                             structure.name() + " has none"});
   if (problems.empty() && o.damped) {
@@ -61,12 +65,15 @@ CutJob make_cut_job(const config::MillingConfig& cfg, const Structure& structure
     const double tooth_s = 60.0 / (s.rpm * cfg.tool.teeth);
     const double needed = std::ceil(td.min_steps_per_mode_period * j.highest_mode_hz * tooth_s);
     if (td.steps_per_tooth > 0 && td.steps_per_tooth < needed)
-      problems.push_back({cfg.source, {}, "time_domain.steps_per_tooth",
-                          "time_domain.steps_per_tooth = " + std::to_string(td.steps_per_tooth) + " steps is too coarse for the modes: allowed >= " +
-                              config::format_number(needed) + " steps (time_domain.min_steps_per_mode_period = " +
-                              std::to_string(td.min_steps_per_mode_period) + " per period of the " +
-                              config::format_number(j.highest_mode_hz) + " Hz mode at " + config::format_number(s.rpm) +
-                              " rpm)"});
+      problems.push_back(
+          {cfg.source,
+           {},
+           "time_domain.steps_per_tooth",
+           "time_domain.steps_per_tooth = " + std::to_string(td.steps_per_tooth) +
+               " steps is too coarse for the modes: allowed >= " + config::format_number(needed) +
+               " steps (time_domain.min_steps_per_mode_period = " + std::to_string(td.min_steps_per_mode_period) +
+               " per period of the " + config::format_number(j.highest_mode_hz) + " Hz mode at " +
+               config::format_number(s.rpm) + " rpm)"});
   }
   if (!problems.empty()) throw config::ConfigError(problems);
   if (!j.damped) {

@@ -24,12 +24,12 @@ struct CutJob {
   std::vector<CutterModalTerm> terms;
   Cutter cutter;
   config::MaterialConfig material;
-  CutSettings settings;       // with the damper: steps of one loop period, rpm the nearest whose tooth
-                              // period is a whole number of them
+  CutSettings settings;  // with the damper: steps of one loop period, rpm the nearest whose tooth
+                         // period is a whole number of them
   double requested_rpm{0.0};
   double highest_mode_hz{0.0};
   bool damped{false};
-  DynamicsFactory dynamics;   // fresh structure dynamics for each cut (refers to the Structure given)
+  DynamicsFactory dynamics;  // fresh structure dynamics for each cut (refers to the Structure given)
 };
 
 // Throws config::ConfigError naming the option (e.g. --radial-mm) or the job key that does not fit.

@@ -61,14 +61,16 @@ CutProcess::CutProcess(const Cutter& cutter, const config::MaterialConfig& mat, 
   double angle_deg = 0.0;
   for (int j = 0; j < n; ++j) {
     const auto uj = static_cast<std::size_t>(j);
-    tooth_bin_[uj] = uneven ? static_cast<std::size_t>(std::lround(angle_deg / 360.0 * static_cast<double>(bins_))) % bins_
-                            : uj * static_cast<std::size_t>(m);
+    tooth_bin_[uj] = uneven
+                         ? static_cast<std::size_t>(std::lround(angle_deg / 360.0 * static_cast<double>(bins_))) % bins_
+                         : uj * static_cast<std::size_t>(m);
     if (uneven) {
       pitch_feed_m_[uj] = feed_per_tooth_m_ * n * s.pitch_deg[uj] / 360.0;
       angle_deg += s.pitch_deg[uj];
     }
   }
-  kt_ = mat.kt_n_per_mm2 * 1e6, kr_ = mat.kr_n_per_mm2 * 1e6, kte_ = mat.kte_n_per_mm * 1e3, kre_ = mat.kre_n_per_mm * 1e3;
+  kt_ = mat.kt_n_per_mm2 * 1e6, kr_ = mat.kr_n_per_mm2 * 1e6, kte_ = mat.kte_n_per_mm * 1e3,
+  kre_ = mat.kre_n_per_mm * 1e3;
   exponent_ = mat.chip_exponent, reference_chip_m_ = mat.reference_chip_mm * 1e-3;
   walls_.reserve(slices_.size() * static_cast<std::size_t>(n));
   wall_per_rev_um_.reserve(static_cast<std::size_t>(std::max(s.revolutions, 0)) + 1);
@@ -140,14 +142,16 @@ std::size_t CutProcess::continue_from(const CutProcess& before, std::size_t step
   const std::size_t k = static_cast<std::size_t>(std::lround(turn * static_cast<double>(bins_))) % bins_;
   feed_origin_m_ = before.feed_at_m(static_cast<double>(steps));
   first_step_ = k;
-  const double depth_before_m = before.slices_.empty() ? 0.0 : before.slices_.back().z_m + 0.5 * before.slices_.back().height_m;
+  const double depth_before_m =
+      before.slices_.empty() ? 0.0 : before.slices_.back().z_m + 0.5 * before.slices_.back().height_m;
   const double dphi = kTwoPi / static_cast<double>(bins_), dphi_before = kTwoPi / static_cast<double>(before.bins_);
   for (SliceState& st : slices_) {
     std::fill(st.cut_before.begin(), st.cut_before.end(), 0);
     if (st.z_m >= depth_before_m) continue;  // fresh material: no pass cut here yet
     // The slice of `before` at this height (its slices are of equal height).
-    const auto j = std::min(before.slices_.size() - 1,
-                            static_cast<std::size_t>(st.z_m / depth_before_m * static_cast<double>(before.slices_.size())));
+    const auto j =
+        std::min(before.slices_.size() - 1,
+                 static_cast<std::size_t>(st.z_m / depth_before_m * static_cast<double>(before.slices_.size())));
     const SliceState& old = before.slices_[j];
     for (std::size_t i = 0; i < bins_; ++i) {
       // Bin i holds the workpiece angle i dphi - lag; the same angle on the old slice's grid.
@@ -168,14 +172,15 @@ std::size_t CutProcess::continue_from(const CutProcess& before, std::size_t step
 void CutProcess::end_step(const Eigen::Vector2d& q, const Eigen::Vector2d& q_next) noexcept {
   for (const WallPass& w : walls_) {  // the deflection when the edge is at the wall, linear in time
     const Eigen::Vector2d at = q + w.slice->wall_fraction * (q_next - q);
-    w.slice->wall_rev_max_m =
-        std::max(w.slice->wall_rev_max_m, w.runout_m + at(0) * std::sin(wall_angle_rad_) + at(1) * std::cos(wall_angle_rad_));
+    w.slice->wall_rev_max_m = std::max(
+        w.slice->wall_rev_max_m, w.runout_m + at(0) * std::sin(wall_angle_rad_) + at(1) * std::cos(wall_angle_rad_));
   }
 }
 
 std::vector<double> CutProcess::wall_um() const {
   std::vector<double> out;
-  for (const SliceState& st : slices_) out.push_back(st.wall_count ? -st.wall_sum_m / st.wall_count * 1e6 : std::nan(""));
+  for (const SliceState& st : slices_)
+    out.push_back(st.wall_count ? -st.wall_sum_m / st.wall_count * 1e6 : std::nan(""));
   return out;
 }
 

@@ -63,8 +63,8 @@ class CutProcess {
     std::vector<double> surface_m;         // radial reach of the last pass that cut, per bin (workpiece frame)
     std::vector<double> surface_feed_m;    // the nominal feed travelled when that pass cut (continue_from)
     std::vector<char> cut_before;
-    std::size_t wall_bin{0};               // bin whose step passes the surface-generating angle
-    double wall_fraction{0.0};             // where in that step
+    std::size_t wall_bin{0};    // bin whose step passes the surface-generating angle
+    double wall_fraction{0.0};  // where in that step
     double wall_sum_m{0.0};
     int wall_count{0};
     double wall_rev_max_m{-std::numeric_limits<double>::infinity()};

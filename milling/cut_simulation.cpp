@@ -15,7 +15,6 @@ int steps_per_tooth(const config::TimeDomainConfig& td, double highest_mode_hz, 
   return std::max(40, static_cast<int>(std::ceil(td.min_steps_per_mode_period * highest_mode_hz * tooth_period_s)));
 }
 
-
 CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                        const config::MaterialConfig& mat, const CutSettings& s) {
   if (!(s.rpm > 0.0) || s.steps_per_tooth < 1)
@@ -24,7 +23,8 @@ CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& 
   return simulate_cut(dyn, cutter, mat, s);
 }
 
-CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::MaterialConfig& mat, const CutSettings& s) {
+CutRecord simulate_cut(CutDynamics& dyn, const Cutter& cutter, const config::MaterialConfig& mat,
+                       const CutSettings& s) {
   if (!(s.rpm > 0.0) || s.steps_per_tooth < 1 || s.revolutions <= s.settle_revolutions)
     throw std::invalid_argument("simulate_cut: needs rpm > 0, steps_per_tooth >= 1, revolutions > settle_revolutions");
   CutProcess process(cutter, mat, s);

@@ -41,15 +41,15 @@ struct CutRecord {
   // Per step, cutter frame (x = feed, y = wall normal): tool displacement at the step's start, m, and the
   // cutting force on the tool held over the step, N.
   std::vector<double> x_m, y_m, fx_n, fy_n;
-  double peak_force_n{0.0};      // after settling
+  double peak_force_n{0.0};  // after settling
   // With the damper (milling/damped_dynamics.hpp), after settling: the actuator's peak transmitted force
   // and the time at a controller or actuator limit; NaN and 0 without.
   double peak_actuator_force_n{std::numeric_limits<double>::quiet_NaN()};
   double actuator_saturated_s{0.0};
-  double sle_um{0.0};            // wall error after settling, mean over the engaged slices (+ = undercut)
-  std::vector<double> wall_um;   // per slice (tip first), NaN where the slice does not reach the wall
+  double sle_um{0.0};                   // wall error after settling, mean over the engaged slices (+ = undercut)
+  std::vector<double> wall_um;          // per slice (tip first), NaN where the slice does not reach the wall
   std::vector<double> wall_per_rev_um;  // the machined wall per revolution after settling (mean over slices)
-  std::uint64_t engaged_samples{0};  // tooth-slice steps wholly inside the engagement after settling
+  std::uint64_t engaged_samples{0};     // tooth-slice steps wholly inside the engagement after settling
   std::uint64_t out_of_cut_samples{0};  // of those, with no chip (h <= 0): the tool left the cut
   [[nodiscard]] double out_of_cut_share() const {
     return engaged_samples ? static_cast<double>(out_of_cut_samples) / static_cast<double>(engaged_samples) : 0.0;
@@ -59,7 +59,7 @@ struct CutRecord {
 [[nodiscard]] CutRecord simulate_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutter,
                                      const config::MaterialConfig& material, const CutSettings& settings);
 // The same with the structure given as dynamics stepping at the tooth period / settings.steps_per_tooth.
-[[nodiscard]] CutRecord simulate_cut(CutDynamics& dynamics, const Cutter& cutter, const config::MaterialConfig& material,
-                                     const CutSettings& settings);
+[[nodiscard]] CutRecord simulate_cut(CutDynamics& dynamics, const Cutter& cutter,
+                                     const config::MaterialConfig& material, const CutSettings& settings);
 
 }  // namespace robodamp::milling

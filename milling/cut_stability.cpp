@@ -22,7 +22,8 @@ CutOutcome run_cut(const std::vector<CutterModalTerm>& terms, const Cutter& cutt
   return classify(simulate_cut(terms, cutter, mat, s), s);
 }
 
-CutOutcome run_cut(CutDynamics& dynamics, const Cutter& cutter, const config::MaterialConfig& mat, const CutSettings& s) {
+CutOutcome run_cut(CutDynamics& dynamics, const Cutter& cutter, const config::MaterialConfig& mat,
+                   const CutSettings& s) {
   return classify(simulate_cut(dynamics, cutter, mat, s), s);
 }
 

@@ -28,10 +28,10 @@ struct CutOutcome {
 using DynamicsFactory = std::function<std::unique_ptr<CutDynamics>()>;
 
 struct CriticalDepth {
-  double depth_mm{0.0};          // largest stable depth found (within rel_tol of the smallest unstable one)
-  CutClass above{CutClass::kStable};  // what the cut does just above it
+  double depth_mm{0.0};                 // largest stable depth found (within rel_tol of the smallest unstable one)
+  CutClass above{CutClass::kStable};    // what the cut does just above it
   CutClass mechanism{CutClass::kHopf};  // Hopf or flip there
-  double chatter_hz{0.0};        // there
+  double chatter_hz{0.0};               // there
   int simulations{0};
 };
 

@@ -96,20 +96,23 @@ std::string cut_verdict_line(const CutVerdict& v) {
   const double tol_pct = 100.0 * v.tolerance;
   o << "VERDICT (the cut, " << v.method << "): ";
   const CutCurve& use = v.scheduled ? *v.scheduled : v.fixed;
-  const std::string what = v.scheduled ? "the speed schedule" : fmt("the damper at K %.0f N s/m", v.fixed_gain_ns_per_m);
+  const std::string what =
+      v.scheduled ? "the speed schedule" : fmt("the damper at K %.0f N s/m", v.fixed_gain_ns_per_m);
   if (v.job_rpm > 0.0)
-    o << what << fmt(" gives %.3f mm at the job's %.1f rpm (%+.1f %% on the open loop's ", use.at_job_mm, v.job_rpm,
-                     100.0 * (use.at_job_mm / v.open.at_job_mm - 1.0))
+    o << what
+      << fmt(" gives %.3f mm at the job's %.1f rpm (%+.1f %% on the open loop's ", use.at_job_mm, v.job_rpm,
+             100.0 * (use.at_job_mm / v.open.at_job_mm - 1.0))
       << fmt("%.3f mm); ", v.open.at_job_mm);
-  o << (use.worse_share > 0.0 ? fmt("it is WORSE than no damper at %.0f %% of the %.0f speeds (down to x%.2f", 100.0 * use.worse_share,
-                                    static_cast<double>(v.rpm.size()), use.worst_ratio) +
+  o << (use.worse_share > 0.0 ? fmt("it is WORSE than no damper at %.0f %% of the %.0f speeds (down to x%.2f",
+                                    100.0 * use.worse_share, static_cast<double>(v.rpm.size()), use.worst_ratio) +
                                     fmt(" at %.0f rpm)", use.worst_rpm)
-                              : fmt("never worse than no damper (by %.1f %%) at the %.0f speeds", tol_pct, static_cast<double>(v.rpm.size())))
+                              : fmt("never worse than no damper (by %.1f %%) at the %.0f speeds", tol_pct,
+                                    static_cast<double>(v.rpm.size())))
     << fmt(", deeper at %.0f %% of them; minimum %.3f mm", 100.0 * use.better_share, use.min_mm)
     << fmt(" (open loop %.3f mm)", v.open.min_mm);
   if (v.scheduled && v.job_rpm > 0.0 && v.fixed.at_job_mm < v.open.at_job_mm * (1.0 - v.tolerance))
-    o << fmt(". Without the schedule, K %.0f N s/m would LOWER the limit at the job's speed by %.1f %%", v.fixed_gain_ns_per_m,
-             100.0 * (1.0 - v.fixed.at_job_mm / v.open.at_job_mm));
+    o << fmt(". Without the schedule, K %.0f N s/m would LOWER the limit at the job's speed by %.1f %%",
+             v.fixed_gain_ns_per_m, 100.0 * (1.0 - v.fixed.at_job_mm / v.open.at_job_mm));
   return o.str();
 }
 
@@ -118,23 +121,30 @@ std::string cut_verdict_text(const CutVerdict& v) {
   o << "What the damper does for the cut (" << v.job << "; " << v.method << ", " << v.rpm.size() << " speeds over "
     << fmt("%.0f-%.0f rpm", v.rpm.front(), v.rpm.back()) << "):\n";
   char line[300];
-  std::snprintf(line, sizeof line, "  %-28s %-22s %-30s %s\n", "", "open loop", fmt("fixed K %.0f N s/m", v.fixed_gain_ns_per_m).c_str(),
+  std::snprintf(line, sizeof line, "  %-28s %-22s %-30s %s\n", "", "open loop",
+                fmt("fixed K %.0f N s/m", v.fixed_gain_ns_per_m).c_str(),
                 v.scheduled ? ("speed schedule (" + std::to_string(v.bands) + " bands)").c_str() : "");
   o << line;
   auto row = [&](const std::string& label, const std::string& a, const std::string& b, const std::string& c) {
     std::snprintf(line, sizeof line, "  %-28s %-22s %-30s %s\n", label.c_str(), a.c_str(), b.c_str(), c.c_str());
     o << line;
   };
-  auto at_job = [&](const CutCurve& c) { return fmt("%.3f mm (%+.1f %%)", c.at_job_mm, 100.0 * (c.at_job_mm / v.open.at_job_mm - 1.0)); };
+  auto at_job = [&](const CutCurve& c) {
+    return fmt("%.3f mm (%+.1f %%)", c.at_job_mm, 100.0 * (c.at_job_mm / v.open.at_job_mm - 1.0));
+  };
   if (v.job_rpm > 0.0)
-    row(fmt("at the job's %.1f rpm", v.job_rpm), fmt("%.3f mm", v.open.at_job_mm), at_job(v.fixed), v.scheduled ? at_job(*v.scheduled) : "");
+    row(fmt("at the job's %.1f rpm", v.job_rpm), fmt("%.3f mm", v.open.at_job_mm), at_job(v.fixed),
+        v.scheduled ? at_job(*v.scheduled) : "");
   auto minimum = [&](const CutCurve& c) { return fmt("%.3f mm at %.0f rpm", c.min_mm, c.min_rpm); };
   row("minimum", minimum(v.open), minimum(v.fixed), v.scheduled ? minimum(*v.scheduled) : "");
-  row("mean over the speeds", "x1", fmt("x%.3f", v.fixed.mean_ratio), v.scheduled ? fmt("x%.3f", v.scheduled->mean_ratio) : "");
+  row("mean over the speeds", "x1", fmt("x%.3f", v.fixed.mean_ratio),
+      v.scheduled ? fmt("x%.3f", v.scheduled->mean_ratio) : "");
   auto worse = [&](const CutCurve& c) {
-    return fmt("%.0f %%", 100.0 * c.worse_share) + (c.worse_share > 0.0 ? fmt(" (to x%.2f at %.0f rpm)", c.worst_ratio, c.worst_rpm) : "");
+    return fmt("%.0f %%", 100.0 * c.worse_share) +
+           (c.worse_share > 0.0 ? fmt(" (to x%.2f at %.0f rpm)", c.worst_ratio, c.worst_rpm) : "");
   };
-  row(fmt("worse than open (> %.1f %%)", 100.0 * v.tolerance), "", worse(v.fixed), v.scheduled ? worse(*v.scheduled) : "");
+  row(fmt("worse than open (> %.1f %%)", 100.0 * v.tolerance), "", worse(v.fixed),
+      v.scheduled ? worse(*v.scheduled) : "");
   o << cut_verdict_line(v) << "\n";
   return o.str();
 }

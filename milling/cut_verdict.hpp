@@ -18,20 +18,20 @@ namespace robodamp::milling {
 
 struct CutCurve {
   double min_mm{0.0}, min_rpm{0.0};
-  double mean_ratio{0.0};          // x the open loop, over the speeds
-  double worse_share{0.0};         // of the speeds below the open loop by more than the tolerance
+  double mean_ratio{0.0};   // x the open loop, over the speeds
+  double worse_share{0.0};  // of the speeds below the open loop by more than the tolerance
   double worst_ratio{0.0}, worst_rpm{0.0};
-  double better_share{0.0};        // above the open loop by more than the tolerance
-  double at_job_mm{0.0};           // at the job's speed
-  std::vector<double> mm;          // per speed
+  double better_share{0.0};  // above the open loop by more than the tolerance
+  double at_job_mm{0.0};     // at the job's speed
+  std::vector<double> mm;    // per speed
 };
 
 struct CutVerdict {
   std::string job, method;
-  double tolerance{0.005};         // what "worse" and "better" mean, relative to the open loop
-  std::vector<double> rpm;         // the speeds (as the sampled loop runs them)
-  double job_rpm{0.0};             // the job's spindle speed as the sampled loop runs it (0: beyond its range)
-  CutCurve open, fixed;            // the open loop; the configuration's controller at controller.gain_ns_per_m
+  double tolerance{0.005};            // what "worse" and "better" mean, relative to the open loop
+  std::vector<double> rpm;            // the speeds (as the sampled loop runs them)
+  double job_rpm{0.0};                // the job's spindle speed as the sampled loop runs it (0: beyond its range)
+  CutCurve open, fixed;               // the open loop; the configuration's controller at controller.gain_ns_per_m
   std::optional<CutCurve> scheduled;  // controller.speed_schedule
   double fixed_gain_ns_per_m{0.0};
   std::size_t bands{0};

@@ -101,8 +101,10 @@ ForceSpectrum force_spectrum(const Cutter& c, const config::MaterialConfig& mat,
       ema[static_cast<std::size_t>(m + 2)] = std::polar(1.0, m * a);
       emb[static_cast<std::size_t>(m + 2)] = std::polar(1.0, m * b);
     }
-    const Complex step_a = std::polar(1.0, -n * a), step_b = std::polar(1.0, -n * b), step_lag = std::polar(1.0, -n * s.lag_rad);
-    Complex eka(1.0), ekb(1.0), shift(1.0);  // exp(-i k n a), exp(-i k n b), exp(-i k n lag): the edge reaches phi at (phi + lag) / Omega
+    const Complex step_a = std::polar(1.0, -n * a), step_b = std::polar(1.0, -n * b),
+                  step_lag = std::polar(1.0, -n * s.lag_rad);
+    Complex eka(1.0), ekb(1.0),
+        shift(1.0);  // exp(-i k n a), exp(-i k n b), exp(-i k n lag): the edge reaches phi at (phi + lag) / Omega
     const double scale = n / (kTwoPi);
     for (int k = 0; k <= harmonics; ++k) {
       Complex sx(0.0), sy(0.0);

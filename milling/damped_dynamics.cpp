@@ -16,7 +16,8 @@ struct DampedDynamics::Loop {
 
 DampedDynamics::DampedDynamics(const Structure& structure, config::Axis feed_axis) : feed_axis_(feed_axis) {
   for (const auto& part : structure.controller_parts()) {
-    if (part.across) throw std::invalid_argument("DampedDynamics: a controller part across the plane (not simulated in time)");
+    if (part.across)
+      throw std::invalid_argument("DampedDynamics: a controller part across the plane (not simulated in time)");
     auto loop = std::make_shared<Loop>();
     loop->model = part.model;
     loop->location = part.location;
@@ -47,7 +48,8 @@ double DampedDynamics::actuator_force_limit_n() const { return loops_.front()->m
 
 Eigen::Vector2d DampedDynamics::loops_displacement() const {
   Eigen::Vector2d machine = Eigen::Vector2d::Zero();
-  for (const auto& l : loops_) machine(static_cast<Eigen::Index>(l->direction)) += l->plant->displacement_m(l->location);
+  for (const auto& l : loops_)
+    machine(static_cast<Eigen::Index>(l->direction)) += l->plant->displacement_m(l->location);
   return to_cutter(machine, feed_axis_);
 }
 
@@ -70,7 +72,8 @@ void DampedDynamics::step(const Eigen::Vector2d& f_cutter) {
       const auto c0 = l->controller->counters();
       next = l->controller->update(s.accel_mps2);
       const auto& c1 = l->controller->counters();
-      limited = c1.force_limited + c1.voltage_limited + c1.slew_limited > c0.force_limited + c0.voltage_limited + c0.slew_limited;
+      limited = c1.force_limited + c1.voltage_limited + c1.slew_limited >
+                c0.force_limited + c0.voltage_limited + c0.slew_limited;
     }
     const auto p0 = l->plant->counters().force_limited + l->plant->counters().voltage_clipped;
     l->cutting->value_n = f_machine(static_cast<Eigen::Index>(l->direction));
@@ -79,7 +82,8 @@ void DampedDynamics::step(const Eigen::Vector2d& f_cutter) {
     if (stats_) {
       const bool clipped = l->plant->counters().force_limited + l->plant->counters().voltage_clipped > p0;
       if (limited || clipped) stats_out_.saturated_s += period_s_;
-      stats_out_.peak_actuator_force_n = std::max(stats_out_.peak_actuator_force_n, std::abs(l->plant->actuator_force_n()));
+      stats_out_.peak_actuator_force_n =
+          std::max(stats_out_.peak_actuator_force_n, std::abs(l->plant->actuator_force_n()));
       stats_out_.peak_coil_force_n =
           std::max(stats_out_.peak_coil_force_n, std::abs(l->command_v) * l->model->config().actuator.constant_n_per_v);
     }

@@ -16,7 +16,8 @@
 namespace robodamp::milling {
 
 std::complex<double> dense_dominant_multiplier(const Eigen::MatrixXd& z) {
-  if (z.rows() != z.cols() || z.rows() == 0) throw std::invalid_argument("dominant multiplier: the matrix must be square");
+  if (z.rows() != z.cols() || z.rows() == 0)
+    throw std::invalid_argument("dominant multiplier: the matrix must be square");
   const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(z, false).eigenvalues();
   Eigen::Index best = 0;
   for (Eigen::Index i = 1; i < ev.size(); ++i)

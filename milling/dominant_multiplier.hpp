@@ -22,7 +22,7 @@ class DominantMultiplier {
   static constexpr int kWanted = 4;                    // Ritz values converged: a complex pair and the next
   static constexpr int kBasis = 40;                    // Arnoldi basis
   static constexpr int kMaxRestarts = 10;
-  static constexpr double kTolerance = 1e-12;          // relative residual of the converged Ritz values
+  static constexpr double kTolerance = 1e-12;  // relative residual of the converged Ritz values
 
   // The eigenvalue of largest magnitude of the square matrix z (of a complex pair, either).
   [[nodiscard]] std::complex<double> operator()(const Eigen::MatrixXd& z);

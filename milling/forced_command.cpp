@@ -13,28 +13,31 @@
 namespace robodamp::milling {
 
 namespace {
-constexpr int kHarmonics = 16;        // of the tooth-passing frequency: the force's spectrum falls fast beyond
+constexpr int kHarmonics = 16;  // of the tooth-passing frequency: the force's spectrum falls fast beyond
 constexpr std::size_t kSamplesPerPeriod = 256;
 
 // exp(i 2 pi j / kSamplesPerPeriod): harmonic k at sample n is entry k n mod kSamplesPerPeriod.
 const std::array<Complex, kSamplesPerPeriod>& unit_phasors() {
   static const auto table = [] {
     std::array<Complex, kSamplesPerPeriod> t{};
-    for (std::size_t j = 0; j < kSamplesPerPeriod; ++j) t[j] = std::polar(1.0, robodamp::kTwoPi * static_cast<double>(j) / kSamplesPerPeriod);
+    for (std::size_t j = 0; j < kSamplesPerPeriod; ++j)
+      t[j] = std::polar(1.0, robodamp::kTwoPi * static_cast<double>(j) / kSamplesPerPeriod);
     return t;
   }();
   return table;
 }
 }  // namespace
 
-ForcedCommand::ForcedCommand(const Structure& damped, const config::MillingConfig& job, double rpm) : job_(job), rpm_(rpm) {
+ForcedCommand::ForcedCommand(const Structure& damped, const config::MillingConfig& job, double rpm)
+    : job_(job), rpm_(rpm) {
   limit_n_ = std::numeric_limits<double>::infinity();
   const double tooth_hz = rpm * job.tool.teeth / 60.0;
   for (const auto& p : damped.controller_parts()) {
     if (p.across) throw std::invalid_argument("ForcedCommand: a controller part across the plane is not supported");
     const analysis::LoopModel& m = *p.model;
     const config::Config& c = m.config();
-    limit_n_ = std::min({limit_n_, c.actuator.force_limit_n, c.amplifier.voltage_limit_v * c.actuator.constant_n_per_v});
+    limit_n_ =
+        std::min({limit_n_, c.actuator.force_limit_n, c.amplifier.voltage_limit_v * c.actuator.constant_n_per_v});
     Part part;
     part.direction = p.direction;
     part.newton_per_newton.assign(kHarmonics + 1, Complex(0.0));
@@ -43,7 +46,8 @@ ForcedCommand::ForcedCommand(const Structure& damped, const config::MillingConfi
       if (f >= 0.5 * m.loop_rate_hz()) break;  // the loop does not see it
       const analysis::PlantResponse r = m.plant_response(f);
       part.newton_per_newton[static_cast<std::size_t>(k)] =
-          c.actuator.constant_n_per_v * m.command_per_force(r, m.chain_filters_digital(f), p.location, p.gain_ns_per_m, p.polarity);
+          c.actuator.constant_n_per_v *
+          m.command_per_force(r, m.chain_filters_digital(f), p.location, p.gain_ns_per_m, p.polarity);
     }
     parts_.push_back(std::move(part));
   }
@@ -51,14 +55,16 @@ ForcedCommand::ForcedCommand(const Structure& damped, const config::MillingConfi
 
 double ForcedCommand::peak_force_n(double axial_mm) const {
   const CutConditions cut{job_.cut.mode, job_.cut.radial_mm, axial_mm, job_.cut.feed_per_tooth_mm};
-  const ForceSpectrum f = force_spectrum(cutter_from(job_.tool), job_.material, cut, job_.time_domain.axial_slices, kHarmonics);
+  const ForceSpectrum f =
+      force_spectrum(cutter_from(job_.tool), job_.material, cut, job_.time_domain.axial_slices, kHarmonics);
   double peak = 0.0;
   for (const Part& p : parts_) {
     std::vector<Complex> c(kHarmonics + 1, Complex(0.0));
     for (std::size_t k = 1; k <= kHarmonics; ++k) {
       // The force on the tool in the cutter's frame (x feed, y wall normal) along the part's machine direction.
       const Complex fx = f.fx[k], fy = f.fy[k];
-      const Complex along = job_.cut.feed_axis == config::Axis::kX ? (p.direction == 0 ? fx : fy) : (p.direction == 0 ? -fy : fx);
+      const Complex along =
+          job_.cut.feed_axis == config::Axis::kX ? (p.direction == 0 ? fx : fy) : (p.direction == 0 ? -fy : fx);
       c[k] = p.newton_per_newton[k] * along;
     }
     const auto& unit = unit_phasors();
@@ -80,8 +86,10 @@ double ForcedCommand::holding_depth_mm(double max_mm) const {
   bool crossed = false;
   for (int i = 1; i <= kSteps && !crossed; ++i) {
     const double b = max_mm * i / kSteps;
-    if (peak_force_n(b) > limit_n_) hi = b, crossed = true;
-    else lo = b;
+    if (peak_force_n(b) > limit_n_)
+      hi = b, crossed = true;
+    else
+      lo = b;
   }
   if (!crossed) return max_mm;
   while (hi - lo > 1e-4 * hi) {
@@ -91,8 +99,9 @@ double ForcedCommand::holding_depth_mm(double max_mm) const {
   return lo;
 }
 
-std::vector<double> holding_limits_mm(const Structure& damped, const config::MillingConfig& job, const std::vector<double>& rpm,
-                                      const std::vector<double>& limit_mm, std::size_t threads) {
+std::vector<double> holding_limits_mm(const Structure& damped, const config::MillingConfig& job,
+                                      const std::vector<double>& rpm, const std::vector<double>& limit_mm,
+                                      std::size_t threads) {
   std::vector<double> out = limit_mm;
   if (!damped.damped() || !damped.has_controller()) return out;
   std::vector<std::function<void()>> tasks;

@@ -11,10 +11,20 @@ namespace {
 
 // Higham (2005): the [13/13] Pade approximant's coefficients and the 1-norm up to which it is accurate to
 // double precision without squaring.
-constexpr double kPade13[14] = {64764752532480000.0, 32382376266240000.0, 7771770303897600.0, 1187353796428800.0,
-                                129060195264000.0,   10559470521600.0,    670442572800.0,     33522128640.0,
-                                1323241920.0,        40840800.0,          960960.0,           16380.0,
-                                182.0,               1.0};
+constexpr double kPade13[14] = {64764752532480000.0,
+                                32382376266240000.0,
+                                7771770303897600.0,
+                                1187353796428800.0,
+                                129060195264000.0,
+                                10559470521600.0,
+                                670442572800.0,
+                                33522128640.0,
+                                1323241920.0,
+                                40840800.0,
+                                960960.0,
+                                16380.0,
+                                182.0,
+                                1.0};
 constexpr double kTheta13 = 5.371920351148152;
 
 }  // namespace
@@ -46,8 +56,10 @@ void IntervalExp::apply(const Eigen::MatrixXd& x, Eigen::MatrixXd& y) const {
       const Eigen::Matrix2d& a = a_[k];
       const std::size_t i = 2 * k;
       const double x0 = xj[i], x1 = xj[i + 1];
-      yj[i] = a(0, 0) * x0 + a(0, 1) * x1 + l_(static_cast<Eigen::Index>(i), 0) * r0 + l_(static_cast<Eigen::Index>(i), 1) * r1;
-      yj[i + 1] = a(1, 0) * x0 + a(1, 1) * x1 + l_(static_cast<Eigen::Index>(i + 1), 0) * r0 + l_(static_cast<Eigen::Index>(i + 1), 1) * r1;
+      yj[i] = a(0, 0) * x0 + a(0, 1) * x1 + l_(static_cast<Eigen::Index>(i), 0) * r0 +
+              l_(static_cast<Eigen::Index>(i), 1) * r1;
+      yj[i + 1] = a(1, 0) * x0 + a(1, 1) * x1 + l_(static_cast<Eigen::Index>(i + 1), 0) * r0 +
+                  l_(static_cast<Eigen::Index>(i + 1), 1) * r1;
     }
     yj[n_] = shift_(0) * xj[n_ + 2];
     yj[n_ + 1] = shift_(1) * xj[n_ + 3];

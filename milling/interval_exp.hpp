@@ -42,7 +42,7 @@ class IntervalExp {
   std::vector<Eigen::Matrix2d> a_;
   Eigen::MatrixXd l_, r_;
   Eigen::Vector2d shift_;
-  Eigen::VectorXd d_;                // the balancing similarity's diagonal
+  Eigen::VectorXd d_;  // the balancing similarity's diagonal
   mutable Eigen::MatrixXd rx_;
   Eigen::MatrixXd dense_, a2_, a4_, a6_, t1_, t2_, u_, v_;
   int squarings_{0};

@@ -25,15 +25,17 @@ config::StructureConfig pick_structure(const config::MillingConfig& job, const s
   const config::StructureConfig* s = job.find_structure(wanted);
   if (s == nullptr && name.empty() && !job.structures.empty()) s = &job.structures.front();
   if (s == nullptr)
-    throw config::ConfigError({config::Problem{job.source, {}, "structure",
-                                               "the job has no structure named '" + wanted + "'"}});
+    throw config::ConfigError(
+        {config::Problem{job.source, {}, "structure", "the job has no structure named '" + wanted + "'"}});
   if (pose) return robot_through_cell(*s, cell.actuator.location, pose->axis, cell.source);
   if (!needs_controller) return *s;
   bool has_controller = false;
   for (const auto& p : s->parts) has_controller = has_controller || p.controller.has_value();
   if (!has_controller)
     throw config::ConfigError(
-        {config::Problem{job.source, {}, "structures." + s->name,
+        {config::Problem{job.source,
+                         {},
+                         "structures." + s->name,
                          "live stability needs a part with a controller (the damper's location and direction)"}});
   return *s;
 }
@@ -63,7 +65,8 @@ LiveStability::~LiveStability() {
   worker_.stop();
 }
 
-LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg) const {
+LiveStability::Key LiveStability::key(double rpm, std::size_t set, double gain,
+                                      const std::vector<double>& pose_deg) const {
   Key k{std::lround(rpm / s_.rpm_step), set < sets_.size() ? set : 0, std::lround(gain / s_.gain_step_ns_per_m), {}};
   if (!pose_) return k;
   for (const double q : pose_deg) {
@@ -99,7 +102,8 @@ std::optional<LiveLimits> LiveStability::lookup(double rpm, std::size_t set, dou
   return std::nullopt;
 }
 
-LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_per_m, const std::vector<double>& pose_deg) {
+LiveLimits LiveStability::compute(double rpm, std::size_t set, double gain_ns_per_m,
+                                  const std::vector<double>& pose_deg) {
   const Key k = key(rpm, set, gain_ns_per_m, pose_deg);
   {
     std::lock_guard<std::mutex> lock(m_);
@@ -121,7 +125,8 @@ void LiveStability::sweep(std::size_t set, double gain_ns_per_m, const std::vect
   sweeper_.notify();
 }
 
-std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per_m, const std::vector<double>& pose_deg) const {
+std::vector<LiveLimits> LiveStability::known(std::size_t set, double gain_ns_per_m,
+                                             const std::vector<double>& pose_deg) const {
   const Key k = key(0.0, set, gain_ns_per_m, pose_deg);
   std::vector<LiveLimits> out;
   std::lock_guard<std::mutex> lock(m_);
@@ -218,7 +223,8 @@ void LiveStability::check_loop_model(LiveLimits& l, bool damping) const {
   robot.name = "robot";
   robot.pose = config::PosePartConfig{pose_->model_path, l.pose_deg};
   whole.parts.push_back(robot);
-  const SdmPoint o = AccurateStability(Structure(whole, false), job_).critical(l.rpm, std::isfinite(l.open_mm) ? l.open_mm : 1.0);
+  const SdmPoint o =
+      AccurateStability(Structure(whole, false), job_).critical(l.rpm, std::isfinite(l.open_mm) ? l.open_mm : 1.0);
   l.loop_open_mm = l.open_mm;
   l.open_mm = o.critical_depth_mm;
   l.open_chatter_hz = o.chatter_hz;
@@ -227,10 +233,11 @@ void LiveStability::check_loop_model(LiveLimits& l, bool damping) const {
   if (!damping) l.damped_mm = l.open_mm, l.damped_chatter_hz = l.open_chatter_hz;  // K = 0: the open loop
   if (l.loop_model_verified || !l.damped_valid || !damping) return;
   char b[400];
-  std::snprintf(b, sizeof b,
-                "at this pose the robot's modes above the loop's %d set the limit: open %.3f mm by the robot model, %.3f mm by "
-                "the loop's model, more than %.0f %% apart (pose_schedule.modes); the damper's effect is not claimed",
-                pose_->modes, l.open_mm, l.loop_open_mm, 100.0 * s_.loop_model_tolerance);
+  std::snprintf(
+      b, sizeof b,
+      "at this pose the robot's modes above the loop's %d set the limit: open %.3f mm by the robot model, %.3f mm by "
+      "the loop's model, more than %.0f %% apart (pose_schedule.modes); the damper's effect is not claimed",
+      pose_->modes, l.open_mm, l.loop_open_mm, 100.0 * s_.loop_model_tolerance);
   l.problem = b;
   l.damped_mm = l.open_mm;
   l.damped_chatter_hz = l.open_chatter_hz;
@@ -264,15 +271,15 @@ LiveLimits LiveStability::evaluate_loop(const Key& k) const {
   out.open_chatter_hz = o.chatter_hz;
   out.open_method = "SDM";
   out.analysed_rpm = out.rpm;
-  if (gain <= 0.0) {  // K 0 (a speed schedule's open-loop band): the damper commands nothing, the cut sees the open loop
+  if (gain <=
+      0.0) {  // K 0 (a speed schedule's open-loop band): the damper commands nothing, the cut sees the open loop
     out.damped_mm = out.open_mm;
     out.damped_chatter_hz = out.open_chatter_hz;
     out.method = "SDM (K = 0: the open loop)";
     return out;
   }
   try {
-    const Structure damped(st, true,
-                           {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});
+    const Structure damped(st, true, {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});
     const auto zoa = LobeModel(damped, process, lobes).limit_at(out.rpm);
     const AccurateStability truth(damped, job_);
     if (out.rpm <= truth.max_rpm()) {

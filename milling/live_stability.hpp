@@ -32,14 +32,14 @@ namespace robodamp::milling {
 
 struct LiveLimits {
   double rpm{0.0};
-  double analysed_rpm{0.0};    // the damped limit's speed: a whole number of loop periods per tooth period
-  double open_mm{0.0};         // limit of the open-loop structure at rpm (+inf: none below 1 m)
-  double damped_mm{0.0};       // with the loop closed at the set and gain, notches at rpm
+  double analysed_rpm{0.0};  // the damped limit's speed: a whole number of loop periods per tooth period
+  double open_mm{0.0};       // limit of the open-loop structure at rpm (+inf: none below 1 m)
+  double damped_mm{0.0};     // with the loop closed at the set and gain, notches at rpm
   double open_chatter_hz{0.0}, damped_chatter_hz{0.0};
-  bool damped_valid{true};     // false: the loop is unstable there (no damped FRF); damped_mm is 0
-  std::string problem;         // why damped_valid is false
-  std::string method;          // of the damped limit: "sampled-loop SDM", or "zero-order preview" above its speeds
-  std::string open_method;     // of the open limit: "SDM"
+  bool damped_valid{true};       // false: the loop is unstable there (no damped FRF); damped_mm is 0
+  std::string problem;           // why damped_valid is false
+  std::string method;            // of the damped limit: "sampled-loop SDM", or "zero-order preview" above its speeds
+  std::string open_method;       // of the open limit: "SDM"
   std::vector<double> pose_deg;  // the pose grid's point the limits are for (empty: no pose: the sets' own plants)
   // At a pose: the open limit is the robot model's whole receptance's (every mode of the chain, both
   // directions); the damped one comes from the loop's plant (the model's lowest pose_schedule.modes modes in
@@ -52,7 +52,7 @@ struct LiveLimits {
 
 // Limits as a cell met them (the run summary's trail along the robot's path): when, for which set and K.
 struct LiveLimitsRecord {
-  double time_s{0.0};          // loop time of the view that found them
+  double time_s{0.0};  // loop time of the view that found them
   std::size_t set{0};
   double gain_ns_per_m{0.0};
   LiveLimits limits;
@@ -60,16 +60,16 @@ struct LiveLimitsRecord {
 
 // The robot model a pose-scheduled cell's sets are designed on (pose_schedule: model, axis, modes).
 struct PoseDynamics {
-  std::string model_path;      // the model's file (a pose part of the structure at the pose)
+  std::string model_path;  // the model's file (a pose part of the structure at the pose)
   config::RobotModelConfig model;
-  int axis{1};                 // the actuator's direction in the model's plane: 0 = x, 1 = y
-  int modes{3};                // the model's lowest modes in the loop's plant
+  int axis{1};   // the actuator's direction in the model's plane: 0 = x, 1 = y
+  int modes{3};  // the model's lowest modes in the loop's plant
 };
 
 struct LiveStabilitySettings {
-  double rpm_step{1.0};        // speeds are rounded to this for the cache
+  double rpm_step{1.0};  // speeds are rounded to this for the cache
   double gain_step_ns_per_m{10.0};
-  double pose_step_deg{2.0};   // joint angles are rounded to this (PoseDynamics)
+  double pose_step_deg{2.0};          // joint angles are rounded to this (PoseDynamics)
   double loop_model_tolerance{0.10};  // the loop's plant's open limit against the whole model's (PoseDynamics)
   std::size_t cache_entries{4096};
 };
@@ -104,9 +104,11 @@ class LiveStability {
 
   // Low priority (the live lobes): a thread of its own below the cell's others (nice 10) computes these speeds
   // for (set, gain, pose) into the cache; a new sweep replaces the one before. Any thread.
-  void sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm, const std::vector<double>& pose_deg = {});
+  void sweep(std::size_t set, double gain_ns_per_m, const std::vector<double>& rpm,
+             const std::vector<double>& pose_deg = {});
   // Any thread: every limit computed so far for (set, gain, pose), by speed.
-  [[nodiscard]] std::vector<LiveLimits> known(std::size_t set, double gain_ns_per_m, const std::vector<double>& pose_deg = {}) const;
+  [[nodiscard]] std::vector<LiveLimits> known(std::size_t set, double gain_ns_per_m,
+                                              const std::vector<double>& pose_deg = {}) const;
   // The same for a speed schedule (controller.speed_schedule): each speed with the set and K it runs there.
   struct SweepPoint {
     double rpm{0.0};
@@ -135,8 +137,8 @@ class LiveStability {
   [[nodiscard]] Key key(double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg) const;
   [[nodiscard]] std::vector<double> pose_of(const Key& k) const;
   [[nodiscard]] LiveLimits evaluate(const Key& k) const;
-  [[nodiscard]] LiveLimits evaluate_loop(const Key& k) const;  // through the loop's plant at the key's pose
-  void check_loop_model(LiveLimits& l, bool damping) const;   // at a pose: the whole model's open limit
+  [[nodiscard]] LiveLimits evaluate_loop(const Key& k) const;      // through the loop's plant at the key's pose
+  void check_loop_model(LiveLimits& l, bool damping) const;        // at a pose: the whole model's open limit
   [[nodiscard]] LiveLimits evaluate_reported(const Key& k) const;  // a failure as a result with its problem
   void store(const Key& k, LiveLimits l);                          // under m_
   void worker(std::stop_token stop);

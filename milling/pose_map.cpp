@@ -29,13 +29,18 @@ std::pair<double, double> job_minimum(const config::MillingConfig& job, const st
 
 }  // namespace
 
-PoseMap pose_map(const config::RobotModelConfig& m, const PoseMapRequest& req, const std::function<void(int, int)>& progress) {
+PoseMap pose_map(const config::RobotModelConfig& m, const PoseMapRequest& req,
+                 const std::function<void(int, int)>& progress) {
   if (req.job) {
     bool has_pose = false;
-    for (const auto& part : req.job->find_structure(req.job->structure)->parts) has_pose = has_pose || part.pose.has_value();
+    for (const auto& part : req.job->find_structure(req.job->structure)->parts)
+      has_pose = has_pose || part.pose.has_value();
     if (!has_pose)
-      throw config::ConfigError({config::Problem{req.job->source, {}, "structures",
-                                                 "--job: the job's structure has no robot pose part (pose: {model, joints_deg})"}});
+      throw config::ConfigError(
+          {config::Problem{req.job->source,
+                           {},
+                           "structures",
+                           "--job: the job's structure has no robot pose part (pose: {model, joints_deg})"}});
   }
   PoseMap out;
   out.f1_min_hz = INFINITY;

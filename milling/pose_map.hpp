@@ -23,17 +23,17 @@ struct PoseMapPoint {
 };
 
 struct PoseMapRequest {
-  std::vector<double> base_deg;         // the other joints' angles
-  std::size_t joint_a{1}, joint_b{2};   // the two joints varied over their travel (0-based)
-  int steps{21};                        // grid steps per joint (>= 2)
+  std::vector<double> base_deg;        // the other joints' angles
+  std::size_t joint_a{1}, joint_b{2};  // the two joints varied over their travel (0-based)
+  int steps{21};                       // grid steps per joint (>= 2)
   const config::MillingConfig* job{nullptr};
-  bool zero_order{false};               // the job's depth by the zero-order preview (else the accurate method)
+  bool zero_order{false};  // the job's depth by the zero-order preview (else the accurate method)
 };
 
 struct PoseMap {
-  std::vector<PoseMapPoint> grid;       // joint_a's steps outer, joint_b's inner
+  std::vector<PoseMapPoint> grid;  // joint_a's steps outer, joint_b's inner
   double f1_min_hz{0.0}, f1_max_hz{0.0};
-  std::string method;                   // with a job: "SDM" or "zero-order preview"
+  std::string method;  // with a job: "SDM" or "zero-order preview"
   double min_depth_min_mm{0.0}, min_depth_max_mm{0.0};
 };
 

@@ -58,7 +58,8 @@ SampledSdm::SampledSdm(const Structure& damped, const Cutter& cutter, const conf
       feed_axis_(feed_axis),
       settings_(settings) {
   if (parts_.empty()) throw std::invalid_argument("SampledSdm: the structure has no controller part");
-  if (settings_.min_grid_per_period < 3) throw std::invalid_argument("SampledSdm: needs at least 3 grid points per period");
+  if (settings_.min_grid_per_period < 3)
+    throw std::invalid_argument("SampledSdm: needs at least 3 grid points per period");
   for (const auto& p : parts_) {
     const double t = 1.0 / p.model->loop_rate_hz();
     if (tick_s_ > 0.0 && std::abs(t - tick_s_) > 1e-12 * t)
@@ -77,7 +78,8 @@ std::optional<std::string> sampled_speed_problem(double rpm, int teeth, double l
   const double ticks = std::round(60.0 / (rpm * teeth) / tick_s);
   if (rpm > 0.0 && std::isfinite(rpm) && ticks >= SampledSdmSettings::kMinTicksPerTooth) return std::nullopt;
   const double max_rpm = 60.0 / (teeth * (SampledSdmSettings::kMinTicksPerTooth - 0.5) * tick_s) * (1.0 - 1e-9);
-  return "spindle speed = " + fmt(rpm) + " rpm: the sampled loop's semi-discretization needs a tooth period of at least " +
+  return "spindle speed = " + fmt(rpm) +
+         " rpm: the sampled loop's semi-discretization needs a tooth period of at least " +
          std::to_string(SampledSdmSettings::kMinTicksPerTooth) + " loop periods (" +
          fmt(SampledSdmSettings::kMinTicksPerTooth * tick_s * 1e3) + " ms at " + fmt(loop_rate_hz) +
          " Hz), allowed range (0, " + fmt(max_rpm) + "] rpm";
@@ -108,7 +110,8 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
       continue;
     }
     // Across the plane: forces along both machine axes in, displacements along both out (machine frame).
-    const analysis::SampledPaths p = model->sampled_paths({part.location, *part.across}, part.gain_ns_per_m, part.polarity);
+    const analysis::SampledPaths p =
+        model->sampled_paths({part.location, *part.across}, part.gain_ns_per_m, part.polarity);
     MatrixXd bm(p.b.rows(), 2), cm(2, p.c.cols());
     bm.col(d) = p.b.col(0), bm.col(1 - d) = p.b.col(1);
     cm.row(d) = p.c.row(0), cm.row(1 - d) = p.c.row(1);
@@ -139,16 +142,19 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
 }
 
 // long: one monodromy matrix over a tooth period on preallocated blocks (the hot loop of the accurate method)
-SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks, bool want_vector) const {
+SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks,
+                                         bool want_vector) const {
   const Eigen::Index n = sys.a.rows();
   const double period_s = ticks * tick_s_;
-  const int k = std::min(ticks, std::max(settings_.min_grid_per_period,
-                                         static_cast<int>(std::ceil(kTwoPi * sys.highest_mode_hz * period_s /
-                                                                    settings_.max_grid_phase_rad))));
+  const int k = std::min(
+      ticks,
+      std::max(settings_.min_grid_per_period,
+               static_cast<int>(std::ceil(kTwoPi * sys.highest_mode_hz * period_s / settings_.max_grid_phase_rad))));
   const Eigen::Index dim = n + 2 * (k + 1);
   Result res;
   res.grid.resize(static_cast<std::size_t>(k) + 1);
-  for (int j = 0; j <= k; ++j) res.grid[static_cast<std::size_t>(j)] = static_cast<int>(std::lround(static_cast<double>(j) * ticks / k));
+  for (int j = 0; j <= k; ++j)
+    res.grid[static_cast<std::size_t>(j)] = static_cast<int>(std::lround(static_cast<double>(j) * ticks / k));
   auto grid_tick = [&](int q) {  // any grid index, periodic in k
     const int p = q >= 0 ? q / k : -((-q + k - 1) / k);
     return static_cast<double>(res.grid[static_cast<std::size_t>(q - p * k)] + p * ticks);

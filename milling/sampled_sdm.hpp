@@ -33,9 +33,9 @@ namespace robodamp::milling {
 
 struct SampledSdmSettings {
   int axial_slices{20};
-  int min_grid_per_period{40};      // grid points per tooth period at least (time_domain.sdm_steps_per_period)
-  double max_grid_phase_rad{0.5};   // and a grid interval at most this phase of the highest loop mode (0.25
-                                    // moves the limits of active_damping_c2.yaml by 0.2 % at most, 100-700 rpm)
+  int min_grid_per_period{40};     // grid points per tooth period at least (time_domain.sdm_steps_per_period)
+  double max_grid_phase_rad{0.5};  // and a grid interval at most this phase of the highest loop mode (0.25
+                                   // moves the limits of active_damping_c2.yaml by 0.2 % at most, 100-700 rpm)
   static constexpr int kMinTicksPerTooth = 10;  // below, the speed grid of the loop period is too coarse
 };
 
@@ -67,23 +67,24 @@ class SampledSdm {
 
  private:
   struct System {
-    Eigen::MatrixXd a, b, c;           // cutter frame: b n x 2, c 2 x n
+    Eigen::MatrixXd a, b, c;  // cutter frame: b n x 2, c 2 x n
     double highest_mode_hz{0.0};
   };
   struct Result {
     std::complex<double> mu;
-    Eigen::VectorXcd history;          // the critical eigenvector's grid displacements g_{-1} .. g_{-k}
-    std::vector<int> grid;             // tick index of each grid point 0..k
+    Eigen::VectorXcd history;  // the critical eigenvector's grid displacements g_{-1} .. g_{-k}
+    std::vector<int> grid;     // tick index of each grid point 0..k
   };
   // A^m and A^r B of one System, made as the monodromy needs them and kept across the depths of one search
   // (one per System and thread), and the search's dominant-multiplier finder.
   struct Propagators {
-    std::map<int, Eigen::MatrixXd> a_pow;      // A^m, by m
-    std::vector<Eigen::MatrixXd> a_pow_b;      // A^r B, r = 0, 1, ...
+    std::map<int, Eigen::MatrixXd> a_pow;  // A^m, by m
+    std::vector<Eigen::MatrixXd> a_pow_b;  // A^r B, r = 0, 1, ...
     DominantMultiplier dominant;
   };
   [[nodiscard]] System system_at(double rpm) const;
-  [[nodiscard]] Result monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks, bool want_vector) const;
+  [[nodiscard]] Result monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks,
+                                 bool want_vector) const;
   [[nodiscard]] double chatter_hz(const Result& r, int ticks) const;
 
   std::vector<Structure::ControllerPart> parts_;

@@ -33,7 +33,8 @@ std::vector<SdmPoint> scheduled_limits(const config::StructureConfig& sc, const 
   for (const auto& [candidate, idx] : groups) {
     const auto [set, gain] = candidate;
     if (gain <= 0.0) continue;  // the damper commands nothing: the open loop
-    const Structure damped(sc, true, {std::make_shared<const analysis::LoopModel>(sets[set]), gain, sets[set].controller.polarity});
+    const Structure damped(
+        sc, true, {std::make_shared<const analysis::LoopModel>(sets[set]), gain, sets[set].controller.polarity});
     const AccurateStability truth(damped, job);
     std::vector<double> rpm, guess;
     for (const std::size_t i : idx) rpm.push_back(speeds[i]), guess.push_back(open[i].critical_depth_mm);
@@ -41,7 +42,7 @@ std::vector<SdmPoint> scheduled_limits(const config::StructureConfig& sc, const 
     std::vector<double> mm;
     for (const auto& p : pts) mm.push_back(p.critical_depth_mm);
     mm = holding_limits_mm(damped, job, rpm, mm);  // as deep as the actuator follows the forced vibration
-    for (std::size_t k = 0; k < rpm.size(); ++k)      // no deeper than the band vouches for (the cut in time)
+    for (std::size_t k = 0; k < rpm.size(); ++k)   // no deeper than the band vouches for (the cut in time)
       if (const auto cap = config::scheduled_depth_limit_mm(sets[set], set, rpm[k]); cap && *cap < mm[k]) mm[k] = *cap;
     for (std::size_t k = 0; k < idx.size(); ++k) pts[k].critical_depth_mm = mm[k], out[idx[k]] = pts[k];
   }
@@ -51,7 +52,8 @@ std::vector<SdmPoint> scheduled_limits(const config::StructureConfig& sc, const 
 std::optional<ScheduledLobes> scheduled_lobe_study(const config::StructureConfig& sc, const config::MillingConfig& job,
                                                    const std::vector<double>& rpms,
                                                    const std::function<void(std::size_t, std::size_t)>& progress) {
-  const auto part = std::find_if(sc.parts.begin(), sc.parts.end(), [](const auto& p) { return p.controller.has_value(); });
+  const auto part =
+      std::find_if(sc.parts.begin(), sc.parts.end(), [](const auto& p) { return p.controller.has_value(); });
   if (part == sc.parts.end()) return std::nullopt;
   const config::Config cell = config::load_config_file(part->controller->config_path);
   if (!cell.controller.speed_schedule) return std::nullopt;
@@ -91,7 +93,8 @@ std::optional<ScheduledLobes> scheduled_lobe_study(const config::StructureConfig
     st.curve.push_back({s[i].rpm, s[i].critical_depth_mm, s[i].chatter_hz, std::nullopt, to_string(s[i].type)});
     out.open_mm.push_back(o[i].critical_depth_mm);
     if (s[i].critical_depth_mm < o[i].critical_depth_mm * 0.995) ++out.below_open;
-    if (s[i].critical_depth_mm < st.min_b_lim_mm) st.min_b_lim_mm = s[i].critical_depth_mm, st.min_rpm = s[i].rpm, st.min_chatter_hz = s[i].chatter_hz;
+    if (s[i].critical_depth_mm < st.min_b_lim_mm)
+      st.min_b_lim_mm = s[i].critical_depth_mm, st.min_rpm = s[i].rpm, st.min_chatter_hz = s[i].chatter_hz;
   }
   for (std::size_t k = 0; k < rpms.size(); ++k) {
     const SdmPoint& p = s[grid.size() + k];
@@ -104,7 +107,8 @@ std::optional<ScheduledLobes> scheduled_lobe_study(const config::StructureConfig
     st.at_rpm.push_back(a);
   }
   st.diagram_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  st.notes.push_back(cell.source + "'s speed schedule: " + std::to_string(out.bands) + " bands, each speed with its band's "
+  st.notes.push_back(cell.source + "'s speed schedule: " + std::to_string(out.bands) +
+                     " bands, each speed with its band's "
                      "controller and K (K = 0: the open loop's SDM there)");
   return out;
 }

@@ -19,18 +19,19 @@
 namespace robodamp::milling {
 
 struct ScheduledLobes {
-  LobeStudy study;                 // method "sampled-loop SDM, speed schedule"
-  std::vector<double> open_mm;     // the open loop's SDM at each of study.curve's speeds
-  std::size_t below_open{0};       // speeds where the schedule's limit is below the open loop's by > 0.5 %
+  LobeStudy study;              // method "sampled-loop SDM, speed schedule"
+  std::vector<double> open_mm;  // the open loop's SDM at each of study.curve's speeds
+  std::size_t below_open{0};    // speeds where the schedule's limit is below the open loop's by > 0.5 %
   std::size_t bands{0};
-  std::string config;              // the damping configuration whose schedule it is
+  std::string config;  // the damping configuration whose schedule it is
 };
 
 // Each speed's limit with the controller and K of the band of cell's speed schedule that holds it (the
 // structure's controller parts running them), open[i] where the band's K is 0.
 [[nodiscard]] std::vector<SdmPoint> scheduled_limits(const config::StructureConfig& structure,
                                                      const config::MillingConfig& job, const config::Config& cell,
-                                                     const std::vector<double>& speeds, const std::vector<SdmPoint>& open);
+                                                     const std::vector<double>& speeds,
+                                                     const std::vector<SdmPoint>& open);
 
 // Nothing when the structure's (first) controller configuration has no speed schedule. rpms: the direct test's
 // speeds (the band holding each). progress(done, of) as the speeds finish.

@@ -33,7 +33,8 @@ SdmModel::SdmModel(const std::vector<CutterModalTerm>& terms, const Cutter& cutt
   for (Eigen::Index k = 0; k < a_.rows(); k += 2) blocks_.emplace_back(a_.block(k, k, 2, 2));
   Eigen::MatrixXd check = Eigen::MatrixXd::Zero(a_.rows(), a_.cols());
   for (Eigen::Index k = 0; k < a_.rows(); k += 2) check.block(k, k, 2, 2) = a_.block(k, k, 2, 2);
-  if (a_.rows() % 2 != 0 || check != a_) throw std::logic_error("SdmModel: the structure's model is not block diagonal");
+  if (a_.rows() % 2 != 0 || check != a_)
+    throw std::logic_error("SdmModel: the structure's model is not block diagonal");
 }
 
 DirectionalMatrix::DirectionalMatrix(const Cutter& cutter, const config::MaterialConfig& material,
@@ -75,7 +76,9 @@ Eigen::Matrix2d DirectionalMatrix::mean(double phi0, double dphi, int sub) const
   return mean;
 }
 
-std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const { return multiplier(axial_mm, rpm, nullptr); }
+std::complex<double> SdmModel::multiplier(double axial_mm, double rpm) const {
+  return multiplier(axial_mm, rpm, nullptr);
+}
 
 double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t, const Eigen::VectorXcd& history,
                           double tooth_hz) {
@@ -85,7 +88,8 @@ double floquet_chatter_hz(std::complex<double> mu, const std::vector<double>& t,
   for (int m = -k / 2; m <= k / 2; ++m) {
     std::complex<double> cx = 0.0, cy = 0.0;
     for (int q = 0; q < k; ++q) {
-      const std::complex<double> w = std::exp(-t[static_cast<std::size_t>(q)] * log_mu - kTwoPi * i * static_cast<double>(m) * t[static_cast<std::size_t>(q)]);
+      const std::complex<double> w = std::exp(-t[static_cast<std::size_t>(q)] * log_mu -
+                                              kTwoPi * i * static_cast<double>(m) * t[static_cast<std::size_t>(q)]);
       cx += w * history(2 * q), cy += w * history(2 * q + 1);
     }
     const double energy = std::norm(cx) + std::norm(cy);
@@ -167,7 +171,8 @@ std::complex<double> SdmModel::dominant(const Eigen::MatrixXd& z, double rpm, do
     // History slot j holds q at -(j + 1) / m tooth periods.
     std::vector<double> t(static_cast<std::size_t>(m_));
     for (int j = 0; j < m_; ++j) t[static_cast<std::size_t>(j)] = -(j + 1.0) / m_;
-    *chatter_hz = floquet_chatter_hz(ev(best), t, es.eigenvectors().col(best).segment(n, 2 * m_), rpm * cutter_.teeth / 60.0);
+    *chatter_hz =
+        floquet_chatter_hz(ev(best), t, es.eigenvectors().col(best).segment(n, 2 * m_), rpm * cutter_.teeth / 60.0);
   }
   return ev(best);
 }

@@ -54,7 +54,8 @@ class DirectionalMatrix {
 struct DepthBracket {
   double lo_mm{0.0}, hi_mm{0.0};
 };
-[[nodiscard]] DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol);
+[[nodiscard]] DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm,
+                                               double rel_tol);
 
 // The chatter frequency of a Floquet mode q(t) = mu^(t/T) p(t), p periodic, from its displacement at times
 // t_periods (in tooth periods, over one period) as [x, y] pairs: p's strongest harmonic m gives the

@@ -16,10 +16,10 @@ namespace robodamp::milling {
 
 struct SleResult {
   double rpm{0.0};
-  double sle_um{0.0};                // mean over the engaged axial depth
-  double min_um{0.0}, max_um{0.0};   // across the depth
-  std::vector<double> profile_um;    // per axial slice, tip first
-  double mean_normal_force_n{0.0};   // static force towards the wall normal (+y of the cutter frame)
+  double sle_um{0.0};               // mean over the engaged axial depth
+  double min_um{0.0}, max_um{0.0};  // across the depth
+  std::vector<double> profile_um;   // per axial slice, tip first
+  double mean_normal_force_n{0.0};  // static force towards the wall normal (+y of the cutter frame)
 };
 
 [[nodiscard]] SleResult surface_location_error(const Structure& structure, const Cutter& cutter,

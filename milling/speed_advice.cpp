@@ -46,8 +46,8 @@ struct AlongPath {
   bool valid{true};
 };
 
-AlongPath limit_along(LiveStability& stability, const SpeedAdviceRequest& request, const std::vector<std::vector<double>>& poses,
-                      double rpm) {
+AlongPath limit_along(LiveStability& stability, const SpeedAdviceRequest& request,
+                      const std::vector<std::vector<double>>& poses, double rpm) {
   AlongPath out;
   bool first = true;
   const auto now = request.controller_at ? request.controller_at(rpm) : std::pair{request.set, request.gain_ns_per_m};
@@ -133,7 +133,8 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.limit_now_mm = limit_of(now);
   a.method = request.damped ? now.method : now.open_method;
   a.depth_mm = request.depth_mm;
-  if (request.chatter_hz > 0.0 && a.limit_now_mm > request.depth_mm) a.depth_mm = a.limit_now_mm, a.depth_from_chatter = true;
+  if (request.chatter_hz > 0.0 && a.limit_now_mm > request.depth_mm)
+    a.depth_mm = a.limit_now_mm, a.depth_from_chatter = true;
   const double margin = a.depth_from_chatter ? s.chatter_depth_margin : s.depth_margin;
   const int teeth = stability.job().tool.teeth;
   if (!request.pose_deg.empty()) {
@@ -146,7 +147,8 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   for (std::size_t i = 0; i < std::max<std::size_t>(a.poses_checked.size(), 1); ++i) {
     const std::vector<double> pose = a.poses_checked.empty() ? std::vector<double>{} : a.poses_checked[i];
     for (const double f : mode_frequencies(stability.structure(), stability.loop_config(request.set, pose)))
-      if (std::none_of(modes.begin(), modes.end(), [&](double g) { return std::abs(g - f) < 0.005; })) modes.push_back(f);
+      if (std::none_of(modes.begin(), modes.end(), [&](double g) { return std::abs(g - f) < 0.005; }))
+        modes.push_back(f);
   }
   std::vector<SpeedOption> qualified;
   a.best.margin = -1.0;
@@ -159,8 +161,8 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
     ++a.evaluated;
     if (!l.valid) continue;  // the loop itself unstable there (at a pose checked)
     // The damped verdict is for the speed the sampled loop steps (whole loop periods per tooth period).
-    const SpeedOption o{request.damped ? l.at_lowest.analysed_rpm : l.at_lowest.rpm, l.limit_mm, l.limit_mm / a.depth_mm,
-                        c.source, l.pose_deg};
+    const SpeedOption o{request.damped ? l.at_lowest.analysed_rpm : l.at_lowest.rpm, l.limit_mm,
+                        l.limit_mm / a.depth_mm, c.source, l.pose_deg};
     if (o.margin > a.best.margin) a.best = o;
     if (o.margin >= margin && std::abs(o.rpm - request.rpm) > 0.5) qualified.push_back(o);
   }
@@ -172,12 +174,15 @@ SpeedAdvice advise_speed(LiveStability& stability, const SpeedAdviceRequest& req
   a.found = !a.options.empty();
   if (!a.found)
     a.reason = "no speed in " + number(rpm_min, "%.0f") + ".." + number(rpm_max, "%.0f") + " rpm is stable at " +
-               number(a.depth_mm, "%.3f") + " mm" + (a.depth_from_chatter ? " (the limit where it chatters)" : "") + " with " + number(100.0 * (margin - 1.0), "%.0f") +
-               " % margin (" + std::to_string(a.evaluated) + " speeds analysed; the best, " +
-               number(a.best.rpm, "%.0f") + " rpm, allows " + number(a.best.limit_mm, "%.3f") +
-               " mm" + (a.poses_checked.size() > 1 ? " at " + config::describe_pose(a.best.limiting_pose_deg) : std::string()) +
-               "): reduce the depth" + (a.poses_checked.size() > 1 ? " (checked at the pose now and " + std::to_string(a.poses_checked.size() - 1) +
-                                                                         " of the path ahead)" : std::string());
+               number(a.depth_mm, "%.3f") + " mm" + (a.depth_from_chatter ? " (the limit where it chatters)" : "") +
+               " with " + number(100.0 * (margin - 1.0), "%.0f") + " % margin (" + std::to_string(a.evaluated) +
+               " speeds analysed; the best, " + number(a.best.rpm, "%.0f") + " rpm, allows " +
+               number(a.best.limit_mm, "%.3f") + " mm" +
+               (a.poses_checked.size() > 1 ? " at " + config::describe_pose(a.best.limiting_pose_deg) : std::string()) +
+               "): reduce the depth" +
+               (a.poses_checked.size() > 1 ? " (checked at the pose now and " +
+                                                 std::to_string(a.poses_checked.size() - 1) + " of the path ahead)"
+                                           : std::string());
   a.compute_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return a;
 }

@@ -18,8 +18,8 @@ void add_resonances(std::vector<Resonance>& out, const config::FrfConfig& frf) {
 
 }  // namespace
 
-config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis, const std::string& source,
-                                           int across_location) {
+config::StructureConfig robot_through_cell(const config::StructureConfig& s, int location, int axis,
+                                           const std::string& source, int across_location) {
   config::StructureConfig st;
   st.name = "robot_at_pose";
   for (const auto& part : s.parts)
@@ -94,10 +94,11 @@ void Structure::add_pose(const std::string& part, const config::PosePartConfig& 
 // terms: along the measured axis (H11), across it (H22) and between (H21, both ways). A mode the measurements
 // alone know moves the TCP along the measured axis only. The chain itself would be the model without what the
 // measurements corrected.
-void Structure::add_mapped_pose(const std::string& part, const config::PosePartConfig& pc, const config::RobotModelConfig& m) {
+void Structure::add_mapped_pose(const std::string& part, const config::PosePartConfig& pc,
+                                const config::RobotModelConfig& m) {
   const int axis = m.measured_modes->axis, across = 1 - axis;
-  const config::Config plane = analysis::config_in_plane_at_pose(config::Config{}, m, pc.joints_deg, axis,
-                                                                 static_cast<int>(kPoseModesForCut));
+  const config::Config plane =
+      analysis::config_in_plane_at_pose(config::Config{}, m, pc.joints_deg, axis, static_cast<int>(kPoseModesForCut));
   for (const config::FrfConfig& f : plane.robot.frfs) {
     const int r = f.response_location == 1 ? axis : across, e = f.excitation_location == 1 ? axis : across;
     for (const std::size_t k : {static_cast<std::size_t>(2 * r + e), static_cast<std::size_t>(2 * e + r)}) {
@@ -127,10 +128,12 @@ void Structure::add_controller(const std::string& part, const std::string& sourc
   os << part << ": location " << pc.location << " of " << source;
   if (damped_) {
     if (!model->stable(c.gain_ns_per_m, c.polarity))
-      throw config::ConfigError({config::Problem{source, {}, "controller",
-                                                 "the damping loop is unstable at K = " +
-                                                     std::to_string(c.gain_ns_per_m) + " N s/m, polarity " +
-                                                     std::to_string(c.polarity) + ": no closed-loop FRF exists"}});
+      throw config::ConfigError(
+          {config::Problem{source,
+                           {},
+                           "controller",
+                           "the damping loop is unstable at K = " + std::to_string(c.gain_ns_per_m) +
+                               " N s/m, polarity " + std::to_string(c.polarity) + ": no closed-loop FRF exists"}});
     // Closed-loop poles below Nyquist: where the damped FRF has its resonances.
     const double fs = model->loop_rate_hz();
     for (const auto& z : model->closed_loop_poles(c.gain_ns_per_m, c.polarity)) {
@@ -139,8 +142,8 @@ void Structure::add_controller(const std::string& part, const std::string& sourc
       const double f = std::abs(s.imag()) / (kTwoPi);
       if (f > 0.5 && f < 0.5 * fs) resonances_.push_back({f, std::max(1e-4, -s.real() / std::abs(s))});
     }
-    os << ", closed loop at K = " << c.gain_ns_per_m << " N s/m, polarity " << c.polarity
-       << " (sampled controller at " << fs << " Hz)";
+    os << ", closed loop at K = " << c.gain_ns_per_m << " N s/m, polarity " << c.polarity << " (sampled controller at "
+       << fs << " Hz)";
   } else {
     os << ", open loop";
   }
@@ -154,11 +157,13 @@ bool Structure::has_controller() const { return !controllers_.empty(); }
 std::vector<Structure::ControllerPath> Structure::controller_paths() const {
   std::vector<ControllerPath> out;
   for (const auto& c : controllers_) {
-    if (const sim::FrfPath* p = c.model->plant().path(c.location, c.location)) out.push_back({c.direction, c.direction, *p});
+    if (const sim::FrfPath* p = c.model->plant().path(c.location, c.location))
+      out.push_back({c.direction, c.direction, *p});
     if (!c.across) continue;
     const std::size_t o = 1 - c.direction;
-    for (const auto& [g, h, dg, dh] : {std::tuple{*c.across, c.location, o, c.direction}, std::tuple{c.location, *c.across, c.direction, o},
-                                       std::tuple{*c.across, *c.across, o, o}})
+    for (const auto& [g, h, dg, dh] :
+         {std::tuple{*c.across, c.location, o, c.direction}, std::tuple{c.location, *c.across, c.direction, o},
+          std::tuple{*c.across, *c.across, o, o}})
       if (const sim::FrfPath* p = c.model->plant().path(g, h)) out.push_back({dg, dh, *p});
   }
   return out;
@@ -173,12 +178,14 @@ Eigen::Matrix2cd Structure::frf(double f_hz) const {
   for (const auto& c : controllers_) {
     auto add = [&](std::size_t resp, std::size_t exc, std::size_t dr, std::size_t de) {
       g(static_cast<Eigen::Index>(dr), static_cast<Eigen::Index>(de)) +=
-          damped_ ? c.model->closed_sampled(resp, exc, f_hz, c.gain_ns_per_m, c.polarity) : c.model->open_continuous(resp, exc, f_hz);
+          damped_ ? c.model->closed_sampled(resp, exc, f_hz, c.gain_ns_per_m, c.polarity)
+                  : c.model->open_continuous(resp, exc, f_hz);
     };
     add(c.location, c.location, c.direction, c.direction);
     if (!c.across) continue;
     const std::size_t o = 1 - c.direction;
-    add(*c.across, c.location, o, c.direction), add(c.location, *c.across, c.direction, o), add(*c.across, *c.across, o, o);
+    add(*c.across, c.location, o, c.direction), add(c.location, *c.across, c.direction, o),
+        add(*c.across, *c.across, o, o);
   }
   return g;
 }

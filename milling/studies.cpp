@@ -20,7 +20,8 @@ double elapsed_ms(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-LobeStudy zero_order_lobe_study(const Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms) {
+LobeStudy zero_order_lobe_study(const Structure& structure, const config::MillingConfig& cfg,
+                                const std::vector<double>& rpms) {
   const auto t0 = std::chrono::steady_clock::now();
   const LobeModel model(structure, chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
   const LobeDiagram d = model.diagram();
@@ -31,7 +32,8 @@ LobeStudy zero_order_lobe_study(const Structure& structure, const config::Millin
   s.frequency_points = d.frequency_points;
   for (const auto& p : d.curve)
     s.curve.push_back({p.rpm, p.b_lim_mm,
-                       std::isfinite(p.b_lim_mm) ? std::optional<double>(p.chatter_hz) : std::nullopt, p.lobe, std::nullopt});
+                       std::isfinite(p.b_lim_mm) ? std::optional<double>(p.chatter_hz) : std::nullopt, p.lobe,
+                       std::nullopt});
   s.min_b_lim_mm = d.minimum.b_lim_mm;
   s.min_rpm = d.minimum.rpm;
   s.min_chatter_hz = d.minimum.chatter_hz;
@@ -48,8 +50,9 @@ LobeStudy zero_order_lobe_study(const Structure& structure, const config::Millin
   return s;
 }
 
-LobeStudy accurate_lobe_study(const Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms,
-                              const std::function<void(const std::string&, std::size_t, std::size_t, double)>& progress) {
+LobeStudy accurate_lobe_study(
+    const Structure& structure, const config::MillingConfig& cfg, const std::vector<double>& rpms,
+    const std::function<void(const std::string&, std::size_t, std::size_t, double)>& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const AccurateStability truth(structure, cfg);
   for (double rpm : rpms)
@@ -143,7 +146,8 @@ void sle_conditions(const Structure& structure, const config::MillingConfig& cfg
       const config::Axis feed = normal == config::Axis::kY ? config::Axis::kX : config::Axis::kY;
       const CutConditions cc{cfg.cut.mode, c.radial_mm, c.axial_mm, c.feed_per_tooth_mm};
       const double offset_um = 1000.0 * (normal == config::Axis::kX ? c.path_offset_x_mm : c.path_offset_y_mm);
-      const auto r = surface_location_error(structure, cutter, cfg.material, cc, feed, c.rpm, s.axial_slices, s.harmonics);
+      const auto r =
+          surface_location_error(structure, cutter, cfg.material, cc, feed, c.rpm, s.axial_slices, s.harmonics);
       const auto comp = compensate(structure, cutter, cfg.material, cc, feed, c.rpm, offset_um, s);
       config::CutConfig cut_c = cfg.cut;
       cut_c.radial_mm = c.radial_mm;

@@ -35,11 +35,13 @@ std::vector<CutterModalTerm> cutter_modal_terms(const Structure& structure, conf
       const double wn = kTwoPi * md.freq_hz, zeta = std::max(kMinZeta, 0.5 * md.loss_factor);
       for (int r = 0; r < 2; ++r)
         for (int e = 0; e < 2; ++e)
-          if (const double a = md.tcp_shape(r) * md.tcp_shape(e); a != 0.0 && wn > 0.0) add(out, r, e, wn, zeta, a, 0.0);
+          if (const double a = md.tcp_shape(r) * md.tcp_shape(e); a != 0.0 && wn > 0.0)
+            add(out, r, e, wn, zeta, a, 0.0);
     }
   for (const auto& c : structure.controller_paths())
     for (const auto& m : c.path.modes)
-      add(out, static_cast<int>(c.direction), static_cast<int>(c.excitation_direction), m.wn_rad_per_s, m.damping_ratio, m.a, m.b);
+      add(out, static_cast<int>(c.direction), static_cast<int>(c.excitation_direction), m.wn_rad_per_s, m.damping_ratio,
+          m.a, m.b);
   return out;
 }
 
@@ -54,7 +56,8 @@ ToolDynamics::ToolDynamics(const std::vector<CutterModalTerm>& terms, double ste
   std::vector<Key> keys;
   for (const auto& t : terms) {
     std::size_t k = 0;
-    while (k < keys.size() && !(keys[k].excitation == t.excitation && keys[k].wn == t.wn_rad_per_s && keys[k].zeta == t.damping_ratio))
+    while (k < keys.size() &&
+           !(keys[k].excitation == t.excitation && keys[k].wn == t.wn_rad_per_s && keys[k].zeta == t.damping_ratio))
       ++k;
     if (k == keys.size()) keys.push_back({t.excitation, t.wn_rad_per_s, t.damping_ratio});
     block_of.push_back(k);

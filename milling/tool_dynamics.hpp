@@ -65,8 +65,8 @@ class ToolDynamics final : public CutDynamics {
  private:
   struct Block {
     Eigen::Matrix2d phi;
-    Eigen::Vector2d gamma;    // held input
-    Eigen::Vector2d ramp;     // input rising linearly from 0 to 1 over the step
+    Eigen::Vector2d gamma;  // held input
+    Eigen::Vector2d ramp;   // input rising linearly from 0 to 1 over the step
     int excitation{0};
     Eigen::Vector2d x{Eigen::Vector2d::Zero()};
   };

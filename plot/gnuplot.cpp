@@ -26,8 +26,9 @@ std::string run_gnuplot(const std::string& script, const std::string& data, cons
     fs::remove(data_path, ec);
     return "cannot start gnuplot (apt-get install gnuplot-nox)";
   }
-  std::fprintf(gp, "DATA = '%s'\nset terminal pngcairo noenhanced size 1200,900 font ',10'\nset output '%s'\n%s\nset output\n",
-               data_path.c_str(), png_path.c_str(), script.c_str());
+  std::fprintf(
+      gp, "DATA = '%s'\nset terminal pngcairo noenhanced size 1200,900 font ',10'\nset output '%s'\n%s\nset output\n",
+      data_path.c_str(), png_path.c_str(), script.c_str());
   const int rc = pclose(gp);
   fs::remove(data_path, ec);
   if (rc != 0) return "gnuplot exited with status " + std::to_string(rc);

@@ -46,7 +46,8 @@ Eigen::MatrixXd correlation(const std::vector<Eigen::VectorXd>& x, double length
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j)
       r(i, j) = std::exp(-0.5 * (x[static_cast<std::size_t>(i)] - x[static_cast<std::size_t>(j)]).squaredNorm() /
-                         (length_rad * length_rad)) + (i == j ? nugget : 0.0);
+                         (length_rad * length_rad)) +
+                (i == j ? nugget : 0.0);
   return r;
 }
 
@@ -57,7 +58,8 @@ Eigen::MatrixXd correlation(const std::vector<Eigen::VectorXd>& x, double length
 // from three poses on (with two, leaving one out says nothing about the shape between). On the robot wrong in
 // form (docs/pose_dynamics.md) the model's damping varies with the pose where the measured damping is flat, and
 // its participation passes through zero where the measured one peaks: there the track's own form wins.
-double leave_one_out_sse(const std::vector<Eigen::VectorXd>& x, const std::vector<double>& y, double noise, bool about_mean) {
+double leave_one_out_sse(const std::vector<Eigen::VectorXd>& x, const std::vector<double>& y, double noise,
+                         bool about_mean) {
   double sse = 0.0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     std::vector<Eigen::VectorXd> xs;
@@ -74,7 +76,8 @@ ModalMap::Field fitted_form(const std::vector<Eigen::VectorXd>& x, const std::ve
                             const std::vector<double>& against_model, double noise, QuantityForm& form) {
   const double n = static_cast<double>(x.size());
   form.own_rms = x.size() >= 2 ? std::sqrt(leave_one_out_sse(x, own, noise, true) / n) : 0.0;
-  form.model_rms = !against_model.empty() && x.size() >= 2 ? std::sqrt(leave_one_out_sse(x, against_model, noise, false) / n) : 0.0;
+  form.model_rms =
+      !against_model.empty() && x.size() >= 2 ? std::sqrt(leave_one_out_sse(x, against_model, noise, false) / n) : 0.0;
   form.own = against_model.empty() || (x.size() >= 3 && form.own_rms < form.model_rms);
   return form.own ? ModalMap::Field(x, own, noise, true) : ModalMap::Field(x, against_model, noise, false);
 }
@@ -88,8 +91,8 @@ struct Sample {
 
 // One measured mode over the poses (a track): each quantity in the form leave-one-out chooses, its model mode
 // (-1 where no one model mode follows it at every pose), its frequencies.
-void fit_track(const std::vector<Sample>& t, ModalMap::Field& freq, ModalMap::Field& damping, ModalMap::Field& stiffness,
-               TrackForm& form) {
+void fit_track(const std::vector<Sample>& t, ModalMap::Field& freq, ModalMap::Field& damping,
+               ModalMap::Field& stiffness, TrackForm& form) {
   form.model_index = t.front().model_index;
   for (const Sample& s : t)
     if (s.model_index != form.model_index) form.model_index = -1;
@@ -127,10 +130,11 @@ void fit_track(const std::vector<Sample>& t, ModalMap::Field& freq, ModalMap::Fi
 // The measured modes' indices among the model's: as many pairs within 25 % as possible, then the smallest
 // sum of |log frequency ratio|. Small counts (a few modes each): searched exhaustively.
 void best_assignment(const std::vector<double>& measured_hz, const std::vector<double>& model_hz, std::size_t i,
-                     std::vector<int>& now, std::vector<bool>& used, int pairs, double cost, int& best_pairs, double& best_cost,
-                     std::vector<int>& best) {
+                     std::vector<int>& now, std::vector<bool>& used, int pairs, double cost, int& best_pairs,
+                     double& best_cost, std::vector<int>& best) {
   if (i == measured_hz.size()) {
-    if (pairs > best_pairs || (pairs == best_pairs && cost < best_cost)) best_pairs = pairs, best_cost = cost, best = now;
+    if (pairs > best_pairs || (pairs == best_pairs && cost < best_cost))
+      best_pairs = pairs, best_cost = cost, best = now;
     return;
   }
   now[i] = -1;
@@ -156,7 +160,8 @@ std::vector<int> match_modes(const std::vector<double>& measured_hz, const std::
 
 }  // namespace
 
-std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis, int count) {
+std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const std::vector<double>& q, int axis,
+                                 int count) {
   const PlanarChain chain = at_pose(model, q);
   std::vector<AxisMode> out;
   for (const Mode& md : chain.modes(static_cast<std::size_t>(count))) {
@@ -168,7 +173,8 @@ std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const st
   return out;
 }
 
-ModalMap::Field::Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, double noise, bool about_mean) : x_(std::move(x)) {
+ModalMap::Field::Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, double noise, bool about_mean)
+    : x_(std::move(x)) {
   const auto n = static_cast<Eigen::Index>(y.size());
   const Eigen::VectorXd yv = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n);
@@ -228,8 +234,9 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
   if (!model.measured_modes || model.measured_modes->poses.empty())
     throw std::invalid_argument(model.source + ": no measured_modes to interpolate");
   if (model.measured_modes->axis != axis)
-    throw std::invalid_argument(model.source + ": measured_modes are along " + (model.measured_modes->axis == 0 ? "x" : "y") +
-                                ", the schedule's axis is " + (axis == 0 ? "x" : "y") + ": measure along the actuator's axis");
+    throw std::invalid_argument(model.source + ": measured_modes are along " +
+                                (model.measured_modes->axis == 0 ? "x" : "y") + ", the schedule's axis is " +
+                                (axis == 0 ? "x" : "y") + ": measure along the actuator's axis");
   // The tracks: a measured mode matched to a model mode joins that mode's track (the model's order is the prior's
   // identity of a mode: a mode a driving point misses at some poses does not shift the others); the modes the
   // model has no match for, by their rank among the unmatched at each pose.
@@ -237,7 +244,8 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
   for (const config::MeasuredPoseModes& p : model.measured_modes->poses) {
     const std::vector<AxisMode> prior = axis_modes(model, p.joints_deg, axis, count);
     std::vector<config::ModeConfig> measured = p.modes;
-    std::sort(measured.begin(), measured.end(), [](const auto& l, const auto& r) { return l.natural_freq_hz < r.natural_freq_hz; });
+    std::sort(measured.begin(), measured.end(),
+              [](const auto& l, const auto& r) { return l.natural_freq_hz < r.natural_freq_hz; });
     std::vector<double> measured_hz, model_hz;
     for (const auto& m : measured) measured_hz.push_back(m.natural_freq_hz);
     for (const auto& m : prior) model_hz.push_back(m.freq_hz);
@@ -247,8 +255,8 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
       const int j = match.model_of_measured[k];
       const AxisMode a = j >= 0 ? prior[static_cast<std::size_t>(j)] : AxisMode{};
       by_key[j >= 0 ? j : kUnmatchedKey + unmatched++].push_back(
-          {radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m, a.freq_hz,
-           a.damping_ratio, a.stiffness_n_per_m, j});
+          {radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m,
+           a.freq_hz, a.damping_ratio, a.stiffness_n_per_m, j});
     }
     matches_.push_back(std::move(match));
     measured_deg_.push_back(p.joints_deg);
@@ -315,7 +323,8 @@ std::vector<ModeCorrection> ModalMap::at(const std::vector<double>& q_deg, const
     out.push_back(c);
   }
   std::sort(out.begin(), out.end(), [](const auto& l, const auto& r) { return l.freq_hz < r.freq_hz; });
-  if (out.size() > static_cast<std::size_t>(count_)) out.resize(static_cast<std::size_t>(count_));  // the plant's N lowest
+  if (out.size() > static_cast<std::size_t>(count_))
+    out.resize(static_cast<std::size_t>(count_));  // the plant's N lowest
   return out;
 }
 

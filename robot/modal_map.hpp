@@ -26,13 +26,13 @@ namespace robodamp::robot {
 // modes that do not move the TCP along the axis are left out.
 struct AxisMode {
   double freq_hz{0.0};
-  double damping_ratio{0.0};       // half the joints' loss factor (modal_damping_ratio)
-  double stiffness_n_per_m{0.0};   // w^2 / phi_axis^2
+  double damping_ratio{0.0};      // half the joints' loss factor (modal_damping_ratio)
+  double stiffness_n_per_m{0.0};  // w^2 / phi_axis^2
   Eigen::Vector2d tcp_shape{0.0, 0.0};
 };
 // Throws config::ConfigError (a pose outside the travel) or std::invalid_argument (a non-physical model).
-[[nodiscard]] std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model, const std::vector<double>& joints_deg,
-                                               int axis, int count);
+[[nodiscard]] std::vector<AxisMode> axis_modes(const config::RobotModelConfig& model,
+                                               const std::vector<double>& joints_deg, int axis, int count);
 
 // One mode at a pose, mapped. A track is one mode over the measured poses: the measured modes matched to the
 // same model mode (the nearest within 25 %), or those the model has no match for, by their rank among the
@@ -44,7 +44,7 @@ struct AxisMode {
 // sigma_*: one standard deviation of the log value (x 100: about a percentage); the stiffness's from its
 // participation's, relative to the mapped one.
 struct ModeCorrection {
-  double freq_hz{0.0}, damping_ratio{0.0}, stiffness_n_per_m{0.0};  // the mapped mode
+  double freq_hz{0.0}, damping_ratio{0.0}, stiffness_n_per_m{0.0};   // the mapped mode
   double freq_scale{1.0}, damping_scale{1.0}, stiffness_scale{1.0};  // against the model's mode model_index
   double freq_sigma{0.0}, damping_sigma{0.0}, stiffness_sigma{0.0};
   int measured_poses{0};  // the track's poses (0: the model's mode as it is)
@@ -81,7 +81,8 @@ class ModalMap {
 
   // The mapped modes at a pose, the `count` lowest of: every track (kept when measured at half the poses at
   // least) and the model's modes no track follows. prior: axis_modes(model, joints_deg, axis, count).
-  [[nodiscard]] std::vector<ModeCorrection> at(const std::vector<double>& joints_deg, const std::vector<AxisMode>& prior) const;
+  [[nodiscard]] std::vector<ModeCorrection> at(const std::vector<double>& joints_deg,
+                                               const std::vector<AxisMode>& prior) const;
   [[nodiscard]] const std::vector<PoseMatch>& matches() const { return matches_; }
   // Each track's forms, lowest measured mode first.
   [[nodiscard]] std::vector<TrackForm> forms() const;

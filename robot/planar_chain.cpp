@@ -26,7 +26,9 @@ void check(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
 }
 
-Complex joint_stiffness(const Joint& j) { return {j.stiffness_nm_per_rad, 2.0 * j.damping_ratio * j.stiffness_nm_per_rad}; }
+Complex joint_stiffness(const Joint& j) {
+  return {j.stiffness_nm_per_rad, 2.0 * j.damping_ratio * j.stiffness_nm_per_rad};
+}
 Complex joint_translational_stiffness(const Joint& j) {
   return {j.translational_stiffness_n_per_m, 2.0 * j.damping_ratio * j.translational_stiffness_n_per_m};
 }
@@ -63,9 +65,10 @@ ElementMatrices frame_element(double l, double mass_per_m, double ei, double ea)
 PlanarChain::PlanarChain(ChainModel model, std::vector<double> joint_angles_rad) : m_(std::move(model)) {
   check(!m_.links.empty(), "robot model: no links");
   check(m_.joints.size() == m_.links.size(), "robot model: one joint per link (" + std::to_string(m_.links.size()) +
-                                                  " links, " + std::to_string(m_.joints.size()) + " joints)");
+                                                 " links, " + std::to_string(m_.joints.size()) + " joints)");
   check(joint_angles_rad.size() == m_.links.size(), "pose: " + std::to_string(joint_angles_rad.size()) +
-                                                        " joint angles for " + std::to_string(m_.links.size()) + " joints");
+                                                        " joint angles for " + std::to_string(m_.links.size()) +
+                                                        " joints");
   for (std::size_t i = 0; i < m_.links.size(); ++i) {
     const Link& l = m_.links[i];
     const Joint& j = m_.joints[i];
@@ -73,10 +76,13 @@ PlanarChain::PlanarChain(ChainModel model, std::vector<double> joint_angles_rad)
     check(std::isfinite(joint_angles_rad[i]), "pose: joint " + n + " angle is not a number");
     check(l.length_m > 0.0 && std::isfinite(l.length_m), "link " + n + ": length_m must be > 0 m");
     check(l.mass_kg > 0.0 && std::isfinite(l.mass_kg), "link " + n + ": mass_kg must be > 0 kg");
-    check(l.bending_stiffness_nm2 > 0.0 && std::isfinite(l.bending_stiffness_nm2), "link " + n + ": bending stiffness must be > 0 N m^2");
-    check(l.axial_stiffness_n > 0.0 && std::isfinite(l.axial_stiffness_n), "link " + n + ": axial stiffness must be > 0 N");
+    check(l.bending_stiffness_nm2 > 0.0 && std::isfinite(l.bending_stiffness_nm2),
+          "link " + n + ": bending stiffness must be > 0 N m^2");
+    check(l.axial_stiffness_n > 0.0 && std::isfinite(l.axial_stiffness_n),
+          "link " + n + ": axial stiffness must be > 0 N");
     check(l.elements >= 1 && l.elements <= 64, "link " + n + ": elements must be 1..64");
-    check(j.stiffness_nm_per_rad > 0.0 && std::isfinite(j.stiffness_nm_per_rad), "joint " + n + ": stiffness must be > 0 N m/rad");
+    check(j.stiffness_nm_per_rad > 0.0 && std::isfinite(j.stiffness_nm_per_rad),
+          "joint " + n + ": stiffness must be > 0 N m/rad");
     check(j.damping_ratio >= 0.0 && j.damping_ratio < 1.0, "joint " + n + ": damping ratio must be in [0, 1)");
     check(j.translational_stiffness_n_per_m >= 0.0 && std::isfinite(j.translational_stiffness_n_per_m),
           "joint " + n + ": translational stiffness must be >= 0 N/m (0: rigid)");
@@ -111,8 +117,10 @@ void PlanarChain::assemble() {
   for (std::size_t i = 0; i < m_.links.size(); ++i) {
     for (int j = 0; j <= m_.links[i].elements; ++j) {
       NodeDofs d{};
-      if (j == 0 && translation_rigid(m_.joints[i])) d.x = prev_x;
-      else d.x = n, n += 2;
+      if (j == 0 && translation_rigid(m_.joints[i]))
+        d.x = prev_x;
+      else
+        d.x = n, n += 2;
       d.rot = n++;
       nodes[i].push_back(d);
     }

@@ -21,15 +21,15 @@ using Complex = std::complex<double>;
 
 struct Link {
   double length_m{1.0};
-  double mass_kg{10.0};              // distributed uniformly along the link
-  double bending_stiffness_nm2{1e7}; // E I
-  double axial_stiffness_n{1e9};     // E A
+  double mass_kg{10.0};               // distributed uniformly along the link
+  double bending_stiffness_nm2{1e7};  // E I
+  double axial_stiffness_n{1e9};      // E A
   int elements{4};
 };
 
 struct Joint {
   double stiffness_nm_per_rad{1e5};
-  double damping_ratio{0.02};        // hysteretic: the spring is k (1 + 2 i zeta)
+  double damping_ratio{0.02};  // hysteretic: the spring is k (1 + 2 i zeta)
   // The joint's bearings in translation (x and y alike, the same hysteretic damping): 0 = rigid, the
   // translations shared. A compliance the torsional-only model lacks (docs/pose_dynamics.md).
   double translational_stiffness_n_per_m{0.0};
@@ -37,18 +37,19 @@ struct Joint {
 
 struct ChainModel {
   std::vector<Link> links;
-  std::vector<Joint> joints;         // joint i drives link i (joint 0: base to link 0)
+  std::vector<Joint> joints;  // joint i drives link i (joint 0: base to link 0)
   double head_mass_kg{0.0};
   double head_inertia_kgm2{0.0};
 };
 
 struct Mode {
   double freq_hz{0.0};
-  Eigen::VectorXd shape;             // over the assembled DOFs
-  double tcp_modal_stiffness_n_per_m{0.0};  // in the direction it moves the TCP most (k = w^2 / (phi_tcp^2 / phi' M phi))
+  Eigen::VectorXd shape;  // over the assembled DOFs
+  double tcp_modal_stiffness_n_per_m{
+      0.0};  // in the direction it moves the TCP most (k = w^2 / (phi_tcp^2 / phi' M phi))
   double tcp_direction_rad{0.0};
-  Eigen::Vector2d tcp_shape{0.0, 0.0};      // the mass-normalised shape's TCP x and y, 1/sqrt(kg)
-  double loss_factor{0.0};                  // phi' Im(K) phi / phi' Re(K) phi: the joints' hysteretic share
+  Eigen::Vector2d tcp_shape{0.0, 0.0};  // the mass-normalised shape's TCP x and y, 1/sqrt(kg)
+  double loss_factor{0.0};              // phi' Im(K) phi / phi' Re(K) phi: the joints' hysteretic share
 };
 
 // A mode's viscous damping ratio as the plant and the schedule's analysis model it (docs/pose_dynamics.md):
@@ -93,9 +94,9 @@ class PlanarChain {
   [[nodiscard]] Eigen::MatrixXcd link_dynamic_stiffness(std::size_t i, double w) const;
 
   ChainModel m_;
-  std::vector<double> angles_;      // absolute angle of each link
+  std::vector<double> angles_;  // absolute angle of each link
   std::vector<Eigen::Vector2d> start_;
-  Eigen::MatrixXcd k_;              // complex stiffness (joint damping)
+  Eigen::MatrixXcd k_;  // complex stiffness (joint damping)
   Eigen::MatrixXd m_mass_;
   int tcp_x_{0}, tcp_rot_{0};
 };

@@ -22,7 +22,8 @@ std::complex<double> pick(const Eigen::Matrix2cd& g, FrfDirection d) {
 class ModelAtPose {
  public:
   ModelAtPose(const config::RobotModelConfig& m, const std::vector<double>& q, int modes)
-      : chain_(at_pose(m, q)), modes_(modes > 0 ? chain_.modes(static_cast<std::size_t>(modes)) : std::vector<Mode>{}),
+      : chain_(at_pose(m, q)),
+        modes_(modes > 0 ? chain_.modes(static_cast<std::size_t>(modes)) : std::vector<Mode>{}),
         modal_(modes > 0) {}
   [[nodiscard]] std::complex<double> at(double f_hz, FrfDirection d) const {
     return pick(modal_ ? modal_tcp_frf(modes_, f_hz) : chain_.tcp_frf_direct(f_hz), d);
@@ -40,7 +41,8 @@ struct Band {
   std::vector<double> w;
 };
 
-config::RobotModelConfig with_joints(config::RobotModelConfig m, const std::vector<double>& x, const PoseFitSettings& s) {
+config::RobotModelConfig with_joints(config::RobotModelConfig m, const std::vector<double>& x,
+                                     const PoseFitSettings& s) {
   const std::size_t n = m.joints.size();
   for (std::size_t j = 0; j < n; ++j) {
     m.joints[j].stiffness_nm_per_rad = std::pow(10.0, x[j]);
@@ -117,8 +119,10 @@ std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::ve
     Band b;
     double peak = 0.0;
     for (std::size_t i = 0; i < d.freq_hz.size(); ++i)
-      if (d.freq_hz[i] >= s.band_min_hz && d.freq_hz[i] <= s.band_max_hz && std::isfinite(std::abs(d.receptance_m_per_n[i])))
-        b.f.push_back(d.freq_hz[i]), b.h.push_back(d.receptance_m_per_n[i]), peak = std::max(peak, std::abs(d.receptance_m_per_n[i]));
+      if (d.freq_hz[i] >= s.band_min_hz && d.freq_hz[i] <= s.band_max_hz &&
+          std::isfinite(std::abs(d.receptance_m_per_n[i])))
+        b.f.push_back(d.freq_hz[i]), b.h.push_back(d.receptance_m_per_n[i]),
+            peak = std::max(peak, std::abs(d.receptance_m_per_n[i]));
     if (static_cast<int>(b.f.size()) > max_points) {  // thinned evenly: each point costs a solve
       Band t;
       const double step = static_cast<double>(b.f.size() - 1) / (max_points - 1);
@@ -129,9 +133,12 @@ std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::ve
       b = std::move(t);
     }
     if (b.f.size() < 8 || !(peak > 0.0))
-      throw config::ConfigError({config::Problem{d.name, {}, "", "fewer than 8 usable points in the fit band " +
-                                                                     config::format_number(s.band_min_hz) + "-" +
-                                                                     config::format_number(s.band_max_hz) + " Hz"}});
+      throw config::ConfigError(
+          {config::Problem{d.name,
+                           {},
+                           "",
+                           "fewer than 8 usable points in the fit band " + config::format_number(s.band_min_hz) + "-" +
+                               config::format_number(s.band_max_hz) + " Hz"}});
     for (const auto& h : b.h) b.w.push_back(std::abs(h) / peak);
     bands.push_back(std::move(b));
   }
@@ -143,13 +150,15 @@ std::vector<Band> fit_bands(const config::RobotModelConfig& model, const std::ve
 std::vector<double> model_errors(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
                                  const PoseFitSettings& s) {
   std::vector<double> out;
-  for (double e : pose_errors(model, data, fit_bands(model, data, s, s.final_points_per_pose), s)) out.push_back(std::sqrt(e));
+  for (double e : pose_errors(model, data, fit_bands(model, data, s, s.final_points_per_pose), s))
+    out.push_back(std::sqrt(e));
   return out;
 }
 
-MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at, FrfDirection direction, double f_lo_hz,
-                      double f_hi_hz, int modes) {
-  if (auto p = config::pose_problem(model, at.joints_deg)) throw config::ConfigError({config::Problem{at.name, {}, "pose", *p}});
+MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at, FrfDirection direction,
+                      double f_lo_hz, double f_hi_hz, int modes) {
+  if (auto p = config::pose_problem(model, at.joints_deg))
+    throw config::ConfigError({config::Problem{at.name, {}, "pose", *p}});
   const ModelAtPose c(model, at.joints_deg, modes);
   MeasuredFrf out{at.name, at.joints_deg, {}, {}};
   for (const double f : at.freq_hz)
@@ -162,7 +171,8 @@ std::vector<double> peak_hz(const config::RobotModelConfig* model, const std::ve
   std::vector<double> out;
   for (const MeasuredFrf& d : data) {
     double best = -1.0, at = 0.0;
-    const std::optional<ModelAtPose> c = model ? std::optional<ModelAtPose>(ModelAtPose(*model, d.joints_deg, s.modes)) : std::nullopt;
+    const std::optional<ModelAtPose> c =
+        model ? std::optional<ModelAtPose>(ModelAtPose(*model, d.joints_deg, s.modes)) : std::nullopt;
     for (std::size_t i = 0; i < d.freq_hz.size(); ++i) {
       const double f = d.freq_hz[i];
       if (f < s.band_min_hz || f > s.band_max_hz) continue;
@@ -192,12 +202,16 @@ PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vecto
     for (double e : pose_errors(with_joints(coarse, x, s), data, bands, s, log_weight)) sum += e;
     return sum / static_cast<double>(data.size());
   };
-  const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) { return mean_error(x, 0.0); };
+  const std::function<double(const std::vector<double>&)> cost = [&](const std::vector<double>& x) {
+    return mean_error(x, 0.0);
+  };
   // The swarm also weighs the log-magnitude error, smooth where the complex error is rugged (a mode a little
   // off in frequency turns its phase over): on the two measured planar robots of docs/pose_dynamics.md 8 and
   // 4 of 8 restarts reach the best basin, against 2 and 1 of 8 on the complex error alone. BOBYQA then
   // polishes the complex error alone.
-  const std::function<double(const std::vector<double>&)> swarm_cost = [&](const std::vector<double>& x) { return mean_error(x, 1.0); };
+  const std::function<double(const std::vector<double>&)> swarm_cost = [&](const std::vector<double>& x) {
+    return mean_error(x, 1.0);
+  };
   PoseFitResult r;
   std::vector<std::vector<double>> ks;
   PsoResult best;

@@ -27,7 +27,7 @@ struct MeasuredFrf {
 
 struct PoseFitSettings {
   FrfDirection direction{FrfDirection::kYY};
-  double band_min_hz{10.0}, band_max_hz{30.0};   // the planar-robot study fits 10-30 Hz
+  double band_min_hz{10.0}, band_max_hz{30.0};  // the planar-robot study fits 10-30 Hz
   // The direct form (modes 0) costs a solve per point and searches on a coarse, thinned model: the band's
   // points thinned evenly to at most max_points_per_pose and search_elements per link. The modal form costs
   // one eigen-solve per pose and searches on the model as written over final_points_per_pose points.
@@ -46,7 +46,7 @@ struct PoseFitSettings {
   double damping_min{0.002}, damping_max{0.1};
   int restarts{3};
   PsoSettings pso{};
-  bool polish{true};          // each restart's swarm result refined by NLopt's BOBYQA within the bounds
+  bool polish{true};  // each restart's swarm result refined by NLopt's BOBYQA within the bounds
   int polish_evaluations{3000};
   // The points per pose the modal form searches on and both forms report their errors on. On the measured
   // planar robot (docs/pose_dynamics.md) the modal form's joints come within 0.2 % searched this way, and
@@ -55,19 +55,19 @@ struct PoseFitSettings {
 };
 
 struct PoseFitResult {
-  config::RobotModelConfig fitted;            // the model with the best restart's joints
+  config::RobotModelConfig fitted;  // the model with the best restart's joints
   std::vector<double> stiffness_nm_per_rad, damping_ratio;
-  std::vector<double> stiffness_spread_pct;   // standard deviation / mean over the converged restarts
-  int converged_restarts{0};                  // restarts ending within 0.5 points of the best's error
-  std::vector<double> pose_error;             // the best fit's weighted relative RMS error per pose
+  std::vector<double> stiffness_spread_pct;  // standard deviation / mean over the converged restarts
+  int converged_restarts{0};                 // restarts ending within 0.5 points of the best's error
+  std::vector<double> pose_error;            // the best fit's weighted relative RMS error per pose
   std::vector<double> restart_costs;
   int evaluations{0};
 };
 
 // Each pose's weighted relative RMS error of `model` against the data (the fit's measure, on at most
 // final_points_per_pose points, for poses held out of it). Throws as fit_joints.
-[[nodiscard]] std::vector<double> model_errors(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,
-                                               const PoseFitSettings& s);
+[[nodiscard]] std::vector<double> model_errors(const config::RobotModelConfig& model,
+                                               const std::vector<MeasuredFrf>& data, const PoseFitSettings& s);
 
 // The frequency of each pose's largest receptance in the fit band, on the measurement's own frequencies:
 // of the measurement (model = nullptr) or of the model's TCP FRF there (the first mode a matched
@@ -78,8 +78,8 @@ struct PoseFitResult {
 // The model's receptance at a measurement's pose, on the measurement's frequencies in [f_lo_hz, f_hi_hz].
 // Throws config::ConfigError for a pose outside the joints' travel.
 // modes: as PoseFitSettings::modes.
-[[nodiscard]] MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at, FrfDirection direction,
-                                    double f_lo_hz, double f_hi_hz, int modes = 0);
+[[nodiscard]] MeasuredFrf model_frf(const config::RobotModelConfig& model, const MeasuredFrf& at,
+                                    FrfDirection direction, double f_lo_hz, double f_hi_hz, int modes = 0);
 
 // Throws config::ConfigError for a pose outside the joints' travel or a measurement without points in the band.
 [[nodiscard]] PoseFitResult fit_joints(const config::RobotModelConfig& model, const std::vector<MeasuredFrf>& data,

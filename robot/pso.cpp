@@ -11,7 +11,8 @@ PsoResult particle_swarm(const std::function<double(const std::vector<double>&)>
                          const std::vector<double>& hi, const PsoSettings& s) {
   const std::size_t d = lo.size();
   if (d == 0 || hi.size() != d || s.particles < 2 || s.iterations < 1)
-    throw std::invalid_argument("particle swarm: bounds of equal, non-zero length, at least 2 particles and 1 iteration");
+    throw std::invalid_argument(
+        "particle swarm: bounds of equal, non-zero length, at least 2 particles and 1 iteration");
   for (std::size_t j = 0; j < d; ++j)
     if (!(lo[j] < hi[j])) throw std::invalid_argument("particle swarm: each lower bound must be below its upper bound");
   std::mt19937_64 rng(s.seed);

@@ -14,7 +14,7 @@ struct PsoSettings {
   int particles{40};
   int iterations{150};
   std::uint64_t seed{1};
-  double inertia{0.7298};     // Clerc's constriction: chi = 0.7298, c1 = c2 = chi x 2.05
+  double inertia{0.7298};  // Clerc's constriction: chi = 0.7298, c1 = c2 = chi x 2.05
   double cognitive{1.49618};
   double social{1.49618};
   double max_velocity_fraction{0.2};  // of each bound's width per iteration

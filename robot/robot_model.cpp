@@ -8,7 +8,8 @@ ChainModel chain_model(const config::RobotModelConfig& cfg) {
   ChainModel m;
   for (const auto& l : cfg.links)
     m.links.push_back({l.length_m, l.mass_kg, l.bending_stiffness_nm2, l.axial_stiffness_n, l.elements});
-  for (const auto& j : cfg.joints) m.joints.push_back({j.stiffness_nm_per_rad, j.damping_ratio, j.translational_stiffness_n_per_m});
+  for (const auto& j : cfg.joints)
+    m.joints.push_back({j.stiffness_nm_per_rad, j.damping_ratio, j.translational_stiffness_n_per_m});
   m.head_mass_kg = cfg.head_mass_kg;
   m.head_inertia_kgm2 = cfg.head_inertia_kgm2;
   return m;

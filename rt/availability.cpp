@@ -6,8 +6,10 @@ namespace robodamp::rt {
 
 void AvailabilityMeter::on_frame(const TelemetryFrame& f) {
   const bool active = f.state == static_cast<std::uint8_t>(State::kActive);
-  if (!active) active_since_s_ = -1.0;
-  else if (active_since_s_ < 0.0) active_since_s_ = f.time_s;
+  if (!active)
+    active_since_s_ = -1.0;
+  else if (active_since_s_ < 0.0)
+    active_since_s_ = f.time_s;
   // Full gain: active for a whole gain ramp (the arming's and every re-arm's fade-in is over).
   const bool full = active && f.time_s - active_since_s_ >= ramp_s_ - 0.5 * period_s_;
   if (full && a_.first_full_gain_s < 0.0) a_.first_full_gain_s = f.time_s;
@@ -51,4 +53,4 @@ void AvailabilityMeter::on_frame(const TelemetryFrame& f) {
   }
 }
 
-}  // namespace robodamp::runtime
+}  // namespace robodamp::rt

@@ -19,11 +19,11 @@
 namespace robodamp::rt {
 
 struct TripRecord {
-  std::string trip;               // rt::Trip's name
+  std::string trip;  // rt::Trip's name
   double trip_s{0.0};
-  double safe_s{-1.0};            // -1: not safe before the run ended
-  double rearmed_s{-1.0};         // active again (the fade-in starts); -1: never again
-  double full_gain_again_s{-1.0}; // -1: never again (latched, or the run ended first)
+  double safe_s{-1.0};             // -1: not safe before the run ended
+  double rearmed_s{-1.0};          // active again (the fade-in starts); -1: never again
+  double full_gain_again_s{-1.0};  // -1: never again (latched, or the run ended first)
 };
 
 struct Availability {
@@ -36,7 +36,7 @@ struct Availability {
   double derated_s{0.0};
   double first_full_gain_s{-1.0};  // -1: never at full gain
   std::uint64_t trips_total{0};
-  std::vector<TripRecord> trips;   // the first kMaxTrips
+  std::vector<TripRecord> trips;  // the first kMaxTrips
   static constexpr std::size_t kMaxTrips = 256;
   [[nodiscard]] double share() const { return asked_s > 0.0 ? active_s / asked_s : 0.0; }
 };
@@ -59,4 +59,4 @@ class AvailabilityMeter {
   TripRecord* open_{nullptr};  // the trip waiting for its safe time or its full gain again
 };
 
-}  // namespace robodamp::runtime
+}  // namespace robodamp::rt

@@ -3,10 +3,9 @@
 // stamps or measures time reads CLOCK_MONOTONIC through monotonic_ns(). RT-safe: no allocation, no locks.
 #pragma once
 
-#include <time.h>
-
 #include <cerrno>
 #include <cstdint>
+#include <ctime>  // clock_nanosleep, clock_gettime (POSIX, through glibc's time.h)
 
 namespace robodamp::rt {
 
@@ -25,8 +24,7 @@ inline constexpr std::int64_t kNsPerS = 1'000'000'000;
 // Sleeps until an absolute CLOCK_MONOTONIC time (restarted after a signal).
 inline void sleep_until_ns(std::int64_t t_ns) noexcept {
   const timespec ts{static_cast<time_t>(t_ns / kNsPerS), static_cast<long>(t_ns % kNsPerS)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {}
 }
 
 // Absolute-deadline pacing: each period's deadline is the previous one plus the period (no drift from
@@ -35,9 +33,9 @@ inline void sleep_until_ns(std::int64_t t_ns) noexcept {
 class DeadlinePacer {
  public:
   struct Wake {
-    std::int64_t wake_ns{0};   // when the thread woke
-    std::int64_t late_ns{0};   // how long after the deadline
-    std::uint64_t missed{0};   // whole periods skipped
+    std::int64_t wake_ns{0};  // when the thread woke
+    std::int64_t late_ns{0};  // how long after the deadline
+    std::uint64_t missed{0};  // whole periods skipped
   };
 
   DeadlinePacer(std::int64_t period_ns, std::int64_t first_deadline_ns) noexcept

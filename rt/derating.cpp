@@ -55,9 +55,7 @@ bool Supervisor::in_scheduled_band() const noexcept {
   return p.speed_scheduled() && p.speed_band_of(controller_.schedule_rpm()) < p.speed_band_count;
 }
 
-bool Supervisor::derating_on() const noexcept {
-  return s_.limits.derate.enabled && controller_.schedule_rpm() > 0.0;
-}
+bool Supervisor::derating_on() const noexcept { return s_.limits.derate.enabled && controller_.schedule_rpm() > 0.0; }
 
 // What the growth detector follows: with the spindle stopped the controller's output (as it always did); with
 // it turning what the controller would command at the K it is heading for, without derating or limits: the
@@ -102,7 +100,7 @@ bool Supervisor::judge_growth(double rms, double accel_rms, bool grown) noexcept
   const double rpm = controller_.schedule_rpm();
   switch (growth_) {
     case Growth::kNone:
-    case Growth::kGainFed:  // held lowered, it grows again: probe again
+    case Growth::kGainFed:                            // held lowered, it grows again: probe again
       if (grown) start_probe(rms, accel_rms, false);  // where the instability rule trips with the spindle stopped
       break;
     case Growth::kProbe: {
@@ -126,7 +124,7 @@ bool Supervisor::judge_growth(double rms, double accel_rms, bool grown) noexcept
         growth_run_ = 0;
         apply_derate(d.probe_ramp_s);
       } else if (end) {
-        process_growth();  // it grew on, or held, without the gain: the process's
+        process_growth();                                  // it grew on, or held, without the gain: the process's
         if (probe_saturation_) (void)derate_saturation();  // an external force saturates the actuator (the first: 0.5)
       }
       break;

@@ -9,11 +9,13 @@
 namespace robodamp::rt {
 
 namespace {
-std::uint32_t sat32(std::uint64_t v) noexcept { return v > 0xFFFFFFFFULL ? 0xFFFFFFFFU : static_cast<std::uint32_t>(v); }
+std::uint32_t sat32(std::uint64_t v) noexcept {
+  return v > 0xFFFFFFFFULL ? 0xFFFFFFFFU : static_cast<std::uint32_t>(v);
+}
 }  // namespace
 
-Loop::Loop(double rate_hz, ClockKind clock, Supervisor& supervisor, SensorSource& sensor,
-           ActuatorSink& actuator, AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry)
+Loop::Loop(double rate_hz, ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
+           AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry)
     : period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
       clock_(clock),
       sup_(supervisor),
@@ -98,7 +100,8 @@ TickInput Loop::inputs(const Run& r, const Pace& p) noexcept {
 OperatorCommand Loop::next_command(Run& r) noexcept {
   const bool scripted = next_scheduled_ < scheduled_.size() && scheduled_[next_scheduled_].first <= tick_;
   PolicyDecision policy{};
-  if (policy_ != nullptr && !r.ending && !scripted) policy = policy_->on_tick(tick_, sup_.state(), sup_.last_arm_refusal());
+  if (policy_ != nullptr && !r.ending && !scripted)
+    policy = policy_->on_tick(tick_, sup_.state(), sup_.last_arm_refusal());
   if (!r.ending && (tick_ >= r.end_tick || policy.end_run || stop_.load(std::memory_order_relaxed))) {
     r.ending = true;
     return {CommandKind::kDisarm, 0.0};

@@ -38,11 +38,11 @@ struct LoopStats {
   std::uint64_t missed_ticks{0};
   std::uint64_t overruns{0};
   std::uint64_t ring_drops{0};
-  std::uint64_t ring_waits{0};  // virtual clock: times the loop waited for the drain (never drops)
-  double elapsed_s{0.0};        // wall time of the run
+  std::uint64_t ring_waits{0};         // virtual clock: times the loop waited for the drain (never drops)
+  double elapsed_s{0.0};               // wall time of the run
   std::int64_t start_monotonic_ns{0};  // CLOCK_MONOTONIC of tick 0's deadline: a frame's time_s after it (wall clock)
-  TimingHistogram wake_latency;  // wake-up minus deadline (wall clock)
-  TimingHistogram compute;       // wake-up to end of the tick's work
+  TimingHistogram wake_latency;        // wake-up minus deadline (wall clock)
+  TimingHistogram compute;             // wake-up to end of the tick's work
 };
 
 class Loop {
@@ -87,7 +87,7 @@ class Loop {
     std::uint64_t tail_ticks;  // ticks after the end for the slowest ramp to finish
     std::int64_t prev_wake_ns;
     ActuatorStatus actuator{};
-    bool overrun{false};       // the previous tick's work ended past the next deadline
+    bool overrun{false};  // the previous tick's work ended past the next deadline
     bool ending{false};
     std::uint64_t ending_ticks{0};
   };

@@ -45,8 +45,8 @@ RealtimeProcess::RealtimeProcess(const RealtimeSettings& c, RealtimeStatus& stat
       locked_ = status.memory_locked = true;
     } else {
       warn(status, "mlockall failed: " + err(errno) +
-                                "; pages may fault during the run. Run as root, or raise the memlock limit "
-                                "(`ulimit -l unlimited`, LimitMEMLOCK=infinity in the systemd unit)");
+                       "; pages may fault during the run. Run as root, or raise the memlock limit "
+                       "(`ulimit -l unlimited`, LimitMEMLOCK=infinity in the systemd unit)");
     }
   }
   if (c.hold_cpu_dma_latency) {
@@ -59,8 +59,8 @@ RealtimeProcess::RealtimeProcess(const RealtimeSettings& c, RealtimeStatus& stat
       if (dma_fd_ >= 0) ::close(dma_fd_);
       dma_fd_ = -1;
       warn(status, "cannot hold /dev/cpu_dma_latency at 0: " + err(e) +
-                                "; deep C-states may add wake-up latency. Run as root or grant write access "
-                                "to /dev/cpu_dma_latency (or set realtime.hold_cpu_dma_latency: false)");
+                       "; deep C-states may add wake-up latency. Run as root or grant write access "
+                       "to /dev/cpu_dma_latency (or set realtime.hold_cpu_dma_latency: false)");
     }
   }
 }
@@ -80,9 +80,9 @@ void setup_realtime_thread(const RealtimeSettings& c, RealtimeStatus& status) {
       status.priority = c.priority;
     } else {
       warn(status, "SCHED_FIFO priority " + std::to_string(c.priority) + " not permitted: " + err(e) +
-                                "; the loop runs SCHED_OTHER and its latency will suffer. Run as root, or give "
-                                "the user an rtprio limit (`@robodamp - rtprio 95` in /etc/security/limits.conf, "
-                                "LimitRTPRIO=95 in the systemd unit)");
+                       "; the loop runs SCHED_OTHER and its latency will suffer. Run as root, or give "
+                       "the user an rtprio limit (`@robodamp - rtprio 95` in /etc/security/limits.conf, "
+                       "LimitRTPRIO=95 in the systemd unit)");
     }
   }
   if (c.cpu >= 0) {
@@ -94,14 +94,14 @@ void setup_realtime_thread(const RealtimeSettings& c, RealtimeStatus& status) {
       status.affinity = true;
     } else {
       warn(status, "cannot pin the loop to CPU " + std::to_string(c.cpu) + ": " + err(e) +
-                                "; check realtime.cpu against `nproc` and the cpuset of the service");
+                       "; check realtime.cpu against `nproc` and the cpuset of the service");
     }
   }
   if (prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL) == 0) {
     status.timer_slack = true;
   } else {
     warn(status, "PR_SET_TIMERSLACK 1 ns failed: " + err(errno) +
-                              "; SCHED_OTHER wake-ups may be late by the default 50 us slack");
+                     "; SCHED_OTHER wake-ups may be late by the default 50 us slack");
   }
   if (c.stack_prefault_kib > 0) {
     const std::size_t bytes = static_cast<std::size_t>(c.stack_prefault_kib) * 1024U;

@@ -1,5 +1,6 @@
 #include "rt/recording.hpp"
 
+#include <bit>
 #include <cstring>
 #include <ctime>
 
@@ -14,11 +15,20 @@ namespace {
 json notch_json(const control::ControllerParams& p) {
   const auto& n = p.harmonic_notch;
   json refused = json::array();
-  for (std::size_t i = 0; i < p.refused_rpm_count; ++i) refused.push_back({p.refused_rpm[i].first, p.refused_rpm[i].second});
-  return {{"enabled", n.enabled},         {"harmonics", n.harmonics},   {"bandwidth_hz", n.bandwidth_hz},
-          {"depth_db", n.depth_db},       {"slew_fraction", n.slew_fraction}, {"min_hz", n.min_hz},
-          {"fade_s", n.fade_s},           {"update_hz", n.update_hz},   {"max_fraction_of_fs", n.max_fraction_of_fs},
-          {"spindle_teeth", p.spindle_teeth}, {"spindle_rpm_max", p.spindle_rpm_max}, {"refused_rpm", refused}};
+  for (std::size_t i = 0; i < p.refused_rpm_count; ++i)
+    refused.push_back({p.refused_rpm[i].first, p.refused_rpm[i].second});
+  return {{"enabled", n.enabled},
+          {"harmonics", n.harmonics},
+          {"bandwidth_hz", n.bandwidth_hz},
+          {"depth_db", n.depth_db},
+          {"slew_fraction", n.slew_fraction},
+          {"min_hz", n.min_hz},
+          {"fade_s", n.fade_s},
+          {"update_hz", n.update_hz},
+          {"max_fraction_of_fs", n.max_fraction_of_fs},
+          {"spindle_teeth", p.spindle_teeth},
+          {"spindle_rpm_max", p.spindle_rpm_max},
+          {"refused_rpm", refused}};
 }
 
 // Recordings made before the harmonic notches have none of this: the defaults (off) replay them.
@@ -151,9 +161,9 @@ json to_json(const SupervisorSettings& s) {
 }
 
 json to_json(const PeriodicChirp& c) {
-  return {{"enabled", c.enabled}, {"start_s", c.start_s}, {"period_s", c.period_s}, {"periods", c.periods},
-          {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},     {"amplitude_v", c.amplitude_v},
-          {"ramp_s", c.ramp_s},   {"on_command", c.on_command}};
+  return {{"enabled", c.enabled},         {"start_s", c.start_s}, {"period_s", c.period_s},
+          {"periods", c.periods},         {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},
+          {"amplitude_v", c.amplitude_v}, {"ramp_s", c.ramp_s},   {"on_command", c.on_command}};
 }
 
 namespace {
@@ -167,7 +177,7 @@ PeriodicChirp chirp_from(const json& t) {
   c.f0_hz = t.at("f0_hz");
   c.f1_hz = t.at("f1_hz");
   c.amplitude_v = t.at("amplitude_v");
-  c.ramp_s = t.value("ramp_s", 0.0);  // recorded before the ramp existed: none
+  c.ramp_s = t.value("ramp_s", 0.0);            // recorded before the ramp existed: none
   c.on_command = t.value("on_command", false);  // recorded before measure --along-path: a start time
   return c;
 }
@@ -233,13 +243,16 @@ SupervisorSettings supervisor_settings_from(const json& j) {
   s.delay_margin_s = j.value("delay_margin_s", 0.0);
   s.pose_scheduled = j.value("pose_scheduled", false);  // absent before pose_schedule existed
   // Recorded while the supervisor owned the chirp: its voltage limit was the chirp's; before that, none.
-  if (j.contains("command_limit_v")) s.command_limit_v = j.at("command_limit_v");
-  else if (j.contains("test_signal")) s.command_limit_v = j.at("test_signal").at("voltage_limit_v");
+  if (j.contains("command_limit_v"))
+    s.command_limit_v = j.at("command_limit_v");
+  else if (j.contains("test_signal"))
+    s.command_limit_v = j.at("test_signal").at("voltage_limit_v");
   return s;
 }
 
 std::vector<std::string> trip_names(const std::vector<Trip>& trips) {
   std::vector<std::string> out;
+  out.reserve(trips.size());
   for (const Trip t : trips) out.emplace_back(trip_name(t));
   return out;
 }
@@ -367,7 +380,8 @@ Recording read_recording(const std::string& path) {
 
 void write_csv(const Recording& r, std::FILE* out) {
   const auto& fields = frame_fields();
-  for (std::size_t i = 0; i < fields.size(); ++i) std::fprintf(out, "%s%.*s", i ? "," : "", static_cast<int>(fields[i].name.size()), fields[i].name.data());
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    std::fprintf(out, "%s%.*s", i ? "," : "", static_cast<int>(fields[i].name.size()), fields[i].name.data());
   std::fprintf(out, ",state_name,trip_name\n");
   for (const auto& f : r.frames) {
     const auto* base = reinterpret_cast<const unsigned char*>(&f);
@@ -375,12 +389,39 @@ void write_csv(const Recording& r, std::FILE* out) {
       const unsigned char* p = base + fields[i].offset;
       if (i) std::fputc(',', out);
       switch (fields[i].type) {
-        case FieldType::kU8: std::fprintf(out, "%u", static_cast<unsigned>(*p)); break;
-        case FieldType::kU16: { std::uint16_t v; std::memcpy(&v, p, 2); std::fprintf(out, "%u", static_cast<unsigned>(v)); break; }
-        case FieldType::kU32: { std::uint32_t v; std::memcpy(&v, p, 4); std::fprintf(out, "%u", v); break; }
-        case FieldType::kU64: { std::uint64_t v; std::memcpy(&v, p, 8); std::fprintf(out, "%llu", static_cast<unsigned long long>(v)); break; }
-        case FieldType::kF32: { float v; std::memcpy(&v, p, 4); std::fprintf(out, "%.9g", static_cast<double>(v)); break; }
-        case FieldType::kF64: { double v; std::memcpy(&v, p, 8); std::fprintf(out, "%.17g", v); break; }
+        case FieldType::kU8:
+          std::fprintf(out, "%u", static_cast<unsigned>(*p));
+          break;
+        case FieldType::kU16: {
+          std::uint16_t v;
+          std::memcpy(&v, p, 2);
+          std::fprintf(out, "%u", static_cast<unsigned>(v));
+          break;
+        }
+        case FieldType::kU32: {
+          std::uint32_t v;
+          std::memcpy(&v, p, 4);
+          std::fprintf(out, "%u", v);
+          break;
+        }
+        case FieldType::kU64: {
+          std::uint64_t v;
+          std::memcpy(&v, p, 8);
+          std::fprintf(out, "%llu", static_cast<unsigned long long>(v));
+          break;
+        }
+        case FieldType::kF32: {
+          float v;
+          std::memcpy(&v, p, 4);
+          std::fprintf(out, "%.9g", static_cast<double>(v));
+          break;
+        }
+        case FieldType::kF64: {
+          double v;
+          std::memcpy(&v, p, 8);
+          std::fprintf(out, "%.17g", v);
+          break;
+        }
       }
     }
     std::fprintf(out, ",%s,%s\n", to_string(static_cast<State>(f.state)), to_string(static_cast<Trip>(f.trip)));
@@ -401,8 +442,9 @@ ReplayResult replay(const Recording& r) {
     if (in.command.kind == CommandKind::kStartExcitation) excitation.start_next_tick();
     const TickOutput out = sup.step(in);
     ++res.frames;
-    const bool same = std::memcmp(&out.command_v, &f.command_v, sizeof(double)) == 0 &&
-                      std::memcmp(&out.controller_v, &f.controller_v, sizeof(double)) == 0 &&
+    // Bit for bit: the same double, not only an equal one (a replay reproduces the run exactly).
+    const bool same = std::bit_cast<std::uint64_t>(out.command_v) == std::bit_cast<std::uint64_t>(f.command_v) &&
+                      std::bit_cast<std::uint64_t>(out.controller_v) == std::bit_cast<std::uint64_t>(f.controller_v) &&
                       static_cast<std::uint8_t>(out.state) == f.state && static_cast<std::uint8_t>(out.trip) == f.trip;
     if (!same && res.mismatches++ == 0) {
       res.first_mismatch_tick = f.tick;

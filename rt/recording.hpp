@@ -71,6 +71,7 @@ class Recorder {
   std::uint64_t write_errors_{0};
 };
 
+// NOLINTNEXTLINE(bugprone-exception-escape): nlohmann::json's destructor may allocate (its stack of nested values)
 struct Recording {
   nlohmann::json header;
   std::vector<TelemetryFrame> frames;
@@ -84,7 +85,7 @@ void write_csv(const Recording& r, std::FILE* out);
 
 struct ReplayResult {
   std::uint64_t frames{0};
-  std::uint64_t mismatches{0};            // frames whose command, state or trip differ in any bit
+  std::uint64_t mismatches{0};  // frames whose command, state or trip differ in any bit
   std::uint64_t first_mismatch_tick{0};
   double first_recorded_v{0.0}, first_replayed_v{0.0};
   std::string final_state, final_trip;

@@ -69,7 +69,8 @@ void Supervisor::set_pose_region(double value) noexcept {
 }
 
 void Supervisor::follow_pose() noexcept {
-  if (!s_.pose_scheduled || !pose_known_ || pose_set_ == active_parameter_set() || controller_.handover_pending()) return;
+  if (!s_.pose_scheduled || !pose_known_ || pose_set_ == active_parameter_set() || controller_.handover_pending())
+    return;
   if (!select(static_cast<double>(pose_set_))) {  // the region's set refused (cannot pass the configuration's analysis)
     pose_known_ = false;
     if (driving()) trip(Trip::kPoseOutOfMap);
@@ -153,8 +154,8 @@ void Supervisor::recover(const TickInput& in) noexcept {
   // Healthy: none of the sensor's trip conditions building up (a lone repeated sample, which a CAN
   // de-jitter makes now and then, is not one), ticks on time (no run of consecutive overruns as long as
   // half the trip's: a lone late tick on an ordinary PC is not a burst), and everything else arming asks.
-  const bool sensor_ok = in.sensor_ok && 2 * stale_run_ < static_cast<std::uint64_t>(l.stale_sensor_cycles) + 1 &&
-                         invalid_run_ == 0;
+  const bool sensor_ok =
+      in.sensor_ok && 2 * stale_run_ < static_cast<std::uint64_t>(l.stale_sensor_cycles) + 1 && invalid_run_ == 0;
   const bool on_time = 2 * overrun_run_ < static_cast<std::uint64_t>(l.overrun_cycles);
   const bool healthy = sensor_ok && on_time && !in.shutdown && arm_refusal(true) == ArmRefusal::kNone;
   healthy_s_ = healthy ? healthy_s_ + in.dt_s : 0.0;
@@ -182,7 +183,8 @@ void Supervisor::recover(const TickInput& in) noexcept {
 void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
   ++counters_.commands;
   switch (c.kind) {
-    case CommandKind::kNone: break;
+    case CommandKind::kNone:
+      break;
     case CommandKind::kArm: {
       refusal_ = state_ != State::kDisabled ? ArmRefusal::kNotDisabled : arm_refusal(live);
       if (refusal_ != ArmRefusal::kNone) {
@@ -216,8 +218,11 @@ void Supervisor::handle(const OperatorCommand& c, bool live) noexcept {
       else
         (void)select(c.value);
       break;
-    case CommandKind::kSetPoseRegion: set_pose_region(c.value); break;
-    case CommandKind::kStartExcitation: break;  // the loop's excitation clock, not a decision of the supervisor
+    case CommandKind::kSetPoseRegion:
+      set_pose_region(c.value);
+      break;
+    case CommandKind::kStartExcitation:
+      break;                        // the loop's excitation clock, not a decision of the supervisor
     case CommandKind::kSetSpindle:  // validated by the controller: refused speeds park the notches
       if (controller_.set_spindle_rpm(c.value) != control::RequestStatus::kAccepted) ++counters_.spindle_refused;
       break;
@@ -392,7 +397,9 @@ Supervisor::ControlStep Supervisor::run_controller(const TickInput& in, bool val
 // where the saturation duty and the instability detector can trip, and the fade-out while stopping.
 void Supervisor::drive(const TickInput& in, const ControlStep& c, TickOutput& out) noexcept {
   switch (state_) {
-    case State::kDisabled: command_v_ = 0.0; break;
+    case State::kDisabled:
+      command_v_ = 0.0;
+      break;
     case State::kArming:
       command_v_ = 0.0;
       out.amplifier_enable = true;
@@ -437,7 +444,8 @@ void Supervisor::drive(const TickInput& in, const ControlStep& c, TickOutput& ou
         out.amplifier_enable = true;
       }
       break;
-    case State::kFault: break;
+    case State::kFault:
+      break;
   }
 }
 

@@ -32,10 +32,24 @@ enum class State : std::uint8_t { kDisabled, kArming, kActive, kStopping, kFault
 
 // Trip, its names and kTripCount: rt_settings/rt_settings.hpp.
 
-enum class ArmRefusal : std::uint8_t { kNone, kNotDisabled, kSensorNotLive, kActuatorPath, kAnalysisUnstable, kPoseUnknown };
+enum class ArmRefusal : std::uint8_t {
+  kNone,
+  kNotDisabled,
+  kSensorNotLive,
+  kActuatorPath,
+  kAnalysisUnstable,
+  kPoseUnknown
+};
 
 enum class CommandKind : std::uint8_t {
-  kNone, kArm, kDisarm, kResetFault, kSetGain, kSelectParams, kSetSpindle, kSetPoseRegion,
+  kNone,
+  kArm,
+  kDisarm,
+  kResetFault,
+  kSetGain,
+  kSelectParams,
+  kSetSpindle,
+  kSetPoseRegion,
   kStartExcitation,  // the loop's: its on-command chirp starts at the next tick (rt/excitation.hpp); not the supervisor's
 };
 inline constexpr CommandKind kLastCommandKind = CommandKind::kStartExcitation;
@@ -63,9 +77,9 @@ struct TickInput {
   bool actuator_saturated{false};
   bool amplifier_ready{false};
   bool amplifier_fault{false};
-  bool overrun{false};   // the previous tick ran past its deadline, or ticks were missed
+  bool overrun{false};       // the previous tick ran past its deadline, or ticks were missed
   double excitation_v{0.0};  // the loop's command source beside the controller (rt/excitation.hpp), V
-  bool shutdown{false};  // SIGINT / SIGTERM seen
+  bool shutdown{false};      // SIGINT / SIGTERM seen
   OperatorCommand command{};
 };
 
@@ -129,7 +143,8 @@ struct SupervisorCounters {
   using S = SupervisorCounters;
   using fields::Field;
   return std::tuple{
-      fields::NamedCounts<S, kTripCount>{"trips", &S::trips, +[](std::size_t i) { return trip_name(static_cast<Trip>(i)); }},
+      fields::NamedCounts<S, kTripCount>{"trips", &S::trips,
+                                         +[](std::size_t i) { return trip_name(static_cast<Trip>(i)); }},
       Field<S, std::uint64_t>{"ticks", &S::ticks, "ticks"},
       Field<S, std::uint64_t>{"stale_ticks", &S::stale_ticks, "stale ticks"},
       Field<S, std::uint64_t>{"invalid_samples", &S::invalid_samples, "invalid samples"},
@@ -164,7 +179,16 @@ static_assert(fields::lists_every_member<SupervisorCounters>(), "each counter in
 // What the supervisor did about faults, with its time (the supervisor's clock: the sum of the measured
 // dt since the start), in a fixed log of the first kEventLogSize events.
 // kProbe .. kRestored: the derating (supervision.derate); their trip is the one they stand in for.
-enum class EventKind : std::uint8_t { kTrip, kRecovered, kLatched, kProbe, kProcessGrowth, kGainFedGrowth, kSaturationDerate, kRestored };
+enum class EventKind : std::uint8_t {
+  kTrip,
+  kRecovered,
+  kLatched,
+  kProbe,
+  kProcessGrowth,
+  kGainFedGrowth,
+  kSaturationDerate,
+  kRestored
+};
 struct SupervisorEvent {
   double time_s{0.0};
   EventKind kind{EventKind::kTrip};
@@ -185,7 +209,6 @@ struct ParameterSet {
   double delay_margin_s{0.0};  // at its gain; 0: none known (the overrun trip is overrun_cycles alone)
 };
 
-
 class Supervisor {
  public:
   Supervisor(const SupervisorSettings& s, const control::ControllerParams& params);
@@ -195,10 +218,14 @@ class Supervisor {
   // What a gain request may ask for now: max_gain_fraction x the active set's analysed K_max (any thread).
   [[nodiscard]] double gain_limit_ns_per_m() const noexcept { return max_gain_ns_per_m(); }
   // Safe to read from any thread (relaxed atomic; DDS status and parameter requests read it).
-  [[nodiscard]] std::size_t active_parameter_set() const noexcept { return active_set_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::size_t active_parameter_set() const noexcept {
+    return active_set_.load(std::memory_order_relaxed);
+  }
   // The set whose chain acts now: during a hand-over the outgoing one (fading out, then at K = 0 while the
   // incoming chain warms up) until the swap; the live limits are for this chain at the K it runs (any thread).
-  [[nodiscard]] std::size_t running_parameter_set() const noexcept { return running_set_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::size_t running_parameter_set() const noexcept {
+    return running_set_.load(std::memory_order_relaxed);
+  }
 
   // RT-safe.
   [[nodiscard]] TickOutput step(const TickInput& in) noexcept;
@@ -229,7 +256,7 @@ class Supervisor {
   void handle(const OperatorCommand& c, bool live) noexcept;
   void trip(Trip t) noexcept;
   [[nodiscard]] Trip check_trips(const TickInput& in) const noexcept;
-  bool record_saturation(bool saturated) noexcept;  // true: duty exceeded
+  bool record_saturation(bool saturated) noexcept;                // true: duty exceeded
   bool instability(double growth_v, double accel_mps2) noexcept;  // true: growing oscillation (trip)
   // The derating (rt/derating.cpp): the growth's verdict with the spindle turning (true: trip), the return
   // to full gain once quiet, a saturation derate (false: none left, trip), the factor to the controller.
@@ -270,10 +297,10 @@ class Supervisor {
   [[nodiscard]] bool driving() const noexcept {
     return state_ == State::kArming || state_ == State::kActive || state_ == State::kStopping;
   }
-  void follow_pose() noexcept;  // each tick: hand over to the pose's region's set once the controller can
+  void follow_pose() noexcept;   // each tick: hand over to the pose's region's set once the controller can
   void follow_speed() noexcept;  // each tick: hand over to the spindle speed's band's set once the controller can
   [[nodiscard]] ArmRefusal arm_refusal(bool live) const noexcept;  // why arming would be refused now
-  void recover(const TickInput& in) noexcept;                       // in Fault after the ramp: recover when allowed
+  void recover(const TickInput& in) noexcept;                      // in Fault after the ramp: recover when allowed
   void log_event(EventKind k, Trip t) noexcept;
 
   SupervisorSettings s_;
@@ -299,14 +326,14 @@ class Supervisor {
   bool hold_now_{false};       // this tick's sample is stale or invalid (zero_command_while_stale)
   double overrun_run_s_{0.0};  // the measured time the current run of overruns has lasted
   bool path_ok_{true};
-  double fade_{0.0};       // 0..1, activation / disarm
-  double arming_s_{0.0};   // time spent arming
+  double fade_{0.0};      // 0..1, activation / disarm
+  double arming_s_{0.0};  // time spent arming
   double trip_from_v_{0.0}, trip_ramp_left_s_{0.0};
   double command_v_{0.0};
   double time_s_{0.0};  // sum of dt so far: the events' and the probation's clock
   control::ControllerCounters last_limits_{};
   bool pose_known_{false};
-  std::size_t pose_set_{0};  // the set the pose's region wants (pose_scheduled)
+  std::size_t pose_set_{0};           // the set the pose's region wants (pose_scheduled)
   std::size_t speed_refused_set_{1};  // the speed schedule's set last refused (sets_.size(): none)
 
   // Recovery: which trips may recover (bit per Trip), whether this fault may, its timers, the probation
@@ -328,7 +355,7 @@ class Supervisor {
   std::uint64_t block_ticks_{0}, block_len_{1};
   double block_sum_sq_{0.0};
   double last_block_rms_{0.0}, run_start_rms_{0.0};
-  double last_accel_rms_{0.0};     // the acceleration's RMS over the last block
+  double last_accel_rms_{0.0};          // the acceleration's RMS over the last block
   std::uint64_t blocks_since_jump_{0};  // blocks since the last blow or a cut's entry (spindle turning)
   int growth_run_{0};
   // The last blocks' RMS (newest at block_history_pos_ - 1), to tell a growth from a build-up or a beat
@@ -344,8 +371,8 @@ class Supervisor {
   [[nodiscard]] bool beating() const noexcept;
 
   Growth growth_{Growth::kNone};
-  bool process_{false};            // a growth judged the process's since the last quiet spell
-  double probe_rms_{0.0};          // the block's RMS (and the acceleration's) when the probe started
+  bool process_{false};    // a growth judged the process's since the last quiet spell
+  double probe_rms_{0.0};  // the block's RMS (and the acceleration's) when the probe started
   double probe_accel_rms_{0.0};
   struct ProbeTrend {
     double slope{0.0};  // ln RMS per block
@@ -356,12 +383,12 @@ class Supervisor {
     ProbeTrend add(double rms) noexcept;
   };
   ProbeFit probe_fit_;
-  bool probe_saturation_{false};   // the probe started at a saturation, not a growth
+  bool probe_saturation_{false};  // the probe started at a saturation, not a growth
   double block_accel_sum_sq_{0.0};
   int probe_blocks_{0};            // blocks since
   double saturation_derate_{1.0};  // the product of the saturation derates since the last restore
   std::uint64_t quiet_blocks_{0};
-  double gain_fed_rpm_{-1.0};      // the speed the gain last fed a growth at (-1: none)
+  double gain_fed_rpm_{-1.0};  // the speed the gain last fed a growth at (-1: none)
 };
 
 }  // namespace robodamp::rt

@@ -4,17 +4,24 @@ namespace robodamp::rt {
 
 const char* to_string(FieldType t) {
   switch (t) {
-    case FieldType::kU8: return "u8";
-    case FieldType::kU16: return "u16";
-    case FieldType::kU32: return "u32";
-    case FieldType::kU64: return "u64";
-    case FieldType::kF32: return "f32";
-    case FieldType::kF64: return "f64";
+    case FieldType::kU8:
+      return "u8";
+    case FieldType::kU16:
+      return "u16";
+    case FieldType::kU32:
+      return "u32";
+    case FieldType::kU64:
+      return "u64";
+    case FieldType::kF32:
+      return "f32";
+    case FieldType::kF64:
+      return "f64";
   }
   return "?";
 }
 
-#define RD_FIELD(name, type, unit) FieldInfo{#name, FieldType::type, offsetof(TelemetryFrame, name), unit}
+#define RD_FIELD(name, type, unit) \
+  FieldInfo { #name, FieldType::type, offsetof(TelemetryFrame, name), unit }
 
 const std::array<FieldInfo, 21>& frame_fields() {
   static const std::array<FieldInfo, 21> fields{

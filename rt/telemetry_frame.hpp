@@ -48,9 +48,9 @@ struct TelemetryFrame {
   std::uint32_t stale_ticks{0};
   std::uint32_t invalid_samples{0};
   std::uint16_t flags{0};
-  std::uint8_t state{0};          // rt::State
-  std::uint8_t trip{0};           // rt::Trip latched
-  std::uint8_t command_kind{0};   // rt::CommandKind applied at this tick
+  std::uint8_t state{0};         // rt::State
+  std::uint8_t trip{0};          // rt::Trip latched
+  std::uint8_t command_kind{0};  // rt::CommandKind applied at this tick
   std::uint8_t reserved[3]{};
 };
 static_assert(sizeof(TelemetryFrame) == 112, "the recording format fixes the frame layout");

@@ -15,11 +15,16 @@ ArmingSchedule ArmingSchedule::from(const config::SupervisionConfig& s, double r
 
 const char* to_string(ArmingOutcome o) {
   switch (o) {
-    case ArmingOutcome::kWaiting: return "waiting";
-    case ArmingOutcome::kArmed: return "armed";
-    case ArmingOutcome::kFaulted: return "faulted";
-    case ArmingOutcome::kGaveUp: return "gave_up";
-    case ArmingOutcome::kCancelled: return "cancelled";
+    case ArmingOutcome::kWaiting:
+      return "waiting";
+    case ArmingOutcome::kArmed:
+      return "armed";
+    case ArmingOutcome::kFaulted:
+      return "faulted";
+    case ArmingOutcome::kGaveUp:
+      return "gave_up";
+    case ArmingOutcome::kCancelled:
+      return "cancelled";
   }
   return "?";
 }
@@ -36,11 +41,17 @@ rt::PolicyDecision ArmingPolicy::on_tick(std::uint64_t tick, rt::State state, rt
   if (attempts_.load(std::memory_order_relaxed) > 0 && refusal != rt::ArmRefusal::kNone)
     refusal_.store(refusal, std::memory_order_relaxed);
   switch (state) {
-    case rt::State::kActive: finish(ArmingOutcome::kArmed); return {};
-    case rt::State::kFault: finish(ArmingOutcome::kFaulted); return {};
+    case rt::State::kActive:
+      finish(ArmingOutcome::kArmed);
+      return {};
+    case rt::State::kFault:
+      finish(ArmingOutcome::kFaulted);
+      return {};
     case rt::State::kArming:
-    case rt::State::kStopping: return {};  // an attempt is under way, or a fade-out to finish first
-    case rt::State::kDisabled: break;
+    case rt::State::kStopping:
+      return {};  // an attempt is under way, or a fade-out to finish first
+    case rt::State::kDisabled:
+      break;
   }
   if (tick >= s_.deadline_tick) {
     finish(ArmingOutcome::kGaveUp);

@@ -42,7 +42,8 @@ control::ControllerParams with_notch_speed_map(const config::Config& cfg, contro
         why = pt.reason;
         break;
       }
-    spdlog::warn("{}: the harmonic notches are refused at {:.0f}-{:.0f} rpm ({}); they park there", cfg.source, lo, hi, why);
+    spdlog::warn("{}: the harmonic notches are refused at {:.0f}-{:.0f} rpm ({}); they park there", cfg.source, lo, hi,
+                 why);
   }
   analysis::apply_refused_speeds(map, p);
   return p;
@@ -62,7 +63,9 @@ Status Cell::configure() {
     return {StatusKind::kWrongState, std::string("cell: cannot configure while ") + to_string(state_)};
   if (cfg_.can.has_value() != cfg_.modbus.has_value())
     return {StatusKind::kConfigError,
-            config::ConfigError({{cfg_.source, {}, cfg_.can ? "modbus" : "can",
+            config::ConfigError({{cfg_.source,
+                                  {},
+                                  cfg_.can ? "modbus" : "can",
                                   "missing: a hardware cell needs both the can section (sensor and command frames) and "
                                   "the modbus section (the amplifier's enable and status)"}})
                 .what()};
@@ -110,11 +113,13 @@ Status Cell::compose_devices() {
   rt::SensorSource* sensor = can_ ? static_cast<rt::SensorSource*>(&can_->driver()) : &sim_->backend();
   rt::ActuatorSink* actuator = can_ ? static_cast<rt::ActuatorSink*>(&can_->driver()) : &sim_->backend();
   rt::AmplifierIo* io = modbus_ ? static_cast<rt::AmplifierIo*>(&modbus_->client()) : &sim_->backend();
-  loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io, ring_.get());
+  loop_ = std::make_unique<rt::Loop>(cfg_.loop.rate_hz, cfg_.loop.clock, *supervisor_, *sensor, *actuator, *io,
+                                     ring_.get());
   if (o_.chirp.enabled) loop_->set_excitation(o_.chirp);
   arming_ = std::make_unique<ArmingPolicy>(ArmingSchedule::from(cfg_.supervision, cfg_.loop.rate_hz));
   if (o_.arm_at_start) loop_->set_policy(arming_.get());
-  if (supervisor_->settings().pose_scheduled && !o_.pose_deg.empty() && !cfg_.can) {  // the simulated robot stands at --pose
+  if (supervisor_->settings().pose_scheduled && !o_.pose_deg.empty() &&
+      !cfg_.can) {  // the simulated robot stands at --pose
     const auto region = config::region_of(*cfg_.pose_schedule, o_.pose_deg.data(), o_.pose_deg.size());
     loop_->schedule(0, {rt::CommandKind::kSetPoseRegion, region ? static_cast<double>(*region) : -1.0});
   }
@@ -125,15 +130,16 @@ Status Cell::compose_devices() {
     in.active_set = [this] { return supervisor_->running_parameter_set(); };
     in.on_advice = [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
       if (!modbus_ || r.status == AdviceStatus::kFollowed) return;
-      if (r.status == AdviceStatus::kExpired) modbus_->withdraw_advice(r.seq);
+      if (r.status == AdviceStatus::kExpired)
+        modbus_->withdraw_advice(r.seq);
       else
         modbus_->publish_advice(r.seq, r.advice.found, r.advice.found ? r.advice.options.front().rpm : 0.0,
                                 r.advice.found ? r.advice.options.front().margin : 0.0);
     };
     in.robot_depth_mm = [this] { return modbus_ ? modbus_->robot_depth_mm() : std::nan(""); };
     if (cfg_.pose_schedule) {
-      in.pose = milling::PoseDynamics{cfg_.pose_schedule->model_resolved, pose_schedule_.model, cfg_.pose_schedule->axis,
-                                      cfg_.pose_schedule->modes};
+      in.pose = milling::PoseDynamics{cfg_.pose_schedule->model_resolved, pose_schedule_.model,
+                                      cfg_.pose_schedule->axis, cfg_.pose_schedule->modes};
       in.pose_deg = [this] { return robot_pose_deg(); };
       in.schedule = *cfg_.pose_schedule;
       if (path_ahead_) in.path_ahead_deg = [this] { return path_ahead_->poses_deg(); };
@@ -169,7 +175,8 @@ Status Cell::configure_devices() {
     config::Config plant_cfg = o_.plant_config ? *o_.plant_config : cfg_;
     if (cfg_.pose_schedule && !o_.pose_deg.empty())  // the robot model at the pose
       plant_cfg = analysis::config_at_pose(
-          plant_cfg, analysis::pose_modes(pose_schedule_.model, o_.pose_deg, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes));
+          plant_cfg,
+          analysis::pose_modes(pose_schedule_.model, o_.pose_deg, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes));
     const bool own = o_.plant_config || (cfg_.pose_schedule && !o_.pose_deg.empty());
     const sim::PlantModel plant_model = own ? sim::build_plant_model(plant_cfg) : model_->plant();
     sim_ = std::make_unique<SimBackendComponent>(plant_model, plant_cfg, o_.backend);
@@ -184,9 +191,7 @@ Status Cell::configure_devices() {
   if (cfg_.dds && cfg_.dds->path_ahead && cfg_.pose_schedule && !cfg_.spindle.job.empty())
     path_ahead_ = std::make_unique<PathAhead>(*cfg_.dds->path_ahead, cfg_.dds->path_ahead->names);
   if (cfg_.dds) {
-    dds_ = std::make_unique<DdsEndpoint>(
-        *cfg_.dds, cfg_.loop.rate_hz, cfg_.source,
-        bridge_sources());
+    dds_ = std::make_unique<DdsEndpoint>(*cfg_.dds, cfg_.loop.rate_hz, cfg_.source, bridge_sources());
     spectrum_ = std::make_unique<SpectrumMonitor>(cfg_);
   }
   for (Component* c : components()) {
@@ -221,7 +226,8 @@ void Cell::configure_pose_sets() {
 Status Cell::configure_parameter_sets() {
   set_configs_.assign(1, pose_schedule_.regions.empty() ? cfg_ : pose_schedule_.regions.front().config);
   if (supervisor_->settings().pose_scheduled)
-    for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i) set_configs_.push_back(pose_schedule_.regions[i].config);
+    for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i)
+      set_configs_.push_back(pose_schedule_.regions[i].config);
   mounting_sets_.clear();
   mounting_sets_.emplace_back(cfg_.actuator.mounting, 0);
   try {
@@ -231,14 +237,20 @@ Status Cell::configure_parameter_sets() {
     for (const auto& ref : cfg_.parameter_sets) {
       const config::Config other = config::load_config_file(ref.resolved_path);
       if (other.loop.rate_hz != cfg_.loop.rate_hz)
-        throw config::ConfigError({{cfg_.source, {}, "parameter_sets." + ref.mounting,
-                                    "= '" + ref.path + "' runs at loop.rate_hz = " + std::to_string(other.loop.rate_hz) +
-                                        " Hz; every set must run at this configuration's " +
-                                        std::to_string(cfg_.loop.rate_hz) + " Hz"}});
+        throw config::ConfigError(
+            {{cfg_.source,
+              {},
+              "parameter_sets." + ref.mounting,
+              "= '" + ref.path + "' runs at loop.rate_hz = " + std::to_string(other.loop.rate_hz) +
+                  " Hz; every set must run at this configuration's " + std::to_string(cfg_.loop.rate_hz) + " Hz"}});
       if (other.controller.speed_schedule && !other.controller.speed_schedule->controllers.empty())
-        throw config::ConfigError({{cfg_.source, {}, "parameter_sets." + ref.mounting,
-                                    "= '" + ref.path + "' schedules its controller by spindle speed "
-                                    "(controller.speed_schedule.controllers): a mounting's set may schedule K alone"}});
+        throw config::ConfigError(
+            {{cfg_.source,
+              {},
+              "parameter_sets." + ref.mounting,
+              "= '" + ref.path +
+                  "' schedules its controller by spindle speed "
+                  "(controller.speed_schedule.controllers): a mounting's set may schedule K alone"}});
       const std::size_t idx = add_parameter_set(other, true);
       const auto mounting = ref.mounting == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal;
       std::erase_if(mounting_sets_, [&](const auto& p) { return p.first == mounting; });
@@ -325,13 +337,14 @@ Status Cell::activate(double duration_s) {
   if (o_.impact_every_s > 0.0 && sim_) {
     std::vector<double> hits;
     for (double t = o_.impact_every_s; t < duration_s; t += o_.impact_every_s) hits.push_back(t);
-    sim_->plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, cfg_.bench.impact_peak_n,
-                                                                     cfg_.bench.impact_duration_ms * 1e-3, hits));
+    sim_->plant().add_excitation(
+        std::make_unique<sim::ImpactHammer>(0, cfg_.bench.impact_peak_n, cfg_.bench.impact_duration_ms * 1e-3, hits));
   }
   try {
     if (!o_.record_path.empty())
-      recorder_ = std::make_unique<rt::Recorder>(o_.record_path,
-                                                 rt::recording_header({cfg_.loop.rate_hz, cfg_.source, cfg_.yaml_text}, *supervisor_, cfg_.loop.clock, loop_->excitation()));
+      recorder_ = std::make_unique<rt::Recorder>(
+          o_.record_path, rt::recording_header({cfg_.loop.rate_hz, cfg_.source, cfg_.yaml_text}, *supervisor_,
+                                               cfg_.loop.clock, loop_->excitation()));
   } catch (const std::exception& e) {
     return {StatusKind::kDeviceError, std::string("--record: ") + e.what()};
   }
@@ -408,7 +421,8 @@ void Cell::finish_summary() {
   if (const std::size_t band = cp.speed_band_of(supervisor_->controller().schedule_rpm()); band < cp.speed_band_count)
     s.speed_band = band;
   s.gain_ns_per_m = supervisor_->controller().target_gain_ns_per_m();
-  s.notch_centre_hz = supervisor_->controller().notches().settings().enabled ? supervisor_->controller().notches().centre_hz() : 0.0;
+  s.notch_centre_hz =
+      supervisor_->controller().notches().settings().enabled ? supervisor_->controller().notches().centre_hz() : 0.0;
   s.final_state = rt::to_string(supervisor_->state());
   s.active_parameter_set = supervisor_->active_parameter_set();
   s.trip = rt::to_string(supervisor_->latched_trip());

@@ -128,10 +128,10 @@ class Cell {
   [[nodiscard]] MachiningMonitor* machining() { return machining_.get(); }
 
  private:
-  Status plan_analysis();    // configure(): the analysis and the supervisor
-  Status compose_devices();  // configure(): the devices, the loop and what runs beside it
+  Status plan_analysis();               // configure(): the analysis and the supervisor
+  Status compose_devices();             // configure(): the devices, the loop and what runs beside it
   dds::BridgeSources bridge_sources();  // what the DDS bridge publishes and whom it calls (runtime/cell_dds.cpp)
-  void release();            // configure's rollback and cleanup(): everything configure built
+  void release();                       // configure's rollback and cleanup(): everything configure built
   Status configure_devices();
   Status configure_parameter_sets();
   Status configure_pose_schedule();  // before the supervisor: region 0's set becomes set 0
@@ -162,10 +162,10 @@ class Cell {
   std::unique_ptr<rt::SpscRing<rt::TelemetryFrame>> ring_;
   std::unique_ptr<rt::Loop> loop_;
   std::unique_ptr<ArmingPolicy> arming_;
-  std::vector<config::Config> set_configs_;       // every parameter set's configuration, index = set
-  std::unique_ptr<SpectrumMonitor> spectrum_;     // dds: the accelerometer's spectrum for the operator's screen
-  std::unique_ptr<MachiningMonitor> machining_;   // spindle.job: live stability and the chatter indicator
-  analysis::PoseScheduleAnalysis pose_schedule_;  // region i's set is supervisor set i
+  std::vector<config::Config> set_configs_;               // every parameter set's configuration, index = set
+  std::unique_ptr<SpectrumMonitor> spectrum_;             // dds: the accelerometer's spectrum for the operator's screen
+  std::unique_ptr<MachiningMonitor> machining_;           // spindle.job: live stability and the chatter indicator
+  analysis::PoseScheduleAnalysis pose_schedule_;          // region i's set is supervisor set i
   static constexpr double kMachiningSummaryWaitS = 30.0;  // for the limits at the last state (worker thread)
 
   // Active run.

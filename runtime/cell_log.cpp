@@ -17,7 +17,8 @@ void Cell::log_changes(const rt::TelemetryFrame& f) {
   if (f.state != seen_state_ && seen_state_ != 255)
     spdlog::info("loop: {} at {:.3f} s", rt::to_string(static_cast<rt::State>(f.state)), f.time_s);
   if (const bool derated = (f.flags & rt::kFlagDerated) != 0; derated && !seen_derated_)
-    spdlog::info("loop: derated at {:.3f} s (the cut's growth or the actuator's saturation: supervision.derate)", f.time_s);
+    spdlog::info("loop: derated at {:.3f} s (the cut's growth or the actuator's saturation: supervision.derate)",
+                 f.time_s);
   else if (!derated && seen_derated_)
     spdlog::info("loop: back to full gain at {:.3f} s", f.time_s);
   seen_trip_ = f.trip;

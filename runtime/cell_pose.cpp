@@ -14,10 +14,11 @@ Status Cell::configure_pose_schedule() {
   try {
     pose_schedule_ = analysis::analyse_pose_schedule(cfg_);
     for (const auto& r : pose_schedule_.regions)
-      spdlog::info("pose region '{}': matched at {:.2f} Hz (dominant mode {:.2f}-{:.2f} Hz over {} poses), K = {} N s/m, "
-                   "polarity {}, K_max {:.0f} N s/m",
-                   r.name, r.dominant_hz, r.dominant_min_hz, r.dominant_max_hz, r.grid_poses, r.gain_ns_per_m, r.polarity,
-                   r.k_max_ns_per_m);
+      spdlog::info(
+          "pose region '{}': matched at {:.2f} Hz (dominant mode {:.2f}-{:.2f} Hz over {} poses), K = {} N s/m, "
+          "polarity {}, K_max {:.0f} N s/m",
+          r.name, r.dominant_hz, r.dominant_min_hz, r.dominant_max_hz, r.grid_poses, r.gain_ns_per_m, r.polarity,
+          r.k_max_ns_per_m);
     if (!o_.pose_deg.empty())
       if (auto p = config::pose_problem(pose_schedule_.model, o_.pose_deg))
         throw config::ConfigError({config::Problem{cfg_.source, {}, "--pose", *p}});
@@ -29,8 +30,10 @@ Status Cell::configure_pose_schedule() {
 
 std::vector<double> Cell::robot_pose_deg() const {
   std::vector<double> q = o_.pose_deg;  // the simulated robot stands there
-  if (joint_pose_) q = joint_pose_->joints_deg();
-  else if (modbus_ && cfg_.modbus->robot.joints_register >= 0) q = modbus_->client().joints_deg();
+  if (joint_pose_)
+    q = joint_pose_->joints_deg();
+  else if (modbus_ && cfg_.modbus->robot.joints_register >= 0)
+    q = modbus_->client().joints_deg();
   for (const double v : q)
     if (!std::isfinite(v)) return {};  // a joint not available: the pose is not known
   return q;
@@ -42,7 +45,8 @@ std::optional<dds::SpectrumSample> Cell::spectrum_at_pose() {
   const std::vector<double> q = robot_pose_deg();
   if (q.empty()) return s;  // not known: the configuration's table
   try {
-    const analysis::PoseModes pm = analysis::pose_modes(pose_schedule_.model, q, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes);
+    const analysis::PoseModes pm =
+        analysis::pose_modes(pose_schedule_.model, q, cfg_.pose_schedule->axis, cfg_.pose_schedule->modes);
     s->mode_hz.clear();
     for (const auto& m : pm.modes) s->mode_hz.push_back(static_cast<float>(m.natural_freq_hz));
   } catch (const std::exception&) {  // a pose outside the model's travel: the configuration's table

@@ -14,7 +14,7 @@
 namespace robodamp::runtime {
 
 SimBackendComponent::SimBackendComponent(const sim::PlantModel& model, const config::Config& plant_cfg,
-                               drivers::SimBackendOptions o)
+                                         drivers::SimBackendOptions o)
     : Component("simulated plant"), model_(model), cfg_(plant_cfg), o_(o) {}
 
 Status SimBackendComponent::on_configure() {
@@ -31,15 +31,22 @@ Status SimBackendComponent::on_cleanup() {
 }
 
 CanBus::CanBus(const config::CanConfig& cfg, double rate_hz, config::ClockKind clock, double connect_timeout_s)
-    : Component("CAN " + cfg.interface), cfg_(cfg), rate_hz_(rate_hz), clock_(clock), connect_timeout_s_(connect_timeout_s) {}
+    : Component("CAN " + cfg.interface),
+      cfg_(cfg),
+      rate_hz_(rate_hz),
+      clock_(clock),
+      connect_timeout_s_(connect_timeout_s) {}
 
 Status CanBus::on_configure() {
   driver_ = std::make_unique<drivers::CanDriver>(
-      cfg_, drivers::CanChannel::open(cfg_.interface, cfg_.fd, cfg_.sensor.id, cfg_.sensor.extended_id, connect_timeout_s_),
+      cfg_,
+      drivers::CanChannel::open(cfg_.interface, cfg_.fd, cfg_.sensor.id, cfg_.sensor.extended_id, connect_timeout_s_),
       rate_hz_);
   // Lockstep with the emulator: a missing frame waits up to this long, then counts towards the stale trip.
-  if (clock_ == config::ClockKind::kVirtual) driver_->set_lockstep_wait(1.0);
-  else driver_->set_dejitter(true);
+  if (clock_ == config::ClockKind::kVirtual)
+    driver_->set_lockstep_wait(1.0);
+  else
+    driver_->set_dejitter(true);
   return {};
 }
 
@@ -63,7 +70,8 @@ void CanBus::reconnect_loop(std::stop_token stop) {
     if (!driver_->link_lost()) continue;
     try {
       drivers::CanChannel c = drivers::CanChannel::connect_unix(path, 0.05);
-      if (driver_->offer_channel(std::move(c))) spdlog::warn("CAN: {} reconnected (the trip stays latched until reset)", cfg_.interface);
+      if (driver_->offer_channel(std::move(c)))
+        spdlog::warn("CAN: {} reconnected (the trip stays latched until reset)", cfg_.interface);
     } catch (const std::exception&) {
       // nobody listening yet: try again at the next round
     }
@@ -87,7 +95,7 @@ Status CanBus::on_cleanup() {
 }
 
 ModbusComponent::ModbusComponent(const config::ModbusConfig& cfg, config::Mounting initial,
-                                     drivers::ModbusClient::MountingCallback on_mounting, double connect_timeout_s)
+                                 drivers::ModbusClient::MountingCallback on_mounting, double connect_timeout_s)
     : Component("Modbus " + config::describe(cfg.amplifier_link)),
       cfg_(cfg),
       initial_(initial),

@@ -79,7 +79,7 @@ class CanBus final : public Component {
 class ModbusComponent final : public Component {
  public:
   ModbusComponent(const config::ModbusConfig& cfg, config::Mounting initial,
-                    drivers::ModbusClient::MountingCallback on_mounting, double connect_timeout_s);
+                  drivers::ModbusClient::MountingCallback on_mounting, double connect_timeout_s);
   // Between on_configure and on_cleanup only (the loop's thread and the lifecycle's).
   [[nodiscard]] drivers::ModbusClient& client() { return *client_; }
   // Any thread, in any state (the machining monitor's advisor runs from the cell's configure on, before

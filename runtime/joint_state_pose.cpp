@@ -23,16 +23,19 @@ void JointStatePose::on_message(const std::vector<std::string>& names, const std
     problem = std::to_string(names.size()) + " names and " + std::to_string(position_rad.size()) + " positions";
   for (std::size_t i = 0; i < cfg_.names.size() && problem.empty(); ++i) {
     const auto at = std::find(names.begin(), names.end(), cfg_.names[i]);
-    if (at == names.end()) problem = "no joint '" + cfg_.names[i] + "'";
+    if (at == names.end())
+      problem = "no joint '" + cfg_.names[i] + "'";
     else if (const double rad = position_rad[static_cast<std::size_t>(at - names.begin())]; !std::isfinite(rad))
       problem = "joint '" + cfg_.names[i] + "' is not finite";
-    else q[i] = rad * kDegPerRad;
+    else
+      q[i] = rad * kDegPerRad;
   }
   last_ = now, heard_ = true, lost_ = false;  // heard, even when refused: not a silence
   if (!problem.empty()) {
     ++n_.refused;
     if (problem != last_problem_)  // once per kind of problem, not 50 times a second
-      spdlog::warn("dds joint states on {}: a message with {} (dds.joint_states.names): the pose is unknown", cfg_.topic, problem);
+      spdlog::warn("dds joint states on {}: a message with {} (dds.joint_states.names): the pose is unknown",
+                   cfg_.topic, problem);
     last_problem_ = problem;
     joints_deg_.clear();
     settling_.restart();
@@ -43,7 +46,8 @@ void JointStatePose::on_message(const std::vector<std::string>& names, const std
   joints_deg_ = q;
   const auto region = config::region_of(schedule_, q.data(), q.size(), settling_.current());
   if (!region) ++n_.out_of_map;
-  if (settling_.settled(region ? static_cast<long>(*region) : -1, cfg_.settle_samples)) report(region ? static_cast<long>(*region) : -1);
+  if (settling_.settled(region ? static_cast<long>(*region) : -1, cfg_.settle_samples))
+    report(region ? static_cast<long>(*region) : -1);
 }
 
 void JointStatePose::check(Clock::time_point now) {

@@ -23,10 +23,10 @@ namespace robodamp::runtime {
 
 struct JointStateCounters {
   std::uint64_t messages{0};
-  std::uint64_t refused{0};      // a joint missing, position and name of different lengths, or not finite
-  std::uint64_t out_of_map{0};   // messages whose pose no region holds
-  std::uint64_t changes{0};      // regions reported (out of the map included)
-  std::uint64_t losses{0};       // silences of timeout_s
+  std::uint64_t refused{0};     // a joint missing, position and name of different lengths, or not finite
+  std::uint64_t out_of_map{0};  // messages whose pose no region holds
+  std::uint64_t changes{0};     // regions reported (out of the map included)
+  std::uint64_t losses{0};      // silences of timeout_s
 };
 
 // JointStateCounters' JSON keys (the run summary's "joint_states") and their words in its text line.
@@ -35,8 +35,7 @@ struct JointStateCounters {
   using F = fields::Field<J, std::uint64_t>;
   return std::tuple{F{"messages", &J::messages, "messages"},
                     F{"refused", &J::refused, "refused (a joint missing or not finite)"},
-                    F{"out_of_map", &J::out_of_map, "out of the map"},
-                    F{"changes", &J::changes, "pose changes"},
+                    F{"out_of_map", &J::out_of_map, "out of the map"}, F{"changes", &J::changes, "pose changes"},
                     F{"losses", &J::losses, "silences"}};
 }
 static_assert(fields::lists_every_member<JointStateCounters>(), "each counter in JointStateCounters' field list");

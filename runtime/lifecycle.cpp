@@ -8,9 +8,12 @@ namespace robodamp::runtime {
 
 const char* to_string(LifecycleState s) {
   switch (s) {
-    case LifecycleState::kUnconfigured: return "unconfigured";
-    case LifecycleState::kInactive: return "inactive";
-    case LifecycleState::kActive: return "active";
+    case LifecycleState::kUnconfigured:
+      return "unconfigured";
+    case LifecycleState::kInactive:
+      return "inactive";
+    case LifecycleState::kActive:
+      return "active";
   }
   return "?";
 }

@@ -16,9 +16,9 @@ namespace robodamp::runtime {
 
 namespace {
 
-constexpr int kLobeSpeeds = 80;  // the live lobes' sweep: 81 speeds over the job's range
+constexpr int kLobeSpeeds = 80;                  // the live lobes' sweep: 81 speeds over the job's range
 constexpr std::uint64_t kMaxHeldTicks = 100000;  // longer than the indicator's buffer (8 s at 5 kHz)
-constexpr double kChatterLogPeriodS = 0.25;       // the indicator's verdict for the log, in loop time
+constexpr double kChatterLogPeriodS = 0.25;      // the indicator's verdict for the log, in loop time
 
 // The job's spindle: without runout (time_domain.runout_um all zero) only the tooth harmonics are forced.
 milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) {
@@ -32,31 +32,40 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 }  // namespace
 
 MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, MachiningInputs in)
-    : teeth_(cfg.spindle.teeth), active_set_(std::move(in.active_set)), robot_depth_mm_(std::move(in.robot_depth_mm)),
-      pose_deg_(std::move(in.pose_deg)), path_ahead_deg_(std::move(in.path_ahead_deg)), pose_(in.pose), schedule_(std::move(in.schedule)),
+    : teeth_(cfg.spindle.teeth),
+      active_set_(std::move(in.active_set)),
+      robot_depth_mm_(std::move(in.robot_depth_mm)),
+      pose_deg_(std::move(in.pose_deg)),
+      path_ahead_deg_(std::move(in.path_ahead_deg)),
+      pose_(in.pose),
+      schedule_(std::move(in.schedule)),
       chatter_(cfg.loop.rate_hz, indicator_settings(cfg)) {
   set_configs_ = sets;
   config::MillingConfig job = config::load_milling_config(cfg.spindle.job_resolved);
   if (job.tool.teeth != cfg.spindle.teeth)
-    throw config::ConfigError({config::Problem{cfg.source, {}, "spindle.teeth",
-                                               "= " + std::to_string(cfg.spindle.teeth) + " but the job " +
-                                                   cfg.spindle.job + " cuts with tool.teeth = " +
-                                                   std::to_string(job.tool.teeth)}});
+    throw config::ConfigError(
+        {config::Problem{cfg.source,
+                         {},
+                         "spindle.teeth",
+                         "= " + std::to_string(cfg.spindle.teeth) + " but the job " + cfg.spindle.job +
+                             " cuts with tool.teeth = " + std::to_string(job.tool.teeth)}});
   unheard_modes_hz_ = milling::modes_above_band(job, cfg.spindle.structure, cfg.loop.rate_hz);
   if (const auto& u = unheard_modes_hz_; !u.empty())
-    spdlog::warn("machining: the live chatter indicator hears up to {:.0f} Hz (0.45 x the {:.0f} Hz loop rate); {} above "
-                 "it: a chatter there is not seen here (record the cut with a microphone or a fast accelerometer and run "
-                 "robodamp chatter)",
-                 milling::indicator_band_max_hz(cfg.loop.rate_hz), cfg.loop.rate_hz,
-                 u.size() == 1 ? fmt::format("the job's mode at {:.0f} Hz is", u[0])
-                               : fmt::format("{} of the job's modes, {:.0f}-{:.0f} Hz, are", u.size(), u.front(), u.back()));
+    spdlog::warn(
+        "machining: the live chatter indicator hears up to {:.0f} Hz (0.45 x the {:.0f} Hz loop rate); {} above "
+        "it: a chatter there is not seen here (record the cut with a microphone or a fast accelerometer and run "
+        "robodamp chatter)",
+        milling::indicator_band_max_hz(cfg.loop.rate_hz), cfg.loop.rate_hz,
+        u.size() == 1 ? fmt::format("the job's mode at {:.0f} Hz is", u[0])
+                      : fmt::format("{} of the job's modes, {:.0f}-{:.0f} Hz, are", u.size(), u.front(), u.back()));
   const double rpm_min = job.lobes.rpm_min, rpm_max = std::min(job.lobes.rpm_max, cfg.spindle.rpm_max);
   for (int i = 0; i <= kLobeSpeeds; ++i) lobe_rpm_.push_back(rpm_min + (rpm_max - rpm_min) * i / kLobeSpeeds);
   milling::LiveStabilitySettings ls;
   ls.pose_step_deg = cfg.spindle.pose_step_deg;
   stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets), ls,
                                                         std::move(in.pose));
-  advisor_ = std::make_unique<SpeedAdvisor>(*stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(in.on_advice));
+  advisor_ = std::make_unique<SpeedAdvisor>(
+      *stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(in.on_advice));
 }
 
 void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
@@ -67,7 +76,8 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
   }
   // Missed ticks keep their place in the indicator's time base (as gaps), bounded by its buffer.
   if (last_.tick > 0 && f.tick > last_.tick + 1)
-    for (std::uint64_t k = std::min<std::uint64_t>(f.tick - last_.tick - 1, kMaxHeldTicks); k > 0; --k) chatter_.push(0.0, false);
+    for (std::uint64_t k = std::min<std::uint64_t>(f.tick - last_.tick - 1, kMaxHeldTicks); k > 0; --k)
+      chatter_.push(0.0, false);
   chatter_.push(f.accel_mps2, (f.flags & rt::kFlagFresh) != 0);
   last_ = f;
   // The log's verdicts every kChatterLogPeriodS of loop time, whoever else asks (the status thread, the
@@ -81,7 +91,8 @@ void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {
 Cutting cutting_state(double spindle_rpm, bool depth_measured, double depth_mm, const milling::ChatterIndicator& c) {
   if (!(spindle_rpm > 0.0)) return {dds::kNotCutting, "spindle stopped"};
   if (depth_measured)
-    return depth_mm > 0.0 ? Cutting{dds::kCutting, "the robot's depth"} : Cutting{dds::kNotCutting, "the robot's depth is 0"};
+    return depth_mm > 0.0 ? Cutting{dds::kCutting, "the robot's depth"}
+                          : Cutting{dds::kNotCutting, "the robot's depth is 0"};
   if (!c.valid) return {dds::kCuttingUnknown, "the indicator's window is not full yet"};
   if (c.chatter) return {dds::kCutting, "chatter"};
   if (c.forced_lines) return {dds::kCutting, "tooth-passing lines in the vibration"};
@@ -96,10 +107,11 @@ void MachiningMonitor::log_chatter(const milling::ChatterIndicator& c) {
   if (!c.valid || c.chatter == chatter_logged_) return;
   chatter_logged_ = c.chatter;
   if (c.chatter)
-    spdlog::warn("machining: chatter at {:.2f} Hz at {:.3f} s, {:.0f} rpm (the live indicator over the last {:.1f} s: "
-                 "once-per-rev {:.2f}, non-harmonic share {:.2f}, {:.3f} m/s^2)",
-                 c.chatter_hz, last_.time_s, rpm_, chatter_.settings().window_s, c.once_per_rev_ratio, c.nonharmonic_share,
-                 c.nonharmonic_rms_mps2);
+    spdlog::warn(
+        "machining: chatter at {:.2f} Hz at {:.3f} s, {:.0f} rpm (the live indicator over the last {:.1f} s: "
+        "once-per-rev {:.2f}, non-harmonic share {:.2f}, {:.3f} m/s^2)",
+        c.chatter_hz, last_.time_s, rpm_, chatter_.settings().window_s, c.once_per_rev_ratio, c.nonharmonic_share,
+        c.nonharmonic_rms_mps2);
   else
     spdlog::info("machining: chatter ended at {:.3f} s, {:.0f} rpm (the live indicator)", last_.time_s, rpm_);
 }
@@ -126,17 +138,19 @@ void MachiningMonitor::add_to_trail(double time_s, std::size_t set, double gain,
   latest_ = milling::LiveLimitsRecord{time_s, set, gain, l};
   if (same || trail_.size() >= kTrailEntries) return;
   trail_.push_back(*latest_);
-  spdlog::info("machining: at pose {}, {:.0f} rpm, set {}, K {:.0f} N s/m: limit open {:.3f} mm ({}), damped {:.3f} mm ({}){}{}",
-               l.pose_deg.empty() ? std::string("not known (the set's own plant)") : config::describe_pose(l.pose_deg),
-               l.rpm, set, gain, l.open_mm, l.open_method, l.damped_mm, l.method.empty() ? "no damped FRF" : l.method,
-               l.problem.empty() ? "" : ": ", l.problem);
+  spdlog::info(
+      "machining: at pose {}, {:.0f} rpm, set {}, K {:.0f} N s/m: limit open {:.3f} mm ({}), damped {:.3f} mm ({}){}{}",
+      l.pose_deg.empty() ? std::string("not known (the set's own plant)") : config::describe_pose(l.pose_deg), l.rpm,
+      set, gain, l.open_mm, l.open_method, l.damped_mm, l.method.empty() ? "no damped FRF" : l.method,
+      l.problem.empty() ? "" : ": ", l.problem);
 }
 
 std::optional<milling::LiveLimits> MachiningMonitor::moved_from(double rpm, std::size_t set, double gain) const {
   std::lock_guard<std::mutex> lock(m_);
   if (!latest_) return std::nullopt;
   const milling::LiveLimitsRecord& last = *latest_;
-  if (last.set != set || std::abs(last.gain_ns_per_m - gain) > 5.0 || std::abs(last.limits.rpm - rpm) > 0.5) return std::nullopt;
+  if (last.set != set || std::abs(last.gain_ns_per_m - gain) > 5.0 || std::abs(last.limits.rpm - rpm) > 0.5)
+    return std::nullopt;
   return last.limits;
 }
 
@@ -220,7 +234,8 @@ AdviceView MachiningMonitor::view() {
     // A pose ahead: the region that holds it (the current one while it does: the hand-over's hysteresis), its
     // set and K; outside every region, region 0's, as the schedule runs there.
     if (schedule_)
-      v.controller_at_pose = [sets = &set_configs_, schedule = &*schedule_, set = set](const std::vector<double>& pose, double) {
+      v.controller_at_pose = [sets = &set_configs_, schedule = &*schedule_, set = set](const std::vector<double>& pose,
+                                                                                       double) {
         std::size_t at = config::region_of(*schedule, pose.data(), pose.size(), set).value_or(0);
         if (at >= sets->size()) at = 0;
         return std::pair{at, (*sets)[at].controller.gain_ns_per_m};
@@ -271,7 +286,8 @@ std::optional<dds::LobesSample> MachiningMonitor::lobes() {
     return scheduled_lobes(owner);
   }
   lobes_scheduled_ = false;
-  if (set != lobes_set_ || gain != lobes_gain_ || pose != lobes_pose_) {  // a new state, a ramp, a move: wait for it to hold
+  if (set != lobes_set_ || gain != lobes_gain_ ||
+      pose != lobes_pose_) {  // a new state, a ramp, a move: wait for it to hold
     lobes_set_ = set, lobes_gain_ = gain, lobes_pose_ = pose;
     lobes_swept_ = false, lobes_published_ = 0;
     return std::nullopt;

@@ -31,13 +31,15 @@ struct Cutting {
   std::uint8_t state{dds::kCuttingUnknown};
   std::string reason;
 };
-[[nodiscard]] Cutting cutting_state(double spindle_rpm, bool depth_measured, double depth_mm, const milling::ChatterIndicator& c);
+[[nodiscard]] Cutting cutting_state(double spindle_rpm, bool depth_measured, double depth_mm,
+                                    const milling::ChatterIndicator& c);
 
 // What the monitor reads of the cell (any thread each, all optional but active_set).
 struct MachiningInputs {
-  std::function<std::size_t()> active_set;             // the supervisor's running set
-  std::function<void(const AdviceRecord&)> on_advice;  // each new spindle-speed advice and each change of its status, on the advisor's thread
-  std::function<double()> robot_depth_mm;              // the robot's depth (0: out of the cut; NaN: the job's)
+  std::function<std::size_t()> active_set;  // the supervisor's running set
+  std::function<void(const AdviceRecord&)>
+      on_advice;  // each new spindle-speed advice and each change of its status, on the advisor's thread
+  std::function<double()> robot_depth_mm;  // the robot's depth (0: out of the cut; NaN: the job's)
   // A pose-scheduled cell: the robot's joints now (empty: not known) and the model its sets are designed on;
   // the limits, the live lobes and the advice are then for the robot at that pose (milling::PoseDynamics).
   std::function<std::vector<double>()> pose_deg;
@@ -78,7 +80,7 @@ class MachiningMonitor {
   [[nodiscard]] std::optional<dds::LobesSample> scheduled_lobes(std::size_t active);
   [[nodiscard]] AdviceView view();
   [[nodiscard]] std::pair<std::size_t, double> set_and_gain();  // the active set and the gain its limits are for
-  [[nodiscard]] std::vector<double> pose_now() const;            // the robot's joints (empty: not known, no pose)
+  [[nodiscard]] std::vector<double> pose_now() const;           // the robot's joints (empty: not known, no pose)
   void log_chatter(const milling::ChatterIndicator& c);
   void add_to_trail(double time_s, std::size_t set, double gain, const milling::LiveLimits& l);
   // The last limits found when they are for this speed, set and K (at another pose).
@@ -98,7 +100,7 @@ class MachiningMonitor {
   std::optional<config::PoseScheduleConfig> schedule_;
   std::unique_ptr<milling::LiveStability> stability_;
   mutable std::mutex m_;
-  std::vector<milling::LiveLimitsRecord> trail_;  // guarded by m_
+  std::vector<milling::LiveLimitsRecord> trail_;     // guarded by m_
   std::optional<milling::LiveLimitsRecord> latest_;  // the last limits found at a pose (guarded by m_)
   milling::ChatterMonitor chatter_;
   bool chatter_logged_{false};  // the last verdict logged
@@ -106,11 +108,11 @@ class MachiningMonitor {
   rt::TelemetryFrame last_{};
   double rpm_{0.0};
   std::vector<double> lobe_rpm_;  // the sweep's speeds
-  std::size_t lobes_set_{0};       // the status thread's
+  std::size_t lobes_set_{0};      // the status thread's
   double lobes_gain_{-1.0};
   std::vector<double> lobes_pose_;  // on the stability's grid
   bool lobes_swept_{false};
-  bool lobes_scheduled_{false};    // the last lobes were a speed schedule's envelope
+  bool lobes_scheduled_{false};  // the last lobes were a speed schedule's envelope
   std::size_t lobes_published_{0};
   std::unique_ptr<SpeedAdvisor> advisor_;  // last: its thread reads the members above
 };

@@ -10,8 +10,8 @@
 namespace robodamp::runtime {
 
 struct CheckedRequest {
-  dds::Decision decision;        // accepted, or refused with the reason
-  rt::OperatorCommand command;   // what to post when accepted
+  dds::Decision decision;       // accepted, or refused with the reason
+  rt::OperatorCommand command;  // what to post when accepted
 };
 
 [[nodiscard]] CheckedRequest check_request(const rt::Supervisor& sup, const config::Config& cfg, dds::RequestKind kind,

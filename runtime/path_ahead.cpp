@@ -18,8 +18,10 @@ void PathAhead::on_message(const std::vector<std::string>& joint_names, const st
   std::vector<std::size_t> column(names_.size());
   for (std::size_t i = 0; i < names_.size() && problem.empty(); ++i) {
     const auto at = std::find(joint_names.begin(), joint_names.end(), names_[i]);
-    if (at == joint_names.end()) problem = "no joint '" + names_[i] + "'";
-    else column[i] = static_cast<std::size_t>(at - joint_names.begin());
+    if (at == joint_names.end())
+      problem = "no joint '" + names_[i] + "'";
+    else
+      column[i] = static_cast<std::size_t>(at - joint_names.begin());
   }
   std::vector<Due> path;
   for (std::size_t k = 0; k < points.size() && problem.empty(); ++k) {
@@ -50,8 +52,8 @@ void PathAhead::on_message(const std::vector<std::string>& joint_names, const st
   if (!problem.empty()) {
     ++n_.refused;
     if (problem != last_problem_)
-      spdlog::warn("dds path ahead on {}: a trajectory with {} (dds.path_ahead.names): refused, the last path kept", cfg_.topic,
-                   problem);
+      spdlog::warn("dds path ahead on {}: a trajectory with {} (dds.path_ahead.names): refused, the last path kept",
+                   cfg_.topic, problem);
     last_problem_ = problem;
     return;
   }

@@ -69,13 +69,13 @@ struct RunSummary {
   std::string record_path;
   double sensor_rms_mps2{0.0};  // control accelerometer over the run
   double peak_command_v{0.0};
-  double spindle_rpm{0.0};         // the speed the controller's notches follow at the end (0: stopped or parked)
-  double notch_centre_hz{0.0};     // the harmonic notches' fundamental at the end
+  double spindle_rpm{0.0};      // the speed the controller's notches follow at the end (0: stopped or parked)
+  double notch_centre_hz{0.0};  // the harmonic notches' fundamental at the end
   // controller.speed_schedule at the end: the bands, the band of the spindle's speed (none: outside every
   // band), and the K asked for there. The hand-overs are in the supervisor's counters.
   std::size_t speed_bands{0};
   std::optional<std::size_t> speed_band;
-  double gain_ns_per_m{0.0};       // K asked for at the end (the schedule's, a request's or the configured)
+  double gain_ns_per_m{0.0};  // K asked for at the end (the schedule's, a request's or the configured)
   std::optional<dds::MachiningSample> machining;  // spindle.job: speed, depth, limits, indicator at the end
   std::optional<AdviceRecord> advice;             // spindle.job: the latest spindle-speed advice, if one was asked for
   std::vector<milling::LiveLimitsRecord> limits_trail;  // spindle.job with pose_schedule: the limits at each pose met

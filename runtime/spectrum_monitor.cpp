@@ -72,7 +72,8 @@ std::optional<dds::SpectrumSample> SpectrumMonitor::next() {
   out.accel_asd.reserve(bins);
   for (std::size_t k = 0; k < bins; ++k) {
     const double one_sided = (k == 0 || 2 * k == n) ? 1.0 : 2.0;
-    out.accel_asd.push_back(static_cast<float>(std::sqrt(one_sided * psd[k] / (fs_hz_ * window_power * static_cast<double>(count)))));
+    out.accel_asd.push_back(
+        static_cast<float>(std::sqrt(one_sided * psd[k] / (fs_hz_ * window_power * static_cast<double>(count)))));
   }
   out.bin_hz = fs_hz_ / static_cast<double>(n);
   out.record_s = static_cast<double>(x.size()) / fs_hz_;

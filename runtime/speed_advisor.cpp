@@ -21,9 +21,12 @@ auto state_key(const milling::SpeedAdviceRequest& r) {
 
 const char* to_string(AdviceStatus s) {
   switch (s) {
-    case AdviceStatus::kCurrent: return "current";
-    case AdviceStatus::kFollowed: return "followed";
-    case AdviceStatus::kExpired: return "expired";
+    case AdviceStatus::kCurrent:
+      return "current";
+    case AdviceStatus::kFollowed:
+      return "followed";
+    case AdviceStatus::kExpired:
+      return "expired";
   }
   return "?";
 }
@@ -63,8 +66,13 @@ dds::AdviceSample to_sample(const AdviceRecord& r) {
 SpeedAdvisor::SpeedAdvisor(milling::LiveStability& stability, std::function<AdviceView()> view, double rpm_min,
                            double rpm_max, std::function<void(const AdviceRecord&)> on_advice, double period_s,
                            milling::SpeedAdviceSettings s)
-    : stability_(stability), view_(std::move(view)), on_advice_(std::move(on_advice)), rpm_min_(rpm_min),
-      rpm_max_(rpm_max), period_s_(period_s), s_(std::move(s)) {
+    : stability_(stability),
+      view_(std::move(view)),
+      on_advice_(std::move(on_advice)),
+      rpm_min_(rpm_min),
+      rpm_max_(rpm_max),
+      period_s_(period_s),
+      s_(std::move(s)) {
   worker_.start("rd-speed-advice", [this](std::stop_token stop) { run(stop); });
 }
 
@@ -110,16 +118,20 @@ std::pair<AdviceStatus, std::string> SpeedAdvisor::status_in(const AdviceRecord&
   const double to = r.advice.found ? r.advice.options.front().rpm : q.rpm, near = same_speed_rpm(q.rpm);
   const bool on_the_way = rpm >= std::min(q.rpm, to) - near && rpm <= std::max(q.rpm, to) + near;
   if (!on_the_way)
-    return {AdviceStatus::kExpired, fmt::format("the spindle at {:.1f} rpm, not the {:.1f} rpm it was for", rpm, q.rpm)};
+    return {AdviceStatus::kExpired,
+            fmt::format("the spindle at {:.1f} rpm, not the {:.1f} rpm it was for", rpm, q.rpm)};
   // On its way, a speed schedule's set and K follow the speed: what else it was for counts at its own speed.
   if (std::abs(rpm - q.rpm) > near) return {AdviceStatus::kCurrent, ""};
   if (v.parameter_set != q.set)
     return {AdviceStatus::kExpired, fmt::format("parameter set {} runs, not set {}", v.parameter_set, q.set)};
   if (std::abs(v.gain_ns_per_m - q.gain_ns_per_m) > std::max(10.0, 0.01 * std::abs(q.gain_ns_per_m)))
-    return {AdviceStatus::kExpired, fmt::format("K = {:.0f} N s/m, not the {:.0f} N s/m it was for", v.gain_ns_per_m, q.gain_ns_per_m)};
-  if (m.loop_active != q.damped) return {AdviceStatus::kExpired, m.loop_active ? "the damper active now" : "the damper off now"};
+    return {AdviceStatus::kExpired,
+            fmt::format("K = {:.0f} N s/m, not the {:.0f} N s/m it was for", v.gain_ns_per_m, q.gain_ns_per_m)};
+  if (m.loop_active != q.damped)
+    return {AdviceStatus::kExpired, m.loop_active ? "the damper active now" : "the damper off now"};
   if (std::abs(m.depth_mm - q.depth_mm) > 1e-3)
-    return {AdviceStatus::kExpired, fmt::format("the depth {:.3f} mm, not the {:.3f} mm it was for", m.depth_mm, q.depth_mm)};
+    return {AdviceStatus::kExpired,
+            fmt::format("the depth {:.3f} mm, not the {:.3f} mm it was for", m.depth_mm, q.depth_mm)};
   if (m.limits_pose_deg != q.pose_deg) return {AdviceStatus::kExpired, "the robot moved to another pose"};
   if (m.indicator_valid && !m.chatter && m.limits_ready && !m.depth_warning)
     return {AdviceStatus::kExpired, "no chatter and the depth within the limit now"};
@@ -137,7 +149,8 @@ bool SpeedAdvisor::follow_status(const AdviceView& v) {
   latest_->status = status, latest_->status_reason = std::move(reason), latest_->status_time_s = v.sample.time_s;
   const AdviceRecord rec = *latest_;
   lock.unlock();
-  spdlog::info("speed advice #{} {} at {:.3f} s: {}", rec.seq, to_string(rec.status), rec.status_time_s, rec.status_reason);
+  spdlog::info("speed advice #{} {} at {:.3f} s: {}", rec.seq, to_string(rec.status), rec.status_time_s,
+               rec.status_reason);
   if (on_advice_) on_advice_(rec);
   return status == AdviceStatus::kExpired;
 }
@@ -163,9 +176,11 @@ void SpeedAdvisor::run(std::stop_token stop) {
         const auto& a = rec.advice;
         if (s_.cancelled()) return;
         if (a.found)
-          spdlog::info("speed advice #{} ({} at {:.0f} rpm, {:.3f} mm{} against a limit of {:.3f} mm): {:.0f} rpm allows {:.3f} mm ({})",
-                       rec.seq, r->trigger, r->rpm, a.depth_mm, a.depth_from_chatter ? " (the limit where it chatters)" : "",
-                       a.limit_now_mm, a.options.front().rpm, a.options.front().limit_mm, a.method);
+          spdlog::info(
+              "speed advice #{} ({} at {:.0f} rpm, {:.3f} mm{} against a limit of {:.3f} mm): {:.0f} rpm allows {:.3f} "
+              "mm ({})",
+              rec.seq, r->trigger, r->rpm, a.depth_mm, a.depth_from_chatter ? " (the limit where it chatters)" : "",
+              a.limit_now_mm, a.options.front().rpm, a.options.front().limit_mm, a.method);
         else
           spdlog::warn("speed advice #{} ({} at {:.0f} rpm): {}", rec.seq, r->trigger, r->rpm, a.reason);
         if (on_advice_) on_advice_(rec);

@@ -28,19 +28,19 @@ enum class AdviceStatus : std::uint8_t { kCurrent, kFollowed, kExpired };
 [[nodiscard]] const char* to_string(AdviceStatus s);
 
 struct AdviceRecord {
-  std::uint64_t seq{0};        // 1, 2, ...: one per new advice
-  double time_s{0.0};          // the loop time of the view that asked for it
+  std::uint64_t seq{0};  // 1, 2, ...: one per new advice
+  double time_s{0.0};    // the loop time of the view that asked for it
   milling::SpeedAdvice advice;
   AdviceStatus status{AdviceStatus::kCurrent};
-  std::string status_reason;   // followed or expired: what the advisor saw (empty while current)
-  double status_time_s{0.0};   // the loop time of the view that changed the status
+  std::string status_reason;  // followed or expired: what the advisor saw (empty while current)
+  double status_time_s{0.0};  // the loop time of the view that changed the status
 };
 
 // What the advisor reads of the cell's machining view, and the state an advice is for.
 struct AdviceView {
   dds::MachiningSample sample;
   std::size_t parameter_set{0};
-  double gain_ns_per_m{0.0};   // the gain the damped limit is for
+  double gain_ns_per_m{0.0};                                                  // the gain the damped limit is for
   std::function<std::pair<std::size_t, double>(double rpm)> controller_at{};  // a speed schedule's (empty: none)
   // The robot program's next poses (dds.path_ahead; empty: none published) and the set and K the pose
   // schedule would run at each (milling::SpeedAdviceRequest).

@@ -19,7 +19,8 @@ void check_speed_bands(const rt::Supervisor& sup, const std::vector<config::Conf
     for (std::size_t b = 0; b < p.speed_band_count; ++b) {
       if (p.speed_bands[b].set != s) continue;  // checked by the set it runs
       char why[200];
-      std::snprintf(why, sizeof why, "supervision.max_gain_fraction = %g x the analysed maximum stable K %.1f N s/m of its controller",
+      std::snprintf(why, sizeof why,
+                    "supervision.max_gain_fraction = %g x the analysed maximum stable K %.1f N s/m of its controller",
                     c.supervision.max_gain_fraction, sets[s].max_stable_gain_ns_per_m);
       if (auto problem = config::gain_request_problem(p.speed_bands[b].gain_ns_per_m, limit, why))
         throw config::ConfigError(config::located(
@@ -30,7 +31,8 @@ void check_speed_bands(const rt::Supervisor& sup, const std::vector<config::Conf
   for (std::size_t s = 0; s < sets.size(); ++s)  // a band naming a set that was never added
     for (std::size_t b = 0; b < sets[s].params.speed_band_count; ++b)
       if (sets[s].params.speed_bands[b].set >= sets.size())
-        throw config::ConfigError({{set_configs.at(s).source, {},
+        throw config::ConfigError({{set_configs.at(s).source,
+                                    {},
                                     "controller.speed_schedule.bands[" + std::to_string(b) + "].controller",
                                     "names a controller this cell does not have"}});
 }

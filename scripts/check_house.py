@@ -6,11 +6,14 @@
   python3 scripts/check_house.py picture CMAKE.dot OUT.dot  # the layered picture from CMake's graphviz
   python3 scripts/check_house.py links                # every link between README.md and docs/ resolves
   python3 scripts/check_house.py parser-free          # rt/, control/, rt_settings/ use no config/ and no yaml-cpp
+  python3 scripts/check_house.py format               # every .cpp/.hpp as clang-format 14 writes it (.clang-format)
 """
 import glob
 import json
 import os
 import re
+import shutil
+import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -251,9 +254,43 @@ def links():
     return report(bad, f"{len(bad)} of {count} links do not resolve", f"all {count} links resolve")
 
 
+def sources_cpp():
+    """The repository's C++ sources and headers (git's list, else every .cpp/.hpp outside build directories)."""
+    try:
+        out = subprocess.run(["git", "-C", ROOT, "ls-files", "*.cpp", "*.hpp"], capture_output=True, text=True, check=True)
+        return [f for f in out.stdout.split("\n") if f]
+    except (OSError, subprocess.CalledProcessError):
+        found = []
+        for d, dirs, names in os.walk(ROOT):
+            dirs[:] = [x for x in dirs if not x.startswith(("build", "."))]
+            found += [os.path.relpath(os.path.join(d, n), ROOT) for n in names if n.endswith((".cpp", ".hpp"))]
+        return sorted(found)
+
+
+def formatted():
+    """Every C++ file is as clang-format 14 writes it with the repository's .clang-format (issue 54)."""
+    tool = shutil.which("clang-format-14") or shutil.which("clang-format")
+    if tool is None:
+        print("clang-format-14 is not installed (scripts/setup.sh installs it)")
+        return 1
+    files = sources_cpp()
+    bad = []
+    for i in range(0, len(files), 50):
+        r = subprocess.run([tool, "--dry-run", "--Werror", "--style=file"] + files[i:i + 50], cwd=ROOT,
+                           capture_output=True, text=True)
+        for line in r.stderr.splitlines():
+            m = re.match(r"^(\S+?):(\d+):\d+: error:", line)
+            if m:
+                bad.append(f"{os.path.relpath(m.group(1), ROOT) if os.path.isabs(m.group(1)) else m.group(1)}:{m.group(2)}")
+    where = sorted({b.rsplit(":", 1)[0] for b in bad})
+    return report([f"{w}: not as clang-format writes it (clang-format-14 -i {w})" for w in where],
+                  f"{len(where)} of {len(files)} files not formatted ({len(bad)} places)",
+                  f"all {len(files)} C++ files formatted (clang-format 14, .clang-format)")
+
+
 if __name__ == "__main__":
     checks = {"sources": (sources, 0), "layers": (layers, 1), "picture": (picture, 2), "links": (links, 0),
-              "parser-free": (parser_free, 0)}
+              "parser-free": (parser_free, 0), "format": (formatted, 0)}
     if len(sys.argv) < 2 or sys.argv[1] not in checks or len(sys.argv) != 2 + checks[sys.argv[1]][1]:
         print(__doc__)
         sys.exit(2)

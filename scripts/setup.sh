@@ -9,7 +9,7 @@ packages=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libgtes
           libbenchmark-dev libcli11-dev libspdlog-dev nlohmann-json3-dev gnuplot-nox valgrind
           libfftw3-dev libnlopt-dev libmodbus-dev libfastrtps-dev libfastcdr-dev fastddsgen libssl-dev openssl can-utils
           libcpp-httplib-dev libjs-dygraphs chromium chromium-driver python3-selenium graphviz
-          universal-ctags libsndfile1-dev libspectra-dev)
+          universal-ctags libsndfile1-dev libspectra-dev clang-format-14 clang-tidy-14)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

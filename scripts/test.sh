@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Set up, build, and run the whole test suite. With CI=true (as CI runs it), also the libraries' unit tests
+# Set up, build, and run the whole test suite (its House.TheTreeIsFormatted checks clang-format). With CI=true
+# (as CI runs it), also clang-tidy over the real-time path and the devices (scripts/tidy.sh) and the libraries' unit tests
 # built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh address,undefined --unit,
 # in build-address-undefined; docs/tests.md "Sanitizers").
 set -euo pipefail
@@ -7,5 +8,6 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 (cd build && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
 if [ "${CI:-}" = true ]; then
+  bash scripts/tidy.sh
   bash scripts/sanitize.sh address,undefined --unit
 fi

@@ -64,7 +64,8 @@ double Chirp::force_n(double t_s, double h_s) noexcept {
   return amplitude_n_ * std::sin(kTwoPi * (f0_ * t + 0.5 * k * t * t));
 }
 
-Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed) : Excitation(location), rms_n_(rms_n), rng_(seed) {}
+Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed)
+    : Excitation(location), rms_n_(rms_n), rng_(seed) {}
 
 Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed, double band_lo_hz, double band_hi_hz,
              double step_rate_hz)
@@ -76,7 +77,8 @@ Noise::Noise(std::size_t location, double rms_n, std::uint64_t seed, double band
   double power = 0.0;
   const int n = 8192;
   for (int i = 0; i < n; ++i)
-    power += std::norm(filters::digital_response(d.sections, 1.0, (i + 0.5) / n * 0.5 * step_rate_hz, step_rate_hz)) / n;
+    power +=
+        std::norm(filters::digital_response(d.sections, 1.0, (i + 0.5) / n * 0.5 * step_rate_hz, step_rate_hz)) / n;
   band_gain_ = 1.0 / std::sqrt(std::max(power, 1e-300));
   band_limited_ = true;
 }

@@ -47,7 +47,7 @@ class Sine final : public Excitation {
 
  private:
   double amplitude_n_, w_, phase_;
-  double end_t_{-1.0}, end_cos_{0.0}, end_sin_{0.0};  // phase at the end of the last step: the next start
+  double end_t_{-1.0}, end_cos_{0.0}, end_sin_{0.0};    // phase at the end of the last step: the next start
   double step_h_s_{0.0}, rot_cos_{1.0}, rot_sin_{0.0};  // rotation of the phase by one step
   int steps_{0};                                        // steps since the phase was evaluated exactly
 };
@@ -67,7 +67,8 @@ class Chirp final : public Excitation {
 class Noise final : public Excitation {
  public:
   Noise(std::size_t location, double rms_n, std::uint64_t seed);
-  Noise(std::size_t location, double rms_n, std::uint64_t seed, double band_lo_hz, double band_hi_hz, double step_rate_hz);
+  Noise(std::size_t location, double rms_n, std::uint64_t seed, double band_lo_hz, double band_hi_hz,
+        double step_rate_hz);
   double force_n(double t_s, double h_s) noexcept override;
 
  private:

@@ -61,7 +61,9 @@ class FaultInjector {
       const Fault& f = faults_[i];
       if (!active(f, t_s)) continue;
       switch (f.kind) {
-        case FaultKind::kSensorDropout: r = {last_.accel_mps2, false}; break;
+        case FaultKind::kSensorDropout:
+          r = {last_.accel_mps2, false};
+          break;
         case FaultKind::kSensorStuck:
           if (!stuck_) stuck_value_ = last_.accel_mps2, stuck_ = true;
           r.accel_mps2 = stuck_value_;
@@ -70,12 +72,17 @@ class FaultInjector {
           // One sample per due time: at the start, then every period.
           if (t_s >= next_spike_s_[i]) {
             r.accel_mps2 += f.magnitude;
-            next_spike_s_[i] = f.period_s > 0.0 ? next_spike_s_[i] + f.period_s * std::ceil((t_s - next_spike_s_[i] + 0.5 * dt_s) / f.period_s)
-                                                : std::numeric_limits<double>::infinity();
+            next_spike_s_[i] =
+                f.period_s > 0.0
+                    ? next_spike_s_[i] + f.period_s * std::ceil((t_s - next_spike_s_[i] + 0.5 * dt_s) / f.period_s)
+                    : std::numeric_limits<double>::infinity();
           }
           break;
-        case FaultKind::kSensorNan: r.accel_mps2 = std::numeric_limits<double>::quiet_NaN(); break;
-        default: break;
+        case FaultKind::kSensorNan:
+          r.accel_mps2 = std::numeric_limits<double>::quiet_NaN();
+          break;
+        default:
+          break;
       }
     }
     if (!any_active(FaultKind::kSensorStuck, t_s)) stuck_ = false;

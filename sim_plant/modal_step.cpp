@@ -65,7 +65,8 @@ ModalStep::ModalStep(const StateSpace& ss, const DelayedZoh& coil, const Matrix&
   for (std::size_t b = 0; b < blocks; ++b) {
     const auto r = static_cast<Eigen::Index>(2 + 2 * b);
     location[b] = driving_location(ss.b, r);
-    driven[b] = ss.a.block(r, 0, 2, 2).cwiseAbs().maxCoeff() != 0.0 || ss.b.block(r, 0, 2, 1).cwiseAbs().maxCoeff() != 0.0;
+    driven[b] =
+        ss.a.block(r, 0, 2, 2).cwiseAbs().maxCoeff() != 0.0 || ss.b.block(r, 0, 2, 1).cwiseAbs().maxCoeff() != 0.0;
   }
   ss_block_.resize(blocks);
   std::iota(ss_block_.begin(), ss_block_.end(), 0U);

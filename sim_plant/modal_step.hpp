@@ -61,7 +61,7 @@ class ModalStep {
   std::vector<Group> driven_, free_;
   std::vector<DrivenBlock> driven_blocks_;
   std::vector<FreeBlock> free_blocks_;
-  std::vector<Eigen::Vector2d> x_;  // [q, q'] per block: the driven ones, then the free ones
+  std::vector<Eigen::Vector2d> x_;       // [q, q'] per block: the driven ones, then the free ones
   std::vector<std::uint32_t> ss_block_;  // step order -> block index in ss
   // Output rows: [row][2] actuator, [row][block] position and velocity weights, [row][input] direct.
   std::vector<double> c_act_, c_x_, d_;  // c_x_: [row][block][q, q']

@@ -19,9 +19,9 @@
 namespace robodamp::sim {
 
 struct PlantCounters {
-  std::uint64_t steps{0};             // loop periods
-  std::uint64_t voltage_clipped{0};   // internal steps with the amplifier at its voltage range
-  std::uint64_t force_limited{0};     // internal steps with the actuator coil force at its limit
+  std::uint64_t steps{0};            // loop periods
+  std::uint64_t voltage_clipped{0};  // internal steps with the amplifier at its voltage range
+  std::uint64_t force_limited{0};    // internal steps with the actuator coil force at its limit
 };
 
 class Plant {
@@ -91,8 +91,8 @@ class Plant {
   // One internal step in modal block form: x[k+1] = phi x + gamma_late u[k-d] + gamma_early u[k-d-1]
   // + gamma_force f[k].
   ModalStep step_;
-  std::vector<double> force_;  // external force per location over the current internal step, N
-  std::vector<double> u_;      // inputs of the last internal step (for the left limits)
+  std::vector<double> force_;         // external force per location over the current internal step, N
+  std::vector<double> u_;             // inputs of the last internal step (for the left limits)
   std::vector<double> coil_history_;  // delay line of the coil drive at the internal rate
   std::size_t history_pos_{0};
   std::vector<double> period_force_;

@@ -22,8 +22,7 @@ std::string num(double v) {
 Complex FrfPath::receptance(double f_hz) const {
   const Complex s(0.0, kTwoPi * f_hz);
   Complex h(0.0);
-  for (const auto& m : modes)
-    h += modal::mode_receptance(m.a, m.b, m.damping_ratio, m.wn_rad_per_s, s);
+  for (const auto& m : modes) h += modal::mode_receptance(m.a, m.b, m.damping_ratio, m.wn_rad_per_s, s);
   return h;
 }
 
@@ -75,7 +74,9 @@ void add_paths(const config::Config& cfg, PlantModel& m, Problems& problems) {
     }
     const double h0 = p.static_compliance_m_per_n();
     if (p.response == p.excitation && !(h0 > 0.0))
-      problems.push_back({cfg.source, {}, p.origin,
+      problems.push_back({cfg.source,
+                          {},
+                          p.origin,
                           "(" + p.name + ") is a driving-point FRF with static compliance " + num(h0) +
                               " m/N after axis_sign " + std::to_string(static_cast<int>(sign)) + " of location " +
                               std::to_string(f.response_location) +
@@ -93,11 +94,13 @@ void add_reciprocals(const config::Config& cfg, PlantModel& m, Problems& problem
     if (p.response == p.excitation) continue;
     if (const FrfPath* q = m.path(p.excitation, p.response)) {
       if (p.static_compliance_m_per_n() * q->static_compliance_m_per_n() < 0.0)
-        problems.push_back({cfg.source, {}, p.origin,
-                            "(" + p.name + ") and " + q->origin + " (" + q->name +
-                                ") have static compliances of opposite sign (" + num(p.static_compliance_m_per_n()) +
-                                " and " + num(q->static_compliance_m_per_n()) +
-                                " m/N) in the physical frame: reciprocity fails; check the axis_sign of both locations"});
+        problems.push_back(
+            {cfg.source,
+             {},
+             p.origin,
+             "(" + p.name + ") and " + q->origin + " (" + q->name + ") have static compliances of opposite sign (" +
+                 num(p.static_compliance_m_per_n()) + " and " + num(q->static_compliance_m_per_n()) +
+                 " m/N) in the physical frame: reciprocity fails; check the axis_sign of both locations"});
       continue;
     }
     FrfPath r = p;
@@ -186,7 +189,10 @@ void build_state_space(const config::ActuatorConfig& ac, PlantModel& m) {
 PlantModel build_plant_model(const config::Config& cfg) {
   Problems problems;
   if (cfg.robot.frfs.empty()) {
-    problems.push_back({cfg.source, {}, "robot.frfs", "missing: the simulated plant and the loop analysis need the robot's modal data"});
+    problems.push_back({cfg.source,
+                        {},
+                        "robot.frfs",
+                        "missing: the simulated plant and the loop analysis need the robot's modal data"});
     throw config::ConfigError(config::located(problems, cfg.yaml_text));
   }
   PlantModel m;
@@ -195,17 +201,22 @@ PlantModel build_plant_model(const config::Config& cfg) {
   add_paths(cfg, m, problems);
   add_reciprocals(cfg, m, problems);
   const config::ActuatorConfig& ac = cfg.actuator;
-  m.actuator = {ac.constant_n_per_v, ac.natural_freq_hz, ac.damping_ratio, ac.delay_s, ac.force_limit_n,
-                m.index_of(ac.location)};
+  m.actuator = {ac.constant_n_per_v, ac.natural_freq_hz, ac.damping_ratio,
+                ac.delay_s,          ac.force_limit_n,   m.index_of(ac.location)};
   const std::size_t act = m.actuator.location, sensor = m.index_of(cfg.sensor.location);
   if (m.path(act, act) == nullptr)
-    problems.push_back({cfg.source, {}, "robot.frfs",
+    problems.push_back({cfg.source,
+                        {},
+                        "robot.frfs",
                         "no driving-point FRF at the actuator location " + std::to_string(ac.location) +
                             ": the actuator's own receptance is needed to simulate and close the loop"});
   if (m.path(sensor, act) == nullptr)
-    problems.push_back({cfg.source, {}, "robot.frfs",
-                        "no FRF from the actuator location " + std::to_string(ac.location) + " to the sensor location " +
-                            std::to_string(cfg.sensor.location) + " (nor its reciprocal): the loop cannot close"});
+    problems.push_back({cfg.source,
+                        {},
+                        "robot.frfs",
+                        "no FRF from the actuator location " + std::to_string(ac.location) +
+                            " to the sensor location " + std::to_string(cfg.sensor.location) +
+                            " (nor its reciprocal): the loop cannot close"});
   if (!problems.empty()) throw config::ConfigError(config::located(problems, cfg.yaml_text));
   build_state_space(ac, m);
   return m;

@@ -34,10 +34,10 @@ inline int free_tcp_port() {
 // Every occurrence; returns how many.
 inline std::size_t replace_all_present(std::string& s, const std::string& from, const std::string& to) {
   std::size_t n = 0;
-  for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size()), ++n) s.replace(p, from.size(), to);
+  for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size()), ++n)
+    s.replace(p, from.size(), to);
   return n;
 }
-
 
 struct HilFiles {
   std::string dir, config, plant_json, run_json, plant_log, run_log;
@@ -56,7 +56,8 @@ inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<s
   replace_all_present(text, "job: milling/", std::string("job: ") + ROBODAMP_SOURCE_DIR + "/config/milling/");
   replace_all_present(text, "model: robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
   replace_all_present(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
-  replace_all_present(text, "vertical: presets/vertical_c1.yaml", std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
+  replace_all_present(text, "vertical: presets/vertical_c1.yaml",
+                      std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
   for (const auto& [from, to] : edits) replace_or_throw(text, from, to);  // a test's own edit must match
   f.config = f.dir + "/hil.yaml";
   std::ofstream(f.config) << text;

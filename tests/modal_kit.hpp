@@ -15,8 +15,8 @@
 namespace robodamp::test {
 
 // robot: the configuration measured; measure_dir: where the measurement goes; returns uff_path.
-inline std::string modal_kit_export(const std::string& robot, const std::string& measure_dir, const std::string& uff_path,
-                                    double calibration) {
+inline std::string modal_kit_export(const std::string& robot, const std::string& measure_dir,
+                                    const std::string& uff_path, double calibration) {
   const commission::MeasureOutcome m = commission::measure(robot, measure_dir);
   EXPECT_EQ(m.status, commission::MeasureStatus::kOk) << m.message;
   measfiles::UffFile f = measfiles::read_uff(measure_dir + "/" + identify::kMeasurementUffName);

@@ -44,7 +44,8 @@ inline Outcome run(const config::Config& cfg, double duration_s, Setup&& setup, 
   return out;
 }
 inline Outcome run(const config::Config& cfg, double duration_s, CellOptions o = virtual_clock()) {
-  return run(cfg, duration_s, [](Cell&) {}, o);
+  return run(
+      cfg, duration_s, [](Cell&) {}, o);
 }
 
 // Every tick the loop ran reached the consumer, in order, none twice.

@@ -26,7 +26,8 @@ runtime::AdviceRecord advised() {
   runtime::AdviceRecord r;
   r.seq = 3;
   milling::SpeedAdviceRequest& q = r.advice.request;
-  q.rpm = 700.0, q.depth_mm = 1.0, q.set = 1, q.gain_ns_per_m = 2000.0, q.damped = true, q.trigger = "depth above the limit";
+  q.rpm = 700.0, q.depth_mm = 1.0, q.set = 1, q.gain_ns_per_m = 2000.0, q.damped = true,
+  q.trigger = "depth above the limit";
   r.advice.found = true;
   r.advice.options.push_back({666.7, 1.74, 1.74, "mode", {}});
   return r;

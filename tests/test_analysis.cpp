@@ -21,7 +21,9 @@ namespace {
 using namespace robodamp;
 using analysis::Complex;
 
-analysis::LoopModel model(const std::string& name) { return analysis::LoopModel(config::load_config_file(test::preset(name))); }
+analysis::LoopModel model(const std::string& name) {
+  return analysis::LoopModel(config::load_config_file(test::preset(name)));
+}
 
 TEST(LoopModel, ClosedLoopFollowsTheCorrectedEquations) {
   // docs/physics.md §1 (Eq. 10-12, H11 corrected), with every FRF in one consistent frame, the
@@ -35,7 +37,7 @@ TEST(LoopModel, ClosedLoopFollowsTheCorrectedEquations) {
     const Complex h11 = modal::frf_receptance(cfg.robot.frfs[0], f);
     const Complex h21 = -modal::frf_receptance(cfg.robot.frfs[1], f);  // physical: location 2 axis reversed
     const Complex h22 = -modal::frf_receptance(cfg.robot.frfs[2], f);
-    const Complex h12 = h21;                                            // reciprocity
+    const Complex h12 = h21;  // reciprocity
     // G / T: force per displacement fed back with negative sign (F_act = -G/T x2).
     const Complex g_over_t = -m.feedback_continuous(f, k, 1);
     const Complex l = g_over_t * h22;
@@ -45,7 +47,8 @@ TEST(LoopModel, ClosedLoopFollowsTheCorrectedEquations) {
     EXPECT_NEAR(std::abs(m.closed_continuous(0, 0, f, k, 1) - h11_cl), 0.0, 1e-9 * std::abs(h11_cl)) << f;
     // Table frame: L_table = G' H22_table / T with G' = -G; the coupling term then enters with +.
     const Complex h21_t = -h21, h22_t = -h22, g_t = -g_over_t, l_t = g_t * h22_t;
-    EXPECT_NEAR(std::abs((h11 * (1.0 + l_t) + h21_t * h21_t * g_t) / (1.0 + l_t) - h11_cl), 0.0, 1e-9 * std::abs(h11_cl));
+    EXPECT_NEAR(std::abs((h11 * (1.0 + l_t) + h21_t * h21_t * g_t) / (1.0 + l_t) - h11_cl), 0.0,
+                1e-9 * std::abs(h11_cl));
   }
 }
 
@@ -219,7 +222,8 @@ TEST(Analysis, HarmonicNotchesJoinTheLoopAtASpindleSpeed) {
   ASSERT_TRUE(k_plain && k_fast);
   EXPECT_NEAR(*k_fast, *k_plain, 0.005 * *k_plain);
   // The notches' depth is in the discrete loop: its filter response at 600 Hz is 30 dB down.
-  EXPECT_NEAR(20.0 * std::log10(std::abs(fast.chain_filters_digital(600.0) / plain.chain_filters_digital(600.0))), -30.0, 0.5);
+  EXPECT_NEAR(20.0 * std::log10(std::abs(fast.chain_filters_digital(600.0) / plain.chain_filters_digital(600.0))),
+              -30.0, 0.5);
 }
 
 // One rule of which notches are on: the loop analysis takes the designed controller's settings and the
@@ -243,7 +247,8 @@ TEST(Analysis, AnalysedNotchesAreTheRunningBanksAtEverySpeed) {
     for (int k = 0; k < filters::kMaxHarmonics; ++k) running += bank.harmonic_gain(k) == 1.0;
     const analysis::LoopModel model(cfg, rpm);
     EXPECT_EQ(model.notch_count(), running) << rpm << " rpm";
-    EXPECT_EQ(static_cast<int>(running), filters::HarmonicNotchBank::steady_count(designed, tooth_hz, cfg.loop.rate_hz));
+    EXPECT_EQ(static_cast<int>(running),
+              filters::HarmonicNotchBank::steady_count(designed, tooth_hz, cfg.loop.rate_hz));
     for (const double f : {9.2, tooth_hz, 1.5 * tooth_hz}) {
       const auto a = model.notch_response(f), b = bank.response(f);
       EXPECT_NEAR(std::abs(a - b), 0.0, 1e-9) << rpm << " rpm at " << f << " Hz";

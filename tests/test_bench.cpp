@@ -32,7 +32,8 @@ void expect_open_loop_matches(const analysis::Bench& bench, double tol_db, doubl
     const auto t = bench.impact_test({loc, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, false, 0.0, 1});
     for (const auto& f : r) {
       if (f.excitation != loc) continue;
-      const auto p = analysis::measured_peak(t.receptance[f.response], cfg.analysis.band_min_hz, cfg.analysis.band_max_hz);
+      const auto p =
+          analysis::measured_peak(t.receptance[f.response], cfg.analysis.band_min_hz, cfg.analysis.band_max_hz);
       EXPECT_NEAR(20 * std::log10(p.magnitude_m_per_n / f.open_peak_m_per_n), 0.0, tol_db) << f.name;
       EXPECT_NEAR(p.freq_hz, f.open_peak_freq_hz, 0.02) << f.name;
       EXPECT_GT(p.coherence_min, min_coherence) << f.name;
@@ -55,7 +56,8 @@ TEST(Bench, MeasuredImprovementMatchesTheAnalysisForEveryPreset) {
   for (const char* name : {"horizontal_c2", "horizontal_c1", "horizontal_c3", "vertical_c1"}) {
     const analysis::Bench bench(config::load_config_file(test::preset(name)));
     const auto& cfg = bench.model().config();
-    const auto predicted = analysis::improvements(bench.model(), cfg.controller.gain_ns_per_m, cfg.controller.polarity, true);
+    const auto predicted =
+        analysis::improvements(bench.model(), cfg.controller.gain_ns_per_m, cfg.controller.polarity, true);
     for (std::size_t loc = 0; loc < 2; ++loc) {
       const auto off = bench.impact_test({loc, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, false, 0.0, 1});
       const auto on = bench.impact_test({loc, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, true,
@@ -66,7 +68,8 @@ TEST(Bench, MeasuredImprovementMatchesTheAnalysisForEveryPreset) {
         const double lo = cfg.analysis.band_min_hz, hi = cfg.analysis.band_max_hz;
         const double measured = (analysis::measured_peak(off.receptance[f.response], lo, hi).magnitude_m_per_n /
                                      analysis::measured_peak(on.receptance[f.response], lo, hi).magnitude_m_per_n -
-                                 1.0) * 100.0;
+                                 1.0) *
+                                100.0;
         EXPECT_NEAR(measured, f.improvement_pct, 0.05 * std::abs(f.improvement_pct)) << name << " " << f.name;
       }
     }
@@ -98,7 +101,9 @@ TEST(Bench, SaturationLowersTheImprovement) {
   const auto predicted = analysis::improvements(bench.model(), cfg.controller.gain_ns_per_m, 1, true);
   const double lo = cfg.analysis.band_min_hz, hi = cfg.analysis.band_max_hz;
   const double measured = (analysis::measured_peak(off.receptance[aml], lo, hi).magnitude_m_per_n /
-                               analysis::measured_peak(sat.receptance[aml], lo, hi).magnitude_m_per_n - 1.0) * 100.0;
+                               analysis::measured_peak(sat.receptance[aml], lo, hi).magnitude_m_per_n -
+                           1.0) *
+                          100.0;
   EXPECT_GT(sat.saturation_time_s, 0.1);
   EXPECT_LT(measured, 0.9 * predicted[2].improvement_pct);
   EXPECT_GT(measured, 0.0);  // clipped damping is still damping

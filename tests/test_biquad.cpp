@@ -143,7 +143,9 @@ TEST(BiquadCascade, CoefficientSwapAtASampleBoundaryDoesNotJump) {
   }
   // The same swap done naively (new coefficients over the old TDF-II state) does jump: this is what
   // the history-preserving swap is for.
-  struct S { double s1 = 0, s2 = 0; };
+  struct S {
+    double s1 = 0, s2 = 0;
+  };
   std::vector<S> st(a.count);
   std::vector<double> naive;
   for (std::size_t i = 0; i < n; ++i) {

@@ -83,7 +83,8 @@ TEST(CanCodec, PacksAndUnpacksEveryLayout) {
         m.length_bytes = 8;
         m.value = {8 - size, size, is_signed, order, 0.5, -3.0};
         const double full = std::ldexp(1.0, 8 * size);
-        for (double counts : {0.0, 1.0, is_signed ? -1.0 : 2.0, is_signed ? full / 2 - 1 : full - 1, is_signed ? -full / 2 : 7.0}) {
+        for (double counts :
+             {0.0, 1.0, is_signed ? -1.0 : 2.0, is_signed ? full / 2 - 1 : full - 1, is_signed ? -full / 2 : 7.0}) {
           const double value = counts * 0.5 - 3.0;
           const auto e = robodamp::drivers::encode(m, false, value, 0);
           EXPECT_FALSE(e.clipped) << size << is_signed;
@@ -342,8 +343,7 @@ TEST(CanDriver, AFullTransmitQueueBacksOffAndRecovers) {
   EXPECT_FALSE(link.driver->write(0.1, t + 2).ok);
   // The bus drains: after the back-off the next command goes out.
   canfd_frame f{};
-  while (recv(link.peer, &f, sizeof f, MSG_DONTWAIT) > 0) {
-  }
+  while (recv(link.peer, &f, sizeof f, MSG_DONTWAIT) > 0) {}
   EXPECT_TRUE(link.driver->write(0.1, t + 100).ok);
   EXPECT_GT(sent, 10);
 }
@@ -395,13 +395,15 @@ can:
   } catch (const cfg::ConfigError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("loop.rate_hz: the bus cannot carry this loop: 5000 Hz x (135.0 us sensor + 135.0 us command"),
-              std::string::npos) << m;
+              std::string::npos)
+        << m;
     EXPECT_NE(m.find("= 135 % of the bus at 1000 kbit/s"), std::string::npos) << m;
     EXPECT_NE(m.find("the highest loop rate is 2592 Hz"), std::string::npos) << m;
   }
   // The same frames on CAN FD with a 5 Mbit/s data phase fit.
   std::string fd = classic;
-  fd.replace(fd.find("  bitrate_bps: 1000000\n"), 23, "  bitrate_bps: 1000000\n  fd: true\n  data_bitrate_bps: 5000000\n");
+  fd.replace(fd.find("  bitrate_bps: 1000000\n"), 23,
+             "  bitrate_bps: 1000000\n  fd: true\n  data_bitrate_bps: 5000000\n");
   const auto c = cfg::parse_config(yaml + fd, "hil.yaml");
   ASSERT_TRUE(c.can);
   EXPECT_LT(cfg::can_bus_load(*c.can, 5000.0), 0.7);
@@ -415,7 +417,9 @@ can:
     ADD_FAILURE();
   } catch (const cfg::ConfigError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("can.command.id = '0x901' is not allowed: an identifier 0 <= id <= 0x7FF (11-bit)"), std::string::npos) << m;
+    EXPECT_NE(m.find("can.command.id = '0x901' is not allowed: an identifier 0 <= id <= 0x7FF (11-bit)"),
+              std::string::npos)
+        << m;
     EXPECT_NE(m.find("can.sensor.counter: overlaps the value's bytes"), std::string::npos) << m;
   }
 }

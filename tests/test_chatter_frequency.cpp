@@ -28,8 +28,8 @@ struct Case {
   const char* job;
   const char* drop_part;  // a part of the job's structure left out ("" none)
   double rpm;
-  double over;            // the cut's depth over SDM's limit
-  double max_hz;          // the indicator's band (covers the harmonic SDM names)
+  double over;             // the cut's depth over SDM's limit
+  double max_hz;           // the indicator's band (covers the harmonic SDM names)
   double cut_s, window_s;  // the simulated cut, the indicator's window
   bool damped;             // the job's controller running (sampled-loop SDM; the real Controller in the cut)
 };
@@ -56,7 +56,8 @@ Frequencies measure(const Case& c) {
   EXPECT_FALSE(near.verdict.stable) << c.what;
   f.detector_hz = near.verdict.chatter_hz;
   ml::CutOverrides o;
-  o.damped = c.damped, o.rpm = c.rpm, o.axial_mm = c.over * sdm.critical_depth_mm, o.revolutions = static_cast<int>(std::ceil(c.cut_s * c.rpm / 60.0));
+  o.damped = c.damped, o.rpm = c.rpm, o.axial_mm = c.over * sdm.critical_depth_mm,
+  o.revolutions = static_cast<int>(std::ceil(c.cut_s * c.rpm / 60.0));
   const ml::CutOutcome cut = ml::run_job(ml::make_cut_job(job, structure, o));
   EXPECT_FALSE(cut.verdict.stable) << c.what;
   f.long_detector_hz = cut.verdict.chatter_hz;
@@ -64,7 +65,8 @@ Frequencies measure(const Case& c) {
   ml::RecordedSignal sig;
   sig.source = "simulated cut", sig.rate_hz = 1.0 / cut.record.step_s;
   const auto& y = job.cut.feed_axis == cfg::Axis::kX ? cut.record.y_m : cut.record.x_m;
-  for (std::size_t i = 2; i < y.size(); ++i) sig.samples.push_back((y[i] - 2.0 * y[i - 1] + y[i - 2]) * sig.rate_hz * sig.rate_hz);
+  for (std::size_t i = 2; i < y.size(); ++i)
+    sig.samples.push_back((y[i] - 2.0 * y[i - 1] + y[i - 2]) * sig.rate_hz * sig.rate_hz);
   ml::ListenSettings s;
   s.teeth = job.tool.teeth, s.rpm = c.rpm, s.window_s = c.window_s, s.max_hz = c.max_hz;
   f.indicator_hz = ml::listen(sig, s).chatter_hz;
@@ -74,21 +76,27 @@ Frequencies measure(const Case& c) {
   std::string notes;
   for (const auto& w : low.warnings) notes += w + "\n";
   // The user is told when the recording holds more than the band (1.5 x).
-  EXPECT_EQ(notes.find("analysed up to 1000 Hz of the") != std::string::npos, 0.5 * sig.rate_hz > 1500.0) << c.what << ": " << notes;
-  std::printf("%-44s SDM %.1f mm at %.1f Hz; detector %.1f Hz at it, %.1f Hz above; indicator %.1f Hz (band %.0f Hz), %.1f Hz (band 1 kHz); "
-              "families %.1f %.1f %.1f %.1f Hz (f_p %.1f Hz)\n",
-              c.what, sdm.critical_depth_mm, f.sdm_hz, f.detector_hz, f.long_detector_hz, f.indicator_hz, c.max_hz, f.low_band_hz,
-              ml::chatter_family_hz(f.sdm_hz, f.tooth_hz), ml::chatter_family_hz(f.detector_hz, f.tooth_hz),
-              ml::chatter_family_hz(f.indicator_hz, f.tooth_hz), ml::chatter_family_hz(f.low_band_hz, f.tooth_hz), f.tooth_hz);
+  EXPECT_EQ(notes.find("analysed up to 1000 Hz of the") != std::string::npos, 0.5 * sig.rate_hz > 1500.0)
+      << c.what << ": " << notes;
+  std::printf(
+      "%-44s SDM %.1f mm at %.1f Hz; detector %.1f Hz at it, %.1f Hz above; indicator %.1f Hz (band %.0f Hz), %.1f Hz "
+      "(band 1 kHz); "
+      "families %.1f %.1f %.1f %.1f Hz (f_p %.1f Hz)\n",
+      c.what, sdm.critical_depth_mm, f.sdm_hz, f.detector_hz, f.long_detector_hz, f.indicator_hz, c.max_hz,
+      f.low_band_hz, ml::chatter_family_hz(f.sdm_hz, f.tooth_hz), ml::chatter_family_hz(f.detector_hz, f.tooth_hz),
+      ml::chatter_family_hz(f.indicator_hz, f.tooth_hz), ml::chatter_family_hz(f.low_band_hz, f.tooth_hz), f.tooth_hz);
   return f;
 }
 
 TEST(ChatterFrequency, SdmTheDetectorAndTheIndicatorNameOneAlias) {
   const Case cases[] = {
-      {"industrial robot, robot and workpiece, 10700 rpm", "industrial_robot_aluminium.yaml", "", 10700.0, 1.05, 8000.0, 3.0, 1.0, false},
-      {"industrial robot, robot alone, 10700 rpm", "industrial_robot_aluminium.yaml", "workpiece", 10700.0, 1.05, 8000.0, 3.0, 1.0, false},
+      {"industrial robot, robot and workpiece, 10700 rpm", "industrial_robot_aluminium.yaml", "", 10700.0, 1.05, 8000.0,
+       3.0, 1.0, false},
+      {"industrial robot, robot alone, 10700 rpm", "industrial_robot_aluminium.yaml", "workpiece", 10700.0, 1.05,
+       8000.0, 3.0, 1.0, false},
       {"default job, open loop, 700 rpm", "active_damping_c2.yaml", "", 700.0, 1.3, 1000.0, 16.0, 4.0, false},
-      {"default job, damped at K = 2000 N s/m, 700 rpm", "active_damping_c2.yaml", "", 700.0, 1.3, 1000.0, 16.0, 4.0, true},
+      {"default job, damped at K = 2000 N s/m, 700 rpm", "active_damping_c2.yaml", "", 700.0, 1.3, 1000.0, 16.0, 4.0,
+       true},
   };
   for (const Case& c : cases) {
     const Frequencies f = measure(c);

@@ -45,8 +45,10 @@ std::vector<double> cut_signal(double rate_hz, double duration_s, bool chatter, 
   for (int i = 0; i < static_cast<int>(duration_s * rate_hz); ++i) {
     const double t = i / rate_hz;
     double v = noise(rng);
-    for (int k = 1; k <= 30; ++k) v += (k % kTeeth == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
-    if (chatter && t > kOnsetS) v += std::min(0.05 * std::exp(3.0 * (t - kOnsetS)), 1.5) * std::sin(2.0 * M_PI * kChatterHz * t);
+    for (int k = 1; k <= 30; ++k)
+      v += (k % kTeeth == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
+    if (chatter && t > kOnsetS)
+      v += std::min(0.05 * std::exp(3.0 * (t - kOnsetS)), 1.5) * std::sin(2.0 * M_PI * kChatterHz * t);
     x.push_back(v);
   }
   return x;
@@ -89,7 +91,7 @@ TEST(ChatterListen, KnownCutsAtThreeRatesGiveTheVerdictsTheOnsetAndTheFrequency)
       sig.source = "synthetic", sig.rate_hz = rate, sig.samples = cut_signal(rate, 20.0, chatter, 5);
       const ml::ListenReport r = ml::listen(sig, settings());
       const std::string what = std::to_string(rate) + (chatter ? " chatter" : " stable");
-      EXPECT_EQ(r.windows.size(), 5u) << what;  // 4 s each
+      EXPECT_EQ(r.windows.size(), 5u) << what;                                // 4 s each
       EXPECT_NEAR(r.rpm, kRpm, 0.01 * kRpm) << what << ": " << r.rpm_source;  // estimated: not given
       expect_truth(r, chatter, what);
       if (chatter) {
@@ -114,7 +116,7 @@ TEST(ChatterListen, AwkwardRecordingsAreSaidPlainly) {
   ml::RecordedSignal sig;
   sig.source = "awkward", sig.rate_hz = 10000.0, sig.samples = cut_signal(10000.0, 12.0, true, 9);
   for (std::size_t i = 30000; i < 30500; ++i) sig.samples[i] = NAN;  // a dropout: 1.25 % of a 4 s window
-  for (double& v : sig.samples) v = std::clamp(v + 3.0, 1.0, 4.0);  // a DC offset, and clipped at 4
+  for (double& v : sig.samples) v = std::clamp(v + 3.0, 1.0, 4.0);   // a DC offset, and clipped at 4
   const ml::ListenReport r = ml::listen(sig, settings());
   std::string all;
   for (const auto& w : r.warnings) all += w + "\n";
@@ -160,12 +162,14 @@ void write_wav24(const std::string& path, const std::vector<double>& x, double r
   f << "RIFF";
   u32(36 + bytes);
   f << "WAVEfmt ";
-  u32(16), u16(1), u16(1), u32(static_cast<std::uint32_t>(rate)), u32(static_cast<std::uint32_t>(rate) * 3), u16(3), u16(24);
+  u32(16), u16(1), u16(1), u32(static_cast<std::uint32_t>(rate)), u32(static_cast<std::uint32_t>(rate) * 3), u16(3),
+      u16(24);
   f << "data";
   u32(bytes);
   for (double v : x) {
     const auto s = static_cast<std::int32_t>(std::lround(std::clamp(v / full_scale, -1.0, 1.0) * 8388607.0));
-    const char b[3] = {static_cast<char>(s & 0xff), static_cast<char>((s >> 8) & 0xff), static_cast<char>((s >> 16) & 0xff)};
+    const char b[3] = {static_cast<char>(s & 0xff), static_cast<char>((s >> 8) & 0xff),
+                       static_cast<char>((s >> 16) & 0xff)};
     f.write(b, 3);
   }
 }
@@ -194,15 +198,16 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
     f.response_node = 1, f.response_direction = 2;
     f.abscissa = {robodamp::measfiles::kUffTime, 0, 0, 0, "Time", "s"};
     f.ordinate = {robodamp::measfiles::kUffAcceleration, 0, 0, 0, "Acceleration", "m/s^2"};
-    for (std::size_t i = 0; i < x.size(); ++i) f.x.push_back(static_cast<double>(i) / rate), f.y.emplace_back(x[i], 0.0);
+    for (std::size_t i = 0; i < x.size(); ++i)
+      f.x.push_back(static_cast<double>(i) / rate), f.y.emplace_back(x[i], 0.0);
     robodamp::measfiles::UffFile file;
     file.functions = {f};
     robodamp::measfiles::write_uff(tmp.file("cut.uff"), file, robodamp::measfiles::UffEncoding::kBinary);
   }
   const std::string json = tmp.file("c.json"), plots = tmp.file("plots");
   for (const std::string input : {"cut.csv --column 2", "cut.wav --full-scale-mps2 20", "cut.uff"}) {
-    const Result r = run("chatter --signal " + tmp.path + "/" + input + " --teeth 3 --rpm-range 300 3000 --json " + json +
-                         " --plot-dir " + plots);
+    const Result r = run("chatter --signal " + tmp.path + "/" + input + " --teeth 3 --rpm-range 300 3000 --json " +
+                         json + " --plot-dir " + plots);
     ASSERT_EQ(r.status, 0) << input << "\n" << r.out;
     EXPECT_NE(r.out.find("CHATTER from"), std::string::npos) << r.out;
     const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
@@ -216,8 +221,9 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
       EXPECT_GT(std::filesystem::file_size(plots + "/" + png), 5000u) << png;
   }
   // With the cell and its job: each speed to try checked by the accurate method, as the cell's advisor does.
-  const Result checked = run("chatter --signal " + tmp.file("cut.uff") + " --teeth 3 --config " + robodamp::test::preset("horizontal_c2") +
-                             " --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml --depth-mm 1.0 --json " + json);
+  const Result checked = run("chatter --signal " + tmp.file("cut.uff") + " --teeth 3 --config " +
+                             robodamp::test::preset("horizontal_c2") + " --job " + std::string(ROBODAMP_SOURCE_DIR) +
+                             "/config/milling/active_damping_c2.yaml --depth-mm 1.0 --json " + json);
   ASSERT_EQ(checked.status, 0) << checked.out;
   EXPECT_NE(checked.out.find("Checked by SDM at"), std::string::npos) << checked.out;
   const auto c = nlohmann::json::parse(robodamp::test::read_file(json))["checked"];
@@ -228,8 +234,9 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
     EXPECT_GE(o["rpm"].get<double>(), 100.0);
     EXPECT_LE(o["rpm"].get<double>(), 1500.0);  // the job's range
   }
-  const Result wrong_teeth = run("chatter --signal " + tmp.file("cut.uff") + " --teeth 4 --config " + robodamp::test::preset("horizontal_c2") +
-                                 " --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  const Result wrong_teeth =
+      run("chatter --signal " + tmp.file("cut.uff") + " --teeth 4 --config " + robodamp::test::preset("horizontal_c2") +
+          " --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
   EXPECT_EQ(wrong_teeth.status, 2) << wrong_teeth.out;
   EXPECT_NE(wrong_teeth.out.find("--teeth 4 but the job"), std::string::npos) << wrong_teeth.out;
   const Result no_teeth = run("chatter --signal " + tmp.file("cut.uff"));
@@ -271,8 +278,8 @@ struct SimulatedCut {
 // One cut of config/milling/active_damping_c2.yaml (open, or damped at its controller's K = 2000 N s/m) with
 // 10 um of runout on one tooth, 20 s; the wall-normal acceleration by differences.
 SimulatedCut simulate(double rpm, double depth_mm, bool damped) {
-  robodamp::config::MillingConfig job =
-      robodamp::config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  robodamp::config::MillingConfig job = robodamp::config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) +
+                                                                              "/config/milling/active_damping_c2.yaml");
   job.time_domain.runout_um = {10.0, 0.0, 0.0};
   const ml::Structure structure(*job.find_structure(job.structure), damped);
   ml::CutOverrides o;
@@ -280,9 +287,11 @@ SimulatedCut simulate(double rpm, double depth_mm, bool damped) {
   const ml::CutOutcome cut = ml::run_job(ml::make_cut_job(job, structure, o));
   SimulatedCut s;
   s.fs_hz = 1.0 / cut.record.step_s, s.rpm = cut.record.rpm;
-  s.chatter = !cut.verdict.stable, s.chatter_hz = cut.verdict.chatter_hz, s.mechanism = ml::to_string(cut.verdict.classification);
+  s.chatter = !cut.verdict.stable, s.chatter_hz = cut.verdict.chatter_hz,
+  s.mechanism = ml::to_string(cut.verdict.classification);
   const auto& y = cut.record.y_m;
-  for (std::size_t i = 2; i < y.size(); ++i) s.accel_mps2.push_back((y[i] - 2.0 * y[i - 1] + y[i - 2]) * s.fs_hz * s.fs_hz);
+  for (std::size_t i = 2; i < y.size(); ++i)
+    s.accel_mps2.push_back((y[i] - 2.0 * y[i - 1] + y[i - 2]) * s.fs_hz * s.fs_hz);
   return s;
 }
 
@@ -332,9 +341,9 @@ TEST(ChatterListen, SimulatedCutsOpenAndDampedHopfAndFlipAtThreeRatesAndThroughA
     double rpm, depth_mm;
     bool damped;
   };
-  const Case cases[] = {{"open 700 rpm below", 700.0, 0.8, false}, {"open 700 rpm above (Hopf)", 700.0, 1.5, false},
+  const Case cases[] = {{"open 700 rpm below", 700.0, 0.8, false},  {"open 700 rpm above (Hopf)", 700.0, 1.5, false},
                         {"open 381 rpm below", 381.0, 0.15, false}, {"open 381 rpm above (flip)", 381.0, 0.35, false},
-                        {"damped 700 rpm below", 700.0, 0.6, true},  {"damped 700 rpm above (Hopf)", 700.0, 1.1, true}};
+                        {"damped 700 rpm below", 700.0, 0.6, true}, {"damped 700 rpm above (Hopf)", 700.0, 1.1, true}};
   for (const Case& c : cases) {
     const SimulatedCut cut = simulate(c.rpm, c.depth_mm, c.damped);
     for (const double rate : {10000.0, 25600.0, 48000.0}) {
@@ -344,18 +353,22 @@ TEST(ChatterListen, SimulatedCutsOpenAndDampedHopfAndFlipAtThreeRatesAndThroughA
         const double onset = cut.chatter ? truth_onset_s(cut, mic, mic ? 0.05 * 0.3 : 0.05) : 0.0;
         if (cut.mechanism == std::string("flip")) s.rpm = cut.rpm;  // see above
         const ml::ListenReport r = ml::listen(recorded(cut, rate, mic, 11), s);
-        const std::string what = std::string(c.what) + " at " + std::to_string(static_cast<int>(rate)) + " Hz" + (mic ? ", microphone" : "");
+        const std::string what =
+            std::string(c.what) + " at " + std::to_string(static_cast<int>(rate)) + " Hz" + (mic ? ", microphone" : "");
         EXPECT_NEAR(r.rpm, cut.rpm, 0.01 * cut.rpm) << what << ": " << r.rpm_source;
         int right = 0, judged = 0;
         for (const auto& w : r.windows) {
-          if (w.start_s < 2.0 || (cut.chatter && w.end_s > onset && w.start_s < onset + 1.0)) continue;  // the entry; the onset's
+          if (w.start_s < 2.0 || (cut.chatter && w.end_s > onset && w.start_s < onset + 1.0))
+            continue;  // the entry; the onset's
           ++judged;
           const bool should = cut.chatter && w.start_s >= onset;
           right += w.verdict == (should ? ml::WindowVerdict::kChatter : ml::WindowVerdict::kStable);
         }
-        std::printf("%-28s %5.1f kHz %-4s: %s %s %.2f Hz (truth %s %.2f Hz), onset %.2f s (truth %.2f s), %d of %d windows right\n",
-                    c.what, rate / 1000.0, mic ? "mic" : "acc", r.onset_s ? "chatter" : "stable", "", r.chatter_hz,
-                    cut.mechanism.c_str(), cut.chatter_hz, r.onset_s.value_or(0.0), onset, right, judged);
+        std::printf(
+            "%-28s %5.1f kHz %-4s: %s %s %.2f Hz (truth %s %.2f Hz), onset %.2f s (truth %.2f s), %d of %d windows "
+            "right\n",
+            c.what, rate / 1000.0, mic ? "mic" : "acc", r.onset_s ? "chatter" : "stable", "", r.chatter_hz,
+            cut.mechanism.c_str(), cut.chatter_hz, r.onset_s.value_or(0.0), onset, right, judged);
         EXPECT_GE(right, (95 * judged + 99) / 100) << what;
         EXPECT_EQ(r.onset_s.has_value(), cut.chatter) << what;
         if (cut.chatter && r.onset_s) {
@@ -374,7 +387,8 @@ TEST(ChatterListen, TheSpeedFromATeethOnlyComb) {
   std::mt19937 rng(4);
   std::normal_distribution<double> noise(0.0, 0.01);
   for (int i = 0; i < 20000; ++i)
-    x.push_back(noise(rng) + 0.4 * std::sin(2.0 * M_PI * f_tooth * i / rate) + 0.2 * std::sin(2.0 * M_PI * 2.0 * f_tooth * i / rate + 1.0) +
+    x.push_back(noise(rng) + 0.4 * std::sin(2.0 * M_PI * f_tooth * i / rate) +
+                0.2 * std::sin(2.0 * M_PI * 2.0 * f_tooth * i / rate + 1.0) +
                 0.1 * std::sin(2.0 * M_PI * 3.0 * f_tooth * i / rate + 2.0));
   const auto e = ml::estimate_rpm(x, rate, kTeeth, 300.0, 3000.0);
   ASSERT_TRUE(e.has_value());
@@ -396,13 +410,15 @@ TEST(ChatterListen, EachWindowAtTheSpeedTheRecordingHeld) {
     for (int i = 0; i < static_cast<int>(16.0 * rate); ++i) {
       const double t = i / rate, rpm = t < 8.0 ? 700.0 : 900.0, f_sp = rpm / 60.0;
       double v = noise(rng);
-      for (int k = 1; k <= 30; ++k) v += (k % kTeeth == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
+      for (int k = 1; k <= 30; ++k)
+        v += (k % kTeeth == 0 ? 0.4 : 0.05) / std::sqrt(k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.7 * k);
       if (t < 8.0) v += 1.5 * std::sin(2.0 * M_PI * kChatterHz * t);
       csv << t << ',' << v << ',' << rpm << '\n';
     }
   }
   const std::string json = tmp.file("c.json");
-  const Result r = run("chatter --signal " + tmp.file("two_speeds.csv") + " --teeth 3 --rpm-column spindle_rpm --json " + json);
+  const Result r =
+      run("chatter --signal " + tmp.file("two_speeds.csv") + " --teeth 3 --rpm-column spindle_rpm --json " + json);
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
   ASSERT_EQ(j["windows"].size(), 4u);
@@ -413,12 +429,14 @@ TEST(ChatterListen, EachWindowAtTheSpeedTheRecordingHeld) {
   EXPECT_NE(j["rpm_source"].get<std::string>().find("the column 'spindle_rpm'"), std::string::npos);
   // A robodamp recording: its spindle command gives the speed.
   const std::string rec = tmp.file("run.rdrec");
-  const Result ran = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 5 --clock virtual --spindle-rpm 700 --record " + rec);
+  const Result ran = run("run --config " + robodamp::test::preset("horizontal_c2") +
+                         " --duration 5 --clock virtual --spindle-rpm 700 --record " + rec);
   ASSERT_EQ(ran.status, 0) << ran.out;
   const Result heard = run("chatter --signal " + rec + " --teeth 3 --json " + json);
   ASSERT_EQ(heard.status, 0) << heard.out;
   const auto h = nlohmann::json::parse(robodamp::test::read_file(json));
-  EXPECT_NE(h["rpm_source"].get<std::string>().find("the recording's spindle commands"), std::string::npos) << heard.out;
+  EXPECT_NE(h["rpm_source"].get<std::string>().find("the recording's spindle commands"), std::string::npos)
+      << heard.out;
   EXPECT_EQ(h["windows"].back()["rpm"].get<double>(), 700.0) << heard.out;
   EXPECT_EQ(h["rate_hz"].get<double>(), 5000.0);
 }

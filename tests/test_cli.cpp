@@ -121,8 +121,10 @@ TEST(Cli, TheMillingJobIsJobEverywhereAndTheOldConfigStillRuns) {
   ASSERT_EQ(pose_now.status, 0) << pose_now.out;
   ASSERT_EQ(pose_old.status, 0) << pose_old.out;
   EXPECT_EQ(pose_now.out.find("deprecated"), std::string::npos) << pose_now.out;
-  EXPECT_NE(pose_old.out.find("--pose is deprecated (kept for one release): use --pose-name NAME"), std::string::npos) << pose_old.out;
-  EXPECT_NE(pose_old.out.find("--csv is deprecated (kept for one release): use --csv-out FILE"), std::string::npos) << pose_old.out;
+  EXPECT_NE(pose_old.out.find("--pose is deprecated (kept for one release): use --pose-name NAME"), std::string::npos)
+      << pose_old.out;
+  EXPECT_NE(pose_old.out.find("--csv is deprecated (kept for one release): use --csv-out FILE"), std::string::npos)
+      << pose_old.out;
   const auto text_of = [](const std::string& path) {
     std::ifstream in(path);
     return std::string(std::istreambuf_iterator<char>(in), {});
@@ -151,13 +153,16 @@ TEST(Cli, CheckConfigAcceptsEveryPreset) {
     EXPECT_NE(r.out.find(": OK (robot model '"), std::string::npos) << r.out;
   }
   const std::string bad = temp_path("bad_robot.yaml");
-  std::string text = robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
+  std::string text =
+      robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   robodamp::test::replace_or_throw(text, "min_deg: 0, max_deg: 170", "min_deg: 0, max_deg: 400");
   std::ofstream(bad) << text;
   const Result r = run("check-config " + bad);
   std::filesystem::remove(bad);
   EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("joints[1].max_deg = 400 deg is out of range: allowed -360 <= value <= 360 deg"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("joints[1].max_deg = 400 deg is out of range: allowed -360 <= value <= 360 deg"),
+            std::string::npos)
+      << r.out;
 }
 
 // A user copies a shipped file to a folder of their own (issue 53): every job, preset, commissioning file
@@ -215,14 +220,18 @@ TEST(Cli, CheckConfigChecksTheDashboardsFile) {
   std::ofstream(path) << "dashboard:\n  port: 8090\ndds:\n  domain_id: 3\n";
   const Result ok = run("check-config " + path);
   EXPECT_EQ(ok.status, 0) << ok.out;
-  EXPECT_NE(ok.out.find(": OK (dashboard, 127.0.0.1:8090, DDS domain 3, no credentials: nobody may act)"), std::string::npos) << ok.out;
-  std::ofstream(path) << "dashboard:\n  port: 70000\n  stale_after: 2\n  credentials: nobody.yaml\ndds:\n  domain_id: 0\n";
+  EXPECT_NE(ok.out.find(": OK (dashboard, 127.0.0.1:8090, DDS domain 3, no credentials: nobody may act)"),
+            std::string::npos)
+      << ok.out;
+  std::ofstream(path)
+      << "dashboard:\n  port: 70000\n  stale_after: 2\n  credentials: nobody.yaml\ndds:\n  domain_id: 0\n";
   const Result bad = run("check-config " + path);
   std::filesystem::remove(path);
   EXPECT_EQ(bad.status, 2) << bad.out;
   EXPECT_NE(bad.out.find("dashboard.port = 70000"), std::string::npos) << bad.out;
   EXPECT_NE(bad.out.find("dashboard.stale_after: unknown key"), std::string::npos) << bad.out;
-  EXPECT_NE(bad.out.find("nobody.yaml': no such file (robodamp dashboard-user makes one)"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("nobody.yaml': no such file (robodamp dashboard-user makes one)"), std::string::npos)
+      << bad.out;
 }
 
 TEST(Cli, CheckConfigReportsAllProblemsAtOnce) {
@@ -231,14 +240,16 @@ TEST(Cli, CheckConfigReportsAllProblemsAtOnce) {
   s.replace(s.find("rate_hz: 5000"), 13, "rate_hz: 50000");
   s.replace(s.find("cutoff_hz: 4,"), 13, "cutoff_hz: 0,");
   s.replace(s.find("force_limit_n: 36"), 17, "force_limt_n: 36");
-  const std::string rate_line = std::to_string(1 + std::count(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(s.find("rate_hz: 50000")), '\n'));
+  const std::string rate_line = std::to_string(
+      1 + std::count(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(s.find("rate_hz: 50000")), '\n'));
   const std::string path = temp_path("bad.yaml");
   std::ofstream(path) << s;
   const Result r = run("check-config " + path);
   std::filesystem::remove(path);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.out.find("4 configuration problem(s)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("loop.rate_hz = 50000 Hz is out of range: allowed 1000 <= value <= 20000 Hz"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("loop.rate_hz = 50000 Hz is out of range: allowed 1000 <= value <= 20000 Hz"), std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("controller.chain[3].cutoff_hz = 0 Hz is out of range"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("actuator.force_limt_n: unknown key"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("actuator.force_limit_n: missing"), std::string::npos) << r.out;
@@ -314,9 +325,12 @@ TEST(Cli, BenchWritesRowsJsonPlotsAndAVerdict) {
   ASSERT_NE(cut_at, std::string::npos) << r.out;
   ASSERT_NE(model_at, std::string::npos) << r.out;
   EXPECT_LT(cut_at, model_at);
-  EXPECT_NE(r.out.find("MODEL AGREEMENT (the simulated bench against the analysis, not the cut): PASS"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("MODEL AGREEMENT (the simulated bench against the analysis, not the cut): PASS"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("never worse than no damper (by 0.5 %) at the 24 speeds"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("Without the schedule, K 2000 N s/m would LOWER the limit at the job's speed by 29.3 %"), std::string::npos)
+  EXPECT_NE(r.out.find("Without the schedule, K 2000 N s/m would LOWER the limit at the job's speed by 29.3 %"),
+            std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("[bench] impact test 1/6"), std::string::npos) << r.out;  // progress lines
   std::ifstream in(json);
@@ -355,14 +369,17 @@ TEST(Cli, BenchOnSeveralThreadsGivesTheSerialRunsOutput) {
     const std::string json = temp_path("bench-jobs-" + std::to_string(jobs) + ".json");
     const Result r = run("bench --config " + path + " --jobs " + std::to_string(jobs) + " --json " + json);
     EXPECT_EQ(r.status, 0) << r.out;
-    const std::string out = std::regex_replace(std::regex_replace(r.out, wall, " in (wall)"), std::regex(json + "|bench-jobs-[0-9].json"), "J");
+    const std::string out = std::regex_replace(std::regex_replace(r.out, wall, " in (wall)"),
+                                               std::regex(json + "|bench-jobs-[0-9].json"), "J");
     const std::string text = std::regex_replace(robodamp::test::read_file(json), json_wall, "\"wall_s\": W");
     std::filesystem::remove(json);
     if (jobs == 1) {
       serial_out = out, serial_json = text;
       EXPECT_GT(text.size(), 1000u);
       EXPECT_NE(out.find("[bench] gain sweep K ="), std::string::npos) << out;
-      EXPECT_NE(out.find("MODEL AGREEMENT (the simulated bench against the analysis, not the cut): PASS"), std::string::npos) << out;
+      EXPECT_NE(out.find("MODEL AGREEMENT (the simulated bench against the analysis, not the cut): PASS"),
+                std::string::npos)
+          << out;
       continue;
     }
     EXPECT_EQ(out, serial_out) << jobs << " threads";
@@ -380,8 +397,9 @@ TEST(Cli, CutChattersOpenLoopAndNotWithTheDamperWithTheDocumentedJsonAndPlots) {
   const Result open = run("cut --job " + job + " --rpm 252 --axial-mm 0.6 --json " + open_json + " --plot-dir " + dir);
   ASSERT_EQ(open.status, 0) << open.out;
   const auto o = nlohmann::json::parse(robodamp::test::read_file(open_json));
-  for (const char* key : {"rpm", "axial_mm", "stable", "classification", "chatter_hz", "once_per_tooth_ratio",
-                          "nonharmonic_energy_ratio", "peak_force_n", "peak_actuator_force_n", "actuator_saturated", "sle_um"})
+  for (const char* key :
+       {"rpm", "axial_mm", "stable", "classification", "chatter_hz", "once_per_tooth_ratio", "nonharmonic_energy_ratio",
+        "peak_force_n", "peak_actuator_force_n", "actuator_saturated", "sle_um"})
     EXPECT_TRUE(o.contains(key)) << key;
   EXPECT_FALSE(o["stable"].get<bool>());
   EXPECT_NEAR(o["chatter_hz"].get<double>(), 9.4, 0.5);  // the robot's first mode, as the planar-robot study saw
@@ -436,7 +454,8 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
   EXPECT_NEAR(da["rpm"].get<double>(), dc["simulated_rpm"].get<double>(), 1e-9);
   EXPECT_NEAR(da["b_lim_mm"].get<double>() / dc["critical_depth_mm"].get<double>(), 1.0, 0.05) << d.out;
   EXPECT_NEAR(dc["accurate_b_lim_mm"].get<double>(), da["b_lim_mm"].get<double>(), 1e-9);
-  EXPECT_GT(da["b_lim_lobes_mm"].get<double>() / dc["critical_depth_mm"].get<double>(), 1.2) << "the preview is the one that is off";
+  EXPECT_GT(da["b_lim_lobes_mm"].get<double>() / dc["critical_depth_mm"].get<double>(), 1.2)
+      << "the preview is the one that is off";
   EXPECT_NE(l.out.find("b_lim"), std::string::npos);
   std::filesystem::remove(cut_json);
 }
@@ -445,7 +464,8 @@ TEST(Cli, CutCriticalDepthAgreesWithTheSemiDiscretizationLobes) {
 // 3 teeth at 5 kHz) is refused with the value, the unit and the range, by lobes and by cut --critical; so is
 // an unstable controller.
 TEST(Cli, DampedStabilityRefusesASpeedTheLoopCannotStepAndAnUnstableController) {
-  std::string yaml = robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  std::string yaml =
+      robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
   yaml.replace(yaml.find("../presets/"), 11, std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/");
   yaml.replace(yaml.find("rpm_max: 1500"), 13, "rpm_max: 15000");
   const std::string job = temp_path("fast.yaml");
@@ -471,7 +491,8 @@ TEST(Cli, DampedStabilityRefusesASpeedTheLoopCannotStepAndAnUnstableController) 
 // analyze --spindle-rpm with a spindle.job: the job's limits at that speed, each with the method that made it.
 TEST(Cli, AnalyzeAtASpindleSpeedGivesTheJobsLimitsWithTheirMethod) {
   std::string text = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
-  text += "\nspindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
+  text +=
+      "\nspindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
   const std::string cfg = temp_path("spindle_job.yaml");
   std::ofstream(cfg) << text;
   const Result r = run("analyze --config " + cfg + " --spindle-rpm 700");
@@ -488,7 +509,8 @@ TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   const Result wide = run("cut --job " + job + " --radial-mm 13");
   EXPECT_EQ(wide.status, 2) << wide.out;
   EXPECT_NE(wide.out.find("--radial-mm = 13 mm is out of range: allowed 0 < value <= 12.7 mm (the tool's diameter)"),
-            std::string::npos) << wide.out;
+            std::string::npos)
+      << wide.out;
   std::string yaml = robodamp::test::read_file(job);
   yaml.replace(yaml.find("../presets/"), 11, std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/");
   yaml += "\ntime_domain: {steps_per_tooth: 2}\n";
@@ -496,7 +518,8 @@ TEST(Cli, CutRefusesARadialDepthBeyondTheToolAndStepsTooCoarseForTheModes) {
   std::ofstream(path) << yaml;
   const Result coarse = run("cut --job " + path);
   EXPECT_EQ(coarse.status, 2) << coarse.out;
-  EXPECT_NE(coarse.out.find("time_domain.steps_per_tooth = 2 steps is too coarse for the modes: allowed >= "), std::string::npos)
+  EXPECT_NE(coarse.out.find("time_domain.steps_per_tooth = 2 steps is too coarse for the modes: allowed >= "),
+            std::string::npos)
       << coarse.out;
   std::filesystem::remove(path);
 }
@@ -509,14 +532,17 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   const Result table = run("pose table");
   ASSERT_EQ(table.status, 0) << table.out;
   EXPECT_NE(table.out.find("pose 1      -120.13 133.37 -14.13            11.80                      16         15.5"),
-            std::string::npos) << table.out;
+            std::string::npos)
+      << table.out;
   const Result far = run("pose frf --joints -100 200 -20");
   EXPECT_EQ(far.status, 2);
-  EXPECT_NE(far.out.find("joint 2 = 200 deg is out of range: allowed 0 <= value <= 170 deg"), std::string::npos) << far.out;
+  EXPECT_NE(far.out.find("joint 2 = 200 deg is out of range: allowed 0 <= value <= 170 deg"), std::string::npos)
+      << far.out;
   const std::string dir = temp_path("pose");
   std::system(("mkdir -p " + dir).c_str());
   std::string measured;
-  const char* poses[3][2] = {{"pose 1", "-120.13,133.37,-14.13"}, {"pose 2", "-100.59,119.81,-19.55"}, {"pose 3", "-84.75,104.63,-20.08"}};
+  const char* poses[3][2] = {
+      {"pose 1", "-120.13,133.37,-14.13"}, {"pose 2", "-100.59,119.81,-19.55"}, {"pose 3", "-84.75,104.63,-20.08"}};
   for (int i = 0; i < 3; ++i) {
     const std::string csv = dir + "/p" + std::to_string(i + 1) + ".csv";
     const Result frf = run("pose frf --pose-name '" + std::string(poses[i][0]) + "' --band-hz 5 40 --csv-out " + csv);
@@ -524,7 +550,8 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
     EXPECT_NE(frf.out.find("receptance coupling (RCSA) within"), std::string::npos) << frf.out;
     measured += std::string(" --measured=") + poses[i][1] + ":" + csv;
   }
-  const Result fit = run("pose fit" + measured + " --restarts 1 --particles 20 --iterations 30 --out " + dir + "/fitted.yaml");
+  const Result fit =
+      run("pose fit" + measured + " --restarts 1 --particles 20 --iterations 30 --out " + dir + "/fitted.yaml");
   ASSERT_EQ(fit.status, 0) << fit.out;
   EXPECT_NE(fit.out.find("weighted relative error"), std::string::npos) << fit.out;
   // Lobes at a pose: the job's pose part takes --pose; a pose out of the travel, or --pose on a job without
@@ -535,7 +562,8 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   EXPECT_NE(at3.out.find("at joints -84.75 104.63 -20.08 deg"), std::string::npos) << at3.out;
   const Result out_of_travel = run("lobes --job " + job + " --pose -84.75 204.63 -20.08");
   EXPECT_EQ(out_of_travel.status, 2);
-  EXPECT_NE(out_of_travel.out.find("--pose: joint 2 = 204.63 deg is out of range"), std::string::npos) << out_of_travel.out;
+  EXPECT_NE(out_of_travel.out.find("--pose: joint 2 = 204.63 deg is out of range"), std::string::npos)
+      << out_of_travel.out;
   const Result no_pose = run("lobes --pose -84.75 104.63 -20.08");
   EXPECT_EQ(no_pose.status, 2);
   EXPECT_NE(no_pose.out.find("the job has no robot pose part"), std::string::npos) << no_pose.out;
@@ -567,8 +595,10 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
   }
   const Result preview = run("pose map --vary 2 3 --steps 2 --method zoa --job " + dir + "/small_job.yaml");
   ASSERT_EQ(preview.status, 0) << preview.out;
-  EXPECT_NE(preview.out.find("minimum limiting depth (open loop, zero-order preview, 500-8000 rpm)"), std::string::npos) << preview.out;
-  const Result no_pose_job = run("pose map --steps 2 --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  EXPECT_NE(preview.out.find("minimum limiting depth (open loop, zero-order preview, 500-8000 rpm)"), std::string::npos)
+      << preview.out;
+  const Result no_pose_job =
+      run("pose map --steps 2 --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
   EXPECT_EQ(no_pose_job.status, 2);
   EXPECT_NE(no_pose_job.out.find("no robot pose part"), std::string::npos) << no_pose_job.out;
   const auto fitted = robodamp::config::load_robot_model(dir + "/fitted.yaml");
@@ -591,12 +621,14 @@ TEST(Cli, PoseScheduleAnalyzeRunAndBadPoses) {
   EXPECT_NE(outside.out.find("a pose needs 3 joint angles (deg), got 2"), std::string::npos) << outside.out;
   const Result no_schedule = run("run --clock virtual --duration 1 --pose -100 10 90");
   EXPECT_EQ(no_schedule.status, 2);
-  EXPECT_NE(no_schedule.out.find("--pose and --no-pose-schedule need a configuration with pose_schedule"), std::string::npos)
+  EXPECT_NE(no_schedule.out.find("--pose and --no-pose-schedule need a configuration with pose_schedule"),
+            std::string::npos)
       << no_schedule.out;
   const std::string hil = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_pose_schedule.yaml";
   const Result bad_waypoint = run("plant --config " + hil + " --pose-at 3:-100,abc,90");
   EXPECT_EQ(bad_waypoint.status, 2);
-  EXPECT_NE(bad_waypoint.out.find("joint angle 'abc' is not a number in -360..360 deg"), std::string::npos) << bad_waypoint.out;
+  EXPECT_NE(bad_waypoint.out.find("joint angle 'abc' is not a number in -360..360 deg"), std::string::npos)
+      << bad_waypoint.out;
   const Result backwards = run("plant --config " + hil + " --pose-at 3:-100,10,90 --pose-at 1:-100,20,90");
   EXPECT_EQ(backwards.status, 2);
   EXPECT_NE(backwards.out.find("waypoint 2 at 1 s comes before the one before it"), std::string::npos) << backwards.out;
@@ -611,9 +643,11 @@ TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
   const std::string dir = temp_path("tune");
   std::system(("mkdir -p " + dir).c_str());
   const std::string out = dir + "/tuned.yaml";
-  const Result unreachable = run("tune --evaluations 10 --polish 0 --gain-margin-db 40 --phase-margin-deg 90 --out " + out);
+  const Result unreachable =
+      run("tune --evaluations 10 --polish 0 --gain-margin-db 40 --phase-margin-deg 90 --out " + out);
   EXPECT_EQ(unreachable.status, 3) << unreachable.out;
-  EXPECT_NE(unreachable.out.find("no candidate met every constraint; the closest violates"), std::string::npos) << unreachable.out;
+  EXPECT_NE(unreachable.out.find("no candidate met every constraint; the closest violates"), std::string::npos)
+      << unreachable.out;
   EXPECT_NE(unreachable.out.find("nothing written"), std::string::npos) << unreachable.out;
   EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
   const Result no_damper = run("tune --evaluations 10 --job " + std::string(ROBODAMP_SOURCE_DIR) +
@@ -623,16 +657,19 @@ TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
   std::string text = robodamp::test::read_file(robodamp::test::preset("horizontal_c2"));
   const std::string compensator = "    - {kind: compensator, model: c2}";
   text.replace(text.find(compensator), compensator.size(), "");
-  text.erase(text.find("  speed_schedule:"), text.find("\nrobot:") - text.find("  speed_schedule:"));  // its bands' controllers need one
+  text.erase(text.find("  speed_schedule:"),
+             text.find("\nrobot:") - text.find("  speed_schedule:"));  // its bands' controllers need one
   std::ofstream(dir + "/no_comp.yaml") << text;
   const Result no_comp = run("tune --evaluations 10 --config " + dir + "/no_comp.yaml --out " + out);
   EXPECT_EQ(no_comp.status, 2) << no_comp.out;
-  EXPECT_NE(no_comp.out.find("has no compensator block for robodamp tune to replace"), std::string::npos) << no_comp.out;
+  EXPECT_NE(no_comp.out.find("has no compensator block for robodamp tune to replace"), std::string::npos)
+      << no_comp.out;
   EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
   // An impact no candidate's command stays within the actuator's limits for (100 kN at the bench's 1 ms).
   const Result hammered = run("tune --evaluations 10 --polish 0 --impact-n 100000 --out " + out);
   EXPECT_EQ(hammered.status, 3) << hammered.out;
-  EXPECT_NE(hammered.out.find("the closest violates the actuator's limits at the impact"), std::string::npos) << hammered.out;
+  EXPECT_NE(hammered.out.find("the closest violates the actuator's limits at the impact"), std::string::npos)
+      << hammered.out;
   EXPECT_FALSE(std::ifstream(out).good()) << "written anyway";
   // A robot 10^4 times softer (every residue x 1e4): the analysis finds every candidate unstable, even at
   // the search's smallest gain (100 N s/m).
@@ -641,7 +678,8 @@ TEST(Cli, TuneRefusesWhatItCannotTuneAndWritesNothing) {
   std::string soft;
   auto from = stiff.cbegin();
   for (std::sregex_iterator it(stiff.begin(), stiff.end(), residue), end; it != end; ++it) {
-    soft.append(from, stiff.cbegin() + it->position()) += (*it)[1].str() + "e-" + std::to_string(std::stoi((*it)[2]) - 4);
+    soft.append(from, stiff.cbegin() + it->position()) +=
+        (*it)[1].str() + "e-" + std::to_string(std::stoi((*it)[2]) - 4);
     from = stiff.cbegin() + it->position() + it->length();
   }
   soft.append(from, stiff.cend());
@@ -670,7 +708,8 @@ TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData)
       out << c << ',' << m.fx_n << ',' << m.fy_n << ',' << m.fz_n << '\n';
     }
   };
-  const std::string csv = temp_path("forces.csv"), json = temp_path("coefficients.json"), yaml = temp_path("material.yaml");
+  const std::string csv = temp_path("forces.csv"), json = temp_path("coefficients.json"),
+                    yaml = temp_path("material.yaml");
   write_csv(csv, {0.05, 0.1, 0.15, 0.2, 0.25});
   const std::string opts = " --teeth 3 --diameter-mm 12.7 --axial-mm 2 --radial-mm 3.175 --mode down";
   const Result r = run("identify cutting --csv " + csv + opts + " --json " + json + " --yaml " + yaml);
@@ -680,7 +719,8 @@ TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData)
   EXPECT_NEAR(j["kre_n_per_mm"]["value"].get<double>(), 20.0, 1e-3);
   for (const char* key : {"r2_xy", "residual_rms_n", "condition_number"}) EXPECT_TRUE(j.contains(key)) << key;
   // The material block goes into a milling job as it is.
-  std::string job = robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/single_mode_low_immersion.yaml");
+  std::string job =
+      robodamp::test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/single_mode_low_immersion.yaml");
   const auto from = job.find("material:"), to = job.find("cut:");
   job.replace(from, to - from, robodamp::test::read_file(yaml) + "\n");
   const std::string job_path = temp_path("identified-job.yaml");
@@ -690,7 +730,8 @@ TEST(Cli, IdentifyCuttingWritesCoefficientsAMaterialBlockAndRefusesIllPosedData)
   write_csv(csv, {0.1, 0.100001, 0.100002});
   const Result close = run("identify cutting --csv " + csv + opts);
   EXPECT_EQ(close.status, 2) << close.out;
-  EXPECT_NE(close.out.find("collinear regressors: the condition number of the regression is"), std::string::npos) << close.out;
+  EXPECT_NE(close.out.find("collinear regressors: the condition number of the regression is"), std::string::npos)
+      << close.out;
   std::ofstream(csv) << "feed_per_tooth_mm,fx_mean_n,fy_mean_n,fz_mean_n\n0.1,1,2,3\n0.2,x,2,3\n";
   const Result bad = run("identify cutting --csv " + csv + opts);
   EXPECT_EQ(bad.status, 2) << bad.out;
@@ -713,8 +754,8 @@ TEST(Cli, IdentifyModesRecoversThePresetsModesFromAnAccelerance) {
       out << f << ',' << a.real() << ',' << a.imag() << ',' << (f < 4.0 ? 0.5 : 0.999) << '\n';
     }
   }
-  const Result r = run("identify modes --frf " + csv + " --kind accelerance --band-hz 5 40 --json " + json + " --yaml " +
-                       yaml + " --plot-dir " + dir);
+  const Result r = run("identify modes --frf " + csv + " --kind accelerance --band-hz 5 40 --json " + json +
+                       " --yaml " + yaml + " --plot-dir " + dir);
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
   ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
@@ -724,7 +765,8 @@ TEST(Cli, IdentifyModesRecoversThePresetsModesFromAnAccelerance) {
     EXPECT_NEAR(m["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.05 * frf.modes[i].damping_ratio);
     const double mag = std::hypot(frf.modes[i].residue_re_m_per_n, frf.modes[i].residue_im_m_per_n);
     EXPECT_NEAR(std::hypot(m["residue_re_m_per_n"].get<double>() - frf.modes[i].residue_re_m_per_n,
-                           m["residue_im_m_per_n"].get<double>() - frf.modes[i].residue_im_m_per_n), 0.0, 0.05 * mag);
+                           m["residue_im_m_per_n"].get<double>() - frf.modes[i].residue_im_m_per_n),
+                0.0, 0.05 * mag);
   }
   EXPECT_LT(j["fit_error_pct"].get<double>(), 1.0);
   EXPECT_NE(robodamp::test::read_file(yaml).find("residue_re_m_per_n:"), std::string::npos);
@@ -771,18 +813,24 @@ TEST(Cli, IdentifyModesFromTimeSeriesOfTheSimulatedPlant) {
       if (k % 10 == 0) out << k / cfg.loop.rate_hz << ',' << plant.excitation_force_n(hammer) << ',' << a << '\n';
     }
   }
-  const Result r = run("identify modes --series " + csv + " --response acceleration --segment-s 20 --band-hz 5 40 --json " + json);
+  const Result r =
+      run("identify modes --series " + csv + " --response acceleration --segment-s 20 --band-hz 5 40 --json " + json);
   ASSERT_EQ(r.status, 0) << r.out;
   std::printf("%s", r.out.c_str());
   const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
   const auto& frf = cfg.robot.frfs[0];  // H11yy
   ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
   for (std::size_t i = 0; i < frf.modes.size(); ++i) {
-    EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz, 0.01 * frf.modes[i].natural_freq_hz) << r.out;
-    EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.1 * frf.modes[i].damping_ratio) << r.out;
+    EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz,
+                0.01 * frf.modes[i].natural_freq_hz)
+        << r.out;
+    EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio,
+                0.1 * frf.modes[i].damping_ratio)
+        << r.out;
     const double mag = std::hypot(frf.modes[i].residue_re_m_per_n, frf.modes[i].residue_im_m_per_n);
     EXPECT_NEAR(std::hypot(j["modes"][i]["residue_re_m_per_n"].get<double>() - frf.modes[i].residue_re_m_per_n,
-                           j["modes"][i]["residue_im_m_per_n"].get<double>() - frf.modes[i].residue_im_m_per_n), 0.0, 0.1 * mag);
+                           j["modes"][i]["residue_im_m_per_n"].get<double>() - frf.modes[i].residue_im_m_per_n),
+                0.0, 0.1 * mag);
   }
   std::filesystem::remove(csv);
   std::filesystem::remove(json);
@@ -839,9 +887,11 @@ TEST(Cli, RunRejectsBadInputWithClearErrors) {
   EXPECT_EQ(d.status, 2) << d.out;
   EXPECT_NE(d.out.find("--duration"), std::string::npos);
   // A speed the configuration's spindle cannot reach: refused before anything runs (the loop would drop it).
-  const Result fast = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 1 --clock virtual --spindle-rpm 50000");
+  const Result fast = run("run --config " + robodamp::test::preset("horizontal_c2") +
+                          " --duration 1 --clock virtual --spindle-rpm 50000");
   EXPECT_EQ(fast.status, 2) << fast.out;
-  EXPECT_NE(fast.out.find("--spindle-rpm = 50000 rpm is above spindle.rpm_max = 30000 rpm"), std::string::npos) << fast.out;
+  EXPECT_NE(fast.out.find("--spindle-rpm = 50000 rpm is above spindle.rpm_max = 30000 rpm"), std::string::npos)
+      << fast.out;
   const Result rp = run("replay " + robodamp::test::preset("horizontal_c2"));
   EXPECT_EQ(rp.status, 2) << rp.out;
   EXPECT_NE(rp.out.find("not a robodamp recording"), std::string::npos) << rp.out;
@@ -870,11 +920,11 @@ TEST(Cli, RunFaultDrillTripsAtItsTimeAndBadDrillsAreRefused) {
   const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
   EXPECT_EQ(j["trip"], "amplifier_fault");
   EXPECT_NEAR(j["trip_timing"]["trip_s"].get<double>(), 2.0, 0.01);
-  for (const auto& [arg, words] : std::vector<std::pair<std::string, std::string>>{
-           {"--fault bogus:1", "names no fault: allowed sensor_dropout"},
-           {"--fault sensor_nan", "is not KIND:START_S[:DURATION_S]"},
-           {"--fault sensor_nan:9", "allowed 0 <= value <= 3 s"},
-           {"--fault sensor_nan:1:0", "--fault duration"}}) {
+  for (const auto& [arg, words] :
+       std::vector<std::pair<std::string, std::string>>{{"--fault bogus:1", "names no fault: allowed sensor_dropout"},
+                                                        {"--fault sensor_nan", "is not KIND:START_S[:DURATION_S]"},
+                                                        {"--fault sensor_nan:9", "allowed 0 <= value <= 3 s"},
+                                                        {"--fault sensor_nan:1:0", "--fault duration"}}) {
     const Result bad = run("run --config " + robodamp::test::preset("horizontal_c2") + " --duration 3 " + arg);
     EXPECT_EQ(bad.status, 2) << arg << ": " << bad.out;
     EXPECT_NE(bad.out.find(words), std::string::npos) << arg << ": " << bad.out;
@@ -890,8 +940,8 @@ TEST(Cli, RunFaultDrillTripsAtItsTimeAndBadDrillsAreRefused) {
 
 TEST(Cli, CtrlCEndsARunThroughTheSafeStateWithASummary) {
   const std::string json = temp_path("sigint.json");
-  const Result r = run_shell("timeout --preserve-status -s INT 1.5 " + std::string(ROBODAMP_BINARY) +
-                             " run --config " + robodamp::test::preset("horizontal_c2") + " --duration 60 --json " + json);
+  const Result r = run_shell("timeout --preserve-status -s INT 1.5 " + std::string(ROBODAMP_BINARY) + " run --config " +
+                             robodamp::test::preset("horizontal_c2") + " --duration 60 --json " + json);
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("tripped: signal"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
@@ -911,7 +961,9 @@ TEST(Cli, RunThatNeverArmsExitsNonZeroNamingTheRefusal) {
   const Result r = run_shell("timeout 120 " + std::string(ROBODAMP_BINARY) + " run --config " + cfg +
                              " --duration 60 --clock virtual --json " + temp_path("never_arms.json"));
   EXPECT_EQ(r.status, 5) << r.out;
-  EXPECT_NE(r.out.find("the loop never armed: 3 attempt(s) within supervision.arm_deadline_s = 1.5 s"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the loop never armed: 3 attempt(s) within supervision.arm_deadline_s = 1.5 s"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("last refusal: the analysis does not find the loop stable"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(robodamp::test::read_file(temp_path("never_arms.json")));
   EXPECT_EQ(j["arming"]["outcome"], "gave_up");
@@ -929,16 +981,18 @@ TEST(Cli, LobesRefusesSpeedsWithTheUnitAndTheAllowedRange) {
   }
   const Result below = run("lobes --rpm 100");  // positive, but outside the job's lobes speed range
   EXPECT_EQ(below.status, 2) << below.out;
-  EXPECT_NE(below.out.find("--rpm = 100 rpm is out of range: allowed 500 <= value <= 15000 rpm (the job's lobes.rpm_min .. "
-                           "lobes.rpm_max)"),
-            std::string::npos)
+  EXPECT_NE(
+      below.out.find("--rpm = 100 rpm is out of range: allowed 500 <= value <= 15000 rpm (the job's lobes.rpm_min .. "
+                     "lobes.rpm_max)"),
+      std::string::npos)
       << below.out;
   // cut: the same range (issue 52: it allowed 200 000 rpm on any job), lobes the same outer bound.
   const Result cut = run("cut --rpm 16000 --revs 2");
   EXPECT_EQ(cut.status, 2) << cut.out;
-  EXPECT_NE(cut.out.find("--rpm = 16000 rpm is out of range: allowed 500 <= value <= 15000 rpm (the job's lobes.rpm_min .. "
-                         "lobes.rpm_max)"),
-            std::string::npos)
+  EXPECT_NE(
+      cut.out.find("--rpm = 16000 rpm is out of range: allowed 500 <= value <= 15000 rpm (the job's lobes.rpm_min .. "
+                   "lobes.rpm_max)"),
+      std::string::npos)
       << cut.out;
   const Result huge = run("lobes --rpm 500000");
   EXPECT_NE(huge.out.find("allowed 0 < value <= 200000 rpm"), std::string::npos) << huge.out;
@@ -961,7 +1015,8 @@ TEST(Cli, EveryNumericOptionNamesTheValueTheUnitAndTheRange) {
       {"request --gain -1", "--gain = -1 N s/m is out of range"},
       {"request --enable 2", "--enable = 2 (1 = arm, 0 = disarm) is out of range"},
       {"request --timeout 0", "--timeout = 0 s is out of range"},
-      {"bench --jobs 300", "--jobs = 300 (threads) is out of range: allowed 0 <= value <= 256 (threads) (0 = one per core)"},
+      {"bench --jobs 300",
+       "--jobs = 300 (threads) is out of range: allowed 0 <= value <= 256 (threads) (0 = one per core)"},
       {"cut --rpm 0", "--rpm = 0 rpm is out of range: allowed 0 < value <= 200000 rpm"},
       {"cut --rpm nan", "--rpm = 'nan' is not a finite number"},
       {"cut --axial-mm 0", "--axial-mm = 0 mm is out of range: allowed 0 < value <= 100 mm"},
@@ -999,8 +1054,8 @@ void expect_lobe_shape(const nlohmann::json& j, std::size_t points) {
 
 TEST(Cli, LobesJsonHasTheDocumentedShapeDampedOverlayAndPlot) {
   const std::string png = temp_path("lobes_plots") + "/lobes.png";
-  const Result r = run("lobes --method zoa --job " + milling_job("active_damping_c2") + " --json --damped --rpm 400 --plot-dir " +
-                       temp_path("lobes_plots"));
+  const Result r = run("lobes --method zoa --job " + milling_job("active_damping_c2") +
+                       " --json --damped --rpm 400 --plot-dir " + temp_path("lobes_plots"));
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out.substr(0, r.out.rfind("wrote")));
   EXPECT_EQ(j["method"], "zero-order preview");  // labelled: not a promise
@@ -1029,7 +1084,8 @@ TEST(Cli, LobesOfTheIndustrialRobotAndTheOrthopaedicPositions) {
   ASSERT_EQ(r.status, 0) << r.out;
   expect_lobe_shape(nlohmann::json::parse(r.out), 2000);
   for (int p = 1; p <= 5; ++p) {
-    const Result b = run("lobes --method zoa --job " + milling_job("orthopaedic_bone") + " --structure position_" + std::to_string(p));
+    const Result b = run("lobes --method zoa --job " + milling_job("orthopaedic_bone") + " --structure position_" +
+                         std::to_string(p));
     EXPECT_EQ(b.status, 0) << b.out;
     EXPECT_NE(b.out.find("minimum limiting depth"), std::string::npos) << b.out;
   }
@@ -1061,7 +1117,8 @@ TEST(Cli, SleJsonHasOneEntryPerConditionAndSurface) {
   EXPECT_EQ(j["map_unstable_points"], 0) << "1.5 mm is below the 3.5 mm SDM limit above 2000 rpm";
   ASSERT_EQ(j["conditions"].size(), 16u);  // 8 conditions x surface normals y and x
   for (const auto& c : j["conditions"]) {
-    for (const char* k : {"name", "rpm", "axial_mm", "radial_mm", "ft_mm", "surface_normal", "sle_um", "compensated_radial_mm"})
+    for (const char* k :
+         {"name", "rpm", "axial_mm", "radial_mm", "ft_mm", "surface_normal", "sle_um", "compensated_radial_mm"})
       EXPECT_TRUE(c.contains(k)) << k;
     EXPECT_GT(c["sle_um"].get<double>(), 10.0);
     EXPECT_GT(c["compensated_radial_mm"].get<double>(), c["radial_mm"].get<double>());
@@ -1138,8 +1195,8 @@ std::vector<std::string> option_entries(const std::string& help) {
 TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
   const std::vector<std::string> subs = subcommands();
   ASSERT_GE(subs.size(), 20U);
-  const std::set<std::string> writes_json{"analyze", "bench", "chatter", "cut", "filters", "identify", "lobes",
-                                          "plant",   "pose",  "run", "schedule", "sle", "tune"};
+  const std::set<std::string> writes_json{"analyze", "bench", "chatter", "cut",      "filters", "identify", "lobes",
+                                          "plant",   "pose",  "run",     "schedule", "sle",     "tune"};
   std::set<std::string> has_json;
   for (const std::string& sub : subs) {
     const Result h = run(sub + " --help");
@@ -1159,7 +1216,8 @@ TEST(Cli, EverySubcommandsHelpFollowsTheConvention) {
         plot_file = plot_file || name == "--plot";
         EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": " << line;
       } else if (name == "--config" && line.find("illing job") != std::string::npos) {
-        EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": --config is the cell; the job is --job: " << line;
+        EXPECT_NE(line.find("deprecated"), std::string::npos)
+            << sub << ": --config is the cell; the job is --job: " << line;
       } else if (name == "--pose" && line.find("joint angles") == std::string::npos) {
         EXPECT_NE(line.find("deprecated"), std::string::npos) << sub << ": --pose is joint angles: " << line;
       }
@@ -1209,7 +1267,7 @@ TEST(Cli, VersionNamesTheBuildAndItsDependencies) {
   const Result r = run("--version");
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_EQ(r.out.rfind("robodamp 0.1.0 (commit ", 0), 0U) << r.out;
-  for (const char* dep : {"Eigen 3", "yaml-cpp 0", "CLI11 2", "FFTW 3", "NLopt 2", "libmodbus 3", "Fast DDS 2", "cpp-httplib 0",
-                          "OpenSSL 3", "GNU 1"})
+  for (const char* dep : {"Eigen 3", "yaml-cpp 0", "CLI11 2", "FFTW 3", "NLopt 2", "libmodbus 3", "Fast DDS 2",
+                          "cpp-httplib 0", "OpenSSL 3", "GNU 1"})
     EXPECT_NE(r.out.find(std::string("\n  ") + dep), std::string::npos) << dep << " in\n" << r.out;
 }

@@ -126,7 +126,8 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   }
   // What a modal package opens (issue 48): every FRF measured with its coherence and the identified modes.
   {
-    const measfiles::UffFile measured = measfiles::read_uff((dir / "measurement" / identify::kMeasurementUffName).string());
+    const measfiles::UffFile measured =
+        measfiles::read_uff((dir / "measurement" / identify::kMeasurementUffName).string());
     EXPECT_EQ(measured.functions.size(), 2u * (r.identified->frfs.size() + 1));
     const measfiles::UffFile modes = measfiles::read_uff((dir / identify::kModesUffName).string());
     EXPECT_EQ(modes.modes.size(), 2u);
@@ -145,14 +146,15 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   // How far the modes may move is measured and said (a warning under +-5 %), matching the loop model.
   ASSERT_TRUE(r.robustness);
   char held[96];
-  std::snprintf(held, sizeof held, "damps the modes it damps from %.1f %% to +%.1f %% of mode shift", -r.robustness->down.pct,
-                r.robustness->up.pct);
+  std::snprintf(held, sizeof held, "damps the modes it damps from %.1f %% to +%.1f %% of mode shift",
+                -r.robustness->down.pct, r.robustness->up.pct);
   EXPECT_NE(html.find(held), std::string::npos) << held;
   EXPECT_EQ(html.find("<b>WARNING:</b> Measured on the identified plant") != std::string::npos,
             r.robustness->pct() < tune::kRobustShiftWarnPct);
   for (const auto* l : {&r.robustness->down, &r.robustness->up}) {
     if (!l->reached_max) {
-      EXPECT_TRUE(l->reason.find("the loop unstable") != std::string::npos || l->reason.find("not damped") != std::string::npos)
+      EXPECT_TRUE(l->reason.find("the loop unstable") != std::string::npos ||
+                  l->reason.find("not damped") != std::string::npos)
           << l->reason;
     }
   }
@@ -161,7 +163,8 @@ TEST(Commission, ATwoModeRobotNoPresetDescribesIsCommissionedAndVerifiedOnTheCel
   for (std::size_t i = 0; i < sched_rows.size(); ++i) {
     EXPECT_NEAR(sched_rows[i][0], r.schedule->speeds[i].rpm, 1e-8 * r.schedule->speeds[i].rpm);  // written to 10 digits
     EXPECT_NEAR(sched_rows[i][3], r.schedule->speeds[i].scheduled_mm, 1e-8 * r.schedule->speeds[i].scheduled_mm);
-    EXPECT_GE(sched_rows[i][3], 0.995 * sched_rows[i][1]) << "the plotted schedule below the plotted open loop at " << sched_rows[i][0];
+    EXPECT_GE(sched_rows[i][3], 0.995 * sched_rows[i][1])
+        << "the plotted schedule below the plotted open loop at " << sched_rows[i][0];
     const auto& cap = r.schedule->bands.at(r.schedule->speeds[i].band).depth_limit_mm;
     EXPECT_DOUBLE_EQ(sched_rows[i][4], cap ? *cap : -1.0) << "the band's depth limit at " << sched_rows[i][0];
     if (cap) {
@@ -361,13 +364,15 @@ TEST(Commission, AHitAtTheEndOfARisingQuietEnvelopeIsNotAnInstability) {
   const std::string entry =
       "{kind: compensator, model: rational, numerator: [0.002478155713971838, 0.32919256175699446, 24.968220864842035, "
       "1065.806967171825], denominator: [0.001572512595165921, 0.28183609945532384, 1.5424148350174098, 1]}";
-  const config::EditedYaml text = config::edit_yaml(cell.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node("825.8137")},
-                                                                     {{"controller", "polarity"}, YAML::Node("-1")},
-                                                                     {{"controller", "match_freq_hz"}, YAML::Node("9.20158")},
-                                                                     {{"controller", "chain", std::size_t{5}}, YAML::Load(entry)}});
+  const config::EditedYaml text =
+      config::edit_yaml(cell.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node("825.8137")},
+                                         {{"controller", "polarity"}, YAML::Node("-1")},
+                                         {{"controller", "match_freq_hz"}, YAML::Node("9.20158")},
+                                         {{"controller", "chain", std::size_t{5}}, YAML::Load(entry)}});
   const config::Config tuned = config::parse_config(text.text, "commissioned");
   ASSERT_EQ(tuned.controller.chain[5].denominator.size(), 4u);
-  const config::MillingConfig j = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
+  const config::MillingConfig j =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
   tune::Verification promise;  // the depths are not what this checks
   promise.min_rpm = 423.7, promise.speed_rpm = 699.3, promise.min_depth_mm = 1.0, promise.depth_at_speed_mm = 1.3;
   const commission::CellCheck c = commission::check_on_cell(cell, tuned, j, promise);

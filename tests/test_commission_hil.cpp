@@ -53,7 +53,8 @@ commission::CommissionSettings short_commission(const test::HilFiles& f) {
 
 TEST(CommissionHil, ARobotNoPresetDescribesIsCommissionedAndVerifiedThroughTheEmulator) {
   // Its own socket and port; a shorter plan (3 chirp periods, 4 impacts of 6 s per location).
-  const test::HilFiles f = robot_a_hil("commission", "chirp_periods: 3, chirp_period_s: 8, impacts_per_location: 4, record_s: 6");
+  const test::HilFiles f =
+      robot_a_hil("commission", "chirp_periods: 3, chirp_period_s: 8, impacts_per_location: 4, record_s: 6");
   commission::CommissionSettings s = short_commission(f);
   s.cut_revolutions = 120;
   std::vector<std::string> lines;
@@ -87,7 +88,8 @@ TEST(CommissionHil, ARobotNoPresetDescribesIsCommissionedAndVerifiedThroughTheEm
     const auto& t = r.cell->cut_trials[i];
     EXPECT_TRUE(t.held()) << t.classification << " at " << t.rpm << " rpm";
     EXPECT_NEAR(t.depth_mm, 0.95 * promised[i], 1e-9);
-    const auto j = nlohmann::json::parse(test::read_file(s.out_dir + "/verify/cut_" + std::to_string(i + 1) + "/plant.json"));
+    const auto j =
+        nlohmann::json::parse(test::read_file(s.out_dir + "/verify/cut_" + std::to_string(i + 1) + "/plant.json"));
     EXPECT_EQ(j["regenerative_cut"]["classification"], "stable");
     EXPECT_EQ(j["regenerative_cut"]["revolutions"], 120);
     EXPECT_NEAR(j["regenerative_cut"]["axial_mm"].get<double>(), t.depth_mm, 1e-5);
@@ -98,7 +100,8 @@ TEST(CommissionHil, ARobotNoPresetDescribesIsCommissionedAndVerifiedThroughTheEm
   ASSERT_TRUE(written.can);
   EXPECT_EQ(written.can->interface, "unix:" + f.dir + "/can.sock");
   EXPECT_NE(test::read_file(s.out_dir + "/configuration.yaml").find("HIL emulator"), std::string::npos);
-  EXPECT_NE(test::read_file(s.out_dir + "/report.html").find("the regenerative cut in the HIL emulator"), std::string::npos);
+  EXPECT_NE(test::read_file(s.out_dir + "/report.html").find("the regenerative cut in the HIL emulator"),
+            std::string::npos);
 }
 
 TEST(CommissionHil, ARealCanBusIsRefusedWithTheReason) {
@@ -122,9 +125,13 @@ TEST(CommissionHil, AnEmulatorThatGoesSilentEndsTheCutWithTheReason) {
   const test::HilFiles f = test::hil_files("silent_emulator");
   const std::string pidfile = f.dir + "/plant.pid", wrapper = f.dir + "/frozen_plant.sh";
   std::ofstream(wrapper) << "#!/bin/bash\n"
-                            "\"" ROBODAMP_BINARY "\" \"$@\" > >(while IFS= read -r l; do echo \"$l\"; "
-                            "[[ $l == *'controller connected'* ]] && kill -STOP \"$(cat " + pidfile + ")\"; done) 2>&1 &\n"
-                            "echo $! > " + pidfile + "\nwait $!\n";
+                            "\"" ROBODAMP_BINARY
+                            "\" \"$@\" > >(while IFS= read -r l; do echo \"$l\"; "
+                            "[[ $l == *'controller connected'* ]] && kill -STOP \"$(cat " +
+                                pidfile +
+                                ")\"; done) 2>&1 &\n"
+                                "echo $! > " +
+                                pidfile + "\nwait $!\n";
   fs::permissions(wrapper, fs::perms::owner_all);
   const config::Config cell = config::load_config_file(f.config);
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml";
@@ -146,7 +153,8 @@ TEST(CommissionHil, AnEmulatorThatGoesSilentEndsTheCutWithTheReason) {
 // The integrator's modal kit: an impact test of robot A on the simulated plant (another noise seed),
 // exported with every FRF 2 % off (the kit's calibration), without the actuator (tests/modal_kit.hpp).
 std::string modal_kit_export(const std::string& dir) {
-  std::string robot = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes.yaml");
+  std::string robot =
+      test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes.yaml");
   test::replace_or_throw(robot, "  seed: 1", "  seed: 29");
   std::ofstream(dir + "/kit_robot.yaml") << robot;
   return test::modal_kit_export(dir + "/kit_robot.yaml", dir + "/kit", dir + "/tap_tests.uff", 1.02);

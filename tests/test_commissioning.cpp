@@ -111,8 +111,10 @@ std::size_t expect_frf_plot_data(const std::string& path, const config::Analysis
   double f_min = 1e300, f_max = 0.0, last_phase = NAN;
   while (std::getline(in, line)) {
     if (line.empty()) {
-      if (++blanks == 2) ++block, --breaks;  // two blank lines: the next block (the first counted as a break)
-      else ++breaks;
+      if (++blanks == 2)
+        ++block, --breaks;  // two blank lines: the next block (the first counted as a break)
+      else
+        ++breaks;
       last_phase = NAN;
       continue;
     }
@@ -147,7 +149,8 @@ std::size_t expect_frf_plot_data(const std::string& path, const config::Analysis
   EXPECT_LE(f_max, band.band_max_hz) << path;
   EXPECT_LT(f_min, band.band_min_hz + 1.0) << path;
   EXPECT_GT(f_max, band.band_max_hz - 1.0) << path;
-  std::cout << path << ": " << rows << " rows over " << f_min << "-" << f_max << " Hz, " << breaks << " phase wraps broken\n";
+  std::cout << path << ": " << rows << " rows over " << f_min << "-" << f_max << " Hz, " << breaks
+            << " phase wraps broken\n";
   return breaks;
 }
 
@@ -161,7 +164,8 @@ TEST(FrfFigure, TheBandAloneThePhaseWrappedWithItsLineBrokenTheCoherenceBeside) 
     for (const auto& [fn, zeta] : {std::pair{10.0, 0.02}, std::pair{40.0, 0.02}})
       h += 1.0 / Complex(fn * fn - f * f, 2.0 * zeta * fn * f);
     h *= std::exp(Complex(0.0, -2.0 * M_PI * f * 0.02));  // 20 ms of delay: the phase wraps every 50 Hz
-    in.f_hz.push_back(f), in.measured.push_back(h), in.fitted.push_back(h), in.coherence.push_back(f < 5.0 ? 0.3 : 0.99);
+    in.f_hz.push_back(f), in.measured.push_back(h), in.fitted.push_back(h),
+        in.coherence.push_back(f < 5.0 ? 0.3 : 0.99);
   }
   in.band_lo_hz = 5.0, in.band_hi_hz = 100.0;
   const plot::FrfFigure fig = plot::frf_figure(in);
@@ -179,7 +183,8 @@ TEST(FrfFigure, TheBandAloneThePhaseWrappedWithItsLineBrokenTheCoherenceBeside) 
   EXPECT_EQ(plot::wrapped_phase_deg(Complex(-1.0, 0.0)), -180.0);  // a mass line's phase stays at -180
   EXPECT_EQ(plot::wrapped_phase_deg(Complex(0.0, 1.0)), 90.0);
   EXPECT_NEAR(plot::wrapped_phase_deg(Complex(-1.0, 0.01)), -180.0 - 0.573, 1e-3);
-  EXPECT_THROW((void)plot::frf_figure({"none", "", {1.0}, {Complex(1.0, 0.0)}, {}, {}, 5.0, 10.0}), std::invalid_argument);
+  EXPECT_THROW((void)plot::frf_figure({"none", "", {1.0}, {Complex(1.0, 0.0)}, {}, {}, 5.0, 10.0}),
+               std::invalid_argument);
 }
 
 TEST(PeriodicChirp, IsAPeriodicChirpOnlyInsideItsWindow) {
@@ -213,7 +218,8 @@ void expect_modes_match(const config::Config& identified, const config::Config& 
     for (std::size_t i = 0; i < fi.modes.size(); ++i) {
       const auto& m = fi.modes[i];
       const auto& t = truth->modes[i];
-      const Complex sm(m.residue_re_m_per_n, m.residue_im_m_per_n), st(sign * t.residue_re_m_per_n, sign * t.residue_im_m_per_n);
+      const Complex sm(m.residue_re_m_per_n, m.residue_im_m_per_n),
+          st(sign * t.residue_re_m_per_n, sign * t.residue_im_m_per_n);
       SCOPED_TRACE(fi.name + " mode " + std::to_string(t.natural_freq_hz) + " Hz");
       EXPECT_NEAR(m.natural_freq_hz, t.natural_freq_hz, 0.01 * t.natural_freq_hz);
       EXPECT_NEAR(m.damping_ratio, t.damping_ratio, 0.10 * t.damping_ratio);
@@ -238,20 +244,23 @@ void expect_analysis_matches(const config::Config& identified, const config::Con
   const analysis::AnalysisResult ap = analysis::analyse(analysis::LoopModel(preset));
   ASSERT_TRUE(ai.stable);
   ASSERT_TRUE(ai.max_stable_gain_ns_per_m && ap.max_stable_gain_ns_per_m);
-  std::cout << "K_max identified " << *ai.max_stable_gain_ns_per_m << " N s/m, preset " << *ap.max_stable_gain_ns_per_m << '\n';
+  std::cout << "K_max identified " << *ai.max_stable_gain_ns_per_m << " N s/m, preset " << *ap.max_stable_gain_ns_per_m
+            << '\n';
   EXPECT_NEAR(*ai.max_stable_gain_ns_per_m, *ap.max_stable_gain_ns_per_m, 0.05 * *ap.max_stable_gain_ns_per_m);
   ASSERT_EQ(ai.frfs_discrete.size(), ap.frfs_discrete.size());
   for (std::size_t i = 0; i < ai.frfs_discrete.size(); ++i) {
     const auto &fi = ai.frfs_discrete[i], &fp = ap.frfs_discrete[i];
     EXPECT_EQ(fi.name, fp.name);
-    std::cout << fi.name << ": improvement identified " << fi.improvement_pct << " %, preset " << fp.improvement_pct << " %\n";
+    std::cout << fi.name << ": improvement identified " << fi.improvement_pct << " %, preset " << fp.improvement_pct
+              << " %\n";
     EXPECT_NEAR(fi.improvement_pct, fp.improvement_pct, 0.05 * fp.improvement_pct);
   }
 }
 
 void expect_round_trip(const std::string& dir, const std::string& measured_config) {
   const std::string log = dir + "/identify.log", out = dir + "/identified.yaml", json_path = dir + "/identified.json";
-  Child identify({"identify", "all", "--in", dir, "--out", out, "--json", json_path, "--plot-dir", dir + "/plots"}, log);
+  Child identify({"identify", "all", "--in", dir, "--out", out, "--json", json_path, "--plot-dir", dir + "/plots"},
+                 log);
   ASSERT_EQ(identify.wait(), 0) << test::read_file(log);
   for (const char* png : {"H11yy_fit.png", "H21yy_stabilisation.png", "H22yy_fit.png", "actuator_fit.png"})
     EXPECT_GT(std::filesystem::file_size(dir + "/plots/" + png), 1000U) << png;
@@ -292,11 +301,13 @@ void expect_uff_round_trip(const std::string& dir, const std::string& measured_c
   const identify::CommissioningResult from_dir = identify::identify_all(own, s);
   const std::string binary = dir + "/binary.uff";
   measfiles::write_uff(binary, identify::measurement_to_uff(own), measfiles::UffEncoding::kBinary);
-  const identify::CommissioningResult from_binary = identify::identify_all(identify::read_measurement_uff(binary, measured_config), s);
+  const identify::CommissioningResult from_binary =
+      identify::identify_all(identify::read_measurement_uff(binary, measured_config), s);
   EXPECT_EQ(from_binary.yaml, from_dir.yaml);
   // The command, from the ASCII file.
   const std::string out = dir + "/from_uff.yaml", modes = dir + "/modes.uff", log = dir + "/identify_uff.log";
-  Child identify({"identify", "all", "--uff", uff, "--config", measured_config, "--out", out, "--modes-uff", modes}, log);
+  Child identify({"identify", "all", "--uff", uff, "--config", measured_config, "--out", out, "--modes-uff", modes},
+                 log);
   ASSERT_EQ(identify.wait(), 0) << test::read_file(log);
   const config::Config a = config::load_config_file(out), b = from_dir.config;
   ASSERT_EQ(a.robot.frfs.size(), b.robot.frfs.size());
@@ -306,8 +317,9 @@ void expect_uff_round_trip(const std::string& dir, const std::string& measured_c
       const auto &x = a.robot.frfs[i].modes[k], &y = b.robot.frfs[i].modes[k];
       EXPECT_NEAR(x.natural_freq_hz, y.natural_freq_hz, 1e-5 * y.natural_freq_hz);
       EXPECT_NEAR(x.damping_ratio, y.damping_ratio, 1e-4 * y.damping_ratio);
-      EXPECT_LT(std::abs(Complex(x.residue_re_m_per_n - y.residue_re_m_per_n, x.residue_im_m_per_n - y.residue_im_m_per_n)),
-                1e-4 * std::abs(Complex(y.residue_re_m_per_n, y.residue_im_m_per_n)));
+      EXPECT_LT(
+          std::abs(Complex(x.residue_re_m_per_n - y.residue_re_m_per_n, x.residue_im_m_per_n - y.residue_im_m_per_n)),
+          1e-4 * std::abs(Complex(y.residue_re_m_per_n, y.residue_im_m_per_n)));
     }
   }
   EXPECT_NEAR(a.actuator.constant_n_per_v, b.actuator.constant_n_per_v, 1e-5 * b.actuator.constant_n_per_v);
@@ -324,7 +336,8 @@ void expect_uff_round_trip(const std::string& dir, const std::string& measured_c
     const Complex psi = m.modes[k].shape[1].second[1];
     const Complex r(driving.fit.modes[k].residue_re, driving.fit.modes[k].residue_im);
     EXPECT_LT(std::abs(psi * psi - r), 1e-4 * std::abs(r)) << k;
-    EXPECT_NEAR(std::abs(m.modes[k].eigenvalue) / (2.0 * M_PI), driving.fit.modes[k].natural_freq_hz, 1e-4 * driving.fit.modes[k].natural_freq_hz);
+    EXPECT_NEAR(std::abs(m.modes[k].eigenvalue) / (2.0 * M_PI), driving.fit.modes[k].natural_freq_hz,
+                1e-4 * driving.fit.modes[k].natural_freq_hz);
   }
 }
 
@@ -354,7 +367,8 @@ TEST(Commissioning, HilEmulatorRoundTripRecoversThePreset) {
   Child measure({"measure", "--config", f.config, "--out", dir, "--clock", "virtual"}, f.run_log);
   ASSERT_EQ(measure.wait(), 0) << test::read_file(f.run_log);
   ASSERT_EQ(plant.wait(), 0) << test::read_file(f.plant_log);
-  EXPECT_NE(test::read_file(f.plant_log).find("commissioning impacts: 8 of 8 records; 4 FRFs written"), std::string::npos)
+  EXPECT_NE(test::read_file(f.plant_log).find("commissioning impacts: 8 of 8 records; 4 FRFs written"),
+            std::string::npos)
       << test::read_file(f.plant_log);
   expect_round_trip(dir, f.config);
 }
@@ -366,7 +380,8 @@ TEST(Commissioning, BadMeasurementsAreRefusedByName) {
   Child empty({"identify", "all", "--in", dir, "--out", dir + "/x.yaml"}, dir + "/empty.log");
   EXPECT_EQ(empty.wait(), 2);
   EXPECT_NE(test::read_file(dir + "/empty.log").find("measurement.json cannot be read: run robodamp measure"),
-            std::string::npos) << test::read_file(dir + "/empty.log");
+            std::string::npos)
+      << test::read_file(dir + "/empty.log");
 
   // A real measurement with one FRF removed.
   const std::string preset = test::preset("horizontal_c2");
@@ -388,7 +403,8 @@ TEST(Commissioning, BadMeasurementsAreRefusedByName) {
   EXPECT_EQ(no_signal.wait(), 2);
   EXPECT_NE(test::read_file(dir + "/no_signal.log").find("holds no test signal"), std::string::npos)
       << test::read_file(dir + "/no_signal.log");
-  Child no_structure({"identify", "actuator", "--recording", dir + "/" + identify::kRecordingName}, dir + "/no_structure.log");
+  Child no_structure({"identify", "actuator", "--recording", dir + "/" + identify::kRecordingName},
+                     dir + "/no_structure.log");
   EXPECT_EQ(no_structure.wait(), 2);
   EXPECT_NE(test::read_file(dir + "/no_structure.log").find("--recording needs --structure"), std::string::npos);
 

@@ -142,7 +142,8 @@ TEST(Config, UnknownKeysAreErrorsThatListTheAllowedOnes) {
   const auto p = problems_of(edited("cutoff_hz: 4}", "cutoff_hz: 4, cutof_hz: 4}"));
   ASSERT_EQ(p.size(), 1U);
   EXPECT_EQ(p[0].key, "controller.chain[2].cutof_hz");
-  EXPECT_NE(p[0].message.find("unknown key; allowed here: cutoff_hz, damping_ratio"), std::string::npos) << p[0].message;
+  EXPECT_NE(p[0].message.find("unknown key; allowed here: cutoff_hz, damping_ratio"), std::string::npos)
+      << p[0].message;
   EXPECT_EQ(p[0].mark.line, 20);
   const auto top = problems_of(std::string(kValid) + "spindle_rpm: 12000\n");
   ASSERT_EQ(top.size(), 1U);
@@ -180,10 +181,12 @@ TEST(Config, ChainStructureIsChecked) {
   // Ideal integrator without a high-pass would wind up on an offset.
   const std::string m = only_problem(edited("    - {kind: highpass2, cutoff_hz: 4}\n", ""));
   EXPECT_NE(m.find("controller.chain[1].leak_hz"), std::string::npos) << m;
-  EXPECT_TRUE(problems_of(edited("    - {kind: highpass2, cutoff_hz: 4}\n", "").replace(
-                              std::string(kValid).find("{kind: integrator}"), 18, "{kind: integrator, leak_hz: 0.1}"))
-                  .empty());
-  EXPECT_NE(only_problem(edited("{kind: notch,", "{kind: notch, name: lowpass2,")).find("used twice"), std::string::npos);
+  EXPECT_TRUE(
+      problems_of(edited("    - {kind: highpass2, cutoff_hz: 4}\n", "")
+                      .replace(std::string(kValid).find("{kind: integrator}"), 18, "{kind: integrator, leak_hz: 0.1}"))
+          .empty());
+  EXPECT_NE(only_problem(edited("{kind: notch,", "{kind: notch, name: lowpass2,")).find("used twice"),
+            std::string::npos);
   const auto renamed = problems_of(edited("  chain:\n", "  chain: {}\n  old_chain:\n"));
   ASSERT_EQ(renamed.size(), 2U);
   EXPECT_NE(renamed[0].message.find("non-empty list"), std::string::npos);
@@ -191,14 +194,16 @@ TEST(Config, ChainStructureIsChecked) {
 }
 
 TEST(Config, UnstableOrImproperCompensatorIsADesignErrorAtItsLine) {
-  const std::string unstable = edited("{kind: compensator, model: c2}",
-                                      "{kind: compensator, model: rational, numerator: [1, 2], denominator: [1, -3, 2]}");
+  const std::string unstable =
+      edited("{kind: compensator, model: c2}",
+             "{kind: compensator, model: rational, numerator: [1, 2], denominator: [1, -3, 2]}");
   const std::string m = only_problem(unstable);
   EXPECT_NE(m.find("bad.yaml:22:"), std::string::npos) << m;
   EXPECT_NE(m.find("controller.chain[4]"), std::string::npos) << m;
   EXPECT_NE(m.find("unstable or marginally stable: pole at s = 2"), std::string::npos) << m;
-  const std::string improper = edited("{kind: compensator, model: c2}",
-                                      "{kind: compensator, model: rational, numerator: [1, 0, 0], denominator: [1, 3]}");
+  const std::string improper =
+      edited("{kind: compensator, model: c2}",
+             "{kind: compensator, model: rational, numerator: [1, 0, 0], denominator: [1, 3]}");
   EXPECT_NE(only_problem(improper).find("improper"), std::string::npos);
   const std::string bad_list = edited("{kind: compensator, model: c2}",
                                       "{kind: compensator, model: rational, numerator: [1, x], denominator: [0, 3]}");
@@ -211,11 +216,13 @@ TEST(Config, CompensatorWithoutMatchFrequencyOrModalData) {
 }
 
 TEST(Config, PrewarpAtOrAboveNyquistIsRejected) {
-  EXPECT_NE(only_problem(edited("{kind: notch,", "{kind: notch, prewarp_hz: 2500,")).find("prewarp_hz"), std::string::npos);
+  EXPECT_NE(only_problem(edited("{kind: notch,", "{kind: notch, prewarp_hz: 2500,")).find("prewarp_hz"),
+            std::string::npos);
 }
 
 TEST(Config, WrongShapesAreReported) {
-  EXPECT_NE(only_problem(edited("loop:\n  rate_hz: 5000\n", "loop: [5000]\n")).find("expected a map"), std::string::npos);
+  EXPECT_NE(only_problem(edited("loop:\n  rate_hz: 5000\n", "loop: [5000]\n")).find("expected a map"),
+            std::string::npos);
   const auto syntax = problems_of("loop:\n  rate_hz: [5000\n");
   ASSERT_EQ(syntax.size(), 1U);
   EXPECT_NE(syntax[0].message.find("syntax error"), std::string::npos);
@@ -291,9 +298,12 @@ TEST(Config, PlantSectionsAreValidated) {
   EXPECT_NE(m.find("plant.oversampling = 2.5 must be a whole number"), std::string::npos) << m;
   m = one(with("band_max_hz: 100", "band_max_hz: 3"));
   EXPECT_NE(m.find("analysis.band_max_hz = 3 Hz must be above analysis.band_min_hz = 5 Hz"), std::string::npos) << m;
-  m = one(with("{natural_freq_hz: 21.0, damping_ratio: 0.025, residue_re_m_per_n: 2.01e-6, residue_im_m_per_n: -7.85e-6}",
-               "{natural_freq_hz: 21.0, damping_ratio: 0.025, residue_re_m_per_n: 2.01e-6, stiffness_n_per_m: 1e6}"));
-  EXPECT_NE(m.find("robot.frfs[0].modes[1].residue_re_m_per_n: given together with stiffness_n_per_m"), std::string::npos) << m;
+  m = one(
+      with("{natural_freq_hz: 21.0, damping_ratio: 0.025, residue_re_m_per_n: 2.01e-6, residue_im_m_per_n: -7.85e-6}",
+           "{natural_freq_hz: 21.0, damping_ratio: 0.025, residue_re_m_per_n: 2.01e-6, stiffness_n_per_m: 1e6}"));
+  EXPECT_NE(m.find("robot.frfs[0].modes[1].residue_re_m_per_n: given together with stiffness_n_per_m"),
+            std::string::npos)
+      << m;
 }
 
 TEST(Config, LoopSupervisionRealtimeAndTelemetryAreValidated) {
@@ -326,8 +336,8 @@ TEST(Config, LoopSupervisionRealtimeAndTelemetryAreValidated) {
   for (const auto& q : p) all += q.to_string() + "\n";
   EXPECT_EQ(p.size(), 8U) << all;
   for (const char* expected :
-       {"loop.clock = 'sundial' is not allowed: one of wall, virtual", "realtime.priority = 120",
-        "realtime.cpu = -2", "supervision.saturation_duty_max = 0 (fraction of the window) is out of range",
+       {"loop.clock = 'sundial' is not allowed: one of wall, virtual", "realtime.priority = 120", "realtime.cpu = -2",
+        "supervision.saturation_duty_max = 0 (fraction of the window) is out of range",
         "supervision.trip_ramp_s = 2 s is out of range", "supervision.stale_sensor_cycles = 0.5",
         "supervision.max_gain_fraction = 1.5", "telemetry.ring_frames = 5000 must be a power of two"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\n" << all;
@@ -347,24 +357,26 @@ TEST(Config, RecoveryIsValidatedByKeyWithItsUnitAndRange) {
   EXPECT_EQ(v.supervision.recovery.max_recoveries, 5);
   EXPECT_TRUE(parse_config(kValid + std::string("supervision: {recovery: {recoverable: []}}\n"), "ok.yaml")
                   .supervision.recovery.recoverable.empty());
-  const auto p = problems_of(kValid + std::string("supervision: {recovery: {recoverable: [instability, overruns, overruns, "
-                                                  "sundial], cool_down_s: -1, max_recoveries: 2.5, window_s: 0, probaton_s: 3}}\n"));
+  const auto p = problems_of(
+      kValid + std::string("supervision: {recovery: {recoverable: [instability, overruns, overruns, "
+                           "sundial], cool_down_s: -1, max_recoveries: 2.5, window_s: 0, probaton_s: 3}}\n"));
   std::string all;
   for (const auto& q : p) all += q.to_string() + "\n";
   EXPECT_EQ(p.size(), 7U) << all;
   for (const char* expected :
-       {"supervision.recovery.recoverable[0] = 'instability' cannot recover by itself", "recoverable[2] = 'overruns' is listed twice",
-        "recoverable[3] = 'sundial' cannot recover", "supervision.recovery.cool_down_s = -1 s is out of range",
-        "supervision.recovery.max_recoveries = 2.5", "supervision.recovery.window_s = 0 s is out of range",
-        "supervision.recovery.probaton_s: unknown key"})
+       {"supervision.recovery.recoverable[0] = 'instability' cannot recover by itself",
+        "recoverable[2] = 'overruns' is listed twice", "recoverable[3] = 'sundial' cannot recover",
+        "supervision.recovery.cool_down_s = -1 s is out of range", "supervision.recovery.max_recoveries = 2.5",
+        "supervision.recovery.window_s = 0 s is out of range", "supervision.recovery.probaton_s: unknown key"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\n" << all;
   // The overrun trip's ride-through: a share of the delay margin, 0..1.
   EXPECT_DOUBLE_EQ(defaults.supervision.overrun_delay_margin_share, 1.0);
   const auto share = problems_of(kValid + std::string("supervision: {overrun_delay_margin_share: 1.5}\n"));
   ASSERT_EQ(share.size(), 1U);
-  EXPECT_NE(share.front().to_string().find("supervision.overrun_delay_margin_share = 1.5 (share of the delay margin) is out "
-                                           "of range: allowed 0 <= value <= 1"),
-            std::string::npos)
+  EXPECT_NE(
+      share.front().to_string().find("supervision.overrun_delay_margin_share = 1.5 (share of the delay margin) is out "
+                                     "of range: allowed 0 <= value <= 1"),
+      std::string::npos)
       << share.front().to_string();
 }
 
@@ -384,10 +396,11 @@ TEST(Config, TheHilConfigurationLoadsWithEveryHardwareSection) {
 }
 
 TEST(Config, ModbusDdsAndHilSectionsAreValidated) {
-  const Config rtu = parse_config(std::string(kValid) +
-                                      "modbus:\n  amplifier: {transport: rtu, device: /dev/ttyS1, baud: 38400, parity: even,"
-                                      " unit_id: 5}\n",
-                                  "ok.yaml");
+  const Config rtu =
+      parse_config(std::string(kValid) +
+                       "modbus:\n  amplifier: {transport: rtu, device: /dev/ttyS1, baud: 38400, parity: even,"
+                       " unit_id: 5}\n",
+                   "ok.yaml");
   ASSERT_TRUE(rtu.modbus);
   EXPECT_EQ(rtu.modbus->amplifier_link.transport, ModbusTransport::kRtu);
   EXPECT_EQ(describe(rtu.modbus->amplifier_link), "rtu /dev/ttyS1 38400 8E1 unit 5");
@@ -404,9 +417,11 @@ TEST(Config, ModbusDdsAndHilSectionsAreValidated) {
   for (const auto& q : p) all += q.to_string() + "\n";
   for (const char* expected :
        {"modbus.link_timeout_s = 0.01 s is shorter than modbus.poll_period_s = 0.05 s",
-        "modbus.amplifier.port = 70000 (TCP port) is out of range", "modbus.amplifier.fault_input = 3 is the ready input's address too",
-        "modbus.robot.vertical_value = 1 is the horizontal value too", "parameter_sets.vertical = 'no_such_file.yaml': no such file",
-        "dds.domain_id = 300", "dds.transport = 'carrier_pigeon' is not allowed", "hil.pacing = 'sometimes' is not allowed",
+        "modbus.amplifier.port = 70000 (TCP port) is out of range",
+        "modbus.amplifier.fault_input = 3 is the ready input's address too",
+        "modbus.robot.vertical_value = 1 is the horizontal value too",
+        "parameter_sets.vertical = 'no_such_file.yaml': no such file", "dds.domain_id = 300",
+        "dds.transport = 'carrier_pigeon' is not allowed", "hil.pacing = 'sometimes' is not allowed",
         "modbus.robot.depth_mm_per_count = -1 mm per count is out of range",
         "modbus.robot.depth_register = 0 is modbus.robot.mounting_register too"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
@@ -418,9 +433,10 @@ TEST(Config, CommissioningSectionIsValidated) {
   EXPECT_EQ(ok.commissioning.chirp_periods, 3);
   EXPECT_EQ(ok.commissioning.record_s, 6.0);
   EXPECT_EQ(ok.commissioning.chirp_f1_hz, 100.0);  // defaults for the rest
-  const auto p = problems_of(std::string(kValid) +
-                             "commissioning: {chirp_f0_hz: 50, chirp_f1_hz: 20, chirp_periods: 1, chirp_force_fraction: 1.5,"
-                             " impacts_per_location: 0, settle_s: .nan}\n");
+  const auto p =
+      problems_of(std::string(kValid) +
+                  "commissioning: {chirp_f0_hz: 50, chirp_f1_hz: 20, chirp_periods: 1, chirp_force_fraction: 1.5,"
+                  " impacts_per_location: 0, settle_s: .nan}\n");
   std::string all;
   for (const auto& q : p) all += q.to_string() + "\n";
   for (const char* expected :
@@ -460,7 +476,8 @@ TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {
   EXPECT_FALSE(gain_request_problem(2000.0, 4324.0, "0.9 x K_max"));
   const auto p = gain_request_problem(5000.0, 4324.0, "0.9 x K_max");
   ASSERT_TRUE(p);
-  EXPECT_EQ(*p, "controller.gain_ns_per_m = 5000 N s/m is out of range: allowed 0 <= value <= 4324 N s/m (0.9 x K_max)");
+  EXPECT_EQ(*p,
+            "controller.gain_ns_per_m = 5000 N s/m is out of range: allowed 0 <= value <= 4324 N s/m (0.9 x K_max)");
   EXPECT_TRUE(gain_request_problem(std::nan(""), 4324.0, ""));
 }
 

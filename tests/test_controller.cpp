@@ -233,13 +233,13 @@ TEST(Controller, SpindleSpeedSteersTheHarmonicNotchesAndBadSpeedsParkThem) {
   }
   EXPECT_NEAR(10.0 * std::log10(out / in), -40.0, 0.5);
   EXPECT_DOUBLE_EQ(c.notches().centre_hz(), 600.0);
-  for (double bad : {std::nan(""), -1.0, 25000.0}) EXPECT_EQ(c.set_spindle_rpm(bad), RequestStatus::kRejectedOutOfRange);
+  for (double bad : {std::nan(""), -1.0, 25000.0})
+    EXPECT_EQ(c.set_spindle_rpm(bad), RequestStatus::kRejectedOutOfRange);
   EXPECT_EQ(c.counters().spindle_refused, 3U);
   for (int i = 0; i < 2000; ++i) (void)c.update(0.0);
-  EXPECT_EQ(c.notches().fade(), 0.0);  // parked
+  EXPECT_EQ(c.notches().fade(), 0.0);    // parked
   EXPECT_DOUBLE_EQ(c.update(0.5), 0.5);  // and out of the signal path
 }
 
 }  // namespace
 }  // namespace robodamp::control
-

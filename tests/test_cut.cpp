@@ -59,7 +59,8 @@ TEST(Sdm, MultiplierConvergesWithTheStepsPerPeriod) {
   const Job j = single_mode_job(1.2, false);
   const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
   std::vector<double> mu;
-  for (int m : {20, 40, 80, 160}) mu.push_back(std::abs(SdmModel(terms, j.cutter, j.material, j.cut.mode, 1.2, 1, m).multiplier(5.0, 12000.0)));
+  for (int m : {20, 40, 80, 160})
+    mu.push_back(std::abs(SdmModel(terms, j.cutter, j.material, j.cut.mode, 1.2, 1, m).multiplier(5.0, 12000.0)));
   // Each doubling at least halves the change (first order or better), and the last change is below 0.2 %.
   EXPECT_LT(std::abs(mu[3] - mu[2]), 0.6 * std::abs(mu[2] - mu[1]));
   EXPECT_LT(std::abs(mu[2] - mu[1]), 0.6 * std::abs(mu[1] - mu[0]));
@@ -102,9 +103,9 @@ TEST(Cut, SlottingCriticalDepthAgreesWithSdmAndTheZeroOrderLobes) {
   const Job j = single_mode_job(12.0, false);
   for (double rpm : {9000.0, 12000.0, 24000.0}) {
     const auto [zoa_mm, p, td] = three_methods(j, rpm);
-    std::printf("slotting %.0f rpm: zero-order %.4f mm, SDM %.4f mm (%s), time domain %.4f mm (%s, %s at %.0f Hz)\n", rpm,
-                zoa_mm, p.critical_depth_mm, to_string(p.type), td.depth_mm, to_string(td.mechanism), to_string(td.above),
-                td.chatter_hz);
+    std::printf("slotting %.0f rpm: zero-order %.4f mm, SDM %.4f mm (%s), time domain %.4f mm (%s, %s at %.0f Hz)\n",
+                rpm, zoa_mm, p.critical_depth_mm, to_string(p.type), td.depth_mm, to_string(td.mechanism),
+                to_string(td.above), td.chatter_hz);
     EXPECT_NEAR(td.depth_mm / p.critical_depth_mm, 1.0, 0.03) << rpm;
     EXPECT_NEAR(p.critical_depth_mm / zoa_mm, 1.0, 0.05) << rpm;
     EXPECT_NEAR(td.chatter_hz, 600.0, 60.0) << rpm;
@@ -117,7 +118,8 @@ TEST(Cut, SlottingCriticalDepthAgreesWithSdmAndTheZeroOrderLobes) {
 TEST(Cut, ChatterShowsAtTheModeAboveTheLimitAndNotBelow) {
   const Job j = single_mode_job(12.0, false);
   const auto terms = cutter_modal_terms(j.structure, config::Axis::kX);
-  const double limit_mm = SdmModel(terms, j.cutter, j.material, j.cut.mode, 12.0, 1, 40).critical(9000.0, 3.0).critical_depth_mm;
+  const double limit_mm =
+      SdmModel(terms, j.cutter, j.material, j.cut.mode, 12.0, 1, 40).critical(9000.0, 3.0).critical_depth_mm;
   const CutOutcome below = run_cut(terms, j.cutter, j.material, settings_for(j, 9000.0, 0.8 * limit_mm));
   const CutOutcome above = run_cut(terms, j.cutter, j.material, settings_for(j, 9000.0, 1.2 * limit_mm));
   EXPECT_TRUE(below.verdict.stable);
@@ -134,23 +136,27 @@ TEST(Cut, TimeDomainSettingsAreValidatedLikeEveryKey) {
   std::stringstream text;
   text << in.rdbuf();
   const std::string dir = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling";
-  const config::MillingConfig ok =
-      config::parse_milling_config(text.str() + "\ntime_domain: {revolutions: 50, settle_revolutions: 10}\n", "job.yaml", dir);
+  const config::MillingConfig ok = config::parse_milling_config(
+      text.str() + "\ntime_domain: {revolutions: 50, settle_revolutions: 10}\n", "job.yaml", dir);
   EXPECT_EQ(ok.time_domain.revolutions, 50);
   EXPECT_EQ(ok.time_domain.min_steps_per_mode_period, 20);
   try {
     (void)config::parse_milling_config(
-        text.str() + "\ntime_domain: {revolutions: 10, settle_revolutions: 10, runout_um: [1, 2], sdm_steps_per_period: 2, "
-                     "pitch_deg: [100, 100, 100]}\n",
+        text.str() +
+            "\ntime_domain: {revolutions: 10, settle_revolutions: 10, runout_um: [1, 2], sdm_steps_per_period: 2, "
+            "pitch_deg: [100, 100, 100]}\n",
         "job.yaml", dir);
     ADD_FAILURE() << "expected a ConfigError";
   } catch (const config::ConfigError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("time_domain.settle_revolutions = 10 must be less than time_domain.revolutions = 10"), std::string::npos) << what;
+    EXPECT_NE(what.find("time_domain.settle_revolutions = 10 must be less than time_domain.revolutions = 10"),
+              std::string::npos)
+        << what;
     EXPECT_NE(what.find("time_domain.runout_um"), std::string::npos) << what;
     EXPECT_NE(what.find("radial offsets, one per tooth"), std::string::npos) << what;
     EXPECT_NE(what.find("time_domain.sdm_steps_per_period = 2"), std::string::npos) << what;
-    EXPECT_NE(what.find("time_domain.pitch_deg: must be a list of 3 angles from each tooth to the next"), std::string::npos)
+    EXPECT_NE(what.find("time_domain.pitch_deg: must be a list of 3 angles from each tooth to the next"),
+              std::string::npos)
         << what;
   }
 }
@@ -182,9 +188,11 @@ TEST(Cut, LowImmersionFlipLobesAgreeWithSdm) {
   int flips = 0;
   for (double rpm : {13000.0, 20000.0, 24000.0, 38000.0}) {
     const auto [zoa_mm, p, td] = three_methods(j, rpm);
-    std::printf("5 %% immersion %.0f rpm: zero-order %.3f mm, SDM %.3f mm (%s, %.0f Hz), time domain %.3f mm (%s, %s at %.0f Hz)\n",
-                rpm, zoa_mm, p.critical_depth_mm, to_string(p.type), p.chatter_hz, td.depth_mm, to_string(td.mechanism),
-                to_string(td.above), td.chatter_hz);
+    std::printf(
+        "5 %% immersion %.0f rpm: zero-order %.3f mm, SDM %.3f mm (%s, %.0f Hz), time domain %.3f mm (%s, %s at %.0f "
+        "Hz)\n",
+        rpm, zoa_mm, p.critical_depth_mm, to_string(p.type), p.chatter_hz, td.depth_mm, to_string(td.mechanism),
+        to_string(td.above), td.chatter_hz);
     EXPECT_NEAR(td.depth_mm / p.critical_depth_mm, 1.0, 0.03) << rpm;
     EXPECT_EQ(td.mechanism, p.type) << rpm;
     if (p.type == CutClass::kFlip) {
@@ -216,7 +224,8 @@ TEST(Cut, RunoutAndTheToolLeavingTheCutComeFromTheSurfaceMemory) {
     }
     const double ft_um = 50.0;
     if (runout_um < ft_um) {
-      EXPECT_NEAR(std::max(peak[0], peak[1]) / std::min(peak[0], peak[1]), (ft_um + runout_um) / (ft_um - runout_um), 0.15);
+      EXPECT_NEAR(std::max(peak[0], peak[1]) / std::min(peak[0], peak[1]), (ft_um + runout_um) / (ft_um - runout_um),
+                  0.15);
       // The short tooth misses the chip only where ft sin(phi) < the runout (near entry and exit).
       EXPECT_GT(o.record.out_of_cut_samples, 0u);
       EXPECT_LT(o.record.out_of_cut_share(), 0.25);
@@ -243,7 +252,8 @@ TEST(Cut, ExponentialForceModelScalesTheCuttingTermsWithTheChip) {
   j.material.reference_chip_mm = 0.05;
   const CutOutcome exponential = run_cut(terms, j.cutter, j.material, s);
   // Where the chip is the reference (phi = 90 deg) the two agree; elsewhere the thinner chip cuts harder.
-  const std::size_t m = static_cast<std::size_t>(s.steps_per_tooth), k90 = exponential.record.fy_n.size() - 2 * m + m / 2;
+  const std::size_t m = static_cast<std::size_t>(s.steps_per_tooth),
+                    k90 = exponential.record.fy_n.size() - 2 * m + m / 2;
   EXPECT_NEAR(exponential.record.fx_n[k90] / linear.record.fx_n[k90], 1.0, 0.01);
   const std::size_t k20 = exponential.record.fy_n.size() - 2 * m + m / 9;  // phi near 20 deg: h = 0.34 ft
   const double chip = std::sin((static_cast<double>(m / 9) + 0.5) * M_PI / static_cast<double>(m));
@@ -341,7 +351,8 @@ TEST(CutProcess, ContinuingAtTheSameSpeedAndDepthIsTheSameCut) {
 // bin of the surface's angle) and exactly it once the new speed's teeth have cut a revolution.
 TEST(CutProcess, ASpeedChangeKeepsTheSurfaceTheAngleAndTheFeed) {
   CutProcess a(kHelical, aluminium(), changing_cut(700.0, 1.0, 40));
-  CutProcess b(kHelical, aluminium(), changing_cut(757.0, 1.0, 37)), fresh(kHelical, aluminium(), changing_cut(757.0, 1.0, 37));
+  CutProcess b(kHelical, aluminium(), changing_cut(757.0, 1.0, 37)),
+      fresh(kHelical, aluminium(), changing_cut(757.0, 1.0, 37));
   const std::size_t n = 3 * a.steps_per_revolution() + 29, per_rev = b.steps_per_revolution();
   (void)step_cut(a, 0, n, 0, true);
   const std::size_t k = b.continue_from(a, n);

@@ -39,7 +39,8 @@ constexpr double kRpm = 3000.0, kFs = 10000.0;
 // The force on the tool in the cutter frame at time t, tooth by tooth (no helix), with each tooth's radial
 // runout changing the chip it cuts; ramp: the share of the engagement reached (entry and exit).
 std::array<double, 3> tool_force(double t_s, double feed_mm, double ramp, const Truth& k) {
-  const robodamp::milling::Engagement e = robodamp::milling::engagement(0.5 * kTest.diameter_mm, kTest.radial_mm, kTest.mode);
+  const robodamp::milling::Engagement e =
+      robodamp::milling::engagement(0.5 * kTest.diameter_mm, kTest.radial_mm, kTest.mode);
   // The chip difference each tooth's radial runout makes (sums to 0). A tooth whose chip vanishes before the
   // exit loses its edge force there, which the model's mean does not hold: with twice this runout the edge
   // coefficients come out 1.5 % low (Kte) on these feeds (docs/identification.md).
@@ -131,24 +132,29 @@ TEST(CuttingRecords, SimulatedDynamometerRecordsGiveTheCoefficientsWithinOnePerc
   EXPECT_NEAR(c.means.fx_n, exact[0], 0.003 * std::abs(exact[0]) + 0.3);
   EXPECT_NEAR(c.means.fy_n, exact[1], 0.003 * std::abs(exact[1]) + 0.3);
   EXPECT_NEAR(c.means.fz_n, exact[2], 0.003 * std::abs(exact[2]) + 0.3);
-  std::cout << "steady means " << c.means.fx_n << " " << c.means.fy_n << " " << c.means.fz_n << " N, exact " << exact[0] << " "
-            << exact[1] << " " << exact[2] << " N\n";
+  std::cout << "steady means " << c.means.fx_n << " " << c.means.fy_n << " " << c.means.fz_n << " N, exact " << exact[0]
+            << " " << exact[1] << " " << exact[2] << " N\n";
 
   const Truth k;
   const std::string json = tmp.file("fit.json");
   for (const std::string& how : {" --tests " + tmp.file("tests.csv"),
-                                 " --records " + tmp.path + "/cut_0.txt " + tmp.path + "/cut_1.txt " + tmp.path + "/cut_2.txt " +
-                                     tmp.path + "/cut_3.txt " + tmp.path + "/cut_4.txt " + tmp.path + "/cut_5.txt --feeds-mm 0.05 0.08 0.11 0.14 0.17 0.2 --rpm 3000"}) {
+                                 " --records " + tmp.path + "/cut_0.txt " + tmp.path + "/cut_1.txt " + tmp.path +
+                                     "/cut_2.txt " + tmp.path + "/cut_3.txt " + tmp.path + "/cut_4.txt " + tmp.path +
+                                     "/cut_5.txt --feeds-mm 0.05 0.08 0.11 0.14 0.17 0.2 --rpm 3000"}) {
     const Result r = run("identify cutting" + how + kGeometry + " --axes=-fy,fx,fz --json " + json);
     ASSERT_EQ(r.status, 0) << r.out;
     EXPECT_NE(r.out.find("drift from the air before and after the cut"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("R^2 "), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("WARNING"), std::string::npos) << r.out;  // linear: no warning
     const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
-    for (const auto& [key, truth] : std::vector<std::pair<std::string, double>>{{"ktc_n_per_mm2", k.ktc}, {"krc_n_per_mm2", k.krc},
-                                                                                {"kac_n_per_mm2", k.kac}, {"kte_n_per_mm", k.kte},
-                                                                                {"kre_n_per_mm", k.kre}, {"kae_n_per_mm", k.kae}}) {
-      std::cout << key << " " << j[key]["value"].get<double>() << " +- " << j[key]["ci95"].get<double>() << " (true " << truth << ")\n";
+    for (const auto& [key, truth] : std::vector<std::pair<std::string, double>>{{"ktc_n_per_mm2", k.ktc},
+                                                                                {"krc_n_per_mm2", k.krc},
+                                                                                {"kac_n_per_mm2", k.kac},
+                                                                                {"kte_n_per_mm", k.kte},
+                                                                                {"kre_n_per_mm", k.kre},
+                                                                                {"kae_n_per_mm", k.kae}}) {
+      std::cout << key << " " << j[key]["value"].get<double>() << " +- " << j[key]["ci95"].get<double>() << " (true "
+                << truth << ")\n";
       EXPECT_NEAR(j[key]["value"].get<double>(), truth, 0.01 * truth) << key;
     }
     for (const char* r2 : {"r2_x", "r2_y", "r2_z"}) EXPECT_GT(j[r2].get<double>(), 0.999) << r2;
@@ -158,7 +164,9 @@ TEST(CuttingRecords, SimulatedDynamometerRecordsGiveTheCoefficientsWithinOnePerc
   // then come out wrong, and nothing can tell from the forces alone: the docs say to map the axes.
   const Result unmapped = run("identify cutting --tests " + tmp.file("tests.csv") + kGeometry + " --json " + json);
   ASSERT_EQ(unmapped.status, 0) << unmapped.out;
-  EXPECT_GT(std::abs(nlohmann::json::parse(robodamp::test::read_file(json))["ktc_n_per_mm2"]["value"].get<double>() - k.ktc), 0.1 * k.ktc);
+  EXPECT_GT(
+      std::abs(nlohmann::json::parse(robodamp::test::read_file(json))["ktc_n_per_mm2"]["value"].get<double>() - k.ktc),
+      0.1 * k.ktc);
 }
 
 // A force that levels off at higher feeds: per-axis R^2, the warning naming the axis and the feeds, and the
@@ -191,12 +199,14 @@ TEST(CuttingRecords, ARadialForceThatLevelsOffIsSaidNotLinear) {
   EXPECT_GT(j["r2_x"].get<double>(), 0.9999);
   ASSERT_EQ(j["not_linear"].size(), 1u);
   EXPECT_EQ(j["not_linear"][0]["axis"], "y");
-  EXPECT_DOUBLE_EQ(j["not_linear"][0]["linear_up_to_mm"].get<double>(), 0.16);  // at 0.16 mm the kink moves Fy by under 1 %
+  EXPECT_DOUBLE_EQ(j["not_linear"][0]["linear_up_to_mm"].get<double>(),
+                   0.16);  // at 0.16 mm the kink moves Fy by under 1 %
   // Over the linear feeds the model holds: the true coefficients.
-  const id::CuttingFit all = id::identify_cutting({id::mean_forces(kTest, 0.04, k.ktc, k.krc, k.kac, k.kte, k.kre, k.kae),
-                                                   id::mean_forces(kTest, 0.08, k.ktc, k.krc, k.kac, k.kte, k.kre, k.kae),
-                                                   id::mean_forces(kTest, 0.12, k.ktc, k.krc, k.kac, k.kte, k.kre, k.kae)},
-                                                  kTest);
+  const id::CuttingFit all =
+      id::identify_cutting({id::mean_forces(kTest, 0.04, k.ktc, k.krc, k.kac, k.kte, k.kre, k.kae),
+                            id::mean_forces(kTest, 0.08, k.ktc, k.krc, k.kac, k.kte, k.kre, k.kae),
+                            id::mean_forces(kTest, 0.12, k.ktc, k.krc, k.kac, k.kte, k.kre, k.kae)},
+                           kTest);
   EXPECT_NEAR(all.krc.value, k.krc, 1e-6 * k.krc);
 }
 
@@ -223,13 +233,15 @@ TEST(CuttingRecords, RecordsThatHoldNoCutAreRefusedByName) {
     out << "t,fx,fy,fz\n";
     for (int i = 0; i < 20000; ++i) out << i / kFs << ',' << n(rng) << ',' << n(rng) << ',' << n(rng) << '\n';
   }
-  refused([&] { (void)id::steady_cut(id::read_force_record(tmp.file("air.csv")), kRpm, 0.1, s); }, "no cutting at that speed");
+  refused([&] { (void)id::steady_cut(id::read_force_record(tmp.file("air.csv")), kRpm, 0.1, s); },
+          "no cutting at that speed");
   {
     std::ofstream out(tmp.file("short.csv"));
     out << "t,fx,fy,fz\n";
     for (int i = 0; i < 100; ++i) out << i / kFs << ",1,2,3\n";
   }
-  refused([&] { (void)id::steady_cut(id::read_force_record(tmp.file("short.csv")), kRpm, 0.1, s); }, "revolutions recorded, at least 5 needed");
+  refused([&] { (void)id::steady_cut(id::read_force_record(tmp.file("short.csv")), kRpm, 0.1, s); },
+          "revolutions recorded, at least 5 needed");
   refused([&] { (void)id::parse_axes("fx,fx,fz"); }, "each of fx, fy, fz once");
   {
     std::ofstream out(tmp.file("uneven.csv"));
@@ -237,7 +249,8 @@ TEST(CuttingRecords, RecordsThatHoldNoCutAreRefusedByName) {
     for (int i = 0; i < 100; ++i) out << (i < 50 ? i : i + 1) / kFs << ",1,2,3\n";
   }
   refused([&] { (void)id::read_force_record(tmp.file("uneven.csv")); }, "uneven.csv:52: the time step changes");
-  const Result cli = run("identify cutting --records " + tmp.file("cut.txt") + " --feeds-mm 0.1 0.2 --rpm 3000" + kGeometry);
+  const Result cli =
+      run("identify cutting --records " + tmp.file("cut.txt") + " --feeds-mm 0.1 0.2 --rpm 3000" + kGeometry);
   EXPECT_EQ(cli.status, 2) << cli.out;
   EXPECT_NE(cli.out.find("1 records and 2 feeds"), std::string::npos) << cli.out;
 }
@@ -262,9 +275,15 @@ TEST(CuttingRecords, FuzzedRecordsAreRefusedCleanly) {
     for (int e = 0; e < 1 + static_cast<int>(rng() % 4); ++e) {
       const std::size_t at = rng() % t.size();
       switch (rng() % 3) {
-        case 0: t[at] = ";,.\t\n-e9"[rng() % 9]; break;
-        case 1: t.erase(at, 1 + rng() % 30); break;
-        default: t = t.substr(0, at) + std::string(1 + rng() % 3, "0\t,\n"[rng() % 4]) + t.substr(at); break;
+        case 0:
+          t[at] = ";,.\t\n-e9"[rng() % 9];
+          break;
+        case 1:
+          t.erase(at, 1 + rng() % 30);
+          break;
+        default:
+          t = t.substr(0, at) + std::string(1 + rng() % 3, "0\t,\n"[rng() % 4]) + t.substr(at);
+          break;
       }
       if (t.empty()) t.push_back('x');
     }

@@ -32,7 +32,9 @@ namespace {
 
 using Clock = dashboard::Authenticator::Clock;
 
-std::string temp(const std::string& name) { return ::testing::TempDir() + "dashboard_" + std::to_string(getpid()) + "_" + name; }
+std::string temp(const std::string& name) {
+  return ::testing::TempDir() + "dashboard_" + std::to_string(getpid()) + "_" + name;
+}
 
 template <typename F>
 bool eventually(F f, double timeout_s) {
@@ -45,7 +47,8 @@ bool eventually(F f, double timeout_s) {
 }
 
 TEST(DashboardAuth, PasswordsAreSaltedHashesThatVerifyOnlyTheRightPassword) {
-  const std::string h1 = dashboard::hash_password("correct horse", 2000), h2 = dashboard::hash_password("correct horse", 2000);
+  const std::string h1 = dashboard::hash_password("correct horse", 2000),
+                    h2 = dashboard::hash_password("correct horse", 2000);
   EXPECT_NE(h1, h2) << "a fresh salt each time";
   EXPECT_EQ(h1.rfind("pbkdf2-sha256$2000$", 0), 0U);
   EXPECT_TRUE(dashboard::verify_password("correct horse", h1));
@@ -61,13 +64,16 @@ TEST(DashboardAuth, WrongPasswordsAreThrottledPerUserAndAddressAndSessionsExpire
                                  {"bob", dashboard::Role::kObserver, dashboard::hash_password("bob-pass", 2000)}},
                                 60.0);
   const auto t0 = Clock::now();
-  for (int i = 0; i < 3; ++i) EXPECT_EQ(auth.login("alice", "nope", "10.0.0.1", t0).outcome, dashboard::LoginOutcome::kWrong);
-  EXPECT_EQ(auth.login("alice", "nope", "10.0.0.1", t0).outcome, dashboard::LoginOutcome::kWrong);  // the 4th: locked 1 s
+  for (int i = 0; i < 3; ++i)
+    EXPECT_EQ(auth.login("alice", "nope", "10.0.0.1", t0).outcome, dashboard::LoginOutcome::kWrong);
+  EXPECT_EQ(auth.login("alice", "nope", "10.0.0.1", t0).outcome,
+            dashboard::LoginOutcome::kWrong);  // the 4th: locked 1 s
   const auto locked = auth.login("alice", "alice-pass", "10.0.0.2", t0 + std::chrono::milliseconds(500));
   EXPECT_EQ(locked.outcome, dashboard::LoginOutcome::kThrottled) << "by user, from another address too";
   EXPECT_GT(locked.retry_after_s, 0.0);
   EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.1", t0 + std::chrono::milliseconds(500)).outcome,
-            dashboard::LoginOutcome::kThrottled) << "by address, for another user too";
+            dashboard::LoginOutcome::kThrottled)
+      << "by address, for another user too";
   const auto ok = auth.login("alice", "alice-pass", "10.0.0.1", t0 + std::chrono::seconds(2));
   ASSERT_EQ(ok.outcome, dashboard::LoginOutcome::kOk);
   EXPECT_EQ(ok.role, dashboard::Role::kOperator);
@@ -76,8 +82,10 @@ TEST(DashboardAuth, WrongPasswordsAreThrottledPerUserAndAddressAndSessionsExpire
   // The lock-out doubles per further failure: 1, 2, 4 s ...
   const auto t1 = t0 + std::chrono::seconds(10);
   for (int i = 0; i < 5; ++i) (void)auth.login("bob", "x", "10.0.0.9", t1 + std::chrono::seconds(100 * i));
-  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.8", t1 + std::chrono::seconds(401)).outcome, dashboard::LoginOutcome::kThrottled);
-  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.8", t1 + std::chrono::seconds(420)).outcome, dashboard::LoginOutcome::kOk);
+  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.8", t1 + std::chrono::seconds(401)).outcome,
+            dashboard::LoginOutcome::kThrottled);
+  EXPECT_EQ(auth.login("bob", "bob-pass", "10.0.0.8", t1 + std::chrono::seconds(420)).outcome,
+            dashboard::LoginOutcome::kOk);
 
   const auto s = auth.session(ok.token, t0 + std::chrono::seconds(30));
   ASSERT_TRUE(s.has_value());
@@ -94,7 +102,8 @@ TEST(DashboardAuth, TheCredentialsFileIsWrittenPrivatelyAndReadBackOrRefusedByKe
   std::remove(path.c_str());
   dashboard::save_user(path, {"alice", dashboard::Role::kOperator, dashboard::hash_password("alice-pass", 2000)});
   dashboard::save_user(path, {"bob", dashboard::Role::kObserver, dashboard::hash_password("bob-pass", 2000)});
-  dashboard::save_user(path, {"alice", dashboard::Role::kObserver, dashboard::hash_password("new-pass", 2000)});  // replaced
+  dashboard::save_user(path,
+                       {"alice", dashboard::Role::kObserver, dashboard::hash_password("new-pass", 2000)});  // replaced
   struct stat st {};
   ASSERT_EQ(stat(path.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600U);
@@ -116,14 +125,17 @@ TEST(DashboardAuth, TheCredentialsFileIsWrittenPrivatelyAndReadBackOrRefusedByKe
 }
 
 TEST(DashboardConfig, EveryKeyIsCheckedWithItsUnitAndRange) {
-  const auto c = config::parse_dashboard_config("dashboard:\n  port: 0\n  stale_after_s: 1.5\ndds:\n  domain_id: 9\n", "d.yaml");
+  const auto c =
+      config::parse_dashboard_config("dashboard:\n  port: 0\n  stale_after_s: 1.5\ndds:\n  domain_id: 9\n", "d.yaml");
   EXPECT_EQ(c.port, 0);
   EXPECT_EQ(c.listen_address, "127.0.0.1") << "loopback unless told";
   EXPECT_EQ(c.stale_after_s, 1.5);
   EXPECT_EQ(c.dds.domain_id, 9);
   try {
-    (void)config::parse_dashboard_config("dashboard:\n  port: 70000\n  stale_after_s: -1\n  colour: red\n"
-                                         "  credentials: /nonexistent/users.yaml\n", "d.yaml");
+    (void)config::parse_dashboard_config(
+        "dashboard:\n  port: 70000\n  stale_after_s: -1\n  colour: red\n"
+        "  credentials: /nonexistent/users.yaml\n",
+        "d.yaml");
     FAIL() << "refused";
   } catch (const config::ConfigError& e) {
     const std::string w = e.what();
@@ -139,8 +151,12 @@ TEST(DashboardConfig, EveryKeyIsCheckedWithItsUnitAndRange) {
     FAIL() << "refused";
   } catch (const config::ConfigError& e) {
     const std::string w = e.what();
-    EXPECT_NE(w.find("dashboard.tls_private_key: not given: HTTPS needs both the certificate and its private key"), std::string::npos) << w;
-    EXPECT_NE(w.find("dashboard.tls_certificate = '/nonexistent/cert.pem': no such file (robodamp dashboard-cert"), std::string::npos) << w;
+    EXPECT_NE(w.find("dashboard.tls_private_key: not given: HTTPS needs both the certificate and its private key"),
+              std::string::npos)
+        << w;
+    EXPECT_NE(w.find("dashboard.tls_certificate = '/nonexistent/cert.pem': no such file (robodamp dashboard-cert"),
+              std::string::npos)
+        << w;
   }
   try {
     (void)config::parse_config(std::string("cell:\n  name: 'no spaces allowed'\n"), "c.yaml");
@@ -165,16 +181,21 @@ struct NamedCell {
   dds::Bridge bridge;
   NamedCell(const std::string& name, const config::DdsConfig& cfg, std::optional<dds::AdviceSample> advice = {})
       : bridge(cfg, 5000.0, name + ".yaml",
-               {name, "simulated plant", [] { return std::size_t{0}; }, [] { return 4000.0; },
+               {name,
+                "simulated plant",
+                [] { return std::size_t{0}; },
+                [] { return 4000.0; },
                 [this](dds::RequestKind k, double) {
                   ++handled;
                   if (k == dds::RequestKind::kResetFault) ++resets;
                   return dds::Decision{true, "ok"};
                 },
-                {}, advice ? std::function<std::optional<dds::AdviceSample>()>([advice]() mutable {
+                {},
+                advice ? std::function<std::optional<dds::AdviceSample>()>([advice]() mutable {
                   ++advice->seq;  // a new one each time: the bridge publishes an advice once
                   return advice;
-                }) : std::function<std::optional<dds::AdviceSample>()>()}) {
+                })
+                       : std::function<std::optional<dds::AdviceSample>()>()}) {
     bridge.start();
   }
   void frames(std::uint64_t from, int n, rt::State state) {
@@ -197,33 +218,39 @@ TEST(DashboardFleet, TwoNamedCellsOnOneDomainAreToldApartAndARequestReachesOnlyI
   auto b_owner = std::make_unique<NamedCell>("cell-b", cfg);
   NamedCell& b = *b_owner;
   dashboard::Fleet fleet(cfg, 1.0);
-  ASSERT_TRUE(eventually([&] {
-    a.frames(0, 500, rt::State::kActive), b.frames(0, 500, rt::State::kActive);
-    return fleet.overview().size() == 2;
-  }, 60.0));
+  ASSERT_TRUE(eventually(
+      [&] {
+        a.frames(0, 500, rt::State::kActive), b.frames(0, 500, rt::State::kActive);
+        return fleet.overview().size() == 2;
+      },
+      60.0));
   const auto tiles = fleet.overview();
   EXPECT_EQ(tiles[0]["cell"], "cell-a");
   EXPECT_EQ(tiles[1]["cell"], "cell-b");
   EXPECT_EQ(tiles[0]["state"], "active");
   // A request named for cell-b: cell-b answers, cell-a ignores it (and counts it).
   dashboard::RequestOutcome r;
-  ASSERT_TRUE(eventually([&] { return (r = fleet.request("cell-b", dds::RequestKind::kResetFault, 0.0, "alice", 2.0)).answered; }, 60.0));
+  ASSERT_TRUE(eventually(
+      [&] { return (r = fleet.request("cell-b", dds::RequestKind::kResetFault, 0.0, "alice", 2.0)).answered; }, 60.0));
   EXPECT_TRUE(r.accepted);
   EXPECT_GE(b.resets.load(), 1);
   // cell-a sees the same request on its own reader thread, possibly after cell-b has answered: wait for it.
-  EXPECT_TRUE(eventually([&] { return a.bridge.counters().other_cells >= 1U; }, 30.0)) << a.bridge.counters().other_cells;
+  EXPECT_TRUE(eventually([&] { return a.bridge.counters().other_cells >= 1U; }, 30.0))
+      << a.bridge.counters().other_cells;
   EXPECT_EQ(a.handled.load(), 0);
   // A trip wakes a waiting page at once; a cell that vanishes goes quiet after stale_after_s.
   const std::uint64_t seen = fleet.wait(0, std::chrono::milliseconds(0), false);
   b.frames(100000, 1, rt::State::kFault);
   EXPECT_GT(fleet.wait(seen, std::chrono::seconds(30), false), seen);
   b_owner.reset();
-  ASSERT_TRUE(eventually([&] {
-    a.frames(200000, 50, rt::State::kActive);
-    for (const auto& t : fleet.overview())
-      if (t["cell"] == "cell-b") return !t["live"].get<bool>();
-    return false;
-  }, 30.0));
+  ASSERT_TRUE(eventually(
+      [&] {
+        a.frames(200000, 50, rt::State::kActive);
+        for (const auto& t : fleet.overview())
+          if (t["cell"] == "cell-b") return !t["live"].get<bool>();
+        return false;
+      },
+      30.0));
   EXPECT_GE(fleet.counters().cells_lost, 1U);
   const auto d = fleet.detail("cell-a", 0);
   ASSERT_TRUE(d.has_value());
@@ -251,9 +278,21 @@ TEST(DashboardFleet, TwoLiveCellsUnderOneNameAreAClashUntilOneStops) {
     if (second) second->frames(k, 50, rt::State::kActive);
     k += 50;
   };
-  EXPECT_TRUE(eventually([&] { beat(); return publishers() == 2; }, 60.0)) << publishers();
+  EXPECT_TRUE(eventually(
+      [&] {
+        beat();
+        return publishers() == 2;
+      },
+      60.0))
+      << publishers();
   second.reset();  // stopped: quiet from now on
-  EXPECT_TRUE(eventually([&] { beat(); return publishers() == 1; }, 3.5)) << publishers();
+  EXPECT_TRUE(eventually(
+      [&] {
+        beat();
+        return publishers() == 1;
+      },
+      3.5))
+      << publishers();
 }
 
 // A cell that restarts is a new run: what its last run published is dropped when the new run's first status
@@ -268,28 +307,35 @@ TEST(DashboardFleet, ARestartedCellsLastRunIsDropped) {
   advice.seq = 3, advice.found = true, advice.advised_rpm = 666.7, advice.trigger = "depth";
   auto first = std::make_unique<NamedCell>("again", cfg, advice);
   const auto detail = [&] { return fleet.detail("again", 0).value_or(nlohmann::json::object()); };
-  ASSERT_TRUE(eventually([&] {
-    first->frames(0, 50, rt::State::kActive);
-    return detail().contains("advice") && !detail()["advice"].is_null();
-  }, 60.0)) << detail();
+  ASSERT_TRUE(eventually(
+      [&] {
+        first->frames(0, 50, rt::State::kActive);
+        return detail().contains("advice") && !detail()["advice"].is_null();
+      },
+      60.0))
+      << detail();
   EXPECT_EQ(detail()["advice"]["advised_rpm"].get<double>(), 666.7);
   EXPECT_EQ(detail()["restarts"].get<std::uint64_t>(), 0U);
   // The same name again while the first still runs: a clash (two publishers), the advice kept.
   auto clash = std::make_unique<NamedCell>("again", cfg);
-  ASSERT_TRUE(eventually([&] {
-    first->frames(100, 50, rt::State::kActive), clash->frames(100, 50, rt::State::kActive);
-    return detail()["publishers"].get<std::size_t>() == 2;
-  }, 60.0));
+  ASSERT_TRUE(eventually(
+      [&] {
+        first->frames(100, 50, rt::State::kActive), clash->frames(100, 50, rt::State::kActive);
+        return detail()["publishers"].get<std::size_t>() == 2;
+      },
+      60.0));
   EXPECT_EQ(detail()["restarts"].get<std::uint64_t>(), 0U);
   EXPECT_FALSE(detail()["advice"].is_null());
   first.reset(), clash.reset();
   // Both stopped; stale_after_s (1 s) later a new run under the name: the old run's advice is gone.
   ASSERT_TRUE(eventually([&] { return !detail()["live"].get<bool>(); }, 30.0));
   auto second = std::make_unique<NamedCell>("again", cfg);
-  ASSERT_TRUE(eventually([&] {
-    second->frames(0, 50, rt::State::kActive);
-    return detail()["restarts"].get<std::uint64_t>() == 1U;
-  }, 60.0));
+  ASSERT_TRUE(eventually(
+      [&] {
+        second->frames(0, 50, rt::State::kActive);
+        return detail()["restarts"].get<std::uint64_t>() == 1U;
+      },
+      60.0));
   EXPECT_TRUE(detail()["advice"].is_null()) << detail()["advice"];
   EXPECT_GE(fleet.counters().cells_restarted, 1U);
 }
@@ -309,22 +355,34 @@ TEST(DashboardFleet, ThePoseTheLimitsAreForReachesThePage) {
   dds::AdviceSample a;
   a.seq = 1, a.found = true, a.advised_rpm = 650.0, a.pose_deg = grid;
   dds::Bridge bridge(cfg, 5000.0, "posed.yaml",
-                     {"posed", "simulated plant", [] { return std::size_t{0}; }, [] { return 4000.0; },
-                      [](dds::RequestKind, double) { return dds::Decision{true, "ok"}; }, [m] { return m; },
-                      [a]() mutable { return std::optional(a); }, {}, [l]() mutable { return std::optional(l); }});
+                     {"posed",
+                      "simulated plant",
+                      [] { return std::size_t{0}; },
+                      [] { return 4000.0; },
+                      [](dds::RequestKind, double) {
+                        return dds::Decision{true, "ok"};
+                      },
+                      [m] { return m; },
+                      [a]() mutable { return std::optional(a); },
+                      {},
+                      [l]() mutable { return std::optional(l); }});
   bridge.start();
   const auto detail = [&] { return fleet.detail("posed", 0, true).value_or(nlohmann::json::object()); };
   std::uint64_t tick = 0;
-  ASSERT_TRUE(eventually([&] {
-    for (int i = 0; i < 50; ++i, ++tick) {
-      rt::TelemetryFrame f;
-      f.tick = tick, f.time_s = static_cast<double>(tick) / 5000.0, f.state = static_cast<std::uint8_t>(rt::State::kActive);
-      bridge.on_frame(f);
-    }
-    const auto d = detail();
-    return d.contains("machining") && d["machining"].contains("pose_deg") && d.contains("lobes") && d["lobes"].is_object() &&
-           d.contains("advice") && d["advice"].is_object();
-  }, 60.0)) << detail();
+  ASSERT_TRUE(eventually(
+      [&] {
+        for (int i = 0; i < 50; ++i, ++tick) {
+          rt::TelemetryFrame f;
+          f.tick = tick, f.time_s = static_cast<double>(tick) / 5000.0,
+          f.state = static_cast<std::uint8_t>(rt::State::kActive);
+          bridge.on_frame(f);
+        }
+        const auto d = detail();
+        return d.contains("machining") && d["machining"].contains("pose_deg") && d.contains("lobes") &&
+               d["lobes"].is_object() && d.contains("advice") && d["advice"].is_object();
+      },
+      60.0))
+      << detail();
   const auto d = detail();
   EXPECT_EQ(d["machining"]["pose_deg"].get<std::vector<double>>(), now);
   EXPECT_EQ(d["machining"]["limits_pose_deg"].get<std::vector<double>>(), grid);
@@ -404,7 +462,8 @@ TEST(DashboardServer, ServesHttpsWithItsCertificateAndSecureHeaders) {
     dashboard::WebServer mismatched(cfg, fleet, auth, log);
     ADD_FAILURE() << "a key that is not the certificate's was taken";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("dashboard.tls_private_key '" + dir + "/other.key'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dashboard.tls_private_key '" + dir + "/other.key'"), std::string::npos)
+        << e.what();
   }
   cfg.tls_private_key = dir + "/key.pem";
   dashboard::WebServer server(cfg, fleet, auth, log);
@@ -418,9 +477,11 @@ TEST(DashboardServer, ServesHttpsWithItsCertificateAndSecureHeaders) {
     c.set_read_timeout(30, 0);
     for (const char* path : {"/", "/api/health", "/no-such-page"}) {
       const auto r = c.Get(path);
-      ASSERT_TRUE(r) << host << path << ": " << httplib::to_string(r.error()) << " (verify " << c.get_openssl_verify_result() << ")";
+      ASSERT_TRUE(r) << host << path << ": " << httplib::to_string(r.error()) << " (verify "
+                     << c.get_openssl_verify_result() << ")";
       EXPECT_EQ(r->status, std::string(path) == "/no-such-page" ? 404 : 200) << path;
-      EXPECT_NE(r->get_header_value("Content-Security-Policy").find("frame-ancestors 'none'"), std::string::npos) << path;
+      EXPECT_NE(r->get_header_value("Content-Security-Policy").find("frame-ancestors 'none'"), std::string::npos)
+          << path;
       EXPECT_EQ(r->get_header_value("X-Content-Type-Options"), "nosniff") << path;
       EXPECT_EQ(r->get_header_value("X-Frame-Options"), "DENY") << path;
       EXPECT_EQ(r->get_header_value("Referrer-Policy"), "no-referrer") << path;
@@ -446,8 +507,9 @@ TEST(DashboardServer, ServesHttpsWithItsCertificateAndSecureHeaders) {
     EXPECT_EQ(dashboard::plain_http_refusal(open, false), "") << loopback;
   }
   open.listen_address = "0.0.0.0";
-  EXPECT_NE(dashboard::plain_http_refusal(open, false).find("plain HTTP on 0.0.0.0 is refused: passwords and session tokens"),
-            std::string::npos);
+  EXPECT_NE(
+      dashboard::plain_http_refusal(open, false).find("plain HTTP on 0.0.0.0 is refused: passwords and session tokens"),
+      std::string::npos);
   EXPECT_EQ(dashboard::plain_http_refusal(open, true), "") << "--insecure-http";
   open.tls_certificate = dir + "/cert.pem", open.tls_private_key = dir + "/key.pem";
   EXPECT_EQ(dashboard::plain_http_refusal(open, false), "");
@@ -455,7 +517,8 @@ TEST(DashboardServer, ServesHttpsWithItsCertificateAndSecureHeaders) {
 }
 
 TEST(DashboardSpectrum, TheAccelerometersSpectrumPeaksAtItsSineWithTheModesAndToothPassing) {
-  config::Config cfg = config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/horizontal_c2.yaml");
+  config::Config cfg =
+      config::load_config_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/horizontal_c2.yaml");
   cfg.spindle.teeth = 3;
   runtime::SpectrumMonitor m(cfg);
   EXPECT_EQ(m.display_rate_hz(), 1000.0);

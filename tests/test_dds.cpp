@@ -135,7 +135,10 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
   cfg.status_rate_hz = 20.0;
   int handled = 0;
   dds::Bridge bridge(cfg, 5000.0, "test.yaml",
-                     {config::cell_name({}), "simulated plant", [] { return std::size_t{0}; }, [] { return 4324.0; },
+                     {config::cell_name({}),
+                      "simulated plant",
+                      [] { return std::size_t{0}; },
+                      [] { return 4324.0; },
                       [&](dds::RequestKind, double) {
                         ++handled;
                         return dds::Decision{true, ""};
@@ -190,7 +193,8 @@ TEST(Dds, TelemetryAndStatusReachASubscriberAndRequestsAreRefusedWhileWritesAreO
 
   const auto reply = client.ask(1, msg::SET_GAIN, 2500.0);
   EXPECT_FALSE(reply.accepted());
-  EXPECT_NE(std::string(reply.reason()).find("dds.parameter_writes is false in test.yaml"), std::string::npos) << reply.reason();
+  EXPECT_NE(std::string(reply.reason()).find("dds.parameter_writes is false in test.yaml"), std::string::npos)
+      << reply.reason();
   EXPECT_EQ(handled, 0);
   bridge.stop();
   EXPECT_EQ(bridge.counters().refused, 1U);
@@ -219,15 +223,18 @@ TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   ASSERT_TRUE(cell.activate(600.0).ok());
   Client client(d.domain_id);
   ASSERT_TRUE(eventually([&] { return client.matched(); }, 60.0));
-  ASSERT_TRUE(eventually([&] { return client.status.size() > 0 && std::string(client.status.last().state()) == "active"; }, 60.0))
+  ASSERT_TRUE(eventually(
+      [&] { return client.status.size() > 0 && std::string(client.status.last().state()) == "active"; }, 60.0))
       << "arming outcome " << runtime::to_string(cell.arming().outcome()) << ", last refusal "
       << rt::to_string(cell.arming().last_refusal());
   const double limit = client.status.last().max_gain_ns_per_m();
-  EXPECT_NEAR(limit, cfg.supervision.max_gain_fraction * cell.supervisor().parameter_sets()[0].max_stable_gain_ns_per_m, 1e-6);
+  EXPECT_NEAR(limit, cfg.supervision.max_gain_fraction * cell.supervisor().parameter_sets()[0].max_stable_gain_ns_per_m,
+              1e-6);
 
   auto r = client.ask(1, msg::SET_GAIN, 90000.0);
   EXPECT_FALSE(r.accepted());
-  EXPECT_NE(std::string(r.reason()).find("controller.gain_ns_per_m = 90000 N s/m is out of range"), std::string::npos) << r.reason();
+  EXPECT_NE(std::string(r.reason()).find("controller.gain_ns_per_m = 90000 N s/m is out of range"), std::string::npos)
+      << r.reason();
   r = client.ask(2, msg::SET_GAIN, -1.0);
   EXPECT_FALSE(r.accepted());
   r = client.ask(3, msg::SELECT_PARAMETER_SET, 7.0);
@@ -237,14 +244,17 @@ TEST(Dds, ParameterRequestsAreValidatedLikeTheConfigurationAndApplied) {
   EXPECT_FALSE(r.accepted());
   r = client.ask(5, msg::SET_GAIN, 2500.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
-  ASSERT_TRUE(eventually([&] { return client.telemetry.size() > 0 && client.telemetry.last().gain_ns_per_m() > 2499.0; }, 60.0));
+  ASSERT_TRUE(eventually(
+      [&] { return client.telemetry.size() > 0 && client.telemetry.last().gain_ns_per_m() > 2499.0; }, 60.0));
   r = client.ask(6, msg::SELECT_PARAMETER_SET, 1.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
   ASSERT_TRUE(eventually([&] { return client.status.last().parameter_set() == 1; }, 60.0));
   r = client.ask(7, msg::SET_SPINDLE_RPM, 40000.0);
   EXPECT_FALSE(r.accepted());
-  EXPECT_NE(std::string(r.reason()).find("spindle_rpm = 40000 rpm is out of range: allowed 0 <= value <= spindle.rpm_max = 30000 rpm"),
-            std::string::npos) << r.reason();
+  EXPECT_NE(std::string(r.reason())
+                .find("spindle_rpm = 40000 rpm is out of range: allowed 0 <= value <= spindle.rpm_max = 30000 rpm"),
+            std::string::npos)
+      << r.reason();
   r = client.ask(8, msg::SET_SPINDLE_RPM, 12000.0);
   EXPECT_TRUE(r.accepted()) << r.reason();
   EXPECT_NE(std::string(r.reason()).find("12000 rpm x 3 teeth = 600 Hz"), std::string::npos) << r.reason();
@@ -278,26 +288,32 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   test::Child run({"run", "--config", dir + "/dds.yaml", "--duration", "600"}, dir + "/run.log");
   std::string view;
   // The monitor shows what it sees: ask again until it has seen the loop active (or a minute passed).
-  const bool seen = eventually([&] {
-    test::Child monitor({"monitor", "--config", dir + "/dds.yaml", "--duration", "3"}, dir + "/monitor.log");
-    (void)monitor.wait_for(60.0);
-    view = test::read_file(dir + "/monitor.log");
-    return view.find("state      active") != std::string::npos;
-  }, 60.0);
+  const bool seen = eventually(
+      [&] {
+        test::Child monitor({"monitor", "--config", dir + "/dds.yaml", "--duration", "3"}, dir + "/monitor.log");
+        (void)monitor.wait_for(60.0);
+        view = test::read_file(dir + "/monitor.log");
+        return view.find("state      active") != std::string::npos;
+      },
+      60.0);
   EXPECT_TRUE(seen) << view << "\nrun log:\n" << test::read_file(dir + "/run.log");
   EXPECT_NE(view.find("m/s^2 RMS"), std::string::npos) << view;
   EXPECT_NE(view.find("wake-up p50"), std::string::npos) << view;
   EXPECT_NE(view.find("parameter writes off"), std::string::npos) << view;
-  test::Child request({"request", "--config", dir + "/dds.yaml", "--gain", "2500", "--timeout", "60"}, dir + "/request.log");
+  test::Child request({"request", "--config", dir + "/dds.yaml", "--gain", "2500", "--timeout", "60"},
+                      dir + "/request.log");
   EXPECT_EQ(request.wait_for(120.0), std::optional<int>(3)) << test::read_file(dir + "/request.log");
   EXPECT_NE(test::read_file(dir + "/request.log").find("refused: parameter writes are off"), std::string::npos);
   // A monitor watching when the loop ends says so instead of freezing (issue 52).
   test::Child watching({"monitor", "--config", dir + "/dds.yaml", "--duration", "300"}, dir + "/watching.log");
-  EXPECT_TRUE(eventually([&] { return test::read_file(dir + "/watching.log").find("state      active") != std::string::npos; }, 60.0))
+  EXPECT_TRUE(eventually(
+      [&] { return test::read_file(dir + "/watching.log").find("state      active") != std::string::npos; }, 60.0))
       << test::read_file(dir + "/watching.log");
   run.kill(SIGINT);
   EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
-  EXPECT_TRUE(eventually([&] { return test::read_file(dir + "/watching.log").find("NO CONTACT: nothing from") != std::string::npos; }, 60.0))
+  EXPECT_TRUE(eventually(
+      [&] { return test::read_file(dir + "/watching.log").find("NO CONTACT: nothing from") != std::string::npos; },
+      60.0))
       << test::read_file(dir + "/watching.log");
   EXPECT_NE(test::read_file(dir + "/watching.log").find("the loop stopped or the link is down"), std::string::npos);
   watching.kill(SIGINT);
@@ -323,32 +339,37 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
   text += "\ndds:\n  domain_id: " + std::to_string(domain) +
           "\n  transport: udp_loopback\n  telemetry_rate_hz: 20\n  parameter_writes: true\n";
   text += "supervision:\n  overrun_cycles: 5000\n";
-  text += "spindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
+  text +=
+      "spindle:\n  teeth: 3\n  job: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml\n";
   // A name of its own: the monitor follows the configuration's cell, and another test's cell on a colliding
   // domain (test_domain is one of 200) is named after the host too (the hogged suite once showed that one).
   text += "cell:\n  name: dds-monitor-" + std::to_string(getpid()) + "\n";
   std::ofstream(dir + "/dds.yaml") << text;
   test::Child run({"run", "--config", dir + "/dds.yaml", "--duration", "600"}, dir + "/run.log");
   // The speed, asked until the loop is there to take it.
-  const bool accepted = eventually([&] {
-    test::Child request({"request", "--config", dir + "/dds.yaml", "--spindle-rpm", "700", "--timeout", "20"},
-                        dir + "/request.log");
-    return request.wait_for(60.0) == std::optional<int>(0);
-  }, 120.0);
+  const bool accepted = eventually(
+      [&] {
+        test::Child request({"request", "--config", dir + "/dds.yaml", "--spindle-rpm", "700", "--timeout", "20"},
+                            dir + "/request.log");
+        return request.wait_for(60.0) == std::optional<int>(0);
+      },
+      120.0);
   EXPECT_TRUE(accepted) << test::read_file(dir + "/request.log") << "\nrun log:\n" << test::read_file(dir + "/run.log");
   std::string view;
-  const bool seen = eventually([&] {
-    test::Child monitor({"monitor", "--config", dir + "/dds.yaml", "--duration", "3"}, dir + "/monitor.log");
-    (void)monitor.wait_for(60.0);
-    view = test::read_file(dir + "/monitor.log");
-    // The preset's speed schedule hands over to its 700 rpm band (C1 at K 3040) first: the view after it, with
-    // the indicator's verdict (after a speed change it collects revolutions for a window first: a loaded run's
-    // three seconds of monitor once fell inside that).
-    return view.find("state      active") != std::string::npos && view.find("once-per-rev") != std::string::npos &&
-           view.find("damper active") != std::string::npos && view.find("K = 3040 N s/m") != std::string::npos &&
-           (view.rfind("collecting revolutions") == std::string::npos ||
-            view.rfind("collecting revolutions") < view.rfind("once-per-rev"));
-  }, 120.0);
+  const bool seen = eventually(
+      [&] {
+        test::Child monitor({"monitor", "--config", dir + "/dds.yaml", "--duration", "3"}, dir + "/monitor.log");
+        (void)monitor.wait_for(60.0);
+        view = test::read_file(dir + "/monitor.log");
+        // The preset's speed schedule hands over to its 700 rpm band (C1 at K 3040) first: the view after it, with
+        // the indicator's verdict (after a speed change it collects revolutions for a window first: a loaded run's
+        // three seconds of monitor once fell inside that).
+        return view.find("state      active") != std::string::npos && view.find("once-per-rev") != std::string::npos &&
+               view.find("damper active") != std::string::npos && view.find("K = 3040 N s/m") != std::string::npos &&
+               (view.rfind("collecting revolutions") == std::string::npos ||
+                view.rfind("collecting revolutions") < view.rfind("once-per-rev"));
+      },
+      120.0);
   EXPECT_TRUE(seen) << view << "\nrun log:\n" << test::read_file(dir + "/run.log");
   EXPECT_NE(view.find("spindle    700 rpm (tooth passing 35.0 Hz), depth 0.500 mm"), std::string::npos) << view;
   // The schedule's promise at 700 rpm (config/presets/horizontal_c2.yaml's header: 2.350 mm; C2 at its fixed
@@ -356,7 +377,10 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
   // the speed to its own step: within 0.2 %.
   std::smatch m;
   const std::string last = view.substr(view.rfind("stability  open"));
-  ASSERT_TRUE(std::regex_search(last, m, std::regex(R"(open 1\.111 mm \(SDM\), damped ([0-9.]+) mm \(sampled-loop SDM\); now ([0-9.]+) mm \(damper active\)  depth within)")))
+  ASSERT_TRUE(std::regex_search(
+      last, m,
+      std::regex(
+          R"(open 1\.111 mm \(SDM\), damped ([0-9.]+) mm \(sampled-loop SDM\); now ([0-9.]+) mm \(damper active\)  depth within)")))
       << view;
   EXPECT_NEAR(std::stod(m[1]), 2.350, 0.005) << view;
   EXPECT_EQ(m[1], m[2]) << view;
@@ -365,10 +389,15 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
   run.kill(SIGINT);
   EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
   const std::string log = test::read_file(dir + "/run.log");
-  ASSERT_TRUE(std::regex_search(log, m, std::regex(R"(machining at the end: 700 rpm, depth 0\.500 mm; limit open 1\.111 mm \(SDM\), damped ([0-9.]+) mm \(sampled-loop SDM\))")))
+  ASSERT_TRUE(std::regex_search(
+      log, m,
+      std::regex(
+          R"(machining at the end: 700 rpm, depth 0\.500 mm; limit open 1\.111 mm \(SDM\), damped ([0-9.]+) mm \(sampled-loop SDM\))")))
       << log;
   EXPECT_NEAR(std::stod(m[1]), 2.350, 0.005) << log;
-  EXPECT_NE(log.find("speed schedule: 28 bands; at the end band 21, set 1 at K 3040 N s/m; 1 hand-overs"), std::string::npos) << log;
+  EXPECT_NE(log.find("speed schedule: 28 bands; at the end band 21, set 1 at K 3040 N s/m; 1 hand-overs"),
+            std::string::npos)
+      << log;
 }
 
 // --- ROS 2 conventions ---
@@ -397,9 +426,14 @@ std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& i
   const std::size_t end = idl.find("};", at);
   std::istringstream body(idl.substr(idl.find('{', at) + 1, end - idl.find('{', at) - 1));
   const std::vector<std::pair<std::string, std::string>> types = {
-      {"unsigned long long", "uint64"}, {"unsigned long", "uint32"}, {"double", "float64"},
-      {"float", "float32"},             {"octet", "uint8"},          {"boolean", "bool"},
-      {"long", "int32"},                {"std_msgs::msg::dds_::Header_", "std_msgs/Header"},
+      {"unsigned long long", "uint64"},
+      {"unsigned long", "uint32"},
+      {"double", "float64"},
+      {"float", "float32"},
+      {"octet", "uint8"},
+      {"boolean", "bool"},
+      {"long", "int32"},
+      {"std_msgs::msg::dds_::Header_", "std_msgs/Header"},
       {"builtin_interfaces::msg::dds_::Time_", "builtin_interfaces/Time"},
       {"builtin_interfaces::msg::dds_::Duration_", "builtin_interfaces/Duration"},
       {"trajectory_msgs::msg::dds_::JointTrajectoryPoint_", "trajectory_msgs/JointTrajectoryPoint"}};
@@ -412,7 +446,7 @@ std::vector<std::pair<std::string, std::string>> idl_fields(const std::string& i
     const std::size_t space = line.rfind(' ');
     std::string type = line.substr(0, space), field = line.substr(space + 1);
     if (type.rfind("string<", 0) == 0) type = "string<=" + type.substr(7, type.size() - 8);
-    std::string bound;  // sequence<T, N>: ROS 2's T[<=N]
+    std::string bound;                      // sequence<T, N>: ROS 2's T[<=N]
     if (type.rfind("sequence<", 0) == 0) {  // sequence<T>: ROS 2's T[]
       const std::size_t comma = type.find(',');
       bound = comma == std::string::npos ? "[]" : "[<=" + type.substr(comma + 2, type.size() - comma - 3) + "]";
@@ -442,14 +476,16 @@ std::vector<std::pair<std::string, std::string>> msg_fields(const std::string& p
 
 TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
-  for (const char* name : {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining", "Advice", "Spectrum", "Lobes"}) {
+  for (const char* name :
+       {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining", "Advice", "Spectrum", "Lobes"}) {
     const auto from_idl = idl_fields(idl, name);
     const auto from_msg = msg_fields(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/" + name + ".msg");
     EXPECT_GT(from_idl.size(), 3U) << name;
     EXPECT_EQ(from_msg, from_idl) << name;
   }
   // The request kinds: the same numbers in both.
-  const std::string request = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/ParameterRequest.msg");
+  const std::string request =
+      test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/ros2/robodamp/msg/ParameterRequest.msg");
   EXPECT_NE(request.find("uint8 SET_GAIN=" + std::to_string(msg::SET_GAIN)), std::string::npos);
   EXPECT_NE(request.find("uint8 SELECT_PARAMETER_SET=" + std::to_string(msg::SELECT_PARAMETER_SET)), std::string::npos);
   EXPECT_NE(request.find("uint8 ENABLE=" + std::to_string(msg::ENABLE)), std::string::npos);
@@ -463,8 +499,11 @@ TEST(Dds, JointStateIsRos2sMessageFieldForField) {
   using Fields = std::vector<std::pair<std::string, std::string>>;
   const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
   // sensor_msgs/msg/JointState.msg, std_msgs/msg/Header.msg, builtin_interfaces/msg/Time.msg (ROS 2).
-  EXPECT_EQ(idl_fields(idl, "JointState"), (Fields{{"std_msgs/Header", "header"}, {"string[]", "name"}, {"float64[]", "position"},
-                                                   {"float64[]", "velocity"}, {"float64[]", "effort"}}));
+  EXPECT_EQ(idl_fields(idl, "JointState"), (Fields{{"std_msgs/Header", "header"},
+                                                   {"string[]", "name"},
+                                                   {"float64[]", "position"},
+                                                   {"float64[]", "velocity"},
+                                                   {"float64[]", "effort"}}));
   EXPECT_EQ(idl_fields(idl, "Header"), (Fields{{"builtin_interfaces/Time", "stamp"}, {"string", "frame_id"}}));
   EXPECT_EQ(idl_fields(idl, "Time"), (Fields{{"int32", "sec"}, {"uint32", "nanosec"}}));
   dds::Participant p(test_domain(6), config::DdsTransport::kUdpLoopback, "joint state names", std::nullopt);
@@ -489,7 +528,8 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
           "\n  transport: udp_loopback\n  joint_states:\n    names: [shoulder, elbow, wrist]\n    timeout_s: 0.5\n"
           "supervision:\n  overrun_cycles: 5000\n";
   std::ofstream(dir + "/cell.yaml") << text;
-  test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--json", dir + "/run.json"}, dir + "/run.log");
+  test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--json", dir + "/run.json"},
+                  dir + "/run.log");
   // The listeners first: they outlive the participant whose threads call them (ThreadSanitizer found them
   // destroyed while its reader thread still delivered).
   Collect<msg::Status> status;      // the cell's own word on the set that runs
@@ -500,11 +540,13 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   driver.reader(dds::TopicKind::kSpectrum, &spectrum);
   const std::string cell = "joints-" + std::to_string(getpid());
   const auto running_set = [&](std::uint32_t set) {
-    return eventually([&] {
-      for (const auto& s : status.all())
-        if (s.cell() == cell && s.state() == "active" && s.parameter_set() == set) return true;
-      return false;
-    }, 60.0);
+    return eventually(
+        [&] {
+          for (const auto& s : status.all())
+            if (s.cell() == cell && s.state() == "active" && s.parameter_set() == set) return true;
+          return false;
+        },
+        60.0);
   };
   std::mutex m;
   std::vector<std::string> names{"wrist", "gripper", "shoulder", "elbow"};
@@ -530,7 +572,8 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   const auto log_has = [&](const std::string& s, double deadline_s) {
     return eventually([&] { return test::read_file(dir + "/run.log").find(s) != std::string::npos; }, deadline_s);
   };
-  EXPECT_TRUE(log_has("dds joint states: pose [-100, 10, 90] deg in region 'folded'", 60.0)) << test::read_file(dir + "/run.log");
+  EXPECT_TRUE(log_has("dds joint states: pose [-100, 10, 90] deg in region 'folded'", 60.0))
+      << test::read_file(dir + "/run.log");
   EXPECT_TRUE(log_has("loop: active at", 60.0)) << test::read_file(dir + "/run.log");
   EXPECT_TRUE(running_set(0)) << "the folded region's set";
   {
@@ -543,13 +586,17 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
     const config::Config cfg = config::load_config_file(dir + "/cell.yaml");
     const auto model = config::load_robot_model(cfg.pose_schedule->model_resolved);
     std::vector<float> stretched;
-    for (const auto& md : analysis::pose_modes(model, {-100.0, 80.0, 90.0}, cfg.pose_schedule->axis, cfg.pose_schedule->modes).modes)
+    for (const auto& md :
+         analysis::pose_modes(model, {-100.0, 80.0, 90.0}, cfg.pose_schedule->axis, cfg.pose_schedule->modes).modes)
       stretched.push_back(static_cast<float>(md.natural_freq_hz));
-    EXPECT_TRUE(eventually([&] {
-      for (const auto& s : spectrum.all())
-        if (s.cell() == cell && s.mode_hz() == stretched) return true;
-      return false;
-    }, 60.0)) << "the spectrum's mode marks at the stretched pose, " << stretched.front() << " Hz first";
+    EXPECT_TRUE(eventually(
+        [&] {
+          for (const auto& s : spectrum.all())
+            if (s.cell() == cell && s.mode_hz() == stretched) return true;
+          return false;
+        },
+        60.0))
+        << "the spectrum's mode marks at the stretched pose, " << stretched.front() << " Hz first";
   }
   {
     std::lock_guard lock(m);
@@ -576,7 +623,8 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
   EXPECT_EQ(js["losses"].get<int>(), 1) << js.dump();
   std::istringstream lines(test::read_file(dir + "/run.log"));
   for (std::string line; std::getline(lines, line);)
-    if (line.find("joint") != std::string::npos || line.find("loop:") != std::string::npos) std::printf("%s\n", line.c_str());
+    if (line.find("joint") != std::string::npos || line.find("loop:") != std::string::npos)
+      std::printf("%s\n", line.c_str());
   std::system(("rm -rf " + dir).c_str());
 }
 
@@ -586,11 +634,14 @@ TEST(Dds, JointTrajectoryIsRos2sMessageFieldForField) {
   using Fields = std::vector<std::pair<std::string, std::string>>;
   const std::string idl = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/dds/robodamp.idl");
   // trajectory_msgs/msg/JointTrajectory.msg, JointTrajectoryPoint.msg, builtin_interfaces/msg/Duration.msg (ROS 2).
-  EXPECT_EQ(idl_fields(idl, "JointTrajectory"),
-            (Fields{{"std_msgs/Header", "header"}, {"string[]", "joint_names"}, {"trajectory_msgs/JointTrajectoryPoint[]", "points"}}));
-  EXPECT_EQ(idl_fields(idl, "JointTrajectoryPoint"),
-            (Fields{{"float64[]", "positions"}, {"float64[]", "velocities"}, {"float64[]", "accelerations"}, {"float64[]", "effort"},
-                    {"builtin_interfaces/Duration", "time_from_start"}}));
+  EXPECT_EQ(idl_fields(idl, "JointTrajectory"), (Fields{{"std_msgs/Header", "header"},
+                                                        {"string[]", "joint_names"},
+                                                        {"trajectory_msgs/JointTrajectoryPoint[]", "points"}}));
+  EXPECT_EQ(idl_fields(idl, "JointTrajectoryPoint"), (Fields{{"float64[]", "positions"},
+                                                             {"float64[]", "velocities"},
+                                                             {"float64[]", "accelerations"},
+                                                             {"float64[]", "effort"},
+                                                             {"builtin_interfaces/Duration", "time_from_start"}}));
   EXPECT_EQ(idl_fields(idl, "Duration"), (Fields{{"int32", "sec"}, {"uint32", "nanosec"}}));
   dds::Participant p(test_domain(8), config::DdsTransport::kUdpLoopback, "trajectory names", std::nullopt);
   DataWriter* w = p.trajectory_writer("rt/joint_trajectory");
@@ -614,12 +665,14 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
   std::string text = test::read_file(test::preset("pose_scheduled_c2"));
   test::replace_or_throw(text, "model: ../robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
   const std::string cell = "path-" + std::to_string(getpid());
-  text += "\ncell:\n  name: " + cell + "\nspindle:\n  teeth: 3\n  job: " + dir + "/job.yaml\ndds:\n  domain_id: " + std::to_string(domain) +
+  text += "\ncell:\n  name: " + cell + "\nspindle:\n  teeth: 3\n  job: " + dir +
+          "/job.yaml\ndds:\n  domain_id: " + std::to_string(domain) +
           "\n  transport: udp_loopback\n  joint_states:\n    names: [shoulder, elbow, wrist]\n  path_ahead: {}\n"
           "supervision:\n  overrun_cycles: 5000\n";
   std::ofstream(dir + "/cell.yaml") << text;
-  test::Child run({"run", "--config", dir + "/cell.yaml", "--duration", "600", "--spindle-rpm", "700", "--json", dir + "/run.json"},
-                  dir + "/run.log");
+  test::Child run(
+      {"run", "--config", dir + "/cell.yaml", "--duration", "600", "--spindle-rpm", "700", "--json", dir + "/run.json"},
+      dir + "/run.log");
   Collect<msg::Advice> advice;  // first: it outlives the participant whose thread calls it
   dds::Participant program(domain, config::DdsTransport::kUdpLoopback, "test robot program", std::nullopt);
   DataWriter* joints = program.joint_state_writer("rt/joint_states");
@@ -648,11 +701,13 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
     }
   });
   std::optional<msg::Advice> along;
-  const bool heard = eventually([&] {
-    for (const auto& a : advice.all())
-      if (a.cell() == cell && a.poses_ahead() > 0) along = a;
-    return along.has_value();
-  }, 240.0);
+  const bool heard = eventually(
+      [&] {
+        for (const auto& a : advice.all())
+          if (a.cell() == cell && a.poses_ahead() > 0) along = a;
+        return along.has_value();
+      },
+      240.0);
   stop = true;
   publisher.join();
   run.kill(SIGINT);
@@ -666,10 +721,12 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
   EXPECT_EQ(summary["path_ahead"]["refused"].get<int>(), 0) << summary.dump();
   // The run summary's advice (as `robodamp monitor` prints the topic's) says where it was checked.
   EXPECT_EQ(summary["advice"]["poses_ahead"].get<int>(), 2) << summary["advice"].dump();
-  EXPECT_NE(test::read_file(dir + "/run.log").find("at the robot's pose [-100, 10, 90] deg and 2 poses of the path ahead (the lowest limit at"),
+  EXPECT_NE(test::read_file(dir + "/run.log")
+                .find("at the robot's pose [-100, 10, 90] deg and 2 poses of the path ahead (the lowest limit at"),
             std::string::npos)
       << test::read_file(dir + "/run.log");
-  std::cout << "advice #" << along->seq() << ": " << (along->found() ? "found " + std::to_string(along->advised_rpm()) + " rpm" : along->reason())
+  std::cout << "advice #" << along->seq() << ": "
+            << (along->found() ? "found " + std::to_string(along->advised_rpm()) + " rpm" : along->reason())
             << "; lowest limit at " << config::describe_pose(along->limiting_pose_deg()) << "\n";
   std::filesystem::remove_all(dir);
 }
@@ -680,7 +737,8 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
 const std::string& security_dir() {
   static const std::string dir = [] {
     const std::string d = ::testing::TempDir() + "robodamp_dds_security_" + std::to_string(getpid());
-    const std::string cmd = "bash " + std::string(ROBODAMP_SOURCE_DIR) + "/scripts/dds_security.sh " + d + " > /dev/null";
+    const std::string cmd =
+        "bash " + std::string(ROBODAMP_SOURCE_DIR) + "/scripts/dds_security.sh " + d + " > /dev/null";
     if (std::system(cmd.c_str()) != 0) return std::string();
     return d;
   }();
@@ -689,8 +747,8 @@ const std::string& security_dir() {
 
 config::DdsSecurityConfig identity(const std::string& who) {
   const std::string d = security_dir() + "/";
-  return {d + "ca.pem", d + who + ".pem", d + who + ".key", d + "ca.pem", d + "governance.smime",
-          d + who + "_permissions.smime"};
+  return {d + "ca.pem", d + who + ".pem",       d + who + ".key",
+          d + "ca.pem", d + "governance.smime", d + who + "_permissions.smime"};
 }
 
 struct SecureLoop {
@@ -704,7 +762,9 @@ struct SecureLoop {
     cfg.parameter_writes = true;
     cfg.security = identity("loop");
     bridge = std::make_unique<dds::Bridge>(cfg, 5000.0, "secure.yaml",
-                                           dds::BridgeSources{config::cell_name({}), "simulated plant", [] { return std::size_t{0}; },
+                                           dds::BridgeSources{config::cell_name({}),
+                                                              "simulated plant",
+                                                              [] { return std::size_t{0}; },
                                                               [] { return 4324.0; },
                                                               [this](dds::RequestKind, double v) {
                                                                 ++handled;
@@ -779,8 +839,12 @@ TEST(DdsSecurity, TheDashboardActsWithAnOperatorIdentityAndOnlyViewsWithAnObserv
   // Asked again while unanswered (the reply path may match after the first 2 s on a loaded machine): each
   // ask reaches the loop at most once, and the answered one did.
   int asked = 0;
-  ASSERT_TRUE(eventually([&] { return ++asked, (r = fleet.request(config::cell_name({}), dds::RequestKind::kSetGain, 2500.0, "alice", 2.0)).answered; },
-                         60.0));
+  ASSERT_TRUE(eventually(
+      [&] {
+        return ++asked,
+               (r = fleet.request(config::cell_name({}), dds::RequestKind::kSetGain, 2500.0, "alice", 2.0)).answered;
+      },
+      60.0));
   EXPECT_TRUE(r.accepted) << r.reason;
   const int handled = loop.handled.load();
   EXPECT_GE(handled, 1);

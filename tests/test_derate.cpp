@@ -28,10 +28,13 @@ config::Config fixed_c2() {
   return c;
 }
 
-config::MillingConfig default_job() { return config::load_milling_config(source("config/milling/active_damping_c2.yaml")); }
+config::MillingConfig default_job() {
+  return config::load_milling_config(source("config/milling/active_damping_c2.yaml"));
+}
 
 // 10.3 s of cut at any speed (120 revolutions at 699.3 rpm).
-tune::ScheduledCut cut_at(const config::Config& cell, double rpm, double depth_mm, const config::Config* plant = nullptr) {
+tune::ScheduledCut cut_at(const config::Config& cell, double rpm, double depth_mm,
+                          const config::Config* plant = nullptr) {
   tune::SupervisedCutOptions o;
   o.revolutions = static_cast<int>(std::lround(120.0 * rpm / 700.0));
   o.plant = plant;
@@ -40,15 +43,19 @@ tune::ScheduledCut cut_at(const config::Config& cell, double rpm, double depth_m
 
 void print(const char* name, const tune::ScheduledCut& r) {
   for (const auto& s : r.segments)
-    std::printf("[ derate   ] %s: %.1f rpm %.2f mm: cut %s, %s/%s, derated %.2f s (lowest %.2f), trip %.2f s into the cut, "
-                "peak force %.1f N, %llu ticks at a limit\n",
-                name, s.rpm, s.depth_mm, milling::to_string(s.verdict.classification), s.state.c_str(), s.trip.c_str(),
-                s.derated_s, s.lowest_derate, s.trip_s, s.peak_force_command_n, static_cast<unsigned long long>(s.limited_ticks));
+    std::printf(
+        "[ derate   ] %s: %.1f rpm %.2f mm: cut %s, %s/%s, derated %.2f s (lowest %.2f), trip %.2f s into the cut, "
+        "peak force %.1f N, %llu ticks at a limit\n",
+        name, s.rpm, s.depth_mm, milling::to_string(s.verdict.classification), s.state.c_str(), s.trip.c_str(),
+        s.derated_s, s.lowest_derate, s.trip_s, s.peak_force_command_n,
+        static_cast<unsigned long long>(s.limited_ticks));
   const auto& c = r.counters;
-  std::printf("[ derate   ] %s: probes %llu (the process's %llu, fed by the gain %llu), saturation derates %llu, restores %llu\n",
-              name, static_cast<unsigned long long>(c.derate_probes), static_cast<unsigned long long>(c.growth_process),
-              static_cast<unsigned long long>(c.growth_gain_fed), static_cast<unsigned long long>(c.saturation_derates),
-              static_cast<unsigned long long>(c.derate_restores));
+  std::printf(
+      "[ derate   ] %s: probes %llu (the process's %llu, fed by the gain %llu), saturation derates %llu, restores "
+      "%llu\n",
+      name, static_cast<unsigned long long>(c.derate_probes), static_cast<unsigned long long>(c.growth_process),
+      static_cast<unsigned long long>(c.growth_gain_fed), static_cast<unsigned long long>(c.saturation_derates),
+      static_cast<unsigned long long>(c.derate_restores));
 }
 
 // C2 at K = 2000 at 699.3 rpm lowers the default job's limit to 0.782 mm (open loop 1.106 mm). Cuts above it: 0.95 mm
@@ -123,9 +130,14 @@ TEST(Derate, ALoopUnstableOnItsOwnTripsInAScheduledBandEvenWhileTheCutChatters) 
   swapped.plant.actuator_wiring = -1;
   k125.actuator.constant_n_per_v *= 1.25 * 11874.0 / 3040.0;
   x3.actuator.constant_n_per_v *= 3.0;
-  struct Case { const char* name; const config::Config* plant; double rpm; std::vector<double> depths_mm; };
-  for (const Case& c : {Case{"leads swapped", &swapped, 700.0, {0.001, 0.3, 3.0, 5.0}}, Case{"1.25 x K_max", &k125, 700.0, {0.001}},
-                        Case{"actuator 3 x", &x3, 1200.0, {0.001, 0.3}}}) {
+  struct Case {
+    const char* name;
+    const config::Config* plant;
+    double rpm;
+    std::vector<double> depths_mm;
+  };
+  for (const Case& c : {Case{"leads swapped", &swapped, 700.0, {0.001, 0.3, 3.0, 5.0}},
+                        Case{"1.25 x K_max", &k125, 700.0, {0.001}}, Case{"actuator 3 x", &x3, 1200.0, {0.001, 0.3}}}) {
     for (const double depth : c.depths_mm) {
       const auto r_off = cut_at(off, c.rpm, depth, c.plant);
       const auto r = cut_at(cell, c.rpm, depth, c.plant);
@@ -135,11 +147,12 @@ TEST(Derate, ALoopUnstableOnItsOwnTripsInAScheduledBandEvenWhileTheCutChatters) 
       const auto& s = r.segments[0];
       EXPECT_EQ(s.trip, "instability") << c.name << ", " << depth << " mm";
       EXPECT_GT(s.trip_s, 0.0) << c.name << ", " << depth << " mm: during the cut";
-      EXPECT_GE(r.counters.growth_gain_fed, 1U) << c.name << ", " << depth << " mm: the probe found the gain feeding it";
+      EXPECT_GE(r.counters.growth_gain_fed, 1U)
+          << c.name << ", " << depth << " mm: the probe found the gain feeding it";
       EXPECT_LE(s.peak_force_command_n, r.force_limit_n + 1e-9);
       const double t_off = r_off.segments[0].trip_s;
-      std::printf("[ derate   ] %s, %.3f mm: tripped %s %.2f s into the cut without derating, %s %.2f s with it\n", c.name, depth,
-                  r_off.segments[0].trip.c_str(), t_off, s.trip.c_str(), s.trip_s);
+      std::printf("[ derate   ] %s, %.3f mm: tripped %s %.2f s into the cut without derating, %s %.2f s with it\n",
+                  c.name, depth, r_off.segments[0].trip.c_str(), t_off, s.trip.c_str(), s.trip_s);
       if (depth < 1.0) {
         EXPECT_EQ(r_off.segments[0].trip, "instability");
         EXPECT_LE(s.trip_s, t_off + 0.6) << c.name << ", " << depth << " mm: the probe's cost";
@@ -177,15 +190,18 @@ TEST(Derate, SwappedLeadsTripOnTheCellWithTheSpindleStoppedOrTurning) {
   for (const double rpm : {0.0, 700.0}) {
     rt::CellOptions o = rt::virtual_clock();
     o.plant_config = swapped;
-    const auto r = rt::run(cell, 30.0, [rpm](rt::Cell& s) {
-      if (rpm > 0.0) s.schedule(100, {rt::CommandKind::kSetSpindle, rpm});
-    }, o);
+    const auto r = rt::run(
+        cell, 30.0,
+        [rpm](rt::Cell& s) {
+          if (rpm > 0.0) s.schedule(100, {rt::CommandKind::kSetSpindle, rpm});
+        },
+        o);
     ASSERT_EQ(r.s.trip, "instability") << rpm << " rpm";
     const std::size_t active = rt::first_state(r, rt::State::kActive), fault = rt::first_state(r, rt::State::kFault);
     ASSERT_LT(fault, r.frames.size());
     const double t = r.frames[fault].time_s - r.frames[active].time_s;
-    std::printf("[ derate   ] the cell, leads swapped, %.0f rpm: instability %.2f s after activation (%llu probes)\n", rpm, t,
-                static_cast<unsigned long long>(r.s.supervisor.derate_probes));
+    std::printf("[ derate   ] the cell, leads swapped, %.0f rpm: instability %.2f s after activation (%llu probes)\n",
+                rpm, t, static_cast<unsigned long long>(r.s.supervisor.derate_probes));
     if (rpm == 0.0) {
       EXPECT_EQ(r.s.supervisor.derate_probes, 0U);
       EXPECT_NEAR(t, 1.40, 0.2);
@@ -203,7 +219,12 @@ TEST(Derate, SwappedLeadsTripOnTheCellWithTheSpindleStoppedOrTurning) {
 TEST(Derate, HammerBlowsAndTheDrivesWithTheSpindleTurningAreNotDerated) {
   rt::CellOptions o = rt::virtual_clock();
   o.impact_every_s = 1.3;
-  const auto r = rt::run(rt::c2(), 20.0, [](rt::Cell& s) { s.schedule(100, {rt::CommandKind::kSetSpindle, 700.0}); }, o);
+  const auto r = rt::run(
+      rt::c2(), 20.0,
+      [](rt::Cell& s) {
+        s.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
+      },
+      o);
   EXPECT_EQ(r.s.trip, "none");
   EXPECT_EQ(r.s.supervisor.derate_probes, 0U);
   EXPECT_EQ(r.s.supervisor.saturation_derates, 0U);
@@ -220,8 +241,14 @@ TEST(Derate, TheDeratingReplaysBitForBit) {
   rt::CellOptions o = rt::virtual_clock();
   o.plant_config = real;
   o.record_path = (dir / "derate.rec").string();
-  const auto r = rt::run(fixed_c2(), 30.0, [](rt::Cell& s) { s.schedule(100, {rt::CommandKind::kSetSpindle, 700.0}); }, o);
-  for (const auto& e : r.s.events) std::printf("  %.3f %s %s\n", e.time_s, rt::to_string(e.kind), rt::to_string(e.trip));
+  const auto r = rt::run(
+      fixed_c2(), 30.0,
+      [](rt::Cell& s) {
+        s.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
+      },
+      o);
+  for (const auto& e : r.s.events)
+    std::printf("  %.3f %s %s\n", e.time_s, rt::to_string(e.kind), rt::to_string(e.trip));
   EXPECT_EQ(r.s.trip, "instability");
   EXPECT_GE(r.s.supervisor.derate_probes, 2U);
   EXPECT_GE(r.s.supervisor.growth_gain_fed, 1U);
@@ -234,10 +261,11 @@ TEST(Derate, TheDeratingReplaysBitForBit) {
   EXPECT_EQ(rp.mismatches, 0U);
   EXPECT_EQ(rp.final_trip, "instability");
   const std::size_t active = rt::first_state(r, rt::State::kActive), fault = rt::first_state(r, rt::State::kFault);
-  std::printf("[ derate   ] the cell, actuator 3 x, spindle turning: instability after %.2f s active (%llu probes, %llu fed "
-              "by the gain)\n", r.frames[fault].time_s - r.frames[active].time_s,
-              static_cast<unsigned long long>(r.s.supervisor.derate_probes),
-              static_cast<unsigned long long>(r.s.supervisor.growth_gain_fed));
+  std::printf(
+      "[ derate   ] the cell, actuator 3 x, spindle turning: instability after %.2f s active (%llu probes, %llu fed "
+      "by the gain)\n",
+      r.frames[fault].time_s - r.frames[active].time_s, static_cast<unsigned long long>(r.s.supervisor.derate_probes),
+      static_cast<unsigned long long>(r.s.supervisor.growth_gain_fed));
   std::filesystem::remove_all(dir);
 }
 
@@ -250,10 +278,16 @@ TEST(Derate, TheConfigurationNamesWhatItRefuses) {
     FAIL() << "accepted";
   } catch (const config::ConfigError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("supervision.derate.probe_blocks = 0 (instability blocks) is out of range: allowed 1 <= value <= 1000"),
-              std::string::npos) << what;
-    EXPECT_NE(what.find("supervision.derate.hold_factor = 1.5 (x K) is out of range: allowed 0 <= value < 1 (x K)"), std::string::npos) << what;
-    EXPECT_NE(what.find("plant.actuator_wiring = 0 is not a wiring: allowed 1 (as configured) or -1 (leads swapped)"), std::string::npos)
+    EXPECT_NE(
+        what.find(
+            "supervision.derate.probe_blocks = 0 (instability blocks) is out of range: allowed 1 <= value <= 1000"),
+        std::string::npos)
+        << what;
+    EXPECT_NE(what.find("supervision.derate.hold_factor = 1.5 (x K) is out of range: allowed 0 <= value < 1 (x K)"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("plant.actuator_wiring = 0 is not a wiring: allowed 1 (as configured) or -1 (leads swapped)"),
+              std::string::npos)
         << what;
   }
 }

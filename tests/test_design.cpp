@@ -88,7 +88,8 @@ TEST(BilinearDesign, SectionsAreNormalisedAndStrictlyStable) {
     const DigitalDesign d = bilinear_sos(b.tf, 5000.0, b.prewarp_hz);
     for (const auto& s : d.sections) {
       double peak = 0.0;
-      for (int i = 0; i <= 2000; ++i) peak = std::max(peak, std::abs(digital_response({s}, 1.0, 2500.0 * i / 2000.0, 5000.0)));
+      for (int i = 0; i <= 2000; ++i)
+        peak = std::max(peak, std::abs(digital_response({s}, 1.0, 2500.0 * i / 2000.0, 5000.0)));
       EXPECT_LT(peak, 1.0 + 1e-3) << b.name;
       EXPECT_LT(pole_radius(s), 1.0) << b.name;
     }
@@ -144,7 +145,8 @@ TEST(BilinearDesign, RejectsWhatCannotRun) {
     return std::string("no error");
   };
   // Pure integrator: pole at s = 0 (marginally stable).
-  EXPECT_NE(message([] { (void)bilinear_sos(integrator(), 5000.0, 9.2); }).find("marginally stable"), std::string::npos);
+  EXPECT_NE(message([] { (void)bilinear_sos(integrator(), 5000.0, 9.2); }).find("marginally stable"),
+            std::string::npos);
   // Unstable pole.
   const TransferFunction unstable(Polynomial({1.0}), Polynomial({-3.0, 1.0}));
   EXPECT_NE(message([&] { (void)bilinear_sos(unstable, 5000.0, 9.2); }).find("pole at s = 3"), std::string::npos);
@@ -155,8 +157,10 @@ TEST(BilinearDesign, RejectsWhatCannotRun) {
   const TransferFunction improper(Polynomial({0.0, 0.0, 1.0}), Polynomial({1.0, 1.0}));
   EXPECT_NE(message([&] { (void)bilinear_sos(improper, 5000.0, 9.2); }).find("improper"), std::string::npos);
   // Cut-off at or above Nyquist.
-  EXPECT_NE(message([] { (void)bilinear_sos(lowpass2(2500.0, 0.7), 5000.0, 2500.0); }).find("Nyquist"), std::string::npos);
-  EXPECT_NE(message([] { (void)bilinear_sos(lowpass2(3000.0, 0.7), 5000.0, 3000.0); }).find("Nyquist"), std::string::npos);
+  EXPECT_NE(message([] { (void)bilinear_sos(lowpass2(2500.0, 0.7), 5000.0, 2500.0); }).find("Nyquist"),
+            std::string::npos);
+  EXPECT_NE(message([] { (void)bilinear_sos(lowpass2(3000.0, 0.7), 5000.0, 3000.0); }).find("Nyquist"),
+            std::string::npos);
   EXPECT_THROW((void)bilinear_sos(lowpass2(50.0, 0.7), 0.0, 50.0), DesignError);
   EXPECT_THROW((void)bilinear_sos(lowpass2(50.0, 0.7), 5000.0, NAN), DesignError);
 }

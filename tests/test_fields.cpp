@@ -37,18 +37,23 @@ void check_round_trip(const char* name) {
   SCOPED_TRACE(name);
   S s{};
   std::uint64_t next = 1;
-  std::apply([&](const auto&... f) {
-    auto fill = [&](const auto& field) {
-      auto& m = s.*(field.member);
-      if constexpr (std::is_integral_v<std::decay_t<decltype(m)>>) m = next++;
-      else for (std::size_t i = 0; i < m.size(); ++i) m[i] = 100 + i;
-    };
-    (fill(f), ...);
-  }, fields::list_of<S>());
+  std::apply(
+      [&](const auto&... f) {
+        auto fill = [&](const auto& field) {
+          auto& m = s.*(field.member);
+          if constexpr (std::is_integral_v<std::decay_t<decltype(m)>>)
+            m = next++;
+          else
+            for (std::size_t i = 0; i < m.size(); ++i) m[i] = 100 + i;
+        };
+        (fill(f), ...);
+      },
+      fields::list_of<S>());
 
   const nlohmann::json j = fields::to_json(s);
   std::set<std::string> keys;
-  fields::for_each_field(s, [&](const auto& field, const auto&) { EXPECT_TRUE(keys.insert(std::string(field.key)).second) << field.key; });
+  fields::for_each_field(
+      s, [&](const auto& field, const auto&) { EXPECT_TRUE(keys.insert(std::string(field.key)).second) << field.key; });
   const S back = fields::from_json<S>(j);
   EXPECT_EQ(fields::to_json(back), j);
   const std::string text = fields::text(s);

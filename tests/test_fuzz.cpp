@@ -35,7 +35,9 @@ using Rng = std::mt19937_64;
 
 std::size_t below(Rng& rng, std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n - 1)(rng); }
 template <typename T>
-const T& one_of(Rng& rng, const std::vector<T>& v) { return v[below(rng, v.size())]; }
+const T& one_of(Rng& rng, const std::vector<T>& v) {
+  return v[below(rng, v.size())];
+}
 
 fs::path scratch(const std::string& name) {
   const fs::path p = fs::path(::testing::TempDir()) / name;  // the process's own (tests/test_main.cpp)
@@ -72,7 +74,8 @@ ChildResult run_in_child(const std::vector<std::string>& args, double timeout_s)
   char buf[4096];
   bool hung = false;
   while (true) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
     if (left <= 0) {
       hung = true;
       break;
@@ -93,10 +96,10 @@ ChildResult run_in_child(const std::vector<std::string>& args, double timeout_s)
 
 struct Sub {
   std::string name;
-  std::vector<std::string> numbers;        // numeric options
-  std::vector<std::string> flags;          // options without a value
+  std::vector<std::string> numbers;                                       // numeric options
+  std::vector<std::string> flags;                                         // options without a value
   std::vector<std::pair<std::string, std::vector<std::string>>> choices;  // options with valid values
-  std::vector<std::string> files;          // options taking an existing file
+  std::vector<std::string> files;                                         // options taking an existing file
   bool positional_file{false};
 };
 
@@ -107,36 +110,88 @@ std::vector<Sub> subcommands() {
       {"check-config", {}, {}, {}, {}, true},
       {"analyze", {"--spindle-rpm"}, {"--json", "--spindle-sweep", "--no-pose-schedule"}, {}, {"--config"}, false},
       {"bench", {}, {}, {}, {"--config"}, false},
-      {"run", {"--duration", "--impact-every", "--spindle-rpm", "--pose"}, {"--no-pose-schedule"}, {{"--clock", {"wall", "virtual"}}}, {"--config", "--job"}, false},
-      {"plant", {"--duration", "--impact-location", "--spindle-register-period", "--pose-register-period", "--pose-update"}, {"--no-impacts"}, {{"--pacing", {"realtime", "lockstep"}}}, {"--config"}, false},
-      {"monitor", {"--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback", "shared_memory"}}}, {"--config"}, false},
-      {"request", {"--domain", "--gain", "--select", "--enable", "--timeout", "--spindle-rpm"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
-      {"dashboard", {"--port", "--domain", "--duration"}, {}, {{"--transport", {"default", "udp_loopback"}}}, {"--config"}, false},
+      {"run",
+       {"--duration", "--impact-every", "--spindle-rpm", "--pose"},
+       {"--no-pose-schedule"},
+       {{"--clock", {"wall", "virtual"}}},
+       {"--config", "--job"},
+       false},
+      {"plant",
+       {"--duration", "--impact-location", "--spindle-register-period", "--pose-register-period", "--pose-update"},
+       {"--no-impacts"},
+       {{"--pacing", {"realtime", "lockstep"}}},
+       {"--config"},
+       false},
+      {"monitor",
+       {"--domain", "--duration"},
+       {},
+       {{"--transport", {"default", "udp_loopback", "shared_memory"}}},
+       {"--config"},
+       false},
+      {"request",
+       {"--domain", "--gain", "--select", "--enable", "--timeout", "--spindle-rpm"},
+       {},
+       {{"--transport", {"default", "udp_loopback"}}},
+       {"--config"},
+       false},
+      {"dashboard",
+       {"--port", "--domain", "--duration"},
+       {},
+       {{"--transport", {"default", "udp_loopback"}}},
+       {"--config"},
+       false},
       {"replay", {}, {}, {}, {}, true},
       {"csv", {}, {}, {}, {}, true},
       {"lobes", {"--rpm", "--pose"}, {"--json", "--damped"}, {}, {"--job", "--controller"}, false},
       {"sle", {"--pose"}, {"--json", "--damped"}, {}, {"--job", "--controller"}, false},
-      {"cut", {"--rpm", "--axial-mm", "--radial-mm", "--revs", "--pose"}, {"--critical", "--damped"}, {}, {"--job"}, false},
-      {"identify", {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm", "--band-hz", "--max-order", "--segment-s", "--overlap",
-                    "--helix-deg", "--order", "--record", "--feeds-mm", "--rpm"}, {"--ball-end"},
-       {{"--mode", {"down", "up"}}, {"--kind", {"receptance", "mobility", "accelerance"}}, {"--response", {"acceleration", "velocity", "1:+Y"}},
-        {"--reference", {"1:+Y", "2:-Z"}}, {"--axes", {"fx,fy,fz", "-fy,fx,fz"}}, {"--force-on", {"workpiece", "tool"}}},
-       {"--csv", "--frf", "--series", "--recording", "--structure", "--records", "--tests", "--uff", "--config"}, false},
+      {"cut",
+       {"--rpm", "--axial-mm", "--radial-mm", "--revs", "--pose"},
+       {"--critical", "--damped"},
+       {},
+       {"--job"},
+       false},
+      {"identify",
+       {"--teeth", "--diameter-mm", "--axial-mm", "--radial-mm", "--band-hz", "--max-order", "--segment-s", "--overlap",
+        "--helix-deg", "--order", "--record", "--feeds-mm", "--rpm"},
+       {"--ball-end"},
+       {{"--mode", {"down", "up"}},
+        {"--kind", {"receptance", "mobility", "accelerance"}},
+        {"--response", {"acceleration", "velocity", "1:+Y"}},
+        {"--reference", {"1:+Y", "2:-Z"}},
+        {"--axes", {"fx,fy,fz", "-fy,fx,fz"}},
+        {"--force-on", {"workpiece", "tool"}}},
+       {"--csv", "--frf", "--series", "--recording", "--structure", "--records", "--tests", "--uff", "--config"},
+       false},
       {"measure", {}, {}, {{"--clock", {"wall", "virtual"}}}, {"--config"}, false},
-      {"chatter", {"--teeth", "--rpm", "--rpm-range", "--rate-hz", "--channel", "--full-scale-mps2", "--record", "--window-s",
-                   "--max-hz", "--floor"}, {"--json"}, {{"--response", {"1:+Y"}}, {"--column", {"2", "accel"}}}, {"--signal"}, false},
-      {"tune", {"--gain-margin-db", "--phase-margin-deg", "--delay-margin-ms", "--depth-at-speed-mm", "--evaluations",
-                 "--polish", "--seed", "--restarts", "--shift-pct", "--impact-n", "--impact-ms"}, {}, {},
-       {"--config", "--job", "--also"}, false},
-      {"pose", {"--joints", "--modes", "--band-hz", "--steps", "--fit-band-hz", "--restarts", "--particles", "--iterations",
-                "--seed", "--csv-step-hz"}, {"--json"}, {{"--direction", {"xx", "yy", "xy"}}}, {"--model", "--job"}, false},
+      {"chatter",
+       {"--teeth", "--rpm", "--rpm-range", "--rate-hz", "--channel", "--full-scale-mps2", "--record", "--window-s",
+        "--max-hz", "--floor"},
+       {"--json"},
+       {{"--response", {"1:+Y"}}, {"--column", {"2", "accel"}}},
+       {"--signal"},
+       false},
+      {"tune",
+       {"--gain-margin-db", "--phase-margin-deg", "--delay-margin-ms", "--depth-at-speed-mm", "--evaluations",
+        "--polish", "--seed", "--restarts", "--shift-pct", "--impact-n", "--impact-ms"},
+       {},
+       {},
+       {"--config", "--job", "--also"},
+       false},
+      {"pose",
+       {"--joints", "--modes", "--band-hz", "--steps", "--fit-band-hz", "--restarts", "--particles", "--iterations",
+        "--seed", "--csv-step-hz"},
+       {"--json"},
+       {{"--direction", {"xx", "yy", "xy"}}},
+       {"--model", "--job"},
+       false},
   };
 }
 
 // Invalid for every numeric option (all allow only finite values in [0, 1e6] at most).
-const std::vector<std::string> kBadNumbers{"nan",  "-nan", "NaN", "inf",   "-inf",   "Infinity", "1e999", "-1e999", "1e9",
-                                           "-1e9", "1e300", "abc", "",     "12abc",  "1.5.5",    "+-1",   "0x",     "--",
-                                           " ",    "1,5",  "\xff\xfe", "1e", "-",   "99999999999999999999999"};
+const std::vector<std::string> kBadNumbers{"nan",   "-nan",   "NaN",      "inf",  "-inf",  "Infinity",
+                                           "1e999", "-1e999", "1e9",      "-1e9", "1e300", "abc",
+                                           "",      "12abc",  "1.5.5",    "+-1",  "0x",    "--",
+                                           " ",     "1,5",    "\xff\xfe", "1e",   "-",     "99999999999999999999999"};
 const std::vector<std::string> kFine{"0.5", "1", "2", "0", "10", "100"};
 
 // One argument vector with at least one element the parser must refuse, in a random place.
@@ -176,8 +231,10 @@ std::vector<std::string> hostile_args(Rng& rng, const std::vector<Sub>& subs, st
       }
       [[fallthrough]];
     case 3:
-      hostile = {one_of(rng, std::vector<std::string>{"--bogus", "-x", "--rpm=", "--config=", "---", "--duration=nan", "-q"})};
-      if (hostile[0] == "--duration=nan" && s.name != "run" && s.name != "plant" && s.name != "monitor") hostile = {"--Config"};
+      hostile = {
+          one_of(rng, std::vector<std::string>{"--bogus", "-x", "--rpm=", "--config=", "---", "--duration=nan", "-q"})};
+      if (hostile[0] == "--duration=nan" && s.name != "run" && s.name != "plant" && s.name != "monitor")
+        hostile = {"--Config"};
       if (s.name == "lobes" && hostile[0] == "--rpm=") hostile = {"--rpm", "nan"};
       if (hostile[0] == "--config=" && !s.files.empty()) hostile = {"--config", "/nonexistent/robodamp.yaml"};
       why = "unknown or malformed option";
@@ -249,9 +306,10 @@ TEST(Fuzz, TenThousandHostileCommandLinesExit2WithAMessage) {
 
 // --- configuration files ----------------------------------------------------------------------------------
 
-const std::vector<std::string> kBadValues{"nan", ".nan", ".inf", "-.inf", "1e308", "-1e308", "0", "-0", "1e-320",
-                                          "99999999999999999999", "abc", "[1, 2]", "{a: 1}", "''", "~", "true",
-                                          "-1", "3.5", "\"5\"", "&anchor 1", "*missing", "!!binary AAAA", "0x10"};
+const std::vector<std::string> kBadValues{
+    "nan",      ".nan",          ".inf",   "-.inf", "1e308", "-1e308", "0",  "-0",  "1e-320", "99999999999999999999",
+    "abc",      "[1, 2]",        "{a: 1}", "''",    "~",     "true",   "-1", "3.5", "\"5\"",  "&anchor 1",
+    "*missing", "!!binary AAAA", "0x10"};
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -277,7 +335,9 @@ std::string mutate(Rng& rng, const std::string& text) {
   for (std::size_t k = 0; k < n && !lines.empty(); ++k) {
     std::string& line = lines[below(rng, lines.size())];
     switch (below(rng, 9)) {
-      case 0: lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(below(rng, lines.size()))); break;
+      case 0:
+        lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(below(rng, lines.size())));
+        break;
       case 1: {
         const std::size_t i = below(rng, lines.size());
         lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(i), lines[i]);  // duplicate key
@@ -289,7 +349,10 @@ std::string mutate(Rng& rng, const std::string& text) {
         if (colon != std::string::npos) line = line.substr(0, colon + 2) + one_of(rng, kBadValues);
         break;
       }
-      case 4: line = (below(rng, 2) ? "  " : "") + line.substr(line.empty() ? 0 : below(rng, std::min<std::size_t>(3, line.size()) + 1)); break;
+      case 4:
+        line = (below(rng, 2) ? "  " : "") +
+               line.substr(line.empty() ? 0 : below(rng, std::min<std::size_t>(3, line.size()) + 1));
+        break;
       case 5: {  // a key renamed
         const std::size_t colon = line.find(':');
         if (colon != std::string::npos) line.insert(colon, "x");
@@ -298,14 +361,15 @@ std::string mutate(Rng& rng, const std::string& text) {
       case 6: {  // bytes inserted
         std::string junk;
         for (std::size_t i = 1 + below(rng, 6); i > 0; --i)
-          junk += one_of(rng, std::vector<std::string>{"\t", ":", "-", "[", "{", "&", "*", "!", "\"", "'", "#", "|", ">",
-                                                       "\xc3\xa9", "\x01", "\xff", " ", "%"});
+          junk += one_of(rng, std::vector<std::string>{"\t", ":", "-", "[", "{", "&", "*", "!", "\"", "'", "#", "|",
+                                                       ">", "\xc3\xa9", "\x01", "\xff", " ", "%"});
         line.insert(below(rng, line.size() + 1), junk);
         break;
       }
       case 7: {  // a map where a number was
         const std::size_t colon = line.find(": ");
-        if (colon != std::string::npos) line = line.substr(0, colon + 2) + "\n" + std::string(colon + 2, ' ') + "nested: 1";
+        if (colon != std::string::npos)
+          line = line.substr(0, colon + 2) + "\n" + std::string(colon + 2, ' ') + "nested: 1";
         break;
       }
       default: {  // truncated
@@ -319,13 +383,15 @@ std::string mutate(Rng& rng, const std::string& text) {
 
 std::string huge(Rng& rng, const std::string& text) {
   switch (below(rng, 3)) {
-    case 0: return text + "notes: \"" + std::string(4 << 20, 'x') + "\"\n";  // a 4 MiB string
+    case 0:
+      return text + "notes: \"" + std::string(4 << 20, 'x') + "\"\n";  // a 4 MiB string
     case 1: {
       std::string s = text + "extra:\n";
       for (int i = 0; i < 200000; ++i) s += "  - " + std::to_string(i) + "\n";  // a 200 000-element list
       return s;
     }
-    default: return std::string(100000, '[') + std::string(100000, ']');  // deep nesting
+    default:
+      return std::string(100000, '[') + std::string(100000, ']');  // deep nesting
   }
 }
 
@@ -362,7 +428,8 @@ TEST(Fuzz, TenThousandMutatedConfigurationsAreRefusedWithFileAndLine) {
     bases.push_back({test::read_file(test::preset(p)), false, dir / "presets" / "fuzz.yaml"});
   bases.push_back({test::read_file(src + "/config/hil_horizontal_c2.yaml"), false, dir / "fuzz_hil.yaml"});
   for (const char* p : {"active_damping_c2", "industrial_robot_aluminium", "orthopaedic_bone"})
-    bases.push_back({test::read_file(src + "/config/milling/" + std::string(p) + ".yaml"), true, dir / "milling" / "fuzz.yaml"});
+    bases.push_back(
+        {test::read_file(src + "/config/milling/" + std::string(p) + ".yaml"), true, dir / "milling" / "fuzz.yaml"});
   ConfigFuzzCounts c;
   int failures = 0;
   const auto t0 = std::chrono::steady_clock::now();
@@ -389,13 +456,15 @@ TEST(Fuzz, TenThousandMutatedConfigurationsAreRefusedWithFileAndLine) {
       const bool other_file = !other.empty() && other != file && fs::exists(other);
       if (!other_file) expect_located(e, file, text, failures);
     } catch (const std::exception& e) {
-      if (++failures <= 10) ADD_FAILURE() << "#" << i << ": not a ConfigError: " << e.what() << "\n--- input ---\n" << text.substr(0, 2000);
+      if (++failures <= 10)
+        ADD_FAILURE() << "#" << i << ": not a ConfigError: " << e.what() << "\n--- input ---\n" << text.substr(0, 2000);
     }
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("[ fuzz cfg ] 10000 mutated files (%zu bases, 10 huge) in %.1f s: %d accepted, %d refused with %d problems, "
-              "every one at file:line: %s\n",
-              bases.size(), s, c.accepted, c.refused, c.problems, failures == 0 ? "yes" : "NO");
+  std::printf(
+      "[ fuzz cfg ] 10000 mutated files (%zu bases, 10 huge) in %.1f s: %d accepted, %d refused with %d problems, "
+      "every one at file:line: %s\n",
+      bases.size(), s, c.accepted, c.refused, c.problems, failures == 0 ? "yes" : "NO");
   // Most mutations break a file (measured: 8066 of 10000); a fuzzer that refused nothing tested nothing.
   EXPECT_GT(c.refused, 5000);
   EXPECT_GE(c.problems, c.refused);
@@ -423,27 +492,39 @@ TEST(Fuzz, CorruptedRecordingsAreRefusedOrReadNeverCrash) {
   for (int i = 0; i < 3000 && failures < 10; ++i) {
     std::string b = bytes;
     switch (below(rng, 7)) {
-      case 0: b.resize(below(rng, b.size())); break;  // truncated anywhere
+      case 0:
+        b.resize(below(rng, b.size()));
+        break;  // truncated anywhere
       case 1:
-        for (std::size_t k = 1 + below(rng, 8); k > 0; --k) b[below(rng, std::min<std::size_t>(b.size(), 16 + header_len))] ^= static_cast<char>(1 + below(rng, 255));
-        break;  // header bytes flipped
+        for (std::size_t k = 1 + below(rng, 8); k > 0; --k)
+          b[below(rng, std::min<std::size_t>(b.size(), 16 + header_len))] ^= static_cast<char>(1 + below(rng, 255));
+        break;   // header bytes flipped
       case 2: {  // a lying header length
-        const std::uint32_t lie = one_of(rng, std::vector<std::uint32_t>{0, 1, header_len - 1, header_len + 1, 0xFFFFFFFFU, 64U << 20, static_cast<std::uint32_t>(b.size())});
+        const std::uint32_t lie =
+            one_of(rng, std::vector<std::uint32_t>{0, 1, header_len - 1, header_len + 1, 0xFFFFFFFFU, 64U << 20,
+                                                   static_cast<std::uint32_t>(b.size())});
         std::memcpy(b.data() + 12, &lie, 4);
         break;
       }
       case 3:
-        for (std::size_t k = 1 + below(rng, 50); k > 0; --k) b[16 + header_len + below(rng, b.size() - 16 - header_len)] = static_cast<char>(below(rng, 256));
-        break;  // frame bytes (states, trips and commands out of their enums)
+        for (std::size_t k = 1 + below(rng, 50); k > 0; --k)
+          b[16 + header_len + below(rng, b.size() - 16 - header_len)] = static_cast<char>(below(rng, 256));
+        break;   // frame bytes (states, trips and commands out of their enums)
       case 4: {  // the header's JSON rewritten with wrong types
         std::string h = b.substr(16, header_len);
-        const auto at = h.find(one_of(rng, std::vector<std::string>{"\"rate_hz\":", "\"frame_bytes\":", "\"supervisor\":", "\"controller_params\":", "\"sections\":"}));
-        if (at != std::string::npos) h.insert(h.find(':', at) + 1, one_of(rng, std::vector<std::string>{"\"x\",\"y\":", "null,\"z\":", "[],\"w\":", "-1e999,\"v\":"}));
+        const auto at =
+            h.find(one_of(rng, std::vector<std::string>{"\"rate_hz\":", "\"frame_bytes\":", "\"supervisor\":",
+                                                        "\"controller_params\":", "\"sections\":"}));
+        if (at != std::string::npos)
+          h.insert(h.find(':', at) + 1,
+                   one_of(rng, std::vector<std::string>{"\"x\",\"y\":", "null,\"z\":", "[],\"w\":", "-1e999,\"v\":"}));
         const auto len = static_cast<std::uint32_t>(h.size());
         b = b.substr(0, 12) + std::string(reinterpret_cast<const char*>(&len), 4) + h + b.substr(16 + header_len);
         break;
       }
-      case 5: b += std::string(below(rng, 300), static_cast<char>(below(rng, 256))); break;  // trailing garbage
+      case 5:
+        b += std::string(below(rng, 300), static_cast<char>(below(rng, 256)));
+        break;  // trailing garbage
       default: {
         b.resize(below(rng, 4096));
         for (auto& ch : b) ch = static_cast<char>(below(rng, 256));

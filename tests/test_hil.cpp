@@ -46,8 +46,8 @@ using nlohmann::json;
 using test::eventually;
 
 using test::Child;
-using test::HilFiles;
 using test::hil_files;
+using test::HilFiles;
 
 json read_json(const std::string& path) { return json::parse(test::read_file(path)); }
 
@@ -75,9 +75,14 @@ TEST(Hil, LockstepImprovementMatchesTheInProcessBench) {
   supervisor.erase("active_parameter_set");
   EXPECT_EQ(fields::to_json(fields::from_json<rt::SupervisorCounters>(supervisor)), supervisor);
   const std::string text = test::read_file(f.run_log);
-  EXPECT_NE(text.find("  CAN: " + fields::text(fields::from_json<drivers::CanCounters>(r["can"])) + "\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("  Modbus: " + fields::text(fields::from_json<drivers::ModbusCounters>(r["modbus"])) + "\n"), std::string::npos) << text;
-  EXPECT_NE(text.find(std::to_string(r["can"]["rx_frames"].get<std::uint64_t>()) + " sensor frames"), std::string::npos) << text;
+  EXPECT_NE(text.find("  CAN: " + fields::text(fields::from_json<drivers::CanCounters>(r["can"])) + "\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("  Modbus: " + fields::text(fields::from_json<drivers::ModbusCounters>(r["modbus"])) + "\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find(std::to_string(r["can"]["rx_frames"].get<std::uint64_t>()) + " sensor frames"), std::string::npos)
+      << text;
 
   // The same impact test in process: the bench's plant and controller at the configured K.
   const config::Config cfg = config::load_config_file(f.config);
@@ -93,10 +98,11 @@ TEST(Hil, LockstepImprovementMatchesTheInProcessBench) {
     const double lo = cfg.analysis.band_min_hz, hi = cfg.analysis.band_max_hz;
     const double bench_pct = (analysis::measured_peak(open.receptance[resp], lo, hi).magnitude_m_per_n /
                                   analysis::measured_peak(closed.receptance[resp], lo, hi).magnitude_m_per_n -
-                              1.0) * 100.0;
+                              1.0) *
+                             100.0;
     const double hil_pct = fr["measured_improvement_pct"];
-    std::cout << fr["name"].get<std::string>() << ": across processes " << hil_pct << " %, in-process bench " << bench_pct
-              << " %\n";
+    std::cout << fr["name"].get<std::string>() << ": across processes " << hil_pct << " %, in-process bench "
+              << bench_pct << " %\n";
     EXPECT_NEAR(hil_pct, bench_pct, 0.05 * bench_pct);
     EXPECT_GT(fr["coherence_min"].get<double>(), 0.99);
   }
@@ -105,7 +111,8 @@ TEST(Hil, LockstepImprovementMatchesTheInProcessBench) {
 TEST(Hil, RealtimeRunReportsItsTimingAndPullingThePlugTripsSafe) {
   // The shipped overrun trip is tight (10 overruns); this machine is shared by both processes and the CI's
   // other jobs, so the test loosens it (and the stale trip, to 100 ms) and checks against what it configured.
-  const HilFiles f = hil_files("realtime", {{"stale_sensor_cycles: 250", "stale_sensor_cycles: 500\n  overrun_cycles: 1000000"}});
+  const HilFiles f =
+      hil_files("realtime", {{"stale_sensor_cycles: 250", "stale_sensor_cycles: 500\n  overrun_cycles: 1000000"}});
   const config::Config cfg = config::load_config_file(f.config);
   Child plant({"plant", "--config", f.config, "--pacing", "realtime", "--json", f.plant_json}, f.plant_log);
   Child run({"run", "--config", f.config, "--duration", "36", "--json", f.run_json}, f.run_log);
@@ -129,9 +136,10 @@ TEST(Hil, RealtimeRunReportsItsTimingAndPullingThePlugTripsSafe) {
   // good the timing is belongs to the machine (the loop against cyclictest, docs/performance.md), not to a
   // test on a shared 2-core machine: it asked for at most 1 % missed and a p99 under one period until a suite
   // beside it missed 1.85 % (the overrun trip is off only so that a loaded machine ends the run by the plug).
-  const double missed_pct = 100.0 * static_cast<double>(r["missed_ticks"].get<std::uint64_t>()) / static_cast<double>(ticks);
-  std::cout << "timing: " << missed_pct << " % of the ticks missed, wake-up p99 " << r["wake_latency"]["p99_us"].get<double>()
-            << " us (one period " << 1e6 / cfg.loop.rate_hz << " us)\n";
+  const double missed_pct =
+      100.0 * static_cast<double>(r["missed_ticks"].get<std::uint64_t>()) / static_cast<double>(ticks);
+  std::cout << "timing: " << missed_pct << " % of the ticks missed, wake-up p99 "
+            << r["wake_latency"]["p99_us"].get<double>() << " us (one period " << 1e6 / cfg.loop.rate_hz << " us)\n";
   EXPECT_GT(r["wake_latency"]["p99_us"].get<double>(), 0.0);
   EXPECT_GT(r["can"]["rx_frames"].get<std::uint64_t>(), 150000U);
 
@@ -147,8 +155,8 @@ TEST(Hil, RealtimeRunReportsItsTimingAndPullingThePlugTripsSafe) {
                                                        std::ceil(cfg.supervision.trip_ramp_s * cfg.loop.rate_hz) + 1);
   const auto ticks_to_safe = r["trip_timing"]["ticks_to_safe"].get<std::int64_t>();
   std::cout << "plug pulled: last fresh sample " << last_fresh_s << " s, trip " << trip_s << " s, safe " << safe_s
-            << " s: " << 1e3 * (safe_s - last_fresh_s) << " ms, " << ticks_to_safe << " ticks (allowed " << allowed_ticks
-            << ")\n";
+            << " s: " << 1e3 * (safe_s - last_fresh_s) << " ms, " << ticks_to_safe << " ticks (allowed "
+            << allowed_ticks << ")\n";
   EXPECT_GE(safe_s, trip_s);
   EXPECT_LE(ticks_to_safe, allowed_ticks);
 }
@@ -172,12 +180,14 @@ TEST(Hil, RobotMountingSelectsTheVerticalParameterSet) {
 // The emulator's robot publishes the spindle speed on its Modbus register; the controller in the other
 // process reads it (settled), and its harmonic notches follow: 12 000 then 6000 rpm x 3 teeth.
 TEST(Hil, RobotSpindleRegisterSteersTheHarmonicNotches) {
-  const HilFiles f = hil_files("spindle", {{"    settle_polls: 3", "    settle_polls: 3\n    spindle_rpm_register: 1\n    rpm_per_count: 10"},
-                                           {"  chain:                 # Eq. 8",
-                                            "  harmonic_notch: {harmonics: 3, bandwidth_hz: 20, depth_db: 30}\n  chain:                 # Eq. 8"}});
+  const HilFiles f = hil_files(
+      "spindle",
+      {{"    settle_polls: 3", "    settle_polls: 3\n    spindle_rpm_register: 1\n    rpm_per_count: 10"},
+       {"  chain:                 # Eq. 8",
+        "  harmonic_notch: {harmonics: 3, bandwidth_hz: 20, depth_db: 30}\n  chain:                 # Eq. 8"}});
   std::ofstream(f.config, std::ios::app) << "\nspindle: {teeth: 3, rpm_max: 20000}\n";
-  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--spindle", "1:12000", "--spindle",
-               "2.5:6000", "--json", f.plant_json},
+  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--spindle", "1:12000",
+               "--spindle", "2.5:6000", "--json", f.plant_json},
               f.plant_log);
   Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", "4", "--json", f.run_json}, f.run_log);
   ASSERT_EQ(run.wait(), 0) << test::read_file(f.run_log);
@@ -204,7 +214,8 @@ TEST(Hil, CuttingForcesAtToothPassingAreNotchedOutAcrossProcesses) {
              std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml", "--spindle", "0.5:12000",
              "--json", f.plant_json},
             f.plant_log);
-    std::vector<std::string> args{"run", "--config", f.config, "--clock", "virtual", "--duration", "40", "--json", f.run_json};
+    std::vector<std::string> args{"run",        "--config", f.config, "--clock", "virtual",
+                                  "--duration", "40",       "--json", f.run_json};
     if (bank == "off") args.push_back("--no-harmonic-notch");
     Child r(args, f.run_log);
     ASSERT_EQ(r.wait(), 0) << test::read_file(f.run_log);
@@ -223,7 +234,8 @@ TEST(Hil, CuttingForcesAtToothPassingAreNotchedOutAcrossProcesses) {
   const auto& on = plant["on"]["cutting"];
   EXPECT_GT(off["command_harmonics_v"][0].get<double>(), 1e-3) << "the cut reaches the command without the notches";
   for (int k = 0; k < 3; ++k) {
-    const double drop_db = 20.0 * std::log10(off["command_harmonics_v"][k].get<double>() / on["command_harmonics_v"][k].get<double>());
+    const double drop_db =
+        20.0 * std::log10(off["command_harmonics_v"][k].get<double>() / on["command_harmonics_v"][k].get<double>());
     std::cout << "harmonic " << k + 1 << ": " << drop_db << " dB\n";
     EXPECT_GE(drop_db, 30.0) << "harmonic " << k + 1;
   }
@@ -264,7 +276,6 @@ TEST(Hil, SpindleRampWhileCuttingKeepsTheLoopActive) {
   EXPECT_DOUBLE_EQ(run["spindle"]["notch_centre_hz"].get<double>(), 300.0);
   EXPECT_EQ(plant["cutting"]["last_rpm"], 6000.0);
 }
-
 
 TEST(Hil, ControllerWithoutTheEmulatorReportsTheTransport) {
   const HilFiles f = hil_files("absent");
@@ -324,7 +335,8 @@ double injected_at_s(const json& plant_report, const std::string& kind) {
 
 TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   const HilFiles f = hil_files("restart", kSharedMachine);
-  auto plant = std::make_unique<Child>(std::vector<std::string>{"plant", "--config", f.config, "--no-impacts"}, f.plant_log);
+  auto plant =
+      std::make_unique<Child>(std::vector<std::string>{"plant", "--config", f.config, "--no-impacts"}, f.plant_log);
   FaultRun r(f.config);
   test::configure(*r.cell);
   ASSERT_TRUE(r.cell->activate(3600.0).ok());
@@ -334,23 +346,27 @@ TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   plant->kill(SIGKILL);  // the cell's other process dies
   EXPECT_EQ(plant->wait(), 128 + SIGKILL);
   ASSERT_TRUE(eventually([&] { return r.in(rt::State::kFault); }, 30.0));
-  plant = std::make_unique<Child>(std::vector<std::string>{"plant", "--config", f.config, "--no-impacts"}, f.plant_log + "2");
+  plant = std::make_unique<Child>(std::vector<std::string>{"plant", "--config", f.config, "--no-impacts"},
+                                  f.plant_log + "2");
   ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().reconnects >= 1; }, 60.0))
       << test::read_file(f.plant_log + "2");
   const auto rx = r.cell->can_driver()->counters().rx_frames;
-  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().rx_frames > rx + 1000; }, 30.0)) << "frames flow again";
+  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().rx_frames > rx + 1000; }, 30.0))
+      << "frames flow again";
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_TRUE(r.in(rt::State::kFault)) << "still safe with the sensor just back: recovery waits for 2 s of health";
 
   // Back to damping: by the supervisor's recovery (sensor_stale is recoverable) or, if a trip while the new
   // emulator's Modbus link and sensor settle latched it, by the operator: reset, arm, and again if refused
   // (an operator looks and tries again; so does this test, for a minute).
-  const bool rearmed = eventually([&] {
-    if (r.in(rt::State::kFault)) (void)r.cell->post({rt::CommandKind::kResetFault, 0.0});
-    if (!eventually([&] { return r.in(rt::State::kDisabled); }, 5.0)) return r.in(rt::State::kActive);
-    (void)r.cell->post({rt::CommandKind::kArm, 0.0});
-    return eventually([&] { return r.in(rt::State::kActive); }, 5.0);
-  }, 60.0);
+  const bool rearmed = eventually(
+      [&] {
+        if (r.in(rt::State::kFault)) (void)r.cell->post({rt::CommandKind::kResetFault, 0.0});
+        if (!eventually([&] { return r.in(rt::State::kDisabled); }, 5.0)) return r.in(rt::State::kActive);
+        (void)r.cell->post({rt::CommandKind::kArm, 0.0});
+        return eventually([&] { return r.in(rt::State::kActive); }, 5.0);
+      },
+      60.0);
   EXPECT_TRUE(rearmed) << "re-armed against the new emulator";
   ASSERT_TRUE(r.cell->deactivate().ok());
 
@@ -373,7 +389,8 @@ TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   // Never active between the trip and the operator's arm.
   std::size_t arm = t.trip;
   while (arm < frames.size() && frames[arm].command_kind != static_cast<std::uint8_t>(rt::CommandKind::kArm)) ++arm;
-  for (std::size_t i = t.trip; i < arm; ++i) ASSERT_NE(frames[i].state, static_cast<std::uint8_t>(rt::State::kActive)) << i;
+  for (std::size_t i = t.trip; i < arm; ++i)
+    ASSERT_NE(frames[i].state, static_cast<std::uint8_t>(rt::State::kActive)) << i;
   // The run summary's availability saw the same trip and safe state, and the outage.
   const rt::Availability& av = r.cell->summary().availability;
   ASSERT_GE(av.trips_total, 1u);
@@ -381,9 +398,10 @@ TEST(HilFaults, EmulatorKilledAndRestartedTripsSafeAndReArms) {
   EXPECT_DOUBLE_EQ(av.trips.front().trip_s, frames[t.trip].time_s);
   EXPECT_DOUBLE_EQ(av.trips.front().safe_s, frames[t.safe].time_s);
   EXPECT_GT(av.asked_s, av.active_s);
-  std::printf("[ hil kill ] emulator killed: trip %s, safe %.1f ms after the last fresh sample (allowed %.1f ms); "
-              "reconnected, reset and re-armed\n",
-              trip.c_str(), 1e3 * safe_after_s, 1e3 * allowed_s);
+  std::printf(
+      "[ hil kill ] emulator killed: trip %s, safe %.1f ms after the last fresh sample (allowed %.1f ms); "
+      "reconnected, reset and re-armed\n",
+      trip.c_str(), 1e3 * safe_after_s, 1e3 * allowed_s);
 }
 
 TEST(HilFaults, CanBusOffTripsToTheSafeStateAtOnce) {
@@ -395,7 +413,8 @@ TEST(HilFaults, CanBusOffTripsToTheSafeStateAtOnce) {
   test::configure(*r.cell);
   ASSERT_TRUE(r.cell->activate(3600.0).ok());
   ASSERT_TRUE(eventually([&] { return r.in(rt::State::kActive); }, 60.0)) << test::read_file(f.plant_log);
-  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().bus_off >= 1; }, 60.0)) << test::read_file(f.plant_log);
+  ASSERT_TRUE(eventually([&] { return r.cell->can_driver()->counters().bus_off >= 1; }, 60.0))
+      << test::read_file(f.plant_log);
   ASSERT_TRUE(eventually([&] { return r.in(rt::State::kFault); }, 30.0));
   const auto rx = r.cell->can_driver()->counters().rx_frames;
   EXPECT_TRUE(eventually([&] { return r.cell->can_driver()->counters().rx_frames > rx + 1000; }, 30.0))
@@ -427,7 +446,8 @@ TEST(HilFaults, CanBusOffTripsToTheSafeStateAtOnce) {
 
 TEST(HilFaults, ModbusHangingDuringARunTripsOnTheAmplifierStatus) {
   const HilFiles f = hil_files("modbushang", kSharedMachine);
-  Child plant({"plant", "--config", f.config, "--no-impacts", "--modbus-hang-at", "6", "--json", f.plant_json}, f.plant_log);
+  Child plant({"plant", "--config", f.config, "--no-impacts", "--modbus-hang-at", "6", "--json", f.plant_json},
+              f.plant_log);
   FaultRun r(f.config);
   test::configure(*r.cell);
   ASSERT_TRUE(r.cell->activate(3600.0).ok());
@@ -452,9 +472,10 @@ TEST(HilFaults, ModbusHangingDuringARunTripsOnTheAmplifierStatus) {
   EXPECT_LE(t.safe - t.trip, ramp_ticks + 1);
   EXPECT_GE(trip_after_s, m.link_timeout_s - m.poll_period_s - 0.001) << "not before the link timeout";
   EXPECT_LE(trip_after_s, m.link_timeout_s + m.poll_period_s + 0.5);
-  std::printf("[ hil mb   ] Modbus hang: trip %.1f ms, safe %.1f ms after the device stopped answering "
-              "(link_timeout_s %.0f ms)\n",
-              1e3 * trip_after_s, 1e3 * safe_after_s, 1e3 * m.link_timeout_s);
+  std::printf(
+      "[ hil mb   ] Modbus hang: trip %.1f ms, safe %.1f ms after the device stopped answering "
+      "(link_timeout_s %.0f ms)\n",
+      1e3 * trip_after_s, 1e3 * safe_after_s, 1e3 * m.link_timeout_s);
 }
 
 }  // namespace

@@ -69,8 +69,9 @@ TEST(HilCut, TheEmulatorsRegenerativeCutAgreesWithTheInProcessCutBothWays) {
   EXPECT_NEAR(chatter.hil["chatter_hz"].get<double>(), chatter.in_process["chatter_hz"].get<double>(), 0.2);
   // The same regeneration: the once-per-tooth differences at the same share of the motion (the emulator's
   // record has the drives' 3 Hz vibration fitted out; the in-process plant has none).
-  EXPECT_NEAR(chatter.hil["once_per_tooth_ratio"].get<double>() / chatter.in_process["once_per_tooth_ratio"].get<double>(),
-              1.0, 0.1);
+  EXPECT_NEAR(
+      chatter.hil["once_per_tooth_ratio"].get<double>() / chatter.in_process["once_per_tooth_ratio"].get<double>(), 1.0,
+      0.1);
 }
 
 // The critical depth by bisection across processes (`cut --critical --hil CELL`, each step a pair of
@@ -96,9 +97,9 @@ TEST(HilCut, TheCriticalDepthAcrossProcessesMatchesTheInProcessOne) {
 // judged by the detector; the surface carries over, so the cut goes on where the last left it.
 TEST(HilCut, TheRobotProgramChangesSpeedAndDepthDuringTheCut) {
   const test::HilFiles f = test::hil_files("regen_program");
-  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", "700",
-               "--cut-axial-mm", "0.85", "--cut-revs", "60", "--cut-at", "1", "--spindle", "5:666.7", "--depth-ramp",
-               "8:9:0.6", "--json", f.plant_json},
+  Child plant({"plant",     "--config", f.config,         "--pacing", "lockstep",   "--no-impacts", "--cut",    kJob,
+               "--cut-rpm", "700",      "--cut-axial-mm", "0.85",     "--cut-revs", "60",           "--cut-at", "1",
+               "--spindle", "5:666.7",  "--depth-ramp",   "8:9:0.6",  "--json",     f.plant_json},
               f.plant_log);
   Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", "16", "--json", f.run_json}, f.run_log);
   ASSERT_EQ(run.wait(), 0) << test::read_file(f.run_log);
@@ -124,14 +125,14 @@ TEST(HilCut, TheRobotProgramChangesSpeedAndDepthDuringTheCut) {
 // The cell that cuts and follows the advice: the robot publishes the spindle speed, the depth it cuts and
 // reads the advice block; spindle.job gives robodamp run the live limits; the emulated robot follows.
 // gain: the damper's (0: open loop); rpm_max: the spindle's.
-test::HilFiles advice_cell(const std::string& name, const std::string& gain = "2000", const std::string& rpm_max = "1500",
-                           const std::string& apply_advice = "true") {
+test::HilFiles advice_cell(const std::string& name, const std::string& gain = "2000",
+                           const std::string& rpm_max = "1500", const std::string& apply_advice = "true") {
   return test::hil_files(name, {{"    mounting_register: 0\n",
                                  "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"
                                  "    depth_register: 2\n    advice_register: 4\n"},
                                 {"  gain_ns_per_m: 2000 ", "  gain_ns_per_m: " + gain + " "},
                                 {"\nhil: ", "\nspindle:\n  teeth: 3\n  rpm_max: " + rpm_max + "\n  job: " + kJob +
-                                               "\n  apply_advice: " + apply_advice + "\n\nhil: "}});
+                                                "\n  apply_advice: " + apply_advice + "\n\nhil: "}});
 }
 
 struct AdviceRun {
@@ -155,21 +156,38 @@ struct AdviceCase {
 AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_mm, bool drives_off,
                              const std::string& plant_config = "", const std::string& rpm = "700") {
   AdviceCase c{f, nullptr, nullptr};
-  std::vector<std::string> plant_args{"plant", "--config", plant_config.empty() ? f.config : plant_config, "--pacing",
-                                      "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", rpm, "--cut-axial-mm",
-                                      depth_mm, "--cut-revs", "60", "--cut-at", "2", "--cut-until-advice", "--json",
+  std::vector<std::string> plant_args{"plant",
+                                      "--config",
+                                      plant_config.empty() ? f.config : plant_config,
+                                      "--pacing",
+                                      "lockstep",
+                                      "--no-impacts",
+                                      "--cut",
+                                      kJob,
+                                      "--cut-rpm",
+                                      rpm,
+                                      "--cut-axial-mm",
+                                      depth_mm,
+                                      "--cut-revs",
+                                      "60",
+                                      "--cut-at",
+                                      "2",
+                                      "--cut-until-advice",
+                                      "--json",
                                       f.plant_json};
   if (drives_off) plant_args.push_back("--drives-off");
   c.plant = std::make_unique<Child>(plant_args, f.plant_log);
-  c.run = std::make_unique<Child>(
-      std::vector<std::string>{"run", "--config", f.config, "--clock", "virtual", "--duration", "600", "--json", f.run_json},
-      f.run_log);
+  c.run = std::make_unique<Child>(std::vector<std::string>{"run", "--config", f.config, "--clock", "virtual",
+                                                           "--duration", "600", "--json", f.run_json},
+                                  f.run_log);
   return c;
 }
 // Waits (up to 110 s) for `line` in the emulator's log, ends the controller with Ctrl-C, and reads both reports.
 AdviceRun finish_after(AdviceCase& c, const std::string& line) {
-  EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 110.0))
-      << line << " not in\n" << test::read_file(c.files.plant_log);
+  EXPECT_TRUE(
+      test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 110.0))
+      << line << " not in\n"
+      << test::read_file(c.files.plant_log);
   c.run->kill(SIGINT);
   AdviceRun r;
   r.run_exit = c.run->wait();
@@ -197,7 +215,8 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
     bool drives_off;
   };
   // One cell after the other (the two at once share CI's 2 cores with the analyses).
-  for (const Case& k : {Case{"advice_damped", "2000", "0.85", 0.85, false}, Case{"advice_open", "0", "1.3", 1.3, true}}) {
+  for (const Case& k :
+       {Case{"advice_damped", "2000", "0.85", 0.85, false}, Case{"advice_open", "0", "1.3", 1.3, true}}) {
     SCOPED_TRACE(k.name);
     AdviceCase one = start_advice_case(advice_cell(k.name, k.gain), k.depth_text, k.drives_off);
     AdviceCase* c = &one;
@@ -221,7 +240,8 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
     // The cut ends at the last advised speed, at the same depth, stable, its 60 revolutions done.
     const json& last = segments.back();
     EXPECT_EQ(last["cause"], "advice");
-    EXPECT_NEAR(last["rpm"].get<double>(), advice.back()["rpm"].get<double>(), 0.01 * advice.back()["rpm"].get<double>());
+    EXPECT_NEAR(last["rpm"].get<double>(), advice.back()["rpm"].get<double>(),
+                0.01 * advice.back()["rpm"].get<double>());
     EXPECT_NEAR(last["start_s"].get<double>(), advice.back()["plant_time_s"].get<double>(), 0.02);
     EXPECT_DOUBLE_EQ(last["axial_mm"].get<double>(), depth);
     EXPECT_TRUE(cut["complete"].get<bool>()) << cut.dump(1);
@@ -252,19 +272,21 @@ TEST(HilCut, AChatteringCutFollowsTheAdviceAndEndsStableAtTheSameDepth) {
 TEST(HilCut, TheLiveIndicatorAndRobodampChatterAgreeOnARecordedRun) {
   const test::HilFiles f = advice_cell("listen_live", "0", "1500", "false");
   const std::string rec = f.dir + "/run.rdrec", listened = f.dir + "/chatter.json";
-  Child plant({"plant", "--config", f.config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", "700",
-               "--cut-axial-mm", "1.3", "--cut-revs", "320", "--cut-at", "2", "--spindle", "14:666.7", "--drives-off", "--json",
-               f.plant_json},
+  Child plant({"plant",    "--config",  f.config,    "--pacing",       "lockstep",     "--no-impacts", "--cut",
+               kJob,       "--cut-rpm", "700",       "--cut-axial-mm", "1.3",          "--cut-revs",   "320",
+               "--cut-at", "2",         "--spindle", "14:666.7",       "--drives-off", "--json",       f.plant_json},
               f.plant_log);
-  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", "30", "--record", rec, "--json", f.run_json},
-            f.run_log);
+  Child run(
+      {"run", "--config", f.config, "--clock", "virtual", "--duration", "30", "--record", rec, "--json", f.run_json},
+      f.run_log);
   ASSERT_EQ(run.wait(), 0) << test::read_file(f.run_log);
   plant.kill(SIGINT);
   plant.wait();
   const std::string log = test::read_file(f.run_log);
   // The live verdicts: (loop time, chatter) at each change.
   std::vector<std::pair<double, bool>> live;
-  for (std::size_t at = log.find("machining: chatter"); at != std::string::npos; at = log.find("machining: chatter", at + 1)) {
+  for (std::size_t at = log.find("machining: chatter"); at != std::string::npos;
+       at = log.find("machining: chatter", at + 1)) {
     const bool ended = log.compare(at, 24, "machining: chatter ended") == 0;
     const std::size_t t = ended ? at + 28 : log.find(" Hz at ", at) + 7;
     live.emplace_back(std::stod(log.substr(t)), !ended);
@@ -289,8 +311,8 @@ TEST(HilCut, TheLiveIndicatorAndRobodampChatterAgreeOnARecordedRun) {
       near_change = near_change || std::abs(t - end) < 0.3;
       if (t <= end) state = c;
     }
-    table += std::to_string(end) + " s: " + w["verdict"].get<std::string>() + ", live " + (state ? "chatter" : "quiet") +
-             (near_change ? " (near a change)\n" : "\n");
+    table += std::to_string(end) + " s: " + w["verdict"].get<std::string>() + ", live " +
+             (state ? "chatter" : "quiet") + (near_change ? " (near a change)\n" : "\n");
     const bool speed_change = end - 4.0 < 14.1 && end > 14.0;  // the register's 50 ms
     if (near_change || speed_change || w["verdict"] == "not enough signal") continue;
     ++judged;
@@ -313,8 +335,10 @@ TEST(HilCut, TheLiveIndicatorAndRobodampChatterAgreeOnARecordedRun) {
 TEST(HilCut, NoStableSpeedOrOneTheSpindleCannotReachKeepsTheSpeed) {
   test::HilFiles none_files = advice_cell("advice_none");
   std::string job = test::read_file(kJob);
-  test::replace_or_throw(job, "  rpm_min: 100\n  rpm_max: 1500\n  points: 2000", "  rpm_min: 690\n  rpm_max: 710\n  points: 2000");
-  test::replace_or_throw(job, "config: ../presets/", std::string("config: ") + ROBODAMP_SOURCE_DIR + "/config/presets/");
+  test::replace_or_throw(job, "  rpm_min: 100\n  rpm_max: 1500\n  points: 2000",
+                         "  rpm_min: 690\n  rpm_max: 710\n  points: 2000");
+  test::replace_or_throw(job, "config: ../presets/",
+                         std::string("config: ") + ROBODAMP_SOURCE_DIR + "/config/presets/");
   const std::string narrow_job = none_files.dir + "/narrow_job.yaml";
   std::ofstream(narrow_job) << job;
   std::string cell = test::read_file(none_files.config);
@@ -350,24 +374,29 @@ struct DerateRun {
 DerateRun derate_across_processes(const std::string& name, const std::string& depth_mm, const std::string& wiring,
                                   const std::string& duration_s, bool scheduled = false) {
   std::vector<std::pair<std::string, std::string>> edits{
-      {"    mounting_register: 0\n", "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"}};
+      {"    mounting_register: 0\n",
+       "    mounting_register: 0\n    spindle_rpm_register: 1\n    rpm_per_count: 0.1\n"}};
   if (scheduled) {
     const std::string preset = test::read_file(test::preset("horizontal_c2"));
     const std::size_t from = preset.find("\n  speed_schedule:") + 1, to = preset.find("\nrobot:", from) + 1;
     edits.push_back({"  gain_ramp_s: 0.5\n", "  gain_ramp_s: 0.5\n" + preset.substr(from, to - from)});
     // Chosen by speed, not also by the mounting (the configuration refuses both).
-    edits.push_back({"parameter_sets:            # the robot's mounting register selects the set (with the supervisor's fade)\n"
-                     "  vertical: " + std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/vertical_c1.yaml\n", ""});
+    edits.push_back(
+        {"parameter_sets:            # the robot's mounting register selects the set (with the supervisor's fade)\n"
+         "  vertical: " +
+             std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/vertical_c1.yaml\n",
+         ""});
   }
   const test::HilFiles f = test::hil_files(name, edits);
   std::string text = test::read_file(f.config);  // the emulator's copy: the same socket and port
   test::replace_or_throw(text, "\nplant:\n", "\nplant:\n  actuator_wiring: " + wiring + "\n");
   const std::string plant_config = f.dir + "/hil_plant.yaml";
   std::ofstream(plant_config) << text;
-  Child plant({"plant", "--config", plant_config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm", "700",
-               "--cut-axial-mm", depth_mm, "--cut-revs", "120", "--cut-at", "2", "--json", f.plant_json},
+  Child plant({"plant", "--config", plant_config, "--pacing", "lockstep", "--no-impacts", "--cut", kJob, "--cut-rpm",
+               "700", "--cut-axial-mm", depth_mm, "--cut-revs", "120", "--cut-at", "2", "--json", f.plant_json},
               f.plant_log);
-  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", duration_s, "--json", f.run_json}, f.run_log);
+  Child run({"run", "--config", f.config, "--clock", "virtual", "--duration", duration_s, "--json", f.run_json},
+            f.run_log);
   const int run_exit = run.wait(), plant_exit = plant.wait();
   const std::string logs = test::read_file(f.plant_log) + test::read_file(f.run_log);
   EXPECT_EQ(plant_exit, 0) << logs;
@@ -410,7 +439,8 @@ void expect_refused(const test::HilFiles& f, const std::string& name, const std:
   const std::string log = f.dir + "/" + name + ".log";
   Child plant(args, log);
   EXPECT_EQ(plant.wait(), 2) << name;
-  for (const auto& text : says) EXPECT_NE(test::read_file(log).find(text), std::string::npos) << text << " in\n" << test::read_file(log);
+  for (const auto& text : says)
+    EXPECT_NE(test::read_file(log).find(text), std::string::npos) << text << " in\n" << test::read_file(log);
 }
 
 TEST(HilCut, BadCutOptionsAreRefusedByName) {

@@ -44,8 +44,12 @@ TEST(IdentifyCutting, RecoversKnownCoefficientsInSlottingAndAtQuarterImmersion) 
   for (const CuttingTest& t : {CuttingTest{3, 12.7, 2.0, 12.7, config::MillingMode::kDown},
                                CuttingTest{3, 12.7, 2.0, 3.175, config::MillingMode::kDown}}) {
     const identify::CuttingFit f = identify::identify_cutting(generated(t, {0.05, 0.075, 0.1, 0.125, 0.15}), t);
-    for (const auto& [got, want] : {std::pair{f.ktc.value, kTc}, {f.krc.value, kRc}, {f.kac.value, kAc},
-                                    {f.kte.value, kTe}, {f.kre.value, kRe}, {f.kae.value, kAe}})
+    for (const auto& [got, want] : {std::pair{f.ktc.value, kTc},
+                                    {f.krc.value, kRc},
+                                    {f.kac.value, kAc},
+                                    {f.kte.value, kTe},
+                                    {f.kre.value, kRe},
+                                    {f.kae.value, kAe}})
       EXPECT_NEAR(got, want, 1e-6 * want) << t.radial_mm << " mm radial";
     EXPECT_NEAR(f.r2_xy, 1.0, 1e-12);
     EXPECT_LT(f.residual_rms_n, 1e-9);
@@ -82,7 +86,8 @@ TEST(IdentifyCutting, RefusesNearlyEqualFeedsTooFewPointsAndNaN) {
     (void)identify::identify_cutting(generated(t, {0.1, 0.100001, 0.100002}), t);
     ADD_FAILURE() << "nearly equal feeds were accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("collinear regressors: the condition number of the regression is"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("collinear regressors: the condition number of the regression is"),
+              std::string::npos)
         << e.what();
   }
   EXPECT_THROW((void)identify::identify_cutting(generated(t, {0.1, 0.2}), t), std::invalid_argument);
@@ -130,7 +135,8 @@ TEST(IdentifyModes, SeparatesCloseModesUnderOnePercentNoise) {
     EXPECT_NEAR(got.natural_freq_hz, want.natural_freq_hz, 0.005 * want.natural_freq_hz);
     EXPECT_NEAR(got.damping_ratio, want.damping_ratio, 0.05 * want.damping_ratio);
     const double mag = std::hypot(want.residue_re_m_per_n, want.residue_im_m_per_n);
-    EXPECT_NEAR(std::hypot(got.residue_re - want.residue_re_m_per_n, got.residue_im - want.residue_im_m_per_n), 0.0, 0.05 * mag);
+    EXPECT_NEAR(std::hypot(got.residue_re - want.residue_re_m_per_n, got.residue_im - want.residue_im_m_per_n), 0.0,
+                0.05 * mag);
   }
   std::printf("fit error %.3f %%\n", fit.fit_error_pct);
   EXPECT_LT(fit.fit_error_pct, 2.0);  // the noise is 1 %
@@ -203,8 +209,9 @@ TEST(IdentifyBallEnd, RecoversCubicShearAndEdgeCoefficientsFromSlotMeanForces) {
   std::printf("condition number %.3g\n", f.condition_number);
   // The mean does not depend on the helix in the shear terms; the edge terms' dS does.
   const identify::BallEndTest steep{8, 4.0, 45.0, 3};
-  EXPECT_NEAR(identify::ball_end_mean_forces(steep, 1.0, 0.02, {{800, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, 0, 0, 0}).fy_n,
-              identify::ball_end_mean_forces(t, 1.0, 0.02, {{800, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, 0, 0, 0}).fy_n, 1e-12);
+  EXPECT_NEAR(
+      identify::ball_end_mean_forces(steep, 1.0, 0.02, {{800, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, 0, 0, 0}).fy_n,
+      identify::ball_end_mean_forces(t, 1.0, 0.02, {{800, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, 0, 0, 0}).fy_n, 1e-12);
 }
 
 TEST(IdentifyBallEnd, RefusesWhatCannotBeSeparated) {
@@ -233,11 +240,12 @@ TEST(IdentifyBallEnd, RefusesWhatCannotBeSeparated) {
 // The ball-end bone study's own slot runs (config/milling/data/ball_end_bone_slot_milling.csv): the fit runs and reports that
 // the shear coefficients are not determined (the forces hardly change with the feed: edge forces dominate).
 TEST(IdentifyBallEnd, BallEndBoneSlotRunsDoNotDetermineTheShearCoefficients) {
-  const auto runs = identify::read_ball_end_csv(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/data/ball_end_bone_slot_milling.csv");
+  const auto runs = identify::read_ball_end_csv(std::string(ROBODAMP_SOURCE_DIR) +
+                                                "/config/milling/data/ball_end_bone_slot_milling.csv");
   ASSERT_EQ(runs.size(), 10u);
   const identify::BallEndFit f = identify::identify_ball_end(runs, {8, 4.0, 30.0, 3});
-  std::printf("the ball-end bone study, cubic: Ktc0 %.4g +- %.3g, Kte %.3g +- %.3g N/mm, R^2 %.3f / %.3f, cond %.3g\n", f.ktc[0].value,
-              f.ktc[0].ci95, f.kte.value, f.kte.ci95, f.r2_y, f.r2_xz, f.condition_number);
+  std::printf("the ball-end bone study, cubic: Ktc0 %.4g +- %.3g, Kte %.3g +- %.3g N/mm, R^2 %.3f / %.3f, cond %.3g\n",
+              f.ktc[0].value, f.ktc[0].ci95, f.kte.value, f.kte.ci95, f.r2_y, f.r2_xz, f.condition_number);
   EXPECT_GT(f.ktc[0].ci95, std::abs(f.ktc[0].value));
   EXPECT_GT(f.kte.value, 1.0);
   EXPECT_LT(f.kte.value, 2.5);
@@ -246,4 +254,3 @@ TEST(IdentifyBallEnd, BallEndBoneSlotRunsDoNotDetermineTheShearCoefficients) {
 }
 
 }  // namespace
-

@@ -68,8 +68,8 @@ TEST(LivePose, TheLimitsAreForTheRobotWhereItStands) {
   for (const auto* l : {&folded, &stretched}) {
     // The open limit is the robot model's at that pose, as `lobes --pose` gives it.
     const double whole = exact_open_mm(c.job, l->pose_deg, l->open_mm);
-    std::cout << "open at " << config::describe_pose(l->pose_deg) << ": live " << l->open_mm << " mm, the model's " << whole
-              << " mm, the loop's plant (its three modes in the plane) " << l->loop_open_mm << " mm\n";
+    std::cout << "open at " << config::describe_pose(l->pose_deg) << ": live " << l->open_mm << " mm, the model's "
+              << whole << " mm, the loop's plant (its three modes in the plane) " << l->loop_open_mm << " mm\n";
     EXPECT_NEAR(l->open_mm, whole, 1e-6 * whole);
     // The loop's plant holds the robot in both directions of the plane: its open limit is the whole
     // model's (the cut feels the feed direction too: along the actuator's axis alone, 1.50 mm folded
@@ -93,7 +93,8 @@ TEST(LivePose, TheLimitsAreForTheRobotWhereItStands) {
   // The set's loop at the pose, not at its region's centre: the stretched set's plant is the model's there,
   // and along the actuator (H11) the 1-D table the set was designed with (pose_modes).
   const config::Config at = live.loop_config(1, kStretched);
-  const auto modes = analysis::pose_modes(c.schedule.model, kStretched, c.cfg.pose_schedule->axis, c.cfg.pose_schedule->modes);
+  const auto modes =
+      analysis::pose_modes(c.schedule.model, kStretched, c.cfg.pose_schedule->axis, c.cfg.pose_schedule->modes);
   ASSERT_EQ(at.robot.frfs.size(), 3U);
   ASSERT_EQ(at.robot.frfs.front().modes.size(), modes.modes.size());
   for (std::size_t i = 0; i < modes.modes.size(); ++i) {
@@ -158,9 +159,11 @@ TEST(LivePose, TheAdviceChecksEveryCandidateAtThePose) {
   }
   // The candidates are the pockets of the robot's modes at the pose (and the grid): the first mode's top
   // pocket, 60 f1 / N, is among them.
-  const auto modes = analysis::pose_modes(c.schedule.model, kStretched, c.cfg.pose_schedule->axis, c.cfg.pose_schedule->modes);
+  const auto modes =
+      analysis::pose_modes(c.schedule.model, kStretched, c.cfg.pose_schedule->axis, c.cfg.pose_schedule->modes);
   const double pocket = 60.0 * modes.modes.front().natural_freq_hz / c.job.tool.teeth;
-  const auto candidates = milling::advice_candidates(100.0, 1500.0, c.job.tool.teeth, 0.0, {modes.modes.front().natural_freq_hz}, 0);
+  const auto candidates =
+      milling::advice_candidates(100.0, 1500.0, c.job.tool.teeth, 0.0, {modes.modes.front().natural_freq_hz}, 0);
   ASSERT_FALSE(candidates.empty());
   EXPECT_NEAR(candidates.back().rpm, pocket, 0.5);
   EXPECT_GT(a.evaluated, s.grid_points + candidates.size() - 1);
@@ -186,7 +189,8 @@ TEST(LivePose, TheAdviceChecksEveryCandidateAlongThePathAhead) {
   int asked_at = 0;
   const auto controller_at_pose = [&](const std::vector<double>& pose, double) {
     ++asked_at;
-    return pose == kStretched ? std::pair<std::size_t, double>{1, c.schedule.regions[1].gain_ns_per_m} : std::pair<std::size_t, double>{0, k};
+    return pose == kStretched ? std::pair<std::size_t, double>{1, c.schedule.regions[1].gain_ns_per_m}
+                              : std::pair<std::size_t, double>{0, k};
   };
   // A depth some speeds allow along the whole path: the best speed's limit along it, less 20 %.
   milling::SpeedAdviceRequest probe = r;
@@ -218,8 +222,10 @@ TEST(LivePose, TheAdviceChecksEveryCandidateAlongThePathAhead) {
   // At the folded pose alone some advised speeds would not hold at the stretched pose ahead.
   int fail_ahead = 0;
   for (const auto& o : here.options) fail_ahead += open_at(o.rpm, kStretched) < s.depth_margin * here.depth_mm ? 1 : 0;
-  std::cout << "folded alone: " << here.options.size() << " options, " << fail_ahead << " not stable at the stretched pose ahead; "
-            << "along the path: " << along.options.size() << " options" << (along.found ? "" : ": " + along.reason) << "\n";
+  std::cout << "folded alone: " << here.options.size() << " options, " << fail_ahead
+            << " not stable at the stretched pose ahead; "
+            << "along the path: " << along.options.size() << " options" << (along.found ? "" : ": " + along.reason)
+            << "\n";
   EXPECT_GT(fail_ahead, 0);
   // Thinned evenly, first and last kept.
   std::vector<std::vector<double>> ten;
@@ -258,7 +264,8 @@ TEST(LivePose, ThePlaneLoopIsTheAxisLoopBesideAnOpenTableWhereTheyDoNotCouple) {
     const milling::Structure a(both, damped, loop), b(beside, damped, loop);
     const double da = milling::AccurateStability(a, c.job).critical(kRpm, 0.1).critical_depth_mm;
     const double db = milling::AccurateStability(b, c.job).critical(kRpm, 0.1).critical_depth_mm;
-    std::cout << (damped ? "damped" : "open") << ": across the plane " << da << " mm, along x beside a table " << db << " mm\n";
+    std::cout << (damped ? "damped" : "open") << ": across the plane " << da << " mm, along x beside a table " << db
+              << " mm\n";
     EXPECT_NEAR(da, db, 1e-6 * db);
   }
 }

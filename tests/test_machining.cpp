@@ -62,7 +62,8 @@ TEST(LiveStability, LimitsAtASpeedAreTheJobsAccurateLimitsThere) {
   for (const double rpm : {350.0, 700.0, 1200.0}) {
     std::optional<milling::LiveLimits> l;
     EXPECT_FALSE(live.lookup(rpm, 0, cfg.controller.gain_ns_per_m).has_value()) << "computed off the caller's thread";
-    ASSERT_TRUE(test::eventually([&] { return (l = live.lookup(rpm, 0, cfg.controller.gain_ns_per_m)).has_value(); }, 120.0));
+    ASSERT_TRUE(
+        test::eventually([&] { return (l = live.lookup(rpm, 0, cfg.controller.gain_ns_per_m)).has_value(); }, 120.0));
     EXPECT_NEAR(l->open_mm / open_truth.critical(rpm, l->open_mm).critical_depth_mm, 1.0, 2e-3) << rpm;
     const milling::SdmPoint d = damped_truth.critical(rpm, l->damped_mm);
     EXPECT_NEAR(l->damped_mm / d.critical_depth_mm, 1.0, 2e-3) << rpm;
@@ -108,7 +109,8 @@ TEST(LiveStability, ABandsDepthLimitCapsTheLimitTheCellPublishesThere) {
   EXPECT_DOUBLE_EQ(l.open_mm, free.open_mm);
   EXPECT_DOUBLE_EQ(capped.compute(390.6, 0, 1000.0).damped_mm, plain.compute(390.6, 0, 1000.0).damped_mm)
       << "another K than the band's: not the limit the band vouches for";
-  EXPECT_DOUBLE_EQ(capped.compute(700.0, 0, 2000.0).damped_mm, plain.compute(700.0, 0, 2000.0).damped_mm) << "another band";
+  EXPECT_DOUBLE_EQ(capped.compute(700.0, 0, 2000.0).damped_mm, plain.compute(700.0, 0, 2000.0).damped_mm)
+      << "another band";
   // The schedule's lobes at the same speed, as `lobes --damped` and the cut's verdict compute them.
   config::StructureConfig sc = *job.find_structure(job.structure);
   const std::vector<milling::SdmPoint> open(1, milling::SdmPoint{390.6, free.open_mm});
@@ -125,8 +127,8 @@ TEST(LiveStability, HarmonicNotchesAtTheSpeedEnterTheDampedLimit) {
   const auto a700 = a.compute(700.0, 0, 2000.0), b700 = b.compute(700.0, 0, 2000.0);
   EXPECT_EQ(a700.open_mm, b700.open_mm);
   EXPECT_GT(std::abs(b700.damped_mm / a700.damped_mm - 1.0), 1e-3) << a700.damped_mm << " " << b700.damped_mm;
-  std::printf("700 rpm: open %.3f mm, damped %.3f mm, with the notches %.3f mm (docs/harmonic_notch.md)\n", a700.open_mm,
-              a700.damped_mm, b700.damped_mm);
+  std::printf("700 rpm: open %.3f mm, damped %.3f mm, with the notches %.3f mm (docs/harmonic_notch.md)\n",
+              a700.open_mm, a700.damped_mm, b700.damped_mm);
   const auto a12k = a.compute(12000.0, 0, 2000.0), b12k = b.compute(12000.0, 0, 2000.0);
   EXPECT_NEAR(b12k.damped_mm / a12k.damped_mm, 1.0, 1e-3);
 }
@@ -181,7 +183,8 @@ TEST(SpeedAdvice, AdvisedSpeedsAreStableAtTheDepthByTheAccurateMethodAndInTheTim
   milling::LiveStability fresh(job, "", {cfg});
   double last_distance = 0.0;
   for (const auto& o : a.options) {
-    std::printf("[ advice   ]   %.1f rpm: limit %.3f mm (margin %.2f, %s)\n", o.rpm, o.limit_mm, o.margin, o.source.c_str());
+    std::printf("[ advice   ]   %.1f rpm: limit %.3f mm (margin %.2f, %s)\n", o.rpm, o.limit_mm, o.margin,
+                o.source.c_str());
     EXPECT_GE(o.margin, 1.15);
     EXPECT_GE(std::abs(o.rpm - 700.0), last_distance);
     last_distance = std::abs(o.rpm - 700.0);
@@ -215,7 +218,8 @@ TEST(SpeedAdvice, AdvisedSpeedsAreStableAtTheDepthByTheAccurateMethodAndInTheTim
   EXPECT_TRUE(measured.depth_from_chatter);
   EXPECT_DOUBLE_EQ(measured.depth_mm, measured.limit_now_mm);
   ASSERT_TRUE(measured.found) << measured.reason;
-  for (const auto& o : measured.options) EXPECT_GE(o.limit_mm, 1.3 * measured.limit_now_mm) << o.rpm;  // a lower bound: more margin
+  for (const auto& o : measured.options)
+    EXPECT_GE(o.limit_mm, 1.3 * measured.limit_now_mm) << o.rpm;  // a lower bound: more margin
 }
 
 TEST(LiveStability, AJobWithoutADampingLocationIsRefused) {
@@ -258,7 +262,8 @@ TEST(ChatterIndicator, ForcedVibrationIsQuietAndAnOffHarmonicModeIsChatter) {
     const double t = i / fs, since = t - 2.3;
     double forced = 0.0;
     for (int k = 1; k <= 12; ++k) forced += (1.0 / k) * std::sin(2.0 * M_PI * k * f_sp * t + 0.3 * k);
-    impact.push(forced + noise(rng) + (since >= 0.0 ? 3.0 * std::exp(-since / 0.87) * std::sin(2.0 * M_PI * 9.2 * since) : 0.0));
+    impact.push(forced + noise(rng) +
+                (since >= 0.0 ? 3.0 * std::exp(-since / 0.87) * std::sin(2.0 * M_PI * 9.2 * since) : 0.0));
   }
   const auto h = impact.evaluate(rpm);
   EXPECT_GT(h.nonharmonic_share, 0.1);
@@ -347,15 +352,17 @@ TEST(ChatterIndicator, SimulatedCutsBelowAndAboveTheLimit) {
     const auto v = m.evaluate(r.record.rpm);
     ASSERT_TRUE(v.valid) << depth;
     EXPECT_EQ(r.verdict.stable, depth < 1.113) << depth;
-    EXPECT_EQ(v.chatter, !r.verdict.stable) << depth << " mm: once-per-rev " << v.once_per_rev_ratio << ", non-harmonic "
-                                           << v.nonharmonic_share << ", " << v.nonharmonic_rms_mps2 << " m/s^2";
+    EXPECT_EQ(v.chatter, !r.verdict.stable)
+        << depth << " mm: once-per-rev " << v.once_per_rev_ratio << ", non-harmonic " << v.nonharmonic_share << ", "
+        << v.nonharmonic_rms_mps2 << " m/s^2";
     EXPECT_GT(v.nonharmonic_share, share_before) << depth << " mm: the non-harmonic share grows with the depth";
     share_before = v.nonharmonic_share;
     if (v.chatter) {
       EXPECT_NEAR(v.chatter_hz, r.verdict.chatter_hz, 1.0 / 3.0);  // within the window's bins
     }
     std::printf("%.1f mm: cut %s, indicator %s (non-harmonic share %.3f, once-per-rev %.3f)\n", depth,
-                r.verdict.stable ? "stable" : "chatters", v.chatter ? "chatter" : "quiet", v.nonharmonic_share, v.once_per_rev_ratio);
+                r.verdict.stable ? "stable" : "chatters", v.chatter ? "chatter" : "quiet", v.nonharmonic_share,
+                v.once_per_rev_ratio);
   }
 }
 
@@ -377,7 +384,7 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_EQ(m.depth_mm, depth);
     EXPECT_FALSE(m.depth_measured) << "no robot reports a depth: the job's planned depth, said as such";
     ASSERT_TRUE(m.limits_ready);
-    EXPECT_NEAR(m.open_limit_mm, 1.111, 0.002);   // SDM
+    EXPECT_NEAR(m.open_limit_mm, 1.111, 0.002);  // SDM
     // The sampled loop's SDM with the preset's speed schedule at 700 rpm: C1 at K 3040 (the header's 2.350 mm;
     // C2 at the fixed K 2000 gave 0.782 mm, below the open loop).
     EXPECT_NEAR(m.damped_limit_mm, 2.350, 0.002);
@@ -393,7 +400,8 @@ TEST(MachiningMonitor, TheCellReportsSpeedDepthLimitsAndWarns) {
     EXPECT_EQ(m.cutting_reason, "no tooth-passing lines in the vibration");
     // While the damper is active the damped limit applies: 1.5 mm is above it.
     milling::LiveStability& live = cell.machining()->stability();
-    EXPECT_EQ(live.compute(700.0, 1, config::scheduled_gain_ns_per_m(config::speed_controller_config(cfg, 1), 1, 700.0)).damped_mm,
+    EXPECT_EQ(live.compute(700.0, 1, config::scheduled_gain_ns_per_m(config::speed_controller_config(cfg, 1), 1, 700.0))
+                  .damped_mm,
               m.damped_limit_mm);
   }
 }
@@ -406,7 +414,8 @@ TEST(MachiningMonitor, TheCuttingStateSaysWhatSaysSo) {
   chatter.valid = true, chatter.chatter = true;
   EXPECT_EQ(runtime::cutting_state(0.0, true, 1.0, lines).reason, "spindle stopped");
   EXPECT_EQ(runtime::cutting_state(0.0, true, 1.0, lines).state, dds::kNotCutting);
-  EXPECT_EQ(runtime::cutting_state(700.0, true, 0.0, chatter).state, dds::kNotCutting) << "the robot says it is out of the cut";
+  EXPECT_EQ(runtime::cutting_state(700.0, true, 0.0, chatter).state, dds::kNotCutting)
+      << "the robot says it is out of the cut";
   EXPECT_EQ(runtime::cutting_state(700.0, true, 0.8, quiet).state, dds::kCutting) << "the robot says it cuts";
   EXPECT_EQ(runtime::cutting_state(700.0, false, 0.8, collecting).state, dds::kCuttingUnknown);
   EXPECT_EQ(runtime::cutting_state(700.0, false, 0.8, lines).state, dds::kCutting);
@@ -495,8 +504,8 @@ TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
 // robot's spindle modes at 2.4-6.6 kHz; its SDM chatter at 10 700 rpm is at 5486 Hz) is said at once, the
 // modes named; the default job's (9.2-23.5 Hz) are all heard. Only the structure the cell uses counts.
 TEST(MachiningMonitor, TheJobsModesAboveTheIndicatorsBandAreSaid) {
-  const config::MillingConfig robot = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) +
-                                                                  "/config/milling/industrial_robot_aluminium.yaml");
+  const config::MillingConfig robot =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/industrial_robot_aluminium.yaml");
   const std::vector<double> above = milling::modes_above_band(robot, "", 5000.0);
   ASSERT_EQ(above.size(), 14U);  // of robot_workpiece's, 2404-6629 Hz (2223.8 Hz is heard)
   EXPECT_EQ(above.front(), 2404.0);

@@ -66,11 +66,13 @@ UffFile sample_file() {
   UffFunction history;  // a real time history, uneven
   history.function_type = mf::kUffTimeResponse, history.is_complex = false;
   history.abscissa = {mf::kUffTime, 0, 0, 0, "Time", "s"};
-  for (int k = 0; k < 11; ++k) history.x.push_back(std::sqrt(k + 0.5)), history.y.emplace_back(std::sin(k) * 3.3e-7, 0.0);
+  for (int k = 0; k < 11; ++k)
+    history.x.push_back(std::sqrt(k + 0.5)), history.y.emplace_back(std::sin(k) * 3.3e-7, 0.0);
   file.functions = {frf, coherence, uneven, history};
   mf::UffMode mode;
   mode.number = 2, mode.eigenvalue = {-1.5, 62.8}, mode.modal_a = {1.0, 0.0};
-  mode.shape = {{1, {std::complex<double>{0.0, 0.0}, {1e-3, -2e-4}, {0.0, 0.0}}}, {2, {std::complex<double>{0.0, 0.0}, {-5e-4, 1e-4}, {0.0, 0.0}}}};
+  mode.shape = {{1, {std::complex<double>{0.0, 0.0}, {1e-3, -2e-4}, {0.0, 0.0}}},
+                {2, {std::complex<double>{0.0, 0.0}, {-5e-4, 1e-4}, {0.0, 0.0}}}};
   file.modes = {mode};
   return file;
 }
@@ -136,7 +138,8 @@ TEST(Uff, ReadsHandWrittenLayoutsOfTheSpecification) {
       "    -1\n"
       "    -1\n"
       "    58\n"
-      "Pr\xc3\xbc""fstand \xc2\xb5-Test\nNONE\n27-Nov-26 10:00:00\nNONE\nNONE\n"
+      "Pr\xc3\xbc"
+      "fstand \xc2\xb5-Test\nNONE\n27-Nov-26 10:00:00\nNONE\nNONE\n"
       "    4    1    1         0 NONE               3   2 NONE               1   2\n"
       "         5         3         1  1.00000E+01  2.50000E-01  0.00000E+00\n"
       "        18    0    0    0 Frequency            Hz                  \n"
@@ -149,7 +152,9 @@ TEST(Uff, ReadsHandWrittenLayoutsOfTheSpecification) {
   EXPECT_EQ(a.skipped_datasets, (std::vector<int>{151, 164}));
   ASSERT_EQ(a.functions.size(), 1u);
   const UffFunction& f = a.functions[0];
-  EXPECT_EQ(f.id[0], "Pr\xc3\xbc""fstand \xc2\xb5-Test");
+  EXPECT_EQ(f.id[0],
+            "Pr\xc3\xbc"
+            "fstand \xc2\xb5-Test");
   EXPECT_EQ(f.response_node, 3);
   EXPECT_EQ(f.reference_node, 1);
   EXPECT_FALSE(f.double_precision);
@@ -275,13 +280,15 @@ TEST(Uff, RefusesWhatItCannotTakeNamingTheRecordAndField) {
   refused(bad_node, "f.uff:13: dataset 2 (type 58), record 6: field 6 (response node) 'x2' is not an integer");
   refused(good.substr(0, good.size() - 8), "not closed with -1");
   refused("hello\n", "a dataset opens with a line holding -1");
-  refused("    -1\n    58b     1     2          11        9999     0     0           0           0\n", "the header announces 9999 bytes");
+  refused("    -1\n    58b     1     2          11        9999     0     0           0           0\n",
+          "the header announces 9999 bytes");
   std::string nan = t;
   const std::size_t z_axis = nan.find("         0    0    0    0 NONE", r7);
   nan.replace(nan.find('\n', z_axis) + 5, 1, "n");
   refused(nan, "f.uff:19: dataset 2 (type 58): '");
   refused(nan, "' is not a number");
-  refused("    -1\n    58b     1     3          11           8     0     0           0           0\n", "only 2 (IEEE 754) is read");
+  refused("    -1\n    58b     1     3          11           8     0     0           0           0\n",
+          "only 2 (IEEE 754) is read");
 }
 
 // Random damage to a valid file (ASCII and binary) is refused or read, never a crash or a hang.
@@ -296,10 +303,18 @@ TEST(Uff, FuzzedFilesAreRefusedCleanly) {
       for (int e = 0; e < edits; ++e) {
         const std::size_t at = rng() % t.size();
         switch (rng() % 4) {
-          case 0: t[at] = static_cast<char>(rng() % 256); break;
-          case 1: t.erase(at, 1 + rng() % 40); break;
-          case 2: t = t.substr(0, at) + std::string(1 + rng() % 5, "-1 \n.E+9b"[rng() % 9]) + t.substr(at); break;
-          default: t.resize(at); break;
+          case 0:
+            t[at] = static_cast<char>(rng() % 256);
+            break;
+          case 1:
+            t.erase(at, 1 + rng() % 40);
+            break;
+          case 2:
+            t = t.substr(0, at) + std::string(1 + rng() % 5, "-1 \n.E+9b"[rng() % 9]) + t.substr(at);
+            break;
+          default:
+            t.resize(at);
+            break;
         }
         if (t.empty()) t.push_back('x');
       }
@@ -328,9 +343,11 @@ TEST(Table, ReadsTheDelimitersDecimalMarksHeadersAndUnitsPeopleSave) {
     EXPECT_DOUBLE_EQ(v[1][2], fy1) << what;
   };
   check("time_s,fx_n,fy_n\n0,1.5,-2\n0.001,2.5,-3e1\n", 0.001, 2.5, -30.0, "comma");
-  check("\xEF\xBB\xBFTime [ms];Fx [kN];Fy [kN]\r\n0;1,5;-2\r\n1;2,5;-0,125\r\n", 0.001, 2500.0, -125.0, "semicolon, decimal comma, BOM, CRLF");
+  check("\xEF\xBB\xBFTime [ms];Fx [kN];Fy [kN]\r\n0;1,5;-2\r\n1;2,5;-0,125\r\n", 0.001, 2500.0, -125.0,
+        "semicolon, decimal comma, BOM, CRLF");
   check("Time\tFx\tFy\n[s]\t[N]\t[lbf]\n0\t1\t1\n0,5\t2\t2\n", 0.5, 2.0, 2.0 * 4.4482216152605, "tab, units row");
-  check("Dynamometer export\nSample rate: 1000 Hz\n\n t (s)   Fx (N)  Fy (N)\n 0  1  2\n 1.25  -3  4\n", 1.25, -3.0, 4.0, "preamble, spaces");
+  check("Dynamometer export\nSample rate: 1000 Hz\n\n t (s)   Fx (N)  Fy (N)\n 0  1  2\n 1.25  -3  4\n", 1.25, -3.0,
+        4.0, "preamble, spaces");
   check("# no header\n0,1,2\n2,3,4\n", 2.0, 3.0, 4.0, "no header: by position");
   check("Fy;Fx;time;\n1;2;0;\n3;4;7;\n", 7.0, 4.0, 3.0, "columns by name, trailing delimiter");
   check("\"time\",\"fx\",\"fy\"\n\"0\",\"1\",\"2\"\n\"1\",\"1.000\",\"2\"\n", 1.0, 1.0, 2.0, "quoted");
@@ -357,17 +374,25 @@ TEST(Table, ReadsTheDelimitersDecimalMarksHeadersAndUnitsPeopleSave) {
 // Random damage to tables as people save them is refused with a reason or read consistently.
 TEST(Table, FuzzedTablesAreRefusedCleanly) {
   std::mt19937 rng(148);
-  const std::vector<mf::ColumnSpec> wanted = {{{"time"}, mf::Quantity::kTime}, {{"fx"}, mf::Quantity::kForce}, {{"fy"}, mf::Quantity::kForce}};
-  const std::string good = "\xEF\xBB\xBFpreamble: 1 kHz\r\nTime [ms];Fx [kN];Fy [N]\r\n0;1,5;-2\r\n1;2,5;-0,125\r\n2;3;4\r\n";
+  const std::vector<mf::ColumnSpec> wanted = {
+      {{"time"}, mf::Quantity::kTime}, {{"fx"}, mf::Quantity::kForce}, {{"fy"}, mf::Quantity::kForce}};
+  const std::string good =
+      "\xEF\xBB\xBFpreamble: 1 kHz\r\nTime [ms];Fx [kN];Fy [N]\r\n0;1,5;-2\r\n1;2,5;-0,125\r\n2;3;4\r\n";
   int refused = 0;
   for (int trial = 0; trial < 3000; ++trial) {
     std::string t = good;
     for (int e = 0; e < 1 + static_cast<int>(rng() % 3); ++e) {
       const std::size_t at = rng() % t.size();
       switch (rng() % 3) {
-        case 0: t[at] = ";,.\t\n\r -e[]()#x9"[rng() % 17]; break;
-        case 1: t.erase(at, 1 + rng() % 6); break;
-        default: t = t.substr(0, at) + static_cast<char>(rng() % 256) + t.substr(at); break;
+        case 0:
+          t[at] = ";,.\t\n\r -e[]()#x9"[rng() % 17];
+          break;
+        case 1:
+          t.erase(at, 1 + rng() % 6);
+          break;
+        default:
+          t = t.substr(0, at) + static_cast<char>(rng() % 256) + t.substr(at);
+          break;
       }
       if (t.empty()) t.push_back(';');
     }
@@ -413,8 +438,9 @@ TEST(Uff, IdentifyModesReadsTheRecordTheUserChooses) {
   const std::string uff = tmp.file("tap.uff"), json = tmp.file("modes.json");
   mf::write_uff(uff, file, mf::UffEncoding::kAscii);
   const auto& frf = cfg.robot.frfs[1];  // H21yy: records 3 (FRF) and 4 (coherence)
-  for (const std::string& choose : {std::string(" --record 3"), " --response " + std::to_string(frf.response_location) + ":+Y --reference " +
-                                                                    std::to_string(frf.excitation_location) + ":Y"}) {
+  for (const std::string& choose :
+       {std::string(" --record 3"), " --response " + std::to_string(frf.response_location) + ":+Y --reference " +
+                                        std::to_string(frf.excitation_location) + ":Y"}) {
     const Result r = run("identify modes --frf " + uff + choose + " --band-hz 5 40 --json " + json);
     ASSERT_EQ(r.status, 0) << r.out;
     EXPECT_NE(r.out.find("record 3: 2:+Y / 1:+Y, accelerance g/lbf read as m/s^2/N"), std::string::npos) << r.out;
@@ -422,8 +448,10 @@ TEST(Uff, IdentifyModesReadsTheRecordTheUserChooses) {
     const auto j = nlohmann::json::parse(robodamp::test::read_file(json));
     ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
     for (std::size_t i = 0; i < frf.modes.size(); ++i) {
-      EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz, 0.005 * frf.modes[i].natural_freq_hz);
-      EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.05 * frf.modes[i].damping_ratio);
+      EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz,
+                  0.005 * frf.modes[i].natural_freq_hz);
+      EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio,
+                  0.05 * frf.modes[i].damping_ratio);
     }
   }
   const Result ambiguous = run("identify modes --frf " + uff);
@@ -475,7 +503,8 @@ TEST(Uff, IdentifyAllCommissionsFromAModalPackagesExport) {
   for (double hz : act.x) {
     const std::complex<double> s(0.0, 2.0 * M_PI * hz);
     const double wa = 2.0 * M_PI * a.natural_freq_hz;
-    const std::complex<double> g = a.constant_n_per_v * s * s / (s * s + 2.0 * a.damping_ratio * wa * s + wa * wa) * std::exp(-s * a.delay_s);
+    const std::complex<double> g =
+        a.constant_n_per_v * s * s / (s * s + 2.0 * a.damping_ratio * wa * s + wa * wa) * std::exp(-s * a.delay_s);
     act.y.push_back(g / 4.4482216152605);
   }
   file.functions.push_back(act);
@@ -498,14 +527,16 @@ TEST(Uff, IdentifyAllCommissionsFromAModalPackagesExport) {
     ASSERT_NE(truth, nullptr) << f.name;
     ASSERT_EQ(f.modes.size(), truth->modes.size()) << f.name << "\n" << r.out;
     for (std::size_t k = 0; k < f.modes.size(); ++k)
-      EXPECT_NEAR(f.modes[k].natural_freq_hz, truth->modes[k].natural_freq_hz, 0.005 * truth->modes[k].natural_freq_hz) << f.name;
+      EXPECT_NEAR(f.modes[k].natural_freq_hz, truth->modes[k].natural_freq_hz, 0.005 * truth->modes[k].natural_freq_hz)
+          << f.name;
   }
   // Without the actuator's record: refused, naming what is needed.
   file.functions.pop_back();
   mf::write_uff(uff, file, mf::UffEncoding::kAscii);
   const Result missing = run("identify all --uff " + uff + " --config " + preset + " --out " + out);
   EXPECT_EQ(missing.status, 2) << missing.out;
-  EXPECT_NE(missing.out.find("the actuator needs an FRF per volt with reference node 2"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("the actuator needs an FRF per volt with reference node 2"), std::string::npos)
+      << missing.out;
 }
 
 // A hammer test's time histories in a universal file (binary, the time in ms, the force in kN, the
@@ -516,7 +547,8 @@ TEST(Uff, IdentifyModesFromTimeHistoriesInAUniversalFile) {
   const auto cfg = robodamp::config::load_config_file(robodamp::test::preset("horizontal_c2"));
   const robodamp::sim::PlantModel model = robodamp::sim::build_plant_model(cfg);
   robodamp::sim::Plant plant(model, cfg);
-  const std::size_t hammer = plant.add_excitation(std::make_unique<robodamp::sim::Noise>(0, 20.0, 5, 2.0, 60.0, cfg.loop.rate_hz));
+  const std::size_t hammer =
+      plant.add_excitation(std::make_unique<robodamp::sim::Noise>(0, 20.0, 5, 2.0, 60.0, cfg.loop.rate_hz));
   UffFunction force, accel;
   force.function_type = accel.function_type = mf::kUffTimeResponse;
   force.is_complex = accel.is_complex = false;
@@ -543,15 +575,21 @@ TEST(Uff, IdentifyModesFromTimeHistoriesInAUniversalFile) {
   const auto& frf = cfg.robot.frfs[0];  // H11yy
   ASSERT_EQ(j["modes"].size(), frf.modes.size()) << r.out;
   for (std::size_t i = 0; i < frf.modes.size(); ++i) {
-    EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz, 0.01 * frf.modes[i].natural_freq_hz) << r.out;
-    EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio, 0.1 * frf.modes[i].damping_ratio) << r.out;
+    EXPECT_NEAR(j["modes"][i]["natural_freq_hz"].get<double>(), frf.modes[i].natural_freq_hz,
+                0.01 * frf.modes[i].natural_freq_hz)
+        << r.out;
+    EXPECT_NEAR(j["modes"][i]["damping_ratio"].get<double>(), frf.modes[i].damping_ratio,
+                0.1 * frf.modes[i].damping_ratio)
+        << r.out;
   }
   // Two responses and no choice: refused, listing them.
   file.functions.push_back(accel);
   mf::write_uff(uff, file, mf::UffEncoding::kBinary);
   const Result two = run("identify modes --series " + uff + " --segment-s 20");
   EXPECT_EQ(two.status, 2) << two.out;
-  EXPECT_NE(two.out.find("2 time histories of a response match; choose one with --response NODE:DIR or --record N"), std::string::npos) << two.out;
+  EXPECT_NE(two.out.find("2 time histories of a response match; choose one with --response NODE:DIR or --record N"),
+            std::string::npos)
+      << two.out;
   const Result chosen = run("identify modes --series " + uff + " --record 3 --segment-s 20 --band-hz 5 40");
   EXPECT_EQ(chosen.status, 0) << chosen.out;
 }

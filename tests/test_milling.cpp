@@ -83,11 +83,12 @@ TEST(Milling, DirectionalFactorsMatchHandValues) {
   EXPECT_NEAR(slot(0, 1), -M_PI, 1e-12);
   EXPECT_NEAR(slot(1, 0), M_PI, 1e-12);
   // Half-immersion down milling: alpha_yy = -1 - pi Kr / 2; 25 % up milling: entry 0, exit 60 deg.
-  EXPECT_NEAR(mill::directional_matrix(mill::engagement(5, 5, cfg::MillingMode::kDown), kr)(1, 1), -1.0 - M_PI * kr / 2, 1e-12);
+  EXPECT_NEAR(mill::directional_matrix(mill::engagement(5, 5, cfg::MillingMode::kDown), kr)(1, 1), -1.0 - M_PI * kr / 2,
+              1e-12);
   const auto up = mill::engagement(5, 2.5, cfg::MillingMode::kUp);
   EXPECT_NEAR(up.exit_rad, M_PI / 3, 1e-12);
-  EXPECT_NEAR(mill::directional_matrix(up, kr)(1, 1),
-              0.5 * (1.5 - kr * (2 * M_PI / 3 + std::sin(2 * M_PI / 3))), 1e-12);
+  EXPECT_NEAR(mill::directional_matrix(up, kr)(1, 1), 0.5 * (1.5 - kr * (2 * M_PI / 3 + std::sin(2 * M_PI / 3))),
+              1e-12);
 }
 
 // Lobe points solve det(I + Lambda Phi0) = 0 with Lambda rebuilt from b_lim and the speed, on a
@@ -108,7 +109,8 @@ TEST(Milling, LobePointsSolveTheCharacteristicEquation) {
       const double lambda = job.tool.teeth / (4 * M_PI) * job.material.kt_n_per_mm2 * 1e3 * p.b_lim_mm *
                             std::abs(1.0 - std::exp(Complex(0.0, -2 * M_PI * p.chatter_hz * tau)));
       const double scale = 1.0 + lambda * model.oriented(p.chatter_hz).cwiseAbs().maxCoeff();
-      EXPECT_LT(std::abs(d) / (scale * scale), 1e-10) << "lobe " << j << " at " << p.chatter_hz << " Hz, b " << p.b_lim_mm;
+      EXPECT_LT(std::abs(d) / (scale * scale), 1e-10)
+          << "lobe " << j << " at " << p.chatter_hz << " Hz, b " << p.b_lim_mm;
       ++checked;
     }
   }
@@ -127,7 +129,8 @@ TEST(Milling, DirectTestAgreesWithLobesWithinOnePercent) {
     const auto zoa = model.limit_at(rpm);
     ASSERT_TRUE(zoa) << rpm;
     const double direct = model.critical_depth_mm(rpm);
-    EXPECT_NEAR(direct / zoa->b_lim_mm, 1.0, 0.01) << rpm << " rpm: direct " << direct << " mm, lobes " << zoa->b_lim_mm;
+    EXPECT_NEAR(direct / zoa->b_lim_mm, 1.0, 0.01)
+        << rpm << " rpm: direct " << direct << " mm, lobes " << zoa->b_lim_mm;
     // Just below the lobe the cut is stable, just above it is not.
     EXPECT_TRUE(model.stable(0.99 * zoa->b_lim_mm, rpm)) << rpm;
     EXPECT_FALSE(model.stable(1.01 * zoa->b_lim_mm, rpm)) << rpm;
@@ -161,7 +164,8 @@ TEST(Milling, SampledClosedLoopMatchesTheDiscreteLoop) {
     EXPECT_LT(std::abs(l_sampled - l_discrete), 0.02 * std::abs(1.0 + l_discrete)) << f << " Hz";
     const auto p = m.plant_response(f);
     const Complex ratio_sampled = m.closed_sampled(0, 0, f, k, pol) / m.open_continuous(0, 0, f);
-    const Complex ratio_discrete = m.closed_discrete(p, m.chain_filters_digital(f), 0, 0, k, pol) / m.open_discrete(p, 0, 0);
+    const Complex ratio_discrete =
+        m.closed_discrete(p, m.chain_filters_digital(f), 0, 0, k, pol) / m.open_discrete(p, 0, 0);
     EXPECT_LT(std::abs(ratio_sampled - ratio_discrete), 0.02 * std::abs(ratio_discrete)) << f << " Hz";
   }
 }
@@ -219,7 +223,8 @@ TEST(Milling, SleOfASingleModeMatchesAHandCalculation) {
     const double wn = 2 * M_PI * fn, w = 2 * M_PI * tooth_hz;
     const Complex g1 = 1.0 / (k * Complex(1.0 - (w / wn) * (w / wn), 2 * zeta * w / wn));
     const double phi_s = mode == cfg::MillingMode::kDown ? M_PI : 0.0;
-    const double y = coefficient(0).real() / k + 2.0 * (g1 * coefficient(1) * std::polar(1.0, cutter.teeth * phi_s)).real();
+    const double y =
+        coefficient(0).real() / k + 2.0 * (g1 * coefficient(1) * std::polar(1.0, cutter.teeth * phi_s)).real();
     const double expected_um = (mode == cfg::MillingMode::kDown ? 1.0 : -1.0) * y * 1e6;
     const auto r = mill::surface_location_error(structure, cutter, mat, cut, cfg::Axis::kX, rpm, 1, 1);
     EXPECT_NEAR(r.sle_um, expected_um, 1e-6 * std::abs(expected_um) + 1e-9) << cfg::to_string(mode);
@@ -263,7 +268,8 @@ TEST(Milling, SleCompensationConverges) {
   mill::CutConditions cmd = cut;
   cmd.radial_mm = comp.radial_mm;
   const double sle = mill::surface_location_error(s, cutter, job.material, cmd, cfg::Axis::kX, c.rpm,
-                                                  job.sle.axial_slices, job.sle.harmonics).sle_um;
+                                                  job.sle.axial_slices, job.sle.harmonics)
+                         .sle_um;
   EXPECT_LT(std::abs(sle + offset_um - (comp.radial_mm - c.radial_mm) * 1000.0), job.sle.tolerance_um);
 }
 
@@ -277,7 +283,9 @@ TEST(Milling, RobotSleIsTensOfMicronsAndNearlySpeedIndependentMachineToolAFew) {
   for (double rpm = 2000; rpm <= 12000; rpm += 500) {
     const double v = mill::surface_location_error(robot, cutter, job.material, cut, cfg::Axis::kX, rpm, 40, 64).sle_um;
     lo = std::min(lo, v), hi = std::max(hi, v);
-    EXPECT_LT(std::abs(mill::surface_location_error(machine, cutter, job.material, cut, cfg::Axis::kX, rpm, 40, 64).sle_um), 5.0);
+    EXPECT_LT(
+        std::abs(mill::surface_location_error(machine, cutter, job.material, cut, cfg::Axis::kX, rpm, 40, 64).sle_um),
+        5.0);
   }
   EXPECT_GT(lo, 10.0);
   EXPECT_LT(hi - lo, 0.5 * lo) << "docs/physics.md §3: nearly independent of speed below 12000 rpm";
@@ -308,10 +316,12 @@ TEST(Milling, ConfigurationErrorsAreSpecific) {
   EXPECT_NE(both.find("material.krc_n_per_mm2: given together with kn_n_per_mm2"), std::string::npos) << both;
   const std::string zeta = problems_of("damping_ratio: 0.182", "damping_ratio: 1.82");
   EXPECT_NE(zeta.find("structures[0].parts[0].xx[0].damping_ratio = 1.82 (dimensionless) is out of range"),
-            std::string::npos) << zeta;
+            std::string::npos)
+      << zeta;
   const std::string sel = problems_of("structure: robot_workpiece", "structure: robot_only");
   EXPECT_NE(sel.find("structure = 'robot_only' is not one of the structures: robot_workpiece, machine_tool"),
-            std::string::npos) << sel;
+            std::string::npos)
+      << sel;
   const std::string speeds = problems_of("  rpm_max: 15000\n", "  rpm_max: 400\n");
   EXPECT_NE(speeds.find("lobes.rpm_max = 400 rpm must exceed lobes.rpm_min = 500 rpm"), std::string::npos) << speeds;
   const std::string typo = problems_of("  feed_axis: x", "  feed_axes: x");
@@ -324,8 +334,10 @@ TEST(Milling, ConfigurationErrorsAreSpecific) {
     (void)cfg::parse_milling_config(text, "ad.yaml", std::string(ROBODAMP_SOURCE_DIR) + "/config/milling");
     ADD_FAILURE() << "no error";
   } catch (const cfg::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("controller.config = '../presets/horizontal_c9.yaml': no such file (looked for "),
-              std::string::npos) << e.what();
+    EXPECT_NE(
+        std::string(e.what()).find("controller.config = '../presets/horizontal_c9.yaml': no such file (looked for "),
+        std::string::npos)
+        << e.what();
   }
 }
 

@@ -96,8 +96,10 @@ TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithi
   const WrongInForm w;
   config::RobotModelConfig mapped = w.model;
   mapped.measured_modes = config::MeasuredModesConfig{w.kAxis, {}};
-  const std::vector<std::pair<std::string, std::vector<double>>> in_map{{"a", {-90, 30, 30}}, {"c", {-90, 65, 30.5}}, {"g", {-90, 80, 30}}, {"h", {-90, 100, 30}}, {"f", {-90, 130, 30}}};
-  const std::vector<std::pair<std::string, std::vector<double>>> held{{"b", {-90, 50, 29.5}}, {"d", {-90, 90, 30}}, {"e", {-90.25, 110, 29.5}}};
+  const std::vector<std::pair<std::string, std::vector<double>>> in_map{
+      {"a", {-90, 30, 30}}, {"c", {-90, 65, 30.5}}, {"g", {-90, 80, 30}}, {"h", {-90, 100, 30}}, {"f", {-90, 130, 30}}};
+  const std::vector<std::pair<std::string, std::vector<double>>> held{
+      {"b", {-90, 50, 29.5}}, {"d", {-90, 90, 30}}, {"e", {-90.25, 110, 29.5}}};
   for (const auto& [name, q] : in_map) mapped.measured_modes->poses.push_back(measured_at(w, name, q));
   // The set: the configuration's controller designed for one region over the path (the analysis's polarity
   // and match frequency at its centre), on the map's modes.
@@ -133,8 +135,8 @@ TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithi
     config::RobotModelConfig there = w.model;
     there.measured_modes = config::MeasuredModesConfig{w.kAxis, {measured_at(w, name, q)}};
     const double p_there = analysis::predicted_improvement_pct(set.config, there, *cfg.pose_schedule, q);
-    std::cout << name << ": damped improvement predicted on the map " << p_map << " %, measured there " << p_there << " %, the truth "
-              << p_truth << " %, the model file " << p_model << " %\n";
+    std::cout << name << ": damped improvement predicted on the map " << p_map << " %, measured there " << p_there
+              << " %, the truth " << p_truth << " %, the model file " << p_model << " %\n";
     worst_points = std::max(worst_points, std::abs(p_map - p_there));
     // Against the truth the map is no more than 5 points worse than a measurement at the pose itself.
     EXPECT_LT(std::abs(p_map - p_truth), std::abs(p_there - p_truth) + 5.0) << name;
@@ -150,7 +152,7 @@ TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithi
   std::cout << "held out: the map's largest frequency error " << worst_mapped << " %, the model file's " << worst_model
             << " %; the damped improvement within " << worst_points << " points of a measurement at the pose\n";
   EXPECT_LT(worst_mapped, 2.0);
-  EXPECT_GT(worst_model, 2.0);  // the case is one the model file alone does not meet
+  EXPECT_GT(worst_model, 2.0);   // the case is one the model file alone does not meet
   EXPECT_LT(worst_points, 5.0);  // measured: 0.6, 0.07 and 4.5 points (docs/pose_dynamics.md)
   // Outside the measured poses (joint 2 at the ends of its travel, 20 and 30 deg beyond them) the spread is
   // larger than anywhere measured.
@@ -158,8 +160,8 @@ TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithi
     const std::vector<double> sg = spreads(analysis::pose_modes(mapped, {-90, q2, 30}, w.kAxis, w.kModes));
     ASSERT_EQ(sg.size(), 3U);
     for (std::size_t i = 0; i < 3; ++i) {
-      std::cout << "mode " << i + 1 << ": frequency sigma at the measured poses <= " << 100 * largest_map_sigma[i] << " %, at joint 2 = "
-                << q2 << " deg " << 100 * sg[i] << " %\n";
+      std::cout << "mode " << i + 1 << ": frequency sigma at the measured poses <= " << 100 * largest_map_sigma[i]
+                << " %, at joint 2 = " << q2 << " deg " << 100 * sg[i] << " %\n";
       EXPECT_GT(sg[i], largest_map_sigma[i]) << i;
     }
   }
@@ -174,7 +176,8 @@ TEST(ModalMap, TheModelStaysThePriorWhereItIsRightInFormAndIsLeftOutWhereItIsWro
   const WrongInForm w;
   config::RobotModelConfig stiffer = w.model;
   for (auto& j : stiffer.joints) j.stiffness_nm_per_rad *= 1.2;
-  const std::vector<std::pair<std::string, std::vector<double>>> in_map{{"a", {-90, 30, 30}}, {"c", {-90, 65, 30.5}}, {"g", {-90, 80, 30}}, {"h", {-90, 100, 30}}, {"f", {-90, 130, 30}}};
+  const std::vector<std::pair<std::string, std::vector<double>>> in_map{
+      {"a", {-90, 30, 30}}, {"c", {-90, 65, 30.5}}, {"g", {-90, 80, 30}}, {"h", {-90, 100, 30}}, {"f", {-90, 130, 30}}};
   const auto forms_of = [&](const config::RobotModelConfig& truth) {
     config::RobotModelConfig mapped = w.model;
     mapped.measured_modes = config::MeasuredModesConfig{w.kAxis, {}};
@@ -191,7 +194,8 @@ TEST(ModalMap, TheModelStaysThePriorWhereItIsRightInFormAndIsLeftOutWhereItIsWro
   for (const robot::TrackForm& f : right_forms) {
     if (f.model_index < 0) continue;
     ++matched;
-    EXPECT_FALSE(f.freq.own) << f.model_index << ": " << f.freq.own_rms << " own, " << f.freq.model_rms << " against the model";
+    EXPECT_FALSE(f.freq.own) << f.model_index << ": " << f.freq.own_rms << " own, " << f.freq.model_rms
+                             << " against the model";
     EXPECT_FALSE(f.damping.own) << f.model_index;
     EXPECT_FALSE(f.stiffness.own) << f.model_index;
   }
@@ -201,7 +205,8 @@ TEST(ModalMap, TheModelStaysThePriorWhereItIsRightInFormAndIsLeftOutWhereItIsWro
     const std::vector<robot::AxisMode> truth = robot::axis_modes(stiffer, q, w.kAxis, w.kModes);
     const analysis::PoseModes got = analysis::pose_modes(right, q, w.kAxis, w.kModes);
     ASSERT_EQ(got.modes.size(), truth.size());
-    for (std::size_t i = 0; i < truth.size(); ++i) EXPECT_NEAR(got.modes[i].natural_freq_hz / truth[i].freq_hz, 1.0, 0.005) << i;
+    for (std::size_t i = 0; i < truth.size(); ++i)
+      EXPECT_NEAR(got.modes[i].natural_freq_hz / truth[i].freq_hz, 1.0, 0.005) << i;
   }
   int damping_own = 0;
   for (const robot::TrackForm& f : forms_of(w.truth).second)
@@ -213,15 +218,20 @@ TEST(ModalMap, TheModelStaysThePriorWhereItIsRightInFormAndIsLeftOutWhereItIsWro
 TEST(ModalMap, TheMeasuredModesSectionIsReadWrittenAndRefusedByKey) {
   const WrongInForm w;
   config::RobotModelConfig m = w.model;
-  m.measured_modes = config::MeasuredModesConfig{0, {measured_at(w, "a", {-90, 30, 30}), measured_at(w, "f", {-90, 130, 30})}};
+  m.measured_modes =
+      config::MeasuredModesConfig{0, {measured_at(w, "a", {-90, 30, 30}), measured_at(w, "f", {-90, 130, 30})}};
   const config::RobotModelConfig back = config::parse_robot_model(config::robot_model_yaml(m), "written");
   ASSERT_TRUE(back.measured_modes);
   EXPECT_EQ(back.measured_modes->axis, 0);
   ASSERT_EQ(back.measured_modes->poses.size(), 2U);
   EXPECT_EQ(back.measured_modes->poses[1].name, "f");
   // Written to 10 significant digits.
-  EXPECT_NEAR(back.measured_modes->poses[1].modes[0].natural_freq_hz / m.measured_modes->poses[1].modes[0].natural_freq_hz, 1.0, 1e-9);
-  EXPECT_NEAR(back.measured_modes->poses[1].modes[2].stiffness_n_per_m / m.measured_modes->poses[1].modes[2].stiffness_n_per_m, 1.0, 1e-9);
+  EXPECT_NEAR(
+      back.measured_modes->poses[1].modes[0].natural_freq_hz / m.measured_modes->poses[1].modes[0].natural_freq_hz, 1.0,
+      1e-9);
+  EXPECT_NEAR(
+      back.measured_modes->poses[1].modes[2].stiffness_n_per_m / m.measured_modes->poses[1].modes[2].stiffness_n_per_m,
+      1.0, 1e-9);
   const std::string base = test::read_file(kSource + "/config/robots/compact_three_link.yaml");
   const auto refused = [&](const std::string& section, const std::string& what) {
     try {
@@ -231,15 +241,20 @@ TEST(ModalMap, TheMeasuredModesSectionIsReadWrittenAndRefusedByKey) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
     }
   };
-  refused("measured_modes:\n  axis: z\n  poses:\n    - name: a\n      joints_deg: [-90, 30, 30]\n      modes:\n"
-          "        - natural_freq_hz: 12\n          damping_ratio: 0.02\n          stiffness_n_per_m: 1e6\n",
-          "measured_modes.axis");
-  refused("measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 200, 30], modes: [{natural_freq_hz: 12, damping_ratio: 0.02, "
-          "stiffness_n_per_m: 1e6}]}\n",
-          "measured_modes.poses[0].joints_deg");
-  refused("measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 30, 30], modes: [{natural_freq_hz: 12, damping_ratio: 0, "
-          "stiffness_n_per_m: 1e6}]}\n",
-          "measured_modes.poses[0].modes[0].damping_ratio");
+  refused(
+      "measured_modes:\n  axis: z\n  poses:\n    - name: a\n      joints_deg: [-90, 30, 30]\n      modes:\n"
+      "        - natural_freq_hz: 12\n          damping_ratio: 0.02\n          stiffness_n_per_m: 1e6\n",
+      "measured_modes.axis");
+  refused(
+      "measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 200, 30], modes: [{natural_freq_hz: 12, "
+      "damping_ratio: 0.02, "
+      "stiffness_n_per_m: 1e6}]}\n",
+      "measured_modes.poses[0].joints_deg");
+  refused(
+      "measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 30, 30], modes: [{natural_freq_hz: 12, "
+      "damping_ratio: 0, "
+      "stiffness_n_per_m: 1e6}]}\n",
+      "measured_modes.poses[0].modes[0].damping_ratio");
   refused("measured_modes:\n  poses:\n    - {name: a, joints_deg: [-90, 30, 30]}\n", "measured_modes.poses[0].modes");
   // Measured along y, asked along x: refused with both.
   config::RobotModelConfig y = m;

@@ -27,8 +27,8 @@
 namespace robodamp {
 namespace {
 
-using drivers::ModbusServer;
 using drivers::ModbusClient;
+using drivers::ModbusServer;
 using test::eventually;
 
 config::ModbusConfig client_config(int port) {
@@ -184,7 +184,8 @@ TEST(Modbus, DisconnectReconnectsWithBackoff) {
   ModbusServer again;
   again.start("127.0.0.1", port);  // the device is back on the same address
   again.set_input_register(2, 400);
-  EXPECT_TRUE(eventually([&] { return sup.amplifier_link_up() && std::abs(sup.amplifier_status().temperature_c - 40.0) < 1e-9; }));
+  EXPECT_TRUE(eventually(
+      [&] { return sup.amplifier_link_up() && std::abs(sup.amplifier_status().temperature_c - 40.0) < 1e-9; }));
   EXPECT_GE(sup.counters().connects, 2U);
   sup.stop();
 }
@@ -217,7 +218,7 @@ TEST(Modbus, RobotMountingSelectsAfterSettling) {
   });
   sup.start();
   ASSERT_TRUE(eventually([&] { return sup.counters().robot_polls >= 5; }));
-  EXPECT_EQ(calls.load(), 0);  // horizontal, as configured
+  EXPECT_EQ(calls.load(), 0);          // horizontal, as configured
   server.set_holding_register(10, 7);  // neither value: counted, ignored
   ASSERT_TRUE(eventually([&] { return sup.counters().mounting_unknown >= 3; }));
   EXPECT_EQ(calls.load(), 0);
@@ -300,7 +301,8 @@ TEST(Modbus, JointRegistersSettleToARegionAndUnknownPosesAreOutOfTheMap) {
   config::PoseScheduleConfig schedule;
   schedule.workspace_min_deg = {-10.0, 0.0};
   schedule.workspace_max_deg = {10.0, 100.0};
-  schedule.regions = {{"low", {-10.0, 0.0}, {10.0, 55.0}, {}, {}, {}, {}}, {"high", {-10.0, 45.0}, {10.0, 100.0}, {}, {}, {}, {}}};
+  schedule.regions = {{"low", {-10.0, 0.0}, {10.0, 55.0}, {}, {}, {}, {}},
+                      {"high", {-10.0, 45.0}, {10.0, 100.0}, {}, {}, {}, {}}};
   std::mutex m;
   std::vector<long> regions;  // -1: out of the map
   ModbusClient sup(cfg, config::Mounting::kHorizontal);
@@ -419,13 +421,27 @@ class GarbageServer {
     const unsigned char tid0 = n > 1 ? req[0] : 0, tid1 = n > 1 ? req[1] : 0, unit = n > 6 ? req[6] : 1;
     const unsigned char fn = n > 7 ? req[7] : 1;
     switch (rng_() % 7) {
-      case 0: random_bytes(1 + rng_() % 40); break;
-      case 1: r = {static_cast<unsigned char>(tid0 + 1), tid1, 0, 0, 0, 4, unit, fn, 1, 0xFF}; break;  // another id
-      case 2: r = {tid0, tid1, 0, 0, 0xFF, 0xFF, unit, fn, 1, 0xFF}; break;                         // length lies
-      case 3: r = {tid0, tid1, 0, 0, 0, 3, unit, static_cast<unsigned char>(fn | 0x80), 4}; break;  // exception
-      case 4: r = {tid0, tid1, 0, 0, 0, 6, unit}; break;                                             // half a reply
-      case 5: return false;                                                                          // hang up
-      default: r = {tid0, tid1, 0, 0, 0, 4, unit, fn, 9}; random_bytes(2); break;  // byte count lies
+      case 0:
+        random_bytes(1 + rng_() % 40);
+        break;
+      case 1:
+        r = {static_cast<unsigned char>(tid0 + 1), tid1, 0, 0, 0, 4, unit, fn, 1, 0xFF};
+        break;  // another id
+      case 2:
+        r = {tid0, tid1, 0, 0, 0xFF, 0xFF, unit, fn, 1, 0xFF};
+        break;  // length lies
+      case 3:
+        r = {tid0, tid1, 0, 0, 0, 3, unit, static_cast<unsigned char>(fn | 0x80), 4};
+        break;  // exception
+      case 4:
+        r = {tid0, tid1, 0, 0, 0, 6, unit};
+        break;  // half a reply
+      case 5:
+        return false;  // hang up
+      default:
+        r = {tid0, tid1, 0, 0, 0, 4, unit, fn, 9};
+        random_bytes(2);
+        break;  // byte count lies
     }
     ++replies_;
     return send(fd, r.data(), r.size(), MSG_NOSIGNAL) >= 0;

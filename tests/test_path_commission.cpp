@@ -38,9 +38,10 @@ test::HilFiles path_cell(const std::string& name) {
   std::ofstream(f.dir + "/truth.yaml") << robot;
   std::string cell = test::read_file(f.config);
   test::replace_or_throw(cell, "  heating_c_per_v2: 0.5\n", "  heating_c_per_v2: 0.5\n  robot_model: truth.yaml\n");
-  std::ofstream(f.config) << cell
-                          << "\ncommissioning: {settle_s: 3, chirp_periods: 3, chirp_period_s: 6, quiet_s: 2, impacts_per_location: 3, "
-                             "record_s: 4}\n";
+  std::ofstream(f.config)
+      << cell
+      << "\ncommissioning: {settle_s: 3, chirp_periods: 3, chirp_period_s: 6, quiet_s: 2, impacts_per_location: 3, "
+         "record_s: 4}\n";
   return f;
 }
 
@@ -79,10 +80,12 @@ TEST(PathCommission, ARobotItsModelDoesNotDescribeIsCommissionedAlongItsPathAndN
   const test::HilFiles f = path_cell("path_commission");
   const commission::PathCommissionSettings s = settings(f);
   std::vector<std::string> lines;
-  const commission::PathCommissionResult r = commission::commission_along_path(s, [&](const std::string& l) { lines.push_back(l); });
+  const commission::PathCommissionResult r =
+      commission::commission_along_path(s, [&](const std::string& l) { lines.push_back(l); });
   for (const auto& l : lines)
     if (l.find("map pose") == std::string::npos && l.find("serve") == std::string::npos) std::cout << l << '\n';
-  ASSERT_EQ(r.outcome, commission::Outcome::kVerified) << commission::to_string(r.stage) << ": " << r.reason << "; files in " << f.dir;
+  ASSERT_EQ(r.outcome, commission::Outcome::kVerified)
+      << commission::to_string(r.stage) << ": " << r.reason << "; files in " << f.dir;
 
   // The emulator moved the robot of hil.robot_model, not the model file the controller was configured with.
   EXPECT_NE(test::read_file(s.out_dir + "/measurement/plant.log").find("hil.robot_model"), std::string::npos);
@@ -99,9 +102,10 @@ TEST(PathCommission, ARobotItsModelDoesNotDescribeIsCommissionedAlongItsPathAndN
   // the job's cut at its speed no worse than the open loop's; somewhere the damper pays (the wall is deeper).
   double best_gain = 0.0;
   for (const auto& st : r.stops) {
-    std::cout << st.name << " (" << st.region << ", K " << st.gain_ns_per_m << "): improvement " << st.measured_improvement_pct
-              << " % measured, " << st.predicted_improvement_pct << " % predicted; the job " << st.damped_limit_mm << " mm damped, "
-              << st.loop_open_limit_mm << " mm open loop\n";
+    std::cout << st.name << " (" << st.region << ", K " << st.gain_ns_per_m << "): improvement "
+              << st.measured_improvement_pct << " % measured, " << st.predicted_improvement_pct
+              << " % predicted; the job " << st.damped_limit_mm << " mm damped, " << st.loop_open_limit_mm
+              << " mm open loop\n";
     EXPECT_TRUE(st.on_cell) << st.name;
     EXPECT_GE(st.records, 2) << st.name;
     EXPECT_TRUE(st.improvement_held(s.improvement_tolerance_points, s.peak_tolerance)) << st.name;
@@ -122,7 +126,8 @@ TEST(PathCommission, ARobotItsModelDoesNotDescribeIsCommissionedAlongItsPathAndN
   for (const auto& st : r.stops) stops.push_back(st.joints_deg);
   const tune::NeverWorse again = tune::never_worse_at_speed(written, config::load_milling_config(kJob), 700.0, stops);
   EXPECT_FALSE(again.changed()) << (again.notes.empty() ? "" : again.notes.front());
-  EXPECT_NE(test::read_file(r.configuration_path).find("Verified on the HIL emulator along the path"), std::string::npos);
+  EXPECT_NE(test::read_file(r.configuration_path).find("Verified on the HIL emulator along the path"),
+            std::string::npos);
 
   // The report: the verdict, the same stops in its JSON, and the plotted data as the result has it.
   EXPECT_NE(test::read_file(s.out_dir + "/report.html").find("VERIFIED at every stop"), std::string::npos);
@@ -190,8 +195,11 @@ TEST(PathCommission, WhatCannotBeCommissionedAlongThePathIsRefusedWithTheReason)
   refused_by(no_schedule, "without pose_schedule");
   // A robot of two joints for a model of three.
   std::string two = test::read_file(f.dir + "/truth.yaml");
-  test::replace_or_throw(two, "  - {length_m: 0.20, mass_kg: 15.8, bending_stiffness_nm2: 9.6e6, axial_stiffness_n: 1.6e9, elements: 2}\n", "");
-  test::replace_or_throw(two, "  - {stiffness_nm_per_rad: 3.6e3, damping_ratio: 0.01, min_deg: -120, max_deg: 120}\n", "");
+  test::replace_or_throw(
+      two, "  - {length_m: 0.20, mass_kg: 15.8, bending_stiffness_nm2: 9.6e6, axial_stiffness_n: 1.6e9, elements: 2}\n",
+      "");
+  test::replace_or_throw(two, "  - {stiffness_nm_per_rad: 3.6e3, damping_ratio: 0.01, min_deg: -120, max_deg: 120}\n",
+                         "");
   two = two.substr(0, two.find("\nposes:")) + "\n";
   std::ofstream(f.dir + "/two.yaml") << two;
   std::string wrong = text;

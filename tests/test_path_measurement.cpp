@@ -28,7 +28,8 @@ using test::Child;
 // A short plan: settle 3 s, 3 chirp periods of 6 s, 2 s quiet, 3 impacts of 4 s at each of the 2 locations:
 // 54 s from the robot's stop to the last record.
 constexpr const char* kPlan =
-    "\ncommissioning: {settle_s: 3, chirp_periods: 3, chirp_period_s: 6, quiet_s: 2, impacts_per_location: 3, record_s: 4}\n";
+    "\ncommissioning: {settle_s: 3, chirp_periods: 3, chirp_period_s: 6, quiet_s: 2, impacts_per_location: 3, "
+    "record_s: 4}\n";
 
 // The same cell without its wires (can, modbus, hil, dds): the simulated plant in process, for the stopped
 // measurements at the same poses.
@@ -54,14 +55,16 @@ void expect_same_modes(const identify::CommissioningResult& along, const identif
     const auto& b = stopped.frfs[i].fit.modes;
     ASSERT_EQ(a.size(), b.size()) << what << " " << along.frfs[i].name;
     for (std::size_t k = 0; k < a.size(); ++k) {
-      std::cout << what << " " << along.frfs[i].name << " mode " << k + 1 << ": " << a[k].natural_freq_hz << " Hz, zeta "
-                << a[k].damping_ratio << " (stopped: " << b[k].natural_freq_hz << " Hz, " << b[k].damping_ratio << ")\n";
+      std::cout << what << " " << along.frfs[i].name << " mode " << k + 1 << ": " << a[k].natural_freq_hz
+                << " Hz, zeta " << a[k].damping_ratio << " (stopped: " << b[k].natural_freq_hz << " Hz, "
+                << b[k].damping_ratio << ")\n";
       EXPECT_NEAR(a[k].natural_freq_hz, b[k].natural_freq_hz, 0.01 * b[k].natural_freq_hz) << what << " mode " << k + 1;
       EXPECT_NEAR(a[k].damping_ratio, b[k].damping_ratio, 0.1 * b[k].damping_ratio) << what << " mode " << k + 1;
     }
   }
   EXPECT_NEAR(along.dominant_mode_hz, stopped.dominant_mode_hz, 0.01 * stopped.dominant_mode_hz) << what;
-  EXPECT_NEAR(along.actuator.natural_freq_hz, stopped.actuator.natural_freq_hz, 0.01 * stopped.actuator.natural_freq_hz) << what;
+  EXPECT_NEAR(along.actuator.natural_freq_hz, stopped.actuator.natural_freq_hz, 0.01 * stopped.actuator.natural_freq_hz)
+      << what;
 }
 
 TEST(PathMeasurement, TheRobotStopsTwiceEachStopIdentifiesAsAStoppedMeasurementThere) {
@@ -96,11 +99,13 @@ TEST(PathMeasurement, TheRobotStopsTwiceEachStopIdentifiesAsAStoppedMeasurementT
     ASSERT_EQ(replay.wait(), 0) << test::read_file(f.dir + "/replay.log");
     EXPECT_NE(test::read_file(f.dir + "/replay.log").find("bit for bit"), std::string::npos);
     // The same pose measured standing still, in process.
-    std::vector<std::string> args{"measure", "--config", stopped, "--out", f.dir + "/stopped_" + std::to_string(i + 1), "--pose"};
+    std::vector<std::string> args{"measure", "--config", stopped, "--out", f.dir + "/stopped_" + std::to_string(i + 1),
+                                  "--pose"};
     for (double q : poses[i]) args.push_back(std::to_string(q));
     Child still(args, f.dir + "/stopped.log");
     ASSERT_EQ(still.wait(), 0) << test::read_file(f.dir + "/stopped.log");
-    expect_same_modes(identified(at), identified(f.dir + "/stopped_" + std::to_string(i + 1)), "dwell " + std::to_string(i + 1));
+    expect_same_modes(identified(at), identified(f.dir + "/stopped_" + std::to_string(i + 1)),
+                      "dwell " + std::to_string(i + 1));
   }
   // The index is what pose fit and pose modes read (--measurements DIR): both stops, at the joints read.
   const identify::PoseMeasurements pm = identify::read_pose_measurements({dir});
@@ -127,8 +132,9 @@ TEST(PathMeasurement, NoJointsToFollowAndStopsTooShortAreRefusedByName) {
                "0:-100,20,90", "--pose-at", "30:-100,20,90"},
               f.plant_log);
   EXPECT_EQ(plant.wait(), 2);
-  EXPECT_NE(test::read_file(f.plant_log).find("dwell 1 at [-100, 20, 90] deg lasts 30 s: the commissioning measurement at "
-                                              "a stop needs 54 s"),
+  EXPECT_NE(test::read_file(f.plant_log)
+                .find("dwell 1 at [-100, 20, 90] deg lasts 30 s: the commissioning measurement at "
+                      "a stop needs 54 s"),
             std::string::npos)
       << test::read_file(f.plant_log);
   std::filesystem::remove_all(f.dir);

@@ -28,7 +28,8 @@ config::Config folded_plant(const std::vector<double>& joints_deg) {
   std::string text = test::read_file(src + "/config/hil_pose_schedule.yaml");
   const std::vector<std::pair<std::string, std::string>> edits{
       {"model: robots/planar_three_link.yaml", "model: robots/compact_three_link.yaml"},
-      {"workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}", "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}"},
+      {"workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}",
+       "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}"},
       {"{name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
        "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}"},
       {"{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
@@ -52,7 +53,8 @@ std::vector<analysis::ModeImprovement> in_band(const config::Config& plant, cons
 }
 
 TEST(PhaseStart, TheFittedShapeDampsTheDominantModeWithoutLiftingTheOtherOneInTheBand) {
-  const std::vector<config::Config> plants{folded_plant({-90, 30, 30}), folded_plant({-90, 37.5, 30}), folded_plant({-90, 45, 30})};
+  const std::vector<config::Config> plants{folded_plant({-90, 30, 30}), folded_plant({-90, 37.5, 30}),
+                                           folded_plant({-90, 45, 30})};
   // Plain velocity feedback (a unity compensator) at the polarity that damps the dominant mode: that mode
   // gains, the second loses.
   tune::Candidate plain;

@@ -57,17 +57,19 @@ Workspace true_robot_cell(const std::string& name, double k2 = 5.6e5, double k3 
   std::ofstream(w.cell) << cell;
   // Written as a person would: a comment, block and flow styles mixed.
   w.poses = w.dir + "/poses.yaml";
-  std::ofstream(w.poses) << "# where the robot was moved for the measurements\nposes:\n- name: p1\n  joints_deg: [-120, 130, -15]\n"
-                            "- {name: p2, joints_deg: [-100, 110, -20]}\n- {name: p3, joints_deg: [-85, 95, 10]}\n"
-                            "- {name: p4, joints_deg: [-110, 60, 30]}\n- {name: p5, joints_deg: [-95, 140, -40]}\n"
-                            "- {name: p6, joints_deg: [-70, 80, 0]}\n";
+  std::ofstream(w.poses)
+      << "# where the robot was moved for the measurements\nposes:\n- name: p1\n  joints_deg: [-120, 130, -15]\n"
+         "- {name: p2, joints_deg: [-100, 110, -20]}\n- {name: p3, joints_deg: [-85, 95, 10]}\n"
+         "- {name: p4, joints_deg: [-110, 60, 30]}\n- {name: p5, joints_deg: [-95, 140, -40]}\n"
+         "- {name: p6, joints_deg: [-70, 80, 0]}\n";
   return w;
 }
 
 TEST(PoseMeasurements, SixPosesMeasuredTheFittedModelFindsTheJointsAndPredictsTheHeldOutPeaks) {
   const Workspace w = true_robot_cell("pose_measurements");
   const std::string m = w.dir + "/measured";
-  const Outcome measure = robodamp({"measure", "--config", w.cell, "--poses", w.poses, "--out", m}, w.dir + "/measure.log");
+  const Outcome measure =
+      robodamp({"measure", "--config", w.cell, "--poses", w.poses, "--out", m}, w.dir + "/measure.log");
   ASSERT_EQ(measure.status, 0) << measure.log;
   const json index = json::parse(test::read_file(m + "/poses.json"));
   ASSERT_EQ(index["poses"].size(), 6U);
@@ -110,8 +112,8 @@ TEST(PoseMeasurements, SixPosesMeasuredTheFittedModelFindsTheJointsAndPredictsTh
 
   const std::string fit = w.dir + "/fit.json";
   const Outcome f = robodamp({"pose", "fit", "--model", kNominal, "--measurements", m, "--hold-out", "p4", "p5", "p6",
-                          "--restarts", "2", "--json", fit},  // seeds 1 and 2 (3, the default, finds the same)
-                         w.dir + "/fit.log");
+                              "--restarts", "2", "--json", fit},  // seeds 1 and 2 (3, the default, finds the same)
+                             w.dir + "/fit.log");
   ASSERT_EQ(f.status, 0) << f.log;
   const json r = json::parse(test::read_file(fit));
   EXPECT_EQ(r["direction"], "xx");  // the cell's pose_schedule.axis
@@ -126,7 +128,7 @@ TEST(PoseMeasurements, SixPosesMeasuredTheFittedModelFindsTheJointsAndPredictsTh
     EXPECT_LT(p["error_pct"].get<double>(), p["nominal_error_pct"].get<double>()) << p.dump();
     if (p["role"] != "held out") continue;
     ++held;
-    EXPECT_NEAR(fitted, measured, 0.1) << p.dump();  // measured: within 0.01 Hz
+    EXPECT_NEAR(fitted, measured, 0.1) << p.dump();            // measured: within 0.01 Hz
     EXPECT_LT(p["error_pct"].get<double>(), 5.0) << p.dump();  // measured: 0.4-1.6 % (the model file: 106-122 %)
     EXPECT_LT(std::abs(fitted - measured), std::abs(nominal - measured) + 0.05) << p.dump();
   }
@@ -136,25 +138,30 @@ TEST(PoseMeasurements, SixPosesMeasuredTheFittedModelFindsTheJointsAndPredictsTh
 TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason) {
   const Workspace w = true_robot_cell("pose_refusals");
   // A pose outside joint 2's travel (0-170 deg).
-  Outcome r = robodamp({"measure", "--config", w.cell, "--pose", "-100", "175", "0", "--out", w.dir + "/out"}, w.dir + "/a.log");
+  Outcome r = robodamp({"measure", "--config", w.cell, "--pose", "-100", "175", "0", "--out", w.dir + "/out"},
+                       w.dir + "/a.log");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.log.find("[-100, 175, 0] deg: joint 2 = 175 deg is out of range"), std::string::npos) << r.log;
   EXPECT_FALSE(fs::exists(w.dir + "/out/measurement.json"));
   // A poses file with a wrong count and a repeated name: nothing measured.
-  std::ofstream(w.dir + "/bad_poses.yaml") << "poses:\n  - {name: a, joints_deg: [-100, 100, 0]}\n"
-                                              "  - {name: b, joints_deg: [-100, 100, 0, 5]}\n  - {name: a, joints_deg: [-90, 90, 0]}\n";
-  r = robodamp({"measure", "--config", w.cell, "--poses", w.dir + "/bad_poses.yaml", "--out", w.dir + "/many"}, w.dir + "/b.log");
+  std::ofstream(w.dir + "/bad_poses.yaml")
+      << "poses:\n  - {name: a, joints_deg: [-100, 100, 0]}\n"
+         "  - {name: b, joints_deg: [-100, 100, 0, 5]}\n  - {name: a, joints_deg: [-90, 90, 0]}\n";
+  r = robodamp({"measure", "--config", w.cell, "--poses", w.dir + "/bad_poses.yaml", "--out", w.dir + "/many"},
+               w.dir + "/b.log");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.log.find("poses[1].joints_deg: a pose needs 3 joint angles"), std::string::npos) << r.log;
   EXPECT_NE(r.log.find("poses[2].name: 'a' names two poses"), std::string::npos) << r.log;
   EXPECT_FALSE(fs::exists(w.dir + "/many/a"));
   // --poses on hardware: nothing moves the robot between the measurements.
-  r = robodamp({"measure", "--config", kSource + "/config/hil_horizontal_c2.yaml", "--poses", w.poses, "--out", w.dir + "/hw"},
-               w.dir + "/hw.log");
+  r = robodamp(
+      {"measure", "--config", kSource + "/config/hil_horizontal_c2.yaml", "--poses", w.poses, "--out", w.dir + "/hw"},
+      w.dir + "/hw.log");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.log.find("only the simulated plant can follow"), std::string::npos) << r.log;
   // A measurement without joint angles.
-  r = robodamp({"measure", "--config", kSource + "/config/presets/horizontal_c2.yaml", "--out", w.dir + "/plain"}, w.dir + "/c.log");
+  r = robodamp({"measure", "--config", kSource + "/config/presets/horizontal_c2.yaml", "--out", w.dir + "/plain"},
+               w.dir + "/c.log");
   ASSERT_EQ(r.status, 0) << r.log;
   r = robodamp({"pose", "fit", "--measurements", w.dir + "/plain"}, w.dir + "/d.log");
   EXPECT_EQ(r.status, 2);
@@ -163,7 +170,8 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   // whose joint 2 is half as stiff.
   const Workspace soft = true_robot_cell("pose_refusals_soft", 2.8e5);
   const std::vector<std::string> at{"--pose", "-100", "110", "-20"};
-  std::vector<std::string> a1{"measure", "--config", w.cell, "--out", w.dir + "/here"}, a2{"measure", "--config", soft.cell, "--out", soft.dir + "/there"};
+  std::vector<std::string> a1{"measure", "--config", w.cell, "--out", w.dir + "/here"},
+      a2{"measure", "--config", soft.cell, "--out", soft.dir + "/there"};
   a1.insert(a1.end(), at.begin(), at.end());
   a2.insert(a2.end(), at.begin(), at.end());
   ASSERT_EQ(robodamp(a1, w.dir + "/e.log").status, 0);
@@ -176,12 +184,16 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   // the data's.
   fs::rename(soft.dir + "/there", soft.dir + "/there_soft");
   std::string manifest = test::read_file(soft.dir + "/there_soft/measurement.json");
-  auto model_of = [](const std::string& dir) { return (fs::path(dir) / "true_robot.yaml").lexically_normal().string(); };
+  auto model_of = [](const std::string& dir) {
+    return (fs::path(dir) / "true_robot.yaml").lexically_normal().string();
+  };
   test::replace_or_throw(manifest, model_of(soft.dir), model_of(w.dir));
   std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
   r = robodamp({"pose", "fit", "--measurements", w.dir + "/here", soft.dir + "/there_soft"}, w.dir + "/h.log");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.log.find("were measured at the same pose [-100, 110, -20] deg and their FRFs differ by"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("were measured at the same pose [-100, 110, -20] deg and their FRFs differ by"),
+            std::string::npos)
+      << r.log;
   EXPECT_NE(r.log.find("contradicting data"), std::string::npos) << r.log;
   // Two poses, not one: the soft robot's measurement labelled 1.5 deg away along joint 3 (a pose read
   // wrong). The models put 15 % (nominal) and 33 % (the cell's) between the two poses' FRFs, the data 106 %:
@@ -189,9 +201,10 @@ TEST(PoseMeasurements, BadPosesAndMeasurementsAreRefusedWithThePoseAndTheReason)
   test::replace_or_throw(manifest, "-20.0", "-18.5");
   std::ofstream(soft.dir + "/there_soft/measurement.json") << manifest;
   for (const std::vector<std::string>& cmd :
-       {std::vector<std::string>{"pose", "fit", "--model", kNominal, "--measurements", w.dir + "/here", soft.dir + "/there_soft"},
-        std::vector<std::string>{"pose", "tune", "--config", w.cell, "--measurements", w.dir + "/here", soft.dir + "/there_soft",
-                                 "--out", w.dir + "/never.yaml"}}) {
+       {std::vector<std::string>{"pose", "fit", "--model", kNominal, "--measurements", w.dir + "/here",
+                                 soft.dir + "/there_soft"},
+        std::vector<std::string>{"pose", "tune", "--config", w.cell, "--measurements", w.dir + "/here",
+                                 soft.dir + "/there_soft", "--out", w.dir + "/never.yaml"}}) {
     r = robodamp(cmd, w.dir + "/i.log");
     EXPECT_EQ(r.status, 2) << r.log;
     EXPECT_NE(r.log.find("[-100, 110, -18.5] deg) and " + w.dir + "/here (pose "), std::string::npos) << r.log;

@@ -40,7 +40,8 @@ TEST(PoseModes, ARobotWrongInFormIsMappedFromItsMeasuredPosesAndMeetsTheHeldOutO
   // model file's torsional joints cannot represent.
   std::string robot = test::read_file(kSource + "/config/robots/compact_three_link.yaml");
   test::replace_or_throw(robot, "{stiffness_nm_per_rad: 2.2e5, damping_ratio: 0.02, min_deg: 10, max_deg: 160}",
-                         "{stiffness_nm_per_rad: 2.2e5, damping_ratio: 0.02, min_deg: 10, max_deg: 160, translational_stiffness_n_per_m: 6e5}");
+                         "{stiffness_nm_per_rad: 2.2e5, damping_ratio: 0.02, min_deg: 10, max_deg: 160, "
+                         "translational_stiffness_n_per_m: 6e5}");
   std::ofstream(d + "/true_robot.yaml") << robot;
   // The HIL cell on the simulated plant (no CAN, no Modbus), its workspace the compact arm's path.
   std::string cell = test::read_file(kSource + "/config/hil_pose_schedule.yaml");
@@ -50,27 +51,32 @@ TEST(PoseModes, ARobotWrongInFormIsMappedFromItsMeasuredPosesAndMeetsTheHeldOutO
                          "workspace: {min_deg: [-90.5, 30, 29], max_deg: [-89.5, 130, 31]}");
   test::replace_or_throw(cell, "{name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
                          "{name: folded, min_deg: [-90.5, 30, 29], max_deg: [-89.5, 62, 31], gain_ns_per_m: 100}");
-  test::replace_or_throw(cell, "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
+  test::replace_or_throw(cell,
+                         "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
                          "{name: stretched, min_deg: [-90.5, 58, 29], max_deg: [-89.5, 130, 31], gain_ns_per_m: 100}");
   std::ofstream(d + "/cell.yaml") << cell;
   // Five poses for the map (about 20-30 deg apart) and three between them held out, written as a person would.
-  std::ofstream(d + "/poses.yaml") << "poses:\n  - {name: a, joints_deg: [-90, 30, 30]}\n  - {name: b, joints_deg: [-90, 50, 29.5]}\n"
-                                      "  - name: c\n    joints_deg: [-90, 65, 30.5]\n  - {name: g, joints_deg: [-90, 80, 30]}\n"
-                                      "  - {name: d, joints_deg: [-90, 90, 30]}\n  - {name: h, joints_deg: [-90, 100, 30]}\n"
-                                      "  - {name: e, joints_deg: [-90.25, 110, 29.5]}\n  - {name: f, joints_deg: [-90, 130, 30]}\n";
-  const Outcome measure = robodamp({"measure", "--config", d + "/cell.yaml", "--poses", d + "/poses.yaml", "--out", d + "/m"}, d + "/measure.log");
+  std::ofstream(d + "/poses.yaml")
+      << "poses:\n  - {name: a, joints_deg: [-90, 30, 30]}\n  - {name: b, joints_deg: [-90, 50, 29.5]}\n"
+         "  - name: c\n    joints_deg: [-90, 65, 30.5]\n  - {name: g, joints_deg: [-90, 80, 30]}\n"
+         "  - {name: d, joints_deg: [-90, 90, 30]}\n  - {name: h, joints_deg: [-90, 100, 30]}\n"
+         "  - {name: e, joints_deg: [-90.25, 110, 29.5]}\n  - {name: f, joints_deg: [-90, 130, 30]}\n";
+  const Outcome measure = robodamp(
+      {"measure", "--config", d + "/cell.yaml", "--poses", d + "/poses.yaml", "--out", d + "/m"}, d + "/measure.log");
   ASSERT_EQ(measure.status, 0) << measure.log;
-  const Outcome fit = robodamp({"pose", "fit", "--model", kSource + "/config/robots/compact_three_link.yaml", "--measurements", d + "/m",
-                                "--hold-out", "b", "d", "e", "--restarts", "1", "--out", d + "/fitted.yaml"},
-                               d + "/fit.log");
+  const Outcome fit =
+      robodamp({"pose", "fit", "--model", kSource + "/config/robots/compact_three_link.yaml", "--measurements",
+                d + "/m", "--hold-out", "b", "d", "e", "--restarts", "1", "--out", d + "/fitted.yaml"},
+               d + "/fit.log");
   ASSERT_EQ(fit.status, 0) << fit.log;
-  const Outcome map = robodamp({"pose", "modes", "--model", d + "/fitted.yaml", "--measurements", d + "/m", "--hold-out", "b", "d", "e",
-                                "--out", d + "/mapped.yaml", "--json", d + "/modes.json"},
+  const Outcome map = robodamp({"pose", "modes", "--model", d + "/fitted.yaml", "--measurements", d + "/m",
+                                "--hold-out", "b", "d", "e", "--out", d + "/mapped.yaml", "--json", d + "/modes.json"},
                                d + "/modes.log");
   ASSERT_EQ(map.status, 0) << map.log;
   std::cout << map.log;
   const json r = json::parse(test::read_file(d + "/modes.json"));
-  const double model_error = r["held_out_worst_freq_error_pct"]["model"], mapped_error = r["held_out_worst_freq_error_pct"]["mapped"];
+  const double model_error = r["held_out_worst_freq_error_pct"]["model"],
+               mapped_error = r["held_out_worst_freq_error_pct"]["mapped"];
   // Every held-out mode found by the map within 2 %; the fitted model misses some or is further off.
   EXPECT_LT(mapped_error, 2.0);
   EXPECT_EQ(r["held_out_modes_missed"]["mapped"].get<int>(), 0);
@@ -85,8 +91,9 @@ TEST(PoseModes, ARobotWrongInFormIsMappedFromItsMeasuredPosesAndMeetsTheHeldOutO
   // The written model reads back with its measured modes; at a held-out pose it shows the modes with their spread.
   const std::string mapped = test::read_file(d + "/mapped.yaml");
   EXPECT_NE(mapped.find("measured_modes:"), std::string::npos);
-  const Outcome show = robodamp({"pose", "modes", "--model", d + "/mapped.yaml", "--joints", "-90", "90", "30", "--json", d + "/show.json"},
-                                d + "/show.log");
+  const Outcome show = robodamp(
+      {"pose", "modes", "--model", d + "/mapped.yaml", "--joints", "-90", "90", "30", "--json", d + "/show.json"},
+      d + "/show.log");
   ASSERT_EQ(show.status, 0) << show.log;
   const json s = json::parse(test::read_file(d + "/show.json"));
   EXPECT_NEAR(s["nearest_measured_deg"].get<double>(), 10.0, 0.1);
@@ -106,9 +113,10 @@ TEST(PoseModes, ARobotWrongInFormIsMappedFromItsMeasuredPosesAndMeetsTheHeldOutO
   test::replace_or_throw(on_map, "model: true_robot.yaml", "model: mapped.yaml");
   std::ofstream(d + "/cell_mapped.yaml") << on_map << "\nspindle:\n  teeth: 3\n  job: job.yaml\n";
   // (The stretched region's set is handed over from region 0's at the start: armed after about 4 s.)
-  const Outcome run = robodamp({"run", "--config", d + "/cell_mapped.yaml", "--pose", "-90", "90", "30", "--spindle-rpm", "700",
-                                "--clock", "virtual", "--duration", "8", "--json", d + "/run.json"},
-                               d + "/run.log");
+  const Outcome run =
+      robodamp({"run", "--config", d + "/cell_mapped.yaml", "--pose", "-90", "90", "30", "--spindle-rpm", "700",
+                "--clock", "virtual", "--duration", "8", "--json", d + "/run.json"},
+               d + "/run.log");
   ASSERT_EQ(run.status, 0) << run.log;
   const json machining = json::parse(test::read_file(d + "/run.json"))["machining"];
   double widest = 0.0;
@@ -118,10 +126,12 @@ TEST(PoseModes, ARobotWrongInFormIsMappedFromItsMeasuredPosesAndMeetsTheHeldOutO
   EXPECT_NEAR(machining["nearest_measured_deg"].get<double>(), 10.0, 0.1) << machining.dump();
   EXPECT_NE(run.log.find("its modes there from the measured map: +-"), std::string::npos) << run.log;
   // Refused: a model with no measured modes to show, and --out without --measurements.
-  const Outcome none = robodamp({"pose", "modes", "--model", d + "/fitted.yaml", "--joints", "-90", "90", "30"}, d + "/none.log");
+  const Outcome none =
+      robodamp({"pose", "modes", "--model", d + "/fitted.yaml", "--joints", "-90", "90", "30"}, d + "/none.log");
   EXPECT_EQ(none.status, 2);
   EXPECT_NE(none.log.find("has no measured modes"), std::string::npos) << none.log;
-  const Outcome out = robodamp({"pose", "modes", "--model", d + "/mapped.yaml", "--out", d + "/x.yaml"}, d + "/out.log");
+  const Outcome out =
+      robodamp({"pose", "modes", "--model", d + "/mapped.yaml", "--out", d + "/x.yaml"}, d + "/out.log");
   EXPECT_EQ(out.status, 2);
   EXPECT_NE(out.log.find("--out and --hold-out go with --measurements"), std::string::npos) << out.log;
 }

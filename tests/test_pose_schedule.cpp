@@ -71,7 +71,8 @@ TEST(PoseScheduleConfig, PresetReadsItsRegionsAndLookupKeepsTheCurrentRegionInTh
 }
 
 TEST(PoseScheduleConfig, AHoleInTheMapIsRefusedWithAPoseInIt) {
-  const std::string e = problems_of({{kFolded, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 15, 92]}"}});
+  const std::string e =
+      problems_of({{kFolded, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 15, 92]}"}});
   EXPECT_NE(e.find("pose_schedule.regions: leave a hole in the workspace"), std::string::npos) << e;
   EXPECT_NE(e.find("[-100, 17.5, 90] deg"), std::string::npos) << e;  // the hole is joint 2 in (15, 20)
 }
@@ -83,7 +84,8 @@ TEST(PoseScheduleConfig, NonPhysicalOrInconsistentSectionsAreRefusedByName) {
   EXPECT_NE(e.find("joint 2's travel"), std::string::npos) << e;
   // A box upside down, a wrong joint count, a duplicate name.
   e = problems_of({{kFolded, "    - {name: folded, min_deg: [-98, 0, 88], max_deg: [-102, 25, 92]}"}});
-  EXPECT_NE(e.find("pose_schedule.regions[0].max_deg[0] = -102 deg is below min_deg = -98 deg"), std::string::npos) << e;
+  EXPECT_NE(e.find("pose_schedule.regions[0].max_deg[0] = -102 deg is below min_deg = -98 deg"), std::string::npos)
+      << e;
   e = problems_of({{kFolded, "    - {name: folded, min_deg: [-102, 0], max_deg: [-98, 25]}"}});
   EXPECT_NE(e.find("pose_schedule.regions[0].min_deg: has 2 angles; the robot model"), std::string::npos) << e;
   e = problems_of({{"{name: stretched,", "{name: folded,"}});
@@ -101,7 +103,8 @@ TEST(PoseScheduleConfig, NonPhysicalOrInconsistentSectionsAreRefusedByName) {
     (void)config::parse_config(text, test::preset(kPreset));
     ADD_FAILURE() << "pose_schedule and parameter_sets accepted together";
   } catch (const config::ConfigError& err) {
-    EXPECT_NE(std::string(err.what()).find("schedules by pose or by mounting, not both"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find("schedules by pose or by mounting, not both"), std::string::npos)
+        << err.what();
   }
 }
 
@@ -116,7 +119,8 @@ TEST(PoseScheduleConfig, JointRegistersMustNotOverlapTheOtherRobotRegisters) {
     (void)config::parse_config(text, std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_pose_schedule.yaml");
     ADD_FAILURE() << "overlapping registers accepted";
   } catch (const config::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("modbus.robot.joints_register = 0 covers registers 0-2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("modbus.robot.joints_register = 0 covers registers 0-2"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -133,21 +137,26 @@ TEST(PoseScheduleConfig, JointStatesNameEachJointOnceAndAreTheOnlySourceOfThePos
     }
     return std::string("accepted");
   };
-  const config::Config ok = config::parse_config(base + "\ndds:\n  joint_states: {names: [a1, a2, a3], timeout_s: 0.2}\n", path);
+  const config::Config ok =
+      config::parse_config(base + "\ndds:\n  joint_states: {names: [a1, a2, a3], timeout_s: 0.2}\n", path);
   ASSERT_TRUE(ok.dds && ok.dds->joint_states);
   EXPECT_EQ(ok.dds->joint_states->names, (std::vector<std::string>{"a1", "a2", "a3"}));
   EXPECT_EQ(ok.dds->joint_states->topic, "rt/joint_states");
   EXPECT_EQ(ok.dds->joint_states->timeout_s, 0.2);
   EXPECT_EQ(ok.dds->joint_states->settle_samples, 3);
   EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2]}\n")
-                .find("dds.joint_states.names: has 2 names; pose_schedule has 3 joints"), std::string::npos);
+                .find("dds.joint_states.names: has 2 names; pose_schedule has 3 joints"),
+            std::string::npos);
   EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2, a1]}\n")
-                .find("dds.joint_states.names[2] = 'a1' is named twice: each joint once"), std::string::npos);
+                .find("dds.joint_states.names[2] = 'a1' is named twice: each joint once"),
+            std::string::npos);
   EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: a1}\n").find("dds.joint_states.names: must be a list"),
             std::string::npos);
-  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2, a3], timeout_s: 0}\n").find("dds.joint_states.timeout_s"),
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {names: [a1, a2, a3], timeout_s: 0}\n")
+                .find("dds.joint_states.timeout_s"),
             std::string::npos);
-  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {topic: rt/joint_states}\n").find("dds.joint_states.names"), std::string::npos);
+  EXPECT_NE(error_of(base + "\ndds:\n  joint_states: {topic: rt/joint_states}\n").find("dds.joint_states.names"),
+            std::string::npos);
   const std::string hil = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_pose_schedule.yaml";
   std::string both = test::read_file(hil);
   replace(both, "  parameter_writes: false", "  joint_states: {names: [a1, a2, a3]}\n  parameter_writes: false");
@@ -156,31 +165,40 @@ TEST(PoseScheduleConfig, JointStatesNameEachJointOnceAndAreTheOnlySourceOfThePos
     ADD_FAILURE() << "two sources of the pose accepted";
   } catch (const config::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("and modbus.robot.joints_register = 10 both give the pose: choose one source"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
   }
-  const std::string no_schedule = test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  joint_states: {names: [a1]}\n";
-  EXPECT_NE(error_of(no_schedule).find("dds.joint_states: is set without pose_schedule"), std::string::npos) << error_of(no_schedule);
+  const std::string no_schedule =
+      test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  joint_states: {names: [a1]}\n";
+  EXPECT_NE(error_of(no_schedule).find("dds.joint_states: is set without pose_schedule"), std::string::npos)
+      << error_of(no_schedule);
   // dds.path_ahead: the robot program's trajectory, its names its own or the joint states'.
-  const config::Config ahead = config::parse_config(base + "\ndds:\n  path_ahead:\n    names: [a1, a2, a3]\n    hold_s: 4\n", path);
+  const config::Config ahead =
+      config::parse_config(base + "\ndds:\n  path_ahead:\n    names: [a1, a2, a3]\n    hold_s: 4\n", path);
   ASSERT_TRUE(ahead.dds && ahead.dds->path_ahead);
   EXPECT_EQ(ahead.dds->path_ahead->topic, "rt/joint_trajectory");
   EXPECT_EQ(ahead.dds->path_ahead->hold_s, 4.0);
-  EXPECT_NO_THROW((void)config::parse_config(base + "\ndds:\n  joint_states: {names: [a1, a2, a3]}\n  path_ahead: {}\n", path));
+  EXPECT_NO_THROW(
+      (void)config::parse_config(base + "\ndds:\n  joint_states: {names: [a1, a2, a3]}\n  path_ahead: {}\n", path));
   EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {}\n").find("dds.path_ahead: needs names"), std::string::npos);
   EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2]}\n")
-                .find("dds.path_ahead.names: has 2 names; pose_schedule has 3 joints"), std::string::npos);
+                .find("dds.path_ahead.names: has 2 names; pose_schedule has 3 joints"),
+            std::string::npos);
   EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2, a3], hold_s: 0}\n").find("dds.path_ahead.hold_s"),
             std::string::npos);
-  EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2, a2]}\n").find("dds.path_ahead.names[2] = 'a2' is named twice"),
+  EXPECT_NE(error_of(base + "\ndds:\n  path_ahead: {names: [a1, a2, a2]}\n")
+                .find("dds.path_ahead.names[2] = 'a2' is named twice"),
             std::string::npos);
-  const std::string no_schedule_path = test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  path_ahead: {names: [a1]}\n";
+  const std::string no_schedule_path =
+      test::read_file(test::preset("horizontal_c2")) + "\ndds:\n  path_ahead: {names: [a1]}\n";
   EXPECT_NE(error_of(no_schedule_path).find("dds.path_ahead: is set without pose_schedule"), std::string::npos);
 }
 
 // The robot model's modes as the loop's modal table: the modal-stiffness form with damping from each
 // mode's loss factor reproduces the assembled model's TCP receptance along the axis at the dominant peak.
 TEST(PoseSchedule, PoseModesReproduceTheRobotModelsReceptanceAtTheDominantPeak) {
-  const config::RobotModelConfig model = config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
+  const config::RobotModelConfig model =
+      config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   for (const std::vector<double>& q : {std::vector<double>{-100, 10, 90}, std::vector<double>{-100, 100, 90}}) {
     const analysis::PoseModes pm = analysis::pose_modes(model, q, 0, 3);
     ASSERT_EQ(pm.modes.size(), 3u);
@@ -216,7 +234,8 @@ TEST(PoseSchedule, EachRegionGetsASetMatchedAtItsDominantModeAndTooMuchGainIsRef
   }
   // The folded region at K = 1000 N s/m: unstable at some pose of its grid, refused with it.
   try {
-    (void)analysis::analyse_pose_schedule(edited({{"max_deg: [-98, 25, 92], gain_ns_per_m: 250}", "max_deg: [-98, 25, 92], gain_ns_per_m: 1000}"}}));
+    (void)analysis::analyse_pose_schedule(
+        edited({{"max_deg: [-98, 25, 92], gain_ns_per_m: 250}", "max_deg: [-98, 25, 92], gain_ns_per_m: 1000}"}}));
     ADD_FAILURE() << "an unstable region accepted";
   } catch (const config::ConfigError& e) {
     const std::string w = e.what();

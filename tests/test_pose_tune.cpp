@@ -19,17 +19,17 @@
 namespace robodamp {
 namespace {
 
-
 using test::replace_or_throw;
 
 // The scheduled preset along joint 2 alone (joints 1 and 3 held): its two modes trade places near 25-50 deg.
 config::Config joint2_cell() {
   std::string text = test::read_file(test::preset("pose_scheduled_c2"));
   replace_or_throw(text, "workspace: {min_deg: [-102, 0, 88], max_deg: [-98, 140, 92]}",
-                    "workspace: {min_deg: [-100, 0, 90], max_deg: [-100, 140, 90]}");
-  replace_or_throw(text, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}\n", "");
+                   "workspace: {min_deg: [-100, 0, 90], max_deg: [-100, 140, 90]}");
+  replace_or_throw(text, "    - {name: folded, min_deg: [-102, 0, 88], max_deg: [-98, 25, 92], gain_ns_per_m: 250}\n",
+                   "");
   replace_or_throw(text, "{name: stretched, min_deg: [-102, 20, 88], max_deg: [-98, 140, 92], gain_ns_per_m: 200}",
-                    "{name: all, min_deg: [-100, 0, 90], max_deg: [-100, 140, 90], gain_ns_per_m: 150}");
+                   "{name: all, min_deg: [-100, 0, 90], max_deg: [-100, 140, 90], gain_ns_per_m: 150}");
   return config::parse_config(text, test::preset("pose_scheduled_c2"));
 }
 
@@ -74,14 +74,16 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
   for (std::size_t i = 0; i < sched.size(); ++i) {
     EXPECT_EQ(a.regions[i].polarity, *sched[i].region.polarity);
     const auto& chain = a.regions[i].config.controller.chain;
-    const auto c = std::find_if(chain.begin(), chain.end(), [](const auto& b) { return b.kind == config::BlockKind::kCompensator; });
+    const auto c = std::find_if(chain.begin(), chain.end(),
+                                [](const auto& b) { return b.kind == config::BlockKind::kCompensator; });
     ASSERT_NE(c, chain.end());
     EXPECT_EQ(c->model, config::CompensatorModel::kRational);
     EXPECT_EQ(c->denominator, sched[i].region.compensator->denominator);
   }
   const tune::MapScores m = tune::score_on_map(
       in, tune::workspace_map(in, 9, {}),
-      {{"robust", tune::schedule_of(*in.cell.pose_schedule, {robust})}, {"scheduled", *written.pose_schedule}}, std::nullopt);
+      {{"robust", tune::schedule_of(*in.cell.pose_schedule, {robust})}, {"scheduled", *written.pose_schedule}},
+      std::nullopt);
   ASSERT_EQ(m.map.size(), 9U);
   const tune::ControllerScore &rs = m.controllers[0], &ss = m.controllers[1];
   EXPECT_TRUE(ss.stable_everywhere);
@@ -112,8 +114,8 @@ TEST(PoseTune, OneSetCannotServeWhereTheModesTradePlacesTheDrawnRegionsDoBetter)
 TEST(PoseTune, ARegionsCompensatorIsCheckedWithItsKeyAndTheReason) {
   std::string text = test::read_file(test::preset("pose_scheduled_c2"));
   replace_or_throw(text, "max_deg: [-98, 25, 92], gain_ns_per_m: 250}",
-                    "max_deg: [-98, 25, 92], gain_ns_per_m: 250, polarity: 2, match_freq_hz: -3,\n"
-                    "       compensator: {numerator: [1, 2, 3], denominator: [-1, 1]}}");
+                   "max_deg: [-98, 25, 92], gain_ns_per_m: 250, polarity: 2, match_freq_hz: -3,\n"
+                   "       compensator: {numerator: [1, 2, 3], denominator: [-1, 1]}}");
   try {
     (void)config::parse_config(text, test::preset("pose_scheduled_c2"));
     FAIL() << "accepted";
@@ -121,9 +123,12 @@ TEST(PoseTune, ARegionsCompensatorIsCheckedWithItsKeyAndTheReason) {
     const std::string w = e.what();
     EXPECT_NE(w.find("pose_schedule.regions[0].polarity"), std::string::npos) << w;
     EXPECT_NE(w.find("pose_schedule.regions[0].match_freq_hz"), std::string::npos) << w;
-    EXPECT_NE(w.find("pose_schedule.regions[0].compensator.numerator: has 3 coefficients, more than the denominator's 2"),
-              std::string::npos) << w;
-    EXPECT_NE(w.find("pose_schedule.regions[0].compensator.denominator[0] = -1 is not allowed"), std::string::npos) << w;
+    EXPECT_NE(
+        w.find("pose_schedule.regions[0].compensator.numerator: has 3 coefficients, more than the denominator's 2"),
+        std::string::npos)
+        << w;
+    EXPECT_NE(w.find("pose_schedule.regions[0].compensator.denominator[0] = -1 is not allowed"), std::string::npos)
+        << w;
   }
 }
 
@@ -138,15 +143,20 @@ TEST(PoseTune, TheDampingBandIsCheckedAndSplitsTheWorstModeInsideFromOutside) {
     (void)config::parse_config(bad, path);
     FAIL() << "accepted";
   } catch (const config::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("pose_schedule.damping_band_max_hz = 5 Hz must be above pose_schedule.damping_band_min_hz = 30 Hz"),
-              std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(
+                  "pose_schedule.damping_band_max_hz = 5 Hz must be above pose_schedule.damping_band_min_hz = 30 Hz"),
+              std::string::npos)
+        << e.what();
   }
   replace_or_throw(bad, "damping_band_max_hz: 5", "damping_band_max_hz: 2e5");
   try {
     (void)config::parse_config(bad, path);
     FAIL() << "accepted";
   } catch (const config::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("pose_schedule.damping_band_max_hz = 200000 Hz is out of range: allowed 0 <= value <= 10000 Hz"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(
+                  "pose_schedule.damping_band_max_hz = 200000 Hz is out of range: allowed 0 <= value <= 10000 Hz"),
+              std::string::npos)
+        << e.what();
   }
   // All modes by default; with a band, the modes outside it are reported apart and the worst inside is
   // the smallest of the modes inside.

@@ -44,7 +44,8 @@ std::string robot_a(const test::ScratchDir& dir, const std::string& name,
 }
 
 // The modal kit's export of a simulated impact test of `robot` (tests/modal_kit.hpp), in dir.
-std::string tap_test_export(const test::ScratchDir& dir, const std::string& robot, const std::string& name, double calibration) {
+std::string tap_test_export(const test::ScratchDir& dir, const std::string& robot, const std::string& name,
+                            double calibration) {
   return test::modal_kit_export(robot, dir.file(name), dir.file(name + ".uff"), calibration);
 }
 
@@ -101,12 +102,16 @@ TEST(RealCell, TapTestsOfTheSameRobotAgreeWithTheChirpAndAnotherRobotsAreRefused
 
   // Tapped on a robot whose modes sit 3 % higher (another pose, another tool): refused, naming the mode.
   std::vector<std::pair<std::string, std::string>> shift;
-  for (int i = 0; i < 3; ++i) shift.emplace_back("natural_freq_hz: 5.5,", "natural_freq_hz: 5.665,"),
-                              shift.emplace_back("natural_freq_hz: 16.0,", "natural_freq_hz: 16.48,");
+  for (int i = 0; i < 3; ++i)
+    shift.emplace_back("natural_freq_hz: 5.5,", "natural_freq_hz: 5.665,"),
+        shift.emplace_back("natural_freq_hz: 16.0,", "natural_freq_hz: 16.48,");
   const Identified other = identify_with(chirp, {tap_test_export(dir, robot_a(dir, "shifted", shift), "other", 1.0)});
   const std::string why = other.check.failure();
-  EXPECT_NE(why.find("the tap tests contradict the actuator's chirp: their mode at 5.67 Hz is at 5.50 Hz"), std::string::npos) << why;
-  EXPECT_GT(other.check.chirp_residual_pct, 3.0 * same.check.chirp_residual_pct) << other.check.summary() << " / " << same.check.summary();
+  EXPECT_NE(why.find("the tap tests contradict the actuator's chirp: their mode at 5.67 Hz is at 5.50 Hz"),
+            std::string::npos)
+      << why;
+  EXPECT_GT(other.check.chirp_residual_pct, 3.0 * same.check.chirp_residual_pct)
+      << other.check.summary() << " / " << same.check.summary();
 }
 
 // The same from the command line: identify all --in (the chirp) --tap-tests, whose output tune reads.
@@ -114,16 +119,19 @@ TEST(RealCell, IdentifyAllTakesTapTestsAndRefusesContradictingOnes) {
   const test::ScratchDir dir("real-cell-cli");
   const std::string chirp = chirp_only(dir, kRobotA, "chirp");
   const std::string taps = tap_test_export(dir, kRobotA, "kit", 1.0);
-  const auto ok = test::run_robodamp("identify all --in " + chirp + " --tap-tests " + taps + " --out " + dir.file("id.yaml"));
+  const auto ok =
+      test::run_robodamp("identify all --in " + chirp + " --tap-tests " + taps + " --out " + dir.file("id.yaml"));
   EXPECT_EQ(ok.status, 0) << ok.out;
   EXPECT_NE(ok.out.find("the tap tests against the actuator's chirp: 5.500 Hz tapped"), std::string::npos) << ok.out;
   EXPECT_NEAR(config::load_config_file(dir.file("id.yaml")).robot.frfs.at(0).modes.at(1).natural_freq_hz, 16.0, 0.16);
   std::vector<std::pair<std::string, std::string>> shift;
   for (int i = 0; i < 3; ++i) shift.emplace_back("natural_freq_hz: 16.0,", "natural_freq_hz: 16.48,");
   const std::string other = tap_test_export(dir, robot_a(dir, "shifted", shift), "other", 1.0);
-  const auto bad = test::run_robodamp("identify all --in " + chirp + " --tap-tests " + other + " --out " + dir.file("id2.yaml"));
+  const auto bad =
+      test::run_robodamp("identify all --in " + chirp + " --tap-tests " + other + " --out " + dir.file("id2.yaml"));
   EXPECT_EQ(bad.status, 2) << bad.out;
-  EXPECT_NE(bad.out.find("the tap tests contradict the actuator's chirp: their mode at 16.48 Hz"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("the tap tests contradict the actuator's chirp: their mode at 16.48 Hz"), std::string::npos)
+      << bad.out;
   EXPECT_FALSE(fs::exists(dir.file("id2.yaml")));
 }
 
@@ -139,7 +147,8 @@ TEST(RealCell, TapTestsComeAsUniversalFilesOrFrfCsvsAndReciprocityIsChecked) {
   EXPECT_TRUE(csv.taps.reciprocal.empty());
 
   // Both ways round: compared, and close (the simulated structure is reciprocal; each estimate has its noise).
-  const Identified both = identify_with(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", sim + "/frf_1_2.csv", sim + "/frf_2_2.csv"});
+  const Identified both =
+      identify_with(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", sim + "/frf_1_2.csv", sim + "/frf_2_2.csv"});
   ASSERT_EQ(both.check.reciprocity.size(), 1u);
   EXPECT_LT(both.check.reciprocity[0].difference_pct, 10.0);
   EXPECT_EQ(both.check.failure(), "");
@@ -152,11 +161,14 @@ TEST(RealCell, TapTestsComeAsUniversalFilesOrFrfCsvsAndReciprocityIsChecked) {
   out.precision(9);
   for (std::string line; std::getline(in, line);) {
     double f = 0, re = 0, im = 0, coh = 0;
-    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &f, &re, &im, &coh) == 4) out << f << ',' << 1.5 * re << ',' << 1.5 * im << ',' << coh << '\n';
-    else out << line << '\n';
+    if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &f, &re, &im, &coh) == 4)
+      out << f << ',' << 1.5 * re << ',' << 1.5 * im << ',' << coh << '\n';
+    else
+      out << line << '\n';
   }
   out.close();
-  const Identified wrong = identify_with(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", bad + "/frf_1_2.csv", sim + "/frf_2_2.csv"});
+  const Identified wrong =
+      identify_with(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", bad + "/frf_1_2.csv", sim + "/frf_2_2.csv"});
   EXPECT_NE(wrong.check.failure().find("not reciprocal: H21yy and H12 differ by"), std::string::npos)
       << wrong.check.failure() << " / " << wrong.check.summary();
 
@@ -169,8 +181,10 @@ TEST(RealCell, TapTestsComeAsUniversalFilesOrFrfCsvsAndReciprocityIsChecked) {
     EXPECT_NE(std::string(e.what()).find("no FRF between locations 2 and 1"), std::string::npos) << e.what();
   }
   try {
-    (void)identify::inputs_with_tap_tests(chirp, {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", sim + "/frf_2_2.csv",
-                                               sim + "/" + identify::kMeasurementUffName}, t);
+    (void)identify::inputs_with_tap_tests(
+        chirp,
+        {sim + "/frf_1_1.csv", sim + "/frf_2_1.csv", sim + "/frf_2_2.csv", sim + "/" + identify::kMeasurementUffName},
+        t);
     ADD_FAILURE() << "a pair given twice was accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("two tap tests from node 1 to node 1"), std::string::npos) << e.what();
@@ -198,7 +212,8 @@ TEST(RealCell, TheChirpWaitsForACellAtRestAndStopsWhenItSaturates) {
   o.control_on = true;
   const commission::MeasureOutcome s = commission::measure(hot, dir.file("hot"), o);
   EXPECT_EQ(s.status, commission::MeasureStatus::kSaturated);
-  EXPECT_NE(s.message.find("the excitation saturates: the supervisor limited the command"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("the excitation saturates: the supervisor limited the command"), std::string::npos)
+      << s.message;
   EXPECT_LT(s.chirp_active_share, 1.0);  // it did not play on
   EXPECT_EQ(commission::exit_code(s.status), 7);
   // The same level with control off stays inside the limit: measured.
@@ -230,16 +245,20 @@ TEST(RealCell, DryRunPrintsThePlanAndRunsNothing) {
   const test::ScratchDir dir("real-cell-dry");
   const auto r = test::run_robodamp("measure --dry-run --no-hammer --config " + kRobotA + " --out " + dir.file("out"));
   EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("what moves: the inertial actuator's mass only; 4 periods of a 2.0-100.0 Hz chirp"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("what moves: the inertial actuator's mass only; 4 periods of a 2.0-100.0 Hz chirp"),
+            std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("predicted peak actuator force 20.0 N of its 40 N limit"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("no hammer"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir.file("out")));
   std::ofstream(dir.file("taps.uff")) << "";  // a dry run reads no tap test
-  const auto c = test::run_robodamp("commission --dry-run --config " + kRobotA + " --job " + std::string(ROBODAMP_SOURCE_DIR) +
-                                    "/config/commissioning/job_a_two_modes.yaml --out " + dir.file("c") + " --tap-tests " +
-                                    dir.file("taps.uff"));
+  const auto c = test::run_robodamp(
+      "commission --dry-run --config " + kRobotA + " --job " + std::string(ROBODAMP_SOURCE_DIR) +
+      "/config/commissioning/job_a_two_modes.yaml --out " + dir.file("c") + " --tap-tests " + dir.file("taps.uff"));
   EXPECT_EQ(c.status, 0) << c.out;
-  EXPECT_NE(c.out.find("the same chirp with the tuned controller running (control ON), no hammer, no cut"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("the same chirp with the tuned controller running (control ON), no hammer, no cut"),
+            std::string::npos)
+      << c.out;
   EXPECT_FALSE(fs::exists(dir.file("c")));
 }
 

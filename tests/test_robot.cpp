@@ -30,7 +30,8 @@ TEST(RobotModel, CantileverMatchesEulerBernoulli) {
   const double beta_l[3] = {1.87510407, 4.69409113, 7.85475744};
   for (int i = 0; i < 3; ++i) {
     const double exact = beta_l[i] * beta_l[i] / (2.0 * M_PI * length * length) * std::sqrt(ei / (mass / length));
-    std::cout << "mode " << i + 1 << ": " << modes[static_cast<std::size_t>(i)].freq_hz << " Hz, Euler-Bernoulli " << exact << " Hz\n";
+    std::cout << "mode " << i + 1 << ": " << modes[static_cast<std::size_t>(i)].freq_hz << " Hz, Euler-Bernoulli "
+              << exact << " Hz\n";
     EXPECT_NEAR(modes[static_cast<std::size_t>(i)].freq_hz / exact, 1.0, 0.005) << i;
   }
 }
@@ -76,14 +77,16 @@ TEST(RobotModel, AJointsTranslationalComplianceIsCoupledAlikeBothWays) {
     const Eigen::Matrix2cd d = c.tcp_frf_direct(f), r = c.tcp_frf_rcsa(f);
     worst = std::max(worst, (d - r).norm() / d.norm());
   }
-  for (const auto& md : c.modes(4)) worst = std::max(worst, (c.tcp_frf_direct(md.freq_hz) - c.tcp_frf_rcsa(md.freq_hz)).norm() /
-                                                                c.tcp_frf_direct(md.freq_hz).norm());
+  for (const auto& md : c.modes(4))
+    worst = std::max(worst, (c.tcp_frf_direct(md.freq_hz) - c.tcp_frf_rcsa(md.freq_hz)).norm() /
+                                c.tcp_frf_direct(md.freq_hz).norm());
   EXPECT_LT(worst, 1e-6);
   const robot::PlanarChain rigid(three_links(), q);
   EXPECT_LT(c.modes(1)[0].freq_hz, rigid.modes(1)[0].freq_hz * 0.999);  // softer
   soft.joints[0].translational_stiffness_n_per_m = soft.joints[1].translational_stiffness_n_per_m = 1e13;
   const robot::PlanarChain stiff(soft, q);
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(stiff.modes(3)[i].freq_hz, rigid.modes(3)[i].freq_hz, 1e-4 * rigid.modes(3)[i].freq_hz);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(stiff.modes(3)[i].freq_hz, rigid.modes(3)[i].freq_hz, 1e-4 * rigid.modes(3)[i].freq_hz);
   soft.joints[1].translational_stiffness_n_per_m = -1.0;
   EXPECT_THROW(robot::PlanarChain(soft, q), std::invalid_argument);
 }
@@ -117,7 +120,8 @@ namespace robodamp {
 namespace {
 
 config::RobotModelConfig coarse_planar_robot() {
-  config::RobotModelConfig m = config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
+  config::RobotModelConfig m =
+      config::load_robot_model(std::string(ROBODAMP_SOURCE_DIR) + "/config/robots/planar_three_link.yaml");
   for (auto& l : m.links) l.elements = std::min(l.elements, 2);  // the links are stiff: 2 elements suffice here
   return m;
 }
@@ -154,7 +158,8 @@ TEST(PoseFit, ParticleSwarmRecoversJointStiffnessesFromNoisyFrfsAtThreePoses) {
   }
   for (double e : r.pose_error) EXPECT_LT(e, 0.03);
   EXPECT_GE(r.converged_restarts, 1);
-  std::cout << r.converged_restarts << " of " << s.restarts << " restarts converged; " << r.evaluations << " evaluations\n";
+  std::cout << r.converged_restarts << " of " << s.restarts << " restarts converged; " << r.evaluations
+            << " evaluations\n";
   // Seeded: the same search twice gives the same numbers (a short one: repeatability, not accuracy).
   s.restarts = 1;
   s.pso.iterations = 5;
@@ -186,7 +191,8 @@ TEST(PoseFit, TheModalFormIsThePlantsAndRecoversItsJoints) {
     robot::MeasuredFrf m{p.name, p.joints_deg, {}, {}};
     for (double f = 10.0; f <= 30.0; f += 0.05) {
       m.freq_hz.push_back(f);
-      m.receptance_m_per_n.push_back(robot::modal_tcp_frf(modes, f)(1, 1) * std::complex<double>(1.0 + noise(rng), noise(rng)));
+      m.receptance_m_per_n.push_back(robot::modal_tcp_frf(modes, f)(1, 1) *
+                                     std::complex<double>(1.0 + noise(rng), noise(rng)));
     }
     data.push_back(std::move(m));
   }
@@ -195,8 +201,8 @@ TEST(PoseFit, TheModalFormIsThePlantsAndRecoversItsJoints) {
   double e_direct = 0.0, e_modal = 0.0;
   for (double e : robot::model_errors(truth, data, direct)) e_direct = std::max(e_direct, e);
   for (double e : robot::model_errors(truth, data, modal)) e_modal = std::max(e_modal, e);
-  std::cout << "the truth's largest error against its own plant: " << 100.0 * e_modal << " % as modes, " << 100.0 * e_direct
-            << " % as its own receptance\n";
+  std::cout << "the truth's largest error against its own plant: " << 100.0 * e_modal << " % as modes, "
+            << 100.0 * e_direct << " % as its own receptance\n";
   EXPECT_LT(e_modal, 0.006);
   EXPECT_GT(e_direct, 2.0 * e_modal);
   config::RobotModelConfig start = truth;
@@ -206,8 +212,8 @@ TEST(PoseFit, TheModalFormIsThePlantsAndRecoversItsJoints) {
   modal.pso.iterations = 40;
   const robot::PoseFitResult r = robot::fit_joints(start, data, modal);
   for (std::size_t j = 0; j < truth.joints.size(); ++j) {
-    std::cout << "joint " << j + 1 << ": " << r.stiffness_nm_per_rad[j] << " N m/rad (truth " << truth.joints[j].stiffness_nm_per_rad
-              << "), damping " << r.damping_ratio[j] << "\n";
+    std::cout << "joint " << j + 1 << ": " << r.stiffness_nm_per_rad[j] << " N m/rad (truth "
+              << truth.joints[j].stiffness_nm_per_rad << "), damping " << r.damping_ratio[j] << "\n";
     EXPECT_NEAR(r.stiffness_nm_per_rad[j] / truth.joints[j].stiffness_nm_per_rad, 1.0, 0.005) << "joint " << j + 1;
   }
 }
@@ -252,7 +258,8 @@ namespace {
 // structure's FRF is the model's TCP receptance, the lobes and the direct test agree, another pose moves the
 // low modes' lobes, and the time-domain cut refuses it by name.
 TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
-  config::MillingConfig job = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml");
+  config::MillingConfig job =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml");
   job.lobes.points = 400;  // enough for the check, a fifth of the job's cost
   job.lobes.points_per_mode = 80;
   const auto& part = *job.structures.front().parts.front().pose;
@@ -283,7 +290,8 @@ TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
     Eigen::Matrix2cd h = Eigen::Matrix2cd::Zero();
     const std::complex<double> jw(0.0, 2.0 * M_PI * f);
     for (const auto& t : terms)
-      h(t.response, t.excitation) += (t.a + t.b * jw) / (jw * jw + 2.0 * t.damping_ratio * t.wn_rad_per_s * jw + t.wn_rad_per_s * t.wn_rad_per_s);
+      h(t.response, t.excitation) +=
+          (t.a + t.b * jw) / (jw * jw + 2.0 * t.damping_ratio * t.wn_rad_per_s * jw + t.wn_rad_per_s * t.wn_rad_per_s);
     const Eigen::Matrix2cd exact = chain.tcp_frf_direct(f);
     std::cout << f << " Hz: modal terms against the model " << (h - exact).norm() / exact.norm() << " relative\n";
     // The joints' damping is not proportional (zeta 0.02, 0.02, 0.01): undamped shapes with modal damping
@@ -295,11 +303,12 @@ TEST(PoseLobes, AJobAtAPoseTakesTheRobotModelsTcpReceptance) {
   ov.rpm = rpm;
   const milling::CutJob at = milling::make_cut_job(job, s, ov);
   const double zoa_mm = lobes.critical_depth_mm(rpm);
-  const milling::SdmPoint sdm = milling::SdmModel(at.terms, at.cutter, at.material, job.cut.mode, job.cut.radial_mm, 1, 40)
-                                    .critical(rpm, zoa_mm);
-  const milling::CriticalDepth td = milling::critical_depth(at.dynamics, at.cutter, at.material, at.settings, sdm.critical_depth_mm);
-  std::cout << "pose 2 at " << rpm << " rpm: zero-order " << zoa_mm << " mm, SDM " << sdm.critical_depth_mm << " mm, time domain "
-            << td.depth_mm << " mm (chatter " << td.chatter_hz << " Hz)\n";
+  const milling::SdmPoint sdm =
+      milling::SdmModel(at.terms, at.cutter, at.material, job.cut.mode, job.cut.radial_mm, 1, 40).critical(rpm, zoa_mm);
+  const milling::CriticalDepth td =
+      milling::critical_depth(at.dynamics, at.cutter, at.material, at.settings, sdm.critical_depth_mm);
+  std::cout << "pose 2 at " << rpm << " rpm: zero-order " << zoa_mm << " mm, SDM " << sdm.critical_depth_mm
+            << " mm, time domain " << td.depth_mm << " mm (chatter " << td.chatter_hz << " Hz)\n";
   EXPECT_GT(cut.terms.size(), 12U);
   // Measured: zero-order 0.0357, SDM 0.0369, time domain 0.0387 mm. The simulated cut keeps the job's
   // helix, runout and the tool leaving the cut, which SDM's linear model does not (at 1500 rpm the soft

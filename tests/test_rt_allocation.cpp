@@ -122,7 +122,7 @@ TEST(RealTimePath, TheHooksCountEveryAllocationPathAndLock) {
   const int rc = posix_memalign(&r, 64, 128);
   void* s = std::aligned_alloc(64, 128);
   void* t = ::operator new(16);
-  void* u = ::operator new(16, std::align_val_t{64});
+  void* u = ::operator new (16, std::align_val_t{64});
   void* v = ::operator new[](16, std::nothrow);
   m.lock();
   m.unlock();
@@ -135,7 +135,7 @@ TEST(RealTimePath, TheHooksCountEveryAllocationPathAndLock) {
   EXPECT_EQ(g_loop_thread_locks.load() - l0, 2) << "lock and try_lock";
   std::free(p), std::free(q), std::free(r), std::free(s);
   ::operator delete(t);
-  ::operator delete(u, std::align_val_t{64});
+  ::operator delete (u, std::align_val_t{64});
   ::operator delete[](v);
   const long before = g_loop_thread_allocations.load();
   std::free(std::malloc(8));  // not a marked thread
@@ -221,16 +221,18 @@ TEST(RealTimePath, CanDriverAllocatesNothing) {
   std::uint64_t ok_reads = 0;
   for (std::uint64_t tick = 0; tick < 200'000; ++tick) {
     const canfd_frame f = drivers::encode(can.sensor, true, std::sin(0.01 * static_cast<double>(tick)),
-                                          static_cast<std::uint32_t>(tick + tick / 2000)).frame;  // a gap every 0.4 s
+                                          static_cast<std::uint32_t>(tick + tick / 2000))
+                              .frame;  // a gap every 0.4 s
     (void)send(sv[1], &f, CANFD_MTU, 0);
     canfd_frame extra = f;
     if (tick % 97 == 0) extra.can_id = 0x555;                                // another node
     if (tick % 5001 == 0) extra.can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;      // bus-off ...
     if (tick % 5001 == 40) extra.can_id = CAN_ERR_FLAG | CAN_ERR_RESTARTED;  // ... and restart
     if (extra.can_id != f.can_id) (void)send(sv[1], &extra, CANFD_MTU, 0);
-    if (tick % 331 == 0) (void)send(sv[1], &f, 9, 0);                        // malformed datagram
-    if (tick % 7 == 0) {  // jitter: two frames in one tick, then none
-      const canfd_frame g = drivers::encode(can.sensor, true, 0.0, static_cast<std::uint32_t>(tick + tick / 2000 + 1)).frame;
+    if (tick % 331 == 0) (void)send(sv[1], &f, 9, 0);  // malformed datagram
+    if (tick % 7 == 0) {                               // jitter: two frames in one tick, then none
+      const canfd_frame g =
+          drivers::encode(can.sensor, true, 0.0, static_cast<std::uint32_t>(tick + tick / 2000 + 1)).frame;
       (void)send(sv[1], &g, CANFD_MTU, 0);
     }
     const auto s = driver.read(tick);
@@ -327,7 +329,8 @@ TEST(RealTimePath, LoopWithSimulatedBackendAllocatesNothingOverAMillionTicks) {
   loop.schedule(31 * 5000, {rt::CommandKind::kSetGain, 1e9});
   loop.schedule(180 * 5000, {rt::CommandKind::kDisarm, 0.0});
   const std::string path = ::testing::TempDir() + "/alloc_loop.rec";
-  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(), config::ClockKind::kVirtual));
+  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(),
+                                                   config::ClockKind::kVirtual));
   rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
   drain.start();
 
@@ -379,7 +382,8 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
   loop.schedule(at(22.0), {rt::CommandKind::kResetFault, 0.0});
   loop.schedule(at(22.1), {rt::CommandKind::kSetPoseRegion, 0.0});
   const std::string path = ::testing::TempDir() + "/alloc_pose.rec";
-  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(), config::ClockKind::kVirtual));
+  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(),
+                                                   config::ClockKind::kVirtual));
   rt::TelemetryDrain drain(session.telemetry_ring(), {[&](const rt::TelemetryFrame& f) { recorder.write(f); }});
   drain.start();
   const LoopThreadCounts counts = run_counted(loop, at(25.0));
@@ -443,10 +447,11 @@ TEST(RealTimePath, TheSaturationDeratingAllocatesNothing) {
   session.plant().add_excitation(std::make_unique<sim::Sine>(0, 400.0, 9.2, 0.0));  // at the TCP, on the 9.2 Hz mode
   expect_none_with_the_spindle_turning(session.loop());
   const auto& c = session.supervisor().counters();
-  std::printf("[ rt path  ] saturation: %llu probes, %llu saturation derates, %llu restores, %llu saturated ticks, trip %s\n",
-              static_cast<unsigned long long>(c.derate_probes), static_cast<unsigned long long>(c.saturation_derates),
-              static_cast<unsigned long long>(c.derate_restores), static_cast<unsigned long long>(c.saturated_ticks),
-              rt::to_string(session.supervisor().observed_trip()));
+  std::printf(
+      "[ rt path  ] saturation: %llu probes, %llu saturation derates, %llu restores, %llu saturated ticks, trip %s\n",
+      static_cast<unsigned long long>(c.derate_probes), static_cast<unsigned long long>(c.saturation_derates),
+      static_cast<unsigned long long>(c.derate_restores), static_cast<unsigned long long>(c.saturated_ticks),
+      rt::to_string(session.supervisor().observed_trip()));
   EXPECT_GE(c.derate_probes, 1U);
   EXPECT_GE(c.growth_process, 1U);
   EXPECT_GE(c.saturation_derates, 2U);
@@ -466,8 +471,13 @@ TEST(RealTimePath, CommissioningMeasurementAllocatesNothing) {
   off.controller.gain_ns_per_m = 0.0;
   runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
-  o.chirp = {true, plan.chirp_start_s, cfg.commissioning.chirp_period_s, cfg.commissioning.chirp_periods,
-             cfg.commissioning.chirp_f0_hz, cfg.commissioning.chirp_f1_hz, plan.chirp_amplitude_v};
+  o.chirp = {true,
+             plan.chirp_start_s,
+             cfg.commissioning.chirp_period_s,
+             cfg.commissioning.chirp_periods,
+             cfg.commissioning.chirp_f0_hz,
+             cfg.commissioning.chirp_f1_hz,
+             plan.chirp_amplitude_v};
   runtime::Cell session(off, o);
   test::configure(session);
   analysis::ModalTest modal(cfg, session.plant(), plan);
@@ -513,10 +523,11 @@ TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   session.plant().add_excitation(std::make_unique<sim::ImpactHammer>(0, 1000.0, 1e-3, hits));
   rt::Loop& loop = session.loop();  // wall clock (loop.clock), armed at tick 51
   const std::string path = ::testing::TempDir() + "/soak.rec";
-  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(), config::ClockKind::kWall));
+  rt::Recorder recorder(path, rt::recording_header({cfg.loop.rate_hz, cfg.source, cfg.yaml_text}, session.supervisor(),
+                                                   config::ClockKind::kWall));
   rt::LiveTiming live;
   rt::TelemetryDrain drain(session.telemetry_ring(),
-                          {[&](const rt::TelemetryFrame& f) { recorder.write(f); }, std::ref(live)});
+                           {[&](const rt::TelemetryFrame& f) { recorder.write(f); }, std::ref(live)});
   rt::RealtimeStatus status;
   rt::RealtimeProcess process(cfg.realtime, status);
   drain.start();
@@ -550,12 +561,13 @@ TEST(RealTimePath, SixtySecondRealTimeSoakHasAFlatMemoryFootprint) {
   const auto [lo, hi] = std::minmax_element(rss.begin(), rss.end());
   EXPECT_LT(*hi - *lo, 1024) << "resident KiB from " << *lo << " to " << *hi;
   const auto snap = live.snapshot();
-  std::printf("[ soak     ] %llu ticks, missed %llu, overruns %llu; wake-up p50 %.0f p99 %.0f p99.9 %.0f max %.1f us; "
-              "RSS %ld..%ld KiB; %s\n",
-              static_cast<unsigned long long>(stats.ticks_run), static_cast<unsigned long long>(stats.missed_ticks),
-              static_cast<unsigned long long>(stats.overruns), stats.wake_latency.percentile_us(0.5),
-              stats.wake_latency.percentile_us(0.99), stats.wake_latency.percentile_us(0.999),
-              stats.wake_latency.max_us(), *lo, *hi, status.fifo ? "SCHED_FIFO" : "SCHED_OTHER");
+  std::printf(
+      "[ soak     ] %llu ticks, missed %llu, overruns %llu; wake-up p50 %.0f p99 %.0f p99.9 %.0f max %.1f us; "
+      "RSS %ld..%ld KiB; %s\n",
+      static_cast<unsigned long long>(stats.ticks_run), static_cast<unsigned long long>(stats.missed_ticks),
+      static_cast<unsigned long long>(stats.overruns), stats.wake_latency.percentile_us(0.5),
+      stats.wake_latency.percentile_us(0.99), stats.wake_latency.percentile_us(0.999), stats.wake_latency.max_us(), *lo,
+      *hi, status.fifo ? "SCHED_FIFO" : "SCHED_OTHER");
   EXPECT_EQ(snap.frames, stats.ticks_run) << "telemetry's timing view saw every tick";
 }
 

@@ -127,13 +127,15 @@ TEST(Loop, TheChirpIsACommandSourceOfTheLoopClampedAndReplayed) {
       continue;
     }
     ++inside;
-    const double fade = std::min(1.0, static_cast<double>(i - active + 1) / (cfg.controller.gain_ramp_s * cfg.loop.rate_hz));
+    const double fade =
+        std::min(1.0, static_cast<double>(i - active + 1) / (cfg.controller.gain_ramp_s * cfg.loop.rate_hz));
     const double want = std::clamp(fade * chirp_v, -2.0, 2.0);
     clamped += std::abs(fade * chirp_v) > 2.0 ? 1 : 0;
     EXPECT_NEAR(f.command_v, want, 1e-9) << "tick " << i;
     peak_v = std::max(peak_v, std::abs(f.command_v));
   }
-  EXPECT_GE(inside, static_cast<std::size_t>(0.99 * o.chirp.period_s * o.chirp.periods * cfg.loop.rate_hz));  // its window, active
+  EXPECT_GE(inside, static_cast<std::size_t>(0.99 * o.chirp.period_s * o.chirp.periods *
+                                             cfg.loop.rate_hz));  // its window, active
   EXPECT_GT(clamped, 100U);
   EXPECT_EQ(r.s.supervisor.saturated_ticks, clamped);
   EXPECT_EQ(peak_v, 2.0);
@@ -152,10 +154,13 @@ TEST(Loop, AnOnCommandChirpStartsAtTheTickAfterEachStartCommandAndReplays) {
   o.chirp = {true, 0.0, 0.25, 2, 5.0, 40.0, 0.5, 0.0, true};
   o.record_path = ::testing::TempDir() + "/chirp_on_command.rec";
   const std::uint64_t first = 5000, second = 9000;  // 1.0 s and 1.8 s at 5 kHz: the loop is active by then
-  const auto r = run(cfg, 2.5, [&](Cell& c) {
-    c.schedule(first, {CommandKind::kStartExcitation, 0.0});
-    c.schedule(second, {CommandKind::kStartExcitation, 0.0});
-  }, o);
+  const auto r = run(
+      cfg, 2.5,
+      [&](Cell& c) {
+        c.schedule(first, {CommandKind::kStartExcitation, 0.0});
+        c.schedule(second, {CommandKind::kStartExcitation, 0.0});
+      },
+      o);
   ASSERT_EQ(r.s.trip, "none") << r.s.final_state;
   const double fs = cfg.loop.rate_hz;
   rt::PeriodicChirp from = o.chirp;
@@ -177,7 +182,8 @@ TEST(Loop, AnOnCommandChirpStartsAtTheTickAfterEachStartCommandAndReplays) {
     EXPECT_NEAR(f.command_v, want, 1e-9) << "tick " << f.tick;
     nonzero += f.command_v != 0.0 ? 1 : 0;
   }
-  EXPECT_GT(nonzero, static_cast<std::size_t>(0.9 * 2 * o.chirp.period_s * o.chirp.periods * fs));  // both chirps played
+  EXPECT_GT(nonzero,
+            static_cast<std::size_t>(0.9 * 2 * o.chirp.period_s * o.chirp.periods * fs));  // both chirps played
   const Recording rec = read_recording(o.record_path);
   EXPECT_EQ(rec.header.at("commands").back(), "start_excitation");
   EXPECT_TRUE(rec.header.at("excitation").at("chirp").at("on_command").get<bool>());
@@ -189,7 +195,12 @@ TEST(Loop, AnOnCommandChirpStartsAtTheTickAfterEachStartCommandAndReplays) {
 TEST(Loop, ArmingRefusedUntilSensorLive) {
   CellOptions o = virtual_clock();
   o.arm_at_start = false;
-  const auto r = run(c2(), 0.1, [](Cell& s) { s.schedule(3, {CommandKind::kArm, 0.0}); }, o);
+  const auto r = run(
+      c2(), 0.1,
+      [](Cell& s) {
+        s.schedule(3, {CommandKind::kArm, 0.0});
+      },
+      o);
   EXPECT_EQ(r.s.supervisor.arm_refused, 1U);
   EXPECT_EQ(first_state(r, State::kArming), r.frames.size());
 }
@@ -249,15 +260,14 @@ TEST_P(Trips, RampToZeroWithinTheConfiguredTimeAndLatch) {
 
 INSTANTIATE_TEST_SUITE_P(
     SimulatedFaults, Trips,
-    ::testing::Values(TripCase{"sensor_dropout", {FaultKind::kSensorDropout, 1.0, 0.5}, Trip::kSensorStale, 5 / 5000.0},
-                      TripCase{"sensor_nan", {FaultKind::kSensorNan, 1.0, 0.5}, Trip::kSampleInvalid, 1 / 5000.0},
-                      TripCase{"sensor_spike", {FaultKind::kSensorSpike, 1.0, 0.5, 1e5}, Trip::kSampleInvalid, 1 / 5000.0},
-                      TripCase{"amplifier_fault", {FaultKind::kAmplifierFault, 1.0, 0.5}, Trip::kAmplifierFault, 1 / 5000.0},
-                      TripCase{"sensor_driver", {FaultKind::kSensorDriverError, 1.0, 0.5}, Trip::kSensorDriver, 1 / 5000.0},
-                      TripCase{"actuator_driver", {FaultKind::kActuatorDriverError, 1.0, 0.5}, Trip::kActuatorDriver,
-                               2 / 5000.0},
-                      TripCase{"actuator_saturated", {FaultKind::kActuatorSaturated, 1.0, 0.5, 0.002}, Trip::kSaturation,
-                               0.11}),
+    ::testing::Values(
+        TripCase{"sensor_dropout", {FaultKind::kSensorDropout, 1.0, 0.5}, Trip::kSensorStale, 5 / 5000.0},
+        TripCase{"sensor_nan", {FaultKind::kSensorNan, 1.0, 0.5}, Trip::kSampleInvalid, 1 / 5000.0},
+        TripCase{"sensor_spike", {FaultKind::kSensorSpike, 1.0, 0.5, 1e5}, Trip::kSampleInvalid, 1 / 5000.0},
+        TripCase{"amplifier_fault", {FaultKind::kAmplifierFault, 1.0, 0.5}, Trip::kAmplifierFault, 1 / 5000.0},
+        TripCase{"sensor_driver", {FaultKind::kSensorDriverError, 1.0, 0.5}, Trip::kSensorDriver, 1 / 5000.0},
+        TripCase{"actuator_driver", {FaultKind::kActuatorDriverError, 1.0, 0.5}, Trip::kActuatorDriver, 2 / 5000.0},
+        TripCase{"actuator_saturated", {FaultKind::kActuatorSaturated, 1.0, 0.5, 0.002}, Trip::kSaturation, 0.11}),
     [](const auto& test_info) { return std::string(test_info.param.name); });
 
 TEST(Loop, AStuckSensorIsNotATripButItsOutputStaysBounded) {
@@ -396,8 +406,8 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   const std::size_t c3 = session.add_parameter_set(config::load_config_file(test::preset("horizontal_c3")));
   const std::size_t bad = session.add_parameter_set(unstable);
   session.schedule(5000, {CommandKind::kSelectParams, static_cast<double>(c3)});
-  session.schedule(5001, {CommandKind::kSelectParams, 0.0});  // refused: hand-over in progress
-  session.schedule(5002, {CommandKind::kSelectParams, 7.0});  // refused: no such set
+  session.schedule(5001, {CommandKind::kSelectParams, 0.0});                        // refused: hand-over in progress
+  session.schedule(5002, {CommandKind::kSelectParams, 7.0});                        // refused: no such set
   session.schedule(15000, {CommandKind::kSelectParams, static_cast<double>(bad)});  // refused: unstable
   ASSERT_TRUE(session.run(4.0).ok());
   const auto& s = session.summary();
@@ -410,7 +420,8 @@ TEST(Loop, ParameterSetSelectionIsValidatedAndHandedOverWithoutATrip) {
   const auto& f = session.frames();
   // Through the hand-over the loop stays active and the command changes smoothly (no step).
   double worst_step = 0.0, normal_step = 0.0;
-  for (std::size_t i = 4000; i < 5000; ++i) normal_step = std::max(normal_step, std::abs(f[i].command_v - f[i - 1].command_v));
+  for (std::size_t i = 4000; i < 5000; ++i)
+    normal_step = std::max(normal_step, std::abs(f[i].command_v - f[i - 1].command_v));
   for (std::size_t i = 5000; i < 15000; ++i) {
     EXPECT_EQ(f[i].state, static_cast<std::uint8_t>(State::kActive));
     worst_step = std::max(worst_step, std::abs(f[i].command_v - f[i - 1].command_v));
@@ -471,10 +482,16 @@ TEST(Loop, WallClockSkipsMissedTicksWithoutBurstAndCountsOverruns) {
   CellOptions o;
   o.keep_frames = true;
   o.realtime_setup = true;
-  const auto r = run(c2(), 0.6, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3}); }, o);
+  const auto r = run(
+      c2(), 0.6,
+      [](Cell& s) {
+        s.plant().faults().add({FaultKind::kDriverStall, 0.3, 1e-4, 1.1e-3});
+      },
+      o);
   expect_nothing_lost(r);
   EXPECT_GE(r.s.loop.missed_ticks, 4U);
-  EXPECT_EQ(r.s.loop.ticks_run + r.s.loop.missed_ticks, r.frames.back().tick + 1) << "every nominal tick run or skipped";
+  EXPECT_EQ(r.s.loop.ticks_run + r.s.loop.missed_ticks, r.frames.back().tick + 1)
+      << "every nominal tick run or skipped";
   bool gap = false;
   const double period_s = 1.0 / c2().loop.rate_hz;
   for (std::size_t i = 1; i < r.frames.size(); ++i)
@@ -495,7 +512,12 @@ TEST(Loop, ConsecutiveOverrunsTrip) {
   o.keep_frames = true;
   auto cfg = c2();
   cfg.supervision.overrun_delay_margin_share = 0.0;
-  const auto r = run(cfg, 1.5, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  const auto r = run(
+      cfg, 1.5,
+      [](Cell& s) {
+        s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4});
+      },
+      o);
   EXPECT_EQ(r.s.trip, "overruns");
   expect_nothing_lost(r);
   const std::size_t fault = first_state(r, State::kFault);
@@ -524,7 +546,12 @@ TEST(Loop, OverrunsWithinTheDelayMarginAreRiddenThrough) {
   // again, three times at most.
   const auto run_clean = [&](double duration_s, double stall_s) {
     for (int attempt = 1;; ++attempt) {
-      auto r = run(cfg, duration_s, [stall_s](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, stall_s, 3e-4}); }, o);
+      auto r = run(
+          cfg, duration_s,
+          [stall_s](Cell& s) {
+            s.plant().faults().add({FaultKind::kDriverStall, 1.0, stall_s, 3e-4});
+          },
+          o);
       const std::size_t fault = first_state(r, State::kFault);
       if (fault == r.frames.size() || r.frames[fault].time_s >= 1.0 || attempt == 3) return r;
       std::printf("[ overruns ] the machine's own stall tripped the loop at %.3f s, before the injection: run again\n",
@@ -546,9 +573,10 @@ TEST(Loop, OverrunsWithinTheDelayMarginAreRiddenThrough) {
   ASSERT_LT(fault, t.frames.size());
   EXPECT_GE(t.frames[fault].time_s - 1.0, dm - 1e-3);
   EXPECT_LE(t.frames[fault].time_s - 1.0, dm + 0.02);
-  std::printf("[ overruns ] delay margin %.2f ms: 8 ms of overruns ridden through (%llu runs), 0.2 s tripped after %.2f ms\n",
-              1e3 * dm, static_cast<unsigned long long>(r.s.supervisor.overrun_runs_ridden),
-              1e3 * (t.frames[fault].time_s - 1.0));
+  std::printf(
+      "[ overruns ] delay margin %.2f ms: 8 ms of overruns ridden through (%llu runs), 0.2 s tripped after %.2f ms\n",
+      1e3 * dm, static_cast<unsigned long long>(r.s.supervisor.overrun_runs_ridden),
+      1e3 * (t.frames[fault].time_s - 1.0));
 }
 
 TEST(Loop, SigintShutsDownThroughTheSafeState) {
@@ -577,7 +605,6 @@ TEST(Loop, SigintShutsDownThroughTheSafeState) {
   ASSERT_LT(trip, f.size());
   EXPECT_LE(f.back().time_s - f[trip].time_s, 0.0102) << "ramped to zero within trip_ramp_s";
 }
-
 
 }  // namespace
 }  // namespace robodamp::rt

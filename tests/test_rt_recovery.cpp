@@ -25,11 +25,14 @@ TEST(StaleRideThrough, AStaleSensorShorterThanTheTripDrivesNothingAndCostsNoTrip
   o.impact_every_s = 0.9;
   const auto clean = run(cfg, 3.5, o);
   o.record_path = ::testing::TempDir() + "/stale_ride_" + std::to_string(::getpid()) + ".rec";
-  const auto r = run(cfg, 3.5, [](Cell& s) {
-    s.plant().faults().add({FaultKind::kSensorDropout, 1.85, 0.04});      // 200 ticks, 50 ms after a hit
-    s.plant().faults().add({FaultKind::kSensorDropout, 2.20010, 0.0002});  // lone repeats (CAN de-jitter)
-    s.plant().faults().add({FaultKind::kSensorDropout, 2.60010, 0.0002});
-  }, o);
+  const auto r = run(
+      cfg, 3.5,
+      [](Cell& s) {
+        s.plant().faults().add({FaultKind::kSensorDropout, 1.85, 0.04});       // 200 ticks, 50 ms after a hit
+        s.plant().faults().add({FaultKind::kSensorDropout, 2.20010, 0.0002});  // lone repeats (CAN de-jitter)
+        s.plant().faults().add({FaultKind::kSensorDropout, 2.60010, 0.0002});
+      },
+      o);
   EXPECT_EQ(r.s.trip, "none");
   EXPECT_EQ(r.s.supervisor.recoveries, 0U);
   const std::size_t full = first_state(r, State::kActive) + static_cast<std::size_t>(0.5 * 5000);
@@ -65,8 +68,8 @@ TEST(StaleRideThrough, AStaleSensorShorterThanTheTripDrivesNothingAndCostsNoTrip
     peak_v = std::max(peak_v, std::abs(r.frames[i].command_v));
     clean_peak_v = std::max(clean_peak_v, std::abs(clean.frames[i].command_v));
   }
-  std::printf("[ stale    ] 40 ms ridden through: peak command %.3f V in the 0.1 s after (undisturbed %.3f V)\n", peak_v,
-              clean_peak_v);
+  std::printf("[ stale    ] 40 ms ridden through: peak command %.3f V in the 0.1 s after (undisturbed %.3f V)\n",
+              peak_v, clean_peak_v);
   EXPECT_LT(peak_v, 2.0 * clean_peak_v + 0.05);
   expect_nothing_lost(r);
   const ReplayResult res = replay(read_recording(o.record_path));
@@ -76,7 +79,12 @@ TEST(StaleRideThrough, AStaleSensorShorterThanTheTripDrivesNothingAndCostsNoTrip
 TEST(Recovery, ATransientSensorDropoutRecoversAfterTheCoolDownAndTheHealthCheck) {
   CellOptions o = virtual_clock();
   o.record_path = ::testing::TempDir() + "/recovery_" + std::to_string(::getpid()) + ".rec";
-  const auto r = run(c2(), 6.0, [](Cell& s) { s.plant().faults().add({FaultKind::kSensorDropout, 1.0, 0.1}); }, o);
+  const auto r = run(
+      c2(), 6.0,
+      [](Cell& s) {
+        s.plant().faults().add({FaultKind::kSensorDropout, 1.0, 0.1});
+      },
+      o);
   // The trip as before: safe within the stale detection and the ramp.
   const std::size_t fault = first_state(r, State::kFault);
   ASSERT_LT(fault, r.frames.size());
@@ -168,7 +176,12 @@ TEST(Recovery, AnOverrunBurstOnTheWallClockRecovers) {
   config::Config cfg = c2();
   cfg.supervision.recovery.cool_down_s = 0.3;
   cfg.supervision.recovery.healthy_for_s = 0.5;
-  const auto r = run(cfg, 4.0, [](Cell& s) { s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4}); }, o);
+  const auto r = run(
+      cfg, 4.0,
+      [](Cell& s) {
+        s.plant().faults().add({FaultKind::kDriverStall, 1.0, 0.2, 3e-4});
+      },
+      o);
   EXPECT_GE(r.s.supervisor.trips[static_cast<std::size_t>(Trip::kOverruns)], 1U);
   EXPECT_GE(r.s.supervisor.recoveries, 1U) << "a loaded machine may stall again, but it recovers at least once";
   EXPECT_LT(first_state_after(r, State::kActive, 1.2), r.frames.size());

@@ -52,7 +52,7 @@ TEST(SpscRing, FullRingRefusesWithoutOverwriting) {
 TEST(TimingHistogram, PercentilesInWholeMicrosecondsAndExactMax) {
   TimingHistogram h;
   for (int i = 0; i < 1000; ++i) h.record(i * 1000 + 400);  // 0.4 us .. 999.4 us
-  h.record(20'000'000);                                    // 20 ms: overflow, max exact
+  h.record(20'000'000);                                     // 20 ms: overflow, max exact
   EXPECT_EQ(h.count(), 1001U);
   EXPECT_EQ(h.overflow(), 1U);
   EXPECT_DOUBLE_EQ(h.percentile_us(0.5), 500.0);
@@ -72,7 +72,7 @@ class RecordingTest : public ::testing::Test {
     o.keep_frames = true;
     runtime::Cell session(config::load_config_file(test::preset("horizontal_c2")), o);
     test::configure(session);
-      session.plant().faults().add({sim::FaultKind::kSensorNan, 1.2, 0.001});
+    session.plant().faults().add({sim::FaultKind::kSensorNan, 1.2, 0.001});
     session.schedule(3000, {CommandKind::kSetGain, 2600.0});
     session.schedule(7000, {CommandKind::kResetFault, 0.0});
     session.schedule(7100, {CommandKind::kArm, 0.0});
@@ -188,7 +188,8 @@ TEST(Recording, AVirtualClockRecordingIsByteIdenticalRunToRun) {
   const std::string a = record(dir + "_a.rec"), b = record(dir + "_b.rec");
   ASSERT_GT(a.size(), 5000U * sizeof(TelemetryFrame));
   EXPECT_EQ(a.size(), b.size());
-  EXPECT_TRUE(a == b) << "first differing byte at " << std::distance(a.begin(), std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first);
+  EXPECT_TRUE(a == b) << "first differing byte at "
+                      << std::distance(a.begin(), std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first);
   EXPECT_NE(a.find("\"created_utc\":null"), std::string::npos);
 }
 

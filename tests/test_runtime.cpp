@@ -61,10 +61,15 @@ TEST(PathAhead, TheProgramsNextPosesByNameUntilTheyAreDue) {
   cfg.hold_s = 3.0;
   PathAhead ahead(cfg, {"shoulder", "elbow", "wrist"});
   const auto t0 = PathAhead::Clock::now();
-  const auto at = [&](double s) { return t0 + std::chrono::duration_cast<PathAhead::Clock::duration>(std::chrono::duration<double>(s)); };
+  const auto at = [&](double s) {
+    return t0 + std::chrono::duration_cast<PathAhead::Clock::duration>(std::chrono::duration<double>(s));
+  };
   const double r = M_PI / 180.0;
   const std::vector<std::string> names{"wrist", "gripper", "elbow", "shoulder"};
-  ahead.on_message(names, {{{90 * r, 0.0, 20 * r, -100 * r}, 1.0}, {{91 * r, 0.0, 60 * r, -100 * r}, 2.5}, {{92 * r, 0.0, 100 * r, -100 * r}, 0.0}},
+  ahead.on_message(names,
+                   {{{90 * r, 0.0, 20 * r, -100 * r}, 1.0},
+                    {{91 * r, 0.0, 60 * r, -100 * r}, 2.5},
+                    {{92 * r, 0.0, 100 * r, -100 * r}, 0.0}},
                    t0);
   auto near = [](const std::vector<double>& a, const std::vector<double>& b) {
     if (a.size() != b.size()) return false;
@@ -125,7 +130,8 @@ TEST(Lifecycle, TransitionsFollowTheStatesAndRefuseTheWrongOnes) {
 
 TEST(ArmingPolicy, ArmsAtTheFirstLiveTickAndRetriesUntilActive) {
   ArmingPolicy p({51, 100, 1000});
-  for (std::uint64_t t = 0; t < 51; ++t) EXPECT_EQ(p.on_tick(t, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kNone);
+  for (std::uint64_t t = 0; t < 51; ++t)
+    EXPECT_EQ(p.on_tick(t, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kNone);
   EXPECT_EQ(p.on_tick(51, State::kDisabled, ArmRefusal::kNone).command.kind, CommandKind::kArm);
   // Refused: the supervisor stays disabled; the next attempt comes retry_ticks later.
   for (std::uint64_t t = 52; t < 151; ++t)
@@ -354,9 +360,21 @@ TEST(ParameterRequests, RandomValuesAreAcceptedOnlyInRangeAndAlwaysSayWhy) {
   const rt::Supervisor& sup = cell.supervisor();
   const double limit = sup.gain_limit_ns_per_m();
   std::mt19937_64 rng(13);
-  const double specials[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
-                             -std::numeric_limits<double>::infinity(), -0.0, 0.0, 1.0, 2.0, -1.0, 1e308, -1e308,
-                             std::numeric_limits<double>::denorm_min(), limit, std::nextafter(limit, 1e9), 0.5, 1.5};
+  const double specials[] = {std::numeric_limits<double>::quiet_NaN(),
+                             std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity(),
+                             -0.0,
+                             0.0,
+                             1.0,
+                             2.0,
+                             -1.0,
+                             1e308,
+                             -1e308,
+                             std::numeric_limits<double>::denorm_min(),
+                             limit,
+                             std::nextafter(limit, 1e9),
+                             0.5,
+                             1.5};
   std::uniform_real_distribution<double> wide(-1e6, 1e6);
   std::uniform_int_distribution<int> pick(0, 4), special(0, std::size(specials) - 1), coin(0, 1);
   int accepted = 0;
@@ -417,19 +435,26 @@ TEST(Availability, CountsTheAskedTimeAtFullGainAndEachTripsSafeAndReArmTimes) {
   };
   for (std::uint64_t k = 0; k <= 10000; ++k) {
     if (k >= 7000 && k < 7020) continue;  // missed: no frames
-    if (k < 100) frame(k, rt::State::kArming, rt::Trip::kNone, 0.0, true);
-    else if (k < 2000) frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
-    else if (k < 2010) frame(k, rt::State::kStopping, rt::Trip::kSensorStale, 0.05, true);
-    else if (k < 4900) frame(k, rt::State::kFault, rt::Trip::kSensorStale, 0.0, false);
-    else if (k < 5000) frame(k, rt::State::kArming, rt::Trip::kNone, 0.0, true);
-    else if (k < 9000) frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
-    else frame(k, rt::State::kStopping, rt::Trip::kNone, 0.0, true);
+    if (k < 100)
+      frame(k, rt::State::kArming, rt::Trip::kNone, 0.0, true);
+    else if (k < 2000)
+      frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
+    else if (k < 2010)
+      frame(k, rt::State::kStopping, rt::Trip::kSensorStale, 0.05, true);
+    else if (k < 4900)
+      frame(k, rt::State::kFault, rt::Trip::kSensorStale, 0.0, false);
+    else if (k < 5000)
+      frame(k, rt::State::kArming, rt::Trip::kNone, 0.0, true);
+    else if (k < 9000)
+      frame(k, rt::State::kActive, rt::Trip::kNone, 0.1, true);
+    else
+      frame(k, rt::State::kStopping, rt::Trip::kNone, 0.0, true);
   }
   const rt::Availability& a = m.result();
   EXPECT_NEAR(a.first_full_gain_s, 0.2, 1e-9);
-  EXPECT_NEAR(a.asked_s, 9.0 - 0.2, 1.5e-3);                            // 0.2 .. 9.0 s
+  EXPECT_NEAR(a.asked_s, 9.0 - 0.2, 1.5e-3);                           // 0.2 .. 9.0 s
   EXPECT_NEAR(a.active_s, (2.0 - 0.2) + (9.0 - 5.1) - 0.004, 1.5e-3);  // less the trip and the stale ticks
-  EXPECT_NEAR(a.missed_while_active_s, 0.020, 1e-9);                       // of it, the 20 missed ticks
+  EXPECT_NEAR(a.missed_while_active_s, 0.020, 1e-9);                   // of it, the 20 missed ticks
   EXPECT_NEAR(a.sensor_held_s, 0.004, 1e-9);
   EXPECT_NEAR(a.share(), a.active_s / a.asked_s, 1e-12);
   ASSERT_EQ(a.trips_total, 1u);

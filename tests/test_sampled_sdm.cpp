@@ -22,7 +22,9 @@ namespace {
 using namespace robodamp;
 using namespace robodamp::milling;
 
-std::string job_path(const std::string& name) { return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + name + ".yaml"; }
+std::string job_path(const std::string& name) {
+  return std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + name + ".yaml";
+}
 
 // The damped time-domain critical depth with enough revolutions that a slow decay near the limit is not
 // read as chatter (docs/milling.md).
@@ -51,10 +53,12 @@ TEST(SampledSdm, DampedLimitIsTheTimeDomainsWhereTheZeroOrderMethodIsWrong) {
     const double zoa = zero_order_mm(cfg, damped, rpm);
     const SdmPoint sdm = truth.critical(rpm, zoa);
     const double td = time_domain_mm(cfg, open, rpm, sdm.critical_depth_mm);
-    EXPECT_NEAR(sdm.critical_depth_mm / td, 1.0, 0.05) << controller << " at " << rpm << " rpm: SDM " << sdm.critical_depth_mm
-                                                         << " mm, time domain " << td << " mm";
-    EXPECT_GT(std::abs(zoa / td - 1.0), 0.2) << controller << ": the zero-order method is not the one that is wrong here";
-    EXPECT_NEAR(sdm.rpm, 60.0 / (3 * std::round(60.0 / (rpm * 3) * 5000.0) / 5000.0), 1e-9) << "stepped to the loop rate";
+    EXPECT_NEAR(sdm.critical_depth_mm / td, 1.0, 0.05)
+        << controller << " at " << rpm << " rpm: SDM " << sdm.critical_depth_mm << " mm, time domain " << td << " mm";
+    EXPECT_GT(std::abs(zoa / td - 1.0), 0.2)
+        << controller << ": the zero-order method is not the one that is wrong here";
+    EXPECT_NEAR(sdm.rpm, 60.0 / (3 * std::round(60.0 / (rpm * 3) * 5000.0) / 5000.0), 1e-9)
+        << "stepped to the loop rate";
   }
 }
 
@@ -66,13 +70,17 @@ config::MillingConfig own_job(const std::string& mode) {
   const std::string path = dir + "/" + mode + ".yaml";
   std::ofstream(path) << "tool: {kind: end_mill, diameter_mm: 16, teeth: 4, helix_deg: 30}\n"
                          "material: {name: cast iron, kt_n_per_mm2: 1100, kn_n_per_mm2: 330}\n"
-                         "cut: {mode: " + mode + ", radial_mm: 4, axial_mm: 0.3, feed_per_tooth_mm: 0.08, feed_axis: x, spindle_rpm: 500}\n"
-                         "structures:\n"
-                         "  - name: robot\n"
-                         "    parts:\n"
-                         "      - name: arm\n"
-                         "        controller: {config: " + test::preset("horizontal_c1") + ", location: 1, direction: y}\n"
-                         "lobes: {rpm_min: 100, rpm_max: 1500, points: 400}\n";
+                         "cut: {mode: " +
+                             mode +
+                             ", radial_mm: 4, axial_mm: 0.3, feed_per_tooth_mm: 0.08, feed_axis: x, spindle_rpm: 500}\n"
+                             "structures:\n"
+                             "  - name: robot\n"
+                             "    parts:\n"
+                             "      - name: arm\n"
+                             "        controller: {config: " +
+                             test::preset("horizontal_c1") +
+                             ", location: 1, direction: y}\n"
+                             "lobes: {rpm_min: 100, rpm_max: 1500, points: 400}\n";
   config::MillingConfig cfg = config::load_milling_config(path);
   std::filesystem::remove_all(dir);
   return cfg;
@@ -85,7 +93,8 @@ TEST(SampledSdm, HoldsOnAJobOfItsOwn) {
   for (double rpm : {500.0, 333.0}) {
     const SdmPoint sdm = truth.critical(rpm, zero_order_mm(cfg, damped, rpm));
     const double td = time_domain_mm(cfg, open, rpm, sdm.critical_depth_mm);
-    EXPECT_NEAR(sdm.critical_depth_mm / td, 1.0, 0.05) << rpm << " rpm: SDM " << sdm.critical_depth_mm << " mm, time domain " << td;
+    EXPECT_NEAR(sdm.critical_depth_mm / td, 1.0, 0.05)
+        << rpm << " rpm: SDM " << sdm.critical_depth_mm << " mm, time domain " << td;
   }
 }
 
@@ -131,10 +140,12 @@ TEST(SampledSdm, AtZeroGainItIsTheOpenLoopSdm) {
 TEST(SampledSdm, RefusesWhatItCannotStepWithTheValueUnitAndRange) {
   const config::MillingConfig cfg = config::load_milling_config(job_path("active_damping_c2"));
   const Structure damped(cfg.structures.front(), true);
-  const SampledSdm sdm(damped, cutter_from(cfg.tool), cfg.material, cfg.cut.mode, cfg.cut.radial_mm, cfg.cut.feed_axis, {});
+  const SampledSdm sdm(damped, cutter_from(cfg.tool), cfg.material, cfg.cut.mode, cfg.cut.radial_mm, cfg.cut.feed_axis,
+                       {});
   // 5 kHz, 3 teeth, 10 ticks per tooth period at least: up to 60 / (3 * 9.5 * 0.2 ms) = 10 526 rpm.
   EXPECT_NEAR(sdm.max_rpm(), 10526.3, 0.1);
-  for (double rpm : {20000.0, 0.0, -5.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+  for (double rpm :
+       {20000.0, 0.0, -5.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     try {
       (void)sdm.critical(rpm, 1.0);
       ADD_FAILURE() << rpm << " rpm accepted";

@@ -95,7 +95,8 @@ TEST(IntervalExp, EqualsTheDenseExponentialOverTheSpeedsAndCutsOfTheIndustrialRo
       big.block(n, n + 2, 2, 2).setIdentity();
       // The truth in long double (Eigen's scaling and squaring at 64-bit precision).
       using MatrixXld = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
-      const Eigen::MatrixXd truth = MatrixXld((big.cast<long double>() * static_cast<long double>(h_s)).exp()).cast<double>();
+      const Eigen::MatrixXd truth =
+          MatrixXld((big.cast<long double>() * static_cast<long double>(h_s)).exp()).cast<double>();
       const Eigen::MatrixXd dense = (big * h_s).exp();
       structured.compute(u, h_s, e);
       // Entry by entry against the entries' own scale (rows and columns mix metres, m/s and N/m).
@@ -124,7 +125,8 @@ TEST(Sdm, TheStructuredMonodromyHasTheDenseFormulasMultipliersAndDepthsOnTheFort
   ASSERT_EQ(r.terms.size(), 46U);
   const Cutter cutter = cutter_from(r.job.tool);
   const int m = r.job.time_domain.sdm_steps_per_period;
-  const SdmModel sdm(r.terms, cutter, r.job.material, r.job.cut.mode, r.job.cut.radial_mm, r.job.time_domain.axial_slices, m);
+  const SdmModel sdm(r.terms, cutter, r.job.material, r.job.cut.mode, r.job.cut.radial_mm,
+                     r.job.time_domain.axial_slices, m);
   // The diagram's minimum (1156 rpm), a middle speed and the published job's 10 700 rpm; a stable and an
   // unstable depth at each.
   for (const double rpm : {1156.0, 5000.0, 10700.0})
@@ -136,8 +138,8 @@ TEST(Sdm, TheStructuredMonodromyHasTheDenseFormulasMultipliersAndDepthsOnTheFort
       EXPECT_NEAR(std::abs(std::arg(got)), std::abs(std::arg(truth)), 1e-7) << rpm << " rpm, " << axial_mm << " mm";
     }
   // The critical depth: the same search on the same function gives the same bracket.
-  const DepthBracket truth = find_critical_depth(
-      [&](double b) { return std::log(std::abs(dense_multiplier(r, b, 1156.0, m))); }, 3.0, 1e-3);
+  const DepthBracket truth =
+      find_critical_depth([&](double b) { return std::log(std::abs(dense_multiplier(r, b, 1156.0, m))); }, 3.0, 1e-3);
   const SdmPoint got = sdm.critical(1156.0, 3.0);
   EXPECT_NEAR(got.critical_depth_mm, truth.lo_mm, 1e-7 * truth.lo_mm);
   EXPECT_NEAR(got.critical_depth_mm, 3.478, 0.0005);  // docs/tests.md's minimum of the 200-speed diagram
@@ -150,7 +152,8 @@ namespace {
 
 // A real matrix of this size with the given multipliers (complex ones with their conjugates), the rest of its
 // spectrum random inside radius `rest`, in a random basis (condition number 3).
-Eigen::MatrixXd with_spectrum(Eigen::Index size, const std::vector<std::complex<double>>& wanted, double rest, unsigned seed) {
+Eigen::MatrixXd with_spectrum(Eigen::Index size, const std::vector<std::complex<double>>& wanted, double rest,
+                              unsigned seed) {
   std::srand(seed);
   Eigen::MatrixXd d = Eigen::MatrixXd::Zero(size, size);
   Eigen::Index i = 0;

@@ -33,8 +33,9 @@ controller:
 robot:
   frfs:
     - {name: H11, response_location: 1, excitation_location: 1,
-       modes: [{natural_freq_hz: )" + std::to_string(fn) + ", damping_ratio: " + std::to_string(zeta) +
-         ", stiffness_n_per_m: " + std::to_string(k) + R"(}]}
+       modes: [{natural_freq_hz: )" +
+         std::to_string(fn) + ", damping_ratio: " + std::to_string(zeta) + ", stiffness_n_per_m: " + std::to_string(k) +
+         R"(}]}
 sensor: {location: 1, noise_density_ug_per_rthz: 0, highpass_hz: 0, adc_bits: 32}
 disturbances: {drives_on: false, drive_vibration_location: 1}
 )" + extra;
@@ -59,7 +60,9 @@ TEST(StateSpace, ZohOfAModeMatchesTheAnalyticStepResponse) {
   for (int i = 1; i <= 5000; ++i) {
     plant.step(0.0);
     const double t = plant.time_s();
-    const double x = 10.0 / k * (1 - std::exp(-zeta * wn * t) * (std::cos(wd * t) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * t)));
+    const double x =
+        10.0 / k *
+        (1 - std::exp(-zeta * wn * t) * (std::cos(wd * t) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * t)));
     worst = std::max(worst, std::abs(plant.displacement_m(0) - x));
   }
   EXPECT_LT(worst, 1e-12 * 10.0 / k * 1e3);  // relative 1e-9 of the static deflection

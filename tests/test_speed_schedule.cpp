@@ -58,12 +58,15 @@ std::string problems(const std::string& schedule_yaml) {
 
 TEST(SpeedScheduleConfig, BandsAscendAndEveryKeyIsNamedWithItsUnitAndRangeWhenRefused) {
   // Block and flow styles read the same.
-  const auto block = with_schedule("  speed_schedule:\n    controllers:\n      - polarity: -1\n        compensator:\n"
-                                   "          kind: compensator\n          model: c1\n          corner_hz: 0.5\n    bands:\n"
-                                   "      - rpm_min: 100\n        rpm_max: 400\n        controller: 1\n        gain_ns_per_m: 2000\n"
-                                   "      - {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}\n");
-  const auto flow = with_schedule("  speed_schedule: {controllers: [{polarity: -1, compensator: {kind: compensator, model: c1, corner_hz: 0.5, corner_damping_ratio: 1.0}}], bands: [{rpm_min: 100, rpm_max: 400, "
-                                  "controller: 1, gain_ns_per_m: 2000}, {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}]}\n");
+  const auto block = with_schedule(
+      "  speed_schedule:\n    controllers:\n      - polarity: -1\n        compensator:\n"
+      "          kind: compensator\n          model: c1\n          corner_hz: 0.5\n    bands:\n"
+      "      - rpm_min: 100\n        rpm_max: 400\n        controller: 1\n        gain_ns_per_m: 2000\n"
+      "      - {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}\n");
+  const auto flow = with_schedule(
+      "  speed_schedule: {controllers: [{polarity: -1, compensator: {kind: compensator, model: c1, corner_hz: 0.5, "
+      "corner_damping_ratio: 1.0}}], bands: [{rpm_min: 100, rpm_max: 400, "
+      "controller: 1, gain_ns_per_m: 2000}, {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}]}\n");
   for (const auto* c : {&block, &flow}) {
     ASSERT_TRUE(c->controller.speed_schedule);
     const auto& s = *c->controller.speed_schedule;
@@ -80,7 +83,8 @@ TEST(SpeedScheduleConfig, BandsAscendAndEveryKeyIsNamedWithItsUnitAndRangeWhenRe
     const config::Config preset_c1 = config::load_config_file(test::preset("horizontal_c1"));
     EXPECT_EQ(c1.controller.polarity, preset_c1.controller.polarity);
     EXPECT_EQ(c1.controller.chain.size(), preset_c1.controller.chain.size());
-    EXPECT_EQ(analysis::LoopModel(c1).chain().params.sections.count, analysis::LoopModel(preset_c1).chain().params.sections.count);
+    EXPECT_EQ(analysis::LoopModel(c1).chain().params.sections.count,
+              analysis::LoopModel(preset_c1).chain().params.sections.count);
     EXPECT_EQ(config::speed_band_of(s.bands, 399.99), 0U);
     EXPECT_EQ(config::speed_band_of(s.bands, 400.0), 1U);
     EXPECT_EQ(config::speed_band_of(s.bands, 900.0), 1U);  // the last band holds its top
@@ -92,44 +96,53 @@ TEST(SpeedScheduleConfig, BandsAscendAndEveryKeyIsNamedWithItsUnitAndRangeWhenRe
                              "      - {rpm_min: 300, rpm_max: 500, gain_ns_per_m: 0}\n")
                 .find("bands[1].rpm_min = 300 rpm overlaps the band before it"),
             std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 400, rpm_max: 400, gain_ns_per_m: 2000}\n").find("bands[0].rpm_max = 400 rpm must exceed"),
+  EXPECT_NE(problems(bands + "      - {rpm_min: 400, rpm_max: 400, gain_ns_per_m: 2000}\n")
+                .find("bands[0].rpm_max = 400 rpm must exceed"),
             std::string::npos);
   EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, controller: 1, gain_ns_per_m: 2000}\n")
                 .find("bands[0].controller = 1 (0 = this configuration's, i = controllers[i - 1]) is out of range"),
             std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: -5}\n").find("bands[0].gain_ns_per_m = -5 N s/m is out of range"),
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: -5}\n")
+                .find("bands[0].gain_ns_per_m = -5 N s/m is out of range"),
             std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 40000, gain_ns_per_m: 5}\n").find("above spindle.rpm_max = 30000 rpm"),
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 40000, gain_ns_per_m: 5}\n")
+                .find("above spindle.rpm_max = 30000 rpm"),
             std::string::npos);
-  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain: 5}\n").find("bands[0].gain: unknown key"), std::string::npos);
-  for (const auto& [limit, says] : std::vector<std::pair<std::string, std::string>>{
-           {"0", "bands[0].depth_limit_mm = 0 mm is out of range"},
-           {"-1", "bands[0].depth_limit_mm = -1 mm is out of range"},
-           {"lots", "bands[0].depth_limit_mm"}}) {
+  EXPECT_NE(problems(bands + "      - {rpm_min: 100, rpm_max: 400, gain: 5}\n").find("bands[0].gain: unknown key"),
+            std::string::npos);
+  for (const auto& [limit, says] :
+       std::vector<std::pair<std::string, std::string>>{{"0", "bands[0].depth_limit_mm = 0 mm is out of range"},
+                                                        {"-1", "bands[0].depth_limit_mm = -1 mm is out of range"},
+                                                        {"lots", "bands[0].depth_limit_mm"}}) {
     const std::string band = "      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 5, depth_limit_mm: " + limit + "}\n";
     EXPECT_NE(problems(bands + band).find(says), std::string::npos) << limit << ": " << problems(bands + band);
   }
-  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: notch, center_hz: 3, bandwidth_hz: 4}}]\n"
+  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: notch, center_hz: 3, "
+                     "bandwidth_hz: 4}}]\n"
                      "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
                 .find("controllers[0].compensator.kind = 'notch': it must be a compensator"),
             std::string::npos);
-  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1}]\n    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
+  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: -1}]\n    bands: [{rpm_min: 1, rpm_max: 2, "
+                     "gain_ns_per_m: 0}]\n")
                 .find("controllers[0].compensator: missing"),
             std::string::npos);
-  EXPECT_NE(problems("  speed_schedule:\n    controllers: [{polarity: 2, compensator: {kind: compensator, model: c3}}]\n"
-                     "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
-                .find("controllers[0].polarity"),
-            std::string::npos);
+  EXPECT_NE(
+      problems("  speed_schedule:\n    controllers: [{polarity: 2, compensator: {kind: compensator, model: c3}}]\n"
+               "    bands: [{rpm_min: 1, rpm_max: 2, gain_ns_per_m: 0}]\n")
+          .find("controllers[0].polarity"),
+      std::string::npos);
   EXPECT_NE(problems("  speed_schedule:\n    bands: []\n").find("must be a non-empty list"), std::string::npos);
   std::string many = bands;
   for (int i = 0; i < 65; ++i)
-    many += "      - {rpm_min: " + std::to_string(100 + 10 * i) + ", rpm_max: " + std::to_string(105 + 10 * i) + ", gain_ns_per_m: 0}\n";
+    many += "      - {rpm_min: " + std::to_string(100 + 10 * i) + ", rpm_max: " + std::to_string(105 + 10 * i) +
+            ", gain_ns_per_m: 0}\n";
   EXPECT_NE(problems(many).find("has 65 bands: allowed at most 64"), std::string::npos);
 }
 
 control::ControllerParams k_only_params() {
-  auto c = with_schedule("  speed_schedule:\n    bands:\n      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 3000}\n"
-                         "      - {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}\n");
+  auto c = with_schedule(
+      "  speed_schedule:\n    bands:\n      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 3000}\n"
+      "      - {rpm_min: 400, rpm_max: 900, gain_ns_per_m: 0}\n");
   return analysis::LoopModel(c).chain().params;
 }
 
@@ -161,10 +174,12 @@ TEST(SpeedScheduleController, TheSpindleSpeedSetsKThroughTheRampAndAGainRequestO
 // A cell whose bands run C1 at 100-400 rpm, its own C2 at 400-900 and K = 0 above: the supervisor hands over
 // as the spindle moves, refuses gain and set requests inside a band, and the recording replays bit for bit.
 TEST(SpeedScheduleCell, TheSupervisorHandsOverAsTheSpindleMovesAndTheRecordingReplays) {
-  const auto cfg = with_schedule("  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: compensator, model: c1, corner_hz: 0.5, corner_damping_ratio: 1.0}}]\n    bands:\n"
-                                 "      - {rpm_min: 100, rpm_max: 400, controller: 1, gain_ns_per_m: 3000}\n"
-                                 "      - {rpm_min: 400, rpm_max: 900, controller: 0, gain_ns_per_m: 1000}\n"
-                                 "      - {rpm_min: 900, rpm_max: 1500, controller: 1, gain_ns_per_m: 0}\n");
+  const auto cfg = with_schedule(
+      "  speed_schedule:\n    controllers: [{polarity: -1, compensator: {kind: compensator, model: c1, corner_hz: 0.5, "
+      "corner_damping_ratio: 1.0}}]\n    bands:\n"
+      "      - {rpm_min: 100, rpm_max: 400, controller: 1, gain_ns_per_m: 3000}\n"
+      "      - {rpm_min: 400, rpm_max: 900, controller: 0, gain_ns_per_m: 1000}\n"
+      "      - {rpm_min: 900, rpm_max: 1500, controller: 1, gain_ns_per_m: 0}\n");
   runtime::CellOptions o;
   o.clock = config::ClockKind::kVirtual;
   o.keep_frames = true;
@@ -176,12 +191,12 @@ TEST(SpeedScheduleCell, TheSupervisorHandsOverAsTheSpindleMovesAndTheRecordingRe
   EXPECT_EQ(cell.supervisor().parameter_sets()[1].params.polarity, -1) << "C1's chain and polarity";
   // A hand-over warms the incoming chain up for its settling time (C1's 0.5 Hz corner: about 2 s), then fades
   // out and in over gain_ramp_s each: every speed below holds long enough for it.
-  cell.schedule(5000, {rt::CommandKind::kSetSpindle, 300.0});     // C1 at 3000: a hand-over
-  cell.schedule(25000, {rt::CommandKind::kSetGain, 500.0});       // refused: inside a band
-  cell.schedule(25001, {rt::CommandKind::kSelectParams, 0.0});    // refused: the spindle chooses the set
-  cell.schedule(26000, {rt::CommandKind::kSetSpindle, 600.0});    // back to C2 at 1000: a hand-over
-  cell.schedule(29000, {rt::CommandKind::kSetSpindle, 650.0});    // the same band, the hand-over still running
-  cell.schedule(50000, {rt::CommandKind::kSetSpindle, 1200.0});   // K 0 with C1
+  cell.schedule(5000, {rt::CommandKind::kSetSpindle, 300.0});    // C1 at 3000: a hand-over
+  cell.schedule(25000, {rt::CommandKind::kSetGain, 500.0});      // refused: inside a band
+  cell.schedule(25001, {rt::CommandKind::kSelectParams, 0.0});   // refused: the spindle chooses the set
+  cell.schedule(26000, {rt::CommandKind::kSetSpindle, 600.0});   // back to C2 at 1000: a hand-over
+  cell.schedule(29000, {rt::CommandKind::kSetSpindle, 650.0});   // the same band, the hand-over still running
+  cell.schedule(50000, {rt::CommandKind::kSetSpindle, 1200.0});  // K 0 with C1
   ASSERT_TRUE(cell.run(14.0).ok());
   const auto& s = cell.summary();
   EXPECT_EQ(s.trip, "none");
@@ -207,8 +222,9 @@ TEST(SpeedScheduleCell, TheSupervisorHandsOverAsTheSpindleMovesAndTheRecordingRe
 
 TEST(SpeedScheduleCell, ABandAboveItsControllersLimitIsRefusedAtConfigurationWithItsKey) {
   // C2's analysed K_max is 4805 N s/m; supervision.max_gain_fraction 0.9 of it is 4324.
-  runtime::Cell cell(with_schedule("  speed_schedule:\n    bands:\n      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 4500}\n"),
-                     runtime::CellOptions{});
+  runtime::Cell cell(
+      with_schedule("  speed_schedule:\n    bands:\n      - {rpm_min: 100, rpm_max: 400, gain_ns_per_m: 4500}\n"),
+      runtime::CellOptions{});
   const runtime::Status st = cell.configure();
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.message.find("controller.speed_schedule.bands[0].gain_ns_per_m"), std::string::npos) << st.message;
@@ -255,8 +271,8 @@ TEST(SpeedSchedule, OnAnArmOfOurOwnTheScheduleIsNeverWorseThanTheOpenLoopAndKeep
   tune::ScheduleSettings s;
   s.speeds = 40;
   s.gains_per_controller = 3;
-  const tune::SpeedSchedule sched = tune::schedule_speeds(cell, {tune::controller_of_file(test::preset("horizontal_c1"))}, job,
-                                                             job.selected_structure(), s);
+  const tune::SpeedSchedule sched = tune::schedule_speeds(
+      cell, {tune::controller_of_file(test::preset("horizontal_c1"))}, job, job.selected_structure(), s);
   const tune::ScheduleSummary& m = sched.summary;
   ASSERT_GE(m.speeds, 40U);
   EXPECT_GT(m.speeds, m.grid_speeds) << "checked between the grid speeds too";
@@ -316,7 +332,8 @@ TEST(ScheduledCut, TheRealSupervisorFollowsTheSpindleAndEveryCutAtNinetyFivePerc
   const std::vector<double> gains{3040.0, 2400.0, 3040.0, 0.0, 2400.0, 0.0};
   for (std::size_t i = 0; i < cut.segments.size(); ++i) {
     const auto& s = cut.segments[i];
-    EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm << " mm: " << milling::to_string(s.verdict.classification);
+    EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm
+                                  << " mm: " << milling::to_string(s.verdict.classification);
     EXPECT_EQ(s.set, sets[i]) << s.rpm << " rpm";
     EXPECT_DOUBLE_EQ(s.gain_ns_per_m, gains[i]) << s.rpm << " rpm";
     EXPECT_EQ(s.switch_limited_ticks, 0U) << s.rpm << " rpm";
@@ -324,14 +341,17 @@ TEST(ScheduledCut, TheRealSupervisorFollowsTheSpindleAndEveryCutAtNinetyFivePerc
     EXPECT_LT(s.switch_s, 5.0) << s.rpm << " rpm: the hand-over's warm-up and fades";
     EXPECT_EQ(s.trip, "none") << s.rpm << " rpm";
     EXPECT_EQ(s.state, "active") << s.rpm << " rpm";
-    std::printf("%7.1f rpm: %.3f mm, set %zu K %.0f, switch %.2f s peak %.2f N; cut %s, peak %.1f N, %llu ticks at a limit\n",
-                s.rpm, s.depth_mm, s.set, s.gain_ns_per_m, s.switch_s, s.switch_peak_force_n,
-                milling::to_string(s.verdict.classification), s.peak_force_command_n, static_cast<unsigned long long>(s.limited_ticks));
+    std::printf(
+        "%7.1f rpm: %.3f mm, set %zu K %.0f, switch %.2f s peak %.2f N; cut %s, peak %.1f N, %llu ticks at a limit\n",
+        s.rpm, s.depth_mm, s.set, s.gain_ns_per_m, s.switch_s, s.switch_peak_force_n,
+        milling::to_string(s.verdict.classification), s.peak_force_command_n,
+        static_cast<unsigned long long>(s.limited_ticks));
   }
   EXPECT_TRUE(cut.all_stable());
   EXPECT_TRUE(cut.switches_within_limits());
   EXPECT_EQ(cut.handovers, 4U);  // to C1, to C2, to C1, and to C2 at 1200 rpm (the K = 0 bands keep the set before)
-  const tune::ScheduledCut over = tune::scheduled_cut(cell, job, {{600.0, 1.10 * limits->study.at_rpm[2].b_lim_mm}}, 40);
+  const tune::ScheduledCut over =
+      tune::scheduled_cut(cell, job, {{600.0, 1.10 * limits->study.at_rpm[2].b_lim_mm}}, 40);
   EXPECT_FALSE(over.segments.front().verdict.stable) << "1.1 x the scheduled limit at 600 rpm";
 }
 
@@ -363,7 +383,8 @@ TEST(ForcedCommand, TheCutsForcedCoilForceMatchesTheSimulatedCutAndCapsTheDepth)
     const milling::CutOutcome r = milling::run_cut(*dyn, cut.cutter, cut.material, cut.settings);
     ASSERT_TRUE(r.verdict.stable) << depth;
     const double simulated = dynamic_cast<const milling::DampedDynamics&>(*dyn).stats().peak_coil_force_n;
-    EXPECT_NEAR(fc.peak_force_n(depth), simulated, 0.10 * simulated) << depth << " mm at " << cut.settings.rpm << " rpm";
+    EXPECT_NEAR(fc.peak_force_n(depth), simulated, 0.10 * simulated)
+        << depth << " mm at " << cut.settings.rpm << " rpm";
   }
   // At 600 rpm (30 Hz tooth passing) the helix keeps the forced force below 17 N at any depth: no cap. At 500 rpm
   // the tooth passing (25 Hz) sits on the 23.5 Hz mode and the actuator holds only to about 3.7 mm.
@@ -389,8 +410,10 @@ TEST(LimitsInTime, ALimitTheCutDoesNotHoldIsLoweredToTheTimeDomainsAndOneItHolds
   const double rpm = accurate.stepped_rpm(390.6);
   const auto model = std::make_shared<const analysis::LoopModel>(c2);
   const milling::Structure open(job.selected_structure(), false, {model, 0.0, c2.controller.polarity});
-  const double open_mm = milling::AccurateStability(open, job).critical(rpm, 0.3).critical_depth_mm;  // the schedule's guess
-  const double sdm_mm = milling::holding_limits_mm(damped, job, {rpm}, {accurate.critical(rpm, open_mm).critical_depth_mm}, 1).front();
+  const double open_mm =
+      milling::AccurateStability(open, job).critical(rpm, 0.3).critical_depth_mm;  // the schedule's guess
+  const double sdm_mm =
+      milling::holding_limits_mm(damped, job, {rpm}, {accurate.critical(rpm, open_mm).critical_depth_mm}, 1).front();
   ASSERT_NEAR(sdm_mm, 1.214, 0.01);
   const auto first = tune::limits_in_time(job, {{rpm, &damped, sdm_mm}, {rpm, &damped, 1.0}}, 2);
   ASSERT_EQ(first.size(), 2U);
@@ -439,21 +462,27 @@ void expect_recorded_schedule_writes_it_again(const std::string& name) {
     const std::vector<double> was = promises(text), now = promises(again);
     ASSERT_EQ(was.size(), now.size()) << name;
     ASSERT_GE(was.size(), 8U) << name;
-    for (std::size_t i = 0; i < was.size(); ++i) EXPECT_NEAR(now[i], was[i], 0.01 * std::abs(was[i]) + 1e-9) << name << " #" << i;
+    for (std::size_t i = 0; i < was.size(); ++i)
+      EXPECT_NEAR(now[i], was[i], 0.01 * std::abs(was[i]) + 1e-9) << name << " #" << i;
     const config::Config a = config::parse_config(text, test::preset(name)), b = config::parse_config(again, out);
     ASSERT_EQ(a.controller.speed_schedule->bands.size(), b.controller.speed_schedule->bands.size()) << name;
     // Deterministic: the same file, but for the --out of the command it records.
     const std::regex out_path(" --out \\S+\n");
-    EXPECT_EQ(std::regex_replace(again, out_path, " --out X\n"), std::regex_replace(text, out_path, " --out X\n")) << name;
+    EXPECT_EQ(std::regex_replace(again, out_path, " --out X\n"), std::regex_replace(text, out_path, " --out X\n"))
+        << name;
   }
   std::filesystem::remove_all(dir);
 }
 
-TEST(SpeedSchedule, TheDefaultPresetsRecordedCommandWritesItAgain) { expect_recorded_schedule_writes_it_again("horizontal_c2"); }
+TEST(SpeedSchedule, TheDefaultPresetsRecordedCommandWritesItAgain) {
+  expect_recorded_schedule_writes_it_again("horizontal_c2");
+}
 TEST(SpeedSchedule, TheTunedHorizontalPresetsRecordedCommandWritesItAgain) {
   expect_recorded_schedule_writes_it_again("tuned_horizontal");
 }
-TEST(SpeedSchedule, TheTunedVerticalPresetsRecordedCommandWritesItAgain) { expect_recorded_schedule_writes_it_again("tuned_vertical"); }
+TEST(SpeedSchedule, TheTunedVerticalPresetsRecordedCommandWritesItAgain) {
+  expect_recorded_schedule_writes_it_again("tuned_vertical");
+}
 
 }  // namespace
 }  // namespace robodamp
@@ -517,7 +546,8 @@ void expect_schedule_holds_in_time(const config::Config& cell, const config::Mil
     }
     handed_over += s.set != previous_set ? 1 : 0;
     previous_set = s.set;
-    EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm << " mm: " << milling::to_string(s.verdict.classification);
+    EXPECT_TRUE(s.verdict.stable) << s.rpm << " rpm at " << s.depth_mm
+                                  << " mm: " << milling::to_string(s.verdict.classification);
     EXPECT_EQ(s.switch_limited_ticks, 0U) << s.rpm << " rpm";
     EXPECT_LT(s.switch_peak_force_n, cut.force_limit_n) << s.rpm << " rpm";
     EXPECT_EQ(s.trip, "none") << s.rpm << " rpm";

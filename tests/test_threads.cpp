@@ -64,7 +64,8 @@ TEST(Worker, NotifyWakesTheBodyOnceWhatItWaitsForHolds) {
     ASSERT_TRUE(eventually([&] {
       std::lock_guard<std::mutex> lock(m);
       return served == k;
-    })) << "request " << k << " not served";
+    })) << "request "
+        << k << " not served";
   }
   w.stop();
   EXPECT_EQ(served, 100);
@@ -80,7 +81,8 @@ TEST(Worker, AStopWinsOverWorkStillQueued) {
   Worker w;
   w.start("rd-test-queue", [&](std::stop_token stop) {
     std::unique_lock<std::mutex> lock(m);
-    while (w.wait(lock, stop, [] { return true; }) && done < 1000) {  // always more to do (bounded: a failure, not a hang)
+    while (w.wait(lock, stop, [] { return true; }) &&
+           done < 1000) {  // always more to do (bounded: a failure, not a hang)
       lock.unlock();
       ++done;
       while (!asked && done >= 3) std::this_thread::yield();  // hold the third piece until the stop is asked

@@ -81,8 +81,10 @@ TEST(Tune, ASetRestatedAtAnotherMatchFrequencyIsTheSameController) {
   }
   EXPECT_EQ(moved.polarity, c.polarity);
   for (const auto& [from, to] : {std::pair{1.0, 18.0}, std::pair{18.0, 1.0}}) {  // |C| differs there: one of each binds
-    EXPECT_GE(tune::restated({tune::kGainMinNsPerM, 4.0, 0.3, 15.0, 0.2, 30.0, 0.5, 1}, from, to).gain_ns_per_m, tune::kGainMinNsPerM);
-    EXPECT_LE(tune::restated({tune::kGainMaxNsPerM, 4.0, 0.3, 15.0, 0.2, 30.0, 0.5, 1}, from, to).gain_ns_per_m, tune::kGainMaxNsPerM);
+    EXPECT_GE(tune::restated({tune::kGainMinNsPerM, 4.0, 0.3, 15.0, 0.2, 30.0, 0.5, 1}, from, to).gain_ns_per_m,
+              tune::kGainMinNsPerM);
+    EXPECT_LE(tune::restated({tune::kGainMaxNsPerM, 4.0, 0.3, 15.0, 0.2, 30.0, 0.5, 1}, from, to).gain_ns_per_m,
+              tune::kGainMaxNsPerM);
   }
 }
 
@@ -163,7 +165,8 @@ TEST(Tune, TheTunedPresetsHaveTheirMarginsAndDepths) {
     EXPECT_GE(*a.margins.phase_margin_deg, 45.0) << preset;
     const std::string text = test::read_file(test::preset(preset));
     double target_mm = 0.0;
-    ASSERT_EQ(std::sscanf(text.c_str() + text.find("--depth-at-speed-mm "), "--depth-at-speed-mm %lf", &target_mm), 1) << preset;
+    ASSERT_EQ(std::sscanf(text.c_str() + text.find("--depth-at-speed-mm "), "--depth-at-speed-mm %lf", &target_mm), 1)
+        << preset;
     const tune::Evaluator evaluate(cfg, job, {});
     const tune::Evaluation e = evaluate.assess(cfg);
     EXPECT_GE(e.depth_at_speed_mm, target_mm * (1.0 - 5e-3)) << preset;
@@ -175,9 +178,13 @@ TEST(Tune, TheTunedPresetsHaveTheirMarginsAndDepths) {
     const std::size_t v = text.find("# Verified (sampled-loop SDM, ");
     ASSERT_NE(v, std::string::npos) << preset;
     ASSERT_EQ(std::sscanf(text.c_str() + text.find("damped minimum", v),
-                          "damped minimum %lf mm at %lf rpm, %lf mm at the job's %lf rpm;", &min_mm, &min_rpm, &at_mm, &at_rpm), 4)
+                          "damped minimum %lf mm at %lf rpm, %lf mm at the job's %lf rpm;", &min_mm, &min_rpm, &at_mm,
+                          &at_rpm),
+              4)
         << preset;
-    ASSERT_EQ(std::sscanf(text.c_str() + text.find("Controller: ", v), "Controller: %lf mm and %lf mm there.", &td_min, &td_at), 2)
+    ASSERT_EQ(std::sscanf(text.c_str() + text.find("Controller: ", v), "Controller: %lf mm and %lf mm there.", &td_min,
+                          &td_at),
+              2)
         << preset;
     const tune::Verification ver = tune::verify(cfg, job);
     std::printf("%s: verified minimum %.3f mm at %.1f rpm, %.3f mm at %.1f rpm; in time %.3f and %.3f mm\n", preset,
@@ -219,8 +226,9 @@ TEST(Tune, ThePredictedImpactCommandMatchesTheBench) {
       worst_measured = std::max(worst_measured, r.peak_command_v);
     }
     const analysis::CommandPeak p = predict.peak(m, k, pol);
-    std::printf("%s: impact %.0f N: predicted largest command %.3f V (%.1f N coil, %.0f V/s, tail %.3f), bench %.3f V\n",
-                preset, cfg.bench.impact_peak_n, p.voltage_v, p.coil_force_n, p.slew_v_per_s, p.tail_fraction, worst_measured);
+    std::printf(
+        "%s: impact %.0f N: predicted largest command %.3f V (%.1f N coil, %.0f V/s, tail %.3f), bench %.3f V\n",
+        preset, cfg.bench.impact_peak_n, p.voltage_v, p.coil_force_n, p.slew_v_per_s, p.tail_fraction, worst_measured);
     EXPECT_NEAR(p.voltage_v, worst_measured, 0.1 * worst_measured) << preset;
     EXPECT_LT(p.tail_fraction, 0.01) << preset;
     // Hard enough that the linear command passes the force limit: the bench clips it.
@@ -254,7 +262,8 @@ TEST(Tune, TheQuietCommandIsAConstraint) {
   EXPECT_FALSE(e.feasible());
   EXPECT_NE(e.binding.find("quiet cell's command"), std::string::npos) << e.binding;
   // The presets' controllers are far below a third of the floor.
-  for (const char* name : {"horizontal_c1", "horizontal_c2", "horizontal_c3", "tuned_horizontal", "tuned_vertical", "vertical_c1"}) {
+  for (const char* name :
+       {"horizontal_c1", "horizontal_c2", "horizontal_c3", "tuned_horizontal", "tuned_vertical", "vertical_c1"}) {
     const config::Config c = config::load_config_file(test::preset(name));
     EXPECT_LT(analysis::quiet_command(analysis::LoopModel(c), c.controller.gain_ns_per_m, c.controller.polarity).rms_v,
               c.supervision.instability_floor_v / 3.0)
@@ -343,10 +352,11 @@ TEST(Tune, TheTunedPresetsStayStableWithModesShiftedFivePercent) {
     for (const double factor : {0.95, 1.05}) {
       const config::Config shifted = tune::with_shifted_modes(cfg, factor);
       const tune::Evaluation e = tune::Evaluator(shifted, job, {}).assess(shifted);
-      std::printf("%s, modes x%.2f: stable %d, GM %.1f dB, PM %.1f deg, worst mode %.0f deg, min depth %.3f mm "
-                  "(open %.3f), %.3f mm at 700 rpm, floors x%.2f\n", preset, factor, e.stable, e.gain_margin_db,
-                  e.phase_margin_deg, e.worst_mode_phase_deg, e.min_depth_mm,
-                  tune::Evaluator(shifted, job, {}).open_min_depth_mm(), e.depth_at_speed_mm, e.floor_ratio);
+      std::printf(
+          "%s, modes x%.2f: stable %d, GM %.1f dB, PM %.1f deg, worst mode %.0f deg, min depth %.3f mm "
+          "(open %.3f), %.3f mm at 700 rpm, floors x%.2f\n",
+          preset, factor, e.stable, e.gain_margin_db, e.phase_margin_deg, e.worst_mode_phase_deg, e.min_depth_mm,
+          tune::Evaluator(shifted, job, {}).open_min_depth_mm(), e.depth_at_speed_mm, e.floor_ratio);
       EXPECT_TRUE(e.stable) << preset << " x" << factor;
       EXPECT_LT(e.worst_mode_phase_deg, 90.0) << preset << " x" << factor;
       EXPECT_GT(e.gain_margin_db, 3.0) << preset << " x" << factor;
@@ -366,8 +376,8 @@ TEST(Tune, TheTunedPresetsPassTheBench) {
         ++nominal;
         EXPECT_FALSE(row.saturated) << preset << " " << row.name;
         ASSERT_TRUE(row.measured_improvement_pct && row.predicted_improvement_pct);
-        std::printf("%s %s: measured %.1f %%, predicted %.1f %%\n", preset, row.name.c_str(), *row.measured_improvement_pct,
-                    *row.predicted_improvement_pct);
+        std::printf("%s %s: measured %.1f %%, predicted %.1f %%\n", preset, row.name.c_str(),
+                    *row.measured_improvement_pct, *row.predicted_improvement_pct);
       }
     EXPECT_EQ(nominal, 3) << preset;
   }
@@ -408,7 +418,8 @@ TEST(Tune, TheTunedControllerHoldsItsDepthsInTheSimulatedCut) {
 
 TEST(Tune, AJobWithoutADampingLocationIsRefused) {
   const config::Config base = config::load_config_file(test::preset("horizontal_c2"));
-  auto job = config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/industrial_robot_aluminium.yaml");
+  auto job =
+      config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/industrial_robot_aluminium.yaml");
   try {
     const tune::Evaluator e(base, job, {});
     ADD_FAILURE() << "accepted";
@@ -435,9 +446,9 @@ TEST(Tune, TheTunedFileReadsBackFromEveryPresetInEveryStyle) {
   for (const char* name : {"horizontal_c1", "horizontal_c2", "horizontal_c3", "vertical_c1", "tuned_horizontal",
                            "tuned_vertical", "pose_scheduled_c2"}) {
     const std::string original = test::read_file(test::preset(name));
-    for (const auto& [style, text] : {std::pair{"as written", original},
-                                      std::pair{"block", in_style(original, YAML::EmitterStyle::Block)},
-                                      std::pair{"flow", in_style(original, YAML::EmitterStyle::Flow)}}) {
+    for (const auto& [style, text] :
+         {std::pair{"as written", original}, std::pair{"block", in_style(original, YAML::EmitterStyle::Block)},
+          std::pair{"flow", in_style(original, YAML::EmitterStyle::Flow)}}) {
       const config::Config base = config::parse_config(text, test::preset(name));  // relative paths from there
       const config::Config want = tune::with_candidate(base, c);
       const config::EditedYaml out = tune::tuned_config_text(base, c);
@@ -445,7 +456,8 @@ TEST(Tune, TheTunedFileReadsBackFromEveryPresetInEveryStyle) {
       const config::Config got = config::parse_config(out.text, test::preset(name));
       EXPECT_EQ(got.controller.gain_ns_per_m, want.controller.gain_ns_per_m) << name << " " << style;
       EXPECT_EQ(got.controller.polarity, -1) << name << " " << style;
-      EXPECT_FALSE(got.controller.speed_schedule) << name << " " << style << ": the schedule chose K for the chain replaced";
+      EXPECT_FALSE(got.controller.speed_schedule)
+          << name << " " << style << ": the schedule chose K for the chain replaced";
       ASSERT_EQ(got.controller.chain.size(), want.controller.chain.size()) << name << " " << style;
       for (std::size_t i = 0; i < got.controller.chain.size(); ++i) {
         const auto& g = got.controller.chain[i];
@@ -503,7 +515,8 @@ TEST(Tune, ACandidateReadBackFromATunedFileIsTheSameController) {
   const config::Config again = tune::with_candidate(tuned, *c);
   const analysis::LoopModel a(tuned), b(again);
   for (const double f_hz : {1.0, 9.2, 21.0, 23.5, 100.0})
-    EXPECT_NEAR(std::abs(b.chain().chain_digital(f_hz) / a.chain().chain_digital(f_hz) - 1.0), 0.0, 1e-9) << f_hz << " Hz";
+    EXPECT_NEAR(std::abs(b.chain().chain_digital(f_hz) / a.chain().chain_digital(f_hz) - 1.0), 0.0, 1e-9)
+        << f_hz << " Hz";
   EXPECT_FALSE(tune::candidate_of(config::load_config_file(test::preset("horizontal_c1"))));
 }
 
@@ -520,7 +533,8 @@ TEST(Tune, EachTunedPresetsRecordedCommandWritesItAgain) {
     const std::vector<double> was = tune_promises(text), now = tune_promises(test::read_file(out));
     ASSERT_EQ(was.size(), 6U) << name;
     ASSERT_EQ(now.size(), was.size()) << name;
-    for (std::size_t i = 0; i < was.size(); ++i) EXPECT_NEAR(now[i], was[i], 0.01 * std::abs(was[i])) << name << " #" << i;
+    for (std::size_t i = 0; i < was.size(); ++i)
+      EXPECT_NEAR(now[i], was[i], 0.01 * std::abs(was[i])) << name << " #" << i;
   }
   std::filesystem::remove_all(dir);
 }

@@ -70,12 +70,13 @@ inline config::Config slow_pole_vertical() {
   const std::string entry =
       "{kind: compensator, model: rational, numerator: [0.027404602793258317, 0.42320583618593827, 341.23272947339467, "
       "1463.5814931482228], denominator: [0.074624991310120958, 0.43650875239379344, 0.96951995294320148, 1]}";
-  return config::parse_config(config::edit_yaml(base.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node("6040.303629")},
-                                                                 {{"controller", "polarity"}, YAML::Node("-1")},
-                                                                 {{"controller", "chain", std::size_t{5}}, YAML::Load(entry)},
-                                                                 {{"supervision", "instability_floor_v"}, YAML::Node("0.02")}})
-                                  .text,
-                              "slow_pole_vertical");
+  return config::parse_config(
+      config::edit_yaml(base.yaml_text, {{{"controller", "gain_ns_per_m"}, YAML::Node("6040.303629")},
+                                         {{"controller", "polarity"}, YAML::Node("-1")},
+                                         {{"controller", "chain", std::size_t{5}}, YAML::Load(entry)},
+                                         {{"supervision", "instability_floor_v"}, YAML::Node("0.02")}})
+          .text,
+      "slow_pole_vertical");
 }
 
 // A mode in modal-stiffness form (Eq. 1 with a stiffness instead of a residue).
@@ -104,19 +105,22 @@ inline std::string read_file(const std::string& path) {
 // The command a file's header records on the line after `header` ("#   robodamp COMMAND ... --out FILE"), run
 // again from the source folder with --out dir/name.yaml (its output in dir/log.txt). Returns that path, or ""
 // with what went wrong in why.
-inline std::string rerun_recorded_command(const std::string& text, const std::string& header, const std::string& command,
-                                          const std::string& dir, const std::string& name, std::string& why) {
+inline std::string rerun_recorded_command(const std::string& text, const std::string& header,
+                                          const std::string& command, const std::string& dir, const std::string& name,
+                                          std::string& why) {
   const auto at = text.find(header);
   if (at == std::string::npos) return why = "no \"" + header + "\" in the file", "";
   std::istringstream lines(text.substr(at));
   std::string first, line;
   std::getline(lines, first);
   std::getline(lines, line);
-  if (line.rfind("#   robodamp " + command + " ", 0) != 0) return why = "not a robodamp " + command + " command: " + line, "";
+  if (line.rfind("#   robodamp " + command + " ", 0) != 0)
+    return why = "not a robodamp " + command + " command: " + line, "";
   const std::string out = dir + "/" + name + ".yaml";
-  line = std::regex_replace(line.substr(std::string("#   robodamp ").size()), std::regex(" --out \\S+$"), " --out " + out);
-  const std::string run = "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + line + " > " + dir +
-                          "/log.txt 2>&1";
+  line =
+      std::regex_replace(line.substr(std::string("#   robodamp ").size()), std::regex(" --out \\S+$"), " --out " + out);
+  const std::string run =
+      "cd " + std::string(ROBODAMP_SOURCE_DIR) + " && " + ROBODAMP_BINARY + " " + line + " > " + dir + "/log.txt 2>&1";
   if (std::system(run.c_str()) != 0) return why = run + "\n" + read_file(dir + "/log.txt"), "";
   return out;
 }

@@ -53,7 +53,8 @@ filters::TransferFunction rational(const std::vector<double>& num, const std::ve
 
 // The candidate's compensator before its pre-warp: numerator and denominator.
 std::pair<std::vector<double>, std::vector<double>> candidate_rational(const Candidate& c) {
-  return {multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz)), multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz))};
+  return {multiply(second_order(c.fz_hz, c.zeta_z), first_order(c.fa_hz)),
+          multiply(second_order(c.fp_hz, c.zeta_p), first_order(c.fb_hz))};
 }
 
 const config::StructureConfig& job_structure(const config::MillingConfig& job) {
@@ -161,8 +162,9 @@ std::optional<Candidate> candidate_of(const config::Config& cfg) {
     if (b.model != config::CompensatorModel::kRational) return std::nullopt;
     const auto zeros = pair_and_corner(b.numerator), poles = pair_and_corner(b.denominator);
     if (!zeros || !poles) return std::nullopt;
-    return Candidate{cfg.controller.gain_ns_per_m, (*zeros)[0], (*zeros)[1], (*poles)[0], (*poles)[1],
-                     (*zeros)[2], (*poles)[2], cfg.controller.polarity};
+    return Candidate{
+        cfg.controller.gain_ns_per_m, (*zeros)[0], (*zeros)[1], (*poles)[0], (*poles)[1], (*zeros)[2], (*poles)[2],
+        cfg.controller.polarity};
   }
   return std::nullopt;
 }
@@ -177,8 +179,8 @@ config::Config with_candidate(const config::Config& base, const Candidate& c) {
   auto it = std::find_if(cfg.controller.chain.begin(), cfg.controller.chain.end(),
                          [](const config::BlockConfig& b) { return b.kind == config::BlockKind::kCompensator; });
   if (it == cfg.controller.chain.end())
-    throw config::ConfigError({config::Problem{base.source, {}, "controller.chain",
-                                               "has no compensator block for robodamp tune to replace"}});
+    throw config::ConfigError({config::Problem{
+        base.source, {}, "controller.chain", "has no compensator block for robodamp tune to replace"}});
   *it = compensator_block(c, *it, unity_gain_hz(base));
   cfg.controller.gain_ns_per_m = c.gain_ns_per_m;
   cfg.controller.polarity = c.polarity;
@@ -201,7 +203,8 @@ std::vector<std::pair<double, double>> lowest_minima(const milling::LobeDiagram&
   for (std::size_t i = 0; i < c.size(); ++i) {
     const double v = c[i].b_lim_mm;
     if (!std::isfinite(v)) continue;
-    if ((i == 0 || v <= c[i - 1].b_lim_mm) && (i + 1 == c.size() || v <= c[i + 1].b_lim_mm)) out.emplace_back(c[i].rpm, v);
+    if ((i == 0 || v <= c[i - 1].b_lim_mm) && (i + 1 == c.size() || v <= c[i + 1].b_lim_mm))
+      out.emplace_back(c[i].rpm, v);
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   if (out.size() > count) out.resize(count);
@@ -220,12 +223,16 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   const auto open_loop = std::make_shared<const analysis::LoopModel>(base_);
   const double impact_n = s_.impact_peak_n.value_or(base_.bench.impact_peak_n);
   if (impact_n > 0.0)
-    impact_ = std::make_unique<Impact>(*open_loop, impact_n, s_.impact_duration_ms.value_or(base_.bench.impact_duration_ms) * 1e-3);
+    impact_ = std::make_unique<Impact>(*open_loop, impact_n,
+                                       s_.impact_duration_ms.value_or(base_.bench.impact_duration_ms) * 1e-3);
   if (!job_) return;
   const config::StructureConfig& st = job_structure(*job_);
-  const bool damps = std::any_of(st.parts.begin(), st.parts.end(), [](const auto& p) { return p.controller.has_value(); });
+  const bool damps =
+      std::any_of(st.parts.begin(), st.parts.end(), [](const auto& p) { return p.controller.has_value(); });
   if (!damps)
-    throw config::ConfigError({config::Problem{job_->source, {}, "structures." + st.name,
+    throw config::ConfigError({config::Problem{job_->source,
+                                               {},
+                                               "structures." + st.name,
                                                "has no damping location (a part with controller: {config, location, "
                                                "direction}): there is nothing for robodamp tune to tune against"}});
   // The open loop of this plant (not of the job's own controller file): each plant's floors are its own.
@@ -250,13 +257,15 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
       as_lobes.curve.push_back({p.rpm, p.critical_depth_mm, p.chatter_hz, 0});
       open_curve_.emplace_back(p.rpm, p.critical_depth_mm);
     }
-    for (const auto& [r, m] : lowest_minima(as_lobes, kCheckedMinima)) open_sdm_min_rpm_.push_back(r), open_sdm_min_mm_.push_back(m);
+    for (const auto& [r, m] : lowest_minima(as_lobes, kCheckedMinima))
+      open_sdm_min_rpm_.push_back(r), open_sdm_min_mm_.push_back(m);
   }
   // The open loop's lobe peaks (local maxima of the envelope), and the floor between each two.
   std::vector<std::size_t> peaks;
   const auto& c = d.curve;
   for (std::size_t i = 1; i + 1 < c.size(); ++i)
-    if (std::isfinite(c[i].b_lim_mm) && c[i].b_lim_mm > c[i - 1].b_lim_mm && c[i].b_lim_mm >= c[i + 1].b_lim_mm) peaks.push_back(i);
+    if (std::isfinite(c[i].b_lim_mm) && c[i].b_lim_mm > c[i - 1].b_lim_mm && c[i].b_lim_mm >= c[i + 1].b_lim_mm)
+      peaks.push_back(i);
   std::vector<std::size_t> edges{0};
   edges.insert(edges.end(), peaks.begin(), peaks.end());
   edges.push_back(c.size() - 1);
@@ -307,7 +316,8 @@ LoopChecks check_loop(const analysis::LoopModel& m, double k, int polarity, bool
     tasks.emplace_back([&] {
       c.phases = analysis::mode_phases(m, k, polarity);
       if (s.no_worse_mode || s.worst_mode_objective)
-        c.worst = analysis::worst_mode(analysis::mode_improvements(m, k, polarity), s.mode_band_min_hz, s.mode_band_max_hz);
+        c.worst =
+            analysis::worst_mode(analysis::mode_improvements(m, k, polarity), s.mode_band_min_hz, s.mode_band_max_hz);
       if (floor_v > 0.0) c.quiet_rms_v = analysis::quiet_command(m, k, polarity).rms_v;
     });
   }
@@ -322,16 +332,19 @@ void add_loop_constraints(Evaluation& e, const LoopChecks& checks, const config:
   add_violation(e, (s.gain_margin_min_db - e.gain_margin_db) / s.gain_margin_min_db, "gain margin");
   add_violation(e, (s.phase_margin_min_deg - e.phase_margin_deg) / s.phase_margin_min_deg, "phase margin");
   add_violation(e, (s.delay_margin_min_ms - e.delay_margin_ms) / s.delay_margin_min_ms, "delay margin");
-  for (const auto& mode : checks.phases) e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
+  for (const auto& mode : checks.phases)
+    e.worst_mode_phase_deg = std::max(e.worst_mode_phase_deg, std::abs(mode.feedback_phase_deg));
   if (s.damping_window) add_violation(e, (e.worst_mode_phase_deg - 90.0) / 90.0, "a mode outside the damping window");
   if (s.no_worse_mode || s.worst_mode_objective) {
     e.worst_mode_improvement_pct = checks.worst ? checks.worst->improvement_pct : kInf;
     if (s.no_worse_mode)
-      add_violation(e, -(e.worst_mode_improvement_pct + s.worse_mode_tolerance_pct) / 100.0, "a mode's peak worse than open loop");
+      add_violation(e, -(e.worst_mode_improvement_pct + s.worse_mode_tolerance_pct) / 100.0,
+                    "a mode's peak worse than open loop");
   }
   if (s.compensator_gain_max > 0.0) {
     e.compensator_gain_ratio = compensator_gain_ratio(cfg);
-    add_violation(e, e.compensator_gain_ratio / s.compensator_gain_max - 1.0, "the compensator's gain away from the match frequency");
+    add_violation(e, e.compensator_gain_ratio / s.compensator_gain_max - 1.0,
+                  "the compensator's gain away from the match frequency");
   }
   if (checks.quiet_rms_v) {
     e.quiet_command_rms_v = *checks.quiet_rms_v;
@@ -425,7 +438,8 @@ void Evaluator::score_on_job(Evaluation& e, const std::shared_ptr<const analysis
     e.floors_mm.push_back(floor);
     e.floor_ratio = std::min(e.floor_ratio, floor / floors_mm_[k2]);
     // The damped curve is on the same speeds as the open one: the point at the open floor's speed.
-    const auto at = std::find_if(d.curve.begin(), d.curve.end(), [&](const auto& p) { return p.rpm >= floor_rpm_[k2]; });
+    const auto at =
+        std::find_if(d.curve.begin(), d.curve.end(), [&](const auto& p) { return p.rpm >= floor_rpm_[k2]; });
     e.at_open_minima_mm.push_back(at == d.curve.end() ? kInf : at->b_lim_mm);
   }
   add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
@@ -450,7 +464,8 @@ std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::
   if (!job_) return out;
   const auto m = std::make_shared<const analysis::LoopModel>(cfg);
   if (!m->stable(cfg.controller.gain_ns_per_m, cfg.controller.polarity)) return out;
-  const milling::Structure damped(job_structure(*job_), true, {m, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
+  const milling::Structure damped(job_structure(*job_), true,
+                                  {m, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
   config::LobesConfig grid = job_->lobes;
   grid.points = job_->time_domain.sdm_points;
   const milling::AccurateStability truth(damped, *job_);

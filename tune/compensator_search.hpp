@@ -38,9 +38,9 @@ namespace robodamp::tune {
 
 struct Candidate {
   double gain_ns_per_m{2000.0};
-  double fz_hz{10.0}, zeta_z{0.5};   // the second-order zero pair
-  double fp_hz{10.0}, zeta_p{0.5};   // the second-order pole pair
-  double fa_hz{10.0}, fb_hz{10.0};   // the first-order zero and pole
+  double fz_hz{10.0}, zeta_z{0.5};  // the second-order zero pair
+  double fp_hz{10.0}, zeta_p{0.5};  // the second-order pole pair
+  double fa_hz{10.0}, fb_hz{10.0};  // the first-order zero and pole
   int polarity{1};
 };
 
@@ -117,29 +117,30 @@ struct Evaluation {
   bool stable{false};
   double gain_margin_db{0.0}, phase_margin_deg{0.0}, delay_margin_ms{0.0};
   double k_max_ns_per_m{0.0};
-  double worst_mode_phase_deg{0.0};  // the largest |phase of -F / v| over the loop's modes (< 90: all damped)
+  double worst_mode_phase_deg{0.0};    // the largest |phase of -F / v| over the loop's modes (< 90: all damped)
   double compensator_gain_ratio{0.0};  // with compensator_gain_max: the largest |C| over |C(match)|
   // With no_worse_mode: the smallest improvement of a mode's peak; NaN when not asked for.
   double worst_mode_improvement_pct{std::numeric_limits<double>::quiet_NaN()};
-  double min_depth_mm{0.0};      // with a job: the damped lobes' minimum (zero-order: it steers the search;
-                                 // tune/verification.hpp gives the verified one)
-  double depth_at_speed_mm{0.0}; // with a job: the damped limit at the job's spindle speed (sampled-loop SDM)
-  double accurate_min_mm{0.0};   // with a job: the objective, the smallest sampled-loop SDM limit over the job's
-  double accurate_min_rpm{0.0};  // speed, the damped zero-order lobes' lowest minima and the open SDM minima
-  double open_minima_ratio{0.0}; // with a job: min over the open loop's SDM minima of damped / open (accurate)
-  double floor_ratio{0.0};       // with a job: min over the open lobes' intervals of damped / open floor
-  std::vector<double> floors_mm; // with a job: the damped floor in each of the open lobes' intervals
+  double min_depth_mm{0.0};       // with a job: the damped lobes' minimum (zero-order: it steers the search;
+                                  // tune/verification.hpp gives the verified one)
+  double depth_at_speed_mm{0.0};  // with a job: the damped limit at the job's spindle speed (sampled-loop SDM)
+  double accurate_min_mm{0.0};    // with a job: the objective, the smallest sampled-loop SDM limit over the job's
+  double accurate_min_rpm{0.0};   // speed, the damped zero-order lobes' lowest minima and the open SDM minima
+  double open_minima_ratio{0.0};  // with a job: min over the open loop's SDM minima of damped / open (accurate)
+  double floor_ratio{0.0};        // with a job: min over the open lobes' intervals of damped / open floor
+  std::vector<double> floors_mm;  // with a job: the damped floor in each of the open lobes' intervals
   std::vector<double> at_open_minima_mm;  // with a job: the damped limit at each open-loop floor's speed
-  double peak_m_per_n{0.0};      // without a job: the largest closed-loop peak
-  double peak_coil_force_n{0.0}; // at the impact: T |V|, the largest coil voltage, the largest slew
+  double peak_m_per_n{0.0};               // without a job: the largest closed-loop peak
+  double peak_coil_force_n{0.0};          // at the impact: T |V|, the largest coil voltage, the largest slew
   double peak_command_v{0.0};
   double peak_slew_v_per_s{0.0};
-  double actuator_use{0.0};      // the largest of those over its limit (1 = at a limit; 0 without the check)
-  double quiet_command_rms_v{0.0};  // the command on a quiet cell (sensor noise, drive vibration): analysis/quiet_command.hpp
-  double objective{0.0};         // larger is better (depth in mm, or -log10 of the peak)
-  double violation{0.0};         // 0 when every constraint holds
-  std::string binding;           // the constraint violated most (empty when feasible)
-  std::string plant;             // the plant this describes (with several, the worst case's)
+  double actuator_use{0.0};  // the largest of those over its limit (1 = at a limit; 0 without the check)
+  double quiet_command_rms_v{
+      0.0};               // the command on a quiet cell (sensor noise, drive vibration): analysis/quiet_command.hpp
+  double objective{0.0};  // larger is better (depth in mm, or -log10 of the peak)
+  double violation{0.0};  // 0 when every constraint holds
+  std::string binding;    // the constraint violated most (empty when feasible)
+  std::string plant;      // the plant this describes (with several, the worst case's)
   std::vector<Evaluation> per_plant;  // with several plants: each plant's own evaluation
   [[nodiscard]] bool feasible() const { return violation <= 0.0; }
 };
@@ -172,7 +173,8 @@ class Evaluator {
   [[nodiscard]] double open_min_depth_mm() const { return open_min_mm_; }
   // With a job: the open loop's smallest limit by the accurate method at its lowest SDM minima.
   [[nodiscard]] double open_accurate_min_mm() const {
-    return open_sdm_min_mm_.empty() ? open_min_mm_ : *std::min_element(open_sdm_min_mm_.begin(), open_sdm_min_mm_.end());
+    return open_sdm_min_mm_.empty() ? open_min_mm_
+                                    : *std::min_element(open_sdm_min_mm_.begin(), open_sdm_min_mm_.end());
   }
   [[nodiscard]] const std::vector<std::pair<double, double>>& open_intervals_rpm() const { return intervals_; }
   [[nodiscard]] const std::vector<double>& open_floors_mm() const { return floors_mm_; }
@@ -201,10 +203,10 @@ class Evaluator {
   std::optional<milling::ChatterProcess> process_;  // with a job: what its cut contributes
   TuneSettings s_;
   double open_min_mm_{0.0};
-  std::vector<std::pair<double, double>> intervals_;  // between neighbouring open-loop lobe peaks
-  std::vector<double> floors_mm_;                     // the open loop's smallest limit in each
-  std::vector<double> floor_rpm_;                     // and the speed where it is
-  std::vector<std::pair<double, double>> open_curve_; // rpm, mm (inf where no lobe reaches)
+  std::vector<std::pair<double, double>> intervals_;        // between neighbouring open-loop lobe peaks
+  std::vector<double> floors_mm_;                           // the open loop's smallest limit in each
+  std::vector<double> floor_rpm_;                           // and the speed where it is
+  std::vector<std::pair<double, double>> open_curve_;       // rpm, mm (inf where no lobe reaches)
   std::vector<double> open_sdm_min_rpm_, open_sdm_min_mm_;  // the open loop's lowest SDM minima
   bool constraints_only_{false};
 };
@@ -234,7 +236,7 @@ class Evaluator {
 
 // The search (seeded global, then the polish) at the start's polarity over the plants, from `start`; the
 // start's own evaluation first (the result is never worse than the start).
-[[nodiscard]] TuneResult tune_from(const std::vector<const Evaluator*>& plants, const Candidate& start, const TuneSettings& s,
-                                   const std::function<void(const std::string&)>& progress = {});
+[[nodiscard]] TuneResult tune_from(const std::vector<const Evaluator*>& plants, const Candidate& start,
+                                   const TuneSettings& s, const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace robodamp::tune

@@ -31,7 +31,8 @@ std::size_t widest_joint(const config::PoseRegionConfig& r) {
   return j;
 }
 
-config::PoseRegionConfig piece(const config::PoseRegionConfig& r, std::size_t j, Interval along, std::string name, bool off) {
+config::PoseRegionConfig piece(const config::PoseRegionConfig& r, std::size_t j, Interval along, std::string name,
+                               bool off) {
   config::PoseRegionConfig p = r;
   p.name = std::move(name);
   p.min_deg[j] = along.lo, p.max_deg[j] = along.hi;
@@ -40,7 +41,8 @@ config::PoseRegionConfig piece(const config::PoseRegionConfig& r, std::size_t j,
 }
 
 // One region's pieces: the set where it is not worse, K = 0 where it is (see the header).
-void split_region(const config::PoseRegionConfig& r, double k, const std::function<double(const std::vector<double>&)>& ratio,
+void split_region(const config::PoseRegionConfig& r, double k,
+                  const std::function<double(const std::vector<double>&)>& ratio,
                   const std::vector<std::vector<double>>& extra, double step, double rpm, NeverWorse& out) {
   const std::size_t j = widest_joint(r);
   std::vector<double> q = analysis::region_centre(r);
@@ -55,9 +57,12 @@ void split_region(const config::PoseRegionConfig& r, double k, const std::functi
   for (std::size_t i = 0; i < line.size(); ++i) {
     if (!(line[i].second < kNotWorse)) continue;
     if (line[i].second < worst) worst = line[i].second, worst_at = line[i].first;
-    const Interval w{std::max(r.min_deg[j], line[i].first - 2.0 * step), std::min(r.max_deg[j], line[i].first + 2.0 * step)};
-    if (!off.empty() && w.lo <= off.back().hi) off.back().hi = w.hi;
-    else off.push_back(w);
+    const Interval w{std::max(r.min_deg[j], line[i].first - 2.0 * step),
+                     std::min(r.max_deg[j], line[i].first + 2.0 * step)};
+    if (!off.empty() && w.lo <= off.back().hi)
+      off.back().hi = w.hi;
+    else
+      off.push_back(w);
   }
   bool whole = false;
   std::string extra_note;
@@ -65,8 +70,11 @@ void split_region(const config::PoseRegionConfig& r, double k, const std::functi
     if (!config::region_holds(r, p.data(), p.size())) continue;
     const double v = ratio(p);
     if (!(v < kNotWorse)) continue;
-    const bool covered = std::any_of(off.begin(), off.end(), [&](const Interval& o) { return p[j] >= o.lo && p[j] <= o.hi; });
-    if (!covered) whole = true, extra_note = fmt(" (%.1f %% at %s, off the line through its centre)", 100.0 * (1.0 - v), config::describe_pose(p).c_str());
+    const bool covered =
+        std::any_of(off.begin(), off.end(), [&](const Interval& o) { return p[j] >= o.lo && p[j] <= o.hi; });
+    if (!covered)
+      whole = true, extra_note = fmt(" (%.1f %% at %s, off the line through its centre)", 100.0 * (1.0 - v),
+                                     config::describe_pose(p).c_str());
     if (v < worst) worst = v, worst_at = p[j];
   }
   if (off.empty() && !whole) {
@@ -84,9 +92,10 @@ void split_region(const config::PoseRegionConfig& r, double k, const std::functi
   std::erase_if(on, [&](const Interval& i) { return i.hi - i.lo < 2.0 * step; });
   if (whole || on.empty()) {
     out.regions.push_back(piece(r, j, {r.min_deg[j], r.max_deg[j]}, r.name, true));
-    out.notes.push_back(fmt("region '%s': its set (K %.0f N s/m) makes the job's cut at %.0f rpm up to %.1f %% shallower than the open "
-                            "loop (joint %zu = %.1f deg)%s: the damper off in the whole region (K = 0)",
-                            r.name.c_str(), k, rpm, 100.0 * (1.0 - worst), j + 1, worst_at, extra_note.c_str()));
+    out.notes.push_back(
+        fmt("region '%s': its set (K %.0f N s/m) makes the job's cut at %.0f rpm up to %.1f %% shallower than the open "
+            "loop (joint %zu = %.1f deg)%s: the damper off in the whole region (K = 0)",
+            r.name.c_str(), k, rpm, 100.0 * (1.0 - worst), j + 1, worst_at, extra_note.c_str()));
     return;
   }
   std::string where;
@@ -95,13 +104,16 @@ void split_region(const config::PoseRegionConfig& r, double k, const std::functi
     pieces.push_back(piece(r, j, off[i], r.name + "_off" + std::to_string(i + 1), true));
     where += fmt("%s%.1f-%.1f", i ? ", " : "", off[i].lo, off[i].hi);
   }
-  for (std::size_t i = 0; i < on.size(); ++i) pieces.push_back(piece(r, j, on[i], r.name + "_" + std::to_string(i + 1), false));
+  for (std::size_t i = 0; i < on.size(); ++i)
+    pieces.push_back(piece(r, j, on[i], r.name + "_" + std::to_string(i + 1), false));
   // In the joint's order (the first region holding a pose runs it at arming: in an overlap, the lower one).
-  std::stable_sort(pieces.begin(), pieces.end(), [&](const auto& a, const auto& b) { return a.min_deg[j] < b.min_deg[j]; });
+  std::stable_sort(pieces.begin(), pieces.end(),
+                   [&](const auto& a, const auto& b) { return a.min_deg[j] < b.min_deg[j]; });
   out.regions.insert(out.regions.end(), pieces.begin(), pieces.end());
-  out.notes.push_back(fmt("region '%s': its set (K %.0f N s/m) makes the job's cut at %.0f rpm up to %.1f %% shallower than the open loop "
-                          "(joint %zu = %.1f deg): the damper off at joint %zu = %s deg, the set kept over the rest",
-                          r.name.c_str(), k, rpm, 100.0 * (1.0 - worst), j + 1, worst_at, j + 1, where.c_str()));
+  out.notes.push_back(fmt(
+      "region '%s': its set (K %.0f N s/m) makes the job's cut at %.0f rpm up to %.1f %% shallower than the open loop "
+      "(joint %zu = %.1f deg): the damper off at joint %zu = %s deg, the set kept over the rest",
+      r.name.c_str(), k, rpm, 100.0 * (1.0 - worst), j + 1, worst_at, j + 1, where.c_str()));
 }
 
 }  // namespace
@@ -112,7 +124,8 @@ NeverWorse never_worse_at_speed(const config::Config& cell, const config::Millin
   const config::PoseScheduleConfig& ps = *cell.pose_schedule;
   std::vector<config::Config> sets;
   for (const auto& rs : sched.regions) sets.push_back(rs.config);
-  milling::LiveStability live(job, "", sets, {}, milling::PoseDynamics{ps.model_resolved, sched.model, ps.axis, ps.modes});
+  milling::LiveStability live(job, "", sets, {},
+                              milling::PoseDynamics{ps.model_resolved, sched.model, ps.axis, ps.modes});
   NeverWorse out;
   for (std::size_t i = 0; i < ps.regions.size(); ++i) {
     const double k = sched.regions[i].gain_ns_per_m;

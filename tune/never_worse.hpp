@@ -33,6 +33,7 @@ struct NeverWorse {
 // job: the cut (its structure replaced by the robot at each pose, milling::LiveStability); extra_poses: poses
 // the set must also not be worse at (the workspace map's, the stops). Throws config::ConfigError.
 [[nodiscard]] NeverWorse never_worse_at_speed(const config::Config& cell, const config::MillingConfig& job, double rpm,
-                                              const std::vector<std::vector<double>>& extra_poses, double step_deg = 2.5);
+                                              const std::vector<std::vector<double>>& extra_poses,
+                                              double step_deg = 2.5);
 
 }  // namespace robodamp::tune

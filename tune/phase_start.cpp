@@ -53,7 +53,8 @@ struct Fit {
 // above 98 % of gain_max (squared natural log; 0 within it or without a limit): the search's own constraint.
 double gain_excess(const Candidate& c, const Fit& fit) {
   if (fit.gain_max <= 0.0) return 0.0;
-  const double over = std::log(compensator_gain_ratio(c, fit.match_hz, fit.nyquist_hz) / (kGainLimitShare * fit.gain_max));
+  const double over =
+      std::log(compensator_gain_ratio(c, fit.match_hz, fit.nyquist_hz) / (kGainLimitShare * fit.gain_max));
   return over > 0.0 ? over * over : 0.0;
 }
 
@@ -110,15 +111,17 @@ std::vector<Candidate> fit_starts(const std::vector<ModeAt>& modes) {
 
 }  // namespace
 
-std::optional<PhaseMatch> phase_matched(const std::vector<config::Config>& plants, double band_min_hz, double band_max_hz,
-                                        double compensator_gain_max) {
+std::optional<PhaseMatch> phase_matched(const std::vector<config::Config>& plants, double band_min_hz,
+                                        double band_max_hz, double compensator_gain_max) {
   const std::vector<ModeAt> modes = modes_in_band(plants, band_min_hz, band_max_hz);
   if (modes.empty()) return std::nullopt;
   const double match_hz = unity_gain_hz(plants.front()), nyquist_hz = 0.5 * plants.front().loop.rate_hz;
-  const std::array<double, kShapeDims> lower{std::log10(kPairMinHz), kZetaMin, std::log10(kPairMinHz),
-                                             kZetaMin, std::log10(kFirstOrderMinHz), std::log10(kFirstOrderMinHz)};
-  const std::array<double, kShapeDims> upper{std::log10(kPairMaxHz), kZetaMax, std::log10(kPairMaxHz),
-                                             kZetaMax, std::log10(kFirstOrderMaxHz), std::log10(kFirstOrderMaxHz)};
+  const std::array<double, kShapeDims> lower{std::log10(kPairMinHz),       kZetaMin,
+                                             std::log10(kPairMinHz),       kZetaMin,
+                                             std::log10(kFirstOrderMinHz), std::log10(kFirstOrderMinHz)};
+  const std::array<double, kShapeDims> upper{std::log10(kPairMaxHz),       kZetaMax,
+                                             std::log10(kPairMaxHz),       kZetaMax,
+                                             std::log10(kFirstOrderMaxHz), std::log10(kFirstOrderMaxHz)};
   std::optional<PhaseMatch> best;
   double best_sum = 0.0;
   for (const int polarity : {1, -1}) {

@@ -22,7 +22,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 config::MillingConfig job_at_poses(const config::MillingConfig& job, const config::Config& cell) {
   config::MillingConfig out = job;
   const config::StructureConfig st = milling::robot_through_cell(job.selected_structure(), cell.actuator.location,
-                                                                    cell.pose_schedule->axis, cell.source);
+                                                                 cell.pose_schedule->axis, cell.source);
   out.structures = {st};
   out.structure = st.name;
   return out;
@@ -77,7 +77,8 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
     p.improvement_pct = std::min(p.improvement_pct, point);
     if (with_job) {
       const Evaluation e = with_job->assess(at);
-      if (!p.damped_min_mm || e.accurate_min_mm < *p.damped_min_mm) p.damped_min_mm = e.accurate_min_mm, p.damped_min_rpm = e.accurate_min_rpm;
+      if (!p.damped_min_mm || e.accurate_min_mm < *p.damped_min_mm)
+        p.damped_min_mm = e.accurate_min_mm, p.damped_min_rpm = e.accurate_min_rpm;
     }
   }
   if (band.inside && band.inside->improvement_pct < p.worst_mode_improvement_pct)
@@ -96,7 +97,8 @@ std::vector<MapPose> workspace_map(const PoseTuneInput& in, int points, const st
   for (NamedPose& q : mode_grid(in, ws, points)) out.push_back({std::move(q), "grid", 0.0, std::nullopt});
   for (const NamedPose& p : in.measured) out.push_back({p, "measured", 0.0, std::nullopt});
   for (const NamedPose& p : held_out) out.push_back({p, "held out", 0.0, std::nullopt});
-  for (MapPose& m : out) m.dominant_hz = analysis::pose_modes(in.model, m.pose.joints_deg, s.axis, s.modes).dominant_hz();
+  for (MapPose& m : out)
+    m.dominant_hz = analysis::pose_modes(in.model, m.pose.joints_deg, s.axis, s.modes).dominant_hz();
   return out;
 }
 
@@ -127,14 +129,17 @@ MapScores score_on_map(const PoseTuneInput& in, std::vector<MapPose> map,
     }
     for (std::size_t c = 0; c < schedules.size(); ++c)
       fold(out.controllers[c], score_pose(in, schedules[c].second, sets[c], mp, ev.get()));
-    if (progress) progress("map pose " + std::to_string(k + 1) + " of " + std::to_string(map.size()) + ": " + mp.pose.name);
+    if (progress)
+      progress("map pose " + std::to_string(k + 1) + " of " + std::to_string(map.size()) + ": " + mp.pose.name);
   }
   out.map = std::move(map);
   return out;
 }
 
 std::size_t better_controller(const MapScores& s, double worse_mode_tolerance_pct) {
-  const auto keeps = [&](const ControllerScore& c) { return c.worst_mode_improvement_pct >= -worse_mode_tolerance_pct; };
+  const auto keeps = [&](const ControllerScore& c) {
+    return c.worst_mode_improvement_pct >= -worse_mode_tolerance_pct;
+  };
   std::size_t best = 0;
   for (std::size_t i = 1; i < s.controllers.size(); ++i) {
     const ControllerScore &a = s.controllers[best], &b = s.controllers[i];

@@ -21,21 +21,21 @@
 namespace robodamp::tune {
 
 struct PoseScore {
-  std::vector<std::string> regions;     // the sets that can run at the pose (none: outside every region, not scored)
+  std::vector<std::string> regions;  // the sets that can run at the pose (none: outside every region, not scored)
   bool stable{false};
   double worst_mode_improvement_pct{0.0};  // of the modes in pose_schedule's damping band
   double worst_mode_hz{0.0};
   std::optional<double> outside_band_pct;  // the worst mode outside the damping band, if one is
   std::optional<double> outside_band_hz;
-  double improvement_pct{0.0};          // the driving point's peak (in an overlap the worse set's)
+  double improvement_pct{0.0};                 // the driving point's peak (in an overlap the worse set's)
   std::vector<double> region_improvement_pct;  // each region's set in `regions`: the driving point's peak
-  std::optional<double> damped_min_mm;  // with a job: sampled-loop SDM
+  std::optional<double> damped_min_mm;         // with a job: sampled-loop SDM
   std::optional<double> damped_min_rpm;
 };
 
 struct ControllerScore {
-  std::string name;                     // "robust", "scheduled"
-  std::vector<PoseScore> poses;         // in the map's order
+  std::string name;              // "robust", "scheduled"
+  std::vector<PoseScore> poses;  // in the map's order
   bool stable_everywhere{true};
   double worst_mode_improvement_pct{0.0};  // over the map, in the damping band
   std::optional<double> outside_band_pct;  // over the map, outside it
@@ -46,15 +46,15 @@ struct ControllerScore {
 
 struct MapPose {
   NamedPose pose;
-  std::string role;                     // "grid", "measured", "held out"
+  std::string role;  // "grid", "measured", "held out"
   double dominant_hz{0.0};
-  std::optional<double> open_min_mm;    // with a job: the open loop's smallest SDM limit at the checked speeds
+  std::optional<double> open_min_mm;  // with a job: the open loop's smallest SDM limit at the checked speeds
 };
 
 struct MapScores {
   std::vector<MapPose> map;
   std::vector<ControllerScore> controllers;
-  std::string method;                   // of the depths: "sampled-loop SDM" (with a job)
+  std::string method;  // of the depths: "sampled-loop SDM" (with a job)
 };
 
 // The map: a grid over the workspace (points per joint along the joints that move the dominant mode,
@@ -67,7 +67,8 @@ struct MapScores {
 // actuator's axis); its other parts are kept. Throws config::ConfigError for a job that cannot be analysed.
 [[nodiscard]] MapScores score_on_map(const PoseTuneInput& in, std::vector<MapPose> map,
                                      const std::vector<std::pair<std::string, config::PoseScheduleConfig>>& schedules,
-                                     const std::optional<config::MillingConfig>& job, const PoseTuneProgress& progress = {});
+                                     const std::optional<config::MillingConfig>& job,
+                                     const PoseTuneProgress& progress = {});
 
 // The better controller: stable at every map pose; then keeping the damping band's promise (no mode in
 // the band more than worse_mode_tolerance_pct worse than open loop at any map pose); then the larger

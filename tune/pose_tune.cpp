@@ -117,7 +117,8 @@ TuneSettings region_settings(const PoseTuneInput& in, const PoseTuneSettings& s)
   t.mode_band_max_hz = in.cell.pose_schedule->damping_band_max_hz;
   t.compensator_gain_max = s.compensator_gain_max;
   const double fraction = in.cell.supervision.max_gain_fraction;
-  if (fraction > 0.0 && fraction < 1.0) t.gain_margin_min_db = std::max(t.gain_margin_min_db, -20.0 * std::log10(fraction) + 0.1);
+  if (fraction > 0.0 && fraction < 1.0)
+    t.gain_margin_min_db = std::max(t.gain_margin_min_db, -20.0 * std::log10(fraction) + 0.1);
   return t;
 }
 
@@ -163,8 +164,8 @@ Candidate best_start(const PoseTuneInput& in, const config::Config& base, const 
     if (!best || better(e, *best)) best = e;
   };
   for (const auto& q : starts) {
-    const Evaluator one(analysis::config_at_pose(base, analysis::pose_modes(in.model, q, sched.axis, sched.modes)), std::nullopt,
-                        single, config::describe_pose(q));
+    const Evaluator one(analysis::config_at_pose(base, analysis::pose_modes(in.model, q, sched.axis, sched.modes)),
+                        std::nullopt, single, config::describe_pose(q));
     contend(tune(std::vector<const Evaluator*>{&one}, single).best.candidate);
   }
   std::vector<config::Config> at_poses;
@@ -197,12 +198,15 @@ constexpr int kCheckRounds = 2;
 // those it was tuned at. Where it does not serve, the worst such pose joins the region's poses and the search
 // runs again from the set (tune_from: never worse over them), at most kCheckRounds times. The result's worst
 // case counts every checked pose, so the region serves only where the check holds too.
-TuneResult checked_between(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t, const PoseTuneSettings& s,
-                           const PoseTuneProgress& progress, TunedRegion& out, std::vector<Evaluator>& plants, TuneResult r) {
+TuneResult checked_between(const PoseTuneInput& in, const config::Config& base, const TuneSettings& t,
+                           const PoseTuneSettings& s, const PoseTuneProgress& progress, TunedRegion& out,
+                           std::vector<Evaluator>& plants, TuneResult r) {
   std::vector<Evaluator> check;
   std::vector<NamedPose> check_poses;
   for (const NamedPose& p : region_poses(in, out.region, 0.5 * s.line_step_deg)) {
-    if (std::any_of(out.poses.begin(), out.poses.end(), [&](const NamedPose& q) { return q.joints_deg == p.joints_deg; })) continue;
+    if (std::any_of(out.poses.begin(), out.poses.end(),
+                    [&](const NamedPose& q) { return q.joints_deg == p.joints_deg; }))
+      continue;
     check.push_back(region_plant(in, base, t, p));
     check_poses.push_back(p);
   }
@@ -216,7 +220,8 @@ TuneResult checked_between(const PoseTuneInput& in, const config::Config& base, 
       if (!e.feasible() && e.violation > worst_violation) worst = i, worst_violation = e.violation;
     }
     if (!worst) return r;
-    if (progress) progress("  does not serve at " + check_poses[*worst].name + " between its poses: searched again with it");
+    if (progress)
+      progress("  does not serve at " + check_poses[*worst].name + " between its poses: searched again with it");
     plants.push_back(std::move(check[*worst]));
     joined[*worst] = true;
     out.poses.push_back(check_poses[*worst]);
@@ -255,18 +260,20 @@ TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const 
     plants.push_back(region_plant(in, base, t, p, pm));
   }
   if (progress)
-    progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) + ": " +
-             std::to_string(out.poses.size()) + " poses, dominant mode " + fmt(out.dominant_min_hz) + "-" +
+    progress("region '" + name + "' " + config::describe_pose(min_deg) + " to " + config::describe_pose(max_deg) +
+             ": " + std::to_string(out.poses.size()) + " poses, dominant mode " + fmt(out.dominant_min_hz) + "-" +
              fmt(out.dominant_max_hz) + " Hz");
   std::optional<Candidate> inherited;
   if (parent) inherited = restated(parent->worst.candidate, *parent->region.match_freq_hz, match_hz);
-  const TuneResult r = checked_between(in, base, t, s, progress, out, plants,
-                                       tune_from(pointers(plants), best_start(in, base, centre, out, plants, t, inherited), t));
+  const TuneResult r =
+      checked_between(in, base, t, s, progress, out, plants,
+                      tune_from(pointers(plants), best_start(in, base, centre, out, plants, t, inherited), t));
   out.worst = r.best;
   const Candidate& c = r.best.candidate;
   const config::Config tuned = with_candidate(base, c);
   for (const config::BlockConfig& b : tuned.controller.chain)
-    if (b.kind == config::BlockKind::kCompensator) out.region.compensator = config::RegionCompensatorConfig{b.numerator, b.denominator};
+    if (b.kind == config::BlockKind::kCompensator)
+      out.region.compensator = config::RegionCompensatorConfig{b.numerator, b.denominator};
   out.region.match_freq_hz = match_hz;
   out.region.gain_ns_per_m = c.gain_ns_per_m;
   out.region.polarity = c.polarity;
@@ -321,10 +328,12 @@ std::optional<Cut> cut_of(const PoseTuneInput& in, const TunedRegion& r, const P
         break;
       }
     // Where the set stops serving, when that is known: halfway from the centre towards that pose.
-    const auto binding = std::find_if(r.poses.begin(), r.poses.end(), [&](const NamedPose& p) { return p.name == r.worst.plant; });
+    const auto binding =
+        std::find_if(r.poses.begin(), r.poses.end(), [&](const NamedPose& p) { return p.name == r.worst.plant; });
     if (binding != r.poses.end() && std::abs(binding->joints_deg[j] - centre[j]) >= s.min_width_deg)
       at = 0.5 * (centre[j] + binding->joints_deg[j]);
-    best = Cut{j, std::clamp(std::round(at * 2.0) / 2.0, lo_deg + s.min_width_deg, lo_deg + width - s.min_width_deg)};  // 0.5 deg
+    best = Cut{j, std::clamp(std::round(at * 2.0) / 2.0, lo_deg + s.min_width_deg,
+                             lo_deg + width - s.min_width_deg)};  // 0.5 deg
   }
   return best;
 }
@@ -355,7 +364,8 @@ std::vector<TunedRegion> tune_schedule(const PoseTuneInput& in, const TunedRegio
     pending.push_back(tune_region(in, r.region.name + "b", hi_min, r.region.max_deg, s, progress, &r));
   }
   // Named in joint order along the workspace: r1, r2, ...
-  std::sort(done.begin(), done.end(), [](const TunedRegion& a, const TunedRegion& b) { return a.region.min_deg < b.region.min_deg; });
+  std::sort(done.begin(), done.end(),
+            [](const TunedRegion& a, const TunedRegion& b) { return a.region.min_deg < b.region.min_deg; });
   for (std::size_t i = 0; i < done.size(); ++i) {
     std::string& name = done[i].region.name;
     name = done.size() == 1 ? "workspace" : "r";
@@ -364,7 +374,8 @@ std::vector<TunedRegion> tune_schedule(const PoseTuneInput& in, const TunedRegio
   return done;
 }
 
-config::PoseScheduleConfig schedule_of(const config::PoseScheduleConfig& base, const std::vector<TunedRegion>& regions) {
+config::PoseScheduleConfig schedule_of(const config::PoseScheduleConfig& base,
+                                       const std::vector<TunedRegion>& regions) {
   config::PoseScheduleConfig out = base;
   out.regions.clear();
   for (const TunedRegion& r : regions) out.regions.push_back(r.region);

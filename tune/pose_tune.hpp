@@ -45,10 +45,10 @@ struct NamedPose {
 };
 
 struct PoseTuneSettings {
-  TuneSettings tune;         // no_worse_mode is set by the pose tune
-  int max_regions{4};        // the scheduled controller's regions at most
-  double overlap_deg{4.0};   // neighbouring regions overlap by this across the cut (the hand-over's hysteresis)
-  double min_width_deg{8.0}; // a region is not cut along a joint narrower than twice this
+  TuneSettings tune;           // no_worse_mode is set by the pose tune
+  int max_regions{4};          // the scheduled controller's regions at most
+  double overlap_deg{4.0};     // neighbouring regions overlap by this across the cut (the hand-over's hysteresis)
+  double min_width_deg{8.0};   // a region is not cut along a joint narrower than twice this
   double line_step_deg{10.0};  // a region's poses along each joint that changes the plant at most this far apart
   double worse_mode_tolerance_pct{0.0};  // a mode's peak up to this much worse than open loop still serves
   double compensator_gain_max{10.0};     // TuneSettings::compensator_gain_max for every set
@@ -63,9 +63,9 @@ struct TunedRegion {
 };
 
 struct PoseTuneInput {
-  config::Config cell;                    // with a pose_schedule (model, axis, modes, grid_points, workspace)
-  config::RobotModelConfig model;         // the pose-indexed model (pose_schedule.model or a fitted one)
-  std::vector<NamedPose> measured;        // tuned at where inside a region
+  config::Config cell;              // with a pose_schedule (model, axis, modes, grid_points, workspace)
+  config::RobotModelConfig model;   // the pose-indexed model (pose_schedule.model or a fitted one)
+  std::vector<NamedPose> measured;  // tuned at where inside a region
 };
 
 using PoseTuneProgress = std::function<void(const std::string&)>;
@@ -77,9 +77,10 @@ using PoseTuneProgress = std::function<void(const std::string&)>;
 // One set tuned over the box's poses; with a parent (the region it was cut from), the parent's set is one
 // of the starts, so a half is never tuned worse over its poses than the set it replaces. Throws
 // config::ConfigError for a pose outside the model's travel.
-[[nodiscard]] TunedRegion tune_region(const PoseTuneInput& in, const std::string& name, const std::vector<double>& min_deg,
-                                      const std::vector<double>& max_deg, const PoseTuneSettings& s,
-                                      const PoseTuneProgress& progress = {}, const TunedRegion* parent = nullptr);
+[[nodiscard]] TunedRegion tune_region(const PoseTuneInput& in, const std::string& name,
+                                      const std::vector<double>& min_deg, const std::vector<double>& max_deg,
+                                      const PoseTuneSettings& s, const PoseTuneProgress& progress = {},
+                                      const TunedRegion* parent = nullptr);
 
 // The robust controller: one region, the workspace.
 [[nodiscard]] TunedRegion tune_robust(const PoseTuneInput& in, const PoseTuneSettings& s,

@@ -63,7 +63,8 @@ WorkspaceTune tune_workspace(const PoseTuneInput& in, const std::vector<NamedPos
 }
 
 std::string write_pose_tuned_config(const config::Config& cell, const std::vector<TunedRegion>& chosen,
-                                    const std::string& model_path, const std::string& out_path, const std::string& header) {
+                                    const std::string& model_path, const std::string& out_path,
+                                    const std::string& header) {
   std::vector<config::PoseRegionConfig> regions;
   for (const auto& r : chosen) regions.push_back(r.region);
   return write_pose_regions(cell, regions, model_path, out_path, header);

@@ -21,8 +21,8 @@ namespace robodamp::tune {
 struct WorkspaceTune {
   TunedRegion robust;
   std::vector<TunedRegion> scheduled;
-  MapScores scores;      // controllers: robust, scheduled, "as given" (the configuration's own schedule)
-  std::size_t best{0};   // into scores.controllers
+  MapScores scores;     // controllers: robust, scheduled, "as given" (the configuration's own schedule)
+  std::size_t best{0};  // into scores.controllers
   // The regions to write: the robust one, the scheduled ones, or none (the configuration's own schedule won).
   [[nodiscard]] std::vector<TunedRegion> chosen() const;
   [[nodiscard]] const ControllerScore& best_score() const { return scores.controllers[best]; }
@@ -38,7 +38,8 @@ struct WorkspaceTune {
 // once it reads back and every region's set analyses over its grid. Returns the text written. Throws
 // config::ConfigError (the check) or std::invalid_argument (the edit).
 std::string write_pose_tuned_config(const config::Config& cell, const std::vector<TunedRegion>& chosen,
-                                    const std::string& model_path, const std::string& out_path, const std::string& header);
+                                    const std::string& model_path, const std::string& out_path,
+                                    const std::string& header);
 // The same with the regions as the configuration holds them (a region's optional keys written where set).
 std::string write_pose_regions(const config::Config& cell, const std::vector<config::PoseRegionConfig>& regions,
                                const std::string& model_path, const std::string& out_path, const std::string& header);

@@ -25,16 +25,18 @@ std::string fault_at(const config::Config& cfg, double factor, const std::vector
   const std::vector<analysis::ModePhase> phases = phases_at(cfg, factor, stable);
   if (!stable) return "the loop unstable";
   for (std::size_t i = 0; i < phases.size() && i < nominal.size(); ++i)
-    if (const auto& mode = phases[i]; std::abs(nominal[i].feedback_phase_deg) < 90.0 && std::abs(mode.feedback_phase_deg) >= 90.0) {
+    if (const auto& mode = phases[i];
+        std::abs(nominal[i].feedback_phase_deg) < 90.0 && std::abs(mode.feedback_phase_deg) >= 90.0) {
       char b[160];
-      std::snprintf(b, sizeof b, "the %.1f Hz mode fed back at %.0f deg: not damped", mode.freq_hz, mode.feedback_phase_deg);
+      std::snprintf(b, sizeof b, "the %.1f Hz mode fed back at %.0f deg: not damped", mode.freq_hz,
+                    mode.feedback_phase_deg);
       return b;
     }
   return {};
 }
 
-ShiftLimit limit(const config::Config& cfg, const std::vector<analysis::ModePhase>& nominal, double sign, double max_pct,
-                 double step_pct) {
+ShiftLimit limit(const config::Config& cfg, const std::vector<analysis::ModePhase>& nominal, double sign,
+                 double max_pct, double step_pct) {
   ShiftLimit out;
   const int steps = static_cast<int>(std::floor(max_pct / step_pct + 1e-9));
   for (int i = 1; i <= steps; ++i) {

@@ -12,9 +12,9 @@
 namespace robodamp::tune {
 
 struct ShiftLimit {
-  double pct{0.0};      // the largest shift (in steps of step_pct) with the loop stable and its damped modes damped
+  double pct{0.0};          // the largest shift (in steps of step_pct) with the loop stable and its damped modes damped
   bool reached_max{false};  // good up to max_pct
-  std::string reason;   // what failed one step further ("unstable", "the 21.0 Hz mode at 94 deg: not damped")
+  std::string reason;       // what failed one step further ("unstable", "the 21.0 Hz mode at 94 deg: not damped")
 };
 
 struct Robustness {

@@ -5,6 +5,8 @@
 #include <memory>
 #include <string>
 
+#include "config/config.hpp"
+#include "config/speed_schedule_config.hpp"
 #include "control/controller.hpp"
 
 namespace robodamp::tune {
@@ -63,8 +65,9 @@ void set_top_gain(ScheduleController& c, const config::Config& cell, const Sched
 
 }  // namespace
 
-std::vector<ScheduleController> schedule_controllers(const config::Config& cell, const std::vector<NamedController>& others,
-                                                const ScheduleSettings& s) {
+std::vector<ScheduleController> schedule_controllers(const config::Config& cell,
+                                                     const std::vector<NamedController>& others,
+                                                     const ScheduleSettings& s) {
   std::vector<ScheduleController> out;
   auto add = [&](const std::string& file, config::Config cfg) {
     cfg.controller.speed_schedule.reset();
@@ -82,6 +85,10 @@ std::vector<ScheduleController> schedule_controllers(const config::Config& cell,
     out.back().entry = o.controller;
   }
   return out;
+}
+
+NamedController controller_of_file(const std::string& path) {
+  return {path, config::speed_controller_of(config::load_config_file(path))};
 }
 
 }  // namespace robodamp::tune

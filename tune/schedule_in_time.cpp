@@ -35,7 +35,8 @@ std::vector<LimitInTimeResult> limits_in_time(const config::MillingConfig& job, 
                                               std::size_t threads, double fraction) {
   std::vector<LimitInTimeResult> out(checks.size());
   std::vector<std::function<void()>> tasks;
-  for (std::size_t i = 0; i < checks.size(); ++i) tasks.emplace_back([&, i] { out[i] = check(job, checks[i], fraction); });
+  for (std::size_t i = 0; i < checks.size(); ++i)
+    tasks.emplace_back([&, i] { out[i] = check(job, checks[i], fraction); });
   analysis::run_tasks(tasks, analysis::task_threads(threads));
   return out;
 }

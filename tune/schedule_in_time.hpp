@@ -17,14 +17,14 @@
 namespace robodamp::tune {
 
 struct LimitInTime {
-  double rpm{0.0};                                // as the sampled loop runs it
-  const milling::Structure* structure{nullptr};   // with the controller part at its candidate's gain
-  double limit_mm{0.0};                           // the accurate method's
+  double rpm{0.0};                               // as the sampled loop runs it
+  const milling::Structure* structure{nullptr};  // with the controller part at its candidate's gain
+  double limit_mm{0.0};                          // the accurate method's
 };
 
 struct LimitInTimeResult {
-  bool held{true};          // the cut at fraction x limit_mm was stable
-  double limit_mm{0.0};     // limit_mm where it held; else the time domain's critical depth (at most limit_mm)
+  bool held{true};       // the cut at fraction x limit_mm was stable
+  double limit_mm{0.0};  // limit_mm where it held; else the time domain's critical depth (at most limit_mm)
   int simulations{0};
 };
 
@@ -32,7 +32,7 @@ inline constexpr double kInTimeFraction = 0.95;  // of the limit, as commission'
 
 // Each check on its own cut(s), on up to `threads` threads (0: one per core); results in the order given.
 [[nodiscard]] std::vector<LimitInTimeResult> limits_in_time(const config::MillingConfig& job,
-                                                            const std::vector<LimitInTime>& checks,
-                                                            std::size_t threads, double fraction = kInTimeFraction);
+                                                            const std::vector<LimitInTime>& checks, std::size_t threads,
+                                                            double fraction = kInTimeFraction);
 
 }  // namespace robodamp::tune

@@ -14,7 +14,8 @@
 namespace robodamp::tune {
 
 bool ScheduledCut::all_stable() const {
-  return !segments.empty() && std::all_of(segments.begin(), segments.end(), [](const auto& s) { return s.verdict.stable; });
+  return !segments.empty() &&
+         std::all_of(segments.begin(), segments.end(), [](const auto& s) { return s.verdict.stable; });
 }
 
 bool ScheduledCut::switches_within_limits() const {
@@ -69,10 +70,12 @@ std::unique_ptr<rt::Supervisor> scheduled_supervisor(const config::Config& cell)
   const analysis::LoopModel m0(cell);
   const int pol = cell.controller.polarity;
   const auto k0 = analysis::max_stable_gain(m0, pol);
-  auto sup = std::make_unique<rt::Supervisor>(
-      config::supervisor_settings(cell, m0.stable(cell.controller.gain_ns_per_m, pol), k0.value_or(control::kMaxGainNsPerM)),
-      m0.chain().params);
-  const std::size_t controllers = cell.controller.speed_schedule ? cell.controller.speed_schedule->controllers.size() : 0;
+  auto sup =
+      std::make_unique<rt::Supervisor>(config::supervisor_settings(cell, m0.stable(cell.controller.gain_ns_per_m, pol),
+                                                                   k0.value_or(control::kMaxGainNsPerM)),
+                                       m0.chain().params);
+  const std::size_t controllers =
+      cell.controller.speed_schedule ? cell.controller.speed_schedule->controllers.size() : 0;
   for (std::size_t i = 1; i <= controllers; ++i) {
     const config::Config c = config::speed_controller_config(cell, i);
     const analysis::LoopModel m(c);
@@ -105,7 +108,8 @@ double settle_switch(milling::DampedDynamics& dyn, const rt::Supervisor& sup, do
 
 ScheduledCut scheduled_cut(const config::Config& cell, const config::MillingConfig& job,
                            const std::vector<ScheduledCutStep>& steps, int revolutions) {
-  if (!cell.controller.speed_schedule) throw std::invalid_argument("scheduled_cut: the configuration has no speed schedule");
+  if (!cell.controller.speed_schedule)
+    throw std::invalid_argument("scheduled_cut: the configuration has no speed schedule");
   SupervisedCutOptions o;
   o.revolutions = revolutions;
   return supervised_cut(cell, job, steps, o);

@@ -20,32 +20,32 @@
 namespace robodamp::tune {
 
 struct ScheduledCutStep {
-  double rpm{0.0};        // asked for
+  double rpm{0.0};  // asked for
   double depth_mm{0.0};
 };
 
 struct ScheduledCutSegment {
-  double rpm{0.0};              // as cut (a whole number of loop periods per tooth period)
+  double rpm{0.0};  // as cut (a whole number of loop periods per tooth period)
   double depth_mm{0.0};
-  std::size_t set{0};           // the supervisor's set when the cut ended
-  double gain_ns_per_m{0.0};    // K asked for there
+  std::size_t set{0};         // the supervisor's set when the cut ended
+  double gain_ns_per_m{0.0};  // K asked for there
   milling::ChatterVerdict verdict;
-  double switch_s{0.0};               // from the speed change to K settled on the band's set
-  double switch_peak_force_n{0.0};    // the controller's force command through the switch
+  double switch_s{0.0};                   // from the speed change to K settled on the band's set
+  double switch_peak_force_n{0.0};        // the controller's force command through the switch
   std::uint64_t switch_limited_ticks{0};  // ticks at a controller limit (force, voltage, slew) through the switch
-  double peak_force_command_n{0.0};   // the controller's force command through the cut (its entry included)
-  std::uint64_t limited_ticks{0};     // ticks at a controller limit through the cut
-  std::string state, trip;            // the supervisor's at the end
-  double lowest_derate{1.0};          // the supervisor's derating through the cut (1: none)
-  double derated_s{0.0};              // time through the cut with the command derated
-  double trip_s{-1.0};                // from the cut's start to a trip (-1: none)
+  double peak_force_command_n{0.0};       // the controller's force command through the cut (its entry included)
+  std::uint64_t limited_ticks{0};         // ticks at a controller limit through the cut
+  std::string state, trip;                // the supervisor's at the end
+  double lowest_derate{1.0};              // the supervisor's derating through the cut (1: none)
+  double derated_s{0.0};                  // time through the cut with the command derated
+  double trip_s{-1.0};                    // from the cut's start to a trip (-1: none)
 };
 
 struct ScheduledCut {
   std::vector<ScheduledCutSegment> segments;
-  double force_limit_n{0.0};          // the actuator's (actuator.force_limit_n)
+  double force_limit_n{0.0};  // the actuator's (actuator.force_limit_n)
   std::uint64_t handovers{0}, handovers_refused{0};
-  rt::SupervisorCounters counters;    // the supervisor's at the end
+  rt::SupervisorCounters counters;  // the supervisor's at the end
   [[nodiscard]] bool all_stable() const;
   [[nodiscard]] bool switches_within_limits() const;  // no limit acted through a switch, the force below the limit
 };

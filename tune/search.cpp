@@ -50,15 +50,15 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
   if (!w.binding.empty()) w.binding = w.plant + ": " + w.binding;
   // Margins and depths: the smallest over the plants; peaks and shares of a limit: the largest.
   constexpr double Evaluation::*kMargins[] = {&Evaluation::gain_margin_db, &Evaluation::phase_margin_deg,
-                                             &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
-                                             &Evaluation::worst_mode_improvement_pct};
+                                              &Evaluation::delay_margin_ms, &Evaluation::k_max_ns_per_m,
+                                              &Evaluation::worst_mode_improvement_pct};
   constexpr double Evaluation::*kDepths[] = {&Evaluation::min_depth_mm, &Evaluation::depth_at_speed_mm,
-                                            &Evaluation::floor_ratio, &Evaluation::accurate_min_mm,
-                                            &Evaluation::open_minima_ratio};
+                                             &Evaluation::floor_ratio, &Evaluation::accurate_min_mm,
+                                             &Evaluation::open_minima_ratio};
   constexpr double Evaluation::*kLargest[] = {&Evaluation::worst_mode_phase_deg, &Evaluation::peak_m_per_n,
-                                             &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
-                                             &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use,
-                                             &Evaluation::quiet_command_rms_v};
+                                              &Evaluation::peak_coil_force_n,    &Evaluation::peak_command_v,
+                                              &Evaluation::peak_slew_v_per_s,    &Evaluation::actuator_use,
+                                              &Evaluation::quiet_command_rms_v};
   if (!full(wi) && lowest != per.size())
     for (const auto field : kDepths) w.*field = per[lowest].*field;
   for (std::size_t i = 0; i < per.size(); ++i) {
@@ -77,14 +77,16 @@ namespace {
 
 // x = [log10 K, log10 fz, zeta_z, log10 fp, zeta_p, log10 fa, log10 fb]
 constexpr unsigned kDims = 7;
-const double kLower[kDims] = {std::log10(kGainMinNsPerM), std::log10(kPairMinHz), kZetaMin, std::log10(kPairMinHz), kZetaMin,
-                              std::log10(kFirstOrderMinHz), std::log10(kFirstOrderMinHz)};
-const double kUpper[kDims] = {std::log10(kGainMaxNsPerM), std::log10(kPairMaxHz), kZetaMax, std::log10(kPairMaxHz), kZetaMax,
-                              std::log10(kFirstOrderMaxHz), std::log10(kFirstOrderMaxHz)};
+const double kLower[kDims] = {
+    std::log10(kGainMinNsPerM),   std::log10(kPairMinHz),      kZetaMin, std::log10(kPairMinHz), kZetaMin,
+    std::log10(kFirstOrderMinHz), std::log10(kFirstOrderMinHz)};
+const double kUpper[kDims] = {
+    std::log10(kGainMaxNsPerM),   std::log10(kPairMaxHz),      kZetaMax, std::log10(kPairMaxHz), kZetaMax,
+    std::log10(kFirstOrderMaxHz), std::log10(kFirstOrderMaxHz)};
 
 Candidate candidate_of(const double* x, int polarity) {
-  return {std::pow(10.0, x[0]), std::pow(10.0, x[1]), x[2], std::pow(10.0, x[3]), x[4], std::pow(10.0, x[5]),
-          std::pow(10.0, x[6]), polarity};
+  return {std::pow(10.0, x[0]), std::pow(10.0, x[1]), x[2],    std::pow(10.0, x[3]), x[4],
+          std::pow(10.0, x[5]), std::pow(10.0, x[6]), polarity};
 }
 
 struct Search {
@@ -106,8 +108,8 @@ double penalised(unsigned /*n*/, const double* x, double* /*grad*/, void* data) 
   if (*s.progress && (s.count % 20 == 0 || s.count == s.budget)) {
     const Evaluation& b = s.result->best;
     char line[200];
-    std::snprintf(line, sizeof line, "tune: polarity %+d, %s %d/%d; best so far %s %.4g, %s", s.polarity, s.phase, s.count,
-                  s.budget, b.peak_m_per_n > 0.0 ? "-log10 peak" : "min depth mm", b.objective,
+    std::snprintf(line, sizeof line, "tune: polarity %+d, %s %d/%d; best so far %s %.4g, %s", s.polarity, s.phase,
+                  s.count, s.budget, b.peak_m_per_n > 0.0 ? "-log10 peak" : "min depth mm", b.objective,
                   b.feasible() ? "feasible" : ("violates " + b.binding).c_str());
     (*s.progress)(line);
   }
@@ -128,8 +130,8 @@ void run(nlopt_algorithm algorithm, Search& s, std::vector<double>& x) {
 }
 
 std::vector<double> x_of(const Candidate& c) {
-  return {std::log10(c.gain_ns_per_m), std::log10(c.fz_hz), c.zeta_z, std::log10(c.fp_hz), c.zeta_p, std::log10(c.fa_hz),
-          std::log10(c.fb_hz)};
+  return {std::log10(c.gain_ns_per_m), std::log10(c.fz_hz), c.zeta_z, std::log10(c.fp_hz), c.zeta_p,
+          std::log10(c.fa_hz),         std::log10(c.fb_hz)};
 }
 
 }  // namespace
@@ -144,15 +146,21 @@ namespace {
 
 // One polarity's search (seeded global, then the polish), its evaluations and best added to `result`.
 void search_polarity(const std::vector<const Evaluator*>& plants, const TuneSettings& s, int polarity,
-                     const std::function<void(const std::string&)>& progress, const std::string& tag, TuneResult& result,
-                     const std::optional<Candidate>& start = std::nullopt) {
+                     const std::function<void(const std::string&)>& progress, const std::string& tag,
+                     TuneResult& result, const std::optional<Candidate>& start = std::nullopt) {
   const config::Config& base = plants.front()->base();
   TuneResult per;
   const std::string global_phase = "global search" + tag, local_phase = "local polish" + tag;
   Search global{&plants, polarity, &per, &progress, global_phase.c_str(), s.global_evaluations};
   // From C1's shape (the actuator's resonance cancelled, poles at 0.5 Hz) at the configured gain.
-  const Candidate c1{std::clamp(base.controller.gain_ns_per_m, kGainMinNsPerM, kGainMaxNsPerM), base.actuator.natural_freq_hz,
-                     base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0, polarity};
+  const Candidate c1{std::clamp(base.controller.gain_ns_per_m, kGainMinNsPerM, kGainMaxNsPerM),
+                     base.actuator.natural_freq_hz,
+                     base.actuator.damping_ratio,
+                     0.5,
+                     1.0,
+                     10.0,
+                     10.0,
+                     polarity};
   std::vector<double> x = x_of(start ? *start : c1);
   for (unsigned i = 0; i < kDims; ++i) x[i] = std::clamp(x[i], kLower[i], kUpper[i]);
   run(NLOPT_GN_CRS2_LM, global, x);

@@ -55,7 +55,9 @@ class Depths {
   }
   [[nodiscard]] std::size_t fixed() const { return methods_.size() - 1; }
   [[nodiscard]] const milling::AccurateStability& damped_method() const { return *methods_.back(); }
-  [[nodiscard]] std::string method() const { return methods_.back()->method() + " (damped), " + methods_.front()->method() + " (open loop)"; }
+  [[nodiscard]] std::string method() const {
+    return methods_.back()->method() + " (damped), " + methods_.front()->method() + " (open loop)";
+  }
 
   // Computes what is missing for these speeds and candidates (the open loop first: it is the others' guess).
   void fill(const std::vector<double>& rpm, const std::vector<std::size_t>& which, const std::string& what) {
@@ -117,8 +119,8 @@ class Depths {
 };
 
 struct Grid {
-  std::vector<double> rpm;                 // ascending, the grid speeds as the sampled loop runs them
-  std::vector<std::size_t> choice;         // candidate per grid speed
+  std::vector<double> rpm;          // ascending, the grid speeds as the sampled loop runs them
+  std::vector<std::size_t> choice;  // candidate per grid speed
 };
 
 // The deepest candidate at one grid speed: the open loop unless a damped one beats it by gain_min_pct; the
@@ -187,18 +189,16 @@ double scheduled_at(const Grid& g, const Depths& d, double rpm) {
   return cap ? std::min(mm, *cap) : mm;
 }
 
-}  // namespace
-
-namespace {
-
 // Fewer bands than the controller holds: the run whose speeds lose least (to the open loop) when they take
 // a neighbour's candidate takes it, the narrowest first among equals.
 void fit_band_count(Grid& g, const Depths& d, const std::vector<ScheduleCandidate>& cands, double lo, double hi) {
   while (bands_of(g, caps_of(g, d), cands, lo, hi).size() > config::kMaxSpeedBands) {
     std::vector<std::pair<std::size_t, std::size_t>> runs;  // [first, last] grid index
     for (std::size_t i = 0; i < g.rpm.size(); ++i)
-      if (i == 0 || g.choice[i] != g.choice[i - 1]) runs.push_back({i, i});
-      else runs.back().second = i;
+      if (i == 0 || g.choice[i] != g.choice[i - 1])
+        runs.push_back({i, i});
+      else
+        runs.back().second = i;
     double best_loss = kInf, best_width = kInf;
     std::size_t best_run = 0, best_to = 0;
     for (std::size_t r = 0; r < runs.size(); ++r)
@@ -224,7 +224,8 @@ std::vector<std::size_t> every(std::size_t n) {
 
 // Two speeds between each pair of grid speeds (a quarter and three quarters of the way), as the sampled loop
 // runs them, not already known.
-std::vector<double> checks_between(const Grid& g, const milling::AccurateStability& damped, const std::set<double>& known) {
+std::vector<double> checks_between(const Grid& g, const milling::AccurateStability& damped,
+                                   const std::set<double>& known) {
   std::vector<double> out;
   for (std::size_t i = 0; i + 1 < g.rpm.size(); ++i)
     for (const double f : {0.25, 0.75}) {
@@ -366,8 +367,10 @@ void check_in_time(SpeedSchedule& out, Grid& g, std::set<double>& checked, Depth
     if (choose_again) d.fill(again, every(out.candidates.size()), "choosing again after the cuts in time");
     for (double r : again) {
       std::size_t c = candidate_at(g, r);
-      if (choose_again) c = choose(d, r, out.candidates.size(), std::nullopt, s);
-      else if (d.depth(r, c) < d.depth(r, 0) * tol) c = 0;
+      if (choose_again)
+        c = choose(d, r, out.candidates.size(), std::nullopt, s);
+      else if (d.depth(r, c) < d.depth(r, 0) * tol)
+        c = 0;
       place(r, c);
     }
     fit_band_count(g, d, out.candidates, lo, hi);
@@ -378,10 +381,6 @@ void check_in_time(SpeedSchedule& out, Grid& g, std::set<double>& checked, Depth
   out.lowered = in_time.lowered();
   for (LoweredLimit& l : out.lowered) l.kept = candidate_at(g, l.rpm) == l.candidate;
 }
-
-}  // namespace
-
-namespace {
 
 void summarise(SpeedSchedule& out, const Depths& d, const config::MillingConfig& job, double job_rpm, const Grid& g) {
   ScheduleSummary& m = out.summary;
@@ -425,10 +424,6 @@ std::string describe(const ScheduleController& c) {
 
 }  // namespace
 
-NamedController controller_of_file(const std::string& path) {
-  return {path, config::speed_controller_of(config::load_config_file(path))};
-}
-
 SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<NamedController>& other_controllers,
                               const config::MillingConfig& job, const config::StructureConfig& structure,
                               const ScheduleSettings& s) {
@@ -447,7 +442,8 @@ SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<Name
   const int n = s.speeds > 0 ? s.speeds : job.time_domain.sdm_points;
   const double lo = job.lobes.rpm_min, hi = std::min(job.lobes.rpm_max, damped.max_rpm());
   if (hi < job.lobes.rpm_max)
-    out.notes.push_back("above " + config::format_number(hi) + " rpm the sampled loop has fewer than 10 ticks per tooth "
+    out.notes.push_back("above " + config::format_number(hi) +
+                        " rpm the sampled loop has fewer than 10 ticks per tooth "
                         "period: the schedule stops there, and K there is controller.gain_ns_per_m");
   std::set<double> grid_rpm;
   for (int i = 0; i < n; ++i) grid_rpm.insert(damped.stepped_rpm(lo + (hi - lo) * i / std::max(1, n - 1)));
@@ -457,11 +453,14 @@ SpeedSchedule schedule_speeds(const config::Config& cell, const std::vector<Name
   all.push_back(d.fixed());
   d.fill(g.rpm, all, "every candidate on the grid");
   for (std::size_t i = 0; i < g.rpm.size(); ++i)
-    g.choice.push_back(choose(d, g.rpm[i], out.candidates.size(), i ? std::optional(g.choice[i - 1]) : std::nullopt, s));
+    g.choice.push_back(
+        choose(d, g.rpm[i], out.candidates.size(), i ? std::optional(g.choice[i - 1]) : std::nullopt, s));
   fit_band_count(g, d, out.candidates, lo, hi);
   std::set<double> checked = refine(g, d, out.candidates.size(), damped, s, out.refined_speeds);
   fit_band_count(g, d, out.candidates, lo, hi);
-  const double job_rpm = job.cut.spindle_rpm > 0.0 && job.cut.spindle_rpm <= damped.max_rpm() ? damped.stepped_rpm(job.cut.spindle_rpm) : 0.0;
+  const double job_rpm = job.cut.spindle_rpm > 0.0 && job.cut.spindle_rpm <= damped.max_rpm()
+                             ? damped.stepped_rpm(job.cut.spindle_rpm)
+                             : 0.0;
   if (job_rpm > 0.0) d.fill({job_rpm}, {0, d.fixed()}, "the job's speed");
   check_in_time(out, g, checked, d, job, job_rpm, lo, hi);
 

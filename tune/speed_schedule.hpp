@@ -33,28 +33,28 @@ struct ScheduleSettings {
   double gain_margin_min_db{6.0};
   double phase_margin_min_deg{45.0};
   double delay_margin_min_ms{0.5};
-  int gains_per_controller{6};       // log-spaced from top / 16 to the top gain (the largest with the margins)
-  int speeds{0};                     // the grid over the job's lobes range; 0: time_domain.sdm_points
-  double gain_min_pct{1.0};          // a damped candidate is chosen where it beats the open loop by this
-  double keep_within_pct{2.0};       // the previous speed's candidate is kept while this close to the best
-  double worse_tolerance_pct{0.5};   // below the open loop by more than this is "worse" (the depths are to 0.1 %)
+  int gains_per_controller{6};      // log-spaced from top / 16 to the top gain (the largest with the margins)
+  int speeds{0};                    // the grid over the job's lobes range; 0: time_domain.sdm_points
+  double gain_min_pct{1.0};         // a damped candidate is chosen where it beats the open loop by this
+  double keep_within_pct{2.0};      // the previous speed's candidate is kept while this close to the best
+  double worse_tolerance_pct{0.5};  // below the open loop by more than this is "worse" (the depths are to 0.1 %)
   int refine_rounds{3};
-  std::size_t threads{0};            // 0: one per core
+  std::size_t threads{0};  // 0: one per core
   // Called as the depths come in: what is being computed, done, of.
   std::function<void(const std::string& what, std::size_t done, std::size_t of)> progress;
 };
 
 // A controller a band may run: the cell's own (file empty) or another configuration's chain.
 struct ScheduleController {
-  std::string file;                 // as given; empty: the cell's own controller
+  std::string file;                                    // as given; empty: the cell's own controller
   std::optional<config::SpeedControllerConfig> entry;  // another file's: what the schedule writes for it
-  config::Config config;            // the cell with this controller
+  config::Config config;                               // the cell with this controller
   std::shared_ptr<const analysis::LoopModel> model;
   int polarity{1};
   std::optional<double> k_max_ns_per_m;  // the discrete loop's; none: stable to the gain limit
-  double top_gain_ns_per_m{0.0};    // the largest K with every margin (0: none)
-  std::string top_gain_reason;      // which limit set it
-  std::vector<double> gains;        // tried, ascending
+  double top_gain_ns_per_m{0.0};         // the largest K with every margin (0: none)
+  std::string top_gain_reason;           // which limit set it
+  std::vector<double> gains;             // tried, ascending
 };
 
 // Candidate 0 is the open loop (K = 0); the others a controller at a gain.
@@ -64,11 +64,11 @@ struct ScheduleCandidate {
 };
 
 struct ScheduleSpeed {
-  double rpm{0.0};           // as the sampled loop runs it
+  double rpm{0.0};  // as the sampled loop runs it
   int ticks_per_tooth{0};
-  bool grid{false};          // every candidate computed here (else a check between grid speeds)
+  bool grid{false};  // every candidate computed here (else a check between grid speeds)
   double open_mm{0.0};
-  double fixed_mm{0.0};      // the cell as configured (its controller at controller.gain_ns_per_m)
+  double fixed_mm{0.0};  // the cell as configured (its controller at controller.gain_ns_per_m)
   double scheduled_mm{0.0};
   std::size_t candidate{0};  // the schedule's here
   std::size_t band{0};
@@ -80,7 +80,7 @@ struct ScheduleSummary {
   double open_min_mm{0.0}, open_min_rpm{0.0};
   double fixed_min_mm{0.0}, fixed_min_rpm{0.0};
   double scheduled_min_mm{0.0}, scheduled_min_rpm{0.0};
-  double fixed_mean_ratio{0.0}, scheduled_mean_ratio{0.0};  // over the speeds, x the open loop
+  double fixed_mean_ratio{0.0}, scheduled_mean_ratio{0.0};    // over the speeds, x the open loop
   double fixed_worse_share{0.0}, scheduled_worse_share{0.0};  // of the speeds below the open loop (tolerance)
   double fixed_worst_ratio{0.0}, fixed_worst_rpm{0.0};
   double scheduled_worst_ratio{0.0}, scheduled_worst_rpm{0.0};

@@ -24,7 +24,8 @@ std::string controller_text(const config::SpeedControllerConfig& c) {
     for (std::size_t i = 0; i < v.size(); ++i) o << (i ? ", " : "") << exact(v[i]);
     o << "]";
   };
-  if (b.model == config::CompensatorModel::kRational) list("numerator", b.numerator), list("denominator", b.denominator);
+  if (b.model == config::CompensatorModel::kRational)
+    list("numerator", b.numerator), list("denominator", b.denominator);
   if (b.prewarp_hz) o << ", prewarp_hz: " << exact(*b.prewarp_hz);
   o << "}}";
   return o.str();
@@ -37,12 +38,13 @@ std::string schedule_block(const std::string& indent, const SpeedSchedule& s) {
   if (s.controllers.size() > 1) {
     o << indent << "  controllers:    # a band's controller i >= 1: this chain with controllers[i - 1]'s compensator\n";
     for (std::size_t i = 1; i < s.controllers.size(); ++i)
-      o << indent << "    - " << controller_text(*s.controllers[i].entry) << "   # from " << s.controllers[i].file << "\n";
+      o << indent << "    - " << controller_text(*s.controllers[i].entry) << "   # from " << s.controllers[i].file
+        << "\n";
   }
   o << indent << "  bands:\n";
   for (const auto& b : s.bands)
-    o << indent << "    - {rpm_min: " << exact(b.rpm_min) << ", rpm_max: " << exact(b.rpm_max) << ", controller: " << b.controller
-      << ", gain_ns_per_m: " << exact(b.gain_ns_per_m)
+    o << indent << "    - {rpm_min: " << exact(b.rpm_min) << ", rpm_max: " << exact(b.rpm_max)
+      << ", controller: " << b.controller << ", gain_ns_per_m: " << exact(b.gain_ns_per_m)
       << (b.depth_limit_mm ? ", depth_limit_mm: " + exact(*b.depth_limit_mm) : std::string()) << "}"
       << (b.depth_limit_mm ? "   # the cut in time holds less than the accurate method's limit" : "") << "\n";
   return o.str();
@@ -103,7 +105,8 @@ config::EditedYaml scheduled_config_text(const config::Config& cell_in, const Sp
   if (cell.controller.speed_schedule) cell.yaml_text = without_schedule_block(cell.yaml_text);
   YAML::Node schedule(YAML::NodeType::Map);
   YAML::Node controllers(YAML::NodeType::Sequence);
-  for (std::size_t i = 1; i < s.controllers.size(); ++i) controllers.push_back(YAML::Load(controller_text(*s.controllers[i].entry)));
+  for (std::size_t i = 1; i < s.controllers.size(); ++i)
+    controllers.push_back(YAML::Load(controller_text(*s.controllers[i].entry)));
   if (controllers.size() > 0) schedule["controllers"] = controllers;
   YAML::Node bands(YAML::NodeType::Sequence);
   for (const auto& b : s.bands) {

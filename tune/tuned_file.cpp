@@ -36,9 +36,10 @@ config::EditedYaml tuned_config_text(const config::Config& base, const Candidate
   entry["denominator"] = numbers(block.denominator);
   // A speed schedule chose its K for the controller the tune replaces: dropped (robodamp schedule writes one).
   const std::string text = base.controller.speed_schedule ? without_schedule(base.yaml_text) : base.yaml_text;
-  return config::edit_yaml(text, {{{"controller", "gain_ns_per_m"}, YAML::Node(exact(c.gain_ns_per_m)), "robodamp tune"},
-                                  {{"controller", "polarity"}, YAML::Node(c.polarity > 0 ? "+1" : "-1"), "robodamp tune"},
-                                  {{"controller", "chain", index}, entry, "robodamp tune"}});
+  return config::edit_yaml(text,
+                           {{{"controller", "gain_ns_per_m"}, YAML::Node(exact(c.gain_ns_per_m)), "robodamp tune"},
+                            {{"controller", "polarity"}, YAML::Node(c.polarity > 0 ? "+1" : "-1"), "robodamp tune"},
+                            {{"controller", "chain", index}, entry, "robodamp tune"}});
 }
 
 }  // namespace robodamp::tune

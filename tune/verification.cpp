@@ -27,9 +27,11 @@ double time_domain_mm(const config::MillingConfig& job, const milling::Structure
 
 }  // namespace
 
-double time_domain_critical_mm(const config::Config& cfg, const config::MillingConfig& job, double rpm, double guess_mm) {
+double time_domain_critical_mm(const config::Config& cfg, const config::MillingConfig& job, double rpm,
+                               double guess_mm) {
   const auto model = std::make_shared<const analysis::LoopModel>(cfg);
-  const milling::Structure open(job.selected_structure(), false, {model, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
+  const milling::Structure open(job.selected_structure(), false,
+                                {model, cfg.controller.gain_ns_per_m, cfg.controller.polarity});
   return time_domain_mm(job, open, rpm, guess_mm);
 }
 

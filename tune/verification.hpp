@@ -15,12 +15,12 @@
 namespace robodamp::tune {
 
 struct Verification {
-  std::string method;                 // of the damped limits: "sampled-loop SDM"
-  double min_depth_mm{0.0};           // the damped lobes' minimum over the job's speed range
+  std::string method;        // of the damped limits: "sampled-loop SDM"
+  double min_depth_mm{0.0};  // the damped lobes' minimum over the job's speed range
   double min_rpm{0.0};
-  double depth_at_speed_mm{0.0};      // at the job's spindle speed
-  double speed_rpm{0.0};              // the job's speed as analysed (a whole number of loop periods per tooth)
-  double open_min_depth_mm{0.0};      // the open loop's SDM minimum over the same speeds
+  double depth_at_speed_mm{0.0};        // at the job's spindle speed
+  double speed_rpm{0.0};                // the job's speed as analysed (a whole number of loop periods per tooth)
+  double open_min_depth_mm{0.0};        // the open loop's SDM minimum over the same speeds
   double time_domain_at_speed_mm{0.0};  // the time-domain cut's critical depth at the job's speed
   double time_domain_at_min_mm{0.0};    // and at the damped lobes' minimum
   std::vector<std::pair<double, double>> damped_curve_mm;  // rpm, mm
