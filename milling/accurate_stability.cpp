@@ -1,14 +1,47 @@
 #include "milling/accurate_stability.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <utility>
 
 #include "analysis/task_pool.hpp"
 #include "milling/lobes.hpp"
 
 namespace robodamp::milling {
+
+namespace {
+
+constexpr double kProbeStep = 1.2;   // between probed depths
+constexpr double kMaxProbeMm = 1e3;  // the depth searches' ceiling (milling/sdm.hpp)
+constexpr double kPeakLnMu = -0.69;  // a peak of ln|mu| below ln(0.5) is not searched for a window
+constexpr int kPeakIterations = 12;  // golden-section steps: the peak's bracket to 0.3 % of its depth
+constexpr int kNeighbourRounds = 8;
+
+// A local peak of g = ln|mu| among probes lo < mid < hi (g(mid) the highest of the three): golden-section
+// search for its top in log depth, returning the first depth found unstable (g >= 0), or nothing.
+std::optional<double> unstable_at_peak(const std::function<double(double)>& g, double lo, double mid, double g_mid,
+                                       double hi) {
+  constexpr double kGolden = 0.3819660112501051;
+  double a = std::log(lo), b = std::log(mid), c = std::log(hi), gb = g_mid;
+  for (int i = 0; i < kPeakIterations; ++i) {
+    const bool right = c - b > b - a;
+    const double x = right ? b + kGolden * (c - b) : b - kGolden * (b - a);
+    const double gx = g(std::exp(x));
+    if (gx >= 0.0) return std::exp(x);
+    if (gx > gb) {
+      (right ? a : c) = b;
+      b = x, gb = gx;
+    } else {
+      (right ? c : a) = x;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 AccurateStability::AccurateStability(const Structure& structure, const config::MillingConfig& job)
     : AccurateStability(structure, job, job.cut) {}
@@ -29,6 +62,8 @@ AccurateStability::AccurateStability(const Structure& structure, const config::M
         std::make_unique<SdmModel>(cutter_modal_terms(structure, cut.feed_axis), cutter, job.material, cut.mode,
                                    cut.radial_mm, job.time_domain.axial_slices, job.time_domain.sdm_steps_per_period);
   }
+  const LobeDiagram zoa = LobeModel(structure, chatter_process(job.tool, job.material, cut), job.lobes).diagram();
+  floor_mm_ = std::isfinite(zoa.minimum.b_lim_mm) && zoa.minimum.b_lim_mm > 0.0 ? 0.5 * zoa.minimum.b_lim_mm : 1e-3;
 }
 
 double AccurateStability::max_rpm() const {
@@ -42,14 +77,40 @@ std::optional<std::string> AccurateStability::speed_problem(double rpm) const {
   return std::nullopt;
 }
 
-SdmPoint AccurateStability::critical(double rpm, double guess_mm, double rel_tol) const {
+SdmPoint AccurateStability::search(double rpm, double guess_mm, double rel_tol) const {
   const double guess = std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0;
   return sampled_ ? sampled_->critical(rpm, guess, rel_tol) : open_->critical(rpm, guess, rel_tol);
+}
+
+std::optional<double> AccurateStability::first_unstable(double rpm, double from_mm, double to_mm) const {
+  const auto g = [&](double b) { return ln_mu(b, rpm); };
+  double b0 = 0.0, g0 = 0.0, b1 = 0.0, g1 = 0.0;  // the two probes before this one
+  int probes = 0;
+  for (double b = from_mm; b < to_mm; b *= kProbeStep, ++probes) {
+    const double gb = g(b);
+    if (gb >= 0.0) return b;
+    if (probes >= 2 && g1 > kPeakLnMu && g1 > g0 && g1 > gb)
+      if (const auto u = unstable_at_peak(g, b0, b1, g1, b)) return u;
+    b0 = b1, g0 = g1, b1 = b, g1 = gb;
+  }
+  return std::nullopt;
+}
+
+SdmPoint AccurateStability::below(double rpm, const SdmPoint& p, double from_mm, double rel_tol) const {
+  const double to = std::isfinite(p.critical_depth_mm) ? p.critical_depth_mm : kMaxProbeMm;
+  if (!(from_mm < to)) return p;
+  const std::optional<double> u = first_unstable(rpm, from_mm, to);
+  return u ? search(rpm, *u, rel_tol) : p;
+}
+
+SdmPoint AccurateStability::critical(double rpm, double guess_mm, double rel_tol) const {
+  return below(rpm, search(rpm, guess_mm, rel_tol), floor_mm_, rel_tol);
 }
 
 std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
                                                   std::size_t threads, double rel_tol,
                                                   const std::function<void(std::size_t)>& progress) const {
+  const bool diagram = rpm.size() >= 3 && std::is_sorted(rpm.begin(), rpm.end());
   std::vector<SdmPoint> out(rpm.size());
   std::vector<std::function<void()>> tasks;
   tasks.reserve(rpm.size());
@@ -57,14 +118,51 @@ std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm
   std::size_t done = 0;
   for (std::size_t i = 0; i < rpm.size(); ++i)
     tasks.emplace_back([&, i] {
-      out[i] = critical(rpm[i], i < guess_mm.size() ? guess_mm[i] : 1.0, rel_tol);
+      const double guess = i < guess_mm.size() ? guess_mm[i] : 1.0;
+      out[i] = diagram ? search(rpm[i], guess, rel_tol) : critical(rpm[i], guess, rel_tol);
       if (progress) {
         const std::lock_guard<std::mutex> lock(m);
         progress(++done);
       }
     });
   analysis::run_tasks(tasks, analysis::task_threads(threads));
+  if (diagram) below_neighbours(rpm, out, threads, rel_tol);
   return out;
+}
+
+void AccurateStability::below_neighbours(const std::vector<double>& rpm, std::vector<SdmPoint>& out,
+                                         std::size_t threads, double rel_tol) const {
+  std::vector<std::size_t> check(out.size());
+  for (std::size_t i = 0; i < check.size(); ++i) check[i] = i;
+  for (int round = 0; round < kNeighbourRounds && !check.empty(); ++round) {
+    std::vector<std::pair<std::size_t, double>> todo;  // speed, the neighbour's depth to probe from
+    for (const std::size_t i : check) {
+      double from = std::numeric_limits<double>::infinity();
+      for (const std::size_t j : {i - 1, i + 1})  // i - 1 wraps to SIZE_MAX at 0: out of range
+        if (j < out.size() && out[j].critical_depth_mm * (1.0 + 4.0 * rel_tol) < out[i].critical_depth_mm)
+          from = std::min(from, out[j].critical_depth_mm);
+      if (std::isfinite(from)) todo.emplace_back(i, from);
+    }
+    std::vector<SdmPoint> next(todo.size());
+    std::vector<std::function<void()>> tasks;
+    tasks.reserve(todo.size());
+    for (std::size_t k = 0; k < todo.size(); ++k)
+      tasks.emplace_back([&, k] {
+        const auto [i, from] = todo[k];
+        next[k] = below(rpm[i], out[i], from, rel_tol);
+      });
+    analysis::run_tasks(tasks, analysis::task_threads(threads));
+    check.clear();
+    for (std::size_t k = 0; k < todo.size(); ++k) {
+      const std::size_t i = todo[k].first;
+      if (!(next[k].critical_depth_mm < out[i].critical_depth_mm)) continue;
+      out[i] = next[k];
+      if (i > 0) check.push_back(i - 1);
+      if (i + 1 < out.size()) check.push_back(i + 1);
+    }
+    std::sort(check.begin(), check.end());
+    check.erase(std::unique(check.begin(), check.end()), check.end());
+  }
 }
 
 std::complex<double> AccurateStability::multiplier(double axial_mm, double rpm) const {

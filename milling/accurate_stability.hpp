@@ -5,6 +5,7 @@
 // Off the real-time path.
 #pragma once
 
+#include <cmath>
 #include <complex>
 #include <functional>
 #include <memory>
@@ -38,10 +39,17 @@ class AccurateStability {
   // Grid points per tooth period (open loop: the SDM's steps).
   [[nodiscard]] int grid_per_period() const { return grid_; }
 
-  // Critical depth at one speed from a first guess (e.g. the zero-order limit). Throws
-  // std::invalid_argument for a speed out of range.
+  // Critical depth at one speed: the shallowest depth where the cut loses stability. The search from the
+  // first guess (e.g. the zero-order limit) finds one crossing of |mu| = 1; |mu| can cross it more than once
+  // with depth (just above a lobe's cusp a flip lobe makes the cut unstable in a window below depths that are
+  // stable again), so the depths from floor_mm() up to that crossing are probed in steps of 1.2, each local
+  // peak of |mu| between probes searched for a window, and the first unstable one searched down from.
+  // Throws std::invalid_argument for a speed out of range.
   [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
   // The same at many speeds on `threads` threads (0: one per core); same result for any thread count.
+  // A list of three or more speeds in increasing order (a diagram) is not probed from the floor at each
+  // speed: one search per speed, then wherever a speed's depth is above a neighbour's, the depths from the
+  // neighbour's up are probed as above, again where a depth dropped, until none does (at most 8 rounds).
   // progress (optional) is called after each speed with the number done, from one thread at a time.
   [[nodiscard]] std::vector<SdmPoint> critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
                                                std::size_t threads = 0, double rel_tol = 1e-3,
@@ -52,9 +60,26 @@ class AccurateStability {
   // The same at many speeds on `threads` threads (0: one per core); every speed must be analysable.
   [[nodiscard]] std::vector<bool> stable(double axial_mm, const std::vector<double>& rpm,
                                          std::size_t threads = 0) const;
+  // Where a single speed's probes start: half the zero-order method's lowest limit over the job's lobes
+  // range (flip windows start above it on every job robodamp ships and tests; docs/milling.md).
+  [[nodiscard]] double floor_mm() const { return floor_mm_; }
 
  private:
+  // One crossing of |mu| = 1 from the guess (bracketed in steps of 1.6, then Illinois; milling/sdm.hpp).
+  [[nodiscard]] SdmPoint search(double rpm, double guess_mm, double rel_tol) const;
+  // The shallowest crossing below `p` (a search's answer at rpm) from probes starting at from_mm; p if none.
+  [[nodiscard]] SdmPoint below(double rpm, const SdmPoint& p, double from_mm, double rel_tol) const;
+  // The first depth in [from_mm, to_mm) found unstable by the probes and their peaks' searches, or nothing.
+  [[nodiscard]] std::optional<double> first_unstable(double rpm, double from_mm, double to_mm) const;
+  // A diagram's rounds: each depth above a neighbour's probed from the neighbour's (critical(), above).
+  void below_neighbours(const std::vector<double>& rpm, std::vector<SdmPoint>& out, std::size_t threads,
+                        double rel_tol) const;
+  [[nodiscard]] double ln_mu(double axial_mm, double rpm) const {
+    return std::log(std::abs(multiplier(axial_mm, rpm)));
+  }
+
   std::string method_;
+  double floor_mm_{0.0};
   int grid_{0};
   int teeth_{1};
   std::unique_ptr<SdmModel> open_;

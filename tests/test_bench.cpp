@@ -5,7 +5,11 @@
 
 #include <cmath>
 
+#include <algorithm>
 #include <atomic>
+#include <complex>
+#include <iostream>
+#include <string>
 #include <stdexcept>
 #include <thread>
 
@@ -44,6 +48,54 @@ void expect_open_loop_matches(const analysis::Bench& bench, double tol_db, doubl
 TEST(Bench, OpenLoopImpactsMatchTheModalModelWithoutNoise) {
   const analysis::Bench bench(quiet(config::load_config_file(test::preset("horizontal_c2"))));
   expect_open_loop_matches(bench, 0.5, 0.99);
+}
+
+// The impact campaign's H1, with its accelerometers' AC coupling and the records' timing worked out
+// (analysis/bench_run.cpp, receptance()), is the structure's receptance itself, not near its peaks only:
+// noise-free, every path of robots A (two modes) and C (five) within 0.05 % of its peak and 0.05 deg from 2 to
+// 60 Hz (0.01 % and 0.03 deg here; with the coupling left in it is 1.7 deg off at 5.5 Hz, with the timing left
+// in 4.3 deg at 60 Hz). Not the presets' Table 1: its residues have real parts that do not sum to zero, so its
+// acceleration per force is improper and the impulse a force step causes is not in any sampled acceleration
+// (sim_plant/plant_model.hpp): its impact FRF is 12 deg off at 60 Hz (docs/identification.md).
+TEST(Bench, TheImpactCampaignsFrfIsTheStructuresReceptance) {
+  for (const std::string& name : {"robot_a_two_modes", "robot_c_five_modes"}) {
+    const std::string file = std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/" + name + ".yaml";
+    const analysis::Bench bench(quiet(config::load_config_file(file)));
+    const auto& m = bench.model();
+    const auto& cfg = m.config();
+    for (std::size_t exc = 0; exc < m.plant().locations.size(); ++exc) {
+      const auto t = bench.impact_test({exc, cfg.bench.impact_peak_n, cfg.bench.impact_duration_ms, false, 0.0, 1});
+      for (std::size_t resp = 0; resp < t.receptance.size(); ++resp) {
+        if (m.plant().path(resp, exc) == nullptr) continue;
+        const analysis::FrfEstimate& e = t.receptance[resp];
+        // Errors against the path's peak (an antiresonance's relative error is no measure of the chain), the
+        // phase where the path is within 20 dB of its peak.
+        double peak = 0.0;
+        for (std::size_t k = 0; k < e.f_hz.size(); ++k)
+          if (e.f_hz[k] >= 2.0 && e.f_hz[k] <= 60.0)
+            peak = std::max(peak, std::abs(m.plant().receptance(resp, exc, e.f_hz[k])));
+        int checked = 0;
+        double err = 0.0, deg_err = 0.0, err_at = 0.0, deg_at = 0.0;
+        for (std::size_t k = 0; k < e.f_hz.size(); ++k) {
+          if (e.f_hz[k] < 2.0 || e.f_hz[k] > 60.0) continue;
+          const std::complex<double> want = m.plant().receptance(resp, exc, e.f_hz[k]);
+          const double de = std::abs(e.h1[k] - want) / peak;
+          if (de > err) err = de, err_at = e.f_hz[k];
+          if (std::abs(want) > 0.1 * peak) {
+            const double dp = std::abs(std::arg(e.h1[k] / want) * 180.0 / M_PI);
+            if (dp > deg_err) deg_err = dp, deg_at = e.f_hz[k];
+          }
+          ++checked;
+        }
+        const std::string where = file + " H" + std::to_string(resp + 1) + std::to_string(exc + 1);
+        EXPECT_LT(err, 5e-4) << where << " at " << err_at << " Hz";
+        EXPECT_LT(deg_err, 0.05) << where << " at " << deg_at << " Hz";
+        std::cout << where << ": " << 100.0 * err << " % of the peak at " << err_at << " Hz, " << deg_err << " deg at "
+                  << deg_at << " Hz\n";
+        EXPECT_GT(checked, 100) << file;
+      }
+    }
+  }
 }
 
 TEST(Bench, OpenLoopImpactsMatchTheModalModelWithNoiseAndDrives) {

@@ -4,6 +4,7 @@
 // controller); against the open-loop SDM with the gain at zero; the refusals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -159,6 +160,68 @@ TEST(SampledSdm, RefusesWhatItCannotStepWithTheValueUnitAndRange) {
     EXPECT_THROW((void)sdm.multiplier(mm, 700.0), std::invalid_argument) << mm;
   // A bad first guess falls back to 1 mm and still finds the limit.
   EXPECT_NEAR(sdm.critical(700.0, std::numeric_limits<double>::quiet_NaN()).critical_depth_mm, 0.782, 0.005);
+}
+
+// ln|mu| can cross zero more than once with depth: just above a lobe's cusp a flip lobe makes the cut
+// unstable in a window below depths that are stable again. The depth is the window's start, not the deeper
+// crossing a search from the zero-order guess finds (docs/milling.md, "The shallowest crossing").
+// Probes denser than the method's own (steps of 1.1 from half its floor, where it probes in steps of 1.2 and
+// searches each peak between) find nothing unstable below any answer of the open diagram of the default job, which has such a window at 374 rpm. ln|mu| has a ripple of a
+// few 1e-3 from the axial slices near a flip crossing (stable, unstable, stable within 0.3 % of depth), so
+// "unstable" here is ln|mu| > 0.005 and the answer's own crossing is looked for within 2 % above it.
+TEST(DepthWindows, NoDiagramSpeedIsUnstableBelowItsDepth) {
+  const config::MillingConfig cfg = config::load_milling_config(job_path("active_damping_c2"));
+  const Structure open(cfg.structures.front(), false);
+  const AccurateStability truth(open, cfg);
+  const AccurateDiagram d = accurate_diagram(open, cfg);
+  const auto ln_mu = [&](double b, double rpm) { return std::log(std::abs(truth.multiplier(b, rpm))); };
+  int windows = 0;
+  for (const SdmPoint& p : d.curve) {
+    ASSERT_TRUE(std::isfinite(p.critical_depth_mm)) << p.rpm;
+    double above = -1.0;
+    for (double b = p.critical_depth_mm * 1.004; b < p.critical_depth_mm * 1.02; b *= 1.004)
+      above = std::max(above, ln_mu(b, p.rpm));
+    EXPECT_GE(above, 0.0) << p.rpm << " rpm: stable within 2 % above " << p.critical_depth_mm << " mm";
+    for (double b = 0.5 * truth.floor_mm(); b < p.critical_depth_mm * 0.99; b *= 1.1)
+      if (ln_mu(b, p.rpm) > 0.005) {
+        ADD_FAILURE() << p.rpm << " rpm: unstable at " << b << " mm below the answer " << p.critical_depth_mm;
+        break;
+      }
+    // A window (one is enough): stable again somewhere above the answer, up to 8 times it.
+    for (double b = p.critical_depth_mm * 1.1; windows == 0 && b < p.critical_depth_mm * 8.0; b *= 1.1)
+      if (ln_mu(b, p.rpm) < -0.005) {
+        ++windows;
+        break;
+      }
+  }
+  EXPECT_GT(windows, 0) << "the diagram crosses no window: the test checks nothing";
+  // The default job's open minimum is that window's start.
+  EXPECT_NEAR(d.minimum.rpm, 374.37, 0.01);
+  EXPECT_NEAR(d.minimum.critical_depth_mm, 0.204, 0.002);
+  EXPECT_EQ(d.minimum.type, CutClass::kFlip);
+}
+
+// One speed, where the search from the zero-order guess lands above a window: the open default job at the
+// diagram's minimum, and the damped cut with the tuned horizontal preset at 374.5 rpm, where the cut in time
+// is stable at 0.34 mm and chatters (flip) from 0.36 mm (docs/status.md). Both the depth and the time domain's.
+TEST(DepthWindows, OneSpeedsDepthIsTheWindowsStartAsTheCutInTimeShows) {
+  config::MillingConfig cfg = config::load_milling_config(job_path("active_damping_c2"));
+  for (auto& part : cfg.structures.front().parts)
+    if (part.controller) part.controller->config_path = test::preset("tuned_horizontal");
+  const Structure open(cfg.structures.front(), false), damped(cfg.structures.front(), true);
+  const double rpm = 374.53183520599248;
+  const AccurateStability truth(damped, cfg);
+  const SdmPoint p = truth.critical(rpm, zero_order_mm(cfg, damped, rpm));
+  EXPECT_NEAR(p.critical_depth_mm, 0.353, 0.005);
+  EXPECT_EQ(p.type, CutClass::kFlip);
+  bool stable_above = false;
+  for (double b = p.critical_depth_mm * 1.1; b < 4.0 && !stable_above; b *= 1.1) stable_above = truth.stable(b, rpm);
+  EXPECT_TRUE(stable_above) << "no window at " << rpm << " rpm: the test checks nothing";
+  const double td = time_domain_mm(cfg, open, rpm, p.critical_depth_mm);
+  EXPECT_NEAR(td / p.critical_depth_mm, 1.0, 0.05) << td;
+  const AccurateStability open_truth(open, cfg);
+  const SdmPoint o = open_truth.critical(374.3718592964824, 1.0);  // the open diagram's minimum, above
+  EXPECT_NEAR(o.critical_depth_mm, 0.204, 0.002);
 }
 
 }  // namespace
