@@ -54,8 +54,8 @@ TEST(Bench, OpenLoopImpactsMatchTheModalModelWithoutNoise) {
 // (analysis/bench_run.cpp, receptance()), is the structure's receptance itself, not near its peaks only:
 // noise-free, every path of robot A and of the default preset (whose Table 1 residues have real parts: an
 // improper accelerance, whose impulse no sample holds) within 0.05 % of its peak and 0.05 deg from 2 to
-// 60 Hz (0.01 % and 0.03 deg here; with the coupling left in robot A is 2.8 deg off at 3.4 Hz, with the
-// impulse left out the preset is 12 deg off at 60 Hz).
+// 60 Hz (0.01 % and 0.03 deg here; with the coupling and the timing left in robot A is 2.8 deg off at 3.4 Hz,
+// with the impulse left out the preset is 12 deg off at 60 Hz).
 TEST(Bench, TheImpactCampaignsFrfIsTheStructuresReceptance) {
   for (const std::string& file : {std::string(ROBODAMP_SOURCE_DIR) + "/config/commissioning/robot_a_two_modes.yaml",
                                   test::preset("horizontal_c2")}) {
