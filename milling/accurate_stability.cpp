@@ -17,7 +17,7 @@ namespace {
 constexpr double kProbeStep = 1.2;   // between probed depths
 constexpr double kMaxProbeMm = 1e3;  // the depth searches' ceiling (milling/sdm.hpp)
 constexpr double kPeakLnMu = -0.69;  // a peak of ln|mu| below ln(0.5) is not searched for a window
-constexpr int kPeakIterations = 12;  // golden-section steps: the peak's bracket to 0.3 % of its depth
+constexpr int kPeakIterations = 12;  // golden-section steps: the peak's bracket from 44 % to 0.1 % of its depth
 constexpr int kNeighbourRounds = 8;
 
 // A local peak of g = ln|mu| among probes lo < mid < hi (g(mid) the highest of the three): golden-section
@@ -62,8 +62,13 @@ AccurateStability::AccurateStability(const Structure& structure, const config::M
         std::make_unique<SdmModel>(cutter_modal_terms(structure, cut.feed_axis), cutter, job.material, cut.mode,
                                    cut.radial_mm, job.time_domain.axial_slices, job.time_domain.sdm_steps_per_period);
   }
-  const LobeDiagram zoa = LobeModel(structure, chatter_process(job.tool, job.material, cut), job.lobes).diagram();
-  floor_mm_ = std::isfinite(zoa.minimum.b_lim_mm) && zoa.minimum.b_lim_mm > 0.0 ? 0.5 * zoa.minimum.b_lim_mm : 1e-3;
+  // The zero-order method's lowest limit at any chatter frequency (its lobes' floor at any speed; a lobe's
+  // depth at a frequency is the same on every lobe): one pass over its frequency grid, no diagram.
+  double zoa_min_mm = std::numeric_limits<double>::infinity();
+  for (const LobePoint& p :
+       LobeModel(structure, chatter_process(job.tool, job.material, cut), job.lobes).lobe_points(0))
+    zoa_min_mm = std::min(zoa_min_mm, p.b_lim_mm);
+  floor_mm_ = std::isfinite(zoa_min_mm) && zoa_min_mm > 0.0 ? 0.5 * zoa_min_mm : 1e-3;
 }
 
 double AccurateStability::max_rpm() const {

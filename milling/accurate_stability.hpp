@@ -60,8 +60,8 @@ class AccurateStability {
   // The same at many speeds on `threads` threads (0: one per core); every speed must be analysable.
   [[nodiscard]] std::vector<bool> stable(double axial_mm, const std::vector<double>& rpm,
                                          std::size_t threads = 0) const;
-  // Where a single speed's probes start: half the zero-order method's lowest limit over the job's lobes
-  // range (flip windows start above it on every job robodamp ships and tests; docs/milling.md).
+  // Where a single speed's probes start: half the zero-order method's lowest limit at any chatter frequency
+  // (flip windows start above it on every job robodamp ships and tests; docs/milling.md).
   [[nodiscard]] double floor_mm() const { return floor_mm_; }
 
  private:

@@ -145,6 +145,43 @@ void MachiningMonitor::add_to_trail(double time_s, std::size_t set, double gain,
       l.problem.empty() ? "" : ": ", l.problem);
 }
 
+void MachiningMonitor::await_limits(double time_s, double rpm, std::size_t set, double gain,
+                                    const std::vector<double>& pose_deg) {
+  milling::LiveStability::SweepPoint p{rpm, set, gain, stability_->grid_pose(pose_deg)};
+  std::lock_guard<std::mutex> lock(m_);
+  for (const auto& [t, q] : awaited_)
+    if (q.set == p.set && q.gain_ns_per_m == p.gain_ns_per_m && q.rpm == p.rpm && q.pose_deg == p.pose_deg) return;
+  if (awaited_.size() >= kAwaited) awaited_.erase(awaited_.begin());
+  awaited_.emplace_back(time_s, std::move(p));
+}
+
+void MachiningMonitor::trail_awaited() {
+  std::vector<std::pair<double, milling::LiveStability::SweepPoint>> waiting;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    waiting = awaited_;
+  }
+  for (const auto& [t, p] : waiting) {
+    const std::vector<milling::LiveLimits> got = stability_->known(std::vector{p});  // never waits
+    if (got.empty()) continue;
+    const milling::LiveLimits& l = got.front();
+    std::lock_guard<std::mutex> lock(m_);
+    std::erase_if(awaited_, [&, t = t](const auto& a) { return a.first == t && a.second.pose_deg == p.pose_deg; });
+    const bool met = std::any_of(trail_.begin(), trail_.end(), [&, &p = p](const milling::LiveLimitsRecord& r) {
+      return r.set == p.set && r.gain_ns_per_m == p.gain_ns_per_m && r.limits.rpm == l.rpm &&
+             r.limits.pose_deg == l.pose_deg;
+    });
+    if (met || trail_.size() >= kTrailEntries) continue;
+    const auto at = std::upper_bound(trail_.begin(), trail_.end(), t,
+                                     [](double time, const milling::LiveLimitsRecord& r) { return time < r.time_s; });
+    trail_.insert(at, milling::LiveLimitsRecord{t, p.set, p.gain_ns_per_m, l});
+    spdlog::info(
+        "machining: at pose {} (left before its limits were ready), {:.0f} rpm, set {}: limit open {:.3f} mm, "
+        "damped {:.3f} mm",
+        config::describe_pose(l.pose_deg), l.rpm, p.set, l.open_mm, l.damped_mm);
+  }
+}
+
 std::optional<milling::LiveLimits> MachiningMonitor::moved_from(double rpm, std::size_t set, double gain) const {
   std::lock_guard<std::mutex> lock(m_);
   if (!latest_) return std::nullopt;
@@ -207,7 +244,13 @@ AdviceView MachiningMonitor::view() {
   if (s.spindle_rpm > 0.0) {
     auto l = stability_->lookup(s.spindle_rpm, set, gain, s.pose_deg);
     s.limits_ready = l.has_value();
-    if (l && stability_->pose_dependent()) add_to_trail(s.time_s, set, gain, *l);
+    if (stability_->pose_dependent()) {
+      if (l)
+        add_to_trail(s.time_s, set, gain, *l);
+      else
+        await_limits(s.time_s, s.spindle_rpm, set, gain, s.pose_deg);
+      trail_awaited();
+    }
     // The robot moved on to a grid point not computed yet: the limits at the last pose, for the same speed,
     // set and K, with that pose (limits_ready false says they are being recomputed).
     if (!l) l = moved_from(s.spindle_rpm, set, gain);

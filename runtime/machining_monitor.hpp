@@ -68,7 +68,8 @@ class MachiningMonitor {
   // speeds are known than were last returned.
   [[nodiscard]] std::optional<dds::LobesSample> lobes();
   // Any thread: a pose-scheduled cell's limits at each new state met (pose grid point, speed, set, gain), in
-  // order, the first kTrailEntries (each also logged, one line).
+  // the order met, the first kTrailEntries (each also logged, one line). A state the robot left before its
+  // limits were ready joins when the worker has them (if it had started on them), at the time it was met.
   [[nodiscard]] std::vector<milling::LiveLimitsRecord> trail() const;
   static constexpr std::size_t kTrailEntries = 64;
   // Any thread: the latest spindle-speed advice (runtime/speed_advisor.hpp), if any was asked for.
@@ -83,6 +84,10 @@ class MachiningMonitor {
   [[nodiscard]] std::vector<double> pose_now() const;           // the robot's joints (empty: not known, no pose)
   void log_chatter(const milling::ChatterIndicator& c);
   void add_to_trail(double time_s, std::size_t set, double gain, const milling::LiveLimits& l);
+  // A state met whose limits were not ready: kept (at most kAwaited) until the worker has them.
+  void await_limits(double time_s, double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg);
+  void trail_awaited();  // the awaited states computed since, into the trail in the order met
+  static constexpr std::size_t kAwaited = 8;
   // The last limits found when they are for this speed, set and K (at another pose).
   [[nodiscard]] std::optional<milling::LiveLimits> moved_from(double rpm, std::size_t set, double gain) const;
   int teeth_;
@@ -102,6 +107,7 @@ class MachiningMonitor {
   mutable std::mutex m_;
   std::vector<milling::LiveLimitsRecord> trail_;     // guarded by m_
   std::optional<milling::LiveLimitsRecord> latest_;  // the last limits found at a pose (guarded by m_)
+  std::vector<std::pair<double, milling::LiveStability::SweepPoint>> awaited_;  // (time met, state), guarded by m_
   milling::ChatterMonitor chatter_;
   bool chatter_logged_{false};  // the last verdict logged
   double next_chatter_log_s_{0.0};
