@@ -155,13 +155,15 @@ void MachiningMonitor::await_limits(double time_s, double rpm, std::size_t set, 
   awaited_.emplace_back(time_s, std::move(p));
 }
 
-void MachiningMonitor::trail_awaited() {
+void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& now) {
   std::vector<std::pair<double, milling::LiveStability::SweepPoint>> waiting;
   {
     std::lock_guard<std::mutex> lock(m_);
     waiting = awaited_;
   }
   for (const auto& [t, p] : waiting) {
+    if (p.set == now.set && p.gain_ns_per_m == now.gain_ns_per_m && p.rpm == now.rpm && p.pose_deg == now.pose_deg)
+      continue;  // still there: its limits join the trail as the view finds them
     const std::vector<milling::LiveLimits> got = stability_->known(std::vector{p});  // never waits
     if (got.empty()) continue;
     const milling::LiveLimits& l = got.front();
@@ -249,7 +251,7 @@ AdviceView MachiningMonitor::view() {
         add_to_trail(s.time_s, set, gain, *l);
       else
         await_limits(s.time_s, s.spindle_rpm, set, gain, s.pose_deg);
-      trail_awaited();
+      trail_awaited({s.spindle_rpm, set, gain, stability_->grid_pose(s.pose_deg)});
     }
     // The robot moved on to a grid point not computed yet: the limits at the last pose, for the same speed,
     // set and K, with that pose (limits_ready false says they are being recomputed).

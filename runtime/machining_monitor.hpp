@@ -86,7 +86,8 @@ class MachiningMonitor {
   void add_to_trail(double time_s, std::size_t set, double gain, const milling::LiveLimits& l);
   // A state met whose limits were not ready: kept (at most kAwaited) until the worker has them.
   void await_limits(double time_s, double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg);
-  void trail_awaited();  // the awaited states computed since, into the trail in the order met
+  // The awaited states the robot has left (not `now`) computed since, into the trail in the order met.
+  void trail_awaited(const milling::LiveStability::SweepPoint& now);
   static constexpr std::size_t kAwaited = 8;
   // The last limits found when they are for this speed, set and K (at another pose).
   [[nodiscard]] std::optional<milling::LiveLimits> moved_from(double rpm, std::size_t set, double gain) const;
