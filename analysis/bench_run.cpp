@@ -126,10 +126,10 @@ std::vector<FrfEstimate> ImpactCampaign::receptance() const {
   // "The impact test's FRF").
   const double tick_s = 1.0 / cfg_.loop.rate_hz;
   const sim::PlantModel& model = plant_.model();
+  const auto in = static_cast<Eigen::Index>(model.input_force(test_.excitation));
   std::vector<FrfEstimate> out;
   for (std::size_t l = 0; l < meas_.size(); ++l) {
     FrfEstimate e = acc.result(l);
-    const auto in = static_cast<Eigen::Index>(model.input_force(test_.excitation));
     const double d = model.ss.d(static_cast<Eigen::Index>(model.output_acceleration(l)), in);
     const double v = model.ss.d(static_cast<Eigen::Index>(model.output_velocity(l)), in);
     for (std::size_t k = 0; k < e.f_hz.size(); ++k) {

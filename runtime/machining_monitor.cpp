@@ -145,12 +145,20 @@ void MachiningMonitor::add_to_trail(double time_s, std::size_t set, double gain,
       l.problem.empty() ? "" : ": ", l.problem);
 }
 
+namespace {
+
+bool same_state(const milling::LiveStability::SweepPoint& a, const milling::LiveStability::SweepPoint& b) {
+  return a.set == b.set && a.gain_ns_per_m == b.gain_ns_per_m && a.rpm == b.rpm && a.pose_deg == b.pose_deg;
+}
+
+}  // namespace
+
 void MachiningMonitor::await_limits(double time_s, double rpm, std::size_t set, double gain,
                                     const std::vector<double>& pose_deg) {
   milling::LiveStability::SweepPoint p{rpm, set, gain, stability_->grid_pose(pose_deg)};
   std::lock_guard<std::mutex> lock(m_);
   for (const auto& [t, q] : awaited_)
-    if (q.set == p.set && q.gain_ns_per_m == p.gain_ns_per_m && q.rpm == p.rpm && q.pose_deg == p.pose_deg) return;
+    if (same_state(q, p)) return;
   if (awaited_.size() >= kAwaited) awaited_.erase(awaited_.begin());
   awaited_.emplace_back(time_s, std::move(p));
 }
@@ -162,8 +170,8 @@ void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& n
     waiting = awaited_;
   }
   for (const auto& [t, p] : waiting) {
-    if (p.set == now.set && p.gain_ns_per_m == now.gain_ns_per_m && p.rpm == now.rpm && p.pose_deg == now.pose_deg)
-      continue;  // still there: its limits join the trail as the view finds them
+    if (same_state(p, now))
+      continue;  // still there: its limits join the trail as the view finds them  // still there: its limits join the trail as the view finds them
     const std::vector<milling::LiveLimits> got = stability_->known(std::vector{p});  // never waits
     if (got.empty()) continue;
     const milling::LiveLimits& l = got.front();

@@ -27,6 +27,7 @@
 #include "cell_util.hpp"
 #include "config/config.hpp"
 #include "config/robot_model_config.hpp"
+#include "config/speed_schedule_config.hpp"
 #include "child_process.hpp"
 #include "dashboard/fleet.hpp"
 #include "dds/bridge.hpp"
@@ -399,11 +400,10 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
   const config::Config preset = config::load_config_file(test::preset("horizontal_c2"));
   ASSERT_TRUE(preset.controller.speed_schedule.has_value());
   const auto& bands = preset.controller.speed_schedule->bands;
-  std::size_t at = 0;
-  while (at < bands.size() && !(bands[at].rpm_min <= 699.3 && 699.3 < bands[at].rpm_max)) ++at;
-  ASSERT_LT(at, bands.size());
+  const std::optional<std::size_t> at = config::speed_band_of(bands, 699.3);
+  ASSERT_TRUE(at.has_value());
   EXPECT_NE(log.find("speed schedule: " + std::to_string(bands.size()) + " bands; at the end band " +
-                     std::to_string(at) + ", set 1 at K 3040 N s/m; 1 hand-overs"),
+                     std::to_string(*at) + ", set 1 at K 3040 N s/m; 1 hand-overs"),
             std::string::npos)
       << log;
 }
