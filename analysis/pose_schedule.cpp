@@ -259,4 +259,36 @@ double predicted_improvement_pct(const config::Config& set, const config::RobotM
   return driving_point_improvement_pct(m, set.controller.gain_ns_per_m, set.controller.polarity);
 }
 
+PredictedImprovement predicted_improvement(const config::Config& set, const config::RobotModelConfig& model,
+                                           const config::PoseScheduleConfig& schedule, const std::vector<double>& q) {
+  const PoseModes at = pose_modes(model, q, schedule.axis, schedule.modes);
+  const auto improvement = [&](const PoseModes& pm) {
+    return driving_point_improvement_pct(LoopModel(config_at_pose(set, pm)), set.controller.gain_ns_per_m,
+                                         set.controller.polarity);
+  };
+  PredictedImprovement out;
+  out.pct = improvement(at);
+  if (at.corrections.size() != at.modes.size()) return out;
+  double variance = 0.0;
+  for (std::size_t i = 0; i < at.modes.size(); ++i)
+    for (int quantity = 0; quantity < 3; ++quantity) {
+      const robot::ModeCorrection& c = at.corrections[i];
+      const config::ModeConfig& nominal = at.modes[i];
+      const double sigma = quantity == 0 ? c.freq_sigma : quantity == 1 ? c.damping_sigma : c.stiffness_sigma;
+      if (!(sigma > 0.0)) continue;
+      double ends[2] = {0.0, 0.0};
+      for (int side = 0; side < 2; ++side) {
+        const double scale = std::exp(side == 0 ? sigma : -sigma);
+        PoseModes moved = at;
+        moved.modes[i] = config::stiffness_mode(nominal.natural_freq_hz * (quantity == 0 ? scale : 1.0),
+                                                nominal.damping_ratio * (quantity == 1 ? scale : 1.0),
+                                                nominal.stiffness_n_per_m * (quantity == 2 ? scale : 1.0));
+        ends[side] = improvement(moved);
+      }
+      variance += 0.25 * (ends[0] - ends[1]) * (ends[0] - ends[1]);
+    }
+  out.sigma_pct = std::sqrt(variance);
+  return out;
+}
+
 }  // namespace robodamp::analysis

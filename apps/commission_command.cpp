@@ -201,6 +201,9 @@ void register_commission(Registry& r) {
       sub, "--peak-tolerance-pct", a->peak_tolerance_pct, {"%", 1.0, 100.0},
       "--along-path: ... or the damped peak measured at a stop against the predicted one (a set that takes a peak down "
       "several times is checked on what is left of it)");
+  r.number(sub, "--prediction-sigmas", a->path.prediction_sigmas, {"sigma", 0.0, 5.0},
+           "--along-path: ... or within this many of the prediction's one sigma from the map's spread at the stop "
+           "(0: never)");
   sub->get_option("--evaluations")->each([a](const std::string&) { a->evaluations_given = true; });
   sub->get_option("--polish")->each([a](const std::string&) { a->polish_given = true; });
 }

@@ -26,10 +26,10 @@
 
 namespace robodamp::commission {
 
-bool PathStop::improvement_held(double tolerance_points, double peak_tolerance) const {
+bool PathStop::improvement_held(double tolerance_points, double peak_tolerance, double sigmas) const {
+  const double off = std::abs(measured_improvement_pct - predicted_improvement_pct);
   return on_cell && records >= 2 &&
-         (std::abs(measured_improvement_pct - predicted_improvement_pct) <= tolerance_points ||
-          std::abs(peak_error()) <= peak_tolerance);
+         (off <= tolerance_points || std::abs(peak_error()) <= peak_tolerance || off <= sigmas * predicted_sigma_pct);
 }
 
 namespace {
@@ -369,7 +369,9 @@ class PathRun {
       const analysis::RegionSet& set = sched.regions[*ran[i]];
       st.region = set.name;
       st.gain_ns_per_m = set.gain_ns_per_m;
-      st.predicted_improvement_pct = analysis::predicted_improvement_pct(set.config, sched.model, ps, st.joints_deg);
+      const analysis::PredictedImprovement p =
+          analysis::predicted_improvement(set.config, sched.model, ps, st.joints_deg);
+      st.predicted_improvement_pct = p.pct, st.predicted_sigma_pct = p.sigma_pct;
       const auto d = std::find_if(run.dwells.begin(), run.dwells.end(),
                                   [&](const EmulatedDwell& e) { return same_pose(e.joints_deg, st.joints_deg, 0.05); });
       if (d != run.dwells.end())
@@ -381,11 +383,10 @@ class PathRun {
       st.damped_limit_mm = l.damped_valid ? l.damped_mm : 0.0;
       r_.method = l.method + " (the robot in its plane, on the mapped model)";
       if (!l.damped_valid || !l.loop_model_verified) st.limit_note = l.problem;
-      say_(fmt("commission:   %s (%s): improvement %.1f %% measured, %.1f %% predicted on the map (%d records); the "
-               "job at %.0f rpm: "
-               "%.3f mm damped, %.3f mm open loop",
+      say_(fmt("commission:   %s (%s): improvement %.1f %% measured, %.1f +/- %.1f %% predicted on the map (one sigma "
+               "of its spread there; %d records); the job at %.0f rpm: %.3f mm damped, %.3f mm open loop",
                st.name.c_str(), st.region.c_str(), st.measured_improvement_pct, st.predicted_improvement_pct,
-               st.records, r_.job_rpm, st.damped_limit_mm, st.open_limit_mm) +
+               st.predicted_sigma_pct, st.records, r_.job_rpm, st.damped_limit_mm, st.open_limit_mm) +
            (st.limit_note.empty() ? std::string() : " (" + st.limit_note + ")"));
     }
     if (std::all_of(r_.stops.begin(), r_.stops.end(), [](const PathStop& st) { return st.gain_ns_per_m == 0.0; }))
@@ -400,15 +401,18 @@ class PathRun {
       throw Stop{Stage::kVerify, Outcome::kNotVerified,
                  fmt("the pose left the tuned map %llu times along the path", run.pose_out_of_map)};
     for (const auto& st : r_.stops) {
-      if (!st.improvement_held(s_.improvement_tolerance_points, s_.peak_tolerance))
+      if (!st.improvement_held(s_.improvement_tolerance_points, s_.peak_tolerance, s_.prediction_sigmas))
         throw Stop{
             Stage::kVerify, Outcome::kNotVerified,
             st.name +
                 (st.on_cell
                      ? fmt(": the improvement measured on the cell, %.1f %% (%d records), is not within %.1f points "
-                           "of the map's %.1f %%, nor the damped peak within %.0f %% of the predicted (%+.1f %%)",
+                           "of the map's %.1f %%, nor within %.0f sigma of it (%.1f points), nor the damped peak "
+                           "within %.0f %% of the predicted (%+.1f %%)",
                            st.measured_improvement_pct, st.records, s_.improvement_tolerance_points,
-                           st.predicted_improvement_pct, 100.0 * s_.peak_tolerance, 100.0 * st.peak_error())
+                           st.predicted_improvement_pct, s_.prediction_sigmas,
+                           s_.prediction_sigmas * st.predicted_sigma_pct, 100.0 * s_.peak_tolerance,
+                           100.0 * st.peak_error())
                      : std::string(": the emulator measured nothing there (the stop too short for a record)"))};
       if (!st.cut_not_worse())
         throw Stop{

@@ -42,9 +42,11 @@ struct PathCommissionSettings {
   int map_points{5};                   // the workspace map's grid per joint (pose tune --map-points)
   // Measured against predicted at each stop: the improvement within this many points, or the damped peak
   // itself (the open one over 1 + the improvement) within peak_tolerance of the predicted (a set that takes
-  // a peak down 4 times is checked on what is left of it).
+  // a peak down 4 times is checked on what is left of it), or within prediction_sigmas of the prediction's
+  // own spread on the map (analysis::predicted_improvement: wide between measured stops, at a held-out one).
   double improvement_tolerance_points{5.0};
   double peak_tolerance{0.10};
+  double prediction_sigmas{2.0};
   double held_out_freq_tolerance_pct{2.0};  // the map against a stop held out of it
   std::string command_line;
   std::string robodamp_binary;  // the emulator's executable (default: this process's)
@@ -59,6 +61,7 @@ struct PathStop {
   std::string region;                     // the tuned set that ran there (the hand-over's hysteresis along the path)
   double gain_ns_per_m{0.0};              // its K (0: the damper off there)
   double predicted_improvement_pct{0.0};  // the driving point, the set on the mapped model (discrete loop)
+  double predicted_sigma_pct{0.0};        // its one sigma from the map's spread there (points)
   double measured_improvement_pct{0.0};   // the emulator's impacts, control on against off
   double coherence_min{0.0};
   int records{0};
@@ -68,7 +71,7 @@ struct PathStop {
   // damped by the sampled loop's SDM on that plant. Worse or not is judged against the same plant's open loop.
   double open_limit_mm{0.0}, loop_open_limit_mm{0.0}, damped_limit_mm{0.0};
   std::string limit_note;  // why the damper's effect on the cut is not claimed there, if it is not
-  [[nodiscard]] bool improvement_held(double tolerance_points, double peak_tolerance) const;
+  [[nodiscard]] bool improvement_held(double tolerance_points, double peak_tolerance, double sigmas) const;
   // The damped peak measured over the predicted one, minus one.
   [[nodiscard]] double peak_error() const {
     return (100.0 + predicted_improvement_pct) / (100.0 + measured_improvement_pct) - 1.0;

@@ -99,21 +99,28 @@ std::string modes_figure(const PathCommissionSettings& s, const PathCommissionRe
 }
 
 // At each stop: the driving point's improvement measured on the cell and predicted on the map; the job's limit
-// at its speed damped and open. Data: joint, measured %, predicted %, damped mm, open mm.
-std::string stops_figure(const PathCommissionResult& r, const fs::path& dir) {
+// at its speed damped and open. Data: joint, measured %, predicted %, damped mm, open mm, the prediction's one
+// sigma (points; drawn as its band of PathCommissionSettings::prediction_sigmas).
+std::string stops_figure(const PathCommissionSettings& settings, const PathCommissionResult& r, const fs::path& dir) {
   if (std::none_of(r.stops.begin(), r.stops.end(), [](const PathStop& s) { return s.on_cell; })) return {};
   const std::size_t j = moving_joint(r.stops);
   std::ostringstream d;
   for (const auto& s : r.stops)
     d << num(s.joints_deg[j]) << ' ' << num(s.on_cell ? s.measured_improvement_pct : NAN) << ' '
-      << num(s.predicted_improvement_pct) << ' ' << num(s.damped_limit_mm) << ' ' << num(s.open_limit_mm) << '\n';
+      << num(s.predicted_improvement_pct) << ' ' << num(s.damped_limit_mm) << ' ' << num(s.open_limit_mm) << ' '
+      << num(s.predicted_sigma_pct) << '\n';
   std::ostringstream p;
-  p << "set terminal pngcairo noenhanced size 1100,760 font ',10'\nset multiplot layout 2,1\nset grid\nset key outside "
-       "right\n"
+  // The keys above each panel: outside on the right they widen the panels apart and the joint axes disagree.
+  p << "set terminal pngcairo noenhanced size 1100,760 font ',10'\nset multiplot layout 2,1\nset grid\n"
+       "set key tmargin center horizontal\nset lmargin 11\nset offsets graph 0.04, graph 0.04, 0, 0\n"
        "set xlabel 'joint "
     << j + 1
     << " (deg)'\nset ylabel 'driving-point improvement (%)'\n"
-       "plot DATA using 1:3 with points pt 6 ps 2 lw 2 lc rgb '#3367d6' title 'predicted on the map', "
+       "plot DATA using 1:3:("
+    << num(settings.prediction_sigmas)
+    << "*$6) with yerrorbars pt 6 ps 2 lw 2 lc rgb '#3367d6' title 'predicted on the map (+/- "
+    << num(settings.prediction_sigmas)
+    << " sigma of its spread)', "
        "DATA using 1:2 with points pt 7 ps 1.3 lc rgb '#1d2430' title 'measured on the cell'\n"
        "set ylabel 'the job at its speed (mm)'\nset yrange [0:*]\n"
        "plot DATA using 1:4 with points pt 7 ps 1.5 lc rgb '#2e9e4f' title 'damped', "
@@ -127,17 +134,19 @@ std::string stops_figure(const PathCommissionResult& r, const fs::path& dir) {
 std::string stops_table(const PathCommissionSettings& s, const PathCommissionResult& r) {
   std::ostringstream h;
   h << "<h2>The stops</h2>\n<table><tr><th>stop</th><th>joints (deg)</th><th>map</th><th>actuator (Hz)</th><th>set</th>"
-       "<th>improvement measured (%)</th><th>predicted (%)</th><th>records</th><th>the job: damped / open (mm)</th>"
+       "<th>improvement measured (%)</th><th>predicted, one sigma (%)</th><th>records</th><th>the job: damped / open "
+       "(mm)</th>"
        "<th>open, the loop's plant (mm)</th><th>verdict</th></tr>\n";
   for (const auto& st : r.stops) {
-    const bool held = st.improvement_held(s.improvement_tolerance_points, s.peak_tolerance), cut = st.cut_not_worse();
+    const bool held = st.improvement_held(s.improvement_tolerance_points, s.peak_tolerance, s.prediction_sigmas),
+               cut = st.cut_not_worse();
     h << "<tr><td>" << esc(st.name) << "</td><td>" << esc(config::describe_pose(st.joints_deg)) << "</td><td>"
       << (st.held_out ? "held out" : "in it") << "</td><td>" << fmt("%.3f", st.actuator_hz) << "</td><td>"
       << esc(st.region) << fmt(", K %.0f", st.gain_ns_per_m) << "</td><td>"
       << (st.on_cell ? fmt("%.1f", st.measured_improvement_pct) : std::string("-")) << "</td><td>"
-      << fmt("%.1f", st.predicted_improvement_pct) << "</td><td>" << st.records << "</td><td>"
-      << fmt("%.3f / %.3f", st.damped_limit_mm, st.open_limit_mm) << "</td><td>" << fmt("%.3f", st.loop_open_limit_mm)
-      << "</td><td class=" << (held && cut ? "ok" : "bad") << ">"
+      << fmt("%.1f &plusmn; %.1f", st.predicted_improvement_pct, st.predicted_sigma_pct) << "</td><td>" << st.records
+      << "</td><td>" << fmt("%.3f / %.3f", st.damped_limit_mm, st.open_limit_mm) << "</td><td>"
+      << fmt("%.3f", st.loop_open_limit_mm) << "</td><td class=" << (held && cut ? "ok" : "bad") << ">"
       << (!st.on_cell ? "not measured on the cell"
           : !held     ? fmt("off by %.1f points, the damped peak %+.0f %%",
                             st.measured_improvement_pct - st.predicted_improvement_pct, 100.0 * st.peak_error())
@@ -152,7 +161,10 @@ std::string stops_table(const PathCommissionSettings& s, const PathCommissionRes
        "model "
        "(discrete loop); allowed "
     << fmt("%.1f", s.improvement_tolerance_points) << " points, or the damped peak within "
-    << fmt("%.0f", 100.0 * s.peak_tolerance) << " % of the predicted. The job: its limiting depth at "
+    << fmt("%.0f", 100.0 * s.peak_tolerance) << " % of the predicted, or " << fmt("%.0f", s.prediction_sigmas)
+    << " sigma of the prediction's own spread: the dominant mode's frequency, damping and stiffness on the map each "
+       "carry a sigma there (small at a stop in the map, larger between them), propagated to the improvement to "
+       "first order. The job: its limiting depth at "
     << fmt("%.0f", r.job_rpm) << " rpm by " << esc(r.method)
     << "; the open loop over the model's modes, and over the loop's plant alone (its lowest "
        "modes, as the damped limit sees them): the damper is worse where the damped limit is below the latter.</p>\n";
@@ -220,6 +232,7 @@ json to_json(const PathCommissionResult& r) {
                      {"region", s.region},
                      {"gain_ns_per_m", s.gain_ns_per_m},
                      {"predicted_improvement_pct", s.predicted_improvement_pct},
+                     {"predicted_improvement_sigma_pct", s.predicted_sigma_pct},
                      {"measured_improvement_pct", s.on_cell ? json(s.measured_improvement_pct) : json(nullptr)},
                      {"damped_peak_error_pct", s.on_cell ? json(100.0 * s.peak_error()) : json(nullptr)},
                      {"records", s.records},
@@ -290,7 +303,7 @@ std::string write_path_report(const PathCommissionSettings& s, const PathCommiss
       << fmt("%.1f", t.wall_s) << "</td></tr>\n";
   h << "<tr><td>total</td><td>" << fmt("%.1f", r.wall_s) << "</td></tr></table>\n";
   try {
-    h << stops_table(s, r) << stops_figure(r, dir / "plots") << map_table(r) << modes_figure(s, r, dir / "plots")
+    h << stops_table(s, r) << stops_figure(s, r, dir / "plots") << map_table(r) << modes_figure(s, r, dir / "plots")
       << tuned_table(r);
   } catch (const std::exception& e) {
     h << "<p class=bad>" << esc(e.what()) << "</p>\n";

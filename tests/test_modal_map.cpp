@@ -138,6 +138,14 @@ TEST(ModalMap, ARobotWrongInFormIsMappedFromFivePosesAndThePosesBetweenComeWithi
     std::cout << name << ": damped improvement predicted on the map " << p_map << " %, measured there " << p_there
               << " %, the truth " << p_truth << " %, the model file " << p_model << " %\n";
     worst_points = std::max(worst_points, std::abs(p_map - p_there));
+    // The map states its uncertainty there: the truth within two of its sigmas; the model file states none.
+    const analysis::PredictedImprovement band =
+        analysis::predicted_improvement(set.config, mapped, *cfg.pose_schedule, q);
+    std::cout << name << ": the map's one sigma " << band.sigma_pct << " points\n";
+    EXPECT_DOUBLE_EQ(band.pct, p_map);
+    EXPECT_GT(band.sigma_pct, 0.0) << name;
+    EXPECT_LE(std::abs(p_map - p_truth), 2.0 * band.sigma_pct) << name;
+    EXPECT_EQ(analysis::predicted_improvement(set.config, w.model, *cfg.pose_schedule, q).sigma_pct, 0.0);
     // Against the truth the map is no more than 5 points worse than a measurement at the pose itself.
     EXPECT_LT(std::abs(p_map - p_truth), std::abs(p_there - p_truth) + 5.0) << name;
   }
