@@ -278,11 +278,15 @@ PredictedImprovement predicted_improvement(const config::Config& set, const conf
       if (!(sigma > 0.0)) continue;
       double ends[2] = {0.0, 0.0};
       for (int side = 0; side < 2; ++side) {
-        const double scale = std::exp(side == 0 ? sigma : -sigma);
+        const double sign = side == 0 ? 1.0 : -1.0, scale = std::exp(sign * sigma);
+        // The stiffness through its participation w^2 / k, whose sigma the map's is (relative to it): moved by
+        // its sigma and kept above a thousandth of itself (a mode with next to no participation along the
+        // axis, one a measurement did not see, moves by its absolute sigma, not by a factor).
+        const double k =
+            quantity != 2 ? nominal.stiffness_n_per_m : nominal.stiffness_n_per_m / std::max(1.0 + sign * sigma, 1e-3);
         PoseModes moved = at;
         moved.modes[i] = config::stiffness_mode(nominal.natural_freq_hz * (quantity == 0 ? scale : 1.0),
-                                                nominal.damping_ratio * (quantity == 1 ? scale : 1.0),
-                                                nominal.stiffness_n_per_m * (quantity == 2 ? scale : 1.0));
+                                                nominal.damping_ratio * (quantity == 1 ? scale : 1.0), k);
         ends[side] = improvement(moved);
       }
       variance += 0.25 * (ends[0] - ends[1]) * (ends[0] - ends[1]);

@@ -105,10 +105,12 @@ class LoopModel;
 
 // The same prediction with the uncertainty the model gives it at the pose. On a mapped model (measured_modes)
 // each mapped mode's frequency, damping ratio and stiffness along the axis carries its map's one-sigma spread
-// (robot::ModeCorrection, a log value; 0 for the model's modes no measurement follows); the improvement's own
+// (robot::ModeCorrection: the frequency's and the damping's of their logarithms, the stiffness's of its
+// participation w^2 / k relative to it; 0 for the model's modes no measurement follows); the improvement's own
 // one sigma is propagated to first order from them as independent: the root sum of squares of half the change
-// between each quantity at plus and minus one sigma (every mode counts: the peak may move to another one). Near a measured pose it is the measurement's noise; between measured poses it grows with the
-// map's spread. Without measured_modes it is 0 (the model file states no uncertainty).
+// between each quantity at plus and minus one sigma (every mode counts: the peak may move to another one).
+// Near a measured pose it is the measurement's noise; between measured poses it grows with the map's spread.
+// Without measured_modes it is 0 (the model file states no uncertainty).
 struct PredictedImprovement {
   double pct{0.0};
   double sigma_pct{0.0};  // points of improvement, one sigma

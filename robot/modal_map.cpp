@@ -82,12 +82,19 @@ ModalMap::Field fitted_form(const std::vector<Eigen::VectorXd>& x, const std::ve
   return form.own ? ModalMap::Field(x, own, noise, true) : ModalMap::Field(x, against_model, noise, false);
 }
 
-// A measured mode at one pose, with the model's mode it was matched to there (model_index -1: none).
+// A measured mode at one pose, with the model's mode it was matched to there (model_index -1: none). absent:
+// at a measured pose the track's model mode lies where the measurement would have seen it (below the highest
+// mode measured there, within the match's 25 %) and no measured mode was matched to it: it hardly moves the
+// TCP along the axis there, a participation of zero; its frequency and damping are not known there.
 struct Sample {
   Eigen::VectorXd x;
   double f_hz, zeta, k, model_f_hz, model_zeta, model_k;
   int model_index;
+  bool absent{false};
 };
+std::size_t present(const std::vector<Sample>& t) {
+  return static_cast<std::size_t>(std::count_if(t.begin(), t.end(), [](const Sample& s) { return !s.absent; }));
+}
 
 // One measured mode over the poses (a track): each quantity in the form leave-one-out chooses, its model mode
 // (-1 where no one model mode follows it at every pose), its frequencies.
@@ -97,20 +104,22 @@ void fit_track(const std::vector<Sample>& t, ModalMap::Field& freq, ModalMap::Fi
   for (const Sample& s : t)
     if (s.model_index != form.model_index) form.model_index = -1;
   const bool matched = form.model_index >= 0;
-  std::vector<Eigen::VectorXd> x;
+  std::vector<Eigen::VectorXd> x, x_all;  // the poses it was measured at; with those it is absent at
   // Each quantity in both forms: against the model's mode (a log ratio, or the participation's difference)
   // and as the track's own values.
   std::vector<double> f_own, f_prior, z_own, z_prior, p_own, p_model;
   double p_scale = 0.0;
   for (const Sample& s : t) {
+    x_all.push_back(s.x);
+    p_own.push_back(s.absent ? 0.0 : participation(s.f_hz, s.k));
+    if (matched) p_model.push_back(participation(s.model_f_hz, s.model_k));
+    if (s.absent) continue;
     x.push_back(s.x);
     f_own.push_back(std::log(s.f_hz));
     z_own.push_back(std::log(s.zeta));
-    p_own.push_back(participation(s.f_hz, s.k));
     if (matched) {
       f_prior.push_back(std::log(s.model_f_hz));
       z_prior.push_back(std::log(s.model_zeta));
-      p_model.push_back(participation(s.model_f_hz, s.model_k));
     }
     p_scale = std::max(p_scale, participation(s.f_hz, s.k));
   }
@@ -121,10 +130,11 @@ void fit_track(const std::vector<Sample>& t, ModalMap::Field& freq, ModalMap::Fi
   };
   freq = fitted_form(x, f_own, difference(f_own, f_prior), kFreqNoise, form.freq);
   damping = fitted_form(x, z_own, difference(z_own, z_prior), kDampingNoise, form.damping);
-  stiffness = fitted_form(x, p_own, difference(p_own, p_model), kStiffnessNoise * p_scale, form.stiffness);
-  form.measured_poses = static_cast<int>(t.size());
+  stiffness = fitted_form(x_all, p_own, difference(p_own, p_model), kStiffnessNoise * p_scale, form.stiffness);
+  form.measured_poses = static_cast<int>(x.size());
   form.min_hz = INFINITY;
-  for (const Sample& s : t) form.min_hz = std::min(form.min_hz, s.f_hz), form.max_hz = std::max(form.max_hz, s.f_hz);
+  for (const Sample& s : t)
+    if (!s.absent) form.min_hz = std::min(form.min_hz, s.f_hz), form.max_hz = std::max(form.max_hz, s.f_hz);
 }
 
 // The measured modes' indices among the model's: as many pairs within 25 % as possible, then the smallest
@@ -241,6 +251,13 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
   // identity of a mode: a mode a driving point misses at some poses does not shift the others); the modes the
   // model has no match for, by their rank among the unmatched at each pose.
   std::map<int, std::vector<Sample>> by_key;
+  struct Seen {  // at one measured pose: the model's modes there, which of them a measured mode matched, the highest
+    Eigen::VectorXd x;
+    std::vector<AxisMode> prior;
+    std::vector<bool> matched;
+    double highest_hz{0.0};
+  };
+  std::vector<Seen> seen;
   for (const config::MeasuredPoseModes& p : model.measured_modes->poses) {
     const std::vector<AxisMode> prior = axis_modes(model, p.joints_deg, axis, count);
     std::vector<config::ModeConfig> measured = p.modes;
@@ -258,19 +275,38 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
           {radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m,
            a.freq_hz, a.damping_ratio, a.stiffness_n_per_m, j});
     }
+    Seen here{radians(p.joints_deg), prior, std::vector<bool>(prior.size(), false), 0.0};
+    for (std::size_t k = 0; k < measured.size(); ++k) {
+      if (const int j = match.model_of_measured[k]; j >= 0) here.matched[static_cast<std::size_t>(j)] = true;
+      here.highest_hz = std::max(here.highest_hz, measured[k].natural_freq_hz);
+    }
+    seen.push_back(std::move(here));
     matches_.push_back(std::move(match));
     measured_deg_.push_back(p.joints_deg);
+  }
+  // Where a tracked model mode was not seen at a measured pose that would have seen it, it is there but does
+  // not move the TCP along the axis: without this the regression carried its participation from the poses
+  // where it does into one where the measurement showed nothing (a mode along y at 21 Hz given 5.9e5 N/m along
+  // x, where the robot's is 7e9).
+  for (auto& [key, t] : by_key) {
+    if (key < 0 || key >= kUnmatchedKey) continue;
+    const auto j = static_cast<std::size_t>(key);
+    for (const Seen& p : seen)
+      if (j < p.prior.size() && !p.matched[j] && p.prior[j].freq_hz <= p.highest_hz * std::exp(kMatchLogRatio))
+        t.push_back({p.x, NAN, NAN, INFINITY, p.prior[j].freq_hz, p.prior[j].damping_ratio,
+                     p.prior[j].stiffness_n_per_m, key, true});
   }
   std::vector<std::vector<Sample>> tracks;
   for (auto& [key, t] : by_key) tracks.push_back(std::move(t));
   const auto mean_hz = [](const std::vector<Sample>& t) {
     double sum = 0.0;
-    for (const Sample& x : t) sum += x.f_hz;
-    return sum / static_cast<double>(t.size());
+    for (const Sample& x : t)
+      if (!x.absent) sum += x.f_hz;
+    return sum / static_cast<double>(std::max<std::size_t>(present(t), 1));
   };
   std::sort(tracks.begin(), tracks.end(), [&](const auto& a, const auto& b) { return mean_hz(a) < mean_hz(b); });
   for (const std::vector<Sample>& t : tracks) {
-    if (2 * t.size() < model.measured_modes->poses.size()) continue;  // seen at too few poses to stand for a mode
+    if (2 * present(t) < model.measured_modes->poses.size()) continue;  // seen at too few poses to stand for a mode
     Track tr;
     fit_track(t, tr.freq, tr.damping, tr.stiffness, tr.form);
     tr.model_index = tr.form.model_index;
