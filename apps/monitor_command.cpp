@@ -11,7 +11,7 @@
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
-#include "apps/advice_view.hpp"
+#include "runtime/advice_view.hpp"
 #include "apps/cli.hpp"
 #include "apps/dds_client.hpp"
 #include "config/pose_schedule_config.hpp"
@@ -167,7 +167,7 @@ std::string advice_view(const msg::Advice& m) {
   a.limiting_pose_deg = m.limiting_pose_deg();
   a.status = m.status();
   a.status_reason = m.status_reason();
-  return advice_text(a);
+  return runtime::advice_text(a);
 }
 
 }  // namespace

@@ -14,7 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include "apps/cli.hpp"
-#include "apps/run_summary_text.hpp"
+#include "runtime/run_summary_text.hpp"
 #include "rt/signals.hpp"
 #include "runtime/cell.hpp"
 #include "sim_plant/faults.hpp"
@@ -149,8 +149,8 @@ int run_loop(const RunArgs& a) {
   cell.wait();
   if (runtime::Status s = cell.deactivate(); !s.ok()) std::cerr << "robodamp run: " << s.message << '\n';
   const runtime::RunSummary& s = cell.summary();
-  std::cout << summary_text(s);
-  if (!emit_json(a.json, summary_json(s).dump(2), "run")) return 1;
+  std::cout << runtime::summary_text(s);
+  if (!emit_json(a.json, runtime::summary_json(s).dump(2), "run")) return 1;
   if (!a.histogram_path.empty() && !write_histogram(a.histogram_path, s)) {
     std::cerr << "--histogram " << a.histogram_path << ": cannot write\n";
     return 1;

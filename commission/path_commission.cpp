@@ -389,6 +389,12 @@ class PathRun {
                st.predicted_sigma_pct, st.records, r_.job_rpm, st.damped_limit_mm, st.open_limit_mm) +
            (st.limit_note.empty() ? std::string() : " (" + st.limit_note + ")"));
     }
+    judge(run);
+  }
+
+  // The verify run's verdict: somewhere the damper runs, no trip, nothing out of the map, and at every stop the
+  // improvement as predicted and the cut no worse. Throws Stop with the first that fails.
+  void judge(const EmulatedPathRun& run) const {
     if (std::all_of(r_.stops.begin(), r_.stops.end(), [](const PathStop& st) { return st.gain_ns_per_m == 0.0; }))
       throw Stop{
           Stage::kVerify, Outcome::kNotVerified,

@@ -1,15 +1,15 @@
-#include "apps/run_summary_text.hpp"
+#include "runtime/run_summary_text.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
-#include "apps/advice_view.hpp"
+#include "runtime/advice_view.hpp"
 #include "config/pose_schedule_config.hpp"
 #include "fields/json.hpp"
 
-namespace robodamp::apps {
+namespace robodamp::runtime {
 
 namespace {
 
@@ -363,4 +363,4 @@ std::string summary_text(const runtime::RunSummary& s) {
   return os.str();
 }
 
-}  // namespace robodamp::apps
+}  // namespace robodamp::runtime

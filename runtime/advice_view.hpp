@@ -8,10 +8,10 @@
 
 #include "dds/bridge.hpp"
 
-namespace robodamp::apps {
+namespace robodamp::runtime {
 
 // One line (or two when none qualifies), ending in a newline.
 [[nodiscard]] std::string advice_text(const dds::AdviceSample& a);
 [[nodiscard]] nlohmann::json advice_json(const dds::AdviceSample& a);
 
-}  // namespace robodamp::apps
+}  // namespace robodamp::runtime

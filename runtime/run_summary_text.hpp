@@ -9,9 +9,9 @@
 
 #include "runtime/run_summary.hpp"
 
-namespace robodamp::apps {
+namespace robodamp::runtime {
 
 [[nodiscard]] nlohmann::json summary_json(const runtime::RunSummary& s);
 [[nodiscard]] std::string summary_text(const runtime::RunSummary& s);
 
-}  // namespace robodamp::apps
+}  // namespace robodamp::runtime

@@ -1,11 +1,11 @@
-#include "apps/advice_view.hpp"
+#include "runtime/advice_view.hpp"
 
 #include <cmath>
 #include <cstdio>
 
 #include "config/pose_schedule_config.hpp"
 
-namespace robodamp::apps {
+namespace robodamp::runtime {
 
 std::string advice_text(const dds::AdviceSample& a) {
   char b[512];
@@ -67,4 +67,4 @@ nlohmann::json advice_json(const dds::AdviceSample& a) {
           {"status_reason", a.status_reason}};
 }
 
-}  // namespace robodamp::apps
+}  // namespace robodamp::runtime
