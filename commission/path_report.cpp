@@ -162,8 +162,8 @@ std::string stops_table(const PathCommissionSettings& s, const PathCommissionRes
        "(discrete loop); allowed "
     << fmt("%.1f", s.improvement_tolerance_points) << " points, or the damped peak within "
     << fmt("%.0f", 100.0 * s.peak_tolerance) << " % of the predicted, or " << fmt("%.0f", s.prediction_sigmas)
-    << " sigma of the prediction's own spread: the dominant mode's frequency, damping and stiffness on the map each "
-       "carry a sigma there (small at a stop in the map, larger between them), propagated to the improvement to "
+    << " sigma of the prediction's own spread: each mapped mode's frequency, damping and participation on the map "
+       "carries a sigma there (small at a stop in the map, larger between them), propagated to the improvement to "
        "first order. The job: its limiting depth at "
     << fmt("%.0f", r.job_rpm) << " rpm by " << esc(r.method)
     << "; the open loop over the model's modes, and over the loop's plant alone (its lowest "
