@@ -253,19 +253,25 @@ PoseScheduleAnalysis analyse_pose_schedule(const config::Config& cfg) {
   return out;
 }
 
+namespace {
+
+// The set's driving-point improvement with these modes as its plant.
+double improvement_with(const config::Config& set, const PoseModes& modes) {
+  return driving_point_improvement_pct(LoopModel(config_at_pose(set, modes)), set.controller.gain_ns_per_m,
+                                       set.controller.polarity);
+}
+
+}  // namespace
+
 double predicted_improvement_pct(const config::Config& set, const config::RobotModelConfig& model,
                                  const config::PoseScheduleConfig& schedule, const std::vector<double>& q) {
-  const LoopModel m(config_at_pose(set, pose_modes(model, q, schedule.axis, schedule.modes)));
-  return driving_point_improvement_pct(m, set.controller.gain_ns_per_m, set.controller.polarity);
+  return improvement_with(set, pose_modes(model, q, schedule.axis, schedule.modes));
 }
 
 PredictedImprovement predicted_improvement(const config::Config& set, const config::RobotModelConfig& model,
                                            const config::PoseScheduleConfig& schedule, const std::vector<double>& q) {
   const PoseModes at = pose_modes(model, q, schedule.axis, schedule.modes);
-  const auto improvement = [&](const PoseModes& pm) {
-    return driving_point_improvement_pct(LoopModel(config_at_pose(set, pm)), set.controller.gain_ns_per_m,
-                                         set.controller.polarity);
-  };
+  const auto improvement = [&](const PoseModes& pm) { return improvement_with(set, pm); };
   PredictedImprovement out;
   out.pct = improvement(at);
   if (at.corrections.size() != at.modes.size()) return out;

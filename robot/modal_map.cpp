@@ -267,17 +267,15 @@ ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) :
     for (const auto& m : measured) measured_hz.push_back(m.natural_freq_hz);
     for (const auto& m : prior) model_hz.push_back(m.freq_hz);
     PoseMatch match{p.name, match_modes(measured_hz, model_hz)};
+    Seen here{radians(p.joints_deg), prior, std::vector<bool>(prior.size(), false), 0.0};
     int unmatched = 0;
     for (std::size_t k = 0; k < measured.size(); ++k) {
       const int j = match.model_of_measured[k];
       const AxisMode a = j >= 0 ? prior[static_cast<std::size_t>(j)] : AxisMode{};
       by_key[j >= 0 ? j : kUnmatchedKey + unmatched++].push_back(
-          {radians(p.joints_deg), measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m,
-           a.freq_hz, a.damping_ratio, a.stiffness_n_per_m, j});
-    }
-    Seen here{radians(p.joints_deg), prior, std::vector<bool>(prior.size(), false), 0.0};
-    for (std::size_t k = 0; k < measured.size(); ++k) {
-      if (const int j = match.model_of_measured[k]; j >= 0) here.matched[static_cast<std::size_t>(j)] = true;
+          {here.x, measured[k].natural_freq_hz, measured[k].damping_ratio, measured[k].stiffness_n_per_m, a.freq_hz,
+           a.damping_ratio, a.stiffness_n_per_m, j});
+      if (j >= 0) here.matched[static_cast<std::size_t>(j)] = true;
       here.highest_hz = std::max(here.highest_hz, measured[k].natural_freq_hz);
     }
     seen.push_back(std::move(here));
