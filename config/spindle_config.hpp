@@ -29,6 +29,11 @@ struct SpindleConfig {
   // With pose_schedule: the live limits are for the robot at its pose, rounded to this grid (a new grid
   // point is a new computation; docs/pose_dynamics.md, "Live stability at the pose").
   double pose_step_deg{2.0};
+  // Spindle-speed advice (docs/milling.md, "Spindle-speed advice"): the uniform candidates over the range
+  // beside the pockets the chatter frequency and the modes name. Each costs an accurate limit at every pose
+  // checked (the pose now and the path ahead), about a second on a cell PC's core; fewer answer sooner and
+  // may miss a pocket the frequencies do not name.
+  int advice_grid_points{48};
   // The HIL emulator's robot follows robodamp's spindle-speed advice (modbus.robot.advice_register) in
   // its regenerative cut: an advised speed inside 0 < rpm <= rpm_max replaces the program's speed.
   bool apply_advice{false};

@@ -64,8 +64,10 @@ MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config
   ls.pose_step_deg = cfg.spindle.pose_step_deg;
   stability_ = std::make_unique<milling::LiveStability>(std::move(job), cfg.spindle.structure, std::move(sets), ls,
                                                         std::move(in.pose));
+  milling::SpeedAdviceSettings as;
+  as.grid_points = static_cast<std::size_t>(cfg.spindle.advice_grid_points);
   advisor_ = std::make_unique<SpeedAdvisor>(
-      *stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(in.on_advice));
+      *stability_, [this] { return view(); }, rpm_min, rpm_max, std::move(in.on_advice), 0.2, as);
 }
 
 void MachiningMonitor::on_frame(const rt::TelemetryFrame& f) {

@@ -453,23 +453,25 @@ TEST(Config, HarmonicNotchAndSpindleAreValidated) {
   ASSERT_NE(at, std::string::npos);
   std::string ok = text;
   ok.insert(at + 12, "  harmonic_notch: {harmonics: 4, bandwidth_hz: 20, depth_db: 40}\n");
-  const Config c = parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000, apply_advice: true}\n", "ok.yaml");
+  const Config c = parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000, apply_advice: true, advice_grid_points: 0}\n", "ok.yaml");
   EXPECT_TRUE(c.spindle.apply_advice);
+  EXPECT_EQ(c.spindle.advice_grid_points, 0);
   ASSERT_TRUE(c.controller.harmonic_notch);
   EXPECT_EQ(c.controller.harmonic_notch->harmonics, 4);
   EXPECT_EQ(c.controller.harmonic_notch->slew_fraction, 0.05);  // default
   EXPECT_EQ(c.spindle.teeth, 2);
   std::string bad = text;
   bad.insert(at + 12, "  harmonic_notch: {harmonics: 9, depth_db: 0, slew_fraction: 2, update_hz: .nan}\n");
-  const auto p = problems_of(bad + "spindle: {teeth: 0, rpm_max: -5, apply_advice: sometimes}\n");
+  const auto p = problems_of(bad + "spindle: {teeth: 0, rpm_max: -5, apply_advice: sometimes, advice_grid_points: 401}\n");
   std::string all;
   for (const auto& q : p) all += q.to_string() + "\n";
   for (const char* expected :
        {"controller.harmonic_notch.harmonics = 9", "controller.harmonic_notch.depth_db = 0 dB is out of range",
         "controller.harmonic_notch.slew_fraction = 2", "controller.harmonic_notch.update_hz", "spindle.teeth = 0",
-        "spindle.rpm_max = -5 rpm is out of range", "spindle.apply_advice"})
+        "spindle.rpm_max = -5 rpm is out of range", "spindle.apply_advice",
+        "spindle.advice_grid_points = 401 (speeds) is out of range: allowed 0 <= value <= 400"})
     EXPECT_NE(all.find(expected), std::string::npos) << expected << "\nin:\n" << all;
-  EXPECT_EQ(p.size(), 7U) << all;
+  EXPECT_EQ(p.size(), 8U) << all;
 }
 
 TEST(Config, AParameterRequestsGainIsWordedLikeTheConfiguration) {

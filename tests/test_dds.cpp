@@ -669,15 +669,16 @@ TEST(Dds, TheAdviceIsCheckedAlongTheTrajectoryTheRobotProgramPublishes) {
   std::string job = test::read_file(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_wall_x.yaml");
   test::replace_or_throw(job, "model: ../robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
   test::replace_or_throw(job, "axial_mm: 0.1", "axial_mm: 0.4");
-  // The advice searched over 550-850 rpm, not the job's 100-1500: what is checked is where it looks (the pose
-  // and the path ahead), not what it finds, and each candidate costs an accurate limit at every pose.
+  // The advice searched over 550-850 rpm, not the job's 100-1500, with 4 grid speeds beside the pockets, not 48
+  // (spindle.advice_grid_points): what is checked is where it looks (the pose and the path ahead), not what it
+  // finds, and each candidate costs an accurate limit at every pose.
   test::replace_or_throw(job, "rpm_min: 100", "rpm_min: 550");
   test::replace_or_throw(job, "rpm_max: 1500", "rpm_max: 850");
   std::ofstream(dir + "/job.yaml") << job;
   std::string text = test::read_file(test::preset("pose_scheduled_c2"));
   test::replace_or_throw(text, "model: ../robots/", std::string("model: ") + ROBODAMP_SOURCE_DIR + "/config/robots/");
   const std::string cell = "path-" + std::to_string(getpid());
-  text += "\ncell:\n  name: " + cell + "\nspindle:\n  teeth: 3\n  job: " + dir +
+  text += "\ncell:\n  name: " + cell + "\nspindle:\n  teeth: 3\n  advice_grid_points: 4\n  job: " + dir +
           "/job.yaml\ndds:\n  domain_id: " + std::to_string(domain) +
           "\n  transport: udp_loopback\n  joint_states:\n    names: [shoulder, elbow, wrist]\n  path_ahead: {}\n"
           "supervision:\n  overrun_cycles: 5000\n";
