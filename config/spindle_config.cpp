@@ -42,8 +42,7 @@ SpindleConfig read_spindle(MapReader& top, const std::string& source) {
   if (auto v = r.text("structure", "")) c.structure = *v;
   if (auto v = r.number("pose_step_deg", {"deg", 0.1, 45.0}, c.pose_step_deg)) c.pose_step_deg = *v;
   if (auto v = read_bool(r, "apply_advice", c.apply_advice)) c.apply_advice = *v;
-  if (auto v = read_int(r, "advice_grid_points", {"(speeds)", 0, 400}, c.advice_grid_points))
-    c.advice_grid_points = *v;
+  if (auto v = read_int(r, "advice_grid_points", {"(speeds)", 0, 400}, c.advice_grid_points)) c.advice_grid_points = *v;
   r.finish();
   return c;
 }

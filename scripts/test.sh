@@ -2,7 +2,7 @@
 # Set up, build, and run the whole test suite (its House.TheTreeIsFormatted checks clang-format). With CI=true
 # (as CI runs it), also clang-tidy over the real-time path and the devices (scripts/tidy.sh) and the libraries' unit tests
 # built with AddressSanitizer and UndefinedBehaviorSanitizer (scripts/sanitize.sh address,undefined --unit,
-# in build-address-undefined; docs/tests.md "Sanitizers").
+# at -O1 -g1 in build-address-undefined-unit; docs/tests.md "Sanitizers").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh

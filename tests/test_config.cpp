@@ -453,7 +453,8 @@ TEST(Config, HarmonicNotchAndSpindleAreValidated) {
   ASSERT_NE(at, std::string::npos);
   std::string ok = text;
   ok.insert(at + 12, "  harmonic_notch: {harmonics: 4, bandwidth_hz: 20, depth_db: 40}\n");
-  const Config c = parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000, apply_advice: true, advice_grid_points: 0}\n", "ok.yaml");
+  const Config c =
+      parse_config(ok + "spindle: {teeth: 2, rpm_max: 24000, apply_advice: true, advice_grid_points: 0}\n", "ok.yaml");
   EXPECT_TRUE(c.spindle.apply_advice);
   EXPECT_EQ(c.spindle.advice_grid_points, 0);
   ASSERT_TRUE(c.controller.harmonic_notch);
@@ -462,7 +463,8 @@ TEST(Config, HarmonicNotchAndSpindleAreValidated) {
   EXPECT_EQ(c.spindle.teeth, 2);
   std::string bad = text;
   bad.insert(at + 12, "  harmonic_notch: {harmonics: 9, depth_db: 0, slew_fraction: 2, update_hz: .nan}\n");
-  const auto p = problems_of(bad + "spindle: {teeth: 0, rpm_max: -5, apply_advice: sometimes, advice_grid_points: 401}\n");
+  const auto p =
+      problems_of(bad + "spindle: {teeth: 0, rpm_max: -5, apply_advice: sometimes, advice_grid_points: 401}\n");
   std::string all;
   for (const auto& q : p) all += q.to_string() + "\n";
   for (const char* expected :
