@@ -43,7 +43,7 @@ opt="-O2 -g1 -DNDEBUG"
 if [ "$only_unit" = 1 ]; then dir="$dir-unit" opt="-O1 -g1 -DNDEBUG"; fi
 mkdir -p "$dir/.cmake/api/v1/query" && touch "$dir/.cmake/api/v1/query/codemodel-v2"
 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$opt" \
-      -DCMAKE_C_FLAGS_RELWITHDEBINFO="$opt" -DROBODAMP_SANITIZE="$kind" -DROBODAMP_BUILD_BENCH=OFF >/dev/null
+      -DROBODAMP_SANITIZE="$kind" -DROBODAMP_BUILD_BENCH=OFF >/dev/null
 targets=()
 if [ "$only_unit" = 1 ]; then
   for t in $unit; do targets+=(--target "$t"); done
