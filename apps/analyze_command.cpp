@@ -9,7 +9,7 @@
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/pose_schedule.hpp"
 #include "analysis/speed_schedule_check.hpp"
-#include "apps/milling_report.hpp"
+#include "milling/study_report.hpp"
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
 #include "milling/live_stability.hpp"
@@ -458,7 +458,7 @@ int run_analyze(const AnalyzeArgs& a) {
   if (!job.empty() && result.stable) {
     const milling::CutVerdict v = milling::cut_verdict(model.config(), config::load_milling_config(job), a.cut_speeds);
     table += milling::cut_verdict_text(v);
-    report["cut"] = cut_verdict_json(v);
+    report["cut"] = milling::cut_verdict_json(v);
   }
   if (print_report(
           report.dump(2), a.json, "analyze", table, a.plot_dir,

@@ -8,7 +8,7 @@
 #include "apps/analyze_command.hpp"
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
-#include "apps/milling_report.hpp"
+#include "milling/study_report.hpp"
 #include "milling/cut_verdict.hpp"
 #include <fstream>
 #include <iostream>
@@ -229,7 +229,7 @@ int run_bench(const BenchArgs& a) {
   if (!job.empty() && report.ran_closed_loop) {
     const milling::CutVerdict v = milling::cut_verdict(cfg, config::load_milling_config(job), a.cut_speeds);
     std::cout << "\n" << milling::cut_verdict_text(v);
-    j["cut"] = cut_verdict_json(v);
+    j["cut"] = milling::cut_verdict_json(v);
   } else {
     std::cout
         << "\n(no milling job: give --job, or spindle.job in the configuration, for what the damper does for a cut)\n";

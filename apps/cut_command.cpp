@@ -20,7 +20,7 @@
 #include "apps/cli.hpp"
 #include "milling/accurate_stability.hpp"
 #include "apps/gnuplot.hpp"
-#include "apps/milling_report.hpp"
+#include "milling/study_report.hpp"
 #include "commission/emulated_cell.hpp"
 #include "milling/chatter.hpp"
 #include "milling/cut_job.hpp"
@@ -272,9 +272,7 @@ void critical_study(const CutArgs& a, const config::MillingConfig& cfg, const co
 int run_cut(const CutArgs& a) {
   try {
     config::MillingConfig cfg = config::load_milling_config(a.job_path);
-    MillingOptions pose;
-    pose.pose_deg = a.pose_deg;
-    apply_pose(cfg, pose);
+    milling::apply_pose(cfg, a.pose_deg);
     if (!a.hil_path.empty() &&
         (!a.critical || !a.structure.empty() || !a.controller_path.empty() || !a.pose_deg.empty()))
       throw config::ConfigError(
@@ -283,7 +281,7 @@ int run_cut(const CutArgs& a) {
                            "--hil",
                            "--hil goes with --critical and the job's own structure (no --structure, "
                            "--controller or --pose): the emulator cuts the job as its file says"}});
-    const config::StructureConfig chosen = selected_structure(cfg, a.structure, a.controller_path);
+    const config::StructureConfig chosen = milling::selected_structure(cfg, a.structure, a.controller_path);
     const milling::Structure structure(chosen, false);
     const milling::CutOverrides ov{std::nullopt, a.axial_mm, a.radial_mm, a.revs, a.damped};
     const std::vector<double> speeds = a.rpm.empty() ? std::vector<double>{cfg.cut.spindle_rpm} : a.rpm;

@@ -13,7 +13,7 @@ namespace {
 // 0 done, 1 plot failed, 2 configuration or option error.
 int run_lobes(const MillingOptions& o) {
   config::MillingConfig cfg = config::load_milling_config(o.job_path);
-  apply_pose(cfg, o);
+  milling::apply_pose(cfg, o.pose_deg);
   // The direct test is defined where the job computes its lobes.
   const config::Range speeds{
       "rpm", cfg.lobes.rpm_min, cfg.lobes.rpm_max, false, false, "the job's lobes.rpm_min .. lobes.rpm_max"};

@@ -1,5 +1,5 @@
-// What `robodamp lobes` and `robodamp sle` share: the milling job's options, the reports (what a cut
-// buys with and without active damping, docs/milling.md) as JSON, a table and a plot.
+// What `robodamp lobes` and `robodamp sle` share: the milling job's options and printing the reports the
+// milling library makes (milling/study_report.hpp) as JSON, a table and a plot.
 #pragma once
 
 #include <string>
@@ -10,7 +10,7 @@
 
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
-#include "milling/cut_verdict.hpp"
+#include "milling/study_report.hpp"
 
 namespace robodamp::apps {
 
@@ -27,25 +27,18 @@ struct MillingOptions {
   std::vector<double> pose_deg;  // replaces the joints of every robot pose part (docs/pose_dynamics.md)
 };
 
-// --pose into the job: every pose part takes the joints, checked against its model's travel. Throws
-// config::ConfigError when the job has no pose part or the pose does not fit.
-void apply_pose(config::MillingConfig& cfg, const MillingOptions& o);
+// The study's part of the options.
+[[nodiscard]] milling::StudyOptions study_options(const MillingOptions& o);
 
 // `command` is "lobes" or "sle" (the plot's file name in --plot-dir).
 void add_milling_options(Registry& r, CLI::App* sub, MillingOptions& o, const std::string& command);
 
-// The job's structure by name (empty: the job's choice), every controller part's damping configuration
-// replaced by controller_path when given. Throws config::ConfigError for an unknown name.
-[[nodiscard]] config::StructureConfig selected_structure(const config::MillingConfig& cfg, const std::string& structure,
-                                                         const std::string& controller_path);
-
-// Throw config::ConfigError for a job or an option that does not fit it.
+// The reports with the study's progress on stderr (a many-mode open loop takes minutes). Throw
+// config::ConfigError for a job or an option that does not fit it.
 [[nodiscard]] nlohmann::json lobes_report(const config::MillingConfig& cfg, const MillingOptions& o);
 [[nodiscard]] nlohmann::json sle_report(const config::MillingConfig& cfg, const MillingOptions& o);
 // The table or JSON on stdout, then the plot: 0, or 1 when the plot failed.
 [[nodiscard]] int print_lobes(const nlohmann::json& r, const MillingOptions& o);
-// What the damper does for a cut (milling/cut_verdict.hpp) as the reports' JSON "cut" block.
-[[nodiscard]] nlohmann::json cut_verdict_json(const milling::CutVerdict& v);
 [[nodiscard]] int print_sle(const nlohmann::json& r, const MillingOptions& o);
 
 }  // namespace robodamp::apps

@@ -11,7 +11,7 @@ void register_sle(Registry& r) {
   auto o = std::make_shared<MillingOptions>();
   CLI::App* sub = r.add("sle", "Surface location error over speed and at the test conditions, with compensation", [o] {
     config::MillingConfig cfg = config::load_milling_config(o->job_path);
-    apply_pose(cfg, *o);
+    milling::apply_pose(cfg, o->pose_deg);
     return print_sle(sle_report(cfg, *o), *o);
   });
   add_milling_options(r, sub, *o, "sle");
