@@ -4,22 +4,19 @@
 #include <optional>
 #include <chrono>
 #include <cmath>
-#include <complex>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/fft.hpp"
 #include "apps/cli.hpp"
 #include "milling/accurate_stability.hpp"
-#include "apps/gnuplot.hpp"
+#include "milling/cut_report.hpp"
 #include "milling/study_report.hpp"
 #include "commission/emulated_cell.hpp"
 #include "milling/chatter.hpp"
@@ -84,86 +81,6 @@ const char* alias_note(double cut_hz, double accurate_hz, double tooth_hz) {
                                                                       : " (not the accurate method's chatter)";
 }
 
-json cut_json(const milling::CutJob& job, const milling::CutOutcome& o, double wall_s) {
-  const auto& r = o.record;
-  const auto& v = o.verdict;
-  return {{"rpm", r.rpm},
-          {"axial_mm", job.settings.cut.axial_mm},
-          {"radial_mm", job.settings.cut.radial_mm},
-          {"stable", v.stable},
-          {"classification", milling::to_string(v.classification)},
-          {"mechanism", milling::to_string(v.mechanism)},
-          {"chatter_hz", v.stable ? json(nullptr) : json(v.chatter_hz)},
-          {"chatter_family_hz",
-           v.stable ? json(nullptr) : json(milling::chatter_family_hz(v.chatter_hz, r.rpm * job.cutter.teeth / 60.0))},
-          {"once_per_tooth_ratio", v.once_per_period_ratio},
-          {"nonharmonic_energy_ratio", v.nonharmonic_energy_ratio},
-          {"growth_per_tooth", finite_or_null(v.growth_per_period)},
-          {"out_of_cut_share", v.out_of_cut_share},
-          {"peak_force_n", r.peak_force_n},
-          {"peak_actuator_force_n", finite_or_null(r.peak_actuator_force_n)},
-          {"actuator_saturated", r.actuator_saturated_s > 0.0},
-          {"actuator_saturated_s", r.actuator_saturated_s},
-          {"damped", job.damped},
-          {"requested_rpm", job.requested_rpm},
-          {"sle_um", finite_or_null(r.sle_um)},
-          {"steps_per_tooth", r.steps_per_tooth},
-          {"step_s", r.step_s},
-          {"simulated_s", r.step_s * static_cast<double>(r.x_m.size())},
-          {"wall_s", wall_s}};
-}
-
-std::string plot_cut(const milling::CutOutcome& o, const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  const auto& r = o.record;
-  const std::size_t from = r.settle_steps, n = r.x_m.size();
-  {  // displacement and force after settling
-    std::ostringstream d;
-    for (std::size_t k = from; k < n; ++k)
-      d << static_cast<double>(k) * r.step_s << ' ' << r.x_m[k] * 1e6 << ' ' << r.y_m[k] * 1e6 << ' ' << r.fx_n[k]
-        << ' ' << r.fy_n[k] << '\n';
-    const std::string s1 =
-        "set title 'Tool displacement (cutter frame)'\nset grid\nset xlabel 'time (s)'\nset ylabel 'um'\n"
-        "plot DATA u 1:2 w l t 'x (feed)', DATA u 1:3 w l t 'y (wall normal)'\n";
-    if (auto e = run_gnuplot(s1, d.str(), dir + "/cut_displacement.png"); !e.empty()) return e;
-    const std::string s2 =
-        "set title 'Cutting force on the tool'\nset grid\nset xlabel 'time (s)'\nset ylabel 'N'\n"
-        "plot DATA u 1:4 w l t 'Fx', DATA u 1:5 w l t 'Fy'\n";
-    if (auto e = run_gnuplot(s2, d.str(), dir + "/cut_force.png"); !e.empty()) return e;
-  }
-  {  // spectrum of y after settling, tooth-passing harmonics marked
-    const std::size_t len =
-        ((n - from) / static_cast<std::size_t>(r.steps_per_tooth)) * static_cast<std::size_t>(r.steps_per_tooth);
-    analysis::RealFft fft(len);
-    double mean = 0.0;
-    for (std::size_t i = 0; i < len; ++i) mean += r.y_m[n - len + i] / static_cast<double>(len);
-    for (std::size_t i = 0; i < len; ++i) fft.input()[i] = r.y_m[n - len + i] - mean;
-    const std::complex<double>* x = fft.forward();
-    const double df = 1.0 / (r.step_s * static_cast<double>(len)), tooth_hz = r.rpm * r.teeth / 60.0;
-    const double f_max = std::min(0.5 / r.step_s, 8.0 * tooth_hz + 2.0 * o.verdict.chatter_hz);
-    std::ostringstream d, s;
-    for (std::size_t k = 1; k < fft.bins() && static_cast<double>(k) * df <= f_max; ++k)
-      d << static_cast<double>(k) * df << ' ' << 2.0 * std::abs(x[k]) / static_cast<double>(len) * 1e6 << '\n';
-    s << "set title 'Spectrum of the wall-normal displacement (" << milling::to_string(o.verdict.classification)
-      << ")'\nset grid\nset logscale y\nset xlabel 'frequency (Hz)'\nset ylabel 'amplitude (um)'\n";
-    for (int h = 1; h * tooth_hz <= f_max; ++h)
-      s << "set arrow from " << h * tooth_hz << ", graph 0 to " << h * tooth_hz
-        << ", graph 1 nohead dt 3 lc rgb 'gray50'\n";
-    s << "plot DATA u 1:2 w l lw 2 t 'y (tooth-passing harmonics dotted)'\n";
-    if (auto e = run_gnuplot(s.str(), d.str(), dir + "/cut_spectrum.png"); !e.empty()) return e;
-  }
-  {  // the machined wall per revolution
-    std::ostringstream d;
-    for (std::size_t i = 0; i < r.wall_per_rev_um.size(); ++i) d << i << ' ' << r.wall_per_rev_um[i] << '\n';
-    const std::string s =
-        "set title 'Machined wall: surface location error per revolution (+ = undercut)'\nset grid\n"
-        "set xlabel 'revolution after settling'\nset ylabel 'um'\nplot DATA u 1:2 w lp t 'SLE'\n";
-    if (auto e = run_gnuplot(s, d.str(), dir + "/cut_surface.png"); !e.empty()) return e;
-  }
-  return {};
-}
-
 // One cut at one speed (no --critical): its verdict, the damper's limits, the plots.
 std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, const milling::Structure& structure,
                            milling::CutOverrides ov, const std::vector<double>& speeds, json& out) {
@@ -174,7 +91,7 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
   const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
   const auto t0 = std::chrono::steady_clock::now();
   const milling::CutOutcome o = milling::run_job(job);
-  out = cut_json(job, o, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  out = milling::cut_json(job, o, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   std::printf("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
               out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
               out["classification"].get<std::string>().c_str());
@@ -192,7 +109,7 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
         o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
         o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
   if (!a.plot_dir.empty()) {
-    if (auto e = plot_cut(o, a.plot_dir); !e.empty()) {
+    if (auto e = milling::plot_cut(o, a.plot_dir); !e.empty()) {
       std::cerr << "plot: " << e << '\n';
       return 1;
     }
