@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "apps/analyze_command.hpp"
+#include "analysis/loop_report.hpp"
 #include "apps/cli.hpp"
 #include "apps/gnuplot.hpp"
 #include "milling/study_report.hpp"
@@ -32,7 +32,7 @@ json bench_report_json(const analysis::Bench& bench, const analysis::BenchReport
   const auto& cfg = bench.model().config();
   json j;
   j["config"] = r.config;
-  j["analysis"] = analysis_report(bench.model(), r.analysis);
+  j["analysis"] = analysis::analysis_report(bench.model(), r.analysis);
   j["settings"] = {{"loop_rate_hz", cfg.loop.rate_hz},
                    {"oversampling", cfg.plant.oversampling},
                    {"averages", cfg.bench.averages},
@@ -96,7 +96,7 @@ std::string bench_table(const analysis::Bench& bench, const analysis::BenchRepor
   const auto& cfg = bench.model().config();
   std::ostringstream os;
   char line[320];
-  os << analysis_table(analysis_report(bench.model(), r.analysis)) << "\n";
+  os << analysis::analysis_table(analysis::analysis_report(bench.model(), r.analysis)) << "\n";
   std::snprintf(line, sizeof line,
                 "Impact tests: %d averages x %.0f s records (resolution %.3f Hz, evaluated on a %.4f Hz zero-padded "
                 "grid), H1 estimator;\n  sensor noise %.1f ug/sqrt(Hz), drives %s (%.1f Hz, %.3f m/s^2), seed %llu\n",
@@ -238,7 +238,7 @@ int run_bench(const BenchArgs& a) {
   if (!emit_json(a.json, j.dump(2), "bench")) return 1;
   if (a.json.to_file()) std::cout << "wrote " << a.json.path << '\n';
   if (!a.plot_dir.empty()) {
-    std::string err = plot_analysis(bench.model(), report.analysis, a.plot_dir);
+    std::string err = analysis::plot_analysis(bench.model(), report.analysis, a.plot_dir);
     if (err.empty()) err = plot_bench(bench, report, a.plot_dir);
     if (!err.empty()) {
       std::cerr << "plot: " << err << '\n';
