@@ -1,5 +1,6 @@
 #include "milling/listen_report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -155,6 +156,8 @@ std::string plot_listen(const ListenReport& r, const std::string& dir) {
       << plot::num(w.end_s) << ' ' << level << ' ' << plot::num(w.chatter_share) << ' ' << plot::num(w.chatter_hz)
       << ' ' << plot::num(mid_s) << '\n';
   }
+  const bool chattered =
+      std::any_of(r.windows.begin(), r.windows.end(), [](const auto& w) { return w.chatter_hz > 0.0; });
   std::string onset;
   if (r.onset_s)
     onset = "set arrow from " + plot::num(*r.onset_s) + ", graph 0 to " + plot::num(*r.onset_s) +
@@ -162,13 +165,18 @@ std::string plot_listen(const ListenReport& r, const std::string& dir) {
             plot::num(std::round(*r.onset_s * 100.0) / 100.0) + " s' at " + plot::num(*r.onset_s) +
             ", graph 0.9 offset 0.5,0 tc rgb 'red'\n";
   const std::string s2 =
-      "set multiplot layout 2,1 title 'Chatter over time'\nset grid\nset ylabel 'verdict'\n" + onset +
+      "set multiplot layout 2,1 title 'Chatter over time'\nset lmargin at screen 0.14\nset rmargin at screen 0.9\nset "
+      "grid\nset ylabel 'verdict'\n" +
+      onset +
       "set ytics ('not enough signal' 0, 'stable' 1, 'chatter' 2)\nset yrange [-0.3:2.3]\n"
       "plot DATA u 1:2 w l lw 3 t 'verdict per window'\nset ytics auto\nset yrange [*:*]\nset xlabel 'time (s)'\n"
-      "set key bottom right\nset ylabel 'non-harmonic share'\nset yrange [0:1.05]\nset y2label 'chatter frequency "
-      "(Hz)'\nset y2tics\nset y2range [0:*]\n"
-      "plot DATA u 1:3 w l t 'non-harmonic share of the energy', DATA u 5:($4 > 0 ? $4 : 1/0) axes x1y2 w p pt 7 t "
-      "'chatter frequency (per window)'\n"
+      "set key bottom right\nset ylabel 'non-harmonic share'\nset yrange [-0.03:1.05]\n" +
+      // The chatter frequency on the right axis where a window found one (a recording without chatter has
+      // none to draw: gnuplot refuses an axis with no point on it).
+      (chattered ? "set y2label 'chatter frequency (Hz)'\nset y2tics\nset y2range [0:*]\n"
+                   "plot DATA u 1:3 w l t 'non-harmonic share of the energy', DATA u 5:($4 > 0 ? $4 : 1/0) axes x1y2 "
+                   "w p pt 7 t 'chatter frequency (per window)'\n"
+                 : "plot DATA u 1:3 w l t 'non-harmonic share of the energy (no window chattered)'\n") +
       "unset multiplot\n";
   return plot::run_gnuplot(s2, v.str(), dir + "/chatter_verdict.png");
 }

@@ -239,6 +239,26 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
           " --job " + std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/active_damping_c2.yaml");
   EXPECT_EQ(wrong_teeth.status, 2) << wrong_teeth.out;
   EXPECT_NE(wrong_teeth.out.find("--teeth 4 but the job"), std::string::npos) << wrong_teeth.out;
+  // A recording without chatter: its verdict and both plots (no chatter frequency to draw on the right axis).
+  {
+    const std::vector<double> quiet = cut_signal(rate, 12.0, false, 22);
+    std::ofstream csv(tmp.file("quiet.csv"));
+    csv << "time_s,a_mps2\n";
+    char line[64];
+    for (std::size_t i = 0; i < quiet.size(); ++i) {
+      std::snprintf(line, sizeof line, "%.8f,%.7f\n", static_cast<double>(i) / rate, quiet[i]);
+      csv << line;
+    }
+  }
+  const std::string quiet_plots = tmp.file("quiet_plots");
+  const Result quiet = run("chatter --signal " + tmp.file("quiet.csv") + " --teeth 3 --rpm-range 300 3000 --json " +
+                           json + " --plot-dir " + quiet_plots);
+  ASSERT_EQ(quiet.status, 0) << quiet.out;
+  EXPECT_NE(quiet.out.find("NO CHATTER in 3 windows"), std::string::npos) << quiet.out;
+  for (const auto& w : nlohmann::json::parse(robodamp::test::read_file(json))["windows"])
+    EXPECT_EQ(w["verdict"], "stable") << quiet.out;
+  for (const char* png : {"chatter_spectrogram.png", "chatter_verdict.png"})
+    EXPECT_GT(std::filesystem::file_size(quiet_plots + "/" + png), 5000u) << png;
   const Result no_teeth = run("chatter --signal " + tmp.file("cut.uff"));
   EXPECT_EQ(no_teeth.status, 2) << no_teeth.out;
   EXPECT_NE(no_teeth.out.find("--teeth"), std::string::npos) << no_teeth.out;
