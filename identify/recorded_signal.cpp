@@ -116,7 +116,7 @@ milling::RecordedSignal from_table(const std::string& path, const SignalOptions&
   std::optional<std::size_t> time_col, value_col;
   for (std::size_t k = 0; k < t.names.size(); ++k) {
     const std::string n = measfiles::normalised(t.names[k]);
-    if (n == "time" || n == "t" || n == "time_s" || n == "zeit") time_col = k;
+    if (n == "time" || n == "t" || n == "time_s" || n == "t_s" || n == "zeit") time_col = k;
   }
   if (!o.column.empty()) {
     value_col = column_of(t, o.column);
@@ -160,7 +160,7 @@ milling::RecordedSignal from_table(const std::string& path, const SignalOptions&
                                     ": the time step changes (a constant sample rate is needed)");
     s.rate_hz = 1.0 / dt;
   } else {
-    throw std::invalid_argument(path + ": no time column (time, t, time_s): give --rate-hz");
+    throw std::invalid_argument(path + ": no time column (time, t, time_s, t_s, zeit): give --rate-hz");
   }
   described = "table, column " +
               (*value_col < t.names.size() ? "'" + t.names[*value_col] + "'" : std::to_string(*value_col + 1)) +

@@ -243,7 +243,7 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
   {
     const std::vector<double> quiet = cut_signal(rate, 12.0, false, 22);
     std::ofstream csv(tmp.file("quiet.csv"));
-    csv << "time_s,a_mps2\n";
+    csv << "t_s,a_mps2\n";  // the time column as a logger names it with its unit
     char line[64];
     for (std::size_t i = 0; i < quiet.size(); ++i) {
       std::snprintf(line, sizeof line, "%.8f,%.7f\n", static_cast<double>(i) / rate, quiet[i]);
