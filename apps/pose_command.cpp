@@ -30,6 +30,7 @@
 #include "milling/structure.hpp"
 #include "robot/pose_fit.hpp"
 #include "milling/pose_map.hpp"
+#include "robot/pose_report.hpp"
 #include "robot/robot_model.hpp"
 
 namespace robodamp::apps {
@@ -53,109 +54,24 @@ std::vector<double> pose_of(const config::RobotModelConfig& m, const PoseArgs& a
   return m.poses.front().joints_deg;
 }
 
-json modes_json(const std::vector<robot::Mode>& modes) {
-  json out = json::array();
-  for (const auto& md : modes)
-    out.push_back({{"freq_hz", md.freq_hz},
-                   {"tcp_modal_stiffness_n_per_m", md.tcp_modal_stiffness_n_per_m},
-                   {"tcp_direction_deg", md.tcp_direction_rad * 180.0 / M_PI}});
-  return out;
-}
-
 int run_frf(const config::RobotModelConfig& m, const PoseArgs& a) {
   const std::vector<double> q = pose_of(m, a);
-  const robot::PlanarChain c = robot::at_pose(m, q);
-  const auto modes = c.modes(static_cast<std::size_t>(a.modes));
-  json r = {{"model", m.source},
-            {"joints_deg", q},
-            {"tcp_m", {c.tcp_position_m().x(), c.tcp_position_m().y()}},
-            {"modes", modes_json(modes)}};
-  // The FRF on a log grid across the band, direct; RCSA's largest difference from it reported.
-  json frf = json::array();
-  double worst = 0.0;
-  std::ostringstream data;
-  for (double f = a.band_hz[0]; f <= a.band_hz[1] * 1.0001; f *= std::pow(a.band_hz[1] / a.band_hz[0], 1.0 / 399.0)) {
-    const Eigen::Matrix2cd g = c.tcp_frf_direct(f), h = c.tcp_frf_rcsa(f);
-    worst = std::max(worst, (g - h).norm() / g.norm());
-    frf.push_back({{"freq_hz", f},
-                   {"xx", {g(0, 0).real(), g(0, 0).imag()}},
-                   {"xy", {g(0, 1).real(), g(0, 1).imag()}},
-                   {"yy", {g(1, 1).real(), g(1, 1).imag()}}});
-    data << f << ' ' << std::abs(g(0, 0)) << ' ' << std::abs(g(1, 1)) << ' ' << std::abs(g(0, 1)) << '\n';
+  robot::PoseReport r = robot::pose_frf_report(m, q, static_cast<std::size_t>(a.modes), a.band_hz[0], a.band_hz[1]);
+  if (!a.csv_path.empty() &&
+      !robot::write_frf_csv(robot::at_pose(m, q), a.band_hz[0], a.band_hz[1], a.csv_step_hz, a.direction, a.csv_path)) {
+    std::cerr << "--csv-out " << a.csv_path << ": cannot write\n";
+    return 1;
   }
-  r["frf_m_per_n"] = frf;
-  if (!a.csv_path.empty()) {  // the identification tools' format, one direction
-    std::ofstream csv(a.csv_path);
-    csv << "freq_hz,re_m_per_n,im_m_per_n\n";
-    csv.precision(12);
-    const int row = a.direction == "xx" ? 0 : 1, col = a.direction == "yy" ? 1 : 0;
-    for (double f = a.band_hz[0]; f <= a.band_hz[1] * 1.0001; f += a.csv_step_hz) {
-      const std::complex<double> h = c.tcp_frf_direct(f)(row, col);
-      csv << f << ',' << h.real() << ',' << h.imag() << '\n';
-    }
-    if (!csv) {
-      std::cerr << "--csv-out " << a.csv_path << ": cannot write\n";
-      return 1;
-    }
-  }
-  r["rcsa_max_relative_difference"] = worst;
-  std::ostringstream t;
-  char b[200];
-  std::snprintf(b, sizeof b, "robot %s at joints", m.name.c_str());
-  t << b;
-  for (double v : q) t << ' ' << v;
-  std::snprintf(b, sizeof b, " deg: TCP at (%.3f, %.3f) m\n", c.tcp_position_m().x(), c.tcp_position_m().y());
-  t << b << "  mode   freq Hz   TCP modal stiffness N/m   TCP direction deg\n";
-  for (std::size_t i = 0; i < modes.size(); ++i) {
-    std::snprintf(b, sizeof b, "  %4zu  %8.3f   %22.4g   %17.1f\n", i + 1, modes[i].freq_hz,
-                  modes[i].tcp_modal_stiffness_n_per_m, modes[i].tcp_direction_rad * 180.0 / M_PI);
-    t << b;
-  }
-  std::snprintf(b, sizeof b, "  TCP FRF %g-%g Hz: receptance coupling (RCSA) within %.2g of the assembled model\n",
-                a.band_hz[0], a.band_hz[1], worst);
-  t << b;
-  if (!also_json_out(a, r)) return 1;
+  if (!also_json_out(a, r.json)) return 1;
   return print_report(
-      r.dump(2), a.json, "pose", t.str(), a.plot_path,
-      [&] {
-        const std::string s =
-            "set terminal pngcairo size 900,600; set output '" + a.plot_path +
-            "'; set logscale xy; set grid; set xlabel 'frequency (Hz)'; set ylabel '|receptance| (m/N)';"
-            " set title 'TCP receptance at the pose'; plot DATA u 1:2 w l lw 2 t 'xx', '' u 1:3 w l lw 2 t 'yy',"
-            " '' u 1:4 w l t 'xy'";
-        return run_gnuplot(s, data.str(), a.plot_path);
-      },
-      a.plot_path);
+      r.json.dump(2), a.json, "pose", r.text, a.plot_path,
+      [&] { return robot::plot_pose_frf(r.plot_data, a.plot_path); }, a.plot_path);
 }
 
 int run_table(const config::RobotModelConfig& m, const PoseArgs& a) {
-  json rows = json::array();
-  std::ostringstream t;
-  t << "robot " << m.name
-    << ": the first mode at each named pose\n  pose        joints deg                    model Hz  "
-       "published predicted Hz  measured Hz\n";
-  for (const auto& p : m.poses) {
-    const robot::PlanarChain c = robot::at_pose(m, p.joints_deg);
-    const auto modes = c.modes(3);
-    char b[240];
-    std::string q;
-    for (double v : p.joints_deg) {
-      if (!q.empty()) q += ' ';
-      q += config::format_number(v);
-    }
-    std::snprintf(b, sizeof b, "  %-10s  %-28s  %8.2f  %22s  %11s\n", p.name.c_str(), q.c_str(), modes[0].freq_hz,
-                  p.predicted_f1_hz ? config::format_number(*p.predicted_f1_hz).c_str() : "-",
-                  p.measured_f1_hz ? config::format_number(*p.measured_f1_hz).c_str() : "-");
-    t << b;
-    rows.push_back({{"name", p.name},
-                    {"joints_deg", p.joints_deg},
-                    {"modes", modes_json(modes)},
-                    {"predicted_f1_hz", p.predicted_f1_hz ? json(*p.predicted_f1_hz) : json(nullptr)},
-                    {"measured_f1_hz", p.measured_f1_hz ? json(*p.measured_f1_hz) : json(nullptr)}});
-  }
-  const json r = {{"model", m.source}, {"poses", rows}};
-  if (!also_json_out(a, r)) return 1;
-  return print_report(r.dump(2), a.json, "pose", t.str(), "", {}, "");
+  const robot::PoseReport r = robot::pose_table_report(m);
+  if (!also_json_out(a, r.json)) return 1;
+  return print_report(r.json.dump(2), a.json, "pose", r.text, "", {}, "");
 }
 
 int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
