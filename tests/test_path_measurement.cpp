@@ -88,12 +88,20 @@ TEST(PathMeasurement, TheRobotStopsTwiceEachStopIdentifiesAsAStoppedMeasurementT
   const json index = json::parse(test::read_file(dir + "/poses.json"));
   ASSERT_EQ(index.at("poses").size(), 2U) << index.dump(2);
   const std::string stopped = stopped_config(f);
+  // Each measured stop in the index with its folder. The dwells are numbered as the robot was seen standing:
+  // on a loaded machine the joints, polled on the wall clock while the loop runs on the virtual one, can look
+  // still during the move between the stops; that dwell is skipped with its reason (the robot moved before
+  // the chirp) and the next stop is dwell_3.
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const json& p = index["poses"][i];
-    ASSERT_EQ(p.at("dir"), "dwell_" + std::to_string(i + 1));
+    const std::string name = p.at("dir").get<std::string>();
+    EXPECT_EQ(name.rfind("dwell_", 0), 0U) << index.dump(2);
+    if (name != "dwell_" + std::to_string(i + 1)) {
+      EXPECT_NE(log.find("not measured"), std::string::npos) << "a dwell was left out without its reason:\n" << log;
+    }
     for (std::size_t j = 0; j < 3; ++j)  // read from the registers (0.01 deg per count)
       EXPECT_NEAR(p.at("joints_deg")[j].get<double>(), poses[i][j], 0.006) << i << " joint " << j + 1;
-    const std::string at = dir + "/dwell_" + std::to_string(i + 1);
+    const std::string at = dir + "/" + name;
     // The shared recording replays bit for bit, the on-command chirps included.
     Child replay({"replay", at + "/" + identify::kRecordingName}, f.dir + "/replay.log");
     ASSERT_EQ(replay.wait(), 0) << test::read_file(f.dir + "/replay.log");
@@ -110,7 +118,7 @@ TEST(PathMeasurement, TheRobotStopsTwiceEachStopIdentifiesAsAStoppedMeasurementT
   // The index is what pose fit and pose modes read (--measurements DIR): both stops, at the joints read.
   const identify::PoseMeasurements pm = identify::read_pose_measurements({dir});
   ASSERT_EQ(pm.frfs.size(), 2U);
-  EXPECT_EQ(pm.frfs[1].name, "dwell_2");
+  EXPECT_EQ(pm.frfs[1].name, index["poses"][1].at("dir").get<std::string>());
   EXPECT_NEAR(pm.frfs[1].joints_deg[1], 100.0, 0.006);
   std::filesystem::remove_all(f.dir);
 }
