@@ -138,7 +138,9 @@ double refined_onset(const std::vector<double>& x, double rate_hz, double rpm, d
     return std::sqrt(ss / static_cast<double>(per));
   };
   auto b = static_cast<std::size_t>(window_start_s * rate_hz);
-  if (b + per >= x.size() || rms_from(b) <= floor) return window_start_s;  // not above the floor at the window's start
+  // Not refined where the window starts less than a revolution into the recording (no revolution before it to
+  // compare with: x(t - one revolution) would read before the first sample) or the floor is not crossed there.
+  if (b < per + 1 || b + per >= x.size() || rms_from(b) <= floor) return window_start_s;
   while (b >= per + static_cast<std::size_t>(std::ceil(rev)) + 1 && rms_from(b - per) > floor) b -= per;
   return static_cast<double>(b) / rate_hz;
 }
