@@ -255,8 +255,8 @@ TEST(ChatterListen, TheCommandReadsTablesWavAndUniversalFiles) {
                            json + " --plot-dir " + quiet_plots);
   ASSERT_EQ(quiet.status, 0) << quiet.out;
   EXPECT_NE(quiet.out.find("NO CHATTER in 3 windows"), std::string::npos) << quiet.out;
-  for (const auto& w : nlohmann::json::parse(robodamp::test::read_file(json))["windows"])
-    EXPECT_EQ(w["verdict"], "stable") << quiet.out;
+  const auto quiet_report = nlohmann::json::parse(robodamp::test::read_file(json));  // named: the loop reads it
+  for (const auto& w : quiet_report["windows"]) EXPECT_EQ(w["verdict"], "stable") << quiet.out;
   for (const char* png : {"chatter_spectrogram.png", "chatter_verdict.png"})
     EXPECT_GT(std::filesystem::file_size(quiet_plots + "/" + png), 5000u) << png;
   const Result no_teeth = run("chatter --signal " + tmp.file("cut.uff"));
