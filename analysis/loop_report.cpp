@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 
+#include "fields/json.hpp"
 #include "plot/gnuplot.hpp"
 
 namespace robodamp::analysis {
@@ -14,7 +15,7 @@ using nlohmann::json;
 
 namespace {
 
-json optional_number(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+using fields::number_or_null;
 
 json frf_json(const FrfResult& f, bool stable) {
   return {{"name", f.name},
@@ -25,12 +26,7 @@ json frf_json(const FrfResult& f, bool stable) {
           {"improvement_pct", stable ? json(f.improvement_pct) : json(nullptr)}};
 }
 
-std::string fmt(const json& v, const char* format) {
-  if (v.is_null()) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v.get<double>());
-  return b;
-}
+using fields::number_text;
 
 }  // namespace
 
@@ -44,12 +40,12 @@ json analysis_report(const LoopModel& m, const AnalysisResult& r) {
   j["stable_continuous"] = r.stable_continuous;
   j["spectral_radius"] = r.spectral_radius;
   j["nyquist_encirclements"] = r.nyquist_encirclements;
-  j["max_stable_gain_ns_per_m"] = optional_number(r.max_stable_gain_ns_per_m);
-  j["gain_margin_db"] = optional_number(r.margins.gain_margin_db);
-  j["phase_margin_deg"] = optional_number(r.margins.phase_margin_deg);
-  j["delay_margin_ms"] = optional_number(r.margins.delay_margin_ms);
-  j["gain_crossover_hz"] = optional_number(r.margins.gain_crossover_hz);
-  j["phase_crossover_hz"] = optional_number(r.margins.phase_crossover_hz);
+  j["max_stable_gain_ns_per_m"] = number_or_null(r.max_stable_gain_ns_per_m);
+  j["gain_margin_db"] = number_or_null(r.margins.gain_margin_db);
+  j["phase_margin_deg"] = number_or_null(r.margins.phase_margin_deg);
+  j["delay_margin_ms"] = number_or_null(r.margins.delay_margin_ms);
+  j["gain_crossover_hz"] = number_or_null(r.margins.gain_crossover_hz);
+  j["phase_crossover_hz"] = number_or_null(r.margins.phase_crossover_hz);
   j["recommended_polarity"] = r.recommended_polarity;
   j["polarity_reason"] = r.polarity_reason;
   j["modes"] = json::array();
@@ -82,20 +78,20 @@ std::string analysis_table(const json& r) {
      << " N s/m, polarity " << std::showpos << r["polarity"].get<int>() << std::noshowpos << ", "
      << r["loop_rate_hz"].get<double>() << " Hz)\n";
   os << "  discrete loop:   " << (r["stable"].get<bool>() ? "STABLE" : "UNSTABLE") << " (spectral radius "
-     << fmt(r["spectral_radius"], "%.6f") << ", Nyquist encirclements " << r["nyquist_encirclements"].get<int>()
+     << number_text(r["spectral_radius"], "%.6f") << ", Nyquist encirclements " << r["nyquist_encirclements"].get<int>()
      << ")\n";
   os << "  continuous loop: " << (r["stable_continuous"].get<bool>() ? "stable" : "unstable") << "\n";
-  os << "  max stable K " << fmt(r["max_stable_gain_ns_per_m"], "%.1f") << " N s/m, gain margin "
-     << fmt(r["gain_margin_db"], "%.2f") << " dB, "
+  os << "  max stable K " << number_text(r["max_stable_gain_ns_per_m"], "%.1f") << " N s/m, gain margin "
+     << number_text(r["gain_margin_db"], "%.2f") << " dB, "
      << (r["gain_crossover_hz"].is_null()
              ? std::string("no gain crossover (the loop gain stays below 1: no phase margin to state)")
-             : "phase margin " + fmt(r["phase_margin_deg"], "%.1f") + " deg at " + fmt(r["gain_crossover_hz"], "%.2f") +
-                   " Hz")
-     << ", delay margin " << fmt(r["delay_margin_ms"], "%.2f") << " ms\n";
+             : "phase margin " + number_text(r["phase_margin_deg"], "%.1f") + " deg at " +
+                   number_text(r["gain_crossover_hz"], "%.2f") + " Hz")
+     << ", delay margin " << number_text(r["delay_margin_ms"], "%.2f") << " ms\n";
   if (!r["gain_margin_db"].is_null() && r["gain_margin_db"].get<double>() < 6.0)
-    os << "  WARNING: gain margin " << fmt(r["gain_margin_db"], "%.2f") << " dB, below 6 dB\n";
+    os << "  WARNING: gain margin " << number_text(r["gain_margin_db"], "%.2f") << " dB, below 6 dB\n";
   if (!r["phase_margin_deg"].is_null() && r["phase_margin_deg"].get<double>() < 45.0)
-    os << "  WARNING: phase margin " << fmt(r["phase_margin_deg"], "%.1f") << " deg, below 45 deg\n";
+    os << "  WARNING: phase margin " << number_text(r["phase_margin_deg"], "%.1f") << " deg, below 45 deg\n";
   if (r.contains("spindle")) {
     const auto& sp = r["spindle"];
     std::snprintf(line, sizeof line, "  spindle %.0f rpm x %.0f teeth = %.2f Hz: %zu harmonic notches in the loop\n",
@@ -110,15 +106,17 @@ std::string analysis_table(const json& r) {
   }
   if (r.contains("job_limits")) {
     const auto& l = r["job_limits"];
-    auto mm = [](const json& v) { return v.is_null() ? std::string("none below 1 m") : fmt(v, "%.3f") + " mm"; };
-    os << "  the job (spindle.job) at " << fmt(l["rpm"], "%.0f") << " rpm, depth " << fmt(l["depth_mm"], "%.3f")
-       << " mm: limit open " << mm(l["open_mm"]) << " (" << l["open_method"].get<std::string>() << "), damped "
-       << mm(l["damped_mm"]) << " (" << l["damped_method"].get<std::string>() << " at "
-       << fmt(l["analysed_rpm"], "%.2f") << " rpm)\n";
+    auto mm = [](const json& v) {
+      return v.is_null() ? std::string("none below 1 m") : number_text(v, "%.3f") + " mm";
+    };
+    os << "  the job (spindle.job) at " << number_text(l["rpm"], "%.0f") << " rpm, depth "
+       << number_text(l["depth_mm"], "%.3f") << " mm: limit open " << mm(l["open_mm"]) << " ("
+       << l["open_method"].get<std::string>() << "), damped " << mm(l["damped_mm"]) << " ("
+       << l["damped_method"].get<std::string>() << " at " << number_text(l["analysed_rpm"], "%.2f") << " rpm)\n";
   }
   if (r["stable"].get<bool>())
-    os << "  quiet cell: command " << fmt(r["quiet_command_rms_v"], "%.4f") << " V RMS (density peak at "
-       << fmt(r["quiet_command_peak_hz"], "%.2f") << " Hz; sensor noise, ADC, drive vibration)\n";
+    os << "  quiet cell: command " << number_text(r["quiet_command_rms_v"], "%.4f") << " V RMS (density peak at "
+       << number_text(r["quiet_command_peak_hz"], "%.2f") << " Hz; sensor noise, ADC, drive vibration)\n";
   os << "  recommended polarity " << std::showpos << r["recommended_polarity"].get<int>() << std::noshowpos << ": "
      << r["polarity_reason"].get<std::string>() << "\n";
   for (const auto& mp : r["modes"]) {
@@ -136,10 +134,10 @@ std::string analysis_table(const json& r) {
     const auto& f = r["frfs"][i];
     const auto& c = r["frfs_continuous"][i];
     std::snprintf(line, sizeof line, "  %-22s %14s %10s %14s %10s %11s%% %13s%%\n",
-                  f["name"].get<std::string>().c_str(), fmt(f["open_peak_m_per_n"], "%.4g").c_str(),
-                  fmt(f["open_peak_freq_hz"], "%.2f").c_str(), fmt(f["closed_peak_m_per_n"], "%.4g").c_str(),
-                  fmt(f["peak_freq_hz"], "%.2f").c_str(), fmt(f["improvement_pct"], "%.1f").c_str(),
-                  fmt(c["improvement_pct"], "%.1f").c_str());
+                  f["name"].get<std::string>().c_str(), number_text(f["open_peak_m_per_n"], "%.4g").c_str(),
+                  number_text(f["open_peak_freq_hz"], "%.2f").c_str(),
+                  number_text(f["closed_peak_m_per_n"], "%.4g").c_str(), number_text(f["peak_freq_hz"], "%.2f").c_str(),
+                  number_text(f["improvement_pct"], "%.1f").c_str(), number_text(c["improvement_pct"], "%.1f").c_str());
     os << line;
   }
   for (const auto& n : r["notes"]) os << "  note: " << n.get<std::string>() << "\n";

@@ -12,6 +12,7 @@
 #include "analysis/notch_speed_map.hpp"
 #include "analysis/pose_schedule.hpp"
 #include "analysis/speed_schedule_check.hpp"
+#include "fields/json.hpp"
 #include "milling/study_report.hpp"
 #include "apps/cli.hpp"
 #include "config/milling_config.hpp"
@@ -26,14 +27,9 @@ using nlohmann::json;
 
 namespace {
 
-json optional_number(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+using fields::number_or_null;
 
-std::string fmt(const json& v, const char* format) {
-  if (v.is_null()) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v.get<double>());
-  return b;
-}
+using fields::number_text;
 
 struct AnalyzeArgs {
   std::string config_path{default_cell_config()};
@@ -113,8 +109,8 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
                        {"polarity", r.polarity},
                        {"k_max_ns_per_m", r.k_max_ns_per_m},
                        {"k_max_pose_deg", r.k_max_pose_deg},
-                       {"centre_gain_margin_db", optional_number(a.margins.gain_margin_db)},
-                       {"centre_phase_margin_deg", optional_number(a.margins.phase_margin_deg)},
+                       {"centre_gain_margin_db", number_or_null(a.margins.gain_margin_db)},
+                       {"centre_phase_margin_deg", number_or_null(a.margins.phase_margin_deg)},
                        {"improvement_centre_pct", r.improvement_centre_pct},
                        {"worst_mode_improvement_pct", r.worst_mode_improvement_pct},
                        {"worst_mode_hz", r.worst_mode_hz},
@@ -141,8 +137,8 @@ int print_pose_schedule(const config::Config& cfg, const JsonOut& out) {
     std::printf("%-12s %-26s %-18s %9.2f %+4d %9.0f %11.0f %9s %9s %8.1f\n", r["name"].get<std::string>().c_str(),
                 centre.c_str(), dom, r["dominant_hz"].get<double>(), r["polarity"].get<int>(),
                 r["gain_ns_per_m"].get<double>(), r["k_max_ns_per_m"].get<double>(),
-                fmt(r["centre_gain_margin_db"], "%.1f").c_str(), fmt(r["centre_phase_margin_deg"], "%.1f").c_str(),
-                r["improvement_centre_pct"].get<double>());
+                number_text(r["centre_gain_margin_db"], "%.1f").c_str(),
+                number_text(r["centre_phase_margin_deg"], "%.1f").c_str(), r["improvement_centre_pct"].get<double>());
   }
   std::printf("K_max is the smallest over each region's %d^%zu grid; margins and improvement at its centre\n",
               cfg.pose_schedule->grid_points, cfg.pose_schedule->joints());
@@ -194,12 +190,12 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
   json j = json::array();
   for (const auto& l : loops) {
     char line[300];
-    std::snprintf(line, sizeof line,
-                  "    controller %zu at K %6.0f N s/m (%zu band%s from %.0f rpm): %s, GM %s dB, %s\n", l.controller,
-                  l.gain_ns_per_m, l.bands, l.bands == 1 ? "" : "s", l.rpm_from, l.stable ? "stable" : "UNSTABLE",
-                  l.margins.gain_margin_db ? fmt(json(*l.margins.gain_margin_db), "%.1f").c_str() : "-",
-                  l.margins.phase_margin_deg ? ("PM " + fmt(json(*l.margins.phase_margin_deg), "%.1f") + " deg").c_str()
-                                             : "no gain crossover");
+    std::snprintf(
+        line, sizeof line, "    controller %zu at K %6.0f N s/m (%zu band%s from %.0f rpm): %s, GM %s dB, %s\n",
+        l.controller, l.gain_ns_per_m, l.bands, l.bands == 1 ? "" : "s", l.rpm_from, l.stable ? "stable" : "UNSTABLE",
+        l.margins.gain_margin_db ? number_text(json(*l.margins.gain_margin_db), "%.1f").c_str() : "-",
+        l.margins.phase_margin_deg ? ("PM " + number_text(json(*l.margins.phase_margin_deg), "%.1f") + " deg").c_str()
+                                   : "no gain crossover");
     os << line;
     for (const auto& w : l.warnings) os << "      WARNING: " << w << "\n";
     for (const auto& n : l.notes) os << "      note: " << n << "\n";
@@ -207,8 +203,8 @@ std::string speed_schedule_section(const config::Config& cfg, json& report) {
                  {"gain_ns_per_m", l.gain_ns_per_m},
                  {"bands", l.bands},
                  {"stable", l.stable},
-                 {"gain_margin_db", optional_number(l.margins.gain_margin_db)},
-                 {"phase_margin_deg", optional_number(l.margins.phase_margin_deg)},
+                 {"gain_margin_db", number_or_null(l.margins.gain_margin_db)},
+                 {"phase_margin_deg", number_or_null(l.margins.phase_margin_deg)},
                  {"warnings", l.warnings},
                  {"notes", l.notes}});
   }

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
+#include "fields/json.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/cut_report.hpp"
 #include "milling/study_report.hpp"
@@ -32,7 +33,7 @@ namespace {
 
 constexpr double kHilRelTol = 1e-2;  // each step of the emulator's bisection is a pair of processes
 
-json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+using fields::finite_or_null;
 
 struct CutArgs {
   std::string job_path{default_job()};  // --job (the deprecated --config)

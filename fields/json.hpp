@@ -2,6 +2,9 @@
 // with '/' nested ("derate/probes" is {"derate": {"probes": ...}}), and back.
 #pragma once
 
+#include <cmath>
+#include <cstdio>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -77,6 +80,22 @@ template <class S>
       },
       list_of<S>());
   return s;
+}
+
+// A report's number: null where it is not finite or not there.
+[[nodiscard]] inline nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+[[nodiscard]] inline nlohmann::json number_or_null(const std::optional<double>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
+
+// A report's JSON number as text with a printf format ("%.3f"), "-" for null.
+[[nodiscard]] inline std::string number_text(const nlohmann::json& v, const char* format) {
+  if (v.is_null()) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, format, v.get<double>());
+  return b;
 }
 
 }  // namespace robodamp::fields

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "analysis/fft.hpp"
+#include "fields/json.hpp"
 #include "milling/chatter.hpp"
 #include "plot/gnuplot.hpp"
 
@@ -14,11 +15,7 @@ namespace robodamp::milling {
 
 using nlohmann::json;
 
-namespace {
-
-json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-}  // namespace
+using fields::finite_or_null;
 
 json cut_json(const CutJob& job, const CutOutcome& o, double wall_s) {
   const auto& r = o.record;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "config/robot_model_config.hpp"
+#include "fields/json.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/chatter.hpp"
 #include "milling/lobes.hpp"
@@ -24,7 +25,7 @@ namespace {
 // What the zero-order method's depths are: a fast preview, never a promise (docs/milling.md).
 constexpr const char* kPreview = kZeroOrderPreview;
 
-json finite_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+using fields::finite_or_null;
 
 config::StructureConfig selected(const config::MillingConfig& cfg, const StudyOptions& o) {
   return selected_structure(cfg, o.structure, o.controller_path);
@@ -95,12 +96,7 @@ double pct_change(const json& open, const json& damped) {
   return (damped.get<double>() / open.get<double>() - 1.0) * 100.0;
 }
 
-std::string fmt(const json& v, const char* format) {
-  if (v.is_null()) return "-";
-  char b[64];
-  std::snprintf(b, sizeof b, format, v.get<double>());
-  return b;
-}
+using fields::number_text;
 
 std::string tool_text(const config::MillingConfig& c) {
   std::ostringstream os;
@@ -255,20 +251,22 @@ std::string lobes_table(const json& r) {
   auto one = [&](const json& d, const char* label) {
     const std::string method = d["method"].get<std::string>();
     const bool sdm = method != kPreview;
-    os << "  " << label << ": minimum limiting depth " << fmt(d["min_b_lim_mm"], "%.3f") << " mm (" << method << ") at "
-       << fmt(d["min_rpm"], "%.0f") << " rpm (chatter " << fmt(d["min_chatter_hz"], "%.1f") << " Hz); ";
+    os << "  " << label << ": minimum limiting depth " << number_text(d["min_b_lim_mm"], "%.3f") << " mm (" << method
+       << ") at " << number_text(d["min_rpm"], "%.0f") << " rpm (chatter " << number_text(d["min_chatter_hz"], "%.1f")
+       << " Hz); ";
     if (sdm)
       os << d["curve"].size() << " speeds, " << d["steps_per_period"].get<int>() << " steps per tooth period, ";
     else
       os << d["frequency_points"].get<std::size_t>() << " chatter frequencies, ";
-    os << fmt(d["diagram_ms"], "%.1f") << " ms\n";
+    os << number_text(d["diagram_ms"], "%.1f") << " ms\n";
     for (const auto& a : d["at_rpm"]) {
-      os << "    at " << fmt(a["rpm"], sdm ? "%9.2f" : "%7.0f") << " rpm: b_lim " << fmt(a["b_lim_mm"], "%.3f")
+      os << "    at " << number_text(a["rpm"], sdm ? "%9.2f" : "%7.0f") << " rpm: b_lim "
+         << number_text(a["b_lim_mm"], "%.3f")
          << (sdm ? " mm (" + method + ", " + a["type"].get<std::string>() + ")" : " mm (zero-order direct test)")
-         << (a["b_lim_lobes_mm"].is_null()
-                 ? std::string()
-                 : (sdm ? ", zero-order preview " : ", zero-order lobes ") + fmt(a["b_lim_lobes_mm"], "%.3f") + " mm")
-         << ", chatter " << fmt(a["chatter_hz"], "%.1f") << " Hz\n";
+         << (a["b_lim_lobes_mm"].is_null() ? std::string()
+                                           : (sdm ? ", zero-order preview " : ", zero-order lobes ") +
+                                                 number_text(a["b_lim_lobes_mm"], "%.3f") + " mm")
+         << ", chatter " << number_text(a["chatter_hz"], "%.1f") << " Hz\n";
     }
   };
   os << "Stability lobes (" << r["method"].get<std::string>()
@@ -278,9 +276,10 @@ std::string lobes_table(const json& r) {
   one(r, "open  ");
   if (r.contains("damped")) {
     one(r["damped"], "damped");
-    os << "  change with active damping: minimum limiting depth " << fmt(r["gain"]["min_b_lim_change_pct"], "%+.1f")
-       << " %, at the spindle speed " << fmt(r["gain"]["at_spindle_rpm"], "%.0f") << " rpm "
-       << fmt(r["gain"]["at_spindle_change_pct"], "%+.1f") << " %"
+    os << "  change with active damping: minimum limiting depth "
+       << number_text(r["gain"]["min_b_lim_change_pct"], "%+.1f") << " %, at the spindle speed "
+       << number_text(r["gain"]["at_spindle_rpm"], "%.0f") << " rpm "
+       << number_text(r["gain"]["at_spindle_change_pct"], "%+.1f") << " %"
        << (r["gain"]["at_spindle_change_pct"].is_number() && r["gain"]["at_spindle_change_pct"].get<double>() < 0.0
                ? " (the damper at this fixed gain LOWERS the limit at the job's speed)"
                : "")
@@ -291,9 +290,10 @@ std::string lobes_table(const json& r) {
     one(s, "sched.");
     os << "  change with the speed schedule (" << s["bands"].get<std::size_t>() << " bands of "
        << s["config"].get<std::string>() << "): minimum limiting depth "
-       << fmt(r["gain"]["scheduled_min_b_lim_change_pct"], "%+.1f") << " %, at the spindle speed "
-       << fmt(r["gain"]["scheduled_at_spindle_change_pct"], "%+.1f") << " %; below the open loop (by > 0.5 %) at "
-       << s["below_open"].get<std::size_t>() << " of " << s["curve"].size() << " speeds\n";
+       << number_text(r["gain"]["scheduled_min_b_lim_change_pct"], "%+.1f") << " %, at the spindle speed "
+       << number_text(r["gain"]["scheduled_at_spindle_change_pct"], "%+.1f")
+       << " %; below the open loop (by > 0.5 %) at " << s["below_open"].get<std::size_t>() << " of "
+       << s["curve"].size() << " speeds\n";
   }
   for (const auto& n : r["notes"]) os << "  note: " << n.get<std::string>() << '\n';
   if (r.contains("damped"))
@@ -326,13 +326,14 @@ std::string plot_lobes(const json& r, const std::string& path) {
   s << "set arrow from " << r["spindle_rpm"].get<double>() << ", graph 0 to " << r["spindle_rpm"].get<double>()
     << ", graph 1 nohead dt 3 lc rgb 'gray40'\n";
   s << "plot DATA index 0 u 1:2 w l lw 2 lc rgb '#c0392b' t 'open loop, " << r["method"].get<std::string>() << " (min "
-    << fmt(r["min_b_lim_mm"], "%.3f") << " mm)'";
+    << number_text(r["min_b_lim_mm"], "%.3f") << " mm)'";
   if (damped)
     s << ", DATA index 1 u 1:2 w l lw 2 lc rgb '#2471a3' t 'active damping at a fixed K, "
-      << r["damped"]["method"].get<std::string>() << " (min " << fmt(r["damped"]["min_b_lim_mm"], "%.3f") << " mm)'";
+      << r["damped"]["method"].get<std::string>() << " (min " << number_text(r["damped"]["min_b_lim_mm"], "%.3f")
+      << " mm)'";
   if (scheduled)
     s << ", DATA index 2 u 1:2 w l lw 2.5 lc rgb '#27ae60' t 'active damping by the speed schedule (min "
-      << fmt(r["scheduled"]["min_b_lim_mm"], "%.3f") << " mm)'";
+      << number_text(r["scheduled"]["min_b_lim_mm"], "%.3f") << " mm)'";
   s << '\n';
   return plot::run_gnuplot(s.str(), data.str(), path);
 }
@@ -345,9 +346,9 @@ std::string sle_table(const json& r) {
     double lo = 1e300, hi = -1e300;
     for (const auto& p : d["map"])
       lo = std::min(lo, p["sle_um"].get<double>()), hi = std::max(hi, p["sle_um"].get<double>());
-    os << "  " << label << ": SLE over " << fmt(d["map"].front()["rpm"], "%.0f") << "-"
-       << fmt(d["map"].back()["rpm"], "%.0f") << " rpm at the configured cut: " << fmt(json(lo), "%.1f") << " to "
-       << fmt(json(hi), "%.1f") << " um";
+    os << "  " << label << ": SLE over " << number_text(d["map"].front()["rpm"], "%.0f") << "-"
+       << number_text(d["map"].back()["rpm"], "%.0f") << " rpm at the configured cut: " << number_text(json(lo), "%.1f")
+       << " to " << number_text(json(hi), "%.1f") << " um";
     if (const int u = d["map_unstable_points"].get<int>(); u > 0)
       os << " (the cut chatters at " << u << " of " << d["map"].size() << " speeds by the "
          << d["stability_method"].get<std::string>() << ": SLE not meaningful there)";
