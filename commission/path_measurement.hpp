@@ -7,7 +7,8 @@
 // a stopped measurement's. No manual stop, no --pose typed: the pose is the one the robot reported.
 //
 // Each stop the robot makes is a dwell, numbered from 1 in the order the robot makes them (the emulator
-// numbers its trajectory's dwells the same way): DIR/dwell_<k>/ holds its measurement.json (the joints
+// numbers its trajectory's dwells the same way); a pause shorter than commissioning.settle_s is not a stop
+// (no chirp could start there) and takes no number: DIR/dwell_<k>/ holds its measurement.json (the joints
 // read during the chirp, the chirp's start in the run's recording), the run's recording (a hard link), and,
 // from the plant side, its impact FRFs: each is a `robodamp measure` directory for `identify all`, and
 // DIR/poses.json indexes them for `pose fit --measurements` and `pose modes --measurements`.
@@ -42,6 +43,7 @@ struct DwellMeasurement {
 struct PathMeasureOutcome {
   MeasureOutcome run;                    // the run as a whole (status, message, state, trip, saturation, frames)
   std::vector<DwellMeasurement> dwells;  // every stop seen, measured or not
+  int pauses{0};                         // stillness shorter than commissioning.settle_s: not a stop, no number
   [[nodiscard]] int measured() const;
 };
 

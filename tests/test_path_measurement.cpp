@@ -14,6 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "child_process.hpp"
+#include "commission/dwell_watch.hpp"
 #include "hil_files.hpp"
 #include "identify/commissioning.hpp"
 #include "identify/pose_measurements.hpp"
@@ -88,17 +89,14 @@ TEST(PathMeasurement, TheRobotStopsTwiceEachStopIdentifiesAsAStoppedMeasurementT
   const json index = json::parse(test::read_file(dir + "/poses.json"));
   ASSERT_EQ(index.at("poses").size(), 2U) << index.dump(2);
   const std::string stopped = stopped_config(f);
-  // Each measured stop in the index with its folder. The dwells are numbered as the robot was seen standing:
-  // on a loaded machine the joints, polled on the wall clock while the loop runs on the virtual one, can look
-  // still during the move between the stops; that dwell is skipped with its reason (the robot moved before
-  // the chirp) and the next stop is dwell_3.
+  // Each measured stop in the index with its folder, numbered as the emulator numbers its stops. On a loaded
+  // machine the joints, polled on the wall clock while the loop runs on the virtual one, can look still during
+  // the move between the stops (the CI run at 6e17f3f named the second stop dwell_4 while the hammer's FRFs were
+  // in dwell_2): such a pause is shorter than commissioning.settle_s, logged, and takes no number.
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const json& p = index["poses"][i];
     const std::string name = p.at("dir").get<std::string>();
-    EXPECT_EQ(name.rfind("dwell_", 0), 0U) << index.dump(2);
-    if (name != "dwell_" + std::to_string(i + 1)) {
-      EXPECT_NE(log.find("not measured"), std::string::npos) << "a dwell was left out without its reason:\n" << log;
-    }
+    EXPECT_EQ(name, "dwell_" + std::to_string(i + 1)) << index.dump(2) << log;
     for (std::size_t j = 0; j < 3; ++j)  // read from the registers (0.01 deg per count)
       EXPECT_NEAR(p.at("joints_deg")[j].get<double>(), poses[i][j], 0.006) << i << " joint " << j + 1;
     const std::string at = dir + "/" + name;
@@ -121,6 +119,75 @@ TEST(PathMeasurement, TheRobotStopsTwiceEachStopIdentifiesAsAStoppedMeasurementT
   EXPECT_EQ(pm.frfs[1].name, index["poses"][1].at("dir").get<std::string>());
   EXPECT_NEAR(pm.frfs[1].joints_deg[1], 100.0, 0.006);
   std::filesystem::remove_all(f.dir);
+}
+
+// A robot whose joints are a function of loop time, and a loop that starts the chirp the tick after it is
+// asked to: the dwell watch driven frame by frame, no processes.
+struct ScriptedRobot final : commission::DwellCell {
+  std::vector<double> (*pose_at)(double){nullptr};
+  double now_s{0.0};
+  bool start_posted{false}, stop_requested{false};
+  [[nodiscard]] std::vector<double> robot_pose_deg() const override { return pose_at(now_s); }
+  [[nodiscard]] bool post(const rt::OperatorCommand& c) override {
+    start_posted = start_posted || c.kind == rt::CommandKind::kStartExcitation;
+    return true;
+  }
+  void request_stop() noexcept override { stop_requested = true; }
+};
+
+commission::DwellWatch watched(ScriptedRobot& robot, double run_s, int dwells) {
+  config::Config cfg;
+  cfg.loop.rate_hz = 1000.0;
+  cfg.commissioning.settle_s = 3.0, cfg.commissioning.chirp_period_s = 6.0, cfg.commissioning.chirp_periods = 3;
+  analysis::CommissioningPlan plan;
+  plan.duration_s = 54.0;
+  commission::PathMeasureOptions o;
+  o.dwells = dwells;
+  commission::DwellWatch watch(cfg, plan, o);
+  watch.attach(&robot);
+  rt::TelemetryFrame f;
+  f.state = static_cast<std::uint8_t>(rt::State::kActive);
+  for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(run_s * cfg.loop.rate_hz) && !robot.stop_requested; ++k) {
+    f.tick = k, f.time_s = static_cast<double>(k) / cfg.loop.rate_hz, robot.now_s = f.time_s;
+    f.command_kind =
+        static_cast<std::uint8_t>(robot.start_posted ? rt::CommandKind::kStartExcitation : rt::CommandKind::kNone);
+    robot.start_posted = false;
+    watch.on_frame(f);
+  }
+  return watch;
+}
+
+// The CI run at 6e17f3f: the joints' readings stood still for a moment during the move between two stops, the
+// watch numbered that a dwell, and the second stop became dwell_4 while the hammer's FRFs were in dwell_2. A
+// stillness shorter than commissioning.settle_s is a pause: no number; a stop the robot leaves during the chirp
+// keeps its number (the plant side hammers there) and is skipped with its reason.
+TEST(PathMeasurement, APauseShorterThanTheSettlingTimeTakesNoDwellNumber) {
+  ScriptedRobot robot;
+  robot.pose_at = [](double t) -> std::vector<double> {
+    if (t < 60.0) return {-100, 20, 90};
+    if (t < 66.0) {
+      const double s = t >= 62.0 && t < 63.5 ? 62.0 : t;  // the reading stands for 1.5 s mid-move
+      return {-100, 20 + 80 * (s - 60.0) / 6.0, 90};
+    }
+    if (t < 126.0) return {-100, 100, 90};
+    if (t < 127.0) return {-100, 100 - (t - 126.0), 90};
+    if (t < 137.0) return {-100, 99, 90};  // leaves during the chirp (from 130 s)
+    return {-100, 99 - (t - 137.0), 90};
+  };
+  const commission::DwellWatch watch = watched(robot, 150.0, 3);
+  const auto& d = watch.dwells();
+  ASSERT_EQ(d.size(), 3U);
+  EXPECT_EQ(watch.pauses(), 1);
+  EXPECT_EQ(d[0].name, "dwell_1");
+  EXPECT_EQ(d[1].name, "dwell_2");
+  EXPECT_EQ(d[2].name, "dwell_3");
+  EXPECT_TRUE(d[0].measured && d[1].measured);
+  EXPECT_NEAR(d[1].joints_deg[1], 100.0, 1e-9);
+  EXPECT_NEAR(d[1].still_s, 66.0, 0.02);
+  EXPECT_NEAR(d[1].chirp_start_s, 69.0, 0.02);  // settle_s after the stop
+  EXPECT_FALSE(d[2].measured);
+  EXPECT_NE(d[2].skipped.find("during the chirp"), std::string::npos) << d[2].skipped;
+  EXPECT_FALSE(robot.stop_requested);  // 2 of 3 measured: the run goes on
 }
 
 TEST(PathMeasurement, NoJointsToFollowAndStopsTooShortAreRefusedByName) {
