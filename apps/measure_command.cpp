@@ -66,8 +66,7 @@ int measure_along_path(const MeasureArgs& a, const commission::MeasureOptions& o
                   d.skipped.c_str());
   }
   if (r.pauses > 0)
-    std::printf("robodamp measure: %d pauses shorter than commissioning.settle_s, not stops (see the log)\n",
-                r.pauses);
+    std::printf("robodamp measure: %d pauses shorter than commissioning.settle_s, not stops (see the log)\n", r.pauses);
   std::printf(
       "robodamp measure: %d of %d dwells measured along the path; state %s, trip %s, %llu saturated ticks, peak "
       "command %.3f V; index %s/poses.json\n",
