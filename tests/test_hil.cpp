@@ -108,11 +108,21 @@ TEST(Hil, LockstepImprovementMatchesTheInProcessBench) {
   }
 }
 
+// The shipped trips are tight for a machine both processes share with other jobs: this 2-core VM stalls a
+// process 100-130 ms at a time under load (measured with a 1 ms sleeper beside a CPU hog), which is a stale
+// sensor at 100 ms and, once the socket's queue of frames overflows, a burst of lost frames. Here: stale
+// 300 ms, up to 1024 lost frames a second, no overrun trip (the suite tripped on them before the fault each
+// test injects, on 2026-12-06). The checks are against what is configured here, in ticks the loop ran;
+// times are reported.
+const std::vector<std::pair<std::string, std::string>> kSharedMachine{
+    {"stale_sensor_cycles: 250", "stale_sensor_cycles: 1500\n  overrun_cycles: 1000000"},
+    {"lost_frames_fault: 5", "lost_frames_fault: 1024"}};
+
 TEST(Hil, RealtimeRunReportsItsTimingAndPullingThePlugTripsSafe) {
   // The shipped overrun trip is tight (10 overruns); this machine is shared by both processes and the CI's
-  // other jobs, so the test loosens it (and the stale trip, to 100 ms) and checks against what it configured.
-  const HilFiles f =
-      hil_files("realtime", {{"stale_sensor_cycles: 250", "stale_sensor_cycles: 500\n  overrun_cycles: 1000000"}});
+  // other jobs, so the test loosens it, the stale trip and the lost frames' (kSharedMachine) and checks
+  // against what it configured.
+  const HilFiles f = hil_files("realtime", kSharedMachine);
   const config::Config cfg = config::load_config_file(f.config);
   Child plant({"plant", "--config", f.config, "--pacing", "realtime", "--json", f.plant_json}, f.plant_log);
   Child run({"run", "--config", f.config, "--duration", "36", "--json", f.run_json}, f.run_log);
@@ -291,12 +301,6 @@ TEST(Hil, ControllerWithoutTheEmulatorReportsTheTransport) {
 // and re-arm as an operator would), the emulator as a child process. Times are on CLOCK_MONOTONIC, which
 // both processes share: the emulator reports when it injected a fault, the loop when its tick 0 was.
 
-// The shipped trips are tight for a machine both processes share with other jobs (a CPU hog on both
-// cores stalls the emulator for more than 10 ms now and then): stale 100 ms, no overrun trip. The checks
-// are against what is configured here, in ticks the loop ran; times are reported.
-const std::vector<std::pair<std::string, std::string>> kSharedMachine{
-    {"stale_sensor_cycles: 250", "stale_sensor_cycles: 500\n  overrun_cycles: 1000000"}};
-
 struct FaultRun {
   config::Config cfg;
   std::unique_ptr<runtime::Cell> cell;
@@ -433,7 +437,7 @@ TEST(HilFaults, CanBusOffTripsToTheSafeStateAtOnce) {
   const double safe_after_s = r.tick_monotonic_s(frames[t.safe].time_s) - injected_s;
   // The error frame trips at the tick that reads it; the ramp takes trip_ramp_s in ticks. How long the
   // frame takes to cross between processes is the machine's (9.9 ms measured): bounded by the stale check's
-  // window (500 cycles here, 100 ms), which would otherwise have tripped first as sensor_stale.
+  // window (1500 cycles here, 300 ms), which would otherwise have tripped first as sensor_stale.
   const auto ramp_ticks = static_cast<std::size_t>(std::ceil(r.cfg.supervision.trip_ramp_s * r.cfg.loop.rate_hz));
   const double stale_window_s = r.cfg.supervision.stale_sensor_cycles / r.cfg.loop.rate_hz;
   EXPECT_LE(t.safe - t.trip, ramp_ticks + 1);
