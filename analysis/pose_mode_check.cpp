@@ -73,9 +73,14 @@ std::vector<ModeSweepPoint> sweep_pose_modes(const config::RobotModelConfig& pri
     q[joint] = j.min_deg + (j.max_deg - j.min_deg) * i / (steps - 1);
     ModeSweepPoint p;
     p.joint_deg = q[joint];
-    for (const auto& m : pose_modes(prior, q, axis, count).modes) p.model_hz.push_back(m.natural_freq_hz);
-    const PoseModes b = pose_modes(mapped, q, axis, count);
+    const PoseModes a = pose_modes(prior, q, axis, count), b = pose_modes(mapped, q, axis, count);
     for (std::size_t k = 0; k < b.modes.size(); ++k) {
+      // The model's mode this one follows: the same index in the picture (a mode the measurements alone give
+      // has none; drawing the model's k-th there paired a 1 Hz mode of a fitted model with a 9 Hz measured one).
+      const bool followed = k < b.corrections.size() && !b.corrections[k].measured_only() &&
+                            static_cast<std::size_t>(b.corrections[k].model_index) < a.modes.size();
+      p.model_hz.push_back(followed ? a.modes[static_cast<std::size_t>(b.corrections[k].model_index)].natural_freq_hz
+                                    : std::numeric_limits<double>::quiet_NaN());
       p.mapped_hz.push_back(b.modes[k].natural_freq_hz);
       p.freq_sigma_pct.push_back(k < b.corrections.size() ? 100.0 * b.corrections[k].freq_sigma : 0.0);
     }

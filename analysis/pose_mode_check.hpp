@@ -30,7 +30,8 @@ struct ModeCheckRow {
 
 // The modes along one joint's travel, the others held at base_deg: the model's and the mapped ones with their
 // one-sigma frequency spread (the picture of where the measurements hold the map and where the model alone
-// speaks). joint: 0-based; steps >= 2 over the joint's travel.
+// speaks). joint: 0-based; steps >= 2 over the joint's travel. model_hz[k] is the model's mode that mapped mode k
+// follows (its correction's model index), NaN where the map has it from the measurements alone.
 struct ModeSweepPoint {
   double joint_deg{0.0};
   std::vector<double> model_hz, mapped_hz, freq_sigma_pct;
