@@ -436,6 +436,7 @@ void Cell::finish_summary() {
   if (machining_) {
     s.machining = machining_->settled_sample(kMachiningSummaryWaitS);
     s.advice = machining_->advice();
+    machining_->complete_trail(kMachiningSummaryWaitS);
     s.limits_trail = machining_->trail();
   }
 }

@@ -172,8 +172,7 @@ void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& n
     waiting = awaited_;
   }
   for (const auto& [t, p] : waiting) {
-    if (same_state(p, now))
-      continue;  // still there: its limits join the trail as the view finds them  // still there: its limits join the trail as the view finds them
+    if (same_state(p, now)) continue;  // still there: its limits join the trail as the view finds them
     const std::vector<milling::LiveLimits> got = stability_->known(std::vector{p});  // never waits
     if (got.empty()) continue;
     const milling::LiveLimits& l = got.front();
@@ -192,6 +191,26 @@ void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& n
         "damped {:.3f} mm",
         config::describe_pose(l.pose_deg), l.rpm, p.set, l.open_mm, l.damped_mm);
   }
+}
+
+void MachiningMonitor::complete_trail(double timeout_s) {
+  if (!stability_->pose_dependent()) return;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  std::vector<std::pair<double, milling::LiveStability::SweepPoint>> waiting;
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    waiting = awaited_;
+  }
+  for (const auto& [t, p] : waiting) {
+    if (std::chrono::steady_clock::now() >= end) break;
+    try {
+      (void)stability_->compute(p.rpm, p.set, p.gain_ns_per_m, p.pose_deg);  // cached: trail_awaited finds it
+    } catch (const std::exception& e) {  // a model that cannot be built there: the state stays out of the trail
+      spdlog::warn("machining: the limits at pose {} for the run's summary: {}", config::describe_pose(p.pose_deg),
+                   e.what());
+    }
+  }
+  trail_awaited({});  // the run is over: no state is the robot's now
 }
 
 std::optional<milling::LiveLimits> MachiningMonitor::moved_from(double rpm, std::size_t set, double gain) const {

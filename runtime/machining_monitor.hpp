@@ -62,6 +62,10 @@ class MachiningMonitor {
   [[nodiscard]] dds::MachiningSample sample();
   // Blocking: waits (up to timeout_s) for the limits at the current state, then samples (tests, summary).
   [[nodiscard]] dds::MachiningSample settled_sample(double timeout_s);
+  // For the run's summary: the limits of every state the robot left before the worker had them (robot faster
+  // than the analysis: a lockstep run, a quick move), computed here on the caller's thread until timeout_s,
+  // into the trail in the order met. Off the real-time path.
+  void complete_trail(double timeout_s);
   [[nodiscard]] milling::LiveStability& stability() { return *stability_; }
   // The status thread: the live lobes at the active set and the gain the loop has held since the last call
   // (a sweep over the job's speed range is asked for on the first call with a settled gain), when more
