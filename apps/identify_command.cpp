@@ -3,108 +3,19 @@
 // for milling jobs. `robodamp identify modes`: the modes of a measured FRF (LSCF poles with a stabilisation
 // diagram, LSFD residues, a nonlinear refinement) as JSON, a `modes:` list for presets and milling jobs,
 // and plots. docs/identification.md.
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <sstream>
 #include <fstream>
 #include <iostream>
 #include <memory>
-
-#include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "apps/cli.hpp"
-#include "apps/gnuplot.hpp"
-#include "plot/frf_figure.hpp"
 #include "apps/identify_command.hpp"
-#include "identify/cutting_coefficients.hpp"
-#include "identify/modal_fit.hpp"
-#include "identify/uff_frf.hpp"
-#include "measfiles/uff.hpp"
+#include "identify/modal_fit_report.hpp"
 
 namespace robodamp::apps {
 
-namespace {}  // namespace
-
-std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir,
-                       const std::string& prefix) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  // The fit over the whole band it was made for (not only the sub-bands' cores), at full precision, and
-  // the measurement over that band with its coherence (plot/frf_figure.hpp).
-  plot::FrfFigureInput in;
-  char error[32];
-  std::snprintf(error, sizeof error, "%.2f", fit.fit_error_pct);
-  in.title = std::string("Measured and fitted receptance (fit error ") + error + " %)";
-  in.f_hz = d.f_hz, in.measured = d.h, in.coherence = d.coherence;
-  in.band_lo_hz = fit.band_lo_hz, in.band_hi_hz = fit.band_hi_hz;
-  for (const double f : d.f_hz)
-    in.fitted.push_back(f >= fit.band_lo_hz && f <= fit.band_hi_hz ? identify::fitted_receptance(fit, f)
-                                                                   : std::complex<double>(NAN, NAN));
-  const plot::FrfFigure fig = plot::frf_figure(in);
-  std::ofstream(dir + "/" + prefix + "_fit.dat") << fig.data;
-  if (auto e = run_gnuplot(fig.script, fig.data, dir + "/" + prefix + "_fit.png"); !e.empty()) return e;
-  std::ostringstream diag;
-  for (const auto& p : fit.diagram) diag << plot::num(p.freq_hz) << ' ' << p.order << ' ' << (p.stable ? 1 : 0) << '\n';
-  const std::string s2 =
-      "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
-      "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
-  return run_gnuplot(s2, diag.str(), dir + "/" + prefix + "_stabilisation.png");
-}
-
 namespace {
-
-// The FRF the options name: a universal file's record, a table, or time series (a table or a universal
-// file's time histories) through Welch. Throws std::invalid_argument.
-identify::FrfData frf_of(const IdentifyArgs& a) {
-  const bool dof_response = a.response.find_first_of("0123456789") != std::string::npos;
-  if (!dof_response && a.response != "acceleration" && a.response != "velocity" && a.response != "displacement")
-    throw std::invalid_argument(
-        "--response '" + a.response +
-        "': allowed acceleration, velocity, displacement (--series) or NODE:DIR (a universal file's record)");
-  if (!a.frf_path.empty() && identify::looks_like_uff(a.frf_path)) {
-    identify::UffSelection sel;
-    sel.record = a.record;
-    if (dof_response) sel.response = identify::parse_dof(a.response);
-    if (!a.reference.empty()) sel.reference = identify::parse_dof(a.reference);
-    const measfiles::UffFile file = measfiles::read_uff(a.frf_path);
-    const identify::UffFrf frf = identify::frf_from_uff(file, a.frf_path, sel);
-    if (frf.units.per_volt)
-      throw std::invalid_argument(a.frf_path + ": record " + std::to_string(frf.record) +
-                                  " is per volt (an actuator's FRF); identify modes reads an FRF per force");
-    std::printf("record %d: %s / %s, %s, %zu points%s\n", frf.record,
-                identify::dof_text(frf.function->response_node, frf.function->response_direction).c_str(),
-                identify::dof_text(frf.function->reference_node, frf.function->reference_direction).c_str(),
-                frf.units.shown.c_str(), frf.data.f_hz.size(),
-                frf.data.coherence.empty() ? ", no coherence record" : ", with its coherence");
-    return frf.data;
-  } else if (!a.frf_path.empty()) {
-    if (a.record || dof_response || !a.reference.empty())
-      throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " +
-                                  a.frf_path + " is a table");
-    const auto kind = a.kind == "mobility"      ? identify::FrfKind::kMobility
-                      : a.kind == "accelerance" ? identify::FrfKind::kAccelerance
-                                                : identify::FrfKind::kReceptance;
-    return identify::read_frf_csv(a.frf_path, kind);
-  } else if (identify::looks_like_uff(a.series_path)) {
-    identify::UffSelection sel;
-    sel.record = a.record;
-    if (dof_response) sel.response = identify::parse_dof(a.response);
-    const measfiles::UffFile file = measfiles::read_uff(a.series_path);
-    const identify::UffSeries s = identify::time_series_from_uff(file, a.series_path, sel);
-    std::printf("records %d (force) and %d (response), %zu samples at %.6g Hz\n", s.force_record, s.response_record,
-                s.series.input.size(), s.series.fs_hz);
-    return identify::frf_from_time_series(s.series, s.kind, a.segment_s, a.overlap,
-                                          a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
-  } else {
-    if (dof_response) throw std::invalid_argument("--response with --series: acceleration, velocity or displacement");
-    const auto kind = a.response == "velocity"       ? identify::FrfKind::kMobility
-                      : a.response == "acceleration" ? identify::FrfKind::kAccelerance
-                                                     : identify::FrfKind::kReceptance;
-    return identify::frf_from_time_series_csv(a.series_path, kind, a.segment_s, a.overlap,
-                                              a.band_hz.size() == 2 ? 1.2 * a.band_hz[1] : 1e12);
-  }
-}
 
 int run_modes(const IdentifyArgs& a) {
   identify::ModalFitSettings s;
@@ -117,42 +28,27 @@ int run_modes(const IdentifyArgs& a) {
       throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
     if (a.frf_path.empty() == a.series_path.empty())
       throw std::invalid_argument("give either --frf (an FRF) or --series (force and response in time)");
-    d = frf_of(a);
+    identify::FrfRead read = identify::read_frf_source(
+        {a.frf_path, a.series_path, a.record, a.response, a.reference, a.kind, a.segment_s, a.overlap, a.band_hz});
+    std::fputs(read.note.c_str(), stdout);
+    d = std::move(read.data);
     fit = identify::fit_modes(d, s);
   } catch (const std::invalid_argument& e) {
     std::cerr << "robodamp identify modes: " << e.what() << '\n';
     return 2;
   }
-  std::printf("%zu modes in %.3g-%.3g Hz, fit error %.3f %% (RMS |H - fit| / RMS |H|):\n", fit.modes.size(),
-              fit.band_lo_hz, fit.band_hi_hz, fit.fit_error_pct);
-  nlohmann::json j{{"fit_error_pct", fit.fit_error_pct},
-                   {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}},
-                   {"modes", nlohmann::json::array()}};
-  std::ostringstream yaml;
-  yaml << "# robodamp identify modes " << a.frf_path << ": fit error " << fit.fit_error_pct
-       << " %; Eq. 1 residue form in the table's frame. Paste under a robot.frfs entry or a milling part's "
-          "pair.\nmodes:\n";
-  for (const auto& m : fit.modes) {
-    std::printf("  %9.4f Hz  zeta %.5f  sigma %+.4e %+.4ei m/N  (k %.4g N/m)\n", m.natural_freq_hz, m.damping_ratio,
-                m.residue_re, m.residue_im, m.stiffness_n_per_m);
-    j["modes"].push_back({{"natural_freq_hz", m.natural_freq_hz},
-                          {"damping_ratio", m.damping_ratio},
-                          {"residue_re_m_per_n", m.residue_re},
-                          {"residue_im_m_per_n", m.residue_im},
-                          {"stiffness_n_per_m", m.stiffness_n_per_m}});
-    yaml << "  - {natural_freq_hz: " << m.natural_freq_hz << ", damping_ratio: " << m.damping_ratio
-         << ", residue_re_m_per_n: " << m.residue_re << ", residue_im_m_per_n: " << m.residue_im << "}\n";
-  }
+  const identify::ModalFitReport r = identify::modal_fit_report(fit, a.frf_path);
+  std::fputs(r.text.c_str(), stdout);
   if (a.json.given) {
-    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
+    if (!emit_json(a.json, r.json.dump(2), "identify")) return 1;
     if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   if (!a.yaml_path.empty()) {
-    std::ofstream(a.yaml_path) << yaml.str();
+    std::ofstream(a.yaml_path) << r.yaml;
     std::printf("wrote %s\n", a.yaml_path.c_str());
   }
   if (!a.plot_dir.empty()) {
-    if (auto e = plot_modes(d, fit, a.plot_dir, "modes"); !e.empty()) {
+    if (auto e = identify::plot_modal_fit(d, fit, a.plot_dir, "modes"); !e.empty()) {
       std::cerr << "plot: " << e << '\n';
       return 1;
     }

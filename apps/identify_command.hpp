@@ -43,11 +43,6 @@ struct IdentifyArgs {
   std::vector<std::string> tap_tests;                 // all: --in's chirp with the user's tap tests
 };
 
-// Measured against fitted magnitude and phase (<prefix>_fit.png) and the stabilisation diagram
-// (<prefix>_stabilisation.png) in dir; an empty string, or what went wrong.
-[[nodiscard]] std::string plot_modes(const identify::FrfData& d, const identify::ModalFit& fit, const std::string& dir,
-                                     const std::string& prefix);
-
 [[nodiscard]] int run_identify_actuator(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_ball_end(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_all(const IdentifyArgs& a);

@@ -1,8 +1,4 @@
 // `robodamp identify actuator`: Eq. 3 (T, natural frequency, damping, delay) from a chirp recorded by
-
-#include "identify/tap_tests.hpp"
-#include "identify/uff_commissioning.hpp"
-#include "measfiles/uff.hpp"
 // robodamp measure (with the structure's FRF at the sensor) or from a CSV of command and transmitted
 // force. `robodamp identify all`: a complete configuration from a robodamp measure directory.
 // docs/identification.md.
@@ -19,7 +15,11 @@
 #include "apps/identify_command.hpp"
 #include "identify/actuator_fit.hpp"
 #include "identify/commissioning.hpp"
+#include "identify/modal_fit_report.hpp"
 #include "identify/numeric_csv.hpp"
+#include "identify/tap_tests.hpp"
+#include "identify/uff_commissioning.hpp"
+#include "measfiles/uff.hpp"
 #include "rt/recording.hpp"
 
 namespace robodamp::apps {
@@ -173,7 +173,7 @@ int run_identify_all(const IdentifyArgs& a) {
   if (!a.plot_dir.empty()) {
     std::string e;
     for (const auto& f : r.frfs)
-      if (e.empty()) e = plot_modes(f.data, f.fit, a.plot_dir, f.name);
+      if (e.empty()) e = identify::plot_modal_fit(f.data, f.fit, a.plot_dir, f.name);
     if (e.empty()) e = plot_actuator(r.actuator, a.plot_dir, "actuator_fit.png");
     if (!e.empty()) {
       std::cerr << "plot: " << e << '\n';
