@@ -10,6 +10,7 @@
 #include "fields/json.hpp"
 #include "milling/accurate_stability.hpp"
 #include "milling/chatter.hpp"
+#include "milling/live_stability.hpp"
 #include "milling/lobes.hpp"
 #include "milling/scheduled_lobes.hpp"
 #include "milling/sle.hpp"
@@ -423,6 +424,21 @@ void apply_pose(config::MillingConfig& cfg, const std::vector<double>& pose_deg)
   if (!any)
     throw config::ConfigError({config::Problem{
         cfg.source, {}, "--pose", "the job has no robot pose part (a part with pose: {model, joints_deg})"}});
+}
+
+json job_limits_json(const config::Config& cfg, double rpm) {
+  if (cfg.spindle.job_resolved.empty()) return nullptr;
+  LiveStability live(config::load_milling_config(cfg.spindle.job_resolved), cfg.spindle.structure, {cfg});
+  const LiveLimits l = live.compute(rpm, 0, cfg.controller.gain_ns_per_m);
+  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return {{"rpm", rpm},
+          {"depth_mm", live.depth_mm()},
+          {"open_mm", finite(l.open_mm)},
+          {"open_method", l.open_method},
+          {"damped_mm", finite(l.damped_mm)},
+          {"damped_method", l.method},
+          {"analysed_rpm", l.analysed_rpm},
+          {"damped_valid", l.damped_valid}};
 }
 
 }  // namespace robodamp::milling

@@ -51,4 +51,9 @@ void apply_pose(config::MillingConfig& cfg, const std::vector<double>& pose_deg)
 // What the damper does for a cut as the reports' JSON "cut" block.
 [[nodiscard]] nlohmann::json cut_verdict_json(const CutVerdict& v);
 
+// The cell's job (spindle.job) at a spindle speed: its open and damped limits by the accurate method (the
+// cell's live stability, milling/live_stability.hpp), each with its method, as analyze's "job_limits" block;
+// null without a job.
+[[nodiscard]] nlohmann::json job_limits_json(const config::Config& cfg, double rpm);
+
 }  // namespace robodamp::milling

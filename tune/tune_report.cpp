@@ -232,4 +232,29 @@ std::string verification_report(const Verification& v, json& report) {
       v.time_domain_at_min_mm, (v.time_domain_at_min_mm / v.min_depth_mm - 1.0) * 100.0);
 }
 
+// How far the loop holds as the modes move (tune/robustness.hpp), with a warning under +-5 %.
+std::string robustness_section(const config::Config& cfg, nlohmann::json& report) {
+  const Robustness rb = robustness(cfg);
+  report["robustness"] = {{"down_pct", rb.down.pct},
+                          {"up_pct", rb.up.pct},
+                          {"down_reason", rb.down.reason},
+                          {"up_reason", rb.up.reason},
+                          {"warn_below_pct", kRobustShiftWarnPct}};
+  char line[160];
+  std::snprintf(line, sizeof line,
+                "  modes shifted together: the loop stays stable and damps its modes from -%.1f %% to +%.1f %%",
+                rb.down.pct, rb.up.pct);
+  std::string out = line;
+  for (const auto* s : {&rb.down, &rb.up})
+    if (!s->reason.empty()) out += "; " + s->reason;
+  if (rb.pct() < kRobustShiftWarnPct) {
+    std::snprintf(line, sizeof line,
+                  "\n  WARNING: robust to only +-%.1f %% of mode shift (under +-%.0f %%: a pose or tool change may "
+                  "move the modes further)",
+                  rb.pct(), kRobustShiftWarnPct);
+    out += line;
+  }
+  return out + "\n";
+}
+
 }  // namespace robodamp::tune

@@ -60,4 +60,8 @@ struct ComparedDesign {
 // The tuned file's promises verified on the job: the lines, and report["verified"].
 [[nodiscard]] std::string verification_report(const Verification& v, nlohmann::json& report);
 
+// How far the loop holds as the modes move together (tune/robustness.hpp), into report["robustness"]; its
+// line, with a warning under +-kRobustShiftWarnPct.
+[[nodiscard]] std::string robustness_section(const config::Config& cfg, nlohmann::json& report);
+
 }  // namespace robodamp::tune
