@@ -73,15 +73,6 @@ json hil_critical(const CutArgs& a, const milling::CutJob& job, double rpm, doub
           {"chatter_hz", c.chatter_hz}, {"cuts", c.cuts}, {"rel_tol", kHilRelTol},           {"wall_s", wall}};
 }
 
-// Beside a frequency the simulated cut found, how it relates to the accurate method's (milling/chatter.hpp).
-const char* alias_note(double cut_hz, double accurate_hz, double tooth_hz) {
-  // Within 0.5 % of the larger (the frequency moves with the depth) and 1 % of the tooth frequency.
-  const double tol_hz = 0.005 * std::max(std::abs(cut_hz), std::abs(accurate_hz)) + 0.01 * tooth_hz;
-  if (std::abs(cut_hz - accurate_hz) <= tol_hz) return "";
-  return milling::same_chatter(cut_hz, accurate_hz, tooth_hz, tol_hz) ? " (another alias of the same chatter)"
-                                                                      : " (not the accurate method's chatter)";
-}
-
 // One cut at one speed (no --critical): its verdict, the damper's limits, the plots.
 std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, const milling::Structure& structure,
                            milling::CutOverrides ov, const std::vector<double>& speeds, json& out) {
@@ -93,22 +84,7 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
   const auto t0 = std::chrono::steady_clock::now();
   const milling::CutOutcome o = milling::run_job(job);
   out = milling::cut_json(job, o, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  std::printf("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
-              out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
-              out["classification"].get<std::string>().c_str());
-  if (!o.verdict.stable)
-    std::printf(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
-  std::printf(
-      "; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f "
-      "s\n",
-      o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
-      out["simulated_s"].get<double>(), out["wall_s"].get<double>());
-  if (job.damped)
-    std::printf(
-        "  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole "
-        "number of loop periods)\n",
-        o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
-        o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
+  std::fputs(milling::cut_lines(job, o, out).c_str(), stdout);
   if (!a.plot_dir.empty()) {
     if (auto e = milling::plot_cut(o, a.plot_dir); !e.empty()) {
       std::cerr << "plot: " << e << '\n';
@@ -117,56 +93,6 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
     std::printf("wrote plots in %s\n", a.plot_dir.c_str());
   }
   return std::nullopt;
-}
-
-// --critical at one speed: the time-domain critical depth beside the accurate method's and the zero-order
-// preview, its JSON entry and its line.
-json critical_at(const CutArgs& a, const config::MillingConfig& cfg, const milling::CutJob& job,
-                 const milling::LobeModel& lobes, const milling::AccurateStability& truth, double rpm) {
-  const double zoa_mm = lobes.critical_depth_mm(rpm);
-  milling::SdmPoint sdm;
-  try {
-    sdm = truth.critical(rpm, zoa_mm);
-  } catch (const std::invalid_argument& e) {
-    throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", e.what()}});
-  }
-  std::cerr << "[cut] critical depth at " << rpm << " rpm (" << truth.method() << " " << sdm.critical_depth_mm
-            << " mm, zero-order preview " << zoa_mm << " mm):\n";
-  const auto t0 = std::chrono::steady_clock::now();
-  const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm
-                       : std::isfinite(zoa_mm)              ? zoa_mm
-                                                            : 1.0;
-  const milling::CriticalDepth c =
-      milling::critical_depth(job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3,
-                              [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double tooth_hz = rpm * job.cutter.teeth / 60.0;  // the chatter's family: milling/chatter.hpp
-  json entry = {{"rpm", rpm},
-                {"simulated_rpm", job.settings.rpm},
-                {"damped", a.damped},
-                {"critical_depth_mm", c.depth_mm},
-                {"lobes_b_lim_mm", finite_or_null(zoa_mm)},
-                {"accurate_method", truth.method()},
-                {"accurate_b_lim_mm", finite_or_null(sdm.critical_depth_mm)},
-                {"accurate_rpm", sdm.rpm},
-                {"accurate_chatter_hz", sdm.chatter_hz},
-                {"accurate_chatter_family_hz", milling::chatter_family_hz(sdm.chatter_hz, tooth_hz)},
-                {"chatter_family_hz", milling::chatter_family_hz(c.chatter_hz, tooth_hz)},
-                {"accurate_type", milling::to_string(sdm.type)},
-                {"classification", milling::to_string(c.above)},
-                {"mechanism", milling::to_string(c.mechanism)},
-                {"chatter_hz", c.chatter_hz},
-                {"simulations", c.simulations},
-                {"wall_s", wall}};
-  std::printf(
-      "%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
-      "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
-      rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm,
-      (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0, milling::to_string(sdm.type), sdm.chatter_hz, zoa_mm,
-      milling::to_string(c.above), milling::to_string(c.mechanism), c.chatter_hz,
-      alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz), c.simulations, wall);
-  if (!a.hil_path.empty()) entry["hil"] = hil_critical(a, job, rpm, c.depth_mm);
-  return entry;
 }
 
 // --critical: the three methods at every speed asked for.
@@ -182,7 +108,12 @@ void critical_study(const CutArgs& a, const config::MillingConfig& cfg, const co
   out["critical"] = json::array();
   for (double rpm : speeds) {
     ov.rpm = rpm;
-    out["critical"].push_back(critical_at(a, cfg, milling::make_cut_job(cfg, structure, ov), lobes, truth, rpm));
+    const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
+    milling::CriticalAtSpeed c = milling::critical_at_speed(
+        cfg, job, lobes, truth, rpm, a.damped, [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
+    std::fputs(c.line.c_str(), stdout);
+    if (!a.hil_path.empty()) c.entry["hil"] = hil_critical(a, job, rpm, c.depth_mm);
+    out["critical"].push_back(std::move(c.entry));
   }
 }
 

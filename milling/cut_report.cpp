@@ -1,6 +1,7 @@
 #include "milling/cut_report.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <filesystem>
@@ -8,7 +9,9 @@
 
 #include "analysis/fft.hpp"
 #include "fields/json.hpp"
+#include "fields/printf.hpp"
 #include "milling/chatter.hpp"
+#include "milling/cut_stability.hpp"
 #include "plot/gnuplot.hpp"
 
 namespace robodamp::milling {
@@ -95,6 +98,91 @@ std::string plot_cut(const CutOutcome& o, const std::string& dir) {
     if (auto e = plot::run_gnuplot(s, d.str(), dir + "/cut_surface.png"); !e.empty()) return e;
   }
   return {};
+}
+
+namespace {
+
+// Beside a frequency the simulated cut found, how it relates to the accurate method's (milling/chatter.hpp).
+const char* alias_note(double cut_hz, double accurate_hz, double tooth_hz) {
+  // Within 0.5 % of the larger (the frequency moves with the depth) and 1 % of the tooth frequency.
+  const double tol_hz = 0.005 * std::max(std::abs(cut_hz), std::abs(accurate_hz)) + 0.01 * tooth_hz;
+  if (std::abs(cut_hz - accurate_hz) <= tol_hz) return "";
+  return same_chatter(cut_hz, accurate_hz, tooth_hz, tol_hz) ? " (another alias of the same chatter)"
+                                                             : " (not the accurate method's chatter)";
+}
+
+}  // namespace
+
+std::string cut_lines(const CutJob& job, const CutOutcome& o, const nlohmann::json& out) {
+  using fields::printf_string;
+  std::string t =
+      printf_string("%s cut at %.1f rpm, %.3f mm axial, %.3f mm radial: %s", job.damped ? "damped" : "open-loop",
+                    out["rpm"].get<double>(), out["axial_mm"].get<double>(), out["radial_mm"].get<double>(),
+                    out["classification"].get<std::string>().c_str());
+  if (!o.verdict.stable)
+    t += printf_string(" (%s) at %.1f Hz", out["mechanism"].get<std::string>().c_str(), o.verdict.chatter_hz);
+  t += printf_string(
+      "; off-harmonic energy %.3f, once-per-tooth ratio %.3g, peak force %.1f N, SLE %.2f um; %.1f s simulated in %.2f "
+      "s\n",
+      o.verdict.nonharmonic_energy_ratio, o.verdict.once_per_period_ratio, o.record.peak_force_n, o.record.sle_um,
+      out["simulated_s"].get<double>(), out["wall_s"].get<double>());
+  if (job.damped)
+    t += printf_string(
+        "  damper: peak actuator force %.1f N, at a limit for %.3f s%s (speed %.1f rpm: the tooth period a whole "
+        "number of loop periods)\n",
+        o.record.peak_actuator_force_n, o.record.actuator_saturated_s,
+        o.record.actuator_saturated_s > 0.0 ? " (SATURATED)" : "", o.record.rpm);
+  return t;
+}
+
+CriticalAtSpeed critical_at_speed(const config::MillingConfig& cfg, const CutJob& job, const LobeModel& lobes,
+                                  const AccurateStability& truth, double rpm, bool damped,
+                                  const std::function<void(const std::string&)>& progress) {
+  const double zoa_mm = lobes.critical_depth_mm(rpm);
+  SdmPoint sdm;
+  try {
+    sdm = truth.critical(rpm, zoa_mm);
+  } catch (const std::invalid_argument& e) {
+    throw config::ConfigError({config::Problem{cfg.source, {}, "--rpm", e.what()}});
+  }
+  std::ostringstream head;
+  head << "critical depth at " << rpm << " rpm (" << truth.method() << " " << sdm.critical_depth_mm
+       << " mm, zero-order preview " << zoa_mm << " mm):";
+  progress(head.str());
+  const auto t0 = std::chrono::steady_clock::now();
+  const double guess = std::isfinite(sdm.critical_depth_mm) ? sdm.critical_depth_mm
+                       : std::isfinite(zoa_mm)              ? zoa_mm
+                                                            : 1.0;
+  const CriticalDepth c = critical_depth(job.dynamics, job.cutter, job.material, job.settings, guess, 2e-3, progress);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double tooth_hz = rpm * job.cutter.teeth / 60.0;  // the chatter's family: milling/chatter.hpp
+  CriticalAtSpeed out;
+  out.depth_mm = c.depth_mm;
+  out.entry = {{"rpm", rpm},
+               {"simulated_rpm", job.settings.rpm},
+               {"damped", damped},
+               {"critical_depth_mm", c.depth_mm},
+               {"lobes_b_lim_mm", fields::finite_or_null(zoa_mm)},
+               {"accurate_method", truth.method()},
+               {"accurate_b_lim_mm", fields::finite_or_null(sdm.critical_depth_mm)},
+               {"accurate_rpm", sdm.rpm},
+               {"accurate_chatter_hz", sdm.chatter_hz},
+               {"accurate_chatter_family_hz", chatter_family_hz(sdm.chatter_hz, tooth_hz)},
+               {"chatter_family_hz", chatter_family_hz(c.chatter_hz, tooth_hz)},
+               {"accurate_type", to_string(sdm.type)},
+               {"classification", to_string(c.above)},
+               {"mechanism", to_string(c.mechanism)},
+               {"chatter_hz", c.chatter_hz},
+               {"simulations", c.simulations},
+               {"wall_s", wall}};
+  out.line = fields::printf_string(
+      "%8.0f rpm: time-domain critical depth %.4f mm (%s %.4f mm %+.1f %%, %s at %.1f Hz; zero-order preview %.4f mm), "
+      "above it %s (%s) at %.1f Hz%s; %d cuts in %.2f s\n",
+      rpm, c.depth_mm, truth.method().c_str(), sdm.critical_depth_mm,
+      (sdm.critical_depth_mm / c.depth_mm - 1.0) * 100.0, to_string(sdm.type), sdm.chatter_hz, zoa_mm,
+      to_string(c.above), to_string(c.mechanism), c.chatter_hz, alias_note(c.chatter_hz, sdm.chatter_hz, tooth_hz),
+      c.simulations, wall);
+  return out;
 }
 
 }  // namespace robodamp::milling
