@@ -93,53 +93,11 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
     std::cerr << "robodamp pose map: row " << row << " of " << rows << " done ("
               << (req.zero_order ? "zero-order preview" : "SDM") << ")\n";
   });
-  const std::string& method = map.method;
-  const double f_min = map.f1_min_hz, f_max = map.f1_max_hz, b_min = map.min_depth_min_mm, b_max = map.min_depth_max_mm;
-  json grid = json::array();
-  std::ostringstream data;
-  for (std::size_t i = 0; i < map.grid.size(); ++i) {
-    const milling::PoseMapPoint& p = map.grid[i];
-    json point = {{"joints_deg", p.joints_deg}, {"f1_hz", p.f1_hz}, {"k1_n_per_m", p.k1_n_per_m}};
-    if (p.min_depth_mm) point["min_depth_mm"] = *p.min_depth_mm, point["min_depth_rpm"] = *p.min_depth_rpm;
-    grid.push_back(point);
-    data << p.joints_deg[req.joint_a] << ' ' << p.joints_deg[req.joint_b] << ' ' << p.f1_hz << ' ' << p.k1_n_per_m
-         << ' ' << p.min_depth_mm.value_or(NAN) << '\n';
-    if ((i + 1) % static_cast<std::size_t>(a.steps) == 0) data << '\n';
-  }
-  json r = {{"model", m.source}, {"vary", a.vary},     {"steps", a.steps},
-            {"grid", grid},      {"f1_min_hz", f_min}, {"f1_max_hz", f_max}};
-  std::ostringstream t;
-  char b[200];
-  std::snprintf(b, sizeof b, "robot %s: first mode over joints %d and %d (%d x %d poses): %.2f to %.2f Hz\n",
-                m.name.c_str(), a.vary[0], a.vary[1], a.steps, a.steps, f_min, f_max);
-  t << b;
-  if (job) {
-    std::snprintf(b, sizeof b, "  %s: minimum limiting depth (open loop, %s, %g-%g rpm) %.3f to %.3f mm\n",
-                  a.job_path.c_str(), method.c_str(), job->lobes.rpm_min, job->lobes.rpm_max, b_min, b_max);
-    t << b;
-    r["method"] = method;
-    r["min_depth_min_mm"] = b_min;
-    r["min_depth_max_mm"] = b_max;
-  }
-  if (!also_json_out(a, r)) return 1;
+  const milling::PoseMapReport r = milling::pose_map_report(m, req, map, a.job_path);
+  if (!also_json_out(a, r.json)) return 1;
   return print_report(
-      r.dump(2), a.json, "pose", t.str(), a.plot_path,
-      [&] {
-        const std::string s =
-            "set terminal pngcairo size " + std::string(job ? "2000" : "1400") + ",600; set output '" + a.plot_path +
-            "'; set multiplot layout 1," + std::string(job ? "3" : "2") + "; set view map; set xlabel 'joint " +
-            std::to_string(a.vary[0]) + " (deg)'; set ylabel 'joint " + std::to_string(a.vary[1]) +
-            " (deg)'; set title 'first mode (Hz)'; splot DATA u 1:2:3 w pm3d notitle;"
-            " set title 'TCP modal stiffness of the first mode (N/m)'; set format cb '%.1e';"
-            " splot DATA u 1:2:4 w pm3d notitle;" +
-            std::string(job ? " set format cb '%g'; set title 'minimum limiting depth (mm, " + method +
-                                  ")';"
-                                  " splot DATA u 1:2:5 w pm3d notitle;"
-                            : "") +
-            " unset multiplot";
-        return run_gnuplot(s, data.str(), a.plot_path);
-      },
-      a.plot_path);
+      r.json.dump(2), a.json, "pose", r.text, a.plot_path,
+      [&] { return milling::plot_pose_map(r, req, map, a.plot_path); }, a.plot_path);
 }
 
 // The deprecated --json-out FILE: the JSON written there as well.

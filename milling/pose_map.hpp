@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "config/milling_config.hpp"
 #include "config/robot_model_config.hpp"
 
@@ -41,5 +43,22 @@ struct PoseMap {
 // config::ConfigError when the job's structure has no robot pose part.
 [[nodiscard]] PoseMap pose_map(const config::RobotModelConfig& model, const PoseMapRequest& request,
                                const std::function<void(int row, int rows)>& progress = {});
+
+struct PoseMapReport {
+  nlohmann::json json;
+  std::string text;
+  std::string
+      plot_data;  // per pose: joint a, joint b, f1, k1, the job's minimum depth (NaN without); rows blank-separated
+};
+
+// The map as `pose map` reports it: the grid, the first mode's range and, with a job (job_path), the minimum
+// limiting depth's, with the method. vary: the two joints, 1-based.
+[[nodiscard]] PoseMapReport pose_map_report(const config::RobotModelConfig& model, const PoseMapRequest& request,
+                                            const PoseMap& map, const std::string& job_path);
+
+// The map's plot (PNG): the first mode, its TCP stiffness and, with a job, the minimum depth over the two joints.
+// An empty string, or what went wrong.
+[[nodiscard]] std::string plot_pose_map(const PoseMapReport& r, const PoseMapRequest& request, const PoseMap& map,
+                                        const std::string& png_path);
 
 }  // namespace robodamp::milling
