@@ -94,6 +94,8 @@ CLI::Option* Registry::numbers(CLI::App* sub, const std::string& flag, std::vect
   CLI::Option* opt = text_option(sub, flag, help + " [" + config::describe_range(range) + "]", true);
   const std::vector<std::string>& texts = texts_.back();
   checks_.push_back({sub, [opt, &texts, &target, range]() -> std::optional<std::string> {
+                       // The values given replace a default (pose frf's band was 2-60 Hz whatever --band-hz said).
+                       if (!texts.empty()) target.clear();
                        for (const auto& t : texts) {
                          double v = 0.0;
                          if (auto p = parse_number(first_name(opt), t, range, false, v)) return p;

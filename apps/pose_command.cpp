@@ -111,6 +111,11 @@ int run_pose(const PoseArgs& given) {
     return run_pose_tune(a.tune);
   }
   a.plot_path = plot_file(a.plot_dir, a.plot_path, "pose_" + a.what + ".png");
+  for (const auto& [flag, band] : {std::pair{"--band-hz", &a.band_hz}, std::pair{"--fit-band-hz", &a.fit_band_hz}})
+    if (band->size() != 2 || !((*band)[0] < (*band)[1])) {
+      std::cerr << "robodamp pose: " << flag << ": two frequencies LO HI in Hz, LO < HI\n";
+      return 2;
+    }
   try {
     const config::RobotModelConfig m = config::load_robot_model(a.model_path);
     if (a.what == "frf") return run_frf(m, a);

@@ -14,6 +14,7 @@
 #include "identify/modal_fit.hpp"
 #include "identify/pose_measurements.hpp"
 #include "robot/pose_fit.hpp"
+#include "robot/pose_report.hpp"
 #include "robot/robot_model.hpp"
 
 namespace robodamp::apps {
@@ -86,75 +87,13 @@ robot::PoseFitSettings fit_settings(const PoseArgs& a, const FitData& d) {
   return s;
 }
 
-// Each pose: its role, the model's error before and after the fit, the receptance's peak frequency.
-json pose_rows(const config::RobotModelConfig& nominal, const config::RobotModelConfig& fitted,
-               const std::vector<robot::MeasuredFrf>& data, const robot::PoseFitSettings& s, const char* role,
-               std::ostringstream& t) {
-  json rows = json::array();
-  if (data.empty()) return rows;
-  const std::vector<double> before = robot::model_errors(nominal, data, s),
-                            after = robot::model_errors(fitted, data, s);
-  const std::vector<double> f_data = robot::peak_hz(nullptr, data, s), f_before = robot::peak_hz(&nominal, data, s),
-                            f_after = robot::peak_hz(&fitted, data, s);
-  char b[240];
-  for (std::size_t p = 0; p < data.size(); ++p) {
-    std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %9.2f %9.2f   %8.2f %8.2f %8.2f\n", data[p].name.c_str(),
-                  config::describe_pose(data[p].joints_deg).c_str(), role, 100.0 * before[p], 100.0 * after[p],
-                  f_data[p], f_before[p], f_after[p]);
-    t << b;
-    rows.push_back({{"frf", data[p].name},
-                    {"joints_deg", data[p].joints_deg},
-                    {"role", role},
-                    {"nominal_error_pct", 100.0 * before[p]},
-                    {"error_pct", 100.0 * after[p]},
-                    {"peak_hz", f_data[p]},
-                    {"nominal_peak_hz", f_before[p]},
-                    {"fitted_peak_hz", f_after[p]}});
-  }
-  return rows;
-}
-
 }  // namespace
 
 int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
   const FitData d = fit_data(a, m);
   const robot::PoseFitSettings s = fit_settings(a, d);
   const robot::PoseFitResult r = robot::fit_joints(m, d.fit, s);
-  const char* dir = s.direction == robot::FrfDirection::kXX   ? "xx"
-                    : s.direction == robot::FrfDirection::kXY ? "xy"
-                                                              : "yy";
-  std::ostringstream t;
-  char b[240];
-  const std::string form = s.modes > 0 ? "its " + std::to_string(s.modes) + " lowest modes" : "its own receptance";
-  std::snprintf(b, sizeof b,
-                "robot %s (as %s) fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
-                m.name.c_str(), form.c_str(), d.fit.size(), dir, s.band_min_hz, s.band_max_hz, r.evaluations,
-                r.converged_restarts, s.restarts);
-  t << b << "  joint   stiffness N m/rad   spread %   damping ratio\n";
-  json joints = json::array();
-  for (std::size_t j = 0; j < r.stiffness_nm_per_rad.size(); ++j) {
-    std::snprintf(b, sizeof b, "  %5zu   %17.5g   %8.3f   %13.4f\n", j + 1, r.stiffness_nm_per_rad[j],
-                  r.stiffness_spread_pct[j], r.damping_ratio[j]);
-    t << b;
-    joints.push_back({{"stiffness_nm_per_rad", r.stiffness_nm_per_rad[j]},
-                      {"spread_pct", r.stiffness_spread_pct[j]},
-                      {"damping_ratio", r.damping_ratio[j]}});
-  }
-  t << "  the TCP receptance against the model file as given (nominal) and fitted: the weighted relative error and\n"
-       "  the frequency of the largest receptance in the band\n";
-  std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %19s   %26s\n  %-10s %-30s %-9s %9s %9s   %8s %8s %8s\n", "", "", "",
-                "error %", "peak Hz", "pose", "joints", "role", "nominal", "fitted", "measured", "nominal", "fitted");
-  t << b;
-  json poses = pose_rows(m, r.fitted, d.fit, s, "fit", t);
-  for (auto& row : pose_rows(m, r.fitted, d.held, s, "held out", t)) poses.push_back(std::move(row));
-  const json out = {{"model", m.source},
-                    {"direction", dir},
-                    {"modes", s.modes},
-                    {"joints", joints},
-                    {"poses", poses},
-                    {"restart_costs", r.restart_costs},
-                    {"evaluations", r.evaluations},
-                    {"converged_restarts", r.converged_restarts}};
+  robot::PoseReport report = robot::pose_fit_report(m, r, d.fit, d.held, s);
   if (!a.out_path.empty()) {
     std::ofstream f(a.out_path);
     f << config::robot_model_yaml(r.fitted);
@@ -162,10 +101,10 @@ int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
       std::cerr << "--out " << a.out_path << ": cannot write\n";
       return 1;
     }
-    t << "  wrote the fitted model to " << a.out_path << '\n';
+    report.text += "  wrote the fitted model to " + a.out_path + '\n';
   }
-  if (!also_json_out(a, out)) return 1;
-  return print_report(out.dump(2), a.json, "pose", t.str(), "", {}, "");
+  if (!also_json_out(a, report.json)) return 1;
+  return print_report(report.json.dump(2), a.json, "pose", report.text, "", {}, "");
 }
 
 bool also_json_out(const PoseArgs& a, const nlohmann::json& j) {

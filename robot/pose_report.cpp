@@ -119,4 +119,76 @@ PoseReport pose_table_report(const config::RobotModelConfig& m) {
   return {json{{"model", m.source}, {"poses", rows}}, t.str(), ""};
 }
 
+namespace {
+
+// Each pose: its role, the model's error before and after the fit, the receptance's peak frequency.
+nlohmann::json pose_rows(const config::RobotModelConfig& nominal, const config::RobotModelConfig& fitted,
+                         const std::vector<MeasuredFrf>& data, const PoseFitSettings& s, const char* role,
+                         std::ostringstream& t) {
+  nlohmann::json rows = nlohmann::json::array();
+  if (data.empty()) return rows;
+  const std::vector<double> before = model_errors(nominal, data, s), after = model_errors(fitted, data, s);
+  const std::vector<double> f_data = peak_hz(nullptr, data, s), f_before = peak_hz(&nominal, data, s),
+                            f_after = peak_hz(&fitted, data, s);
+  char b[240];
+  for (std::size_t p = 0; p < data.size(); ++p) {
+    std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %9.2f %9.2f   %8.2f %8.2f %8.2f\n", data[p].name.c_str(),
+                  config::describe_pose(data[p].joints_deg).c_str(), role, 100.0 * before[p], 100.0 * after[p],
+                  f_data[p], f_before[p], f_after[p]);
+    t << b;
+    rows.push_back({{"frf", data[p].name},
+                    {"joints_deg", data[p].joints_deg},
+                    {"role", role},
+                    {"nominal_error_pct", 100.0 * before[p]},
+                    {"error_pct", 100.0 * after[p]},
+                    {"peak_hz", f_data[p]},
+                    {"nominal_peak_hz", f_before[p]},
+                    {"fitted_peak_hz", f_after[p]}});
+  }
+  return rows;
+}
+
+}  // namespace
+
+PoseReport pose_fit_report(const config::RobotModelConfig& m, const PoseFitResult& r,
+                           const std::vector<MeasuredFrf>& fit, const std::vector<MeasuredFrf>& held,
+                           const PoseFitSettings& s) {
+  const char* dir = s.direction == FrfDirection::kXX ? "xx" : s.direction == FrfDirection::kXY ? "xy" : "yy";
+  std::ostringstream t;
+  char b[240];
+  const std::string form = s.modes > 0 ? "its " + std::to_string(s.modes) + " lowest modes" : "its own receptance";
+  std::snprintf(b, sizeof b,
+                "robot %s (as %s) fitted to %zu FRF(s) (%s, %g-%g Hz): %d evaluations, %d of %d restarts converged\n",
+                m.name.c_str(), form.c_str(), fit.size(), dir, s.band_min_hz, s.band_max_hz, r.evaluations,
+                r.converged_restarts, s.restarts);
+  t << b << "  joint   stiffness N m/rad   spread %   damping ratio\n";
+  nlohmann::json joints = nlohmann::json::array();
+  for (std::size_t j = 0; j < r.stiffness_nm_per_rad.size(); ++j) {
+    std::snprintf(b, sizeof b, "  %5zu   %17.5g   %8.3f   %13.4f\n", j + 1, r.stiffness_nm_per_rad[j],
+                  r.stiffness_spread_pct[j], r.damping_ratio[j]);
+    t << b;
+    joints.push_back({{"stiffness_nm_per_rad", r.stiffness_nm_per_rad[j]},
+                      {"spread_pct", r.stiffness_spread_pct[j]},
+                      {"damping_ratio", r.damping_ratio[j]}});
+  }
+  t << "  the TCP receptance against the model file as given (nominal) and fitted: the weighted relative error and\n"
+       "  the frequency of the largest receptance in the band\n";
+  std::snprintf(b, sizeof b, "  %-10s %-30s %-9s %19s   %26s\n  %-10s %-30s %-9s %9s %9s   %8s %8s %8s\n", "", "", "",
+                "error %", "peak Hz", "pose", "joints", "role", "nominal", "fitted", "measured", "nominal", "fitted");
+  t << b;
+  nlohmann::json poses = pose_rows(m, r.fitted, fit, s, "fit", t);
+  for (auto& row : pose_rows(m, r.fitted, held, s, "held out", t)) poses.push_back(std::move(row));
+  PoseReport out;
+  out.json = {{"model", m.source},
+              {"direction", dir},
+              {"modes", s.modes},
+              {"joints", joints},
+              {"poses", poses},
+              {"restart_costs", r.restart_costs},
+              {"evaluations", r.evaluations},
+              {"converged_restarts", r.converged_restarts}};
+  out.text = t.str();
+  return out;
+}
+
 }  // namespace robodamp::robot

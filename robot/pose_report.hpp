@@ -10,6 +10,7 @@
 
 #include "config/robot_model_config.hpp"
 #include "robot/planar_chain.hpp"
+#include "robot/pose_fit.hpp"
 
 namespace robodamp::robot {
 
@@ -36,5 +37,11 @@ struct PoseReport {
 
 // The first mode at each named pose beside the published values.
 [[nodiscard]] PoseReport pose_table_report(const config::RobotModelConfig& m);
+
+// `pose fit`'s report: the joints fitted (stiffness, spread, damping) and, at each pose fitted and held out,
+// the model's error and the receptance's peak frequency before and after.
+[[nodiscard]] PoseReport pose_fit_report(const config::RobotModelConfig& m, const PoseFitResult& r,
+                                         const std::vector<MeasuredFrf>& fit, const std::vector<MeasuredFrf>& held,
+                                         const PoseFitSettings& s);
 
 }  // namespace robodamp::robot

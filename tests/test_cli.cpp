@@ -550,10 +550,31 @@ TEST(Cli, PoseTableFrfAndFitOnThePlanarRobot) {
     EXPECT_NE(frf.out.find("receptance coupling (RCSA) within"), std::string::npos) << frf.out;
     measured += std::string(" --measured=") + poses[i][1] + ":" + csv;
   }
+  // The band given replaces the default (2-60 Hz for frf, 10-30 Hz for fit), which it was appended to before
+  // 2026-12-06 and so ignored; one frequency, or LO >= HI, is refused.
+  {
+    std::ifstream csv(dir + "/p1.csv");
+    std::string line, last;
+    std::getline(csv, line);  // the header
+    std::getline(csv, line);
+    EXPECT_EQ(line.substr(0, line.find(',')), "5") << line;
+    while (std::getline(csv, line))
+      if (!line.empty()) last = line;
+    EXPECT_EQ(last.substr(0, last.find(',')), "40") << last;
+  }
+  for (const char* bad : {"--band-hz 5", "--band-hz 40 5", "--fit-band-hz 30"}) {
+    const Result refused = run(std::string("pose frf --pose-name 'pose 1' ") + bad);
+    EXPECT_EQ(refused.status, 2) << bad;
+    EXPECT_NE(refused.out.find("two frequencies LO HI in Hz, LO < HI"), std::string::npos) << refused.out;
+  }
   const Result fit =
       run("pose fit" + measured + " --restarts 1 --particles 20 --iterations 30 --out " + dir + "/fitted.yaml");
   ASSERT_EQ(fit.status, 0) << fit.out;
   EXPECT_NE(fit.out.find("weighted relative error"), std::string::npos) << fit.out;
+  EXPECT_NE(fit.out.find("(yy, 10-30 Hz)"), std::string::npos) << fit.out;
+  const Result narrow = run("pose fit" + measured + " --restarts 1 --particles 20 --iterations 30 --fit-band-hz 12 25");
+  ASSERT_EQ(narrow.status, 0) << narrow.out;
+  EXPECT_NE(narrow.out.find("(yy, 12-25 Hz)"), std::string::npos) << narrow.out;
   // Lobes at a pose: the job's pose part takes --pose; a pose out of the travel, or --pose on a job without
   // a pose part, is refused by name.
   const std::string job = std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/planar_three_link_pose2.yaml";
