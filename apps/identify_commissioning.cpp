@@ -34,42 +34,6 @@ identify::FrfKind kind_of(const std::string& k) {
                               : identify::FrfKind::kReceptance;
 }
 
-// From a CSV of the amplifier command and the transmitted force (Welch).
-identify::ActuatorFit actuator_from_force_csv(const IdentifyArgs& a) {
-  const identify::TimeSeries ts = identify::read_time_series_csv(a.csv_path, "time_s,command_v,force_n");
-  const auto segment = static_cast<std::size_t>(std::lround(a.segment_s * ts.fs_hz));
-  if (segment < 16 || segment > ts.input.size())
-    throw std::invalid_argument("--segment-s = " + std::to_string(a.segment_s) + " s = " + std::to_string(segment) +
-                                " samples: allowed 16 .. the record's " + std::to_string(ts.input.size()));
-  const analysis::FrfEstimate e =
-      analysis::welch_frf(ts.input, ts.output, ts.fs_hz, segment, a.overlap, 0.45 * ts.fs_hz);
-  identify::ActuatorFrf g;
-  for (std::size_t k = 1; k < e.f_hz.size(); ++k)
-    g.f_hz.push_back(e.f_hz[k]), g.n_per_v.push_back(e.h1[k]), g.coherence.push_back(e.coherence[k]);
-  identify::ActuatorFitSettings s;
-  if (a.band_hz.size() == 2) s.band_lo_hz = a.band_hz[0], s.band_hi_hz = a.band_hz[1];
-  s.min_coherence = kActuatorMinCoherence;
-  return identify::fit_actuator(g, s);
-}
-
-// Measured against fitted force per volt (magnitude and phase) in dir/<name>.
-std::string plot_actuator(const identify::ActuatorFit& fit, const std::string& dir, const std::string& name) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  std::ostringstream data;
-  for (std::size_t i = 0; i < fit.f_hz.size(); ++i)
-    data << fit.f_hz[i] << ' ' << std::abs(fit.measured[i]) << ' ' << std::arg(fit.measured[i]) * 180.0 / M_PI << ' '
-         << std::abs(fit.fitted[i]) << ' ' << std::arg(fit.fitted[i]) * 180.0 / M_PI << '\n';
-  std::ostringstream s;
-  s << "set multiplot layout 2,1 title 'Actuator force per volt: measured and Eq. 3 fitted (fit error "
-    << fit.fit_error_pct << " %)'\nset grid\nset logscale x\nset ylabel '|F/V| (N/V)'\n"
-    << "plot DATA u 1:2 w l t 'measured (hold as 1.5 periods)', DATA u 1:4 w l lw 2 t 'fit (exactly sampled)'\n"
-    << "set xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nplot DATA u 1:3 w l t 'measured (hold as 1.5 periods)', "
-       "DATA u 1:5 w l lw 2 t 'fit (exactly sampled)'\n"
-    << "unset multiplot\n";
-  return run_gnuplot(s.str(), data.str(), dir + "/" + name);
-}
-
 }  // namespace
 
 int run_identify_actuator(const IdentifyArgs& a) {
@@ -98,7 +62,7 @@ int run_identify_actuator(const IdentifyArgs& a) {
       fit = identify::identify_actuator(m, identify::with_collocated_structure(m.config, structure), lo, hi,
                                         kActuatorMinCoherence);
     } else {
-      fit = actuator_from_force_csv(a);
+      fit = identify::actuator_from_force_csv(a.csv_path, a.segment_s, a.overlap, a.band_hz, kActuatorMinCoherence);
     }
   } catch (const std::invalid_argument& e) {
     std::cerr << "robodamp identify actuator: " << e.what() << '\n';
@@ -107,21 +71,10 @@ int run_identify_actuator(const IdentifyArgs& a) {
     std::cerr << "robodamp identify actuator: " << e.what() << '\n';
     return 2;
   }
-  std::printf(
-      "Actuator (%s mounting): T %.4f N/V, natural frequency %.4f Hz, damping ratio %.4f, delay %.4f ms\n"
-      "  fit error %.3f %% (RMS |G - fit| / RMS |G|) over %.3g-%.3g Hz, %d points with coherence >= %.2f\n",
-      mounting.c_str(), fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, fit.delay_ms,
-      fit.fit_error_pct, fit.band_lo_hz, fit.band_hi_hz, fit.points, kActuatorMinCoherence);
+  const identify::ActuatorReport r = identify::actuator_report(fit, mounting, kActuatorMinCoherence);
+  std::fputs(r.text.c_str(), stdout);
   if (a.json.given) {
-    const nlohmann::json j = {{"mounting", mounting},
-                              {"force_constant_n_per_v", fit.force_constant_n_per_v},
-                              {"natural_freq_hz", fit.natural_freq_hz},
-                              {"damping_ratio", fit.damping_ratio},
-                              {"delay_ms", fit.delay_ms},
-                              {"fit_error_pct", fit.fit_error_pct},
-                              {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}},
-                              {"points", fit.points}};
-    if (!emit_json(a.json, j.dump(2), "identify")) return 1;
+    if (!emit_json(a.json, r.json.dump(2), "identify")) return 1;
     if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   return 0;
@@ -174,7 +127,7 @@ int run_identify_all(const IdentifyArgs& a) {
     std::string e;
     for (const auto& f : r.frfs)
       if (e.empty()) e = identify::plot_modal_fit(f.data, f.fit, a.plot_dir, f.name);
-    if (e.empty()) e = plot_actuator(r.actuator, a.plot_dir, "actuator_fit.png");
+    if (e.empty()) e = identify::plot_actuator_fit(r.actuator, a.plot_dir, "actuator_fit.png");
     if (!e.empty()) {
       std::cerr << "plot: " << e << '\n';
       return 1;

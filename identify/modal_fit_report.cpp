@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "analysis/spectral.hpp"
+#include "identify/numeric_csv.hpp"
 #include "identify/uff_frf.hpp"
 #include "measfiles/uff.hpp"
 #include "plot/frf_figure.hpp"
@@ -125,6 +127,62 @@ std::string plot_modal_fit(const FrfData& d, const ModalFit& fit, const std::str
       "set title 'Stabilisation diagram (LSCF)'\nset grid\nset xlabel 'frequency (Hz)'\nset ylabel 'model order'\n"
       "plot DATA u 1:($3 == 0 ? $2 : 1/0) w p pt 1 t 'new pole', DATA u 1:($3 == 1 ? $2 : 1/0) w p pt 7 t 'stable'\n";
   return plot::run_gnuplot(s2, diag.str(), dir + "/" + prefix + "_stabilisation.png");
+}
+
+// From a CSV of the amplifier command and the transmitted force (Welch).
+ActuatorFit actuator_from_force_csv(const std::string& path, double segment_s, double overlap,
+                                    const std::vector<double>& band_hz, double min_coherence) {
+  const TimeSeries ts = read_time_series_csv(path, "time_s,command_v,force_n");
+  const auto segment = static_cast<std::size_t>(std::lround(segment_s * ts.fs_hz));
+  if (segment < 16 || segment > ts.input.size())
+    throw std::invalid_argument("--segment-s = " + std::to_string(segment_s) + " s = " + std::to_string(segment) +
+                                " samples: allowed 16 .. the record's " + std::to_string(ts.input.size()));
+  const analysis::FrfEstimate e = analysis::welch_frf(ts.input, ts.output, ts.fs_hz, segment, overlap, 0.45 * ts.fs_hz);
+  ActuatorFrf g;
+  for (std::size_t k = 1; k < e.f_hz.size(); ++k)
+    g.f_hz.push_back(e.f_hz[k]), g.n_per_v.push_back(e.h1[k]), g.coherence.push_back(e.coherence[k]);
+  ActuatorFitSettings s;
+  if (band_hz.size() == 2) s.band_lo_hz = band_hz[0], s.band_hi_hz = band_hz[1];
+  s.min_coherence = min_coherence;
+  return fit_actuator(g, s);
+}
+
+// Measured against fitted force per volt (magnitude and phase) in dir/<name>.
+std::string plot_actuator_fit(const ActuatorFit& fit, const std::string& dir, const std::string& name) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  std::ostringstream data;
+  for (std::size_t i = 0; i < fit.f_hz.size(); ++i)
+    data << fit.f_hz[i] << ' ' << std::abs(fit.measured[i]) << ' ' << std::arg(fit.measured[i]) * 180.0 / M_PI << ' '
+         << std::abs(fit.fitted[i]) << ' ' << std::arg(fit.fitted[i]) * 180.0 / M_PI << '\n';
+  std::ostringstream s;
+  s << "set multiplot layout 2,1 title 'Actuator force per volt: measured and Eq. 3 fitted (fit error "
+    << fit.fit_error_pct << " %)'\nset grid\nset logscale x\nset ylabel '|F/V| (N/V)'\n"
+    << "plot DATA u 1:2 w l t 'measured (hold as 1.5 periods)', DATA u 1:4 w l lw 2 t 'fit (exactly sampled)'\n"
+    << "set xlabel 'frequency (Hz)'\nset ylabel 'phase (deg)'\nplot DATA u 1:3 w l t 'measured (hold as 1.5 periods)', "
+       "DATA u 1:5 w l lw 2 t 'fit (exactly sampled)'\n"
+    << "unset multiplot\n";
+  return plot::run_gnuplot(s.str(), data.str(), dir + "/" + name);
+}
+
+ActuatorReport actuator_report(const ActuatorFit& fit, const std::string& mounting, double min_coherence) {
+  ActuatorReport r;
+  char b[512];
+  std::snprintf(b, sizeof b,
+                "Actuator (%s mounting): T %.4f N/V, natural frequency %.4f Hz, damping ratio %.4f, delay %.4f ms\n"
+                "  fit error %.3f %% (RMS |G - fit| / RMS |G|) over %.3g-%.3g Hz, %d points with coherence >= %.2f\n",
+                mounting.c_str(), fit.force_constant_n_per_v, fit.natural_freq_hz, fit.damping_ratio, fit.delay_ms,
+                fit.fit_error_pct, fit.band_lo_hz, fit.band_hi_hz, fit.points, min_coherence);
+  r.text = b;
+  r.json = {{"mounting", mounting},
+            {"force_constant_n_per_v", fit.force_constant_n_per_v},
+            {"natural_freq_hz", fit.natural_freq_hz},
+            {"damping_ratio", fit.damping_ratio},
+            {"delay_ms", fit.delay_ms},
+            {"fit_error_pct", fit.fit_error_pct},
+            {"band_hz", {fit.band_lo_hz, fit.band_hi_hz}},
+            {"points", fit.points}};
+  return r;
 }
 
 }  // namespace robodamp::identify

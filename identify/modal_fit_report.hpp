@@ -1,6 +1,7 @@
 // What `robodamp identify modes` reports of one FRF (docs/identification.md): where the FRF comes from (a
 // universal file's record, a table, or time series through Welch), the fitted modes as a table, JSON and a
-// `modes:` list to paste into a preset or a milling job, and the fit's plots. Off the real-time path.
+// `modes:` list to paste into a preset or a milling job, and the fit's plots; and `identify actuator`'s Eq. 3
+// from a table of command and transmitted force, its report and plot. Off the real-time path.
 #pragma once
 
 #include <optional>
@@ -9,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "identify/actuator_fit.hpp"
 #include "identify/modal_fit.hpp"
 
 namespace robodamp::identify {
@@ -45,5 +47,20 @@ struct ModalFitReport {
 // stabilisation diagram (<prefix>_stabilisation.png) in dir; an empty string, or what went wrong.
 [[nodiscard]] std::string plot_modal_fit(const FrfData& d, const ModalFit& fit, const std::string& dir,
                                          const std::string& prefix);
+
+// Eq. 3 from a table time_s,command_v,force_n (the amplifier's command and the force transmitted) through Welch
+// (segment_s, overlap), fitted where the coherence is at least min_coherence, in band_hz (empty: the chirp's).
+// Throws std::invalid_argument naming the option.
+[[nodiscard]] ActuatorFit actuator_from_force_csv(const std::string& path, double segment_s, double overlap,
+                                                  const std::vector<double>& band_hz, double min_coherence);
+
+struct ActuatorReport {
+  nlohmann::json json;
+  std::string text;
+};
+[[nodiscard]] ActuatorReport actuator_report(const ActuatorFit& fit, const std::string& mounting, double min_coherence);
+
+// Measured against fitted force per volt (magnitude and phase) in dir/name; an empty string, or what went wrong.
+[[nodiscard]] std::string plot_actuator_fit(const ActuatorFit& fit, const std::string& dir, const std::string& name);
 
 }  // namespace robodamp::identify
