@@ -36,6 +36,23 @@ struct NamedCounts {
   std::string_view (*name_of)(std::size_t index);
 };
 
+// A member that is a struct with a field list of its own: its fields under key ("" at this level).
+template <class S, class T>
+struct Nested {
+  std::string_view key;
+  T S::*member;
+};
+
+// A member with a JSON form of its own (a set of enum values by name): to and from nlohmann::json, declared
+// in fields/json.hpp's terms by the list that uses it (the list's header includes fields/json.hpp).
+template <class S, class T, class Json>
+struct Converted {
+  std::string_view key;
+  T S::*member;
+  Json (*to)(const T&);
+  T (*from)(const Json&);
+};
+
 template <class S>
 [[nodiscard]] constexpr auto list_of() {
   return field_list(Tag<S>{});

@@ -38,11 +38,38 @@ inline const nlohmann::json* find(const nlohmann::json& j, std::string_view key)
 }
 }  // namespace detail
 
+namespace detail {
+template <class F>
+struct IsNested : std::false_type {};
+template <class S, class T>
+struct IsNested<Nested<S, T>> : std::true_type {};
+template <class F>
+struct IsConverted : std::false_type {};
+template <class S, class T, class J>
+struct IsConverted<Converted<S, T, J>> : std::true_type {};
+// The object a nested field's fields go into: j itself for the key "".
+inline nlohmann::json& nested_slot(nlohmann::json& j, std::string_view key) {
+  if (key.empty()) return j;
+  nlohmann::json& n = slot(j, key);
+  if (!n.is_object()) n = nlohmann::json::object();
+  return n;
+}
+inline const nlohmann::json* nested_find(const nlohmann::json& j, std::string_view key) {
+  return key.empty() ? &j : find(j, key);
+}
+}  // namespace detail
+
 // Adds s's fields to j (an object).
 template <class S>
 void add_json(nlohmann::json& j, const S& s) {
   for_each_field(s, [&](const auto& field, const auto& value) {
-    if constexpr (std::is_integral_v<std::decay_t<decltype(value)>>) {
+    using F = std::decay_t<decltype(field)>;
+    using V = std::decay_t<decltype(value)>;
+    if constexpr (detail::IsNested<F>::value) {
+      add_json(detail::nested_slot(j, field.key), value);
+    } else if constexpr (detail::IsConverted<F>::value) {
+      detail::slot(j, field.key) = field.to(value);
+    } else if constexpr (std::is_arithmetic_v<V>) {
       detail::slot(j, field.key) = value;
     } else {
       nlohmann::json named = nlohmann::json::object();
@@ -59,27 +86,39 @@ template <class S>
   return j;
 }
 
-// s from j; a field j does not hold keeps s's value (a summary written before the field existed).
+// s from j, over `start`: a field j does not hold keeps start's value (a summary or a recording written before
+// the field existed: start says how such a file behaved).
 template <class S>
-[[nodiscard]] S from_json(const nlohmann::json& j) {
-  S s{};
+[[nodiscard]] S from_json(const nlohmann::json& j, S start) {
   std::apply(
       [&](const auto&... field) {
         auto read = [&](const auto& f) {
-          const nlohmann::json* v = detail::find(j, f.key);
-          if (v == nullptr) return;
-          auto& member = s.*(f.member);
-          if constexpr (std::is_integral_v<std::decay_t<decltype(member)>>) {
-            member = v->template get<std::decay_t<decltype(member)>>();
+          using F = std::decay_t<decltype(f)>;
+          auto& member = start.*(f.member);
+          using V = std::decay_t<decltype(member)>;
+          if constexpr (detail::IsNested<F>::value) {
+            if (const nlohmann::json* n = detail::nested_find(j, f.key)) member = from_json<V>(*n, member);
           } else {
-            for (std::size_t i = 1; i < member.size(); ++i)
-              member[i] = v->value(std::string(f.name_of(i)), std::uint64_t{0});
+            const nlohmann::json* v = detail::find(j, f.key);
+            if (v == nullptr) return;
+            if constexpr (detail::IsConverted<F>::value) {
+              member = f.from(*v);
+            } else if constexpr (std::is_arithmetic_v<V>) {
+              member = v->template get<V>();
+            } else {
+              for (std::size_t i = 1; i < member.size(); ++i)
+                member[i] = v->value(std::string(f.name_of(i)), std::uint64_t{0});
+            }
           }
         };
         (read(field), ...);
       },
       list_of<S>());
-  return s;
+  return start;
+}
+template <class S>
+[[nodiscard]] S from_json(const nlohmann::json& j) {
+  return from_json<S>(j, S{});
 }
 
 // A report's number: null where it is not finite or not there.

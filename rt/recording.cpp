@@ -4,6 +4,7 @@
 #include <cstring>
 #include <ctime>
 
+#include "rt/settings_fields.hpp"
 #include "rt/version.hpp"
 
 namespace robodamp::rt {
@@ -115,72 +116,14 @@ control::ControllerParams controller_params_from(const json& j) {
   return p;
 }
 
-json to_json(const SupervisorSettings& s) {
-  const auto& l = s.limits;
-  return {{"stale_sensor_cycles", l.stale_sensor_cycles},
-          {"zero_command_while_stale", l.zero_command_while_stale},
-          {"invalid_sample_cycles", l.invalid_sample_cycles},
-          {"sample_limit_mps2", l.sample_limit_mps2},
-          {"overrun_cycles", l.overrun_cycles},
-          {"overrun_delay_margin_share", l.overrun_delay_margin_share},
-          {"saturation_window_s", l.saturation_window_s},
-          {"saturation_duty_max", l.saturation_duty_max},
-          {"instability_block_s", l.instability_block_s},
-          {"instability_blocks", l.instability_blocks},
-          {"instability_growth_factor", l.instability_growth_factor},
-          {"instability_floor_v", l.instability_floor_v},
-          {"trip_ramp_s", l.trip_ramp_s},
-          {"arming_live_cycles", l.arming_live_cycles},
-          {"amplifier_ready_timeout_s", l.amplifier_ready_timeout_s},
-          {"max_gain_fraction", l.max_gain_fraction},
-          {"recovery",
-           {{"recoverable", trip_names(l.recovery.recoverable)},
-            {"cool_down_s", l.recovery.cool_down_s},
-            {"healthy_for_s", l.recovery.healthy_for_s},
-            {"max_recoveries", l.recovery.max_recoveries},
-            {"window_s", l.recovery.window_s},
-            {"probation_s", l.recovery.probation_s}}},
-          {"derate",
-           {{"enabled", l.derate.enabled},
-            {"probe_blocks", l.derate.probe_blocks},
-            {"probe_factor", l.derate.probe_factor},
-            {"hold_factor", l.derate.hold_factor},
-            {"probe_ramp_s", l.derate.probe_ramp_s},
-            {"quiet_s", l.derate.quiet_s},
-            {"restore_s", l.derate.restore_s},
-            {"saturation_factor", l.derate.saturation_factor},
-            {"min_factor", l.derate.min_factor}}},
-          {"fs_hz", s.fs_hz},
-          {"resolved_sample_limit_mps2", s.sample_limit_mps2},
-          {"fade_s", s.fade_s},
-          {"analysis_stable", s.analysis_stable},
-          {"max_stable_gain_ns_per_m", s.max_stable_gain_ns_per_m},
-          {"delay_margin_s", s.delay_margin_s},
-          {"pose_scheduled", s.pose_scheduled},
-          {"command_limit_v", s.command_limit_v}};
-}
+json to_json(const SupervisorSettings& s) { return fields::to_json(s); }
 
-json to_json(const PeriodicChirp& c) {
-  return {{"enabled", c.enabled},         {"start_s", c.start_s}, {"period_s", c.period_s},
-          {"periods", c.periods},         {"f0_hz", c.f0_hz},     {"f1_hz", c.f1_hz},
-          {"amplitude_v", c.amplitude_v}, {"ramp_s", c.ramp_s},   {"on_command", c.on_command}};
-}
+json to_json(const PeriodicChirp& c) { return fields::to_json(c); }
 
 namespace {
 
-PeriodicChirp chirp_from(const json& t) {
-  PeriodicChirp c;
-  c.enabled = t.at("enabled");
-  c.start_s = t.at("start_s");
-  c.period_s = t.at("period_s");
-  c.periods = t.at("periods");
-  c.f0_hz = t.at("f0_hz");
-  c.f1_hz = t.at("f1_hz");
-  c.amplitude_v = t.at("amplitude_v");
-  c.ramp_s = t.value("ramp_s", 0.0);            // recorded before the ramp existed: none
-  c.on_command = t.value("on_command", false);  // recorded before measure --along-path: a start time
-  return c;
-}
+// A chirp recorded before its ramp or its start on command existed: none, a start time.
+PeriodicChirp chirp_from(const json& t) { return fields::from_json<PeriodicChirp>(t); }
 
 }  // namespace
 
@@ -192,63 +135,23 @@ PeriodicChirp excitation_from(const json& header) {
 }
 
 SupervisorSettings supervisor_settings_from(const json& j) {
-  SupervisorSettings s;
-  auto& l = s.limits;
-  l.stale_sensor_cycles = j.at("stale_sensor_cycles");
-  l.zero_command_while_stale = j.value("zero_command_while_stale", false);  // absent before the stale ride-through
-  l.invalid_sample_cycles = j.at("invalid_sample_cycles");
-  l.sample_limit_mps2 = j.at("sample_limit_mps2");
-  l.overrun_cycles = j.at("overrun_cycles");
-  l.overrun_delay_margin_share = j.value("overrun_delay_margin_share", 0.0);  // absent before issue 28's ride-through
-  l.saturation_window_s = j.at("saturation_window_s");
-  l.saturation_duty_max = j.at("saturation_duty_max");
-  l.instability_block_s = j.at("instability_block_s");
-  l.instability_blocks = j.at("instability_blocks");
-  l.instability_growth_factor = j.at("instability_growth_factor");
-  l.instability_floor_v = j.at("instability_floor_v");
-  l.trip_ramp_s = j.at("trip_ramp_s");
-  l.arming_live_cycles = j.at("arming_live_cycles");
-  l.amplifier_ready_timeout_s = j.at("amplifier_ready_timeout_s");
-  l.max_gain_fraction = j.at("max_gain_fraction");
-  if (j.contains("recovery")) {
-    const json& r = j.at("recovery");
-    l.recovery.recoverable = trips_named(r.at("recoverable").get<std::vector<std::string>>());
-    l.recovery.cool_down_s = r.at("cool_down_s");
-    l.recovery.healthy_for_s = r.at("healthy_for_s");
-    l.recovery.max_recoveries = r.at("max_recoveries");
-    l.recovery.window_s = r.at("window_s");
-    l.recovery.probation_s = r.at("probation_s");
-  } else {
-    l.recovery.recoverable.clear();  // recorded before recovery existed: every trip latched
-  }
-  if (j.contains("derate")) {
-    const json& d = j.at("derate");
-    l.derate.enabled = d.at("enabled");
-    l.derate.probe_blocks = d.at("probe_blocks");
-    l.derate.probe_factor = d.at("probe_factor");
-    l.derate.hold_factor = d.at("hold_factor");
-    l.derate.probe_ramp_s = d.at("probe_ramp_s");
-    l.derate.quiet_s = d.at("quiet_s");
-    l.derate.restore_s = d.at("restore_s");
-    l.derate.saturation_factor = d.at("saturation_factor");
-    l.derate.min_factor = d.at("min_factor");
-  } else {
-    l.derate.enabled = false;  // recorded before derating existed: growth and saturation tripped
-  }
-  s.fs_hz = j.at("fs_hz");
-  s.sample_limit_mps2 = j.at("resolved_sample_limit_mps2");
-  s.fade_s = j.at("fade_s");
-  s.analysis_stable = j.at("analysis_stable");
-  s.max_stable_gain_ns_per_m = j.at("max_stable_gain_ns_per_m");
-  s.delay_margin_s = j.value("delay_margin_s", 0.0);
-  s.pose_scheduled = j.value("pose_scheduled", false);  // absent before pose_schedule existed
+  // What a recording made before a key existed ran with: no stale ride-through, no overrun ride-through, every
+  // trip latched (before recovery), growth and saturation tripping (before derating); the others' defaults.
+  SupervisorSettings legacy;
+  legacy.limits.zero_command_while_stale = false;
+  legacy.limits.overrun_delay_margin_share = 0.0;
+  legacy.limits.recovery.recoverable.clear();
+  legacy.limits.derate.enabled = false;
+  SupervisorSettings s = fields::from_json<SupervisorSettings>(j, legacy);
   // Recorded while the supervisor owned the chirp: its voltage limit was the chirp's; before that, none.
-  if (j.contains("command_limit_v"))
-    s.command_limit_v = j.at("command_limit_v");
-  else if (j.contains("test_signal"))
+  if (!j.contains("command_limit_v") && j.contains("test_signal"))
     s.command_limit_v = j.at("test_signal").at("voltage_limit_v");
   return s;
 }
+
+json trips_to_json(const std::vector<Trip>& trips) { return trip_names(trips); }
+
+std::vector<Trip> trips_from_json(const json& names) { return trips_named(names.get<std::vector<std::string>>()); }
 
 std::vector<std::string> trip_names(const std::vector<Trip>& trips) {
   std::vector<std::string> out;

@@ -10,6 +10,8 @@
 #include "fields/json.hpp"
 #include "runtime/joint_state_pose.hpp"
 #include "runtime/path_ahead.hpp"
+#include "rt/recording.hpp"
+#include "rt/settings_fields.hpp"
 #include "rt/supervisor.hpp"
 
 namespace robodamp {
@@ -98,4 +100,61 @@ TEST(Fields, NestedKeysAndTheTripsByName) {
 }
 
 }  // namespace
+// The recording header's settings (rt/settings_fields.hpp): every member with a value of its own goes to the
+// header's JSON and back (the recovery's trips by name, the limits at the supervisor object's level, recovery
+// and derating nested), and a header written before a key existed reads as that recording ran.
+TEST(Fields, TheRecordedSettingsGoToJsonAndBackAndOldHeadersReadAsTheyRan) {
+  rt::SupervisorSettings s;
+  rt::SupervisionLimits& l = s.limits;
+  l.stale_sensor_cycles = 7, l.zero_command_while_stale = false, l.invalid_sample_cycles = 3;
+  l.sample_limit_mps2 = 123.5, l.overrun_cycles = 11, l.overrun_delay_margin_share = 0.25;
+  l.saturation_window_s = 0.7, l.saturation_duty_max = 0.3, l.instability_block_s = 0.2, l.instability_blocks = 5;
+  l.instability_growth_factor = 1.7, l.instability_floor_v = 0.03, l.trip_ramp_s = 0.02, l.arming_live_cycles = 40;
+  l.arm_retry_s = 0.6, l.arm_deadline_s = 12.0, l.amplifier_ready_timeout_s = 0.3, l.max_gain_fraction = 0.8;
+  l.recovery.recoverable = {rt::Trip::kSensorStale, rt::Trip::kOverruns};
+  l.recovery.cool_down_s = 1.5, l.recovery.healthy_for_s = 2.5, l.recovery.max_recoveries = 4;
+  l.recovery.window_s = 500.0, l.recovery.probation_s = 9.0;
+  l.derate.enabled = false, l.derate.probe_blocks = 3, l.derate.probe_factor = 0.1, l.derate.hold_factor = 0.4;
+  l.derate.probe_ramp_s = 0.03, l.derate.quiet_s = 1.2, l.derate.restore_s = 2.2, l.derate.saturation_factor = 0.6;
+  l.derate.min_factor = 0.05;
+  s.fs_hz = 4000.0, s.sample_limit_mps2 = 490.5, s.fade_s = 0.4, s.analysis_stable = true;
+  s.max_stable_gain_ns_per_m = 4321.0, s.delay_margin_s = 0.012, s.command_limit_v = 9.0, s.pose_scheduled = true;
+  const nlohmann::json j = rt::to_json(s);
+  EXPECT_EQ(j["stale_sensor_cycles"], 7);
+  EXPECT_EQ(j["resolved_sample_limit_mps2"], 490.5);
+  EXPECT_EQ(j["recovery"]["recoverable"], (nlohmann::json{"sensor_stale", "overruns"}));
+  EXPECT_EQ(j["derate"]["min_factor"], 0.05);
+  const rt::SupervisorSettings back = rt::supervisor_settings_from(j);
+  EXPECT_EQ(rt::to_json(back), j);  // every field, the nested ones and the trips included
+  EXPECT_EQ(back.limits.recovery.recoverable, l.recovery.recoverable);
+  // A header from before the stale and overrun ride-throughs, recovery, derating and the supervisor's own
+  // command limit: the chirp's voltage limit, and what such a recording ran with.
+  nlohmann::json old = j;
+  for (const char* key : {"zero_command_while_stale", "overrun_delay_margin_share", "recovery", "derate",
+                          "command_limit_v", "arm_retry_s", "arm_deadline_s"})
+    old.erase(key);
+  old["test_signal"] = {{"voltage_limit_v", 7.5}};
+  const rt::SupervisorSettings was = rt::supervisor_settings_from(old);
+  EXPECT_FALSE(was.limits.zero_command_while_stale);
+  EXPECT_EQ(was.limits.overrun_delay_margin_share, 0.0);
+  EXPECT_TRUE(was.limits.recovery.recoverable.empty());
+  EXPECT_FALSE(was.limits.derate.enabled);
+  EXPECT_EQ(was.command_limit_v, 7.5);
+  EXPECT_EQ(was.limits.arm_retry_s, rt::SupervisionLimits{}.arm_retry_s);
+  EXPECT_EQ(was.limits.stale_sensor_cycles, 7);
+  // A trip the program does not know is refused by name.
+  nlohmann::json bad = j;
+  bad["recovery"]["recoverable"] = {"sensor_stale", "gremlins"};
+  EXPECT_THROW((void)rt::supervisor_settings_from(bad), rt::RecordingError);
+  // The chirp, and one recorded before its ramp and its start on command.
+  rt::PeriodicChirp c{true, 1.0, 6.0, 3, 2.0, 60.0, 0.4, 0.5, true};
+  EXPECT_EQ(fields::to_json(fields::from_json<rt::PeriodicChirp>(rt::to_json(c))), rt::to_json(c));
+  nlohmann::json old_chirp = rt::to_json(c);
+  old_chirp.erase("ramp_s"), old_chirp.erase("on_command");
+  const auto oc = fields::from_json<rt::PeriodicChirp>(old_chirp);
+  EXPECT_EQ(oc.ramp_s, 0.0);
+  EXPECT_FALSE(oc.on_command);
+  EXPECT_EQ(oc.f1_hz, 60.0);
+}
+
 }  // namespace robodamp
