@@ -29,7 +29,8 @@ namespace {
 using nlohmann::json;
 
 struct TuneArgs {
-  tune::TuneCommand cmd{default_cell_config()};
+  TuneArgs() { cmd.config_path = default_cell_config(); }
+  tune::TuneCommand cmd;
   JsonOut json;
   std::string plot_dir, plot_path;
 };
