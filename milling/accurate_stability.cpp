@@ -82,13 +82,30 @@ std::optional<std::string> AccurateStability::speed_problem(double rpm) const {
   return std::nullopt;
 }
 
-SdmPoint AccurateStability::search(double rpm, double guess_mm, double rel_tol) const {
-  const double guess = std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0;
-  return sampled_ ? sampled_->critical(rpm, guess, rel_tol) : open_->critical(rpm, guess, rel_tol);
+class AccurateStability::Speed {
+ public:
+  Speed(const AccurateStability& a, double rpm) : open_(a.open_.get()), rpm_(rpm) {
+    if (a.sampled_) sampled_.emplace(a.sampled_->at(rpm));
+  }
+  [[nodiscard]] double ln_mu(double axial_mm) {
+    return std::log(std::abs(sampled_ ? sampled_->multiplier(axial_mm) : open_->multiplier(axial_mm, rpm_)));
+  }
+  [[nodiscard]] SdmPoint critical(double guess_mm, double rel_tol) {
+    return sampled_ ? sampled_->critical(guess_mm, rel_tol) : open_->critical(rpm_, guess_mm, rel_tol);
+  }
+
+ private:
+  const SdmModel* open_;
+  std::optional<SampledSdm::AtSpeed> sampled_;
+  double rpm_;
+};
+
+SdmPoint AccurateStability::search(Speed& at, double guess_mm, double rel_tol) const {
+  return at.critical(std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0, rel_tol);
 }
 
-std::optional<double> AccurateStability::first_unstable(double rpm, double from_mm, double to_mm) const {
-  const auto g = [&](double b) { return ln_mu(b, rpm); };
+std::optional<double> AccurateStability::first_unstable(Speed& at, double from_mm, double to_mm) {
+  const auto g = [&](double b) { return at.ln_mu(b); };
   double b0 = 0.0, g0 = 0.0, b1 = 0.0, g1 = 0.0;  // the two probes before this one
   int probes = 0;
   for (double b = from_mm; b < to_mm; b *= kProbeStep, ++probes) {
@@ -101,15 +118,16 @@ std::optional<double> AccurateStability::first_unstable(double rpm, double from_
   return std::nullopt;
 }
 
-SdmPoint AccurateStability::below(double rpm, const SdmPoint& p, double from_mm, double rel_tol) const {
+SdmPoint AccurateStability::below(Speed& at, const SdmPoint& p, double from_mm, double rel_tol) const {
   const double to = std::isfinite(p.critical_depth_mm) ? p.critical_depth_mm : kMaxProbeMm;
   if (!(from_mm < to)) return p;
-  const std::optional<double> u = first_unstable(rpm, from_mm, to);
-  return u ? search(rpm, *u, rel_tol) : p;
+  const std::optional<double> u = first_unstable(at, from_mm, to);
+  return u ? search(at, *u, rel_tol) : p;
 }
 
 SdmPoint AccurateStability::critical(double rpm, double guess_mm, double rel_tol) const {
-  return below(rpm, search(rpm, guess_mm, rel_tol), floor_mm_, rel_tol);
+  Speed at(*this, rpm);
+  return below(at, search(at, guess_mm, rel_tol), floor_mm_, rel_tol);
 }
 
 std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
@@ -124,7 +142,12 @@ std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm
   for (std::size_t i = 0; i < rpm.size(); ++i)
     tasks.emplace_back([&, i] {
       const double guess = i < guess_mm.size() ? guess_mm[i] : 1.0;
-      out[i] = diagram ? search(rpm[i], guess, rel_tol) : critical(rpm[i], guess, rel_tol);
+      if (diagram) {
+        Speed at(*this, rpm[i]);
+        out[i] = search(at, guess, rel_tol);
+      } else {
+        out[i] = critical(rpm[i], guess, rel_tol);
+      }
       if (progress) {
         const std::lock_guard<std::mutex> lock(m);
         progress(++done);
@@ -154,7 +177,8 @@ void AccurateStability::below_neighbours(const std::vector<double>& rpm, std::ve
     for (std::size_t k = 0; k < todo.size(); ++k)
       tasks.emplace_back([&, k] {
         const auto [i, from] = todo[k];
-        next[k] = below(rpm[i], out[i], from, rel_tol);
+        Speed at(*this, rpm[i]);
+        next[k] = below(at, out[i], from, rel_tol);
       });
     analysis::run_tasks(tasks, analysis::task_threads(threads));
     check.clear();

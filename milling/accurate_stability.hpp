@@ -65,18 +65,17 @@ class AccurateStability {
   [[nodiscard]] double floor_mm() const { return floor_mm_; }
 
  private:
+  // One speed's model, kept across its search and its probes (the sampled loop's system and propagators).
+  class Speed;
   // One crossing of |mu| = 1 from the guess (bracketed in steps of 1.6, then Illinois; milling/sdm.hpp).
-  [[nodiscard]] SdmPoint search(double rpm, double guess_mm, double rel_tol) const;
-  // The shallowest crossing below `p` (a search's answer at rpm) from probes starting at from_mm; p if none.
-  [[nodiscard]] SdmPoint below(double rpm, const SdmPoint& p, double from_mm, double rel_tol) const;
+  [[nodiscard]] SdmPoint search(Speed& at, double guess_mm, double rel_tol) const;
+  // The shallowest crossing below `p` (a search's answer at the speed) from probes starting at from_mm; p if none.
+  [[nodiscard]] SdmPoint below(Speed& at, const SdmPoint& p, double from_mm, double rel_tol) const;
   // The first depth in [from_mm, to_mm) found unstable by the probes and their peaks' searches, or nothing.
-  [[nodiscard]] std::optional<double> first_unstable(double rpm, double from_mm, double to_mm) const;
+  [[nodiscard]] static std::optional<double> first_unstable(Speed& at, double from_mm, double to_mm);
   // A diagram's rounds: each depth above a neighbour's probed from the neighbour's (critical(), above).
   void below_neighbours(const std::vector<double>& rpm, std::vector<SdmPoint>& out, std::size_t threads,
                         double rel_tol) const;
-  [[nodiscard]] double ln_mu(double axial_mm, double rpm) const {
-    return std::log(std::abs(multiplier(axial_mm, rpm)));
-  }
 
   std::string method_;
   double floor_mm_{0.0};

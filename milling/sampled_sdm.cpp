@@ -182,11 +182,13 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, 
   x.leftCols(n).setIdentity();
   std::vector<MatrixXd> g(static_cast<std::size_t>(k) + 1);
   g[0] = sys.c * x;
-  auto ref = [&](int q) -> MatrixXd {
-    if (q >= 0) return g[static_cast<std::size_t>(q)];
-    MatrixXd e = MatrixXd::Zero(2, dim);
-    e.block(0, n + 2 * (-q - 1), 2, 2).setIdentity();
-    return e;
+  // y += w_i times grid value q: a current one is a 2 x dim row pair; a delayed one is its own history
+  // column pair (the identity there), so the product is w_i added to those columns (the same sums).
+  auto add_ref = [&](MatrixXd& y, const auto& wi, int q) {
+    if (q >= 0)
+      y.noalias() += wi * g[static_cast<std::size_t>(q)];
+    else
+      y.middleCols(n + 2 * (-q - 1), 2) += wi;
   };
   MatrixXd w(n, 12), y(n, dim);
   // The history columns are reached from the oldest: before interval j only g_-(k+1) .. g_-(k-j) have entered
@@ -222,7 +224,7 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, 
     y.middleCols(head, live - head).setZero();
     live = std::max(head, std::min(live, n + 2 * static_cast<Eigen::Index>(std::max(0, k - j - 2))));
     if (any) {
-      for (int i : {0, 1, 3, 4, 5}) y.noalias() += w.middleCols(2 * i, 2) * ref(refs[i]);
+      for (int i : {0, 1, 3, 4, 5}) add_ref(y, w.middleCols(2 * i, 2), refs[i]);
       const MatrixXd wu = w.middleCols(4, 2);
       const Eigen::Matrix2d m = Eigen::Matrix2d::Identity() - sys.c * wu;
       const MatrixXd next = m.partialPivLu().solve(sys.c * y);
@@ -260,33 +262,45 @@ double SampledSdm::chatter_hz(const Result& r, int ticks) const {
   return floquet_chatter_hz(r.mu, t, r.history, 1.0 / (ticks * tick_s_));
 }
 
-std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const {
+SampledSdm::AtSpeed::AtSpeed(const SampledSdm& sdm, double rpm)
+    : sdm_(&sdm),
+      ticks_(sdm.ticks_per_tooth(rpm)),
+      rpm_(sdm.stepped_rpm(rpm)),
+      sys_(sdm.per_speed_ ? sdm.system_at(rpm_) : sdm.base_) {}
+
+SampledSdm::AtSpeed SampledSdm::at(double rpm) const { return AtSpeed(*this, rpm); }
+
+std::complex<double> SampledSdm::AtSpeed::multiplier(double axial_mm) {
   if (!(axial_mm > 0.0) || !std::isfinite(axial_mm))
     throw std::invalid_argument("axial depth = " + fmt(axial_mm) + " mm: must be > 0 and finite");
-  const int ticks = ticks_per_tooth(rpm);
-  Propagators cache;
-  return monodromy(per_speed_ ? system_at(stepped_rpm(rpm)) : base_, cache, axial_mm, ticks, false).mu;
+  cache_.dominant = DominantMultiplier{};
+  return sdm_->monodromy(sys_, cache_, axial_mm, ticks_, false).mu;
 }
 
-SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const {
-  const int ticks = ticks_per_tooth(rpm);
-  const double at_rpm = stepped_rpm(rpm);
-  const System sys = per_speed_ ? system_at(at_rpm) : base_;
-  Propagators cache;
+SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
+  cache_.dominant = DominantMultiplier{};
   const DepthBracket br = find_critical_depth(
-      [&](double b) { return std::log(std::abs(monodromy(sys, cache, b, ticks, false).mu)); }, guess_mm, rel_tol);
+      [&](double b) { return std::log(std::abs(sdm_->monodromy(sys_, cache_, b, ticks_, false).mu)); }, guess_mm,
+      rel_tol);
   SdmPoint p;
-  p.rpm = at_rpm;
+  p.rpm = rpm_;
   p.critical_depth_mm = br.lo_mm;
   if (!std::isfinite(br.hi_mm)) {
     p.critical_depth_mm = br.hi_mm;
     return p;
   }
-  const double hi = br.hi_mm;
-  const Result r = monodromy(sys, cache, hi, ticks, true);
+  const Result r = sdm_->monodromy(sys_, cache_, br.hi_mm, ticks_, true);
   p.type = r.mu.real() < 0.0 && std::abs(r.mu.imag()) < 1e-3 * std::abs(r.mu) ? CutClass::kFlip : CutClass::kHopf;
-  p.chatter_hz = chatter_hz(r, ticks);
+  p.chatter_hz = sdm_->chatter_hz(r, ticks_);
   return p;
+}
+
+std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const {
+  return at(rpm).multiplier(axial_mm);
+}
+
+SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const {
+  return at(rpm).critical(guess_mm, rel_tol);
 }
 
 }  // namespace robodamp::milling

@@ -65,6 +65,10 @@ class SampledSdm {
   // Critical depth (relative tolerance rel_tol) from a first guess, at stepped_rpm(rpm) (in the result).
   [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
 
+  class AtSpeed;
+  // One speed's loop for the depths asked there (AccurateStability's search and its probes below it).
+  [[nodiscard]] AtSpeed at(double rpm) const;
+
  private:
   struct System {
     Eigen::MatrixXd a, b, c;  // cutter frame: b n x 2, c 2 x n
@@ -87,6 +91,7 @@ class SampledSdm {
                                  bool want_vector) const;
   [[nodiscard]] double chatter_hz(const Result& r, int ticks) const;
 
+  friend class AtSpeed;
   std::vector<Structure::ControllerPart> parts_;
   std::vector<CutterModalTerm> tables_;
   Cutter cutter_;
@@ -98,6 +103,26 @@ class SampledSdm {
   double tick_s_{0.0};
   bool per_speed_{false};  // harmonic notches: the loop depends on the speed
   System base_;
+};
+
+// One speed of a SampledSdm: the loop's system there (a LoopModel per speed with harmonic notches) and its
+// propagators A^m, A^r B made once and kept across every depth asked at that speed. Each call's answer is
+// bit for bit the one SampledSdm::multiplier() or critical() gives at the speed (each call starts its own
+// dominant-multiplier finder, as they do). Not shared between threads; the SampledSdm must outlive it.
+class SampledSdm::AtSpeed {
+ public:
+  [[nodiscard]] double rpm() const { return rpm_; }  // stepped
+  [[nodiscard]] std::complex<double> multiplier(double axial_mm);
+  [[nodiscard]] SdmPoint critical(double guess_mm, double rel_tol = 1e-3);
+
+ private:
+  friend class SampledSdm;
+  AtSpeed(const SampledSdm& sdm, double rpm);
+  const SampledSdm* sdm_;
+  int ticks_;
+  double rpm_;
+  System sys_;
+  Propagators cache_;
 };
 
 }  // namespace robodamp::milling
