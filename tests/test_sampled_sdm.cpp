@@ -138,6 +138,38 @@ TEST(SampledSdm, AtZeroGainItIsTheOpenLoopSdm) {
   }
 }
 
+// One speed's loop kept across depths (SampledSdm::AtSpeed, what AccurateStability's search and probes use)
+// answers bit for bit as a fresh multiplier() or critical() at that speed, in any order of depths, with the
+// loop fixed and with one that changes with the speed (harmonic notches: a LoopModel per speed).
+TEST(SampledSdm, OneSpeedsLoopKeptAcrossDepthsAnswersAsAFreshOneDoes) {
+  for (const bool notches : {false, true}) {
+    config::MillingConfig cfg = config::load_milling_config(job_path("active_damping_c2"));
+    if (notches)
+      for (auto& part : cfg.structures.front().parts)
+        if (part.controller) part.controller->config_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_cutting_c2.yaml";
+    const Structure damped(cfg.structures.front(), true);
+    const Cutter cutter = cutter_from(cfg.tool);
+    SampledSdmSettings settings;
+    settings.axial_slices = cfg.time_domain.axial_slices;
+    settings.min_grid_per_period = cfg.time_domain.sdm_steps_per_period;
+    const SampledSdm sdm(damped, cutter, cfg.material, cfg.cut.mode, cfg.cut.radial_mm, cfg.cut.feed_axis, settings);
+    for (const double rpm : {381.0, 700.0}) {
+      SampledSdm::AtSpeed at = sdm.at(rpm);
+      EXPECT_EQ(at.rpm(), sdm.stepped_rpm(rpm));
+      for (const double b : {0.9, 0.2, 2.5, 0.9, 0.45}) {
+        const std::complex<double> kept = at.multiplier(b), fresh = sdm.multiplier(b, rpm);
+        EXPECT_EQ(kept, fresh) << (notches ? "notches, " : "") << rpm << " rpm, " << b << " mm";
+      }
+      const SdmPoint kept = at.critical(0.5), fresh = sdm.critical(rpm, 0.5);
+      EXPECT_EQ(kept.critical_depth_mm, fresh.critical_depth_mm) << rpm << " rpm";
+      EXPECT_EQ(kept.chatter_hz, fresh.chatter_hz) << rpm << " rpm";
+      EXPECT_EQ(kept.type, fresh.type) << rpm << " rpm";
+      EXPECT_GT(kept.critical_depth_mm, 0.0);
+      EXPECT_LT(kept.critical_depth_mm, 100.0);
+    }
+  }
+}
+
 TEST(SampledSdm, RefusesWhatItCannotStepWithTheValueUnitAndRange) {
   const config::MillingConfig cfg = config::load_milling_config(job_path("active_damping_c2"));
   const Structure damped(cfg.structures.front(), true);
