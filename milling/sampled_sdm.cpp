@@ -295,9 +295,7 @@ SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
   return p;
 }
 
-std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const {
-  return at(rpm).multiplier(axial_mm);
-}
+std::complex<double> SampledSdm::multiplier(double axial_mm, double rpm) const { return at(rpm).multiplier(axial_mm); }
 
 SdmPoint SampledSdm::critical(double rpm, double guess_mm, double rel_tol) const {
   return at(rpm).critical(guess_mm, rel_tol);

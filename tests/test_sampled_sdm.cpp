@@ -146,7 +146,8 @@ TEST(SampledSdm, OneSpeedsLoopKeptAcrossDepthsAnswersAsAFreshOneDoes) {
     config::MillingConfig cfg = config::load_milling_config(job_path("active_damping_c2"));
     if (notches)
       for (auto& part : cfg.structures.front().parts)
-        if (part.controller) part.controller->config_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_cutting_c2.yaml";
+        if (part.controller)
+          part.controller->config_path = std::string(ROBODAMP_SOURCE_DIR) + "/config/hil_cutting_c2.yaml";
     const Structure damped(cfg.structures.front(), true);
     const Cutter cutter = cutter_from(cfg.tool);
     SampledSdmSettings settings;
