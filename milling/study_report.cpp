@@ -430,7 +430,7 @@ json job_limits_json(const config::Config& cfg, double rpm) {
   if (cfg.spindle.job_resolved.empty()) return nullptr;
   LiveStability live(config::load_milling_config(cfg.spindle.job_resolved), cfg.spindle.structure, {cfg});
   const LiveLimits l = live.compute(rpm, 0, cfg.controller.gain_ns_per_m);
-  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  const auto finite = fields::finite_or_null;
   return {{"rpm", rpm},
           {"depth_mm", live.depth_mm()},
           {"open_mm", finite(l.open_mm)},

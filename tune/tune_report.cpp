@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "analysis/loop_model.hpp"
+#include "fields/json.hpp"
 #include "plot/gnuplot.hpp"
 #include "tune/robustness.hpp"
 
@@ -43,7 +44,7 @@ json candidate_json(const Candidate& c) {
 }
 
 json evaluation_json(const Evaluation& e) {
-  auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  const auto finite = fields::finite_or_null;
   json j = {{"candidate", candidate_json(e.candidate)},
             {"stable", e.stable},
             {"gain_margin_db", finite(e.gain_margin_db)},
