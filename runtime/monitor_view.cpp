@@ -22,6 +22,21 @@ std::string mm(double v) {
 
 std::string monitor_status_text(const msg::Telemetry& t, std::uint64_t nt, const msg::Status& s, std::uint64_t ns) {
   char b[1200];
+  if (ns == 0) {  // the telemetry alone: the status's numbers (limit, set, timing, damping) are not known yet
+    std::snprintf(b, sizeof b,
+                  "robodamp monitor  cell %s  t = %.2f s  (no status yet)\n"
+                  "  state      %-10s trip %s\n"
+                  "  vibration  %.5f m/s^2 RMS (last %.5f m/s^2), velocity estimate %.3g m/s\n"
+                  "  command    %+.4f V (peak %.4f V), K = %.0f N s/m; limit, parameter set, timing and damping "
+                  "come with the first status\n"
+                  "  saturation %.1f %% of the last window\n"
+                  "  samples    %llu telemetry, 0 status; parameter writes -\n",
+                  t.cell().c_str(), t.time_s(), nt ? rt::to_string(static_cast<rt::State>(t.state())) : "-",
+                  nt ? rt::to_string(static_cast<rt::Trip>(t.trip())) : "-", t.accel_rms_mps2(), t.accel_mps2(),
+                  t.filtered_mps(), t.command_v(), t.command_peak_v(), t.gain_ns_per_m(),
+                  100.0 * t.saturated_fraction(), static_cast<unsigned long long>(nt));
+    return b;
+  }
   const char* state = ns ? s.state().c_str() : nt ? rt::to_string(static_cast<rt::State>(t.state())) : "-";
   const char* trip = ns ? s.trip().c_str() : nt ? rt::to_string(static_cast<rt::Trip>(t.trip())) : "-";
   std::snprintf(

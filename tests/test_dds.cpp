@@ -365,8 +365,10 @@ TEST(Dds, MonitorShowsTheSpindleSpeedDepthLimitsAndChatterIndicator) {
         // The preset's speed schedule hands over to its 700 rpm band (C1 at K 3040) first: the view after it, with
         // the indicator's verdict (after a speed change it collects revolutions for a window first: a loaded run's
         // three seconds of monitor once fell inside that).
+        // A status too (the parameter set comes with it; a loaded run's monitor once saw telemetry alone).
         return view.find("state      active") != std::string::npos && view.find("once-per-rev") != std::string::npos &&
-               view.find("damper active") != std::string::npos && view.find("K = 3040 N s/m") != std::string::npos &&
+               view.find("no status yet") == std::string::npos && view.find("damper active") != std::string::npos &&
+               view.find("K = 3040 N s/m") != std::string::npos &&
                (view.rfind("collecting revolutions") == std::string::npos ||
                 view.rfind("collecting revolutions") < view.rfind("once-per-rev"));
       },
