@@ -1,5 +1,6 @@
 #include "milling/sdm.hpp"
 #include "milling/dominant_multiplier.hpp"
+#include "milling/interval_collocation.hpp"
 #include "milling/interval_exp.hpp"
 #include "units/units.hpp"
 
@@ -121,11 +122,10 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
   Eigen::Index live = d;
   IntervalExp interval(blocks_, c_);
   const std::vector<Eigen::Matrix2d> free = interval.free_blocks(h);
-  const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, slices_, axial_mm);
-  const double dphi = kTwoPi / (cutter_.teeth * m_);  // spindle angle per interval
-  constexpr int kSub = 8;
+  const std::vector<Eigen::Matrix2d> cut = directional_means(axial_mm);
+  std::optional<IntervalCollocation> collocation = low_rank_intervals(cut, h, free);
   for (int i = 0; i < m_; ++i) {
-    const Eigen::Matrix2d mi = directional.mean(i * dphi, dphi, kSub);
+    const Eigen::Matrix2d& mi = cut[static_cast<std::size_t>(i)];
     // x' = (A + B M C) x - B M q(t - tau); the delayed q goes linearly from q_{i-m} to q_{i-m+1}.
     const auto old_x = z.topRows(n);
     const Eigen::Index oldest = slot(first + m_ - 1), next_oldest = slot(first + m_ - 2);  // q_{i-m}, q_{i-m+1}
@@ -136,6 +136,13 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
         x_next.block(r, 0, 2, n).noalias() = free[k] * z.block(r, 0, 2, n);
         if (tail) x_next.block(r, live, 2, tail).noalias() = free[k] * z.block(r, live, 2, tail);
       }
+    } else if (collocation) {
+      live = std::min(live, n + 2 * static_cast<Eigen::Index>(std::max(0, m_ - 2 - i)));
+      const Eigen::Index now = d - live;
+      collocation->set_cut(mi);
+      collocation->step(old_x.leftCols(n), z.block(oldest, 0, 2, n), z.block(next_oldest, 0, 2, n), x_next.leftCols(n));
+      collocation->step(old_x.rightCols(now), z.block(oldest, live, 2, now), z.block(next_oldest, live, 2, now),
+                        x_next.rightCols(now));
     } else {
       interval.compute(b_ * mi, h, e);
       const Eigen::MatrixXd ramp = e.block(0, n + 2, n, 2) / h, held_less_ramp = e.block(0, n, n, 2) - ramp;
@@ -158,6 +165,37 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
   ordered.topRows(n) = z.topRows(n);
   for (int j = 0; j < m_; ++j) ordered.middleRows(n + 2 * j, 2) = z.middleRows(slot(first + j), 2);
   return ordered;
+}
+
+std::vector<Eigen::Matrix2d> SdmModel::directional_means(double axial_mm) const {
+  const DirectionalMatrix directional(cutter_, material_, mode_, radial_mm_, slices_, axial_mm);
+  const double dphi = kTwoPi / (cutter_.teeth * m_);  // spindle angle per interval
+  constexpr int kSub = 8;
+  std::vector<Eigen::Matrix2d> out;
+  out.reserve(static_cast<std::size_t>(m_));
+  for (int i = 0; i < m_; ++i) out.push_back(directional.mean(i * dphi, dphi, kSub));
+  return out;
+}
+
+std::optional<IntervalCollocation> SdmModel::low_rank_intervals(const std::vector<Eigen::Matrix2d>& cut, double h,
+                                                                const std::vector<Eigen::Matrix2d>& free) const {
+  if (!low_rank_) return std::nullopt;
+  // rho bounds |A + B M C|: the largest block's norm plus the cut's rank-2 term's (the largest singular value
+  // of B M C, from the 2 x 2 (B M)^T (B M) C C^T).
+  double rho_a = 0.0, rho_cut = 0.0;
+  for (const Eigen::Matrix2d& a : blocks_) rho_a = std::max(rho_a, a.operatorNorm());
+  const Eigen::Matrix2d cct = c_ * c_.transpose();
+  for (const Eigen::Matrix2d& mi : cut) {
+    if (mi.isZero(0.0)) continue;
+    const Eigen::MatrixXd bm = b_ * mi;
+    const Eigen::Matrix2d g = (bm.transpose() * bm) * cct;
+    const double half = 0.5 * g.trace(), disc = std::max(0.0, half * half - g.determinant());
+    rho_cut = std::max(rho_cut, std::sqrt(std::max(0.0, half + std::sqrt(disc))));
+  }
+  const int p = IntervalCollocation::nodes_for((rho_a + rho_cut) * h);
+  // Worth it where the correction's rank 2p is at most half the modes' state.
+  if (p == 0 || 4 * p > a_.rows()) return std::nullopt;
+  return std::optional<IntervalCollocation>(std::in_place, blocks_, b_, c_, h, p, free);
 }
 
 std::complex<double> SdmModel::dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const {

@@ -12,11 +12,13 @@
 
 #include <complex>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "milling/chatter.hpp"
 #include "milling/cutting.hpp"
+#include "milling/interval_collocation.hpp"
 #include "milling/tool_dynamics.hpp"
 
 namespace robodamp::milling {
@@ -82,11 +84,20 @@ class SdmModel {
   // Critical depth by bisection, starting from a guess (e.g. the zero-order limit).
   [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
   [[nodiscard]] int steps_per_period() const { return m_; }
+  // Every cutting interval by its dense exponential (milling/interval_exp.hpp), never by the low-rank
+  // collocation (milling/interval_collocation.hpp) a many-mode structure's short intervals take otherwise:
+  // the reference the tests compare with.
+  void dense_intervals_only() { low_rank_ = false; }
 
  private:
   // The monodromy matrix over one tooth period; its dominant eigenvalue (and chatter frequency).
   [[nodiscard]] Eigen::MatrixXd monodromy(double axial_mm, double rpm) const;
   [[nodiscard]] std::complex<double> dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const;
+  // Each interval's mean directional matrix at this depth (N/m).
+  [[nodiscard]] std::vector<Eigen::Matrix2d> directional_means(double axial_mm) const;
+  // The collocation for intervals of length h, where it is cheaper than the dense exponential.
+  [[nodiscard]] std::optional<IntervalCollocation> low_rank_intervals(const std::vector<Eigen::Matrix2d>& cut, double h,
+                                                                      const std::vector<Eigen::Matrix2d>& free) const;
 
   Eigen::MatrixXd a_, b_, c_;            // modes' states as (wn q, q'), A block diagonal
   std::vector<Eigen::Matrix2d> blocks_;  // A's blocks
@@ -95,6 +106,7 @@ class SdmModel {
   config::MillingMode mode_;
   double radial_mm_;
   int slices_, m_;
+  bool low_rank_{true};
 };
 
 }  // namespace robodamp::milling
