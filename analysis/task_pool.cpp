@@ -1,5 +1,7 @@
 #include "analysis/task_pool.hpp"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <atomic>
 #include <exception>
@@ -38,6 +40,12 @@ void run_tasks(const std::vector<std::function<void()>>& tasks, std::size_t thre
   for (auto& t : pool) t.join();
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
+}
+
+void keep_freed_memory() {
+  constexpr int kMmapThresholdBytes = 64 << 20, kTrimThresholdBytes = 256 << 20;
+  mallopt(M_MMAP_THRESHOLD, kMmapThresholdBytes);
+  mallopt(M_TRIM_THRESHOLD, kTrimThresholdBytes);
 }
 
 }  // namespace robodamp::analysis

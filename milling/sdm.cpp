@@ -62,7 +62,10 @@ Eigen::Matrix2d DirectionalMatrix::mean(double phi0, double dphi, int sub) const
       const Engagement& e = es.engagement;
       const double sk = es.sin_kappa, w = es.slice.height_mm * 1e-3 * sk / sub;
       for (const ToothOffset& t : es.teeth) {
-        double phi = std::fmod(spindle + t.rad, kTwoPi);
+        // The spindle's angle is within one tooth period and the offset within a turn less the lag, so the
+        // sum is almost always in [0, 2 pi) already, where fmod would return it as it is.
+        double phi = spindle + t.rad;
+        if (!(phi >= 0.0 && phi < kTwoPi)) phi = std::fmod(phi, kTwoPi);
         if (phi < 0.0) phi += kTwoPi;
         if (phi < e.start_rad || phi > e.exit_rad) continue;
         // sin and cos of spindle + offset by the angle sum: one sine and cosine per sub-sample, not per tooth
