@@ -109,7 +109,7 @@ IntervalCollocation::IntervalCollocation(const std::vector<Eigen::Matrix2d>& blo
   tables(blocks, b, c, h);
 }
 
-// long: the three tables of one interval length (one quadrature each, written out)
+// The three tables of one interval length, one quadrature each.
 void IntervalCollocation::tables(const std::vector<Eigen::Matrix2d>& blocks, const Eigen::MatrixXd& b,
                                  const Eigen::MatrixXd& c, double h) {
   const Quadrature s = gauss_legendre(p_, h);
