@@ -129,7 +129,12 @@ void Loop::account(Run& r, const Pace& p, const TickInput& in) noexcept {
 }
 
 // The telemetry frame. Wall clock: a full ring drops the frame (counted); virtual clock: the loop waits
-// for the drain rather than lose one.
+// for the drain rather than lose one, and waits as soon as it is kVirtualLeadFrames ahead of it. On the
+// virtual clock the loop runs as fast as the CPU lets it, and the drain's consumers (the recorder, the
+// safety watches of commissioning and measurement, which stop the cell) would otherwise see each frame as
+// late as the ring is long (65 536 frames, 13 s of loop time at 5 kHz) whenever the drain thread is not
+// scheduled for a while: on a loaded machine a measurement's chirp played 8 s on before the watch that
+// refused it could stop it. The wall clock keeps that lag to the drain's poll on a real cell.
 void Loop::publish(const Pace& p, const TickInput& in, const TickOutput& out) noexcept {
   if (telemetry_ == nullptr) return;
   LoopStats& st = *stats_;
@@ -166,7 +171,7 @@ void Loop::publish(const Pace& p, const TickInput& in, const TickOutput& out) no
     if (!telemetry_->push(f)) ++st.ring_drops;
     return;
   }
-  while (!telemetry_->push(f)) {
+  while (telemetry_->size() >= kVirtualLeadFrames || !telemetry_->push(f)) {
     ++st.ring_waits;
     std::this_thread::yield();
   }

@@ -47,6 +47,9 @@ struct LoopStats {
 
 class Loop {
  public:
+  // On the virtual clock, how far the loop may run ahead of the telemetry drain (frames; 0.2 s at 5 kHz).
+  static constexpr std::size_t kVirtualLeadFrames = 1024;
+
   Loop(double rate_hz, ClockKind clock, Supervisor& supervisor, SensorSource& sensor, ActuatorSink& actuator,
        AmplifierIo& io, SpscRing<TelemetryFrame>* telemetry);
 

@@ -15,6 +15,7 @@
 #include "cell_util.hpp"
 #include "rt/recording.hpp"
 #include "rt/signals.hpp"
+#include "rt/telemetry_drain.hpp"
 #include "rt_loop_outcome.hpp"
 #include "test_util.hpp"
 
@@ -190,6 +191,34 @@ TEST(Loop, AnOnCommandChirpStartsAtTheTickAfterEachStartCommandAndReplays) {
   const ReplayResult rp = replay(rec);
   EXPECT_EQ(rp.frames, r.frames.size());
   EXPECT_EQ(rp.mismatches, 0U);
+}
+
+// On the virtual clock the loop runs as fast as the CPU lets it. The drain's consumers (the recorder, and the
+// watches that stop a measurement whose cell is not at rest) must not fall more than Loop::kVirtualLeadFrames
+// behind it, however slowly they run: with the whole ring as the lead, a measurement on a loaded machine
+// played its chirp 8 s of loop time on before the watch that refused it could stop it
+// (RealCell.TheChirpWaitsForACellAtRestAndStopsWhenItSaturates).
+TEST(Loop, OnTheVirtualClockTheLoopStaysWithinItsLeadOfASlowDrain) {
+  Cell session(c2(), virtual_clock());
+  test::configure(session);
+  rt::Loop& loop = session.loop();
+  rt::SpscRing<rt::TelemetryFrame>& ring = session.telemetry_ring();
+  std::size_t most_ahead = 0, frames = 0;
+  rt::TelemetryDrain drain(ring, {[&](const rt::TelemetryFrame&) {
+                             most_ahead = std::max(most_ahead, ring.size());
+                             ++frames;
+                             // 20 us per frame: several times a tick of the loop with the simulated plant.
+                             const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(20);
+                             while (std::chrono::steady_clock::now() < until) {}
+                           }});
+  drain.start();
+  loop.run(20000);  // 4 s of loop time, on this thread
+  drain.stop();
+  EXPECT_GE(frames, 20000U);
+  EXPECT_LE(most_ahead, rt::Loop::kVirtualLeadFrames);
+  // And it did run ahead as far as that: the drain was the slower by far (0.4 s of its work against a few
+  // milliseconds of the loop's).
+  EXPECT_GE(most_ahead, rt::Loop::kVirtualLeadFrames / 2);
 }
 
 TEST(Loop, ArmingRefusedUntilSensorLive) {
