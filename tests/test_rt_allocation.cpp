@@ -402,10 +402,15 @@ TEST(RealTimePath, PoseScheduledLoopHandsOverAndTripsWithoutAllocating) {
 }
 
 // The spindle at 700 rpm from tick 100, the loop armed at tick 1000, 12 s on the loop thread: no lock, no allocation.
-void expect_none_with_the_spindle_turning(rt::Loop& loop) {
+// A drain empties the telemetry ring as the cell's does: on the virtual clock the loop waits for it once it leads.
+void expect_none_with_the_spindle_turning(runtime::Cell& session) {
+  rt::Loop& loop = session.loop();
   loop.schedule(100, {rt::CommandKind::kSetSpindle, 700.0});
   loop.schedule(1000, {rt::CommandKind::kArm, 0.0});
+  rt::TelemetryDrain drain(session.telemetry_ring(), {[](const rt::TelemetryFrame&) {}});
+  drain.start();
   const LoopThreadCounts counts = run_counted(loop, 12 * 5000);
+  drain.stop();
   EXPECT_EQ(counts.locks, 0) << "mutexes taken on the loop thread";
   EXPECT_EQ(counts.allocations, 0) << "allocations on the loop thread";
 }
@@ -424,7 +429,7 @@ TEST(RealTimePath, TheDeratingProbesHoldsAndRestoresWithoutAllocating) {
   o.plant_config = real;
   runtime::Cell session(cfg, o);
   test::configure(session);
-  expect_none_with_the_spindle_turning(session.loop());
+  expect_none_with_the_spindle_turning(session);
   const auto& c = session.supervisor().counters();
   EXPECT_GE(c.derate_probes, 2U);
   EXPECT_GE(c.growth_gain_fed, 1U);
@@ -445,7 +450,7 @@ TEST(RealTimePath, TheSaturationDeratingAllocatesNothing) {
   runtime::Cell session(cfg, o);
   test::configure(session);
   session.plant().add_excitation(std::make_unique<sim::Sine>(0, 400.0, 9.2, 0.0));  // at the TCP, on the 9.2 Hz mode
-  expect_none_with_the_spindle_turning(session.loop());
+  expect_none_with_the_spindle_turning(session);
   const auto& c = session.supervisor().counters();
   std::printf(
       "[ rt path  ] saturation: %llu probes, %llu saturation derates, %llu restores, %llu saturated ticks, trip %s\n",
