@@ -10,7 +10,6 @@ namespace robodamp::milling {
 namespace {
 
 constexpr double kInterpolationTolerance = 1e-15;
-constexpr int kMinNodes = 4;
 
 // exp(t a) of a 2 x 2 block as exp(s t) (c(t) I + sh(t) N), s half the trace, N = a - s I, N^2 = delta I.
 struct BlockExp {

@@ -38,6 +38,7 @@ struct Quadrature {
 
 class IntervalCollocation {
  public:
+  static constexpr int kMinNodes = 4;  // the fewest nodes a collocation takes
   static constexpr int kMaxNodes = 64;
 
   // The nodes a collocation needs for an interval of length h whose matrix is bounded by rho (1/s), or 0 when

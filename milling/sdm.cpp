@@ -139,25 +139,26 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
         x_next.block(r, 0, 2, n).noalias() = free[k] * z.block(r, 0, 2, n);
         if (tail) x_next.block(r, live, 2, tail).noalias() = free[k] * z.block(r, live, 2, tail);
       }
-    } else if (collocation) {
-      live = std::min(live, n + 2 * static_cast<Eigen::Index>(std::max(0, m_ - 2 - i)));
-      const Eigen::Index now = d - live;
-      collocation->set_cut(mi);
-      collocation->step(old_x.leftCols(n), z.block(oldest, 0, 2, n), z.block(next_oldest, 0, 2, n), x_next.leftCols(n));
-      collocation->step(old_x.rightCols(now), z.block(oldest, live, 2, now), z.block(next_oldest, live, 2, now),
-                        x_next.rightCols(now));
     } else {
-      interval.compute(b_ * mi, h, e);
-      const Eigen::MatrixXd ramp = e.block(0, n + 2, n, 2) / h, held_less_ramp = e.block(0, n, n, 2) - ramp;
       // The delayed samples reach their own columns, at 2 (m - 1 - i) and 2 (m - 2 - i) past n, first here.
       live = std::min(live, n + 2 * static_cast<Eigen::Index>(std::max(0, m_ - 2 - i)));
       const Eigen::Index now = d - live;
-      x_next.leftCols(n).noalias() = e.topLeftCorner(n, n) * old_x.leftCols(n);
-      x_next.rightCols(now).noalias() = e.topLeftCorner(n, n) * old_x.rightCols(now);
-      x_next.leftCols(n).noalias() += held_less_ramp * z.block(oldest, 0, 2, n);
-      x_next.rightCols(now).noalias() += held_less_ramp * z.block(oldest, live, 2, now);
-      x_next.leftCols(n).noalias() += ramp * z.block(next_oldest, 0, 2, n);
-      x_next.rightCols(now).noalias() += ramp * z.block(next_oldest, live, 2, now);
+      if (collocation) {
+        collocation->set_cut(mi);
+        collocation->step(old_x.leftCols(n), z.block(oldest, 0, 2, n), z.block(next_oldest, 0, 2, n),
+                          x_next.leftCols(n));
+        collocation->step(old_x.rightCols(now), z.block(oldest, live, 2, now), z.block(next_oldest, live, 2, now),
+                          x_next.rightCols(now));
+      } else {
+        interval.compute(b_ * mi, h, e);
+        const Eigen::MatrixXd ramp = e.block(0, n + 2, n, 2) / h, held_less_ramp = e.block(0, n, n, 2) - ramp;
+        x_next.leftCols(n).noalias() = e.topLeftCorner(n, n) * old_x.leftCols(n);
+        x_next.rightCols(now).noalias() = e.topLeftCorner(n, n) * old_x.rightCols(now);
+        x_next.leftCols(n).noalias() += held_less_ramp * z.block(oldest, 0, 2, n);
+        x_next.rightCols(now).noalias() += held_less_ramp * z.block(oldest, live, 2, now);
+        x_next.leftCols(n).noalias() += ramp * z.block(next_oldest, 0, 2, n);
+        x_next.rightCols(now).noalias() += ramp * z.block(next_oldest, live, 2, now);
+      }
     }
     z.middleRows(oldest, 2).noalias() = c_ * old_x;  // q_i over q_{i-m}, which is no longer needed
     first = (first + m_ - 1) % m_;                   // q_i is the newest now
@@ -182,7 +183,8 @@ std::vector<Eigen::Matrix2d> SdmModel::directional_means(double axial_mm) const 
 
 std::optional<IntervalCollocation> SdmModel::low_rank_intervals(const std::vector<Eigen::Matrix2d>& cut, double h,
                                                                 const std::vector<Eigen::Matrix2d>& free) const {
-  if (!low_rank_) return std::nullopt;
+  // Worth it only where the correction's rank 2p is at most half the modes' state (below), and p >= kMinNodes.
+  if (!low_rank_ || 4 * IntervalCollocation::kMinNodes > a_.rows()) return std::nullopt;
   // rho bounds |A + B M C|: the largest block's norm plus the cut's rank-2 term's (the largest singular value
   // of B M C, from the 2 x 2 (B M)^T (B M) C C^T).
   double rho_a = 0.0, rho_cut = 0.0;
