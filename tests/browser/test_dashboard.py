@@ -190,9 +190,10 @@ class DashboardInABrowser(unittest.TestCase):
         return self.browser.execute_script(script)
 
     def tile(self, key):
-        """The tile's data attributes and text, read at once (or None while it is not there)."""
+        """The tile's data attributes, text and warning bars, read at once (or None while it is not there)."""
         return self.js(f'const t = document.querySelector(\'.tile[data-cell="{self.fleet.cells[key]}"]\');'
-                       'return t ? Object.assign({text: t.innerText}, t.dataset) : null;')
+                       'return t ? Object.assign({text: t.innerText, warn_bars: t.querySelectorAll(".bar.warn").length},'
+                       ' t.dataset) : null;')
 
     def open_cell(self, key):
         self.browser.get(self.url + "#/cell/" + self.fleet.cells[key])
@@ -229,12 +230,15 @@ class DashboardInABrowser(unittest.TestCase):
         self.assertNotIn(" above the limit\n", text)
         # The simulated plant does not cut: once the indicator's 4 s window is full the tile says "not cutting"
         # (no tooth-passing lines in the vibration), not "quiet", and the plan's depth is not a warning now.
-        text = until(lambda: (lambda t: t if t and "not cutting (no tooth-passing lines in the vibration)" in t["text"] else None)(
-            self.tile("a")), 60, "cell a not cutting")["text"]
+        # The text and the bars of one reading: under the CPU hog (cd65940) a second read after the "not cutting"
+        # text found a warning bar, the tile redrawn in between (with skipped ticks in the indicator's window the
+        # cutting state is "not known yet" at times, and the plan's depth a warning then).
+        tile = until(lambda: (lambda t: t if t and "not cutting (no tooth-passing lines in the vibration)" in t["text"] else None)(
+            self.tile("a")), 60, "cell a not cutting")
+        text = tile["text"]
         self.assertIn("the job's planned depth is above the limit here (not cutting now)", text)
         self.assertNotIn("quiet", text)
-        self.assertEqual(self.js(f'return document.querySelectorAll(\'.tile[data-cell="{self.fleet.cells["a"]}"] '
-                                 '.bar.warn\').length'), 0)
+        self.assertEqual(tile["warn_bars"], 0, text)
         self.browser.save_screenshot(os.path.join(OUT, "dashboard_fleet.png"))
 
         self.open_cell("a")
@@ -254,8 +258,19 @@ class DashboardInABrowser(unittest.TestCase):
         lobes = until(lambda: (lambda l: l if l and l["speeds"] >= 20 else None)(self.js("return window.robodamp.plotted.lobes")),
                       240, "20 speeds of live lobes")
         self.assertEqual(lobes["operating_rpm"], 700)
-        until(lambda: self.js("return window.robodamp.plotted.lobes.operating_label") == "speed now (not cutting)", 30,
-              "the operating point labelled as not cutting (the simulated plant does not cut)")
+        # The label follows the cell's cutting state, which is "not known yet" while skipped ticks fill more than
+        # 5 % of the indicator's 4 s window. With a sanitizer build on both cores beside the suite (cd65940) the
+        # label was not "not cutting" within 30 s, and which label it showed was not kept: a failure says now.
+        seen = set()
+
+        def labelled_not_cutting():
+            label = self.js("return window.robodamp.plotted.lobes.operating_label")
+            seen.add(label)
+            return label == "speed now (not cutting)"
+        try:
+            until(labelled_not_cutting, 120, "the operating point labelled as not cutting (the simulated plant does not cut)")
+        except AssertionError as e:
+            raise AssertionError(f"{e}; the labels the page showed: {sorted(map(str, seen))}") from None
         # The preset's speed schedule: the live lobes are its envelope (each speed its band's controller and K),
         # never below the open loop (0.5 % for the cell's cache of speed and K).
         self.assertTrue(lobes["scheduled"])
