@@ -2,8 +2,8 @@
 // poses"). The robot model (fitted or not) is the prior: at each measured pose its modes along the measured
 // axis are matched to the measured ones. Each measured mode's frequency, damping ratio and participation along
 // the axis (w^2 / k) is interpolated over joint space by Gaussian-process regression (ordinary kriging: a
-// constant mean, a squared-exponential kernel over the joint angles in rad, its length scale chosen by the
-// restricted marginal likelihood), in one of two forms: against the model's mode (the log ratio measured /
+// constant mean, a squared-exponential kernel over the joint angles in rad, averaged over a grid of length
+// scales weighted by their restricted marginal likelihood), in one of two forms: against the model's mode (the log ratio measured /
 // model, the participation's difference), or as the measured values themselves, whichever predicts each
 // measured pose better from the others (leave-one-out). A model right in form carries the shape between
 // the poses; one wrong in form (its damping varying where the measured is flat, its participation through zero
@@ -99,16 +99,21 @@ class ModalMap {
     Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, double noise, bool about_mean = false);
     [[nodiscard]] double mean(const Eigen::VectorXd& x) const;
     [[nodiscard]] double sigma(const Eigen::VectorXd& x) const;
-    [[nodiscard]] double length_scale_rad() const { return length_; }
+    // The length scales' likelihood-weighted geometric mean (rad).
+    [[nodiscard]] double length_scale_rad() const;
     [[nodiscard]] bool empty() const { return x_.empty(); }
     [[nodiscard]] std::size_t points() const { return x_.size(); }
 
    private:
-    [[nodiscard]] Eigen::VectorXd kernel_column(const Eigen::VectorXd& x) const;
+    // The regression at one length scale, its weight its share of the likelihood.
+    struct Scale {
+      double length_rad{0.5}, weight{0.0}, signal_var{0.0}, mu{0.0}, ones_r_ones{1.0};
+      Eigen::LDLT<Eigen::MatrixXd> r;
+      Eigen::VectorXd alpha, r_ones;
+    };
+    [[nodiscard]] Eigen::VectorXd kernel_column(const Eigen::VectorXd& x, double length_rad) const;
     std::vector<Eigen::VectorXd> x_;
-    double length_{0.5}, signal_var_{0.0}, noise_var_{0.0}, mu_{0.0}, ones_r_ones_{1.0};
-    Eigen::LDLT<Eigen::MatrixXd> r_;
-    Eigen::VectorXd alpha_, r_ones_;
+    std::vector<Scale> scales_;
   };
 
  private:

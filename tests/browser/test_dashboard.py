@@ -84,6 +84,8 @@ class Fleet:
     def __init__(self):
         self.dir = tempfile.mkdtemp(prefix="robodamp_dashboard_")
         self.procs = []
+        self.logs = {}
+        self.signalled = set()  # the pids this test stopped itself
         suffix = str(os.getpid())
         self.cells = {"a": "brw-a-" + suffix, "b": "brw-b-" + suffix}
         with open(os.path.join(SOURCE, "config/presets/horizontal_c2.yaml")) as f:
@@ -125,6 +127,7 @@ class Fleet:
         """Cell B again, as a new process whose amplifier faults TRIP_AT_S into its run: the trip comes after
         whoever called this is watching, however long the tests before took on a loaded machine."""
         self.cell_b.send_signal(signal.SIGINT)  # as stop() ends every process
+        self.signalled.add(self.cell_b.pid)
         self.cell_b.wait(timeout=30)
         self.cell_b = self.start_b(["--fault", f"amplifier_fault:{TRIP_AT_S}:1"], "cell_b_trip.log")
 
@@ -132,6 +135,7 @@ class Fleet:
         with open(os.path.join(self.dir, log), "w") as out:
             p = subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, cwd=self.dir)
         self.procs.append(p)
+        self.logs[p.pid] = log
         return p
 
     def dashboard(self, log):
@@ -147,6 +151,13 @@ class Fleet:
         for p in self.procs:
             if p.poll() is None:
                 p.send_signal(signal.SIGINT)
+            elif p.returncode != 0 and p.pid not in self.signalled:
+                # Ended on its own before the test did (a crash, a sanitizer's report): its log's end, before the
+                # directory goes.
+                with open(os.path.join(self.dir, self.logs[p.pid]), errors="replace") as f:
+                    tail = f.readlines()[-60:]
+                print(f"{self.logs[p.pid]} ended with {p.returncode} before the test stopped it:\n" + "".join(tail),
+                      file=sys.stderr)
         for p in self.procs:
             try:
                 p.wait(timeout=30)
