@@ -121,10 +121,13 @@ TEST(PathCommission, ARobotItsModelDoesNotDescribeIsCommissionedAlongItsPathAndN
   // The map knows where it was measured: where the damper runs, the prediction's spread at the stop held out of
   // it is more than twice that at any stop in it (measured: 50-64 points there against 7-14). A run whose tune
   // turns the damper off at the held-out stop (K 0: nothing predicted, no spread) checks nothing here.
-  if (r.stops[1].gain_ns_per_m > 0.0)
-    for (const auto& st : r.stops)
-      if (!st.held_out && st.gain_ns_per_m > 0.0)
+  if (r.stops[1].gain_ns_per_m > 0.0) {
+    for (const auto& st : r.stops) {
+      if (!st.held_out && st.gain_ns_per_m > 0.0) {
         EXPECT_GT(r.stops[1].predicted_sigma_pct, 2.0 * st.predicted_sigma_pct) << st.name;
+      }
+    }
+  }
   EXPECT_EQ(r.trip, "none");
   EXPECT_EQ(r.pose_out_of_map, 0U);
 
