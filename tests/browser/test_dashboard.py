@@ -155,7 +155,7 @@ class Fleet:
                 # Ended on its own before the test did (a crash, a sanitizer's report): its log's end, before the
                 # directory goes.
                 with open(os.path.join(self.dir, self.logs[p.pid]), errors="replace") as f:
-                    tail = f.readlines()[-60:]
+                    tail = f.readlines()[-150:]
                 print(f"{self.logs[p.pid]} ended with {p.returncode} before the test stopped it:\n" + "".join(tail),
                       file=sys.stderr)
         for p in self.procs:
@@ -532,6 +532,7 @@ class DashboardInABrowser(unittest.TestCase):
               "the first dashboard ignores the reply to the second")
         # Cell A stops: its tile says so after dashboard.stale_after_s.
         self.fleet.cell_a.send_signal(signal.SIGKILL)
+        self.fleet.signalled.add(self.fleet.cell_a.pid)
         self.fleet.cell_a.wait(timeout=30)
         self.browser.get(self.url)
         until(lambda: (self.tile("a") or {}).get("live") == "false", 30, "cell a shown without contact")
