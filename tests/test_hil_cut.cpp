@@ -189,11 +189,12 @@ AdviceRun finish_after(AdviceCase& c, const std::string& line, const std::string
       test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 110.0))
       << line << " not in\n"
       << test::read_file(c.files.plant_log);
-  if (!run_line.empty())
+  if (!run_line.empty()) {
     EXPECT_TRUE(
         test::eventually([&] { return test::read_file(c.files.run_log).find(run_line) != std::string::npos; }, 30.0))
         << run_line << " not in\n"
         << test::read_file(c.files.run_log);
+  }
   c.run->kill(SIGINT);
   AdviceRun r;
   r.run_exit = c.run->wait();
