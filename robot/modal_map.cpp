@@ -235,12 +235,6 @@ ModalMap::Field::Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, do
   for (Scale& c : scales_) c.weight /= sum;
 }
 
-double ModalMap::Field::length_scale_rad() const {
-  double log_sum = 0.0;
-  for (const Scale& c : scales_) log_sum += c.weight * std::log(c.length_rad);
-  return scales_.empty() ? 0.0 : std::exp(log_sum);
-}
-
 Eigen::VectorXd ModalMap::Field::kernel_column(const Eigen::VectorXd& x, double length_rad) const {
   Eigen::VectorXd c(static_cast<Eigen::Index>(x_.size()));
   for (std::size_t i = 0; i < x_.size(); ++i)
@@ -254,8 +248,9 @@ double ModalMap::Field::mean(const Eigen::VectorXd& x) const {
   return m;
 }
 
-// The mixture's spread: each scale's variance and the scatter of their means.
-double ModalMap::Field::sigma(const Eigen::VectorXd& x) const {
+// The mixture's mean and spread (each scale's variance and the scatter of their means) from one kernel column per
+// scale.
+ModalMap::Field::Estimate ModalMap::Field::estimate(const Eigen::VectorXd& x) const {
   double m = 0.0, second = 0.0;
   for (const Scale& c : scales_) {
     const Eigen::VectorXd k = kernel_column(x, c.length_rad);
@@ -265,7 +260,7 @@ double ModalMap::Field::sigma(const Eigen::VectorXd& x) const {
     m += c.weight * mi;
     second += c.weight * (v + mi * mi);
   }
-  return std::sqrt(std::max(0.0, second - m * m));
+  return {m, std::sqrt(std::max(0.0, second - m * m))};
 }
 
 ModalMap::ModalMap(const config::RobotModelConfig& model, int axis, int count) : count_(count) {
@@ -354,21 +349,22 @@ std::vector<ModeCorrection> ModalMap::at(const std::vector<double>& q_deg, const
     // A quantity in its own form is the track's value; against the model, the model's times the ratio (or plus
     // the participation's difference).
     const double f_model = own ? 1.0 : a.freq_hz, z_model = own ? 1.0 : a.damping_ratio;
-    c.freq_hz = (own || t.form.freq.own ? 1.0 : f_model) * std::exp(t.freq.mean(x));
-    c.damping_ratio = (own || t.form.damping.own ? 1.0 : z_model) * std::exp(t.damping.mean(x));
+    const Field::Estimate f = t.freq.estimate(x), z = t.damping.estimate(x), pe = t.stiffness.estimate(x);
+    c.freq_hz = (own || t.form.freq.own ? 1.0 : f_model) * std::exp(f.mean);
+    c.damping_ratio = (own || t.form.damping.own ? 1.0 : z_model) * std::exp(z.mean);
     c.freq_scale = own ? 1.0 : c.freq_hz / f_model;
     c.damping_scale = own ? 1.0 : c.damping_ratio / z_model;
-    c.freq_sigma = t.freq.sigma(x);
-    c.damping_sigma = t.damping.sigma(x);
+    c.freq_sigma = f.sigma;
+    c.damping_sigma = z.sigma;
     // The participation w^2 / k: the model's plus the regression's (or its own); the stiffness from it at the
     // mapped frequency.
     const double p_model = own ? 0.0 : participation(a.freq_hz, a.stiffness_n_per_m);
-    const double p = (t.form.stiffness.own ? 0.0 : p_model) + t.stiffness.mean(x);
+    const double p = (t.form.stiffness.own ? 0.0 : p_model) + pe.mean;
     const double p_floor = kParticipationFloor * std::max(p_model, std::abs(p)) + std::numeric_limits<double>::min();
     const double w = kTwoPi * c.freq_hz;
     c.stiffness_n_per_m = w * w / std::max(p, p_floor);
     c.stiffness_scale = own ? 1.0 : c.stiffness_n_per_m / a.stiffness_n_per_m;
-    c.stiffness_sigma = std::min(kMaxRelativeSigma, t.stiffness.sigma(x) / std::max(p, p_floor));
+    c.stiffness_sigma = std::min(kMaxRelativeSigma, pe.sigma / std::max(p, p_floor));
     out.push_back(c);
   }
   // The model's modes no track follows, above every track: below the highest, the measurements would have

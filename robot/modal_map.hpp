@@ -3,13 +3,13 @@
 // axis are matched to the measured ones. Each measured mode's frequency, damping ratio and participation along
 // the axis (w^2 / k) is interpolated over joint space by Gaussian-process regression (ordinary kriging: a
 // constant mean, a squared-exponential kernel over the joint angles in rad, averaged over a grid of length
-// scales weighted by their restricted marginal likelihood), in one of two forms: against the model's mode (the log ratio measured /
-// model, the participation's difference), or as the measured values themselves, whichever predicts each
-// measured pose better from the others (leave-one-out). A model right in form carries the shape between
-// the poses; one wrong in form (its damping varying where the measured is flat, its participation through zero
-// where the measured peaks) is left out of the quantities it predicts worse. At a measured pose the mapped modes are
-// the measured ones (to the measurement's noise); far from every measured pose the regression tends to its mean
-// and its uncertainty to the values' scatter, so the spread grows away from the measurements.
+// scales weighted by their restricted marginal likelihood), in one of two forms: against the model's mode (the
+// log ratio measured / model, the participation's difference), or as the measured values themselves, whichever
+// predicts each measured pose better from the others (leave-one-out). A model right in form carries the shape
+// between the poses; one wrong in form (its damping varying where the measured is flat, its participation
+// through zero where the measured peaks) is left out of the quantities it predicts worse. At a measured pose the
+// mapped modes are the measured ones (to the measurement's noise); far from every measured pose the regression
+// tends to its mean and its uncertainty to the values' scatter, so the spread grows away from the measurements.
 // Off the real-time path.
 #pragma once
 
@@ -98,9 +98,11 @@ class ModalMap {
     // with about_mean, of y about its mean (a value of its own).
     Field(std::vector<Eigen::VectorXd> x, std::vector<double> y, double noise, bool about_mean = false);
     [[nodiscard]] double mean(const Eigen::VectorXd& x) const;
-    [[nodiscard]] double sigma(const Eigen::VectorXd& x) const;
-    // The length scales' likelihood-weighted geometric mean (rad).
-    [[nodiscard]] double length_scale_rad() const;
+    [[nodiscard]] double sigma(const Eigen::VectorXd& x) const { return estimate(x).sigma; }
+    struct Estimate {
+      double mean{0.0}, sigma{0.0};
+    };
+    [[nodiscard]] Estimate estimate(const Eigen::VectorXd& x) const;  // mean and sigma at once
     [[nodiscard]] bool empty() const { return x_.empty(); }
     [[nodiscard]] std::size_t points() const { return x_.size(); }
 
