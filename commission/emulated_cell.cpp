@@ -94,12 +94,12 @@ struct ControllerRun {
 // How long (wall time) the lockstep may go without a fresh sensor sample before the run is ended as stalled:
 // a run under a CPU hog on both cores steps at about plant speed, and each missing frame costs the loop its
 // 1 s lockstep wait, so a silent emulator would otherwise hold the caller for hours.
-constexpr double kStallWallS = 30.0;
+constexpr double kStallWallS = EmulatedCut{}.stall_wall_s;
 
-// Ends the cell's run when no fresh sensor sample has arrived for kStallWallS; joined on every path.
+// Ends the cell's run when no fresh sensor sample has arrived for stall_s of wall time; joined on every path.
 class StallWatch {
  public:
-  explicit StallWatch(runtime::Cell& cell) {
+  StallWatch(runtime::Cell& cell, double stall_s) : stall_s_(stall_s) {
     worker_.start("rd-stall-watch", [this, &cell](std::stop_token stop) { watch(cell, stop); });
   }
   ~StallWatch() { worker_.stop(); }
@@ -116,20 +116,21 @@ class StallWatch {
     while (worker_.sleep_for(stop, std::chrono::milliseconds(200))) {
       if (const std::uint64_t now = fresh_.load(); now != seen) {
         seen = now, since = Clock::now();
-      } else if (std::chrono::duration<double>(Clock::now() - since).count() > kStallWallS) {
+      } else if (std::chrono::duration<double>(Clock::now() - since).count() > stall_s_) {
         stalled_ = true;
         cell.request_stop();
         return;
       }
     }
   }
+  const double stall_s_;
   std::atomic<std::uint64_t> fresh_{0};
   std::atomic<bool> stalled_{false};
   threads::Worker worker_;  // last: started after what it reads
 };
 
 ControllerRun run_controller(const config::Config& cfg, double duration_s, double from_s, double to_s,
-                             const EmulatorProcess& emulator) {
+                             const EmulatorProcess& emulator, double stall_wall_s = kStallWallS) {
   const PinnedToOneCpu pinned;
   pinned.pin(emulator.pid());
   runtime::CellOptions o;
@@ -149,7 +150,7 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
   if (runtime::Status s = cell.activate(duration_s); !s.ok()) throw std::runtime_error("the controller: " + s.message);
   bool stalled = false;
   {
-    StallWatch w(cell);  // from the loop's start: an activation's own waits are bounded by their timeouts
+    StallWatch w(cell, stall_wall_s);  // from the loop's start: an activation's own waits are bounded by their timeouts
     watch.store(&w);
     cell.wait();
     stalled = w.stalled();
@@ -157,7 +158,7 @@ ControllerRun run_controller(const config::Config& cfg, double duration_s, doubl
     watch.store(nullptr);
   }
   if (stalled)
-    throw std::runtime_error("the lockstep stalled: no fresh sensor sample for " + config::format_number(kStallWallS) +
+    throw std::runtime_error("the lockstep stalled: no fresh sensor sample for " + config::format_number(stall_wall_s) +
                              " s of wall time; the emulator's log " + emulator.log_path() + ": " + emulator.log_tail());
   ControllerRun r;
   r.trip = cell.summary().trip;
@@ -369,7 +370,8 @@ CutTrial cut_through_emulator(const config::Config& cell, const config::Config& 
                          config::format_number(start_s), "--json", (d / "plant.json").string()},
                         (d / "plant.log").string());
   // The emulator's speed is within half a loop period per tooth of the request: 2 % more time covers it.
-  const ControllerRun c = run_controller(controller, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant);
+  const ControllerRun c =
+      run_controller(controller, start_s + 1.02 * cut_s + 1.0, start_s, start_s + cut_s, plant, e.stall_wall_s);
   expect_exit_zero(plant, "cut");
   const auto j = nlohmann::json::parse(text_of(d / "plant.json"))["regenerative_cut"];
   t.rpm = j["rpm"].get<double>();

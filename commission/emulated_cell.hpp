@@ -108,6 +108,7 @@ struct EmulatedCheckFiles {
 struct EmulatedCut {
   std::string binary, cell_path, job_path;
   int revolutions{300};
+  double stall_wall_s{30.0};  // wall time without a fresh sensor sample after which the cut ends as stalled
 };
 [[nodiscard]] CutTrial cut_through_emulator(const config::Config& cell, const config::Config& controller,
                                             const EmulatedCut& cut, double rpm, double depth_mm,
