@@ -59,6 +59,14 @@ supp="$PWD/scripts/sanitizers"
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1:new_delete_type_mismatch=0"
 export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+# The tests stretch the scenarios where one process must keep pace with another, and their deadlines, by this
+# (tests/test_util.hpp test::pace, tests/browser/test_dashboard.py PACE). Measured under ThreadSanitizer: a
+# cell's speed advice 249 s after its start (the browser test waits 180 s), the monitor's first limits 26 s
+# into a lockstep run whose first dwell ends at 22 s.
+case "$kind" in
+  thread) export ROBODAMP_TEST_PACE=4 ;;
+  *) export ROBODAMP_TEST_PACE=2 ;;
+esac
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp:print_suppressions=0"
 cd "$dir"
 if [ "$only_unit" = 1 ]; then

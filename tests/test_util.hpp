@@ -133,6 +133,20 @@ inline double phase_diff_deg(double a, double b) {
   return d;
 }
 
+// How many times slower than a plain build this run's processes are: ROBODAMP_TEST_PACE, which
+// scripts/sanitize.sh sets (4 under ThreadSanitizer, 2 under AddressSanitizer), 1 otherwise. A test whose
+// scenario needs one process to keep pace with another (a monitor's analysis within a robot's dwell in
+// virtual time) stretches the scenario by it; nothing is asserted about time.
+inline double pace() {
+  const char* v = std::getenv("ROBODAMP_TEST_PACE");
+  if (v == nullptr || *v == '\0') return 1.0;
+  char* end = nullptr;
+  const double p = std::strtod(v, &end);
+  if (*end != '\0' || !(p >= 1.0 && p <= 20.0))
+    throw std::invalid_argument(std::string("ROBODAMP_TEST_PACE = '") + v + "': expected a number in [1, 20]");
+  return p;
+}
+
 // Polls pred every millisecond until it holds or timeout_s passes (for threads and other processes;
 // the timeout only bounds a failing test, nothing is asserted about how long it took).
 inline bool eventually(const std::function<bool()>& pred, double timeout_s = 10.0) {
