@@ -58,7 +58,11 @@ Cert self_signed(EVP_PKEY* key, const SelfSignedRequest& r) {
   X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_UTF8, reinterpret_cast<const unsigned char*>(cn.c_str()), -1, -1, 0);
   X509_set_issuer_name(cert.get(), name);
   std::string san;
-  for (const auto& h : r.hosts) san += (san.empty() ? "" : ",") + std::string(is_ip(h) ? "IP:" : "DNS:") + h;
+  for (const auto& h : r.hosts) {
+    if (!san.empty()) san += ',';
+    san += is_ip(h) ? "IP:" : "DNS:";
+    san += h;
+  }
   add_extension(cert.get(), NID_subject_alt_name, san);
   add_extension(cert.get(), NID_basic_constraints, "critical,CA:FALSE");
   add_extension(cert.get(), NID_key_usage, "critical,digitalSignature");
