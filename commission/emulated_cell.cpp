@@ -91,11 +91,6 @@ struct ControllerRun {
   unsigned long long pose_out_of_map{0};
 };
 
-// How long (wall time) the lockstep may go without a fresh sensor sample before the run is ended as stalled:
-// a run under a CPU hog on both cores steps at about plant speed, and each missing frame costs the loop its
-// 1 s lockstep wait, so a silent emulator would otherwise hold the caller for hours.
-constexpr double kStallWallS = EmulatedCut{}.stall_wall_s;
-
 // Ends the cell's run when no fresh sensor sample has arrived for stall_s of wall time; joined on every path.
 class StallWatch {
  public:
@@ -130,7 +125,7 @@ class StallWatch {
 };
 
 ControllerRun run_controller(const config::Config& cfg, double duration_s, double from_s, double to_s,
-                             const EmulatorProcess& emulator, double stall_wall_s = kStallWallS) {
+                             const EmulatorProcess& emulator, double stall_wall_s = EmulatedCut{}.stall_wall_s) {
   const PinnedToOneCpu pinned;
   pinned.pin(emulator.pid());
   runtime::CellOptions o;

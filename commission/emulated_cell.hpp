@@ -108,7 +108,10 @@ struct EmulatedCheckFiles {
 struct EmulatedCut {
   std::string binary, cell_path, job_path;
   int revolutions{300};
-  double stall_wall_s{30.0};  // wall time without a fresh sensor sample after which the cut ends as stalled
+  // Wall time without a fresh sensor sample after which the run ends as stalled (every run's, the cut's its
+  // own): a run under a CPU hog on both cores steps at about plant speed, and each missing frame costs the
+  // loop its 1 s lockstep wait, so a silent emulator would otherwise hold the caller for hours.
+  double stall_wall_s{30.0};
 };
 [[nodiscard]] CutTrial cut_through_emulator(const config::Config& cell, const config::Config& controller,
                                             const EmulatedCut& cut, double rpm, double depth_mm,

@@ -109,6 +109,9 @@ class Fleet:
             with open(os.path.join(self.dir, f"cell_{key}.yaml"), "w") as f:
                 f.write(preset + f"\ndds:\n  domain_id: {DOMAIN}\n  transport: udp_loopback\n  parameter_writes: true\n"
                                  f"cell:\n  name: {name}\nspindle:\n  teeth: 3\n  job: {job}\n"
+                                 # 8 uniform candidates beside the pockets, not 48: the page shows whatever
+                                 # advice comes, and each candidate is an accurate limit the cell computes.
+                                 "  advice_grid_points: 8\n"
                                  "supervision:\n  overrun_cycles: 5000\n")
         for user, role, password in (("alice", "operator", "alice-operator-1"), ("bob", "observer", "bob-observer-1")):
             subprocess.run([BINARY, "dashboard-user", "--file", os.path.join(self.dir, "users.yaml"), "--user", user,
