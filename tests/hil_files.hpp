@@ -58,6 +58,9 @@ inline HilFiles hil_files(const std::string& name, const std::vector<std::pair<s
   replace_all_present(text, "port: 1502", "port: " + std::to_string(free_tcp_port()));
   replace_all_present(text, "vertical: presets/vertical_c1.yaml",
                       std::string("vertical: ") + ROBODAMP_SOURCE_DIR + "/config/presets/vertical_c1.yaml");
+  // The emulator's wait for the controller stretched by the build's pace (test::pace): an instrumented
+  // `robodamp run` beside a loaded suite took more than the 30 s to connect.
+  replace_all_present(text, "accept_timeout_s: 30", "accept_timeout_s: " + config::format_number(30.0 * test::pace()));
   for (const auto& [from, to] : edits) replace_or_throw(text, from, to);  // a test's own edit must match
   f.config = f.dir + "/hil.yaml";
   std::ofstream(f.config) << text;
