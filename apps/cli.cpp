@@ -22,22 +22,6 @@ CLI::App* Registry::add(const std::string& name, const std::string& description,
   return sub;
 }
 
-std::optional<std::string> parse_number(const std::string& flag, const std::string& text, const config::Range& range,
-                                        bool whole, double& out) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(begin, &end);
-  const bool parsed = !text.empty() && end != begin && *end == '\0' && errno != ERANGE;
-  if (!parsed || !std::isfinite(v))
-    return flag + " = '" + text + "' is not a finite number: " + config::describe_range(range);
-  if (auto p = config::range_problem(flag, v, range)) return p;
-  if (whole && v != std::floor(v))
-    return flag + " = " + config::format_number(v) + " is not a whole number: " + config::describe_range(range);
-  out = v;
-  return std::nullopt;
-}
-
 CLI::Option* Registry::text_option(CLI::App* sub, const std::string& flag, const std::string& help, bool many) {
   texts_.emplace_back();
   std::vector<std::string>& texts = texts_.back();

@@ -15,6 +15,7 @@
 
 #include "config/file_paths.hpp"
 #include "config/number_range.hpp"
+#include "config/number_text.hpp"
 
 namespace robodamp::apps {
 
@@ -91,9 +92,7 @@ class Registry {
   std::deque<std::vector<std::string>> texts_;  // stable addresses for CLI11 to fill
 };
 
-// The text of one number: finite and nothing after it; else the problem in the configuration's wording.
-[[nodiscard]] std::optional<std::string> parse_number(const std::string& flag, const std::string& text,
-                                                      const config::Range& range, bool whole, double& out);
+using config::parse_number;  // config/number_text.hpp
 
 // `robodamp --version`: robodamp's version and commit, and the dependencies it was built against.
 [[nodiscard]] std::string version_text();

@@ -13,7 +13,7 @@
 
 #include "apps/gnuplot.hpp"
 #include "apps/identify_command.hpp"
-#include "identify/actuator_fit.hpp"
+#include "identify/actuator_sources.hpp"
 #include "identify/commissioning.hpp"
 #include "identify/modal_fit_report.hpp"
 #include "identify/numeric_csv.hpp"
@@ -28,50 +28,19 @@ namespace {
 
 constexpr double kActuatorMinCoherence = 0.9;
 
-identify::FrfKind kind_of(const std::string& k) {
-  return k == "mobility"      ? identify::FrfKind::kMobility
-         : k == "accelerance" ? identify::FrfKind::kAccelerance
-                              : identify::FrfKind::kReceptance;
-}
-
 }  // namespace
 
 int run_identify_actuator(const IdentifyArgs& a) {
-  identify::ActuatorFit fit;
-  std::string mounting = "unknown";
+  identify::IdentifiedActuator id;
   try {
-    if (!a.band_hz.empty() && (a.band_hz.size() != 2 || !(a.band_hz[1] > a.band_hz[0])))
-      throw std::invalid_argument("--band-hz: two frequencies, LO < HI");
-    if (a.recording_path.empty() == a.csv_path.empty())
-      throw std::invalid_argument(
-          "give either --recording (a robodamp measure recording, with --structure) or --csv "
-          "(time_s,command_v,force_n)");
-    if (!a.recording_path.empty()) {
-      if (a.structure_path.empty())
-        throw std::invalid_argument(
-            "--recording needs --structure: the FRF at the sensor for a force at the actuator "
-            "(frf_<sensor>_<actuator>.csv of the same measurement)");
-      const identify::ChirpMeasurement m = identify::read_chirp_measurement(a.recording_path);
-      mounting = config::to_string(m.config.actuator.mounting);
-      identify::ModalFitSettings ms;
-      ms.band_lo_hz = m.config.analysis.band_min_hz, ms.band_hi_hz = m.config.analysis.band_max_hz;
-      ms.max_order = a.max_order.value_or(40);
-      const identify::ModalFit structure =
-          identify::fit_modes(identify::read_frf_csv(a.structure_path, kind_of(a.kind)), ms);
-      const double lo = a.band_hz.size() == 2 ? a.band_hz[0] : 0.0, hi = a.band_hz.size() == 2 ? a.band_hz[1] : 0.0;
-      fit = identify::identify_actuator(m, identify::with_collocated_structure(m.config, structure), lo, hi,
-                                        kActuatorMinCoherence);
-    } else {
-      fit = identify::actuator_from_force_csv(a.csv_path, a.segment_s, a.overlap, a.band_hz, kActuatorMinCoherence);
-    }
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "robodamp identify actuator: " << e.what() << '\n';
-    return 2;
-  } catch (const std::exception& e) {  // a recording that cannot be read, a configuration in it that does not validate
+    id = identify::identify_actuator_from(
+        {a.recording_path, a.structure_path, a.kind, a.csv_path, a.segment_s, a.overlap, a.band_hz, a.max_order},
+        kActuatorMinCoherence);
+  } catch (const std::exception& e) {  // the options, a file that cannot be read, a recorded configuration that fails
     std::cerr << "robodamp identify actuator: " << e.what() << '\n';
     return 2;
   }
-  const identify::ActuatorReport r = identify::actuator_report(fit, mounting, kActuatorMinCoherence);
+  const identify::ActuatorReport r = identify::actuator_report(id.fit, id.mounting, kActuatorMinCoherence);
   std::fputs(r.text.c_str(), stdout);
   if (a.json.given) {
     if (!emit_json(a.json, r.json.dump(2), "identify")) return 1;

@@ -10,6 +10,7 @@
 
 #include "apps/cli.hpp"
 #include "hil/plant_emulator.hpp"
+#include "hil/program_text.hpp"
 #include "rt/signals.hpp"
 
 namespace robodamp::apps {
@@ -42,46 +43,13 @@ struct PlantArgs {
   double bus_off_at_s{-1.0}, bus_off_for_s{0.5}, modbus_hang_at_s{-1.0};
 };
 
-// "T:horizontal" or "T:vertical" with T a finite plant time >= 0 s.
-std::optional<std::pair<double, config::Mounting>> parse_mounting(const std::string& item) {
-  const auto colon = item.find(':');
-  if (colon == std::string::npos) return std::nullopt;
-  double t = 0.0;
-  if (parse_number("--mounting", item.substr(0, colon), {"s", 0.0, 1e7}, false, t)) return std::nullopt;
-  const std::string m = item.substr(colon + 1);
-  if (m != "horizontal" && m != "vertical") return std::nullopt;
-  return std::pair{t, m == "vertical" ? config::Mounting::kVertical : config::Mounting::kHorizontal};
-}
-
-// "T:VALUE" (a step) or, for a ramp, "T0:T1:VALUE" (from the value at T0 to VALUE at T1), plant time in s.
-// Says what is wrong on stderr and returns nothing when it does not parse or is out of range.
-std::optional<hil::SpindleChange> parse_change(const char* option, const std::string& item, const config::Range& value,
-                                               bool ramp) {
-  std::vector<std::string> parts;
-  for (std::size_t from = 0;;) {
-    const auto colon = item.find(':', from);
-    parts.push_back(item.substr(from, colon == std::string::npos ? std::string::npos : colon - from));
-    if (colon == std::string::npos) break;
-    from = colon + 1;
-  }
-  const config::Range time{"s", 0.0, 1e7};
-  hil::SpindleChange c;
-  const bool ok = parts.size() == (ramp ? 3U : 2U) && !parse_number(option, parts[0], time, false, c.t0_s) &&
-                  (!ramp || !parse_number(option, parts[1], time, false, c.t1_s)) &&
-                  !parse_number(option, parts.back(), value, false, c.rpm) && (!ramp || c.t1_s >= c.t0_s);
-  if (!ramp) c.t1_s = c.t0_s;
-  if (ok) return c;
-  const std::string v = std::string(value.unit == "rpm" ? "RPM" : "MM");
-  std::cerr << "robodamp plant: " << option << " = '" << item << "': expected " << (ramp ? "T0_S:T1_S:" : "TIME_S:")
-            << v << ", allowed 0 <= " << (ramp ? "T0_S <= T1_S" : "TIME_S") << " <= 1e+07 s and "
-            << config::format_number(value.min) << " <= " << v << " <= " << config::format_number(value.max) << ' '
-            << value.unit << '\n';
-  return std::nullopt;
-}
-
 // 0 served a controller to the end; 2 configuration or option error; 1 could not set up or the impact
 // schedule did not complete.
 int run_plant(const PlantArgs& a) {
+  const auto refuse = [](const std::string& why) {
+    std::cerr << "robodamp plant: " << why << '\n';
+    return 2;
+  };
   config::Config cfg = config::load_config_file(a.config_path);
   if (a.drives_off) cfg.disturbances.drives_on = false;
   hil::EmulatorOptions eo;
@@ -94,34 +62,21 @@ int run_plant(const PlantArgs& a) {
   eo.bus_off_at_s = a.bus_off_at_s;
   eo.bus_off_for_s = a.bus_off_for_s;
   eo.modbus_hang_at_s = a.modbus_hang_at_s;
-  for (const auto& item : a.mounting_schedule) {
-    const auto m = parse_mounting(item);
-    if (!m) {
-      std::cerr << "robodamp plant: --mounting = '" << item
-                << "': expected TIME_S:horizontal or TIME_S:vertical, allowed 0 <= TIME_S <= 1e+07 s\n";
-      return 2;
-    }
-    eo.mounting_schedule.push_back(*m);
-  }
+  std::string e;
+  for (const auto& item : a.mounting_schedule)
+    if (!hil::parse_mounting(item, eo.mounting_schedule.emplace_back(), e)) return refuse(e);
   const config::Range rpm_range{"rpm", 0.0, 200000.0}, mm_range{"mm", 0.0, 100.0};
   for (const auto& item : a.spindle_schedule) {
-    const auto c = parse_change("--spindle", item, rpm_range, false);
-    if (!c) return 2;
-    eo.spindle_schedule.emplace_back(c->t0_s, c->rpm);
+    hil::SpindleChange c;
+    if (!hil::parse_change("--spindle", item, rpm_range, false, c, e)) return refuse(e);
+    eo.spindle_schedule.emplace_back(c.t0_s, c.rpm);
   }
-  for (const auto& item : a.depth_schedule) {
-    const auto c = parse_change("--depth", item, mm_range, false);
-    if (!c) return 2;
-    eo.depth_changes.push_back(*c);
-  }
-  for (const auto& [items, option, range, out] :
-       {std::tuple{&a.spindle_ramps, "--spindle-ramp", &rpm_range, &eo.spindle_ramps},
-        std::tuple{&a.depth_ramps, "--depth-ramp", &mm_range, &eo.depth_changes}})
-    for (const auto& item : *items) {
-      const auto c = parse_change(option, item, *range, true);
-      if (!c) return 2;
-      out->push_back(*c);
-    }
+  for (const auto& [items, option, range, ramp, out] :
+       {std::tuple{&a.depth_schedule, "--depth", &mm_range, false, &eo.depth_changes},
+        std::tuple{&a.spindle_ramps, "--spindle-ramp", &rpm_range, true, &eo.spindle_ramps},
+        std::tuple{&a.depth_ramps, "--depth-ramp", &mm_range, true, &eo.depth_changes}})
+    for (const auto& item : *items)
+      if (!hil::parse_change(option, item, *range, ramp, out->emplace_back(), e)) return refuse(e);
   eo.cut_job = a.cut_job;
   eo.cut_model =
       a.cut_model == "forced" ? hil::EmulatorOptions::CutModel::kForced : hil::EmulatorOptions::CutModel::kRegenerative;
@@ -132,15 +87,8 @@ int run_plant(const PlantArgs& a) {
   eo.regenerative.until_s = a.cut_until_s;
   eo.regenerative.until_advice = a.cut_until_advice;
   eo.spindle_register_period_s = a.spindle_register_period_s;
-  for (const auto& item : a.pose_at) {
-    hil::PoseWaypoint w;
-    std::string error;
-    if (!hil::parse_waypoint(item, w, error)) {
-      std::cerr << "robodamp plant: --pose-at = " << error << '\n';
-      return 2;
-    }
-    eo.pose_trajectory.push_back(std::move(w));
-  }
+  for (const auto& item : a.pose_at)
+    if (!hil::parse_waypoint(item, eo.pose_trajectory.emplace_back(), e)) return refuse("--pose-at = " + e);
   eo.pose_register_period_s = a.pose_register_period_s;
   eo.pose_update_s = a.pose_update_s;
   rt::install_shutdown_handlers();

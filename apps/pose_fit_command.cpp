@@ -1,18 +1,14 @@
 // `robodamp pose fit`: the robot model's joints fitted to measured TCP receptances (robot/pose_fit.hpp), the
 // error before and after at each pose, the held-out poses apart.
-#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <optional>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/gnuplot.hpp"
 #include "apps/pose_command.hpp"
-#include "identify/modal_fit.hpp"
-#include "identify/pose_measurements.hpp"
+#include "identify/pose_fit_inputs.hpp"
 #include "robot/pose_fit.hpp"
 #include "robot/pose_report.hpp"
 #include "robot/robot_model.hpp"
@@ -23,58 +19,7 @@ namespace {
 
 using nlohmann::json;
 
-// "Q1,Q2,Q3:path" -> the pose and the FRF (a freq_hz,re_m_per_n,im_m_per_n[,coherence] receptance CSV).
-robot::MeasuredFrf measured_frf(const std::string& item) {
-  const auto colon = item.find(':');
-  if (colon == std::string::npos)
-    throw std::invalid_argument("--measured = '" + item + "': expected Q1,Q2,...:FRF.csv (joint angles in deg)");
-  robot::MeasuredFrf m;
-  std::stringstream qs(item.substr(0, colon));
-  for (std::string tok; std::getline(qs, tok, ',');) {
-    double v = 0.0;
-    if (auto p = parse_number("--measured", tok, {"deg", -360.0, 360.0}, false, v))
-      throw std::invalid_argument(*p + " (in '" + item + "')");
-    m.joints_deg.push_back(v);
-  }
-  m.name = item.substr(colon + 1);
-  const identify::FrfData d = identify::read_frf_csv(m.name, identify::FrfKind::kReceptance);
-  m.freq_hz = d.f_hz;
-  m.receptance_m_per_n = d.h;
-  return m;
-}
-
-struct FitData {
-  std::vector<robot::MeasuredFrf> fit, held;
-  std::optional<robot::FrfDirection> direction;  // from the measurements' configuration
-  int modes{0};                                  // its pose_schedule.modes
-};
-
-// --measured items and --measurements directories (checked against the model: identify::check_against_model),
-// the --hold-out poses set apart.
-FitData fit_data(const PoseArgs& a, const config::RobotModelConfig& model) {
-  FitData d;
-  for (const auto& item : a.measured) d.fit.push_back(measured_frf(item));
-  if (!a.measurements.empty()) {
-    identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
-    identify::check_against_model(pm, model);
-    d.direction = pm.direction;
-    d.modes = pm.modes;
-    for (auto& f : pm.frfs) d.fit.push_back(std::move(f));
-  }
-  for (const auto& name : a.hold_out) {
-    const auto it = std::find_if(d.fit.begin(), d.fit.end(), [&](const auto& f) { return f.name == name; });
-    if (it == d.fit.end()) throw std::invalid_argument("--hold-out '" + name + "': no measured pose of that name");
-    d.held.push_back(std::move(*it));
-    d.fit.erase(it);
-  }
-  if (d.fit.empty())
-    throw std::invalid_argument(
-        "robodamp pose fit: give --measured Q1,Q2,...:FRF.csv or --measurements DIR, and keep at "
-        "least one pose in the fit");
-  return d;
-}
-
-robot::PoseFitSettings fit_settings(const PoseArgs& a, const FitData& d) {
+robot::PoseFitSettings fit_settings(const PoseArgs& a, const identify::PoseFitInputs& d) {
   robot::PoseFitSettings s;
   s.direction = a.direction == "xx"   ? robot::FrfDirection::kXX
                 : a.direction == "xy" ? robot::FrfDirection::kXY
@@ -90,7 +35,7 @@ robot::PoseFitSettings fit_settings(const PoseArgs& a, const FitData& d) {
 }  // namespace
 
 int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
-  const FitData d = fit_data(a, m);
+  const identify::PoseFitInputs d = identify::read_pose_fit_inputs(a.measured, a.measurements, a.hold_out, m);
   const robot::PoseFitSettings s = fit_settings(a, d);
   const robot::PoseFitResult r = robot::fit_joints(m, d.fit, s);
   robot::PoseReport report = robot::pose_fit_report(m, r, d.fit, d.held, s);

@@ -17,7 +17,7 @@
 #include "runtime/run_summary_text.hpp"
 #include "rt/signals.hpp"
 #include "runtime/cell.hpp"
-#include "sim_plant/faults.hpp"
+#include "sim_plant/fault_text.hpp"
 
 namespace robodamp::apps {
 
@@ -38,64 +38,6 @@ struct RunArgs {
   bool no_pose_schedule{false};
   std::vector<std::string> faults;  // simulated plant: KIND:START_S[:DURATION_S]
 };
-
-// "--fault amplifier_fault:8" or "sensor_nan:5:0.2": the plant's fault injector from loop time START_S for
-// DURATION_S (default: to the end); actuator_saturated takes the force it still gives, FORCE_N (default 0: none),
-// after the duration. Nothing, after saying why, when the text is not one.
-std::optional<sim::Fault> parse_fault(const std::string& text, double run_s) {
-  const auto fail = [&](const std::string& why) -> std::optional<sim::Fault> {
-    std::cerr << "robodamp run: --fault = '" << text << "' " << why << '\n';
-    return std::nullopt;
-  };
-  std::vector<std::string> parts;
-  std::stringstream ss(text);
-  for (std::string p; std::getline(ss, p, ':');) parts.push_back(p);
-  if (parts.size() < 2 || parts.size() > 4)
-    return fail("is not KIND:START_S[:DURATION_S] (actuator_saturated:START_S:DURATION_S[:FORCE_N])");
-  sim::Fault f;
-  bool known = false;
-  std::string kinds;
-  for (int k = 0; k <= static_cast<int>(sim::FaultKind::kDriverStall); ++k) {
-    const auto kind = static_cast<sim::FaultKind>(k);
-    kinds += std::string(kinds.empty() ? "" : ", ") + sim::to_string(kind);
-    if (parts[0] == sim::to_string(kind)) f.kind = kind, known = true;
-  }
-  if (!known) return fail("names no fault: allowed " + kinds);
-  double start = 0.0, duration = std::numeric_limits<double>::infinity();
-  if (auto p =
-          parse_number("--fault start", parts[1], {"s", 0.0, run_s, false, false, "within --duration"}, false, start))
-    return fail(*p);
-  if (parts.size() >= 3)
-    if (auto p = parse_number("--fault duration", parts[2], {"s", 0.0, 604800.0, true}, false, duration))
-      return fail(*p);
-  f.start_s = start;
-  f.duration_s = duration;
-  if (f.kind == sim::FaultKind::kActuatorSaturated) f.magnitude = 0.0;
-  if (parts.size() == 4) {
-    if (f.kind != sim::FaultKind::kActuatorSaturated)
-      return fail("has a fourth field: only actuator_saturated takes one (FORCE_N)");
-    if (auto p = parse_number("--fault force", parts[3], {"N", 0.0, 1e6}, false, f.magnitude)) return fail(*p);
-  }
-  return f;
-}
-
-// The layout of cyclictest's --histfile (whole-microsecond bins), so one script reads both.
-bool write_histogram(const std::string& path, const runtime::RunSummary& s) {
-  std::ofstream out(path);
-  const auto& h = s.loop.wake_latency;
-  out << "# robodamp run wake-up latency histogram (us)\n";
-  std::size_t last = 0;
-  for (std::size_t us = 0; us < rt::TimingHistogram::kBins; ++us)
-    if (h.bin(us) > 0) last = us;
-  char line[64];
-  for (std::size_t us = 0; us <= last; ++us) {
-    std::snprintf(line, sizeof line, "%06zu %06llu\n", us, static_cast<unsigned long long>(h.bin(us)));
-    out << line;
-  }
-  out << "# Total: " << h.count() << "\n# Max Latencies: " << h.max_us() << "\n# Histogram Overflows: " << h.overflow()
-      << "\n# Loop overruns: " << s.loop.overruns << "\n# Missed ticks: " << s.loop.missed_ticks << '\n';
-  return static_cast<bool>(out);
-}
 
 int exit_status(const runtime::Status& s) { return s.kind == runtime::StatusKind::kConfigError ? 2 : 1; }
 
@@ -123,9 +65,12 @@ int run_loop(const RunArgs& a) {
   }
   std::vector<sim::Fault> faults;
   for (const auto& text : a.faults) {
-    const auto f = parse_fault(text, a.duration_s);
-    if (!f) return 2;
-    faults.push_back(*f);
+    sim::Fault f;
+    if (std::string e; !sim::parse_fault(text, a.duration_s, f, e)) {
+      std::cerr << "robodamp run: --fault = " << e << '\n';
+      return 2;
+    }
+    faults.push_back(f);
   }
   runtime::Cell cell(cfg, o);
   if (runtime::Status s = cell.configure(); !s.ok()) {
@@ -151,7 +96,7 @@ int run_loop(const RunArgs& a) {
   const runtime::RunSummary& s = cell.summary();
   std::cout << runtime::summary_text(s);
   if (!emit_json(a.json, runtime::summary_json(s).dump(2), "run")) return 1;
-  if (!a.histogram_path.empty() && !write_histogram(a.histogram_path, s)) {
+  if (!a.histogram_path.empty() && !runtime::write_latency_histogram(a.histogram_path, s)) {
     std::cerr << "--histogram " << a.histogram_path << ": cannot write\n";
     return 1;
   }

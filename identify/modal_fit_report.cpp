@@ -40,6 +40,10 @@ FrfRead read_uff_frf(const FrfSource& s, bool dof_response) {
 
 }  // namespace
 
+FrfKind frf_kind_named(const std::string& kind) {
+  return kind == "mobility" ? FrfKind::kMobility : kind == "accelerance" ? FrfKind::kAccelerance : FrfKind::kReceptance;
+}
+
 FrfRead read_frf_source(const FrfSource& s) {
   const bool dof_response = s.response.find_first_of("0123456789") != std::string::npos;
   if (!dof_response && s.response != "acceleration" && s.response != "velocity" && s.response != "displacement")
@@ -52,10 +56,7 @@ FrfRead read_frf_source(const FrfSource& s) {
     if (s.record || dof_response || !s.reference.empty())
       throw std::invalid_argument("--record, --response NODE:DIR and --reference choose a universal file's record; " +
                                   s.frf_path + " is a table");
-    const auto kind = s.kind == "mobility"      ? FrfKind::kMobility
-                      : s.kind == "accelerance" ? FrfKind::kAccelerance
-                                                : FrfKind::kReceptance;
-    return {read_frf_csv(s.frf_path, kind), ""};
+    return {read_frf_csv(s.frf_path, frf_kind_named(s.kind)), ""};
   }
   if (looks_like_uff(s.series_path)) {
     UffSelection sel;

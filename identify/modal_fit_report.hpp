@@ -32,6 +32,9 @@ struct FrfRead {
   std::string note;  // what was read from a universal file (its record and units), empty otherwise
 };
 
+// "receptance", "mobility" or "accelerance" (anything else: receptance, as the options' checks allow only these).
+[[nodiscard]] FrfKind frf_kind_named(const std::string& kind);
+
 // The FRF the source names. Throws std::invalid_argument naming the option and what is allowed.
 [[nodiscard]] FrfRead read_frf_source(const FrfSource& s);
 

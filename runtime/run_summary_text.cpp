@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 
 #include "runtime/advice_view.hpp"
@@ -361,6 +362,23 @@ std::string summary_text(const runtime::RunSummary& s) {
   if (!s.realtime.warnings.empty())
     os << "  real-time set-up: " << s.realtime.warnings.size() << " step(s) fell back (warnings at start)\n";
   return os.str();
+}
+
+bool write_latency_histogram(const std::string& path, const runtime::RunSummary& s) {
+  std::ofstream out(path);
+  const auto& h = s.loop.wake_latency;
+  out << "# robodamp run wake-up latency histogram (us)\n";
+  std::size_t last = 0;
+  for (std::size_t us = 0; us < rt::TimingHistogram::kBins; ++us)
+    if (h.bin(us) > 0) last = us;
+  char line[64];
+  for (std::size_t us = 0; us <= last; ++us) {
+    std::snprintf(line, sizeof line, "%06zu %06llu\n", us, static_cast<unsigned long long>(h.bin(us)));
+    out << line;
+  }
+  out << "# Total: " << h.count() << "\n# Max Latencies: " << h.max_us() << "\n# Histogram Overflows: " << h.overflow()
+      << "\n# Loop overruns: " << s.loop.overruns << "\n# Missed ticks: " << s.loop.missed_ticks << '\n';
+  return static_cast<bool>(out);
 }
 
 }  // namespace robodamp::runtime

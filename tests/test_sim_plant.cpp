@@ -5,9 +5,12 @@
 #include <cmath>
 #include <complex>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "modal/receptance.hpp"
 #include "analysis/loop_model.hpp"
+#include "sim_plant/fault_text.hpp"
 #include "sim_plant/plant.hpp"
 #include "sim_plant/state_space.hpp"
 #include "test_util.hpp"
@@ -258,6 +261,33 @@ TEST(Faults, ActuatorDeadAndSaturated) {
   EXPECT_GT(sat.first, 11.0);
   EXPECT_LT(sat.first, 14.0);
   EXPECT_GT(sat.second, 0u);
+}
+
+// `run --fault` as typed: the kind, the start within the run, a duration, and for a saturated actuator the force
+// it still gives; every refusal names the field, its unit and its range.
+TEST(Faults, ReadFromTheCommandLinesText) {
+  sim::Fault f;
+  std::string e;
+  ASSERT_TRUE(sim::parse_fault("actuator_saturated:2:0.5:12", 10.0, f, e)) << e;
+  EXPECT_EQ(f.kind, sim::FaultKind::kActuatorSaturated);
+  EXPECT_EQ(f.start_s, 2.0);
+  EXPECT_EQ(f.duration_s, 0.5);
+  EXPECT_EQ(f.magnitude, 12.0);
+  ASSERT_TRUE(sim::parse_fault("actuator_saturated:1", 10.0, f, e)) << e;
+  EXPECT_EQ(f.magnitude, 0.0);  // no force left
+  EXPECT_TRUE(std::isinf(f.duration_s));
+  const sim::Fault before = f;
+  for (const auto& [text, why] : std::vector<std::pair<std::string, std::string>>{
+           {"sensor_nan:1:0.2:3", "only actuator_saturated takes one (FORCE_N)"},
+           {"actuator_saturated:1:1:-2", "--fault force = -2 N is out of range: allowed 0 <= value <= 1000000 N"},
+           {"sensor_nan:11", "--fault start = 11 s is out of range"},
+           {"sensor_nan:1:x", "--fault duration = 'x' is not a finite number"},
+           {"wet_sensor:1", "names no fault: allowed sensor_dropout, sensor_stuck"}}) {
+    EXPECT_FALSE(sim::parse_fault(text, 10.0, f, e)) << text;
+    EXPECT_NE(e.find(why), std::string::npos) << text << ": " << e;
+    EXPECT_EQ(e.rfind("'" + text + "'", 0), 0U) << e;
+    EXPECT_EQ(f.start_s, before.start_s) << text;  // nothing half-written
+  }
 }
 
 TEST(Plant, SameSeedSameRun) {
