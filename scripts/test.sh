@@ -6,7 +6,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-(cd build && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
+# One test more than cores: some tests wait on the wall clock (the 60 s soak, the real-time HIL runs) while
+# the rest are CPU-bound; on the two cores here 985 s instead of 1046 s (docs/tests.md), every test holding as
+# it does under the CPU hog.
+(cd build && ctest --output-on-failure --parallel "$(($(nproc) + 1))" --timeout 600)
 if [ "${CI:-}" = true ]; then
   bash scripts/tidy.sh
   bash scripts/sanitize.sh address,undefined --unit
