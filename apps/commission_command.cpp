@@ -7,8 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "apps/cli.hpp"
-#include "commission/commission.hpp"
-#include "commission/path_commission.hpp"
+#include "commission/command_line.hpp"
 
 namespace robodamp::apps {
 
@@ -28,24 +27,6 @@ struct CommissionArgs {
   bool evaluations_given{false}, polish_given{false};
   double peak_tolerance_pct{10.0};
 };
-
-std::string command_line(const CommissionArgs& a) {
-  std::string c = "robodamp commission --config " + a.config_path + " --job " + a.job_path + " --out " + a.out_dir;
-  const tune::TuneSettings d = commission::CommissionSettings{}.tune;
-  const tune::TuneSettings& s = a.settings.tune;
-  char b[64];
-  if (a.shift_pct) std::snprintf(b, sizeof b, " --shift-pct %g", *a.shift_pct), c += b;
-  if (s.global_evaluations != d.global_evaluations) c += " --evaluations " + std::to_string(s.global_evaluations);
-  if (s.local_evaluations != d.local_evaluations) c += " --polish " + std::to_string(s.local_evaluations);
-  if (s.seed != d.seed) c += " --seed " + std::to_string(s.seed);
-  const commission::CommissionSettings ds;
-  if (a.settings.schedule_speeds != ds.schedule_speeds)
-    c += " --schedule-speeds " + std::to_string(a.settings.schedule_speeds);
-  if (a.settings.schedule_gains != ds.schedule_gains)
-    c += " --schedule-gains " + std::to_string(a.settings.schedule_gains);
-  for (const auto& t : a.settings.tap_tests) c += " --tap-tests " + t;
-  return c;
-}
 
 bool stage_from(const std::string& text, commission::Stage& out) {
   try {
@@ -70,20 +51,6 @@ int finish(const Result& r, const std::string& where) {
   return commission::exit_code(r.outcome);
 }
 
-std::string path_command_line(const CommissionArgs& a, const commission::PathCommissionSettings& p) {
-  std::string c = "robodamp commission --config " + a.config_path + " --job " + a.job_path + " --out " + a.out_dir +
-                  " --along-path --dwells " + std::to_string(p.dwells);
-  for (const auto& w : p.trajectory) c += " --pose-at " + w;
-  if (!p.hold_out.empty()) {
-    c += " --hold-out";
-    for (const auto& h : p.hold_out) c += " " + h;
-  }
-  c += " --evaluations " + std::to_string(p.pose_tune.tune.global_evaluations) + " --polish " +
-       std::to_string(p.pose_tune.tune.local_evaluations) + " --map-points " + std::to_string(p.map_points) +
-       " --max-regions " + std::to_string(p.pose_tune.max_regions) + " --seed " + std::to_string(p.pose_tune.tune.seed);
-  return c;
-}
-
 int run_along_path(const CommissionArgs& a) {
   commission::PathCommissionSettings s = a.path;
   s.config_path = a.config_path;
@@ -95,7 +62,7 @@ int run_along_path(const CommissionArgs& a) {
   s.pose_tune.tune.global_evaluations = a.evaluations_given ? a.settings.tune.global_evaluations : 60;
   s.pose_tune.tune.local_evaluations = a.polish_given ? a.settings.tune.local_evaluations : 30;
   s.pose_tune.tune.seed = a.settings.tune.seed;
-  s.command_line = path_command_line(a, s);
+  s.command_line = commission::command_line(s);
   const commission::PathCommissionResult r =
       commission::commission_along_path(s, [](const std::string& l) { spdlog::info("{}", l); });
   return finish(r, " along the path at " + std::to_string(r.stops.size()) + " stops");
@@ -131,7 +98,7 @@ int run_commission(CommissionArgs& a) {
   s.out_dir = a.out_dir;
   s.shift_pct = a.shift_pct;
   if (!stage_from(a.from, s.from)) return 2;
-  s.command_line = command_line(a);
+  s.command_line = commission::command_line(s);
   const commission::CommissionResult r = commission::commission(s, [](const std::string& l) { spdlog::info("{}", l); });
   return finish(r, "");
 }

@@ -36,6 +36,10 @@ robot::PoseFitSettings fit_settings(const PoseArgs& a, const identify::PoseFitIn
 
 int run_fit(const config::RobotModelConfig& m, const PoseArgs& a) {
   const identify::PoseFitInputs d = identify::read_pose_fit_inputs(a.measured, a.measurements, a.hold_out, m);
+  if (d.fit.empty())
+    throw std::invalid_argument(
+        "robodamp pose fit: give --measured Q1,Q2,...:FRF.csv or --measurements DIR, and keep at "
+        "least one pose in the fit");
   const robot::PoseFitSettings s = fit_settings(a, d);
   const robot::PoseFitResult r = robot::fit_joints(m, d.fit, s);
   robot::PoseReport report = robot::pose_fit_report(m, r, d.fit, d.held, s);

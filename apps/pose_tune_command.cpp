@@ -1,9 +1,8 @@
 #include "apps/pose_tune_command.hpp"
 
-#include <algorithm>
 #include <iostream>
 
-#include "identify/pose_measurements.hpp"
+#include "identify/pose_fit_inputs.hpp"
 #include "tune/pose_tune_file.hpp"
 #include "tune/pose_tune_report.hpp"
 
@@ -16,15 +15,9 @@ namespace {
 void read_poses(const PoseTuneArgs& a, const config::RobotModelConfig& model, std::vector<tune::NamedPose>& measured,
                 std::vector<tune::NamedPose>& held) {
   if (a.measurements.empty()) return;
-  const identify::PoseMeasurements pm = identify::read_pose_measurements(a.measurements);
-  identify::check_against_model(pm, model);
-  for (const auto& f : pm.frfs) measured.push_back({f.name, f.joints_deg});
-  for (const std::string& name : a.hold_out) {
-    const auto it = std::find_if(measured.begin(), measured.end(), [&](const auto& p) { return p.name == name; });
-    if (it == measured.end()) throw std::invalid_argument("--hold-out '" + name + "': no measured pose of that name");
-    held.push_back(*it);
-    measured.erase(it);
-  }
+  const identify::PoseFitInputs d = identify::read_pose_fit_inputs({}, a.measurements, a.hold_out, model);
+  for (const auto& f : d.fit) measured.push_back({f.name, f.joints_deg});
+  for (const auto& f : d.held) held.push_back({f.name, f.joints_deg});
 }
 
 // The command that reproduces the file (its header).

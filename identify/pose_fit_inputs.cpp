@@ -47,10 +47,6 @@ PoseFitInputs read_pose_fit_inputs(const std::vector<std::string>& measured,
     d.held.push_back(std::move(*it));
     d.fit.erase(it);
   }
-  if (d.fit.empty())
-    throw std::invalid_argument(
-        "robodamp pose fit: give --measured Q1,Q2,...:FRF.csv or --measurements DIR, and keep at "
-        "least one pose in the fit");
   return d;
 }
 

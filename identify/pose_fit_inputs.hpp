@@ -22,7 +22,7 @@ struct PoseFitInputs {
 [[nodiscard]] robot::MeasuredFrf read_measured_frf(const std::string& item);
 
 // The --measured items, then the directories' poses (checked against the model), the held-out names moved to
-// `held`. Throws std::invalid_argument when a held-out name is not measured or no pose is left to fit.
+// `held` (pose fit and pose tune). Throws std::invalid_argument when a held-out name is not measured.
 [[nodiscard]] PoseFitInputs read_pose_fit_inputs(const std::vector<std::string>& measured,
                                                  const std::vector<std::string>& measurement_dirs,
                                                  const std::vector<std::string>& hold_out,

@@ -16,6 +16,7 @@
 
 #include "identify/uff_commissioning.hpp"
 #include "measfiles/uff.hpp"
+#include "commission/command_line.hpp"
 #include "commission/commission.hpp"
 #include "commission/cell_check.hpp"
 #include "commission/measurement.hpp"
@@ -299,6 +300,29 @@ TEST(Commission, BadMeasurementsStopAtTheirStageWithTheReasonAndWriteNoConfigura
   }
   EXPECT_THROW((void)commission::stage_from_string("write"), std::invalid_argument);
   fs::remove_all(dir);
+}
+
+// The command a written configuration's header gives to commission again: what was given, the defaults left out
+// (on the cell), every choice spelled out (along the path, whose budgets are its own).
+TEST(Commission, TheCommandLineInTheWrittenFilesIsTheOneThatWasGiven) {
+  commission::CommissionSettings s;
+  s.config_path = "cell.yaml", s.job_path = "job.yaml", s.out_dir = "out";
+  EXPECT_EQ(commission::command_line(s), "robodamp commission --config cell.yaml --job job.yaml --out out");
+  s.shift_pct = 2.5, s.tune.global_evaluations += 1, s.tune.seed = 7, s.schedule_gains += 2;
+  s.tap_tests = {"a.unv", "b.unv"};
+  EXPECT_EQ(commission::command_line(s),
+            "robodamp commission --config cell.yaml --job job.yaml --out out --shift-pct 2.5 --evaluations " +
+                std::to_string(s.tune.global_evaluations) + " --seed 7 --schedule-gains " +
+                std::to_string(s.schedule_gains) + " --tap-tests a.unv --tap-tests b.unv");
+  commission::PathCommissionSettings p;
+  p.config_path = "cell.yaml", p.job_path = "job.yaml", p.out_dir = "out", p.dwells = 2;
+  p.trajectory = {"0:-100,10,90", "20:-100,10,90"}, p.hold_out = {"dwell_2"};
+  p.pose_tune.tune.global_evaluations = 60, p.pose_tune.tune.local_evaluations = 30, p.pose_tune.tune.seed = 3;
+  p.pose_tune.max_regions = 2, p.map_points = 5;
+  EXPECT_EQ(commission::command_line(p),
+            "robodamp commission --config cell.yaml --job job.yaml --out out --along-path --dwells 2 --pose-at "
+            "0:-100,10,90 --pose-at 20:-100,10,90 --hold-out dwell_2 --evaluations 60 --polish 30 --map-points 5 "
+            "--max-regions 2 --seed 3");
 }
 
 TEST(Commission, TheRobustShiftFollowsTheFitsSpreadWithinItsBounds) {
