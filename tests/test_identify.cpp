@@ -2,11 +2,13 @@
 // model) recovered from forces generated with known coefficients, slotting and 25 % immersion down
 // milling; confidence intervals that cover the truth under noise; refusals for ill-posed data.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <random>
 
 #include "identify/ball_end.hpp"
+#include "identify/ball_end_report.hpp"
 #include "identify/cutting_coefficients.hpp"
 #include "identify/common_pole_fit.hpp"
 #include "identify/modal_fit.hpp"
@@ -235,6 +237,37 @@ TEST(IdentifyBallEnd, RefusesWhatCannotBeSeparated) {
   runs = one_depth;
   runs[0].axial_mm = 2.5;  // beyond the 2 mm ball
   EXPECT_THROW((void)identify::identify_ball_end(runs, {8, 4.0, 30.0, 0}), std::invalid_argument);
+}
+
+// The report: the material block is the fit read at kappa = 1 rad (as the tables give one value), YAML a parser
+// reads, the JSON's keys carry units, and the text names every coefficient.
+TEST(IdentifyBallEnd, TheReportsMaterialBlockIsTheFitAtOneRadian) {
+  const identify::BallEndTest t{6, 5.0, 25.0, 2};
+  const identify::BallEndCoefficients c{{700.0, -200.0, 60.0, 0.0}, {350.0, 90.0, -30.0, 0.0}, {150.0, -40.0, 20.0, 0.0},
+                                        4.0, 2.5, 1.0};
+  std::vector<identify::BallEndRun> runs;
+  for (double a : {0.3, 0.7, 1.1, 1.6, 2.2})
+    for (double fz : {0.015, 0.03, 0.05}) runs.push_back(identify::ball_end_mean_forces(t, a, fz, c));
+  const identify::BallEndFit f = identify::identify_ball_end(runs, t);
+  const identify::BallEndReport r = identify::ball_end_report(f, t, "slots; run 2.csv");
+  const YAML::Node m = YAML::Load(r.yaml)["material"];
+  ASSERT_TRUE(m.IsMap()) << r.yaml;
+  EXPECT_NEAR(m["kt_n_per_mm2"].as<double>(), 700.0 - 200.0 + 60.0, 1e-3) << r.yaml;
+  EXPECT_NEAR(m["kn_n_per_mm2"].as<double>(), 350.0 + 90.0 - 30.0, 1e-3) << r.yaml;
+  EXPECT_NEAR(m["kac_n_per_mm2"].as<double>(), 150.0 - 40.0 + 20.0, 1e-3) << r.yaml;
+  EXPECT_NEAR(m["kte_n_per_mm"].as<double>(), 4.0, 1e-6);
+  EXPECT_NEAR(m["kne_n_per_mm"].as<double>(), 2.5, 1e-6);
+  EXPECT_EQ(m["name"].as<std::string>(), "identified from slots; run 2.csv");
+  EXPECT_NEAR(identify::polynomial_at(f.ktc, identify::kBallEndTableKappaRad), m["kt_n_per_mm2"].as<double>(), 1e-3);
+  ASSERT_EQ(r.json["ktc_n_per_mm2"].size(), 3u);
+  EXPECT_NEAR(r.json["ktc_n_per_mm2"][1]["value"].get<double>(), -200.0, 1e-3);
+  EXPECT_NEAR(r.json["kae_n_per_mm"]["value"].get<double>(), 1.0, 1e-6);
+  EXPECT_EQ(r.json["runs"].get<int>(), 15);
+  EXPECT_EQ(r.json["order"].get<int>(), 2);
+  for (const char* s : {"from 15 slot runs (6 teeth, 5 mm, helix 25 deg), shear terms of order 2", "Ktc:", "Krc:", "Kac:",
+                        "Kte 4 +- ", "at kappa = 1 rad: Ktc 560,", "condition number"})
+    EXPECT_NE(r.text.find(s), std::string::npos) << s << "\n" << r.text;
+  EXPECT_EQ(r.text.find("note:"), std::string::npos) << r.text;  // exact forces: every interval is narrow
 }
 
 // The ball-end bone study's own slot runs (config/milling/data/ball_end_bone_slot_milling.csv): the fit runs and reports that
