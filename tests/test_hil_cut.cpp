@@ -182,16 +182,16 @@ AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_m
                                   f.run_log);
   return c;
 }
-// Waits (up to 110 s) for `line` in the emulator's log and `run_line` (if any) in the controller's, ends the
-// controller with Ctrl-C, and reads both reports.
+// Waits (up to 110 s, times the build's pace: test::pace) for `line` in the emulator's log and `run_line` (if any)
+// in the controller's, ends the controller with Ctrl-C, and reads both reports.
 AdviceRun finish_after(AdviceCase& c, const std::string& line, const std::string& run_line = "") {
-  EXPECT_TRUE(
-      test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; }, 110.0))
+  EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; },
+                               110.0 * test::pace()))
       << line << " not in\n"
       << test::read_file(c.files.plant_log);
   if (!run_line.empty()) {
-    EXPECT_TRUE(
-        test::eventually([&] { return test::read_file(c.files.run_log).find(run_line) != std::string::npos; }, 30.0))
+    EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.run_log).find(run_line) != std::string::npos; },
+                                 30.0 * test::pace()))
         << run_line << " not in\n"
         << test::read_file(c.files.run_log);
   }

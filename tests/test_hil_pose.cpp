@@ -158,7 +158,7 @@ TEST(Hil, PoseTrajectoryHandsOverBetweenRegionsAndSchedulingOffTrips) {
     if (mode == "on") path.insert(path.end(), {"--spindle", "0:700"});
     const Exits e = run_along_path(f, f.config, f.config, path, config::format_number(50 * pace), extra);
     ASSERT_EQ(e.plant, 0) << test::read_file(f.plant_log) << "--- the controller (exit " << e.run << "):\n"
-                           << test::read_file(f.run_log);
+                          << test::read_file(f.run_log);
     ASSERT_EQ(e.run, mode == "on" ? 0 : 4) << test::read_file(f.run_log);
     plant[mode] = read_json(f.plant_json);
     run[mode] = read_json(f.run_json);

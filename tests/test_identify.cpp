@@ -243,8 +243,8 @@ TEST(IdentifyBallEnd, RefusesWhatCannotBeSeparated) {
 // reads, the JSON's keys carry units, and the text names every coefficient.
 TEST(IdentifyBallEnd, TheReportsMaterialBlockIsTheFitAtOneRadian) {
   const identify::BallEndTest t{6, 5.0, 25.0, 2};
-  const identify::BallEndCoefficients c{{700.0, -200.0, 60.0, 0.0}, {350.0, 90.0, -30.0, 0.0}, {150.0, -40.0, 20.0, 0.0},
-                                        4.0, 2.5, 1.0};
+  const identify::BallEndCoefficients c{
+      {700.0, -200.0, 60.0, 0.0}, {350.0, 90.0, -30.0, 0.0}, {150.0, -40.0, 20.0, 0.0}, 4.0, 2.5, 1.0};
   std::vector<identify::BallEndRun> runs;
   for (double a : {0.3, 0.7, 1.1, 1.6, 2.2})
     for (double fz : {0.015, 0.03, 0.05}) runs.push_back(identify::ball_end_mean_forces(t, a, fz, c));
@@ -264,8 +264,8 @@ TEST(IdentifyBallEnd, TheReportsMaterialBlockIsTheFitAtOneRadian) {
   EXPECT_NEAR(r.json["kae_n_per_mm"]["value"].get<double>(), 1.0, 1e-6);
   EXPECT_EQ(r.json["runs"].get<int>(), 15);
   EXPECT_EQ(r.json["order"].get<int>(), 2);
-  for (const char* s : {"from 15 slot runs (6 teeth, 5 mm, helix 25 deg), shear terms of order 2", "Ktc:", "Krc:", "Kac:",
-                        "Kte 4 +- ", "at kappa = 1 rad: Ktc 560,", "condition number"})
+  for (const char* s : {"from 15 slot runs (6 teeth, 5 mm, helix 25 deg), shear terms of order 2",
+                        "Ktc:", "Krc:", "Kac:", "Kte 4 +- ", "at kappa = 1 rad: Ktc 560,", "condition number"})
     EXPECT_NE(r.text.find(s), std::string::npos) << s << "\n" << r.text;
   EXPECT_EQ(r.text.find("note:"), std::string::npos) << r.text;  // exact forces: every interval is narrow
 }
