@@ -1,26 +1,15 @@
 // `robodamp request`: one supervised parameter request over DDS and its reply.
 #include <unistd.h>
 
-#include <chrono>
-#include <cstdio>
 #include <iostream>
 #include <memory>
-#include <mutex>
-#include <thread>
-
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
 
 #include "apps/cli.hpp"
 #include "apps/dds_client.hpp"
-#include "dds/participant.hpp"
 #include "dds/messages.hpp"
-#include "rt/signals.hpp"
-#include "rt/supervisor.hpp"
+#include "dds/parameter_client.hpp"
 
 namespace robodamp::apps {
-
-using namespace eprosima::fastdds::dds;
-using Clock = std::chrono::steady_clock;
 
 struct RequestOptions {
   std::optional<double> gain_ns_per_m;
@@ -29,35 +18,6 @@ struct RequestOptions {
   std::optional<double> spindle_rpm;
   bool reset{false};
 };
-
-namespace {
-class Replies : public DataReaderListener {
- public:
-  Replies(std::string client, std::uint32_t id) : client_(std::move(client)), id_(id) {}
-  void on_data_available(DataReader* r) override {
-    msg::ParameterReply v;
-    SampleInfo info;
-    while (r->take_next_sample(&v, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data && v.client() == client_ && v.request_id() == id_) {
-        std::lock_guard<std::mutex> lock(m_);
-        reply_ = v;
-        got_ = true;
-      }
-  }
-  bool get(msg::ParameterReply& out) {
-    std::lock_guard<std::mutex> lock(m_);
-    out = reply_;
-    return got_;
-  }
-
- private:
-  std::string client_;
-  std::uint32_t id_;
-  std::mutex m_;
-  msg::ParameterReply reply_;
-  bool got_{false};
-};
-}  // namespace
 
 // 0 accepted, 3 refused (the reason is printed), 1 no loop or no reply, 2 bad options.
 int run_request(const DdsClientOptions& o, const RequestOptions& r) {
@@ -78,37 +38,19 @@ int run_request(const DdsClientOptions& o, const RequestOptions& r) {
   if (r.enable) req.kind(msg::ENABLE), req.value(*r.enable);
   if (r.spindle_rpm) req.kind(msg::SET_SPINDLE_RPM), req.value(*r.spindle_rpm);
   const double wait_s = o.duration_s > 0.0 ? o.duration_s : 10.0;
-  int rc = 1;
-  {
-    Replies replies(client, 1);  // before the participant: it outlives the reader that calls it
-    dds::Participant p(o.domain_id, o.transport, "robodamp request", o.security);
-    DataReader* reader = p.reader(dds::TopicKind::kReply, &replies);
-    DataWriter* writer = p.writer(dds::TopicKind::kRequest);
-    const auto end = Clock::now() + std::chrono::duration<double>(wait_s);
-    // Reliable and volatile: send once the loop's reader and reply writer have matched.
-    PublicationMatchedStatus pm;
-    SubscriptionMatchedStatus sm;
-    while (Clock::now() < end) {
-      writer->get_publication_matched_status(pm);
-      reader->get_subscription_matched_status(sm);
-      if (pm.current_count > 0 && sm.current_count > 0) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    if (pm.current_count == 0 || sm.current_count == 0) {
+  const dds::ParameterExchange x = dds::request_parameter(o.domain_id, o.transport, o.security, req, wait_s);
+  switch (x.outcome) {
+    case dds::ParameterExchange::Outcome::kReplied:
+      std::cout << (x.reply.accepted() ? "accepted: " : "refused: ") << x.reply.reason() << '\n';
+      return x.reply.accepted() ? 0 : 3;
+    case dds::ParameterExchange::Outcome::kNoLoop:
       std::cerr << "robodamp request: no loop on domain " << o.domain_id << " within " << wait_s << " s\n";
       return 1;
-    }
-    writer->write(&req);
-    msg::ParameterReply reply;
-    while (Clock::now() < end && !replies.get(reply)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (replies.get(reply)) {
-      std::cout << (reply.accepted() ? "accepted: " : "refused: ") << reply.reason() << '\n';
-      rc = reply.accepted() ? 0 : 3;
-    } else {
+    case dds::ParameterExchange::Outcome::kNoReply:
       std::cerr << "robodamp request: no reply from cell " << req.cell() << " within " << wait_s << " s\n";
-    }
+      return 1;
   }
-  return rc;
+  return 1;
 }
 
 void register_request(Registry& r) {

@@ -31,6 +31,7 @@
 #include "child_process.hpp"
 #include "dashboard/fleet.hpp"
 #include "dds/bridge.hpp"
+#include "dds/parameter_client.hpp"
 #include "dds/participant.hpp"
 #include "dds/messages.hpp"
 #include "test_util.hpp"
@@ -307,14 +308,11 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   EXPECT_NE(test::read_file(dir + "/request.log").find("refused: parameter writes are off"), std::string::npos);
   // A monitor watching when the loop ends says so instead of freezing (issue 52).
   test::Child watching({"monitor", "--config", dir + "/dds.yaml", "--duration", "300"}, dir + "/watching.log");
-  EXPECT_TRUE(eventually(
-      [&] { return test::read_file(dir + "/watching.log").find("state      active") != std::string::npos; }, 60.0))
+  EXPECT_TRUE(test::file_says(dir + "/watching.log", "state      active", 60.0))
       << test::read_file(dir + "/watching.log");
   run.kill(SIGINT);
   EXPECT_EQ(run.wait_for(60.0), std::optional<int>(0)) << test::read_file(dir + "/run.log");
-  EXPECT_TRUE(eventually(
-      [&] { return test::read_file(dir + "/watching.log").find("NO CONTACT: nothing from") != std::string::npos; },
-      60.0))
+  EXPECT_TRUE(test::file_says(dir + "/watching.log", "NO CONTACT: nothing from", 60.0))
       << test::read_file(dir + "/watching.log");
   EXPECT_NE(test::read_file(dir + "/watching.log").find("the loop stopped or the link is down"), std::string::npos);
   watching.kill(SIGINT);
@@ -327,6 +325,31 @@ TEST(Dds, MonitorShowsARunningLoopAndRequestSaysWhyItIsRefused) {
   EXPECT_NE(log.find("loop: tripped signal at"), std::string::npos) << log;
   EXPECT_LT(log.find("loop: tripped signal at"), log.find("tripped: signal")) << "before the summary";
   std::system(("rm -rf " + dir).c_str());
+}
+
+// A request with no loop to answer it: the library's exchange says no loop matched (it never sent), and
+// `robodamp request` says so with status 1 after its --timeout. Domain 229 is outside test_domain's 20..219
+// and the dashboard tests' domains, so no other test's loop can answer.
+TEST(Dds, ARequestWithNoLoopOnItsDomainSaysSoAfterItsWait) {
+  constexpr int kDomain = 229;
+  msg::ParameterRequest req;
+  req.client("test-no-loop");
+  req.cell(config::cell_name({}));
+  req.request_id(1);
+  req.kind(msg::SET_GAIN);
+  req.value(2500.0);
+  const auto x = dds::request_parameter(kDomain, config::DdsTransport::kUdpLoopback, std::nullopt, req, 1.0);
+  EXPECT_EQ(x.outcome, dds::ParameterExchange::Outcome::kNoLoop);
+  const std::string dir = ::testing::TempDir() + "robodamp_dds_no_loop_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  test::Child request({"request", "--domain", std::to_string(kDomain), "--transport", "udp_loopback", "--gain", "2500",
+                       "--timeout", "1"},
+                      dir + "/request.log");
+  EXPECT_EQ(request.wait_for(60.0), std::optional<int>(1)) << test::read_file(dir + "/request.log");
+  EXPECT_NE(test::read_file(dir + "/request.log").find("robodamp request: no loop on domain 229 within 1 s"),
+            std::string::npos)
+      << test::read_file(dir + "/request.log");
+  std::filesystem::remove_all(dir);
 }
 
 // Live stability on DDS: `robodamp run` with a milling job (spindle.job), the spindle speed from a DDS
@@ -580,7 +603,7 @@ TEST(Dds, JointStatesFromARos2DriverSelectThePoseSchedulesSet) {
     }
   });
   const auto log_has = [&](const std::string& s, double deadline_s) {
-    return eventually([&] { return test::read_file(dir + "/run.log").find(s) != std::string::npos; }, deadline_s);
+    return test::file_says(dir + "/run.log", s, deadline_s);
   };
   EXPECT_TRUE(log_has("dds joint states: pose [-100, 10, 90] deg in region 'folded'", 60.0))
       << test::read_file(dir + "/run.log");

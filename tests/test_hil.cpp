@@ -129,9 +129,7 @@ TEST(Hil, RealtimeRunReportsItsTimingAndPullingThePlugTripsSafe) {
   // Pull the plug 33 s into the loop's own run of 36 s: counted from the loop going active, not from the start of
   // the processes (an instrumented controller took 3.3 s more than the emulator to start, and the plug came at
   // 29.7 s of its run; ThreadSanitizer, 2026-12-07).
-  ASSERT_TRUE(test::eventually([&] { return test::read_file(f.run_log).find("loop: active") != std::string::npos; },
-                               60.0 * test::pace()))
-      << test::read_file(f.run_log);
+  ASSERT_TRUE(test::file_says(f.run_log, "loop: active", 60.0 * test::pace())) << test::read_file(f.run_log);
   std::this_thread::sleep_for(std::chrono::seconds(33));
   plant.kill(SIGKILL);
   EXPECT_EQ(plant.wait(), 128 + SIGKILL);

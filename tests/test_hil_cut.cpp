@@ -185,15 +185,11 @@ AdviceCase start_advice_case(const test::HilFiles& f, const std::string& depth_m
 // Waits (up to 110 s, times the build's pace: test::pace) for `line` in the emulator's log and `run_line` (if any)
 // in the controller's, ends the controller with Ctrl-C, and reads both reports.
 AdviceRun finish_after(AdviceCase& c, const std::string& line, const std::string& run_line = "") {
-  EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.plant_log).find(line) != std::string::npos; },
-                               110.0 * test::pace()))
-      << line << " not in\n"
-      << test::read_file(c.files.plant_log);
+  EXPECT_TRUE(test::file_says(c.files.plant_log, line, 110.0 * test::pace())) << line << " not in\n"
+                                                                              << test::read_file(c.files.plant_log);
   if (!run_line.empty()) {
-    EXPECT_TRUE(test::eventually([&] { return test::read_file(c.files.run_log).find(run_line) != std::string::npos; },
-                                 30.0 * test::pace()))
-        << run_line << " not in\n"
-        << test::read_file(c.files.run_log);
+    EXPECT_TRUE(test::file_says(c.files.run_log, run_line, 30.0 * test::pace())) << run_line << " not in\n"
+                                                                                 << test::read_file(c.files.run_log);
   }
   c.run->kill(SIGINT);
   AdviceRun r;

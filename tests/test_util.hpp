@@ -158,4 +158,9 @@ inline bool eventually(const std::function<bool()>& pred, double timeout_s = 10.
   return pred();
 }
 
+// Until the file at `path` (a process's log) contains `text`, or timeout_s passes.
+inline bool file_says(const std::string& path, const std::string& text, double timeout_s) {
+  return eventually([&] { return read_file(path).find(text) != std::string::npos; }, timeout_s);
+}
+
 }  // namespace robodamp::test
