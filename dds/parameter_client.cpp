@@ -50,7 +50,7 @@ ParameterExchange request_parameter(int domain_id, config::DdsTransport transpor
                                     const std::optional<config::DdsSecurityConfig>& security,
                                     const msg::ParameterRequest& request, double wait_s) {
   ParameterExchange out;
-  Replies replies(request.client(), request.request_id());  // before the participant: it outlives the reader
+  Replies replies(request.client().c_str(), request.request_id());  // before the participant: it outlives the reader
   Participant p(domain_id, transport, "robodamp request", security);
   DataReader* reader = p.reader(TopicKind::kReply, &replies);
   DataWriter* writer = p.writer(TopicKind::kRequest);
