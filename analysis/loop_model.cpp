@@ -8,15 +8,16 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
 #include "control/controller.hpp"
 #include "filters/design.hpp"
 #include "filters/harmonic_notch.hpp"
-#include "sim_plant/state_space.hpp"
 #include "units/units.hpp"
 
 namespace robodamp::analysis {
@@ -66,12 +67,13 @@ DiscreteSs section_ss(const filters::BiquadCoefficients& q, double scale) {
 }  // namespace
 
 LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rpm)
-    : cfg_(cfg),
-      plant_(sim::build_plant_model(cfg)),
-      chain_(analysis::design_chain(cfg)),
-      sensor_model_(cfg.sensor, cfg.loop.rate_hz, 0),
-      sensor_(plant_.index_of(cfg.sensor.location)) {
-  const double t = 1.0 / cfg.loop.rate_hz;
+    : LoopModel(cfg, std::make_shared<const SampledPlant>(cfg), spindle_rpm) {}
+
+LoopModel LoopModel::at_speed(double spindle_rpm) const { return {cfg_, s_, spindle_rpm}; }
+
+LoopModel::LoopModel(const config::Config& cfg, std::shared_ptr<const SampledPlant> sampled,
+                     std::optional<double> spindle_rpm)
+    : cfg_(cfg), s_(std::move(sampled)), chain_(analysis::design_chain(cfg)) {
   // The harmonic notches at this speed, fully faded in, as the chain runs them: the designed controller's
   // own settings and the bank's rule of which are on (filters/harmonic_notch.hpp).
   if (spindle_rpm && chain_.params.harmonic_notch.enabled) {
@@ -89,22 +91,6 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
       notches_.sections[notches_.count++] = c;
     }
   }
-  const auto& ss = plant_.ss;
-  const Eigen::Index nu = ss.b.cols(), nl = static_cast<Eigen::Index>(plant_.locations.size());
-  const sim::DelayedZoh coil = sim::discretise_zoh_delayed(ss.a, ss.b.leftCols(1), t, plant_.actuator.delay_s);
-  const sim::Zoh forces = sim::discretise_zoh(ss.a, ss.b.rightCols(nu - 1), t);
-  phi_ = coil.phi;
-  gamma_late_ = coil.gamma_late;
-  gamma_early_ = coil.gamma_early;
-  gamma_force_ = forces.gamma;
-  delay_steps_ = coil.steps;
-  c_accel_ = ss.c.middleRows(2 * nl, nl);
-  d_accel_coil_ = ss.d.block(2 * nl, 0, nl, 1);
-  d_accel_force_ = ss.d.block(2 * nl, 1, nl, nl);
-  Eigen::MatrixXd inputs(phi_.rows(), 2 + nl);
-  inputs << gamma_late_, gamma_early_, gamma_force_;
-  resolvent_ = Resolvent(phi_, inputs, c_accel_);
-
   open_loop_unit_ = open_loop({});
 }
 
@@ -113,29 +99,29 @@ DiscreteSs LoopModel::open_loop(const std::vector<std::size_t>& forces_at) const
   // force locations, the plant keeps the last held force at each as a state too: the sampled acceleration
   // feels it directly (the same left limit as the coil drive's, plant_response).
   DiscreteSs plant;  // input w[k] = coil drive, state [x; w[k-1] (; f_i[k-1] ...)], output sampled acceleration
-  const Eigen::Index n = phi_.rows(), extra = 1 + static_cast<Eigen::Index>(forces_at.size());
+  const Eigen::Index n = s_->phi.rows(), extra = 1 + static_cast<Eigen::Index>(forces_at.size());
   plant.a = MatrixXd::Zero(n + extra, n + extra);
-  plant.a.topLeftCorner(n, n) = phi_;
-  plant.a.block(0, n, n, 1) = gamma_early_;
+  plant.a.topLeftCorner(n, n) = s_->phi;
+  plant.a.block(0, n, n, 1) = s_->gamma_early;
   plant.b = MatrixXd::Zero(n + extra, 1);
-  plant.b.topRows(n) = gamma_late_;
+  plant.b.topRows(n) = s_->gamma_late;
   plant.b(n, 0) = 1.0;
   plant.c = MatrixXd::Zero(1, n + extra);
-  plant.c.leftCols(n) = c_accel_.row(static_cast<Eigen::Index>(sensor_));
-  plant.c(0, n) = d_accel_coil_(static_cast<Eigen::Index>(sensor_), 0);
+  plant.c.leftCols(n) = s_->c_accel.row(static_cast<Eigen::Index>(s_->sensor));
+  plant.c(0, n) = s_->d_accel_coil(static_cast<Eigen::Index>(s_->sensor), 0);
   plant.d = MatrixXd::Zero(1, 1);
   for (std::size_t i = 0; i < forces_at.size(); ++i)
     plant.c(0, n + 1 + static_cast<Eigen::Index>(i)) =
-        d_accel_force_(static_cast<Eigen::Index>(sensor_), static_cast<Eigen::Index>(forces_at[i]));
+        s_->d_accel_force(static_cast<Eigen::Index>(s_->sensor), static_cast<Eigen::Index>(forces_at[i]));
   DiscreteSs sensor;
-  if (sensor_model_.has_highpass()) {
-    const double g = sensor_model_.highpass_gain(), p = sensor_model_.highpass_pole();
+  if (s_->sensor_model.has_highpass()) {
+    const double g = s_->sensor_model.highpass_gain(), p = s_->sensor_model.highpass_pole();
     sensor = {MatrixXd::Constant(1, 1, p), MatrixXd::Constant(1, 1, g * (p - 1.0)), MatrixXd::Constant(1, 1, 1.0),
               MatrixXd::Constant(1, 1, g)};
   } else {
     sensor = {MatrixXd::Zero(0, 0), MatrixXd::Zero(0, 1), MatrixXd::Zero(1, 0), MatrixXd::Constant(1, 1, 1.0)};
   }
-  DiscreteSs o = series(series(delay_line(1 + delay_steps_), plant), sensor);
+  DiscreteSs o = series(series(delay_line(1 + s_->delay_steps), plant), sensor);
   const auto& sos = chain_.params.sections;
   for (std::size_t i = 0; i < sos.count; ++i) {
     const double scale = i == 0 ? chain_.params.sections_gain / chain_.params.actuator_constant_n_per_v : 1.0;
@@ -151,9 +137,9 @@ SampledPath LoopModel::sampled_path(std::size_t location, double gain, int polar
 
 SampledPaths LoopModel::sampled_paths(const std::vector<std::size_t>& locations, double gain, int polarity) const {
   for (const std::size_t l : locations)
-    if (l >= plant_.locations.size()) throw std::invalid_argument("LoopModel::sampled_paths: no such location");
+    if (l >= s_->plant.locations.size()) throw std::invalid_argument("LoopModel::sampled_paths: no such location");
   const DiscreteSs o = open_loop(locations);
-  const Eigen::Index n = phi_.rows(), plant_at = 1 + delay_steps_;  // the delay line's states come first
+  const Eigen::Index n = s_->phi.rows(), plant_at = 1 + s_->delay_steps;  // the delay line's states come first
   const auto m = static_cast<Eigen::Index>(locations.size());
   SampledPaths p;
   p.a = o.a + (polarity * gain) * o.b * o.c;
@@ -161,9 +147,9 @@ SampledPaths LoopModel::sampled_paths(const std::vector<std::size_t>& locations,
   p.c = MatrixXd::Zero(m, o.a.rows());
   for (Eigen::Index i = 0; i < m; ++i) {
     const std::size_t l = locations[static_cast<std::size_t>(i)];
-    p.b.col(i).segment(plant_at, n) = gamma_force_.col(static_cast<Eigen::Index>(l));
+    p.b.col(i).segment(plant_at, n) = s_->gamma_force.col(static_cast<Eigen::Index>(l));
     p.b(plant_at + n + 1 + i, i) = 1.0;
-    p.c.row(i).segment(plant_at, n) = plant_.ss.c.row(static_cast<Eigen::Index>(plant_.output_displacement(l)));
+    p.c.row(i).segment(plant_at, n) = s_->plant.ss.c.row(static_cast<Eigen::Index>(s_->plant.output_displacement(l)));
   }
   return p;
 }
@@ -178,21 +164,22 @@ Complex LoopModel::notch_response(double f_hz) const {
 Complex LoopModel::feedback_continuous(double f_hz, double gain, int polarity) const {
   const Complex s(0.0, kTwoPi * f_hz);
   return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_analog(f_hz) *
-         notch_response(f_hz) * plant_.actuator.n_per_v(f_hz) * sensor_model_.analog_response(f_hz) * s * s;
+         notch_response(f_hz) * s_->plant.actuator.n_per_v(f_hz) * s_->sensor_model.analog_response(f_hz) * s * s;
 }
 
 Complex LoopModel::loop_continuous(double f_hz, double gain, int polarity) const {
-  return -feedback_continuous(f_hz, gain, polarity) * plant_.receptance(sensor_, actuator_location(), f_hz);
+  return -feedback_continuous(f_hz, gain, polarity) * s_->plant.receptance(s_->sensor, actuator_location(), f_hz);
 }
 
 Complex LoopModel::open_continuous(std::size_t g, std::size_t h, double f_hz) const {
-  return plant_.receptance(g, h, f_hz);
+  return s_->plant.receptance(g, h, f_hz);
 }
 
 Complex LoopModel::closed_with_feedback(std::size_t g, std::size_t h, double f_hz, Complex q) const {
   const std::size_t a = actuator_location();
-  return plant_.receptance(g, h, f_hz) + plant_.receptance(g, a, f_hz) * q * plant_.receptance(sensor_, h, f_hz) /
-                                             (1.0 - q * plant_.receptance(sensor_, a, f_hz));
+  return s_->plant.receptance(g, h, f_hz) + s_->plant.receptance(g, a, f_hz) * q *
+                                                s_->plant.receptance(s_->sensor, h, f_hz) /
+                                                (1.0 - q * s_->plant.receptance(s_->sensor, a, f_hz));
 }
 
 Complex LoopModel::closed_continuous(std::size_t g, std::size_t h, double f_hz, double gain, int polarity) const {
@@ -205,7 +192,7 @@ Complex LoopModel::feedback_sampled(double f_hz, double gain, int polarity) cons
   const Complex delay = std::exp(-s * period_s);  // the command computed at tick k is applied from k + 1
   const Complex zoh = f_hz > 0.0 ? (1.0 - delay) / (s * period_s) : Complex(1.0);
   return polarity * gain / chain_.params.actuator_constant_n_per_v * chain_.filters_digital(f_hz) * delay * zoh *
-         plant_.actuator.n_per_v(f_hz) * sensor_model_.analog_response(f_hz) * s * s;
+         s_->plant.actuator.n_per_v(f_hz) * s_->sensor_model.analog_response(f_hz) * s * s;
 }
 
 Complex LoopModel::closed_sampled(std::size_t g, std::size_t h, double f_hz, double gain, int polarity) const {
@@ -213,22 +200,22 @@ Complex LoopModel::closed_sampled(std::size_t g, std::size_t h, double f_hz, dou
 }
 
 PlantResponse LoopModel::plant_response(double f_hz) const {
-  const Eigen::Index nl = static_cast<Eigen::Index>(plant_.locations.size());
+  const Eigen::Index nl = static_cast<Eigen::Index>(s_->plant.locations.size());
   const Complex zi = std::exp(Complex(0.0, -kTwoPi * f_hz / cfg_.loop.rate_hz));  // z^-1
-  const Eigen::MatrixXcd r = resolvent_(1.0 / zi);  // the late and early coil inputs, then the forces
+  const Eigen::MatrixXcd r = s_->resolvent(1.0 / zi);  // the late and early coil inputs, then the forces
   Eigen::MatrixXcd y(nl, 1 + nl);
   y.col(0) = r.col(0) + r.col(1) * zi;
   y.rightCols(nl) = r.rightCols(nl);
-  const Complex delay = std::pow(zi, delay_steps_);
+  const Complex delay = std::pow(zi, s_->delay_steps);
   PlantResponse p;
   p.f_hz = f_hz;
   p.accel_per_volt.resize(static_cast<std::size_t>(nl));
   p.accel_per_force.assign(static_cast<std::size_t>(nl), std::vector<Complex>(static_cast<std::size_t>(nl)));
   for (Eigen::Index g = 0; g < nl; ++g) {
-    p.accel_per_volt[static_cast<std::size_t>(g)] = (y(g, 0) + d_accel_coil_(g, 0) * zi) * delay;
+    p.accel_per_volt[static_cast<std::size_t>(g)] = (y(g, 0) + s_->d_accel_coil(g, 0) * zi) * delay;
     for (Eigen::Index h = 0; h < nl; ++h)
       p.accel_per_force[static_cast<std::size_t>(g)][static_cast<std::size_t>(h)] =
-          y(g, 1 + h) + d_accel_force_(g, h) * zi;
+          y(g, 1 + h) + s_->d_accel_force(g, h) * zi;
   }
   return p;
 }
@@ -244,8 +231,8 @@ Complex discrete_feedback(const PlantResponse& p, Complex filters, double gain, 
 
 Complex LoopModel::loop_discrete(const PlantResponse& p, Complex filters, double gain, int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
-  return -q * p.accel_per_volt[sensor_];
+                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+  return -q * p.accel_per_volt[s_->sensor];
 }
 
 Complex LoopModel::loop_discrete(double f_hz, double gain, int polarity) const {
@@ -260,9 +247,9 @@ Complex LoopModel::open_discrete(const PlantResponse& p, std::size_t g, std::siz
 Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std::size_t g, std::size_t h, double gain,
                                    int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
-  const Complex a = p.accel_per_force[g][h] +
-                    p.accel_per_volt[g] * q * p.accel_per_force[sensor_][h] / (1.0 - q * p.accel_per_volt[sensor_]);
+                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+  const Complex a = p.accel_per_force[g][h] + p.accel_per_volt[g] * q * p.accel_per_force[s_->sensor][h] /
+                                                  (1.0 - q * p.accel_per_volt[s_->sensor]);
   const double w = kTwoPi * p.f_hz;
   return a / (-w * w);
 }
@@ -270,21 +257,21 @@ Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std:
 Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, std::size_t h, double gain,
                                      int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
-  return q * p.accel_per_force[sensor_][h] / (1.0 - q * p.accel_per_volt[sensor_]);
+                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+  return q * p.accel_per_force[s_->sensor][h] / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 
 Complex LoopModel::command_per_sensor_noise(const PlantResponse& p, Complex filters, double gain, int polarity) const {
   const Complex q_noise =
       discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v, 1.0);
-  const Complex q = q_noise * sensor_model_.response(p.f_hz);
-  return q_noise / (1.0 - q * p.accel_per_volt[sensor_]);
+  const Complex q = q_noise * s_->sensor_model.response(p.f_hz);
+  return q_noise / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 
 Complex LoopModel::command_per_open_accel(const PlantResponse& p, Complex filters, double gain, int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, sensor_model_.response(p.f_hz));
-  return q / (1.0 - q * p.accel_per_volt[sensor_]);
+                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+  return q / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 
 Eigen::MatrixXd LoopModel::closed_loop_matrix(double gain, int polarity) const {

@@ -7,15 +7,16 @@
 
 #include <complex>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
-#include "analysis/resolvent.hpp"
-#include "config/config.hpp"
 #include "analysis/chain_design.hpp"
+#include "analysis/sampled_plant.hpp"
+#include "config/config.hpp"
 #include "sim_plant/plant_model.hpp"
 #include "sim_plant/sensor.hpp"
 
@@ -47,17 +48,22 @@ struct PlantResponse {
   std::vector<std::vector<Complex>> accel_per_force;  // [response][excitation]
 };
 
+// The loop is what it computes, in two parts: the sampled plant (analysis/sampled_plant.hpp: the plant, its
+// sensor and its discretisation at the loop rate, shared) and the controller's side (the designed chain, the
+// harmonic notches at a spindle speed, the unit open loop they close).
 class LoopModel {
  public:
   // spindle_rpm: with controller.harmonic_notch, the notches at that speed (fully faded in) join the
   // chain: the discrete loop runs them, the continuous model takes their digital response.
   explicit LoopModel(const config::Config& cfg, std::optional<double> spindle_rpm = std::nullopt);
+  // The same loop with the notches at spindle_rpm: this model's sampled plant, the chain designed again.
+  [[nodiscard]] LoopModel at_speed(double spindle_rpm) const;
 
-  [[nodiscard]] const sim::PlantModel& plant() const { return plant_; }
+  [[nodiscard]] const sim::PlantModel& plant() const { return s_->plant; }
   [[nodiscard]] const analysis::ChainDesign& chain() const { return chain_; }
   [[nodiscard]] const config::Config& config() const { return cfg_; }
-  [[nodiscard]] std::size_t sensor_location() const { return sensor_; }
-  [[nodiscard]] std::size_t actuator_location() const { return plant_.actuator.location; }
+  [[nodiscard]] std::size_t sensor_location() const { return s_->sensor; }
+  [[nodiscard]] std::size_t actuator_location() const { return s_->plant.actuator.location; }
   [[nodiscard]] double loop_rate_hz() const { return cfg_.loop.rate_hz; }
   // The harmonic notches in the model (none without a spindle speed) and their response.
   [[nodiscard]] std::size_t notch_count() const { return notches_.count; }
@@ -102,7 +108,7 @@ class LoopModel {
   // Volts per m/s^2 of acceleration at the sensor that an outside force causes with control off.
   [[nodiscard]] Complex command_per_open_accel(const PlantResponse& p, Complex chain_filters, double gain_ns_per_m,
                                                int polarity) const;
-  [[nodiscard]] const sim::Accelerometer& sensor_model() const { return sensor_model_; }
+  [[nodiscard]] const sim::Accelerometer& sensor_model() const { return s_->sensor_model; }
 
   // The loop that runs, closed at gain K and polarity, from a force held over each tick at `location` to
   // the displacement there (milling/sampled_sdm.hpp: the damped cut's semi-discretization).
@@ -126,19 +132,14 @@ class LoopModel {
   [[nodiscard]] int nyquist_encirclements(double gain_ns_per_m, int polarity) const;
 
  private:
+  LoopModel(const config::Config& cfg, std::shared_ptr<const SampledPlant> sampled, std::optional<double> spindle_rpm);
   config::Config cfg_;
+  std::shared_ptr<const SampledPlant> s_;
   filters::SosCoefficients notches_{};
   std::optional<double> spindle_rpm_;
-  sim::PlantModel plant_;
   analysis::ChainDesign chain_;
-  sim::Accelerometer sensor_model_;
-  std::size_t sensor_;
   // Closed-loop receptance g <- h for a feedback force q per displacement at the sensor.
   [[nodiscard]] Complex closed_with_feedback(std::size_t g, std::size_t h, double f_hz, Complex q) const;
-  // Loop-rate discretisation of the plant with the actuator delay.
-  Eigen::MatrixXd phi_, gamma_late_, gamma_early_, gamma_force_, c_accel_, d_accel_coil_, d_accel_force_;
-  int delay_steps_{0};
-  Resolvent resolvent_;        // c_accel_ (z I - phi_)^-1 [gamma_late_, gamma_early_, gamma_force_]
   DiscreteSs open_loop_unit_;  // controller output -> controller output at K = 1, polarity +1 (no gain yet)
   // The same, with the last held force at force_at as one more plant state (sampled_path).
   [[nodiscard]] DiscreteSs open_loop(const std::vector<std::size_t>& forces_at) const;

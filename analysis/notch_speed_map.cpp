@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include "analysis/loop_model.hpp"
 #include "units/units.hpp"
@@ -21,9 +22,16 @@ std::vector<bool> damps(const LoopModel& m, const std::vector<double>& modes_hz,
 }  // namespace
 
 NotchSpeedMap notch_speed_map(const config::Config& cfg, int points) {
+  if (!cfg.controller.harmonic_notch || points < 2) return {};
+  return notch_speed_map(LoopModel(cfg), points);
+}
+
+NotchSpeedMap notch_speed_map(const LoopModel& plain, int points) {
+  if (plain.spindle_rpm())
+    throw std::invalid_argument("notch_speed_map: the plain loop, not one with the notches at a spindle speed");
   NotchSpeedMap map;
+  const config::Config& cfg = plain.config();
   if (!cfg.controller.harmonic_notch || points < 2) return map;
-  const LoopModel plain(cfg);
   const double gain = cfg.controller.gain_ns_per_m;
   const int pol = cfg.controller.polarity;
   std::vector<double> modes_hz;
@@ -36,7 +44,7 @@ NotchSpeedMap notch_speed_map(const config::Config& cfg, int points) {
     NotchSpeedPoint p;
     p.rpm = lo * std::pow(hi / lo, static_cast<double>(i) / (points - 1));
     p.tooth_hz = p.rpm * cfg.spindle.teeth / 60.0;
-    const LoopModel m(cfg, p.rpm);
+    const LoopModel m = plain.at_speed(p.rpm);
     p.notches = m.notch_count();
     p.spectral_radius = m.spectral_radius(gain, pol);
     p.stable = p.spectral_radius < 1.0;

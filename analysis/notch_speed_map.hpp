@@ -14,6 +14,8 @@
 
 namespace robodamp::analysis {
 
+class LoopModel;
+
 struct NotchSpeedPoint {
   double rpm{0.0}, tooth_hz{0.0};
   std::size_t notches{0};
@@ -32,6 +34,9 @@ struct NotchSpeedMap {
 // Log-spaced from where the notches start (min_hz x 60 / teeth) to spindle.rpm_max; empty without
 // controller.harmonic_notch.
 [[nodiscard]] NotchSpeedMap notch_speed_map(const config::Config& cfg, int points = 400);
+// The same from the loop without notches (its configuration's): every speed's loop shares its sampled plant.
+// Throws std::invalid_argument for a model built at a spindle speed (its notches are not the plain loop).
+[[nodiscard]] NotchSpeedMap notch_speed_map(const LoopModel& plain, int points = 400);
 
 // The map's refused intervals into the controller's parameters; more than it holds are merged across
 // the smallest gaps (refusing a little more, never less).

@@ -264,7 +264,8 @@ LiveLimits LiveStability::evaluate_loop(const Key& k) const {
   // The zero-order limits are the accurate method's first guesses (and, labelled, the answer where the
   // sampled loop cannot step the speed).
   const config::StructureConfig& st = out.pose_deg.empty() ? structure_ : plane_structure_;
-  const Structure open(st, false, {std::make_shared<const analysis::LoopModel>(cfg), gain, polarity});
+  const auto plain = std::make_shared<const analysis::LoopModel>(cfg);
+  const Structure open(st, false, {plain, gain, polarity});
   const auto open_zoa = LobeModel(open, process, lobes).limit_at(out.rpm);
   const SdmPoint o = AccurateStability(open, job_).critical(out.rpm, open_zoa ? open_zoa->b_lim_mm : 1.0);
   out.open_mm = o.critical_depth_mm;
@@ -279,7 +280,8 @@ LiveLimits LiveStability::evaluate_loop(const Key& k) const {
     return out;
   }
   try {
-    const Structure damped(st, true, {std::make_shared<const analysis::LoopModel>(cfg, out.rpm), gain, polarity});
+    const Structure damped(st, true,
+                           {std::make_shared<const analysis::LoopModel>(plain->at_speed(out.rpm)), gain, polarity});
     const auto zoa = LobeModel(damped, process, lobes).limit_at(out.rpm);
     const AccurateStability truth(damped, job_);
     if (out.rpm <= truth.max_rpm()) {

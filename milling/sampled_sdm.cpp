@@ -102,7 +102,7 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
   const Eigen::Matrix2d r = to_machine(feed_axis_);
   for (const auto& part : parts_) {
     std::shared_ptr<const analysis::LoopModel> model = part.model;
-    if (per_speed_ && rpm > 0.0) model = std::make_shared<const analysis::LoopModel>(part.model->config(), rpm);
+    if (per_speed_ && rpm > 0.0) model = std::make_shared<const analysis::LoopModel>(part.model->at_speed(rpm));
     const auto d = static_cast<Eigen::Index>(part.direction);
     if (!part.across) {
       const analysis::SampledPath p = model->sampled_path(part.location, part.gain_ns_per_m, part.polarity);

@@ -32,9 +32,12 @@ double delay_margin_s(const analysis::LoopModel& m, const config::Config& c, std
 }
 
 // The harmonic notches' speed map (analysis/notch_speed_map.hpp): the speeds refused go into the
-// controller's parameters, and each refused interval is reported once here.
-control::ControllerParams with_notch_speed_map(const config::Config& cfg, control::ControllerParams p) {
-  const analysis::NotchSpeedMap map = analysis::notch_speed_map(cfg);
+// controller's parameters, and each refused interval is reported once here. From the set's own model: every
+// speed's loop shares its sampled plant.
+control::ControllerParams with_notch_speed_map(const analysis::LoopModel& m) {
+  const config::Config& cfg = m.config();
+  control::ControllerParams p = m.chain().params;
+  const analysis::NotchSpeedMap map = analysis::notch_speed_map(m);
   for (const auto& [lo, hi] : map.refused_rpm) {
     std::string why;
     for (const auto& pt : map.points)
@@ -100,7 +103,7 @@ Status Cell::plan_analysis() {
   rt::SupervisorSettings settings =
       config::supervisor_settings(cfg_, stable_, k_max, delay_margin_s(*model_, set0, max_stable_gain_));
   settings.pose_scheduled = !pose_schedule_.regions.empty() && !o_.pose_schedule_off;
-  supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(set0, model_->chain().params));
+  supervisor_ = std::make_unique<rt::Supervisor>(settings, with_notch_speed_map(*model_));
   if (settings.pose_scheduled) configure_pose_sets();
   return {};
 }
@@ -218,8 +221,8 @@ void Cell::configure_pose_sets() {
   for (std::size_t i = 1; i < pose_schedule_.regions.size(); ++i) {
     const auto& r = pose_schedule_.regions[i];
     const analysis::LoopModel m(r.config);
-    supervisor_->add_parameter_set({with_notch_speed_map(r.config, m.chain().params), true, r.k_max_ns_per_m,
-                                    delay_margin_s(m, r.config, r.k_max_ns_per_m)});
+    supervisor_->add_parameter_set(
+        {with_notch_speed_map(m), true, r.k_max_ns_per_m, delay_margin_s(m, r.config, r.k_max_ns_per_m)});
   }
 }
 
@@ -269,7 +272,7 @@ std::size_t Cell::add_parameter_set(const config::Config& cfg, bool own_schedule
   set_configs_.push_back(cfg);
   const int polarity = cfg.controller.polarity;
   const auto k_max = analysis::max_stable_gain(m, polarity);
-  control::ControllerParams p = with_notch_speed_map(cfg, m.chain().params);
+  control::ControllerParams p = with_notch_speed_map(m);
   // A mounting's own K schedule names set 0 for "this set"; a speed schedule's controllers carry the cell's.
   if (own_schedule) own_speed_bands(p, set_configs_.size() - 1);
   return supervisor_->add_parameter_set({p, m.stable(cfg.controller.gain_ns_per_m, polarity),

@@ -262,6 +262,47 @@ TEST(Analysis, AnalysedNotchesAreTheRunningBanksAtEverySpeed) {
   EXPECT_GT(saw_cut, 0);
 }
 
+// A loop model is its sampled plant and its controller's side: the loop at a spindle speed made from the plain
+// one (at_speed) shares the plain one's sampled plant and answers exactly as one built there from the
+// configuration; the notch speed map from the model equals the one from the configuration.
+TEST(Analysis, ALoopAtASpindleSpeedSharesItsSampledPlantAndAnswersAsOneBuiltThere) {
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  config::HarmonicNotchConfig n;
+  n.harmonics = 3, n.bandwidth_hz = 15.0, n.depth_db = 35.0;
+  cfg.controller.harmonic_notch = n;
+  cfg.spindle.teeth = 2;
+  cfg.spindle.rpm_max = 24000.0;
+  const analysis::LoopModel plain(cfg);
+  const int pol = cfg.controller.polarity;
+  const double k = cfg.controller.gain_ns_per_m;
+  for (const double rpm : {450.0, 2600.0, 17000.0}) {
+    const analysis::LoopModel built(cfg, rpm);
+    const analysis::LoopModel shared = plain.at_speed(rpm);
+    EXPECT_EQ(&shared.plant(), &plain.plant()) << rpm;
+    EXPECT_NE(&built.plant(), &plain.plant()) << rpm;
+    ASSERT_EQ(shared.notch_count(), built.notch_count()) << rpm;
+    EXPECT_GT(shared.notch_count(), 0U) << rpm;
+    EXPECT_EQ(shared.spindle_rpm(), std::optional<double>(rpm));
+    EXPECT_EQ(shared.spectral_radius(k, pol), built.spectral_radius(k, pol)) << rpm;
+    for (const double f_hz : {3.0, 9.2, 41.0, rpm * 2 / 60.0, 700.0}) {
+      EXPECT_EQ(shared.loop_discrete(f_hz, k, pol), built.loop_discrete(f_hz, k, pol)) << rpm << " rpm, " << f_hz;
+      EXPECT_EQ(shared.feedback_continuous(f_hz, k, pol), built.feedback_continuous(f_hz, k, pol)) << f_hz;
+      EXPECT_EQ(shared.notch_response(f_hz), built.notch_response(f_hz)) << f_hz;
+    }
+  }
+  const analysis::NotchSpeedMap from_cfg = analysis::notch_speed_map(cfg, 60);
+  const analysis::NotchSpeedMap from_model = analysis::notch_speed_map(plain, 60);
+  ASSERT_EQ(from_model.points.size(), 60U);
+  ASSERT_EQ(from_cfg.points.size(), from_model.points.size());
+  for (std::size_t i = 0; i < from_cfg.points.size(); ++i) {
+    EXPECT_EQ(from_cfg.points[i].spectral_radius, from_model.points[i].spectral_radius) << i;
+    EXPECT_EQ(from_cfg.points[i].notch_phase_deg, from_model.points[i].notch_phase_deg) << i;
+    EXPECT_EQ(from_cfg.points[i].refused, from_model.points[i].refused) << i;
+  }
+  EXPECT_EQ(from_cfg.refused_rpm, from_model.refused_rpm);
+  EXPECT_THROW((void)analysis::notch_speed_map(plain.at_speed(3000.0)), std::invalid_argument);
+}
+
 // Across the speed range: a notch just above the 9.2 Hz mode (tooth frequency 10-14.6 Hz, 20 Hz wide)
 // turns the feedback there by up to -118 deg, out of its damping window: those speeds are refused and
 // go into the controller's parameters, which then refuse a spindle speed there and park the notches.
