@@ -159,25 +159,31 @@ void MachiningMonitor::await_limits(double time_s, double rpm, std::size_t set, 
                                     const std::vector<double>& pose_deg) {
   milling::LiveStability::SweepPoint p{rpm, set, gain, stability_->grid_pose(pose_deg)};
   std::lock_guard<std::mutex> lock(m_);
-  for (const auto& [t, q] : awaited_)
-    if (same_state(q, p)) return;
-  if (awaited_.size() >= kAwaited) awaited_.erase(awaited_.begin());
-  awaited_.emplace_back(time_s, std::move(p));
+  for (Awaited& a : awaited_)
+    if (same_state(a.point, p)) {
+      a.last_s = time_s;
+      return;
+    }
+  if (awaited_.size() >= kAwaited)  // the shortest stay goes (the first of equals: the oldest)
+    awaited_.erase(std::min_element(awaited_.begin(), awaited_.end(), [](const Awaited& x, const Awaited& y) {
+      return x.last_s - x.met_s < y.last_s - y.met_s;
+    }));
+  awaited_.push_back({time_s, time_s, std::move(p)});
 }
 
 void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& now) {
-  std::vector<std::pair<double, milling::LiveStability::SweepPoint>> waiting;
+  std::vector<Awaited> waiting;
   {
     std::lock_guard<std::mutex> lock(m_);
     waiting = awaited_;
   }
-  for (const auto& [t, p] : waiting) {
+  for (const auto& [t, last_s, p] : waiting) {
     if (same_state(p, now)) continue;  // still there: its limits join the trail as the view finds them
     const std::vector<milling::LiveLimits> got = stability_->known(std::vector{p});  // never waits
     if (got.empty()) continue;
     const milling::LiveLimits& l = got.front();
     std::lock_guard<std::mutex> lock(m_);
-    std::erase_if(awaited_, [&, t = t](const auto& a) { return a.first == t && a.second.pose_deg == p.pose_deg; });
+    std::erase_if(awaited_, [&, t = t](const Awaited& a) { return a.met_s == t && a.point.pose_deg == p.pose_deg; });
     const bool met = std::any_of(trail_.begin(), trail_.end(), [&, &p = p](const milling::LiveLimitsRecord& r) {
       return r.set == p.set && r.gain_ns_per_m == p.gain_ns_per_m && r.limits.rpm == l.rpm &&
              r.limits.pose_deg == l.pose_deg;
@@ -196,12 +202,12 @@ void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& n
 void MachiningMonitor::complete_trail(double timeout_s) {
   if (!stability_->pose_dependent()) return;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  std::vector<std::pair<double, milling::LiveStability::SweepPoint>> waiting;
+  std::vector<Awaited> waiting;
   {
     std::lock_guard<std::mutex> lock(m_);
     waiting = awaited_;
   }
-  for (const auto& [t, p] : waiting) {
+  for (const auto& [met_s, last_s, p] : waiting) {
     if (std::chrono::steady_clock::now() >= end) break;
     try {
       (void)stability_->compute(p.rpm, p.set, p.gain_ns_per_m, p.pose_deg);  // cached: trail_awaited finds it
