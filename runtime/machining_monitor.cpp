@@ -147,32 +147,15 @@ void MachiningMonitor::add_to_trail(double time_s, std::size_t set, double gain,
       l.problem.empty() ? "" : ": ", l.problem);
 }
 
-namespace {
-
-bool same_state(const milling::LiveStability::SweepPoint& a, const milling::LiveStability::SweepPoint& b) {
-  return a.set == b.set && a.gain_ns_per_m == b.gain_ns_per_m && a.rpm == b.rpm && a.pose_deg == b.pose_deg;
-}
-
-}  // namespace
-
 void MachiningMonitor::await_limits(double time_s, double rpm, std::size_t set, double gain,
                                     const std::vector<double>& pose_deg) {
   milling::LiveStability::SweepPoint p{rpm, set, gain, stability_->grid_pose(pose_deg)};
   std::lock_guard<std::mutex> lock(m_);
-  for (Awaited& a : awaited_)
-    if (same_state(a.point, p)) {
-      a.last_s = time_s;
-      return;
-    }
-  if (awaited_.size() >= kAwaited)  // the shortest stay goes (the first of equals: the oldest)
-    awaited_.erase(std::min_element(awaited_.begin(), awaited_.end(), [](const Awaited& x, const Awaited& y) {
-      return x.last_s - x.met_s < y.last_s - y.met_s;
-    }));
-  awaited_.push_back({time_s, time_s, std::move(p)});
+  await_state(awaited_, kAwaited, time_s, std::move(p));
 }
 
 void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& now) {
-  std::vector<Awaited> waiting;
+  std::vector<AwaitedState> waiting;
   {
     std::lock_guard<std::mutex> lock(m_);
     waiting = awaited_;
@@ -183,7 +166,8 @@ void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& n
     if (got.empty()) continue;
     const milling::LiveLimits& l = got.front();
     std::lock_guard<std::mutex> lock(m_);
-    std::erase_if(awaited_, [&, t = t](const Awaited& a) { return a.met_s == t && a.point.pose_deg == p.pose_deg; });
+    std::erase_if(awaited_,
+                  [&, t = t](const AwaitedState& a) { return a.met_s == t && a.point.pose_deg == p.pose_deg; });
     const bool met = std::any_of(trail_.begin(), trail_.end(), [&, &p = p](const milling::LiveLimitsRecord& r) {
       return r.set == p.set && r.gain_ns_per_m == p.gain_ns_per_m && r.limits.rpm == l.rpm &&
              r.limits.pose_deg == l.pose_deg;
@@ -202,7 +186,7 @@ void MachiningMonitor::trail_awaited(const milling::LiveStability::SweepPoint& n
 void MachiningMonitor::complete_trail(double timeout_s) {
   if (!stability_->pose_dependent()) return;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  std::vector<Awaited> waiting;
+  std::vector<AwaitedState> waiting;
   {
     std::lock_guard<std::mutex> lock(m_);
     waiting = awaited_;

@@ -17,6 +17,7 @@
 #include "milling/chatter_indicator.hpp"
 #include "milling/live_stability.hpp"
 #include "rt/telemetry_frame.hpp"
+#include "runtime/awaited_states.hpp"
 #include "runtime/speed_advisor.hpp"
 
 namespace robodamp::runtime {
@@ -88,9 +89,8 @@ class MachiningMonitor {
   [[nodiscard]] std::vector<double> pose_now() const;           // the robot's joints (empty: not known, no pose)
   void log_chatter(const milling::ChatterIndicator& c);
   void add_to_trail(double time_s, std::size_t set, double gain, const milling::LiveLimits& l);
-  // A state met whose limits were not ready: kept until the worker has them, at most kAwaited; past that the
-  // one the robot stayed in least goes (a dwell outlasts the poses a move passes through: on a slow machine or
-  // a virtual clock faster than the wall's, a move meets more new states than are kept).
+  // A state met whose limits were not ready: kept until the worker has them, at most kAwaited, the shortest
+  // stay dropped first (runtime/awaited_states.hpp).
   void await_limits(double time_s, double rpm, std::size_t set, double gain, const std::vector<double>& pose_deg);
   // The awaited states the robot has left (not `now`) computed since, into the trail in the order met.
   void trail_awaited(const milling::LiveStability::SweepPoint& now);
@@ -114,11 +114,7 @@ class MachiningMonitor {
   mutable std::mutex m_;
   std::vector<milling::LiveLimitsRecord> trail_;     // guarded by m_
   std::optional<milling::LiveLimitsRecord> latest_;  // the last limits found at a pose (guarded by m_)
-  struct Awaited {
-    double met_s{0.0}, last_s{0.0};  // when the robot met the state, and when it was last seen in it
-    milling::LiveStability::SweepPoint point;
-  };
-  std::vector<Awaited> awaited_;  // guarded by m_
+  std::vector<AwaitedState> awaited_;                // guarded by m_
   milling::ChatterMonitor chatter_;
   bool chatter_logged_{false};  // the last verdict logged
   double next_chatter_log_s_{0.0};

@@ -16,6 +16,7 @@
 #include "milling/scheduled_lobes.hpp"
 #include "milling/speed_advice.hpp"
 #include "milling/structure.hpp"
+#include "runtime/awaited_states.hpp"
 #include "runtime/cell.hpp"
 #include "runtime/machining_monitor.hpp"
 #include "runtime/speed_advisor.hpp"
@@ -503,6 +504,38 @@ TEST(SpeedAdvisor, TheCellAdvisesSpeedsWhereTheJobsDepthIsStable) {
 // The live indicator hears up to 0.45 x the loop rate: a job whose modes go above that (the industrial
 // robot's spindle modes at 2.4-6.6 kHz; its SDM chatter at 10 700 rpm is at 5486 Hz) is said at once, the
 // modes named; the default job's (9.2-23.5 Hz) are all heard. Only the structure the cell uses counts.
+// The states the monitor waits on: a dwell's state outlasts the poses a move passes through. The robot stands
+// at the folded pose for 40 s (seen every half second) and then moves through 20 grid points a quarter of a
+// second each, all met before any limits are ready: of the 8 kept, the dwell and the move's last 7. (Dropping
+// the oldest instead, as before 2026-12-07, lost the dwell: Hil.PoseTrajectory... under AddressSanitizer.)
+TEST(MachiningMonitor, AwaitedStatesKeepTheDwellThroughAMovesPassingPoses) {
+  using Point = milling::LiveStability::SweepPoint;
+  const auto at = [](double joint2_deg) { return Point{700.0, 0, 250.0, {-100.0, joint2_deg, 90.0}}; };
+  std::vector<runtime::AwaitedState> states;
+  for (double t = 0.0; t <= 40.0; t += 0.5) runtime::await_state(states, 8, t, at(10.0));
+  ASSERT_EQ(states.size(), 1U);
+  EXPECT_EQ(states[0].met_s, 0.0);
+  EXPECT_EQ(states[0].last_s, 40.0);
+  for (int i = 1; i <= 20; ++i) runtime::await_state(states, 8, 40.0 + 0.25 * i, at(10.0 + 2.0 * i));
+  ASSERT_EQ(states.size(), 8U);
+  EXPECT_TRUE(runtime::same_state(states[0].point, at(10.0))) << "the dwell is kept";
+  for (std::size_t k = 1; k < 8; ++k)
+    EXPECT_EQ(states[k].point.pose_deg[1], 10.0 + 2.0 * static_cast<double>(13 + k)) << k;  // 38 .. 50 deg
+  // Seen again: its last time moves, nothing is added; another set or K at the same pose is another state.
+  runtime::await_state(states, 8, 70.0, at(50.0));
+  EXPECT_EQ(states.back().last_s, 70.0);
+  Point other_set = at(50.0);
+  other_set.set = 1;
+  EXPECT_FALSE(runtime::same_state(other_set, at(50.0)));
+  runtime::await_state(states, 8, 71.0, other_set);
+  ASSERT_EQ(states.size(), 8U);
+  EXPECT_TRUE(runtime::same_state(states[0].point, at(10.0)));
+  EXPECT_TRUE(runtime::same_state(states.back().point, other_set));
+  std::vector<runtime::AwaitedState> none;
+  runtime::await_state(none, 0, 1.0, at(10.0));
+  EXPECT_TRUE(none.empty()) << "capacity 0 keeps nothing";
+}
+
 TEST(MachiningMonitor, TheJobsModesAboveTheIndicatorsBandAreSaid) {
   const config::MillingConfig robot =
       config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/industrial_robot_aluminium.yaml");
