@@ -262,16 +262,26 @@ TEST(Analysis, AnalysedNotchesAreTheRunningBanksAtEverySpeed) {
   EXPECT_GT(saw_cut, 0);
 }
 
+// The default preset with harmonic notches (harmonics, bandwidth, depth) on a spindle of `teeth` up to rpm_max.
+struct NotchSettings {
+  int harmonics;
+  double bandwidth_hz, depth_db;
+};
+config::Config c2_with_notches(const NotchSettings& s, int teeth, double rpm_max) {
+  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
+  config::HarmonicNotchConfig n;
+  n.harmonics = s.harmonics, n.bandwidth_hz = s.bandwidth_hz, n.depth_db = s.depth_db;
+  cfg.controller.harmonic_notch = n;
+  cfg.spindle.teeth = teeth;
+  cfg.spindle.rpm_max = rpm_max;
+  return cfg;
+}
+
 // A loop model is its sampled plant and its controller's side: the loop at a spindle speed made from the plain
 // one (at_speed) shares the plain one's sampled plant and answers exactly as one built there from the
 // configuration; the notch speed map from the model equals the one from the configuration.
 TEST(Analysis, ALoopAtASpindleSpeedSharesItsSampledPlantAndAnswersAsOneBuiltThere) {
-  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-  config::HarmonicNotchConfig n;
-  n.harmonics = 3, n.bandwidth_hz = 15.0, n.depth_db = 35.0;
-  cfg.controller.harmonic_notch = n;
-  cfg.spindle.teeth = 2;
-  cfg.spindle.rpm_max = 24000.0;
+  const config::Config cfg = c2_with_notches({3, 15.0, 35.0}, 2, 24000.0);
   const analysis::LoopModel plain(cfg);
   const int pol = cfg.controller.polarity;
   const double k = cfg.controller.gain_ns_per_m;
@@ -307,12 +317,7 @@ TEST(Analysis, ALoopAtASpindleSpeedSharesItsSampledPlantAndAnswersAsOneBuiltTher
 // turns the feedback there by up to -118 deg, out of its damping window: those speeds are refused and
 // go into the controller's parameters, which then refuse a spindle speed there and park the notches.
 TEST(Analysis, NotchSpeedMapRefusesSpeedsThatPushADampedModeOutOfItsWindow) {
-  config::Config cfg = config::load_config_file(test::preset("horizontal_c2"));
-  config::HarmonicNotchConfig n;
-  n.harmonics = 4, n.bandwidth_hz = 20.0, n.depth_db = 30.0;
-  cfg.controller.harmonic_notch = n;
-  cfg.spindle.teeth = 3;
-  cfg.spindle.rpm_max = 20000.0;
+  const config::Config cfg = c2_with_notches({4, 20.0, 30.0}, 3, 20000.0);
   const analysis::NotchSpeedMap map = analysis::notch_speed_map(cfg);
   ASSERT_EQ(map.points.size(), 400U);
   EXPECT_NEAR(map.points.front().rpm, 200.0, 1e-9);  // min_hz 10 Hz x 60 / 3 teeth
