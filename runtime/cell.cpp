@@ -131,6 +131,7 @@ Status Cell::compose_devices() {
   try {
     MachiningInputs in;
     in.active_set = [this] { return supervisor_->running_parameter_set(); };
+    in.handing_over = [this] { return supervisor_->active_parameter_set() != supervisor_->running_parameter_set(); };
     in.on_advice = [this](const AdviceRecord& r) {  // the robot program reads it from modbus.robot.advice_register
       if (!modbus_ || r.status == AdviceStatus::kFollowed) return;
       if (r.status == AdviceStatus::kExpired)

@@ -34,6 +34,7 @@ milling::ChatterIndicatorSettings indicator_settings(const config::Config& cfg) 
 MachiningMonitor::MachiningMonitor(const config::Config& cfg, std::vector<config::Config> sets, MachiningInputs in)
     : teeth_(cfg.spindle.teeth),
       active_set_(std::move(in.active_set)),
+      handing_over_(std::move(in.handing_over)),
       robot_depth_mm_(std::move(in.robot_depth_mm)),
       pose_deg_(std::move(in.pose_deg)),
       path_ahead_deg_(std::move(in.path_ahead_deg)),
@@ -239,6 +240,7 @@ void MachiningMonitor::mode_spread(dds::MachiningSample& s) {
 AdviceView MachiningMonitor::view() {
   AdviceView v;
   dds::MachiningSample& s = v.sample;
+  v.handing_over = handing_over_ && handing_over_();
   const auto [set, gain] = set_and_gain();
   milling::ChatterIndicator c;
   {

@@ -38,6 +38,9 @@ struct Cutting {
 // What the monitor reads of the cell (any thread each, all optional but active_set).
 struct MachiningInputs {
   std::function<std::size_t()> active_set;  // the supervisor's running set
+  // Whether a parameter-set hand-over is under way (the set selected is not yet the one running; empty: never):
+  // the state it would be advised for ends within the hand-over's fade and warm-up.
+  std::function<bool()> handing_over;
   std::function<void(const AdviceRecord&)>
       on_advice;  // each new spindle-speed advice and each change of its status, on the advisor's thread
   std::function<double()> robot_depth_mm;  // the robot's depth (0: out of the cut; NaN: the job's)
@@ -101,6 +104,7 @@ class MachiningMonitor {
   std::vector<double> unheard_modes_hz_;
   std::vector<config::Config> set_configs_;  // every parameter set's configuration (their K by speed)
   std::function<std::size_t()> active_set_;
+  std::function<bool()> handing_over_;
   std::function<double()> robot_depth_mm_;
   std::function<std::vector<double>()> pose_deg_;
   std::function<std::vector<std::vector<double>>()> path_ahead_deg_;

@@ -85,7 +85,7 @@ std::optional<AdviceRecord> SpeedAdvisor::latest() const {
 
 std::optional<milling::SpeedAdviceRequest> SpeedAdvisor::wanted(const AdviceView& v, bool gain_settled) {
   const dds::MachiningSample& m = v.sample;
-  if (!(m.spindle_rpm > 0.0) || !gain_settled) return std::nullopt;
+  if (!(m.spindle_rpm > 0.0) || !gain_settled || v.handing_over) return std::nullopt;
   milling::SpeedAdviceRequest r;
   if (m.indicator_valid && m.chatter) {
     r.trigger = "chatter";

@@ -40,7 +40,10 @@ struct AdviceRecord {
 struct AdviceView {
   dds::MachiningSample sample;
   std::size_t parameter_set{0};
-  double gain_ns_per_m{0.0};                                                  // the gain the damped limit is for
+  double gain_ns_per_m{0.0};  // the gain the damped limit is for
+  // A parameter-set hand-over under way (a speed or pose schedule's, a request's): the set and K above are
+  // the outgoing chain's, fading out or held at 0 while the incoming one warms up; no advice is asked for them.
+  bool handing_over{false};
   std::function<std::pair<std::size_t, double>(double rpm)> controller_at{};  // a speed schedule's (empty: none)
   // The robot program's next poses (dds.path_ahead; empty: none published) and the set and K the pose
   // schedule would run at each (milling::SpeedAdviceRequest).
@@ -64,7 +67,8 @@ class SpeedAdvisor {
   // Any thread: the latest advice (none yet: nothing asked for one).
   [[nodiscard]] std::optional<AdviceRecord> latest() const;
   // Whether the view now asks for advice, and for which request (the trigger set), or not. gain_settled:
-  // the gain the same as a period ago (an advice during a fade would be for a passing state).
+  // the gain the same as a period ago (an advice during a fade would be for a passing state); nor during a
+  // hand-over (AdviceView::handing_over), whose outgoing chain sits at K = 0 through the incoming one's warm-up.
   [[nodiscard]] static std::optional<milling::SpeedAdviceRequest> wanted(const AdviceView& v, bool gain_settled);
   // The advice's status in the view now: followed at the advised speed (within same_speed_rpm); expired
   // when the spindle stopped or turns at another speed (not on its way to the advised one; on its way the
