@@ -25,6 +25,35 @@ std::complex<double> dense_dominant_multiplier(const Eigen::MatrixXd& z) {
   return ev(best);
 }
 
+Eigen::VectorXcd eigenvector_for(const Eigen::MatrixXd& z, std::complex<double> mu) {
+  if (z.rows() != z.cols() || z.rows() == 0) throw std::invalid_argument("eigenvector: the matrix must be square");
+  const Eigen::Index n = z.rows();
+  constexpr int kSolves = 3;
+  const double off = 1e-12 * std::max(1.0, z.cwiseAbs().colwise().sum().maxCoeff());
+  Eigen::MatrixXcd a = z.cast<std::complex<double>>();
+  a.diagonal().array() -= mu + std::complex<double>(off, off);
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(a);
+  // A fixed start with every component present (no eigenvector is orthogonal to it but by accident).
+  Eigen::VectorXcd v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto x = static_cast<double>(i);
+    v(i) = std::complex<double>(1.0 + 0.37 * std::sin(1.3 * x), 0.21 * std::cos(0.7 * x));
+  }
+  for (int k = 0; k < kSolves; ++k) {
+    v = lu.solve(v);
+    const double norm = v.norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) {
+      const Eigen::EigenSolver<Eigen::MatrixXd> es(z, true);
+      Eigen::Index best = 0;
+      for (Eigen::Index i = 1; i < n; ++i)
+        if (std::abs(es.eigenvalues()(i) - mu) < std::abs(es.eigenvalues()(best) - mu)) best = i;
+      return es.eigenvectors().col(best);
+    }
+    v /= norm;
+  }
+  return v;
+}
+
 std::complex<double> DominantMultiplier::operator()(const Eigen::MatrixXd& z) {
   if (z.rows() >= kMinArnoldiSize && z.rows() == z.cols() && !arnoldi_gave_up_) {
     Spectra::DenseGenMatProd<double> product(z);

@@ -38,4 +38,12 @@ class DominantMultiplier {
 // By the dense QR alone (Eigen's EigenSolver): the reference the tests compare with.
 [[nodiscard]] std::complex<double> dense_dominant_multiplier(const Eigen::MatrixXd& z);
 
+// The eigenvector of z for its eigenvalue mu (known to round-off, as above), by inverse iteration: a few
+// solves with one complex LU of z - mu I, the shift moved off mu by 1e-12 of z's norm so the LU is not exactly
+// singular (each solve then multiplies the wanted direction by its gap to the next eigenvalue over 1e-12).
+// The critical Floquet mode's chatter frequency needs only this vector: a dense QR with vectors took twice
+// the eigenvalues' time (30 ms at 172 states against 3.5 ms here). Falls back to the dense QR's vector when
+// the iteration does not settle (a non-finite solve). Off the real-time path.
+[[nodiscard]] Eigen::VectorXcd eigenvector_for(const Eigen::MatrixXd& z, std::complex<double> mu);
+
 }  // namespace robodamp::milling

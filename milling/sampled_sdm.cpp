@@ -239,17 +239,8 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, 
   phi.topRows(n) = x;
   for (int m = 1; m <= k; ++m) phi.middleRows(n + 2 * (m - 1), 2) = g[static_cast<std::size_t>(k - m)];
   phi.block(n + 2 * k, n, 2, 2).setIdentity();  // g'_-(k+1) = g_-1
-  if (!want_vector) {
-    res.mu = cache.dominant(phi);
-    return res;
-  }
-  const Eigen::EigenSolver<MatrixXd> es(phi, true);
-  const Eigen::VectorXcd ev = es.eigenvalues();
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 1; i < ev.size(); ++i)
-    if (std::abs(ev(i)) > std::abs(ev(best))) best = i;
-  res.mu = ev(best);
-  res.history = es.eigenvectors().col(best).segment(n, 2 * k);
+  res.mu = cache.dominant(phi);
+  if (want_vector) res.history = eigenvector_for(phi, res.mu).segment(n, 2 * k);
   return res;
 }
 

@@ -204,20 +204,16 @@ std::optional<IntervalCollocation> SdmModel::low_rank_intervals(const std::vecto
 }
 
 std::complex<double> SdmModel::dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const {
-  const Eigen::Index n = a_.rows();
-  const Eigen::EigenSolver<Eigen::MatrixXd> es(z, chatter_hz != nullptr);
-  const Eigen::VectorXcd ev = es.eigenvalues();
-  Eigen::Index best = 0;
-  for (Eigen::Index i = 1; i < ev.size(); ++i)
-    if (std::abs(ev(i)) > std::abs(ev(best))) best = i;
-  if (chatter_hz) {
-    // History slot j holds q at -(j + 1) / m tooth periods.
-    std::vector<double> t(static_cast<std::size_t>(m_));
-    for (int j = 0; j < m_; ++j) t[static_cast<std::size_t>(j)] = -(j + 1.0) / m_;
-    *chatter_hz =
-        floquet_chatter_hz(ev(best), t, es.eigenvectors().col(best).segment(n, 2 * m_), rpm * cutter_.teeth / 60.0);
-  }
-  return ev(best);
+  const std::complex<double> mu = dense_dominant_multiplier(z);
+  if (chatter_hz) *chatter_hz = chatter_hz_of(z, mu, rpm);
+  return mu;
+}
+
+double SdmModel::chatter_hz_of(const Eigen::MatrixXd& z, std::complex<double> mu, double rpm) const {
+  // History slot j holds q at -(j + 1) / m tooth periods.
+  std::vector<double> t(static_cast<std::size_t>(m_));
+  for (int j = 0; j < m_; ++j) t[static_cast<std::size_t>(j)] = -(j + 1.0) / m_;
+  return floquet_chatter_hz(mu, t, eigenvector_for(z, mu).segment(a_.rows(), 2 * m_), rpm * cutter_.teeth / 60.0);
 }
 
 DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol) {
@@ -269,13 +265,15 @@ DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, dou
 
 SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
   if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
-  Eigen::MatrixXd z_hi;  // the monodromy matrix at the last unstable depth: the bracket's hi at the end
+  Eigen::MatrixXd z_hi;  // the monodromy matrix and its multiplier at the last unstable depth: the bracket's hi
+  std::complex<double> mu_hi;
   DominantMultiplier largest;
   const DepthBracket br = find_critical_depth(
       [&](double b) {
         Eigen::MatrixXd z = monodromy(b, rpm);
-        const double ln_mu = std::log(std::abs(largest(z)));
-        if (ln_mu >= 0.0) z_hi.swap(z);
+        const std::complex<double> mu = largest(z);
+        const double ln_mu = std::log(std::abs(mu));
+        if (ln_mu >= 0.0) z_hi.swap(z), mu_hi = mu;
         return ln_mu;
       },
       guess_mm, rel_tol);
@@ -286,9 +284,9 @@ SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
     p.critical_depth_mm = br.hi_mm;
     return p;
   }
-  const std::complex<double> mu = dominant(z_hi, rpm, &p.chatter_hz);
+  p.chatter_hz = chatter_hz_of(z_hi, mu_hi, rpm);
   // Period doubling when the critical multiplier is (nearly) real and negative.
-  p.type = mu.real() < 0.0 && std::abs(mu.imag()) < 1e-3 * std::abs(mu) ? CutClass::kFlip : CutClass::kHopf;
+  p.type = mu_hi.real() < 0.0 && std::abs(mu_hi.imag()) < 1e-3 * std::abs(mu_hi) ? CutClass::kFlip : CutClass::kHopf;
   return p;
 }
 

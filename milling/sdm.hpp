@@ -93,6 +93,8 @@ class SdmModel {
   // The monodromy matrix over one tooth period; its dominant eigenvalue (and chatter frequency).
   [[nodiscard]] Eigen::MatrixXd monodromy(double axial_mm, double rpm) const;
   [[nodiscard]] std::complex<double> dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const;
+  // The chatter frequency of z's Floquet mode for its multiplier mu (the eigenvector by inverse iteration).
+  [[nodiscard]] double chatter_hz_of(const Eigen::MatrixXd& z, std::complex<double> mu, double rpm) const;
   // Each interval's mean directional matrix at this depth (N/m).
   [[nodiscard]] std::vector<Eigen::Matrix2d> directional_means(double axial_mm) const;
   // The collocation for intervals of length h, where it is cheaper than the dense exponential.
