@@ -64,7 +64,7 @@ void BM_OpenSdm46ModesMultiplier(benchmark::State& state) {
   const double rpm = static_cast<double>(state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(sdm.multiplier(3.0, rpm));
 }
-BENCHMARK(BM_OpenSdm46ModesMultiplier)->Arg(1156)->Arg(10700)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OpenSdm46ModesMultiplier)->Arg(500)->Arg(1156)->Arg(2500)->Arg(10700)->Unit(benchmark::kMillisecond);
 
 void BM_OpenSdm46ModesCriticalDepth(benchmark::State& state) {
   const milling::Structure s(job().selected_structure(), false);
