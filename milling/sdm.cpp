@@ -109,7 +109,7 @@ std::complex<double> SdmModel::multiplier(double axial_mm, double rpm, double* c
 }
 
 // long: one monodromy matrix over a tooth period (the hot loop of the open loop's accurate method)
-Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
+Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm, Collocations* kept) const {
   const Eigen::Index n = a_.rows(), d = n + 2 * m_;
   const double h = 60.0 / (rpm * cutter_.teeth) / m_;
   // Rows: the modes' states, then the delayed displacements q_{i-1} .. q_{i-m} in a ring of m slots of two rows
@@ -126,7 +126,14 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm) const {
   IntervalExp interval(blocks_, c_);
   const std::vector<Eigen::Matrix2d> free = interval.free_blocks(h);
   const std::vector<Eigen::Matrix2d> cut = directional_means(axial_mm);
-  std::optional<IntervalCollocation> collocation = low_rank_intervals(cut, h, free);
+  std::optional<IntervalCollocation> own;
+  IntervalCollocation* collocation = nullptr;
+  if (const int p = collocation_nodes(cut, h); p > 0 && kept != nullptr) {
+    if (kept->h != h) kept->by_nodes.clear(), kept->h = h;
+    collocation = &kept->by_nodes.try_emplace(p, blocks_, b_, c_, h, p, free).first->second;
+  } else if (p > 0) {
+    collocation = &own.emplace(blocks_, b_, c_, h, p, free);
+  }
   for (int i = 0; i < m_; ++i) {
     const Eigen::Matrix2d& mi = cut[static_cast<std::size_t>(i)];
     // x' = (A + B M C) x - B M q(t - tau); the delayed q goes linearly from q_{i-m} to q_{i-m+1}.
@@ -181,11 +188,10 @@ std::vector<Eigen::Matrix2d> SdmModel::directional_means(double axial_mm) const 
   return out;
 }
 
-std::optional<IntervalCollocation> SdmModel::low_rank_intervals(const std::vector<Eigen::Matrix2d>& cut, double h,
-                                                                const std::vector<Eigen::Matrix2d>& free) const {
+int SdmModel::collocation_nodes(const std::vector<Eigen::Matrix2d>& cut, double h) const {
   // Only for a structure of 8 modes or more (every few-mode job, so every preset, keeps the dense exponential to
   // the bit), and where the correction's rank 2p is at most the modes' state (below).
-  if (!low_rank_ || 4 * IntervalCollocation::kMinNodes > a_.rows()) return std::nullopt;
+  if (!low_rank_ || 4 * IntervalCollocation::kMinNodes > a_.rows()) return 0;
   // rho bounds |A + B M C|: the largest block's norm plus the cut's rank-2 term's (the largest singular value
   // of B M C, from the 2 x 2 (B M)^T (B M) C C^T).
   double rho_a = 0.0, rho_cut = 0.0;
@@ -202,8 +208,7 @@ std::optional<IntervalCollocation> SdmModel::low_rank_intervals(const std::vecto
   // Worth it where the correction's rank 2p is at most the modes' state: on the 46-mode robot (n = 92) one
   // monodromy matrix by collocation against the dense exponential took 15.1 against 22.8 ms at 1156 rpm
   // (p = 33), 12.1 against 21.0 ms at 2500 rpm, and 35.1 against 25.2 ms at 500 rpm (p = 53 > n / 2: dense).
-  if (p == 0 || 2 * p > a_.rows()) return std::nullopt;
-  return std::optional<IntervalCollocation>(std::in_place, blocks_, b_, c_, h, p, free);
+  return 2 * p > a_.rows() ? 0 : p;
 }
 
 std::complex<double> SdmModel::dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const {
@@ -271,9 +276,10 @@ SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
   Eigen::MatrixXd z_hi;  // the monodromy matrix and its multiplier at the last unstable depth: the bracket's hi
   std::complex<double> mu_hi;
   DominantMultiplier largest;
+  Collocations kept;
   const DepthBracket br = find_critical_depth(
       [&](double b) {
-        Eigen::MatrixXd z = monodromy(b, rpm);
+        Eigen::MatrixXd z = monodromy(b, rpm, &kept);
         const std::complex<double> mu = largest(z);
         const double ln_mu = std::log(std::abs(mu));
         if (ln_mu >= 0.0) z_hi.swap(z), mu_hi = mu;

@@ -12,6 +12,7 @@
 
 #include <complex>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,15 +92,22 @@ class SdmModel {
 
  private:
   // The monodromy matrix over one tooth period; its dominant eigenvalue (and chatter frequency).
-  [[nodiscard]] Eigen::MatrixXd monodromy(double axial_mm, double rpm) const;
+  // The collocations a search at one speed has made, by their node counts: their tables depend on the interval
+  // alone, so the search's depths share them (the same arithmetic as making them again).
+  struct Collocations {
+    double h{0.0};
+    std::map<int, IntervalCollocation> by_nodes;
+  };
+  [[nodiscard]] Eigen::MatrixXd monodromy(double axial_mm, double rpm, Collocations* kept = nullptr) const;
   [[nodiscard]] std::complex<double> dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const;
   // The chatter frequency of z's Floquet mode for its multiplier mu (the eigenvector by inverse iteration).
   [[nodiscard]] double chatter_hz_of(const Eigen::MatrixXd& z, std::complex<double> mu, double rpm) const;
   // Each interval's mean directional matrix at this depth (N/m).
   [[nodiscard]] std::vector<Eigen::Matrix2d> directional_means(double axial_mm) const;
   // The collocation for intervals of length h, where it is cheaper than the dense exponential.
-  [[nodiscard]] std::optional<IntervalCollocation> low_rank_intervals(const std::vector<Eigen::Matrix2d>& cut, double h,
-                                                                      const std::vector<Eigen::Matrix2d>& free) const;
+  // The nodes of the collocation for intervals of length h where it is cheaper than the dense exponential;
+  // 0: the dense exponential.
+  [[nodiscard]] int collocation_nodes(const std::vector<Eigen::Matrix2d>& cut, double h) const;
 
   Eigen::MatrixXd a_, b_, c_;            // modes' states as (wn q, q'), A block diagonal
   std::vector<Eigen::Matrix2d> blocks_;  // A's blocks
