@@ -143,7 +143,7 @@ SampledSdm::System SampledSdm::system_at(double rpm) const {
 
 // long: one monodromy matrix over a tooth period on preallocated blocks (the hot loop of the accurate method)
 SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks,
-                                         bool want_vector) const {
+                                         Eigen::MatrixXd* phi_out) const {
   const Eigen::Index n = sys.a.rows();
   const double period_s = ticks * tick_s_;
   const int k = std::min(
@@ -240,7 +240,7 @@ SampledSdm::Result SampledSdm::monodromy(const System& sys, Propagators& cache, 
   for (int m = 1; m <= k; ++m) phi.middleRows(n + 2 * (m - 1), 2) = g[static_cast<std::size_t>(k - m)];
   phi.block(n + 2 * k, n, 2, 2).setIdentity();  // g'_-(k+1) = g_-1
   res.mu = cache.dominant(phi);
-  if (want_vector) res.history = eigenvector_for(phi, res.mu).segment(n, 2 * k);
+  if (phi_out) *phi_out = std::move(phi);
   return res;
 }
 
@@ -265,14 +265,23 @@ std::complex<double> SampledSdm::AtSpeed::multiplier(double axial_mm) {
   if (!(axial_mm > 0.0) || !std::isfinite(axial_mm))
     throw std::invalid_argument("axial depth = " + fmt(axial_mm) + " mm: must be > 0 and finite");
   cache_.dominant = DominantMultiplier{};
-  return sdm_->monodromy(sys_, cache_, axial_mm, ticks_, false).mu;
+  return sdm_->monodromy(sys_, cache_, axial_mm, ticks_).mu;
 }
 
 SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
   cache_.dominant = DominantMultiplier{};
+  // The last unstable depth's matrix and result (the bracket's hi at the end): its critical mode's vector
+  // gives the chatter frequency without forming the matrix again.
+  MatrixXd phi, phi_hi;
+  Result hi;
   const DepthBracket br = find_critical_depth(
-      [&](double b) { return std::log(std::abs(sdm_->monodromy(sys_, cache_, b, ticks_, false).mu)); }, guess_mm,
-      rel_tol);
+      [&](double b) {
+        Result r = sdm_->monodromy(sys_, cache_, b, ticks_, &phi);
+        const double ln_mu = std::log(std::abs(r.mu));
+        if (ln_mu >= 0.0) phi_hi.swap(phi), hi = std::move(r);
+        return ln_mu;
+      },
+      guess_mm, rel_tol);
   SdmPoint p;
   p.rpm = rpm_;
   p.critical_depth_mm = br.lo_mm;
@@ -280,9 +289,10 @@ SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
     p.critical_depth_mm = br.hi_mm;
     return p;
   }
-  const Result r = sdm_->monodromy(sys_, cache_, br.hi_mm, ticks_, true);
-  p.type = r.mu.real() < 0.0 && std::abs(r.mu.imag()) < 1e-3 * std::abs(r.mu) ? CutClass::kFlip : CutClass::kHopf;
-  p.chatter_hz = sdm_->chatter_hz(r, ticks_);
+  const auto k = static_cast<Eigen::Index>(hi.grid.size()) - 1;
+  hi.history = eigenvector_for(phi_hi, hi.mu).segment(phi_hi.rows() - 2 * (k + 1), 2 * k);
+  p.type = hi.mu.real() < 0.0 && std::abs(hi.mu.imag()) < 1e-3 * std::abs(hi.mu) ? CutClass::kFlip : CutClass::kHopf;
+  p.chatter_hz = sdm_->chatter_hz(hi, ticks_);
   return p;
 }
 

@@ -87,8 +87,9 @@ class SampledSdm {
     DominantMultiplier dominant;
   };
   [[nodiscard]] System system_at(double rpm) const;
+  // The dominant multiplier and the grid (not the history); phi_out (optional) takes the matrix itself.
   [[nodiscard]] Result monodromy(const System& sys, Propagators& cache, double axial_mm, int ticks,
-                                 bool want_vector) const;
+                                 Eigen::MatrixXd* phi_out = nullptr) const;
   [[nodiscard]] double chatter_hz(const Result& r, int ticks) const;
 
   friend class AtSpeed;
