@@ -290,7 +290,7 @@ SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
     return p;
   }
   const auto k = static_cast<Eigen::Index>(hi.grid.size()) - 1;
-  hi.history = eigenvector_for(phi_hi, hi.mu).segment(phi_hi.rows() - 2 * (k + 1), 2 * k);
+  hi.history = eigenvector_for(phi_hi, hi.mu).segment(sys_.a.rows(), 2 * k);
   p.type = hi.mu.real() < 0.0 && std::abs(hi.mu.imag()) < 1e-3 * std::abs(hi.mu) ? CutClass::kFlip : CutClass::kHopf;
   p.chatter_hz = sdm_->chatter_hz(hi, ticks_);
   return p;

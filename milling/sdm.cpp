@@ -126,13 +126,12 @@ Eigen::MatrixXd SdmModel::monodromy(double axial_mm, double rpm, Collocations* k
   IntervalExp interval(blocks_, c_);
   const std::vector<Eigen::Matrix2d> free = interval.free_blocks(h);
   const std::vector<Eigen::Matrix2d> cut = directional_means(axial_mm);
-  std::optional<IntervalCollocation> own;
+  Collocations own;
+  Collocations& made = kept != nullptr ? *kept : own;
   IntervalCollocation* collocation = nullptr;
-  if (const int p = collocation_nodes(cut, h); p > 0 && kept != nullptr) {
-    if (kept->h != h) kept->by_nodes.clear(), kept->h = h;
-    collocation = &kept->by_nodes.try_emplace(p, blocks_, b_, c_, h, p, free).first->second;
-  } else if (p > 0) {
-    collocation = &own.emplace(blocks_, b_, c_, h, p, free);
+  if (const int p = collocation_nodes(cut, h); p > 0) {
+    if (made.h != h) made.by_nodes.clear(), made.h = h;
+    collocation = &made.by_nodes.try_emplace(p, blocks_, b_, c_, h, p, free).first->second;
   }
   for (int i = 0; i < m_; ++i) {
     const Eigen::Matrix2d& mi = cut[static_cast<std::size_t>(i)];

@@ -91,20 +91,20 @@ class SdmModel {
   void dense_intervals_only() { low_rank_ = false; }
 
  private:
-  // The monodromy matrix over one tooth period; its dominant eigenvalue (and chatter frequency).
   // The collocations a search at one speed has made, by their node counts: their tables depend on the interval
   // alone, so the search's depths share them (the same arithmetic as making them again).
   struct Collocations {
     double h{0.0};
     std::map<int, IntervalCollocation> by_nodes;
   };
+  // The monodromy matrix over one tooth period (kept: a search's collocations); its dominant eigenvalue (and
+  // chatter frequency).
   [[nodiscard]] Eigen::MatrixXd monodromy(double axial_mm, double rpm, Collocations* kept = nullptr) const;
   [[nodiscard]] std::complex<double> dominant(const Eigen::MatrixXd& z, double rpm, double* chatter_hz) const;
   // The chatter frequency of z's Floquet mode for its multiplier mu (the eigenvector by inverse iteration).
   [[nodiscard]] double chatter_hz_of(const Eigen::MatrixXd& z, std::complex<double> mu, double rpm) const;
   // Each interval's mean directional matrix at this depth (N/m).
   [[nodiscard]] std::vector<Eigen::Matrix2d> directional_means(double axial_mm) const;
-  // The collocation for intervals of length h, where it is cheaper than the dense exponential.
   // The nodes of the collocation for intervals of length h where it is cheaper than the dense exponential;
   // 0: the dense exponential.
   [[nodiscard]] int collocation_nodes(const std::vector<Eigen::Matrix2d>& cut, double h) const;
