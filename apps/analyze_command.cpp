@@ -9,8 +9,6 @@
 #include "analysis/loop_report.hpp"
 #include "analysis/schedule_report.hpp"
 #include "apps/cli.hpp"
-#include "apps/gnuplot.hpp"
-#include "config/milling_config.hpp"
 #include "milling/study_report.hpp"
 #include "tune/tune_report.hpp"
 

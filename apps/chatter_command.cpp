@@ -1,24 +1,15 @@
 // `robodamp chatter --signal FILE`: a recorded cut's vibration or sound (a table, a WAV, a universal file's
 // time history, a robodamp recording) -> chatter over time, its frequency, and the speeds to try next
 // (milling/chatter_listen.hpp). docs/milling.md, "Listening to a recorded cut".
-#include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
-#include "apps/gnuplot.hpp"
 #include "identify/recorded_signal.hpp"
-#include "config/config.hpp"
-#include "config/milling_config.hpp"
-#include "milling/chatter.hpp"
 #include "milling/chatter_listen.hpp"
 #include "milling/listen_report.hpp"
-#include "milling/live_stability.hpp"
-#include "milling/speed_advice.hpp"
 
 namespace robodamp::apps {
 
@@ -39,40 +30,6 @@ struct ChatterArgs {
   JsonOut json;
 };
 
-// Each speed to try checked as the cell's advisor checks it: the accurate limit at the recorded depth there.
-struct Cell {
-  config::Config cfg;
-  config::MillingConfig job;
-};
-
-std::optional<Cell> cell_of(const ChatterArgs& a) {
-  if (a.config_path.empty()) {
-    if (!a.job_path.empty() || a.depth_mm || a.damped)
-      throw std::invalid_argument("--job, --depth-mm and --damped need --config (the cell)");
-    return std::nullopt;
-  }
-  config::Config cfg = config::load_config_file(a.config_path);
-  const std::string job_path = !a.job_path.empty() ? a.job_path : cfg.spindle.job_resolved;
-  if (job_path.empty()) throw std::invalid_argument(a.config_path + ": no spindle.job: give --job");
-  Cell c{std::move(cfg), config::load_milling_config(job_path)};
-  if (c.job.tool.teeth != a.teeth)
-    throw std::invalid_argument("--teeth " + std::to_string(a.teeth) + " but the job " + job_path +
-                                " cuts with tool.teeth = " + std::to_string(c.job.tool.teeth));
-  return c;
-}
-
-milling::SpeedAdvice checked_speeds(const ChatterArgs& a, const Cell& c, const milling::ListenReport& r,
-                                    const std::vector<double>& range) {
-  const config::Config& cfg = c.cfg;
-  config::MillingConfig job = c.job;
-  milling::SpeedAdviceRequest q;
-  q.rpm = r.rpm, q.depth_mm = a.depth_mm.value_or(job.cut.axial_mm), q.set = 0,
-  q.gain_ns_per_m = cfg.controller.gain_ns_per_m;
-  q.damped = a.damped, q.chatter_hz = r.chatter_hz, q.trigger = "chatter";
-  milling::LiveStability stability(std::move(job), cfg.spindle.structure, {cfg});
-  return milling::advise_speed(stability, q, range[0], range[1]);
-}
-
 int run_chatter(const ChatterArgs& a) {
   milling::ListenReport r;
   std::vector<double> range;
@@ -82,7 +39,8 @@ int run_chatter(const ChatterArgs& a) {
     if (a.teeth == 0) throw std::invalid_argument("--teeth: the cutter's teeth are required (the tooth-passing lines)");
     range = a.rpm_range.empty() ? std::vector<double>{100.0, 30000.0} : a.rpm_range;
     if (range.size() != 2 || !(range[1] > range[0])) throw std::invalid_argument("--rpm-range: two speeds, LO < HI");
-    const std::optional<Cell> cell = cell_of(a);
+    const std::optional<milling::ListenCell> cell =
+        milling::listen_cell(a.config_path, a.job_path, a.depth_mm.has_value() || a.damped, a.teeth);
     if (cell && a.rpm_range.empty())
       range = {cell->job.lobes.rpm_min, std::min(cell->job.lobes.rpm_max, cell->cfg.spindle.rpm_max)};
     identify::SignalOptions o;
@@ -94,7 +52,8 @@ int run_chatter(const ChatterArgs& a) {
     s.teeth = a.teeth, s.rpm = a.rpm, s.rpm_min = range[0], s.rpm_max = range[1];
     s.window_s = a.window_s, s.max_hz = a.max_hz, s.floor = a.floor;
     r = milling::listen(sig, s);
-    if (cell && r.chatter_hz > 0.0) advice = checked_speeds(a, *cell, r, range);
+    if (cell && r.chatter_hz > 0.0)
+      advice = milling::checked_speeds(*cell, r, a.depth_mm, a.damped, range[0], range[1]);
   } catch (const std::exception& e) {
     std::cerr << "robodamp chatter: " << e.what() << '\n';
     return 2;

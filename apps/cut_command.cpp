@@ -1,39 +1,25 @@
 // `robodamp cut`: one simulated cut of a milling job in time, with the chatter detector's verdict, the
 // forces, the machined wall and plots; or, with --critical, the time-domain critical depth at speeds next
 // to the zero-order limit (docs/milling.md, "Time domain").
-#include <optional>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
-
-#include <unistd.h>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
-#include "fields/json.hpp"
-#include "milling/accurate_stability.hpp"
 #include "milling/cut_report.hpp"
 #include "milling/study_report.hpp"
-#include "commission/emulated_cell.hpp"
-#include "milling/chatter.hpp"
+#include "commission/hil_critical.hpp"
 #include "milling/cut_job.hpp"
-#include "milling/cut_stability.hpp"
-#include "milling/lobes.hpp"
 
 namespace robodamp::apps {
 
 using nlohmann::json;
 
 namespace {
-
-constexpr double kHilRelTol = 1e-2;  // each step of the emulator's bisection is a pair of processes
-
-using fields::finite_or_null;
 
 struct CutArgs {
   std::string job_path{default_job()};  // --job (the deprecated --config)
@@ -49,29 +35,6 @@ struct CutArgs {
   std::vector<double> pose_deg;  // the joints of the job's robot pose parts
   std::string hil_path;          // --critical through the HIL emulator too: the cell's configuration
 };
-
-// The critical depth through the HIL emulator beside the in-process one (commission/emulated_cell.hpp):
-// the cell's own controller with --damped, control off (K = 0, the actuator passive) without.
-json hil_critical(const CutArgs& a, const milling::CutJob& job, double rpm, double in_process_mm) {
-  const config::Config cell = config::load_config_file(a.hil_path);
-  config::Config controller = cell;
-  if (!a.damped) controller.controller.gain_ns_per_m = 0.0;
-  const std::string dir = (std::filesystem::temp_directory_path() /
-                           ("robodamp_cut_hil_" + std::to_string(::getpid()) + "_" + std::to_string(std::lround(rpm))))
-                              .string();
-  const auto t0 = std::chrono::steady_clock::now();
-  const commission::EmulatedCritical c = commission::critical_through_emulator(
-      cell, controller, {commission::this_executable(), a.hil_path, a.job_path, job.settings.revolutions}, rpm,
-      in_process_mm, kHilRelTol, dir, [](const std::string& line) { std::cerr << "[cut hil] " << line << '\n'; });
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf(
-      "          through the HIL emulator (%s): critical %.4f mm at %.1f rpm (%+.1f %% against in process), above it "
-      "%s at %.1f Hz; %d cuts across processes in %.1f s\n",
-      a.hil_path.c_str(), c.depth_mm, c.rpm, (c.depth_mm / in_process_mm - 1.0) * 100.0, c.above.c_str(), c.chatter_hz,
-      c.cuts, wall);
-  return {{"cell", a.hil_path},         {"rpm", c.rpm},   {"critical_depth_mm", c.depth_mm}, {"above", c.above},
-          {"chatter_hz", c.chatter_hz}, {"cuts", c.cuts}, {"rel_tol", kHilRelTol},           {"wall_s", wall}};
-}
 
 // One cut at one speed (no --critical): its verdict, the damper's limits, the plots.
 std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, const milling::Structure& structure,
@@ -93,28 +56,6 @@ std::optional<int> one_cut(const CutArgs& a, const config::MillingConfig& cfg, c
     std::printf("wrote plots in %s\n", a.plot_dir.c_str());
   }
   return std::nullopt;
-}
-
-// --critical: the three methods at every speed asked for.
-void critical_study(const CutArgs& a, const config::MillingConfig& cfg, const config::StructureConfig& chosen,
-                    const milling::Structure& structure, milling::CutOverrides ov, const std::vector<double>& speeds,
-                    json& out) {
-  // The accurate verdict (what lobes and tune promise) beside the simulation, and its first guess.
-  const milling::Structure model_structure(chosen, a.damped);
-  const milling::LobeModel lobes(model_structure, milling::chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
-  config::MillingConfig at_cut = cfg;
-  if (a.radial_mm) at_cut.cut.radial_mm = *a.radial_mm;
-  const milling::AccurateStability truth(model_structure, at_cut);
-  out["critical"] = json::array();
-  for (double rpm : speeds) {
-    ov.rpm = rpm;
-    const milling::CutJob job = milling::make_cut_job(cfg, structure, ov);
-    milling::CriticalAtSpeed c = milling::critical_at_speed(
-        cfg, job, lobes, truth, rpm, a.damped, [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; });
-    std::fputs(c.line.c_str(), stdout);
-    if (!a.hil_path.empty()) c.entry["hil"] = hil_critical(a, job, rpm, c.depth_mm);
-    out["critical"].push_back(std::move(c.entry));
-  }
 }
 
 // The job with the options applied and checked, then one cut or the critical-depth study.
@@ -144,7 +85,14 @@ int run_cut(const CutArgs& a) {
     if (!a.critical) {
       if (const auto failed = one_cut(a, cfg, structure, ov, speeds, out)) return *failed;
     } else {
-      critical_study(a, cfg, chosen, structure, ov, speeds, out);
+      milling::CriticalStudy study{chosen, structure, ov, speeds, a.damped, a.radial_mm};
+      out["critical"] = milling::critical_study(
+          cfg, study, [](const std::string& line) { std::cerr << "[cut] " << line << '\n'; },
+          [&](const milling::CutJob& job, double rpm, const milling::CriticalAtSpeed& c) {
+            return a.hil_path.empty()
+                       ? nlohmann::json()
+                       : commission::hil_critical_json(a.hil_path, a.job_path, a.damped, job, rpm, c.depth_mm);
+          });
     }
     out["config"] = cfg.source;
     out["structure"] = structure.name();

@@ -3,91 +3,17 @@
 #include <iostream>
 #include <memory>
 #include <string>
-#include <thread>
-
-#include <spdlog/spdlog.h>
 
 #include "apps/cli.hpp"
-#include "config/config.hpp"
-#include "config/dashboard_config.hpp"
 #include "dashboard/auth.hpp"
-#include "dashboard/fleet.hpp"
-#include "dashboard/server.hpp"
+#include "dashboard/serve.hpp"
 #include "dashboard/tls.hpp"
-#include "rt/signals.hpp"
 
 namespace robodamp::apps {
 
 namespace {
 
-struct DashboardArgs {
-  std::string config_path;
-  std::string listen;
-  std::optional<int> port, domain;
-  std::string transport;
-  double duration_s{0.0};
-  bool insecure_http{false};
-};
-
-int run_dashboard(const DashboardArgs& a) {
-  config::DashboardConfig cfg;
-  try {
-    if (!a.config_path.empty()) cfg = config::load_dashboard_config(a.config_path);
-  } catch (const config::ConfigError& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
-  }
-  if (!a.listen.empty()) cfg.listen_address = a.listen;
-  if (a.port) cfg.port = *a.port;
-  if (a.domain) cfg.dds.domain_id = *a.domain;
-  if (a.transport == "udp_loopback") cfg.dds.transport = config::DdsTransport::kUdpLoopback;
-  if (a.transport == "shared_memory") cfg.dds.transport = config::DdsTransport::kSharedMemory;
-  if (a.transport == "default") cfg.dds.transport = config::DdsTransport::kDefault;
-  if (const std::string why = dashboard::plain_http_refusal(cfg, a.insecure_http); !why.empty()) {
-    std::cerr << "robodamp dashboard: " << why << '\n';
-    return 2;
-  }
-  if (!dashboard::plain_http_refusal(cfg, false).empty())  // served anyway: --insecure-http
-    spdlog::warn(
-        "dashboard: plain HTTP on {} (--insecure-http): passwords and session tokens cross the network readable",
-        cfg.listen_address);
-  std::vector<dashboard::User> users;
-  try {
-    if (!cfg.credentials.empty()) users = dashboard::load_users(cfg.credentials);
-  } catch (const config::ConfigError& e) {
-    std::cerr << e.what() << '\n';
-    return 2;
-  }
-  rt::install_shutdown_handlers();
-  try {
-    dashboard::Authenticator auth(users, cfg.session_idle_s);
-    dashboard::ActionLog log(cfg.action_log);
-    dashboard::Fleet fleet(cfg.dds, cfg.stale_after_s);
-    dashboard::WebServer server(cfg, fleet, auth, log);
-    const int port = server.bind();
-    std::jthread serving([&] { server.serve(); });
-    struct StopOnExit {
-      dashboard::WebServer& s;
-      ~StopOnExit() { s.stop(); }  // before `serving` joins, on every path
-    } stop_on_exit{server};
-    std::cout << "robodamp dashboard: " << (cfg.tls() ? "https://" : "http://") << cfg.listen_address << ":" << port
-              << "/  (DDS domain " << cfg.dds.domain_id << ", " << config::to_string(cfg.dds.transport)
-              << (cfg.dds.security ? ", secured" : "") << "; "
-              << (auth.anyone_may_act() ? std::to_string(users.size()) + " users from " + cfg.credentials
-                                        : std::string("no operator configured: view only"))
-              << "; Ctrl-C ends)" << std::endl;
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(a.duration_s);
-    while (rt::shutdown_signal().load() == 0 && (a.duration_s <= 0.0 || std::chrono::steady_clock::now() < end))
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    server.stop();
-    serving.join();
-    std::cout << "robodamp dashboard: " << server.health().dump() << std::endl;
-  } catch (const std::exception& e) {
-    std::cerr << "robodamp dashboard: " << e.what() << '\n';
-    return 1;
-  }
-  return 0;
-}
+using DashboardArgs = dashboard::ServeRequest;
 
 struct CertArgs {
   std::string certificate, key;
@@ -139,7 +65,7 @@ void register_dashboard(Registry& r) {
       r.add("dashboard",
             "Web page for every robodamp cell on the DDS domain: fleet tiles, a cell's live plots and counters, "
             "operator actions after a login (docs/dashboard.md)",
-            [a] { return run_dashboard(*a); });
+            [a] { return dashboard::serve(*a, std::cout, std::cerr); });
   sub->add_option("--config", a->config_path, "Dashboard configuration (dashboard and dds sections; docs/dashboard.md)")
       ->check(CLI::ExistingFile);
   sub->add_option("--listen", a->listen, "Address to serve on (default dashboard.listen_address, else 127.0.0.1)");

@@ -1,7 +1,5 @@
 #include "apps/dds_client.hpp"
 
-#include <iostream>
-
 namespace robodamp::apps {
 
 void add_dds_options(Registry& r, CLI::App* sub, DdsClientArgs& a) {
@@ -18,29 +16,6 @@ void add_dds_options(Registry& r, CLI::App* sub, DdsClientArgs& a) {
         const std::string p = config::cell_name_problem(v);
         return p.empty() ? std::string() : "--cell = \"" + v.substr(0, 64) + "\" " + p;
       });
-}
-
-std::optional<DdsClientOptions> resolve(const DdsClientArgs& a) {
-  DdsClientOptions o = a.options;
-  if (!a.config_path.empty()) {
-    try {
-      const auto cfg = config::load_config_file(a.config_path);
-      if (cfg.dds) {
-        o.domain_id = cfg.dds->domain_id;
-        o.transport = cfg.dds->transport;
-        o.security = cfg.dds->security;
-      }
-      o.cell = config::cell_name(cfg.cell);
-    } catch (const config::ConfigError& e) {
-      std::cerr << e.what() << '\n';
-      return std::nullopt;
-    }
-  }
-  if (!a.cell.empty()) o.cell = a.cell;
-  if (a.domain) o.domain_id = *a.domain;
-  if (a.transport == "udp_loopback") o.transport = config::DdsTransport::kUdpLoopback;
-  if (a.transport == "shared_memory") o.transport = config::DdsTransport::kSharedMemory;
-  return o;
 }
 
 }  // namespace robodamp::apps

@@ -7,7 +7,6 @@
 
 #include "analysis/chain_report.hpp"
 #include "apps/cli.hpp"
-#include "apps/gnuplot.hpp"
 
 namespace robodamp::apps {
 

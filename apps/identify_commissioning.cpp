@@ -2,25 +2,16 @@
 // robodamp measure (with the structure's FRF at the sensor) or from a CSV of command and transmitted
 // force. `robodamp identify all`: a complete configuration from a robodamp measure directory.
 // docs/identification.md.
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
-#include "apps/gnuplot.hpp"
 #include "apps/identify_command.hpp"
 #include "identify/actuator_sources.hpp"
-#include "identify/commissioning.hpp"
 #include "identify/modal_fit_report.hpp"
-#include "identify/numeric_csv.hpp"
-#include "identify/tap_tests.hpp"
 #include "identify/uff_commissioning.hpp"
-#include "measfiles/uff.hpp"
-#include "rt/recording.hpp"
 
 namespace robodamp::apps {
 
@@ -60,21 +51,8 @@ int run_identify_all(const IdentifyArgs& a) {
   if (a.max_order) s.max_order = *a.max_order;
   identify::CommissioningResult r;
   try {
-    identify::TapTests taps;
-    const identify::CommissioningInputs in =
-        !a.uff_path.empty()    ? identify::read_measurement_uff(a.uff_path, a.config_path)
-        : !a.tap_tests.empty() ? identify::inputs_with_tap_tests(a.in_dir, a.tap_tests, taps)
-                               : identify::read_measurement_dir(a.in_dir);
-    r = identify::identify_all(in, s);
-    if (!a.tap_tests.empty()) {
-      const identify::TapTestConsistency c = identify::check_tap_tests(in, r, taps);
-      std::printf("robodamp identify all: the tap tests against the actuator's chirp: %s\n", c.summary().c_str());
-      if (const std::string f = c.failure(); !f.empty()) throw std::invalid_argument(f);
-    }
-    if (!a.modes_uff_path.empty()) {
-      measfiles::write_uff(a.modes_uff_path, identify::modes_to_uff(r), measfiles::UffEncoding::kAscii);
-      std::printf("wrote %s\n", a.modes_uff_path.c_str());
-    }
+    r = identify::identify_all_files({a.in_dir, a.uff_path, a.config_path, a.tap_tests, a.modes_uff_path}, s,
+                                     std::cout);
   } catch (const std::exception& e) {
     std::cerr << "robodamp identify all: " << e.what() << '\n';
     return 2;

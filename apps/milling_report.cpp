@@ -2,8 +2,6 @@
 
 #include <iostream>
 
-#include "apps/gnuplot.hpp"
-
 namespace robodamp::apps {
 
 using nlohmann::json;

@@ -7,28 +7,16 @@
 //             modes measured at poses as the model's measured_modes, or the mapped modes at a pose
 //   pose map  --model F --vary J1 J2 [--steps N] [--job JOB] [--json F] [--plot PNG]: first-mode frequency,
 //             modal stiffness and (with a job) the minimum limiting depth over a grid of two joints
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.hpp"
-#include "apps/gnuplot.hpp"
 #include "apps/pose_command.hpp"
 #include "apps/pose_modes_command.hpp"
 #include "apps/pose_tune_command.hpp"
-#include "identify/modal_fit.hpp"
-#include "identify/pose_measurements.hpp"
-#include "milling/accurate_stability.hpp"
-#include "milling/lobes.hpp"
-#include "milling/structure.hpp"
-#include "robot/pose_fit.hpp"
 #include "milling/pose_map.hpp"
 #include "robot/pose_report.hpp"
 #include "robot/robot_model.hpp"
@@ -99,8 +87,6 @@ int run_map(const config::RobotModelConfig& m, const PoseArgs& a) {
       r.json.dump(2), a.json, "pose", r.text, a.plot_path,
       [&] { return milling::plot_pose_map(r, req, map, a.plot_path); }, a.plot_path);
 }
-
-// The deprecated --json-out FILE: the JSON written there as well.
 
 int run_pose(const PoseArgs& given) {
   PoseArgs a = given;

@@ -1,12 +1,10 @@
 // `robodamp pose fit`: the robot model's joints fitted to measured TCP receptances (robot/pose_fit.hpp), the
 // error before and after at each pose, the held-out poses apart.
-#include <cstdio>
 #include <fstream>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 
-#include "apps/gnuplot.hpp"
 #include "apps/pose_command.hpp"
 #include "identify/pose_fit_inputs.hpp"
 #include "robot/pose_fit.hpp"

@@ -5,7 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "apps/gnuplot.hpp"
 #include "identify/pose_modes_report.hpp"
 
 namespace robodamp::apps {

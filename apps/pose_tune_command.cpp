@@ -20,26 +20,6 @@ void read_poses(const PoseTuneArgs& a, const config::RobotModelConfig& model, st
   for (const auto& f : d.held) held.push_back({f.name, f.joints_deg});
 }
 
-// The command that reproduces the file (its header).
-std::string command_line(const PoseTuneArgs& a) {
-  std::string c = "robodamp pose tune --config " + a.config_path;
-  if (!a.model_path.empty()) c += " --model " + a.model_path;
-  if (!a.measurements.empty()) {
-    c += " --measurements";
-    for (const auto& m : a.measurements) c += " " + m;
-  }
-  if (!a.hold_out.empty()) {
-    c += " --hold-out";
-    for (const auto& h : a.hold_out) c += " " + h;
-  }
-  if (!a.job_path.empty()) c += " --job " + a.job_path;
-  c += " --evaluations " + std::to_string(a.evaluations) + " --polish " + std::to_string(a.polish) + " --max-regions " +
-       std::to_string(a.max_regions) + " --map-points " + std::to_string(a.map_points) + " --overlap-deg " +
-       config::format_number(a.overlap_deg) + " --worse-mode-pct " + config::format_number(a.worse_mode_pct) +
-       " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
-  return c;
-}
-
 }  // namespace
 
 // The command's steps: read, tune both, score and choose (tune/pose_tune_file.hpp), report, write.
@@ -69,7 +49,7 @@ int run_pose_tune(const PoseTuneArgs& a) {
     if (!a.out_path.empty()) {
       const std::string header =
           "# robodamp pose tune: the " + best.name + " controller over the workspace of " + a.config_path +
-          ", written by\n#   " + command_line(a) +
+          ", written by\n#   " + tune::pose_tune_command_line(a) +
           "\n# (the comparison of the robust, the scheduled and the given controllers: the same with --json)\n";
       (void)tune::write_pose_tuned_config(in.cell, w.chosen(), a.model_path, a.out_path, header);
       r.text += "wrote " + a.out_path + " (read back, every region's set analysed over its grid)\n";

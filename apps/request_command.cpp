@@ -58,7 +58,7 @@ void register_request(Registry& r) {
   auto req = std::make_shared<RequestOptions>();
   CLI::App* sub =
       r.add("request", "One supervised parameter request over DDS (needs dds.parameter_writes: true)", [o, req] {
-        const auto opts = resolve(*o);
+        const auto opts = dds::resolve(*o, std::cerr);
         return opts ? run_request(*opts, *req) : 2;
       });
   add_dds_options(r, sub, *o);

@@ -5,71 +5,31 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "apps/cli.hpp"
-#include "apps/gnuplot.hpp"
-#include "config/file_paths.hpp"
-#include "config/milling_config.hpp"
+#include "plot/gnuplot.hpp"
 #include "tune/speed_schedule.hpp"
 #include "tune/speed_schedule_report.hpp"
+#include "tune/speed_schedule_file.hpp"
 
 namespace robodamp::apps {
 
 namespace {
 
-struct ScheduleArgs {
-  std::string config_path{default_cell_config()};
-  std::string job_path;
-  std::vector<std::string> controllers;
-  std::string out_path;
+struct ScheduleArgs : tune::ScheduleCommand {
+  ScheduleArgs() { config_path = default_cell_config(); }
   JsonOut json;
   std::string plot_dir;
-  tune::ScheduleSettings settings;
 };
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
-
-// The command that writes the file again (the options that differ from their defaults).
-std::string command_line(const ScheduleArgs& a) {
-  const tune::ScheduleSettings d;
-  const tune::ScheduleSettings& s = a.settings;
-  std::string c = "robodamp schedule --config " + a.config_path + (a.job_path.empty() ? "" : " --job " + a.job_path);
-  for (const auto& p : a.controllers) c += " --controller " + p;
-  if (s.speeds != d.speeds) c += " --speeds " + std::to_string(s.speeds);
-  if (s.gains_per_controller != d.gains_per_controller) c += " --gains " + std::to_string(s.gains_per_controller);
-  if (s.gain_margin_min_db != d.gain_margin_min_db) c += " --gain-margin-db " + num(s.gain_margin_min_db);
-  if (s.phase_margin_min_deg != d.phase_margin_min_deg) c += " --phase-margin-deg " + num(s.phase_margin_min_deg);
-  if (s.delay_margin_min_ms != d.delay_margin_min_ms) c += " --delay-margin-ms " + num(s.delay_margin_min_ms);
-  return c + " --out " + a.out_path;
-}
-
-// A header this command wrote before (a file scheduled again): it is replaced, not stacked.
-std::string without_schedule_header(const std::string& text) {
-  const std::string start = "# robodamp schedule wrote", end = "'s, whose header follows.\n#\n";
-  if (text.rfind(start, 0) != 0) return text;
-  const std::size_t e = text.find(end);
-  return e == std::string::npos ? text : text.substr(e + end.size());
-}
 
 // The cell's text with the schedule, moved to --out (its relative paths rebased), checked before it is written.
 int write_config(const ScheduleArgs& a, config::Config cell, const tune::SpeedSchedule& s) {
-  cell.yaml_text = without_schedule_header(cell.yaml_text);
-  const config::EditedYaml edited = tune::scheduled_config_text(cell, s);
-  if (!edited.comments_kept)
+  bool comments_kept = true;
+  const std::string text = tune::scheduled_file_text(a, std::move(cell), s, comments_kept);  // checked: throws (exit 2)
+  if (!comments_kept)
     std::fprintf(stderr,
                  "schedule: %s could not be edited in place; written again from its data, without its comments\n",
                  a.config_path.c_str());
-  std::ostringstream header;
-  header << "# robodamp schedule wrote the speed schedule into " << a.config_path << " (docs/tuning.md):\n#   "
-         << command_line(a) << "\n"
-         << tune::schedule_header(s) << "# Everything else is " << a.config_path << "'s, whose header follows.\n#\n";
-  const std::string text = header.str() + config::rebase_file_paths(edited.text, cell.source, a.out_path).text;
-  (void)config::parse_config(text, a.out_path);  // throws (exit 2) before anything is written
   std::ofstream out(a.out_path);
   out << text;
   if (!out.good()) {
@@ -108,7 +68,7 @@ int run_schedule(const ScheduleArgs& a) {
       tune::schedule_json(sched).dump(2), a.json, "schedule", text, plot,
       [&] {
         const auto [data, script] = tune::schedule_plot(sched, "Limiting depth by spindle speed: " + job_path);
-        return run_gnuplot(script, data, plot);
+        return plot::run_gnuplot(script, data, plot);
       },
       plot);
   if (printed != 0) return printed;

@@ -2,24 +2,18 @@
 // configuration's compensator (as a rational block) and gain, prints progress, compares the result with
 // C1, C2 and C3 on the same chain and job, and writes the tuned configuration only when every constraint
 // holds and the written file passes the configuration checks and the analysis.
-#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <vector>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/loop_model.hpp"
 #include "apps/cli.hpp"
-#include "config/file_paths.hpp"
-#include "apps/gnuplot.hpp"
 #include "tune/tune_report.hpp"
 #include "tune/compensator_search.hpp"
 #include "tune/tuned_file.hpp"
-#include "tune/robustness.hpp"
 #include "tune/verification.hpp"
 
 namespace robodamp::apps {
@@ -81,26 +75,8 @@ int run_tune(const TuneArgs& a) {
   std::printf("robodamp tune: %s%s, %zu plant%s, %zu evaluations\n", a.cmd.config_path.c_str(),
               job ? (" on " + a.cmd.job_path).c_str() : "", plants.size(), plants.size() == 1 ? "" : "s",
               r.history.size());
-  json report{{"config", a.cmd.config_path},
-              {"also", a.cmd.also_paths},
-              {"job", a.cmd.job_path},
-              {"best", tune::evaluation_json_with_plants(r.best)}};
-  json per_plant;
-  for (std::size_t i = 0; i < plants.size(); ++i) {
-    const bool nominal = !a.cmd.shift_pct || i % 3 == 0;
-    const auto rows = tune::compare_designs(plants[i], plants.size() == 1 ? r.best : r.best.per_plant[i], nominal);
-    std::fputs(tune::plant_report(plants[i], rows, per_plant).c_str(), stdout);
-    if (const std::string plot = plot_file(a.plot_dir, a.plot_path, "tune_lobes.png"); i == 0 && !plot.empty() && job) {
-      const std::string failed = tune::plot_compared_lobes(plants[i], rows, plot);
-      if (!failed.empty()) throw std::runtime_error("the lobes plot: " + failed);
-      std::printf("wrote %s\n", plot.c_str());
-    }
-  }
-  report["plants"] = per_plant;
-  if (plants.size() > 1) std::fputs(tune::evaluation_row("worst", r.best).c_str(), stdout);
-  json history = json::array();
-  for (const auto& e : r.history) history.push_back(tune::evaluation_json(e));
-  report["history"] = history;
+  json report = tune::search_report(a.cmd, plants, r, job.has_value(),
+                                    plot_file(a.plot_dir, a.plot_path, "tune_lobes.png"), stdout);
   if (!r.best.feasible()) {
     std::cerr << "robodamp tune: no candidate met every constraint; the closest violates " << r.best.binding
               << ": nothing written\n";

@@ -1,5 +1,6 @@
 #include "hil/program_text.hpp"
 
+#include <tuple>
 #include <vector>
 
 #include "config/number_text.hpp"
@@ -49,6 +50,29 @@ bool parse_change(const std::string& option, const std::string& item, const conf
           config::format_number(value.min) + " <= " + v + " <= " + config::format_number(value.max) + ' ' +
           std::string(value.unit);
   return false;
+}
+
+bool apply_program(const ProgramText& text, EmulatorOptions& eo, std::string& error) {
+  for (const auto& item : text.mounting)
+    if (!parse_mounting(item, eo.mounting_schedule.emplace_back(), error)) return false;
+  const config::Range rpm_range{"rpm", 0.0, 200000.0}, mm_range{"mm", 0.0, 100.0};
+  for (const auto& item : text.spindle) {
+    SpindleChange c;
+    if (!parse_change("--spindle", item, rpm_range, false, c, error)) return false;
+    eo.spindle_schedule.emplace_back(c.t0_s, c.rpm);
+  }
+  for (const auto& [items, option, range, ramp, out] :
+       {std::tuple{&text.depth, "--depth", &mm_range, false, &eo.depth_changes},
+        std::tuple{&text.spindle_ramps, "--spindle-ramp", &rpm_range, true, &eo.spindle_ramps},
+        std::tuple{&text.depth_ramps, "--depth-ramp", &mm_range, true, &eo.depth_changes}})
+    for (const auto& item : *items)
+      if (!parse_change(option, item, *range, ramp, out->emplace_back(), error)) return false;
+  for (const auto& item : text.pose_at)
+    if (!parse_waypoint(item, eo.pose_trajectory.emplace_back(), error)) {
+      error = "--pose-at = " + error;
+      return false;
+    }
+  return true;
 }
 
 }  // namespace robodamp::hil

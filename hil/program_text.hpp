@@ -5,9 +5,11 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "config/config.hpp"
 #include "hil/cutting_load.hpp"
+#include "hil/plant_emulator.hpp"
 
 namespace robodamp::hil {
 
@@ -20,5 +22,19 @@ namespace robodamp::hil {
 // form expected and every field's allowed range.
 [[nodiscard]] bool parse_change(const std::string& option, const std::string& item, const config::Range& value,
                                 bool ramp, SpindleChange& out, std::string& error);
+
+// The robot program as typed on `robodamp plant`'s command line, each repeatable option's items as given.
+struct ProgramText {
+  std::vector<std::string> mounting;       // "T:horizontal|vertical"
+  std::vector<std::string> spindle;        // "T:RPM"
+  std::vector<std::string> spindle_ramps;  // "T0:T1:RPM"
+  std::vector<std::string> depth;          // "T:MM"
+  std::vector<std::string> depth_ramps;    // "T0:T1:MM"
+  std::vector<std::string> pose_at;        // "T:Q1,Q2,..." waypoints
+};
+
+// Every item parsed into the emulator's schedules, ramps, depth changes and pose trajectory, in that order.
+// False with the first refusal in `error`, in the command line's words.
+[[nodiscard]] bool apply_program(const ProgramText& text, EmulatorOptions& eo, std::string& error);
 
 }  // namespace robodamp::hil

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "identify/tap_tests.hpp"
 #include "identify/uff_frf.hpp"
 #include "sim_plant/plant_model.hpp"
 
@@ -215,6 +216,24 @@ CommissioningInputs read_measurement_uff(const std::string& uff_path, const std:
   read_actuator(file, uff_path, cfg, in);
   in.identified_path = (fs::absolute(uff_path).parent_path() / "identified.yaml").string();
   return in;
+}
+
+CommissioningResult identify_all_files(const AllFiles& f, const CommissioningSettings& s, std::ostream& out) {
+  TapTests taps;
+  const CommissioningInputs in = !f.uff_path.empty()    ? read_measurement_uff(f.uff_path, f.config_path)
+                                 : !f.tap_tests.empty() ? inputs_with_tap_tests(f.in_dir, f.tap_tests, taps)
+                                                        : read_measurement_dir(f.in_dir);
+  CommissioningResult r = identify_all(in, s);
+  if (!f.tap_tests.empty()) {
+    const TapTestConsistency c = check_tap_tests(in, r, taps);
+    out << "robodamp identify all: the tap tests against the actuator's chirp: " << c.summary() << '\n';
+    if (const std::string failed = c.failure(); !failed.empty()) throw std::invalid_argument(failed);
+  }
+  if (!f.modes_uff.empty()) {
+    measfiles::write_uff(f.modes_uff, modes_to_uff(r), measfiles::UffEncoding::kAscii);
+    out << "wrote " << f.modes_uff << '\n';
+  }
+  return r;
 }
 
 }  // namespace robodamp::identify

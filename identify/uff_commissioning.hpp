@@ -12,7 +12,9 @@
 #pragma once
 
 #include <optional>
+#include <ostream>
 #include <string>
+#include <vector>
 
 #include "identify/commissioning.hpp"
 #include "identify/uff_frf.hpp"
@@ -36,5 +38,18 @@ inline constexpr const char* kVoltageEntity = "VOLTAGE";
 // per force between every pair of the configuration's locations (either way round), and the actuator's
 // acceleration per volt at the sensor. Throws std::invalid_argument naming the pair or record missing.
 [[nodiscard]] CommissioningInputs read_measurement_uff(const std::string& uff_path, const std::string& config_path);
+
+// identify all from the files `robodamp identify all` names: a measure directory (`in_dir`, with the user's tap
+// tests from `tap_tests` when it names them, checked against the actuator's chirp and refused when they disagree)
+// or a universal file (`uff_path`) with the configuration it was measured with; the identified modes written as a
+// universal file when `modes_uff` names one. What it checked and wrote on `out`; throws std::exception with the
+// reason.
+struct AllFiles {
+  std::string in_dir, uff_path, config_path;
+  std::vector<std::string> tap_tests;
+  std::string modes_uff;
+};
+[[nodiscard]] CommissioningResult identify_all_files(const AllFiles& f, const CommissioningSettings& s,
+                                                     std::ostream& out);
 
 }  // namespace robodamp::identify

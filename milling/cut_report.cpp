@@ -185,4 +185,27 @@ CriticalAtSpeed critical_at_speed(const config::MillingConfig& cfg, const CutJob
   return out;
 }
 
+nlohmann::json critical_study(
+    const config::MillingConfig& cfg, const CriticalStudy& study,
+    const std::function<void(const std::string&)>& progress,
+    const std::function<nlohmann::json(const CutJob&, double, const CriticalAtSpeed&)>& more) {
+  // The accurate verdict (what lobes and tune promise) beside the simulation, and its first guess.
+  const Structure model_structure(study.chosen, study.damped);
+  const LobeModel lobes(model_structure, chatter_process(cfg.tool, cfg.material, cfg.cut), cfg.lobes);
+  config::MillingConfig at_cut = cfg;
+  if (study.radial_mm) at_cut.cut.radial_mm = *study.radial_mm;
+  const AccurateStability truth(model_structure, at_cut);
+  nlohmann::json out = nlohmann::json::array();
+  CutOverrides ov = study.overrides;
+  for (double rpm : study.speeds) {
+    ov.rpm = rpm;
+    const CutJob job = make_cut_job(cfg, study.structure, ov);
+    CriticalAtSpeed c = critical_at_speed(cfg, job, lobes, truth, rpm, study.damped, progress);
+    std::fputs(c.line.c_str(), stdout);
+    if (nlohmann::json extra = more(job, rpm, c); !extra.is_null()) c.entry["hil"] = std::move(extra);
+    out.push_back(std::move(c.entry));
+  }
+  return out;
+}
+
 }  // namespace robodamp::milling

@@ -35,6 +35,23 @@ struct CriticalAtSpeed {
                                                 const LobeModel& lobes, const AccurateStability& truth, double rpm,
                                                 bool damped, const std::function<void(const std::string&)>& progress);
 
+// --critical's study: critical_at_speed at every speed of the chosen structure (zero-order and accurate models
+// with the damper as asked, the cut at radial_mm when given).
+struct CriticalStudy {
+  config::StructureConfig chosen;  // the job's structure as chosen (--structure, --controller)
+  const Structure& structure;      // it open, for the simulated cuts
+  CutOverrides overrides;
+  std::vector<double> speeds;
+  bool damped{false};
+  std::optional<double> radial_mm;
+};
+// The report's "critical" entries, each speed's line on stdout; `more`, when it returns a value, adds it to the
+// speed's entry as "hil" (the same cut through the HIL emulator).
+[[nodiscard]] nlohmann::json critical_study(
+    const config::MillingConfig& cfg, const CriticalStudy& study,
+    const std::function<void(const std::string&)>& progress,
+    const std::function<nlohmann::json(const CutJob&, double, const CriticalAtSpeed&)>& more);
+
 // Into dir (created): cut_displacement.png, cut_force.png, cut_spectrum.png (the wall-normal displacement
 // after settling, tooth-passing harmonics marked) and cut_surface.png (the wall per revolution). An empty
 // string, or why a plot failed.

@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 #include "milling/chatter.hpp"
+#include "milling/live_stability.hpp"
 #include "plot/gnuplot.hpp"
 
 namespace robodamp::milling {
@@ -179,6 +181,34 @@ std::string plot_listen(const ListenReport& r, const std::string& dir) {
                  : "plot DATA u 1:3 w l t 'non-harmonic share of the energy (no window chattered)'\n") +
       "unset multiplot\n";
   return plot::run_gnuplot(s2, v.str(), dir + "/chatter_verdict.png");
+}
+
+std::optional<ListenCell> listen_cell(const std::string& config_path, const std::string& job_path, bool needs_cell,
+                                      int teeth) {
+  if (config_path.empty()) {
+    if (!job_path.empty() || needs_cell)
+      throw std::invalid_argument("--job, --depth-mm and --damped need --config (the cell)");
+    return std::nullopt;
+  }
+  config::Config cfg = config::load_config_file(config_path);
+  const std::string path = !job_path.empty() ? job_path : cfg.spindle.job_resolved;
+  if (path.empty()) throw std::invalid_argument(config_path + ": no spindle.job: give --job");
+  ListenCell c{std::move(cfg), config::load_milling_config(path)};
+  if (c.job.tool.teeth != teeth)
+    throw std::invalid_argument("--teeth " + std::to_string(teeth) + " but the job " + path +
+                                " cuts with tool.teeth = " + std::to_string(c.job.tool.teeth));
+  return c;
+}
+
+SpeedAdvice checked_speeds(const ListenCell& c, const ListenReport& r, std::optional<double> depth_mm, bool damped,
+                           double rpm_lo, double rpm_hi) {
+  config::MillingConfig job = c.job;
+  SpeedAdviceRequest q;
+  q.rpm = r.rpm, q.depth_mm = depth_mm.value_or(job.cut.axial_mm), q.set = 0,
+  q.gain_ns_per_m = c.cfg.controller.gain_ns_per_m;
+  q.damped = damped, q.chatter_hz = r.chatter_hz, q.trigger = "chatter";
+  LiveStability stability(std::move(job), c.cfg.spindle.structure, {c.cfg});
+  return advise_speed(stability, q, rpm_lo, rpm_hi);
 }
 
 }  // namespace robodamp::milling

@@ -1,9 +1,17 @@
 #include "runtime/monitor_view.hpp"
 
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <thread>
 
 #include "config/pose_schedule_config.hpp"
+#include "dds/latest_sample.hpp"
+#include "dds/participant.hpp"
+#include "rt/signals.hpp"
 #include "rt/supervisor.hpp"
 #include "runtime/advice_view.hpp"
 
@@ -135,6 +143,65 @@ std::string monitor_advice_text(const msg::Advice& m) {
   a.status = m.status();
   a.status_reason = m.status_reason();
   return advice_text(a);
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Nothing new for this long: the monitor says the loop is out of contact (the dashboard's stale_after_s is 2 s;
+// the status alone comes at dds.status_rate_hz, 5 Hz by default).
+constexpr double kNoContactS = 3.0;
+
+}  // namespace
+
+int watch_cell(const dds::ClientOptions& o, std::ostream& out, std::ostream& err) {
+  rt::install_shutdown_handlers();
+  auto cell = std::make_shared<std::string>(o.cell);  // empty: the first cell heard
+  dds::Latest<msg::Telemetry> telemetry(cell);        // before the participant: it outlives the readers that call it
+  dds::Latest<msg::Status> status(cell);
+  dds::Latest<msg::Machining> machining(cell);
+  dds::Latest<msg::Advice> advice(cell);
+  dds::Participant p(o.domain_id, o.transport, "robodamp monitor", o.security);
+  p.reader(dds::TopicKind::kTelemetry, &telemetry);
+  p.reader(dds::TopicKind::kStatus, &status);
+  p.reader(dds::TopicKind::kMachining, &machining);
+  p.reader(dds::TopicKind::kAdvice, &advice);
+  const bool tty = isatty(STDOUT_FILENO) != 0;  // the terminal redrawn in place
+  err << "robodamp monitor: domain " << o.domain_id << " (" << config::to_string(o.transport)
+      << "), waiting for a loop; Ctrl-C ends\n";
+  const auto end = Clock::now() + std::chrono::duration<double>(o.duration_s);
+  std::uint64_t shown = 0;
+  auto heard = Clock::now();
+  bool silent = false;  // said "no contact" and heard nothing since
+  while (rt::shutdown_signal().load() == 0 && (o.duration_s <= 0.0 || Clock::now() < end)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const auto [t, nt] = telemetry.get();
+    const auto [s, ns] = status.get();
+    const auto [m, nm] = machining.get();
+    const auto [a, na] = advice.get();
+    if (nt + ns + nm + na == shown) {
+      // A loop that stops publishing (ended, crashed, the link down) is said, not shown frozen.
+      const double quiet_s = std::chrono::duration<double>(Clock::now() - heard).count();
+      if (shown > 0 && !silent && quiet_s >= kNoContactS) {
+        silent = true;
+        out << "robodamp monitor: NO CONTACT: nothing from " << (ns ? s.cell().c_str() : t.cell().c_str()) << " for "
+            << static_cast<int>(quiet_s) << " s: the loop stopped or the link is down (last seen: state "
+            << (nt ? rt::to_string(static_cast<rt::State>(t.state())) : s.state().c_str()) << " at loop time "
+            << (nt ? t.time_s() : s.time_s()) << " s); the view above is old\n"
+            << std::flush;
+      }
+      continue;
+    }
+    if (silent) out << "robodamp monitor: contact again\n";
+    silent = false;
+    heard = Clock::now();
+    shown = nt + ns + nm + na;
+    if (tty) out << "\x1b[H\x1b[2J";  // redraw in place
+    out << runtime::monitor_status_text(t, nt, s, ns) << (nm ? runtime::monitor_machining_text(m) : "")
+        << (na ? runtime::monitor_advice_text(a) : "") << (tty ? "" : "\n") << std::flush;
+  }
+  return shown > 0 ? 0 : 1;
 }
 
 }  // namespace robodamp::runtime

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <ostream>
 #include <string>
 
+#include "dds/client_options.hpp"
 #include "dds/messages.hpp"
 
 namespace robodamp::runtime {
@@ -15,5 +17,10 @@ namespace robodamp::runtime {
                                               std::uint64_t ns);
 [[nodiscard]] std::string monitor_machining_text(const msg::Machining& m);
 [[nodiscard]] std::string monitor_advice_text(const msg::Advice& m);
+
+// `robodamp monitor`: joins the domain, shows the cell's topics on `out` as they change (redrawn in place on a
+// terminal) and says when the loop falls silent, until Ctrl-C or o.duration_s; the waiting line on `err`.
+// 0 when it saw the loop (telemetry or status), 1 when nothing came.
+[[nodiscard]] int watch_cell(const dds::ClientOptions& o, std::ostream& out, std::ostream& err);
 
 }  // namespace robodamp::runtime

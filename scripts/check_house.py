@@ -64,7 +64,7 @@ LAYERS = [
     ("analysis and the loop", ["analysis", "rt"]),
     ("machining, devices, network", ["milling", "drivers", "dds"]),
     ("studies and composition", ["identify", "tune", "hil", "runtime", "dashboard"]),
-    ("commissioning", ["commission"]),
+    ("commissioning and the command line's machinery", ["commission", "command_line"]),
     ("command line", ["apps"]),
 ]
 # Folder -> CMake target (the folder's name with the robodamp_ prefix, but for these).

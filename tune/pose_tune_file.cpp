@@ -8,6 +8,7 @@
 
 #include "analysis/pose_schedule.hpp"
 #include "config/file_paths.hpp"
+#include "config/number_range.hpp"
 #include "config/yaml_edit.hpp"
 #include "tune/tuned_file.hpp"
 
@@ -96,6 +97,25 @@ std::string write_pose_regions(const config::Config& cell, const std::vector<con
   }
   std::filesystem::rename(check, out_path);
   return text;
+}
+
+std::string pose_tune_command_line(const PoseTuneCommand& a) {
+  std::string c = "robodamp pose tune --config " + a.config_path;
+  if (!a.model_path.empty()) c += " --model " + a.model_path;
+  if (!a.measurements.empty()) {
+    c += " --measurements";
+    for (const auto& m : a.measurements) c += " " + m;
+  }
+  if (!a.hold_out.empty()) {
+    c += " --hold-out";
+    for (const auto& h : a.hold_out) c += " " + h;
+  }
+  if (!a.job_path.empty()) c += " --job " + a.job_path;
+  c += " --evaluations " + std::to_string(a.evaluations) + " --polish " + std::to_string(a.polish) + " --max-regions " +
+       std::to_string(a.max_regions) + " --map-points " + std::to_string(a.map_points) + " --overlap-deg " +
+       config::format_number(a.overlap_deg) + " --worse-mode-pct " + config::format_number(a.worse_mode_pct) +
+       " --seed " + std::to_string(a.seed) + " --out " + a.out_path;
+  return c;
 }
 
 }  // namespace robodamp::tune

@@ -44,4 +44,19 @@ std::string write_pose_tuned_config(const config::Config& cell, const std::vecto
 std::string write_pose_regions(const config::Config& cell, const std::vector<config::PoseRegionConfig>& regions,
                                const std::string& model_path, const std::string& out_path, const std::string& header);
 
+// What `robodamp pose tune` was asked (its options as given): the written file's header repeats it as a command.
+struct PoseTuneCommand {
+  std::string config_path;  // the cell, with a pose_schedule
+  std::string model_path;   // the pose-indexed model; default pose_schedule.model
+  std::vector<std::string> measurements, hold_out;
+  std::string job_path;
+  int evaluations{60}, polish{30}, max_regions{4}, map_points{9}, seed{1};
+  double overlap_deg{4.0};
+  double worse_mode_pct{0.0};  // a mode in the damping band this much worse than open loop still serves
+  std::string out_path;
+};
+
+// The command that writes the file again.
+[[nodiscard]] std::string pose_tune_command_line(const PoseTuneCommand& c);
+
 }  // namespace robodamp::tune

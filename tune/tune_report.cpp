@@ -5,6 +5,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 #include "analysis/loop_model.hpp"
 #include "fields/json.hpp"
@@ -256,6 +257,31 @@ std::string robustness_section(const config::Config& cfg, nlohmann::json& report
     out += line;
   }
   return out + "\n";
+}
+
+nlohmann::json search_report(const TuneCommand& cmd, const std::vector<Evaluator>& plants, const TuneResult& r,
+                             bool has_job, const std::string& plot_path, std::FILE* out) {
+  nlohmann::json report{{"config", cmd.config_path},
+                        {"also", cmd.also_paths},
+                        {"job", cmd.job_path},
+                        {"best", evaluation_json_with_plants(r.best)}};
+  nlohmann::json per_plant;
+  for (std::size_t i = 0; i < plants.size(); ++i) {
+    const bool nominal = !cmd.shift_pct || i % 3 == 0;
+    const auto rows = compare_designs(plants[i], plants.size() == 1 ? r.best : r.best.per_plant[i], nominal);
+    std::fputs(plant_report(plants[i], rows, per_plant).c_str(), out);
+    if (i == 0 && !plot_path.empty() && has_job) {
+      const std::string failed = plot_compared_lobes(plants[i], rows, plot_path);
+      if (!failed.empty()) throw std::runtime_error("the lobes plot: " + failed);
+      std::fprintf(out, "wrote %s\n", plot_path.c_str());
+    }
+  }
+  report["plants"] = per_plant;
+  if (plants.size() > 1) std::fputs(evaluation_row("worst", r.best).c_str(), out);
+  nlohmann::json history = nlohmann::json::array();
+  for (const auto& e : r.history) history.push_back(evaluation_json(e));
+  report["history"] = history;
+  return report;
 }
 
 }  // namespace robodamp::tune

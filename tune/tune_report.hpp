@@ -3,6 +3,7 @@
 // the tuned loop's robustness and the verification of its promises. Off the real-time path.
 #pragma once
 
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "config/config.hpp"
 #include "config/milling_config.hpp"
 #include "tune/compensator_search.hpp"
+#include "tune/tuned_file.hpp"
 #include "tune/verification.hpp"
 
 namespace robodamp::tune {
@@ -63,5 +65,13 @@ struct ComparedDesign {
 // How far the loop holds as the modes move together (tune/robustness.hpp), into report["robustness"]; its
 // line, with a warning under +-kRobustShiftWarnPct.
 [[nodiscard]] std::string robustness_section(const config::Config& cfg, nlohmann::json& report);
+
+// The search's report on `out` as it goes (each plant's comparison with the hand designs, the first plant's
+// compared lobes into plot_path when a job is given and it is not empty, the worst over the plants) and its JSON
+// (the configurations, the best with each plant's, the comparisons, the history). Throws std::runtime_error
+// when the plot cannot be written.
+[[nodiscard]] nlohmann::json search_report(const TuneCommand& cmd, const std::vector<Evaluator>& plants,
+                                           const TuneResult& r, bool has_job, const std::string& plot_path,
+                                           std::FILE* out);
 
 }  // namespace robodamp::tune

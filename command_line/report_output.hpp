@@ -1,17 +1,15 @@
-// Headless PNG plots through gnuplot (gnuplot-nox, pngcairo), off the real-time path.
+// A command's report as the user asked for it: the JSON where --json said, the table, then its plot (PNG),
+// and where a command's one plot goes. Off the real-time path.
 #pragma once
 
 #include <functional>
 #include <string>
 
-#include "apps/cli.hpp"
-#include "plot/gnuplot.hpp"
+#include "command_line/registry.hpp"
 
-namespace robodamp::apps {
+namespace robodamp::command_line {
 
-using plot::run_gnuplot;
-
-// A report: the JSON where --json asked (apps/cli.hpp), the table unless the JSON is on stdout, then the
+// A report: the JSON where --json asked (registry.hpp), the table unless the JSON is on stdout, then the
 // plot if a target is given: plot() returns the reason it failed or an empty string, and "wrote <what>"
 // follows. Returns 0, or 1 when the JSON or the plot could not be written.
 [[nodiscard]] int print_report(const std::string& json_text, const JsonOut& json, const std::string& command,
@@ -23,4 +21,4 @@ using plot::run_gnuplot;
 [[nodiscard]] std::string plot_file(const std::string& plot_dir, const std::string& legacy_file,
                                     const std::string& name);
 
-}  // namespace robodamp::apps
+}  // namespace robodamp::command_line

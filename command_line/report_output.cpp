@@ -1,9 +1,9 @@
-#include "apps/gnuplot.hpp"
+#include "command_line/report_output.hpp"
 
 #include <filesystem>
 #include <iostream>
 
-namespace robodamp::apps {
+namespace robodamp::command_line {
 
 int print_report(const std::string& json_text, const JsonOut& json, const std::string& command,
                  const std::string& table, const std::string& plot_target, const std::function<std::string()>& plot,
@@ -15,7 +15,7 @@ int print_report(const std::string& json_text, const JsonOut& json, const std::s
       std::cerr << "plot: " << err << '\n';
       return 1;
     }
-    std::cout << "wrote " << wrote << '\n';  // stderr while the JSON is on stdout (apps/cli.hpp)
+    std::cout << "wrote " << wrote << '\n';  // stderr while the JSON is on stdout (registry.hpp)
   }
   return 0;
 }
@@ -27,4 +27,4 @@ std::string plot_file(const std::string& plot_dir, const std::string& legacy_fil
   return plot_dir + "/" + name;
 }
 
-}  // namespace robodamp::apps
+}  // namespace robodamp::command_line
