@@ -25,15 +25,7 @@ int run_identify_ball_end(const IdentifyArgs& a) {
     return 2;
   }
   const identify::BallEndReport r = identify::ball_end_report(f, t, a.csv_path);
-  std::fputs(r.text.c_str(), stdout);
-  if (a.json.given) {
-    if (!emit_json(a.json, r.json.dump(2), "identify")) return 1;
-    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
-  }
-  if (!a.yaml_path.empty()) {
-    std::ofstream(a.yaml_path) << r.yaml;
-    std::printf("wrote %s\n", a.yaml_path.c_str());
-  }
+  if (!print_identified(a, r.text, r.json, r.yaml)) return 1;
   return 0;
 }
 

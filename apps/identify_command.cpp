@@ -15,6 +15,20 @@
 
 namespace robodamp::apps {
 
+bool print_identified(const IdentifyArgs& a, const std::string& text, const nlohmann::json& json,
+                      const std::string& yaml) {
+  std::fputs(text.c_str(), stdout);
+  if (a.json.given) {
+    if (!emit_json(a.json, json.dump(2), "identify")) return false;
+    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
+  }
+  if (!a.yaml_path.empty()) {
+    std::ofstream(a.yaml_path) << yaml;
+    std::printf("wrote %s\n", a.yaml_path.c_str());
+  }
+  return true;
+}
+
 namespace {
 
 int run_modes(const IdentifyArgs& a) {
@@ -38,15 +52,7 @@ int run_modes(const IdentifyArgs& a) {
     return 2;
   }
   const identify::ModalFitReport r = identify::modal_fit_report(fit, a.frf_path);
-  std::fputs(r.text.c_str(), stdout);
-  if (a.json.given) {
-    if (!emit_json(a.json, r.json.dump(2), "identify")) return 1;
-    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
-  }
-  if (!a.yaml_path.empty()) {
-    std::ofstream(a.yaml_path) << r.yaml;
-    std::printf("wrote %s\n", a.yaml_path.c_str());
-  }
+  if (!print_identified(a, r.text, r.json, r.yaml)) return 1;
   if (!a.plot_dir.empty()) {
     if (auto e = identify::plot_modal_fit(d, fit, a.plot_dir, "modes"); !e.empty()) {
       std::cerr << "plot: " << e << '\n';

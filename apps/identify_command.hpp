@@ -6,6 +6,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/cli.hpp"
 #include <vector>
 
@@ -43,6 +45,10 @@ struct IdentifyArgs {
   std::vector<std::string> tap_tests;                 // all: --in's chirp with the user's tap tests
 };
 
+// A fit's report: its text on stdout, its JSON where --json asked and its YAML block to --yaml, each file named
+// as written. False when the JSON cannot be written.
+[[nodiscard]] bool print_identified(const IdentifyArgs& a, const std::string& text, const nlohmann::json& json,
+                                    const std::string& yaml);
 [[nodiscard]] int run_identify_actuator(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_ball_end(const IdentifyArgs& a);
 [[nodiscard]] int run_identify_all(const IdentifyArgs& a);

@@ -48,15 +48,7 @@ int run_identify_cutting(const IdentifyArgs& a) {
   }
   const identify::CuttingReport r =
       identify::cutting_report(f, samples, t, a.mode, records ? std::string("force records") : a.csv_path, record_json);
-  std::fputs(r.text.c_str(), stdout);
-  if (a.json.given) {
-    if (!emit_json(a.json, r.json.dump(2), "identify")) return 1;
-    if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
-  }
-  if (!a.yaml_path.empty()) {
-    std::ofstream(a.yaml_path) << r.yaml;
-    std::printf("wrote %s\n", a.yaml_path.c_str());
-  }
+  if (!print_identified(a, r.text, r.json, r.yaml)) return 1;
   return 0;
 }
 

@@ -69,7 +69,7 @@ bool apply_program(const ProgramText& text, EmulatorOptions& eo, std::string& er
       if (!parse_change(option, item, *range, ramp, out->emplace_back(), error)) return false;
   for (const auto& item : text.pose_at)
     if (!parse_waypoint(item, eo.pose_trajectory.emplace_back(), error)) {
-      error = "--pose-at = " + error;
+      error.insert(0, "--pose-at = ");
       return false;
     }
   return true;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # clang-tidy 14 with the repository's .clang-tidy (bugprone, performance, the modernisations that carry meaning)
 # over the real-time path and the devices: rt/, filters/, drivers/, threads/ and the headers they include from
-# rt_settings/, control/, fields/ and units/ (HeaderFilterRegex). Every finding is an error. Needs the build's
+# rt_settings/, control/, fields/ and units/ (HeaderFilterRegex); and the command line's machinery, where every
+# option a user types is parsed: command_line/ and config/number_text. Every finding is an error. Needs the build's
 # compile_commands.json (scripts/setup.sh builds it). CI runs it (CI=true in scripts/test.sh); about 3 minutes of
 # CPU here. Why not the whole tree: each translation unit costs 5-20 s under clang's front end (Eigen, Fast DDS),
 # 250 of them half an hour on CI's two cores.
@@ -10,7 +11,7 @@ cd "$(dirname "$0")/.."
 tool=$(command -v clang-tidy-14 || command -v clang-tidy || true)
 [[ -n $tool ]] || { echo "tidy.sh: clang-tidy-14 is not installed (scripts/setup.sh installs it)" >&2; exit 1; }
 [[ -f build/compile_commands.json ]] || { echo "tidy.sh: no build/compile_commands.json: run scripts/setup.sh" >&2; exit 1; }
-files=$(git ls-files 'rt/*.cpp' 'filters/*.cpp' 'drivers/*.cpp' 'threads/*.cpp')
+files=$(git ls-files 'rt/*.cpp' 'filters/*.cpp' 'drivers/*.cpp' 'threads/*.cpp' 'command_line/*.cpp' 'config/number_text.cpp')
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 status=0
