@@ -1,20 +1,14 @@
 #include "tune/speed_schedule_file.hpp"
 
-#include <cstdio>
 #include <sstream>
 
 #include "config/file_paths.hpp"
+#include "config/number_range.hpp"
 #include "tune/speed_schedule_report.hpp"
 
 namespace robodamp::tune {
 
 namespace {
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
-}
 
 // A header this command wrote before (a file scheduled again): it is replaced, not stacked.
 std::string without_schedule_header(const std::string& text) {
@@ -33,9 +27,12 @@ std::string schedule_command_line(const ScheduleCommand& a) {
   for (const auto& p : a.controllers) c += " --controller " + p;
   if (s.speeds != d.speeds) c += " --speeds " + std::to_string(s.speeds);
   if (s.gains_per_controller != d.gains_per_controller) c += " --gains " + std::to_string(s.gains_per_controller);
-  if (s.gain_margin_min_db != d.gain_margin_min_db) c += " --gain-margin-db " + num(s.gain_margin_min_db);
-  if (s.phase_margin_min_deg != d.phase_margin_min_deg) c += " --phase-margin-deg " + num(s.phase_margin_min_deg);
-  if (s.delay_margin_min_ms != d.delay_margin_min_ms) c += " --delay-margin-ms " + num(s.delay_margin_min_ms);
+  if (s.gain_margin_min_db != d.gain_margin_min_db)
+    c += " --gain-margin-db " + config::format_number(s.gain_margin_min_db);
+  if (s.phase_margin_min_deg != d.phase_margin_min_deg)
+    c += " --phase-margin-deg " + config::format_number(s.phase_margin_min_deg);
+  if (s.delay_margin_min_ms != d.delay_margin_min_ms)
+    c += " --delay-margin-ms " + config::format_number(s.delay_margin_min_ms);
   return c + " --out " + a.out_path;
 }
 
