@@ -19,6 +19,9 @@ constexpr double kMaxProbeMm = 1e3;  // the depth searches' ceiling (milling/sdm
 constexpr double kPeakLnMu = -0.69;  // a peak of ln|mu| below ln(0.5) is not searched for a window
 constexpr int kPeakIterations = 12;  // golden-section steps: the peak's bracket from 44 % to 0.1 % of its depth
 constexpr int kNeighbourRounds = 8;
+// A diagram's runs of neighbouring speeds, and the first bracketing step from a guess a neighbour corrected.
+constexpr std::size_t kDiagramRun = 10;
+constexpr double kNeighbourStep = 1.1;
 
 // A local peak of g = ln|mu| among probes lo < mid < hi (g(mid) the highest of the three): golden-section
 // search for its top in log depth, returning the first depth found unstable (g >= 0), or nothing.
@@ -90,8 +93,9 @@ class AccurateStability::Speed {
   [[nodiscard]] double ln_mu(double axial_mm) {
     return std::log(std::abs(sampled_ ? sampled_->multiplier(axial_mm) : open_->multiplier(axial_mm, rpm_)));
   }
-  [[nodiscard]] SdmPoint critical(double guess_mm, double rel_tol) {
-    return sampled_ ? sampled_->critical(guess_mm, rel_tol) : open_->critical(rpm_, guess_mm, rel_tol);
+  [[nodiscard]] SdmPoint critical(double guess_mm, double rel_tol, double first_step) {
+    return sampled_ ? sampled_->critical(guess_mm, rel_tol, first_step)
+                    : open_->critical(rpm_, guess_mm, rel_tol, first_step);
   }
 
  private:
@@ -100,8 +104,9 @@ class AccurateStability::Speed {
   double rpm_;
 };
 
-SdmPoint AccurateStability::search(Speed& at, double guess_mm, double rel_tol) const {
-  return at.critical(std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0, rel_tol);
+SdmPoint AccurateStability::search(Speed& at, double guess_mm, double rel_tol, double first_step) const {
+  const bool usable = std::isfinite(guess_mm) && guess_mm > 0.0;
+  return at.critical(usable ? guess_mm : 1.0, rel_tol, usable ? first_step : kBracketStep);
 }
 
 std::optional<double> AccurateStability::first_unstable(Speed& at, double from_mm, double to_mm) {
@@ -155,6 +160,36 @@ std::vector<SdmPoint> AccurateStability::critical(const std::vector<double>& rpm
     });
   analysis::run_tasks(tasks, analysis::task_threads(threads));
   if (diagram) below_neighbours(rpm, out, threads, rel_tol);
+  return out;
+}
+
+std::vector<SdmPoint> AccurateStability::diagram(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
+                                                 std::size_t threads, double rel_tol,
+                                                 const std::function<void(std::size_t)>& progress) const {
+  if (rpm.size() < 3 || !std::is_sorted(rpm.begin(), rpm.end()))
+    return critical(rpm, guess_mm, threads, rel_tol, progress);
+  std::vector<SdmPoint> out(rpm.size());
+  std::mutex m;
+  std::size_t done = 0;
+  std::vector<std::function<void()>> tasks;
+  for (std::size_t first = 0; first < rpm.size(); first += kDiagramRun)
+    tasks.emplace_back([&, first] {
+      double ratio = 0.0;  // the speed before's answer over its guess
+      for (std::size_t i = first; i < std::min(rpm.size(), first + kDiagramRun); ++i) {
+        const double guess = i < guess_mm.size() ? guess_mm[i] : 1.0;
+        const bool usable = std::isfinite(guess) && guess > 0.0;
+        Speed at(*this, rpm[i]);
+        out[i] = ratio > 0.0 && std::isfinite(ratio) && usable ? search(at, guess * ratio, rel_tol, kNeighbourStep)
+                                                               : search(at, guess, rel_tol);
+        ratio = usable ? out[i].critical_depth_mm / guess : 0.0;
+        if (progress) {
+          const std::lock_guard<std::mutex> lock(m);
+          progress(++done);
+        }
+      }
+    });
+  analysis::run_tasks(tasks, analysis::task_threads(threads));
+  below_neighbours(rpm, out, threads, rel_tol);
   return out;
 }
 
@@ -223,7 +258,7 @@ AccurateDiagram accurate_diagram(const Structure& structure, const config::Milli
   d.grid_per_period = truth.grid_per_period();
   d.speeds_left_out = guess.curve.size() - speeds.size();
   d.max_rpm = truth.max_rpm();
-  d.curve = truth.critical(speeds, guesses, threads, 1e-3, [&](std::size_t done) {
+  d.curve = truth.diagram(speeds, guesses, threads, 1e-3, [&](std::size_t done) {
     if (progress) progress(done, speeds.size());
   });
   d.minimum.critical_depth_mm = std::numeric_limits<double>::infinity();

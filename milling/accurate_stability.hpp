@@ -54,6 +54,15 @@ class AccurateStability {
   [[nodiscard]] std::vector<SdmPoint> critical(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
                                                std::size_t threads = 0, double rel_tol = 1e-3,
                                                const std::function<void(std::size_t)>& progress = {}) const;
+  // A diagram (three or more speeds in increasing order on a fine grid; otherwise the same as critical() on the
+  // list): the same search and neighbours' rounds, but each speed's first guess is its own times the ratio of
+  // answer to guess the speed before it found (the accurate and the zero-order limits drift slowly along the
+  // speeds), bracketed from a first step of 1.1 (milling/sdm.hpp). Speeds in runs of 10, each run in order on
+  // one thread: the same answer on any number of threads. Each depth within rel_tol of a crossing as
+  // critical()'s, found in about a quarter fewer monodromy matrices (docs/milling.md "How fast").
+  [[nodiscard]] std::vector<SdmPoint> diagram(const std::vector<double>& rpm, const std::vector<double>& guess_mm,
+                                              std::size_t threads = 0, double rel_tol = 1e-3,
+                                              const std::function<void(std::size_t)>& progress = {}) const;
   // The dominant multiplier at this depth and speed, and whether it is inside the unit circle.
   [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm) const;
   [[nodiscard]] bool stable(double axial_mm, double rpm) const { return std::abs(multiplier(axial_mm, rpm)) < 1.0; }
@@ -68,7 +77,7 @@ class AccurateStability {
   // One speed's model, kept across its search and its probes (the sampled loop's system and propagators).
   class Speed;
   // One crossing of |mu| = 1 from the guess (bracketed in steps of 1.6, then Illinois; milling/sdm.hpp).
-  [[nodiscard]] SdmPoint search(Speed& at, double guess_mm, double rel_tol) const;
+  [[nodiscard]] SdmPoint search(Speed& at, double guess_mm, double rel_tol, double first_step = kBracketStep) const;
   // The shallowest crossing below `p` (a search's answer at the speed) from probes starting at from_mm; p if none.
   [[nodiscard]] SdmPoint below(Speed& at, const SdmPoint& p, double from_mm, double rel_tol) const;
   // The first depth in [from_mm, to_mm) found unstable by the probes and their peaks' searches, or nothing.

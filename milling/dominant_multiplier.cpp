@@ -54,21 +54,59 @@ Eigen::VectorXcd eigenvector_for(const Eigen::MatrixXd& z, std::complex<double> 
   return v;
 }
 
+namespace {
+
+// Arnoldi's largest-magnitude Ritz value and vector of z, or nothing when it does not converge.
+bool arnoldi_largest(const Eigen::MatrixXd& z, std::complex<double>& value, Eigen::VectorXcd* vector) {
+  Spectra::DenseGenMatProd<double> product(z);
+  const auto basis = static_cast<Eigen::Index>(std::min<Eigen::Index>(DominantMultiplier::kBasis, z.rows()));
+  Spectra::GenEigsSolver<Spectra::DenseGenMatProd<double>> arnoldi(product, DominantMultiplier::kWanted, basis);
+  arnoldi.init();
+  const Eigen::Index converged =
+      arnoldi.compute(Spectra::SortRule::LargestMagn, DominantMultiplier::kMaxRestarts, DominantMultiplier::kTolerance);
+  if (arnoldi.info() != Spectra::CompInfo::Successful || converged < DominantMultiplier::kWanted) return false;
+  const Eigen::VectorXcd ev = arnoldi.eigenvalues();  // largest magnitude first
+  if (ev.size() == 0 || !std::isfinite(ev(0).real()) || !std::isfinite(ev(0).imag())) return false;
+  value = ev(0);
+  if (vector) *vector = arnoldi.eigenvectors(1).col(0);
+  return true;
+}
+
+// The dominant multiplier by Arnoldi on z^(2^kSquarings): moduli that crowd the unit circle spread apart (two
+// multipliers 1 % apart in modulus are 8 % apart in z^8), and Arnoldi converges where it gave up on z. Its
+// Ritz vector is z's eigenvector for the dominant multiplier, whose Rayleigh quotient in z is the multiplier
+// (its argument too, which z^8's eigenvalue has lost); accepted only when that pair's residual in z is at
+// round-off.
+bool powered_largest(const Eigen::MatrixXd& z, std::complex<double>& mu) {
+  Eigen::MatrixXd p = z;
+  for (int k = 0; k < DominantMultiplier::kSquarings; ++k) p = (p * p).eval();
+  std::complex<double> big;
+  Eigen::VectorXcd v;
+  if (!arnoldi_largest(p, big, &v)) return false;
+  const Eigen::VectorXcd zv = z.cast<std::complex<double>>() * v;
+  mu = v.dot(zv) / v.squaredNorm();
+  const double residual = (zv - mu * v).norm() / v.norm();
+  return std::isfinite(residual) && residual < 1e-9 * std::max(1.0, std::abs(mu));
+}
+
+}  // namespace
+
 std::complex<double> DominantMultiplier::operator()(const Eigen::MatrixXd& z) {
-  if (z.rows() >= kMinArnoldiSize && z.rows() == z.cols() && !arnoldi_gave_up_) {
-    Spectra::DenseGenMatProd<double> product(z);
-    const auto basis = static_cast<Eigen::Index>(std::min<Eigen::Index>(kBasis, z.rows()));
-    Spectra::GenEigsSolver<Spectra::DenseGenMatProd<double>> arnoldi(product, kWanted, basis);
-    arnoldi.init();
-    const Eigen::Index converged = arnoldi.compute(Spectra::SortRule::LargestMagn, kMaxRestarts, kTolerance);
-    if (arnoldi.info() == Spectra::CompInfo::Successful && converged >= kWanted) {
-      const Eigen::VectorXcd ev = arnoldi.eigenvalues();  // largest magnitude first
-      if (ev.size() > 0 && std::isfinite(ev(0).real()) && std::isfinite(ev(0).imag())) {
-        ++arnoldi_;
-        return ev(0);
-      }
+  const bool large = z.rows() >= kMinArnoldiSize && z.rows() == z.cols();
+  std::complex<double> mu;
+  if (large && !arnoldi_gave_up_) {
+    if (arnoldi_largest(z, mu, nullptr)) {
+      ++arnoldi_;
+      return mu;
     }
     arnoldi_gave_up_ = true;
+  }
+  if (large && !powered_gave_up_) {
+    if (powered_largest(z, mu)) {
+      ++powered_;
+      return mu;
+    }
+    powered_gave_up_ = true;
   }
   ++dense_;
   return dense_dominant_multiplier(z);

@@ -6,8 +6,12 @@
 // finds it from products of the matrix with vectors when the multipliers near the unit circle are few, as
 // in the damped loop, whose controller damps most of its modes within a tooth period. When they crowd the
 // circle (the 46 lightly damped modes of the industrial robot over a short tooth period) Arnoldi needs
-// hundreds of restarts: after kMaxRestarts without convergence it gives up, the dense QR answers, and this
-// object's later calls (the rest of one speed's search) go to the dense QR at once. Off the real-time path.
+// hundreds of restarts: after kMaxRestarts without convergence it gives up, and Arnoldi on z^8 (three
+// squarings, which spread the crowded moduli apart) answers with its Ritz vector's Rayleigh quotient in z,
+// checked by its residual in z. Only when that fails too does the dense QR answer. A method that gave up stays
+// given up for this object's later calls (the rest of one speed's search). On the 46-mode robot's diagram the
+// powered Arnoldi answers every one of the 1166 matrices the dense QR answered before, the depths the same to
+// 1e-14. Off the real-time path.
 #pragma once
 
 #include <complex>
@@ -23,16 +27,19 @@ class DominantMultiplier {
   static constexpr int kBasis = 40;                    // Arnoldi basis
   static constexpr int kMaxRestarts = 10;
   static constexpr double kTolerance = 1e-12;  // relative residual of the converged Ritz values
+  static constexpr int kSquarings = 3;         // Arnoldi's second try on z^8
 
   // The eigenvalue of largest magnitude of the square matrix z (of a complex pair, either).
   [[nodiscard]] std::complex<double> operator()(const Eigen::MatrixXd& z);
 
   [[nodiscard]] int arnoldi_answers() const { return arnoldi_; }
+  [[nodiscard]] int powered_answers() const { return powered_; }
   [[nodiscard]] int dense_answers() const { return dense_; }
 
  private:
   bool arnoldi_gave_up_{false};
-  int arnoldi_{0}, dense_{0};
+  bool powered_gave_up_{false};
+  int arnoldi_{0}, powered_{0}, dense_{0};
 };
 
 // By the dense QR alone (Eigen's EigenSolver): the reference the tests compare with.

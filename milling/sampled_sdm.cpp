@@ -268,7 +268,7 @@ std::complex<double> SampledSdm::AtSpeed::multiplier(double axial_mm) {
   return sdm_->monodromy(sys_, cache_, axial_mm, ticks_).mu;
 }
 
-SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
+SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol, double first_step) {
   cache_.dominant = DominantMultiplier{};
   // The last unstable depth's matrix and result (the bracket's hi at the end): its critical mode's vector
   // gives the chatter frequency without forming the matrix again.
@@ -281,7 +281,7 @@ SdmPoint SampledSdm::AtSpeed::critical(double guess_mm, double rel_tol) {
         if (ln_mu >= 0.0) phi_hi.swap(phi), hi = std::move(r);
         return ln_mu;
       },
-      guess_mm, rel_tol);
+      guess_mm, rel_tol, first_step);
   SdmPoint p;
   p.rpm = rpm_;
   p.critical_depth_mm = br.lo_mm;

@@ -114,7 +114,7 @@ class SampledSdm::AtSpeed {
  public:
   [[nodiscard]] double rpm() const { return rpm_; }  // stepped
   [[nodiscard]] std::complex<double> multiplier(double axial_mm);
-  [[nodiscard]] SdmPoint critical(double guess_mm, double rel_tol = 1e-3);
+  [[nodiscard]] SdmPoint critical(double guess_mm, double rel_tol = 1e-3, double first_step = kBracketStep);
 
  private:
   friend class SampledSdm;

@@ -4,6 +4,7 @@
 #include "milling/interval_exp.hpp"
 #include "units/units.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -223,14 +224,20 @@ double SdmModel::chatter_hz_of(const Eigen::MatrixXd& z, std::complex<double> mu
   return floquet_chatter_hz(mu, t, eigenvector_for(z, mu).segment(a_.rows(), 2 * m_), rpm * cutter_.teeth / 60.0);
 }
 
-DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol) {
-  constexpr double kStep = 1.6, kMaxMm = 1e3, kMinMm = 1e-6;
+DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm, double rel_tol,
+                                 double first_step) {
+  constexpr double kMaxMm = 1e3, kMinMm = 1e-6;
+  // Each step from the guess the square of the last, up to kBracketStep (every step kBracketStep by default):
+  // a guess within a few per cent is bracketed that closely, a poor one in a few more steps.
+  double step = std::clamp(first_step, 1.0 + 1e-3, kBracketStep);
+  const auto grow = [&] { step = std::min(kBracketStep, step * step); };
   double lo = 0.0, hi = 0.0, g_lo = 0.0, g_hi = 0.0;
   double b = std::isfinite(guess_mm) && guess_mm > 0.0 ? guess_mm : 1.0;
   if (const double g0 = ln_mu(b); g0 < 0.0) {
     lo = b, g_lo = g0;
     for (;;) {
-      b *= kStep;
+      b *= step;
+      grow();
       if (b > kMaxMm) return {lo, std::numeric_limits<double>::infinity()};
       const double gb = ln_mu(b);
       if (gb >= 0.0) {
@@ -242,7 +249,8 @@ DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, dou
   } else {
     hi = b, g_hi = g0;
     for (;;) {
-      b /= kStep;
+      b /= step;
+      grow();
       if (b < kMinMm) throw std::runtime_error("semi-discretization: the cut is unstable at any depth");
       const double gb = ln_mu(b);
       if (gb < 0.0) {
@@ -270,7 +278,7 @@ DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, dou
   return {lo, hi};
 }
 
-SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
+SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol, double first_step) const {
   if (!(guess_mm > 0.0)) throw std::invalid_argument("SdmModel::critical: the first guess must be > 0 mm");
   Eigen::MatrixXd z_hi;  // the monodromy matrix and its multiplier at the last unstable depth: the bracket's hi
   std::complex<double> mu_hi;
@@ -284,7 +292,7 @@ SdmPoint SdmModel::critical(double rpm, double guess_mm, double rel_tol) const {
         if (ln_mu >= 0.0) z_hi.swap(z), mu_hi = mu;
         return ln_mu;
       },
-      guess_mm, rel_tol);
+      guess_mm, rel_tol, first_step);
   SdmPoint p;
   p.rpm = rpm;
   p.critical_depth_mm = br.lo_mm;

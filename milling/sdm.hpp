@@ -50,15 +50,18 @@ class DirectionalMatrix {
   double kt_, kr_;
 };
 
-// The smallest unstable depth near a first guess from ln|mu(depth)| (< 0 stable): bracketed by factors of 1.6
-// from the guess, then the Illinois method (regula falsi halving the stale end's weight; bisection while the
-// bracket is wide) to hi - lo <= rel_tol hi. lo is stable, hi unstable; hi = inf when stable up to 1 m.
+// The smallest unstable depth near a first guess from ln|mu(depth)| (< 0 stable): bracketed by steps from the
+// guess (the first `first_step`, each next the square of the last, at most kBracketStep = 1.6), then the
+// Illinois method (regula falsi halving the stale end's weight; bisection while the bracket is wide) to
+// hi - lo <= rel_tol hi. lo is stable, hi unstable; hi = inf when stable up to 1 m. A guess known to be close
+// (a neighbouring speed's answer) takes a small first step and a narrow bracket.
 // Throws std::runtime_error when unstable down to 1 nm.
+inline constexpr double kBracketStep = 1.6;
 struct DepthBracket {
   double lo_mm{0.0}, hi_mm{0.0};
 };
 [[nodiscard]] DepthBracket find_critical_depth(const std::function<double(double)>& ln_mu, double guess_mm,
-                                               double rel_tol);
+                                               double rel_tol, double first_step = kBracketStep);
 
 // The chatter frequency of a Floquet mode q(t) = mu^(t/T) p(t), p periodic, from its displacement at times
 // t_periods (in tooth periods, over one period) as [x, y] pairs: p's strongest harmonic m gives the
@@ -83,7 +86,8 @@ class SdmModel {
   // The same with the critical eigenvector's chatter frequency (floquet_chatter_hz).
   [[nodiscard]] std::complex<double> multiplier(double axial_mm, double rpm, double* chatter_hz) const;
   // Critical depth by bisection, starting from a guess (e.g. the zero-order limit).
-  [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3) const;
+  [[nodiscard]] SdmPoint critical(double rpm, double guess_mm, double rel_tol = 1e-3,
+                                  double first_step = kBracketStep) const;
   [[nodiscard]] int steps_per_period() const { return m_; }
   // Every cutting interval by its dense exponential (milling/interval_exp.hpp), never by the low-rank
   // collocation (milling/interval_collocation.hpp) a many-mode structure's short intervals take otherwise:

@@ -111,6 +111,45 @@ TEST(Tune, EvaluationMatchesTheAnalysisForC1AndC2) {
   EXPECT_GE(e1.gain_margin_db, 6.0);
 }
 
+// The search checks every plant's constraints first and scores a candidate only where they all hold; scoring
+// it from where its check left it (Evaluator::finish) is its whole evaluation, to the bit: a stable candidate of
+// each polarity and an unstable one, with the job and without.
+TEST(Tune, ACheckedCandidateFinishedIsItsWholeEvaluation) {
+  const config::Config base = config::load_config_file(test::preset("horizontal_c2"));
+  const tune::Evaluator with_job(base, config::load_milling_config(kJob), {}), alone(base, std::nullopt, {});
+  const auto c1 = [&](double k, int polarity) {
+    return tune::Candidate{k,       base.actuator.natural_freq_hz, base.actuator.damping_ratio, 0.5, 1.0, 10.0, 10.0,
+                           polarity};
+  };
+  int stable = 0, unstable = 0;
+  for (const tune::Evaluator* e : {&with_job, &alone})
+    for (const tune::Candidate& c : {c1(2000.0, 1), c1(2000.0, -1), c1(4e5, 1)}) {
+      const tune::Evaluation whole = (*e)(c), checked = (*e)(c, true), finished = e->finish(checked);
+      const std::string what = std::string(e == &alone ? "no job" : "job") + ", K " + std::to_string(c.gain_ns_per_m) +
+                               ", polarity " + std::to_string(c.polarity);
+      EXPECT_EQ(finished.stable, whole.stable) << what;
+      EXPECT_EQ(finished.objective, whole.objective) << what;
+      EXPECT_EQ(finished.violation, whole.violation) << what;
+      EXPECT_EQ(finished.binding, whole.binding) << what;
+      EXPECT_EQ(finished.gain_margin_db, whole.gain_margin_db) << what;
+      EXPECT_EQ(finished.actuator_use, whole.actuator_use) << what;
+      EXPECT_EQ(finished.min_depth_mm, whole.min_depth_mm) << what;
+      EXPECT_EQ(finished.accurate_min_mm, whole.accurate_min_mm) << what;
+      EXPECT_EQ(finished.depth_at_speed_mm, whole.depth_at_speed_mm) << what;
+      EXPECT_EQ(finished.floors_mm, whole.floors_mm) << what;
+      EXPECT_EQ(finished.peak_m_per_n, whole.peak_m_per_n) << what;
+      if (whole.stable && e == &with_job) {
+        EXPECT_GT(whole.accurate_min_mm, 0.0) << what << ": the job scored";
+      }
+      if (!whole.stable) {
+        EXPECT_EQ(finished.objective, checked.objective) << what << ": nothing to score";
+      }
+      ++(whole.stable ? stable : unstable);
+    }
+  EXPECT_GE(stable, 2);
+  EXPECT_GE(unstable, 2);
+}
+
 // A short search: seeded, so it repeats exactly; feasible, and deeper than the open loop.
 TEST(Tune, AShortSeededSearchRepeatsAndBeatsTheOpenLoopWithinItsConstraints) {
   const config::Config base = config::load_config_file(test::preset("horizontal_c2"));

@@ -280,13 +280,25 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
   }
 }
 
+namespace {
+
+// A candidate whose compensator the chain cannot realise at the loop rate (its configuration refused).
+Evaluation unrealisable(const Candidate& cand) {
+  Evaluation e;
+  add_violation(e, 100.0, "the chain cannot realise the compensator at the loop rate");
+  e.objective = -kInf;
+  e.candidate = cand;
+  return e;
+}
+
+}  // namespace
+
 Evaluation Evaluator::operator()(const Candidate& cand, bool constraints_only) const {
   Evaluation e;
   try {
     e = assess(with_candidate(base_, cand), constraints_only || constraints_only_);
   } catch (const config::ConfigError&) {
-    add_violation(e, 100.0, "the chain cannot realise the compensator at the loop rate");
-    e.objective = -kInf;
+    return unrealisable(cand);
   }
   e.candidate = cand;
   return e;
@@ -387,14 +399,25 @@ Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) c
     return e;
   }
   add_loop_constraints(e, checks, cfg, s_);
-  if (constraints_only) return e;
-  if (!job_) {
-    e.peak_m_per_n = closed_peak(*m, k, cand.polarity);
-    e.objective = s_.worst_mode_objective ? e.worst_mode_improvement_pct / 100.0 : -std::log10(e.peak_m_per_n);
-    return e;
-  }
-  score_on_job(e, m);
+  if (!constraints_only) score(e, m);
   return e;
+}
+
+Evaluation Evaluator::finish(Evaluation checked) const {
+  // An unstable candidate, or one the chain cannot realise, has no objective; a constraints-only plant none.
+  if (constraints_only_ || !checked.stable) return checked;
+  try {
+    score(checked, std::make_shared<const analysis::LoopModel>(with_candidate(base_, checked.candidate)));
+  } catch (const config::ConfigError&) {  // as operator() has it
+    return unrealisable(checked.candidate);
+  }
+  return checked;
+}
+
+void Evaluator::score(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const {
+  if (job_) return score_on_job(e, m);
+  e.peak_m_per_n = closed_peak(*m, e.candidate.gain_ns_per_m, e.candidate.polarity);
+  e.objective = s_.worst_mode_objective ? e.worst_mode_improvement_pct / 100.0 : -std::log10(e.peak_m_per_n);
 }
 
 // The job's depths with the damped loop: the accurate limits at the job's speed and where the damped and
@@ -443,20 +466,6 @@ void Evaluator::score_on_job(Evaluation& e, const std::shared_ptr<const analysis
     e.at_open_minima_mm.push_back(at == d.curve.end() ? kInf : at->b_lim_mm);
   }
   add_violation(e, 1.0 - e.floor_ratio, "a lobe floor below the open loop's");
-}
-
-config::Config with_shifted_modes(const config::Config& base, double factor) {
-  config::Config cfg = base;
-  // The controller stays the nominal's: its compensator pre-warped and scaled at the nominal match frequency.
-  cfg.controller.match_freq_hz = unity_gain_hz(base);
-  for (auto& frf : cfg.robot.frfs)
-    for (auto& mode : frf.modes) {
-      mode.natural_freq_hz *= factor;
-      mode.residue_re_m_per_n /= factor;
-      mode.residue_im_m_per_n /= factor;
-      mode.stiffness_n_per_m *= factor * factor;
-    }
-  return cfg;
 }
 
 std::vector<std::pair<double, double>> Evaluator::damped_curve_mm(const config::Config& cfg) const {

@@ -167,6 +167,9 @@ class Evaluator {
   // constraints_only: stop after the cheap constraints (stability, margins, the damping window, the
   // actuator's limits), objective 0; the search uses it to skip the lobes of a candidate already infeasible.
   [[nodiscard]] Evaluation operator()(const Candidate& c, bool constraints_only = false) const;
+  // The rest of a candidate's evaluation after its constraints: finish((*this)(c, true)) equals (*this)(c),
+  // without checking the loop's constraints a second time.
+  [[nodiscard]] Evaluation finish(Evaluation checked) const;
   // Any configuration at its own gain and polarity (C1, C2, C3 for the report).
   [[nodiscard]] Evaluation assess(const config::Config& cfg, bool constraints_only = false) const;
   // The open loop's lobes, for reports: the minimum and the floors between neighbouring peaks.
@@ -194,7 +197,9 @@ class Evaluator {
 
  private:
   struct Impact;
-  // assess's last step with a job: the damped depths, the objective and the floors' constraints.
+  // assess's last step: the objective (with a job, score_on_job; without, the closed-loop peak).
+  void score(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const;
+  // With a job: the damped depths, the objective and the floors' constraints.
   void score_on_job(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const;
   config::Config base_;
   std::string name_;

@@ -9,6 +9,20 @@
 
 namespace robodamp::tune {
 
+config::Config with_shifted_modes(const config::Config& base, double factor) {
+  config::Config cfg = base;
+  // The controller stays the nominal's: its compensator pre-warped and scaled at the nominal match frequency.
+  cfg.controller.match_freq_hz = unity_gain_hz(base);
+  for (auto& frf : cfg.robot.frfs)
+    for (auto& mode : frf.modes) {
+      mode.natural_freq_hz *= factor;
+      mode.residue_re_m_per_n /= factor;
+      mode.residue_im_m_per_n /= factor;
+      mode.stiffness_n_per_m *= factor * factor;
+    }
+  return cfg;
+}
+
 namespace {
 
 std::vector<analysis::ModePhase> phases_at(const config::Config& cfg, double factor, bool& stable) {

@@ -28,7 +28,12 @@ Evaluation evaluate_worst(const std::vector<const Evaluator*>& plants, const Can
       per.push_back((*p)(c, true));
       per.back().plant = p->name();
     }
-    if (std::none_of(per.begin(), per.end(), [](const Evaluation& e) { return e.violation > 0.0; })) per.clear();
+    // Every plant's constraints hold: each plant's objective, from where its constraints left it.
+    if (std::none_of(per.begin(), per.end(), [](const Evaluation& e) { return e.violation > 0.0; }))
+      for (std::size_t i = 0; i < per.size(); ++i) {
+        per[i] = plants[i]->finish(std::move(per[i]));
+        per[i].plant = plants[i]->name();
+      }
   }
   if (per.empty())
     for (const Evaluator* p : plants) {
