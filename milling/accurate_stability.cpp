@@ -177,11 +177,11 @@ std::vector<SdmPoint> AccurateStability::diagram(const std::vector<double>& rpm,
       double ratio = 0.0;  // the speed before's answer over its guess
       for (std::size_t i = first; i < std::min(rpm.size(), first + kDiagramRun); ++i) {
         const double guess = i < guess_mm.size() ? guess_mm[i] : 1.0;
-        const bool usable = std::isfinite(guess) && guess > 0.0;
         Speed at(*this, rpm[i]);
-        out[i] = ratio > 0.0 && std::isfinite(ratio) && usable ? search(at, guess * ratio, rel_tol, kNeighbourStep)
-                                                               : search(at, guess, rel_tol);
-        ratio = usable ? out[i].critical_depth_mm / guess : 0.0;
+        // A guess that is not a positive finite depth gives no ratio, and search() starts from 1 mm without it.
+        out[i] = ratio > 0.0 && std::isfinite(ratio) ? search(at, guess * ratio, rel_tol, kNeighbourStep)
+                                                     : search(at, guess, rel_tol);
+        ratio = out[i].critical_depth_mm / guess;
         if (progress) {
           const std::lock_guard<std::mutex> lock(m);
           progress(++done);
