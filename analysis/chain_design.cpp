@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <sstream>
 
 namespace robodamp::analysis {
@@ -211,10 +212,9 @@ Complex ChainDesign::filters_analog(double f_hz) const {
 }
 
 Complex ChainDesign::filters_digital(double f_hz) const {
-  std::vector<filters::BiquadCoefficients> v(
-      params.sections.sections.begin(),
-      params.sections.sections.begin() + static_cast<std::ptrdiff_t>(params.sections.count));
-  return filters::digital_response(v, params.sections_gain, f_hz, params.fs_hz);
+  return filters::digital_response(
+      std::span<const filters::BiquadCoefficients>(params.sections.sections.data(), params.sections.count),
+      params.sections_gain, f_hz, params.fs_hz);
 }
 
 Complex ChainDesign::chain_analog(double f_hz) const {

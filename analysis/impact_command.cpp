@@ -27,14 +27,14 @@ ImpactCommand::ImpactCommand(const LoopModel& plant, double peak_n, double durat
 CommandPeak ImpactCommand::peak(const LoopModel& m, double gain, int polarity) {
   CommandPeak best;
   const std::size_t n = inverse_.size();
-  std::vector<Complex> chain(responses_.size());
-  for (std::size_t k = 0; k < responses_.size(); ++k) chain[k] = m.chain_filters_digital(responses_[k].f_hz);
+  std::vector<Complex> q(responses_.size());  // the controller's volts per sampled m/s^2, per bin
+  for (std::size_t k = 0; k < responses_.size(); ++k)
+    q[k] = m.feedback_discrete(responses_[k], m.chain_filters_digital(responses_[k].f_hz), gain, polarity);
   for (std::size_t h = 0; h < locations_; ++h) {
     Complex* v = inverse_.input();
     v[0] = 0.0;
     for (std::size_t k = 0; k < responses_.size(); ++k)
-      v[k + 1] =
-          m.command_per_force(responses_[k], chain[k], h, gain, polarity) * force_[k + 1] / static_cast<double>(n);
+      v[k + 1] = m.command_per_force(responses_[k], q[k], h) * force_[k + 1] / static_cast<double>(n);
     const double* x = inverse_.inverse();
     double peak = 0.0, slew = 0.0, tail = 0.0;
     std::size_t at = 0;

@@ -18,6 +18,11 @@
 #include "units/units.hpp"
 
 namespace robodamp::analysis {
+namespace {
+// max_stable_gain starts its scan at its last step below this share of the margins' crossing gain: the step
+// is 10 %, so two or three steps before the crossing, the sweep's bisected crossings being far finer.
+constexpr double kCrossingShare = 0.8;
+}  // namespace
 
 std::vector<double> linear_grid(double lo, double hi, double step) {
   std::vector<double> g;
@@ -53,14 +58,23 @@ Peak find_peak(const std::vector<double>& grid, const std::vector<double>& v,
   return best;
 }
 
-std::optional<double> max_stable_gain(const LoopModel& m, int polarity) {
-  const GainPath path(m.open_loop_unit());  // the poles at ~140 gains: the Hessenberg reduction once
+std::optional<double> max_stable_gain(const LoopModel& m, int polarity, std::optional<double> crossing_gain_ns_per_m) {
+  const GainPath path(m.open_loop_unit());  // the poles at each gain: the Hessenberg reduction once
   const auto stable = [&](double k) { return path.spectral_radius(k, polarity) < 1.0; };
   const double k_max = control::kMaxGainNsPerM;
-  double lo = 0.0, hi = 0.0;
   const int n = 120;  // log scan 1 .. k_max N s/m
-  for (int i = 0; i <= n; ++i) {
-    const double k = std::pow(k_max, static_cast<double>(i) / n);
+  const auto scan_gain = [&](int i) { return std::pow(k_max, static_cast<double>(i) / n); };
+  int first = 0;
+  if (crossing_gain_ns_per_m && *crossing_gain_ns_per_m > 1.0) {
+    // Every scan step below the first crossing is stable (the poles move continuously with K and reach the
+    // unit circle only where L meets -1); the step the scan would start from is checked, or it starts at 1.
+    const double steps = std::log(kCrossingShare * *crossing_gain_ns_per_m) / std::log(k_max) * n;
+    const int i0 = std::min(n, static_cast<int>(std::floor(steps)));
+    if (i0 > 0 && stable(scan_gain(i0))) first = i0 + 1;
+  }
+  double lo = first > 0 ? scan_gain(first - 1) : 0.0, hi = 0.0;
+  for (int i = first; i <= n; ++i) {
+    const double k = scan_gain(i);
     if (!stable(k)) {
       hi = k;
       break;
@@ -79,15 +93,29 @@ Margins margins(const LoopModel& m, double gain, int polarity, std::optional<dou
   Margins r;
   if (max_gain) r.gain_margin_db = 20.0 * std::log10(*max_gain / gain);
   // Log grid over (0.1 Hz, Nyquist), crossings refined by bisection.
-  const double lo = 0.1, hi = 0.499 * m.loop_rate_hz();
-  const int n = 6000;
-  auto f_at = [&](int i) { return lo * std::pow(hi / lo, static_cast<double>(i) / n); };
+  const LogGrid grid{0.1, 0.499 * m.loop_rate_hz(), 6000};
+  const int n = grid.intervals;
+  const auto sweep = m.plant_sweep(grid);  // the plant on the grid, shared by the loops on this plant
+  auto f_at = [&](int i) { return grid.at(i); };
   auto loop = [&](double f) { return m.loop_discrete(f, gain, polarity); };
-  Complex prev = loop(f_at(0));
+  auto loop_at = [&](int i) {
+    const double f = f_at(i);
+    return m.loop_discrete((*sweep)[static_cast<std::size_t>(i)], m.chain_filters_digital(f), gain, polarity);
+  };
+  // L at gain K meets -1 at gain K / |L| where it crosses the negative real axis; at the sweep's ends (0.1 Hz,
+  // Nyquist) L on the negative side counts as one, for a crossing beyond them.
+  const auto note_crossing = [&](Complex l) {
+    if (gain <= 0.0 || !(l.real() < 0.0)) return;
+    const double k = gain / std::abs(l);
+    if (!r.crossing_gain_ns_per_m || k < *r.crossing_gain_ns_per_m) r.crossing_gain_ns_per_m = k;
+  };
+  note_crossing(loop(0.5 * m.loop_rate_hz()));
+  Complex prev = loop_at(0);
+  note_crossing(prev);
   double best_phase_cross_gap = std::numeric_limits<double>::infinity();
   for (int i = 1; i <= n; ++i) {
     const double f0 = f_at(i - 1), f1 = f_at(i);
-    const Complex cur = loop(f1);
+    const Complex cur = loop_at(i);
     if ((std::abs(prev) - 1.0) * (std::abs(cur) - 1.0) < 0.0) {
       double a = f0, b = f1;
       const bool rising = std::abs(prev) < 1.0;
@@ -113,6 +141,7 @@ Margins margins(const LoopModel& m, double gain, int polarity, std::optional<dou
         ((loop(c).imag() > 0.0) == from_above ? a : b) = c;
       }
       const double fp = 0.5 * (a + b);
+      note_crossing(loop(fp));
       const double gap = std::abs(std::log(std::abs(loop(fp))));
       if (gap < best_phase_cross_gap) best_phase_cross_gap = gap, r.phase_crossover_hz = fp;
     }
@@ -232,8 +261,9 @@ AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
   // From just above 0 Hz: the ideal integrator block alone is singular at s = 0 (its product is not).
   const double t = turns([&](double f) { return 1.0 + m.loop_continuous(f, gain, polarity); }, 1e-6, hi);
   r.stable_continuous = std::lround(2.0 * t) == 0;
-  r.max_stable_gain_ns_per_m = max_stable_gain(m, polarity);
-  r.margins = margins(m, gain, polarity, r.max_stable_gain_ns_per_m);
+  r.margins = margins(m, gain, polarity, std::nullopt);
+  r.max_stable_gain_ns_per_m = max_stable_gain(m, polarity, r.margins.crossing_gain_ns_per_m);
+  if (r.max_stable_gain_ns_per_m) r.margins.gain_margin_db = 20.0 * std::log10(*r.max_stable_gain_ns_per_m / gain);
 
   r.modes = mode_phases(m, gain, polarity);
   const sim::FrfPath* loop_path = m.plant().path(m.sensor_location(), m.actuator_location());

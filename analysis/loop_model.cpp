@@ -71,6 +71,13 @@ LoopModel::LoopModel(const config::Config& cfg, std::optional<double> spindle_rp
 
 LoopModel LoopModel::at_speed(double spindle_rpm) const { return {cfg_, s_, spindle_rpm}; }
 
+LoopModel LoopModel::with_controller(const config::Config& cfg) const {
+  if (cfg.loop.rate_hz != s_->loop_rate_hz)
+    throw std::invalid_argument("LoopModel::with_controller: a controller at " + std::to_string(cfg.loop.rate_hz) +
+                                " Hz on a plant sampled at " + std::to_string(s_->loop_rate_hz) + " Hz");
+  return {cfg, s_, spindle_rpm_};
+}
+
 LoopModel::LoopModel(const config::Config& cfg, std::shared_ptr<const SampledPlant> sampled,
                      std::optional<double> spindle_rpm)
     : cfg_(cfg), s_(std::move(sampled)), chain_(analysis::design_chain(cfg)) {
@@ -199,39 +206,21 @@ Complex LoopModel::closed_sampled(std::size_t g, std::size_t h, double f_hz, dou
   return closed_with_feedback(g, h, f_hz, feedback_sampled(f_hz, gain, polarity));
 }
 
-PlantResponse LoopModel::plant_response(double f_hz) const {
-  const Eigen::Index nl = static_cast<Eigen::Index>(s_->plant.locations.size());
-  const Complex zi = std::exp(Complex(0.0, -kTwoPi * f_hz / cfg_.loop.rate_hz));  // z^-1
-  const Eigen::MatrixXcd r = s_->resolvent(1.0 / zi);  // the late and early coil inputs, then the forces
-  Eigen::MatrixXcd y(nl, 1 + nl);
-  y.col(0) = r.col(0) + r.col(1) * zi;
-  y.rightCols(nl) = r.rightCols(nl);
-  const Complex delay = std::pow(zi, s_->delay_steps);
-  PlantResponse p;
-  p.f_hz = f_hz;
-  p.accel_per_volt.resize(static_cast<std::size_t>(nl));
-  p.accel_per_force.assign(static_cast<std::size_t>(nl), std::vector<Complex>(static_cast<std::size_t>(nl)));
-  for (Eigen::Index g = 0; g < nl; ++g) {
-    p.accel_per_volt[static_cast<std::size_t>(g)] = (y(g, 0) + s_->d_accel_coil(g, 0) * zi) * delay;
-    for (Eigen::Index h = 0; h < nl; ++h)
-      p.accel_per_force[static_cast<std::size_t>(g)][static_cast<std::size_t>(h)] =
-          y(g, 1 + h) + s_->d_accel_force(g, h) * zi;
-  }
-  return p;
-}
+PlantResponse LoopModel::plant_response(double f_hz) const { return s_->response(f_hz); }
 
 namespace {
 // Volts per m/s^2 of sampled acceleration that the controller commands, with the computation delay.
 Complex discrete_feedback(const PlantResponse& p, Complex filters, double gain, int polarity, double fs,
                           double t_n_per_v, Complex sensor) {
-  const Complex zi = std::exp(Complex(0.0, -kTwoPi * p.f_hz / fs));
-  return zi * (polarity * gain / t_n_per_v) * filters * sensor;
+  // p's z^-1 is e^{-j 2 pi f / fs} at the plant's loop rate, this loop's (LoopModel::with_controller).
+  (void)fs;
+  return p.z_inverse * (polarity * gain / t_n_per_v) * filters * sensor;
 }
 }  // namespace
 
 Complex LoopModel::loop_discrete(const PlantResponse& p, Complex filters, double gain, int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+                                      chain_.params.actuator_constant_n_per_v, p.sensor_response);
   return -q * p.accel_per_volt[s_->sensor];
 }
 
@@ -247,7 +236,7 @@ Complex LoopModel::open_discrete(const PlantResponse& p, std::size_t g, std::siz
 Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std::size_t g, std::size_t h, double gain,
                                    int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+                                      chain_.params.actuator_constant_n_per_v, p.sensor_response);
   const Complex a = p.accel_per_force[g][h] + p.accel_per_volt[g] * q * p.accel_per_force[s_->sensor][h] /
                                                   (1.0 - q * p.accel_per_volt[s_->sensor]);
   const double w = kTwoPi * p.f_hz;
@@ -256,21 +245,28 @@ Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std:
 
 Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, std::size_t h, double gain,
                                      int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+  return command_per_force(p, feedback_discrete(p, filters, gain, polarity), h);
+}
+
+Complex LoopModel::feedback_discrete(const PlantResponse& p, Complex filters, double gain, int polarity) const {
+  return discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
+                           p.sensor_response);
+}
+
+Complex LoopModel::command_per_force(const PlantResponse& p, Complex q, std::size_t h) const {
   return q * p.accel_per_force[s_->sensor][h] / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 
 Complex LoopModel::command_per_sensor_noise(const PlantResponse& p, Complex filters, double gain, int polarity) const {
   const Complex q_noise =
       discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v, 1.0);
-  const Complex q = q_noise * s_->sensor_model.response(p.f_hz);
+  const Complex q = q_noise * p.sensor_response;
   return q_noise / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 
 Complex LoopModel::command_per_open_accel(const PlantResponse& p, Complex filters, double gain, int polarity) const {
   const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, s_->sensor_model.response(p.f_hz));
+                                      chain_.params.actuator_constant_n_per_v, p.sensor_response);
   return q / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 

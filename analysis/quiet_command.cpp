@@ -16,9 +16,11 @@ QuietCommand quiet_command(const LoopModel& m, double gain, int polarity) {
   const double density = (noise * noise + lsb * lsb / 12.0) / nyquist;  // (m/s^2)^2 / Hz, one-sided
   QuietCommand out;
   double power = 0.0, peak = 0.0, f_prev = 0.0, d_prev = 0.0;
+  const LogGrid grid{kLowestHz, 0.999 * nyquist, kPoints - 1};
+  const auto sweep = m.plant_sweep(grid);  // the plant on the grid, shared by the loops on this plant
   for (int i = 0; i < kPoints; ++i) {
-    const double f = kLowestHz * std::pow(0.999 * nyquist / kLowestHz, static_cast<double>(i) / (kPoints - 1));
-    const PlantResponse p = m.plant_response(f);
+    const double f = grid.at(i);
+    const PlantResponse& p = (*sweep)[static_cast<std::size_t>(i)];
     const double d = std::norm(m.command_per_sensor_noise(p, m.chain_filters_digital(f), gain, polarity)) * density;
     if (i > 0) power += 0.5 * (d + d_prev) * (f - f_prev);
     if (d > peak) peak = d, out.peak_density_hz = f;

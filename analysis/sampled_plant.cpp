@@ -1,6 +1,7 @@
 #include "analysis/sampled_plant.hpp"
 
 #include "sim_plant/state_space.hpp"
+#include "units/units.hpp"
 
 namespace robodamp::analysis {
 
@@ -25,6 +26,41 @@ SampledPlant::SampledPlant(const config::Config& cfg)
   Eigen::MatrixXd inputs(phi.rows(), 2 + nl);
   inputs << gamma_late, gamma_early, gamma_force;
   resolvent = Resolvent(phi, inputs, c_accel);
+}
+
+PlantResponse SampledPlant::response(double f_hz) const {
+  using Complex = std::complex<double>;
+  const Eigen::Index nl = static_cast<Eigen::Index>(plant.locations.size());
+  const Complex zi = std::exp(Complex(0.0, -kTwoPi * f_hz / loop_rate_hz));  // z^-1
+  const Eigen::MatrixXcd r = resolvent(1.0 / zi);  // the late and early coil inputs, then the forces
+  Eigen::MatrixXcd y(nl, 1 + nl);
+  y.col(0) = r.col(0) + r.col(1) * zi;
+  y.rightCols(nl) = r.rightCols(nl);
+  const Complex delay = std::pow(zi, delay_steps);
+  PlantResponse p;
+  p.f_hz = f_hz;
+  p.accel_per_volt.resize(static_cast<std::size_t>(nl));
+  p.accel_per_force.assign(static_cast<std::size_t>(nl), std::vector<Complex>(static_cast<std::size_t>(nl)));
+  for (Eigen::Index g = 0; g < nl; ++g) {
+    p.accel_per_volt[static_cast<std::size_t>(g)] = (y(g, 0) + d_accel_coil(g, 0) * zi) * delay;
+    for (Eigen::Index h = 0; h < nl; ++h)
+      p.accel_per_force[static_cast<std::size_t>(g)][static_cast<std::size_t>(h)] =
+          y(g, 1 + h) + d_accel_force(g, h) * zi;
+  }
+  p.sensor_response = sensor_model.response(f_hz);
+  p.z_inverse = zi;
+  return p;
+}
+
+std::shared_ptr<const std::vector<PlantResponse>> SampledPlant::sweep(const LogGrid& grid) const {
+  const std::lock_guard<std::mutex> lock(sweeps_mutex_);  // a caller at a time: the first one fills it
+  for (const auto& [g, responses] : sweeps_)
+    if (g == grid) return responses;
+  auto responses = std::make_shared<std::vector<PlantResponse>>();
+  responses->reserve(static_cast<std::size_t>(grid.intervals) + 1);
+  for (int i = 0; i <= grid.intervals; ++i) responses->push_back(response(grid.at(i)));
+  sweeps_.emplace_back(grid, responses);
+  return responses;
 }
 
 }  // namespace robodamp::analysis

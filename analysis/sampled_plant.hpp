@@ -5,7 +5,13 @@
 // real-time path.
 #pragma once
 
+#include <cmath>
+#include <complex>
 #include <cstddef>
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -15,6 +21,25 @@
 #include "sim_plant/sensor.hpp"
 
 namespace robodamp::analysis {
+
+// The plant's discrete transfers at one frequency: sampled acceleration at each location per held
+// coil voltage and per held external force at each location (sample at t_k per input held over [k, k+1)),
+// and the sensor's own response there (its analog coupling: what the controller reads per m/s^2).
+struct PlantResponse {
+  double f_hz{0.0};
+  std::vector<std::complex<double>> accel_per_volt;                // [location]
+  std::vector<std::vector<std::complex<double>>> accel_per_force;  // [response][excitation]
+  std::complex<double> sensor_response{1.0, 0.0};
+  std::complex<double> z_inverse{1.0, 0.0};  // e^{-j 2 pi f / fs}: the loop's one sample of computation delay
+};
+
+// intervals + 1 frequencies from lo_hz to hi_hz, evenly spaced in log: lo (hi / lo)^(i / intervals).
+struct LogGrid {
+  double lo_hz{0.0}, hi_hz{0.0};
+  int intervals{0};
+  [[nodiscard]] double at(int i) const { return lo_hz * std::pow(hi_hz / lo_hz, static_cast<double>(i) / intervals); }
+  [[nodiscard]] bool operator==(const LogGrid&) const = default;
+};
 
 struct SampledPlant {
   // Throws config::ConfigError where the configuration's plant cannot be built (sim::build_plant_model).
@@ -31,6 +56,17 @@ struct SampledPlant {
   Eigen::MatrixXd c_accel, d_accel_coil, d_accel_force;
   int delay_steps{0};   // whole samples of the actuator's delay
   Resolvent resolvent;  // c_accel (z I - phi)^-1 [gamma_late, gamma_early, gamma_force]
+
+  // The plant's discrete transfers at f_hz (LoopModel::plant_response).
+  [[nodiscard]] PlantResponse response(double f_hz) const;
+  // response() at every point of a grid the loop's analyses sweep whatever the controller (the margins', the
+  // quiet command's): computed once per grid on first use, from any thread, and shared by every loop model on
+  // this plant (LoopModel::with_controller: a tune's candidates).
+  [[nodiscard]] std::shared_ptr<const std::vector<PlantResponse>> sweep(const LogGrid& grid) const;
+
+ private:
+  mutable std::mutex sweeps_mutex_;
+  mutable std::vector<std::pair<LogGrid, std::shared_ptr<const std::vector<PlantResponse>>>> sweeps_;
 };
 
 }  // namespace robodamp::analysis

@@ -141,6 +141,10 @@ double pole_radius(const BiquadCoefficients& s) {
 }
 
 Complex digital_response(const std::vector<BiquadCoefficients>& sections, double gain, double f_hz, double fs_hz) {
+  return digital_response(std::span<const BiquadCoefficients>(sections), gain, f_hz, fs_hz);
+}
+
+Complex digital_response(std::span<const BiquadCoefficients> sections, double gain, double f_hz, double fs_hz) {
   const Complex w = std::polar(1.0, -kTwoPi * f_hz / fs_hz);  // z^-1
   Complex h(gain);
   for (const auto& s : sections) h *= (s.b0 + w * (s.b1 + w * s.b2)) / (1.0 + w * (s.a1 + w * s.a2));

@@ -1,6 +1,7 @@
 // Discretisation of continuous blocks into second-order sections (off the real-time path).
 #pragma once
 
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,6 +42,8 @@ struct DigitalDesign {
 
 // Response of sections x gain at f_hz for sample rate fs_hz.
 [[nodiscard]] Complex digital_response(const std::vector<BiquadCoefficients>& sections, double gain, double f_hz,
+                                       double fs_hz);
+[[nodiscard]] Complex digital_response(std::span<const BiquadCoefficients> sections, double gain, double f_hz,
                                        double fs_hz);
 // The exact response of the bilinear image of tf: tf evaluated at the warped frequency
 // j c tan(pi f / fs). Defined for any tf, also a pure integrator that is never realised alone.

@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
+#include <thread>
 
 #include "modal/receptance.hpp"
 #include "analysis/gain_path.hpp"
+#include "analysis/impact_command.hpp"
 #include "analysis/loop_model.hpp"
 #include "analysis/notch_speed_map.hpp"
+#include "analysis/quiet_command.hpp"
 #include "analysis/resolvent.hpp"
 #include "analysis/chain_design.hpp"
 #include "control/controller.hpp"
@@ -344,6 +348,95 @@ TEST(Analysis, NotchSpeedMapRefusesSpeedsThatPushADampedModeOutOfItsWindow) {
   EXPECT_EQ(params.refused_rpm_count, control::ControllerParams::kMaxRefusedSpeeds);
   EXPECT_EQ(params.refused_rpm[0].first, 0.0);
   EXPECT_EQ(params.refused_rpm[params.refused_rpm_count - 1].second, 11111.0);
+}
+
+// Loops no preset describes: C3 at a 2 kHz loop, and C1 on a robot whose modes sit elsewhere, lighter damped.
+std::vector<std::pair<std::string, config::Config>> own_loops() {
+  std::vector<std::pair<std::string, config::Config>> out;
+  for (const char* name : {"horizontal_c1", "horizontal_c2", "horizontal_c3", "tuned_horizontal", "tuned_vertical"})
+    out.emplace_back(name, config::load_config_file(test::preset(name)));
+  std::string slow = test::read_file(test::preset("horizontal_c3"));
+  test::replace_or_throw(slow, "rate_hz: 5000", "rate_hz: 2000");
+  out.emplace_back("C3 at 2 kHz", config::parse_config(slow, test::preset("horizontal_c3")));
+  std::string moved = test::read_file(test::preset("horizontal_c1"));
+  for (const auto& [was, now] :
+       {std::pair{"natural_freq_hz: 9.2, damping_ratio: 0.0238", "natural_freq_hz: 13.1, damping_ratio: 0.0110"},
+        std::pair{"natural_freq_hz: 9.2, damping_ratio: 0.020",
+                  "natural_freq_hz: 13.1, "
+                  "damping_ratio: 0.011"},
+        std::pair{"natural_freq_hz: 21.0, damping_ratio: 0.0285", "natural_freq_hz: 31.0, damping_ratio: 0.0150"},
+        std::pair{"natural_freq_hz: 21.0, damping_ratio: 0.025,", "natural_freq_hz: 31.0, damping_ratio: 0.013,"}})
+    test::replace_or_throw(moved, was, now);
+  out.emplace_back("C1 on modes of our own", config::parse_config(moved, test::preset("horizontal_c1")));
+  return out;
+}
+
+// The scan for K_max started from the margins' crossing gain (two or three steps below it, once the poles there
+// are checked stable) names the same gain to the bit as the scan from 1 N s/m; the crossing is where the poles
+// reach the unit circle (within the bisection's 1e-6); a crossing too high or too low only costs steps.
+TEST(Analysis, TheScanForKMaxFromTheMarginsCrossingFindsTheSameGainToTheBit) {
+  int hinted = 0;
+  for (const auto& [name, cfg] : own_loops()) {
+    const analysis::LoopModel m(cfg);
+    for (const int pol : {1, -1}) {
+      const auto from_one = analysis::max_stable_gain(m, pol);
+      const analysis::Margins mg = analysis::margins(m, cfg.controller.gain_ns_per_m, pol, std::nullopt);
+      if (!from_one) continue;
+      ++hinted;
+      ASSERT_TRUE(mg.crossing_gain_ns_per_m) << name << " " << pol;
+      EXPECT_NEAR(*mg.crossing_gain_ns_per_m, *from_one, 1e-5 * *from_one) << name << " " << pol;
+      EXPECT_EQ(analysis::max_stable_gain(m, pol, mg.crossing_gain_ns_per_m), from_one) << name << " " << pol;
+      for (const double wrong : {30.0 * *from_one, 1.3 * *from_one, 0.01 * *from_one, 0.5})
+        EXPECT_EQ(analysis::max_stable_gain(m, pol, wrong), from_one) << name << " " << pol << " from " << wrong;
+    }
+  }
+  EXPECT_GE(hinted, 10);
+}
+
+// A tune's candidates: loops on one sampled plant (with_controller) share it and its sweeps, and answer exactly
+// as loops built alone from their configurations: margins, K_max, the quiet command, the impact's command.
+TEST(Analysis, LoopsOnOneSampledPlantShareItsSweepsAndAnswerAsLoopsBuiltAlone) {
+  const config::Config base = config::load_config_file(test::preset("horizontal_c1"));
+  const analysis::LoopModel first(base);
+  analysis::ImpactCommand impact(first, 600.0, 1e-3, std::size_t{1} << 12);
+  for (const char* name : {"horizontal_c2", "horizontal_c3"}) {
+    const config::Config cfg = config::load_config_file(test::preset(name));
+    const analysis::LoopModel shared = first.with_controller(cfg), alone(cfg);
+    EXPECT_EQ(&shared.plant(), &first.plant()) << name;
+    const analysis::LogGrid grid{0.1, 0.499 * cfg.loop.rate_hz, 6000};
+    EXPECT_EQ(shared.plant_sweep(grid), first.plant_sweep(grid)) << name;  // one sweep, computed once
+    EXPECT_NE(alone.plant_sweep(grid), first.plant_sweep(grid)) << name;
+    const int pol = cfg.controller.polarity;
+    for (const double k : {300.0, cfg.controller.gain_ns_per_m}) {
+      const analysis::Margins a = analysis::margins(shared, k, pol, std::nullopt),
+                              b = analysis::margins(alone, k, pol, std::nullopt);
+      EXPECT_EQ(a.phase_margin_deg, b.phase_margin_deg) << name << " " << k;
+      EXPECT_EQ(a.delay_margin_ms, b.delay_margin_ms) << name << " " << k;
+      EXPECT_EQ(a.phase_crossover_hz, b.phase_crossover_hz) << name << " " << k;
+      EXPECT_EQ(a.crossing_gain_ns_per_m, b.crossing_gain_ns_per_m) << name << " " << k;
+      EXPECT_EQ(analysis::quiet_command(shared, k, pol).rms_v, analysis::quiet_command(alone, k, pol).rms_v) << name;
+      EXPECT_EQ(impact.peak(shared, k, pol).voltage_v, impact.peak(alone, k, pol).voltage_v) << name << " " << k;
+    }
+    EXPECT_EQ(analysis::max_stable_gain(shared, pol), analysis::max_stable_gain(alone, pol)) << name;
+  }
+  // The sweep holds response() at each of its points, and two threads asking at once get the one sweep.
+  const analysis::LoopModel fresh(base);
+  const analysis::LogGrid grid{0.5, 2000.0, 300};
+  std::shared_ptr<const std::vector<analysis::PlantResponse>> one, two;
+  std::thread t([&] { one = fresh.plant_sweep(grid); });
+  two = fresh.plant_sweep(grid);
+  t.join();
+  ASSERT_EQ(one, two);
+  ASSERT_EQ(one->size(), 301U);
+  for (const int i : {0, 17, 150, 300}) {
+    const analysis::PlantResponse direct = fresh.plant_response(grid.at(i));
+    EXPECT_EQ((*one)[static_cast<std::size_t>(i)].accel_per_volt, direct.accel_per_volt) << i;
+    EXPECT_EQ((*one)[static_cast<std::size_t>(i)].accel_per_force, direct.accel_per_force) << i;
+    EXPECT_EQ((*one)[static_cast<std::size_t>(i)].sensor_response, direct.sensor_response) << i;
+  }
+  config::Config other_rate = base;
+  other_rate.loop.rate_hz = 4000.0;
+  EXPECT_THROW((void)first.with_controller(other_rate), std::invalid_argument);
 }
 
 }  // namespace

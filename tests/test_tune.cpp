@@ -111,9 +111,28 @@ TEST(Tune, EvaluationMatchesTheAnalysisForC1AndC2) {
   EXPECT_GE(e1.gain_margin_db, 6.0);
 }
 
+void expect_same_evaluation(const tune::Evaluation& a, const tune::Evaluation& b, const std::string& what) {
+  EXPECT_EQ(a.stable, b.stable) << what;
+  EXPECT_EQ(a.objective, b.objective) << what;
+  EXPECT_EQ(a.violation, b.violation) << what;
+  EXPECT_EQ(a.binding, b.binding) << what;
+  EXPECT_EQ(a.k_max_ns_per_m, b.k_max_ns_per_m) << what;
+  EXPECT_EQ(a.gain_margin_db, b.gain_margin_db) << what;
+  EXPECT_EQ(a.phase_margin_deg, b.phase_margin_deg) << what;
+  EXPECT_EQ(a.delay_margin_ms, b.delay_margin_ms) << what;
+  EXPECT_EQ(a.quiet_command_rms_v, b.quiet_command_rms_v) << what;
+  EXPECT_EQ(a.actuator_use, b.actuator_use) << what;
+  EXPECT_EQ(a.min_depth_mm, b.min_depth_mm) << what;
+  EXPECT_EQ(a.accurate_min_mm, b.accurate_min_mm) << what;
+  EXPECT_EQ(a.depth_at_speed_mm, b.depth_at_speed_mm) << what;
+  EXPECT_EQ(a.floors_mm, b.floors_mm) << what;
+  EXPECT_EQ(a.peak_m_per_n, b.peak_m_per_n) << what;
+}
+
 // The search checks every plant's constraints first and scores a candidate only where they all hold; scoring
 // it from where its check left it (Evaluator::finish) is its whole evaluation, to the bit: a stable candidate of
-// each polarity and an unstable one, with the job and without.
+// each polarity and an unstable one, with the job and without. A candidate's loop runs on the plant the
+// evaluator sampled once (its sweeps shared): the same evaluation, to the bit, as its configuration's own loop.
 TEST(Tune, ACheckedCandidateFinishedIsItsWholeEvaluation) {
   const config::Config base = config::load_config_file(test::preset("horizontal_c2"));
   const tune::Evaluator with_job(base, config::load_milling_config(kJob), {}), alone(base, std::nullopt, {});
@@ -127,17 +146,8 @@ TEST(Tune, ACheckedCandidateFinishedIsItsWholeEvaluation) {
       const tune::Evaluation whole = (*e)(c), checked = (*e)(c, true), finished = e->finish(checked);
       const std::string what = std::string(e == &alone ? "no job" : "job") + ", K " + std::to_string(c.gain_ns_per_m) +
                                ", polarity " + std::to_string(c.polarity);
-      EXPECT_EQ(finished.stable, whole.stable) << what;
-      EXPECT_EQ(finished.objective, whole.objective) << what;
-      EXPECT_EQ(finished.violation, whole.violation) << what;
-      EXPECT_EQ(finished.binding, whole.binding) << what;
-      EXPECT_EQ(finished.gain_margin_db, whole.gain_margin_db) << what;
-      EXPECT_EQ(finished.actuator_use, whole.actuator_use) << what;
-      EXPECT_EQ(finished.min_depth_mm, whole.min_depth_mm) << what;
-      EXPECT_EQ(finished.accurate_min_mm, whole.accurate_min_mm) << what;
-      EXPECT_EQ(finished.depth_at_speed_mm, whole.depth_at_speed_mm) << what;
-      EXPECT_EQ(finished.floors_mm, whole.floors_mm) << what;
-      EXPECT_EQ(finished.peak_m_per_n, whole.peak_m_per_n) << what;
+      expect_same_evaluation(finished, whole, what);
+      expect_same_evaluation(e->assess(tune::with_candidate(base, c)), whole, what + ", its own loop");
       if (whole.stable && e == &with_job) {
         EXPECT_GT(whole.accurate_min_mm, 0.0) << what << ": the job scored";
       }

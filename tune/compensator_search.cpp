@@ -220,10 +220,11 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
                      std::string name)
     : base_(base), name_(name.empty() ? base.source : std::move(name)), job_(std::move(job)), s_(s) {
   (void)with_candidate(base_, {});  // a chain without a compensator is refused here
-  const auto open_loop = std::make_shared<const analysis::LoopModel>(base_);
+  base_model_ = std::make_shared<const analysis::LoopModel>(base_);
+  const analysis::LoopModel& open_loop = *base_model_;
   const double impact_n = s_.impact_peak_n.value_or(base_.bench.impact_peak_n);
   if (impact_n > 0.0)
-    impact_ = std::make_unique<Impact>(*open_loop, impact_n,
+    impact_ = std::make_unique<Impact>(open_loop, impact_n,
                                        s_.impact_duration_ms.value_or(base_.bench.impact_duration_ms) * 1e-3);
   if (!job_) return;
   const config::StructureConfig& st = job_structure(*job_);
@@ -236,7 +237,7 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
                                                "has no damping location (a part with controller: {config, location, "
                                                "direction}): there is nothing for robodamp tune to tune against"}});
   // The open loop of this plant (not of the job's own controller file): each plant's floors are its own.
-  const milling::Structure open(st, false, {open_loop, base_.controller.gain_ns_per_m, base_.controller.polarity});
+  const milling::Structure open(st, false, {base_model_, base_.controller.gain_ns_per_m, base_.controller.polarity});
   process_ = milling::chatter_process(job_->tool, job_->material, job_->cut);
   // The depth at the job's speed is promised by the sampled loop's semi-discretization: a speed it can step.
   if (auto p = milling::sampled_speed_problem(job_->cut.spindle_rpm, job_->tool.teeth, base_.loop.rate_hz))
@@ -296,7 +297,7 @@ Evaluation unrealisable(const Candidate& cand) {
 Evaluation Evaluator::operator()(const Candidate& cand, bool constraints_only) const {
   Evaluation e;
   try {
-    e = assess(with_candidate(base_, cand), constraints_only || constraints_only_);
+    e = assess_model(candidate_model(cand), constraints_only || constraints_only_);
   } catch (const config::ConfigError&) {
     return unrealisable(cand);
   }
@@ -321,8 +322,10 @@ struct LoopChecks {
 LoopChecks check_loop(const analysis::LoopModel& m, double k, int polarity, bool stable, const TuneSettings& s,
                       analysis::ImpactCommand* impact, double floor_v) {
   LoopChecks c;
-  std::vector<std::function<void()>> tasks{[&] { c.k_max = analysis::max_stable_gain(m, polarity); },
-                                           [&] { c.margins = analysis::margins(m, k, polarity, std::nullopt); }};
+  std::vector<std::function<void()>> tasks{[&] {  // the margins' crossing gain starts the scan for K_max
+    c.margins = analysis::margins(m, k, polarity, std::nullopt);
+    c.k_max = analysis::max_stable_gain(m, polarity, c.margins.crossing_gain_ns_per_m);
+  }};
   if (stable) {
     if (impact) tasks.emplace_back([&] { c.peak = impact->peak(m, k, polarity); });
     tasks.emplace_back([&] {
@@ -379,11 +382,15 @@ void add_loop_constraints(Evaluation& e, const LoopChecks& checks, const config:
 // Every constraint of one candidate in the order the report names them, then its objective: the loop's
 // checks, then the job's depths (or, without a job, the closed-loop peak or the worst mode).
 Evaluation Evaluator::assess(const config::Config& cfg, bool constraints_only) const {
+  return assess_model(std::make_shared<const analysis::LoopModel>(cfg), constraints_only);
+}
+
+Evaluation Evaluator::assess_model(const std::shared_ptr<const analysis::LoopModel>& m, bool constraints_only) const {
+  const config::Config& cfg = m->config();
   Evaluation e;
   e.candidate.gain_ns_per_m = cfg.controller.gain_ns_per_m;
   e.candidate.polarity = cfg.controller.polarity;
   const Candidate& cand = e.candidate;
-  const auto m = std::make_shared<const analysis::LoopModel>(cfg);
   const double k = cand.gain_ns_per_m;
   e.stable = m->stable(k, cand.polarity);
   const LoopChecks checks = check_loop(*m, k, cand.polarity, e.stable, s_, impact_ ? &impact_->command : nullptr,
@@ -407,7 +414,7 @@ Evaluation Evaluator::finish(Evaluation checked) const {
   // An unstable candidate, or one the chain cannot realise, has no objective; a constraints-only plant none.
   if (constraints_only_ || !checked.stable) return checked;
   try {
-    score(checked, std::make_shared<const analysis::LoopModel>(with_candidate(base_, checked.candidate)));
+    score(checked, candidate_model(checked.candidate));
   } catch (const config::ConfigError&) {  // as operator() has it
     return unrealisable(checked.candidate);
   }

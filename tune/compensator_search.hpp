@@ -201,7 +201,14 @@ class Evaluator {
   void score(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const;
   // With a job: the damped depths, the objective and the floors' constraints.
   void score_on_job(Evaluation& e, const std::shared_ptr<const analysis::LoopModel>& m) const;
+  [[nodiscard]] Evaluation assess_model(const std::shared_ptr<const analysis::LoopModel>& m,
+                                        bool constraints_only) const;
+  // A candidate's loop on the base's sampled plant (and its shared sweeps).
+  [[nodiscard]] std::shared_ptr<const analysis::LoopModel> candidate_model(const Candidate& c) const {
+    return std::make_shared<const analysis::LoopModel>(base_model_->with_controller(with_candidate(base_, c)));
+  }
   config::Config base_;
+  std::shared_ptr<const analysis::LoopModel> base_model_;  // the base's loop: its sampled plant for every candidate
   std::string name_;
   std::unique_ptr<Impact> impact_;  // the actuator-limit check's precomputed plant (one thread at a time)
   std::optional<config::MillingConfig> job_;
