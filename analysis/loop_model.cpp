@@ -210,17 +210,16 @@ PlantResponse LoopModel::plant_response(double f_hz) const { return s_->response
 
 namespace {
 // Volts per m/s^2 of sampled acceleration that the controller commands, with the computation delay.
-Complex discrete_feedback(const PlantResponse& p, Complex filters, double gain, int polarity, double fs,
-                          double t_n_per_v, Complex sensor) {
-  // p's z^-1 is e^{-j 2 pi f / fs} at the plant's loop rate, this loop's (LoopModel::with_controller).
-  (void)fs;
+// p's z^-1 is e^{-j 2 pi f / fs} at the plant's loop rate, which is this loop's (LoopModel::with_controller).
+Complex discrete_feedback(const PlantResponse& p, Complex filters, double gain, int polarity, double t_n_per_v,
+                          Complex sensor) {
   return p.z_inverse * (polarity * gain / t_n_per_v) * filters * sensor;
 }
 }  // namespace
 
 Complex LoopModel::loop_discrete(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, p.sensor_response);
+  const Complex q =
+      discrete_feedback(p, filters, gain, polarity, chain_.params.actuator_constant_n_per_v, p.sensor_response);
   return -q * p.accel_per_volt[s_->sensor];
 }
 
@@ -235,8 +234,8 @@ Complex LoopModel::open_discrete(const PlantResponse& p, std::size_t g, std::siz
 
 Complex LoopModel::closed_discrete(const PlantResponse& p, Complex filters, std::size_t g, std::size_t h, double gain,
                                    int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, p.sensor_response);
+  const Complex q =
+      discrete_feedback(p, filters, gain, polarity, chain_.params.actuator_constant_n_per_v, p.sensor_response);
   const Complex a = p.accel_per_force[g][h] + p.accel_per_volt[g] * q * p.accel_per_force[s_->sensor][h] /
                                                   (1.0 - q * p.accel_per_volt[s_->sensor]);
   const double w = kTwoPi * p.f_hz;
@@ -249,8 +248,7 @@ Complex LoopModel::command_per_force(const PlantResponse& p, Complex filters, st
 }
 
 Complex LoopModel::feedback_discrete(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  return discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v,
-                           p.sensor_response);
+  return discrete_feedback(p, filters, gain, polarity, chain_.params.actuator_constant_n_per_v, p.sensor_response);
 }
 
 Complex LoopModel::command_per_force(const PlantResponse& p, Complex q, std::size_t h) const {
@@ -258,15 +256,14 @@ Complex LoopModel::command_per_force(const PlantResponse& p, Complex q, std::siz
 }
 
 Complex LoopModel::command_per_sensor_noise(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const Complex q_noise =
-      discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz, chain_.params.actuator_constant_n_per_v, 1.0);
+  const Complex q_noise = discrete_feedback(p, filters, gain, polarity, chain_.params.actuator_constant_n_per_v, 1.0);
   const Complex q = q_noise * p.sensor_response;
   return q_noise / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 
 Complex LoopModel::command_per_open_accel(const PlantResponse& p, Complex filters, double gain, int polarity) const {
-  const Complex q = discrete_feedback(p, filters, gain, polarity, cfg_.loop.rate_hz,
-                                      chain_.params.actuator_constant_n_per_v, p.sensor_response);
+  const Complex q =
+      discrete_feedback(p, filters, gain, polarity, chain_.params.actuator_constant_n_per_v, p.sensor_response);
   return q / (1.0 - q * p.accel_per_volt[s_->sensor]);
 }
 

@@ -472,12 +472,16 @@ TEST(HilFaults, ModbusHangingDuringARunTripsOnTheAmplifierStatus) {
   EXPECT_EQ(rt::to_string(static_cast<rt::Trip>(frames[t.trip].trip)), std::string("actuator_driver"));
   const double trip_after_s = r.tick_monotonic_s(frames[t.trip].time_s) - injected_s;
   const double safe_after_s = r.tick_monotonic_s(frames[t.safe].time_s) - injected_s;
-  // Unknown for link_timeout_s after the last good poll (at most one poll period before the hang), then
-  // the ramp in ticks. Scheduling on a loaded machine adds to the detection: bounded loosely, reported.
+  // Unknown for link_timeout_s after the last good poll (one poll period before the hang on time), then
+  // the ramp in ticks. Scheduling on a loaded machine adds to the detection: bounded loosely, reported. A
+  // starved poller's last good answer can also come more than a period before the hang (under the CPU hog the
+  // trip came 493.5 ms after it, 0.5 ms inside the period): 50 ms allowed for that, far from a trip on one
+  // missed poll.
   const auto& m = *r.cfg.modbus;
   const auto ramp_ticks = static_cast<std::size_t>(std::ceil(r.cfg.supervision.trip_ramp_s * r.cfg.loop.rate_hz));
+  constexpr double kStarvedPollS = 0.05;
   EXPECT_LE(t.safe - t.trip, ramp_ticks + 1);
-  EXPECT_GE(trip_after_s, m.link_timeout_s - m.poll_period_s - 0.001) << "not before the link timeout";
+  EXPECT_GE(trip_after_s, m.link_timeout_s - m.poll_period_s - kStarvedPollS) << "not before the link timeout";
   EXPECT_LE(trip_after_s, m.link_timeout_s + m.poll_period_s + 0.5);
   std::printf(
       "[ hil mb   ] Modbus hang: trip %.1f ms, safe %.1f ms after the device stopped answering "
