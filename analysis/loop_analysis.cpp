@@ -91,7 +91,7 @@ std::optional<double> max_stable_gain(const LoopModel& m, int polarity, std::opt
 
 Margins margins(const LoopModel& m, double gain, int polarity, std::optional<double> max_gain) {
   Margins r;
-  if (max_gain) r.gain_margin_db = 20.0 * std::log10(*max_gain / gain);
+  if (max_gain) r.gain_margin_db = gain_margin_db(*max_gain, gain);
   // Log grid over (0.1 Hz, Nyquist), crossings refined by bisection.
   const LogGrid grid{0.1, 0.499 * m.loop_rate_hz(), 6000};
   const int n = grid.intervals;
@@ -141,8 +141,9 @@ Margins margins(const LoopModel& m, double gain, int polarity, std::optional<dou
         ((loop(c).imag() > 0.0) == from_above ? a : b) = c;
       }
       const double fp = 0.5 * (a + b);
-      note_crossing(loop(fp));
-      const double gap = std::abs(std::log(std::abs(loop(fp))));
+      const Complex at_crossing = loop(fp);
+      note_crossing(at_crossing);
+      const double gap = std::abs(std::log(std::abs(at_crossing)));
       if (gap < best_phase_cross_gap) best_phase_cross_gap = gap, r.phase_crossover_hz = fp;
     }
     prev = cur;
@@ -263,7 +264,7 @@ AnalysisResult analyse(const LoopModel& m, double gain, int polarity) {
   r.stable_continuous = std::lround(2.0 * t) == 0;
   r.margins = margins(m, gain, polarity, std::nullopt);
   r.max_stable_gain_ns_per_m = max_stable_gain(m, polarity, r.margins.crossing_gain_ns_per_m);
-  if (r.max_stable_gain_ns_per_m) r.margins.gain_margin_db = 20.0 * std::log10(*r.max_stable_gain_ns_per_m / gain);
+  if (r.max_stable_gain_ns_per_m) r.margins.gain_margin_db = gain_margin_db(*r.max_stable_gain_ns_per_m, gain);
 
   r.modes = mode_phases(m, gain, polarity);
   const sim::FrfPath* loop_path = m.plant().path(m.sensor_location(), m.actuator_location());

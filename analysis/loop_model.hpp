@@ -5,6 +5,7 @@
 // its closed-loop poles, cross-checked by a Nyquist count. Off the real-time path.
 #pragma once
 
+#include <cmath>
 #include <complex>
 #include <functional>
 #include <memory>
@@ -230,6 +231,10 @@ struct SweepPoint {
 [[nodiscard]] std::optional<double> max_stable_gain(const LoopModel& m, int polarity,
                                                     std::optional<double> crossing_gain_ns_per_m = std::nullopt);
 [[nodiscard]] Margins margins(const LoopModel& m, double gain_ns_per_m, int polarity, std::optional<double> max_gain);
+// 20 log10(K_max / K), as Margins::gain_margin_db holds it.
+[[nodiscard]] inline double gain_margin_db(double max_gain_ns_per_m, double gain_ns_per_m) {
+  return 20.0 * std::log10(max_gain_ns_per_m / gain_ns_per_m);
+}
 [[nodiscard]] std::vector<FrfResult> improvements(const LoopModel& m, double gain_ns_per_m, int polarity,
                                                   bool discrete);
 // Phase of the feedback force against the velocity at each mode of the loop's own FRF (continuous loop).

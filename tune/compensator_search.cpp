@@ -221,10 +221,9 @@ Evaluator::Evaluator(const config::Config& base, std::optional<config::MillingCo
     : base_(base), name_(name.empty() ? base.source : std::move(name)), job_(std::move(job)), s_(s) {
   (void)with_candidate(base_, {});  // a chain without a compensator is refused here
   base_model_ = std::make_shared<const analysis::LoopModel>(base_);
-  const analysis::LoopModel& open_loop = *base_model_;
   const double impact_n = s_.impact_peak_n.value_or(base_.bench.impact_peak_n);
   if (impact_n > 0.0)
-    impact_ = std::make_unique<Impact>(open_loop, impact_n,
+    impact_ = std::make_unique<Impact>(*base_model_, impact_n,
                                        s_.impact_duration_ms.value_or(base_.bench.impact_duration_ms) * 1e-3);
   if (!job_) return;
   const config::StructureConfig& st = job_structure(*job_);
@@ -337,7 +336,7 @@ LoopChecks check_loop(const analysis::LoopModel& m, double k, int polarity, bool
     });
   }
   analysis::run_tasks(tasks, analysis::task_threads(0));
-  if (c.k_max) c.margins.gain_margin_db = 20.0 * std::log10(*c.k_max / k);  // as analysis::margins writes it
+  if (c.k_max) c.margins.gain_margin_db = analysis::gain_margin_db(*c.k_max, k);
   return c;
 }
 
