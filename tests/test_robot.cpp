@@ -59,9 +59,11 @@ TEST(RobotModel, ReceptanceCouplingEqualsTheAssembledModel) {
   }
   std::cout << "largest relative difference: " << worst << "\n";
   EXPECT_LT(worst, 1e-6);
-  // Reciprocity: the assembled TCP receptance is symmetric.
+  // Reciprocity: the assembled TCP receptance is symmetric, to the round-off of one complex solve of a stiffness
+  // whose links (EA 5e9 N) and wrist joint (4e3 N m/rad) are far apart: 1.1e-9 relative in the x86-64-v3 build,
+  // under 1e-9 in the x86-64 one. A term left out of the assembly would be of order one.
   const Eigen::Matrix2cd g = c.tcp_frf_direct(12.0);
-  EXPECT_LT(std::abs(g(0, 1) - g(1, 0)) / std::abs(g(0, 0)), 1e-9);
+  EXPECT_LT(std::abs(g(0, 1) - g(1, 0)) / std::abs(g(0, 0)), 1e-8);
 }
 
 // A joint whose bearings give in translation (a compliance the torsional-only model lacks): the two
