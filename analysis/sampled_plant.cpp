@@ -29,18 +29,18 @@ SampledPlant::SampledPlant(const config::Config& cfg)
 }
 
 PlantResponse SampledPlant::response(double f_hz) const {
-  using Complex = std::complex<double>;
+  using ComplexD = std::complex<double>;
   const Eigen::Index nl = static_cast<Eigen::Index>(plant.locations.size());
-  const Complex zi = std::exp(Complex(0.0, -kTwoPi * f_hz / loop_rate_hz));  // z^-1
+  const ComplexD zi = std::exp(ComplexD(0.0, -kTwoPi * f_hz / loop_rate_hz));  // z^-1
   const Eigen::MatrixXcd r = resolvent(1.0 / zi);  // the late and early coil inputs, then the forces
   Eigen::MatrixXcd y(nl, 1 + nl);
   y.col(0) = r.col(0) + r.col(1) * zi;
   y.rightCols(nl) = r.rightCols(nl);
-  const Complex delay = std::pow(zi, delay_steps);
+  const ComplexD delay = std::pow(zi, delay_steps);
   PlantResponse p;
   p.f_hz = f_hz;
   p.accel_per_volt.resize(static_cast<std::size_t>(nl));
-  p.accel_per_force.assign(static_cast<std::size_t>(nl), std::vector<Complex>(static_cast<std::size_t>(nl)));
+  p.accel_per_force.assign(static_cast<std::size_t>(nl), std::vector<ComplexD>(static_cast<std::size_t>(nl)));
   for (Eigen::Index g = 0; g < nl; ++g) {
     p.accel_per_volt[static_cast<std::size_t>(g)] = (y(g, 0) + d_accel_coil(g, 0) * zi) * delay;
     for (Eigen::Index h = 0; h < nl; ++h)

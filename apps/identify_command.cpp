@@ -15,11 +15,11 @@
 
 namespace robodamp::apps {
 
-bool print_identified(const IdentifyArgs& a, const std::string& text, const nlohmann::json& json,
+bool print_identified(const IdentifyArgs& a, const std::string& text, const nlohmann::json& report_json,
                       const std::string& yaml) {
   std::fputs(text.c_str(), stdout);
   if (a.json.given) {
-    if (!emit_json(a.json, json.dump(2), "identify")) return false;
+    if (!emit_json(a.json, report_json.dump(2), "identify")) return false;
     if (a.json.to_file()) std::printf("wrote %s\n", a.json.path.c_str());
   }
   if (!a.yaml_path.empty()) {

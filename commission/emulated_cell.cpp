@@ -40,8 +40,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-constexpr double kEmulatorEndS = 60.0;  // after the controller leaves: the emulator writes its files and ends
-constexpr double kRampMarginS = 2.0;    // after settle and the gain ramp: the loop at full gain
+constexpr double kEmulatorEndS = 60.0;        // after the controller leaves: the emulator writes its files and ends
+constexpr double kEmulatorRampMarginS = 2.0;  // after settle and the gain ramp: the loop at full gain
 
 std::string text_of(const fs::path& p) {
   std::ifstream in(p);
@@ -356,7 +356,7 @@ CutTrial cut_through_emulator(const config::Config& cell, const config::Config& 
   t.depth_mm = depth_mm;
   const fs::path d(dir);
   fs::create_directories(d);
-  const double start_s = cell.commissioning.settle_s + controller.controller.gain_ramp_s + kRampMarginS;
+  const double start_s = cell.commissioning.settle_s + controller.controller.gain_ramp_s + kEmulatorRampMarginS;
   const double cut_s = e.revolutions * 60.0 / rpm;
   EmulatorProcess plant(e.binary,
                         {"plant", "--config", e.cell_path, "--pacing", "lockstep", "--no-impacts", "--drives-off",

@@ -19,7 +19,14 @@ namespace {
 namespace fs = std::filesystem;
 using Pair = std::pair<int, int>;  // response, excitation
 
-std::string pair_text(Pair p) { return "H" + std::to_string(p.first) + std::to_string(p.second); }
+// Appended, not "H" + ...: GCC 12 at -O3 warns a false -Wstringop-overflow on operator+(const char*, string&&)
+// where this file is compiled with others (the unity build).
+std::string pair_text(Pair p) {
+  std::string text = "H";
+  text += std::to_string(p.first);
+  text += std::to_string(p.second);
+  return text;
+}
 
 void add(std::map<Pair, IdentifiedFrf>& found, IdentifiedFrf f) {
   const Pair p{f.response_id, f.excitation_id};

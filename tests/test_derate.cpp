@@ -20,7 +20,10 @@
 namespace robodamp {
 namespace {
 
-std::string source(const std::string& rel) { return std::string(ROBODAMP_SOURCE_DIR) + "/" + rel; }
+std::string source(const std::string& rel) {
+  std::string path = ROBODAMP_SOURCE_DIR;
+  return path.append("/").append(rel);
+}
 
 config::Config fixed_c2() {
   config::Config c = config::load_config_file(test::preset("horizontal_c2"));

@@ -53,7 +53,11 @@ inline CommandResult run_robodamp(const std::string& args) {
 #endif
 
 inline std::string preset(const std::string& name) {
-  return std::string(ROBODAMP_SOURCE_DIR) + "/config/presets/" + name + ".yaml";
+  // Appended, not a chain of +: GCC 12 warns a false -Warray-bounds on the chain's temporaries at -O1 with the
+  // precompiled header (cmake/precompiled_headers.cmake).
+  std::string path = ROBODAMP_SOURCE_DIR;
+  path.append("/config/presets/").append(name).append(".yaml");
+  return path;
 }
 
 inline analysis::ChainDesign design_preset(const std::string& name, double rate_hz = 0.0) {

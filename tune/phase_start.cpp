@@ -37,7 +37,7 @@ Candidate shape_of(const double* x, int polarity) {
   return c;
 }
 
-std::array<double, kShapeDims> x_of(const Candidate& c) {
+std::array<double, kShapeDims> shape_x_of(const Candidate& c) {
   return {std::log10(c.fz_hz), c.zeta_z, std::log10(c.fp_hz), c.zeta_p, std::log10(c.fa_hz), std::log10(c.fb_hz)};
 }
 
@@ -127,7 +127,7 @@ std::optional<PhaseMatch> phase_matched(const std::vector<config::Config>& plant
   for (const int polarity : {1, -1}) {
     Fit fit{&modes, polarity, match_hz, nyquist_hz, compensator_gain_max};
     for (const Candidate& start : fit_starts(modes)) {
-      std::array<double, kShapeDims> x = x_of(start);
+      std::array<double, kShapeDims> x = shape_x_of(start);
       for (unsigned i = 0; i < kShapeDims; ++i) x[i] = std::clamp(x[i], lower[i], upper[i]);
       nlopt_opt opt = nlopt_create(NLOPT_LN_NELDERMEAD, kShapeDims);
       nlopt_set_lower_bounds(opt, lower.data());

@@ -15,8 +15,6 @@ namespace robodamp::tune {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // The job with its structure replaced: the robot at the pose closed through the set at the TCP along the
 // actuator's axis (the Evaluator's live loop), beside the structure's modal parts (a workpiece).
 config::MillingConfig job_at_poses(const config::MillingConfig& job, const config::Config& cell) {
@@ -45,7 +43,8 @@ void fold(ControllerScore& c, const PoseScore& p) {
   c.worst_improvement_pct = std::min(c.worst_improvement_pct, p.improvement_pct);
   if (p.outside_band_pct && (!c.outside_band_pct || *p.outside_band_pct < *c.outside_band_pct))
     c.outside_band_pct = p.outside_band_pct, c.outside_band_hz = p.outside_band_hz;
-  if (p.damped_min_mm) c.damped_min_mm = std::min(c.damped_min_mm.value_or(kInf), *p.damped_min_mm);
+  if (p.damped_min_mm)
+    c.damped_min_mm = std::min(c.damped_min_mm.value_or(std::numeric_limits<double>::infinity()), *p.damped_min_mm);
 }
 
 // One schedule at one pose: the worst over the sets that can run there.
@@ -55,7 +54,7 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
   const analysis::PoseModes pm = analysis::pose_modes(in.model, mp.pose.joints_deg, s.axis, s.modes);
   PoseScore p;
   p.stable = true;
-  p.worst_mode_improvement_pct = p.improvement_pct = kInf;
+  p.worst_mode_improvement_pct = p.improvement_pct = std::numeric_limits<double>::infinity();
   analysis::BandWorst band;  // over the stable sets that can run here
   for (std::size_t i = 0; i < sets.size(); ++i) {
     if (!config::region_holds(schedule.regions[i], mp.pose.joints_deg.data(), mp.pose.joints_deg.size())) continue;
@@ -65,9 +64,9 @@ PoseScore score_pose(const PoseTuneInput& in, const config::PoseScheduleConfig& 
     const double k = sets[i].gain_ns_per_m;
     const int pol = sets[i].polarity;
     if (!m.stable(k, pol)) {
-      p.region_improvement_pct.push_back(-kInf);
+      p.region_improvement_pct.push_back(-std::numeric_limits<double>::infinity());
       p.stable = false;
-      p.worst_mode_improvement_pct = p.improvement_pct = -kInf;
+      p.worst_mode_improvement_pct = p.improvement_pct = -std::numeric_limits<double>::infinity();
       if (with_job) p.damped_min_mm = 0.0;
       continue;
     }
@@ -111,7 +110,7 @@ MapScores score_on_map(const PoseTuneInput& in, std::vector<MapPose> map,
     sets.push_back(sets_of(in, schedule));
     ControllerScore c;
     c.name = name;
-    c.worst_mode_improvement_pct = c.worst_improvement_pct = kInf;
+    c.worst_mode_improvement_pct = c.worst_improvement_pct = std::numeric_limits<double>::infinity();
     out.controllers.push_back(c);
   }
   std::optional<config::MillingConfig> jp;

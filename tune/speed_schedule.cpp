@@ -22,8 +22,6 @@ namespace robodamp::tune {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // Band edges to 0.01 rpm.
 double edge(double a, double b) {
   const double m = std::round(50.0 * (a + b)) / 100.0;
@@ -199,7 +197,7 @@ void fit_band_count(Grid& g, const Depths& d, const std::vector<ScheduleCandidat
         runs.push_back({i, i});
       else
         runs.back().second = i;
-    double best_loss = kInf, best_width = kInf;
+    double best_loss = std::numeric_limits<double>::infinity(), best_width = std::numeric_limits<double>::infinity();
     std::size_t best_run = 0, best_to = 0;
     for (std::size_t r = 0; r < runs.size(); ++r)
       for (const std::size_t n : {r == 0 ? r : r - 1, r + 1 < runs.size() ? r + 1 : r}) {
@@ -385,8 +383,8 @@ void check_in_time(SpeedSchedule& out, Grid& g, std::set<double>& checked, Depth
 void summarise(SpeedSchedule& out, const Depths& d, const config::MillingConfig& job, double job_rpm, const Grid& g) {
   ScheduleSummary& m = out.summary;
   const double tol = 1.0 - 0.01 * out.settings.worse_tolerance_pct, better = 1.0 + 0.01 * out.settings.gain_min_pct;
-  m.open_min_mm = m.fixed_min_mm = m.scheduled_min_mm = kInf;
-  m.fixed_worst_ratio = m.scheduled_worst_ratio = kInf;
+  m.open_min_mm = m.fixed_min_mm = m.scheduled_min_mm = std::numeric_limits<double>::infinity();
+  m.fixed_worst_ratio = m.scheduled_worst_ratio = std::numeric_limits<double>::infinity();
   double fixed_sum = 0.0, sched_sum = 0.0;
   std::size_t fixed_worse = 0, sched_worse = 0, sched_better = 0;
   for (const ScheduleSpeed& p : out.speeds) {
