@@ -39,7 +39,8 @@ struct Frequencies {
 };
 
 Frequencies measure(const Case& c) {
-  cfg::MillingConfig job = cfg::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) + "/config/milling/" + c.job);
+  cfg::MillingConfig job =
+      cfg::load_milling_config(std::string(ROBODAMP_SOURCE_DIR).append("/config/milling/").append(c.job));
   cfg::StructureConfig sc = job.selected_structure();
   std::erase_if(sc.parts, [&](const cfg::StructurePartConfig& p) { return p.name == c.drop_part; });
   const ml::Structure structure(sc, c.damped);

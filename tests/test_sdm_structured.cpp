@@ -34,8 +34,8 @@ struct Robot {
 
 const Robot& industrial_robot() {
   static const Robot r = [] {
-    Robot out{config::load_milling_config(std::string(ROBODAMP_SOURCE_DIR) +
-                                          "/config/milling/industrial_robot_aluminium.yaml"),
+    Robot out{config::load_milling_config(
+                  std::string(ROBODAMP_SOURCE_DIR).append("/config/milling/industrial_robot_aluminium.yaml")),
               {}};
     out.terms = cutter_modal_terms(Structure(out.job.selected_structure(), false), out.job.cut.feed_axis);
     return out;
