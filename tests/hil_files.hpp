@@ -8,7 +8,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <fstream>
+#include <random>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,16 +23,30 @@
 
 namespace robodamp::test {
 
+// A TCP port on loopback that nothing listens on, drawn at random from below the kernel's ephemeral range
+// (/proc/sys/net/ipv4/ip_local_port_range) and tried by a bind. Not a port the kernel hands out and takes back
+// (bind to 0): the emulator listens on it up to minutes later, and such a port was once taken by then as the
+// local end of another test's Modbus connection ("Address already in use"). Below the range, no connection's
+// local end takes it; another test drawing the same one of ~20 000 ports at the same moment is what remains.
 inline int free_tcp_port() {
-  const int s = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  getsockname(s, reinterpret_cast<sockaddr*>(&a), &len);
-  close(s);
-  return ntohs(a.sin_port);
+  int ephemeral_low = 32768;
+  std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> ephemeral_low;
+  const int first = 10000, last = std::max(first + 1000, ephemeral_low) - 1;
+  std::mt19937 rng(std::random_device{}() ^ static_cast<unsigned>(getpid()));
+  std::uniform_int_distribution<int> draw(first, last);
+  for (int tries = 0; tries < 1000; ++tries) {
+    const int port = draw(rng);
+    const int s = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    const bool bound = s >= 0 && bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    if (s >= 0) close(s);
+    if (bound) return port;
+  }
+  throw std::runtime_error("free_tcp_port: no free TCP port on loopback in " + std::to_string(first) + "-" +
+                           std::to_string(last));
 }
 
 // Every occurrence; returns how many.
