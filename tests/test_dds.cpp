@@ -512,8 +512,7 @@ TEST(Dds, Ros2MsgFilesMatchTheIdlFieldForField) {
   for (const char* name :
        {"Telemetry", "Status", "ParameterRequest", "ParameterReply", "Machining", "Advice", "Spectrum", "Lobes"}) {
     const auto from_idl = idl_fields(idl, name);
-    std::string msg_path = ROBODAMP_SOURCE_DIR;
-    const auto from_msg = msg_fields(msg_path.append("/ros2/robodamp/msg/").append(name).append(".msg"));
+    const auto from_msg = msg_fields(test::source_path(std::string("ros2/robodamp/msg/") + name + ".msg"));
     EXPECT_GT(from_idl.size(), 3U) << name;
     EXPECT_EQ(from_msg, from_idl) << name;
   }

@@ -20,11 +20,6 @@
 namespace robodamp {
 namespace {
 
-std::string source(const std::string& rel) {
-  std::string path = ROBODAMP_SOURCE_DIR;
-  return path.append("/").append(rel);
-}
-
 config::Config fixed_c2() {
   config::Config c = config::load_config_file(test::preset("horizontal_c2"));
   c.controller.speed_schedule.reset();  // C2 at K = 2000 N s/m at every speed: the default preset without its schedule
@@ -32,7 +27,7 @@ config::Config fixed_c2() {
 }
 
 config::MillingConfig default_job() {
-  return config::load_milling_config(source("config/milling/active_damping_c2.yaml"));
+  return config::load_milling_config(test::source_path("config/milling/active_damping_c2.yaml"));
 }
 
 // 10.3 s of cut at any speed (120 revolutions at 699.3 rpm).

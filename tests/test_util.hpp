@@ -52,13 +52,15 @@ inline CommandResult run_robodamp(const std::string& args) {
 }
 #endif
 
-inline std::string preset(const std::string& name) {
-  // Appended, not a chain of +: GCC 12 warns a false -Warray-bounds on the chain's temporaries at -O1 with the
-  // precompiled header (cmake/precompiled_headers.cmake).
+// A file of this source tree by its path under the root. Appended, not a chain of +: GCC 12 warns a false
+// -Warray-bounds on std::string(ROBODAMP_SOURCE_DIR) + ... at -O1 with the precompiled header
+// (cmake/build_speed.cmake).
+inline std::string source_path(const std::string& rel) {
   std::string path = ROBODAMP_SOURCE_DIR;
-  path.append("/config/presets/").append(name).append(".yaml");
-  return path;
+  return path.append("/").append(rel);
 }
+
+inline std::string preset(const std::string& name) { return source_path("config/presets/" + name + ".yaml"); }
 
 inline analysis::ChainDesign design_preset(const std::string& name, double rate_hz = 0.0) {
   config::Config c = config::load_config_file(preset(name));
